@@ -1,0 +1,44 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Installs what `make test` needs, idempotently: Debian packages (only the missing ones), the
+# Unity test framework source (tools/scripts/fetch_unity.sh), and the Python venv from the pinned
+# requirements. Safe to run again: every step checks first and does nothing when satisfied.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+PKGS="cmake make gcc g++ libeigen3-dev python3 python3-venv ca-certificates"
+missing=""
+for p in $PKGS; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  # python3/python3-venv are not needed when a usable python3 with venv is already on PATH (pyenv)
+  if python3 -c 'import venv, ensurepip' 2>/dev/null; then
+    missing=$(echo "$missing" | tr ' ' '\n' | grep -vx -e python3 -e python3-venv | tr '\n' ' ' || true)
+  fi
+fi
+if [ -n "${missing// /}" ]; then
+  echo "install_deps: installing Debian packages:$missing"
+  SUDO=""
+  if [ "$(id -u)" != 0 ]; then
+    command -v sudo >/dev/null || { echo "install_deps: need root (or sudo) to apt-get install:$missing" >&2; exit 1; }
+    SUDO=sudo
+  fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -q
+  $SUDO apt-get install -y -q --no-install-recommends $missing
+fi
+
+bash tools/scripts/fetch_unity.sh
+
+VENV=${VENV:-.venv}
+stamp="$VENV/.requirements.sha256"
+want=$(cat requirements.txt pyproject.toml | sha256sum | cut -d' ' -f1)
+if [ ! -x "$VENV/bin/python" ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; then
+  echo "install_deps: creating Python venv $VENV from requirements.txt"
+  python3 -m venv "$VENV"
+  "$VENV/bin/python" -m pip install -q --upgrade pip
+  "$VENV/bin/python" -m pip install -q -r requirements.txt
+  "$VENV/bin/python" -m pip install -q --no-deps -e .
+  echo "$want" > "$stamp"
+fi
