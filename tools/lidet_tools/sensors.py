@@ -59,10 +59,12 @@ def uniform_beams(fov_up_deg: float, fov_down_deg: float, rows: int) -> np.ndarr
     return _deg(fov_up_deg - (np.arange(rows) + 0.5) * step)
 
 
-# KITTI HDL-64E (nominal): upper block 32 lasers +2.0 .. -8.33 deg (1/3 deg spacing), lower block
-# 32 lasers -8.83 .. -24.9 deg (~1/2 deg spacing). Ring order = top to bottom (KITTI has no ring
-# field; this is the order a ring recovered from the scan order gives).
-_HDL64 = np.concatenate([np.linspace(2.0, -8.33, 32), np.linspace(-8.83, -24.9, 32)])
+# KITTI HDL-64E. The datasheet gives +2.0 .. -24.8 deg; in KITTI's own (calibrated, motion-
+# compensated) scans the beams sit higher. We recovered each point's ring from the scan order of 11
+# real KITTI scans (a new ring starts where the azimuth wraps) and took each ring's median
+# elevation: upper block +2.5 .. -7.7 deg (~0.33 deg apart), lower block -8.25 .. -23.5 deg
+# (~0.49 deg apart). Ring order = top to bottom, as KITTI's scan order.
+_HDL64 = np.concatenate([np.linspace(2.5, -7.7, 32), np.linspace(-8.25, -23.5, 32)])
 
 # Velodyne VLP-16: -15..+15 deg every 2 deg. Ring order as velodyne_pointcloud reports it:
 # ring 0 = lowest beam.
