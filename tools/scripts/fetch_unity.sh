@@ -19,8 +19,10 @@ echo "fetch_unity: downloading Debian's cjson source package (carries Unity 2.4.
 apt-get $O update -q >/dev/null
 (cd "$tmp/dl" && apt-get $O source --download-only cjson >/dev/null 2>&1)
 orig=$(ls "$tmp"/dl/cjson_*.orig.tar.* | head -n1)
-tar -xf "$orig" -C "$tmp" --wildcards '*/tests/unity/src/*'
+# cJSON's copy of unity_internals.h includes ../examples/unity_config.h: take that file too
+tar -xf "$orig" -C "$tmp" --wildcards '*/tests/unity/src/*' '*/tests/unity/examples/unity_config.h'
 src=$(ls -d "$tmp"/cJSON-*/tests/unity)
-mkdir -p "$dest"
+mkdir -p "$dest/examples"
 cp -r "$src/src" "$dest/"
+cp "$src/examples/unity_config.h" "$dest/examples/"
 echo "fetch_unity: Unity sources in $dest/src"

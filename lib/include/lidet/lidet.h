@@ -1,0 +1,40 @@
+/* SPDX-License-Identifier: MIT */
+/**
+ * @file lidet.h
+ * @brief lidet: road-user detection in one LiDAR scan on one CPU core or a microcontroller.
+ *
+ * Umbrella header. The pipeline, each stage callable alone over caller-owned memory:
+ *   points -> lidet_proj (range image) -> ground mask -> clusters (proposals) -> PointNets.
+ * Frame: x forward, y left, z up, metres, radians (lidet_types.h). No allocation, no stdio, no
+ * double anywhere in the library; capacities are compile-time (lidet_opt.h).
+ * Method: Seppänen et al., "No GPU? No problem: an ultra fast 3D detection of road users with a
+ * simple proposal generator and energy-based out-of-distribution PointNets".
+ */
+#ifndef LIDET_H
+#define LIDET_H
+
+#define LIDET_VERSION_MAJOR 0
+#define LIDET_VERSION_MINOR 1
+#define LIDET_VERSION_PATCH 0
+#define LIDET_VERSION_STRING "0.1.0"
+
+/** Format version of generated weight files (weights/); a mismatch is a compile error there. */
+#define LIDET_WEIGHTS_FORMAT_VERSION 1
+
+#include "lidet_opt.h"
+#include "lidet_types.h"
+#include "lidet_sensor.h"
+#include "lidet_proj.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** @brief The library version as "MAJOR.MINOR.PATCH" (static storage). */
+const char *lidet_version(void);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LIDET_H */

@@ -1,0 +1,104 @@
+/* SPDX-License-Identifier: MIT */
+/**
+ * @file lidet_opt.h
+ * @brief Compile-time options of lidet (lwIP style): every capacity of the library.
+ *
+ * Each option is `#ifndef X / #define X default`. Override them either with `-DX=...` on the compiler
+ * command line (CMake cache variables of the same name do that), or in a header named
+ * `lidet_user_config.h` on the include path, read when `LIDET_USER_CONFIG` is defined.
+ * All consistency checks (`#error`) live at the end of this file, in one place.
+ *
+ * Memory: every buffer of a stage is a fixed-size array inside its state struct, sized from these
+ * options, so the linker reports a RAM overflow instead of the library failing at run time. The
+ * byte counts are documented in each stage's header and reported by `lidet_*_bytes()` calls.
+ *
+ * Defaults fit every shipped sensor profile on a host (os1-128: 128 x 2048 pixels, 262,144 points).
+ * A VLP-16 robot board would use e.g. LIDET_MAX_ROWS 16, LIDET_MAX_COLS 1800, LIDET_MAX_POINTS 30000.
+ */
+#ifndef LIDET_OPT_H
+#define LIDET_OPT_H
+
+#ifdef LIDET_USER_CONFIG
+#include "lidet_user_config.h"
+#endif
+
+/** Maximum range-image rows (beams) of any sensor used with this build. */
+#ifndef LIDET_MAX_ROWS
+#define LIDET_MAX_ROWS 128
+#endif
+
+/** Maximum range-image columns (azimuth steps per revolution). */
+#ifndef LIDET_MAX_COLS
+#define LIDET_MAX_COLS 2048
+#endif
+
+/** Maximum points per scan; points past it are not processed (status LIDET_TRUNCATED). */
+#ifndef LIDET_MAX_POINTS
+#define LIDET_MAX_POINTS 262144
+#endif
+
+/** Maximum clusters (proposals before filtering) per scan. */
+#ifndef LIDET_MAX_CLUSTERS
+#define LIDET_MAX_CLUSTERS 1024
+#endif
+
+/** Points per proposal handed to the PointNets (resampled). */
+#ifndef LIDET_PROPOSAL_POINTS
+#define LIDET_PROPOSAL_POINTS 128
+#endif
+
+/** Maximum detections reported per scan. */
+#ifndef LIDET_MAX_DETECTIONS
+#define LIDET_MAX_DETECTIONS 128
+#endif
+
+/** Entries of the row lookup table of the projection (elevation -> candidate row). */
+#ifndef LIDET_PROJ_ROW_LUT
+#define LIDET_PROJ_ROW_LUT 1024
+#endif
+
+/** 1: asserts (LIDET_ASSERT) are compiled in; the port may override LIDET_ASSERT itself. */
+#ifndef LIDET_DEBUG
+#define LIDET_DEBUG 0
+#endif
+
+/** 1: lidet_status_str() returns descriptive strings; 0: it returns "" (saves flash). */
+#ifndef LIDET_ENABLE_STATUS_STRINGS
+#define LIDET_ENABLE_STATUS_STRINGS 1
+#endif
+
+/* ---- consistency checks (all in one place) ------------------------------------------------ */
+#if LIDET_MAX_ROWS < 1 || LIDET_MAX_ROWS > 256
+#error "LIDET_MAX_ROWS must be in [1, 256] (rows are stored as uint8 indices in places)"
+#endif
+#if LIDET_MAX_COLS < 8 || LIDET_MAX_COLS > 16384
+#error "LIDET_MAX_COLS must be in [8, 16384]"
+#endif
+#if LIDET_MAX_POINTS < 1 || LIDET_MAX_POINTS > 16777216
+#error "LIDET_MAX_POINTS must be in [1, 2^24]"
+#endif
+#if (LIDET_MAX_ROWS * LIDET_MAX_COLS) > 2147483647 / 4
+#error "range image too large for int32 pixel indices"
+#endif
+#if LIDET_MAX_CLUSTERS < 1 || LIDET_MAX_CLUSTERS > 65535
+#error "LIDET_MAX_CLUSTERS must be in [1, 65535]"
+#endif
+#if LIDET_PROPOSAL_POINTS < 1 || LIDET_PROPOSAL_POINTS > 4096
+#error "LIDET_PROPOSAL_POINTS must be in [1, 4096]"
+#endif
+#if LIDET_MAX_DETECTIONS < 1 || LIDET_MAX_DETECTIONS > LIDET_MAX_CLUSTERS
+#error "LIDET_MAX_DETECTIONS must be in [1, LIDET_MAX_CLUSTERS]"
+#endif
+#if LIDET_PROJ_ROW_LUT < 16 || LIDET_PROJ_ROW_LUT > 65536
+#error "LIDET_PROJ_ROW_LUT must be in [16, 65536]"
+#endif
+#if ((-1) >> 1) != -1
+#error "lidet needs arithmetic right shifts of negative integers (the fixed-point build relies on them)"
+#endif
+#ifdef LIDET_FIXED_POINT
+#if LIDET_FIXED_POINT
+#error "LIDET_FIXED_POINT is not implemented yet: build the float configuration (LIDET_FIXED_POINT=0)"
+#endif
+#endif
+
+#endif /* LIDET_OPT_H */

@@ -1,0 +1,186 @@
+/* SPDX-License-Identifier: MIT */
+/**
+ * @file lidet_proj.h
+ * @brief Spherical projection: a point cloud -> a range image (rows = beams, cols = azimuth).
+ *
+ * Algorithm (eq. 1 of Seppänen et al., with nearest-beam rows):
+ *  - column: azimuth = atan2(y, x); col = floor(0.5 * (1 - azimuth/pi) * n_cols), so +x is the middle
+ *    column, azimuth decreases to the right and the seam (col 0 / n_cols - 1) is straight behind;
+ *    columns wrap around (azimuth -pi and +pi both land in col 0).
+ *  - row: the beam whose elevation is nearest to the point's elevation (the sensor's real per-beam
+ *    table, not only a uniform formula), or the caller's per-point ring index when the sensor gives
+ *    one. Row 0 is the highest beam.
+ *  - several points in one pixel: the closest one (smallest range) wins; ties keep the earlier point.
+ * No libm atan2/asin in the hot loop, and no approximation either: both tests are exact comparisons
+ * against boundaries precomputed in init.
+ *  - elevation: tan(elevation) = z / sqrt(x^2 + y^2) against the tangents of the mid-angles between
+ *    beams (tan is monotonic), found through a lookup table plus at most a step or two;
+ *  - azimuth: a "diamond" pseudo-angle D = 1 + x/(|x|+|y|) for y >= 0, 3 - x/(|x|+|y|) for y < 0
+ *    (monotonic in azimuth, 0 at +-180 deg, 2 at +x, 4 just before -180 deg), against the D of
+ *    every column edge, found the same way. One division, no polynomial; the only error is float
+ *    rounding (max 1e-5 deg, measured in docs/BENCHMARKS.md).
+ * Points that are NaN/Inf, closer than min_range_m, farther than max_range_m (if set), outside the
+ * vertical field of view, or with an invalid ring index are counted per reason and skipped before any
+ * float -> int conversion.
+ *
+ * Memory: lidet_proj_t holds every buffer, sizeof = LIDET_MAX_ROWS * LIDET_MAX_COLS * 24 B (x, y, z,
+ * range, R as float, winning point as int32) + LIDET_MAX_POINTS * 4 B (pixel of each input point)
+ * + LIDET_MAX_COLS * 8 B (column edges and their lookup table) + LIDET_PROJ_ROW_LUT * 1 B
+ * + LIDET_MAX_ROWS * 9 B + ~100 B. Defaults (128 x 2048, 262,144 points): about 7.3 MiB; a VLP-16
+ * build (16 x 1800, 30,000 points): about 0.8 MiB. lidet_proj_bytes() returns the exact figure.
+ * Declare it `static`.
+ * Time: O(n_points + n_rows * n_cols) per run, no allocation, no recursion.
+ */
+#ifndef LIDET_PROJ_H
+#define LIDET_PROJ_H
+
+#include "lidet_sensor.h"
+#include "lidet_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** @brief Runtime configuration of the projection. Fill with lidet_proj_cfg_default(). */
+typedef struct
+{
+    lidet_sensor_t sensor; /**< the sensor (its table is copied by init) */
+    float min_range_m;     /**< points closer than this are dropped (zero range included);
+                                [0, 10], default 0.1 m */
+    float max_range_m;     /**< points farther are dropped; 0 = no limit (default) */
+    float fov_margin_rad;  /**< how far above the top beam / below the bottom beam a point may lie
+                                and still map to the edge row; [0, 0.5], default 5 deg (0.0873): the
+                                lasers sit centimetres off the optical centre, so close returns appear
+                                degrees outside the table (real KITTI: top-beam points at 4 m show up
+                                to 2.5 deg above it). For a uniform fov (table NULL) the margin is
+                                added to fov_up / fov_down. */
+} lidet_proj_cfg_t;
+
+/** @brief Why points were not projected (counts of the last run). */
+typedef struct
+{
+    uint32_t n_points_in;     /**< points passed to run */
+    uint32_t n_projected;     /**< points that map to a pixel (winners and losers of a pixel) */
+    uint32_t n_pixels_filled; /**< pixels holding a point */
+    uint32_t n_nonfinite;     /**< x, y or z NaN or +-Inf */
+    uint32_t n_too_close;     /**< range < min_range_m (zero range included) */
+    uint32_t n_too_far;       /**< range > max_range_m */
+    uint32_t n_out_of_fov;    /**< elevation outside the beams (+ margin) */
+    uint32_t n_bad_ring;      /**< ring index >= n_rows (ring path only) */
+    uint32_t n_truncated;     /**< points past LIDET_MAX_POINTS, not looked at */
+} lidet_proj_stats_t;
+
+/**
+ * @brief The range image: row-major arrays of n_rows * n_cols pixels, pixel = row * n_cols + col.
+ * Empty pixels hold 0 in every float array and -1 in point_idx. A view into lidet_proj_t, valid
+ * until the next lidet_proj_run or lidet_proj_init on the same state.
+ */
+typedef struct
+{
+    uint16_t n_rows;
+    uint16_t n_cols;
+    const float *x_m;          /**< x of the pixel's point */
+    const float *y_m;          /**< y */
+    const float *z_m;          /**< z */
+    const float *range_m;      /**< sqrt(x^2 + y^2 + z^2); > 0 exactly for valid pixels */
+    const float *rxy_m;        /**< R = sqrt(x^2 + y^2), the horizontal range */
+    const int32_t *point_idx;  /**< index of the winning input point; -1 = empty (validity) */
+    const float *row_elev_rad; /**< n_rows beam elevations in row order (row 0 = top) */
+} lidet_range_image_t;
+
+/** @brief Projection state and workspace. Caller-owned; declare it static (it is large). */
+typedef struct
+{
+    uint32_t magic;
+    lidet_proj_cfg_t cfg;
+    /* derived in init */
+    float row_elev_rad[LIDET_MAX_ROWS];     /* beam elevations, row order (descending) */
+    float row_bound_tan[LIDET_MAX_ROWS + 1]; /* [r] = tan of the mid-angle between rows r-1 and r;
+                                               sentinels [0] = +big, [n_rows] = -big */
+    uint8_t ring_to_row[LIDET_MAX_ROWS];    /* ring index -> row */
+    uint8_t row_lut[LIDET_PROJ_ROW_LUT];    /* tan(elevation) bucket -> smallest possible row */
+    float tan_lo, tan_hi, lut_scale;        /* accepted tan(elevation) range, buckets per unit */
+    float col_edge_key[LIDET_MAX_COLS + 1];   /* pseudo-azimuth D of the left edge of each column;
+                                                 [n_cols] = 5 (> any D), a sentinel */
+    uint16_t col_lut[2 * LIDET_MAX_COLS];     /* D bucket (width 2/n_cols) -> column of its low end */
+    float col_lut_scale;                      /* n_cols / 2: buckets per unit of D */
+    /* outputs of the last run */
+    float x_m[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    float y_m[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    float z_m[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    float range_m[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    float rxy_m[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    int32_t point_idx[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    int32_t point_pixel[LIDET_MAX_POINTS]; /* pixel of every input point, -1 = not projected */
+    uint32_t n_points;                     /* points covered by point_pixel (<= LIDET_MAX_POINTS) */
+    lidet_proj_stats_t stats;
+} lidet_proj_t;
+
+/**
+ * @brief Default configuration for a sensor.
+ * @param[out] cfg    filled with defaults (min range 0.1 m, no max range, 5 deg fov margin).
+ * @param[in]  sensor profile to copy (a preset from lidet_sensor_find, or your own); may be NULL,
+ *                    in which case cfg->sensor is zeroed and init will fail until it is set.
+ */
+void lidet_proj_cfg_default(lidet_proj_cfg_t *cfg, const lidet_sensor_t *sensor);
+
+/**
+ * @brief Validate the configuration and precompute the tables. Call once (or again to change
+ *        sensor); no allocation.
+ * @param[out] proj state to initialise (caller-owned, static storage recommended).
+ * @param[in]  cfg  configuration; the sensor's beam table is copied, cfg may be freed afterwards.
+ * @return LIDET_OK; LIDET_ERR_ARG (NULL); LIDET_ERR_BUFFER (n_rows > LIDET_MAX_ROWS or
+ *         n_cols > LIDET_MAX_COLS); LIDET_ERR_CONFIG (n_rows 0, n_cols < 8, elevations not finite,
+ *         outside (-pi/2, pi/2) or not distinct, fov_up <= fov_down, ranges or margin out of range).
+ */
+lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg);
+
+/**
+ * @brief Project one scan.
+ * @param[in,out] proj     initialised state; its image and point_pixel are overwritten.
+ * @param[in]     points   n_points records of `stride` floats, x y z first (metres, sensor frame);
+ *                         may be NULL only when n_points == 0. Not modified, not retained.
+ * @param[in]     n_points number of records. Only the first LIDET_MAX_POINTS are processed.
+ * @param[in]     stride   floats per record, >= 3 (4 for KITTI .bin).
+ * @param[in]     ring     optional per-point ring index (sensor's ring order, < n_rows), or NULL
+ *                         to choose rows by elevation.
+ * @return LIDET_OK; LIDET_TRUNCATED when n_points > LIDET_MAX_POINTS (the rest is counted in
+ *         stats.n_truncated and not looked at); LIDET_ERR_ARG (NULL state, NULL points with
+ *         n_points > 0, stride < 3); LIDET_ERR_STATE (not initialised).
+ */
+lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t n_points, uint32_t stride,
+                              const uint16_t *ring);
+
+/**
+ * @brief A view of the range image of the last run (valid until the next run/init).
+ * @param[in]  proj initialised state.
+ * @param[out] img  filled with pointers into proj.
+ */
+void lidet_proj_image(const lidet_proj_t *proj, lidet_range_image_t *img);
+
+/**
+ * @brief Pixel of each input point of the last run: `*n_points` entries, -1 = not projected.
+ * Every input point that maps to a pixel gets its pixel, also those that lost the pixel to a
+ * closer point (so per-point labels can be given to every point). Valid until the next run.
+ */
+const int32_t *lidet_proj_point_pixels(const lidet_proj_t *proj, uint32_t *n_points);
+
+/** @brief Counts of the last run. */
+const lidet_proj_stats_t *lidet_proj_stats(const lidet_proj_t *proj);
+
+/** @brief sizeof(lidet_proj_t): the bytes firmware must place for this stage. */
+uint32_t lidet_proj_bytes(void);
+
+/**
+ * @brief The pseudo-azimuth the projection bins columns on (exposed for tests and benchmarks):
+ *        D = 1 + x/(|x|+|y|) for y >= 0, 3 - x/(|x|+|y|) for y < 0; in [0, 4], increasing as the
+ *        azimuth atan2(y, x) decreases from +pi to -pi (column = floor(D / 4 * n_cols) up to the
+ *        exact edge table). Returns 2 (straight ahead) for x = y = 0.
+ */
+float lidet_proj_azimuth_key(float x, float y);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LIDET_PROJ_H */

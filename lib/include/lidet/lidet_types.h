@@ -1,0 +1,84 @@
+/* SPDX-License-Identifier: MIT */
+/**
+ * @file lidet_types.h
+ * @brief Status codes, the coordinate frame, and the point and box types shared by every stage.
+ *
+ * Frame (fixed for the whole library): origin at the sensor's optical centre, x forward, y left,
+ * z up (right-handed); lengths in metres (`_m`), angles in radians (`_rad`), yaw about +z measured
+ * from +x towards +y. Point clouds are arrays of float32 records of `stride` floats whose first
+ * three are x, y, z (KITTI .bin records are x, y, z, remission: stride 4).
+ */
+#ifndef LIDET_TYPES_H
+#define LIDET_TYPES_H
+
+#include <stdint.h>
+
+#include "lidet_opt.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/**
+ * @brief Result of every lidet call. 0 is success, positive values are success with a remark,
+ *        negative values are errors (nothing useful was produced).
+ */
+typedef enum
+{
+    LIDET_OK = 0,            /**< success */
+    LIDET_TRUNCATED = 1,     /**< success, but the input exceeded a capacity: the excess was dropped
+                                  deterministically and counted in the stage's stats */
+    LIDET_ERR_ARG = -1,      /**< a NULL pointer or an argument out of range */
+    LIDET_ERR_CONFIG = -2,   /**< a configuration value is out of range or inconsistent */
+    LIDET_ERR_BUFFER = -3,   /**< a buffer or compile-time capacity is too small for the request */
+    LIDET_ERR_MODEL = -4,    /**< model shape, format or version mismatch */
+    LIDET_ERR_STATE = -5,    /**< the state was not initialised by the stage's init */
+    LIDET_ERR_NOT_FOUND = -6 /**< a named item (e.g. sensor profile) does not exist */
+} lidet_status_t;
+
+/** @brief True for LIDET_OK and the positive (success with remark) statuses. */
+#define LIDET_SUCCEEDED(st) ((st) >= 0)
+
+/**
+ * @brief Human-readable name of a status ("LIDET_OK: success", ...); never NULL.
+ * Returns "" when built with LIDET_ENABLE_STATUS_STRINGS 0.
+ */
+const char *lidet_status_str(lidet_status_t status);
+
+/** @brief A point in the sensor frame (metres). */
+typedef struct
+{
+    float x_m;
+    float y_m;
+    float z_m;
+} lidet_point_t;
+
+/** @brief Object classes, in the order of the classifier's logits. */
+typedef enum
+{
+    LIDET_CLASS_CAR = 0,
+    LIDET_CLASS_CYCLIST = 1,
+    LIDET_CLASS_PEDESTRIAN = 2,
+    LIDET_N_CLASSES = 3
+} lidet_class_t;
+
+/**
+ * @brief An oriented 3D box in the sensor frame.
+ * The centre is the box's geometric centre (not the bottom, unlike KITTI's camera labels);
+ * l runs along the heading, w across it, h along +z.
+ */
+typedef struct
+{
+    float cx_m, cy_m, cz_m; /**< centre */
+    float l_m, w_m, h_m;    /**< length (along heading), width, height */
+    float yaw_rad;          /**< heading about +z from +x, in (-pi, pi] */
+} lidet_box_t;
+
+/** @brief Magic value stored by every stage's init, checked by its run (LIDET_ERR_STATE). */
+#define LIDET_INIT_MAGIC 0x6C646574u /* "ldet" */
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LIDET_TYPES_H */

@@ -1,0 +1,77 @@
+/* SPDX-License-Identifier: MIT */
+/* Sensor presets. Mirrored by tools/lidet_tools/sensors.py; tests/python/test_bindings.py checks
+ * that both give the same beam tables. Elevations in ring order, radians, float32-rounded. */
+#include "lidet/lidet_sensor.h"
+
+/* KITTI HDL-64E, measured on real KITTI scans (median elevation per ring recovered from scan order):
+ * upper block +2.5 .. -7.7 deg in 32 equal steps, lower block -8.25 .. -23.5 deg in 32 steps.
+ * Ring order top to bottom. */
+static const float k_hdl64_elev_rad[64] = {
+    0.04363323f, 0.0378905348f, 0.0321478397f, 0.0264051426f, 0.0206624456f, 0.0149197504f, 0.00917705335f, 0.00343435747f,
+    -0.00230833865f, -0.00805103499f, -0.0137937311f, -0.0195364282f, -0.0252791233f, -0.0310218204f, -0.0367645174f, -0.0425072126f,
+    -0.0482499078f, -0.0539926067f, -0.0597353019f, -0.0654779971f, -0.071220696f, -0.0769633874f, -0.0827060863f, -0.0884487852f,
+    -0.0941914767f, -0.0999341756f, -0.105676875f, -0.111419566f, -0.117162265f, -0.122904956f, -0.128647655f, -0.134390354f,
+    -0.143989667f, -0.152575552f, -0.161161453f, -0.169747338f, -0.178333238f, -0.186919138f, -0.195505023f, -0.204090923f,
+    -0.212676808f, -0.221262708f, -0.229848608f, -0.238434494f, -0.247020394f, -0.255606294f, -0.264192164f, -0.272778064f,
+    -0.281363964f, -0.289949864f, -0.298535764f, -0.307121634f, -0.315707535f, -0.324293435f, -0.332879335f, -0.341465235f,
+    -0.350051105f, -0.358637005f, -0.367222905f, -0.375808805f, -0.384394705f, -0.392980576f, -0.401566476f, -0.410152376f,
+};
+
+/* Velodyne VLP-16: -15 .. +15 deg every 2 deg, ring 0 = lowest (velodyne_pointcloud's ring). */
+static const float k_vlp16_elev_rad[16] = {
+    -0.261799395f, -0.226892799f, -0.191986218f, -0.157079637f, -0.122173049f, -0.0872664601f, -0.052359879f, -0.0174532924f,
+    0.0174532924f, 0.052359879f, 0.0872664601f, 0.122173049f, 0.157079637f, 0.191986218f, 0.226892799f, 0.261799395f,
+};
+
+/* Velodyne VLP-32C: its real non-uniform table (dense near the horizon), ring 0 = lowest. */
+static const float k_vlp32c_elev_rad[32] = {
+    -0.436332315f, -0.27295205f, -0.19739674f, -0.154339463f, -0.126606181f, -0.107302845f, -0.0930784121f, -0.0814545155f,
+    -0.0698131695f, -0.0640012249f, -0.0581718236f, -0.052359879f, -0.0465479307f, -0.0407185331f, -0.0349065848f, -0.0290946383f,
+    -0.0232652389f, -0.0174532924f, -0.0116413459f, -0.00581194647f, 0.0f, 0.00581194647f, 0.0116413459f, 0.0174532924f,
+    0.0232652389f, 0.0290946383f, 0.0407185331f, 0.0581718236f, 0.0814545155f, 0.122173049f, 0.180344865f, 0.261799395f,
+};
+
+#define DEG(d) ((float)(d) * 0.0174532925f)
+
+static const lidet_sensor_t k_presets[] = {
+    {"hdl64", 64u, 2048u, k_hdl64_elev_rad, 0.0f, 0.0f, 1.73f, 120.0f},
+    {"vlp16", 16u, 1800u, k_vlp16_elev_rad, 0.0f, 0.0f, 0.5f, 100.0f},
+    {"vlp32c", 32u, 1800u, k_vlp32c_elev_rad, 0.0f, 0.0f, 1.0f, 200.0f},
+    /* Ouster OS1: uniform +-22.5 deg; ring 0 = top beam (Ouster's convention) */
+    {"os1-64", 64u, 2048u, 0, DEG(22.5), DEG(-22.5), 1.0f, 120.0f},
+    {"os1-128", 128u, 2048u, 0, DEG(22.5), DEG(-22.5), 1.0f, 120.0f},
+};
+
+#define N_PRESETS (sizeof(k_presets) / sizeof(k_presets[0]))
+
+static int str_equal(const char *a, const char *b)
+{
+    while (*a != '\0' && *a == *b)
+    {
+        ++a;
+        ++b;
+    }
+    return *a == *b;
+}
+
+const lidet_sensor_t *lidet_sensor_find(const char *name)
+{
+    uint32_t i;
+    if (name == 0)
+    {
+        return 0;
+    }
+    for (i = 0; i < N_PRESETS; ++i)
+    {
+        if (str_equal(name, k_presets[i].name))
+        {
+            return &k_presets[i];
+        }
+    }
+    return 0;
+}
+
+const lidet_sensor_t *lidet_sensor_at(uint32_t index)
+{
+    return index < N_PRESETS ? &k_presets[index] : 0;
+}

@@ -1,0 +1,275 @@
+/* SPDX-License-Identifier: MIT */
+/* Projection benchmark: lidet_proj_run versus a plain libm projection (atan2f for the column,
+ * asinf for the elevation, nearest beam by binary search, same closest-wins rule and the same
+ * output arrays) on the same scans, in the same run, interleaved. Also measures the angular error of
+ * lidet's azimuth and elevation tests against a double-precision reference, and the row/column
+ * agreement with it. Prints one JSON object per scan and a summary object (tools/bench reads them).
+ *
+ * usage: lidet_bench_proj --sensor hdl64 [--repeat 30] SCAN.bin...
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "lidet/lidet.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static lidet_proj_t g_proj;
+
+/* baseline state (same sizes as lidet's) */
+static float b_x[LIDET_MAX_ROWS * LIDET_MAX_COLS], b_y[LIDET_MAX_ROWS * LIDET_MAX_COLS],
+    b_z[LIDET_MAX_ROWS * LIDET_MAX_COLS], b_r[LIDET_MAX_ROWS * LIDET_MAX_COLS], b_rxy[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+static int32_t b_idx[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+static int32_t b_pp[LIDET_MAX_POINTS];
+static float b_mid_rad[LIDET_MAX_ROWS]; /* mid-angles between rows, descending */
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static int cmpd(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof v[0], cmpd);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+/* exact inverse of lidet's pseudo-azimuth (in double): the azimuth lidet effectively binned */
+static double key_to_azimuth(float key)
+{
+    const double d = key;
+    int quadrant = (int)floor(d);
+    double g, theta, u;
+    quadrant = quadrant > 3 ? 3 : quadrant;
+    g = d - quadrant;
+    theta = atan2(g, 1.0 - g); /* g = sin/(sin+cos) */
+    u = (quadrant + theta / (M_PI / 2.0)) / 4.0;
+    return M_PI * (1.0 - 2.0 * u);
+}
+
+/* the plain projection: libm trigonometry per point */
+static void baseline_run(const float *pts, uint32_t n, int rows, int cols, float lo_rad, float hi_rad)
+{
+    const int npix = rows * cols;
+    uint32_t i;
+    int pix;
+    memset(b_idx, 0xFF, sizeof(int32_t) * (size_t)npix);
+    for (i = 0; i < n; ++i)
+    {
+        const float x = pts[4 * i], y = pts[4 * i + 1], z = pts[4 * i + 2];
+        const float r = sqrtf(x * x + y * y + z * z);
+        float pitch, yaw;
+        int row, col, lo, hi;
+        b_pp[i] = -1;
+        if (!isfinite(r) || r < 0.1f)
+            continue;
+        pitch = asinf(z / r);
+        if (!(pitch >= lo_rad && pitch <= hi_rad))
+            continue;
+        yaw = atan2f(y, x);
+        col = (int)(0.5f * (1.0f - yaw / 3.14159265f) * (float)cols);
+        col = col >= cols ? col - cols : (col < 0 ? 0 : col);
+        /* nearest beam: first mid-angle below the pitch, binary search */
+        lo = 0;
+        hi = rows - 1;
+        while (lo < hi)
+        {
+            const int m = (lo + hi) / 2;
+            if (b_mid_rad[m] > pitch)
+                lo = m + 1;
+            else
+                hi = m;
+        }
+        row = lo;
+        pix = row * cols + col;
+        b_pp[i] = pix;
+        if (b_idx[pix] < 0 || r < b_r[pix])
+        {
+            b_idx[pix] = (int32_t)i;
+            b_r[pix] = r;
+        }
+    }
+    for (pix = 0; pix < npix; ++pix)
+    {
+        const int32_t k = b_idx[pix];
+        if (k < 0)
+        {
+            b_x[pix] = b_y[pix] = b_z[pix] = b_r[pix] = b_rxy[pix] = 0.0f;
+        }
+        else
+        {
+            b_x[pix] = pts[4 * k];
+            b_y[pix] = pts[4 * k + 1];
+            b_z[pix] = pts[4 * k + 2];
+            b_rxy[pix] = sqrtf(b_x[pix] * b_x[pix] + b_y[pix] * b_y[pix]);
+        }
+    }
+}
+
+int main(int argc, char **argv)
+{
+    const char *sensor = "hdl64";
+    int repeat = 30, a, n_files = 0;
+    double sum_pts = 0, sum_lidet_ms = 0, sum_base_ms = 0, worst_az_deg = 0, worst_el_deg = 0;
+    double agree_row = 0, agree_col = 0, agree_n = 0, fill_sum = 0;
+    lidet_proj_cfg_t cfg;
+    lidet_range_image_t img;
+    int rows, cols, r;
+    float lo_rad, hi_rad;
+
+    for (a = 1; a < argc; ++a)
+    {
+        if (strcmp(argv[a], "--sensor") == 0 && a + 1 < argc)
+            sensor = argv[++a];
+        else if (strcmp(argv[a], "--repeat") == 0 && a + 1 < argc)
+            repeat = atoi(argv[++a]);
+    }
+    if (repeat < 1 || lidet_sensor_find(sensor) == NULL)
+    {
+        fprintf(stderr, "usage: lidet_bench_proj --sensor NAME [--repeat N] SCAN.bin...\n");
+        return 1;
+    }
+    lidet_proj_cfg_default(&cfg, lidet_sensor_find(sensor));
+    if (lidet_proj_init(&g_proj, &cfg) != LIDET_OK)
+        return 1;
+    lidet_proj_image(&g_proj, &img);
+    rows = img.n_rows;
+    cols = img.n_cols;
+    for (r = 0; r + 1 < rows; ++r)
+        b_mid_rad[r] = 0.5f * (img.row_elev_rad[r] + img.row_elev_rad[r + 1]);
+    b_mid_rad[rows - 1] = -10.0f;
+    hi_rad = img.row_elev_rad[0] + cfg.fov_margin_rad;
+    lo_rad = img.row_elev_rad[rows - 1] - cfg.fov_margin_rad;
+
+    for (a = 1; a < argc; ++a)
+    {
+        FILE *f;
+        long size;
+        float *pts;
+        uint32_t n, i, np;
+        double *tl, *tb, ml, mb;
+        const int32_t *pp;
+        int k;
+        if (strcmp(argv[a], "--sensor") == 0 || strcmp(argv[a], "--repeat") == 0)
+        {
+            ++a;
+            continue;
+        }
+        f = fopen(argv[a], "rb");
+        if (f == NULL)
+        {
+            fprintf(stderr, "cannot open %s\n", argv[a]);
+            return 1;
+        }
+        fseek(f, 0, SEEK_END);
+        size = ftell(f);
+        fseek(f, 0, SEEK_SET);
+        if (size <= 0 || size % 16 != 0)
+        {
+            fprintf(stderr, "%s: not a KITTI scan\n", argv[a]);
+            fclose(f);
+            return 1;
+        }
+        n = (uint32_t)(size / 16);
+        pts = (float *)malloc((size_t)size);
+        if (pts == NULL || fread(pts, 1, (size_t)size, f) != (size_t)size)
+        {
+            fclose(f);
+            return 1;
+        }
+        fclose(f);
+        tl = (double *)malloc(sizeof(double) * (size_t)repeat);
+        tb = (double *)malloc(sizeof(double) * (size_t)repeat);
+        for (k = 0; k < repeat; ++k) /* interleaved, so both see the same machine state */
+        {
+            double t0 = now_ms();
+            lidet_proj_run(&g_proj, pts, n, 4, NULL);
+            tl[k] = now_ms() - t0;
+            t0 = now_ms();
+            baseline_run(pts, n, rows, cols, lo_rad, hi_rad);
+            tb[k] = now_ms() - t0;
+        }
+        ml = median(tl, repeat);
+        mb = median(tb, repeat);
+        free(tl);
+        free(tb);
+
+        /* accuracy against double precision */
+        pp = lidet_proj_point_pixels(&g_proj, &np);
+        {
+            double w_az = 0, w_el = 0;
+            uint32_t same_row = 0, same_col = 0, cnt = 0;
+            for (i = 0; i < n; ++i)
+            {
+                const double x = pts[4 * i], y = pts[4 * i + 1], z = pts[4 * i + 2];
+                const double rxy = sqrt(x * x + y * y);
+                double az_err, el_err, az, el, u;
+                int row_ref, col_ref;
+                if (pp[i] < 0 || rxy <= 0.0)
+                    continue;
+                az = atan2(y, x);
+                az_err = fabs(key_to_azimuth(lidet_proj_azimuth_key((float)x, (float)y)) - az);
+                az_err = az_err > M_PI ? 2.0 * M_PI - az_err : az_err;
+                /* lidet decides the row on tan(el) = z / rxy computed in float */
+                el = atan2(z, rxy);
+                el_err = fabs(atan((double)(pts[4 * i + 2] / sqrtf(pts[4 * i] * pts[4 * i] + pts[4 * i + 1] * pts[4 * i + 1]))) - el);
+                w_az = az_err > w_az ? az_err : w_az;
+                w_el = el_err > w_el ? el_err : w_el;
+                /* double-precision reference pixel */
+                u = 0.5 * (1.0 - az / M_PI) * cols;
+                col_ref = (int)floor(u);
+                col_ref = col_ref >= cols ? col_ref - cols : col_ref;
+                row_ref = 0;
+                while (row_ref + 1 < rows &&
+                       0.5 * ((double)img.row_elev_rad[row_ref] + (double)img.row_elev_rad[row_ref + 1]) > el)
+                    ++row_ref;
+                same_row += (uint32_t)(pp[i] / cols == row_ref);
+                same_col += (uint32_t)(pp[i] % cols == col_ref);
+                ++cnt;
+            }
+            w_az *= 180.0 / M_PI;
+            w_el *= 180.0 / M_PI;
+            worst_az_deg = w_az > worst_az_deg ? w_az : worst_az_deg;
+            worst_el_deg = w_el > worst_el_deg ? w_el : worst_el_deg;
+            agree_row += same_row;
+            agree_col += same_col;
+            agree_n += cnt;
+            fill_sum += (double)lidet_proj_stats(&g_proj)->n_pixels_filled / (double)(rows * cols);
+            printf("{\"scan\": \"%s\", \"points\": %u, \"projected\": %u, \"fill_ratio\": %.4f, \"lidet_ms\": %.4f, "
+                   "\"libm_ms\": %.4f, \"lidet_ns_per_point\": %.2f, \"libm_ns_per_point\": %.2f, \"speedup\": %.2f, "
+                   "\"max_az_err_deg\": %.6f, \"max_el_err_deg\": %.6f, \"row_agree\": %.6f, \"col_agree\": %.6f}\n",
+                   argv[a], n, lidet_proj_stats(&g_proj)->n_projected,
+                   (double)lidet_proj_stats(&g_proj)->n_pixels_filled / (double)(rows * cols), ml, mb, ml * 1e6 / n,
+                   mb * 1e6 / n, mb / ml, w_az, w_el, cnt ? (double)same_row / cnt : 0.0,
+                   cnt ? (double)same_col / cnt : 0.0);
+        }
+        sum_pts += n;
+        sum_lidet_ms += ml;
+        sum_base_ms += mb;
+        ++n_files;
+        free(pts);
+    }
+    if (n_files > 0)
+    {
+        printf("{\"summary\": true, \"sensor\": \"%s\", \"scans\": %d, \"repeat\": %d, \"lidet_ns_per_point\": %.2f, "
+               "\"libm_ns_per_point\": %.2f, \"speedup\": %.2f, \"max_az_err_deg\": %.6f, \"max_el_err_deg\": %.6f, "
+               "\"row_agree\": %.6f, \"col_agree\": %.6f, \"mean_fill_ratio\": %.4f}\n",
+               sensor, n_files, repeat, sum_lidet_ms * 1e6 / sum_pts, sum_base_ms * 1e6 / sum_pts,
+               sum_base_ms / sum_lidet_ms, worst_az_deg, worst_el_deg, agree_row / agree_n, agree_col / agree_n,
+               fill_sum / n_files);
+    }
+    return 0;
+}

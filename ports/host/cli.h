@@ -1,0 +1,52 @@
+/* SPDX-License-Identifier: MIT */
+/* Host CLI internals: shared option parsing, scan loading, timing and output helpers.
+ * One file per subcommand (cli_<stage>.c) registers a function in cli_main.c's table. */
+#ifndef LIDET_CLI_H
+#define LIDET_CLI_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "lidet/lidet.h"
+
+typedef struct
+{
+    const char *scan_path;  /* positional SCAN.bin */
+    const char *sensor;     /* --sensor NAME (default hdl64) */
+    const char *out_path;   /* --out FILE */
+    const char *png_path;   /* --png FILE */
+    const char *ring_path;  /* --ring FILE (uint16 per point) */
+    int json;               /* --json */
+    int repeat;             /* --repeat N (>= 1) */
+    /* loaded by cli_load */
+    float *points;          /* n_points * 4 floats (x, y, z, remission) */
+    uint32_t n_points;
+    uint16_t *ring;         /* NULL unless --ring */
+    const lidet_sensor_t *sensor_profile;
+} cli_args_t;
+
+/* Parses argv (after the subcommand). Returns 0, or prints usage/error to stderr and returns 1. */
+int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a);
+/* Reads the scan (and ring file); clear error and 1 on a missing, truncated or odd-sized file. */
+int cli_load(cli_args_t *a);
+void cli_free(cli_args_t *a);
+/* Monotonic clock in milliseconds. */
+double cli_now_ms(void);
+/* Median of n values (sorts in place). */
+double cli_median(double *v, int n);
+/* JSON helpers: open object, key/values with separators, close. */
+void cli_json_begin(FILE *f);
+void cli_json_num(FILE *f, const char *key, double v);
+void cli_json_int(FILE *f, const char *key, long long v);
+void cli_json_str(FILE *f, const char *key, const char *v);
+void cli_json_end(FILE *f);
+
+/* Subcommands */
+int cli_project(int argc, char **argv);
+
+/* PNG writer (8-bit RGB, no compression library needed). Returns 0 or -1. */
+int lidet_png_write_rgb(const char *path, const uint8_t *rgb, uint32_t width, uint32_t height);
+/* A perceptual colour map: t in [0, 1] -> rgb. */
+void cli_colormap(float t, uint8_t rgb[3]);
+
+#endif

@@ -1,0 +1,239 @@
+/* SPDX-License-Identifier: MIT */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+#include "cli.h"
+
+static void usage(const char *cmd)
+{
+    fprintf(stderr,
+            "usage: lidet %s SCAN.bin [--sensor NAME] [--ring RING.bin] [--out FILE] [--png FILE] [--json]\n"
+            "                 [--repeat N]\n"
+            "  SCAN.bin   KITTI velodyne scan: float32 records x, y, z, remission (metres, sensor frame)\n"
+            "  --sensor   hdl64 (default), vlp16, vlp32c, os1-64, os1-128\n"
+            "  --ring     optional uint16 ring index per point (sensor's ring order) instead of elevation\n"
+            "  --json     print one JSON object (stage timings as <stage>_ms)\n"
+            "  --repeat   run the stage N times and report the median time (file reading excluded)\n",
+            cmd);
+}
+
+int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
+{
+    int i;
+    memset(a, 0, sizeof *a);
+    a->sensor = "hdl64";
+    a->repeat = 1;
+    for (i = 0; i < argc; ++i)
+    {
+        const char *s = argv[i];
+        const int has_val = i + 1 < argc;
+        if (strcmp(s, "--json") == 0)
+        {
+            a->json = 1;
+        }
+        else if ((strcmp(s, "--sensor") == 0 || strcmp(s, "--out") == 0 || strcmp(s, "--png") == 0 ||
+                  strcmp(s, "--repeat") == 0 || strcmp(s, "--ring") == 0))
+        {
+            if (!has_val)
+            {
+                fprintf(stderr, "lidet %s: %s needs a value\n", cmd, s);
+                return 1;
+            }
+            if (strcmp(s, "--sensor") == 0)
+                a->sensor = argv[++i];
+            else if (strcmp(s, "--out") == 0)
+                a->out_path = argv[++i];
+            else if (strcmp(s, "--png") == 0)
+                a->png_path = argv[++i];
+            else if (strcmp(s, "--ring") == 0)
+                a->ring_path = argv[++i];
+            else
+            {
+                char *end;
+                long v = strtol(argv[++i], &end, 10);
+                if (*end != '\0' || v < 1 || v > 100000)
+                {
+                    fprintf(stderr, "lidet %s: --repeat needs an integer in [1, 100000]\n", cmd);
+                    return 1;
+                }
+                a->repeat = (int)v;
+            }
+        }
+        else if (strcmp(s, "-h") == 0 || strcmp(s, "--help") == 0)
+        {
+            usage(cmd);
+            return 1;
+        }
+        else if (s[0] == '-' && s[1] != '\0')
+        {
+            fprintf(stderr, "lidet %s: unknown option %s\n", cmd, s);
+            usage(cmd);
+            return 1;
+        }
+        else if (a->scan_path == NULL)
+        {
+            a->scan_path = s;
+        }
+        else
+        {
+            fprintf(stderr, "lidet %s: unexpected argument %s\n", cmd, s);
+            return 1;
+        }
+    }
+    if (a->scan_path == NULL)
+    {
+        usage(cmd);
+        return 1;
+    }
+    a->sensor_profile = lidet_sensor_find(a->sensor);
+    if (a->sensor_profile == NULL)
+    {
+        fprintf(stderr, "lidet %s: unknown sensor '%s' (known: hdl64, vlp16, vlp32c, os1-64, os1-128)\n", cmd,
+                a->sensor);
+        return 1;
+    }
+    return 0;
+}
+
+/* Reads a whole file whose size must be a multiple of `unit` bytes. */
+static int read_file(const char *path, size_t unit, void **data, size_t *n_units, const char *what)
+{
+    struct stat st;
+    FILE *f;
+    size_t size;
+    if (stat(path, &st) != 0)
+    {
+        fprintf(stderr, "lidet: cannot open %s '%s': %s\n", what, path, strerror(errno));
+        return 1;
+    }
+    if (!S_ISREG(st.st_mode))
+    {
+        fprintf(stderr, "lidet: %s '%s' is not a regular file\n", what, path);
+        return 1;
+    }
+    size = (size_t)st.st_size;
+    if (size % unit != 0)
+    {
+        fprintf(stderr,
+                "lidet: %s '%s' has %zu bytes, not a multiple of %zu: truncated or not a KITTI-format file\n",
+                what, path, size, unit);
+        return 1;
+    }
+    *data = malloc(size > 0 ? size : 1);
+    f = fopen(path, "rb");
+    if (*data == NULL || f == NULL || (size > 0 && fread(*data, 1, size, f) != size))
+    {
+        fprintf(stderr, "lidet: cannot read %s '%s'\n", what, path);
+        if (f != NULL)
+            fclose(f);
+        free(*data);
+        *data = NULL;
+        return 1;
+    }
+    fclose(f);
+    *n_units = size / unit;
+    return 0;
+}
+
+int cli_load(cli_args_t *a)
+{
+    void *buf = NULL;
+    size_t n = 0;
+    if (read_file(a->scan_path, 16, &buf, &n, "scan") != 0)
+    {
+        return 1;
+    }
+    if (n > 0xFFFFFFFFu)
+    {
+        fprintf(stderr, "lidet: scan '%s' has too many points\n", a->scan_path);
+        free(buf);
+        return 1;
+    }
+    a->points = (float *)buf;
+    a->n_points = (uint32_t)n;
+    if (a->ring_path != NULL)
+    {
+        size_t nr = 0;
+        if (read_file(a->ring_path, 2, &buf, &nr, "ring file") != 0)
+        {
+            return 1;
+        }
+        if (nr != n)
+        {
+            fprintf(stderr, "lidet: ring file '%s' has %zu entries for %zu points\n", a->ring_path, nr, n);
+            free(buf);
+            return 1;
+        }
+        a->ring = (uint16_t *)buf;
+    }
+    return 0;
+}
+
+void cli_free(cli_args_t *a)
+{
+    free(a->points);
+    free(a->ring);
+    a->points = NULL;
+    a->ring = NULL;
+}
+
+double cli_now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+double cli_median(double *v, int n)
+{
+    if (n <= 0)
+        return 0.0;
+    qsort(v, (size_t)n, sizeof v[0], cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static int json_first;
+
+void cli_json_begin(FILE *f)
+{
+    fputc('{', f);
+    json_first = 1;
+}
+
+static void json_key(FILE *f, const char *key)
+{
+    fprintf(f, "%s\"%s\": ", json_first ? "" : ", ", key);
+    json_first = 0;
+}
+
+void cli_json_num(FILE *f, const char *key, double v)
+{
+    json_key(f, key);
+    fprintf(f, "%.6g", v);
+}
+
+void cli_json_int(FILE *f, const char *key, long long v)
+{
+    json_key(f, key);
+    fprintf(f, "%lld", v);
+}
+
+void cli_json_str(FILE *f, const char *key, const char *v)
+{
+    json_key(f, key);
+    fprintf(f, "\"%s\"", v);
+}
+
+void cli_json_end(FILE *f)
+{
+    fputs("}\n", f);
+}

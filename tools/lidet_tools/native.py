@@ -1,0 +1,175 @@
+# SPDX-License-Identifier: MIT
+"""Python bindings over the C library (ctypes + numpy), so tools and training see exactly what the
+firmware computes.
+
+The shared library `liblidet_py.so` is built by CMake (ports/python). It is found, in order, at
+`$LIDET_LIB`, under `$LIDET_BUILD_DIR/ports/python/`, or under `<repo>/build/ports/python/`
+(`make build` puts it there).
+
+Every function takes numpy arrays and returns numpy arrays; nothing is retained by the C side
+between calls except the stage's own workspace (so these calls are not thread-safe).
+"""
+from __future__ import annotations
+
+import ctypes as C
+import os
+import pathlib
+from dataclasses import dataclass
+
+import numpy as np
+
+from .sensors import Sensor, get_sensor
+
+_ROOT = pathlib.Path(__file__).resolve().parents[2]
+_lib = None
+
+STATUS = {0: "LIDET_OK", 1: "LIDET_TRUNCATED", -1: "LIDET_ERR_ARG", -2: "LIDET_ERR_CONFIG",
+          -3: "LIDET_ERR_BUFFER", -4: "LIDET_ERR_MODEL", -5: "LIDET_ERR_STATE", -6: "LIDET_ERR_NOT_FOUND"}
+
+
+class LidetError(RuntimeError):
+    """A negative lidet status."""
+
+    def __init__(self, status: int, what: str):
+        self.status = status
+        super().__init__(f"{what}: {lib().lidet_py_status_str(status).decode()}")
+
+
+def _find_library() -> pathlib.Path:
+    cands = []
+    if os.environ.get("LIDET_LIB"):
+        cands.append(pathlib.Path(os.environ["LIDET_LIB"]))
+    if os.environ.get("LIDET_BUILD_DIR"):
+        cands.append(pathlib.Path(os.environ["LIDET_BUILD_DIR"]) / "ports" / "python" / "liblidet_py.so")
+    cands.append(_ROOT / "build" / "ports" / "python" / "liblidet_py.so")
+    for c in cands:
+        if c.exists():
+            return c
+    raise FileNotFoundError("liblidet_py.so not found (tried: " + ", ".join(map(str, cands)) +
+                            "); build it with `make build` or set LIDET_LIB")
+
+
+_f32p = np.ctypeslib.ndpointer(np.float32, flags="C_CONTIGUOUS")
+_i32p = np.ctypeslib.ndpointer(np.int32, flags="C_CONTIGUOUS")
+_u32p = np.ctypeslib.ndpointer(np.uint32, flags="C_CONTIGUOUS")
+
+
+def _opt(ptype):
+    """ndpointer that also accepts None (NULL)."""
+    class _Opt(ptype):  # type: ignore[misc, valid-type]
+        @classmethod
+        def from_param(cls, obj):
+            return None if obj is None else ptype.from_param(obj)
+    return _Opt
+
+
+def lib():
+    """The loaded shared library (loaded once)."""
+    global _lib
+    if _lib is None:
+        L = C.CDLL(str(_find_library()))
+        L.lidet_py_status_str.restype = C.c_char_p
+        L.lidet_py_status_str.argtypes = [C.c_int]
+        L.lidet_py_capacity.argtypes = [_u32p]
+        L.lidet_py_sensor.argtypes = [C.c_uint32, C.c_char_p, _u32p, _f32p, C.POINTER(C.c_float)]
+        L.lidet_py_proj_init.argtypes = [C.c_uint32, C.c_uint32, _opt(_f32p), C.c_float, C.c_float,
+                                         C.c_float, C.c_float, C.c_float, C.c_float]
+        L.lidet_py_proj_run.argtypes = [_opt(_f32p), C.c_uint32, C.c_uint32,
+                                        _opt(np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")),
+                                        _opt(_f32p), _opt(_i32p), _opt(_i32p), _opt(_u32p), _opt(_f32p)]
+        _lib = L
+    return _lib
+
+
+def capacity() -> dict:
+    """Compile-time capacities of the built library (lidet_opt.h)."""
+    out = np.zeros(6, np.uint32)
+    lib().lidet_py_capacity(out)
+    keys = ["max_rows", "max_cols", "max_points", "max_clusters", "proposal_points", "max_detections"]
+    return dict(zip(keys, map(int, out)))
+
+
+def c_sensors() -> dict:
+    """The C library's presets: name -> (rows, cols, elevations in ring order (rad), mount height)."""
+    res = {}
+    i = 0
+    while True:
+        name = C.create_string_buffer(64)
+        rc = np.zeros(2, np.uint32)
+        elev = np.zeros(256, np.float32)
+        mh = C.c_float()
+        if lib().lidet_py_sensor(i, name, rc, elev, C.byref(mh)) != 0:
+            return res
+        res[name.value.decode()] = (int(rc[0]), int(rc[1]), elev[: rc[0]].copy(), float(mh.value))
+        i += 1
+
+
+@dataclass
+class RangeImage:
+    """Output of `project`. Images are (rows, cols); row 0 = top beam."""
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    range: np.ndarray
+    rxy: np.ndarray
+    point_idx: np.ndarray    #: (rows, cols) int32 index of the winning input point, -1 = empty
+    point_pixel: np.ndarray  #: (n,) int32 flat pixel of each input point, -1 = not projected
+    row_elev: np.ndarray     #: (rows,) beam elevation per row, radians
+    stats: dict
+    status: int
+
+    @property
+    def valid(self) -> np.ndarray:
+        return self.point_idx >= 0
+
+    @property
+    def shape(self):
+        return self.point_idx.shape
+
+
+_STAT_KEYS = ["n_points_in", "n_projected", "n_pixels_filled", "n_nonfinite", "n_too_close",
+              "n_too_far", "n_out_of_fov", "n_bad_ring", "n_truncated"]
+
+
+def _as_points(points) -> tuple[np.ndarray, int]:
+    pts = np.ascontiguousarray(points, dtype=np.float32)
+    if pts.ndim != 2 or pts.shape[1] < 3:
+        raise ValueError(f"points must be (N, >=3) float32, got shape {pts.shape}")
+    return pts, pts.shape[1]
+
+
+def proj_init(sensor: str | Sensor = "hdl64", min_range_m: float = 0.1, max_range_m: float = 0.0,
+              fov_margin_rad: float = np.radians(5.0)) -> Sensor:
+    """Initialise the C projection for a preset name or a `Sensor` (custom table)."""
+    s = get_sensor(sensor) if isinstance(sensor, str) else sensor
+    elev = np.ascontiguousarray(s.beam_elev_rad, dtype=np.float32)
+    st = lib().lidet_py_proj_init(s.rows, s.cols, elev, 0.0, 0.0, s.mount_height_m, min_range_m,
+                                  max_range_m, fov_margin_rad)
+    if st < 0:
+        raise LidetError(st, "lidet_proj_init")
+    return s
+
+
+def project(points, sensor: str | Sensor = "hdl64", ring=None, **cfg) -> RangeImage:
+    """Project (N, >=3) points (x, y, z first) with the C library. `ring`: optional (N,) uint16."""
+    s = proj_init(sensor, **cfg)
+    pts, stride = _as_points(points)
+    n = len(pts)
+    cap = capacity()["max_points"]
+    rows, cols = s.rows, s.cols
+    img = np.zeros((5, rows, cols), np.float32)
+    idx = np.zeros((rows, cols), np.int32)
+    pp = np.full(n, -1, np.int32)
+    stats = np.zeros(9, np.uint32)
+    row_elev = np.zeros(rows, np.float32)
+    rg = None
+    if ring is not None:
+        rg = np.ascontiguousarray(ring, dtype=np.uint16)
+        if rg.shape != (n,):
+            raise ValueError(f"ring must have one entry per point ({n}), got {rg.shape}")
+    st = lib().lidet_py_proj_run(pts if n else None, n, stride, rg, img, idx, pp[: min(n, cap)] if n else None,
+                                 stats, row_elev)
+    if st < 0:
+        raise LidetError(st, "lidet_proj_run")
+    return RangeImage(img[0], img[1], img[2], img[3], img[4], idx, pp, row_elev,
+                      dict(zip(_STAT_KEYS, map(int, stats))), int(st))
