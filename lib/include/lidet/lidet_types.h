@@ -74,6 +74,17 @@ typedef struct
     float yaw_rad;          /**< heading about +z from +x, in (-pi, pi] */
 } lidet_box_t;
 
+/**
+ * @brief A plane n . p + d = 0 in the sensor frame: (nx, ny, nz) unit normal pointing up (nz > 0),
+ * so n . p + d is the signed height of p above the plane (metres). The ground stage produces one per
+ * azimuth sector; later stages (cluster height filter) read them.
+ */
+typedef struct
+{
+    float nx, ny, nz;
+    float d_m;
+} lidet_plane_t;
+
 /** @brief Magic value stored by every stage's init, checked by its run (LIDET_ERR_STATE). */
 #define LIDET_INIT_MAGIC 0x6C646574u /* "ldet" */
 
