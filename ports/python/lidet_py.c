@@ -13,6 +13,7 @@
 #endif
 
 static lidet_proj_t g_proj;
+static lidet_ground_t g_ground;
 
 LIDET_PY_API int lidet_py_capacity(uint32_t *out)
 {
@@ -117,6 +118,175 @@ LIDET_PY_API int lidet_py_proj_run(const float *pts, uint32_t n, uint32_t stride
     }
     if (out_row_elev != NULL)
         memcpy(out_row_elev, img.row_elev_rad, img.n_rows * sizeof(float));
+    return rc;
+}
+
+/* ---- ground stage ------------------------------------------------------------------------------
+ * The configuration crosses the boundary as two flat arrays in this order (native.py: GROUND_F, GROUND_U):
+ *   cfg_f[11]: fy_max fx_max_m gate_above_m gate_below_m mount_height_m inlier_m max_tilt_rad
+ *              max_height_dev_m ground_m ground_m_per_m below_factor
+ *   cfg_u[11]: fx_on_z require_descending height_gate n_sectors ransac_iters eval_samples min_samples
+ *              min_inliers refine_iters fallback_sectors seed */
+static void ground_cfg_to_arrays(const lidet_ground_cfg_t *c, float *f, uint32_t *u)
+{
+    f[0] = c->fy_max;
+    f[1] = c->fx_max_m;
+    f[2] = c->gate_above_m;
+    f[3] = c->gate_below_m;
+    f[4] = c->mount_height_m;
+    f[5] = c->inlier_m;
+    f[6] = c->max_tilt_rad;
+    f[7] = c->max_height_dev_m;
+    f[8] = c->ground_m;
+    f[9] = c->ground_m_per_m;
+    f[10] = c->below_factor;
+    u[0] = c->fx_on_z;
+    u[1] = c->require_descending;
+    u[2] = c->height_gate;
+    u[3] = c->n_sectors;
+    u[4] = c->ransac_iters;
+    u[5] = c->eval_samples;
+    u[6] = c->min_samples;
+    u[7] = c->min_inliers;
+    u[8] = c->refine_iters;
+    u[9] = c->fallback_sectors;
+    u[10] = c->seed;
+}
+
+static int ground_cfg_from_arrays(lidet_ground_cfg_t *c, const float *f, const uint32_t *u)
+{
+    int i;
+    for (i = 0; i < 10; ++i)
+    {
+        if (u[i] > 0xFFFFu)
+            return LIDET_ERR_CONFIG;
+    }
+    c->fy_max = f[0];
+    c->fx_max_m = f[1];
+    c->gate_above_m = f[2];
+    c->gate_below_m = f[3];
+    c->mount_height_m = f[4];
+    c->inlier_m = f[5];
+    c->max_tilt_rad = f[6];
+    c->max_height_dev_m = f[7];
+    c->ground_m = f[8];
+    c->ground_m_per_m = f[9];
+    c->below_factor = f[10];
+    if (u[0] > 255u || u[1] > 255u || u[2] > 255u || u[8] > 255u)
+        return LIDET_ERR_CONFIG;
+    c->fx_on_z = (uint8_t)u[0];
+    c->require_descending = (uint8_t)u[1];
+    c->height_gate = (uint8_t)u[2];
+    c->n_sectors = (uint16_t)u[3];
+    c->ransac_iters = (uint16_t)u[4];
+    c->eval_samples = (uint16_t)u[5];
+    c->min_samples = (uint16_t)u[6];
+    c->min_inliers = (uint16_t)u[7];
+    c->refine_iters = (uint8_t)u[8];
+    c->fallback_sectors = (uint16_t)u[9];
+    c->seed = u[10];
+    return LIDET_OK;
+}
+
+/* Defaults of lidet_ground_cfg_default for a sensor with `rows` beams mounted at mount_height_m. */
+LIDET_PY_API int lidet_py_ground_default(uint32_t rows, uint32_t cols, float mount_height_m, float *cfg_f,
+                                         uint32_t *cfg_u)
+{
+    lidet_ground_cfg_t c;
+    lidet_sensor_t s;
+    memset(&s, 0, sizeof s);
+    s.name = "python";
+    s.n_rows = (uint16_t)(rows > 0xFFFFu ? 0xFFFFu : rows);
+    s.n_cols = (uint16_t)(cols > 0xFFFFu ? 0xFFFFu : cols);
+    s.mount_height_m = mount_height_m;
+    lidet_ground_cfg_default(&c, &s);
+    ground_cfg_to_arrays(&c, cfg_f, cfg_u);
+    return 0;
+}
+
+/* Initialise the ground stage and run it on the image of the last lidet_py_proj_run. Outputs (any may
+ * be NULL): mask_pixel / sample_pixel rows*cols bytes, mask_point n_points bytes (n_points = the
+ * projection's point count), planes 4*n_sectors floats (nx ny nz d), source n_sectors bytes,
+ * stats 10 uint32 (n_valid n_samples n_samples_dropped n_ground fitted neighbour mount sparse
+ * rejected hypotheses). */
+LIDET_PY_API int lidet_py_ground_run(const float *cfg_f, const uint32_t *cfg_u, uint8_t *mask_pixel,
+                                     uint8_t *sample_pixel, uint8_t *mask_point, float *planes, uint8_t *source,
+                                     uint32_t *stats)
+{
+    lidet_ground_cfg_t c;
+    lidet_range_image_t img;
+    const lidet_ground_stats_t *st;
+    const int32_t *pp;
+    uint32_t npix, np, ns, s;
+    int rc;
+    lidet_ground_cfg_default(&c, NULL);
+    rc = ground_cfg_from_arrays(&c, cfg_f, cfg_u);
+    if (rc < 0)
+        return rc;
+    rc = lidet_ground_init(&g_ground, &c);
+    if (rc < 0)
+        return rc;
+    lidet_proj_image(&g_proj, &img);
+    rc = lidet_ground_run(&g_ground, &img);
+    if (rc < 0)
+        return rc;
+    npix = (uint32_t)img.n_rows * img.n_cols;
+    if (mask_pixel != NULL)
+        memcpy(mask_pixel, lidet_ground_mask(&g_ground), npix);
+    if (sample_pixel != NULL)
+        memcpy(sample_pixel, lidet_ground_samples(&g_ground), npix);
+    pp = lidet_proj_point_pixels(&g_proj, &np);
+    if (mask_point != NULL)
+    {
+        const int r2 = lidet_ground_point_labels(&g_ground, pp, np, mask_point);
+        if (r2 < 0)
+            return r2;
+    }
+    {
+        const lidet_plane_t *pl = lidet_ground_planes(&g_ground, &ns);
+        const uint8_t *src = lidet_ground_sector_source(&g_ground);
+        for (s = 0; s < ns; ++s)
+        {
+            if (planes != NULL)
+            {
+                planes[4 * s + 0] = pl[s].nx;
+                planes[4 * s + 1] = pl[s].ny;
+                planes[4 * s + 2] = pl[s].nz;
+                planes[4 * s + 3] = pl[s].d_m;
+            }
+            if (source != NULL)
+                source[s] = src[s];
+        }
+    }
+    st = lidet_ground_stats(&g_ground);
+    if (stats != NULL)
+    {
+        stats[0] = st->n_valid;
+        stats[1] = st->n_samples;
+        stats[2] = st->n_samples_dropped;
+        stats[3] = st->n_ground;
+        stats[4] = st->n_sectors_fitted;
+        stats[5] = st->n_sectors_neighbour;
+        stats[6] = st->n_sectors_mount;
+        stats[7] = st->n_sectors_sparse;
+        stats[8] = st->n_sectors_rejected;
+        stats[9] = st->n_hypotheses;
+    }
+    return rc;
+}
+
+/* Least-squares plane (lidet_ground_fit_plane): plane 4 floats, eig 3 floats (may be NULL). */
+LIDET_PY_API int lidet_py_ground_fit_plane(const float *x, const float *y, const float *z, uint32_t n, float *plane,
+                                           float *eig)
+{
+    lidet_plane_t p;
+    const int rc = lidet_ground_fit_plane(x, y, z, n, &p, eig);
+    if (rc < 0)
+        return rc;
+    plane[0] = p.nx;
+    plane[1] = p.ny;
+    plane[2] = p.nz;
+    plane[3] = p.d_m;
     return rc;
 }
 

@@ -77,6 +77,11 @@ def lib():
         L.lidet_py_proj_run.argtypes = [_opt(_f32p), C.c_uint32, C.c_uint32,
                                         _opt(np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")),
                                         _opt(_f32p), _opt(_i32p), _opt(_i32p), _opt(_u32p), _opt(_f32p)]
+        _u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
+        L.lidet_py_ground_default.argtypes = [C.c_uint32, C.c_uint32, C.c_float, _f32p, _u32p]
+        L.lidet_py_ground_run.argtypes = [_f32p, _u32p, _opt(_u8p), _opt(_u8p), _opt(_u8p), _opt(_f32p),
+                                          _opt(_u8p), _opt(_u32p)]
+        L.lidet_py_ground_fit_plane.argtypes = [_f32p, _f32p, _f32p, C.c_uint32, _f32p, _opt(_f32p)]
         _lib = L
     return _lib
 
@@ -173,3 +178,84 @@ def project(points, sensor: str | Sensor = "hdl64", ring=None, **cfg) -> RangeIm
         raise LidetError(st, "lidet_proj_run")
     return RangeImage(img[0], img[1], img[2], img[3], img[4], idx, pp, row_elev,
                       dict(zip(_STAT_KEYS, map(int, stats))), int(st))
+
+
+# --------------------------------------------------------------------------------------------
+# Ground stage (lidet_ground.h)
+
+#: float and integer fields of lidet_ground_cfg_t, in the order of ports/python/lidet_py.c
+GROUND_F = ["fy_max", "fx_max_m", "gate_above_m", "gate_below_m", "mount_height_m", "inlier_m",
+            "max_tilt_rad", "max_height_dev_m", "ground_m", "ground_m_per_m", "below_factor"]
+GROUND_U = ["fx_on_z", "require_descending", "height_gate", "n_sectors", "ransac_iters", "eval_samples",
+            "min_samples", "min_inliers", "refine_iters", "fallback_sectors", "seed"]
+_GROUND_STATS = ["n_valid", "n_samples", "n_samples_dropped", "n_ground", "n_sectors_fitted",
+                 "n_sectors_neighbour", "n_sectors_mount", "n_sectors_sparse", "n_sectors_rejected",
+                 "n_hypotheses"]
+PLANE_SOURCE = {0: "fitted", 1: "neighbour", 2: "mount"}
+
+
+def ground_defaults(sensor: str | Sensor = "hdl64") -> dict:
+    """lidet_ground_cfg_default for a preset name or a `Sensor` (as a dict of field -> value)."""
+    s = get_sensor(sensor) if isinstance(sensor, str) else sensor
+    f = np.zeros(len(GROUND_F), np.float32)
+    u = np.zeros(len(GROUND_U), np.uint32)
+    lib().lidet_py_ground_default(s.rows, s.cols, s.mount_height_m, f, u)
+    out = {k: float(v) for k, v in zip(GROUND_F, f)}
+    out.update({k: int(v) for k, v in zip(GROUND_U, u)})
+    return out
+
+
+@dataclass
+class GroundResult:
+    """Output of `ground`."""
+    mask_point: np.ndarray   #: (n,) uint8 per input point, input order: 1 ground, 0 not (or not projected)
+    mask_pixel: np.ndarray   #: (rows, cols) uint8 per pixel
+    planes: np.ndarray       #: (n_sectors, 4) float32 rows (nx, ny, nz, d): n.p + d = height above plane
+    stats: dict
+    sample_pixel: np.ndarray  #: (rows, cols) uint8: pixels that passed the sample filter
+    source: np.ndarray        #: (n_sectors,) uint8: 0 fitted, 1 neighbour, 2 mount plane
+    image: RangeImage
+    status: int
+
+    def __iter__(self):
+        """Unpacks as (mask_point, mask_pixel, planes, stats)."""
+        return iter((self.mask_point, self.mask_pixel, self.planes, self.stats))
+
+
+def ground(points, sensor: str | Sensor = "hdl64", ring=None, proj_cfg: dict | None = None, **cfg) -> GroundResult:
+    """Project (N, >=3) points with the C projection, then segment the ground with the C ground stage.
+    `cfg` overrides fields of lidet_ground_cfg_default(sensor) (names as in lidet_ground_cfg_t)."""
+    s = get_sensor(sensor) if isinstance(sensor, str) else sensor
+    full = ground_defaults(s)
+    unknown = set(cfg) - set(full)
+    if unknown:
+        raise TypeError(f"unknown ground config field(s): {sorted(unknown)}")
+    full.update(cfg)
+    img = project(points, s, ring=ring, **(proj_cfg or {}))
+    f = np.array([full[k] for k in GROUND_F], np.float32)
+    u = np.array([full[k] for k in GROUND_U], np.uint32)
+    n = len(img.point_pixel)
+    rows, cols = img.shape
+    ns = int(full["n_sectors"])
+    mp = np.zeros((rows, cols), np.uint8)
+    sp = np.zeros((rows, cols), np.uint8)
+    mpt = np.zeros(n, np.uint8)
+    planes = np.zeros((max(ns, 1), 4), np.float32)
+    src = np.zeros(max(ns, 1), np.uint8)
+    stats = np.zeros(len(_GROUND_STATS), np.uint32)
+    cap = capacity()["max_points"]
+    st = lib().lidet_py_ground_run(f, u, mp, sp, mpt[: min(n, cap)] if n else None, planes, src, stats)
+    if st < 0:
+        raise LidetError(st, "lidet_ground_run")
+    return GroundResult(mpt, mp, planes[:ns], dict(zip(_GROUND_STATS, map(int, stats))), sp, src[:ns], img, int(st))
+
+
+def ground_fit_plane(xyz) -> tuple[np.ndarray, np.ndarray]:
+    """lidet_ground_fit_plane on (N, 3) points: ((nx, ny, nz, d), eigenvalues ascending)."""
+    p = np.ascontiguousarray(np.asarray(xyz, np.float32)[:, :3].T)
+    plane = np.zeros(4, np.float32)
+    eig = np.zeros(3, np.float32)
+    st = lib().lidet_py_ground_fit_plane(p[0].copy(), p[1].copy(), p[2].copy(), p.shape[1], plane, eig)
+    if st < 0:
+        raise LidetError(st, "lidet_ground_fit_plane")
+    return plane, eig

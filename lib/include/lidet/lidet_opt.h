@@ -57,6 +57,17 @@
 #define LIDET_PROJ_ROW_LUT 1024
 #endif
 
+/** Maximum azimuth sectors of the ground stage (one plane each). */
+#ifndef LIDET_GROUND_MAX_SECTORS
+#define LIDET_GROUND_MAX_SECTORS 256
+#endif
+
+/** Maximum ground samples (pixels passing the ground filter) kept per scan; the excess is dropped
+ *  (status LIDET_TRUNCATED). The default never truncates (one per pixel); a small board may halve it. */
+#ifndef LIDET_GROUND_MAX_SAMPLES
+#define LIDET_GROUND_MAX_SAMPLES (LIDET_MAX_ROWS * LIDET_MAX_COLS)
+#endif
+
 /** 1: asserts (LIDET_ASSERT) are compiled in; the port may override LIDET_ASSERT itself. */
 #ifndef LIDET_DEBUG
 #define LIDET_DEBUG 0
@@ -91,6 +102,12 @@
 #endif
 #if LIDET_PROJ_ROW_LUT < 16 || LIDET_PROJ_ROW_LUT > 65536
 #error "LIDET_PROJ_ROW_LUT must be in [16, 65536]"
+#endif
+#if LIDET_GROUND_MAX_SECTORS < 1 || LIDET_GROUND_MAX_SECTORS > 4096
+#error "LIDET_GROUND_MAX_SECTORS must be in [1, 4096]"
+#endif
+#if LIDET_GROUND_MAX_SAMPLES < 3 || LIDET_GROUND_MAX_SAMPLES > (LIDET_MAX_ROWS * LIDET_MAX_COLS)
+#error "LIDET_GROUND_MAX_SAMPLES must be in [3, LIDET_MAX_ROWS * LIDET_MAX_COLS]"
 #endif
 #if ((-1) >> 1) != -1
 #error "lidet needs arithmetic right shifts of negative integers (the fixed-point build relies on them)"

@@ -1,0 +1,229 @@
+/* SPDX-License-Identifier: MIT */
+/**
+ * @file lidet_ground.h
+ * @brief Ground segmentation on the range image: Sobel-inspired sample filter + one RANSAC plane
+ *        per azimuth sector (Seppänen et al., "No GPU? No problem", section on ground removal).
+ *
+ * Algorithm (lib/src/lidet_ground_filter.c, lib/src/lidet_ground_ransac.c; numpy mirror in
+ * codegen/lidet_codegen/ref/ground.py):
+ *  1. Sample filter over the projection's R (horizontal range) and Z images. For pixel (r, c), with
+ *     row r+1 the beam below and columns wrapping around:
+ *       S_v = [[2, 1], [-2, -1]] on rows r, r+1 and cols c, c+1:  dZ = S_v*Z, dR = S_v*R;
+ *       F_y = dZ / dR, tested without division as |dZ| <= fy_max * |dR| (and dR > 0 when
+ *       require_descending: the lower beam must land closer, as it does on ground);
+ *       S_u = [1, 2, -2, -1] on cols c-1..c+2 of row r: F_x = S_u*R (paper) or S_u*Z (the authors'
+ *       released code, fx_on_z = 1), tested as |F_x| <= fx_max_m.
+ *     Optional height gate (released code): the pixel's z must lie in
+ *     [-mount_height_m - gate_below_m, -mount_height_m + gate_above_m].
+ *     Every pixel the kernels touch must hold a point; the bottom row has no sample.
+ *  2. Per azimuth sector (sector of column c = c * n_sectors / n_cols), RANSAC over the samples:
+ *     a seeded xorshift32 (state) draws 3 samples, hypotheses tilted more than max_tilt_rad are
+ *     rejected before scoring, the rest are scored on at most eval_samples evenly strided
+ *     samples (inliers: |distance| <= inlier_m). The best plane is optionally refined by least
+ *     squares on all its inlier samples (3x3 covariance, smallest eigenvector by Jacobi
+ *     rotations), refine_iters times. A plane is accepted when it has >= min_inliers inliers,
+ *     a tilt <= max_tilt_rad and a height of the sensor above it within max_height_dev_m of
+ *     mount_height_m.
+ *  3. Fallback for sectors with fewer than min_samples samples or no accepted plane: the plane of
+ *     the nearest fitted sector at most fallback_sectors away (ties: sector s-k before s+k), else the
+ *     mount plane z = -mount_height_m (normal +z).
+ *  4. Ground pixel: holds a point and its signed height h above its sector's plane satisfies
+ *     -below_m(R) < h < above_m(R), with above_m(R) = ground_m + ground_m_per_m * R and
+ *     below_m(R) = below_factor * above_m(R) (R = horizontal range). With below_factor 1 and
+ *     ground_m_per_m 0 this is the paper's |distance| < p_th.
+ *
+ * Memory: sizeof(lidet_ground_t) = LIDET_MAX_ROWS * LIDET_MAX_COLS * 2 B (ground and sample masks)
+ * + LIDET_GROUND_MAX_SAMPLES * 12 B (x, y, z of the samples) + LIDET_GROUND_MAX_SECTORS * 24 B
+ * + ~200 B; defaults (128 x 2048, 262,144 samples): about 3.5 MiB; a VLP-16 build (16 x 1800,
+ * samples = pixels): about 0.4 MiB. lidet_ground_bytes() returns the exact figure. Declare it static.
+ * Time: O(n_rows * n_cols) for the filter and the labelling, O(n_sectors * ransac_iters *
+ * eval_samples + refine_iters * n_samples) for the planes; no allocation, no recursion.
+ */
+#ifndef LIDET_GROUND_H
+#define LIDET_GROUND_H
+
+#include "lidet_proj.h"
+#include "lidet_sensor.h"
+#include "lidet_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** @brief Where a sector's plane came from (lidet_ground_sector_source). */
+typedef enum
+{
+    LIDET_GROUND_PLANE_FITTED = 0,   /**< RANSAC (+ refinement) on the sector's own samples */
+    LIDET_GROUND_PLANE_NEIGHBOUR = 1, /**< copied from the nearest fitted sector */
+    LIDET_GROUND_PLANE_MOUNT = 2      /**< the mount plane z = -mount_height_m */
+} lidet_ground_plane_source_t;
+
+/**
+ * @brief Runtime configuration of the ground stage. Fill with lidet_ground_cfg_default(), which
+ *        picks per-profile values (see docs/GROUND.md for how each default was measured).
+ */
+typedef struct
+{
+    /* ---- sample filter ---- */
+    float fy_max;             /**< f_th1: max |F_y| = |S_v*Z / S_v*R|, the slope dz/dR between two
+                                   beams (dimensionless); [0, 10], typical 0.1-0.3 (0.2 ~ 11 deg) */
+    float fx_max_m;           /**< f_th2: max |F_x| = |S_u*R| (or |S_u*Z|), metres; (0, 100],
+                                   typical 0.3-2 m */
+    uint8_t fx_on_z;          /**< 0: F_x = S_u*R (paper), 1: F_x = S_u*Z (authors' released code) */
+    uint8_t require_descending; /**< 1: also require dR > 0 (the lower beam lands closer, true on
+                                   any ground the sensor looks down on); 0: the paper's |F_y| only */
+    uint8_t height_gate;      /**< 1: samples must also pass the height gate (released code) */
+    float gate_above_m;       /**< gate: max height above the nominal ground z = -mount_height_m,
+                                   metres; [-5, 10], typical 0.3-0.5 (released KITTI: 0.43) */
+    float gate_below_m;       /**< gate: max depth below the nominal ground, metres; [0, 20],
+                                   typical 1-8 (released KITTI: 8.27, i.e. z > -10 m) */
+    float mount_height_m;     /**< sensor optical centre above the ground, metres; [0, 10]; from the
+                                   sensor profile. Used by the gate, the height check and the
+                                   mount-plane fallback */
+    /* ---- RANSAC per sector ---- */
+    uint16_t n_sectors;       /**< azimuth sectors over 360 deg; [1, min(n_cols, LIDET_GROUND_MAX_SECTORS)],
+                                   default 32 (11.25 deg) */
+    uint16_t ransac_iters;    /**< hypotheses per sector; [1, 1000], typical 8-30 */
+    uint16_t eval_samples;    /**< samples a hypothesis is scored on (evenly strided subset);
+                                   [3, 65535], typical 64-512 */
+    uint16_t min_samples;     /**< fewer samples in a sector: fallback; [3, 65535], typical 10-30 */
+    uint16_t min_inliers;     /**< fewer inliers (among the scored subset): fallback; [3, 65535] */
+    uint8_t refine_iters;     /**< least-squares refinements on the inliers; [0, 10], 0 = plain RANSAC */
+    float inlier_m;           /**< RANSAC inlier distance, metres; (0, 5], typical 0.1-0.3 */
+    float max_tilt_rad;       /**< max angle between a plane normal and +z, radians; (0, pi/2),
+                                   typical 0.1-0.35 (the released code used 0.1) */
+    float max_height_dev_m;   /**< accepted |sensor height above the plane - mount_height_m|,
+                                   metres; (0, 20], typical 0.5-1.5 */
+    uint16_t fallback_sectors;/**< how far (in sectors, either side) a fitted neighbour may be;
+                                   [0, n_sectors] */
+    uint32_t seed;            /**< xorshift32 seed (0 is replaced by a fixed non-zero value);
+                                   re-applied at every run, so runs are deterministic */
+    /* ---- labelling ---- */
+    float ground_m;           /**< p_th: max height above the sector plane for ground, metres;
+                                   (0, 5], typical 0.1-0.3 */
+    float ground_m_per_m;     /**< p_th grows by this much per metre of horizontal range (far
+                                   ground is noisier and the plane is extrapolated); [0, 0.1],
+                                   typical 0-0.01; 0 = the paper's constant p_th */
+    float below_factor;       /**< the tolerance below the plane is below_factor * the one above;
+                                   [0, 20], 1 = symmetric (paper) */
+} lidet_ground_cfg_t;
+
+/** @brief Counts of the last run. */
+typedef struct
+{
+    uint32_t n_valid;            /**< pixels holding a point */
+    uint32_t n_samples;          /**< pixels that passed the sample filter */
+    uint32_t n_samples_dropped;  /**< samples past LIDET_GROUND_MAX_SAMPLES (not used; status TRUNCATED) */
+    uint32_t n_ground;           /**< pixels labelled ground */
+    uint16_t n_sectors_fitted;   /**< sectors with their own plane */
+    uint16_t n_sectors_neighbour;/**< sectors that took a neighbour's plane */
+    uint16_t n_sectors_mount;    /**< sectors that took the mount plane */
+    uint16_t n_sectors_sparse;   /**< sectors with fewer than min_samples samples */
+    uint16_t n_sectors_rejected; /**< sectors whose best plane failed the inlier/tilt/height checks */
+    uint32_t n_hypotheses;       /**< RANSAC hypotheses scored (after degenerate/tilt rejection) */
+} lidet_ground_stats_t;
+
+/** @brief Ground stage state and workspace. Caller-owned; declare it static (it is large). */
+typedef struct
+{
+    uint32_t magic;
+    lidet_ground_cfg_t cfg;
+    uint32_t rng;                                        /* xorshift32 state */
+    uint16_t n_rows, n_cols;                             /* of the last image */
+    uint8_t mask[LIDET_MAX_ROWS * LIDET_MAX_COLS];       /* 1 ground, 0 not / empty */
+    uint8_t sample[LIDET_MAX_ROWS * LIDET_MAX_COLS];     /* 1 sample of the filter */
+    float sx_m[LIDET_GROUND_MAX_SAMPLES];                /* samples, grouped by sector */
+    float sy_m[LIDET_GROUND_MAX_SAMPLES];
+    float sz_m[LIDET_GROUND_MAX_SAMPLES];
+    uint32_t sector_first[LIDET_GROUND_MAX_SECTORS + 1]; /* samples of sector s: [first[s], first[s+1]) */
+    lidet_plane_t planes[LIDET_GROUND_MAX_SECTORS];
+    uint8_t source[LIDET_GROUND_MAX_SECTORS];            /* lidet_ground_plane_source_t */
+    lidet_ground_stats_t stats;
+} lidet_ground_t;
+
+/**
+ * @brief Defaults for a sensor profile (per-profile values measured on simulated and real scans).
+ * @param[out] cfg    filled; never NULL-dereferenced (NULL: no-op).
+ * @param[in]  sensor profile (its mount height and beam count choose the defaults); NULL gives the
+ *                    hdl64-like defaults with mount_height_m 1.73.
+ */
+void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sensor);
+
+/**
+ * @brief Validate the configuration and reset the state. No allocation.
+ * @param[out] g   state (caller-owned, static storage recommended).
+ * @param[in]  cfg configuration (copied).
+ * @return LIDET_OK; LIDET_ERR_ARG (NULL); LIDET_ERR_BUFFER (n_sectors > LIDET_GROUND_MAX_SECTORS);
+ *         LIDET_ERR_CONFIG (a value outside its documented range, or not finite).
+ */
+lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cfg);
+
+/**
+ * @brief Segment the ground of one range image.
+ * @param[in,out] g   initialised state; its mask, samples and planes are overwritten.
+ * @param[in]     img range image from lidet_proj_image (or built by hand with the same contract:
+ *                    row 0 = top beam, rows ordered by decreasing elevation, point_idx -1 = empty).
+ *                    Not retained.
+ * @return LIDET_OK; LIDET_TRUNCATED when more than LIDET_GROUND_MAX_SAMPLES pixels passed the filter
+ *         (the excess, last sectors first, is counted in stats.n_samples_dropped and not used);
+ *         LIDET_ERR_ARG (NULL, NULL image arrays); LIDET_ERR_STATE (not initialised);
+ *         LIDET_ERR_BUFFER (image larger than LIDET_MAX_ROWS x LIDET_MAX_COLS);
+ *         LIDET_ERR_CONFIG (image has fewer columns than n_sectors).
+ */
+lidet_status_t lidet_ground_run(lidet_ground_t *g, const lidet_range_image_t *img);
+
+/**
+ * @brief Ground mask of the last run: n_rows * n_cols bytes, row-major like the image, 1 ground,
+ *        0 not ground or empty. A view into g, valid until the next run/init.
+ */
+const uint8_t *lidet_ground_mask(const lidet_ground_t *g);
+
+/** @brief Sample mask of the last run (1 = passed the filter), same layout as the ground mask. */
+const uint8_t *lidet_ground_samples(const lidet_ground_t *g);
+
+/**
+ * @brief Planes of the last run, one per sector (sector of column c = c * n_sectors / n_cols).
+ * @param[out] n_sectors number of planes (may be NULL).
+ * @return a view into g (valid until the next run/init), normals unit length with nz > 0.
+ */
+const lidet_plane_t *lidet_ground_planes(const lidet_ground_t *g, uint32_t *n_sectors);
+
+/** @brief Source of each sector's plane (lidet_ground_plane_source_t values), n_sectors bytes. */
+const uint8_t *lidet_ground_sector_source(const lidet_ground_t *g);
+
+/**
+ * @brief Per-point labels: every input point, in input order.
+ * @param[in]  g           state after a run.
+ * @param[in]  point_pixel pixel of each input point (lidet_proj_point_pixels), -1 = not projected;
+ *                         a point that lost its pixel to a closer one takes the pixel's label.
+ * @param[in]  n_points    entries of point_pixel and out.
+ * @param[out] out         n_points bytes: 1 ground, 0 not (also for unprojected points and
+ *                         out-of-image pixel indices). May not alias point_pixel.
+ * @return LIDET_OK; LIDET_ERR_ARG (NULL with n_points > 0); LIDET_ERR_STATE (not initialised).
+ */
+lidet_status_t lidet_ground_point_labels(const lidet_ground_t *g, const int32_t *point_pixel, uint32_t n_points,
+                                         uint8_t *out);
+
+/** @brief Counts of the last run. */
+const lidet_ground_stats_t *lidet_ground_stats(const lidet_ground_t *g);
+
+/** @brief sizeof(lidet_ground_t): the bytes firmware must place for this stage. */
+uint32_t lidet_ground_bytes(void);
+
+/**
+ * @brief Least-squares plane through weighted-free points (exposed for the Eigen cross-check).
+ *        Centroid + 3x3 covariance, normal = eigenvector of the smallest eigenvalue (cyclic Jacobi).
+ * @param[in]  x_m,y_m,z_m n coordinates, metres.
+ * @param[in]  n           >= 3.
+ * @param[out] plane       normal with nz >= 0 (flipped if needed), d so n.p + d = 0 at the centroid.
+ * @param[out] eigvals     optional (may be NULL): the 3 covariance eigenvalues, ascending.
+ * @return LIDET_OK; LIDET_ERR_ARG (NULL, n < 3, or a degenerate set: all points on a line).
+ */
+lidet_status_t lidet_ground_fit_plane(const float *x_m, const float *y_m, const float *z_m, uint32_t n,
+                                      lidet_plane_t *plane, float *eigvals);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LIDET_GROUND_H */

@@ -1,0 +1,34 @@
+/* SPDX-License-Identifier: MIT */
+/* xorshift32 (Marsaglia 2003, shifts 13, 17, 5): the deterministic generator of every randomised
+ * stage (RANSAC). Mirrored bit for bit by codegen/lidet_codegen/ref/rng.py. Never installed. */
+#ifndef LIDET_RNG_H
+#define LIDET_RNG_H
+
+#include <stdint.h>
+
+/* seed 0 would stay 0 forever: it is replaced by this fixed non-zero value */
+#define LIDET_RNG_DEFAULT_SEED 0x9E3779B9u
+
+static inline uint32_t lidet__rng_seed(uint32_t seed)
+{
+    return seed != 0u ? seed : LIDET_RNG_DEFAULT_SEED;
+}
+
+/* advances *state and returns the new value (never 0 for a non-zero state) */
+static inline uint32_t lidet__rng_next(uint32_t *state)
+{
+    uint32_t x = *state;
+    x ^= x << 13;
+    x ^= x >> 17;
+    x ^= x << 5;
+    *state = x;
+    return x;
+}
+
+/* uniform-ish integer in [0, n), n >= 1: the high 32 bits of x * n (no division, bias < n / 2^32) */
+static inline uint32_t lidet__rng_below(uint32_t *state, uint32_t n)
+{
+    return (uint32_t)(((uint64_t)lidet__rng_next(state) * (uint64_t)n) >> 32);
+}
+
+#endif

@@ -1,0 +1,323 @@
+/* SPDX-License-Identifier: MIT */
+/* Ground stage: configuration, the Sobel-inspired sample filter, the per-pixel labelling and the
+ * accessors (algorithm in lidet_ground.h). The plane fits live in lidet_ground_ransac.c.
+ * Mirrored by codegen/lidet_codegen/ref/ground.py (sample_mask, label_pixels). */
+#include <string.h>
+
+#include "internal/lidet_assert.h"
+#include "internal/lidet_ground_internal.h"
+#include "internal/lidet_math.h"
+#include "internal/lidet_rng.h"
+
+/* Defaults measured on simulated scans and on the real SemanticKITTI scans (docs/GROUND.md).
+ * Two families: a tall car mount with many beams (hdl64, os1-*), and a low robot mount with few
+ * beams (vlp16 at 0.5 m), where rings are far apart and the ground is seen at grazing angles. */
+void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sensor)
+{
+    float mount = 1.73f;
+    uint32_t rows = 64u;
+    if (cfg == 0)
+    {
+        return;
+    }
+    memset(cfg, 0, sizeof *cfg);
+    if (sensor != 0)
+    {
+        mount = sensor->mount_height_m;
+        rows = sensor->n_rows;
+    }
+    cfg->fy_max = 0.2f;
+    cfg->fx_max_m = 1.0f;
+    cfg->fx_on_z = 0u;
+    cfg->require_descending = 1u;
+    cfg->height_gate = 0u;
+    cfg->gate_above_m = 0.43f;
+    cfg->gate_below_m = 8.27f;
+    cfg->mount_height_m = mount;
+    cfg->n_sectors = 32u;
+    cfg->ransac_iters = 16u;
+    cfg->eval_samples = 256u;
+    cfg->min_samples = 10u;
+    cfg->min_inliers = 8u;
+    cfg->refine_iters = 1u;
+    cfg->inlier_m = 0.15f;
+    cfg->max_tilt_rad = 0.2f;
+    cfg->max_height_dev_m = 1.0f;
+    cfg->fallback_sectors = 4u;
+    cfg->seed = 12345u;
+    cfg->ground_m = 0.2f;
+    cfg->ground_m_per_m = 0.0f;
+    cfg->below_factor = 1.0f;
+    if (rows <= 32u || mount < 1.0f)
+    {
+        cfg->max_height_dev_m = 0.5f;
+    }
+}
+
+static int in_range(float v, float lo, float hi)
+{
+    return lidet__isfinite(v) && v >= lo && v <= hi;
+}
+
+lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cfg)
+{
+    if (g == 0 || cfg == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    g->magic = 0;
+    if (cfg->n_sectors > LIDET_GROUND_MAX_SECTORS)
+    {
+        return LIDET_ERR_BUFFER;
+    }
+    if (cfg->n_sectors < 1u || cfg->ransac_iters < 1u || cfg->ransac_iters > 1000u || cfg->eval_samples < 3u ||
+        cfg->min_samples < 3u || cfg->min_inliers < 3u || cfg->refine_iters > 10u || cfg->fx_on_z > 1u ||
+        cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors ||
+        !in_range(cfg->fy_max, 0.0f, 10.0f) || !in_range(cfg->fx_max_m, 0.0f, 100.0f) || cfg->fx_max_m <= 0.0f ||
+        !in_range(cfg->gate_above_m, -5.0f, 10.0f) || !in_range(cfg->gate_below_m, 0.0f, 20.0f) ||
+        !in_range(cfg->mount_height_m, 0.0f, 10.0f) || !in_range(cfg->inlier_m, 0.0f, 5.0f) ||
+        cfg->inlier_m <= 0.0f || !in_range(cfg->max_tilt_rad, 0.0f, LIDET_HALF_PI_F) || cfg->max_tilt_rad <= 0.0f ||
+        cfg->max_tilt_rad >= LIDET_HALF_PI_F || !in_range(cfg->max_height_dev_m, 0.0f, 20.0f) ||
+        cfg->max_height_dev_m <= 0.0f || !in_range(cfg->ground_m, 0.0f, 5.0f) || cfg->ground_m <= 0.0f ||
+        !in_range(cfg->ground_m_per_m, 0.0f, 0.1f) || !in_range(cfg->below_factor, 0.0f, 20.0f))
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    g->cfg = *cfg;
+    g->rng = lidet__rng_seed(cfg->seed);
+    g->n_rows = 0;
+    g->n_cols = 0;
+    memset(&g->stats, 0, sizeof g->stats);
+    g->magic = LIDET_INIT_MAGIC;
+    return LIDET_OK;
+}
+
+/* Filter parameters in locals (so the compiler keeps them in registers across the stores). */
+typedef struct
+{
+    float fy_max, fx_max, z_lo, z_hi;
+    int descending, gate;
+} filt_t;
+
+/* Sample test of one pixel of row r, given its column c and the wrapped neighbours cm1 = c-1,
+ * cp1 = c+1, cp2 = c+2. R0/Z0: row r, R1/Z1: row r+1, F0: the channel S_u runs over (R or Z of
+ * row r). Every touched pixel must hold a point (R > 0; empty pixels are 0 by the image contract). */
+static inline uint8_t sample_test(const float *R0, const float *R1, const float *Z0, const float *Z1,
+                                  const float *F0, uint32_t cm1, uint32_t c, uint32_t cp1, uint32_t cp2,
+                                  const filt_t *f)
+{
+    const float dr = (2.0f * R0[c] + R0[cp1]) - (2.0f * R1[c] + R1[cp1]);
+    const float dz = (2.0f * Z0[c] + Z0[cp1]) - (2.0f * Z1[c] + Z1[cp1]);
+    const float fx = (F0[cm1] + 2.0f * F0[c]) - (2.0f * F0[cp1] + F0[cp2]);
+    const float adr = fabsf(dr);
+    int ok = R0[cm1] > 0.0f && R0[c] > 0.0f && R0[cp1] > 0.0f && R0[cp2] > 0.0f && R1[c] > 0.0f && R1[cp1] > 0.0f;
+    ok = ok && fabsf(dz) <= f->fy_max * adr && fabsf(fx) <= f->fx_max;
+    ok = ok && (!f->descending || dr > 0.0f);
+    ok = ok && (!f->gate || (Z0[c] >= f->z_lo && Z0[c] <= f->z_hi));
+    return (uint8_t)ok;
+}
+
+/* Pass 1 (mirrors ref/ground.py: sample_mask): the sample mask, row by row. */
+static void filter_rows(lidet_ground_t *g, const lidet_range_image_t *img)
+{
+    const uint32_t rows = img->n_rows, cols = img->n_cols;
+    filt_t f;
+    uint32_t r, c;
+    f.fy_max = g->cfg.fy_max;
+    f.fx_max = g->cfg.fx_max_m;
+    f.z_lo = -g->cfg.mount_height_m - g->cfg.gate_below_m;
+    f.z_hi = -g->cfg.mount_height_m + g->cfg.gate_above_m;
+    f.descending = g->cfg.require_descending;
+    f.gate = g->cfg.height_gate;
+    /* the bottom row has no beam below it: never a sample */
+    memset(g->sample + (size_t)(rows - 1u) * cols, 0, cols);
+    for (r = 0; r + 1u < rows; ++r)
+    {
+        const float *R0 = img->rxy_m + (size_t)r * cols;
+        const float *R1 = R0 + cols;
+        const float *Z0 = img->z_m + (size_t)r * cols;
+        const float *Z1 = Z0 + cols;
+        const float *F0 = g->cfg.fx_on_z ? Z0 : R0;
+        uint8_t *out = g->sample + (size_t)r * cols;
+        /* columns wrap around: the first and the last two columns take their neighbours modulo cols */
+        out[0] = sample_test(R0, R1, Z0, Z1, F0, cols - 1u, 0u, 1u, 2u, &f);
+        for (c = 1; c + 2u < cols; ++c)
+        {
+            out[c] = sample_test(R0, R1, Z0, Z1, F0, c - 1u, c, c + 1u, c + 2u, &f);
+        }
+        out[cols - 2u] = sample_test(R0, R1, Z0, Z1, F0, cols - 3u, cols - 2u, cols - 1u, 0u, &f);
+        out[cols - 1u] = sample_test(R0, R1, Z0, Z1, F0, cols - 2u, cols - 1u, 0u, 1u, &f);
+    }
+}
+
+/* Pass 2: gather the samples' coordinates grouped by sector (sector-major, then raster order), so
+ * each sector's RANSAC reads one contiguous block. Stops at LIDET_GROUND_MAX_SAMPLES. */
+static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
+{
+    const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors;
+    uint32_t s, r, c, n = 0, total = 0;
+    for (s = 0; s < ns; ++s)
+    {
+        const uint32_t c0 = lidet__ground_sector_col(s, ns, cols), c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+        g->sector_first[s] = n;
+        for (r = 0; r + 1u < rows; ++r)
+        {
+            const uint8_t *m = g->sample + (size_t)r * cols;
+            const size_t base = (size_t)r * cols;
+            for (c = c0; c < c1; ++c)
+            {
+                if (m[c] != 0u)
+                {
+                    ++total;
+                    if (n < LIDET_GROUND_MAX_SAMPLES)
+                    {
+                        g->sx_m[n] = img->x_m[base + c];
+                        g->sy_m[n] = img->y_m[base + c];
+                        g->sz_m[n] = img->z_m[base + c];
+                        ++n;
+                    }
+                }
+            }
+        }
+    }
+    g->sector_first[ns] = n;
+    g->stats.n_samples = total;
+    g->stats.n_samples_dropped = total - n;
+}
+
+/* Pass 3 (mirrors ref/ground.py: label_pixels): ground = valid and -below < height < above. */
+static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
+{
+    const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors;
+    const float g0 = g->cfg.ground_m, k = g->cfg.ground_m_per_m, bf = g->cfg.below_factor;
+    const float below0 = bf * g0;
+    uint32_t r, s, c, n_ground = 0, n_valid = 0;
+    for (r = 0; r < rows; ++r)
+    {
+        const size_t base = (size_t)r * cols;
+        const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base, *R = img->rxy_m + base;
+        const int32_t *V = img->point_idx + base;
+        uint8_t *out = g->mask + base;
+        for (s = 0; s < ns; ++s)
+        {
+            const uint32_t c0 = lidet__ground_sector_col(s, ns, cols), c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+            const lidet_plane_t p = g->planes[s];
+            if (k == 0.0f)
+            {
+                for (c = c0; c < c1; ++c)
+                {
+                    const float h = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
+                    out[c] = (uint8_t)(V[c] >= 0 && h < g0 && h > -below0);
+                }
+            }
+            else
+            {
+                for (c = c0; c < c1; ++c)
+                {
+                    const float h = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
+                    const float above = g0 + k * R[c];
+                    out[c] = (uint8_t)(V[c] >= 0 && h < above && h > -bf * above);
+                }
+            }
+        }
+        for (c = 0; c < cols; ++c)
+        {
+            n_ground += out[c];
+            n_valid += (uint32_t)(V[c] >= 0);
+        }
+    }
+    g->stats.n_ground = n_ground;
+    g->stats.n_valid = n_valid;
+}
+
+lidet_status_t lidet_ground_run(lidet_ground_t *g, const lidet_range_image_t *img)
+{
+    if (g == 0 || img == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (g->magic != LIDET_INIT_MAGIC)
+    {
+        return LIDET_ERR_STATE;
+    }
+    if (img->x_m == 0 || img->y_m == 0 || img->z_m == 0 || img->rxy_m == 0 || img->point_idx == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (img->n_rows > LIDET_MAX_ROWS || img->n_cols > LIDET_MAX_COLS)
+    {
+        return LIDET_ERR_BUFFER;
+    }
+    if (img->n_rows < 1u || img->n_cols < 4u || img->n_cols < g->cfg.n_sectors)
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    memset(&g->stats, 0, sizeof g->stats);
+    g->n_rows = img->n_rows;
+    g->n_cols = img->n_cols;
+    g->rng = lidet__rng_seed(g->cfg.seed); /* every run starts from the seed: deterministic per scan */
+    filter_rows(g, img);
+    gather_samples(g, img);
+    lidet__ground_fit_sectors(g);
+    label_rows(g, img);
+    return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
+}
+
+const uint8_t *lidet_ground_mask(const lidet_ground_t *g)
+{
+    return g == 0 ? 0 : g->mask;
+}
+
+const uint8_t *lidet_ground_samples(const lidet_ground_t *g)
+{
+    return g == 0 ? 0 : g->sample;
+}
+
+const lidet_plane_t *lidet_ground_planes(const lidet_ground_t *g, uint32_t *n_sectors)
+{
+    if (g == 0)
+    {
+        return 0;
+    }
+    if (n_sectors != 0)
+    {
+        *n_sectors = g->cfg.n_sectors;
+    }
+    return g->planes;
+}
+
+const uint8_t *lidet_ground_sector_source(const lidet_ground_t *g)
+{
+    return g == 0 ? 0 : g->source;
+}
+
+lidet_status_t lidet_ground_point_labels(const lidet_ground_t *g, const int32_t *point_pixel, uint32_t n_points,
+                                         uint8_t *out)
+{
+    uint32_t i, npix;
+    if (g == 0 || ((point_pixel == 0 || out == 0) && n_points > 0u))
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (g->magic != LIDET_INIT_MAGIC)
+    {
+        return LIDET_ERR_STATE;
+    }
+    npix = (uint32_t)g->n_rows * g->n_cols;
+    for (i = 0; i < n_points; ++i)
+    {
+        const int32_t p = point_pixel[i];
+        out[i] = (p >= 0 && (uint32_t)p < npix) ? g->mask[p] : 0u;
+    }
+    return LIDET_OK;
+}
+
+const lidet_ground_stats_t *lidet_ground_stats(const lidet_ground_t *g)
+{
+    return g == 0 ? 0 : &g->stats;
+}
+
+uint32_t lidet_ground_bytes(void)
+{
+    return (uint32_t)sizeof(lidet_ground_t);
+}

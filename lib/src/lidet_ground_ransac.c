@@ -1,0 +1,350 @@
+/* SPDX-License-Identifier: MIT */
+/* Ground stage: one RANSAC plane per azimuth sector, least-squares refinement, fallback
+ * (algorithm in lidet_ground.h). Mirrored by codegen/lidet_codegen/ref/ground.py (fit_sectors,
+ * fit_plane_lsq). */
+#include <string.h>
+
+#include "internal/lidet_assert.h"
+#include "internal/lidet_ground_internal.h"
+#include "internal/lidet_math.h"
+#include "internal/lidet_rng.h"
+
+/* cross products shorter than this (m^2) are degenerate triples (collinear or repeated points) */
+#define MIN_CROSS2 1.0e-8f
+#define JACOBI_SWEEPS 12
+
+/* Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations. a is destroyed (its
+ * diagonal ends up holding the eigenvalues), v receives the eigenvectors as columns. Jacobi is
+ * slower than the closed form but has no acos/cos branch cuts and stays accurate for the very
+ * unequal eigenvalues of a ground patch (metres^2 along the ground, centimetres^2 across). */
+static void jacobi3(float a[3][3], float v[3][3])
+{
+    int sweep, p, q, i;
+    memset(v, 0, 9 * sizeof(float));
+    v[0][0] = v[1][1] = v[2][2] = 1.0f;
+    for (sweep = 0; sweep < JACOBI_SWEEPS; ++sweep)
+    {
+        const float off = fabsf(a[0][1]) + fabsf(a[0][2]) + fabsf(a[1][2]);
+        const float diag = fabsf(a[0][0]) + fabsf(a[1][1]) + fabsf(a[2][2]);
+        if (!(off > 1.0e-9f * diag) || off == 0.0f)
+        {
+            break;
+        }
+        for (p = 0; p < 2; ++p)
+        {
+            for (q = p + 1; q < 3; ++q)
+            {
+                float theta, t, c, s, tau, apq = a[p][q];
+                if (fabsf(apq) <= 1.0e-12f * (fabsf(a[p][p]) + fabsf(a[q][q])) || apq == 0.0f)
+                {
+                    continue;
+                }
+                /* rotation angle zeroing a[p][q]: t = tan(phi), the smaller root of t^2 + 2 theta t - 1 */
+                theta = (a[q][q] - a[p][p]) / (2.0f * apq);
+                t = 1.0f / (fabsf(theta) + sqrtf(theta * theta + 1.0f));
+                if (theta < 0.0f)
+                {
+                    t = -t;
+                }
+                c = 1.0f / sqrtf(t * t + 1.0f);
+                s = t * c;
+                tau = s / (1.0f + c);
+                a[p][p] -= t * apq;
+                a[q][q] += t * apq;
+                a[p][q] = a[q][p] = 0.0f;
+                for (i = 0; i < 3; ++i)
+                {
+                    if (i != p && i != q)
+                    {
+                        const float aip = a[i][p], aiq = a[i][q];
+                        a[i][p] = a[p][i] = aip - s * (aiq + tau * aip);
+                        a[i][q] = a[q][i] = aiq + s * (aip - tau * aiq);
+                    }
+                }
+                for (i = 0; i < 3; ++i)
+                {
+                    const float vip = v[i][p], viq = v[i][q];
+                    v[i][p] = vip - s * (viq + tau * vip);
+                    v[i][q] = viq + s * (vip - tau * viq);
+                }
+            }
+        }
+    }
+}
+
+/* Plane from centroid and covariance (mean of shifted coordinates + shift). Returns 0 when the
+ * points are (nearly) collinear. eig (optional) gets the eigenvalues ascending. */
+static int plane_from_cov(float cov[3][3], const float centroid[3], lidet_plane_t *pl, float *eig)
+{
+    float v[3][3], nx, ny, nz, len;
+    int i, lo = 0, hi = 0, mid;
+    jacobi3(cov, v);
+    for (i = 1; i < 3; ++i)
+    {
+        if (cov[i][i] < cov[lo][lo])
+            lo = i;
+        if (cov[i][i] > cov[hi][hi])
+            hi = i;
+    }
+    if (lo == hi)
+    {
+        hi = lo == 0 ? 1 : 0;
+    }
+    mid = 3 - lo - hi;
+    if (eig != 0)
+    {
+        eig[0] = cov[lo][lo];
+        eig[1] = cov[mid][mid];
+        eig[2] = cov[hi][hi];
+    }
+    if (!(cov[mid][mid] > 1.0e-7f * cov[hi][hi]) || !(cov[hi][hi] > 0.0f))
+    {
+        return 0; /* a line (or a point): no unique plane */
+    }
+    nx = v[0][lo];
+    ny = v[1][lo];
+    nz = v[2][lo];
+    len = sqrtf(nx * nx + ny * ny + nz * nz);
+    if (!(len > 0.0f))
+    {
+        return 0;
+    }
+    len = nz < 0.0f ? -1.0f / len : 1.0f / len;
+    pl->nx = nx * len;
+    pl->ny = ny * len;
+    pl->nz = nz * len;
+    pl->d_m = -(pl->nx * centroid[0] + pl->ny * centroid[1] + pl->nz * centroid[2]);
+    return 1;
+}
+
+/* Accumulates mean and covariance of the points (optionally only those within `thr` of `ref`)
+ * around `shift` (keeps float sums small: coordinates of a sector are tens of metres, heights
+ * centimetres). Returns the point count used. */
+static uint32_t accumulate(const float *xs, const float *ys, const float *zs, uint32_t n, const lidet_plane_t *ref,
+                           float thr, const float shift[3], float cov[3][3], float centroid[3])
+{
+    float sx = 0.0f, sy = 0.0f, sz = 0.0f, sxx = 0.0f, sxy = 0.0f, sxz = 0.0f, syy = 0.0f, syz = 0.0f, szz = 0.0f;
+    float inv, mx, my, mz;
+    uint32_t i, m = 0;
+    for (i = 0; i < n; ++i)
+    {
+        float x, y, z;
+        if (ref != 0 && !(fabsf(ref->nx * xs[i] + ref->ny * ys[i] + ref->nz * zs[i] + ref->d_m) <= thr))
+        {
+            continue;
+        }
+        x = xs[i] - shift[0];
+        y = ys[i] - shift[1];
+        z = zs[i] - shift[2];
+        sx += x;
+        sy += y;
+        sz += z;
+        sxx += x * x;
+        sxy += x * y;
+        sxz += x * z;
+        syy += y * y;
+        syz += y * z;
+        szz += z * z;
+        ++m;
+    }
+    if (m == 0u)
+    {
+        return 0u;
+    }
+    inv = 1.0f / (float)m;
+    mx = sx * inv;
+    my = sy * inv;
+    mz = sz * inv;
+    cov[0][0] = sxx * inv - mx * mx;
+    cov[0][1] = cov[1][0] = sxy * inv - mx * my;
+    cov[0][2] = cov[2][0] = sxz * inv - mx * mz;
+    cov[1][1] = syy * inv - my * my;
+    cov[1][2] = cov[2][1] = syz * inv - my * mz;
+    cov[2][2] = szz * inv - mz * mz;
+    centroid[0] = mx + shift[0];
+    centroid[1] = my + shift[1];
+    centroid[2] = mz + shift[2];
+    return m;
+}
+
+lidet_status_t lidet_ground_fit_plane(const float *x_m, const float *y_m, const float *z_m, uint32_t n,
+                                      lidet_plane_t *plane, float *eigvals)
+{
+    float cov[3][3], centroid[3], shift[3];
+    if (x_m == 0 || y_m == 0 || z_m == 0 || plane == 0 || n < 3u)
+    {
+        return LIDET_ERR_ARG;
+    }
+    shift[0] = x_m[0];
+    shift[1] = y_m[0];
+    shift[2] = z_m[0];
+    if (accumulate(x_m, y_m, z_m, n, 0, 0.0f, shift, cov, centroid) < 3u ||
+        !plane_from_cov(cov, centroid, plane, eigvals))
+    {
+        return LIDET_ERR_ARG;
+    }
+    return LIDET_OK;
+}
+
+/* Counts the points of the evenly strided subset (every `stride`-th) within thr of the plane. */
+static uint32_t score(const float *xs, const float *ys, const float *zs, uint32_t n, uint32_t stride,
+                      const lidet_plane_t *p, float thr)
+{
+    uint32_t i, cnt = 0;
+    for (i = 0; i < n; i += stride)
+    {
+        const float h = p->nx * xs[i] + p->ny * ys[i] + p->nz * zs[i] + p->d_m;
+        cnt += (uint32_t)(fabsf(h) <= thr);
+    }
+    return cnt;
+}
+
+/* RANSAC on one sector (mirrors ref/ground.py: ransac_sector). Returns 1 with *out set when a
+ * plane passes every check. */
+static int fit_sector(lidet_ground_t *g, const float *xs, const float *ys, const float *zs, uint32_t n,
+                      lidet_plane_t *out)
+{
+    const lidet_ground_cfg_t *cfg = &g->cfg;
+    const float cos_tilt = cosf(cfg->max_tilt_rad);
+    const float cos2 = cos_tilt * cos_tilt;
+    const uint32_t stride = (n + cfg->eval_samples - 1u) / cfg->eval_samples;
+    lidet_plane_t best;
+    uint32_t best_cnt = 0, it, r;
+    int have = 0;
+    memset(&best, 0, sizeof best);
+    for (it = 0; it < cfg->ransac_iters; ++it)
+    {
+        const uint32_t i0 = lidet__rng_below(&g->rng, n);
+        const uint32_t i1 = lidet__rng_below(&g->rng, n);
+        const uint32_t i2 = lidet__rng_below(&g->rng, n);
+        float ux, uy, uz, vx, vy, vz, cx, cy, cz, len2, inv;
+        lidet_plane_t p;
+        uint32_t cnt;
+        if (i0 == i1 || i0 == i2 || i1 == i2)
+        {
+            continue;
+        }
+        ux = xs[i1] - xs[i0];
+        uy = ys[i1] - ys[i0];
+        uz = zs[i1] - zs[i0];
+        vx = xs[i2] - xs[i0];
+        vy = ys[i2] - ys[i0];
+        vz = zs[i2] - zs[i0];
+        cx = uy * vz - uz * vy;
+        cy = uz * vx - ux * vz;
+        cz = ux * vy - uy * vx;
+        len2 = cx * cx + cy * cy + cz * cz;
+        /* degenerate triple, or tilted beyond max_tilt (cz^2 < cos^2 * |c|^2): skip before scoring */
+        if (!(len2 > MIN_CROSS2) || !(cz * cz >= cos2 * len2))
+        {
+            continue;
+        }
+        inv = 1.0f / sqrtf(len2);
+        if (cz < 0.0f)
+        {
+            inv = -inv;
+        }
+        p.nx = cx * inv;
+        p.ny = cy * inv;
+        p.nz = cz * inv;
+        p.d_m = -(p.nx * xs[i0] + p.ny * ys[i0] + p.nz * zs[i0]);
+        ++g->stats.n_hypotheses;
+        cnt = score(xs, ys, zs, n, stride, &p, cfg->inlier_m);
+        if (!have || cnt > best_cnt)
+        {
+            best = p;
+            best_cnt = cnt;
+            have = 1;
+        }
+    }
+    if (!have || best_cnt < cfg->min_inliers)
+    {
+        return 0;
+    }
+    /* least-squares refinement on the inliers of the current plane (all samples of the sector) */
+    for (r = 0; r < cfg->refine_iters; ++r)
+    {
+        float cov[3][3], centroid[3], shift[3];
+        lidet_plane_t p;
+        /* shift: the point of the plane under the sector's first sample */
+        shift[0] = xs[0];
+        shift[1] = ys[0];
+        shift[2] = best.nz > 0.0f ? -(best.nx * xs[0] + best.ny * ys[0] + best.d_m) / best.nz : zs[0];
+        if (accumulate(xs, ys, zs, n, &best, cfg->inlier_m, shift, cov, centroid) < 3u ||
+            !plane_from_cov(cov, centroid, &p, 0) || !(p.nz * p.nz >= cos2))
+        {
+            break; /* keep the last good plane */
+        }
+        best = p;
+    }
+    if (!(best.nz >= cos_tilt) || !(fabsf(best.d_m - cfg->mount_height_m) <= cfg->max_height_dev_m))
+    {
+        return 0;
+    }
+    *out = best;
+    return 1;
+}
+
+void lidet__ground_fit_sectors(lidet_ground_t *g)
+{
+    const uint32_t ns = g->cfg.n_sectors;
+    uint32_t s, k;
+    lidet_plane_t mount;
+    mount.nx = 0.0f;
+    mount.ny = 0.0f;
+    mount.nz = 1.0f;
+    mount.d_m = g->cfg.mount_height_m;
+    for (s = 0; s < ns; ++s)
+    {
+        const uint32_t a = g->sector_first[s], n = g->sector_first[s + 1u] - a;
+        LIDET_ASSERT(g->sector_first[s + 1u] >= a);
+        g->source[s] = LIDET_GROUND_PLANE_MOUNT;
+        if (n < g->cfg.min_samples)
+        {
+            ++g->stats.n_sectors_sparse;
+            continue;
+        }
+        if (fit_sector(g, g->sx_m + a, g->sy_m + a, g->sz_m + a, n, &g->planes[s]))
+        {
+            g->source[s] = LIDET_GROUND_PLANE_FITTED;
+            ++g->stats.n_sectors_fitted;
+        }
+        else
+        {
+            ++g->stats.n_sectors_rejected;
+        }
+    }
+    /* fallback: nearest sector that has its own plane (never a copied one), else the mount plane */
+    for (s = 0; s < ns; ++s)
+    {
+        int found = 0;
+        if (g->source[s] == LIDET_GROUND_PLANE_FITTED)
+        {
+            continue;
+        }
+        for (k = 1; k <= g->cfg.fallback_sectors && !found; ++k)
+        {
+            const uint32_t left = (s + ns - (k % ns)) % ns, right = (s + k) % ns;
+            if (g->source[left] == LIDET_GROUND_PLANE_FITTED)
+            {
+                g->planes[s] = g->planes[left];
+                found = 1;
+            }
+            else if (g->source[right] == LIDET_GROUND_PLANE_FITTED)
+            {
+                g->planes[s] = g->planes[right];
+                found = 1;
+            }
+        }
+        if (found)
+        {
+            g->source[s] = LIDET_GROUND_PLANE_NEIGHBOUR; /* never FITTED: not a source for others */
+            ++g->stats.n_sectors_neighbour;
+        }
+        else
+        {
+            g->planes[s] = mount;
+            ++g->stats.n_sectors_mount;
+        }
+    }
+}
