@@ -123,44 +123,87 @@ static int plane_from_cov(float cov[3][3], const float centroid[3], lidet_plane_
 static uint32_t accumulate(const float *xs, const float *ys, const float *zs, uint32_t n, const lidet_plane_t *ref,
                            float thr, const float shift[3], float cov[3][3], float centroid[3])
 {
-    float sx = 0.0f, sy = 0.0f, sz = 0.0f, sxx = 0.0f, sxy = 0.0f, sxz = 0.0f, syy = 0.0f, syz = 0.0f, szz = 0.0f;
-    float inv, mx, my, mz;
-    uint32_t i, m = 0;
-    for (i = 0; i < n; ++i)
+    /* LANES independent partial sums per moment, combined at the end: the compiler turns the
+     * j loop into vector instructions (a plain float reduction would stay scalar without
+     * -ffast-math), and the order of additions is fixed, so results are deterministic. */
+    enum
     {
-        float x, y, z;
-        if (ref != 0 && !(fabsf(ref->nx * xs[i] + ref->ny * ys[i] + ref->nz * zs[i] + ref->d_m) <= thr))
-        {
-            continue;
-        }
-        x = xs[i] - shift[0];
-        y = ys[i] - shift[1];
-        z = zs[i] - shift[2];
-        sx += x;
-        sy += y;
-        sz += z;
-        sxx += x * x;
-        sxy += x * y;
-        sxz += x * z;
-        syy += y * y;
-        syz += y * z;
-        szz += z * z;
-        ++m;
+        LANES = 4
+    };
+    float acc[10][LANES];
+    float sum[10], inv, mx, my, mz;
+    lidet_plane_t p;
+    uint32_t i, m;
+    int j, k;
+    if (ref != 0)
+    {
+        p = *ref;
     }
+    else
+    {
+        p.nx = p.ny = p.nz = p.d_m = 0.0f; /* h = 0 <= thr: every point counts */
+        thr = 1.0f;
+    }
+    memset(acc, 0, sizeof acc);
+    /* branch-free: each point enters with weight w = 1 (inlier of the plane) or 0 */
+    for (i = 0; i + LANES <= n; i += LANES)
+    {
+        for (j = 0; j < LANES; ++j)
+        {
+            const float h = p.nx * xs[i + j] + p.ny * ys[i + j] + p.nz * zs[i + j] + p.d_m;
+            const float w = fabsf(h) <= thr ? 1.0f : 0.0f;
+            const float x = w * (xs[i + j] - shift[0]);
+            const float y = w * (ys[i + j] - shift[1]);
+            const float z = w * (zs[i + j] - shift[2]);
+            acc[0][j] += w;
+            acc[1][j] += x;
+            acc[2][j] += y;
+            acc[3][j] += z;
+            acc[4][j] += x * x;
+            acc[5][j] += x * y;
+            acc[6][j] += x * z;
+            acc[7][j] += y * y;
+            acc[8][j] += y * z;
+            acc[9][j] += z * z;
+        }
+    }
+    for (; i < n; ++i) /* the tail goes to lane 0 */
+    {
+        const float h = p.nx * xs[i] + p.ny * ys[i] + p.nz * zs[i] + p.d_m;
+        const float w = fabsf(h) <= thr ? 1.0f : 0.0f;
+        const float x = w * (xs[i] - shift[0]);
+        const float y = w * (ys[i] - shift[1]);
+        const float z = w * (zs[i] - shift[2]);
+        acc[0][0] += w;
+        acc[1][0] += x;
+        acc[2][0] += y;
+        acc[3][0] += z;
+        acc[4][0] += x * x;
+        acc[5][0] += x * y;
+        acc[6][0] += x * z;
+        acc[7][0] += y * y;
+        acc[8][0] += y * z;
+        acc[9][0] += z * z;
+    }
+    for (k = 0; k < 10; ++k)
+    {
+        sum[k] = (acc[k][0] + acc[k][1]) + (acc[k][2] + acc[k][3]);
+    }
+    m = (uint32_t)(sum[0] + 0.5f); /* exact: counts stay far below 2^24 */
     if (m == 0u)
     {
         return 0u;
     }
-    inv = 1.0f / (float)m;
-    mx = sx * inv;
-    my = sy * inv;
-    mz = sz * inv;
-    cov[0][0] = sxx * inv - mx * mx;
-    cov[0][1] = cov[1][0] = sxy * inv - mx * my;
-    cov[0][2] = cov[2][0] = sxz * inv - mx * mz;
-    cov[1][1] = syy * inv - my * my;
-    cov[1][2] = cov[2][1] = syz * inv - my * mz;
-    cov[2][2] = szz * inv - mz * mz;
+    inv = 1.0f / sum[0];
+    mx = sum[1] * inv;
+    my = sum[2] * inv;
+    mz = sum[3] * inv;
+    cov[0][0] = sum[4] * inv - mx * mx;
+    cov[0][1] = cov[1][0] = sum[5] * inv - mx * my;
+    cov[0][2] = cov[2][0] = sum[6] * inv - mx * mz;
+    cov[1][1] = sum[7] * inv - my * my;
+    cov[1][2] = cov[2][1] = sum[8] * inv - my * mz;
+    cov[2][2] = sum[9] * inv - mz * mz;
     centroid[0] = mx + shift[0];
     centroid[1] = my + shift[1];
     centroid[2] = mz + shift[2];
@@ -208,6 +251,7 @@ static int fit_sector(lidet_ground_t *g, const float *xs, const float *ys, const
     const float cos_tilt = cosf(cfg->max_tilt_rad);
     const float cos2 = cos_tilt * cos_tilt;
     const uint32_t stride = (n + cfg->eval_samples - 1u) / cfg->eval_samples;
+    const uint32_t n_eval = (n + stride - 1u) / stride; /* size of the strided subset */
     lidet_plane_t best;
     uint32_t best_cnt = 0, it, r;
     int have = 0;
@@ -255,6 +299,23 @@ static int fit_sector(lidet_ground_t *g, const float *xs, const float *ys, const
             best = p;
             best_cnt = cnt;
             have = 1;
+            /* adaptive stop (deterministic: depends on counts only): enough hypotheses were drawn
+             * to pick an all-inlier triple with probability `confidence`, given the inlier share w
+             * of the best plane: stop once (1 - w^3)^(it + 1) <= 1 - confidence */
+            if (cfg->confidence > 0.0f)
+            {
+                const float w = (float)cnt / (float)n_eval;
+                float miss = 1.0f, q = 1.0f - w * w * w;
+                uint32_t k;
+                for (k = 0; k <= it; ++k)
+                {
+                    miss *= q;
+                }
+                if (miss <= 1.0f - cfg->confidence)
+                {
+                    break;
+                }
+            }
         }
     }
     if (!have || best_cnt < cfg->min_inliers)

@@ -13,6 +13,7 @@ typedef struct
 
 static const cli_cmd_t k_cmds[] = {
     {"project", cli_project, "spherical projection: points -> range image"},
+    {"ground", cli_ground, "ground segmentation: points -> ground mask per point"},
 };
 
 int main(int argc, char **argv)

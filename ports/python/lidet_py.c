@@ -123,10 +123,10 @@ LIDET_PY_API int lidet_py_proj_run(const float *pts, uint32_t n, uint32_t stride
 
 /* ---- ground stage ------------------------------------------------------------------------------
  * The configuration crosses the boundary as two flat arrays in this order (native.py: GROUND_F, GROUND_U):
- *   cfg_f[11]: fy_max fx_max_m gate_above_m gate_below_m mount_height_m inlier_m max_tilt_rad
- *              max_height_dev_m ground_m ground_m_per_m below_factor
- *   cfg_u[11]: fx_on_z require_descending height_gate n_sectors ransac_iters eval_samples min_samples
- *              min_inliers refine_iters fallback_sectors seed */
+ *   cfg_f[12]: fy_max fx_max_m gate_above_m gate_below_m mount_height_m inlier_m max_tilt_rad
+ *              max_height_dev_m ground_m ground_m_per_m below_factor confidence
+ *   cfg_u[12]: fx_on_z require_descending height_gate n_sectors ransac_iters eval_samples min_samples
+ *              min_inliers refine_iters fallback_sectors seed sample_step */
 static void ground_cfg_to_arrays(const lidet_ground_cfg_t *c, float *f, uint32_t *u)
 {
     f[0] = c->fy_max;
@@ -140,6 +140,7 @@ static void ground_cfg_to_arrays(const lidet_ground_cfg_t *c, float *f, uint32_t
     f[8] = c->ground_m;
     f[9] = c->ground_m_per_m;
     f[10] = c->below_factor;
+    f[11] = c->confidence;
     u[0] = c->fx_on_z;
     u[1] = c->require_descending;
     u[2] = c->height_gate;
@@ -151,6 +152,7 @@ static void ground_cfg_to_arrays(const lidet_ground_cfg_t *c, float *f, uint32_t
     u[8] = c->refine_iters;
     u[9] = c->fallback_sectors;
     u[10] = c->seed;
+    u[11] = c->sample_step;
 }
 
 static int ground_cfg_from_arrays(lidet_ground_cfg_t *c, const float *f, const uint32_t *u)
@@ -172,6 +174,7 @@ static int ground_cfg_from_arrays(lidet_ground_cfg_t *c, const float *f, const u
     c->ground_m = f[8];
     c->ground_m_per_m = f[9];
     c->below_factor = f[10];
+    c->confidence = f[11];
     if (u[0] > 255u || u[1] > 255u || u[2] > 255u || u[8] > 255u)
         return LIDET_ERR_CONFIG;
     c->fx_on_z = (uint8_t)u[0];
@@ -185,6 +188,9 @@ static int ground_cfg_from_arrays(lidet_ground_cfg_t *c, const float *f, const u
     c->refine_iters = (uint8_t)u[8];
     c->fallback_sectors = (uint16_t)u[9];
     c->seed = u[10];
+    if (u[11] > 0xFFFFu)
+        return LIDET_ERR_CONFIG;
+    c->sample_step = (uint16_t)u[11];
     return LIDET_OK;
 }
 
@@ -207,7 +213,7 @@ LIDET_PY_API int lidet_py_ground_default(uint32_t rows, uint32_t cols, float mou
 /* Initialise the ground stage and run it on the image of the last lidet_py_proj_run. Outputs (any may
  * be NULL): mask_pixel / sample_pixel rows*cols bytes, mask_point n_points bytes (n_points = the
  * projection's point count), planes 4*n_sectors floats (nx ny nz d), source n_sectors bytes,
- * stats 10 uint32 (n_valid n_samples n_samples_dropped n_ground fitted neighbour mount sparse
+ * stats 10 uint32 (0 n_samples n_samples_dropped n_ground fitted neighbour mount sparse
  * rejected hypotheses). */
 LIDET_PY_API int lidet_py_ground_run(const float *cfg_f, const uint32_t *cfg_u, uint8_t *mask_pixel,
                                      uint8_t *sample_pixel, uint8_t *mask_point, float *planes, uint8_t *source,
@@ -261,7 +267,7 @@ LIDET_PY_API int lidet_py_ground_run(const float *cfg_f, const uint32_t *cfg_u, 
     st = lidet_ground_stats(&g_ground);
     if (stats != NULL)
     {
-        stats[0] = st->n_valid;
+        stats[0] = 0;
         stats[1] = st->n_samples;
         stats[2] = st->n_samples_dropped;
         stats[3] = st->n_ground;

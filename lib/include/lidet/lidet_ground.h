@@ -15,11 +15,14 @@
  *       released code, fx_on_z = 1), tested as |F_x| <= fx_max_m.
  *     Optional height gate (released code): the pixel's z must lie in
  *     [-mount_height_m - gate_below_m, -mount_height_m + gate_above_m].
- *     Every pixel the kernels touch must hold a point; the bottom row has no sample.
+ *     Every pixel the kernels touch must hold a point; the bottom row has no sample. With
+ *     sample_step > 1 only rows 0, step, 2 step, ... are filtered and only the samples of columns
+ *     0, step, 2 step, ... go to RANSAC (a speed knob).
  *  2. Per azimuth sector (sector of column c = c * n_sectors / n_cols), RANSAC over the samples:
  *     a seeded xorshift32 (state) draws 3 samples, hypotheses tilted more than max_tilt_rad are
  *     rejected before scoring, the rest are scored on at most eval_samples evenly strided
- *     samples (inliers: |distance| <= inlier_m). The best plane is optionally refined by least
+ *     samples (inliers: |distance| <= inlier_m), stopping early once the best plane's inlier share
+ *     makes a better draw unlikely (confidence). The best plane is optionally refined by least
  *     squares on all its inlier samples (3x3 covariance, smallest eigenvector by Jacobi
  *     rotations), refine_iters times. A plane is accepted when it has >= min_inliers inliers,
  *     a tilt <= max_tilt_rad and a height of the sensor above it within max_height_dev_m of
@@ -84,10 +87,17 @@ typedef struct
     uint16_t n_sectors;       /**< azimuth sectors over 360 deg; [1, min(n_cols, LIDET_GROUND_MAX_SECTORS)],
                                    default 32 (11.25 deg) */
     uint16_t ransac_iters;    /**< hypotheses per sector; [1, 1000], typical 8-30 */
+    uint16_t sample_step;     /**< sample grid: the filter runs on rows 0, step, 2 step, ... and
+                                   RANSAC takes the samples of columns 0, step, 2 step, ... of them.
+                                   A speed knob (planes need far fewer points than the image holds);
+                                   [1, 16], 1 = every pixel (paper), typical 1-3 */
     uint16_t eval_samples;    /**< samples a hypothesis is scored on (evenly strided subset);
                                    [3, 65535], typical 64-512 */
     uint16_t min_samples;     /**< fewer samples in a sector: fallback; [3, 65535], typical 10-30 */
     uint16_t min_inliers;     /**< fewer inliers (among the scored subset): fallback; [3, 65535] */
+    float confidence;         /**< adaptive RANSAC stop: after a new best plane with inlier share w,
+                                   stop once (1 - w^3)^(hypotheses drawn) <= 1 - confidence;
+                                   [0, 0.999999], 0 = always ransac_iters, typical 0.99 */
     uint8_t refine_iters;     /**< least-squares refinements on the inliers; [0, 10], 0 = plain RANSAC */
     float inlier_m;           /**< RANSAC inlier distance, metres; (0, 5], typical 0.1-0.3 */
     float max_tilt_rad;       /**< max angle between a plane normal and +z, radians; (0, pi/2),
@@ -111,8 +121,7 @@ typedef struct
 /** @brief Counts of the last run. */
 typedef struct
 {
-    uint32_t n_valid;            /**< pixels holding a point */
-    uint32_t n_samples;          /**< pixels that passed the sample filter */
+    uint32_t n_samples;          /**< samples handed to RANSAC (passed the filter, on the step grid) */
     uint32_t n_samples_dropped;  /**< samples past LIDET_GROUND_MAX_SAMPLES (not used; status TRUNCATED) */
     uint32_t n_ground;           /**< pixels labelled ground */
     uint16_t n_sectors_fitted;   /**< sectors with their own plane */
