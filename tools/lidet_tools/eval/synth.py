@@ -97,8 +97,8 @@ def synth_kitti(n_frames: int, seed: int = 0, calib: Calib | None = None, p_dete
     # predictions: re-detections with noise, then false positives
     det = rng.uniform(size=len(fr)) < p_detect
     rng_m = np.hypot(xyz[:, 0], xyz[:, 1])
-    pxyz = xyz + rng.normal(0, 1, xyz.shape) * (0.05 + 0.004 * rng_m)[:, None]
-    plwh = lwh * rng.normal(1.0, 0.04, lwh.shape)
+    pxyz = xyz + rng.normal(0, 1, xyz.shape) * (0.03 + 0.0015 * rng_m)[:, None]
+    plwh = lwh * rng.normal(1.0, 0.03, lwh.shape)
     pyaw = yaw + rng.normal(0, 0.05, len(yaw))
     score = np.clip(rng.beta(5, 2, len(fr)) - 0.003 * rng_m, 0.01, 1.0)
     ptyp = typ.copy()

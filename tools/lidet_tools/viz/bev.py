@@ -139,12 +139,13 @@ def plot_bev(points, point_labels=None, gt_boxes=None, pred_boxes=None, *, color
     s = point_size if point_size is not None else float(np.clip(3000.0 / max(area, 1.0), 0.15, 4.0))
     if colorbar:
         sc = ax.scatter(pts[inview, 0], pts[inview, 1], c=np.clip(vals[inview], -2.5, 2.5), s=s,
-                        cmap="viridis", linewidths=0, vmin=-2.5, vmax=2.5)
+                        cmap="viridis", linewidths=0, vmin=-2.5, vmax=2.5, zorder=4.5)
         fig.colorbar(sc, ax=ax, shrink=0.6, label="z [m] (height above the sensor)")
     else:
-        ax.scatter(pts[inview, 0], pts[inview, 1], c=vals[inview], s=s, linewidths=0)
+        ax.scatter(pts[inview, 0], pts[inview, 1], c=vals[inview], s=s, linewidths=0, zorder=4.5)
 
-    # range rings and the sensor
+    # points above the ground-truth outlines (an object's returns lie on its box's edges),
+    # below the predictions; range rings and the sensor
     rmax = float(np.hypot(max(abs(xlim[0]), abs(xlim[1])), max(abs(ylim[0]), abs(ylim[1]))))
     for r in np.arange(ring_step_m, rmax + 1e-9, ring_step_m):
         ax.add_patch(Circle((0, 0), r, fill=False, lw=0.6, ls=":", color="#888888", zorder=1))

@@ -8,7 +8,7 @@
     lidet-viz pr --gt DIR --pred DIR [--protocol kitti|boxes] [--metric 3d|bev|2d] [--overlap SET]
                  [--classes Car,Pedestrian,Cyclist] --out PNG
     lidet-viz energy --id FILE --ood FILE [--threshold GAMMA] --out PNG
-    lidet-viz demo --out PNG
+    lidet-viz demo [--kind bev|pr] --out PNG
 
 Box files: lidet sensor-frame box lines (9 fields) or KITTI label_2 (15/16 fields, needs --calib;
 DontCare skipped), told apart by their field count. --point-labels: one uint8 or uint32 per point
@@ -98,7 +98,9 @@ def build_parser():
     e.add_argument("--threshold", type=float, help="gate gamma (default: 95 %% TPR on ID)")
     e.add_argument("--title")
     e.add_argument("--out", required=True)
-    d = sub.add_parser("demo", help="BEV picture of a synthetic street scene (docs/img)")
+    d = sub.add_parser("demo", help="pictures of synthetic data for the docs (docs/img)")
+    d.add_argument("--kind", choices=("bev", "pr"), default="bev",
+                   help="bev: a synthetic street scene; pr: curves of 1000 synthetic KITTI-like frames")
     d.add_argument("--out", required=True)
     return p
 
@@ -151,6 +153,18 @@ def main(argv=None) -> int:
 
             fig = plot_energy_hist(_load_values(args.id), _load_values(args.ood), args.threshold,
                                    title=args.title)
+        elif args.kind == "pr":
+            import tempfile
+
+            from ..eval import kitti_ap, synth
+            from .curves import plot_pr
+
+            gt, pred = synth.synth_kitti(1000, seed=0)
+            with tempfile.TemporaryDirectory() as tmp:
+                synth.write_frames(os.path.join(tmp, "gt"), gt)
+                synth.write_frames(os.path.join(tmp, "pred"), pred)
+                res = kitti_ap.evaluate_dirs(os.path.join(tmp, "gt"), os.path.join(tmp, "pred"))
+            fig = plot_pr(res, "3d")
         else:
             from .bev import plot_bev
             from .demo import demo_scene
