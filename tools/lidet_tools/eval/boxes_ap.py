@@ -152,6 +152,8 @@ def evaluate(gt: BoxSet, dt: BoxSet, classes=("Car", "Pedestrian", "Cyclist"), m
 
 def evaluate_dirs(gt_dir, pred_dir, warn=True, **kw) -> dict:
     gt = load_boxes_dir(gt_dir)
+    if gt.n_frames == 0:
+        raise ValueError(f"{gt_dir}: no box files")
     dt = load_boxes_dir(pred_dir, gt.frame_ids, missing_ok=True)
     if warn:
         have = set(_stems(os.fspath(pred_dir)))

@@ -232,6 +232,8 @@ def evaluate_dirs(gt_dir, pred_dir, frame_ids=None, warn=True, **kw) -> dict:
     """Evaluate every frame of gt_dir (or the listed ids) against pred_dir; a missing prediction
     file counts as a frame without detections."""
     gt = load_label_dir(gt_dir, frame_ids)
+    if gt.n_frames == 0:
+        raise ValueError(f"{gt_dir}: no label files (<id>.txt)")
     if warn:
         missing = [f for f in gt.frame_ids if not os.path.exists(os.path.join(pred_dir, f"{f}.txt"))]
         if missing:
