@@ -196,4 +196,10 @@ def test_cli_json_shape_and_table(tmp_path, capsys):
                      "--classes", "Car", "--overlap", "loose"]) == 0
     cap = capsys.readouterr()
     assert "Car" in cap.out and "moderate" in cap.out and "1 of 40 frames" in cap.err
+    (tmp_path / "ids.txt").write_text("\n".join(ids[:10]) + "\n")
+    assert cli.main(["kitti", "--gt", str(tmp_path / "gt"), "--pred", str(tmp_path / "dt"),
+                     "--frames", str(tmp_path / "ids.txt"), "--metrics", "bev"]) == 0
+    assert "10 frames" in capsys.readouterr().out
     assert cli.main(["kitti", "--gt", str(tmp_path / "nope"), "--pred", str(tmp_path / "dt")]) == 2
+    assert cli.main(["kitti", "--gt", str(tmp_path / "gt"), "--pred", str(tmp_path / "dt"),
+                     "--classes", "Bus"]) == 2
