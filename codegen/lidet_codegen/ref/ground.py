@@ -1,0 +1,192 @@
+# SPDX-License-Identifier: MIT
+"""numpy reference of the ground stage (lib/src/lidet_ground_filter.c, lidet_ground_ransac.c).
+
+Same algorithm, same order, same random draws (ref/rng.py mirrors the C xorshift32):
+
+* `sample_mask`: the Sobel-inspired filter in float32, operation for operation as the C code, so the
+  sample mask is bit-identical;
+* `gather_samples`: samples grouped by sector on the step grid, in the C order;
+* `ransac_sector`: hypotheses and their scores in float32 (identical draws and counts), the
+  least-squares refinement in float64 with numpy's eigh (the C code uses float sums and Jacobi
+  rotations: planes agree to ~1e-5, so a few pixels at the p_th boundary may flip);
+* `fallback`, `label_pixels`, and `ground` chaining them.
+
+Configuration: a dict with the field names of lidet_ground_cfg_t (native.ground_defaults gives the
+C defaults).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .rng import XorShift32
+
+F = np.float32
+FITTED, NEIGHBOUR, MOUNT = 0, 1, 2
+
+
+def sector_col(s: int, n_sectors: int, cols: int) -> int:
+    """First column of sector s (sector of column c = c * n_sectors // cols)."""
+    return (s * cols + n_sectors - 1) // n_sectors
+
+
+def sample_mask(R: np.ndarray, Z: np.ndarray, cfg: dict) -> np.ndarray:
+    """(rows, cols) uint8 sample mask from the R (horizontal range) and Z images (float32, empty = 0)."""
+    R = np.asarray(R, F)
+    Z = np.asarray(Z, F)
+    rows, cols = R.shape
+    step = int(cfg["sample_step"])
+    fy, fx_max = F(cfg["fy_max"]), F(cfg["fx_max_m"])
+    dr_min = F(0.0) if cfg["require_descending"] else F(-3.0e38)
+    mount = F(cfg["mount_height_m"])
+    if cfg["height_gate"]:
+        z_lo, z_hi = -mount - F(cfg["gate_below_m"]), -mount + F(cfg["gate_above_m"])
+    else:
+        z_lo, z_hi = F(-3.0e38), F(3.0e38)
+    out = np.zeros((rows, cols), np.uint8)
+    two = F(2.0)
+    for r in range(0, rows - 1, step):
+        R0, R1, Z0, Z1 = R[r], R[r + 1], Z[r], Z[r + 1]
+        F0 = Z0 if cfg["fx_on_z"] else R0
+        nxt = lambda a, k: np.roll(a, -k)  # a[c + k] with wrap-around
+        dr = (two * R0 + nxt(R0, 1)) - (two * R1 + nxt(R1, 1))
+        dz = (two * Z0 + nxt(Z0, 1)) - (two * Z1 + nxt(Z1, 1))
+        fx = (np.roll(F0, 1) + two * F0) - (two * nxt(F0, 1) + nxt(F0, 2))
+        rmin = np.minimum.reduce([np.roll(R0, 1), R0, nxt(R0, 1), nxt(R0, 2), R1, nxt(R1, 1)])
+        ok = ((rmin > 0) & (np.abs(dz) <= fy * np.abs(dr)) & (np.abs(fx) <= fx_max) & (dr > dr_min)
+              & (Z0 >= z_lo) & (Z0 <= z_hi))
+        out[r] = ok
+    return out
+
+
+def gather_samples(sample: np.ndarray, X, Y, Z, cfg: dict):
+    """Per sector: (N, 3) float32 samples on the step grid, raster order (as gather_samples in C)."""
+    rows, cols = sample.shape
+    ns, step = int(cfg["n_sectors"]), int(cfg["sample_step"])
+    out = []
+    rr = np.arange(0, rows - 1, step)
+    for s in range(ns):
+        c0, c1 = sector_col(s, ns, cols), sector_col(s + 1, ns, cols)
+        cc = np.arange(c0 + (step - c0 % step) % step, c1, step)
+        m = sample[np.ix_(rr, cc)].astype(bool)
+        pts = np.stack([np.asarray(A, F)[np.ix_(rr, cc)][m] for A in (X, Y, Z)], 1)
+        out.append(pts.reshape(-1, 3))
+    return out
+
+
+def fit_plane_lsq(pts: np.ndarray):
+    """Least-squares plane (float64): (nx, ny, nz, d) with nz >= 0, and eigenvalues ascending; None if
+    the points are (nearly) collinear."""
+    p = np.asarray(pts, np.float64)
+    if len(p) < 3:
+        return None
+    c = p.mean(0)
+    q = p - c
+    cov = q.T @ q / len(p)
+    w, v = np.linalg.eigh(cov)
+    if not (w[1] > 1e-7 * w[2] and w[2] > 0):
+        return None
+    n = v[:, 0] / np.linalg.norm(v[:, 0])
+    if n[2] < 0:
+        n = -n
+    return np.array([n[0], n[1], n[2], -n @ c]), w
+
+
+def ransac_sector(pts: np.ndarray, rng: XorShift32, cfg: dict):
+    """One sector's plane (float64 array nx, ny, nz, d) or None, and the number of hypotheses scored."""
+    n = len(pts)
+    xs, ys, zs = (pts[:, k].astype(F) for k in range(3))
+    cos_t = F(np.cos(F(cfg["max_tilt_rad"])))
+    cos2 = cos_t * cos_t
+    stride = (n + int(cfg["eval_samples"]) - 1) // int(cfg["eval_samples"])
+    n_eval = (n + stride - 1) // stride
+    thr = F(cfg["inlier_m"])
+    conf = F(cfg["confidence"])
+    best, best_cnt, hyps = None, 0, 0
+    for it in range(int(cfg["ransac_iters"])):
+        i0, i1, i2 = rng.below(n), rng.below(n), rng.below(n)
+        if i0 == i1 or i0 == i2 or i1 == i2:
+            continue
+        ux, uy, uz = xs[i1] - xs[i0], ys[i1] - ys[i0], zs[i1] - zs[i0]
+        vx, vy, vz = xs[i2] - xs[i0], ys[i2] - ys[i0], zs[i2] - zs[i0]
+        cx, cy, cz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+        len2 = cx * cx + cy * cy + cz * cz
+        if not (len2 > F(1e-8)) or not (cz * cz >= cos2 * len2):
+            continue
+        inv = F(1.0) / np.sqrt(len2)
+        if cz < 0:
+            inv = -inv
+        p = (cx * inv, cy * inv, cz * inv)
+        d = -(p[0] * xs[i0] + p[1] * ys[i0] + p[2] * zs[i0])
+        hyps += 1
+        h = p[0] * xs[::stride] + p[1] * ys[::stride] + p[2] * zs[::stride] + d
+        cnt = int(np.count_nonzero(np.abs(h) <= thr))
+        if best is None or cnt > best_cnt:
+            best, best_cnt = np.array([p[0], p[1], p[2], d], np.float64), cnt
+            if conf > 0:
+                w = F(cnt) / F(n_eval)
+                q = F(1.0) - w * w * w
+                miss = F(1.0)
+                for _ in range(it + 1):
+                    miss = F(miss * q)
+                if miss <= F(1.0) - conf:
+                    break
+    if best is None or best_cnt < int(cfg["min_inliers"]):
+        return None, hyps
+    p64 = pts.astype(np.float64)
+    for _ in range(int(cfg["refine_iters"])):
+        inl = np.abs(p64 @ best[:3] + best[3]) <= float(thr)
+        fit = fit_plane_lsq(p64[inl])
+        if fit is None or not (fit[0][2] ** 2 >= float(cos2)):
+            break
+        best = fit[0]
+    if not (best[2] >= float(cos_t)) or not (abs(best[3] - cfg["mount_height_m"]) <= cfg["max_height_dev_m"]):
+        return None, hyps
+    return best, hyps
+
+
+def fit_sectors(samples, cfg: dict):
+    """(n_sectors, 4) planes and (n_sectors,) sources, with the fallback applied."""
+    ns = int(cfg["n_sectors"])
+    rng = XorShift32(int(cfg["seed"]))
+    planes = np.zeros((ns, 4))
+    src = np.full(ns, MOUNT, np.uint8)
+    for s in range(ns):
+        if len(samples[s]) < int(cfg["min_samples"]):
+            continue
+        p, _ = ransac_sector(samples[s], rng, cfg)
+        if p is not None:
+            planes[s], src[s] = p, FITTED
+    mount = np.array([0.0, 0.0, 1.0, cfg["mount_height_m"]])
+    fitted = src == FITTED
+    for s in range(ns):
+        if fitted[s]:
+            continue
+        for k in range(1, int(cfg["fallback_sectors"]) + 1):
+            left, right = (s - k) % ns, (s + k) % ns
+            if fitted[left]:
+                planes[s], src[s] = planes[left], NEIGHBOUR
+                break
+            if fitted[right]:
+                planes[s], src[s] = planes[right], NEIGHBOUR
+                break
+        else:
+            planes[s] = mount
+    return planes, src
+
+
+def label_pixels(X, Y, Z, R, valid, planes, cfg: dict) -> np.ndarray:
+    """(rows, cols) uint8 ground mask: valid and -below < height above the sector plane < above."""
+    rows, cols = np.shape(X)
+    ns = int(cfg["n_sectors"])
+    sec = (np.arange(cols) * ns) // cols
+    pl = np.asarray(planes, F)[sec]  # (cols, 4)
+    h = pl[:, 0] * np.asarray(X, F) + pl[:, 1] * np.asarray(Y, F) + pl[:, 2] * np.asarray(Z, F) + pl[:, 3]
+    above = F(cfg["ground_m"]) + F(cfg["ground_m_per_m"]) * np.asarray(R, F)
+    return (np.asarray(valid, bool) & (h < above) & (h > -F(cfg["below_factor"]) * above)).astype(np.uint8)
+
+
+def ground(X, Y, Z, R, valid, cfg: dict):
+    """The whole stage on a range image: (mask, sample mask, planes, sources)."""
+    smp = sample_mask(R, Z, cfg)
+    planes, src = fit_sectors(gather_samples(smp, X, Y, Z, cfg), cfg)
+    return label_pixels(X, Y, Z, R, valid, planes, cfg), smp, planes, src
