@@ -3,6 +3,7 @@
  * ground_ms is the median over --repeat runs of lidet_ground_run alone (file reading and projection
  * excluded); project_ms the median of lidet_proj_run; total_ms the median of both together. */
 #include <stdlib.h>
+#include <string.h>
 
 #include "cli.h"
 
@@ -71,6 +72,63 @@ static int write_bev_png(const char *path, const float *pts, uint32_t n, const u
     return rc;
 }
 
+/* `--set KEY=VALUE` overrides one lidet_ground_cfg_t field (for tuning and the filter comparison in
+ * tools/bench/bench_ground.py). Returns 0, or 1 for an unknown key or a bad number. */
+static int apply_set(lidet_ground_cfg_t *c, const char *kv)
+{
+    const char *eq = strchr(kv, '=');
+    char *end;
+    double v;
+    size_t klen;
+    if (eq == NULL)
+        return 1;
+    klen = (size_t)(eq - kv);
+    v = strtod(eq + 1, &end);
+    if (*end != '\0' || end == eq + 1)
+        return 1;
+#define FLOAT_FIELD(name)                                                                                          \
+    if (klen == sizeof #name - 1 && strncmp(kv, #name, klen) == 0)                                                 \
+    {                                                                                                              \
+        c->name = (float)v;                                                                                        \
+        return 0;                                                                                                  \
+    }
+#define INT_FIELD(name, type, maxv)                                                                                \
+    if (klen == sizeof #name - 1 && strncmp(kv, #name, klen) == 0)                                                 \
+    {                                                                                                              \
+        if (v < 0.0 || v > (double)(maxv) || v != (double)(long long)v)                                            \
+            return 1;                                                                                              \
+        c->name = (type)v;                                                                                         \
+        return 0;                                                                                                  \
+    }
+    FLOAT_FIELD(fy_max)
+    FLOAT_FIELD(fx_max_m)
+    FLOAT_FIELD(gate_above_m)
+    FLOAT_FIELD(gate_below_m)
+    FLOAT_FIELD(mount_height_m)
+    FLOAT_FIELD(inlier_m)
+    FLOAT_FIELD(max_tilt_rad)
+    FLOAT_FIELD(max_height_dev_m)
+    FLOAT_FIELD(ground_m)
+    FLOAT_FIELD(ground_m_per_m)
+    FLOAT_FIELD(below_factor)
+    FLOAT_FIELD(confidence)
+    INT_FIELD(fx_on_z, uint8_t, 1)
+    INT_FIELD(require_descending, uint8_t, 1)
+    INT_FIELD(height_gate, uint8_t, 1)
+    INT_FIELD(refine_iters, uint8_t, 255)
+    INT_FIELD(n_sectors, uint16_t, 65535)
+    INT_FIELD(ransac_iters, uint16_t, 65535)
+    INT_FIELD(eval_samples, uint16_t, 65535)
+    INT_FIELD(sample_step, uint16_t, 65535)
+    INT_FIELD(min_samples, uint16_t, 65535)
+    INT_FIELD(min_inliers, uint16_t, 65535)
+    INT_FIELD(fallback_sectors, uint16_t, 65535)
+    INT_FIELD(seed, uint32_t, 4294967295.0)
+#undef FLOAT_FIELD
+#undef INT_FIELD
+    return 1;
+}
+
 int cli_ground(int argc, char **argv)
 {
     cli_args_t a;
@@ -85,10 +143,46 @@ int cli_ground(int argc, char **argv)
     uint32_t np = 0, i, n_ground_points = 0;
     int k, ret = 1;
 
-    if (cli_parse(argc, argv, "ground", &a) != 0 || cli_load(&a) != 0)
+    char **rest = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
+    const char **sets = (const char **)malloc(sizeof(char *) * (size_t)(argc + 1));
+    int n_rest = 0, n_sets = 0;
+    if (rest == NULL || sets == NULL)
+    {
+        free(rest);
+        free(sets);
         return 1;
+    }
+    /* --set KEY=VALUE pairs are ours; everything else goes to the shared parser */
+    for (k = 0; k < argc; ++k)
+    {
+        if (strcmp(argv[k], "--set") == 0 && k + 1 < argc)
+            sets[n_sets++] = argv[++k];
+        else
+            rest[n_rest++] = argv[k];
+    }
+    if (cli_parse(n_rest, rest, "ground", &a) != 0 || cli_load(&a) != 0)
+    {
+        if (n_rest > 0 && (strcmp(rest[0], "--help") == 0 || strcmp(rest[0], "-h") == 0))
+            fprintf(stderr, "  --set KEY=VALUE  override a lidet_ground_cfg_t field (repeatable), e.g. --set ground_m=0.2\n");
+        free(rest);
+        free(sets);
+        return 1;
+    }
     lidet_proj_cfg_default(&pcfg, a.sensor_profile);
     lidet_ground_cfg_default(&gcfg, a.sensor_profile);
+    for (k = 0; k < n_sets; ++k)
+    {
+        if (apply_set(&gcfg, sets[k]) != 0)
+        {
+            fprintf(stderr, "lidet ground: bad --set '%s' (KEY=VALUE with a lidet_ground_cfg_t field)\n", sets[k]);
+            free(rest);
+            free(sets);
+            cli_free(&a);
+            return 1;
+        }
+    }
+    free(rest);
+    free(sets);
     st = lidet_proj_init(&g_proj, &pcfg);
     if (st == LIDET_OK)
         st = lidet_ground_init(&g_ground, &gcfg);
