@@ -9,9 +9,10 @@
 #include "internal/lidet_math.h"
 #include "internal/lidet_rng.h"
 
-/* Defaults measured on simulated scans and on the real SemanticKITTI scans (docs/GROUND.md).
- * Two families: a tall car mount with many beams (hdl64, os1-*), and a low robot mount with few
- * beams (vlp16 at 0.5 m), where rings are far apart and the ground is seen at grazing angles. */
+/* Defaults measured on the real SemanticKITTI scans (tools/bench/bench_ground.py, docs/GROUND.md).
+ * Two families: a tall car mount with many beams (hdl64, os1-*, vlp32c), and a low robot mount or few
+ * beams (vlp16 at 0.5 m), where rings are far apart: there every row is filtered (sample_step 1) and
+ * the plane height must stay closer to the mount height. */
 void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sensor)
 {
     float mount = 1.73f;
@@ -26,34 +27,33 @@ void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sen
         mount = sensor->mount_height_m;
         rows = sensor->n_rows;
     }
+    /* sample filter: the paper's (S_u on R, |F_y| <= 0.2, no height gate) */
     cfg->fy_max = 0.2f;
     cfg->fx_max_m = 1.0f;
     cfg->fx_on_z = 0u;
-    cfg->require_descending = 1u;
+    cfg->require_descending = 0u;
     cfg->height_gate = 0u;
-    cfg->gate_above_m = 0.43f;
-    cfg->gate_below_m = 8.27f;
+    cfg->gate_above_m = 0.43f; /* released code on KITTI: z < -1.3 m at a 1.73 m mount */
+    cfg->gate_below_m = 8.27f; /* ... and z > -10 m */
     cfg->mount_height_m = mount;
+    cfg->sample_step = rows >= 48u ? 4u : (rows >= 24u ? 2u : 1u);
+    /* RANSAC */
     cfg->n_sectors = 32u;
     cfg->ransac_iters = 16u;
     cfg->eval_samples = 256u;
-    cfg->sample_step = 4u;
+    cfg->confidence = 0.99f;
     cfg->min_samples = 10u;
     cfg->min_inliers = 8u;
     cfg->refine_iters = 1u;
-    cfg->confidence = 0.99f;
-    cfg->inlier_m = 0.15f;
-    cfg->max_tilt_rad = 0.2f;
-    cfg->max_height_dev_m = 1.0f;
+    cfg->inlier_m = 0.2f;
+    cfg->max_tilt_rad = 0.1f;
+    cfg->max_height_dev_m = (rows <= 32u || mount < 1.0f) ? 0.5f : 1.0f;
     cfg->fallback_sectors = 4u;
     cfg->seed = 12345u;
-    cfg->ground_m = 0.2f;
+    /* labelling: 0.15 m above, 0.3 m below the plane */
+    cfg->ground_m = 0.15f;
     cfg->ground_m_per_m = 0.0f;
-    cfg->below_factor = 1.0f;
-    if (rows <= 32u || mount < 1.0f)
-    {
-        cfg->max_height_dev_m = 0.5f;
-    }
+    cfg->below_factor = 2.0f;
 }
 
 static int in_range(float v, float lo, float hi)
