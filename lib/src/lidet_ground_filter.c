@@ -9,14 +9,17 @@
 #include "internal/lidet_math.h"
 #include "internal/lidet_rng.h"
 
-/* Defaults measured on the real SemanticKITTI scans (tools/bench/bench_ground.py, docs/GROUND.md).
- * Two families: a tall car mount with many beams (hdl64, os1-*, vlp32c), and a low robot mount or few
- * beams (vlp16 at 0.5 m), where rings are far apart: there every row is filtered (sample_step 1) and
- * the plane height must stay closer to the mount height. */
+/* Defaults measured by tools/bench/bench_ground.py and coordinate-descent sweeps (docs/GROUND.md) on
+ * the real SemanticKITTI scans and 20 simulated scans per profile. Two families:
+ *  - a tall car mount with many beams (hdl64; also os1-*): filter every 2nd row, sectors split at
+ *    15 m into a near and a far plane, 0.15 m above / 0.3 m below the plane is ground;
+ *  - a low robot mount or few beams (vlp16 at 0.5 m; also vlp32c): every row, one plane per sector,
+ *    a tighter 0.1 m above (0.4 m below) and a plane height closer to the mount height. */
 void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sensor)
 {
     float mount = 1.73f;
     uint32_t rows = 64u;
+    int low;
     if (cfg == 0)
     {
         return;
@@ -27,33 +30,35 @@ void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sen
         mount = sensor->mount_height_m;
         rows = sensor->n_rows;
     }
+    low = rows <= 32u || mount < 1.0f;
     /* sample filter: the paper's (S_u on R, |F_y| <= 0.2, no height gate) */
     cfg->fy_max = 0.2f;
-    cfg->fx_max_m = 1.0f;
+    cfg->fx_max_m = low ? 0.2f : 1.0f;
     cfg->fx_on_z = 0u;
     cfg->require_descending = 0u;
     cfg->height_gate = 0u;
     cfg->gate_above_m = 0.43f; /* released code on KITTI: z < -1.3 m at a 1.73 m mount */
     cfg->gate_below_m = 8.27f; /* ... and z > -10 m */
     cfg->mount_height_m = mount;
-    cfg->sample_step = rows >= 48u ? 4u : (rows >= 24u ? 2u : 1u);
+    cfg->sample_step = low ? 1u : 2u;
     /* RANSAC */
     cfg->n_sectors = 32u;
     cfg->ransac_iters = 16u;
     cfg->eval_samples = 256u;
     cfg->confidence = 0.99f;
-    cfg->min_samples = 10u;
+    cfg->min_samples = low ? 10u : 20u;
     cfg->min_inliers = 8u;
-    cfg->refine_iters = 1u;
-    cfg->inlier_m = 0.2f;
-    cfg->max_tilt_rad = 0.1f;
-    cfg->max_height_dev_m = (rows <= 32u || mount < 1.0f) ? 0.5f : 1.0f;
+    cfg->refine_iters = low ? 2u : 1u;
+    cfg->inlier_m = low ? 0.15f : 0.2f;
+    cfg->max_tilt_rad = low ? 0.2f : 0.1f;
+    cfg->max_height_dev_m = low ? 0.5f : 1.0f;
+    cfg->ring_split_m = low ? 0.0f : 15.0f;
     cfg->fallback_sectors = 4u;
     cfg->seed = 12345u;
-    /* labelling: 0.15 m above, 0.3 m below the plane */
-    cfg->ground_m = 0.15f;
+    /* labelling */
+    cfg->ground_m = low ? 0.1f : 0.15f;
     cfg->ground_m_per_m = 0.0f;
-    cfg->below_factor = 2.0f;
+    cfg->below_factor = low ? 4.0f : 2.0f;
 }
 
 static int in_range(float v, float lo, float hi)
@@ -81,7 +86,8 @@ lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cf
         cfg->inlier_m <= 0.0f || !in_range(cfg->max_tilt_rad, 0.0f, LIDET_HALF_PI_F) || cfg->max_tilt_rad <= 0.0f ||
         cfg->max_tilt_rad >= LIDET_HALF_PI_F || !in_range(cfg->max_height_dev_m, 0.0f, 20.0f) ||
         cfg->max_height_dev_m <= 0.0f || !in_range(cfg->ground_m, 0.0f, 5.0f) || cfg->ground_m <= 0.0f ||
-        !in_range(cfg->ground_m_per_m, 0.0f, 0.1f) || !in_range(cfg->below_factor, 0.0f, 20.0f) || !in_range(cfg->confidence, 0.0f, 0.999999f))
+        !in_range(cfg->ground_m_per_m, 0.0f, 0.1f) || !in_range(cfg->below_factor, 0.0f, 20.0f) || !in_range(cfg->confidence, 0.0f, 0.999999f) ||
+        !in_range(cfg->ring_split_m, 0.0f, 500.0f))
     {
         return LIDET_ERR_CONFIG;
     }
@@ -159,49 +165,57 @@ static void filter_rows(lidet_ground_t *g, const lidet_range_image_t *img)
     }
 }
 
-/* Pass 2: gather the samples' coordinates grouped by sector (sector-major, then raster order), so
- * each sector's RANSAC reads one contiguous block. Only columns on the step grid (c % step == 0)
- * of the filtered rows are taken: with step 2 a quarter of the image. Stops at LIDET_GROUND_MAX_SAMPLES. While the
- * remaining capacity covers a whole sector, the copy is branch-free (store, then advance by the
- * mask bit): samples are ~40 % of the pixels in no predictable pattern. */
+/* Pass 2 (mirrors ref/ground.py: gather_samples): the samples' coordinates grouped by cell, so each
+ * cell's RANSAC reads one contiguous block. Only columns on the step grid (c % step == 0) of the
+ * filtered rows are taken (with step 4, 1/16 of the image). Near samples (R < ring_split_m) fill the
+ * buffer upwards from its start, far ones downwards from its end, so one pass serves both cells of a
+ * sector (far cells hold their samples in reverse raster order). While the free space covers every
+ * candidate of a sector, the copy is branch-free: every candidate is written to the next free slot
+ * of its end, and the mask bit decides whether that end advances (samples come in no predictable pattern). Past LIDET_GROUND_MAX_SAMPLES,
+ * samples are dropped and counted. */
 static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
+    const float split = g->cfg.ring_split_m > 0.0f ? g->cfg.ring_split_m : 3.0e38f;
     float *const sx = g->sx_m, *const sy = g->sy_m, *const sz = g->sz_m;
-    uint32_t s, r, c, n = 0, total = 0;
+    uint32_t s, r, c, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
     for (s = 0; s < ns; ++s)
     {
         const uint32_t c0 = lidet__ground_sector_col(s, ns, cols), c1 = lidet__ground_sector_col(s + 1u, ns, cols);
-        const int roomy = (uint32_t)LIDET_GROUND_MAX_SAMPLES - n >= (rows - 1u) * (c1 - c0);
-        g->sector_first[s] = n;
+        const uint32_t cstart = c0 + (step - c0 % step) % step;
+        const int roomy = hi - lo >= rows * (c1 - c0);
+        const uint32_t near_start = lo, far_end = hi;
         for (r = 0; r + 1u < rows; r += step)
         {
-            const uint8_t *m = g->sample + (size_t)r * cols;
-            const float *X = img->x_m + (size_t)r * cols, *Y = img->y_m + (size_t)r * cols;
-            const float *Z = img->z_m + (size_t)r * cols;
+            const size_t base = (size_t)r * cols;
+            const uint8_t *m = g->sample + base;
+            const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base, *R = img->rxy_m + base;
             if (roomy)
             {
-                for (c = c0 + (step - c0 % step) % step; c < c1; c += step)
+                for (c = cstart; c < c1; c += step)
                 {
-                    sx[n] = X[c];
-                    sy[n] = Y[c];
-                    sz[n] = Z[c];
-                    n += m[c];
+                    const uint32_t far = (uint32_t)(R[c] >= split), take = m[c];
+                    const uint32_t k = far ? hi - 1u : lo; /* lo < hi: roomy leaves a slot per candidate */
+                    sx[k] = X[c];
+                    sy[k] = Y[c];
+                    sz[k] = Z[c];
+                    lo += take & (far ^ 1u);
+                    hi -= take & far;
                 }
             }
             else
             {
-                for (c = c0 + (step - c0 % step) % step; c < c1; c += step)
+                for (c = cstart; c < c1; c += step)
                 {
                     if (m[c] != 0u)
                     {
                         ++total;
-                        if (n < LIDET_GROUND_MAX_SAMPLES)
+                        if (lo < hi)
                         {
-                            sx[n] = X[c];
-                            sy[n] = Y[c];
-                            sz[n] = Z[c];
-                            ++n;
+                            const uint32_t k = R[c] >= split ? --hi : lo++;
+                            sx[k] = X[c];
+                            sy[k] = Y[c];
+                            sz[k] = Z[c];
                         }
                     }
                 }
@@ -209,22 +223,27 @@ static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
         }
         if (roomy)
         {
-            total += n - g->sector_first[s];
+            total += (lo - near_start) + (far_end - hi);
         }
+        g->cell_first[s] = near_start;
+        g->cell_n[s] = lo - near_start;
+        g->cell_first[ns + s] = hi;
+        g->cell_n[ns + s] = far_end - hi;
     }
-    g->sector_first[ns] = n;
     g->stats.n_samples = total;
-    g->stats.n_samples_dropped = total - n;
+    g->stats.n_samples_dropped = total - (lo + (LIDET_GROUND_MAX_SAMPLES - hi));
 }
 
-/* Pass 3 (mirrors ref/ground.py: label_pixels): ground = holds a point and -below < height < above.
- * Empty pixels are excluded through point_idx (their coordinates are 0, which may lie within
- * ground_m of a plane through the origin). */
+/* Pass 3 (mirrors ref/ground.py: label_pixels): ground = holds a point and -below < height < above,
+ * height above the pixel's cell plane (near or far part of its sector). Empty pixels are excluded
+ * through point_idx (their coordinates are 0, which may lie within ground_m of a plane). */
 static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors;
     const float g0 = g->cfg.ground_m, k = g->cfg.ground_m_per_m, bf = g->cfg.below_factor;
     const float below0 = bf * g0;
+    const float split = g->cfg.ring_split_m > 0.0f ? g->cfg.ring_split_m : 3.0e38f;
+    const int simple = k == 0.0f && !(g->cfg.ring_split_m > 0.0f);
     uint32_t r, s, c, n_ground = 0;
     for (r = 0; r < rows; ++r)
     {
@@ -235,9 +254,9 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
         for (s = 0; s < ns; ++s)
         {
             const uint32_t c0 = lidet__ground_sector_col(s, ns, cols), c1 = lidet__ground_sector_col(s + 1u, ns, cols);
-            const lidet_plane_t p = g->planes[s];
+            const lidet_plane_t p = g->planes[s], q = g->planes[ns + s];
             uint32_t cnt = 0;
-            if (k == 0.0f)
+            if (simple)
             {
                 for (c = c0; c < c1; ++c)
                 {
@@ -247,13 +266,34 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
                     cnt += m;
                 }
             }
+            else if (k == 0.0f)
+            {
+                /* two planes, constant tolerance. Branch-free select of the cell plane (a ?: on
+                 * floats stays a branch here, which stops vectorisation): both tests, blended by
+                 * the near/far bit */
+                for (c = c0; c < c1; ++c)
+                {
+                    const float hn = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
+                    const float hf = q.nx * X[c] + q.ny * Y[c] + q.nz * Z[c] + q.d_m;
+                    const int is_near = R[c] < split;
+                    const int in_n = (hn < g0) & (hn > -below0);
+                    const int in_f = (hf < g0) & (hf > -below0);
+                    const uint8_t m = (uint8_t)((V[c] >= 0) & ((is_near & in_n) | ((is_near ^ 1) & in_f)));
+                    out[c] = m;
+                    cnt += m;
+                }
+            }
             else
             {
                 for (c = c0; c < c1; ++c)
                 {
-                    const float h = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
+                    const float hn = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
+                    const float hf = q.nx * X[c] + q.ny * Y[c] + q.nz * Z[c] + q.d_m;
                     const float above = g0 + k * R[c];
-                    const uint8_t m = (uint8_t)((V[c] >= 0) & (h < above) & (h > -bf * above));
+                    const int is_near = R[c] < split;
+                    const int in_n = (hn < above) & (hn > -bf * above);
+                    const int in_f = (hf < above) & (hf > -bf * above);
+                    const uint8_t m = (uint8_t)((V[c] >= 0) & ((is_near & in_n) | ((is_near ^ 1) & in_f)));
                     out[c] = m;
                     cnt += m;
                 }

@@ -349,33 +349,40 @@ static int fit_sector(lidet_ground_t *g, const float *xs, const float *ys, const
 void lidet__ground_fit_sectors(lidet_ground_t *g)
 {
     const uint32_t ns = g->cfg.n_sectors;
+    const uint32_t n_cells = g->cfg.ring_split_m > 0.0f ? 2u * ns : ns;
     uint32_t s, k;
     lidet_plane_t mount;
     mount.nx = 0.0f;
     mount.ny = 0.0f;
     mount.nz = 1.0f;
     mount.d_m = g->cfg.mount_height_m;
-    for (s = 0; s < ns; ++s)
+    /* every cell on its own samples: near cells 0..ns-1, then far cells (the RNG runs in this order) */
+    for (k = 0; k < 2u * ns; ++k)
     {
-        const uint32_t a = g->sector_first[s], n = g->sector_first[s + 1u] - a;
-        LIDET_ASSERT(g->sector_first[s + 1u] >= a);
-        g->source[s] = LIDET_GROUND_PLANE_MOUNT;
-        if (n < g->cfg.min_samples)
+        const uint32_t a = g->cell_first[k], n = g->cell_n[k];
+        const int near = k < ns;
+        g->source[k] = near ? LIDET_GROUND_PLANE_MOUNT : LIDET_GROUND_PLANE_NEAR;
+        if (k >= n_cells || n < g->cfg.min_samples)
         {
-            ++g->stats.n_sectors_sparse;
+            g->stats.n_sectors_sparse += (uint16_t)near;
             continue;
         }
-        if (fit_sector(g, g->sx_m + a, g->sy_m + a, g->sz_m + a, n, &g->planes[s]))
+        LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
+        if (fit_sector(g, g->sx_m + a, g->sy_m + a, g->sz_m + a, n, &g->planes[k]))
         {
-            g->source[s] = LIDET_GROUND_PLANE_FITTED;
-            ++g->stats.n_sectors_fitted;
+            g->source[k] = LIDET_GROUND_PLANE_FITTED;
+            if (near)
+                ++g->stats.n_sectors_fitted;
+            else
+                ++g->stats.n_far_fitted;
         }
         else
         {
-            ++g->stats.n_sectors_rejected;
+            g->stats.n_sectors_rejected += (uint16_t)near;
         }
     }
-    /* fallback: nearest sector that has its own plane (never a copied one), else the mount plane */
+    /* near fallback: nearest sector that has its own near plane (never a copied one), else the
+     * mount plane */
     for (s = 0; s < ns; ++s)
     {
         int found = 0;
@@ -406,6 +413,15 @@ void lidet__ground_fit_sectors(lidet_ground_t *g)
         {
             g->planes[s] = mount;
             ++g->stats.n_sectors_mount;
+        }
+    }
+    /* far fallback: the sector's own near plane */
+    for (s = 0; s < ns; ++s)
+    {
+        if (g->source[ns + s] != LIDET_GROUND_PLANE_FITTED)
+        {
+            g->planes[ns + s] = g->planes[s];
+            g->source[ns + s] = LIDET_GROUND_PLANE_NEAR;
         }
     }
 }

@@ -112,6 +112,7 @@ static int apply_set(lidet_ground_cfg_t *c, const char *kv)
     FLOAT_FIELD(ground_m_per_m)
     FLOAT_FIELD(below_factor)
     FLOAT_FIELD(confidence)
+    FLOAT_FIELD(ring_split_m)
     INT_FIELD(fx_on_z, uint8_t, 1)
     INT_FIELD(require_descending, uint8_t, 1)
     INT_FIELD(height_gate, uint8_t, 1)
@@ -260,6 +261,7 @@ int cli_ground(int argc, char **argv)
         cli_json_int(stdout, "sectors_fitted", gs->n_sectors_fitted);
         cli_json_int(stdout, "sectors_neighbour", gs->n_sectors_neighbour);
         cli_json_int(stdout, "sectors_mount", gs->n_sectors_mount);
+        cli_json_int(stdout, "far_fitted", gs->n_far_fitted);
         cli_json_int(stdout, "hypotheses", gs->n_hypotheses);
         cli_json_int(stdout, "repeat", a.repeat);
         cli_json_num(stdout, "project_ms", proj_ms);

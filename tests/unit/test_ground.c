@@ -307,6 +307,17 @@ static void test_ramp_two_planes(void)
     TEST_ASSERT_TRUE(share(1, 1, before_ramp) >= 0.95);
     TEST_ASSERT_TRUE(share(1, 1, NULL) >= 0.80);
     TEST_ASSERT_TRUE(share(0, 0, NULL) >= 0.999);
+    /* near/far cells split at 12 m (the kink) and a tilt limit above the ramp's 8.5 deg: the far
+     * cells ahead fit the ramp itself, so most of the ramp becomes ground too */
+    gcfg.ring_split_m = 12.0f;
+    gcfg.max_tilt_rad = 0.2f;
+    gcfg.max_height_dev_m = 2.0f; /* the ramp's plane passes 3.46 m below the sensor */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_init(&gg.ws, &gcfg));
+    run_all();
+    TEST_ASSERT_TRUE(lidet_ground_stats(&gg.ws)->n_far_fitted > 8u);
+    TEST_ASSERT_TRUE(share(1, 1, behind) >= 0.999);
+    TEST_ASSERT_TRUE(share(1, 1, NULL) >= 0.96);
+    TEST_ASSERT_TRUE(share(0, 0, NULL) >= 0.999);
 }
 
 static void test_curb_step(void)
@@ -322,7 +333,8 @@ static void test_curb_step(void)
     TEST_ASSERT_TRUE(share(0, 0, NULL) >= 0.999);
 }
 
-/* drops sectors 4..6 entirely and keeps only the bottom row in sector 12 (too few samples) */
+/* drops sectors 4..6 entirely and keeps only the bottom row in sector 12 (no samples: the bottom row
+ * has no beam below it) */
 static int keep_holes(double az, int row)
 {
     const double u = 0.5 * (1.0 - az / M_PI); /* column fraction in [0, 1) */
@@ -330,7 +342,7 @@ static int keep_holes(double az, int row)
     if (s >= 4 && s <= 6)
         return 0;
     if (s == 12)
-        return row >= 62;
+        return row >= 63;
     return 1;
 }
 

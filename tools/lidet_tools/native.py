@@ -185,13 +185,13 @@ def project(points, sensor: str | Sensor = "hdl64", ring=None, **cfg) -> RangeIm
 
 #: float and integer fields of lidet_ground_cfg_t, in the order of ports/python/lidet_py.c
 GROUND_F = ["fy_max", "fx_max_m", "gate_above_m", "gate_below_m", "mount_height_m", "inlier_m",
-            "max_tilt_rad", "max_height_dev_m", "ground_m", "ground_m_per_m", "below_factor", "confidence"]
+            "max_tilt_rad", "max_height_dev_m", "ground_m", "ground_m_per_m", "below_factor", "confidence", "ring_split_m"]
 GROUND_U = ["fx_on_z", "require_descending", "height_gate", "n_sectors", "ransac_iters", "eval_samples",
             "min_samples", "min_inliers", "refine_iters", "fallback_sectors", "seed", "sample_step"]
 _GROUND_STATS = ["_unused", "n_samples", "n_samples_dropped", "n_ground", "n_sectors_fitted",
                  "n_sectors_neighbour", "n_sectors_mount", "n_sectors_sparse", "n_sectors_rejected",
-                 "n_hypotheses"]
-PLANE_SOURCE = {0: "fitted", 1: "neighbour", 2: "mount"}
+                 "n_hypotheses", "n_far_fitted"]
+PLANE_SOURCE = {0: "fitted", 1: "neighbour", 2: "mount", 3: "near"}
 
 
 def ground_defaults(sensor: str | Sensor = "hdl64") -> dict:
@@ -210,10 +210,11 @@ class GroundResult:
     """Output of `ground`."""
     mask_point: np.ndarray   #: (n,) uint8 per input point, input order: 1 ground, 0 not (or not projected)
     mask_pixel: np.ndarray   #: (rows, cols) uint8 per pixel
-    planes: np.ndarray       #: (n_sectors, 4) float32 rows (nx, ny, nz, d): n.p + d = height above plane
+    planes: np.ndarray       #: (n_sectors, 4) float32 near planes (nx, ny, nz, d): n.p + d = height above
+    planes_far: np.ndarray   #: (n_sectors, 4) far planes (horizontal range >= ring_split_m)
     stats: dict
     sample_pixel: np.ndarray  #: (rows, cols) uint8: pixels that passed the sample filter
-    source: np.ndarray        #: (n_sectors,) uint8: 0 fitted, 1 neighbour, 2 mount plane
+    source: np.ndarray        #: (2 * n_sectors,) uint8 near then far: 0 fitted, 1 neighbour, 2 mount, 3 near
     image: RangeImage
     status: int
 
@@ -240,14 +241,15 @@ def ground(points, sensor: str | Sensor = "hdl64", ring=None, proj_cfg: dict | N
     mp = np.zeros((rows, cols), np.uint8)
     sp = np.zeros((rows, cols), np.uint8)
     mpt = np.zeros(n, np.uint8)
-    planes = np.zeros((max(ns, 1), 4), np.float32)
-    src = np.zeros(max(ns, 1), np.uint8)
+    planes = np.zeros((2 * max(ns, 1), 4), np.float32)
+    src = np.zeros(2 * max(ns, 1), np.uint8)
     stats = np.zeros(len(_GROUND_STATS), np.uint32)
     cap = capacity()["max_points"]
     st = lib().lidet_py_ground_run(f, u, mp, sp, mpt[: min(n, cap)] if n else None, planes, src, stats)
     if st < 0:
         raise LidetError(st, "lidet_ground_run")
-    return GroundResult(mpt, mp, planes[:ns], dict(zip(_GROUND_STATS, map(int, stats))), sp, src[:ns], img, int(st))
+    return GroundResult(mpt, mp, planes[:ns], planes[ns:2 * ns], dict(zip(_GROUND_STATS, map(int, stats))), sp,
+                        src[:2 * ns], img, int(st))
 
 
 def ground_fit_plane(xyz) -> tuple[np.ndarray, np.ndarray]:

@@ -9,7 +9,8 @@ Same algorithm, same order, same random draws (ref/rng.py mirrors the C xorshift
 * `ransac_sector`: hypotheses and their scores in float32 (identical draws and counts), the
   least-squares refinement in float64 with numpy's eigh (the C code uses float sums and Jacobi
   rotations: planes agree to ~1e-5, so a few pixels at the p_th boundary may flip);
-* `fallback`, `label_pixels`, and `ground` chaining them.
+* `fit_sectors` (per cell: near / far part of each sector, with the fallback), `label_pixels`, and
+  `ground` chaining them.
 
 Configuration: a dict with the field names of lidet_ground_cfg_t (native.ground_defaults gives the
 C defaults).
@@ -21,7 +22,7 @@ import numpy as np
 from .rng import XorShift32
 
 F = np.float32
-FITTED, NEIGHBOUR, MOUNT = 0, 1, 2
+FITTED, NEIGHBOUR, MOUNT, NEAR = 0, 1, 2, 3
 
 
 def sector_col(s: int, n_sectors: int, cols: int) -> int:
@@ -58,19 +59,25 @@ def sample_mask(R: np.ndarray, Z: np.ndarray, cfg: dict) -> np.ndarray:
     return out
 
 
-def gather_samples(sample: np.ndarray, X, Y, Z, cfg: dict):
-    """Per sector: (N, 3) float32 samples on the step grid, raster order (as gather_samples in C)."""
+def gather_samples(sample: np.ndarray, X, Y, Z, cfg: dict, R=None):
+    """Samples per cell as (N, 3) float32 arrays: cells 0..ns-1 are the near parts of the sectors
+    (horizontal range < ring_split_m, or everything when it is 0), cells ns..2ns-1 the far parts.
+    Near samples in raster order, far samples in reverse raster order (as the C buffer fills)."""
     rows, cols = sample.shape
     ns, step = int(cfg["n_sectors"]), int(cfg["sample_step"])
-    out = []
+    split = F(cfg.get("ring_split_m", 0.0))
+    R = np.zeros_like(np.asarray(X, F)) if R is None else np.asarray(R, F)
+    near, far = [], []
     rr = np.arange(0, rows - 1, step)
     for s in range(ns):
         c0, c1 = sector_col(s, ns, cols), sector_col(s + 1, ns, cols)
         cc = np.arange(c0 + (step - c0 % step) % step, c1, step)
         m = sample[np.ix_(rr, cc)].astype(bool)
-        pts = np.stack([np.asarray(A, F)[np.ix_(rr, cc)][m] for A in (X, Y, Z)], 1)
-        out.append(pts.reshape(-1, 3))
-    return out
+        pts = np.stack([np.asarray(A, F)[np.ix_(rr, cc)][m] for A in (X, Y, Z)], 1).reshape(-1, 3)
+        is_far = (R[np.ix_(rr, cc)][m] >= split) if split > 0 else np.zeros(len(pts), bool)
+        near.append(pts[~is_far])
+        far.append(pts[is_far][::-1])
+    return near + far
 
 
 def fit_plane_lsq(pts: np.ndarray):
@@ -144,20 +151,21 @@ def ransac_sector(pts: np.ndarray, rng: XorShift32, cfg: dict):
     return best, hyps
 
 
-def fit_sectors(samples, cfg: dict):
-    """(n_sectors, 4) planes and (n_sectors,) sources, with the fallback applied."""
+def fit_sectors(cells, cfg: dict):
+    """(2 * n_sectors, 4) planes (near, then far) and sources, with the fallback applied."""
     ns = int(cfg["n_sectors"])
+    n_cells = 2 * ns if cfg.get("ring_split_m", 0.0) > 0 else ns
     rng = XorShift32(int(cfg["seed"]))
-    planes = np.zeros((ns, 4))
-    src = np.full(ns, MOUNT, np.uint8)
-    for s in range(ns):
-        if len(samples[s]) < int(cfg["min_samples"]):
+    planes = np.zeros((2 * ns, 4))
+    src = np.array([MOUNT] * ns + [NEAR] * ns, np.uint8)
+    for k in range(n_cells):
+        if len(cells[k]) < int(cfg["min_samples"]):
             continue
-        p, _ = ransac_sector(samples[s], rng, cfg)
+        p, _ = ransac_sector(cells[k], rng, cfg)
         if p is not None:
-            planes[s], src[s] = p, FITTED
+            planes[k], src[k] = p, FITTED
     mount = np.array([0.0, 0.0, 1.0, cfg["mount_height_m"]])
-    fitted = src == FITTED
+    fitted = src[:ns] == FITTED
     for s in range(ns):
         if fitted[s]:
             continue
@@ -171,22 +179,32 @@ def fit_sectors(samples, cfg: dict):
                 break
         else:
             planes[s] = mount
+    for s in range(ns):
+        if src[ns + s] != FITTED:
+            planes[ns + s], src[ns + s] = planes[s], NEAR
     return planes, src
 
 
 def label_pixels(X, Y, Z, R, valid, planes, cfg: dict) -> np.ndarray:
-    """(rows, cols) uint8 ground mask: valid and -below < height above the sector plane < above."""
+    """(rows, cols) uint8 ground mask: valid and -below < height above the pixel's cell plane < above."""
     rows, cols = np.shape(X)
     ns = int(cfg["n_sectors"])
     sec = (np.arange(cols) * ns) // cols
-    pl = np.asarray(planes, F)[sec]  # (cols, 4)
-    h = pl[:, 0] * np.asarray(X, F) + pl[:, 1] * np.asarray(Y, F) + pl[:, 2] * np.asarray(Z, F) + pl[:, 3]
-    above = F(cfg["ground_m"]) + F(cfg["ground_m_per_m"]) * np.asarray(R, F)
-    return (np.asarray(valid, bool) & (h < above) & (h > -F(cfg["below_factor"]) * above)).astype(np.uint8)
+    R = np.asarray(R, F)
+    split = F(cfg.get("ring_split_m", 0.0))
+    above = F(cfg["ground_m"]) + F(cfg["ground_m_per_m"]) * R
+    below = -F(cfg["below_factor"]) * above
+    ok = np.zeros((rows, cols), bool)
+    for part, sel in ((0, R < split if split > 0 else np.ones_like(R, bool)),
+                      (1, R >= split if split > 0 else np.zeros_like(R, bool))):
+        pl = np.asarray(planes, F)[part * ns + sec]  # (cols, 4)
+        h = pl[:, 0] * np.asarray(X, F) + pl[:, 1] * np.asarray(Y, F) + pl[:, 2] * np.asarray(Z, F) + pl[:, 3]
+        ok |= sel & (h < above) & (h > below)
+    return (np.asarray(valid, bool) & ok).astype(np.uint8)
 
 
 def ground(X, Y, Z, R, valid, cfg: dict):
-    """The whole stage on a range image: (mask, sample mask, planes, sources)."""
+    """The whole stage on a range image: (mask, sample mask, planes (near then far), sources)."""
     smp = sample_mask(R, Z, cfg)
-    planes, src = fit_sectors(gather_samples(smp, X, Y, Z, cfg), cfg)
+    planes, src = fit_sectors(gather_samples(smp, X, Y, Z, cfg, R), cfg)
     return label_pixels(X, Y, Z, R, valid, planes, cfg), smp, planes, src

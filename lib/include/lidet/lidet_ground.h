@@ -27,16 +27,19 @@
  *     rotations), refine_iters times. A plane is accepted when it has >= min_inliers inliers,
  *     a tilt <= max_tilt_rad and a height of the sensor above it within max_height_dev_m of
  *     mount_height_m.
- *  3. Fallback for sectors with fewer than min_samples samples or no accepted plane: the plane of
- *     the nearest fitted sector at most fallback_sectors away (ties: sector s-k before s+k), else the
- *     mount plane z = -mount_height_m (normal +z).
- *  4. Ground pixel: holds a point and its signed height h above its sector's plane satisfies
+ *     With ring_split_m > 0 each sector has two cells, near (R < ring_split_m) and far, each
+ *     fitted on its own samples (a lidet extension: real ground bends between 3 m and 70 m).
+ *  3. Fallback for near cells with fewer than min_samples samples or no accepted plane: the plane
+ *     of the nearest fitted near cell at most fallback_sectors away (ties: sector s-k before s+k),
+ *     else the mount plane z = -mount_height_m (normal +z). A far cell without its own plane takes
+ *     its sector's near plane.
+ *  4. Ground pixel: holds a point and its signed height h above its cell's plane satisfies
  *     -below_m(R) < h < above_m(R), with above_m(R) = ground_m + ground_m_per_m * R and
  *     below_m(R) = below_factor * above_m(R) (R = horizontal range). With below_factor 1 and
  *     ground_m_per_m 0 this is the paper's |distance| < p_th.
  *
  * Memory: sizeof(lidet_ground_t) = LIDET_MAX_ROWS * LIDET_MAX_COLS * 2 B (ground and sample masks)
- * + LIDET_GROUND_MAX_SAMPLES * 12 B (x, y, z of the samples) + LIDET_GROUND_MAX_SECTORS * 24 B
+ * + LIDET_GROUND_MAX_SAMPLES * 12 B (x, y, z of the samples) + LIDET_GROUND_MAX_SECTORS * 50 B
  * + ~200 B; defaults (128 x 2048, 262,144 samples): about 3.5 MiB; a VLP-16 build (16 x 1800,
  * samples = pixels): about 0.4 MiB. lidet_ground_bytes() returns the exact figure. Declare it static.
  * Time: O(n_rows * n_cols) for the filter and the labelling, O(n_sectors * ransac_iters *
@@ -58,7 +61,9 @@ typedef enum
 {
     LIDET_GROUND_PLANE_FITTED = 0,   /**< RANSAC (+ refinement) on the sector's own samples */
     LIDET_GROUND_PLANE_NEIGHBOUR = 1, /**< copied from the nearest fitted sector */
-    LIDET_GROUND_PLANE_MOUNT = 2      /**< the mount plane z = -mount_height_m */
+    LIDET_GROUND_PLANE_MOUNT = 2,     /**< the mount plane z = -mount_height_m */
+    LIDET_GROUND_PLANE_NEAR = 3       /**< far part of a sector without its own plane: the sector's
+                                           near plane (also every far part when ring_split_m is 0) */
 } lidet_ground_plane_source_t;
 
 /**
@@ -104,6 +109,10 @@ typedef struct
                                    typical 0.1-0.35 (the released code used 0.1) */
     float max_height_dev_m;   /**< accepted |sensor height above the plane - mount_height_m|,
                                    metres; (0, 20], typical 0.5-1.5 */
+    float ring_split_m;       /**< each sector is split at this horizontal range (metres) into a
+                                   near and a far part with a plane each (ground is rarely one plane
+                                   from 3 m to 70 m); 0 = one plane per sector (paper); [0, 500],
+                                   typical 10-20 m */
     uint16_t fallback_sectors;/**< how far (in sectors, either side) a fitted neighbour may be;
                                    [0, n_sectors] */
     uint32_t seed;            /**< xorshift32 seed (0 is replaced by a fixed non-zero value);
@@ -124,11 +133,12 @@ typedef struct
     uint32_t n_samples;          /**< samples handed to RANSAC (passed the filter, on the step grid) */
     uint32_t n_samples_dropped;  /**< samples past LIDET_GROUND_MAX_SAMPLES (not used; status TRUNCATED) */
     uint32_t n_ground;           /**< pixels labelled ground */
-    uint16_t n_sectors_fitted;   /**< sectors with their own plane */
-    uint16_t n_sectors_neighbour;/**< sectors that took a neighbour's plane */
-    uint16_t n_sectors_mount;    /**< sectors that took the mount plane */
-    uint16_t n_sectors_sparse;   /**< sectors with fewer than min_samples samples */
-    uint16_t n_sectors_rejected; /**< sectors whose best plane failed the inlier/tilt/height checks */
+    uint16_t n_sectors_fitted;   /**< near cells (whole sectors when ring_split_m is 0) with their own plane */
+    uint16_t n_sectors_neighbour;/**< near cells that took a neighbour's plane */
+    uint16_t n_sectors_mount;    /**< near cells that took the mount plane */
+    uint16_t n_sectors_sparse;   /**< near cells with fewer than min_samples samples */
+    uint16_t n_sectors_rejected; /**< near cells whose best plane failed the inlier/tilt/height checks */
+    uint16_t n_far_fitted;       /**< far cells with their own plane (0 when ring_split_m is 0) */
     uint32_t n_hypotheses;       /**< RANSAC hypotheses scored (after degenerate/tilt rejection) */
 } lidet_ground_stats_t;
 
@@ -144,9 +154,12 @@ typedef struct
     float sx_m[LIDET_GROUND_MAX_SAMPLES];                /* samples, grouped by sector */
     float sy_m[LIDET_GROUND_MAX_SAMPLES];
     float sz_m[LIDET_GROUND_MAX_SAMPLES];
-    uint32_t sector_first[LIDET_GROUND_MAX_SECTORS + 1]; /* samples of sector s: [first[s], first[s+1]) */
-    lidet_plane_t planes[LIDET_GROUND_MAX_SECTORS];
-    uint8_t source[LIDET_GROUND_MAX_SECTORS];            /* lidet_ground_plane_source_t */
+    /* cells: k = s (near part of sector s) and k = n_sectors + s (far part); the samples of cell k
+     * are sx/sy/sz[cell_first[k] .. cell_first[k] + cell_n[k]) */
+    uint32_t cell_first[2 * LIDET_GROUND_MAX_SECTORS];
+    uint32_t cell_n[2 * LIDET_GROUND_MAX_SECTORS];
+    lidet_plane_t planes[2 * LIDET_GROUND_MAX_SECTORS]; /* near planes, then far planes */
+    uint8_t source[2 * LIDET_GROUND_MAX_SECTORS];        /* lidet_ground_plane_source_t, same order */
     lidet_ground_stats_t stats;
 } lidet_ground_t;
 
@@ -191,13 +204,17 @@ const uint8_t *lidet_ground_mask(const lidet_ground_t *g);
 const uint8_t *lidet_ground_samples(const lidet_ground_t *g);
 
 /**
- * @brief Planes of the last run, one per sector (sector of column c = c * n_sectors / n_cols).
- * @param[out] n_sectors number of planes (may be NULL).
- * @return a view into g (valid until the next run/init), normals unit length with nz > 0.
+ * @brief Planes of the last run, one per sector (sector of column c = c * n_sectors / n_cols): the
+ *        near planes (horizontal range < ring_split_m; the whole sector when ring_split_m is 0).
+ *        The far planes follow in the same array: planes[n_sectors + s] (equal to the near plane
+ *        when the far part had no plane of its own).
+ * @param[out] n_sectors number of sectors (may be NULL).
+ * @return a view into g of 2 * n_sectors planes (valid until the next run/init), unit normals, nz > 0.
  */
 const lidet_plane_t *lidet_ground_planes(const lidet_ground_t *g, uint32_t *n_sectors);
 
-/** @brief Source of each sector's plane (lidet_ground_plane_source_t values), n_sectors bytes. */
+/** @brief Source of each plane (lidet_ground_plane_source_t values), 2 * n_sectors bytes in the
+ *         order of lidet_ground_planes (near, then far). */
 const uint8_t *lidet_ground_sector_source(const lidet_ground_t *g);
 
 /**
