@@ -41,12 +41,13 @@ void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sen
     cfg->gate_below_m = 8.27f; /* ... and z > -10 m */
     cfg->mount_height_m = mount;
     cfg->sample_step = low ? 1u : 2u;
+    cfg->sample_col_step = low ? 1u : 4u;
     /* RANSAC */
     cfg->n_sectors = 32u;
     cfg->ransac_iters = 16u;
     cfg->eval_samples = 256u;
     cfg->confidence = 0.99f;
-    cfg->min_samples = low ? 10u : 20u;
+    cfg->min_samples = 10u;
     cfg->min_inliers = 8u;
     cfg->refine_iters = low ? 2u : 1u;
     cfg->inlier_m = low ? 0.15f : 0.2f;
@@ -78,6 +79,7 @@ lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cf
         return LIDET_ERR_BUFFER;
     }
     if (cfg->n_sectors < 1u || cfg->ransac_iters < 1u || cfg->ransac_iters > 1000u || cfg->eval_samples < 3u || cfg->sample_step < 1u || cfg->sample_step > 16u ||
+        cfg->sample_col_step < 1u || cfg->sample_col_step > 16u ||
         cfg->min_samples < 3u || cfg->min_inliers < 3u || cfg->refine_iters > 10u || cfg->fx_on_z > 1u ||
         cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors ||
         !in_range(cfg->fy_max, 0.0f, 10.0f) || !in_range(cfg->fx_max_m, 0.0f, 100.0f) || cfg->fx_max_m <= 0.0f ||
@@ -166,8 +168,8 @@ static void filter_rows(lidet_ground_t *g, const lidet_range_image_t *img)
 }
 
 /* Pass 2 (mirrors ref/ground.py: gather_samples): the samples' coordinates grouped by cell, so each
- * cell's RANSAC reads one contiguous block. Only columns on the step grid (c % step == 0) of the
- * filtered rows are taken (with step 4, 1/16 of the image). Near samples (R < ring_split_m) fill the
+ * cell's RANSAC reads one contiguous block. Only columns on the column grid (c % sample_col_step == 0)
+ * of the filtered rows are taken (hdl64 defaults: every 2nd row, every 4th column). Near samples (R < ring_split_m) fill the
  * buffer upwards from its start, far ones downwards from its end, so one pass serves both cells of a
  * sector (far cells hold their samples in reverse raster order). While the free space covers every
  * candidate of a sector, the copy is branch-free: every candidate is written to the next free slot
@@ -176,13 +178,14 @@ static void filter_rows(lidet_ground_t *g, const lidet_range_image_t *img)
 static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
+    const uint32_t cstep = g->cfg.sample_col_step;
     const float split = g->cfg.ring_split_m > 0.0f ? g->cfg.ring_split_m : 3.0e38f;
     float *const sx = g->sx_m, *const sy = g->sy_m, *const sz = g->sz_m;
     uint32_t s, r, c, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
     for (s = 0; s < ns; ++s)
     {
         const uint32_t c0 = lidet__ground_sector_col(s, ns, cols), c1 = lidet__ground_sector_col(s + 1u, ns, cols);
-        const uint32_t cstart = c0 + (step - c0 % step) % step;
+        const uint32_t cstart = c0 + (cstep - c0 % cstep) % cstep;
         const int roomy = hi - lo >= rows * (c1 - c0);
         const uint32_t near_start = lo, far_end = hi;
         for (r = 0; r + 1u < rows; r += step)
@@ -192,7 +195,7 @@ static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
             const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base, *R = img->rxy_m + base;
             if (roomy)
             {
-                for (c = cstart; c < c1; c += step)
+                for (c = cstart; c < c1; c += cstep)
                 {
                     const uint32_t far = (uint32_t)(R[c] >= split), take = m[c];
                     const uint32_t k = far ? hi - 1u : lo; /* lo < hi: roomy leaves a slot per candidate */
@@ -205,7 +208,7 @@ static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
             }
             else
             {
-                for (c = cstart; c < c1; c += step)
+                for (c = cstart; c < c1; c += cstep)
                 {
                     if (m[c] != 0u)
                     {

@@ -125,8 +125,8 @@ LIDET_PY_API int lidet_py_proj_run(const float *pts, uint32_t n, uint32_t stride
  * The configuration crosses the boundary as two flat arrays in this order (native.py: GROUND_F, GROUND_U):
  *   cfg_f[13]: fy_max fx_max_m gate_above_m gate_below_m mount_height_m inlier_m max_tilt_rad
  *              max_height_dev_m ground_m ground_m_per_m below_factor confidence ring_split_m
- *   cfg_u[12]: fx_on_z require_descending height_gate n_sectors ransac_iters eval_samples min_samples
- *              min_inliers refine_iters fallback_sectors seed sample_step */
+ *   cfg_u[13]: fx_on_z require_descending height_gate n_sectors ransac_iters eval_samples min_samples
+ *              min_inliers refine_iters fallback_sectors seed sample_step sample_col_step */
 static void ground_cfg_to_arrays(const lidet_ground_cfg_t *c, float *f, uint32_t *u)
 {
     f[0] = c->fy_max;
@@ -154,6 +154,7 @@ static void ground_cfg_to_arrays(const lidet_ground_cfg_t *c, float *f, uint32_t
     u[9] = c->fallback_sectors;
     u[10] = c->seed;
     u[11] = c->sample_step;
+    u[12] = c->sample_col_step;
 }
 
 static int ground_cfg_from_arrays(lidet_ground_cfg_t *c, const float *f, const uint32_t *u)
@@ -193,6 +194,9 @@ static int ground_cfg_from_arrays(lidet_ground_cfg_t *c, const float *f, const u
     if (u[11] > 0xFFFFu)
         return LIDET_ERR_CONFIG;
     c->sample_step = (uint16_t)u[11];
+    if (u[12] > 0xFFFFu)
+        return LIDET_ERR_CONFIG;
+    c->sample_col_step = (uint16_t)u[12];
     return LIDET_OK;
 }
 

@@ -490,6 +490,7 @@ static void test_filter_variants(void)
     gcfg.height_gate = 1;
     gcfg.require_descending = 0;
     gcfg.sample_step = 1;
+    gcfg.sample_col_step = 1;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_init(&gg.ws, &gcfg));
     cast_scene(&sc, NULL);
     run_all();
@@ -557,6 +558,9 @@ static void test_config_and_arguments(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_init(&gg.ws, &c));
     c = gcfg;
     c.sample_step = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_init(&gg.ws, &c));
+    c = gcfg;
+    c.sample_col_step = 17;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_init(&gg.ws, &c));
     /* a failed init leaves the state unusable */
     lidet_proj_image(&gp.ws, &img);

@@ -179,9 +179,9 @@ FILTERS = {
     "paper, no descending test": ["require_descending=0"],
     "released: F_x = S_u*Z + height gate": ["fx_on_z=1", "height_gate=1", "require_descending=0"],
     "paper F_x + height gate": ["height_gate=1"],
-    "released, every pixel (sample_step 1)": ["fx_on_z=1", "height_gate=1", "require_descending=0",
-                                               "sample_step=1"],
-    "paper, every pixel (sample_step 1)": ["sample_step=1"],
+    "released, every pixel": ["fx_on_z=1", "height_gate=1", "require_descending=0", "sample_step=1",
+                              "sample_col_step=1"],
+    "paper, every pixel": ["sample_step=1", "sample_col_step=1"],
 }
 
 

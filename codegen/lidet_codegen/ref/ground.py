@@ -64,14 +64,14 @@ def gather_samples(sample: np.ndarray, X, Y, Z, cfg: dict, R=None):
     (horizontal range < ring_split_m, or everything when it is 0), cells ns..2ns-1 the far parts.
     Near samples in raster order, far samples in reverse raster order (as the C buffer fills)."""
     rows, cols = sample.shape
-    ns, step = int(cfg["n_sectors"]), int(cfg["sample_step"])
+    ns, step, cstep = int(cfg["n_sectors"]), int(cfg["sample_step"]), int(cfg.get("sample_col_step", 1))
     split = F(cfg.get("ring_split_m", 0.0))
     R = np.zeros_like(np.asarray(X, F)) if R is None else np.asarray(R, F)
     near, far = [], []
     rr = np.arange(0, rows - 1, step)
     for s in range(ns):
         c0, c1 = sector_col(s, ns, cols), sector_col(s + 1, ns, cols)
-        cc = np.arange(c0 + (step - c0 % step) % step, c1, step)
+        cc = np.arange(c0 + (cstep - c0 % cstep) % cstep, c1, cstep)
         m = sample[np.ix_(rr, cc)].astype(bool)
         pts = np.stack([np.asarray(A, F)[np.ix_(rr, cc)][m] for A in (X, Y, Z)], 1).reshape(-1, 3)
         is_far = (R[np.ix_(rr, cc)][m] >= split) if split > 0 else np.zeros(len(pts), bool)

@@ -16,8 +16,8 @@
  *     Optional height gate (released code): the pixel's z must lie in
  *     [-mount_height_m - gate_below_m, -mount_height_m + gate_above_m].
  *     Every pixel the kernels touch must hold a point; the bottom row has no sample. With
- *     sample_step > 1 only rows 0, step, 2 step, ... are filtered and only the samples of columns
- *     0, step, 2 step, ... go to RANSAC (a speed knob).
+ *     sample_step > 1 only rows 0, step, 2 step, ... are filtered, and with sample_col_step > 1
+ *     only the samples of columns 0, k, 2k, ... go to RANSAC (speed knobs).
  *  2. Per azimuth sector (sector of column c = c * n_sectors / n_cols), RANSAC over the samples:
  *     a seeded xorshift32 (state) draws 3 samples, hypotheses tilted more than max_tilt_rad are
  *     rejected before scoring, the rest are scored on at most eval_samples evenly strided
@@ -92,10 +92,12 @@ typedef struct
     uint16_t n_sectors;       /**< azimuth sectors over 360 deg; [1, min(n_cols, LIDET_GROUND_MAX_SECTORS)],
                                    default 32 (11.25 deg) */
     uint16_t ransac_iters;    /**< hypotheses per sector; [1, 1000], typical 8-30 */
-    uint16_t sample_step;     /**< sample grid: the filter runs on rows 0, step, 2 step, ... and
-                                   RANSAC takes the samples of columns 0, step, 2 step, ... of them.
-                                   A speed knob (planes need far fewer points than the image holds);
-                                   [1, 16], 1 = every pixel (paper), typical 1-3 */
+    uint16_t sample_step;     /**< the filter runs on rows 0, step, 2 step, ... only: a speed knob
+                                   (planes need far fewer points than the image holds); [1, 16],
+                                   1 = every row (paper), typical 1-4 */
+    uint16_t sample_col_step; /**< RANSAC takes the samples of columns 0, k, 2k, ... of the filtered
+                                   rows only (a speed knob); [1, 16], 1 = every sample (paper),
+                                   typical 1-4 */
     uint16_t eval_samples;    /**< samples a hypothesis is scored on (evenly strided subset);
                                    [3, 65535], typical 64-512 */
     uint16_t min_samples;     /**< fewer samples in a sector: fallback; [3, 65535], typical 10-30 */
