@@ -60,6 +60,8 @@ void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sen
     cfg->ground_m = low ? 0.1f : 0.15f;
     cfg->ground_m_per_m = 0.0f;
     cfg->below_factor = low ? 4.0f : 2.0f;
+    cfg->veto_slope = low ? 2.0f : 1.0f;
+    cfg->veto_min_dz_m = 0.05f;
 }
 
 static int in_range(float v, float lo, float hi)
@@ -89,7 +91,8 @@ lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cf
         cfg->max_tilt_rad >= LIDET_HALF_PI_F || !in_range(cfg->max_height_dev_m, 0.0f, 20.0f) ||
         cfg->max_height_dev_m <= 0.0f || !in_range(cfg->ground_m, 0.0f, 5.0f) || cfg->ground_m <= 0.0f ||
         !in_range(cfg->ground_m_per_m, 0.0f, 0.1f) || !in_range(cfg->below_factor, 0.0f, 20.0f) || !in_range(cfg->confidence, 0.0f, 0.999999f) ||
-        !in_range(cfg->ring_split_m, 0.0f, 500.0f))
+        !in_range(cfg->ring_split_m, 0.0f, 500.0f) || !in_range(cfg->veto_slope, 0.0f, 100.0f) ||
+        !in_range(cfg->veto_min_dz_m, 0.0f, 5.0f))
     {
         return LIDET_ERR_CONFIG;
     }
@@ -307,6 +310,37 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
     g->stats.n_ground = n_ground;
 }
 
+/* Pass 4 (mirrors ref/ground.py: veto_vertical): a pixel close to its plane is still not ground when
+ * it and the pixel above it (the next beam up, same column) form a steep surface: |dz| > veto_slope
+ * * |dR| and |dz| > veto_min_dz_m. That is the foot of a wall, a kerb face, a car's bumper or a tree
+ * trunk, whose lowest returns lie within ground_m of the ground; ground seen from above has the
+ * beam above landing much farther (|dR| >> |dz|). Row 0 has no pixel above: never vetoed. */
+static void veto_vertical(lidet_ground_t *g, const lidet_range_image_t *img)
+{
+    const uint32_t rows = img->n_rows, cols = img->n_cols;
+    const float slope = g->cfg.veto_slope, min_dz = g->cfg.veto_min_dz_m;
+    uint32_t r, c, removed = 0;
+    for (r = 1; r < rows; ++r)
+    {
+        const size_t base = (size_t)r * cols;
+        const float *R = img->rxy_m + base, *Z = img->z_m + base;
+        const float *Ru = R - cols, *Zu = Z - cols;
+        uint8_t *out = g->mask + base;
+        uint32_t cnt = 0;
+        for (c = 0; c < cols; ++c)
+        {
+            const float dz = fabsf(Zu[c] - Z[c]), dr = fabsf(Ru[c] - R[c]);
+            const uint8_t vert = (uint8_t)((Ru[c] > 0.0f) & (dz > slope * dr) & (dz > min_dz));
+            const uint8_t m = out[c];
+            out[c] = (uint8_t)(m & (vert ^ 1u));
+            cnt += m & vert;
+        }
+        removed += cnt;
+    }
+    g->stats.n_vetoed = removed;
+    g->stats.n_ground -= removed;
+}
+
 lidet_status_t lidet_ground_run(lidet_ground_t *g, const lidet_range_image_t *img)
 {
     if (g == 0 || img == 0)
@@ -337,6 +371,10 @@ lidet_status_t lidet_ground_run(lidet_ground_t *g, const lidet_range_image_t *im
     gather_samples(g, img);
     lidet__ground_fit_sectors(g);
     label_rows(g, img);
+    if (g->cfg.veto_slope > 0.0f)
+    {
+        veto_vertical(g, img);
+    }
     return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
 }
 

@@ -113,6 +113,8 @@ static int apply_set(lidet_ground_cfg_t *c, const char *kv)
     FLOAT_FIELD(below_factor)
     FLOAT_FIELD(confidence)
     FLOAT_FIELD(ring_split_m)
+    FLOAT_FIELD(veto_slope)
+    FLOAT_FIELD(veto_min_dz_m)
     INT_FIELD(fx_on_z, uint8_t, 1)
     INT_FIELD(require_descending, uint8_t, 1)
     INT_FIELD(height_gate, uint8_t, 1)
@@ -263,6 +265,7 @@ int cli_ground(int argc, char **argv)
         cli_json_int(stdout, "sectors_neighbour", gs->n_sectors_neighbour);
         cli_json_int(stdout, "sectors_mount", gs->n_sectors_mount);
         cli_json_int(stdout, "far_fitted", gs->n_far_fitted);
+        cli_json_int(stdout, "vetoed_pixels", gs->n_vetoed);
         cli_json_int(stdout, "hypotheses", gs->n_hypotheses);
         cli_json_int(stdout, "repeat", a.repeat);
         cli_json_num(stdout, "project_ms", proj_ms);

@@ -123,8 +123,8 @@ LIDET_PY_API int lidet_py_proj_run(const float *pts, uint32_t n, uint32_t stride
 
 /* ---- ground stage ------------------------------------------------------------------------------
  * The configuration crosses the boundary as two flat arrays in this order (native.py: GROUND_F, GROUND_U):
- *   cfg_f[13]: fy_max fx_max_m gate_above_m gate_below_m mount_height_m inlier_m max_tilt_rad
- *              max_height_dev_m ground_m ground_m_per_m below_factor confidence ring_split_m
+ *   cfg_f[15]: fy_max fx_max_m gate_above_m gate_below_m mount_height_m inlier_m max_tilt_rad
+ *              max_height_dev_m ground_m ground_m_per_m below_factor confidence ring_split_m veto_slope veto_min_dz_m
  *   cfg_u[13]: fx_on_z require_descending height_gate n_sectors ransac_iters eval_samples min_samples
  *              min_inliers refine_iters fallback_sectors seed sample_step sample_col_step */
 static void ground_cfg_to_arrays(const lidet_ground_cfg_t *c, float *f, uint32_t *u)
@@ -142,6 +142,8 @@ static void ground_cfg_to_arrays(const lidet_ground_cfg_t *c, float *f, uint32_t
     f[10] = c->below_factor;
     f[11] = c->confidence;
     f[12] = c->ring_split_m;
+    f[13] = c->veto_slope;
+    f[14] = c->veto_min_dz_m;
     u[0] = c->fx_on_z;
     u[1] = c->require_descending;
     u[2] = c->height_gate;
@@ -178,6 +180,8 @@ static int ground_cfg_from_arrays(lidet_ground_cfg_t *c, const float *f, const u
     c->below_factor = f[10];
     c->confidence = f[11];
     c->ring_split_m = f[12];
+    c->veto_slope = f[13];
+    c->veto_min_dz_m = f[14];
     if (u[0] > 255u || u[1] > 255u || u[2] > 255u || u[8] > 255u)
         return LIDET_ERR_CONFIG;
     c->fx_on_z = (uint8_t)u[0];
@@ -219,8 +223,8 @@ LIDET_PY_API int lidet_py_ground_default(uint32_t rows, uint32_t cols, float mou
 /* Initialise the ground stage and run it on the image of the last lidet_py_proj_run. Outputs (any may
  * be NULL): mask_pixel / sample_pixel rows*cols bytes, mask_point n_points bytes (n_points = the
  * projection's point count), planes 8*n_sectors floats (nx ny nz d; near planes, then far planes),
- * source 2*n_sectors bytes (same order), stats 11 uint32 (0 n_samples n_samples_dropped n_ground fitted
- * neighbour mount sparse rejected hypotheses far_fitted). */
+ * source 2*n_sectors bytes (same order), stats 12 uint32 (0 n_samples n_samples_dropped n_ground fitted
+ * neighbour mount sparse rejected hypotheses far_fitted vetoed). */
 LIDET_PY_API int lidet_py_ground_run(const float *cfg_f, const uint32_t *cfg_u, uint8_t *mask_pixel,
                                      uint8_t *sample_pixel, uint8_t *mask_point, float *planes, uint8_t *source,
                                      uint32_t *stats)
@@ -284,6 +288,7 @@ LIDET_PY_API int lidet_py_ground_run(const float *cfg_f, const uint32_t *cfg_u, 
         stats[8] = st->n_sectors_rejected;
         stats[9] = st->n_hypotheses;
         stats[10] = st->n_far_fitted;
+        stats[11] = st->n_vetoed;
     }
     return rc;
 }

@@ -185,13 +185,14 @@ def project(points, sensor: str | Sensor = "hdl64", ring=None, **cfg) -> RangeIm
 
 #: float and integer fields of lidet_ground_cfg_t, in the order of ports/python/lidet_py.c
 GROUND_F = ["fy_max", "fx_max_m", "gate_above_m", "gate_below_m", "mount_height_m", "inlier_m",
-            "max_tilt_rad", "max_height_dev_m", "ground_m", "ground_m_per_m", "below_factor", "confidence", "ring_split_m"]
+            "max_tilt_rad", "max_height_dev_m", "ground_m", "ground_m_per_m", "below_factor", "confidence", "ring_split_m",
+            "veto_slope", "veto_min_dz_m"]
 GROUND_U = ["fx_on_z", "require_descending", "height_gate", "n_sectors", "ransac_iters", "eval_samples",
             "min_samples", "min_inliers", "refine_iters", "fallback_sectors", "seed", "sample_step",
             "sample_col_step"]
 _GROUND_STATS = ["_unused", "n_samples", "n_samples_dropped", "n_ground", "n_sectors_fitted",
                  "n_sectors_neighbour", "n_sectors_mount", "n_sectors_sparse", "n_sectors_rejected",
-                 "n_hypotheses", "n_far_fitted"]
+                 "n_hypotheses", "n_far_fitted", "n_vetoed"]
 PLANE_SOURCE = {0: "fitted", 1: "neighbour", 2: "mount", 3: "near"}
 
 

@@ -10,7 +10,7 @@ Same algorithm, same order, same random draws (ref/rng.py mirrors the C xorshift
   least-squares refinement in float64 with numpy's eigh (the C code uses float sums and Jacobi
   rotations: planes agree to ~1e-5, so a few pixels at the p_th boundary may flip);
 * `fit_sectors` (per cell: near / far part of each sector, with the fallback), `label_pixels`, and
-  `ground` chaining them.
+  `veto_vertical`, and `ground` chaining them.
 
 Configuration: a dict with the field names of lidet_ground_cfg_t (native.ground_defaults gives the
 C defaults).
@@ -203,8 +203,24 @@ def label_pixels(X, Y, Z, R, valid, planes, cfg: dict) -> np.ndarray:
     return (np.asarray(valid, bool) & ok).astype(np.uint8)
 
 
+def veto_vertical(mask, R, Z, cfg: dict) -> np.ndarray:
+    """Drops ground pixels that form a steep surface with the pixel above (row - 1, same column)."""
+    slope, min_dz = F(cfg.get("veto_slope", 0.0)), F(cfg.get("veto_min_dz_m", 0.0))
+    if not slope > 0:
+        return mask
+    R = np.asarray(R, F)
+    Z = np.asarray(Z, F)
+    dz = np.abs(Z[:-1] - Z[1:])
+    dr = np.abs(R[:-1] - R[1:])
+    vert = (R[:-1] > 0) & (dz > slope * dr) & (dz > min_dz)
+    out = mask.copy()
+    out[1:] &= ~vert
+    return out
+
+
 def ground(X, Y, Z, R, valid, cfg: dict):
     """The whole stage on a range image: (mask, sample mask, planes (near then far), sources)."""
     smp = sample_mask(R, Z, cfg)
     planes, src = fit_sectors(gather_samples(smp, X, Y, Z, cfg, R), cfg)
-    return label_pixels(X, Y, Z, R, valid, planes, cfg), smp, planes, src
+    mask = veto_vertical(label_pixels(X, Y, Z, R, valid, planes, cfg), R, Z, cfg)
+    return mask, smp, planes, src

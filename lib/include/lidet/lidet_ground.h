@@ -37,6 +37,9 @@
  *     -below_m(R) < h < above_m(R), with above_m(R) = ground_m + ground_m_per_m * R and
  *     below_m(R) = below_factor * above_m(R) (R = horizontal range). With below_factor 1 and
  *     ground_m_per_m 0 this is the paper's |distance| < p_th.
+ *  5. Vertical veto (veto_slope > 0, a lidet extension): a ground pixel is dropped when it and the
+ *     pixel above it form a surface steeper than veto_slope (|dz| > veto_slope |dR|, |dz| >
+ *     veto_min_dz_m): the lowest returns of walls, kerbs, bumpers and trunks.
  *
  * Memory: sizeof(lidet_ground_t) = LIDET_MAX_ROWS * LIDET_MAX_COLS * 2 B (ground and sample masks)
  * + LIDET_GROUND_MAX_SAMPLES * 12 B (x, y, z of the samples) + LIDET_GROUND_MAX_SECTORS * 50 B
@@ -127,6 +130,13 @@ typedef struct
                                    typical 0-0.01; 0 = the paper's constant p_th */
     float below_factor;       /**< the tolerance below the plane is below_factor * the one above;
                                    [0, 20], 1 = symmetric (paper) */
+    float veto_slope;         /**< vertical veto (a lidet extension): a pixel within the tolerance
+                                   is not ground when it and the pixel above it (next beam up)
+                                   are steeper than this, |dz| > veto_slope * |dR| (wall feet,
+                                   kerb faces, bumpers, trunks); 0 = off (paper); [0, 100],
+                                   typical 1-2 (1 = 45 deg) */
+    float veto_min_dz_m;      /**< ... and only when |dz| > this (metres; ignores range noise on
+                                   flat ground); [0, 5], typical 0.03-0.1 */
 } lidet_ground_cfg_t;
 
 /** @brief Counts of the last run. */
@@ -141,6 +151,7 @@ typedef struct
     uint16_t n_sectors_sparse;   /**< near cells with fewer than min_samples samples */
     uint16_t n_sectors_rejected; /**< near cells whose best plane failed the inlier/tilt/height checks */
     uint16_t n_far_fitted;       /**< far cells with their own plane (0 when ring_split_m is 0) */
+    uint32_t n_vetoed;           /**< pixels within the plane tolerance removed by the vertical veto */
     uint32_t n_hypotheses;       /**< RANSAC hypotheses scored (after degenerate/tilt rejection) */
 } lidet_ground_stats_t;
 
