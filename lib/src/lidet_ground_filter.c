@@ -240,53 +240,68 @@ static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
     g->stats.n_samples_dropped = total - (lo + (LIDET_GROUND_MAX_SAMPLES - hi));
 }
 
-/* Pass 3 (mirrors ref/ground.py: label_pixels): ground = holds a point and -below < height < above,
- * height above the pixel's cell plane (near or far part of its sector). Empty pixels are excluded
- * through point_idx (their coordinates are 0, which may lie within ground_m of a plane). */
+/* Pass 3 (mirrors ref/ground.py: label_pixels, veto_vertical): ground = holds a point and
+ * -below < height < above, height above the pixel's cell plane (near or far part of its sector),
+ * and not vetoed. Empty pixels are excluded through point_idx (their coordinates are 0, which may
+ * lie within ground_m of a plane).
+ * Vertical veto: a pixel is not ground when it and the pixel above it (the next beam up, same
+ * column, holding a point) form a steep surface, |dz| > veto_slope * |dR| and |dz| > veto_min_dz_m:
+ * the foot of a wall, a kerb face, a bumper or a trunk, whose lowest returns lie within ground_m of
+ * the ground, while ground seen from above has the beam above landing much farther (|dR| >> |dz|).
+ * Row 0 compares with itself (dz = 0: never vetoed); veto_slope 0 disables it (min dz = +huge).
+ * All loops are branch-free so that they vectorise. */
 static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors;
     const float g0 = g->cfg.ground_m, k = g->cfg.ground_m_per_m, bf = g->cfg.below_factor;
     const float below0 = bf * g0;
     const float split = g->cfg.ring_split_m > 0.0f ? g->cfg.ring_split_m : 3.0e38f;
+    const float slope = g->cfg.veto_slope;
+    const float min_dz = g->cfg.veto_slope > 0.0f ? g->cfg.veto_min_dz_m : 3.0e38f;
     const int simple = k == 0.0f && !(g->cfg.ring_split_m > 0.0f);
-    uint32_t r, s, c, n_ground = 0;
+    uint32_t r, s, c, n_ground = 0, n_vetoed = 0;
     for (r = 0; r < rows; ++r)
     {
         const size_t base = (size_t)r * cols;
         const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base, *R = img->rxy_m + base;
+        const float *Ru = r > 0u ? R - cols : R, *Zu = r > 0u ? Z - cols : Z;
         const int32_t *V = img->point_idx + base;
         uint8_t *out = g->mask + base;
         for (s = 0; s < ns; ++s)
         {
             const uint32_t c0 = lidet__ground_sector_col(s, ns, cols), c1 = lidet__ground_sector_col(s + 1u, ns, cols);
             const lidet_plane_t p = g->planes[s], q = g->planes[ns + s];
-            uint32_t cnt = 0;
+            uint32_t cnt = 0, nv = 0;
             if (simple)
             {
                 for (c = c0; c < c1; ++c)
                 {
                     const float h = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
-                    const uint8_t m = (uint8_t)((V[c] >= 0) & (h < g0) & (h > -below0));
-                    out[c] = m;
-                    cnt += m;
+                    const float dz = fabsf(Zu[c] - Z[c]), dr = fabsf(Ru[c] - R[c]);
+                    const uint32_t vert = (uint32_t)((Ru[c] > 0.0f) & (dz > slope * dr) & (dz > min_dz));
+                    const uint32_t near = (uint32_t)((V[c] >= 0) & (h < g0) & (h > -below0));
+                    out[c] = (uint8_t)(near & (vert ^ 1u));
+                    cnt += near & (vert ^ 1u);
+                    nv += near & vert;
                 }
             }
             else if (k == 0.0f)
             {
-                /* two planes, constant tolerance. Branch-free select of the cell plane (a ?: on
-                 * floats stays a branch here, which stops vectorisation): both tests, blended by
-                 * the near/far bit */
+                /* two planes, constant tolerance: both tests, blended by the near/far bit (a ?: on
+                 * floats stays a branch here, which stops vectorisation) */
                 for (c = c0; c < c1; ++c)
                 {
                     const float hn = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
                     const float hf = q.nx * X[c] + q.ny * Y[c] + q.nz * Z[c] + q.d_m;
-                    const int is_near = R[c] < split;
-                    const int in_n = (hn < g0) & (hn > -below0);
-                    const int in_f = (hf < g0) & (hf > -below0);
-                    const uint8_t m = (uint8_t)((V[c] >= 0) & ((is_near & in_n) | ((is_near ^ 1) & in_f)));
-                    out[c] = m;
-                    cnt += m;
+                    const float dz = fabsf(Zu[c] - Z[c]), dr = fabsf(Ru[c] - R[c]);
+                    const uint32_t vert = (uint32_t)((Ru[c] > 0.0f) & (dz > slope * dr) & (dz > min_dz));
+                    const uint32_t is_near = (uint32_t)(R[c] < split);
+                    const uint32_t in_n = (uint32_t)((hn < g0) & (hn > -below0));
+                    const uint32_t in_f = (uint32_t)((hf < g0) & (hf > -below0));
+                    const uint32_t m = (uint32_t)(V[c] >= 0) & ((is_near & in_n) | ((is_near ^ 1u) & in_f));
+                    out[c] = (uint8_t)(m & (vert ^ 1u));
+                    cnt += m & (vert ^ 1u);
+                    nv += m & vert;
                 }
             }
             else
@@ -296,49 +311,23 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
                     const float hn = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
                     const float hf = q.nx * X[c] + q.ny * Y[c] + q.nz * Z[c] + q.d_m;
                     const float above = g0 + k * R[c];
-                    const int is_near = R[c] < split;
-                    const int in_n = (hn < above) & (hn > -bf * above);
-                    const int in_f = (hf < above) & (hf > -bf * above);
-                    const uint8_t m = (uint8_t)((V[c] >= 0) & ((is_near & in_n) | ((is_near ^ 1) & in_f)));
-                    out[c] = m;
-                    cnt += m;
+                    const float dz = fabsf(Zu[c] - Z[c]), dr = fabsf(Ru[c] - R[c]);
+                    const uint32_t vert = (uint32_t)((Ru[c] > 0.0f) & (dz > slope * dr) & (dz > min_dz));
+                    const uint32_t is_near = (uint32_t)(R[c] < split);
+                    const uint32_t in_n = (uint32_t)((hn < above) & (hn > -bf * above));
+                    const uint32_t in_f = (uint32_t)((hf < above) & (hf > -bf * above));
+                    const uint32_t m = (uint32_t)(V[c] >= 0) & ((is_near & in_n) | ((is_near ^ 1u) & in_f));
+                    out[c] = (uint8_t)(m & (vert ^ 1u));
+                    cnt += m & (vert ^ 1u);
+                    nv += m & vert;
                 }
             }
             n_ground += cnt;
+            n_vetoed += nv;
         }
     }
     g->stats.n_ground = n_ground;
-}
-
-/* Pass 4 (mirrors ref/ground.py: veto_vertical): a pixel close to its plane is still not ground when
- * it and the pixel above it (the next beam up, same column) form a steep surface: |dz| > veto_slope
- * * |dR| and |dz| > veto_min_dz_m. That is the foot of a wall, a kerb face, a car's bumper or a tree
- * trunk, whose lowest returns lie within ground_m of the ground; ground seen from above has the
- * beam above landing much farther (|dR| >> |dz|). Row 0 has no pixel above: never vetoed. */
-static void veto_vertical(lidet_ground_t *g, const lidet_range_image_t *img)
-{
-    const uint32_t rows = img->n_rows, cols = img->n_cols;
-    const float slope = g->cfg.veto_slope, min_dz = g->cfg.veto_min_dz_m;
-    uint32_t r, c, removed = 0;
-    for (r = 1; r < rows; ++r)
-    {
-        const size_t base = (size_t)r * cols;
-        const float *R = img->rxy_m + base, *Z = img->z_m + base;
-        const float *Ru = R - cols, *Zu = Z - cols;
-        uint8_t *out = g->mask + base;
-        uint32_t cnt = 0;
-        for (c = 0; c < cols; ++c)
-        {
-            const float dz = fabsf(Zu[c] - Z[c]), dr = fabsf(Ru[c] - R[c]);
-            const uint8_t vert = (uint8_t)((Ru[c] > 0.0f) & (dz > slope * dr) & (dz > min_dz));
-            const uint8_t m = out[c];
-            out[c] = (uint8_t)(m & (vert ^ 1u));
-            cnt += m & vert;
-        }
-        removed += cnt;
-    }
-    g->stats.n_vetoed = removed;
-    g->stats.n_ground -= removed;
+    g->stats.n_vetoed = n_vetoed;
 }
 
 lidet_status_t lidet_ground_run(lidet_ground_t *g, const lidet_range_image_t *img)
@@ -371,10 +360,6 @@ lidet_status_t lidet_ground_run(lidet_ground_t *g, const lidet_range_image_t *im
     gather_samples(g, img);
     lidet__ground_fit_sectors(g);
     label_rows(g, img);
-    if (g->cfg.veto_slope > 0.0f)
-    {
-        veto_vertical(g, img);
-    }
     return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
 }
 
