@@ -503,6 +503,39 @@ static void test_filter_variants(void)
     TEST_ASSERT_EQUAL_UINT32(0u, lidet_ground_stats(&gg.ws)->n_samples);
 }
 
+static void test_vertical_veto(void)
+{
+    /* a wall 6 m ahead: its lowest returns lie within ground_m of the floor (ground by height);
+     * the veto removes them because the beam above lands on the wall too (steep), and keeps the
+     * real ground */
+    scene_t sc = {SC_FLAT, 1.73, 1, {{{6.0, -6.0, -1.73}, {6.3, 6.0, 1.0}}}};
+    uint32_t i, foot = 0, foot_ground = 0;
+    init_sensor("hdl64");
+    cast_scene(&sc, NULL);
+    gcfg.veto_slope = 0.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_init(&gg.ws, &gcfg));
+    run_all();
+    for (i = 0; i < n_pts; ++i)
+        foot_ground += truth[i] == 2 && labels[i];
+    TEST_ASSERT_TRUE(foot_ground > 5u); /* without the veto the wall foot is ground */
+    TEST_ASSERT_EQUAL_UINT32(0u, lidet_ground_stats(&gg.ws)->n_vetoed);
+    gcfg.veto_slope = 1.0f;
+    gcfg.veto_min_dz_m = 0.05f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_init(&gg.ws, &gcfg));
+    run_all();
+    foot_ground = 0;
+    for (i = 0; i < n_pts; ++i)
+    {
+        foot += truth[i] == 2;
+        foot_ground += truth[i] == 2 && labels[i];
+    }
+    TEST_ASSERT_TRUE(foot > 5u);
+    TEST_ASSERT_TRUE(foot_ground * 10u <= foot); /* at most 10 % of the foot left */
+    TEST_ASSERT_TRUE(lidet_ground_stats(&gg.ws)->n_vetoed > 0u);
+    TEST_ASSERT_TRUE(share(1, 1, NULL) >= 0.995);
+    TEST_ASSERT_TRUE(share(0, 0, NULL) >= 0.999);
+}
+
 static void test_fit_plane(void)
 {
     /* points on z = 0.1 x - 0.2 y - 1.5 with a small grid spread */
@@ -606,6 +639,7 @@ int main(void)
     RUN_TEST(test_vlp16_low_mount);
     RUN_TEST(test_ransac_determinism);
     RUN_TEST(test_filter_variants);
+    RUN_TEST(test_vertical_veto);
     RUN_TEST(test_fit_plane);
     RUN_TEST(test_config_and_arguments);
     return UNITY_END();
