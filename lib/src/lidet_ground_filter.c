@@ -13,8 +13,9 @@
  * the real SemanticKITTI scans and 20 simulated scans per profile. Two families:
  *  - a tall car mount with many beams (hdl64; also os1-*): filter every 2nd row, sectors split at
  *    15 m into a near and a far plane, 0.15 m above / 0.3 m below the plane is ground;
- *  - a low robot mount or few beams (vlp16 at 0.5 m; also vlp32c): every row, one plane per sector,
- *    a tighter 0.1 m above (0.4 m below) and a plane height closer to the mount height. */
+ *  - a low robot mount or few beams (vlp16 at 0.5 m; also vlp32c): every row and every sample, one
+ *    plane per sector, 0.2 m above / 0.4 m below, a tighter F_x, a steeper veto and a plane height
+ *    closer to the mount height. */
 void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sensor)
 {
     float mount = 1.73f;
@@ -50,17 +51,17 @@ void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sen
     cfg->min_samples = 10u;
     cfg->min_inliers = 8u;
     cfg->refine_iters = low ? 2u : 1u;
-    cfg->inlier_m = low ? 0.15f : 0.2f;
+    cfg->inlier_m = 0.2f;
     cfg->max_tilt_rad = low ? 0.2f : 0.1f;
     cfg->max_height_dev_m = low ? 0.5f : 1.0f;
     cfg->ring_split_m = low ? 0.0f : 15.0f;
     cfg->fallback_sectors = 4u;
     cfg->seed = 12345u;
     /* labelling */
-    cfg->ground_m = low ? 0.1f : 0.15f;
+    cfg->ground_m = low ? 0.2f : 0.15f;
     cfg->ground_m_per_m = 0.0f;
-    cfg->below_factor = low ? 4.0f : 2.0f;
-    cfg->veto_slope = low ? 2.0f : 1.0f;
+    cfg->below_factor = 2.0f;
+    cfg->veto_slope = low ? 1.5f : 1.0f;
     cfg->veto_min_dz_m = 0.05f;
 }
 
