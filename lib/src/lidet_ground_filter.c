@@ -11,7 +11,8 @@
 
 /* Defaults measured by tools/bench/bench_ground.py and coordinate-descent sweeps (docs/GROUND.md) on
  * the real SemanticKITTI scans and 20 simulated scans per profile. Two families:
- *  - a tall car mount with many beams (hdl64; also os1-*): filter every 2nd row, sectors split at
+ *  - a tall car mount with many beams (hdl64; also os1-*): filter every 4th row (samples of every
+ *    4th column), sectors split at
  *    15 m into a near and a far plane, 0.15 m above / 0.3 m below the plane is ground;
  *  - a low robot mount or few beams (vlp16 at 0.5 m; also vlp32c): every row and every sample, one
  *    plane per sector, 0.2 m above / 0.4 m below, a tighter F_x, a steeper veto and a plane height
@@ -41,7 +42,7 @@ void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sen
     cfg->gate_above_m = 0.43f; /* released code on KITTI: z < -1.3 m at a 1.73 m mount */
     cfg->gate_below_m = 8.27f; /* ... and z > -10 m */
     cfg->mount_height_m = mount;
-    cfg->sample_step = low ? 1u : 2u;
+    cfg->sample_step = low ? 1u : 4u;
     cfg->sample_col_step = low ? 1u : 4u;
     /* RANSAC */
     cfg->n_sectors = 32u;
