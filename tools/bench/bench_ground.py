@@ -177,6 +177,7 @@ def _table(res, label):
 PURE = ["sample_step=1", "sample_col_step=1", "ring_split_m=0", "veto_slope=0", "ground_m=0.2", "below_factor=1"]
 FILTERS = {
     "lidet defaults: paper filter F_x = S_u*R": [],
+    "defaults, released F_x = S_u*Z, no gate": ["fx_on_z=1"],
     "defaults, released filter F_x = S_u*Z + height gate": ["fx_on_z=1", "height_gate=1"],
     "defaults, paper filter + height gate": ["height_gate=1"],
     "defaults without the vertical veto": ["veto_slope=0"],
