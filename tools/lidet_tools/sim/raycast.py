@@ -1,0 +1,314 @@
+# SPDX-License-Identifier: MIT
+"""Vectorized ray casting against analytic primitives and a heightfield ground.
+
+All rays start at the sensor origin (0, 0, 0) of the *level* simulation frame (x fwd, y left, z up),
+so each primitive's ray origin in its own unit frame is a constant.
+
+Primitives are affine images of unit shapes: a point p is inside primitive k when
+q = M_k (p - c_k) lies in the unit shape, with
+  * BOX       the cube [-1, 1]^3,
+  * ELLIPSOID the unit sphere,
+  * CYLINDER  x^2 + y^2 <= 1, |z| <= 1 (axis = local z).
+M_k = diag(1 / half_extents) R_k^T, so boxes, ellipsoids and cylinders of any orientation share one code path.
+
+Culling: every primitive has a bounding sphere; only the rays of its (row, column) window in the ray grid
+are tested, so the work is the sum of the objects' angular footprints, not rays x primitives.
+
+The ground is a heightfield on a regular grid (bilinear heights, nearest-cell class codes). A ray is
+bracketed by sampling it inside the vertical band [zmin, zmax] of the field, then refined by regula falsi.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+BOX, ELLIPSOID, CYLINDER = 0, 1, 2
+
+
+@dataclass
+class Primitives:
+    """Struct of arrays, one entry per primitive (see module doc)."""
+    kind: np.ndarray      # (P,) int8
+    center: np.ndarray    # (P, 3)
+    M: np.ndarray         # (P, 3, 3) world -> unit frame
+    radius: np.ndarray    # (P,) bounding-sphere radius
+    sem: np.ndarray       # (P,) SemanticKITTI class
+    obj: np.ndarray       # (P,) object index (-1: stuff)
+    albedo: np.ndarray    # (P,) mean remission at normal incidence
+    drop: np.ndarray      # (P,) extra dropout probability (dark paint, tyres)
+    transp: np.ndarray    # (P,) probability that a ray passes through (glass, leaves, spokes)
+
+    def __len__(self):
+        return len(self.kind)
+
+
+class PrimitiveList:
+    """Accumulates primitives; `freeze()` returns the arrays."""
+
+    def __init__(self):
+        self.rows = []
+
+    def add(self, kind, center, half, R=None, sem=0, obj=-1, albedo=0.3, drop=0.0, transp=0.0):
+        half = np.maximum(np.asarray(half, dtype=np.float64), 1e-3)
+        R = np.eye(3) if R is None else np.asarray(R, dtype=np.float64)
+        M = (R / half[None, :]).T  # diag(1/half) @ R^T
+        rad = float(np.max(half)) if kind == ELLIPSOID else float(np.linalg.norm(half))
+        self.rows.append((kind, np.asarray(center, dtype=np.float64), M, rad, sem, obj, albedo, drop, transp))
+
+    def freeze(self) -> Primitives:
+        if not self.rows:
+            z = np.zeros(0)
+            return Primitives(z.astype(np.int8), np.zeros((0, 3)), np.zeros((0, 3, 3)), z,
+                              z.astype(np.int32), z.astype(np.int32), z, z, z)
+        k, c, M, r, s, o, a, d, t = zip(*self.rows)
+        return Primitives(np.array(k, np.int8), np.array(c), np.array(M), np.array(r),
+                          np.array(s, np.int32), np.array(o, np.int32), np.array(a, np.float64),
+                          np.array(d, np.float64), np.array(t, np.float64))
+
+
+def rot_z(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def rot_y(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+
+
+def rot_x(a):
+    c, s = np.cos(a), np.sin(a)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+# ------------------------------------------------------------------------------------------------
+# Ray grid
+
+
+@dataclass
+class RayGrid:
+    """Rays in row-major (row, col) order; rows sorted top to bottom by *nominal* elevation."""
+    dirs: np.ndarray        # (rows*cols, 3) unit directions in the level frame
+    rows: int
+    cols: int
+    elev_rows: np.ndarray   # (rows,) nominal elevation of each row (descending)
+    tilt_rad: float         # bound on |elevation change| caused by mount pitch/roll
+
+
+def cull_pairs(prims: Primitives, grid: RayGrid):
+    """(ray index, primitive index) pairs whose ray lies in the primitive's angular window."""
+    P = len(prims)
+    if P == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    c = prims.center
+    dxy = np.hypot(c[:, 0], c[:, 1])
+    d = np.sqrt(dxy ** 2 + c[:, 2] ** 2)
+    r = prims.radius + 0.05
+    inside = d <= r * 1.0001
+    az = np.arctan2(c[:, 1], c[:, 0])
+    half_az = np.where(dxy > r, np.arcsin(np.clip(r / np.maximum(dxy, 1e-9), 0, 1)), np.pi)
+    el = np.arctan2(c[:, 2], dxy)
+    half_el = np.where(inside, np.pi, np.arcsin(np.clip(r / np.maximum(d, 1e-9), 0, 1)))
+    el_hi = el + half_el + grid.tilt_rad
+    el_lo = el - half_el - grid.tilt_rad
+    asc = grid.elev_rows[::-1]  # ascending
+    n = grid.rows
+    # rows with elev in [el_lo, el_hi] (rows are descending elevation)
+    r0 = n - np.searchsorted(asc, el_hi, side="right")
+    r1 = n - 1 - np.searchsorted(asc, el_lo, side="left")
+    cols = grid.cols
+    step = 2.0 * np.pi / cols
+    # col = floor(0.5 * (1 - az / pi) * cols); az decreases with col
+    full = half_az >= np.pi - 1e-9
+    c_lo = np.floor(0.5 * (1.0 - (az + half_az) / np.pi) * cols).astype(np.int64)
+    c_hi = np.floor(0.5 * (1.0 - (az - half_az) / np.pi) * cols).astype(np.int64) + 1
+    c_lo = np.where(full, 0, c_lo)
+    c_hi = np.where(full, cols - 1, c_hi)
+    nc = np.minimum(c_hi - c_lo + 1, cols)
+    nr = np.maximum(r1 - r0 + 1, 0)
+    cnt = nr * nc
+    total = int(cnt.sum())
+    if total == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    pidx = np.repeat(np.arange(P), cnt)
+    start = np.cumsum(cnt) - cnt
+    local = np.arange(total) - np.repeat(start, cnt)
+    ncp = nc[pidx]
+    row = r0[pidx] + local // ncp
+    col = (c_lo[pidx] + local % ncp) % cols
+    del step
+    return row * cols + col, pidx
+
+
+def intersect_pairs(prims: Primitives, dirs: np.ndarray, ray: np.ndarray, pidx: np.ndarray):
+    """Entry distance t (inf on a miss) and unit-frame hit normal for each pair."""
+    M = prims.M[pidx]                                   # (n, 3, 3)
+    o = -np.einsum("pij,pj->pi", prims.M, prims.center)[pidx]
+    d = np.einsum("nij,nj->ni", M, dirs[ray])
+    t = np.full(len(ray), np.inf)
+    nrm = np.zeros((len(ray), 3))
+    kind = prims.kind[pidx]
+
+    m = kind == BOX
+    if m.any():
+        oo, dd = o[m], d[m]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv = 1.0 / np.where(np.abs(dd) < 1e-12, 1e-12, dd)
+        t1 = (-1.0 - oo) * inv
+        t2 = (1.0 - oo) * inv
+        tn = np.minimum(t1, t2)
+        tf = np.maximum(t1, t2)
+        axis = np.argmax(tn, axis=1)
+        tmin = tn[np.arange(len(tn)), axis]
+        tmax = tf.min(axis=1)
+        ok = (tmax >= tmin) & (tmin > 1e-6)
+        tb = np.where(ok, tmin, np.inf)
+        nb = np.zeros_like(oo)
+        nb[np.arange(len(nb)), axis] = -np.sign(dd[np.arange(len(dd)), axis])
+        t[m] = tb
+        nrm[m] = nb
+
+    m = kind == ELLIPSOID
+    if m.any():
+        oo, dd = o[m], d[m]
+        a = (dd * dd).sum(1)
+        b = (oo * dd).sum(1)
+        c = (oo * oo).sum(1) - 1.0
+        disc = b * b - a * c
+        ok = (disc >= 0) & (c > 0)
+        sq = np.sqrt(np.where(ok, disc, 0.0))
+        te = (-b - sq) / a
+        ok &= te > 1e-6
+        te = np.where(ok, te, np.inf)
+        t[m] = te
+        nrm[m] = oo + np.where(ok, te, 0.0)[:, None] * dd
+
+    m = kind == CYLINDER
+    if m.any():
+        oo, dd = o[m], d[m]
+        a = dd[:, 0] ** 2 + dd[:, 1] ** 2
+        b = oo[:, 0] * dd[:, 0] + oo[:, 1] * dd[:, 1]
+        c = oo[:, 0] ** 2 + oo[:, 1] ** 2 - 1.0
+        disc = b * b - a * c
+        ok = (disc >= 0) & (c > 0) & (a > 1e-18)
+        sq = np.sqrt(np.where(ok, disc, 0.0))
+        ts = (-b - sq) / np.where(a > 1e-18, a, 1.0)
+        zs = oo[:, 2] + ts * dd[:, 2]
+        ok &= (ts > 1e-6) & (np.abs(zs) <= 1.0)
+        ts = np.where(ok, ts, np.inf)
+        # caps: the ray enters through the cap on the origin's side
+        zc = np.where(oo[:, 2] > 0, 1.0, -1.0)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            tc = (zc - oo[:, 2]) / np.where(np.abs(dd[:, 2]) < 1e-12, 1e-12, dd[:, 2])
+        xc = oo[:, 0] + tc * dd[:, 0]
+        yc = oo[:, 1] + tc * dd[:, 1]
+        okc = (np.abs(oo[:, 2]) > 1.0) & (tc > 1e-6) & (xc * xc + yc * yc <= 1.0)
+        tc = np.where(okc, tc, np.inf)
+        use_cap = tc < ts
+        tt = np.minimum(ts, tc)
+        n_side = oo + np.where(np.isfinite(ts), ts, 0.0)[:, None] * dd
+        n_side[:, 2] = 0.0
+        n_cap = np.zeros_like(oo)
+        n_cap[:, 2] = zc
+        t[m] = tt
+        nrm[m] = np.where(use_cap[:, None], n_cap, n_side)
+    return t, nrm
+
+
+def world_normals(prims: Primitives, pidx: np.ndarray, nrm_local: np.ndarray) -> np.ndarray:
+    """Unit-frame normal -> level-frame unit normal (n_world ~ M^T n_local)."""
+    n = np.einsum("nji,nj->ni", prims.M[pidx], nrm_local)
+    return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
+
+
+# ------------------------------------------------------------------------------------------------
+# Heightfield ground
+
+
+@dataclass
+class HeightField:
+    x0: float
+    y0: float
+    res: float
+    z: np.ndarray      # (ny, nx) heights, level frame (sensor at z = 0)
+    code: np.ndarray   # (ny, nx) SemanticKITTI ground class per cell
+
+    def _idx(self, x, y):
+        ny, nx = self.z.shape
+        fx = np.clip((x - self.x0) / self.res, 0.0, nx - 1.000001)
+        fy = np.clip((y - self.y0) / self.res, 0.0, ny - 1.000001)
+        return fx, fy
+
+    def height(self, x, y):
+        fx, fy = self._idx(x, y)
+        ix = fx.astype(np.int64)
+        iy = fy.astype(np.int64)
+        ax = fx - ix
+        ay = fy - iy
+        nx = self.z.shape[1]
+        zf = self.z.ravel()
+        i = iy * nx + ix
+        z00 = zf[i]
+        z01 = zf[i + 1]
+        z10 = zf[i + nx]
+        z11 = zf[i + nx + 1]
+        return (z00 * (1 - ax) + z01 * ax) * (1 - ay) + (z10 * (1 - ax) + z11 * ax) * ay
+
+    def cls(self, x, y):
+        fx, fy = self._idx(x, y)
+        return self.code[np.rint(fy).astype(np.int64), np.rint(fx).astype(np.int64)]
+
+    def normal(self, x, y):
+        e = self.res
+        gx = (self.height(x + e, y) - self.height(x - e, y)) / (2 * e)
+        gy = (self.height(x, y + e) - self.height(x, y - e)) / (2 * e)
+        n = np.stack([-gx, -gy, np.ones_like(gx)], 1)
+        return n / np.linalg.norm(n, axis=1, keepdims=True)
+
+
+def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max: float, n_samples: int = 14,
+                     n_refine: int = 6) -> np.ndarray:
+    """Distance along each unit ray to the first crossing of the heightfield (inf: none)."""
+    t = np.full(len(dirs), np.inf)
+    zmin, zmax = float(hf.z.min()), float(hf.z.max())
+    dz = dirs[:, 2]
+    # ray z(t) = dz * t; restrict to the band zmin <= z <= zmax, t <= t_max
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_lo = np.where(dz < 0, zmax / dz, 0.0)
+        t_hi = np.where(dz < 0, zmin / dz, np.where(dz > 0, zmax / dz, t_max))
+    t_lo = np.maximum(t_lo, 0.05)
+    t_hi = np.minimum(t_hi, t_max)
+    cand = np.nonzero((t_hi > t_lo) & ((dz < 0) | (zmax > 0)))[0]
+    if cand.size == 0:
+        return t
+    d = dirs[cand]
+    lo, hi = t_lo[cand], t_hi[cand]
+    s = np.linspace(0.0, 1.0, n_samples)
+    ts = lo[:, None] + (hi - lo)[:, None] * s[None, :]          # (n, S)
+    px = d[:, 0:1] * ts
+    py = d[:, 1:2] * ts
+    f = d[:, 2:3] * ts - hf.height(px.ravel(), py.ravel()).reshape(ts.shape)
+    below = f <= 0
+    has = below.any(1)
+    j = np.argmax(below, axis=1)
+    keep = has & (j > 0)
+    rows = np.nonzero(keep)[0]
+    j = j[keep]
+    a = ts[rows, j - 1]
+    b = ts[rows, j]
+    fa = f[rows, j - 1]
+    fb = f[rows, j]
+    dd = d[rows]
+    for _ in range(n_refine):
+        # regula falsi, guarded towards bisection
+        m = a + (b - a) * np.clip(fa / np.maximum(fa - fb, 1e-12), 0.1, 0.9)
+        fm = dd[:, 2] * m - hf.height(dd[:, 0] * m, dd[:, 1] * m)
+        pos = fm > 0
+        a = np.where(pos, m, a)
+        fa = np.where(pos, fm, fa)
+        b = np.where(pos, b, m)
+        fb = np.where(pos, fb, fm)
+    tt = a + (b - a) * np.clip(fa / np.maximum(fa - fb, 1e-12), 0.0, 1.0)
+    t[cand[rows]] = tt
+    return t
