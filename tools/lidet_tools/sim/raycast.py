@@ -38,6 +38,7 @@ class Primitives:
     albedo: np.ndarray    # (P,) mean remission at normal incidence
     drop: np.ndarray      # (P,) extra dropout probability (dark paint, tyres)
     transp: np.ndarray    # (P,) probability that a ray passes through (glass, leaves, spokes)
+    A: np.ndarray = None  # (P, 3, 3) unit frame -> world (R diag(half)), for bounding corners
 
     def __len__(self):
         return len(self.kind)
@@ -60,11 +61,12 @@ class PrimitiveList:
         if not self.rows:
             z = np.zeros(0)
             return Primitives(z.astype(np.int8), np.zeros((0, 3)), np.zeros((0, 3, 3)), z,
-                              z.astype(np.int32), z.astype(np.int32), z, z, z)
+                              z.astype(np.int32), z.astype(np.int32), z, z, z, np.zeros((0, 3, 3)))
         k, c, M, r, s, o, a, d, t = zip(*self.rows)
-        return Primitives(np.array(k, np.int8), np.array(c), np.array(M), np.array(r),
+        M = np.array(M)
+        return Primitives(np.array(k, np.int8), np.array(c), M, np.array(r),
                           np.array(s, np.int32), np.array(o, np.int32), np.array(a, np.float64),
-                          np.array(d, np.float64), np.array(t, np.float64))
+                          np.array(d, np.float64), np.array(t, np.float64), np.linalg.inv(M))
 
 
 def rot_z(a):
@@ -96,35 +98,46 @@ class RayGrid:
     tilt_rad: float         # bound on |elevation change| caused by mount pitch/roll
 
 
+_SIGNS = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)], float)
+
+
 def cull_pairs(prims: Primitives, grid: RayGrid):
-    """(ray index, primitive index) pairs whose ray lies in the primitive's angular window."""
+    """(ray index, primitive index) pairs whose ray lies in the primitive's angular window.
+
+    The window comes from the corners of the primitive's oriented bounding box: the azimuth range of
+    the corners bounds the azimuths of a convex body seen from outside its plan; the elevation range
+    uses the nearest and farthest horizontal distances of the plan (an edge passing close overhead is
+    steeper than its corners)."""
     P = len(prims)
     if P == 0:
         return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    corners = prims.center[:, None, :] + np.einsum("pij,kj->pki", prims.A, _SIGNS)   # (P, 8, 3)
     c = prims.center
-    dxy = np.hypot(c[:, 0], c[:, 1])
-    d = np.sqrt(dxy ** 2 + c[:, 2] ** 2)
-    r = prims.radius + 0.05
-    inside = d <= r * 1.0001
-    az = np.arctan2(c[:, 1], c[:, 0])
-    half_az = np.where(dxy > r, np.arcsin(np.clip(r / np.maximum(dxy, 1e-9), 0, 1)), np.pi)
-    el = np.arctan2(c[:, 2], dxy)
-    half_el = np.where(inside, np.pi, np.arcsin(np.clip(r / np.maximum(d, 1e-9), 0, 1)))
-    el_hi = el + half_el + grid.tilt_rad
-    el_lo = el - half_el - grid.tilt_rad
+    az_c = np.arctan2(c[:, 1], c[:, 0])
+    dxy_c = np.hypot(c[:, 0], c[:, 1])
+    rxy = np.hypot(corners[:, :, 0] - c[:, None, 0], corners[:, :, 1] - c[:, None, 1]).max(1)
+    da = np.angle(np.exp(1j * (np.arctan2(corners[:, :, 1], corners[:, :, 0]) - az_c[:, None])))
+    inside = dxy_c <= rxy * 1.0001 + 0.05
+    a_hi = az_c + da.max(1) + 1e-3
+    a_lo = az_c + da.min(1) - 1e-3
+    dmin = np.maximum(dxy_c - rxy, 1e-3)
+    dmax = dxy_c + rxy
+    zmax = corners[:, :, 2].max(1)
+    zmin = corners[:, :, 2].min(1)
+    el_hi = np.where(zmax >= 0, np.arctan2(zmax, dmin), np.arctan2(zmax, dmax)) + grid.tilt_rad + 1e-3
+    el_lo = np.where(zmin < 0, np.arctan2(zmin, dmin), np.arctan2(zmin, dmax)) - grid.tilt_rad - 1e-3
+    el_hi = np.where(inside, np.pi, el_hi)
+    el_lo = np.where(inside, -np.pi, el_lo)
     asc = grid.elev_rows[::-1]  # ascending
     n = grid.rows
-    # rows with elev in [el_lo, el_hi] (rows are descending elevation)
     r0 = n - np.searchsorted(asc, el_hi, side="right")
     r1 = n - 1 - np.searchsorted(asc, el_lo, side="left")
     cols = grid.cols
-    step = 2.0 * np.pi / cols
     # col = floor(0.5 * (1 - az / pi) * cols); az decreases with col
-    full = half_az >= np.pi - 1e-9
-    c_lo = np.floor(0.5 * (1.0 - (az + half_az) / np.pi) * cols).astype(np.int64)
-    c_hi = np.floor(0.5 * (1.0 - (az - half_az) / np.pi) * cols).astype(np.int64) + 1
-    c_lo = np.where(full, 0, c_lo)
-    c_hi = np.where(full, cols - 1, c_hi)
+    c_lo = np.floor(0.5 * (1.0 - a_hi / np.pi) * cols).astype(np.int64)
+    c_hi = np.floor(0.5 * (1.0 - a_lo / np.pi) * cols).astype(np.int64)
+    c_lo = np.where(inside, 0, c_lo)
+    c_hi = np.where(inside, cols - 1, c_hi)
     nc = np.minimum(c_hi - c_lo + 1, cols)
     nr = np.maximum(r1 - r0 + 1, 0)
     cnt = nr * nc
@@ -137,7 +150,6 @@ def cull_pairs(prims: Primitives, grid: RayGrid):
     ncp = nc[pidx]
     row = r0[pidx] + local // ncp
     col = (c_lo[pidx] + local % ncp) % cols
-    del step
     return row * cols + col, pidx
 
 
@@ -226,52 +238,63 @@ def world_normals(prims: Primitives, pidx: np.ndarray, nrm_local: np.ndarray) ->
 # Heightfield ground
 
 
-@dataclass
 class HeightField:
-    x0: float
-    y0: float
-    res: float
-    z: np.ndarray      # (ny, nx) heights, level frame (sensor at z = 0)
-    code: np.ndarray   # (ny, nx) SemanticKITTI ground class per cell
+    """Ground heights on a regular grid (row = y, col = x) with bilinear interpolation, and a
+    SemanticKITTI class code per cell (nearest cell). Each cell keeps its bilinear coefficients
+    (z00, dz_x, dz_y, dz_xy) side by side, so one height costs one gather."""
 
-    def _idx(self, x, y):
+    def __init__(self, x0, y0, res, z, code):
+        self.x0, self.y0, self.res = float(x0), float(y0), float(res)
+        self.z = np.asarray(z)
+        self.code = code
+        self.refresh()
+
+    def refresh(self):
+        """Recompute the interpolation table after editing `z`."""
+        z = self.z.astype(np.float32)
+        zp = np.pad(z, ((0, 1), (0, 1)), mode="edge")
+        z00, z01, z10, z11 = zp[:-1, :-1], zp[:-1, 1:], zp[1:, :-1], zp[1:, 1:]
+        self._coef = np.stack([z00, z01 - z00, z10 - z00, z11 - z10 - z01 + z00], -1).reshape(-1, 4)
+        self._zmin, self._zmax = float(z.min()), float(z.max())
+
+    def _lookup(self, x, y):
         ny, nx = self.z.shape
-        fx = np.clip((x - self.x0) / self.res, 0.0, nx - 1.000001)
-        fy = np.clip((y - self.y0) / self.res, 0.0, ny - 1.000001)
-        return fx, fy
+        inv = np.float32(1.0 / self.res)
+        fx = (np.asarray(x, np.float32) - np.float32(self.x0)) * inv
+        fy = (np.asarray(y, np.float32) - np.float32(self.y0)) * inv
+        np.clip(fx, 0.0, nx - 1.001, out=fx)
+        np.clip(fy, 0.0, ny - 1.001, out=fy)
+        ix = fx.astype(np.int32)
+        iy = fy.astype(np.int32)
+        fx -= ix
+        fy -= iy
+        c = self._coef[iy * nx + ix]
+        return c, fx, fy
 
     def height(self, x, y):
-        fx, fy = self._idx(x, y)
-        ix = fx.astype(np.int64)
-        iy = fy.astype(np.int64)
-        ax = fx - ix
-        ay = fy - iy
-        nx = self.z.shape[1]
-        zf = self.z.ravel()
-        i = iy * nx + ix
-        z00 = zf[i]
-        z01 = zf[i + 1]
-        z10 = zf[i + nx]
-        z11 = zf[i + nx + 1]
-        return (z00 * (1 - ax) + z01 * ax) * (1 - ay) + (z10 * (1 - ax) + z11 * ax) * ay
+        c, ax, ay = self._lookup(x, y)
+        return c[:, 0] + ax * c[:, 1] + ay * (c[:, 2] + ax * c[:, 3])
 
     def cls(self, x, y):
-        fx, fy = self._idx(x, y)
-        return self.code[np.rint(fy).astype(np.int64), np.rint(fx).astype(np.int64)]
+        ny, nx = self.z.shape
+        ix = np.clip(np.rint((np.asarray(x) - self.x0) / self.res), 0, nx - 1).astype(np.int64)
+        iy = np.clip(np.rint((np.asarray(y) - self.y0) / self.res), 0, ny - 1).astype(np.int64)
+        return self.code[iy, ix]
 
     def normal(self, x, y):
-        e = self.res
-        gx = (self.height(x + e, y) - self.height(x - e, y)) / (2 * e)
-        gy = (self.height(x, y + e) - self.height(x, y - e)) / (2 * e)
-        n = np.stack([-gx, -gy, np.ones_like(gx)], 1)
+        c, ax, ay = self._lookup(x, y)
+        gx = (c[:, 1] + ay * c[:, 3]) / self.res
+        gy = (c[:, 2] + ax * c[:, 3]) / self.res
+        n = np.stack([-gx, -gy, np.ones_like(gx)], 1).astype(np.float64)
         return n / np.linalg.norm(n, axis=1, keepdims=True)
 
 
-def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max: float, n_samples: int = 14,
-                     n_refine: int = 6) -> np.ndarray:
-    """Distance along each unit ray to the first crossing of the heightfield (inf: none)."""
+def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max, n_samples: int = 10,
+                     n_refine: int = 5) -> np.ndarray:
+    """Distance along each unit ray to the first crossing of the heightfield (inf: none).
+    t_max: scalar or per-ray bound (e.g. the nearest object hit: the ground behind it is not searched)."""
     t = np.full(len(dirs), np.inf)
-    zmin, zmax = float(hf.z.min()), float(hf.z.max())
+    zmin, zmax = hf._zmin, hf._zmax
     dz = dirs[:, 2]
     # ray z(t) = dz * t; restrict to the band zmin <= z <= zmax, t <= t_max
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -282,9 +305,9 @@ def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max: float, n_samples:
     cand = np.nonzero((t_hi > t_lo) & ((dz < 0) | (zmax > 0)))[0]
     if cand.size == 0:
         return t
-    d = dirs[cand]
-    lo, hi = t_lo[cand], t_hi[cand]
-    s = np.linspace(0.0, 1.0, n_samples)
+    d = dirs[cand].astype(np.float32)
+    lo, hi = t_lo[cand].astype(np.float32), t_hi[cand].astype(np.float32)
+    s = np.linspace(0.0, 1.0, n_samples, dtype=np.float32)
     ts = lo[:, None] + (hi - lo)[:, None] * s[None, :]          # (n, S)
     px = d[:, 0:1] * ts
     py = d[:, 1:2] * ts
@@ -310,5 +333,5 @@ def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max: float, n_samples:
         b = np.where(pos, b, m)
         fb = np.where(pos, fb, fm)
     tt = a + (b - a) * np.clip(fa / np.maximum(fa - fb, 1e-12), 0.0, 1.0)
-    t[cand[rows]] = tt
+    t[cand[rows]] = tt.astype(np.float64)
     return t

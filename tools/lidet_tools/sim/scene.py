@@ -100,6 +100,7 @@ class SceneBuilder:
             d["walk"] = r.uniform(1.8, 4.5) if k != "suburban" else r.uniform(1.5, 2.5)
             d["verge"] = r.uniform(0.0, 3.0) if k in ("street", "intersection") else r.uniform(3.0, 10.0)
             d["slope"] = np.tan(np.radians(r.uniform(-8, 8)))
+            d["slope_len"] = r.uniform(3.0, 12.0)
             d["setback"] = r.uniform(0.0, 4.0) if k != "suburban" else r.uniform(4.0, 12.0)
             d["v_curb"] = self.Wr + d["park"]
             d["v_walk_out"] = d["v_curb"] + d["walk"]
@@ -136,21 +137,24 @@ class SceneBuilder:
     def ground(self):
         r = self.rng
         n = int(2 * self.half / self.res) + 1
-        ax = -self.half + self.res * np.arange(n)
+        ax = (-self.half + self.res * np.arange(n)).astype(np.float32)
         X, Y = np.meshgrid(ax, ax)
         U, V = self.to_road(X, Y)
         A = np.abs(V)
         sgn = np.where(V >= 0, 1, -1)
         code = np.full(X.shape, TERRAIN, np.int8)
-        z = np.zeros(X.shape)
+        z = np.zeros(X.shape, np.float32)
+
+        pos = (V < 0).astype(np.int8)
 
         def per_side(key):
-            return np.where(V >= 0, self.side[1][key], self.side[-1][key])
+            return np.array([self.side[1][key], self.side[-1][key]], np.float32)[pos]
 
         v_curb = per_side("v_curb")
         v_walk = per_side("v_walk_out")
         curb_h = per_side("curb")
         slope = per_side("slope")
+        slope_len = per_side("slope_len")
         park = per_side("park")
         road = A < self.Wr
         code[road] = ROAD
@@ -195,7 +199,7 @@ class SceneBuilder:
         z -= 0.02 * np.clip(A / max(self.Wr, 1e-3), 0, 1)                    # camber
         z += np.where(raised, curb_h, 0.0)
         verge = raised & ~walk
-        z += np.where(verge, slope * np.maximum(A - v_walk, 0.0), 0.0)
+        z += np.where(verge, slope * np.clip(A - v_walk, 0.0, slope_len), 0.0)
         for _ in range(3):
             kx, ky = r.normal(0, 1, 2)
             lam = r.uniform(20, 60)
@@ -206,8 +210,12 @@ class SceneBuilder:
         for _ in range(int(r.integers(4, 12))):
             cx, cy = r.uniform(-self.half, self.half, 2)
             sig = r.uniform(1.0, 5.0)
-            bumps += r.uniform(-0.4, 0.4) * np.exp(-((X - cx) ** 2 + (Y - cy) ** 2) / (2 * sig * sig))
-        rough = r.normal(0.0, r.uniform(0.015, 0.04), X.shape)
+            amp = r.uniform(-0.4, 0.4)
+            i0, i1 = np.clip(np.round((np.array([cx - 3 * sig, cx + 3 * sig]) + self.half) / self.res), 0, n).astype(int)
+            j0, j1 = np.clip(np.round((np.array([cy - 3 * sig, cy + 3 * sig]) + self.half) / self.res), 0, n).astype(int)
+            bumps[j0:j1, i0:i1] += amp * np.exp(-((X[j0:j1, i0:i1] - cx) ** 2 + (Y[j0:j1, i0:i1] - cy) ** 2)
+                                                / (2 * sig * sig))
+        rough = r.standard_normal(X.shape, dtype=np.float32) * r.uniform(0.015, 0.04)
         z += np.where(terr, bumps + rough, 0.0)
         # the sensor sits mount_height above the local ground
         i0 = n // 2
@@ -431,6 +439,7 @@ class SceneBuilder:
             m = (np.abs(lx) < l / 2 + 0.4) & (np.abs(ly) < w / 2 + 0.4)
             sub = hf.z[j0:j1 + 1, i0:i1 + 1]
             sub[m] = np.minimum(sub[m], zb)
+        hf.refresh()
 
     def build(self) -> Scene:
         self.layout()

@@ -15,6 +15,24 @@ from ..sensors import Sensor
 from .raycast import RayGrid, rot_x, rot_y
 
 
+_DIRS_CACHE: dict = {}
+
+
+def _sensor_dirs(s: Sensor):
+    key = (s.name, s.cols, s.beam_elev_rad.tobytes())
+    if key not in _DIRS_CACHE:
+        order = np.argsort(-s.beam_elev_rad, kind="stable")     # row -> ring
+        elev = s.beam_elev_rad[order]
+        az = np.pi * (1.0 - 2.0 * (np.arange(s.cols) + 0.5) / s.cols)
+        ce, se = np.cos(elev)[:, None], np.sin(elev)[:, None]
+        d = np.stack([ce * np.cos(az)[None, :], ce * np.sin(az)[None, :],
+                      np.broadcast_to(se, (len(elev), s.cols))], -1).reshape(-1, 3)
+        if len(_DIRS_CACHE) > 8:
+            _DIRS_CACHE.clear()
+        _DIRS_CACHE[key] = (d, elev, order)
+    return _DIRS_CACHE[key]
+
+
 @dataclass
 class SensorModel:
     sensor: Sensor
@@ -34,26 +52,14 @@ class SensorModel:
 
     def ray_grid(self) -> tuple[RayGrid, np.ndarray]:
         """Level-frame ray grid (rows top to bottom) and the ring index of each row."""
-        s = self.sensor
-        order = np.argsort(-s.beam_elev_rad, kind="stable")     # row -> ring
-        elev = s.beam_elev_rad[order]
-        cols = s.cols
-        az = np.pi * (1.0 - 2.0 * (np.arange(cols) + 0.5) / cols)
-        ce, se = np.cos(elev)[:, None], np.sin(elev)[:, None]
-        d = np.stack([ce * np.cos(az)[None, :], ce * np.sin(az)[None, :],
-                      np.broadcast_to(se, (len(elev), cols))], -1).reshape(-1, 3)
+        d, elev, order = _sensor_dirs(self.sensor)
         d_level = d @ self.R_mount.T
         tilt = abs(self.pitch_rad) + abs(self.roll_rad) + 1e-4
-        return RayGrid(d_level, len(elev), cols, elev, tilt), order
+        return RayGrid(d_level, len(elev), self.sensor.cols, elev, tilt), order
 
     def sensor_dirs(self) -> np.ndarray:
-        s = self.sensor
-        order = np.argsort(-s.beam_elev_rad, kind="stable")
-        elev = s.beam_elev_rad[order]
-        az = np.pi * (1.0 - 2.0 * (np.arange(s.cols) + 0.5) / s.cols)
-        ce, se = np.cos(elev)[:, None], np.sin(elev)[:, None]
-        return np.stack([ce * np.cos(az)[None, :], ce * np.sin(az)[None, :],
-                         np.broadcast_to(se, (len(elev), s.cols))], -1).reshape(-1, 3)
+        """Unit ray directions in the sensor frame, row-major (rows top to bottom)."""
+        return _sensor_dirs(self.sensor)[0]
 
     def returns(self, rng, t, albedo, cos_inc, extra_drop):
         """Apply the return model to first hits. Returns (keep mask, noisy range, remission)."""

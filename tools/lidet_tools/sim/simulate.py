@@ -60,8 +60,6 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
     t_max = sensor.max_range_m + 1.0
     n_rays = len(dirs)
 
-    # ground
-    t_best = rc.intersect_ground(scene.ground, dirs, t_max)
     # primitives
     prims = scene.prims
     ray, pidx = rc.cull_pairs(prims, grid)
@@ -77,7 +75,11 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
     through = noise_rng.random(len(t)) < prims.transp[pidx]
     m = ~through
     ray, pidx, t, nrm = ray[m], pidx[m], t[m], nrm[m]
+    t_best = np.full(n_rays, np.inf)
     np.minimum.at(t_best, ray, t)
+    # ground, searched only up to the nearest object
+    t_g = rc.intersect_ground(scene.ground, dirs, np.minimum(t_best, t_max))
+    t_best = np.minimum(t_best, t_g)
     win = t <= t_best[ray]
     ray_w, pidx_w, nrm_w = ray[win], pidx[win], nrm[win]
     ray_w, first = np.unique(ray_w, return_index=True)
