@@ -294,7 +294,7 @@ def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max, n_samples: int = 
     """Distance along each unit ray to the first crossing of the heightfield (inf: none).
     t_max: scalar or per-ray bound (e.g. the nearest object hit: the ground behind it is not searched)."""
     t = np.full(len(dirs), np.inf)
-    zmin, zmax = hf._zmin, hf._zmax
+    zmin, zmax = hf._zmin - 0.01, hf._zmax + 0.01
     dz = dirs[:, 2]
     # ray z(t) = dz * t; restrict to the band zmin <= z <= zmax, t <= t_max
     with np.errstate(divide="ignore", invalid="ignore"):
