@@ -30,6 +30,7 @@ class Part:
     albedo: float
     drop: float = 0.0
     transp: float = 0.0
+    in_box: bool = True   # False: outside the labelled box (mirrors, as KITTI annotators leave them out)
 
 
 @dataclass
@@ -38,6 +39,7 @@ class Shape:
     sem: int              # SemanticKITTI class of the whole object
     parts: list = field(default_factory=list)
     thing: bool = True    # gets an instance id
+    pad: tuple = (0.0, 0.0, 0.0)   # annotation margin added to the tight box (l, w, h), metres
 
     def add(self, kind, center, half, R=None, albedo=0.3, drop=0.0, transp=0.0, sem=None):
         self.parts.append(Part(kind, np.asarray(center, float), np.asarray(half, float),
@@ -52,11 +54,14 @@ class Shape:
         r = np.broadcast_to(np.asarray(radius, float), (2,))
         self.add(kind, c, [r[0], r[1], half_len], R, albedo, drop, transp, sem)
 
-    def extent(self):
-        """(lo, hi) corners of the axis-aligned box around all parts, object frame."""
+    def extent(self, all_parts=False):
+        """(lo, hi) corners of the labelled box (parts with in_box, plus `pad`), object frame;
+        all_parts: the tight box around every part, no pad."""
         lo = np.full(3, np.inf)
         hi = np.full(3, -np.inf)
         for p in self.parts:
+            if not (p.in_box or all_parts):
+                continue
             A = np.abs(p.R) * p.half[None, :]
             if p.kind == ELLIPSOID:
                 e = np.sqrt(((p.R * p.half[None, :]) ** 2).sum(1))
@@ -64,6 +69,10 @@ class Shape:
                 e = A.sum(1)
             lo = np.minimum(lo, p.center - e)
             hi = np.maximum(hi, p.center + e)
+        if not all_parts:
+            pad = np.array([self.pad[0], self.pad[1], 0.0]) / 2
+            lo, hi = lo - pad, hi + pad
+            hi[2] += self.pad[2]
         return lo, hi
 
 
@@ -97,6 +106,8 @@ def collision_cylinders(shape: Shape, x, y, yaw):
     Rz = rot_z(yaw)
     if shape.label:
         lo, hi = shape.extent()
+        lo2, hi2 = shape.extent(all_parts=True)
+        lo, hi = np.minimum(lo, lo2), np.maximum(hi, hi2)
         c = Rz @ ((lo + hi) / 2)
         r = float(np.hypot(hi[0] - lo[0], hi[1] - lo[1]) / 2)
         return [(x + c[0], y + c[1], r, lo[2] - 0.3, hi[2] + 0.3)]
@@ -130,15 +141,15 @@ def paint(rng):
 
 
 def car(rng, kind=None) -> Shape:
-    kind = kind or str(rng.choice(CAR_TYPES, p=[0.45, 0.3, 0.25]))
+    kind = kind or str(rng.choice(CAR_TYPES, p=[0.4, 0.38, 0.22]))
     if kind == "sedan":
-        L, W, H = rng.uniform(4.2, 5.0), rng.uniform(1.70, 1.88), rng.uniform(1.40, 1.52)
+        L, W, H = rng.uniform(4.0, 4.9), rng.uniform(1.62, 1.82), rng.uniform(1.40, 1.52)
         cab0, cab1, roof0, roof1 = -0.34, 0.17, -0.22, 0.04   # fractions of L (rear .. front)
     elif kind == "hatchback":
-        L, W, H = rng.uniform(3.5, 4.3), rng.uniform(1.62, 1.80), rng.uniform(1.42, 1.56)
+        L, W, H = rng.uniform(3.5, 4.2), rng.uniform(1.55, 1.75), rng.uniform(1.42, 1.56)
         cab0, cab1, roof0, roof1 = -0.44, 0.16, -0.40, 0.02
     else:
-        L, W, H = rng.uniform(4.3, 5.2), rng.uniform(1.80, 1.96), rng.uniform(1.62, 1.80)
+        L, W, H = rng.uniform(4.2, 5.2), rng.uniform(1.74, 1.92), rng.uniform(1.62, 1.80)
         cab0, cab1, roof0, roof1 = -0.45, 0.17, -0.43, 0.06
     s = Shape("Car", S["car"])
     alb, drop = paint(rng)
@@ -172,6 +183,7 @@ def car(rng, kind=None) -> Shape:
     # mirrors
     for sy in (-1, 1):
         s.add(BOX, [x1 - 0.05, sy * (W / 2 + 0.06), belt + 0.12], [0.08, 0.07, 0.06], albedo=alb, drop=drop)
+        s.parts[-1].in_box = False
     return s
 
 
@@ -237,9 +249,10 @@ def pedestrian(rng, height=None, child=False, walking=None) -> Shape:
     w = h / 1.75 * rng.uniform(0.9, 1.12)      # girth scale
     walking = bool(rng.random() < 0.65) if walking is None else walking
     phase = rng.uniform(0, 2 * np.pi)
-    amp = rng.uniform(0.25, 0.42) if walking else rng.uniform(0.0, 0.06)
+    amp = rng.uniform(0.3, 0.5) if walking else rng.uniform(0.0, 0.06)
     phi = amp * np.sin(phase)
-    s = Shape("Pedestrian", S["person"])
+    # KITTI annotators draw pedestrian boxes looser than the body (mean l 0.84, w 0.66 m)
+    s = Shape("Pedestrian", S["person"], pad=(0.3, 0.1, 0.0))
     cloth_top = float(rng.uniform(0.06, 0.45))
     cloth_leg = float(rng.uniform(0.05, 0.35))
     drop_top = 0.25 if cloth_top < 0.08 else 0.05
@@ -289,7 +302,7 @@ def _bicycle(s: Shape, rng, sem, alb=None):
 
 def cyclist(rng) -> Shape:
     """Bicycle plus a leaning rider; the whole object is class bicyclist (31) with one instance."""
-    s = Shape("Cyclist", S["bicyclist"])
+    s = Shape("Cyclist", S["bicyclist"], pad=(0.05, 0.05, 0.0))
     _bicycle(s, rng, S["bicyclist"])
     h = float(np.clip(rng.normal(1.75, 0.08), 1.55, 1.95))
     k = h / 1.75
@@ -337,7 +350,7 @@ def stuff(sem) -> Shape:
 
 def tree(rng) -> Shape:
     s = stuff(S["vegetation"])
-    th = rng.uniform(1.8, 3.5)
+    th = rng.uniform(1.2, 3.0)
     tr = rng.uniform(0.1, 0.25)
     s.add(CYLINDER, [0, 0, th / 2 + 0.3], [tr, tr, th / 2 + 0.3], albedo=0.31, sem=S["trunk"])
     cr = rng.uniform(1.5, 3.5)

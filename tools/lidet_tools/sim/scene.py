@@ -98,10 +98,10 @@ class SceneBuilder:
             d["park"] = r.uniform(2.2, 2.6) if (r.random() < (0.75 if k == "street" else 0.4)) else 0.0
             d["curb"] = r.uniform(0.10, 0.20)
             d["walk"] = r.uniform(1.8, 4.5) if k != "suburban" else r.uniform(1.5, 2.5)
-            d["verge"] = r.uniform(0.0, 3.0) if k in ("street", "intersection") else r.uniform(3.0, 10.0)
+            d["verge"] = r.uniform(0.0, 2.0) if k in ("street", "intersection") else r.uniform(2.0, 6.0)
             d["slope"] = np.tan(np.radians(r.uniform(-8, 8)))
             d["slope_len"] = r.uniform(3.0, 12.0)
-            d["setback"] = r.uniform(0.0, 4.0) if k != "suburban" else r.uniform(4.0, 12.0)
+            d["setback"] = r.uniform(0.0, 2.5) if k != "suburban" else r.uniform(2.0, 7.0)
             d["v_curb"] = self.Wr + d["park"]
             d["v_walk_out"] = d["v_curb"] + d["walk"]
             d["v_build"] = d["v_walk_out"] + d["verge"] + d["setback"]
@@ -350,9 +350,9 @@ class SceneBuilder:
                 self.put(ob.pole(r, "sign"), r.uniform(-60, 60), s * (vc + r.uniform(-0.2, 0.3)), r.uniform(-3, 3),
                          margin=0.1)
             # street trees
-            if r.random() < 0.7:
+            if r.random() < 0.8:
                 u = r.uniform(-75, -65)
-                gap = r.uniform(7, 16)
+                gap = r.uniform(6, 14)
                 vt = vc + 0.4 if d["walk"] > 2.5 else d["v_walk_out"] + min(d["verge"], 2.0) / 2 + 0.5
                 while u < 75:
                     if r.random() < 0.8:
@@ -363,9 +363,13 @@ class SceneBuilder:
                 v = s * r.uniform(d["v_curb"] + 0.3, max(d["v_curb"] + 0.4, d["v_walk_out"] - 0.3))
                 sh = ob.parked_bicycle(r) if r.random() < 0.15 else ob.clutter(r)
                 self.put(sh, r.uniform(-60, 60), v, r.uniform(-np.pi, np.pi), margin=0.1)
+            # bushes along the outer edge of the sidewalk
+            for _ in range(int(r.poisson(r.uniform(2, 12)))):
+                v = s * (d["v_walk_out"] + r.uniform(0.3, 1.5))
+                self.put(ob.bush(r), r.uniform(-70, 70), v, 0.0, margin=0.0)
             # verge vegetation
             if d["verge"] > 1.0:
-                for _ in range(int(r.poisson(d["verge"] * 3))):
+                for _ in range(int(r.poisson((d["verge"] + d["setback"]) * 6))):
                     v = s * r.uniform(d["v_walk_out"] + 0.5, d["v_walk_out"] + d["verge"] + d["setback"])
                     sh = ob.bush(r) if r.random() < 0.6 else ob.tree(r)
                     self.put(sh, r.uniform(-70, 70), v, 0.0, margin=0.0)
@@ -395,6 +399,19 @@ class SceneBuilder:
                                albedo=r.uniform(0.2, 0.45), transp=0.0 if solid else 0.45)
                         self.put(sh, u + seg / 2, s * vf, 0.0, check=False)
                     u += seg + r.uniform(0.5, 4.0)
+            # hedges in front of the buildings
+            if r.random() < (0.8 if sub else 0.5):
+                vh = d["v_build"] - r.uniform(0.8, 2.0)
+                u = -78.0
+                while u < 78:
+                    seg = r.uniform(4, 15)
+                    if r.random() < 0.7 and not self._in_cross(u + seg / 2, seg):
+                        hh = r.uniform(0.8, 2.2)
+                        sh = ob.stuff(70)
+                        sh.add(ob.BOX, [0, 0, hh / 2], [seg / 2, r.uniform(0.3, 0.7), hh / 2], albedo=0.33,
+                               transp=0.25)
+                        self.put(sh, u + seg / 2, s * vh, 0.0, check=False)
+                    u += seg + r.uniform(1.0, 8.0)
             if r.random() < 0.08:
                 continue  # open field on this side
             u = -78.0
@@ -412,6 +429,28 @@ class SceneBuilder:
                                albedo=r.uniform(0.25, 0.5))
                     self.put(sh, u + wdt / 2, s * vv, 0.0 if s > 0 else np.pi, check=False)
                 u += wdt + (r.uniform(3, 15) if sub else r.uniform(0, 5))
+
+    def cross_street(self):
+        """Corner buildings and trees along the cross street of an intersection."""
+        if self.u_x is None:
+            return
+        r = self.rng
+        for e in (1, -1):
+            for s in (1, -1):
+                vb = self.side[s]["v_build"]
+                v = vb + r.uniform(0, 3)
+                while v < 75:
+                    wdt = r.uniform(10, 30)
+                    depth = r.uniform(8, 16)
+                    hgt = r.uniform(6, 20)
+                    sh = ob.stuff(50)
+                    sh.add(ob.BOX, [0, 0, hgt / 2], [wdt / 2, depth / 2, hgt / 2], albedo=r.uniform(0.25, 0.55))
+                    uu = self.u_x + e * (self.Wx / 2 + 3.0 + r.uniform(0, 3) + depth / 2)
+                    self.put(sh, uu, s * (v + wdt / 2), np.pi / 2, check=False)
+                    v += wdt + r.uniform(0, 6)
+                for _ in range(int(r.integers(2, 7))):
+                    uu = self.u_x + e * (self.Wx / 2 + 1.0)
+                    self.put(ob.tree(r), uu, s * r.uniform(vb, 70), 0.0, margin=0.0)
 
     def _in_cross(self, u, length):
         return self.u_x is not None and abs(u - self.u_x) < (self.Wx + length) / 2 + 1.0
@@ -445,6 +484,7 @@ class SceneBuilder:
         self.layout()
         self.ground()
         self.structures()
+        self.cross_street()
         self.traffic()
         self.people()
         self.furniture()
