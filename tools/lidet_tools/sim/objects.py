@@ -57,6 +57,10 @@ class Shape:
     def extent(self, all_parts=False):
         """(lo, hi) corners of the labelled box (parts with in_box, plus `pad`), object frame;
         all_parts: the tight box around every part, no pad."""
+        key = (bool(all_parts), len(self.parts))
+        cache = self.__dict__.setdefault("_ext", {})
+        if key in cache:
+            return cache[key]
         lo = np.full(3, np.inf)
         hi = np.full(3, -np.inf)
         for p in self.parts:
@@ -73,6 +77,7 @@ class Shape:
             pad = np.array([self.pad[0], self.pad[1], 0.0]) / 2
             lo, hi = lo - pad, hi + pad
             hi[2] += self.pad[2]
+        cache[key] = (lo, hi)
         return lo, hi
 
 
@@ -80,11 +85,13 @@ def segment_frame(p0, p1):
     d = p1 - p0
     L = float(np.linalg.norm(d))
     z = d / max(L, 1e-9)
-    a = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    x = np.cross(a, z)
-    x /= np.linalg.norm(x)
-    y = np.cross(z, x)
-    return (p0 + p1) / 2.0, np.stack([x, y, z], 1), L / 2.0
+    if abs(z[0]) < 0.9:      # x = unit(e_x cross z)
+        x = np.array([0.0, -z[2], z[1]])
+    else:                    # x = unit(e_y cross z)
+        x = np.array([z[2], 0.0, -z[0]])
+    x /= np.sqrt(x @ x)
+    y = np.array([z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0]])
+    return (p0 + p1) / 2.0, np.column_stack([x, y, z]), L / 2.0
 
 
 def place(plist: PrimitiveList, shape: Shape, x, y, z, yaw, obj=-1):

@@ -155,16 +155,20 @@ def cull_pairs(prims: Primitives, grid: RayGrid):
 
 def intersect_pairs(prims: Primitives, dirs: np.ndarray, ray: np.ndarray, pidx: np.ndarray):
     """Entry distance t (inf on a miss) and unit-frame hit normal for each pair."""
-    M = prims.M[pidx]                                   # (n, 3, 3)
-    o = -np.einsum("pij,pj->pi", prims.M, prims.center)[pidx]
-    d = np.einsum("nij,nj->ni", M, dirs[ray])
+    # np.take(axis=0) instead of fancy row indexing: same result, many times faster
+    M = np.take(prims.M.reshape(-1, 9), pidx, axis=0)                  # (n, 9)
+    o = np.take(-np.einsum("pij,pj->pi", prims.M, prims.center), pidx, axis=0)
+    dr = np.take(dirs, ray, axis=0)
+    d = np.empty_like(dr)
+    for i in range(3):
+        d[:, i] = M[:, 3 * i] * dr[:, 0] + M[:, 3 * i + 1] * dr[:, 1] + M[:, 3 * i + 2] * dr[:, 2]
     t = np.full(len(ray), np.inf)
     nrm = np.zeros((len(ray), 3))
     kind = prims.kind[pidx]
 
-    m = kind == BOX
-    if m.any():
-        oo, dd = o[m], d[m]
+    m = np.nonzero(kind == BOX)[0]
+    if m.size:
+        oo, dd = np.take(o, m, axis=0), np.take(d, m, axis=0)
         with np.errstate(divide="ignore", invalid="ignore"):
             inv = 1.0 / np.where(np.abs(dd) < 1e-12, 1e-12, dd)
         t1 = (-1.0 - oo) * inv
@@ -181,9 +185,9 @@ def intersect_pairs(prims: Primitives, dirs: np.ndarray, ray: np.ndarray, pidx: 
         t[m] = tb
         nrm[m] = nb
 
-    m = kind == ELLIPSOID
-    if m.any():
-        oo, dd = o[m], d[m]
+    m = np.nonzero(kind == ELLIPSOID)[0]
+    if m.size:
+        oo, dd = np.take(o, m, axis=0), np.take(d, m, axis=0)
         a = (dd * dd).sum(1)
         b = (oo * dd).sum(1)
         c = (oo * oo).sum(1) - 1.0
@@ -196,9 +200,9 @@ def intersect_pairs(prims: Primitives, dirs: np.ndarray, ray: np.ndarray, pidx: 
         t[m] = te
         nrm[m] = oo + np.where(ok, te, 0.0)[:, None] * dd
 
-    m = kind == CYLINDER
-    if m.any():
-        oo, dd = o[m], d[m]
+    m = np.nonzero(kind == CYLINDER)[0]
+    if m.size:
+        oo, dd = np.take(o, m, axis=0), np.take(d, m, axis=0)
         a = dd[:, 0] ** 2 + dd[:, 1] ** 2
         b = oo[:, 0] * dd[:, 0] + oo[:, 1] * dd[:, 1]
         c = oo[:, 0] ** 2 + oo[:, 1] ** 2 - 1.0
@@ -230,7 +234,7 @@ def intersect_pairs(prims: Primitives, dirs: np.ndarray, ray: np.ndarray, pidx: 
 
 def world_normals(prims: Primitives, pidx: np.ndarray, nrm_local: np.ndarray) -> np.ndarray:
     """Unit-frame normal -> level-frame unit normal (n_world ~ M^T n_local)."""
-    n = np.einsum("nji,nj->ni", prims.M[pidx], nrm_local)
+    n = np.einsum("nji,nj->ni", np.take(prims.M, pidx, axis=0), nrm_local)
     return n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-12)
 
 
@@ -264,11 +268,11 @@ class HeightField:
         fy = (np.asarray(y, np.float32) - np.float32(self.y0)) * inv
         np.clip(fx, 0.0, nx - 1.001, out=fx)
         np.clip(fy, 0.0, ny - 1.001, out=fy)
-        ix = fx.astype(np.int32)
-        iy = fy.astype(np.int32)
+        ix = fx.astype(np.int64)
+        iy = fy.astype(np.int64)
         fx -= ix
         fy -= iy
-        c = self._coef[iy * nx + ix]
+        c = np.take(self._coef, iy * nx + ix, axis=0)   # (much faster than fancy row indexing)
         return c, fx, fy
 
     def height(self, x, y):
@@ -289,7 +293,7 @@ class HeightField:
         return n / np.linalg.norm(n, axis=1, keepdims=True)
 
 
-def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max, n_samples: int = 10,
+def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max, n_samples: int = 9,
                      n_refine: int = 5) -> np.ndarray:
     """Distance along each unit ray to the first crossing of the heightfield (inf: none).
     t_max: scalar or per-ray bound (e.g. the nearest object hit: the ground behind it is not searched)."""
@@ -305,7 +309,7 @@ def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max, n_samples: int = 
     cand = np.nonzero((t_hi > t_lo) & ((dz < 0) | (zmax > 0)))[0]
     if cand.size == 0:
         return t
-    d = dirs[cand].astype(np.float32)
+    d = np.take(dirs, cand, axis=0).astype(np.float32)
     lo, hi = t_lo[cand].astype(np.float32), t_hi[cand].astype(np.float32)
     s = np.linspace(0.0, 1.0, n_samples, dtype=np.float32)
     ts = lo[:, None] + (hi - lo)[:, None] * s[None, :]          # (n, S)
@@ -322,7 +326,7 @@ def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max, n_samples: int = 
     b = ts[rows, j]
     fa = f[rows, j - 1]
     fb = f[rows, j]
-    dd = d[rows]
+    dd = np.take(d, rows, axis=0)
     for _ in range(n_refine):
         # regula falsi, guarded towards bisection
         m = a + (b - a) * np.clip(fa / np.maximum(fa - fb, 1e-12), 0.1, 0.9)

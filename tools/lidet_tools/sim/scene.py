@@ -72,7 +72,7 @@ def _smoothstep(e0, e1, x):
 
 
 class SceneBuilder:
-    def __init__(self, rng, mount_height_m, max_range_m, kind=None, robot=False, res=0.25):
+    def __init__(self, rng, mount_height_m, max_range_m, kind=None, robot=False, res=0.3):
         self.rng = rng
         self.H = mount_height_m
         self.kind = kind or str(rng.choice(SCENE_TYPES, p=[0.4, 0.25, 0.15, 0.2]))

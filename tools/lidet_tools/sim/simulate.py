@@ -90,7 +90,7 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
     valid = np.nonzero(np.isfinite(t_best))[0]
     tv = t_best[valid]
     hp = hit_prim[valid]
-    dv = dirs[valid]
+    dv = np.take(dirs, valid, axis=0)
     pts_level = dv * tv[:, None]
     is_g = hp < 0
     sem = np.zeros(len(valid), np.int32)
@@ -107,9 +107,7 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
     sem[po] = prims.sem[hpo]
     alb[po] = prims.albedo[hpo]
     drop[po] = prims.drop[hpo]
-    nloc = np.zeros((len(valid), 3))
-    nloc[ray_w.searchsorted(valid[po])] if False else None
-    normal[po] = rc.world_normals(prims, hpo, nrm_w[np.searchsorted(ray_w, valid[po])])
+    normal[po] = rc.world_normals(prims, hpo, np.take(nrm_w, np.searchsorted(ray_w, valid[po]), axis=0))
     cos_inc = np.abs((normal * dv).sum(1))
     keep, tn, rem = sm.returns(noise_rng, tv, alb, cos_inc, drop)
 
@@ -119,11 +117,11 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
     ring = row2ring[row]
     order = np.lexsort((col, ring))          # ring by ring, columns in image order
     sdirs = sm.sensor_dirs()
-    xyz = sdirs[sel] * tn[keep][:, None]
+    xyz = np.take(sdirs, sel, axis=0) * tn[keep][:, None]
     pts = np.empty((len(sel), 4), np.float32)
     pts[:, :3] = xyz
     pts[:, 3] = rem[keep]
-    pts = pts[order]
+    pts = np.take(pts, order, axis=0)
     sem_k = sem[keep][order].astype(np.uint16)
     hobj = np.where(hp[keep] >= 0, prims.obj[np.maximum(hp[keep], 0)], -1)[order]
     inst_of_obj = np.array([o.instance for o in scene.objects] + [0], np.int64)
