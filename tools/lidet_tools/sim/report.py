@@ -261,10 +261,13 @@ def make_report(real_dir, n_scans=24, seed=1000, img_dir="docs/img", md_path="do
                 j = int(np.argmin([abs(d2 - d) for d2, _ in ss]))
                 pick.append(ss[j][1])
         sp = np.concatenate(pick) if pick else np.zeros((0, 3))
+        sub = np.random.default_rng(0)
+        sp_plot = sp[sub.permutation(len(sp))[:3000]]
+        rp_plot = rp[sub.permutation(len(rp))[:3000]]
         for v, (i0, i1, lab) in enumerate(((0, 2, "side: x (m) vs z (m)"), (0, 1, "top: x (m) vs y (m)"))):
             a = ax[v, k]
-            a.scatter(sp[:, i0], sp[:, i1], s=1, alpha=0.4, color="C1", label=f"sim ({len(pick)} objects)")
-            a.scatter(rp[:, i0], rp[:, i1], s=1, alpha=0.4, color="C0", label=f"real ({len(rs)} objects)")
+            a.scatter(sp_plot[:, i0], sp_plot[:, i1], s=1, alpha=0.5, color="C1", label=f"sim ({len(pick)} objects)")
+            a.scatter(rp_plot[:, i0], rp_plot[:, i1], s=1, alpha=0.5, color="C0", label=f"real ({len(rs)} objects)")
             a.set_aspect("equal")
             a.set_title(f"{name} {lab}", fontsize=9)
             a.legend(fontsize=7, markerscale=6)
@@ -273,7 +276,7 @@ def make_report(real_dir, n_scans=24, seed=1000, img_dir="docs/img", md_path="do
                 ext = np.percentile(q_, 99, axis=0) - np.percentile(q_, 1, axis=0)
                 curve_rows.append((f"{name} shape {tag}", ext))
     fig.tight_layout()
-    fig.savefig(os.path.join(img_dir, "sim_shapes.png"), dpi=80)
+    fig.savefig(os.path.join(img_dir, "sim_shapes.png"), dpi=70)
     plt.close(fig)
     for name in ("car", "pedestrian"):
         ext = {t: e for (n, e) in [(r[0], r[1]) for r in curve_rows if len(r) == 2] for t in ("x",)
@@ -323,14 +326,15 @@ def _bev(plt, path, real_dir, seed):
     r = simulate_scan("hdl64", seed, 0)
     for a, (p, s, t) in zip(ax, ((pts, kitti.semantic_base(sem), "real: SemanticKITTI 00/000000"),
                                  (r.points, r.sem, f"sim: hdl64 seed {seed} scan 0"))):
-        c = [colors.get(int(v), "0.8") for v in s]
-        a.scatter(p[:, 0], p[:, 1], s=0.05, c=c)
+        k = np.random.default_rng(0).permutation(len(p))[:40000]
+        c = [colors.get(int(v), "0.8") for v in s[k]]
+        a.scatter(p[k, 0], p[k, 1], s=0.05, c=c)
         a.set_xlim(-40, 40)
         a.set_ylim(-40, 40)
         a.set_aspect("equal")
         a.set_title(t, fontsize=9)
     fig.tight_layout()
-    fig.savefig(path, dpi=80)
+    fig.savefig(path, dpi=65)
     plt.close(fig)
 
 

@@ -43,7 +43,7 @@ class SensorModel:
     dropout: float = 0.015           # random loss of any return
     min_range_m: float = 1.0
     far_dropout: float = 0.35        # extra loss at max range (grows with (t / max_range)^2)
-    weak_return: float = 0.004       # returns with remission / t^2 * 100 below this are lost
+    weak_return: float = 0.0015      # returns with remission / t^2 * 100 below this are lost
 
     @property
     def R_mount(self) -> np.ndarray:
