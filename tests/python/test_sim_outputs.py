@@ -105,7 +105,8 @@ def test_ground_points_carry_ground_classes():
     dz = xyz[:, 2] - hf.height(xyz[:, 0], xyz[:, 1])
     ground = np.isin(r.sem, kitti.GROUND_IDS)
     assert ground.mean() > 0.25
-    assert np.abs(dz[ground]).max() < 0.08           # ground labels lie on the heightfield
+    # ground labels lie on the heightfield (up to noise; hits on a curb face may be one cell off)
+    assert np.percentile(np.abs(dz[ground]), 99.5) < 0.05 and np.abs(dz[ground]).max() < 0.2
     near = np.abs(dz) < 0.02
     assert ground[near].mean() > 0.95                # and what lies on it is ground
     # several ground classes occur

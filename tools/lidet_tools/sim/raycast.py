@@ -294,7 +294,7 @@ class HeightField:
 
 
 def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max, n_samples: int = 9,
-                     n_refine: int = 5) -> np.ndarray:
+                     n_refine: int = 7) -> np.ndarray:
     """Distance along each unit ray to the first crossing of the heightfield (inf: none).
     t_max: scalar or per-ray bound (e.g. the nearest object hit: the ground behind it is not searched)."""
     t = np.full(len(dirs), np.inf)
