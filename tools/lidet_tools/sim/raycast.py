@@ -156,21 +156,22 @@ def cull_pairs(prims: Primitives, grid: RayGrid):
 def intersect_pairs(prims: Primitives, dirs: np.ndarray, ray: np.ndarray, pidx: np.ndarray):
     """Entry distance t (inf on a miss) and unit-frame hit normal for each pair."""
     # np.take(axis=0) instead of fancy row indexing: same result, many times faster
-    M = np.take(prims.M.reshape(-1, 9), pidx, axis=0)                  # (n, 9)
-    o = np.take(-np.einsum("pij,pj->pi", prims.M, prims.center), pidx, axis=0)
-    dr = np.take(dirs, ray, axis=0)
+    # float32 halves the memory traffic; 1e-7 relative is < 0.1 mm at 120 m
+    M = np.take(prims.M.reshape(-1, 9).astype(np.float32), pidx, axis=0)                  # (n, 9)
+    o = np.take(-np.einsum("pij,pj->pi", prims.M, prims.center).astype(np.float32), pidx, axis=0)
+    dr = np.take(dirs.astype(np.float32), ray, axis=0)
     d = np.empty_like(dr)
     for i in range(3):
         d[:, i] = M[:, 3 * i] * dr[:, 0] + M[:, 3 * i + 1] * dr[:, 1] + M[:, 3 * i + 2] * dr[:, 2]
-    t = np.full(len(ray), np.inf)
-    nrm = np.zeros((len(ray), 3))
+    t = np.full(len(ray), np.inf, np.float32)
+    nrm = np.zeros((len(ray), 3), np.float32)
     kind = prims.kind[pidx]
 
     m = np.nonzero(kind == BOX)[0]
     if m.size:
         oo, dd = np.take(o, m, axis=0), np.take(d, m, axis=0)
         with np.errstate(divide="ignore", invalid="ignore"):
-            inv = 1.0 / np.where(np.abs(dd) < 1e-12, 1e-12, dd)
+            inv = np.float32(1.0) / np.where(np.abs(dd) < 1e-12, np.float32(1e-12), dd)
         t1 = (-1.0 - oo) * inv
         t2 = (1.0 - oo) * inv
         tn = np.minimum(t1, t2)
@@ -188,13 +189,13 @@ def intersect_pairs(prims: Primitives, dirs: np.ndarray, ray: np.ndarray, pidx: 
     m = np.nonzero(kind == ELLIPSOID)[0]
     if m.size:
         oo, dd = np.take(o, m, axis=0), np.take(d, m, axis=0)
+        # closest approach first (no cancellation in float32): p = o + tc d, h2 = 1 - |p|^2
         a = (dd * dd).sum(1)
-        b = (oo * dd).sum(1)
-        c = (oo * oo).sum(1) - 1.0
-        disc = b * b - a * c
-        ok = (disc >= 0) & (c > 0)
-        sq = np.sqrt(np.where(ok, disc, 0.0))
-        te = (-b - sq) / a
+        tc = -(oo * dd).sum(1) / a
+        pc = oo + tc[:, None] * dd
+        h2 = 1.0 - (pc * pc).sum(1)
+        ok = (h2 >= 0) & ((oo * oo).sum(1) > 1.0)
+        te = tc - np.sqrt(np.where(ok, h2, 0.0) / a)
         ok &= te > 1e-6
         te = np.where(ok, te, np.inf)
         t[m] = te
@@ -204,12 +205,13 @@ def intersect_pairs(prims: Primitives, dirs: np.ndarray, ray: np.ndarray, pidx: 
     if m.size:
         oo, dd = np.take(o, m, axis=0), np.take(d, m, axis=0)
         a = dd[:, 0] ** 2 + dd[:, 1] ** 2
-        b = oo[:, 0] * dd[:, 0] + oo[:, 1] * dd[:, 1]
-        c = oo[:, 0] ** 2 + oo[:, 1] ** 2 - 1.0
-        disc = b * b - a * c
-        ok = (disc >= 0) & (c > 0) & (a > 1e-18)
-        sq = np.sqrt(np.where(ok, disc, 0.0))
-        ts = (-b - sq) / np.where(a > 1e-18, a, 1.0)
+        a_ = np.where(a > 1e-18, a, 1.0)
+        tc = -(oo[:, 0] * dd[:, 0] + oo[:, 1] * dd[:, 1]) / a_
+        px = oo[:, 0] + tc * dd[:, 0]
+        py = oo[:, 1] + tc * dd[:, 1]
+        h2 = 1.0 - (px * px + py * py)
+        ok = (h2 >= 0) & (oo[:, 0] ** 2 + oo[:, 1] ** 2 > 1.0) & (a > 1e-18)
+        ts = tc - np.sqrt(np.where(ok, h2, 0.0) / a_)
         zs = oo[:, 2] + ts * dd[:, 2]
         ok &= (ts > 1e-6) & (np.abs(zs) <= 1.0)
         ts = np.where(ok, ts, np.inf)
@@ -229,7 +231,7 @@ def intersect_pairs(prims: Primitives, dirs: np.ndarray, ray: np.ndarray, pidx: 
         n_cap[:, 2] = zc
         t[m] = tt
         nrm[m] = np.where(use_cap[:, None], n_cap, n_side)
-    return t, nrm
+    return t.astype(np.float64), nrm.astype(np.float64)
 
 
 def world_normals(prims: Primitives, pidx: np.ndarray, nrm_local: np.ndarray) -> np.ndarray:

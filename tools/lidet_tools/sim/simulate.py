@@ -68,8 +68,10 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
     ray, pidx, t, nrm = ray[m], pidx[m], t[m], nrm[m]
     obj = prims.obj[pidx]
     n_obj = len(scene.objects)
-    # rays that meet each object at all (for occlusion levels)
-    key_any = np.unique(ray.astype(np.int64) * (n_obj + 1) + obj)
+    # rays that meet each labelled object at all (for occlusion levels)
+    labelled = np.array([bool(o.label) for o in scene.objects] + [False])
+    lm = labelled[obj]
+    key_any = np.unique(ray[lm].astype(np.int64) * (n_obj + 1) + obj[lm])
     any_cnt = np.bincount(key_any % (n_obj + 1), minlength=n_obj + 1)[:n_obj]
     # see-through surfaces (glass, leaves, spokes, mesh fences)
     through = noise_rng.random(len(t)) < prims.transp[pidx]
