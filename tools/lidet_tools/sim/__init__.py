@@ -4,3 +4,5 @@ ray cast with a sensor profile's beams, written in KITTI's layout. Entry points:
 `write_scan`, and the `lidet-sim` CLI (cli.py)."""
 from .simulate import LABEL2_CLASSES, ScanResult, simulate_scan  # noqa: F401
 from .writer import SUBDIRS, read_ring, scan_paths, write_scan  # noqa: F401
+
+__all__ = ["LABEL2_CLASSES", "ScanResult", "simulate_scan", "SUBDIRS", "read_ring", "scan_paths", "write_scan"]

@@ -129,11 +129,6 @@ def collision_cylinders(shape: Shape, x, y, yaw):
     return out
 
 
-def footprint_radius(shape: Shape) -> float:
-    lo, hi = shape.extent()
-    return float(np.hypot(max(abs(lo[0]), abs(hi[0])), max(abs(lo[1]), abs(hi[1]))))
-
-
 # ------------------------------------------------------------------------------------------------
 # Vehicles
 
@@ -179,7 +174,8 @@ def car(rng, kind=None) -> Shape:
     s.add(BOX, [(r0 + r1) / 2, 0, H - roof_t / 2], [(r1 - r0) / 2 + 0.05, wc, roof_t / 2], albedo=alb, drop=drop)
     for pa, pb in (((x1, belt), (r1, H - roof_t)), ((x0, belt), (r0, H - roof_t))):
         s.limb([pa[0], 0, pa[1]], [pb[0], 0, pb[1]], [wc, 0.02], albedo=0.05, kind=BOX, drop=0.3, transp=0.8)
-    s.add(BOX, [(x0 + x1) / 2, 0, belt + 0.2], [(x1 - x0) / 2 - 0.1, wc - 0.05, 0.25], albedo=0.08, drop=0.2)
+    # seats and dashboard: below the window line mostly, narrower than the cabin
+    s.add(BOX, [(x0 + x1) / 2, 0, belt + 0.05], [(x1 - x0) / 2 - 0.15, wc - 0.25, 0.25], albedo=0.08, drop=0.4)
     # wheels
     r = rng.uniform(0.30, 0.36) + (0.03 if kind == "suv" else 0.0)
     wb = L / 2 - max(0.75, 0.18 * L)

@@ -66,11 +66,6 @@ class _Placer:
         self.c = np.vstack([self.c, np.asarray(cyl)])
 
 
-def _smoothstep(e0, e1, x):
-    t = np.clip((x - e0) / (e1 - e0), 0.0, 1.0)
-    return t * t * (3 - 2 * t)
-
-
 class SceneBuilder:
     def __init__(self, rng, mount_height_m, max_range_m, kind=None, robot=False, res=0.3):
         self.rng = rng

@@ -12,7 +12,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import kitti
-from ..sensors import Sensor, get_sensor
+from ..sensors import get_sensor
 from . import raycast as rc
 from .scene import SURF_ALB, SURF_ROUGH_DROP, SURF_SEM, Scene, make_scene
 from .sensor_model import SensorModel
@@ -35,8 +35,9 @@ class ScanResult:
     n_points_obj: np.ndarray = field(repr=False, default=None)
 
 
-def _robot(sensor: Sensor, mount: float) -> bool:
-    return mount < 1.2
+def _robot(mount_height_m: float) -> bool:
+    """Low mounts are robots: sensor on the sidewalk half of the time, 0.3 m minimum range."""
+    return mount_height_m < 1.2
 
 
 def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float | None = None,
@@ -51,7 +52,7 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
         np.clip(mount_rng.normal(0, 0.25), -0.6, 0.6))
     roll = np.radians(roll_deg) if roll_deg is not None else np.radians(
         np.clip(mount_rng.normal(0, 0.25), -0.6, 0.6))
-    robot = _robot(sensor, H)
+    robot = _robot(H)
     scene = make_scene(scene_rng, H, sensor.max_range_m, scene_kind, robot)
     sm = SensorModel(sensor, H, float(pitch), float(roll), range_noise_m=range_noise_m, dropout=dropout,
                      min_range_m=0.3 if robot else 1.0)
