@@ -78,3 +78,17 @@ def test_culling_matches_brute_force():
     assert np.isfinite(ref).sum() > 500
     assert np.array_equal(np.isfinite(best), np.isfinite(ref))
     assert np.allclose(best[np.isfinite(ref)], ref[np.isfinite(ref)])
+
+
+def test_ground_search_band_keeps_hits():
+    """The per-row radial band must not drop ground hits that a dense search finds (hills, rising rays)."""
+    from lidet_tools.sim.scene import make_scene
+    from lidet_tools.sensors import get_sensor
+    s = get_sensor("vlp16")
+    sc = make_scene(np.random.default_rng(2), 0.5, s.max_range_m, robot=True)
+    grid, _ = SensorModel(s, 0.5, 0.008, -0.006).ray_grid()
+    fast = rc.intersect_ground(sc.ground, grid.dirs, 101.0, grid=grid)
+    ref = rc.intersect_ground(sc.ground, grid.dirs, 101.0, n_samples=60, n_refine=14)
+    assert np.isfinite(fast).sum() >= 0.99 * np.isfinite(ref).sum()
+    both = np.isfinite(fast) & np.isfinite(ref)
+    assert np.median(np.abs(fast[both] - ref[both])) < 0.01

@@ -244,6 +244,26 @@ def world_normals(prims: Primitives, pidx: np.ndarray, nrm_local: np.ndarray) ->
 # Heightfield ground
 
 
+_RING_CACHE: dict = {}
+
+
+def _ring_index(shape, x0, y0, res):
+    """Grid points sorted by 1 m ring of horizontal distance to the origin (cached per grid)."""
+    key = (shape, x0, y0, res)
+    if key not in _RING_CACHE:
+        xs = x0 + res * np.arange(shape[1])
+        ys = y0 + res * np.arange(shape[0])
+        r = np.hypot(xs[None, :], ys[:, None]).ravel()
+        b = np.floor(r).astype(np.int64)
+        perm = np.argsort(b, kind="stable")
+        nb = int(b.max()) + 1
+        starts = np.searchsorted(b[perm], np.arange(nb))
+        if len(_RING_CACHE) > 4:
+            _RING_CACHE.clear()
+        _RING_CACHE[key] = (perm, starts, nb)
+    return _RING_CACHE[key]
+
+
 class HeightField:
     """Ground heights on a regular grid (row = y, col = x) with bilinear interpolation, and a
     SemanticKITTI class code per cell (nearest cell). Each cell keeps its bilinear coefficients
@@ -262,6 +282,20 @@ class HeightField:
         z00, z01, z10, z11 = zp[:-1, :-1], zp[:-1, 1:], zp[1:, :-1], zp[1:, 1:]
         self._coef = np.stack([z00, z01 - z00, z10 - z00, z11 - z10 - z01 + z00], -1).reshape(-1, 4)
         self._zmin, self._zmax = float(z.min()), float(z.max())
+        # radial profile: min / max height of the grid points per 1 m ring around the sensor, widened by
+        # one ring on each side (a bilinear patch spans < 0.5 m of radius); beyond the grid's inscribed
+        # circle heights are clamped edge values, so the global extremes apply there
+        perm, starts, nb = _ring_index(z.shape, self.x0, self.y0, self.res)
+        zs = z.ravel()[perm]
+        lo = np.minimum.reduceat(zs, starts)
+        hi = np.maximum.reduceat(zs, starts)
+        lo = np.minimum(np.minimum(lo, np.r_[lo[1:], lo[-1]]), np.r_[lo[0], lo[:-1]])
+        hi = np.maximum(np.maximum(hi, np.r_[hi[1:], hi[-1]]), np.r_[hi[0], hi[:-1]])
+        half = min(-self.x0, -self.y0, self.x0 + self.res * (z.shape[1] - 1), self.y0 + self.res * (z.shape[0] - 1))
+        edge = np.arange(nb) + 2 > half
+        lo[edge] = self._zmin
+        hi[edge] = self._zmax
+        self._ring_zmin, self._ring_zmax = lo.astype(np.float64) - 0.01, hi.astype(np.float64) + 0.01
 
     def _lookup(self, x, y):
         ny, nx = self.z.shape
@@ -295,17 +329,52 @@ class HeightField:
         return n / np.linalg.norm(n, axis=1, keepdims=True)
 
 
+def _ring_band(hf: HeightField, dirs: np.ndarray, grid: RayGrid):
+    """Per ray, the stretch [t_lo, t_hi] where it can first meet the ground: from the first ring whose
+    highest point the ray may reach, to the end of the first ring whose lowest point it is surely below.
+    Worked out per row of the grid with the row's elevation widened by the mount tilt."""
+    zlo, zhi = hf._ring_zmin, hf._ring_zmax
+    nb = len(zlo)
+    e0 = np.arange(nb, dtype=np.float64)
+    e1 = e0 + 1.0
+    tan_lo = np.tan(grid.elev_rows - grid.tilt_rad)[:, None]
+    tan_hi = np.tan(grid.elev_rows + grid.tilt_rad)[:, None]
+    zmin_ray = np.minimum(e0 * tan_lo, e1 * tan_lo)          # (rows, rings)
+    zmax_ray = np.maximum(e0 * tan_hi, e1 * tan_hi)
+    possible = zmin_ray <= zhi[None, :]
+    below = zmax_ray < zlo[None, :]
+    below[:, -1] = True
+    # rising rays: above every farther ring from here on
+    zhi_after = np.maximum.accumulate(zhi[::-1])[::-1]
+    above = zmin_ray > zhi_after[None, :]
+    k_lo = np.where(possible.any(1), np.argmax(possible, 1), nb)
+    k_hi = np.argmax(below, 1)
+    s_lo = np.where(k_lo < nb, k_lo, np.inf)
+    s_hi = np.where(k_hi < nb - 1, k_hi + 1.0, np.inf)
+    k_ab = np.where(above.any(1), np.argmax(above, 1), nb)
+    s_hi = np.minimum(s_hi, np.where(k_ab < nb, k_ab + 0.0, np.inf))
+    s_lo = np.repeat(s_lo, grid.cols)
+    s_hi = np.repeat(s_hi, grid.cols)
+    ch = np.maximum(np.hypot(dirs[:, 0], dirs[:, 1]), 1e-9)
+    return s_lo / ch, s_hi / ch
+
+
 def intersect_ground(hf: HeightField, dirs: np.ndarray, t_max, n_samples: int = 9,
-                     n_refine: int = 7) -> np.ndarray:
+                     n_refine: int = 7, grid: RayGrid | None = None) -> np.ndarray:
     """Distance along each unit ray to the first crossing of the heightfield (inf: none).
-    t_max: scalar or per-ray bound (e.g. the nearest object hit: the ground behind it is not searched)."""
+    t_max: scalar or per-ray bound (e.g. the nearest object hit: the ground behind it is not searched).
+    grid: the RayGrid the rays come from (rows x cols); narrows each ray's search with the field's
+    radial height profile."""
     t = np.full(len(dirs), np.inf)
     zmin, zmax = hf._zmin - 0.01, hf._zmax + 0.01
     dz = dirs[:, 2]
-    # ray z(t) = dz * t; restrict to the band zmin <= z <= zmax, t <= t_max
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t_lo = np.where(dz < 0, zmax / dz, 0.0)
-        t_hi = np.where(dz < 0, zmin / dz, np.where(dz > 0, zmax / dz, t_max))
+    if grid is not None:
+        t_lo, t_hi = _ring_band(hf, dirs, grid)
+    else:
+        # ray z(t) = dz * t; restrict to the band zmin <= z <= zmax
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t_lo = np.where(dz < 0, zmax / dz, 0.0)
+            t_hi = np.where(dz < 0, zmin / dz, np.where(dz > 0, zmax / dz, np.inf))
     t_lo = np.maximum(t_lo, 0.05)
     t_hi = np.minimum(t_hi, t_max)
     cand = np.nonzero((t_hi > t_lo) & ((dz < 0) | (zmax > 0)))[0]

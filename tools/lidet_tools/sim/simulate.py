@@ -81,7 +81,7 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
     t_best = np.full(n_rays, np.inf)
     np.minimum.at(t_best, ray, t)
     # ground, searched only up to the nearest object
-    t_g = rc.intersect_ground(scene.ground, dirs, np.minimum(t_best, t_max))
+    t_g = rc.intersect_ground(scene.ground, dirs, np.minimum(t_best, t_max), grid=grid)
     t_best = np.minimum(t_best, t_g)
     win = t <= t_best[ray]
     ray_w, pidx_w, nrm_w = ray[win], pidx[win], nrm[win]
