@@ -92,3 +92,17 @@ def test_ground_search_band_keeps_hits():
     assert np.isfinite(fast).sum() >= 0.99 * np.isfinite(ref).sum()
     both = np.isfinite(fast) & np.isfinite(ref)
     assert np.median(np.abs(fast[both] - ref[both])) < 0.01
+
+
+def test_ground_search_band_low_field():
+    """A field entirely below the sensor (zmax < 0) keeps all its hits with the radial band."""
+    n = 301
+    x = -45.0 + 0.3 * np.arange(n)
+    z = -1.7 - 0.05 * np.abs(x)[None, :] * np.ones((n, 1))      # falls away from the sensor
+    hf = rc.HeightField(-45.0, -45.0, 0.3, z, np.zeros((n, n), np.int8))
+    from lidet_tools.sensors import get_sensor
+    grid, _ = SensorModel(get_sensor("hdl64"), 1.7, 0.004, 0.003).ray_grid()
+    fast = rc.intersect_ground(hf, grid.dirs, 121.0, grid=grid)
+    ref = rc.intersect_ground(hf, grid.dirs, 121.0, n_samples=60, n_refine=14)
+    assert np.isfinite(ref).sum() > 50000
+    assert np.isfinite(fast).sum() >= 0.99 * np.isfinite(ref).sum()

@@ -346,7 +346,7 @@ def _ring_band(hf: HeightField, dirs: np.ndarray, grid: RayGrid):
     below[:, -1] = True
     # rising rays: above every farther ring from here on
     zhi_after = np.maximum.accumulate(zhi[::-1])[::-1]
-    above = zmin_ray > zhi_after[None, :]
+    above = (zmin_ray > zhi_after[None, :]) & (tan_lo >= 0)     # only rays that never descend
     k_lo = np.where(possible.any(1), np.argmax(possible, 1), nb)
     k_hi = np.argmax(below, 1)
     s_lo = np.where(k_lo < nb, k_lo, np.inf)
