@@ -138,7 +138,7 @@ CAR_TYPES = ("sedan", "hatchback", "suv")
 def paint(rng):
     """Car paint remission and dropout: dark paints return weakly and drop more."""
     a = float(rng.choice([0.04, 0.07, 0.12, 0.18, 0.25, 0.35, 0.5], p=[.18, .14, .16, .16, .14, .12, .10]))
-    drop = 0.45 if a < 0.06 else (0.25 if a < 0.1 else 0.06)
+    drop = 0.3 if a < 0.06 else (0.15 if a < 0.1 else 0.05)
     return a, drop
 
 
