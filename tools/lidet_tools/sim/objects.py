@@ -125,7 +125,20 @@ def collision_cylinders(shape: Shape, x, y, yaw):
         else:
             e = (np.abs(p.R) * p.half[None, :]).sum(1)
         c = Rz @ p.center
-        out.append((x + c[0], y + c[1], float(np.hypot(e[0], e[1])), p.center[2] - e[2], p.center[2] + e[2]))
+        zlo, zhi = p.center[2] - e[2], p.center[2] + e[2]
+        long_ax = int(np.argmax(e[:2]))
+        a, b = e[long_ax], e[1 - long_ax]
+        if p.kind == BOX and a > 1.0 and a > 2.0 * b:
+            # walls, fences, hedges: a row of circles along the long side instead of one huge circle
+            n = int(np.ceil(a / max(b, 0.25)))
+            step = a / n
+            r = float(np.hypot(b, step))
+            ax = Rz[:, long_ax]
+            for k in range(n):
+                off = -a + step * (2 * k + 1)
+                out.append((x + c[0] + ax[0] * off, y + c[1] + ax[1] * off, r, zlo, zhi))
+        else:
+            out.append((x + c[0], y + c[1], float(np.hypot(e[0], e[1])), zlo, zhi))
     return out
 
 

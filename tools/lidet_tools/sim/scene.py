@@ -56,11 +56,11 @@ class _Placer:
 
     def free(self, cyl, margin):
         a = self.c
-        for x, y, r, lo, hi in cyl:
-            hit = (np.hypot(a[:, 0] - x, a[:, 1] - y) < a[:, 2] + r + margin) & (a[:, 3] < hi) & (a[:, 4] > lo)
-            if hit.any():
-                return False
-        return True
+        c = np.asarray(cyl, dtype=np.float64)
+        d = np.hypot(a[None, :, 0] - c[:, None, 0], a[None, :, 1] - c[:, None, 1])
+        hit = ((d < a[None, :, 2] + c[:, None, 2] + margin) & (a[None, :, 3] < c[:, None, 4])
+               & (a[None, :, 4] > c[:, None, 3]))
+        return not hit.any()
 
     def take(self, cyl):
         self.c = np.vstack([self.c, np.asarray(cyl)])
@@ -293,11 +293,17 @@ class SceneBuilder:
                             u += r.uniform(2.5, 2.9)
                     row_v += 5.2 + 6.5
         # cyclists
-        for _ in range(int(r.poisson(1.0))):
+        for _ in range(int(r.poisson(1.6))):
             s = int(r.choice([1, -1]))
             forward = s < 0
-            v = s * (self.Wr - r.uniform(0.5, 1.2))
-            self.put(ob.cyclist(r), r.uniform(-45, 45), v, (0.0 if forward else np.pi) + r.normal(0, 0.1))
+            if r.random() < 0.75:       # near the road edge, with the traffic
+                v = s * (self.Wr - r.uniform(0.5, 1.2))
+                yaw = (0.0 if forward else np.pi) + r.normal(0, 0.1)
+            else:                       # on the sidewalk, either way
+                d = self.side[s]
+                v = s * r.uniform(d["v_curb"] + 0.5, max(d["v_curb"] + 0.6, d["v_walk_out"] - 0.5))
+                yaw = (0.0 if r.random() < 0.5 else np.pi) + r.normal(0, 0.15)
+            self.put(ob.cyclist(r), r.uniform(-45, 45), v, yaw)
 
     def people(self):
         r = self.rng
@@ -392,11 +398,11 @@ class SceneBuilder:
                         sh = ob.stuff(50 if solid and fh > 1.5 else 51)
                         sh.add(ob.BOX, [0, 0, fh / 2], [seg / 2, 0.05 if not solid else 0.12, fh / 2],
                                albedo=r.uniform(0.2, 0.45), transp=0.0 if solid else 0.45)
-                        self.put(sh, u + seg / 2, s * vf, 0.0, check=False)
+                        self.put(sh, u + seg / 2, s * vf, 0.0, margin=0.05)
                     u += seg + r.uniform(0.5, 4.0)
             # hedges in front of the buildings
             if r.random() < (0.8 if sub else 0.5):
-                vh = d["v_build"] - r.uniform(0.8, 2.0)
+                vh = max(d["v_build"] - r.uniform(0.8, 2.0), d["v_walk_out"] + 0.7)
                 u = -78.0
                 while u < 78:
                     seg = r.uniform(4, 15)
@@ -405,7 +411,7 @@ class SceneBuilder:
                         sh = ob.stuff(70)
                         sh.add(ob.BOX, [0, 0, hh / 2], [seg / 2, r.uniform(0.3, 0.7), hh / 2], albedo=0.33,
                                transp=0.25)
-                        self.put(sh, u + seg / 2, s * vh, 0.0, check=False)
+                        self.put(sh, u + seg / 2, s * vh, 0.0, margin=0.05)
                     u += seg + r.uniform(1.0, 8.0)
             if r.random() < 0.08:
                 continue  # open field on this side
