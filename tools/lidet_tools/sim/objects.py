@@ -150,8 +150,8 @@ CAR_TYPES = ("sedan", "hatchback", "suv")
 
 def paint(rng):
     """Car paint remission and dropout: dark paints return weakly and drop more."""
-    a = float(rng.choice([0.04, 0.07, 0.12, 0.18, 0.25, 0.35, 0.5], p=[.18, .14, .16, .16, .14, .12, .10]))
-    drop = 0.3 if a < 0.06 else (0.15 if a < 0.1 else 0.05)
+    a = float(rng.choice([0.055, 0.085, 0.12, 0.17, 0.24, 0.33, 0.45], p=[.18, .14, .16, .16, .14, .12, .10]))
+    drop = 0.3 if a < 0.07 else (0.15 if a < 0.1 else 0.05)
     return a, drop
 
 
@@ -183,10 +183,10 @@ def car(rng, kind=None) -> Shape:
     roof_t = 0.06
     wc = W / 2 - 0.08
     s.add(BOX, [(r0 + r1) / 2, 0, (belt + H - roof_t) / 2], [(r1 - r0) / 2, wc, (H - roof_t - belt) / 2],
-          albedo=0.05, drop=0.3, transp=0.85)
+          albedo=0.05, drop=0.3, transp=0.7)
     s.add(BOX, [(r0 + r1) / 2, 0, H - roof_t / 2], [(r1 - r0) / 2 + 0.05, wc, roof_t / 2], albedo=alb, drop=drop)
     for pa, pb in (((x1, belt), (r1, H - roof_t)), ((x0, belt), (r0, H - roof_t))):
-        s.limb([pa[0], 0, pa[1]], [pb[0], 0, pb[1]], [wc, 0.02], albedo=0.05, kind=BOX, drop=0.3, transp=0.8)
+        s.limb([pa[0], 0, pa[1]], [pb[0], 0, pb[1]], [wc, 0.02], albedo=0.05, kind=BOX, drop=0.3, transp=0.7)
     # seats and dashboard: below the window line mostly, narrower than the cabin
     s.add(BOX, [(x0 + x1) / 2, 0, belt + 0.05], [(x1 - x0) / 2 - 0.15, wc - 0.25, 0.25], albedo=0.08, drop=0.4)
     # wheels
@@ -265,8 +265,11 @@ def pedestrian(rng, height=None, child=False, walking=None) -> Shape:
     w = h / 1.75 * rng.uniform(0.9, 1.12)      # girth scale
     walking = bool(rng.random() < 0.65) if walking is None else walking
     phase = rng.uniform(0, 2 * np.pi)
-    amp = rng.uniform(0.3, 0.5) if walking else rng.uniform(0.0, 0.06)
-    phi = amp * np.sin(phase)
+    # gait: each leg swings up to 0.4-0.55 rad (a 0.6-0.9 m step); sqrt-shaped, as legs spend most of
+    # a stride apart rather than passing each other
+    amp = rng.uniform(0.4, 0.55) if walking else rng.uniform(0.0, 0.06)
+    sp = np.sin(phase)
+    phi = amp * np.sign(sp) * np.sqrt(abs(sp))
     # KITTI annotators draw pedestrian boxes looser than the body (mean l 0.84, w 0.66 m)
     s = Shape("Pedestrian", S["person"], pad=(0.3, 0.1, 0.0))
     cloth_top = float(rng.uniform(0.06, 0.45))
@@ -366,14 +369,15 @@ def stuff(sem) -> Shape:
 
 def tree(rng) -> Shape:
     s = stuff(S["vegetation"])
-    th = rng.uniform(1.2, 3.0)
+    th = rng.uniform(1.8, 3.5)                     # canopy bottom above the ground
     tr = rng.uniform(0.1, 0.25)
-    s.add(CYLINDER, [0, 0, th / 2 + 0.3], [tr, tr, th / 2 + 0.3], albedo=0.31, sem=S["trunk"])
     cr = rng.uniform(1.5, 3.5)
     ch = cr * rng.uniform(0.8, 1.4)
-    s.add(ELLIPSOID, [0, 0, th + ch * 0.85], [cr, cr, ch], albedo=0.33, transp=0.45, drop=0.05)
+    zc = th + ch
+    s.add(CYLINDER, [0, 0, zc / 2], [tr, tr, zc / 2], albedo=0.31, sem=S["trunk"])
+    s.add(ELLIPSOID, [0, 0, zc], [cr, cr, ch], albedo=0.33, transp=0.45, drop=0.05)
     if rng.random() < 0.5:
-        s.add(ELLIPSOID, [rng.uniform(-0.6, 0.6), rng.uniform(-0.6, 0.6), th + ch * 1.4],
+        s.add(ELLIPSOID, [rng.uniform(-0.6, 0.6), rng.uniform(-0.6, 0.6), zc + ch * 0.6],
               [cr * 0.7, cr * 0.7, ch * 0.6], albedo=0.33, transp=0.45)
     return s
 
@@ -397,9 +401,9 @@ def pole(rng, kind="lamp") -> Shape:
         h = rng.uniform(2.2, 3.0)
         s.add(CYLINDER, [0, 0, h / 2], [0.04, 0.04, h / 2], albedo=0.2)
         if rng.random() < 0.5:
-            s.add(BOX, [0, 0, h + 0.3], [0.02, 0.32, 0.32], albedo=0.8, sem=S["traffic-sign"])
+            s.add(BOX, [0, 0, h + 0.3], [0.02, 0.32, 0.32], albedo=0.45, sem=S["traffic-sign"])
         else:
-            s.add(CYLINDER, [0, 0, h + 0.3], [0.35, 0.35, 0.015], rot_y(np.pi / 2), albedo=0.8,
+            s.add(CYLINDER, [0, 0, h + 0.3], [0.35, 0.35, 0.015], rot_y(np.pi / 2), albedo=0.45,
                   sem=S["traffic-sign"])
     else:  # traffic light
         h = rng.uniform(3.0, 4.0)

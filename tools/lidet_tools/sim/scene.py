@@ -24,7 +24,7 @@ from .raycast import HeightField, PrimitiveList
 # surface codes of the ground grid -> SemanticKITTI class and remission
 ROAD, PAINT, PARKING, SIDEWALK, OTHER_GROUND, TERRAIN = range(6)
 SURF_SEM = np.array([40, 40, 44, 48, 49, 72], np.int32)
-SURF_ALB = np.array([0.21, 0.5, 0.28, 0.32, 0.26, 0.34])
+SURF_ALB = np.array([0.255, 0.5, 0.38, 0.385, 0.3, 0.40])   # calibrated on SemanticKITTI class means
 SURF_ROUGH_DROP = np.array([0.0, 0.0, 0.0, 0.0, 0.0, 0.02])
 
 SCENE_TYPES = ("street", "intersection", "parking", "suburban")
@@ -257,7 +257,7 @@ class SceneBuilder:
             forward = vc < 0
             u = r.uniform(-75, -60)
             while u < 75:
-                u += r.uniform(6, 40) / dens
+                u += r.uniform(10, 50) / dens
                 sh = self.vehicle(True)
                 yaw = (0.0 if forward else np.pi) + r.normal(0, 0.03)
                 self.put(sh, u, vc + r.normal(0, 0.25), yaw)
@@ -266,7 +266,7 @@ class SceneBuilder:
             d = self.side[s]
             if d["park"] > 0:
                 u = r.uniform(-75, -65)
-                fill = r.uniform(0.4, 0.95)
+                fill = r.uniform(0.3, 0.9)
                 while u < 75:
                     sh = self.vehicle(False)
                     lo, hi = sh.extent()
@@ -423,7 +423,7 @@ class SceneBuilder:
                     hgt = r.uniform(5, 9) if sub else r.uniform(6, 22)
                     sh = ob.stuff(50)
                     vv = vb + r.uniform(0, 2) + depth / 2
-                    sh.add(ob.BOX, [0, 0, hgt / 2], [wdt / 2, depth / 2, hgt / 2], albedo=r.uniform(0.25, 0.55))
+                    sh.add(ob.BOX, [0, 0, hgt / 2], [wdt / 2, depth / 2, hgt / 2], albedo=r.uniform(0.3, 0.65))
                     if r.random() < 0.4:
                         h2 = hgt * r.uniform(0.3, 0.7)
                         sh.add(ob.BOX, [0, -depth / 2 - 0.8, h2 / 2], [wdt / 2 * 0.8, 0.8, h2 / 2],
@@ -445,7 +445,7 @@ class SceneBuilder:
                     depth = r.uniform(8, 16)
                     hgt = r.uniform(6, 20)
                     sh = ob.stuff(50)
-                    sh.add(ob.BOX, [0, 0, hgt / 2], [wdt / 2, depth / 2, hgt / 2], albedo=r.uniform(0.25, 0.55))
+                    sh.add(ob.BOX, [0, 0, hgt / 2], [wdt / 2, depth / 2, hgt / 2], albedo=r.uniform(0.3, 0.65))
                     uu = self.u_x + e * (self.Wx / 2 + 3.0 + r.uniform(0, 3) + depth / 2)
                     self.put(sh, uu, s * (v + wdt / 2), np.pi / 2, check=False)
                     v += wdt + r.uniform(0, 6)

@@ -66,7 +66,7 @@ class SensorModel:
         n = len(t)
         noise = np.clip(rng.standard_normal(n), -2.5, 2.5) * self.range_noise_m
         tn = t + noise
-        rem = albedo * (0.35 + 0.65 * np.clip(cos_inc, 0.0, 1.0))
+        rem = albedo * (0.7 + 0.3 * np.clip(cos_inc, 0.0, 1.0))
         rem = np.clip(rem + rng.normal(0.0, 0.025, n), 0.0, 0.99)
         u = rng.random(n)
         frac = t / self.sensor.max_range_m
