@@ -158,13 +158,13 @@ def paint(rng):
 def car(rng, kind=None) -> Shape:
     kind = kind or str(rng.choice(CAR_TYPES, p=[0.4, 0.38, 0.22]))
     if kind == "sedan":
-        L, W, H = rng.uniform(4.0, 4.9), rng.uniform(1.62, 1.82), rng.uniform(1.40, 1.52)
+        L, W, H = rng.uniform(3.9, 4.8), rng.uniform(1.62, 1.82), rng.uniform(1.40, 1.52)
         cab0, cab1, roof0, roof1 = -0.34, 0.17, -0.22, 0.04   # fractions of L (rear .. front)
     elif kind == "hatchback":
-        L, W, H = rng.uniform(3.5, 4.2), rng.uniform(1.55, 1.75), rng.uniform(1.42, 1.56)
+        L, W, H = rng.uniform(3.5, 4.1), rng.uniform(1.55, 1.75), rng.uniform(1.42, 1.56)
         cab0, cab1, roof0, roof1 = -0.44, 0.16, -0.40, 0.02
     else:
-        L, W, H = rng.uniform(4.2, 5.2), rng.uniform(1.74, 1.92), rng.uniform(1.62, 1.80)
+        L, W, H = rng.uniform(4.1, 5.2), rng.uniform(1.74, 1.92), rng.uniform(1.62, 1.80)
         cab0, cab1, roof0, roof1 = -0.45, 0.17, -0.43, 0.06
     s = Shape("Car", S["car"])
     alb, drop = paint(rng)

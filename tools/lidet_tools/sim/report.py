@@ -269,13 +269,13 @@ def make_report(real_dir, n_scans=24, seed=1000, img_dir="docs/img", md_path="do
     for k, (name, ss, rs) in enumerate((("car", sim.car_shapes, real.car_shapes),
                                         ("pedestrian", sim.ped_shapes, real.ped_shapes))):
         rp = np.concatenate([q for _, q in rs]) if rs else np.zeros((0, 3))
-        # for each real object, the simulated object nearest in distance (shown in the overlay); the
-        # extents compare the median per-object extent of the 5 nearest simulated objects per real one
+        # for each real object, the 5 simulated objects nearest in distance: the overlay shows the one
+        # with the most points, the extents compare their median per-object extent
         pick, ext_s = [], []
         for d, _ in rs:
             if ss:
-                order = np.argsort([abs(d2 - d) for d2, _ in ss])
-                pick.append(ss[int(order[0])][1])
+                order = np.argsort([abs(d2 - d) for d2, _ in ss])[:5]
+                pick.append(ss[int(max(order, key=lambda j: len(ss[j][1])))][1])   # best seen of the 5
                 ext_s += [_extent(ss[int(j)][1]) for j in order[:5]]
         ext_r = [_extent(q) for _, q in rs]
         sp = np.concatenate(pick) if pick else np.zeros((0, 3))
