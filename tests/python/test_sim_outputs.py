@@ -132,6 +132,9 @@ def test_same_seed_same_bytes_other_seed_other_scene(tmp_path):
                          "--no-progress"])
     hd = _hashes(tmp_path / "d")
     assert hd["velodyne/000001.bin"] == ha["velodyne/000001.bin"]
+    # worker processes write the same bytes
+    sim_main(args + ["--seed", "7", "--jobs", "2", "--out", str(tmp_path / "e")])
+    assert _hashes(tmp_path / "e") == ha
 
 
 def test_mount_height_and_sensor_model():
