@@ -44,6 +44,11 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
                   pitch_deg: float | None = None, roll_deg: float | None = None,
                   scene_kind: str | None = None, range_noise_m: float = 0.02,
                   dropout: float = 0.015, keep_scene: bool = False) -> ScanResult:
+    """Simulate scan `index` of run `seed` for a sensor profile (name or Sensor).
+
+    mount_height_m defaults to the profile's; pitch/roll default to a random mounting tilt; scene_kind
+    forces one of scene.SCENE_TYPES. keep_scene keeps the Scene (ground, primitives, objects) in the
+    result for tests and plots."""
     sensor = get_sensor(sensor) if isinstance(sensor, str) else sensor
     H = float(sensor.mount_height_m if mount_height_m is None else mount_height_m)
     ss = np.random.SeedSequence([int(seed), int(index)])
