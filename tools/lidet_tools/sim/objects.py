@@ -54,25 +54,32 @@ class Shape:
         r = np.broadcast_to(np.asarray(radius, float), (2,))
         self.add(kind, c, [r[0], r[1], half_len], R, albedo, drop, transp, sem)
 
+    def part_extents(self):
+        """Per part: centre (k, 3), half extent of its axis-aligned box in the object frame (k, 3),
+        kind (k,), in_box (k,). Computed once per shape (shapes are not edited after placement)."""
+        cache = self.__dict__.setdefault("_ext", {})
+        key = ("parts", len(self.parts))
+        if key not in cache:
+            R = np.stack([p.R for p in self.parts])
+            half = np.stack([p.half for p in self.parts])
+            kind = np.array([p.kind for p in self.parts])
+            RH = R * half[:, None, :]
+            e = np.where((kind == ELLIPSOID)[:, None], np.sqrt((RH ** 2).sum(2)), np.abs(RH).sum(2))
+            cache[key] = (np.stack([p.center for p in self.parts]), e, kind,
+                          np.array([p.in_box for p in self.parts]))
+        return cache[key]
+
     def extent(self, all_parts=False):
         """(lo, hi) corners of the labelled box (parts with in_box, plus `pad`), object frame;
         all_parts: the tight box around every part, no pad."""
-        key = (bool(all_parts), len(self.parts))
         cache = self.__dict__.setdefault("_ext", {})
+        key = (bool(all_parts), len(self.parts))
         if key in cache:
             return cache[key]
-        lo = np.full(3, np.inf)
-        hi = np.full(3, -np.inf)
-        for p in self.parts:
-            if not (p.in_box or all_parts):
-                continue
-            A = np.abs(p.R) * p.half[None, :]
-            if p.kind == ELLIPSOID:
-                e = np.sqrt(((p.R * p.half[None, :]) ** 2).sum(1))
-            else:
-                e = A.sum(1)
-            lo = np.minimum(lo, p.center - e)
-            hi = np.maximum(hi, p.center + e)
+        c, e, _, in_box = self.part_extents()
+        m = np.ones(len(c), bool) if all_parts else in_box
+        lo = (c[m] - e[m]).min(0)
+        hi = (c[m] + e[m]).max(0)
         if not all_parts:
             pad = np.array([self.pad[0], self.pad[1], 0.0]) / 2
             lo, hi = lo - pad, hi + pad
@@ -119,16 +126,13 @@ def collision_cylinders(shape: Shape, x, y, yaw):
         r = float(np.hypot(hi[0] - lo[0], hi[1] - lo[1]) / 2)
         return [(x + c[0], y + c[1], r, lo[2] - 0.3, hi[2] + 0.3)]
     out = []
-    for p in shape.parts:
-        if p.kind == ELLIPSOID:
-            e = np.sqrt(((p.R * p.half[None, :]) ** 2).sum(1))
-        else:
-            e = (np.abs(p.R) * p.half[None, :]).sum(1)
-        c = Rz @ p.center
-        zlo, zhi = p.center[2] - e[2], p.center[2] + e[2]
+    cs, es, kinds, _ = shape.part_extents()
+    cw = cs @ Rz.T
+    for c, e, ctr, kind in zip(cw, es, cs, kinds):
+        zlo, zhi = ctr[2] - e[2], ctr[2] + e[2]
         long_ax = int(np.argmax(e[:2]))
         a, b = e[long_ax], e[1 - long_ax]
-        if p.kind == BOX and a > 1.0 and a > 2.0 * b:
+        if kind == BOX and a > 1.0 and a > 2.0 * b:
             # walls, fences, hedges: a row of circles along the long side instead of one huge circle
             n = int(np.ceil(a / max(b, 0.25)))
             step = a / n

@@ -125,7 +125,7 @@ class SceneBuilder:
         return c * u - s * vv, s * u + c * vv
 
     def to_road(self, x, y):
-        c, s = np.cos(self.psi), np.sin(self.psi)
+        c, s = float(np.cos(self.psi)), float(np.sin(self.psi))   # python floats keep float32 grids float32
         return c * x + s * y, -s * x + c * y + self.v_s
 
     # -- ground ------------------------------------------------------------------------------
@@ -143,7 +143,7 @@ class SceneBuilder:
         pos = (V < 0).astype(np.int8)
 
         def per_side(key):
-            return np.array([self.side[1][key], self.side[-1][key]], np.float32)[pos]
+            return np.take(np.array([self.side[1][key], self.side[-1][key]], np.float32), pos)
 
         v_curb = per_side("v_curb")
         v_walk = per_side("v_walk_out")
@@ -171,13 +171,15 @@ class SceneBuilder:
             raised &= ~xr
             # crosswalk stripes on the main road, next to the cross street
             for e in (-1, 1):
-                cw = np.abs(U - (self.u_x + e * (self.Wx / 2 + 2.0))) < 1.5
-                stripe = cw & road & (np.mod(V, 1.0) < 0.5)
-                code[stripe] = PAINT
+                cw = np.nonzero((np.abs(U - float(self.u_x + e * (self.Wx / 2 + 2.0))) < 1.5) & road)
+                vv = V[cw]
+                white = vv - np.floor(vv) < 0.5          # 0.5 m stripes across the road
+                code[cw[0][white], cw[1][white]] = PAINT
         # lane markings: dashed lines between lanes, solid edge lines
+        u9 = U * np.float32(1.0 / 9.0)
+        dash = (u9 - np.floor(u9)) < np.float32(1.0 / 3.0)
         for i in range(1, self.n_lanes):
-            vl = -self.Wr + i * self.lane_w
-            dash = np.mod(U, 9.0) < 3.0
+            vl = float(-self.Wr + i * self.lane_w)
             code[(np.abs(V - vl) < 0.07) & dash & road] = PAINT
         code[(np.abs(A - (self.Wr - 0.25)) < 0.06) & road] = PAINT
         # occasional gravel/driveway strips in the verge
@@ -187,30 +189,35 @@ class SceneBuilder:
             code[m] = OTHER_GROUND
         # heights: grade changes ahead/behind, camber, curb, verge slopes, undulation, bumps
         for e in (1, -1):
-            u1 = r.uniform(10, 40)
-            g = np.tan(np.radians(r.uniform(-6, 6)))
-            s_ = e * U - u1
-            z += g * np.where(s_ > 0, s_ - 4.0 * (1 - np.exp(-np.maximum(s_, 0) / 4.0)), 0.0)
-        z -= 0.02 * np.clip(A / max(self.Wr, 1e-3), 0, 1)                    # camber
+            u1 = float(r.uniform(10, 40))
+            g = float(np.tan(np.radians(r.uniform(-6, 6))))
+            s_ = np.maximum(e * U - u1, 0.0)
+            z += g * (s_ - 4.0 * (1 - np.exp(-s_ / 4.0)))
+        z -= 0.02 * np.clip(A / float(max(self.Wr, 1e-3)), 0, 1)             # camber
         z += np.where(raised, curb_h, 0.0)
         verge = raised & ~walk
         z += np.where(verge, slope * np.clip(A - v_walk, 0.0, slope_len), 0.0)
         for _ in range(3):
-            kx, ky = r.normal(0, 1, 2)
-            lam = r.uniform(20, 60)
-            amp = r.uniform(0.02, 0.08)
-            z += amp * np.sin(2 * np.pi * (kx * X + ky * Y) / (lam * np.hypot(kx, ky) + 1e-9) + r.uniform(0, 6.3))
+            kx, ky = (float(k) for k in r.normal(0, 1, 2))
+            lam = float(r.uniform(20, 60))
+            amp = float(r.uniform(0.02, 0.08))
+            f = 2 * np.pi / (lam * np.hypot(kx, ky) + 1e-9)
+            ph = float(r.uniform(0, 6.3))
+            # sin(a x + b y + ph) = sin(a x + ph) cos(b y) + cos(a x + ph) sin(b y): 1-D trig only
+            sx, cx_ = np.sin(kx * f * ax + ph), np.cos(kx * f * ax + ph)
+            sy, cy_ = np.sin(ky * f * ax), np.cos(ky * f * ax)
+            z += amp * (cy_[:, None] * sx[None, :] + sy[:, None] * cx_[None, :])
         terr = code == TERRAIN
         bumps = np.zeros_like(z)
         for _ in range(int(r.integers(4, 12))):
-            cx, cy = r.uniform(-self.half, self.half, 2)
-            sig = r.uniform(1.0, 5.0)
-            amp = r.uniform(-0.4, 0.4)
+            cx, cy = (float(c) for c in r.uniform(-self.half, self.half, 2))
+            sig = float(r.uniform(1.0, 5.0))
+            amp = float(r.uniform(-0.4, 0.4))
             i0, i1 = np.clip(np.round((np.array([cx - 3 * sig, cx + 3 * sig]) + self.half) / self.res), 0, n).astype(int)
             j0, j1 = np.clip(np.round((np.array([cy - 3 * sig, cy + 3 * sig]) + self.half) / self.res), 0, n).astype(int)
             bumps[j0:j1, i0:i1] += amp * np.exp(-((X[j0:j1, i0:i1] - cx) ** 2 + (Y[j0:j1, i0:i1] - cy) ** 2)
                                                 / (2 * sig * sig))
-        rough = r.standard_normal(X.shape, dtype=np.float32) * r.uniform(0.015, 0.04)
+        rough = r.standard_normal(X.shape, dtype=np.float32) * float(r.uniform(0.015, 0.04))
         z += np.where(terr, bumps + rough, 0.0)
         # the sensor sits mount_height above the local ground
         i0 = n // 2
