@@ -82,19 +82,25 @@ lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cf
     {
         return LIDET_ERR_BUFFER;
     }
-    if (cfg->n_sectors < 1u || cfg->ransac_iters < 1u || cfg->ransac_iters > 1000u || cfg->eval_samples < 3u || cfg->sample_step < 1u || cfg->sample_step > 16u ||
+    if (cfg->n_sectors < 1u || cfg->ransac_iters < 1u || cfg->ransac_iters > 1000u ||
+        cfg->eval_samples < 3u || cfg->sample_step < 1u || cfg->sample_step > 16u ||
         cfg->sample_col_step < 1u || cfg->sample_col_step > 16u ||
         cfg->min_samples < 3u || cfg->min_inliers < 3u || cfg->refine_iters > 10u || cfg->fx_on_z > 1u ||
-        cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors ||
-        !in_range(cfg->fy_max, 0.0f, 10.0f) || !in_range(cfg->fx_max_m, 0.0f, 100.0f) || cfg->fx_max_m <= 0.0f ||
+        cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors)
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    if (!in_range(cfg->fy_max, 0.0f, 10.0f) || !in_range(cfg->fx_max_m, 0.0f, 100.0f) ||
+        cfg->fx_max_m <= 0.0f ||
         !in_range(cfg->gate_above_m, -5.0f, 10.0f) || !in_range(cfg->gate_below_m, 0.0f, 20.0f) ||
         !in_range(cfg->mount_height_m, 0.0f, 10.0f) || !in_range(cfg->inlier_m, 0.0f, 5.0f) ||
-        cfg->inlier_m <= 0.0f || !in_range(cfg->max_tilt_rad, 0.0f, LIDET_HALF_PI_F) || cfg->max_tilt_rad <= 0.0f ||
+        cfg->inlier_m <= 0.0f || !in_range(cfg->max_tilt_rad, 0.0f, LIDET_HALF_PI_F) ||
+        cfg->max_tilt_rad <= 0.0f ||
         cfg->max_tilt_rad >= LIDET_HALF_PI_F || !in_range(cfg->max_height_dev_m, 0.0f, 20.0f) ||
         cfg->max_height_dev_m <= 0.0f || !in_range(cfg->ground_m, 0.0f, 5.0f) || cfg->ground_m <= 0.0f ||
-        !in_range(cfg->ground_m_per_m, 0.0f, 0.1f) || !in_range(cfg->below_factor, 0.0f, 20.0f) || !in_range(cfg->confidence, 0.0f, 0.999999f) ||
-        !in_range(cfg->ring_split_m, 0.0f, 500.0f) || !in_range(cfg->veto_slope, 0.0f, 100.0f) ||
-        !in_range(cfg->veto_min_dz_m, 0.0f, 5.0f))
+        !in_range(cfg->ground_m_per_m, 0.0f, 0.1f) || !in_range(cfg->below_factor, 0.0f, 20.0f) ||
+        !in_range(cfg->confidence, 0.0f, 0.999999f) || !in_range(cfg->ring_split_m, 0.0f, 500.0f) ||
+        !in_range(cfg->veto_slope, 0.0f, 100.0f) || !in_range(cfg->veto_min_dz_m, 0.0f, 5.0f))
     {
         return LIDET_ERR_CONFIG;
     }
@@ -173,13 +179,14 @@ static void filter_rows(lidet_ground_t *g, const lidet_range_image_t *img)
 }
 
 /* Pass 2 (mirrors ref/ground.py: gather_samples): the samples' coordinates grouped by cell, so each
- * cell's RANSAC reads one contiguous block. Only columns on the column grid (c % sample_col_step == 0)
- * of the filtered rows are taken (hdl64 defaults: every 2nd row, every 4th column). Near samples (R < ring_split_m) fill the
- * buffer upwards from its start, far ones downwards from its end, so one pass serves both cells of a
- * sector (far cells hold their samples in reverse raster order). While the free space covers every
- * candidate of a sector, the copy is branch-free: every candidate is written to the next free slot
- * of its end, and the mask bit decides whether that end advances (samples come in no predictable pattern). Past LIDET_GROUND_MAX_SAMPLES,
- * samples are dropped and counted. */
+ * cell's RANSAC reads one contiguous block. Only columns on the column grid (c % sample_col_step
+ * == 0) of the filtered rows are taken (hdl64 defaults: every 4th row, every 4th column). Near
+ * samples (R < ring_split_m) fill the buffer upwards from its start, far ones downwards from its
+ * end, so one pass serves both cells of a sector (far cells hold their samples in reverse raster
+ * order). While the free space covers every candidate of a sector, the copy is branch-free: every
+ * candidate is written to the next free slot of its end, and the mask bit decides whether that end
+ * advances (samples come in no predictable pattern). Past LIDET_GROUND_MAX_SAMPLES, samples are
+ * dropped (in sector and raster order) and counted. */
 static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
@@ -189,7 +196,8 @@ static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
     uint32_t s, r, c, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
     for (s = 0; s < ns; ++s)
     {
-        const uint32_t c0 = lidet__ground_sector_col(s, ns, cols), c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+        const uint32_t c0 = lidet__ground_sector_col(s, ns, cols);
+        const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
         const uint32_t cstart = c0 + (cstep - c0 % cstep) % cstep;
         const int roomy = hi - lo >= rows * (c1 - c0);
         const uint32_t near_start = lo, far_end = hi;
@@ -197,7 +205,8 @@ static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
         {
             const size_t base = (size_t)r * cols;
             const uint8_t *m = g->sample + base;
-            const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base, *R = img->rxy_m + base;
+            const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base;
+            const float *R = img->rxy_m + base;
             if (roomy)
             {
                 for (c = cstart; c < c1; c += cstep)
@@ -271,7 +280,8 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
         uint8_t *out = g->mask + base;
         for (s = 0; s < ns; ++s)
         {
-            const uint32_t c0 = lidet__ground_sector_col(s, ns, cols), c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+            const uint32_t c0 = lidet__ground_sector_col(s, ns, cols);
+        const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
             const lidet_plane_t p = g->planes[s], q = g->planes[ns + s];
             uint32_t cnt = 0, nv = 0;
             if (simple)
@@ -393,8 +403,8 @@ const uint8_t *lidet_ground_sector_source(const lidet_ground_t *g)
     return g == 0 ? 0 : g->source;
 }
 
-lidet_status_t lidet_ground_point_labels(const lidet_ground_t *g, const int32_t *point_pixel, uint32_t n_points,
-                                         uint8_t *out)
+lidet_status_t lidet_ground_point_labels(const lidet_ground_t *g, const int32_t *point_pixel,
+                                         uint32_t n_points, uint8_t *out)
 {
     uint32_t i, npix;
     if (g == 0 || ((point_pixel == 0 || out == 0) && n_points > 0u))

@@ -120,8 +120,9 @@ static int plane_from_cov(float cov[3][3], const float centroid[3], lidet_plane_
 /* Accumulates mean and covariance of the points (optionally only those within `thr` of `ref`)
  * around `shift` (keeps float sums small: coordinates of a sector are tens of metres, heights
  * centimetres). Returns the point count used. */
-static uint32_t accumulate(const float *xs, const float *ys, const float *zs, uint32_t n, const lidet_plane_t *ref,
-                           float thr, const float shift[3], float cov[3][3], float centroid[3])
+static uint32_t accumulate(const float *xs, const float *ys, const float *zs, uint32_t n,
+                           const lidet_plane_t *ref, float thr, const float shift[3], float cov[3][3],
+                           float centroid[3])
 {
     /* LANES independent partial sums per moment, combined at the end: the compiler turns the
      * j loop into vector instructions (a plain float reduction would stay scalar without

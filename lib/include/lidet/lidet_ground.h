@@ -145,7 +145,7 @@ typedef struct
     uint32_t n_samples;          /**< samples handed to RANSAC (passed the filter, on the step grid) */
     uint32_t n_samples_dropped;  /**< samples past LIDET_GROUND_MAX_SAMPLES (not used; status TRUNCATED) */
     uint32_t n_ground;           /**< pixels labelled ground */
-    uint16_t n_sectors_fitted;   /**< near cells (whole sectors when ring_split_m is 0) with their own plane */
+    uint16_t n_sectors_fitted;   /**< near cells (whole sectors when ring_split_m is 0) with own plane */
     uint16_t n_sectors_neighbour;/**< near cells that took a neighbour's plane */
     uint16_t n_sectors_mount;    /**< near cells that took the mount plane */
     uint16_t n_sectors_sparse;   /**< near cells with fewer than min_samples samples */
@@ -240,8 +240,8 @@ const uint8_t *lidet_ground_sector_source(const lidet_ground_t *g);
  *                         out-of-image pixel indices). May not alias point_pixel.
  * @return LIDET_OK; LIDET_ERR_ARG (NULL with n_points > 0); LIDET_ERR_STATE (not initialised).
  */
-lidet_status_t lidet_ground_point_labels(const lidet_ground_t *g, const int32_t *point_pixel, uint32_t n_points,
-                                         uint8_t *out);
+lidet_status_t lidet_ground_point_labels(const lidet_ground_t *g, const int32_t *point_pixel,
+                                         uint32_t n_points, uint8_t *out);
 
 /** @brief Counts of the last run. */
 const lidet_ground_stats_t *lidet_ground_stats(const lidet_ground_t *g);
