@@ -86,19 +86,19 @@ static int apply_set(lidet_ground_cfg_t *c, const char *kv)
     v = strtod(eq + 1, &end);
     if (*end != '\0' || end == eq + 1)
         return 1;
-#define FLOAT_FIELD(name)                                                                                          \
-    if (klen == sizeof #name - 1 && strncmp(kv, #name, klen) == 0)                                                 \
-    {                                                                                                              \
-        c->name = (float)v;                                                                                        \
-        return 0;                                                                                                  \
+#define FLOAT_FIELD(name)                                                                                    \
+    if (klen == sizeof #name - 1 && strncmp(kv, #name, klen) == 0)                                           \
+    {                                                                                                        \
+        c->name = (float)v;                                                                                  \
+        return 0;                                                                                            \
     }
-#define INT_FIELD(name, type, maxv)                                                                                \
-    if (klen == sizeof #name - 1 && strncmp(kv, #name, klen) == 0)                                                 \
-    {                                                                                                              \
-        if (v < 0.0 || v > (double)(maxv) || v != (double)(long long)v)                                            \
-            return 1;                                                                                              \
-        c->name = (type)v;                                                                                         \
-        return 0;                                                                                                  \
+#define INT_FIELD(name, type, maxv)                                                                          \
+    if (klen == sizeof #name - 1 && strncmp(kv, #name, klen) == 0)                                           \
+    {                                                                                                        \
+        if (v < 0.0 || v > (double)(maxv) || v != (double)(long long)v)                                      \
+            return 1;                                                                                        \
+        c->name = (type)v;                                                                                   \
+        return 0;                                                                                            \
     }
     FLOAT_FIELD(fy_max)
     FLOAT_FIELD(fx_max_m)
