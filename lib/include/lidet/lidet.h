@@ -25,6 +25,7 @@
 #include "lidet_types.h"
 #include "lidet_sensor.h"
 #include "lidet_proj.h"
+#include "lidet_cluster.h"
 
 #ifdef __cplusplus
 extern "C" {
