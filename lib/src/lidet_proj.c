@@ -48,13 +48,14 @@ static void init_columns(lidet_proj_t *proj, uint32_t cols)
         const float sn = sinf(t), cs = cosf(t);
         proj->col_edge_key[c] = (float)quadrant + sn / (sn + cs);
     }
-    proj->col_edge_key[0] = 0.0f;    /* D >= 0: ends the downward correction */
+    proj->col_edge_key[0] = -1.0f;   /* below any D (which may be -1 ulp): ends the downward correction */
     proj->col_edge_key[cols] = 5.0f; /* D <= 4 < 5: ends the upward correction (D = 4 stays in the last column) */
-    /* bucket k covers D in [2k/cols, 2(k+1)/cols); a column is at least pi/cols wide in D, so a
-     * bucket holds at most one column edge and run() corrects at most one step */
-    proj->col_lut_scale = 0.5f * (float)cols;
+    /* bucket k covers D in [k/cols, (k+1)/cols); one more entry takes D = 4 exactly. A column is at
+     * least pi/cols wide in D (dD/du is in [pi, 2 pi]), i.e. > 3 buckets, so a bucket's guess is off
+     * by at most one column even when float rounding puts D into a neighbouring bucket. */
+    proj->col_lut_scale = (float)cols;
     c = 0;
-    for (k = 0; k < 2u * cols; ++k)
+    for (k = 0; k <= 4u * cols; ++k)
     {
         const float d_low = (float)k / proj->col_lut_scale;
         while (c + 1 < cols && proj->col_edge_key[c + 1] <= d_low)
@@ -62,6 +63,14 @@ static void init_columns(lidet_proj_t *proj, uint32_t cols)
             ++c;
         }
         proj->col_lut[k] = (uint16_t)c;
+    }
+    proj->col_single_step = 1;
+    for (c = 1; c < cols; ++c) /* verify the spacing claim on the float edges */
+    {
+        if (proj->col_edge_key[c] - proj->col_edge_key[c - 1] <= 2.0f / proj->col_lut_scale)
+        {
+            proj->col_single_step = 0;
+        }
     }
 }
 
@@ -88,7 +97,7 @@ lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg)
         return LIDET_ERR_BUFFER;
     }
     if (!in_range(cfg->min_range_m, 0.0f, 10.0f) || !in_range(cfg->fov_margin_rad, 0.0f, 0.5f) ||
-        !lidet__isfinite(cfg->max_range_m) || cfg->max_range_m < 0.0f ||
+        !in_range(cfg->max_range_m, 0.0f, 1.0e6f) ||
         (cfg->max_range_m > 0.0f && cfg->max_range_m <= cfg->min_range_m))
     {
         return LIDET_ERR_CONFIG;
@@ -172,7 +181,7 @@ lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg)
     /* bucket k covers tan in [lo + k/scale, lo + (k+1)/scale): store the row of its top end, the
      * smallest row any tan in the bucket can have; run() walks down from there (usually 0-1 step) */
     r = 0;
-    for (k = LIDET_PROJ_ROW_LUT; k-- > 0;)
+    for (k = LIDET_PROJ_ROW_LUT + 1u; k-- > 0;) /* entry LIDET_PROJ_ROW_LUT takes tan == tan_hi */
     {
         const float t_top = proj->tan_lo + (float)(k + 1u) / proj->lut_scale;
         while (proj->row_bound_tan[r + 1] > t_top)
@@ -180,6 +189,17 @@ lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg)
             ++r;
         }
         proj->row_lut[k] = (uint8_t)r;
+    }
+    /* With every pair of neighbouring row boundaries more than two buckets apart, the bucket's guess
+     * is off by at most one row (also when rounding moves tan into the next bucket), so run() makes one
+     * branch-free correction step each way. Dense custom tables fall back to correction loops. */
+    proj->row_single_step = 1;
+    for (r = 2; r < rows; ++r)
+    {
+        if (proj->row_bound_tan[r - 1] - proj->row_bound_tan[r] <= 2.0f / proj->lut_scale)
+        {
+            proj->row_single_step = 0;
+        }
     }
     init_columns(proj, s->n_cols);
     proj->cfg = *cfg;
@@ -192,7 +212,9 @@ lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg)
 
 float lidet_proj_azimuth_key(float x, float y)
 {
-    return lidet__azimuth_key(x, y);
+    float t, d, rxy;
+    lidet__proj_keys(x, y, 0.0f, x * x + y * y, &t, &d, &rxy);
+    return d;
 }
 
 lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t n_points, uint32_t stride,
@@ -201,7 +223,6 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
     uint32_t n, i, rows, cols, npix, pix;
     float min2, max2;
     lidet_proj_stats_t st;
-    const float *best_r2 = proj == 0 ? 0 : proj->range_m;
 
     if (proj == 0 || stride < 3 || (points == 0 && n_points > 0))
     {
@@ -221,16 +242,23 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
     /* squared limits; zero range is always "too close", no limit means "finite" */
     min2 = proj->cfg.min_range_m * proj->cfg.min_range_m;
     min2 = min2 > 1.0e-30f ? min2 : 1.0e-30f;
-    max2 = proj->cfg.max_range_m > 0.0f ? proj->cfg.max_range_m * proj->cfg.max_range_m : 3.4e38f;
+    max2 = proj->cfg.max_range_m > 0.0f ? proj->cfg.max_range_m * proj->cfg.max_range_m : 3.0e38f;
 
-    /* pass 1, over points: pixel of each point, closest point per pixel. range_m holds the winner's
-     * squared range until pass 2 (only read where point_idx >= 0, so it needs no clearing).
+    /* pass 1, over points: pixel of each point; the closest point per pixel writes its coordinates.
+     * range_m holds the winner's squared range until pass 2, starting at 3.39e38 (every byte 0x7F),
+     * above any accepted r^2 (max2 <= 3.0e38), so the winner test needs no emptiness check.
      * Invariants live in locals: the stores below could alias the state's float fields otherwise. */
     memset(proj->point_idx, 0xFF, (size_t)npix * sizeof proj->point_idx[0]);
+    memset(proj->range_m, 0x7F, (size_t)npix * sizeof proj->range_m[0]);
+    memset(proj->x_m, 0, (size_t)npix * sizeof proj->x_m[0]);
+    memset(proj->y_m, 0, (size_t)npix * sizeof proj->y_m[0]);
+    memset(proj->z_m, 0, (size_t)npix * sizeof proj->z_m[0]);
+    memset(proj->rxy_m, 0, (size_t)npix * sizeof proj->rxy_m[0]);
     {
         const float tan_lo = proj->tan_lo, tan_hi = proj->tan_hi, row_scale = proj->lut_scale;
         const float col_scale = proj->col_lut_scale;
-        const int32_t last_col_bucket = 2 * (int32_t)cols - 1;
+        const int32_t last_col_bucket = 4 * (int32_t)cols;
+        const int row_single = proj->row_single_step, col_single = proj->col_single_step;
         const float *const row_bound = proj->row_bound_tan;
         const float *const col_edge = proj->col_edge_key;
         const uint8_t *const row_lut = proj->row_lut;
@@ -239,6 +267,10 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
         int32_t *const point_idx = proj->point_idx;
         int32_t *const point_pixel = proj->point_pixel;
         float *const best = proj->range_m;
+        float *const x_m = proj->x_m;
+        float *const y_m = proj->y_m;
+        float *const z_m = proj->z_m;
+        float *const rxy_m = proj->rxy_m;
 
         for (i = 0; i < n; ++i)
         {
@@ -246,7 +278,7 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
             const float x = pt[0], y = pt[1], z = pt[2];
             const float rxy2 = x * x + y * y;
             const float r2 = rxy2 + z * z;
-            float d;
+            float t, d, rxy;
             int32_t row, col, k;
 
             /* one test covers NaN, Inf, overflow and both range limits; classify only when it fails */
@@ -261,6 +293,7 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
                 point_pixel[i] = -1;
                 continue;
             }
+            lidet__proj_keys(x, y, z, rxy2, &t, &d, &rxy);
             if (ring != 0)
             {
                 if (ring[i] >= rows)
@@ -273,64 +306,73 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
             }
             else
             {
-                /* tan(elevation); rxy == 0 gives +-inf, rejected by the range test (never cast) */
-                const float t = z / sqrtf(rxy2);
-                if (!(t >= tan_lo && t <= tan_hi))
+                if (!(t >= tan_lo && t <= tan_hi)) /* also rejects NaN: never cast */
                 {
                     ++st.n_out_of_fov;
                     point_pixel[i] = -1;
                     continue;
                 }
-                k = (int32_t)((t - tan_lo) * row_scale);
-                row = row_lut[k < LIDET_PROJ_ROW_LUT ? k : LIDET_PROJ_ROW_LUT - 1];
-                /* exact nearest beam: correct the bucket's guess against the mid-angle tangents
-                 * (ties go to the upper row); the sentinels stop both loops */
-                while (row_bound[row] <= t)
-                    --row;
-                while (row_bound[row + 1] > t)
-                    ++row;
+                k = (int32_t)((t - tan_lo) * row_scale); /* in [0, LIDET_PROJ_ROW_LUT] */
+                row = row_lut[k];
+                /* exact nearest beam: correct the bucket's guess against the mid-angle tangents (ties
+                 * go to the upper row); the sentinels stop the loops of the dense-table fallback */
+                if (row_single)
+                {
+                    row -= (int32_t)(row_bound[row] <= t);
+                    row += (int32_t)(row_bound[row + 1] > t);
+                }
+                else
+                {
+                    while (row_bound[row] <= t)
+                        --row;
+                    while (row_bound[row + 1] > t)
+                        ++row;
+                }
             }
-            d = lidet__azimuth_key(x, y); /* in [0, 4]: the cast below is safe */
-            k = (int32_t)(d * col_scale);
-            col = col_lut[k < last_col_bucket ? k : last_col_bucket];
-            while (col_edge[col] > d)
-                --col;
-            while (col_edge[col + 1] <= d)
-                ++col;
+            k = (int32_t)(d * col_scale); /* d in [0, 4] up to rounding: k in [0, 4 cols] */
+            k = k > last_col_bucket ? last_col_bucket : k;
+            col = col_lut[k];
+            if (col_single)
+            {
+                col -= (int32_t)(col_edge[col] > d);
+                col += (int32_t)(col_edge[col + 1] <= d);
+            }
+            else
+            {
+                while (col_edge[col] > d)
+                    --col;
+                while (col_edge[col + 1] <= d)
+                    ++col;
+            }
             pix = (uint32_t)row * cols + (uint32_t)col;
             LIDET_ASSERT(pix < npix);
             point_pixel[i] = (int32_t)pix;
             ++st.n_projected;
-            if (point_idx[pix] < 0 || r2 < best[pix])
+            if (r2 < best[pix]) /* strict: exact ties keep the earlier point */
             {
-                point_idx[pix] = (int32_t)i;
                 best[pix] = r2;
+                point_idx[pix] = (int32_t)i;
+                x_m[pix] = x;
+                y_m[pix] = y;
+                z_m[pix] = z;
+                rxy_m[pix] = rxy;
             }
         }
     }
 
-    /* pass 2, over pixels: gather the winners; empty pixels are zero */
-    for (pix = 0; pix < npix; ++pix)
+    /* pass 2, over pixels: squared range -> range; empty pixels get 0 (a select, so compilers can
+     * vectorise the loop) */
     {
-        const int32_t idx = proj->point_idx[pix];
-        if (idx < 0)
+        float *const range = proj->range_m;
+        const int32_t *const idx = proj->point_idx;
+        uint32_t filled = 0;
+        for (pix = 0; pix < npix; ++pix)
         {
-            proj->x_m[pix] = 0.0f;
-            proj->y_m[pix] = 0.0f;
-            proj->z_m[pix] = 0.0f;
-            proj->range_m[pix] = 0.0f;
-            proj->rxy_m[pix] = 0.0f;
+            const int valid = idx[pix] >= 0;
+            range[pix] = valid ? sqrtf(range[pix]) : 0.0f;
+            filled += (uint32_t)valid;
         }
-        else
-        {
-            const float *pt = points + (size_t)idx * stride;
-            proj->x_m[pix] = pt[0];
-            proj->y_m[pix] = pt[1];
-            proj->z_m[pix] = pt[2];
-            proj->range_m[pix] = sqrtf(best_r2[pix]);
-            proj->rxy_m[pix] = sqrtf(pt[0] * pt[0] + pt[1] * pt[1]);
-            ++st.n_pixels_filled;
-        }
+        st.n_pixels_filled = filled;
     }
     proj->n_points = n;
     proj->stats = st;

@@ -176,6 +176,37 @@ static void test_azimuth_key(void)
     }
 }
 
+/* points a hair either side of the seam (D a few ulp outside [0, 4]) stay inside the image */
+static void test_seam_rounding(void)
+{
+    int i, n = 0;
+    uint32_t np;
+    const int32_t *pp;
+    init_sensor("hdl64");
+    for (i = 0; i < 200; ++i)
+    {
+        const float x = -(1.0f + 0.37f * (float)i);
+        const float ys[4] = {1e-30f, -1e-30f, 1e-7f * (float)i, -1e-7f * (float)i};
+        int k;
+        for (k = 0; k < 4; ++k)
+        {
+            pts[4 * n] = x;
+            pts[4 * n + 1] = ys[k];
+            pts[4 * n + 2] = 0.05f * x;
+            pts[4 * n + 3] = 0.0f;
+            ++n;
+        }
+    }
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, pts, (uint32_t)n, 4, NULL));
+    pp = lidet_proj_point_pixels(&g.ws, &np);
+    for (i = 0; i < n; ++i)
+    {
+        const int col = pp[i] % 2048;
+        TEST_ASSERT_TRUE(pp[i] >= 0 && pp[i] < 64 * 2048);
+        TEST_ASSERT_TRUE(col == 0 || col == 2047);
+    }
+}
+
 /* the caller's ring index decides the row (vlp16: ring 0 = lowest beam = last row) */
 static void test_ring_index_path(void)
 {
@@ -306,6 +337,9 @@ static void test_argument_and_config_errors(void)
     cfg.min_range_m = 1.0f;
     cfg.max_range_m = 0.5f;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proj_init(&g.ws, &cfg));
+    cfg.max_range_m = 2.0e6f; /* above the documented 1e6 m */
+    cfg.min_range_m = 0.1f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proj_init(&g.ws, &cfg));
     cfg.max_range_m = 0.0f;
     cfg.sensor.beam_elev_rad = NULL; /* uniform fov, inverted */
     cfg.sensor.fov_up_rad = -0.1f;
@@ -363,6 +397,7 @@ int main(void)
     RUN_TEST(test_wraparound);
     RUN_TEST(test_columns_sweep);
     RUN_TEST(test_azimuth_key);
+    RUN_TEST(test_seam_rounding);
     RUN_TEST(test_ring_index_path);
     RUN_TEST(test_closest_wins);
     RUN_TEST(test_invalid_points_counted);

@@ -25,7 +25,7 @@
  *
  * Memory: lidet_proj_t holds every buffer, sizeof = LIDET_MAX_ROWS * LIDET_MAX_COLS * 24 B (x, y, z,
  * range, R as float, winning point as int32) + LIDET_MAX_POINTS * 4 B (pixel of each input point)
- * + LIDET_MAX_COLS * 8 B (column edges and their lookup table) + LIDET_PROJ_ROW_LUT * 1 B
+ * + LIDET_MAX_COLS * 12 B (column edges and their lookup table) + LIDET_PROJ_ROW_LUT * 1 B
  * + LIDET_MAX_ROWS * 9 B + ~100 B. Defaults (128 x 2048, 262,144 points): about 7.3 MiB; a VLP-16
  * build (16 x 1800, 30,000 points): about 0.8 MiB. lidet_proj_bytes() returns the exact figure.
  * Declare it `static`.
@@ -47,7 +47,7 @@ typedef struct
     lidet_sensor_t sensor; /**< the sensor (its table is copied by init) */
     float min_range_m;     /**< points closer than this are dropped (zero range included);
                                 [0, 10], default 0.1 m */
-    float max_range_m;     /**< points farther are dropped; 0 = no limit (default) */
+    float max_range_m;     /**< points farther are dropped; [0, 1e6], 0 = no limit (default) */
     float fov_margin_rad;  /**< how far above the top beam / below the bottom beam a point may lie
                                 and still map to the edge row; [0, 0.5], default 5 deg (0.0873): the
                                 lasers sit centimetres off the optical centre, so close returns appear
@@ -98,12 +98,14 @@ typedef struct
     float row_bound_tan[LIDET_MAX_ROWS + 1]; /* [r] = tan of the mid-angle between rows r-1 and r;
                                                sentinels [0] = +big, [n_rows] = -big */
     uint8_t ring_to_row[LIDET_MAX_ROWS];    /* ring index -> row */
-    uint8_t row_lut[LIDET_PROJ_ROW_LUT];    /* tan(elevation) bucket -> smallest possible row */
+    uint8_t row_lut[LIDET_PROJ_ROW_LUT + 1]; /* tan(elevation) bucket -> row of its top end */
     float tan_lo, tan_hi, lut_scale;        /* accepted tan(elevation) range, buckets per unit */
+    uint8_t row_single_step;                /* 1: boundaries > 2 buckets apart, one correction step is exact */
+    uint8_t col_single_step;                /* same for the column edges */
     float col_edge_key[LIDET_MAX_COLS + 1];   /* pseudo-azimuth D of the left edge of each column;
                                                  [n_cols] = 5 (> any D), a sentinel */
-    uint16_t col_lut[2 * LIDET_MAX_COLS];     /* D bucket (width 2/n_cols) -> column of its low end */
-    float col_lut_scale;                      /* n_cols / 2: buckets per unit of D */
+    uint16_t col_lut[4 * LIDET_MAX_COLS + 1]; /* D bucket (width 1/n_cols) -> column of its low end */
+    float col_lut_scale;                      /* n_cols: buckets per unit of D */
     /* outputs of the last run */
     float x_m[LIDET_MAX_ROWS * LIDET_MAX_COLS];
     float y_m[LIDET_MAX_ROWS * LIDET_MAX_COLS];
