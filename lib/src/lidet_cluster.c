@@ -23,14 +23,23 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
         return;
     }
     memset(cfg, 0, sizeof *cfg);
-    /* theta measured per beam count on simulated and real scans (docs/BENCHMARKS.md): sparse
-     * 16-beam images need a smaller angle (the paper's authors used 0.15 rad on theirs) */
-    cfg->theta_rad = 0.20f;
+    /* measured on simulated (20 + 20 scans) and real SemanticKITTI scans, docs/BENCHMARKS.md: dense
+     * sensors (> 16 beams) recover most objects whole with a wider angle, short bridging and the
+     * occluder rule; sparse 16-beam images do best with a smaller angle and no occluder rule (rows
+     * 2 deg apart already bridge far) */
     if (sensor != 0 && sensor->n_rows <= 16)
     {
-        cfg->theta_rad = 0.15f;
+        cfg->theta_rad = 0.25f;
+        cfg->max_steps = 3u;
+        cfg->bridge_occluders = 0;
     }
-    cfg->max_steps = 9u < STEPS ? 9u : STEPS;
+    else
+    {
+        cfg->theta_rad = 0.35f;
+        cfg->max_steps = 5u;
+        cfg->bridge_occluders = 1;
+    }
+    cfg->max_steps = cfg->max_steps < STEPS ? cfg->max_steps : STEPS;
     cfg->min_points = 10;
     cfg->max_extent_m = 6.0f;
     cfg->max_mean_height_m = 2.5f;
@@ -303,6 +312,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     uint16_t *lab;
     int32_t *mem;
     float tan_theta;
+    int occl;
     lidet_cluster_stats_t st;
 
     if (c == 0 || img == 0 || (planes != 0 && n_sectors == 0))
@@ -332,6 +342,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     lab = c->labels;
     mem = c->members;
     tan_theta = c->tan_theta;
+    occl = c->cfg.bridge_occluders != 0;
     kc = c->cfg.max_steps < cols - 1 ? c->cfg.max_steps : cols - 1; /* never wrap onto itself */
 
     for (p = 0; p < npix; ++p)
@@ -369,12 +380,17 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 n = rowbase + cc;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (lab[n] == LAB_FREE && joins(d, img->range_m[n], c->col_sin[k - 1], c->col_cos[k - 1], tan_theta))
+                if (joins(d, img->range_m[n], c->col_sin[k - 1], c->col_cos[k - 1], tan_theta))
                 {
-                    lab[n] = (uint16_t)LAB_PENDING;
-                    mem[tail++] = (int32_t)n;
+                    if (lab[n] == LAB_FREE)
+                    {
+                        lab[n] = (uint16_t)LAB_PENDING;
+                        mem[tail++] = (int32_t)n;
+                    }
+                    break;
                 }
-                break;
+                if (!(occl && img->range_m[n] < d))
+                    break; /* a surface behind, or occluders not bridged: stop */
             }
             /* left (wrapping) */
             for (k = 1; k <= kc; ++k)
@@ -383,12 +399,17 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 const uint32_t n = rowbase + cc;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (lab[n] == LAB_FREE && joins(d, img->range_m[n], c->col_sin[k - 1], c->col_cos[k - 1], tan_theta))
+                if (joins(d, img->range_m[n], c->col_sin[k - 1], c->col_cos[k - 1], tan_theta))
                 {
-                    lab[n] = (uint16_t)LAB_PENDING;
-                    mem[tail++] = (int32_t)n;
+                    if (lab[n] == LAB_FREE)
+                    {
+                        lab[n] = (uint16_t)LAB_PENDING;
+                        mem[tail++] = (int32_t)n;
+                    }
+                    break;
                 }
-                break;
+                if (!(occl && img->range_m[n] < d))
+                    break; /* a surface behind, or occluders not bridged: stop */
             }
             /* down: rows r and r + k */
             for (k = 1; k <= c->cfg.max_steps && r + k < rows; ++k)
@@ -396,13 +417,17 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 const uint32_t n = q + k * cols;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (lab[n] == LAB_FREE &&
-                    joins(d, img->range_m[n], c->row_sin[r * STEPS + k - 1], c->row_cos[r * STEPS + k - 1], tan_theta))
+                if (joins(d, img->range_m[n], c->row_sin[r * STEPS + k - 1], c->row_cos[r * STEPS + k - 1], tan_theta))
                 {
-                    lab[n] = (uint16_t)LAB_PENDING;
-                    mem[tail++] = (int32_t)n;
+                    if (lab[n] == LAB_FREE)
+                    {
+                        lab[n] = (uint16_t)LAB_PENDING;
+                        mem[tail++] = (int32_t)n;
+                    }
+                    break;
                 }
-                break;
+                if (!(occl && img->range_m[n] < d))
+                    break; /* a surface behind, or occluders not bridged: stop */
             }
             /* up: rows r - k and r (the pair's entry is stored at the upper row) */
             for (k = 1; k <= c->cfg.max_steps && k <= r; ++k)
@@ -411,12 +436,17 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 const uint32_t e = (r - k) * STEPS + k - 1;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (lab[n] == LAB_FREE && joins(d, img->range_m[n], c->row_sin[e], c->row_cos[e], tan_theta))
+                if (joins(d, img->range_m[n], c->row_sin[e], c->row_cos[e], tan_theta))
                 {
-                    lab[n] = (uint16_t)LAB_PENDING;
-                    mem[tail++] = (int32_t)n;
+                    if (lab[n] == LAB_FREE)
+                    {
+                        lab[n] = (uint16_t)LAB_PENDING;
+                        mem[tail++] = (int32_t)n;
+                    }
+                    break;
                 }
-                break;
+                if (!(occl && img->range_m[n] < d))
+                    break; /* a surface behind, or occluders not bridged: stop */
             }
         }
         tail = finish_cluster(c, start, tail, planes, n_sectors, &st);

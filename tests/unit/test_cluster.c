@@ -114,6 +114,32 @@ static void test_hole_joins(void)
     expect_labels(want_split, 6);
 }
 
+/* a pole in front of a wall: with the occluder rule the wall stays one cluster behind it */
+static void test_occluder_bridging(void)
+{
+    static const char *const art[] = {
+        "......kkkkakkkkk................................................",
+        "......kkkkakkkkk................................................",
+        "......kkkkakkkkk................................................",
+    };
+    static const char *const want_bridged[] = {
+        "0000001111211111000000000000000000000000000000000000000000000000",
+        "0000001111211111000000000000000000000000000000000000000000000000",
+        "0000001111211111000000000000000000000000000000000000000000000000",
+    };
+    static const char *const want_split[] = {
+        "0000001111233333000000000000000000000000000000000000000000000000",
+        "0000001111233333000000000000000000000000000000000000000000000000",
+        "0000001111233333000000000000000000000000000000000000000000000000",
+    };
+    cfg.bridge_occluders = 1;
+    run(art, 3, NULL);
+    expect_labels(want_bridged, 3);
+    cfg.bridge_occluders = 0;
+    run(art, 3, NULL);
+    expect_labels(want_split, 3);
+}
+
 /* vertical bridging uses the real beam angles and also steps over ground pixels */
 static void test_vertical_hole_and_ground(void)
 {
@@ -324,7 +350,8 @@ static void test_defaults_per_profile(void)
     lidet_cluster_cfg_t d;
     lidet_cluster_cfg_default(&d, lidet_sensor_find("hdl64"));
     TEST_ASSERT_EQUAL_UINT32(10, d.min_points);
-    TEST_ASSERT_EQUAL_UINT32(9, d.max_steps);
+    TEST_ASSERT_EQUAL_UINT32(5, d.max_steps);
+    TEST_ASSERT_EQUAL_UINT32(1, d.bridge_occluders);
     TEST_ASSERT_CLOSE(1.73, d.mount_height_m, 1e-3, 0);
     TEST_ASSERT_TRUE(d.theta_rad > 0.0f && d.theta_rad < 0.8f);
     lidet_cluster_cfg_default(&d, lidet_sensor_find("vlp16"));
@@ -428,6 +455,7 @@ int main(void)
     RUN_TEST(test_depth_jump_splits);
     RUN_TEST(test_slanted_surface_joins);
     RUN_TEST(test_hole_joins);
+    RUN_TEST(test_occluder_bridging);
     RUN_TEST(test_vertical_hole_and_ground);
     RUN_TEST(test_wraparound_joins);
     RUN_TEST(test_filters);

@@ -5,7 +5,7 @@ lib/src/lidet_proposal.c; the contract is written in lib/include/lidet/lidet_clu
 - `proposal_indices` / `make_proposal` reproduce the C resampling *exactly* (integer xorshift32):
   training uses them, or the bindings (`lidet_tools.native.proposals`), and both give the same points.
 - `cluster_ref` is a plain-Python BFS with the same rules (4-neighbourhood, hole bridging over
-  non-candidates up to max_steps, column wrap, the angle criterion in tangent form, filters, capacity,
+  non-candidates up to max_steps, optionally over nearer occluders, column wrap, the angle criterion in tangent form, filters, capacity,
   canonical ids). It is slow (seconds per 64 x 2048 image) and meant for tests.
 """
 from __future__ import annotations
@@ -76,7 +76,7 @@ def make_proposal(member_xyz: np.ndarray, mean=None, n_points: int = 64, seed: i
 
 
 def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.ndarray, xyz: np.ndarray,
-                theta_rad: float = 0.2, max_steps: int = 9, min_points: int = 1, max_extent_m: float = 1e30,
+                theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, min_points: int = 1, max_extent_m: float = 1e30,
                 max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
@@ -128,17 +128,18 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
             for name, k, n in dirs:
                 if name in done or state[n] == -2:
                     continue
-                done.add(name)
-                if state[n] != 0:
-                    continue
                 if name in "RL":
                     sn, cs = csin[k - 1], ccos[k - 1]
                 else:
                     sn, cs = row_sc(r if name == "D" else r - k, k)
                 if joins(d, rng[n], sn, cs):
-                    state[n] = -1
-                    mem.append(n)
-                    q.append(n)
+                    done.add(name)
+                    if state[n] == 0:
+                        state[n] = -1
+                        mem.append(n)
+                        q.append(n)
+                elif not (bridge_occluders and rng[n] < d):
+                    done.add(name)  # a surface behind it: stop; a nearer occluder is stepped over
         m = np.array(mem)
         if len(m) < min_points:
             continue

@@ -12,6 +12,8 @@
  *    return, or ground) up to `max_steps` pixels away and tests the first candidate it meets; the
  *    angle alpha between the two beams grows with the steps (columns: k * 2 pi / n_cols; rows: the
  *    real elevation difference of the two beams from the profile's table);
+ *  - occluders (bridge_occluders): a candidate that fails the test and is nearer than the current
+ *    pixel is stepped over like a hole (the search goes on behind it, still up to max_steps);
  *  - join test: with d1 the larger and d2 the smaller range, beta = atan2(d2 sin a, d1 - d2 cos a);
  *    join when beta > theta. No atan2 at run time: sin/cos of every alpha are precomputed in init
  *    and the test is d2 sin a > tan(theta) (d1 - d2 cos a) (always true when the bracket is <= 0);
@@ -61,9 +63,16 @@ extern "C" {
 typedef struct
 {
     float theta_rad;         /**< join when beta > theta; (0, pi/2). Defaults per profile (measured,
-                                  docs/BENCHMARKS.md): hdl64 0.20, vlp16 0.15, vlp32c/os1 0.20 */
+                                  docs/BENCHMARKS.md): > 16 beams (hdl64, vlp32c, os1) 0.35 rad,
+                                  <= 16 beams (vlp16) 0.25 rad */
     uint32_t max_steps;      /**< hole bridging: search up to this many pixels away in each direction
-                                  (1 = direct neighbours only); [1, LIDET_CLUSTER_MAX_STEPS], default 9 */
+                                  (1 = direct neighbours only); [1, LIDET_CLUSTER_MAX_STEPS]; default 5
+                                  (> 16 beams), 3 (<= 16 beams); the authors used 9 */
+    uint32_t bridge_occluders; /**< 1: the search also steps over a candidate that fails the test and is
+                                  nearer than the current pixel (a pole or branch in front of the
+                                  object), so objects seen through occluders stay whole; 0: stop at
+                                  the first candidate (the authors' variant). Default 1 for > 16 beams,
+                                  0 for <= 16 beams (measured) */
     uint32_t min_points;     /**< drop clusters with fewer pixels; >= 1, default 10 */
     float max_extent_m;      /**< drop clusters wider than this in x, y or z; > 0, default 6 m */
     float max_mean_height_m; /**< drop clusters whose mean lies higher above the ground plane; default
