@@ -32,6 +32,34 @@ static inline uint32_t xorshift32(uint32_t x)
     return x;
 }
 
+static uint32_t rng_start(uint32_t seed, uint32_t n_src)
+{
+    const uint32_t s = seed ^ (n_src * 0x9E3779B9u);
+    return s != 0 ? s : 0x6C646574u; /* xorshift's only fixed point */
+}
+
+/* member index of output i (0, 1, ... in order; *s is the generator state). n_src <= n_out: every
+ * member once, then draws with replacement; else one member from each of n_out equal runs of the
+ * member list (stratified, without replacement). */
+static uint32_t next_index(uint32_t *s, uint32_t i, uint32_t n_src, uint32_t n_out)
+{
+    if (n_src <= n_out)
+    {
+        if (i < n_src)
+        {
+            return i;
+        }
+        *s = xorshift32(*s);
+        return *s % n_src;
+    }
+    {
+        const uint32_t b0 = (uint32_t)(((uint64_t)i * n_src) / n_out);
+        const uint32_t b1 = (uint32_t)(((uint64_t)(i + 1u) * n_src) / n_out);
+        *s = xorshift32(*s);
+        return b0 + *s % (b1 - b0); /* b1 > b0 because n_src > n_out */
+    }
+}
+
 lidet_status_t lidet_proposal_indices(uint32_t n_src, uint32_t n_out, uint32_t seed, uint32_t *out)
 {
     uint32_t i, s;
@@ -39,31 +67,10 @@ lidet_status_t lidet_proposal_indices(uint32_t n_src, uint32_t n_out, uint32_t s
     {
         return LIDET_ERR_ARG;
     }
-    s = seed ^ (n_src * 0x9E3779B9u);
-    s = s != 0 ? s : 0x6C646574u; /* xorshift's only fixed point */
-    if (n_src <= n_out)
+    s = rng_start(seed, n_src);
+    for (i = 0; i < n_out; ++i)
     {
-        /* every member once, then draws with replacement */
-        for (i = 0; i < n_src; ++i)
-        {
-            out[i] = i;
-        }
-        for (; i < n_out; ++i)
-        {
-            s = xorshift32(s);
-            out[i] = s % n_src;
-        }
-    }
-    else
-    {
-        /* stratified: one member from each of n_out equal runs of the member list (raster order) */
-        for (i = 0; i < n_out; ++i)
-        {
-            const uint32_t b0 = (uint32_t)(((uint64_t)i * n_src) / n_out);
-            const uint32_t b1 = (uint32_t)(((uint64_t)(i + 1u) * n_src) / n_out);
-            s = xorshift32(s);
-            out[i] = b0 + s % (b1 - b0); /* b1 > b0 because n_src > n_out */
-        }
+        out[i] = next_index(&s, i, n_src, n_out);
     }
     return LIDET_OK;
 }
@@ -88,8 +95,7 @@ lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_in
 {
     const lidet_cluster_rec_t *rec;
     const lidet_range_image_t *img;
-    uint32_t idx[LIDET_PROPOSAL_POINTS];
-    uint32_t i, npix;
+    uint32_t i, npix, state;
     float mx, my, mz, rxy;
 
     if (c == 0 || cfg == 0 || out == 0)
@@ -113,13 +119,13 @@ lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_in
     rec = &c->recs[cluster_index];
     img = &c->img;
     npix = (uint32_t)img->n_rows * img->n_cols;
-    (void)lidet_proposal_indices(rec->n_points, cfg->n_points, cfg->seed, idx); /* n_points >= 1 */
+    state = rng_start(cfg->seed, rec->n_points);
     mx = rec->mean_m[0];
     my = rec->mean_m[1];
     mz = rec->mean_m[2];
     for (i = 0; i < cfg->n_points; ++i)
     {
-        const int32_t p = c->members[rec->first_member + idx[i]];
+        const int32_t p = c->members[rec->first_member + next_index(&state, i, rec->n_points, cfg->n_points)];
         if (p < 0 || (uint32_t)p >= npix)
         {
             return LIDET_ERR_STATE; /* cannot happen after a run; guards a stale state */
