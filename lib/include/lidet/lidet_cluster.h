@@ -13,7 +13,10 @@
  *    angle alpha between the two beams grows with the steps (columns: k * 2 pi / n_cols; rows: the
  *    real elevation difference of the two beams from the profile's table);
  *  - occluders (bridge_occluders): a candidate that fails the test and is nearer than the current
- *    pixel is stepped over like a hole (the search goes on behind it, still up to max_steps);
+ *    pixel is stepped over like a hole (the search goes on behind it, still up to max_steps, testing
+ *    each further candidate at the wider angle, the occluder's own continuation included). A stricter
+ *    variant that never re-tests nearer pixels separates overlapping parked cars better but measured
+ *    lower recovery overall (simulated hdl64 cars within 40 m: 58 % instead of 74 % at 0.35 rad);
  *  - join test: with d1 the larger and d2 the smaller range, beta = atan2(d2 sin a, d1 - d2 cos a);
  *    join when beta > theta. No atan2 at run time: sin/cos of every alpha are precomputed in init
  *    and the test is d2 sin a > tan(theta) (d1 - d2 cos a) (always true when the bracket is <= 0);
