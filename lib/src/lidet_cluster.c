@@ -54,9 +54,10 @@ lidet_status_t lidet_cluster_init(lidet_cluster_t *c, const lidet_cluster_cfg_t 
     }
     c->magic = 0;
     if (!lidet__isfinite(cfg->theta_rad) || !(cfg->theta_rad > 0.0f) || !(cfg->theta_rad < 1.5f) ||
-        cfg->max_steps < 1 || cfg->max_steps > STEPS || cfg->min_points < 1 || !lidet__isfinite(cfg->max_extent_m) ||
-        !(cfg->max_extent_m > 0.0f) || !lidet__isfinite(cfg->max_mean_height_m) ||
-        !lidet__isfinite(cfg->mount_height_m) || cfg->mount_height_m < 0.0f)
+        cfg->max_steps < 1 || cfg->max_steps > STEPS || cfg->min_points < 1 ||
+        !lidet__isfinite(cfg->max_extent_m) || !(cfg->max_extent_m > 0.0f) ||
+        !lidet__isfinite(cfg->max_mean_height_m) || !lidet__isfinite(cfg->mount_height_m) ||
+        cfg->mount_height_m < 0.0f)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -305,8 +306,8 @@ static void canonicalise(lidet_cluster_t *c, uint32_t npix, lidet_cluster_stats_
     }
 }
 
-lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *img, const uint8_t *ground_mask,
-                                 const lidet_plane_t *planes, uint32_t n_sectors)
+lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *img,
+                                 const uint8_t *ground_mask, const lidet_plane_t *planes, uint32_t n_sectors)
 {
     uint32_t rows, cols, npix, p, tail, kc;
     uint16_t *lab;
@@ -329,8 +330,8 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     {
         return LIDET_ERR_BUFFER;
     }
-    if (img->range_m == 0 || img->point_idx == 0 || img->row_elev_rad == 0 || img->x_m == 0 || img->y_m == 0 ||
-        img->z_m == 0)
+    if (img->range_m == 0 || img->point_idx == 0 || img->row_elev_rad == 0 || img->x_m == 0 ||
+        img->y_m == 0 || img->z_m == 0)
     {
         return LIDET_ERR_ARG;
     }
@@ -417,7 +418,8 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 const uint32_t n = q + k * cols;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (joins(d, img->range_m[n], c->row_sin[r * STEPS + k - 1], c->row_cos[r * STEPS + k - 1], tan_theta))
+                if (joins(d, img->range_m[n], c->row_sin[r * STEPS + k - 1], c->row_cos[r * STEPS + k - 1],
+                          tan_theta))
                 {
                     if (lab[n] == LAB_FREE)
                     {
@@ -485,8 +487,8 @@ const lidet_cluster_stats_t *lidet_cluster_stats(const lidet_cluster_t *c)
     return c == 0 ? 0 : &c->stats;
 }
 
-lidet_status_t lidet_cluster_point_labels(const lidet_cluster_t *c, const int32_t *point_pixel, uint32_t n_points,
-                                          uint32_t *out)
+lidet_status_t lidet_cluster_point_labels(const lidet_cluster_t *c, const int32_t *point_pixel,
+                                          uint32_t n_points, uint32_t *out)
 {
     uint32_t i, npix;
     if (c == 0 || ((point_pixel == 0 || out == 0) && n_points > 0))

@@ -90,8 +90,8 @@ static int16_t bin_of(float v, float bin)
     return (int16_t)f;
 }
 
-lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_index, const lidet_proposal_cfg_t *cfg,
-                                   lidet_proposal_t *out)
+lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_index,
+                                   const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out)
 {
     const lidet_cluster_rec_t *rec;
     const lidet_range_image_t *img;
@@ -106,9 +106,10 @@ lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_in
     {
         return LIDET_ERR_STATE;
     }
-    if (cfg->n_points < 1 || cfg->n_points > LIDET_PROPOSAL_POINTS || !lidet__isfinite(cfg->azimuth_bin_rad) ||
-        !(cfg->azimuth_bin_rad > 0.0f) || !lidet__isfinite(cfg->elevation_bin_rad) ||
-        !(cfg->elevation_bin_rad > 0.0f) || !lidet__isfinite(cfg->range_bin_m) || !(cfg->range_bin_m > 0.0f))
+    if (cfg->n_points < 1 || cfg->n_points > LIDET_PROPOSAL_POINTS ||
+        !lidet__isfinite(cfg->azimuth_bin_rad) || !(cfg->azimuth_bin_rad > 0.0f) ||
+        !lidet__isfinite(cfg->elevation_bin_rad) || !(cfg->elevation_bin_rad > 0.0f) ||
+        !lidet__isfinite(cfg->range_bin_m) || !(cfg->range_bin_m > 0.0f))
     {
         return LIDET_ERR_CONFIG;
     }

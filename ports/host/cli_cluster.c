@@ -30,8 +30,8 @@ static void id_colour(uint32_t id, uint8_t rgb[3])
 
 /* bird's-eye view, +x up, +y left, 80 m x 80 m at 0.1 m per pixel: ground dark, other points grey,
  * clustered points in their cluster's colour */
-static int write_bev_png(const char *path, const float *pts, uint32_t n, const uint32_t *ids, const int32_t *pp,
-                         const uint8_t *ground_pix)
+static int write_bev_png(const char *path, const float *pts, uint32_t n, const uint32_t *ids,
+                         const int32_t *pp, const uint8_t *ground_pix)
 {
     const uint32_t W = 800, H = 800;
     const float res = 0.1f;
@@ -260,8 +260,8 @@ int cli_cluster(int argc, char **argv)
                cs->n_kept, cs->n_found, cs->n_dropped_small, cs->n_dropped_extent, cs->n_dropped_height,
                cs->n_dropped_capacity);
         printf("proposals       %u x %u points\n", cs->n_kept, prcfg.n_points);
-        printf("cluster_ms      %.3f (median of %d; projection %.3f, proposals %.3f)\n", ms_clu, a.repeat, ms_proj,
-               ms_prop);
+        printf("cluster_ms      %.3f (median of %d; projection %.3f, proposals %.3f)\n", ms_clu, a.repeat,
+               ms_proj, ms_prop);
         if (a.png_path != NULL)
             printf("picture         %s\n", a.png_path);
     }

@@ -431,8 +431,8 @@ static void test_proposal_centred(void)
     for (i = 0; i < 64; ++i)
     {
         const double x = a.xyz[i][0] + a.mean_m[0], y = a.xyz[i][1] + a.mean_m[1];
-        TEST_ASSERT_CLOSE(10.0 * cos(atan2(a.xyz[i][2] + a.mean_m[2], sqrt(x * x + y * y))), sqrt(x * x + y * y),
-                          1e-4, 0);
+        const double rxy = sqrt(x * x + y * y);
+        TEST_ASSERT_CLOSE(10.0 * cos(atan2(a.xyz[i][2] + a.mean_m[2], rxy)), rxy, 1e-4, 0);
     }
     /* the voxel of the mean: signed floor bins */
     az = atan2(a.mean_m[1], a.mean_m[0]);

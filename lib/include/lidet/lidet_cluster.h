@@ -166,8 +166,8 @@ lidet_status_t lidet_cluster_init(lidet_cluster_t *c, const lidet_cluster_cfg_t 
  *         LIDET_ERR_ARG (NULL c/img, planes with n_sectors 0); LIDET_ERR_BUFFER (image larger than
  *         the capacities, or n_cols < 2); LIDET_ERR_STATE (not initialised).
  */
-lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *img, const uint8_t *ground_mask,
-                                 const lidet_plane_t *planes, uint32_t n_sectors);
+lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *img,
+                                 const uint8_t *ground_mask, const lidet_plane_t *planes, uint32_t n_sectors);
 
 /**
  * @brief Per-pixel labels of the last run: n_rows * n_cols canonical ids (0 = none). Valid until
@@ -199,8 +199,8 @@ const lidet_cluster_stats_t *lidet_cluster_stats(const lidet_cluster_t *c);
  * @param[out] out         n_points ids (0 = none). May not alias point_pixel.
  * @return LIDET_OK; LIDET_ERR_ARG (NULL with n_points > 0); LIDET_ERR_STATE (never run).
  */
-lidet_status_t lidet_cluster_point_labels(const lidet_cluster_t *c, const int32_t *point_pixel, uint32_t n_points,
-                                          uint32_t *out);
+lidet_status_t lidet_cluster_point_labels(const lidet_cluster_t *c, const int32_t *point_pixel,
+                                          uint32_t n_points, uint32_t *out);
 
 /** @brief sizeof(lidet_cluster_t): the bytes firmware must place for this stage. */
 uint32_t lidet_cluster_bytes(void);
@@ -242,8 +242,8 @@ void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg);
  *         LIDET_ERR_CONFIG (n_points outside [1, LIDET_PROPOSAL_POINTS], a bin size <= 0 or not finite);
  *         LIDET_ERR_STATE (never run).
  */
-lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_index, const lidet_proposal_cfg_t *cfg,
-                                   lidet_proposal_t *out);
+lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_index,
+                                   const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out);
 
 /**
  * @brief The resampling rule alone: writes n_out member indices (each < n_src) for a cluster of
