@@ -57,7 +57,7 @@ lidet_status_t lidet_cluster_init(lidet_cluster_t *c, const lidet_cluster_cfg_t 
         cfg->max_steps < 1 || cfg->max_steps > STEPS || cfg->min_points < 1 ||
         !lidet__isfinite(cfg->max_extent_m) || !(cfg->max_extent_m > 0.0f) ||
         !lidet__isfinite(cfg->max_mean_height_m) || !lidet__isfinite(cfg->mount_height_m) ||
-        cfg->mount_height_m < 0.0f)
+        cfg->mount_height_m < 0.0f || !lidet__isfinite(cfg->max_gap_m) || cfg->max_gap_m < 0.0f)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -111,6 +111,22 @@ static inline int joins(float da, float db, float sn, float cs, float tan_theta)
     const float d1 = da > db ? da : db;
     const float d2 = da > db ? db : da;
     return d2 * sn > tan_theta * (d1 - d2 * cs);
+}
+
+/* the angle test, plus (gap2 > 0) a bound on the squared 3D distance between the two points */
+static inline int link(const lidet_range_image_t *img, uint32_t q, uint32_t n, float gap2, float sn, float cs,
+                       float tan_theta)
+{
+    if (!joins(img->range_m[q], img->range_m[n], sn, cs, tan_theta))
+    {
+        return 0;
+    }
+    if (gap2 > 0.0f)
+    {
+        const float dx = img->x_m[q] - img->x_m[n], dy = img->y_m[q] - img->y_m[n], dz = img->z_m[q] - img->z_m[n];
+        return dx * dx + dy * dy + dz * dz <= gap2;
+    }
+    return 1;
 }
 
 /* the smallest kept cluster (ties: the later seed), the one capacity drops first */
@@ -314,6 +330,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     int32_t *mem;
     float tan_theta;
     int occl;
+    float gap2;
     lidet_cluster_stats_t st;
 
     if (c == 0 || img == 0 || (planes != 0 && n_sectors == 0))
@@ -344,6 +361,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     mem = c->members;
     tan_theta = c->tan_theta;
     occl = c->cfg.bridge_occluders != 0;
+    gap2 = c->cfg.max_gap_m * c->cfg.max_gap_m;
     kc = c->cfg.max_steps < cols - 1 ? c->cfg.max_steps : cols - 1; /* never wrap onto itself */
 
     for (p = 0; p < npix; ++p)
@@ -381,7 +399,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 n = rowbase + cc;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (joins(d, img->range_m[n], c->col_sin[k - 1], c->col_cos[k - 1], tan_theta))
+                if (link(img, q, n, gap2, c->col_sin[k - 1], c->col_cos[k - 1], tan_theta))
                 {
                     if (lab[n] == LAB_FREE)
                     {
@@ -400,7 +418,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 const uint32_t n = rowbase + cc;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (joins(d, img->range_m[n], c->col_sin[k - 1], c->col_cos[k - 1], tan_theta))
+                if (link(img, q, n, gap2, c->col_sin[k - 1], c->col_cos[k - 1], tan_theta))
                 {
                     if (lab[n] == LAB_FREE)
                     {
@@ -418,7 +436,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 const uint32_t n = q + k * cols;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (joins(d, img->range_m[n], c->row_sin[r * STEPS + k - 1], c->row_cos[r * STEPS + k - 1],
+                if (link(img, q, n, gap2, c->row_sin[r * STEPS + k - 1], c->row_cos[r * STEPS + k - 1],
                           tan_theta))
                 {
                     if (lab[n] == LAB_FREE)
@@ -438,7 +456,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 const uint32_t e = (r - k) * STEPS + k - 1;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (joins(d, img->range_m[n], c->row_sin[e], c->row_cos[e], tan_theta))
+                if (link(img, q, n, gap2, c->row_sin[e], c->row_cos[e], tan_theta))
                 {
                     if (lab[n] == LAB_FREE)
                     {

@@ -140,6 +140,26 @@ static void test_occluder_bridging(void)
     expect_labels(want_split, 3);
 }
 
+/* max_gap_m: neighbours further apart than the gap do not join even when the angle test passes */
+static void test_max_gap(void)
+{
+    static const char *const art[] = {
+        "..cc.cc.........................",
+    };
+    /* 10 m, columns 11.25 deg apart: neighbours ~2 m apart, across the hole ~3.9 m */
+    cfg.max_gap_m = 0.0f;
+    run(art, 1, NULL);
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g.ws)->n_kept);
+    cfg.max_gap_m = 3.0f;
+    run(art, 1, NULL);
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_cluster_stats(&g.ws)->n_kept);
+    cfg.max_gap_m = 1.0f;
+    run(art, 1, NULL);
+    TEST_ASSERT_EQUAL_UINT32(4, lidet_cluster_stats(&g.ws)->n_kept);
+    cfg.max_gap_m = -1.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &cfg));
+}
+
 /* vertical bridging uses the real beam angles and also steps over ground pixels */
 static void test_vertical_hole_and_ground(void)
 {
@@ -456,6 +476,7 @@ int main(void)
     RUN_TEST(test_slanted_surface_joins);
     RUN_TEST(test_hole_joins);
     RUN_TEST(test_occluder_bridging);
+    RUN_TEST(test_max_gap);
     RUN_TEST(test_vertical_hole_and_ground);
     RUN_TEST(test_wraparound_joins);
     RUN_TEST(test_filters);

@@ -76,7 +76,7 @@ def make_proposal(member_xyz: np.ndarray, mean=None, n_points: int = 64, seed: i
 
 
 def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.ndarray, xyz: np.ndarray,
-                theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, min_points: int = 1, max_extent_m: float = 1e30,
+                theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, max_gap_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
                 max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
@@ -132,7 +132,11 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                     sn, cs = csin[k - 1], ccos[k - 1]
                 else:
                     sn, cs = row_sc(r if name == "D" else r - k, k)
-                if joins(d, rng[n], sn, cs):
+                ok = joins(d, rng[n], sn, cs)
+                if ok and max_gap_m > 0:
+                    dd = (np.asarray(xyz, np.float32).reshape(-1, 3)[p] - np.asarray(xyz, np.float32).reshape(-1, 3)[n])
+                    ok = float(np.dot(dd, dd)) <= float(np.float32(max_gap_m) ** 2)
+                if ok:
                     done.add(name)
                     if state[n] == 0:
                         state[n] = -1

@@ -76,6 +76,8 @@ typedef struct
                                   object), so objects seen through occluders stay whole; 0: stop at
                                   the first candidate (the authors' variant). Default 1 for > 16 beams,
                                   0 for <= 16 beams (measured) */
+    float max_gap_m;         /**< 0 (default): the angle test alone; > 0: neighbours also need a 3D
+                                  distance <= max_gap_m (metres) to join */
     uint32_t min_points;     /**< drop clusters with fewer pixels; >= 1, default 10 */
     float max_extent_m;      /**< drop clusters wider than this in x, y or z; > 0, default 6 m */
     float max_mean_height_m; /**< drop clusters whose mean lies higher above the ground plane; default
