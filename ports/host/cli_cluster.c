@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* `lidet cluster`: projection, ground mask, depth clustering and proposals on one scan.
- * Ground: from a SemanticKITTI label file (--labels, classes 40 44 48 49 60 72), or a flat ground
- * (z below -(mount height - 0.25 m)) when no ground stage is linked into this build. */
+ * Ground: from a SemanticKITTI label file (--labels, classes 40 44 48 49 60 72); else the ground stage
+ * (lidet_ground.h, with its per-sector planes for the height filter) when the library has it; else a
+ * flat ground (z below -(mount height - 0.25 m)). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -11,6 +12,12 @@ static lidet_proj_t g_proj;
 static lidet_cluster_t g_cl;
 static uint8_t g_ground[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 static lidet_proposal_t g_prop;
+#ifdef LIDET_GROUND_H
+static lidet_ground_t g_gnd;
+#define HAVE_GROUND_STAGE 1
+#else
+#define HAVE_GROUND_STAGE 0
+#endif
 
 #define FLAT_GROUND_MARGIN_M 0.25f
 
@@ -93,9 +100,13 @@ int cli_cluster(int argc, char **argv)
     lidet_status_t st;
     const lidet_cluster_stats_t *cs;
     const char *labels_path = NULL;
+    int use_stage = 0; /* ground from the ground stage, rerun every repetition */
+    const lidet_plane_t *planes = NULL;
+    uint32_t n_sectors = 0;
+    double ms_gnd = 0.0;
     char **rest;
     int nrest = 0, i;
-    double *t_proj, *t_clu, *t_prop, ms_proj, ms_clu, ms_prop;
+    double *t_proj, *t_clu, *t_prop, *t_gnd, ms_proj, ms_clu, ms_prop;
     uint32_t npix, p, n_pp, k, n_rec;
     const int32_t *pp;
     uint32_t *ids;
@@ -114,7 +125,8 @@ int cli_cluster(int argc, char **argv)
     if (cli_parse(nrest, rest, "cluster", &a) != 0)
     {
         fprintf(stderr, "  --labels   SemanticKITTI .label file: its ground classes are the ground mask\n"
-                        "             (default: flat ground 0.25 m above -mount height)\n");
+                        "             (default: the ground stage, or a flat ground 0.25 m above -mount height\n"
+                        "             in builds without it)\n");
         free(rest);
         return 1;
     }
@@ -131,7 +143,7 @@ int cli_cluster(int argc, char **argv)
         return fail(&a, "cluster init", st);
     lidet_proposal_cfg_default(&prcfg);
 
-    t_proj = (double *)malloc(sizeof(double) * (size_t)a.repeat * 3u);
+    t_proj = (double *)malloc(sizeof(double) * (size_t)a.repeat * 4u);
     ids = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(a.n_points > 0 ? a.n_points : 1));
     if (t_proj == NULL || ids == NULL)
     {
@@ -142,6 +154,7 @@ int cli_cluster(int argc, char **argv)
     }
     t_clu = t_proj + a.repeat;
     t_prop = t_clu + a.repeat;
+    t_gnd = t_prop + a.repeat;
 
     /* ground mask of the scan (computed once: it is not this stage's time) */
     st = lidet_proj_run(&g_proj, a.points, a.n_points, 4, a.ring);
@@ -169,12 +182,23 @@ int cli_cluster(int argc, char **argv)
             g_ground[p] = (uint8_t)(img.point_idx[p] >= 0 && is_ground_class(lab[img.point_idx[p]]));
         free(lab);
     }
-    else
+    else if (!HAVE_GROUND_STAGE)
     {
         const float zmax = -(a.sensor_profile->mount_height_m - FLAT_GROUND_MARGIN_M);
         for (p = 0; p < npix; ++p)
             g_ground[p] = (uint8_t)(img.point_idx[p] >= 0 && img.z_m[p] < zmax);
     }
+#if HAVE_GROUND_STAGE
+    else
+    {
+        lidet_ground_cfg_t gcfg;
+        lidet_ground_cfg_default(&gcfg, a.sensor_profile);
+        st = lidet_ground_init(&g_gnd, &gcfg);
+        if (st != LIDET_OK)
+            return fail(&a, "ground init", st);
+        use_stage = 1;
+    }
+#endif
 
     for (i = 0; i < a.repeat; ++i)
     {
@@ -184,8 +208,20 @@ int cli_cluster(int argc, char **argv)
         if (!LIDET_SUCCEEDED(st))
             return fail(&a, "projection", st);
         lidet_proj_image(&g_proj, &img);
+#if HAVE_GROUND_STAGE
+        if (use_stage)
+        {
+            t0 = cli_now_ms();
+            st = lidet_ground_run(&g_gnd, &img);
+            t_gnd[i] = cli_now_ms() - t0;
+            if (!LIDET_SUCCEEDED(st))
+                return fail(&a, "ground", st);
+            memcpy(g_ground, lidet_ground_mask(&g_gnd), npix);
+            planes = lidet_ground_planes(&g_gnd, &n_sectors);
+        }
+#endif
         t0 = cli_now_ms();
-        st = lidet_cluster_run(&g_cl, &img, g_ground, NULL, 0);
+        st = lidet_cluster_run(&g_cl, &img, g_ground, planes, n_sectors);
         t_clu[i] = cli_now_ms() - t0;
         if (!LIDET_SUCCEEDED(st))
             return fail(&a, "clustering", st);
@@ -202,6 +238,8 @@ int cli_cluster(int argc, char **argv)
     ms_proj = cli_median(t_proj, a.repeat);
     ms_clu = cli_median(t_clu, a.repeat);
     ms_prop = cli_median(t_prop, a.repeat);
+    if (use_stage)
+        ms_gnd = cli_median(t_gnd, a.repeat);
     free(t_proj);
     cs = lidet_cluster_stats(&g_cl);
     pp = lidet_proj_point_pixels(&g_proj, &n_pp);
@@ -232,7 +270,7 @@ int cli_cluster(int argc, char **argv)
         cli_json_begin(stdout);
         cli_json_str(stdout, "sensor", a.sensor);
         cli_json_int(stdout, "points", a.n_points);
-        cli_json_str(stdout, "ground", labels_path != NULL ? "labels" : "flat");
+        cli_json_str(stdout, "ground", labels_path != NULL ? "labels" : (use_stage ? "stage" : "flat"));
         cli_json_int(stdout, "candidates", cs->n_candidates);
         cli_json_int(stdout, "found", cs->n_found);
         cli_json_int(stdout, "dropped_small", cs->n_dropped_small);
@@ -246,16 +284,18 @@ int cli_cluster(int argc, char **argv)
         cli_json_int(stdout, "max_steps", ccfg.max_steps);
         cli_json_int(stdout, "repeat", a.repeat);
         cli_json_num(stdout, "project_ms", ms_proj);
+        if (use_stage)
+            cli_json_num(stdout, "ground_ms", ms_gnd);
         cli_json_num(stdout, "cluster_ms", ms_clu);
         cli_json_num(stdout, "proposal_ms", ms_prop);
-        cli_json_num(stdout, "total_ms", ms_proj + ms_clu + ms_prop);
+        cli_json_num(stdout, "total_ms", ms_proj + ms_gnd + ms_clu + ms_prop);
         cli_json_end(stdout);
     }
     else
     {
         printf("scan            %s (%s)\n", a.scan_path, a.sensor);
         printf("points          %u, non-ground pixels %u (ground: %s)\n", a.n_points, cs->n_candidates,
-               labels_path != NULL ? labels_path : "flat");
+               labels_path != NULL ? labels_path : (use_stage ? "ground stage" : "flat"));
         printf("clusters        %u kept of %u found (dropped: small %u, extent %u, height %u, capacity %u)\n",
                cs->n_kept, cs->n_found, cs->n_dropped_small, cs->n_dropped_extent, cs->n_dropped_height,
                cs->n_dropped_capacity);
