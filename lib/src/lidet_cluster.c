@@ -23,19 +23,20 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
         return;
     }
     memset(cfg, 0, sizeof *cfg);
-    /* measured on simulated (20 + 20 scans) and real SemanticKITTI scans, docs/BENCHMARKS.md: dense
-     * sensors (> 16 beams) recover most objects whole with a wider angle, short bridging and the
-     * occluder rule; sparse 16-beam images do best with a smaller angle and no occluder rule (rows
-     * 2 deg apart already bridge far) */
+    /* measured on simulated (20 + 20 scans) and real SemanticKITTI scans, docs/BENCHMARKS.md: the
+     * 8-neighbourhood keeps the sparse, dotted returns of car bodies together on every profile; dense
+     * sensors (> 16 beams) do best with a wider angle, short bridging and the occluder rule; sparse
+     * 16-beam images with a smaller angle and no occluder rule (rows 2 deg apart already bridge far) */
+    cfg->diagonals = 1;
     if (sensor != 0 && sensor->n_rows <= 16)
     {
-        cfg->theta_rad = 0.25f;
+        cfg->theta_rad = 0.30f;
         cfg->max_steps = 3u;
         cfg->bridge_occluders = 0;
     }
     else
     {
-        cfg->theta_rad = 0.35f;
+        cfg->theta_rad = 0.40f;
         cfg->max_steps = 5u;
         cfg->bridge_occluders = 1;
     }
@@ -99,6 +100,18 @@ static void setup_geometry(lidet_cluster_t *c, const lidet_range_image_t *img)
             a = a < 0.0f ? -a : a;
             c->row_sin[r * STEPS + k - 1] = sinf(a);
             c->row_cos[r * STEPS + k - 1] = cosf(a);
+        }
+    }
+    /* diagonal pairs (r, c) - (r + 1, c +- 1): cos of the angle between the two beam directions */
+    {
+        const float cd = cosf(2.0f * LIDET_PI_F / (float)cols);
+        for (r = 0; r + 1 < rows; ++r)
+        {
+            const float e1 = img->row_elev_rad[r], e2 = img->row_elev_rad[r + 1];
+            float cs = sinf(e1) * sinf(e2) + cosf(e1) * cosf(e2) * cd;
+            cs = cs > 1.0f ? 1.0f : (cs < -1.0f ? -1.0f : cs);
+            c->diag_cos[r] = cs;
+            c->diag_sin[r] = sqrtf(1.0f - cs * cs);
         }
     }
     c->geo_rows = (uint16_t)rows;
@@ -329,7 +342,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     uint16_t *lab;
     int32_t *mem;
     float tan_theta;
-    int occl;
+    int occl, diag;
     float gap2;
     lidet_cluster_stats_t st;
 
@@ -362,6 +375,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     tan_theta = c->tan_theta;
     occl = c->cfg.bridge_occluders != 0;
     gap2 = c->cfg.max_gap_m * c->cfg.max_gap_m;
+    diag = c->cfg.diagonals != 0;
     kc = c->cfg.max_steps < cols - 1 ? c->cfg.max_steps : cols - 1; /* never wrap onto itself */
 
     for (p = 0; p < npix; ++p)
@@ -467,6 +481,26 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 }
                 if (!(occl && img->range_m[n] < d))
                     break; /* a surface behind, or occluders not bridged: stop */
+            }
+            /* diagonals (8-neighbourhood option): direct neighbours only, no bridging */
+            if (diag)
+            {
+                const uint32_t cl = col > 0 ? col - 1 : cols - 1, cr = col + 1 < cols ? col + 1 : 0;
+                uint32_t j;
+                for (j = 0; j < 4; ++j)
+                {
+                    const int down = j < 2;
+                    uint32_t n, e;
+                    if (down ? r + 1 >= rows : r == 0)
+                        continue;
+                    n = (down ? rowbase + cols : rowbase - cols) + ((j & 1u) ? cr : cl);
+                    e = down ? r : r - 1;
+                    if (lab[n] == LAB_FREE && link(img, q, n, gap2, c->diag_sin[e], c->diag_cos[e], tan_theta))
+                    {
+                        lab[n] = (uint16_t)LAB_PENDING;
+                        mem[tail++] = (int32_t)n;
+                    }
+                }
             }
         }
         tail = finish_cluster(c, start, tail, planes, n_sectors, &st);

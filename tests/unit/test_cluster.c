@@ -140,6 +140,34 @@ static void test_occluder_bridging(void)
     expect_labels(want_split, 3);
 }
 
+/* diagonals: a staircase of returns (every other pixel missing) joins in the 8-neighbourhood only;
+ * the diagonal search also wraps around the seam */
+static void test_diagonals(void)
+{
+    static const char *const art[] = {
+        "c.....................c.........",
+        ".c.....................c........",
+        "..c.....................c.......",
+        ".......................c.......c",
+        "c...............................",
+    };
+    static const char *const want8[] = {
+        "10000000000000000000002000000000",
+        "01000000000000000000000200000000",
+        "00100000000000000000000020000000",
+        "00000000000000000000000200000003",
+        "30000000000000000000000000000000",
+    };
+    cfg.diagonals = 1;
+    cfg.max_steps = 1;
+    run(art, 5, NULL);
+    expect_labels(want8, 5);
+    TEST_ASSERT_EQUAL_UINT32(3, lidet_cluster_stats(&g.ws)->n_kept);
+    cfg.diagonals = 0;
+    run(art, 5, NULL);
+    TEST_ASSERT_EQUAL_UINT32(9, lidet_cluster_stats(&g.ws)->n_kept);
+}
+
 /* max_gap_m: neighbours further apart than the gap do not join even when the angle test passes */
 static void test_max_gap(void)
 {
@@ -372,6 +400,7 @@ static void test_defaults_per_profile(void)
     TEST_ASSERT_EQUAL_UINT32(10, d.min_points);
     TEST_ASSERT_EQUAL_UINT32(5, d.max_steps);
     TEST_ASSERT_EQUAL_UINT32(1, d.bridge_occluders);
+    TEST_ASSERT_EQUAL_UINT32(1, d.diagonals);
     TEST_ASSERT_CLOSE(1.73, d.mount_height_m, 1e-3, 0);
     TEST_ASSERT_TRUE(d.theta_rad > 0.0f && d.theta_rad < 0.8f);
     lidet_cluster_cfg_default(&d, lidet_sensor_find("vlp16"));
@@ -476,6 +505,7 @@ int main(void)
     RUN_TEST(test_slanted_surface_joins);
     RUN_TEST(test_hole_joins);
     RUN_TEST(test_occluder_bridging);
+    RUN_TEST(test_diagonals);
     RUN_TEST(test_max_gap);
     RUN_TEST(test_vertical_hole_and_ground);
     RUN_TEST(test_wraparound_joins);

@@ -191,8 +191,8 @@ def project(points, sensor: str | Sensor = "hdl64", ring=None, **cfg) -> RangeIm
 def cluster_defaults(sensor: str | Sensor = "hdl64") -> dict:
     s = get_sensor(sensor) if isinstance(sensor, str) else sensor
     sparse = s.rows <= 16
-    return dict(theta_rad=0.25 if sparse else 0.35, max_steps=3 if sparse else 5, bridge_occluders=0 if sparse else 1,
-                max_gap_m=0.0, min_points=10, max_extent_m=6.0,
+    return dict(theta_rad=0.30 if sparse else 0.40, max_steps=3 if sparse else 5, bridge_occluders=0 if sparse else 1,
+                diagonals=1, max_gap_m=0.0, min_points=10, max_extent_m=6.0,
                 max_mean_height_m=2.5, mount_height_m=float(s.mount_height_m))
 
 
@@ -251,7 +251,8 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
         pl = np.ascontiguousarray(planes, dtype=np.float32).reshape(-1, 4)
     cfg_f = np.array([c["theta_rad"], c["max_extent_m"], c["max_mean_height_m"], c["mount_height_m"],
                       c["max_gap_m"]], np.float32)
-    cfg_u = np.array([c["max_steps"], c["min_points"], int(bool(c["bridge_occluders"]))], np.uint32)
+    cfg_u = np.array([c["max_steps"], c["min_points"], int(bool(c["bridge_occluders"])), int(bool(c["diagonals"]))],
+                     np.uint32)
     pl_out = np.zeros(n, np.uint32)
     pix = np.zeros((rows, cols), np.uint16)
     mem = np.zeros(rows * cols, np.int32)

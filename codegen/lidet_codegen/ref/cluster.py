@@ -76,7 +76,7 @@ def make_proposal(member_xyz: np.ndarray, mean=None, n_points: int = 64, seed: i
 
 
 def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.ndarray, xyz: np.ndarray,
-                theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, max_gap_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
+                theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, diagonals: bool = True, max_gap_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
                 max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
@@ -95,6 +95,14 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
     def row_sc(r_top, k):
         a = np.float32(abs(np.float32(elev[r_top]) - np.float32(elev[r_top + k])))
         return np.float32(np.sin(a)), np.float32(np.cos(a))
+
+    cd = np.float32(np.cos(np.float32(2.0 * np.pi / cols)))
+
+    def diag_sc(r_top):
+        e1, e2 = np.float32(elev[r_top]), np.float32(elev[r_top + 1])
+        cs = np.float32(np.sin(e1) * np.sin(e2) + np.cos(e1) * np.cos(e2) * cd)
+        cs = np.float32(min(max(cs, -1.0), 1.0))
+        return np.float32(np.sqrt(np.float32(1.0) - cs * cs)), cs
 
     def joins(da, db, sn, cs):
         d1, d2 = (da, db) if da > db else (db, da)
@@ -144,6 +152,24 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                         q.append(n)
                 elif not (bridge_occluders and rng[n] < d):
                     done.add(name)  # a surface behind it: stop; a nearer occluder is stepped over
+            if diagonals:  # direct diagonal neighbours: down-left, down-right, up-left, up-right
+                for dr, dc in ((1, -1), (1, 1), (-1, -1), (-1, 1)):
+                    rr = r + dr
+                    if rr < 0 or rr >= rows:
+                        continue
+                    n = rr * cols + (c + dc) % cols
+                    if state[n] != 0:
+                        continue
+                    sn, cs = diag_sc(r if dr > 0 else r - 1)
+                    ok = joins(d, rng[n], sn, cs)
+                    if ok and max_gap_m > 0:
+                        dd = (np.asarray(xyz, np.float32).reshape(-1, 3)[p]
+                              - np.asarray(xyz, np.float32).reshape(-1, 3)[n])
+                        ok = float(np.dot(dd, dd)) <= float(np.float32(max_gap_m) ** 2)
+                    if ok:
+                        state[n] = -1
+                        mem.append(n)
+                        q.append(n)
         m = np.array(mem)
         if len(m) < min_points:
             continue

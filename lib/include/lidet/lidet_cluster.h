@@ -6,8 +6,9 @@
  *
  * Algorithm (Bogoslavskyi & Stachniss 2016, in the variant of Seppänen et al.):
  *  - candidates: pixels holding a point (point_idx >= 0) that the ground mask does not mark;
- *  - BFS flood fill from every unvisited candidate in raster order, 4-neighbourhood; columns wrap
- *    around (col 0 and col n_cols - 1 are neighbours), rows do not;
+ *  - BFS flood fill from every unvisited candidate in raster order, 4-neighbourhood (plus the four
+ *    diagonal neighbours with `diagonals`, tested at the true angle between the two beams); columns
+ *    wrap around (col 0 and col n_cols - 1 are neighbours), rows do not;
  *  - hole bridging: in each direction the search steps over pixels that are not candidates (no
  *    return, or ground) up to `max_steps` pixels away and tests the first candidate it meets; the
  *    angle alpha between the two beams grows with the steps (columns: k * 2 pi / n_cols; rows: the
@@ -16,7 +17,7 @@
  *    pixel is stepped over like a hole (the search goes on behind it, still up to max_steps, testing
  *    each further candidate at the wider angle, the occluder's own continuation included). A stricter
  *    variant that never re-tests nearer pixels separates overlapping parked cars better but measured
- *    lower recovery overall (simulated hdl64 cars within 40 m: 58 % instead of 74 % at 0.35 rad);
+ *    lower recovery overall (simulated hdl64 cars within 40 m, 4-neighbourhood: 58 % instead of 74 % at 0.35 rad);
  *  - join test: with d1 the larger and d2 the smaller range, beta = atan2(d2 sin a, d1 - d2 cos a);
  *    join when beta > theta. No atan2 at run time: sin/cos of every alpha are precomputed in init
  *    and the test is d2 sin a > tan(theta) (d1 - d2 cos a) (always true when the bracket is <= 0);
@@ -66,8 +67,8 @@ extern "C" {
 typedef struct
 {
     float theta_rad;         /**< join when beta > theta; (0, pi/2). Defaults per profile (measured,
-                                  docs/BENCHMARKS.md): > 16 beams (hdl64, vlp32c, os1) 0.35 rad,
-                                  <= 16 beams (vlp16) 0.25 rad */
+                                  docs/BENCHMARKS.md): > 16 beams (hdl64, vlp32c, os1) 0.40 rad,
+                                  <= 16 beams (vlp16) 0.30 rad; the authors used 0.4 / 0.15 */
     uint32_t max_steps;      /**< hole bridging: search up to this many pixels away in each direction
                                   (1 = direct neighbours only); [1, LIDET_CLUSTER_MAX_STEPS]; default 5
                                   (> 16 beams), 3 (<= 16 beams); the authors used 9 */
@@ -76,6 +77,9 @@ typedef struct
                                   object), so objects seen through occluders stay whole; 0: stop at
                                   the first candidate (the authors' variant). Default 1 for > 16 beams,
                                   0 for <= 16 beams (measured) */
+    uint32_t diagonals;      /**< 1 (default, measured): also test the 4 diagonal neighbours
+                                  (8-neighbourhood; no bridging on them); 0: the 4-neighbourhood of
+                                  the paper and of depth_clustering */
     float max_gap_m;         /**< 0 (default): the angle test alone; > 0: neighbours also need a 3D
                                   distance <= max_gap_m (metres) to join */
     uint32_t min_points;     /**< drop clusters with fewer pixels; >= 1, default 10 */
@@ -125,6 +129,7 @@ typedef struct
     float col_sin[LIDET_CLUSTER_MAX_STEPS], col_cos[LIDET_CLUSTER_MAX_STEPS]; /* alpha = k 2pi/cols */
     float row_sin[LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS];  /* [r * STEPS + k - 1]: rows r, r + k */
     float row_cos[LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS];
+    float diag_sin[LIDET_MAX_ROWS], diag_cos[LIDET_MAX_ROWS]; /* [r]: rows r, r + 1, one column apart */
     /* outputs of the last run */
     uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];    /* per pixel, canonical id, 0 = none */
     int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];    /* member pixels, cluster after cluster */
