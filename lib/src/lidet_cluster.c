@@ -142,6 +142,28 @@ static inline int link(const lidet_range_image_t *img, uint32_t q, uint32_t n, f
     return 1;
 }
 
+/* One step of a directional search that met candidate n (q: the pixel being expanded). Joins n
+ * when it is free and passes the test. Returns 1 when the search goes on behind n (n is a nearer
+ * occluder that fails the test, with occluder bridging on), 0 when it stops there. A visited n is
+ * only tested when that decides between the two (joining it again would change nothing). */
+static inline int probe(lidet_cluster_t *c, uint32_t q, uint32_t n, float sn, float cs, float tan_theta,
+                        float gap2, int occl, uint32_t *tail)
+{
+    const lidet_range_image_t *img = &c->img;
+    const int nearer = img->range_m[n] < img->range_m[q];
+    if (c->labels[n] != LAB_FREE)
+    {
+        return occl && nearer && !link(img, q, n, gap2, sn, cs, tan_theta);
+    }
+    if (link(img, q, n, gap2, sn, cs, tan_theta))
+    {
+        c->labels[n] = (uint16_t)LAB_PENDING;
+        c->members[(*tail)++] = (int32_t)n;
+        return 0;
+    }
+    return occl && nearer;
+}
+
 /* the smallest kept cluster (ties: the later seed), the one capacity drops first */
 static uint32_t smallest_slot(const lidet_cluster_t *c)
 {
@@ -401,7 +423,6 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
         {
             const uint32_t q = (uint32_t)mem[head++];
             const uint32_t r = q / cols, col = q - r * cols, rowbase = r * cols;
-            const float d = img->range_m[q];
             uint32_t k;
             LIDET_ASSERT(tail <= npix);
             /* right (wrapping) */
@@ -413,17 +434,8 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 n = rowbase + cc;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (link(img, q, n, gap2, c->col_sin[k - 1], c->col_cos[k - 1], tan_theta))
-                {
-                    if (lab[n] == LAB_FREE)
-                    {
-                        lab[n] = (uint16_t)LAB_PENDING;
-                        mem[tail++] = (int32_t)n;
-                    }
+                if (!probe(c, q, n, c->col_sin[k - 1], c->col_cos[k - 1], tan_theta, gap2, occl, &tail))
                     break;
-                }
-                if (!(occl && img->range_m[n] < d))
-                    break; /* a surface behind, or occluders not bridged: stop */
             }
             /* left (wrapping) */
             for (k = 1; k <= kc; ++k)
@@ -432,36 +444,18 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 const uint32_t n = rowbase + cc;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (link(img, q, n, gap2, c->col_sin[k - 1], c->col_cos[k - 1], tan_theta))
-                {
-                    if (lab[n] == LAB_FREE)
-                    {
-                        lab[n] = (uint16_t)LAB_PENDING;
-                        mem[tail++] = (int32_t)n;
-                    }
+                if (!probe(c, q, n, c->col_sin[k - 1], c->col_cos[k - 1], tan_theta, gap2, occl, &tail))
                     break;
-                }
-                if (!(occl && img->range_m[n] < d))
-                    break; /* a surface behind, or occluders not bridged: stop */
             }
             /* down: rows r and r + k */
             for (k = 1; k <= c->cfg.max_steps && r + k < rows; ++k)
             {
                 const uint32_t n = q + k * cols;
+                const uint32_t e = r * STEPS + k - 1;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (link(img, q, n, gap2, c->row_sin[r * STEPS + k - 1], c->row_cos[r * STEPS + k - 1],
-                          tan_theta))
-                {
-                    if (lab[n] == LAB_FREE)
-                    {
-                        lab[n] = (uint16_t)LAB_PENDING;
-                        mem[tail++] = (int32_t)n;
-                    }
+                if (!probe(c, q, n, c->row_sin[e], c->row_cos[e], tan_theta, gap2, occl, &tail))
                     break;
-                }
-                if (!(occl && img->range_m[n] < d))
-                    break; /* a surface behind, or occluders not bridged: stop */
             }
             /* up: rows r - k and r (the pair's entry is stored at the upper row) */
             for (k = 1; k <= c->cfg.max_steps && k <= r; ++k)
@@ -470,17 +464,8 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
                 const uint32_t e = (r - k) * STEPS + k - 1;
                 if (lab[n] == LAB_NONCAND)
                     continue;
-                if (link(img, q, n, gap2, c->row_sin[e], c->row_cos[e], tan_theta))
-                {
-                    if (lab[n] == LAB_FREE)
-                    {
-                        lab[n] = (uint16_t)LAB_PENDING;
-                        mem[tail++] = (int32_t)n;
-                    }
+                if (!probe(c, q, n, c->row_sin[e], c->row_cos[e], tan_theta, gap2, occl, &tail))
                     break;
-                }
-                if (!(occl && img->range_m[n] < d))
-                    break; /* a surface behind, or occluders not bridged: stop */
             }
             /* diagonals (8-neighbourhood option): direct neighbours only, no bridging */
             if (diag)
