@@ -184,6 +184,8 @@ def main(argv=None) -> int:
                     help="ground mask: SemanticKITTI ground classes (isolates the clustering), or a flat cut")
     ap.add_argument("--theta", type=float, default=None, help="theta_rad (default: the profile's)")
     ap.add_argument("--max-steps", type=int, default=None)
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="any other cluster option, e.g. --set diagonals=0 --set bridge_occluders=0")
     ap.add_argument("--json", action="store_true", help="print the summary as JSON")
     a = ap.parse_args(argv)
     cfg = {}
@@ -191,6 +193,9 @@ def main(argv=None) -> int:
         cfg["theta_rad"] = a.theta
     if a.max_steps is not None:
         cfg["max_steps"] = a.max_steps
+    for kv in a.set:
+        k, _, v = kv.partition("=")
+        cfg[k] = float(v) if "." in v or "e" in v.lower() else int(v)
     res = evaluate_lidet(a.data, a.sensor, a.ground, **cfg)
     if not res:
         print(f"no labelled road users with >= 10 points under {a.data}", file=sys.stderr)
