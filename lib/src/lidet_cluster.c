@@ -36,7 +36,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     }
     else
     {
-        cfg->theta_rad = 0.40f;
+        cfg->theta_rad = 0.35f;
         cfg->max_steps = 5u;
         cfg->bridge_occluders = 1;
     }

@@ -66,7 +66,7 @@ def test_synthetic_objects_are_separate_clusters():
 
 def test_defaults_and_options():
     d = native.cluster_defaults("hdl64")
-    assert d["min_points"] == 10 and d["max_steps"] == 5 and d["theta_rad"] == 0.40 and d["diagonals"] == 1
+    assert d["min_points"] == 10 and d["max_steps"] == 5 and d["theta_rad"] == 0.35 and d["diagonals"] == 1
     assert native.cluster_defaults("vlp16")["theta_rad"] == 0.30
     pts, ground, _, _ = _synthetic()
     a = native.cluster(pts, "hdl64", ground=ground, min_points=100000)

@@ -122,7 +122,7 @@ def run(args) -> str:
             n = len(list((d / "velodyne").glob("*.bin")))
             sets.append((f"simulated {sensor} ({n} scans, lidet-sim seed {SIM_SEED[sensor]})", d, sensor))
     lines = ["## Clustering (issue 6)", "",
-             "lidet depth clustering (per-profile defaults, 8-neighbourhood: > 16 beams theta 0.40 rad, 5 steps, "
+             "lidet depth clustering (per-profile defaults, 8-neighbourhood: > 16 beams theta 0.35 rad, 5 steps, "
              "occluder bridging; 16 beams theta 0.30 rad, 3 steps) versus Open3D DBSCAN (eps 0.5 m, min_points 10) on the "
              "same non-ground points (ground = the labels' ground classes). Recovered = the best-matching cluster "
              "holds >= 80 % of the object's points and >= 80 % of the cluster is the object; objects with >= 10 "

@@ -191,7 +191,7 @@ def project(points, sensor: str | Sensor = "hdl64", ring=None, **cfg) -> RangeIm
 def cluster_defaults(sensor: str | Sensor = "hdl64") -> dict:
     s = get_sensor(sensor) if isinstance(sensor, str) else sensor
     sparse = s.rows <= 16
-    return dict(theta_rad=0.30 if sparse else 0.40, max_steps=3 if sparse else 5, bridge_occluders=0 if sparse else 1,
+    return dict(theta_rad=0.30 if sparse else 0.35, max_steps=3 if sparse else 5, bridge_occluders=0 if sparse else 1,
                 diagonals=1, max_gap_m=0.0, min_points=10, max_extent_m=6.0,
                 max_mean_height_m=2.5, mount_height_m=float(s.mount_height_m))
 

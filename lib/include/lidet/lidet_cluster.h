@@ -67,7 +67,7 @@ extern "C" {
 typedef struct
 {
     float theta_rad;         /**< join when beta > theta; (0, pi/2). Defaults per profile (measured,
-                                  docs/BENCHMARKS.md): > 16 beams (hdl64, vlp32c, os1) 0.40 rad,
+                                  docs/BENCHMARKS.md): > 16 beams (hdl64, vlp32c, os1) 0.35 rad,
                                   <= 16 beams (vlp16) 0.30 rad; the authors used 0.4 / 0.15 */
     uint32_t max_steps;      /**< hole bridging: search up to this many pixels away in each direction
                                   (1 = direct neighbours only); [1, LIDET_CLUSTER_MAX_STEPS]; default 5
