@@ -44,6 +44,7 @@ void cli_json_end(FILE *f);
 /* Subcommands */
 int cli_project(int argc, char **argv);
 int cli_ground(int argc, char **argv);
+int cli_cluster(int argc, char **argv);
 
 /* PNG writer (8-bit RGB, no compression library needed). Returns 0 or -1. */
 int lidet_png_write_rgb(const char *path, const uint8_t *rgb, uint32_t width, uint32_t height);

@@ -14,6 +14,7 @@ typedef struct
 static const cli_cmd_t k_cmds[] = {
     {"project", cli_project, "spherical projection: points -> range image"},
     {"ground", cli_ground, "ground segmentation: points -> ground mask per point"},
+    {"cluster", cli_cluster, "depth clustering + proposals: non-ground pixels -> clusters"},
 };
 
 int main(int argc, char **argv)

@@ -77,17 +77,27 @@ LIDET_PY_API int lidet_py_proj_init(uint32_t rows, uint32_t cols, const float *e
 /* Run the projection; copy the image out. out_img: 5 * rows * cols floats (x, y, z, range, rxy planes),
  * out_idx: rows * cols int32, out_point_pixel: min(n, LIDET_MAX_POINTS) int32, out_stats: 9 uint32,
  * out_row_elev: rows floats. Any output may be NULL. */
+static int lidet_py_proj_run_outputs(float *out_img, int32_t *out_idx, int32_t *out_point_pixel,
+                                     uint32_t *out_stats, float *out_row_elev);
+
 LIDET_PY_API int lidet_py_proj_run(const float *pts, uint32_t n, uint32_t stride, const uint16_t *ring,
                                    float *out_img, int32_t *out_idx, int32_t *out_point_pixel, uint32_t *out_stats,
                                    float *out_row_elev)
+{
+    const int rc = lidet_proj_run(&g_proj, pts, n, stride, ring);
+    if (rc < 0)
+        return rc;
+    lidet_py_proj_run_outputs(out_img, out_idx, out_point_pixel, out_stats, out_row_elev);
+    return rc;
+}
+
+static int lidet_py_proj_run_outputs(float *out_img, int32_t *out_idx, int32_t *out_point_pixel,
+                                     uint32_t *out_stats, float *out_row_elev)
 {
     lidet_range_image_t img;
     const lidet_proj_stats_t *st;
     uint32_t npix, np;
     const int32_t *pp;
-    const int rc = lidet_proj_run(&g_proj, pts, n, stride, ring);
-    if (rc < 0)
-        return rc;
     lidet_proj_image(&g_proj, &img);
     npix = (uint32_t)img.n_rows * img.n_cols;
     if (out_img != NULL)
@@ -118,7 +128,7 @@ LIDET_PY_API int lidet_py_proj_run(const float *pts, uint32_t n, uint32_t stride
     }
     if (out_row_elev != NULL)
         memcpy(out_row_elev, img.row_elev_rad, img.n_rows * sizeof(float));
-    return rc;
+    return 0;
 }
 
 /* ---- ground stage ------------------------------------------------------------------------------
@@ -311,4 +321,159 @@ LIDET_PY_API int lidet_py_ground_fit_plane(const float *x, const float *y, const
 LIDET_PY_API const char *lidet_py_status_str(int status)
 {
     return lidet_status_str((lidet_status_t)status);
+}
+
+/* ---- clustering + proposals ------------------------------------------------------------------ */
+static lidet_cluster_t g_cluster;
+static uint8_t g_ground_pix[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+
+/* Project with the state of lidet_py_proj_init, then cluster. ground_per_point: n bytes (1 = ground)
+ * or NULL; a pixel is ground when its winning point is. planes: n_sectors * 4 floats (nx, ny, nz, d)
+ * or NULL. cfg_f: theta_rad, max_extent_m, max_mean_height_m, mount_height_m,
+ * max_gap_m; cfg_u: max_steps,
+ * min_points, bridge_occluders, diagonals. Outputs (any may be NULL): out_point_labels n uint32 (0 for points past capacity),
+ * out_pixel_labels rows * cols uint16, out_members rows * cols int32 (first n_pixels_kept used),
+ * out_rec_u max_recs * 3 uint32 (n_points, first_member, seed_pixel), out_rec_f max_recs * 10 floats
+ * (mean xyz, min xyz, max xyz, height), out_n_recs, out_stats 9 uint32 (lidet_cluster_stats_t order). */
+LIDET_PY_API int lidet_py_cluster_run(const float *pts, uint32_t n, uint32_t stride, const uint8_t *ground_per_point,
+                                      const float *planes, uint32_t n_sectors, const float *cfg_f,
+                                      const uint32_t *cfg_u, uint32_t *out_point_labels, uint16_t *out_pixel_labels,
+                                      int32_t *out_members, uint32_t *out_rec_u, float *out_rec_f, uint32_t max_recs,
+                                      uint32_t *out_n_recs, uint32_t *out_stats)
+{
+    lidet_range_image_t img;
+    lidet_cluster_cfg_t cfg;
+    lidet_plane_t pl[256];
+    const lidet_cluster_rec_t *rec;
+    const lidet_cluster_stats_t *st;
+    uint32_t npix, p, k, np;
+    const int32_t *pp;
+    int rc;
+    rc = lidet_proj_run(&g_proj, pts, n, stride, NULL);
+    if (rc < 0)
+        return rc;
+    lidet_proj_image(&g_proj, &img);
+    npix = (uint32_t)img.n_rows * img.n_cols;
+    if (ground_per_point != NULL)
+    {
+        for (p = 0; p < npix; ++p)
+            g_ground_pix[p] = (uint8_t)(img.point_idx[p] >= 0 && ground_per_point[img.point_idx[p]] != 0);
+    }
+    if (planes != NULL)
+    {
+        if (n_sectors == 0 || n_sectors > 256)
+            return LIDET_ERR_ARG;
+        for (k = 0; k < n_sectors; ++k)
+        {
+            pl[k].nx = planes[4 * k];
+            pl[k].ny = planes[4 * k + 1];
+            pl[k].nz = planes[4 * k + 2];
+            pl[k].d_m = planes[4 * k + 3];
+        }
+    }
+    lidet_cluster_cfg_default(&cfg, NULL);
+    cfg.theta_rad = cfg_f[0];
+    cfg.max_extent_m = cfg_f[1];
+    cfg.max_mean_height_m = cfg_f[2];
+    cfg.mount_height_m = cfg_f[3];
+    cfg.max_gap_m = cfg_f[4];
+    cfg.max_steps = cfg_u[0];
+    cfg.min_points = cfg_u[1];
+    cfg.bridge_occluders = cfg_u[2];
+    cfg.diagonals = cfg_u[3];
+    rc = lidet_cluster_init(&g_cluster, &cfg);
+    if (rc < 0)
+        return rc;
+    rc = lidet_cluster_run(&g_cluster, &img, ground_per_point != NULL ? g_ground_pix : NULL,
+                           planes != NULL ? pl : NULL, n_sectors);
+    if (rc < 0)
+        return rc;
+    pp = lidet_proj_point_pixels(&g_proj, &np);
+    if (out_point_labels != NULL)
+    {
+        lidet_cluster_point_labels(&g_cluster, pp, np, out_point_labels);
+        for (p = np; p < n; ++p)
+            out_point_labels[p] = 0;
+    }
+    if (out_pixel_labels != NULL)
+        memcpy(out_pixel_labels, lidet_cluster_labels(&g_cluster), npix * sizeof(uint16_t));
+    st = lidet_cluster_stats(&g_cluster);
+    if (out_members != NULL)
+        memcpy(out_members, lidet_cluster_members(&g_cluster), st->n_pixels_kept * sizeof(int32_t));
+    rec = lidet_cluster_records(&g_cluster, &k);
+    if (out_n_recs != NULL)
+        *out_n_recs = k;
+    for (p = 0; p < k && p < max_recs; ++p)
+    {
+        if (out_rec_u != NULL)
+        {
+            out_rec_u[3 * p] = rec[p].n_points;
+            out_rec_u[3 * p + 1] = rec[p].first_member;
+            out_rec_u[3 * p + 2] = rec[p].seed_pixel;
+        }
+        if (out_rec_f != NULL)
+        {
+            float *f = out_rec_f + 10 * p;
+            memcpy(f, rec[p].mean_m, 3 * sizeof(float));
+            memcpy(f + 3, rec[p].min_m, 3 * sizeof(float));
+            memcpy(f + 6, rec[p].max_m, 3 * sizeof(float));
+            f[9] = rec[p].height_m;
+        }
+    }
+    if (out_stats != NULL)
+    {
+        out_stats[0] = st->n_candidates;
+        out_stats[1] = st->n_found;
+        out_stats[2] = st->n_dropped_small;
+        out_stats[3] = st->n_dropped_extent;
+        out_stats[4] = st->n_dropped_height;
+        out_stats[5] = st->n_dropped_capacity;
+        out_stats[6] = st->n_kept;
+        out_stats[7] = st->n_pixels_kept;
+        out_stats[8] = st->n_queue_overflow;
+    }
+    return rc;
+}
+
+/* Proposals of every kept cluster of the last lidet_py_cluster_run (its scan must still be alive on
+ * the Python side: the range image points into the projection state, which holds copies).
+ * out_xyz: n_clusters * n_points * 3 floats, out_mean: n_clusters * 3, out_voxel: n_clusters * 3
+ * int16, out_n_src: n_clusters uint32. */
+LIDET_PY_API int lidet_py_proposals(uint32_t n_points, uint32_t seed, float az_bin_rad, float el_bin_rad,
+                                    float range_bin_m, uint32_t n_clusters, float *out_xyz, float *out_mean,
+                                    int16_t *out_voxel, uint32_t *out_n_src)
+{
+    static lidet_proposal_t pr;
+    lidet_proposal_cfg_t cfg;
+    uint32_t i;
+    lidet_proposal_cfg_default(&cfg);
+    cfg.n_points = n_points;
+    cfg.seed = seed;
+    cfg.azimuth_bin_rad = az_bin_rad;
+    cfg.elevation_bin_rad = el_bin_rad;
+    cfg.range_bin_m = range_bin_m;
+    for (i = 0; i < n_clusters; ++i)
+    {
+        const int rc = lidet_proposal_make(&g_cluster, i, &cfg, &pr);
+        if (rc < 0)
+            return rc;
+        memcpy(out_xyz + (size_t)i * n_points * 3, pr.xyz, (size_t)n_points * 3 * sizeof(float));
+        memcpy(out_mean + 3 * i, pr.mean_m, 3 * sizeof(float));
+        memcpy(out_voxel + 3 * i, pr.voxel, 3 * sizeof(int16_t));
+        out_n_src[i] = pr.n_points_src;
+    }
+    return 0;
+}
+
+LIDET_PY_API int lidet_py_proposal_indices(uint32_t n_src, uint32_t n_out, uint32_t seed, uint32_t *out)
+{
+    return lidet_proposal_indices(n_src, n_out, seed, out);
+}
+
+/* The image of the last projection, copied out without running again (same layout as
+ * lidet_py_proj_run's outputs; any output may be NULL). */
+LIDET_PY_API int lidet_py_proj_copy(float *out_img, int32_t *out_idx, int32_t *out_point_pixel, uint32_t *out_stats,
+                                    float *out_row_elev)
+{
+    return lidet_py_proj_run_outputs(out_img, out_idx, out_point_pixel, out_stats, out_row_elev);
 }

@@ -82,6 +82,15 @@ def lib():
         L.lidet_py_ground_run.argtypes = [_f32p, _u32p, _opt(_u8p), _opt(_u8p), _opt(_u8p), _opt(_f32p),
                                           _opt(_u8p), _opt(_u32p)]
         L.lidet_py_ground_fit_plane.argtypes = [_f32p, _f32p, _f32p, C.c_uint32, _f32p, _opt(_f32p)]
+        _u16p = np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")
+        _i16p = np.ctypeslib.ndpointer(np.int16, flags="C_CONTIGUOUS")
+        L.lidet_py_cluster_run.argtypes = [_opt(_f32p), C.c_uint32, C.c_uint32, _opt(_u8p), _opt(_f32p),
+                                           C.c_uint32, _f32p, _u32p, _opt(_u32p), _opt(_u16p), _opt(_i32p),
+                                           _opt(_u32p), _opt(_f32p), C.c_uint32, _opt(_u32p), _opt(_u32p)]
+        L.lidet_py_proposals.argtypes = [C.c_uint32, C.c_uint32, C.c_float, C.c_float, C.c_float, C.c_uint32,
+                                         _f32p, _f32p, _i16p, _u32p]
+        L.lidet_py_proj_copy.argtypes = [_opt(_f32p), _opt(_i32p), _opt(_i32p), _opt(_u32p), _opt(_f32p)]
+        L.lidet_py_proposal_indices.argtypes = [C.c_uint32, C.c_uint32, C.c_uint32, _u32p]
         _lib = L
     return _lib
 
@@ -263,3 +272,153 @@ def ground_fit_plane(xyz) -> tuple[np.ndarray, np.ndarray]:
     if st < 0:
         raise LidetError(st, "lidet_ground_fit_plane")
     return plane, eig
+
+
+# ---- clustering and proposals (lib/include/lidet/lidet_cluster.h) -------------------------------
+
+#: per-profile defaults of lidet_cluster_cfg_default (kept identical by tests/python/test_bindings_cluster.py)
+def cluster_defaults(sensor: str | Sensor = "hdl64") -> dict:
+    s = get_sensor(sensor) if isinstance(sensor, str) else sensor
+    sparse = s.rows <= 16
+    return dict(theta_rad=0.30 if sparse else 0.35, max_steps=3 if sparse else 5, bridge_occluders=0 if sparse else 1,
+                diagonals=1, max_gap_m=0.0, min_points=10, max_extent_m=6.0,
+                max_mean_height_m=2.5, mount_height_m=float(s.mount_height_m))
+
+
+_CLUSTER_STAT_KEYS = ["n_candidates", "n_found", "n_dropped_small", "n_dropped_extent", "n_dropped_height",
+                      "n_dropped_capacity", "n_kept", "n_pixels_kept", "n_queue_overflow"]
+
+
+@dataclass
+class Clusters:
+    """Output of `cluster`. Ids are canonical (1-based, raster order of first pixel), 0 = none."""
+    point_labels: np.ndarray  #: (N,) uint32 cluster id per input point, input order
+    pixel_labels: np.ndarray  #: (rows, cols) uint16
+    members: np.ndarray       #: (n_pixels_kept,) int32 flat pixels, cluster after cluster, raster order
+    n_points: np.ndarray      #: (K,) member pixels per cluster
+    first_member: np.ndarray  #: (K,) index into members
+    seed_pixel: np.ndarray    #: (K,) first pixel (raster order)
+    mean: np.ndarray          #: (K, 3) float32
+    min: np.ndarray           #: (K, 3)
+    max: np.ndarray           #: (K, 3)
+    height: np.ndarray        #: (K,) mean height above the ground plane used by the filter
+    stats: dict
+    status: int
+    image: RangeImage | None = None  #: the projection of the same call (when asked for)
+
+    def __len__(self) -> int:
+        return len(self.n_points)
+
+
+def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, with_image: bool = False,
+            proj_cfg: dict | None = None, **cfg) -> Clusters:
+    """Project `points` (N, >=3) and cluster the non-ground pixels with the C library.
+
+    ground: optional (N,) bool/uint8 per point (1 = ground; a pixel is ground when its winning point
+    is), e.g. SemanticKITTI ground labels or the ground stage's per-point mask. planes: optional
+    (S, 4) (nx, ny, nz, d) per azimuth sector for the height filter (None: flat ground at
+    -mount_height_m). cfg: theta_rad, max_steps, bridge_occluders, max_gap_m, min_points, max_extent_m, max_mean_height_m,
+    mount_height_m (defaults: `cluster_defaults(sensor)`).
+    """
+    s = proj_init(sensor, **(proj_cfg or {}))
+    c = cluster_defaults(s)
+    unknown = set(cfg) - set(c)
+    if unknown:
+        raise TypeError(f"unknown cluster option(s): {sorted(unknown)}")
+    c.update(cfg)
+    pts, stride = _as_points(points)
+    n = len(pts)
+    rows, cols = s.rows, s.cols
+    cap = capacity()["max_clusters"]
+    gm = None
+    if ground is not None:
+        gm = np.ascontiguousarray(np.asarray(ground).astype(bool), dtype=np.uint8)
+        if gm.shape != (n,):
+            raise ValueError(f"ground must have one entry per point ({n}), got {gm.shape}")
+    pl = None
+    if planes is not None:
+        pl = np.ascontiguousarray(planes, dtype=np.float32).reshape(-1, 4)
+    cfg_f = np.array([c["theta_rad"], c["max_extent_m"], c["max_mean_height_m"], c["mount_height_m"],
+                      c["max_gap_m"]], np.float32)
+    cfg_u = np.array([c["max_steps"], c["min_points"], int(bool(c["bridge_occluders"])), int(bool(c["diagonals"]))],
+                     np.uint32)
+    pl_out = np.zeros(n, np.uint32)
+    pix = np.zeros((rows, cols), np.uint16)
+    mem = np.zeros(rows * cols, np.int32)
+    ru = np.zeros((cap, 3), np.uint32)
+    rf = np.zeros((cap, 10), np.float32)
+    nrec = np.zeros(1, np.uint32)
+    stats = np.zeros(9, np.uint32)
+    st = lib().lidet_py_cluster_run(pts if n else None, n, stride, gm if n else None, pl,
+                                    0 if pl is None else len(pl), cfg_f, cfg_u, pl_out if n else None, pix, mem,
+                                    ru, rf, cap, nrec, stats)
+    if st < 0:
+        raise LidetError(st, "lidet_cluster_run")
+    k = int(nrec[0])
+    sd = dict(zip(_CLUSTER_STAT_KEYS, map(int, stats)))
+    img = None
+    if with_image:
+        img = _last_image(s, n)
+    return Clusters(pl_out, pix, mem[: sd["n_pixels_kept"]].copy(), ru[:k, 0].copy(), ru[:k, 1].copy(),
+                    ru[:k, 2].copy(), rf[:k, 0:3].copy(), rf[:k, 3:6].copy(), rf[:k, 6:9].copy(),
+                    rf[:k, 9].copy(), sd, int(st), img)
+
+
+def _last_image(s: Sensor, n: int) -> RangeImage:
+    """The range image of the last projection (re-read from the C state without running again)."""
+    rows, cols = s.rows, s.cols
+    img = np.zeros((5, rows, cols), np.float32)
+    idx = np.zeros((rows, cols), np.int32)
+    stats = np.zeros(9, np.uint32)
+    row_elev = np.zeros(rows, np.float32)
+    pp = np.full(n, -1, np.int32)
+    lib().lidet_py_proj_copy(img, idx, pp[: min(n, capacity()["max_points"])] if n else None, stats, row_elev)
+    return RangeImage(img[0], img[1], img[2], img[3], img[4], idx, pp, row_elev,
+                      dict(zip(_STAT_KEYS, map(int, stats))), 0)
+
+
+@dataclass
+class Proposals:
+    """What the PointNets see, one row per kept cluster of the last `cluster` call."""
+    xyz: np.ndarray    #: (K, n_points, 3) float32, centred on `mean`
+    mean: np.ndarray   #: (K, 3) cluster means (sensor frame)
+    voxel: np.ndarray  #: (K, 3) int16 azimuth, elevation, range bins of the mean
+    n_src: np.ndarray  #: (K,) member pixels per cluster
+
+
+def proposal_defaults() -> dict:
+    return dict(n_points=min(64, capacity()["proposal_points"]), seed=0x5EED1234,
+                azimuth_bin_rad=float(np.float32(np.radians(10.0))),
+                elevation_bin_rad=float(np.float32(np.radians(10.0))), range_bin_m=1.0)
+
+
+def proposals(n_clusters: int | None = None, **cfg) -> Proposals:
+    """Proposals of the kept clusters of the last `cluster` call (lidet_proposal_make, exactly as the
+    firmware builds them). cfg: n_points, seed, azimuth_bin_rad, elevation_bin_rad, range_bin_m."""
+    c = proposal_defaults()
+    unknown = set(cfg) - set(c)
+    if unknown:
+        raise TypeError(f"unknown proposal option(s): {sorted(unknown)}")
+    c.update(cfg)
+    if n_clusters is None:
+        raise ValueError("pass n_clusters=len(clusters) of the last cluster() call")
+    k, n = int(n_clusters), int(c["n_points"])
+    xyz = np.zeros((k, n, 3), np.float32)
+    mean = np.zeros((k, 3), np.float32)
+    vox = np.zeros((k, 3), np.int16)
+    nsrc = np.zeros(k, np.uint32)
+    if k:
+        st = lib().lidet_py_proposals(n, int(c["seed"]) & 0xFFFFFFFF, c["azimuth_bin_rad"], c["elevation_bin_rad"],
+                                      c["range_bin_m"], k, xyz, mean, vox, nsrc)
+        if st < 0:
+            raise LidetError(st, "lidet_proposal_make")
+    return Proposals(xyz, mean, vox, nsrc)
+
+
+def proposal_indices(n_src: int, n_out: int, seed: int = 0x5EED1234) -> np.ndarray:
+    """The C resampling rule (lidet_proposal_indices): n_out member indices."""
+    out = np.zeros(n_out, np.uint32)
+    st = lib().lidet_py_proposal_indices(n_src, n_out, seed & 0xFFFFFFFF, out)
+    if st < 0:
+        raise LidetError(st, "lidet_proposal_indices")
+    return out

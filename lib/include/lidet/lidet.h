@@ -26,6 +26,7 @@
 #include "lidet_sensor.h"
 #include "lidet_proj.h"
 #include "lidet_ground.h"
+#include "lidet_cluster.h"
 
 #ifdef __cplusplus
 extern "C" {

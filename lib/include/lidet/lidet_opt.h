@@ -47,6 +47,11 @@
 #define LIDET_PROPOSAL_POINTS 128
 #endif
 
+/** Hole bridging: the most pixels the clustering searches onward in one direction (cfg max_steps <= this). */
+#ifndef LIDET_CLUSTER_MAX_STEPS
+#define LIDET_CLUSTER_MAX_STEPS 16
+#endif
+
 /** Maximum detections reported per scan. */
 #ifndef LIDET_MAX_DETECTIONS
 #define LIDET_MAX_DETECTIONS 128
@@ -91,8 +96,11 @@
 #if (LIDET_MAX_ROWS * LIDET_MAX_COLS) > 2147483647 / 4
 #error "range image too large for int32 pixel indices"
 #endif
-#if LIDET_MAX_CLUSTERS < 1 || LIDET_MAX_CLUSTERS > 65535
-#error "LIDET_MAX_CLUSTERS must be in [1, 65535]"
+#if LIDET_MAX_CLUSTERS < 1 || LIDET_MAX_CLUSTERS > 65533
+#error "LIDET_MAX_CLUSTERS must be in [1, 65533] (cluster ids are uint16; two values mark pixel states)"
+#endif
+#if LIDET_CLUSTER_MAX_STEPS < 1 || LIDET_CLUSTER_MAX_STEPS > 64
+#error "LIDET_CLUSTER_MAX_STEPS must be in [1, 64]"
 #endif
 #if LIDET_PROPOSAL_POINTS < 1 || LIDET_PROPOSAL_POINTS > 4096
 #error "LIDET_PROPOSAL_POINTS must be in [1, 4096]"

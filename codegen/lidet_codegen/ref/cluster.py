@@ -1,0 +1,188 @@
+# SPDX-License-Identifier: MIT
+"""Reference of the clustering stage and of the proposals (mirrors lib/src/lidet_cluster.c and
+lib/src/lidet_proposal.c; the contract is written in lib/include/lidet/lidet_cluster.h).
+
+- `proposal_indices` / `make_proposal` reproduce the C resampling *exactly* (integer xorshift32):
+  training uses them, or the bindings (`lidet_tools.native.proposals`), and both give the same points.
+- `cluster_ref` is a plain-Python BFS with the same rules (4-neighbourhood, hole bridging over
+  non-candidates up to max_steps, optionally over nearer occluders, column wrap, the angle criterion in tangent form, filters, capacity,
+  canonical ids). It is slow (seconds per 64 x 2048 image) and meant for tests.
+"""
+from __future__ import annotations
+
+from collections import deque
+
+import numpy as np
+
+_M32 = 0xFFFFFFFF
+
+
+def xorshift32(x: int) -> int:
+    """One step of the (13, 17, 5) xorshift32 generator (uint32 arithmetic)."""
+    x ^= (x << 13) & _M32
+    x ^= x >> 17
+    x ^= (x << 5) & _M32
+    return x & _M32
+
+
+def proposal_indices(n_src: int, n_out: int, seed: int = 0x5EED1234) -> np.ndarray:
+    """Member indices a proposal takes (lidet_proposal_indices): every member once then draws with
+    replacement when n_src <= n_out; one member per equal stratum otherwise."""
+    if n_src <= 0 or n_out <= 0:
+        raise ValueError("n_src and n_out must be positive")
+    s = (seed ^ ((n_src * 0x9E3779B9) & _M32)) & _M32
+    if s == 0:
+        s = 0x6C646574
+    out = np.empty(n_out, np.int64)
+    if n_src <= n_out:
+        out[:n_src] = np.arange(n_src)
+        for i in range(n_src, n_out):
+            s = xorshift32(s)
+            out[i] = s % n_src
+    else:
+        for i in range(n_out):
+            b0 = (i * n_src) // n_out
+            b1 = ((i + 1) * n_src) // n_out
+            s = xorshift32(s)
+            out[i] = b0 + s % (b1 - b0)
+    return out
+
+
+def voxel_of(mean, azimuth_bin_rad=np.float32(np.radians(10.0)), elevation_bin_rad=np.float32(np.radians(10.0)),
+             range_bin_m=1.0) -> np.ndarray:
+    """PVLE voxel of a cluster mean: floor(azimuth / bin), floor(elevation / bin), floor(range / bin),
+    azimuth = atan2(y, x), elevation = atan2(z, hypot(x, y)); int16, saturating. (float64 here, float32
+    in C: the two can differ only for a mean within float rounding of a bin edge.)"""
+    m = np.asarray(mean, np.float64)
+    x, y, z = m[..., 0], m[..., 1], m[..., 2]
+    rxy = np.hypot(x, y)
+    v = np.stack([np.floor(np.arctan2(y, x) / float(azimuth_bin_rad)),
+                  np.floor(np.arctan2(z, rxy) / float(elevation_bin_rad)),
+                  np.floor(np.sqrt(rxy ** 2 + z ** 2) / float(range_bin_m))], -1)
+    return np.clip(v, -32768, 32767).astype(np.int16)
+
+
+def make_proposal(member_xyz: np.ndarray, mean=None, n_points: int = 64, seed: int = 0x5EED1234,
+                  azimuth_bin_rad=np.float32(np.radians(10.0)), elevation_bin_rad=np.float32(np.radians(10.0)),
+                  range_bin_m: float = 1.0):
+    """A proposal from a cluster's member points (n_src, 3) in member order (raster order of their
+    pixels, as lidet_cluster_members lists them). mean: the cluster mean (default: the float64 mean of
+    the members). Returns (xyz (n_points, 3) float32 centred on the mean, mean float32 (3,), voxel int16 (3,))."""
+    pts = np.asarray(member_xyz, np.float32)
+    mean32 = (pts.astype(np.float64).mean(0) if mean is None else np.asarray(mean, np.float64)).astype(np.float32)
+    idx = proposal_indices(len(pts), n_points, seed)
+    xyz = pts[idx] - mean32  # float32 - float32, as in C
+    return xyz, mean32, voxel_of(mean32, azimuth_bin_rad, elevation_bin_rad, range_bin_m)
+
+
+def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.ndarray, xyz: np.ndarray,
+                theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, diagonals: bool = True, max_gap_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
+                max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30):
+    """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
+    non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
+    member-pixel arrays per kept cluster in raster order). Float32 tangent test like the C."""
+    rows, cols = range_m.shape
+    rng = np.asarray(range_m, np.float32).ravel()
+    cand = np.asarray(candidate, bool).ravel()
+    P = np.asarray(xyz, np.float64).reshape(-1, 3)
+    tan_t = np.float32(np.tan(np.float32(theta_rad)))
+    elev = np.asarray(row_elev_rad, np.float32)
+    ks = np.arange(1, max_steps + 1)
+    a_col = (2.0 * np.pi * (ks % cols) / cols).astype(np.float32)
+    a_col = np.where(a_col > np.float32(np.pi), np.float32(2 * np.pi) - a_col, a_col)
+    csin, ccos = np.sin(a_col).astype(np.float32), np.cos(a_col).astype(np.float32)
+
+    def row_sc(r_top, k):
+        a = np.float32(abs(np.float32(elev[r_top]) - np.float32(elev[r_top + k])))
+        return np.float32(np.sin(a)), np.float32(np.cos(a))
+
+    cd = np.float32(np.cos(np.float32(2.0 * np.pi / cols)))
+
+    def diag_sc(r_top):
+        e1, e2 = np.float32(elev[r_top]), np.float32(elev[r_top + 1])
+        cs = np.float32(np.sin(e1) * np.sin(e2) + np.cos(e1) * np.cos(e2) * cd)
+        cs = np.float32(min(max(cs, -1.0), 1.0))
+        return np.float32(np.sqrt(np.float32(1.0) - cs * cs)), cs
+
+    def joins(da, db, sn, cs):
+        d1, d2 = (da, db) if da > db else (db, da)
+        return np.float32(d2 * sn) > np.float32(tan_t * np.float32(d1 - np.float32(d2 * cs)))
+
+    state = np.where(cand, 0, -2).astype(np.int64)  # 0 free, -2 non-candidate, -1 visited, >0 slot+1
+    kc = min(max_steps, cols - 1)
+    kept = []  # (n, seed, members)
+    for seed in range(rows * cols):
+        if state[seed] != 0:
+            continue
+        state[seed] = -1
+        mem = [seed]
+        q = deque([seed])
+        while q:
+            p = q.popleft()
+            r, c = divmod(p, cols)
+            d = rng[p]
+            dirs = []
+            for k in range(1, kc + 1):
+                dirs.append(("R", k, r * cols + (c + k) % cols))
+            for k in range(1, kc + 1):
+                dirs.append(("L", k, r * cols + (c - k) % cols))
+            for k in range(1, max_steps + 1):
+                if r + k < rows:
+                    dirs.append(("D", k, p + k * cols))
+            for k in range(1, max_steps + 1):
+                if k <= r:
+                    dirs.append(("U", k, p - k * cols))
+            done = set()
+            for name, k, n in dirs:
+                if name in done or state[n] == -2:
+                    continue
+                if name in "RL":
+                    sn, cs = csin[k - 1], ccos[k - 1]
+                else:
+                    sn, cs = row_sc(r if name == "D" else r - k, k)
+                ok = joins(d, rng[n], sn, cs)
+                if ok and max_gap_m > 0:
+                    dd = (np.asarray(xyz, np.float32).reshape(-1, 3)[p] - np.asarray(xyz, np.float32).reshape(-1, 3)[n])
+                    ok = float(np.dot(dd, dd)) <= float(np.float32(max_gap_m) ** 2)
+                if ok:
+                    done.add(name)
+                    if state[n] == 0:
+                        state[n] = -1
+                        mem.append(n)
+                        q.append(n)
+                elif not (bridge_occluders and rng[n] < d):
+                    done.add(name)  # a surface behind it: stop; a nearer occluder is stepped over
+            if diagonals:  # direct diagonal neighbours: down-left, down-right, up-left, up-right
+                for dr, dc in ((1, -1), (1, 1), (-1, -1), (-1, 1)):
+                    rr = r + dr
+                    if rr < 0 or rr >= rows:
+                        continue
+                    n = rr * cols + (c + dc) % cols
+                    if state[n] != 0:
+                        continue
+                    sn, cs = diag_sc(r if dr > 0 else r - 1)
+                    ok = joins(d, rng[n], sn, cs)
+                    if ok and max_gap_m > 0:
+                        dd = (np.asarray(xyz, np.float32).reshape(-1, 3)[p]
+                              - np.asarray(xyz, np.float32).reshape(-1, 3)[n])
+                        ok = float(np.dot(dd, dd)) <= float(np.float32(max_gap_m) ** 2)
+                    if ok:
+                        state[n] = -1
+                        mem.append(n)
+                        q.append(n)
+        m = np.array(mem)
+        if len(m) < min_points:
+            continue
+        pts = P[m]
+        if np.any(pts.max(0) - pts.min(0) > max_extent_m):
+            continue
+        if pts[:, 2].mean() + mount_height_m > max_mean_height_m:
+            continue
+        kept.append((len(m), seed, np.sort(m)))
+    if len(kept) > max_clusters:  # smallest dropped first, ties: the later seed
+        order = sorted(range(len(kept)), key=lambda i: (-kept[i][0], kept[i][1]))[:max_clusters]
+        kept = [kept[i] for i in sorted(order)]
+    labels = np.zeros(rows * cols, np.int64)
+    for i, (_, _, m) in enumerate(kept):
+        labels[m] = i + 1
+    return labels.reshape(rows, cols), [m for _, _, m in kept]

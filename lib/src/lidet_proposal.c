@@ -1,0 +1,148 @@
+/* SPDX-License-Identifier: MIT */
+/* Proposals: a kept cluster resampled to N centred points plus its mean's spherical voxel (see
+ * lidet_cluster.h). Mirrored exactly by codegen/lidet_codegen/ref/cluster.py: proposal_indices,
+ * make_proposal; training reads proposals through the Python bindings of these functions. */
+#include <math.h>
+#include <string.h>
+
+#include "internal/lidet_math.h"
+#include "lidet/lidet_cluster.h"
+
+#define DEG2RAD 0.0174532925f
+
+void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg)
+{
+    if (cfg == 0)
+    {
+        return;
+    }
+    memset(cfg, 0, sizeof *cfg);
+    cfg->n_points = 64u < LIDET_PROPOSAL_POINTS ? 64u : LIDET_PROPOSAL_POINTS;
+    cfg->seed = 0x5EED1234u;
+    cfg->azimuth_bin_rad = 10.0f * DEG2RAD;
+    cfg->elevation_bin_rad = 10.0f * DEG2RAD;
+    cfg->range_bin_m = 1.0f;
+}
+
+static inline uint32_t xorshift32(uint32_t x)
+{
+    x ^= x << 13;
+    x ^= x >> 17;
+    x ^= x << 5;
+    return x;
+}
+
+static uint32_t rng_start(uint32_t seed, uint32_t n_src)
+{
+    const uint32_t s = seed ^ (n_src * 0x9E3779B9u);
+    return s != 0 ? s : 0x6C646574u; /* xorshift's only fixed point */
+}
+
+/* member index of output i (0, 1, ... in order; *s is the generator state). n_src <= n_out: every
+ * member once, then draws with replacement; else one member from each of n_out equal runs of the
+ * member list (stratified, without replacement). */
+static uint32_t next_index(uint32_t *s, uint32_t i, uint32_t n_src, uint32_t n_out)
+{
+    if (n_src <= n_out)
+    {
+        if (i < n_src)
+        {
+            return i;
+        }
+        *s = xorshift32(*s);
+        return *s % n_src;
+    }
+    {
+        const uint32_t b0 = (uint32_t)(((uint64_t)i * n_src) / n_out);
+        const uint32_t b1 = (uint32_t)(((uint64_t)(i + 1u) * n_src) / n_out);
+        *s = xorshift32(*s);
+        return b0 + *s % (b1 - b0); /* b1 > b0 because n_src > n_out */
+    }
+}
+
+lidet_status_t lidet_proposal_indices(uint32_t n_src, uint32_t n_out, uint32_t seed, uint32_t *out)
+{
+    uint32_t i, s;
+    if (out == 0 || n_src == 0 || n_out == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    s = rng_start(seed, n_src);
+    for (i = 0; i < n_out; ++i)
+    {
+        out[i] = next_index(&s, i, n_src, n_out);
+    }
+    return LIDET_OK;
+}
+
+/* floor(v / bin) as int16, saturating; v and bin finite, bin > 0 */
+static int16_t bin_of(float v, float bin)
+{
+    const float f = floorf(v / bin);
+    if (!(f > -32768.0f))
+    {
+        return (int16_t)-32768;
+    }
+    if (!(f < 32767.0f))
+    {
+        return (int16_t)32767;
+    }
+    return (int16_t)f;
+}
+
+lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_index,
+                                   const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out)
+{
+    const lidet_cluster_rec_t *rec;
+    const lidet_range_image_t *img;
+    uint32_t i, npix, state;
+    float mx, my, mz, rxy;
+
+    if (c == 0 || cfg == 0 || out == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (c->magic != LIDET_INIT_MAGIC || c->img.point_idx == 0)
+    {
+        return LIDET_ERR_STATE;
+    }
+    if (cfg->n_points < 1 || cfg->n_points > LIDET_PROPOSAL_POINTS ||
+        !lidet__isfinite(cfg->azimuth_bin_rad) || !(cfg->azimuth_bin_rad > 0.0f) ||
+        !lidet__isfinite(cfg->elevation_bin_rad) || !(cfg->elevation_bin_rad > 0.0f) ||
+        !lidet__isfinite(cfg->range_bin_m) || !(cfg->range_bin_m > 0.0f))
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    if (cluster_index >= c->n_recs)
+    {
+        return LIDET_ERR_ARG;
+    }
+    rec = &c->recs[cluster_index];
+    img = &c->img;
+    npix = (uint32_t)img->n_rows * img->n_cols;
+    state = rng_start(cfg->seed, rec->n_points);
+    mx = rec->mean_m[0];
+    my = rec->mean_m[1];
+    mz = rec->mean_m[2];
+    for (i = 0; i < cfg->n_points; ++i)
+    {
+        const int32_t p = c->members[rec->first_member + next_index(&state, i, rec->n_points, cfg->n_points)];
+        if (p < 0 || (uint32_t)p >= npix)
+        {
+            return LIDET_ERR_STATE; /* cannot happen after a run; guards a stale state */
+        }
+        out->xyz[i][0] = img->x_m[p] - mx;
+        out->xyz[i][1] = img->y_m[p] - my;
+        out->xyz[i][2] = img->z_m[p] - mz;
+    }
+    out->mean_m[0] = mx;
+    out->mean_m[1] = my;
+    out->mean_m[2] = mz;
+    rxy = sqrtf(mx * mx + my * my);
+    out->voxel[0] = bin_of(atan2f(my, mx), cfg->azimuth_bin_rad);
+    out->voxel[1] = bin_of(atan2f(mz, rxy), cfg->elevation_bin_rad);
+    out->voxel[2] = bin_of(sqrtf(mx * mx + my * my + mz * mz), cfg->range_bin_m);
+    out->n_points = cfg->n_points;
+    out->n_points_src = rec->n_points;
+    return LIDET_OK;
+}

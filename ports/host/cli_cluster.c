@@ -1,0 +1,311 @@
+/* SPDX-License-Identifier: MIT */
+/* `lidet cluster`: projection, ground mask, depth clustering and proposals on one scan.
+ * Ground: from a SemanticKITTI label file (--labels, classes 40 44 48 49 60 72); else the ground stage
+ * (lidet_ground.h, with its per-sector planes for the height filter) when the library has it; else a
+ * flat ground (z below -(mount height - 0.25 m)). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+static lidet_proj_t g_proj;
+static lidet_cluster_t g_cl;
+static uint8_t g_ground[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+static lidet_proposal_t g_prop;
+#ifdef LIDET_GROUND_H
+static lidet_ground_t g_gnd;
+#define HAVE_GROUND_STAGE 1
+#else
+#define HAVE_GROUND_STAGE 0
+#endif
+
+#define FLAT_GROUND_MARGIN_M 0.25f
+
+static int is_ground_class(uint32_t label)
+{
+    const uint32_t s = label & 0xFFFFu;
+    return s == 40u || s == 44u || s == 48u || s == 49u || s == 60u || s == 72u;
+}
+
+/* cluster id -> a bright colour (golden-ratio hue walk) */
+static void id_colour(uint32_t id, uint8_t rgb[3])
+{
+    float t = (float)id * 0.61803398875f;
+    t -= (float)(int)t;
+    cli_colormap(0.15f + 0.85f * t, rgb);
+}
+
+/* bird's-eye view, +x up, +y left, 80 m x 80 m at 0.1 m per pixel: ground dark, other points grey,
+ * clustered points in their cluster's colour */
+static int write_bev_png(const char *path, const float *pts, uint32_t n, const uint32_t *ids,
+                         const int32_t *pp, const uint8_t *ground_pix)
+{
+    const uint32_t W = 800, H = 800;
+    const float res = 0.1f;
+    uint8_t *rgb = (uint8_t *)calloc((size_t)W * H * 3u, 1);
+    uint32_t i;
+    int rc;
+    if (rgb == NULL)
+        return -1;
+    for (i = 0; i < n; ++i)
+    {
+        const float x = pts[4 * i], y = pts[4 * i + 1];
+        const float u = (float)W * 0.5f - y / res, v = (float)H * 0.5f - x / res;
+        uint8_t c[3];
+        uint8_t *px;
+        if (!(u >= 0.0f && u < (float)W && v >= 0.0f && v < (float)H))
+            continue;
+        px = rgb + (((size_t)(uint32_t)v * W) + (uint32_t)u) * 3u;
+        if (ids[i] > 0)
+            id_colour(ids[i], c);
+        else if (pp[i] >= 0 && ground_pix[pp[i]])
+        {
+            c[0] = 40;
+            c[1] = 40;
+            c[2] = 48;
+            if (px[0] | px[1] | px[2])
+                continue; /* never paint ground over something else */
+        }
+        else
+        {
+            c[0] = 110;
+            c[1] = 110;
+            c[2] = 110;
+            if (px[0] > 110 || px[1] > 110 || px[2] > 110)
+                continue; /* keep cluster colours */
+        }
+        px[0] = c[0];
+        px[1] = c[1];
+        px[2] = c[2];
+    }
+    rc = lidet_png_write_rgb(path, rgb, W, H);
+    free(rgb);
+    return rc;
+}
+
+static int fail(cli_args_t *a, const char *what, lidet_status_t st)
+{
+    fprintf(stderr, "lidet cluster: %s: %s\n", what, lidet_status_str(st));
+    cli_free(a);
+    return 1;
+}
+
+int cli_cluster(int argc, char **argv)
+{
+    cli_args_t a;
+    lidet_proj_cfg_t pcfg;
+    lidet_cluster_cfg_t ccfg;
+    lidet_proposal_cfg_t prcfg;
+    lidet_range_image_t img;
+    lidet_status_t st;
+    const lidet_cluster_stats_t *cs;
+    const char *labels_path = NULL;
+    int use_stage = 0; /* ground from the ground stage, rerun every repetition */
+    const lidet_plane_t *planes = NULL;
+    uint32_t n_sectors = 0;
+    double ms_gnd = 0.0;
+    char **rest;
+    int nrest = 0, i;
+    double *t_proj, *t_clu, *t_prop, *t_gnd, ms_proj, ms_clu, ms_prop;
+    uint32_t npix, p, n_pp, k, n_rec;
+    const int32_t *pp;
+    uint32_t *ids;
+
+    /* our own option first; the rest goes to the shared parser */
+    rest = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
+    if (rest == NULL)
+        return 1;
+    for (i = 0; i < argc; ++i)
+    {
+        if (strcmp(argv[i], "--labels") == 0 && i + 1 < argc)
+            labels_path = argv[++i];
+        else
+            rest[nrest++] = argv[i];
+    }
+    if (cli_parse(nrest, rest, "cluster", &a) != 0)
+    {
+        fprintf(stderr, "  --labels   SemanticKITTI .label file: its ground classes are the ground mask\n"
+                        "             (default: the ground stage, or a flat ground 0.25 m above -mount height\n"
+                        "             in builds without it)\n");
+        free(rest);
+        return 1;
+    }
+    free(rest);
+    if (cli_load(&a) != 0)
+        return 1;
+    lidet_proj_cfg_default(&pcfg, a.sensor_profile);
+    st = lidet_proj_init(&g_proj, &pcfg);
+    if (st != LIDET_OK)
+        return fail(&a, "projection init", st);
+    lidet_cluster_cfg_default(&ccfg, a.sensor_profile);
+    st = lidet_cluster_init(&g_cl, &ccfg);
+    if (st != LIDET_OK)
+        return fail(&a, "cluster init", st);
+    lidet_proposal_cfg_default(&prcfg);
+
+    t_proj = (double *)malloc(sizeof(double) * (size_t)a.repeat * 4u);
+    ids = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(a.n_points > 0 ? a.n_points : 1));
+    if (t_proj == NULL || ids == NULL)
+    {
+        free(t_proj);
+        free(ids);
+        cli_free(&a);
+        return 1;
+    }
+    t_clu = t_proj + a.repeat;
+    t_prop = t_clu + a.repeat;
+    t_gnd = t_prop + a.repeat;
+
+    /* ground mask of the scan (computed once: it is not this stage's time) */
+    st = lidet_proj_run(&g_proj, a.points, a.n_points, 4, a.ring);
+    if (!LIDET_SUCCEEDED(st))
+        return fail(&a, "projection", st);
+    lidet_proj_image(&g_proj, &img);
+    npix = (uint32_t)img.n_rows * img.n_cols;
+    if (labels_path != NULL)
+    {
+        FILE *f = fopen(labels_path, "rb");
+        uint32_t *lab = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(a.n_points > 0 ? a.n_points : 1));
+        size_t got = (f != NULL && lab != NULL) ? fread(lab, sizeof(uint32_t), a.n_points, f) : 0;
+        if (f != NULL)
+            fclose(f);
+        if (got != a.n_points)
+        {
+            fprintf(stderr, "lidet cluster: cannot read %u labels from '%s'\n", a.n_points, labels_path);
+            free(lab);
+            free(t_proj);
+            free(ids);
+            cli_free(&a);
+            return 1;
+        }
+        for (p = 0; p < npix; ++p)
+            g_ground[p] = (uint8_t)(img.point_idx[p] >= 0 && is_ground_class(lab[img.point_idx[p]]));
+        free(lab);
+    }
+    else if (!HAVE_GROUND_STAGE)
+    {
+        const float zmax = -(a.sensor_profile->mount_height_m - FLAT_GROUND_MARGIN_M);
+        for (p = 0; p < npix; ++p)
+            g_ground[p] = (uint8_t)(img.point_idx[p] >= 0 && img.z_m[p] < zmax);
+    }
+#if HAVE_GROUND_STAGE
+    else
+    {
+        lidet_ground_cfg_t gcfg;
+        lidet_ground_cfg_default(&gcfg, a.sensor_profile);
+        st = lidet_ground_init(&g_gnd, &gcfg);
+        if (st != LIDET_OK)
+            return fail(&a, "ground init", st);
+        use_stage = 1;
+    }
+#endif
+
+    for (i = 0; i < a.repeat; ++i)
+    {
+        double t0 = cli_now_ms();
+        st = lidet_proj_run(&g_proj, a.points, a.n_points, 4, a.ring);
+        t_proj[i] = cli_now_ms() - t0;
+        if (!LIDET_SUCCEEDED(st))
+            return fail(&a, "projection", st);
+        lidet_proj_image(&g_proj, &img);
+#if HAVE_GROUND_STAGE
+        if (use_stage)
+        {
+            t0 = cli_now_ms();
+            st = lidet_ground_run(&g_gnd, &img);
+            t_gnd[i] = cli_now_ms() - t0;
+            if (!LIDET_SUCCEEDED(st))
+                return fail(&a, "ground", st);
+            memcpy(g_ground, lidet_ground_mask(&g_gnd), npix);
+            planes = lidet_ground_planes(&g_gnd, &n_sectors);
+        }
+#endif
+        t0 = cli_now_ms();
+        st = lidet_cluster_run(&g_cl, &img, g_ground, planes, n_sectors);
+        t_clu[i] = cli_now_ms() - t0;
+        if (!LIDET_SUCCEEDED(st))
+            return fail(&a, "clustering", st);
+        lidet_cluster_records(&g_cl, &n_rec);
+        t0 = cli_now_ms();
+        for (k = 0; k < n_rec; ++k)
+        {
+            st = lidet_proposal_make(&g_cl, k, &prcfg, &g_prop);
+            if (st != LIDET_OK)
+                return fail(&a, "proposal", st);
+        }
+        t_prop[i] = cli_now_ms() - t0;
+    }
+    ms_proj = cli_median(t_proj, a.repeat);
+    ms_clu = cli_median(t_clu, a.repeat);
+    ms_prop = cli_median(t_prop, a.repeat);
+    if (use_stage)
+        ms_gnd = cli_median(t_gnd, a.repeat);
+    free(t_proj);
+    cs = lidet_cluster_stats(&g_cl);
+    pp = lidet_proj_point_pixels(&g_proj, &n_pp);
+    lidet_cluster_point_labels(&g_cl, pp, n_pp, ids);
+    for (p = n_pp; p < a.n_points; ++p)
+        ids[p] = 0; /* past LIDET_MAX_POINTS */
+
+    if (a.out_path != NULL)
+    {
+        FILE *f = fopen(a.out_path, "wb");
+        if (f == NULL || fwrite(ids, sizeof ids[0], a.n_points, f) != a.n_points || fclose(f) != 0)
+        {
+            fprintf(stderr, "lidet cluster: cannot write '%s'\n", a.out_path);
+            free(ids);
+            cli_free(&a);
+            return 1;
+        }
+    }
+    if (a.png_path != NULL && write_bev_png(a.png_path, a.points, n_pp, ids, pp, g_ground) != 0)
+    {
+        fprintf(stderr, "lidet cluster: cannot write '%s'\n", a.png_path);
+        free(ids);
+        cli_free(&a);
+        return 1;
+    }
+    if (a.json)
+    {
+        cli_json_begin(stdout);
+        cli_json_str(stdout, "sensor", a.sensor);
+        cli_json_int(stdout, "points", a.n_points);
+        cli_json_str(stdout, "ground", labels_path != NULL ? "labels" : (use_stage ? "stage" : "flat"));
+        cli_json_int(stdout, "candidates", cs->n_candidates);
+        cli_json_int(stdout, "found", cs->n_found);
+        cli_json_int(stdout, "dropped_small", cs->n_dropped_small);
+        cli_json_int(stdout, "dropped_extent", cs->n_dropped_extent);
+        cli_json_int(stdout, "dropped_height", cs->n_dropped_height);
+        cli_json_int(stdout, "dropped_capacity", cs->n_dropped_capacity);
+        cli_json_int(stdout, "clusters", cs->n_kept);
+        cli_json_int(stdout, "proposals", cs->n_kept);
+        cli_json_int(stdout, "proposal_points", prcfg.n_points);
+        cli_json_num(stdout, "theta_rad", ccfg.theta_rad);
+        cli_json_int(stdout, "max_steps", ccfg.max_steps);
+        cli_json_int(stdout, "repeat", a.repeat);
+        cli_json_num(stdout, "project_ms", ms_proj);
+        if (use_stage)
+            cli_json_num(stdout, "ground_ms", ms_gnd);
+        cli_json_num(stdout, "cluster_ms", ms_clu);
+        cli_json_num(stdout, "proposal_ms", ms_prop);
+        cli_json_num(stdout, "total_ms", ms_proj + ms_gnd + ms_clu + ms_prop);
+        cli_json_end(stdout);
+    }
+    else
+    {
+        printf("scan            %s (%s)\n", a.scan_path, a.sensor);
+        printf("points          %u, non-ground pixels %u (ground: %s)\n", a.n_points, cs->n_candidates,
+               labels_path != NULL ? labels_path : (use_stage ? "ground stage" : "flat"));
+        printf("clusters        %u kept of %u found (dropped: small %u, extent %u, height %u, capacity %u)\n",
+               cs->n_kept, cs->n_found, cs->n_dropped_small, cs->n_dropped_extent, cs->n_dropped_height,
+               cs->n_dropped_capacity);
+        printf("proposals       %u x %u points\n", cs->n_kept, prcfg.n_points);
+        printf("cluster_ms      %.3f (median of %d; projection %.3f, proposals %.3f)\n", ms_clu, a.repeat,
+               ms_proj, ms_prop);
+        if (a.png_path != NULL)
+            printf("picture         %s\n", a.png_path);
+    }
+    free(ids);
+    cli_free(&a);
+    return 0;
+}

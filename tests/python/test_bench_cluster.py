@@ -1,0 +1,23 @@
+# SPDX-License-Identifier: MIT
+"""Smoke test of the clustering benchmark on the real scans (the timing itself is `make bench`'s job):
+the simulated sets and the DBSCAN peer are switched off here to keep `make test` short."""
+import argparse
+import importlib.util
+import os
+import pathlib
+
+import pytest
+
+
+def test_bench_cluster_runs(root, real_dir):
+    build = pathlib.Path(os.environ.get("LIDET_BUILD_DIR", root / "build"))
+    if not (build / "ports" / "host" / "lidet").exists():
+        pytest.skip("CLI not built")
+    spec = importlib.util.spec_from_file_location("bench_cluster", root / "tools" / "bench" / "bench_cluster.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    mod._sim_dir = lambda sensor, quick: None
+    mod._open3d = lambda: None
+    md = mod.run(argparse.Namespace(real=real_dir, build=build, quick=True))
+    assert md.startswith("## Clustering (issue 6)")
+    assert "| real SemanticKITTI 00 (3 labelled scans) | lidet |" in md and "DBSCAN columns skipped" in md

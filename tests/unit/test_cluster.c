@@ -1,0 +1,520 @@
+/* SPDX-License-Identifier: MIT */
+/* Unity tests of the depth clustering and the proposals (lib/src/lidet_cluster.c, lidet_proposal.c)
+ * on hand-drawn range images (test_cluster_util.h: letters are ranges, '.' empty, 'g' ground). */
+#include <math.h>
+#include <string.h>
+
+#include "lidet/lidet.h"
+#include "test_util.h"
+#include "test_cluster_util.h"
+
+LIDET_GUARDED(lidet_cluster_t, g);
+static tcu_image_t t;
+static lidet_cluster_cfg_t cfg;
+
+void setUp(void)
+{
+    CANARY_FILL(g);
+    tcu_cfg(&cfg);
+}
+
+void tearDown(void)
+{
+    CANARY_CHECK(g);
+}
+
+/* expected labels as art: '0' = none, '1'..'9' = canonical id */
+static void expect_labels(const char *const *want, int rows)
+{
+    const uint16_t *lab = lidet_cluster_labels(&g.ws);
+    const int cols = (int)strlen(want[0]);
+    int r, c;
+    for (r = 0; r < rows; ++r)
+    {
+        for (c = 0; c < cols; ++c)
+        {
+            char msg[64];
+            sprintf(msg, "pixel row %d col %d", r, c);
+            TEST_ASSERT_EQUAL_INT_MESSAGE(want[r][c] - '0', lab[r * cols + c], msg);
+        }
+    }
+}
+
+static void run(const char *const *art, int rows, const uint8_t *ground)
+{
+    tcu_draw(&t, art, rows);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g.ws, &t.img, ground, NULL, 0));
+}
+
+/* two objects touching in the image, one 10 m away, one 30 m behind it: split at the depth jump */
+static void test_depth_jump_splits(void)
+{
+    static const char *const art[] = {
+        "................................",
+        "....cccckkkk....................",
+        "....cccckkkk....................",
+        "....cccckkkk....................",
+    };
+    static const char *const want[] = {
+        "00000000000000000000000000000000",
+        "00001111222200000000000000000000",
+        "00001111222200000000000000000000",
+        "00001111222200000000000000000000",
+    };
+    run(art, 4, NULL);
+    expect_labels(want, 4);
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_cluster_stats(&g.ws)->n_kept);
+}
+
+/* the angle criterion joins a slanted surface (small range steps) but not a jump */
+static void test_slanted_surface_joins(void)
+{
+    static const char *const art[] = {
+        "......cdefhi.......................z",
+    };
+    static const char *const want[] = {
+        "000000111111000000000000000000000002",
+    };
+    run(art, 1, NULL);
+    expect_labels(want, 1);
+}
+
+/* one object with holes (missing returns) joins through the bridging; without it, it splits */
+static void test_hole_joins(void)
+{
+    static const char *const art[] = {
+        "................................",
+        "....cc.ccc......................",
+        "....cc..cc......................",
+        "....cc.ccc......................",
+        "......................c.........",
+        "......................c.........",
+    };
+    static const char *const want_bridged[] = {
+        "00000000000000000000000000000000",
+        "00001101110000000000000000000000",
+        "00001100110000000000000000000000",
+        "00001101110000000000000000000000",
+        "00000000000000000000002000000000",
+        "00000000000000000000002000000000",
+    };
+    static const char *const want_split[] = {
+        "00000000000000000000000000000000",
+        "00001102220000000000000000000000",
+        "00001100220000000000000000000000",
+        "00001102220000000000000000000000",
+        "00000000000000000000003000000000",
+        "00000000000000000000003000000000",
+    };
+    run(art, 6, NULL);
+    expect_labels(want_bridged, 6);
+    cfg.max_steps = 1;
+    run(art, 6, NULL);
+    expect_labels(want_split, 6);
+}
+
+/* a pole in front of a wall: with the occluder rule the wall stays one cluster behind it */
+static void test_occluder_bridging(void)
+{
+    static const char *const art[] = {
+        "......kkkkakkkkk................................................",
+        "......kkkkakkkkk................................................",
+        "......kkkkakkkkk................................................",
+    };
+    static const char *const want_bridged[] = {
+        "0000001111211111000000000000000000000000000000000000000000000000",
+        "0000001111211111000000000000000000000000000000000000000000000000",
+        "0000001111211111000000000000000000000000000000000000000000000000",
+    };
+    static const char *const want_split[] = {
+        "0000001111233333000000000000000000000000000000000000000000000000",
+        "0000001111233333000000000000000000000000000000000000000000000000",
+        "0000001111233333000000000000000000000000000000000000000000000000",
+    };
+    cfg.bridge_occluders = 1;
+    run(art, 3, NULL);
+    expect_labels(want_bridged, 3);
+    cfg.bridge_occluders = 0;
+    run(art, 3, NULL);
+    expect_labels(want_split, 3);
+}
+
+/* diagonals: a staircase of returns (every other pixel missing) joins in the 8-neighbourhood only;
+ * the diagonal search also wraps around the seam */
+static void test_diagonals(void)
+{
+    static const char *const art[] = {
+        "c.....................c.........",
+        ".c.....................c........",
+        "..c.....................c.......",
+        ".......................c.......c",
+        "c...............................",
+    };
+    static const char *const want8[] = {
+        "10000000000000000000002000000000",
+        "01000000000000000000000200000000",
+        "00100000000000000000000020000000",
+        "00000000000000000000000200000003",
+        "30000000000000000000000000000000",
+    };
+    cfg.diagonals = 1;
+    cfg.max_steps = 1;
+    run(art, 5, NULL);
+    expect_labels(want8, 5);
+    TEST_ASSERT_EQUAL_UINT32(3, lidet_cluster_stats(&g.ws)->n_kept);
+    cfg.diagonals = 0;
+    run(art, 5, NULL);
+    TEST_ASSERT_EQUAL_UINT32(9, lidet_cluster_stats(&g.ws)->n_kept);
+}
+
+/* max_gap_m: neighbours further apart than the gap do not join even when the angle test passes */
+static void test_max_gap(void)
+{
+    static const char *const art[] = {
+        "..cc.cc.........................",
+    };
+    /* 10 m, columns 11.25 deg apart: neighbours ~2 m apart, across the hole ~3.9 m */
+    cfg.max_gap_m = 0.0f;
+    run(art, 1, NULL);
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g.ws)->n_kept);
+    cfg.max_gap_m = 3.0f;
+    run(art, 1, NULL);
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_cluster_stats(&g.ws)->n_kept);
+    cfg.max_gap_m = 1.0f;
+    run(art, 1, NULL);
+    TEST_ASSERT_EQUAL_UINT32(4, lidet_cluster_stats(&g.ws)->n_kept);
+    cfg.max_gap_m = -1.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &cfg));
+}
+
+/* vertical bridging uses the real beam angles and also steps over ground pixels */
+static void test_vertical_hole_and_ground(void)
+{
+    static const char *const art[] = {
+        "...c....",
+        "...g....",
+        "...c....",
+        "...g....",
+        "...g....",
+        "...c....",
+    };
+    static const char *const want[] = {
+        "00010000",
+        "00000000",
+        "00010000",
+        "00000000",
+        "00000000",
+        "00010000",
+    };
+    uint8_t ground[48];
+    tcu_draw(&t, art, 6);
+    memcpy(ground, t.ground, sizeof ground);
+    run(art, 6, ground);
+    expect_labels(want, 6);
+    TEST_ASSERT_EQUAL_UINT32(3, lidet_cluster_stats(&g.ws)->n_candidates);
+    /* without the mask the ground pixels (10 m, like the object) are part of it */
+    run(art, 6, NULL);
+    TEST_ASSERT_EQUAL_UINT32(6, lidet_cluster_stats(&g.ws)->n_pixels_kept);
+    /* steps limited to 2: the gap of two ground rows (3 steps) is not bridged */
+    cfg.max_steps = 2;
+    run(art, 6, ground);
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_cluster_stats(&g.ws)->n_kept);
+}
+
+/* an object straddling the seam (columns 0 and cols-1) is one cluster, also across a hole */
+static void test_wraparound_joins(void)
+{
+    static const char *const art[] = {
+        "cc..........................z.cc",
+        "c.............................cc",
+        "cc....kk......................c.",
+    };
+    static const char *const want[] = {
+        "11..........................2.11",
+        "1.............................11",
+        "11....33......................1.",
+    };
+    char w0[3][33];
+    const char *want_digits[3];
+    int r, c;
+    for (r = 0; r < 3; ++r)
+    {
+        for (c = 0; c < 32; ++c)
+            w0[r][c] = want[r][c] == '.' ? '0' : want[r][c];
+        w0[r][32] = '\0';
+        want_digits[r] = w0[r];
+    }
+    run(art, 3, NULL);
+    expect_labels(want_digits, 3);
+    TEST_ASSERT_EQUAL_UINT32(3, lidet_cluster_stats(&g.ws)->n_kept);
+}
+
+/* filters: min points, extent, height; each dropped cluster counted once */
+static void test_filters(void)
+{
+    static const char *const art[] = {
+        "..cc.........a..................................................",
+        "..cc.........a..........................................zzzzzzzz",
+        "..cc.........a..................................................",
+    };
+    const lidet_cluster_stats_t *st;
+    cfg.min_points = 4;
+    run(art, 3, NULL);
+    st = lidet_cluster_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(3, st->n_found);
+    TEST_ASSERT_EQUAL_UINT32(1, st->n_dropped_small);
+    TEST_ASSERT_EQUAL_UINT32(2, st->n_kept);
+    /* the 8-pixel arc at 70 m spans ~ 8 * 5.6 deg: > 6 m wide */
+    cfg.max_extent_m = 6.0f;
+    run(art, 3, NULL);
+    st = lidet_cluster_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(1, st->n_dropped_extent);
+    TEST_ASSERT_EQUAL_UINT32(1, st->n_kept);
+    /* flat ground 1.73 m below: the 10 m block's mean (row 1 at +5 deg: z ~ 0.87 m) is 2.6 m high */
+    cfg.max_mean_height_m = 2.0f;
+    run(art, 3, NULL);
+    st = lidet_cluster_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(1, st->n_dropped_height);
+    TEST_ASSERT_EQUAL_UINT32(0, st->n_kept);
+    /* a tilted plane per sector: sector 0 says everything is low -> kept again */
+    {
+        lidet_plane_t planes[2] = {{0.0f, 0.0f, 1.0f, -5.0f}, {0.0f, 0.0f, 1.0f, 1.73f}};
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g.ws, &t.img, NULL, planes, 2));
+        TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g.ws)->n_kept);
+        TEST_ASSERT_CLOSE(lidet_cluster_records(&g.ws, NULL)[0].mean_m[2] - 5.0f,
+                          lidet_cluster_records(&g.ws, NULL)[0].height_m, 1e-5, 0);
+        TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_cluster_run(&g.ws, &t.img, NULL, planes, 0));
+    }
+}
+
+/* records: counts, bounds, means and member lists agree with the labels; determinism */
+static void test_records_members_determinism(void)
+{
+    static const char *const art[] = {
+        "....kk.......c..........a.a.a.a.",
+        "...ckk.......c..........aaaaaaa.",
+        "...cc........c..........a.....a.",
+    };
+    uint16_t first[96];
+    uint32_t n, i, j, total = 0;
+    const lidet_cluster_rec_t *rec;
+    const int32_t *mem;
+    run(art, 3, NULL);
+    memcpy(first, lidet_cluster_labels(&g.ws), sizeof first);
+    rec = lidet_cluster_records(&g.ws, &n);
+    mem = lidet_cluster_members(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(4, n);
+    for (i = 0; i < n; ++i)
+    {
+        double s[3] = {0, 0, 0};
+        TEST_ASSERT_EQUAL_UINT32(total, rec[i].first_member);
+        for (j = 0; j < rec[i].n_points; ++j)
+        {
+            const int32_t p = mem[rec[i].first_member + j];
+            TEST_ASSERT_EQUAL_UINT16(i + 1, first[p]);
+            if (j > 0)
+            {
+                TEST_ASSERT_TRUE(p > mem[rec[i].first_member + j - 1]); /* raster order */
+            }
+            else
+            {
+                TEST_ASSERT_EQUAL_UINT32((uint32_t)p, rec[i].seed_pixel);
+            }
+            s[0] += t.x[p];
+            s[1] += t.y[p];
+            s[2] += t.z[p];
+            TEST_ASSERT_TRUE(t.x[p] >= rec[i].min_m[0] && t.x[p] <= rec[i].max_m[0]);
+            TEST_ASSERT_TRUE(t.z[p] >= rec[i].min_m[2] && t.z[p] <= rec[i].max_m[2]);
+        }
+        TEST_ASSERT_CLOSE(s[0] / rec[i].n_points, rec[i].mean_m[0], 1e-4, 1e-5);
+        TEST_ASSERT_CLOSE(s[2] / rec[i].n_points, rec[i].mean_m[2], 1e-4, 1e-5);
+        total += rec[i].n_points;
+    }
+    TEST_ASSERT_EQUAL_UINT32(total, lidet_cluster_stats(&g.ws)->n_pixels_kept);
+    /* ids in raster order of first pixel: 'k' block (row 0 col 4) = 1, 'c' (row 0 col 13) = 2,
+     * 'a' comb = 3, the left 'c' L-shape (row 1 col 3) = 4 */
+    TEST_ASSERT_EQUAL_UINT16(1, first[4]);
+    TEST_ASSERT_EQUAL_UINT16(2, first[13]);
+    TEST_ASSERT_EQUAL_UINT16(3, first[24]);
+    TEST_ASSERT_EQUAL_UINT16(4, first[32 + 3]);
+    TEST_ASSERT_EQUAL_UINT32(13, rec[2].n_points);
+    /* a second run on the same input gives the same bytes */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+    TEST_ASSERT_EQUAL_MEMORY(first, lidet_cluster_labels(&g.ws), sizeof first);
+}
+
+/* per-point labels: every input point in input order; unprojected points 0 */
+static void test_point_labels(void)
+{
+    static const char *const art[] = {
+        "..cc....kk..",
+    };
+    int32_t pp[6] = {2, 3, 8, -1, 2, 1000};
+    uint32_t out[6];
+    run(art, 1, NULL);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_point_labels(&g.ws, pp, 6, out));
+    TEST_ASSERT_EQUAL_UINT32(1, out[0]);
+    TEST_ASSERT_EQUAL_UINT32(1, out[1]);
+    TEST_ASSERT_EQUAL_UINT32(2, out[2]);
+    TEST_ASSERT_EQUAL_UINT32(0, out[3]);
+    TEST_ASSERT_EQUAL_UINT32(1, out[4]);
+    TEST_ASSERT_EQUAL_UINT32(0, out[5]);
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_cluster_point_labels(&g.ws, NULL, 6, out));
+}
+
+/* empty image, all ground, bad config, not initialised */
+static void test_edge_cases(void)
+{
+    static const char *const empty[] = {"........", "........"};
+    static const char *const allg[] = {"gggggggg", "gggggggg"};
+    lidet_cluster_cfg_t bad;
+    uint8_t ground[16];
+    run(empty, 2, NULL);
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g.ws)->n_found);
+    tcu_draw(&t, allg, 2);
+    memcpy(ground, t.ground, sizeof ground);
+    run(allg, 2, ground);
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g.ws)->n_candidates);
+    bad = cfg;
+    bad.theta_rad = 0.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &bad));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+    bad = cfg;
+    bad.max_steps = LIDET_CLUSTER_MAX_STEPS + 1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &bad));
+    bad = cfg;
+    bad.min_points = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &bad));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_cluster_init(NULL, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_cluster_run(&g.ws, NULL, NULL, NULL, 0));
+    TEST_ASSERT_EQUAL_UINT32(sizeof(lidet_cluster_t), lidet_cluster_bytes());
+}
+
+/* default thresholds per profile */
+static void test_defaults_per_profile(void)
+{
+    lidet_cluster_cfg_t d;
+    lidet_cluster_cfg_default(&d, lidet_sensor_find("hdl64"));
+    TEST_ASSERT_EQUAL_UINT32(10, d.min_points);
+    TEST_ASSERT_EQUAL_UINT32(5, d.max_steps);
+    TEST_ASSERT_EQUAL_UINT32(1, d.bridge_occluders);
+    TEST_ASSERT_EQUAL_UINT32(1, d.diagonals);
+    TEST_ASSERT_CLOSE(1.73, d.mount_height_m, 1e-3, 0);
+    TEST_ASSERT_TRUE(d.theta_rad > 0.0f && d.theta_rad < 0.8f);
+    lidet_cluster_cfg_default(&d, lidet_sensor_find("vlp16"));
+    TEST_ASSERT_TRUE(d.theta_rad > 0.0f && d.theta_rad < 0.8f);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &d));
+}
+
+/* the resampling rule: deterministic, in range, every member once when small, distinct when large */
+static void test_proposal_indices(void)
+{
+    uint32_t a[128], b[128], i;
+    uint8_t seen[1000];
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(10, 64, 7, a));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(10, 64, 7, b));
+    TEST_ASSERT_EQUAL_MEMORY(a, b, 64 * sizeof a[0]);
+    for (i = 0; i < 10; ++i)
+        TEST_ASSERT_EQUAL_UINT32(i, a[i]);
+    for (i = 0; i < 64; ++i)
+        TEST_ASSERT_TRUE(a[i] < 10);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(1000, 128, 7, a));
+    memset(seen, 0, sizeof seen);
+    for (i = 0; i < 128; ++i)
+    {
+        TEST_ASSERT_TRUE(a[i] < 1000);
+        TEST_ASSERT_EQUAL_UINT8(0, seen[a[i]]);
+        seen[a[i]] = 1;
+        TEST_ASSERT_TRUE(a[i] >= i * 1000 / 128 && a[i] < (i + 1) * 1000 / 128);
+    }
+    /* another seed gives another pattern */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(1000, 128, 8, b));
+    TEST_ASSERT_TRUE(memcmp(a, b, 128 * sizeof a[0]) != 0);
+    /* golden values (codegen/lidet_codegen/ref/cluster.py: proposal_indices must give the same) */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(5, 8, 0x5EED1234u, a));
+    TEST_ASSERT_EQUAL_UINT32(0, a[0]);
+    TEST_ASSERT_EQUAL_UINT32(4, a[4]);
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proposal_indices(0, 8, 1, a));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proposal_indices(5, 0, 1, a));
+}
+
+/* proposals: centred on the cluster mean, deterministic, voxel of the mean */
+static void test_proposal_centred(void)
+{
+    static const char *const art[] = {
+        "..........................cccc..",
+        "..........................cccc..",
+        "..........................cccc..",
+        "..........................cccc..",
+    };
+    lidet_proposal_cfg_t pc;
+    static lidet_proposal_t a, b;
+    const lidet_cluster_rec_t *rec;
+    double s[3] = {0, 0, 0}, az, el, rr;
+    uint32_t i;
+    run(art, 4, NULL);
+    rec = lidet_cluster_records(&g.ws, NULL);
+    lidet_proposal_cfg_default(&pc);
+    TEST_ASSERT_EQUAL_UINT32(64, pc.n_points);
+    pc.n_points = 16; /* = the cluster's size: every member exactly once */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_make(&g.ws, 0, &pc, &a));
+    TEST_ASSERT_EQUAL_UINT32(16, a.n_points_src);
+    for (i = 0; i < 16; ++i)
+    {
+        s[0] += a.xyz[i][0];
+        s[1] += a.xyz[i][1];
+        s[2] += a.xyz[i][2];
+    }
+    TEST_ASSERT_CLOSE(0.0, s[0] / 16, 1e-5, 0);
+    TEST_ASSERT_CLOSE(0.0, s[1] / 16, 1e-5, 0);
+    TEST_ASSERT_CLOSE(0.0, s[2] / 16, 1e-5, 0);
+    for (i = 0; i < 3; ++i)
+        TEST_ASSERT_EQUAL_FLOAT(rec[0].mean_m[i], a.mean_m[i]);
+    /* 64 points: deterministic, every point a member minus the mean */
+    pc.n_points = 64;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_make(&g.ws, 0, &pc, &a));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_make(&g.ws, 0, &pc, &b));
+    TEST_ASSERT_EQUAL_MEMORY(&a, &b, sizeof a);
+    for (i = 0; i < 64; ++i)
+    {
+        const double x = a.xyz[i][0] + a.mean_m[0], y = a.xyz[i][1] + a.mean_m[1];
+        const double rxy = sqrt(x * x + y * y);
+        TEST_ASSERT_CLOSE(10.0 * cos(atan2(a.xyz[i][2] + a.mean_m[2], rxy)), rxy, 1e-4, 0);
+    }
+    /* the voxel of the mean: signed floor bins */
+    az = atan2(a.mean_m[1], a.mean_m[0]);
+    el = atan2(a.mean_m[2], sqrt((double)a.mean_m[0] * a.mean_m[0] + (double)a.mean_m[1] * a.mean_m[1]));
+    rr = sqrt((double)a.mean_m[0] * a.mean_m[0] + (double)a.mean_m[1] * a.mean_m[1] +
+              (double)a.mean_m[2] * a.mean_m[2]);
+    TEST_ASSERT_EQUAL_INT16((int16_t)floor(az / (10.0 * M_PI / 180.0)), a.voxel[0]);
+    TEST_ASSERT_EQUAL_INT16((int16_t)floor(el / (10.0 * M_PI / 180.0)), a.voxel[1]);
+    TEST_ASSERT_EQUAL_INT16((int16_t)floor(rr), a.voxel[2]);
+    TEST_ASSERT_TRUE(a.voxel[0] < 0); /* right of +x: negative azimuth */
+    /* errors */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proposal_make(&g.ws, 1, &pc, &a));
+    pc.n_points = LIDET_PROPOSAL_POINTS + 1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proposal_make(&g.ws, 0, &pc, &a));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_depth_jump_splits);
+    RUN_TEST(test_slanted_surface_joins);
+    RUN_TEST(test_hole_joins);
+    RUN_TEST(test_occluder_bridging);
+    RUN_TEST(test_diagonals);
+    RUN_TEST(test_max_gap);
+    RUN_TEST(test_vertical_hole_and_ground);
+    RUN_TEST(test_wraparound_joins);
+    RUN_TEST(test_filters);
+    RUN_TEST(test_records_members_determinism);
+    RUN_TEST(test_point_labels);
+    RUN_TEST(test_edge_cases);
+    RUN_TEST(test_defaults_per_profile);
+    RUN_TEST(test_proposal_indices);
+    RUN_TEST(test_proposal_centred);
+    return UNITY_END();
+}

@@ -1,0 +1,106 @@
+/* SPDX-License-Identifier: MIT */
+/* Clustering against a library built with LIDET_MAX_CLUSTERS 8 (16 x 64 pixels): more clusters
+ * than the capacity are dropped smallest first (ties: the later one), counted, never overrun. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "lidet/lidet.h"
+#include "test_util.h"
+#include "test_cluster_util.h"
+
+LIDET_GUARDED(lidet_cluster_t, g);
+static tcu_image_t t;
+
+void setUp(void)
+{
+    CANARY_FILL(g);
+}
+
+void tearDown(void)
+{
+    CANARY_CHECK(g);
+}
+
+/* 12 vertical bars 4 columns apart (never bridged with 3 steps), heights = their sizes */
+static void test_capacity_overflow_counted(void)
+{
+    static const int height[12] = {3, 1, 4, 1, 5, 9, 2, 6, 5, 3, 5, 8};
+    static const int kept_bar[8] = {0, 2, 4, 5, 7, 8, 10, 11};
+    static char rows_buf[16][65];
+    const char *art[16];
+    lidet_cluster_cfg_t cfg;
+    const lidet_cluster_rec_t *rec;
+    const lidet_cluster_stats_t *st;
+    const uint16_t *lab;
+    uint32_t n, i;
+    int r, b;
+    TEST_ASSERT_EQUAL_INT(8, LIDET_MAX_CLUSTERS);
+    for (r = 0; r < 16; ++r)
+    {
+        memset(rows_buf[r], '.', 64);
+        rows_buf[r][64] = '\0';
+        for (b = 0; b < 12; ++b)
+        {
+            if (r < height[b])
+                rows_buf[r][4 * b + 1] = 'c';
+        }
+        art[r] = rows_buf[r];
+    }
+    tcu_draw(&t, art, 16);
+    tcu_cfg(&cfg);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+    st = lidet_cluster_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(12, st->n_found);
+    TEST_ASSERT_EQUAL_UINT32(4, st->n_dropped_capacity);
+    TEST_ASSERT_EQUAL_UINT32(8, st->n_kept);
+    rec = lidet_cluster_records(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(8, n);
+    lab = lidet_cluster_labels(&g.ws);
+    for (i = 0; i < 8; ++i)
+    {
+        const int bar = kept_bar[i];
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)height[bar], rec[i].n_points);
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)(4 * bar + 1), rec[i].seed_pixel);
+        TEST_ASSERT_EQUAL_UINT16(i + 1, lab[4 * bar + 1]);
+    }
+    /* dropped bars are unlabelled */
+    TEST_ASSERT_EQUAL_UINT16(0, lab[4 * 1 + 1]);
+    TEST_ASSERT_EQUAL_UINT16(0, lab[4 * 3 + 1]);
+    TEST_ASSERT_EQUAL_UINT16(0, lab[4 * 6 + 1]);
+    TEST_ASSERT_EQUAL_UINT16(0, lab[4 * 9 + 1]);
+    /* same answer again (determinism, also after evictions) */
+    TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+    TEST_ASSERT_EQUAL_UINT32(4, lidet_cluster_stats(&g.ws)->n_dropped_capacity);
+    /* proposals still work on every kept cluster */
+    {
+        lidet_proposal_cfg_t pc;
+        static lidet_proposal_t pr;
+        lidet_proposal_cfg_default(&pc);
+        for (i = 0; i < 8; ++i)
+        {
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_make(&g.ws, i, &pc, &pr));
+        }
+    }
+}
+
+/* an image larger than the capacity is refused */
+static void test_image_too_large(void)
+{
+    lidet_cluster_cfg_t cfg;
+    static const char *const one[] = {"cc"};
+    tcu_draw(&t, one, 1);
+    t.img.n_cols = 65;
+    tcu_cfg(&cfg);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_BUFFER, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_capacity_overflow_counted);
+    RUN_TEST(test_image_too_large);
+    return UNITY_END();
+}

@@ -1,0 +1,162 @@
+# SPDX-License-Identifier: MIT
+"""Clustering (issue 6): lidet's depth clustering versus Open3D DBSCAN (eps 0.5 m, min_points 10) on
+the same non-ground points (ground = SemanticKITTI ground classes of the labels, so both see the
+same input), in one run: median milliseconds per scan and recovery of labelled road users.
+
+lidet's time is `cluster_ms` of `lidet cluster SCAN --labels LABELS --json --repeat N` (the
+clustering stage alone: the projection is reported separately, like DBSCAN's KD-tree build is
+included in its time); its ids come from the same command's --out. DBSCAN runs in this process on
+one thread (OMP_NUM_THREADS=1, set before Open3D is imported); its noise (-1) is "no cluster" and its
+clusters are not filtered. Quality: lidet_tools.cluster_eval (best-matching cluster per object,
+recovered = >= 80 % precision and recall).
+
+Runnable alone: `python tools/bench/bench_cluster.py [--build build] [--real ../shared/data/real]`.
+Simulated scans are read from data/sim_<sensor> (generated with lidet-sim when absent and the
+simulator is installed)."""
+from __future__ import annotations
+
+import json
+import os
+import pathlib
+import subprocess
+import sys
+import tempfile
+import time
+
+os.environ.setdefault("OMP_NUM_THREADS", "1")  # before open3d: one core, like lidet
+
+import numpy as np  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "tools"))
+sys.path.insert(0, str(ROOT / "codegen"))
+
+from lidet_tools import cluster_eval as ce  # noqa: E402
+
+N_SIM = 20
+SIM_SEED = {"hdl64": 1, "vlp16": 2}
+
+
+def _open3d():
+    try:
+        import open3d as o3d  # noqa: F401
+        return o3d
+    except Exception:  # not installed (make bench installs requirements-bench.txt)
+        return None
+
+
+def _sim_dir(sensor: str, quick: bool) -> pathlib.Path | None:
+    d = ROOT / "data" / f"sim_{sensor}"
+    if len(list((d / "velodyne").glob("*.bin"))) >= (3 if quick else N_SIM):
+        return d
+    try:
+        r = subprocess.run([sys.executable, "-m", "lidet_tools.sim.cli", "--sensor", sensor, "--scenes",
+                            str(3 if quick else N_SIM), "--seed", str(SIM_SEED[sensor]), "--out", str(d),
+                            "--no-progress"], capture_output=True, text=True, env={**os.environ,
+                                                                                   "PYTHONPATH": str(ROOT / "tools")})
+    except OSError:
+        return None
+    return d if r.returncode == 0 else None
+
+
+def _lidet(cli, scan, label, sensor, repeat, tmp):
+    out = pathlib.Path(tmp) / "ids.bin"
+    j = json.loads(subprocess.run([str(cli), "cluster", str(scan), "--sensor", sensor, "--labels", str(label),
+                                   "--json", "--repeat", str(repeat), "--out", str(out)], check=True,
+                                  capture_output=True, text=True).stdout)
+    return j["cluster_ms"], np.fromfile(out, np.uint32), j
+
+
+def _dbscan(o3d, pts, ground, repeat):
+    ng = np.nonzero(~ground)[0]
+    times, lab = [], None
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        pc = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(pts[ng, :3].astype(np.float64)))
+        lab = np.asarray(pc.cluster_dbscan(eps=0.5, min_points=10, print_progress=False))
+        times.append((time.perf_counter() - t0) * 1e3)
+    ids = np.zeros(len(pts), np.int64)
+    ids[ng] = lab + 1  # -1 (noise) -> 0
+    return float(np.median(times)), ids
+
+
+def _rate(summary, cls, band="0-40"):
+    d = summary[cls][band]
+    return "-" if d["n"] == 0 else f"{100 * d['recovered']:.0f}% ({d['n']})"
+
+
+def _dataset(name, data_dir, sensor, cli, o3d, rep_l, rep_d):
+    res_l, res_d, ms_l, ms_d, scans = [], [], [], [], 0
+    with tempfile.TemporaryDirectory() as tmp:
+        for stem, pts, lab in ce.scans(data_dir):
+            scan = data_dir / "velodyne" / f"{stem}.bin"
+            label = data_dir / "labels" / f"{stem}.label"
+            ms, ids, _ = _lidet(cli, scan, label, sensor, rep_l, tmp)
+            ms_l.append(ms)
+            res_l += ce.evaluate_scan(ids, lab, pts, stem)
+            if o3d is not None:
+                msd, idsd = _dbscan(o3d, pts, ce.ground_mask(lab), rep_d)
+                ms_d.append(msd)
+                res_d += ce.evaluate_scan(idsd, lab, pts, stem)
+            scans += 1
+    sl = ce.summarize(res_l)
+    out = {"name": name, "sensor": sensor, "scans": scans, "lidet_ms": float(np.median(ms_l)), "lidet": sl,
+           "lidet_results": res_l}
+    if o3d is not None:
+        out.update(dbscan_ms=float(np.median(ms_d)), dbscan=ce.summarize(res_d), dbscan_results=res_d)
+    return out
+
+
+def run(args) -> str:
+    quick = getattr(args, "quick", False)
+    rep_l, rep_d = (5, 1) if quick else (20, 3)
+    cli = pathlib.Path(args.build) / "ports" / "host" / "lidet"
+    o3d = _open3d()
+    sets = []
+    real = pathlib.Path(args.real) / "semantickitti"
+    if (real / "labels").exists():
+        sets.append(("real SemanticKITTI 00 (3 labelled scans)", real, "hdl64"))
+    for sensor in ("hdl64", "vlp16"):
+        d = _sim_dir(sensor, quick)
+        if d is not None:
+            n = len(list((d / "velodyne").glob("*.bin")))
+            sets.append((f"simulated {sensor} ({n} scans, lidet-sim seed {SIM_SEED[sensor]})", d, sensor))
+    lines = ["## Clustering (issue 6)", "",
+             "lidet depth clustering (per-profile defaults, 8-neighbourhood: > 16 beams theta 0.35 rad, 5 steps, "
+             "occluder bridging; 16 beams theta 0.30 rad, 3 steps) versus Open3D DBSCAN (eps 0.5 m, min_points 10) on the "
+             "same non-ground points (ground = the labels' ground classes). Recovered = the best-matching cluster "
+             "holds >= 80 % of the object's points and >= 80 % of the cluster is the object; objects with >= 10 "
+             "points, within 40 m (count in brackets).", ""]
+    if o3d is None:
+        lines += ["Open3D is not importable (pip install -r requirements-bench.txt): DBSCAN columns skipped.", ""]
+    if not sets:
+        return "\n".join(lines + ["No labelled scans found (../shared/data/real, data/sim_*): skipped.", ""])
+    lines += ["| scans | method | ms/scan (median) | speed ratio | car | person | bicyclist |",
+              "|---|---|---:|---:|---:|---:|---:|"]
+    results = [_dataset(n, d, s, cli, o3d, rep_l, rep_d) for n, d, s in sets]
+    for r in results:
+        lines.append(f"| {r['name']} | lidet | {r['lidet_ms']:.2f} | | {_rate(r['lidet'], 'car')} | "
+                     f"{_rate(r['lidet'], 'person')} | {_rate(r['lidet'], 'bicyclist')} |")
+        if "dbscan" in r:
+            lines.append(f"| | Open3D DBSCAN | {r['dbscan_ms']:.1f} | **{r['dbscan_ms'] / r['lidet_ms']:.0f}x** | "
+                         f"{_rate(r['dbscan'], 'car')} | {_rate(r['dbscan'], 'person')} | "
+                         f"{_rate(r['dbscan'], 'bicyclist')} |")
+    lines += ["", f"Commands: `lidet cluster SCAN.bin --sensor SENSOR --labels SCAN.label --json --repeat {rep_l} "
+              f"--out ids.bin` (cluster_ms); DBSCAN: `open3d.geometry.PointCloud.cluster_dbscan(eps=0.5, "
+              f"min_points=10)` on the non-ground points, median of {rep_d}, OMP_NUM_THREADS=1, point-cloud "
+              "construction included. Whole table: `python tools/bench/bench_cluster.py` (or `make bench`).", ""]
+    for r in results:
+        lines.append(ce.markdown(r["lidet"], f"lidet, {r['name']}: per class and distance band"))
+        if "dbscan" in r:
+            lines.append(ce.markdown(r["dbscan"], f"Open3D DBSCAN, {r['name']}: per class and distance band"))
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    import argparse
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default=str(ROOT / "build"))
+    ap.add_argument("--real", default=str(ROOT.parent / "shared" / "data" / "real"))
+    ap.add_argument("--quick", action="store_true")
+    print(run(ap.parse_args()))
+    sys.exit(0)
