@@ -1,8 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* `lidet cluster`: projection, ground mask, depth clustering and proposals on one scan.
- * Ground: from a SemanticKITTI label file (--labels, classes 40 44 48 49 60 72); else the ground stage
- * (lidet_ground.h, with its per-sector planes for the height filter) when the library has it; else a
- * flat ground (z below -(mount height - 0.25 m)). */
+ * Ground: from a SemanticKITTI label file (--labels, classes 40 44 48 49 60 72), else the ground stage
+ * (lidet_ground.h, with its per-sector planes for the height filter). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -12,14 +11,7 @@ static lidet_proj_t g_proj;
 static lidet_cluster_t g_cl;
 static uint8_t g_ground[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 static lidet_proposal_t g_prop;
-#ifdef LIDET_GROUND_H
 static lidet_ground_t g_gnd;
-#define HAVE_GROUND_STAGE 1
-#else
-#define HAVE_GROUND_STAGE 0
-#endif
-
-#define FLAT_GROUND_MARGIN_M 0.25f
 
 static int is_ground_class(uint32_t label)
 {
@@ -125,8 +117,7 @@ int cli_cluster(int argc, char **argv)
     if (cli_parse(nrest, rest, "cluster", &a) != 0)
     {
         fprintf(stderr, "  --labels   SemanticKITTI .label file: its ground classes are the ground mask\n"
-                        "             (default: the ground stage, or a flat ground 0.25 m above -mount height\n"
-                        "             in builds without it)\n");
+                        "             (default: the ground stage, with its per-sector planes)\n");
         free(rest);
         return 1;
     }
@@ -182,13 +173,6 @@ int cli_cluster(int argc, char **argv)
             g_ground[p] = (uint8_t)(img.point_idx[p] >= 0 && is_ground_class(lab[img.point_idx[p]]));
         free(lab);
     }
-    else if (!HAVE_GROUND_STAGE)
-    {
-        const float zmax = -(a.sensor_profile->mount_height_m - FLAT_GROUND_MARGIN_M);
-        for (p = 0; p < npix; ++p)
-            g_ground[p] = (uint8_t)(img.point_idx[p] >= 0 && img.z_m[p] < zmax);
-    }
-#if HAVE_GROUND_STAGE
     else
     {
         lidet_ground_cfg_t gcfg;
@@ -198,7 +182,6 @@ int cli_cluster(int argc, char **argv)
             return fail(&a, "ground init", st);
         use_stage = 1;
     }
-#endif
 
     for (i = 0; i < a.repeat; ++i)
     {
@@ -208,7 +191,6 @@ int cli_cluster(int argc, char **argv)
         if (!LIDET_SUCCEEDED(st))
             return fail(&a, "projection", st);
         lidet_proj_image(&g_proj, &img);
-#if HAVE_GROUND_STAGE
         if (use_stage)
         {
             t0 = cli_now_ms();
@@ -219,7 +201,6 @@ int cli_cluster(int argc, char **argv)
             memcpy(g_ground, lidet_ground_mask(&g_gnd), npix);
             planes = lidet_ground_planes(&g_gnd, &n_sectors);
         }
-#endif
         t0 = cli_now_ms();
         st = lidet_cluster_run(&g_cl, &img, g_ground, planes, n_sectors);
         t_clu[i] = cli_now_ms() - t0;
@@ -270,7 +251,7 @@ int cli_cluster(int argc, char **argv)
         cli_json_begin(stdout);
         cli_json_str(stdout, "sensor", a.sensor);
         cli_json_int(stdout, "points", a.n_points);
-        cli_json_str(stdout, "ground", labels_path != NULL ? "labels" : (use_stage ? "stage" : "flat"));
+        cli_json_str(stdout, "ground", labels_path != NULL ? "labels" : "stage");
         cli_json_int(stdout, "candidates", cs->n_candidates);
         cli_json_int(stdout, "found", cs->n_found);
         cli_json_int(stdout, "dropped_small", cs->n_dropped_small);
@@ -295,7 +276,7 @@ int cli_cluster(int argc, char **argv)
     {
         printf("scan            %s (%s)\n", a.scan_path, a.sensor);
         printf("points          %u, non-ground pixels %u (ground: %s)\n", a.n_points, cs->n_candidates,
-               labels_path != NULL ? labels_path : (use_stage ? "ground stage" : "flat"));
+               labels_path != NULL ? labels_path : "ground stage");
         printf("clusters        %u kept of %u found (dropped: small %u, extent %u, height %u, capacity %u)\n",
                cs->n_kept, cs->n_found, cs->n_dropped_small, cs->n_dropped_extent, cs->n_dropped_height,
                cs->n_dropped_capacity);
