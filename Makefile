@@ -40,11 +40,17 @@ test-asan:
 	cmake --build $(ASAN) -j $(JOBS)
 	ctest --test-dir $(ASAN) --output-on-failure -j $(JOBS)
 
-# Runs the host CLI on a simulated scan shipped in the repo: figures on stdout, pictures in out/.
+# Runs the host CLI on a simulated scan shipped in the repo, stage by stage: figures on stdout,
+# pictures in out/ (range image, ground in a bird's-eye view, clusters in a bird's-eye view).
 demo: build
 	@mkdir -p out
+	@echo "== projection"
 	$(BUILD)/ports/host/lidet project $(SAMPLE) --sensor hdl64 --png out/demo_project.png
-	@echo "demo: picture written to out/demo_project.png"
+	@echo "== ground segmentation"
+	$(BUILD)/ports/host/lidet ground $(SAMPLE) --sensor hdl64 --png out/demo_ground.png --repeat 20
+	@echo "== depth clustering and proposals"
+	$(BUILD)/ports/host/lidet cluster $(SAMPLE) --sensor hdl64 --png out/demo_cluster.png --repeat 20
+	@echo "demo: pictures in out/demo_project.png, out/demo_ground.png, out/demo_cluster.png"
 
 # Benchmarks against peers measured in the same run; results go to docs/BENCHMARKS.md.
 bench: deps build
