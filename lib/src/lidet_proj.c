@@ -11,6 +11,7 @@
 #define DEG2RAD 0.0174532925f
 /* keep every accepted elevation away from +-90 deg so its tangent stays finite */
 #define MAX_ABS_ELEV_RAD 1.55f
+#define PASS2_BLOCK 1024u /* pixels per pass-2 block: 5 planes x 4 KiB stay in L1 */
 
 void lidet_proj_cfg_default(lidet_proj_cfg_t *cfg, const lidet_sensor_t *sensor)
 {
@@ -210,6 +211,70 @@ lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg)
     return LIDET_OK;
 }
 
+/* Pass 1 works on blocks of KEY_BLOCK points (stack: 6 arrays of KEY_BLOCK x 4 B = 1.5 KiB):
+ *  (a) key_block: range test, tan(elevation), pseudo-azimuth and both lookup-table buckets of every
+ *      point, in one loop without branches or table accesses, which compilers vectorize (SSE2: 4
+ *      points per sqrt and per division);
+ *  (b) table lookups and exact corrections, point by point, giving each point its pixel;
+ *  (c) the closest-point test over the block's projected points, in a loop of its own.
+ * Measured on 11 real KITTI scans: 11.7 ns/point against 16.4 for the same code in one loop per point
+ * (keys, lookups and the closest-point test together), which stalls on the test's scattered
+ * read-modify-writes. */
+#define KEY_BLOCK 64u
+#define KEY_RANGE_OK 1 /* min2 <= r^2 <= max2 (so x, y, z finite) */
+#define KEY_FOV_OK 2   /* tan(elevation) in [tan_lo, tan_hi] (so not NaN) */
+#define KEY_DEN_OK 4   /* (|x|+|y|) * rxy > 0: t and d are lidet__proj_keys' */
+#define KEY_ALL 7
+
+typedef struct
+{
+    float t[KEY_BLOCK];       /* tan(elevation) */
+    float d[KEY_BLOCK];       /* pseudo-azimuth */
+    float r2[KEY_BLOCK];      /* squared range */
+    int32_t row_k[KEY_BLOCK]; /* row_lut bucket; reused by (b) for the pixel of the k-th projected point */
+    int32_t col_k[KEY_BLOCK]; /* col_lut bucket; reused by (b) for the block index of that point */
+    int32_t flags[KEY_BLOCK]; /* KEY_* */
+} key_block_t;
+
+/* (a) above. The arithmetic is lidet__proj_keys' without its branch: with den = 0, inv = +inf makes
+ * t +-inf or NaN (rejected by the field-of-view test) and d NaN (replaced by 2 in run() on the ring
+ * path). Every float -> int conversion is of a clamped value (NaN clamps to the low end), so invalid
+ * points get harmless buckets and no UB. Written so that GCC/Clang if-convert it under the default FP
+ * semantics: selects of operands, no arithmetic inside a condition (an add that may trap is not
+ * speculated, which blocks vectorization). */
+static inline void key_block(key_block_t *kb, const float *pts, uint32_t m, uint32_t stride, float min2, float max2,
+                             float tan_lo, float tan_hi, float row_scale, float col_scale, float last_col_bucket)
+{
+    uint32_t j;
+    for (j = 0; j < m; ++j)
+    {
+        const float *pt = pts + (size_t)j * stride;
+        const float x = pt[0], y = pt[1], z = pt[2];
+        const float rxy2 = x * x + y * y;
+        const float r2 = rxy2 + z * z;
+        const float s = fabsf(x) + fabsf(y);
+        const float rxy = sqrtf(rxy2);
+        const float den = s * rxy;
+        const float inv = 1.0f / den;
+        const float q = x * rxy * inv;
+        const float t = z * s * inv;
+        const float d = (y >= 0.0f ? 1.0f : 3.0f) + (y >= 0.0f ? q : -q); /* 1 + q or 3 - q (= 3 + -q) */
+        const int32_t range_ok = (r2 >= min2) & (r2 <= max2);
+        const int32_t fov_ok = (t >= tan_lo) & (t <= tan_hi);
+        const float tc0 = t >= tan_lo ? t : tan_lo; /* t itself when fov_ok */
+        const float tc = tc0 <= tan_hi ? tc0 : tan_hi;
+        float uc = d * col_scale;
+        uc = uc >= 0.0f ? uc : 0.0f;                       /* also NaN */
+        uc = uc <= last_col_bucket ? uc : last_col_bucket; /* d may exceed 4 by a few ulp */
+        kb->t[j] = t;
+        kb->d[j] = d;
+        kb->r2[j] = r2;
+        kb->row_k[j] = (int32_t)((tc - tan_lo) * row_scale); /* in [0, LIDET_PROJ_ROW_LUT] */
+        kb->col_k[j] = (int32_t)uc;                          /* in [0, 4 cols] */
+        kb->flags[j] = range_ok | (fov_ok << 1) | ((int32_t)(den > 0.0f) << 2);
+    }
+}
+
 float lidet_proj_azimuth_key(float x, float y)
 {
     float t, d, rxy;
@@ -220,7 +285,7 @@ float lidet_proj_azimuth_key(float x, float y)
 lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t n_points, uint32_t stride,
                               const uint16_t *ring)
 {
-    uint32_t n, i, rows, cols, npix, pix;
+    uint32_t n, rows, cols, npix, pix;
     float min2, max2;
     lidet_proj_stats_t st;
 
@@ -244,15 +309,16 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
     min2 = min2 > 1.0e-30f ? min2 : 1.0e-30f;
     max2 = proj->cfg.max_range_m > 0.0f ? proj->cfg.max_range_m * proj->cfg.max_range_m : 3.0e38f;
 
-    /* pass 1, over points: pixel of each point and the closest point per pixel. range_m holds the
-     * winner's squared range until pass 2, starting at 3.39e38 (every byte 0x7F), above any accepted r^2 (max2 <= 3.0e38), so the winner test needs no emptiness check.
+    /* pass 1, over points in blocks (see KEY_BLOCK): pixel of each point and the closest point per
+     * pixel. range_m holds the winner's squared range until pass 2, starting at 3.39e38 (every byte
+     * 0x7F), above any accepted r^2 (max2 <= 3.0e38), so the winner test needs no emptiness check.
      * Invariants live in locals: the stores below could alias the state's float fields otherwise. */
     memset(proj->point_idx, 0xFF, (size_t)npix * sizeof proj->point_idx[0]);
     memset(proj->range_m, 0x7F, (size_t)npix * sizeof proj->range_m[0]);
     {
         const float tan_lo = proj->tan_lo, tan_hi = proj->tan_hi, row_scale = proj->lut_scale;
         const float col_scale = proj->col_lut_scale;
-        const int32_t last_col_bucket = 4 * (int32_t)cols;
+        const float last_col_bucket = (float)(4u * cols);
         const int row_single = proj->row_single_step, col_single = proj->col_single_step;
         const float *const row_bound = proj->row_bound_tan;
         const float *const col_edge = proj->col_edge_key;
@@ -262,120 +328,158 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
         int32_t *const point_idx = proj->point_idx;
         int32_t *const point_pixel = proj->point_pixel;
         float *const best = proj->range_m;
+        uint32_t base, projected = 0;
+        key_block_t kb;
 
-        for (i = 0; i < n; ++i)
+        for (base = 0; base < n; base += KEY_BLOCK)
         {
-            const float *pt = points + (size_t)i * stride;
-            const float x = pt[0], y = pt[1], z = pt[2];
-            const float rxy2 = x * x + y * y;
-            const float r2 = rxy2 + z * z;
-            float t, d, rxy;
-            int32_t row, col, k;
-
-            /* one test covers NaN, Inf, overflow and both range limits; classify only when it fails */
-            if (!(r2 >= min2 && r2 <= max2))
-            {
-                if (!lidet__isfinite(x) || !lidet__isfinite(y) || !lidet__isfinite(z))
-                    ++st.n_nonfinite;
-                else if (r2 < min2)
-                    ++st.n_too_close;
-                else
-                    ++st.n_too_far; /* beyond max_range_m, or so large that r^2 overflows */
-                point_pixel[i] = -1;
-                continue;
-            }
-            lidet__proj_keys(x, y, z, rxy2, &t, &d, &rxy);
-            if (ring != 0)
-            {
-                if (ring[i] >= rows)
-                {
-                    ++st.n_bad_ring;
-                    point_pixel[i] = -1;
-                    continue;
-                }
-                row = ring_to_row[ring[i]];
-            }
+            const uint32_t m = n - base < KEY_BLOCK ? n - base : KEY_BLOCK;
+            uint32_t j, nw = 0;
+            /* (a); KITTI-style records (stride 4) get their own copy, with a constant stride */
+            if (stride == 4u)
+                key_block(&kb, points + (size_t)base * 4u, m, 4u, min2, max2, tan_lo, tan_hi, row_scale, col_scale,
+                          last_col_bucket);
             else
+                key_block(&kb, points + (size_t)base * stride, m, stride, min2, max2, tan_lo, tan_hi, row_scale,
+                          col_scale, last_col_bucket);
+            /* (b) */
+            for (j = 0; j < m; ++j)
             {
-                if (!(t >= tan_lo && t <= tan_hi)) /* also rejects NaN: never cast */
+                const uint32_t i = base + j;
+                const float t = kb.t[j];
+                float d = kb.d[j];
+                int32_t row, col, col_k = kb.col_k[j];
+                if (kb.flags[j] != KEY_ALL)
                 {
-                    ++st.n_out_of_fov;
-                    point_pixel[i] = -1;
-                    continue;
+                    /* one test covered NaN, Inf, overflow and both range limits; classify only now */
+                    if (!(kb.flags[j] & KEY_RANGE_OK))
+                    {
+                        const float *pt = points + (size_t)i * stride;
+                        if (!lidet__isfinite(pt[0]) || !lidet__isfinite(pt[1]) || !lidet__isfinite(pt[2]))
+                            ++st.n_nonfinite;
+                        else if (kb.r2[j] < min2)
+                            ++st.n_too_close;
+                        else
+                            ++st.n_too_far; /* beyond max_range_m, or so large that r^2 overflows */
+                        point_pixel[i] = -1;
+                        continue;
+                    }
+                    if (ring == 0) /* elevation outside the beams (+ margin), x = y = 0 included */
+                    {
+                        ++st.n_out_of_fov;
+                        point_pixel[i] = -1;
+                        continue;
+                    }
+                    if (!(kb.flags[j] & KEY_DEN_OK)) /* ring path, x = y = 0: straight ahead */
+                    {
+                        d = 2.0f;
+                        col_k = (int32_t)(d * col_scale);
+                    }
                 }
-                k = (int32_t)((t - tan_lo) * row_scale); /* in [0, LIDET_PROJ_ROW_LUT] */
-                row = row_lut[k];
-                /* exact nearest beam: correct the bucket's guess against the mid-angle tangents (ties
-                 * go to the upper row); the sentinels stop the loops of the dense-table fallback */
-                if (row_single)
+                if (ring != 0)
                 {
-                    row -= (int32_t)(row_bound[row] <= t);
-                    row += (int32_t)(row_bound[row + 1] > t);
+                    if (ring[i] >= rows)
+                    {
+                        ++st.n_bad_ring;
+                        point_pixel[i] = -1;
+                        continue;
+                    }
+                    row = ring_to_row[ring[i]];
                 }
                 else
                 {
-                    while (row_bound[row] <= t)
-                        --row;
-                    while (row_bound[row + 1] > t)
-                        ++row;
+                    row = row_lut[kb.row_k[j]];
+                    /* exact nearest beam: correct the bucket's guess against the mid-angle tangents (ties
+                     * go to the upper row); the sentinels stop the loops of the dense-table fallback */
+                    if (row_single)
+                    {
+                        row -= (int32_t)(row_bound[row] <= t);
+                        row += (int32_t)(row_bound[row + 1] > t);
+                    }
+                    else
+                    {
+                        while (row_bound[row] <= t)
+                            --row;
+                        while (row_bound[row + 1] > t)
+                            ++row;
+                    }
+                }
+                col = col_lut[col_k];
+                if (col_single)
+                {
+                    col -= (int32_t)(col_edge[col] > d);
+                    col += (int32_t)(col_edge[col + 1] <= d);
+                }
+                else
+                {
+                    while (col_edge[col] > d)
+                        --col;
+                    while (col_edge[col + 1] <= d)
+                        ++col;
+                }
+                pix = (uint32_t)row * cols + (uint32_t)col;
+                LIDET_ASSERT(pix < npix);
+                point_pixel[i] = (int32_t)pix;
+                /* nw <= j: the entries rewritten here have been read already */
+                kb.row_k[nw] = (int32_t)pix;
+                kb.col_k[nw] = (int32_t)j;
+                ++nw;
+            }
+            /* (c) in point order: strict test, exact ties keep the earlier point */
+            for (j = 0; j < nw; ++j)
+            {
+                const uint32_t p = (uint32_t)kb.row_k[j];
+                const uint32_t jj = (uint32_t)kb.col_k[j];
+                const float r2 = kb.r2[jj];
+                if (r2 < best[p])
+                {
+                    best[p] = r2;
+                    point_idx[p] = (int32_t)(base + jj);
                 }
             }
-            k = (int32_t)(d * col_scale); /* d in [0, 4] up to rounding: k in [0, 4 cols] */
-            k = k > last_col_bucket ? last_col_bucket : k;
-            col = col_lut[k];
-            if (col_single)
-            {
-                col -= (int32_t)(col_edge[col] > d);
-                col += (int32_t)(col_edge[col + 1] <= d);
-            }
-            else
-            {
-                while (col_edge[col] > d)
-                    --col;
-                while (col_edge[col + 1] <= d)
-                    ++col;
-            }
-            pix = (uint32_t)row * cols + (uint32_t)col;
-            LIDET_ASSERT(pix < npix);
-            point_pixel[i] = (int32_t)pix;
-            ++st.n_projected;
-            if (r2 < best[pix]) /* strict: exact ties keep the earlier point */
-            {
-                best[pix] = r2;
-                point_idx[pix] = (int32_t)i;
-            }
+            projected += nw;
         }
+        st.n_projected = projected;
     }
 
-    /* pass 2, over pixels (sequential): gather each winner's coordinates, squared range -> range,
-     * zeros for empty pixels. Writing the coordinates here rather than on every win in pass 1 keeps
-     * pass 1's working set at two arrays (index + squared range): measured 16.6 vs 17.8 ns/point on
-     * real KITTI scans, because six scattered 512 KiB arrays overflow L2. */
+    /* pass 2, over pixels, in blocks that stay in L1: (a) gather each winner's coordinates, an empty
+     * pixel reading record 0 masked to +0 (no branch: 21 % of KITTI pixels are empty, scattered);
+     * (b) the square roots of the block in a loop compilers vectorize: R from x and y, the range from
+     * the squared range (0x7F7F7F7F > max2 marks an empty pixel). Writing the coordinates here rather
+     * than on every win in pass 1 keeps pass 1's working set at two arrays (index + squared range):
+     * measured 16.6 vs 17.8 ns/point on real KITTI scans, six scattered 512 KiB arrays overflow L2. */
     {
-        float *const range = proj->range_m;
+        static const float zero_rec[3] = {0.0f, 0.0f, 0.0f};
+        const float *const src = st.n_projected > 0 ? points : zero_rec; /* points may be NULL if n = 0 */
+        float *const xo = proj->x_m, *const yo = proj->y_m, *const zo = proj->z_m;
+        float *const ro = proj->rxy_m, *const rng = proj->range_m;
         const int32_t *const idx = proj->point_idx;
-        uint32_t filled = 0;
-        for (pix = 0; pix < npix; ++pix)
+        uint32_t filled = 0, base;
+        for (base = 0; base < npix; base += PASS2_BLOCK)
         {
-            const int32_t k = idx[pix];
-            if (k >= 0)
+            const uint32_t end = npix - base < PASS2_BLOCK ? npix : base + PASS2_BLOCK;
+            for (pix = base; pix < end; ++pix)
             {
-                const float *pt = points + (size_t)k * stride;
-                const float x = pt[0], y = pt[1];
-                proj->x_m[pix] = x;
-                proj->y_m[pix] = y;
-                proj->z_m[pix] = pt[2];
-                proj->rxy_m[pix] = sqrtf(x * x + y * y);
-                range[pix] = sqrtf(range[pix]);
-                ++filled;
+                const int32_t k = idx[pix];
+                const uint32_t keep = 0u - (uint32_t)(k >= 0); /* all ones for a winner, else 0 */
+                const float *pt = src + (size_t)((uint32_t)k & keep) * stride;
+                uint32_t ux, uy, uz;
+                memcpy(&ux, &pt[0], sizeof ux);
+                memcpy(&uy, &pt[1], sizeof uy);
+                memcpy(&uz, &pt[2], sizeof uz);
+                ux &= keep;
+                uy &= keep;
+                uz &= keep;
+                memcpy(&xo[pix], &ux, sizeof ux);
+                memcpy(&yo[pix], &uy, sizeof uy);
+                memcpy(&zo[pix], &uz, sizeof uz);
+                filled += keep & 1u;
             }
-            else
+            for (pix = base; pix < end; ++pix)
             {
-                proj->x_m[pix] = 0.0f;
-                proj->y_m[pix] = 0.0f;
-                proj->z_m[pix] = 0.0f;
-                proj->rxy_m[pix] = 0.0f;
-                range[pix] = 0.0f;
+                const float x = xo[pix], y = yo[pix], b = rng[pix];
+                ro[pix] = sqrtf(x * x + y * y);
+                rng[pix] = b <= max2 ? sqrtf(b) : 0.0f;
             }
         }
         st.n_pixels_filled = filled;
