@@ -389,6 +389,123 @@ static void test_custom_ring_order(void)
     }
 }
 
+/* run() works on blocks of points (vectorizable keys, then lookups, then the closest-point test): the
+ * result must not depend on the block split nor on the record stride. 300 points (not a multiple of
+ * the block) with invalid ones at block edges and repeated pixels across blocks, projected with
+ * strides 4, 3 and 6 and one point at a time, must give the same image, pixels and counts. */
+#define NB 300
+static float st_pts[NB * 6];
+static float ref_x[64 * 2048], ref_range[64 * 2048], ref_rxy[64 * 2048];
+static int32_t ref_idx[64 * 2048], ref_pp[NB];
+
+static void project_strided(uint32_t stride, lidet_proj_stats_t *out)
+{
+    uint32_t i, k;
+    for (i = 0; i < NB; ++i)
+    {
+        for (k = 0; k < stride; ++k)
+        {
+            st_pts[i * stride + k] = k < 3 ? pts[4 * i + k] : -7.0f;
+        }
+    }
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, st_pts, NB, stride, NULL));
+    *out = *lidet_proj_stats(&g.ws);
+}
+
+static void test_blocks_and_strides_agree(void)
+{
+    const float nan = NAN, inf = INFINITY;
+    const int bad_at[8] = {0, 63, 64, 65, 127, 128, 200, 299};
+    const float bad[8][3] = {{nan, 1.0f, 1.0f},    {1.0f, inf, 1.0f},     {0.0f, 0.0f, 0.0f},
+                             {0.0f, 0.0f, -5.0f},  {1.0f, 0.0f, 1.0f},    {3e19f, 3e19f, 0.0f},
+                             {0.01f, 0.0f, 0.0f},  {0.0f, 0.0f, 4.0f}};
+    const uint32_t npix = 64u * 2048u;
+    lidet_proj_stats_t st4, st;
+    lidet_range_image_t img;
+    const int32_t *pp;
+    uint32_t i, n, strides[2] = {3, 6};
+    uint32_t seed = 12345u;
+    init_sensor("hdl64");
+    lidet_proj_image(&g.ws, &img);
+    for (i = 0; i < NB; ++i)
+    {
+        double az, el, r;
+        seed = seed * 1664525u + 1013904223u;
+        az = -M_PI + 2.0 * M_PI * (double)(seed >> 8) / 16777216.0;
+        seed = seed * 1664525u + 1013904223u;
+        el = -0.43 + 0.47 * (double)(seed >> 8) / 16777216.0;
+        seed = seed * 1664525u + 1013904223u;
+        r = 1.0 + 60.0 * (double)(seed >> 8) / 16777216.0;
+        put(&pts[4 * i], r, az, el);
+    }
+    for (i = 0; i < 40; ++i) /* the same directions again, some closer, some farther, blocks later */
+    {
+        const float f = (i % 2) ? 0.5f : 2.0f;
+        pts[4 * (150 + i)] = f * pts[4 * i];
+        pts[4 * (150 + i) + 1] = f * pts[4 * i + 1];
+        pts[4 * (150 + i) + 2] = f * pts[4 * i + 2];
+    }
+    memcpy(&pts[4 * 260], &pts[4 * 20], 4 * sizeof(float)); /* exact tie, blocks apart */
+    for (i = 0; i < 8; ++i)
+    {
+        memcpy(&pts[4 * bad_at[i]], bad[i], 3 * sizeof(float));
+    }
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, pts, NB, 4, NULL));
+    st4 = *lidet_proj_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(NB - 8, st4.n_projected);
+    TEST_ASSERT_EQUAL_UINT32(2, st4.n_nonfinite);
+    TEST_ASSERT_EQUAL_UINT32(2, st4.n_too_close);
+    TEST_ASSERT_EQUAL_UINT32(1, st4.n_too_far);
+    TEST_ASSERT_EQUAL_UINT32(3, st4.n_out_of_fov);
+    pp = lidet_proj_point_pixels(&g.ws, &n);
+    TEST_ASSERT_EQUAL_INT32(20, img.point_idx[pp[260]]);
+    memcpy(ref_pp, pp, sizeof ref_pp);
+    memcpy(ref_x, img.x_m, sizeof ref_x);
+    memcpy(ref_range, img.range_m, sizeof ref_range);
+    memcpy(ref_rxy, img.rxy_m, sizeof ref_rxy);
+    memcpy(ref_idx, img.point_idx, sizeof ref_idx);
+    for (i = 0; i < 2; ++i)
+    {
+        project_strided(strides[i], &st);
+        TEST_ASSERT_EQUAL_MEMORY(&st4, &st, sizeof st);
+        TEST_ASSERT_EQUAL_MEMORY(ref_pp, pp, sizeof ref_pp);
+        TEST_ASSERT_EQUAL_MEMORY(ref_x, img.x_m, npix * sizeof(float));
+        TEST_ASSERT_EQUAL_MEMORY(ref_range, img.range_m, npix * sizeof(float));
+        TEST_ASSERT_EQUAL_MEMORY(ref_rxy, img.rxy_m, npix * sizeof(float));
+        TEST_ASSERT_EQUAL_MEMORY(ref_idx, img.point_idx, npix * sizeof(int32_t));
+    }
+    for (i = 0; i < NB; ++i) /* one point per run: a block of one */
+    {
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, &pts[4 * i], 1, 4, NULL));
+        TEST_ASSERT_EQUAL_INT32(ref_pp[i], pp[0]);
+        if (pp[0] >= 0 && ref_idx[pp[0]] == (int32_t)i)
+        {
+            TEST_ASSERT_EQUAL_FLOAT(ref_range[pp[0]], img.range_m[pp[0]]);
+            TEST_ASSERT_EQUAL_FLOAT(ref_rxy[pp[0]], img.rxy_m[pp[0]]);
+        }
+    }
+}
+
+/* ring path: a point straight above or below the sensor (x = y = 0) has no azimuth; it goes to the
+ * straight-ahead column of its ring's row */
+static void test_ring_path_vertical_point(void)
+{
+    uint16_t ring[2] = {3, 7};
+    const float p[8] = {0.0f, 0.0f, 5.0f, 0.0f, 10.0f, 0.0f, 0.0f, 0.0f};
+    uint32_t n;
+    const int32_t *pp;
+    lidet_range_image_t img;
+    init_sensor("vlp16");
+    lidet_proj_image(&g.ws, &img);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, p, 2, 4, ring));
+    pp = lidet_proj_point_pixels(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_proj_stats(&g.ws)->n_projected);
+    TEST_ASSERT_EQUAL_INT(img.n_cols / 2, pp[0] % img.n_cols);
+    TEST_ASSERT_EQUAL_INT(img.n_cols / 2, pp[1] % img.n_cols);
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, img.rxy_m[pp[0]]);
+    TEST_ASSERT_EQUAL_FLOAT(5.0f, img.range_m[pp[0]]);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -404,5 +521,7 @@ int main(void)
     RUN_TEST(test_empty_scan);
     RUN_TEST(test_argument_and_config_errors);
     RUN_TEST(test_custom_ring_order);
+    RUN_TEST(test_blocks_and_strides_agree);
+    RUN_TEST(test_ring_path_vertical_point);
     return UNITY_END();
 }

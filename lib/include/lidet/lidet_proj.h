@@ -29,7 +29,8 @@
  * + LIDET_MAX_ROWS * 9 B + ~100 B. Defaults (128 x 2048, 262,144 points): about 7.3 MiB; a VLP-16
  * build (16 x 1800, 30,000 points): about 0.8 MiB. lidet_proj_bytes() returns the exact figure.
  * Declare it `static`.
- * Time: O(n_points + n_rows * n_cols) per run, no allocation, no recursion.
+ * Time: O(n_points + n_rows * n_cols) per run, no allocation, no recursion. Stack: about 1.6 KiB in
+ * run() (the keys of a block of 64 points, see lidet_proj.c).
  */
 #ifndef LIDET_PROJ_H
 #define LIDET_PROJ_H
