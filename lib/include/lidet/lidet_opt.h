@@ -62,6 +62,12 @@
 #define LIDET_PROJ_ROW_LUT 1024
 #endif
 
+/** Points per block of the projection's first pass (keys of a block, then lookups, then the
+ *  closest-point test); lidet_proj_run() keeps one block's keys on the stack, 24 B per point. */
+#ifndef LIDET_PROJ_BLOCK
+#define LIDET_PROJ_BLOCK 64
+#endif
+
 /** Maximum azimuth sectors of the ground stage (one plane each). */
 #ifndef LIDET_GROUND_MAX_SECTORS
 #define LIDET_GROUND_MAX_SECTORS 256
@@ -110,6 +116,9 @@
 #endif
 #if LIDET_PROJ_ROW_LUT < 16 || LIDET_PROJ_ROW_LUT > 65536
 #error "LIDET_PROJ_ROW_LUT must be in [16, 65536]"
+#endif
+#if LIDET_PROJ_BLOCK < 1 || LIDET_PROJ_BLOCK > 4096
+#error "LIDET_PROJ_BLOCK must be in [1, 4096]"
 #endif
 #if LIDET_GROUND_MAX_SECTORS < 1 || LIDET_GROUND_MAX_SECTORS > 4096
 #error "LIDET_GROUND_MAX_SECTORS must be in [1, 4096]"

@@ -29,8 +29,8 @@
  * + LIDET_MAX_ROWS * 9 B + ~100 B. Defaults (128 x 2048, 262,144 points): about 7.3 MiB; a VLP-16
  * build (16 x 1800, 30,000 points): about 0.8 MiB. lidet_proj_bytes() returns the exact figure.
  * Declare it `static`.
- * Time: O(n_points + n_rows * n_cols) per run, no allocation, no recursion. Stack: about 1.6 KiB in
- * run() (the keys of a block of 64 points, see lidet_proj.c).
+ * Time: O(n_points + n_rows * n_cols) per run, no allocation, no recursion. Stack: run() keeps the keys
+ * of a block of LIDET_PROJ_BLOCK points, 24 B each (1.5 KiB with the default 64; see lidet_opt.h).
  */
 #ifndef LIDET_PROJ_H
 #define LIDET_PROJ_H
