@@ -330,7 +330,7 @@ static uint8_t g_ground_pix[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 /* Project with the state of lidet_py_proj_init, then cluster. ground_per_point: n bytes (1 = ground)
  * or NULL; a pixel is ground when its winning point is. planes: n_sectors * 4 floats (nx, ny, nz, d)
  * or NULL. cfg_f: theta_rad, max_extent_m, max_mean_height_m, mount_height_m,
- * max_gap_m; cfg_u: max_steps,
+ * max_gap_m, max_gap_per_m; cfg_u: max_steps,
  * min_points, bridge_occluders, diagonals. Outputs (any may be NULL): out_point_labels n uint32 (0 for points past capacity),
  * out_pixel_labels rows * cols uint16, out_members rows * cols int32 (first n_pixels_kept used),
  * out_rec_u max_recs * 3 uint32 (n_points, first_member, seed_pixel), out_rec_f max_recs * 10 floats
@@ -377,6 +377,7 @@ LIDET_PY_API int lidet_py_cluster_run(const float *pts, uint32_t n, uint32_t str
     cfg.max_mean_height_m = cfg_f[2];
     cfg.mount_height_m = cfg_f[3];
     cfg.max_gap_m = cfg_f[4];
+    cfg.max_gap_per_m = cfg_f[5];
     cfg.max_steps = cfg_u[0];
     cfg.min_points = cfg_u[1];
     cfg.bridge_occluders = cfg_u[2];

@@ -66,8 +66,10 @@ def test_synthetic_objects_are_separate_clusters():
 
 def test_defaults_and_options():
     d = native.cluster_defaults("hdl64")
-    assert d["min_points"] == 10 and d["max_steps"] == 5 and d["theta_rad"] == 0.35 and d["diagonals"] == 1
-    assert native.cluster_defaults("vlp16")["theta_rad"] == 0.30
+    assert d["min_points"] == 10 and d["max_steps"] == 5 and d["theta_rad"] == 0.18 and d["diagonals"] == 1
+    assert d["max_gap_m"] == 0.7 and d["max_gap_per_m"] == 0.025 and d["bridge_occluders"] == 1
+    v = native.cluster_defaults("vlp16")
+    assert v["theta_rad"] == 0.12 and v["max_steps"] == 4 and v["bridge_occluders"] == 0 and v["max_gap_per_m"] == 0.04
     pts, ground, _, _ = _synthetic()
     a = native.cluster(pts, "hdl64", ground=ground, min_points=100000)
     assert a.stats["n_kept"] == 0 and a.stats["n_dropped_small"] == a.stats["n_found"]
@@ -88,9 +90,10 @@ def test_real_scan_matches_reference(real_dir):
     """The C labels equal the plain-Python BFS reference on a real SemanticKITTI scan."""
     pts, ground = _real(real_dir)
     for cfg in (dict(theta_rad=0.40, max_steps=5, bridge_occluders=True, diagonals=True, min_points=10,
-                     max_extent_m=6.0, max_mean_height_m=2.5),
+                     max_extent_m=6.0, max_mean_height_m=2.5, max_gap_m=0.0, max_gap_per_m=0.0),
                 dict(theta_rad=0.2, max_steps=9, bridge_occluders=False, diagonals=False, min_points=10,
-                     max_extent_m=6.0, max_mean_height_m=2.5)):
+                     max_extent_m=6.0, max_mean_height_m=2.5, max_gap_m=0.0, max_gap_per_m=0.0),
+                {k: v for k, v in native.cluster_defaults("hdl64").items() if k != "mount_height_m"}):
         _check_against_ref(pts, ground, cfg)
 
 

@@ -186,6 +186,14 @@ static void test_max_gap(void)
     TEST_ASSERT_EQUAL_UINT32(4, lidet_cluster_stats(&g.ws)->n_kept);
     cfg.max_gap_m = -1.0f;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &cfg));
+    /* the bound grows with range: 1 m + 0.1 m per metre at 10 m = 2 m, neighbours (1.96 m) join,
+     * the pair across the hole (3.9 m) does not */
+    cfg.max_gap_m = 1.0f;
+    cfg.max_gap_per_m = 0.1f;
+    run(art, 1, NULL);
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_cluster_stats(&g.ws)->n_kept);
+    cfg.max_gap_per_m = -0.1f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &cfg));
 }
 
 /* vertical bridging uses the real beam angles and also steps over ground pixels */
@@ -403,8 +411,12 @@ static void test_defaults_per_profile(void)
     TEST_ASSERT_EQUAL_UINT32(1, d.diagonals);
     TEST_ASSERT_CLOSE(1.73, d.mount_height_m, 1e-3, 0);
     TEST_ASSERT_TRUE(d.theta_rad > 0.0f && d.theta_rad < 0.8f);
+    TEST_ASSERT_TRUE(d.max_gap_m > 0.0f && d.max_gap_per_m > 0.0f);
     lidet_cluster_cfg_default(&d, lidet_sensor_find("vlp16"));
     TEST_ASSERT_TRUE(d.theta_rad > 0.0f && d.theta_rad < 0.8f);
+    TEST_ASSERT_EQUAL_UINT32(4, d.max_steps);
+    TEST_ASSERT_EQUAL_UINT32(0, d.bridge_occluders);
+    TEST_ASSERT_TRUE(d.max_gap_m > 0.0f && d.max_gap_per_m > 0.0f);
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &d));
 }
 

@@ -75,6 +75,8 @@ static void tcu_cfg(lidet_cluster_cfg_t *cfg)
     cfg->min_points = 1;
     cfg->max_extent_m = 100.0f;
     cfg->max_mean_height_m = 1e30f;
+    cfg->max_gap_m = 0.0f; /* the angle test alone (the defaults' gap bound is for real-sized images) */
+    cfg->max_gap_per_m = 0.0f;
 }
 
 #endif

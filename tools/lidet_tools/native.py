@@ -280,8 +280,8 @@ def ground_fit_plane(xyz) -> tuple[np.ndarray, np.ndarray]:
 def cluster_defaults(sensor: str | Sensor = "hdl64") -> dict:
     s = get_sensor(sensor) if isinstance(sensor, str) else sensor
     sparse = s.rows <= 16
-    return dict(theta_rad=0.30 if sparse else 0.35, max_steps=3 if sparse else 5, bridge_occluders=0 if sparse else 1,
-                diagonals=1, max_gap_m=0.0, min_points=10, max_extent_m=6.0,
+    return dict(theta_rad=0.12 if sparse else 0.18, max_steps=4 if sparse else 5, bridge_occluders=0 if sparse else 1,
+                diagonals=1, max_gap_m=0.7, max_gap_per_m=0.04 if sparse else 0.025, min_points=10, max_extent_m=6.0,
                 max_mean_height_m=2.5, mount_height_m=float(s.mount_height_m))
 
 
@@ -317,7 +317,7 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     ground: optional (N,) bool/uint8 per point (1 = ground; a pixel is ground when its winning point
     is), e.g. SemanticKITTI ground labels or the ground stage's per-point mask. planes: optional
     (S, 4) (nx, ny, nz, d) per azimuth sector for the height filter (None: flat ground at
-    -mount_height_m). cfg: theta_rad, max_steps, bridge_occluders, max_gap_m, min_points, max_extent_m, max_mean_height_m,
+    -mount_height_m). cfg: theta_rad, max_steps, bridge_occluders, max_gap_m, max_gap_per_m, min_points, max_extent_m, max_mean_height_m,
     mount_height_m (defaults: `cluster_defaults(sensor)`).
     """
     s = proj_init(sensor, **(proj_cfg or {}))
@@ -339,7 +339,7 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     if planes is not None:
         pl = np.ascontiguousarray(planes, dtype=np.float32).reshape(-1, 4)
     cfg_f = np.array([c["theta_rad"], c["max_extent_m"], c["max_mean_height_m"], c["mount_height_m"],
-                      c["max_gap_m"]], np.float32)
+                      c["max_gap_m"], c["max_gap_per_m"]], np.float32)
     cfg_u = np.array([c["max_steps"], c["min_points"], int(bool(c["bridge_occluders"])), int(bool(c["diagonals"]))],
                      np.uint32)
     pl_out = np.zeros(n, np.uint32)

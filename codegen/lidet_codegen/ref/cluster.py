@@ -76,7 +76,7 @@ def make_proposal(member_xyz: np.ndarray, mean=None, n_points: int = 64, seed: i
 
 
 def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.ndarray, xyz: np.ndarray,
-                theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, diagonals: bool = True, max_gap_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
+                theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, diagonals: bool = True, max_gap_m: float = 0.0, max_gap_per_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
                 max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
@@ -104,9 +104,19 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
         cs = np.float32(min(max(cs, -1.0), 1.0))
         return np.float32(np.sqrt(np.float32(1.0) - cs * cs)), cs
 
-    def joins(da, db, sn, cs):
+    gap, gap_per_m = np.float32(max_gap_m), np.float32(max_gap_per_m)
+
+    def link(da, db, sn, cs):
+        # angle test; with a gap bound also the distance of the two returns along their beams,
+        # sqrt(u^2 + v^2) <= gap + gap_per_m * d2 (computed from the ranges, like the C)
         d1, d2 = (da, db) if da > db else (db, da)
-        return np.float32(d2 * sn) > np.float32(tan_t * np.float32(d1 - np.float32(d2 * cs)))
+        u, v = np.float32(d1 - np.float32(d2 * cs)), np.float32(d2 * sn)
+        if not v > np.float32(tan_t * u):
+            return False
+        if gap > 0:
+            g = np.float32(gap + np.float32(gap_per_m * d2))
+            return bool(np.float32(np.float32(u * u) + np.float32(v * v)) <= np.float32(g * g))
+        return True
 
     state = np.where(cand, 0, -2).astype(np.int64)  # 0 free, -2 non-candidate, -1 visited, >0 slot+1
     kc = min(max_steps, cols - 1)
@@ -140,10 +150,7 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                     sn, cs = csin[k - 1], ccos[k - 1]
                 else:
                     sn, cs = row_sc(r if name == "D" else r - k, k)
-                ok = joins(d, rng[n], sn, cs)
-                if ok and max_gap_m > 0:
-                    dd = (np.asarray(xyz, np.float32).reshape(-1, 3)[p] - np.asarray(xyz, np.float32).reshape(-1, 3)[n])
-                    ok = float(np.dot(dd, dd)) <= float(np.float32(max_gap_m) ** 2)
+                ok = link(d, rng[n], sn, cs)
                 if ok:
                     done.add(name)
                     if state[n] == 0:
@@ -161,11 +168,7 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                     if state[n] != 0:
                         continue
                     sn, cs = diag_sc(r if dr > 0 else r - 1)
-                    ok = joins(d, rng[n], sn, cs)
-                    if ok and max_gap_m > 0:
-                        dd = (np.asarray(xyz, np.float32).reshape(-1, 3)[p]
-                              - np.asarray(xyz, np.float32).reshape(-1, 3)[n])
-                        ok = float(np.dot(dd, dd)) <= float(np.float32(max_gap_m) ** 2)
+                    ok = link(d, rng[n], sn, cs)
                     if ok:
                         state[n] = -1
                         mem.append(n)
