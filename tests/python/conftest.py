@@ -19,3 +19,22 @@ def real_dir():
     if not (REAL / "README.md").exists():
         pytest.skip(f"real scans not available at {REAL}")
     return REAL
+
+
+@pytest.fixture(scope="session")
+def cli():
+    """The host CLI `lidet` of the build under test ($LIDET_BUILD_DIR, else build/); skips if not built."""
+    exe = pathlib.Path(os.environ.get("LIDET_BUILD_DIR", ROOT / "build")) / "ports" / "host" / "lidet"
+    if not exe.exists():
+        pytest.skip(f"{exe} not built")
+    return exe
+
+
+@pytest.fixture(scope="session")
+def need_lib():
+    """Skips when the bindings' shared library (liblidet_py.so) is not built."""
+    from lidet_tools import native
+    try:
+        native.lib()
+    except FileNotFoundError as e:
+        pytest.skip(str(e))

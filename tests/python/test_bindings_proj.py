@@ -7,12 +7,7 @@ from lidet_codegen.ref.proj import project_ref
 from lidet_tools import kitti, native, sensors
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _need_lib():
-    try:
-        native.lib()
-    except FileNotFoundError as e:
-        pytest.skip(str(e))
+pytestmark = pytest.mark.usefixtures("need_lib")
 
 
 def test_python_and_c_sensor_tables_identical():

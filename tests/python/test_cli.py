@@ -2,7 +2,6 @@
 """The host CLI `lidet` (ports/host): JSON contract, pictures, and clear errors on bad files."""
 import json
 import os
-import pathlib
 import subprocess
 
 import numpy as np
@@ -11,15 +10,6 @@ from PIL import Image
 
 from lidet_tools import kitti
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-
-
-@pytest.fixture(scope="module")
-def cli():
-    exe = pathlib.Path(os.environ.get("LIDET_BUILD_DIR", ROOT / "build")) / "ports" / "host" / "lidet"
-    if not exe.exists():
-        pytest.skip(f"{exe} not built")
-    return exe
 
 
 def _scan(tmp_path, n=5000, seed=0):

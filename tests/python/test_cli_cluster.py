@@ -1,25 +1,13 @@
 # SPDX-License-Identifier: MIT
 """`lidet cluster`: JSON contract, ids per point equal the bindings', picture."""
 import json
-import os
-import pathlib
 import subprocess
 
 import numpy as np
-import pytest
 from PIL import Image
 
 from lidet_tools import native
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-
-
-@pytest.fixture(scope="module")
-def cli():
-    exe = pathlib.Path(os.environ.get("LIDET_BUILD_DIR", ROOT / "build")) / "ports" / "host" / "lidet"
-    if not exe.exists():
-        pytest.skip(f"{exe} not built")
-    return exe
 
 
 def _scene(tmp_path):

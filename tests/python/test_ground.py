@@ -17,12 +17,7 @@ from lidet_tools import ground_eval, kitti, native
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
-@pytest.fixture(scope="module", autouse=True)
-def _need_lib():
-    try:
-        native.lib()
-    except FileNotFoundError as e:
-        pytest.skip(str(e))
+pytestmark = pytest.mark.usefixtures("need_lib")
 
 
 def _scene(rng, n_rows=64, h=1.73, n_cars=6):
