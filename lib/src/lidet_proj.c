@@ -36,7 +36,7 @@ static int in_range(float v, float lo, float hi)
 
 /* Column c spans u = (pi - azimuth) / (2 pi) in [c/cols, (c+1)/cols). In pseudo-azimuth terms, with
  * v = 4u = quadrant + f (f in [0, 1)), D(u) = quadrant + g(f pi/2), g(t) = sin t / (sin t + cos t)
- * (derived from the four quadrant cases of lidet__azimuth_key). Computing the edges from (quadrant,
+ * (derived from the four quadrant cases of the pseudo-azimuth in key_block). Computing the edges from (quadrant,
  * f) keeps them exact at the quadrant seams, where sin/cos of pi-sized floats would lose the sign. */
 static void init_columns(lidet_proj_t *proj, uint32_t cols)
 {
@@ -223,7 +223,7 @@ lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg)
 #define KEY_BLOCK ((uint32_t)LIDET_PROJ_BLOCK) /* lidet_opt.h, 64 by default */
 #define KEY_RANGE_OK 1 /* min2 <= r^2 <= max2 (so x, y, z finite) */
 #define KEY_FOV_OK 2   /* tan(elevation) in [tan_lo, tan_hi] (so not NaN) */
-#define KEY_DEN_OK 4   /* (|x|+|y|) * rxy > 0: t and d are lidet__proj_keys' */
+#define KEY_DEN_OK 4   /* (|x|+|y|) * rxy > 0: t and d are defined */
 #define KEY_ALL 7
 
 typedef struct
@@ -236,8 +236,12 @@ typedef struct
     int32_t flags[KEY_BLOCK]; /* KEY_* */
 } key_block_t;
 
-/* (a) above. The arithmetic is lidet__proj_keys' without its branch: with den = 0, inv = +inf makes
- * t +-inf or NaN (rejected by the field-of-view test) and d NaN (replaced by 2 in run() on the ring
+/* (a) above: the two per-point keys from one division and one square root,
+ *   tan(elevation) t = z / rxy, and the pseudo-azimuth ("diamond angle") in [0, 4]
+ *   d = 1 + x/(|x|+|y|) for y >= 0, 3 - x/(|x|+|y|) for y < 0,
+ * monotonic in azimuth: 0 at +-pi, 1 at +pi/2, 2 at 0, 3 at -pi/2, -> 4 towards -pi. With
+ * inv = 1 / ((|x|+|y|) rxy): x/(|x|+|y|) = x rxy inv and z/rxy = z (|x|+|y|) inv. There is no branch:
+ * with den = 0, inv = +inf makes t +-inf or NaN (rejected by the field-of-view test) and d NaN (replaced by 2 in run() on the ring
  * path). Every float -> int conversion is of a clamped value (NaN clamps to the low end), so invalid
  * points get harmless buckets and no UB. Written so that GCC/Clang if-convert it under the default FP
  * semantics: selects of operands, no arithmetic inside a condition (an add that may trap is not
@@ -278,9 +282,11 @@ static inline void key_block(key_block_t *kb, const float *pts, uint32_t m, uint
 
 float lidet_proj_azimuth_key(float x, float y)
 {
-    float t, d, rxy;
-    lidet__proj_keys(x, y, 0.0f, x * x + y * y, &t, &d, &rxy);
-    return d;
+    /* the very arithmetic run() bins on (one point through key_block), so tests measure exactly that */
+    const float pt[3] = {x, y, 0.0f};
+    key_block_t kb;
+    key_block(&kb, pt, 1u, 3u, 0.0f, 3.0e38f, -1.0f, 1.0f, 1.0f, 1.0f, 4.0f);
+    return (kb.flags[0] & KEY_DEN_OK) ? kb.d[0] : 2.0f;
 }
 
 lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t n_points, uint32_t stride,
