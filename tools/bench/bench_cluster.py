@@ -154,10 +154,6 @@ def run(args) -> str:
 
 
 if __name__ == "__main__":
-    import argparse
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--build", default=str(ROOT / "build"))
-    ap.add_argument("--real", default=str(ROOT.parent / "shared" / "data" / "real"))
-    ap.add_argument("--quick", action="store_true")
-    print(run(ap.parse_args()))
-    sys.exit(0)
+    from run_bench import standalone  # the script's own folder is on sys.path
+
+    standalone(run)

@@ -21,7 +21,6 @@ simulator is installed; reported as pending otherwise). Runnable alone:
 """
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import pathlib
@@ -268,8 +267,6 @@ def run(args) -> str:
 
 
 if __name__ == "__main__":
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--build", default=str(ROOT / "build"))
-    ap.add_argument("--real", default=str(ROOT.parent / "shared" / "data" / "real"))
-    ap.add_argument("--quick", action="store_true")
-    print(run(ap.parse_args()))
+    from run_bench import standalone  # the script's own folder is on sys.path
+
+    standalone(run, __doc__.split("\n\n")[0])

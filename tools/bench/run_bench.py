@@ -32,6 +32,16 @@ def machine() -> str:
     return f"{cpu}, {platform.system()} {platform.machine()}, Python {platform.python_version()}"
 
 
+def standalone(run, description=None) -> None:
+    """`python tools/bench/bench_X.py`: one benchmark alone, with the runner's defaults; prints its section."""
+    root = HERE.parents[1]
+    ap = argparse.ArgumentParser(description=description)
+    ap.add_argument("--build", default=str(root / "build"))
+    ap.add_argument("--real", default=str(root.parent / "shared" / "data" / "real"))
+    ap.add_argument("--quick", action="store_true", help="fewer repetitions (smoke test)")
+    print(run(ap.parse_args()))
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--build", default="build")
