@@ -130,6 +130,11 @@ static inline float min2f(float a, float b)
     return a < b ? a : b; /* compiles to minss/minps; fminf would be a libm call in strict C99 */
 }
 
+static inline float max2f(float a, float b)
+{
+    return a > b ? a : b;
+}
+
 static inline uint8_t sample_test(const float *R0, const float *R1, const float *Z0, const float *Z1,
                                   const float *F0, uint32_t cm1, uint32_t c, uint32_t cp1, uint32_t cp2,
                                   const filt_t *f)
@@ -253,85 +258,164 @@ static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
 
 /* Pass 3 (mirrors ref/ground.py: label_pixels, veto_vertical): ground = holds a point and
  * -below < height < above, height above the pixel's cell plane (near or far part of its sector),
- * and not vetoed. Empty pixels are excluded through point_idx (their coordinates are 0, which may
- * lie within ground_m of a plane).
+ * and not vetoed. Empty pixels are excluded by R > 0 (the image contract: empty pixels are exactly
+ * 0, and their coordinates 0 may lie within ground_m of a plane).
  * Vertical veto: a pixel is not ground when it and the pixel above it (the next beam up, same
  * column, holding a point) form a steep surface, |dz| > veto_slope * |dR| and |dz| > veto_min_dz_m:
  * the foot of a wall, a kerb face, a bumper or a trunk, whose lowest returns lie within ground_m of
  * the ground, while ground seen from above has the beam above landing much farther (|dR| >> |dz|).
  * Row 0 compares with itself (dz = 0: never vetoed); veto_slope 0 disables it (min dz = +huge).
- * All loops are branch-free so that they vectorise. */
+ *
+ * Speed (this pass dominates the stage): rows are cut into chunks of at most LABEL_CHUNK columns
+ * within one sector. A chunk whose points all lie on one side of ring_split_m (the common case:
+ * one beam over a short arc sees mostly the ground at one distance) is tested against that plane
+ * only; mixed chunks test both planes and select by bits. With a constant tolerance the band test
+ * is one compare, |h - mid| < half (mid and half fold -below and above together). Kernels write
+ * 0 / -1 words to a small stack buffer, so the loops stay 4 lanes wide (no uint8 packing inside
+ * them, which made the compiler unroll 16 pixels and spill registers); a second loop packs bytes
+ * and counts. All loops are branch-free so that they vectorise. */
+#define LABEL_CHUNK 64u
+
+typedef struct
+{
+    float split, slope, min_dz, mid, half; /* constant tolerance: |h - mid| < half */
+    float g0, k, bf;                        /* general tolerance: -bf (g0 + k R) < h < g0 + k R */
+} label_par_t;
+
+/* veto word of pixel c: -1 when vetoed */
+static inline int32_t veto(const float *R, const float *Z, const float *Ru, const float *Zu, uint32_t c,
+                           const label_par_t *lp)
+{
+    const float dz = fabsf(Zu[c] - Z[c]), dr = fabsf(Ru[c] - R[c]);
+    return -(int32_t)((Ru[c] > 0.0f) & (dz > max2f(lp->slope * dr, lp->min_dz)));
+}
+
+/* one plane (d already shifted by -mid), constant tolerance */
+static void label_one(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
+                      const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, const label_par_t *lp,
+                      int32_t *restrict in, int32_t *restrict vt)
+{
+    const float half = lp->half;
+    uint32_t j;
+    for (j = 0; j < n; ++j)
+    {
+        const uint32_t c = c0 + j;
+        const float h = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
+        in[j] = -(int32_t)((R[c] > 0.0f) & (fabsf(h) < half));
+        vt[j] = veto(R, Z, Ru, Zu, c, lp);
+    }
+}
+
+/* near plane p below split, far plane q from it (both d shifted by -mid), constant tolerance */
+static void label_two(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
+                      const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, lidet_plane_t q,
+                      const label_par_t *lp, int32_t *restrict in, int32_t *restrict vt)
+{
+    const float half = lp->half, split = lp->split;
+    uint32_t j;
+    for (j = 0; j < n; ++j)
+    {
+        const uint32_t c = c0 + j;
+        const float hn = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
+        const float hf = q.nx * X[c] + q.ny * Y[c] + q.nz * Z[c] + q.d_m;
+        const int32_t near = -(int32_t)(R[c] < split);
+        const int32_t in_n = -(int32_t)(fabsf(hn) < half), in_f = -(int32_t)(fabsf(hf) < half);
+        in[j] = -(int32_t)(R[c] > 0.0f) & ((near & in_n) | (~near & in_f));
+        vt[j] = veto(R, Z, Ru, Zu, c, lp);
+    }
+}
+
+/* tolerance growing with range (ground_m_per_m > 0), planes unshifted */
+static void label_general(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
+                          const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, lidet_plane_t q,
+                          const label_par_t *lp, int32_t *restrict in, int32_t *restrict vt)
+{
+    uint32_t j;
+    for (j = 0; j < n; ++j)
+    {
+        const uint32_t c = c0 + j;
+        const float hn = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
+        const float hf = q.nx * X[c] + q.ny * Y[c] + q.nz * Z[c] + q.d_m;
+        const float above = lp->g0 + lp->k * R[c], below = -lp->bf * above;
+        const int32_t near = -(int32_t)(R[c] < lp->split);
+        const int32_t in_n = -(int32_t)((hn < above) & (hn > below));
+        const int32_t in_f = -(int32_t)((hf < above) & (hf > below));
+        in[j] = -(int32_t)(R[c] > 0.0f) & ((near & in_n) | (~near & in_f));
+        vt[j] = veto(R, Z, Ru, Zu, c, lp);
+    }
+}
+
 static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors;
-    const float g0 = g->cfg.ground_m, k = g->cfg.ground_m_per_m, bf = g->cfg.below_factor;
-    const float below0 = bf * g0;
-    const float split = g->cfg.ring_split_m > 0.0f ? g->cfg.ring_split_m : 3.0e38f;
-    const float slope = g->cfg.veto_slope;
-    const float min_dz = g->cfg.veto_slope > 0.0f ? g->cfg.veto_min_dz_m : 3.0e38f;
-    const int simple = k == 0.0f && !(g->cfg.ring_split_m > 0.0f);
-    uint32_t r, s, c, n_ground = 0, n_vetoed = 0;
+    const float g0 = g->cfg.ground_m, below0 = g->cfg.below_factor * g0;
+    const int two = g->cfg.ring_split_m > 0.0f, general = g->cfg.ground_m_per_m > 0.0f;
+    label_par_t lp;
+    int32_t in[LABEL_CHUNK], vt[LABEL_CHUNK];
+    uint32_t r, s, c, j, n_ground = 0, n_vetoed = 0;
+    lp.split = two ? g->cfg.ring_split_m : 3.0e38f;
+    lp.slope = g->cfg.veto_slope;
+    lp.min_dz = g->cfg.veto_slope > 0.0f ? g->cfg.veto_min_dz_m : 3.0e38f;
+    lp.mid = 0.5f * (g0 - below0);
+    lp.half = 0.5f * (g0 + below0);
+    lp.g0 = g0;
+    lp.k = g->cfg.ground_m_per_m;
+    lp.bf = g->cfg.below_factor;
     for (r = 0; r < rows; ++r)
     {
         const size_t base = (size_t)r * cols;
         const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base, *R = img->rxy_m + base;
         const float *Ru = r > 0u ? R - cols : R, *Zu = r > 0u ? Z - cols : Z;
-        const int32_t *V = img->point_idx + base;
         uint8_t *out = g->mask + base;
         for (s = 0; s < ns; ++s)
         {
-            const uint32_t c0 = lidet__ground_sector_col(s, ns, cols);
-        const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
-            const lidet_plane_t p = g->planes[s], q = g->planes[ns + s];
+            const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+            lidet_plane_t p = g->planes[s], q = g->planes[ns + s];
             uint32_t cnt = 0, nv = 0;
-            if (simple)
+            if (!general)
             {
-                for (c = c0; c < c1; ++c)
-                {
-                    const float h = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
-                    const float dz = fabsf(Zu[c] - Z[c]), dr = fabsf(Ru[c] - R[c]);
-                    const uint32_t vert = (uint32_t)((Ru[c] > 0.0f) & (dz > slope * dr) & (dz > min_dz));
-                    const uint32_t near = (uint32_t)((V[c] >= 0) & (h < g0) & (h > -below0));
-                    out[c] = (uint8_t)(near & (vert ^ 1u));
-                    cnt += near & (vert ^ 1u);
-                    nv += near & vert;
-                }
+                p.d_m -= lp.mid;
+                q.d_m -= lp.mid;
             }
-            else if (k == 0.0f)
+            for (c = lidet__ground_sector_col(s, ns, cols); c < c1; c += LABEL_CHUNK)
             {
-                /* two planes, constant tolerance: both tests, blended by the near/far bit (a ?: on
-                 * floats stays a branch here, which stops vectorisation) */
-                for (c = c0; c < c1; ++c)
+                const uint32_t n = c1 - c < LABEL_CHUNK ? c1 - c : LABEL_CHUNK;
+                if (general)
                 {
-                    const float hn = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
-                    const float hf = q.nx * X[c] + q.ny * Y[c] + q.nz * Z[c] + q.d_m;
-                    const float dz = fabsf(Zu[c] - Z[c]), dr = fabsf(Ru[c] - R[c]);
-                    const uint32_t vert = (uint32_t)((Ru[c] > 0.0f) & (dz > slope * dr) & (dz > min_dz));
-                    const uint32_t is_near = (uint32_t)(R[c] < split);
-                    const uint32_t in_n = (uint32_t)((hn < g0) & (hn > -below0));
-                    const uint32_t in_f = (uint32_t)((hf < g0) & (hf > -below0));
-                    const uint32_t m = (uint32_t)(V[c] >= 0) & ((is_near & in_n) | ((is_near ^ 1u) & in_f));
-                    out[c] = (uint8_t)(m & (vert ^ 1u));
-                    cnt += m & (vert ^ 1u);
-                    nv += m & vert;
+                    label_general(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, in, vt);
                 }
-            }
-            else
-            {
-                for (c = c0; c < c1; ++c)
+                else if (!two)
                 {
-                    const float hn = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
-                    const float hf = q.nx * X[c] + q.ny * Y[c] + q.nz * Z[c] + q.d_m;
-                    const float above = g0 + k * R[c];
-                    const float dz = fabsf(Zu[c] - Z[c]), dr = fabsf(Ru[c] - R[c]);
-                    const uint32_t vert = (uint32_t)((Ru[c] > 0.0f) & (dz > slope * dr) & (dz > min_dz));
-                    const uint32_t is_near = (uint32_t)(R[c] < split);
-                    const uint32_t in_n = (uint32_t)((hn < above) & (hn > -bf * above));
-                    const uint32_t in_f = (uint32_t)((hf < above) & (hf > -bf * above));
-                    const uint32_t m = (uint32_t)(V[c] >= 0) & ((is_near & in_n) | ((is_near ^ 1u) & in_f));
-                    out[c] = (uint8_t)(m & (vert ^ 1u));
-                    cnt += m & (vert ^ 1u);
-                    nv += m & vert;
+                    label_one(X, Y, Z, R, Ru, Zu, c, n, p, &lp, in, vt);
+                }
+                else
+                {
+                    /* all points near, all far, or mixed (empty pixels count as neither) */
+                    uint32_t n_pts = 0, n_far = 0;
+                    for (j = 0; j < n; ++j)
+                    {
+                        n_pts += (uint32_t)(R[c + j] > 0.0f);
+                        n_far += (uint32_t)(R[c + j] >= lp.split);
+                    }
+                    if (n_far == 0u)
+                    {
+                        label_one(X, Y, Z, R, Ru, Zu, c, n, p, &lp, in, vt);
+                    }
+                    else if (n_far == n_pts)
+                    {
+                        label_one(X, Y, Z, R, Ru, Zu, c, n, q, &lp, in, vt);
+                    }
+                    else
+                    {
+                        label_two(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, in, vt);
+                    }
+                }
+                for (j = 0; j < n; ++j)
+                {
+                    const int32_t o = in[j] & ~vt[j];
+                    out[c + j] = (uint8_t)(o & 1);
+                    cnt -= (uint32_t)o;
+                    nv -= (uint32_t)(in[j] & vt[j]);
                 }
             }
             n_ground += cnt;
