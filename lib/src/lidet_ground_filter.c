@@ -137,16 +137,31 @@ static inline float max2f(float a, float b)
 
 static inline uint8_t sample_test(const float *R0, const float *R1, const float *Z0, const float *Z1,
                                   const float *F0, uint32_t cm1, uint32_t c, uint32_t cp1, uint32_t cp2,
-                                  const filt_t *f)
+                                  const filt_t *f, int opt)
 {
     const float dr = (2.0f * R0[c] + R0[cp1]) - (2.0f * R1[c] + R1[cp1]);
     const float dz = (2.0f * Z0[c] + Z0[cp1]) - (2.0f * Z1[c] + Z1[cp1]);
     const float fx = (F0[cm1] + 2.0f * F0[c]) - (2.0f * F0[cp1] + F0[cp2]);
     /* every touched pixel holds a point: the smallest R is > 0 (empty pixels are exactly 0) */
     const float rmin = min2f(min2f(min2f(R0[cm1], R0[c]), min2f(R0[cp1], R0[cp2])), min2f(R1[c], R1[cp1]));
-    const int tests = (rmin > 0.0f) & (fabsf(dz) <= f->fy_max * fabsf(dr)) & (fabsf(fx) <= f->fx_max) &
-                      (dr > f->dr_min) & (Z0[c] >= f->z_lo) & (Z0[c] <= f->z_hi);
-    return (uint8_t)tests;
+    const int tests = (rmin > 0.0f) & (fabsf(dz) <= f->fy_max * fabsf(dr)) & (fabsf(fx) <= f->fx_max);
+    /* opt is a constant at every call: without the optional tests they cost nothing */
+    return (uint8_t)(opt ? tests & (dr > f->dr_min) & (Z0[c] >= f->z_lo) & (Z0[c] <= f->z_hi) : tests);
+}
+
+/* one row of the sample mask; columns wrap around: the first and the last two columns take their
+ * neighbours modulo cols */
+static inline void filter_row(const float *R0, const float *R1, const float *Z0, const float *Z1, const float *F0,
+                              uint32_t cols, const filt_t *f, uint8_t *out, int opt)
+{
+    uint32_t c;
+    out[0] = sample_test(R0, R1, Z0, Z1, F0, cols - 1u, 0u, 1u, 2u, f, opt);
+    for (c = 1; c + 2u < cols; ++c)
+    {
+        out[c] = sample_test(R0, R1, Z0, Z1, F0, c - 1u, c, c + 1u, c + 2u, f, opt);
+    }
+    out[cols - 2u] = sample_test(R0, R1, Z0, Z1, F0, cols - 3u, cols - 2u, cols - 1u, 0u, f, opt);
+    out[cols - 1u] = sample_test(R0, R1, Z0, Z1, F0, cols - 2u, cols - 1u, 0u, 1u, f, opt);
 }
 
 /* Pass 1 (mirrors ref/ground.py: sample_mask): the sample mask, row by row. */
@@ -154,8 +169,9 @@ static void filter_rows(lidet_ground_t *g, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols;
     const uint32_t step = g->cfg.sample_step;
+    const int opt = g->cfg.require_descending || g->cfg.height_gate;
     filt_t f;
-    uint32_t r, c;
+    uint32_t r;
     f.fy_max = g->cfg.fy_max;
     f.fx_max = g->cfg.fx_max_m;
     f.dr_min = g->cfg.require_descending ? 0.0f : -3.0e38f;
@@ -172,14 +188,14 @@ static void filter_rows(lidet_ground_t *g, const lidet_range_image_t *img)
         const float *F0 = g->cfg.fx_on_z ? Z0 : R0;
         uint8_t *out = g->sample + (size_t)r * cols;
         const filt_t fl = f;
-        /* columns wrap around: the first and the last two columns take their neighbours modulo cols */
-        out[0] = sample_test(R0, R1, Z0, Z1, F0, cols - 1u, 0u, 1u, 2u, &fl);
-        for (c = 1; c + 2u < cols; ++c)
+        if (opt)
         {
-            out[c] = sample_test(R0, R1, Z0, Z1, F0, c - 1u, c, c + 1u, c + 2u, &fl);
+            filter_row(R0, R1, Z0, Z1, F0, cols, &fl, out, 1);
         }
-        out[cols - 2u] = sample_test(R0, R1, Z0, Z1, F0, cols - 3u, cols - 2u, cols - 1u, 0u, &fl);
-        out[cols - 1u] = sample_test(R0, R1, Z0, Z1, F0, cols - 2u, cols - 1u, 0u, 1u, &fl);
+        else
+        {
+            filter_row(R0, R1, Z0, Z1, F0, cols, &fl, out, 0);
+        }
     }
 }
 
@@ -291,28 +307,30 @@ static inline int32_t veto(const float *R, const float *Z, const float *Ru, cons
 }
 
 /* one plane (d already shifted by -mid), constant tolerance */
-static void label_one(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
+static uint32_t label_one(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
                       const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, const label_par_t *lp,
-                      int32_t *restrict in, int32_t *restrict vt)
+                      int32_t *restrict o)
 {
     const float half = lp->half;
-    uint32_t j;
+    uint32_t j, nv = 0;
     for (j = 0; j < n; ++j)
     {
         const uint32_t c = c0 + j;
         const float h = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
-        in[j] = -(int32_t)((R[c] > 0.0f) & (fabsf(h) < half));
-        vt[j] = veto(R, Z, Ru, Zu, c, lp);
+        const int32_t in = -(int32_t)((R[c] > 0.0f) & (fabsf(h) < half)), vt = veto(R, Z, Ru, Zu, c, lp);
+        o[j] = in & ~vt;
+        nv -= (uint32_t)(in & vt);
     }
+    return nv;
 }
 
 /* near plane p below split, far plane q from it (both d shifted by -mid), constant tolerance */
-static void label_two(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
+static uint32_t label_two(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
                       const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, lidet_plane_t q,
-                      const label_par_t *lp, int32_t *restrict in, int32_t *restrict vt)
+                      const label_par_t *lp, int32_t *restrict o)
 {
     const float half = lp->half, split = lp->split;
-    uint32_t j;
+    uint32_t j, nv = 0;
     for (j = 0; j < n; ++j)
     {
         const uint32_t c = c0 + j;
@@ -320,17 +338,19 @@ static void label_two(const float *X, const float *Y, const float *Z, const floa
         const float hf = q.nx * X[c] + q.ny * Y[c] + q.nz * Z[c] + q.d_m;
         const int32_t near = -(int32_t)(R[c] < split);
         const int32_t in_n = -(int32_t)(fabsf(hn) < half), in_f = -(int32_t)(fabsf(hf) < half);
-        in[j] = -(int32_t)(R[c] > 0.0f) & ((near & in_n) | (~near & in_f));
-        vt[j] = veto(R, Z, Ru, Zu, c, lp);
+        const int32_t in = -(int32_t)(R[c] > 0.0f) & ((near & in_n) | (~near & in_f)), vt = veto(R, Z, Ru, Zu, c, lp);
+        o[j] = in & ~vt;
+        nv -= (uint32_t)(in & vt);
     }
+    return nv;
 }
 
 /* tolerance growing with range (ground_m_per_m > 0), planes unshifted */
-static void label_general(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
+static uint32_t label_general(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
                           const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, lidet_plane_t q,
-                          const label_par_t *lp, int32_t *restrict in, int32_t *restrict vt)
+                          const label_par_t *lp, int32_t *restrict o)
 {
-    uint32_t j;
+    uint32_t j, nv = 0;
     for (j = 0; j < n; ++j)
     {
         const uint32_t c = c0 + j;
@@ -340,9 +360,11 @@ static void label_general(const float *X, const float *Y, const float *Z, const 
         const int32_t near = -(int32_t)(R[c] < lp->split);
         const int32_t in_n = -(int32_t)((hn < above) & (hn > below));
         const int32_t in_f = -(int32_t)((hf < above) & (hf > below));
-        in[j] = -(int32_t)(R[c] > 0.0f) & ((near & in_n) | (~near & in_f));
-        vt[j] = veto(R, Z, Ru, Zu, c, lp);
+        const int32_t in = -(int32_t)(R[c] > 0.0f) & ((near & in_n) | (~near & in_f)), vt = veto(R, Z, Ru, Zu, c, lp);
+        o[j] = in & ~vt;
+        nv -= (uint32_t)(in & vt);
     }
+    return nv;
 }
 
 static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
@@ -351,7 +373,7 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
     const float g0 = g->cfg.ground_m, below0 = g->cfg.below_factor * g0;
     const int two = g->cfg.ring_split_m > 0.0f, general = g->cfg.ground_m_per_m > 0.0f;
     label_par_t lp;
-    int32_t in[LABEL_CHUNK], vt[LABEL_CHUNK];
+    int32_t o[LABEL_CHUNK];
     uint32_t r, s, c, j, n_ground = 0, n_vetoed = 0;
     lp.split = two ? g->cfg.ring_split_m : 3.0e38f;
     lp.slope = g->cfg.veto_slope;
@@ -382,11 +404,11 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
                 const uint32_t n = c1 - c < LABEL_CHUNK ? c1 - c : LABEL_CHUNK;
                 if (general)
                 {
-                    label_general(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, in, vt);
+                    nv += label_general(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, o);
                 }
                 else if (!two)
                 {
-                    label_one(X, Y, Z, R, Ru, Zu, c, n, p, &lp, in, vt);
+                    nv += label_one(X, Y, Z, R, Ru, Zu, c, n, p, &lp, o);
                 }
                 else
                 {
@@ -399,23 +421,21 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
                     }
                     if (n_far == 0u)
                     {
-                        label_one(X, Y, Z, R, Ru, Zu, c, n, p, &lp, in, vt);
+                        nv += label_one(X, Y, Z, R, Ru, Zu, c, n, p, &lp, o);
                     }
                     else if (n_far == n_pts)
                     {
-                        label_one(X, Y, Z, R, Ru, Zu, c, n, q, &lp, in, vt);
+                        nv += label_one(X, Y, Z, R, Ru, Zu, c, n, q, &lp, o);
                     }
                     else
                     {
-                        label_two(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, in, vt);
+                        nv += label_two(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, o);
                     }
                 }
                 for (j = 0; j < n; ++j)
                 {
-                    const int32_t o = in[j] & ~vt[j];
-                    out[c + j] = (uint8_t)(o & 1);
-                    cnt -= (uint32_t)o;
-                    nv -= (uint32_t)(in[j] & vt[j]);
+                    out[c + j] = (uint8_t)(o[j] & 1);
+                    cnt -= (uint32_t)o[j];
                 }
             }
             n_ground += cnt;
