@@ -59,7 +59,7 @@ def test_rng_matches_known_sequence():
 
 
 @pytest.mark.parametrize("variant", [{}, {"fx_on_z": 1, "height_gate": 1, "require_descending": 0},
-                                     {"require_descending": 1},
+                                     {"require_descending": 1, "eval_samples": 300},
                                      {"sample_step": 1, "sample_col_step": 1, "n_sectors": 16, "refine_iters": 0,
                                       "ring_split_m": 0.0},
                                      {"ring_split_m": 25.0, "ground_m_per_m": 0.003, "sample_step": 3, "sample_col_step": 2}])

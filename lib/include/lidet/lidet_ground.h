@@ -42,7 +42,8 @@
  *     veto_min_dz_m): the lowest returns of walls, kerbs, bumpers and trunks.
  *
  * Memory: sizeof(lidet_ground_t) = LIDET_MAX_ROWS * LIDET_MAX_COLS * 2 B (ground and sample masks)
- * + LIDET_GROUND_MAX_SAMPLES * 12 B (x, y, z of the samples) + LIDET_GROUND_MAX_SECTORS * 50 B
+ * + (LIDET_GROUND_MAX_SAMPLES + LIDET_GROUND_EVAL_MAX) * 12 B (x, y, z of the samples and of a cell's
+ * scoring subset) + LIDET_GROUND_MAX_SECTORS * 50 B
  * + ~200 B; defaults (128 x 2048, 262,144 samples): about 3.5 MiB; a VLP-16 build (16 x 1800,
  * samples = pixels): about 0.4 MiB. lidet_ground_bytes() returns the exact figure. Declare it static.
  * Time: O(n_rows * n_cols) for the filter and the labelling, O(n_sectors * ransac_iters *
@@ -167,6 +168,9 @@ typedef struct
     float sx_m[LIDET_GROUND_MAX_SAMPLES];                /* samples, grouped by sector */
     float sy_m[LIDET_GROUND_MAX_SAMPLES];
     float sz_m[LIDET_GROUND_MAX_SAMPLES];
+    float ev_x_m[LIDET_GROUND_EVAL_MAX];                 /* a cell's strided scoring subset */
+    float ev_y_m[LIDET_GROUND_EVAL_MAX];
+    float ev_z_m[LIDET_GROUND_EVAL_MAX];
     /* cells: k = s (near part of sector s) and k = n_sectors + s (far part); the samples of cell k
      * are sx/sy/sz[cell_first[k] .. cell_first[k] + cell_n[k]) */
     uint32_t cell_first[2 * LIDET_GROUND_MAX_SECTORS];

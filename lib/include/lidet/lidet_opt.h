@@ -79,6 +79,12 @@
 #define LIDET_GROUND_MAX_SAMPLES (LIDET_MAX_ROWS * LIDET_MAX_COLS)
 #endif
 
+/** Scoring subset a RANSAC cell copies into the workspace (12 B each) so that every hypothesis scores
+ *  a contiguous block; cells whose subset (eval_samples) is larger score in place, slower, same result. */
+#ifndef LIDET_GROUND_EVAL_MAX
+#define LIDET_GROUND_EVAL_MAX 256
+#endif
+
 /** 1: asserts (LIDET_ASSERT) are compiled in; the port may override LIDET_ASSERT itself. */
 #ifndef LIDET_DEBUG
 #define LIDET_DEBUG 0
@@ -125,6 +131,9 @@
 #endif
 #if LIDET_GROUND_MAX_SAMPLES < 3 || LIDET_GROUND_MAX_SAMPLES > (LIDET_MAX_ROWS * LIDET_MAX_COLS)
 #error "LIDET_GROUND_MAX_SAMPLES must be in [3, LIDET_MAX_ROWS * LIDET_MAX_COLS]"
+#endif
+#if LIDET_GROUND_EVAL_MAX < 1 || LIDET_GROUND_EVAL_MAX > 65536
+#error "LIDET_GROUND_EVAL_MAX must be in [1, 65536]"
 #endif
 #if ((-1) >> 1) != -1
 #error "lidet needs arithmetic right shifts of negative integers (the fixed-point build relies on them)"
