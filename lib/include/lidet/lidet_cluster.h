@@ -149,8 +149,7 @@ typedef struct
     float diag_sin[LIDET_MAX_ROWS], diag_cos[LIDET_MAX_ROWS]; /* [r]: rows r, r + 1, one column apart */
     /* outputs of the last run */
     uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];    /* per pixel, canonical id, 0 = none */
-    int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS + 1]; /* member pixels, cluster after cluster (+ 1 spare:
-                                                              the flood fill writes one slot past its queue) */
+    int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];    /* member pixels, cluster after cluster */
     lidet_cluster_rec_t recs[LIDET_MAX_CLUSTERS];
     uint16_t order[LIDET_MAX_CLUSTERS];                  /* scratch: slots in seed order */
     uint16_t slot_id[LIDET_MAX_CLUSTERS + 1];            /* scratch: slot + 1 -> canonical id */
