@@ -124,46 +124,196 @@ static void setup_geometry(lidet_cluster_t *c, const lidet_range_image_t *img)
     c->geo_cols = (uint16_t)cols;
 }
 
+/* Constants of one run's flood fill. */
+typedef struct
+{
+    uint32_t rows, cols, ks, kc, row_magic;
+    int diag;
+    float tan_theta, gap, gpm;
+} grow_t;
+
 /* beta > theta  <=>  d2 sin(a) > tan(theta) (d1 - d2 cos(a)), d1 >= d2 (true when the bracket <= 0).
  * With gap > 0 the two returns must also lie within gap + gap_per_m * d2 of each other; their
  * distance along the two beams is sqrt((d1 - d2 cos a)^2 + (d2 sin a)^2), from the same two terms
  * (no point coordinates are read) */
-static inline int link(float da, float db, float gap, float sn, float cs, float tan_theta, float gap_per_m)
+static inline int link(float da, float db, float sn, float cs, const grow_t *g)
 {
     const float d1 = da > db ? da : db;
     const float d2 = da > db ? db : da;
     const float u = d1 - d2 * cs, v = d2 * sn;
-    if (!(v > tan_theta * u))
+    if (!(v > g->tan_theta * u))
     {
         return 0;
     }
-    if (gap > 0.0f)
+    if (g->gap > 0.0f)
     {
-        const float g = gap + gap_per_m * d2;
-        return u * u + v * v <= g * g;
+        const float gg = g->gap + g->gpm * d2;
+        return u * u + v * v <= gg * gg;
     }
     return 1;
 }
 
-/* One step of a directional search that met candidate n (dq: range of the pixel being expanded). Joins n
- * when it is free and passes the test. Returns 1 when the search goes on behind n (n is a nearer
- * occluder that fails the test, with occluder bridging on), 0 when it stops there. A visited n is
- * only tested when that decides between the two (joining it again would change nothing). */
-static inline int probe(lidet_cluster_t *c, float dq, uint32_t n, float sn, float cs, float tan_theta,
-                        float gap, int occl, uint32_t *tail)
+/* One step of a directional search from a pixel of range dq that met candidate n (label l, range dn):
+ * joins n when it is free and passes the test. Returns 1 when the search goes on behind n (n is a
+ * nearer occluder that fails the test, with occluder bridging on), 0 when it stops there. A visited
+ * n is only tested when that decides between the two (joining it again would change nothing). */
+#define PROBE_GOES_ON(l, n, dn, sn, cs)                                                             \
+    ((l) == LAB_FREE ? (link(dq, (dn), (sn), (cs), g) ? (lab[n] = (uint16_t)LAB_PENDING,           \
+                                                         mem[tail++] = (int32_t)(n), 0)             \
+                                                      : (occl && (dn) < dq))                        \
+                     : (occl && (dn) < dq && !link(dq, (dn), (sn), (cs), g)))
+
+/* One directional search from q (range dq): pixels q + k * step, k = 1..nk, never wrapping (the
+ * caller sends the columns within kc of either edge to search_wrap); beam pair sin/cos at
+ * sn[(k - 1) * gs], cs[(k - 1) * gs]. Non-candidates are stepped over. */
+static inline uint32_t search(uint16_t *lab, int32_t *mem, const float *rng, uint32_t tail, float dq, uint32_t q,
+                              int32_t step, uint32_t nk, const float *sn, const float *cs, int32_t gs,
+                              const grow_t *g, int occl)
 {
-    const float dn = c->img.range_m[n];
-    if (c->labels[n] != LAB_FREE)
+    uint32_t k, n = q;
+    if (!occl)
     {
-        return occl && dn < dq && !link(dq, dn, gap, sn, cs, tan_theta, c->cfg.max_gap_per_m);
+        /* the search stops at the first candidate whatever it is: find it, then test it only when
+         * free (nk >= 1; k ends at the step of that candidate, or at nk - 1 on a non-candidate) */
+        uint32_t l;
+        k = 0;
+        for (;;)
+        {
+            n = (uint32_t)((int32_t)n + step);
+            l = lab[n];
+            if (l != LAB_NONCAND || ++k >= nk)
+            {
+                break;
+            }
+        }
+        if (l == LAB_FREE && link(dq, rng[n], sn[(int32_t)k * gs], cs[(int32_t)k * gs], g))
+        {
+            lab[n] = (uint16_t)LAB_PENDING;
+            mem[tail++] = (int32_t)n;
+        }
+        return tail;
     }
-    if (link(dq, dn, gap, sn, cs, tan_theta, c->cfg.max_gap_per_m))
+    for (k = 0; k < nk; ++k, sn += gs, cs += gs)
     {
-        c->labels[n] = (uint16_t)LAB_PENDING;
-        c->members[(*tail)++] = (int32_t)n;
-        return 0;
+        uint32_t l;
+        n = (uint32_t)((int32_t)n + step);
+        l = lab[n];
+        if (l == LAB_NONCAND)
+        {
+            continue;
+        }
+        if (!PROBE_GOES_ON(l, n, rng[n], *sn, *cs))
+        {
+            break;
+        }
     }
-    return occl && dn < dq;
+    return tail;
+}
+
+/* The same along a row across the wrap (the rare columns within kc of either edge): step k meets
+ * rowbase + (col +- k mod cols); angles col_sin/col_cos */
+static uint32_t search_wrap(lidet_cluster_t *c, uint32_t tail, float dq, uint32_t rowbase, uint32_t col, int right,
+                            const grow_t *g, int occl)
+{
+    uint16_t *lab = c->labels;
+    int32_t *mem = c->members;
+    const float *rng = c->img.range_m;
+    const uint32_t cols = g->cols;
+    uint32_t k;
+    for (k = 1; k <= g->kc; ++k)
+    {
+        const uint32_t cc =
+            right ? (col + k >= cols ? col + k - cols : col + k) : (col >= k ? col - k : col + cols - k);
+        const uint32_t n = rowbase + cc;
+        const uint32_t l = lab[n];
+        if (l == LAB_NONCAND)
+        {
+            continue;
+        }
+        if (!PROBE_GOES_ON(l, n, rng[n], c->col_sin[k - 1], c->col_cos[k - 1]))
+        {
+            break;
+        }
+    }
+    return tail;
+}
+
+/* a direct (diagonal) neighbour: joins n when free and linked; no bridging */
+#define DIAG(n, sn, cs)                                                                             \
+    if (lab[n] == LAB_FREE && link(dq, rng[n], (sn), (cs), g))                                      \
+    {                                                                                               \
+        lab[n] = (uint16_t)LAB_PENDING;                                                             \
+        mem[tail++] = (int32_t)(n);                                                                 \
+    }
+
+/* Breadth-first flood fill of the cluster seeded at members[start] (tail = start + 1): expands
+ * members[head] for head = start .. tail (the member array is the queue, every pixel is pushed at
+ * most once). Returns the new tail. Directions in the reference's order: right, left, down, up, then
+ * the diagonals down-left, down-right, up-left, up-right. occl is a constant at each call site. */
+static inline uint32_t grow(lidet_cluster_t *c, const grow_t *g, uint32_t start, uint32_t tail, int occl)
+{
+    uint16_t *lab = c->labels;
+    int32_t *mem = c->members;
+    const float *rng = c->img.range_m;
+    const uint32_t rows = g->rows, cols = g->cols, ks = g->ks, kc = g->kc;
+    uint32_t head = start;
+    while (head < tail)
+    {
+        const uint32_t q = (uint32_t)mem[head++];
+        const uint32_t r = g->row_magic != 0u ? (uint32_t)(((uint64_t)q * g->row_magic) >> 32) : q / cols;
+        const uint32_t rowbase = r * cols, col = q - rowbase;
+        const float dq = rng[q];
+        const uint32_t nd = rows - 1u - r < ks ? rows - 1u - r : ks; /* steps that stay in the image */
+        const uint32_t nu = r < ks ? r : ks;
+        LIDET_ASSERT(tail <= rows * cols);
+        /* right, left (wrapping) */
+        if (col + kc < cols)
+        {
+            tail = search(lab, mem, rng, tail, dq, q, 1, kc, c->col_sin, c->col_cos, 1, g, occl);
+        }
+        else
+        {
+            tail = search_wrap(c, tail, dq, rowbase, col, 1, g, occl);
+        }
+        if (col >= kc)
+        {
+            tail = search(lab, mem, rng, tail, dq, q, -1, kc, c->col_sin, c->col_cos, 1, g, occl);
+        }
+        else
+        {
+            tail = search_wrap(c, tail, dq, rowbase, col, 0, g, occl);
+        }
+        /* down: rows r and r + k, entry [r * STEPS + k - 1]; up: rows r - k and r, entry
+         * [(r - k) * STEPS + k - 1] (stored at the upper row), i.e. stride 1 - STEPS from (r - 1) * STEPS */
+        if (nd > 0u)
+        {
+            tail = search(lab, mem, rng, tail, dq, q, (int32_t)cols, nd, c->row_sin + r * STEPS,
+                          c->row_cos + r * STEPS, 1, g, occl);
+        }
+        if (nu > 0u)
+        {
+            tail = search(lab, mem, rng, tail, dq, q, -(int32_t)cols, nu, c->row_sin + (r - 1u) * STEPS,
+                          c->row_cos + (r - 1u) * STEPS, 1 - STEPS, g, occl);
+        }
+        /* diagonals (8-neighbourhood option): direct neighbours only, no bridging */
+        if (g->diag)
+        {
+            const uint32_t cl = col > 0u ? col - 1u : cols - 1u, cr = col + 1u < cols ? col + 1u : 0u;
+            if (r + 1u < rows)
+            {
+                const uint32_t b = rowbase + cols;
+                DIAG(b + cl, c->diag_sin[r], c->diag_cos[r])
+                DIAG(b + cr, c->diag_sin[r], c->diag_cos[r])
+            }
+            if (r > 0u)
+            {
+                const uint32_t b = rowbase - cols;
+                DIAG(b + cl, c->diag_sin[r - 1u], c->diag_cos[r - 1u])
+                DIAG(b + cr, c->diag_sin[r - 1u], c->diag_cos[r - 1u])
+            }
+        }
+    }
+    return tail;
 }
 
 /* the smallest kept cluster (ties: the later seed), the one capacity drops first */
@@ -301,6 +451,18 @@ static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail
     return tail;
 }
 
+/* canonical id of kept pixel i (label slot + 1, or 0 = none), appended to its cluster's members */
+static inline void place_kept(lidet_cluster_t *c, uint16_t *lab, uint32_t i)
+{
+    const uint32_t l = lab[i];
+    if (l != 0u)
+    {
+        const uint32_t id = c->slot_id[l];
+        lab[i] = (uint16_t)id;
+        c->members[c->recs[id - 1u].first_member++] = (int32_t)i;
+    }
+}
+
 /* canonical order: records sorted by seed, labels rewritten, members regrouped in raster order */
 static void canonicalise(lidet_cluster_t *c, uint32_t npix, lidet_cluster_stats_t *st)
 {
@@ -355,19 +517,30 @@ static void canonicalise(lidet_cluster_t *c, uint32_t npix, lidet_cluster_stats_
         start += c->recs[i].n_points;
     }
     st->n_pixels_kept = start;
+    /* every pixel that is not in a kept cluster (non-candidate, dropped; none is still free) -> 0,
+     * without a branch (it vectorises); kept pixels keep slot + 1 */
     for (i = 0; i < npix; ++i)
     {
         const uint32_t l = lab[i];
-        if (l == LAB_FREE || l >= LAB_PENDING)
+        lab[i] = (uint16_t)(l < LAB_PENDING ? l : 0u);
+    }
+    /* slot + 1 -> id and the members in raster order. Kept pixels are a minority: blocks of four
+     * labels that are all 0 (one 64-bit word, read with memcpy) are skipped at once */
+    for (i = 0; i + 4u <= npix; i += 4u)
+    {
+        uint64_t w;
+        memcpy(&w, &lab[i], sizeof w);
+        if (w != 0u)
         {
-            lab[i] = 0;
+            place_kept(c, lab, i);
+            place_kept(c, lab, i + 1u);
+            place_kept(c, lab, i + 2u);
+            place_kept(c, lab, i + 3u);
         }
-        else
-        {
-            const uint32_t id = c->slot_id[l];
-            lab[i] = (uint16_t)id;
-            c->members[c->recs[id - 1u].first_member++] = (int32_t)i;
-        }
+    }
+    for (; i < npix; ++i)
+    {
+        place_kept(c, lab, i);
     }
     for (i = 0; i < k; ++i)
     {
@@ -375,15 +548,39 @@ static void canonicalise(lidet_cluster_t *c, uint32_t npix, lidet_cluster_stats_
     }
 }
 
+/* the first free pixel (label 0) at or after p, npix if none. Seeds are rare once most pixels are
+ * visited: four labels at a time (a 64-bit word, read with memcpy) are skipped when none is 0. The
+ * test (w - 0x0001..) & ~w & 0x8000.. is nonzero exactly when some 16-bit lane of w is zero (a
+ * borrow only starts at a zero lane, and the lowest zero lane always sets its top bit) */
+static inline uint32_t next_free(const uint16_t *lab, uint32_t p, uint32_t npix)
+{
+    for (;;)
+    {
+        while (p + 4u <= npix)
+        {
+            uint64_t w;
+            memcpy(&w, &lab[p], sizeof w);
+            if (((w - 0x0001000100010001u) & ~w & 0x8000800080008000u) != 0u)
+            {
+                break;
+            }
+            p += 4u;
+        }
+        if (p >= npix || lab[p] == LAB_FREE)
+        {
+            return p < npix ? p : npix;
+        }
+        ++p;
+    }
+}
+
 lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *img,
                                  const uint8_t *ground_mask, const lidet_plane_t *planes, uint32_t n_sectors)
 {
-    uint32_t rows, cols, npix, p, tail, kc, ks;
+    uint32_t rows, cols, npix, p, tail, ks;
     uint16_t *lab;
     int32_t *mem;
-    float tan_theta;
-    int occl, diag;
-    float gap, gpm;
+    grow_t lk;
     lidet_cluster_stats_t st;
 
     if (c == 0 || img == 0 || (planes != 0 && n_sectors == 0))
@@ -412,104 +609,55 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     memset(&st, 0, sizeof st);
     lab = c->labels;
     mem = c->members;
-    tan_theta = c->tan_theta;
-    occl = c->cfg.bridge_occluders != 0;
-    gap = c->cfg.max_gap_m;
-    gpm = c->cfg.max_gap_per_m;
-    diag = c->cfg.diagonals != 0;
     ks = c->cfg.max_steps;
-    kc = ks < cols - 1 ? ks : cols - 1; /* never wrap onto itself */
+    lk.rows = rows;
+    lk.cols = cols;
+    lk.ks = ks;
+    lk.kc = ks < cols - 1 ? ks : cols - 1; /* never wrap onto itself */
+    lk.diag = c->cfg.diagonals != 0;
+    lk.tan_theta = c->tan_theta;
+    lk.gap = c->cfg.max_gap_m;
+    lk.gpm = c->cfg.max_gap_per_m;
+    /* row of pixel q without a division: floor(q * m / 2^32) with m = floor(2^32 / cols) + 1 is
+     * floor(q / cols) exactly when q * cols < 2^32 (m exceeds 2^32 / cols by e in (0, 1], so the
+     * quotient is overestimated by q e / 2^32 < 1 / cols, less than the distance of q / cols to the
+     * next integer). q < npix, so npix * cols <= 2^32 suffices (128 x 2048: 2^29); else divide */
+    lk.row_magic = (uint64_t)npix * cols <= 0xFFFFFFFFu ? (uint32_t)(0xFFFFFFFFu / cols) + 1u : 0u;
 
-    for (p = 0; p < npix; ++p)
+    /* candidates: FREE (0) or NONCAND (0xFFFF) = cand - 1 in 16 bits; no branch, so it vectorises */
     {
-        const int cand = img->point_idx[p] >= 0 && (ground_mask == 0 || ground_mask[p] == 0);
-        lab[p] = (uint16_t)(cand ? LAB_FREE : LAB_NONCAND);
-        st.n_candidates += (uint32_t)cand;
+        const int32_t *pidx = img->point_idx;
+        uint32_t n_cand = 0;
+        if (ground_mask != 0)
+        {
+            for (p = 0; p < npix; ++p)
+            {
+                const uint32_t cand = (uint32_t)(pidx[p] >= 0) & (uint32_t)(ground_mask[p] == 0);
+                lab[p] = (uint16_t)(cand - 1u);
+                n_cand += cand;
+            }
+        }
+        else
+        {
+            for (p = 0; p < npix; ++p)
+            {
+                const uint32_t cand = (uint32_t)(pidx[p] >= 0);
+                lab[p] = (uint16_t)(cand - 1u);
+                n_cand += cand;
+            }
+        }
+        st.n_candidates = n_cand;
     }
 
     tail = 0;
-    for (p = 0; p < npix; ++p)
+    for (p = next_free(lab, 0, npix); p < npix; p = next_free(lab, p + 1u, npix))
     {
-        uint32_t head, start;
-        if (lab[p] != LAB_FREE)
-        {
-            continue;
-        }
+        uint32_t start;
         start = tail;
-        head = tail;
         lab[p] = (uint16_t)LAB_PENDING;
         mem[tail++] = (int32_t)p;
-        while (head < tail)
-        {
-            const uint32_t q = (uint32_t)mem[head++];
-            const uint32_t r = q / cols, col = q - r * cols, rowbase = r * cols;
-            const float dq = img->range_m[q];
-            uint32_t k;
-            LIDET_ASSERT(tail <= npix);
-            /* right (wrapping) */
-            for (k = 1; k <= kc; ++k)
-            {
-                uint32_t cc = col + k;
-                uint32_t n;
-                cc = cc >= cols ? cc - cols : cc;
-                n = rowbase + cc;
-                if (lab[n] == LAB_NONCAND)
-                    continue;
-                if (!probe(c, dq, n, c->col_sin[k - 1], c->col_cos[k - 1], tan_theta, gap, occl, &tail))
-                    break;
-            }
-            /* left (wrapping) */
-            for (k = 1; k <= kc; ++k)
-            {
-                const uint32_t cc = col >= k ? col - k : col + cols - k;
-                const uint32_t n = rowbase + cc;
-                if (lab[n] == LAB_NONCAND)
-                    continue;
-                if (!probe(c, dq, n, c->col_sin[k - 1], c->col_cos[k - 1], tan_theta, gap, occl, &tail))
-                    break;
-            }
-            /* down: rows r and r + k */
-            for (k = 1; k <= ks && r + k < rows; ++k)
-            {
-                const uint32_t n = q + k * cols;
-                const uint32_t e = r * STEPS + k - 1;
-                if (lab[n] == LAB_NONCAND)
-                    continue;
-                if (!probe(c, dq, n, c->row_sin[e], c->row_cos[e], tan_theta, gap, occl, &tail))
-                    break;
-            }
-            /* up: rows r - k and r (the pair's entry is stored at the upper row) */
-            for (k = 1; k <= ks && k <= r; ++k)
-            {
-                const uint32_t n = q - k * cols;
-                const uint32_t e = (r - k) * STEPS + k - 1;
-                if (lab[n] == LAB_NONCAND)
-                    continue;
-                if (!probe(c, dq, n, c->row_sin[e], c->row_cos[e], tan_theta, gap, occl, &tail))
-                    break;
-            }
-            /* diagonals (8-neighbourhood option): direct neighbours only, no bridging */
-            if (diag)
-            {
-                const uint32_t cl = col > 0 ? col - 1 : cols - 1, cr = col + 1 < cols ? col + 1 : 0;
-                uint32_t j;
-                for (j = 0; j < 4; ++j)
-                {
-                    const int down = j < 2;
-                    uint32_t n, e;
-                    if (down ? r + 1 >= rows : r == 0)
-                        continue;
-                    n = (down ? rowbase + cols : rowbase - cols) + ((j & 1u) ? cr : cl);
-                    e = down ? r : r - 1;
-                    if (lab[n] == LAB_FREE &&
-                        link(dq, img->range_m[n], gap, c->diag_sin[e], c->diag_cos[e], tan_theta, gpm))
-                    {
-                        lab[n] = (uint16_t)LAB_PENDING;
-                        mem[tail++] = (int32_t)n;
-                    }
-                }
-            }
-        }
+        /* two copies of the flood fill, with the occluder rule a constant in each */
+        tail = c->cfg.bridge_occluders != 0 ? grow(c, &lk, start, tail, 1) : grow(c, &lk, start, tail, 0);
         tail = finish_cluster(c, start, tail, planes, n_sectors, &st);
     }
     canonicalise(c, npix, &st);
