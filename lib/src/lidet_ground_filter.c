@@ -306,61 +306,51 @@ static inline int32_t veto(const float *R, const float *Z, const float *Ru, cons
     return -(int32_t)((Ru[c] > 0.0f) & (dz > max2f(lp->slope * dr, lp->min_dz)));
 }
 
-/* one plane (d already shifted by -mid), constant tolerance */
+static inline float height(const lidet_plane_t *p, const float *X, const float *Y, const float *Z, uint32_t c)
+{
+    return p->nx * X[c] + p->ny * Y[c] + p->nz * Z[c] + p->d_m;
+}
+
+/* in-band word of a pixel holding a point at range r: the near plane's test below split, else the far's */
+static inline int32_t pick(float r, float split, int32_t in_near, int32_t in_far)
+{
+    const int32_t near = -(int32_t)(r < split);
+    return -(int32_t)(r > 0.0f) & ((near & in_near) | (~near & in_far));
+}
+
+/* one plane (d already shifted by -mid), constant tolerance; returns the vetoed count */
 static uint32_t label_one(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
-                      const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, const label_par_t *lp,
-                      int32_t *restrict o)
+                          const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, const label_par_t *lp,
+                          int32_t *restrict o)
 {
-    const float half = lp->half;
     uint32_t j, nv = 0;
     for (j = 0; j < n; ++j)
     {
         const uint32_t c = c0 + j;
-        const float h = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
-        const int32_t in = -(int32_t)((R[c] > 0.0f) & (fabsf(h) < half)), vt = veto(R, Z, Ru, Zu, c, lp);
+        const int32_t in = -(int32_t)((R[c] > 0.0f) & (fabsf(height(&p, X, Y, Z, c)) < lp->half));
+        const int32_t vt = veto(R, Z, Ru, Zu, c, lp);
         o[j] = in & ~vt;
         nv -= (uint32_t)(in & vt);
     }
     return nv;
 }
 
-/* near plane p below split, far plane q from it (both d shifted by -mid), constant tolerance */
-static uint32_t label_two(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
-                      const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, lidet_plane_t q,
-                      const label_par_t *lp, int32_t *restrict o)
-{
-    const float half = lp->half, split = lp->split;
-    uint32_t j, nv = 0;
-    for (j = 0; j < n; ++j)
-    {
-        const uint32_t c = c0 + j;
-        const float hn = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
-        const float hf = q.nx * X[c] + q.ny * Y[c] + q.nz * Z[c] + q.d_m;
-        const int32_t near = -(int32_t)(R[c] < split);
-        const int32_t in_n = -(int32_t)(fabsf(hn) < half), in_f = -(int32_t)(fabsf(hf) < half);
-        const int32_t in = -(int32_t)(R[c] > 0.0f) & ((near & in_n) | (~near & in_f)), vt = veto(R, Z, Ru, Zu, c, lp);
-        o[j] = in & ~vt;
-        nv -= (uint32_t)(in & vt);
-    }
-    return nv;
-}
-
-/* tolerance growing with range (ground_m_per_m > 0), planes unshifted */
-static uint32_t label_general(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
-                          const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, lidet_plane_t q,
-                          const label_par_t *lp, int32_t *restrict o)
+/* near plane p below split, far plane q from it (both d shifted by -mid), constant tolerance; or,
+ * general != 0, the tolerance growing with range (ground_m_per_m > 0, planes unshifted). general is
+ * a constant at both calls. Returns the vetoed count. */
+static inline uint32_t label_two(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
+                                 const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, lidet_plane_t q,
+                                 const label_par_t *lp, int32_t *restrict o, int general)
 {
     uint32_t j, nv = 0;
     for (j = 0; j < n; ++j)
     {
         const uint32_t c = c0 + j;
-        const float hn = p.nx * X[c] + p.ny * Y[c] + p.nz * Z[c] + p.d_m;
-        const float hf = q.nx * X[c] + q.ny * Y[c] + q.nz * Z[c] + q.d_m;
+        const float hn = height(&p, X, Y, Z, c), hf = height(&q, X, Y, Z, c);
         const float above = lp->g0 + lp->k * R[c], below = -lp->bf * above;
-        const int32_t near = -(int32_t)(R[c] < lp->split);
-        const int32_t in_n = -(int32_t)((hn < above) & (hn > below));
-        const int32_t in_f = -(int32_t)((hf < above) & (hf > below));
-        const int32_t in = -(int32_t)(R[c] > 0.0f) & ((near & in_n) | (~near & in_f)), vt = veto(R, Z, Ru, Zu, c, lp);
+        const int32_t in_n = general ? -(int32_t)((hn < above) & (hn > below)) : -(int32_t)(fabsf(hn) < lp->half);
+        const int32_t in_f = general ? -(int32_t)((hf < above) & (hf > below)) : -(int32_t)(fabsf(hf) < lp->half);
+        const int32_t in = pick(R[c], lp->split, in_n, in_f), vt = veto(R, Z, Ru, Zu, c, lp);
         o[j] = in & ~vt;
         nv -= (uint32_t)(in & vt);
     }
@@ -404,7 +394,7 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
                 const uint32_t n = c1 - c < LABEL_CHUNK ? c1 - c : LABEL_CHUNK;
                 if (general)
                 {
-                    nv += label_general(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, o);
+                    nv += label_two(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, o, 1);
                 }
                 else if (!two)
                 {
@@ -429,7 +419,7 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
                     }
                     else
                     {
-                        nv += label_two(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, o);
+                        nv += label_two(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, o, 0);
                     }
                 }
                 for (j = 0; j < n; ++j)
