@@ -230,28 +230,24 @@ lidet_status_t lidet_ground_fit_plane(const float *x_m, const float *y_m, const 
     return LIDET_OK;
 }
 
-/* Counts the points within thr of the plane (contiguous: vectorises). */
-static uint32_t score_all(const float *xs, const float *ys, const float *zs, uint32_t n, const lidet_plane_t *p,
-                          float thr)
-{
-    const float nx = p->nx, ny = p->ny, nz = p->nz, d = p->d_m;
-    uint32_t i, cnt = 0;
-    for (i = 0; i < n; ++i)
-    {
-        cnt += (uint32_t)(fabsf(nx * xs[i] + ny * ys[i] + nz * zs[i] + d) <= thr);
-    }
-    return cnt;
-}
-
-/* Counts the points of the evenly strided subset (every `stride`-th) within thr of the plane. */
+/* Counts the points of the evenly strided subset (every `stride`-th) within thr of the plane; the
+ * contiguous case (stride 1) has its own loop, which vectorises. */
 static uint32_t score(const float *xs, const float *ys, const float *zs, uint32_t n, uint32_t stride,
                       const lidet_plane_t *p, float thr)
 {
+    const float nx = p->nx, ny = p->ny, nz = p->nz, d = p->d_m;
     uint32_t i, cnt = 0;
+    if (stride == 1u)
+    {
+        for (i = 0; i < n; ++i)
+        {
+            cnt += (uint32_t)(fabsf(nx * xs[i] + ny * ys[i] + nz * zs[i] + d) <= thr);
+        }
+        return cnt;
+    }
     for (i = 0; i < n; i += stride)
     {
-        const float h = p->nx * xs[i] + p->ny * ys[i] + p->nz * zs[i] + p->d_m;
-        cnt += (uint32_t)(fabsf(h) <= thr);
+        cnt += (uint32_t)(fabsf(nx * xs[i] + ny * ys[i] + nz * zs[i] + d) <= thr);
     }
     return cnt;
 }
@@ -267,11 +263,13 @@ static int fit_sector(lidet_ground_t *g, const float *xs, const float *ys, const
     const uint32_t stride = (n + cfg->eval_samples - 1u) / cfg->eval_samples;
     const uint32_t n_eval = (n + stride - 1u) / stride; /* size of the strided subset */
     lidet_plane_t best;
+    /* the scoring subset: the strided one, copied once into the workspace when it fits, so that every
+     * hypothesis scores a contiguous block (same points, same order, same counts) */
+    const float *ex = xs, *ey = ys, *ez = zs;
+    uint32_t en = n, es = stride;
     uint32_t best_cnt = 0, it, r, i;
-    int have = 0, compact = 0;
+    int have = 0;
     memset(&best, 0, sizeof best);
-    /* the strided subset, copied once into the workspace when it fits: every hypothesis then scores
-     * a contiguous block (same points, same order, same counts) */
     if (stride > 1u && n_eval <= LIDET_GROUND_EVAL_MAX)
     {
         for (i = 0; i < n_eval; ++i)
@@ -280,7 +278,11 @@ static int fit_sector(lidet_ground_t *g, const float *xs, const float *ys, const
             g->ev_y_m[i] = ys[i * stride];
             g->ev_z_m[i] = zs[i * stride];
         }
-        compact = 1;
+        ex = g->ev_x_m;
+        ey = g->ev_y_m;
+        ez = g->ev_z_m;
+        en = n_eval;
+        es = 1u;
     }
     for (it = 0; it < cfg->ransac_iters; ++it)
     {
@@ -319,12 +321,7 @@ static int fit_sector(lidet_ground_t *g, const float *xs, const float *ys, const
         p.nz = cz * inv;
         p.d_m = -(p.nx * xs[i0] + p.ny * ys[i0] + p.nz * zs[i0]);
         ++g->stats.n_hypotheses;
-        if (stride == 1u)
-            cnt = score_all(xs, ys, zs, n, &p, cfg->inlier_m);
-        else if (compact)
-            cnt = score_all(g->ev_x_m, g->ev_y_m, g->ev_z_m, n_eval, &p, cfg->inlier_m);
-        else
-            cnt = score(xs, ys, zs, n, stride, &p, cfg->inlier_m);
+        cnt = score(ex, ey, ez, en, es, &p, cfg->inlier_m);
         if (!have || cnt > best_cnt)
         {
             best = p;
