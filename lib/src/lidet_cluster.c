@@ -11,10 +11,12 @@
 
 /* pixel states in labels[] during a run (ids 1..LIDET_MAX_CLUSTERS are slots + 1) */
 #define LAB_FREE 0u         /* a candidate not visited yet */
+#define LAB_SMALL 0xFFFDu   /* a fragment (component below min_points) waiting for the rescue pass */
 #define LAB_PENDING 0xFFFEu /* visited: current cluster, or a dropped one */
 #define LAB_NONCAND 0xFFFFu /* no point, or ground: bridged over, never joined */
 
 #define STEPS LIDET_CLUSTER_MAX_STEPS
+#define RESCUE_MAX_COLS 15u /* rescue_cols limit: a window row fits a small local array */
 
 void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *sensor)
 {
@@ -50,6 +52,11 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->max_extent_m = 6.0f;
     cfg->max_mean_height_m = 2.5f;
     cfg->mount_height_m = sensor != 0 ? sensor->mount_height_m : 1.73f;
+    /* measured (docs/BENCHMARKS.md): see lidet_cluster.h */
+    cfg->rescue_gap_m = 0.8f;
+    cfg->rescue_gap_per_m = 0.03f;
+    cfg->rescue_rows = sensor != 0 && sensor->n_rows <= 16 ? 1u : 2u;
+    cfg->rescue_cols = 6u;
 }
 
 lidet_status_t lidet_cluster_init(lidet_cluster_t *c, const lidet_cluster_cfg_t *cfg)
@@ -64,7 +71,10 @@ lidet_status_t lidet_cluster_init(lidet_cluster_t *c, const lidet_cluster_cfg_t 
         !lidet__isfinite(cfg->max_extent_m) || !(cfg->max_extent_m > 0.0f) ||
         !lidet__isfinite(cfg->max_mean_height_m) || !lidet__isfinite(cfg->mount_height_m) ||
         cfg->mount_height_m < 0.0f || !lidet__isfinite(cfg->max_gap_m) || cfg->max_gap_m < 0.0f ||
-        !lidet__isfinite(cfg->max_gap_per_m) || cfg->max_gap_per_m < 0.0f)
+        !lidet__isfinite(cfg->max_gap_per_m) || cfg->max_gap_per_m < 0.0f ||
+        !lidet__isfinite(cfg->rescue_gap_m) || cfg->rescue_gap_m < 0.0f ||
+        !lidet__isfinite(cfg->rescue_gap_per_m) || cfg->rescue_gap_per_m < 0.0f ||
+        cfg->rescue_rows > LIDET_MAX_ROWS || cfg->rescue_cols > RESCUE_MAX_COLS)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -129,7 +139,8 @@ typedef struct
 {
     uint32_t rows, cols, ks, kc, row_magic;
     int diag;
-    float tan_theta, gap, gpm;
+    uint32_t rrows, rcols; /* rescue window half-sizes (2 rcols < cols) */
+    float tan_theta, gap, gpm, rgap, rgpm;
 } grow_t;
 
 /* beta > theta  <=>  d2 sin(a) > tan(theta) (d1 - d2 cos(a)), d1 >= d2 (true when the bracket <= 0).
@@ -316,6 +327,118 @@ static inline uint32_t grow(lidet_cluster_t *c, const grow_t *g, uint32_t start,
     return tail;
 }
 
+/* ---- fragment rescue ------------------------------------------------------------------------ */
+
+/* Running state of one rescue group: the queue tail and the nearest kept pixel met so far. */
+typedef struct
+{
+    uint32_t tail;
+    uint32_t best;  /* slot + 1 of the nearest kept cluster met, 0 = none */
+    float best_d2;  /* its squared distance */
+} rescue_t;
+
+/* One pixel n (label l < LAB_PENDING) of the window of group pixel q (range dq): the two returns'
+ * distance (from their coordinates) against gg = rgap + rgpm * (nearer range). Within it a fragment
+ * pixel joins and a kept pixel is a contact (the nearest one wins, ties: the first met). */
+static inline void rescue_link(lidet_cluster_t *c, rescue_t *rs, uint32_t n, uint32_t l, uint32_t q, float dq,
+                               const grow_t *g)
+{
+    const lidet_range_image_t *img = &c->img;
+    const float dn = img->range_m[n];
+    const float gg = g->rgap + g->rgpm * (dq < dn ? dq : dn);
+    const float dx = img->x_m[n] - img->x_m[q], dy = img->y_m[n] - img->y_m[q], dz = img->z_m[n] - img->z_m[q];
+    const float dd = dx * dx + dy * dy + dz * dz;
+    if (!(dd <= gg * gg))
+    {
+        return;
+    }
+    if (l == LAB_SMALL)
+    {
+        c->labels[n] = (uint16_t)LAB_PENDING;
+        c->members[rs->tail++] = (int32_t)n;
+    }
+    else if (dd < rs->best_d2)
+    {
+        rs->best_d2 = dd;
+        rs->best = l;
+    }
+}
+
+/* Pixel n of the window: looked at when it is a fragment or kept pixel (labels below LAB_PENDING;
+ * visited, dropped and empty pixels are looked past) and its range lies in [lo, hi], the ranges
+ * whose difference to dq can be within the gap (it bounds the distance from below; most pixels
+ * stop here, before their coordinates are read) */
+#define RESCUE_PROBE(n)                                                                             \
+    {                                                                                               \
+        const uint32_t l_ = lab[n];                                                                 \
+        const float d_ = rng[n];                                                                    \
+        if (l_ < LAB_PENDING && d_ >= lo && d_ <= hi && (n) != q)                                   \
+        {                                                                                           \
+            rescue_link(c, rs, (n), l_, q, dq, g);                                                  \
+        }                                                                                           \
+    }
+
+/* Breadth-first fill of the rescue group seeded at members[start]. Around each member q it looks at
+ * every pixel of the window rescue_rows rows up and down and rescue_cols columns left and right
+ * (wrapping), row by row from the top left, q itself excepted. Four labels at a time (a 64-bit
+ * word) are skipped when all are LAB_PENDING or LAB_NONCAND (0xFFFE, 0xFFFF: the only labels with
+ * every bit but the lowest set). Fragments are few (hundreds of pixels per scan), windows small. */
+static void rescue_grow(lidet_cluster_t *c, const grow_t *g, uint32_t start, rescue_t *rs)
+{
+    const int32_t *mem = c->members;
+    const uint16_t *lab = c->labels;
+    const float *rng = c->img.range_m;
+    const uint32_t rows = g->rows, cols = g->cols, wr = g->rrows, wc = g->rcols;
+    uint32_t head = start;
+    while (head < rs->tail)
+    {
+        const uint32_t q = (uint32_t)mem[head++];
+        const uint32_t r = q / cols, col = q - r * cols;
+        const uint32_t r0 = r >= wr ? r - wr : 0u, r1 = r + wr < rows ? r + wr : rows - 1u;
+        const uint32_t c0 = col >= wc ? col - wc : col + cols - wc; /* 2 wc < cols: none repeats */
+        const float dq = rng[q];
+        /* |d - dq| <= rgap + rgpm * min(d, dq)  <=>  lo <= d <= hi */
+        const float hi = dq * (1.0f + g->rgpm) + g->rgap, lo = (dq - g->rgap) / (1.0f + g->rgpm);
+        uint32_t rr, k;
+        LIDET_ASSERT(rs->tail <= rows * cols);
+        for (rr = r0; rr <= r1; ++rr)
+        {
+            const uint32_t base = rr * cols;
+            if (c0 + 2u * wc < cols)
+            {
+                const uint32_t end = base + c0 + 2u * wc + 1u;
+                uint32_t n = base + c0;
+                for (; n + 4u <= end; n += 4u)
+                {
+                    uint64_t w;
+                    memcpy(&w, &lab[n], sizeof w);
+                    if ((w | 0x0001000100010001u) != 0xFFFFFFFFFFFFFFFFu)
+                    {
+                        RESCUE_PROBE(n)
+                        RESCUE_PROBE(n + 1u)
+                        RESCUE_PROBE(n + 2u)
+                        RESCUE_PROBE(n + 3u)
+                    }
+                }
+                for (; n < end; ++n)
+                {
+                    RESCUE_PROBE(n)
+                }
+            }
+            else
+            {
+                uint32_t cc = c0;
+                for (k = 0; k <= 2u * wc; ++k)
+                {
+                    RESCUE_PROBE(base + cc)
+                    cc = cc + 1u < cols ? cc + 1u : 0u;
+                }
+            }
+        }
+    }
+}
+#undef RESCUE_PROBE
+
 /* the smallest kept cluster (ties: the later seed), the one capacity drops first */
 static uint32_t smallest_slot(const lidet_cluster_t *c)
 {
@@ -331,35 +454,22 @@ static uint32_t smallest_slot(const lidet_cluster_t *c)
     return m;
 }
 
-/* filters + bookkeeping of the cluster members[start, tail); returns the new tail */
-static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
-                               uint32_t n_sectors, lidet_cluster_stats_t *st)
+/* sum, min and max of the points of members[start, tail) (tail > start). Returns 1 (the sums then
+ * incomplete) as soon as an x, y or z extent exceeds max_extent: the test runs after every block of
+ * 64 members, so a wall stops early instead of being summed to its end */
+static int member_stats(const lidet_cluster_t *c, uint32_t start, uint32_t tail, float max_extent, float sum[3],
+                        float lo[3], float hi[3])
 {
-    const lidet_range_image_t *img = &c->img;
-    const uint32_t n = tail - start;
+    const float *xs = c->img.x_m, *ys = c->img.y_m, *zs = c->img.z_m;
     const int32_t *mem = c->members;
-    float sum[3] = {0.0f, 0.0f, 0.0f};
-    float lo[3], hi[3], mean[3], h, inv;
-    uint32_t i, slot;
-    lidet_cluster_rec_t *rec;
-
-    ++st->n_found;
-    if (n < c->cfg.min_points)
+    const int32_t p0 = mem[start];
+    float sx = 0.0f, sy = 0.0f, sz = 0.0f;
+    float lx = xs[p0], ly = ys[p0], lz = zs[p0], hx = lx, hy = ly, hz = lz;
+    uint32_t i = start, over = 0;
+    while (i < tail && over == 0u)
     {
-        ++st->n_dropped_small;
-        return start;
-    }
-    {
-        const int32_t p0 = mem[start];
-        lo[0] = hi[0] = img->x_m[p0];
-        lo[1] = hi[1] = img->y_m[p0];
-        lo[2] = hi[2] = img->z_m[p0];
-    }
-    {
-        const float *xs = img->x_m, *ys = img->y_m, *zs = img->z_m;
-        float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-        float lx = lo[0], ly = lo[1], lz = lo[2], hx = hi[0], hy = hi[1], hz = hi[2];
-        for (i = start; i < tail; ++i)
+        const uint32_t e = tail - i < 64u ? tail : i + 64u;
+        for (; i < e; ++i)
         {
             const int32_t p = mem[i];
             const float x = xs[p], y = ys[p], z = zs[p];
@@ -373,18 +483,80 @@ static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail
             hy = y > hy ? y : hy;
             hz = z > hz ? z : hz;
         }
-        sum[0] = sx;
-        sum[1] = sy;
-        sum[2] = sz;
-        lo[0] = lx;
-        lo[1] = ly;
-        lo[2] = lz;
-        hi[0] = hx;
-        hi[1] = hy;
-        hi[2] = hz;
+        over = (uint32_t)(hx - lx > max_extent) | (uint32_t)(hy - ly > max_extent) | (uint32_t)(hz - lz > max_extent);
     }
-    if (hi[0] - lo[0] > c->cfg.max_extent_m || hi[1] - lo[1] > c->cfg.max_extent_m ||
-        hi[2] - lo[2] > c->cfg.max_extent_m)
+    sum[0] = sx;
+    sum[1] = sy;
+    sum[2] = sz;
+    lo[0] = lx;
+    lo[1] = ly;
+    lo[2] = lz;
+    hi[0] = hx;
+    hi[1] = hy;
+    hi[2] = hz;
+    return over != 0u;
+}
+
+/* height of `mean` above the ground plane of the sector of the seed's column (or the flat ground) */
+static float height_above_ground(const lidet_cluster_t *c, uint32_t seed, const float mean[3],
+                                 const lidet_plane_t *planes, uint32_t n_sectors)
+{
+    if (planes != 0)
+    {
+        /* seed < rows * cols so the product fits in 64 bits */
+        const uint32_t col = seed % c->img.n_cols;
+        uint32_t s = (uint32_t)(((uint64_t)col * n_sectors) / c->img.n_cols);
+        const lidet_plane_t *pl;
+        s = s < n_sectors ? s : n_sectors - 1;
+        pl = &planes[s];
+        return pl->nx * mean[0] + pl->ny * mean[1] + pl->nz * mean[2] + pl->d_m;
+    }
+    return mean[2] + c->cfg.mount_height_m;
+}
+
+/* filters + bookkeeping of the component members[start, tail); returns the new tail. rescue = 0:
+ * a component of the first fill (one below min_points becomes a fragment when the rescue is on);
+ * 1: a rescue group that joined no cluster (dropped when small; takes only a free slot) */
+static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
+                               uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue)
+{
+    const uint32_t n = tail - start;
+    const int32_t *mem = c->members;
+    float sum[3], lo[3], hi[3], mean[3], h, inv;
+    uint32_t i, slot;
+    lidet_cluster_rec_t *rec;
+
+    if (!rescue)
+    {
+        ++st->n_found;
+    }
+    if (n < c->cfg.min_points)
+    {
+        if (rescue || !(c->cfg.rescue_gap_m > 0.0f))
+        {
+            ++st->n_dropped_small;
+            return start;
+        }
+        /* a fragment for the rescue, unless its mean lies above the height limit (canopies, wires:
+         * nothing a road user would take in; it saves a third of the rescue's work) */
+        (void)member_stats(c, start, tail, 3.0e38f, sum, lo, hi);
+        inv = 1.0f / (float)n;
+        mean[0] = sum[0] * inv;
+        mean[1] = sum[1] * inv;
+        mean[2] = sum[2] * inv;
+        if (!(height_above_ground(c, (uint32_t)mem[start], mean, planes, n_sectors) <= c->cfg.max_mean_height_m))
+        {
+            ++st->n_dropped_height;
+            return start;
+        }
+        ++st->n_fragments;
+        for (i = start; i < tail; ++i)
+        {
+            c->labels[mem[i]] = (uint16_t)LAB_SMALL;
+        }
+        return start;
+    }
+    if (member_stats(c, start, tail, c->cfg.max_extent_m, sum, lo, hi))
     {
         ++st->n_dropped_extent;
         return start;
@@ -393,20 +565,7 @@ static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail
     mean[0] = sum[0] * inv;
     mean[1] = sum[1] * inv;
     mean[2] = sum[2] * inv;
-    if (planes != 0)
-    {
-        /* sector of the seed's column; seed < rows * cols so the product fits in 64 bits */
-        const uint32_t col = (uint32_t)mem[start] % img->n_cols;
-        uint32_t s = (uint32_t)(((uint64_t)col * n_sectors) / img->n_cols);
-        const lidet_plane_t *pl;
-        s = s < n_sectors ? s : n_sectors - 1;
-        pl = &planes[s];
-        h = pl->nx * mean[0] + pl->ny * mean[1] + pl->nz * mean[2] + pl->d_m;
-    }
-    else
-    {
-        h = mean[2] + c->cfg.mount_height_m;
-    }
+    h = height_above_ground(c, (uint32_t)mem[start], mean, planes, n_sectors);
     if (!(h <= c->cfg.max_mean_height_m))
     {
         ++st->n_dropped_height;
@@ -421,12 +580,13 @@ static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail
         /* full: the new cluster has the latest seed, so it loses every tie */
         const uint32_t m = smallest_slot(c);
         ++st->n_dropped_capacity;
-        if (n <= c->recs[m].n_points)
+        if (rescue || n <= c->recs[m].n_points)
         {
             return start;
         }
         /* evict m: its pixels become "visited, dropped"; its member range stays as a hole that the
-         * final raster pass compacts away */
+         * final raster pass compacts away (only first-fill clusters are evicted, and they own
+         * exactly their member range) */
         for (i = c->recs[m].first_member; i < c->recs[m].first_member + c->recs[m].n_points; ++i)
         {
             c->labels[mem[i]] = (uint16_t)LAB_PENDING;
@@ -437,6 +597,7 @@ static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail
     rec->n_points = n;
     rec->first_member = start;
     rec->seed_pixel = (uint32_t)mem[start];
+    rec->n_rescued = rescue ? n : 0u;
     for (i = 0; i < 3; ++i)
     {
         rec->mean_m[i] = mean[i];
@@ -444,11 +605,46 @@ static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail
         rec->max_m[i] = hi[i];
     }
     rec->height_m = h;
+    if (rescue)
+    {
+        st->n_rescue_pixels += n;
+    }
     for (i = start; i < tail; ++i)
     {
         c->labels[mem[i]] = (uint16_t)(slot + 1u);
     }
     return tail;
+}
+
+/* a rescue group members[start, tail) joins kept cluster `slot`: count, bounds and mean are
+ * updated (mean = (mean * n_old + group sum) / n_new, in float) and the height recomputed. The
+ * group's seed is its first pixel in raster order, so the cluster's first pixel is the smaller of
+ * the two seeds (the height uses that pixel's sector, as for any cluster) */
+static void rescue_join(lidet_cluster_t *c, uint32_t slot, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
+                        uint32_t n_sectors, lidet_cluster_stats_t *st)
+{
+    lidet_cluster_rec_t *rec = &c->recs[slot];
+    const uint32_t n = tail - start, seed = (uint32_t)c->members[start];
+    const float inv = 1.0f / (float)(rec->n_points + n);
+    float sum[3], lo[3], hi[3];
+    uint32_t i;
+    (void)member_stats(c, start, tail, 3.0e38f, sum, lo, hi);
+    for (i = 0; i < 3; ++i)
+    {
+        rec->mean_m[i] = (rec->mean_m[i] * (float)rec->n_points + sum[i]) * inv;
+        rec->min_m[i] = lo[i] < rec->min_m[i] ? lo[i] : rec->min_m[i];
+        rec->max_m[i] = hi[i] > rec->max_m[i] ? hi[i] : rec->max_m[i];
+    }
+    for (i = start; i < tail; ++i)
+    {
+        c->labels[c->members[i]] = (uint16_t)(slot + 1u);
+    }
+    rec->n_points += n;
+    rec->n_rescued += n;
+    rec->seed_pixel = seed < rec->seed_pixel ? seed : rec->seed_pixel;
+    rec->height_m = height_above_ground(c, rec->seed_pixel, rec->mean_m, planes, n_sectors);
+    ++st->n_rescue_joined;
+    st->n_rescue_pixels += n;
 }
 
 /* canonical id of kept pixel i (label slot + 1, or 0 = none), appended to its cluster's members */
@@ -470,7 +666,8 @@ static void canonicalise(lidet_cluster_t *c, uint32_t npix, lidet_cluster_stats_
     uint32_t i, j, start;
     uint16_t *lab = c->labels;
 
-    /* insertion sort of slots by seed: already sorted unless capacity evictions happened */
+    /* insertion sort of slots by seed: already sorted unless capacity evictions happened or the rescue
+     * added clusters or moved a seed */
     for (i = 0; i < k; ++i)
     {
         const uint16_t s = (uint16_t)i;
@@ -522,7 +719,7 @@ static void canonicalise(lidet_cluster_t *c, uint32_t npix, lidet_cluster_stats_
     for (i = 0; i < npix; ++i)
     {
         const uint32_t l = lab[i];
-        lab[i] = (uint16_t)(l < LAB_PENDING ? l : 0u);
+        lab[i] = (uint16_t)(l < LAB_SMALL ? l : 0u);
     }
     /* slot + 1 -> id and the members in raster order. Kept pixels are a minority: blocks of four
      * labels that are all 0 (one 64-bit word, read with memcpy) are skipped at once */
@@ -574,6 +771,31 @@ static inline uint32_t next_free(const uint16_t *lab, uint32_t p, uint32_t npix)
     }
 }
 
+/* the first fragment pixel (LAB_SMALL) at or after p, npix if none: blocks of 64 labels are tested
+ * in a loop without branches (it vectorises), and only a block that holds one is searched */
+static uint32_t next_fragment(const uint16_t *lab, uint32_t p, uint32_t npix)
+{
+    while (p < npix)
+    {
+        const uint32_t e = npix - p < 64u ? npix : p + 64u;
+        uint32_t i;
+        uint16_t any = 0;
+        for (i = p; i < e; ++i)
+        {
+            any |= (uint16_t)(lab[i] == LAB_SMALL);
+        }
+        if (any != 0u)
+        {
+            for (i = p; lab[i] != LAB_SMALL; ++i)
+            {
+            }
+            return i;
+        }
+        p = e;
+    }
+    return npix;
+}
+
 lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *img,
                                  const uint8_t *ground_mask, const lidet_plane_t *planes, uint32_t n_sectors)
 {
@@ -618,6 +840,10 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     lk.tan_theta = c->tan_theta;
     lk.gap = c->cfg.max_gap_m;
     lk.gpm = c->cfg.max_gap_per_m;
+    lk.rgap = c->cfg.rescue_gap_m;
+    lk.rgpm = c->cfg.rescue_gap_per_m;
+    lk.rrows = c->cfg.rescue_rows;
+    lk.rcols = c->cfg.rescue_cols < (cols - 1u) / 2u ? c->cfg.rescue_cols : (cols - 1u) / 2u;
     /* row of pixel q without a division: floor(q * m / 2^32) with m = floor(2^32 / cols) + 1 is
      * floor(q / cols) exactly when q * cols < 2^32 (m exceeds 2^32 / cols by e in (0, 1], so the
      * quotient is overestimated by q e / 2^32 < 1 / cols, less than the distance of q / cols to the
@@ -658,7 +884,32 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
         mem[tail++] = (int32_t)p;
         /* two copies of the flood fill, with the occluder rule a constant in each */
         tail = c->cfg.bridge_occluders != 0 ? grow(c, &lk, start, tail, 1) : grow(c, &lk, start, tail, 0);
-        tail = finish_cluster(c, start, tail, planes, n_sectors, &st);
+        tail = finish_cluster(c, start, tail, planes, n_sectors, &st, 0);
+    }
+    /* the rescue pass over the fragments (LAB_SMALL), groups seeded in raster order. Kept pixels,
+     * the fragments and the current group are distinct pixels, so the member array holds them */
+    if (st.n_fragments > 0u)
+    {
+        for (p = next_fragment(lab, 0, npix); p < npix; p = next_fragment(lab, p + 1u, npix))
+        {
+            rescue_t rs;
+            const uint32_t start = tail;
+            lab[p] = (uint16_t)LAB_PENDING;
+            mem[tail++] = (int32_t)p;
+            rs.tail = tail;
+            rs.best = 0u;
+            rs.best_d2 = 3.0e38f;
+            rescue_grow(c, &lk, start, &rs);
+            if (rs.best != 0u)
+            {
+                rescue_join(c, rs.best - 1u, start, rs.tail, planes, n_sectors, &st);
+                tail = start;
+            }
+            else
+            {
+                tail = finish_cluster(c, start, rs.tail, planes, n_sectors, &st, 1);
+            }
+        }
     }
     canonicalise(c, npix, &st);
     st.n_kept = c->n_recs;

@@ -6,6 +6,7 @@
 
 #include <stdint.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "lidet/lidet.h"
 
@@ -40,6 +41,26 @@ void cli_json_num(FILE *f, const char *key, double v);
 void cli_json_int(FILE *f, const char *key, long long v);
 void cli_json_str(FILE *f, const char *key, const char *v);
 void cli_json_end(FILE *f);
+
+/* `--set KEY=VALUE` overrides of one configuration struct's fields. cli_split_set splits kv into the
+ * key length and the number; 0, or 1 when there is no '=' or the value is not a number. Inside a
+ * function `int apply(cfg_t *c, const char *kv)` that has called it (locals klen, v), CLI_SET_FLOAT
+ * and CLI_SET_INT return 0 when the key names that field (1 for an integer out of [0, maxv]). */
+int cli_split_set(const char *kv, size_t *klen, double *v);
+#define CLI_SET_FLOAT(c, kv, klen, v, name)                                                          \
+    if ((klen) == sizeof #name - 1 && strncmp((kv), #name, (klen)) == 0)                             \
+    {                                                                                                \
+        (c)->name = (float)(v);                                                                      \
+        return 0;                                                                                    \
+    }
+#define CLI_SET_INT(c, kv, klen, v, name, type, maxv)                                                \
+    if ((klen) == sizeof #name - 1 && strncmp((kv), #name, (klen)) == 0)                             \
+    {                                                                                                \
+        if ((v) < 0.0 || (v) > (double)(maxv) || (v) != (double)(long long)(v))                      \
+            return 1;                                                                                \
+        (c)->name = (type)(v);                                                                       \
+        return 0;                                                                                    \
+    }
 
 /* Subcommands */
 int cli_project(int argc, char **argv);

@@ -75,6 +75,31 @@ static int write_bev_png(const char *path, const float *pts, uint32_t n, const u
     return rc;
 }
 
+/* `--set KEY=VALUE` overrides one lidet_cluster_cfg_t field. Returns 0, or 1 for an unknown key or
+ * a bad number. */
+static int apply_set(lidet_cluster_cfg_t *c, const char *kv)
+{
+    size_t klen;
+    double v;
+    if (cli_split_set(kv, &klen, &v) != 0)
+        return 1;
+    CLI_SET_FLOAT(c, kv, klen, v, theta_rad)
+    CLI_SET_FLOAT(c, kv, klen, v, max_gap_m)
+    CLI_SET_FLOAT(c, kv, klen, v, max_gap_per_m)
+    CLI_SET_FLOAT(c, kv, klen, v, max_extent_m)
+    CLI_SET_FLOAT(c, kv, klen, v, max_mean_height_m)
+    CLI_SET_FLOAT(c, kv, klen, v, mount_height_m)
+    CLI_SET_FLOAT(c, kv, klen, v, rescue_gap_m)
+    CLI_SET_FLOAT(c, kv, klen, v, rescue_gap_per_m)
+    CLI_SET_INT(c, kv, klen, v, max_steps, uint32_t, LIDET_CLUSTER_MAX_STEPS)
+    CLI_SET_INT(c, kv, klen, v, bridge_occluders, uint32_t, 1)
+    CLI_SET_INT(c, kv, klen, v, diagonals, uint32_t, 1)
+    CLI_SET_INT(c, kv, klen, v, min_points, uint32_t, 4294967295.0)
+    CLI_SET_INT(c, kv, klen, v, rescue_rows, uint32_t, LIDET_MAX_ROWS)
+    CLI_SET_INT(c, kv, klen, v, rescue_cols, uint32_t, 15)
+    return 1;
+}
+
 static int fail(cli_args_t *a, const char *what, lidet_status_t st)
 {
     fprintf(stderr, "lidet cluster: %s: %s\n", what, lidet_status_str(st));
@@ -97,38 +122,66 @@ int cli_cluster(int argc, char **argv)
     uint32_t n_sectors = 0;
     double ms_gnd = 0.0;
     char **rest;
-    int nrest = 0, i;
+    const char **sets;
+    int nrest = 0, nsets = 0, i;
     double *t_proj, *t_clu, *t_prop, *t_gnd, ms_proj, ms_clu, ms_prop;
     uint32_t npix, p, n_pp, k, n_rec;
     const int32_t *pp;
     uint32_t *ids;
 
-    /* our own option first; the rest goes to the shared parser */
+    /* our own options first; the rest goes to the shared parser */
     rest = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
-    if (rest == NULL)
+    sets = (const char **)malloc(sizeof(char *) * (size_t)(argc + 1));
+    if (rest == NULL || sets == NULL)
+    {
+        free(rest);
+        free(sets);
         return 1;
+    }
     for (i = 0; i < argc; ++i)
     {
         if (strcmp(argv[i], "--labels") == 0 && i + 1 < argc)
             labels_path = argv[++i];
+        else if (strcmp(argv[i], "--set") == 0 && i + 1 < argc)
+            sets[nsets++] = argv[++i];
         else
             rest[nrest++] = argv[i];
     }
     if (cli_parse(nrest, rest, "cluster", &a) != 0)
     {
         fprintf(stderr, "  --labels   SemanticKITTI .label file: its ground classes are the ground mask\n"
-                        "             (default: the ground stage, with its per-sector planes)\n");
+                        "             (default: the ground stage, with its per-sector planes)\n"
+                        "  --set KEY=VALUE  override a lidet_cluster_cfg_t field (repeatable), e.g.\n"
+                        "             --set rescue_gap_m=0 (no fragment rescue)\n");
         free(rest);
+        free(sets);
         return 1;
     }
     free(rest);
     if (cli_load(&a) != 0)
+    {
+        free(sets);
         return 1;
+    }
     lidet_proj_cfg_default(&pcfg, a.sensor_profile);
     st = lidet_proj_init(&g_proj, &pcfg);
     if (st != LIDET_OK)
+    {
+        free(sets);
         return fail(&a, "projection init", st);
+    }
     lidet_cluster_cfg_default(&ccfg, a.sensor_profile);
+    for (i = 0; i < nsets; ++i)
+    {
+        if (apply_set(&ccfg, sets[i]) != 0)
+        {
+            fprintf(stderr, "lidet cluster: bad --set '%s' (KEY=VALUE with a lidet_cluster_cfg_t field)\n", sets[i]);
+            free(sets);
+            cli_free(&a);
+            return 1;
+        }
+    }
+    free(sets);
     st = lidet_cluster_init(&g_cl, &ccfg);
     if (st != LIDET_OK)
         return fail(&a, "cluster init", st);
@@ -258,6 +311,9 @@ int cli_cluster(int argc, char **argv)
         cli_json_int(stdout, "dropped_extent", cs->n_dropped_extent);
         cli_json_int(stdout, "dropped_height", cs->n_dropped_height);
         cli_json_int(stdout, "dropped_capacity", cs->n_dropped_capacity);
+        cli_json_int(stdout, "fragments", cs->n_fragments);
+        cli_json_int(stdout, "rescue_joined", cs->n_rescue_joined);
+        cli_json_int(stdout, "rescue_pixels", cs->n_rescue_pixels);
         cli_json_int(stdout, "clusters", cs->n_kept);
         cli_json_int(stdout, "proposals", cs->n_kept);
         cli_json_int(stdout, "proposal_points", prcfg.n_points);
@@ -280,6 +336,8 @@ int cli_cluster(int argc, char **argv)
         printf("clusters        %u kept of %u found (dropped: small %u, extent %u, height %u, capacity %u)\n",
                cs->n_kept, cs->n_found, cs->n_dropped_small, cs->n_dropped_extent, cs->n_dropped_height,
                cs->n_dropped_capacity);
+        printf("rescue          %u fragments; %u groups joined clusters, %u pixels kept\n", cs->n_fragments,
+               cs->n_rescue_joined, cs->n_rescue_pixels);
         printf("proposals       %u x %u points\n", cs->n_kept, prcfg.n_points);
         printf("cluster_ms      %.3f (median of %d; projection %.3f, proposals %.3f)\n", ms_clu, a.repeat,
                ms_proj, ms_prop);

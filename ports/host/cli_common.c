@@ -193,6 +193,17 @@ static int cmp_double(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
+int cli_split_set(const char *kv, size_t *klen, double *v)
+{
+    const char *eq = strchr(kv, '=');
+    char *end;
+    if (eq == NULL || eq == kv)
+        return 1;
+    *klen = (size_t)(eq - kv);
+    *v = strtod(eq + 1, &end);
+    return (*end != '\0' || end == eq + 1) ? 1 : 0;
+}
+
 double cli_median(double *v, int n)
 {
     if (n <= 0)

@@ -76,60 +76,38 @@ static int write_bev_png(const char *path, const float *pts, uint32_t n, const u
  * tools/bench/bench_ground.py). Returns 0, or 1 for an unknown key or a bad number. */
 static int apply_set(lidet_ground_cfg_t *c, const char *kv)
 {
-    const char *eq = strchr(kv, '=');
-    char *end;
-    double v;
     size_t klen;
-    if (eq == NULL)
+    double v;
+    if (cli_split_set(kv, &klen, &v) != 0)
         return 1;
-    klen = (size_t)(eq - kv);
-    v = strtod(eq + 1, &end);
-    if (*end != '\0' || end == eq + 1)
-        return 1;
-#define FLOAT_FIELD(name)                                                                                    \
-    if (klen == sizeof #name - 1 && strncmp(kv, #name, klen) == 0)                                           \
-    {                                                                                                        \
-        c->name = (float)v;                                                                                  \
-        return 0;                                                                                            \
-    }
-#define INT_FIELD(name, type, maxv)                                                                          \
-    if (klen == sizeof #name - 1 && strncmp(kv, #name, klen) == 0)                                           \
-    {                                                                                                        \
-        if (v < 0.0 || v > (double)(maxv) || v != (double)(long long)v)                                      \
-            return 1;                                                                                        \
-        c->name = (type)v;                                                                                   \
-        return 0;                                                                                            \
-    }
-    FLOAT_FIELD(fy_max)
-    FLOAT_FIELD(fx_max_m)
-    FLOAT_FIELD(gate_above_m)
-    FLOAT_FIELD(gate_below_m)
-    FLOAT_FIELD(mount_height_m)
-    FLOAT_FIELD(inlier_m)
-    FLOAT_FIELD(max_tilt_rad)
-    FLOAT_FIELD(max_height_dev_m)
-    FLOAT_FIELD(ground_m)
-    FLOAT_FIELD(ground_m_per_m)
-    FLOAT_FIELD(below_factor)
-    FLOAT_FIELD(confidence)
-    FLOAT_FIELD(ring_split_m)
-    FLOAT_FIELD(veto_slope)
-    FLOAT_FIELD(veto_min_dz_m)
-    INT_FIELD(fx_on_z, uint8_t, 1)
-    INT_FIELD(require_descending, uint8_t, 1)
-    INT_FIELD(height_gate, uint8_t, 1)
-    INT_FIELD(refine_iters, uint8_t, 255)
-    INT_FIELD(n_sectors, uint16_t, 65535)
-    INT_FIELD(ransac_iters, uint16_t, 65535)
-    INT_FIELD(eval_samples, uint16_t, 65535)
-    INT_FIELD(sample_step, uint16_t, 65535)
-    INT_FIELD(sample_col_step, uint16_t, 65535)
-    INT_FIELD(min_samples, uint16_t, 65535)
-    INT_FIELD(min_inliers, uint16_t, 65535)
-    INT_FIELD(fallback_sectors, uint16_t, 65535)
-    INT_FIELD(seed, uint32_t, 4294967295.0)
-#undef FLOAT_FIELD
-#undef INT_FIELD
+    CLI_SET_FLOAT(c, kv, klen, v, fy_max)
+    CLI_SET_FLOAT(c, kv, klen, v, fx_max_m)
+    CLI_SET_FLOAT(c, kv, klen, v, gate_above_m)
+    CLI_SET_FLOAT(c, kv, klen, v, gate_below_m)
+    CLI_SET_FLOAT(c, kv, klen, v, mount_height_m)
+    CLI_SET_FLOAT(c, kv, klen, v, inlier_m)
+    CLI_SET_FLOAT(c, kv, klen, v, max_tilt_rad)
+    CLI_SET_FLOAT(c, kv, klen, v, max_height_dev_m)
+    CLI_SET_FLOAT(c, kv, klen, v, ground_m)
+    CLI_SET_FLOAT(c, kv, klen, v, ground_m_per_m)
+    CLI_SET_FLOAT(c, kv, klen, v, below_factor)
+    CLI_SET_FLOAT(c, kv, klen, v, confidence)
+    CLI_SET_FLOAT(c, kv, klen, v, ring_split_m)
+    CLI_SET_FLOAT(c, kv, klen, v, veto_slope)
+    CLI_SET_FLOAT(c, kv, klen, v, veto_min_dz_m)
+    CLI_SET_INT(c, kv, klen, v, fx_on_z, uint8_t, 1)
+    CLI_SET_INT(c, kv, klen, v, require_descending, uint8_t, 1)
+    CLI_SET_INT(c, kv, klen, v, height_gate, uint8_t, 1)
+    CLI_SET_INT(c, kv, klen, v, refine_iters, uint8_t, 255)
+    CLI_SET_INT(c, kv, klen, v, n_sectors, uint16_t, 65535)
+    CLI_SET_INT(c, kv, klen, v, ransac_iters, uint16_t, 65535)
+    CLI_SET_INT(c, kv, klen, v, eval_samples, uint16_t, 65535)
+    CLI_SET_INT(c, kv, klen, v, sample_step, uint16_t, 65535)
+    CLI_SET_INT(c, kv, klen, v, sample_col_step, uint16_t, 65535)
+    CLI_SET_INT(c, kv, klen, v, min_samples, uint16_t, 65535)
+    CLI_SET_INT(c, kv, klen, v, min_inliers, uint16_t, 65535)
+    CLI_SET_INT(c, kv, klen, v, fallback_sectors, uint16_t, 65535)
+    CLI_SET_INT(c, kv, klen, v, seed, uint32_t, 4294967295.0)
     return 1;
 }
 

@@ -330,11 +330,13 @@ static uint8_t g_ground_pix[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 /* Project with the state of lidet_py_proj_init, then cluster. ground_per_point: n bytes (1 = ground)
  * or NULL; a pixel is ground when its winning point is. planes: n_sectors * 4 floats (nx, ny, nz, d)
  * or NULL. cfg_f: theta_rad, max_extent_m, max_mean_height_m, mount_height_m,
- * max_gap_m, max_gap_per_m; cfg_u: max_steps,
- * min_points, bridge_occluders, diagonals. Outputs (any may be NULL): out_point_labels n uint32 (0 for points past capacity),
+ * max_gap_m, max_gap_per_m, rescue_gap_m, rescue_gap_per_m; cfg_u: max_steps,
+ * min_points, bridge_occluders, diagonals, rescue_rows, rescue_cols. Outputs (any may be NULL): out_point_labels n uint32 (0 for points past capacity),
  * out_pixel_labels rows * cols uint16, out_members rows * cols int32 (first n_pixels_kept used),
- * out_rec_u max_recs * 3 uint32 (n_points, first_member, seed_pixel), out_rec_f max_recs * 10 floats
- * (mean xyz, min xyz, max xyz, height), out_n_recs, out_stats 9 uint32 (lidet_cluster_stats_t order). */
+ * out_rec_u max_recs * 4 uint32 (n_points, first_member, seed_pixel, n_rescued), out_rec_f max_recs * 10
+ * floats (mean xyz, min xyz, max xyz, height), out_n_recs, out_stats 12 uint32 (n_candidates, n_found,
+ * n_dropped_small, _extent, _height, _capacity, n_kept, n_pixels_kept, n_queue_overflow, n_fragments,
+ * n_rescue_joined, n_rescue_pixels). */
 LIDET_PY_API int lidet_py_cluster_run(const float *pts, uint32_t n, uint32_t stride, const uint8_t *ground_per_point,
                                       const float *planes, uint32_t n_sectors, const float *cfg_f,
                                       const uint32_t *cfg_u, uint32_t *out_point_labels, uint16_t *out_pixel_labels,
@@ -378,10 +380,14 @@ LIDET_PY_API int lidet_py_cluster_run(const float *pts, uint32_t n, uint32_t str
     cfg.mount_height_m = cfg_f[3];
     cfg.max_gap_m = cfg_f[4];
     cfg.max_gap_per_m = cfg_f[5];
+    cfg.rescue_gap_m = cfg_f[6];
+    cfg.rescue_gap_per_m = cfg_f[7];
     cfg.max_steps = cfg_u[0];
     cfg.min_points = cfg_u[1];
     cfg.bridge_occluders = cfg_u[2];
     cfg.diagonals = cfg_u[3];
+    cfg.rescue_rows = cfg_u[4];
+    cfg.rescue_cols = cfg_u[5];
     rc = lidet_cluster_init(&g_cluster, &cfg);
     if (rc < 0)
         return rc;
@@ -408,9 +414,10 @@ LIDET_PY_API int lidet_py_cluster_run(const float *pts, uint32_t n, uint32_t str
     {
         if (out_rec_u != NULL)
         {
-            out_rec_u[3 * p] = rec[p].n_points;
-            out_rec_u[3 * p + 1] = rec[p].first_member;
-            out_rec_u[3 * p + 2] = rec[p].seed_pixel;
+            out_rec_u[4 * p] = rec[p].n_points;
+            out_rec_u[4 * p + 1] = rec[p].first_member;
+            out_rec_u[4 * p + 2] = rec[p].seed_pixel;
+            out_rec_u[4 * p + 3] = rec[p].n_rescued;
         }
         if (out_rec_f != NULL)
         {
@@ -432,6 +439,9 @@ LIDET_PY_API int lidet_py_cluster_run(const float *pts, uint32_t n, uint32_t str
         out_stats[6] = st->n_kept;
         out_stats[7] = st->n_pixels_kept;
         out_stats[8] = st->n_queue_overflow;
+        out_stats[9] = st->n_fragments;
+        out_stats[10] = st->n_rescue_joined;
+        out_stats[11] = st->n_rescue_pixels;
     }
     return rc;
 }

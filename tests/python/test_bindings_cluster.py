@@ -68,11 +68,18 @@ def test_defaults_and_options():
     d = native.cluster_defaults("hdl64")
     assert d["min_points"] == 10 and d["max_steps"] == 5 and d["theta_rad"] == 0.18 and d["diagonals"] == 1
     assert d["max_gap_m"] == 0.7 and d["max_gap_per_m"] == 0.025 and d["bridge_occluders"] == 1
+    assert d["rescue_gap_m"] == 0.8 and d["rescue_gap_per_m"] == 0.03 and d["rescue_rows"] == 2 and d["rescue_cols"] == 6
     v = native.cluster_defaults("vlp16")
     assert v["theta_rad"] == 0.12 and v["max_steps"] == 4 and v["bridge_occluders"] == 0 and v["max_gap_per_m"] == 0.04
+    assert v["rescue_rows"] == 1
     pts, ground, _, _ = _synthetic()
-    a = native.cluster(pts, "hdl64", ground=ground, min_points=100000)
+    a = native.cluster(pts, "hdl64", ground=ground, min_points=100000, rescue_gap_m=0.0)
     assert a.stats["n_kept"] == 0 and a.stats["n_dropped_small"] == a.stats["n_found"]
+    assert a.stats["n_fragments"] == 0 and a.stats["n_rescue_pixels"] == 0
+    # with the rescue every component is a fragment (or too high); the rescue groups are all small
+    b = native.cluster(pts, "hdl64", ground=ground, min_points=100000)
+    assert b.stats["n_kept"] == 0 and b.stats["n_fragments"] + b.stats["n_dropped_height"] == b.stats["n_found"]
+    assert 1 <= b.stats["n_dropped_small"] <= b.stats["n_fragments"]
     with pytest.raises(TypeError):
         native.cluster(pts, "hdl64", theta=0.3)
     with pytest.raises(native.LidetError):
@@ -89,25 +96,53 @@ def _real(real_dir, k=0):
 def test_real_scan_matches_reference(real_dir):
     """The C labels equal the plain-Python BFS reference on a real SemanticKITTI scan."""
     pts, ground = _real(real_dir)
+    defaults = {k: v for k, v in native.cluster_defaults("hdl64").items() if k != "mount_height_m"}
     for cfg in (dict(theta_rad=0.40, max_steps=5, bridge_occluders=True, diagonals=True, min_points=10,
-                     max_extent_m=6.0, max_mean_height_m=2.5, max_gap_m=0.0, max_gap_per_m=0.0),
+                     max_extent_m=6.0, max_mean_height_m=2.5, max_gap_m=0.0, max_gap_per_m=0.0, rescue_gap_m=0.0),
                 dict(theta_rad=0.2, max_steps=9, bridge_occluders=False, diagonals=False, min_points=10,
-                     max_extent_m=6.0, max_mean_height_m=2.5, max_gap_m=0.0, max_gap_per_m=0.0),
-                {k: v for k, v in native.cluster_defaults("hdl64").items() if k != "mount_height_m"}):
+                     max_extent_m=6.0, max_mean_height_m=2.5, max_gap_m=0.0, max_gap_per_m=0.0, rescue_gap_m=0.0),
+                defaults,
+                {**defaults, "rescue_gap_m": 1.0, "rescue_gap_per_m": 0.05, "rescue_rows": 3, "rescue_cols": 9,
+                 "min_points": 20}):
         _check_against_ref(pts, ground, cfg)
 
 
-def _check_against_ref(pts, ground, cfg):
-    c = native.cluster(pts, "hdl64", ground=ground, with_image=True, **cfg)
+def test_rescue_matches_reference_on_sample(root):
+    """The fragment rescue (on by default) in C and in the reference, on the shipped simulated VLP-16
+    sample (16 beams: where the rescue matters most); and it really rescues pixels there."""
+    d = root / "tests" / "data" / "sim_vlp16"
+    pts = np.fromfile(d / "velodyne" / "000000.bin", np.float32).reshape(-1, 4)
+    lab = np.fromfile(d / "labels" / "000000.label", np.uint32)
+    defaults = {k: v for k, v in native.cluster_defaults("vlp16").items() if k != "mount_height_m"}
+    c = _check_against_ref(pts, np.isin(lab & 0xFFFF, GROUND), defaults, "vlp16", exact=True)
+    assert c.stats["n_fragments"] > 0 and c.stats["n_rescue_joined"] > 0 and c.stats["n_rescue_pixels"] > 0
+    assert c.n_rescued.sum() == c.stats["n_rescue_pixels"] and np.all(c.n_rescued <= c.n_points)
+    # the records of clusters that took in fragments describe all their members
+    xyz = np.stack([c.image.x, c.image.y, c.image.z], -1).reshape(-1, 3)
+    for i in np.nonzero(c.n_rescued)[0]:
+        m = c.members[c.first_member[i]:c.first_member[i] + c.n_points[i]]
+        assert c.seed_pixel[i] == m[0]
+        np.testing.assert_allclose(xyz[m].mean(0), c.mean[i], atol=1e-4)
+        np.testing.assert_array_equal(xyz[m].min(0), c.min[i])
+        np.testing.assert_array_equal(xyz[m].max(0), c.max[i])
+    assert np.all(np.diff(c.seed_pixel.astype(np.int64)) > 0)
+
+
+def _check_against_ref(pts, ground, cfg, sensor="hdl64", exact=False):
+    c = native.cluster(pts, sensor, ground=ground, with_image=True, **cfg)
     img = c.image
     cand = img.valid.copy()
     w = img.point_idx[img.valid]
     cand[img.valid] = ~ground[w]
     xyz = np.stack([img.x, img.y, img.z], -1)
-    labels, members = ref.cluster_ref(img.range, cand, img.row_elev, xyz, mount_height_m=1.73, **cfg)
+    labels, members = ref.cluster_ref(img.range, cand, img.row_elev, xyz,
+                                      mount_height_m=native.cluster_defaults(sensor)["mount_height_m"], **cfg)
+    if exact:  # no mean within float rounding of a filter's edge here
+        np.testing.assert_array_equal(labels, c.pixel_labels)
     agree = np.mean(labels == c.pixel_labels)
     assert agree > 0.999, agree
     assert abs(len(members) - len(c)) <= 1
+    return c
 
 
 def test_proposals_match_reference(real_dir):

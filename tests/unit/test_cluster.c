@@ -279,11 +279,15 @@ static void test_filters(void)
     st = lidet_cluster_stats(&g.ws);
     TEST_ASSERT_EQUAL_UINT32(1, st->n_dropped_extent);
     TEST_ASSERT_EQUAL_UINT32(1, st->n_kept);
-    /* flat ground 1.73 m below: the 10 m block's mean (row 1 at +5 deg: z ~ 0.87 m) is 2.6 m high */
+    TEST_ASSERT_EQUAL_UINT32(1, st->n_fragments); /* the 'a' column, rescued by nothing */
+    /* flat ground 1.73 m below: the 10 m block's mean (row 1 at +5 deg: z ~ 0.87 m) is 2.6 m high;
+     * the 'a' fragment (5 m: 2.17 m high) is dropped for height before the rescue */
     cfg.max_mean_height_m = 2.0f;
     run(art, 3, NULL);
     st = lidet_cluster_stats(&g.ws);
-    TEST_ASSERT_EQUAL_UINT32(1, st->n_dropped_height);
+    TEST_ASSERT_EQUAL_UINT32(2, st->n_dropped_height);
+    TEST_ASSERT_EQUAL_UINT32(0, st->n_fragments);
+    TEST_ASSERT_EQUAL_UINT32(0, st->n_dropped_small);
     TEST_ASSERT_EQUAL_UINT32(0, st->n_kept);
     /* a tilted plane per sector: sector 0 says everything is low -> kept again */
     {
@@ -294,6 +298,130 @@ static void test_filters(void)
                           lidet_cluster_records(&g.ws, NULL)[0].height_m, 1e-5, 0);
         TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_cluster_run(&g.ws, &t.img, NULL, planes, 0));
     }
+}
+
+/* set pixel p of the drawing to a return at range_m (same beam direction) */
+static void set_range(int p, int cols, float range_m)
+{
+    const int r = p / cols, c = p % cols;
+    const double az = M_PI * (1.0 - 2.0 * (c + 0.5) / cols), el = t.elev[r];
+    t.x[p] = (float)(range_m * cos(el) * cos(az));
+    t.y[p] = (float)(range_m * cos(el) * sin(az));
+    t.z[p] = (float)(range_m * sin(el));
+    t.r[p] = range_m;
+    t.rxy[p] = (float)(range_m * cos(el));
+}
+
+/* Fragment rescue (256 columns, 1.4 deg each; theta 0.5 rad, no diagonals, no occluder bridging):
+ *  - A: row 1, cols 100..109 at 10 m (kept); row 0 has 4 returns at 11 m at cols 100, 102, 104,
+ *    106 (the far side seen through glass): they join each other (bridged holes) but fail the angle
+ *    test to A (beta 0.33 < 0.5): a fragment of 4 (< min_points 6) about 1.06 m from A -> joins A;
+ *  - B: row 2, cols 20..31 alternating 20 m / 21 m: every pixel a singleton for the angle test
+ *    (beta 0.45), 1.1 m apart -> one rescue group of 12, a cluster of its own;
+ *  - C: row 2, cols 200..202 at 30 m: a fragment of 3 with nothing near -> dropped. */
+static void test_fragment_rescue(void)
+{
+    enum { COLS = 256, ROWS = 3 };
+    static char rowbuf[ROWS][COLS + 1];
+    const char *art[ROWS];
+    const lidet_cluster_rec_t *rec;
+    const lidet_cluster_stats_t *st;
+    const uint16_t *lab;
+    uint32_t n, i;
+    int r, c;
+    for (r = 0; r < ROWS; ++r)
+    {
+        memset(rowbuf[r], '.', COLS);
+        rowbuf[r][COLS] = '\0';
+        art[r] = rowbuf[r];
+    }
+    for (c = 100; c < 110; ++c)
+        rowbuf[1][c] = 'c';
+    for (c = 100; c <= 106; c += 2)
+        rowbuf[0][c] = 'c';
+    for (c = 20; c < 32; ++c)
+        rowbuf[2][c] = 'c';
+    for (c = 200; c < 203; ++c)
+        rowbuf[2][c] = 'c';
+    cfg.theta_rad = 0.5f;
+    cfg.diagonals = 0;
+    cfg.bridge_occluders = 0;
+    cfg.min_points = 6;
+    cfg.rescue_gap_m = 0.8f;
+    cfg.rescue_gap_per_m = 0.03f;
+    cfg.rescue_rows = 1;
+    cfg.rescue_cols = 6;
+    tcu_draw(&t, art, ROWS);
+    for (c = 100; c <= 106; c += 2)
+        set_range(c, COLS, 11.0f);
+    for (c = 20; c < 32; ++c)
+        set_range(2 * COLS + c, COLS, (c & 1) ? 21.0f : 20.0f);
+    for (c = 200; c < 203; ++c)
+        set_range(2 * COLS + c, COLS, 30.0f);
+
+    /* without the rescue: A alone */
+    cfg.rescue_gap_m = 0.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+    st = lidet_cluster_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(1, st->n_kept);
+    TEST_ASSERT_EQUAL_UINT32(15, st->n_found); /* A, the 11 m fragment, 12 singletons, C */
+    TEST_ASSERT_EQUAL_UINT32(14, st->n_dropped_small);
+    TEST_ASSERT_EQUAL_UINT32(0, st->n_fragments);
+    TEST_ASSERT_EQUAL_UINT32(10, lidet_cluster_records(&g.ws, NULL)[0].n_points);
+
+    cfg.rescue_gap_m = 0.8f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+    st = lidet_cluster_stats(&g.ws);
+    lab = lidet_cluster_labels(&g.ws);
+    rec = lidet_cluster_records(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(15, st->n_found);
+    TEST_ASSERT_EQUAL_UINT32(14, st->n_fragments);
+    TEST_ASSERT_EQUAL_UINT32(1, st->n_rescue_joined);
+    TEST_ASSERT_EQUAL_UINT32(16, st->n_rescue_pixels);
+    TEST_ASSERT_EQUAL_UINT32(1, st->n_dropped_small); /* C */
+    TEST_ASSERT_EQUAL_UINT32(2, n);
+    /* ids in raster order of the first pixel: A's rescued pixel (0, 100) is its first, before B's
+     * (2, 20): A = 1, B = 2 (without the rescue A's first pixel was (1, 100)) */
+    TEST_ASSERT_EQUAL_UINT32(14, rec[0].n_points);
+    TEST_ASSERT_EQUAL_UINT32(4, rec[0].n_rescued);
+    TEST_ASSERT_EQUAL_UINT32(100, rec[0].seed_pixel);
+    TEST_ASSERT_EQUAL_UINT32(12, rec[1].n_points);
+    TEST_ASSERT_EQUAL_UINT32(12, rec[1].n_rescued);
+    TEST_ASSERT_EQUAL_UINT32(2 * COLS + 20, rec[1].seed_pixel);
+    for (c = 100; c <= 106; c += 2)
+        TEST_ASSERT_EQUAL_UINT16(1, lab[c]);
+    for (c = 20; c < 32; ++c)
+        TEST_ASSERT_EQUAL_UINT16(2, lab[2 * COLS + c]);
+    for (c = 200; c < 203; ++c)
+        TEST_ASSERT_EQUAL_UINT16(0, lab[2 * COLS + c]);
+    /* A's record covers its 14 members: bounds and mean */
+    {
+        double s[3] = {0, 0, 0};
+        const int32_t *mem = lidet_cluster_members(&g.ws);
+        for (i = 0; i < rec[0].n_points; ++i)
+        {
+            const int32_t p = mem[rec[0].first_member + i];
+            TEST_ASSERT_EQUAL_UINT16(1, lab[p]);
+            s[0] += t.x[p];
+            s[1] += t.y[p];
+            s[2] += t.z[p];
+            TEST_ASSERT_TRUE(t.x[p] >= rec[0].min_m[0] && t.x[p] <= rec[0].max_m[0]);
+            TEST_ASSERT_TRUE(t.y[p] >= rec[0].min_m[1] && t.y[p] <= rec[0].max_m[1]);
+            TEST_ASSERT_TRUE(t.z[p] >= rec[0].min_m[2] && t.z[p] <= rec[0].max_m[2]);
+        }
+        for (i = 0; i < 3; ++i)
+            TEST_ASSERT_CLOSE(s[i] / 14.0, rec[0].mean_m[i], 1e-4, 1e-5);
+        TEST_ASSERT_CLOSE(rec[0].mean_m[2] + cfg.mount_height_m, rec[0].height_m, 1e-5, 0);
+    }
+    /* a smaller rescue distance (0.5 m) rescues nothing here */
+    cfg.rescue_gap_m = 0.5f;
+    cfg.rescue_gap_per_m = 0.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g.ws)->n_rescue_pixels);
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g.ws)->n_kept);
 }
 
 /* records: counts, bounds, means and member lists agree with the labels; determinism */
@@ -394,6 +522,18 @@ static void test_edge_cases(void)
     bad = cfg;
     bad.min_points = 0;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &bad));
+    bad = cfg;
+    bad.rescue_gap_m = -0.1f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &bad));
+    bad = cfg;
+    bad.rescue_gap_per_m = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &bad));
+    bad = cfg;
+    bad.rescue_cols = 16;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &bad));
+    bad = cfg;
+    bad.rescue_rows = LIDET_MAX_ROWS + 1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &bad));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_cluster_init(NULL, &cfg));
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_cluster_run(&g.ws, NULL, NULL, NULL, 0));
@@ -412,7 +552,10 @@ static void test_defaults_per_profile(void)
     TEST_ASSERT_CLOSE(1.73, d.mount_height_m, 1e-3, 0);
     TEST_ASSERT_TRUE(d.theta_rad > 0.0f && d.theta_rad < 0.8f);
     TEST_ASSERT_TRUE(d.max_gap_m > 0.0f && d.max_gap_per_m > 0.0f);
+    TEST_ASSERT_TRUE(d.rescue_gap_m > 0.0f);
+    TEST_ASSERT_EQUAL_UINT32(2, d.rescue_rows);
     lidet_cluster_cfg_default(&d, lidet_sensor_find("vlp16"));
+    TEST_ASSERT_EQUAL_UINT32(1, d.rescue_rows);
     TEST_ASSERT_TRUE(d.theta_rad > 0.0f && d.theta_rad < 0.8f);
     TEST_ASSERT_EQUAL_UINT32(4, d.max_steps);
     TEST_ASSERT_EQUAL_UINT32(0, d.bridge_occluders);
@@ -522,6 +665,7 @@ int main(void)
     RUN_TEST(test_vertical_hole_and_ground);
     RUN_TEST(test_wraparound_joins);
     RUN_TEST(test_filters);
+    RUN_TEST(test_fragment_rescue);
     RUN_TEST(test_records_members_determinism);
     RUN_TEST(test_point_labels);
     RUN_TEST(test_edge_cases);

@@ -85,6 +85,81 @@ static void test_capacity_overflow_counted(void)
     }
 }
 
+/* row 0, odd columns 41..51: 11 m instead of 10 m (same beams) */
+static void odd_columns_at_11m(void)
+{
+    int c;
+    for (c = 41; c < 52; c += 2)
+    {
+        t.x[c] *= 1.1f;
+        t.y[c] *= 1.1f;
+        t.z[c] *= 1.1f;
+        t.r[c] *= 1.1f;
+        t.rxy[c] *= 1.1f;
+    }
+}
+
+/* the rescue never evicts: 8 bars of 6 pixels fill the capacity; 12 alternating 10 m / 11 m
+ * returns in one row (singletons for the angle test at theta 0.8: beta 0.75) become one rescue
+ * group that would be a cluster of its own: dropped for capacity and counted, the bars stay */
+static void test_rescue_never_evicts(void)
+{
+    static char rows_buf[6][65];
+    const char *art[6];
+    lidet_cluster_cfg_t cfg;
+    const lidet_cluster_stats_t *st;
+    const lidet_cluster_rec_t *rec;
+    uint32_t n, i;
+    int r, b, c;
+    for (r = 0; r < 6; ++r)
+    {
+        memset(rows_buf[r], '.', 64);
+        rows_buf[r][64] = '\0';
+        for (b = 0; b < 8; ++b)
+            rows_buf[r][4 * b + 1] = 'c';
+        art[r] = rows_buf[r];
+    }
+    for (c = 40; c < 52; ++c)
+        rows_buf[0][c] = 'c';
+    tcu_draw(&t, art, 6);
+    odd_columns_at_11m();
+    tcu_cfg(&cfg);
+    cfg.theta_rad = 0.8f;
+    cfg.diagonals = 0;
+    cfg.bridge_occluders = 0;
+    cfg.min_points = 5;
+    cfg.rescue_gap_m = 1.6f;
+    cfg.rescue_gap_per_m = 0.0f;
+    cfg.rescue_rows = 1;
+    cfg.rescue_cols = 6;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+    st = lidet_cluster_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(8 + 12, st->n_found);
+    TEST_ASSERT_EQUAL_UINT32(12, st->n_fragments);
+    TEST_ASSERT_EQUAL_UINT32(1, st->n_dropped_capacity);
+    TEST_ASSERT_EQUAL_UINT32(0, st->n_rescue_pixels);
+    rec = lidet_cluster_records(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(8, n);
+    for (i = 0; i < 8; ++i)
+    {
+        TEST_ASSERT_EQUAL_UINT32(6, rec[i].n_points);
+        TEST_ASSERT_EQUAL_UINT32(4 * i + 1, rec[i].seed_pixel);
+    }
+    for (c = 40; c < 52; ++c)
+        TEST_ASSERT_EQUAL_UINT16(0, lidet_cluster_labels(&g.ws)[c]);
+    /* with one bar fewer the group takes the free slot */
+    for (r = 0; r < 6; ++r)
+        rows_buf[r][29] = '.';
+    tcu_draw(&t, art, 6);
+    odd_columns_at_11m();
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+    st = lidet_cluster_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(8, st->n_kept);
+    TEST_ASSERT_EQUAL_UINT32(12, st->n_rescue_pixels);
+    TEST_ASSERT_EQUAL_UINT16(8, lidet_cluster_labels(&g.ws)[40]);
+}
+
 /* an image larger than the capacity is refused */
 static void test_image_too_large(void)
 {
@@ -101,6 +176,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_capacity_overflow_counted);
+    RUN_TEST(test_rescue_never_evicts);
     RUN_TEST(test_image_too_large);
     return UNITY_END();
 }

@@ -282,11 +282,13 @@ def cluster_defaults(sensor: str | Sensor = "hdl64") -> dict:
     sparse = s.rows <= 16
     return dict(theta_rad=0.12 if sparse else 0.18, max_steps=4 if sparse else 5, bridge_occluders=0 if sparse else 1,
                 diagonals=1, max_gap_m=0.7, max_gap_per_m=0.04 if sparse else 0.025, min_points=10, max_extent_m=6.0,
-                max_mean_height_m=2.5, mount_height_m=float(s.mount_height_m))
+                max_mean_height_m=2.5, mount_height_m=float(s.mount_height_m), rescue_gap_m=0.8,
+                rescue_gap_per_m=0.03, rescue_rows=1 if sparse else 2, rescue_cols=6)
 
 
 _CLUSTER_STAT_KEYS = ["n_candidates", "n_found", "n_dropped_small", "n_dropped_extent", "n_dropped_height",
-                      "n_dropped_capacity", "n_kept", "n_pixels_kept", "n_queue_overflow"]
+                      "n_dropped_capacity", "n_kept", "n_pixels_kept", "n_queue_overflow", "n_fragments",
+                      "n_rescue_joined", "n_rescue_pixels"]
 
 
 @dataclass
@@ -298,6 +300,7 @@ class Clusters:
     n_points: np.ndarray      #: (K,) member pixels per cluster
     first_member: np.ndarray  #: (K,) index into members
     seed_pixel: np.ndarray    #: (K,) first pixel (raster order)
+    n_rescued: np.ndarray     #: (K,) member pixels that came from fragments (the rescue pass)
     mean: np.ndarray          #: (K, 3) float32
     min: np.ndarray           #: (K, 3)
     max: np.ndarray           #: (K, 3)
@@ -317,8 +320,9 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     ground: optional (N,) bool/uint8 per point (1 = ground; a pixel is ground when its winning point
     is), e.g. SemanticKITTI ground labels or the ground stage's per-point mask. planes: optional
     (S, 4) (nx, ny, nz, d) per azimuth sector for the height filter (None: flat ground at
-    -mount_height_m). cfg: theta_rad, max_steps, bridge_occluders, max_gap_m, max_gap_per_m, min_points, max_extent_m, max_mean_height_m,
-    mount_height_m (defaults: `cluster_defaults(sensor)`).
+    -mount_height_m). cfg: theta_rad, max_steps, bridge_occluders, diagonals, max_gap_m, max_gap_per_m, min_points,
+    max_extent_m, max_mean_height_m, mount_height_m, rescue_gap_m, rescue_gap_per_m, rescue_rows, rescue_cols (defaults:
+    `cluster_defaults(sensor)`).
     """
     s = proj_init(sensor, **(proj_cfg or {}))
     c = cluster_defaults(s)
@@ -339,16 +343,16 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     if planes is not None:
         pl = np.ascontiguousarray(planes, dtype=np.float32).reshape(-1, 4)
     cfg_f = np.array([c["theta_rad"], c["max_extent_m"], c["max_mean_height_m"], c["mount_height_m"],
-                      c["max_gap_m"], c["max_gap_per_m"]], np.float32)
-    cfg_u = np.array([c["max_steps"], c["min_points"], int(bool(c["bridge_occluders"])), int(bool(c["diagonals"]))],
-                     np.uint32)
+                      c["max_gap_m"], c["max_gap_per_m"], c["rescue_gap_m"], c["rescue_gap_per_m"]], np.float32)
+    cfg_u = np.array([c["max_steps"], c["min_points"], int(bool(c["bridge_occluders"])), int(bool(c["diagonals"])),
+                      c["rescue_rows"], c["rescue_cols"]], np.uint32)
     pl_out = np.zeros(n, np.uint32)
     pix = np.zeros((rows, cols), np.uint16)
     mem = np.zeros(rows * cols, np.int32)
-    ru = np.zeros((cap, 3), np.uint32)
+    ru = np.zeros((cap, 4), np.uint32)
     rf = np.zeros((cap, 10), np.float32)
     nrec = np.zeros(1, np.uint32)
-    stats = np.zeros(9, np.uint32)
+    stats = np.zeros(len(_CLUSTER_STAT_KEYS), np.uint32)
     st = lib().lidet_py_cluster_run(pts if n else None, n, stride, gm if n else None, pl,
                                     0 if pl is None else len(pl), cfg_f, cfg_u, pl_out if n else None, pix, mem,
                                     ru, rf, cap, nrec, stats)
@@ -360,7 +364,7 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     if with_image:
         img = _last_image(s, n)
     return Clusters(pl_out, pix, mem[: sd["n_pixels_kept"]].copy(), ru[:k, 0].copy(), ru[:k, 1].copy(),
-                    ru[:k, 2].copy(), rf[:k, 0:3].copy(), rf[:k, 3:6].copy(), rf[:k, 6:9].copy(),
+                    ru[:k, 2].copy(), ru[:k, 3].copy(), rf[:k, 0:3].copy(), rf[:k, 3:6].copy(), rf[:k, 6:9].copy(),
                     rf[:k, 9].copy(), sd, int(st), img)
 
 

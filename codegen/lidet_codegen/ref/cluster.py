@@ -4,9 +4,10 @@ lib/src/lidet_proposal.c; the contract is written in lib/include/lidet/lidet_clu
 
 - `proposal_indices` / `make_proposal` reproduce the C resampling *exactly* (integer xorshift32):
   training uses them, or the bindings (`lidet_tools.native.proposals`), and both give the same points.
-- `cluster_ref` is a plain-Python BFS with the same rules (4-neighbourhood, hole bridging over
-  non-candidates up to max_steps, optionally over nearer occluders, column wrap, the angle criterion in tangent form, filters, capacity,
-  canonical ids). It is slow (seconds per 64 x 2048 image) and meant for tests.
+- `cluster_ref` is a plain-Python BFS with the same rules (4- or 8-neighbourhood, hole bridging over
+  non-candidates up to max_steps, optionally over nearer occluders, column wrap, the angle criterion in
+  tangent form, the gap bound, filters, capacity, the fragment rescue, canonical ids). It is slow
+  (seconds per 64 x 2048 image) and meant for tests.
 """
 from __future__ import annotations
 
@@ -76,11 +77,15 @@ def make_proposal(member_xyz: np.ndarray, mean=None, n_points: int = 64, seed: i
 
 
 def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.ndarray, xyz: np.ndarray,
-                theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, diagonals: bool = True, max_gap_m: float = 0.0, max_gap_per_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
-                max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30):
+                theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, diagonals: bool = True,
+                max_gap_m: float = 0.0, max_gap_per_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
+                max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30,
+                rescue_gap_m: float = 0.0, rescue_gap_per_m: float = 0.0, rescue_rows: int = 0, rescue_cols: int = 0):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
-    member-pixel arrays per kept cluster in raster order). Float32 tangent test like the C."""
+    member-pixel arrays per kept cluster in raster order). Float32 tangent and distance tests like the
+    C; the filters use float64 means (they can differ from the C's float32 only at a filter's edge).
+    rescue_gap_m > 0 turns the fragment rescue on (lidet_cluster.h)."""
     rows, cols = range_m.shape
     rng = np.asarray(range_m, np.float32).ravel()
     cand = np.asarray(candidate, bool).ravel()
@@ -118,7 +123,64 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
             return bool(np.float32(np.float32(u * u) + np.float32(v * v)) <= np.float32(g * g))
         return True
 
-    state = np.where(cand, 0, -2).astype(np.int64)  # 0 free, -2 non-candidate, -1 visited, >0 slot+1
+    rescue = rescue_gap_m > 0
+    ra, rb = np.float32(rescue_gap_m), np.float32(rescue_gap_per_m)
+    rb1 = np.float32(np.float32(1.0) + rb)
+    P32 = np.asarray(xyz, np.float32).reshape(-1, 3)
+    wr, wc = int(rescue_rows), min(int(rescue_cols), (cols - 1) // 2)
+
+    def _passes(m):
+        pts = P[m]
+        if np.any(pts.max(0) - pts.min(0) > max_extent_m):
+            return False
+        return pts[:, 2].mean() + mount_height_m <= max_mean_height_m
+
+    def _rescue(state, owner, kept):
+        # second fill over the fragments (state -3), seeds in raster order; window of wr rows and
+        # wc columns around each member; a group joins the nearest kept pixel's cluster met within
+        # the distance, else it is a cluster of its own when it passes the filters and a slot is free
+        for seed in range(rows * cols):
+            if state[seed] != -3:
+                continue
+            state[seed] = -1
+            mem, head = [seed], 0
+            best, best_d = -1, np.float32(3.0e38)
+            while head < len(mem):
+                q = mem[head]
+                head += 1
+                r, c = divmod(q, cols)
+                dq = rng[q]
+                hi = np.float32(np.float32(dq * rb1) + ra)
+                lo = np.float32(np.float32(dq - ra) / rb1)
+                for rr in range(max(r - wr, 0), min(r + wr, rows - 1) + 1):
+                    for k in range(-wc, wc + 1):
+                        n = rr * cols + (c + k) % cols
+                        if n == q or not (state[n] == -3 or owner[n] >= 0):
+                            continue
+                        dn = rng[n]
+                        if not (dn >= lo and dn <= hi):
+                            continue
+                        gg = np.float32(ra + np.float32(rb * min(dq, dn)))
+                        d = P32[n] - P32[q]
+                        dd = np.float32(np.float32(np.float32(d[0] * d[0]) + np.float32(d[1] * d[1])) + np.float32(d[2] * d[2]))
+                        if not dd <= np.float32(gg * gg):
+                            continue
+                        if state[n] == -3:
+                            state[n] = -1
+                            mem.append(n)
+                        elif dd < best_d:
+                            best, best_d = owner[n], dd
+            m = np.array(mem)
+            if best >= 0:
+                kept[best][0] += len(m)
+                kept[best][1] = min(kept[best][1], seed)
+                kept[best][2] = np.concatenate([kept[best][2], m])
+                owner[m] = best
+            elif len(m) >= min_points and _passes(m) and len(kept) < max_clusters:
+                owner[m] = len(kept)
+                kept.append([len(m), seed, m])
+
+    state = np.where(cand, 0, -2).astype(np.int64)  # 0 free, -2 non-candidate, -1 visited, -3 fragment
     kc = min(max_steps, cols - 1)
     kept = []  # (n, seed, members)
     for seed in range(rows * cols):
@@ -175,17 +237,25 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                         q.append(n)
         m = np.array(mem)
         if len(m) < min_points:
+            if rescue and P[m][:, 2].mean() + mount_height_m <= max_mean_height_m:
+                state[m] = -3  # a fragment, for the rescue
             continue
-        pts = P[m]
-        if np.any(pts.max(0) - pts.min(0) > max_extent_m):
+        if not _passes(m):
             continue
-        if pts[:, 2].mean() + mount_height_m > max_mean_height_m:
-            continue
-        kept.append((len(m), seed, np.sort(m)))
+        kept.append([len(m), seed, m])
     if len(kept) > max_clusters:  # smallest dropped first, ties: the later seed
         order = sorted(range(len(kept)), key=lambda i: (-kept[i][0], kept[i][1]))[:max_clusters]
         kept = [kept[i] for i in sorted(order)]
-    labels = np.zeros(rows * cols, np.int64)
+    owner = np.full(rows * cols, -1, np.int64)  # index into kept, or -1
     for i, (_, _, m) in enumerate(kept):
+        owner[m] = i
+    if rescue:
+        _rescue(state, owner, kept)
+    labels = np.zeros(rows * cols, np.int64)
+    kept.sort(key=lambda k: k[1])  # canonical ids: raster order of the first pixel
+    out = []
+    for i, (_, _, m) in enumerate(kept):
+        m = np.sort(np.asarray(m))
         labels[m] = i + 1
-    return labels.reshape(rows, cols), [m for _, _, m in kept]
+        out.append(m)
+    return labels.reshape(rows, cols), out

@@ -108,8 +108,8 @@
 #if (LIDET_MAX_ROWS * LIDET_MAX_COLS) > 2147483647 / 4
 #error "range image too large for int32 pixel indices"
 #endif
-#if LIDET_MAX_CLUSTERS < 1 || LIDET_MAX_CLUSTERS > 65533
-#error "LIDET_MAX_CLUSTERS must be in [1, 65533] (cluster ids are uint16; two values mark pixel states)"
+#if LIDET_MAX_CLUSTERS < 1 || LIDET_MAX_CLUSTERS > 65532
+#error "LIDET_MAX_CLUSTERS must be in [1, 65532] (cluster ids are uint16; three values mark pixel states)"
 #endif
 #if LIDET_CLUSTER_MAX_STEPS < 1 || LIDET_CLUSTER_MAX_STEPS > 64
 #error "LIDET_CLUSTER_MAX_STEPS must be in [1, 64]"
