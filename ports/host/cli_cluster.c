@@ -91,12 +91,12 @@ static int apply_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, mount_height_m)
     CLI_SET_FLOAT(c, kv, klen, v, rescue_gap_m)
     CLI_SET_FLOAT(c, kv, klen, v, rescue_gap_per_m)
-    CLI_SET_INT(c, kv, klen, v, max_steps, uint32_t, LIDET_CLUSTER_MAX_STEPS)
+    CLI_SET_INT(c, kv, klen, v, max_steps, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, bridge_occluders, uint32_t, 1)
     CLI_SET_INT(c, kv, klen, v, diagonals, uint32_t, 1)
     CLI_SET_INT(c, kv, klen, v, min_points, uint32_t, 4294967295.0)
-    CLI_SET_INT(c, kv, klen, v, rescue_rows, uint32_t, LIDET_MAX_ROWS)
-    CLI_SET_INT(c, kv, klen, v, rescue_cols, uint32_t, 15)
+    CLI_SET_INT(c, kv, klen, v, rescue_rows, uint32_t, 4294967295.0)
+    CLI_SET_INT(c, kv, klen, v, rescue_cols, uint32_t, 4294967295.0)
     return 1;
 }
 

@@ -21,3 +21,4 @@ def test_bench_cluster_runs(root, real_dir):
     md = mod.run(argparse.Namespace(real=real_dir, build=build, quick=True))
     assert md.startswith("## Clustering (issue 6)")
     assert "| real SemanticKITTI 00 (3 labelled scans) | lidet |" in md and "DBSCAN columns skipped" in md
+    assert "| | lidet, no rescue |" in md
