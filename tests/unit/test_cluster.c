@@ -343,14 +343,7 @@ static void test_fragment_rescue(void)
         rowbuf[2][c] = 'c';
     for (c = 200; c < 203; ++c)
         rowbuf[2][c] = 'c';
-    cfg.theta_rad = 0.5f;
-    cfg.diagonals = 0;
-    cfg.bridge_occluders = 0;
-    cfg.min_points = 6;
-    cfg.rescue_gap_m = 0.8f;
-    cfg.rescue_gap_per_m = 0.03f;
-    cfg.rescue_rows = 1;
-    cfg.rescue_cols = 6;
+    tcu_rescue_cfg(&cfg, 0.5f, 6, 0.8f, 0.03f);
     tcu_draw(&t, art, ROWS);
     for (c = 100; c <= 106; c += 2)
         set_range(c, COLS, 11.0f);

@@ -79,4 +79,20 @@ static void tcu_cfg(lidet_cluster_cfg_t *cfg)
     cfg->max_gap_per_m = 0.0f;
 }
 
+/* the rescue scenes: 4-neighbourhood without occluder bridging (every singleton stays one), the
+ * fragment rescue over 1 row and 6 columns */
+static void tcu_rescue_cfg(lidet_cluster_cfg_t *cfg, float theta_rad, uint32_t min_points, float gap_m,
+                           float gap_per_m)
+{
+    tcu_cfg(cfg);
+    cfg->theta_rad = theta_rad;
+    cfg->diagonals = 0;
+    cfg->bridge_occluders = 0;
+    cfg->min_points = min_points;
+    cfg->rescue_gap_m = gap_m;
+    cfg->rescue_gap_per_m = gap_per_m;
+    cfg->rescue_rows = 1;
+    cfg->rescue_cols = 6;
+}
+
 #endif

@@ -123,15 +123,7 @@ static void test_rescue_never_evicts(void)
         rows_buf[0][c] = 'c';
     tcu_draw(&t, art, 6);
     odd_columns_at_11m();
-    tcu_cfg(&cfg);
-    cfg.theta_rad = 0.8f;
-    cfg.diagonals = 0;
-    cfg.bridge_occluders = 0;
-    cfg.min_points = 5;
-    cfg.rescue_gap_m = 1.6f;
-    cfg.rescue_gap_per_m = 0.0f;
-    cfg.rescue_rows = 1;
-    cfg.rescue_cols = 6;
+    tcu_rescue_cfg(&cfg, 0.8f, 5, 1.6f, 0.0f);
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
     TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
     st = lidet_cluster_stats(&g.ws);
