@@ -16,7 +16,7 @@
 #define LAB_NONCAND 0xFFFFu /* no point, or ground: bridged over, never joined */
 
 #define STEPS LIDET_CLUSTER_MAX_STEPS
-#define RESCUE_MAX_COLS 15u /* rescue_cols limit: a window row fits a small local array */
+#define RESCUE_MAX_COLS 15u /* rescue_cols limit (each fragment pixel looks at (2 rows + 1)(2 cols + 1) pixels) */
 
 void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *sensor)
 {
