@@ -337,14 +337,13 @@ typedef struct
     float best_d2;  /* its squared distance */
 } rescue_t;
 
-/* One pixel n (label l < LAB_PENDING) of the window of group pixel q (range dq): the two returns'
+/* One pixel n (label l < LAB_PENDING, range dn) of the window of group pixel q (range dq): the two returns'
  * distance (from their coordinates) against gg = rgap + rgpm * (nearer range). Within it a fragment
  * pixel joins and a kept pixel is a contact (the nearest one wins, ties: the first met). */
-static inline void rescue_link(lidet_cluster_t *c, rescue_t *rs, uint32_t n, uint32_t l, uint32_t q, float dq,
-                               const grow_t *g)
+static inline void rescue_link(lidet_cluster_t *c, rescue_t *rs, uint32_t n, uint32_t l, float dn, uint32_t q,
+                               float dq, const grow_t *g)
 {
     const lidet_range_image_t *img = &c->img;
-    const float dn = img->range_m[n];
     const float gg = g->rgap + g->rgpm * (dq < dn ? dq : dn);
     const float dx = img->x_m[n] - img->x_m[q], dy = img->y_m[n] - img->y_m[q], dz = img->z_m[n] - img->z_m[q];
     const float dd = dx * dx + dy * dy + dz * dz;
@@ -374,7 +373,7 @@ static inline void rescue_link(lidet_cluster_t *c, rescue_t *rs, uint32_t n, uin
         const float d_ = rng[n];                                                                    \
         if (l_ < LAB_PENDING && d_ >= lo && d_ <= hi && (n) != q)                                   \
         {                                                                                           \
-            rescue_link(c, rs, (n), l_, q, dq, g);                                                  \
+            rescue_link(c, rs, (n), l_, d_, q, dq, g);                                              \
         }                                                                                           \
     }
 
@@ -524,39 +523,23 @@ static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail
     const int32_t *mem = c->members;
     float sum[3], lo[3], hi[3], mean[3], h, inv;
     uint32_t i, slot;
+    int small;
     lidet_cluster_rec_t *rec;
 
     if (!rescue)
     {
         ++st->n_found;
     }
-    if (n < c->cfg.min_points)
+    small = n < c->cfg.min_points;
+    if (small && (rescue || !(c->cfg.rescue_gap_m > 0.0f)))
     {
-        if (rescue || !(c->cfg.rescue_gap_m > 0.0f))
-        {
-            ++st->n_dropped_small;
-            return start;
-        }
-        /* a fragment for the rescue, unless its mean lies above the height limit (canopies, wires:
-         * nothing a road user would take in; it saves a third of the rescue's work) */
-        (void)member_stats(c, start, tail, 3.0e38f, sum, lo, hi);
-        inv = 1.0f / (float)n;
-        mean[0] = sum[0] * inv;
-        mean[1] = sum[1] * inv;
-        mean[2] = sum[2] * inv;
-        if (!(height_above_ground(c, (uint32_t)mem[start], mean, planes, n_sectors) <= c->cfg.max_mean_height_m))
-        {
-            ++st->n_dropped_height;
-            return start;
-        }
-        ++st->n_fragments;
-        for (i = start; i < tail; ++i)
-        {
-            c->labels[mem[i]] = (uint16_t)LAB_SMALL;
-        }
+        ++st->n_dropped_small;
         return start;
     }
-    if (member_stats(c, start, tail, c->cfg.max_extent_m, sum, lo, hi))
+    /* the same filters for a fragment-to-be (small: no extent limit), so that one above the height
+     * limit (canopies, wires: nothing a road user would take in) never reaches the rescue; it saves
+     * a third of the rescue's work */
+    if (member_stats(c, start, tail, small ? 3.0e38f : c->cfg.max_extent_m, sum, lo, hi))
     {
         ++st->n_dropped_extent;
         return start;
@@ -569,6 +552,15 @@ static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail
     if (!(h <= c->cfg.max_mean_height_m))
     {
         ++st->n_dropped_height;
+        return start;
+    }
+    if (small)
+    {
+        ++st->n_fragments;
+        for (i = start; i < tail; ++i)
+        {
+            c->labels[mem[i]] = (uint16_t)LAB_SMALL;
+        }
         return start;
     }
     if (c->n_recs < LIDET_MAX_CLUSTERS)
