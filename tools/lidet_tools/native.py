@@ -426,3 +426,142 @@ def proposal_indices(n_src: int, n_out: int, seed: int = 0x5EED1234) -> np.ndarr
     if st < 0:
         raise LidetError(st, "lidet_proposal_indices")
     return out
+
+
+# ---- PointNets (lib/include/lidet/lidet_pointnet.h) over the models of lidet::weights ---------------
+
+@dataclass
+class PnModel:
+    """A model compiled into liblidet_py (weights/, lidet::weights)."""
+    index: int
+    name: str
+    kind: str              #: "classifier" or "box"
+    n_points: int
+    n_outputs: int
+    scratch_bytes: int
+    n_stages: int
+    n_heading_bins: int
+    n_size_clusters: int
+    gamma: np.ndarray
+    energy_t: float
+    pvle_bins: np.ndarray
+    mean_sizes: np.ndarray
+
+
+def _pn_lib():
+    L = lib()
+    if not getattr(L, "_pn_ready", False):
+        _u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
+        _i16p = np.ctypeslib.ndpointer(np.int16, flags="C_CONTIGUOUS")
+        _u64p = np.ctypeslib.ndpointer(np.uint64, flags="C_CONTIGUOUS")
+        L.lidet_py_pn_count.restype = C.c_uint32
+        L.lidet_py_pn_info.argtypes = [C.c_uint32, C.c_char_p, _u32p, _f32p]
+        L.lidet_py_pn_forward.argtypes = [C.c_uint32, C.c_uint32, C.c_uint32, _f32p, _f32p, _opt(_f32p), _f32p]
+        L.lidet_py_pn_classify.argtypes = [C.c_uint32, C.c_uint32, C.c_uint32, _f32p, _f32p, _i16p, _f32p, _f32p,
+                                           _f32p, _u8p, _u8p]
+        L.lidet_py_pn_box.argtypes = [C.c_uint32, C.c_uint32, C.c_uint32, _f32p, _f32p, _i16p, _u8p, _f32p, _f32p,
+                                      _u8p, _u8p]
+        L.lidet_py_pn_time.argtypes = [C.c_uint32, C.c_uint32, C.c_uint32, C.c_uint32, _f32p, _f32p, _i16p,
+                                       C.c_uint32, _u64p]
+        L._pn_ready = True
+    return L
+
+
+def pn_models() -> dict:
+    """name -> PnModel for every model compiled into the bindings."""
+    L = _pn_lib()
+    out = {}
+    for i in range(int(L.lidet_py_pn_count())):
+        name = C.create_string_buffer(64)
+        info = np.zeros(8, np.uint32)
+        fl = np.zeros(32, np.float32)
+        st = L.lidet_py_pn_info(i, name, info, fl)
+        if st < 0:
+            raise LidetError(st, f"model {name.value.decode()}")
+        ns = int(info[6])
+        out[name.value.decode()] = PnModel(i, name.value.decode(), {1: "classifier", 2: "box"}[int(info[0])],
+                                           int(info[1]), int(info[2]), int(info[3]), int(info[4]), int(info[5]), ns,
+                                           fl[0:3].copy(), float(fl[3]), fl[4:7].copy(), fl[7:7 + 3 * ns].reshape(-1, 3))
+    return out
+
+
+def _pn(model) -> PnModel:
+    if isinstance(model, PnModel):
+        return model
+    ms = pn_models()
+    if model not in ms:
+        raise KeyError(f"model {model!r} is not compiled into the bindings (have: {sorted(ms)})")
+    return ms[model]
+
+
+def _batch_arrays(xyz, mean, voxel, n_points):
+    xyz = np.ascontiguousarray(xyz, np.float32)
+    if xyz.ndim != 3 or xyz.shape[1:] != (n_points, 3):
+        raise ValueError(f"proposal points must be (B, {n_points}, 3), got {xyz.shape}")
+    b = xyz.shape[0]
+    mean = np.ascontiguousarray(mean, np.float32).reshape(b, 3)
+    voxel = np.ascontiguousarray(voxel, np.int16).reshape(b, 3)
+    return xyz, mean, voxel, b
+
+
+def pn_forward(model, points, voxel, onehot=None) -> np.ndarray:
+    """The raw network (lidet_pn_forward) on model-frame points (B, N, 3), voxel (B, 3) floats and, for a
+    box net, onehot (B, 3): (B, n_outputs) = logits, or [T-Net centre (3) | box values]."""
+    m = _pn(model)
+    pts = np.ascontiguousarray(points, np.float32)
+    if pts.ndim != 3 or pts.shape[1:] != (m.n_points, 3):
+        raise ValueError(f"points must be (B, {m.n_points}, 3), got {pts.shape}")
+    b = pts.shape[0]
+    vox = np.ascontiguousarray(voxel, np.float32).reshape(b, 3)
+    oh = None
+    if m.kind == "box":
+        if onehot is None:
+            raise ValueError("a box net needs onehot (B, 3)")
+        oh = np.ascontiguousarray(onehot, np.float32).reshape(b, 3)
+    out = np.zeros((b, m.n_outputs), np.float32)
+    if b:
+        st = _pn_lib().lidet_py_pn_forward(m.index, b, m.n_points, pts, vox, oh, out)
+        if st < 0:
+            raise LidetError(st, "lidet_pn_forward")
+    return out
+
+
+def pn_classify(model, xyz, mean, voxel) -> dict:
+    """lidet_pn_classify on a batch of proposals (xyz (B, N, 3) centred, mean (B, 3), voxel (B, 3) int):
+    logits, prob, energy, cls, passed (gate 1)."""
+    m = _pn(model)
+    xyz, mean, voxel, b = _batch_arrays(xyz, mean, voxel, m.n_points)
+    lo, pr = np.zeros((b, 3), np.float32), np.zeros((b, 3), np.float32)
+    en, cl, ps = np.zeros(b, np.float32), np.zeros(b, np.uint8), np.zeros(b, np.uint8)
+    if b:
+        st = _pn_lib().lidet_py_pn_classify(m.index, b, m.n_points, xyz, mean, voxel, lo, pr, en, cl, ps)
+        if st < 0:
+            raise LidetError(st, "lidet_pn_classify")
+    return dict(logits=lo, prob=pr, energy=en, cls=cl, passed=ps.astype(bool))
+
+
+def pn_box(model, xyz, mean, voxel, cls) -> dict:
+    """lidet_pn_box on a batch: box (B, 7) cx cy cz l w h yaw (sensor frame), energy_heading, energy_size,
+    energy, heading_bin, size_cluster, passed (gate 2)."""
+    m = _pn(model)
+    xyz, mean, voxel, b = _batch_arrays(xyz, mean, voxel, m.n_points)
+    cls = np.ascontiguousarray(np.broadcast_to(np.asarray(cls, np.uint8), (b,)))
+    bx, en = np.zeros((b, 7), np.float32), np.zeros((b, 3), np.float32)
+    bins, ps = np.zeros((b, 2), np.uint8), np.zeros(b, np.uint8)
+    if b:
+        st = _pn_lib().lidet_py_pn_box(m.index, b, m.n_points, xyz, mean, voxel, cls, bx, en, bins, ps)
+        if st < 0:
+            raise LidetError(st, "lidet_pn_box")
+    return dict(box=bx, energy_heading=en[:, 0], energy_size=en[:, 1], energy=en[:, 2], heading_bin=bins[:, 0],
+                size_cluster=bins[:, 1], passed=ps.astype(bool))
+
+
+def pn_time(cls_model, box_model, xyz, mean, voxel, repeats: int = 5) -> tuple[float, float]:
+    """Seconds per proposal of lidet_pn_classify and lidet_pn_box (fastest of `repeats` passes over the batch)."""
+    mc, mb = _pn(cls_model), _pn(box_model)
+    xyz, mean, voxel, b = _batch_arrays(xyz, mean, voxel, mc.n_points)
+    ns = np.zeros(2, np.uint64)
+    st = _pn_lib().lidet_py_pn_time(mc.index, mb.index, b, mc.n_points, xyz, mean, voxel, repeats, ns)
+    if st < 0:
+        raise LidetError(st, "lidet_py_pn_time")
+    return float(ns[0]) * 1e-9 / b, float(ns[1]) * 1e-9 / b

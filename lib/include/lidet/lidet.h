@@ -18,15 +18,13 @@
 #define LIDET_VERSION_PATCH 0
 #define LIDET_VERSION_STRING "0.1.0"
 
-/** Format version of generated weight files (weights/); a mismatch is a compile error there. */
-#define LIDET_WEIGHTS_FORMAT_VERSION 1
-
 #include "lidet_opt.h"
 #include "lidet_types.h"
 #include "lidet_sensor.h"
 #include "lidet_proj.h"
 #include "lidet_ground.h"
 #include "lidet_cluster.h"
+#include "lidet_pointnet.h"
 
 #ifdef __cplusplus
 extern "C" {

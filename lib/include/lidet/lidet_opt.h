@@ -68,6 +68,12 @@
 #define LIDET_PROJ_BLOCK 64
 #endif
 
+/** Points per block of the PointNet forward pass: every shared layer runs on a block of this many
+ *  points at a time (two blocks of activations in the scratch, see lidet_pointnet.h). */
+#ifndef LIDET_PN_BLOCK
+#define LIDET_PN_BLOCK 8
+#endif
+
 /** Maximum azimuth sectors of the ground stage (one plane each). */
 #ifndef LIDET_GROUND_MAX_SECTORS
 #define LIDET_GROUND_MAX_SECTORS 256
@@ -125,6 +131,9 @@
 #endif
 #if LIDET_PROJ_BLOCK < 1 || LIDET_PROJ_BLOCK > 4096
 #error "LIDET_PROJ_BLOCK must be in [1, 4096]"
+#endif
+#if LIDET_PN_BLOCK < 1 || LIDET_PN_BLOCK > 256
+#error "LIDET_PN_BLOCK must be in [1, 256]"
 #endif
 #if LIDET_GROUND_MAX_SECTORS < 1 || LIDET_GROUND_MAX_SECTORS > 4096
 #error "LIDET_GROUND_MAX_SECTORS must be in [1, 4096]"

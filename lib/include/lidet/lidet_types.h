@@ -85,6 +85,10 @@ typedef struct
     float d_m;
 } lidet_plane_t;
 
+/** Format version of generated weight files (weights/): a generated file whose version differs fails
+ *  to compile, and lidet_pn_init rejects a descriptor of another version (LIDET_ERR_MODEL). */
+#define LIDET_WEIGHTS_FORMAT_VERSION 1
+
 /** @brief Magic value stored by every stage's init, checked by its run (LIDET_ERR_STATE). */
 #define LIDET_INIT_MAGIC 0x6C646574u /* "ldet" */
 

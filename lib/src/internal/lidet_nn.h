@@ -1,0 +1,19 @@
+/* SPDX-License-Identifier: MIT */
+/* Dense-layer kernels of the PointNet forward pass (lib/src/nn/lidet_nn_f32.c). Stateless, caller
+ * buffers only (CMSIS-NN style); a port may replace the file with kernels of the same signatures, and
+ * this portable one stays the test oracle. Never installed. */
+#ifndef LIDET_NN_H
+#define LIDET_NN_H
+
+#include <stdint.h>
+
+/* out[r * n_out + o] = act(b[o] + sum_i in[r * n_in + i] * w_t[i * n_out + o]), r < n_rows.
+ * in and out may not alias. relu: 1 = max(0, .) after the bias. */
+void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t, const float *b,
+                         uint32_t n_out, int relu, float *out);
+
+/* vmax[k] = max(vmax[k], in[r * n + k]) over the rows: the max-pool over points, applied block by block
+ * (the caller initialises vmax), so no N x C buffer is needed. */
+void lidet__nn_max_rows_f32(const float *in, uint32_t n_rows, uint32_t n, float *vmax);
+
+#endif

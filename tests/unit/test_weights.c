@@ -1,0 +1,80 @@
+/* SPDX-License-Identifier: MIT */
+/* The generated models of weights/ (lidet::weights): every one passes the descriptor check, its
+ * <NAME>_SCRATCH_BYTES macro equals lidet_pn_scratch_bytes (no drift between codegen and lib/), it is
+ * found by name, and it runs on a proposal with finite outputs. */
+#include <math.h>
+#include <string.h>
+
+#include "lidet/lidet.h"
+#include "lidet_weights.h"
+#include "test_util.h"
+
+static float g_scratch[16384];
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
+}
+
+void test_every_model_is_valid(void)
+{
+    uint32_t i;
+    TEST_ASSERT_TRUE(LIDET_WEIGHTS_N_MODELS >= 2);
+    for (i = 0; i < LIDET_WEIGHTS_N_MODELS; ++i)
+    {
+        const lidet_pn_model_t *m = lidet_weights_models[i].model;
+        TEST_ASSERT_EQUAL_INT_MESSAGE(LIDET_OK, lidet_pn_check(m, 0, 0), lidet_weights_models[i].name);
+        TEST_ASSERT_EQUAL_STRING(lidet_weights_models[i].name, m->name);
+        TEST_ASSERT_EQUAL_PTR(m, lidet_pn_find(lidet_weights_models, LIDET_WEIGHTS_N_MODELS, m->name));
+        TEST_ASSERT_TRUE(lidet_pn_scratch_bytes(m) <= sizeof g_scratch);
+    }
+}
+
+void test_scratch_macros_match(void)
+{
+    TEST_ASSERT_EQUAL_UINT32(CLS_HDL64_SCRATCH_BYTES, lidet_pn_scratch_bytes(&lidet_model_cls_hdl64));
+    TEST_ASSERT_EQUAL_UINT32(BOX_HDL64_SCRATCH_BYTES, lidet_pn_scratch_bytes(&lidet_model_box_hdl64));
+    TEST_ASSERT_EQUAL_UINT32(CLS_HDL64_N_POINTS, lidet_model_cls_hdl64.n_points);
+    TEST_ASSERT_EQUAL_UINT32(BOX_HDL64_N_OUTPUTS, lidet_pn_n_outputs(&lidet_model_box_hdl64));
+}
+
+void test_models_run(void)
+{
+    static lidet_pn_t cls, box;
+    lidet_proposal_t p;
+    lidet_pn_class_out_t co;
+    lidet_pn_box_out_t bo;
+    uint32_t i;
+    memset(&p, 0, sizeof p);
+    p.n_points = lidet_model_cls_hdl64.n_points;
+    for (i = 0; i < p.n_points; ++i)
+    {
+        p.xyz[i][0] = 0.02f * (float)(i % 17) - 0.2f;
+        p.xyz[i][1] = 0.01f * (float)(i % 5);
+        p.xyz[i][2] = 0.03f * (float)(i % 11) - 0.15f;
+    }
+    p.mean_m[0] = 15.0f;
+    p.mean_m[1] = -3.0f;
+    p.mean_m[2] = -1.0f;
+    p.voxel[2] = 15;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_init(&cls, &lidet_model_cls_hdl64, g_scratch, sizeof g_scratch, NULL));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_classify(&cls, &p, &co));
+    TEST_ASSERT_TRUE(co.cls < LIDET_N_CLASSES && isfinite(co.energy));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_init(&box, &lidet_model_box_hdl64, g_scratch, sizeof g_scratch, NULL));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_box(&box, &p, co.cls, &bo));
+    TEST_ASSERT_TRUE(isfinite(bo.box.cx_m) && bo.box.l_m > 0.0f && isfinite(bo.energy));
+    /* a classifier is not a box net */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_pn_box(&cls, &p, 0, &bo));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_every_model_is_valid);
+    RUN_TEST(test_scratch_macros_match);
+    RUN_TEST(test_models_run);
+    return UNITY_END();
+}
