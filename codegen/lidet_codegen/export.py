@@ -12,6 +12,7 @@ from __future__ import annotations
 import hashlib
 import io
 import pathlib
+import warnings
 
 import numpy as np
 
@@ -63,10 +64,6 @@ def untrained(kind: str, n_points: int = 64, seed: int = 0, cfg: dict | None = N
     return m, dict(kind=kind, cfg=m.cfg, state_dict=m.state_dict(), meta=meta)
 
 
-class _BoxExport:
-    """Wraps BoxNet so the ONNX graph has exactly the contract's outputs (no zero T-Net without one)."""
-
-
 def export_onnx(model, ck: dict, out_path, name: str | None = None) -> pathlib.Path:
     """Export `model` (eval mode) with the contract's names and metadata. Returns the path."""
     torch = _torch()
@@ -102,6 +99,11 @@ def export_onnx(model, ck: dict, out_path, name: str | None = None) -> pathlib.P
             wrapped = _NoTnet(model).eval()
     buf = io.BytesIO()
     dyn = {k: {0: "batch"} for k in in_names + out_names}
+    # The TorchScript exporter (dynamo=False) writes the plain Conv / Gemm / BatchNormalization / Relu graph
+    # codegen reads; the torch.export-based one needs onnxscript and was not checked against codegen. Its
+    # deprecation warning is expected.
+    warnings.filterwarnings("ignore", category=DeprecationWarning, module=r"torch\.onnx.*")
+    warnings.filterwarnings("ignore", message=".*legacy TorchScript-based ONNX export.*")
     torch.onnx.export(wrapped, args, buf, dynamo=False, opset_version=17, input_names=in_names,
                       output_names=out_names, dynamic_axes=dyn, do_constant_folding=True)
     om = onnx.load_from_string(buf.getvalue())
