@@ -59,7 +59,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->rescue_cols = 6u;
 }
 
-lidet_status_t lidet_cluster_init(lidet_cluster_t *c, const lidet_cluster_cfg_t *cfg)
+lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cluster_cfg_t *cfg)
 {
     if (c == 0 || cfg == 0)
     {
@@ -83,6 +83,8 @@ lidet_status_t lidet_cluster_init(lidet_cluster_t *c, const lidet_cluster_cfg_t 
     c->geo_rows = 0;
     c->geo_cols = 0;
     c->n_recs = 0;
+    c->labels = 0;
+    c->members = 0;
     memset(&c->img, 0, sizeof c->img);
     memset(&c->stats, 0, sizeof c->stats);
     c->magic = LIDET_INIT_MAGIC;
@@ -90,7 +92,7 @@ lidet_status_t lidet_cluster_init(lidet_cluster_t *c, const lidet_cluster_cfg_t 
 }
 
 /* sin/cos of every alpha the search can meet; recomputed only when the image geometry changes */
-static void setup_geometry(lidet_cluster_t *c, const lidet_range_image_t *img)
+static void setup_geometry(lidet_cluster_state_t *c, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols;
     uint32_t r, k;
@@ -223,7 +225,7 @@ static inline uint32_t search(uint16_t *lab, int32_t *mem, const float *rng, uin
 
 /* The same along a row across the wrap (the rare columns within kc of either edge): step k meets
  * rowbase + (col +- k mod cols); angles col_sin/col_cos */
-static uint32_t search_wrap(lidet_cluster_t *c, uint32_t tail, float dq, uint32_t rowbase, uint32_t col, int right,
+static uint32_t search_wrap(lidet_cluster_state_t *c, uint32_t tail, float dq, uint32_t rowbase, uint32_t col, int right,
                             const grow_t *g, int occl)
 {
     uint16_t *lab = c->labels;
@@ -261,7 +263,7 @@ static uint32_t search_wrap(lidet_cluster_t *c, uint32_t tail, float dq, uint32_
  * members[head] for head = start .. tail (the member array is the queue, every pixel is pushed at
  * most once). Returns the new tail. Directions in the reference's order: right, left, down, up, then
  * the diagonals down-left, down-right, up-left, up-right. occl is a constant at each call site. */
-static inline uint32_t grow(lidet_cluster_t *c, const grow_t *g, uint32_t start, uint32_t tail, int occl)
+static inline uint32_t grow(lidet_cluster_state_t *c, const grow_t *g, uint32_t start, uint32_t tail, int occl)
 {
     uint16_t *lab = c->labels;
     int32_t *mem = c->members;
@@ -340,7 +342,7 @@ typedef struct
 /* One pixel n (label l < LAB_PENDING, range dn) of the window of group pixel q (range dq): the two returns'
  * distance (from their coordinates) against gg = rgap + rgpm * (nearer range). Within it a fragment
  * pixel joins and a kept pixel is a contact (the nearest one wins, ties: the first met). */
-static inline void rescue_link(lidet_cluster_t *c, rescue_t *rs, uint32_t n, uint32_t l, float dn, uint32_t q,
+static inline void rescue_link(lidet_cluster_state_t *c, rescue_t *rs, uint32_t n, uint32_t l, float dn, uint32_t q,
                                float dq, const grow_t *g)
 {
     const lidet_range_image_t *img = &c->img;
@@ -382,7 +384,7 @@ static inline void rescue_link(lidet_cluster_t *c, rescue_t *rs, uint32_t n, uin
  * (wrapping), row by row from the top left, q itself excepted. Four labels at a time (a 64-bit
  * word) are skipped when all are LAB_PENDING or LAB_NONCAND (0xFFFE, 0xFFFF: the only labels with
  * every bit but the lowest set). Fragments are few (hundreds of pixels per scan), windows small. */
-static void rescue_grow(lidet_cluster_t *c, const grow_t *g, uint32_t start, rescue_t *rs)
+static void rescue_grow(lidet_cluster_state_t *c, const grow_t *g, uint32_t start, rescue_t *rs)
 {
     const int32_t *mem = c->members;
     const uint16_t *lab = c->labels;
@@ -439,7 +441,7 @@ static void rescue_grow(lidet_cluster_t *c, const grow_t *g, uint32_t start, res
 #undef RESCUE_PROBE
 
 /* the smallest kept cluster (ties: the later seed), the one capacity drops first */
-static uint32_t smallest_slot(const lidet_cluster_t *c)
+static uint32_t smallest_slot(const lidet_cluster_state_t *c)
 {
     uint32_t i, m = 0;
     for (i = 1; i < c->n_recs; ++i)
@@ -456,7 +458,7 @@ static uint32_t smallest_slot(const lidet_cluster_t *c)
 /* sum, min and max of the points of members[start, tail) (tail > start). Returns 1 (the sums then
  * incomplete) as soon as an x, y or z extent exceeds max_extent: the test runs after every block of
  * 64 members, so a wall stops early instead of being summed to its end */
-static int member_stats(const lidet_cluster_t *c, uint32_t start, uint32_t tail, float max_extent, float sum[3],
+static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, float max_extent, float sum[3],
                         float lo[3], float hi[3])
 {
     const float *xs = c->img.x_m, *ys = c->img.y_m, *zs = c->img.z_m;
@@ -497,7 +499,7 @@ static int member_stats(const lidet_cluster_t *c, uint32_t start, uint32_t tail,
 }
 
 /* height of `mean` above the ground plane of the sector of the seed's column (or the flat ground) */
-static float height_above_ground(const lidet_cluster_t *c, uint32_t seed, const float mean[3],
+static float height_above_ground(const lidet_cluster_state_t *c, uint32_t seed, const float mean[3],
                                  const lidet_plane_t *planes, uint32_t n_sectors)
 {
     if (planes != 0)
@@ -516,7 +518,7 @@ static float height_above_ground(const lidet_cluster_t *c, uint32_t seed, const 
 /* filters + bookkeeping of the component members[start, tail); returns the new tail. rescue = 0:
  * a component of the first fill (one below min_points becomes a fragment when the rescue is on);
  * 1: a rescue group that joined no cluster (dropped when small; takes only a free slot) */
-static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
+static uint32_t finish_cluster(lidet_cluster_state_t *c, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
                                uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue)
 {
     const uint32_t n = tail - start;
@@ -612,7 +614,7 @@ static uint32_t finish_cluster(lidet_cluster_t *c, uint32_t start, uint32_t tail
  * updated (mean = (mean * n_old + group sum) / n_new, in float) and the height recomputed. The
  * group's seed is its first pixel in raster order, so the cluster's first pixel is the smaller of
  * the two seeds (the height uses that pixel's sector, as for any cluster) */
-static void rescue_join(lidet_cluster_t *c, uint32_t slot, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
+static void rescue_join(lidet_cluster_state_t *c, uint32_t slot, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
                         uint32_t n_sectors, lidet_cluster_stats_t *st)
 {
     lidet_cluster_rec_t *rec = &c->recs[slot];
@@ -640,7 +642,7 @@ static void rescue_join(lidet_cluster_t *c, uint32_t slot, uint32_t start, uint3
 }
 
 /* canonical id of kept pixel i (label slot + 1, or 0 = none), appended to its cluster's members */
-static inline void place_kept(lidet_cluster_t *c, uint16_t *lab, uint32_t i)
+static inline void place_kept(lidet_cluster_state_t *c, uint16_t *lab, uint32_t i)
 {
     const uint32_t l = lab[i];
     if (l != 0u)
@@ -652,7 +654,7 @@ static inline void place_kept(lidet_cluster_t *c, uint16_t *lab, uint32_t i)
 }
 
 /* canonical order: records sorted by seed, labels rewritten, members regrouped in raster order */
-static void canonicalise(lidet_cluster_t *c, uint32_t npix, lidet_cluster_stats_t *st)
+static void canonicalise(lidet_cluster_state_t *c, uint32_t npix, lidet_cluster_stats_t *st)
 {
     const uint32_t k = c->n_recs;
     uint32_t i, j, start;
@@ -788,8 +790,9 @@ static uint32_t next_fragment(const uint16_t *lab, uint32_t p, uint32_t npix)
     return npix;
 }
 
-lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *img,
-                                 const uint8_t *ground_mask, const lidet_plane_t *planes, uint32_t n_sectors)
+lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *labels, int32_t *members,
+                                         const lidet_range_image_t *img, const uint8_t *ground_mask,
+                                         const lidet_plane_t *planes, uint32_t n_sectors)
 {
     uint32_t rows, cols, npix, p, tail, ks;
     uint16_t *lab;
@@ -797,7 +800,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     grow_t lk;
     lidet_cluster_stats_t st;
 
-    if (c == 0 || img == 0 || (planes != 0 && n_sectors == 0))
+    if (c == 0 || labels == 0 || members == 0 || img == 0 || (planes != 0 && n_sectors == 0))
     {
         return LIDET_ERR_ARG;
     }
@@ -811,7 +814,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     {
         return LIDET_ERR_BUFFER;
     }
-    if (img->range_m == 0 || img->point_idx == 0 || img->row_elev_rad == 0 || img->x_m == 0 ||
+    if (img->range_m == 0 || img->row_elev_rad == 0 || img->x_m == 0 ||
         img->y_m == 0 || img->z_m == 0)
     {
         return LIDET_ERR_ARG;
@@ -819,6 +822,8 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     npix = rows * cols;
     setup_geometry(c, img);
     c->img = *img;
+    c->labels = labels;
+    c->members = members;
     c->n_recs = 0;
     memset(&st, 0, sizeof st);
     lab = c->labels;
@@ -842,15 +847,16 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
      * next integer). q < npix, so npix * cols <= 2^32 suffices (128 x 2048: 2^29); else divide */
     lk.row_magic = (uint64_t)npix * cols <= 0xFFFFFFFFu ? (uint32_t)(0xFFFFFFFFu / cols) + 1u : 0u;
 
-    /* candidates: FREE (0) or NONCAND (0xFFFF) = cand - 1 in 16 bits; no branch, so it vectorises */
+    /* candidates: FREE (0) or NONCAND (0xFFFF) = cand - 1 in 16 bits; no branch, so it vectorises.
+     * A pixel holds a point iff its range is > 0 (the image contract; point_idx may be absent) */
     {
-        const int32_t *pidx = img->point_idx;
+        const float *prng = img->range_m;
         uint32_t n_cand = 0;
         if (ground_mask != 0)
         {
             for (p = 0; p < npix; ++p)
             {
-                const uint32_t cand = (uint32_t)(pidx[p] >= 0) & (uint32_t)(ground_mask[p] == 0);
+                const uint32_t cand = (uint32_t)(prng[p] > 0.0f) & (uint32_t)(ground_mask[p] == 0);
                 lab[p] = (uint16_t)(cand - 1u);
                 n_cand += cand;
             }
@@ -859,7 +865,7 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
         {
             for (p = 0; p < npix; ++p)
             {
-                const uint32_t cand = (uint32_t)(pidx[p] >= 0);
+                const uint32_t cand = (uint32_t)(prng[p] > 0.0f);
                 lab[p] = (uint16_t)(cand - 1u);
                 n_cand += cand;
             }
@@ -909,6 +915,21 @@ lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *
     return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }
 
+lidet_status_t lidet_cluster_init(lidet_cluster_t *c, const lidet_cluster_cfg_t *cfg)
+{
+    return c == 0 ? LIDET_ERR_ARG : lidet_cluster_state_init(&c->state, cfg);
+}
+
+lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *img, const uint8_t *ground_mask,
+                                 const lidet_plane_t *planes, uint32_t n_sectors)
+{
+    if (c == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    return lidet_cluster_run_buffers(&c->state, c->labels, c->members, img, ground_mask, planes, n_sectors);
+}
+
 const uint16_t *lidet_cluster_labels(const lidet_cluster_t *c)
 {
     return c == 0 ? 0 : c->labels;
@@ -922,9 +943,9 @@ const lidet_cluster_rec_t *lidet_cluster_records(const lidet_cluster_t *c, uint3
     }
     if (n_clusters != 0)
     {
-        *n_clusters = c->n_recs;
+        *n_clusters = c->state.n_recs;
     }
-    return c->recs;
+    return c->state.recs;
 }
 
 const int32_t *lidet_cluster_members(const lidet_cluster_t *c)
@@ -934,18 +955,18 @@ const int32_t *lidet_cluster_members(const lidet_cluster_t *c)
 
 const lidet_cluster_stats_t *lidet_cluster_stats(const lidet_cluster_t *c)
 {
-    return c == 0 ? 0 : &c->stats;
+    return c == 0 ? 0 : &c->state.stats;
 }
 
-lidet_status_t lidet_cluster_point_labels(const lidet_cluster_t *c, const int32_t *point_pixel,
-                                          uint32_t n_points, uint32_t *out)
+lidet_status_t lidet_cluster_point_labels_of(const lidet_cluster_state_t *c, const int32_t *point_pixel,
+                                             uint32_t n_points, uint32_t *out)
 {
     uint32_t i, npix;
     if (c == 0 || ((point_pixel == 0 || out == 0) && n_points > 0))
     {
         return LIDET_ERR_ARG;
     }
-    if (c->magic != LIDET_INIT_MAGIC || c->img.point_idx == 0)
+    if (c->magic != LIDET_INIT_MAGIC || c->labels == 0)
     {
         return LIDET_ERR_STATE;
     }
@@ -958,7 +979,18 @@ lidet_status_t lidet_cluster_point_labels(const lidet_cluster_t *c, const int32_
     return LIDET_OK;
 }
 
+lidet_status_t lidet_cluster_point_labels(const lidet_cluster_t *c, const int32_t *point_pixel,
+                                          uint32_t n_points, uint32_t *out)
+{
+    return c == 0 ? LIDET_ERR_ARG : lidet_cluster_point_labels_of(&c->state, point_pixel, n_points, out);
+}
+
 uint32_t lidet_cluster_bytes(void)
 {
     return (uint32_t)sizeof(lidet_cluster_t);
+}
+
+uint32_t lidet_cluster_state_bytes(void)
+{
+    return (uint32_t)sizeof(lidet_cluster_state_t);
 }

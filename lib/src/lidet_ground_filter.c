@@ -71,7 +71,7 @@ static int in_range(float v, float lo, float hi)
     return lidet__isfinite(v) && v >= lo && v <= hi;
 }
 
-lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cfg)
+lidet_status_t lidet_ground_state_init(lidet_ground_state_t *g, const lidet_ground_cfg_t *cfg)
 {
     if (g == 0 || cfg == 0)
     {
@@ -165,7 +165,7 @@ static inline void filter_row(const float *R0, const float *R1, const float *Z0,
 }
 
 /* Pass 1 (mirrors ref/ground.py: sample_mask): the sample mask, row by row. */
-static void filter_rows(lidet_ground_t *g, const lidet_range_image_t *img)
+static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, const float *rxy, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols;
     const uint32_t step = g->cfg.sample_step;
@@ -178,15 +178,15 @@ static void filter_rows(lidet_ground_t *g, const lidet_range_image_t *img)
     f.z_lo = g->cfg.height_gate ? -g->cfg.mount_height_m - g->cfg.gate_below_m : -3.0e38f;
     f.z_hi = g->cfg.height_gate ? -g->cfg.mount_height_m + g->cfg.gate_above_m : 3.0e38f;
     /* rows off the step grid and the bottom row (no beam below it) hold no sample */
-    memset(g->sample, 0, (size_t)rows * cols);
+    memset(sample, 0, (size_t)rows * cols);
     for (r = 0; r + 1u < rows; r += step)
     {
-        const float *R0 = img->rxy_m + (size_t)r * cols;
+        const float *R0 = rxy + (size_t)r * cols;
         const float *R1 = R0 + cols;
         const float *Z0 = img->z_m + (size_t)r * cols;
         const float *Z1 = Z0 + cols;
         const float *F0 = g->cfg.fx_on_z ? Z0 : R0;
-        uint8_t *out = g->sample + (size_t)r * cols;
+        uint8_t *out = sample + (size_t)r * cols;
         const filt_t fl = f;
         if (opt)
         {
@@ -208,12 +208,13 @@ static void filter_rows(lidet_ground_t *g, const lidet_range_image_t *img)
  * candidate is written to the next free slot of its end, and the mask bit decides whether that end
  * advances (samples come in no predictable pattern). Past LIDET_GROUND_MAX_SAMPLES, samples are
  * dropped (in sector and raster order) and counted. */
-static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
+static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const float *rxy,
+                           const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
     const uint32_t cstep = g->cfg.sample_col_step;
     const float split = g->cfg.ring_split_m > 0.0f ? g->cfg.ring_split_m : 3.0e38f;
-    float *const sx = g->sx_m, *const sy = g->sy_m, *const sz = g->sz_m;
+    float *const sx = sc->sx_m, *const sy = sc->sy_m, *const sz = sc->sz_m;
     uint32_t s, r, c, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
     for (s = 0; s < ns; ++s)
     {
@@ -225,9 +226,9 @@ static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
         for (r = 0; r + 1u < rows; r += step)
         {
             const size_t base = (size_t)r * cols;
-            const uint8_t *m = g->sample + base;
+            const uint8_t *m = sc->sample + base;
             const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base;
-            const float *R = img->rxy_m + base;
+            const float *R = rxy + base;
             if (roomy)
             {
                 for (c = cstart; c < c1; c += cstep)
@@ -263,10 +264,10 @@ static void gather_samples(lidet_ground_t *g, const lidet_range_image_t *img)
         {
             total += (lo - near_start) + (far_end - hi);
         }
-        g->cell_first[s] = near_start;
-        g->cell_n[s] = lo - near_start;
-        g->cell_first[ns + s] = hi;
-        g->cell_n[ns + s] = far_end - hi;
+        sc->cell_first[s] = near_start;
+        sc->cell_n[s] = lo - near_start;
+        sc->cell_first[ns + s] = hi;
+        sc->cell_n[ns + s] = far_end - hi;
     }
     g->stats.n_samples = total;
     g->stats.n_samples_dropped = total - (lo + (LIDET_GROUND_MAX_SAMPLES - hi));
@@ -357,7 +358,7 @@ static inline uint32_t label_two(const float *X, const float *Y, const float *Z,
     return nv;
 }
 
-static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
+static void label_rows(lidet_ground_state_t *g, uint8_t *mask, const float *rxy, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors;
     const float g0 = g->cfg.ground_m, below0 = g->cfg.below_factor * g0;
@@ -376,9 +377,9 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
     for (r = 0; r < rows; ++r)
     {
         const size_t base = (size_t)r * cols;
-        const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base, *R = img->rxy_m + base;
+        const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base, *R = rxy + base;
         const float *Ru = r > 0u ? R - cols : R, *Zu = r > 0u ? Z - cols : Z;
-        uint8_t *out = g->mask + base;
+        uint8_t *out = mask + base;
         for (s = 0; s < ns; ++s)
         {
             const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
@@ -436,9 +437,25 @@ static void label_rows(lidet_ground_t *g, const lidet_range_image_t *img)
     g->stats.n_vetoed = n_vetoed;
 }
 
-lidet_status_t lidet_ground_run(lidet_ground_t *g, const lidet_range_image_t *img)
+/* R of every pixel from its x and y (an image without R, as a detector workspace builds it): the
+ * projection's own expression, so the bits equal those it would have stored */
+static const float *compute_rxy(float *rxy, const lidet_range_image_t *img)
 {
-    if (g == 0 || img == 0)
+    const uint32_t npix = (uint32_t)img->n_rows * img->n_cols;
+    const float *const x = img->x_m, *const y = img->y_m;
+    uint32_t p;
+    for (p = 0; p < npix; ++p)
+    {
+        rxy[p] = lidet__rxy(x[p], y[p]);
+    }
+    return rxy;
+}
+
+lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_scratch_t *scratch, uint8_t *mask,
+                                        float *rxy_m, const lidet_range_image_t *img)
+{
+    const float *rxy;
+    if (g == 0 || scratch == 0 || mask == 0 || img == 0)
     {
         return LIDET_ERR_ARG;
     }
@@ -446,7 +463,7 @@ lidet_status_t lidet_ground_run(lidet_ground_t *g, const lidet_range_image_t *im
     {
         return LIDET_ERR_STATE;
     }
-    if (img->x_m == 0 || img->y_m == 0 || img->z_m == 0 || img->rxy_m == 0 || img->point_idx == 0)
+    if (img->x_m == 0 || img->y_m == 0 || img->z_m == 0 || (img->rxy_m == 0 && rxy_m == 0))
     {
         return LIDET_ERR_ARG;
     }
@@ -462,11 +479,26 @@ lidet_status_t lidet_ground_run(lidet_ground_t *g, const lidet_range_image_t *im
     g->n_rows = img->n_rows;
     g->n_cols = img->n_cols;
     g->rng = lidet__rng_seed(g->cfg.seed); /* every run starts from the seed: deterministic per scan */
-    filter_rows(g, img);
-    gather_samples(g, img);
-    lidet__ground_fit_sectors(g);
-    label_rows(g, img);
+    rxy = img->rxy_m != 0 ? img->rxy_m : compute_rxy(rxy_m, img);
+    filter_rows(g, scratch->sample, rxy, img);
+    gather_samples(g, scratch, rxy, img);
+    lidet__ground_fit_sectors(g, scratch);
+    label_rows(g, mask, rxy, img);
     return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
+}
+
+lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cfg)
+{
+    return g == 0 ? LIDET_ERR_ARG : lidet_ground_state_init(&g->state, cfg);
+}
+
+lidet_status_t lidet_ground_run(lidet_ground_t *g, const lidet_range_image_t *img)
+{
+    if (g == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    return lidet_ground_run_buffers(&g->state, &g->scratch, g->mask, 0, img);
 }
 
 const uint8_t *lidet_ground_mask(const lidet_ground_t *g)
@@ -476,7 +508,7 @@ const uint8_t *lidet_ground_mask(const lidet_ground_t *g)
 
 const uint8_t *lidet_ground_samples(const lidet_ground_t *g)
 {
-    return g == 0 ? 0 : g->sample;
+    return g == 0 ? 0 : g->scratch.sample;
 }
 
 const lidet_plane_t *lidet_ground_planes(const lidet_ground_t *g, uint32_t *n_sectors)
@@ -487,21 +519,21 @@ const lidet_plane_t *lidet_ground_planes(const lidet_ground_t *g, uint32_t *n_se
     }
     if (n_sectors != 0)
     {
-        *n_sectors = g->cfg.n_sectors;
+        *n_sectors = g->state.cfg.n_sectors;
     }
-    return g->planes;
+    return g->state.planes;
 }
 
 const uint8_t *lidet_ground_sector_source(const lidet_ground_t *g)
 {
-    return g == 0 ? 0 : g->source;
+    return g == 0 ? 0 : g->state.source;
 }
 
-lidet_status_t lidet_ground_point_labels(const lidet_ground_t *g, const int32_t *point_pixel,
-                                         uint32_t n_points, uint8_t *out)
+lidet_status_t lidet_ground_point_labels_of(const lidet_ground_state_t *g, const uint8_t *mask,
+                                            const int32_t *point_pixel, uint32_t n_points, uint8_t *out)
 {
     uint32_t i, npix;
-    if (g == 0 || ((point_pixel == 0 || out == 0) && n_points > 0u))
+    if (g == 0 || mask == 0 || ((point_pixel == 0 || out == 0) && n_points > 0u))
     {
         return LIDET_ERR_ARG;
     }
@@ -513,17 +545,33 @@ lidet_status_t lidet_ground_point_labels(const lidet_ground_t *g, const int32_t 
     for (i = 0; i < n_points; ++i)
     {
         const int32_t p = point_pixel[i];
-        out[i] = (p >= 0 && (uint32_t)p < npix) ? g->mask[p] : 0u;
+        out[i] = (p >= 0 && (uint32_t)p < npix) ? mask[p] : 0u;
     }
     return LIDET_OK;
 }
 
+lidet_status_t lidet_ground_point_labels(const lidet_ground_t *g, const int32_t *point_pixel,
+                                         uint32_t n_points, uint8_t *out)
+{
+    return g == 0 ? LIDET_ERR_ARG : lidet_ground_point_labels_of(&g->state, g->mask, point_pixel, n_points, out);
+}
+
 const lidet_ground_stats_t *lidet_ground_stats(const lidet_ground_t *g)
 {
-    return g == 0 ? 0 : &g->stats;
+    return g == 0 ? 0 : &g->state.stats;
 }
 
 uint32_t lidet_ground_bytes(void)
 {
     return (uint32_t)sizeof(lidet_ground_t);
+}
+
+uint32_t lidet_ground_state_bytes(void)
+{
+    return (uint32_t)sizeof(lidet_ground_state_t);
+}
+
+uint32_t lidet_ground_scratch_bytes(void)
+{
+    return (uint32_t)sizeof(lidet_ground_scratch_t);
 }

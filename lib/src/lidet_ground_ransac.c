@@ -254,7 +254,7 @@ static uint32_t score(const float *xs, const float *ys, const float *zs, uint32_
 
 /* RANSAC on one sector (mirrors ref/ground.py: ransac_sector). Returns 1 with *out set when a
  * plane passes every check. */
-static int fit_sector(lidet_ground_t *g, const float *xs, const float *ys, const float *zs, uint32_t n,
+static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const float *xs, const float *ys, const float *zs, uint32_t n,
                       lidet_plane_t *out)
 {
     const lidet_ground_cfg_t *cfg = &g->cfg;
@@ -274,13 +274,13 @@ static int fit_sector(lidet_ground_t *g, const float *xs, const float *ys, const
     {
         for (i = 0; i < n_eval; ++i)
         {
-            g->ev_x_m[i] = xs[i * stride];
-            g->ev_y_m[i] = ys[i * stride];
-            g->ev_z_m[i] = zs[i * stride];
+            sc->ev_x_m[i] = xs[i * stride];
+            sc->ev_y_m[i] = ys[i * stride];
+            sc->ev_z_m[i] = zs[i * stride];
         }
-        ex = g->ev_x_m;
-        ey = g->ev_y_m;
-        ez = g->ev_z_m;
+        ex = sc->ev_x_m;
+        ey = sc->ev_y_m;
+        ez = sc->ev_z_m;
         en = n_eval;
         es = 1u;
     }
@@ -374,7 +374,7 @@ static int fit_sector(lidet_ground_t *g, const float *xs, const float *ys, const
     return 1;
 }
 
-void lidet__ground_fit_sectors(lidet_ground_t *g)
+void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc)
 {
     const uint32_t ns = g->cfg.n_sectors;
     const uint32_t n_cells = g->cfg.ring_split_m > 0.0f ? 2u * ns : ns;
@@ -387,7 +387,7 @@ void lidet__ground_fit_sectors(lidet_ground_t *g)
     /* every cell on its own samples: near cells 0..ns-1, then far cells (the RNG runs in this order) */
     for (k = 0; k < 2u * ns; ++k)
     {
-        const uint32_t a = g->cell_first[k], n = g->cell_n[k];
+        const uint32_t a = sc->cell_first[k], n = sc->cell_n[k];
         const int near = k < ns;
         g->source[k] = near ? LIDET_GROUND_PLANE_MOUNT : LIDET_GROUND_PLANE_NEAR;
         if (k >= n_cells || n < g->cfg.min_samples)
@@ -396,7 +396,7 @@ void lidet__ground_fit_sectors(lidet_ground_t *g)
             continue;
         }
         LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
-        if (fit_sector(g, g->sx_m + a, g->sy_m + a, g->sz_m + a, n, &g->planes[k]))
+        if (fit_sector(g, sc, sc->sx_m + a, sc->sy_m + a, sc->sz_m + a, n, &g->planes[k]))
         {
             g->source[k] = LIDET_GROUND_PLANE_FITTED;
             if (near)

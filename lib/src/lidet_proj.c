@@ -38,7 +38,7 @@ static int in_range(float v, float lo, float hi)
  * v = 4u = quadrant + f (f in [0, 1)), D(u) = quadrant + g(f pi/2), g(t) = sin t / (sin t + cos t)
  * (derived from the four quadrant cases of the pseudo-azimuth in key_block). Computing the edges from (quadrant,
  * f) keeps them exact at the quadrant seams, where sin/cos of pi-sized floats would lose the sign. */
-static void init_columns(lidet_proj_t *proj, uint32_t cols)
+static void init_columns(lidet_proj_state_t *proj, uint32_t cols)
 {
     uint32_t c, k;
     for (c = 0; c <= cols; ++c)
@@ -75,7 +75,7 @@ static void init_columns(lidet_proj_t *proj, uint32_t cols)
     }
 }
 
-lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg)
+lidet_status_t lidet_proj_state_init(lidet_proj_state_t *proj, const lidet_proj_cfg_t *cfg)
 {
     const lidet_sensor_t *s;
     float elev[LIDET_MAX_ROWS];
@@ -211,7 +211,16 @@ lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg)
     return LIDET_OK;
 }
 
-/* Pass 1 works on blocks of KEY_BLOCK points (stack: 6 arrays of KEY_BLOCK x 4 B, 1.5 KiB by default):
+lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg)
+{
+    if (proj == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    return lidet_proj_state_init(&proj->state, cfg);
+}
+
+/* Pass 1 works on blocks of KEY_BLOCK points (stack: 7 arrays of KEY_BLOCK x 4 B, 1.75 KiB by default):
  *  (a) key_block: range test, tan(elevation), pseudo-azimuth and both lookup-table buckets of every
  *      point, in one loop without branches or table accesses, which compilers vectorize (SSE2: 4
  *      points per sqrt and per division);
@@ -234,6 +243,7 @@ typedef struct
     int32_t row_k[KEY_BLOCK]; /* row_lut bucket; reused by (b) for the pixel of the k-th projected point */
     int32_t col_k[KEY_BLOCK]; /* col_lut bucket; reused by (b) for the block index of that point */
     int32_t flags[KEY_BLOCK]; /* KEY_* */
+    int32_t pix[KEY_BLOCK];   /* (b): pixel of each point, -1 = not projected; copied to point_pixel */
 } key_block_t;
 
 /* (a) above: the two per-point keys from one division and one square root,
@@ -289,14 +299,18 @@ float lidet_proj_azimuth_key(float x, float y)
     return (kb.flags[0] & KEY_DEN_OK) ? kb.d[0] : 2.0f;
 }
 
-lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t n_points, uint32_t stride,
-                              const uint16_t *ring)
+lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj_buffers_t *buf, const float *points,
+                                      uint32_t n_points, uint32_t stride, const uint16_t *ring)
 {
     uint32_t n, rows, cols, npix, pix;
     float min2, max2;
     lidet_proj_stats_t st;
 
-    if (proj == 0 || stride < 3 || (points == 0 && n_points > 0))
+    if (proj == 0 || buf == 0 || stride < 3 || (points == 0 && n_points > 0))
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (buf->x_m == 0 || buf->y_m == 0 || buf->z_m == 0 || buf->range_m == 0 || buf->point_idx == 0)
     {
         return LIDET_ERR_ARG;
     }
@@ -320,8 +334,8 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
      * pixel. range_m holds the winner's squared range until pass 2, starting at 3.39e38 (every byte
      * 0x7F), above any accepted r^2 (max2 <= 3.0e38), so the winner test needs no emptiness check.
      * Invariants live in locals: the stores below could alias the state's float fields otherwise. */
-    memset(proj->point_idx, 0xFF, (size_t)npix * sizeof proj->point_idx[0]);
-    memset(proj->range_m, 0x7F, (size_t)npix * sizeof proj->range_m[0]);
+    memset(buf->point_idx, 0xFF, (size_t)npix * sizeof buf->point_idx[0]);
+    memset(buf->range_m, 0x7F, (size_t)npix * sizeof buf->range_m[0]);
     {
         const float tan_lo = proj->tan_lo, tan_hi = proj->tan_hi, row_scale = proj->lut_scale;
         const float col_scale = proj->col_lut_scale;
@@ -332,9 +346,9 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
         const uint8_t *const row_lut = proj->row_lut;
         const uint16_t *const col_lut = proj->col_lut;
         const uint8_t *const ring_to_row = proj->ring_to_row;
-        int32_t *const point_idx = proj->point_idx;
-        int32_t *const point_pixel = proj->point_pixel;
-        float *const best = proj->range_m;
+        int32_t *const point_idx = buf->point_idx;
+        int32_t *const point_pixel = buf->point_pixel; /* may be NULL: per-point outputs not wanted */
+        float *const best = buf->range_m;
         uint32_t base, projected = 0;
         key_block_t kb;
 
@@ -368,13 +382,13 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
                             ++st.n_too_close;
                         else
                             ++st.n_too_far; /* beyond max_range_m, or so large that r^2 overflows */
-                        point_pixel[i] = -1;
+                        kb.pix[j] = -1;
                         continue;
                     }
                     if (ring == 0) /* elevation outside the beams (+ margin), x = y = 0 included */
                     {
                         ++st.n_out_of_fov;
-                        point_pixel[i] = -1;
+                        kb.pix[j] = -1;
                         continue;
                     }
                     if (!(kb.flags[j] & KEY_DEN_OK)) /* ring path, x = y = 0: straight ahead */
@@ -388,7 +402,7 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
                     if (ring[i] >= rows)
                     {
                         ++st.n_bad_ring;
-                        point_pixel[i] = -1;
+                        kb.pix[j] = -1;
                         continue;
                     }
                     row = ring_to_row[ring[i]];
@@ -426,7 +440,7 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
                 }
                 pix = (uint32_t)row * cols + (uint32_t)col;
                 LIDET_ASSERT(pix < npix);
-                point_pixel[i] = (int32_t)pix;
+                kb.pix[j] = (int32_t)pix;
                 /* nw <= j: the entries rewritten here have been read already */
                 kb.row_k[nw] = (int32_t)pix;
                 kb.col_k[nw] = (int32_t)j;
@@ -445,6 +459,10 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
                 }
             }
             projected += nw;
+            if (point_pixel != 0) /* per-point outputs only when asked for */
+            {
+                memcpy(point_pixel + base, kb.pix, m * sizeof kb.pix[0]);
+            }
         }
         st.n_projected = projected;
     }
@@ -458,9 +476,9 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
     {
         static const float zero_rec[3] = {0.0f, 0.0f, 0.0f};
         const float *const src = st.n_projected > 0 ? points : zero_rec; /* points may be NULL if n = 0 */
-        float *const xo = proj->x_m, *const yo = proj->y_m, *const zo = proj->z_m;
-        float *const ro = proj->rxy_m, *const rng = proj->range_m;
-        const int32_t *const idx = proj->point_idx;
+        float *const xo = buf->x_m, *const yo = buf->y_m, *const zo = buf->z_m;
+        float *const ro = buf->rxy_m, *const rng = buf->range_m; /* ro may be NULL */
+        const int32_t *const idx = buf->point_idx;
         uint32_t filled = 0, base;
         for (base = 0; base < npix; base += PASS2_BLOCK)
         {
@@ -482,11 +500,22 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
                 memcpy(&zo[pix], &uz, sizeof uz);
                 filled += keep & 1u;
             }
-            for (pix = base; pix < end; ++pix)
+            if (ro != 0)
             {
-                const float x = xo[pix], y = yo[pix], b = rng[pix];
-                ro[pix] = sqrtf(x * x + y * y);
-                rng[pix] = b <= max2 ? sqrtf(b) : 0.0f;
+                for (pix = base; pix < end; ++pix)
+                {
+                    const float x = xo[pix], y = yo[pix], b = rng[pix];
+                    ro[pix] = lidet__rxy(x, y);
+                    rng[pix] = b <= max2 ? sqrtf(b) : 0.0f;
+                }
+            }
+            else
+            {
+                for (pix = base; pix < end; ++pix)
+                {
+                    const float b = rng[pix];
+                    rng[pix] = b <= max2 ? sqrtf(b) : 0.0f;
+                }
             }
         }
         st.n_pixels_filled = filled;
@@ -496,21 +525,61 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
     return st.n_truncated > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }
 
+static void own_buffers(lidet_proj_t *proj, lidet_proj_buffers_t *b)
+{
+    b->x_m = proj->x_m;
+    b->y_m = proj->y_m;
+    b->z_m = proj->z_m;
+    b->range_m = proj->range_m;
+    b->rxy_m = proj->rxy_m;
+    b->point_idx = proj->point_idx;
+    b->point_pixel = proj->point_pixel;
+}
+
+lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t n_points, uint32_t stride,
+                              const uint16_t *ring)
+{
+    lidet_proj_buffers_t b;
+    if (proj == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    own_buffers(proj, &b);
+    return lidet_proj_run_buffers(&proj->state, &b, points, n_points, stride, ring);
+}
+
+void lidet_proj_image_of(const lidet_proj_state_t *st, const lidet_proj_buffers_t *buf, lidet_range_image_t *img)
+{
+    if (st == 0 || buf == 0 || img == 0)
+    {
+        return;
+    }
+    img->n_rows = st->cfg.sensor.n_rows;
+    img->n_cols = st->cfg.sensor.n_cols;
+    img->x_m = buf->x_m;
+    img->y_m = buf->y_m;
+    img->z_m = buf->z_m;
+    img->range_m = buf->range_m;
+    img->rxy_m = buf->rxy_m;
+    img->point_idx = buf->point_idx;
+    img->row_elev_rad = st->row_elev_rad;
+}
+
 void lidet_proj_image(const lidet_proj_t *proj, lidet_range_image_t *img)
 {
     if (proj == 0 || img == 0)
     {
         return;
     }
-    img->n_rows = proj->cfg.sensor.n_rows;
-    img->n_cols = proj->cfg.sensor.n_cols;
+    img->n_rows = proj->state.cfg.sensor.n_rows;
+    img->n_cols = proj->state.cfg.sensor.n_cols;
     img->x_m = proj->x_m;
     img->y_m = proj->y_m;
     img->z_m = proj->z_m;
     img->range_m = proj->range_m;
     img->rxy_m = proj->rxy_m;
     img->point_idx = proj->point_idx;
-    img->row_elev_rad = proj->row_elev_rad;
+    img->row_elev_rad = proj->state.row_elev_rad;
 }
 
 const int32_t *lidet_proj_point_pixels(const lidet_proj_t *proj, uint32_t *n_points)
@@ -521,17 +590,22 @@ const int32_t *lidet_proj_point_pixels(const lidet_proj_t *proj, uint32_t *n_poi
     }
     if (n_points != 0)
     {
-        *n_points = proj->n_points;
+        *n_points = proj->state.n_points;
     }
     return proj->point_pixel;
 }
 
 const lidet_proj_stats_t *lidet_proj_stats(const lidet_proj_t *proj)
 {
-    return proj == 0 ? 0 : &proj->stats;
+    return proj == 0 ? 0 : &proj->state.stats;
 }
 
 uint32_t lidet_proj_bytes(void)
 {
     return (uint32_t)sizeof(lidet_proj_t);
+}
+
+uint32_t lidet_proj_state_bytes(void)
+{
+    return (uint32_t)sizeof(lidet_proj_state_t);
 }

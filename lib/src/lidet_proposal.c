@@ -93,6 +93,12 @@ static int16_t bin_of(float v, float bin)
 lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_index,
                                    const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out)
 {
+    return c == 0 ? LIDET_ERR_ARG : lidet_proposal_make_of(&c->state, cluster_index, cfg, out);
+}
+
+lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t cluster_index,
+                                      const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out)
+{
     const lidet_cluster_rec_t *rec;
     const lidet_range_image_t *img;
     uint32_t i, npix, state;
@@ -102,7 +108,7 @@ lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_in
     {
         return LIDET_ERR_ARG;
     }
-    if (c->magic != LIDET_INIT_MAGIC || c->img.point_idx == 0)
+    if (c->magic != LIDET_INIT_MAGIC || c->members == 0 || c->img.x_m == 0)
     {
         return LIDET_ERR_STATE;
     }

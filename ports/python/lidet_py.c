@@ -1,7 +1,15 @@
 /* SPDX-License-Identifier: MIT */
 /* Flat C entry points for the Python bindings (tools/lidet_tools/native.py, ctypes).
- * Host only: each stage's workspace is a static object here, so calls are not reentrant. Arrays
- * are caller-allocated numpy buffers whose sizes the Python side derives from the same inputs. */
+ *
+ * Every call works on an explicit scan context (lidet_py_ctx_new): the stages' states of one scan,
+ * allocated on the host heap (this is a host port, not lib/). Nothing is global, so a call on one
+ * context never sees another's scan: proposals read the clusters and the image of their own context.
+ *
+ * Configurations and statistics cross the boundary as the C structs themselves. Python learns their
+ * layout by name from lidet_py_field (name, offset, size, kind of every field, offsets from offsetof),
+ * so nothing is kept in step by hand, and the defaults come from the C cfg_default functions. */
+#include <stddef.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "lidet/lidet.h"
@@ -12,8 +20,158 @@
 #define LIDET_PY_API __attribute__((visibility("default")))
 #endif
 
-static lidet_proj_t g_proj;
-static lidet_ground_t g_ground;
+/* one scan's states */
+typedef struct
+{
+    lidet_proj_t proj;
+    lidet_ground_t ground;
+    lidet_cluster_t cluster;
+    uint8_t ground_pix[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    lidet_proposal_t proposal;
+    int proj_ready;    /* lidet_py_proj_init succeeded */
+    int cluster_ready; /* a lidet_py_cluster_run succeeded (proposals may be made) */
+} lidet_py_ctx_t;
+
+LIDET_PY_API void *lidet_py_ctx_new(void)
+{
+    return calloc(1, sizeof(lidet_py_ctx_t));
+}
+
+LIDET_PY_API void lidet_py_ctx_free(void *ctx)
+{
+    free(ctx);
+}
+
+/* ---- struct layouts by name ------------------------------------------------------------------ */
+typedef struct
+{
+    const char *type;
+    const char *field;
+    uint32_t offset;
+    uint32_t size;
+    char kind; /* 'f' float, 'u' unsigned integer, 'i' signed integer */
+} py_field_t;
+
+#define FLD(T, f, k) {#T, #f, (uint32_t)offsetof(T, f), (uint32_t)sizeof(((T *)0)->f), k}
+
+static const py_field_t k_fields[] = {
+    /* lidet_proj_cfg_t (its sensor member travels as separate arguments) */
+    FLD(lidet_proj_cfg_t, min_range_m, 'f'), FLD(lidet_proj_cfg_t, max_range_m, 'f'),
+    FLD(lidet_proj_cfg_t, fov_margin_rad, 'f'),
+    FLD(lidet_proj_stats_t, n_points_in, 'u'), FLD(lidet_proj_stats_t, n_projected, 'u'),
+    FLD(lidet_proj_stats_t, n_pixels_filled, 'u'), FLD(lidet_proj_stats_t, n_nonfinite, 'u'),
+    FLD(lidet_proj_stats_t, n_too_close, 'u'), FLD(lidet_proj_stats_t, n_too_far, 'u'),
+    FLD(lidet_proj_stats_t, n_out_of_fov, 'u'), FLD(lidet_proj_stats_t, n_bad_ring, 'u'),
+    FLD(lidet_proj_stats_t, n_truncated, 'u'),
+    FLD(lidet_ground_cfg_t, fy_max, 'f'), FLD(lidet_ground_cfg_t, fx_max_m, 'f'),
+    FLD(lidet_ground_cfg_t, fx_on_z, 'u'), FLD(lidet_ground_cfg_t, require_descending, 'u'),
+    FLD(lidet_ground_cfg_t, height_gate, 'u'), FLD(lidet_ground_cfg_t, gate_above_m, 'f'),
+    FLD(lidet_ground_cfg_t, gate_below_m, 'f'), FLD(lidet_ground_cfg_t, mount_height_m, 'f'),
+    FLD(lidet_ground_cfg_t, n_sectors, 'u'), FLD(lidet_ground_cfg_t, ransac_iters, 'u'),
+    FLD(lidet_ground_cfg_t, sample_step, 'u'), FLD(lidet_ground_cfg_t, sample_col_step, 'u'),
+    FLD(lidet_ground_cfg_t, eval_samples, 'u'), FLD(lidet_ground_cfg_t, min_samples, 'u'),
+    FLD(lidet_ground_cfg_t, min_inliers, 'u'), FLD(lidet_ground_cfg_t, confidence, 'f'),
+    FLD(lidet_ground_cfg_t, refine_iters, 'u'), FLD(lidet_ground_cfg_t, inlier_m, 'f'),
+    FLD(lidet_ground_cfg_t, max_tilt_rad, 'f'), FLD(lidet_ground_cfg_t, max_height_dev_m, 'f'),
+    FLD(lidet_ground_cfg_t, ring_split_m, 'f'), FLD(lidet_ground_cfg_t, fallback_sectors, 'u'),
+    FLD(lidet_ground_cfg_t, seed, 'u'), FLD(lidet_ground_cfg_t, ground_m, 'f'),
+    FLD(lidet_ground_cfg_t, ground_m_per_m, 'f'), FLD(lidet_ground_cfg_t, below_factor, 'f'),
+    FLD(lidet_ground_cfg_t, veto_slope, 'f'), FLD(lidet_ground_cfg_t, veto_min_dz_m, 'f'),
+    FLD(lidet_ground_stats_t, n_samples, 'u'), FLD(lidet_ground_stats_t, n_samples_dropped, 'u'),
+    FLD(lidet_ground_stats_t, n_ground, 'u'), FLD(lidet_ground_stats_t, n_sectors_fitted, 'u'),
+    FLD(lidet_ground_stats_t, n_sectors_neighbour, 'u'), FLD(lidet_ground_stats_t, n_sectors_mount, 'u'),
+    FLD(lidet_ground_stats_t, n_sectors_sparse, 'u'), FLD(lidet_ground_stats_t, n_sectors_rejected, 'u'),
+    FLD(lidet_ground_stats_t, n_far_fitted, 'u'), FLD(lidet_ground_stats_t, n_vetoed, 'u'),
+    FLD(lidet_ground_stats_t, n_hypotheses, 'u'),
+    FLD(lidet_cluster_cfg_t, theta_rad, 'f'), FLD(lidet_cluster_cfg_t, max_steps, 'u'),
+    FLD(lidet_cluster_cfg_t, bridge_occluders, 'u'), FLD(lidet_cluster_cfg_t, diagonals, 'u'),
+    FLD(lidet_cluster_cfg_t, max_gap_m, 'f'), FLD(lidet_cluster_cfg_t, max_gap_per_m, 'f'),
+    FLD(lidet_cluster_cfg_t, min_points, 'u'), FLD(lidet_cluster_cfg_t, max_extent_m, 'f'),
+    FLD(lidet_cluster_cfg_t, max_mean_height_m, 'f'), FLD(lidet_cluster_cfg_t, mount_height_m, 'f'),
+    FLD(lidet_cluster_cfg_t, rescue_gap_m, 'f'), FLD(lidet_cluster_cfg_t, rescue_gap_per_m, 'f'),
+    FLD(lidet_cluster_cfg_t, rescue_rows, 'u'), FLD(lidet_cluster_cfg_t, rescue_cols, 'u'),
+    FLD(lidet_cluster_stats_t, n_candidates, 'u'), FLD(lidet_cluster_stats_t, n_found, 'u'),
+    FLD(lidet_cluster_stats_t, n_fragments, 'u'), FLD(lidet_cluster_stats_t, n_rescue_joined, 'u'),
+    FLD(lidet_cluster_stats_t, n_rescue_pixels, 'u'), FLD(lidet_cluster_stats_t, n_dropped_small, 'u'),
+    FLD(lidet_cluster_stats_t, n_dropped_extent, 'u'), FLD(lidet_cluster_stats_t, n_dropped_height, 'u'),
+    FLD(lidet_cluster_stats_t, n_dropped_capacity, 'u'), FLD(lidet_cluster_stats_t, n_kept, 'u'),
+    FLD(lidet_cluster_stats_t, n_pixels_kept, 'u'), FLD(lidet_cluster_stats_t, n_queue_overflow, 'u'),
+    FLD(lidet_proposal_cfg_t, n_points, 'u'), FLD(lidet_proposal_cfg_t, seed, 'u'),
+    FLD(lidet_proposal_cfg_t, azimuth_bin_rad, 'f'), FLD(lidet_proposal_cfg_t, elevation_bin_rad, 'f'),
+    FLD(lidet_proposal_cfg_t, range_bin_m, 'f'),
+};
+
+typedef struct
+{
+    const char *type;
+    uint32_t size;
+} py_struct_t;
+
+static const py_struct_t k_structs[] = {
+    {"lidet_proj_cfg_t", (uint32_t)sizeof(lidet_proj_cfg_t)},
+    {"lidet_proj_stats_t", (uint32_t)sizeof(lidet_proj_stats_t)},
+    {"lidet_ground_cfg_t", (uint32_t)sizeof(lidet_ground_cfg_t)},
+    {"lidet_ground_stats_t", (uint32_t)sizeof(lidet_ground_stats_t)},
+    {"lidet_cluster_cfg_t", (uint32_t)sizeof(lidet_cluster_cfg_t)},
+    {"lidet_cluster_stats_t", (uint32_t)sizeof(lidet_cluster_stats_t)},
+    {"lidet_proposal_cfg_t", (uint32_t)sizeof(lidet_proposal_cfg_t)},
+};
+
+/* Field number `index` of the table: its struct's name and size, its name, offset, size and kind.
+ * Returns 0, or LIDET_ERR_NOT_FOUND past the end. */
+LIDET_PY_API int lidet_py_field(uint32_t index, const char **type, uint32_t *type_size, const char **field,
+                                uint32_t *offset, uint32_t *size, char *kind)
+{
+    uint32_t s;
+    if (index >= sizeof k_fields / sizeof k_fields[0])
+        return LIDET_ERR_NOT_FOUND;
+    *type = k_fields[index].type;
+    *field = k_fields[index].field;
+    *offset = k_fields[index].offset;
+    *size = k_fields[index].size;
+    *kind = k_fields[index].kind;
+    *type_size = 0;
+    for (s = 0; s < sizeof k_structs / sizeof k_structs[0]; ++s)
+    {
+        if (strcmp(k_structs[s].type, *type) == 0)
+            *type_size = k_structs[s].size;
+    }
+    return 0;
+}
+
+/* ---- defaults (the C cfg_default functions, for a sensor given by its shape and mount) ---------- */
+static void py_sensor(lidet_sensor_t *s, uint32_t rows, uint32_t cols, float mount_height_m)
+{
+    memset(s, 0, sizeof *s);
+    s->name = "python";
+    s->n_rows = (uint16_t)(rows > 0xFFFFu ? 0xFFFFu : rows);
+    s->n_cols = (uint16_t)(cols > 0xFFFFu ? 0xFFFFu : cols);
+    s->mount_height_m = mount_height_m;
+}
+
+LIDET_PY_API void lidet_py_proj_default(lidet_proj_cfg_t *out)
+{
+    lidet_proj_cfg_default(out, NULL);
+}
+
+LIDET_PY_API void lidet_py_ground_default(uint32_t rows, uint32_t cols, float mount_height_m, lidet_ground_cfg_t *out)
+{
+    lidet_sensor_t s;
+    py_sensor(&s, rows, cols, mount_height_m);
+    lidet_ground_cfg_default(out, &s);
+}
+
+LIDET_PY_API void lidet_py_cluster_default(uint32_t rows, uint32_t cols, float mount_height_m, lidet_cluster_cfg_t *out)
+{
+    lidet_sensor_t s;
+    py_sensor(&s, rows, cols, mount_height_m);
+    lidet_cluster_cfg_default(out, &s);
+}
+
+LIDET_PY_API void lidet_py_proposal_default(lidet_proposal_cfg_t *out)
+{
+    lidet_proposal_cfg_default(out);
+}
 
 LIDET_PY_API int lidet_py_capacity(uint32_t *out)
 {
@@ -50,55 +208,46 @@ LIDET_PY_API int lidet_py_sensor(uint32_t index, char *name_buf, uint32_t *rows_
     return 0;
 }
 
-/* Initialise the projection. elev_rad may be NULL (uniform fov). */
-LIDET_PY_API int lidet_py_proj_init(uint32_t rows, uint32_t cols, const float *elev_rad, float fov_up_rad,
-                                    float fov_down_rad, float mount_height_m, float min_range_m, float max_range_m,
-                                    float fov_margin_rad)
+/* ---- projection ------------------------------------------------------------------------------- */
+
+/* Initialise the context's projection. elev_rad may be NULL (uniform fov); cfg: a lidet_proj_cfg_t whose
+ * sensor member is ignored (the sensor is given by the other arguments). */
+LIDET_PY_API int lidet_py_proj_init(lidet_py_ctx_t *ctx, uint32_t rows, uint32_t cols, const float *elev_rad,
+                                    float fov_up_rad, float fov_down_rad, float mount_height_m,
+                                    const lidet_proj_cfg_t *cfg)
 {
-    lidet_proj_cfg_t cfg;
+    lidet_proj_cfg_t c;
     lidet_sensor_t s;
-    memset(&s, 0, sizeof s);
-    s.name = "python";
+    int rc;
+    if (ctx == NULL || cfg == NULL)
+        return LIDET_ERR_ARG;
     if (rows > 0xFFFFu || cols > 0xFFFFu)
         return LIDET_ERR_BUFFER;
-    s.n_rows = (uint16_t)rows;
-    s.n_cols = (uint16_t)cols;
+    py_sensor(&s, rows, cols, mount_height_m);
     s.beam_elev_rad = elev_rad;
     s.fov_up_rad = fov_up_rad;
     s.fov_down_rad = fov_down_rad;
-    s.mount_height_m = mount_height_m;
-    lidet_proj_cfg_default(&cfg, &s);
-    cfg.min_range_m = min_range_m;
-    cfg.max_range_m = max_range_m;
-    cfg.fov_margin_rad = fov_margin_rad;
-    return lidet_proj_init(&g_proj, &cfg);
-}
-
-/* Run the projection; copy the image out. out_img: 5 * rows * cols floats (x, y, z, range, rxy planes),
- * out_idx: rows * cols int32, out_point_pixel: min(n, LIDET_MAX_POINTS) int32, out_stats: 9 uint32,
- * out_row_elev: rows floats. Any output may be NULL. */
-static int lidet_py_proj_run_outputs(float *out_img, int32_t *out_idx, int32_t *out_point_pixel,
-                                     uint32_t *out_stats, float *out_row_elev);
-
-LIDET_PY_API int lidet_py_proj_run(const float *pts, uint32_t n, uint32_t stride, const uint16_t *ring,
-                                   float *out_img, int32_t *out_idx, int32_t *out_point_pixel, uint32_t *out_stats,
-                                   float *out_row_elev)
-{
-    const int rc = lidet_proj_run(&g_proj, pts, n, stride, ring);
-    if (rc < 0)
-        return rc;
-    lidet_py_proj_run_outputs(out_img, out_idx, out_point_pixel, out_stats, out_row_elev);
+    c = *cfg;
+    c.sensor = s;
+    ctx->proj_ready = 0;
+    ctx->cluster_ready = 0;
+    rc = lidet_proj_init(&ctx->proj, &c);
+    ctx->proj_ready = rc == LIDET_OK;
     return rc;
 }
 
-static int lidet_py_proj_run_outputs(float *out_img, int32_t *out_idx, int32_t *out_point_pixel,
-                                     uint32_t *out_stats, float *out_row_elev)
+/* Copy the context's image out. out_img: 5 * rows * cols floats (x, y, z, range, rxy planes),
+ * out_idx: rows * cols int32, out_point_pixel: the projection's point count int32, out_stats: a
+ * lidet_proj_stats_t, out_row_elev: rows floats. Any output may be NULL. */
+LIDET_PY_API int lidet_py_proj_copy(lidet_py_ctx_t *ctx, float *out_img, int32_t *out_idx, int32_t *out_point_pixel,
+                                    lidet_proj_stats_t *out_stats, float *out_row_elev)
 {
     lidet_range_image_t img;
-    const lidet_proj_stats_t *st;
     uint32_t npix, np;
     const int32_t *pp;
-    lidet_proj_image(&g_proj, &img);
+    if (ctx == NULL || !ctx->proj_ready)
+        return LIDET_ERR_STATE;
+    lidet_proj_image(&ctx->proj, &img);
     npix = (uint32_t)img.n_rows * img.n_cols;
     if (out_img != NULL)
     {
@@ -110,167 +259,72 @@ static int lidet_py_proj_run_outputs(float *out_img, int32_t *out_idx, int32_t *
     }
     if (out_idx != NULL)
         memcpy(out_idx, img.point_idx, npix * sizeof(int32_t));
-    pp = lidet_proj_point_pixels(&g_proj, &np);
+    pp = lidet_proj_point_pixels(&ctx->proj, &np);
     if (out_point_pixel != NULL)
         memcpy(out_point_pixel, pp, np * sizeof(int32_t));
-    st = lidet_proj_stats(&g_proj);
     if (out_stats != NULL)
-    {
-        out_stats[0] = st->n_points_in;
-        out_stats[1] = st->n_projected;
-        out_stats[2] = st->n_pixels_filled;
-        out_stats[3] = st->n_nonfinite;
-        out_stats[4] = st->n_too_close;
-        out_stats[5] = st->n_too_far;
-        out_stats[6] = st->n_out_of_fov;
-        out_stats[7] = st->n_bad_ring;
-        out_stats[8] = st->n_truncated;
-    }
+        *out_stats = *lidet_proj_stats(&ctx->proj);
     if (out_row_elev != NULL)
         memcpy(out_row_elev, img.row_elev_rad, img.n_rows * sizeof(float));
     return 0;
 }
 
-/* ---- ground stage ------------------------------------------------------------------------------
- * The configuration crosses the boundary as two flat arrays in this order (native.py: GROUND_F, GROUND_U):
- *   cfg_f[15]: fy_max fx_max_m gate_above_m gate_below_m mount_height_m inlier_m max_tilt_rad
- *              max_height_dev_m ground_m ground_m_per_m below_factor confidence ring_split_m veto_slope veto_min_dz_m
- *   cfg_u[13]: fx_on_z require_descending height_gate n_sectors ransac_iters eval_samples min_samples
- *              min_inliers refine_iters fallback_sectors seed sample_step sample_col_step */
-static void ground_cfg_to_arrays(const lidet_ground_cfg_t *c, float *f, uint32_t *u)
+/* Project a scan with the context's projection, then copy the outputs (as lidet_py_proj_copy). */
+LIDET_PY_API int lidet_py_proj_run(lidet_py_ctx_t *ctx, const float *pts, uint32_t n, uint32_t stride,
+                                   const uint16_t *ring, float *out_img, int32_t *out_idx, int32_t *out_point_pixel,
+                                   lidet_proj_stats_t *out_stats, float *out_row_elev)
 {
-    f[0] = c->fy_max;
-    f[1] = c->fx_max_m;
-    f[2] = c->gate_above_m;
-    f[3] = c->gate_below_m;
-    f[4] = c->mount_height_m;
-    f[5] = c->inlier_m;
-    f[6] = c->max_tilt_rad;
-    f[7] = c->max_height_dev_m;
-    f[8] = c->ground_m;
-    f[9] = c->ground_m_per_m;
-    f[10] = c->below_factor;
-    f[11] = c->confidence;
-    f[12] = c->ring_split_m;
-    f[13] = c->veto_slope;
-    f[14] = c->veto_min_dz_m;
-    u[0] = c->fx_on_z;
-    u[1] = c->require_descending;
-    u[2] = c->height_gate;
-    u[3] = c->n_sectors;
-    u[4] = c->ransac_iters;
-    u[5] = c->eval_samples;
-    u[6] = c->min_samples;
-    u[7] = c->min_inliers;
-    u[8] = c->refine_iters;
-    u[9] = c->fallback_sectors;
-    u[10] = c->seed;
-    u[11] = c->sample_step;
-    u[12] = c->sample_col_step;
+    int rc;
+    if (ctx == NULL || !ctx->proj_ready)
+        return LIDET_ERR_STATE;
+    ctx->cluster_ready = 0; /* the image changes under any earlier clusters */
+    rc = lidet_proj_run(&ctx->proj, pts, n, stride, ring);
+    if (rc < 0)
+        return rc;
+    lidet_py_proj_copy(ctx, out_img, out_idx, out_point_pixel, out_stats, out_row_elev);
+    return rc;
 }
 
-static int ground_cfg_from_arrays(lidet_ground_cfg_t *c, const float *f, const uint32_t *u)
-{
-    int i;
-    for (i = 0; i < 10; ++i)
-    {
-        if (u[i] > 0xFFFFu)
-            return LIDET_ERR_CONFIG;
-    }
-    c->fy_max = f[0];
-    c->fx_max_m = f[1];
-    c->gate_above_m = f[2];
-    c->gate_below_m = f[3];
-    c->mount_height_m = f[4];
-    c->inlier_m = f[5];
-    c->max_tilt_rad = f[6];
-    c->max_height_dev_m = f[7];
-    c->ground_m = f[8];
-    c->ground_m_per_m = f[9];
-    c->below_factor = f[10];
-    c->confidence = f[11];
-    c->ring_split_m = f[12];
-    c->veto_slope = f[13];
-    c->veto_min_dz_m = f[14];
-    if (u[0] > 255u || u[1] > 255u || u[2] > 255u || u[8] > 255u)
-        return LIDET_ERR_CONFIG;
-    c->fx_on_z = (uint8_t)u[0];
-    c->require_descending = (uint8_t)u[1];
-    c->height_gate = (uint8_t)u[2];
-    c->n_sectors = (uint16_t)u[3];
-    c->ransac_iters = (uint16_t)u[4];
-    c->eval_samples = (uint16_t)u[5];
-    c->min_samples = (uint16_t)u[6];
-    c->min_inliers = (uint16_t)u[7];
-    c->refine_iters = (uint8_t)u[8];
-    c->fallback_sectors = (uint16_t)u[9];
-    c->seed = u[10];
-    if (u[11] > 0xFFFFu)
-        return LIDET_ERR_CONFIG;
-    c->sample_step = (uint16_t)u[11];
-    if (u[12] > 0xFFFFu)
-        return LIDET_ERR_CONFIG;
-    c->sample_col_step = (uint16_t)u[12];
-    return LIDET_OK;
-}
+/* ---- ground stage ----------------------------------------------------------------------------- */
 
-/* Defaults of lidet_ground_cfg_default for a sensor with `rows` beams mounted at mount_height_m. */
-LIDET_PY_API int lidet_py_ground_default(uint32_t rows, uint32_t cols, float mount_height_m, float *cfg_f,
-                                         uint32_t *cfg_u)
-{
-    lidet_ground_cfg_t c;
-    lidet_sensor_t s;
-    memset(&s, 0, sizeof s);
-    s.name = "python";
-    s.n_rows = (uint16_t)(rows > 0xFFFFu ? 0xFFFFu : rows);
-    s.n_cols = (uint16_t)(cols > 0xFFFFu ? 0xFFFFu : cols);
-    s.mount_height_m = mount_height_m;
-    lidet_ground_cfg_default(&c, &s);
-    ground_cfg_to_arrays(&c, cfg_f, cfg_u);
-    return 0;
-}
-
-/* Initialise the ground stage and run it on the image of the last lidet_py_proj_run. Outputs (any may
- * be NULL): mask_pixel / sample_pixel rows*cols bytes, mask_point n_points bytes (n_points = the
- * projection's point count), planes 8*n_sectors floats (nx ny nz d; near planes, then far planes),
- * source 2*n_sectors bytes (same order), stats 12 uint32 (0 n_samples n_samples_dropped n_ground fitted
- * neighbour mount sparse rejected hypotheses far_fitted vetoed). */
-LIDET_PY_API int lidet_py_ground_run(const float *cfg_f, const uint32_t *cfg_u, uint8_t *mask_pixel,
+/* Initialise the context's ground stage with cfg and run it on the context's image. Outputs (any may
+ * be NULL): mask_pixel / sample_pixel rows*cols bytes, mask_point n_points bytes (the projection's
+ * point count), planes 8*n_sectors floats (nx ny nz d; near planes, then far planes), source
+ * 2*n_sectors bytes (same order), stats a lidet_ground_stats_t. */
+LIDET_PY_API int lidet_py_ground_run(lidet_py_ctx_t *ctx, const lidet_ground_cfg_t *cfg, uint8_t *mask_pixel,
                                      uint8_t *sample_pixel, uint8_t *mask_point, float *planes, uint8_t *source,
-                                     uint32_t *stats)
+                                     lidet_ground_stats_t *stats)
 {
-    lidet_ground_cfg_t c;
     lidet_range_image_t img;
-    const lidet_ground_stats_t *st;
     const int32_t *pp;
     uint32_t npix, np, ns, s;
     int rc;
-    lidet_ground_cfg_default(&c, NULL);
-    rc = ground_cfg_from_arrays(&c, cfg_f, cfg_u);
+    if (ctx == NULL || !ctx->proj_ready)
+        return LIDET_ERR_STATE;
+    if (cfg == NULL)
+        return LIDET_ERR_ARG;
+    rc = lidet_ground_init(&ctx->ground, cfg);
     if (rc < 0)
         return rc;
-    rc = lidet_ground_init(&g_ground, &c);
-    if (rc < 0)
-        return rc;
-    lidet_proj_image(&g_proj, &img);
-    rc = lidet_ground_run(&g_ground, &img);
+    lidet_proj_image(&ctx->proj, &img);
+    rc = lidet_ground_run(&ctx->ground, &img);
     if (rc < 0)
         return rc;
     npix = (uint32_t)img.n_rows * img.n_cols;
     if (mask_pixel != NULL)
-        memcpy(mask_pixel, lidet_ground_mask(&g_ground), npix);
+        memcpy(mask_pixel, lidet_ground_mask(&ctx->ground), npix);
     if (sample_pixel != NULL)
-        memcpy(sample_pixel, lidet_ground_samples(&g_ground), npix);
-    pp = lidet_proj_point_pixels(&g_proj, &np);
+        memcpy(sample_pixel, lidet_ground_samples(&ctx->ground), npix);
+    pp = lidet_proj_point_pixels(&ctx->proj, &np);
     if (mask_point != NULL)
     {
-        const int r2 = lidet_ground_point_labels(&g_ground, pp, np, mask_point);
+        const int r2 = lidet_ground_point_labels(&ctx->ground, pp, np, mask_point);
         if (r2 < 0)
             return r2;
     }
     {
-        const lidet_plane_t *pl = lidet_ground_planes(&g_ground, &ns);
-        const uint8_t *src = lidet_ground_sector_source(&g_ground);
+        const lidet_plane_t *pl = lidet_ground_planes(&ctx->ground, &ns);
+        const uint8_t *src = lidet_ground_sector_source(&ctx->ground);
         for (s = 0; s < 2u * ns; ++s)
         {
             if (planes != NULL)
@@ -284,22 +338,8 @@ LIDET_PY_API int lidet_py_ground_run(const float *cfg_f, const uint32_t *cfg_u, 
                 source[s] = src[s];
         }
     }
-    st = lidet_ground_stats(&g_ground);
     if (stats != NULL)
-    {
-        stats[0] = 0;
-        stats[1] = st->n_samples;
-        stats[2] = st->n_samples_dropped;
-        stats[3] = st->n_ground;
-        stats[4] = st->n_sectors_fitted;
-        stats[5] = st->n_sectors_neighbour;
-        stats[6] = st->n_sectors_mount;
-        stats[7] = st->n_sectors_sparse;
-        stats[8] = st->n_sectors_rejected;
-        stats[9] = st->n_hypotheses;
-        stats[10] = st->n_far_fitted;
-        stats[11] = st->n_vetoed;
-    }
+        *stats = *lidet_ground_stats(&ctx->ground);
     return rc;
 }
 
@@ -324,42 +364,41 @@ LIDET_PY_API const char *lidet_py_status_str(int status)
 }
 
 /* ---- clustering + proposals ------------------------------------------------------------------ */
-static lidet_cluster_t g_cluster;
-static uint8_t g_ground_pix[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 
-/* Project with the state of lidet_py_proj_init, then cluster. ground_per_point: n bytes (1 = ground)
- * or NULL; a pixel is ground when its winning point is. planes: n_sectors * 4 floats (nx, ny, nz, d)
- * or NULL. cfg_f: theta_rad, max_extent_m, max_mean_height_m, mount_height_m,
- * max_gap_m, max_gap_per_m, rescue_gap_m, rescue_gap_per_m; cfg_u: max_steps,
- * min_points, bridge_occluders, diagonals, rescue_rows, rescue_cols. Outputs (any may be NULL): out_point_labels n uint32 (0 for points past capacity),
- * out_pixel_labels rows * cols uint16, out_members rows * cols int32 (first n_pixels_kept used),
- * out_rec_u max_recs * 4 uint32 (n_points, first_member, seed_pixel, n_rescued), out_rec_f max_recs * 10
- * floats (mean xyz, min xyz, max xyz, height), out_n_recs, out_stats 12 uint32 (n_candidates, n_found,
- * n_dropped_small, _extent, _height, _capacity, n_kept, n_pixels_kept, n_queue_overflow, n_fragments,
- * n_rescue_joined, n_rescue_pixels). */
-LIDET_PY_API int lidet_py_cluster_run(const float *pts, uint32_t n, uint32_t stride, const uint8_t *ground_per_point,
-                                      const float *planes, uint32_t n_sectors, const float *cfg_f,
-                                      const uint32_t *cfg_u, uint32_t *out_point_labels, uint16_t *out_pixel_labels,
-                                      int32_t *out_members, uint32_t *out_rec_u, float *out_rec_f, uint32_t max_recs,
-                                      uint32_t *out_n_recs, uint32_t *out_stats)
+/* Project with the context's projection, then cluster. ground_per_point: n bytes (1 = ground) or NULL; a
+ * pixel is ground when its winning point is. planes: n_sectors * 4 floats (nx, ny, nz, d) or NULL.
+ * Outputs (any may be NULL): out_point_labels n uint32 (0 for points past capacity), out_pixel_labels
+ * rows * cols uint16, out_members rows * cols int32 (first n_pixels_kept used), out_rec_u max_recs * 4
+ * uint32 (n_points, first_member, seed_pixel, n_rescued), out_rec_f max_recs * 10 floats (mean xyz, min
+ * xyz, max xyz, height), out_n_recs, out_stats a lidet_cluster_stats_t. */
+LIDET_PY_API int lidet_py_cluster_run(lidet_py_ctx_t *ctx, const float *pts, uint32_t n, uint32_t stride,
+                                      const uint8_t *ground_per_point, const float *planes, uint32_t n_sectors,
+                                      const lidet_cluster_cfg_t *cfg, uint32_t *out_point_labels,
+                                      uint16_t *out_pixel_labels, int32_t *out_members, uint32_t *out_rec_u,
+                                      float *out_rec_f, uint32_t max_recs, uint32_t *out_n_recs,
+                                      lidet_cluster_stats_t *out_stats)
 {
     lidet_range_image_t img;
-    lidet_cluster_cfg_t cfg;
     lidet_plane_t pl[256];
     const lidet_cluster_rec_t *rec;
     const lidet_cluster_stats_t *st;
     uint32_t npix, p, k, np;
     const int32_t *pp;
     int rc;
-    rc = lidet_proj_run(&g_proj, pts, n, stride, NULL);
+    if (ctx == NULL || !ctx->proj_ready)
+        return LIDET_ERR_STATE;
+    if (cfg == NULL)
+        return LIDET_ERR_ARG;
+    ctx->cluster_ready = 0;
+    rc = lidet_proj_run(&ctx->proj, pts, n, stride, NULL);
     if (rc < 0)
         return rc;
-    lidet_proj_image(&g_proj, &img);
+    lidet_proj_image(&ctx->proj, &img);
     npix = (uint32_t)img.n_rows * img.n_cols;
     if (ground_per_point != NULL)
     {
         for (p = 0; p < npix; ++p)
-            g_ground_pix[p] = (uint8_t)(img.point_idx[p] >= 0 && ground_per_point[img.point_idx[p]] != 0);
+            ctx->ground_pix[p] = (uint8_t)(img.point_idx[p] >= 0 && ground_per_point[img.point_idx[p]] != 0);
     }
     if (planes != NULL)
     {
@@ -373,41 +412,27 @@ LIDET_PY_API int lidet_py_cluster_run(const float *pts, uint32_t n, uint32_t str
             pl[k].d_m = planes[4 * k + 3];
         }
     }
-    lidet_cluster_cfg_default(&cfg, NULL);
-    cfg.theta_rad = cfg_f[0];
-    cfg.max_extent_m = cfg_f[1];
-    cfg.max_mean_height_m = cfg_f[2];
-    cfg.mount_height_m = cfg_f[3];
-    cfg.max_gap_m = cfg_f[4];
-    cfg.max_gap_per_m = cfg_f[5];
-    cfg.rescue_gap_m = cfg_f[6];
-    cfg.rescue_gap_per_m = cfg_f[7];
-    cfg.max_steps = cfg_u[0];
-    cfg.min_points = cfg_u[1];
-    cfg.bridge_occluders = cfg_u[2];
-    cfg.diagonals = cfg_u[3];
-    cfg.rescue_rows = cfg_u[4];
-    cfg.rescue_cols = cfg_u[5];
-    rc = lidet_cluster_init(&g_cluster, &cfg);
+    rc = lidet_cluster_init(&ctx->cluster, cfg);
     if (rc < 0)
         return rc;
-    rc = lidet_cluster_run(&g_cluster, &img, ground_per_point != NULL ? g_ground_pix : NULL,
+    rc = lidet_cluster_run(&ctx->cluster, &img, ground_per_point != NULL ? ctx->ground_pix : NULL,
                            planes != NULL ? pl : NULL, n_sectors);
     if (rc < 0)
         return rc;
-    pp = lidet_proj_point_pixels(&g_proj, &np);
+    ctx->cluster_ready = 1;
+    pp = lidet_proj_point_pixels(&ctx->proj, &np);
     if (out_point_labels != NULL)
     {
-        lidet_cluster_point_labels(&g_cluster, pp, np, out_point_labels);
+        lidet_cluster_point_labels(&ctx->cluster, pp, np, out_point_labels);
         for (p = np; p < n; ++p)
             out_point_labels[p] = 0;
     }
     if (out_pixel_labels != NULL)
-        memcpy(out_pixel_labels, lidet_cluster_labels(&g_cluster), npix * sizeof(uint16_t));
-    st = lidet_cluster_stats(&g_cluster);
+        memcpy(out_pixel_labels, lidet_cluster_labels(&ctx->cluster), npix * sizeof(uint16_t));
+    st = lidet_cluster_stats(&ctx->cluster);
     if (out_members != NULL)
-        memcpy(out_members, lidet_cluster_members(&g_cluster), st->n_pixels_kept * sizeof(int32_t));
-    rec = lidet_cluster_records(&g_cluster, &k);
+        memcpy(out_members, lidet_cluster_members(&ctx->cluster), st->n_pixels_kept * sizeof(int32_t));
+    rec = lidet_cluster_records(&ctx->cluster, &k);
     if (out_n_recs != NULL)
         *out_n_recs = k;
     for (p = 0; p < k && p < max_recs; ++p)
@@ -429,49 +454,36 @@ LIDET_PY_API int lidet_py_cluster_run(const float *pts, uint32_t n, uint32_t str
         }
     }
     if (out_stats != NULL)
-    {
-        out_stats[0] = st->n_candidates;
-        out_stats[1] = st->n_found;
-        out_stats[2] = st->n_dropped_small;
-        out_stats[3] = st->n_dropped_extent;
-        out_stats[4] = st->n_dropped_height;
-        out_stats[5] = st->n_dropped_capacity;
-        out_stats[6] = st->n_kept;
-        out_stats[7] = st->n_pixels_kept;
-        out_stats[8] = st->n_queue_overflow;
-        out_stats[9] = st->n_fragments;
-        out_stats[10] = st->n_rescue_joined;
-        out_stats[11] = st->n_rescue_pixels;
-    }
+        *out_stats = *st;
     return rc;
 }
 
-/* Proposals of every kept cluster of the last lidet_py_cluster_run (its scan must still be alive on
- * the Python side: the range image points into the projection state, which holds copies).
- * out_xyz: n_clusters * n_points * 3 floats, out_mean: n_clusters * 3, out_voxel: n_clusters * 3
- * int16, out_n_src: n_clusters uint32. */
-LIDET_PY_API int lidet_py_proposals(uint32_t n_points, uint32_t seed, float az_bin_rad, float el_bin_rad,
-                                    float range_bin_m, uint32_t n_clusters, float *out_xyz, float *out_mean,
-                                    int16_t *out_voxel, uint32_t *out_n_src)
+/* Proposals of the first n_clusters kept clusters of the context's last lidet_py_cluster_run (the
+ * context holds that scan's image: no other call can change it). out_xyz: n_clusters * n_points * 3
+ * floats, out_mean: n_clusters * 3, out_voxel: n_clusters * 3 int16, out_n_src: n_clusters uint32. */
+LIDET_PY_API int lidet_py_proposals(lidet_py_ctx_t *ctx, const lidet_proposal_cfg_t *cfg, uint32_t n_clusters,
+                                    float *out_xyz, float *out_mean, int16_t *out_voxel, uint32_t *out_n_src)
 {
-    static lidet_proposal_t pr;
-    lidet_proposal_cfg_t cfg;
-    uint32_t i;
-    lidet_proposal_cfg_default(&cfg);
-    cfg.n_points = n_points;
-    cfg.seed = seed;
-    cfg.azimuth_bin_rad = az_bin_rad;
-    cfg.elevation_bin_rad = el_bin_rad;
-    cfg.range_bin_m = range_bin_m;
+    lidet_proposal_t *const pr = &ctx->proposal;
+    uint32_t i, k;
+    if (ctx == NULL)
+        return LIDET_ERR_ARG;
+    if (!ctx->cluster_ready)
+        return LIDET_ERR_STATE;
+    if (cfg == NULL)
+        return LIDET_ERR_ARG;
+    lidet_cluster_records(&ctx->cluster, &k);
+    if (n_clusters > k)
+        return LIDET_ERR_ARG;
     for (i = 0; i < n_clusters; ++i)
     {
-        const int rc = lidet_proposal_make(&g_cluster, i, &cfg, &pr);
+        const int rc = lidet_proposal_make(&ctx->cluster, i, cfg, pr);
         if (rc < 0)
             return rc;
-        memcpy(out_xyz + (size_t)i * n_points * 3, pr.xyz, (size_t)n_points * 3 * sizeof(float));
-        memcpy(out_mean + 3 * i, pr.mean_m, 3 * sizeof(float));
-        memcpy(out_voxel + 3 * i, pr.voxel, 3 * sizeof(int16_t));
-        out_n_src[i] = pr.n_points_src;
+        memcpy(out_xyz + (size_t)i * cfg->n_points * 3, pr->xyz, (size_t)cfg->n_points * 3 * sizeof(float));
+        memcpy(out_mean + 3 * i, pr->mean_m, 3 * sizeof(float));
+        memcpy(out_voxel + 3 * i, pr->voxel, 3 * sizeof(int16_t));
+        out_n_src[i] = pr->n_points_src;
     }
     return 0;
 }
@@ -479,12 +491,4 @@ LIDET_PY_API int lidet_py_proposals(uint32_t n_points, uint32_t seed, float az_b
 LIDET_PY_API int lidet_py_proposal_indices(uint32_t n_src, uint32_t n_out, uint32_t seed, uint32_t *out)
 {
     return lidet_proposal_indices(n_src, n_out, seed, out);
-}
-
-/* The image of the last projection, copied out without running again (same layout as
- * lidet_py_proj_run's outputs; any output may be NULL). */
-LIDET_PY_API int lidet_py_proj_copy(float *out_img, int32_t *out_idx, int32_t *out_point_pixel, uint32_t *out_stats,
-                                    float *out_row_elev)
-{
-    return lidet_py_proj_run_outputs(out_img, out_idx, out_point_pixel, out_stats, out_row_elev);
 }

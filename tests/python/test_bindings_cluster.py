@@ -65,12 +65,15 @@ def test_synthetic_objects_are_separate_clusters():
 
 
 def test_defaults_and_options():
+    f = np.float32  # the defaults come from C: float32 values
     d = native.cluster_defaults("hdl64")
-    assert d["min_points"] == 10 and d["max_steps"] == 5 and d["theta_rad"] == 0.18 and d["diagonals"] == 1
-    assert d["max_gap_m"] == 0.7 and d["max_gap_per_m"] == 0.025 and d["bridge_occluders"] == 1
-    assert d["rescue_gap_m"] == 0.8 and d["rescue_gap_per_m"] == 0.03 and d["rescue_rows"] == 2 and d["rescue_cols"] == 6
+    assert d["min_points"] == 10 and d["max_steps"] == 5 and d["theta_rad"] == f(0.18) and d["diagonals"] == 1
+    assert d["max_gap_m"] == f(0.7) and d["max_gap_per_m"] == f(0.025) and d["bridge_occluders"] == 1
+    assert d["rescue_gap_m"] == f(0.8) and d["rescue_gap_per_m"] == f(0.03) and d["rescue_rows"] == 2
+    assert d["rescue_cols"] == 6 and d["mount_height_m"] == f(1.73)
     v = native.cluster_defaults("vlp16")
-    assert v["theta_rad"] == 0.12 and v["max_steps"] == 4 and v["bridge_occluders"] == 0 and v["max_gap_per_m"] == 0.04
+    assert v["theta_rad"] == f(0.12) and v["max_steps"] == 4 and v["bridge_occluders"] == 0
+    assert v["max_gap_per_m"] == f(0.04)
     assert v["rescue_rows"] == 1
     pts, ground, _, _ = _synthetic()
     a = native.cluster(pts, "hdl64", ground=ground, min_points=100000, rescue_gap_m=0.0)
@@ -150,8 +153,8 @@ def test_proposals_match_reference(real_dir):
     c = native.cluster(pts, "hdl64", ground=ground, with_image=True)
     assert len(c) > 20
     for n_points in (16, 64):
-        p = native.proposals(n_clusters=len(c), n_points=n_points)
-        p2 = native.proposals(n_clusters=len(c), n_points=n_points)
+        p = native.proposals(c, n_points=n_points)
+        p2 = native.proposals(c, n_points=n_points)
         np.testing.assert_array_equal(p.xyz, p2.xyz)
         xyz = np.stack([c.image.x, c.image.y, c.image.z], -1).reshape(-1, 3)
         edge = 0

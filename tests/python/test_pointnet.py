@@ -34,7 +34,7 @@ def _scan_proposals(path, sensor, seeds):
     cl = native.cluster(pts, sensor, ground=g.mask_point, planes=g.planes)
     out = []
     for s in seeds:
-        out.append(native.proposals(len(cl), n_points=64, seed=s))
+        out.append(native.proposals(cl, n_points=64, seed=s))
     return out
 
 

@@ -23,7 +23,7 @@ def _proposals(native, kitti, real: pathlib.Path):
         pts = kitti.read_bin(path)
         g = native.ground(pts, sensor)
         cl = native.cluster(pts, sensor, ground=g.mask_point, planes=g.planes)
-        props.append(native.proposals(len(cl), n_points=64))
+        props.append(native.proposals(cl, n_points=64))
     return (np.concatenate([p.xyz for p in props]), np.concatenate([p.mean for p in props]),
             np.concatenate([p.voxel for p in props]), len(scans))
 

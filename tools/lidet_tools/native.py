@@ -6,15 +6,20 @@ The shared library `liblidet_py.so` is built by CMake (ports/python). It is foun
 `$LIDET_LIB`, under `$LIDET_BUILD_DIR/ports/python/`, or under `<repo>/build/ports/python/`
 (`make build` puts it there).
 
-Every function takes numpy arrays and returns numpy arrays; nothing is retained by the C side
-between calls except the stage's own workspace (so these calls are not thread-safe).
+Every call works on an explicit scan context: a C object holding one scan's stage states. `project`,
+`ground` and `cluster` each run on a fresh one, and what they return keeps it (`Clusters` keeps the
+scan it clustered), so `proposals(clusters)` always reads the scan of that `cluster` call, whatever
+ran in between. Configurations and statistics cross the boundary as the C structs themselves, by
+field name: the layout (names, offsets, sizes) comes from the C side (`lidet_py_field`), and every
+default from the C `*_cfg_default` functions.
 """
 from __future__ import annotations
 
 import ctypes as C
 import os
 import pathlib
-from dataclasses import dataclass
+import weakref
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -72,27 +77,94 @@ def lib():
         L.lidet_py_status_str.argtypes = [C.c_int]
         L.lidet_py_capacity.argtypes = [_u32p]
         L.lidet_py_sensor.argtypes = [C.c_uint32, C.c_char_p, _u32p, _f32p, C.POINTER(C.c_float)]
-        L.lidet_py_proj_init.argtypes = [C.c_uint32, C.c_uint32, _opt(_f32p), C.c_float, C.c_float,
-                                         C.c_float, C.c_float, C.c_float, C.c_float]
-        L.lidet_py_proj_run.argtypes = [_opt(_f32p), C.c_uint32, C.c_uint32,
-                                        _opt(np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")),
-                                        _opt(_f32p), _opt(_i32p), _opt(_i32p), _opt(_u32p), _opt(_f32p)]
+        V = C.c_void_p  # a scan context, or a struct passed by pointer (numpy record's address)
         _u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
-        L.lidet_py_ground_default.argtypes = [C.c_uint32, C.c_uint32, C.c_float, _f32p, _u32p]
-        L.lidet_py_ground_run.argtypes = [_f32p, _u32p, _opt(_u8p), _opt(_u8p), _opt(_u8p), _opt(_f32p),
-                                          _opt(_u8p), _opt(_u32p)]
-        L.lidet_py_ground_fit_plane.argtypes = [_f32p, _f32p, _f32p, C.c_uint32, _f32p, _opt(_f32p)]
         _u16p = np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")
         _i16p = np.ctypeslib.ndpointer(np.int16, flags="C_CONTIGUOUS")
-        L.lidet_py_cluster_run.argtypes = [_opt(_f32p), C.c_uint32, C.c_uint32, _opt(_u8p), _opt(_f32p),
-                                           C.c_uint32, _f32p, _u32p, _opt(_u32p), _opt(_u16p), _opt(_i32p),
-                                           _opt(_u32p), _opt(_f32p), C.c_uint32, _opt(_u32p), _opt(_u32p)]
-        L.lidet_py_proposals.argtypes = [C.c_uint32, C.c_uint32, C.c_float, C.c_float, C.c_float, C.c_uint32,
-                                         _f32p, _f32p, _i16p, _u32p]
-        L.lidet_py_proj_copy.argtypes = [_opt(_f32p), _opt(_i32p), _opt(_i32p), _opt(_u32p), _opt(_f32p)]
+        L.lidet_py_ctx_new.restype = V
+        L.lidet_py_ctx_new.argtypes = []
+        L.lidet_py_ctx_free.restype = None
+        L.lidet_py_ctx_free.argtypes = [V]
+        L.lidet_py_field.argtypes = [C.c_uint32, C.POINTER(C.c_char_p), C.POINTER(C.c_uint32),
+                                     C.POINTER(C.c_char_p), C.POINTER(C.c_uint32), C.POINTER(C.c_uint32),
+                                     C.POINTER(C.c_char)]
+        for f in ("lidet_py_proj_default", "lidet_py_proposal_default"):
+            getattr(L, f).restype = None
+            getattr(L, f).argtypes = [V]
+        for f in ("lidet_py_ground_default", "lidet_py_cluster_default"):
+            getattr(L, f).restype = None
+            getattr(L, f).argtypes = [C.c_uint32, C.c_uint32, C.c_float, V]
+        L.lidet_py_proj_init.argtypes = [V, C.c_uint32, C.c_uint32, _opt(_f32p), C.c_float, C.c_float, C.c_float, V]
+        L.lidet_py_proj_run.argtypes = [V, _opt(_f32p), C.c_uint32, C.c_uint32, _opt(_u16p),
+                                        _opt(_f32p), _opt(_i32p), _opt(_i32p), V, _opt(_f32p)]
+        L.lidet_py_proj_copy.argtypes = [V, _opt(_f32p), _opt(_i32p), _opt(_i32p), V, _opt(_f32p)]
+        L.lidet_py_ground_run.argtypes = [V, V, _opt(_u8p), _opt(_u8p), _opt(_u8p), _opt(_f32p), _opt(_u8p), V]
+        L.lidet_py_ground_fit_plane.argtypes = [_f32p, _f32p, _f32p, C.c_uint32, _f32p, _opt(_f32p)]
+        L.lidet_py_cluster_run.argtypes = [V, _opt(_f32p), C.c_uint32, C.c_uint32, _opt(_u8p), _opt(_f32p),
+                                           C.c_uint32, V, _opt(_u32p), _opt(_u16p), _opt(_i32p),
+                                           _opt(_u32p), _opt(_f32p), C.c_uint32, _opt(_u32p), V]
+        L.lidet_py_proposals.argtypes = [V, V, C.c_uint32, _f32p, _f32p, _i16p, _u32p]
         L.lidet_py_proposal_indices.argtypes = [C.c_uint32, C.c_uint32, C.c_uint32, _u32p]
         _lib = L
     return _lib
+
+
+_layouts: dict | None = None
+_KIND = {("f", 4): "<f4", ("u", 1): "u1", ("u", 2): "<u2", ("u", 4): "<u4", ("i", 1): "i1", ("i", 2): "<i2",
+         ("i", 4): "<i4"}
+
+
+def struct_layouts() -> dict:
+    """C struct name -> numpy structured dtype with the C field names, offsets and total size (from the
+    C side's offsetof table, so it follows the header: nothing is kept in step by hand)."""
+    global _layouts
+    if _layouts is None:
+        fields: dict = {}
+        i = 0
+        while True:
+            t, f = C.c_char_p(), C.c_char_p()
+            tsize, off, size, kind = C.c_uint32(), C.c_uint32(), C.c_uint32(), C.c_char()
+            if lib().lidet_py_field(i, C.byref(t), C.byref(tsize), C.byref(f), C.byref(off), C.byref(size),
+                                    C.byref(kind)) != 0:
+                break
+            ent = fields.setdefault(t.value.decode(), {"names": [], "formats": [], "offsets": [],
+                                                      "itemsize": int(tsize.value)})
+            ent["names"].append(f.value.decode())
+            ent["formats"].append(_KIND[(kind.value.decode(), int(size.value))])
+            ent["offsets"].append(int(off.value))
+            i += 1
+        _layouts = {k: np.dtype(v) for k, v in fields.items()}
+    return _layouts
+
+
+def _record(type_name: str, values: dict | None = None) -> np.ndarray:
+    """A zeroed C struct (numpy record, shape (1,)) with `values` set by field name."""
+    dt = struct_layouts()[type_name]
+    rec = np.zeros(1, dt)
+    for k, v in (values or {}).items():
+        if k not in dt.names:
+            raise TypeError(f"{type_name} has no field {k!r}")
+        rec[k] = v
+    return rec
+
+
+def _to_dict(rec: np.ndarray) -> dict:
+    return {k: (float(rec[k][0]) if rec.dtype[k].kind == "f" else int(rec[k][0])) for k in rec.dtype.names}
+
+
+def _addr(rec: np.ndarray) -> int:
+    return rec.ctypes.data
+
+
+class ScanContext:
+    """One scan's C states (lidet_py_ctx_t): the projection, ground and clustering of that scan only.
+    Freed when the last object referring to it goes away."""
+
+    def __init__(self):
+        self.ptr = lib().lidet_py_ctx_new()
+        if not self.ptr:
+            raise MemoryError("lidet_py_ctx_new")
+        weakref.finalize(self, lib().lidet_py_ctx_free, self.ptr)
 
 
 def capacity() -> dict:
@@ -141,9 +213,6 @@ class RangeImage:
         return self.point_idx.shape
 
 
-_STAT_KEYS = ["n_points_in", "n_projected", "n_pixels_filled", "n_nonfinite", "n_too_close",
-              "n_too_far", "n_out_of_fov", "n_bad_ring", "n_truncated"]
-
 
 def _as_points(points) -> tuple[np.ndarray, int]:
     pts = np.ascontiguousarray(points, dtype=np.float32)
@@ -152,68 +221,79 @@ def _as_points(points) -> tuple[np.ndarray, int]:
     return pts, pts.shape[1]
 
 
-def proj_init(sensor: str | Sensor = "hdl64", min_range_m: float = 0.1, max_range_m: float = 0.0,
-              fov_margin_rad: float = np.radians(5.0)) -> Sensor:
-    """Initialise the C projection for a preset name or a `Sensor` (custom table)."""
+def proj_defaults() -> dict:
+    """lidet_proj_cfg_default's tunables (min_range_m, max_range_m, fov_margin_rad), from C."""
+    rec = _record("lidet_proj_cfg_t")
+    lib().lidet_py_proj_default(_addr(rec))
+    return _to_dict(rec)
+
+
+def proj_init(sensor: str | Sensor = "hdl64", ctx: ScanContext | None = None, **cfg) -> tuple[Sensor, ScanContext]:
+    """Initialise the C projection of a scan context (a new one unless given) for a preset name or a
+    `Sensor` (custom table). cfg: fields of lidet_proj_cfg_t (defaults: `proj_defaults()`)."""
     s = get_sensor(sensor) if isinstance(sensor, str) else sensor
+    full = proj_defaults()
+    unknown = set(cfg) - set(full)
+    if unknown:
+        raise TypeError(f"unknown projection config field(s): {sorted(unknown)}")
+    full.update(cfg)
+    ctx = ctx or ScanContext()
     elev = np.ascontiguousarray(s.beam_elev_rad, dtype=np.float32)
-    st = lib().lidet_py_proj_init(s.rows, s.cols, elev, 0.0, 0.0, s.mount_height_m, min_range_m,
-                                  max_range_m, fov_margin_rad)
+    st = lib().lidet_py_proj_init(ctx.ptr, s.rows, s.cols, elev, 0.0, 0.0, s.mount_height_m,
+                                  _addr(_record("lidet_proj_cfg_t", full)))
     if st < 0:
         raise LidetError(st, "lidet_proj_init")
-    return s
+    return s, ctx
 
 
-def project(points, sensor: str | Sensor = "hdl64", ring=None, **cfg) -> RangeImage:
-    """Project (N, >=3) points (x, y, z first) with the C library. `ring`: optional (N,) uint16."""
-    s = proj_init(sensor, **cfg)
-    pts, stride = _as_points(points)
-    n = len(pts)
-    cap = capacity()["max_points"]
+def _copy_image(ctx: ScanContext, s: Sensor, n: int, status: int) -> RangeImage:
+    """The range image held by a context (copied out)."""
     rows, cols = s.rows, s.cols
     img = np.zeros((5, rows, cols), np.float32)
     idx = np.zeros((rows, cols), np.int32)
-    pp = np.full(n, -1, np.int32)
-    stats = np.zeros(9, np.uint32)
+    stats = _record("lidet_proj_stats_t")
     row_elev = np.zeros(rows, np.float32)
+    pp = np.full(n, -1, np.int32)
+    st = lib().lidet_py_proj_copy(ctx.ptr, img, idx, pp[: min(n, capacity()["max_points"])] if n else None,
+                                  _addr(stats), row_elev)
+    if st < 0:
+        raise LidetError(st, "lidet_py_proj_copy")
+    return RangeImage(img[0], img[1], img[2], img[3], img[4], idx, pp, row_elev, _to_dict(stats), status)
+
+
+def _project_into(ctx: ScanContext, s: Sensor, points, ring=None) -> RangeImage:
+    pts, stride = _as_points(points)
+    n = len(pts)
     rg = None
     if ring is not None:
         rg = np.ascontiguousarray(ring, dtype=np.uint16)
         if rg.shape != (n,):
             raise ValueError(f"ring must have one entry per point ({n}), got {rg.shape}")
-    st = lib().lidet_py_proj_run(pts if n else None, n, stride, rg, img, idx, pp[: min(n, cap)] if n else None,
-                                 stats, row_elev)
+    st = lib().lidet_py_proj_run(ctx.ptr, pts if n else None, n, stride, rg, None, None, None, None, None)
     if st < 0:
         raise LidetError(st, "lidet_proj_run")
-    return RangeImage(img[0], img[1], img[2], img[3], img[4], idx, pp, row_elev,
-                      dict(zip(_STAT_KEYS, map(int, stats))), int(st))
+    return _copy_image(ctx, s, n, int(st))
+
+
+def project(points, sensor: str | Sensor = "hdl64", ring=None, **cfg) -> RangeImage:
+    """Project (N, >=3) points (x, y, z first) with the C library, on a scan context of its own.
+    `ring`: optional (N,) uint16. cfg: fields of lidet_proj_cfg_t."""
+    s, ctx = proj_init(sensor, **cfg)
+    return _project_into(ctx, s, points, ring)
 
 
 # --------------------------------------------------------------------------------------------
 # Ground stage (lidet_ground.h)
 
-#: float and integer fields of lidet_ground_cfg_t, in the order of ports/python/lidet_py.c
-GROUND_F = ["fy_max", "fx_max_m", "gate_above_m", "gate_below_m", "mount_height_m", "inlier_m",
-            "max_tilt_rad", "max_height_dev_m", "ground_m", "ground_m_per_m", "below_factor", "confidence", "ring_split_m",
-            "veto_slope", "veto_min_dz_m"]
-GROUND_U = ["fx_on_z", "require_descending", "height_gate", "n_sectors", "ransac_iters", "eval_samples",
-            "min_samples", "min_inliers", "refine_iters", "fallback_sectors", "seed", "sample_step",
-            "sample_col_step"]
-_GROUND_STATS = ["_unused", "n_samples", "n_samples_dropped", "n_ground", "n_sectors_fitted",
-                 "n_sectors_neighbour", "n_sectors_mount", "n_sectors_sparse", "n_sectors_rejected",
-                 "n_hypotheses", "n_far_fitted", "n_vetoed"]
 PLANE_SOURCE = {0: "fitted", 1: "neighbour", 2: "mount", 3: "near"}
 
 
 def ground_defaults(sensor: str | Sensor = "hdl64") -> dict:
-    """lidet_ground_cfg_default for a preset name or a `Sensor` (as a dict of field -> value)."""
+    """lidet_ground_cfg_default for a preset name or a `Sensor` (as a dict of field -> value), from C."""
     s = get_sensor(sensor) if isinstance(sensor, str) else sensor
-    f = np.zeros(len(GROUND_F), np.float32)
-    u = np.zeros(len(GROUND_U), np.uint32)
-    lib().lidet_py_ground_default(s.rows, s.cols, s.mount_height_m, f, u)
-    out = {k: float(v) for k, v in zip(GROUND_F, f)}
-    out.update({k: int(v) for k, v in zip(GROUND_U, u)})
-    return out
+    rec = _record("lidet_ground_cfg_t")
+    lib().lidet_py_ground_default(s.rows, s.cols, s.mount_height_m, _addr(rec))
+    return _to_dict(rec)
 
 
 @dataclass
@@ -235,17 +315,16 @@ class GroundResult:
 
 
 def ground(points, sensor: str | Sensor = "hdl64", ring=None, proj_cfg: dict | None = None, **cfg) -> GroundResult:
-    """Project (N, >=3) points with the C projection, then segment the ground with the C ground stage.
-    `cfg` overrides fields of lidet_ground_cfg_default(sensor) (names as in lidet_ground_cfg_t)."""
-    s = get_sensor(sensor) if isinstance(sensor, str) else sensor
+    """Project (N, >=3) points with the C projection, then segment the ground with the C ground stage,
+    on a scan context of its own. `cfg` overrides fields of lidet_ground_cfg_default(sensor) (names as in
+    lidet_ground_cfg_t)."""
+    s, ctx = proj_init(sensor, **(proj_cfg or {}))
     full = ground_defaults(s)
     unknown = set(cfg) - set(full)
     if unknown:
         raise TypeError(f"unknown ground config field(s): {sorted(unknown)}")
     full.update(cfg)
-    img = project(points, s, ring=ring, **(proj_cfg or {}))
-    f = np.array([full[k] for k in GROUND_F], np.float32)
-    u = np.array([full[k] for k in GROUND_U], np.uint32)
+    img = _project_into(ctx, s, points, ring)
     n = len(img.point_pixel)
     rows, cols = img.shape
     ns = int(full["n_sectors"])
@@ -254,13 +333,13 @@ def ground(points, sensor: str | Sensor = "hdl64", ring=None, proj_cfg: dict | N
     mpt = np.zeros(n, np.uint8)
     planes = np.zeros((2 * max(ns, 1), 4), np.float32)
     src = np.zeros(2 * max(ns, 1), np.uint8)
-    stats = np.zeros(len(_GROUND_STATS), np.uint32)
+    stats = _record("lidet_ground_stats_t")
     cap = capacity()["max_points"]
-    st = lib().lidet_py_ground_run(f, u, mp, sp, mpt[: min(n, cap)] if n else None, planes, src, stats)
+    st = lib().lidet_py_ground_run(ctx.ptr, _addr(_record("lidet_ground_cfg_t", full)), mp, sp,
+                                   mpt[: min(n, cap)] if n else None, planes, src, _addr(stats))
     if st < 0:
         raise LidetError(st, "lidet_ground_run")
-    return GroundResult(mpt, mp, planes[:ns], planes[ns:2 * ns], dict(zip(_GROUND_STATS, map(int, stats))), sp,
-                        src[:2 * ns], img, int(st))
+    return GroundResult(mpt, mp, planes[:ns], planes[ns:2 * ns], _to_dict(stats), sp, src[:2 * ns], img, int(st))
 
 
 def ground_fit_plane(xyz) -> tuple[np.ndarray, np.ndarray]:
@@ -276,19 +355,12 @@ def ground_fit_plane(xyz) -> tuple[np.ndarray, np.ndarray]:
 
 # ---- clustering and proposals (lib/include/lidet/lidet_cluster.h) -------------------------------
 
-#: per-profile defaults of lidet_cluster_cfg_default (kept identical by tests/python/test_bindings_cluster.py)
 def cluster_defaults(sensor: str | Sensor = "hdl64") -> dict:
+    """lidet_cluster_cfg_default for a preset name or a `Sensor` (field -> value), from C."""
     s = get_sensor(sensor) if isinstance(sensor, str) else sensor
-    sparse = s.rows <= 16
-    return dict(theta_rad=0.12 if sparse else 0.18, max_steps=4 if sparse else 5, bridge_occluders=0 if sparse else 1,
-                diagonals=1, max_gap_m=0.7, max_gap_per_m=0.04 if sparse else 0.025, min_points=10, max_extent_m=6.0,
-                max_mean_height_m=2.5, mount_height_m=float(s.mount_height_m), rescue_gap_m=0.8,
-                rescue_gap_per_m=0.03, rescue_rows=1 if sparse else 2, rescue_cols=6)
-
-
-_CLUSTER_STAT_KEYS = ["n_candidates", "n_found", "n_dropped_small", "n_dropped_extent", "n_dropped_height",
-                      "n_dropped_capacity", "n_kept", "n_pixels_kept", "n_queue_overflow", "n_fragments",
-                      "n_rescue_joined", "n_rescue_pixels"]
+    rec = _record("lidet_cluster_cfg_t")
+    lib().lidet_py_cluster_default(s.rows, s.cols, s.mount_height_m, _addr(rec))
+    return _to_dict(rec)
 
 
 @dataclass
@@ -308,6 +380,7 @@ class Clusters:
     stats: dict
     status: int
     image: RangeImage | None = None  #: the projection of the same call (when asked for)
+    context: ScanContext | None = field(default=None, repr=False)  #: the scan these clusters belong to
 
     def __len__(self) -> int:
         return len(self.n_points)
@@ -324,12 +397,14 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     max_extent_m, max_mean_height_m, mount_height_m, rescue_gap_m, rescue_gap_per_m, rescue_rows, rescue_cols (defaults:
     `cluster_defaults(sensor)`).
     """
-    s = proj_init(sensor, **(proj_cfg or {}))
+    s, ctx = proj_init(sensor, **(proj_cfg or {}))
     c = cluster_defaults(s)
     unknown = set(cfg) - set(c)
     if unknown:
         raise TypeError(f"unknown cluster option(s): {sorted(unknown)}")
     c.update(cfg)
+    c["bridge_occluders"] = int(bool(c["bridge_occluders"]))
+    c["diagonals"] = int(bool(c["diagonals"]))
     pts, stride = _as_points(points)
     n = len(pts)
     rows, cols = s.rows, s.cols
@@ -342,43 +417,24 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     pl = None
     if planes is not None:
         pl = np.ascontiguousarray(planes, dtype=np.float32).reshape(-1, 4)
-    cfg_f = np.array([c["theta_rad"], c["max_extent_m"], c["max_mean_height_m"], c["mount_height_m"],
-                      c["max_gap_m"], c["max_gap_per_m"], c["rescue_gap_m"], c["rescue_gap_per_m"]], np.float32)
-    cfg_u = np.array([c["max_steps"], c["min_points"], int(bool(c["bridge_occluders"])), int(bool(c["diagonals"])),
-                      c["rescue_rows"], c["rescue_cols"]], np.uint32)
     pl_out = np.zeros(n, np.uint32)
     pix = np.zeros((rows, cols), np.uint16)
     mem = np.zeros(rows * cols, np.int32)
     ru = np.zeros((cap, 4), np.uint32)
     rf = np.zeros((cap, 10), np.float32)
     nrec = np.zeros(1, np.uint32)
-    stats = np.zeros(len(_CLUSTER_STAT_KEYS), np.uint32)
-    st = lib().lidet_py_cluster_run(pts if n else None, n, stride, gm if n else None, pl,
-                                    0 if pl is None else len(pl), cfg_f, cfg_u, pl_out if n else None, pix, mem,
-                                    ru, rf, cap, nrec, stats)
+    stats = _record("lidet_cluster_stats_t")
+    st = lib().lidet_py_cluster_run(ctx.ptr, pts if n else None, n, stride, gm if n else None, pl,
+                                    0 if pl is None else len(pl), _addr(_record("lidet_cluster_cfg_t", c)),
+                                    pl_out if n else None, pix, mem, ru, rf, cap, nrec, _addr(stats))
     if st < 0:
         raise LidetError(st, "lidet_cluster_run")
     k = int(nrec[0])
-    sd = dict(zip(_CLUSTER_STAT_KEYS, map(int, stats)))
-    img = None
-    if with_image:
-        img = _last_image(s, n)
+    sd = _to_dict(stats)
+    img = _copy_image(ctx, s, n, 0) if with_image else None
     return Clusters(pl_out, pix, mem[: sd["n_pixels_kept"]].copy(), ru[:k, 0].copy(), ru[:k, 1].copy(),
                     ru[:k, 2].copy(), ru[:k, 3].copy(), rf[:k, 0:3].copy(), rf[:k, 3:6].copy(), rf[:k, 6:9].copy(),
-                    rf[:k, 9].copy(), sd, int(st), img)
-
-
-def _last_image(s: Sensor, n: int) -> RangeImage:
-    """The range image of the last projection (re-read from the C state without running again)."""
-    rows, cols = s.rows, s.cols
-    img = np.zeros((5, rows, cols), np.float32)
-    idx = np.zeros((rows, cols), np.int32)
-    stats = np.zeros(9, np.uint32)
-    row_elev = np.zeros(rows, np.float32)
-    pp = np.full(n, -1, np.int32)
-    lib().lidet_py_proj_copy(img, idx, pp[: min(n, capacity()["max_points"])] if n else None, stats, row_elev)
-    return RangeImage(img[0], img[1], img[2], img[3], img[4], idx, pp, row_elev,
-                      dict(zip(_STAT_KEYS, map(int, stats))), 0)
+                    rf[:k, 9].copy(), sd, int(st), img, ctx)
 
 
 @dataclass
@@ -391,29 +447,38 @@ class Proposals:
 
 
 def proposal_defaults() -> dict:
-    return dict(n_points=min(64, capacity()["proposal_points"]), seed=0x5EED1234,
-                azimuth_bin_rad=float(np.float32(np.radians(10.0))),
-                elevation_bin_rad=float(np.float32(np.radians(10.0))), range_bin_m=1.0)
+    """lidet_proposal_cfg_default, from C."""
+    rec = _record("lidet_proposal_cfg_t")
+    lib().lidet_py_proposal_default(_addr(rec))
+    return _to_dict(rec)
 
 
-def proposals(n_clusters: int | None = None, **cfg) -> Proposals:
-    """Proposals of the kept clusters of the last `cluster` call (lidet_proposal_make, exactly as the
-    firmware builds them). cfg: n_points, seed, azimuth_bin_rad, elevation_bin_rad, range_bin_m."""
+def proposals(clusters: Clusters, n_clusters: int | None = None, **cfg) -> Proposals:
+    """Proposals of the kept clusters of `clusters` (the result of a `cluster` call), made by
+    lidet_proposal_make exactly as the firmware makes them, from that call's own scan (its context):
+    later `project`, `ground` or `cluster` calls do not change them. n_clusters: only the first ones
+    (default: all). cfg: fields of lidet_proposal_cfg_t (n_points, seed, azimuth_bin_rad,
+    elevation_bin_rad, range_bin_m)."""
+    if not isinstance(clusters, Clusters) or clusters.context is None:
+        raise TypeError("proposals() takes the Clusters returned by cluster() (the scan to read), "
+                        "e.g. proposals(c, n_points=64)")
     c = proposal_defaults()
     unknown = set(cfg) - set(c)
     if unknown:
         raise TypeError(f"unknown proposal option(s): {sorted(unknown)}")
     c.update(cfg)
-    if n_clusters is None:
-        raise ValueError("pass n_clusters=len(clusters) of the last cluster() call")
-    k, n = int(n_clusters), int(c["n_points"])
+    c["seed"] = int(c["seed"]) & 0xFFFFFFFF
+    k = len(clusters) if n_clusters is None else int(n_clusters)
+    if not 0 <= k <= len(clusters):
+        raise ValueError(f"n_clusters must be in [0, {len(clusters)}], got {k}")
+    n = int(c["n_points"])
     xyz = np.zeros((k, n, 3), np.float32)
     mean = np.zeros((k, 3), np.float32)
     vox = np.zeros((k, 3), np.int16)
     nsrc = np.zeros(k, np.uint32)
     if k:
-        st = lib().lidet_py_proposals(n, int(c["seed"]) & 0xFFFFFFFF, c["azimuth_bin_rad"], c["elevation_bin_rad"],
-                                      c["range_bin_m"], k, xyz, mean, vox, nsrc)
+        st = lib().lidet_py_proposals(clusters.context.ptr, _addr(_record("lidet_proposal_cfg_t", c)), k, xyz, mean,
+                                      vox, nsrc)
         if st < 0:
             raise LidetError(st, "lidet_proposal_make")
     return Proposals(xyz, mean, vox, nsrc)

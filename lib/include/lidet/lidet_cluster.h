@@ -5,7 +5,7 @@
  *        centred point sets plus a spherical voxel) handed to the PointNets.
  *
  * Algorithm (Bogoslavskyi & Stachniss 2016, in the variant of Seppänen et al.):
- *  - candidates: pixels holding a point (point_idx >= 0) that the ground mask does not mark;
+ *  - candidates: pixels holding a point (range_m > 0) that the ground mask does not mark;
  *  - BFS flood fill from every unvisited candidate in raster order, 4-neighbourhood (plus the four
  *    diagonal neighbours with `diagonals`, tested at the true angle between the two beams); columns
  *    wrap around (col 0 and col n_cols - 1 are neighbours), rows do not;
@@ -164,7 +164,12 @@ typedef struct
     uint32_t n_queue_overflow;    /**< always 0: the queue holds every pixel (kept for the record) */
 } lidet_cluster_stats_t;
 
-/** @brief Clustering state and workspace. Caller-owned; declare it static. */
+/**
+ * @brief What the clustering keeps across runs and its small outputs: configuration, the angle tables
+ *        of the image geometry, the kept clusters' records and the counts, plus where the last run
+ *        wrote its per-pixel outputs (labels, members). No per-pixel array:
+ *        LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS * 8 B + LIDET_MAX_CLUSTERS * (sizeof(lidet_cluster_rec_t) + 4) B + ~300 B.
+ */
 typedef struct
 {
     uint32_t magic;
@@ -178,14 +183,23 @@ typedef struct
     float row_cos[LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS];
     float diag_sin[LIDET_MAX_ROWS], diag_cos[LIDET_MAX_ROWS]; /* [r]: rows r, r + 1, one column apart */
     /* outputs of the last run */
-    uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];    /* per pixel, canonical id, 0 = none */
-    int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];    /* member pixels, cluster after cluster */
     lidet_cluster_rec_t recs[LIDET_MAX_CLUSTERS];
     uint16_t order[LIDET_MAX_CLUSTERS];                  /* scratch: slots in seed order */
     uint16_t slot_id[LIDET_MAX_CLUSTERS + 1];            /* scratch: slot + 1 -> canonical id */
     lidet_range_image_t img;                             /* the image of the last run (a view) */
+    uint16_t *labels;                                    /* the last run's per-pixel ids (its buffer) */
+    int32_t *members;                                    /* the last run's member pixels (its buffer) */
     uint32_t n_recs;
     lidet_cluster_stats_t stats;
+} lidet_cluster_state_t;
+
+/** @brief Clustering with every buffer inside (the standalone form): the state plus its per-pixel
+ *         outputs. Caller-owned; declare it static. */
+typedef struct
+{
+    lidet_cluster_state_t state;
+    uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];    /* per pixel, canonical id, 0 = none */
+    int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];    /* member pixels, cluster after cluster */
 } lidet_cluster_t;
 
 /**
@@ -259,6 +273,27 @@ lidet_status_t lidet_cluster_point_labels(const lidet_cluster_t *c, const int32_
 /** @brief sizeof(lidet_cluster_t): the bytes firmware must place for this stage. */
 uint32_t lidet_cluster_bytes(void);
 
+/** @brief lidet_cluster_init on the state alone, for a caller that places the per-pixel buffers. */
+lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *st, const lidet_cluster_cfg_t *cfg);
+
+/**
+ * @brief lidet_cluster_run writing into caller-placed buffers; same results, bit for bit.
+ * @param[out] labels  n_rows * n_cols uint16: the per-pixel ids (also the fill's scratch).
+ * @param[out] members n_rows * n_cols int32: the member pixels (also the fill's queue).
+ * Both must stay untouched while the records, labels or proposals of this run are read.
+ * @return as lidet_cluster_run; LIDET_ERR_ARG also for NULL buffers.
+ */
+lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *st, uint16_t *labels, int32_t *members,
+                                         const lidet_range_image_t *img, const uint8_t *ground_mask,
+                                         const lidet_plane_t *planes, uint32_t n_sectors);
+
+/** @brief lidet_cluster_point_labels on a state (the buffers of its last run). */
+lidet_status_t lidet_cluster_point_labels_of(const lidet_cluster_state_t *st, const int32_t *point_pixel,
+                                             uint32_t n_points, uint32_t *out);
+
+/** @brief sizeof(lidet_cluster_state_t). */
+uint32_t lidet_cluster_state_bytes(void);
+
 /* ---- proposals ------------------------------------------------------------------------------ */
 
 /** @brief How proposals are built. Fill with lidet_proposal_cfg_default(). */
@@ -298,6 +333,10 @@ void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg);
  */
 lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_index,
                                    const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out);
+
+/** @brief lidet_proposal_make on a state (the image and buffers of its last run). */
+lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *st, uint32_t cluster_index,
+                                      const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out);
 
 /**
  * @brief The resampling rule alone: writes n_out member indices (each < n_src) for a cluster of

@@ -156,16 +156,31 @@ typedef struct
     uint32_t n_hypotheses;       /**< RANSAC hypotheses scored (after degenerate/tilt rejection) */
 } lidet_ground_stats_t;
 
-/** @brief Ground stage state and workspace. Caller-owned; declare it static (it is large). */
+/**
+ * @brief What the ground stage keeps across runs and its small outputs: configuration, generator,
+ *        planes, their sources and the counts (no per-pixel array; ~ LIDET_GROUND_MAX_SECTORS * 34 B).
+ */
 typedef struct
 {
     uint32_t magic;
     lidet_ground_cfg_t cfg;
     uint32_t rng;                                        /* xorshift32 state */
     uint16_t n_rows, n_cols;                             /* of the last image */
-    uint8_t mask[LIDET_MAX_ROWS * LIDET_MAX_COLS];       /* 1 ground, 0 not / empty */
+    lidet_plane_t planes[2 * LIDET_GROUND_MAX_SECTORS]; /* near planes, then far planes */
+    uint8_t source[2 * LIDET_GROUND_MAX_SECTORS];        /* lidet_ground_plane_source_t, same order */
+    lidet_ground_stats_t stats;
+} lidet_ground_state_t;
+
+/**
+ * @brief Scratch of one ground run: nothing in it is read after the run returns except the sample
+ *        mask (lidet_ground_samples, a diagnostic). A detector workspace overlays it with the other
+ *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + (LIDET_GROUND_MAX_SAMPLES +
+ *        LIDET_GROUND_EVAL_MAX) * 12 B + LIDET_GROUND_MAX_SECTORS * 16 B.
+ */
+typedef struct
+{
     uint8_t sample[LIDET_MAX_ROWS * LIDET_MAX_COLS];     /* 1 sample of the filter */
-    float sx_m[LIDET_GROUND_MAX_SAMPLES];                /* samples, grouped by sector */
+    float sx_m[LIDET_GROUND_MAX_SAMPLES];                /* samples, grouped by cell */
     float sy_m[LIDET_GROUND_MAX_SAMPLES];
     float sz_m[LIDET_GROUND_MAX_SAMPLES];
     float ev_x_m[LIDET_GROUND_EVAL_MAX];                 /* a cell's strided scoring subset */
@@ -175,9 +190,15 @@ typedef struct
      * are sx/sy/sz[cell_first[k] .. cell_first[k] + cell_n[k]) */
     uint32_t cell_first[2 * LIDET_GROUND_MAX_SECTORS];
     uint32_t cell_n[2 * LIDET_GROUND_MAX_SECTORS];
-    lidet_plane_t planes[2 * LIDET_GROUND_MAX_SECTORS]; /* near planes, then far planes */
-    uint8_t source[2 * LIDET_GROUND_MAX_SECTORS];        /* lidet_ground_plane_source_t, same order */
-    lidet_ground_stats_t stats;
+} lidet_ground_scratch_t;
+
+/** @brief Ground stage with every buffer inside (the standalone form): state, the ground mask (the
+ *         output the clustering reads) and the scratch. Caller-owned; declare it static (it is large). */
+typedef struct
+{
+    lidet_ground_state_t state;
+    uint8_t mask[LIDET_MAX_ROWS * LIDET_MAX_COLS]; /* 1 ground, 0 not / empty */
+    lidet_ground_scratch_t scratch;
 } lidet_ground_t;
 
 /**
@@ -252,6 +273,30 @@ const lidet_ground_stats_t *lidet_ground_stats(const lidet_ground_t *g);
 
 /** @brief sizeof(lidet_ground_t): the bytes firmware must place for this stage. */
 uint32_t lidet_ground_bytes(void);
+
+/** @brief lidet_ground_init on the state alone, for a caller that places the buffers itself. */
+lidet_status_t lidet_ground_state_init(lidet_ground_state_t *st, const lidet_ground_cfg_t *cfg);
+
+/**
+ * @brief lidet_ground_run on caller-placed buffers; same results, bit for bit.
+ * @param[in,out] st      initialised state (planes, sources and stats are written).
+ * @param[out]    scratch the run's scratch (its sample mask stays readable until it is reused).
+ * @param[out]    mask    n_rows * n_cols bytes: the ground mask.
+ * @param[out]    rxy_m   n_rows * n_cols floats of scratch for R when img->rxy_m is NULL (computed
+ *                        from x and y exactly as the projection would); may be NULL when the image has R.
+ * @param[in]     img     range image (rxy_m and point_idx may be NULL).
+ * @return as lidet_ground_run; LIDET_ERR_ARG also when img has no R and rxy_m is NULL.
+ */
+lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *st, lidet_ground_scratch_t *scratch, uint8_t *mask,
+                                        float *rxy_m, const lidet_range_image_t *img);
+
+/** @brief Per-point labels from a state and the mask it produced (lidet_ground_point_labels). */
+lidet_status_t lidet_ground_point_labels_of(const lidet_ground_state_t *st, const uint8_t *mask,
+                                            const int32_t *point_pixel, uint32_t n_points, uint8_t *out);
+
+/** @brief sizeof(lidet_ground_state_t) and sizeof(lidet_ground_scratch_t). */
+uint32_t lidet_ground_state_bytes(void);
+uint32_t lidet_ground_scratch_bytes(void);
 
 /**
  * @brief Least-squares plane through weighted-free points (exposed for the Eigen cross-check).

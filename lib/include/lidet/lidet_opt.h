@@ -63,7 +63,7 @@
 #endif
 
 /** Points per block of the projection's first pass (keys of a block, then lookups, then the
- *  closest-point test); lidet_proj_run() keeps one block's keys on the stack, 24 B per point. */
+ *  closest-point test); lidet_proj_run() keeps one block's keys on the stack, 28 B per point. */
 #ifndef LIDET_PROJ_BLOCK
 #define LIDET_PROJ_BLOCK 64
 #endif

@@ -28,9 +28,11 @@
  * + LIDET_MAX_COLS * 12 B (column edges and their lookup table) + LIDET_PROJ_ROW_LUT * 1 B
  * + LIDET_MAX_ROWS * 9 B + ~100 B. Defaults (128 x 2048, 262,144 points): about 7.3 MiB; a VLP-16
  * build (16 x 1800, 30,000 points): about 0.8 MiB. lidet_proj_bytes() returns the exact figure.
- * Declare it `static`.
+ * Declare it `static`. The state alone (lidet_proj_state_t: configuration, tables, counts) is the
+ * part that lives across runs; lidet_proj_run_buffers() writes into buffers the caller places, where
+ * R and the per-point pixels are optional (a detector workspace, lidet_workspace.h, keeps neither).
  * Time: O(n_points + n_rows * n_cols) per run, no allocation, no recursion. Stack: run() keeps the keys
- * of a block of LIDET_PROJ_BLOCK points, 24 B each (1.5 KiB with the default 64; see lidet_opt.h).
+ * of a block of LIDET_PROJ_BLOCK points, 28 B each (1.75 KiB with the default 64; see lidet_opt.h).
  */
 #ifndef LIDET_PROJ_H
 #define LIDET_PROJ_H
@@ -73,8 +75,8 @@ typedef struct
 
 /**
  * @brief The range image: row-major arrays of n_rows * n_cols pixels, pixel = row * n_cols + col.
- * Empty pixels hold 0 in every float array and -1 in point_idx. A view into lidet_proj_t, valid
- * until the next lidet_proj_run or lidet_proj_init on the same state.
+ * Empty pixels hold 0 in every float array and -1 in point_idx. A view into lidet_proj_t (or the
+ * buffers of lidet_proj_run_buffers), valid until the next run or init on the same state.
  */
 typedef struct
 {
@@ -84,12 +86,20 @@ typedef struct
     const float *y_m;          /**< y */
     const float *z_m;          /**< z */
     const float *range_m;      /**< sqrt(x^2 + y^2 + z^2); > 0 exactly for valid pixels */
-    const float *rxy_m;        /**< R = sqrt(x^2 + y^2), the horizontal range */
-    const int32_t *point_idx;  /**< index of the winning input point; -1 = empty (validity) */
+    const float *rxy_m;        /**< R = sqrt(x^2 + y^2), the horizontal range; may be NULL (a detector
+                                    workspace does not keep it: the ground stage computes it) */
+    const int32_t *point_idx;  /**< index of the winning input point, -1 = empty; may be NULL (a
+                                    workspace overlays it with later scratch). Validity is range_m > 0,
+                                    which the later stages read (the two agree on every image) */
     const float *row_elev_rad; /**< n_rows beam elevations in row order (row 0 = top) */
 } lidet_range_image_t;
 
-/** @brief Projection state and workspace. Caller-owned; declare it static (it is large). */
+/**
+ * @brief What the projection keeps across runs: the configuration, the row and column tables derived
+ *        in init, and the counts of the last run (no per-pixel array). About 12 B per column + 9 B per
+ *        row + LIDET_PROJ_ROW_LUT B: 24 KiB for a VLP-16 build. lidet_proj_t embeds one; a detector
+ *        workspace (lidet_workspace.h) embeds one beside its own buffers.
+ */
 typedef struct
 {
     uint32_t magic;
@@ -107,6 +117,32 @@ typedef struct
                                                  [n_cols] = 5 (> any D), a sentinel */
     uint16_t col_lut[4 * LIDET_MAX_COLS + 1]; /* D bucket (width 1/n_cols) -> column of its low end */
     float col_lut_scale;                      /* n_cols: buckets per unit of D */
+    uint32_t n_points;                        /* points of the last run (<= LIDET_MAX_POINTS) */
+    lidet_proj_stats_t stats;
+} lidet_proj_state_t;
+
+/**
+ * @brief Where a run writes: caller-owned arrays of n_rows * n_cols pixels (row-major) unless noted.
+ * Used by lidet_proj_run_buffers(), so that a workspace can place each array where its lifetime
+ * allows (lidet_workspace.h overlays point_idx with the later stages' scratch).
+ */
+typedef struct
+{
+    float *x_m, *y_m, *z_m; /**< required: the winning point's coordinates (0 for empty pixels) */
+    float *range_m;         /**< required: its range, > 0 exactly for valid pixels, else 0 */
+    float *rxy_m;           /**< optional (NULL: not produced): R = sqrt(x^2 + y^2); the ground stage
+                                 computes it itself when the image has none */
+    int32_t *point_idx;     /**< required: the winning input point of each pixel, -1 = empty. The run
+                                 needs it as scratch; keep it only if per-pixel -> point is wanted */
+    int32_t *point_pixel;   /**< optional (NULL: not produced): LIDET_MAX_POINTS entries, the pixel of
+                                 each input point (per-point outputs: 4 B per point) */
+} lidet_proj_buffers_t;
+
+/** @brief Projection state with every buffer inside (the standalone form of the stage): the state
+ *         plus the buffers of lidet_proj_buffers_t, all produced. Caller-owned; declare it static. */
+typedef struct
+{
+    lidet_proj_state_t state;
     /* outputs of the last run */
     float x_m[LIDET_MAX_ROWS * LIDET_MAX_COLS];
     float y_m[LIDET_MAX_ROWS * LIDET_MAX_COLS];
@@ -115,8 +151,6 @@ typedef struct
     float rxy_m[LIDET_MAX_ROWS * LIDET_MAX_COLS];
     int32_t point_idx[LIDET_MAX_ROWS * LIDET_MAX_COLS];
     int32_t point_pixel[LIDET_MAX_POINTS]; /* pixel of every input point, -1 = not projected */
-    uint32_t n_points;                     /* points covered by point_pixel (<= LIDET_MAX_POINTS) */
-    lidet_proj_stats_t stats;
 } lidet_proj_t;
 
 /**
@@ -173,6 +207,29 @@ const lidet_proj_stats_t *lidet_proj_stats(const lidet_proj_t *proj);
 
 /** @brief sizeof(lidet_proj_t): the bytes firmware must place for this stage. */
 uint32_t lidet_proj_bytes(void);
+
+/**
+ * @brief lidet_proj_init on the state alone (the tables), for a caller that places the buffers itself.
+ * @return as lidet_proj_init.
+ */
+lidet_status_t lidet_proj_state_init(lidet_proj_state_t *st, const lidet_proj_cfg_t *cfg);
+
+/**
+ * @brief lidet_proj_run writing into caller-placed buffers (see lidet_proj_buffers_t for which are
+ *        optional). Same results, bit for bit, as lidet_proj_run.
+ * @return as lidet_proj_run; LIDET_ERR_ARG also when a required buffer is NULL.
+ */
+lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *st, const lidet_proj_buffers_t *buf, const float *points,
+                                      uint32_t n_points, uint32_t stride, const uint16_t *ring);
+
+/**
+ * @brief The range image view of buffers filled by lidet_proj_run_buffers (rxy_m and point_idx as
+ *        given, possibly NULL: pass NULL there when the array no longer holds this run's values).
+ */
+void lidet_proj_image_of(const lidet_proj_state_t *st, const lidet_proj_buffers_t *buf, lidet_range_image_t *img);
+
+/** @brief sizeof(lidet_proj_state_t): the bytes that live across runs (tables and counts). */
+uint32_t lidet_proj_state_bytes(void);
 
 /**
  * @brief The pseudo-azimuth the projection bins columns on (exposed for tests and benchmarks):

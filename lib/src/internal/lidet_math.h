@@ -19,4 +19,11 @@ static inline int lidet__isfinite(float v)
     return (u & 0x7F800000u) != 0x7F800000u;
 }
 
+/* horizontal range R of a point: the one expression the projection (when it keeps R) and the ground
+ * stage (when it computes R itself) share, so both give the same bits */
+static inline float lidet__rxy(float x, float y)
+{
+    return sqrtf(x * x + y * y);
+}
+
 #endif

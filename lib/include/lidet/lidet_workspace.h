@@ -1,0 +1,188 @@
+/* SPDX-License-Identifier: MIT */
+/**
+ * @file lidet_workspace.h
+ * @brief The detector workspace: projection -> ground -> clustering (-> proposals) on one object
+ *        whose size is the peak of the stages' memory, not the sum (the future lidet_detector_t
+ *        grows from it when the PointNets land).
+ *
+ * Memory model. Every stage's memory is split three ways:
+ *  - state (lidet_proj_state_t, lidet_ground_state_t, lidet_cluster_state_t): configuration, the
+ *    tables derived in init, the small outputs (planes, cluster records) and the counts. Lives across
+ *    runs; no per-pixel array.
+ *  - outputs a later stage (or the caller) still reads: the image's x, y, z and range (read up to the
+ *    proposals), the ground mask (read by the clustering, and a result), the cluster labels and
+ *    members (read by the proposals).
+ *  - scratch, alive only during its own stage's run: the projection's winning point per pixel; the
+ *    ground stage's R image, sample mask and samples.
+ * Stages run one after the other, so the workspace overlays (a union) the projection's scratch, the
+ * ground stage's scratch and the clustering's outputs, none of which is alive while another is.
+ * What the workspace does not keep, by design (a firmware that wants boxes pays for none of it):
+ *  - R = sqrt(x^2 + y^2) per pixel: the ground stage recomputes it into its scratch, with the same
+ *    expression, so every result is bit-identical to the standalone stages';
+ *  - the winning point's index per pixel (point_idx): scratch of the projection; validity is range > 0;
+ *  - per-point outputs (the pixel of every input point, 4 B per point): only when the caller passes
+ *    a buffer of LIDET_MAX_POINTS entries to lidet_workspace_run; per-point labels are then derived
+ *    from it (lidet_workspace_point_labels).
+ * The x, y, z and range planes stay float (16 B per pixel): they are the real point's coordinates,
+ * which the ground filter, the cluster statistics and the proposals read; see docs/MEMORY.md for
+ * the measured sizes of each part and what a more compact pixel would cost.
+ *
+ * Bytes (lidet_workspace_sizes reports each part): states ~ LIDET_MAX_COLS * 12 B + LIDET_PROJ_ROW_LUT B
+ * + LIDET_MAX_CLUSTERS * 60 B + LIDET_GROUND_MAX_SECTORS * 34 B; per pixel 17 B (x, y, z, range, ground
+ * mask) + the overlay, the largest of 4 B (projection), 5 B + (LIDET_GROUND_MAX_SAMPLES / pixels) * 12 B
+ * (ground) and 6 B (clustering). Declare it static, or place it with the port's section macro
+ * (LIDET_WORKSPACE_SECTION, lidet_port.h).
+ * Time: the sum of the three stages, plus one pass over the pixels for R (vectorised). No allocation.
+ */
+#ifndef LIDET_WORKSPACE_H
+#define LIDET_WORKSPACE_H
+
+#include "lidet_cluster.h"
+#include "lidet_ground.h"
+#include "lidet_proj.h"
+#include "lidet_sensor.h"
+#include "lidet_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#define LIDET__WS_PIXELS (LIDET_MAX_ROWS * LIDET_MAX_COLS)
+
+/** @brief Configuration of every stage the workspace runs. Fill with lidet_workspace_cfg_default(). */
+typedef struct
+{
+    lidet_proj_cfg_t proj;
+    lidet_ground_cfg_t ground;
+    lidet_cluster_cfg_t cluster;
+} lidet_workspace_cfg_t;
+
+/** @brief Counts of the last run of each stage. */
+typedef struct
+{
+    lidet_proj_stats_t proj;
+    lidet_ground_stats_t ground;
+    lidet_cluster_stats_t cluster;
+} lidet_workspace_stats_t;
+
+/** @brief The workspace. Caller-owned, fixed size (sizeof = lidet_workspace_bytes()). Fields are
+ *         public only so that sizeof works; read results through the functions below. */
+typedef struct
+{
+    uint32_t magic;
+    lidet_proj_state_t proj;
+    lidet_ground_state_t ground;
+    lidet_cluster_state_t cluster;
+    /* outputs read up to the end of the scan */
+    float x_m[LIDET__WS_PIXELS];
+    float y_m[LIDET__WS_PIXELS];
+    float z_m[LIDET__WS_PIXELS];
+    float range_m[LIDET__WS_PIXELS];
+    uint8_t ground_mask[LIDET__WS_PIXELS];
+    /* one of these is alive at a time */
+    union
+    {
+        int32_t proj_point_idx[LIDET__WS_PIXELS]; /* projection: winning point per pixel */
+        struct
+        {
+            float rxy_m[LIDET__WS_PIXELS]; /* R, recomputed from x and y */
+            lidet_ground_scratch_t scratch;
+        } ground;
+        struct
+        {
+            int32_t members[LIDET__WS_PIXELS]; /* clustering outputs, read by the proposals */
+            uint16_t labels[LIDET__WS_PIXELS];
+        } cluster;
+    } overlay;
+} lidet_workspace_t;
+
+/** @brief Sizes in bytes of the parts of lidet_workspace_t (this build's capacities). */
+typedef struct
+{
+    uint32_t proj_state, ground_state, cluster_state; /**< the three states (tables, small outputs) */
+    uint32_t image;                                   /**< x, y, z, range planes */
+    uint32_t ground_mask;                             /**< the ground mask */
+    uint32_t overlay_proj;                            /**< projection scratch (point_idx) */
+    uint32_t overlay_ground;                          /**< ground scratch (R, sample mask, samples) */
+    uint32_t overlay_cluster;                         /**< cluster labels and members */
+    uint32_t overlay;                                 /**< the overlay: the largest of the three */
+    uint32_t total;                                   /**< sizeof(lidet_workspace_t) */
+    uint32_t stages_standalone;                       /**< lidet_proj_bytes() + lidet_ground_bytes() +
+                                                           lidet_cluster_bytes(), for comparison */
+} lidet_workspace_sizes_t;
+
+/**
+ * @brief Defaults of every stage for a sensor (each stage's own cfg_default).
+ * @param[out] cfg    filled (NULL: no-op).
+ * @param[in]  sensor profile (copied into cfg->proj.sensor); NULL leaves the sensor zeroed.
+ */
+void lidet_workspace_cfg_default(lidet_workspace_cfg_t *cfg, const lidet_sensor_t *sensor);
+
+/**
+ * @brief Initialise every stage (each stage's init, in pipeline order). No allocation.
+ * @return LIDET_OK or the first failing stage's error (LIDET_ERR_ARG, _CONFIG, _BUFFER).
+ */
+lidet_status_t lidet_workspace_init(lidet_workspace_t *ws, const lidet_workspace_cfg_t *cfg);
+
+/**
+ * @brief Projection, ground segmentation and clustering of one scan, with the same results, bit for
+ *        bit, as the standalone stages chained by hand (the cluster height filter reads the ground
+ *        stage's near planes).
+ * @param[in,out] ws          initialised workspace; every result of the previous scan is overwritten.
+ * @param[in]     points      n_points records of `stride` floats (x, y, z first); read only during
+ *                            this call (the workspace keeps the winners' coordinates).
+ * @param[in]     ring        optional per-point ring index, or NULL (as lidet_proj_run).
+ * @param[out]    point_pixel optional: LIDET_MAX_POINTS int32, the pixel of each input point (-1 =
+ *                            not projected), needed only for per-point labels; NULL = not produced.
+ * @return LIDET_OK; LIDET_TRUNCATED when a stage truncated (stats say which); the first error of a
+ *         stage (LIDET_ERR_ARG, _STATE, _BUFFER, _CONFIG): later stages then did not run.
+ */
+lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, uint32_t n_points, uint32_t stride,
+                                   const uint16_t *ring, int32_t *point_pixel);
+
+/** @brief The range image of the last run: x, y, z and range; rxy_m and point_idx are NULL. */
+void lidet_workspace_image(const lidet_workspace_t *ws, lidet_range_image_t *img);
+
+/** @brief Ground mask of the last run (n_rows * n_cols bytes, 1 = ground). */
+const uint8_t *lidet_workspace_ground_mask(const lidet_workspace_t *ws);
+
+/** @brief Ground planes of the last run (near then far, as lidet_ground_planes). */
+const lidet_plane_t *lidet_workspace_planes(const lidet_workspace_t *ws, uint32_t *n_sectors);
+
+/** @brief Kept clusters of the last run (as lidet_cluster_records). */
+const lidet_cluster_rec_t *lidet_workspace_clusters(const lidet_workspace_t *ws, uint32_t *n_clusters);
+
+/** @brief Per-pixel cluster ids of the last run (as lidet_cluster_labels). */
+const uint16_t *lidet_workspace_labels(const lidet_workspace_t *ws);
+
+/** @brief Member pixels of the last run (as lidet_cluster_members). */
+const int32_t *lidet_workspace_members(const lidet_workspace_t *ws);
+
+/** @brief The proposal of kept cluster `cluster_index` of the last run (as lidet_proposal_make). */
+lidet_status_t lidet_workspace_proposal(const lidet_workspace_t *ws, uint32_t cluster_index,
+                                        const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out);
+
+/**
+ * @brief Per-point labels from the point_pixel buffer the last run filled.
+ * @param[in]  point_pixel the buffer passed to lidet_workspace_run, n_points entries.
+ * @param[out] cluster_id  n_points cluster ids (0 = none), or NULL.
+ * @param[out] ground      n_points bytes (1 = ground), or NULL.
+ * @return LIDET_OK; LIDET_ERR_ARG (NULL ws or point_pixel with n_points > 0); LIDET_ERR_STATE (never run).
+ */
+lidet_status_t lidet_workspace_point_labels(const lidet_workspace_t *ws, const int32_t *point_pixel,
+                                            uint32_t n_points, uint32_t *cluster_id, uint8_t *ground);
+
+/** @brief Counts of the last run of each stage (copied). */
+void lidet_workspace_stats(const lidet_workspace_t *ws, lidet_workspace_stats_t *out);
+
+/** @brief sizeof(lidet_workspace_t): the bytes firmware must place. */
+uint32_t lidet_workspace_bytes(void);
+
+/** @brief The size of every part of the workspace (sizeof of each member; nothing is estimated). */
+void lidet_workspace_sizes(lidet_workspace_sizes_t *out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LIDET_WORKSPACE_H */

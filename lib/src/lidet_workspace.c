@@ -1,0 +1,223 @@
+/* SPDX-License-Identifier: MIT */
+/* The detector workspace (see lidet_workspace.h for the memory model): the three stages run on
+ * their states and on buffers placed by lifetime, the scratch of each overlaid with the others'. */
+#include <string.h>
+
+#include "lidet/lidet_workspace.h"
+
+void lidet_workspace_cfg_default(lidet_workspace_cfg_t *cfg, const lidet_sensor_t *sensor)
+{
+    if (cfg == 0)
+    {
+        return;
+    }
+    lidet_proj_cfg_default(&cfg->proj, sensor);
+    lidet_ground_cfg_default(&cfg->ground, sensor);
+    lidet_cluster_cfg_default(&cfg->cluster, sensor);
+}
+
+lidet_status_t lidet_workspace_init(lidet_workspace_t *ws, const lidet_workspace_cfg_t *cfg)
+{
+    lidet_status_t st;
+    if (ws == 0 || cfg == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    ws->magic = 0;
+    st = lidet_proj_state_init(&ws->proj, &cfg->proj);
+    if (st != LIDET_OK)
+    {
+        return st;
+    }
+    st = lidet_ground_state_init(&ws->ground, &cfg->ground);
+    if (st != LIDET_OK)
+    {
+        return st;
+    }
+    st = lidet_cluster_state_init(&ws->cluster, &cfg->cluster);
+    if (st != LIDET_OK)
+    {
+        return st;
+    }
+    ws->magic = LIDET_INIT_MAGIC;
+    return LIDET_OK;
+}
+
+/* the image the later stages read: no R (the ground stage recomputes it into its scratch) and no
+ * point_idx (the overlay reuses it once the projection is done) */
+static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
+{
+    img->n_rows = ws->proj.cfg.sensor.n_rows;
+    img->n_cols = ws->proj.cfg.sensor.n_cols;
+    img->x_m = ws->x_m;
+    img->y_m = ws->y_m;
+    img->z_m = ws->z_m;
+    img->range_m = ws->range_m;
+    img->rxy_m = 0;
+    img->point_idx = 0;
+    img->row_elev_rad = ws->proj.row_elev_rad;
+}
+
+lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, uint32_t n_points, uint32_t stride,
+                                   const uint16_t *ring, int32_t *point_pixel)
+{
+    lidet_proj_buffers_t b;
+    lidet_range_image_t img;
+    lidet_status_t st, worst;
+    if (ws == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (ws->magic != LIDET_INIT_MAGIC)
+    {
+        return LIDET_ERR_STATE;
+    }
+    /* the previous scan's clusters live in the overlay: forget them before the projection reuses it */
+    ws->cluster.labels = 0;
+    ws->cluster.members = 0;
+    ws->cluster.n_recs = 0;
+    b.x_m = ws->x_m;
+    b.y_m = ws->y_m;
+    b.z_m = ws->z_m;
+    b.range_m = ws->range_m;
+    b.rxy_m = 0;
+    b.point_idx = ws->overlay.proj_point_idx;
+    b.point_pixel = point_pixel;
+    st = lidet_proj_run_buffers(&ws->proj, &b, points, n_points, stride, ring);
+    if (st < 0)
+    {
+        return st;
+    }
+    worst = st;
+    ws_image(ws, &img);
+    st = lidet_ground_run_buffers(&ws->ground, &ws->overlay.ground.scratch, ws->ground_mask,
+                                  ws->overlay.ground.rxy_m, &img);
+    if (st < 0)
+    {
+        return st;
+    }
+    worst = st > worst ? st : worst;
+    st = lidet_cluster_run_buffers(&ws->cluster, ws->overlay.cluster.labels, ws->overlay.cluster.members, &img,
+                                   ws->ground_mask, ws->ground.planes, ws->ground.cfg.n_sectors);
+    if (st < 0)
+    {
+        return st;
+    }
+    return st > worst ? st : worst;
+}
+
+void lidet_workspace_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
+{
+    if (ws == 0 || img == 0)
+    {
+        return;
+    }
+    ws_image(ws, img);
+}
+
+const uint8_t *lidet_workspace_ground_mask(const lidet_workspace_t *ws)
+{
+    return ws == 0 ? 0 : ws->ground_mask;
+}
+
+const lidet_plane_t *lidet_workspace_planes(const lidet_workspace_t *ws, uint32_t *n_sectors)
+{
+    if (ws == 0)
+    {
+        return 0;
+    }
+    if (n_sectors != 0)
+    {
+        *n_sectors = ws->ground.cfg.n_sectors;
+    }
+    return ws->ground.planes;
+}
+
+const lidet_cluster_rec_t *lidet_workspace_clusters(const lidet_workspace_t *ws, uint32_t *n_clusters)
+{
+    if (ws == 0)
+    {
+        return 0;
+    }
+    if (n_clusters != 0)
+    {
+        *n_clusters = ws->cluster.n_recs;
+    }
+    return ws->cluster.recs;
+}
+
+const uint16_t *lidet_workspace_labels(const lidet_workspace_t *ws)
+{
+    return ws == 0 ? 0 : ws->cluster.labels;
+}
+
+const int32_t *lidet_workspace_members(const lidet_workspace_t *ws)
+{
+    return ws == 0 ? 0 : ws->cluster.members;
+}
+
+lidet_status_t lidet_workspace_proposal(const lidet_workspace_t *ws, uint32_t cluster_index,
+                                        const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out)
+{
+    return ws == 0 ? LIDET_ERR_ARG : lidet_proposal_make_of(&ws->cluster, cluster_index, cfg, out);
+}
+
+lidet_status_t lidet_workspace_point_labels(const lidet_workspace_t *ws, const int32_t *point_pixel,
+                                            uint32_t n_points, uint32_t *cluster_id, uint8_t *ground)
+{
+    lidet_status_t st = LIDET_OK;
+    if (ws == 0 || (point_pixel == 0 && n_points > 0u))
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (ws->magic != LIDET_INIT_MAGIC || ws->cluster.labels == 0)
+    {
+        return LIDET_ERR_STATE;
+    }
+    if (cluster_id != 0)
+    {
+        st = lidet_cluster_point_labels_of(&ws->cluster, point_pixel, n_points, cluster_id);
+    }
+    if (st == LIDET_OK && ground != 0)
+    {
+        st = lidet_ground_point_labels_of(&ws->ground, ws->ground_mask, point_pixel, n_points, ground);
+    }
+    return st;
+}
+
+void lidet_workspace_stats(const lidet_workspace_t *ws, lidet_workspace_stats_t *out)
+{
+    if (ws == 0 || out == 0)
+    {
+        return;
+    }
+    out->proj = ws->proj.stats;
+    out->ground = ws->ground.stats;
+    out->cluster = ws->cluster.stats;
+}
+
+uint32_t lidet_workspace_bytes(void)
+{
+    return (uint32_t)sizeof(lidet_workspace_t);
+}
+
+void lidet_workspace_sizes(lidet_workspace_sizes_t *out)
+{
+    const lidet_workspace_t *w = 0; /* sizeof only: never dereferenced */
+    if (out == 0)
+    {
+        return;
+    }
+    memset(out, 0, sizeof *out);
+    out->proj_state = (uint32_t)sizeof w->proj;
+    out->ground_state = (uint32_t)sizeof w->ground;
+    out->cluster_state = (uint32_t)sizeof w->cluster;
+    out->image = (uint32_t)(sizeof w->x_m + sizeof w->y_m + sizeof w->z_m + sizeof w->range_m);
+    out->ground_mask = (uint32_t)sizeof w->ground_mask;
+    out->overlay_proj = (uint32_t)sizeof w->overlay.proj_point_idx;
+    out->overlay_ground = (uint32_t)sizeof w->overlay.ground;
+    out->overlay_cluster = (uint32_t)sizeof w->overlay.cluster;
+    out->overlay = (uint32_t)sizeof w->overlay;
+    out->total = (uint32_t)sizeof(lidet_workspace_t);
+    out->stages_standalone = lidet_proj_bytes() + lidet_ground_bytes() + lidet_cluster_bytes();
+}

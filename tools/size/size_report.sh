@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# SPDX-License-Identifier: MIT
+# Workspace and stage sizes for the capacity configurations of docs/MEMORY.md, as a markdown table.
+# Usage: tools/size/size_report.sh [CC]   (default cc; sizes are sizeof, so any C99 compiler for the
+# target gives that target's figure; a 32-bit target differs only in the few pointer fields)
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+cc="${1:-cc}"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+# name rows cols points clusters detections
+configs=(
+  "hdl64 64 2048 131072 1024 128"
+  "vlp16 16 1800 30000 64 64"
+  "os1-64 64 2048 131072 1024 128"
+  "host-default 128 2048 262144 1024 128"
+)
+kib() { awk -v b="$1" 'BEGIN { printf "%.1f", b / 1024 }'; }
+echo "| config (rows x cols, points, clusters) | proj+ground+cluster states | image x,y,z,range | ground mask | overlay (proj / ground / cluster) | **workspace** | standalone stages (proj + ground + cluster) |"
+echo "|---|---|---|---|---|---|---|"
+for c in "${configs[@]}"; do
+  read -r name rows cols pts cl det <<<"$c"
+  "$cc" -std=c99 -O1 -I"$root/lib/include" -I"$root/lib/src" -DLIDET_MAX_ROWS="$rows" -DLIDET_MAX_COLS="$cols" \
+        -DLIDET_MAX_POINTS="$pts" -DLIDET_MAX_CLUSTERS="$cl" -DLIDET_MAX_DETECTIONS="$det" \
+        "$here/size_report.c" "$root"/lib/src/*.c -lm -o "$tmp/sz"
+  declare -A v=()
+  while read -r k n; do v[$k]=$n; done < <("$tmp/sz")
+  states=$(( v[proj_state] + v[ground_state] + v[cluster_state] ))
+  echo "| $name ($rows x $cols, $pts, $cl) | $(kib $states) KiB | $(kib ${v[image]}) KiB | $(kib ${v[ground_mask]}) KiB |" \
+       "$(kib ${v[overlay]}) KiB ($(kib ${v[overlay_proj]}) / $(kib ${v[overlay_ground]}) / $(kib ${v[overlay_cluster]})) |" \
+       "**$(kib ${v[workspace]}) KiB** | $(kib ${v[stages_standalone]}) KiB ($(kib ${v[proj_t]}) + $(kib ${v[ground_t]}) + $(kib ${v[cluster_t]})) |"
+  unset v
+done
