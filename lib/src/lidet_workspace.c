@@ -61,6 +61,20 @@ static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
 lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, uint32_t n_points, uint32_t stride,
                                    const uint16_t *ring, int32_t *point_pixel)
 {
+    return lidet_workspace_run_timed(ws, points, n_points, stride, ring, point_pixel, 0, 0, 0);
+}
+
+static uint32_t tick(lidet_clock_fn clock, void *ctx)
+{
+    return clock != 0 ? clock(ctx) : 0u;
+}
+
+lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *points, uint32_t n_points,
+                                         uint32_t stride, const uint16_t *ring, int32_t *point_pixel,
+                                         lidet_clock_fn clock, void *clock_ctx, uint32_t ticks[3])
+{
+    uint32_t t0, t1;
+    uint32_t dummy[3];
     lidet_proj_buffers_t b;
     lidet_range_image_t img;
     lidet_status_t st, worst;
@@ -83,7 +97,15 @@ lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, u
     b.rxy_m = 0;
     b.point_idx = ws->overlay.proj_point_idx;
     b.point_pixel = point_pixel;
+    if (ticks == 0)
+    {
+        ticks = dummy;
+    }
+    ticks[0] = ticks[1] = ticks[2] = 0u;
+    t0 = tick(clock, clock_ctx);
     st = lidet_proj_run_buffers(&ws->proj, &b, points, n_points, stride, ring);
+    t1 = tick(clock, clock_ctx);
+    ticks[0] = t1 - t0;
     if (st < 0)
     {
         return st;
@@ -92,6 +114,8 @@ lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, u
     ws_image(ws, &img);
     st = lidet_ground_run_buffers(&ws->ground, &ws->overlay.ground.scratch, ws->ground_mask,
                                   ws->overlay.ground.rxy_m, &img);
+    t0 = tick(clock, clock_ctx);
+    ticks[1] = t0 - t1;
     if (st < 0)
     {
         return st;
@@ -99,6 +123,7 @@ lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, u
     worst = st > worst ? st : worst;
     st = lidet_cluster_run_buffers(&ws->cluster, ws->overlay.cluster.labels, ws->overlay.cluster.members, &img,
                                    ws->ground_mask, ws->ground.planes, ws->ground.cfg.n_sectors);
+    ticks[2] = tick(clock, clock_ctx) - t0;
     if (st < 0)
     {
         return st;

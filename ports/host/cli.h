@@ -66,6 +66,9 @@ int cli_split_set(const char *kv, size_t *klen, double *v);
 int cli_project(int argc, char **argv);
 int cli_ground(int argc, char **argv);
 int cli_cluster(int argc, char **argv);
+int cli_detect(int argc, char **argv);
+
+#define M_PI_D 3.14159265358979323846
 
 /* PNG writer (8-bit RGB, no compression library needed). Returns 0 or -1. */
 int lidet_png_write_rgb(const char *path, const uint8_t *rgb, uint32_t width, uint32_t height);

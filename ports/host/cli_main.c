@@ -15,6 +15,7 @@ static const cli_cmd_t k_cmds[] = {
     {"project", cli_project, "spherical projection: points -> range image"},
     {"ground", cli_ground, "ground segmentation: points -> ground mask per point"},
     {"cluster", cli_cluster, "depth clustering + proposals: non-ground pixels -> clusters"},
+    {"detect", cli_detect, "the whole detector: points -> road users with 3D boxes"},
 };
 
 int main(int argc, char **argv)

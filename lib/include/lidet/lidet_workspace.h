@@ -140,6 +140,18 @@ lidet_status_t lidet_workspace_init(lidet_workspace_t *ws, const lidet_workspace
 lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, uint32_t n_points, uint32_t stride,
                                    const uint16_t *ring, int32_t *point_pixel);
 
+/** @brief A timestamp source (e.g. a cycle counter or a monotonic clock); ticks in the caller's unit. */
+typedef uint32_t (*lidet_clock_fn)(void *ctx);
+
+/**
+ * @brief lidet_workspace_run with per-stage timing: ticks[0..2] receive the clock differences around the
+ *        projection, the ground stage and the clustering (0 for a stage that did not run). clock may be
+ *        NULL (no timing; ticks, if given, are zeroed); ticks may be NULL. Same results as lidet_workspace_run.
+ */
+lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *points, uint32_t n_points,
+                                         uint32_t stride, const uint16_t *ring, int32_t *point_pixel,
+                                         lidet_clock_fn clock, void *clock_ctx, uint32_t ticks[3]);
+
 /** @brief The range image of the last run: x, y, z and range; rxy_m and point_idx are NULL. */
 void lidet_workspace_image(const lidet_workspace_t *ws, lidet_range_image_t *img);
 

@@ -1,0 +1,186 @@
+/* SPDX-License-Identifier: MIT */
+/**
+ * @file lidet_detector.h
+ * @brief The whole detector in one object: projection -> ground -> clustering -> proposals ->
+ *        classifier + gate 1 -> box net + gate 2 -> size check -> BEV non-maximum suppression.
+ *
+ * One lidet_detector_t holds every buffer of every stage (the stage workspace of lidet_workspace.h,
+ * whose scratch is overlaid, plus the PointNet scratch, one proposal and the detections); a firmware
+ * declares one static object (or places it with the port's section macro) and calls
+ * lidet_detector_run once per scan. Every stage stays callable alone; this only chains them.
+ *
+ * Per scan:
+ *  1. lidet_workspace_run: projection, ground, clustering (lidet_workspace.h).
+ *  2. Candidate clusters: those whose mean lies in the azimuth window (|azimuth| <= crop_half_rad, when
+ *     set: the KITTI camera field of view is pi/4) and within max_range_m; at most max_proposals of
+ *     them, nearest first (ties: lower cluster id), so the networks' time per scan is bounded whatever
+ *     the scan holds. The rest is counted, not classified.
+ *  3. Per candidate: the proposal (lidet_proposal_make with the models' points per proposal), the
+ *     classifier (gate 1: energy < gamma_c[class]), then the box net with that class (gate 2:
+ *     heading + size energy < gamma_b[class]). Either gate can be switched off (evaluation).
+ *  4. Boxes of impossible size for their class (outside [size_min, size_max] per dimension) are dropped.
+ *  5. Non-maximum suppression in bird's-eye view: detections sorted by score (ties: cluster id); one
+ *     whose rotated BEV IoU with a kept detection of any class exceeds nms_iou is dropped.
+ * Score: 1 / (1 + exp(E_c - gamma_c[class])), monotonic in the classifier energy, 0.5 at gate 1's
+ * threshold (the authors' score is also a function of the classifier energy alone).
+ *
+ * Memory: sizeof(lidet_detector_t) = lidet_workspace_bytes() + LIDET_DETECTOR_PN_SCRATCH
+ * + sizeof(lidet_proposal_t) + LIDET_MAX_CLUSTERS * 8 B + LIDET_MAX_DETECTIONS * sizeof(lidet_detection_t)
+ * + ~600 B; lidet_detector_bytes() returns it (docs/MEMORY.md has the table per sensor configuration).
+ * Time: the stages + max_proposals * (classifier + box net) + O(K log K) to order K clusters
+ * + O(D^2) for the NMS of D detections. No allocation, no recursion.
+ */
+#ifndef LIDET_DETECTOR_H
+#define LIDET_DETECTOR_H
+
+#include "lidet_pointnet.h"
+#include "lidet_types.h"
+#include "lidet_workspace.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** @brief Stages timed by the detector (indices of lidet_detector_stats_t.ticks). */
+enum
+{
+    LIDET_DET_STAGE_PROJECT = 0,  /**< projection */
+    LIDET_DET_STAGE_GROUND = 1,   /**< ground segmentation */
+    LIDET_DET_STAGE_CLUSTER = 2,  /**< clustering */
+    LIDET_DET_STAGE_CLASSIFY = 3, /**< candidate ordering, proposals, classifier */
+    LIDET_DET_STAGE_BOX = 4,      /**< box net */
+    LIDET_DET_STAGE_POST = 5,     /**< size check, NMS */
+    LIDET_DET_N_STAGES = 6
+};
+
+/** @brief Configuration. Fill with lidet_detector_cfg_default(). */
+typedef struct
+{
+    lidet_workspace_cfg_t stages;   /**< projection, ground, clustering */
+    lidet_proposal_cfg_t proposal;  /**< n_points is set from the models by init; seed and PVLE bins used */
+    float crop_half_rad;            /**< 0: 360 degrees; else keep clusters with |azimuth| <= this (KITTI
+                                         camera field of view: pi/4); (0, pi] */
+    float max_range_m;              /**< clusters whose mean is farther are not classified; 0 = no limit */
+    uint32_t max_proposals;         /**< at most this many clusters classified per scan, nearest first;
+                                         [1, LIDET_MAX_CLUSTERS], default 64 */
+    uint8_t gate1;                  /**< 1 (default): drop proposals failing gate 1 */
+    uint8_t gate2;                  /**< 1 (default): drop boxes failing gate 2 */
+    float nms_iou;                  /**< BEV IoU above which the lower-scored detection is dropped; [0, 1],
+                                         default 0.1 (detections come from disjoint clusters) */
+    float size_min_m[LIDET_N_CLASSES][3]; /**< plausible l, w, h per class (lidet_class_t order) */
+    float size_max_m[LIDET_N_CLASSES][3];
+    lidet_clock_fn clock;           /**< optional timestamp source for stats.ticks (NULL: no timing) */
+    void *clock_ctx;                /**< passed to clock */
+} lidet_detector_cfg_t;
+
+/** @brief One detection (sensor frame). */
+typedef struct
+{
+    lidet_box_t box;      /**< centre, l w h, yaw */
+    uint8_t cls;          /**< lidet_class_t */
+    float score;          /**< (0, 1), see the file comment */
+    float energy_cls;     /**< classifier energy (gate 1) */
+    float energy_box;     /**< box net energy, heading + size (gate 2) */
+    uint32_t cluster_id;  /**< 1-based id of its cluster in the last run (lidet_workspace_labels) */
+    uint32_t n_points;    /**< member pixels of that cluster */
+} lidet_detection_t;
+
+/** @brief Counts of the last run. */
+typedef struct
+{
+    uint32_t n_clusters;       /**< kept clusters */
+    uint32_t n_out_of_crop;    /**< outside the azimuth window */
+    uint32_t n_out_of_range;   /**< beyond max_range_m */
+    uint32_t n_over_budget;    /**< past max_proposals (farthest first) */
+    uint32_t n_classified;     /**< proposals through the classifier */
+    uint32_t n_gate1_rejected; /**< failed gate 1 */
+    uint32_t n_boxed;          /**< proposals through the box net */
+    uint32_t n_gate2_rejected; /**< failed gate 2 */
+    uint32_t n_size_rejected;  /**< boxes of impossible size */
+    uint32_t n_nms_suppressed; /**< dropped by the NMS */
+    uint32_t n_over_capacity;  /**< detections past LIDET_MAX_DETECTIONS (lowest scores) */
+    uint32_t n_detections;     /**< in the output */
+    uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
+    lidet_workspace_stats_t stages;     /**< the stages' own counts */
+} lidet_detector_stats_t;
+
+#ifndef LIDET_DETECTOR_PN_SCRATCH
+/** Bytes of PointNet scratch in the detector (the classifier and the box net share it); init fails with
+ *  LIDET_ERR_BUFFER when a model needs more. lidet's models need 10-13 KiB. */
+#define LIDET_DETECTOR_PN_SCRATCH 16384
+#endif
+
+/** @brief The detector. Caller-owned, fixed size; declare it static. Read results through the functions. */
+typedef struct
+{
+    uint32_t magic;
+    lidet_detector_cfg_t cfg;
+    lidet_workspace_t ws;
+    lidet_pn_t cls, box;
+    float pn_scratch[LIDET_DETECTOR_PN_SCRATCH / 4];
+    lidet_proposal_t proposal;
+    uint16_t order[LIDET_MAX_CLUSTERS];  /* candidate clusters, nearest first */
+    float key[LIDET_MAX_CLUSTERS];       /* their squared horizontal ranges */
+    lidet_detection_t det[LIDET_MAX_DETECTIONS + 1]; /* + 1: a candidate before the capacity check */
+    uint32_t n_det;
+    lidet_detector_stats_t stats;
+} lidet_detector_t;
+
+/**
+ * @brief Defaults for a sensor: each stage's defaults, 64 points per proposal, 360 degrees, at most 64
+ *        proposals, both gates on, NMS at BEV IoU 0.1, the class size ranges of docs/DETECTOR.md.
+ */
+void lidet_detector_cfg_default(lidet_detector_cfg_t *cfg, const lidet_sensor_t *sensor);
+
+/**
+ * @brief Initialise the stages and bind the two models (checked: format version, kinds, dimensions,
+ *        the same points per proposal, which must fit LIDET_PROPOSAL_POINTS, and the scratch they need).
+ * @param[out] d   detector (caller-owned, static).
+ * @param[in]  cfg configuration (copied).
+ * @param[in]  cls classifier model (retained; generated models are static const).
+ * @param[in]  box box-net model (retained).
+ * @return LIDET_OK; LIDET_ERR_ARG (NULL); LIDET_ERR_CONFIG (a detector field out of range) or a stage's
+ *         init error; LIDET_ERR_MODEL (a model fails lidet_pn_check, wrong kind, different points per
+ *         proposal, or PVLE bins other than the proposal configuration's); LIDET_ERR_BUFFER (a model
+ *         needs more than LIDET_DETECTOR_PN_SCRATCH bytes of scratch).
+ */
+lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *cls,
+                                   const lidet_pn_model_t *box);
+
+/**
+ * @brief Detect road users in one scan.
+ * @param[in,out] d           initialised detector; the previous scan's results are overwritten.
+ * @param[in]     points      n_points records of `stride` floats, x y z first (metres, sensor frame).
+ * @param[in]     n_points    records (only the first LIDET_MAX_POINTS are read).
+ * @param[in]     stride      floats per record (>= 3; 4 for KITTI .bin).
+ * @param[in]     ring        optional ring index per point, or NULL.
+ * @param[out]    point_pixel optional LIDET_MAX_POINTS int32 for per-point labels, or NULL.
+ * @return LIDET_OK; LIDET_TRUNCATED when a stage truncated, clusters were over the proposal budget or
+ *         detections over capacity (stats say which); a stage's error (nothing detected).
+ */
+lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint32_t n_points, uint32_t stride,
+                                  const uint16_t *ring, int32_t *point_pixel);
+
+/** @brief Detections of the last run, best score first (valid until the next run). */
+const lidet_detection_t *lidet_detector_detections(const lidet_detector_t *d, uint32_t *n_detections);
+
+/** @brief Counts (and ticks) of the last run. */
+const lidet_detector_stats_t *lidet_detector_stats(const lidet_detector_t *d);
+
+/** @brief The stage workspace (range image, ground mask, clusters of the last run). */
+const lidet_workspace_t *lidet_detector_workspace(const lidet_detector_t *d);
+
+/** @brief sizeof(lidet_detector_t): the bytes a firmware must place. */
+uint32_t lidet_detector_bytes(void);
+
+/**
+ * @brief Rotated bird's-eye-view IoU of two boxes (footprints in x-y; exposed for tests and tools).
+ * @return intersection area / union area in [0, 1]; 0 for degenerate boxes.
+ */
+float lidet_box_bev_iou(const lidet_box_t *a, const lidet_box_t *b);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LIDET_DETECTOR_H */

@@ -1,0 +1,461 @@
+/* SPDX-License-Identifier: MIT */
+/* The detector (see lidet_detector.h): the stage workspace, the two PointNets, the size check and the
+ * BEV NMS. Mirrored by tools/lidet_tools/detect_ref.py (the same chain through the bindings). */
+#include <math.h>
+#include <string.h>
+
+#include "internal/lidet_math.h"
+#include "lidet/lidet_detector.h"
+
+/* plausible sizes (l, w, h, metres) per class; the KITTI training labels' range with margin
+ * (docs/DETECTOR.md): car 2.0-7.5 x 1.2-3.0 x 0.9-3.2, cyclist 0.8-2.6 x 0.2-1.5 x 0.8-2.4,
+ * pedestrian 0.2-1.6 x 0.2-1.6 x 0.7-2.4 */
+static const float CLASS_SIZE_MIN[LIDET_N_CLASSES][3] = {{2.0f, 1.2f, 0.9f}, {0.8f, 0.2f, 0.8f}, {0.2f, 0.2f, 0.7f}};
+static const float CLASS_SIZE_MAX[LIDET_N_CLASSES][3] = {{7.5f, 3.0f, 3.2f}, {2.6f, 1.5f, 2.4f}, {1.6f, 1.6f, 2.4f}};
+
+void lidet_detector_cfg_default(lidet_detector_cfg_t *cfg, const lidet_sensor_t *sensor)
+{
+    if (cfg == 0)
+    {
+        return;
+    }
+    memset(cfg, 0, sizeof *cfg);
+    lidet_workspace_cfg_default(&cfg->stages, sensor);
+    lidet_proposal_cfg_default(&cfg->proposal);
+    cfg->crop_half_rad = 0.0f;
+    cfg->max_range_m = 0.0f;
+    cfg->max_proposals = 64u < LIDET_MAX_CLUSTERS ? 64u : LIDET_MAX_CLUSTERS;
+    cfg->gate1 = 1;
+    cfg->gate2 = 1;
+    cfg->nms_iou = 0.1f;
+    memcpy(cfg->size_min_m, CLASS_SIZE_MIN, sizeof CLASS_SIZE_MIN);
+    memcpy(cfg->size_max_m, CLASS_SIZE_MAX, sizeof CLASS_SIZE_MAX);
+}
+
+static int cfg_ok(const lidet_detector_cfg_t *c)
+{
+    uint32_t k, j;
+    if (!lidet__isfinite(c->crop_half_rad) || c->crop_half_rad < 0.0f || c->crop_half_rad > LIDET_PI_F + 1e-6f ||
+        !lidet__isfinite(c->max_range_m) || c->max_range_m < 0.0f || c->max_proposals < 1 ||
+        c->max_proposals > LIDET_MAX_CLUSTERS || c->gate1 > 1 || c->gate2 > 1 || !lidet__isfinite(c->nms_iou) ||
+        c->nms_iou < 0.0f || c->nms_iou > 1.0f)
+    {
+        return 0;
+    }
+    for (k = 0; k < LIDET_N_CLASSES; ++k)
+    {
+        for (j = 0; j < 3; ++j)
+        {
+            if (!lidet__isfinite(c->size_min_m[k][j]) || !lidet__isfinite(c->size_max_m[k][j]) ||
+                !(c->size_min_m[k][j] <= c->size_max_m[k][j]))
+            {
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
+lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *cls,
+                                   const lidet_pn_model_t *box)
+{
+    lidet_status_t st;
+    uint32_t k;
+    if (d == 0 || cfg == 0 || cls == 0 || box == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    d->magic = 0;
+    if (!cfg_ok(cfg))
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    if (lidet_pn_check(cls, LIDET_PN_CLASSIFIER, 0) != LIDET_OK || lidet_pn_check(box, LIDET_PN_BOX, 0) != LIDET_OK ||
+        cls->n_points != box->n_points)
+    {
+        return LIDET_ERR_MODEL;
+    }
+    for (k = 0; k < 3; ++k)
+    {
+        /* the models were trained on voxels of these sizes: another proposal configuration would feed
+         * them bins they never saw */
+        const float p = k == 0 ? cfg->proposal.azimuth_bin_rad : k == 1 ? cfg->proposal.elevation_bin_rad
+                                                                         : cfg->proposal.range_bin_m;
+        if (cls->pvle_bin[k] != p || box->pvle_bin[k] != p)
+        {
+            return LIDET_ERR_MODEL;
+        }
+    }
+    st = lidet_workspace_init(&d->ws, &cfg->stages);
+    if (st != LIDET_OK)
+    {
+        return st;
+    }
+    st = lidet_pn_init(&d->cls, cls, d->pn_scratch, sizeof d->pn_scratch, 0);
+    if (st == LIDET_OK)
+    {
+        st = lidet_pn_init(&d->box, box, d->pn_scratch, sizeof d->pn_scratch, 0);
+    }
+    if (st != LIDET_OK)
+    {
+        return st;
+    }
+    d->cfg = *cfg;
+    d->cfg.proposal.n_points = cls->n_points;
+    d->n_det = 0;
+    memset(&d->stats, 0, sizeof d->stats);
+    d->magic = LIDET_INIT_MAGIC;
+    return LIDET_OK;
+}
+
+static uint32_t now(const lidet_detector_t *d)
+{
+    return d->cfg.clock != 0 ? d->cfg.clock(d->cfg.clock_ctx) : 0u;
+}
+
+/* ---- candidate order: heapsort of (key, index), ties by index (deterministic, no recursion) -------- */
+
+static int before(const float *key, const uint16_t *idx, uint32_t a, uint32_t b)
+{
+    return key[a] < key[b] || (key[a] == key[b] && idx[a] < idx[b]);
+}
+
+static void swap2(float *key, uint16_t *idx, uint32_t a, uint32_t b)
+{
+    const float k = key[a];
+    const uint16_t i = idx[a];
+    key[a] = key[b];
+    idx[a] = idx[b];
+    key[b] = k;
+    idx[b] = i;
+}
+
+static void sift(float *key, uint16_t *idx, uint32_t root, uint32_t n)
+{
+    for (;;)
+    {
+        uint32_t c = 2u * root + 1u;
+        if (c >= n)
+        {
+            return;
+        }
+        if (c + 1u < n && before(key, idx, c, c + 1u))
+        {
+            ++c;
+        }
+        if (!before(key, idx, root, c))
+        {
+            return;
+        }
+        swap2(key, idx, root, c);
+        root = c;
+    }
+}
+
+static void sort_candidates(float *key, uint16_t *idx, uint32_t n)
+{
+    uint32_t i;
+    if (n < 2)
+    {
+        return;
+    }
+    for (i = n / 2u; i-- > 0;)
+    {
+        sift(key, idx, i, n);
+    }
+    for (i = n - 1u; i > 0; --i)
+    {
+        swap2(key, idx, 0, i);
+        sift(key, idx, 0, i);
+    }
+}
+
+/* ---- rotated BEV IoU (convex polygon clipping, Sutherland-Hodgman) ---------------------------------- */
+
+static void corners(const lidet_box_t *b, float xy[8])
+{
+    const float c = cosf(b->yaw_rad), s = sinf(b->yaw_rad);
+    const float hl = 0.5f * b->l_m, hw = 0.5f * b->w_m;
+    const float dx[4] = {hl, -hl, -hl, hl}, dy[4] = {hw, hw, -hw, -hw};
+    uint32_t k;
+    for (k = 0; k < 4; ++k)
+    {
+        xy[2u * k] = b->cx_m + c * dx[k] - s * dy[k];
+        xy[2u * k + 1u] = b->cy_m + s * dx[k] + c * dy[k];
+    }
+}
+
+/* clip polygon p (n vertices, counter-clockwise) by the half-plane left of edge a -> b */
+static uint32_t clip(const float *p, uint32_t n, float ax, float ay, float bx, float by, float *out)
+{
+    uint32_t i, m = 0;
+    for (i = 0; i < n; ++i)
+    {
+        const float *u = p + 2u * i, *v = p + 2u * ((i + 1u) % n);
+        const float su = (bx - ax) * (u[1] - ay) - (by - ay) * (u[0] - ax);
+        const float sv = (bx - ax) * (v[1] - ay) - (by - ay) * (v[0] - ax);
+        if (su >= 0.0f)
+        {
+            out[2u * m] = u[0];
+            out[2u * m + 1u] = u[1];
+            ++m;
+        }
+        if ((su >= 0.0f) != (sv >= 0.0f))
+        {
+            const float t = su / (su - sv);
+            out[2u * m] = u[0] + t * (v[0] - u[0]);
+            out[2u * m + 1u] = u[1] + t * (v[1] - u[1]);
+            ++m;
+        }
+    }
+    return m;
+}
+
+static float area(const float *p, uint32_t n)
+{
+    uint32_t i;
+    float a = 0.0f;
+    for (i = 0; i < n; ++i)
+    {
+        const float *u = p + 2u * i, *v = p + 2u * ((i + 1u) % n);
+        a += u[0] * v[1] - v[0] * u[1];
+    }
+    return 0.5f * fabsf(a);
+}
+
+float lidet_box_bev_iou(const lidet_box_t *a, const lidet_box_t *b)
+{
+    float pa[8], pb[8], buf0[32], buf1[32], inter, ua, ub;
+    uint32_t n = 4, k;
+    if (a == 0 || b == 0 || !(a->l_m > 0.0f) || !(a->w_m > 0.0f) || !(b->l_m > 0.0f) || !(b->w_m > 0.0f))
+    {
+        return 0.0f;
+    }
+    /* far apart: no overlap (also avoids clipping far-away polygons) */
+    {
+        const float ra = 0.5f * (a->l_m + a->w_m), rb = 0.5f * (b->l_m + b->w_m);
+        const float dx = a->cx_m - b->cx_m, dy = a->cy_m - b->cy_m;
+        if (dx * dx + dy * dy > (ra + rb) * (ra + rb))
+        {
+            return 0.0f;
+        }
+    }
+    corners(a, pa);
+    corners(b, pb);
+    memcpy(buf0, pa, sizeof pa);
+    for (k = 0; k < 4 && n > 0; ++k)
+    {
+        const float *e0 = pb + 2u * k, *e1 = pb + 2u * ((k + 1u) % 4u);
+        n = clip(buf0, n, e0[0], e0[1], e1[0], e1[1], buf1);
+        memcpy(buf0, buf1, 2u * n * sizeof(float));
+    }
+    inter = n >= 3 ? area(buf0, n) : 0.0f;
+    ua = a->l_m * a->w_m;
+    ub = b->l_m * b->w_m;
+    return inter > 0.0f ? inter / (ua + ub - inter) : 0.0f;
+}
+
+/* ---- the run -------------------------------------------------------------------------------------- */
+
+static int size_ok(const lidet_detector_cfg_t *c, uint32_t cls, const lidet_box_t *b)
+{
+    const float v[3] = {b->l_m, b->w_m, b->h_m};
+    uint32_t j;
+    for (j = 0; j < 3; ++j)
+    {
+        if (!(v[j] >= c->size_min_m[cls][j] && v[j] <= c->size_max_m[cls][j]))
+        {
+            return 0;
+        }
+    }
+    return 1;
+}
+
+/* insert detection t (at det[n]) into det[0..n) sorted by score, best first (ties: lower cluster id) */
+static void insert_sorted(lidet_detection_t *det, uint32_t n)
+{
+    const lidet_detection_t t = det[n];
+    uint32_t i = n;
+    while (i > 0 && (det[i - 1u].score < t.score ||
+                     (det[i - 1u].score == t.score && det[i - 1u].cluster_id > t.cluster_id)))
+    {
+        det[i] = det[i - 1u];
+        --i;
+    }
+    det[i] = t;
+}
+
+lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint32_t n_points, uint32_t stride,
+                                  const uint16_t *ring, int32_t *point_pixel)
+{
+    const lidet_cluster_rec_t *recs;
+    lidet_detector_stats_t *st;
+    lidet_status_t s, worst;
+    uint32_t n_rec = 0, n_cand = 0, i, t0, t1, cls_ticks = 0, box_ticks = 0;
+    const int crop = d != 0 && d->cfg.crop_half_rad > 0.0f && d->cfg.crop_half_rad < LIDET_PI_F;
+    const float crop_s = crop ? sinf(d->cfg.crop_half_rad) : 0.0f, crop_c = crop ? cosf(d->cfg.crop_half_rad) : 0.0f;
+    if (d == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (d->magic != LIDET_INIT_MAGIC)
+    {
+        return LIDET_ERR_STATE;
+    }
+    st = &d->stats;
+    memset(st, 0, sizeof *st);
+    d->n_det = 0;
+    s = lidet_workspace_run_timed(&d->ws, points, n_points, stride, ring, point_pixel, d->cfg.clock,
+                                  d->cfg.clock_ctx, &st->ticks[LIDET_DET_STAGE_PROJECT]);
+    lidet_workspace_stats(&d->ws, &st->stages);
+    if (s < 0)
+    {
+        return s;
+    }
+    worst = s;
+
+    /* candidates: in the window and range, nearest first, at most max_proposals */
+    t0 = now(d);
+    recs = lidet_workspace_clusters(&d->ws, &n_rec);
+    st->n_clusters = n_rec;
+    for (i = 0; i < n_rec; ++i)
+    {
+        const float x = recs[i].mean_m[0], y = recs[i].mean_m[1];
+        const float r2 = x * x + y * y;
+        /* |atan2(y, x)| <= h  <=>  x sin h >= |y| cos h  (sin(h - |azimuth|) >= 0), for any h in (0, pi) */
+        if (crop && !(x * crop_s >= fabsf(y) * crop_c))
+        {
+            ++st->n_out_of_crop;
+            continue;
+        }
+        if (d->cfg.max_range_m > 0.0f && r2 > d->cfg.max_range_m * d->cfg.max_range_m)
+        {
+            ++st->n_out_of_range;
+            continue;
+        }
+        d->key[n_cand] = r2;
+        d->order[n_cand] = (uint16_t)i;
+        ++n_cand;
+    }
+    sort_candidates(d->key, d->order, n_cand);
+    if (n_cand > d->cfg.max_proposals)
+    {
+        st->n_over_budget = n_cand - d->cfg.max_proposals;
+        n_cand = d->cfg.max_proposals;
+        worst = LIDET_TRUNCATED;
+    }
+
+    for (i = 0; i < n_cand; ++i)
+    {
+        const uint32_t ci = d->order[i];
+        lidet_pn_class_out_t co;
+        lidet_pn_box_out_t bo;
+        lidet_detection_t *t;
+        uint32_t tb;
+        s = lidet_workspace_proposal(&d->ws, ci, &d->cfg.proposal, &d->proposal);
+        if (s == LIDET_OK)
+        {
+            s = lidet_pn_classify(&d->cls, &d->proposal, &co);
+        }
+        if (s != LIDET_OK)
+        {
+            return s; /* cannot happen after a successful init and run */
+        }
+        ++st->n_classified;
+        if (d->cfg.gate1 && !co.pass)
+        {
+            ++st->n_gate1_rejected;
+            continue;
+        }
+        tb = now(d);
+        s = lidet_pn_box(&d->box, &d->proposal, co.cls, &bo);
+        box_ticks += now(d) - tb;
+        if (s != LIDET_OK)
+        {
+            return s;
+        }
+        ++st->n_boxed;
+        if (d->cfg.gate2 && !bo.pass)
+        {
+            ++st->n_gate2_rejected;
+            continue;
+        }
+        if (!size_ok(&d->cfg, co.cls, &bo.box))
+        {
+            ++st->n_size_rejected;
+            continue;
+        }
+        t = &d->det[d->n_det];
+        t->box = bo.box;
+        t->cls = co.cls;
+        t->score = 1.0f / (1.0f + expf(co.energy - d->cls.model->gamma[co.cls]));
+        t->energy_cls = co.energy;
+        t->energy_box = bo.energy;
+        t->cluster_id = ci + 1u;
+        t->n_points = recs[ci].n_points;
+        insert_sorted(d->det, d->n_det);
+        ++d->n_det;
+        if (d->n_det > LIDET_MAX_DETECTIONS)
+        {
+            --d->n_det; /* the lowest score goes */
+            ++st->n_over_capacity;
+            worst = LIDET_TRUNCATED;
+        }
+    }
+    t1 = now(d);
+    cls_ticks = (t1 - t0) - box_ticks;
+    st->ticks[LIDET_DET_STAGE_CLASSIFY] = cls_ticks;
+    st->ticks[LIDET_DET_STAGE_BOX] = box_ticks;
+
+    /* NMS over the score-sorted list: keep a detection unless it overlaps a kept one too much */
+    t0 = now(d);
+    {
+        uint32_t kept = 0, j;
+        for (i = 0; i < d->n_det; ++i)
+        {
+            int drop = 0;
+            for (j = 0; j < kept && !drop; ++j)
+            {
+                drop = lidet_box_bev_iou(&d->det[i].box, &d->det[j].box) > d->cfg.nms_iou;
+            }
+            if (drop)
+            {
+                ++st->n_nms_suppressed;
+                continue;
+            }
+            d->det[kept++] = d->det[i];
+        }
+        d->n_det = kept;
+    }
+    st->n_detections = d->n_det;
+    st->ticks[LIDET_DET_STAGE_POST] = now(d) - t0;
+    return worst;
+}
+
+const lidet_detection_t *lidet_detector_detections(const lidet_detector_t *d, uint32_t *n_detections)
+{
+    if (d == 0)
+    {
+        return 0;
+    }
+    if (n_detections != 0)
+    {
+        *n_detections = d->magic == LIDET_INIT_MAGIC ? d->n_det : 0u;
+    }
+    return d->det;
+}
+
+const lidet_detector_stats_t *lidet_detector_stats(const lidet_detector_t *d)
+{
+    return d == 0 ? 0 : &d->stats;
+}
+
+const lidet_workspace_t *lidet_detector_workspace(const lidet_detector_t *d)
+{
+    return d == 0 ? 0 : &d->ws;
+}
+
+uint32_t lidet_detector_bytes(void)
+{
+    return (uint32_t)sizeof(lidet_detector_t);
+}

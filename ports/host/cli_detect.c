@@ -1,0 +1,640 @@
+/* SPDX-License-Identifier: MIT */
+/* `lidet detect`: the whole detector (lidet_detector.h) on one scan, with the models of lidet::weights.
+ * Outputs: a table (or --json), lidet's sensor-frame box lines (--out), KITTI label_2 lines in the camera
+ * frame with the 2D box of the projected corners (--calib + --kitti-out, so lidet-eval kitti scores them),
+ * and a bird's-eye view with the detections and, given --gt, the ground-truth boxes (--png). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cli.h"
+#include "lidet_weights.h"
+
+static lidet_detector_t g_det;
+
+static const char *const k_class_names[LIDET_N_CLASSES] = {"Car", "Cyclist", "Pedestrian"};
+
+static uint32_t clock_ns(void *ctx)
+{
+    struct timespec ts;
+    (void)ctx;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (uint32_t)((uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec);
+}
+
+/* ---- KITTI calibration and label_2 output ------------------------------------------------------ */
+
+typedef struct
+{
+    double P2[12], R0[9], Tr[12];
+    int have_p2, have_tr;
+} calib_t;
+
+static int read_calib(const char *path, calib_t *c)
+{
+    FILE *f = fopen(path, "r");
+    char line[1024];
+    int ln = 0;
+    memset(c, 0, sizeof *c);
+    c->R0[0] = c->R0[4] = c->R0[8] = 1.0;
+    if (f == NULL)
+    {
+        fprintf(stderr, "lidet detect: cannot open calibration '%s'\n", path);
+        return 1;
+    }
+    while (fgets(line, sizeof line, f) != NULL)
+    {
+        char *colon = strchr(line, ':'), *p;
+        double *dst = NULL;
+        int n = 0, want = 0;
+        ++ln;
+        if (colon == NULL)
+            continue;
+        *colon = '\0';
+        if (strcmp(line, "P2") == 0)
+        {
+            dst = c->P2;
+            want = 12;
+            c->have_p2 = 1;
+        }
+        else if (strcmp(line, "R0_rect") == 0 || strcmp(line, "R_rect") == 0)
+        {
+            dst = c->R0;
+            want = 9;
+        }
+        else if (strcmp(line, "Tr_velo_to_cam") == 0 || strcmp(line, "Tr_velo_cam") == 0)
+        {
+            dst = c->Tr;
+            want = 12;
+            c->have_tr = 1;
+        }
+        if (dst == NULL)
+            continue;
+        p = colon + 1;
+        while (n < want)
+        {
+            char *end;
+            const double v = strtod(p, &end);
+            if (end == p || !isfinite(v))
+                break;
+            dst[n++] = v;
+            p = end;
+        }
+        if (n != want)
+        {
+            fprintf(stderr, "lidet detect: %s:%d: %s needs %d numbers\n", path, ln, line, want);
+            fclose(f);
+            return 1;
+        }
+    }
+    fclose(f);
+    if (!c->have_p2 || !c->have_tr)
+    {
+        fprintf(stderr, "lidet detect: %s: P2 and Tr_velo_to_cam are required\n", path);
+        return 1;
+    }
+    return 0;
+}
+
+/* sensor frame -> rectified camera frame: R0 (Tr p) */
+static void velo_to_rect(const calib_t *c, const double p[3], double out[3])
+{
+    double q[3];
+    int i;
+    for (i = 0; i < 3; ++i)
+        q[i] = c->Tr[4 * i] * p[0] + c->Tr[4 * i + 1] * p[1] + c->Tr[4 * i + 2] * p[2] + c->Tr[4 * i + 3];
+    for (i = 0; i < 3; ++i)
+        out[i] = c->R0[3 * i] * q[0] + c->R0[3 * i + 1] * q[1] + c->R0[3 * i + 2] * q[2];
+}
+
+static double wrap_pi(double a)
+{
+    while (a > M_PI_D)
+        a -= 2.0 * M_PI_D;
+    while (a <= -M_PI_D)
+        a += 2.0 * M_PI_D;
+    return a;
+}
+
+/* One label_2 line; 0, or 1 when the box is behind the camera (not written). Image 1242 x 375. */
+static int kitti_line(FILE *f, const calib_t *c, const lidet_detection_t *d)
+{
+    const lidet_box_t *b = &d->box;
+    const double cy = cos(b->yaw_rad), sy = sin(b->yaw_rad);
+    double ctr[3], loc[3], dir_s[3], dir_r[3], zero[3] = {0, 0, 0}, o_r[3], ry, alpha;
+    double x1 = 1e30, y1 = 1e30, x2 = -1e30, y2 = -1e30;
+    int k;
+    ctr[0] = b->cx_m;
+    ctr[1] = b->cy_m;
+    ctr[2] = b->cz_m;
+    velo_to_rect(c, ctr, loc);
+    loc[1] += 0.5 * b->h_m; /* KITTI stores the bottom centre; camera y points down */
+    /* heading direction through the rotation part only */
+    dir_s[0] = cy;
+    dir_s[1] = sy;
+    dir_s[2] = 0.0;
+    velo_to_rect(c, dir_s, dir_r);
+    velo_to_rect(c, zero, o_r);
+    for (k = 0; k < 3; ++k)
+        dir_r[k] -= o_r[k];
+    ry = wrap_pi(atan2(-dir_r[2], dir_r[0]));
+    alpha = wrap_pi(ry - atan2(loc[0], loc[2]));
+    for (k = 0; k < 8; ++k)
+    {
+        const double dx = ((k & 3) == 0 || (k & 3) == 3 ? 0.5 : -0.5) * b->l_m;
+        const double dy = ((k & 3) < 2 ? 0.5 : -0.5) * b->w_m;
+        const double dz = (k < 4 ? -0.5 : 0.5) * b->h_m;
+        double p[3], r[3], u, v, w;
+        p[0] = b->cx_m + cy * dx - sy * dy;
+        p[1] = b->cy_m + sy * dx + cy * dy;
+        p[2] = b->cz_m + dz;
+        velo_to_rect(c, p, r);
+        if (r[2] < 0.1)
+            return 1;
+        u = c->P2[0] * r[0] + c->P2[1] * r[1] + c->P2[2] * r[2] + c->P2[3];
+        v = c->P2[4] * r[0] + c->P2[5] * r[1] + c->P2[6] * r[2] + c->P2[7];
+        w = c->P2[8] * r[0] + c->P2[9] * r[1] + c->P2[10] * r[2] + c->P2[11];
+        u /= w;
+        v /= w;
+        x1 = u < x1 ? u : x1;
+        x2 = u > x2 ? u : x2;
+        y1 = v < y1 ? v : y1;
+        y2 = v > y2 ? v : y2;
+    }
+    x1 = x1 < 0 ? 0 : (x1 > 1241 ? 1241 : x1);
+    x2 = x2 < 0 ? 0 : (x2 > 1241 ? 1241 : x2);
+    y1 = y1 < 0 ? 0 : (y1 > 374 ? 374 : y1);
+    y2 = y2 < 0 ? 0 : (y2 > 374 ? 374 : y2);
+    fprintf(f, "%s 0.00 0 %.2f %.2f %.2f %.2f %.2f %.3f %.3f %.3f %.3f %.3f %.3f %.4f %.4f\n", k_class_names[d->cls],
+            alpha, x1, y1, x2, y2, (double)b->h_m, (double)b->w_m, (double)b->l_m, loc[0], loc[1], loc[2], ry,
+            (double)d->score);
+    return 0;
+}
+
+/* ---- ground truth in lidet's sensor-frame line format (for the picture) ------------------------- */
+
+typedef struct
+{
+    lidet_box_t box;
+    char cls[32];
+} gt_t;
+
+static int read_gt(const char *path, gt_t **out, uint32_t *n)
+{
+    FILE *f = fopen(path, "r");
+    char line[512];
+    uint32_t cap = 0;
+    int ln = 0;
+    *out = NULL;
+    *n = 0;
+    if (f == NULL)
+    {
+        fprintf(stderr, "lidet detect: cannot open '%s'\n", path);
+        return 1;
+    }
+    while (fgets(line, sizeof line, f) != NULL)
+    {
+        gt_t g;
+        float v[8];
+        char *hash = strchr(line, '#');
+        ++ln;
+        if (hash != NULL)
+            *hash = '\0';
+        if (strspn(line, " \t\r\n") == strlen(line))
+            continue;
+        if (sscanf(line, "%31s %f %f %f %f %f %f %f %f", g.cls, &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6],
+                   &v[7]) != 9)
+        {
+            fprintf(stderr, "lidet detect: %s:%d: expected '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>'\n", path,
+                    ln);
+            free(*out);
+            fclose(f);
+            return 1;
+        }
+        g.box.cx_m = v[0];
+        g.box.cy_m = v[1];
+        g.box.cz_m = v[2];
+        g.box.l_m = v[3];
+        g.box.w_m = v[4];
+        g.box.h_m = v[5];
+        g.box.yaw_rad = v[6];
+        if (*n == cap)
+        {
+            gt_t *t;
+            cap = cap ? 2u * cap : 16u;
+            t = (gt_t *)realloc(*out, cap * sizeof(gt_t));
+            if (t == NULL)
+            {
+                free(*out);
+                fclose(f);
+                return 1;
+            }
+            *out = t;
+        }
+        (*out)[(*n)++] = g;
+    }
+    fclose(f);
+    return 0;
+}
+
+/* ---- bird's-eye picture -------------------------------------------------------------------------- */
+
+#define BEV_W 800u
+#define BEV_H 800u
+#define BEV_RES 0.1f
+
+static void put(uint8_t *rgb, int u, int v, const uint8_t c[3])
+{
+    if (u >= 0 && v >= 0 && u < (int)BEV_W && v < (int)BEV_H)
+    {
+        uint8_t *p = rgb + ((size_t)v * BEV_W + (size_t)u) * 3u;
+        p[0] = c[0];
+        p[1] = c[1];
+        p[2] = c[2];
+    }
+}
+
+static void line_px(uint8_t *rgb, float x0, float y0, float x1, float y1, const uint8_t c[3])
+{
+    /* sensor (x, y) -> pixel (u, v): +x up, +y left */
+    const float u0 = (float)BEV_W * 0.5f - y0 / BEV_RES, v0 = (float)BEV_H * 0.5f - x0 / BEV_RES;
+    const float u1 = (float)BEV_W * 0.5f - y1 / BEV_RES, v1 = (float)BEV_H * 0.5f - x1 / BEV_RES;
+    const float du = u1 - u0, dv = v1 - v0;
+    const int steps = (int)(fabsf(du) > fabsf(dv) ? fabsf(du) : fabsf(dv)) + 1;
+    int i;
+    if (steps > 4 * (int)BEV_W)
+        return;
+    for (i = 0; i <= steps; ++i)
+    {
+        const float t = (float)i / (float)steps;
+        const int u = (int)floorf(u0 + t * du), v = (int)floorf(v0 + t * dv);
+        put(rgb, u, v, c);
+        put(rgb, u + 1, v, c);
+    }
+}
+
+static void draw_box(uint8_t *rgb, const lidet_box_t *b, const uint8_t c[3], int heading)
+{
+    const float cy = cosf(b->yaw_rad), sy = sinf(b->yaw_rad);
+    float x[4], y[4];
+    int k;
+    for (k = 0; k < 4; ++k)
+    {
+        const float dx = (k == 0 || k == 3 ? 0.5f : -0.5f) * b->l_m, dy = (k < 2 ? 0.5f : -0.5f) * b->w_m;
+        x[k] = b->cx_m + cy * dx - sy * dy;
+        y[k] = b->cy_m + sy * dx + cy * dy;
+    }
+    for (k = 0; k < 4; ++k)
+        line_px(rgb, x[k], y[k], x[(k + 1) % 4], y[(k + 1) % 4], c);
+    if (heading) /* a tick from the centre to the front */
+        line_px(rgb, b->cx_m, b->cy_m, 0.5f * (x[0] + x[3]), 0.5f * (y[0] + y[3]), c);
+}
+
+static const uint8_t k_class_rgb[LIDET_N_CLASSES][3] = {{255, 80, 60}, {60, 220, 255}, {255, 220, 40}};
+
+static int write_png(const char *path, const float *pts, uint32_t n, const uint8_t *ground_pp,
+                     const lidet_detection_t *det, uint32_t n_det, const gt_t *gt, uint32_t n_gt)
+{
+    uint8_t *rgb = (uint8_t *)calloc((size_t)BEV_W * BEV_H * 3u, 1);
+    const uint8_t grey[3] = {120, 120, 120}, dark[3] = {45, 45, 55}, green[3] = {60, 230, 90};
+    uint32_t i;
+    int rc;
+    if (rgb == NULL)
+        return -1;
+    for (i = 0; i < n; ++i)
+    {
+        const float x = pts[4 * i], y = pts[4 * i + 1];
+        const int u = (int)floorf((float)BEV_W * 0.5f - y / BEV_RES), v = (int)floorf((float)BEV_H * 0.5f - x / BEV_RES);
+        if (ground_pp != NULL && ground_pp[i])
+        {
+            if (u >= 0 && v >= 0 && u < (int)BEV_W && v < (int)BEV_H && rgb[((size_t)v * BEV_W + (size_t)u) * 3u] == 0)
+                put(rgb, u, v, dark);
+        }
+        else
+            put(rgb, u, v, grey);
+    }
+    for (i = 0; i < n_gt; ++i)
+        draw_box(rgb, &gt[i].box, green, 0);
+    for (i = 0; i < n_det; ++i)
+        draw_box(rgb, &det[i].box, k_class_rgb[det[i].cls], 1);
+    rc = lidet_png_write_rgb(path, rgb, BEV_W, BEV_H);
+    free(rgb);
+    return rc;
+}
+
+/* ---- options -------------------------------------------------------------------------------------- */
+
+static int apply_set(lidet_detector_cfg_t *c, const char *kv)
+{
+    size_t klen;
+    double v;
+    if (cli_split_set(kv, &klen, &v) != 0)
+        return 1;
+    CLI_SET_FLOAT(c, kv, klen, v, crop_half_rad)
+    CLI_SET_FLOAT(c, kv, klen, v, max_range_m)
+    CLI_SET_FLOAT(c, kv, klen, v, nms_iou)
+    CLI_SET_INT(c, kv, klen, v, max_proposals, uint32_t, 4294967295.0)
+    CLI_SET_INT(c, kv, klen, v, gate1, uint8_t, 1)
+    CLI_SET_INT(c, kv, klen, v, gate2, uint8_t, 1)
+    return 1;
+}
+
+static void usage_extra(void)
+{
+    fprintf(stderr, "  --model NAME     model family: weights cls_NAME + box_NAME (default: the sensor's family,\n"
+                    "                   else hdl64); available:");
+    {
+        uint32_t i;
+        for (i = 0; i < LIDET_WEIGHTS_N_MODELS; ++i)
+            fprintf(stderr, " %s", lidet_weights_models[i].name);
+    }
+    fprintf(stderr, "\n  --crop           keep the KITTI camera field of view only (|azimuth| <= 45 deg)\n"
+                    "  --calib FILE     KITTI calibration (P2, R0_rect, Tr_velo_to_cam) for --kitti-out\n"
+                    "  --kitti-out FILE label_2 lines in the camera frame (2D box from the projected corners)\n"
+                    "  --gt FILE        ground-truth boxes (lidet's sensor-frame lines) drawn in --png\n"
+                    "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
+                    "                   nms_iou, max_proposals, gate1, gate2\n"
+                    "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n");
+}
+
+static int pick_models(const char *family, const char *sensor, const lidet_pn_model_t **cls,
+                       const lidet_pn_model_t **box, char *chosen, size_t chosen_len)
+{
+    char name[96];
+    const char *fams[2];
+    int k;
+    fams[0] = family != NULL ? family : sensor;
+    fams[1] = family != NULL ? NULL : "hdl64";
+    for (k = 0; k < 2 && fams[k] != NULL; ++k)
+    {
+        snprintf(name, sizeof name, "cls_%s", fams[k]);
+        *cls = lidet_pn_find(lidet_weights_models, LIDET_WEIGHTS_N_MODELS, name);
+        snprintf(name, sizeof name, "box_%s", fams[k]);
+        *box = lidet_pn_find(lidet_weights_models, LIDET_WEIGHTS_N_MODELS, name);
+        if (*cls != NULL && *box != NULL)
+        {
+            snprintf(chosen, chosen_len, "%s", fams[k]);
+            return 0;
+        }
+    }
+    fprintf(stderr, "lidet detect: no models cls_%s / box_%s in weights/ (lidet detect --help lists them)\n",
+            fams[0], fams[0]);
+    return 1;
+}
+
+static int fail(cli_args_t *a, const char *what, lidet_status_t st)
+{
+    fprintf(stderr, "lidet detect: %s: %s\n", what, lidet_status_str(st));
+    cli_free(a);
+    return 1;
+}
+
+int cli_detect(int argc, char **argv)
+{
+    cli_args_t a;
+    lidet_detector_cfg_t cfg;
+    const lidet_pn_model_t *mc = NULL, *mb = NULL;
+    const lidet_detector_stats_t *ds;
+    const lidet_detection_t *det;
+    lidet_status_t st = LIDET_OK;
+    const char *family = NULL, *calib_path = NULL, *kitti_path = NULL, *gt_path = NULL;
+    char chosen[64];
+    char **rest;
+    const char **sets;
+    int nrest = 0, nsets = 0, i, crop = 0;
+    double *t, ms[LIDET_DET_N_STAGES + 1];
+    uint32_t n_det = 0, k;
+    int32_t *pp = NULL;
+    uint8_t *gp = NULL;
+
+    rest = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
+    sets = (const char **)malloc(sizeof(char *) * (size_t)(argc + 1));
+    if (rest == NULL || sets == NULL)
+    {
+        free(rest);
+        free(sets);
+        return 1;
+    }
+    for (i = 0; i < argc; ++i)
+    {
+        if (strcmp(argv[i], "--model") == 0 && i + 1 < argc)
+            family = argv[++i];
+        else if (strcmp(argv[i], "--calib") == 0 && i + 1 < argc)
+            calib_path = argv[++i];
+        else if (strcmp(argv[i], "--kitti-out") == 0 && i + 1 < argc)
+            kitti_path = argv[++i];
+        else if (strcmp(argv[i], "--gt") == 0 && i + 1 < argc)
+            gt_path = argv[++i];
+        else if (strcmp(argv[i], "--set") == 0 && i + 1 < argc)
+            sets[nsets++] = argv[++i];
+        else if (strcmp(argv[i], "--crop") == 0)
+            crop = 1;
+        else
+            rest[nrest++] = argv[i];
+    }
+    if (cli_parse(nrest, rest, "detect", &a) != 0)
+    {
+        usage_extra();
+        free(rest);
+        free(sets);
+        return 1;
+    }
+    free(rest);
+    if ((kitti_path != NULL) != (calib_path != NULL))
+    {
+        fprintf(stderr, "lidet detect: --kitti-out and --calib go together\n");
+        free(sets);
+        return 1;
+    }
+    if (cli_load(&a) != 0)
+    {
+        free(sets);
+        return 1;
+    }
+    if (pick_models(family, a.sensor, &mc, &mb, chosen, sizeof chosen) != 0)
+    {
+        free(sets);
+        cli_free(&a);
+        return 1;
+    }
+    lidet_detector_cfg_default(&cfg, a.sensor_profile);
+    if (crop)
+        cfg.crop_half_rad = (float)(M_PI_D / 4.0);
+    for (i = 0; i < nsets; ++i)
+    {
+        if (apply_set(&cfg, sets[i]) != 0)
+        {
+            fprintf(stderr, "lidet detect: bad --set '%s' (KEY=VALUE with a lidet_detector_cfg_t field)\n", sets[i]);
+            free(sets);
+            cli_free(&a);
+            return 1;
+        }
+    }
+    free(sets);
+    cfg.clock = clock_ns;
+    st = lidet_detector_init(&g_det, &cfg, mc, mb);
+    if (st != LIDET_OK)
+        return fail(&a, "init (configuration or models)", st);
+
+    t = (double *)malloc(sizeof(double) * (size_t)a.repeat * (LIDET_DET_N_STAGES + 1u));
+    pp = (int32_t *)malloc(sizeof(int32_t) * LIDET_MAX_POINTS);
+    if (t == NULL || pp == NULL)
+    {
+        free(t);
+        free(pp);
+        cli_free(&a);
+        return 1;
+    }
+    for (i = 0; i < a.repeat; ++i)
+    {
+        const double t0 = cli_now_ms();
+        st = lidet_detector_run(&g_det, a.points, a.n_points, 4, a.ring, i == 0 ? pp : NULL);
+        t[(size_t)LIDET_DET_N_STAGES * (size_t)a.repeat + (size_t)i] = cli_now_ms() - t0;
+        if (!LIDET_SUCCEEDED(st))
+        {
+            free(t);
+            free(pp);
+            return fail(&a, "detector", st);
+        }
+        ds = lidet_detector_stats(&g_det);
+        for (k = 0; k < LIDET_DET_N_STAGES; ++k)
+            t[(size_t)k * (size_t)a.repeat + (size_t)i] = (double)ds->ticks[k] * 1e-6;
+    }
+    for (k = 0; k <= LIDET_DET_N_STAGES; ++k)
+        ms[k] = cli_median(t + (size_t)k * (size_t)a.repeat, a.repeat);
+    free(t);
+    ds = lidet_detector_stats(&g_det);
+    det = lidet_detector_detections(&g_det, &n_det);
+
+    if (a.out_path != NULL)
+    {
+        FILE *f = fopen(a.out_path, "w");
+        for (k = 0; f != NULL && k < n_det; ++k)
+            fprintf(f, "%s %.4f %.4f %.4f %.4f %.4f %.4f %.5f %.4f\n", k_class_names[det[k].cls],
+                    (double)det[k].box.cx_m, (double)det[k].box.cy_m, (double)det[k].box.cz_m, (double)det[k].box.l_m,
+                    (double)det[k].box.w_m, (double)det[k].box.h_m, (double)det[k].box.yaw_rad, (double)det[k].score);
+        if (f == NULL || fclose(f) != 0)
+        {
+            fprintf(stderr, "lidet detect: cannot write '%s'\n", a.out_path);
+            free(pp);
+            cli_free(&a);
+            return 1;
+        }
+    }
+    if (kitti_path != NULL)
+    {
+        calib_t c;
+        FILE *f;
+        uint32_t written = 0;
+        if (read_calib(calib_path, &c) != 0)
+        {
+            free(pp);
+            cli_free(&a);
+            return 1;
+        }
+        f = fopen(kitti_path, "w");
+        for (k = 0; f != NULL && k < n_det; ++k)
+            written += kitti_line(f, &c, &det[k]) == 0 ? 1u : 0u;
+        if (f != NULL && written == 0)
+            fprintf(f, "DontCare -1 -1 -10 0 0 0 0 -1 -1 -1 -1000 -1000 -1000 -10 0\n"); /* KITTI's empty frame */
+        if (f == NULL || fclose(f) != 0)
+        {
+            fprintf(stderr, "lidet detect: cannot write '%s'\n", kitti_path);
+            free(pp);
+            cli_free(&a);
+            return 1;
+        }
+    }
+    if (a.png_path != NULL)
+    {
+        gt_t *gt = NULL;
+        uint32_t n_gt = 0, np = a.n_points < LIDET_MAX_POINTS ? a.n_points : LIDET_MAX_POINTS;
+        uint32_t *ids = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(np + 1u));
+        gp = (uint8_t *)malloc((size_t)np + 1u);
+        if (ids == NULL || gp == NULL ||
+            lidet_workspace_point_labels(lidet_detector_workspace(&g_det), pp, np, ids, gp) != LIDET_OK ||
+            (gt_path != NULL && read_gt(gt_path, &gt, &n_gt) != 0) ||
+            write_png(a.png_path, a.points, np, gp, det, n_det, gt, n_gt) != 0)
+        {
+            fprintf(stderr, "lidet detect: cannot write the picture '%s'\n", a.png_path);
+            free(ids);
+            free(gp);
+            free(gt);
+            free(pp);
+            cli_free(&a);
+            return 1;
+        }
+        free(ids);
+        free(gt);
+    }
+    if (a.json)
+    {
+        cli_json_begin(stdout);
+        cli_json_str(stdout, "sensor", a.sensor);
+        cli_json_str(stdout, "model", chosen);
+        cli_json_int(stdout, "points", a.n_points);
+        cli_json_int(stdout, "clusters", ds->n_clusters);
+        cli_json_int(stdout, "out_of_crop", ds->n_out_of_crop);
+        cli_json_int(stdout, "out_of_range", ds->n_out_of_range);
+        cli_json_int(stdout, "over_budget", ds->n_over_budget);
+        cli_json_int(stdout, "classified", ds->n_classified);
+        cli_json_int(stdout, "gate1_rejected", ds->n_gate1_rejected);
+        cli_json_int(stdout, "boxed", ds->n_boxed);
+        cli_json_int(stdout, "gate2_rejected", ds->n_gate2_rejected);
+        cli_json_int(stdout, "size_rejected", ds->n_size_rejected);
+        cli_json_int(stdout, "nms_suppressed", ds->n_nms_suppressed);
+        cli_json_int(stdout, "detections", n_det);
+        cli_json_int(stdout, "status", st);
+        cli_json_int(stdout, "repeat", a.repeat);
+        cli_json_num(stdout, "project_ms", ms[LIDET_DET_STAGE_PROJECT]);
+        cli_json_num(stdout, "ground_ms", ms[LIDET_DET_STAGE_GROUND]);
+        cli_json_num(stdout, "cluster_ms", ms[LIDET_DET_STAGE_CLUSTER]);
+        cli_json_num(stdout, "classify_ms", ms[LIDET_DET_STAGE_CLASSIFY]);
+        cli_json_num(stdout, "box_ms", ms[LIDET_DET_STAGE_BOX]);
+        cli_json_num(stdout, "post_ms", ms[LIDET_DET_STAGE_POST]);
+        cli_json_num(stdout, "total_ms", ms[LIDET_DET_N_STAGES]);
+        fprintf(stdout, ", \"boxes\": [");
+        for (k = 0; k < n_det; ++k)
+            fprintf(stdout,
+                    "%s{\"class\": \"%s\", \"score\": %.5f, \"energy_cls\": %.4f, \"energy_box\": %.4f, "
+                    "\"x\": %.4f, \"y\": %.4f, \"z\": %.4f, \"l\": %.4f, \"w\": %.4f, \"h\": %.4f, \"yaw\": %.5f, "
+                    "\"cluster\": %u, \"cluster_points\": %u}",
+                    k ? ", " : "", k_class_names[det[k].cls], (double)det[k].score, (double)det[k].energy_cls,
+                    (double)det[k].energy_box, (double)det[k].box.cx_m, (double)det[k].box.cy_m,
+                    (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m, (double)det[k].box.h_m,
+                    (double)det[k].box.yaw_rad, det[k].cluster_id, det[k].n_points);
+        fprintf(stdout, "]");
+        cli_json_end(stdout);
+    }
+    else
+    {
+        printf("scan         %s (%s, models %s)\n", a.scan_path, a.sensor, chosen);
+        printf("clusters     %u: %u classified (%u outside the crop, %u beyond range, %u over the budget of %u)\n",
+               ds->n_clusters, ds->n_classified, ds->n_out_of_crop, ds->n_out_of_range, ds->n_over_budget,
+               cfg.max_proposals);
+        printf("gates        %u rejected by gate 1, %u by gate 2; %u impossible sizes, %u suppressed by NMS\n",
+               ds->n_gate1_rejected, ds->n_gate2_rejected, ds->n_size_rejected, ds->n_nms_suppressed);
+        printf("time (ms)    project %.3f  ground %.3f  cluster %.3f  classify %.3f  box %.3f  total %.3f"
+               " (median of %d)\n",
+               ms[LIDET_DET_STAGE_PROJECT], ms[LIDET_DET_STAGE_GROUND], ms[LIDET_DET_STAGE_CLUSTER],
+               ms[LIDET_DET_STAGE_CLASSIFY], ms[LIDET_DET_STAGE_BOX], ms[LIDET_DET_N_STAGES], a.repeat);
+        printf("detections   %u\n", n_det);
+        if (n_det > 0)
+            printf("  %-10s %6s %8s %8s %7s %7s %7s %5s %5s %5s %7s %6s\n", "class", "score", "E_cls", "E_box", "x",
+                   "y", "z", "l", "w", "h", "yaw", "points");
+        for (k = 0; k < n_det; ++k)
+            printf("  %-10s %6.3f %8.3f %8.3f %7.2f %7.2f %7.2f %5.2f %5.2f %5.2f %7.3f %6u\n",
+                   k_class_names[det[k].cls], (double)det[k].score, (double)det[k].energy_cls,
+                   (double)det[k].energy_box, (double)det[k].box.cx_m, (double)det[k].box.cy_m,
+                   (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m, (double)det[k].box.h_m,
+                   (double)det[k].box.yaw_rad, det[k].n_points);
+        if (a.png_path != NULL)
+            printf("picture      %s (detections: car red, cyclist cyan, pedestrian yellow; ground truth green)\n",
+                   a.png_path);
+    }
+    free(gp);
+    free(pp);
+    cli_free(&a);
+    return 0;
+}

@@ -1,0 +1,339 @@
+/* SPDX-License-Identifier: MIT */
+/* Unity tests of the detector (lib/src/lidet_detector.c): a synthetic scan (flat ground plus vertical
+ * faces) through hand-made models whose outputs are known (every proposal a car with the car template,
+ * centred on its cluster mean, heading along the azimuth), so the counts, the crop, the budget, the order,
+ * the NMS and the decoded boxes can be checked exactly; the rotated BEV IoU by hand; init errors. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lidet/lidet.h"
+#include "test_util.h"
+
+LIDET_GUARDED(lidet_detector_t, g);
+
+/* ---- hand-made models: constant outputs from the biases -------------------------------------------- */
+static const float z3[3] = {0, 0, 0};
+static const float z1[1] = {0};
+static const float cls_hw[1 * 3] = {0, 0, 0};
+static const float cls_hb[3] = {5.0f, 0.0f, 0.0f}; /* car, energy -(5 + log(1 + 2 e^-5)) */
+static const lidet_pn_layer_t cls_point[1] = {{3, 1, 1, z3, z1}};
+static const lidet_pn_layer_t cls_head[1] = {{1, 3, 0, cls_hw, cls_hb}};
+static float box_hw[4 * 39];
+static float box_hb[39];
+static const lidet_pn_layer_t box_point[1] = {{3, 1, 1, z3, z1}};
+static const lidet_pn_layer_t box_head[1] = {{4, 39, 0, box_hw, box_hb}};
+static const float mean_size[9] = {3.883f, 1.629f, 1.526f, 1.763f, 0.597f, 1.737f, 0.844f, 0.661f, 1.763f};
+static lidet_pn_model_t m_cls, m_box;
+
+static void make_models(void)
+{
+    memset(&m_cls, 0, sizeof m_cls);
+    m_cls.format_version = LIDET_WEIGHTS_FORMAT_VERSION;
+    m_cls.kind = LIDET_PN_CLASSIFIER;
+    m_cls.n_stages = 1;
+    m_cls.n_classes = LIDET_N_CLASSES;
+    m_cls.n_points = 16;
+    m_cls.stage[0].point = cls_point;
+    m_cls.stage[0].head = cls_head;
+    m_cls.stage[0].n_point = 1;
+    m_cls.stage[0].n_head = 1;
+    m_cls.energy_t = 1.0f;
+    m_cls.gamma[0] = m_cls.gamma[1] = m_cls.gamma[2] = 0.0f;
+    m_cls.pvle_bin[0] = m_cls.pvle_bin[1] = 10.0f * 0.0174532925f;
+    m_cls.pvle_bin[2] = 1.0f;
+    memset(box_hb, 0, sizeof box_hb);
+    box_hb[3] = 4.0f;  /* heading bin 0 (along the azimuth), residual 0 */
+    box_hb[27] = 4.0f; /* size template 0 (car), residual 0 */
+    memset(&m_box, 0, sizeof m_box);
+    m_box = m_cls;
+    m_box.kind = LIDET_PN_BOX;
+    m_box.n_heading_bins = 12;
+    m_box.n_size_clusters = 3;
+    m_box.stage[0].point = box_point;
+    m_box.stage[0].head = box_head;
+    m_box.stage[0].use_onehot = 1;
+    m_box.mean_size_m = mean_size;
+    m_box.gamma[0] = m_box.gamma[1] = m_box.gamma[2] = 100.0f;
+}
+
+/* ---- a synthetic scan -------------------------------------------------------------------------------- */
+#define MAXP 120000
+static float g_pts[MAXP * 4];
+static uint32_t g_n;
+static uint32_t g_rng = 12345u;
+
+static float frand(void)
+{
+    g_rng ^= g_rng << 13;
+    g_rng ^= g_rng >> 17;
+    g_rng ^= g_rng << 5;
+    return (float)(g_rng >> 8) / 16777216.0f;
+}
+
+static void add(float x, float y, float z)
+{
+    if (g_n < MAXP)
+    {
+        g_pts[4 * g_n] = x;
+        g_pts[4 * g_n + 1] = y;
+        g_pts[4 * g_n + 2] = z;
+        g_pts[4 * g_n + 3] = 0.0f;
+        ++g_n;
+    }
+}
+
+/* a vertical face facing the sensor, centred at (x, y), width w, from the ground (z = -1.73) up h */
+static void face(float x, float y, float w, float h, uint32_t n)
+{
+    const float r = sqrtf(x * x + y * y), tx = -y / r, ty = x / r;
+    uint32_t i;
+    for (i = 0; i < n; ++i)
+    {
+        const float u = (frand() - 0.5f) * w, v = frand() * h;
+        add(x + u * tx, y + u * ty, -1.73f + 0.05f + v);
+    }
+}
+
+static void scene(void)
+{
+    uint32_t i;
+    g_n = 0;
+    g_rng = 12345u;
+    for (i = 0; i < 60000; ++i)
+    {
+        add((frand() - 0.5f) * 60.0f, (frand() - 0.5f) * 60.0f, -1.73f);
+    }
+    face(10.0f, 0.0f, 1.8f, 1.5f, 6000);  /* A: in front */
+    face(8.0f, 6.0f, 0.6f, 1.7f, 3000);   /* B: 37 deg left, inside a 45 deg crop */
+    face(-15.0f, 3.0f, 2.0f, 1.5f, 6000); /* C: behind */
+}
+
+static lidet_detector_cfg_t cfg;
+
+void setUp(void)
+{
+    CANARY_FILL(g);
+    make_models();
+    lidet_detector_cfg_default(&cfg, lidet_sensor_find("hdl64"));
+    cfg.proposal.n_points = 16;
+}
+
+void tearDown(void)
+{
+    CANARY_CHECK(g);
+}
+
+void test_three_objects_three_cars(void)
+{
+    const lidet_detection_t *d;
+    const lidet_detector_stats_t *s;
+    uint32_t n = 0, k;
+    scene();
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    s = lidet_detector_stats(&g.ws);
+    d = lidet_detector_detections(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(3, s->n_clusters);
+    TEST_ASSERT_EQUAL_UINT32(3, s->n_classified);
+    TEST_ASSERT_EQUAL_UINT32(3, s->n_boxed);
+    TEST_ASSERT_EQUAL_UINT32(0, s->n_gate1_rejected + s->n_gate2_rejected + s->n_size_rejected);
+    TEST_ASSERT_EQUAL_UINT32(3, n);
+    TEST_ASSERT_EQUAL_UINT32(3, s->n_detections);
+    for (k = 0; k < n; ++k)
+    {
+        const lidet_cluster_rec_t *recs = lidet_workspace_clusters(lidet_detector_workspace(&g.ws), NULL);
+        const lidet_cluster_rec_t *r = &recs[d[k].cluster_id - 1u];
+        const float az = atan2f(r->mean_m[1], r->mean_m[0]);
+        TEST_ASSERT_EQUAL_UINT8(LIDET_CLASS_CAR, d[k].cls);
+        TEST_ASSERT_CLOSE(r->mean_m[0], d[k].box.cx_m, 1e-4, 0);
+        TEST_ASSERT_CLOSE(r->mean_m[1], d[k].box.cy_m, 1e-4, 0);
+        TEST_ASSERT_CLOSE(r->mean_m[2], d[k].box.cz_m, 1e-4, 0);
+        TEST_ASSERT_CLOSE(az, d[k].box.yaw_rad, 1e-4, 0);
+        TEST_ASSERT_CLOSE(3.883, d[k].box.l_m, 1e-5, 0);
+        TEST_ASSERT_EQUAL_UINT32(r->n_points, d[k].n_points);
+        /* score = 1 / (1 + exp(E - gamma)), E = -(5 + log(1 + 2 exp(-5))) */
+        TEST_ASSERT_CLOSE(1.0 / (1.0 + exp(-(5.0 + log(1.0 + 2.0 * exp(-5.0))))), d[k].score, 1e-5, 0);
+        TEST_ASSERT_TRUE(k == 0 || d[k - 1].cluster_id < d[k].cluster_id); /* equal scores: id order */
+    }
+}
+
+void test_crop_budget_range_and_gates(void)
+{
+    const lidet_detector_stats_t *s;
+    const lidet_detection_t *d;
+    uint32_t n = 0;
+    scene();
+    cfg.crop_half_rad = 0.25f * 3.14159265f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    s = lidet_detector_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(1, s->n_out_of_crop); /* C, behind */
+    TEST_ASSERT_EQUAL_UINT32(2, s->n_classified);
+
+    /* budget of one: the nearest (B at 10 m, before A at ~10 m? B is at sqrt(100) = 10, A at 10): the
+     * range ties break by cluster id; the other is over the budget and the status says so */
+    cfg.crop_half_rad = 0.0f;
+    cfg.max_proposals = 1;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    s = lidet_detector_stats(&g.ws);
+    d = lidet_detector_detections(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(2, s->n_over_budget);
+    TEST_ASSERT_EQUAL_UINT32(1, n);
+    TEST_ASSERT_TRUE(d[0].box.cx_m > 0.0f); /* not C at 15 m */
+
+    /* range limit 12 m drops C */
+    cfg.max_proposals = 64;
+    cfg.max_range_m = 12.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_detector_stats(&g.ws)->n_out_of_range);
+
+    /* gate 1: a threshold below the energy rejects every proposal; gate off lets them through */
+    cfg.max_range_m = 0.0f;
+    m_cls.gamma[0] = -6.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    TEST_ASSERT_EQUAL_UINT32(3, lidet_detector_stats(&g.ws)->n_gate1_rejected);
+    lidet_detector_detections(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(0, n);
+    cfg.gate1 = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    lidet_detector_detections(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(3, n);
+    /* gate 2 and the size check */
+    m_box.gamma[0] = -100.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    TEST_ASSERT_EQUAL_UINT32(3, lidet_detector_stats(&g.ws)->n_gate2_rejected);
+    m_box.gamma[0] = 100.0f;
+    cfg.size_max_m[LIDET_CLASS_CAR][0] = 3.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    TEST_ASSERT_EQUAL_UINT32(3, lidet_detector_stats(&g.ws)->n_size_rejected);
+}
+
+void test_nms_drops_overlapping_boxes(void)
+{
+    const lidet_detector_stats_t *s;
+    uint32_t n = 0;
+    /* two faces on one ray, 2.5 m apart: separate clusters whose car boxes (3.9 m long) overlap */
+    g_n = 0;
+    g_rng = 99u;
+    {
+        uint32_t i;
+        for (i = 0; i < 60000; ++i)
+        {
+            add((frand() - 0.5f) * 60.0f, (frand() - 0.5f) * 60.0f, -1.73f);
+        }
+    }
+    face(10.0f, 0.0f, 1.0f, 0.8f, 4000);
+    face(12.5f, 0.0f, 3.0f, 2.0f, 8000);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    s = lidet_detector_stats(&g.ws);
+    lidet_detector_detections(&g.ws, &n);
+    TEST_ASSERT_TRUE(s->n_boxed >= 2);
+    TEST_ASSERT_EQUAL_UINT32(s->n_boxed - s->n_nms_suppressed, n);
+    TEST_ASSERT_TRUE(s->n_nms_suppressed >= 1);
+    /* with the threshold at 1 nothing is suppressed */
+    cfg.nms_iou = 1.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_detector_stats(&g.ws)->n_nms_suppressed);
+}
+
+void test_deterministic_and_empty(void)
+{
+    static lidet_detection_t first[LIDET_MAX_DETECTIONS];
+    const lidet_detection_t *d;
+    uint32_t n = 0, n2 = 0;
+    scene();
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    d = lidet_detector_detections(&g.ws, &n);
+    memcpy(first, d, n * sizeof *d);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    d = lidet_detector_detections(&g.ws, &n2);
+    TEST_ASSERT_EQUAL_UINT32(n, n2);
+    TEST_ASSERT_EQUAL_MEMORY(first, d, n * sizeof *d);
+    /* no points: no clusters, no detections, OK */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, 0, 4, NULL, NULL));
+    lidet_detector_detections(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(0, n);
+    /* NaN points are counted by the projection, never crash the detector */
+    g_pts[0] = g_pts[1] = g_pts[2] = NAN;
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL)));
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_detector_stats(&g.ws)->stages.proj.n_nonfinite);
+}
+
+void test_init_errors(void)
+{
+    lidet_detector_cfg_t c;
+    lidet_pn_model_t other;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_init(NULL, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_init(&g.ws, &cfg, NULL, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_init(&g.ws, &cfg, &m_box, &m_cls)); /* kinds swapped */
+    other = m_box;
+    other.n_points = 32; /* another points-per-proposal setting */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_init(&g.ws, &cfg, &m_cls, &other));
+    other = m_box;
+    other.pvle_bin[2] = 2.0f; /* trained on other voxels */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_init(&g.ws, &cfg, &m_cls, &other));
+    other = m_cls;
+    other.format_version = 99;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_init(&g.ws, &cfg, &other, &m_box));
+    c = cfg;
+    c.max_proposals = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
+    c.nms_iou = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
+    c.size_min_m[1][2] = 5.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
+    c.stages.cluster.theta_rad = -1.0f; /* a stage's own validation */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_detector_run(&g.ws, g_pts, 0, 4, NULL, NULL));
+    TEST_ASSERT_EQUAL_UINT32(sizeof(lidet_detector_t), lidet_detector_bytes());
+}
+
+void test_bev_iou_by_hand(void)
+{
+    lidet_box_t a, b;
+    memset(&a, 0, sizeof a);
+    a.l_m = 4.0f;
+    a.w_m = 2.0f;
+    a.h_m = 1.5f;
+    b = a;
+    TEST_ASSERT_CLOSE(1.0, lidet_box_bev_iou(&a, &b), 1e-5, 0);
+    b.cx_m = 2.0f; /* half overlap: 4 / (8 + 8 - 4) */
+    TEST_ASSERT_CLOSE(1.0 / 3.0, lidet_box_bev_iou(&a, &b), 1e-5, 0);
+    b.cx_m = 10.0f;
+    TEST_ASSERT_CLOSE(0.0, lidet_box_bev_iou(&a, &b), 0, 0);
+    /* a 2 x 2 square and the same square turned 45 deg: intersection = the octagon, 8 (sqrt 2 - 1) */
+    a.l_m = a.w_m = 2.0f;
+    b = a;
+    b.yaw_rad = 0.25f * 3.14159265f;
+    {
+        const double inter = 8.0 * (sqrt(2.0) - 1.0);
+        TEST_ASSERT_CLOSE(inter / (8.0 - inter), lidet_box_bev_iou(&a, &b), 1e-4, 0);
+    }
+    b.l_m = 0.0f;
+    TEST_ASSERT_CLOSE(0.0, lidet_box_bev_iou(&a, &b), 0, 0);
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_three_objects_three_cars);
+    RUN_TEST(test_crop_budget_range_and_gates);
+    RUN_TEST(test_nms_drops_overlapping_boxes);
+    RUN_TEST(test_deterministic_and_empty);
+    RUN_TEST(test_init_errors);
+    RUN_TEST(test_bev_iou_by_hand);
+    return UNITY_END();
+}
