@@ -40,17 +40,29 @@ test-asan:
 	cmake --build $(ASAN) -j $(JOBS)
 	ctest --test-dir $(ASAN) --output-on-failure -j $(JOBS)
 
-# Runs the host CLI on a simulated scan shipped in the repo, stage by stage: figures on stdout,
-# pictures in out/ (range image, ground in a bird's-eye view, clusters in a bird's-eye view).
+# The detector on the simulated scans shipped in the repo (hdl64 and vlp16; ground truth drawn in green),
+# and on a real KITTI frame when ../shared/data/real is there; then the stages one by one with their pictures.
+REAL_FRAME ?= $(REAL)/kitti/training
 demo: build
 	@mkdir -p out
-	@echo "== projection"
+	@echo "== detector: simulated HDL-64 scan (tests/data/sim_hdl64)"
+	$(BUILD)/ports/host/lidet detect $(SAMPLE) --sensor hdl64 --gt tests/data/sim_hdl64/boxes/000000.txt \
+	    --png out/demo_detect.png --repeat 20
+	@echo "== detector: simulated VLP-16 scan (tests/data/sim_vlp16)"
+	$(BUILD)/ports/host/lidet detect tests/data/sim_vlp16/velodyne/000000.bin --sensor vlp16 \
+	    --gt tests/data/sim_vlp16/boxes/000000.txt --png out/demo_detect_vlp16.png --repeat 20
+	@if [ -f $(REAL_FRAME)/velodyne/000000.bin ]; then \
+	  echo "== detector: real KITTI frame ($(REAL_FRAME)/velodyne/000000.bin, ground truth from label_2)"; \
+	  $(BUILD)/ports/host/lidet detect $(REAL_FRAME)/velodyne/000000.bin --sensor hdl64 \
+	    --calib $(REAL_FRAME)/calib/000000.txt --gt-kitti $(REAL_FRAME)/label_2/000000.txt \
+	    --png out/demo_detect_real.png --repeat 20; \
+	else echo "== (no real KITTI frame at $(REAL_FRAME): skipped)"; fi
+	@echo "== the stages alone: projection, ground segmentation, depth clustering"
 	$(BUILD)/ports/host/lidet project $(SAMPLE) --sensor hdl64 --png out/demo_project.png
-	@echo "== ground segmentation"
 	$(BUILD)/ports/host/lidet ground $(SAMPLE) --sensor hdl64 --png out/demo_ground.png --repeat 20
-	@echo "== depth clustering and proposals"
 	$(BUILD)/ports/host/lidet cluster $(SAMPLE) --sensor hdl64 --png out/demo_cluster.png --repeat 20
-	@echo "demo: pictures in out/demo_project.png, out/demo_ground.png, out/demo_cluster.png"
+	@echo "demo: pictures in out/ (demo_detect*.png: detections, car red, cyclist cyan, pedestrian yellow;"
+	@echo "      ground truth green; demo_project/ground/cluster.png: the stages)"
 
 # Benchmarks against peers measured in the same run; results go to docs/BENCHMARKS.md.
 bench: deps build

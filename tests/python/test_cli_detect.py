@@ -1,0 +1,106 @@
+# SPDX-License-Identifier: MIT
+"""`lidet detect` (host CLI): the JSON contract, the box files, the KITTI label_2 output against the Python
+conversion (lidet_tools.kitti.box_to_kitti), the batch script, and clear errors."""
+import json
+import pathlib
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from lidet_tools import kitti
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SIM = ROOT / "tests" / "data" / "sim_hdl64"
+SCAN = SIM / "velodyne" / "000000.bin"
+
+
+def _run(cli, *args, ok=True):
+    r = subprocess.run([str(cli), "detect", *map(str, args)], capture_output=True, text=True)
+    if ok:
+        assert r.returncode == 0, r.stderr
+    return r
+
+
+def test_json_contract(cli):
+    js = json.loads(_run(cli, SCAN, "--sensor", "hdl64", "--json", "--repeat", "3").stdout)
+    for k in ("points", "project_ms", "ground_ms", "cluster_ms", "classify_ms", "box_ms", "total_ms"):
+        assert k in js and js[k] >= 0, k
+    assert js["points"] == len(kitti.read_bin(SCAN))
+    assert js["classified"] == min(js["clusters"] - js["out_of_crop"] - js["out_of_range"], 64)
+    assert js["classified"] == js["gate1_rejected"] + js["boxed"]
+    assert js["boxed"] == js["gate2_rejected"] + js["size_rejected"] + js["nms_suppressed"] + js["detections"]
+    assert len(js["boxes"]) == js["detections"]
+    assert js["total_ms"] >= js["box_ms"]
+
+
+def test_crop_keeps_the_front(cli):
+    full = json.loads(_run(cli, SCAN, "--json").stdout)
+    crop = json.loads(_run(cli, SCAN, "--json", "--crop").stdout)
+    assert crop["out_of_crop"] > 0 and full["out_of_crop"] == 0
+    assert crop["clusters"] == full["clusters"]
+    assert crop["classified"] == min(crop["clusters"] - crop["out_of_crop"], 64)
+
+
+def test_outputs_agree_with_python_conversion(cli, tmp_path):
+    out, kout = tmp_path / "b.txt", tmp_path / "k.txt"
+    # gates off so that the (possibly untrained) models still give boxes to compare; the size check and
+    # NMS stay on
+    js = json.loads(_run(cli, SCAN, "--json", "--out", out, "--calib", SIM / "calib" / "000000.txt",
+                         "--kitti-out", kout, "--set", "gate1=0", "--set", "gate2=0", "--set", "nms_iou=1").stdout)
+    boxes = kitti.read_boxes(out)
+    assert len(boxes) == js["detections"]
+    for b, j in zip(boxes, js["boxes"]):
+        assert b.cls == j["class"] and abs(b.x - j["x"]) < 1e-3 and abs(b.score - j["score"]) < 1e-3
+    calib = kitti.read_calib(SIM / "calib" / "000000.txt")
+    objs = [o for o in kitti.read_label2(kout) if o.type != "DontCare"]
+    front = [b for b in boxes if (calib.velo_to_cam_points(kitti.box_corners(b))[:, 2] >= 0.1).all()]
+    assert len(objs) == len(front)
+    for b, o in zip(front, objs):
+        ref = kitti.box_to_kitti(b, calib, score=b.score)
+        np.testing.assert_allclose(o.loc, ref.loc, atol=2e-3)
+        np.testing.assert_allclose([o.h, o.w, o.l], [ref.h, ref.w, ref.l], atol=2e-3)
+        assert abs((o.ry - ref.ry + np.pi) % (2 * np.pi) - np.pi) < 2e-3
+        np.testing.assert_allclose(o.bbox, ref.bbox, atol=0.05)
+        back = kitti.kitti_to_box(o, calib)
+        assert abs(back.x - b.x) < 5e-3 and abs(back.y - b.y) < 5e-3
+
+
+def test_errors_are_clear(cli, tmp_path):
+    r = _run(cli, SCAN, "--model", "nosuchmodel", ok=False)
+    assert r.returncode == 1 and "no models cls_nosuchmodel" in r.stderr
+    r = _run(cli, SCAN, "--kitti-out", tmp_path / "k.txt", ok=False)
+    assert r.returncode == 1 and "need --calib" in r.stderr
+    bad = tmp_path / "calib.txt"
+    bad.write_text("P2: 1 2 3\n")
+    r = _run(cli, SCAN, "--calib", bad, "--kitti-out", tmp_path / "k.txt", ok=False)
+    assert r.returncode == 1 and "P2 needs 12 numbers" in r.stderr
+    r = _run(cli, SCAN, "--set", "max_proposals=0", ok=False)
+    assert r.returncode == 1 and "init" in r.stderr
+    r = _run(cli, SCAN, "--set", "nosuchfield=1", ok=False)
+    assert r.returncode == 1 and "bad --set" in r.stderr
+    trunc = tmp_path / "t.bin"
+    trunc.write_bytes(SCAN.read_bytes()[:1001])
+    r = _run(cli, trunc, ok=False)
+    assert r.returncode == 1 and r.stderr.strip()
+
+
+def test_batch_script_writes_a_prediction_folder(cli, tmp_path):
+    kd = tmp_path / "kitti"
+    for sub in ("velodyne", "calib"):
+        (kd / sub).mkdir(parents=True)
+    for k, src in enumerate(["000000"]):
+        (kd / "velodyne" / f"{k:06d}.bin").write_bytes((SIM / "velodyne" / f"{src}.bin").read_bytes())
+        (kd / "calib" / f"{k:06d}.txt").write_text((SIM / "calib" / f"{src}.txt").read_text())
+    r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(kd), "--out", str(tmp_path / "pred"),
+                        "--set", "gate1=0"], capture_output=True, text=True,
+                       env={**__import__("os").environ, "LIDET_BUILD_DIR": str(pathlib.Path(cli).parents[2])})
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "pred" / "label_2" / "000000.txt").exists()
+    assert (tmp_path / "pred" / "boxes" / "000000.txt").exists()
+    t = json.loads((tmp_path / "pred" / "timing.json").read_text())
+    assert t[0]["frame"] == "000000" and t[0]["total_ms"] > 0
+    r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(tmp_path / "nothing"), "--out",
+                        str(tmp_path / "p2")], capture_output=True, text=True)
+    assert r.returncode == 1 and "no scans" in r.stderr
