@@ -325,11 +325,13 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
         /* |atan2(y, x)| <= h  <=>  x sin h >= |y| cos h  (sin(h - |azimuth|) >= 0), for any h in (0, pi) */
         if (crop && !(x * crop_s >= fabsf(y) * crop_c))
         {
+            d->outcome[i] = LIDET_DET_OUT_CROP;
             ++st->n_out_of_crop;
             continue;
         }
         if (d->cfg.max_range_m > 0.0f && r2 > d->cfg.max_range_m * d->cfg.max_range_m)
         {
+            d->outcome[i] = LIDET_DET_OUT_RANGE;
             ++st->n_out_of_range;
             continue;
         }
@@ -340,6 +342,10 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
     sort_candidates(d->key, d->order, n_cand);
     if (n_cand > d->cfg.max_proposals)
     {
+        for (i = d->cfg.max_proposals; i < n_cand; ++i)
+        {
+            d->outcome[d->order[i]] = LIDET_DET_OUT_BUDGET;
+        }
         st->n_over_budget = n_cand - d->cfg.max_proposals;
         n_cand = d->cfg.max_proposals;
         worst = LIDET_TRUNCATED;
@@ -364,6 +370,7 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
         ++st->n_classified;
         if (d->cfg.gate1 && !co.pass)
         {
+            d->outcome[ci] = LIDET_DET_OUT_GATE1;
             ++st->n_gate1_rejected;
             continue;
         }
@@ -377,11 +384,13 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
         ++st->n_boxed;
         if (d->cfg.gate2 && !bo.pass)
         {
+            d->outcome[ci] = LIDET_DET_OUT_GATE2;
             ++st->n_gate2_rejected;
             continue;
         }
         if (!size_ok(&d->cfg, co.cls, &bo.box))
         {
+            d->outcome[ci] = LIDET_DET_OUT_SIZE;
             ++st->n_size_rejected;
             continue;
         }
@@ -395,9 +404,11 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
         t->n_points = recs[ci].n_points;
         insert_sorted(d->det, d->n_det);
         ++d->n_det;
+        d->outcome[ci] = LIDET_DET_OUT_DETECTED;
         if (d->n_det > LIDET_MAX_DETECTIONS)
         {
             --d->n_det; /* the lowest score goes */
+            d->outcome[d->det[d->n_det].cluster_id - 1u] = LIDET_DET_OUT_CAPACITY;
             ++st->n_over_capacity;
             worst = LIDET_TRUNCATED;
         }
@@ -420,6 +431,7 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
             }
             if (drop)
             {
+                d->outcome[d->det[i].cluster_id - 1u] = LIDET_DET_OUT_NMS;
                 ++st->n_nms_suppressed;
                 continue;
             }
@@ -443,6 +455,19 @@ const lidet_detection_t *lidet_detector_detections(const lidet_detector_t *d, ui
         *n_detections = d->magic == LIDET_INIT_MAGIC ? d->n_det : 0u;
     }
     return d->det;
+}
+
+const uint8_t *lidet_detector_outcomes(const lidet_detector_t *d, uint32_t *n_clusters)
+{
+    if (d == 0)
+    {
+        return 0;
+    }
+    if (n_clusters != 0)
+    {
+        *n_clusters = d->magic == LIDET_INIT_MAGIC ? d->stats.n_clusters : 0u;
+    }
+    return d->outcome;
 }
 
 const lidet_detector_stats_t *lidet_detector_stats(const lidet_detector_t *d)

@@ -238,6 +238,83 @@ static int read_gt(const char *path, gt_t **out, uint32_t *n)
     return 0;
 }
 
+/* rectified camera frame -> sensor frame: v = Tr_R^T (R0^T r - Tr_t) (both rotations orthonormal) */
+static void rect_to_velo(const calib_t *c, const double r[3], double v[3])
+{
+    double q[3];
+    int i;
+    for (i = 0; i < 3; ++i)
+        q[i] = c->R0[i] * r[0] + c->R0[3 + i] * r[1] + c->R0[6 + i] * r[2] - c->Tr[4 * i + 3];
+    for (i = 0; i < 3; ++i)
+        v[i] = c->Tr[i] * q[0] + c->Tr[4 + i] * q[1] + c->Tr[8 + i] * q[2];
+}
+
+/* KITTI label_2 (camera frame, bottom centre) -> sensor-frame boxes; DontCare lines skipped */
+static int read_gt_kitti(const char *path, const calib_t *c, gt_t **out, uint32_t *n)
+{
+    FILE *f = fopen(path, "r");
+    char line[512];
+    uint32_t cap = 0;
+    int ln = 0;
+    *out = NULL;
+    *n = 0;
+    if (f == NULL)
+    {
+        fprintf(stderr, "lidet detect: cannot open '%s'\n", path);
+        return 1;
+    }
+    while (fgets(line, sizeof line, f) != NULL)
+    {
+        gt_t g;
+        double v[14], ctr[3], vel[3], d[3], o[3], zero[3] = {0, 0, 0}, dv[3];
+        ++ln;
+        if (strspn(line, " \t\r\n") == strlen(line))
+            continue;
+        if (sscanf(line, "%31s %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf", g.cls, &v[0], &v[1], &v[2],
+                   &v[3], &v[4], &v[5], &v[6], &v[7], &v[8], &v[9], &v[10], &v[11], &v[12], &v[13]) != 15)
+        {
+            fprintf(stderr, "lidet detect: %s:%d: not a KITTI label_2 line (15 fields)\n", path, ln);
+            free(*out);
+            fclose(f);
+            return 1;
+        }
+        if (strcmp(g.cls, "DontCare") == 0)
+            continue;
+        ctr[0] = v[10];
+        ctr[1] = v[11] - 0.5 * v[7]; /* bottom centre -> centre (camera y down) */
+        ctr[2] = v[12];
+        rect_to_velo(c, ctr, vel);
+        d[0] = cos(v[13]);
+        d[1] = 0.0;
+        d[2] = -sin(v[13]);
+        rect_to_velo(c, d, dv);
+        rect_to_velo(c, zero, o);
+        g.box.cx_m = (float)vel[0];
+        g.box.cy_m = (float)vel[1];
+        g.box.cz_m = (float)vel[2];
+        g.box.h_m = (float)v[7];
+        g.box.w_m = (float)v[8];
+        g.box.l_m = (float)v[9];
+        g.box.yaw_rad = (float)atan2(dv[1] - o[1], dv[0] - o[0]);
+        if (*n == cap)
+        {
+            gt_t *t;
+            cap = cap ? 2u * cap : 16u;
+            t = (gt_t *)realloc(*out, cap * sizeof(gt_t));
+            if (t == NULL)
+            {
+                free(*out);
+                fclose(f);
+                return 1;
+            }
+            *out = t;
+        }
+        (*out)[(*n)++] = g;
+    }
+    fclose(f);
+    return 0;
+}
+
 /* ---- bird's-eye picture -------------------------------------------------------------------------- */
 
 #define BEV_W 800u
@@ -353,6 +430,7 @@ static void usage_extra(void)
                     "  --calib FILE     KITTI calibration (P2, R0_rect, Tr_velo_to_cam) for --kitti-out\n"
                     "  --kitti-out FILE label_2 lines in the camera frame (2D box from the projected corners)\n"
                     "  --gt FILE        ground-truth boxes (lidet's sensor-frame lines) drawn in --png\n"
+                    "  --gt-kitti FILE  ground truth as KITTI label_2 (with --calib) drawn in --png\n"
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
                     "                   nms_iou, max_proposals, gate1, gate2\n"
                     "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n");
@@ -398,7 +476,7 @@ int cli_detect(int argc, char **argv)
     const lidet_detector_stats_t *ds;
     const lidet_detection_t *det;
     lidet_status_t st = LIDET_OK;
-    const char *family = NULL, *calib_path = NULL, *kitti_path = NULL, *gt_path = NULL;
+    const char *family = NULL, *calib_path = NULL, *kitti_path = NULL, *gt_path = NULL, *gt_kitti_path = NULL;
     char chosen[64];
     char **rest;
     const char **sets;
@@ -426,6 +504,8 @@ int cli_detect(int argc, char **argv)
             kitti_path = argv[++i];
         else if (strcmp(argv[i], "--gt") == 0 && i + 1 < argc)
             gt_path = argv[++i];
+        else if (strcmp(argv[i], "--gt-kitti") == 0 && i + 1 < argc)
+            gt_kitti_path = argv[++i];
         else if (strcmp(argv[i], "--set") == 0 && i + 1 < argc)
             sets[nsets++] = argv[++i];
         else if (strcmp(argv[i], "--crop") == 0)
@@ -441,9 +521,9 @@ int cli_detect(int argc, char **argv)
         return 1;
     }
     free(rest);
-    if ((kitti_path != NULL) != (calib_path != NULL))
+    if ((kitti_path != NULL || gt_kitti_path != NULL) && calib_path == NULL)
     {
-        fprintf(stderr, "lidet detect: --kitti-out and --calib go together\n");
+        fprintf(stderr, "lidet detect: --kitti-out and --gt-kitti need --calib\n");
         free(sets);
         return 1;
     }
@@ -549,12 +629,15 @@ int cli_detect(int argc, char **argv)
     if (a.png_path != NULL)
     {
         gt_t *gt = NULL;
+        calib_t gcal;
         uint32_t n_gt = 0, np = a.n_points < LIDET_MAX_POINTS ? a.n_points : LIDET_MAX_POINTS;
         uint32_t *ids = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(np + 1u));
         gp = (uint8_t *)malloc((size_t)np + 1u);
         if (ids == NULL || gp == NULL ||
             lidet_workspace_point_labels(lidet_detector_workspace(&g_det), pp, np, ids, gp) != LIDET_OK ||
             (gt_path != NULL && read_gt(gt_path, &gt, &n_gt) != 0) ||
+            (gt_kitti_path != NULL && (read_calib(calib_path, &gcal) != 0 ||
+                                       read_gt_kitti(gt_kitti_path, &gcal, &gt, &n_gt) != 0)) ||
             write_png(a.png_path, a.points, np, gp, det, n_det, gt, n_gt) != 0)
         {
             fprintf(stderr, "lidet detect: cannot write the picture '%s'\n", a.png_path);

@@ -140,6 +140,15 @@ void test_three_objects_three_cars(void)
     TEST_ASSERT_EQUAL_UINT32(0, s->n_gate1_rejected + s->n_gate2_rejected + s->n_size_rejected);
     TEST_ASSERT_EQUAL_UINT32(3, n);
     TEST_ASSERT_EQUAL_UINT32(3, s->n_detections);
+    {
+        uint32_t nc = 0;
+        const uint8_t *oc = lidet_detector_outcomes(&g.ws, &nc);
+        TEST_ASSERT_EQUAL_UINT32(3, nc);
+        for (k = 0; k < nc; ++k)
+        {
+            TEST_ASSERT_EQUAL_UINT8(LIDET_DET_OUT_DETECTED, oc[k]);
+        }
+    }
     for (k = 0; k < n; ++k)
     {
         const lidet_cluster_rec_t *recs = lidet_workspace_clusters(lidet_detector_workspace(&g.ws), NULL);
@@ -181,6 +190,16 @@ void test_crop_budget_range_and_gates(void)
     d = lidet_detector_detections(&g.ws, &n);
     TEST_ASSERT_EQUAL_UINT32(2, s->n_over_budget);
     TEST_ASSERT_EQUAL_UINT32(1, n);
+    {
+        uint32_t nc = 0, k, nb = 0;
+        const uint8_t *oc = lidet_detector_outcomes(&g.ws, &nc);
+        for (k = 0; k < nc; ++k)
+        {
+            nb += oc[k] == LIDET_DET_OUT_BUDGET;
+        }
+        TEST_ASSERT_EQUAL_UINT32(2, nb);
+        TEST_ASSERT_EQUAL_UINT8(LIDET_DET_OUT_DETECTED, oc[d[0].cluster_id - 1u]);
+    }
     TEST_ASSERT_TRUE(d[0].box.cx_m > 0.0f); /* not C at 15 m */
 
     /* range limit 12 m drops C */
@@ -238,6 +257,15 @@ void test_nms_drops_overlapping_boxes(void)
     TEST_ASSERT_TRUE(s->n_boxed >= 2);
     TEST_ASSERT_EQUAL_UINT32(s->n_boxed - s->n_nms_suppressed, n);
     TEST_ASSERT_TRUE(s->n_nms_suppressed >= 1);
+    {
+        uint32_t nc = 0, k, nn = 0;
+        const uint8_t *oc = lidet_detector_outcomes(&g.ws, &nc);
+        for (k = 0; k < nc; ++k)
+        {
+            nn += oc[k] == LIDET_DET_OUT_NMS;
+        }
+        TEST_ASSERT_EQUAL_UINT32(s->n_nms_suppressed, nn);
+    }
     /* with the threshold at 1 nothing is suppressed */
     cfg.nms_iou = 1.0f;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));

@@ -630,3 +630,66 @@ def pn_time(cls_model, box_model, xyz, mean, voxel, repeats: int = 5) -> tuple[f
     if st < 0:
         raise LidetError(st, "lidet_py_pn_time")
     return float(ns[0]) * 1e-9 / b, float(ns[1]) * 1e-9 / b
+
+
+# ---- the whole detector (lib/include/lidet/lidet_detector.h) -------------------------------------------
+
+#: lidet_det_outcome_t values
+OUTCOME = {1: "crop", 2: "range", 3: "budget", 4: "gate1", 5: "gate2", 6: "size", 7: "nms", 8: "capacity",
+           9: "detected"}
+CLASSES = ("Car", "Cyclist", "Pedestrian")
+_DET_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
+              "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity",
+              "n_detections", "status"]
+
+
+@dataclass
+class Detections:
+    """Output of `detect`: the detector's boxes (sensor frame), what became of each cluster, per-point labels."""
+    cls: np.ndarray           #: (D,) class index (0 Car, 1 Cyclist, 2 Pedestrian)
+    score: np.ndarray         #: (D,)
+    energy_cls: np.ndarray    #: (D,) gate-1 energy
+    energy_box: np.ndarray    #: (D,) gate-2 energy
+    box: np.ndarray           #: (D, 7) cx cy cz l w h yaw
+    cluster_id: np.ndarray    #: (D,) 1-based cluster id
+    outcome: np.ndarray       #: (K,) uint8 per kept cluster (OUTCOME names)
+    point_cluster: np.ndarray  #: (N,) cluster id per input point (0 = none)
+    point_ground: np.ndarray  #: (N,) 1 = ground
+    stats: dict
+
+
+def detect(points, sensor: str = "hdl64", model: str | None = None, crop_half_rad: float = 0.0,
+           max_range_m: float = 0.0, nms_iou: float = 0.1, max_proposals: int = 64, gate1: bool = True,
+           gate2: bool = True) -> Detections:
+    """lidet_detector_run on (N, >=3) points with the models cls_<model> / box_<model> compiled into the bindings
+    (default: the sensor's family if present, else hdl64). A preset sensor name only."""
+    ms = pn_models()
+    fam = model or (sensor if f"cls_{sensor}" in ms and f"box_{sensor}" in ms else "hdl64")
+    if f"cls_{fam}" not in ms or f"box_{fam}" not in ms:
+        raise KeyError(f"models cls_{fam} / box_{fam} are not compiled into the bindings (have: {sorted(ms)})")
+    L = lib()
+    if not getattr(L, "_det_ready", False):
+        _u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
+        L.lidet_py_det_run.argtypes = [C.c_char_p, C.c_uint32, C.c_uint32, _f32p, _u32p, _f32p, C.c_uint32, C.c_uint32,
+                                       _f32p, _u32p, _u8p, _u32p, _opt(_u32p), _opt(_u8p), _u32p]
+        L._det_ready = True
+    pts, stride = _as_points(points)
+    n = len(pts)
+    cap = capacity()
+    det = np.zeros((cap["max_detections"], 12), np.float32)
+    nd = np.zeros(1, np.uint32)
+    oc = np.zeros(cap["max_clusters"], np.uint8)
+    nc = np.zeros(1, np.uint32)
+    pc = np.zeros(max(n, 1), np.uint32)
+    pg = np.zeros(max(n, 1), np.uint8)
+    st = np.zeros(len(_DET_STATS), np.uint32)
+    fc = np.array([crop_half_rad, max_range_m, nms_iou], np.float32)
+    uc = np.array([max_proposals, int(bool(gate1)), int(bool(gate2))], np.uint32)
+    rc = L.lidet_py_det_run(sensor.encode(), ms[f"cls_{fam}"].index, ms[f"box_{fam}"].index, fc, uc,
+                            pts if n else np.zeros((1, 4), np.float32), n, stride, det, nd, oc, nc, pc, pg, st)
+    if rc < 0:
+        raise LidetError(rc, "lidet_detector")
+    d = det[: int(nd[0])]
+    return Detections(d[:, 0].astype(np.int64), d[:, 1].copy(), d[:, 2].copy(), d[:, 3].copy(), d[:, 4:11].copy(),
+                      d[:, 11].astype(np.int64), oc[: int(nc[0])].copy(), pc[:n], pg[:n],
+                      dict(zip(_DET_STATS, map(int, st))))

@@ -25,7 +25,7 @@
  * threshold (the authors' score is also a function of the classifier energy alone).
  *
  * Memory: sizeof(lidet_detector_t) = lidet_workspace_bytes() + LIDET_DETECTOR_PN_SCRATCH
- * + sizeof(lidet_proposal_t) + LIDET_MAX_CLUSTERS * 8 B + LIDET_MAX_DETECTIONS * sizeof(lidet_detection_t)
+ * + sizeof(lidet_proposal_t) + LIDET_MAX_CLUSTERS * 9 B + LIDET_MAX_DETECTIONS * sizeof(lidet_detection_t)
  * + ~600 B; lidet_detector_bytes() returns it (docs/MEMORY.md has the table per sensor configuration).
  * Time: the stages + max_proposals * (classifier + box net) + O(K log K) to order K clusters
  * + O(D^2) for the NMS of D detections. No allocation, no recursion.
@@ -52,6 +52,20 @@ enum
     LIDET_DET_STAGE_POST = 5,     /**< size check, NMS */
     LIDET_DET_N_STAGES = 6
 };
+
+/** @brief What became of each kept cluster in the last run (lidet_detector_outcomes). */
+typedef enum
+{
+    LIDET_DET_OUT_CROP = 1,     /**< outside the azimuth window */
+    LIDET_DET_OUT_RANGE = 2,    /**< beyond max_range_m */
+    LIDET_DET_OUT_BUDGET = 3,   /**< past max_proposals */
+    LIDET_DET_OUT_GATE1 = 4,    /**< classified, rejected by gate 1 */
+    LIDET_DET_OUT_GATE2 = 5,    /**< boxed, rejected by gate 2 */
+    LIDET_DET_OUT_SIZE = 6,     /**< boxed, impossible size for its class */
+    LIDET_DET_OUT_NMS = 7,      /**< suppressed by the NMS */
+    LIDET_DET_OUT_CAPACITY = 8, /**< past LIDET_MAX_DETECTIONS */
+    LIDET_DET_OUT_DETECTED = 9  /**< a detection of the output */
+} lidet_det_outcome_t;
 
 /** @brief Configuration. Fill with lidet_detector_cfg_default(). */
 typedef struct
@@ -122,6 +136,7 @@ typedef struct
     uint16_t order[LIDET_MAX_CLUSTERS];  /* candidate clusters, nearest first */
     float key[LIDET_MAX_CLUSTERS];       /* their squared horizontal ranges */
     lidet_detection_t det[LIDET_MAX_DETECTIONS + 1]; /* + 1: a candidate before the capacity check */
+    uint8_t outcome[LIDET_MAX_CLUSTERS];             /* lidet_det_outcome_t per kept cluster */
     uint32_t n_det;
     lidet_detector_stats_t stats;
 } lidet_detector_t;
@@ -163,6 +178,12 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
 
 /** @brief Detections of the last run, best score first (valid until the next run). */
 const lidet_detection_t *lidet_detector_detections(const lidet_detector_t *d, uint32_t *n_detections);
+
+/**
+ * @brief What became of each kept cluster of the last run (lidet_det_outcome_t values, index = cluster
+ *        id - 1): where a road user was lost (evaluation, debugging). Valid until the next run.
+ */
+const uint8_t *lidet_detector_outcomes(const lidet_detector_t *d, uint32_t *n_clusters);
 
 /** @brief Counts (and ticks) of the last run. */
 const lidet_detector_stats_t *lidet_detector_stats(const lidet_detector_t *d);

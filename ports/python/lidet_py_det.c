@@ -1,0 +1,112 @@
+/* SPDX-License-Identifier: MIT */
+/* Flat C entry point over the whole detector (lidet_detector.h) for the Python bindings: one scan in,
+ * detections, per-cluster outcomes and per-point labels out. Host only: one static detector, so calls are
+ * not reentrant; each call initialises it (the configuration may change between calls). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "lidet/lidet.h"
+#include "lidet_weights.h"
+
+#if defined(_WIN32)
+#define LIDET_PY_API __declspec(dllexport)
+#else
+#define LIDET_PY_API __attribute__((visibility("default")))
+#endif
+
+static lidet_detector_t g_det;
+static int32_t g_pp[LIDET_MAX_POINTS];
+
+/* fcfg: crop_half_rad, max_range_m, nms_iou; ucfg: max_proposals, gate1, gate2.
+ * out_det: LIDET_MAX_DETECTIONS rows of 12 floats (class, score, energy_cls, energy_box, cx, cy, cz, l, w, h,
+ * yaw, cluster id); out_outcome: LIDET_MAX_CLUSTERS bytes; out_point_cluster / out_point_ground: n entries
+ * (may be NULL); out_stats: 13 uint32 (the lidet_detector_stats_t counts in order, then the status). */
+LIDET_PY_API int lidet_py_det_run(const char *sensor, uint32_t cls_index, uint32_t box_index, const float *fcfg,
+                                  const uint32_t *ucfg, const float *pts, uint32_t n, uint32_t stride,
+                                  float *out_det, uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters,
+                                  uint32_t *out_point_cluster, uint8_t *out_point_ground, uint32_t *out_stats)
+{
+    const lidet_sensor_t *s = lidet_sensor_find(sensor);
+    lidet_detector_cfg_t cfg;
+    const lidet_detection_t *d;
+    const lidet_detector_stats_t *st;
+    const uint8_t *oc;
+    uint32_t k, m = n < LIDET_MAX_POINTS ? n : LIDET_MAX_POINTS;
+    int rc;
+    if (s == NULL)
+    {
+        return LIDET_ERR_NOT_FOUND;
+    }
+    if (cls_index >= LIDET_WEIGHTS_N_MODELS || box_index >= LIDET_WEIGHTS_N_MODELS)
+    {
+        return LIDET_ERR_NOT_FOUND;
+    }
+    lidet_detector_cfg_default(&cfg, s);
+    cfg.crop_half_rad = fcfg[0];
+    cfg.max_range_m = fcfg[1];
+    cfg.nms_iou = fcfg[2];
+    cfg.max_proposals = ucfg[0];
+    cfg.gate1 = (uint8_t)ucfg[1];
+    cfg.gate2 = (uint8_t)ucfg[2];
+    rc = lidet_detector_init(&g_det, &cfg, lidet_weights_models[cls_index].model, lidet_weights_models[box_index].model);
+    if (rc != LIDET_OK)
+    {
+        return rc;
+    }
+    rc = lidet_detector_run(&g_det, pts, n, stride, NULL, g_pp);
+    if (rc < 0)
+    {
+        return rc;
+    }
+    d = lidet_detector_detections(&g_det, n_det);
+    for (k = 0; k < *n_det; ++k)
+    {
+        float *o = out_det + 12u * k;
+        o[0] = (float)d[k].cls;
+        o[1] = d[k].score;
+        o[2] = d[k].energy_cls;
+        o[3] = d[k].energy_box;
+        o[4] = d[k].box.cx_m;
+        o[5] = d[k].box.cy_m;
+        o[6] = d[k].box.cz_m;
+        o[7] = d[k].box.l_m;
+        o[8] = d[k].box.w_m;
+        o[9] = d[k].box.h_m;
+        o[10] = d[k].box.yaw_rad;
+        o[11] = (float)d[k].cluster_id;
+    }
+    oc = lidet_detector_outcomes(&g_det, n_clusters);
+    memcpy(out_outcome, oc, *n_clusters);
+    if (out_point_cluster != NULL || out_point_ground != NULL)
+    {
+        uint32_t *ids = out_point_cluster;
+        uint8_t *gnd = out_point_ground;
+        int r2 = lidet_workspace_point_labels(lidet_detector_workspace(&g_det), g_pp, m, ids, gnd);
+        if (r2 != LIDET_OK)
+        {
+            return r2;
+        }
+        for (k = m; k < n; ++k)
+        {
+            if (ids != NULL)
+                ids[k] = 0;
+            if (gnd != NULL)
+                gnd[k] = 0;
+        }
+    }
+    st = lidet_detector_stats(&g_det);
+    out_stats[0] = st->n_clusters;
+    out_stats[1] = st->n_out_of_crop;
+    out_stats[2] = st->n_out_of_range;
+    out_stats[3] = st->n_over_budget;
+    out_stats[4] = st->n_classified;
+    out_stats[5] = st->n_gate1_rejected;
+    out_stats[6] = st->n_boxed;
+    out_stats[7] = st->n_gate2_rejected;
+    out_stats[8] = st->n_size_rejected;
+    out_stats[9] = st->n_nms_suppressed;
+    out_stats[10] = st->n_over_capacity;
+    out_stats[11] = st->n_detections;
+    out_stats[12] = (uint32_t)rc;
+    return rc;
+}
