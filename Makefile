@@ -24,7 +24,10 @@ build: $(BUILD)/CMakeCache.txt
 	cmake --build $(BUILD) -j $(JOBS)
 
 # Every test: C (Unity + Eigen + consumer projects), Python (pytest), then the sanitizer build.
+# (re)configure after deps: a build folder configured earlier (e.g. by `make demo` on a fresh machine, before
+# Eigen was installed) picks up what deps installed, so no test is silently left out
 test: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DLIDET_BUILD_TESTS=ON $(CMAKE_FLAGS)
 	$(MAKE) --no-print-directory build
 	$(MAKE) --no-print-directory test-c test-py test-asan
 

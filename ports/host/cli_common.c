@@ -159,12 +159,14 @@ int cli_load(cli_args_t *a)
         size_t nr = 0;
         if (read_file(a->ring_path, 2, &buf, &nr, "ring file") != 0)
         {
+            cli_free(a); /* the scan read above */
             return 1;
         }
         if (nr != n)
         {
             fprintf(stderr, "lidet: ring file '%s' has %zu entries for %zu points\n", a->ring_path, nr, n);
             free(buf);
+            cli_free(a);
             return 1;
         }
         a->ring = (uint16_t *)buf;
@@ -201,7 +203,11 @@ int cli_split_set(const char *kv, size_t *klen, double *v)
         return 1;
     *klen = (size_t)(eq - kv);
     *v = strtod(eq + 1, &end);
-    return (*end != '\0' || end == eq + 1) ? 1 : 0;
+    /* NaN, +-inf (and their spellings "nan", "inf") are refused here: casting them to an integer field
+     * would be undefined, and no float field takes them either */
+    if (*end != '\0' || end == eq + 1 || !(*v == *v) || *v > 1.0e300 || *v < -1.0e300)
+        return 1;
+    return 0;
 }
 
 double cli_median(double *v, int n)

@@ -101,7 +101,17 @@ int cli_project(int argc, char **argv)
         uint32_t n;
         const int32_t *pp = lidet_proj_point_pixels(&g_proj, &n);
         FILE *f = fopen(a.out_path, "wb");
-        if (f == NULL || fwrite(pp, sizeof pp[0], n, f) != n || fclose(f) != 0)
+        int bad = f == NULL || fwrite(pp, sizeof pp[0], n, f) != n;
+        uint32_t k;
+        /* every input point gets an entry, also those past LIDET_MAX_POINTS (not projected: -1) */
+        for (k = n; !bad && k < a.n_points; ++k)
+        {
+            const int32_t none = -1;
+            bad = fwrite(&none, sizeof none, 1, f) != 1;
+        }
+        if (f != NULL && fclose(f) != 0)
+            bad = 1;
+        if (bad)
         {
             fprintf(stderr, "lidet project: cannot write '%s'\n", a.out_path);
             cli_free(&a);

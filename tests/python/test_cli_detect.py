@@ -104,3 +104,27 @@ def test_batch_script_writes_a_prediction_folder(cli, tmp_path):
     r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(tmp_path / "nothing"), "--out",
                         str(tmp_path / "p2")], capture_output=True, text=True)
     assert r.returncode == 1 and "no scans" in r.stderr
+
+
+def test_set_refuses_nan_and_inf(cli):
+    for kv in ("min_points=nan", "theta_rad=inf", "max_steps=-inf", "min_points=1e400"):
+        r = subprocess.run([str(cli), "cluster", str(SCAN), "--set", kv], capture_output=True, text=True)
+        assert r.returncode == 1 and "bad --set" in r.stderr, kv
+    r = _run(cli, SCAN, "--set", "nms_iou=nan", ok=False)
+    assert r.returncode == 1 and "bad --set" in r.stderr
+
+
+def test_project_out_covers_every_point_past_capacity(cli, tmp_path):
+    from lidet_tools import native
+    cap = native.capacity()["max_points"]
+    rng = np.random.default_rng(0)
+    n = cap + 1000
+    pts = np.c_[rng.uniform(-30, 30, (n, 2)), rng.uniform(-2, 1, n), np.zeros(n)].astype(np.float32)
+    scan = tmp_path / "big.bin"
+    pts.tofile(scan)
+    out = tmp_path / "pix.bin"
+    r = subprocess.run([str(cli), "project", str(scan), "--out", str(out)], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    pix = np.fromfile(out, np.int32)
+    assert len(pix) == n  # one entry per input point, like ground and cluster
+    assert np.all(pix[cap:] == -1) and np.any(pix[:cap] >= 0)
