@@ -145,6 +145,8 @@ def read_calib(path) -> Calib:
                 vals[k.strip()] = np.array([float(x) for x in v.split()], dtype=np.float64)
             except ValueError:
                 raise ValueError(f"{path}:{ln}: non-numeric value") from None
+            if not np.all(np.isfinite(vals[k.strip()])):
+                raise ValueError(f"{path}:{ln}: non-finite value (nan or inf)")
     need = {"P2": 12, "Tr_velo_to_cam": 12}
     for k, n in need.items():
         if k not in vals or vals[k].size != n:
@@ -232,6 +234,8 @@ def read_label2(path) -> list[KittiObject]:
                 v = [float(x) for x in p[1:]]
             except ValueError:
                 raise ValueError(f"{path}:{ln}: non-numeric field") from None
+            if not np.all(np.isfinite(v)):
+                raise ValueError(f"{path}:{ln}: non-finite field (nan or inf)")
             objs.append(KittiObject(p[0], v[0], int(v[1]), v[2], np.array(v[3:7]), v[7], v[8],
                                     v[9], np.array(v[10:13]), v[13],
                                     v[14] if len(v) == 15 else None))
@@ -314,6 +318,10 @@ def read_boxes(path) -> list[Box3D]:
                 v = [float(x) for x in p[1:]]
             except ValueError:
                 raise ValueError(f"{path}:{ln}: non-numeric field") from None
+            if not np.all(np.isfinite(v)):
+                raise ValueError(f"{path}:{ln}: non-finite field (nan or inf)")
+            if min(v[3:6]) < 0:
+                raise ValueError(f"{path}:{ln}: negative box size")
             out.append(Box3D(p[0], *v))
     return out
 
