@@ -180,6 +180,22 @@ typedef struct
     char cls[32];
 } gt_t;
 
+/* appends g to the growing array *out (*n entries, *cap allocated); 0, or 1 when out of memory */
+static int gt_push(gt_t **out, uint32_t *n, uint32_t *cap, const gt_t *g)
+{
+    if (*n == *cap)
+    {
+        gt_t *t;
+        *cap = *cap ? 2u * *cap : 16u;
+        t = (gt_t *)realloc(*out, *cap * sizeof(gt_t));
+        if (t == NULL)
+            return 1;
+        *out = t;
+    }
+    (*out)[(*n)++] = *g;
+    return 0;
+}
+
 static int read_gt(const char *path, gt_t **out, uint32_t *n)
 {
     FILE *f = fopen(path, "r");
@@ -219,20 +235,12 @@ static int read_gt(const char *path, gt_t **out, uint32_t *n)
         g.box.w_m = v[4];
         g.box.h_m = v[5];
         g.box.yaw_rad = v[6];
-        if (*n == cap)
+        if (gt_push(out, n, &cap, &g) != 0)
         {
-            gt_t *t;
-            cap = cap ? 2u * cap : 16u;
-            t = (gt_t *)realloc(*out, cap * sizeof(gt_t));
-            if (t == NULL)
-            {
-                free(*out);
-                fclose(f);
-                return 1;
-            }
-            *out = t;
+            free(*out);
+            fclose(f);
+            return 1;
         }
-        (*out)[(*n)++] = g;
     }
     fclose(f);
     return 0;
@@ -296,20 +304,12 @@ static int read_gt_kitti(const char *path, const calib_t *c, gt_t **out, uint32_
         g.box.w_m = (float)v[8];
         g.box.l_m = (float)v[9];
         g.box.yaw_rad = (float)atan2(dv[1] - o[1], dv[0] - o[0]);
-        if (*n == cap)
+        if (gt_push(out, n, &cap, &g) != 0)
         {
-            gt_t *t;
-            cap = cap ? 2u * cap : 16u;
-            t = (gt_t *)realloc(*out, cap * sizeof(gt_t));
-            if (t == NULL)
-            {
-                free(*out);
-                fclose(f);
-                return 1;
-            }
-            *out = t;
+            free(*out);
+            fclose(f);
+            return 1;
         }
-        (*out)[(*n)++] = g;
     }
     fclose(f);
     return 0;
