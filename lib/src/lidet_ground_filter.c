@@ -199,8 +199,9 @@ static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, const fl
     }
 }
 
-/* Pass 2 (mirrors ref/ground.py: gather_samples): the samples' coordinates grouped by cell, so each
- * cell's RANSAC reads one contiguous block. Only columns on the column grid (c % sample_col_step
+/* Pass 2 (mirrors ref/ground.py: gather_samples): the samples' pixels grouped by cell, so each cell's
+ * RANSAC reads one contiguous block of indices (4 B a sample, where a copy of the coordinates took 12 B:
+ * RANSAC reads them from the image). Only columns on the column grid (c % sample_col_step
  * == 0) of the filtered rows are taken (hdl64 defaults: every 4th row, every 4th column). Near
  * samples (R < ring_split_m) fill the buffer upwards from its start, far ones downwards from its
  * end, so one pass serves both cells of a sector (far cells hold their samples in reverse raster
@@ -214,7 +215,7 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
     const uint32_t cstep = g->cfg.sample_col_step;
     const float split = g->cfg.ring_split_m > 0.0f ? g->cfg.ring_split_m : 3.0e38f;
-    float *const sx = sc->sx_m, *const sy = sc->sy_m, *const sz = sc->sz_m;
+    uint32_t *const si = sc->sample_pix;
     uint32_t s, r, c, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
     for (s = 0; s < ns; ++s)
     {
@@ -227,7 +228,6 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
         {
             const size_t base = (size_t)r * cols;
             const uint8_t *m = sc->sample + base;
-            const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base;
             const float *R = rxy + base;
             if (roomy)
             {
@@ -235,9 +235,7 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
                 {
                     const uint32_t far = (uint32_t)(R[c] >= split), take = m[c];
                     const uint32_t k = far ? hi - 1u : lo; /* lo < hi: roomy leaves a slot per candidate */
-                    sx[k] = X[c];
-                    sy[k] = Y[c];
-                    sz[k] = Z[c];
+                    si[k] = (uint32_t)base + c;
                     lo += take & (far ^ 1u);
                     hi -= take & far;
                 }
@@ -252,9 +250,7 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
                         if (lo < hi)
                         {
                             const uint32_t k = R[c] >= split ? --hi : lo++;
-                            sx[k] = X[c];
-                            sy[k] = Y[c];
-                            sz[k] = Z[c];
+                            si[k] = (uint32_t)base + c;
                         }
                     }
                 }
@@ -482,7 +478,7 @@ lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_sc
     rxy = img->rxy_m != 0 ? img->rxy_m : compute_rxy(rxy_m, img);
     filter_rows(g, scratch->sample, rxy, img);
     gather_samples(g, scratch, rxy, img);
-    lidet__ground_fit_sectors(g, scratch);
+    lidet__ground_fit_sectors(g, scratch, img);
     label_rows(g, mask, rxy, img);
     return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
 }

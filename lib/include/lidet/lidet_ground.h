@@ -42,10 +42,12 @@
  *     veto_min_dz_m): the lowest returns of walls, kerbs, bumpers and trunks.
  *
  * Memory: sizeof(lidet_ground_t) = LIDET_MAX_ROWS * LIDET_MAX_COLS * 2 B (ground and sample masks)
- * + (LIDET_GROUND_MAX_SAMPLES + LIDET_GROUND_EVAL_MAX) * 12 B (x, y, z of the samples and of a cell's
- * scoring subset) + LIDET_GROUND_MAX_SECTORS * 50 B
- * + ~200 B; defaults (128 x 2048, 262,144 samples): about 3.5 MiB; a VLP-16 build (16 x 1800,
- * samples = pixels): about 0.4 MiB. lidet_ground_bytes() returns the exact figure. Declare it static.
+ * + LIDET_GROUND_MAX_SAMPLES * 4 B (the samples' pixels) + LIDET_GROUND_EVAL_MAX * 12 B (x, y, z of a
+ * cell's scoring subset) + LIDET_GROUND_MAX_SECTORS * 50 B + ~200 B; defaults (128 x 2048, 262,144
+ * samples): about 1.5 MiB; a VLP-16 build (16 x 1800, samples = pixels): about 0.18 MiB.
+ * lidet_ground_bytes() returns the exact figure. Declare it static. The state alone
+ * (lidet_ground_state_t) is what lives across runs; lidet_ground_run_buffers() runs on buffers the
+ * caller places (a detector workspace overlays the scratch, lidet_workspace.h).
  * Time: O(n_rows * n_cols) for the filter and the labelling, O(n_sectors * ransac_iters *
  * eval_samples + refine_iters * n_samples) for the planes; no allocation, no recursion.
  */
@@ -174,20 +176,19 @@ typedef struct
 /**
  * @brief Scratch of one ground run: nothing in it is read after the run returns except the sample
  *        mask (lidet_ground_samples, a diagnostic). A detector workspace overlays it with the other
- *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + (LIDET_GROUND_MAX_SAMPLES +
- *        LIDET_GROUND_EVAL_MAX) * 12 B + LIDET_GROUND_MAX_SECTORS * 16 B.
+ *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + LIDET_GROUND_MAX_SAMPLES * 4 B (a sample
+ *        is its pixel: RANSAC reads its coordinates from the image) + LIDET_GROUND_EVAL_MAX * 12 B
+ *        + LIDET_GROUND_MAX_SECTORS * 16 B.
  */
 typedef struct
 {
     uint8_t sample[LIDET_MAX_ROWS * LIDET_MAX_COLS];     /* 1 sample of the filter */
-    float sx_m[LIDET_GROUND_MAX_SAMPLES];                /* samples, grouped by cell */
-    float sy_m[LIDET_GROUND_MAX_SAMPLES];
-    float sz_m[LIDET_GROUND_MAX_SAMPLES];
+    uint32_t sample_pix[LIDET_GROUND_MAX_SAMPLES];       /* samples (their pixels), grouped by cell */
     float ev_x_m[LIDET_GROUND_EVAL_MAX];                 /* a cell's strided scoring subset */
     float ev_y_m[LIDET_GROUND_EVAL_MAX];
     float ev_z_m[LIDET_GROUND_EVAL_MAX];
     /* cells: k = s (near part of sector s) and k = n_sectors + s (far part); the samples of cell k
-     * are sx/sy/sz[cell_first[k] .. cell_first[k] + cell_n[k]) */
+     * are sample_pix[cell_first[k] .. cell_first[k] + cell_n[k]) */
     uint32_t cell_first[2 * LIDET_GROUND_MAX_SECTORS];
     uint32_t cell_n[2 * LIDET_GROUND_MAX_SECTORS];
 } lidet_ground_scratch_t;

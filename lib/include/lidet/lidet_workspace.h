@@ -29,7 +29,7 @@
  *
  * Bytes (lidet_workspace_sizes reports each part): states ~ LIDET_MAX_COLS * 12 B + LIDET_PROJ_ROW_LUT B
  * + LIDET_MAX_CLUSTERS * 60 B + LIDET_GROUND_MAX_SECTORS * 34 B; per pixel 17 B (x, y, z, range, ground
- * mask) + the overlay, the largest of 4 B (projection), 5 B + (LIDET_GROUND_MAX_SAMPLES / pixels) * 12 B
+ * mask) + the overlay, the largest of 4 B (projection), 5 B + (LIDET_GROUND_MAX_SAMPLES / pixels) * 4 B
  * (ground) and 6 B (clustering). Declare it static, or place it with the port's section macro
  * (LIDET_WORKSPACE_SECTION, lidet_port.h).
  * Time: the sum of the three stages, plus one pass over the pixels for R (vectorised). No allocation.
