@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Unity tests of the depth clustering and the proposals (lib/src/lidet_cluster.c, lidet_proposal.c)
+/* Unity tests of the depth clustering and the proposals (lib/src/lidet_cluster*.c, lidet_proposal.c)
  * on hand-drawn range images (test_cluster_util.h: letters are ranges, '.' empty, 'g' ground). */
 #include <math.h>
 #include <string.h>
