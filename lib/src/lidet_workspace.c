@@ -90,8 +90,7 @@ lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, u
     }
     worst = st;
     ws_image(ws, &img);
-    st = lidet_ground_run_buffers(&ws->ground, &ws->overlay.ground.scratch, ws->ground_mask,
-                                  ws->overlay.ground.rxy_m, &img);
+    st = lidet_ground_run_buffers(&ws->ground, &ws->overlay.ground, ws->ground_mask, &img);
     if (st < 0)
     {
         return st;

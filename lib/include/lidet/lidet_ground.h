@@ -178,7 +178,7 @@ typedef struct
  *        mask (lidet_ground_samples, a diagnostic). A detector workspace overlays it with the other
  *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + LIDET_GROUND_MAX_SAMPLES * 4 B (a sample
  *        is its pixel: RANSAC reads its coordinates from the image) + LIDET_GROUND_EVAL_MAX * 12 B
- *        + LIDET_GROUND_MAX_SECTORS * 16 B.
+ *        + LIDET_GROUND_MAX_SECTORS * 16 B + LIDET_MAX_COLS * 8 B (two rows of R, for images without R).
  */
 typedef struct
 {
@@ -191,6 +191,7 @@ typedef struct
      * are sample_pix[cell_first[k] .. cell_first[k] + cell_n[k]) */
     uint32_t cell_first[2 * LIDET_GROUND_MAX_SECTORS];
     uint32_t cell_n[2 * LIDET_GROUND_MAX_SECTORS];
+    float rxy_rows[2][LIDET_MAX_COLS]; /* R of two rows, computed when the image has no R */
 } lidet_ground_scratch_t;
 
 /** @brief Ground stage with every buffer inside (the standalone form): state, the ground mask (the
@@ -283,13 +284,12 @@ lidet_status_t lidet_ground_state_init(lidet_ground_state_t *st, const lidet_gro
  * @param[in,out] st      initialised state (planes, sources and stats are written).
  * @param[out]    scratch the run's scratch (its sample mask stays readable until it is reused).
  * @param[out]    mask    n_rows * n_cols bytes: the ground mask.
- * @param[out]    rxy_m   n_rows * n_cols floats of scratch for R when img->rxy_m is NULL (computed
- *                        from x and y exactly as the projection would); may be NULL when the image has R.
- * @param[in]     img     range image (rxy_m and point_idx may be NULL).
- * @return as lidet_ground_run; LIDET_ERR_ARG also when img has no R and rxy_m is NULL.
+ * @param[in]     img     range image; rxy_m and point_idx may be NULL (without R the stage computes it
+ *                        row by row from x and y, exactly as the projection would: same results).
+ * @return as lidet_ground_run.
  */
 lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *st, lidet_ground_scratch_t *scratch, uint8_t *mask,
-                                        float *rxy_m, const lidet_range_image_t *img);
+                                        const lidet_range_image_t *img);
 
 /** @brief Per-point labels from a state and the mask it produced (lidet_ground_point_labels). */
 lidet_status_t lidet_ground_point_labels_of(const lidet_ground_state_t *st, const uint8_t *mask,
