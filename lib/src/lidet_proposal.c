@@ -9,7 +9,6 @@
 #include "internal/lidet_rng.h"
 #include "lidet/lidet_cluster.h"
 
-#define DEG2RAD 0.0174532925f
 
 void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg)
 {
@@ -20,8 +19,8 @@ void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg)
     memset(cfg, 0, sizeof *cfg);
     cfg->n_points = 64u < LIDET_PROPOSAL_POINTS ? 64u : LIDET_PROPOSAL_POINTS;
     cfg->seed = 0x5EED1234u;
-    cfg->azimuth_bin_rad = 10.0f * DEG2RAD;
-    cfg->elevation_bin_rad = 10.0f * DEG2RAD;
+    cfg->azimuth_bin_rad = 10.0f * LIDET_DEG2RAD_F;
+    cfg->elevation_bin_rad = 10.0f * LIDET_DEG2RAD_F;
     cfg->range_bin_m = 1.0f;
 }
 
