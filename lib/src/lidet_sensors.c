@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Sensor presets. Mirrored by tools/lidet_tools/sensors.py; tests/python/test_bindings.py checks
+/* Sensor presets. Mirrored by tools/lidet_tools/sensors.py; tests/python/test_bindings_proj.py checks
  * that both give the same beam tables. Elevations in ring order, radians, float32-rounded. */
 #include "internal/lidet_math.h"
 #include "lidet/lidet_sensor.h"

@@ -224,11 +224,12 @@ lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cf
  * @brief Segment the ground of one range image.
  * @param[in,out] g   initialised state; its mask, samples and planes are overwritten.
  * @param[in]     img range image from lidet_proj_image (or built by hand with the same contract:
- *                    row 0 = top beam, rows ordered by decreasing elevation, point_idx -1 = empty).
- *                    Not retained.
+ *                    row 0 = top beam, rows ordered by decreasing elevation, empty pixels 0 in every
+ *                    float array). x, y, z are read; R when given (else computed row by row);
+ *                    point_idx is not read. Not retained.
  * @return LIDET_OK; LIDET_TRUNCATED when more than LIDET_GROUND_MAX_SAMPLES pixels passed the filter
  *         (the excess, last sectors first, is counted in stats.n_samples_dropped and not used);
- *         LIDET_ERR_ARG (NULL, NULL image arrays); LIDET_ERR_STATE (not initialised);
+ *         LIDET_ERR_ARG (NULL, NULL x, y or z); LIDET_ERR_STATE (not initialised);
  *         LIDET_ERR_BUFFER (image larger than LIDET_MAX_ROWS x LIDET_MAX_COLS);
  *         LIDET_ERR_CONFIG (image has fewer columns than n_sectors).
  */
