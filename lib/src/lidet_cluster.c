@@ -1,22 +1,15 @@
 /* SPDX-License-Identifier: MIT */
-/* Depth clustering (see lidet_cluster.h for the algorithm and memory).
- * The numpy reference is codegen/lidet_codegen/ref/cluster.py: cluster_ref (this file) and
+/* Depth clustering (see lidet_cluster.h for the algorithm and memory): configuration, the run (candidates,
+ * first fill, rescue pass), the filters and records of each component, canonical ids, accessors. The
+ * growth is in lidet_cluster_grow.c, the fragment rescue in lidet_cluster_rescue.c.
+ * The numpy reference is codegen/lidet_codegen/ref/cluster.py: cluster_ref (these three files) and
  * proposal_indices / make_proposal (lidet_proposal.c). */
 #include <math.h>
 #include <string.h>
 
 #include "internal/lidet_assert.h"
+#include "internal/lidet_cluster_internal.h"
 #include "internal/lidet_math.h"
-#include "lidet/lidet_cluster.h"
-
-/* pixel states in labels[] during a run (ids 1..LIDET_MAX_CLUSTERS are slots + 1) */
-#define LAB_FREE 0u         /* a candidate not visited yet */
-#define LAB_SMALL 0xFFFDu   /* a fragment (component below min_points) waiting for the rescue pass */
-#define LAB_PENDING 0xFFFEu /* visited: current cluster, or a dropped one */
-#define LAB_NONCAND 0xFFFFu /* no point, or ground: bridged over, never joined */
-
-#define STEPS LIDET_CLUSTER_MAX_STEPS
-#define RESCUE_MAX_COLS 15u /* rescue_cols limit (each fragment pixel looks at (2 rows + 1)(2 cols + 1) pixels) */
 
 void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *sensor)
 {
@@ -91,354 +84,6 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
     return LIDET_OK;
 }
 
-/* sin/cos of every alpha the search can meet; recomputed only when the image geometry changes */
-static void setup_geometry(lidet_cluster_state_t *c, const lidet_range_image_t *img)
-{
-    const uint32_t rows = img->n_rows, cols = img->n_cols;
-    uint32_t r, k;
-    if (c->geo_rows == rows && c->geo_cols == cols &&
-        memcmp(c->geo_elev, img->row_elev_rad, rows * sizeof(float)) == 0)
-    {
-        return;
-    }
-    for (k = 1; k <= STEPS; ++k)
-    {
-        /* k * 2pi / cols, reduced to at most pi (the two beams' angle) */
-        const float a = LIDET_PI_F * 2.0f * (float)(k % cols) / (float)cols;
-        const float a2 = a > LIDET_PI_F ? 2.0f * LIDET_PI_F - a : a;
-        c->col_sin[k - 1] = sinf(a2);
-        c->col_cos[k - 1] = cosf(a2);
-    }
-    for (r = 0; r < rows; ++r)
-    {
-        c->geo_elev[r] = img->row_elev_rad[r];
-        for (k = 1; k <= STEPS; ++k)
-        {
-            float a = r + k < rows ? img->row_elev_rad[r] - img->row_elev_rad[r + k] : 0.0f;
-            a = a < 0.0f ? -a : a;
-            c->row_sin[r * STEPS + k - 1] = sinf(a);
-            c->row_cos[r * STEPS + k - 1] = cosf(a);
-        }
-    }
-    /* diagonal pairs (r, c) - (r + 1, c +- 1): cos of the angle between the two beam directions */
-    {
-        const float cd = cosf(2.0f * LIDET_PI_F / (float)cols);
-        for (r = 0; r + 1 < rows; ++r)
-        {
-            const float e1 = img->row_elev_rad[r], e2 = img->row_elev_rad[r + 1];
-            float cs = sinf(e1) * sinf(e2) + cosf(e1) * cosf(e2) * cd;
-            cs = cs > 1.0f ? 1.0f : (cs < -1.0f ? -1.0f : cs);
-            c->diag_cos[r] = cs;
-            c->diag_sin[r] = sqrtf(1.0f - cs * cs);
-        }
-    }
-    c->geo_rows = (uint16_t)rows;
-    c->geo_cols = (uint16_t)cols;
-}
-
-/* Constants of one run's flood fill. */
-typedef struct
-{
-    uint32_t rows, cols, ks, kc, row_magic;
-    int diag;
-    uint32_t rrows, rcols; /* rescue window half-sizes (2 rcols < cols) */
-    float tan_theta, gap, gpm, rgap, rgpm;
-} grow_t;
-
-/* beta > theta  <=>  d2 sin(a) > tan(theta) (d1 - d2 cos(a)), d1 >= d2 (true when the bracket <= 0).
- * With gap > 0 the two returns must also lie within gap + gap_per_m * d2 of each other; their
- * distance along the two beams is sqrt((d1 - d2 cos a)^2 + (d2 sin a)^2), from the same two terms
- * (no point coordinates are read) */
-static inline int link(float da, float db, float sn, float cs, const grow_t *g)
-{
-    const float d1 = da > db ? da : db;
-    const float d2 = da > db ? db : da;
-    const float u = d1 - d2 * cs, v = d2 * sn;
-    if (!(v > g->tan_theta * u))
-    {
-        return 0;
-    }
-    if (g->gap > 0.0f)
-    {
-        const float gg = g->gap + g->gpm * d2;
-        return u * u + v * v <= gg * gg;
-    }
-    return 1;
-}
-
-/* One step of a directional search from a pixel of range dq that met candidate n (label l, range dn):
- * joins n when it is free and passes the test. Returns 1 when the search goes on behind n (n is a
- * nearer occluder that fails the test, with occluder bridging on), 0 when it stops there. A visited
- * n is only tested when that decides between the two (joining it again would change nothing). */
-#define PROBE_GOES_ON(l, n, dn, sn, cs)                                                             \
-    ((l) == LAB_FREE ? (link(dq, (dn), (sn), (cs), g) ? (lab[n] = (uint16_t)LAB_PENDING,           \
-                                                         mem[tail++] = (int32_t)(n), 0)             \
-                                                      : (occl && (dn) < dq))                        \
-                     : (occl && (dn) < dq && !link(dq, (dn), (sn), (cs), g)))
-
-/* One directional search from q (range dq): pixels q + k * step, k = 1..nk, never wrapping (the
- * caller sends the columns within kc of either edge to search_wrap); beam pair sin/cos at
- * sn[(k - 1) * gs], cs[(k - 1) * gs]. Non-candidates are stepped over. */
-static inline uint32_t search(uint16_t *lab, int32_t *mem, const float *rng, uint32_t tail, float dq, uint32_t q,
-                              int32_t step, uint32_t nk, const float *sn, const float *cs, int32_t gs,
-                              const grow_t *g, int occl)
-{
-    uint32_t k, n = q;
-    if (!occl)
-    {
-        /* the search stops at the first candidate whatever it is: find it, then test it only when
-         * free (nk >= 1; k ends at the step of that candidate, or at nk - 1 on a non-candidate) */
-        uint32_t l;
-        k = 0;
-        for (;;)
-        {
-            n = (uint32_t)((int32_t)n + step);
-            l = lab[n];
-            if (l != LAB_NONCAND || ++k >= nk)
-            {
-                break;
-            }
-        }
-        if (l == LAB_FREE && link(dq, rng[n], sn[(int32_t)k * gs], cs[(int32_t)k * gs], g))
-        {
-            lab[n] = (uint16_t)LAB_PENDING;
-            mem[tail++] = (int32_t)n;
-        }
-        return tail;
-    }
-    for (k = 0; k < nk; ++k, sn += gs, cs += gs)
-    {
-        uint32_t l;
-        n = (uint32_t)((int32_t)n + step);
-        l = lab[n];
-        if (l == LAB_NONCAND)
-        {
-            continue;
-        }
-        if (!PROBE_GOES_ON(l, n, rng[n], *sn, *cs))
-        {
-            break;
-        }
-    }
-    return tail;
-}
-
-/* The same along a row across the wrap (the rare columns within kc of either edge): step k meets
- * rowbase + (col +- k mod cols); angles col_sin/col_cos */
-static uint32_t search_wrap(lidet_cluster_state_t *c, uint32_t tail, float dq, uint32_t rowbase, uint32_t col, int right,
-                            const grow_t *g, int occl)
-{
-    uint16_t *lab = c->labels;
-    int32_t *mem = c->members;
-    const float *rng = c->img.range_m;
-    const uint32_t cols = g->cols;
-    uint32_t k;
-    for (k = 1; k <= g->kc; ++k)
-    {
-        const uint32_t cc =
-            right ? (col + k >= cols ? col + k - cols : col + k) : (col >= k ? col - k : col + cols - k);
-        const uint32_t n = rowbase + cc;
-        const uint32_t l = lab[n];
-        if (l == LAB_NONCAND)
-        {
-            continue;
-        }
-        if (!PROBE_GOES_ON(l, n, rng[n], c->col_sin[k - 1], c->col_cos[k - 1]))
-        {
-            break;
-        }
-    }
-    return tail;
-}
-
-/* a direct (diagonal) neighbour: joins n when free and linked; no bridging */
-#define DIAG(n, sn, cs)                                                                             \
-    if (lab[n] == LAB_FREE && link(dq, rng[n], (sn), (cs), g))                                      \
-    {                                                                                               \
-        lab[n] = (uint16_t)LAB_PENDING;                                                             \
-        mem[tail++] = (int32_t)(n);                                                                 \
-    }
-
-/* Breadth-first flood fill of the cluster seeded at members[start] (tail = start + 1): expands
- * members[head] for head = start .. tail (the member array is the queue, every pixel is pushed at
- * most once). Returns the new tail. Directions in the reference's order: right, left, down, up, then
- * the diagonals down-left, down-right, up-left, up-right. occl is a constant at each call site. */
-static inline uint32_t grow(lidet_cluster_state_t *c, const grow_t *g, uint32_t start, uint32_t tail, int occl)
-{
-    uint16_t *lab = c->labels;
-    int32_t *mem = c->members;
-    const float *rng = c->img.range_m;
-    const uint32_t rows = g->rows, cols = g->cols, ks = g->ks, kc = g->kc;
-    uint32_t head = start;
-    while (head < tail)
-    {
-        const uint32_t q = (uint32_t)mem[head++];
-        const uint32_t r = g->row_magic != 0u ? (uint32_t)(((uint64_t)q * g->row_magic) >> 32) : q / cols;
-        const uint32_t rowbase = r * cols, col = q - rowbase;
-        const float dq = rng[q];
-        const uint32_t nd = rows - 1u - r < ks ? rows - 1u - r : ks; /* steps that stay in the image */
-        const uint32_t nu = r < ks ? r : ks;
-        LIDET_ASSERT(tail <= rows * cols);
-        /* right, left (wrapping) */
-        if (col + kc < cols)
-        {
-            tail = search(lab, mem, rng, tail, dq, q, 1, kc, c->col_sin, c->col_cos, 1, g, occl);
-        }
-        else
-        {
-            tail = search_wrap(c, tail, dq, rowbase, col, 1, g, occl);
-        }
-        if (col >= kc)
-        {
-            tail = search(lab, mem, rng, tail, dq, q, -1, kc, c->col_sin, c->col_cos, 1, g, occl);
-        }
-        else
-        {
-            tail = search_wrap(c, tail, dq, rowbase, col, 0, g, occl);
-        }
-        /* down: rows r and r + k, entry [r * STEPS + k - 1]; up: rows r - k and r, entry
-         * [(r - k) * STEPS + k - 1] (stored at the upper row), i.e. stride 1 - STEPS from (r - 1) * STEPS */
-        if (nd > 0u)
-        {
-            tail = search(lab, mem, rng, tail, dq, q, (int32_t)cols, nd, c->row_sin + r * STEPS,
-                          c->row_cos + r * STEPS, 1, g, occl);
-        }
-        if (nu > 0u)
-        {
-            tail = search(lab, mem, rng, tail, dq, q, -(int32_t)cols, nu, c->row_sin + (r - 1u) * STEPS,
-                          c->row_cos + (r - 1u) * STEPS, 1 - STEPS, g, occl);
-        }
-        /* diagonals (8-neighbourhood option): direct neighbours only, no bridging */
-        if (g->diag)
-        {
-            const uint32_t cl = col > 0u ? col - 1u : cols - 1u, cr = col + 1u < cols ? col + 1u : 0u;
-            if (r + 1u < rows)
-            {
-                const uint32_t b = rowbase + cols;
-                DIAG(b + cl, c->diag_sin[r], c->diag_cos[r])
-                DIAG(b + cr, c->diag_sin[r], c->diag_cos[r])
-            }
-            if (r > 0u)
-            {
-                const uint32_t b = rowbase - cols;
-                DIAG(b + cl, c->diag_sin[r - 1u], c->diag_cos[r - 1u])
-                DIAG(b + cr, c->diag_sin[r - 1u], c->diag_cos[r - 1u])
-            }
-        }
-    }
-    return tail;
-}
-
-/* ---- fragment rescue ------------------------------------------------------------------------ */
-
-/* Running state of one rescue group: the queue tail and the nearest kept pixel met so far. */
-typedef struct
-{
-    uint32_t tail;
-    uint32_t best;  /* slot + 1 of the nearest kept cluster met, 0 = none */
-    float best_d2;  /* its squared distance */
-} rescue_t;
-
-/* One pixel n (label l < LAB_PENDING, range dn) of the window of group pixel q (range dq): the two returns'
- * distance (from their coordinates) against gg = rgap + rgpm * (nearer range). Within it a fragment
- * pixel joins and a kept pixel is a contact (the nearest one wins, ties: the first met). */
-static inline void rescue_link(lidet_cluster_state_t *c, rescue_t *rs, uint32_t n, uint32_t l, float dn, uint32_t q,
-                               float dq, const grow_t *g)
-{
-    const lidet_range_image_t *img = &c->img;
-    const float gg = g->rgap + g->rgpm * (dq < dn ? dq : dn);
-    const float dx = img->x_m[n] - img->x_m[q], dy = img->y_m[n] - img->y_m[q], dz = img->z_m[n] - img->z_m[q];
-    const float dd = dx * dx + dy * dy + dz * dz;
-    if (!(dd <= gg * gg))
-    {
-        return;
-    }
-    if (l == LAB_SMALL)
-    {
-        c->labels[n] = (uint16_t)LAB_PENDING;
-        c->members[rs->tail++] = (int32_t)n;
-    }
-    else if (dd < rs->best_d2)
-    {
-        rs->best_d2 = dd;
-        rs->best = l;
-    }
-}
-
-/* Pixel n of the window: looked at when it is a fragment or kept pixel (labels below LAB_PENDING;
- * visited, dropped and empty pixels are looked past) and its range lies in [lo, hi], the ranges
- * whose difference to dq can be within the gap (it bounds the distance from below; most pixels
- * stop here, before their coordinates are read) */
-#define RESCUE_PROBE(n)                                                                             \
-    {                                                                                               \
-        const uint32_t l_ = lab[n];                                                                 \
-        const float d_ = rng[n];                                                                    \
-        if (l_ < LAB_PENDING && d_ >= lo && d_ <= hi && (n) != q)                                   \
-        {                                                                                           \
-            rescue_link(c, rs, (n), l_, d_, q, dq, g);                                              \
-        }                                                                                           \
-    }
-
-/* Breadth-first fill of the rescue group seeded at members[start]. Around each member q it looks at
- * every pixel of the window rescue_rows rows up and down and rescue_cols columns left and right
- * (wrapping), row by row from the top left, q itself excepted. Four labels at a time (a 64-bit
- * word) are skipped when all are LAB_PENDING or LAB_NONCAND (0xFFFE, 0xFFFF: the only labels with
- * every bit but the lowest set). Fragments are few (hundreds of pixels per scan), windows small. */
-static void rescue_grow(lidet_cluster_state_t *c, const grow_t *g, uint32_t start, rescue_t *rs)
-{
-    const int32_t *mem = c->members;
-    const uint16_t *lab = c->labels;
-    const float *rng = c->img.range_m;
-    const uint32_t rows = g->rows, cols = g->cols, wr = g->rrows, wc = g->rcols;
-    uint32_t head = start;
-    while (head < rs->tail)
-    {
-        const uint32_t q = (uint32_t)mem[head++];
-        const uint32_t r = q / cols, col = q - r * cols;
-        const uint32_t r0 = r >= wr ? r - wr : 0u, r1 = r + wr < rows ? r + wr : rows - 1u;
-        const uint32_t c0 = col >= wc ? col - wc : col + cols - wc; /* 2 wc < cols: none repeats */
-        const float dq = rng[q];
-        /* |d - dq| <= rgap + rgpm * min(d, dq)  <=>  lo <= d <= hi */
-        const float hi = dq * (1.0f + g->rgpm) + g->rgap, lo = (dq - g->rgap) / (1.0f + g->rgpm);
-        uint32_t rr, k;
-        LIDET_ASSERT(rs->tail <= rows * cols);
-        for (rr = r0; rr <= r1; ++rr)
-        {
-            const uint32_t base = rr * cols;
-            if (c0 + 2u * wc < cols)
-            {
-                const uint32_t end = base + c0 + 2u * wc + 1u;
-                uint32_t n = base + c0;
-                for (; n + 4u <= end; n += 4u)
-                {
-                    uint64_t w;
-                    memcpy(&w, &lab[n], sizeof w);
-                    if ((w | 0x0001000100010001u) != 0xFFFFFFFFFFFFFFFFu)
-                    {
-                        RESCUE_PROBE(n)
-                        RESCUE_PROBE(n + 1u)
-                        RESCUE_PROBE(n + 2u)
-                        RESCUE_PROBE(n + 3u)
-                    }
-                }
-                for (; n < end; ++n)
-                {
-                    RESCUE_PROBE(n)
-                }
-            }
-            else
-            {
-                uint32_t cc = c0;
-                for (k = 0; k <= 2u * wc; ++k)
-                {
-                    RESCUE_PROBE(base + cc)
-                    cc = cc + 1u < cols ? cc + 1u : 0u;
-                }
-            }
-        }
-    }
-}
-#undef RESCUE_PROBE
 
 /* the smallest kept cluster (ties: the later seed), the one capacity drops first */
 static uint32_t smallest_slot(const lidet_cluster_state_t *c)
@@ -797,7 +442,7 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     uint32_t rows, cols, npix, p, tail, ks;
     uint16_t *lab;
     int32_t *mem;
-    grow_t lk;
+    lidet__grow_t lk;
     lidet_cluster_stats_t st;
 
     if (c == 0 || labels == 0 || members == 0 || img == 0 || (planes != 0 && n_sectors == 0))
@@ -820,7 +465,7 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
         return LIDET_ERR_ARG;
     }
     npix = rows * cols;
-    setup_geometry(c, img);
+    lidet__cluster_setup_geometry(c, img);
     c->img = *img;
     c->labels = labels;
     c->members = members;
@@ -880,8 +525,7 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
         start = tail;
         lab[p] = (uint16_t)LAB_PENDING;
         mem[tail++] = (int32_t)p;
-        /* two copies of the flood fill, with the occluder rule a constant in each */
-        tail = c->cfg.bridge_occluders != 0 ? grow(c, &lk, start, tail, 1) : grow(c, &lk, start, tail, 0);
+        tail = lidet__cluster_grow(c, &lk, start, tail);
         tail = finish_cluster(c, start, tail, planes, n_sectors, &st, 0);
     }
     /* the rescue pass over the fragments (LAB_SMALL), groups seeded in raster order. Kept pixels,
@@ -890,14 +534,14 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     {
         for (p = next_fragment(lab, 0, npix); p < npix; p = next_fragment(lab, p + 1u, npix))
         {
-            rescue_t rs;
+            lidet__rescue_t rs;
             const uint32_t start = tail;
             lab[p] = (uint16_t)LAB_PENDING;
             mem[tail++] = (int32_t)p;
             rs.tail = tail;
             rs.best = 0u;
             rs.best_d2 = 3.0e38f;
-            rescue_grow(c, &lk, start, &rs);
+            lidet__cluster_rescue_grow(c, &lk, start, &rs);
             if (rs.best != 0u)
             {
                 rescue_join(c, rs.best - 1u, start, rs.tail, planes, n_sectors, &st);

@@ -164,8 +164,54 @@ static inline void filter_row(const float *R0, const float *R1, const float *Z0,
     out[cols - 1u] = sample_test(R0, R1, Z0, Z1, F0, cols - 2u, cols - 1u, 0u, 1u, f, opt);
 }
 
+/* Rows of R: the image's when it has R, else computed on demand into the two scratch rows (row r in
+ * slot r % 2, so rows r and r + 1 are available together) with the projection's own expression
+ * (lidet__rxy: the same bits as a stored R). A pass over the rows in increasing order computes each
+ * row once. */
+typedef struct
+{
+    const float *img_rxy; /* the image's R, or NULL */
+    const float *x, *y;
+    float *slot[2];
+    int32_t row_in[2]; /* row held by each slot, -1 = none */
+    uint32_t cols;
+} rxy_rows_t;
+
+static void rxy_rows_init(rxy_rows_t *rr, lidet_ground_scratch_t *sc, const lidet_range_image_t *img)
+{
+    rr->img_rxy = img->rxy_m;
+    rr->x = img->x_m;
+    rr->y = img->y_m;
+    rr->slot[0] = sc->rxy_rows[0];
+    rr->slot[1] = sc->rxy_rows[1];
+    rr->row_in[0] = -1;
+    rr->row_in[1] = -1;
+    rr->cols = img->n_cols;
+}
+
+static const float *rxy_row(rxy_rows_t *rr, uint32_t r)
+{
+    const uint32_t cols = rr->cols, k = r & 1u;
+    float *out = rr->slot[k];
+    if (rr->img_rxy != 0)
+    {
+        return rr->img_rxy + (size_t)r * cols;
+    }
+    if (rr->row_in[k] != (int32_t)r)
+    {
+        const float *x = rr->x + (size_t)r * cols, *y = rr->y + (size_t)r * cols;
+        uint32_t c;
+        for (c = 0; c < cols; ++c)
+        {
+            out[c] = lidet__rxy(x[c], y[c]);
+        }
+        rr->row_in[k] = (int32_t)r;
+    }
+    return out;
+}
+
 /* Pass 1 (mirrors ref/ground.py: sample_mask): the sample mask, row by row. */
-static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, const float *rxy, const lidet_range_image_t *img)
+static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, rxy_rows_t *rr, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols;
     const uint32_t step = g->cfg.sample_step;
@@ -181,8 +227,8 @@ static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, const fl
     memset(sample, 0, (size_t)rows * cols);
     for (r = 0; r + 1u < rows; r += step)
     {
-        const float *R0 = rxy + (size_t)r * cols;
-        const float *R1 = R0 + cols;
+        const float *R0 = rxy_row(rr, r);
+        const float *R1 = rxy_row(rr, r + 1u);
         const float *Z0 = img->z_m + (size_t)r * cols;
         const float *Z1 = Z0 + cols;
         const float *F0 = g->cfg.fx_on_z ? Z0 : R0;
@@ -199,8 +245,9 @@ static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, const fl
     }
 }
 
-/* Pass 2 (mirrors ref/ground.py: gather_samples): the samples' coordinates grouped by cell, so each
- * cell's RANSAC reads one contiguous block. Only columns on the column grid (c % sample_col_step
+/* Pass 2 (mirrors ref/ground.py: gather_samples): the samples' pixels grouped by cell, so each cell's
+ * RANSAC reads one contiguous block of indices (4 B a sample, where a copy of the coordinates took 12 B:
+ * RANSAC reads them from the image). Only columns on the column grid (c % sample_col_step
  * == 0) of the filtered rows are taken (hdl64 defaults: every 4th row, every 4th column). Near
  * samples (R < ring_split_m) fill the buffer upwards from its start, far ones downwards from its
  * end, so one pass serves both cells of a sector (far cells hold their samples in reverse raster
@@ -208,13 +255,13 @@ static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, const fl
  * candidate is written to the next free slot of its end, and the mask bit decides whether that end
  * advances (samples come in no predictable pattern). Past LIDET_GROUND_MAX_SAMPLES, samples are
  * dropped (in sector and raster order) and counted. */
-static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const float *rxy,
-                           const lidet_range_image_t *img)
+static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
     const uint32_t cstep = g->cfg.sample_col_step;
-    const float split = g->cfg.ring_split_m > 0.0f ? g->cfg.ring_split_m : 3.0e38f;
-    float *const sx = sc->sx_m, *const sy = sc->sy_m, *const sz = sc->sz_m;
+    const int two = g->cfg.ring_split_m > 0.0f;
+    const float split = two ? g->cfg.ring_split_m : 3.0e38f;
+    uint32_t *const si = sc->sample_pix;
     uint32_t s, r, c, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
     for (s = 0; s < ns; ++s)
     {
@@ -227,17 +274,17 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
         {
             const size_t base = (size_t)r * cols;
             const uint8_t *m = sc->sample + base;
-            const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base;
-            const float *R = rxy + base;
+            /* R decides near or far only with a split: the image's, else computed for this pixel */
+            const float *R = img->rxy_m != 0 ? img->rxy_m + base : 0;
+            const float *X = img->x_m + base, *Y = img->y_m + base;
             if (roomy)
             {
                 for (c = cstart; c < c1; c += cstep)
                 {
-                    const uint32_t far = (uint32_t)(R[c] >= split), take = m[c];
+                    const float rc = !two ? 0.0f : (R != 0 ? R[c] : lidet__rxy(X[c], Y[c]));
+                    const uint32_t far = (uint32_t)(rc >= split), take = m[c];
                     const uint32_t k = far ? hi - 1u : lo; /* lo < hi: roomy leaves a slot per candidate */
-                    sx[k] = X[c];
-                    sy[k] = Y[c];
-                    sz[k] = Z[c];
+                    si[k] = (uint32_t)base + c;
                     lo += take & (far ^ 1u);
                     hi -= take & far;
                 }
@@ -251,10 +298,9 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
                         ++total;
                         if (lo < hi)
                         {
-                            const uint32_t k = R[c] >= split ? --hi : lo++;
-                            sx[k] = X[c];
-                            sy[k] = Y[c];
-                            sz[k] = Z[c];
+                            const float rc = !two ? 0.0f : (R != 0 ? R[c] : lidet__rxy(X[c], Y[c]));
+                            const uint32_t k = rc >= split ? --hi : lo++;
+                            si[k] = (uint32_t)base + c;
                         }
                     }
                 }
@@ -358,7 +404,7 @@ static inline uint32_t label_two(const float *X, const float *Y, const float *Z,
     return nv;
 }
 
-static void label_rows(lidet_ground_state_t *g, uint8_t *mask, const float *rxy, const lidet_range_image_t *img)
+static void label_rows(lidet_ground_state_t *g, uint8_t *mask, rxy_rows_t *rr, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors;
     const float g0 = g->cfg.ground_m, below0 = g->cfg.below_factor * g0;
@@ -377,8 +423,8 @@ static void label_rows(lidet_ground_state_t *g, uint8_t *mask, const float *rxy,
     for (r = 0; r < rows; ++r)
     {
         const size_t base = (size_t)r * cols;
-        const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base, *R = rxy + base;
-        const float *Ru = r > 0u ? R - cols : R, *Zu = r > 0u ? Z - cols : Z;
+        const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base, *R = rxy_row(rr, r);
+        const float *Ru = r > 0u ? rxy_row(rr, r - 1u) : R, *Zu = r > 0u ? Z - cols : Z;
         uint8_t *out = mask + base;
         for (s = 0; s < ns; ++s)
         {
@@ -437,24 +483,10 @@ static void label_rows(lidet_ground_state_t *g, uint8_t *mask, const float *rxy,
     g->stats.n_vetoed = n_vetoed;
 }
 
-/* R of every pixel from its x and y (an image without R, as a detector workspace builds it): the
- * projection's own expression, so the bits equal those it would have stored */
-static const float *compute_rxy(float *rxy, const lidet_range_image_t *img)
-{
-    const uint32_t npix = (uint32_t)img->n_rows * img->n_cols;
-    const float *const x = img->x_m, *const y = img->y_m;
-    uint32_t p;
-    for (p = 0; p < npix; ++p)
-    {
-        rxy[p] = lidet__rxy(x[p], y[p]);
-    }
-    return rxy;
-}
-
 lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_scratch_t *scratch, uint8_t *mask,
-                                        float *rxy_m, const lidet_range_image_t *img)
+                                        const lidet_range_image_t *img)
 {
-    const float *rxy;
+    rxy_rows_t rr;
     if (g == 0 || scratch == 0 || mask == 0 || img == 0)
     {
         return LIDET_ERR_ARG;
@@ -463,7 +495,7 @@ lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_sc
     {
         return LIDET_ERR_STATE;
     }
-    if (img->x_m == 0 || img->y_m == 0 || img->z_m == 0 || (img->rxy_m == 0 && rxy_m == 0))
+    if (img->x_m == 0 || img->y_m == 0 || img->z_m == 0)
     {
         return LIDET_ERR_ARG;
     }
@@ -479,11 +511,12 @@ lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_sc
     g->n_rows = img->n_rows;
     g->n_cols = img->n_cols;
     g->rng = lidet__rng_seed(g->cfg.seed); /* every run starts from the seed: deterministic per scan */
-    rxy = img->rxy_m != 0 ? img->rxy_m : compute_rxy(rxy_m, img);
-    filter_rows(g, scratch->sample, rxy, img);
-    gather_samples(g, scratch, rxy, img);
-    lidet__ground_fit_sectors(g, scratch);
-    label_rows(g, mask, rxy, img);
+    rxy_rows_init(&rr, scratch, img);
+    filter_rows(g, scratch->sample, &rr, img);
+    gather_samples(g, scratch, img);
+    lidet__ground_fit_sectors(g, scratch, img);
+    rxy_rows_init(&rr, scratch, img); /* the label pass recomputes the rows it needs */
+    label_rows(g, mask, &rr, img);
     return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
 }
 
@@ -498,7 +531,7 @@ lidet_status_t lidet_ground_run(lidet_ground_t *g, const lidet_range_image_t *im
     {
         return LIDET_ERR_ARG;
     }
-    return lidet_ground_run_buffers(&g->state, &g->scratch, g->mask, 0, img);
+    return lidet_ground_run_buffers(&g->state, &g->scratch, g->mask, img);
 }
 
 const uint8_t *lidet_ground_mask(const lidet_ground_t *g)

@@ -117,45 +117,41 @@ static int plane_from_cov(float cov[3][3], const float centroid[3], lidet_plane_
     return 1;
 }
 
-/* Accumulates mean and covariance of the points (optionally only those within `thr` of `ref`)
- * around `shift` (keeps float sums small: coordinates of a sector are tens of metres, heights
- * centimetres). Returns the point count used. */
-static uint32_t accumulate(const float *xs, const float *ys, const float *zs, uint32_t n,
-                           const lidet_plane_t *ref, float thr, const float shift[3], float cov[3][3],
-                           float centroid[3])
+/* LANES independent partial sums per moment, combined at the end: the compiler turns the j loop into
+ * vector instructions (a plain float reduction would stay scalar without -ffast-math), and the order
+ * of additions is fixed, so results are deterministic. */
+#define LANES 4
+#define GATHER_BLOCK 64 /* indexed samples are gathered in blocks of this many (a multiple of LANES) */
+
+typedef struct
 {
-    /* LANES independent partial sums per moment, combined at the end: the compiler turns the
-     * j loop into vector instructions (a plain float reduction would stay scalar without
-     * -ffast-math), and the order of additions is fixed, so results are deterministic. */
-    enum
-    {
-        LANES = 4
-    };
     float acc[10][LANES];
-    float sum[10], inv, mx, my, mz;
     lidet_plane_t p;
-    uint32_t i, m;
-    int j, k;
-    if (ref != 0)
-    {
-        p = *ref;
-    }
-    else
-    {
-        p.nx = p.ny = p.nz = p.d_m = 0.0f; /* h = 0 <= thr: every point counts */
-        thr = 1.0f;
-    }
-    memset(acc, 0, sizeof acc);
-    /* branch-free: each point enters with weight w = 1 (inlier of the plane) or 0 */
-    for (i = 0; i + LANES <= n; i += LANES)
+    float thr;
+    float shift[3];
+} moments_t;
+
+/* Adds m contiguous points: lane j takes the points i = j mod LANES of the first LANES * floor(m / LANES),
+ * the rest goes to lane 0. Called on consecutive blocks whose sizes are multiples of LANES (but the
+ * last), the additions happen in the same order as one call on all the points. Branch-free: each
+ * point enters with weight w = 1 (inlier of the plane) or 0. */
+static inline void moments_add(moments_t *mo, const float *xs, const float *ys, const float *zs, uint32_t m)
+{
+    const lidet_plane_t p = mo->p;
+    const float thr = mo->thr, s0 = mo->shift[0], s1 = mo->shift[1], s2 = mo->shift[2];
+    float acc[10][LANES]; /* a local copy: the compiler keeps it in vector registers */
+    uint32_t i;
+    int j;
+    memcpy(acc, mo->acc, sizeof acc);
+    for (i = 0; i + LANES <= m; i += LANES)
     {
         for (j = 0; j < LANES; ++j)
         {
             const float h = p.nx * xs[i + j] + p.ny * ys[i + j] + p.nz * zs[i + j] + p.d_m;
             const float w = fabsf(h) <= thr ? 1.0f : 0.0f;
-            const float x = w * (xs[i + j] - shift[0]);
-            const float y = w * (ys[i + j] - shift[1]);
-            const float z = w * (zs[i + j] - shift[2]);
+            const float x = w * (xs[i + j] - s0);
+            const float y = w * (ys[i + j] - s1);
+            const float z = w * (zs[i + j] - s2);
             acc[0][j] += w;
             acc[1][j] += x;
             acc[2][j] += y;
@@ -168,13 +164,13 @@ static uint32_t accumulate(const float *xs, const float *ys, const float *zs, ui
             acc[9][j] += z * z;
         }
     }
-    for (; i < n; ++i) /* the tail goes to lane 0 */
+    for (; i < m; ++i) /* the tail goes to lane 0 */
     {
         const float h = p.nx * xs[i] + p.ny * ys[i] + p.nz * zs[i] + p.d_m;
         const float w = fabsf(h) <= thr ? 1.0f : 0.0f;
-        const float x = w * (xs[i] - shift[0]);
-        const float y = w * (ys[i] - shift[1]);
-        const float z = w * (zs[i] - shift[2]);
+        const float x = w * (xs[i] - s0);
+        const float y = w * (ys[i] - s1);
+        const float z = w * (zs[i] - s2);
         acc[0][0] += w;
         acc[1][0] += x;
         acc[2][0] += y;
@@ -186,9 +182,38 @@ static uint32_t accumulate(const float *xs, const float *ys, const float *zs, ui
         acc[8][0] += y * z;
         acc[9][0] += z * z;
     }
+    memcpy(mo->acc, acc, sizeof acc);
+}
+
+/* Starts the moments of the points (optionally only those within `thr` of `ref`) around `shift`
+ * (keeps float sums small: coordinates of a sector are tens of metres, heights centimetres). */
+static void moments_start(moments_t *mo, const lidet_plane_t *ref, float thr, const float shift[3])
+{
+    memset(mo->acc, 0, sizeof mo->acc);
+    if (ref != 0)
+    {
+        mo->p = *ref;
+        mo->thr = thr;
+    }
+    else
+    {
+        mo->p.nx = mo->p.ny = mo->p.nz = mo->p.d_m = 0.0f; /* h = 0 <= thr: every point counts */
+        mo->thr = 1.0f;
+    }
+    mo->shift[0] = shift[0];
+    mo->shift[1] = shift[1];
+    mo->shift[2] = shift[2];
+}
+
+/* Mean and covariance from the moments. Returns the point count used. */
+static uint32_t moments_finish(const moments_t *mo, float cov[3][3], float centroid[3])
+{
+    float sum[10], inv, mx, my, mz;
+    uint32_t m;
+    int k;
     for (k = 0; k < 10; ++k)
     {
-        sum[k] = (acc[k][0] + acc[k][1]) + (acc[k][2] + acc[k][3]);
+        sum[k] = (mo->acc[k][0] + mo->acc[k][1]) + (mo->acc[k][2] + mo->acc[k][3]);
     }
     m = (uint32_t)(sum[0] + 0.5f); /* exact: counts stay far below 2^24 */
     if (m == 0u)
@@ -205,10 +230,46 @@ static uint32_t accumulate(const float *xs, const float *ys, const float *zs, ui
     cov[1][1] = sum[7] * inv - my * my;
     cov[1][2] = cov[2][1] = sum[8] * inv - my * mz;
     cov[2][2] = sum[9] * inv - mz * mz;
-    centroid[0] = mx + shift[0];
-    centroid[1] = my + shift[1];
-    centroid[2] = mz + shift[2];
+    centroid[0] = mx + mo->shift[0];
+    centroid[1] = my + mo->shift[1];
+    centroid[2] = mz + mo->shift[2];
     return m;
+}
+
+/* The moments of n contiguous points. */
+static uint32_t accumulate(const float *xs, const float *ys, const float *zs, uint32_t n,
+                           const lidet_plane_t *ref, float thr, const float shift[3], float cov[3][3],
+                           float centroid[3])
+{
+    moments_t mo;
+    moments_start(&mo, ref, thr, shift);
+    moments_add(&mo, xs, ys, zs, n);
+    return moments_finish(&mo, cov, centroid);
+}
+
+/* The same for the n image pixels idx[0..n) (a cell's samples), gathered in blocks: the same sums, bit
+ * for bit, as on a contiguous copy of the points. */
+static uint32_t accumulate_idx(const float *X, const float *Y, const float *Z, const uint32_t *idx, uint32_t n,
+                               const lidet_plane_t *ref, float thr, const float shift[3], float cov[3][3],
+                               float centroid[3])
+{
+    float bx[GATHER_BLOCK], by[GATHER_BLOCK], bz[GATHER_BLOCK];
+    moments_t mo;
+    uint32_t base, i;
+    moments_start(&mo, ref, thr, shift);
+    for (base = 0; base < n; base += GATHER_BLOCK)
+    {
+        const uint32_t m = n - base < GATHER_BLOCK ? n - base : GATHER_BLOCK;
+        for (i = 0; i < m; ++i)
+        {
+            const uint32_t q = idx[base + i];
+            bx[i] = X[q];
+            by[i] = Y[q];
+            bz[i] = Z[q];
+        }
+        moments_add(&mo, bx, by, bz, m);
+    }
+    return moments_finish(&mo, cov, centroid);
 }
 
 lidet_status_t lidet_ground_fit_plane(const float *x_m, const float *y_m, const float *z_m, uint32_t n,
@@ -230,32 +291,37 @@ lidet_status_t lidet_ground_fit_plane(const float *x_m, const float *y_m, const 
     return LIDET_OK;
 }
 
-/* Counts the points of the evenly strided subset (every `stride`-th) within thr of the plane; the
- * contiguous case (stride 1) has its own loop, which vectorises. */
-static uint32_t score(const float *xs, const float *ys, const float *zs, uint32_t n, uint32_t stride,
-                      const lidet_plane_t *p, float thr)
+/* Counts the n contiguous points within thr of the plane (the loop vectorises). */
+static uint32_t score(const float *xs, const float *ys, const float *zs, uint32_t n, const lidet_plane_t *p,
+                      float thr)
 {
     const float nx = p->nx, ny = p->ny, nz = p->nz, d = p->d_m;
     uint32_t i, cnt = 0;
-    if (stride == 1u)
-    {
-        for (i = 0; i < n; ++i)
-        {
-            cnt += (uint32_t)(fabsf(nx * xs[i] + ny * ys[i] + nz * zs[i] + d) <= thr);
-        }
-        return cnt;
-    }
-    for (i = 0; i < n; i += stride)
+    for (i = 0; i < n; ++i)
     {
         cnt += (uint32_t)(fabsf(nx * xs[i] + ny * ys[i] + nz * zs[i] + d) <= thr);
     }
     return cnt;
 }
 
+/* score() on the image pixels idx[0, stride, 2 stride, ...) (a cell too large for the scoring copy) */
+static uint32_t score_idx(const float *X, const float *Y, const float *Z, const uint32_t *idx, uint32_t n,
+                          uint32_t stride, const lidet_plane_t *p, float thr)
+{
+    const float nx = p->nx, ny = p->ny, nz = p->nz, d = p->d_m;
+    uint32_t i, cnt = 0;
+    for (i = 0; i < n; i += stride)
+    {
+        const uint32_t q = idx[i];
+        cnt += (uint32_t)(fabsf(nx * X[q] + ny * Y[q] + nz * Z[q] + d) <= thr);
+    }
+    return cnt;
+}
+
 /* RANSAC on one sector (mirrors ref/ground.py: ransac_sector). Returns 1 with *out set when a
  * plane passes every check. */
-static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const float *xs, const float *ys, const float *zs, uint32_t n,
-                      lidet_plane_t *out)
+static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const float *X, const float *Y,
+                      const float *Z, const uint32_t *idx, uint32_t n, lidet_plane_t *out)
 {
     const lidet_ground_cfg_t *cfg = &g->cfg;
     const float cos_tilt = cosf(cfg->max_tilt_rad);
@@ -263,45 +329,47 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
     const uint32_t stride = (n + cfg->eval_samples - 1u) / cfg->eval_samples;
     const uint32_t n_eval = (n + stride - 1u) / stride; /* size of the strided subset */
     lidet_plane_t best;
-    /* the scoring subset: the strided one, copied once into the workspace when it fits, so that every
-     * hypothesis scores a contiguous block (same points, same order, same counts) */
-    const float *ex = xs, *ey = ys, *ez = zs;
-    uint32_t en = n, es = stride;
+    /* the scoring subset: the strided one of the cell's samples (pixel indices into the image), copied
+     * once into the scratch when it fits, so that every hypothesis scores a contiguous block (same
+     * points, same counts); a larger subset is scored through the indices */
+    const int copied = n_eval <= LIDET_GROUND_EVAL_MAX;
     uint32_t best_cnt = 0, it, r, i;
     int have = 0;
     memset(&best, 0, sizeof best);
-    if (stride > 1u && n_eval <= LIDET_GROUND_EVAL_MAX)
+    if (copied)
     {
         for (i = 0; i < n_eval; ++i)
         {
-            sc->ev_x_m[i] = xs[i * stride];
-            sc->ev_y_m[i] = ys[i * stride];
-            sc->ev_z_m[i] = zs[i * stride];
+            const uint32_t q = idx[i * stride];
+            sc->ev_x_m[i] = X[q];
+            sc->ev_y_m[i] = Y[q];
+            sc->ev_z_m[i] = Z[q];
         }
-        ex = sc->ev_x_m;
-        ey = sc->ev_y_m;
-        ez = sc->ev_z_m;
-        en = n_eval;
-        es = 1u;
     }
     for (it = 0; it < cfg->ransac_iters; ++it)
     {
         const uint32_t i0 = lidet__rng_below(&g->rng, n);
         const uint32_t i1 = lidet__rng_below(&g->rng, n);
         const uint32_t i2 = lidet__rng_below(&g->rng, n);
-        float ux, uy, uz, vx, vy, vz, cx, cy, cz, len2, inv;
+        float x0, y0, z0, ux, uy, uz, vx, vy, vz, cx, cy, cz, len2, inv;
         lidet_plane_t p;
         uint32_t cnt;
         if (i0 == i1 || i0 == i2 || i1 == i2)
         {
             continue;
         }
-        ux = xs[i1] - xs[i0];
-        uy = ys[i1] - ys[i0];
-        uz = zs[i1] - zs[i0];
-        vx = xs[i2] - xs[i0];
-        vy = ys[i2] - ys[i0];
-        vz = zs[i2] - zs[i0];
+        {
+            const uint32_t q0 = idx[i0], q1 = idx[i1], q2 = idx[i2];
+            x0 = X[q0];
+            y0 = Y[q0];
+            z0 = Z[q0];
+            ux = X[q1] - x0;
+            uy = Y[q1] - y0;
+            uz = Z[q1] - z0;
+            vx = X[q2] - x0;
+            vy = Y[q2] - y0;
+            vz = Z[q2] - z0;
+        }
         cx = uy * vz - uz * vy;
         cy = uz * vx - ux * vz;
         cz = ux * vy - uy * vx;
@@ -319,9 +387,10 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
         p.nx = cx * inv;
         p.ny = cy * inv;
         p.nz = cz * inv;
-        p.d_m = -(p.nx * xs[i0] + p.ny * ys[i0] + p.nz * zs[i0]);
+        p.d_m = -(p.nx * x0 + p.ny * y0 + p.nz * z0);
         ++g->stats.n_hypotheses;
-        cnt = score(ex, ey, ez, en, es, &p, cfg->inlier_m);
+        cnt = copied ? score(sc->ev_x_m, sc->ev_y_m, sc->ev_z_m, n_eval, &p, cfg->inlier_m)
+                     : score_idx(X, Y, Z, idx, n, stride, &p, cfg->inlier_m);
         if (!have || cnt > best_cnt)
         {
             best = p;
@@ -356,10 +425,10 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
         float cov[3][3], centroid[3], shift[3];
         lidet_plane_t p;
         /* shift: the point of the plane under the sector's first sample */
-        shift[0] = xs[0];
-        shift[1] = ys[0];
-        shift[2] = best.nz > 0.0f ? -(best.nx * xs[0] + best.ny * ys[0] + best.d_m) / best.nz : zs[0];
-        if (accumulate(xs, ys, zs, n, &best, cfg->inlier_m, shift, cov, centroid) < 3u ||
+        shift[0] = X[idx[0]];
+        shift[1] = Y[idx[0]];
+        shift[2] = best.nz > 0.0f ? -(best.nx * shift[0] + best.ny * shift[1] + best.d_m) / best.nz : Z[idx[0]];
+        if (accumulate_idx(X, Y, Z, idx, n, &best, cfg->inlier_m, shift, cov, centroid) < 3u ||
             !plane_from_cov(cov, centroid, &p, 0) || !(p.nz * p.nz >= cos2))
         {
             break; /* keep the last good plane */
@@ -374,7 +443,7 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
     return 1;
 }
 
-void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc)
+void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img)
 {
     const uint32_t ns = g->cfg.n_sectors;
     const uint32_t n_cells = g->cfg.ring_split_m > 0.0f ? 2u * ns : ns;
@@ -396,7 +465,7 @@ void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *
             continue;
         }
         LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
-        if (fit_sector(g, sc, sc->sx_m + a, sc->sy_m + a, sc->sz_m + a, n, &g->planes[k]))
+        if (fit_sector(g, sc, img->x_m, img->y_m, img->z_m, sc->sample_pix + a, n, &g->planes[k]))
         {
             g->source[k] = LIDET_GROUND_PLANE_FITTED;
             if (near)

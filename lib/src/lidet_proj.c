@@ -8,7 +8,6 @@
 #include "internal/lidet_math.h"
 #include "lidet/lidet_proj.h"
 
-#define DEG2RAD 0.0174532925f
 /* keep every accepted elevation away from +-90 deg so its tangent stays finite */
 #define MAX_ABS_ELEV_RAD 1.55f
 #define PASS2_BLOCK 1024u /* pixels per pass-2 block: 5 planes x 4 KiB stay in L1 */
@@ -26,7 +25,7 @@ void lidet_proj_cfg_default(lidet_proj_cfg_t *cfg, const lidet_sensor_t *sensor)
     }
     cfg->min_range_m = 0.1f;
     cfg->max_range_m = 0.0f;
-    cfg->fov_margin_rad = 5.0f * DEG2RAD;
+    cfg->fov_margin_rad = 5.0f * LIDET_DEG2RAD_F;
 }
 
 static int in_range(float v, float lo, float hi)

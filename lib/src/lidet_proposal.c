@@ -6,9 +6,9 @@
 #include <string.h>
 
 #include "internal/lidet_math.h"
+#include "internal/lidet_rng.h"
 #include "lidet/lidet_cluster.h"
 
-#define DEG2RAD 0.0174532925f
 
 void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg)
 {
@@ -19,23 +19,18 @@ void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg)
     memset(cfg, 0, sizeof *cfg);
     cfg->n_points = 64u < LIDET_PROPOSAL_POINTS ? 64u : LIDET_PROPOSAL_POINTS;
     cfg->seed = 0x5EED1234u;
-    cfg->azimuth_bin_rad = 10.0f * DEG2RAD;
-    cfg->elevation_bin_rad = 10.0f * DEG2RAD;
+    cfg->azimuth_bin_rad = 10.0f * LIDET_DEG2RAD_F;
+    cfg->elevation_bin_rad = 10.0f * LIDET_DEG2RAD_F;
     cfg->range_bin_m = 1.0f;
 }
 
-static inline uint32_t xorshift32(uint32_t x)
-{
-    x ^= x << 13;
-    x ^= x >> 17;
-    x ^= x << 5;
-    return x;
-}
-
+/* the generator state of one cluster's resampling: the seed mixed with the member count, so clusters
+ * of different sizes draw different streams; 0 (xorshift's only fixed point) is replaced by
+ * LIDET_RNG_PROPOSAL_ZERO_SEED (the value the reference, ref/cluster.py, uses) */
 static uint32_t rng_start(uint32_t seed, uint32_t n_src)
 {
     const uint32_t s = seed ^ (n_src * 0x9E3779B9u);
-    return s != 0 ? s : 0x6C646574u; /* xorshift's only fixed point */
+    return s != 0 ? s : LIDET_RNG_PROPOSAL_ZERO_SEED;
 }
 
 /* member index of output i (0, 1, ... in order; *s is the generator state). n_src <= n_out: every
@@ -49,14 +44,12 @@ static uint32_t next_index(uint32_t *s, uint32_t i, uint32_t n_src, uint32_t n_o
         {
             return i;
         }
-        *s = xorshift32(*s);
-        return *s % n_src;
+        return lidet__rng_next(s) % n_src;
     }
     {
         const uint32_t b0 = (uint32_t)(((uint64_t)i * n_src) / n_out);
         const uint32_t b1 = (uint32_t)(((uint64_t)(i + 1u) * n_src) / n_out);
-        *s = xorshift32(*s);
-        return b0 + *s % (b1 - b0); /* b1 > b0 because n_src > n_out */
+        return b0 + lidet__rng_next(s) % (b1 - b0); /* b1 > b0 because n_src > n_out */
     }
 }
 

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
-/* Sensor presets. Mirrored by tools/lidet_tools/sensors.py; tests/python/test_bindings.py checks
+/* Sensor presets. Mirrored by tools/lidet_tools/sensors.py; tests/python/test_bindings_proj.py checks
  * that both give the same beam tables. Elevations in ring order, radians, float32-rounded. */
+#include "internal/lidet_math.h"
 #include "lidet/lidet_sensor.h"
 
 /* KITTI HDL-64E, measured on real KITTI scans (median elevation per ring recovered from scan order):
@@ -31,7 +32,7 @@ static const float k_vlp32c_elev_rad[32] = {
     0.0232652389f, 0.0290946383f, 0.0407185331f, 0.0581718236f, 0.0814545155f, 0.122173049f, 0.180344865f, 0.261799395f,
 };
 
-#define DEG(d) ((float)(d) * 0.0174532925f)
+#define DEG(d) ((float)(d) * LIDET_DEG2RAD_F)
 
 static const lidet_sensor_t k_presets[] = {
     {"hdl64", 64u, 2048u, k_hdl64_elev_rad, 0.0f, 0.0f, 1.73f, 120.0f},

@@ -112,8 +112,7 @@ lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *poi
     }
     worst = st;
     ws_image(ws, &img);
-    st = lidet_ground_run_buffers(&ws->ground, &ws->overlay.ground.scratch, ws->ground_mask,
-                                  ws->overlay.ground.rxy_m, &img);
+    st = lidet_ground_run_buffers(&ws->ground, &ws->overlay.ground, ws->ground_mask, &img);
     t0 = tick(clock, clock_ctx);
     ticks[1] = t0 - t1;
     if (st < 0)

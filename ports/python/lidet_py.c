@@ -8,6 +8,7 @@
  * Configurations and statistics cross the boundary as the C structs themselves. Python learns their
  * layout by name from lidet_py_field (name, offset, size, kind of every field, offsets from offsetof),
  * so nothing is kept in step by hand, and the defaults come from the C cfg_default functions. */
+#include <math.h>
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
@@ -28,6 +29,8 @@ typedef struct
     lidet_cluster_t cluster;
     uint8_t ground_pix[LIDET_MAX_ROWS * LIDET_MAX_COLS];
     lidet_proposal_t proposal;
+    int pixel_model;   /* LIDET_PY_PIXEL_*: what a compact pixel would hand the later stages */
+    float pixel_q_m;   /* quantum of LIDET_PY_PIXEL_S16 */
     int proj_ready;    /* lidet_py_proj_init succeeded */
     int cluster_ready; /* a lidet_py_cluster_run succeeded (proposals may be made) */
 } lidet_py_ctx_t;
@@ -208,6 +211,70 @@ LIDET_PY_API int lidet_py_sensor(uint32_t index, char *name_buf, uint32_t *rows_
     return 0;
 }
 
+/* ---- pixel models: measuring what a more compact pixel than float x, y, z, range would cost ------
+ * After each projection the context's image is rewritten as a pixel stored another way would decode
+ * (the stages then run unchanged on it): the accuracy a storage choice costs (docs/MEMORY.md). */
+enum
+{
+    LIDET_PY_PIXEL_FLOAT = 0,        /* the real point (what the library stores) */
+    LIDET_PY_PIXEL_S16 = 1,          /* x, y, z and range rounded to multiples of q (int16 / uint16 storage) */
+    LIDET_PY_PIXEL_RECOMPUTE = 2,    /* range only; x, y, z from the beam's elevation and the column centre */
+    LIDET_PY_PIXEL_REAL_ELEV = 3,    /* range and the real elevation; azimuth of the column centre */
+    LIDET_PY_PIXEL_REAL_AZIMUTH = 4  /* range and the real azimuth; elevation of the beam */
+};
+
+LIDET_PY_API int lidet_py_ctx_pixel_model(lidet_py_ctx_t *ctx, int model, float q_m)
+{
+    if (ctx == NULL || model < LIDET_PY_PIXEL_FLOAT || model > LIDET_PY_PIXEL_REAL_AZIMUTH ||
+        (model == LIDET_PY_PIXEL_S16 && !(q_m > 0.0f)))
+        return LIDET_ERR_ARG;
+    ctx->pixel_model = model;
+    ctx->pixel_q_m = q_m;
+    return 0;
+}
+
+static void apply_pixel_model(lidet_py_ctx_t *ctx)
+{
+    lidet_proj_t *pj = &ctx->proj;
+    const uint32_t rows = pj->state.cfg.sensor.n_rows, cols = pj->state.cfg.sensor.n_cols;
+    const double q = ctx->pixel_q_m;
+    uint32_t r, c;
+    if (ctx->pixel_model == LIDET_PY_PIXEL_FLOAT)
+        return;
+    for (r = 0; r < rows; ++r)
+    {
+        for (c = 0; c < cols; ++c)
+        {
+            const uint32_t p = r * cols + c;
+            const double rng = pj->range_m[p], x = pj->x_m[p], y = pj->y_m[p], z = pj->z_m[p];
+            double el, az, nx, ny, nz;
+            if (!(rng > 0.0))
+                continue;
+            if (ctx->pixel_model == LIDET_PY_PIXEL_S16)
+            {
+                nx = floor(x / q + 0.5) * q;
+                ny = floor(y / q + 0.5) * q;
+                nz = floor(z / q + 0.5) * q;
+                pj->range_m[p] = (float)(floor(rng / q + 0.5) * q);
+            }
+            else
+            {
+                const double az_col = 3.14159265358979323846 * (1.0 - 2.0 * ((double)c + 0.5) / (double)cols);
+                const double el_row = pj->state.row_elev_rad[r];
+                el = ctx->pixel_model == LIDET_PY_PIXEL_REAL_ELEV ? asin(z / rng) : el_row;
+                az = ctx->pixel_model == LIDET_PY_PIXEL_REAL_AZIMUTH ? atan2(y, x) : az_col;
+                nx = rng * cos(el) * cos(az);
+                ny = rng * cos(el) * sin(az);
+                nz = rng * sin(el);
+            }
+            pj->x_m[p] = (float)nx;
+            pj->y_m[p] = (float)ny;
+            pj->z_m[p] = (float)nz;
+            pj->rxy_m[p] = sqrtf(pj->x_m[p] * pj->x_m[p] + pj->y_m[p] * pj->y_m[p]);
+        }
+    }
+}
+
 /* ---- projection ------------------------------------------------------------------------------- */
 
 /* Initialise the context's projection. elev_rad may be NULL (uniform fov); cfg: a lidet_proj_cfg_t whose
@@ -281,6 +348,7 @@ LIDET_PY_API int lidet_py_proj_run(lidet_py_ctx_t *ctx, const float *pts, uint32
     rc = lidet_proj_run(&ctx->proj, pts, n, stride, ring);
     if (rc < 0)
         return rc;
+    apply_pixel_model(ctx);
     lidet_py_proj_copy(ctx, out_img, out_idx, out_point_pixel, out_stats, out_row_elev);
     return rc;
 }
@@ -393,6 +461,7 @@ LIDET_PY_API int lidet_py_cluster_run(lidet_py_ctx_t *ctx, const float *pts, uin
     rc = lidet_proj_run(&ctx->proj, pts, n, stride, NULL);
     if (rc < 0)
         return rc;
+    apply_pixel_model(ctx);
     lidet_proj_image(&ctx->proj, &img);
     npix = (uint32_t)img.n_rows * img.n_cols;
     if (ground_per_point != NULL)

@@ -123,3 +123,27 @@ def test_defaults_and_stats_come_from_c():
     gr = native.ground(pts, "hdl64")
     assert set(gr.stats) == set(native.struct_layouts()["lidet_ground_stats_t"].names)
     assert gr.stats["n_ground"] > 0
+
+
+def test_pixel_models_rewrite_the_image_as_stored():
+    """The measurement hook of docs/MEMORY.md: an image decoded from another pixel storage."""
+    pts, _ = _scene(6, (10.0, 0.0, -0.9), (8.0, 4.0, -0.85))
+    ref_img = native.project(pts, "vlp16")
+    ctx = native.ScanContext("s16", 0.004)
+    s, ctx = native.proj_init("vlp16", ctx=ctx)
+    q = native._project_into(ctx, s, pts)
+    v = ref_img.valid
+    np.testing.assert_array_equal(q.valid, v)
+    for a, b in ((q.x, ref_img.x), (q.y, ref_img.y), (q.z, ref_img.z), (q.range, ref_img.range)):
+        assert np.max(np.abs(a[v] - b[v])) <= 0.002 + 1e-5
+        k = a[v] / 0.004
+        assert np.max(np.abs(k - np.round(k))) < 1e-2  # multiples of 4 mm
+    ctx = native.ScanContext("recompute")
+    s, ctx = native.proj_init("vlp16", ctx=ctx)
+    r = native._project_into(ctx, s, pts)
+    np.testing.assert_array_equal(r.range, ref_img.range)
+    el = np.arcsin(np.clip(r.z / np.where(v, r.range, 1), -1, 1))
+    rows = np.broadcast_to(r.row_elev[:, None], r.shape)
+    assert np.max(np.abs(el[v] - rows[v])) < 1e-5  # every point on its beam
+    with pytest.raises(KeyError):
+        native.ScanContext("int4")

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Unity tests of the depth clustering and the proposals (lib/src/lidet_cluster.c, lidet_proposal.c)
+/* Unity tests of the depth clustering and the proposals (lib/src/lidet_cluster*.c, lidet_proposal.c)
  * on hand-drawn range images (test_cluster_util.h: letters are ranges, '.' empty, 'g' ground). */
 #include <math.h>
 #include <string.h>
@@ -305,11 +305,11 @@ static void set_range(int p, int cols, float range_m)
 {
     const int r = p / cols, c = p % cols;
     const double az = M_PI * (1.0 - 2.0 * (c + 0.5) / cols), el = t.elev[r];
-    t.x[p] = (float)(range_m * cos(el) * cos(az));
-    t.y[p] = (float)(range_m * cos(el) * sin(az));
-    t.z[p] = (float)(range_m * sin(el));
+    t.x[p] = (float)((double)range_m * cos(el) * cos(az));
+    t.y[p] = (float)((double)range_m * cos(el) * sin(az));
+    t.z[p] = (float)((double)range_m * sin(el));
     t.r[p] = range_m;
-    t.rxy[p] = (float)(range_m * cos(el));
+    t.rxy[p] = (float)((double)range_m * cos(el));
 }
 
 /* Fragment rescue (256 columns, 1.4 deg each; theta 0.5 rad, no diagonals, no occluder bridging):
@@ -397,9 +397,9 @@ static void test_fragment_rescue(void)
         {
             const int32_t p = mem[rec[0].first_member + i];
             TEST_ASSERT_EQUAL_UINT16(1, lab[p]);
-            s[0] += t.x[p];
-            s[1] += t.y[p];
-            s[2] += t.z[p];
+            s[0] += (double)t.x[p];
+            s[1] += (double)t.y[p];
+            s[2] += (double)t.z[p];
             TEST_ASSERT_TRUE(t.x[p] >= rec[0].min_m[0] && t.x[p] <= rec[0].max_m[0]);
             TEST_ASSERT_TRUE(t.y[p] >= rec[0].min_m[1] && t.y[p] <= rec[0].max_m[1]);
             TEST_ASSERT_TRUE(t.z[p] >= rec[0].min_m[2] && t.z[p] <= rec[0].max_m[2]);
@@ -450,9 +450,9 @@ static void test_records_members_determinism(void)
             {
                 TEST_ASSERT_EQUAL_UINT32((uint32_t)p, rec[i].seed_pixel);
             }
-            s[0] += t.x[p];
-            s[1] += t.y[p];
-            s[2] += t.z[p];
+            s[0] += (double)t.x[p];
+            s[1] += (double)t.y[p];
+            s[2] += (double)t.z[p];
             TEST_ASSERT_TRUE(t.x[p] >= rec[i].min_m[0] && t.x[p] <= rec[i].max_m[0]);
             TEST_ASSERT_TRUE(t.z[p] >= rec[i].min_m[2] && t.z[p] <= rec[i].max_m[2]);
         }
@@ -611,9 +611,9 @@ static void test_proposal_centred(void)
     TEST_ASSERT_EQUAL_UINT32(16, a.n_points_src);
     for (i = 0; i < 16; ++i)
     {
-        s[0] += a.xyz[i][0];
-        s[1] += a.xyz[i][1];
-        s[2] += a.xyz[i][2];
+        s[0] += (double)a.xyz[i][0];
+        s[1] += (double)a.xyz[i][1];
+        s[2] += (double)a.xyz[i][2];
     }
     TEST_ASSERT_CLOSE(0.0, s[0] / 16, 1e-5, 0);
     TEST_ASSERT_CLOSE(0.0, s[1] / 16, 1e-5, 0);
@@ -633,9 +633,9 @@ static void test_proposal_centred(void)
     }
     /* the voxel of the mean: signed floor bins */
     az = atan2(a.mean_m[1], a.mean_m[0]);
-    el = atan2(a.mean_m[2], sqrt((double)a.mean_m[0] * a.mean_m[0] + (double)a.mean_m[1] * a.mean_m[1]));
-    rr = sqrt((double)a.mean_m[0] * a.mean_m[0] + (double)a.mean_m[1] * a.mean_m[1] +
-              (double)a.mean_m[2] * a.mean_m[2]);
+    el = atan2(a.mean_m[2], sqrt((double)a.mean_m[0] * (double)a.mean_m[0] + (double)a.mean_m[1] * (double)a.mean_m[1]));
+    rr = sqrt((double)a.mean_m[0] * (double)a.mean_m[0] + (double)a.mean_m[1] * (double)a.mean_m[1] +
+              (double)a.mean_m[2] * (double)a.mean_m[2]);
     TEST_ASSERT_EQUAL_INT16((int16_t)floor(az / (10.0 * M_PI / 180.0)), a.voxel[0]);
     TEST_ASSERT_EQUAL_INT16((int16_t)floor(el / (10.0 * M_PI / 180.0)), a.voxel[1]);
     TEST_ASSERT_EQUAL_INT16((int16_t)floor(rr), a.voxel[2]);

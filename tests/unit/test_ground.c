@@ -165,7 +165,7 @@ static void cast_scene(const scene_t *sc, int (*keep)(double az, int row))
             pts[4 * n_pts + 3] = 0.0f;
             /* box points less than ground_m (+10 cm for plane tilt) above the box's floor are
              * ground by definition of the height test: not scored */
-            truth[n_pts] = (uint8_t)(ground ? 1 : (t * d[2] < floor_z + gcfg.ground_m + 0.1 ? 2 : 0));
+            truth[n_pts] = (uint8_t)(ground ? 1 : (t * d[2] < floor_z + (double)gcfg.ground_m + 0.1 ? 2 : 0));
             ++n_pts;
         }
     }

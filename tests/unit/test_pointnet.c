@@ -229,7 +229,7 @@ static double naive(const lidet_pn_layer_t *l, int n, const double *in, double *
         double s = l[n].b[o];
         for (i = 0; i < l[n].n_in; ++i)
         {
-            s += in[i] * l[n].w_t[i * l[n].n_out + o];
+            s += in[i] * (double)l[n].w_t[i * l[n].n_out + o];
         }
         out[o] = l[n].relu && s < 0 ? 0 : s;
     }

@@ -72,7 +72,7 @@ static void test_every_profile_beam_rows(void)
             int pix = r * img.n_cols + col;
             TEST_ASSERT_EQUAL_INT32_MESSAGE(r, img.point_idx[pix], k_names[k]);
             TEST_ASSERT_CLOSE(5.0 + r, img.range_m[pix], 1e-4, 1e-6);
-            TEST_ASSERT_CLOSE(sqrt((double)img.x_m[pix] * img.x_m[pix] + (double)img.y_m[pix] * img.y_m[pix]),
+            TEST_ASSERT_CLOSE(sqrt((double)img.x_m[pix] * (double)img.x_m[pix] + (double)img.y_m[pix] * (double)img.y_m[pix]),
                               img.rxy_m[pix], 1e-5, 1e-6);
         }
         /* rows are sorted top to bottom */

@@ -105,6 +105,7 @@ def lib():
                                            _opt(_u32p), _opt(_f32p), C.c_uint32, _opt(_u32p), V]
         L.lidet_py_proposals.argtypes = [V, V, C.c_uint32, _f32p, _f32p, _i16p, _u32p]
         L.lidet_py_proposal_indices.argtypes = [C.c_uint32, C.c_uint32, C.c_uint32, _u32p]
+        L.lidet_py_ctx_pixel_model.argtypes = [V, C.c_int, C.c_float]
         _lib = L
     return _lib
 
@@ -156,15 +157,28 @@ def _addr(rec: np.ndarray) -> int:
     return rec.ctypes.data
 
 
+#: pixel models of lidet_py_ctx_pixel_model (what a more compact pixel would hand the stages)
+PIXEL_MODELS = {"float": 0, "s16": 1, "recompute": 2, "real_elev": 3, "real_azimuth": 4}
+
+
 class ScanContext:
     """One scan's C states (lidet_py_ctx_t): the projection, ground and clustering of that scan only.
-    Freed when the last object referring to it goes away."""
+    Freed when the last object referring to it goes away.
 
-    def __init__(self):
+    pixel_model (measurement only, docs/MEMORY.md): after each projection the image is rewritten as a
+    pixel stored another way would decode: "float" (the library), "s16" (x, y, z, range rounded to
+    multiples of q_m), "recompute" (x, y, z from the range, the beam's elevation and the column
+    centre), "real_elev" / "real_azimuth" (one of the two angles kept exact)."""
+
+    def __init__(self, pixel_model: str = "float", q_m: float = 0.004):
         self.ptr = lib().lidet_py_ctx_new()
         if not self.ptr:
             raise MemoryError("lidet_py_ctx_new")
         weakref.finalize(self, lib().lidet_py_ctx_free, self.ptr)
+        if pixel_model != "float":
+            st = lib().lidet_py_ctx_pixel_model(self.ptr, PIXEL_MODELS[pixel_model], q_m)
+            if st < 0:
+                raise LidetError(st, "lidet_py_ctx_pixel_model")
 
 
 def capacity() -> dict:
@@ -314,11 +328,12 @@ class GroundResult:
         return iter((self.mask_point, self.mask_pixel, self.planes, self.stats))
 
 
-def ground(points, sensor: str | Sensor = "hdl64", ring=None, proj_cfg: dict | None = None, **cfg) -> GroundResult:
+def ground(points, sensor: str | Sensor = "hdl64", ring=None, proj_cfg: dict | None = None,
+           context: ScanContext | None = None, **cfg) -> GroundResult:
     """Project (N, >=3) points with the C projection, then segment the ground with the C ground stage,
     on a scan context of its own. `cfg` overrides fields of lidet_ground_cfg_default(sensor) (names as in
-    lidet_ground_cfg_t)."""
-    s, ctx = proj_init(sensor, **(proj_cfg or {}))
+    lidet_ground_cfg_t). context: a fresh ScanContext to run on (e.g. with a pixel model); default a new one."""
+    s, ctx = proj_init(sensor, ctx=context, **(proj_cfg or {}))
     full = ground_defaults(s)
     unknown = set(cfg) - set(full)
     if unknown:
@@ -387,7 +402,7 @@ class Clusters:
 
 
 def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, with_image: bool = False,
-            proj_cfg: dict | None = None, **cfg) -> Clusters:
+            proj_cfg: dict | None = None, context: ScanContext | None = None, **cfg) -> Clusters:
     """Project `points` (N, >=3) and cluster the non-ground pixels with the C library.
 
     ground: optional (N,) bool/uint8 per point (1 = ground; a pixel is ground when its winning point
@@ -397,7 +412,7 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     max_extent_m, max_mean_height_m, mount_height_m, rescue_gap_m, rescue_gap_per_m, rescue_rows, rescue_cols (defaults:
     `cluster_defaults(sensor)`).
     """
-    s, ctx = proj_init(sensor, **(proj_cfg or {}))
+    s, ctx = proj_init(sensor, ctx=context, **(proj_cfg or {}))
     c = cluster_defaults(s)
     unknown = set(cfg) - set(c)
     if unknown:

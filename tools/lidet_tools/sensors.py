@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Sensor profiles, mirrored from lib/src/lidet_sensors.c (tests/python/test_sensors.py keeps the
+"""Sensor profiles, mirrored from lib/src/lidet_sensors.c (tests/python/test_bindings_proj.py keeps the
 two identical through the bindings).
 
 Frame: x forward, y left, z up, metres, radians, origin at the sensor's optical centre.

@@ -17,18 +17,30 @@ configs=(
   "host-default 128 2048 262144 1024 128"
 )
 kib() { awk -v b="$1" 'BEGIN { printf "%.1f", b / 1024 }'; }
-echo "| config (rows x cols, points, clusters) | proj+ground+cluster states | image x,y,z,range | ground mask | overlay (proj / ground / cluster) | **workspace** | standalone stages (proj + ground + cluster) |"
-echo "|---|---|---|---|---|---|---|"
+# sizeof for a 32-bit target (ILP32: the layout an arm-none-eabi build gets for these structs, which hold
+# no 64-bit members), read from the symbol sizes of an object compiled with -m32; "n/a" without -m32
+size32() {
+  printf '#include "lidet/lidet_workspace.h"\nchar sz_ws[sizeof(lidet_workspace_t)];\n' > "$tmp/p32.c"
+  if "$cc" -m32 -ffreestanding -std=c99 -c -I"$root/lib/include" "$@" "$tmp/p32.c" -o "$tmp/p32.o" 2>/dev/null; then
+    nm -S -t d "$tmp/p32.o" | awk '$4 == "sz_ws" { printf "%.1f KiB", $2 / 1024 }'
+  else
+    echo "n/a"
+  fi
+}
+echo "| config (rows x cols, points, clusters) | proj+ground+cluster states | image x,y,z,range | ground mask | overlay (proj / ground / cluster) | **workspace** | workspace, 32-bit target | standalone stages (proj + ground + cluster) |"
+echo "|---|---|---|---|---|---|---|---|"
 for c in "${configs[@]}"; do
   read -r name rows cols pts cl det <<<"$c"
-  "$cc" -std=c99 -O1 -I"$root/lib/include" -I"$root/lib/src" -DLIDET_MAX_ROWS="$rows" -DLIDET_MAX_COLS="$cols" \
-        -DLIDET_MAX_POINTS="$pts" -DLIDET_MAX_CLUSTERS="$cl" -DLIDET_MAX_DETECTIONS="$det" \
-        "$here/size_report.c" "$root"/lib/src/*.c -lm -o "$tmp/sz"
+  caps=(-DLIDET_MAX_ROWS="$rows" -DLIDET_MAX_COLS="$cols" -DLIDET_MAX_POINTS="$pts" -DLIDET_MAX_CLUSTERS="$cl"
+        -DLIDET_MAX_DETECTIONS="$det")
+  "$cc" -std=c99 -O1 -I"$root/lib/include" -I"$root/lib/src" "${caps[@]}" "$here/size_report.c" "$root"/lib/src/*.c \
+        -lm -o "$tmp/sz"
+  ws32="$(size32 "${caps[@]}")"
   declare -A v=()
   while read -r k n; do v[$k]=$n; done < <("$tmp/sz")
   states=$(( v[proj_state] + v[ground_state] + v[cluster_state] ))
   echo "| $name ($rows x $cols, $pts, $cl) | $(kib $states) KiB | $(kib ${v[image]}) KiB | $(kib ${v[ground_mask]}) KiB |" \
        "$(kib ${v[overlay]}) KiB ($(kib ${v[overlay_proj]}) / $(kib ${v[overlay_ground]}) / $(kib ${v[overlay_cluster]})) |" \
-       "**$(kib ${v[workspace]}) KiB** | $(kib ${v[stages_standalone]}) KiB ($(kib ${v[proj_t]}) + $(kib ${v[ground_t]}) + $(kib ${v[cluster_t]})) |"
+       "**$(kib ${v[workspace]}) KiB** | $ws32 | $(kib ${v[stages_standalone]}) KiB ($(kib ${v[proj_t]}) + $(kib ${v[ground_t]}) + $(kib ${v[cluster_t]})) |"
   unset v
 done

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Reference of the clustering stage and of the proposals (mirrors lib/src/lidet_cluster.c and
+"""Reference of the clustering stage and of the proposals (mirrors lib/src/lidet_cluster*.c and
 lib/src/lidet_proposal.c; the contract is written in lib/include/lidet/lidet_cluster.h).
 
 - `proposal_indices` / `make_proposal` reproduce the C resampling *exactly* (integer xorshift32):

@@ -42,10 +42,12 @@
  *     veto_min_dz_m): the lowest returns of walls, kerbs, bumpers and trunks.
  *
  * Memory: sizeof(lidet_ground_t) = LIDET_MAX_ROWS * LIDET_MAX_COLS * 2 B (ground and sample masks)
- * + (LIDET_GROUND_MAX_SAMPLES + LIDET_GROUND_EVAL_MAX) * 12 B (x, y, z of the samples and of a cell's
- * scoring subset) + LIDET_GROUND_MAX_SECTORS * 50 B
- * + ~200 B; defaults (128 x 2048, 262,144 samples): about 3.5 MiB; a VLP-16 build (16 x 1800,
- * samples = pixels): about 0.4 MiB. lidet_ground_bytes() returns the exact figure. Declare it static.
+ * + LIDET_GROUND_MAX_SAMPLES * 4 B (the samples' pixels) + LIDET_GROUND_EVAL_MAX * 12 B (x, y, z of a
+ * cell's scoring subset) + LIDET_GROUND_MAX_SECTORS * 50 B + ~200 B; defaults (128 x 2048, 262,144
+ * samples): about 1.5 MiB; a VLP-16 build (16 x 1800, samples = pixels): about 0.18 MiB.
+ * lidet_ground_bytes() returns the exact figure. Declare it static. The state alone
+ * (lidet_ground_state_t) is what lives across runs; lidet_ground_run_buffers() runs on buffers the
+ * caller places (a detector workspace overlays the scratch, lidet_workspace.h).
  * Time: O(n_rows * n_cols) for the filter and the labelling, O(n_sectors * ransac_iters *
  * eval_samples + refine_iters * n_samples) for the planes; no allocation, no recursion.
  */
@@ -174,22 +176,22 @@ typedef struct
 /**
  * @brief Scratch of one ground run: nothing in it is read after the run returns except the sample
  *        mask (lidet_ground_samples, a diagnostic). A detector workspace overlays it with the other
- *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + (LIDET_GROUND_MAX_SAMPLES +
- *        LIDET_GROUND_EVAL_MAX) * 12 B + LIDET_GROUND_MAX_SECTORS * 16 B.
+ *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + LIDET_GROUND_MAX_SAMPLES * 4 B (a sample
+ *        is its pixel: RANSAC reads its coordinates from the image) + LIDET_GROUND_EVAL_MAX * 12 B
+ *        + LIDET_GROUND_MAX_SECTORS * 16 B + LIDET_MAX_COLS * 8 B (two rows of R, for images without R).
  */
 typedef struct
 {
     uint8_t sample[LIDET_MAX_ROWS * LIDET_MAX_COLS];     /* 1 sample of the filter */
-    float sx_m[LIDET_GROUND_MAX_SAMPLES];                /* samples, grouped by cell */
-    float sy_m[LIDET_GROUND_MAX_SAMPLES];
-    float sz_m[LIDET_GROUND_MAX_SAMPLES];
+    uint32_t sample_pix[LIDET_GROUND_MAX_SAMPLES];       /* samples (their pixels), grouped by cell */
     float ev_x_m[LIDET_GROUND_EVAL_MAX];                 /* a cell's strided scoring subset */
     float ev_y_m[LIDET_GROUND_EVAL_MAX];
     float ev_z_m[LIDET_GROUND_EVAL_MAX];
     /* cells: k = s (near part of sector s) and k = n_sectors + s (far part); the samples of cell k
-     * are sx/sy/sz[cell_first[k] .. cell_first[k] + cell_n[k]) */
+     * are sample_pix[cell_first[k] .. cell_first[k] + cell_n[k]) */
     uint32_t cell_first[2 * LIDET_GROUND_MAX_SECTORS];
     uint32_t cell_n[2 * LIDET_GROUND_MAX_SECTORS];
+    float rxy_rows[2][LIDET_MAX_COLS]; /* R of two rows, computed when the image has no R */
 } lidet_ground_scratch_t;
 
 /** @brief Ground stage with every buffer inside (the standalone form): state, the ground mask (the
@@ -222,11 +224,12 @@ lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cf
  * @brief Segment the ground of one range image.
  * @param[in,out] g   initialised state; its mask, samples and planes are overwritten.
  * @param[in]     img range image from lidet_proj_image (or built by hand with the same contract:
- *                    row 0 = top beam, rows ordered by decreasing elevation, point_idx -1 = empty).
- *                    Not retained.
+ *                    row 0 = top beam, rows ordered by decreasing elevation, empty pixels 0 in every
+ *                    float array). x, y, z are read; R when given (else computed row by row);
+ *                    point_idx is not read. Not retained.
  * @return LIDET_OK; LIDET_TRUNCATED when more than LIDET_GROUND_MAX_SAMPLES pixels passed the filter
  *         (the excess, last sectors first, is counted in stats.n_samples_dropped and not used);
- *         LIDET_ERR_ARG (NULL, NULL image arrays); LIDET_ERR_STATE (not initialised);
+ *         LIDET_ERR_ARG (NULL, NULL x, y or z); LIDET_ERR_STATE (not initialised);
  *         LIDET_ERR_BUFFER (image larger than LIDET_MAX_ROWS x LIDET_MAX_COLS);
  *         LIDET_ERR_CONFIG (image has fewer columns than n_sectors).
  */
@@ -282,13 +285,12 @@ lidet_status_t lidet_ground_state_init(lidet_ground_state_t *st, const lidet_gro
  * @param[in,out] st      initialised state (planes, sources and stats are written).
  * @param[out]    scratch the run's scratch (its sample mask stays readable until it is reused).
  * @param[out]    mask    n_rows * n_cols bytes: the ground mask.
- * @param[out]    rxy_m   n_rows * n_cols floats of scratch for R when img->rxy_m is NULL (computed
- *                        from x and y exactly as the projection would); may be NULL when the image has R.
- * @param[in]     img     range image (rxy_m and point_idx may be NULL).
- * @return as lidet_ground_run; LIDET_ERR_ARG also when img has no R and rxy_m is NULL.
+ * @param[in]     img     range image; rxy_m and point_idx may be NULL (without R the stage computes it
+ *                        row by row from x and y, exactly as the projection would: same results).
+ * @return as lidet_ground_run.
  */
 lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *st, lidet_ground_scratch_t *scratch, uint8_t *mask,
-                                        float *rxy_m, const lidet_range_image_t *img);
+                                        const lidet_range_image_t *img);
 
 /** @brief Per-point labels from a state and the mask it produced (lidet_ground_point_labels). */
 lidet_status_t lidet_ground_point_labels_of(const lidet_ground_state_t *st, const uint8_t *mask,

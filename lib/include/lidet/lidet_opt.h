@@ -22,6 +22,14 @@
 #include "lidet_user_config.h"
 #endif
 
+/* Port layer: a target's ports/<target>/lidet_port.h, read when LIDET_PORT is defined (CMake:
+ * -DLIDET_PORT_DIR=ports/<target> adds its folder to the include path and defines LIDET_PORT). It may
+ * define the hooks below (LIDET_ASSERT, LIDET_ALIGN, LIDET_WORKSPACE_SECTION, LIDET_RODATA); what it
+ * leaves undefined takes the defaults at the end of this file. See ports/cortex-m/lidet_port.h. */
+#ifdef LIDET_PORT
+#include "lidet_port.h"
+#endif
+
 /** Maximum range-image rows (beams) of any sensor used with this build. */
 #ifndef LIDET_MAX_ROWS
 #define LIDET_MAX_ROWS 128
@@ -99,6 +107,29 @@
 /** 1: lidet_status_str() returns descriptive strings; 0: it returns "" (saves flash). */
 #ifndef LIDET_ENABLE_STATUS_STRINGS
 #define LIDET_ENABLE_STATUS_STRINGS 1
+#endif
+
+/* ---- port hooks (defaults; a port header overrides them) ------------------------------------ */
+/* LIDET_ASSERT(c): see lib/src/internal/lidet_assert.h (compiled out unless LIDET_DEBUG). */
+
+/** Alignment of a declaration, e.g. `static lidet_workspace_t ws LIDET_ALIGN(32);`. */
+#ifndef LIDET_ALIGN
+#if defined(__GNUC__) || defined(__clang__)
+#define LIDET_ALIGN(n) __attribute__((aligned(n)))
+#else
+#define LIDET_ALIGN(n)
+#endif
+#endif
+
+/** Where the firmware places its detector workspace, e.g. `__attribute__((section(".sdram")))`:
+ *  `static lidet_workspace_t ws LIDET_WORKSPACE_SECTION;`. Empty by default (ordinary .bss). */
+#ifndef LIDET_WORKSPACE_SECTION
+#define LIDET_WORKSPACE_SECTION
+#endif
+
+/** Placement of generated constant tables (weights), e.g. a flash section. Empty by default. */
+#ifndef LIDET_RODATA
+#define LIDET_RODATA
 #endif
 
 /* ---- consistency checks (all in one place) ------------------------------------------------ */

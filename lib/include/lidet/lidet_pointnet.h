@@ -46,18 +46,8 @@
 extern "C" {
 #endif
 
-/** Alignment and placement of generated constant arrays; a port may define them first (e.g. to put
- *  weights in a flash section). */
-#ifndef LIDET_ALIGN
-#if defined(__GNUC__) || defined(__clang__)
-#define LIDET_ALIGN(n) __attribute__((aligned(n)))
-#else
-#define LIDET_ALIGN(n)
-#endif
-#endif
-#ifndef LIDET_RODATA
-#define LIDET_RODATA
-#endif
+/* Generated arrays are declared with LIDET_ALIGN(16) LIDET_RODATA (lidet_opt.h: a port may place them in a
+ * flash section). */
 
 /** Most layers per part of a stage (shared, PVLE, head); a descriptor with more is LIDET_ERR_MODEL. */
 #define LIDET_PN_MAX_LAYERS 8

@@ -17,8 +17,8 @@
  * Stages run one after the other, so the workspace overlays (a union) the projection's scratch, the
  * ground stage's scratch and the clustering's outputs, none of which is alive while another is.
  * What the workspace does not keep, by design (a firmware that wants boxes pays for none of it):
- *  - R = sqrt(x^2 + y^2) per pixel: the ground stage recomputes it into its scratch, with the same
- *    expression, so every result is bit-identical to the standalone stages';
+ *  - R = sqrt(x^2 + y^2) per pixel: the ground stage recomputes it row by row (two rows of scratch),
+ *    with the same expression, so every result is bit-identical to the standalone stages';
  *  - the winning point's index per pixel (point_idx): scratch of the projection; validity is range > 0;
  *  - per-point outputs (the pixel of every input point, 4 B per point): only when the caller passes
  *    a buffer of LIDET_MAX_POINTS entries to lidet_workspace_run; per-point labels are then derived
@@ -29,10 +29,10 @@
  *
  * Bytes (lidet_workspace_sizes reports each part): states ~ LIDET_MAX_COLS * 12 B + LIDET_PROJ_ROW_LUT B
  * + LIDET_MAX_CLUSTERS * 60 B + LIDET_GROUND_MAX_SECTORS * 34 B; per pixel 17 B (x, y, z, range, ground
- * mask) + the overlay, the largest of 4 B (projection), 5 B + (LIDET_GROUND_MAX_SAMPLES / pixels) * 12 B
+ * mask) + the overlay, the largest of 4 B (projection), 1 B + (LIDET_GROUND_MAX_SAMPLES / pixels) * 4 B
  * (ground) and 6 B (clustering). Declare it static, or place it with the port's section macro
  * (LIDET_WORKSPACE_SECTION, lidet_port.h).
- * Time: the sum of the three stages, plus one pass over the pixels for R (vectorised). No allocation.
+ * Time: the sum of the three stages, plus two passes over the pixels for R (vectorised). No allocation.
  */
 #ifndef LIDET_WORKSPACE_H
 #define LIDET_WORKSPACE_H
@@ -83,11 +83,7 @@ typedef struct
     union
     {
         int32_t proj_point_idx[LIDET__WS_PIXELS]; /* projection: winning point per pixel */
-        struct
-        {
-            float rxy_m[LIDET__WS_PIXELS]; /* R, recomputed from x and y */
-            lidet_ground_scratch_t scratch;
-        } ground;
+        lidet_ground_scratch_t ground; /* sample mask, samples, two rows of R */
         struct
         {
             int32_t members[LIDET__WS_PIXELS]; /* clustering outputs, read by the proposals */
@@ -103,7 +99,7 @@ typedef struct
     uint32_t image;                                   /**< x, y, z, range planes */
     uint32_t ground_mask;                             /**< the ground mask */
     uint32_t overlay_proj;                            /**< projection scratch (point_idx) */
-    uint32_t overlay_ground;                          /**< ground scratch (R, sample mask, samples) */
+    uint32_t overlay_ground;                          /**< ground scratch (sample mask, samples, two rows of R) */
     uint32_t overlay_cluster;                         /**< cluster labels and members */
     uint32_t overlay;                                 /**< the overlay: the largest of the three */
     uint32_t total;                                   /**< sizeof(lidet_workspace_t) */

@@ -11,8 +11,9 @@ static inline uint32_t lidet__ground_sector_col(uint32_t s, uint32_t n_sectors, 
     return (s * n_cols + n_sectors - 1u) / n_sectors;
 }
 
-/* Fits one plane per cell from sc->sx/sy/sz grouped by sc->cell_first / cell_n, applies the fallback,
- * fills g->planes, g->source and the sector counts of g->stats (lidet_ground_ransac.c). */
-void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc);
+/* Fits one plane per cell from the samples sc->sample_pix (pixels of img) grouped by sc->cell_first /
+ * cell_n, applies the fallback, fills g->planes, g->source and the sector counts of g->stats
+ * (lidet_ground_ransac.c). */
+void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img);
 
 #endif

@@ -9,6 +9,7 @@
 
 #define LIDET_PI_F 3.14159265f
 #define LIDET_HALF_PI_F 1.57079633f
+#define LIDET_DEG2RAD_F 0.0174532925f /* pi / 180 */
 
 /* finite test without libm or the C99 classification macros (those may promote to double on some
  * toolchains): a float is finite iff its exponent bits are not all ones. */

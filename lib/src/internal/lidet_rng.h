@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
-/* xorshift32 (Marsaglia 2003, shifts 13, 17, 5): the deterministic generator of every randomised
- * stage (RANSAC). Mirrored bit for bit by codegen/lidet_codegen/ref/rng.py. Never installed. */
+/* xorshift32 (Marsaglia 2003, shifts 13, 17, 5): the one deterministic generator of every randomised
+ * stage (the ground RANSAC, lidet_ground_ransac.c; the proposal resampling, lidet_proposal.c). Mirrored
+ * bit for bit by codegen/lidet_codegen/ref/rng.py and ref/cluster.py. Never installed. */
 #ifndef LIDET_RNG_H
 #define LIDET_RNG_H
 
@@ -8,6 +9,8 @@
 
 /* seed 0 would stay 0 forever: it is replaced by this fixed non-zero value */
 #define LIDET_RNG_DEFAULT_SEED 0x9E3779B9u
+/* the proposals' replacement for a zero start state ("ldet"; lidet_cluster.h documents the rule) */
+#define LIDET_RNG_PROPOSAL_ZERO_SEED 0x6C646574u
 
 static inline uint32_t lidet__rng_seed(uint32_t seed)
 {
