@@ -57,6 +57,16 @@ def test_train_export_onnx_parity(tiny, tmp_path):
     got = _ort(tmp_path / "box.onnx", dict(feeds, onehot=oh))
     for k in ("center_tnet", "box"):
         assert np.abs(got[k] - ref[k]).max() <= 1e-5
+    # the evaluation on the validation scan: figures in range, tables rendered
+    from lidet_tools.train import evaluate as EV
+    res = EV.evaluate(D.load(path), 1, tmp_path / "cls.pt", tmp_path / "box.pt", tmp_path / "en")
+    g1 = res["cls"]["gate1"]
+    assert g1["n_id"] == int((d["label"][d["split"] == 1] >= 0).sum()) and 0.0 <= g1["auroc"] <= 1.0
+    assert 0.0 <= res["boxnet"]["gate2"]["fpr95"] <= 1.0
+    assert all(0.0 <= b["iou_mean"] <= 1.0 for b in res["boxnet"]["box"].values() if b.get("n"))
+    md = EV.markdown(res, "tiny")
+    assert "gate 1 (classifier energy)" in md and "gate 2 (box-net energy)" in md
+    assert len(np.load(tmp_path / "en" / "cls_ood.npy")) == g1["n_ood"]
     # budgets, counted from the graphs
     assert macs.count(tmp_path / "cls.onnx")["macs"] <= 1_000_000
     assert macs.count(tmp_path / "box.onnx")["macs"] <= 2_000_000
