@@ -63,7 +63,7 @@ bench: deps build
 WEIGHTS_ARGS ?=
 weights: deps build
 	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \
-	    --jobs $(JOBS) --threads 1 --real $(REAL)/kitti/training $(WEIGHTS_ARGS)
+	    --jobs $(JOBS) --threads 1 --real $(REAL)/kitti/training --real-semantickitti $(REAL)/semantickitti $(WEIGHTS_ARGS)
 
 clean:
 	rm -rf $(BUILD) $(ASAN) out
