@@ -71,10 +71,32 @@ def run_family(fam: str, a, timings: dict) -> dict:
     res["val"] = EV.evaluate(dd, 1, out["cls"], out["box"])
     res["balance"] = D.balance_table(dd)
     res["dataset_meta"] = dd["meta"]
+    res["onnx_parity"] = onnx_parity(dd, out, a.weights, fam)
     (w / f"{fam}_test.json").write_text(json.dumps(res, indent=1, default=float))
     _histograms(fam, w / f"{fam}_energy", a)
     timings[f"{fam} evaluation"] = time.perf_counter() - t
     return res
+
+
+def onnx_parity(dd: dict, cks: dict, wdir, fam: str) -> dict:
+    """Max abs difference onnxruntime vs PyTorch over every test-split proposal, per output."""
+    import numpy as np
+    import onnxruntime as ort
+    from lidet_codegen.export import load_checkpoint, torch_forward
+    from . import common as C
+    te = C.split(dd, 2)
+    feeds = {"points": te["points"].astype(np.float32), "voxel": te["voxel"].astype(np.float32)}
+    oh = np.eye(M.N_CLASSES, dtype=np.float32)[np.maximum(te["label"], 0)]
+    out = {}
+    for kind, mk in (("cls", "classifier"), ("box", "box")):
+        m, _ = load_checkpoint(cks[kind])
+        f = dict(feeds, onehot=oh) if kind == "box" else feeds
+        ref = torch_forward(m, mk, f["points"], f["voxel"], f.get("onehot"))
+        sess = ort.InferenceSession(str(wdir / f"{kind}_{fam}.onnx"), providers=["CPUExecutionProvider"])
+        got = dict(zip([o.name for o in sess.get_outputs()], sess.run(None, f)))
+        for k in got:
+            out[f"{kind}.{k}"] = float(np.abs(got[k] - ref[k]).max())
+    return out
 
 
 def _histograms(fam, edir, a):
@@ -152,6 +174,9 @@ def model_card(a, results: dict, real, timings: dict) -> str:
     L += ["## Figures on the test split (simulated, scans never seen in training or model selection)", ""]
     for fam, r in results.items():
         L.append(EV.markdown(r, f"{fam}, test split"))
+        if "onnx_parity" in r:
+            L.append("onnxruntime vs PyTorch on all " + str(r["n"]) + " test proposals, max abs difference: " +
+                     ", ".join(f"{k} {v:.1e}" for k, v in r["onnx_parity"].items()) + "\n")
     if real:
         L += ["## Classifier on real scans", "",
               "The hdl64 classifier on ../shared/data/real: the three labelled KITTI object frames (only clusters "
