@@ -10,7 +10,7 @@ CMAKE_FLAGS ?=
 SAMPLE   ?= tests/data/sim_hdl64/velodyne/000000.bin
 REAL     ?= ../shared/data/real
 
-.PHONY: all deps build test test-c test-py test-asan demo bench clean
+.PHONY: all deps build test test-c test-py test-asan demo bench weights clean
 
 all: build
 
@@ -71,6 +71,14 @@ demo: build
 bench: deps build
 	-$(PY) -m pip install -q -r requirements-bench.txt || echo "bench: peers not installable here; their rows are skipped"
 	$(PY) tools/bench/run_bench.py --build $(BUILD) --real $(REAL) --out docs/BENCHMARKS.md
+
+# Trains the PointNets from nothing: simulated proposal datasets (C stages through the bindings),
+# classifier + box net per sensor family, ONNX export, test-split figures and weights/MODEL_CARD.md.
+# Resumable (state under data/train/); about 40 min on a 2-core machine (docs/TRAINING.md).
+WEIGHTS_ARGS ?=
+weights: deps build
+	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \
+	    --jobs $(JOBS) --threads 1 --real $(REAL)/kitti/training --real-semantickitti $(REAL)/semantickitti $(WEIGHTS_ARGS)
 
 clean:
 	rm -rf $(BUILD) $(ASAN) out

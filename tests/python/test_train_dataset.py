@@ -1,0 +1,75 @@
+# SPDX-License-Identifier: MIT
+"""Proposal dataset builder (lidet_tools.train.dataset): labelling rules, frames, splits, errors."""
+import numpy as np
+import pytest
+
+from lidet_tools.train import dataset as D
+from lidet_tools.train import models as M
+
+
+def test_points_in_box_rotated_and_margin():
+    box = (10.0, 5.0, 0.0, 4.0, 2.0, 1.5, np.pi / 2)  # l along +y after the rotation
+    pts = np.array([[10.0, 6.9, 0.0], [11.2, 5.0, 0.0], [10.0, 5.0, 0.8], [10.0, 7.05, 0.0]])
+    m = D.points_in_box(pts, box)
+    assert m.tolist() == [True, False, False, False]
+    assert D.points_in_box(pts, box, margin=0.1).tolist() == [True, False, True, True]
+
+
+def test_box_model_frame_round_trip():
+    rng = np.random.default_rng(0)
+    mean = rng.uniform(-30, 30, (20, 3)).astype(np.float32)
+    box = np.concatenate([mean + rng.normal(0, 1, (20, 3)), rng.uniform(0.5, 4, (20, 3)),
+                          rng.uniform(-np.pi, np.pi, (20, 1))], 1).astype(np.float32)
+    bm = D.box_to_model_frame(box, mean)
+    back = D.box_from_model_frame(bm, mean)
+    np.testing.assert_allclose(back[:, :6], box[:, :6], atol=1e-4)
+    dyaw = (back[:, 6] - box[:, 6] + np.pi) % (2 * np.pi) - np.pi
+    np.testing.assert_allclose(dyaw, 0, atol=1e-5)
+    # a box straight ahead along the mean's ray has y = 0 in the model frame
+    c = mean[:, :2] / np.linalg.norm(mean[:, :2], axis=1, keepdims=True)
+    ahead = box.copy()
+    ahead[:, 0:2] = mean[:, :2] + 2.0 * c
+    np.testing.assert_allclose(D.box_to_model_frame(ahead, mean)[:, 1], 0, atol=1e-4)
+
+
+def test_sim_scans_labelled_by_the_rules(need_lib):
+    parts = [D._job(("sim", s, 7, s, None), "hdl64", dict(D.DEFAULTS)) for s in range(2)]
+    d = D.concat(parts)
+    lab = d["label"]
+    idm = lab >= 0
+    assert idm.sum() >= 5 and (~idm).sum() >= 20
+    # ID: mostly one object, holding most of it, with a box target near the proposal
+    assert (d["share"][idm] >= 0.8).all() and (d["recall"][idm] >= 0.5).all()
+    assert not np.isnan(d["box"][idm]).any() and np.isnan(d["box"][~idm]).all()
+    assert (np.hypot(d["box"][idm, 0], d["box"][idm, 1]) < 3.0).all()
+    # the size target matches the class (cars are long)
+    car = lab == 0
+    if car.any():
+        assert d["box"][car, 3].min() > 2.5
+    # points are in the model frame: centred, and the mean sits on +x
+    np.testing.assert_allclose(d["points"], M.to_model_frame(d["xyz"], d["mean"]), atol=0)
+    assert d["points"].shape[1:] == (64, 3) and d["voxel"].dtype == np.int16
+    assert d["split"].tolist() == [0] * len(parts[0]["label"]) + [1] * len(parts[1]["label"])
+    # OOD holds no well-covered pure road user
+    ood = ~idm
+    assert not ((d["share"][ood] >= 0.8) & (d["recall"][ood] >= 0.5) & np.isin(d["sem"][ood], [10, 30, 31])).any()
+
+
+def test_bad_input_errors(tmp_path):
+    with pytest.raises(FileNotFoundError, match="label_2"):
+        D.kitti_scans(tmp_path)
+    for s in ("velodyne", "label_2", "calib"):
+        (tmp_path / s).mkdir()
+    with pytest.raises(ValueError, match="no velodyne"):
+        D.kitti_scans(tmp_path)
+    assert D.main(["--kitti", str(tmp_path / "nope"), "--out", str(tmp_path / "x.npz")]) == 2
+    with pytest.raises(FileNotFoundError):
+        D.load(tmp_path / "missing.npz")
+
+
+def test_real_kitti_frames(real_dir, need_lib, tmp_path):
+    out = tmp_path / "real.npz"
+    assert D.main(["--kitti", str(real_dir / "kitti" / "training"), "--split", "test", "--out", str(out),
+                   "--no-progress"]) == 0
+    d = D.load(out)
+    assert (d["split"] == 2).all() and (d["label"] >= 0).sum() >= 1

@@ -1,0 +1,119 @@
+# SPDX-License-Identifier: MIT
+"""Training smoke test: two simulated scans -> proposals -> one epoch of each phase of both trainers ->
+ONNX export -> onnxruntime agrees with PyTorch (max abs diff <= 1e-5) on real proposals. Also the
+MAC counter, the energy and gate helpers, and the resumable state."""
+import json
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+ort = pytest.importorskip("onnxruntime")
+
+from lidet_tools.train import common as C  # noqa: E402
+from lidet_tools.train import dataset as D  # noqa: E402
+from lidet_tools.train import macs  # noqa: E402
+from lidet_tools.train import metrics as MX  # noqa: E402
+from lidet_tools.train import train_box, train_cls  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory, need_lib):
+    """Two hdl64 scans: scan 0 is the training split, scan 1 validation."""
+    d = D.concat([D._job(("sim", s, 1, s, None), "hdl64", dict(D.DEFAULTS)) for s in range(2)])
+    p = tmp_path_factory.mktemp("tiny") / "tiny.npz"
+    np.savez_compressed(p, meta=json.dumps({"sensor": "hdl64", "command": "test"}), **d)
+    return p, d
+
+
+def _ort(path, feeds):
+    s = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    return dict(zip([o.name for o in s.get_outputs()], s.run(None, feeds)))
+
+
+def test_train_export_onnx_parity(tiny, tmp_path):
+    path, d = tiny
+    a = train_cls.add_args(__import__("argparse").ArgumentParser()).parse_args(
+        ["--data", str(path), "--work", str(tmp_path / "cw"), "--out", str(tmp_path / "cls.pt"), "--onnx",
+         str(tmp_path / "cls.onnx"), "--epochs-ce", "1", "--epochs-energy", "1", "--batch", "8", "--no-progress"])
+    ck = train_cls.train(a)
+    assert ck["meta"]["trained"] == 1 and len(ck["meta"]["gamma"]) == 3 and np.isfinite(ck["meta"]["gamma"]).all()
+    assert ck["meta"]["margins"]["m_out"] >= ck["meta"]["margins"]["m_in"] + 3.0 - 1e-9
+    from lidet_codegen.export import load_checkpoint, torch_forward
+    model, _ = load_checkpoint(tmp_path / "cls.pt")
+    feeds = {"points": d["points"], "voxel": d["voxel"].astype(np.float32)}
+    ref = torch_forward(model, "classifier", feeds["points"], feeds["voxel"])
+    got = _ort(tmp_path / "cls.onnx", feeds)
+    assert np.abs(got["logits"] - ref["logits"]).max() <= 1e-5
+
+    b = train_box.add_args(__import__("argparse").ArgumentParser()).parse_args(
+        ["--data", str(path), "--work", str(tmp_path / "bw"), "--out", str(tmp_path / "box.pt"), "--onnx",
+         str(tmp_path / "box.onnx"), "--epochs-box", "1", "--epochs-energy", "1", "--batch", "8", "--no-progress"])
+    ckb = train_box.train(b)
+    assert ckb["kind"] == "box" and len(ckb["meta"]["gamma"]) == 3
+    model, _ = load_checkpoint(tmp_path / "box.pt")
+    oh = np.eye(3, dtype=np.float32)[np.arange(len(d["label"])) % 3]
+    ref = torch_forward(model, "box", feeds["points"], feeds["voxel"], oh)
+    got = _ort(tmp_path / "box.onnx", dict(feeds, onehot=oh))
+    for k in ("center_tnet", "box"):
+        assert np.abs(got[k] - ref[k]).max() <= 1e-5
+    # the evaluation on the validation scan: figures in range, tables rendered
+    from lidet_tools.train import evaluate as EV
+    res = EV.evaluate(D.load(path), 1, tmp_path / "cls.pt", tmp_path / "box.pt", tmp_path / "en")
+    g1 = res["cls"]["gate1"]
+    assert g1["n_id"] == int((d["label"][d["split"] == 1] >= 0).sum()) and 0.0 <= g1["auroc"] <= 1.0
+    assert 0.0 <= res["boxnet"]["gate2"]["fpr95"] <= 1.0
+    assert all(0.0 <= b["iou_mean"] <= 1.0 for b in res["boxnet"]["box"].values() if b.get("n"))
+    md = EV.markdown(res, "tiny")
+    assert "gate 1 (classifier energy)" in md and "gate 2 (box-net energy)" in md
+    assert len(np.load(tmp_path / "en" / "cls_ood.npy")) == g1["n_ood"]
+    # budgets, counted from the graphs
+    assert macs.count(tmp_path / "cls.onnx")["macs"] <= 1_000_000
+    assert macs.count(tmp_path / "box.onnx")["macs"] <= 2_000_000
+    # resuming a finished run changes nothing
+    ck2 = train_cls.train(a)
+    for k, v in ck["state_dict"].items():
+        assert torch.equal(v, ck2["state_dict"][k])
+    # other arguments with the same state folder are refused
+    a.epochs_ce = 2
+    with pytest.raises(ValueError, match="other arguments"):
+        train_cls.train(a)
+
+
+def test_macs_hand_count(tmp_path):
+    """The counter against the MACs computed by hand from the default widths at 64 points."""
+    from lidet_codegen.export import export_onnx, untrained
+    m, ck = untrained("classifier")
+    export_onnx(m, ck, tmp_path / "c.onnx")
+    n = 64
+    hand = n * (3 * 32 + 32 * 64 + 64 * 128) + (3 * 32 + 32 * 32) + (160 * 64 + 64 * 3)
+    assert macs.count(tmp_path / "c.onnx")["macs"] == hand
+    assert macs.count(tmp_path / "c.onnx", 128)["macs"] == hand + n * (3 * 32 + 32 * 64 + 64 * 128)
+
+
+def test_energy_gate_helpers():
+    lg = torch.tensor([[10.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    e = C.energy(lg).numpy()
+    np.testing.assert_allclose(e, [-(10 + np.log(1 + 2 * np.exp(-10))), -np.log(3)], rtol=1e-6)
+    np.testing.assert_allclose(MX.energy_np(lg.numpy()), e, rtol=1e-6)
+    e_id = np.arange(100, dtype=np.float64)   # 0..99
+    g = C.threshold_at_tpr(e_id, 0.95)
+    assert np.mean(e_id < g) == 0.95
+    assert C.fpr_at_tpr(e_id, np.array([50.0, 200.0, 94.0, 95.0])) == 0.5
+    assert C.auroc(np.array([0.0, 1.0]), np.array([2.0, 3.0])) == 1.0
+    assert C.auroc(np.array([2.0, 3.0]), np.array([0.0, 1.0])) == 0.0
+    assert C.auroc(np.array([1.0]), np.array([1.0])) == 0.5
+    assert C.hinge(torch.tensor([-5.0, -1.0]), torch.tensor([0.0, -4.0]), -3.0, -2.0).item() == pytest.approx(2.0 + 2.0)
+
+
+def test_augment_keeps_box_consistent():
+    """Mirroring, rotation and translation move points and box together (corners stay in the box frame)."""
+    rng = np.random.default_rng(3)
+    box = np.array([[1.0, 0.3, 0.1, 4.0, 1.6, 1.5, 0.4]], np.float32)
+    u = rng.uniform(-0.5, 0.5, (64, 3)) * box[0, 3:6]
+    c, s = np.cos(box[0, 6]), np.sin(box[0, 6])
+    pts = np.stack([c * u[:, 0] - s * u[:, 1], s * u[:, 0] + c * u[:, 1], u[:, 2]], 1) + box[0, :3]
+    for _ in range(5):
+        p, b = C.augment(rng, pts[None].astype(np.float32), box)
+        inside = D.points_in_box(p[0], b[0], margin=0.035)
+        assert inside.all()

@@ -1,0 +1,178 @@
+# SPDX-License-Identifier: MIT
+"""What the two trainers share: seeds and threads, augmentation, energies, OOD metrics, checkpoints.
+
+Augmentation (training batches only, model frame; `augment`):
+* mirror about the model frame's x axis with probability 0.5 (y -> -y; a box's centre y and heading
+  change sign). The mean stays on +x, so the PVLE voxel is unchanged;
+* rotation about z through the mean by U(-5, 5) deg (box centre and heading follow), so the nets do
+  not rely on the exact frustum rotation;
+* translation of the points by U(-0.1, 0.1) m in x, y and U(-0.05, 0.05) m in z (the box centre
+  follows): the authors used +-0.2 / +-0.1 m; lidet's proposals are centred on the exact cluster mean,
+  so a smaller shift suffices to cover the mean's shift when points drop out;
+* point jitter N(0, 0.01 m) clipped at 0.03 m (range noise);
+* point dropout by resampling: keep a random 60-100 % of the 64 points and draw the 64 again from them
+  with replacement, as the C resampling does for a sparse cluster.
+"""
+from __future__ import annotations
+
+import math
+import os
+import pathlib
+
+import numpy as np
+import torch
+
+from . import models as M
+
+
+def setup(seed: int, threads: int) -> None:
+    """Fixed seeds, deterministic kernels, and the thread count (1 on a shared 2-core machine)."""
+    torch.manual_seed(seed)
+    np.random.seed(seed)
+    torch.set_num_threads(max(1, int(threads)))
+    torch.use_deterministic_algorithms(True, warn_only=True)
+
+
+def device(name: str) -> torch.device:
+    if name == "cuda" and not torch.cuda.is_available():
+        raise RuntimeError("--device cuda asked for, but torch sees no CUDA device")
+    return torch.device(name)
+
+
+def augment(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None = None):
+    """Augment a batch: pts (B, N, 3) model frame, box (B, 7) model-frame targets (or None). Copies."""
+    pts = pts.copy()
+    B, N, _ = pts.shape
+    box = None if box is None else box.copy()
+    # dropout by resampling
+    keep = rng.uniform(0.6, 1.0, B)
+    for i in range(B):
+        k = max(4, int(round(keep[i] * N)))
+        src = rng.permutation(N)[:k]
+        pts[i] = pts[i, src[rng.integers(0, k, N)]]
+    # mirror
+    flip = rng.random(B) < 0.5
+    pts[flip, :, 1] *= -1
+    if box is not None:
+        box[flip, 1] *= -1
+        box[flip, 6] *= -1
+    # rotation about z through the mean
+    a = rng.uniform(-math.radians(5), math.radians(5), B).astype(np.float32)
+    c, s = np.cos(a)[:, None], np.sin(a)[:, None]
+    x, y = pts[..., 0].copy(), pts[..., 1].copy()
+    pts[..., 0], pts[..., 1] = c * x - s * y, s * x + c * y
+    if box is not None:
+        bx, by = box[:, 0].copy(), box[:, 1].copy()
+        box[:, 0], box[:, 1] = c[:, 0] * bx - s[:, 0] * by, s[:, 0] * bx + c[:, 0] * by
+        box[:, 6] += a
+    # translation
+    t = np.concatenate([rng.uniform(-0.1, 0.1, (B, 2)), rng.uniform(-0.05, 0.05, (B, 1))], 1).astype(np.float32)
+    pts += t[:, None, :]
+    if box is not None:
+        box[:, 0:3] += t
+    # jitter
+    pts += np.clip(rng.normal(0, 0.01, pts.shape), -0.03, 0.03).astype(np.float32)
+    return pts.astype(np.float32), (None if box is None else box.astype(np.float32))
+
+
+def energy(logits: torch.Tensor, T: float = 1.0) -> torch.Tensor:
+    """E = -T logsumexp(logits / T) over the last axis."""
+    return -T * torch.logsumexp(logits / T, dim=-1)
+
+
+def box_energy(box_out: torch.Tensor, T: float = 1.0) -> torch.Tensor:
+    """Gate-2 energy of box-net outputs (B, 39): E(heading scores) + E(size scores)."""
+    h = box_out[:, 3:3 + M.N_HEADING_BINS]
+    o = 3 + 2 * M.N_HEADING_BINS
+    s = box_out[:, o:o + M.N_SIZE_CLUSTERS]
+    return energy(h, T) + energy(s, T)
+
+
+def hinge(e_in: torch.Tensor, e_out: torch.Tensor, m_in: float, m_out: float) -> torch.Tensor:
+    """energy_ood's squared hinge: mean(relu(E_in - m_in)^2) + mean(relu(m_out - E_out)^2)."""
+    return (torch.relu(e_in - m_in) ** 2).mean() + (torch.relu(m_out - e_out) ** 2).mean()
+
+
+def auroc(e_id: np.ndarray, e_ood: np.ndarray) -> float:
+    """AUROC of ID (positive) vs OOD with score -energy (ties count half)."""
+    s = np.concatenate([-np.asarray(e_id, np.float64), -np.asarray(e_ood, np.float64)])
+    y = np.concatenate([np.ones(len(e_id)), np.zeros(len(e_ood))])
+    if len(e_id) == 0 or len(e_ood) == 0:
+        return float("nan")
+    order = np.argsort(s, kind="mergesort")
+    ranks = np.empty(len(s))
+    ss = s[order]
+    # average ranks of ties
+    i = 0
+    while i < len(ss):
+        j = i
+        while j + 1 < len(ss) and ss[j + 1] == ss[i]:
+            j += 1
+        ranks[order[i:j + 1]] = 0.5 * (i + j) + 1
+        i = j + 1
+    n1, n0 = len(e_id), len(e_ood)
+    return float((ranks[y == 1].sum() - n1 * (n1 + 1) / 2) / (n1 * n0))
+
+
+def threshold_at_tpr(e_id: np.ndarray, tpr: float = 0.95) -> float:
+    """Smallest energy threshold gamma such that at least `tpr` of ID energies are < gamma... as the
+    gate keeps E < gamma, gamma is just above the tpr-quantile of the ID energies."""
+    e = np.sort(np.asarray(e_id, np.float64))
+    if len(e) == 0:
+        return float("nan")
+    k = int(math.ceil(tpr * len(e))) - 1
+    k = min(max(k, 0), len(e) - 1)
+    return float(np.nextafter(np.float32(e[k]), np.float32(np.inf)))
+
+
+def fpr_at_tpr(e_id: np.ndarray, e_ood: np.ndarray, tpr: float = 0.95) -> float:
+    """Share of OOD kept (E < gamma) at the gamma that keeps `tpr` of the ID samples."""
+    if len(e_ood) == 0 or len(e_id) == 0:
+        return float("nan")
+    g = threshold_at_tpr(e_id, tpr)
+    return float(np.mean(np.asarray(e_ood) < g))
+
+
+def per_class_gamma(e: np.ndarray, cls: np.ndarray, tpr: float = 0.95, min_n: int = 20) -> list:
+    """gamma per class at `tpr` ID recall; a class with fewer than min_n samples gets the pooled value."""
+    pooled = threshold_at_tpr(e, tpr)
+    out = []
+    for c in range(M.N_CLASSES):
+        m = cls == c
+        out.append(threshold_at_tpr(e[m], tpr) if m.sum() >= min_n else pooled)
+    return out
+
+
+def save_atomic(obj, path) -> None:
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(path.name + ".tmp")
+    torch.save(obj, tmp)
+    os.replace(tmp, path)
+
+
+def batches(rng: np.random.Generator, n: int, bs: int, drop_last: bool = True):
+    idx = rng.permutation(n)
+    stop = n - (n % bs) if (drop_last and n >= bs) else n
+    for i in range(0, stop, bs):
+        yield idx[i:i + bs]
+
+
+def tensors(d: dict, idx, dev, pts=None):
+    """points, voxel (float32) tensors of rows idx (pts overrides the points, e.g. augmented)."""
+    p = d["points"][idx] if pts is None else pts
+    return (torch.from_numpy(np.ascontiguousarray(p, np.float32)).to(dev),
+            torch.from_numpy(d["voxel"][idx].astype(np.float32)).to(dev))
+
+
+def split(d: dict, s: int) -> dict:
+    """Rows of split s (0 train, 1 val, 2 test) as a new dict of arrays."""
+    m = d["split"] == s
+    return {k: (v[m] if isinstance(v, np.ndarray) and v.shape[:1] == m.shape else v) for k, v in d.items()}
+
+
+def progress(it, enabled: bool, **kw):
+    if not enabled:
+        return it
+    from tqdm import tqdm
+    return tqdm(it, **kw)

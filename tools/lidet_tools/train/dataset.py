@@ -1,0 +1,453 @@
+# SPDX-License-Identifier: MIT
+"""Proposal datasets for the two PointNets, made by lidet's own C stages (bindings).
+
+Every scan goes through projection -> ground stage -> depth clustering (with the ground stage's
+per-sector planes for the height filter) -> `lidet_proposal_make` (64 resampled points, mean, PVLE
+voxel), exactly what `lidet_detect` does on the device. Each kept cluster is then labelled against
+the scan's ground-truth boxes:
+
+* **ID of class c** (Car, Cyclist, Pedestrian): the cluster is *mostly one object* and *holds most of
+  it*: share = |cluster points inside the object's box| / |cluster| >= 0.8 (`--purity`), and
+  recall = |cluster points inside the box| / |non-ground points inside the box| >= 0.5 (`--recall`).
+  0.8 is the purity cluster_eval.py already uses for "under-segmented", so ID here means a cluster
+  that the clustering report counts as one object; 0.5 is "most of it" (a majority of the object's
+  points): below it the box target is mostly extrapolation and the cluster is a fragment. The box
+  target is the object's box.
+* **excluded**: the largest share (>= 0.5) of the cluster lies in a box of a class KITTI ignores
+  for scoring (`Van`, `Person_sitting`; in the simulator vans are `Van`; in SemanticKITTI-only
+  folders `other-vehicle` 20/259, which holds the vans). A detector that calls these a car or a
+  pedestrian is not penalised by KITTI, so they must not be taught as negatives. Also excluded:
+  clusters whose mean falls in a KITTI `DontCare` 2D region, and for KITTI folders clusters outside
+  the camera's field of view (label_2 annotates only what the camera sees: an unlabelled car behind
+  the vehicle must not become a negative).
+* **OOD**: every other cluster (poles, trees, walls, bushes, trucks, buses, parked bicycles,
+  fragments of road users, groups merged into one cluster, ...).
+
+Points are assigned to boxes enlarged by `--margin` (0.1 m on every side) to absorb the real
+annotators' tight boxes and the range noise; the simulator's boxes never overlap, and a point in
+two enlarged boxes goes to the nearer box centre.
+
+Splits are by scan, never by proposal: simulator scans of split s come from their own run seed
+(`--seed` + 0 train, + 1 val, + 2 test), folder scans go to the split given by `--split` (or a
+stable hash of the scan name: 70/15/15).
+
+Output: one .npz with, per proposal, `points` (K, N, 3) float32 in the *model frame* (models.to_model_frame),
+`xyz` (K, N, 3) centred sensor-frame points as the C code made them, `mean` (K, 3), `voxel` (K, 3)
+int16, `label` (K,) int8 (0 Car, 1 Cyclist, 2 Pedestrian, -1 OOD; excluded clusters are not stored),
+`box` (K, 7) float32 target in the model frame (x, y, z, l, w, h, heading; NaN when none),
+`box_sensor` (K, 7) the same box in the sensor frame, `split` (K,) int8 (0 train, 1 val, 2 test),
+`scan` (K,) int32 into `scan_names`, `share`, `recall` (K,) float32, `n_src` (K,) member pixels,
+`sem` (K,) int16 dominant SemanticKITTI class of the cluster (-1 unknown), and the run's `meta`
+(JSON string).
+
+    python -m lidet_tools.train.dataset --sensor hdl64 --sim 160,40,40 --seed 1000 --out data/train/hdl64.npz
+    python -m lidet_tools.train.dataset --sensor vlp16 --mounts 0.3,0.5,0.7,1.0 --sim 200,50,50 --out ...
+    python -m lidet_tools.train.dataset --sensor hdl64 --kitti ../shared/data/real/kitti/training --split test --out real.npz
+    python -m lidet_tools.train.dataset --sensor hdl64 --semantickitti DIR --out ...
+"""
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import os
+import pathlib
+import sys
+import time
+import zlib
+
+import numpy as np
+
+from .. import kitti
+from . import models as M
+
+ID_CLASSES = {c: i for i, c in enumerate(M.CLASSES)}      # Car 0, Cyclist 1, Pedestrian 2
+IGNORED_CLASSES = ("Van", "Person_sitting")
+SPLITS = ("train", "val", "test")
+#: SemanticKITTI ids -> role for folders without boxes (labels/ only)
+SEMKITTI_ID = {10: 0, 252: 0, 31: 1, 253: 1, 30: 2, 254: 2}
+SEMKITTI_IGNORED = (20, 259)
+GROUND_IDS = (40, 44, 48, 49, 60, 72)
+
+DEFAULTS = dict(purity=0.8, recall=0.5, ignored_share=0.5, margin=0.1, n_points=64)
+
+
+# ---- geometry -------------------------------------------------------------------------------------
+
+def points_in_box(xyz: np.ndarray, box, margin: float = 0.0) -> np.ndarray:
+    """Boolean mask of points (N, 3) inside the sensor-frame box (x, y, z, l, w, h, yaw) enlarged by margin."""
+    x, y, z, l, w, h, yaw = [float(v) for v in box]
+    d = xyz[:, :3].astype(np.float64) - np.array([x, y, z])
+    c, s = np.cos(yaw), np.sin(yaw)
+    u = c * d[:, 0] + s * d[:, 1]
+    v = -s * d[:, 0] + c * d[:, 1]
+    return (np.abs(u) <= l / 2 + margin) & (np.abs(v) <= w / 2 + margin) & (np.abs(d[:, 2]) <= h / 2 + margin)
+
+
+def box_to_model_frame(box_sensor: np.ndarray, mean: np.ndarray) -> np.ndarray:
+    """(K, 7) sensor-frame boxes -> model frame of proposals with means (K, 3): centre relative to the
+    mean rotated by minus the mean's azimuth, heading = yaw - azimuth, wrapped to [-pi, pi)."""
+    b = np.asarray(box_sensor, np.float32)
+    mean = np.asarray(mean, np.float32)
+    rel = (b[:, 0:3] - mean)[:, None, :]
+    out = b.copy()
+    out[:, 0:3] = M.to_model_frame(rel, mean)[:, 0, :]
+    az = np.arctan2(*M.azimuth_cos_sin(mean)[::-1]).astype(np.float32)
+    out[:, 6] = (b[:, 6] - az + np.pi) % (2 * np.pi) - np.pi
+    return out
+
+
+def box_from_model_frame(box_model: np.ndarray, mean: np.ndarray) -> np.ndarray:
+    """Inverse of box_to_model_frame (float64)."""
+    b = np.asarray(box_model, np.float64)
+    mean = np.asarray(mean, np.float64)
+    c, s = M.azimuth_cos_sin(mean)
+    c, s = c.astype(np.float64), s.astype(np.float64)
+    out = b.copy()
+    out[:, 0] = c * b[:, 0] - s * b[:, 1] + mean[:, 0]
+    out[:, 1] = s * b[:, 0] + c * b[:, 1] + mean[:, 1]
+    out[:, 2] = b[:, 2] + mean[:, 2]
+    out[:, 6] = b[:, 6] + np.arctan2(s, c)
+    return out
+
+
+# ---- scans -----------------------------------------------------------------------------------------
+
+class Scan:
+    """One labelled scan: points (N, 4), boxes [(class, (x, y, z, l, w, h, yaw))] in the sensor frame,
+    optional per-point SemanticKITTI labels, ring, camera (for KITTI field-of-view and DontCare)."""
+
+    def __init__(self, name, points, boxes, sem=None, inst=None, ring=None, calib=None, dontcare=(), fov_only=False):
+        self.name, self.points, self.boxes = name, points, boxes
+        self.sem, self.inst, self.ring, self.calib = sem, inst, ring, calib
+        self.dontcare, self.fov_only = list(dontcare), fov_only
+
+
+def sim_scan(sensor: str, seed: int, index: int, mount: float | None) -> Scan:
+    from ..sim.simulate import simulate_scan
+    r = simulate_scan(sensor, seed, index, mount)
+    boxes = [(b.cls, (b.x, b.y, b.z, b.l, b.w, b.h, b.yaw)) for b in r.boxes]
+    return Scan(f"sim:{sensor}:{seed}:{index}:{mount}", r.points, boxes, sem=r.sem.astype(np.int64),
+                inst=r.inst, ring=r.ring)
+
+
+def kitti_scans(folder) -> list[str]:
+    """Scan names of a KITTI-format folder (velodyne/ + label_2/ + calib/). Raises on a bad folder."""
+    folder = pathlib.Path(folder)
+    for sub in ("velodyne", "label_2", "calib"):
+        if not (folder / sub).is_dir():
+            raise FileNotFoundError(f"{folder}: no {sub}/ folder (a KITTI folder holds velodyne/, label_2/, calib/)")
+    names = sorted(f.stem for f in (folder / "velodyne").glob("*.bin") if (folder / "label_2" / (f.stem + ".txt")).exists())
+    if not names:
+        raise ValueError(f"{folder}: no velodyne/*.bin with a label_2/*.txt")
+    return names
+
+
+def kitti_scan(folder, name: str) -> Scan:
+    folder = pathlib.Path(folder)
+    pts = kitti.read_bin(folder / "velodyne" / f"{name}.bin")
+    calib = kitti.read_calib(folder / "calib" / f"{name}.txt")
+    boxes, dc = [], []
+    for o in kitti.read_label2(folder / "label_2" / f"{name}.txt"):
+        if o.type == "DontCare":
+            dc.append(np.asarray(o.bbox, np.float64))
+            continue
+        b = kitti.kitti_to_box(o, calib)
+        boxes.append((o.type, (b.x, b.y, b.z, b.l, b.w, b.h, b.yaw)))
+    sem = inst = None
+    lab = folder / "labels" / f"{name}.label"
+    if lab.exists():
+        s, i = kitti.read_label(lab, len(pts))
+        sem, inst = kitti.semantic_base(s).astype(np.int64), i
+    return Scan(f"kitti:{folder}:{name}", pts, boxes, sem=sem, inst=inst, calib=calib, dontcare=dc, fov_only=True)
+
+
+def semkitti_scans(folder) -> list[str]:
+    folder = pathlib.Path(folder)
+    for sub in ("velodyne", "labels"):
+        if not (folder / sub).is_dir():
+            raise FileNotFoundError(f"{folder}: no {sub}/ folder (a SemanticKITTI folder holds velodyne/ and labels/)")
+    names = sorted(f.stem for f in (folder / "velodyne").glob("*.bin") if (folder / "labels" / (f.stem + ".label")).exists())
+    if not names:
+        raise ValueError(f"{folder}: no velodyne/*.bin with a labels/*.label")
+    return names
+
+
+def semkitti_scan(folder, name: str) -> Scan:
+    """SemanticKITTI folder: objects are (class, instance) groups; no boxes (box target NaN)."""
+    folder = pathlib.Path(folder)
+    pts = kitti.read_bin(folder / "velodyne" / f"{name}.bin")
+    s, i = kitti.read_label(folder / "labels" / f"{name}.label", len(pts))
+    return Scan(f"semantickitti:{folder}:{name}", pts, [], sem=s.astype(np.int64), inst=i)
+
+
+# ---- labelling --------------------------------------------------------------------------------------
+
+def _objects(scan: Scan, nonground: np.ndarray, margin: float):
+    """Per-point object index (-1 none) and per object (role, class, box or None, n non-ground points).
+    role: 'id', 'ignored' or 'other'."""
+    n = len(scan.points)
+    owner = np.full(n, -1, np.int64)
+    objs = []
+    if scan.boxes:
+        best = np.full(n, np.inf)
+        for j, (cls, box) in enumerate(scan.boxes):
+            m = points_in_box(scan.points, box, margin)
+            d = np.sum((scan.points[m, :3] - np.asarray(box[:3])) ** 2, axis=1)
+            idx = np.nonzero(m)[0]
+            closer = d < best[idx]
+            owner[idx[closer]] = j
+            best[idx[closer]] = d[closer]
+            role = "id" if cls in ID_CLASSES else ("ignored" if cls in IGNORED_CLASSES else "other")
+            objs.append([role, ID_CLASSES.get(cls, -1), np.asarray(box, np.float64), 0])
+    elif scan.sem is not None:
+        key = scan.sem.astype(np.int64) * 65536 + scan.inst.astype(np.int64)
+        groups = {}
+        for k in np.unique(key[scan.inst > 0]):
+            s = int(k // 65536)
+            if s in SEMKITTI_ID:
+                role, c = "id", SEMKITTI_ID[s]
+            elif s in SEMKITTI_IGNORED:
+                role, c = "ignored", -1
+            else:
+                continue
+            groups[int(k)] = len(objs)
+            objs.append([role, c, None, 0])
+        if groups:
+            ks = np.array(list(groups)), np.array(list(groups.values()))
+            pos = np.searchsorted(ks[0], key)
+            pos = np.clip(pos, 0, len(ks[0]) - 1)
+            hit = ks[0][pos] == key
+            owner[hit] = ks[1][pos[hit]]
+    counts = np.bincount(owner[(owner >= 0) & nonground], minlength=len(objs))
+    for j, o in enumerate(objs):
+        o[3] = int(counts[j])
+    return owner, objs
+
+
+def _in_camera(calib, xyz: np.ndarray) -> np.ndarray:
+    """Points (K, 3) in front of the camera and inside its image."""
+    cam = calib.velo_to_cam_points(xyz)
+    uv = calib.project_rect_to_image(cam)
+    W, H = calib.image_size
+    return (cam[:, 2] > 0.5) & (uv[:, 0] >= 0) & (uv[:, 0] < W) & (uv[:, 1] >= 0) & (uv[:, 1] < H)
+
+
+def _in_dontcare(calib, xyz: np.ndarray, regions) -> np.ndarray:
+    out = np.zeros(len(xyz), bool)
+    if not regions:
+        return out
+    uv = calib.project_rect_to_image(calib.velo_to_cam_points(xyz))
+    for r in regions:
+        out |= (uv[:, 0] >= r[0]) & (uv[:, 0] <= r[2]) & (uv[:, 1] >= r[1]) & (uv[:, 1] <= r[3])
+    return out
+
+
+def process_scan(scan: Scan, sensor: str, cfg: dict) -> dict:
+    """C stages + labels for one scan -> dict of per-proposal arrays (excluded clusters dropped)."""
+    from .. import native
+    pts = np.ascontiguousarray(scan.points, np.float32)
+    # no ring indices: the clustering bindings project from the elevation table (as KITTI scans must)
+    gr = native.ground(pts, sensor)
+    cl = native.cluster(pts, sensor, ground=gr.mask_point, planes=gr.planes)
+    k = len(cl)
+    pr = native.proposals(cl, n_points=cfg["n_points"])
+    nonground = (gr.mask_point == 0) & (gr.image.point_pixel >= 0)
+    owner, objs = _objects(scan, nonground, cfg["margin"])
+    lab = cl.point_labels.astype(np.int64)
+    label = np.full(k, -1, np.int8)
+    keep = np.ones(k, bool)
+    box = np.full((k, 7), np.nan, np.float32)
+    share = np.zeros(k, np.float32)
+    recall = np.zeros(k, np.float32)
+    sem_dom = np.full(k, -1, np.int16)
+    if k:
+        in_cl = lab > 0
+        cid = lab[in_cl] - 1
+        own = owner[in_cl]
+        size = np.bincount(cid, minlength=k)
+        for c in range(k):
+            o = own[cid == c]
+            o = o[o >= 0]
+            if scan.sem is not None:
+                sc = scan.sem[in_cl][cid == c]
+                vals, cnt = np.unique(sc, return_counts=True)
+                sem_dom[c] = int(vals[np.argmax(cnt)])
+            if len(o) == 0:
+                continue
+            vals, cnt = np.unique(o, return_counts=True)
+            j = int(vals[np.argmax(cnt)])
+            sh = float(cnt.max()) / float(size[c])
+            role, cls, bx, nobj = objs[j]
+            rc = float(cnt.max()) / max(nobj, 1)
+            share[c], recall[c] = sh, min(rc, 1.0)
+            if role == "ignored" and sh >= cfg["ignored_share"]:
+                keep[c] = False
+            elif role == "id" and sh >= cfg["purity"] and rc >= cfg["recall"]:
+                label[c] = cls
+                if bx is not None:
+                    box[c] = bx
+        if scan.calib is not None:
+            if scan.fov_only:
+                keep &= _in_camera(scan.calib, pr.mean.astype(np.float64))
+            keep &= ~_in_dontcare(scan.calib, pr.mean.astype(np.float64), scan.dontcare)
+    box_model = np.full((k, 7), np.nan, np.float32)
+    ok = ~np.isnan(box[:, 0])
+    if ok.any():
+        box_model[ok] = box_to_model_frame(box[ok], pr.mean[ok])
+    sel = keep
+    return dict(points=M.to_model_frame(pr.xyz, pr.mean)[sel], xyz=pr.xyz[sel], mean=pr.mean[sel],
+                voxel=pr.voxel[sel], label=label[sel], box=box_model[sel], box_sensor=box[sel],
+                share=share[sel], recall=recall[sel], n_src=pr.n_src[sel].astype(np.int32), sem=sem_dom[sel],
+                n_excluded=int((~keep).sum()),
+                n_objects=np.bincount([o[1] for o in objs if o[0] == "id" and o[3] >= 10], minlength=3))
+
+
+# ---- jobs -------------------------------------------------------------------------------------------
+
+def _job(task, sensor, cfg):
+    kind, split, a, b, c = task
+    if kind == "sim":
+        scan = sim_scan(sensor, a, b, c)
+    elif kind == "kitti":
+        scan = kitti_scan(a, b)
+    else:
+        scan = semkitti_scan(a, b)
+    out = process_scan(scan, sensor, cfg)
+    out["split"] = np.full(len(out["label"]), split, np.int8)
+    out["name"] = scan.name
+    return out
+
+
+def hash_split(name: str) -> int:
+    """Stable split of a folder scan by its name: 70 % train, 15 % val, 15 % test."""
+    h = zlib.crc32(name.encode()) % 100
+    return 0 if h < 70 else (1 if h < 85 else 2)
+
+
+def build_tasks(a) -> list:
+    tasks = []
+    if a.sim:
+        counts = [int(v) for v in a.sim.split(",")]
+        if len(counts) != 3 or min(counts) < 0:
+            raise ValueError("--sim takes three counts: train,val,test")
+        mounts = [float(v) for v in a.mounts.split(",")] if a.mounts else [None]
+        for s, n in enumerate(counts):
+            for i in range(n):
+                tasks.append(("sim", s, a.seed + s, i, mounts[i % len(mounts)]))
+    split_of = (lambda n: SPLITS.index(a.split)) if a.split else hash_split
+    for folder in a.kitti or []:
+        for n in kitti_scans(folder):
+            tasks.append(("kitti", split_of(n), str(folder), n, None))
+    for folder in a.semantickitti or []:
+        for n in semkitti_scans(folder):
+            tasks.append(("semantickitti", split_of(n), str(folder), n, None))
+    return tasks
+
+
+def concat(parts: list) -> dict:
+    keys = ["points", "xyz", "mean", "voxel", "label", "box", "box_sensor", "share", "recall", "n_src", "sem", "split"]
+    out = {k: np.concatenate([p[k] for p in parts]) if parts else np.zeros(0) for k in keys}
+    out["scan"] = np.concatenate([np.full(len(p["label"]), i, np.int32) for i, p in enumerate(parts)]) \
+        if parts else np.zeros(0, np.int32)
+    out["scan_names"] = np.array([p["name"] for p in parts])
+    return out
+
+
+def balance_table(d: dict) -> str:
+    """Markdown table: proposals per split and label."""
+    names = list(M.CLASSES) + ["OOD"]
+    lines = ["| split | scans | " + " | ".join(names) + " | ID share |", "|---|---:|" + "---:|" * (len(names) + 1)]
+    for s, sn in enumerate(SPLITS):
+        m = d["split"] == s
+        if not m.any():
+            continue
+        lab = d["label"][m]
+        cnt = [int((lab == c).sum()) for c in range(3)] + [int((lab < 0).sum())]
+        nscan = len(np.unique(d["scan"][m]))
+        lines.append(f"| {sn} | {nscan} | " + " | ".join(map(str, cnt)) + f" | {100 * sum(cnt[:3]) / max(1, sum(cnt)):.1f} % |")
+    return "\n".join(lines)
+
+
+def load(path) -> dict:
+    """Load a dataset .npz as a dict of arrays (+ meta dict)."""
+    path = pathlib.Path(path)
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: no such dataset (make it with python -m lidet_tools.train.dataset)")
+    with np.load(path, allow_pickle=False) as z:
+        d = {k: z[k] for k in z.files}
+    d["meta"] = json.loads(str(d["meta"])) if "meta" in d else {}
+    return d
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m lidet_tools.train.dataset", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--sensor", default="hdl64", help="sensor profile of the C stages (hdl64, vlp16, ...)")
+    ap.add_argument("--sim", help="simulated scans per split: TRAIN,VAL,TEST (e.g. 160,40,40)")
+    ap.add_argument("--seed", type=int, default=1000, help="simulator run seed of the train split (val +1, test +2)")
+    ap.add_argument("--mounts", help="simulator mount heights in m, cycled over scans (e.g. 0.3,0.5,0.7,1.0)")
+    ap.add_argument("--kitti", action="append", type=pathlib.Path, help="KITTI folder (velodyne/ label_2/ calib/)")
+    ap.add_argument("--semantickitti", action="append", type=pathlib.Path, help="SemanticKITTI folder (velodyne/ labels/)")
+    ap.add_argument("--split", choices=SPLITS, help="split of every folder scan (default: hash of the scan name)")
+    ap.add_argument("--purity", type=float, default=DEFAULTS["purity"])
+    ap.add_argument("--recall", type=float, default=DEFAULTS["recall"])
+    ap.add_argument("--margin", type=float, default=DEFAULTS["margin"])
+    ap.add_argument("--n-points", type=int, default=DEFAULTS["n_points"])
+    ap.add_argument("--jobs", type=int, default=1, help="worker processes")
+    ap.add_argument("--out", type=pathlib.Path, required=True)
+    ap.add_argument("--no-progress", action="store_true")
+    a = ap.parse_args(argv)
+    if not a.sim and not a.kitti and not a.semantickitti:
+        ap.error("give at least one source: --sim, --kitti or --semantickitti")
+    if a.jobs < 1:
+        ap.error("--jobs must be >= 1")
+    try:
+        tasks = build_tasks(a)
+    except (FileNotFoundError, ValueError) as e:
+        print(f"dataset: {e}", file=sys.stderr)
+        return 2
+    cfg = dict(DEFAULTS, purity=a.purity, recall=a.recall, margin=a.margin, n_points=a.n_points)
+    job = functools.partial(_job, sensor=a.sensor, cfg=cfg)
+    t0 = time.perf_counter()
+    parts = [None] * len(tasks)
+    bar = None
+    if not a.no_progress:
+        from tqdm import tqdm
+        bar = tqdm(total=len(tasks), desc=f"proposals {a.sensor}", unit="scan")
+    if a.jobs > 1:
+        import multiprocessing as mp
+        with mp.get_context("spawn").Pool(a.jobs) as pool:
+            for i, r in enumerate(pool.imap(job, tasks, chunksize=2)):
+                parts[i] = r
+                if bar:
+                    bar.update(1)
+    else:
+        for i, t in enumerate(tasks):
+            parts[i] = job(t)
+            if bar:
+                bar.update(1)
+    if bar:
+        bar.close()
+    d = concat(parts)
+    if len(d["label"]) == 0:
+        print("dataset: no proposals (empty scans?)", file=sys.stderr)
+        return 1
+    meta = dict(sensor=a.sensor, sim=a.sim, seed=a.seed, mounts=a.mounts, kitti=[str(p) for p in a.kitti or []],
+                semantickitti=[str(p) for p in a.semantickitti or []], n_excluded=int(sum(p["n_excluded"] for p in parts)),
+                n_objects=[int(v) for v in np.sum([p["n_objects"] for p in parts], axis=0)], **cfg,
+                command="python -m lidet_tools.train.dataset " + " ".join(argv if argv is not None else sys.argv[1:]))
+    a.out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = a.out.with_name(a.out.name + ".tmp.npz")
+    np.savez_compressed(tmp, meta=json.dumps(meta), **d)
+    os.replace(tmp, a.out)
+    dt = time.perf_counter() - t0
+    print(balance_table(d))
+    print(f"excluded (ignored classes, DontCare, outside the camera): {meta['n_excluded']}; "
+          f"labelled ID objects with >= 10 non-ground points: {dict(zip(M.CLASSES, meta['n_objects']))}")
+    print(f"dataset: {len(tasks)} scans -> {len(d['label'])} proposals in {dt:.1f} s -> {a.out}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
