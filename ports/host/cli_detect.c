@@ -661,6 +661,7 @@ int cli_detect(int argc, char **argv)
         cli_json_int(stdout, "out_of_crop", ds->n_out_of_crop);
         cli_json_int(stdout, "out_of_range", ds->n_out_of_range);
         cli_json_int(stdout, "over_budget", ds->n_over_budget);
+        cli_json_int(stdout, "budget", cfg.max_proposals);
         cli_json_int(stdout, "classified", ds->n_classified);
         cli_json_int(stdout, "gate1_rejected", ds->n_gate1_rejected);
         cli_json_int(stdout, "boxed", ds->n_boxed);

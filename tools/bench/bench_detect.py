@@ -122,7 +122,7 @@ def _cli_json(build, scan, sensor, *args):
 
 def _ort_pipeline_ms(scan, sensor, fam, sc, sb, crop, repeats=5):
     """The C stages (bindings) + proposals, then the networks in onnxruntime, batch 1, per proposal, with the
-    same budget (64 nearest), gates and decoding in numpy: median ms per scan."""
+    same budget (nearest first), gates and decoding in numpy: median ms per scan."""
     from lidet_tools import kitti, native
     from lidet_tools.train.models import to_model_frame
     pts = kitti.read_bin(scan)
@@ -136,7 +136,8 @@ def _ort_pipeline_ms(scan, sensor, fam, sc, sb, crop, repeats=5):
         keep = np.ones(len(mean), bool)
         if crop:
             keep &= np.abs(np.arctan2(mean[:, 1], mean[:, 0])) <= np.pi / 4
-        order = np.argsort(np.hypot(mean[:, 0], mean[:, 1]) + np.where(keep, 0, 1e9), kind="stable")[:64]
+        budget = 128 if sensor == "vlp16" else 256  # lidet_detector_cfg_default
+        order = np.argsort(np.hypot(mean[:, 0], mean[:, 1]) + np.where(keep, 0, 1e9), kind="stable")[:budget]
         order = order[keep[order]]
         for i in order:
             mp = to_model_frame(pr.xyz[i:i + 1], mean[i:i + 1])

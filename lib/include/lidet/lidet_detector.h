@@ -76,7 +76,8 @@ typedef struct
                                          camera field of view: pi/4); (0, pi] */
     float max_range_m;              /**< clusters whose mean is farther are not classified; 0 = no limit */
     uint32_t max_proposals;         /**< at most this many clusters classified per scan, nearest first;
-                                         [1, LIDET_MAX_CLUSTERS], default 64 */
+                                         [1, LIDET_MAX_CLUSTERS]; default 256 (> 16 beams), 128 (<= 16 beams),
+                                         capped by LIDET_MAX_CLUSTERS */
     uint8_t gate1;                  /**< 1 (default): drop proposals failing gate 1 */
     uint8_t gate2;                  /**< 1 (default): drop boxes failing gate 2 */
     float nms_iou;                  /**< BEV IoU above which the lower-scored detection is dropped; [0, 1],
@@ -142,8 +143,9 @@ typedef struct
 } lidet_detector_t;
 
 /**
- * @brief Defaults for a sensor: each stage's defaults, 64 points per proposal, 360 degrees, at most 64
- *        proposals, both gates on, NMS at BEV IoU 0.1, the class size ranges of docs/DETECTOR.md.
+ * @brief Defaults for a sensor: each stage's defaults, 64 points per proposal, 360 degrees, at most 256
+ *        proposals (128 for <= 16 beams), both gates on, NMS at BEV IoU 0.1, the class size ranges of
+ *        docs/DETECTOR.md.
  */
 void lidet_detector_cfg_default(lidet_detector_cfg_t *cfg, const lidet_sensor_t *sensor);
 
