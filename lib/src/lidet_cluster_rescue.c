@@ -15,7 +15,8 @@ static inline void rescue_link(lidet_cluster_state_t *c, lidet__rescue_t *rs, ui
 {
     const lidet_range_image_t *img = &c->img;
     const float gg = g->rgap + g->rgpm * (dq < dn ? dq : dn);
-    const float dx = img->x_m[n] - img->x_m[q], dy = img->y_m[n] - img->y_m[q], dz = img->z_m[n] - img->z_m[q];
+    const float dx = lidet__img_x(img, n) - lidet__img_x(img, q), dy = lidet__img_y(img, n) - lidet__img_y(img, q);
+    const float dz = lidet__img_z(img, n) - lidet__img_z(img, q);
     const float dd = dx * dx + dy * dy + dz * dz;
     if (!(dd <= gg * gg))
     {
@@ -44,11 +45,12 @@ typedef struct
 /* Pixel n of q's window: looked at when it is a fragment or kept pixel (labels below LAB_PENDING;
  * visited, dropped and empty pixels are looked past) and its range lies in [lo, hi] (a bound of the
  * distance from below: most pixels stop here, before their coordinates are read) */
-static inline void rescue_probe(lidet_cluster_state_t *c, lidet__rescue_t *rs, const uint16_t *lab, const float *rng,
+static inline void rescue_probe(lidet_cluster_state_t *c, lidet__rescue_t *rs, const uint16_t *lab,
+                                const lidet_range_image_t *rng,
                                 uint32_t n, const window_t *w, const lidet__grow_t *g)
 {
     const uint32_t l = lab[n];
-    const float dn = rng[n];
+    const float dn = lidet__img_range(rng, n);
     if (l < LAB_PENDING && dn >= w->lo && dn <= w->hi && n != w->q)
     {
         rescue_link(c, rs, n, l, dn, w->q, w->dq, g);
@@ -64,7 +66,7 @@ void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g
 {
     const int32_t *mem = c->members;
     const uint16_t *lab = c->labels;
-    const float *rng = c->img.range_m;
+    const lidet_range_image_t *rng = &c->img; /* ranges read through lidet__img_range */
     const uint32_t rows = g->rows, cols = g->cols, wr = g->rrows, wc = g->rcols;
     uint32_t head = start;
     while (head < rs->tail)
@@ -73,7 +75,7 @@ void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g
         const uint32_t r = q / cols, col = q - r * cols;
         const uint32_t r0 = r >= wr ? r - wr : 0u, r1 = r + wr < rows ? r + wr : rows - 1u;
         const uint32_t c0 = col >= wc ? col - wc : col + cols - wc; /* 2 wc < cols: none repeats */
-        const float dq = rng[q];
+        const float dq = lidet__img_range(rng, q);
         /* |d - dq| <= rgap + rgpm * min(d, dq)  <=>  lo <= d <= hi */
         const float hi = dq * (1.0f + g->rgpm) + g->rgap, lo = (dq - g->rgap) / (1.0f + g->rgpm);
         window_t win;

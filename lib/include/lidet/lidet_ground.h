@@ -178,7 +178,8 @@ typedef struct
  *        mask (lidet_ground_samples, a diagnostic). A detector workspace overlays it with the other
  *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + LIDET_GROUND_MAX_SAMPLES * 4 B (a sample
  *        is its pixel: RANSAC reads its coordinates from the image) + LIDET_GROUND_EVAL_MAX * 12 B
- *        + LIDET_GROUND_MAX_SECTORS * 16 B + LIDET_MAX_COLS * 8 B (two rows of R, for images without R).
+ *        + LIDET_GROUND_MAX_SECTORS * 16 B + LIDET_MAX_COLS * 24 B (two rows of R, for images without R;
+ *        two rows of z and one of x and y, decoded, for a compact image).
  */
 typedef struct
 {
@@ -192,6 +193,9 @@ typedef struct
     uint32_t cell_first[2 * LIDET_GROUND_MAX_SECTORS];
     uint32_t cell_n[2 * LIDET_GROUND_MAX_SECTORS];
     float rxy_rows[2][LIDET_MAX_COLS]; /* R of two rows, computed when the image has no R */
+    float z_rows[2][LIDET_MAX_COLS];   /* compact image: z of two rows, decoded */
+    float x_row[LIDET_MAX_COLS];       /* compact image: x and y of one row, decoded */
+    float y_row[LIDET_MAX_COLS];
 } lidet_ground_scratch_t;
 
 /** @brief Ground stage with every buffer inside (the standalone form): state, the ground mask (the
