@@ -337,7 +337,7 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
     const uint32_t cstep = g->cfg.sample_col_step;
     const int two = g->cfg.ring_split_m > 0.0f;
     const float split = two ? g->cfg.ring_split_m : 3.0e38f;
-    uint32_t *const si = sc->sample_pix;
+    lidet_ground_sample_t *const si = sc->sample_pix;
     uint32_t s, r, c, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
     for (s = 0; s < ns; ++s)
     {
@@ -359,7 +359,7 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
                     const float rc = !two ? 0.0f : (R != 0 ? R[c] : pixel_rxy(img, (uint32_t)base + c));
                     const uint32_t far = (uint32_t)(rc >= split), take = m[c];
                     const uint32_t k = far ? hi - 1u : lo; /* lo < hi: roomy leaves a slot per candidate */
-                    si[k] = (uint32_t)base + c;
+                    si[k] = (lidet_ground_sample_t)(base + c);
                     lo += take & (far ^ 1u);
                     hi -= take & far;
                 }
@@ -375,7 +375,7 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
                         {
                             const float rc = !two ? 0.0f : (R != 0 ? R[c] : pixel_rxy(img, (uint32_t)base + c));
                             const uint32_t k = rc >= split ? --hi : lo++;
-                            si[k] = (uint32_t)base + c;
+                            si[k] = (lidet_ground_sample_t)(base + c);
                         }
                     }
                 }

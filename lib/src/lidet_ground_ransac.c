@@ -250,7 +250,7 @@ static uint32_t accumulate(const float *xs, const float *ys, const float *zs, ui
 
 /* The same for the n image pixels idx[0..n) (a cell's samples), gathered in blocks: the same sums, bit
  * for bit, as on a contiguous copy of the points. */
-static uint32_t accumulate_idx(const lidet_range_image_t *img, int compact, const uint32_t *idx, uint32_t n,
+static uint32_t accumulate_idx(const lidet_range_image_t *img, int compact, const lidet_ground_sample_t *idx, uint32_t n,
                                const lidet_plane_t *ref, float thr, const float shift[3], float cov[3][3],
                                float centroid[3])
 {
@@ -303,7 +303,7 @@ static uint32_t score(const float *xs, const float *ys, const float *zs, uint32_
 }
 
 /* score() on the image pixels idx[0, stride, 2 stride, ...) (a cell too large for the scoring copy) */
-static uint32_t score_idx(const lidet_range_image_t *img, int compact, const uint32_t *idx, uint32_t n,
+static uint32_t score_idx(const lidet_range_image_t *img, int compact, const lidet_ground_sample_t *idx, uint32_t n,
                           uint32_t stride, const lidet_plane_t *p, float thr)
 {
     const float nx = p->nx, ny = p->ny, nz = p->nz, d = p->d_m;
@@ -320,7 +320,7 @@ static uint32_t score_idx(const lidet_range_image_t *img, int compact, const uin
 /* RANSAC on one sector (mirrors ref/ground.py: ransac_sector). Returns 1 with *out set when a
  * plane passes every check. */
 static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img,
-                      const uint32_t *idx, uint32_t n, lidet_plane_t *out)
+                      const lidet_ground_sample_t *idx, uint32_t n, lidet_plane_t *out)
 {
     const int compact = lidet__img_compact(img);
     const lidet_ground_cfg_t *cfg = &g->cfg;

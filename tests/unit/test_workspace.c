@@ -94,77 +94,127 @@ static void chain(lidet_range_image_t *img, const lidet_workspace_cfg_t *cfg)
 /* Agreement of the workspace with the float stages: ground labels (share of valid pixels with the same
  * label) and cluster ids (share of valid pixels whose ids correspond: a workspace cluster and a float
  * cluster correspond when each is the other's largest overlap; ids 0 correspond to each other). */
-static uint32_t g_hist[LIDET_MAX_CLUSTERS + 2], g_map_ws[LIDET_MAX_CLUSTERS + 2], g_map_ref[LIDET_MAX_CLUSTERS + 2];
+static uint32_t g_pairs[LIDET_MAX_CLUSTERS + 1][LIDET_MAX_CLUSTERS + 1]; /* [a][b]: pixels labelled a and b */
+static uint32_t g_map_ab[LIDET_MAX_CLUSTERS + 1], g_map_ba[LIDET_MAX_CLUSTERS + 1];
 
-static void best_overlap(const uint16_t *a, const uint16_t *b, uint32_t npix, const uint8_t *valid, uint32_t *map)
+static uint16_t kept(uint16_t l)
 {
-    uint32_t la, p;
-    for (la = 1; la <= LIDET_MAX_CLUSTERS; ++la)
-    {
-        uint32_t best = 0, best_n = 0, lb;
-        memset(g_hist, 0, sizeof g_hist);
-        for (p = 0; p < npix; ++p)
-        {
-            if (valid[p] && a[p] == la && b[p] <= LIDET_MAX_CLUSTERS)
-                ++g_hist[b[p]];
-        }
-        for (lb = 0; lb <= LIDET_MAX_CLUSTERS; ++lb)
-        {
-            if (g_hist[lb] > best_n)
-            {
-                best_n = g_hist[lb];
-                best = lb;
-            }
-        }
-        map[la] = best;
-    }
-    map[0] = 0;
+    return l <= LIDET_MAX_CLUSTERS ? l : 0u; /* labels of pixels in no kept cluster read as 0 */
 }
 
-static uint8_t g_valid[LIDET_MAX_ROWS * LIDET_MAX_COLS];
-
-static void agreement(const uint8_t *gnd_ref, const uint16_t *lab_ref, const lidet_range_image_t *img, double *ground,
-                      double *cluster)
+/* map_ab[a] = the id b overlapping id a most (and map_ba the other way) over the valid pixels */
+static void best_overlap(const uint16_t *a, const uint16_t *b, uint32_t npix, const uint8_t *valid)
 {
-    const uint32_t npix = (uint32_t)img->n_rows * img->n_cols;
-    const uint8_t *gnd_ws = lidet_workspace_ground_mask(&g_ws.ws);
-    const uint16_t *lab_ws = lidet_workspace_labels(&g_ws.ws);
-    uint16_t a, b;
-    uint32_t p, n = 0, same_g = 0, same_c = 0, max_id = 0;
+    uint32_t p, la, lb;
+    memset(g_pairs, 0, sizeof g_pairs);
+    memset(g_map_ab, 0, sizeof g_map_ab);
+    memset(g_map_ba, 0, sizeof g_map_ba);
     for (p = 0; p < npix; ++p)
     {
-        /* a pixel valid in either image (they differ only beyond 131 m) */
-        g_valid[p] = (uint8_t)(img->range_m[p] > 0.0f || g_ws.ws.range_4mm[p] > 0u);
+        if (valid[p])
+            ++g_pairs[kept(a[p])][kept(b[p])];
     }
-    for (p = 0; p < npix; ++p)
+    for (la = 0; la <= LIDET_MAX_CLUSTERS; ++la)
     {
-        a = lab_ws[p] <= LIDET_MAX_CLUSTERS ? lab_ws[p] : 0; /* non-kept labels read as 0 */
-        b = lab_ref[p] <= LIDET_MAX_CLUSTERS ? lab_ref[p] : 0;
-        max_id = a > max_id ? a : max_id;
-        max_id = b > max_id ? b : max_id;
+        for (lb = 0; lb <= LIDET_MAX_CLUSTERS; ++lb)
+        {
+            if (g_pairs[la][lb] > g_pairs[la][g_map_ab[la]])
+                g_map_ab[la] = lb;
+            if (g_pairs[la][lb] > g_pairs[g_map_ba[lb]][lb])
+                g_map_ba[lb] = la;
+        }
     }
-    TEST_ASSERT_TRUE(max_id <= LIDET_MAX_CLUSTERS);
-    best_overlap(lab_ws, lab_ref, npix, g_valid, g_map_ws);
-    best_overlap(lab_ref, lab_ws, npix, g_valid, g_map_ref);
+}
+
+/* Tolerances against the float stages, measured on the shipped scans and the 9 real scans of
+ * ../shared/data/real (docs/MEMORY.md): the clustering alone agrees on >= 99.93 % of the pixels; the
+ * chain agrees on >= 98.7 % (ground) and >= 94.5 % (cluster ids, one real scan where a reseeded float
+ * run agrees on 88.7 %), never more than 0.6 point below a reseeded float run. */
+#define MIN_CLUSTER_STAGE_PCT 99.9
+#define MIN_GROUND_PCT 98.5
+#define MIN_CLUSTER_PCT 94.0
+#define SEED_MARGIN_PCT 1.0
+
+static uint8_t g_valid[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+static uint8_t g_gnd_f[LIDET_MAX_ROWS * LIDET_MAX_COLS], g_gnd_seed[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+static uint16_t g_lab_f[LIDET_MAX_ROWS * LIDET_MAX_COLS], g_lab_seed[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+static lidet_plane_t g_planes_f[2 * LIDET_GROUND_MAX_SECTORS];
+
+/* share of the valid pixels (g_valid) whose ground labels agree (gnd_a, gnd_b NULL: not measured) and
+ * whose cluster ids correspond */
+static void agreement(const uint8_t *gnd_a, const uint16_t *lab_a, const uint8_t *gnd_b, const uint16_t *lab_b,
+                      uint32_t npix, double *ground, double *cluster)
+{
+    uint32_t p, n = 0, same_g = 0, same_c = 0;
+    best_overlap(lab_a, lab_b, npix, g_valid);
     for (p = 0; p < npix; ++p)
     {
+        const uint16_t a = kept(lab_a[p]), b = kept(lab_b[p]);
         if (!g_valid[p])
             continue;
-        a = lab_ws[p] <= LIDET_MAX_CLUSTERS ? lab_ws[p] : 0;
-        b = lab_ref[p] <= LIDET_MAX_CLUSTERS ? lab_ref[p] : 0;
         ++n;
-        same_g += (uint32_t)(gnd_ws[p] == gnd_ref[p]);
-        same_c += (uint32_t)((a == 0 && b == 0) || (a != 0 && b != 0 && g_map_ws[a] == b && g_map_ref[b] == a));
+        same_g += (uint32_t)(gnd_a == NULL || gnd_a[p] == gnd_b[p]);
+        same_c += (uint32_t)((a == 0 && b == 0) || (a != 0 && b != 0 && g_map_ab[a] == b && g_map_ba[b] == a));
     }
     TEST_ASSERT_TRUE(n > 0u);
     *ground = 100.0 * same_g / n;
     *cluster = 100.0 * same_c / n;
 }
 
+/* The workspace against the float stages (the reference) on one scan: ground labels and cluster ids of
+ * the whole chain, and of the clustering alone (on the workspace's image, with the float ground mask).
+ * RANSAC draws its hypotheses from the samples, so a sample more or less moves a sector's plane as much
+ * as another seed would: the chain's agreement is compared with that of the float stages with the next
+ * seed (the noise floor), the clustering's alone with a fixed tolerance (it reads the ranges only). */
+static void against_float(const char *rel, const lidet_workspace_cfg_t *cfg, uint32_t n)
+{
+    lidet_range_image_t img, wimg;
+    lidet_workspace_cfg_t cfg_seed = *cfg;
+    const lidet_plane_t *planes;
+    uint32_t npix, ns, p;
+    double agree_g, agree_c, noise_g, noise_c, stage_g, stage_c;
+
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_init(&g_proj.ws, &cfg->proj));
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_proj_run(&g_proj.ws, g_points, n, 4, NULL)));
+    lidet_proj_image(&g_proj.ws, &img);
+    lidet_workspace_image(&g_ws.ws, &wimg);
+    npix = (uint32_t)img.n_rows * img.n_cols;
+    for (p = 0; p < npix; ++p)
+    {
+        /* a pixel valid in either image (they differ only beyond 131 m) */
+        g_valid[p] = (uint8_t)(img.range_m[p] > 0.0f || wimg.range_4mm[p] > 0u);
+    }
+    chain(&img, cfg);
+    memcpy(g_gnd_f, lidet_ground_mask(&g_ground.ws), npix);
+    memcpy(g_lab_f, lidet_cluster_labels(&g_cluster.ws), npix * sizeof(uint16_t));
+    planes = lidet_ground_planes(&g_ground.ws, &ns);
+    memcpy(g_planes_f, planes, 2u * ns * sizeof(lidet_plane_t));
+    agreement(lidet_workspace_ground_mask(&g_ws.ws), lidet_workspace_labels(&g_ws.ws), g_gnd_f, g_lab_f, npix,
+              &agree_g, &agree_c);
+    /* the clustering alone on the compact image, with the float ground */
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_cluster_run(&g_cluster.ws, &wimg, g_gnd_f, g_planes_f, ns)));
+    agreement(NULL, lidet_cluster_labels(&g_cluster.ws), NULL, g_lab_f, npix, &stage_g, &stage_c);
+    /* the noise floor: the float stages with the next seed */
+    cfg_seed.ground.seed = cfg->ground.seed + 1u;
+    chain(&img, &cfg_seed);
+    memcpy(g_gnd_seed, lidet_ground_mask(&g_ground.ws), npix);
+    memcpy(g_lab_seed, lidet_cluster_labels(&g_cluster.ws), npix * sizeof(uint16_t));
+    agreement(g_gnd_seed, g_lab_seed, g_gnd_f, g_lab_f, npix, &noise_g, &noise_c);
+    printf("%s: 4 mm workspace vs float stages, %% of %u pixels: ground labels %.3f (float, next seed: %.3f), "
+           "cluster ids %.3f (next seed: %.3f), clustering alone %.3f\n",
+           rel, (unsigned)g_proj.ws.state.stats.n_pixels_filled, agree_g, noise_g, agree_c, noise_c, stage_c);
+    (void)stage_g;
+    TEST_ASSERT_TRUE_MESSAGE(stage_c >= MIN_CLUSTER_STAGE_PCT, "clustering alone: agreement with the float stage");
+    TEST_ASSERT_TRUE_MESSAGE(agree_g >= MIN_GROUND_PCT && agree_g >= noise_g - SEED_MARGIN_PCT,
+                             "ground labels: agreement with the float stages");
+    TEST_ASSERT_TRUE_MESSAGE(agree_c >= MIN_CLUSTER_PCT && agree_c >= noise_c - SEED_MARGIN_PCT,
+                             "cluster ids: agreement with the float stages");
+}
+
 /* run the workspace and the standalone stages on one scan: every output equals the stages chained on
  * the compact image made by hand, and agrees with the float stages within the tolerances (the float
  * stages are the reference; the workspace differs from them by the 4 mm rounding only) */
-static void compare_on(const char *rel, const char *sensor_name, double min_ground_pct, double min_cluster_pct)
+static void compare_on(const char *rel, const char *sensor_name)
 {
     const lidet_sensor_t *s = lidet_sensor_find(sensor_name);
     lidet_workspace_cfg_t cfg, cfg_ref;
@@ -175,7 +225,6 @@ static void compare_on(const char *rel, const char *sensor_name, double min_grou
     uint32_t n, npix, ns, k_ws, k_ref, i, np;
     lidet_status_t st_ws, st;
     lidet_workspace_stats_t wst;
-    double agree_g, agree_c;
 
     TEST_ASSERT_NOT_NULL(s);
     n = load_scan(rel);
@@ -202,15 +251,7 @@ static void compare_on(const char *rel, const char *sensor_name, double min_grou
     npix = (uint32_t)wimg.n_rows * wimg.n_cols;
 
     /* 1. the float stages (the reference): agreement within the tolerances */
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_init(&g_proj.ws, &cfg.proj));
-    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_proj_run(&g_proj.ws, g_points, n, 4, NULL)));
-    lidet_proj_image(&g_proj.ws, &img);
-    chain(&img, &cfg);
-    agreement(lidet_ground_mask(&g_ground.ws), lidet_cluster_labels(&g_cluster.ws), &img, &agree_g, &agree_c);
-    printf("%s: workspace (4 mm pixels) vs float stages: ground labels %.3f %%, cluster ids %.3f %% of %u pixels\n",
-           rel, agree_g, agree_c, (unsigned)g_proj.ws.state.stats.n_pixels_filled);
-    TEST_ASSERT_TRUE_MESSAGE(agree_g >= min_ground_pct, "ground labels: agreement with the float stages");
-    TEST_ASSERT_TRUE_MESSAGE(agree_c >= min_cluster_pct, "cluster ids: agreement with the float stages");
+    against_float(rel, &cfg, n);
 
     /* 2. the stages chained by hand on the compact image: equal, bit for bit */
     cfg_ref = cfg;
@@ -270,18 +311,14 @@ static void compare_on(const char *rel, const char *sensor_name, double min_grou
     TEST_ASSERT_EQUAL_MEMORY(g_gnd_ref, g_gnd_ws, n);
 }
 
-/* tolerances against the float stages (issue 16's agreement targets for the integer build) */
-#define MIN_GROUND_PCT 90.0
-#define MIN_CLUSTER_PCT 90.0
-
 static void test_workspace_matches_stages_vlp16(void)
 {
-    compare_on("tests/data/sim_vlp16/velodyne/000000.bin", "vlp16", MIN_GROUND_PCT, MIN_CLUSTER_PCT);
+    compare_on("tests/data/sim_vlp16/velodyne/000000.bin", "vlp16");
 }
 
 static void test_workspace_matches_stages_hdl64(void)
 {
-    compare_on("tests/data/sim_hdl64/velodyne/000000.bin", "hdl64", MIN_GROUND_PCT, MIN_CLUSTER_PCT);
+    compare_on("tests/data/sim_hdl64/velodyne/000000.bin", "hdl64");
 }
 
 /* real HDL-64 scans of ../shared/data/real, when present (not shipped: KITTI licence) */
@@ -303,7 +340,7 @@ static void test_workspace_real_scans(void)
         if (f == NULL)
             continue;
         fclose(f);
-        compare_on(scans[i], "hdl64", MIN_GROUND_PCT, MIN_CLUSTER_PCT);
+        compare_on(scans[i], "hdl64");
         ++ran;
     }
     if (ran == 0u)

@@ -173,18 +173,26 @@ typedef struct
     lidet_ground_stats_t stats;
 } lidet_ground_state_t;
 
+/** @brief A ground sample: its pixel index. 2 B when every pixel index of the build fits (LIDET_MAX_ROWS
+ *         * LIDET_MAX_COLS <= 65536, e.g. VLP-16 16 x 1800), else 4 B. */
+#if LIDET_MAX_ROWS * LIDET_MAX_COLS <= 65536L
+typedef uint16_t lidet_ground_sample_t;
+#else
+typedef uint32_t lidet_ground_sample_t;
+#endif
+
 /**
  * @brief Scratch of one ground run: nothing in it is read after the run returns except the sample
  *        mask (lidet_ground_samples, a diagnostic). A detector workspace overlays it with the other
- *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + LIDET_GROUND_MAX_SAMPLES * 4 B (a sample
- *        is its pixel: RANSAC reads its coordinates from the image) + LIDET_GROUND_EVAL_MAX * 12 B
+ *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + LIDET_GROUND_MAX_SAMPLES * 2 or 4 B (a
+ *        sample is its pixel, lidet_ground_sample_t: RANSAC reads its coordinates from the image) + LIDET_GROUND_EVAL_MAX * 12 B
  *        + LIDET_GROUND_MAX_SECTORS * 16 B + LIDET_MAX_COLS * 24 B (two rows of R, for images without R;
  *        two rows of z and one of x and y, decoded, for a compact image).
  */
 typedef struct
 {
     uint8_t sample[LIDET_MAX_ROWS * LIDET_MAX_COLS];     /* 1 sample of the filter */
-    uint32_t sample_pix[LIDET_GROUND_MAX_SAMPLES];       /* samples (their pixels), grouped by cell */
+    lidet_ground_sample_t sample_pix[LIDET_GROUND_MAX_SAMPLES]; /* samples (their pixels), grouped by cell */
     float ev_x_m[LIDET_GROUND_EVAL_MAX];                 /* a cell's strided scoring subset */
     float ev_y_m[LIDET_GROUND_EVAL_MAX];
     float ev_z_m[LIDET_GROUND_EVAL_MAX];
