@@ -238,7 +238,9 @@ lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cf
  * @param[in]     img range image from lidet_proj_image (or built by hand with the same contract:
  *                    row 0 = top beam, rows ordered by decreasing elevation, empty pixels 0 in every
  *                    float array). x, y, z are read; R when given (else computed row by row);
- *                    point_idx is not read. Not retained.
+ *                    point_idx is not read. A compact image (x_m NULL, x_4mm ... set, as a
+ *                    workspace's) is read too: its rows are decoded into the scratch, R computed
+ *                    from the decoded x, y. Not retained.
  * @return LIDET_OK; LIDET_TRUNCATED when more than LIDET_GROUND_MAX_SAMPLES pixels passed the filter
  *         (the excess, last sectors first, is counted in stats.n_samples_dropped and not used);
  *         LIDET_ERR_ARG (NULL, NULL x, y or z); LIDET_ERR_STATE (not initialised);

@@ -19,9 +19,11 @@
  *    (monotonic in azimuth, 0 at +-180 deg, 2 at +x, 4 just before -180 deg), against the D of
  *    every column edge, found the same way. One division, no polynomial; the only error is float
  *    rounding (max 1e-5 deg, measured in docs/BENCHMARKS.md).
- * Points that are NaN/Inf, closer than min_range_m, farther than max_range_m (if set), outside the
- * vertical field of view, or with an invalid ring index are counted per reason and skipped before any
- * float -> int conversion.
+ * Points that are NaN/Inf, closer than min_range_m, farther than max_range_m (if set; when writing a
+ * compact image, farther than LIDET_PIXEL_MAX_RANGE_M = 131 m too), outside the vertical field of
+ * view, or with an invalid ring index are counted per reason and skipped before any float -> int
+ * conversion. The image is float (lidet_proj_t) or, into caller buffers, compact: int16 x, y, z and
+ * uint16 range in 4 mm steps (lidet_proj_buffers_t, lidet_range_image_t), the float values rounded.
  *
  * Memory: lidet_proj_t holds every buffer, sizeof = LIDET_MAX_ROWS * LIDET_MAX_COLS * 24 B (x, y, z,
  * range, R as float, winning point as int32) + LIDET_MAX_POINTS * 4 B (pixel of each input point)
