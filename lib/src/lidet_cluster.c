@@ -506,7 +506,8 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
             const uint16_t *qrng = img->range_4mm;
             for (p = 0; p < npix; ++p)
             {
-                const uint32_t cand = (uint32_t)(qrng[p] > 0u) & (uint32_t)(ground_mask == 0 || ground_mask[p] == 0);
+                const uint32_t cand =
+                    (uint32_t)(qrng[p] > 0u) & (uint32_t)(ground_mask == 0 || ground_mask[p] == 0);
                 lab[p] = (uint16_t)(cand - 1u);
                 n_cand += cand;
             }

@@ -207,8 +207,8 @@ static uint32_t search_wrap(lidet_cluster_state_t *c, uint32_t tail, float dq, u
  * members[head] for head = start .. tail (the member array is the queue, every pixel is pushed at
  * most once). Returns the new tail. Directions in the reference's order: right, left, down, up, then
  * the diagonals down-left, down-right, up-left, up-right. occl is a constant at each call site. */
-static inline uint32_t grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start, uint32_t tail, int occl,
-                            int compact)
+static inline uint32_t grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start, uint32_t tail,
+                            int occl, int compact)
 {
     uint16_t *lab = c->labels;
     int32_t *mem = c->members;
@@ -261,11 +261,13 @@ static inline uint32_t grow(lidet_cluster_state_t *c, const lidet__grow_t *g, ui
             if (r + 1u < rows)
             {
                 const uint32_t dl = rowbase + cols + cl, dr = rowbase + cols + cr;
-                if (lab[dl] == LAB_FREE && link(dq, rng_at(rng, dl, compact), c->diag_sin[r], c->diag_cos[r], g))
+                if (lab[dl] == LAB_FREE &&
+                    link(dq, rng_at(rng, dl, compact), c->diag_sin[r], c->diag_cos[r], g))
                 {
                     tail = take(lab, mem, tail, dl);
                 }
-                if (lab[dr] == LAB_FREE && link(dq, rng_at(rng, dr, compact), c->diag_sin[r], c->diag_cos[r], g))
+                if (lab[dr] == LAB_FREE &&
+                    link(dq, rng_at(rng, dr, compact), c->diag_sin[r], c->diag_cos[r], g))
                 {
                     tail = take(lab, mem, tail, dr);
                 }
@@ -273,11 +275,13 @@ static inline uint32_t grow(lidet_cluster_state_t *c, const lidet__grow_t *g, ui
             if (r > 0u)
             {
                 const uint32_t ul = rowbase - cols + cl, ur = rowbase - cols + cr;
-                if (lab[ul] == LAB_FREE && link(dq, rng_at(rng, ul, compact), c->diag_sin[r - 1u], c->diag_cos[r - 1u], g))
+                if (lab[ul] == LAB_FREE &&
+                    link(dq, rng_at(rng, ul, compact), c->diag_sin[r - 1u], c->diag_cos[r - 1u], g))
                 {
                     tail = take(lab, mem, tail, ul);
                 }
-                if (lab[ur] == LAB_FREE && link(dq, rng_at(rng, ur, compact), c->diag_sin[r - 1u], c->diag_cos[r - 1u], g))
+                if (lab[ur] == LAB_FREE &&
+                    link(dq, rng_at(rng, ur, compact), c->diag_sin[r - 1u], c->diag_cos[r - 1u], g))
                 {
                     tail = take(lab, mem, tail, ur);
                 }

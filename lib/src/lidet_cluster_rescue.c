@@ -15,7 +15,8 @@ static inline void rescue_link(lidet_cluster_state_t *c, lidet__rescue_t *rs, ui
 {
     const lidet_range_image_t *img = &c->img;
     const float gg = g->rgap + g->rgpm * (dq < dn ? dq : dn);
-    const float dx = lidet__img_x(img, n) - lidet__img_x(img, q), dy = lidet__img_y(img, n) - lidet__img_y(img, q);
+    const float dx = lidet__img_x(img, n) - lidet__img_x(img, q);
+    const float dy = lidet__img_y(img, n) - lidet__img_y(img, q);
     const float dz = lidet__img_z(img, n) - lidet__img_z(img, q);
     const float dd = dx * dx + dy * dy + dz * dz;
     if (!(dd <= gg * gg))
@@ -46,8 +47,8 @@ typedef struct
  * visited, dropped and empty pixels are looked past) and its range lies in [lo, hi] (a bound of the
  * distance from below: most pixels stop here, before their coordinates are read) */
 static inline void rescue_probe(lidet_cluster_state_t *c, lidet__rescue_t *rs, const uint16_t *lab,
-                                const lidet_range_image_t *rng,
-                                uint32_t n, const window_t *w, const lidet__grow_t *g)
+                                const lidet_range_image_t *rng, uint32_t n, const window_t *w,
+                                const lidet__grow_t *g)
 {
     const uint32_t l = lab[n];
     const float dn = lidet__img_range(rng, n);

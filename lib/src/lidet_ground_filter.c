@@ -373,7 +373,8 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
                         ++total;
                         if (lo < hi)
                         {
-                            const float rc = !two ? 0.0f : (R != 0 ? R[c] : pixel_rxy(img, (uint32_t)base + c));
+                            const float rc =
+                                !two ? 0.0f : (R != 0 ? R[c] : pixel_rxy(img, (uint32_t)base + c));
                             const uint32_t k = rc >= split ? --hi : lo++;
                             si[k] = (lidet_ground_sample_t)(base + c);
                         }

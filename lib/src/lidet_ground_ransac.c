@@ -250,9 +250,9 @@ static uint32_t accumulate(const float *xs, const float *ys, const float *zs, ui
 
 /* The same for the n image pixels idx[0..n) (a cell's samples), gathered in blocks: the same sums, bit
  * for bit, as on a contiguous copy of the points. */
-static uint32_t accumulate_idx(const lidet_range_image_t *img, int compact, const lidet_ground_sample_t *idx, uint32_t n,
-                               const lidet_plane_t *ref, float thr, const float shift[3], float cov[3][3],
-                               float centroid[3])
+static uint32_t accumulate_idx(const lidet_range_image_t *img, int compact, const lidet_ground_sample_t *idx,
+                               uint32_t n, const lidet_plane_t *ref, float thr, const float shift[3],
+                               float cov[3][3], float centroid[3])
 {
     float bx[GATHER_BLOCK], by[GATHER_BLOCK], bz[GATHER_BLOCK];
     moments_t mo;
@@ -303,8 +303,8 @@ static uint32_t score(const float *xs, const float *ys, const float *zs, uint32_
 }
 
 /* score() on the image pixels idx[0, stride, 2 stride, ...) (a cell too large for the scoring copy) */
-static uint32_t score_idx(const lidet_range_image_t *img, int compact, const lidet_ground_sample_t *idx, uint32_t n,
-                          uint32_t stride, const lidet_plane_t *p, float thr)
+static uint32_t score_idx(const lidet_range_image_t *img, int compact, const lidet_ground_sample_t *idx,
+                          uint32_t n, uint32_t stride, const lidet_plane_t *p, float thr)
 {
     const float nx = p->nx, ny = p->ny, nz = p->nz, d = p->d_m;
     uint32_t i, cnt = 0;

@@ -315,8 +315,8 @@ static inline int32_t to_4mm(float v)
  * squared ranges (an empty pixel reads record 0 masked to +0); (b) the rounding, in a loop without
  * branches that compilers vectorise. */
 #define COMPACT_BLOCK 192u
-static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *points, uint32_t stride, uint32_t npix,
-                              int any)
+static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *points, uint32_t stride,
+                              uint32_t npix, int any)
 {
     static const float zero_rec[3] = {0.0f, 0.0f, 0.0f};
     const float *const src = any ? points : zero_rec;

@@ -88,7 +88,8 @@ static void chain(lidet_range_image_t *img, const lidet_workspace_cfg_t *cfg)
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g_cluster.ws, &cfg->cluster));
     TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_ground_run(&g_ground.ws, img)));
     planes = lidet_ground_planes(&g_ground.ws, &ns);
-    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_cluster_run(&g_cluster.ws, img, lidet_ground_mask(&g_ground.ws), planes, ns)));
+    TEST_ASSERT_TRUE(
+        LIDET_SUCCEEDED(lidet_cluster_run(&g_cluster.ws, img, lidet_ground_mask(&g_ground.ws), planes, ns)));
 }
 
 /* Agreement of the workspace with the float stages: ground labels (share of valid pixels with the same
@@ -142,8 +143,8 @@ static lidet_plane_t g_planes_f[2 * LIDET_GROUND_MAX_SECTORS];
 
 /* share of the valid pixels (g_valid) whose ground labels agree (gnd_a, gnd_b NULL: not measured) and
  * whose cluster ids correspond */
-static void agreement(const uint8_t *gnd_a, const uint16_t *lab_a, const uint8_t *gnd_b, const uint16_t *lab_b,
-                      uint32_t npix, double *ground, double *cluster)
+static void agreement(const uint8_t *gnd_a, const uint16_t *lab_a, const uint8_t *gnd_b,
+                      const uint16_t *lab_b, uint32_t npix, double *ground, double *cluster)
 {
     uint32_t p, n = 0, same_g = 0, same_c = 0;
     best_overlap(lab_a, lab_b, npix, g_valid);
@@ -154,7 +155,8 @@ static void agreement(const uint8_t *gnd_a, const uint16_t *lab_a, const uint8_t
             continue;
         ++n;
         same_g += (uint32_t)(gnd_a == NULL || gnd_a[p] == gnd_b[p]);
-        same_c += (uint32_t)((a == 0 && b == 0) || (a != 0 && b != 0 && g_map_ab[a] == b && g_map_ba[b] == a));
+        same_c +=
+            (uint32_t)((a == 0 && b == 0) || (a != 0 && b != 0 && g_map_ab[a] == b && g_map_ba[b] == a));
     }
     TEST_ASSERT_TRUE(n > 0u);
     *ground = 100.0 * same_g / n;
@@ -200,11 +202,12 @@ static void against_float(const char *rel, const lidet_workspace_cfg_t *cfg, uin
     memcpy(g_gnd_seed, lidet_ground_mask(&g_ground.ws), npix);
     memcpy(g_lab_seed, lidet_cluster_labels(&g_cluster.ws), npix * sizeof(uint16_t));
     agreement(g_gnd_seed, g_lab_seed, g_gnd_f, g_lab_f, npix, &noise_g, &noise_c);
-    printf("%s: 4 mm workspace vs float stages, %% of %u pixels: ground labels %.3f (float, next seed: %.3f), "
-           "cluster ids %.3f (next seed: %.3f), clustering alone %.3f\n",
+    printf("%s: 4 mm workspace vs float stages, %% of %u pixels: ground labels %.3f "
+           "(float, next seed: %.3f), cluster ids %.3f (next seed: %.3f), clustering alone %.3f\n",
            rel, (unsigned)g_proj.ws.state.stats.n_pixels_filled, agree_g, noise_g, agree_c, noise_c, stage_c);
     (void)stage_g;
-    TEST_ASSERT_TRUE_MESSAGE(stage_c >= MIN_CLUSTER_STAGE_PCT, "clustering alone: agreement with the float stage");
+    TEST_ASSERT_TRUE_MESSAGE(stage_c >= MIN_CLUSTER_STAGE_PCT,
+                             "clustering alone: agreement with the float stage");
     TEST_ASSERT_TRUE_MESSAGE(agree_g >= MIN_GROUND_PCT && agree_g >= noise_g - SEED_MARGIN_PCT,
                              "ground labels: agreement with the float stages");
     TEST_ASSERT_TRUE_MESSAGE(agree_c >= MIN_CLUSTER_PCT && agree_c >= noise_c - SEED_MARGIN_PCT,
@@ -324,12 +327,15 @@ static void test_workspace_matches_stages_hdl64(void)
 /* real HDL-64 scans of ../shared/data/real, when present (not shipped: KITTI licence) */
 static void test_workspace_real_scans(void)
 {
-    static const char *const scans[] = {
-        "../shared/data/real/semantickitti/velodyne/00_000000.bin", "../shared/data/real/semantickitti/velodyne/00_000001.bin",
-        "../shared/data/real/semantickitti/velodyne/00_000002.bin", "../shared/data/real/semantickitti/velodyne/00_000003.bin",
-        "../shared/data/real/semantickitti/velodyne/00_000004.bin", "../shared/data/real/semantickitti/velodyne/00_000005.bin",
-        "../shared/data/real/kitti/training/velodyne/000000.bin",   "../shared/data/real/kitti/training/velodyne/000001.bin",
-        "../shared/data/real/kitti/training/velodyne/000002.bin"};
+    static const char *const scans[] = {"../shared/data/real/semantickitti/velodyne/00_000000.bin",
+                                         "../shared/data/real/semantickitti/velodyne/00_000001.bin",
+                                         "../shared/data/real/semantickitti/velodyne/00_000002.bin",
+                                         "../shared/data/real/semantickitti/velodyne/00_000003.bin",
+                                         "../shared/data/real/semantickitti/velodyne/00_000004.bin",
+                                         "../shared/data/real/semantickitti/velodyne/00_000005.bin",
+                                         "../shared/data/real/kitti/training/velodyne/000000.bin",
+                                         "../shared/data/real/kitti/training/velodyne/000001.bin",
+                                         "../shared/data/real/kitti/training/velodyne/000002.bin"};
     char path[512];
     FILE *f;
     uint32_t i, ran = 0;

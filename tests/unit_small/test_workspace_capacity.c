@@ -157,7 +157,8 @@ static void test_sizes_at_tiny_capacities(void)
 {
     lidet_workspace_sizes_t s;
     lidet_workspace_sizes(&s);
-    /* 16 x 64 pixels: 8 B image (int16 x, y, z, range) + 1 B mask per pixel, the overlay the largest of its parts */
+    /* 16 x 64 pixels: 8 B image (int16 x, y, z, range) + 1 B mask per pixel, the overlay the largest of
+     * its parts */
     TEST_ASSERT_EQUAL_UINT32(8u * 1024u, s.image);
     TEST_ASSERT_EQUAL_UINT32(1024u, s.ground_mask);
     TEST_ASSERT_EQUAL_UINT32(lidet_ground_scratch_bytes(), s.overlay_ground);

@@ -21,12 +21,13 @@ int main(void)
     {
         const lidet_detector_t *d = 0; /* sizeof only: never dereferenced */
         const uint32_t pn_states = (uint32_t)(sizeof d->cls + sizeof d->box);
-        const uint32_t parts = (uint32_t)(sizeof d->ws + sizeof d->pn_scratch + sizeof d->proposal + sizeof d->det) +
-                               pn_states;
-        printf("det_workspace %u\ndet_pn_scratch %u\ndet_pn_states %u\ndet_proposal %u\ndet_detections %u\n",
-               (unsigned)sizeof d->ws, (unsigned)sizeof d->pn_scratch, pn_states, (unsigned)sizeof d->proposal,
-               (unsigned)sizeof d->det);
-        printf("det_rest %u\ndetector %u\n", (unsigned)(lidet_detector_bytes() - parts), (unsigned)lidet_detector_bytes());
+        const uint32_t parts =
+            (uint32_t)(sizeof d->ws + sizeof d->pn_scratch + sizeof d->proposal + sizeof d->det) + pn_states;
+        printf("det_workspace %u\ndet_pn_scratch %u\ndet_pn_states %u\n", (unsigned)sizeof d->ws,
+               (unsigned)sizeof d->pn_scratch, pn_states);
+        printf("det_proposal %u\ndet_detections %u\n", (unsigned)sizeof d->proposal, (unsigned)sizeof d->det);
+        printf("det_rest %u\ndetector %u\n", (unsigned)(lidet_detector_bytes() - parts),
+               (unsigned)lidet_detector_bytes());
     }
     return 0;
 }

@@ -185,7 +185,8 @@ typedef uint32_t lidet_ground_sample_t;
  * @brief Scratch of one ground run: nothing in it is read after the run returns except the sample
  *        mask (lidet_ground_samples, a diagnostic). A detector workspace overlays it with the other
  *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + LIDET_GROUND_MAX_SAMPLES * 2 or 4 B (a
- *        sample is its pixel, lidet_ground_sample_t: RANSAC reads its coordinates from the image) + LIDET_GROUND_EVAL_MAX * 12 B
+ *        sample is its pixel, lidet_ground_sample_t: RANSAC reads its coordinates from the image)
+ *        + LIDET_GROUND_EVAL_MAX * 12 B
  *        + LIDET_GROUND_MAX_SECTORS * 16 B + LIDET_MAX_COLS * 24 B (two rows of R, for images without R;
  *        two rows of z and one of x and y, decoded, for a compact image).
  */

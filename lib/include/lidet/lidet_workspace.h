@@ -35,7 +35,8 @@
  * Bytes (lidet_workspace_sizes reports each part): states ~ LIDET_MAX_COLS * 12 B + LIDET_PROJ_ROW_LUT B
  * + LIDET_MAX_CLUSTERS * 60 B + LIDET_GROUND_MAX_SECTORS * 34 B; per pixel 9 B (x, y, z, range, ground
  * mask) + the overlay, the largest of 4 B (projection), 1 B + (LIDET_GROUND_MAX_SAMPLES / pixels) * 4 B
- * + 24 B per column (ground) and 6 B (clustering). Declare it static, or place it with the port's section macro
+ * + 24 B per column (ground) and 6 B (clustering). Declare it static, or place it with the port's section
+ * macro
  * (LIDET_WORKSPACE_SECTION, lidet_port.h).
  * Time: the sum of the three stages, plus two passes over the pixels for R (vectorised). No allocation.
  */
