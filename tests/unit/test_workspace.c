@@ -378,6 +378,52 @@ static void test_workspace_errors(void)
     TEST_ASSERT_EQUAL_UINT32(0, pcfg.n_points);
 }
 
+/* The compact image spans +-131 m: farther points are dropped by the projection and counted as too far,
+ * never wrapped into int16; points within it keep their coordinates to 2 mm (half a step) */
+static void test_workspace_compact_span(void)
+{
+    static const float far_pts[][4] = {
+        {130.9f, 0.0f, 0.0f, 0.0f},   /* kept: 32725 steps */
+        {0.0f, -130.0f, -1.0f, 0.0f}, /* kept */
+        {131.5f, 0.0f, 0.0f, 0.0f},   /* beyond 131 m: dropped */
+        {-200.0f, 10.0f, 0.0f, 0.0f}, /* dropped (would wrap int16) */
+        {0.0f, 0.0f, 0.05f, 0.0f}};   /* too close */
+    lidet_workspace_cfg_t cfg;
+    lidet_workspace_stats_t st;
+    lidet_range_image_t wimg;
+    uint32_t p, npix, n_valid = 0;
+    lidet_workspace_cfg_default(&cfg, lidet_sensor_find("vlp16"));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_workspace_init(&g_ws.ws, &cfg));
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_workspace_run(&g_ws.ws, &far_pts[0][0], 5, 4, NULL, NULL)));
+    lidet_workspace_stats(&g_ws.ws, &st);
+    TEST_ASSERT_EQUAL_UINT32(2u, st.proj.n_too_far);
+    TEST_ASSERT_EQUAL_UINT32(1u, st.proj.n_too_close);
+    TEST_ASSERT_EQUAL_UINT32(2u, st.proj.n_pixels_filled);
+    lidet_workspace_image(&g_ws.ws, &wimg);
+    npix = (uint32_t)wimg.n_rows * wimg.n_cols;
+    for (p = 0; p < npix; ++p)
+    {
+        if (wimg.range_4mm[p] == 0u)
+        {
+            TEST_ASSERT_TRUE(wimg.x_4mm[p] == 0 && wimg.y_4mm[p] == 0 && wimg.z_4mm[p] == 0);
+            continue;
+        }
+        ++n_valid;
+        if (wimg.x_4mm[p] > 0)
+        {
+            TEST_ASSERT_EQUAL_INT16(32725, wimg.x_4mm[p]); /* 130.9 m */
+            TEST_ASSERT_EQUAL_UINT16(32725, wimg.range_4mm[p]);
+        }
+        else
+        {
+            TEST_ASSERT_EQUAL_INT16(-32500, wimg.y_4mm[p]);
+            TEST_ASSERT_EQUAL_INT16(-250, wimg.z_4mm[p]);
+            TEST_ASSERT_EQUAL_UINT16(32501, wimg.range_4mm[p]); /* 130.0038 m */
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT32(2u, n_valid);
+}
+
 static void test_workspace_sizes(void)
 {
     lidet_workspace_sizes_t s;
@@ -409,6 +455,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_workspace_sizes);
     RUN_TEST(test_workspace_errors);
+    RUN_TEST(test_workspace_compact_span);
     RUN_TEST(test_workspace_matches_stages_vlp16);
     RUN_TEST(test_workspace_matches_stages_hdl64);
     RUN_TEST(test_workspace_real_scans);
