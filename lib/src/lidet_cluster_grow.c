@@ -54,8 +54,10 @@ void lidet__cluster_setup_geometry(lidet_cluster_state_t *c, const lidet_range_i
     c->geo_cols = (uint16_t)cols;
 }
 
-/* The ranges the flood fill reads: the float image's, or the compact image's 4 mm steps decoded where
- * read. compact is a constant in each copy of grow() (lidet__cluster_grow), so the test folds away. */
+/* The ranges the flood fill reads: the float image's in metres, or the compact image's in 4 mm steps
+ * (converted to float, not scaled: the angle test is homogeneous in the ranges, and the gap bound is
+ * scaled to steps once, in lidet__cluster_grow). compact is a constant in each copy of grow(), so the
+ * test folds away. */
 typedef struct
 {
     const float *f;
@@ -72,7 +74,7 @@ static inline rng_t rng_view(const lidet_range_image_t *img)
 
 static inline float rng_at(rng_t v, uint32_t n, int compact)
 {
-    return compact ? lidet__pix_m(v.q[n]) : v.f[n];
+    return compact ? (float)v.q[n] : v.f[n];
 }
 
 /* beta > theta  <=>  d2 sin(a) > tan(theta) (d1 - d2 cos(a)), d1 >= d2 (true when the bracket <= 0).
@@ -294,9 +296,12 @@ static inline uint32_t grow(lidet_cluster_state_t *c, const lidet__grow_t *g, ui
 uint32_t lidet__cluster_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start, uint32_t tail)
 {
     /* four copies of the flood fill, with the occluder rule and the image format constants in each */
+    lidet__grow_t gs;
     if (!lidet__img_compact(&c->img))
     {
         return c->cfg.bridge_occluders != 0 ? grow(c, g, start, tail, 1, 0) : grow(c, g, start, tail, 0, 0);
     }
-    return c->cfg.bridge_occluders != 0 ? grow(c, g, start, tail, 1, 1) : grow(c, g, start, tail, 0, 1);
+    gs = *g; /* ranges in 4 mm steps: the gap bound in steps (gap_per_m is a ratio) */
+    gs.gap = g->gap * LIDET_PIXEL_PER_M;
+    return c->cfg.bridge_occluders != 0 ? grow(c, &gs, start, tail, 1, 1) : grow(c, &gs, start, tail, 0, 1);
 }
