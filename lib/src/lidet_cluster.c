@@ -103,11 +103,10 @@ static uint32_t smallest_slot(const lidet_cluster_state_t *c)
 /* sum, min and max of the points of members[start, tail) (tail > start). Returns 1 (the sums then
  * incomplete) as soon as an x, y or z extent exceeds max_extent: the test runs after every block of
  * 64 members, so a wall stops early instead of being summed to its end */
-static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, float max_extent, float sum[3],
-                        float lo[3], float hi[3])
+static inline int member_stats_of(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, float max_extent,
+                                  float sum[3], float lo[3], float hi[3], int compact)
 {
     const lidet_range_image_t *img = &c->img;
-    const int compact = lidet__img_compact(img);
     const int32_t *mem = c->members;
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
     float lx, ly, lz, hx, hy, hz;
@@ -145,6 +144,14 @@ static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t
     hi[1] = hy;
     hi[2] = hz;
     return over != 0u;
+}
+
+/* member_stats_of with the image format a constant in each copy */
+static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, float max_extent, float sum[3],
+                        float lo[3], float hi[3])
+{
+    return lidet__img_compact(&c->img) ? member_stats_of(c, start, tail, max_extent, sum, lo, hi, 1)
+                                       : member_stats_of(c, start, tail, max_extent, sum, lo, hi, 0);
 }
 
 /* height of `mean` above the ground plane of the sector of the seed's column (or the flat ground) */

@@ -218,6 +218,15 @@ static const float *rxy_row(rxy_rows_t *rr, uint32_t r)
                 out[c] = lidet__rxy(x[c], y[c]);
             }
         }
+        else if (rr->xyrow_in == (int32_t)r)
+        {
+            /* x and y of this row are decoded already (the label pass decodes them first) */
+            const float *x = rr->xrow, *y = rr->yrow;
+            for (c = 0; c < cols; ++c)
+            {
+                out[c] = lidet__rxy(x[c], y[c]);
+            }
+        }
         else
         {
             const int16_t *x = rr->img->x_4mm + base, *y = rr->img->y_4mm + base;
@@ -499,10 +508,13 @@ static void label_rows(lidet_ground_state_t *g, uint8_t *mask, rxy_rows_t *rr, c
     for (r = 0; r < rows; ++r)
     {
         const size_t base = (size_t)r * cols;
-        const float *X, *Y, *Z = z_row(rr, r), *R = rxy_row(rr, r);
-        const float *Ru = r > 0u ? rxy_row(rr, r - 1u) : R, *Zu = r > 0u ? z_row(rr, r - 1u) : Z;
+        const float *X, *Y, *Z, *R, *Ru, *Zu;
         uint8_t *out = mask + base;
-        xy_row(rr, r, &X, &Y);
+        xy_row(rr, r, &X, &Y); /* first: a compact image's R of row r is then computed from them */
+        Z = z_row(rr, r);
+        R = rxy_row(rr, r);
+        Ru = r > 0u ? rxy_row(rr, r - 1u) : R;
+        Zu = r > 0u ? z_row(rr, r - 1u) : Z;
         for (s = 0; s < ns; ++s)
         {
             const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);

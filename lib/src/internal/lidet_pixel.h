@@ -47,6 +47,12 @@ static inline float lidet__img_range(const lidet_range_image_t *img, uint32_t p)
     return img->x_m != 0 ? img->range_m[p] : lidet__pix_m(img->range_4mm[p]);
 }
 
+/* the range of pixel p; `compact` a constant at the call in hot loops (lidet__img_compact(img)) */
+static inline float lidet__img_range_c(const lidet_range_image_t *img, uint32_t p, int compact)
+{
+    return compact ? lidet__pix_m(img->range_4mm[p]) : img->range_m[p];
+}
+
 /* x, y, z of pixel p; `compact` a constant at the call in hot loops (lidet__img_compact(img)) */
 static inline void lidet__img_xyz(const lidet_range_image_t *img, uint32_t p, int compact, float *x, float *y,
                                   float *z)
