@@ -157,8 +157,9 @@ typedef struct
     int16_t *x_4mm, *y_4mm, *z_4mm; /**< compact image (x_m NULL): the coordinates in 4 mm steps; points
                                          beyond LIDET_PIXEL_MAX_RANGE_M are then dropped (n_too_far) */
     uint16_t *range_4mm;    /**< compact image: the range in 4 mm steps, >= 1 for valid pixels, else 0 */
-    float *rxy_m;           /**< optional (NULL: not produced): R = sqrt(x^2 + y^2); the ground stage
-                                 computes it itself when the image has none */
+    float *rxy_m;           /**< optional (NULL: not produced), float image only (a compact run does not
+                                 write it): R = sqrt(x^2 + y^2); the ground stage computes it itself when
+                                 the image has none */
     int32_t *point_idx;     /**< required: the winning input point of each pixel, -1 = empty. The run
                                  needs it as scratch; keep it only if per-pixel -> point is wanted.
                                  A compact run uses its bytes as scratch for the squared ranges too:
