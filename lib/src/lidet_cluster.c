@@ -103,22 +103,25 @@ static uint32_t smallest_slot(const lidet_cluster_state_t *c)
 /* sum, min and max of the points of members[start, tail) (tail > start). Returns 1 (the sums then
  * incomplete) as soon as an x, y or z extent exceeds max_extent: the test runs after every block of
  * 64 members, so a wall stops early instead of being summed to its end */
-static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, float max_extent, float sum[3],
-                        float lo[3], float hi[3])
+static inline int member_stats_of(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, float max_extent,
+                                  float sum[3], float lo[3], float hi[3], int compact)
 {
-    const float *xs = c->img.x_m, *ys = c->img.y_m, *zs = c->img.z_m;
+    const lidet_range_image_t *img = &c->img;
     const int32_t *mem = c->members;
-    const int32_t p0 = mem[start];
     float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    float lx = xs[p0], ly = ys[p0], lz = zs[p0], hx = lx, hy = ly, hz = lz;
+    float lx, ly, lz, hx, hy, hz;
     uint32_t i = start, over = 0;
+    lidet__img_xyz(img, (uint32_t)mem[start], compact, &lx, &ly, &lz);
+    hx = lx;
+    hy = ly;
+    hz = lz;
     while (i < tail && over == 0u)
     {
         const uint32_t e = tail - i < 64u ? tail : i + 64u;
         for (; i < e; ++i)
         {
-            const int32_t p = mem[i];
-            const float x = xs[p], y = ys[p], z = zs[p];
+            float x, y, z;
+            lidet__img_xyz(img, (uint32_t)mem[i], compact, &x, &y, &z);
             sx += x;
             sy += y;
             sz += z;
@@ -141,6 +144,14 @@ static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t
     hi[1] = hy;
     hi[2] = hz;
     return over != 0u;
+}
+
+/* member_stats_of with the image format a constant in each copy */
+static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, float max_extent, float sum[3],
+                        float lo[3], float hi[3])
+{
+    return lidet__img_compact(&c->img) ? member_stats_of(c, start, tail, max_extent, sum, lo, hi, 1)
+                                       : member_stats_of(c, start, tail, max_extent, sum, lo, hi, 0);
 }
 
 /* height of `mean` above the ground plane of the sector of the seed's column (or the flat ground) */
@@ -459,8 +470,7 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     {
         return LIDET_ERR_BUFFER;
     }
-    if (img->range_m == 0 || img->row_elev_rad == 0 || img->x_m == 0 ||
-        img->y_m == 0 || img->z_m == 0)
+    if (img->row_elev_rad == 0 || !lidet__img_complete(img))
     {
         return LIDET_ERR_ARG;
     }
@@ -497,7 +507,19 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     {
         const float *prng = img->range_m;
         uint32_t n_cand = 0;
-        if (ground_mask != 0)
+        if (lidet__img_compact(img))
+        {
+            /* compact image: a valid pixel has range_4mm >= 1 */
+            const uint16_t *qrng = img->range_4mm;
+            for (p = 0; p < npix; ++p)
+            {
+                const uint32_t cand =
+                    (uint32_t)(qrng[p] > 0u) & (uint32_t)(ground_mask == 0 || ground_mask[p] == 0);
+                lab[p] = (uint16_t)(cand - 1u);
+                n_cand += cand;
+            }
+        }
+        else if (ground_mask != 0)
         {
             for (p = 0; p < npix; ++p)
             {

@@ -11,11 +11,16 @@
  * distance (from their coordinates) against gg = rgap + rgpm * (nearer range). Within it a fragment
  * pixel joins and a kept pixel is a contact (the nearest one wins, ties: the first met). */
 static inline void rescue_link(lidet_cluster_state_t *c, lidet__rescue_t *rs, uint32_t n, uint32_t l, float dn, uint32_t q,
-                               float dq, const lidet__grow_t *g)
+                               float dq, const lidet__grow_t *g, int compact)
 {
     const lidet_range_image_t *img = &c->img;
     const float gg = g->rgap + g->rgpm * (dq < dn ? dq : dn);
-    const float dx = img->x_m[n] - img->x_m[q], dy = img->y_m[n] - img->y_m[q], dz = img->z_m[n] - img->z_m[q];
+    float xn, yn, zn, xq, yq, zq, dx, dy, dz;
+    lidet__img_xyz(img, n, compact, &xn, &yn, &zn);
+    lidet__img_xyz(img, q, compact, &xq, &yq, &zq);
+    dx = xn - xq;
+    dy = yn - yq;
+    dz = zn - zq;
     const float dd = dx * dx + dy * dy + dz * dz;
     if (!(dd <= gg * gg))
     {
@@ -44,14 +49,15 @@ typedef struct
 /* Pixel n of q's window: looked at when it is a fragment or kept pixel (labels below LAB_PENDING;
  * visited, dropped and empty pixels are looked past) and its range lies in [lo, hi] (a bound of the
  * distance from below: most pixels stop here, before their coordinates are read) */
-static inline void rescue_probe(lidet_cluster_state_t *c, lidet__rescue_t *rs, const uint16_t *lab, const float *rng,
-                                uint32_t n, const window_t *w, const lidet__grow_t *g)
+static inline void rescue_probe(lidet_cluster_state_t *c, lidet__rescue_t *rs, const uint16_t *lab,
+                                const lidet_range_image_t *rng, uint32_t n, const window_t *w,
+                                const lidet__grow_t *g, int compact)
 {
     const uint32_t l = lab[n];
-    const float dn = rng[n];
+    const float dn = lidet__img_range_c(rng, n, compact);
     if (l < LAB_PENDING && dn >= w->lo && dn <= w->hi && n != w->q)
     {
-        rescue_link(c, rs, n, l, dn, w->q, w->dq, g);
+        rescue_link(c, rs, n, l, dn, w->q, w->dq, g, compact);
     }
 }
 
@@ -60,11 +66,12 @@ static inline void rescue_probe(lidet_cluster_state_t *c, lidet__rescue_t *rs, c
  * (wrapping), row by row from the top left, q itself excepted. Four labels at a time (a 64-bit
  * word) are skipped when all are LAB_PENDING or LAB_NONCAND (0xFFFE, 0xFFFF: the only labels with
  * every bit but the lowest set). Fragments are few (hundreds of pixels per scan), windows small. */
-void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start, lidet__rescue_t *rs)
+static inline void rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start, lidet__rescue_t *rs,
+                               int compact)
 {
     const int32_t *mem = c->members;
     const uint16_t *lab = c->labels;
-    const float *rng = c->img.range_m;
+    const lidet_range_image_t *rng = &c->img; /* ranges read through lidet__img_range_c */
     const uint32_t rows = g->rows, cols = g->cols, wr = g->rrows, wc = g->rcols;
     uint32_t head = start;
     while (head < rs->tail)
@@ -73,7 +80,7 @@ void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g
         const uint32_t r = q / cols, col = q - r * cols;
         const uint32_t r0 = r >= wr ? r - wr : 0u, r1 = r + wr < rows ? r + wr : rows - 1u;
         const uint32_t c0 = col >= wc ? col - wc : col + cols - wc; /* 2 wc < cols: none repeats */
-        const float dq = rng[q];
+        const float dq = lidet__img_range_c(rng, q, compact);
         /* |d - dq| <= rgap + rgpm * min(d, dq)  <=>  lo <= d <= hi */
         const float hi = dq * (1.0f + g->rgpm) + g->rgap, lo = (dq - g->rgap) / (1.0f + g->rgpm);
         window_t win;
@@ -96,15 +103,15 @@ void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g
                     memcpy(&w4, &lab[n], sizeof w4);
                     if ((w4 | 0x0001000100010001u) != 0xFFFFFFFFFFFFFFFFu)
                     {
-                        rescue_probe(c, rs, lab, rng, n, &win, g);
-                        rescue_probe(c, rs, lab, rng, n + 1u, &win, g);
-                        rescue_probe(c, rs, lab, rng, n + 2u, &win, g);
-                        rescue_probe(c, rs, lab, rng, n + 3u, &win, g);
+                        rescue_probe(c, rs, lab, rng, n, &win, g, compact);
+                        rescue_probe(c, rs, lab, rng, n + 1u, &win, g, compact);
+                        rescue_probe(c, rs, lab, rng, n + 2u, &win, g, compact);
+                        rescue_probe(c, rs, lab, rng, n + 3u, &win, g, compact);
                     }
                 }
                 for (; n < end; ++n)
                 {
-                    rescue_probe(c, rs, lab, rng, n, &win, g);
+                    rescue_probe(c, rs, lab, rng, n, &win, g, compact);
                 }
             }
             else
@@ -112,10 +119,23 @@ void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g
                 uint32_t cc = c0;
                 for (k = 0; k <= 2u * wc; ++k)
                 {
-                    rescue_probe(c, rs, lab, rng, base + cc, &win, g);
+                    rescue_probe(c, rs, lab, rng, base + cc, &win, g, compact);
                     cc = cc + 1u < cols ? cc + 1u : 0u;
                 }
             }
         }
+    }
+}
+
+void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start, lidet__rescue_t *rs)
+{
+    /* two copies, with the image format a constant in each */
+    if (lidet__img_compact(&c->img))
+    {
+        rescue_grow(c, g, start, rs, 1);
+    }
+    else
+    {
+        rescue_grow(c, g, start, rs, 0);
     }
 }

@@ -7,6 +7,7 @@
 #include "internal/lidet_assert.h"
 #include "internal/lidet_ground_internal.h"
 #include "internal/lidet_math.h"
+#include "internal/lidet_pixel.h"
 #include "internal/lidet_rng.h"
 
 /* Defaults measured by tools/bench/bench_ground.py and coordinate-descent sweeps (docs/GROUND.md) on
@@ -164,28 +165,36 @@ static inline void filter_row(const float *R0, const float *R1, const float *Z0,
     out[cols - 1u] = sample_test(R0, R1, Z0, Z1, F0, cols - 2u, cols - 1u, 0u, 1u, f, opt);
 }
 
-/* Rows of R: the image's when it has R, else computed on demand into the two scratch rows (row r in
- * slot r % 2, so rows r and r + 1 are available together) with the projection's own expression
- * (lidet__rxy: the same bits as a stored R). A pass over the rows in increasing order computes each
- * row once. */
+/* Rows of R (and, for a compact image, of x, y, z): the image's own rows where it has them (a float image:
+ * pointers into it; R when the image keeps R), else computed on demand into scratch rows: R of row r and
+ * z of row r in slot r % 2 (so rows r and r + 1, or r - 1 and r, are available together), x and y of one
+ * row. R is always the projection's expression (lidet__rxy) on the float coordinates the stage reads:
+ * for a float image the same bits as a stored R; for a compact image, on the decoded 4 mm values. A pass
+ * over the rows in increasing order computes each row once. */
 typedef struct
 {
+    const lidet_range_image_t *img;
     const float *img_rxy; /* the image's R, or NULL */
-    const float *x, *y;
-    float *slot[2];
-    int32_t row_in[2]; /* row held by each slot, -1 = none */
+    float *slot[2], *zslot[2], *xrow, *yrow;
+    int32_t row_in[2], zrow_in[2], xyrow_in; /* row held by each slot, -1 = none */
     uint32_t cols;
+    int compact;
 } rxy_rows_t;
 
 static void rxy_rows_init(rxy_rows_t *rr, lidet_ground_scratch_t *sc, const lidet_range_image_t *img)
 {
-    rr->img_rxy = img->rxy_m;
-    rr->x = img->x_m;
-    rr->y = img->y_m;
+    rr->img = img;
+    rr->compact = lidet__img_compact(img);
+    rr->img_rxy = rr->compact ? 0 : img->rxy_m;
     rr->slot[0] = sc->rxy_rows[0];
     rr->slot[1] = sc->rxy_rows[1];
-    rr->row_in[0] = -1;
-    rr->row_in[1] = -1;
+    rr->zslot[0] = sc->z_rows[0];
+    rr->zslot[1] = sc->z_rows[1];
+    rr->xrow = sc->x_row;
+    rr->yrow = sc->y_row;
+    rr->row_in[0] = rr->row_in[1] = -1;
+    rr->zrow_in[0] = rr->zrow_in[1] = -1;
+    rr->xyrow_in = -1;
     rr->cols = img->n_cols;
 }
 
@@ -199,15 +208,85 @@ static const float *rxy_row(rxy_rows_t *rr, uint32_t r)
     }
     if (rr->row_in[k] != (int32_t)r)
     {
-        const float *x = rr->x + (size_t)r * cols, *y = rr->y + (size_t)r * cols;
+        const size_t base = (size_t)r * cols;
         uint32_t c;
-        for (c = 0; c < cols; ++c)
+        if (!rr->compact)
         {
-            out[c] = lidet__rxy(x[c], y[c]);
+            const float *x = rr->img->x_m + base, *y = rr->img->y_m + base;
+            for (c = 0; c < cols; ++c)
+            {
+                out[c] = lidet__rxy(x[c], y[c]);
+            }
+        }
+        else if (rr->xyrow_in == (int32_t)r)
+        {
+            /* x and y of this row are decoded already (the label pass decodes them first) */
+            const float *x = rr->xrow, *y = rr->yrow;
+            for (c = 0; c < cols; ++c)
+            {
+                out[c] = lidet__rxy(x[c], y[c]);
+            }
+        }
+        else
+        {
+            const int16_t *x = rr->img->x_4mm + base, *y = rr->img->y_4mm + base;
+            for (c = 0; c < cols; ++c)
+            {
+                out[c] = lidet__rxy(lidet__pix_m(x[c]), lidet__pix_m(y[c]));
+            }
         }
         rr->row_in[k] = (int32_t)r;
     }
     return out;
+}
+
+/* z of row r: the image's row, or (compact image) decoded into slot r % 2 */
+static const float *z_row(rxy_rows_t *rr, uint32_t r)
+{
+    const uint32_t cols = rr->cols, k = r & 1u;
+    const size_t base = (size_t)r * cols;
+    if (!rr->compact)
+    {
+        return rr->img->z_m + base;
+    }
+    if (rr->zrow_in[k] != (int32_t)r)
+    {
+        const int16_t *z = rr->img->z_4mm + base;
+        float *out = rr->zslot[k];
+        uint32_t c;
+        for (c = 0; c < cols; ++c)
+        {
+            out[c] = lidet__pix_m(z[c]);
+        }
+        rr->zrow_in[k] = (int32_t)r;
+    }
+    return rr->zslot[k];
+}
+
+/* x and y of row r: the image's rows, or (compact image) decoded into the one x and y scratch row */
+static void xy_row(rxy_rows_t *rr, uint32_t r, const float **X, const float **Y)
+{
+    const uint32_t cols = rr->cols;
+    const size_t base = (size_t)r * cols;
+    if (!rr->compact)
+    {
+        *X = rr->img->x_m + base;
+        *Y = rr->img->y_m + base;
+        return;
+    }
+    if (rr->xyrow_in != (int32_t)r)
+    {
+        const int16_t *x = rr->img->x_4mm + base, *y = rr->img->y_4mm + base;
+        uint32_t c;
+        for (c = 0; c < cols; ++c)
+        {
+            rr->xrow[c] = lidet__pix_m(x[c]);
+            rr->yrow[c] = lidet__pix_m(y[c]);
+        }
+        rr->xyrow_in = (int32_t)r;
+    }
+    *X = rr->xrow;
+    *Y = rr->yrow;
 }
 
 /* Pass 1 (mirrors ref/ground.py: sample_mask): the sample mask, row by row. */
@@ -229,8 +308,8 @@ static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, rxy_rows
     {
         const float *R0 = rxy_row(rr, r);
         const float *R1 = rxy_row(rr, r + 1u);
-        const float *Z0 = img->z_m + (size_t)r * cols;
-        const float *Z1 = Z0 + cols;
+        const float *Z0 = z_row(rr, r);
+        const float *Z1 = z_row(rr, r + 1u);
         const float *F0 = g->cfg.fx_on_z ? Z0 : R0;
         uint8_t *out = sample + (size_t)r * cols;
         const filt_t fl = f;
@@ -255,13 +334,19 @@ static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, rxy_rows
  * candidate is written to the next free slot of its end, and the mask bit decides whether that end
  * advances (samples come in no predictable pattern). Past LIDET_GROUND_MAX_SAMPLES, samples are
  * dropped (in sector and raster order) and counted. */
+/* R of one pixel, as rxy_row computes it */
+static inline float pixel_rxy(const lidet_range_image_t *img, uint32_t p)
+{
+    return lidet__rxy(lidet__img_x(img, p), lidet__img_y(img, p));
+}
+
 static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
     const uint32_t cstep = g->cfg.sample_col_step;
     const int two = g->cfg.ring_split_m > 0.0f;
     const float split = two ? g->cfg.ring_split_m : 3.0e38f;
-    uint32_t *const si = sc->sample_pix;
+    lidet_ground_sample_t *const si = sc->sample_pix;
     uint32_t s, r, c, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
     for (s = 0; s < ns; ++s)
     {
@@ -275,16 +360,15 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
             const size_t base = (size_t)r * cols;
             const uint8_t *m = sc->sample + base;
             /* R decides near or far only with a split: the image's, else computed for this pixel */
-            const float *R = img->rxy_m != 0 ? img->rxy_m + base : 0;
-            const float *X = img->x_m + base, *Y = img->y_m + base;
+            const float *R = !lidet__img_compact(img) && img->rxy_m != 0 ? img->rxy_m + base : 0;
             if (roomy)
             {
                 for (c = cstart; c < c1; c += cstep)
                 {
-                    const float rc = !two ? 0.0f : (R != 0 ? R[c] : lidet__rxy(X[c], Y[c]));
+                    const float rc = !two ? 0.0f : (R != 0 ? R[c] : pixel_rxy(img, (uint32_t)base + c));
                     const uint32_t far = (uint32_t)(rc >= split), take = m[c];
                     const uint32_t k = far ? hi - 1u : lo; /* lo < hi: roomy leaves a slot per candidate */
-                    si[k] = (uint32_t)base + c;
+                    si[k] = (lidet_ground_sample_t)(base + c);
                     lo += take & (far ^ 1u);
                     hi -= take & far;
                 }
@@ -298,9 +382,10 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
                         ++total;
                         if (lo < hi)
                         {
-                            const float rc = !two ? 0.0f : (R != 0 ? R[c] : lidet__rxy(X[c], Y[c]));
+                            const float rc =
+                                !two ? 0.0f : (R != 0 ? R[c] : pixel_rxy(img, (uint32_t)base + c));
                             const uint32_t k = rc >= split ? --hi : lo++;
-                            si[k] = (uint32_t)base + c;
+                            si[k] = (lidet_ground_sample_t)(base + c);
                         }
                     }
                 }
@@ -423,9 +508,13 @@ static void label_rows(lidet_ground_state_t *g, uint8_t *mask, rxy_rows_t *rr, c
     for (r = 0; r < rows; ++r)
     {
         const size_t base = (size_t)r * cols;
-        const float *X = img->x_m + base, *Y = img->y_m + base, *Z = img->z_m + base, *R = rxy_row(rr, r);
-        const float *Ru = r > 0u ? rxy_row(rr, r - 1u) : R, *Zu = r > 0u ? Z - cols : Z;
+        const float *X, *Y, *Z, *R, *Ru, *Zu;
         uint8_t *out = mask + base;
+        xy_row(rr, r, &X, &Y); /* first: a compact image's R of row r is then computed from them */
+        Z = z_row(rr, r);
+        R = rxy_row(rr, r);
+        Ru = r > 0u ? rxy_row(rr, r - 1u) : R;
+        Zu = r > 0u ? z_row(rr, r - 1u) : Z;
         for (s = 0; s < ns; ++s)
         {
             const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
@@ -495,7 +584,8 @@ lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_sc
     {
         return LIDET_ERR_STATE;
     }
-    if (img->x_m == 0 || img->y_m == 0 || img->z_m == 0)
+    if (lidet__img_compact(img) ? (img->x_4mm == 0 || img->y_4mm == 0 || img->z_4mm == 0)
+                                : (img->y_m == 0 || img->z_m == 0))
     {
         return LIDET_ERR_ARG;
     }

@@ -7,6 +7,7 @@
 #include "internal/lidet_assert.h"
 #include "internal/lidet_ground_internal.h"
 #include "internal/lidet_math.h"
+#include "internal/lidet_pixel.h"
 #include "internal/lidet_rng.h"
 
 /* cross products shorter than this (m^2) are degenerate triples (collinear or repeated points) */
@@ -249,9 +250,9 @@ static uint32_t accumulate(const float *xs, const float *ys, const float *zs, ui
 
 /* The same for the n image pixels idx[0..n) (a cell's samples), gathered in blocks: the same sums, bit
  * for bit, as on a contiguous copy of the points. */
-static uint32_t accumulate_idx(const float *X, const float *Y, const float *Z, const uint32_t *idx, uint32_t n,
-                               const lidet_plane_t *ref, float thr, const float shift[3], float cov[3][3],
-                               float centroid[3])
+static uint32_t accumulate_idx(const lidet_range_image_t *img, int compact, const lidet_ground_sample_t *idx,
+                               uint32_t n, const lidet_plane_t *ref, float thr, const float shift[3],
+                               float cov[3][3], float centroid[3])
 {
     float bx[GATHER_BLOCK], by[GATHER_BLOCK], bz[GATHER_BLOCK];
     moments_t mo;
@@ -262,10 +263,7 @@ static uint32_t accumulate_idx(const float *X, const float *Y, const float *Z, c
         const uint32_t m = n - base < GATHER_BLOCK ? n - base : GATHER_BLOCK;
         for (i = 0; i < m; ++i)
         {
-            const uint32_t q = idx[base + i];
-            bx[i] = X[q];
-            by[i] = Y[q];
-            bz[i] = Z[q];
+            lidet__img_xyz(img, idx[base + i], compact, &bx[i], &by[i], &bz[i]);
         }
         moments_add(&mo, bx, by, bz, m);
     }
@@ -305,24 +303,26 @@ static uint32_t score(const float *xs, const float *ys, const float *zs, uint32_
 }
 
 /* score() on the image pixels idx[0, stride, 2 stride, ...) (a cell too large for the scoring copy) */
-static uint32_t score_idx(const float *X, const float *Y, const float *Z, const uint32_t *idx, uint32_t n,
-                          uint32_t stride, const lidet_plane_t *p, float thr)
+static uint32_t score_idx(const lidet_range_image_t *img, int compact, const lidet_ground_sample_t *idx,
+                          uint32_t n, uint32_t stride, const lidet_plane_t *p, float thr)
 {
     const float nx = p->nx, ny = p->ny, nz = p->nz, d = p->d_m;
     uint32_t i, cnt = 0;
     for (i = 0; i < n; i += stride)
     {
-        const uint32_t q = idx[i];
-        cnt += (uint32_t)(fabsf(nx * X[q] + ny * Y[q] + nz * Z[q] + d) <= thr);
+        float x, y, z;
+        lidet__img_xyz(img, idx[i], compact, &x, &y, &z);
+        cnt += (uint32_t)(fabsf(nx * x + ny * y + nz * z + d) <= thr);
     }
     return cnt;
 }
 
 /* RANSAC on one sector (mirrors ref/ground.py: ransac_sector). Returns 1 with *out set when a
  * plane passes every check. */
-static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const float *X, const float *Y,
-                      const float *Z, const uint32_t *idx, uint32_t n, lidet_plane_t *out)
+static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img,
+                      const lidet_ground_sample_t *idx, uint32_t n, lidet_plane_t *out)
 {
+    const int compact = lidet__img_compact(img);
     const lidet_ground_cfg_t *cfg = &g->cfg;
     const float cos_tilt = cosf(cfg->max_tilt_rad);
     const float cos2 = cos_tilt * cos_tilt;
@@ -340,10 +340,7 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
     {
         for (i = 0; i < n_eval; ++i)
         {
-            const uint32_t q = idx[i * stride];
-            sc->ev_x_m[i] = X[q];
-            sc->ev_y_m[i] = Y[q];
-            sc->ev_z_m[i] = Z[q];
+            lidet__img_xyz(img, idx[i * stride], compact, &sc->ev_x_m[i], &sc->ev_y_m[i], &sc->ev_z_m[i]);
         }
     }
     for (it = 0; it < cfg->ransac_iters; ++it)
@@ -359,16 +356,16 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
             continue;
         }
         {
-            const uint32_t q0 = idx[i0], q1 = idx[i1], q2 = idx[i2];
-            x0 = X[q0];
-            y0 = Y[q0];
-            z0 = Z[q0];
-            ux = X[q1] - x0;
-            uy = Y[q1] - y0;
-            uz = Z[q1] - z0;
-            vx = X[q2] - x0;
-            vy = Y[q2] - y0;
-            vz = Z[q2] - z0;
+            float x1, y1, z1, x2, y2, z2;
+            lidet__img_xyz(img, idx[i0], compact, &x0, &y0, &z0);
+            lidet__img_xyz(img, idx[i1], compact, &x1, &y1, &z1);
+            lidet__img_xyz(img, idx[i2], compact, &x2, &y2, &z2);
+            ux = x1 - x0;
+            uy = y1 - y0;
+            uz = z1 - z0;
+            vx = x2 - x0;
+            vy = y2 - y0;
+            vz = z2 - z0;
         }
         cx = uy * vz - uz * vy;
         cy = uz * vx - ux * vz;
@@ -390,7 +387,7 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
         p.d_m = -(p.nx * x0 + p.ny * y0 + p.nz * z0);
         ++g->stats.n_hypotheses;
         cnt = copied ? score(sc->ev_x_m, sc->ev_y_m, sc->ev_z_m, n_eval, &p, cfg->inlier_m)
-                     : score_idx(X, Y, Z, idx, n, stride, &p, cfg->inlier_m);
+                     : score_idx(img, compact, idx, n, stride, &p, cfg->inlier_m);
         if (!have || cnt > best_cnt)
         {
             best = p;
@@ -425,10 +422,10 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
         float cov[3][3], centroid[3], shift[3];
         lidet_plane_t p;
         /* shift: the point of the plane under the sector's first sample */
-        shift[0] = X[idx[0]];
-        shift[1] = Y[idx[0]];
-        shift[2] = best.nz > 0.0f ? -(best.nx * shift[0] + best.ny * shift[1] + best.d_m) / best.nz : Z[idx[0]];
-        if (accumulate_idx(X, Y, Z, idx, n, &best, cfg->inlier_m, shift, cov, centroid) < 3u ||
+        float z_first;
+        lidet__img_xyz(img, idx[0], compact, &shift[0], &shift[1], &z_first);
+        shift[2] = best.nz > 0.0f ? -(best.nx * shift[0] + best.ny * shift[1] + best.d_m) / best.nz : z_first;
+        if (accumulate_idx(img, compact, idx, n, &best, cfg->inlier_m, shift, cov, centroid) < 3u ||
             !plane_from_cov(cov, centroid, &p, 0) || !(p.nz * p.nz >= cos2))
         {
             break; /* keep the last good plane */
@@ -465,7 +462,7 @@ void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *
             continue;
         }
         LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
-        if (fit_sector(g, sc, img->x_m, img->y_m, img->z_m, sc->sample_pix + a, n, &g->planes[k]))
+        if (fit_sector(g, sc, img, sc->sample_pix + a, n, &g->planes[k]))
         {
             g->source[k] = LIDET_GROUND_PLANE_FITTED;
             if (near)

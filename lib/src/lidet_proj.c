@@ -298,18 +298,87 @@ float lidet_proj_azimuth_key(float x, float y)
     return (kb.flags[0] & KEY_DEN_OK) ? kb.d[0] : 2.0f;
 }
 
+/* v in 4 mm steps, rounded half up (floor(v / 0.004 + 0.5), as tools/bench/bench_pixel.py's s16 model);
+ * |v| <= LIDET_PIXEL_MAX_RANGE_M, so it fits int16. Branch-free floor of a truncating conversion. */
+static inline int32_t to_4mm(float v)
+{
+    const float t = v * LIDET_PIXEL_PER_M + 0.5f;
+    const int32_t i = (int32_t)t;
+    return i - (int32_t)(t < (float)i);
+}
+
+/* Pass 2 of a compact image (see pass 2 below for the float one): each winner's coordinates and range,
+ * rounded to 4 mm steps; the range is the float path's sqrtf of the same squared range (kept in the two
+ * 16-bit halves), so the compact image is the float image rounded. A valid pixel's range is >= 1 step
+ * (a point closer than 2 mm, possible with min_range_m 0, would otherwise read as empty). In blocks of
+ * COMPACT_BLOCK pixels (3 KiB of stack): (a) a branch-free gather of the winners' coordinates and
+ * squared ranges (an empty pixel reads record 0 masked to +0); (b) the rounding, in a loop without
+ * branches that compilers vectorise. */
+#define COMPACT_BLOCK 192u
+static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *points, uint32_t stride,
+                              uint32_t npix, int any)
+{
+    static const float zero_rec[3] = {0.0f, 0.0f, 0.0f};
+    const float *const src = any ? points : zero_rec;
+    const int32_t *const idx = buf->point_idx;
+    int16_t *const xo = buf->x_4mm, *const yo = buf->y_4mm, *const zo = buf->z_4mm;
+    uint16_t *const ro = buf->range_4mm;
+    float bx[COMPACT_BLOCK], by[COMPACT_BLOCK], bz[COMPACT_BLOCK], b2[COMPACT_BLOCK];
+    uint32_t base, filled = 0;
+    for (base = 0; base < npix; base += COMPACT_BLOCK)
+    {
+        const uint32_t m = npix - base < COMPACT_BLOCK ? npix - base : COMPACT_BLOCK;
+        uint32_t j;
+        for (j = 0; j < m; ++j)
+        {
+            const uint32_t pix = base + j;
+            const int32_t k = idx[pix];
+            const uint32_t keep = 0u - (uint32_t)(k >= 0);
+            const float *pt = src + (size_t)((uint32_t)k & keep) * stride;
+            uint32_t ux, uy, uz, key = ((uint32_t)ro[pix] << 16) | (uint16_t)zo[pix];
+            memcpy(&ux, &pt[0], sizeof ux);
+            memcpy(&uy, &pt[1], sizeof uy);
+            memcpy(&uz, &pt[2], sizeof uz);
+            ux &= keep;
+            uy &= keep;
+            uz &= keep;
+            key &= keep; /* empty: 0, i.e. range 0 */
+            memcpy(&bx[j], &ux, sizeof ux);
+            memcpy(&by[j], &uy, sizeof uy);
+            memcpy(&bz[j], &uz, sizeof uz);
+            memcpy(&b2[j], &key, sizeof key);
+            filled += keep & 1u;
+        }
+        for (j = 0; j < m; ++j)
+        {
+            /* b2: a winner's squared range (<= max2 <= 131^2 m^2 by the range test) or 0 (empty) */
+            const float r = sqrtf(b2[j]);
+            const int32_t rq = to_4mm(r);
+            xo[base + j] = (int16_t)to_4mm(bx[j]);
+            yo[base + j] = (int16_t)to_4mm(by[j]);
+            zo[base + j] = (int16_t)to_4mm(bz[j]);
+            ro[base + j] = (uint16_t)(rq + (int32_t)((r > 0.0f) & (rq == 0)));
+        }
+    }
+    return filled;
+}
+
 lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj_buffers_t *buf, const float *points,
                                       uint32_t n_points, uint32_t stride, const uint16_t *ring)
 {
     uint32_t n, rows, cols, npix, pix;
     float min2, max2;
     lidet_proj_stats_t st;
+    int compact;
 
     if (proj == 0 || buf == 0 || stride < 3 || (points == 0 && n_points > 0))
     {
         return LIDET_ERR_ARG;
     }
-    if (buf->x_m == 0 || buf->y_m == 0 || buf->z_m == 0 || buf->range_m == 0 || buf->point_idx == 0)
+    compact = buf->x_m == 0;
+    if (buf->point_idx == 0 ||
+        (!compact && (buf->y_m == 0 || buf->z_m == 0 || buf->range_m == 0)) ||
+        (compact && (buf->x_4mm == 0 || buf->y_4mm == 0 || buf->z_4mm == 0 || buf->range_4mm == 0)))
     {
         return LIDET_ERR_ARG;
     }
@@ -328,13 +397,28 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
     min2 = proj->cfg.min_range_m * proj->cfg.min_range_m;
     min2 = min2 > 1.0e-30f ? min2 : 1.0e-30f;
     max2 = proj->cfg.max_range_m > 0.0f ? proj->cfg.max_range_m * proj->cfg.max_range_m : 3.0e38f;
+    if (compact && max2 > LIDET_PIXEL_MAX_RANGE_M * LIDET_PIXEL_MAX_RANGE_M)
+    {
+        /* a compact image holds int16 coordinates in 4 mm steps: farther points are dropped, never wrapped */
+        max2 = LIDET_PIXEL_MAX_RANGE_M * LIDET_PIXEL_MAX_RANGE_M;
+    }
 
     /* pass 1, over points in blocks (see KEY_BLOCK): pixel of each point and the closest point per
      * pixel. range_m holds the winner's squared range until pass 2, starting at 3.39e38 (every byte
      * 0x7F), above any accepted r^2 (max2 <= 3.0e38), so the winner test needs no emptiness check.
      * Invariants live in locals: the stores below could alias the state's float fields otherwise. */
     memset(buf->point_idx, 0xFF, (size_t)npix * sizeof buf->point_idx[0]);
-    memset(buf->range_m, 0x7F, (size_t)npix * sizeof buf->range_m[0]);
+    if (!compact)
+    {
+        memset(buf->range_m, 0x7F, (size_t)npix * sizeof buf->range_m[0]);
+    }
+    else
+    {
+        /* compact: the squared range's bits, high half in range_4mm and low half in z_4mm until pass 2
+         * (a positive float orders as its bits do, so the winner test is the float one, exactly) */
+        memset(buf->range_4mm, 0x7F, (size_t)npix * sizeof buf->range_4mm[0]);
+        memset(buf->z_4mm, 0x7F, (size_t)npix * sizeof buf->z_4mm[0]);
+    }
     {
         const float tan_lo = proj->tan_lo, tan_hi = proj->tan_hi, row_scale = proj->lut_scale;
         const float col_scale = proj->col_lut_scale;
@@ -347,7 +431,9 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
         const uint8_t *const ring_to_row = proj->ring_to_row;
         int32_t *const point_idx = buf->point_idx;
         int32_t *const point_pixel = buf->point_pixel; /* may be NULL: per-point outputs not wanted */
-        float *const best = buf->range_m;
+        float *const best = buf->range_m;      /* float image: squared range of the winner */
+        uint16_t *const key_hi = buf->range_4mm; /* compact image: its bits, high and low halves */
+        int16_t *const key_lo = buf->z_4mm;
         uint32_t base, projected = 0;
         key_block_t kb;
 
@@ -446,15 +532,37 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
                 ++nw;
             }
             /* (c) in point order: strict test, exact ties keep the earlier point */
-            for (j = 0; j < nw; ++j)
+            if (!compact)
             {
-                const uint32_t p = (uint32_t)kb.row_k[j];
-                const uint32_t jj = (uint32_t)kb.col_k[j];
-                const float r2 = kb.r2[jj];
-                if (r2 < best[p])
+                for (j = 0; j < nw; ++j)
                 {
-                    best[p] = r2;
-                    point_idx[p] = (int32_t)(base + jj);
+                    const uint32_t p = (uint32_t)kb.row_k[j];
+                    const uint32_t jj = (uint32_t)kb.col_k[j];
+                    const float r2 = kb.r2[jj];
+                    if (r2 < best[p])
+                    {
+                        best[p] = r2;
+                        point_idx[p] = (int32_t)(base + jj);
+                    }
+                }
+            }
+            else
+            {
+                for (j = 0; j < nw; ++j)
+                {
+                    const uint32_t p = (uint32_t)kb.row_k[j];
+                    const uint32_t jj = (uint32_t)kb.col_k[j];
+                    const uint32_t khi = key_hi[p];
+                    uint32_t r2;
+                    memcpy(&r2, &kb.r2[jj], sizeof r2);
+                    /* r2 < the key, as unsigned 32-bit values (r2 >= 0 here: the range test passed); the
+                     * low half is read only on a tie of the high halves */
+                    if ((r2 >> 16) < khi || ((r2 >> 16) == khi && (r2 & 0xFFFFu) < (uint16_t)key_lo[p]))
+                    {
+                        key_hi[p] = (uint16_t)(r2 >> 16);
+                        key_lo[p] = (int16_t)(uint16_t)(r2 & 0xFFFFu); /* two's complement: C99 int16_t */
+                        point_idx[p] = (int32_t)(base + jj);
+                    }
                 }
             }
             projected += nw;
@@ -472,6 +580,11 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
      * the squared range (0x7F7F7F7F > max2 marks an empty pixel). Writing the coordinates here rather
      * than on every win in pass 1 keeps pass 1's working set at two arrays (index + squared range):
      * measured 16.6 vs 17.8 ns/point on real KITTI scans, six scattered 512 KiB arrays overflow L2. */
+    if (compact)
+    {
+        st.n_pixels_filled = pass2_compact(buf, points, stride, npix, st.n_projected > 0);
+    }
+    else
     {
         static const float zero_rec[3] = {0.0f, 0.0f, 0.0f};
         const float *const src = st.n_projected > 0 ? points : zero_rec; /* points may be NULL if n = 0 */
@@ -530,6 +643,10 @@ static void own_buffers(lidet_proj_t *proj, lidet_proj_buffers_t *b)
     b->y_m = proj->y_m;
     b->z_m = proj->z_m;
     b->range_m = proj->range_m;
+    b->x_4mm = 0;
+    b->y_4mm = 0;
+    b->z_4mm = 0;
+    b->range_4mm = 0;
     b->rxy_m = proj->rxy_m;
     b->point_idx = proj->point_idx;
     b->point_pixel = proj->point_pixel;
@@ -559,7 +676,11 @@ void lidet_proj_image_of(const lidet_proj_state_t *st, const lidet_proj_buffers_
     img->y_m = buf->y_m;
     img->z_m = buf->z_m;
     img->range_m = buf->range_m;
-    img->rxy_m = buf->rxy_m;
+    img->x_4mm = buf->x_4mm;
+    img->y_4mm = buf->y_4mm;
+    img->z_4mm = buf->z_4mm;
+    img->range_4mm = buf->range_4mm;
+    img->rxy_m = buf->x_m != 0 ? buf->rxy_m : 0;
     img->point_idx = buf->point_idx;
     img->row_elev_rad = st->row_elev_rad;
 }
@@ -576,6 +697,10 @@ void lidet_proj_image(const lidet_proj_t *proj, lidet_range_image_t *img)
     img->y_m = proj->y_m;
     img->z_m = proj->z_m;
     img->range_m = proj->range_m;
+    img->x_4mm = 0;
+    img->y_4mm = 0;
+    img->z_4mm = 0;
+    img->range_4mm = 0;
     img->rxy_m = proj->rxy_m;
     img->point_idx = proj->point_idx;
     img->row_elev_rad = proj->state.row_elev_rad;

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "internal/lidet_math.h"
+#include "internal/lidet_pixel.h"
 #include "internal/lidet_rng.h"
 #include "lidet/lidet_cluster.h"
 
@@ -101,7 +102,7 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
     {
         return LIDET_ERR_ARG;
     }
-    if (c->magic != LIDET_INIT_MAGIC || c->members == 0 || c->img.x_m == 0)
+    if (c->magic != LIDET_INIT_MAGIC || c->members == 0 || !lidet__img_complete(&c->img))
     {
         return LIDET_ERR_STATE;
     }
@@ -130,9 +131,9 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
         {
             return LIDET_ERR_STATE; /* cannot happen after a run; guards a stale state */
         }
-        out->xyz[i][0] = img->x_m[p] - mx;
-        out->xyz[i][1] = img->y_m[p] - my;
-        out->xyz[i][2] = img->z_m[p] - mz;
+        out->xyz[i][0] = lidet__img_x(img, (uint32_t)p) - mx;
+        out->xyz[i][1] = lidet__img_y(img, (uint32_t)p) - my;
+        out->xyz[i][2] = lidet__img_z(img, (uint32_t)p) - mz;
     }
     out->mean_m[0] = mx;
     out->mean_m[1] = my;

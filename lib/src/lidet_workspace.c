@@ -49,10 +49,14 @@ static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
 {
     img->n_rows = ws->proj.cfg.sensor.n_rows;
     img->n_cols = ws->proj.cfg.sensor.n_cols;
-    img->x_m = ws->x_m;
-    img->y_m = ws->y_m;
-    img->z_m = ws->z_m;
-    img->range_m = ws->range_m;
+    img->x_m = 0; /* a compact image */
+    img->y_m = 0;
+    img->z_m = 0;
+    img->range_m = 0;
+    img->x_4mm = ws->x_4mm;
+    img->y_4mm = ws->y_4mm;
+    img->z_4mm = ws->z_4mm;
+    img->range_4mm = ws->range_4mm;
     img->rxy_m = 0;
     img->point_idx = 0;
     img->row_elev_rad = ws->proj.row_elev_rad;
@@ -90,10 +94,14 @@ lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *poi
     ws->cluster.labels = 0;
     ws->cluster.members = 0;
     ws->cluster.n_recs = 0;
-    b.x_m = ws->x_m;
-    b.y_m = ws->y_m;
-    b.z_m = ws->z_m;
-    b.range_m = ws->range_m;
+    b.x_m = 0; /* a compact image */
+    b.y_m = 0;
+    b.z_m = 0;
+    b.range_m = 0;
+    b.x_4mm = ws->x_4mm;
+    b.y_4mm = ws->y_4mm;
+    b.z_4mm = ws->z_4mm;
+    b.range_4mm = ws->range_4mm;
     b.rxy_m = 0;
     b.point_idx = ws->overlay.proj_point_idx;
     b.point_pixel = point_pixel;
@@ -236,7 +244,7 @@ void lidet_workspace_sizes(lidet_workspace_sizes_t *out)
     out->proj_state = (uint32_t)sizeof w->proj;
     out->ground_state = (uint32_t)sizeof w->ground;
     out->cluster_state = (uint32_t)sizeof w->cluster;
-    out->image = (uint32_t)(sizeof w->x_m + sizeof w->y_m + sizeof w->z_m + sizeof w->range_m);
+    out->image = (uint32_t)(sizeof w->x_4mm + sizeof w->y_4mm + sizeof w->z_4mm + sizeof w->range_4mm);
     out->ground_mask = (uint32_t)sizeof w->ground_mask;
     out->overlay_proj = (uint32_t)sizeof w->overlay.proj_point_idx;
     out->overlay_ground = (uint32_t)sizeof w->overlay.ground;

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # SPDX-License-Identifier: MIT
-# Workspace and stage sizes for the capacity configurations of docs/MEMORY.md, as a markdown table.
+# Detector, workspace and stage sizes for the capacity configurations of docs/MEMORY.md, as markdown tables.
 # Usage: tools/size/size_report.sh [CC]   (default cc; sizes are sizeof, so any C99 compiler for the
 # target gives that target's figure; a 32-bit target differs only in the few pointer fields)
 set -euo pipefail
@@ -18,29 +18,42 @@ configs=(
 )
 kib() { awk -v b="$1" 'BEGIN { printf "%.1f", b / 1024 }'; }
 # sizeof for a 32-bit target (ILP32: the layout an arm-none-eabi build gets for these structs, which hold
-# no 64-bit members), read from the symbol sizes of an object compiled with -m32; "n/a" without -m32
+# no 64-bit members), read from the symbol sizes of an object compiled with -m32; "n/a" without -m32.
+# Prints "<workspace KiB> <detector KiB>".
 size32() {
-  printf '#include "lidet/lidet_workspace.h"\nchar sz_ws[sizeof(lidet_workspace_t)];\n' > "$tmp/p32.c"
+  printf '%s\n' '#include "lidet/lidet_detector.h"' 'char sz_ws[sizeof(lidet_workspace_t)];' \
+    'char sz_det[sizeof(lidet_detector_t)];' > "$tmp/p32.c"
   if "$cc" -m32 -ffreestanding -std=c99 -c -I"$root/lib/include" "$@" "$tmp/p32.c" -o "$tmp/p32.o" 2>/dev/null; then
-    nm -S -t d "$tmp/p32.o" | awk '$4 == "sz_ws" { printf "%.1f KiB", $2 / 1024 }'
+    nm -S -t d "$tmp/p32.o" | awk '$4 == "sz_ws" { w = $2 } $4 == "sz_det" { d = $2 }
+                                  END { printf "%.1f %.1f", w / 1024, d / 1024 }'
   else
-    echo "n/a"
+    echo "n/a n/a"
   fi
 }
-echo "| config (rows x cols, points, clusters) | proj+ground+cluster states | image x,y,z,range | ground mask | overlay (proj / ground / cluster) | **workspace** | workspace, 32-bit target | standalone stages (proj + ground + cluster) |"
-echo "|---|---|---|---|---|---|---|---|"
+ws_rows=()
+det_rows=()
 for c in "${configs[@]}"; do
   read -r name rows cols pts cl det <<<"$c"
   caps=(-DLIDET_MAX_ROWS="$rows" -DLIDET_MAX_COLS="$cols" -DLIDET_MAX_POINTS="$pts" -DLIDET_MAX_CLUSTERS="$cl"
         -DLIDET_MAX_DETECTIONS="$det")
   "$cc" -std=c99 -O1 -I"$root/lib/include" -I"$root/lib/src" "${caps[@]}" "$here/size_report.c" "$root"/lib/src/*.c \
-        -lm -o "$tmp/sz"
-  ws32="$(size32 "${caps[@]}")"
+        "$root"/lib/src/nn/*.c -lm -o "$tmp/sz"
+  read -r ws32 det32 <<<"$(size32 "${caps[@]}")"
   declare -A v=()
   while read -r k n; do v[$k]=$n; done < <("$tmp/sz")
   states=$(( v[proj_state] + v[ground_state] + v[cluster_state] ))
-  echo "| $name ($rows x $cols, $pts, $cl) | $(kib $states) KiB | $(kib ${v[image]}) KiB | $(kib ${v[ground_mask]}) KiB |" \
-       "$(kib ${v[overlay]}) KiB ($(kib ${v[overlay_proj]}) / $(kib ${v[overlay_ground]}) / $(kib ${v[overlay_cluster]})) |" \
-       "**$(kib ${v[workspace]}) KiB** | $ws32 | $(kib ${v[stages_standalone]}) KiB ($(kib ${v[proj_t]}) + $(kib ${v[ground_t]}) + $(kib ${v[cluster_t]})) |"
+  ws_rows+=("| $name ($rows x $cols, $pts, $cl) | $(kib $states) KiB | $(kib ${v[image]}) KiB | $(kib ${v[ground_mask]}) KiB | $(kib ${v[overlay]}) KiB ($(kib ${v[overlay_proj]}) / $(kib ${v[overlay_ground]}) / $(kib ${v[overlay_cluster]})) | **$(kib ${v[workspace]}) KiB** | $ws32 KiB | $(kib ${v[stages_standalone]}) KiB ($(kib ${v[proj_t]}) + $(kib ${v[ground_t]}) + $(kib ${v[cluster_t]})) |")
+  det_rows+=("| $name ($rows x $cols, $pts, $cl, $det) | $(kib ${v[det_workspace]}) KiB | $(kib ${v[det_pn_scratch]}) KiB | $(kib ${v[det_pn_states]}) KiB | $(kib ${v[det_proposal]}) KiB | $(kib ${v[det_detections]}) KiB | $(kib ${v[det_rest]}) KiB | **$(kib ${v[detector]}) KiB** | **$det32 KiB** |")
   unset v
 done
+echo "Workspace (lidet_workspace_sizes):"
+echo
+echo "| config (rows x cols, points, clusters) | proj+ground+cluster states | image x,y,z,range | ground mask | overlay (proj / ground / cluster) | **workspace** | workspace, 32-bit target | standalone stages (proj + ground + cluster) |"
+echo "|---|---|---|---|---|---|---|---|"
+printf '%s\n' "${ws_rows[@]}"
+echo
+echo "Detector (lidet_detector_bytes: the workspace and the rest of lidet_detector_t):"
+echo
+echo "| config (rows x cols, points, clusters, detections) | workspace | PointNet scratch | 2 PointNet states | proposal | detections | rest (cfg, candidate order, outcomes, stats) | **detector** | **detector, 32-bit target** |"
+echo "|---|---|---|---|---|---|---|---|---|"
+printf '%s\n' "${det_rows[@]}"

@@ -223,7 +223,8 @@ lidet_status_t lidet_cluster_init(lidet_cluster_t *c, const lidet_cluster_cfg_t 
 /**
  * @brief Cluster one range image.
  * @param[in,out] c           initialised state; labels, members, records and stats are overwritten.
- * @param[in]     img         range image (lidet_proj_image); n_rows <= LIDET_MAX_ROWS,
+ * @param[in]     img         range image (lidet_proj_image; float or compact, lidet_range_image_t);
+ *                            n_rows <= LIDET_MAX_ROWS,
  *                            n_cols <= LIDET_MAX_COLS; its row_elev_rad gives the vertical alphas
  *                            (sin/cos recomputed only when the geometry changes).
  * @param[in]     ground_mask n_rows * n_cols bytes, 1 = ground (not clustered), or NULL (no ground).

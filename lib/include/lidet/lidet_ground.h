@@ -173,17 +173,27 @@ typedef struct
     lidet_ground_stats_t stats;
 } lidet_ground_state_t;
 
+/** @brief A ground sample: its pixel index. 2 B when every pixel index of the build fits (LIDET_MAX_ROWS
+ *         * LIDET_MAX_COLS <= 65536, e.g. VLP-16 16 x 1800), else 4 B. */
+#if LIDET_MAX_ROWS * LIDET_MAX_COLS <= 65536L
+typedef uint16_t lidet_ground_sample_t;
+#else
+typedef uint32_t lidet_ground_sample_t;
+#endif
+
 /**
  * @brief Scratch of one ground run: nothing in it is read after the run returns except the sample
  *        mask (lidet_ground_samples, a diagnostic). A detector workspace overlays it with the other
- *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + LIDET_GROUND_MAX_SAMPLES * 4 B (a sample
- *        is its pixel: RANSAC reads its coordinates from the image) + LIDET_GROUND_EVAL_MAX * 12 B
- *        + LIDET_GROUND_MAX_SECTORS * 16 B + LIDET_MAX_COLS * 8 B (two rows of R, for images without R).
+ *        stages' scratch. LIDET_MAX_ROWS * LIDET_MAX_COLS B + LIDET_GROUND_MAX_SAMPLES * 2 or 4 B (a
+ *        sample is its pixel, lidet_ground_sample_t: RANSAC reads its coordinates from the image)
+ *        + LIDET_GROUND_EVAL_MAX * 12 B
+ *        + LIDET_GROUND_MAX_SECTORS * 16 B + LIDET_MAX_COLS * 24 B (two rows of R, for images without R;
+ *        two rows of z and one of x and y, decoded, for a compact image).
  */
 typedef struct
 {
     uint8_t sample[LIDET_MAX_ROWS * LIDET_MAX_COLS];     /* 1 sample of the filter */
-    uint32_t sample_pix[LIDET_GROUND_MAX_SAMPLES];       /* samples (their pixels), grouped by cell */
+    lidet_ground_sample_t sample_pix[LIDET_GROUND_MAX_SAMPLES]; /* samples (their pixels), grouped by cell */
     float ev_x_m[LIDET_GROUND_EVAL_MAX];                 /* a cell's strided scoring subset */
     float ev_y_m[LIDET_GROUND_EVAL_MAX];
     float ev_z_m[LIDET_GROUND_EVAL_MAX];
@@ -192,6 +202,9 @@ typedef struct
     uint32_t cell_first[2 * LIDET_GROUND_MAX_SECTORS];
     uint32_t cell_n[2 * LIDET_GROUND_MAX_SECTORS];
     float rxy_rows[2][LIDET_MAX_COLS]; /* R of two rows, computed when the image has no R */
+    float z_rows[2][LIDET_MAX_COLS];   /* compact image: z of two rows, decoded */
+    float x_row[LIDET_MAX_COLS];       /* compact image: x and y of one row, decoded */
+    float y_row[LIDET_MAX_COLS];
 } lidet_ground_scratch_t;
 
 /** @brief Ground stage with every buffer inside (the standalone form): state, the ground mask (the
@@ -226,7 +239,9 @@ lidet_status_t lidet_ground_init(lidet_ground_t *g, const lidet_ground_cfg_t *cf
  * @param[in]     img range image from lidet_proj_image (or built by hand with the same contract:
  *                    row 0 = top beam, rows ordered by decreasing elevation, empty pixels 0 in every
  *                    float array). x, y, z are read; R when given (else computed row by row);
- *                    point_idx is not read. Not retained.
+ *                    point_idx is not read. A compact image (x_m NULL, x_4mm ... set, as a
+ *                    workspace's) is read too: its rows are decoded into the scratch, R computed
+ *                    from the decoded x, y. Not retained.
  * @return LIDET_OK; LIDET_TRUNCATED when more than LIDET_GROUND_MAX_SAMPLES pixels passed the filter
  *         (the excess, last sectors first, is counted in stats.n_samples_dropped and not used);
  *         LIDET_ERR_ARG (NULL, NULL x, y or z); LIDET_ERR_STATE (not initialised);

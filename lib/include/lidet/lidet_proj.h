@@ -19,9 +19,11 @@
  *    (monotonic in azimuth, 0 at +-180 deg, 2 at +x, 4 just before -180 deg), against the D of
  *    every column edge, found the same way. One division, no polynomial; the only error is float
  *    rounding (max 1e-5 deg, measured in docs/BENCHMARKS.md).
- * Points that are NaN/Inf, closer than min_range_m, farther than max_range_m (if set), outside the
- * vertical field of view, or with an invalid ring index are counted per reason and skipped before any
- * float -> int conversion.
+ * Points that are NaN/Inf, closer than min_range_m, farther than max_range_m (if set; when writing a
+ * compact image, farther than LIDET_PIXEL_MAX_RANGE_M = 131 m too), outside the vertical field of
+ * view, or with an invalid ring index are counted per reason and skipped before any float -> int
+ * conversion. The image is float (lidet_proj_t) or, into caller buffers, compact: int16 x, y, z and
+ * uint16 range in 4 mm steps (lidet_proj_buffers_t, lidet_range_image_t), the float values rounded.
  *
  * Memory: lidet_proj_t holds every buffer, sizeof = LIDET_MAX_ROWS * LIDET_MAX_COLS * 24 B (x, y, z,
  * range, R as float, winning point as int32) + LIDET_MAX_POINTS * 4 B (pixel of each input point)
@@ -73,19 +75,40 @@ typedef struct
     uint32_t n_truncated;     /**< points past LIDET_MAX_POINTS, not looked at */
 } lidet_proj_stats_t;
 
+/** @brief Unit of the compact image (a detector workspace's pixels, lidet_workspace.h): 4 mm, so int16
+ *         x, y, z span +-131 m. Fixed (the field names say it: x_4mm ...). */
+#define LIDET_PIXEL_M 0.004f
+#define LIDET_PIXEL_PER_M 250.0f
+/** @brief A compact image holds points up to this range (32750 steps of 4 mm, a margin below the int16
+ *         limit for rounding): the projection drops farther points when it writes a compact image
+ *         (counted in n_too_far, as points beyond max_range_m), so no coordinate ever wraps. */
+#define LIDET_PIXEL_MAX_RANGE_M 131.0f
+
 /**
  * @brief The range image: row-major arrays of n_rows * n_cols pixels, pixel = row * n_cols + col.
  * Empty pixels hold 0 in every float array and -1 in point_idx. A view into lidet_proj_t (or the
  * buffers of lidet_proj_run_buffers), valid until the next run or init on the same state.
+ *
+ * Two pixel formats. A float image (what lidet_proj_t produces, the reference) sets x_m, y_m, z_m,
+ * range_m. A compact image (what a detector workspace keeps: 8 B per pixel instead of 16) sets x_m to
+ * NULL and x_4mm, y_4mm, z_4mm, range_4mm instead: the same point rounded to 4 mm steps (round half
+ * up, floor(v / 0.004 + 0.5)); a valid pixel has range_4mm >= 1, an empty one 0 everywhere. Every
+ * stage reads both formats and decodes a compact value as (float)v * LIDET_PIXEL_M where it reads it.
+ * The format is decided by x_m: non-NULL = float (the compact fields are then not read).
  */
 typedef struct
 {
     uint16_t n_rows;
     uint16_t n_cols;
-    const float *x_m;          /**< x of the pixel's point */
+    const float *x_m;          /**< x of the pixel's point; NULL for a compact image */
     const float *y_m;          /**< y */
     const float *z_m;          /**< z */
     const float *range_m;      /**< sqrt(x^2 + y^2 + z^2); > 0 exactly for valid pixels */
+    const int16_t *x_4mm;      /**< compact image only (x_m NULL): x in 4 mm steps */
+    const int16_t *y_4mm;      /**< compact: y */
+    const int16_t *z_4mm;      /**< compact: z */
+    const uint16_t *range_4mm; /**< compact: the range (of the float point, then rounded); >= 1 exactly
+                                    for valid pixels */
     const float *rxy_m;        /**< R = sqrt(x^2 + y^2), the horizontal range; may be NULL (a detector
                                     workspace does not keep it: the ground stage computes it) */
     const int32_t *point_idx;  /**< index of the winning input point, -1 = empty; may be NULL (a
@@ -128,12 +151,19 @@ typedef struct
  */
 typedef struct
 {
-    float *x_m, *y_m, *z_m; /**< required: the winning point's coordinates (0 for empty pixels) */
-    float *range_m;         /**< required: its range, > 0 exactly for valid pixels, else 0 */
-    float *rxy_m;           /**< optional (NULL: not produced): R = sqrt(x^2 + y^2); the ground stage
-                                 computes it itself when the image has none */
+    float *x_m, *y_m, *z_m; /**< the winning point's coordinates (0 for empty pixels); required for a
+                                 float image; all NULL for a compact image */
+    float *range_m;         /**< float image: its range, > 0 exactly for valid pixels, else 0 */
+    int16_t *x_4mm, *y_4mm, *z_4mm; /**< compact image (x_m NULL): the coordinates in 4 mm steps; points
+                                         beyond LIDET_PIXEL_MAX_RANGE_M are then dropped (n_too_far) */
+    uint16_t *range_4mm;    /**< compact image: the range in 4 mm steps, >= 1 for valid pixels, else 0 */
+    float *rxy_m;           /**< optional (NULL: not produced), float image only (a compact run does not
+                                 write it): R = sqrt(x^2 + y^2); the ground stage computes it itself when
+                                 the image has none */
     int32_t *point_idx;     /**< required: the winning input point of each pixel, -1 = empty. The run
-                                 needs it as scratch; keep it only if per-pixel -> point is wanted */
+                                 needs it as scratch; keep it only if per-pixel -> point is wanted.
+                                 A compact run uses its bytes as scratch for the squared ranges too:
+                                 it holds the winners' indices again when the run returns */
     int32_t *point_pixel;   /**< optional (NULL: not produced): LIDET_MAX_POINTS entries, the pixel of
                                  each input point (per-point outputs: 4 B per point) */
 } lidet_proj_buffers_t;

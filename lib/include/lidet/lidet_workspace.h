@@ -18,19 +18,25 @@
  * ground stage's scratch and the clustering's outputs, none of which is alive while another is.
  * What the workspace does not keep, by design (a firmware that wants boxes pays for none of it):
  *  - R = sqrt(x^2 + y^2) per pixel: the ground stage recomputes it row by row (two rows of scratch),
- *    with the same expression, so every result is bit-identical to the standalone stages';
+ *    from the decoded coordinates;
  *  - the winning point's index per pixel (point_idx): scratch of the projection; validity is range > 0;
  *  - per-point outputs (the pixel of every input point, 4 B per point): only when the caller passes
  *    a buffer of LIDET_MAX_POINTS entries to lidet_workspace_run; per-point labels are then derived
  *    from it (lidet_workspace_point_labels).
- * The x, y, z and range planes stay float (16 B per pixel): they are the real point's coordinates,
- * which the ground filter, the cluster statistics and the proposals read; see docs/MEMORY.md for
- * the measured sizes of each part and what a more compact pixel would cost.
+ * The image is compact (8 B per pixel instead of 16): x, y, z as int16 and the range as uint16, all in
+ * 4 mm steps (lidet_range_image_t, LIDET_PIXEL_M), the real point's coordinates rounded, which the ground
+ * filter, the cluster statistics and the proposals decode where they read them. Points beyond
+ * LIDET_PIXEL_MAX_RANGE_M (131 m, the int16 span) are dropped by the projection and counted as too far.
+ * Results are those of the stages chained by hand on that compact image, bit for bit, and differ from
+ * the float stages by the rounding only: the clustering alone agrees on >= 99.9 % of the pixels; the
+ * ground stage's RANSAC, fed a sample more or less, moves a plane as another seed would (measured in
+ * docs/MEMORY.md, asserted in tests/unit/test_workspace.c).
  *
  * Bytes (lidet_workspace_sizes reports each part): states ~ LIDET_MAX_COLS * 12 B + LIDET_PROJ_ROW_LUT B
- * + LIDET_MAX_CLUSTERS * 60 B + LIDET_GROUND_MAX_SECTORS * 34 B; per pixel 17 B (x, y, z, range, ground
+ * + LIDET_MAX_CLUSTERS * 60 B + LIDET_GROUND_MAX_SECTORS * 34 B; per pixel 9 B (x, y, z, range, ground
  * mask) + the overlay, the largest of 4 B (projection), 1 B + (LIDET_GROUND_MAX_SAMPLES / pixels) * 4 B
- * (ground) and 6 B (clustering). Declare it static, or place it with the port's section macro
+ * + 24 B per column (ground) and 6 B (clustering). Declare it static, or place it with the port's section
+ * macro
  * (LIDET_WORKSPACE_SECTION, lidet_port.h).
  * Time: the sum of the three stages, plus two passes over the pixels for R (vectorised). No allocation.
  */
@@ -73,11 +79,11 @@ typedef struct
     lidet_proj_state_t proj;
     lidet_ground_state_t ground;
     lidet_cluster_state_t cluster;
-    /* outputs read up to the end of the scan */
-    float x_m[LIDET__WS_PIXELS];
-    float y_m[LIDET__WS_PIXELS];
-    float z_m[LIDET__WS_PIXELS];
-    float range_m[LIDET__WS_PIXELS];
+    /* outputs read up to the end of the scan: the compact image (4 mm steps, see lidet_range_image_t) */
+    int16_t x_4mm[LIDET__WS_PIXELS];
+    int16_t y_4mm[LIDET__WS_PIXELS];
+    int16_t z_4mm[LIDET__WS_PIXELS];
+    uint16_t range_4mm[LIDET__WS_PIXELS];
     uint8_t ground_mask[LIDET__WS_PIXELS];
     /* one of these is alive at a time */
     union
@@ -96,7 +102,7 @@ typedef struct
 typedef struct
 {
     uint32_t proj_state, ground_state, cluster_state; /**< the three states (tables, small outputs) */
-    uint32_t image;                                   /**< x, y, z, range planes */
+    uint32_t image;                                   /**< x, y, z, range planes (int16, 4 mm steps) */
     uint32_t ground_mask;                             /**< the ground mask */
     uint32_t overlay_proj;                            /**< projection scratch (point_idx) */
     uint32_t overlay_ground;                          /**< ground scratch (sample mask, samples, two rows of R) */
@@ -121,9 +127,9 @@ void lidet_workspace_cfg_default(lidet_workspace_cfg_t *cfg, const lidet_sensor_
 lidet_status_t lidet_workspace_init(lidet_workspace_t *ws, const lidet_workspace_cfg_t *cfg);
 
 /**
- * @brief Projection, ground segmentation and clustering of one scan, with the same results, bit for
- *        bit, as the standalone stages chained by hand (the cluster height filter reads the ground
- *        stage's near planes).
+ * @brief Projection, ground segmentation and clustering of one scan: the standalone stages chained by
+ *        hand (the cluster height filter reads the ground stage's near planes), on the compact image
+ *        (the same results up to the 4 mm rounding of the pixels; points beyond 131 m dropped).
  * @param[in,out] ws          initialised workspace; every result of the previous scan is overwritten.
  * @param[in]     points      n_points records of `stride` floats (x, y, z first); read only during
  *                            this call (the workspace keeps the winners' coordinates).
@@ -148,7 +154,8 @@ lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *poi
                                          uint32_t stride, const uint16_t *ring, int32_t *point_pixel,
                                          lidet_clock_fn clock, void *clock_ctx, uint32_t ticks[3]);
 
-/** @brief The range image of the last run: x, y, z and range; rxy_m and point_idx are NULL. */
+/** @brief The range image of the last run: a compact image (x_m ... range_m, rxy_m and point_idx NULL;
+ *         x_4mm, y_4mm, z_4mm, range_4mm set: decode as value * LIDET_PIXEL_M metres). */
 void lidet_workspace_image(const lidet_workspace_t *ws, lidet_range_image_t *img);
 
 /** @brief Ground mask of the last run (n_rows * n_cols bytes, 1 = ground). */

@@ -5,6 +5,7 @@
 #ifndef LIDET_CLUSTER_INTERNAL_H
 #define LIDET_CLUSTER_INTERNAL_H
 
+#include "internal/lidet_pixel.h"
 #include "lidet/lidet_cluster.h"
 
 /* pixel states in labels[] during a run (ids 1..LIDET_MAX_CLUSTERS are slots + 1) */

@@ -1,0 +1,193 @@
+/* SPDX-License-Identifier: MIT */
+/* The flood fill of the clustering, written once for both image formats: lidet_cluster_grow.c includes
+ * this file twice, with GROW_RNG_T float (a float image: ranges in metres) and uint16_t (a compact
+ * image: ranges in 4 mm steps, read as floats; the caller scales the gap bound to steps), GROW_RANGES
+ * the image's range plane and GROW_FN(name) the copy's function names. Each copy is the code the float
+ * stage had before the compact image (reads are (float)rng[n], a no-op for float), so neither pays for
+ * the other. Not a public header; include nowhere else. */
+
+/* One directional search from q (range dq): pixels q + k * step, k = 1..nk, never wrapping (the
+ * caller sends the columns within kc of either edge to search_wrap); beam pair sin/cos at
+ * sn[(k - 1) * gs], cs[(k - 1) * gs]. Non-candidates are stepped over. */
+static inline uint32_t GROW_FN(search)(uint16_t *lab, int32_t *mem, const GROW_RNG_T *rng, uint32_t tail,
+                                       float dq, uint32_t q, int32_t step, uint32_t nk, const float *sn,
+                                       const float *cs, int32_t gs, const lidet__grow_t *g, int occl)
+{
+    uint32_t k, n = q;
+    if (!occl)
+    {
+        /* the search stops at the first candidate whatever it is: find it, then test it only when
+         * free (nk >= 1; k ends at the step of that candidate, or at nk - 1 on a non-candidate) */
+        uint32_t l;
+        k = 0;
+        for (;;)
+        {
+            n = (uint32_t)((int32_t)n + step);
+            l = lab[n];
+            if (l != LAB_NONCAND || ++k >= nk)
+            {
+                break;
+            }
+        }
+        if (l == LAB_FREE && link(dq, (float)rng[n], sn[(int32_t)k * gs], cs[(int32_t)k * gs], g))
+        {
+            tail = take(lab, mem, tail, n);
+        }
+        return tail;
+    }
+    for (k = 0; k < nk; ++k, sn += gs, cs += gs)
+    {
+        uint32_t l;
+        n = (uint32_t)((int32_t)n + step);
+        l = lab[n];
+        if (l == LAB_NONCAND)
+        {
+            continue;
+        }
+        /* occluder bridging: a free candidate that passes the test joins, and the search ends; one
+         * that fails it, or a visited one, ends the search unless it is nearer than q and fails the
+         * test (an occluder: the search goes on behind it). A visited candidate is only tested when
+         * that decides between the two (joining it again would change nothing) */
+        const float dn = (float)rng[n];
+        if (l == LAB_FREE)
+        {
+            if (link(dq, dn, *sn, *cs, g))
+            {
+                tail = take(lab, mem, tail, n);
+                break;
+            }
+            if (!(dn < dq))
+            {
+                break;
+            }
+        }
+        else if (!(dn < dq) || link(dq, dn, *sn, *cs, g))
+        {
+            break;
+        }
+    }
+    return tail;
+}
+
+/* The same along a row across the wrap (the rare columns within kc of either edge): step k meets
+ * rowbase + (col +- k mod cols); angles col_sin/col_cos */
+static uint32_t GROW_FN(search_wrap)(lidet_cluster_state_t *c, uint32_t tail, float dq, uint32_t rowbase,
+                                     uint32_t col, int right, const lidet__grow_t *g, int occl)
+{
+    uint16_t *lab = c->labels;
+    int32_t *mem = c->members;
+    const GROW_RNG_T *rng = GROW_RANGES(&c->img);
+    const uint32_t cols = g->cols;
+    uint32_t k;
+    for (k = 1; k <= g->kc; ++k)
+    {
+        const uint32_t cc =
+            right ? (col + k >= cols ? col + k - cols : col + k) : (col >= k ? col - k : col + cols - k);
+        const uint32_t n = rowbase + cc;
+        const uint32_t l = lab[n];
+        if (l == LAB_NONCAND)
+        {
+            continue;
+        }
+        const float dn = (float)rng[n], sn = c->col_sin[k - 1], cs = c->col_cos[k - 1];
+        if (l == LAB_FREE && link(dq, dn, sn, cs, g))
+        {
+            tail = take(lab, mem, tail, n); /* joins, and the search ends */
+            break;
+        }
+        /* without occluder bridging any candidate ends the search; with it, one nearer than q that
+         * fails the test is stepped over (as in search) */
+        if (!occl || !(dn < dq) || (l != LAB_FREE && link(dq, dn, sn, cs, g)))
+        {
+            break;
+        }
+    }
+    return tail;
+}
+
+/* Breadth-first flood fill of the cluster seeded at members[start] (tail = start + 1): expands
+ * members[head] for head = start .. tail (the member array is the queue, every pixel is pushed at
+ * most once). Returns the new tail. Directions in the reference's order: right, left, down, up, then
+ * the diagonals down-left, down-right, up-left, up-right. occl is a constant at each call site. */
+static inline uint32_t GROW_FN(grow)(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start,
+                                     uint32_t tail, int occl)
+{
+    uint16_t *lab = c->labels;
+    int32_t *mem = c->members;
+    const GROW_RNG_T *rng = GROW_RANGES(&c->img);
+    const uint32_t rows = g->rows, cols = g->cols, ks = g->ks, kc = g->kc;
+    uint32_t head = start;
+    while (head < tail)
+    {
+        const uint32_t q = (uint32_t)mem[head++];
+        const uint32_t r = g->row_magic != 0u ? (uint32_t)(((uint64_t)q * g->row_magic) >> 32) : q / cols;
+        const uint32_t rowbase = r * cols, col = q - rowbase;
+        const float dq = (float)rng[q];
+        const uint32_t nd = rows - 1u - r < ks ? rows - 1u - r : ks; /* steps that stay in the image */
+        const uint32_t nu = r < ks ? r : ks;
+        LIDET_ASSERT(tail <= rows * cols);
+        /* right, left (wrapping) */
+        if (col + kc < cols)
+        {
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, 1, kc, c->col_sin, c->col_cos, 1, g, occl);
+        }
+        else
+        {
+            tail = GROW_FN(search_wrap)(c, tail, dq, rowbase, col, 1, g, occl);
+        }
+        if (col >= kc)
+        {
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -1, kc, c->col_sin, c->col_cos, 1, g, occl);
+        }
+        else
+        {
+            tail = GROW_FN(search_wrap)(c, tail, dq, rowbase, col, 0, g, occl);
+        }
+        /* down: rows r and r + k, entry [r * STEPS + k - 1]; up: rows r - k and r, entry
+         * [(r - k) * STEPS + k - 1] (stored at the upper row), i.e. stride 1 - STEPS from (r - 1) * STEPS */
+        if (nd > 0u)
+        {
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, (int32_t)cols, nd, c->row_sin + r * STEPS,
+                                   c->row_cos + r * STEPS, 1, g, occl);
+        }
+        if (nu > 0u)
+        {
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -(int32_t)cols, nu,
+                                   c->row_sin + (r - 1u) * STEPS, c->row_cos + (r - 1u) * STEPS, 1 - STEPS, g,
+                                   occl);
+        }
+        /* diagonals (8-neighbourhood option): direct neighbours only, no bridging; each joins when
+         * free and linked (down-left, down-right, up-left, up-right) */
+        if (g->diag)
+        {
+            const uint32_t cl = col > 0u ? col - 1u : cols - 1u, cr = col + 1u < cols ? col + 1u : 0u;
+            if (r + 1u < rows)
+            {
+                const uint32_t dl = rowbase + cols + cl, dr = rowbase + cols + cr;
+                if (lab[dl] == LAB_FREE && link(dq, (float)rng[dl], c->diag_sin[r], c->diag_cos[r], g))
+                {
+                    tail = take(lab, mem, tail, dl);
+                }
+                if (lab[dr] == LAB_FREE && link(dq, (float)rng[dr], c->diag_sin[r], c->diag_cos[r], g))
+                {
+                    tail = take(lab, mem, tail, dr);
+                }
+            }
+            if (r > 0u)
+            {
+                const uint32_t ul = rowbase - cols + cl, ur = rowbase - cols + cr;
+                if (lab[ul] == LAB_FREE &&
+                    link(dq, (float)rng[ul], c->diag_sin[r - 1u], c->diag_cos[r - 1u], g))
+                {
+                    tail = take(lab, mem, tail, ul);
+                }
+                if (lab[ur] == LAB_FREE &&
+                    link(dq, (float)rng[ur], c->diag_sin[r - 1u], c->diag_cos[r - 1u], g))
+                {
+                    tail = take(lab, mem, tail, ur);
+                }
+            }
+        }
+    }
+    return tail;
+}
