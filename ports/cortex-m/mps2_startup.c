@@ -1,0 +1,62 @@
+/* SPDX-License-Identifier: MIT */
+/* Cortex-M reset for the Arm MPS2 boards QEMU models (mps2-an385 Cortex-M3, mps2-an386 Cortex-M4F,
+ * mps2-an500 Cortex-M7): the vector table, the reset handler (FPU on, counter on, then fw_start) and one
+ * fault handler that reports the fault and stops. Written for lidet; no CMSIS needed. */
+#include <stdint.h>
+
+#include "fw_port.h"
+
+typedef void (*fw_vector_t)(void);
+
+extern uint32_t __stack_top[];
+void fw_start(void);
+void fw_mps2_counter_start(void);
+void fw_mps2_report_fault(uint32_t exc, const uint32_t *frame);
+
+void Reset_Handler(void);
+void Fault_Handler(void);
+
+#define SCB_CPACR (*(volatile uint32_t *)0xE000ED88u)
+#define SCB_VTOR (*(volatile uint32_t *)0xE000ED08u)
+
+void Reset_Handler(void)
+{
+#if defined(__ARM_FP)
+    /* CP10 and CP11 (the FPU) full access, before the first floating-point instruction */
+    SCB_CPACR |= (0xFu << 20);
+    __asm__ volatile("dsb\n\tisb" ::: "memory");
+#endif
+    fw_mps2_counter_start();
+    fw_start();
+    for (;;)
+    {
+    }
+}
+
+/* Every exception but reset: which one (IPSR) and the stacked frame (PC at word 6), then exit. */
+__attribute__((naked)) void Fault_Handler(void)
+{
+    __asm__ volatile("mrs r0, ipsr\n\t"
+                     "tst lr, #4\n\t"
+                     "ite eq\n\t"
+                     "mrseq r1, msp\n\t"
+                     "mrsne r1, psp\n\t"
+                     "b fw_mps2_report_fault\n\t");
+}
+
+/* 16 core exceptions; the boards' interrupts stay disabled (none is used), so no IRQ vectors are needed. */
+__attribute__((section(".vectors"), used)) const fw_vector_t fw_vectors[16] = {
+    (fw_vector_t)(uintptr_t)__stack_top, /* initial MSP */
+    Reset_Handler,
+    Fault_Handler, /* NMI */
+    Fault_Handler, /* HardFault */
+    Fault_Handler, /* MemManage */
+    Fault_Handler, /* BusFault */
+    Fault_Handler, /* UsageFault */
+    0, 0, 0, 0,
+    Fault_Handler, /* SVCall */
+    Fault_Handler, /* DebugMonitor */
+    0,
+    Fault_Handler, /* PendSV */
+    Fault_Handler, /* SysTick */
+};
