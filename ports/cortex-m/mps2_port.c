@@ -4,10 +4,13 @@
  *
  * Instruction counting (exact): QEMU runs with `-icount shift=S` (FW_ICOUNT_SHIFT, default 8), so its virtual
  * clock advances exactly 2^S ns per executed guest instruction. CMSDK APB timer 0 (0x40000000) counts that
- * virtual clock at the board's 25 MHz (40 ns per tick), i.e. 2^S / 40 = 6.4 ticks per instruction at S = 8.
- * Each read is off by less than one tick, so a difference of two reads is within 2 ticks of 6.4 x N and
- * N = round(ticks * 40 / 2^S) is exact (2 / 6.4 < 0.5). The timer is 32 bits: at most 671 M instructions per
- * measured interval. fw_detect.c checks the conversion against loops of known length at every run. */
+ * virtual clock at the board's 25 MHz (40 ns per tick): 2^S / 40 = 6.4 ticks per instruction at S = 8. Its
+ * wrap interrupt (IRQ 8, every 671 M instructions) extends it to 64 bits. fw_clock returns the instructions
+ * since the counter started: round((T - T0) x 40 / 2^S) with T the 64-bit tick count. Each read is within
+ * one tick of 6.4 x N (plus a constant), so the error is at most 2 / 6.4 < 0.5 instruction and the rounding
+ * gives N exactly; differences of fw_clock values are then exact instruction counts (up to 4.29 G apart).
+ * The wrap handler's own ~20 instructions every 671 M are counted where they happen, as every instruction is.
+ * fw_detect.c checks the counter against loops of known length at every run. */
 #include <stdint.h>
 
 #include "fw_port.h"
@@ -20,6 +23,9 @@
 #define TIMER0_CTRL (*(volatile uint32_t *)0x40000000u)
 #define TIMER0_VALUE (*(volatile uint32_t *)0x40000004u)
 #define TIMER0_RELOAD (*(volatile uint32_t *)0x40000008u)
+#define TIMER0_INT (*(volatile uint32_t *)0x4000000Cu) /* read: status, write 1: clear */
+#define TIMER0_IRQ 8u
+#define NVIC_ISER0 (*(volatile uint32_t *)0xE000E100u)
 
 #define SEMI_SYS_WRITE0 0x04
 #define SEMI_SYS_EXIT 0x18
@@ -27,6 +33,7 @@
 #define ADP_STOPPED_RUNTIME_ERROR 0x20023u    /* QEMU exits with 1 */
 
 void fw_mps2_counter_start(void);
+void fw_mps2_timer0_irq(void);
 void fw_mps2_report_fault(uint32_t exc, const uint32_t *frame);
 
 static int semihost(int op, const void *arg)
@@ -65,23 +72,48 @@ void fw_exit(int code)
                                                                       : ADP_STOPPED_RUNTIME_ERROR));
 }
 
+static volatile uint32_t g_wraps; /* timer 0 wrap-arounds (high word of the tick count) */
+static uint64_t g_t0;               /* tick count when the counter started */
+
+void fw_mps2_timer0_irq(void)
+{
+    TIMER0_INT = 1u;
+    ++g_wraps;
+}
+
+/* 64-bit tick count; interrupts masked so that a wrap between the two halves is seen as pending */
+static uint64_t ticks64(void)
+{
+    uint32_t hi, lo;
+    __asm__ volatile("cpsid i" ::: "memory");
+    hi = g_wraps;
+    lo = ~TIMER0_VALUE; /* counts up */
+    if ((TIMER0_INT & 1u) != 0u && lo < 0x80000000u)
+        ++hi; /* wrapped, handler not run yet */
+    __asm__ volatile("cpsie i" ::: "memory");
+    return ((uint64_t)hi << 32) | lo;
+}
+
 void fw_mps2_counter_start(void)
 {
     TIMER0_CTRL = 0u;
     TIMER0_RELOAD = 0xFFFFFFFFu;
     TIMER0_VALUE = 0xFFFFFFFFu;
-    TIMER0_CTRL = 1u; /* enable, system clock, no interrupt */
+    TIMER0_INT = 1u;
+    NVIC_ISER0 = 1u << TIMER0_IRQ;
+    TIMER0_CTRL = 1u | 8u; /* enable, system clock, interrupt at wrap */
+    g_t0 = ticks64();
 }
 
 uint32_t fw_clock(void *ctx)
 {
     (void)ctx;
-    return ~TIMER0_VALUE; /* counts up */
+    return (uint32_t)(((ticks64() - g_t0) * FW_TIMER_NS + (1u << (FW_ICOUNT_SHIFT - 1))) >> FW_ICOUNT_SHIFT);
 }
 
 uint32_t fw_ticks_to_insn(uint32_t ticks)
 {
-    return (uint32_t)(((uint64_t)ticks * FW_TIMER_NS + (1u << (FW_ICOUNT_SHIFT - 1))) >> FW_ICOUNT_SHIFT);
+    return ticks; /* fw_clock counts instructions already */
 }
 
 int fw_have_counter(void)

@@ -11,6 +11,7 @@ typedef void (*fw_vector_t)(void);
 extern uint32_t __stack_top[];
 void fw_start(void);
 void fw_mps2_counter_start(void);
+void fw_mps2_timer0_irq(void);
 void fw_mps2_report_fault(uint32_t exc, const uint32_t *frame);
 
 void Reset_Handler(void);
@@ -44,8 +45,9 @@ __attribute__((naked)) void Fault_Handler(void)
                      "b fw_mps2_report_fault\n\t");
 }
 
-/* 16 core exceptions; the boards' interrupts stay disabled (none is used), so no IRQ vectors are needed. */
-__attribute__((section(".vectors"), used)) const fw_vector_t fw_vectors[16] = {
+/* 16 core exceptions, then the board's interrupts up to timer 0 (IRQ 8, the instruction counter's wrap);
+ * the others stay disabled. */
+__attribute__((section(".vectors"), used)) const fw_vector_t fw_vectors[16 + 9] = {
     (fw_vector_t)(uintptr_t)__stack_top, /* initial MSP */
     Reset_Handler,
     Fault_Handler, /* NMI */
@@ -59,4 +61,7 @@ __attribute__((section(".vectors"), used)) const fw_vector_t fw_vectors[16] = {
     0,
     Fault_Handler, /* PendSV */
     Fault_Handler, /* SysTick */
+    Fault_Handler, Fault_Handler, Fault_Handler, Fault_Handler, /* IRQ 0-3: UART 0-1 */
+    Fault_Handler, Fault_Handler, Fault_Handler, Fault_Handler, /* IRQ 4-7 */
+    fw_mps2_timer0_irq,                                         /* IRQ 8: CMSDK timer 0 */
 };

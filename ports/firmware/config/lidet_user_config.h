@@ -15,6 +15,6 @@
 #define LIDET_MAX_COLS 1800      /* 360 deg / 0.2 deg (600 rpm) */
 #define LIDET_MAX_POINTS 30000   /* 16 x 1800 = 28800 returns + margin; more are counted, not read */
 #define LIDET_MAX_CLUSTERS 64    /* proposals per scan (the detector classifies at most this many) */
-#define LIDET_MAX_DETECTIONS 32  /* road users reported per scan */
+#define LIDET_MAX_DETECTIONS 64  /* road users reported per scan (= clusters: never truncated) */
 
 #endif /* LIDET_USER_CONFIG_H */
