@@ -58,6 +58,7 @@ add_custom_target(firmware DEPENDS fw_host_ref)
 # board | toolchain file | compiler | size tool
 set(fw_boards
     "mps2-an385|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
+    "mps2-an385-m0plus|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
     "mps2-an386|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
     "mps2-an500|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
     "virt-rv32imafc|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size")

@@ -105,15 +105,15 @@ void fw_mps2_counter_start(void)
     g_t0 = ticks64();
 }
 
+uint64_t fw_insn64(void)
+{
+    return ((ticks64() - g_t0) * FW_TIMER_NS + (1u << (FW_ICOUNT_SHIFT - 1))) >> FW_ICOUNT_SHIFT;
+}
+
 uint32_t fw_clock(void *ctx)
 {
     (void)ctx;
-    return (uint32_t)(((ticks64() - g_t0) * FW_TIMER_NS + (1u << (FW_ICOUNT_SHIFT - 1))) >> FW_ICOUNT_SHIFT);
-}
-
-uint32_t fw_ticks_to_insn(uint32_t ticks)
-{
-    return ticks; /* fw_clock counts instructions already */
+    return (uint32_t)fw_insn64();
 }
 
 int fw_have_counter(void)
@@ -125,7 +125,8 @@ int fw_have_counter(void)
 __attribute__((naked, noinline)) void fw_spin(uint32_t n)
 {
     (void)n;
-    __asm__ volatile("1:\n\t"
+    __asm__ volatile(".syntax unified\n\t"
+                     "1:\n\t"
                      "subs r0, r0, #1\n\t"
                      "bne 1b\n\t"
                      "bx lr\n\t");

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Cortex-M reset for the Arm MPS2 boards QEMU models (mps2-an385 Cortex-M3, mps2-an386 Cortex-M4F,
- * mps2-an500 Cortex-M7): the vector table, the reset handler (FPU on, counter on, then fw_start) and one
+ * mps2-an500 Cortex-M7; and ARMv6-M code for the Cortex-M0+ run on the AN385's M3): the vector table, the reset handler (FPU on, counter on, then fw_start) and one
  * fault handler that reports the fault and stops. Written for lidet; no CMSIS needed. */
 #include <stdint.h>
 
@@ -34,15 +34,15 @@ void Reset_Handler(void)
     }
 }
 
-/* Every exception but reset: which one (IPSR) and the stacked frame (PC at word 6), then exit. */
+/* Every exception but reset: which one (IPSR) and the stacked frame (PC at word 6), then exit. The firmware
+ * runs on the main stack only (no PSP). ARMv6-M instructions only, so the Cortex-M0+ build shares it. */
 __attribute__((naked)) void Fault_Handler(void)
 {
     __asm__ volatile("mrs r0, ipsr\n\t"
-                     "tst lr, #4\n\t"
-                     "ite eq\n\t"
-                     "mrseq r1, msp\n\t"
-                     "mrsne r1, psp\n\t"
-                     "b fw_mps2_report_fault\n\t");
+                     "mrs r1, msp\n\t"
+                     "ldr r2, =fw_mps2_report_fault\n\t"
+                     "bx r2\n\t"
+                     ".ltorg\n\t");
 }
 
 /* 16 core exceptions, then the board's interrupts up to timer 0 (IRQ 8, the instruction counter's wrap);

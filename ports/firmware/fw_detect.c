@@ -54,6 +54,19 @@ static void put_u(uint32_t v)
         fw_putc(b[--n]);
 }
 
+static void put_u64(uint64_t v)
+{
+    char b[21];
+    int n = 0;
+    do
+    {
+        b[n++] = (char)('0' + (unsigned)(v % 10u));
+        v /= 10u;
+    } while (v != 0u);
+    while (n > 0)
+        fw_putc(b[--n]);
+}
+
 static void put_i(int32_t v)
 {
     if (v < 0)
@@ -138,6 +151,55 @@ static const char *pick_models(const lidet_pn_model_t **cls, const lidet_pn_mode
     return 0;
 }
 
+/* ---- 64-bit stage counts ------------------------------------------------------------------------------ */
+
+/* The detector's per-stage ticks are uint32 (lidet_detector_stats_t), and a scan on a core without FPU runs
+ * past 2^32 instructions (the Cortex-M3's box net alone: ~5.5 G). So the clock hook also records every
+ * 64-bit timestamp it hands out, and the stages are rebuilt from them in the order the detector takes them:
+ * 4 calls around projection, ground and clustering (lidet_workspace_run_timed), the classification start,
+ * a pair around each box net, the classification end, and a pair around the post-processing. The low 32 bits
+ * of every rebuilt stage must equal the detector's own ticks, which checks that order at every run. */
+#define REC_MAX (8u + 2u * LIDET_MAX_CLUSTERS)
+
+typedef struct
+{
+    uint64_t t[REC_MAX];
+    uint32_t n;
+} rec_t;
+
+static rec_t g_rec;
+
+static uint32_t rec_clock(void *ctx)
+{
+    rec_t *r = (rec_t *)ctx;
+    const uint64_t v = fw_insn64();
+    if (r->n < REC_MAX)
+        r->t[r->n] = v;
+    ++r->n;
+    return (uint32_t)v;
+}
+
+/* -> 0 and out[] filled, or 1 when the recorded calls do not match the detector's order */
+static int rec_stages(const rec_t *r, const lidet_detector_stats_t *s, uint64_t out[LIDET_DET_N_STAGES])
+{
+    uint64_t box = 0u;
+    uint32_t k, nb = s->n_boxed;
+    if (r->n != 8u + 2u * nb || r->n > REC_MAX)
+        return 1;
+    out[LIDET_DET_STAGE_PROJECT] = r->t[1] - r->t[0];
+    out[LIDET_DET_STAGE_GROUND] = r->t[2] - r->t[1];
+    out[LIDET_DET_STAGE_CLUSTER] = r->t[3] - r->t[2];
+    for (k = 0; k < nb; ++k)
+        box += r->t[6u + 2u * k] - r->t[5u + 2u * k];
+    out[LIDET_DET_STAGE_BOX] = box;
+    out[LIDET_DET_STAGE_CLASSIFY] = (r->t[5u + 2u * nb] - r->t[4]) - box;
+    out[LIDET_DET_STAGE_POST] = r->t[7u + 2u * nb] - r->t[6u + 2u * nb];
+    for (k = 0; k < LIDET_DET_N_STAGES; ++k)
+        if ((uint32_t)out[k] != s->ticks[k])
+            return 1;
+    return 0;
+}
+
 /* ---- one run ---------------------------------------------------------------------------------------- */
 
 static int run_once(const char *name, const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *mc,
@@ -148,7 +210,8 @@ static int run_once(const char *name, const lidet_detector_cfg_t *cfg, const lid
     const lidet_detector_stats_t *s;
     const lidet_detection_t *det;
     lidet_status_t st;
-    uint32_t n_det = 0, k, t0, t1;
+    uint32_t n_det = 0, k;
+    uint64_t t0, t1;
 
     st = lidet_detector_init(&g_det, cfg, mc, mb);
     if (st != LIDET_OK)
@@ -160,9 +223,10 @@ static int run_once(const char *name, const lidet_detector_cfg_t *cfg, const lid
         fw_putc('\n');
         return 1;
     }
-    t0 = fw_clock(0);
+    g_rec.n = 0u;
+    t0 = fw_insn64();
     st = lidet_detector_run(&g_det, fw_scan_xyz, fw_scan_n, 3u, fw_scan_has_ring ? fw_scan_ring : 0, 0);
-    t1 = fw_clock(0);
+    t1 = fw_insn64();
     s = lidet_detector_stats(&g_det);
     det = lidet_detector_detections(&g_det, &n_det);
 
@@ -222,11 +286,25 @@ static int run_once(const char *name, const lidet_detector_cfg_t *cfg, const lid
     }
     if (fw_have_counter())
     {
+        uint64_t stage64[LIDET_DET_N_STAGES];
+        if (rec_stages(&g_rec, s, stage64) != 0)
+        {
+            put_s("insn run=");
+            put_s(name);
+            put_s(" FAIL: the clock calls do not match the detector's stage order (fw_detect.c: rec_stages)\n");
+            return 1;
+        }
         put_s("insn run=");
         put_s(name);
         for (k = 0; k < LIDET_DET_N_STAGES; ++k)
-            put_kv(stage_names[k], fw_ticks_to_insn(s->ticks[k]));
-        put_kv("scan", fw_ticks_to_insn(t1 - t0));
+        {
+            fw_putc(' ');
+            put_s(stage_names[k]);
+            fw_putc('=');
+            put_u64(stage64[k]);
+        }
+        put_s(" scan="); /* 64 bits: the stages' uint32 counts are checked against it (run_fw.py) */
+        put_u64(t1 - t0);
         fw_putc('\n');
     }
     return LIDET_SUCCEEDED(st) ? 0 : 1;
@@ -247,11 +325,11 @@ static int calibrate(void)
     static volatile uint32_t lens[4] = {1u, 1000u, 12345u, 1000000u}; /* volatile: no constant folding */
     uint32_t base, k;
     int bad = 0;
-    base = fw_ticks_to_insn(measure(lens[0]));
+    base = measure(lens[0]);
     for (k = 1; k < 4u; ++k)
     {
         const uint32_t n = lens[k];
-        const uint32_t measured = fw_ticks_to_insn(measure(n)) - base;
+        const uint32_t measured = measure(n) - base;
         const uint32_t expected = fw_spin_insn(n) - fw_spin_insn(lens[0]);
         put_s("calib");
         put_kv("n", n);
@@ -265,7 +343,7 @@ static int calibrate(void)
     {
         static volatile uint32_t long_n = 350000000u;
         const uint32_t n = long_n;
-        const uint32_t measured = fw_ticks_to_insn(measure(n)) - base;
+        const uint32_t measured = measure(n) - base;
         const uint32_t expected = fw_spin_insn(n) - fw_spin_insn(lens[0]);
         put_s("calib_long");
         put_kv("n", n);
@@ -316,7 +394,8 @@ int fw_main(void)
 
     /* run 1: the configuration a user gets (gates and size checks on) */
     lidet_detector_cfg_default(&cfg, sensor);
-    cfg.clock = fw_clock;
+    cfg.clock = rec_clock;
+    cfg.clock_ctx = &g_rec;
     bad |= run_once("default", &cfg, mc, mb);
     /* run 2: gates and size checks off, so that every classified proposal is boxed and reported */
     cfg.gate1 = 0u;

@@ -24,18 +24,19 @@ void fw_putc(char c);
 /** Leave the program: 0 = success. Under QEMU this ends QEMU with a matching exit status. */
 void fw_exit(int code);
 
-/** Raw ticks of the board's instruction counter (a lidet_clock_fn; ctx unused); 0 on the host. */
+/** Instructions executed since the counter started, low 32 bits (a lidet_clock_fn; ctx unused): the
+ *  difference of two values is the exact instruction count in between (ports: the method). 0 on the host. */
 uint32_t fw_clock(void *ctx);
 
-/** Ticks (a difference of two fw_clock values) -> instructions executed (see the port for the method). */
-uint32_t fw_ticks_to_insn(uint32_t ticks);
+/** Instructions since the counter started, 64 bits (a whole scan on a core without FPU exceeds 2^32). */
+uint64_t fw_insn64(void);
 
 /** Nonzero when fw_clock counts instructions (QEMU with -icount); 0 on the host. */
 int fw_have_counter(void);
 
 /**
  * Calibration of the counter: executes a loop of exactly fw_spin_insn(n) instructions (hand-written
- * assembly, so the count is known), for checking fw_ticks_to_insn against a known answer.
+ * assembly, so the count is known), for checking fw_clock against a known answer.
  */
 void fw_spin(uint32_t n);
 uint32_t fw_spin_insn(uint32_t n);

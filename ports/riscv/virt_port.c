@@ -5,7 +5,7 @@
  * Instruction counting (exact): with `-icount shift=0` QEMU's minstret CSR returns its instruction counter
  * (without -icount it returns host time), one per executed guest instruction; a difference of two reads is
  * the instructions in between, including the csrr itself. fw_detect.c checks it against loops of known
- * length at every run. 32 bits read (low half): at most 4.29 G instructions per measured interval. */
+ * length at every run. fw_clock reads the low half (differences up to 4.29 G), fw_insn64 both halves. */
 #include <stdint.h>
 
 #include "fw_port.h"
@@ -41,9 +41,16 @@ uint32_t fw_clock(void *ctx)
     return v;
 }
 
-uint32_t fw_ticks_to_insn(uint32_t ticks)
+uint64_t fw_insn64(void)
 {
-    return ticks;
+    uint32_t hi, lo, hi2;
+    do
+    {
+        __asm__ volatile("csrr %0, minstreth" : "=r"(hi));
+        __asm__ volatile("csrr %0, minstret" : "=r"(lo));
+        __asm__ volatile("csrr %0, minstreth" : "=r"(hi2));
+    } while (hi != hi2);
+    return ((uint64_t)hi << 32) | lo;
 }
 
 int fw_have_counter(void)
