@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* The firmware application: the whole detector (lidet_detector.h) on the scan stored in flash (fw_scan.h),
+/* The firmware application: the whole detector (lidet_detector.h) on the scan stored in flash (fw_scan.h)
+ * with the capacities of config/<FW_SENSOR>/lidet_user_config.h,
  * twice: once with the default configuration (gates and size checks as they are) and once with the gates
  * and size checks off, so that many boxes reach the output and the comparison with the host is not vacuous.
  * It prints, line by line (parsed by tools/firmware/run_fw.py, which compares them with the host build):
@@ -23,7 +24,7 @@
 #include "lidet/lidet_proj.h"
 #include "lidet_weights.h"
 
-/* The detector: ~1 MiB at the VLP-16 capacities, in .bss. A board with several RAM banks places it with a
+/* The detector: ~1 MiB at the VLP-16 capacities (~5 MiB for HDL-64), in .bss. A board with several RAM banks places it with a
  * section attribute instead, e.g. LIDET_FW_DETECTOR_SECTION=".bss.sram2" (docs/PORTING.md). */
 #ifdef LIDET_FW_DETECTOR_SECTION
 static lidet_detector_t g_det __attribute__((section(LIDET_FW_DETECTOR_SECTION)));
@@ -136,10 +137,16 @@ static void put_kv(const char *key, uint32_t v)
 
 /* ---- models ---------------------------------------------------------------------------------------- */
 
-/* The VLP-16 models when weights/ has them (trained for this sensor), else the HDL-64 ones. */
+/* The sensor of the build (FW_SENSOR, with its capacities in config/<sensor>/lidet_user_config.h) */
+#ifndef FW_SENSOR
+#define FW_SENSOR "vlp16"
+#endif
+
+/* The sensor's own models when weights/ has them (trained for it), else the HDL-64 ones. */
 static const char *pick_models(const lidet_pn_model_t **cls, const lidet_pn_model_t **box)
 {
-    static const char *const fams[2][3] = {{"vlp16", "cls_vlp16", "box_vlp16"}, {"hdl64", "cls_hdl64", "box_hdl64"}};
+    static const char *const fams[2][3] = {{FW_SENSOR, "cls_" FW_SENSOR, "box_" FW_SENSOR},
+                                           {"hdl64", "cls_hdl64", "box_hdl64"}};
     int k;
     for (k = 0; k < 2; ++k)
     {
@@ -359,7 +366,7 @@ int fw_main(void)
 {
     lidet_detector_cfg_t cfg;
     const lidet_pn_model_t *mc = 0, *mb = 0;
-    const lidet_sensor_t *sensor = lidet_sensor_find("vlp16");
+    const lidet_sensor_t *sensor = lidet_sensor_find(FW_SENSOR);
     const char *family = pick_models(&mc, &mb);
     int bad = 0, c;
 
@@ -367,7 +374,7 @@ int fw_main(void)
     put_s(fw_board_name);
     put_s(" core=");
     put_s(fw_core_name);
-    put_s(" build=float models=");
+    put_s(" build=float sensor=" FW_SENSOR " models=");
     put_s(family != 0 ? family : "none");
     put_s(" scan=");
     put_s(fw_scan_name);
@@ -383,7 +390,7 @@ int fw_main(void)
     fw_putc('\n');
     if (family == 0 || sensor == 0)
     {
-        put_s("lidet-fw: FAIL (no models or no vlp16 sensor profile)\n");
+        put_s("lidet-fw: FAIL (no models or no " FW_SENSOR " sensor profile)\n");
         return 1;
     }
     if (fw_have_counter() && calibrate() != 0)

@@ -6,7 +6,7 @@
         --host-ref build/tests/fw_host_ref [--qemu qemu-system-arm] [--size arm-none-eabi-size] [--json OUT]
 
 1. Runs the host reference (fw_detect.c built for the host against lidet with the same capacities,
-   ports/firmware/config/lidet_user_config.h, on the same generated scan).
+   ports/firmware/config/vlp16/lidet_user_config.h, on the same generated scan).
 2. Runs the image under QEMU with exact instruction counting (-icount), with a timeout.
 3. Checks: the image says PASS (its instruction counter matched loops of known length), and for every run
    (gates as they are, and gates + size checks off) the same counts at every step of the detector, the
@@ -171,6 +171,7 @@ def size_report(size_tool, elf):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--board", required=True, choices=sorted(BOARDS))
+    ap.add_argument("--label", help="name of the image in messages (default: the board)")
     ap.add_argument("--elf")
     ap.add_argument("--host-ref", help="fw_host_ref executable")
     ap.add_argument("--qemu", help="QEMU binary (default: by board)")
@@ -179,24 +180,25 @@ def main(argv=None):
     ap.add_argument("--json", help="write the parsed results and the size report here")
     ap.add_argument("--skip", help="print this reason and exit 77 (ctest: skipped)")
     a = ap.parse_args(argv)
+    name = a.label or a.board
 
     if a.skip:
-        print(f"SKIPPED firmware_{a.board}: {a.skip}")
+        print(f"SKIPPED firmware_{name}: {a.skip}")
         return SKIP
     qemu = shutil.which(a.qemu or BOARDS[a.board][0])
     if qemu is None:
-        print(f"SKIPPED firmware_{a.board}: {a.qemu or BOARDS[a.board][0]} not found "
+        print(f"SKIPPED firmware_{name}: {a.qemu or BOARDS[a.board][0]} not found "
               "(tools/scripts/install_deps.sh installs qemu-system-arm / qemu-system-misc)")
         return SKIP
     if not a.elf or not os.path.isfile(a.elf) or not a.host_ref or not os.path.isfile(a.host_ref):
-        print(f"FAIL firmware_{a.board}: image {a.elf} or host reference {a.host_ref} missing (make firmware)")
+        print(f"FAIL firmware_{name}: image {a.elf} or host reference {a.host_ref} missing (make firmware)")
         return 1
 
     host_p = subprocess.run([a.host_ref], capture_output=True, text=True, timeout=a.timeout)
     host = parse(host_p.stdout)
     if host_p.returncode != 0 or not host["pass"]:
         print(host_p.stdout + host_p.stderr)
-        print(f"FAIL firmware_{a.board}: the host reference failed (exit {host_p.returncode})")
+        print(f"FAIL firmware_{name}: the host reference failed (exit {host_p.returncode})")
         return 1
 
     cmd = qemu_cmd(a.board, qemu, a.elf)
@@ -206,7 +208,7 @@ def main(argv=None):
         fw_p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=a.timeout)
     except subprocess.TimeoutExpired as e:
         print((e.stdout or b"").decode(errors="replace") if isinstance(e.stdout, bytes) else (e.stdout or ""))
-        print(f"FAIL firmware_{a.board}: QEMU did not finish within {a.timeout:.0f} s")
+        print(f"FAIL firmware_{name}: QEMU did not finish within {a.timeout:.0f} s")
         return 1
     print(fw_p.stdout, end="")
     fw = parse(fw_p.stdout)
@@ -231,7 +233,7 @@ def main(argv=None):
     cerr, summary = compare(host, fw)
     errors += cerr
 
-    print(f"---- firmware_{a.board}: comparison with the host build (same capacities, same scan)")
+    print(f"---- firmware_{name}: comparison with the host build (same capacities, same scan)")
     for line in summary:
         print(line)
     for run, ins in sorted(fw["insn"].items()):
@@ -249,9 +251,9 @@ def main(argv=None):
                        "comparison": summary, "errors": errors}, f, indent=1)
     if errors:
         for e in errors:
-            print(f"FAIL firmware_{a.board}: {e}")
+            print(f"FAIL firmware_{name}: {e}")
         return 1
-    print(f"PASS firmware_{a.board}")
+    print(f"PASS firmware_{name}")
     return 0
 
 

@@ -5,7 +5,7 @@
  *        at 0.2 deg, at most ~29k returns per revolution in single-return mode).
  *
  * Read by lidet_opt.h when LIDET_USER_CONFIG is defined. The firmware images and the host reference
- * program they are compared with (fw_host_ref, tests/) are built with this same file, so both run the
+ * program they are compared with (fw_host_ref, tests/firmware.cmake) are built with this same file, so both run the
  * detector with identical capacities. Copy it next to your own firmware and adapt it (docs/PORTING.md).
  */
 #ifndef LIDET_USER_CONFIG_H
