@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* Cortex-M reset for the Arm MPS2 boards QEMU models (mps2-an385 Cortex-M3, mps2-an386 Cortex-M4F,
- * mps2-an500 Cortex-M7; and ARMv6-M code for the Cortex-M0+ run on the AN385's M3): the vector table, the reset handler (FPU on, counter on, then fw_start) and one
- * fault handler that reports the fault and stops. Written for lidet; no CMSIS needed. */
+ * mps2-an500 Cortex-M7; and ARMv6-M code for the Cortex-M0+ run on the AN385's M3): the vector table, the
+ * reset handler (FPU on, counter on, then fw_start) and one fault handler that reports the fault and stops.
+ * Written for lidet; no CMSIS needed. */
 #include <stdint.h>
 
 #include "fw_port.h"

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* The firmware application: the whole detector (lidet_detector.h) on the scan stored in flash (fw_scan.h)
- * with the capacities of config/<FW_SENSOR>/lidet_user_config.h,
- * twice: once with the default configuration (gates and size checks as they are) and once with the gates
- * and size checks off, so that many boxes reach the output and the comparison with the host is not vacuous.
+ * with the capacities of config/<FW_SENSOR>/lidet_user_config.h, twice: once with the default configuration
+ * (gates and size checks as they are) and once with the gates and size checks off, so that many boxes reach
+ * the output and the comparison with the host is not vacuous.
  * It prints, line by line (parsed by tools/firmware/run_fw.py, which compares them with the host build):
  *   lidet-fw board=... core=... build=float ...        the target
  *   mem detector_bytes=N                                sizeof(lidet_detector_t)
@@ -24,8 +24,9 @@
 #include "lidet/lidet_proj.h"
 #include "lidet_weights.h"
 
-/* The detector: ~1 MiB at the VLP-16 capacities (~5 MiB for HDL-64), in .bss. A board with several RAM banks places it with a
- * section attribute instead, e.g. LIDET_FW_DETECTOR_SECTION=".bss.sram2" (docs/PORTING.md). */
+/* The detector: ~1 MiB at the VLP-16 capacities (~4.4 MiB for HDL-64), in .bss. A board with several RAM banks
+ * places it with a section attribute instead, e.g. -DLIDET_FW_DETECTOR_SECTION='".bss.sram2"' and a matching
+ * output section in its linker script (docs/PORTING.md). */
 #ifdef LIDET_FW_DETECTOR_SECTION
 static lidet_detector_t g_det __attribute__((section(LIDET_FW_DETECTOR_SECTION)));
 #else
