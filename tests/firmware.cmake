@@ -62,13 +62,14 @@ lidet_fw_host_ref(hdl64 fw_host_ref_hdl64)
 
 # ---- the images --------------------------------------------------------------------------------
 add_custom_target(firmware DEPENDS fw_host_ref fw_host_ref_hdl64)
-# image name | board | sensor | toolchain file | compiler | size tool. The HDL-64 (KITTI-like) image needs ~5 MiB
-# of RAM: QEMU virt only.
+# image name | board | sensor | toolchain file | compiler | size tool. The HDL-64 (KITTI-like) images need ~4.5 MiB
+# of RAM: QEMU virt, and the AN500's Cortex-M7 with the detector placed in its 16 MiB PSRAM.
 set(fw_images
     "mps2-an385|mps2-an385|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
     "mps2-an385-m0plus|mps2-an385-m0plus|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
     "mps2-an386|mps2-an386|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
     "mps2-an500|mps2-an500|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
+    "mps2-an500-hdl64|mps2-an500|hdl64|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
     "virt-rv32imafc|virt-rv32imafc|vlp16|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size"
     "virt-rv32imafc-hdl64|virt-rv32imafc|hdl64|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size")
 foreach(entry IN LISTS fw_images)

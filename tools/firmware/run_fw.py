@@ -153,14 +153,16 @@ def size_report(size_tool, elf):
         t = line.split()
         if len(t) == 3 and t[0].startswith(".") and t[1].isdigit():
             sec[t[0]] = int(t[1])
-    text = sum(v for k, v in sec.items() if k == ".text" or k.startswith(".ARM."))
+    # code: .text plus the Arm unwind tables (loaded); .ARM.attributes and debug sections are not in flash
+    text = sum(v for k, v in sec.items() if k in (".text", ".ARM.exidx", ".ARM.extab"))
     rep = {
         "text": text,
         "rodata_weights": sec.get(".rodata.weights", 0),
         "rodata_scan": sec.get(".rodata.scan", 0),
         "rodata_other": sec.get(".rodata", 0),
         "data": sec.get(".data", 0),
-        "bss": sec.get(".bss", 0),
+        "bss": sec.get(".bss", 0) + sec.get(".extram", 0),
+        "bss_extram": sec.get(".extram", 0),  # placed in the board's external RAM (part of bss above)
         "stack_reserved": sec.get(".stack", 0),
     }
     rep["flash_without_scan"] = text + rep["rodata_weights"] + rep["rodata_other"] + rep["data"]
