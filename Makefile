@@ -10,7 +10,7 @@ CMAKE_FLAGS ?=
 SAMPLE   ?= tests/data/sim_hdl64/velodyne/000000.bin
 REAL     ?= ../shared/data/real
 
-.PHONY: all deps build test test-c test-py test-asan demo bench weights clean
+.PHONY: all deps build test test-c test-py test-asan demo bench weights clean firmware firmware-run
 
 all: build
 
@@ -66,6 +66,15 @@ demo: build
 	$(BUILD)/ports/host/lidet cluster $(SAMPLE) --sensor hdl64 --png out/demo_cluster.png --repeat 20
 	@echo "demo: pictures in out/ (demo_detect*.png: detections, car red, cyclist cyan, pedestrian yellow;"
 	@echo "      ground truth green; demo_project/ground/cluster.png: the stages)"
+
+# Firmware images (ports/firmware: Cortex-M3/M4F/M7 on QEMU's MPS2 boards, RISC-V rv32imafc on QEMU virt), built
+# by the normal build when the cross compilers are installed (make deps installs them); firmware-run runs each
+# image under QEMU and compares it with the host build, printing instruction counts, stack and sizes.
+firmware: $(BUILD)/CMakeCache.txt
+	cmake --build $(BUILD) --target firmware -j $(JOBS)
+
+firmware-run: firmware
+	ctest --test-dir $(BUILD) -R '^firmware_' -V
 
 # Benchmarks against peers measured in the same run; results go to docs/BENCHMARKS.md.
 bench: deps build

@@ -1,0 +1,428 @@
+/* SPDX-License-Identifier: MIT */
+/* The firmware application: the whole detector (lidet_detector.h) on the scan stored in flash (fw_scan.h)
+ * with the capacities of config/<FW_SENSOR>/lidet_user_config.h, twice: once with the default configuration
+ * (gates and size checks as they are) and once with the gates and size checks off, so that many boxes reach
+ * the output and the comparison with the host is not vacuous.
+ * It prints, line by line (parsed by tools/firmware/run_fw.py, which compares them with the host build):
+ *   lidet-fw board=... core=... build=float ...        the target
+ *   mem detector_bytes=N                                sizeof(lidet_detector_t)
+ *   calib n=N expected=E measured=M                     the instruction counter against a loop of known length
+ *   stats run=R status=S clusters=... detections=D      the detector's counts
+ *   det R k CLASS CLUSTER NPTS h0 .. h9 # readable      one detection: its cluster id and points, the float32
+ *                                                       bits of score, cx, cy, cz, l, w, h, yaw, energy_cls,
+ *                                                       energy_box (hex), then decimals for people
+ *   insn run=R project=.. ground=.. cluster=.. classify=.. box=.. post=.. scan=..   instructions per stage
+ *   stack used=N size=S                                 stack high-water (painted at reset)
+ *   lidet-fw: PASS | FAIL (...)
+ * No stdio: the few number formats needed are here, so the image carries no printf. */
+#include <stdint.h>
+#include <string.h>
+
+#include "fw_port.h"
+#include "fw_scan.h"
+#include "lidet/lidet_detector.h"
+#include "lidet/lidet_proj.h"
+#include "lidet_weights.h"
+
+/* The detector: ~1 MiB at the VLP-16 capacities (~4.4 MiB for HDL-64), in .bss. A board with several RAM banks
+ * places it with a section attribute instead, e.g. -DLIDET_FW_DETECTOR_SECTION='".bss.sram2"' and a matching
+ * output section in its linker script (docs/PORTING.md). */
+#ifdef LIDET_FW_DETECTOR_SECTION
+static lidet_detector_t g_det __attribute__((section(LIDET_FW_DETECTOR_SECTION)));
+#else
+static lidet_detector_t g_det;
+#endif
+
+static const char *const k_class_names[LIDET_N_CLASSES] = {"Car", "Cyclist", "Pedestrian"};
+
+/* ---- output ---------------------------------------------------------------------------------------- */
+
+static void put_s(const char *s)
+{
+    while (*s != '\0')
+        fw_putc(*s++);
+}
+
+static void put_u(uint32_t v)
+{
+    char b[11];
+    int n = 0;
+    do
+    {
+        b[n++] = (char)('0' + v % 10u);
+        v /= 10u;
+    } while (v != 0u);
+    while (n > 0)
+        fw_putc(b[--n]);
+}
+
+static void put_u64(uint64_t v)
+{
+    char b[21];
+    int n = 0;
+    do
+    {
+        b[n++] = (char)('0' + (unsigned)(v % 10u));
+        v /= 10u;
+    } while (v != 0u);
+    while (n > 0)
+        fw_putc(b[--n]);
+}
+
+static void put_i(int32_t v)
+{
+    if (v < 0)
+    {
+        fw_putc('-');
+        put_u((uint32_t)(-(v + 1)) + 1u);
+    }
+    else
+        put_u((uint32_t)v);
+}
+
+static void put_hex(uint32_t v)
+{
+    int k;
+    for (k = 28; k >= 0; k -= 4)
+        fw_putc("0123456789abcdef"[(v >> k) & 15u]);
+}
+
+static uint32_t bits(float f)
+{
+    uint32_t u;
+    memcpy(&u, &f, sizeof u);
+    return u;
+}
+
+/* fixed-point decimal with 4 digits (readability only; the comparison reads the hex bits) */
+static void put_f(float f)
+{
+    uint32_t whole, frac;
+    if (!(f == f))
+    {
+        put_s("nan");
+        return;
+    }
+    if (f < 0.0f)
+    {
+        fw_putc('-');
+        f = -f;
+    }
+    if (f >= 1.0e6f)
+    {
+        put_s("big");
+        return;
+    }
+    whole = (uint32_t)f;
+    frac = (uint32_t)((f - (float)whole) * 10000.0f + 0.5f);
+    if (frac >= 10000u)
+    {
+        ++whole;
+        frac -= 10000u;
+    }
+    put_u(whole);
+    fw_putc('.');
+    fw_putc((char)('0' + frac / 1000u));
+    fw_putc((char)('0' + frac / 100u % 10u));
+    fw_putc((char)('0' + frac / 10u % 10u));
+    fw_putc((char)('0' + frac % 10u));
+}
+
+static void put_kv(const char *key, uint32_t v)
+{
+    fw_putc(' ');
+    put_s(key);
+    fw_putc('=');
+    put_u(v);
+}
+
+/* ---- models ---------------------------------------------------------------------------------------- */
+
+/* The sensor of the build (FW_SENSOR, with its capacities in config/<sensor>/lidet_user_config.h) */
+#ifndef FW_SENSOR
+#define FW_SENSOR "vlp16"
+#endif
+
+/* The sensor's own models when weights/ has them (trained for it), else the HDL-64 ones. */
+static const char *pick_models(const lidet_pn_model_t **cls, const lidet_pn_model_t **box)
+{
+    static const char *const fams[2][3] = {{FW_SENSOR, "cls_" FW_SENSOR, "box_" FW_SENSOR},
+                                           {"hdl64", "cls_hdl64", "box_hdl64"}};
+    int k;
+    for (k = 0; k < 2; ++k)
+    {
+        *cls = lidet_pn_find(lidet_weights_models, LIDET_WEIGHTS_N_MODELS, fams[k][1]);
+        *box = lidet_pn_find(lidet_weights_models, LIDET_WEIGHTS_N_MODELS, fams[k][2]);
+        if (*cls != 0 && *box != 0)
+            return fams[k][0];
+    }
+    return 0;
+}
+
+/* ---- 64-bit stage counts ------------------------------------------------------------------------------ */
+
+/* The detector's per-stage ticks are uint32 (lidet_detector_stats_t), and a scan on a core without FPU runs
+ * past 2^32 instructions (the Cortex-M3's box net alone: ~5.5 G). So the clock hook also records every
+ * 64-bit timestamp it hands out, and the stages are rebuilt from them in the order the detector takes them:
+ * 4 calls around projection, ground and clustering (lidet_workspace_run_timed), the classification start,
+ * a pair around each box net, the classification end, and a pair around the post-processing. The low 32 bits
+ * of every rebuilt stage must equal the detector's own ticks, which checks that order at every run. */
+#define REC_MAX (8u + 2u * LIDET_MAX_CLUSTERS)
+
+typedef struct
+{
+    uint64_t t[REC_MAX];
+    uint32_t n;
+} rec_t;
+
+static rec_t g_rec;
+
+static uint32_t rec_clock(void *ctx)
+{
+    rec_t *r = (rec_t *)ctx;
+    const uint64_t v = fw_insn64();
+    if (r->n < REC_MAX)
+        r->t[r->n] = v;
+    ++r->n;
+    return (uint32_t)v;
+}
+
+/* -> 0 and out[] filled, or 1 when the recorded calls do not match the detector's order */
+static int rec_stages(const rec_t *r, const lidet_detector_stats_t *s, uint64_t out[LIDET_DET_N_STAGES])
+{
+    uint64_t box = 0u;
+    uint32_t k, nb = s->n_boxed;
+    if (r->n != 8u + 2u * nb || r->n > REC_MAX)
+        return 1;
+    out[LIDET_DET_STAGE_PROJECT] = r->t[1] - r->t[0];
+    out[LIDET_DET_STAGE_GROUND] = r->t[2] - r->t[1];
+    out[LIDET_DET_STAGE_CLUSTER] = r->t[3] - r->t[2];
+    for (k = 0; k < nb; ++k)
+        box += r->t[6u + 2u * k] - r->t[5u + 2u * k];
+    out[LIDET_DET_STAGE_BOX] = box;
+    out[LIDET_DET_STAGE_CLASSIFY] = (r->t[5u + 2u * nb] - r->t[4]) - box;
+    out[LIDET_DET_STAGE_POST] = r->t[7u + 2u * nb] - r->t[6u + 2u * nb];
+    for (k = 0; k < LIDET_DET_N_STAGES; ++k)
+        if ((uint32_t)out[k] != s->ticks[k])
+            return 1;
+    return 0;
+}
+
+/* ---- one run ---------------------------------------------------------------------------------------- */
+
+static int run_once(const char *name, const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *mc,
+                    const lidet_pn_model_t *mb)
+{
+    static const char *const stage_names[LIDET_DET_N_STAGES] = {"project", "ground", "cluster",
+                                                                 "classify", "box", "post"};
+    const lidet_detector_stats_t *s;
+    const lidet_detection_t *det;
+    lidet_status_t st;
+    uint32_t n_det = 0, k;
+    uint64_t t0, t1;
+
+    st = lidet_detector_init(&g_det, cfg, mc, mb);
+    if (st != LIDET_OK)
+    {
+        put_s("init run=");
+        put_s(name);
+        put_s(" failed status=");
+        put_i((int32_t)st);
+        fw_putc('\n');
+        return 1;
+    }
+    g_rec.n = 0u;
+    t0 = fw_insn64();
+    st = lidet_detector_run(&g_det, fw_scan_xyz, fw_scan_n, 3u, fw_scan_has_ring ? fw_scan_ring : 0, 0);
+    t1 = fw_insn64();
+    s = lidet_detector_stats(&g_det);
+    det = lidet_detector_detections(&g_det, &n_det);
+
+    put_s("stats run=");
+    put_s(name);
+    put_s(" status=");
+    put_i((int32_t)st);
+    put_kv("clusters", s->n_clusters);
+    put_kv("classified", s->n_classified);
+    put_kv("gate1_rejected", s->n_gate1_rejected);
+    put_kv("boxed", s->n_boxed);
+    put_kv("gate2_rejected", s->n_gate2_rejected);
+    put_kv("size_rejected", s->n_size_rejected);
+    put_kv("nms_suppressed", s->n_nms_suppressed);
+    put_kv("over_budget", s->n_over_budget);
+    put_kv("over_capacity", s->n_over_capacity);
+    put_kv("detections", n_det);
+    fw_putc('\n');
+    for (k = 0; k < n_det; ++k)
+    {
+        const lidet_detection_t *d = &det[k];
+        const float v[10] = {d->score, d->box.cx_m, d->box.cy_m, d->box.cz_m, d->box.l_m,
+                             d->box.w_m, d->box.h_m, d->box.yaw_rad, d->energy_cls, d->energy_box};
+        uint32_t j;
+        put_s("det ");
+        put_s(name);
+        fw_putc(' ');
+        put_u(k);
+        fw_putc(' ');
+        put_s(d->cls < LIDET_N_CLASSES ? k_class_names[d->cls] : "?");
+        fw_putc(' ');
+        put_u(d->cluster_id);
+        fw_putc(' ');
+        put_u(d->n_points);
+        for (j = 0; j < 10u; ++j)
+        {
+            fw_putc(' ');
+            put_hex(bits(v[j]));
+        }
+        put_s(" # score ");
+        put_f(d->score);
+        put_s(" xyz ");
+        put_f(d->box.cx_m);
+        fw_putc(' ');
+        put_f(d->box.cy_m);
+        fw_putc(' ');
+        put_f(d->box.cz_m);
+        put_s(" lwh ");
+        put_f(d->box.l_m);
+        fw_putc(' ');
+        put_f(d->box.w_m);
+        fw_putc(' ');
+        put_f(d->box.h_m);
+        put_s(" yaw ");
+        put_f(d->box.yaw_rad);
+        fw_putc('\n');
+    }
+    if (fw_have_counter())
+    {
+        uint64_t stage64[LIDET_DET_N_STAGES];
+        if (rec_stages(&g_rec, s, stage64) != 0)
+        {
+            put_s("insn run=");
+            put_s(name);
+            put_s(" FAIL: the clock calls do not match the detector's stage order (fw_detect.c: rec_stages)\n");
+            return 1;
+        }
+        put_s("insn run=");
+        put_s(name);
+        for (k = 0; k < LIDET_DET_N_STAGES; ++k)
+        {
+            fw_putc(' ');
+            put_s(stage_names[k]);
+            fw_putc('=');
+            put_u64(stage64[k]);
+        }
+        put_s(" scan="); /* 64 bits: the stages' uint32 counts are checked against it (run_fw.py) */
+        put_u64(t1 - t0);
+        fw_putc('\n');
+    }
+    return LIDET_SUCCEEDED(st) ? 0 : 1;
+}
+
+/* The counter against loops of known length. measure() is one function whatever n is (n arrives in a
+ * register), so the instructions around the loop are the same in every call; the difference of two loops
+ * removes them (and the clock calls), so measured must equal expected exactly. */
+static __attribute__((noinline)) uint32_t measure(uint32_t n)
+{
+    const uint32_t t0 = fw_clock(0);
+    fw_spin(n);
+    return fw_clock(0) - t0;
+}
+
+static int calibrate(void)
+{
+    static volatile uint32_t lens[4] = {1u, 1000u, 12345u, 1000000u}; /* volatile: no constant folding */
+    uint32_t base, k;
+    int bad = 0;
+    base = measure(lens[0]);
+    for (k = 1; k < 4u; ++k)
+    {
+        const uint32_t n = lens[k];
+        const uint32_t measured = measure(n) - base;
+        const uint32_t expected = fw_spin_insn(n) - fw_spin_insn(lens[0]);
+        put_s("calib");
+        put_kv("n", n);
+        put_kv("expected", expected);
+        put_kv("measured", measured);
+        fw_putc('\n');
+        bad |= measured != expected;
+    }
+    /* a loop longer than a 32-bit tick counter can hold at 6.4 ticks per instruction (MPS2: 671 M): the
+     * counter must be extended past its wrap. Here the wrap handler's few instructions count too. */
+    {
+        static volatile uint32_t long_n = 350000000u;
+        const uint32_t n = long_n;
+        const uint32_t measured = measure(n) - base;
+        const uint32_t expected = fw_spin_insn(n) - fw_spin_insn(lens[0]);
+        put_s("calib_long");
+        put_kv("n", n);
+        put_kv("expected", expected);
+        put_kv("measured", measured);
+        fw_putc('\n');
+        bad |= measured < expected || measured - expected > 64u;
+    }
+    return bad;
+}
+
+int fw_main(void)
+{
+    lidet_detector_cfg_t cfg;
+    const lidet_pn_model_t *mc = 0, *mb = 0;
+    const lidet_sensor_t *sensor = lidet_sensor_find(FW_SENSOR);
+    const char *family = pick_models(&mc, &mb);
+    int bad = 0, c;
+
+    put_s("lidet-fw board=");
+    put_s(fw_board_name);
+    put_s(" core=");
+    put_s(fw_core_name);
+    put_s(" build=float sensor=" FW_SENSOR " models=");
+    put_s(family != 0 ? family : "none");
+    put_s(" scan=");
+    put_s(fw_scan_name);
+    put_kv("points", fw_scan_n);
+    put_kv("ring", (uint32_t)fw_scan_has_ring);
+    fw_putc('\n');
+    put_s("mem");
+    put_kv("detector_bytes", lidet_detector_bytes());
+    put_kv("max_rows", LIDET_MAX_ROWS);
+    put_kv("max_cols", LIDET_MAX_COLS);
+    put_kv("max_points", LIDET_MAX_POINTS);
+    put_kv("max_clusters", LIDET_MAX_CLUSTERS);
+    fw_putc('\n');
+    if (family == 0 || sensor == 0)
+    {
+        put_s("lidet-fw: FAIL (no models or no " FW_SENSOR " sensor profile)\n");
+        return 1;
+    }
+    if (fw_have_counter() && calibrate() != 0)
+    {
+        put_s("lidet-fw: FAIL (instruction counter does not match the calibration loop)\n");
+        return 1;
+    }
+
+    /* run 1: the configuration a user gets (gates and size checks on) */
+    lidet_detector_cfg_default(&cfg, sensor);
+    cfg.clock = rec_clock;
+    cfg.clock_ctx = &g_rec;
+    bad |= run_once("default", &cfg, mc, mb);
+    /* run 2: gates and size checks off, so that every classified proposal is boxed and reported */
+    cfg.gate1 = 0u;
+    cfg.gate2 = 0u;
+    for (c = 0; c < LIDET_N_CLASSES; ++c)
+    {
+        int j;
+        for (j = 0; j < 3; ++j)
+        {
+            cfg.size_min_m[c][j] = 0.0f;
+            cfg.size_max_m[c][j] = 1000.0f;
+        }
+    }
+    bad |= run_once("open", &cfg, mc, mb);
+
+    put_s("stack");
+    put_kv("used", fw_stack_used());
+    put_kv("size", fw_stack_size());
+    fw_putc('\n');
+    put_s(bad ? "lidet-fw: FAIL (a detector run failed)\n" : "lidet-fw: PASS\n");
+    return bad;
+}

@@ -1,0 +1,112 @@
+# SPDX-License-Identifier: MIT
+# Firmware images (ports/firmware) under QEMU, compared with the host build (issue 17).
+#
+# - fw_host_ref (fw_host_ref_hdl64): the firmware application (ports/firmware/fw_detect.c) built for the host
+#   against lidet rebuilt with the firmware's capacities (ports/firmware/config/<sensor>/lidet_user_config.h),
+#   on the same generated scan.
+# - firmware_<board>: one cross build per board (ExternalProject: its own toolchain file), part of the normal
+#   build when its cross compiler is installed (tools/scripts/install_deps.sh installs them), and one ctest test
+#   per board that runs the image under QEMU and compares it with fw_host_ref (tools/firmware/run_fw.py).
+#   Without the compiler or QEMU the test reports itself skipped with the reason.
+# `make firmware` builds the target `firmware`; `make firmware-run` runs the tests with their figures.
+include(ExternalProject)
+set(fw_default ON)
+if(LIDET_SANITIZE)
+  set(fw_default OFF) # the sanitizer build re-runs the host tests; the images are the same as the normal build's
+endif()
+option(LIDET_BUILD_FIRMWARE "Build the firmware images when their cross compilers are installed" ${fw_default})
+if(NOT LIDET_BUILD_FIRMWARE)
+  return()
+endif()
+find_package(Python3 COMPONENTS Interpreter)
+if(NOT Python3_Interpreter_FOUND)
+  message(WARNING "python3 not found: the firmware tests are not registered")
+  return()
+endif()
+
+set(fw_src ${PROJECT_SOURCE_DIR}/ports/firmware)
+
+# ---- the host references: one per sensor configuration (ports/firmware/config/<sensor>) ------------
+file(GLOB fw_weights_sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/weights/*.c)
+function(lidet_fw_host_ref sensor exe)
+  set(lib lidet_fwcap_${sensor})
+  add_library(${lib} STATIC ${LIDET_SOURCES} ${fw_weights_sources})
+  set_target_properties(${lib} PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
+  target_include_directories(${lib} PUBLIC ${PROJECT_SOURCE_DIR}/lib/include ${PROJECT_SOURCE_DIR}/weights
+                                           ${fw_src}/config/${sensor} PRIVATE ${PROJECT_SOURCE_DIR}/lib/src)
+  target_compile_definitions(${lib} PUBLIC LIDET_USER_CONFIG)
+  # the same numerics as the images: one rounding per operation, no errno, no AVX2 kernel clones
+  target_compile_options(${lib} PRIVATE -Wall -Wextra -Wpedantic -Werror -Wdouble-promotion -fno-math-errno
+                                        -ffp-contract=off)
+  if(LIDET_HAVE_LIBM)
+    target_link_libraries(${lib} PUBLIC m)
+  endif()
+  set(scan_c ${CMAKE_CURRENT_BINARY_DIR}/fw_host_scan_${sensor}.c)
+  set(data ${PROJECT_SOURCE_DIR}/tests/data/sim_${sensor})
+  add_custom_command(OUTPUT ${scan_c}
+    COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tools/firmware/scan_to_c.py ${data}/velodyne/000000.bin
+            --ring ${data}/ring/000000.bin --name tests/data/sim_${sensor}/000000 --out ${scan_c}
+    DEPENDS ${PROJECT_SOURCE_DIR}/tools/firmware/scan_to_c.py ${data}/velodyne/000000.bin ${data}/ring/000000.bin
+    VERBATIM)
+  add_executable(${exe} ${fw_src}/fw_detect.c ${fw_src}/fw_host_port.c ${scan_c})
+  set_target_properties(${exe} PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
+  target_include_directories(${exe} PRIVATE ${fw_src})
+  target_compile_definitions(${exe} PRIVATE FW_SENSOR="${sensor}")
+  target_compile_options(${exe} PRIVATE -Wall -Wextra -Werror -fno-math-errno -ffp-contract=off)
+  target_link_libraries(${exe} PRIVATE ${lib})
+  add_test(NAME firmware_${exe} COMMAND ${exe})
+  set_tests_properties(firmware_${exe} PROPERTIES PASS_REGULAR_EXPRESSION "lidet-fw: PASS")
+endfunction()
+lidet_fw_host_ref(vlp16 fw_host_ref)
+lidet_fw_host_ref(hdl64 fw_host_ref_hdl64)
+
+# ---- the images --------------------------------------------------------------------------------
+add_custom_target(firmware DEPENDS fw_host_ref fw_host_ref_hdl64)
+# image name | board | sensor | toolchain file | compiler | size tool. The HDL-64 (KITTI-like) images need ~4.5 MiB
+# of RAM: QEMU virt, and the AN500's Cortex-M7 with the detector placed in its 16 MiB PSRAM.
+set(fw_images
+    "mps2-an385|mps2-an385|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
+    "mps2-an385-m0plus|mps2-an385-m0plus|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
+    "mps2-an386|mps2-an386|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
+    "mps2-an500|mps2-an500|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
+    "mps2-an500-hdl64|mps2-an500|hdl64|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
+    "virt-rv32imafc|virt-rv32imafc|vlp16|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size"
+    "virt-rv32imafc-hdl64|virt-rv32imafc|hdl64|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size")
+foreach(entry IN LISTS fw_images)
+  string(REPLACE "|" ";" f "${entry}")
+  list(GET f 0 image)
+  list(GET f 1 board)
+  list(GET f 2 sensor)
+  list(GET f 3 tc)
+  list(GET f 4 cc)
+  list(GET f 5 sz)
+  if(sensor STREQUAL "vlp16")
+    set(ref fw_host_ref)
+  else()
+    set(ref fw_host_ref_${sensor})
+  endif()
+  find_program(LIDET_FW_CC_${tc} ${cc})
+  if(NOT LIDET_FW_CC_${tc})
+    add_test(NAME firmware_${image}
+             COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tools/firmware/run_fw.py --board ${board}
+                     --label ${image}
+                     --skip "${cc} not found (tools/scripts/install_deps.sh installs the cross toolchains)")
+    set_tests_properties(firmware_${image} PROPERTIES SKIP_RETURN_CODE 77)
+    continue()
+  endif()
+  set(bdir ${CMAKE_BINARY_DIR}/firmware/${image})
+  ExternalProject_Add(firmware_${image}
+    SOURCE_DIR ${fw_src}
+    BINARY_DIR ${bdir}
+    CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/cmake/toolchains/${tc}.cmake
+               -DLIDET_FW_BOARD=${board} -DLIDET_FW_SENSOR=${sensor} -DPython3_EXECUTABLE=${Python3_EXECUTABLE}
+    BUILD_ALWAYS ON
+    INSTALL_COMMAND ""
+    BUILD_BYPRODUCTS ${bdir}/lidet_fw.elf)
+  add_dependencies(firmware firmware_${image})
+  add_test(NAME firmware_${image}
+           COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tools/firmware/run_fw.py --board ${board}
+                   --label ${image} --elf ${bdir}/lidet_fw.elf --host-ref $<TARGET_FILE:${ref}> --size ${sz}
+                   --json ${bdir}/report.json --timeout 600)
+  set_tests_properties(firmware_${image} PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 900 LABELS firmware)
+endforeach()

@@ -1,0 +1,129 @@
+# SPDX-License-Identifier: MIT
+"""tools/firmware: the scan -> C generator and the QEMU-vs-host comparison of run_fw.py (issue 17).
+
+The images themselves run under ctest (firmware_<board>, tests/firmware.cmake); these tests check that the
+tools they rely on read exactly what was written and that the comparison fails when it should."""
+import copy
+import importlib.util
+import os
+import pathlib
+import re
+import struct
+import subprocess
+import sys
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def _load(name):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / "firmware" / f"{name}.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+run_fw = _load("run_fw")
+scan_to_c = _load("scan_to_c")
+
+
+def test_scan_to_c_writes_the_exact_bits(tmp_path):
+    pts = [(1.0, -2.5, 0.1, 0.3), (-0.0, 1e-30, 3.4028234e38, 7.0), (12.345678, -98.7654, 1.5e-3, 0.0)]
+    scan = tmp_path / "s.bin"
+    scan.write_bytes(b"".join(struct.pack("<4f", *p) for p in pts))
+    ring = tmp_path / "r.bin"
+    ring.write_bytes(struct.pack("<3H", 0, 15, 7))
+    out = tmp_path / "fw_scan.c"
+    assert scan_to_c.main([str(scan), "--ring", str(ring), "--name", "tiny", "--out", str(out)]) == 0
+    text = out.read_text()
+    assert "const uint32_t fw_scan_n = 3u;" in text and "fw_scan_has_ring = 1" in text
+    body = text.split("fw_scan_xyz[9] = {")[1].split("};")[0]
+    lits = re.findall(r"(-?0x[0-9a-f.]+p[+-]\d+)f", body)
+    got = [float.fromhex(x) for x in lits]
+    want = [struct.unpack("<f", struct.pack("<f", v))[0] for p in pts for v in p[:3]]
+    assert got == want  # every coordinate bit for bit, the intensity dropped
+    assert struct.pack("<9f", *got) == struct.pack("<9f", *want)
+    assert "0, 15, 7," in text
+
+
+def test_scan_to_c_rejects_bad_files(tmp_path):
+    scan = tmp_path / "s.bin"
+    scan.write_bytes(b"\0" * 20)
+    with pytest.raises(SystemExit):
+        scan_to_c.main([str(scan), "--out", str(tmp_path / "x.c")])
+    scan.write_bytes(b"\0" * 32)
+    ring = tmp_path / "r.bin"
+    ring.write_bytes(b"\0" * 2)
+    with pytest.raises(SystemExit):
+        scan_to_c.main([str(scan), "--ring", str(ring), "--out", str(tmp_path / "x.c")])
+
+
+def _bits(v):
+    return "%08x" % struct.unpack("<I", struct.pack("<f", v))[0]
+
+
+def _report(dets, counts=None):
+    """A firmware-style report with the given detections of run 'open': (cluster, class, [10 floats])."""
+    counts = counts or {"clusters": 5, "detections": len(dets)}
+    lines = ["lidet-fw board=x core=y build=float", "mem detector_bytes=100 max_rows=16",
+             "stats run=open status=0 " + " ".join(f"{k}={v}" for k, v in counts.items())]
+    for k, (cl, cls, vals) in enumerate(dets):
+        lines.append(f"det open {k} {cls} {cl} 20 " + " ".join(_bits(v) for v in vals) + " # readable")
+    lines.append("lidet-fw: PASS")
+    return "\n".join(lines) + "\n"
+
+
+BASE = [(3, "Car", [0.9, 10.0, -2.0, 0.5, 4.0, 1.7, 1.5, 0.3, -5.0, -3.0]),
+        (7, "Pedestrian", [0.6, 4.0, 1.0, 0.8, 0.6, 0.6, 1.7, -3.1415, -2.0, -1.0])]
+
+
+def test_compare_accepts_identical_and_tiny_differences():
+    host = run_fw.parse(_report(BASE))
+    assert host["pass"] and set(host["det"]["open"]) == {3, 7}
+    assert run_fw.compare(host, copy.deepcopy(host))[0] == []
+    near = copy.deepcopy(BASE)
+    near[0][2][1] += 2e-4                 # 0.2 mm
+    near[1][2][7] = 3.1415  # the same heading across the +-pi seam (0.2 mrad apart)
+    assert run_fw.compare(host, run_fw.parse(_report(near)))[0] == []
+
+
+@pytest.mark.parametrize("mutate, message", [
+    (lambda d: d[0][2].__setitem__(2, d[0][2][2] + 5e-3), "cy"),          # 5 mm off
+    (lambda d: d[1][2].__setitem__(7, d[1][2][7] + 0.01), "yaw"),
+    (lambda d: d.__setitem__(0, (3, "Cyclist", d[0][2])), "Cyclist"),
+    (lambda d: d.pop(), "detections of clusters"),
+])
+def test_compare_rejects(mutate, message):
+    host = run_fw.parse(_report(BASE))
+    bad = copy.deepcopy(BASE)
+    mutate(bad)
+    errors, _ = run_fw.compare(host, run_fw.parse(_report(bad)))
+    assert errors and any(message in e for e in errors), errors
+
+
+def test_compare_rejects_different_counts():
+    host = run_fw.parse(_report(BASE, {"clusters": 5, "gate1_rejected": 0}))
+    fw = run_fw.parse(_report(BASE, {"clusters": 5, "gate1_rejected": 1}))
+    errors, _ = run_fw.compare(host, fw)
+    assert any("counts differ" in e for e in errors)
+
+
+def test_skip_exit_code(capsys):
+    assert run_fw.main(["--board", "mps2-an386", "--skip", "no compiler"]) == 77
+    assert "SKIPPED firmware_mps2-an386: no compiler" in capsys.readouterr().out
+
+
+def test_host_reference_reports_two_runs_with_detections():
+    """The host build of the firmware application (fw_host_ref): both runs, boxes in the open run."""
+    exe = pathlib.Path(os.environ.get("LIDET_BUILD_DIR", ROOT / "build")) / "tests" / "fw_host_ref"
+    if not exe.exists():
+        pytest.skip(f"{exe} not built")
+    p = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stdout + p.stderr
+    rep = run_fw.parse(p.stdout)
+    assert rep["pass"] and set(rep["stats"]) == {"default", "open"}
+    assert rep["mem"]["max_rows"] == 16 and rep["mem"]["max_cols"] == 1800
+    assert len(rep["det"]["open"]) == rep["stats"]["open"]["detections"] > 0
+    for d in rep["det"]["open"].values():
+        assert d["l"] > 0 and d["w"] > 0 and d["h"] > 0 and 0 < d["score"] < 1

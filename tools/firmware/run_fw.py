@@ -1,0 +1,263 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Run one lidet firmware image under QEMU and compare it with the host build (a ctest test per board).
+
+    python3 tools/firmware/run_fw.py --board mps2-an386 --elf build/firmware/mps2-an386/lidet_fw.elf \\
+        --host-ref build/tests/fw_host_ref [--qemu qemu-system-arm] [--size arm-none-eabi-size] [--json OUT]
+
+1. Runs the host reference (fw_detect.c built for the host against lidet with the same capacities,
+   ports/firmware/config/vlp16/lidet_user_config.h, on the same generated scan).
+2. Runs the image under QEMU with exact instruction counting (-icount), with a timeout.
+3. Checks: the image says PASS (its instruction counter matched loops of known length), and for every run
+   (gates as they are, and gates + size checks off) the same counts at every step of the detector, the
+   same detections (matched by cluster id: same number, same classes), boxes within ATOL_M metres and
+   ATOL_RAD radians, scores within ATOL_SCORE and energies within RTOL_ENERGY (relative).
+   Why not bit-identical: the host, newlib (Arm) and picolibc (RISC-V) each have their own expf, logf, sinf,
+   cosf, tanf and atan2f (each within an ulp or two); everything else is IEEE single precision in the same
+   order on both sides (-ffp-contract=off, no reassociation). The report says how many values were
+   bit-identical and the largest differences.
+4. Prints the instruction counts per stage, the stack high-water and a size report (`size -A`).
+Exit status: 0 pass, 1 fail, 77 skipped (a tool is missing: ctest reports the test as skipped).
+"""
+import argparse
+import json
+import math
+import os
+import shutil
+import struct
+import subprocess
+import sys
+
+ATOL_M = 1e-3
+ATOL_RAD = 1e-3
+ATOL_SCORE = 1e-4
+RTOL_ENERGY = 1e-4
+SKIP = 77
+
+BOARDS = {
+    # board: (qemu binary, machine args, icount shift)
+    "mps2-an385": ("qemu-system-arm", ["-M", "mps2-an385"], 8),
+    # Cortex-M0+ code (ARMv6-M) on the AN385's Cortex-M3: QEMU 7.2 has no M0+ board
+    "mps2-an385-m0plus": ("qemu-system-arm", ["-M", "mps2-an385"], 8),
+    "mps2-an386": ("qemu-system-arm", ["-M", "mps2-an386"], 8),
+    "mps2-an500": ("qemu-system-arm", ["-M", "mps2-an500"], 8),
+    "virt-rv32imafc": ("qemu-system-riscv32", ["-M", "virt", "-bios", "none"], 0),
+}
+
+FIELDS = ["score", "cx", "cy", "cz", "l", "w", "h", "yaw", "energy_cls", "energy_box"]
+
+
+def qemu_cmd(board, qemu, elf):
+    _, machine, shift = BOARDS[board]
+    cmd = [qemu] + machine + ["-icount", f"shift={shift}", "-display", "none", "-monitor", "none", "-kernel", elf]
+    if board.startswith("mps2-"):
+        cmd += ["-semihosting-config", "enable=on,target=native", "-serial", "null"]
+    else:
+        cmd += ["-serial", "stdio"]
+    return cmd
+
+
+def f32(hexbits):
+    return struct.unpack("<f", struct.pack("<I", int(hexbits, 16)))[0]
+
+
+def parse(text):
+    """-> dict: header, mem, calib list, stats{run: {k: v}}, det{run: {cluster: rec}}, insn{run: {}}, stack."""
+    out = {"stats": {}, "det": {}, "insn": {}, "calib": [], "pass": False, "lines": text.splitlines()}
+    for line in out["lines"]:
+        tok = line.split("#")[0].split()
+        if not tok:
+            continue
+        kv = {t.split("=", 1)[0]: t.split("=", 1)[1] for t in tok[1:] if "=" in t}
+        if tok[0] == "lidet-fw:":
+            out["pass"] = tok[1] == "PASS"
+        elif tok[0] == "lidet-fw":
+            out["header"] = kv
+        elif tok[0] in ("mem", "stack"):
+            out[tok[0]] = {k: int(v) for k, v in kv.items()}
+        elif tok[0] == "calib":
+            out["calib"].append({k: int(v) for k, v in kv.items()})
+        elif tok[0] == "stats":
+            run = kv.pop("run")
+            out["stats"][run] = {k: int(v) for k, v in kv.items()}
+        elif tok[0] == "insn":
+            run = kv.pop("run")
+            out["insn"][run] = {k: int(v) for k, v in kv.items()}
+        elif tok[0] == "det":
+            run, k, cls, cluster, npts = tok[1], int(tok[2]), tok[3], int(tok[4]), int(tok[5])
+            vals = [f32(h) for h in tok[6:16]]
+            rec = {"rank": k, "cls": cls, "n_points": npts, "bits": tok[6:16]}
+            rec.update(dict(zip(FIELDS, vals)))
+            out["det"].setdefault(run, {})[cluster] = rec
+    return out
+
+
+def ang_diff(a, b):
+    d = math.fmod(a - b, 2.0 * math.pi)
+    if d > math.pi:
+        d -= 2.0 * math.pi
+    if d < -math.pi:
+        d += 2.0 * math.pi
+    return abs(d)
+
+
+def compare(host, fw):
+    """-> (errors, summary lines)."""
+    errors, lines = [], []
+    if set(host["stats"]) != set(fw["stats"]) or not host["stats"]:
+        errors.append(f"runs differ: host {sorted(host['stats'])} firmware {sorted(fw['stats'])}")
+        return errors, lines
+    for run in sorted(host["stats"]):
+        hs, fs = host["stats"][run], fw["stats"][run]
+        if hs != fs:
+            diff = {k: (hs.get(k), fs.get(k)) for k in set(hs) | set(fs) if hs.get(k) != fs.get(k)}
+            errors.append(f"run {run}: counts differ (host, firmware): {diff}")
+        hd, fd = host["det"].get(run, {}), fw["det"].get(run, {})
+        if set(hd) != set(fd):
+            errors.append(f"run {run}: detections of clusters {sorted(hd)} on the host, {sorted(fd)} on the firmware")
+            continue
+        worst = {f: 0.0 for f in FIELDS}
+        same_bits = total = 0
+        for cl in sorted(hd):
+            h, f = hd[cl], fd[cl]
+            if h["cls"] != f["cls"] or h["n_points"] != f["n_points"]:
+                errors.append(f"run {run} cluster {cl}: host {h['cls']}/{h['n_points']} pts, "
+                              f"firmware {f['cls']}/{f['n_points']} pts")
+            for i, name in enumerate(FIELDS):
+                total += 1
+                same_bits += h["bits"][i] == f["bits"][i]
+                if name == "yaw":
+                    d = ang_diff(h[name], f[name])
+                    tol = ATOL_RAD
+                elif name == "score":
+                    d, tol = abs(h[name] - f[name]), ATOL_SCORE
+                elif name.startswith("energy"):
+                    d, tol = abs(h[name] - f[name]), RTOL_ENERGY * max(1.0, abs(h[name]))
+                else:
+                    d, tol = abs(h[name] - f[name]), ATOL_M
+                worst[name] = max(worst[name], d)
+                if not d <= tol:
+                    errors.append(f"run {run} cluster {cl}: {name} host {h[name]!r} firmware {f[name]!r} "
+                                  f"(|diff| {d:.3g} > {tol:.3g})")
+        lines.append(f"run {run}: {len(hd)} detections, counts identical: {hs == fs}; "
+                     f"{same_bits}/{total} values bit-identical; max |diff| box "
+                     f"{max(worst[k] for k in ('cx', 'cy', 'cz', 'l', 'w', 'h')):.3g} m, yaw {worst['yaw']:.3g} rad, "
+                     f"score {worst['score']:.3g}, energies {max(worst['energy_cls'], worst['energy_box']):.3g}")
+    return errors, lines
+
+
+def size_report(size_tool, elf):
+    out = subprocess.run([size_tool, "-A", elf], check=True, capture_output=True, text=True).stdout
+    sec = {}
+    for line in out.splitlines():
+        t = line.split()
+        if len(t) == 3 and t[0].startswith(".") and t[1].isdigit():
+            sec[t[0]] = int(t[1])
+    # code: .text plus the Arm unwind tables (loaded); .ARM.attributes and debug sections are not in flash
+    text = sum(v for k, v in sec.items() if k in (".text", ".ARM.exidx", ".ARM.extab"))
+    rep = {
+        "text": text,
+        "rodata_weights": sec.get(".rodata.weights", 0),
+        "rodata_scan": sec.get(".rodata.scan", 0),
+        "rodata_other": sec.get(".rodata", 0),
+        "data": sec.get(".data", 0),
+        "bss": sec.get(".bss", 0) + sec.get(".extram", 0),
+        "bss_extram": sec.get(".extram", 0),  # placed in the board's external RAM (part of bss above)
+        "stack_reserved": sec.get(".stack", 0),
+    }
+    rep["flash_without_scan"] = text + rep["rodata_weights"] + rep["rodata_other"] + rep["data"]
+    rep["ram"] = rep["data"] + rep["bss"] + rep["stack_reserved"]
+    return rep
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--board", required=True, choices=sorted(BOARDS))
+    ap.add_argument("--label", help="name of the image in messages (default: the board)")
+    ap.add_argument("--elf")
+    ap.add_argument("--host-ref", help="fw_host_ref executable")
+    ap.add_argument("--qemu", help="QEMU binary (default: by board)")
+    ap.add_argument("--size", help="the toolchain's size tool, for the size report")
+    ap.add_argument("--timeout", type=float, default=600.0)
+    ap.add_argument("--json", help="write the parsed results and the size report here")
+    ap.add_argument("--skip", help="print this reason and exit 77 (ctest: skipped)")
+    a = ap.parse_args(argv)
+    name = a.label or a.board
+
+    if a.skip:
+        print(f"SKIPPED firmware_{name}: {a.skip}")
+        return SKIP
+    qemu = shutil.which(a.qemu or BOARDS[a.board][0])
+    if qemu is None:
+        print(f"SKIPPED firmware_{name}: {a.qemu or BOARDS[a.board][0]} not found "
+              "(tools/scripts/install_deps.sh installs qemu-system-arm / qemu-system-misc)")
+        return SKIP
+    if not a.elf or not os.path.isfile(a.elf) or not a.host_ref or not os.path.isfile(a.host_ref):
+        print(f"FAIL firmware_{name}: image {a.elf} or host reference {a.host_ref} missing (make firmware)")
+        return 1
+
+    host_p = subprocess.run([a.host_ref], capture_output=True, text=True, timeout=a.timeout)
+    host = parse(host_p.stdout)
+    if host_p.returncode != 0 or not host["pass"]:
+        print(host_p.stdout + host_p.stderr)
+        print(f"FAIL firmware_{name}: the host reference failed (exit {host_p.returncode})")
+        return 1
+
+    cmd = qemu_cmd(a.board, qemu, a.elf)
+    print("$ " + " ".join(cmd))
+    try:
+        # semihosting writes to QEMU's stderr, the UART (-serial stdio) to stdout: read both, in order
+        fw_p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=a.timeout)
+    except subprocess.TimeoutExpired as e:
+        print((e.stdout or b"").decode(errors="replace") if isinstance(e.stdout, bytes) else (e.stdout or ""))
+        print(f"FAIL firmware_{name}: QEMU did not finish within {a.timeout:.0f} s")
+        return 1
+    print(fw_p.stdout, end="")
+    fw = parse(fw_p.stdout)
+    errors = []
+    if fw_p.returncode != 0 or not fw["pass"]:
+        errors.append(f"the image failed (QEMU exit {fw_p.returncode}, PASS line {'seen' if fw['pass'] else 'missing'})")
+    if len(fw["calib"]) < 3 or any(c["measured"] != c["expected"] for c in fw["calib"]):
+        errors.append(f"instruction counter calibration: {fw['calib']}")
+    # the capacities must agree; sizeof(lidet_detector_t) may not (pointers are 8 bytes on the host)
+    caps = lambda m: {k: v for k, v in (m or {}).items() if k != "detector_bytes"}
+    if not caps(fw.get("mem")) or caps(fw.get("mem")) != caps(host.get("mem")):
+        errors.append(f"capacities differ: host {host.get('mem')} firmware {fw.get('mem')}")
+    if "open" not in fw["det"] or not fw["det"]["open"]:
+        errors.append("run 'open' (gates and size checks off) produced no detection: the comparison would be vacuous")
+    for run, ins in fw["insn"].items():
+        stages = sum(v for k, v in ins.items() if k != "scan")
+        # the stages (rebuilt in 64 bits from the clock hook's timestamps, fw_detect.c) must add up to the
+        # 64-bit scan total but for the few instructions between them
+        if not 0 <= ins.get("scan", -1) - stages <= 10000:
+            errors.append(f"run {run}: stages add up to {stages:,} instructions, the scan took {ins.get('scan')}: "
+                          "a stage count is wrong")
+    cerr, summary = compare(host, fw)
+    errors += cerr
+
+    print(f"---- firmware_{name}: comparison with the host build (same capacities, same scan)")
+    for line in summary:
+        print(line)
+    for run, ins in sorted(fw["insn"].items()):
+        print(f"instructions run {run}: " + ", ".join(f"{k} {v:,}" for k, v in ins.items()))
+    if "stack" in fw:
+        print(f"stack high-water: {fw['stack']['used']} of {fw['stack']['size']} bytes")
+    rep = None
+    if a.size and shutil.which(a.size):
+        rep = size_report(shutil.which(a.size), a.elf)
+        print("size (bytes): " + ", ".join(f"{k} {v:,}" for k, v in rep.items()))
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump({"board": a.board, "header": fw.get("header"), "mem": fw.get("mem"), "insn": fw["insn"],
+                       "stack": fw.get("stack"), "stats": fw["stats"], "size": rep, "qemu": cmd,
+                       "comparison": summary, "errors": errors}, f, indent=1)
+    if errors:
+        for e in errors:
+            print(f"FAIL firmware_{name}: {e}")
+        return 1
+    print(f"PASS firmware_{name}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
