@@ -42,6 +42,18 @@ def standalone(run, description=None) -> None:
     print(run(ap.parse_args()))
 
 
+def splice(text: str, section: str) -> str:
+    """Replace the section of `text` whose '## ' heading equals section's first line (up to the next '## '
+    heading), or append it."""
+    head = section.strip().splitlines()[0]
+    lines = text.splitlines(keepends=True)
+    start = next((i for i, ln in enumerate(lines) if ln.rstrip("\n") == head), None)
+    if start is None:
+        return text.rstrip("\n") + "\n\n" + section.strip() + "\n"
+    end = next((i for i in range(start + 1, len(lines)) if lines[i].startswith("## ")), len(lines))
+    return "".join(lines[:start]) + section.strip() + "\n\n" + "".join(lines[end:])
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--build", default="build")
@@ -49,6 +61,8 @@ def main(argv=None) -> int:
     ap.add_argument("--out", default="docs/BENCHMARKS.md")
     ap.add_argument("--only", default="", help="comma-separated subset, e.g. proj,ground")
     ap.add_argument("--quick", action="store_true", help="fewer repetitions (smoke test)")
+    ap.add_argument("--update", action="store_true",
+                    help="with --only: replace those sections (same '## ' heading) in --out, keep the others")
     args = ap.parse_args(argv)
     args.build = pathlib.Path(args.build).resolve()
     args.real = pathlib.Path(args.real).resolve()
@@ -77,7 +91,13 @@ def main(argv=None) -> int:
             f"{datetime.date.today().isoformat()}, {machine()}, one core per process. Every figure below "
             "was measured in that run; each section compares lidet with a peer on the same input in the "
             "same run and gives the ratio.\n\n")
-    if only and pathlib.Path(args.out).exists():
+    if only and args.update and pathlib.Path(args.out).exists():
+        text = pathlib.Path(args.out).read_text()
+        for sec in sections:
+            text = splice(text, sec)
+        pathlib.Path(args.out).write_text(text)
+        print(f"updated {len(sections)} section(s) of {args.out}")
+    elif only and pathlib.Path(args.out).exists():
         print(f"--only given: not overwriting {args.out}; sections printed above")
     else:
         pathlib.Path(args.out).write_text(head + "\n".join(sections))
