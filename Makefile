@@ -83,7 +83,7 @@ bench: deps build
 
 # Trains the PointNets from nothing: simulated proposal datasets (C stages through the bindings),
 # classifier + box net per sensor family, ONNX export, test-split figures and weights/MODEL_CARD.md.
-# Resumable (state under data/train/); about 40 min on a 2-core machine (docs/TRAINING.md).
+# Resumable (state under data/train/); about 45 min on a 2-core machine (docs/TRAINING.md).
 WEIGHTS_ARGS ?=
 weights: deps build
 	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \

@@ -73,3 +73,18 @@ def test_real_kitti_frames(real_dir, need_lib, tmp_path):
                    "--no-progress"]) == 0
     d = D.load(out)
     assert (d["split"] == 2).all() and (d["label"] >= 0).sum() >= 1
+
+
+def test_jobs_do_not_change_the_dataset(need_lib, tmp_path):
+    """--jobs 2 (worker processes) gives the same proposals, in the same order, as --jobs 1."""
+    outs = []
+    for j in (1, 2):
+        out = tmp_path / f"j{j}.npz"
+        assert D.main(["--sensor", "vlp16", "--mounts", "0.5", "--sim", "1,1,1", "--seed", "5", "--jobs", str(j),
+                       "--out", str(out), "--no-progress"]) == 0
+        outs.append(D.load(out))
+    a, b = outs
+    assert a["meta"]["jobs"] == 1 and b["meta"]["jobs"] == 2
+    for k in ("points", "voxel", "label", "box", "split", "scan"):
+        np.testing.assert_array_equal(a[k], b[k])
+    assert sorted(set(a["split"].tolist())) == [0, 1, 2]

@@ -115,8 +115,8 @@ def auroc(e_id: np.ndarray, e_ood: np.ndarray) -> float:
 
 
 def threshold_at_tpr(e_id: np.ndarray, tpr: float = 0.95) -> float:
-    """Smallest energy threshold gamma such that at least `tpr` of ID energies are < gamma... as the
-    gate keeps E < gamma, gamma is just above the tpr-quantile of the ID energies."""
+    """The gate threshold that keeps at least `tpr` of the ID energies: the gate keeps E < gamma, so
+    gamma is the next float32 above the ceil(tpr n)-th smallest ID energy."""
     e = np.sort(np.asarray(e_id, np.float64))
     if len(e) == 0:
         return float("nan")

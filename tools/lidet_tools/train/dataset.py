@@ -437,6 +437,8 @@ def main(argv=None) -> int:
                 semantickitti=[str(p) for p in a.semantickitti or []], n_excluded=int(sum(p["n_excluded"] for p in parts)),
                 n_objects=[int(v) for v in np.sum([p["n_objects"] for p in parts], axis=0)], **cfg,
                 command="python -m lidet_tools.train.dataset " + " ".join(argv if argv is not None else sys.argv[1:]))
+    meta["seconds"] = time.perf_counter() - t0
+    meta["jobs"] = a.jobs
     a.out.parent.mkdir(parents=True, exist_ok=True)
     tmp = a.out.with_name(a.out.name + ".tmp.npz")
     np.savez_compressed(tmp, meta=json.dumps(meta), **d)
