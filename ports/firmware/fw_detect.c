@@ -143,20 +143,19 @@ static void put_kv(const char *key, uint32_t v)
 #define FW_SENSOR "vlp16"
 #endif
 
-/* The sensor's own models when weights/ has them (trained for it), else the HDL-64 ones. */
+/* The sensor's own models (weights/cls_<sensor>, box_<sensor>), referenced by name: only these two are
+ * linked (each model is its own object in the weights archive; the index lidet_weights_models, which
+ * would pull in every model, is not referenced). FW_SENSOR_ID is the sensor as an identifier. */
+#ifndef FW_SENSOR_ID
+#define FW_SENSOR_ID vlp16
+#endif
+#define FW_XCAT(a, b) a##b
+#define FW_CAT(a, b) FW_XCAT(a, b)
 static const char *pick_models(const lidet_pn_model_t **cls, const lidet_pn_model_t **box)
 {
-    static const char *const fams[2][3] = {{FW_SENSOR, "cls_" FW_SENSOR, "box_" FW_SENSOR},
-                                           {"hdl64", "cls_hdl64", "box_hdl64"}};
-    int k;
-    for (k = 0; k < 2; ++k)
-    {
-        *cls = lidet_pn_find(lidet_weights_models, LIDET_WEIGHTS_N_MODELS, fams[k][1]);
-        *box = lidet_pn_find(lidet_weights_models, LIDET_WEIGHTS_N_MODELS, fams[k][2]);
-        if (*cls != 0 && *box != 0)
-            return fams[k][0];
-    }
-    return 0;
+    *cls = &FW_CAT(lidet_model_cls_, FW_SENSOR_ID);
+    *box = &FW_CAT(lidet_model_box_, FW_SENSOR_ID);
+    return FW_SENSOR;
 }
 
 /* ---- 64-bit stage counts ------------------------------------------------------------------------------ */

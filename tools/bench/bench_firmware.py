@@ -66,11 +66,11 @@ def run(args) -> str:
         f"{mem.get('max_cols')} pixels, {mem.get('max_points'):,} points, {mem.get('max_clusters')} clusters). "
         "Images built with GCC 12 (Debian's gcc-arm-none-eabi + newlib-nano, gcc-riscv64-unknown-elf + picolibc), "
         "-O2, and run under QEMU 7.2 with `-icount`. Two runs per image: `default` (the configuration a user gets: "
-        "gates and size checks on; the untrained models' boxes all fail the size check) and `open` (gates and "
+        "gates and size checks on) and `open` (gates and "
         "size checks off, so that every classified proposal is boxed and compared). The last two rows of each table "
         "are the KITTI-like images: the simulated HDL-64 scan `tests/data/sim_hdl64/000000` (124,205 points) with "
         "the capacities of `ports/firmware/config/hdl64/lidet_user_config.h` (64 x 2048, 131,072 points, 1024 "
-        "clusters; the detector classifies the 64 nearest of its 137 clusters). Its detector (4.4 MiB) does not fit "
+        "clusters). Its detector (4.4 MiB) does not fit "
         "the MPS2 boards' 4 MiB SRAM: on the AN500's Cortex-M7 it is placed in the 16 MiB PSRAM with a section "
         "attribute (`-DLIDET_FW_DETECTOR_SECTION='\".bss.extram\"'`, docs/PORTING.md), on QEMU virt it is in RAM.",
         "",
