@@ -211,11 +211,14 @@ int cli_cluster(int argc, char **argv)
         FILE *f = fopen(labels_path, "rb");
         uint32_t *lab = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(a.n_points > 0 ? a.n_points : 1));
         size_t got = (f != NULL && lab != NULL) ? fread(lab, sizeof(uint32_t), a.n_points, f) : 0;
+        /* exactly one label per point: a longer file belongs to another scan */
+        const int extra = f != NULL && got == a.n_points && fgetc(f) != EOF;
         if (f != NULL)
             fclose(f);
-        if (got != a.n_points)
+        if (got != a.n_points || extra)
         {
-            fprintf(stderr, "lidet cluster: cannot read %u labels from '%s'\n", a.n_points, labels_path);
+            fprintf(stderr, "lidet cluster: '%s' must hold exactly %u labels (one uint32 per point)\n", labels_path,
+                    a.n_points);
             free(lab);
             free(t_proj);
             free(ids);

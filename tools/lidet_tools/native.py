@@ -145,8 +145,29 @@ def _record(type_name: str, values: dict | None = None) -> np.ndarray:
     for k, v in (values or {}).items():
         if k not in dt.names:
             raise TypeError(f"{type_name} has no field {k!r}")
-        rec[k] = v
+        rec[k] = _checked(type_name, k, v, dt[k])
     return rec
+
+
+def _checked(type_name: str, field: str, v, dtype: np.dtype):
+    """A value for a C field, refused with a clear message instead of a silent cast: integer fields take
+    integers (or integral floats) in range, float fields finite numbers (a NaN or a string would otherwise
+    become garbage or undefined behaviour on the C side)."""
+    where = f"{type_name}.{field}"
+    if isinstance(v, (bool, np.bool_)):
+        v = int(v)
+    if isinstance(v, (str, bytes)) or not np.isscalar(v) or not isinstance(v, (int, float, np.number)):
+        raise TypeError(f"{where}: expected a number, got {v!r}")
+    if dtype.kind == "f":
+        if not np.isfinite(v):
+            raise ValueError(f"{where}: {v!r} is not finite")
+        return v
+    if not np.isfinite(v) or float(v) != int(v):
+        raise ValueError(f"{where}: expected an integer, got {v!r}")
+    info = np.iinfo(dtype)
+    if not info.min <= int(v) <= info.max:
+        raise ValueError(f"{where}: {v!r} outside [{info.min}, {info.max}]")
+    return int(v)
 
 
 def _to_dict(rec: np.ndarray) -> dict:
@@ -228,11 +249,36 @@ class RangeImage:
 
 
 
+#: most floats per point record the bindings accept (x, y, z, remission and a few extra channels)
+MAX_STRIDE = 16
+
+
 def _as_points(points) -> tuple[np.ndarray, int]:
-    pts = np.ascontiguousarray(points, dtype=np.float32)
-    if pts.ndim != 2 or pts.shape[1] < 3:
-        raise ValueError(f"points must be (N, >=3) float32, got shape {pts.shape}")
-    return pts, pts.shape[1]
+    arr = np.asarray(points)
+    if arr.dtype.kind not in "fiu":
+        raise TypeError(f"points must be numeric, got dtype {arr.dtype}")
+    if arr.ndim != 2 or not 3 <= arr.shape[1] <= MAX_STRIDE:
+        hint = " (transposed? points are rows)" if arr.ndim == 2 and 3 <= arr.shape[0] <= MAX_STRIDE else ""
+        raise ValueError(f"points must be (N, 3..{MAX_STRIDE}): x, y, z first; got shape {arr.shape}{hint}")
+    return np.ascontiguousarray(arr, dtype=np.float32), arr.shape[1]
+
+
+def _as_per_point(values, n: int, what: str, dtype, lo: int, hi: int) -> np.ndarray:
+    """(n,) integer values in [lo, hi]: booleans, integers, or floats that are whole numbers; anything else
+    (strings, NaN, 3.7, 65539 for a uint16) is a ValueError, never a silent cast."""
+    a = np.asarray(values)
+    if a.shape != (n,):
+        raise ValueError(f"{what} must have one entry per point ({n}), got shape {a.shape}")
+    if a.dtype.kind == "b":
+        a = a.astype(np.int64)
+    elif a.dtype.kind == "f":
+        if not np.all(np.isfinite(a)) or np.any(a != np.round(a)):
+            raise ValueError(f"{what}: non-integer or non-finite values")
+    elif a.dtype.kind not in "iu":
+        raise TypeError(f"{what} must be integers or booleans, got dtype {a.dtype}")
+    if n and (a.min() < lo or a.max() > hi):
+        raise ValueError(f"{what}: values outside [{lo}, {hi}] (min {a.min()}, max {a.max()})")
+    return np.ascontiguousarray(a, dtype=dtype)
 
 
 def proj_defaults() -> dict:
@@ -280,9 +326,9 @@ def _project_into(ctx: ScanContext, s: Sensor, points, ring=None) -> RangeImage:
     n = len(pts)
     rg = None
     if ring is not None:
-        rg = np.ascontiguousarray(ring, dtype=np.uint16)
-        if rg.shape != (n,):
-            raise ValueError(f"ring must have one entry per point ({n}), got {rg.shape}")
+        # out-of-range rings (>= rows) are the C side's to count (n_bad_ring); what does not fit the uint16
+        # the C function takes, or is not a whole number, is refused here
+        rg = _as_per_point(ring, n, "ring", np.uint16, 0, 0xFFFF)
     st = lib().lidet_py_proj_run(ctx.ptr, pts if n else None, n, stride, rg, None, None, None, None, None)
     if st < 0:
         raise LidetError(st, "lidet_proj_run")
@@ -418,17 +464,16 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     if unknown:
         raise TypeError(f"unknown cluster option(s): {sorted(unknown)}")
     c.update(cfg)
-    c["bridge_occluders"] = int(bool(c["bridge_occluders"]))
-    c["diagonals"] = int(bool(c["diagonals"]))
+    for flag in ("bridge_occluders", "diagonals"):
+        if c[flag] not in (0, 1, True, False):
+            raise ValueError(f"{flag} must be 0/1 or a bool, got {c[flag]!r}")
     pts, stride = _as_points(points)
     n = len(pts)
     rows, cols = s.rows, s.cols
     cap = capacity()["max_clusters"]
     gm = None
     if ground is not None:
-        gm = np.ascontiguousarray(np.asarray(ground).astype(bool), dtype=np.uint8)
-        if gm.shape != (n,):
-            raise ValueError(f"ground must have one entry per point ({n}), got {gm.shape}")
+        gm = _as_per_point(ground, n, "ground", np.uint8, 0, 1)
     pl = None
     if planes is not None:
         pl = np.ascontiguousarray(planes, dtype=np.float32).reshape(-1, 4)
