@@ -176,3 +176,108 @@ def progress(it, enabled: bool, **kw):
         return it
     from tqdm import tqdm
     return tqdm(it, **kw)
+
+
+# --- several processes (torchrun) -----------------------------------------------------------------
+# Without the launcher's environment (WORLD_SIZE unset or 1) `dist_from_env` returns None and the
+# trainers run their single-process code unchanged (same numerics, same RNG use).
+
+class Dist:
+    """One process of a `torchrun` job: rank, world size, device, and the few collectives the
+    trainers need. BatchNorm keeps per-rank statistics (no SyncBatchNorm): each rank normalises its own
+    batch of `--batch` proposals, as one process does, and the running statistics are averaged over the
+    ranks after every epoch (`sync`), so validation, checkpoints and ONNX see one model."""
+
+    def __init__(self, rank: int, world: int, local_rank: int, dev: torch.device, backend: str):
+        self.rank, self.world, self.local_rank, self.dev, self.backend = rank, world, local_rank, dev, backend
+
+    @property
+    def main(self) -> bool:
+        return self.rank == 0
+
+    def wrap(self, model):
+        from torch.nn.parallel import DistributedDataParallel as DDP
+        ids = [self.dev.index] if self.dev.type == "cuda" else None
+        # buffers (BN running statistics) stay per rank during the epoch; `sync` averages them
+        return DDP(model, device_ids=ids, broadcast_buffers=False)
+
+    def shard(self, n: int, epoch: int, seed: int, drop_last: bool = True) -> np.ndarray:
+        """This rank's indices into range(n) for `epoch` (DistributedSampler, shuffled, set_epoch)."""
+        from torch.utils.data.distributed import DistributedSampler
+        s = DistributedSampler(range(n), num_replicas=self.world, rank=self.rank, shuffle=True, seed=seed,
+                               drop_last=drop_last)
+        s.set_epoch(epoch)
+        return np.asarray(list(s), np.int64)
+
+    def sum(self, values):
+        """All-reduced sums of a few floats."""
+        import torch.distributed as dist
+        t = torch.tensor([float(v) for v in values], dtype=torch.float64, device=self.dev)
+        dist.all_reduce(t)
+        return [float(v) for v in t.cpu()]
+
+    def bcast(self, obj):
+        """rank 0's Python object on every rank."""
+        import torch.distributed as dist
+        box = [obj]
+        dist.broadcast_object_list(box, src=0)
+        return box[0]
+
+    def sync(self, model) -> None:
+        """Average the floating-point buffers (BN running mean / var) over the ranks, then give every
+        rank rank 0's parameters and buffers (guards against any drift, e.g. after loading a state)."""
+        import torch.distributed as dist
+        with torch.no_grad():
+            for b in model.buffers():
+                if b.is_floating_point():
+                    dist.all_reduce(b)
+                    b /= self.world
+            for t in list(model.parameters()) + list(model.buffers()):
+                dist.broadcast(t.data, src=0)
+
+    def barrier(self) -> None:
+        import torch.distributed as dist
+        if self.dev.type == "cuda":
+            dist.barrier(device_ids=[self.dev.index])
+        else:
+            dist.barrier()
+
+
+def dist_from_env(device_name: str) -> Dist | None:
+    """Initialise torch.distributed when started by torchrun (WORLD_SIZE > 1): nccl on CUDA (one GPU per
+    process, cuda:LOCAL_RANK), gloo on CPU. None otherwise."""
+    world = int(os.environ.get("WORLD_SIZE", "1"))
+    if world <= 1:
+        return None
+    import torch.distributed as dist
+    rank = int(os.environ["RANK"])
+    local = int(os.environ.get("LOCAL_RANK", "0"))
+    if device_name.startswith("cuda"):
+        if not torch.cuda.is_available():
+            raise RuntimeError("--device cuda asked for, but torch sees no CUDA device")
+        torch.cuda.set_device(local)
+        dev, backend = torch.device("cuda", local), "nccl"
+    else:
+        dev, backend = torch.device(device_name), "gloo"
+    if not dist.is_initialized():
+        dist.init_process_group(backend=backend)
+    return Dist(rank, world, local, dev, backend)
+
+
+def dist_close() -> None:
+    """Destroy the process group, if one was initialised."""
+    import torch.distributed as dist
+    if dist.is_available() and dist.is_initialized():
+        dist.destroy_process_group()
+
+
+def dump_shards(dd: Dist | None, name: str, shards: list) -> None:
+    """Debug: with LIDET_TRAIN_SHARD_DUMP=DIR, every rank writes DIR/<name>_rank<r>.json with the
+    training rows (ID, OOD) it was given, per epoch (the test checks that the ranks' shards differ)."""
+    out = os.environ.get("LIDET_TRAIN_SHARD_DUMP")
+    if dd is None or not out:
+        return
+    import json
+    p = pathlib.Path(out)
+    p.mkdir(parents=True, exist_ok=True)
+    (p / f"{name}_rank{dd.rank}.json").write_text(json.dumps(dict(rank=dd.rank, world=dd.world, epochs=shards)))

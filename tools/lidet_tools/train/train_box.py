@@ -28,6 +28,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import pathlib
 import sys
 import time
@@ -128,7 +129,9 @@ def add_args(ap):
 
 def train(a) -> dict:
     C.setup(a.seed, a.threads)
-    dev = C.device(a.device)
+    dd = C.dist_from_env(a.device)  # None without torchrun: the single-process path below is unchanged
+    main = dd is None or dd.main
+    dev = dd.dev if dd else C.device(a.device)
     data = D.load(a.data)
     tr, va = C.split(data, 0), C.split(data, 1)
     ok = (tr["label"] >= 0) & ~np.isnan(tr["box"][:, 0])
@@ -136,6 +139,8 @@ def train(a) -> dict:
     tr_ood = np.nonzero(tr["label"] < 0)[0]
     if len(tr_id) < a.batch or not ((va["label"] >= 0) & ~np.isnan(va["box"][:, 0])).any():
         raise ValueError(f"{a.data}: too few box targets to train ({len(tr_id)} training, none or few in validation)")
+    if dd and len(tr_id) // dd.world < a.batch:
+        raise ValueError(f"{a.data}: {len(tr_id)} box targets are too few for {dd.world} ranks of --batch {a.batch}")
     counts = np.bincount(tr["label"][tr_id], minlength=M.N_CLASSES).astype(np.float64)
     pw = 1.0 / np.sqrt(np.maximum(counts, 1))[tr["label"][tr_id]]
     pw /= pw.sum()
@@ -144,26 +149,37 @@ def train(a) -> dict:
     state_path = a.work / "state.pt"
     args_key = {k: (str(v) if isinstance(v, pathlib.Path) else v) for k, v in vars(a).items()
                 if k not in ("no_progress", "threads", "device", "work", "out", "onnx", "command")}
+    if dd:
+        args_key["world_size"] = dd.world  # the shards depend on it: resume with the same number of ranks
     st = dict(epoch=0, history=[], best_box=None, best_en=None, margins=None, args=args_key)
-    if state_path.exists():
-        s = torch.load(state_path, map_location="cpu", weights_only=False)
+    s = torch.load(state_path, map_location="cpu", weights_only=False) if main and state_path.exists() else None
+    if dd:
+        s = dd.bcast(s)  # rank 0 reads the state; --work need not be shared between machines
+    if s is not None:
         if s.get("args") != args_key:
             raise ValueError(f"{state_path}: made with other arguments; remove {a.work} to start over")
         st = s
         model.load_state_dict(s["model"])
-        print(f"train_box: resuming after epoch {s['epoch']}", file=sys.stderr)
+        if main:
+            print(f"train_box: resuming after epoch {s['epoch']}", file=sys.stderr)
+    net = dd.wrap(model) if dd else model  # trains through DDP; validation and export use `model`
+    shards = []
     E1, E2 = a.epochs_box, a.epochs_energy
     t0 = time.perf_counter() - (st["history"][-1]["seconds"] if st["history"] else 0.0)
     for ep in range(st["epoch"], E1 + E2):
         phase = "box" if ep < E1 else "energy"
         if ep == E1 and E2 > 0:
             model.load_state_dict(st["best_box"]["state_dict"])
+            if dd:
+                dd.sync(model)
             if st["margins"] is None:
                 r = MX.eval_box(model, tr, dev)
                 ei, eo = r["energies"]["id"], r["energies"]["ood"]
                 m_in = float(ei.mean())
                 st["margins"] = dict(m_in=m_in, m_out=max(float(eo.mean()), m_in + a.min_gap),
                                      e_id_mean=float(ei.mean()), e_ood_mean=float(eo.mean()))
+                if dd:
+                    st["margins"] = dd.bcast(st["margins"])
         lr0, ne = (1e-3, E1) if phase == "box" else (5e-4, E2)
         k = ep if phase == "box" else ep - E1
         opt = torch.optim.Adam(model.parameters(), lr=lr0)
@@ -172,18 +188,30 @@ def train(a) -> dict:
         lr = 1e-5 + 0.5 * (lr0 - 1e-5) * (1 + math.cos(math.pi * k / max(ne, 1)))
         for g in opt.param_groups:
             g["lr"] = lr
-        rng = np.random.default_rng([a.seed, ep])
         torch.manual_seed(a.seed * 1000 + ep)
-        model.train()
+        net.train()
         tot, nb = 0.0, 0
-        nsteps = len(tr_id) // a.batch
-        for _ in C.progress(range(nsteps), not a.no_progress, desc=f"box {phase} {ep + 1}/{E1 + E2}", leave=False):
-            idx = tr_id[rng.choice(len(tr_id), a.batch, p=pw)]
+        if dd:
+            # this rank's shard of the targets (DistributedSampler, set_epoch), drawn from with the class
+            # weights renormalised over the shard; the OOD rows are sharded too
+            rng = np.random.default_rng([a.seed, ep, dd.rank])
+            order = dd.shard(len(tr_id), ep, a.seed)
+            ids, p_ids = tr_id[order], pw[order] / pw[order].sum()
+            ood = tr_ood[dd.shard(len(tr_ood), ep, a.seed + 1, drop_last=False)] if len(tr_ood) else tr_ood
+            shards.append(dict(epoch=ep + 1, id=ids.tolist(), ood=ood.tolist()))
+            print(f"train_box: rank {dd.rank} of {dd.world}, epoch {ep + 1}: {len(ids)} box targets and "
+                  f"{len(ood)} OOD proposals in this rank's shard", file=sys.stderr)
+        else:
+            rng = np.random.default_rng([a.seed, ep])
+            ids, p_ids, ood = tr_id, pw, tr_ood
+        nsteps = len(ids) // a.batch
+        for _ in C.progress(range(nsteps), main and not a.no_progress, desc=f"box {phase} {ep + 1}/{E1 + E2}", leave=False):
+            idx = ids[rng.choice(len(ids), a.batch, p=p_ids)]
             p, bx = C.augment(rng, tr["points"][idx], tr["box"][idx])
             cls = tr["label"][idx].astype(np.int64)
             T = Targets(bx, cls, dev)
             if phase == "energy":
-                oi = tr_ood[rng.integers(0, len(tr_ood), 2 * a.batch)]
+                oi = ood[rng.integers(0, len(ood), 2 * a.batch)]
                 po, _ = C.augment(rng, tr["points"][oi])
                 pts, vox = C.tensors(tr, np.concatenate([idx, oi]), dev, np.concatenate([p, po]))
                 cls_all = np.concatenate([cls, rng.integers(0, M.N_CLASSES, len(oi))])
@@ -191,7 +219,7 @@ def train(a) -> dict:
                 pts, vox = C.tensors(tr, idx, dev, p)
                 cls_all = cls
             oh = F.one_hot(torch.from_numpy(cls_all).to(dev), M.N_CLASSES).float()
-            dc1, out = model(pts, vox, oh)
+            dc1, out = net(pts, vox, oh)
             n = len(idx)
             loss, _parts = box_loss(dc1[:n], out[:n], T, cfg["use_tnet"])
             if phase == "energy":
@@ -202,6 +230,9 @@ def train(a) -> dict:
             opt.step()
             tot += float(loss.detach())
             nb += 1
+        if dd:
+            tot, nb = dd.sum([tot, nb])  # the loss logged is the mean over all ranks' batches
+            dd.sync(model)  # BN running statistics averaged over the ranks; one model everywhere
         r = MX.eval_box(model, va, dev)
         miou = MX.mean_iou(r)
         fpr = r["gate2"]["fpr95"]
@@ -209,15 +240,22 @@ def train(a) -> dict:
         h = dict(epoch=ep + 1, phase=phase, lr=lr, loss=tot / max(nb, 1), val_mean_iou=miou, val_fpr95=fpr,
                  val_auroc=r["gate2"]["auroc"], score=score, seconds=time.perf_counter() - t0,
                  val_share=[r["box"][c].get("share_iou", float("nan")) for c in M.CLASSES])
+        if dd:
+            # every rank validates the same model on the whole validation split; rank 0's figures decide
+            h = dd.bcast(h)
+            miou, fpr, score = h["val_mean_iou"], h["val_fpr95"], h["score"]
         st["history"].append(h)
         key = "best_box" if phase == "box" else "best_en"
         if st[key] is None or score < st[key]["score"]:
             st[key] = dict(score=score, epoch=ep + 1, state_dict={k: v.detach().cpu().clone() for k, v in model.state_dict().items()})
-        print(f"box {phase} epoch {ep + 1}: loss {h['loss']:.3f} val mean IoU {miou:.3f} share>=thr "
-              f"{' '.join(f'{v:.2f}' for v in h['val_share'])} gate2 FPR95 {fpr:.3f} AUROC {h['val_auroc']:.3f}",
-              file=sys.stderr)
+        if main:
+            print(f"box {phase} epoch {ep + 1}: loss {h['loss']:.3f} val mean IoU {miou:.3f} share>=thr "
+                  f"{' '.join(f'{v:.2f}' for v in h['val_share'])} gate2 FPR95 {fpr:.3f} AUROC {h['val_auroc']:.3f}",
+                  file=sys.stderr)
         st.update(epoch=ep + 1, model=model.state_dict(), opt=opt.state_dict(), opt_phase=phase)
-        C.save_atomic(st, state_path)
+        if main:
+            C.save_atomic(st, state_path)  # state for resuming: rank 0 only
+    C.dump_shards(dd, "box", shards)
     best = st["best_en"] if (E2 > 0 and st["best_en"] is not None) else st["best_box"]
     model.load_state_dict(best["state_dict"])
     model.eval()
@@ -228,11 +266,16 @@ def train(a) -> dict:
                 command=getattr(a, "command", None) or "python -m lidet_tools.train.train_box",
                 margins=st["margins"], best_epoch=best["epoch"], seed=a.seed, history=st["history"],
                 train_seconds=st["history"][-1]["seconds"] if st["history"] else 0.0)
+    if dd:
+        meta["world_size"] = dd.world
     ck = dict(kind="box", cfg=dict(model.cfg), state_dict=model.cpu().state_dict(), meta=meta)
-    C.save_atomic(ck, a.out)
-    if a.onnx:
-        from lidet_codegen.export import export_onnx
-        export_onnx(model.cpu(), ck, a.onnx)
+    if main:  # checkpoint and ONNX from rank 0 only
+        C.save_atomic(ck, a.out)
+        if a.onnx:
+            from lidet_codegen.export import export_onnx
+            export_onnx(model.cpu(), ck, a.onnx)
+    if dd:
+        dd.barrier()  # no rank leaves before rank 0 has written its files
     return ck
 
 
@@ -246,6 +289,10 @@ def main(argv=None) -> int:
     except (FileNotFoundError, ValueError, RuntimeError) as e:
         print(f"train_box: {e}", file=sys.stderr)
         return 2
+    finally:
+        C.dist_close()
+    if int(os.environ.get("RANK", "0")) != 0:
+        return 0
     print(json.dumps(dict(gamma=ck["meta"]["gamma"], margins=ck["meta"]["margins"], best_epoch=ck["meta"]["best_epoch"])))
     return 0
 

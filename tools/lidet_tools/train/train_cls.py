@@ -25,6 +25,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import pathlib
 import sys
 import time
@@ -71,13 +72,17 @@ def _ints(s):
 
 def train(a) -> dict:
     C.setup(a.seed, a.threads)
-    dev = C.device(a.device)
+    dd = C.dist_from_env(a.device)  # None without torchrun: the single-process path below is unchanged
+    main = dd is None or dd.main
+    dev = dd.dev if dd else C.device(a.device)
     data = D.load(a.data)
     tr, va = C.split(data, 0), C.split(data, 1)
     tr_id = np.nonzero(tr["label"] >= 0)[0]
     tr_ood = np.nonzero(tr["label"] < 0)[0]
     if len(tr_id) < a.batch or len(va["label"]) == 0:
         raise ValueError(f"{a.data}: too few proposals to train ({len(tr_id)} training ID, {len(va['label'])} validation)")
+    if dd and len(tr_id) // dd.world < a.batch:
+        raise ValueError(f"{a.data}: {len(tr_id)} training ID proposals are too few for {dd.world} ranks of --batch {a.batch}")
     counts = np.bincount(tr["label"][tr_id], minlength=M.N_CLASSES).astype(np.float64)
     w = np.sqrt(counts.sum() / (M.N_CLASSES * np.maximum(counts, 1)))
     cw = torch.tensor(w, dtype=torch.float32, device=dev)
@@ -86,14 +91,21 @@ def train(a) -> dict:
     state_path = a.work / "state.pt"
     args_key = {k: (str(v) if isinstance(v, pathlib.Path) else v) for k, v in vars(a).items()
                 if k not in ("no_progress", "threads", "device", "work", "out", "onnx", "command")}
+    if dd:
+        args_key["world_size"] = dd.world  # the shards depend on it: resume with the same number of ranks
     st = dict(epoch=0, history=[], best_ce=None, best_en=None, margins=None, args=args_key)
-    if state_path.exists():
-        s = torch.load(state_path, map_location="cpu", weights_only=False)
+    s = torch.load(state_path, map_location="cpu", weights_only=False) if main and state_path.exists() else None
+    if dd:
+        s = dd.bcast(s)  # rank 0 reads the state; --work need not be shared between machines
+    if s is not None:
         if s.get("args") != args_key:
             raise ValueError(f"{state_path}: made with other arguments; remove {a.work} to start over")
         st = s
         model.load_state_dict(s["model"])
-        print(f"train_cls: resuming after epoch {s['epoch']}", file=sys.stderr)
+        if main:
+            print(f"train_cls: resuming after epoch {s['epoch']}", file=sys.stderr)
+    net = dd.wrap(model) if dd else model  # trains through DDP; validation and export use `model`
+    shards = []
     E1, E2 = a.epochs_ce, a.epochs_energy
     t0 = time.perf_counter() - (st["history"][-1]["seconds"] if st["history"] else 0.0)
     for ep in range(st["epoch"], E1 + E2):
@@ -101,6 +113,8 @@ def train(a) -> dict:
         if ep == E1 and E2 > 0:
             # phase 2 starts from the best CE model; margins from its training energies
             model.load_state_dict(st["best_ce"]["state_dict"])
+            if dd:
+                dd.sync(model)
             if st["margins"] is None:
                 lg = MX.cls_logits(model, tr, dev)
                 e = MX.energy_np(lg)
@@ -108,6 +122,8 @@ def train(a) -> dict:
                 m_out = max(float(e[tr["label"] < 0].mean()), m_in + a.min_gap)
                 st["margins"] = dict(m_in=m_in, m_out=m_out, e_id_mean=float(e[tr["label"] >= 0].mean()),
                                      e_ood_mean=float(e[tr["label"] < 0].mean()))
+                if dd:
+                    st["margins"] = dd.bcast(st["margins"])
         lr0, ne = (1e-3, E1) if phase == "ce" else (5e-4, E2)
         k = ep if phase == "ce" else ep - E1
         opt = torch.optim.Adam(model.parameters(), lr=lr0)
@@ -116,22 +132,33 @@ def train(a) -> dict:
         lr = 1e-5 + 0.5 * (lr0 - 1e-5) * (1 + math.cos(math.pi * k / max(ne, 1)))
         for g in opt.param_groups:
             g["lr"] = lr
-        rng = np.random.default_rng([a.seed, ep])
         torch.manual_seed(a.seed * 1000 + ep)
-        model.train()
+        net.train()
         tot, nb = 0.0, 0
-        it = C.batches(rng, len(tr_id), a.batch)
-        for bi in C.progress(list(it), not a.no_progress, desc=f"cls {phase} {ep + 1}/{E1 + E2}", leave=False):
+        if dd:
+            # this rank's shard of the ID rows (DistributedSampler, set_epoch) and of the OOD rows
+            rng = np.random.default_rng([a.seed, ep, dd.rank])
+            order = dd.shard(len(tr_id), ep, a.seed)
+            it = [order[i:i + a.batch] for i in range(0, len(order) - len(order) % a.batch, a.batch)]
+            ood = tr_ood[dd.shard(len(tr_ood), ep, a.seed + 1, drop_last=False)] if len(tr_ood) else tr_ood
+            shards.append(dict(epoch=ep + 1, id=tr_id[order].tolist(), ood=ood.tolist()))
+            print(f"train_cls: rank {dd.rank} of {dd.world}, epoch {ep + 1}: {len(order)} training ID and "
+                  f"{len(ood)} OOD proposals in this rank's shard", file=sys.stderr)
+        else:
+            rng = np.random.default_rng([a.seed, ep])
+            it = C.batches(rng, len(tr_id), a.batch)
+            ood = tr_ood
+        for bi in C.progress(list(it), main and not a.no_progress, desc=f"cls {phase} {ep + 1}/{E1 + E2}", leave=False):
             idx = tr_id[bi]
             p, _ = C.augment(rng, tr["points"][idx])
             if phase == "energy":
-                oi = tr_ood[rng.integers(0, len(tr_ood), 2 * a.batch)]
+                oi = ood[rng.integers(0, len(ood), 2 * a.batch)]
                 po, _ = C.augment(rng, tr["points"][oi])
                 pts, vox = C.tensors(tr, np.concatenate([idx, oi]), dev, np.concatenate([p, po]))
             else:
                 pts, vox = C.tensors(tr, idx, dev, p)
             y = torch.from_numpy(tr["label"][idx].astype(np.int64)).to(dev)
-            logits = model(pts, vox)
+            logits = net(pts, vox)
             loss = F.cross_entropy(logits[:len(idx)], y, weight=cw)
             if phase == "energy":
                 e = C.energy(logits)
@@ -141,20 +168,30 @@ def train(a) -> dict:
             opt.step()
             tot += float(loss.detach())
             nb += 1
+        if dd:
+            tot, nb = dd.sum([tot, nb])  # the loss logged is the mean over all ranks' batches
+            dd.sync(model)  # BN running statistics averaged over the ranks; one model everywhere
         res = MX.cls_figures(MX.cls_logits(model, va, dev), va["label"])
         bal = balanced_acc(res)
         score = res["gate1"]["fpr95"] + (1 - bal) if phase == "energy" else -bal
         h = dict(epoch=ep + 1, phase=phase, lr=lr, loss=tot / max(nb, 1), val_bal_acc=bal,
                  val_fpr95=res["gate1"]["fpr95"], val_auroc=res["gate1"]["auroc"], score=score,
                  seconds=time.perf_counter() - t0)
+        if dd:
+            # every rank validates the same model on the whole validation split; rank 0's figures decide
+            h = dd.bcast(h)
+            bal, score = h["val_bal_acc"], h["score"]
         st["history"].append(h)
         key = "best_ce" if phase == "ce" else "best_en"
         if st[key] is None or score < st[key]["score"]:
             st[key] = dict(score=score, epoch=ep + 1, state_dict={k: v.detach().cpu().clone() for k, v in model.state_dict().items()})
-        print(f"cls {phase} epoch {ep + 1}: loss {h['loss']:.4f} val bal.acc {bal:.3f} FPR95 {h['val_fpr95']:.3f} "
-              f"AUROC {h['val_auroc']:.3f}", file=sys.stderr)
+        if main:
+            print(f"cls {phase} epoch {ep + 1}: loss {h['loss']:.4f} val bal.acc {bal:.3f} FPR95 {h['val_fpr95']:.3f} "
+                  f"AUROC {h['val_auroc']:.3f}", file=sys.stderr)
         st.update(epoch=ep + 1, model=model.state_dict(), opt=opt.state_dict(), opt_phase=phase)
-        C.save_atomic(st, state_path)
+        if main:
+            C.save_atomic(st, state_path)  # state for resuming: rank 0 only
+    C.dump_shards(dd, "cls", shards)
     best = st["best_en"] if (E2 > 0 and st["best_en"] is not None) else st["best_ce"]
     model.load_state_dict(best["state_dict"])
     model.eval()
@@ -166,11 +203,16 @@ def train(a) -> dict:
                 command=getattr(a, "command", None) or "python -m lidet_tools.train.train_cls",
                 margins=st["margins"], best_epoch=best["epoch"], seed=a.seed, history=st["history"],
                 train_seconds=st["history"][-1]["seconds"] if st["history"] else 0.0)
+    if dd:
+        meta["world_size"] = dd.world
     ck = dict(kind="classifier", cfg={k: v for k, v in model.cfg.items()}, state_dict=model.cpu().state_dict(), meta=meta)
-    C.save_atomic(ck, a.out)
-    if a.onnx:
-        from lidet_codegen.export import export_onnx
-        export_onnx(model.cpu(), ck, a.onnx)
+    if main:  # checkpoint and ONNX from rank 0 only
+        C.save_atomic(ck, a.out)
+        if a.onnx:
+            from lidet_codegen.export import export_onnx
+            export_onnx(model.cpu(), ck, a.onnx)
+    if dd:
+        dd.barrier()  # no rank leaves before rank 0 has written its files
     return ck
 
 
@@ -184,6 +226,10 @@ def main(argv=None) -> int:
     except (FileNotFoundError, ValueError, RuntimeError) as e:
         print(f"train_cls: {e}", file=sys.stderr)
         return 2
+    finally:
+        C.dist_close()
+    if int(os.environ.get("RANK", "0")) != 0:
+        return 0
     print(json.dumps(dict(gamma=ck["meta"]["gamma"], margins=ck["meta"]["margins"], best_epoch=ck["meta"]["best_epoch"])))
     return 0
 
