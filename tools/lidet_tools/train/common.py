@@ -198,8 +198,12 @@ class Dist:
     def wrap(self, model):
         from torch.nn.parallel import DistributedDataParallel as DDP
         ids = [self.dev.index] if self.dev.type == "cuda" else None
-        # buffers (BN running statistics) stay per rank during the epoch; `sync` averages them
-        return DDP(model, device_ids=ids, broadcast_buffers=False)
+        # buffers (BN running statistics) stay per rank during the epoch; `sync` averages them. Newer
+        # torch names this forward_sync_buffers (it still syncs once at init: every rank starts equal)
+        import inspect
+        kw = ("forward_sync_buffers" if "forward_sync_buffers" in inspect.signature(DDP.__init__).parameters
+              else "broadcast_buffers")
+        return DDP(model, device_ids=ids, **{kw: False})
 
     def shard(self, n: int, epoch: int, seed: int, drop_last: bool = True) -> np.ndarray:
         """This rank's indices into range(n) for `epoch` (DistributedSampler, shuffled, set_epoch)."""
