@@ -285,3 +285,39 @@ def dump_shards(dd: Dist | None, name: str, shards: list) -> None:
     p = pathlib.Path(out)
     p.mkdir(parents=True, exist_ok=True)
     (p / f"{name}_rank{dd.rank}.json").write_text(json.dumps(dict(rank=dd.rank, world=dd.world, epochs=shards)))
+
+
+def write_outputs(ck: dict, model, a, main: bool, dd) -> dict:
+    """The trainers' last step: checkpoint and ONNX from rank 0 only, then a barrier so that no rank leaves
+    before rank 0 has written its files. Returns ck."""
+    if main:
+        save_atomic(ck, a.out)
+        if a.onnx:
+            from lidet_codegen.export import export_onnx
+            export_onnx(model.cpu(), ck, a.onnx)
+    if dd:
+        dd.barrier()
+    return ck
+
+
+def run_cli(module: str, add_args, train, doc: str, argv=None) -> int:
+    """`python -m lidet_tools.train.<module>`: parse, train, close the process group; rank 0 prints the
+    result line (gamma, margins, best epoch) as JSON."""
+    import argparse
+    import json
+    import sys
+    ap = add_args(argparse.ArgumentParser(prog=f"python -m lidet_tools.train.{module}", description=doc,
+                                          formatter_class=argparse.RawDescriptionHelpFormatter))
+    a = ap.parse_args(argv)
+    a.command = f"python -m lidet_tools.train.{module} " + " ".join(argv if argv is not None else sys.argv[1:])
+    try:
+        ck = train(a)
+    except (FileNotFoundError, ValueError, RuntimeError) as e:
+        print(f"{module}: {e}", file=sys.stderr)
+        return 2
+    finally:
+        dist_close()
+    if int(os.environ.get("RANK", "0")) != 0:
+        return 0
+    print(json.dumps(dict(gamma=ck["meta"]["gamma"], margins=ck["meta"]["margins"], best_epoch=ck["meta"]["best_epoch"])))
+    return 0

@@ -25,10 +25,7 @@ Selection: lowest validation (FPR95 of gate 2 - mean IoU). gamma_b per class: th
 """
 from __future__ import annotations
 
-import argparse
-import json
 import math
-import os
 import pathlib
 import sys
 import time
@@ -269,32 +266,11 @@ def train(a) -> dict:
     if dd:
         meta["world_size"] = dd.world
     ck = dict(kind="box", cfg=dict(model.cfg), state_dict=model.cpu().state_dict(), meta=meta)
-    if main:  # checkpoint and ONNX from rank 0 only
-        C.save_atomic(ck, a.out)
-        if a.onnx:
-            from lidet_codegen.export import export_onnx
-            export_onnx(model.cpu(), ck, a.onnx)
-    if dd:
-        dd.barrier()  # no rank leaves before rank 0 has written its files
-    return ck
+    return C.write_outputs(ck, model, a, main, dd)  # checkpoint and ONNX from rank 0 only
 
 
 def main(argv=None) -> int:
-    ap = add_args(argparse.ArgumentParser(prog="python -m lidet_tools.train.train_box", description=__doc__,
-                                          formatter_class=argparse.RawDescriptionHelpFormatter))
-    a = ap.parse_args(argv)
-    a.command = "python -m lidet_tools.train.train_box " + " ".join(argv if argv is not None else sys.argv[1:])
-    try:
-        ck = train(a)
-    except (FileNotFoundError, ValueError, RuntimeError) as e:
-        print(f"train_box: {e}", file=sys.stderr)
-        return 2
-    finally:
-        C.dist_close()
-    if int(os.environ.get("RANK", "0")) != 0:
-        return 0
-    print(json.dumps(dict(gamma=ck["meta"]["gamma"], margins=ck["meta"]["margins"], best_epoch=ck["meta"]["best_epoch"])))
-    return 0
+    return C.run_cli("train_box", add_args, train, __doc__, argv)
 
 
 if __name__ == "__main__":
