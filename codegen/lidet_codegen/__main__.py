@@ -1,16 +1,18 @@
 # SPDX-License-Identifier: MIT
-"""python -m lidet_codegen {export,emit,macs} ... (see each subcommand's --help)."""
+"""python -m lidet_codegen {export,emit,macs,qtables} ... (see each subcommand's --help)."""
 import sys
 
 
 def main(argv=None) -> int:
     argv = list(sys.argv[1:] if argv is None else argv)
-    cmds = {"emit": "lidet_codegen.emit", "export": "lidet_codegen.export_cli", "macs": "lidet_codegen.macs"}
+    cmds = {"emit": "lidet_codegen.emit", "export": "lidet_codegen.export_cli", "macs": "lidet_codegen.macs",
+            "qtables": "lidet_codegen.qtables"}
     if not argv or argv[0] not in cmds:
-        print("usage: python -m lidet_codegen {export|emit|macs} ...\n"
+        print("usage: python -m lidet_codegen {export|emit|macs|qtables} ...\n"
               "  export  PyTorch checkpoint (or --untrained KIND) -> ONNX with lidet's metadata\n"
               "  emit    ONNX -> weights/<name>.{c,h} (const arrays + model descriptor)\n"
-              "  macs    multiply-adds and parameters of ONNX models", file=sys.stderr)
+              "  macs    multiply-adds and parameters of ONNX models\n"
+              "  qtables the integer math tables of the fixed-point build (lib/src/lidet_qmath_tables.c)", file=sys.stderr)
         return 2
     import importlib
     return importlib.import_module(cmds[argv[0]]).main(argv[1:])

@@ -20,6 +20,7 @@
 
 #include "lidet_opt.h"
 #include "lidet_types.h"
+#include "lidet_q.h"
 #include "lidet_sensor.h"
 #include "lidet_proj.h"
 #include "lidet_ground.h"
