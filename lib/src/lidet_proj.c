@@ -146,6 +146,8 @@ lidet_status_t lidet_proj_state_init(lidet_proj_state_t *proj, const lidet_proj_
     for (r = 0; r < rows; ++r)
     {
         proj->row_elev_rad[r] = elev[ring_of_row[r]];
+        /* BAM32 of an elevation in (-pi/2, pi/2): |value| < 2^30, exact to float's 24 bits (<= 64 BAM) */
+        proj->row_elev_bam[r] = (int32_t)(proj->row_elev_rad[r] * 683565275.6f);
         proj->ring_to_row[ring_of_row[r]] = (uint8_t)r;
         if (r > 0 && !(proj->row_elev_rad[r] < proj->row_elev_rad[r - 1]))
         {
@@ -683,6 +685,7 @@ void lidet_proj_image_of(const lidet_proj_state_t *st, const lidet_proj_buffers_
     img->rxy_m = buf->x_m != 0 ? buf->rxy_m : 0;
     img->point_idx = buf->point_idx;
     img->row_elev_rad = st->row_elev_rad;
+    img->row_elev_bam = st->row_elev_bam;
 }
 
 void lidet_proj_image(const lidet_proj_t *proj, lidet_range_image_t *img)
@@ -704,6 +707,7 @@ void lidet_proj_image(const lidet_proj_t *proj, lidet_range_image_t *img)
     img->rxy_m = proj->rxy_m;
     img->point_idx = proj->point_idx;
     img->row_elev_rad = proj->state.row_elev_rad;
+    img->row_elev_bam = proj->state.row_elev_bam;
 }
 
 const int32_t *lidet_proj_point_pixels(const lidet_proj_t *proj, uint32_t *n_points)

@@ -60,6 +60,7 @@ static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
     img->rxy_m = 0;
     img->point_idx = 0;
     img->row_elev_rad = ws->proj.row_elev_rad;
+    img->row_elev_bam = ws->proj.row_elev_bam;
 }
 
 lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, uint32_t n_points, uint32_t stride,

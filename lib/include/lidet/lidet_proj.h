@@ -115,6 +115,8 @@ typedef struct
                                     workspace overlays it with later scratch). Validity is range_m > 0,
                                     which the later stages read (the two agree on every image) */
     const float *row_elev_rad; /**< n_rows beam elevations in row order (row 0 = top) */
+    const int32_t *row_elev_bam; /**< the same elevations as signed BAM32 (lidet_q.h: 2^32 a turn), what the
+                                      integer stages read; the float projection rounds its float ones */
 } lidet_range_image_t;
 
 /**
@@ -129,6 +131,7 @@ typedef struct
     lidet_proj_cfg_t cfg;
     /* derived in init */
     float row_elev_rad[LIDET_MAX_ROWS];     /* beam elevations, row order (descending) */
+    int32_t row_elev_bam[LIDET_MAX_ROWS];   /* the same in BAM32, for the integer stages */
     float row_bound_tan[LIDET_MAX_ROWS + 1]; /* [r] = tan of the mid-angle between rows r-1 and r;
                                                sentinels [0] = +big, [n_rows] = -big */
     uint8_t ring_to_row[LIDET_MAX_ROWS];    /* ring index -> row */
