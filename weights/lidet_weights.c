@@ -9,3 +9,10 @@ const lidet_pn_entry_t lidet_weights_models[LIDET_WEIGHTS_N_MODELS] = {
     {"cls_hdl64", &lidet_model_cls_hdl64},
     {"cls_vlp16", &lidet_model_cls_vlp16}
 };
+
+const lidet_pointnet_q_entry_t lidet_weights_models_s8[LIDET_WEIGHTS_N_MODELS_S8] = {
+    {"box_hdl64_s8", &lidet_model_box_hdl64_s8},
+    {"box_vlp16_s8", &lidet_model_box_vlp16_s8},
+    {"cls_hdl64_s8", &lidet_model_cls_hdl64_s8},
+    {"cls_vlp16_s8", &lidet_model_cls_vlp16_s8}
+};

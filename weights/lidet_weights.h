@@ -19,6 +19,16 @@ extern "C" {
 #define LIDET_WEIGHTS_N_MODELS 4u
 extern const lidet_pn_entry_t lidet_weights_models[LIDET_WEIGHTS_N_MODELS];
 
+#include "lidet/lidet_pointnet_q.h"
+#include "box_hdl64_s8.h"
+#include "box_vlp16_s8.h"
+#include "cls_hdl64_s8.h"
+#include "cls_vlp16_s8.h"
+
+/** every int8 model of weights/, by name (lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, name)) */
+#define LIDET_WEIGHTS_N_MODELS_S8 4u
+extern const lidet_pointnet_q_entry_t lidet_weights_models_s8[LIDET_WEIGHTS_N_MODELS_S8];
+
 #ifdef __cplusplus
 }
 #endif

@@ -40,6 +40,7 @@
 #define LIDET_POINTNET_H
 
 #include "lidet_cluster.h"
+#include "lidet_pointnet_common.h"
 #include "lidet_types.h"
 
 #ifdef __cplusplus
@@ -49,30 +50,9 @@ extern "C" {
 /* Generated arrays are declared with LIDET_ALIGN(16) LIDET_RODATA (lidet_opt.h: a port may place them in a
  * flash section). */
 
-/** Most layers per part of a stage (shared, PVLE, head); a descriptor with more is LIDET_ERR_MODEL. */
-#define LIDET_PN_MAX_LAYERS 8
-/** Widest layer (channels) the forward pass accepts. */
-#define LIDET_PN_MAX_WIDTH 1024
-/** Heading bins / size templates the box decoding accepts at most. */
-#define LIDET_PN_MAX_HEADING_BINS 64
-#define LIDET_PN_MAX_SIZE_CLUSTERS 8
-
 /** Scratch bytes for a model whose widest shared layer has wp channels and widest vector wv. */
 #define LIDET_PN_SCRATCH_BYTES(wp, wv) \
     (4u * (2u * LIDET_PN_BLOCK * (uint32_t)(wp) + 3u * (uint32_t)(wv) + 3u * LIDET_PN_BLOCK + 8u))
-
-/** @brief Model kinds. */
-typedef enum
-{
-    LIDET_PN_CLASSIFIER = 1, /**< one stage; output: n_classes logits */
-    LIDET_PN_BOX = 2         /**< T-Net (optional) + box PointNet; output: 3 + 2H + 4S values */
-} lidet_pn_kind_t;
-
-/** @brief Numeric format of the weights (the integer build adds its own). */
-typedef enum
-{
-    LIDET_PN_F32 = 0 /**< float32 weights and activations */
-} lidet_pn_precision_t;
 
 /** @brief One dense layer y = act(W x + b); W stored transposed, w_t[i * n_out + o]. */
 typedef struct
