@@ -344,10 +344,14 @@ def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS) -> dict:
     xyz, mean, vox = proposals_of(scans, sensor, seeds, model.n_points)
     cls = calib_classes(model, xyz, mean, vox)
     tr = float_trace(model, float_inputs(xyz, mean), vox.astype(np.float64), cls)
-    ranges = {nm: float(np.percentile(np.abs(t), CALIB_PERCENTILE)) for nm, t in zip(layer_names(model), tr)}
-    rel = lambda p: p.relative_to(ROOT).as_posix() if p.is_relative_to(ROOT) else "real/" + "/".join(p.parts[-3:])  # noqa: E731
+    names = layer_names(model)
+    ranges = {nm: float(np.percentile(np.abs(t), CALIB_PERCENTILE)) for nm, t in zip(names, tr)}
+    def rel(p):
+        return p.relative_to(ROOT).as_posix() if p.is_relative_to(ROOT) else "real/" + "/".join(p.parts[-3:])
+
     return {"model": onnx_path.stem, "onnx_sha256": hashlib.sha256(onnx_path.read_bytes()).hexdigest(),
-            "sensor": sensor, "seeds": [int(s) for s in seeds], "percentile": CALIB_PERCENTILE, "scans": [rel(p) for p in scans],
+            "sensor": sensor, "seeds": [int(s) for s in seeds], "percentile": CALIB_PERCENTILE,
+            "scans": [rel(p) for p in scans],
             "n_proposals": int(len(xyz)), "ranges": ranges}
 
 
@@ -459,7 +463,8 @@ def emit_c_s8(qm: QModel, onnx_path, calib_path, cmd: str, src_sha: str, calib_s
              f"    {qm.n_heading_bins}u, {qm.n_size_clusters}u, /* heading bins, size templates */\n"
              f"    {{{', '.join(stage_c)}}},\n"
              f"    {ms}, {hb}, {qm.heading_res_bam}, /* size templates, heading bins, pi / H in BAM32 */\n"
-             f"    {{{', '.join(str(v) for v in qm.pvle_bin)}}}, /* PVLE bins: azimuth, elevation (urad), range (mm) */\n"
+             f"    {{{', '.join(str(v) for v in qm.pvle_bin)}}}, "
+             "/* PVLE bins: azimuth, elevation (urad), range (mm) */\n"
              f"    {qm.energy_t_q16}, /* energy temperature, Q16 */\n"
              f"    {{{', '.join(str(g) for g in qm.gamma_q16)}}}, /* gate thresholds per class, Q16 nats */\n"
              f"    \"{n}\",\n    \"{qm.classes}\"\n}};\n")

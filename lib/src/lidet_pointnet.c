@@ -8,6 +8,7 @@
 
 #include "internal/lidet_math.h"
 #include "internal/lidet_nn.h"
+#include "internal/lidet_pn_common.h"
 #include "lidet/lidet_pointnet.h"
 
 #define NEG_BIG (-3.0e38f)
@@ -58,24 +59,13 @@ static int stage_ok(const lidet_pn_stage_t *s, uint32_t n_classes, uint32_t n_ou
     {
         return 0;
     }
-    if (concat > *wv)
-    {
-        *wv = (uint16_t)concat;
-    }
-    if (w_pvle > *wv)
-    {
-        *wv = w_pvle;
-    }
-    if (w_head > *wv)
-    {
-        *wv = w_head;
-    }
+    *wv = lidet__pn_widest(*wv, concat, w_pvle, w_head);
     return 1;
 }
 
 static uint32_t box_outputs(const lidet_pn_model_t *m)
 {
-    return 3u + 2u * m->n_heading_bins + 4u * m->n_size_clusters;
+    return lidet__pn_box_outputs(m->n_heading_bins, m->n_size_clusters);
 }
 
 static lidet_status_t check_widths(const lidet_pn_model_t *m, uint16_t *wp, uint16_t *wv)
@@ -84,25 +74,17 @@ static lidet_status_t check_widths(const lidet_pn_model_t *m, uint16_t *wp, uint
     *wp = 3;
     *wv = 8;
     if (m->format_version != LIDET_WEIGHTS_FORMAT_VERSION || m->precision != LIDET_PN_F32 ||
-        m->n_classes != LIDET_N_CLASSES || m->n_points < 1 || m->n_points > LIDET_PROPOSAL_POINTS ||
+        !lidet__pn_dims_ok(m->kind, m->n_stages, m->n_classes, m->n_points, m->n_heading_bins, m->n_size_clusters,
+                           m->mean_size_m != 0) ||
         !lidet__isfinite(m->energy_t) || !(m->energy_t > 0.0f))
     {
         return LIDET_ERR_MODEL;
     }
     if (m->kind == LIDET_PN_CLASSIFIER)
     {
-        if (m->n_stages != 1 || !stage_ok(&m->stage[0], m->n_classes, m->n_classes, wp, wv) ||
-            m->stage[0].use_onehot)
-        {
-            return LIDET_ERR_MODEL;
-        }
-        return LIDET_OK;
-    }
-    if (m->kind != LIDET_PN_BOX || m->n_stages < 1 || m->n_stages > 2 || m->n_heading_bins < 1 ||
-        m->n_heading_bins > LIDET_PN_MAX_HEADING_BINS || m->n_size_clusters < 1 ||
-        m->n_size_clusters > LIDET_PN_MAX_SIZE_CLUSTERS || m->mean_size_m == 0)
-    {
-        return LIDET_ERR_MODEL;
+        return stage_ok(&m->stage[0], m->n_classes, m->n_classes, wp, wv) && !m->stage[0].use_onehot
+                   ? LIDET_OK
+                   : LIDET_ERR_MODEL;
     }
     for (st = 0; st < m->n_stages; ++st)
     {
@@ -124,15 +106,7 @@ lidet_status_t lidet_pn_check(const lidet_pn_model_t *model, uint32_t kind, uint
         return LIDET_ERR_ARG;
     }
     st = check_widths(model, &wp, &wv);
-    if (st != LIDET_OK)
-    {
-        return st;
-    }
-    if ((kind != 0 && model->kind != kind) || (n_points != 0 && n_points != model->n_points))
-    {
-        return LIDET_ERR_MODEL;
-    }
-    return LIDET_OK;
+    return st != LIDET_OK ? st : lidet__pn_match(model->kind, model->n_points, kind, n_points);
 }
 
 uint32_t lidet_pn_scratch_bytes(const lidet_pn_model_t *model)
@@ -171,17 +145,10 @@ lidet_status_t lidet_pn_init(lidet_pn_t *pn, const lidet_pn_model_t *model, void
         return st;
     }
     need = LIDET_PN_SCRATCH_BYTES(wp, wv);
-    if (required != 0)
+    st = lidet__pn_scratch_ok(scratch, scratch_bytes, need, required);
+    if (st != LIDET_OK)
     {
-        *required = need;
-    }
-    if (scratch == 0 || scratch_bytes < need)
-    {
-        return LIDET_ERR_BUFFER;
-    }
-    if (((uintptr_t)scratch & 3u) != 0)
-    {
-        return LIDET_ERR_ARG;
+        return st;
     }
     pn->model = model;
     pn->scratch = (float *)scratch;
@@ -535,12 +502,6 @@ const lidet_pn_model_t *lidet_pn_find(const lidet_pn_entry_t *table, uint32_t n,
     {
         return 0;
     }
-    for (i = 0; i < n; ++i)
-    {
-        if (table[i].name != 0 && strcmp(table[i].name, name) == 0)
-        {
-            return table[i].model;
-        }
-    }
-    return 0;
+    i = lidet__pn_find_index(table, n, sizeof *table, name);
+    return i < n ? table[i].model : 0;
 }

@@ -4,6 +4,7 @@
  * frame_cs, load_block -> model_frame, lidet_pointnet_q_energy -> energy, decode_box -> decode_box. */
 #include <string.h>
 
+#include "internal/lidet_pn_common.h"
 #include "internal/lidet_pointnet_q_internal.h"
 #include "internal/lidet_qmath.h"
 #include "lidet/lidet_pointnet_q.h"
@@ -83,15 +84,13 @@ static int stage_ok(const lidet_pointnet_q_stage_t *s, uint32_t n_classes, uint3
             return 0;
         }
     }
-    *wv = (uint16_t)(concat > *wv ? concat : *wv);
-    *wv = w_pvle > *wv ? w_pvle : *wv;
-    *wv = w_head > *wv ? w_head : *wv;
+    *wv = lidet__pn_widest(*wv, concat, w_pvle, w_head);
     return 1;
 }
 
 static uint32_t box_outputs(const lidet_pointnet_q_model_t *m)
 {
-    return 3u + 2u * m->n_heading_bins + 4u * m->n_size_clusters;
+    return lidet__pn_box_outputs(m->n_heading_bins, m->n_size_clusters);
 }
 
 static lidet_status_t check_widths(const lidet_pointnet_q_model_t *m, uint16_t *wp, uint16_t *wv)
@@ -100,24 +99,17 @@ static lidet_status_t check_widths(const lidet_pointnet_q_model_t *m, uint16_t *
     *wp = 3;
     *wv = 8;
     if (m->format_version != LIDET_WEIGHTS_FORMAT_VERSION || m->precision != LIDET_PN_S8 ||
-        m->n_classes != LIDET_N_CLASSES || m->n_points < 1 || m->n_points > LIDET_PROPOSAL_POINTS ||
+        !lidet__pn_dims_ok(m->kind, m->n_stages, m->n_classes, m->n_points, m->n_heading_bins, m->n_size_clusters,
+                           m->mean_size_mm != 0 && m->heading_bam != 0) ||
         m->energy_t_q16 <= 0 || m->pvle_bin[0] <= 0 || m->pvle_bin[1] <= 0 || m->pvle_bin[2] <= 0)
     {
         return LIDET_ERR_MODEL;
     }
     if (m->kind == LIDET_PN_CLASSIFIER)
     {
-        if (m->n_stages != 1 || m->stage[0].use_onehot || !stage_ok(&m->stage[0], m->n_classes, m->n_classes, wp, wv))
-        {
-            return LIDET_ERR_MODEL;
-        }
-        return LIDET_OK;
-    }
-    if (m->kind != LIDET_PN_BOX || m->n_stages < 1 || m->n_stages > 2 || m->n_heading_bins < 1 ||
-        m->n_heading_bins > LIDET_PN_MAX_HEADING_BINS || m->n_size_clusters < 1 ||
-        m->n_size_clusters > LIDET_PN_MAX_SIZE_CLUSTERS || m->mean_size_mm == 0 || m->heading_bam == 0)
-    {
-        return LIDET_ERR_MODEL;
+        return !m->stage[0].use_onehot && stage_ok(&m->stage[0], m->n_classes, m->n_classes, wp, wv)
+                   ? LIDET_OK
+                   : LIDET_ERR_MODEL;
     }
     for (st = 0; st < m->n_stages; ++st)
     {
@@ -139,15 +131,7 @@ lidet_status_t lidet_pointnet_q_check(const lidet_pointnet_q_model_t *model, uin
         return LIDET_ERR_ARG;
     }
     st = check_widths(model, &wp, &wv);
-    if (st != LIDET_OK)
-    {
-        return st;
-    }
-    if ((kind != 0 && model->kind != kind) || (n_points != 0 && n_points != model->n_points))
-    {
-        return LIDET_ERR_MODEL;
-    }
-    return LIDET_OK;
+    return st != LIDET_OK ? st : lidet__pn_match(model->kind, model->n_points, kind, n_points);
 }
 
 uint32_t lidet_pointnet_q_scratch_bytes(const lidet_pointnet_q_model_t *model)
@@ -186,17 +170,10 @@ lidet_status_t lidet_pointnet_q_init(lidet_pointnet_q_t *pn, const lidet_pointne
         return st;
     }
     need = LIDET_POINTNET_Q_SCRATCH_BYTES(wp, wv);
-    if (required != 0)
+    st = lidet__pn_scratch_ok(scratch, scratch_bytes, need, required);
+    if (st != LIDET_OK)
     {
-        *required = need;
-    }
-    if (scratch == 0 || scratch_bytes < need)
-    {
-        return LIDET_ERR_BUFFER;
-    }
-    if (((uintptr_t)scratch & 3u) != 0)
-    {
-        return LIDET_ERR_ARG;
+        return st;
     }
     pn->model = model;
     pn->scratch = (uint8_t *)scratch;
@@ -609,7 +586,8 @@ static void decode_box(const lidet_pointnet_q_model_t *m, const int32_t *raw, co
     for (k = 0; k < 3u; ++k)
     {
         cen[k] = (int64_t)raw[k] + bx[k];
-        cen[k] = cen[k] < -CENTRE_LIMIT_Q16 ? -CENTRE_LIMIT_Q16 : (cen[k] > CENTRE_LIMIT_Q16 ? CENTRE_LIMIT_Q16 : cen[k]);
+        cen[k] = cen[k] < -CENTRE_LIMIT_Q16 ? -CENTRE_LIMIT_Q16
+                                            : (cen[k] > CENTRE_LIMIT_Q16 ? CENTRE_LIMIT_Q16 : cen[k]);
         cm8[k] = lidet__q_rshift_round(cen[k] * 1000, 8); /* mm, Q8 */
     }
     out->box.cx_mm = (int32_t)((int64_t)p->mean_4mm[0] * 4 +
@@ -676,12 +654,6 @@ const lidet_pointnet_q_model_t *lidet_pointnet_q_find(const lidet_pointnet_q_ent
     {
         return 0;
     }
-    for (i = 0; i < n; ++i)
-    {
-        if (table[i].name != 0 && strcmp(table[i].name, name) == 0)
-        {
-            return table[i].model;
-        }
-    }
-    return 0;
+    i = lidet__pn_find_index(table, n, sizeof *table, name);
+    return i < n ? table[i].model : 0;
 }

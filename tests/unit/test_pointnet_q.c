@@ -167,7 +167,7 @@ void test_malformed_descriptors(void)
     EXPECT_BAD(p0.shift = bad_s);
     EXPECT_BAD(p0.out = LIDET_PNQ_OUT_Q16);
     EXPECT_BAD(g_head[0].out = LIDET_PNQ_OUT_S8);
-    EXPECT_BAD(g_head[0].n_out = 4);
+    EXPECT_BAD(g_head[0].n_out = 2); /* not n_classes logits */
 #undef EXPECT_BAD
     make_model();
 }
@@ -245,6 +245,21 @@ void test_generated_int8_models(void)
     TEST_ASSERT_TRUE(bo.box.l_mm > 0 && bo.box.w_mm > 0 && bo.box.h_mm > 0);
     TEST_ASSERT_EQUAL_INT32(bo.energy_heading_q16 + bo.energy_size_q16, bo.energy_q16);
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_pointnet_q_box(&box, &p, LIDET_N_CLASSES, &bo));
+    /* points at the int16 limits and a mean at the coordinate limit: saturation, no overflow (UBSan build) */
+    for (i = 0; i < p.n_points; ++i)
+    {
+        p.xyz[i][0] = (int16_t)(i & 1u ? 32767 : -32768);
+        p.xyz[i][1] = (int16_t)(i & 2u ? 32767 : -32768);
+        p.xyz[i][2] = (int16_t)(i & 4u ? 32767 : -32768);
+    }
+    p.mean_4mm[0] = -LIDET_Q_COORD_MAX_MM / 4;
+    p.mean_4mm[1] = LIDET_Q_COORD_MAX_MM / 4;
+    p.mean_4mm[2] = LIDET_Q_COORD_MAX_MM / 4;
+    p.voxel[0] = INT16_MIN;
+    p.voxel[2] = INT16_MAX;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pointnet_q_classify(&cls, &p, &co));
+    TEST_ASSERT_TRUE(co.cls < LIDET_N_CLASSES);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pointnet_q_box(&box, &p, co.cls, &bo));
 }
 
 int main(void)

@@ -63,6 +63,34 @@ def _portable_times(args, n_files) -> dict | None:
     return code, bdir
 
 
+def _int8_lines(native, xyz, mean, vox, fams, repeats) -> list:
+    """The int8 nets (lidet_pointnet_q_classify / _box, integer proposals: the same proposals rounded to 4 mm)
+    next to the float ones, and the flash size of the weights."""
+    import json
+    from lidet_codegen import emit as E
+    from lidet_codegen import quant as QU
+    from lidet_tools import native_q
+    q4, m4 = QU.int_proposals(xyz, mean)
+    out = ["", "int8 (issue 16, lib/src/lidet_pointnet_q.c, portable C99, no float) against float, same proposals "
+               "(integer ones: the same points rounded to 4 mm steps), same clock; flash: the bytes of the weight "
+               "arrays (float32 weights and biases; int8 weights, int32 biases, multipliers, one-hot biases, "
+               "uint8 shifts).", "",
+           "| model | float us/proposal | int8 us/proposal | int8 speed-up | float weights B | int8 weights B |",
+           "|---|---:|---:|---:|---:|---:|"]
+    for fam in fams:
+        if not (ROOT / "weights" / f"cls_{fam}.calib.json").exists():
+            continue
+        tf = native.pn_time(f"cls_{fam}", f"box_{fam}", xyz, mean, vox, repeats)
+        tq = native_q.pnq_time(f"cls_{fam}_s8", f"box_{fam}_s8", q4, m4, vox, repeats)
+        for k, kind in enumerate(("cls", "box")):
+            name = f"{kind}_{fam}"
+            m = E.load(ROOT / "weights" / f"{name}.onnx", name)
+            qm = QU.quantize(m, json.loads((ROOT / "weights" / f"{name}.calib.json").read_text()))
+            out.append(f"| {name} | {tf[k] * 1e6:.1f} | {tq[k] * 1e6:.1f} | {tf[k] / tq[k]:.2f}x | {4 * m.params():,} "
+                       f"| {qm.flash_bytes():,} |")
+    return out
+
+
 def run(args) -> str:
     os.environ.setdefault("LIDET_BUILD_DIR", str(args.build))
     sys.path.insert(0, str(ROOT / "tools"))
@@ -127,6 +155,7 @@ def run(args) -> str:
                                      (f"both ({fam}), SSE2 only", pcl + pbx, o1c + o1b, o64c + o64b)):
                 lines.append(f"| {name} | | {t * 1e6:.1f} | {o1 * 1e6:.1f} | {o64 * 1e6:.1f} | {o1 / t:.2f}x "
                              f"| {o64 / t:.2f}x |")
+    lines += _int8_lines(native, xyz, mean, vox, fams, repeats)
     lines += ["", "Ratios above 1 mean lidet is faster. The C kernels are portable C99 (lib/src/nn/lidet_nn_f32.c); "
               "on x86-64 hosts the build also compiles them for AVX2 and picks the variant at load time "
               "(CMake option LIDET_NN_CLONES, like onnxruntime's own dispatch), with identical results. The "

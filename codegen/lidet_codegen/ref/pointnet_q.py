@@ -206,7 +206,8 @@ def decode_box(model, raw, mean_4mm, c, s):
     eh = energy(hs, model.energy_t_q16)
     es = energy(ss, model.energy_t_q16)
     box = np.stack([cx, cy, cz, size[:, 0], size[:, 1], size[:, 2], yaw], 1)
-    return dict(box=box, energy_heading=eh, energy_size=es, energy=np.clip(eh + es, *I32), heading_bin=hb, size_cluster=sc)
+    return dict(box=box, energy_heading=eh, energy_size=es, energy=np.clip(eh + es, *I32), heading_bin=hb,
+                size_cluster=sc)
 
 
 def box(model, xyz_4mm, mean_4mm, voxel, cls):

@@ -7,6 +7,15 @@
 
 #include <stdint.h>
 
+/* Host builds on x86-64 (CMake option LIDET_NN_CLONES, on by default there): GCC/clang also compile the kernels
+ * marked LIDET_NN_KERNEL for AVX2 and pick the variant when the program loads (ifunc). Same C source, same
+ * results. Firmware builds never define it. */
+#if defined(LIDET_NN_CLONES) && LIDET_NN_CLONES && (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
+#define LIDET_NN_KERNEL __attribute__((target_clones("avx2", "default")))
+#else
+#define LIDET_NN_KERNEL
+#endif
+
 /* out[r * n_out + o] = act(b[o] + sum_i in[r * n_in + i] * w_t[i * n_out + o]), r < n_rows.
  * in and out may not alias. relu: 1 = max(0, .) after the bias. */
 void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t, const float *b,

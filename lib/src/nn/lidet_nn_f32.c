@@ -12,14 +12,10 @@
 #include "internal/lidet_nn.h"
 
 /* Host builds on x86-64 (CMake option LIDET_NN_CLONES, on by default there): GCC/clang also compile these
- * kernels for AVX2 and pick the variant when the program loads (ifunc), the way onnxruntime dispatches its
- * kernels. Same C source, same results: no FMA contraction (-ffp-contract=off), each sum in the same order.
- * Measured (8 x 64 -> 128): 19 GMAC/s SSE2, 39 GMAC/s AVX2. Firmware builds never define it. */
-#if defined(LIDET_NN_CLONES) && LIDET_NN_CLONES && (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
-#define KERNEL __attribute__((target_clones("avx2", "default")))
-#else
-#define KERNEL
-#endif
+ * kernels for AVX2 and pick the variant when the program loads (ifunc, LIDET_NN_KERNEL in internal/lidet_nn.h),
+ * the way onnxruntime dispatches its kernels. Same C source, same results: no FMA contraction
+ * (-ffp-contract=off), each sum in the same order. Measured (8 x 64 -> 128): 19 GMAC/s SSE2, 39 GMAC/s AVX2.
+ * Firmware builds never define it. */
 
 /* rows r..r+3 of out += in rows * W over inputs [0, n_in), 4 inputs per pass */
 static inline void rows4(const float *x, uint32_t n_in, const float *w_t, uint32_t n_out, float *restrict o0)
@@ -90,8 +86,8 @@ static inline void rows1(const float *x, uint32_t n_in, const float *w_t, uint32
     }
 }
 
-KERNEL void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t, const float *b,
-                         uint32_t n_out, int relu, float *out)
+LIDET_NN_KERNEL void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t,
+                                         const float *b, uint32_t n_out, int relu, float *out)
 {
     uint32_t r, k;
     for (r = 0; r < n_rows; ++r)
