@@ -296,11 +296,12 @@ def scan_list(sensor: str, real_dir=None):
 
 
 def proposals_of(scans, sensor: str, seeds, n_points: int = 64):
-    """(xyz (B, N, 3) float32, mean (B, 3), voxel (B, 3) int16) of the scans with every resampling seed."""
+    """(xyz (B, N, 3) float32, mean (B, 3), voxel (B, 3) int16) of the scans (paths of KITTI .bin files, or
+    point arrays) with every resampling seed."""
     from lidet_tools import kitti, native
     xs, ms, vs = [], [], []
     for path in scans:
-        pts = kitti.read_bin(path)
+        pts = path if isinstance(path, np.ndarray) else kitti.read_bin(path)
         g = native.ground(pts, sensor)
         cl = native.cluster(pts, sensor, ground=g.mask_point, planes=g.planes)
         for s in seeds:

@@ -40,14 +40,18 @@ def qmodels():
 @pytest.fixture(scope="module")
 def props(need_lib):
     """family -> (xyz 4 mm (B, N, 3), mean 4 mm (B, 3), voxel (B, 3)): the simulated sample with 8 resampling
-    seeds, plus the real KITTI scans (one seed) for hdl64 when ../shared/data/real is there. Built from the float
-    proposals rounded to 4 mm steps until the integer proposal stage (lidet_proposal_q_make) lands."""
+    seeds, two freshly simulated scans (lidet_tools.sim, run seed 16, scans 0 and 1) with two, plus the real KITTI
+    scans (one seed) for hdl64 when ../shared/data/real is there. Built from the float proposals rounded to 4 mm
+    steps until the integer proposal stage (lidet_proposal_q_make) lands."""
     from conftest import REAL
+    from lidet_tools.sim.simulate import simulate_scan
     real = REAL if (REAL / "kitti").exists() else None
     out = {}
     for fam in FAMILIES:
         xyz, mean, vox = QU.proposals_of(QU.scan_list(fam)[:1], fam, SEEDS)
         parts = [(xyz, mean, vox)]
+        fresh = [simulate_scan(fam, 16, k).points for k in range(2)]
+        parts.append(QU.proposals_of(fresh, fam, SEEDS[:2]))
         if real is not None and fam == "hdl64":
             parts.append(QU.proposals_of(QU.scan_list(fam, real)[1:], fam, SEEDS[:1]))
         xyz = np.concatenate([p[0] for p in parts])
@@ -146,7 +150,7 @@ def agreement(fam, props):
 
 def test_int8_agrees_with_float(props):
     """int8 against float over all test proposals (figures in docs/FIXED_POINT.md). Issue 16 asks class >= 99 %
-    of proposals and mean BEV IoU >= 0.95: the IoU is met; the class agreement over all proposals is 98.6-99.0 %
+    of proposals and mean BEV IoU >= 0.95: the IoU is met; the class agreement over all proposals is 98.3-99.0 %
     (the int8 activations of the shared layers cost about 0.08 of a logit on average, and 3 % of the proposals
     have their two best logits within 0.2), so it is asserted at 98.5 % here, and at 99 % on the proposals the
     float gate 1 keeps (the ones that can become detections). The gates agree on >= 98 % (a gate flips where the
