@@ -11,7 +11,8 @@ def main(argv=None) -> int:
     if not argv or argv[0] not in cmds:
         print("usage: python -m lidet_codegen {export|emit|macs|qtables|calibrate|pnqtables} ...\n"
               "  export  PyTorch checkpoint (or --untrained KIND) -> ONNX with lidet's metadata\n"
-              "  emit    ONNX -> weights/<name>.{c,h} (const arrays + model descriptor); --int8 --calib: <name>_s8.{c,h}\n"
+              "  emit    ONNX -> weights/<name>.{c,h} (const arrays + model descriptor);\n"
+              "          --int8 --calib FILE: the int8 model weights/<name>_s8.{c,h}\n"
               "  calibrate activation ranges of a model for its int8 version (<name>.calib.json)\n"
               "  macs    multiply-adds and parameters of ONNX models\n"
               "  qtables the integer math tables of the fixed-point build (lib/src/lidet_qmath_tables.c)\n"

@@ -165,3 +165,27 @@ def test_int8_agrees_with_float(props):
     assert tot["cls"] >= 0.985, res
     assert tot["cls_kept"] >= 0.99, res
     assert tot["gate1"] >= 0.98 and tot["gate2"] >= 0.98, res
+
+
+def test_emit_int8_refuses_a_calibration_of_another_model(tmp_path):
+    cal = json.loads((WEIGHTS / "cls_vlp16.calib.json").read_text())
+    cal["onnx_sha256"] = "0" * 64
+    p = tmp_path / "cls_vlp16.calib.json"
+    p.write_text(json.dumps(cal))
+    with pytest.raises(E.EmitError, match="recalibrate"):
+        QU.emit_s8(WEIGHTS / "cls_vlp16.onnx", p, tmp_path, "cmd", report=False)
+    assert not list(tmp_path.glob("*.c"))
+
+
+def test_quantized_layers_follow_the_scheme(qmodels):
+    """int8 weights in [-127, 127], |bias| < 2^29, multipliers in [2^30, 2^31), shifts in [1, 62], zero point -128
+    after every ReLU, Q16 only on the last head layer, the one-hot folded only where the stage takes it."""
+    for name, qm in qmodels.items():
+        for st in qm.stages:
+            for part, layers in (("point", st.point), ("pvle", st.pvle), ("head", st.head)):
+                for i, l in enumerate(layers):
+                    assert np.abs(l.w_q).max() <= 127 and np.abs(l.b).max() < 2 ** 29, (name, part, i)
+                    assert np.all((l.mult >= 2 ** 30) & (l.mult < 2 ** 31)) and np.all((l.shift >= 1) & (l.shift <= 62))
+                    assert l.out_q16 == (part == "head" and i + 1 == len(layers)), (name, part, i)
+                    assert l.out_q16 or (l.relu and l.out_zp == -128)
+            assert (st.onehot_b is not None) == st.use_onehot == (qm.kind == "box")
