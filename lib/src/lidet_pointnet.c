@@ -197,6 +197,60 @@ static void run_vec_layers(const lidet_pn_layer_t *l, uint32_t n, const float *i
     }
 }
 
+/* the frame of one stage's points: rotation by cs (cos, sin of the mean's azimuth; NULL: already in the model
+ * frame) and minus `shift` (the T-Net centre; NULL: none) */
+typedef struct
+{
+    const float *cs;
+    const float *shift;
+} frame_t;
+
+/* one block of points into the model frame (b->shifted), or the points themselves when there is nothing to do */
+static const void *load_block(const bufs_t *b, const float *pts, uint32_t nb, const frame_t *f)
+{
+    const float c = f->cs != 0 ? f->cs[0] : 1.0f, sn = f->cs != 0 ? f->cs[1] : 0.0f;
+    const float sx = f->shift != 0 ? f->shift[0] : 0.0f, sy = f->shift != 0 ? f->shift[1] : 0.0f;
+    const float sz = f->shift != 0 ? f->shift[2] : 0.0f;
+    uint32_t i;
+    if (f->cs == 0 && f->shift == 0)
+    {
+        return pts;
+    }
+    for (i = 0; i < nb; ++i)
+    {
+        const float x = pts[3u * i], y = pts[3u * i + 1u];
+        b->shifted[3u * i + 0u] = (c * x + sn * y) - sx;
+        b->shifted[3u * i + 1u] = (-sn * x + c * y) - sy;
+        b->shifted[3u * i + 2u] = pts[3u * i + 2u] - sz;
+    }
+    return b->shifted;
+}
+
+static void max_init(const bufs_t *b, uint32_t n)
+{
+    uint32_t i;
+    for (i = 0; i < n; ++i)
+    {
+        b->vec[0][i] = NEG_BIG;
+    }
+}
+
+/* the shared layers (internal/lidet_pn_points_body.h): layer l writes act[l & 1], the last one is folded into
+ * the running maximum g = vec[0] */
+#define PNB_FN run_points
+#define PNB_LAYER_T lidet_pn_layer_t
+#define PNB_BUFS_T bufs_t
+#define PNB_PTS_T float
+#define PNB_FRAME_T frame_t
+#define PNB_MAX_INIT(b, n) max_init(b, n)
+#define PNB_LOAD(b, pts, nb, f) load_block(b, pts, nb, f)
+#define PNB_DENSE(ly, in, nb, b, l)                                                                              \
+    lidet__nn_dense_f32((const float *)(in), nb, (ly)->n_in, (ly)->w_t, (ly)->b, (ly)->n_out, (ly)->relu,       \
+                        (b)->act[(l) & 1u])
+#define PNB_STORE(ly, nb, b, dst) ((void)0)
+#define PNB_FOLD_MAX(ly, nb, b, l) lidet__nn_max_rows_f32((b)->act[(l) & 1u], nb, (ly)->n_out, (b)->vec[0])
+#include "internal/lidet_pn_points_body.h"
+
 /* One stage (ref: run_stage): the points, rotated into the model frame by cs (cos, sin of the mean's
  * azimuth; NULL: already there) and shifted by minus `shift` (NULL: none) one block at a time, through
  * the shared layers with the fused max over the n points; then [g | onehot | pvle(voxel)] -> head -> out. */
@@ -205,42 +259,11 @@ static void run_stage(const lidet_pn_stage_t *s, const bufs_t *b, const float *p
 {
     const lidet_pn_layer_t *last = &s->point[s->n_point - 1];
     float *g = b->vec[0];
-    const float c = cs != 0 ? cs[0] : 1.0f, sn = cs != 0 ? cs[1] : 0.0f;
-    const float sx = shift != 0 ? shift[0] : 0.0f, sy = shift != 0 ? shift[1] : 0.0f;
-    const float sz = shift != 0 ? shift[2] : 0.0f;
-    uint32_t p0, i, l, pos;
-    for (i = 0; i < last->n_out; ++i)
-    {
-        g[i] = NEG_BIG;
-    }
-    for (p0 = 0; p0 < n; p0 += LIDET_PN_BLOCK)
-    {
-        const uint32_t nb = n - p0 < LIDET_PN_BLOCK ? n - p0 : LIDET_PN_BLOCK;
-        const float *cur = points + 3u * p0;
-        if (cs != 0 || shift != 0)
-        {
-            for (i = 0; i < nb; ++i)
-            {
-                const float x = cur[3u * i], y = cur[3u * i + 1u];
-                b->shifted[3u * i + 0u] = (c * x + sn * y) - sx;
-                b->shifted[3u * i + 1u] = (-sn * x + c * y) - sy;
-                b->shifted[3u * i + 2u] = cur[3u * i + 2u] - sz;
-            }
-            cur = b->shifted;
-        }
-        for (l = 0; l + 1u < s->n_point; ++l)
-        {
-            float *dst = b->act[l & 1u];
-            lidet__nn_dense_f32(cur, nb, s->point[l].n_in, s->point[l].w_t, s->point[l].b, s->point[l].n_out,
-                                s->point[l].relu, dst);
-            cur = dst;
-        }
-        {
-            float *dst = b->act[(s->n_point - 1u) & 1u]; /* not the buffer holding the last layer's input */
-            lidet__nn_dense_f32(cur, nb, last->n_in, last->w_t, last->b, last->n_out, last->relu, dst);
-            lidet__nn_max_rows_f32(dst, nb, last->n_out, g);
-        }
-    }
+    frame_t f;
+    uint32_t i, pos;
+    f.cs = cs;
+    f.shift = shift;
+    run_points(s->point, s->n_point, b, points, n, &f);
     pos = last->n_out;
     if (s->use_onehot)
     {

@@ -229,8 +229,9 @@ typedef struct
     const int32_t *shift_mm; /* T-Net centre, or NULL */
 } frame_t;
 
-static void load_block(const int16_t *xyz, uint32_t nb, const frame_t *f, int16_t *out)
+static const void *load_block(const bufs_t *b, const int16_t *xyz, uint32_t nb, const frame_t *f)
 {
+    int16_t *out = b->pts;
     uint32_t i;
     const int32_t sx = f->shift_mm != 0 ? f->shift_mm[0] : 0, sy = f->shift_mm != 0 ? f->shift_mm[1] : 0;
     const int32_t sz = f->shift_mm != 0 ? f->shift_mm[2] : 0;
@@ -249,6 +250,7 @@ static void load_block(const int16_t *xyz, uint32_t nb, const frame_t *f, int16_
         out[3u * i + 1u] = sat16(yr - sy);
         out[3u * i + 2u] = sat16(zr - sz);
     }
+    return out;
 }
 
 static void requant_s8(const lidet_pointnet_q_layer_t *l, const int32_t *acc, uint32_t n_rows, int8_t *out)
@@ -291,45 +293,50 @@ static void run_vec_layers(const lidet_pointnet_q_layer_t *l, uint32_t n, const 
     }
 }
 
+static void max_init(const bufs_t *b, uint32_t n)
+{
+    uint32_t i;
+    for (i = 0; i < n; ++i)
+    {
+        b->gmax[i] = INT32_MIN;
+    }
+}
+
+/* layer l into the int32 accumulators: int16 x int8 for the first (the points in mm), int8 x int8 after */
+static void dense_acc(const lidet_pointnet_q_layer_t *ly, const void *in, uint32_t nb, const bufs_t *b, uint32_t l)
+{
+    if (l == 0)
+    {
+        lidet__nn_acc_s16((const int16_t *)in, nb, 3u, ly->w_t, ly->b, ly->n_out, b->acc);
+    }
+    else
+    {
+        lidet__nn_acc_s8((const int8_t *)in, nb, ly->n_in, ly->w_t, ly->b, ly->n_out, b->acc);
+    }
+}
+
+/* the shared layers (internal/lidet_pn_points_body.h): hidden layers requantized into act[l & 1], the last
+ * one's accumulators folded into the running maximum gmax (requantized once by run_stage) */
+#define PNB_FN run_points
+#define PNB_LAYER_T lidet_pointnet_q_layer_t
+#define PNB_BUFS_T bufs_t
+#define PNB_PTS_T int16_t
+#define PNB_FRAME_T frame_t
+#define PNB_MAX_INIT(b, n) max_init(b, n)
+#define PNB_LOAD(b, pts, nb, f) load_block(b, pts, nb, f)
+#define PNB_DENSE(ly, in, nb, b, l) dense_acc(ly, in, nb, b, l)
+#define PNB_STORE(ly, nb, b, dst) requant_s8(ly, (b)->acc, nb, dst)
+#define PNB_FOLD_MAX(ly, nb, b, l) lidet__nn_max_rows_s32((b)->acc, nb, (ly)->n_out, (b)->gmax)
+#include "internal/lidet_pn_points_body.h"
+
 /* One stage (ref: run_stage): blocks of points -> model frame (int16 mm) -> shared layers, the last one's
  * accumulators folded into a running max; requantized once -> g; [g | pvle(voxel)] -> head -> out (Q16). */
 static void run_stage(const lidet_pointnet_q_stage_t *s, const bufs_t *b, const int16_t *xyz, uint32_t n,
                       const frame_t *f, const int16_t voxel[3], uint32_t cls, uint32_t n_classes, int32_t *out)
 {
     const lidet_pointnet_q_layer_t *last = &s->point[s->n_point - 1];
-    uint32_t p0, i, l;
     (void)n_classes;
-    for (i = 0; i < last->n_out; ++i)
-    {
-        b->gmax[i] = INT32_MIN;
-    }
-    for (p0 = 0; p0 < n; p0 += LIDET_PN_BLOCK)
-    {
-        const uint32_t nb = n - p0 < LIDET_PN_BLOCK ? n - p0 : LIDET_PN_BLOCK;
-        const int8_t *cur = 0;
-        load_block(xyz + 3u * p0, nb, f, b->pts);
-        for (l = 0; l < s->n_point; ++l)
-        {
-            const lidet_pointnet_q_layer_t *ly = &s->point[l];
-            if (l == 0)
-            {
-                lidet__nn_acc_s16(b->pts, nb, 3u, ly->w_t, ly->b, ly->n_out, b->acc);
-            }
-            else
-            {
-                lidet__nn_acc_s8(cur, nb, ly->n_in, ly->w_t, ly->b, ly->n_out, b->acc);
-            }
-            if (l + 1u == s->n_point)
-            {
-                lidet__nn_max_rows_s32(b->acc, nb, ly->n_out, b->gmax);
-            }
-            else
-            {
-                requant_s8(ly, b->acc, nb, b->act[l & 1u]);
-                cur = b->act[l & 1u];
-            }
-        }
-    }
+    run_points(s->point, s->n_point, b, xyz, n, f);
     requant_s8(last, b->gmax, 1u, b->vec[0]);
     if (s->n_pvle > 0)
     {
