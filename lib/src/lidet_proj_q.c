@@ -72,6 +72,18 @@ static inline int cmp_tan(int32_t z, uint64_t z2, uint64_t rxy2, const lidet_pro
     return sz > 0 ? mag : -mag;
 }
 
+/* 1 when boundary a is strictly below boundary b (exact: n * 2^(max q - q) < 2^27 * 2^35) */
+static int bound_below(const lidet_proj_q_bound_t *a, const lidet_proj_q_bound_t *b)
+{
+    const unsigned qm = a->q > b->q ? a->q : b->q;
+    const uint64_t ma = (uint64_t)a->n << (qm - a->q), mb = (uint64_t)b->n << (qm - b->q);
+    if (a->sign != b->sign)
+    {
+        return a->sign < b->sign;
+    }
+    return a->sign > 0 ? ma < mb : (a->sign < 0 ? ma > mb : 0);
+}
+
 static int32_t clamp_elev(int64_t urad)
 {
     return urad > LIDET_Q_MAX_ELEV_URAD ? LIDET_Q_MAX_ELEV_URAD
@@ -187,7 +199,7 @@ lidet_status_t lidet_proj_q_init(lidet_proj_q_state_t *st, const lidet_proj_q_cf
     {
         const int32_t sum_bam = lidet__q_urad_to_bam(st->row_elev_urad[r - 1] + st->row_elev_urad[r]);
         const int64_t t = make_bound(&st->row_bound[r], (int32_t)lidet__q_rshift_round(sum_bam, 1));
-        if (t >= t_prev)
+        if (t >= t_prev || (r > 1u && !bound_below(&st->row_bound[r], &st->row_bound[r - 1u])))
         {
             return LIDET_ERR_CONFIG;
         }
@@ -233,7 +245,7 @@ static inline int16_t to_4mm(int32_t v)
 lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf, const int32_t *points,
                                 uint32_t n_points, uint32_t stride, const uint16_t *ring)
 {
-    uint32_t n, i, rows, cols, npix, pix;
+    uint32_t n, i, rows, cols, npix, pix, guess = 0;
     uint64_t min2, max2;
     lidet_proj_stats_t sts;
 
@@ -303,22 +315,29 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
         }
         else
         {
-            uint32_t lo = 0, hi = rows - 1u;
             if (cmp_tan(z, z2, rxy2, &st->fov_hi) > 0 || cmp_tan(z, z2, rxy2, &st->fov_lo) < 0)
             {
                 ++sts.n_out_of_fov; /* x = y = 0 included (t = +-inf) */
                 goto next;
             }
-            /* the first row r whose lower boundary r + 1 the point is at or above (boundary rows = -inf) */
-            while (lo < hi)
+            /* the row r with T[r] > t >= T[r + 1] (T[0] = +inf, T[rows] = -inf): unique, as the boundaries
+             * strictly decrease (checked in init) and each test is exact. Tried first: the previous point's row
+             * (scans come ring by ring: usually right, two tests); else a binary search (log2(rows) tests). */
+            row = guess;
+            if ((row > 0u && cmp_tan(z, z2, rxy2, &st->row_bound[row]) >= 0) ||
+                (row + 1u < rows && cmp_tan(z, z2, rxy2, &st->row_bound[row + 1u]) < 0))
             {
-                const uint32_t mid = (lo + hi) >> 1;
-                if (cmp_tan(z, z2, rxy2, &st->row_bound[mid + 1u]) >= 0)
-                    hi = mid;
-                else
-                    lo = mid + 1u;
+                uint32_t lo = 0, hi = rows - 1u;
+                while (lo < hi)
+                {
+                    const uint32_t mid = (lo + hi) >> 1;
+                    const int at_or_above = cmp_tan(z, z2, rxy2, &st->row_bound[mid + 1u]) >= 0;
+                    hi = at_or_above ? mid : hi;
+                    lo = at_or_above ? lo : mid + 1u;
+                }
+                row = lo;
             }
-            row = lo;
+            guess = row;
         }
         /* column: D = num / sum in [0, 4); x = y = 0 (ring path only) is straight ahead, D = 2 */
         sum = ax + ay;
@@ -367,8 +386,9 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
             const int32_t *pt = points + (size_t)k * stride;
             const uint64_t r2 = (uint64_t)((int64_t)pt[0] * pt[0]) + (uint64_t)((int64_t)pt[1] * pt[1]) +
                                 (uint64_t)((int64_t)pt[2] * pt[2]);
-            /* round(sqrt(r2) / 4) = (floor(sqrt(r2) / 2) + 1) / 2, halves up; >= 1 for a valid pixel */
-            const uint32_t rq = ((lidet__q_isqrt64(r2) >> 1) + 1u) >> 1;
+            /* round(sqrt(r2) / 4) = (floor(sqrt(r2) / 2) + 1) / 2, halves up, and floor(sqrt(r2) / 2) =
+             * floor(sqrt(floor(r2 / 4))) < 2^16 in 32-bit arithmetic (r2 / 4 <= 131000^2 / 4 < 2^32); >= 1 when valid */
+            const uint32_t rq = (lidet__q_isqrt32((uint32_t)(r2 >> 2)) + 1u) >> 1;
             buf->x_4mm[pix] = to_4mm(pt[0]);
             buf->y_4mm[pix] = to_4mm(pt[1]);
             buf->z_4mm[pix] = to_4mm(pt[2]);

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "internal/lidet_qmath.h"
 #include "lidet/lidet.h"
 
 #if defined(_WIN32)
@@ -92,4 +93,15 @@ LIDET_PY_API int lidet_py_proj_q(const int32_t *sensor_ints, const int32_t *elev
     }
     free(st);
     return status;
+}
+
+/* lidet__q_isqrt32 over an array (the 32-bit root the projection takes per filled pixel) */
+LIDET_PY_API int lidet_py_isqrt32(const uint32_t *v, uint32_t n, int64_t *out)
+{
+    uint32_t i;
+    if (v == NULL || out == NULL)
+        return LIDET_ERR_ARG;
+    for (i = 0; i < n; ++i)
+        out[i] = lidet__q_isqrt32(v[i]);
+    return LIDET_OK;
 }

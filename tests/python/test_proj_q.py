@@ -60,6 +60,14 @@ def test_integer_presets_match_python_and_float(nq):
         assert q["mount_height_mm"] == round(cf[name][3] * 1000), name
 
 
+def test_isqrt32_exact(nq):
+    rng = np.random.default_rng(32)
+    k = np.arange(1, 65536, dtype=np.int64)
+    v = np.concatenate([[0, 1, 2, 3, 4, 2**32 - 1, 2**32 - 2, 2**30, 2**30 - 1], k * k, k * k - 1,
+                        rng.integers(0, 2**32, 200_000)])
+    np.testing.assert_array_equal(nq.isqrt32(v), qmath.isqrt(v))
+
+
 def _edge_scan(sensor, n, rng):
     s = sensors.get_sensor(sensor)
     el = rng.uniform(s.beam_elev_rad.min() - 0.12, s.beam_elev_rad.max() + 0.12, n)

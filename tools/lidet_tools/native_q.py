@@ -62,6 +62,7 @@ def _proj_q_lib():
     L = native.lib()
     if not _proj_q_ready:
         L.lidet_py_sensor_q.argtypes = [C.c_uint32, C.c_char_p, _u32p, _i32p, _i32p]
+        L.lidet_py_isqrt32.argtypes = [_u32p, C.c_uint32, _i64p]
         L.lidet_py_proj_q.argtypes = [_i32p, native._opt(_i32p), _i32p, native._opt(_i32p), C.c_uint32, C.c_uint32,
                                       native._opt(_u16p), native._opt(_i32p), _i32p, _i16p, _u16p, _u32p, _i32p]
         _proj_q_ready = True
@@ -124,3 +125,13 @@ def project_q(points_mm, sensor="hdl64", ring=None, min_range_mm: int = 100, max
         raise native.LidetError(st, "lidet_proj_q")
     return dict(point_pixel=pp, point_idx=idx, x_4mm=xyz[:npix], y_4mm=xyz[npix:2 * npix], z_4mm=xyz[2 * npix:],
                 range_4mm=rng, stats=dict(zip(PROJ_Q_STATS, map(int, stats))), row_elev_bam=bam, status=int(st))
+
+
+def isqrt32(v) -> np.ndarray:
+    """lidet__q_isqrt32 (floor sqrt in 32-bit arithmetic) over uint32 values, as int64."""
+    a = np.ascontiguousarray(np.asarray(v, dtype=np.int64).astype(np.uint32))
+    out = np.zeros(a.shape, np.int64)
+    st = _proj_q_lib().lidet_py_isqrt32(a.ravel(), a.size, out.ravel())
+    if st != 0:
+        raise native.LidetError(st, "lidet_py_isqrt32")
+    return out

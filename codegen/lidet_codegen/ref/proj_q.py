@@ -40,6 +40,15 @@ def _bound(a_bam: int):
     return n, 60 - sh, (t > 0) - (t < 0), t
 
 
+def _below(a, b) -> bool:
+    """bound_below: tangent a < tangent b, exactly, on the (n, q, sign) representations."""
+    if a[2] != b[2]:
+        return a[2] < b[2]
+    qm = max(int(a[1]), int(b[1]))
+    ma, mb = int(a[0]) << (qm - int(a[1])), int(b[0]) << (qm - int(b[1]))
+    return ma < mb if a[2] > 0 else (ma > mb if a[2] < 0 else False)
+
+
 def _clamp(u: int) -> int:
     return max(-MAX_ELEV_URAD, min(MAX_ELEV_URAD, u))
 
@@ -82,7 +91,7 @@ def init(elev_urad_ring_order, cols: int, fov_margin_urad: int = 87266, fov_urad
     for r in range(1, rows):
         s = int(qmath.urad_to_bam(int(row_elev[r - 1]) + int(row_elev[r])))
         b = _bound(int(qmath.rshift_round(s, 1)))
-        if b[3] >= t_prev:
+        if b[3] >= t_prev or (r > 1 and not _below(b, bound[r - 1])):
             raise ValueError("CONFIG: boundaries not strictly decreasing")
         t_prev = b[3]
         bound[r] = b[:3]
@@ -180,7 +189,7 @@ def project(points_mm, tab: Tables, min_range_mm: int = 100, max_range_mm: int =
     filled = point_idx >= 0
     w = np.where(filled, point_idx, 0)
     planes = [np.where(filled, (p[w, k] + 2) >> 2, 0) if n else np.zeros(npix, np.int64) for k in range(3)]
-    rq = ((qmath.isqrt(r2[w]) >> 1) + 1) >> 1 if n else np.zeros(npix, np.int64)
+    rq = (qmath.isqrt(r2[w] >> 2) + 1) >> 1 if n else np.zeros(npix, np.int64)
     range_4mm = np.where(filled, np.maximum(rq, 1), 0)
     stats["n_pixels_filled"] = int(filled.sum())
     return dict(point_pixel=pix, point_idx=point_idx, x_4mm=planes[0], y_4mm=planes[1], z_4mm=planes[2],
