@@ -42,6 +42,7 @@ static int64_t make_bound(lidet_proj_q_bound_t *b, int32_t a_bam)
     }
     b->n = (uint32_t)(sh > 0 ? lidet__q_rshift_round((int64_t)v, sh) : (int64_t)v);
     b->q = (uint8_t)(60u - sh);
+    b->z2_max = ((uint64_t)1 << (3u + sh)) - 1u; /* z^2 above this: z^2 2^q >= 2^63 */
     b->sign = (int8_t)((t > 0) - (t < 0));
     return t;
 }
@@ -60,13 +61,16 @@ static inline int cmp_tan(int32_t z, uint64_t z2, uint64_t rxy2, const lidet_pro
         return 0;
     }
     /* same sign: |t| against |T| as z^2 2^q against n rxy2; z^2 2^q >= 2^63 exceeds any n rxy2 (< 2^62) */
-    if ((z2 >> (63u - b->q)) != 0u)
+    if (z2 > b->z2_max)
     {
         mag = 1;
     }
     else
     {
-        const uint64_t lhs = z2 << b->q, rhs = (uint64_t)b->n * rxy2;
+        /* n rxy2 with rxy2 < 2^35 as n (low 32 bits) + (n (high bits)) 2^32 (n (high bits) < 2^30): a 32 x 32 -> 64
+         * product and a 32-bit one, not a 64 x 64 one */
+        const uint64_t lhs = z2 << b->q;
+        const uint64_t rhs = (uint64_t)b->n * (uint32_t)rxy2 + ((uint64_t)(b->n * (uint32_t)(rxy2 >> 32)) << 32);
         mag = (lhs > rhs) - (lhs < rhs);
     }
     return sz > 0 ? mag : -mag;
@@ -236,6 +240,31 @@ static inline void key_set(const lidet_proj_q_buffers_t *b, uint32_t p, uint64_t
     b->y_4mm[p] = (int16_t)(uint16_t)k;
 }
 
+/* a^2 for a < 2^18 (here a <= LIDET_Q_COORD_MAX_MM) from 32-bit products only (a = h 2^16 + l: h^2 2^32 + h l 2^17 + l^2),
+ * so a core without a 32 x 32 -> 64 multiply (Cortex-M0+) calls no 64-bit multiplication helper */
+static inline uint64_t square_17(uint32_t a)
+{
+    const uint32_t h = a >> 16, l = a & 0xFFFFu;
+    return ((uint64_t)(h * h) << 32) + ((uint64_t)(h * l) << 17) + (uint64_t)(l * l);
+}
+
+/* E[c] <= D, i.e. e sum <= num 2^29 = dn, exactly. First in 32 bits, where it is decided unless D is within
+ * 2^-11 of the edge: c = floor(e / 2^18) (< 10 241) and num11 = num 2^11 (< 2^31), products < 2.7e9; only the
+ * undecided rest takes the 64-bit product (one call to a helper on Cortex-M0+). */
+static inline int edge_le(uint32_t e, uint32_t sum, uint32_t num11, uint64_t dn)
+{
+    const uint32_t c = e >> 18;
+    if ((c + 1u) * sum <= num11) /* e < (c + 1) 2^18 */
+    {
+        return 1;
+    }
+    if (c * sum > num11) /* e >= c 2^18 */
+    {
+        return 0;
+    }
+    return (uint64_t)e * sum <= dn;
+}
+
 /* v mm -> 4 mm steps, rounded half up; |v| <= LIDET_Q_COORD_MAX_MM so the result fits int16 */
 static inline int16_t to_4mm(int32_t v)
 {
@@ -245,8 +274,9 @@ static inline int16_t to_4mm(int32_t v)
 lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf, const int32_t *points,
                                 uint32_t n_points, uint32_t stride, const uint16_t *ring)
 {
-    uint32_t n, i, rows, cols, npix, pix, guess = 0;
+    uint32_t n, i, rows, cols, npix, pix, row_guess = 0, col_guess = 0;
     uint64_t min2, max2;
+    const uint32_t *edge;
     lidet_proj_stats_t sts;
 
     if (st == 0 || buf == 0 || stride < 3 || (points == 0 && n_points > 0) || buf->x_4mm == 0 || buf->y_4mm == 0 ||
@@ -261,6 +291,7 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     rows = st->cfg.sensor.n_rows;
     cols = st->cfg.sensor.n_cols;
     npix = rows * cols;
+    edge = st->col_edge_q29;
     n = n_points > LIDET_MAX_POINTS ? LIDET_MAX_POINTS : n_points;
     memset(&sts, 0, sizeof sts);
     sts.n_points_in = n_points;
@@ -280,7 +311,7 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
         const int32_t *pt = points + (size_t)i * stride;
         const int32_t x = pt[0], y = pt[1], z = pt[2];
         uint64_t rxy2, z2, r2;
-        uint32_t ax, ay, sum, num, bucket, row, col;
+        uint32_t ax, ay, sum, num, row, col;
         int32_t out = -1;
         /* |coordinate| <= LIDET_Q_COORD_MAX_MM, tested on unsigned values (no overflow at the int32 limits) */
         if ((uint32_t)x + COORD_SPAN > 2u * COORD_SPAN || (uint32_t)y + COORD_SPAN > 2u * COORD_SPAN ||
@@ -291,8 +322,8 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
         }
         ax = (uint32_t)(x < 0 ? -x : x);
         ay = (uint32_t)(y < 0 ? -y : y);
-        rxy2 = (uint64_t)ax * ax + (uint64_t)ay * ay;
-        z2 = (uint64_t)((int64_t)z * z);
+        rxy2 = square_17(ax) + square_17(ay);
+        z2 = square_17((uint32_t)(z < 0 ? -z : z));
         r2 = rxy2 + z2;
         if (r2 < min2)
         {
@@ -315,15 +346,10 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
         }
         else
         {
-            if (cmp_tan(z, z2, rxy2, &st->fov_hi) > 0 || cmp_tan(z, z2, rxy2, &st->fov_lo) < 0)
-            {
-                ++sts.n_out_of_fov; /* x = y = 0 included (t = +-inf) */
-                goto next;
-            }
             /* the row r with T[r] > t >= T[r + 1] (T[0] = +inf, T[rows] = -inf): unique, as the boundaries
              * strictly decrease (checked in init) and each test is exact. Tried first: the previous point's row
              * (scans come ring by ring: usually right, two tests); else a binary search (log2(rows) tests). */
-            row = guess;
+            row = row_guess;
             if ((row > 0u && cmp_tan(z, z2, rxy2, &st->row_bound[row]) >= 0) ||
                 (row + 1u < rows && cmp_tan(z, z2, rxy2, &st->row_bound[row + 1u]) < 0))
             {
@@ -337,9 +363,20 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
                 }
                 row = lo;
             }
-            guess = row;
+            row_guess = row;
+            /* the field of view: fov_hi > T[1] > ... > T[rows - 1] > fov_lo (init), so only the edge rows
+             * can hold a point outside it (x = y = 0, t = +-inf, included) */
+            if ((row == 0u && cmp_tan(z, z2, rxy2, &st->fov_hi) > 0) ||
+                (row + 1u == rows && cmp_tan(z, z2, rxy2, &st->fov_lo) < 0))
+            {
+                ++sts.n_out_of_fov;
+                goto next;
+            }
         }
-        /* column: D = num / sum in [0, 4); x = y = 0 (ring path only) is straight ahead, D = 2 */
+        /* column: D = num / sum in [0, 4); x = y = 0 (ring path only) is straight ahead, D = 2. The column c
+         * with E[c] <= D < E[c + 1] (exact cross-multiplications): the previous point's column and its two
+         * neighbours first (consecutive points share or neighbour columns in both the ring-by-ring and the
+         * firing order), else the bucket floor(D cols) (one division), its table entry and one step up. */
         sum = ax + ay;
         num = y >= 0 ? sum + (uint32_t)x : 3u * sum - (uint32_t)x; /* unsigned wrap-around is exact here */
         if (sum == 0u)
@@ -347,13 +384,37 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
             sum = 1u;
             num = 2u;
         }
+        {
+            const uint64_t dn = (uint64_t)num << 29; /* D in Q29, times sum */
+            const uint32_t num11 = num << 11;        /* num <= 4 sum < 2^20 */
+            int lo_ok, hi_ok; /* E[col] <= D, D < E[col + 1] */
+            col = col_guess;
+            lo_ok = edge_le(edge[col], sum, num11, dn);
+            hi_ok = !edge_le(edge[col + 1u], sum, num11, dn);
+            if (!lo_ok && col > 0u) /* one column down: its upper edge is the old lower one */
+            {
+                --col;
+                lo_ok = edge_le(edge[col], sum, num11, dn);
+                hi_ok = 1;
+            }
+            else if (!hi_ok) /* one up: its lower edge is the old upper one (the sentinel stops it at cols - 1) */
+            {
+                ++col;
+                lo_ok = 1;
+                hi_ok = !edge_le(edge[col + 1u], sum, num11, dn);
+            }
+            if (!lo_ok || !hi_ok)
+            {
 #if LIDET_MAX_COLS <= 4096
-        bucket = num * cols / sum; /* num * cols <= 4 * 262000 * 4096 < 2^32 */
+                const uint32_t bucket = num * cols / sum; /* num * cols <= 4 * 262000 * 4096 < 2^32 */
 #else
-        bucket = (uint32_t)((uint64_t)num * cols / sum);
+                const uint32_t bucket = (uint32_t)((uint64_t)num * cols / sum);
 #endif
-        col = st->col_lut[bucket];
-        col += (uint32_t)((uint64_t)st->col_edge_q29[col + 1u] * sum <= (uint64_t)num * EDGE_ONE);
+                col = st->col_lut[bucket];
+                col += (uint32_t)edge_le(edge[col + 1u], sum, num11, dn);
+            }
+            col_guess = col;
+        }
         pix = row * cols + col;
         LIDET_ASSERT(pix < npix);
         out = (int32_t)pix;
@@ -384,8 +445,7 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
         else
         {
             const int32_t *pt = points + (size_t)k * stride;
-            const uint64_t r2 = (uint64_t)((int64_t)pt[0] * pt[0]) + (uint64_t)((int64_t)pt[1] * pt[1]) +
-                                (uint64_t)((int64_t)pt[2] * pt[2]);
+            const uint64_t r2 = key_get(buf, pix); /* the winner's squared range, kept by pass 1 */
             /* round(sqrt(r2) / 4) = (floor(sqrt(r2) / 2) + 1) / 2, halves up, and floor(sqrt(r2) / 2) =
              * floor(sqrt(floor(r2 / 4))) < 2^16 in 32-bit arithmetic (r2 / 4 <= 131000^2 / 4 < 2^32); >= 1 when valid */
             const uint32_t rq = (lidet__q_isqrt32((uint32_t)(r2 >> 2)) + 1u) >> 1;

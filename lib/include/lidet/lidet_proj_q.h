@@ -50,6 +50,7 @@ typedef struct
 /** @brief A row boundary: tan(angle)^2 = n / 2^q, sign = the sign of tan (0: the horizon, n = 0). */
 typedef struct
 {
+    uint64_t z2_max; /**< 2^(63 - q) - 1: a larger z^2 makes z^2 2^q exceed any n (x^2 + y^2) */
     uint32_t n;
     uint8_t q;
     int8_t sign;
