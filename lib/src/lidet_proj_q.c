@@ -227,17 +227,18 @@ lidet_status_t lidet_proj_q_init(lidet_proj_q_state_t *st, const lidet_proj_q_cf
     return LIDET_OK;
 }
 
-/* the 48-bit squared-range key of a pixel during pass 1: range_4mm (bits 32..47), z_4mm (16..31), y_4mm (0..15) */
-static inline uint64_t key_get(const lidet_proj_q_buffers_t *b, uint32_t p)
+/* The winner test's key of a pixel during pass 1: floor(r^2 / 4), the squared range in 4 mm^2 steps (< 2^32 as
+ * r^2 <= 131000^2), kept as the float projection keeps its own: high half in range_4mm, low half in z_4mm. All
+ * ones (the initial value) exceeds any key. */
+static inline uint32_t key_get(const lidet_proj_q_buffers_t *b, uint32_t p)
 {
-    return ((uint64_t)b->range_4mm[p] << 32) | ((uint64_t)(uint16_t)b->z_4mm[p] << 16) | (uint16_t)b->y_4mm[p];
+    return ((uint32_t)b->range_4mm[p] << 16) | (uint16_t)b->z_4mm[p];
 }
 
-static inline void key_set(const lidet_proj_q_buffers_t *b, uint32_t p, uint64_t k)
+static inline void key_set(const lidet_proj_q_buffers_t *b, uint32_t p, uint32_t k)
 {
-    b->range_4mm[p] = (uint16_t)(k >> 32);
-    b->z_4mm[p] = (int16_t)(uint16_t)(k >> 16); /* two's complement: C99 int16_t */
-    b->y_4mm[p] = (int16_t)(uint16_t)k;
+    b->range_4mm[p] = (uint16_t)(k >> 16);
+    b->z_4mm[p] = (int16_t)(uint16_t)k; /* two's complement: C99 int16_t */
 }
 
 /* a^2 for a < 2^18 (here a <= LIDET_Q_COORD_MAX_MM) from 32-bit products only (a = h 2^16 + l: h^2 2^32 + h l 2^17 + l^2),
@@ -305,7 +306,6 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     memset(buf->point_idx, 0xFF, (size_t)npix * sizeof buf->point_idx[0]);
     memset(buf->range_4mm, 0xFF, (size_t)npix * sizeof buf->range_4mm[0]);
     memset(buf->z_4mm, 0xFF, (size_t)npix * sizeof buf->z_4mm[0]);
-    memset(buf->y_4mm, 0xFF, (size_t)npix * sizeof buf->y_4mm[0]);
     for (i = 0; i < n; ++i)
     {
         const int32_t *pt = points + (size_t)i * stride;
@@ -419,9 +419,9 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
         LIDET_ASSERT(pix < npix);
         out = (int32_t)pix;
         ++sts.n_projected;
-        if (r2 < key_get(buf, pix)) /* strict: ties keep the earlier point */
+        if ((uint32_t)(r2 >> 2) < key_get(buf, pix)) /* strict: ties keep the earlier point */
         {
-            key_set(buf, pix, r2);
+            key_set(buf, pix, (uint32_t)(r2 >> 2));
             buf->point_idx[pix] = (int32_t)i;
         }
     next:
@@ -445,10 +445,9 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
         else
         {
             const int32_t *pt = points + (size_t)k * stride;
-            const uint64_t r2 = key_get(buf, pix); /* the winner's squared range, kept by pass 1 */
             /* round(sqrt(r2) / 4) = (floor(sqrt(r2) / 2) + 1) / 2, halves up, and floor(sqrt(r2) / 2) =
-             * floor(sqrt(floor(r2 / 4))) < 2^16 in 32-bit arithmetic (r2 / 4 <= 131000^2 / 4 < 2^32); >= 1 when valid */
-            const uint32_t rq = (lidet__q_isqrt32((uint32_t)(r2 >> 2)) + 1u) >> 1;
+             * floor(sqrt(floor(r2 / 4))), the root of the key pass 1 kept (32-bit); >= 1 for a valid pixel */
+            const uint32_t rq = (lidet__q_isqrt32(key_get(buf, pix)) + 1u) >> 1;
             buf->x_4mm[pix] = to_4mm(pt[0]);
             buf->y_4mm[pix] = to_4mm(pt[1]);
             buf->z_4mm[pix] = to_4mm(pt[2]);

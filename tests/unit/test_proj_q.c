@@ -150,7 +150,7 @@ static void test_closest_wins_and_rounding(void)
     TEST_ASSERT_EQUAL_INT32(bpix[0], bpix[1]);
     TEST_ASSERT_EQUAL_INT32(bpix[0], bpix[2]);
     TEST_ASSERT_EQUAL_INT32(bpix[0], bpix[4]);
-    TEST_ASSERT_EQUAL_INT32(1, bidx[pix]); /* 1002 mm: tie with point 2, the earlier wins; point 4 is 0.0005 mm farther */
+    TEST_ASSERT_EQUAL_INT32(1, bidx[pix]); /* 1002 mm: tie with point 2, the earlier wins; point 4 (r^2 + 1) has the same floor(r^2 / 4) */
     lidet_proj_q_image(&g.ws, &buf, &img);
     TEST_ASSERT_EQUAL_INT16(251, img.x_4mm[pix]); /* 1002 / 4 = 250.5 -> 251 */
     TEST_ASSERT_EQUAL_UINT16(251, img.range_4mm[pix]);

@@ -181,7 +181,8 @@ def project(points_mm, tab: Tables, min_range_mm: int = 100, max_range_mm: int =
 
     point_idx = np.full(npix, -1, np.int64)
     idx = np.nonzero(ok)[0]
-    o = np.lexsort((idx, r2[idx], pix[idx]))
+    key = r2 >> 2  # the winner test compares floor(r^2 / 4): squared ranges in 4 mm^2 steps
+    o = np.lexsort((idx, key[idx], pix[idx]))
     sp = pix[idx][o]
     first = np.ones(len(sp), bool)
     first[1:] = sp[1:] != sp[:-1]
@@ -189,7 +190,7 @@ def project(points_mm, tab: Tables, min_range_mm: int = 100, max_range_mm: int =
     filled = point_idx >= 0
     w = np.where(filled, point_idx, 0)
     planes = [np.where(filled, (p[w, k] + 2) >> 2, 0) if n else np.zeros(npix, np.int64) for k in range(3)]
-    rq = (qmath.isqrt(r2[w] >> 2) + 1) >> 1 if n else np.zeros(npix, np.int64)
+    rq = (qmath.isqrt(key[w]) + 1) >> 1 if n else np.zeros(npix, np.int64)
     range_4mm = np.where(filled, np.maximum(rq, 1), 0)
     stats["n_pixels_filled"] = int(filled.sum())
     return dict(point_pixel=pix, point_idx=point_idx, x_4mm=planes[0], y_4mm=planes[1], z_4mm=planes[2],

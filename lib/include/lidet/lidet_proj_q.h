@@ -16,8 +16,9 @@
  *    of lidet_proj.h; its bucket floor(D n_cols) from one 32-bit unsigned division, a table gives the column of
  *    the bucket's low end and one exact test against the next column edge (edges in Q29, from qmath sin/cos,
  *    compared by cross-multiplication) finishes it.
- *  - the closest point wins a pixel (squared ranges in mm^2 compared exactly, ties keep the earlier point);
- *    only the winners get a square root (exact isqrt), range_4mm = round(sqrt(r^2) / 4) (>= 1 for a valid pixel).
+ *  - the closest point wins a pixel: the squared ranges compared in 4 mm^2 steps, floor(r^2 / 4) (< 2^32; the float
+ *    projection compares float32 squares, coarser beyond 5.8 m), ties keep the earlier point; only the winners get a
+ *    square root (exact, 32-bit): range_4mm = round(sqrt(r^2) / 4) (>= 1 for a valid pixel).
  * Points with |x|, |y| or |z| > LIDET_Q_COORD_MAX_MM or a range above max_range_mm (or 131 000 mm, the compact
  * image's limit) count as n_too_far; closer than min_range_mm, or at zero range, as n_too_close; n_nonfinite
  * stays 0. No float anywhere, no 64-bit division per point.
