@@ -7,7 +7,7 @@
  * lidet's azimuth and elevation tests against a double-precision reference, and the row/column
  * agreement with it. Prints one JSON object per scan and a summary object (tools/bench reads them).
  *
- * usage: lidet_bench_proj --sensor hdl64 [--repeat 30] SCAN.bin...
+ * usage: lidet_bench_proj --sensor hdl64 [--repeat 30] [--clock wall|cpu] SCAN.bin...
  */
 #include <math.h>
 #include <stdio.h>
@@ -36,10 +36,13 @@ static int16_t c_x[LIDET_MAX_ROWS * LIDET_MAX_COLS], c_y[LIDET_MAX_ROWS * LIDET_
 static uint16_t c_r[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 static lidet_proj_q_state_t g_proj_q;
 
+static clockid_t g_clock = CLOCK_MONOTONIC; /* --clock cpu: CLOCK_PROCESS_CPUTIME_ID (a loaded machine
+                                                preempts the longer runs: wall time then says little) */
+
 static double now_ms(void)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(g_clock, &ts);
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
@@ -148,10 +151,12 @@ int main(int argc, char **argv)
             sensor = argv[++a];
         else if (strcmp(argv[a], "--repeat") == 0 && a + 1 < argc)
             repeat = atoi(argv[++a]);
+        else if (strcmp(argv[a], "--clock") == 0 && a + 1 < argc)
+            g_clock = strcmp(argv[++a], "cpu") == 0 ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC;
     }
     if (repeat < 1 || lidet_sensor_find(sensor) == NULL)
     {
-        fprintf(stderr, "usage: lidet_bench_proj --sensor NAME [--repeat N] SCAN.bin...\n");
+        fprintf(stderr, "usage: lidet_bench_proj --sensor NAME [--repeat N] [--clock wall|cpu] SCAN.bin...\n");
         return 1;
     }
     lidet_proj_cfg_default(&cfg, lidet_sensor_find(sensor));
@@ -191,7 +196,7 @@ int main(int argc, char **argv)
         double *tl, *tb, *tc, *tq, ml, mb, mc, mq;
         const int32_t *pp;
         int k;
-        if (strcmp(argv[a], "--sensor") == 0 || strcmp(argv[a], "--repeat") == 0)
+        if (strcmp(argv[a], "--sensor") == 0 || strcmp(argv[a], "--repeat") == 0 || strcmp(argv[a], "--clock") == 0)
         {
             ++a;
             continue;
