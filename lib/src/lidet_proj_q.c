@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "internal/lidet_assert.h"
+#include "internal/lidet_proj_rows.h"
 #include "internal/lidet_qmath.h"
 #include "lidet/lidet_proj_q.h"
 
@@ -88,6 +89,13 @@ static int bound_below(const lidet_proj_q_bound_t *a, const lidet_proj_q_bound_t
     return a->sign > 0 ? ma < mb : (a->sign < 0 ? ma > mb : 0);
 }
 
+/* lidet__proj_rows_top_down's order on this file's elevations */
+static int beam_above(const void *elev, uint32_t a, uint32_t b)
+{
+    const int32_t *e = (const int32_t *)elev;
+    return e[a] > e[b];
+}
+
 static int32_t clamp_elev(int64_t urad)
 {
     return urad > LIDET_Q_MAX_ELEV_URAD ? LIDET_Q_MAX_ELEV_URAD
@@ -144,13 +152,10 @@ lidet_status_t lidet_proj_q_init(lidet_proj_q_state_t *st, const lidet_proj_q_cf
     }
     st->magic = 0;
     s = &cfg->sensor;
-    if (s->n_rows == 0 || s->n_cols < 8)
+    status = lidet__proj_check_shape(s->n_rows, s->n_cols);
+    if (status != LIDET_OK)
     {
-        return LIDET_ERR_CONFIG;
-    }
-    if (s->n_rows > LIDET_MAX_ROWS || s->n_cols > LIDET_MAX_COLS)
-    {
-        return LIDET_ERR_BUFFER;
+        return status;
     }
     if (cfg->min_range_mm < 0 || cfg->min_range_mm > 10000 || cfg->fov_margin_urad < 0 ||
         cfg->fov_margin_urad > 500000 || cfg->max_range_mm < 0 || cfg->max_range_mm > 1000000000 ||
@@ -165,16 +170,7 @@ lidet_status_t lidet_proj_q_init(lidet_proj_q_state_t *st, const lidet_proj_q_cf
     }
     rows = s->n_rows;
     /* rows = beams sorted top to bottom (stable insertion sort; equal elevations are rejected below) */
-    for (r = 0; r < rows; ++r)
-    {
-        uint32_t j = r;
-        while (j > 0 && elev[ring_of_row[j - 1]] < elev[r])
-        {
-            ring_of_row[j] = ring_of_row[j - 1];
-            --j;
-        }
-        ring_of_row[j] = (uint8_t)r;
-    }
+    lidet__proj_rows_top_down(rows, elev, beam_above, ring_of_row);
     for (r = 0; r < rows; ++r)
     {
         st->row_elev_urad[r] = elev[ring_of_row[r]];

@@ -17,8 +17,6 @@ static int32_t pts[(LIDET_MAX_POINTS + 3) * 3];
 static lidet_proj_q_buffers_t buf = {bx, by, bz, brange, bidx, bpix};
 static lidet_proj_q_cfg_t cfg;
 
-static const char *const k_names[] = {"hdl64", "vlp16", "vlp32c", "os1-64", "os1-128"};
-
 void setUp(void)
 {
     CANARY_FILL(g);
@@ -79,15 +77,15 @@ static void test_presets_match_float(void)
  * the microradians in BAM32 */
 static void test_every_profile_beam_rows_and_columns(void)
 {
-    unsigned k;
-    for (k = 0; k < sizeof k_names / sizeof k_names[0]; ++k)
+    const lidet_sensor_q_t *s;
+    uint32_t k;
+    for (k = 0; (s = lidet_sensor_q_at(k)) != 0; ++k)
     {
-        const lidet_sensor_q_t *s = lidet_sensor_q_find(k_names[k]);
         lidet_range_image_t img;
         uint32_t r, n = 0, cols = s->n_cols;
         if (s->n_rows > LIDET_MAX_ROWS || s->n_cols > LIDET_MAX_COLS)
             continue;
-        init_sensor(k_names[k]);
+        init_sensor(s->name);
         for (r = 0; r < s->n_rows; ++r)
         {
             const uint32_t c = (r * 37u + 5u) % cols;

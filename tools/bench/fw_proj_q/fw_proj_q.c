@@ -4,7 +4,6 @@
  * projection (lidet_proj_q_run) of the stored scan in mm, by elevation and by ring, next to the float projection
  * writing the same compact image (lidet_proj_run_buffers, soft float on this core). One line on the console. */
 #include <stdint.h>
-#include <string.h>
 
 #include "fw_port.h"
 #include "fw_scan.h"
@@ -18,6 +17,9 @@ static int32_t g_idx[NPIX];
 static int32_t g_mm[LIDET_MAX_POINTS * 3];
 static lidet_proj_q_state_t g_q;
 static lidet_proj_state_t g_f;
+static const lidet_proj_q_buffers_t g_bq = {g_x, g_y, g_z, g_r, g_idx, 0};
+/* the float projection's compact image: x_m NULL, the 4 mm planes, no per-point pixels */
+static const lidet_proj_buffers_t g_bf = {0, 0, 0, 0, g_x, g_y, g_z, g_r, 0, g_idx, 0};
 
 static void put_s(const char *s)
 {
@@ -45,8 +47,6 @@ int fw_main(void)
     const uint32_t n = fw_scan_n < LIDET_MAX_POINTS ? fw_scan_n : LIDET_MAX_POINTS;
     lidet_proj_q_cfg_t cq;
     lidet_proj_cfg_t cf;
-    lidet_proj_q_buffers_t bq = {g_x, g_y, g_z, g_r, g_idx, 0};
-    lidet_proj_buffers_t bf;
     uint64_t t0, t1, t2, t3;
     uint32_t i, filled;
     for (i = 0; i < 3u * n; ++i) /* mm, rounded half away from zero (not timed) */
@@ -58,19 +58,13 @@ int fw_main(void)
     lidet_proj_cfg_default(&cf, lidet_sensor_find(FW_SENSOR));
     if (lidet_proj_q_init(&g_q, &cq) != LIDET_OK || lidet_proj_state_init(&g_f, &cf) != LIDET_OK)
         return 1;
-    memset(&bf, 0, sizeof bf);
-    bf.x_4mm = g_x;
-    bf.y_4mm = g_y;
-    bf.z_4mm = g_z;
-    bf.range_4mm = g_r;
-    bf.point_idx = g_idx;
     t0 = fw_insn64();
-    lidet_proj_q_run(&g_q, &bq, g_mm, n, 3u, 0);
+    lidet_proj_q_run(&g_q, &g_bq, g_mm, n, 3u, 0);
     t1 = fw_insn64();
     filled = g_q.stats.n_pixels_filled;
-    lidet_proj_q_run(&g_q, &bq, g_mm, n, 3u, fw_scan_has_ring ? fw_scan_ring : 0);
+    lidet_proj_q_run(&g_q, &g_bq, g_mm, n, 3u, fw_scan_has_ring ? fw_scan_ring : 0);
     t2 = fw_insn64();
-    lidet_proj_run_buffers(&g_f, &bf, fw_scan_xyz, n, 3u, 0);
+    lidet_proj_run_buffers(&g_f, &g_bf, fw_scan_xyz, n, 3u, 0);
     t3 = fw_insn64();
     put_s("proj_q core=");
     put_s(fw_core_name);
