@@ -9,13 +9,14 @@
  *    are the tangents of the mid-angles between beams, computed in init from lidet_qmath's sin/cos of the
  *    mid-angle in BAM32 (tangent in Q30, kept squared as n / 2^q with n < 2^27 and q <= 60). A point is at or
  *    above boundary T when z / rxy >= T: signs first, then z^2 * 2^q against n * (x^2 + y^2), exact in 64 bits
- *    (no square root, no division); the row is a binary search over the boundaries (log2(rows) tests). Ties go
- *    to the upper row, as in the float projection. The field of view (top beam + margin, bottom beam - margin,
- *    both clamped to +-LIDET_Q_MAX_ELEV_URAD) uses the same test.
+ *    (no square root, no division); the row is the previous point's when its two boundaries confirm it (scans
+ *    come ring by ring), else a binary search over the boundaries (log2(rows) tests). Ties go to the upper row,
+ *    as in the float projection. The field of view (top beam + margin, bottom beam - margin, both clamped to
+ *    +-LIDET_Q_MAX_ELEV_URAD) uses the same test, on the edge rows only.
  *  - column: the pseudo-azimuth D = (|x|+|y| + x) / (|x|+|y|) for y >= 0, (3 (|x|+|y|) - x) / (|x|+|y|) for y < 0
- *    of lidet_proj.h; its bucket floor(D n_cols) from one 32-bit unsigned division, a table gives the column of
- *    the bucket's low end and one exact test against the next column edge (edges in Q29, from qmath sin/cos,
- *    compared by cross-multiplication) finishes it.
+ *    of lidet_proj.h, against the column edges (Q29, from qmath sin/cos) by cross-multiplication (a 32-bit test
+ *    first, 64 bits near an edge): the previous point's column or a neighbour when they confirm it, else the
+ *    bucket floor(D n_cols) (one 32-bit unsigned division), a table and one step up.
  *  - the closest point wins a pixel: the squared ranges compared in 4 mm^2 steps, floor(r^2 / 4) (< 2^32; the float
  *    projection compares float32 squares, coarser beyond 5.8 m), ties keep the earlier point; only the winners get a
  *    square root (exact, 32-bit): range_4mm = round(sqrt(r^2) / 4) (>= 1 for a valid pixel).
@@ -23,9 +24,10 @@
  * image's limit) count as n_too_far; closer than min_range_mm, or at zero range, as n_too_close; n_nonfinite
  * stays 0. No float anywhere, no 64-bit division per point.
  *
- * Memory: lidet_proj_q_state_t (the tables) is about 12 B per row + 12 B per column + ~100 B (VLP-16 build:
+ * Memory: lidet_proj_q_state_t (the tables) is about 25 B per row + 12 B per column + ~130 B (VLP-16 build:
  * 22 KiB); the buffers are the caller's (lidet_proj_q_buffers_t), 12 B per pixel + optionally 4 B per point.
- * Time: O(n_points log2(n_rows) + n_rows n_cols) per run; no allocation, no recursion, a few dozen bytes of stack.
+ * Time: O(n_points log2(n_rows) + n_rows n_cols) per run (Cortex-M0+ code: 16.8 M instructions for the 23 252
+ * points of the simulated VLP-16 sample, docs/FIXED_POINT.md); no allocation, no recursion, little stack.
  */
 #ifndef LIDET_PROJ_Q_H
 #define LIDET_PROJ_Q_H
