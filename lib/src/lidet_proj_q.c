@@ -403,7 +403,7 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
             {
 #if LIDET_MAX_COLS <= 4096
                 const uint32_t bucket = num * cols / sum; /* num * cols <= 4 * 262000 * 4096 < 2^32 */
-#else
+#else /* builds for more than 4096 columns: one 64-bit division on this fallback */
                 const uint32_t bucket = (uint32_t)((uint64_t)num * cols / sum);
 #endif
                 col = st->col_lut[bucket];
