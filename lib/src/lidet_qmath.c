@@ -29,26 +29,16 @@ uint32_t lidet__q_isqrt64(uint64_t v)
 
 uint32_t lidet__q_isqrt32(uint32_t v)
 {
-    /* lidet__q_isqrt64 in 32-bit arithmetic (16 steps at most): what a 32-bit core without a multiplier for
-     * 64-bit products runs cheaply */
-    uint32_t rem = v, res = 0, bit = 1u << 30;
-    while ((bit >> 8) > v)
+    /* the root's 16 bits from the top, each kept when its square still fits: one 16 x 16 -> 32 product per bit
+     * (a single instruction on Cortex-M0+), no 64-bit arithmetic */
+    uint32_t r = 0, bit = v < (1u << 24) ? 1u << 11 : 1u << 15; /* v < 2^24: the root < 2^12 */
+    while (bit != 0u)
     {
-        bit >>= 8;
+        const uint32_t t = r | bit;
+        r = t * t <= v ? t : r;
+        bit >>= 1;
     }
-    while (bit > v)
-    {
-        bit >>= 2;
-    }
-    while (bit != 0)
-    {
-        const uint32_t t = res + bit;
-        const uint32_t take = 0u - (uint32_t)(rem >= t);
-        rem -= t & take;
-        res = (res >> 1) + (bit & take);
-        bit >>= 2;
-    }
-    return res;
+    return r;
 }
 
 uint32_t lidet__q_sqrt_round64(uint64_t v)

@@ -26,7 +26,7 @@
  *
  * Memory: lidet_proj_q_state_t (the tables) is about 25 B per row + 12 B per column + ~130 B (VLP-16 build:
  * 22 KiB); the buffers are the caller's (lidet_proj_q_buffers_t), 12 B per pixel + optionally 4 B per point.
- * Time: O(n_points log2(n_rows) + n_rows n_cols) per run (Cortex-M0+ code: 16.8 M instructions for the 23 252
+ * Time: O(n_points log2(n_rows) + n_rows n_cols) per run (Cortex-M0+ code: 16.0 M instructions for the 23 252
  * points of the simulated VLP-16 sample, docs/FIXED_POINT.md); no allocation, no recursion, little stack.
  */
 #ifndef LIDET_PROJ_Q_H
