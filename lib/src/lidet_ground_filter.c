@@ -655,7 +655,6 @@ const uint8_t *lidet_ground_sector_source(const lidet_ground_t *g)
 lidet_status_t lidet_ground_point_labels_of(const lidet_ground_state_t *g, const uint8_t *mask,
                                             const int32_t *point_pixel, uint32_t n_points, uint8_t *out)
 {
-    uint32_t i, npix;
     if (g == 0 || mask == 0 || ((point_pixel == 0 || out == 0) && n_points > 0u))
     {
         return LIDET_ERR_ARG;
@@ -664,12 +663,7 @@ lidet_status_t lidet_ground_point_labels_of(const lidet_ground_state_t *g, const
     {
         return LIDET_ERR_STATE;
     }
-    npix = (uint32_t)g->n_rows * g->n_cols;
-    for (i = 0; i < n_points; ++i)
-    {
-        const int32_t p = point_pixel[i];
-        out[i] = (p >= 0 && (uint32_t)p < npix) ? mask[p] : 0u;
-    }
+    lidet__ground_point_labels(mask, (uint32_t)g->n_rows * g->n_cols, point_pixel, n_points, out);
     return LIDET_OK;
 }
 

@@ -353,6 +353,13 @@ LIDET_PY_API int lidet_py_proj_run(lidet_py_ctx_t *ctx, const float *pts, uint32
     return rc;
 }
 
+/* The context's projection state (NULL before lidet_py_proj_init succeeded): lidet_py_ground_q.c projects
+ * into a compact image with it, as a detector workspace does. */
+LIDET_PY_API lidet_proj_state_t *lidet_py_ctx_proj_state(lidet_py_ctx_t *ctx)
+{
+    return ctx != NULL && ctx->proj_ready ? &ctx->proj.state : NULL;
+}
+
 /* ---- ground stage ----------------------------------------------------------------------------- */
 
 /* Initialise the context's ground stage with cfg and run it on the context's image. Outputs (any may

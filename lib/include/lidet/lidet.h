@@ -24,6 +24,7 @@
 #include "lidet_sensor.h"
 #include "lidet_proj.h"
 #include "lidet_ground.h"
+#include "lidet_ground_q.h"
 #include "lidet_cluster.h"
 #include "lidet_pointnet.h"
 #include "lidet_detector.h"

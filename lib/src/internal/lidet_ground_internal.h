@@ -11,6 +11,93 @@ static inline uint32_t lidet__ground_sector_col(uint32_t s, uint32_t n_sectors, 
     return (s * n_cols + n_sectors - 1u) / n_sectors;
 }
 
+/* Per-point labels from a pixel mask of npix pixels (both stages' point_labels_of): a point takes its pixel's
+ * label, 0 when it has none (-1) or the index is outside the image. */
+static inline void lidet__ground_point_labels(const uint8_t *mask, uint32_t npix, const int32_t *point_pixel,
+                                              uint32_t n_points, uint8_t *out)
+{
+    uint32_t i;
+    for (i = 0; i < n_points; ++i)
+    {
+        const int32_t p = point_pixel[i];
+        out[i] = (p >= 0 && (uint32_t)p < npix) ? mask[p] : 0u;
+    }
+}
+
+/* The per-cell control flow of both ground stages (the float one, lidet_ground_ransac.c, and the integer one,
+ * lidet_ground_q_fit.c); numeric-agnostic, the planes are the caller's. Cells: k < ns the near part of
+ * sector k, k >= ns the far part of sector k - ns; only the first n_cells (ns, or 2 ns with a split) are
+ * fitted, each with at least min_samples samples, in this order (the RNG runs in it). fit(ctx, k) fits cell
+ * k and returns 1 when its plane passed the checks; copy(ctx, dst, src) sets the plane of cell dst to that
+ * of cell src (src < 0: the mount plane). Then the fallback: a near cell without its own plane takes the
+ * nearest FITTED near cell at most `reach` sectors away (s - k before s + k), else the mount plane; a far
+ * cell without its own plane takes its sector's near plane. Fills source and the cell counts of stats. */
+typedef int (*lidet__ground_fit_fn)(void *ctx, uint32_t k);
+typedef void (*lidet__ground_copy_fn)(void *ctx, uint32_t dst, int32_t src);
+
+static inline void lidet__ground_cells(uint8_t *source, const uint32_t *cell_n, uint32_t ns, uint32_t n_cells,
+                                       uint32_t min_samples, uint32_t reach, lidet_ground_stats_t *stats,
+                                       lidet__ground_fit_fn fit, lidet__ground_copy_fn copy, void *ctx)
+{
+    uint32_t s, k;
+    for (k = 0; k < 2u * ns; ++k)
+    {
+        const int near = k < ns;
+        source[k] = near ? LIDET_GROUND_PLANE_MOUNT : LIDET_GROUND_PLANE_NEAR;
+        if (k >= n_cells || cell_n[k] < min_samples)
+        {
+            stats->n_sectors_sparse += (uint16_t)near;
+            continue;
+        }
+        if (fit(ctx, k))
+        {
+            source[k] = LIDET_GROUND_PLANE_FITTED;
+            if (near)
+                ++stats->n_sectors_fitted;
+            else
+                ++stats->n_far_fitted;
+        }
+        else
+        {
+            stats->n_sectors_rejected += (uint16_t)near;
+        }
+    }
+    for (s = 0; s < ns; ++s)
+    {
+        int32_t from = -1;
+        if (source[s] == LIDET_GROUND_PLANE_FITTED)
+        {
+            continue;
+        }
+        for (k = 1; k <= reach && from < 0; ++k)
+        {
+            const uint32_t left = (s + ns - (k % ns)) % ns, right = (s + k) % ns;
+            if (source[left] == LIDET_GROUND_PLANE_FITTED)
+                from = (int32_t)left;
+            else if (source[right] == LIDET_GROUND_PLANE_FITTED)
+                from = (int32_t)right;
+        }
+        copy(ctx, s, from);
+        if (from >= 0)
+        {
+            source[s] = LIDET_GROUND_PLANE_NEIGHBOUR; /* never FITTED: not a source for others */
+            ++stats->n_sectors_neighbour;
+        }
+        else
+        {
+            ++stats->n_sectors_mount;
+        }
+    }
+    for (s = 0; s < ns; ++s)
+    {
+        if (source[ns + s] != LIDET_GROUND_PLANE_FITTED)
+        {
+            copy(ctx, ns + s, (int32_t)s);
+            source[ns + s] = LIDET_GROUND_PLANE_NEAR;
+        }
+    }
+}
+
 /* Fits one plane per cell from the samples sc->sample_pix (pixels of img) grouped by sc->cell_first /
  * cell_n, applies the fallback, fills g->planes, g->source and the sector counts of g->stats
  * (lidet_ground_ransac.c). */
