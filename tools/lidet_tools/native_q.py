@@ -196,3 +196,17 @@ def ground_q_time(img: CompactImage, sensor="hdl64", repeats=100) -> tuple[float
     if st < 0:
         raise native.LidetError(st, "lidet_py_ground_q_time")
     return float(out[0]) / 1e6, float(out[1]) / 1e6
+
+
+def ground_pair(points, sensor="hdl64"):
+    """Both ground stages on one compact image of `points`: (float per-point mask, integer per-point mask, the
+    image, the integer result); per-point masks in input order (a point takes its pixel's label, 0 when it has
+    none)."""
+    img = project_compact(points, sensor)
+    q = ground_q(img, sensor)
+    fm = ground_float_compact(img, sensor)[0]
+    pp = img.point_pixel
+
+    def per_point(mask):
+        return np.where(pp >= 0, mask.reshape(-1)[np.clip(pp, 0, None)], 0).astype(np.uint8)
+    return per_point(fm), per_point(q.mask), img, q
