@@ -95,35 +95,77 @@ lidet_status_t lidet_ground_q_init(lidet_ground_q_t *g, const lidet_ground_q_cfg
     return g == 0 ? LIDET_ERR_ARG : lidet_ground_q_state_init(&g->state, cfg);
 }
 
+/* round(sqrt(v) * 256) for v < 2^31, exactly lidet__q_sqrt_round64(v << 16): digit by digit on v * 2^16 with
+ * 32-bit values only (remainder <= 2 root < 2^25), branch-free, no division: 16 integer and 8 fraction
+ * digits. One digit step of one value: */
+#define R_DIGITS (16 + LIDET_GROUND_Q_R_SHIFT)
+static inline void r_digit(uint32_t bits, uint32_t *root, uint32_t *rem)
+{
+    const uint32_t rm = (*rem << 2) | bits, trial = (*root << 2) | 1u, ge = 0u - (uint32_t)(rm >= trial);
+    *rem = rm - (trial & ge);
+    *root = (*root << 1) | (ge & 1u);
+}
+
+static inline uint32_t r_bits(uint32_t v, int i)
+{
+    return i >= 0 ? (v >> i) & 3u : 0u;
+}
+
+/* R of one pixel (the veto's occasional test) */
+static int32_t r_of(uint32_t v)
+{
+    uint32_t root = 0, rem = 0;
+    int i = 30;
+    while (i > 0 && (v >> i) == 0u)
+    {
+        i -= 2; /* a leading zero digit pair leaves root and remainder 0 */
+    }
+    for (; i > 30 - 2 * R_DIGITS; i -= 2)
+    {
+        r_digit(r_bits(v, i), &root, &rem);
+    }
+    return (int32_t)(root + (uint32_t)(rem > root));
+}
+
 /* x^2 + y^2 of a pixel (4 mm steps squared; < 2^31 for int16 values) */
 static inline uint32_t rxy2(const int16_t *x, const int16_t *y, uint32_t p)
 {
     return (uint32_t)((int32_t)x[p] * x[p]) + (uint32_t)((int32_t)y[p] * y[p]);
 }
 
-/* round(sqrt(v) * 256) for v < 2^31, exactly lidet__q_sqrt_round64(v << 16): digit by digit on v * 2^16 with
- * 32-bit values only (remainder <= 2 root < 2^25), branch-free, no division: 16 integer and 8 fraction
- * digits. */
-static inline int32_t r_of(uint32_t v)
+/* R of a whole row, digit step by digit step over the columns (the same values as r_of, but the column loops
+ * are independent lanes that a compiler vectorises); v, rem: scratch of cols entries */
+static void r_of_row(const int16_t *x, const int16_t *y, uint32_t cols, int32_t *restrict out, uint32_t *restrict v,
+                     uint32_t *restrict rem)
 {
-    uint32_t root = 0, rem = 0, trial, ge;
+    uint32_t *restrict root = (uint32_t *)out;
+    uint32_t c;
     int i;
-    for (i = 30; i >= -2 * LIDET_GROUND_Q_R_SHIFT; i -= 2)
+    for (c = 0; c < cols; ++c)
     {
-        rem = (rem << 2) | (i >= 0 ? (v >> i) & 3u : 0u);
-        trial = (root << 2) | 1u;
-        ge = 0u - (uint32_t)(rem >= trial);
-        rem -= trial & ge;
-        root = (root << 1) | (ge & 1u);
+        v[c] = rxy2(x, y, c);
+        root[c] = 0u;
+        rem[c] = 0u;
     }
-    return (int32_t)(root + (uint32_t)(rem > root));
+    for (i = 30; i > 30 - 2 * R_DIGITS; i -= 2)
+    {
+        for (c = 0; c < cols; ++c)
+        {
+            r_digit(r_bits(v[c], i), &root[c], &rem[c]);
+        }
+    }
+    for (c = 0; c < cols; ++c)
+    {
+        root[c] += (uint32_t)(rem[c] > root[c]);
+    }
 }
 
-/* R of row r into slot r % 2 (once per row): round(sqrt(x^2 + y^2) * 256), 0 for an empty pixel */
+/* R of row r into slot r % 2 (once per row) */
 typedef struct
 {
     const lidet_range_image_t *img;
     int32_t *slot[2];
+    uint32_t *v, *rem;
     int32_t row_in[2];
 } r_rows_t;
 
@@ -132,24 +174,21 @@ static void r_rows_init(r_rows_t *rr, lidet_ground_q_scratch_t *sc, const lidet_
     rr->img = img;
     rr->slot[0] = sc->r_rows[0];
     rr->slot[1] = sc->r_rows[1];
+    rr->v = sc->r_v;
+    rr->rem = sc->r_rem;
     rr->row_in[0] = rr->row_in[1] = -1;
 }
 
 static const int32_t *r_row(r_rows_t *rr, uint32_t r)
 {
     const uint32_t k = r & 1u, cols = rr->img->n_cols;
-    int32_t *out = rr->slot[k];
     if (rr->row_in[k] != (int32_t)r)
     {
-        const int16_t *x = rr->img->x_4mm + (size_t)r * cols, *y = rr->img->y_4mm + (size_t)r * cols;
-        uint32_t c;
-        for (c = 0; c < cols; ++c)
-        {
-            out[c] = r_of(rxy2(x, y, c));
-        }
+        r_of_row(rr->img->x_4mm + (size_t)r * cols, rr->img->y_4mm + (size_t)r * cols, cols, rr->slot[k], rr->v,
+                 rr->rem);
         rr->row_in[k] = (int32_t)r;
     }
-    return out;
+    return rr->slot[k];
 }
 
 static inline int32_t abs32(int32_t v)
@@ -158,44 +197,56 @@ static inline int32_t abs32(int32_t v)
 }
 
 /* Pass 1 (ref/ground_q.py: sample_mask): the sample test of lidet_ground_filter.c with integer kernels.
- * dR in R steps (4 mm / 256), dZ in 4 mm: |dZ| <= fy |dR| is |dZ| * 2^24 <= fy_q16 * |dR|. */
+ * dR in R steps (4 mm / 256), dZ in 4 mm: |dZ| <= fy |dR| is |dZ| * 2^24 <= fy_q16 * |dR|; F_x on R against
+ * fx_max_mm * 64 (R steps), on Z as 4 |F_x| <= fx_max_mm. Every touched pixel holds a point (R > 0). Bitwise &
+ * and no branch, as the float kernel: the column loop vectorises. */
+typedef struct
+{
+    uint64_t fy;
+    int32_t fx_r, fx_mm, z_lo, z_hi;
+    int on_z, desc, gate;
+} filt_q_t;
+
+static inline uint8_t sample_test(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
+                                  uint32_t cm1, uint32_t c, uint32_t cp1, uint32_t cp2, const filt_q_t *f)
+{
+    const int32_t dr = (2 * R0[c] + R0[cp1]) - (2 * R1[c] + R1[cp1]);
+    const int32_t dz = (2 * Z0[c] + Z0[cp1]) - (2 * Z1[c] + Z1[cp1]);
+    const int32_t fxr = (R0[cm1] + 2 * R0[c]) - (2 * R0[cp1] + R0[cp2]);
+    const int32_t fxz = (Z0[cm1] + 2 * Z0[c]) - (2 * Z0[cp1] + Z0[cp2]);
+    const int pts = (R0[cm1] > 0) & (R0[c] > 0) & (R0[cp1] > 0) & (R0[cp2] > 0) & (R1[c] > 0) & (R1[cp1] > 0);
+    const int fy = ((uint64_t)(uint32_t)abs32(dz) << 24) <= f->fy * (uint32_t)abs32(dr);
+    const int fx = f->on_z ? 4 * abs32(fxz) <= f->fx_mm : abs32(fxr) <= f->fx_r;
+    const int opt = ((f->desc == 0) | (dr > 0)) & ((f->gate == 0) | ((4 * Z0[c] >= f->z_lo) & (4 * Z0[c] <= f->z_hi)));
+    return (uint8_t)(pts & fy & fx & opt);
+}
+
 static void filter_rows(const lidet_ground_q_state_t *g, uint8_t *sample, r_rows_t *rr, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, step = g->cfg.sample_step;
-    const int64_t fy = g->cfg.fy_max_q16;
-    const int32_t fx_r = (int32_t)g->cfg.fx_max_mm * (1 << (LIDET_GROUND_Q_R_SHIFT - 2)); /* mm in R steps */
-    const int32_t fx_mm = (int32_t)g->cfg.fx_max_mm;
-    const int on_z = g->cfg.fx_on_z, desc = g->cfg.require_descending, gate = g->cfg.height_gate;
-    const int32_t z_lo = -g->cfg.mount_height_mm - g->cfg.gate_below_mm;
-    const int32_t z_hi = -g->cfg.mount_height_mm + g->cfg.gate_above_mm;
+    filt_q_t f;
     uint32_t r, c;
+    f.fy = g->cfg.fy_max_q16;
+    f.fx_r = (int32_t)g->cfg.fx_max_mm * (1 << (LIDET_GROUND_Q_R_SHIFT - 2)); /* mm in R steps */
+    f.fx_mm = (int32_t)g->cfg.fx_max_mm;
+    f.on_z = g->cfg.fx_on_z;
+    f.desc = g->cfg.require_descending;
+    f.gate = g->cfg.height_gate;
+    f.z_lo = -g->cfg.mount_height_mm - g->cfg.gate_below_mm;
+    f.z_hi = -g->cfg.mount_height_mm + g->cfg.gate_above_mm;
     memset(sample, 0, (size_t)rows * cols);
     for (r = 0; r + 1u < rows; r += step)
     {
         const int32_t *R0 = r_row(rr, r), *R1 = r_row(rr, r + 1u);
         const int16_t *Z0 = img->z_4mm + (size_t)r * cols, *Z1 = Z0 + cols;
         uint8_t *out = sample + (size_t)r * cols;
-        for (c = 0; c < cols; ++c)
+        out[0] = sample_test(R0, R1, Z0, Z1, cols - 1u, 0u, 1u, 2u, &f);
+        for (c = 1; c + 2u < cols; ++c)
         {
-            const uint32_t cm1 = c == 0u ? cols - 1u : c - 1u, cp1 = c + 1u < cols ? c + 1u : c + 1u - cols;
-            const uint32_t cp2 = c + 2u < cols ? c + 2u : c + 2u - cols;
-            const int32_t dr = (2 * R0[c] + R0[cp1]) - (2 * R1[c] + R1[cp1]);
-            const int32_t dz = (2 * Z0[c] + Z0[cp1]) - (2 * Z1[c] + Z1[cp1]);
-            int ok = R0[cm1] > 0 && R0[c] > 0 && R0[cp1] > 0 && R0[cp2] > 0 && R1[c] > 0 && R1[cp1] > 0;
-            ok = ok && ((int64_t)abs32(dz) << 24) <= fy * abs32(dr);
-            if (on_z)
-            {
-                const int32_t fx = (Z0[cm1] + 2 * Z0[c]) - (2 * Z0[cp1] + Z0[cp2]);
-                ok = ok && 4 * abs32(fx) <= fx_mm;
-            }
-            else
-            {
-                const int32_t fx = (R0[cm1] + 2 * R0[c]) - (2 * R0[cp1] + R0[cp2]);
-                ok = ok && abs32(fx) <= fx_r;
-            }
-            ok = ok && (!desc || dr > 0) && (!gate || (4 * Z0[c] >= z_lo && 4 * Z0[c] <= z_hi));
-            out[c] = (uint8_t)ok;
+            out[c] = sample_test(R0, R1, Z0, Z1, c - 1u, c, c + 1u, c + 2u, &f);
         }
+        out[cols - 2u] = sample_test(R0, R1, Z0, Z1, cols - 3u, cols - 2u, cols - 1u, 0u, &f);
+        out[cols - 1u] = sample_test(R0, R1, Z0, Z1, cols - 2u, cols - 1u, 0u, 1u, &f);
     }
 }
 
@@ -242,7 +293,18 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
  * (row - 1) holds a point, 4 |dz| > veto_min_dz_mm and |dz| * 2^24 > veto_slope_q16 * |dR|. R is computed only
  * where a test needs it: the veto's slope test of an in-band pixel with a step of more than veto_min_dz_mm
  * (rare on the ground), or every pixel with a tolerance growing with range. */
-static void label_rows(lidet_ground_q_state_t *g, uint8_t *mask, const lidet_range_image_t *img)
+/* R of pixel c of a row through a lazily filled row cache (-1 = not computed yet) */
+static inline int32_t r_cached(int32_t *row, uint32_t c, uint32_t v)
+{
+    if (row[c] < 0)
+    {
+        row[c] = r_of(v);
+    }
+    return row[c];
+}
+
+static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, uint8_t *mask,
+                       const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, split_v = g->split_v;
     const int64_t above0 = (int64_t)g->cfg.ground_mm << 28, k = g->cfg.ground_per_m_q16;
@@ -253,43 +315,39 @@ static void label_rows(lidet_ground_q_state_t *g, uint8_t *mask, const lidet_ran
     uint32_t r, s, c, n_ground = 0, n_vetoed = 0;
     for (r = 0; r < rows; ++r)
     {
-        const uint32_t base = r * cols;
+        const uint32_t base = r * cols, up = r > 0u ? cols : 0u; /* row 0 compares with itself: never vetoed */
+        int32_t *Rr = sc->r_rows[r & 1u], *Ru = sc->r_rows[(r & 1u) ^ (r > 0u)];
+        for (c = 0; c < cols; ++c)
+        {
+            Rr[c] = -1;
+        }
         for (s = 0; s < ns; ++s)
         {
             const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
-            const lidet_plane_q_t *pn = &g->planes[s], *pf = &g->planes[ns + s];
+            const lidet_plane_q_t pn = g->planes[s], pf = g->planes[ns + s];
             const int64_t dn = g->plane_d[s], df = g->plane_d[ns + s];
             for (c = lidet__ground_sector_col(s, ns, cols); c < c1; ++c)
             {
-                const uint32_t p = base + c, v = rxy2(X, Y, p);
+                const uint32_t p = base + c, v = rxy2(X, Y, p), vu = rxy2(X, Y, p - up);
                 const int far = v >= split_v;
-                const lidet_plane_q_t *pl = far ? pf : pn;
-                int64_t h, above = above0, below = below0;
+                const int32_t dz = abs32(Z[p - up] - Z[p]);
+                const int64_t h = (int64_t)(far ? pf.nx : pn.nx) * X[p] + (int64_t)(far ? pf.ny : pn.ny) * Y[p] +
+                                  (int64_t)(far ? pf.nz : pn.nz) * Z[p] + (far ? df : dn);
+                int64_t above = above0, below = below0;
                 int in, vt = 0;
-                if (v == 0u)
-                {
-                    mask[p] = 0u;
-                    continue;
-                }
-                h = (int64_t)pl->nx * X[p] + (int64_t)pl->ny * Y[p] + (int64_t)pl->nz * Z[p] + (far ? df : dn);
                 if (k != 0)
                 {
                     /* R steps are 1/64 mm: k R / 2^16 mm = (k R) << 6 in 4 mm / 2^30 */
-                    above = above0 + ((k * r_of(v)) << 6);
+                    above = above0 + ((k * r_cached(Rr, c, v)) << 6);
                     below = lidet__q_rshift_round(bf * above, 16);
                 }
-                in = h < above && h > -below;
-                if (in && r > 0u && slope > 0)
+                in = (v != 0u) & (h < above) & (h > -below);
+                if (in & (vu != 0u) & (4 * dz > min_dz) & (slope > 0))
                 {
-                    const uint32_t vu = rxy2(X, Y, p - cols);
-                    const int32_t dz = abs32(Z[p - cols] - Z[p]);
-                    if (vu > 0u && 4 * dz > min_dz)
-                    {
-                        vt = ((int64_t)dz << 24) > slope * abs32(r_of(vu) - r_of(v));
-                    }
+                    vt = ((int64_t)dz << 24) > slope * abs32(r_cached(Ru, c, vu) - r_cached(Rr, c, v));
                 }
-                mask[p] = (uint8_t)(in && !vt);
-                n_ground += (uint32_t)(in && !vt);
+                mask[p] = (uint8_t)(in & !vt);
+                n_ground += (uint32_t)(in & !vt);
                 n_vetoed += (uint32_t)vt;
             }
         }
@@ -330,7 +388,7 @@ lidet_status_t lidet_ground_q_run_buffers(lidet_ground_q_state_t *g, lidet_groun
     filter_rows(g, scratch->sample, &rr, img);
     gather_samples(g, scratch, img);
     lidet__ground_q_fit_sectors(g, scratch, img);
-    label_rows(g, mask, img);
+    label_rows(g, scratch, mask, img);
     return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
 }
 

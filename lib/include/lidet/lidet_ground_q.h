@@ -27,8 +27,8 @@
  * normal, d in 4 mm steps; the labels use the unrounded D), their sources, the counts (lidet_ground_stats_t).
  *
  * Memory: lidet_ground_q_state_t ~ LIDET_GROUND_MAX_SECTORS * 42 B; lidet_ground_q_scratch_t = a sample mask
- * byte per pixel + LIDET_GROUND_MAX_SAMPLES sample indices + LIDET_GROUND_EVAL_MAX * 6 B + LIDET_MAX_COLS * 8 B
- * (two rows of R) + LIDET_GROUND_MAX_SECTORS * 16 B. No allocation, no recursion, no float.
+ * byte per pixel + LIDET_GROUND_MAX_SAMPLES sample indices + LIDET_GROUND_EVAL_MAX * 6 B + LIDET_MAX_COLS * 16 B
+ * (two rows of R, the square root's work rows) + LIDET_GROUND_MAX_SECTORS * 16 B. No allocation, no recursion, no float.
  */
 #ifndef LIDET_GROUND_Q_H
 #define LIDET_GROUND_Q_H
@@ -100,6 +100,8 @@ typedef struct
     uint32_t cell_first[2 * LIDET_GROUND_MAX_SECTORS];
     uint32_t cell_n[2 * LIDET_GROUND_MAX_SECTORS];
     int32_t r_rows[2][LIDET_MAX_COLS]; /* R of two rows, 4 mm / 256 */
+    uint32_t r_v[LIDET_MAX_COLS];      /* x^2 + y^2 and the square root's remainder of the row being computed */
+    uint32_t r_rem[LIDET_MAX_COLS];
 } lidet_ground_q_scratch_t;
 
 /** @brief The integer stage with every buffer inside. Declare it static (it is large). */
