@@ -141,6 +141,16 @@ static void r_of_row(const int16_t *x, const int16_t *y, uint32_t cols, int32_t 
     uint32_t *restrict root = (uint32_t *)out;
     uint32_t c;
     int i;
+#if !LIDET_GROUND_Q_SQRT_LANES
+    (void)root;
+    (void)v;
+    (void)rem;
+    for (c = 0; c < cols; ++c)
+    {
+        out[c] = r_of(rxy2(x, y, c));
+    }
+    return;
+#endif
     for (c = 0; c < cols; ++c)
     {
         v[c] = rxy2(x, y, c);
@@ -324,15 +334,21 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
         for (s = 0; s < ns; ++s)
         {
             const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
-            const lidet_plane_q_t pn = g->planes[s], pf = g->planes[ns + s];
-            const int64_t dn = g->plane_d[s], df = g->plane_d[ns + s];
+            lidet__ground_q_hplane_t hp[2];
+            int32_t nn[3];
+            for (c = 0; c < 2u; ++c)
+            {
+                const lidet_plane_q_t *pl = &g->planes[c * ns + s];
+                nn[0] = pl->nx;
+                nn[1] = pl->ny;
+                nn[2] = pl->nz;
+                lidet__ground_q_hplane(nn, g->plane_d[c * ns + s], &hp[c]);
+            }
             for (c = lidet__ground_sector_col(s, ns, cols); c < c1; ++c)
             {
                 const uint32_t p = base + c, v = rxy2(X, Y, p), vu = rxy2(X, Y, p - up);
-                const int far = v >= split_v;
                 const int32_t dz = abs32(Z[p - up] - Z[p]);
-                const int64_t h = (int64_t)(far ? pf.nx : pn.nx) * X[p] + (int64_t)(far ? pf.ny : pn.ny) * Y[p] +
-                                  (int64_t)(far ? pf.nz : pn.nz) * Z[p] + (far ? df : dn);
+                const int64_t h = lidet__ground_q_height(&hp[v >= split_v], X[p], Y[p], Z[p]);
                 int64_t above = above0, below = below0;
                 int in, vt = 0;
                 if (k != 0)

@@ -79,11 +79,6 @@ static inline void pixel(const lidet_range_image_t *img, uint32_t p, int32_t q[3
     q[2] = img->z_4mm[p];
 }
 
-/* height of q above the plane, 4 mm / 2^30 */
-static inline int64_t height(const qplane_t *pl, const int32_t q[3])
-{
-    return (int64_t)pl->n[0] * q[0] + (int64_t)pl->n[1] * q[1] + (int64_t)pl->n[2] * q[2] + pl->d;
-}
 
 /* The least-squares plane through the inliers (|height| <= thr) of cur among the cell's samples: their
  * centroid c0 (rounded to 4 mm steps) and scatter matrix about c0 in exact int64 sums, the normal by
@@ -100,11 +95,13 @@ static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *i
     uint32_t i, m = 0;
     unsigned s;
     int k, it;
+    lidet__ground_q_hplane_t hp;
+    lidet__ground_q_hplane(cur->n, cur->d, &hp);
     pixel(img, idx[0], first);
     for (i = 0; i < n; ++i)
     {
         pixel(img, idx[i], q);
-        if (abs64(height(cur, q)) <= thr)
+        if (abs64(lidet__ground_q_height(&hp, q[0], q[1], q[2])) <= thr)
         {
             ++m;
             for (k = 0; k < 3; ++k)
@@ -124,18 +121,31 @@ static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *i
     for (i = 0; i < n; ++i)
     {
         pixel(img, idx[i], q);
-        if (abs64(height(cur, q)) <= thr)
+        if (abs64(lidet__ground_q_height(&hp, q[0], q[1], q[2])) <= thr)
         {
-            const int64_t x = q[0] - c0[0], y = q[1] - c0[1], z = q[2] - c0[2];
+            const int32_t x = q[0] - c0[0], y = q[1] - c0[1], z = q[2] - c0[2];
             e[0] += x;
             e[1] += y;
             e[2] += z;
-            a[0] += x * x;
-            a[1] += x * y;
-            a[2] += x * z;
-            a[3] += y * y;
-            a[4] += y * z;
-            a[5] += z * z;
+            if (x >= -46340 && x <= 46340 && y >= -46340 && y <= 46340 && z >= -46340 && z <= 46340)
+            {
+                /* the products fit int32 (a core without a 32 x 32 -> 64 multiply saves the wide ones) */
+                a[0] += x * x;
+                a[1] += x * y;
+                a[2] += x * z;
+                a[3] += y * y;
+                a[4] += y * z;
+                a[5] += z * z;
+            }
+            else
+            {
+                a[0] += (int64_t)x * x;
+                a[1] += (int64_t)x * y;
+                a[2] += (int64_t)x * z;
+                a[3] += (int64_t)y * y;
+                a[4] += (int64_t)y * z;
+                a[5] += (int64_t)z * z;
+            }
         }
     }
     /* scatter a = (xx xy xz yy yz zz) scaled to < 2^30, its adjugate b (entries < 2^61) */
