@@ -186,16 +186,17 @@ def ground_float_compact(img: CompactImage, sensor="hdl64", **cfg):
     return mask, smp, planes, src, native._to_dict(stats)
 
 
-def ground_q_time(img: CompactImage, sensor="hdl64", repeats=100) -> tuple[float, float]:
-    """Host medians (ms) of the float and the integer ground stage on one compact image, interleaved."""
-    out = np.zeros(2, np.uint64)
+def ground_q_time(img: CompactImage, sensor="hdl64", repeats=100) -> tuple[float, float, float, float]:
+    """Host timing (ms) of the float and the integer ground stage on one compact image, interleaved: (float median,
+    integer median, float minimum, integer minimum)."""
+    out = np.zeros(4, np.uint64)
     cf = native._record("lidet_ground_cfg_t", native.ground_defaults(sensor))
     rows, cols = img.shape
     st = _ground_q_lib().lidet_py_ground_q_time(native._addr(cf), _cfg_vec(ground_q_defaults(sensor)), rows, cols,
                                                 img.x, img.y, img.z, img.range, repeats, out)
     if st < 0:
         raise native.LidetError(st, "lidet_py_ground_q_time")
-    return float(out[0]) / 1e6, float(out[1]) / 1e6
+    return tuple(float(v) / 1e6 for v in out)
 
 
 def ground_pair(points, sensor="hdl64"):
