@@ -1,8 +1,11 @@
 /* SPDX-License-Identifier: MIT */
 /* A measurement image (LIDET_FW_APP=ground_q): the scan in flash projected into a compact image (the float
  * projection's compact path, as a detector workspace), then the integer ground stage (lidet_ground_q) and the
- * float ground stage on that same image, each between two reads of the instruction counter. One line:
- *   ground_q core=C status_q=S status_f=S insn_q=N insn_f=N ground_q=N ground_f=N same=N pixels=N
+ * float ground stage on that same image, each between two reads of the instruction counter; then the integer
+ * stage again with parts switched off, one after the other (no refinement; + one hypothesis per cell; + no veto),
+ * for where its instructions go. One line:
+ *   ground_q core=C status_q=S status_f=S insn_q=N insn_f=N insn_q_norefine=N insn_q_1hyp=N insn_q_noveto=N
+ *            ground_q=N ground_f=N same=N pixels=N
  * (same: pixels whose labels agree). Build and run (Cortex-M0+ code on QEMU's AN385, docs/FIXED_POINT.md):
  *   cmake -S ports/firmware -B build-fw/gq-m0 -DLIDET_FW_BOARD=mps2-an385-m0plus -DLIDET_FW_APP=ground_q \
  *         -DCMAKE_TOOLCHAIN_FILE=$PWD/cmake/toolchains/arm-none-eabi.cmake && cmake --build build-fw/gq-m0
@@ -61,8 +64,8 @@ int fw_main(void)
     lidet_range_image_t img;
     lidet_ground_q_cfg_t qc;
     lidet_ground_cfg_t fc;
-    uint64_t t0, t1, t2, t3;
-    uint32_t p, same = 0, npix;
+    uint64_t t0, t1, t2, t3, insn_q, part[3];
+    uint32_t p, same = 0, npix, n_ground_q;
     int rq, rf;
     if (sensor == 0)
         return 1;
@@ -96,13 +99,34 @@ int fw_main(void)
     npix = (uint32_t)img.n_rows * img.n_cols;
     for (p = 0; p < npix; ++p)
         same += g_q.mask[p] == g_f.mask[p];
+    n_ground_q = g_q.state.stats.n_ground;
+    insn_q = t1 - t0;
+    {
+        int v;
+        for (v = 0; v < 3; ++v)
+        {
+            lidet_ground_q_cfg_t c2 = qc;
+            c2.refine_iters = 0u;
+            c2.ransac_iters = v >= 1 ? 1u : c2.ransac_iters;
+            c2.veto_slope_q16 = v >= 2 ? 0u : c2.veto_slope_q16;
+            if (lidet_ground_q_init(&g_q, &c2) != LIDET_OK)
+                return 1;
+            t0 = fw_insn64();
+            (void)lidet_ground_q_run(&g_q, &img);
+            t1 = fw_insn64();
+            part[v] = t1 - t0;
+        }
+    }
     put_s("ground_q core=");
     put_s(fw_core_name);
     field("status_q", rq);
     field("status_f", rf);
-    field("insn_q", (int64_t)(t1 - t0));
+    field("insn_q", (int64_t)insn_q);
     field("insn_f", (int64_t)(t3 - t2));
-    field("ground_q", g_q.state.stats.n_ground);
+    field("insn_q_norefine", (int64_t)part[0]);
+    field("insn_q_1hyp", (int64_t)part[1]);
+    field("insn_q_noveto", (int64_t)part[2]);
+    field("ground_q", n_ground_q);
     field("ground_f", g_f.state.stats.n_ground);
     field("same", same);
     field("pixels", npix);
