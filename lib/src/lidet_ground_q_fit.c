@@ -34,6 +34,31 @@ static inline int64_t shr(int64_t v, unsigned s)
     return s == 0u ? v : lidet__q_rshift_round(v, s);
 }
 
+/* the largest magnitude of n values */
+static uint64_t max_abs(const int64_t *v, int n)
+{
+    uint64_t m = 0;
+    int i;
+    for (i = 0; i < n; ++i)
+    {
+        const uint64_t a = (uint64_t)abs64(v[i]);
+        m = a > m ? a : m;
+    }
+    return m;
+}
+
+/* scales the n values down together (rounded shifts) until the largest magnitude is <= 2^29: products of two
+ * stay below 2^58 */
+static void scale_down(int64_t *v, int n)
+{
+    const unsigned s = norm_shift(max_abs(v, n));
+    int i;
+    for (i = 0; i < n; ++i)
+    {
+        v[i] = shr(v[i], s);
+    }
+}
+
 /* a plane in the stage's internal form: Q30 unit normal, D in 4 mm / 2^30 */
 typedef struct
 {
@@ -45,20 +70,14 @@ typedef struct
 static int unit_q30(const int64_t v_in[3], int32_t out[3])
 {
     int64_t v[3];
-    uint64_t m = 0, len2;
+    uint64_t len2;
     uint32_t len;
-    unsigned s;
     int i;
     for (i = 0; i < 3; ++i)
     {
-        const uint64_t a = (uint64_t)abs64(v_in[i]);
-        m = a > m ? a : m;
+        v[i] = v_in[i];
     }
-    s = norm_shift(m);
-    for (i = 0; i < 3; ++i)
-    {
-        v[i] = shr(v_in[i], s);
-    }
+    scale_down(v, 3);
     len2 = (uint64_t)(v[0] * v[0]) + (uint64_t)(v[1] * v[1]) + (uint64_t)(v[2] * v[2]);
     len = lidet__q_sqrt_round64(len2);
     if (len == 0u)
@@ -91,9 +110,8 @@ static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *i
 {
     int64_t s1[3] = {0, 0, 0}, e[3] = {0, 0, 0}, a[6] = {0, 0, 0, 0, 0, 0}, b[6], v[3], nd;
     int32_t q[3], first[3], c0[3], nv[3];
-    uint64_t ma = 0, mb = 0;
+    uint64_t ma, mb;
     uint32_t i, m = 0;
-    unsigned s;
     int k, it;
     lidet__ground_q_hplane_t hp;
     lidet__ground_q_hplane(cur->n, cur->d, &hp);
@@ -148,44 +166,22 @@ static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *i
             }
         }
     }
-    /* scatter a = (xx xy xz yy yz zz) scaled to < 2^30, its adjugate b (entries < 2^61) */
-    for (k = 0; k < 6; ++k)
-    {
-        const uint64_t t = (uint64_t)abs64(a[k]);
-        ma = t > ma ? t : ma;
-    }
-    s = norm_shift(ma);
-    for (k = 0; k < 6; ++k)
-    {
-        a[k] = shr(a[k], s);
-    }
-    ma = 0;
-    for (k = 0; k < 6; ++k)
-    {
-        const uint64_t t = (uint64_t)abs64(a[k]);
-        ma = t > ma ? t : ma;
-    }
+    /* scatter a = (xx xy xz yy yz zz) scaled to <= 2^29, its adjugate b (entries < 2^59) */
+    scale_down(a, 6);
+    ma = max_abs(a, 6);
     b[0] = a[3] * a[5] - a[4] * a[4];
     b[1] = a[2] * a[4] - a[1] * a[5];
     b[2] = a[1] * a[4] - a[2] * a[3];
     b[3] = a[0] * a[5] - a[2] * a[2];
     b[4] = a[1] * a[2] - a[0] * a[4];
     b[5] = a[0] * a[3] - a[1] * a[1];
-    for (k = 0; k < 6; ++k)
-    {
-        const uint64_t t = (uint64_t)abs64(b[k]);
-        mb = t > mb ? t : mb;
-    }
+    mb = max_abs(b, 6);
     /* a line (or a point): the adjugate's largest eigenvalue l2 l3 is below 2^-23 l3^2 */
     if (mb == 0u || mb < ((ma * ma) >> 23))
     {
         return 0;
     }
-    s = norm_shift(mb);
-    for (k = 0; k < 6; ++k)
-    {
-        b[k] = shr(b[k], s);
-    }
+    scale_down(b, 6);
     nv[0] = cur->n[0];
     nv[1] = cur->n[1];
     nv[2] = cur->n[2];
@@ -249,9 +245,7 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, c
         const uint32_t i2 = lidet__rng_below(&g->rng, n);
         int32_t p0[3], p1[3], p2[3];
         int64_t c[3], thr_l, len2;
-        uint64_t m = 0;
         uint32_t len, cnt = 0;
-        unsigned s;
         if (i0 == i1 || i0 == i2 || i1 == i2)
         {
             continue;
@@ -267,16 +261,7 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, c
             c[2] = ux * vy - uy * vx;
         }
         /* |c| < 2^34; beyond 2^29 (sides of tens of metres both) it is scaled down, rounded */
-        for (i = 0; i < 3u; ++i)
-        {
-            const uint64_t t = (uint64_t)abs64(c[i]);
-            m = t > m ? t : m;
-        }
-        s = norm_shift(m);
-        for (i = 0; i < 3u; ++i)
-        {
-            c[i] = shr(c[i], s);
-        }
+        scale_down(c, 3);
         len2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
         if (len2 <= LIDET_GROUND_Q_MIN_CROSS2)
         {

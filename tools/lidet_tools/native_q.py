@@ -149,17 +149,21 @@ class GroundQResult:
     status: int
 
 
+def _ground_outputs(img: CompactImage, cfg: dict):
+    """rows, cols, n_sectors and zeroed outputs (mask, sample mask, sources, stats record) of a ground run."""
+    rows, cols = img.shape
+    ns = int(cfg["n_sectors"])
+    return (rows, cols, ns, np.zeros((rows, cols), np.uint8), np.zeros((rows, cols), np.uint8),
+            np.zeros(2 * ns, np.uint8), native._record("lidet_ground_stats_t"))
+
+
 def ground_q(img: CompactImage, sensor="hdl64", **cfg) -> GroundQResult:
     """The integer ground stage on a compact image; cfg overrides ground_q_defaults(sensor)."""
     full = ground_q_defaults(sensor)
     full.update(cfg)
-    rows, cols = img.shape
-    ns = int(full["n_sectors"])
-    mask, smp = np.zeros((rows, cols), np.uint8), np.zeros((rows, cols), np.uint8)
+    rows, cols, ns, mask, smp, src, stats = _ground_outputs(img, full)
     planes = np.zeros((2 * ns, 4), np.int32)
     pd = np.zeros(2 * ns, np.int64)
-    src = np.zeros(2 * ns, np.uint8)
-    stats = native._record("lidet_ground_stats_t")
     st = _ground_q_lib().lidet_py_ground_q_run(_cfg_vec(full), rows, cols, img.x, img.y, img.z, img.range, mask,
                                                smp, planes, pd, src, native._addr(stats))
     if st < 0:
@@ -172,12 +176,8 @@ def ground_float_compact(img: CompactImage, sensor="hdl64", **cfg):
     stats)."""
     full = native.ground_defaults(sensor)
     full.update(cfg)
-    rows, cols = img.shape
-    ns = int(full["n_sectors"])
-    mask, smp = np.zeros((rows, cols), np.uint8), np.zeros((rows, cols), np.uint8)
+    rows, cols, ns, mask, smp, src, stats = _ground_outputs(img, full)
     planes = np.zeros((2 * ns, 4), np.float32)
-    src = np.zeros(2 * ns, np.uint8)
-    stats = native._record("lidet_ground_stats_t")
     st = _ground_q_lib().lidet_py_ground_float_compact(native._addr(native._record("lidet_ground_cfg_t", full)),
                                                        rows, cols, img.x, img.y, img.z, img.range, mask, smp,
                                                        planes, src, native._addr(stats))

@@ -26,7 +26,7 @@
  * Outputs as the float stage: a ground mask per pixel (1 ground), planes per cell (lidet_plane_q_t: Q30
  * normal, d in 4 mm steps; the labels use the unrounded D), their sources, the counts (lidet_ground_stats_t).
  *
- * Memory: lidet_ground_q_state_t ~ LIDET_GROUND_MAX_SECTORS * 42 B; lidet_ground_q_scratch_t = a sample mask
+ * Memory: lidet_ground_q_state_t ~ LIDET_GROUND_MAX_SECTORS * 50 B; lidet_ground_q_scratch_t = a sample mask
  * byte per pixel + LIDET_GROUND_MAX_SAMPLES sample indices + LIDET_GROUND_EVAL_MAX * 6 B + LIDET_MAX_COLS * 16 B
  * (two rows of R, the square root's work rows) + LIDET_GROUND_MAX_SECTORS * 16 B. No allocation, no recursion, no float.
  */
