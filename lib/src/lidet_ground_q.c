@@ -289,13 +289,9 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
                 }
             }
         }
-        sc->cell_first[s] = near_start;
-        sc->cell_n[s] = lo - near_start;
-        sc->cell_first[ns + s] = hi;
-        sc->cell_n[ns + s] = far_end - hi;
+        lidet__ground_cell_span(sc->cell_first, sc->cell_n, s, ns, near_start, lo, hi, far_end);
     }
-    g->stats.n_samples = total;
-    g->stats.n_samples_dropped = total - (lo + (LIDET_GROUND_MAX_SAMPLES - hi));
+    lidet__ground_sample_counts(&g->stats, total, lo, hi);
 }
 
 /* Pass 3 (ref/ground_q.py: label_pixels): ground = holds a point, -below < h < above with h = n . p + D in
@@ -376,27 +372,19 @@ lidet_status_t lidet_ground_q_run_buffers(lidet_ground_q_state_t *g, lidet_groun
                                           uint8_t *mask, const lidet_range_image_t *img)
 {
     r_rows_t rr;
+    lidet_status_t st;
     if (g == 0 || scratch == 0 || mask == 0 || img == 0)
     {
         return LIDET_ERR_ARG;
     }
-    if (g->magic != LIDET_INIT_MAGIC)
+    /* a compact image only: x, y, z in 4 mm steps */
+    st = lidet__ground_run_check(g->magic == LIDET_INIT_MAGIC,
+                                 img->x_m == 0 && img->x_4mm != 0 && img->y_4mm != 0 && img->z_4mm != 0, img,
+                                 g->cfg.n_sectors, &g->stats);
+    if (st != LIDET_OK)
     {
-        return LIDET_ERR_STATE;
+        return st;
     }
-    if (img->x_m != 0 || img->x_4mm == 0 || img->y_4mm == 0 || img->z_4mm == 0)
-    {
-        return LIDET_ERR_ARG;
-    }
-    if (img->n_rows > LIDET_MAX_ROWS || img->n_cols > LIDET_MAX_COLS)
-    {
-        return LIDET_ERR_BUFFER;
-    }
-    if (img->n_rows < 1u || img->n_cols < 4u || img->n_cols < g->cfg.n_sectors)
-    {
-        return LIDET_ERR_CONFIG;
-    }
-    memset(&g->stats, 0, sizeof g->stats);
     g->n_rows = img->n_rows;
     g->n_cols = img->n_cols;
     g->rng = lidet__rng_seed(g->cfg.seed);
@@ -425,15 +413,11 @@ const uint8_t *lidet_ground_q_samples(const lidet_ground_q_t *g)
 
 const lidet_plane_q_t *lidet_ground_q_planes(const lidet_ground_q_t *g, uint32_t *n_sectors)
 {
-    if (g == 0)
-    {
-        return 0;
-    }
-    if (n_sectors != 0)
+    if (g != 0 && n_sectors != 0)
     {
         *n_sectors = g->state.cfg.n_sectors;
     }
-    return g->state.planes;
+    return g == 0 ? 0 : g->state.planes;
 }
 
 const uint8_t *lidet_ground_q_sector_source(const lidet_ground_q_t *g)
@@ -449,14 +433,7 @@ const lidet_ground_stats_t *lidet_ground_q_stats(const lidet_ground_q_t *g)
 lidet_status_t lidet_ground_q_point_labels_of(const lidet_ground_q_state_t *g, const uint8_t *mask,
                                               const int32_t *point_pixel, uint32_t n_points, uint8_t *out)
 {
-    if (g == 0 || mask == 0 || ((point_pixel == 0 || out == 0) && n_points > 0u))
-    {
-        return LIDET_ERR_ARG;
-    }
-    if (g->magic != LIDET_INIT_MAGIC)
-    {
-        return LIDET_ERR_STATE;
-    }
-    lidet__ground_point_labels(mask, (uint32_t)g->n_rows * g->n_cols, point_pixel, n_points, out);
-    return LIDET_OK;
+    return g == 0 ? LIDET_ERR_ARG
+                  : lidet__ground_point_labels(g->magic == LIDET_INIT_MAGIC, mask, (uint32_t)g->n_rows * g->n_cols,
+                                               point_pixel, n_points, out);
 }

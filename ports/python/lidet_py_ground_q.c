@@ -17,6 +17,7 @@
 
 /* lidet_py.c */
 lidet_proj_state_t *lidet_py_ctx_proj_state(void *ctx);
+void lidet_py_ground_planes_out(const lidet_ground_t *g, float *planes, uint8_t *source, lidet_ground_stats_t *stats);
 
 /* Project a scan with the context's projection into a compact image: x4, y4, z4 (int16), r4 (uint16) of
  * rows * cols pixels, point_pixel (n entries, may be NULL), row_elev_bam (rows, may be NULL). */
@@ -203,7 +204,7 @@ LIDET_PY_API int lidet_py_ground_float_compact(const lidet_ground_cfg_t *cfg, ui
 {
     lidet_range_image_t img;
     lidet_ground_t *g;
-    uint32_t npix = rows * cols, s, ns;
+    uint32_t npix = rows * cols;
     int rc;
     if (cfg == NULL || rows > 0xFFFFu || cols > 0xFFFFu)
         return LIDET_ERR_ARG;
@@ -216,25 +217,11 @@ LIDET_PY_API int lidet_py_ground_float_compact(const lidet_ground_cfg_t *cfg, ui
         rc = lidet_ground_run(g, &img);
     if (rc >= 0)
     {
-        const lidet_plane_t *pl = lidet_ground_planes(g, &ns);
         if (mask != NULL)
             memcpy(mask, lidet_ground_mask(g), npix);
         if (sample != NULL)
             memcpy(sample, lidet_ground_samples(g), npix);
-        for (s = 0; s < 2u * ns; ++s)
-        {
-            if (planes != NULL)
-            {
-                planes[4 * s + 0] = pl[s].nx;
-                planes[4 * s + 1] = pl[s].ny;
-                planes[4 * s + 2] = pl[s].nz;
-                planes[4 * s + 3] = pl[s].d_m;
-            }
-            if (source != NULL)
-                source[s] = lidet_ground_sector_source(g)[s];
-        }
-        if (stats != NULL)
-            *stats = *lidet_ground_stats(g);
+        lidet_py_ground_planes_out(g, planes, source, stats);
     }
     free(g);
     return rc;

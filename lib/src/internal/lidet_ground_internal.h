@@ -3,6 +3,8 @@
 #ifndef LIDET_GROUND_INTERNAL_H
 #define LIDET_GROUND_INTERNAL_H
 
+#include <string.h>
+
 #include "lidet/lidet_ground.h"
 
 /* first column of sector s: the smallest c with c * n_sectors / n_cols >= s */
@@ -11,17 +13,71 @@ static inline uint32_t lidet__ground_sector_col(uint32_t s, uint32_t n_sectors, 
     return (s * n_cols + n_sectors - 1u) / n_sectors;
 }
 
+/* The checks of both stages' runs, in this order: LIDET_ERR_STATE (not initialised), LIDET_ERR_ARG (the image
+ * lacks a plane the stage reads), LIDET_ERR_BUFFER (larger than the build's capacity), LIDET_ERR_CONFIG (no row,
+ * fewer than 4 columns or fewer columns than sectors); else LIDET_OK, and the stage's counts are zeroed. */
+static inline lidet_status_t lidet__ground_run_check(int inited, int planes_ok, const lidet_range_image_t *img,
+                                                     uint32_t n_sectors, lidet_ground_stats_t *stats)
+{
+    if (!inited)
+    {
+        return LIDET_ERR_STATE;
+    }
+    if (!planes_ok)
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (img->n_rows > LIDET_MAX_ROWS || img->n_cols > LIDET_MAX_COLS)
+    {
+        return LIDET_ERR_BUFFER;
+    }
+    if (img->n_rows < 1u || img->n_cols < 4u || img->n_cols < n_sectors)
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    memset(stats, 0, sizeof *stats);
+    return LIDET_OK;
+}
+
+/* The sample buffer of both stages' gathering: near samples of sector s fill it upwards from near_start to lo,
+ * far ones downwards from far_end to hi (cells s and ns + s); after the last sector the counts: `total`
+ * samples met, those past the buffer dropped. */
+static inline void lidet__ground_cell_span(uint32_t *cell_first, uint32_t *cell_n, uint32_t s, uint32_t ns,
+                                           uint32_t near_start, uint32_t lo, uint32_t hi, uint32_t far_end)
+{
+    cell_first[s] = near_start;
+    cell_n[s] = lo - near_start;
+    cell_first[ns + s] = hi;
+    cell_n[ns + s] = far_end - hi;
+}
+
+static inline void lidet__ground_sample_counts(lidet_ground_stats_t *stats, uint32_t total, uint32_t lo, uint32_t hi)
+{
+    stats->n_samples = total;
+    stats->n_samples_dropped = total - (lo + (LIDET_GROUND_MAX_SAMPLES - hi));
+}
+
 /* Per-point labels from a pixel mask of npix pixels (both stages' point_labels_of): a point takes its pixel's
- * label, 0 when it has none (-1) or the index is outside the image. */
-static inline void lidet__ground_point_labels(const uint8_t *mask, uint32_t npix, const int32_t *point_pixel,
-                                              uint32_t n_points, uint8_t *out)
+ * label, 0 when it has none (-1) or the index is outside the image. inited: the stage's state is initialised.
+ * LIDET_ERR_ARG (NULL mask, NULL arrays with n_points > 0), LIDET_ERR_STATE, else LIDET_OK. */
+static inline lidet_status_t lidet__ground_point_labels(int inited, const uint8_t *mask, uint32_t npix,
+                                                        const int32_t *point_pixel, uint32_t n_points, uint8_t *out)
 {
     uint32_t i;
+    if (mask == 0 || ((point_pixel == 0 || out == 0) && n_points > 0u))
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (!inited)
+    {
+        return LIDET_ERR_STATE;
+    }
     for (i = 0; i < n_points; ++i)
     {
         const int32_t p = point_pixel[i];
         out[i] = (p >= 0 && (uint32_t)p < npix) ? mask[p] : 0u;
     }
+    return LIDET_OK;
 }
 
 /* The per-cell control flow of both ground stages (the float one, lidet_ground_ransac.c, and the integer one,
