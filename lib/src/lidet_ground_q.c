@@ -2,6 +2,8 @@
 /* Integer ground stage: configuration, the sample filter, the sample gathering, the labels and the accessors
  * (lidet_ground_q.h; the plane fits are in lidet_ground_q_fit.c). Integers only: no <math.h>, no float.
  * Mirrored bit for bit by codegen/lidet_codegen/ref/ground_q.py. */
+#include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
+
 #include <string.h>
 
 #include "internal/lidet_ground_internal.h"

@@ -3,6 +3,8 @@
  * power iteration on the adjugate of the inliers' scatter matrix, the checks and the fallback
  * (lidet_ground_q.h). Integers only. Mirrored bit for bit by codegen/lidet_codegen/ref/ground_q.py
  * (ransac_cell, refine). */
+#include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
+
 #include <string.h>
 
 #include "internal/lidet_assert.h"
