@@ -7,6 +7,7 @@ wrappers live apart from the float ones. Each area below configures its own entr
 from __future__ import annotations
 
 import ctypes as C
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -194,3 +195,168 @@ def isqrt32(v) -> np.ndarray:
     if st != 0:
         raise native.LidetError(st, "lidet_py_isqrt32")
     return out
+
+
+# ---- ground (lib/src/lidet_ground_q.c, lidet_ground_q_fit.c) ---------------------------------------
+
+_ground_q_ready = False
+_i16p = np.ctypeslib.ndpointer(np.int16, flags="C_CONTIGUOUS")
+_u16p = np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")
+_u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
+_f32p = np.ctypeslib.ndpointer(np.float32, flags="C_CONTIGUOUS")
+_u64p = np.ctypeslib.ndpointer(np.uint64, flags="C_CONTIGUOUS")
+
+
+def _ground_q_lib():
+    global _ground_q_ready
+    L = native.lib()
+    if not _ground_q_ready:
+        V = C.c_void_p
+        o = native._opt
+        L.lidet_py_ground_q_project.argtypes = [V, _f32p, C.c_uint32, C.c_uint32, _i16p, _i16p, _i16p, _u16p,
+                                                o(_i32p), o(_i32p)]
+        L.lidet_py_ground_q_field.restype = C.c_char_p
+        L.lidet_py_ground_q_field.argtypes = [C.c_uint32]
+        L.lidet_py_ground_q_default.argtypes = [C.c_uint32, C.c_int32, _i64p]
+        img = [C.c_uint32, C.c_uint32, _i16p, _i16p, _i16p, _u16p]
+        L.lidet_py_ground_q_run.argtypes = [_i64p, *img, o(_u8p), o(_u8p), o(_i32p), o(_i64p), o(_u8p), V]
+        L.lidet_py_ground_float_compact.argtypes = [V, *img, o(_u8p), o(_u8p), o(_f32p), o(_u8p), V]
+        L.lidet_py_ground_q_time.argtypes = [V, _i64p, *img, C.c_uint32, _u64p]
+        _ground_q_ready = True
+    return L
+
+
+def ground_q_fields() -> list[str]:
+    """Field names of lidet_ground_q_cfg_t, in the order the entry points take them."""
+    L = _ground_q_lib()
+    out, i = [], 0
+    while (name := L.lidet_py_ground_q_field(i)) is not None:
+        out.append(name.decode())
+        i += 1
+    return out
+
+
+@dataclass
+class CompactImage:
+    """A compact range image (lidet_proj.h): (rows, cols) int16 x, y, z and uint16 range in 4 mm steps."""
+    x: np.ndarray
+    y: np.ndarray
+    z: np.ndarray
+    range: np.ndarray
+    point_pixel: np.ndarray  #: (n,) int32 pixel of each input point, -1 = none
+    row_elev_bam: np.ndarray  #: (rows,) int32
+    status: int
+
+    @property
+    def shape(self):
+        return self.x.shape
+
+
+def project_compact(points, sensor="hdl64", **proj_cfg) -> CompactImage:
+    """Project (N, >=3) float points into a compact image with the float projection's compact path (as the
+    detector workspace does)."""
+    s, ctx = native.proj_init(sensor, **proj_cfg)
+    pts, stride = native._as_points(points)
+    n = len(pts)
+    rows, cols = s.rows, s.cols
+    x, y, z = (np.zeros((rows, cols), np.int16) for _ in range(3))
+    r = np.zeros((rows, cols), np.uint16)
+    pp = np.full(n, -1, np.int32)
+    elev = np.zeros(rows, np.int32)
+    L = _ground_q_lib()
+    st = L.lidet_py_ground_q_project(ctx.ptr, pts if n else np.zeros(3, np.float32), n, stride, x, y, z, r,
+                                     pp if n else None, elev)
+    if st < 0:
+        raise native.LidetError(st, "lidet_proj_run_buffers")
+    return CompactImage(x, y, z, r, pp, elev, int(st))
+
+
+def ground_q_defaults(sensor="hdl64") -> dict:
+    """lidet_ground_q_cfg_default for a preset name or a Sensor (field -> int)."""
+    s = native.get_sensor(sensor) if isinstance(sensor, str) else sensor
+    v = np.zeros(len(ground_q_fields()), np.int64)
+    _ground_q_lib().lidet_py_ground_q_default(s.rows, int(round(s.mount_height_m * 1000)), v)
+    return dict(zip(ground_q_fields(), (int(a) for a in v)))
+
+
+def _cfg_vec(cfg: dict) -> np.ndarray:
+    names = ground_q_fields()
+    unknown = set(cfg) - set(names)
+    if unknown:
+        raise TypeError(f"unknown ground_q config field(s): {sorted(unknown)}")
+    return np.array([int(cfg[k]) for k in names], np.int64)
+
+
+@dataclass
+class GroundQResult:
+    mask: np.ndarray     #: (rows, cols) uint8
+    sample: np.ndarray   #: (rows, cols) uint8
+    planes: np.ndarray   #: (2 ns, 4) int32 nx, ny, nz (Q30), d_4mm; near then far
+    plane_d: np.ndarray  #: (2 ns,) int64 D in 4 mm / 2^30
+    source: np.ndarray   #: (2 ns,) uint8
+    stats: dict
+    status: int
+
+
+def _ground_outputs(img: CompactImage, cfg: dict):
+    """rows, cols, n_sectors and zeroed outputs (mask, sample mask, sources, stats record) of a ground run."""
+    rows, cols = img.shape
+    ns = int(cfg["n_sectors"])
+    return (rows, cols, ns, np.zeros((rows, cols), np.uint8), np.zeros((rows, cols), np.uint8),
+            np.zeros(2 * ns, np.uint8), native._record("lidet_ground_stats_t"))
+
+
+def ground_q(img: CompactImage, sensor="hdl64", **cfg) -> GroundQResult:
+    """The integer ground stage on a compact image; cfg overrides ground_q_defaults(sensor)."""
+    full = ground_q_defaults(sensor)
+    full.update(cfg)
+    rows, cols, ns, mask, smp, src, stats = _ground_outputs(img, full)
+    planes = np.zeros((2 * ns, 4), np.int32)
+    pd = np.zeros(2 * ns, np.int64)
+    st = _ground_q_lib().lidet_py_ground_q_run(_cfg_vec(full), rows, cols, img.x, img.y, img.z, img.range, mask,
+                                               smp, planes, pd, src, native._addr(stats))
+    if st < 0:
+        raise native.LidetError(st, "lidet_ground_q_run")
+    return GroundQResult(mask, smp, planes, pd, src, native._to_dict(stats), int(st))
+
+
+def ground_float_compact(img: CompactImage, sensor="hdl64", **cfg):
+    """The float ground stage on the same compact image: (mask, sample, planes (2 ns, 4) float32, source,
+    stats)."""
+    full = native.ground_defaults(sensor)
+    full.update(cfg)
+    rows, cols, ns, mask, smp, src, stats = _ground_outputs(img, full)
+    planes = np.zeros((2 * ns, 4), np.float32)
+    st = _ground_q_lib().lidet_py_ground_float_compact(native._addr(native._record("lidet_ground_cfg_t", full)),
+                                                       rows, cols, img.x, img.y, img.z, img.range, mask, smp,
+                                                       planes, src, native._addr(stats))
+    if st < 0:
+        raise native.LidetError(st, "lidet_ground_run")
+    return mask, smp, planes, src, native._to_dict(stats)
+
+
+def ground_q_time(img: CompactImage, sensor="hdl64", repeats=100) -> tuple[float, float, float, float]:
+    """Host timing (ms) of the float and the integer ground stage on one compact image, interleaved: (float median,
+    integer median, float minimum, integer minimum)."""
+    out = np.zeros(4, np.uint64)
+    cf = native._record("lidet_ground_cfg_t", native.ground_defaults(sensor))
+    rows, cols = img.shape
+    st = _ground_q_lib().lidet_py_ground_q_time(native._addr(cf), _cfg_vec(ground_q_defaults(sensor)), rows, cols,
+                                                img.x, img.y, img.z, img.range, repeats, out)
+    if st < 0:
+        raise native.LidetError(st, "lidet_py_ground_q_time")
+    return tuple(float(v) / 1e6 for v in out)
+
+
+def ground_pair(points, sensor="hdl64"):
+    """Both ground stages on one compact image of `points`: (float per-point mask, integer per-point mask, the
+    image, the integer result); per-point masks in input order (a point takes its pixel's label, 0 when it has
+    none)."""
+    img = project_compact(points, sensor)
+    q = ground_q(img, sensor)
+    fm = ground_float_compact(img, sensor)[0]
+    pp = img.point_pixel
+
+    def per_point(mask):
+        return np.where(pp >= 0, mask.reshape(-1)[np.clip(pp, 0, None)], 0).astype(np.uint8)
+    return per_point(fm), per_point(q.mask), img, q

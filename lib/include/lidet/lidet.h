@@ -26,6 +26,7 @@
 #include "lidet_sensor_q.h"
 #include "lidet_proj_q.h"
 #include "lidet_ground.h"
+#include "lidet_ground_q.h"
 #include "lidet_cluster.h"
 #include "lidet_pointnet.h"
 #include "lidet_detector.h"
