@@ -85,20 +85,23 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
 }
 
 
-/* the smallest kept cluster (ties: the later seed), the one capacity drops first */
-static uint32_t smallest_slot(const lidet_cluster_state_t *c)
-{
-    uint32_t i, m = 0;
-    for (i = 1; i < c->n_recs; ++i)
-    {
-        const lidet_cluster_rec_t *a = &c->recs[i], *b = &c->recs[m];
-        if (a->n_points < b->n_points || (a->n_points == b->n_points && a->seed_pixel > b->seed_pixel))
-        {
-            m = i;
-        }
-    }
-    return m;
-}
+static uint32_t finish_cluster(lidet_cluster_state_t *c, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
+                               uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue);
+static void rescue_join(lidet_cluster_state_t *c, uint32_t slot, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
+                        uint32_t n_sectors, lidet_cluster_stats_t *st);
+
+/* the shared bookkeeping (capacity, canonical ids, the run's driver) with the float stage's types */
+#define RUN_STATE_T lidet_cluster_state_t
+#define RUN_REC_T lidet_cluster_rec_t
+#define RUN_PARAM_T lidet__grow_t
+#define RUN_PLANE_T lidet_plane_t
+#define RUN_GROW lidet__cluster_grow
+#define RUN_FINISH finish_cluster
+#define RUN_RESCUE_T lidet__rescue_t
+#define RUN_RESCUE_FAR 3.0e38f
+#define RUN_RESCUE_GROW lidet__cluster_rescue_grow
+#define RUN_RESCUE_JOIN rescue_join
+#include "internal/lidet_cluster_run_body.h"
 
 /* sum, min and max of the points of members[start, tail) (tail > start). Returns 1 (the sums then
  * incomplete) as soon as an x, y or z extent exceeds max_extent: the test runs after every block of
@@ -221,27 +224,10 @@ static uint32_t finish_cluster(lidet_cluster_state_t *c, uint32_t start, uint32_
         }
         return start;
     }
-    if (c->n_recs < LIDET_MAX_CLUSTERS)
+    slot = claim_slot(c, n, rescue, st);
+    if (slot == RUN_NO_SLOT)
     {
-        slot = c->n_recs++;
-    }
-    else
-    {
-        /* full: the new cluster has the latest seed, so it loses every tie */
-        const uint32_t m = smallest_slot(c);
-        ++st->n_dropped_capacity;
-        if (rescue || n <= c->recs[m].n_points)
-        {
-            return start;
-        }
-        /* evict m: its pixels become "visited, dropped"; its member range stays as a hole that the
-         * final raster pass compacts away (only first-fill clusters are evicted, and they own
-         * exactly their member range) */
-        for (i = c->recs[m].first_member; i < c->recs[m].first_member + c->recs[m].n_points; ++i)
-        {
-            c->labels[mem[i]] = (uint16_t)LAB_PENDING;
-        }
-        slot = m;
+        return start;
     }
     rec = &c->recs[slot];
     rec->n_points = n;
@@ -297,162 +283,12 @@ static void rescue_join(lidet_cluster_state_t *c, uint32_t slot, uint32_t start,
     st->n_rescue_pixels += n;
 }
 
-/* canonical id of kept pixel i (label slot + 1, or 0 = none), appended to its cluster's members */
-static inline void place_kept(lidet_cluster_state_t *c, uint16_t *lab, uint32_t i)
-{
-    const uint32_t l = lab[i];
-    if (l != 0u)
-    {
-        const uint32_t id = c->slot_id[l];
-        lab[i] = (uint16_t)id;
-        c->members[c->recs[id - 1u].first_member++] = (int32_t)i;
-    }
-}
-
-/* canonical order: records sorted by seed, labels rewritten, members regrouped in raster order */
-static void canonicalise(lidet_cluster_state_t *c, uint32_t npix, lidet_cluster_stats_t *st)
-{
-    const uint32_t k = c->n_recs;
-    uint32_t i, j, start;
-    uint16_t *lab = c->labels;
-
-    /* insertion sort of slots by seed: already sorted unless capacity evictions happened or the rescue
-     * added clusters or moved a seed */
-    for (i = 0; i < k; ++i)
-    {
-        const uint16_t s = (uint16_t)i;
-        j = i;
-        while (j > 0 && c->recs[c->order[j - 1]].seed_pixel > c->recs[s].seed_pixel)
-        {
-            c->order[j] = c->order[j - 1];
-            --j;
-        }
-        c->order[j] = s;
-    }
-    c->slot_id[0] = 0;
-    for (i = 0; i < k; ++i)
-    {
-        c->slot_id[c->order[i] + 1u] = (uint16_t)(i + 1u);
-    }
-    /* gather permutation recs[i] = old recs[order[i]], following cycles (order[] is consumed) */
-    for (i = 0; i < k; ++i)
-    {
-        lidet_cluster_rec_t tmp;
-        if (c->order[i] == i)
-        {
-            continue;
-        }
-        tmp = c->recs[i];
-        j = i;
-        for (;;)
-        {
-            const uint32_t src = c->order[j];
-            c->order[j] = (uint16_t)j;
-            if (src == i)
-            {
-                c->recs[j] = tmp;
-                break;
-            }
-            c->recs[j] = c->recs[src];
-            j = src;
-        }
-    }
-    start = 0;
-    for (i = 0; i < k; ++i)
-    {
-        c->recs[i].first_member = start; /* a write cursor during the pass below */
-        start += c->recs[i].n_points;
-    }
-    st->n_pixels_kept = start;
-    /* every pixel that is not in a kept cluster (non-candidate, dropped; none is still free) -> 0,
-     * without a branch (it vectorises); kept pixels keep slot + 1 */
-    for (i = 0; i < npix; ++i)
-    {
-        const uint32_t l = lab[i];
-        lab[i] = (uint16_t)(l < LAB_SMALL ? l : 0u);
-    }
-    /* slot + 1 -> id and the members in raster order. Kept pixels are a minority: blocks of four
-     * labels that are all 0 (one 64-bit word, read with memcpy) are skipped at once */
-    for (i = 0; i + 4u <= npix; i += 4u)
-    {
-        uint64_t w;
-        memcpy(&w, &lab[i], sizeof w);
-        if (w != 0u)
-        {
-            place_kept(c, lab, i);
-            place_kept(c, lab, i + 1u);
-            place_kept(c, lab, i + 2u);
-            place_kept(c, lab, i + 3u);
-        }
-    }
-    for (; i < npix; ++i)
-    {
-        place_kept(c, lab, i);
-    }
-    for (i = 0; i < k; ++i)
-    {
-        c->recs[i].first_member -= c->recs[i].n_points;
-    }
-}
-
-/* the first free pixel (label 0) at or after p, npix if none. Seeds are rare once most pixels are
- * visited: four labels at a time (a 64-bit word, read with memcpy) are skipped when none is 0. The
- * test (w - 0x0001..) & ~w & 0x8000.. is nonzero exactly when some 16-bit lane of w is zero (a
- * borrow only starts at a zero lane, and the lowest zero lane always sets its top bit) */
-static inline uint32_t next_free(const uint16_t *lab, uint32_t p, uint32_t npix)
-{
-    for (;;)
-    {
-        while (p + 4u <= npix)
-        {
-            uint64_t w;
-            memcpy(&w, &lab[p], sizeof w);
-            if (((w - 0x0001000100010001u) & ~w & 0x8000800080008000u) != 0u)
-            {
-                break;
-            }
-            p += 4u;
-        }
-        if (p >= npix || lab[p] == LAB_FREE)
-        {
-            return p < npix ? p : npix;
-        }
-        ++p;
-    }
-}
-
-/* the first fragment pixel (LAB_SMALL) at or after p, npix if none: blocks of 64 labels are tested
- * in a loop without branches (it vectorises), and only a block that holds one is searched */
-static uint32_t next_fragment(const uint16_t *lab, uint32_t p, uint32_t npix)
-{
-    while (p < npix)
-    {
-        const uint32_t e = npix - p < 64u ? npix : p + 64u;
-        uint32_t i;
-        uint16_t any = 0;
-        for (i = p; i < e; ++i)
-        {
-            any |= (uint16_t)(lab[i] == LAB_SMALL);
-        }
-        if (any != 0u)
-        {
-            for (i = p; lab[i] != LAB_SMALL; ++i)
-            {
-            }
-            return i;
-        }
-        p = e;
-    }
-    return npix;
-}
-
 lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *labels, int32_t *members,
                                          const lidet_range_image_t *img, const uint8_t *ground_mask,
                                          const lidet_plane_t *planes, uint32_t n_sectors)
 {
-    uint32_t rows, cols, npix, p, tail, ks;
+    uint32_t rows, cols, npix, p;
     uint16_t *lab;
-    int32_t *mem;
     lidet__grow_t lk;
     lidet_cluster_stats_t st;
 
@@ -482,25 +318,12 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     c->n_recs = 0;
     memset(&st, 0, sizeof st);
     lab = c->labels;
-    mem = c->members;
-    ks = c->cfg.max_steps;
-    lk.rows = rows;
-    lk.cols = cols;
-    lk.ks = ks;
-    lk.kc = ks < cols - 1 ? ks : cols - 1; /* never wrap onto itself */
-    lk.diag = c->cfg.diagonals != 0;
+    LIDET__GROW_GEOMETRY(lk, rows, cols, c->cfg);
     lk.tan_theta = c->tan_theta;
     lk.gap = c->cfg.max_gap_m;
     lk.gpm = c->cfg.max_gap_per_m;
     lk.rgap = c->cfg.rescue_gap_m;
     lk.rgpm = c->cfg.rescue_gap_per_m;
-    lk.rrows = c->cfg.rescue_rows;
-    lk.rcols = c->cfg.rescue_cols < (cols - 1u) / 2u ? c->cfg.rescue_cols : (cols - 1u) / 2u;
-    /* row of pixel q without a division: floor(q * m / 2^32) with m = floor(2^32 / cols) + 1 is
-     * floor(q / cols) exactly when q * cols < 2^32 (m exceeds 2^32 / cols by e in (0, 1], so the
-     * quotient is overestimated by q e / 2^32 < 1 / cols, less than the distance of q / cols to the
-     * next integer). q < npix, so npix * cols <= 2^32 suffices (128 x 2048: 2^29); else divide */
-    lk.row_magic = (uint64_t)npix * cols <= 0xFFFFFFFFu ? (uint32_t)(0xFFFFFFFFu / cols) + 1u : 0u;
 
     /* candidates: FREE (0) or NONCAND (0xFFFF) = cand - 1 in 16 bits; no branch, so it vectorises.
      * A pixel holds a point iff its range is > 0 (the image contract; point_idx may be absent) */
@@ -510,14 +333,7 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
         if (lidet__img_compact(img))
         {
             /* compact image: a valid pixel has range_4mm >= 1 */
-            const uint16_t *qrng = img->range_4mm;
-            for (p = 0; p < npix; ++p)
-            {
-                const uint32_t cand =
-                    (uint32_t)(qrng[p] > 0u) & (uint32_t)(ground_mask == 0 || ground_mask[p] == 0);
-                lab[p] = (uint16_t)(cand - 1u);
-                n_cand += cand;
-            }
+            n_cand = lidet__cluster_mark_4mm(img->range_4mm, ground_mask, npix, lab);
         }
         else if (ground_mask != 0)
         {
@@ -540,43 +356,7 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
         st.n_candidates = n_cand;
     }
 
-    tail = 0;
-    for (p = next_free(lab, 0, npix); p < npix; p = next_free(lab, p + 1u, npix))
-    {
-        uint32_t start;
-        start = tail;
-        lab[p] = (uint16_t)LAB_PENDING;
-        mem[tail++] = (int32_t)p;
-        tail = lidet__cluster_grow(c, &lk, start, tail);
-        tail = finish_cluster(c, start, tail, planes, n_sectors, &st, 0);
-    }
-    /* the rescue pass over the fragments (LAB_SMALL), groups seeded in raster order. Kept pixels,
-     * the fragments and the current group are distinct pixels, so the member array holds them */
-    if (st.n_fragments > 0u)
-    {
-        for (p = next_fragment(lab, 0, npix); p < npix; p = next_fragment(lab, p + 1u, npix))
-        {
-            lidet__rescue_t rs;
-            const uint32_t start = tail;
-            lab[p] = (uint16_t)LAB_PENDING;
-            mem[tail++] = (int32_t)p;
-            rs.tail = tail;
-            rs.best = 0u;
-            rs.best_d2 = 3.0e38f;
-            lidet__cluster_rescue_grow(c, &lk, start, &rs);
-            if (rs.best != 0u)
-            {
-                rescue_join(c, rs.best - 1u, start, rs.tail, planes, n_sectors, &st);
-                tail = start;
-            }
-            else
-            {
-                tail = finish_cluster(c, start, rs.tail, planes, n_sectors, &st, 1);
-            }
-        }
-    }
-    canonicalise(c, npix, &st);
-    st.n_kept = c->n_recs;
+    run_fills(c, &lk, npix, planes, n_sectors, &st);
     c->stats = st;
     return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }

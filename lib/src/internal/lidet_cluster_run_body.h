@@ -1,0 +1,250 @@
+/* SPDX-License-Identifier: MIT */
+/* The clustering's bookkeeping, written once for the float stage (lidet_cluster.c) and the integer one
+ * (lidet_cluster_q.c), each of which includes this file once: the capacity (the smallest kept cluster,
+ * a slot for a new one), the canonical ids, the searches for the next seed, and the run's driver (first
+ * fill, rescue pass, canonical order). Nothing here reads a coordinate or a range. Parameters:
+ *   RUN_STATE_T, RUN_REC_T       the state and its record type (members n_recs, recs, order, slot_id,
+ *                                labels, members; records n_points, first_member, seed_pixel);
+ *   RUN_PARAM_T, RUN_PLANE_T     the flood fill's constants and the ground plane type;
+ *   RUN_GROW(c, g, start, tail)  the first fill of one component (returns the new tail);
+ *   RUN_FINISH(c, start, tail, planes, n_sectors, st, rescue)  filters and records (returns the new tail);
+ *   RUN_RESCUE_T, RUN_RESCUE_FAR  the rescue group's running state and its "no contact yet" distance;
+ *   RUN_RESCUE_GROW(c, g, start, rs), RUN_RESCUE_JOIN(c, slot, start, tail, planes, n_sectors, st).
+ * Not a public header; include nowhere else. */
+
+#define RUN_NO_SLOT 0xFFFFFFFFu
+
+/* the smallest kept cluster (ties: the later seed), the one capacity drops first */
+static uint32_t smallest_slot(const RUN_STATE_T *c)
+{
+    uint32_t i, m = 0;
+    for (i = 1; i < c->n_recs; ++i)
+    {
+        const RUN_REC_T *a = &c->recs[i], *b = &c->recs[m];
+        if (a->n_points < b->n_points || (a->n_points == b->n_points && a->seed_pixel > b->seed_pixel))
+        {
+            m = i;
+        }
+    }
+    return m;
+}
+
+/* a slot for a cluster of n pixels that passed the filters, or RUN_NO_SLOT (counted) when the capacity
+ * is full and it does not win one: a first-fill cluster evicts the smallest kept one when it is larger
+ * (the new one has the latest seed, so it loses every tie); a rescue group never evicts. The evicted
+ * cluster's pixels become "visited, dropped"; its member range stays as a hole that the final raster
+ * pass compacts away (only first-fill clusters are evicted, and they own exactly their member range) */
+static uint32_t claim_slot(RUN_STATE_T *c, uint32_t n, int rescue, lidet_cluster_stats_t *st)
+{
+    uint32_t i, m;
+    if (c->n_recs < LIDET_MAX_CLUSTERS)
+    {
+        return c->n_recs++;
+    }
+    m = smallest_slot(c);
+    ++st->n_dropped_capacity;
+    if (rescue || n <= c->recs[m].n_points)
+    {
+        return RUN_NO_SLOT;
+    }
+    for (i = c->recs[m].first_member; i < c->recs[m].first_member + c->recs[m].n_points; ++i)
+    {
+        c->labels[c->members[i]] = (uint16_t)LAB_PENDING;
+    }
+    return m;
+}
+
+/* canonical id of kept pixel i (label slot + 1, or 0 = none), appended to its cluster's members */
+static inline void place_kept(RUN_STATE_T *c, uint16_t *lab, uint32_t i)
+{
+    const uint32_t l = lab[i];
+    if (l != 0u)
+    {
+        const uint32_t id = c->slot_id[l];
+        lab[i] = (uint16_t)id;
+        c->members[c->recs[id - 1u].first_member++] = (int32_t)i;
+    }
+}
+
+/* canonical order: records sorted by seed, labels rewritten, members regrouped in raster order */
+static void canonicalise(RUN_STATE_T *c, uint32_t npix, lidet_cluster_stats_t *st)
+{
+    const uint32_t k = c->n_recs;
+    uint32_t i, j, start;
+    uint16_t *lab = c->labels;
+
+    /* insertion sort of slots by seed: already sorted unless capacity evictions happened or the rescue
+     * added clusters or moved a seed */
+    for (i = 0; i < k; ++i)
+    {
+        const uint16_t s = (uint16_t)i;
+        j = i;
+        while (j > 0 && c->recs[c->order[j - 1]].seed_pixel > c->recs[s].seed_pixel)
+        {
+            c->order[j] = c->order[j - 1];
+            --j;
+        }
+        c->order[j] = s;
+    }
+    c->slot_id[0] = 0;
+    for (i = 0; i < k; ++i)
+    {
+        c->slot_id[c->order[i] + 1u] = (uint16_t)(i + 1u);
+    }
+    /* gather permutation recs[i] = old recs[order[i]], following cycles (order[] is consumed) */
+    for (i = 0; i < k; ++i)
+    {
+        RUN_REC_T tmp;
+        if (c->order[i] == i)
+        {
+            continue;
+        }
+        tmp = c->recs[i];
+        j = i;
+        for (;;)
+        {
+            const uint32_t src = c->order[j];
+            c->order[j] = (uint16_t)j;
+            if (src == i)
+            {
+                c->recs[j] = tmp;
+                break;
+            }
+            c->recs[j] = c->recs[src];
+            j = src;
+        }
+    }
+    start = 0;
+    for (i = 0; i < k; ++i)
+    {
+        c->recs[i].first_member = start; /* a write cursor during the pass below */
+        start += c->recs[i].n_points;
+    }
+    st->n_pixels_kept = start;
+    /* every pixel that is not in a kept cluster (non-candidate, dropped; none is still free) -> 0,
+     * without a branch (it vectorises); kept pixels keep slot + 1 */
+    for (i = 0; i < npix; ++i)
+    {
+        const uint32_t l = lab[i];
+        lab[i] = (uint16_t)(l < LAB_SMALL ? l : 0u);
+    }
+    /* slot + 1 -> id and the members in raster order. Kept pixels are a minority: blocks of four
+     * labels that are all 0 (one 64-bit word, read with memcpy) are skipped at once */
+    for (i = 0; i + 4u <= npix; i += 4u)
+    {
+        uint64_t w;
+        memcpy(&w, &lab[i], sizeof w);
+        if (w != 0u)
+        {
+            place_kept(c, lab, i);
+            place_kept(c, lab, i + 1u);
+            place_kept(c, lab, i + 2u);
+            place_kept(c, lab, i + 3u);
+        }
+    }
+    for (; i < npix; ++i)
+    {
+        place_kept(c, lab, i);
+    }
+    for (i = 0; i < k; ++i)
+    {
+        c->recs[i].first_member -= c->recs[i].n_points;
+    }
+}
+
+/* the first free pixel (label 0) at or after p, npix if none. Seeds are rare once most pixels are
+ * visited: four labels at a time (a 64-bit word, read with memcpy) are skipped when none is 0. The
+ * test (w - 0x0001..) & ~w & 0x8000.. is nonzero exactly when some 16-bit lane of w is zero (a
+ * borrow only starts at a zero lane, and the lowest zero lane always sets its top bit) */
+static inline uint32_t next_free(const uint16_t *lab, uint32_t p, uint32_t npix)
+{
+    for (;;)
+    {
+        while (p + 4u <= npix)
+        {
+            uint64_t w;
+            memcpy(&w, &lab[p], sizeof w);
+            if (((w - 0x0001000100010001u) & ~w & 0x8000800080008000u) != 0u)
+            {
+                break;
+            }
+            p += 4u;
+        }
+        if (p >= npix || lab[p] == LAB_FREE)
+        {
+            return p < npix ? p : npix;
+        }
+        ++p;
+    }
+}
+
+/* the first fragment pixel (LAB_SMALL) at or after p, npix if none: blocks of 64 labels are tested
+ * in a loop without branches (it vectorises), and only a block that holds one is searched */
+static uint32_t next_fragment(const uint16_t *lab, uint32_t p, uint32_t npix)
+{
+    while (p < npix)
+    {
+        const uint32_t e = npix - p < 64u ? npix : p + 64u;
+        uint32_t i;
+        uint16_t any = 0;
+        for (i = p; i < e; ++i)
+        {
+            any |= (uint16_t)(lab[i] == LAB_SMALL);
+        }
+        if (any != 0u)
+        {
+            for (i = p; lab[i] != LAB_SMALL; ++i)
+            {
+            }
+            return i;
+        }
+        p = e;
+    }
+    return npix;
+}
+
+
+/* the whole run after the candidates are marked in labels (FREE / NONCAND) and the stats zeroed but
+ * n_candidates: the first fill in raster order, the rescue pass over the fragments (LAB_SMALL), groups
+ * seeded in raster order (kept pixels, the fragments and the current group are distinct pixels, so the
+ * member array holds them), and the canonical order */
+static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, uint32_t npix, const RUN_PLANE_T *planes,
+                      uint32_t n_sectors, lidet_cluster_stats_t *st)
+{
+    uint16_t *lab = c->labels;
+    int32_t *mem = c->members;
+    uint32_t p, tail = 0;
+    for (p = next_free(lab, 0, npix); p < npix; p = next_free(lab, p + 1u, npix))
+    {
+        const uint32_t start = tail;
+        lab[p] = (uint16_t)LAB_PENDING;
+        mem[tail++] = (int32_t)p;
+        tail = RUN_GROW(c, lk, start, tail);
+        tail = RUN_FINISH(c, start, tail, planes, n_sectors, st, 0);
+    }
+    if (st->n_fragments > 0u)
+    {
+        for (p = next_fragment(lab, 0, npix); p < npix; p = next_fragment(lab, p + 1u, npix))
+        {
+            RUN_RESCUE_T rs;
+            const uint32_t start = tail;
+            lab[p] = (uint16_t)LAB_PENDING;
+            mem[tail++] = (int32_t)p;
+            rs.tail = tail;
+            rs.best = 0u;
+            rs.best_d2 = RUN_RESCUE_FAR;
+            RUN_RESCUE_GROW(c, lk, start, &rs);
+            if (rs.best != 0u)
+            {
+                RUN_RESCUE_JOIN(c, rs.best - 1u, start, rs.tail, planes, n_sectors, st);
+                tail = start;
+            }
+            else
+            {
+                tail = RUN_FINISH(c, start, rs.tail, planes, n_sectors, st, 1);
+            }
+        }
+    }
+    canonicalise(c, npix, st);
+    st->n_kept = c->n_recs;
+}
