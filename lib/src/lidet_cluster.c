@@ -407,7 +407,6 @@ const lidet_cluster_stats_t *lidet_cluster_stats(const lidet_cluster_t *c)
 lidet_status_t lidet_cluster_point_labels_of(const lidet_cluster_state_t *c, const int32_t *point_pixel,
                                              uint32_t n_points, uint32_t *out)
 {
-    uint32_t i, npix;
     if (c == 0 || ((point_pixel == 0 || out == 0) && n_points > 0))
     {
         return LIDET_ERR_ARG;
@@ -416,12 +415,7 @@ lidet_status_t lidet_cluster_point_labels_of(const lidet_cluster_state_t *c, con
     {
         return LIDET_ERR_STATE;
     }
-    npix = (uint32_t)c->img.n_rows * c->img.n_cols;
-    for (i = 0; i < n_points; ++i)
-    {
-        const int32_t p = point_pixel[i];
-        out[i] = (p >= 0 && (uint32_t)p < npix) ? c->labels[p] : 0u;
-    }
+    lidet__cluster_point_labels(c->labels, (uint32_t)c->img.n_rows * c->img.n_cols, point_pixel, n_points, out);
     return LIDET_OK;
 }
 

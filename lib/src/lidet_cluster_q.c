@@ -1,0 +1,331 @@
+/* SPDX-License-Identifier: MIT */
+/* Integer clustering (lidet_cluster_q.h): configuration, the run, the filters and records of each component,
+ * the rescue join, accessors. The bookkeeping and the run's driver are the float stage's
+ * (lidet_cluster_run_body.h); the growth is in lidet_cluster_q_grow.c, the rescue in lidet_cluster_q_rescue.c.
+ * Integer only. The numpy reference is codegen/lidet_codegen/ref/cluster_q.py (bit for bit). */
+#include <string.h>
+
+#include "internal/lidet_assert.h"
+#include "internal/lidet_cluster_q_internal.h"
+#include "internal/lidet_qmath.h"
+
+void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, uint32_t mount_height_mm)
+{
+    /* lidet_cluster_cfg_default's values (measured there, docs/BENCHMARKS.md), rounded to the integer units */
+    const int sparse = n_rows >= 1u && n_rows <= 16u;
+    if (cfg == 0)
+    {
+        return;
+    }
+    memset(cfg, 0, sizeof *cfg);
+    cfg->diagonals = 1u;
+    cfg->max_gap_mm = 700u;
+    cfg->theta_urad = sparse ? 120000u : 180000u;
+    cfg->max_steps = sparse ? 4u : 5u;
+    cfg->max_steps = cfg->max_steps < STEPS ? cfg->max_steps : STEPS;
+    cfg->bridge_occluders = sparse ? 0u : 1u;
+    cfg->max_gap_per_m_q16 = sparse ? 2621u : 1638u; /* 0.04, 0.025 */
+    cfg->min_points = 10u;
+    cfg->max_extent_mm = 6000u;
+    cfg->max_mean_height_mm = 2500;
+    cfg->mount_height_mm = mount_height_mm;
+    cfg->rescue_gap_mm = 800u;
+    cfg->rescue_gap_per_m_q16 = 1966u; /* 0.03 */
+    cfg->rescue_rows = sparse ? 1u : 2u;
+    cfg->rescue_cols = 6u;
+}
+
+lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lidet_cluster_q_cfg_t *cfg)
+{
+    if (c == 0 || cfg == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    c->magic = 0;
+    if (cfg->theta_urad == 0u || cfg->theta_urad >= 1500000u || cfg->max_steps < 1u || cfg->max_steps > STEPS ||
+        cfg->min_points < 1u || cfg->max_extent_mm == 0u || cfg->max_extent_mm > 1000000u ||
+        cfg->max_gap_mm > 1000000u || cfg->max_gap_per_m_q16 > 65536u || cfg->mount_height_mm > 100000u ||
+        cfg->rescue_gap_mm > 10000u || cfg->rescue_gap_per_m_q16 > 16384u || cfg->rescue_rows > LIDET_MAX_ROWS ||
+        cfg->rescue_cols > RESCUE_MAX_COLS)
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    c->cfg = *cfg;
+    c->theta_bam = lidet__q_urad_to_bam((int32_t)cfg->theta_urad);
+    c->sin_theta_q16 = (uint32_t)lidet__q_rshift_round(lidet__q_sin((uint32_t)c->theta_bam), 14);
+    c->geo_rows = 0;
+    c->geo_cols = 0;
+    c->n_recs = 0;
+    c->labels = 0;
+    c->members = 0;
+    memset(&c->img, 0, sizeof c->img);
+    memset(&c->stats, 0, sizeof c->stats);
+    c->magic = LIDET_INIT_MAGIC;
+    return LIDET_OK;
+}
+
+lidet_status_t lidet_cluster_q_init(lidet_cluster_q_t *c, const lidet_cluster_q_cfg_t *cfg)
+{
+    return c == 0 ? LIDET_ERR_ARG : lidet_cluster_q_state_init(&c->state, cfg);
+}
+
+/* sums, min and max of the coordinates of members[start, tail) (tail > start). Returns 1 (the sums then
+ * incomplete) as soon as an extent exceeds max_extent_mm: tested after every block of 64 members, as the
+ * float stage does (the decision does not depend on where it stops) */
+static int member_stats_q(const lidet_cluster_q_state_t *c, uint32_t start, uint32_t tail, uint32_t max_extent_mm,
+                          int64_t sum[3], int32_t lo[3], int32_t hi[3])
+{
+    const lidet_range_image_t *img = &c->img;
+    const int32_t *mem = c->members;
+    const int16_t *const plane[3] = {img->x_4mm, img->y_4mm, img->z_4mm};
+    uint32_t i = start, a, over = 0;
+    for (a = 0; a < 3; ++a)
+    {
+        sum[a] = 0;
+        lo[a] = hi[a] = plane[a][mem[start]];
+    }
+    while (i < tail && over == 0u)
+    {
+        const uint32_t e = tail - i < 64u ? tail : i + 64u;
+        for (a = 0; a < 3; ++a)
+        {
+            const int16_t *v = plane[a];
+            int64_t s = 0;
+            int32_t l = lo[a], h = hi[a];
+            uint32_t k;
+            for (k = i; k < e; ++k)
+            {
+                const int32_t x = v[mem[k]];
+                s += x;
+                l = x < l ? x : l;
+                h = x > h ? x : h;
+            }
+            sum[a] += s;
+            lo[a] = l;
+            hi[a] = h;
+            over |= (uint32_t)((uint32_t)(h - l) * 4u > max_extent_mm);
+        }
+        i = e;
+    }
+    return over != 0u;
+}
+
+/* height of `mean` above the plane of the seed column's sector (or the flat ground at -mount), 4 mm steps */
+static int32_t height_q(const lidet_cluster_q_state_t *c, uint32_t seed, const int32_t mean[3],
+                        const lidet_plane_q_t *planes, uint32_t n_sectors)
+{
+    int64_t h;
+    if (planes != 0)
+    {
+        const uint32_t col = seed % c->img.n_cols;
+        uint32_t s = (uint32_t)(((uint64_t)col * n_sectors) / c->img.n_cols);
+        const lidet_plane_q_t *pl;
+        s = s < n_sectors ? s : n_sectors - 1u;
+        pl = &planes[s];
+        /* |mean| <= 2^15, |n| <= 2^31: the sum is below 2^49 */
+        h = lidet__q_rshift_round((int64_t)pl->nx * mean[0] + (int64_t)pl->ny * mean[1] + (int64_t)pl->nz * mean[2],
+                                  30) + pl->d_4mm;
+    }
+    else
+    {
+        h = (int64_t)mean[2] + lidet__q_div_round((int64_t)c->cfg.mount_height_mm, 4);
+    }
+    return h > 0x7FFFFFFF ? 0x7FFFFFFF : (h < -0x7FFFFFFF ? -0x7FFFFFFF : (int32_t)h);
+}
+
+static void mean_of(const int64_t sum[3], uint32_t n, int32_t mean[3])
+{
+    uint32_t a;
+    for (a = 0; a < 3; ++a)
+    {
+        mean[a] = (int32_t)lidet__q_div_round(sum[a], (int64_t)n);
+    }
+}
+
+static uint32_t finish_q(lidet_cluster_q_state_t *c, uint32_t start, uint32_t tail, const lidet_plane_q_t *planes,
+                         uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue);
+static void join_q(lidet_cluster_q_state_t *c, uint32_t slot, uint32_t start, uint32_t tail,
+                   const lidet_plane_q_t *planes, uint32_t n_sectors, lidet_cluster_stats_t *st);
+
+/* the shared bookkeeping (capacity, canonical ids, the run's driver) with the integer stage's types */
+#define RUN_STATE_T lidet_cluster_q_state_t
+#define RUN_REC_T lidet_cluster_q_rec_t
+#define RUN_PARAM_T lidet__grow_q_t
+#define RUN_PLANE_T lidet_plane_q_t
+#define RUN_GROW lidet__cluster_q_grow
+#define RUN_FINISH finish_q
+#define RUN_RESCUE_T lidet__rescue_q_t
+#define RUN_RESCUE_FAR 0xFFFFFFFFu
+#define RUN_RESCUE_GROW lidet__cluster_q_rescue_grow
+#define RUN_RESCUE_JOIN join_q
+#include "internal/lidet_cluster_run_body.h"
+
+/* filters + bookkeeping of the component members[start, tail) (the float stage's finish_cluster in integers):
+ * rescue = 0 a component of the first fill, 1 a rescue group that joined no cluster */
+static uint32_t finish_q(lidet_cluster_q_state_t *c, uint32_t start, uint32_t tail, const lidet_plane_q_t *planes,
+                         uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue)
+{
+    const uint32_t n = tail - start;
+    const int32_t *mem = c->members;
+    int64_t sum[3];
+    int32_t lo[3], hi[3], mean[3], h;
+    uint32_t i, slot;
+    const int small = n < c->cfg.min_points;
+    lidet_cluster_q_rec_t *rec;
+
+    st->n_found += rescue ? 0u : 1u;
+    if (small && (rescue || c->cfg.rescue_gap_mm == 0u))
+    {
+        ++st->n_dropped_small;
+        return start;
+    }
+    if (member_stats_q(c, start, tail, small ? 0xFFFFFFFFu : c->cfg.max_extent_mm, sum, lo, hi))
+    {
+        ++st->n_dropped_extent;
+        return start;
+    }
+    mean_of(sum, n, mean);
+    h = height_q(c, (uint32_t)mem[start], mean, planes, n_sectors);
+    if ((int64_t)h * 4 > c->cfg.max_mean_height_mm)
+    {
+        ++st->n_dropped_height;
+        return start;
+    }
+    if (small)
+    {
+        ++st->n_fragments;
+        for (i = start; i < tail; ++i)
+        {
+            c->labels[mem[i]] = (uint16_t)LAB_SMALL;
+        }
+        return start;
+    }
+    slot = claim_slot(c, n, rescue, st);
+    if (slot == RUN_NO_SLOT)
+    {
+        return start;
+    }
+    rec = &c->recs[slot];
+    rec->n_points = n;
+    rec->first_member = start;
+    rec->seed_pixel = (uint32_t)mem[start];
+    rec->n_rescued = rescue ? n : 0u;
+    for (i = 0; i < 3; ++i)
+    {
+        c->sums[slot][i] = sum[i];
+        rec->mean_4mm[i] = mean[i];
+        rec->min_4mm[i] = lo[i];
+        rec->max_4mm[i] = hi[i];
+    }
+    rec->height_4mm = h;
+    st->n_rescue_pixels += rescue ? n : 0u;
+    for (i = start; i < tail; ++i)
+    {
+        c->labels[mem[i]] = (uint16_t)(slot + 1u);
+    }
+    return tail;
+}
+
+/* a rescue group members[start, tail) joins kept cluster `slot`: its sums are added (the mean is the rounded
+ * mean of all members), the bounds widened, the seed the smaller one, the height recomputed; no filter */
+static void join_q(lidet_cluster_q_state_t *c, uint32_t slot, uint32_t start, uint32_t tail,
+                   const lidet_plane_q_t *planes, uint32_t n_sectors, lidet_cluster_stats_t *st)
+{
+    lidet_cluster_q_rec_t *rec = &c->recs[slot];
+    const uint32_t n = tail - start, seed = (uint32_t)c->members[start];
+    int64_t sum[3];
+    int32_t lo[3], hi[3];
+    uint32_t i;
+    (void)member_stats_q(c, start, tail, 0xFFFFFFFFu, sum, lo, hi);
+    rec->n_points += n;
+    rec->n_rescued += n;
+    for (i = 0; i < 3; ++i)
+    {
+        c->sums[slot][i] += sum[i];
+        rec->min_4mm[i] = lo[i] < rec->min_4mm[i] ? lo[i] : rec->min_4mm[i];
+        rec->max_4mm[i] = hi[i] > rec->max_4mm[i] ? hi[i] : rec->max_4mm[i];
+    }
+    mean_of(c->sums[slot], rec->n_points, rec->mean_4mm);
+    for (i = start; i < tail; ++i)
+    {
+        c->labels[c->members[i]] = (uint16_t)(slot + 1u);
+    }
+    rec->seed_pixel = seed < rec->seed_pixel ? seed : rec->seed_pixel;
+    rec->height_4mm = height_q(c, rec->seed_pixel, rec->mean_4mm, planes, n_sectors);
+    ++st->n_rescue_joined;
+    st->n_rescue_pixels += n;
+}
+
+lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t *labels, int32_t *members,
+                                           const lidet_range_image_t *img, const uint8_t *ground_mask,
+                                           const lidet_plane_q_t *planes, uint32_t n_sectors)
+{
+    uint32_t rows, cols, npix;
+    lidet__grow_q_t lk;
+    lidet_cluster_stats_t st;
+
+    if (c == 0 || labels == 0 || members == 0 || img == 0 || (planes != 0 && n_sectors == 0))
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (c->magic != LIDET_INIT_MAGIC)
+    {
+        return LIDET_ERR_STATE;
+    }
+    rows = img->n_rows;
+    cols = img->n_cols;
+    if (rows < 1 || cols < 2 || rows > LIDET_MAX_ROWS || cols > LIDET_MAX_COLS)
+    {
+        return LIDET_ERR_BUFFER;
+    }
+    if (img->x_m != 0 || img->x_4mm == 0 || img->y_4mm == 0 || img->z_4mm == 0 || img->range_4mm == 0 ||
+        img->row_elev_bam == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    npix = rows * cols;
+    lidet__cluster_q_setup_geometry(c, img);
+    c->img = *img;
+    c->labels = labels;
+    c->members = members;
+    c->n_recs = 0;
+    memset(&st, 0, sizeof st);
+    LIDET__GROW_GEOMETRY(lk, rows, cols, c->cfg);
+    lk.sin_t = c->sin_theta_q16;
+    lk.gap_on = c->cfg.max_gap_mm > 0u;
+    lk.gap = (uint32_t)lidet__q_div_round((int64_t)c->cfg.max_gap_mm, 4);
+    lk.gpm = c->cfg.max_gap_per_m_q16;
+    lk.rgap = (uint32_t)lidet__q_div_round((int64_t)c->cfg.rescue_gap_mm, 4);
+    lk.rgpm = c->cfg.rescue_gap_per_m_q16;
+    st.n_candidates = lidet__cluster_mark_4mm(img->range_4mm, ground_mask, npix, labels);
+    run_fills(c, &lk, npix, planes, n_sectors, &st);
+    c->stats = st;
+    return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;
+}
+
+lidet_status_t lidet_cluster_q_run(lidet_cluster_q_t *c, const lidet_range_image_t *img, const uint8_t *ground_mask,
+                                   const lidet_plane_q_t *planes, uint32_t n_sectors)
+{
+    return c == 0 ? LIDET_ERR_ARG
+                  : lidet_cluster_q_run_buffers(&c->state, c->labels, c->members, img, ground_mask, planes, n_sectors);
+}
+
+lidet_status_t lidet_cluster_q_point_labels(const lidet_cluster_q_state_t *c, const int32_t *point_pixel,
+                                            uint32_t n_points, uint32_t *out)
+{
+    if (c == 0 || ((point_pixel == 0 || out == 0) && n_points > 0))
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (c->magic != LIDET_INIT_MAGIC || c->labels == 0)
+    {
+        return LIDET_ERR_STATE;
+    }
+    lidet__cluster_point_labels(c->labels, (uint32_t)c->img.n_rows * c->img.n_cols, point_pixel, n_points, out);
+    return LIDET_OK;
+}
+
+uint32_t lidet_cluster_q_bytes(void)
+{
+    return (uint32_t)sizeof(lidet_cluster_q_t);
+}
