@@ -85,23 +85,6 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
 }
 
 
-static uint32_t finish_cluster(lidet_cluster_state_t *c, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
-                               uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue);
-static void rescue_join(lidet_cluster_state_t *c, uint32_t slot, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
-                        uint32_t n_sectors, lidet_cluster_stats_t *st);
-
-/* the shared bookkeeping (capacity, canonical ids, the run's driver) with the float stage's types */
-#define RUN_STATE_T lidet_cluster_state_t
-#define RUN_REC_T lidet_cluster_rec_t
-#define RUN_PARAM_T lidet__grow_t
-#define RUN_PLANE_T lidet_plane_t
-#define RUN_GROW lidet__cluster_grow
-#define RUN_FINISH finish_cluster
-#define RUN_RESCUE_T lidet__rescue_t
-#define RUN_RESCUE_FAR 3.0e38f
-#define RUN_RESCUE_GROW lidet__cluster_rescue_grow
-#define RUN_RESCUE_JOIN rescue_join
-#include "internal/lidet_cluster_run_body.h"
 
 /* sum, min and max of the points of members[start, tail) (tail > start). Returns 1 (the sums then
  * incomplete) as soon as an x, y or z extent exceeds max_extent: the test runs after every block of
@@ -174,114 +157,78 @@ static float height_above_ground(const lidet_cluster_state_t *c, uint32_t seed, 
     return mean[2] + c->cfg.mount_height_m;
 }
 
-/* filters + bookkeeping of the component members[start, tail); returns the new tail. rescue = 0:
- * a component of the first fill (one below min_points becomes a fragment when the rescue is on);
- * 1: a rescue group that joined no cluster (dropped when small; takes only a free slot) */
-static uint32_t finish_cluster(lidet_cluster_state_t *c, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
-                               uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue)
+/* the numeric kernels of the shared filters and records (lidet_cluster_run_body.h) */
+typedef struct
 {
-    const uint32_t n = tail - start;
-    const int32_t *mem = c->members;
-    float sum[3], lo[3], hi[3], mean[3], h, inv;
-    uint32_t i, slot;
-    int small;
-    lidet_cluster_rec_t *rec;
+    float sum[3], lo[3], hi[3], mean[3], h;
+} summary_t;
 
-    if (!rescue)
-    {
-        ++st->n_found;
-    }
-    small = n < c->cfg.min_points;
-    if (small && (rescue || !(c->cfg.rescue_gap_m > 0.0f)))
-    {
-        ++st->n_dropped_small;
-        return start;
-    }
-    /* the same filters for a fragment-to-be (small: no extent limit), so that one above the height
-     * limit (canopies, wires: nothing a road user would take in) never reaches the rescue; it saves
-     * a third of the rescue's work */
-    if (member_stats(c, start, tail, small ? 3.0e38f : c->cfg.max_extent_m, sum, lo, hi))
-    {
-        ++st->n_dropped_extent;
-        return start;
-    }
-    inv = 1.0f / (float)n;
-    mean[0] = sum[0] * inv;
-    mean[1] = sum[1] * inv;
-    mean[2] = sum[2] * inv;
-    h = height_above_ground(c, (uint32_t)mem[start], mean, planes, n_sectors);
-    if (!(h <= c->cfg.max_mean_height_m))
-    {
-        ++st->n_dropped_height;
-        return start;
-    }
-    if (small)
-    {
-        ++st->n_fragments;
-        for (i = start; i < tail; ++i)
-        {
-            c->labels[mem[i]] = (uint16_t)LAB_SMALL;
-        }
-        return start;
-    }
-    slot = claim_slot(c, n, rescue, st);
-    if (slot == RUN_NO_SLOT)
-    {
-        return start;
-    }
-    rec = &c->recs[slot];
-    rec->n_points = n;
-    rec->first_member = start;
-    rec->seed_pixel = (uint32_t)mem[start];
-    rec->n_rescued = rescue ? n : 0u;
-    for (i = 0; i < 3; ++i)
-    {
-        rec->mean_m[i] = mean[i];
-        rec->min_m[i] = lo[i];
-        rec->max_m[i] = hi[i];
-    }
-    rec->height_m = h;
-    if (rescue)
-    {
-        st->n_rescue_pixels += n;
-    }
-    for (i = start; i < tail; ++i)
-    {
-        c->labels[mem[i]] = (uint16_t)(slot + 1u);
-    }
-    return tail;
+static int summarise(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, int small, summary_t *s)
+{
+    return member_stats(c, start, tail, small ? 3.0e38f : c->cfg.max_extent_m, s->sum, s->lo, s->hi);
 }
 
-/* a rescue group members[start, tail) joins kept cluster `slot`: count, bounds and mean are
- * updated (mean = (mean * n_old + group sum) / n_new, in float) and the height recomputed. The
- * group's seed is its first pixel in raster order, so the cluster's first pixel is the smaller of
- * the two seeds (the height uses that pixel's sector, as for any cluster) */
-static void rescue_join(lidet_cluster_state_t *c, uint32_t slot, uint32_t start, uint32_t tail, const lidet_plane_t *planes,
-                        uint32_t n_sectors, lidet_cluster_stats_t *st)
+static int mean_height_ok(const lidet_cluster_state_t *c, uint32_t n, uint32_t seed, summary_t *s,
+                          const lidet_plane_t *planes, uint32_t n_sectors)
+{
+    const float inv = 1.0f / (float)n;
+    s->mean[0] = s->sum[0] * inv;
+    s->mean[1] = s->sum[1] * inv;
+    s->mean[2] = s->sum[2] * inv;
+    s->h = height_above_ground(c, seed, s->mean, planes, n_sectors);
+    return s->h <= c->cfg.max_mean_height_m;
+}
+
+static void record_numbers(lidet_cluster_state_t *c, uint32_t slot, const summary_t *s)
 {
     lidet_cluster_rec_t *rec = &c->recs[slot];
-    const uint32_t n = tail - start, seed = (uint32_t)c->members[start];
-    const float inv = 1.0f / (float)(rec->n_points + n);
-    float sum[3], lo[3], hi[3];
     uint32_t i;
-    (void)member_stats(c, start, tail, 3.0e38f, sum, lo, hi);
     for (i = 0; i < 3; ++i)
     {
-        rec->mean_m[i] = (rec->mean_m[i] * (float)rec->n_points + sum[i]) * inv;
-        rec->min_m[i] = lo[i] < rec->min_m[i] ? lo[i] : rec->min_m[i];
-        rec->max_m[i] = hi[i] > rec->max_m[i] ? hi[i] : rec->max_m[i];
+        rec->mean_m[i] = s->mean[i];
+        rec->min_m[i] = s->lo[i];
+        rec->max_m[i] = s->hi[i];
     }
-    for (i = start; i < tail; ++i)
-    {
-        c->labels[c->members[i]] = (uint16_t)(slot + 1u);
-    }
-    rec->n_points += n;
-    rec->n_rescued += n;
-    rec->seed_pixel = seed < rec->seed_pixel ? seed : rec->seed_pixel;
-    rec->height_m = height_above_ground(c, rec->seed_pixel, rec->mean_m, planes, n_sectors);
-    ++st->n_rescue_joined;
-    st->n_rescue_pixels += n;
+    rec->height_m = s->h;
 }
+
+/* mean = (mean * n_old + group sum) / n_new, in float */
+static void join_numbers(lidet_cluster_state_t *c, uint32_t slot, uint32_t n, const summary_t *s)
+{
+    lidet_cluster_rec_t *rec = &c->recs[slot];
+    const float inv = 1.0f / (float)(rec->n_points + n);
+    uint32_t i;
+    for (i = 0; i < 3; ++i)
+    {
+        rec->mean_m[i] = (rec->mean_m[i] * (float)rec->n_points + s->sum[i]) * inv;
+        rec->min_m[i] = s->lo[i] < rec->min_m[i] ? s->lo[i] : rec->min_m[i];
+        rec->max_m[i] = s->hi[i] > rec->max_m[i] ? s->hi[i] : rec->max_m[i];
+    }
+}
+
+static void reheight(lidet_cluster_state_t *c, uint32_t slot, const lidet_plane_t *planes, uint32_t n_sectors)
+{
+    lidet_cluster_rec_t *rec = &c->recs[slot];
+    rec->height_m = height_above_ground(c, rec->seed_pixel, rec->mean_m, planes, n_sectors);
+}
+
+static int rescue_on(const lidet_cluster_state_t *c)
+{
+    return c->cfg.rescue_gap_m > 0.0f;
+}
+
+/* the shared bookkeeping (capacity, filters, records, canonical ids, the run's driver) with the float
+ * stage's types */
+#define RUN_STATE_T lidet_cluster_state_t
+#define RUN_REC_T lidet_cluster_rec_t
+#define RUN_PARAM_T lidet__grow_t
+#define RUN_PLANE_T lidet_plane_t
+#define RUN_SUMMARY_T summary_t
+#define RUN_GROW lidet__cluster_grow
+#define RUN_RESCUE_T lidet__rescue_t
+#define RUN_RESCUE_FAR 3.0e38f
+#define RUN_RESCUE_GROW lidet__cluster_rescue_grow
+#include "internal/lidet_cluster_run_body.h"
 
 lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *labels, int32_t *members,
                                          const lidet_range_image_t *img, const uint8_t *ground_mask,

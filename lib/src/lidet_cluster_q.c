@@ -142,119 +142,77 @@ static void mean_of(const int64_t sum[3], uint32_t n, int32_t mean[3])
     }
 }
 
-static uint32_t finish_q(lidet_cluster_q_state_t *c, uint32_t start, uint32_t tail, const lidet_plane_q_t *planes,
-                         uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue);
-static void join_q(lidet_cluster_q_state_t *c, uint32_t slot, uint32_t start, uint32_t tail,
-                   const lidet_plane_q_t *planes, uint32_t n_sectors, lidet_cluster_stats_t *st);
+/* the numeric kernels of the shared filters and records (lidet_cluster_run_body.h), in integers */
+typedef struct
+{
+    int64_t sum[3];
+    int32_t lo[3], hi[3], mean[3], h;
+} summary_q_t;
 
-/* the shared bookkeeping (capacity, canonical ids, the run's driver) with the integer stage's types */
+static int summarise(const lidet_cluster_q_state_t *c, uint32_t start, uint32_t tail, int small, summary_q_t *s)
+{
+    return member_stats_q(c, start, tail, small ? 0xFFFFFFFFu : c->cfg.max_extent_mm, s->sum, s->lo, s->hi);
+}
+
+static int mean_height_ok(const lidet_cluster_q_state_t *c, uint32_t n, uint32_t seed, summary_q_t *s,
+                          const lidet_plane_q_t *planes, uint32_t n_sectors)
+{
+    mean_of(s->sum, n, s->mean);
+    s->h = height_q(c, seed, s->mean, planes, n_sectors);
+    return (int64_t)s->h * 4 <= c->cfg.max_mean_height_mm;
+}
+
+static void record_numbers(lidet_cluster_q_state_t *c, uint32_t slot, const summary_q_t *s)
+{
+    lidet_cluster_q_rec_t *rec = &c->recs[slot];
+    uint32_t i;
+    for (i = 0; i < 3; ++i)
+    {
+        c->sums[slot][i] = s->sum[i];
+        rec->mean_4mm[i] = s->mean[i];
+        rec->min_4mm[i] = s->lo[i];
+        rec->max_4mm[i] = s->hi[i];
+    }
+    rec->height_4mm = s->h;
+}
+
+/* the group's sums are added: the mean is the rounded mean of all members, exactly */
+static void join_numbers(lidet_cluster_q_state_t *c, uint32_t slot, uint32_t n, const summary_q_t *s)
+{
+    lidet_cluster_q_rec_t *rec = &c->recs[slot];
+    uint32_t i;
+    for (i = 0; i < 3; ++i)
+    {
+        c->sums[slot][i] += s->sum[i];
+        rec->min_4mm[i] = s->lo[i] < rec->min_4mm[i] ? s->lo[i] : rec->min_4mm[i];
+        rec->max_4mm[i] = s->hi[i] > rec->max_4mm[i] ? s->hi[i] : rec->max_4mm[i];
+    }
+    mean_of(c->sums[slot], rec->n_points + n, rec->mean_4mm);
+}
+
+static void reheight(lidet_cluster_q_state_t *c, uint32_t slot, const lidet_plane_q_t *planes, uint32_t n_sectors)
+{
+    lidet_cluster_q_rec_t *rec = &c->recs[slot];
+    rec->height_4mm = height_q(c, rec->seed_pixel, rec->mean_4mm, planes, n_sectors);
+}
+
+static int rescue_on(const lidet_cluster_q_state_t *c)
+{
+    return c->cfg.rescue_gap_mm > 0u;
+}
+
+/* the shared bookkeeping (capacity, filters, records, canonical ids, the run's driver) with the integer
+ * stage's types */
 #define RUN_STATE_T lidet_cluster_q_state_t
 #define RUN_REC_T lidet_cluster_q_rec_t
 #define RUN_PARAM_T lidet__grow_q_t
 #define RUN_PLANE_T lidet_plane_q_t
+#define RUN_SUMMARY_T summary_q_t
 #define RUN_GROW lidet__cluster_q_grow
-#define RUN_FINISH finish_q
 #define RUN_RESCUE_T lidet__rescue_q_t
 #define RUN_RESCUE_FAR 0xFFFFFFFFu
 #define RUN_RESCUE_GROW lidet__cluster_q_rescue_grow
-#define RUN_RESCUE_JOIN join_q
 #include "internal/lidet_cluster_run_body.h"
-
-/* filters + bookkeeping of the component members[start, tail) (the float stage's finish_cluster in integers):
- * rescue = 0 a component of the first fill, 1 a rescue group that joined no cluster */
-static uint32_t finish_q(lidet_cluster_q_state_t *c, uint32_t start, uint32_t tail, const lidet_plane_q_t *planes,
-                         uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue)
-{
-    const uint32_t n = tail - start;
-    const int32_t *mem = c->members;
-    int64_t sum[3];
-    int32_t lo[3], hi[3], mean[3], h;
-    uint32_t i, slot;
-    const int small = n < c->cfg.min_points;
-    lidet_cluster_q_rec_t *rec;
-
-    st->n_found += rescue ? 0u : 1u;
-    if (small && (rescue || c->cfg.rescue_gap_mm == 0u))
-    {
-        ++st->n_dropped_small;
-        return start;
-    }
-    if (member_stats_q(c, start, tail, small ? 0xFFFFFFFFu : c->cfg.max_extent_mm, sum, lo, hi))
-    {
-        ++st->n_dropped_extent;
-        return start;
-    }
-    mean_of(sum, n, mean);
-    h = height_q(c, (uint32_t)mem[start], mean, planes, n_sectors);
-    if ((int64_t)h * 4 > c->cfg.max_mean_height_mm)
-    {
-        ++st->n_dropped_height;
-        return start;
-    }
-    if (small)
-    {
-        ++st->n_fragments;
-        for (i = start; i < tail; ++i)
-        {
-            c->labels[mem[i]] = (uint16_t)LAB_SMALL;
-        }
-        return start;
-    }
-    slot = claim_slot(c, n, rescue, st);
-    if (slot == RUN_NO_SLOT)
-    {
-        return start;
-    }
-    rec = &c->recs[slot];
-    rec->n_points = n;
-    rec->first_member = start;
-    rec->seed_pixel = (uint32_t)mem[start];
-    rec->n_rescued = rescue ? n : 0u;
-    for (i = 0; i < 3; ++i)
-    {
-        c->sums[slot][i] = sum[i];
-        rec->mean_4mm[i] = mean[i];
-        rec->min_4mm[i] = lo[i];
-        rec->max_4mm[i] = hi[i];
-    }
-    rec->height_4mm = h;
-    st->n_rescue_pixels += rescue ? n : 0u;
-    for (i = start; i < tail; ++i)
-    {
-        c->labels[mem[i]] = (uint16_t)(slot + 1u);
-    }
-    return tail;
-}
-
-/* a rescue group members[start, tail) joins kept cluster `slot`: its sums are added (the mean is the rounded
- * mean of all members), the bounds widened, the seed the smaller one, the height recomputed; no filter */
-static void join_q(lidet_cluster_q_state_t *c, uint32_t slot, uint32_t start, uint32_t tail,
-                   const lidet_plane_q_t *planes, uint32_t n_sectors, lidet_cluster_stats_t *st)
-{
-    lidet_cluster_q_rec_t *rec = &c->recs[slot];
-    const uint32_t n = tail - start, seed = (uint32_t)c->members[start];
-    int64_t sum[3];
-    int32_t lo[3], hi[3];
-    uint32_t i;
-    (void)member_stats_q(c, start, tail, 0xFFFFFFFFu, sum, lo, hi);
-    rec->n_points += n;
-    rec->n_rescued += n;
-    for (i = 0; i < 3; ++i)
-    {
-        c->sums[slot][i] += sum[i];
-        rec->min_4mm[i] = lo[i] < rec->min_4mm[i] ? lo[i] : rec->min_4mm[i];
-        rec->max_4mm[i] = hi[i] > rec->max_4mm[i] ? hi[i] : rec->max_4mm[i];
-    }
-    mean_of(c->sums[slot], rec->n_points, rec->mean_4mm);
-    for (i = start; i < tail; ++i)
-    {
-        c->labels[c->members[i]] = (uint16_t)(slot + 1u);
-    }
-    rec->seed_pixel = seed < rec->seed_pixel ? seed : rec->seed_pixel;
-    rec->height_4mm = height_q(c, rec->seed_pixel, rec->mean_4mm, planes, n_sectors);
-    ++st->n_rescue_joined;
-    st->n_rescue_pixels += n;
-}
 
 lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t *labels, int32_t *members,
                                            const lidet_range_image_t *img, const uint8_t *ground_mask,

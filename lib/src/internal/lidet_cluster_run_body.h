@@ -7,9 +7,19 @@
  *                                labels, members; records n_points, first_member, seed_pixel);
  *   RUN_PARAM_T, RUN_PLANE_T     the flood fill's constants and the ground plane type;
  *   RUN_GROW(c, g, start, tail)  the first fill of one component (returns the new tail);
- *   RUN_FINISH(c, start, tail, planes, n_sectors, st, rescue)  filters and records (returns the new tail);
  *   RUN_RESCUE_T, RUN_RESCUE_FAR  the rescue group's running state and its "no contact yet" distance;
- *   RUN_RESCUE_GROW(c, g, start, rs), RUN_RESCUE_JOIN(c, slot, start, tail, planes, n_sectors, st).
+ *   RUN_RESCUE_GROW(c, g, start, rs);
+ * and the numeric kernels of the filters and records, static functions of the including file:
+ *   RUN_SUMMARY_T                          what one pass over a component's members gives (sums, bounds, mean,
+ *                                          height);
+ *   int summarise(c, start, tail, small, s)  sums and bounds; nonzero when an extent exceeds the limit
+ *                                          (small: no limit);
+ *   int mean_height_ok(c, n, seed, s, planes, n_sectors)  the mean and its height; nonzero when it passes;
+ *   void record_numbers(c, slot, s)        the record's numeric fields from s;
+ *   void join_numbers(c, slot, n, s)       a rescue group of n pixels added to the record's numbers (before
+ *                                          its count grows);
+ *   void reheight(c, slot, planes, n_sectors)  the record's height from its mean and seed;
+ *   int rescue_on(c)                       the fragment rescue is configured.
  * Not a public header; include nowhere else. */
 
 #define RUN_NO_SLOT 0xFFFFFFFFu
@@ -204,6 +214,97 @@ static uint32_t next_fragment(const uint16_t *lab, uint32_t p, uint32_t npix)
 }
 
 
+/* filters + bookkeeping of the component members[start, tail); returns the new tail. rescue = 0:
+ * a component of the first fill (one below min_points becomes a fragment when the rescue is on);
+ * 1: a rescue group that joined no cluster (dropped when small; takes only a free slot) */
+static uint32_t finish_cluster(RUN_STATE_T *c, uint32_t start, uint32_t tail, const RUN_PLANE_T *planes,
+                               uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue)
+{
+    const uint32_t n = tail - start;
+    const int32_t *mem = c->members;
+    RUN_SUMMARY_T sm;
+    uint32_t i, slot;
+    int small;
+    RUN_REC_T *rec;
+
+    if (!rescue)
+    {
+        ++st->n_found;
+    }
+    small = n < c->cfg.min_points;
+    if (small && (rescue || !rescue_on(c)))
+    {
+        ++st->n_dropped_small;
+        return start;
+    }
+    /* the same filters for a fragment-to-be (small: no extent limit), so that one above the height
+     * limit (canopies, wires: nothing a road user would take in) never reaches the rescue; it saves
+     * a third of the rescue's work */
+    if (summarise(c, start, tail, small, &sm))
+    {
+        ++st->n_dropped_extent;
+        return start;
+    }
+    if (!mean_height_ok(c, n, (uint32_t)mem[start], &sm, planes, n_sectors))
+    {
+        ++st->n_dropped_height;
+        return start;
+    }
+    if (small)
+    {
+        ++st->n_fragments;
+        for (i = start; i < tail; ++i)
+        {
+            c->labels[mem[i]] = (uint16_t)LAB_SMALL;
+        }
+        return start;
+    }
+    slot = claim_slot(c, n, rescue, st);
+    if (slot == RUN_NO_SLOT)
+    {
+        return start;
+    }
+    rec = &c->recs[slot];
+    rec->n_points = n;
+    rec->first_member = start;
+    rec->seed_pixel = (uint32_t)mem[start];
+    rec->n_rescued = rescue ? n : 0u;
+    record_numbers(c, slot, &sm);
+    if (rescue)
+    {
+        st->n_rescue_pixels += n;
+    }
+    for (i = start; i < tail; ++i)
+    {
+        c->labels[mem[i]] = (uint16_t)(slot + 1u);
+    }
+    return tail;
+}
+
+/* a rescue group members[start, tail) joins kept cluster `slot`: count, bounds and mean are updated and the
+ * height recomputed (no filter). The group's seed is its first pixel in raster order, so the cluster's first
+ * pixel is the smaller of the two seeds (the height uses that pixel's sector, as for any cluster) */
+static void rescue_join(RUN_STATE_T *c, uint32_t slot, uint32_t start, uint32_t tail, const RUN_PLANE_T *planes,
+                        uint32_t n_sectors, lidet_cluster_stats_t *st)
+{
+    RUN_REC_T *rec = &c->recs[slot];
+    const uint32_t n = tail - start, seed = (uint32_t)c->members[start];
+    RUN_SUMMARY_T sm;
+    uint32_t i;
+    (void)summarise(c, start, tail, 1, &sm);
+    join_numbers(c, slot, n, &sm);
+    for (i = start; i < tail; ++i)
+    {
+        c->labels[c->members[i]] = (uint16_t)(slot + 1u);
+    }
+    rec->n_points += n;
+    rec->n_rescued += n;
+    rec->seed_pixel = seed < rec->seed_pixel ? seed : rec->seed_pixel;
+    reheight(c, slot, planes, n_sectors);
+    ++st->n_rescue_joined;
+    st->n_rescue_pixels += n;
+}
+
 /* the whole run after the candidates are marked in labels (FREE / NONCAND) and the stats zeroed but
  * n_candidates: the first fill in raster order, the rescue pass over the fragments (LAB_SMALL), groups
  * seeded in raster order (kept pixels, the fragments and the current group are distinct pixels, so the
@@ -220,7 +321,7 @@ static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, uint32_t npix, cons
         lab[p] = (uint16_t)LAB_PENDING;
         mem[tail++] = (int32_t)p;
         tail = RUN_GROW(c, lk, start, tail);
-        tail = RUN_FINISH(c, start, tail, planes, n_sectors, st, 0);
+        tail = finish_cluster(c, start, tail, planes, n_sectors, st, 0);
     }
     if (st->n_fragments > 0u)
     {
@@ -236,12 +337,12 @@ static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, uint32_t npix, cons
             RUN_RESCUE_GROW(c, lk, start, &rs);
             if (rs.best != 0u)
             {
-                RUN_RESCUE_JOIN(c, rs.best - 1u, start, rs.tail, planes, n_sectors, st);
+                rescue_join(c, rs.best - 1u, start, rs.tail, planes, n_sectors, st);
                 tail = start;
             }
             else
             {
-                tail = RUN_FINISH(c, start, rs.tail, planes, n_sectors, st, 1);
+                tail = finish_cluster(c, start, rs.tail, planes, n_sectors, st, 1);
             }
         }
     }
