@@ -52,6 +52,8 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->rescue_cols = 6u;
 }
 
+static lidet_status_t init_done(lidet_cluster_state_t *c); /* lidet_cluster_run_body.h */
+
 lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cluster_cfg_t *cfg)
 {
     if (c == 0 || cfg == 0)
@@ -73,15 +75,7 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
     }
     c->cfg = *cfg;
     c->tan_theta = tanf(cfg->theta_rad);
-    c->geo_rows = 0;
-    c->geo_cols = 0;
-    c->n_recs = 0;
-    c->labels = 0;
-    c->members = 0;
-    memset(&c->img, 0, sizeof c->img);
-    memset(&c->stats, 0, sizeof c->stats);
-    c->magic = LIDET_INIT_MAGIC;
-    return LIDET_OK;
+    return init_done(c);
 }
 
 
@@ -179,21 +173,15 @@ static int mean_height_ok(const lidet_cluster_state_t *c, uint32_t n, uint32_t s
     return s->h <= c->cfg.max_mean_height_m;
 }
 
-static void record_numbers(lidet_cluster_state_t *c, uint32_t slot, const summary_t *s)
+static void record_sums(lidet_cluster_state_t *c, uint32_t slot, const summary_t *s)
 {
-    lidet_cluster_rec_t *rec = &c->recs[slot];
-    uint32_t i;
-    for (i = 0; i < 3; ++i)
-    {
-        rec->mean_m[i] = s->mean[i];
-        rec->min_m[i] = s->lo[i];
-        rec->max_m[i] = s->hi[i];
-    }
-    rec->height_m = s->h;
+    (void)c; /* the float record keeps its mean only */
+    (void)slot;
+    (void)s;
 }
 
 /* mean = (mean * n_old + group sum) / n_new, in float */
-static void join_numbers(lidet_cluster_state_t *c, uint32_t slot, uint32_t n, const summary_t *s)
+static void join_mean(lidet_cluster_state_t *c, uint32_t slot, uint32_t n, const summary_t *s)
 {
     lidet_cluster_rec_t *rec = &c->recs[slot];
     const float inv = 1.0f / (float)(rec->n_points + n);
@@ -201,8 +189,6 @@ static void join_numbers(lidet_cluster_state_t *c, uint32_t slot, uint32_t n, co
     for (i = 0; i < 3; ++i)
     {
         rec->mean_m[i] = (rec->mean_m[i] * (float)rec->n_points + s->sum[i]) * inv;
-        rec->min_m[i] = s->lo[i] < rec->min_m[i] ? s->lo[i] : rec->min_m[i];
-        rec->max_m[i] = s->hi[i] > rec->max_m[i] ? s->hi[i] : rec->max_m[i];
     }
 }
 
@@ -224,6 +210,10 @@ static int rescue_on(const lidet_cluster_state_t *c)
 #define RUN_PARAM_T lidet__grow_t
 #define RUN_PLANE_T lidet_plane_t
 #define RUN_SUMMARY_T summary_t
+#define RUN_MEAN(r) ((r)->mean_m)
+#define RUN_MIN(r) ((r)->min_m)
+#define RUN_MAX(r) ((r)->max_m)
+#define RUN_HEIGHT(r) ((r)->height_m)
 #define RUN_GROW lidet__cluster_grow
 #define RUN_RESCUE_T lidet__rescue_t
 #define RUN_RESCUE_FAR 3.0e38f
@@ -239,31 +229,20 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     lidet__grow_t lk;
     lidet_cluster_stats_t st;
 
-    if (c == 0 || labels == 0 || members == 0 || img == 0 || (planes != 0 && n_sectors == 0))
+    const lidet_status_t chk = run_check(c, labels, members, img, planes, n_sectors);
+    if (chk != LIDET_OK)
     {
-        return LIDET_ERR_ARG;
-    }
-    if (c->magic != LIDET_INIT_MAGIC)
-    {
-        return LIDET_ERR_STATE;
+        return chk;
     }
     rows = img->n_rows;
     cols = img->n_cols;
-    if (rows < 1 || cols < 2 || rows > LIDET_MAX_ROWS || cols > LIDET_MAX_COLS)
-    {
-        return LIDET_ERR_BUFFER;
-    }
     if (img->row_elev_rad == 0 || !lidet__img_complete(img))
     {
         return LIDET_ERR_ARG;
     }
     npix = rows * cols;
     lidet__cluster_setup_geometry(c, img);
-    c->img = *img;
-    c->labels = labels;
-    c->members = members;
-    c->n_recs = 0;
-    memset(&st, 0, sizeof st);
+    run_bind(c, labels, members, img, &st);
     lab = c->labels;
     LIDET__GROW_GEOMETRY(lk, rows, cols, c->cfg);
     lk.tan_theta = c->tan_theta;
@@ -354,16 +333,7 @@ const lidet_cluster_stats_t *lidet_cluster_stats(const lidet_cluster_t *c)
 lidet_status_t lidet_cluster_point_labels_of(const lidet_cluster_state_t *c, const int32_t *point_pixel,
                                              uint32_t n_points, uint32_t *out)
 {
-    if (c == 0 || ((point_pixel == 0 || out == 0) && n_points > 0))
-    {
-        return LIDET_ERR_ARG;
-    }
-    if (c->magic != LIDET_INIT_MAGIC || c->labels == 0)
-    {
-        return LIDET_ERR_STATE;
-    }
-    lidet__cluster_point_labels(c->labels, (uint32_t)c->img.n_rows * c->img.n_cols, point_pixel, n_points, out);
-    return LIDET_OK;
+    return labels_of_points(c, point_pixel, n_points, out);
 }
 
 lidet_status_t lidet_cluster_point_labels(const lidet_cluster_t *c, const int32_t *point_pixel,

@@ -35,6 +35,8 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     cfg->rescue_cols = 6u;
 }
 
+static lidet_status_t init_done(lidet_cluster_q_state_t *c); /* lidet_cluster_run_body.h */
+
 lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lidet_cluster_q_cfg_t *cfg)
 {
     if (c == 0 || cfg == 0)
@@ -53,15 +55,7 @@ lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lide
     c->cfg = *cfg;
     c->theta_bam = lidet__q_urad_to_bam((int32_t)cfg->theta_urad);
     c->sin_theta_q16 = (uint32_t)lidet__q_rshift_round(lidet__q_sin((uint32_t)c->theta_bam), 14);
-    c->geo_rows = 0;
-    c->geo_cols = 0;
-    c->n_recs = 0;
-    c->labels = 0;
-    c->members = 0;
-    memset(&c->img, 0, sizeof c->img);
-    memset(&c->stats, 0, sizeof c->stats);
-    c->magic = LIDET_INIT_MAGIC;
-    return LIDET_OK;
+    return init_done(c);
 }
 
 lidet_status_t lidet_cluster_q_init(lidet_cluster_q_t *c, const lidet_cluster_q_cfg_t *cfg)
@@ -162,32 +156,24 @@ static int mean_height_ok(const lidet_cluster_q_state_t *c, uint32_t n, uint32_t
     return (int64_t)s->h * 4 <= c->cfg.max_mean_height_mm;
 }
 
-static void record_numbers(lidet_cluster_q_state_t *c, uint32_t slot, const summary_q_t *s)
+static void record_sums(lidet_cluster_q_state_t *c, uint32_t slot, const summary_q_t *s)
 {
-    lidet_cluster_q_rec_t *rec = &c->recs[slot];
     uint32_t i;
     for (i = 0; i < 3; ++i)
     {
         c->sums[slot][i] = s->sum[i];
-        rec->mean_4mm[i] = s->mean[i];
-        rec->min_4mm[i] = s->lo[i];
-        rec->max_4mm[i] = s->hi[i];
     }
-    rec->height_4mm = s->h;
 }
 
 /* the group's sums are added: the mean is the rounded mean of all members, exactly */
-static void join_numbers(lidet_cluster_q_state_t *c, uint32_t slot, uint32_t n, const summary_q_t *s)
+static void join_mean(lidet_cluster_q_state_t *c, uint32_t slot, uint32_t n, const summary_q_t *s)
 {
-    lidet_cluster_q_rec_t *rec = &c->recs[slot];
     uint32_t i;
     for (i = 0; i < 3; ++i)
     {
         c->sums[slot][i] += s->sum[i];
-        rec->min_4mm[i] = s->lo[i] < rec->min_4mm[i] ? s->lo[i] : rec->min_4mm[i];
-        rec->max_4mm[i] = s->hi[i] > rec->max_4mm[i] ? s->hi[i] : rec->max_4mm[i];
     }
-    mean_of(c->sums[slot], rec->n_points + n, rec->mean_4mm);
+    mean_of(c->sums[slot], c->recs[slot].n_points + n, c->recs[slot].mean_4mm);
 }
 
 static void reheight(lidet_cluster_q_state_t *c, uint32_t slot, const lidet_plane_q_t *planes, uint32_t n_sectors)
@@ -208,6 +194,10 @@ static int rescue_on(const lidet_cluster_q_state_t *c)
 #define RUN_PARAM_T lidet__grow_q_t
 #define RUN_PLANE_T lidet_plane_q_t
 #define RUN_SUMMARY_T summary_q_t
+#define RUN_MEAN(r) ((r)->mean_4mm)
+#define RUN_MIN(r) ((r)->min_4mm)
+#define RUN_MAX(r) ((r)->max_4mm)
+#define RUN_HEIGHT(r) ((r)->height_4mm)
 #define RUN_GROW lidet__cluster_q_grow
 #define RUN_RESCUE_T lidet__rescue_q_t
 #define RUN_RESCUE_FAR 0xFFFFFFFFu
@@ -218,37 +208,24 @@ lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t 
                                            const lidet_range_image_t *img, const uint8_t *ground_mask,
                                            const lidet_plane_q_t *planes, uint32_t n_sectors)
 {
-    uint32_t rows, cols, npix;
     lidet__grow_q_t lk;
     lidet_cluster_stats_t st;
-
-    if (c == 0 || labels == 0 || members == 0 || img == 0 || (planes != 0 && n_sectors == 0))
+    uint32_t npix;
+    lidet_status_t chk = run_check(c, labels, members, img, planes, n_sectors);
+    /* a compact image with its BAM32 elevations */
+    if (chk == LIDET_OK && (img->x_m != 0 || img->x_4mm == 0 || img->y_4mm == 0 || img->z_4mm == 0 ||
+                            img->range_4mm == 0 || img->row_elev_bam == 0))
     {
-        return LIDET_ERR_ARG;
+        chk = LIDET_ERR_ARG;
     }
-    if (c->magic != LIDET_INIT_MAGIC)
+    if (chk != LIDET_OK)
     {
-        return LIDET_ERR_STATE;
+        return chk;
     }
-    rows = img->n_rows;
-    cols = img->n_cols;
-    if (rows < 1 || cols < 2 || rows > LIDET_MAX_ROWS || cols > LIDET_MAX_COLS)
-    {
-        return LIDET_ERR_BUFFER;
-    }
-    if (img->x_m != 0 || img->x_4mm == 0 || img->y_4mm == 0 || img->z_4mm == 0 || img->range_4mm == 0 ||
-        img->row_elev_bam == 0)
-    {
-        return LIDET_ERR_ARG;
-    }
-    npix = rows * cols;
+    npix = (uint32_t)img->n_rows * img->n_cols;
     lidet__cluster_q_setup_geometry(c, img);
-    c->img = *img;
-    c->labels = labels;
-    c->members = members;
-    c->n_recs = 0;
-    memset(&st, 0, sizeof st);
-    LIDET__GROW_GEOMETRY(lk, rows, cols, c->cfg);
+    run_bind(c, labels, members, img, &st);
+    LIDET__GROW_GEOMETRY(lk, img->n_rows, img->n_cols, c->cfg);
     lk.sin_t = c->sin_theta_q16;
     lk.gap_on = c->cfg.max_gap_mm > 0u;
     lk.gap = (uint32_t)lidet__q_div_round((int64_t)c->cfg.max_gap_mm, 4);
@@ -271,16 +248,7 @@ lidet_status_t lidet_cluster_q_run(lidet_cluster_q_t *c, const lidet_range_image
 lidet_status_t lidet_cluster_q_point_labels(const lidet_cluster_q_state_t *c, const int32_t *point_pixel,
                                             uint32_t n_points, uint32_t *out)
 {
-    if (c == 0 || ((point_pixel == 0 || out == 0) && n_points > 0))
-    {
-        return LIDET_ERR_ARG;
-    }
-    if (c->magic != LIDET_INIT_MAGIC || c->labels == 0)
-    {
-        return LIDET_ERR_STATE;
-    }
-    lidet__cluster_point_labels(c->labels, (uint32_t)c->img.n_rows * c->img.n_cols, point_pixel, n_points, out);
-    return LIDET_OK;
+    return labels_of_points(c, point_pixel, n_points, out);
 }
 
 uint32_t lidet_cluster_q_bytes(void)

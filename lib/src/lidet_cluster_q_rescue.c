@@ -60,16 +60,7 @@ static inline void probe_q(lidet_cluster_q_state_t *c, lidet__rescue_q_t *rs, co
     {
         return;
     }
-    if (l == LAB_SMALL)
-    {
-        c->labels[n] = (uint16_t)LAB_PENDING;
-        c->members[rs->tail++] = (int32_t)n;
-    }
-    else if (dd < rs->best_d2)
-    {
-        rs->best_d2 = dd;
-        rs->best = l;
-    }
+    LIDET__RESCUE_ACCEPT(c, rs, n, l, dd);
 }
 
 /* the window walk (lidet_cluster_rescue_body.h) with the integer stage's types */

@@ -26,16 +26,7 @@ static inline void rescue_link(lidet_cluster_state_t *c, lidet__rescue_t *rs, ui
     {
         return;
     }
-    if (l == LAB_SMALL)
-    {
-        c->labels[n] = (uint16_t)LAB_PENDING;
-        c->members[rs->tail++] = (int32_t)n;
-    }
-    else if (dd < rs->best_d2)
-    {
-        rs->best_d2 = dd;
-        rs->best = l;
-    }
+    LIDET__RESCUE_ACCEPT(c, rs, n, l, dd);
 }
 
 /* The group pixel q whose window is looked at: its range dq and the ranges [lo, hi] whose difference

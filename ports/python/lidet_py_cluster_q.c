@@ -135,6 +135,129 @@ static void compact_view(lidet_range_image_t *img, uint32_t rows, uint32_t cols,
     img->row_elev_bam = elev_bam;
 }
 
+/* One stage on a compact image through its own functions, so both bindings below share the driver: init, the
+ * timed runs, the counts, then emit(i) for every kept cluster (its record and proposal into the outputs). */
+typedef struct
+{
+    void *st;          /* the stage's state (heap) */
+    const void *cfg;   /* its configuration */
+    const void *pcfg;  /* its proposal configuration */
+    void *out;         /* the binding's outputs */
+    int (*init)(void *st, const void *cfg);
+    int (*run)(void *st, uint16_t *labels, int32_t *members, const lidet_range_image_t *img, const uint8_t *ground,
+               const void *planes, uint32_t n_sectors);
+    uint32_t (*count)(const void *st, lidet_cluster_stats_t *stats);
+    int (*emit)(const void *st, const void *pcfg, void *out, uint32_t i);
+} stage_t;
+
+static int run_stage(const stage_t *s, const lidet_range_image_t *img, const uint8_t *ground, const void *planes,
+                     uint32_t n_sectors, uint32_t repeat, uint16_t *out_labels, int32_t *out_members,
+                     uint32_t *out_nrec, lidet_cluster_stats_t *out_stats, uint64_t *out_ns)
+{
+    uint32_t i, k;
+    int rc = s->init(s->st, s->cfg);
+    for (i = 0; rc >= 0 && i < (repeat > 0u ? repeat : 1u); ++i)
+    {
+        const uint64_t t0 = now_ns();
+        rc = s->run(s->st, out_labels, out_members, img, ground, planes, n_sectors);
+        out_ns[i] = now_ns() - t0;
+    }
+    if (rc < 0)
+    {
+        return rc;
+    }
+    k = s->count(s->st, out_stats);
+    *out_nrec = k;
+    for (i = 0; i < k; ++i)
+    {
+        const int rp = s->emit(s->st, s->pcfg, s->out, i);
+        if (rp < 0)
+        {
+            return rp;
+        }
+    }
+    return rc;
+}
+
+/* run_stage on a compact image view of the arrays and a freshly allocated state of state_bytes (freed after) */
+static int run_entry(stage_t *s, size_t state_bytes, const void *cfg, const void *pcfg, void *out, uint32_t rows,
+                     uint32_t cols, const int16_t *x, const int16_t *y, const int16_t *z, const uint16_t *rng,
+                     const float *elev_rad, const int32_t *elev_bam, const uint8_t *ground, const void *planes,
+                     uint32_t n_sectors, uint32_t repeat, uint16_t *out_labels, int32_t *out_members,
+                     uint32_t *out_nrec, lidet_cluster_stats_t *out_stats, uint64_t *out_ns)
+{
+    lidet_range_image_t img;
+    int rc = LIDET_ERR_ARG;
+    s->cfg = cfg;
+    s->pcfg = pcfg;
+    s->out = out;
+    s->st = malloc(state_bytes);
+    compact_view(&img, rows, cols, x, y, z, rng, elev_rad, elev_bam);
+    if (s->st != NULL && cfg != NULL && pcfg != NULL)
+    {
+        rc = run_stage(s, &img, ground, planes, n_sectors, repeat, out_labels, out_members, out_nrec, out_stats,
+                       out_ns);
+    }
+    free(s->st);
+    return rc;
+}
+
+/* a stage's init, run and count behind the stage_t signatures */
+#define STAGE_ADAPTERS(prefix, state_t, init_fn, run_fn, cfg_t, plane_t)                                           \
+    static int prefix##_init(void *st, const void *cfg)                                                      \
+    {                                                                                                        \
+        return init_fn((state_t *)st, (const cfg_t *)cfg);                                                   \
+    }                                                                                                        \
+    static int prefix##_run(void *st, uint16_t *labels, int32_t *members, const lidet_range_image_t *img,    \
+                            const uint8_t *ground, const void *planes, uint32_t n_sectors)                   \
+    {                                                                                                        \
+        return run_fn((state_t *)st, labels, members, img, ground, (const plane_t *)planes, n_sectors);      \
+    }                                                                                                        \
+    static uint32_t prefix##_count(const void *st, lidet_cluster_stats_t *stats)                             \
+    {                                                                                                        \
+        *stats = ((const state_t *)st)->stats;                                                               \
+        return ((const state_t *)st)->n_recs;                                                                \
+    }
+
+/* ---- the integer stage ---- */
+
+typedef struct
+{
+    int32_t *recs; /* LIDET_MAX_CLUSTERS * CQ_REC_INTS */
+    int16_t *pxyz;
+    int32_t *pmean;
+    int16_t *pvox;
+    lidet_proposal_q_t pr;
+} q_out_t;
+
+STAGE_ADAPTERS(q, lidet_cluster_q_state_t, lidet_cluster_q_state_init, lidet_cluster_q_run_buffers,
+               lidet_cluster_q_cfg_t, lidet_plane_q_t)
+
+static int q_emit(const void *st, const void *pcfg, void *out, uint32_t i)
+{
+    const lidet_cluster_q_rec_t *r = &((const lidet_cluster_q_state_t *)st)->recs[i];
+    const lidet_proposal_q_cfg_t *pc = pcfg;
+    q_out_t *o = out;
+    int32_t *v = o->recs + i * CQ_REC_INTS;
+    uint32_t a;
+    const int rc = lidet_proposal_q_make(st, i, pc, &o->pr);
+    v[0] = (int32_t)r->n_points;
+    v[1] = (int32_t)r->first_member;
+    v[2] = (int32_t)r->seed_pixel;
+    v[3] = (int32_t)r->n_rescued;
+    for (a = 0; a < 3; ++a)
+    {
+        v[4 + a] = r->mean_4mm[a];
+        v[7 + a] = r->min_4mm[a];
+        v[10 + a] = r->max_4mm[a];
+        o->pmean[i * 3u + a] = o->pr.mean_4mm[a];
+        o->pvox[i * 3u + a] = o->pr.voxel[a];
+    }
+    v[13] = r->height_4mm;
+    memcpy(o->pxyz + (size_t)i * pc->n_points * 3u, o->pr.xyz, pc->n_points * 3u * sizeof(int16_t));
+    return rc;
+}
+
 /* The integer clustering of a compact image, `repeat` times (out_ns: each run's nanoseconds), then the
  * proposals of every kept cluster. planes_q: n_sectors * 4 int32 (nx, ny, nz Q30, d_4mm) or NULL. Outputs:
  * labels rows * cols, members rows * cols, recs LIDET_MAX_CLUSTERS * CQ_REC_INTS (n_points, first_member,
@@ -148,63 +271,52 @@ LIDET_PY_API int lidet_py_cluster_q_run(uint32_t rows, uint32_t cols, const int1
                                         int32_t *out_recs, uint32_t *out_nrec, lidet_cluster_stats_t *out_stats,
                                         int16_t *out_pxyz, int32_t *out_pmean, int16_t *out_pvox, uint64_t *out_ns)
 {
-    lidet_cluster_q_state_t *st = malloc(sizeof *st);
-    lidet_proposal_q_t *pr = malloc(sizeof *pr);
-    lidet_range_image_t img;
-    uint32_t i, k, a;
-    int rc = LIDET_ERR_ARG;
-    if (st == NULL || pr == NULL || cfg == NULL || pcfg == NULL)
+    static q_out_t o; /* the proposal scratch (host bindings: one call at a time) */
+    stage_t s = {NULL, NULL, NULL, NULL, q_init, q_run, q_count, q_emit};
+    o.recs = out_recs;
+    o.pxyz = out_pxyz;
+    o.pmean = out_pmean;
+    o.pvox = out_pvox;
+    return run_entry(&s, sizeof(lidet_cluster_q_state_t), cfg, pcfg, &o, rows, cols, x, y, z, rng, NULL, elev_bam,
+                     ground, planes_q, n_sectors, repeat, out_labels, out_members, out_nrec, out_stats, out_ns);
+}
+
+/* ---- the float stage on the same image ---- */
+
+typedef struct
+{
+    uint32_t *ru; /* LIDET_MAX_CLUSTERS * 4 */
+    float *rf;    /* LIDET_MAX_CLUSTERS * 10 */
+    float *pxyz;
+    float *pmean;
+    int16_t *pvox;
+    lidet_proposal_t pr;
+} f_out_t;
+
+STAGE_ADAPTERS(f, lidet_cluster_state_t, lidet_cluster_state_init, lidet_cluster_run_buffers, lidet_cluster_cfg_t,
+               lidet_plane_t)
+
+static int f_emit(const void *st, const void *pcfg, void *out, uint32_t i)
+{
+    const lidet_cluster_rec_t *r = &((const lidet_cluster_state_t *)st)->recs[i];
+    const lidet_proposal_cfg_t *pc = pcfg;
+    f_out_t *o = out;
+    uint32_t a;
+    const int rc = lidet_proposal_make_of(st, i, pc, &o->pr);
+    o->ru[i * 4u] = r->n_points;
+    o->ru[i * 4u + 1u] = r->first_member;
+    o->ru[i * 4u + 2u] = r->seed_pixel;
+    o->ru[i * 4u + 3u] = r->n_rescued;
+    for (a = 0; a < 3; ++a)
     {
-        goto done;
+        o->rf[i * 10u + a] = r->mean_m[a];
+        o->rf[i * 10u + 3u + a] = r->min_m[a];
+        o->rf[i * 10u + 6u + a] = r->max_m[a];
+        o->pmean[i * 3u + a] = o->pr.mean_m[a];
+        o->pvox[i * 3u + a] = o->pr.voxel[a];
     }
-    compact_view(&img, rows, cols, x, y, z, rng, NULL, elev_bam);
-    rc = lidet_cluster_q_state_init(st, cfg);
-    for (i = 0; rc >= 0 && i < (repeat > 0u ? repeat : 1u); ++i)
-    {
-        const uint64_t t0 = now_ns();
-        rc = lidet_cluster_q_run_buffers(st, out_labels, out_members, &img, ground, (const lidet_plane_q_t *)planes_q,
-                                         n_sectors);
-        out_ns[i] = now_ns() - t0;
-    }
-    if (rc < 0)
-    {
-        goto done;
-    }
-    k = st->n_recs;
-    *out_nrec = k;
-    *out_stats = st->stats;
-    for (i = 0; i < k; ++i)
-    {
-        const lidet_cluster_q_rec_t *r = &st->recs[i];
-        int32_t *o = out_recs + i * CQ_REC_INTS;
-        int rp;
-        o[0] = (int32_t)r->n_points;
-        o[1] = (int32_t)r->first_member;
-        o[2] = (int32_t)r->seed_pixel;
-        o[3] = (int32_t)r->n_rescued;
-        for (a = 0; a < 3; ++a)
-        {
-            o[4 + a] = r->mean_4mm[a];
-            o[7 + a] = r->min_4mm[a];
-            o[10 + a] = r->max_4mm[a];
-        }
-        o[13] = r->height_4mm;
-        rp = lidet_proposal_q_make(st, i, pcfg, pr);
-        if (rp < 0)
-        {
-            rc = rp;
-            goto done;
-        }
-        memcpy(out_pxyz + (size_t)i * pcfg->n_points * 3u, pr->xyz, pcfg->n_points * 3u * sizeof(int16_t));
-        for (a = 0; a < 3; ++a)
-        {
-            out_pmean[i * 3u + a] = pr->mean_4mm[a];
-            out_pvox[i * 3u + a] = pr->voxel[a];
-        }
-    }
-done:
-    free(st);
-    free(pr);
+    o->rf[i * 10u + 9u] = r->height_m;
+    memcpy(o->pxyz + (size_t)i * pc->n_points * 3u, o->pr.xyz, pc->n_points * 3u * sizeof(float));
     return rc;
 }
 
@@ -220,61 +332,13 @@ LIDET_PY_API int lidet_py_cluster_f_compact(uint32_t rows, uint32_t cols, const 
                                             lidet_cluster_stats_t *out_stats, float *out_pxyz, float *out_pmean,
                                             int16_t *out_pvox, uint64_t *out_ns)
 {
-    lidet_cluster_state_t *st = malloc(sizeof *st);
-    lidet_proposal_t *pr = malloc(sizeof *pr);
-    lidet_range_image_t img;
-    uint32_t i, k, a;
-    int rc = LIDET_ERR_ARG;
-    if (st == NULL || pr == NULL || cfg == NULL || pcfg == NULL)
-    {
-        goto done;
-    }
-    compact_view(&img, rows, cols, x, y, z, rng, elev_rad, elev_bam);
-    rc = lidet_cluster_state_init(st, cfg);
-    for (i = 0; rc >= 0 && i < (repeat > 0u ? repeat : 1u); ++i)
-    {
-        const uint64_t t0 = now_ns();
-        rc = lidet_cluster_run_buffers(st, out_labels, out_members, &img, ground, (const lidet_plane_t *)planes,
-                                       n_sectors);
-        out_ns[i] = now_ns() - t0;
-    }
-    if (rc < 0)
-    {
-        goto done;
-    }
-    k = st->n_recs;
-    *out_nrec = k;
-    *out_stats = st->stats;
-    for (i = 0; i < k; ++i)
-    {
-        const lidet_cluster_rec_t *r = &st->recs[i];
-        int rp;
-        out_ru[i * 4u] = r->n_points;
-        out_ru[i * 4u + 1u] = r->first_member;
-        out_ru[i * 4u + 2u] = r->seed_pixel;
-        out_ru[i * 4u + 3u] = r->n_rescued;
-        for (a = 0; a < 3; ++a)
-        {
-            out_rf[i * 10u + a] = r->mean_m[a];
-            out_rf[i * 10u + 3u + a] = r->min_m[a];
-            out_rf[i * 10u + 6u + a] = r->max_m[a];
-        }
-        out_rf[i * 10u + 9u] = r->height_m;
-        rp = lidet_proposal_make_of(st, i, pcfg, pr);
-        if (rp < 0)
-        {
-            rc = rp;
-            goto done;
-        }
-        memcpy(out_pxyz + (size_t)i * pcfg->n_points * 3u, pr->xyz, pcfg->n_points * 3u * sizeof(float));
-        for (a = 0; a < 3; ++a)
-        {
-            out_pmean[i * 3u + a] = pr->mean_m[a];
-            out_pvox[i * 3u + a] = pr->voxel[a];
-        }
-    }
-done:
-    free(st);
-    free(pr);
-    return rc;
+    static f_out_t o; /* the proposal scratch (host bindings: one call at a time) */
+    stage_t s = {NULL, NULL, NULL, NULL, f_init, f_run, f_count, f_emit};
+    o.ru = out_ru;
+    o.rf = out_rf;
+    o.pxyz = out_pxyz;
+    o.pmean = out_pmean;
+    o.pvox = out_pvox;
+    return run_entry(&s, sizeof(lidet_cluster_state_t), cfg, pcfg, &o, rows, cols, x, y, z, rng, elev_rad, elev_bam,
+                     ground, planes, n_sectors, repeat, out_labels, out_members, out_nrec, out_stats, out_ns);
 }

@@ -190,8 +190,26 @@ class ClustersOnImage:
         return len(self.n_points)
 
 
-def _stats(rec) -> dict:
-    return native._to_dict(rec)
+def _outputs(rows: int, cols: int, npts: int, coord) -> dict:
+    """The arrays a clustering binding fills (capacity-sized; coord: the proposals' and means' dtype)."""
+    cap = native.capacity()["max_clusters"]
+    return {"lab": np.zeros((rows, cols), np.uint16), "mem": np.zeros(rows * cols, np.int32),
+            "nrec": np.zeros(1, np.uint32), "stats": native._record("lidet_cluster_stats_t"),
+            "pxyz": np.zeros((cap, npts, 3), np.int16 if coord == np.int32 else coord),
+            "pmean": np.zeros((cap, 3), coord), "pvox": np.zeros((cap, 3), np.int16)}
+
+
+def _result(o: dict, st: int, what: str, ints, floats, ns) -> ClustersOnImage:
+    """ClustersOnImage from the filled arrays: ints (K, >= 4) n_points, first_member, seed_pixel, n_rescued;
+    floats (K, 10) mean, min, max, height (the same array as ints for the integer stage)."""
+    if st < 0:
+        raise native.LidetError(st, what)
+    k = int(o["nrec"][0])
+    sd = native._to_dict(o["stats"])
+    i, f = ints[:k], floats[:k]
+    return ClustersOnImage(o["lab"], o["mem"][: sd["n_pixels_kept"]].copy(), *(i[:, j].copy() for j in range(4)),
+                           f[:, 0:3].copy(), f[:, 3:6].copy(), f[:, 6:9].copy(), f[:, 9].copy(), sd, int(st),
+                           o["pxyz"][:k].copy(), o["pmean"][:k].copy(), o["pvox"][:k].copy(), ns)
 
 
 def cluster_q(scan: CompactScan, planes_q=None, use_ground: bool = True, repeat: int = 1, proposal_cfg=None,
@@ -204,28 +222,15 @@ def cluster_q(scan: CompactScan, planes_q=None, use_ground: bool = True, repeat:
     p = _cfg_array(PROPOSAL_Q_FIELDS, dp, proposal_cfg or {}, "lidet_proposal_q_cfg_t")
     rows, cols = scan.shape
     cap = native.capacity()["max_clusters"]
-    npts = int(p[0])
     pl = None if planes_q is None else np.ascontiguousarray(planes_q, np.int32).reshape(-1, 4)
-    lab = np.zeros((rows, cols), np.uint16)
-    mem = np.zeros(rows * cols, np.int32)
+    o = _outputs(rows, cols, int(p[0]), np.int32)
     recs = np.zeros((cap, 14), np.int32)
-    nrec = np.zeros(1, np.uint32)
-    stats = native._record("lidet_cluster_stats_t")
-    pxyz = np.zeros((cap, npts, 3), np.int16)
-    pmean = np.zeros((cap, 3), np.int32)
-    pvox = np.zeros((cap, 3), np.int16)
     ns = np.zeros(max(repeat, 1), np.uint64)
     st = L.lidet_py_cluster_q_run(rows, cols, scan.x, scan.y, scan.z, scan.range, scan.row_elev_bam,
                                   scan.ground if use_ground else None, pl, 0 if pl is None else len(pl), c, p, repeat,
-                                  lab, mem, recs, nrec, native._addr(stats), pxyz, pmean, pvox, ns)
-    if st < 0:
-        raise native.LidetError(st, "lidet_cluster_q_run")
-    k = int(nrec[0])
-    sd = _stats(stats)
-    r = recs[:k]
-    return ClustersOnImage(lab, mem[: sd["n_pixels_kept"]].copy(), r[:, 0].copy(), r[:, 1].copy(), r[:, 2].copy(),
-                           r[:, 3].copy(), r[:, 4:7].copy(), r[:, 7:10].copy(), r[:, 10:13].copy(), r[:, 13].copy(),
-                           sd, int(st), pxyz[:k].copy(), pmean[:k].copy(), pvox[:k].copy(), ns)
+                                  o["lab"], o["mem"], recs, o["nrec"], native._addr(o["stats"]), o["pxyz"], o["pmean"],
+                                  o["pvox"], ns)
+    return _result(o, st, "lidet_cluster_q_run", recs, recs[:, 4:14], ns)
 
 
 def cluster_f_compact(scan: CompactScan, planes=None, use_ground: bool = True, repeat: int = 1,
@@ -242,29 +247,16 @@ def cluster_f_compact(scan: CompactScan, planes=None, use_ground: bool = True, r
     pc.update(proposal_cfg or {})
     rows, cols = scan.shape
     cap = native.capacity()["max_clusters"]
-    npts = int(pc["n_points"])
     pl = None if planes is None else np.ascontiguousarray(planes, np.float32).reshape(-1, 4)
-    lab = np.zeros((rows, cols), np.uint16)
-    mem = np.zeros(rows * cols, np.int32)
+    o = _outputs(rows, cols, int(pc["n_points"]), np.float32)
     ru = np.zeros((cap, 4), np.uint32)
     rf = np.zeros((cap, 10), np.float32)
-    nrec = np.zeros(1, np.uint32)
-    stats = native._record("lidet_cluster_stats_t")
-    pxyz = np.zeros((cap, npts, 3), np.float32)
-    pmean = np.zeros((cap, 3), np.float32)
-    pvox = np.zeros((cap, 3), np.int16)
     ns = np.zeros(max(repeat, 1), np.uint64)
     st = L.lidet_py_cluster_f_compact(rows, cols, scan.x, scan.y, scan.z, scan.range, scan.row_elev_rad,
                                       scan.row_elev_bam, scan.ground if use_ground else None, pl,
                                       0 if pl is None else len(pl),
                                       native._addr(native._record("lidet_cluster_cfg_t", c)),
-                                      native._addr(native._record("lidet_proposal_cfg_t", pc)), repeat, lab, mem, ru,
-                                      rf, nrec, native._addr(stats), pxyz, pmean, pvox, ns)
-    if st < 0:
-        raise native.LidetError(st, "lidet_cluster_run (compact)")
-    k = int(nrec[0])
-    sd = _stats(stats)
-    return ClustersOnImage(lab, mem[: sd["n_pixels_kept"]].copy(), ru[:k, 0].copy(), ru[:k, 1].copy(),
-                           ru[:k, 2].copy(), ru[:k, 3].copy(), rf[:k, 0:3].copy(), rf[:k, 3:6].copy(),
-                           rf[:k, 6:9].copy(), rf[:k, 9].copy(), sd, int(st), pxyz[:k].copy(), pmean[:k].copy(),
-                           pvox[:k].copy(), ns)
+                                      native._addr(native._record("lidet_proposal_cfg_t", pc)), repeat, o["lab"],
+                                      o["mem"], ru, rf, o["nrec"], native._addr(o["stats"]), o["pxyz"], o["pmean"],
+                                      o["pvox"], ns)
+    return _result(o, st, "lidet_cluster_run (compact)", ru, rf, ns)

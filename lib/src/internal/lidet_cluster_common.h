@@ -63,6 +63,24 @@ static inline uint32_t lidet__cluster_mark_4mm(const uint16_t *rng, const uint8_
                              : 0u;                                                                             \
     } while (0)
 
+/* The rescue's verdict on window pixel n (label l) whose return lies within the rescue distance (dd its
+ * squared distance, in the stage's units): a fragment pixel joins the group (queued), a kept pixel is a
+ * contact (the nearest one wins, ties: the first met). For both stages' rescue_link / probe. */
+#define LIDET__RESCUE_ACCEPT(c, rs, n, l, dd)                                                                  \
+    do                                                                                                         \
+    {                                                                                                          \
+        if ((l) == LAB_SMALL)                                                                                  \
+        {                                                                                                      \
+            (c)->labels[n] = (uint16_t)LAB_PENDING;                                                            \
+            (c)->members[(rs)->tail++] = (int32_t)(n);                                                         \
+        }                                                                                                      \
+        else if ((dd) < (rs)->best_d2)                                                                         \
+        {                                                                                                      \
+            (rs)->best_d2 = (dd);                                                                              \
+            (rs)->best = (l);                                                                                  \
+        }                                                                                                      \
+    } while (0)
+
 /* Cluster id of every input point from the per-pixel ids (shared by both stages' point_labels). */
 static inline void lidet__cluster_point_labels(const uint16_t *labels, uint32_t npix, const int32_t *point_pixel,
                                                uint32_t n_points, uint32_t *out)

@@ -5,6 +5,8 @@
  * fill, rescue pass, canonical order). Nothing here reads a coordinate or a range. Parameters:
  *   RUN_STATE_T, RUN_REC_T       the state and its record type (members n_recs, recs, order, slot_id,
  *                                labels, members; records n_points, first_member, seed_pixel);
+ *   RUN_MEAN(r), RUN_MIN(r), RUN_MAX(r), RUN_HEIGHT(r)  a record's numeric fields (summary fields: lo, hi,
+ *                                mean, h);
  *   RUN_PARAM_T, RUN_PLANE_T     the flood fill's constants and the ground plane type;
  *   RUN_GROW(c, g, start, tail)  the first fill of one component (returns the new tail);
  *   RUN_RESCUE_T, RUN_RESCUE_FAR  the rescue group's running state and its "no contact yet" distance;
@@ -15,9 +17,9 @@
  *   int summarise(c, start, tail, small, s)  sums and bounds; nonzero when an extent exceeds the limit
  *                                          (small: no limit);
  *   int mean_height_ok(c, n, seed, s, planes, n_sectors)  the mean and its height; nonzero when it passes;
- *   void record_numbers(c, slot, s)        the record's numeric fields from s;
- *   void join_numbers(c, slot, n, s)       a rescue group of n pixels added to the record's numbers (before
- *                                          its count grows);
+ *   void record_sums(c, slot, s)           what the stage keeps of s beside the record (or nothing);
+ *   void join_mean(c, slot, n, s)          a rescue group of n pixels added to the record's mean (before its
+ *                                          count grows);
  *   void reheight(c, slot, planes, n_sectors)  the record's height from its mean and seed;
  *   int rescue_on(c)                       the fragment rescue is configured.
  * Not a public header; include nowhere else. */
@@ -214,6 +216,81 @@ static uint32_t next_fragment(const uint16_t *lab, uint32_t p, uint32_t npix)
 }
 
 
+/* the end of a successful init: no geometry, run or record yet */
+static lidet_status_t init_done(RUN_STATE_T *c)
+{
+    c->geo_rows = 0;
+    c->geo_cols = 0;
+    c->n_recs = 0;
+    c->labels = 0;
+    c->members = 0;
+    memset(&c->img, 0, sizeof c->img);
+    memset(&c->stats, 0, sizeof c->stats);
+    c->magic = LIDET_INIT_MAGIC;
+    return LIDET_OK;
+}
+
+/* the checks every run starts with (arguments, state, image size) */
+static lidet_status_t run_check(const RUN_STATE_T *c, const uint16_t *labels, const int32_t *members,
+                                const lidet_range_image_t *img, const RUN_PLANE_T *planes, uint32_t n_sectors)
+{
+    if (c == 0 || labels == 0 || members == 0 || img == 0 || (planes != 0 && n_sectors == 0))
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (c->magic != LIDET_INIT_MAGIC)
+    {
+        return LIDET_ERR_STATE;
+    }
+    if (img->n_rows < 1 || img->n_cols < 2 || img->n_rows > LIDET_MAX_ROWS || img->n_cols > LIDET_MAX_COLS)
+    {
+        return LIDET_ERR_BUFFER;
+    }
+    return LIDET_OK;
+}
+
+/* the cluster id of every input point from the last run's per-pixel ids (point_labels of both stages) */
+static lidet_status_t labels_of_points(const RUN_STATE_T *c, const int32_t *point_pixel, uint32_t n_points,
+                                       uint32_t *out)
+{
+    if (c == 0 || ((point_pixel == 0 || out == 0) && n_points > 0))
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (c->magic != LIDET_INIT_MAGIC || c->labels == 0)
+    {
+        return LIDET_ERR_STATE;
+    }
+    lidet__cluster_point_labels(c->labels, (uint32_t)c->img.n_rows * c->img.n_cols, point_pixel, n_points, out);
+    return LIDET_OK;
+}
+
+/* the run's image and buffers bound to the state, the records and counts cleared */
+static void run_bind(RUN_STATE_T *c, uint16_t *labels, int32_t *members, const lidet_range_image_t *img,
+                     lidet_cluster_stats_t *st)
+{
+    c->img = *img;
+    c->labels = labels;
+    c->members = members;
+    c->n_recs = 0;
+    memset(st, 0, sizeof *st);
+}
+
+/* a record's numbers from the summary of its members */
+static void record_numbers(RUN_STATE_T *c, uint32_t slot, const RUN_SUMMARY_T *s)
+{
+    RUN_REC_T *rec = &c->recs[slot];
+    uint32_t i;
+    for (i = 0; i < 3; ++i)
+    {
+        RUN_MEAN(rec)[i] = s->mean[i];
+        RUN_MIN(rec)[i] = s->lo[i];
+        RUN_MAX(rec)[i] = s->hi[i];
+    }
+    RUN_HEIGHT(rec) = s->h;
+    record_sums(c, slot, s);
+}
+
 /* filters + bookkeeping of the component members[start, tail); returns the new tail. rescue = 0:
  * a component of the first fill (one below min_points becomes a fragment when the rescue is on);
  * 1: a rescue group that joined no cluster (dropped when small; takes only a free slot) */
@@ -292,7 +369,12 @@ static void rescue_join(RUN_STATE_T *c, uint32_t slot, uint32_t start, uint32_t 
     RUN_SUMMARY_T sm;
     uint32_t i;
     (void)summarise(c, start, tail, 1, &sm);
-    join_numbers(c, slot, n, &sm);
+    join_mean(c, slot, n, &sm);
+    for (i = 0; i < 3; ++i)
+    {
+        RUN_MIN(rec)[i] = sm.lo[i] < RUN_MIN(rec)[i] ? sm.lo[i] : RUN_MIN(rec)[i];
+        RUN_MAX(rec)[i] = sm.hi[i] > RUN_MAX(rec)[i] ? sm.hi[i] : RUN_MAX(rec)[i];
+    }
     for (i = start; i < tail; ++i)
     {
         c->labels[c->members[i]] = (uint16_t)(slot + 1u);
