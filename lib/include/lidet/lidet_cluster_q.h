@@ -31,7 +31,7 @@
  * voxel: floor(atan2(y, x) / az_bin), floor(atan2(z, round(sqrt(x^2 + y^2))) / el_bin) (BAM32 angles and bins),
  * floor(round(sqrt(x^2 + y^2 + z^2)) / range_bin) (4 mm), clamped to int16.
  *
- * Memory: as lidet_cluster.h (uint16 label + int32 member per pixel) plus the records (48 B) and their sums
+ * Memory: as lidet_cluster.h (uint16 label + int32 member per pixel) plus the records (56 B) and their sums
  * (24 B) per cluster slot; lidet_cluster_q_bytes().
  */
 #ifndef LIDET_CLUSTER_Q_H
