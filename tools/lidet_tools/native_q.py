@@ -48,6 +48,67 @@ def qmath(op: str, a, b=None) -> np.ndarray:
     return out
 
 
+# ---- post-processing: size check, BEV IoU, NMS (lib/src/lidet_post_q.c) -------------------------
+
+_post_ready = False
+
+
+def _post_lib():
+    global _post_ready
+    L = native.lib()
+    if not _post_ready:
+        f32p = np.ctypeslib.ndpointer(np.float32, flags="C_CONTIGUOUS")
+        u16p = np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")
+        u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
+        L.lidet_py_q_bev_iou.argtypes = [_i32p, _i32p, C.c_uint32, _i32p]
+        L.lidet_py_bev_iou.argtypes = [f32p, f32p, C.c_uint32, f32p]
+        L.lidet_py_q_post.argtypes = [_i32p, _i32p, u16p, u8p, C.c_uint32, C.c_int32, u8p, u16p, u8p]
+        _post_ready = True
+    return L
+
+
+def _boxes(a, dtype) -> np.ndarray:
+    a = np.ascontiguousarray(a, dtype=dtype)
+    if a.ndim != 2 or a.shape[1] != 7:
+        raise ValueError(f"boxes must be (N, 7), got {a.shape}")
+    return a
+
+
+def bev_iou_q(a, b) -> np.ndarray:
+    """Q15 rotated BEV IoU of box pairs (N, 7) int32 (cx cy cz l w h in mm, yaw BAM32), in C."""
+    a, b = _boxes(a, np.int32), _boxes(b, np.int32)
+    if a.shape != b.shape:
+        raise ValueError("a and b must have the same shape")
+    out = np.zeros(len(a), dtype=np.int32)
+    _post_lib().lidet_py_q_bev_iou(a, b, len(a), out)
+    return out
+
+
+def bev_iou_float(a, b) -> np.ndarray:
+    """The float detector's rotated BEV IoU (lidet_box_bev_iou) of box pairs (N, 7): metres and radians."""
+    a, b = _boxes(a, np.float32), _boxes(b, np.float32)
+    out = np.zeros(len(a), dtype=np.float32)
+    _post_lib().lidet_py_bev_iou(a, b, len(a), out)
+    return out
+
+
+def post_q(boxes, score_q15, cluster_id, cls, iou_q15: int) -> dict:
+    """Size check + score order + NMS of the integer path in C: {'size_ok', 'kept' (cluster ids in order),
+    'suppressed' (per sorted position)}."""
+    boxes = _boxes(boxes, np.int32)
+    n = len(boxes)
+    score = np.ascontiguousarray(score_q15, dtype=np.int32)
+    cid = np.ascontiguousarray(cluster_id, dtype=np.uint16)
+    cl = np.ascontiguousarray(cls, dtype=np.uint8)
+    size_ok = np.zeros(n, np.uint8)
+    order = np.zeros(n, np.uint16)
+    supp = np.zeros(n, np.uint8)
+    k = _post_lib().lidet_py_q_post(boxes, score, cid, cl, n, int(iou_q15), size_ok, order, supp)
+    if k < 0:
+        raise ValueError(f"lidet_py_q_post: status {k} (more than LIDET_MAX_DETECTIONS detections?)")
+    return {"size_ok": size_ok.astype(bool), "kept": order[:k].tolist(), "suppressed": supp.tolist()}
+
+
 # ---- integer clustering and proposals (lib/include/lidet/lidet_cluster_q.h) ----------------------------
 
 #: lidet_cluster_q_cfg_t / lidet_proposal_q_cfg_t fields in declaration order (all 32-bit: passed as arrays)

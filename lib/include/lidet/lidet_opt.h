@@ -178,10 +178,10 @@
 #if ((-1) >> 1) != -1
 #error "lidet needs arithmetic right shifts of negative integers (the fixed-point build relies on them)"
 #endif
-#ifdef LIDET_FIXED_POINT
-#if LIDET_FIXED_POINT
-#error "LIDET_FIXED_POINT is not implemented yet: build the float configuration (LIDET_FIXED_POINT=0)"
-#endif
+/* LIDET_FIXED_POINT 1: the integer-only build (docs/FIXED_POINT.md): CMake compiles only the integer sources;
+ * the float stages' declarations stay visible but are not built. */
+#ifndef LIDET_FIXED_POINT
+#define LIDET_FIXED_POINT 0
 #endif
 
 #endif /* LIDET_OPT_H */
