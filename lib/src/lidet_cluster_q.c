@@ -71,36 +71,41 @@ static int member_stats_q(const lidet_cluster_q_state_t *c, uint32_t start, uint
 {
     const lidet_range_image_t *img = &c->img;
     const int32_t *mem = c->members;
-    const int16_t *const plane[3] = {img->x_4mm, img->y_4mm, img->z_4mm};
-    uint32_t i = start, a, over = 0;
-    for (a = 0; a < 3; ++a)
-    {
-        sum[a] = 0;
-        lo[a] = hi[a] = plane[a][mem[start]];
-    }
+    const int16_t *px = img->x_4mm, *py = img->y_4mm, *pz = img->z_4mm;
+    /* sums in scalars (registers): an int64 array zeroed in memory becomes a 64-bit FPU store on cores with one */
+    int64_t sx = 0, sy = 0, sz = 0;
+    int32_t lx = px[mem[start]], ly = py[mem[start]], lz = pz[mem[start]];
+    int32_t hx = lx, hy = ly, hz = lz;
+    uint32_t i = start, over = 0;
     while (i < tail && over == 0u)
     {
         const uint32_t e = tail - i < 64u ? tail : i + 64u;
-        for (a = 0; a < 3; ++a)
+        for (; i < e; ++i)
         {
-            const int16_t *v = plane[a];
-            int64_t s = 0;
-            int32_t l = lo[a], h = hi[a];
-            uint32_t k;
-            for (k = i; k < e; ++k)
-            {
-                const int32_t x = v[mem[k]];
-                s += x;
-                l = x < l ? x : l;
-                h = x > h ? x : h;
-            }
-            sum[a] += s;
-            lo[a] = l;
-            hi[a] = h;
-            over |= (uint32_t)((uint32_t)(h - l) * 4u > max_extent_mm);
+            const int32_t p = mem[i], x = px[p], y = py[p], z = pz[p];
+            sx += x;
+            sy += y;
+            sz += z;
+            lx = x < lx ? x : lx;
+            ly = y < ly ? y : ly;
+            lz = z < lz ? z : lz;
+            hx = x > hx ? x : hx;
+            hy = y > hy ? y : hy;
+            hz = z > hz ? z : hz;
         }
-        i = e;
+        over = (uint32_t)((uint32_t)(hx - lx) * 4u > max_extent_mm) |
+               (uint32_t)((uint32_t)(hy - ly) * 4u > max_extent_mm) |
+               (uint32_t)((uint32_t)(hz - lz) * 4u > max_extent_mm);
     }
+    sum[0] = sx;
+    sum[1] = sy;
+    sum[2] = sz;
+    lo[0] = lx;
+    lo[1] = ly;
+    lo[2] = lz;
+    hi[0] = hx;
+    hi[1] = hy;
+    hi[2] = hz;
     return over != 0u;
 }
 

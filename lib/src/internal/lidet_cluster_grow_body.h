@@ -174,11 +174,13 @@ static inline uint32_t GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uin
             if (r + 1u < rows)
             {
                 const uint32_t dl = rowbase + cols + cl, dr = rowbase + cols + cr;
-                if (lab[dl] == LAB_FREE && GROW_LINK(dq, (GROW_D_T)rng[dl], GROW_TA(c, diag)[r], GROW_TB(c, diag)[r], g))
+                if (lab[dl] == LAB_FREE &&
+                    GROW_LINK(dq, (GROW_D_T)rng[dl], GROW_TA(c, diag)[r], GROW_TB(c, diag)[r], g))
                 {
                     tail = lidet__cluster_take(lab, mem, tail, dl);
                 }
-                if (lab[dr] == LAB_FREE && GROW_LINK(dq, (GROW_D_T)rng[dr], GROW_TA(c, diag)[r], GROW_TB(c, diag)[r], g))
+                if (lab[dr] == LAB_FREE &&
+                    GROW_LINK(dq, (GROW_D_T)rng[dr], GROW_TA(c, diag)[r], GROW_TB(c, diag)[r], g))
                 {
                     tail = lidet__cluster_take(lab, mem, tail, dr);
                 }
