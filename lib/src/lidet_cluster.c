@@ -80,51 +80,14 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
 
 
 
-/* sum, min and max of the points of members[start, tail) (tail > start). Returns 1 (the sums then
- * incomplete) as soon as an x, y or z extent exceeds max_extent: the test runs after every block of
- * 64 members, so a wall stops early instead of being summed to its end */
-static inline int member_stats_of(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, float max_extent,
-                                  float sum[3], float lo[3], float hi[3], int compact)
-{
-    const lidet_range_image_t *img = &c->img;
-    const int32_t *mem = c->members;
-    float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-    float lx, ly, lz, hx, hy, hz;
-    uint32_t i = start, over = 0;
-    lidet__img_xyz(img, (uint32_t)mem[start], compact, &lx, &ly, &lz);
-    hx = lx;
-    hy = ly;
-    hz = lz;
-    while (i < tail && over == 0u)
-    {
-        const uint32_t e = tail - i < 64u ? tail : i + 64u;
-        for (; i < e; ++i)
-        {
-            float x, y, z;
-            lidet__img_xyz(img, (uint32_t)mem[i], compact, &x, &y, &z);
-            sx += x;
-            sy += y;
-            sz += z;
-            lx = x < lx ? x : lx;
-            ly = y < ly ? y : ly;
-            lz = z < lz ? z : lz;
-            hx = x > hx ? x : hx;
-            hy = y > hy ? y : hy;
-            hz = z > hz ? z : hz;
-        }
-        over = (uint32_t)(hx - lx > max_extent) | (uint32_t)(hy - ly > max_extent) | (uint32_t)(hz - lz > max_extent);
-    }
-    sum[0] = sx;
-    sum[1] = sy;
-    sum[2] = sz;
-    lo[0] = lx;
-    lo[1] = ly;
-    lo[2] = lz;
-    hi[0] = hx;
-    hi[1] = hy;
-    hi[2] = hz;
-    return over != 0u;
-}
+/* the members' sums and bounds (lidet_cluster_stats_body.h) on float values */
+#define STATS_STATE_T lidet_cluster_state_t
+#define STATS_V_T float
+#define STATS_S_T float
+#define STATS_LIM_T float
+#define STATS_READ(c, p, compact, x, y, z) lidet__img_xyz(&(c)->img, p, compact, x, y, z)
+#define STATS_OVER(lo, hi, lim) ((hi) - (lo) > (lim))
+#include "internal/lidet_cluster_stats_body.h"
 
 /* member_stats_of with the image format a constant in each copy */
 static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, float max_extent, float sum[3],

@@ -35,79 +35,22 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     cfg->rescue_cols = 6u;
 }
 
-static lidet_status_t init_done(lidet_cluster_q_state_t *c); /* lidet_cluster_run_body.h */
-
-lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lidet_cluster_q_cfg_t *cfg)
+/* the members' sums and bounds (lidet_cluster_stats_body.h) on the int16 pixels, int64 sums; the extent
+ * (at most 65535 steps) in mm against the limit */
+static inline void read_q(const lidet_cluster_q_state_t *c, uint32_t p, int32_t *x, int32_t *y, int32_t *z)
 {
-    if (c == 0 || cfg == 0)
-    {
-        return LIDET_ERR_ARG;
-    }
-    c->magic = 0;
-    if (cfg->theta_urad == 0u || cfg->theta_urad >= 1500000u || cfg->max_steps < 1u || cfg->max_steps > STEPS ||
-        cfg->min_points < 1u || cfg->max_extent_mm == 0u || cfg->max_extent_mm > 1000000u ||
-        cfg->max_gap_mm > 1000000u || cfg->max_gap_per_m_q16 > 65536u || cfg->mount_height_mm > 100000u ||
-        cfg->rescue_gap_mm > 10000u || cfg->rescue_gap_per_m_q16 > 16384u || cfg->rescue_rows > LIDET_MAX_ROWS ||
-        cfg->rescue_cols > RESCUE_MAX_COLS)
-    {
-        return LIDET_ERR_CONFIG;
-    }
-    c->cfg = *cfg;
-    c->theta_bam = lidet__q_urad_to_bam((int32_t)cfg->theta_urad);
-    c->sin_theta_q16 = (uint32_t)lidet__q_rshift_round(lidet__q_sin((uint32_t)c->theta_bam), 14);
-    return init_done(c);
+    *x = c->img.x_4mm[p];
+    *y = c->img.y_4mm[p];
+    *z = c->img.z_4mm[p];
 }
 
-lidet_status_t lidet_cluster_q_init(lidet_cluster_q_t *c, const lidet_cluster_q_cfg_t *cfg)
-{
-    return c == 0 ? LIDET_ERR_ARG : lidet_cluster_q_state_init(&c->state, cfg);
-}
-
-/* sums, min and max of the coordinates of members[start, tail) (tail > start). Returns 1 (the sums then
- * incomplete) as soon as an extent exceeds max_extent_mm: tested after every block of 64 members, as the
- * float stage does (the decision does not depend on where it stops) */
-static int member_stats_q(const lidet_cluster_q_state_t *c, uint32_t start, uint32_t tail, uint32_t max_extent_mm,
-                          int64_t sum[3], int32_t lo[3], int32_t hi[3])
-{
-    const lidet_range_image_t *img = &c->img;
-    const int32_t *mem = c->members;
-    const int16_t *px = img->x_4mm, *py = img->y_4mm, *pz = img->z_4mm;
-    /* sums in scalars (registers): an int64 array zeroed in memory becomes a 64-bit FPU store on cores with one */
-    int64_t sx = 0, sy = 0, sz = 0;
-    int32_t lx = px[mem[start]], ly = py[mem[start]], lz = pz[mem[start]];
-    int32_t hx = lx, hy = ly, hz = lz;
-    uint32_t i = start, over = 0;
-    while (i < tail && over == 0u)
-    {
-        const uint32_t e = tail - i < 64u ? tail : i + 64u;
-        for (; i < e; ++i)
-        {
-            const int32_t p = mem[i], x = px[p], y = py[p], z = pz[p];
-            sx += x;
-            sy += y;
-            sz += z;
-            lx = x < lx ? x : lx;
-            ly = y < ly ? y : ly;
-            lz = z < lz ? z : lz;
-            hx = x > hx ? x : hx;
-            hy = y > hy ? y : hy;
-            hz = z > hz ? z : hz;
-        }
-        over = (uint32_t)((uint32_t)(hx - lx) * 4u > max_extent_mm) |
-               (uint32_t)((uint32_t)(hy - ly) * 4u > max_extent_mm) |
-               (uint32_t)((uint32_t)(hz - lz) * 4u > max_extent_mm);
-    }
-    sum[0] = sx;
-    sum[1] = sy;
-    sum[2] = sz;
-    lo[0] = lx;
-    lo[1] = ly;
-    lo[2] = lz;
-    hi[0] = hx;
-    hi[1] = hy;
-    hi[2] = hz;
-    return over != 0u;
-}
+#define STATS_STATE_T lidet_cluster_q_state_t
+#define STATS_V_T int32_t
+#define STATS_S_T int64_t
+#define STATS_LIM_T uint32_t
+#define STATS_READ(c, p, compact, x, y, z) read_q(c, p, x, y, z)
+#define STATS_OVER(lo, hi, lim) ((uint32_t)((hi) - (lo)) * 4u > (lim))
+#include "internal/lidet_cluster_stats_body.h"
 
 /* height of `mean` above the plane of the seed column's sector (or the flat ground at -mount), 4 mm steps */
 static int32_t height_q(const lidet_cluster_q_state_t *c, uint32_t seed, const int32_t mean[3],
@@ -150,7 +93,7 @@ typedef struct
 
 static int summarise(const lidet_cluster_q_state_t *c, uint32_t start, uint32_t tail, int small, summary_q_t *s)
 {
-    return member_stats_q(c, start, tail, small ? 0xFFFFFFFFu : c->cfg.max_extent_mm, s->sum, s->lo, s->hi);
+    return member_stats_of(c, start, tail, small ? 0xFFFFFFFFu : c->cfg.max_extent_mm, s->sum, s->lo, s->hi, 1);
 }
 
 static int mean_height_ok(const lidet_cluster_q_state_t *c, uint32_t n, uint32_t seed, summary_q_t *s,
@@ -208,6 +151,32 @@ static int rescue_on(const lidet_cluster_q_state_t *c)
 #define RUN_RESCUE_FAR 0xFFFFFFFFu
 #define RUN_RESCUE_GROW lidet__cluster_q_rescue_grow
 #include "internal/lidet_cluster_run_body.h"
+
+lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lidet_cluster_q_cfg_t *cfg)
+{
+    if (c == 0 || cfg == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    c->magic = 0;
+    if (cfg->theta_urad == 0u || cfg->theta_urad >= 1500000u || cfg->max_steps < 1u || cfg->max_steps > STEPS ||
+        cfg->min_points < 1u || cfg->max_extent_mm == 0u || cfg->max_extent_mm > 1000000u ||
+        cfg->max_gap_mm > 1000000u || cfg->max_gap_per_m_q16 > 65536u || cfg->mount_height_mm > 100000u ||
+        cfg->rescue_gap_mm > 10000u || cfg->rescue_gap_per_m_q16 > 16384u || cfg->rescue_rows > LIDET_MAX_ROWS ||
+        cfg->rescue_cols > RESCUE_MAX_COLS)
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    c->cfg = *cfg;
+    c->theta_bam = lidet__q_urad_to_bam((int32_t)cfg->theta_urad);
+    c->sin_theta_q16 = (uint32_t)lidet__q_rshift_round(lidet__q_sin((uint32_t)c->theta_bam), 14);
+    return init_done(c);
+}
+
+lidet_status_t lidet_cluster_q_init(lidet_cluster_q_t *c, const lidet_cluster_q_cfg_t *cfg)
+{
+    return c == 0 ? LIDET_ERR_ARG : lidet_cluster_q_state_init(&c->state, cfg);
+}
 
 lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t *labels, int32_t *members,
                                            const lidet_range_image_t *img, const uint8_t *ground_mask,
