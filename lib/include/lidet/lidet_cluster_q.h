@@ -5,7 +5,8 @@
  *        compact range image (int16 x, y, z and uint16 range in 4 mm steps), with integers only.
  *
  * Same algorithm, control flow and outputs as lidet_cluster.h (the flood fill, the rescue window walk, the
- * capacity and the canonical ids are the same source, internal/lidet_cluster_*_body.h); the numeric kernels:
+ * filters and records, the capacity and the canonical ids are the same source, internal/lidet_cluster_*_body.h);
+ * the numeric kernels:
  *  - join test beta > theta: with d1 >= d2 the two ranges (4 mm steps) and alpha the angle of the two beams,
  *    d2 sin(alpha + theta) > d1 sin(theta) (the float stage's d2 sin a > tan(theta) (d1 - d2 cos a) multiplied
  *    by cos(theta): the law of sines), both sides uint32: S = sin(alpha + theta) (Q16, clamped at 0: a
