@@ -107,6 +107,94 @@ def post_q(boxes, score_q15, cluster_id, cls, iou_q15: int) -> dict:
     if k < 0:
         raise ValueError(f"lidet_py_q_post: status {k} (more than LIDET_MAX_DETECTIONS detections?)")
     return {"size_ok": size_ok.astype(bool), "kept": order[:k].tolist(), "suppressed": supp.tolist()}
+# ---- integer projection and sensor presets (lib/src/lidet_proj_q.c, lib/src/lidet_sensor_q.c) ---------------
+
+_u16p = np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")
+_i16p = np.ctypeslib.ndpointer(np.int16, flags="C_CONTIGUOUS")
+_u32p = np.ctypeslib.ndpointer(np.uint32, flags="C_CONTIGUOUS")
+_proj_q_ready = False
+PROJ_Q_STATS = ("n_points_in", "n_projected", "n_pixels_filled", "n_nonfinite", "n_too_close", "n_too_far",
+                "n_out_of_fov", "n_bad_ring", "n_truncated")
+
+
+def _proj_q_lib():
+    global _proj_q_ready
+    L = native.lib()
+    if not _proj_q_ready:
+        L.lidet_py_sensor_q.argtypes = [C.c_uint32, C.c_char_p, _u32p, _i32p, _i32p]
+        L.lidet_py_isqrt32.argtypes = [_u32p, C.c_uint32, _i64p]
+        L.lidet_py_proj_q.argtypes = [_i32p, native._opt(_i32p), _i32p, native._opt(_i32p), C.c_uint32, C.c_uint32,
+                                      native._opt(_u16p), native._opt(_i32p), _i32p, _i16p, _u16p, _u32p, _i32p]
+        _proj_q_ready = True
+    return L
+
+
+def sensors_q() -> dict:
+    """The C integer presets: name -> dict(rows, cols, elev_urad (ring order, uniform ones expanded),
+    fov_urad ((up, down) or None for a table), mount_height_mm, max_range_mm)."""
+    L = _proj_q_lib()
+    res = {}
+    i = 0
+    while True:
+        name = C.create_string_buffer(64)
+        rc = np.zeros(2, np.uint32)
+        elev = np.zeros(256, np.int32)
+        ints = np.zeros(5, np.int32)
+        st = L.lidet_py_sensor_q(i, name, rc, elev, ints)
+        if st == -6:
+            return res
+        if st != 0:
+            raise native.LidetError(st, "lidet_py_sensor_q")
+        res[name.value.decode()] = dict(rows=int(rc[0]), cols=int(rc[1]), elev_urad=elev[: rc[0]].copy(),
+                                        fov_urad=None if ints[4] else (int(ints[0]), int(ints[1])),
+                                        mount_height_mm=int(ints[2]), max_range_mm=int(ints[3]))
+        i += 1
+
+
+def project_q(points_mm, sensor="hdl64", ring=None, min_range_mm: int = 100, max_range_mm: int = 0,
+              fov_margin_urad: int = 87266) -> dict:
+    """The C integer projection of (N, >=3) int32 mm points (x, y, z first). sensor: a preset name or a
+    sensors.Sensor (its integer profile: beam_elev_urad, or fov_urad for a uniform one). Returns the keys of
+    lidet_codegen.ref.proj_q.project (point_pixel, point_idx, x_4mm, y_4mm, z_4mm, range_4mm, stats,
+    row_elev_bam) and status."""
+    from lidet_tools.sensors import get_sensor
+
+    L = _proj_q_lib()
+    s = get_sensor(sensor) if isinstance(sensor, str) else sensor
+    pts = np.asarray(points_mm)
+    if pts.ndim != 2 or not 3 <= pts.shape[1] <= native.MAX_STRIDE or pts.dtype.kind not in "iu":
+        raise ValueError(f"points_mm must be integer (N, 3..{native.MAX_STRIDE}), got {pts.dtype} {pts.shape}")
+    pts = np.ascontiguousarray(pts, dtype=np.int32)
+    n, stride = pts.shape
+    npix = s.rows * s.cols
+    fov = s.fov_urad if s.fov_urad is not None else (0, 0)
+    sens = np.array([s.rows, s.cols, fov[0], fov[1]], np.int32)
+    elev = None if s.fov_urad is not None else np.ascontiguousarray(s.beam_elev_urad, dtype=np.int32)
+    cfg = np.array([min_range_mm, max_range_mm, fov_margin_urad], np.int32)
+    rg = None if ring is None else native._as_per_point(ring, n, "ring", np.uint16, 0, 0xFFFF)
+    cap = native.capacity()["max_points"]
+    pp = np.full(n, -1, np.int32)
+    idx = np.zeros(npix, np.int32)
+    xyz = np.zeros(3 * npix, np.int16)
+    rng = np.zeros(npix, np.uint16)
+    stats = np.zeros(9, np.uint32)
+    bam = np.zeros(s.rows, np.int32)
+    st = L.lidet_py_proj_q(sens, elev, cfg, pts.ravel() if n else None, n, stride, rg,
+                           pp if 0 < n <= cap else None, idx, xyz, rng, stats, bam)
+    if st < 0:
+        raise native.LidetError(st, "lidet_proj_q")
+    return dict(point_pixel=pp, point_idx=idx, x_4mm=xyz[:npix], y_4mm=xyz[npix:2 * npix], z_4mm=xyz[2 * npix:],
+                range_4mm=rng, stats=dict(zip(PROJ_Q_STATS, map(int, stats))), row_elev_bam=bam, status=int(st))
+
+
+def isqrt32(v) -> np.ndarray:
+    """lidet__q_isqrt32 (floor sqrt in 32-bit arithmetic) over uint32 values, as int64."""
+    a = np.ascontiguousarray(np.asarray(v, dtype=np.int64).astype(np.uint32))
+    out = np.zeros(a.shape, np.int64)
+    st = _proj_q_lib().lidet_py_isqrt32(a.ravel(), a.size, out.ravel())
+    if st != 0:
+        raise native.LidetError(st, "lidet_py_isqrt32")
+    return out
 
 
 # ---- integer clustering and proposals (lib/include/lidet/lidet_cluster_q.h) ----------------------------

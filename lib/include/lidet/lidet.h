@@ -23,6 +23,8 @@
 #include "lidet_q.h"
 #include "lidet_sensor.h"
 #include "lidet_proj.h"
+#include "lidet_sensor_q.h"
+#include "lidet_proj_q.h"
 #include "lidet_ground.h"
 #include "lidet_cluster.h"
 #include "lidet_cluster_q.h"
