@@ -223,3 +223,46 @@ def test_bad_config_refused(sim_scans):
         native_q.cluster_q(scan, proposal_cfg=dict(range_bin_4mm=0))
     with pytest.raises(TypeError):
         native_q.cluster_q(scan, theta_rad=1)
+
+
+def _integer_chain_scan(sensor, pts):
+    """The integer projection's compact image of the scan (points rounded to mm), with the float ground stage's
+    mask and planes of the float projection of the same scan (the integer ground stage is not there yet)."""
+    s = native_q.compact_scan(pts, sensor)
+    pq = native_q.project_q(np.round(pts[:, :3].astype(np.float64) * 1000).astype(np.int32), sensor)
+    rows, cols = s.shape
+    return native_q.CompactScan(s.sensor, pq["x_4mm"].reshape(rows, cols), pq["y_4mm"].reshape(rows, cols),
+                                pq["z_4mm"].reshape(rows, cols), pq["range_4mm"].reshape(rows, cols),
+                                pq["row_elev_bam"], s.row_elev_rad, pq["point_pixel"], s.ground, s.planes), s
+
+
+def _on_integer_projection(scans, what):
+    """On the integer projection's image (lidet_proj_q): bit for bit with the reference, and the per-point ids of
+    the integer chain (integer projection + integer clustering) against the float chain (float compact
+    projection + float clustering), both with the float ground stage's mask."""
+    n = qf = fq = 0.0
+    for sensor, pts in scans:
+        scan_q, scan_f = _integer_chain_scan(sensor, pts)
+        c = native_q.cluster_q(scan_q, native_q.planes_to_q(scan_q.planes))
+        dc, _ = native_q.cluster_q_defaults(sensor)
+        lab, mem, recs, st = ref.cluster_q_ref(scan_q.x, scan_q.y, scan_q.z, scan_q.range, scan_q.row_elev_bam,
+                                               scan_q.ground, native_q.planes_to_q(scan_q.planes), dc)
+        assert np.array_equal(lab, c.labels) and np.array_equal(mem, c.members) and st == c.stats
+        f = native_q.cluster_f_compact(scan_f, scan_f.planes)
+        ppq, ppf = scan_q.point_pixel, scan_f.point_pixel
+        keep = (ppq >= 0) & (ppf >= 0)
+        keep[keep] = scan_f.ground.ravel()[ppf[keep]] == 0
+        x, y, k = id_agreement(c.labels.ravel()[ppq[keep]].astype(np.int64),
+                               f.labels.ravel()[ppf[keep]].astype(np.int64))
+        n, qf, fq = n + k, qf + x * k, fq + y * k
+    print(f"\nwhole integer chain vs float chain, {len(scans)} {what} scans, {int(n)} points: "
+          f"ids int -> float {qf / n:.5f}, float -> int {fq / n:.5f}")
+    assert qf / n >= 0.99 and fq / n >= 0.99
+
+
+def test_on_integer_projection_simulated(sim_scans):
+    _on_integer_projection(sim_scans, "simulated")
+
+
+def test_on_integer_projection_real(real_dir, need_lib):
+    _on_integer_projection(_real_scans(real_dir), "real")
