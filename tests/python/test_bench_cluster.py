@@ -22,3 +22,4 @@ def test_bench_cluster_runs(root, real_dir):
     assert md.startswith("## Clustering (issue 6)")
     assert "| real SemanticKITTI 00 (3 labelled scans) | lidet |" in md and "DBSCAN columns skipped" in md
     assert "| | lidet, no rescue |" in md
+    assert "| | lidet integer (lidet_cluster_q), same images |" in md

@@ -81,6 +81,20 @@ def _dbscan(o3d, pts, ground, repeat):
     return float(np.median(times)), ids
 
 
+def _int_vs_float(pts, sensor, repeat):
+    """Host speed of the integer clustering (lidet_cluster_q_run) next to the float one on the same compact
+    image (the float projection's compact path and ground stage, as a detector workspace), in one process:
+    (float ms, integer ms) medians of `repeat` runs each, or None when the bindings are not built."""
+    try:
+        from lidet_tools import native_q
+        scan = native_q.compact_scan(pts, sensor)
+    except (FileNotFoundError, OSError, AttributeError):
+        return None
+    cf = native_q.cluster_f_compact(scan, scan.planes, repeat=repeat)
+    cq = native_q.cluster_q(scan, native_q.planes_to_q(scan.planes), repeat=repeat)
+    return float(np.median(cf.run_ns)) / 1e6, float(np.median(cq.run_ns)) / 1e6
+
+
 def _rate(summary, cls, band="0-40"):
     d = summary[cls][band]
     return "-" if d["n"] == 0 else f"{100 * d['recovered']:.0f}% ({d['n']})"
@@ -88,6 +102,7 @@ def _rate(summary, cls, band="0-40"):
 
 def _dataset(name, data_dir, sensor, cli, o3d, rep_l, rep_d):
     res_l, res_d, res_n, ms_l, ms_d, ms_n, scans = [], [], [], [], [], [], 0
+    ms_f, ms_q = [], []
     with tempfile.TemporaryDirectory() as tmp:
         for stem, pts, lab in ce.scans(data_dir):
             scan = data_dir / "velodyne" / f"{stem}.bin"
@@ -102,10 +117,16 @@ def _dataset(name, data_dir, sensor, cli, o3d, rep_l, rep_d):
                 msd, idsd = _dbscan(o3d, pts, ce.ground_mask(lab), rep_d)
                 ms_d.append(msd)
                 res_d += ce.evaluate_scan(idsd, lab, pts, stem)
+            fq = _int_vs_float(pts, sensor, rep_l)
+            if fq is not None:
+                ms_f.append(fq[0])
+                ms_q.append(fq[1])
             scans += 1
     sl = ce.summarize(res_l)
     out = {"name": name, "sensor": sensor, "scans": scans, "lidet_ms": float(np.median(ms_l)), "lidet": sl,
            "lidet_results": res_l, "norescue_ms": float(np.median(ms_n)), "norescue": ce.summarize(res_n)}
+    if ms_q:
+        out.update(compact_float_ms=float(np.median(ms_f)), compact_int_ms=float(np.median(ms_q)))
     if o3d is not None:
         out.update(dbscan_ms=float(np.median(ms_d)), dbscan=ce.summarize(res_d), dbscan_results=res_d)
     return out
@@ -115,6 +136,9 @@ def run(args) -> str:
     quick = getattr(args, "quick", False)
     rep_l, rep_d = (5, 1) if quick else (20, 3)
     cli = pathlib.Path(args.build) / "ports" / "host" / "lidet"
+    so = pathlib.Path(args.build) / "ports" / "python" / "liblidet_py.so"
+    if so.exists() and "LIDET_LIB" not in os.environ and "LIDET_BUILD_DIR" not in os.environ:
+        os.environ["LIDET_LIB"] = str(so)  # the bindings of the build under test (integer vs float rows)
     o3d = _open3d()
     sets = []
     real = pathlib.Path(args.real) / "semantickitti"
@@ -146,6 +170,10 @@ def run(args) -> str:
                      f"{_rate(r['lidet'], 'person')} | {_rate(r['lidet'], 'bicyclist')} |")
         lines.append(f"| | lidet, no rescue | {r['norescue_ms']:.2f} | | {_rate(r['norescue'], 'car')} | "
                      f"{_rate(r['norescue'], 'person')} | {_rate(r['norescue'], 'bicyclist')} |")
+        if "compact_int_ms" in r:
+            lines.append(f"| | lidet float, compact image, ground stage | {r['compact_float_ms']:.2f} | | | | |")
+            lines.append(f"| | lidet integer (lidet_cluster_q), same images | {r['compact_int_ms']:.2f} | "
+                         f"{r['compact_float_ms'] / r['compact_int_ms']:.2f}x vs float | | | |")
         if "dbscan" in r:
             lines.append(f"| | Open3D DBSCAN | {r['dbscan_ms']:.1f} | **{r['dbscan_ms'] / r['lidet_ms']:.0f}x** | "
                          f"{_rate(r['dbscan'], 'car')} | {_rate(r['dbscan'], 'person')} | "
@@ -153,7 +181,10 @@ def run(args) -> str:
     lines += ["", f"Commands: `lidet cluster SCAN.bin --sensor SENSOR --labels SCAN.label --json --repeat {rep_l} "
               f"--out ids.bin` (cluster_ms); DBSCAN: `open3d.geometry.PointCloud.cluster_dbscan(eps=0.5, "
               f"min_points=10)` on the non-ground points, median of {rep_d}, OMP_NUM_THREADS=1, point-cloud "
-              "construction included. Whole table: `python tools/bench/bench_cluster.py` (or `make bench`).", ""]
+              "construction included. Integer versus float (docs/FIXED_POINT.md): both clusterings on the same "
+              "compact image with the ground stage's mask and planes (Q30 for the integer one), through the bindings "
+              f"(lidet_tools.native_q: cluster_f_compact, cluster_q), the stage alone, median of {rep_l} runs per "
+              "scan, then the median over the scans. Whole table: `python tools/bench/bench_cluster.py` (or `make bench`).", ""]
     for r in results:
         lines.append(ce.markdown(r["lidet"], f"lidet, {r['name']}: per class and distance band"))
         if "dbscan" in r:

@@ -360,3 +360,215 @@ def ground_pair(points, sensor="hdl64"):
     def per_point(mask):
         return np.where(pp >= 0, mask.reshape(-1)[np.clip(pp, 0, None)], 0).astype(np.uint8)
     return per_point(fm), per_point(q.mask), img, q
+# ---- integer clustering and proposals (lib/include/lidet/lidet_cluster_q.h) ----------------------------
+
+#: lidet_cluster_q_cfg_t / lidet_proposal_q_cfg_t fields in declaration order (all 32-bit: passed as arrays)
+CLUSTER_Q_FIELDS = ["theta_urad", "max_steps", "bridge_occluders", "diagonals", "max_gap_mm", "max_gap_per_m_q16",
+                    "min_points", "max_extent_mm", "max_mean_height_mm", "mount_height_mm", "rescue_gap_mm",
+                    "rescue_gap_per_m_q16", "rescue_rows", "rescue_cols"]
+PROPOSAL_Q_FIELDS = ["n_points", "seed", "azimuth_bin_bam", "elevation_bin_bam", "range_bin_4mm"]
+_cq_ready = False
+
+
+def _cq_lib():
+    global _cq_ready
+    L = native.lib()
+    if not _cq_ready:
+        V = C.c_void_p
+        i16p = np.ctypeslib.ndpointer(np.int16, flags="C_CONTIGUOUS")
+        u16p = np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")
+        u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
+        u32p = np.ctypeslib.ndpointer(np.uint32, flags="C_CONTIGUOUS")
+        u64p = np.ctypeslib.ndpointer(np.uint64, flags="C_CONTIGUOUS")
+        f32p = np.ctypeslib.ndpointer(np.float32, flags="C_CONTIGUOUS")
+        o = native._opt
+        L.lidet_py_cluster_q_sizes.restype = None
+        L.lidet_py_cluster_q_sizes.argtypes = [u32p]
+        L.lidet_py_cluster_q_default.restype = None
+        L.lidet_py_cluster_q_default.argtypes = [C.c_uint32, C.c_uint32, _i32p, _i32p]
+        L.lidet_py_cq_prepare.argtypes = [C.c_uint32, C.c_uint32, f32p, C.c_float, V, V, f32p, C.c_uint32, C.c_uint32,
+                                          i16p, i16p, i16p, u16p, _i32p, f32p, _i32p, u8p, f32p]
+        L.lidet_py_cluster_q_run.argtypes = [C.c_uint32, C.c_uint32, i16p, i16p, i16p, u16p, _i32p, o(u8p), o(_i32p),
+                                             C.c_uint32, _i32p, _i32p, C.c_uint32, u16p, _i32p, _i32p, u32p, V, i16p,
+                                             _i32p, i16p, u64p]
+        L.lidet_py_cluster_f_compact.argtypes = [C.c_uint32, C.c_uint32, i16p, i16p, i16p, u16p, f32p, _i32p, o(u8p),
+                                                 o(f32p), C.c_uint32, V, V, C.c_uint32, u16p, _i32p, u32p, f32p, u32p,
+                                                 V, f32p, f32p, i16p, u64p]
+        sizes = np.zeros(4, np.uint32)
+        L.lidet_py_cluster_q_sizes(sizes)
+        if sizes[0] != 4 * len(CLUSTER_Q_FIELDS) or sizes[1] != 4 * len(PROPOSAL_Q_FIELDS):
+            raise RuntimeError(f"lidet_cluster_q_cfg_t / lidet_proposal_q_cfg_t layout changed: {sizes}")
+        _cq_ready = True
+    return L
+
+
+def cluster_q_defaults(sensor="hdl64") -> tuple[dict, dict]:
+    """(lidet_cluster_q_cfg_default, lidet_proposal_q_cfg_default) for a preset name or a Sensor, from C."""
+    s = native.get_sensor(sensor) if isinstance(sensor, str) else sensor
+    cq = np.zeros(len(CLUSTER_Q_FIELDS), np.int32)
+    pq = np.zeros(len(PROPOSAL_Q_FIELDS), np.int32)
+    _cq_lib().lidet_py_cluster_q_default(s.rows, int(round(s.mount_height_m * 1000)), cq, pq)
+    return ({k: int(v) for k, v in zip(CLUSTER_Q_FIELDS, cq)},
+            {k: int(np.uint32(np.int32(v))) for k, v in zip(PROPOSAL_Q_FIELDS, pq)})
+
+
+def _cfg_array(fields, defaults: dict, cfg: dict, what: str) -> np.ndarray:
+    full = dict(defaults)
+    unknown = set(cfg) - set(full)
+    if unknown:
+        raise TypeError(f"unknown {what} field(s): {sorted(unknown)}")
+    full.update(cfg)
+    return np.array([np.uint32(int(full[k]) & 0xFFFFFFFF).view(np.int32) for k in fields], np.int32)
+
+
+@dataclass
+class CompactScan:
+    """A scan as the integer clustering reads it: the float projection's compact image (4 mm steps) and the
+    float ground stage's mask and near planes on it."""
+    sensor: object
+    x: np.ndarray            #: (rows, cols) int16, 4 mm
+    y: np.ndarray
+    z: np.ndarray
+    range: np.ndarray        #: (rows, cols) uint16, 4 mm; 0 = empty
+    row_elev_bam: np.ndarray  #: (rows,) int32
+    row_elev_rad: np.ndarray  #: (rows,) float32
+    point_pixel: np.ndarray  #: (n,) int32, -1 = not projected
+    ground: np.ndarray       #: (rows, cols) uint8
+    planes: np.ndarray       #: (n_sectors, 4) float32 (nx, ny, nz, d_m)
+
+    @property
+    def shape(self):
+        return self.range.shape
+
+
+def compact_scan(points, sensor="hdl64") -> CompactScan:
+    """Project (N, >=3) points into a compact image with the C projection and run the C ground stage on it
+    (default configurations), as a detector workspace does."""
+    s = native.get_sensor(sensor) if isinstance(sensor, str) else sensor
+    pts, stride = native._as_points(points)
+    n = len(pts)
+    rows, cols = s.rows, s.cols
+    gcfg = native.ground_defaults(s)
+    ns = int(gcfg["n_sectors"])
+    x, y, z = (np.zeros((rows, cols), np.int16) for _ in range(3))
+    rng = np.zeros((rows, cols), np.uint16)
+    eb = np.zeros(rows, np.int32)
+    er = np.zeros(rows, np.float32)
+    pp = np.full(max(n, 1), -1, np.int32)
+    mask = np.zeros((rows, cols), np.uint8)
+    planes = np.zeros((max(ns, 1), 4), np.float32)
+    st = _cq_lib().lidet_py_cq_prepare(rows, cols, np.ascontiguousarray(s.beam_elev_rad, np.float32),
+                                       s.mount_height_m, native._addr(native._record("lidet_proj_cfg_t",
+                                                                                     native.proj_defaults())),
+                                       native._addr(native._record("lidet_ground_cfg_t", gcfg)),
+                                       pts if n else np.zeros((1, 3), np.float32), n, stride, x, y, z, rng, eb, er,
+                                       pp, mask, planes)
+    if st < 0:
+        raise native.LidetError(st, "lidet_py_cq_prepare")
+    return CompactScan(s, x, y, z, rng, eb, er, pp[:n], mask, planes[:ns])
+
+
+def planes_to_q(planes) -> np.ndarray:
+    """Float ground planes (S, 4) (nx, ny, nz, d_m) -> lidet_plane_q_t (S, 4) int32: Q30 normal, d in 4 mm steps
+    (rounded), until the integer ground stage produces them."""
+    p = np.asarray(planes, np.float64).reshape(-1, 4)
+    out = np.empty(p.shape, np.int64)
+    out[:, :3] = np.clip(np.round(p[:, :3] * (1 << 30)), -(1 << 31), (1 << 31) - 1)
+    out[:, 3] = np.round(p[:, 3] / 0.004)
+    return out.astype(np.int32)
+
+
+@dataclass
+class ClustersOnImage:
+    """Clusters and proposals of one compact image (integer: 4 mm steps; float: metres)."""
+    labels: np.ndarray        #: (rows, cols) uint16 canonical ids
+    members: np.ndarray       #: (n_pixels_kept,) int32
+    n_points: np.ndarray      #: (K,)
+    first_member: np.ndarray
+    seed_pixel: np.ndarray
+    n_rescued: np.ndarray
+    mean: np.ndarray          #: (K, 3)
+    min: np.ndarray
+    max: np.ndarray
+    height: np.ndarray        #: (K,)
+    stats: dict
+    status: int
+    prop_xyz: np.ndarray      #: (K, n_points, 3)
+    prop_mean: np.ndarray     #: (K, 3)
+    prop_voxel: np.ndarray    #: (K, 3) int16
+    run_ns: np.ndarray        #: (repeat,) nanoseconds of each clustering run
+
+    def __len__(self) -> int:
+        return len(self.n_points)
+
+
+def _outputs(rows: int, cols: int, npts: int, coord) -> dict:
+    """The arrays a clustering binding fills (capacity-sized; coord: the proposals' and means' dtype)."""
+    cap = native.capacity()["max_clusters"]
+    return {"lab": np.zeros((rows, cols), np.uint16), "mem": np.zeros(rows * cols, np.int32),
+            "nrec": np.zeros(1, np.uint32), "stats": native._record("lidet_cluster_stats_t"),
+            "pxyz": np.zeros((cap, npts, 3), np.int16 if coord == np.int32 else coord),
+            "pmean": np.zeros((cap, 3), coord), "pvox": np.zeros((cap, 3), np.int16)}
+
+
+def _result(o: dict, st: int, what: str, ints, floats, ns) -> ClustersOnImage:
+    """ClustersOnImage from the filled arrays: ints (K, >= 4) n_points, first_member, seed_pixel, n_rescued;
+    floats (K, 10) mean, min, max, height (the same array as ints for the integer stage)."""
+    if st < 0:
+        raise native.LidetError(st, what)
+    k = int(o["nrec"][0])
+    sd = native._to_dict(o["stats"])
+    i, f = ints[:k], floats[:k]
+    return ClustersOnImage(o["lab"], o["mem"][: sd["n_pixels_kept"]].copy(), *(i[:, j].copy() for j in range(4)),
+                           f[:, 0:3].copy(), f[:, 3:6].copy(), f[:, 6:9].copy(), f[:, 9].copy(), sd, int(st),
+                           o["pxyz"][:k].copy(), o["pmean"][:k].copy(), o["pvox"][:k].copy(), ns)
+
+
+def cluster_q(scan: CompactScan, planes_q=None, use_ground: bool = True, repeat: int = 1, proposal_cfg=None,
+              **cfg) -> ClustersOnImage:
+    """lidet_cluster_q_run on a compact scan (planes_q: (S, 4) int32 lidet_plane_q_t, or None: flat ground) and
+    lidet_proposal_q_make for every kept cluster. cfg: fields of lidet_cluster_q_cfg_t."""
+    L = _cq_lib()
+    dc, dp = cluster_q_defaults(scan.sensor)
+    c = _cfg_array(CLUSTER_Q_FIELDS, dc, cfg, "lidet_cluster_q_cfg_t")
+    p = _cfg_array(PROPOSAL_Q_FIELDS, dp, proposal_cfg or {}, "lidet_proposal_q_cfg_t")
+    rows, cols = scan.shape
+    cap = native.capacity()["max_clusters"]
+    pl = None if planes_q is None else np.ascontiguousarray(planes_q, np.int32).reshape(-1, 4)
+    o = _outputs(rows, cols, int(p[0]), np.int32)
+    recs = np.zeros((cap, 14), np.int32)
+    ns = np.zeros(max(repeat, 1), np.uint64)
+    st = L.lidet_py_cluster_q_run(rows, cols, scan.x, scan.y, scan.z, scan.range, scan.row_elev_bam,
+                                  scan.ground if use_ground else None, pl, 0 if pl is None else len(pl), c, p, repeat,
+                                  o["lab"], o["mem"], recs, o["nrec"], native._addr(o["stats"]), o["pxyz"], o["pmean"],
+                                  o["pvox"], ns)
+    return _result(o, st, "lidet_cluster_q_run", recs, recs[:, 4:14], ns)
+
+
+def cluster_f_compact(scan: CompactScan, planes=None, use_ground: bool = True, repeat: int = 1,
+                      proposal_cfg=None, **cfg) -> ClustersOnImage:
+    """The float clustering (lidet_cluster_run_buffers) and proposals on the same compact image.
+    planes: (S, 4) float (nx, ny, nz, d_m) or None. cfg: fields of lidet_cluster_cfg_t."""
+    L = _cq_lib()
+    c = native.cluster_defaults(scan.sensor)
+    unknown = set(cfg) - set(c)
+    if unknown:
+        raise TypeError(f"unknown cluster option(s): {sorted(unknown)}")
+    c.update(cfg)
+    pc = native.proposal_defaults()
+    pc.update(proposal_cfg or {})
+    rows, cols = scan.shape
+    cap = native.capacity()["max_clusters"]
+    pl = None if planes is None else np.ascontiguousarray(planes, np.float32).reshape(-1, 4)
+    o = _outputs(rows, cols, int(pc["n_points"]), np.float32)
+    ru = np.zeros((cap, 4), np.uint32)
+    rf = np.zeros((cap, 10), np.float32)
+    ns = np.zeros(max(repeat, 1), np.uint64)
+    st = L.lidet_py_cluster_f_compact(rows, cols, scan.x, scan.y, scan.z, scan.range, scan.row_elev_rad,
+                                      scan.row_elev_bam, scan.ground if use_ground else None, pl,
+                                      0 if pl is None else len(pl),
+                                      native._addr(native._record("lidet_cluster_cfg_t", c)),
+                                      native._addr(native._record("lidet_proposal_cfg_t", pc)), repeat, o["lab"],
+                                      o["mem"], ru, rf, o["nrec"], native._addr(o["stats"]), o["pxyz"], o["pmean"],
+                                      o["pvox"], ns)
+    return _result(o, st, "lidet_cluster_run (compact)", ru, rf, ns)

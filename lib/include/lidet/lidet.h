@@ -28,6 +28,7 @@
 #include "lidet_ground.h"
 #include "lidet_ground_q.h"
 #include "lidet_cluster.h"
+#include "lidet_cluster_q.h"
 #include "lidet_pointnet.h"
 #include "lidet_detector.h"
 

@@ -5,17 +5,9 @@
 #ifndef LIDET_CLUSTER_INTERNAL_H
 #define LIDET_CLUSTER_INTERNAL_H
 
+#include "internal/lidet_cluster_common.h"
 #include "internal/lidet_pixel.h"
 #include "lidet/lidet_cluster.h"
-
-/* pixel states in labels[] during a run (ids 1..LIDET_MAX_CLUSTERS are slots + 1) */
-#define LAB_FREE 0u         /* a candidate not visited yet */
-#define LAB_SMALL 0xFFFDu   /* a fragment (component below min_points) waiting for the rescue pass */
-#define LAB_PENDING 0xFFFEu /* visited: current cluster, or a dropped one */
-#define LAB_NONCAND 0xFFFFu /* no point, or ground: bridged over, never joined */
-
-#define STEPS LIDET_CLUSTER_MAX_STEPS
-#define RESCUE_MAX_COLS 15u /* rescue_cols limit (each fragment pixel looks at (2 rows + 1)(2 cols + 1) pixels) */
 
 /* Constants of one run's flood fill. */
 typedef struct
