@@ -50,6 +50,15 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->rescue_gap_per_m = 0.03f;
     cfg->rescue_rows = sensor != 0 && sensor->n_rows <= 16 ? 1u : 2u;
     cfg->rescue_cols = 6u;
+    /* refinement (issue 15), measured on the simulated crowd scenes (docs/BENCHMARKS.md) */
+    cfg->split_people = 1u;
+    cfg->split_min_width_m = 0.9f;
+    cfg->split_cell_m = 0.12f;
+    cfg->split_cell_per_m = 0.0f;
+    cfg->person_max_width_m = 1.0f;
+    cfg->person_min_height_m = 0.9f;
+    cfg->person_min_aspect = 1.8f;
+    cfg->person_min_cols = 3u;
 }
 
 lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cluster_cfg_t *cfg)
@@ -67,7 +76,13 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
         !lidet__isfinite(cfg->max_gap_per_m) || cfg->max_gap_per_m < 0.0f ||
         !lidet__isfinite(cfg->rescue_gap_m) || cfg->rescue_gap_m < 0.0f ||
         !lidet__isfinite(cfg->rescue_gap_per_m) || cfg->rescue_gap_per_m < 0.0f ||
-        cfg->rescue_rows > LIDET_MAX_ROWS || cfg->rescue_cols > RESCUE_MAX_COLS)
+        cfg->rescue_rows > LIDET_MAX_ROWS || cfg->rescue_cols > RESCUE_MAX_COLS || cfg->split_people > 1u ||
+        !lidet__isfinite(cfg->split_min_width_m) || !(cfg->split_min_width_m > 0.0f) ||
+        !lidet__isfinite(cfg->split_cell_m) || !(cfg->split_cell_m > 0.0f) ||
+        !lidet__isfinite(cfg->split_cell_per_m) || cfg->split_cell_per_m < 0.0f ||
+        !lidet__isfinite(cfg->person_max_width_m) || !(cfg->person_max_width_m > 0.0f) ||
+        !lidet__isfinite(cfg->person_min_height_m) || cfg->person_min_height_m < 0.0f ||
+        !lidet__isfinite(cfg->person_min_aspect) || cfg->person_min_aspect < 0.0f)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -155,8 +170,8 @@ static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t
 }
 
 /* height of `mean` above the ground plane of the sector of the seed's column (or the flat ground) */
-static float height_above_ground(const lidet_cluster_state_t *c, uint32_t seed, const float mean[3],
-                                 const lidet_plane_t *planes, uint32_t n_sectors)
+float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const float mean[3],
+                            const lidet_plane_t *planes, uint32_t n_sectors)
 {
     if (planes != 0)
     {
@@ -206,7 +221,7 @@ static uint32_t finish_cluster(lidet_cluster_state_t *c, uint32_t start, uint32_
     mean[0] = sum[0] * inv;
     mean[1] = sum[1] * inv;
     mean[2] = sum[2] * inv;
-    h = height_above_ground(c, (uint32_t)mem[start], mean, planes, n_sectors);
+    h = lidet__cluster_height(c, (uint32_t)mem[start], mean, planes, n_sectors);
     if (!(h <= c->cfg.max_mean_height_m))
     {
         ++st->n_dropped_height;
@@ -292,7 +307,7 @@ static void rescue_join(lidet_cluster_state_t *c, uint32_t slot, uint32_t start,
     rec->n_points += n;
     rec->n_rescued += n;
     rec->seed_pixel = seed < rec->seed_pixel ? seed : rec->seed_pixel;
-    rec->height_m = height_above_ground(c, rec->seed_pixel, rec->mean_m, planes, n_sectors);
+    rec->height_m = lidet__cluster_height(c, rec->seed_pixel, rec->mean_m, planes, n_sectors);
     ++st->n_rescue_joined;
     st->n_rescue_pixels += n;
 }
@@ -576,6 +591,10 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
         }
     }
     canonicalise(c, npix, &st);
+    if (c->cfg.split_people != 0u && lidet__refine_split(c, planes, n_sectors, &st))
+    {
+        canonicalise(c, npix, &st);
+    }
     st.n_kept = c->n_recs;
     c->stats = st;
     return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;

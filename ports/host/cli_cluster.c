@@ -97,6 +97,14 @@ static int apply_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, min_points, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, rescue_rows, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, rescue_cols, uint32_t, 4294967295.0)
+    CLI_SET_INT(c, kv, klen, v, split_people, uint32_t, 1)
+    CLI_SET_FLOAT(c, kv, klen, v, split_min_width_m)
+    CLI_SET_FLOAT(c, kv, klen, v, split_cell_m)
+    CLI_SET_FLOAT(c, kv, klen, v, split_cell_per_m)
+    CLI_SET_FLOAT(c, kv, klen, v, person_max_width_m)
+    CLI_SET_FLOAT(c, kv, klen, v, person_min_height_m)
+    CLI_SET_FLOAT(c, kv, klen, v, person_min_aspect)
+    CLI_SET_INT(c, kv, klen, v, person_min_cols, uint32_t, 65535)
     return 1;
 }
 
@@ -152,7 +160,8 @@ int cli_cluster(int argc, char **argv)
         fprintf(stderr, "  --labels   SemanticKITTI .label file: its ground classes are the ground mask\n"
                         "             (default: the ground stage, with its per-sector planes)\n"
                         "  --set KEY=VALUE  override a lidet_cluster_cfg_t field (repeatable), e.g.\n"
-                        "             --set rescue_gap_m=0 (no fragment rescue)\n");
+                        "             --set rescue_gap_m=0 (no fragment rescue),\n"
+                        "             --set split_people=0 (no refinement: people are not cut out of wide clusters)\n");
         free(rest);
         free(sets);
         return 1;
@@ -317,6 +326,8 @@ int cli_cluster(int argc, char **argv)
         cli_json_int(stdout, "fragments", cs->n_fragments);
         cli_json_int(stdout, "rescue_joined", cs->n_rescue_joined);
         cli_json_int(stdout, "rescue_pixels", cs->n_rescue_pixels);
+        cli_json_int(stdout, "split", cs->n_split);
+        cli_json_int(stdout, "split_parts", cs->n_split_parts);
         cli_json_int(stdout, "clusters", cs->n_kept);
         cli_json_int(stdout, "proposals", cs->n_kept);
         cli_json_int(stdout, "proposal_points", prcfg.n_points);

@@ -414,6 +414,15 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, max_proposals, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, gate1, uint8_t, 1)
     CLI_SET_INT(c, kv, klen, v, gate2, uint8_t, 1)
+    /* the proposal refinement (lidet_cluster_cfg_t, issue 15) */
+    CLI_SET_INT(c, kv, klen, v, stages.cluster.split_people, uint32_t, 1)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.split_min_width_m)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.split_cell_m)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.split_cell_per_m)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.person_max_width_m)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.person_min_height_m)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.person_min_aspect)
+    CLI_SET_INT(c, kv, klen, v, stages.cluster.person_min_cols, uint32_t, 65535)
     return 1;
 }
 
@@ -432,7 +441,10 @@ static void usage_extra(void)
                     "  --gt FILE        ground-truth boxes (lidet's sensor-frame lines) drawn in --png\n"
                     "  --gt-kitti FILE  ground truth as KITTI label_2 (with --calib) drawn in --png\n"
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
-                    "                   nms_iou, max_proposals, gate1, gate2\n"
+                    "                   nms_iou, max_proposals, gate1, gate2; the proposal refinement:\n"
+                    "                   stages.cluster.split_people (0/1), stages.cluster.split_min_width_m,\n"
+                    "                   .split_cell_m, .split_cell_per_m, .person_max_width_m, .person_min_height_m, .person_min_aspect,\n"
+                    "                   .person_min_cols\n"
                     "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n");
 }
 

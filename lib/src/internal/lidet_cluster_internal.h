@@ -46,4 +46,15 @@ uint32_t lidet__cluster_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, u
 void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start,
                                 lidet__rescue_t *rs);
 
+/* signed height of `mean` above the ground plane of the sector of pixel `seed`'s column, or the flat
+ * ground (lidet_cluster.c) */
+float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const float mean[3],
+                            const lidet_plane_t *planes, uint32_t n_sectors);
+
+/* The refinement (lidet_refine.c) on the canonical output of a run: cuts person-sized parts off wide
+ * clusters (cfg split_people). Labels and records are left for one more canonical pass; returns 1 when
+ * anything changed */
+int lidet__refine_split(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
+                        lidet_cluster_stats_t *st);
+
 #endif
