@@ -35,14 +35,13 @@ static inline uint32_t cell_of(const lidet_range_image_t *img, uint32_t p, const
 
 /* 8-connected parts of the occupied cells, numbered in the order their first member is met. Returns
  * the number of parts, or 0 when there are more than LIDET_REFINE_MAX_PARTS */
-static uint32_t label_parts(lidet_cluster_state_t *c, const lidet_cluster_rec_t *rec, const float lo[2], float inv,
-                            uint32_t nx, uint32_t ny)
+static uint32_t label_parts(lidet_cluster_state_t *c, uint32_t n, uint32_t nx, uint32_t ny)
 {
     uint16_t *grid = c->rf_grid, *q = c->rf_queue;
     uint32_t i, n_parts = 0;
-    for (i = rec->first_member; i < rec->first_member + rec->n_points; ++i)
+    for (i = 0; i < n; ++i)
     {
-        const uint32_t cell = cell_of(&c->img, (uint32_t)c->members[i], lo, inv, nx, ny);
+        const uint32_t cell = c->rf_cell[i];
         uint32_t head = 0, tail = 0;
         if (grid[cell] != CELL_OCC)
         {
@@ -136,7 +135,11 @@ static int split_one(lidet_cluster_state_t *c, uint32_t k, const lidet_plane_t *
     uint32_t nx, ny, n_parts, i, p, largest, largest_person, n_stay, n_new;
     int any_person = 0, all_person = 1;
 
-    if (!(ex > cfg->split_min_width_m) && !(ey > cfg->split_min_width_m))
+    /* examined: wider than one person. Two early outs that change no decision, only the time: a cut
+     * needs two parts of min_points each, and no part spans more in z than the whole */
+    if ((!(ex > cfg->split_min_width_m) && !(ey > cfg->split_min_width_m)) || rec.n_points < 2u * cfg->min_points ||
+        rec.n_points > LIDET_REFINE_MAX_POINTS ||
+        !(rec.max_m[2] - rec.min_m[2] >= cfg->person_min_height_m))
     {
         return 0;
     }
@@ -157,11 +160,13 @@ static int split_one(lidet_cluster_state_t *c, uint32_t k, const lidet_plane_t *
     lo[0] = rec.min_m[0];
     lo[1] = rec.min_m[1];
     memset(c->rf_grid, 0, (size_t)nx * ny * sizeof c->rf_grid[0]);
-    for (i = rec.first_member; i < rec.first_member + rec.n_points; ++i)
+    for (i = 0; i < rec.n_points; ++i)
     {
-        c->rf_grid[cell_of(&c->img, (uint32_t)c->members[i], lo, inv, nx, ny)] = (uint16_t)CELL_OCC;
+        const uint32_t cell = cell_of(&c->img, (uint32_t)c->members[rec.first_member + i], lo, inv, nx, ny);
+        c->rf_cell[i] = (uint16_t)cell;
+        c->rf_grid[cell] = (uint16_t)CELL_OCC;
     }
-    n_parts = label_parts(c, &rec, lo, inv, nx, ny);
+    n_parts = label_parts(c, rec.n_points, nx, ny);
     if (n_parts == 0u)
     {
         ++st->n_split_skipped;
@@ -183,10 +188,10 @@ static int split_one(lidet_cluster_state_t *c, uint32_t k, const lidet_plane_t *
         c->rf_col[p][0] = 0xFFFFu;
         c->rf_col[p][1] = 0;
     }
-    for (i = rec.first_member; i < rec.first_member + rec.n_points; ++i)
+    for (i = 0; i < rec.n_points; ++i)
     {
-        const uint32_t px = (uint32_t)c->members[i];
-        const uint32_t cell = cell_of(&c->img, px, lo, inv, nx, ny), cx = cell % nx, cy = cell / nx;
+        const uint32_t px = (uint32_t)c->members[rec.first_member + i];
+        const uint32_t cell = c->rf_cell[i], cx = cell % nx, cy = cell / nx;
         const uint32_t q = c->rf_grid[cell] - 1u;
         const float z = lidet__img_z(&c->img, px);
         const uint32_t col = px % c->img.n_cols;
@@ -263,10 +268,9 @@ static int split_one(lidet_cluster_state_t *c, uint32_t k, const lidet_plane_t *
     {
         return 0;
     }
-    for (i = rec.first_member; i < rec.first_member + rec.n_points; ++i)
+    for (i = 0; i < rec.n_points; ++i)
     {
-        const uint32_t px = (uint32_t)c->members[i];
-        c->labels[px] = (uint16_t)(c->rf_target[c->rf_grid[cell_of(&c->img, px, lo, inv, nx, ny)] - 1u] + 1u);
+        c->labels[c->members[rec.first_member + i]] = (uint16_t)(c->rf_target[c->rf_grid[c->rf_cell[i]] - 1u] + 1u);
     }
     rebuild(c, k, &rec, planes, n_sectors);
     c->recs[k].n_rescued = rec.n_rescued < c->recs[k].n_points ? rec.n_rescued : c->recs[k].n_points;

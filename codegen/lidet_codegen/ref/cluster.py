@@ -269,7 +269,8 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
 def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_people: bool = True,
                split_min_width_m: float = 0.9, split_cell_m: float = 0.12, split_cell_per_m: float = 0.0,
                person_max_width_m: float = 1.0, person_min_height_m: float = 0.9, person_min_aspect: float = 1.8, person_min_cols: int = 3,
-               max_clusters: int = 1 << 30, max_cells: int = 4096, max_parts: int = 32) -> np.ndarray:
+               max_clusters: int = 1 << 30, max_cells: int = 4096, max_parts: int = 32,
+               max_points: int = 4096) -> np.ndarray:
     """The refinement of lib/src/lidet_refine.c (split_people, the rule in lidet_cluster.h) on canonical
     cluster labels (rows, cols) of the clustering without it, with the image's points xyz (rows, cols, 3)
     float32. Returns the canonical labels the C gives with it: the same float32 operations in the same
@@ -284,7 +285,7 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_
     n_recs = k0
     for k in range(1, k0 + 1):
         mem = np.nonzero(lab == k)[0]          # raster order, as the C's members
-        if len(mem) == 0:
+        if len(mem) == 0 or len(mem) > max_points:
             continue
         pts = P[mem]
         lo, hi = pts.min(0), pts.max(0)

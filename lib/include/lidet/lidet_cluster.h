@@ -56,7 +56,8 @@
  *    their own; the other parts stay together in the cluster (when every part is person-sized the
  *    largest stays; parts below min_points stay, and when what stays would be below min_points the
  *    largest person-sized part stays with it). Records are recomputed, slots come from the free ones
- *    (none free: the rest stays). Only compares and integer cells: the integer build has an exact
+ *    (none free: the rest stays). Clusters needing more than LIDET_REFINE_MAX_CELLS cells,
+ *    LIDET_REFINE_MAX_PARTS parts or holding more than LIDET_REFINE_MAX_POINTS pixels stay whole. Only compares and integer cells: the integer build has an exact
  *    counterpart. Measured (docs/BENCHMARKS.md): simulated crowd scenes, people within 40 m;
  *  - output ids are canonical: 1-based in raster order of each kept cluster's first pixel;
  *    0 = no cluster. Each cluster's member pixels are listed contiguously, in raster order.
@@ -228,6 +229,7 @@ typedef struct
     /* scratch of the refinement (lidet_refine.c) */
     uint16_t rf_grid[LIDET_REFINE_MAX_CELLS];            /* cell -> part + 1 (0 = empty, 0xFFFF = occupied) */
     uint16_t rf_queue[LIDET_REFINE_MAX_CELLS];           /* cells of the part being filled */
+    uint16_t rf_cell[LIDET_REFINE_MAX_POINTS];           /* cell of each member of the examined cluster */
     uint16_t rf_target[LIDET_REFINE_MAX_PARTS];          /* part -> slot it goes to */
     uint32_t rf_n[LIDET_REFINE_MAX_PARTS];               /* points per part */
     uint16_t rf_box[LIDET_REFINE_MAX_PARTS][4];          /* cell bounds: ix0, ix1, iy0, iy1 */

@@ -56,6 +56,11 @@
 #define LIDET_REFINE_MAX_CELLS 4096
 #endif
 
+/** Proposal refinement: member pixels of a cluster it examines (more: left whole); 2 B each. */
+#ifndef LIDET_REFINE_MAX_POINTS
+#define LIDET_REFINE_MAX_POINTS 4096
+#endif
+
 /** Proposal refinement: connected parts one cluster may have on that grid (more: left whole). */
 #ifndef LIDET_REFINE_MAX_PARTS
 #define LIDET_REFINE_MAX_PARTS 32
@@ -164,6 +169,9 @@
 #endif
 #if LIDET_REFINE_MAX_CELLS < 16 || LIDET_REFINE_MAX_CELLS > 65535
 #error "LIDET_REFINE_MAX_CELLS must be in [16, 65535]"
+#endif
+#if LIDET_REFINE_MAX_POINTS < 1 || LIDET_REFINE_MAX_POINTS > 16777216
+#error "LIDET_REFINE_MAX_POINTS must be in [1, 2^24]"
 #endif
 #if LIDET_REFINE_MAX_PARTS < 2 || LIDET_REFINE_MAX_PARTS > 65535
 #error "LIDET_REFINE_MAX_PARTS must be in [2, 65535]"
