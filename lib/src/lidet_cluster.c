@@ -59,6 +59,13 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->person_min_height_m = 0.9f;
     cfg->person_min_aspect = 1.8f;
     cfg->person_min_cols = 3u;
+    cfg->join_cars = 1u;
+    cfg->join_gap_m = 0.5f;
+    cfg->car_max_length_m = 5.2f;
+    cfg->car_max_width_m = 2.2f;
+    cfg->car_max_height_m = 2.0f;
+    cfg->car_min_length_m = 2.5f;
+    cfg->upright_max_width_m = 1.3f;
 }
 
 lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cluster_cfg_t *cfg)
@@ -82,7 +89,12 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
         !lidet__isfinite(cfg->split_cell_per_m) || cfg->split_cell_per_m < 0.0f ||
         !lidet__isfinite(cfg->person_max_width_m) || !(cfg->person_max_width_m > 0.0f) ||
         !lidet__isfinite(cfg->person_min_height_m) || cfg->person_min_height_m < 0.0f ||
-        !lidet__isfinite(cfg->person_min_aspect) || cfg->person_min_aspect < 0.0f)
+        !lidet__isfinite(cfg->person_min_aspect) || cfg->person_min_aspect < 0.0f || cfg->join_cars > 1u ||
+        !lidet__isfinite(cfg->join_gap_m) || cfg->join_gap_m < 0.0f || !lidet__isfinite(cfg->car_max_length_m) ||
+        !(cfg->car_max_length_m > 0.0f) || !lidet__isfinite(cfg->car_max_width_m) || !(cfg->car_max_width_m > 0.0f) ||
+        !lidet__isfinite(cfg->car_max_height_m) || !(cfg->car_max_height_m > 0.0f) ||
+        !lidet__isfinite(cfg->car_min_length_m) || cfg->car_min_length_m < 0.0f ||
+        !lidet__isfinite(cfg->upright_max_width_m) || cfg->upright_max_width_m < 0.0f)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -591,9 +603,15 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
         }
     }
     canonicalise(c, npix, &st);
-    if (c->cfg.split_people != 0u && lidet__refine_split(c, planes, n_sectors, &st))
     {
-        canonicalise(c, npix, &st);
+        int changed;
+        memset(c->order, 0, sizeof c->order); /* the cut marks */
+        changed = c->cfg.split_people != 0u && lidet__refine_split(c, planes, n_sectors, &st);
+        changed |= c->cfg.join_cars != 0u && lidet__refine_join(c, npix, planes, n_sectors, &st);
+        if (changed)
+        {
+            canonicalise(c, npix, &st);
+        }
     }
     st.n_kept = c->n_recs;
     c->stats = st;

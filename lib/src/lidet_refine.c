@@ -282,6 +282,11 @@ static int split_one(lidet_cluster_state_t *c, uint32_t k, const lidet_plane_t *
             c->recs[c->rf_target[p]].n_rescued = 0;
         }
     }
+    c->order[k] = 1u; /* cut: no join */
+    for (p = 0; p < n_parts; ++p)
+    {
+        c->order[c->rf_target[p]] = 1u;
+    }
     ++st->n_split;
     st->n_split_parts += n_new;
     return 1;
@@ -298,4 +303,110 @@ int lidet__refine_split(lidet_cluster_state_t *c, const lidet_plane_t *planes, u
         changed |= split_one(c, k, planes, n_sectors, st);
     }
     return changed;
+}
+
+/* a join candidate by its own box: not upright (a person, a cyclist, a pole: narrow in x and y, tall),
+ * and it fits a car */
+static int car_piece(const lidet_cluster_cfg_t *cfg, const lidet_cluster_rec_t *r)
+{
+    const float wx = r->max_m[0] - r->min_m[0], wy = r->max_m[1] - r->min_m[1], wz = r->max_m[2] - r->min_m[2];
+    const int upright = wx <= cfg->upright_max_width_m && wy <= cfg->upright_max_width_m && wz >= cfg->person_min_height_m;
+    return !upright && wz <= cfg->car_max_height_m && (wx > wy ? wx : wy) <= cfg->car_max_length_m &&
+           (wx > wy ? wy : wx) <= cfg->car_max_width_m;
+}
+
+/* can cluster b join a (boxes): near enough, and the union fits a car */
+static int joinable(const lidet_cluster_cfg_t *cfg, const lidet_cluster_rec_t *a, const lidet_cluster_rec_t *b)
+{
+    float gx = b->min_m[0] - a->max_m[0], gy = b->min_m[1] - a->max_m[1], ux, uy, uz, lo, hi;
+    const float g2 = cfg->join_gap_m * cfg->join_gap_m;
+    gx = a->min_m[0] - b->max_m[0] > gx ? a->min_m[0] - b->max_m[0] : gx;
+    gy = a->min_m[1] - b->max_m[1] > gy ? a->min_m[1] - b->max_m[1] : gy;
+    gx = gx > 0.0f ? gx : 0.0f;
+    gy = gy > 0.0f ? gy : 0.0f;
+    if (gx * gx + gy * gy > g2)
+    {
+        return 0;
+    }
+    lo = a->min_m[0] < b->min_m[0] ? a->min_m[0] : b->min_m[0];
+    hi = a->max_m[0] > b->max_m[0] ? a->max_m[0] : b->max_m[0];
+    ux = hi - lo;
+    lo = a->min_m[1] < b->min_m[1] ? a->min_m[1] : b->min_m[1];
+    hi = a->max_m[1] > b->max_m[1] ? a->max_m[1] : b->max_m[1];
+    uy = hi - lo;
+    lo = a->min_m[2] < b->min_m[2] ? a->min_m[2] : b->min_m[2];
+    hi = a->max_m[2] > b->max_m[2] ? a->max_m[2] : b->max_m[2];
+    uz = hi - lo;
+    return uz <= cfg->car_max_height_m && (ux > uy ? ux : uy) <= cfg->car_max_length_m &&
+           (ux > uy ? ux : uy) >= cfg->car_min_length_m && (ux > uy ? uy : ux) <= cfg->car_max_width_m;
+}
+
+int lidet__refine_join(lidet_cluster_state_t *c, uint32_t npix, const lidet_plane_t *planes, uint32_t n_sectors,
+                       lidet_cluster_stats_t *st)
+{
+    const lidet_cluster_cfg_t *cfg = &c->cfg;
+    const uint32_t k = c->n_recs;
+    uint16_t *map = c->slot_id; /* slot + 1 -> slot + 1 it goes to; 0 stays 0 (canonicalise rewrites it) */
+    uint32_t i, j, n_alive = 0, n_joined = 0;
+    for (i = 0; i <= k; ++i)
+    {
+        map[i] = (uint16_t)i;
+    }
+    for (i = 0; i < k; ++i)
+    {
+        lidet_cluster_rec_t *a = &c->recs[i];
+        if (map[i + 1u] != i + 1u || c->order[i] != 0u || !car_piece(cfg, a))
+        {
+            continue;
+        }
+        for (j = i + 1u; j < k; ++j)
+        {
+            const lidet_cluster_rec_t *b = &c->recs[j];
+            uint32_t d;
+            float inv;
+            if (map[j + 1u] != j + 1u || c->order[j] != 0u || !car_piece(cfg, b) || !joinable(cfg, a, b))
+            {
+                continue;
+            }
+            /* b joins a: count, bounds, mean (float, weighted), seed, height */
+            inv = 1.0f / (float)(a->n_points + b->n_points);
+            for (d = 0; d < 3u; ++d)
+            {
+                a->mean_m[d] = (a->mean_m[d] * (float)a->n_points + b->mean_m[d] * (float)b->n_points) * inv;
+                a->min_m[d] = b->min_m[d] < a->min_m[d] ? b->min_m[d] : a->min_m[d];
+                a->max_m[d] = b->max_m[d] > a->max_m[d] ? b->max_m[d] : a->max_m[d];
+            }
+            a->n_points += b->n_points;
+            a->n_rescued += b->n_rescued;
+            a->seed_pixel = b->seed_pixel < a->seed_pixel ? b->seed_pixel : a->seed_pixel;
+            a->height_m = lidet__cluster_height(c, a->seed_pixel, a->mean_m, planes, n_sectors);
+            map[j + 1u] = (uint16_t)(i + 1u);
+            ++n_joined;
+        }
+    }
+    if (n_joined == 0u)
+    {
+        return 0;
+    }
+    /* compact the records (the joined ones leave) and renumber every label */
+    for (i = 0; i < k; ++i)
+    {
+        if (map[i + 1u] == i + 1u)
+        {
+            c->recs[n_alive] = c->recs[i];
+            map[i + 1u] = (uint16_t)(++n_alive);
+        }
+        else
+        {
+            map[i + 1u] = map[map[i + 1u]]; /* its target is earlier, so already renumbered */
+        }
+    }
+    c->n_recs = n_alive;
+    for (i = 0; i < npix; ++i)
+    {
+        const uint32_t l = c->labels[i];
+        c->labels[i] = (uint16_t)(l <= k ? map[l] : 0u);
+    }
+    st->n_joined += n_joined;
+    return 1;
 }

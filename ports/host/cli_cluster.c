@@ -105,6 +105,13 @@ static int apply_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, person_min_height_m)
     CLI_SET_FLOAT(c, kv, klen, v, person_min_aspect)
     CLI_SET_INT(c, kv, klen, v, person_min_cols, uint32_t, 65535)
+    CLI_SET_INT(c, kv, klen, v, join_cars, uint32_t, 1)
+    CLI_SET_FLOAT(c, kv, klen, v, join_gap_m)
+    CLI_SET_FLOAT(c, kv, klen, v, car_max_length_m)
+    CLI_SET_FLOAT(c, kv, klen, v, car_max_width_m)
+    CLI_SET_FLOAT(c, kv, klen, v, car_max_height_m)
+    CLI_SET_FLOAT(c, kv, klen, v, car_min_length_m)
+    CLI_SET_FLOAT(c, kv, klen, v, upright_max_width_m)
     return 1;
 }
 
@@ -161,7 +168,8 @@ int cli_cluster(int argc, char **argv)
                         "             (default: the ground stage, with its per-sector planes)\n"
                         "  --set KEY=VALUE  override a lidet_cluster_cfg_t field (repeatable), e.g.\n"
                         "             --set rescue_gap_m=0 (no fragment rescue),\n"
-                        "             --set split_people=0 (no refinement: people are not cut out of wide clusters)\n");
+                        "             --set split_people=0 (people are not cut out of wide clusters),\n"
+                        "             --set join_cars=0 (car fragments are not joined)\n");
         free(rest);
         free(sets);
         return 1;
@@ -328,6 +336,7 @@ int cli_cluster(int argc, char **argv)
         cli_json_int(stdout, "rescue_pixels", cs->n_rescue_pixels);
         cli_json_int(stdout, "split", cs->n_split);
         cli_json_int(stdout, "split_parts", cs->n_split_parts);
+        cli_json_int(stdout, "joined", cs->n_joined);
         cli_json_int(stdout, "clusters", cs->n_kept);
         cli_json_int(stdout, "proposals", cs->n_kept);
         cli_json_int(stdout, "proposal_points", prcfg.n_points);

@@ -423,6 +423,13 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.person_min_height_m)
     CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.person_min_aspect)
     CLI_SET_INT(c, kv, klen, v, stages.cluster.person_min_cols, uint32_t, 65535)
+    CLI_SET_INT(c, kv, klen, v, stages.cluster.join_cars, uint32_t, 1)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.join_gap_m)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.car_max_length_m)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.car_max_width_m)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.car_max_height_m)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.car_min_length_m)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.upright_max_width_m)
     return 1;
 }
 
@@ -444,7 +451,8 @@ static void usage_extra(void)
                     "                   nms_iou, max_proposals, gate1, gate2; the proposal refinement:\n"
                     "                   stages.cluster.split_people (0/1), stages.cluster.split_min_width_m,\n"
                     "                   .split_cell_m, .split_cell_per_m, .person_max_width_m, .person_min_height_m, .person_min_aspect,\n"
-                    "                   .person_min_cols\n"
+                    "                   .person_min_cols, .join_cars (0/1), .join_gap_m, .car_max_length_m,\n"
+                    "                   .car_max_width_m, .car_max_height_m, .car_min_length_m, .upright_max_width_m\n"
                     "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n");
 }
 

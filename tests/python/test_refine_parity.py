@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The proposal refinement (lib/src/lidet_refine.c, cfg split_people) against its numpy reference
+"""The proposal refinement (lib/src/lidet_refine.c, cfg split_people and join_cars) against its numpy reference
 (codegen/lidet_codegen/ref/cluster.py: refine_ref): the C's labels without the refinement, refined in
 numpy, equal the C's labels with it, on simulated crowd scans (issue 15) of both sensor kinds."""
 import numpy as np
@@ -15,21 +15,34 @@ from lidet_tools.sim.simulate import simulate_scan
 def test_refine_matches_reference(sensor, index):
     r = simulate_scan(sensor, seed=15, index=index, crowd=True)
     g = ce.ground_mask(r.sem.astype(np.uint32))
-    plain = native.cluster(r.points, sensor, ground=g, split_people=0, with_image=True)
+    plain = native.cluster(r.points, sensor, ground=g, split_people=0, join_cars=0, with_image=True)
     refined = native.cluster(r.points, sensor, ground=g)
     xyz = np.stack([plain.image.x, plain.image.y, plain.image.z], -1)
     want = ref.refine_ref(plain.pixel_labels, xyz)
     assert refined.stats["n_split"] > 0          # the scene has groups to cut (else the test shows nothing)
     np.testing.assert_array_equal(refined.pixel_labels, want)
-    assert len(refined) == len(plain) + refined.stats["n_split_parts"]
+    assert len(refined) == len(plain) + refined.stats["n_split_parts"] - refined.stats["n_joined"]
+
+
+@pytest.mark.parametrize("split,join", [(1, 0), (0, 1)])
+def test_each_rule_alone_matches_reference(split, join):
+    r = simulate_scan("hdl64", seed=15, index=3, crowd=True)
+    g = ce.ground_mask(r.sem.astype(np.uint32))
+    plain = native.cluster(r.points, "hdl64", ground=g, split_people=0, join_cars=0, with_image=True)
+    one = native.cluster(r.points, "hdl64", ground=g, split_people=split, join_cars=join)
+    assert one.stats["n_split" if split else "n_joined"] > 0 and one.stats["n_joined" if split else "n_split"] == 0
+    xyz = np.stack([plain.image.x, plain.image.y, plain.image.z], -1)
+    np.testing.assert_array_equal(one.pixel_labels,
+                                  ref.refine_ref(plain.pixel_labels, xyz, split_people=bool(split), join_cars=bool(join)))
 
 
 def test_refine_off_is_the_plain_clustering():
     r = simulate_scan("hdl64", seed=15, index=0, crowd=True)
     g = ce.ground_mask(r.sem.astype(np.uint32))
-    a = native.cluster(r.points, "hdl64", ground=g, split_people=0, with_image=True)
+    a = native.cluster(r.points, "hdl64", ground=g, split_people=0, join_cars=0, with_image=True)
     xyz = np.stack([a.image.x, a.image.y, a.image.z], -1)
-    np.testing.assert_array_equal(ref.refine_ref(a.pixel_labels, xyz, split_people=False), a.pixel_labels)
+    off = ref.refine_ref(a.pixel_labels, xyz, split_people=False, join_cars=False)
+    np.testing.assert_array_equal(off, a.pixel_labels)
     assert a.stats["n_split"] == 0
 
 

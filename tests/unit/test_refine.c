@@ -63,8 +63,8 @@ static double hit_box(const obj_t *o, double dx, double dy)
     return t0 <= t1 ? t0 : -1.0;
 }
 
-/* ray-cast the scene; `drop(col)` nonzero removes that column's returns on objects (dropouts) */
-static void render(const obj_t *objs, int n, int (*drop)(int col))
+/* ray-cast the scene; `drop(row, col)` nonzero removes that pixel's return (dropouts) */
+static void render(const obj_t *objs, int n, int (*drop)(int row, int col))
 {
     int r, c, i, np = 0;
     for (r = 0; r < ROWS; ++r)
@@ -92,7 +92,7 @@ static void render(const obj_t *objs, int n, int (*drop)(int col))
             g_idx[p] = -1;
             g_obj[p] = 0;
             g_x[p] = g_y[p] = g_z[p] = g_r[p] = g_rxy[p] = 0.0f;
-            if (who < 0 || (drop != 0 && drop(c)))
+            if (who < 0 || (drop != 0 && drop(r, c)))
                 continue;
             g_x[p] = (float)(best * dx);
             g_y[p] = (float)(best * dy);
@@ -239,22 +239,87 @@ static void test_group_with_child(void)
     assert_records_consistent();
 }
 
-/* dropouts in two column bands of the car's flank: the clustering gives three pieces; the refinement
- * cuts none of them (no piece is person-sized) and does not join them either (not implemented) */
-static int car_gaps(int col)
+/* a car (4.4 x 1.8 x 1.5 m, 8 m ahead and 1 m to the left: its rear and its right flank seen) with two
+ * bands of five beams lost (dark paint, glass): the depth clustering (defaults) gives three pieces, one
+ * above the other; the refinement joins them into one and cuts nothing */
+static int car_bands(int row, int col)
 {
-    return (col >= 996 && col < 1014) || (col >= 1034 && col < 1052);
+    (void)col;
+    return (row >= 12 && row < 17) || (row >= 20 && row < 25);
 }
 
-static void test_car_in_three_pieces_not_cut(void)
+static uint32_t run_defaults(int split, int join)
 {
-    const obj_t s[1] = {{1, 8.0, -0.9, 12.4, 0.9, -1.60, -0.25}};
-    uint32_t n0;
-    render(s, 1, car_gaps);
-    n0 = run(0);
-    TEST_ASSERT_EQUAL_UINT32(3, n0);
-    TEST_ASSERT_EQUAL_UINT32(n0, run(1));
+    lidet_cluster_cfg_t cfg;
+    uint32_t n = 0;
+    lidet_cluster_cfg_default(&cfg, NULL);
+    cfg.split_people = (uint32_t)split;
+    cfg.join_cars = (uint32_t)join;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g_cl, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g_cl, &g_img, NULL, NULL, 0));
+    (void)lidet_cluster_records(&g_cl, &n);
+    return n;
+}
+
+static void test_car_in_three_pieces_joined(void)
+{
+    const obj_t s[1] = {{1, 8.0, 1.0, 12.4, 2.8, -1.70, -0.20}};
+    render(s, 1, car_bands);
+    TEST_ASSERT_EQUAL_UINT32(3, run_defaults(1, 0));
+    TEST_ASSERT_EQUAL_UINT32(1, run_defaults(1, 1));
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_cluster_stats(&g_cl)->n_joined);
     TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g_cl)->n_split);
+    assert_one_to_one(1);
+    assert_records_consistent();
+}
+
+/* two cars nose to tail 1.2 m apart, the join gap widened to 1.5 m: their union is longer than a car,
+ * so no cluster takes both; allowing a 12 m car joins them (the rule is what keeps them apart) */
+static uint32_t run_join(float gap_m, float max_len_m)
+{
+    lidet_cluster_cfg_t cfg;
+    uint32_t n = 0;
+    lidet_cluster_cfg_default(&cfg, NULL);
+    cfg.join_gap_m = gap_m;
+    cfg.car_max_length_m = max_len_m;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g_cl, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g_cl, &g_img, NULL, NULL, 0));
+    (void)lidet_cluster_records(&g_cl, &n);
+    return n;
+}
+
+static int cars_mixed(void)
+{
+    const uint16_t *lab = lidet_cluster_labels(&g_cl);
+    uint32_t owner[64], p;
+    memset(owner, 0, sizeof owner);
+    for (p = 0; p < NPIX; ++p)
+    {
+        if (lab[p] == 0)
+        {
+            continue;
+        }
+        TEST_ASSERT_TRUE(lab[p] < 64u);
+        if (owner[lab[p]] == 0)
+        {
+            owner[lab[p]] = g_obj[p];
+        }
+        if (owner[lab[p]] != g_obj[p])
+        {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static void test_two_cars_not_joined(void)
+{
+    const obj_t s[2] = {{1, 8.0, 1.0, 12.4, 2.8, -1.70, -0.20}, {1, 13.6, 1.0, 18.0, 2.8, -1.70, -0.20}};
+    render(s, 2, 0);
+    TEST_ASSERT_TRUE(run_join(1.5f, 5.2f) >= 2u);
+    TEST_ASSERT_FALSE(cars_mixed());
+    (void)run_join(1.5f, 12.0f);
+    TEST_ASSERT_TRUE(cars_mixed());
 }
 
 /* one car alone is never cut */
@@ -279,6 +344,7 @@ static void test_deterministic_and_config(void)
     TEST_ASSERT_EQUAL_MEMORY(first, lidet_cluster_labels(&g_cl), sizeof first);
     lidet_cluster_cfg_default(&cfg, NULL);
     TEST_ASSERT_EQUAL_UINT32(1, cfg.split_people);
+    TEST_ASSERT_EQUAL_UINT32(1, cfg.join_cars);
     bad = cfg;
     bad.split_people = 2;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad));
@@ -287,6 +353,12 @@ static void test_deterministic_and_config(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad));
     bad = cfg;
     bad.person_min_aspect = -1.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad));
+    bad = cfg;
+    bad.join_cars = 3;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad));
+    bad = cfg;
+    bad.car_max_width_m = -1.0f;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad));
     bad = cfg;
     bad.split_min_width_m = (float)NAN;
@@ -299,7 +371,8 @@ int main(void)
     RUN_TEST(test_two_people_0_4m_apart);
     RUN_TEST(test_person_beside_car);
     RUN_TEST(test_group_with_child);
-    RUN_TEST(test_car_in_three_pieces_not_cut);
+    RUN_TEST(test_car_in_three_pieces_joined);
+    RUN_TEST(test_two_cars_not_joined);
     RUN_TEST(test_car_alone_not_cut);
     RUN_TEST(test_deterministic_and_config);
     return UNITY_END();

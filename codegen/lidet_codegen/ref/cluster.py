@@ -81,12 +81,13 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                 max_gap_m: float = 0.0, max_gap_per_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
                 max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30,
                 rescue_gap_m: float = 0.0, rescue_gap_per_m: float = 0.0, rescue_rows: int = 0, rescue_cols: int = 0,
-                split_people: bool = False, **refine):
+                split_people: bool = False, join_cars: bool = False, **refine):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
     member-pixel arrays per kept cluster in raster order). Float32 tangent and distance tests like the
     C; the filters use float64 means (they can differ from the C's float32 only at a filter's edge).
-    rescue_gap_m > 0 turns the fragment rescue on, split_people the refinement (refine_ref; lidet_cluster.h)."""
+    rescue_gap_m > 0 turns the fragment rescue on, split_people / join_cars the refinement (refine_ref;
+    lidet_cluster.h)."""
     rows, cols = range_m.shape
     rng = np.asarray(range_m, np.float32).ravel()
     cand = np.asarray(candidate, bool).ravel()
@@ -259,9 +260,9 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
         m = np.sort(np.asarray(m))
         labels[m] = i + 1
         out.append(m)
-    if split_people:  # the refinement (refine_ref; its other settings in `refine`)
+    if split_people or join_cars:  # the refinement (refine_ref; its other settings in `refine`)
         labels = refine_ref(labels.reshape(rows, cols), xyz, min_points=min_points, max_clusters=max_clusters,
-                            **refine).ravel()
+                            split_people=bool(split_people), join_cars=bool(join_cars), **refine).ravel()
         out = [np.nonzero(labels == i)[0] for i in range(1, int(labels.max(initial=0)) + 1)]
     return labels.reshape(rows, cols), out
 
@@ -270,8 +271,10 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_
                split_min_width_m: float = 0.9, split_cell_m: float = 0.12, split_cell_per_m: float = 0.0,
                person_max_width_m: float = 1.0, person_min_height_m: float = 0.9, person_min_aspect: float = 1.8, person_min_cols: int = 3,
                max_clusters: int = 1 << 30, max_cells: int = 4096, max_parts: int = 32,
-               max_points: int = 4096) -> np.ndarray:
-    """The refinement of lib/src/lidet_refine.c (split_people, the rule in lidet_cluster.h) on canonical
+               max_points: int = 4096, join_cars: bool = True, join_gap_m: float = 0.5,
+               car_max_length_m: float = 5.2, car_max_width_m: float = 2.2, car_max_height_m: float = 2.0,
+               car_min_length_m: float = 2.5, upright_max_width_m: float = 1.3) -> np.ndarray:
+    """The refinement of lib/src/lidet_refine.c (split_people, join_cars; the rules in lidet_cluster.h) on canonical
     cluster labels (rows, cols) of the clustering without it, with the image's points xyz (rows, cols, 3)
     float32. Returns the canonical labels the C gives with it: the same float32 operations in the same
     order (cell size, truncated cell indices, spans), so the decisions match bit for bit."""
@@ -279,11 +282,10 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_
     lab = np.asarray(labels).astype(np.int64).ravel().copy()
     P = np.asarray(xyz, np.float32).reshape(-1, 3)
     n_cols = np.shape(labels)[1]
-    if not split_people:
-        return lab.reshape(np.shape(labels))
     k0 = int(lab.max(initial=0))
     n_recs = k0
-    for k in range(1, k0 + 1):
+    cut = set()
+    for k in range(1, k0 + 1 if split_people else 1):
         mem = np.nonzero(lab == k)[0]          # raster order, as the C's members
         if len(mem) == 0 or len(mem) > max_points:
             continue
@@ -354,9 +356,49 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_
         if not (target != k).any():
             continue
         lab[mem] = target[part]
+        cut.update(target.tolist())
+    if join_cars:
+        lab = _join_ref(lab, P, n_recs, cut, f32(join_gap_m), f32(car_max_length_m), f32(car_max_width_m),
+                        f32(car_max_height_m), f32(car_min_length_m), f32(upright_max_width_m),
+                        f32(person_min_height_m))
     # canonical ids: raster order of each cluster's first pixel
     ids = np.unique(lab[lab > 0])
     first = np.array([np.argmax(lab == i) for i in ids])
     new = np.zeros(int(lab.max(initial=0)) + 1, np.int64)
     new[ids[np.argsort(first, kind="stable")]] = np.arange(1, len(ids) + 1)
     return new[lab].reshape(np.shape(labels))
+
+
+def _join_ref(lab, P, n_recs, cut, gap, lmax, wmax, hmax, lmin, umax, pmin):
+    """The joins of lidet_refine.c (join_cars) on slot labels 1..n_recs (slot order: canonical ids, then
+    the cut-off parts); returns the labels with the joined slots renumbered (not yet canonical)."""
+    f32 = np.float32
+    lo = np.zeros((n_recs + 1, 3), np.float32)
+    hi = np.zeros((n_recs + 1, 3), np.float32)
+    for k in range(1, n_recs + 1):
+        m = lab == k
+        lo[k], hi[k] = P[m].min(0), P[m].max(0)
+
+    def piece(k):
+        wx, wy, wz = f32(hi[k, 0] - lo[k, 0]), f32(hi[k, 1] - lo[k, 1]), f32(hi[k, 2] - lo[k, 2])
+        upright = wx <= umax and wy <= umax and wz >= pmin
+        return not upright and wz <= hmax and max(wx, wy) <= lmax and min(wx, wy) <= wmax
+
+    def joinable(a, b):
+        gx = max(f32(lo[b, 0] - hi[a, 0]), f32(lo[a, 0] - hi[b, 0]), f32(0.0))
+        gy = max(f32(lo[b, 1] - hi[a, 1]), f32(lo[a, 1] - hi[b, 1]), f32(0.0))
+        if f32(f32(gx * gx) + f32(gy * gy)) > f32(gap * gap):
+            return False
+        u = [f32(max(hi[a, d], hi[b, d]) - min(lo[a, d], lo[b, d])) for d in range(3)]
+        return u[2] <= hmax and lmin <= max(u[0], u[1]) <= lmax and min(u[0], u[1]) <= wmax
+
+    to = list(range(n_recs + 1))
+    for i in range(1, n_recs + 1):
+        if to[i] != i or i in cut or not piece(i):
+            continue
+        for j in range(i + 1, n_recs + 1):
+            if to[j] != j or j in cut or not piece(j) or not joinable(i, j):
+                continue
+            lo[i], hi[i] = np.minimum(lo[i], lo[j]), np.maximum(hi[i], hi[j])
+            to[j] = i
+    return np.asarray(to)[lab]

@@ -57,7 +57,15 @@
  *    largest stays; parts below min_points stay, and when what stays would be below min_points the
  *    largest person-sized part stays with it). Records are recomputed, slots come from the free ones
  *    (none free: the rest stays). Clusters needing more than LIDET_REFINE_MAX_CELLS cells,
- *    LIDET_REFINE_MAX_PARTS parts or holding more than LIDET_REFINE_MAX_POINTS pixels stay whole. Only compares and integer cells: the integer build has an exact
+ *    LIDET_REFINE_MAX_PARTS parts or holding more than LIDET_REFINE_MAX_POINTS pixels stay whole.
+ *    Then (join_cars, the default) car fragments are joined: clusters in slot order (the canonical
+ *    ids, then the cut-off parts in the order they were made), each cluster i takes every later
+ *    cluster j that lies within join_gap_m of it (squared x-y gap of the two boxes) when neither is
+ *    upright by its box (x and y span <= upright_max_width_m, z span >= person_min_height_m), each
+ *    fits a car alone, and the union's box spans at most
+ *    car_max_length_m (longer x-y side, and at least car_min_length_m), car_max_width_m (shorter) and
+ *    car_max_height_m (z); clusters the cuts made or cut take part in no join; i's box grows with
+ *    each join; Only compares and integer cells: the integer build has an exact
  *    counterpart. Measured (docs/BENCHMARKS.md): simulated crowd scenes, people within 40 m;
  *  - output ids are canonical: 1-based in raster order of each kept cluster's first pixel;
  *    0 = no cluster. Each cluster's member pixels are listed contiguously, in raster order.
@@ -161,6 +169,22 @@ typedef struct
     uint32_t person_min_cols; /**< ... and its pixels span at least this many image columns (a slice of a
                                   car's flank or a wall seen at a grazing angle, one column per cell, is
                                   not a person); default 3 */
+    uint32_t join_cars;      /**< 1 (default): after the cuts, two clusters whose boxes lie within
+                                  join_gap_m of each other in x-y and whose union fits a car (x-y
+                                  spans at most car_max_length_m and car_max_width_m, z span at most
+                                  car_max_height_m), neither upright, become one (a car cut by dark
+                                  paint, glass or wheel dropouts); 0: off */
+    float join_gap_m;        /**< >= 0; default 0.5 m (measured: 0.8 joined a cyclist to a car) */
+    float car_max_length_m;  /**< > 0; default 5.2 m */
+    float car_max_width_m;   /**< > 0; default 2.2 m (measured: 2.3-2.4 joined neighbouring real parked
+                                  cars, real SemanticKITTI cars within 40 m 94 -> 89 %) */
+    float car_max_height_m;  /**< > 0; default 2.0 m */
+    float car_min_length_m;  /**< ... and the union's longer x-y side at least this (two people or a
+                                  person and a bin seen by a few rings do not make a car); >= 0;
+                                  default 2.5 m */
+    float upright_max_width_m; /**< a cluster spanning at most this in x and in y and at least
+                                  person_min_height_m in z is upright (a person, a cyclist, a pole)
+                                  and joins nothing; >= 0; default 1.3 m */
 } lidet_cluster_cfg_t;
 
 /** @brief One kept cluster. Coordinates in the sensor frame (metres). */
@@ -197,6 +221,7 @@ typedef struct
     uint32_t n_split;             /**< refinement: clusters cut into parts */
     uint32_t n_split_parts;       /**< refinement: new clusters the cuts made */
     uint32_t n_split_skipped;     /**< refinement: clusters examined but too large for the grid caps */
+    uint32_t n_joined;            /**< refinement: clusters joined into another (car fragments) */
 } lidet_cluster_stats_t;
 
 /**
@@ -219,7 +244,8 @@ typedef struct
     float diag_sin[LIDET_MAX_ROWS], diag_cos[LIDET_MAX_ROWS]; /* [r]: rows r, r + 1, one column apart */
     /* outputs of the last run */
     lidet_cluster_rec_t recs[LIDET_MAX_CLUSTERS];
-    uint16_t order[LIDET_MAX_CLUSTERS];                  /* scratch: slots in seed order */
+    uint16_t order[LIDET_MAX_CLUSTERS];                  /* scratch: slots in seed order; during the
+                                                            refinement 1 = a slot the cuts made or cut */
     uint16_t slot_id[LIDET_MAX_CLUSTERS + 1];            /* scratch: slot + 1 -> canonical id */
     lidet_range_image_t img;                             /* the image of the last run (a view) */
     uint16_t *labels;                                    /* the last run's per-pixel ids (its buffer) */
