@@ -607,10 +607,11 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
         int changed;
         memset(c->order, 0, sizeof c->order); /* the cut marks */
         changed = c->cfg.split_people != 0u && lidet__refine_split(c, planes, n_sectors, &st);
-        changed |= c->cfg.join_cars != 0u && lidet__refine_join(c, npix, planes, n_sectors, &st);
+        changed |= c->cfg.join_cars != 0u && lidet__refine_join(c, planes, n_sectors, &st);
         if (changed)
         {
             canonicalise(c, npix, &st);
+            c->n_recs -= st.n_joined; /* the emptied records, ordered last */
         }
     }
     st.n_kept = c->n_recs;

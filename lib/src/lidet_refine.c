@@ -136,7 +136,8 @@ static int split_one(lidet_cluster_state_t *c, uint32_t k, const lidet_plane_t *
     int any_person = 0, all_person = 1;
 
     /* examined: wider than one person. Two early outs that change no decision, only the time: a cut
-     * needs two parts of min_points each, and no part spans more in z than the whole */
+     * needs two parts of min_points each, and no part spans more in z than the whole (measured: a limit
+     * on the cluster's height, skipping walls and trees, saved no time and lost people beside poles) */
     if ((!(ex > cfg->split_min_width_m) && !(ey > cfg->split_min_width_m)) || rec.n_points < 2u * cfg->min_points ||
         rec.n_points > LIDET_REFINE_MAX_POINTS ||
         !(rec.max_m[2] - rec.min_m[2] >= cfg->person_min_height_m))
@@ -341,34 +342,32 @@ static int joinable(const lidet_cluster_cfg_t *cfg, const lidet_cluster_rec_t *a
            (ux > uy ? ux : uy) >= cfg->car_min_length_m && (ux > uy ? uy : ux) <= cfg->car_max_width_m;
 }
 
-int lidet__refine_join(lidet_cluster_state_t *c, uint32_t npix, const lidet_plane_t *planes, uint32_t n_sectors,
+int lidet__refine_join(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
                        lidet_cluster_stats_t *st)
 {
     const lidet_cluster_cfg_t *cfg = &c->cfg;
     const uint32_t k = c->n_recs;
-    uint16_t *map = c->slot_id; /* slot + 1 -> slot + 1 it goes to; 0 stays 0 (canonicalise rewrites it) */
-    uint32_t i, j, n_alive = 0, n_joined = 0;
-    for (i = 0; i <= k; ++i)
-    {
-        map[i] = (uint16_t)i;
-    }
+    uint32_t i, j, n_joined = 0;
     for (i = 0; i < k; ++i)
     {
         lidet_cluster_rec_t *a = &c->recs[i];
-        if (map[i + 1u] != i + 1u || c->order[i] != 0u || !car_piece(cfg, a))
+        /* order[]: 1 = cut by the split, 2 = joined into an earlier cluster */
+        if (c->order[i] != 0u || !car_piece(cfg, a))
         {
             continue;
         }
         for (j = i + 1u; j < k; ++j)
         {
-            const lidet_cluster_rec_t *b = &c->recs[j];
-            uint32_t d;
+            lidet_cluster_rec_t *b = &c->recs[j];
+            uint32_t d, m;
             float inv;
-            if (map[j + 1u] != j + 1u || c->order[j] != 0u || !car_piece(cfg, b) || !joinable(cfg, a, b))
+            if (c->order[j] != 0u || !car_piece(cfg, b) || !joinable(cfg, a, b))
             {
                 continue;
             }
-            /* b joins a: count, bounds, mean (float, weighted), seed, height */
+            /* b joins a: count, bounds, mean (float, weighted), seed, height. b was neither cut nor has it
+             * taken anything (later clusters take only at their own turn), so its record is the canonical
+             * one: its members are members[first_member, + n_points) */
             inv = 1.0f / (float)(a->n_points + b->n_points);
             for (d = 0; d < 3u; ++d)
             {
@@ -376,37 +375,21 @@ int lidet__refine_join(lidet_cluster_state_t *c, uint32_t npix, const lidet_plan
                 a->min_m[d] = b->min_m[d] < a->min_m[d] ? b->min_m[d] : a->min_m[d];
                 a->max_m[d] = b->max_m[d] > a->max_m[d] ? b->max_m[d] : a->max_m[d];
             }
+            for (m = b->first_member; m < b->first_member + b->n_points; ++m)
+            {
+                c->labels[c->members[m]] = (uint16_t)(i + 1u);
+            }
             a->n_points += b->n_points;
             a->n_rescued += b->n_rescued;
             a->seed_pixel = b->seed_pixel < a->seed_pixel ? b->seed_pixel : a->seed_pixel;
             a->height_m = lidet__cluster_height(c, a->seed_pixel, a->mean_m, planes, n_sectors);
-            map[j + 1u] = (uint16_t)(i + 1u);
+            /* b is left empty with the largest seed: the canonical pass puts it last, then it is dropped */
+            b->n_points = 0;
+            b->seed_pixel = 0xFFFFFFFFu;
+            c->order[j] = 2u;
             ++n_joined;
         }
     }
-    if (n_joined == 0u)
-    {
-        return 0;
-    }
-    /* compact the records (the joined ones leave) and renumber every label */
-    for (i = 0; i < k; ++i)
-    {
-        if (map[i + 1u] == i + 1u)
-        {
-            c->recs[n_alive] = c->recs[i];
-            map[i + 1u] = (uint16_t)(++n_alive);
-        }
-        else
-        {
-            map[i + 1u] = map[map[i + 1u]]; /* its target is earlier, so already renumbered */
-        }
-    }
-    c->n_recs = n_alive;
-    for (i = 0; i < npix; ++i)
-    {
-        const uint32_t l = c->labels[i];
-        c->labels[i] = (uint16_t)(l <= k ? map[l] : 0u);
-    }
     st->n_joined += n_joined;
-    return 1;
+    return n_joined > 0u;
 }

@@ -62,6 +62,9 @@ int cli_split_set(const char *kv, size_t *klen, double *v);
         return 0;                                                                                    \
     }
 
+/* `--set KEY=VALUE` on a clustering configuration (cli_cluster.c): 0, or 1 for an unknown key or a bad value */
+int cli_cluster_set(lidet_cluster_cfg_t *c, const char *kv);
+
 /* Subcommands */
 int cli_project(int argc, char **argv);
 int cli_ground(int argc, char **argv);

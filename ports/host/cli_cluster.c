@@ -75,9 +75,9 @@ static int write_bev_png(const char *path, const float *pts, uint32_t n, const u
     return rc;
 }
 
-/* `--set KEY=VALUE` overrides one lidet_cluster_cfg_t field. Returns 0, or 1 for an unknown key or
- * a bad number. */
-static int apply_set(lidet_cluster_cfg_t *c, const char *kv)
+/* `--set KEY=VALUE` overrides one lidet_cluster_cfg_t field (also `lidet detect --set
+ * stages.cluster.KEY=VALUE`). Returns 0, or 1 for an unknown key or a bad number. */
+int cli_cluster_set(lidet_cluster_cfg_t *c, const char *kv)
 {
     size_t klen;
     double v;
@@ -190,7 +190,7 @@ int cli_cluster(int argc, char **argv)
     lidet_cluster_cfg_default(&ccfg, a.sensor_profile);
     for (i = 0; i < nsets; ++i)
     {
-        if (apply_set(&ccfg, sets[i]) != 0)
+        if (cli_cluster_set(&ccfg, sets[i]) != 0)
         {
             fprintf(stderr, "lidet cluster: bad --set '%s' (KEY=VALUE with a lidet_cluster_cfg_t field)\n", sets[i]);
             free(sets);

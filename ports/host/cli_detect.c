@@ -414,22 +414,9 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, max_proposals, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, gate1, uint8_t, 1)
     CLI_SET_INT(c, kv, klen, v, gate2, uint8_t, 1)
-    /* the proposal refinement (lidet_cluster_cfg_t, issue 15) */
-    CLI_SET_INT(c, kv, klen, v, stages.cluster.split_people, uint32_t, 1)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.split_min_width_m)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.split_cell_m)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.split_cell_per_m)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.person_max_width_m)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.person_min_height_m)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.person_min_aspect)
-    CLI_SET_INT(c, kv, klen, v, stages.cluster.person_min_cols, uint32_t, 65535)
-    CLI_SET_INT(c, kv, klen, v, stages.cluster.join_cars, uint32_t, 1)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.join_gap_m)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.car_max_length_m)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.car_max_width_m)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.car_max_height_m)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.car_min_length_m)
-    CLI_SET_FLOAT(c, kv, klen, v, stages.cluster.upright_max_width_m)
+    /* any clustering field, the proposal refinement of issue 15 included */
+    if (strncmp(kv, "stages.cluster.", 15) == 0)
+        return cli_cluster_set(&c->stages.cluster, kv + 15);
     return 1;
 }
 
@@ -448,11 +435,9 @@ static void usage_extra(void)
                     "  --gt FILE        ground-truth boxes (lidet's sensor-frame lines) drawn in --png\n"
                     "  --gt-kitti FILE  ground truth as KITTI label_2 (with --calib) drawn in --png\n"
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
-                    "                   nms_iou, max_proposals, gate1, gate2; the proposal refinement:\n"
-                    "                   stages.cluster.split_people (0/1), stages.cluster.split_min_width_m,\n"
-                    "                   .split_cell_m, .split_cell_per_m, .person_max_width_m, .person_min_height_m, .person_min_aspect,\n"
-                    "                   .person_min_cols, .join_cars (0/1), .join_gap_m, .car_max_length_m,\n"
-                    "                   .car_max_width_m, .car_max_height_m, .car_min_length_m, .upright_max_width_m\n"
+                    "                   nms_iou, max_proposals, gate1, gate2; stages.cluster.KEY: a\n"
+                    "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
+                    "                   stages.cluster.split_people=0: no proposal refinement)\n"
                     "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n");
 }
 

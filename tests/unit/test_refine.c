@@ -49,15 +49,10 @@ static double hit_box(const obj_t *o, double dx, double dy)
             continue;
         }
         {
-            double ta = lo[k] / d[k], tb = hi[k] / d[k];
-            if (ta > tb)
-            {
-                const double t = ta;
-                ta = tb;
-                tb = t;
-            }
-            t0 = ta > t0 ? ta : t0;
-            t1 = tb < t1 ? tb : t1;
+            const double ta = lo[k] / d[k], tb = hi[k] / d[k];
+            const double t_in = ta < tb ? ta : tb, t_out = ta < tb ? tb : ta; /* entering and leaving the slab */
+            t0 = t_in > t0 ? t_in : t0;
+            t1 = t_out < t1 ? t_out : t1;
         }
     }
     return t0 <= t1 ? t0 : -1.0;
@@ -117,18 +112,23 @@ static void render(const obj_t *objs, int n, int (*drop)(int row, int col))
 
 /* the defaults, but joining generously (a small angle, 16 steps of hole bridging: 0.5 m at 10 m), so
  * that close objects come out of the depth clustering as one cluster, as they do on real streets */
+static uint32_t run_with(const lidet_cluster_cfg_t *cfg)
+{
+    uint32_t n = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g_cl, cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g_cl, &g_img, NULL, NULL, 0));
+    (void)lidet_cluster_records(&g_cl, &n);
+    return n;
+}
+
 static uint32_t run(int split)
 {
     lidet_cluster_cfg_t cfg;
-    uint32_t n = 0;
     lidet_cluster_cfg_default(&cfg, NULL);
     cfg.theta_rad = 0.02f;
     cfg.max_steps = 16u;
     cfg.split_people = (uint32_t)split;
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g_cl, &cfg));
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g_cl, &g_img, NULL, NULL, 0));
-    (void)lidet_cluster_records(&g_cl, &n);
-    return n;
+    return run_with(&cfg);
 }
 
 /* every cluster holds returns of one object only, and each object's returns lie in one cluster */
@@ -251,14 +251,10 @@ static int car_bands(int row, int col)
 static uint32_t run_defaults(int split, int join)
 {
     lidet_cluster_cfg_t cfg;
-    uint32_t n = 0;
     lidet_cluster_cfg_default(&cfg, NULL);
     cfg.split_people = (uint32_t)split;
     cfg.join_cars = (uint32_t)join;
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g_cl, &cfg));
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g_cl, &g_img, NULL, NULL, 0));
-    (void)lidet_cluster_records(&g_cl, &n);
-    return n;
+    return run_with(&cfg);
 }
 
 static void test_car_in_three_pieces_joined(void)
@@ -278,14 +274,10 @@ static void test_car_in_three_pieces_joined(void)
 static uint32_t run_join(float gap_m, float max_len_m)
 {
     lidet_cluster_cfg_t cfg;
-    uint32_t n = 0;
     lidet_cluster_cfg_default(&cfg, NULL);
     cfg.join_gap_m = gap_m;
     cfg.car_max_length_m = max_len_m;
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g_cl, &cfg));
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g_cl, &g_img, NULL, NULL, 0));
-    (void)lidet_cluster_records(&g_cl, &n);
-    return n;
+    return run_with(&cfg);
 }
 
 static int cars_mixed(void)
@@ -331,12 +323,21 @@ static void test_car_alone_not_cut(void)
     TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g_cl)->n_split);
 }
 
+/* a copy of cfg with one field set is refused by init */
+#define REFUSED(field, value)                                                                                \
+    do                                                                                                       \
+    {                                                                                                        \
+        lidet_cluster_cfg_t bad_ = cfg;                                                                      \
+        bad_.field = (value);                                                                                \
+        TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad_));                           \
+    } while (0)
+
 /* the same input gives the same labels (deterministic), and bad refinement settings are refused */
 static void test_deterministic_and_config(void)
 {
     static uint16_t first[NPIX];
     const obj_t s[2] = {{0, 10.0, -0.42, 0.22, 0.0, -1.73, 0.02}, {0, 10.0, 0.42, 0.22, 0.0, -1.73, 0.02}};
-    lidet_cluster_cfg_t cfg, bad;
+    lidet_cluster_cfg_t cfg;
     render(s, 2, 0);
     (void)run(1);
     memcpy(first, lidet_cluster_labels(&g_cl), sizeof first);
@@ -345,24 +346,12 @@ static void test_deterministic_and_config(void)
     lidet_cluster_cfg_default(&cfg, NULL);
     TEST_ASSERT_EQUAL_UINT32(1, cfg.split_people);
     TEST_ASSERT_EQUAL_UINT32(1, cfg.join_cars);
-    bad = cfg;
-    bad.split_people = 2;
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad));
-    bad = cfg;
-    bad.split_cell_m = 0.0f;
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad));
-    bad = cfg;
-    bad.person_min_aspect = -1.0f;
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad));
-    bad = cfg;
-    bad.join_cars = 3;
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad));
-    bad = cfg;
-    bad.car_max_width_m = -1.0f;
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad));
-    bad = cfg;
-    bad.split_min_width_m = (float)NAN;
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad));
+    REFUSED(split_people, 2u);
+    REFUSED(split_cell_m, 0.0f);
+    REFUSED(person_min_aspect, -1.0f);
+    REFUSED(join_cars, 3u);
+    REFUSED(car_max_width_m, -1.0f);
+    REFUSED(split_min_width_m, (float)NAN);
 }
 
 int main(void)

@@ -86,13 +86,16 @@
  *
  * Memory: sizeof(lidet_cluster_t) = LIDET_MAX_ROWS * LIDET_MAX_COLS * 6 B (uint16 label and int32
  * member per pixel) + LIDET_MAX_CLUSTERS * (sizeof(lidet_cluster_rec_t) + 6) B
- * + LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS * 8 B + ~200 B: about 1.6 MiB with the defaults
- * (128 x 2048), 0.17 MiB for a VLP-16 board (16 x 1800, 64 clusters). lidet_cluster_bytes() returns
- * the exact figure. Declare it `static`.
+ * + LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS * 8 B + the refinement's scratch (LIDET_REFINE_MAX_CELLS
+ * * 4 B + LIDET_REFINE_MAX_POINTS * 2 B + LIDET_REFINE_MAX_PARTS * 26 B) + ~200 B: about 1.6 MiB with
+ * the defaults (128 x 2048; 1,678,080 B on x86-64), 0.18 MiB for a VLP-16 board (16 x 1800, 64 clusters,
+ * refinement caps 2048: 192,448 B). lidet_cluster_bytes() returns the exact figure. Declare it `static`.
  * Time: O(n_rows * n_cols * max_steps) per run worst case, O(n_rows * n_cols) typical (the rescue
  * looks at (2 rescue_rows + 1)(2 rescue_cols + 1) pixels around each fragment pixel); plus O(K * LIDET_MAX_CLUSTERS)
  * when K clusters overflow the capacity, and at most O(LIDET_MAX_CLUSTERS^2) to order the ids when
- * rescued pixels precede a cluster's seed. No allocation.
+ * rescued pixels precede a cluster's seed. The refinement: O(members + cells) per examined cluster
+ * (cells <= LIDET_REFINE_MAX_CELLS), O(parts * members) for one it cuts, O(K^2) box tests for the joins of
+ * K clusters, and one more canonical pass over the image when anything changed. No allocation.
  */
 #ifndef LIDET_CLUSTER_H
 #define LIDET_CLUSTER_H

@@ -57,10 +57,11 @@ float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const
 int lidet__refine_split(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
                         lidet_cluster_stats_t *st);
 
-/* The refinement's joins of car fragments (cfg join_cars) on the records after the cuts: labels are
- * renumbered to the remaining slots (one pass over the npix labels when anything joined); returns 1
- * when anything joined */
-int lidet__refine_join(lidet_cluster_state_t *c, uint32_t npix, const lidet_plane_t *planes, uint32_t n_sectors,
+/* The refinement's joins of car fragments (cfg join_cars) on the records after the cuts: a joined
+ * cluster's pixels are relabelled and its record left empty with seed 0xFFFFFFFF (the canonical pass
+ * orders it last; the caller then drops it); order[] holds 1 for clusters the cuts made or cut (they
+ * take part in no join) and gets 2 for the joined ones. Returns 1 when anything joined */
+int lidet__refine_join(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
                        lidet_cluster_stats_t *st);
 
 #endif

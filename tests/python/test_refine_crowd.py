@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
 """The proposal refinement (lib/src/lidet_refine.c, cfg split_people and join_cars) against its numpy reference
 (codegen/lidet_codegen/ref/cluster.py: refine_ref): the C's labels without the refinement, refined in
-numpy, equal the C's labels with it, on simulated crowd scans (issue 15) of both sensor kinds."""
+numpy, equal the C's labels with it, on simulated crowd scans (issue 15) of both sensor kinds; and the
+crowd scenes of lidet-sim (close people; the default scenes unchanged)."""
 import numpy as np
 import pytest
 
@@ -54,3 +55,15 @@ def test_crowd_scene_has_close_people():
     cent = np.array([r.points[person & (r.inst == i), :2].mean(0) for i in ids])
     d = np.hypot(*(cent[:, None] - cent[None]).transpose(2, 0, 1)) + np.eye(len(cent)) * 1e9
     assert (d.min(1) < 1.2).sum() >= 4
+
+
+@pytest.mark.parametrize("sensor", ["hdl64", "vlp16"])
+def test_default_scenes_unchanged(sensor):
+    """Scenes without --crowd are the bytes of before it existed: the committed test scans (tests/data,
+    seed 0) come out again."""
+    import pathlib
+    d = pathlib.Path(__file__).resolve().parents[1] / "data" / f"sim_{sensor}"
+    r = simulate_scan(sensor, seed=0, index=0)
+    assert r.points.tobytes() == (d / "velodyne" / "000000.bin").read_bytes()
+    lab = (r.inst.astype(np.uint32) << 16) | r.sem.astype(np.uint32)
+    assert lab.tobytes() == (d / "labels" / "000000.label").read_bytes()
