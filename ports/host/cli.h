@@ -33,6 +33,9 @@ int cli_load(cli_args_t *a);
 void cli_free(cli_args_t *a);
 /* Monotonic clock in milliseconds. */
 double cli_now_ms(void);
+/* CPU time of the calling thread in ms (wall time where the platform has no thread clock): timings on
+ * a loaded machine, where other processes take the core in the middle of a run */
+double cli_cpu_ms(void);
 /* Median of n values (sorts in place). */
 double cli_median(double *v, int n);
 /* JSON helpers: open object, key/values with separators, close. */
