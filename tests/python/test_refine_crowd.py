@@ -92,3 +92,17 @@ def test_cli_switches_the_rules(cli, tmp_path):
     assert d_on["clusters"] != d_off["clusters"]  # its own ground stage and image: other counts, but they move
     rc, err = run("detect", str(scan), "--sensor", "hdl64", "--set", "stages.cluster.nope=1")
     assert rc != 0 and "bad --set" in err
+
+
+def test_realism_rows_measures():
+    """crowd_report's measures on hand-made points: fragments of a car's points and the gap between people."""
+    from lidet_tools.sim.crowd_report import fragments, person_gaps
+    line = np.stack([np.linspace(0, 4, 40), np.zeros(40), np.zeros(40)], 1)
+    assert fragments(line) == 1
+    two = np.concatenate([line[:10], line[-10:]])          # 0-0.9 m and 3.1-4 m: 2.2 m apart
+    assert fragments(two) == 2
+    assert fragments(np.concatenate([two, [[10.0, 0, 0]]])) == 2  # a stray point is no fragment
+    pts = np.array([[10, 0, 0], [10, 0.3, 0], [10, 0.9, 0], [60, 0, 0], [60, 5, 0]], np.float32)
+    sem = np.array([30, 30, 30, 30, 30])
+    inst = np.array([1, 1, 2, 3, 4])
+    np.testing.assert_allclose(sorted(person_gaps(pts, sem, inst)), [0.6, 0.6], atol=1e-6)  # 3, 4 beyond 40 m

@@ -47,26 +47,28 @@
  *    and the far side 1-2 m behind it, and the angle test cuts it into singletons that min_points
  *    dropped. Measured (docs/BENCHMARKS.md): simulated cars within 40 m recovered as one cluster
  *    vlp16 77 -> 90 %, hdl64 87 -> 94 %, real SemanticKITTI 89 -> 92 %;
- *  - refinement (split_people, the default; lib/src/lidet_refine.c): a kept cluster wider than
- *    split_min_width_m in x or y is drawn on a bird's-eye-view grid of cell split_cell_m +
- *    split_cell_per_m * r (r = max(|cx|, |cy|) + min(|cx|, |cy|) / 2 of its box centre: no sqrt) and
- *    cut into the 8-connected parts of its occupied cells. Parts spanning at most person_max_width_m
- *    in x and y whose points span at least person_min_height_m and person_min_aspect times that span in
- *    z, over at least person_min_cols image columns (person-sized) become clusters of
- *    their own; the other parts stay together in the cluster (when every part is person-sized the
- *    largest stays; parts below min_points stay, and when what stays would be below min_points the
- *    largest person-sized part stays with it). Records are recomputed, slots come from the free ones
- *    (none free: the rest stays). Clusters needing more than LIDET_REFINE_MAX_CELLS cells,
- *    LIDET_REFINE_MAX_PARTS parts or holding more than LIDET_REFINE_MAX_POINTS pixels stay whole.
- *    Then (join_cars, the default) car fragments are joined: clusters in slot order (the canonical
- *    ids, then the cut-off parts in the order they were made), each cluster i takes every later
- *    cluster j that lies within join_gap_m of it (squared x-y gap of the two boxes) when neither is
- *    upright by its box (x and y span <= upright_max_width_m, z span >= person_min_height_m), each
- *    fits a car alone, and the union's box spans at most
- *    car_max_length_m (longer x-y side, and at least car_min_length_m), car_max_width_m (shorter) and
- *    car_max_height_m (z); clusters the cuts made or cut take part in no join; i's box grows with
- *    each join; Only compares and integer cells: the integer build has an exact
- *    counterpart. Measured (docs/BENCHMARKS.md): simulated crowd scenes, people within 40 m;
+ *  - refinement, after the rescue (lib/src/lidet_refine.c; issue 15). Cuts (split_people, the default):
+ *    a kept cluster wider than split_min_width_m in x or y is drawn on a bird's-eye-view grid of cell
+ *    split_cell_m + split_cell_per_m * r (r = max(|cx|, |cy|) + min(|cx|, |cy|) / 2 of its box centre:
+ *    no sqrt) and cut into the 8-connected parts of its occupied cells. Parts spanning at most
+ *    person_max_width_m in x and y whose points span at least person_min_height_m and
+ *    person_min_aspect times that span in z, over at least person_min_cols image columns
+ *    (person-sized), become clusters of their own; the other parts stay together in the cluster (when
+ *    every part is person-sized the largest stays; parts below min_points stay, and when what stays
+ *    would be below min_points the largest person-sized part stays with it). Records are recomputed,
+ *    slots come from the free ones (none free: the rest stays). Clusters needing more than
+ *    LIDET_REFINE_MAX_CELLS cells or LIDET_REFINE_MAX_PARTS parts, or holding more than
+ *    LIDET_REFINE_MAX_POINTS pixels, stay whole. Joins (join_cars, the default): in slot order (the
+ *    canonical ids, then the cut-off parts in the order they were made) each cluster i takes every
+ *    later cluster j within join_gap_m of it (squared x-y gap of the two boxes) when neither is upright
+ *    by its box (x and y span <= upright_max_width_m, z span >= person_min_height_m), each fits a car
+ *    alone, and the union's box spans at most car_max_length_m (longer x-y side, and at least
+ *    car_min_length_m), car_max_width_m (shorter side) and car_max_height_m (z); i's box grows with
+ *    each join; clusters the cuts made or cut take part in no join. Both rules only compare
+ *    coordinates, integer cells and counts: the integer build has an exact counterpart. Measured
+ *    (docs/BENCHMARKS.md, issue 15's proposal recall within 40 m): simulated crowd scenes people
+ *    65 -> 85 % (hdl64), 71 -> 85 % (vlp16), cars 92 -> 93 %, 89 -> 91 %; default scenes and real
+ *    SemanticKITTI cars no worse;
  *  - output ids are canonical: 1-based in raster order of each kept cluster's first pixel;
  *    0 = no cluster. Each cluster's member pixels are listed contiguously, in raster order.
  * The BFS queue is the member array itself (every pixel is pushed at most once), so it cannot
