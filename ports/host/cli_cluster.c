@@ -366,6 +366,8 @@ int cli_cluster(int argc, char **argv)
                cs->n_dropped_capacity);
         printf("rescue          %u fragments; %u groups joined clusters, %u pixels kept\n", cs->n_fragments,
                cs->n_rescue_joined, cs->n_rescue_pixels);
+        printf("refinement      %u clusters cut into %u more (people); %u car fragments joined\n", cs->n_split,
+               cs->n_split_parts, cs->n_joined);
         printf("proposals       %u x %u points\n", cs->n_kept, prcfg.n_points);
         printf("cluster_ms      %.3f (median of %d; CPU %.3f; projection %.3f, proposals %.3f)\n", ms_clu,
                a.repeat, ms_cpu, ms_proj, ms_prop);
