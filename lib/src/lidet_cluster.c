@@ -50,6 +50,22 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->rescue_gap_per_m = 0.03f;
     cfg->rescue_rows = sensor != 0 && sensor->n_rows <= 16 ? 1u : 2u;
     cfg->rescue_cols = 6u;
+    /* refinement (issue 15), measured on the simulated crowd scenes (docs/BENCHMARKS.md) */
+    cfg->split_people = 1u;
+    cfg->split_min_width_m = 0.9f;
+    cfg->split_cell_m = 0.12f;
+    cfg->split_cell_per_m = 0.0f;
+    cfg->person_max_width_m = 1.0f;
+    cfg->person_min_height_m = 0.9f;
+    cfg->person_min_aspect = 1.8f;
+    cfg->person_min_cols = 3u;
+    cfg->join_cars = 1u;
+    cfg->join_gap_m = 0.5f;
+    cfg->car_max_length_m = 5.2f;
+    cfg->car_max_width_m = 2.2f;
+    cfg->car_max_height_m = 2.0f;
+    cfg->car_min_length_m = 2.5f;
+    cfg->upright_max_width_m = 1.3f;
 }
 
 static lidet_status_t init_done(lidet_cluster_state_t *c); /* lidet_cluster_run_body.h */
@@ -69,7 +85,18 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
         !lidet__isfinite(cfg->max_gap_per_m) || cfg->max_gap_per_m < 0.0f ||
         !lidet__isfinite(cfg->rescue_gap_m) || cfg->rescue_gap_m < 0.0f ||
         !lidet__isfinite(cfg->rescue_gap_per_m) || cfg->rescue_gap_per_m < 0.0f ||
-        cfg->rescue_rows > LIDET_MAX_ROWS || cfg->rescue_cols > RESCUE_MAX_COLS)
+        cfg->rescue_rows > LIDET_MAX_ROWS || cfg->rescue_cols > RESCUE_MAX_COLS || cfg->split_people > 1u ||
+        !lidet__isfinite(cfg->split_min_width_m) || !(cfg->split_min_width_m > 0.0f) ||
+        !lidet__isfinite(cfg->split_cell_m) || !(cfg->split_cell_m > 0.0f) ||
+        !lidet__isfinite(cfg->split_cell_per_m) || cfg->split_cell_per_m < 0.0f ||
+        !lidet__isfinite(cfg->person_max_width_m) || !(cfg->person_max_width_m > 0.0f) ||
+        !lidet__isfinite(cfg->person_min_height_m) || cfg->person_min_height_m < 0.0f ||
+        !lidet__isfinite(cfg->person_min_aspect) || cfg->person_min_aspect < 0.0f || cfg->join_cars > 1u ||
+        !lidet__isfinite(cfg->join_gap_m) || cfg->join_gap_m < 0.0f || !lidet__isfinite(cfg->car_max_length_m) ||
+        !(cfg->car_max_length_m > 0.0f) || !lidet__isfinite(cfg->car_max_width_m) || !(cfg->car_max_width_m > 0.0f) ||
+        !lidet__isfinite(cfg->car_max_height_m) || !(cfg->car_max_height_m > 0.0f) ||
+        !lidet__isfinite(cfg->car_min_length_m) || cfg->car_min_length_m < 0.0f ||
+        !lidet__isfinite(cfg->upright_max_width_m) || cfg->upright_max_width_m < 0.0f)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -98,7 +125,7 @@ static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t
 }
 
 /* height of `mean` above the ground plane of the sector of the seed's column (or the flat ground) */
-static float height_above_ground(const lidet_cluster_state_t *c, uint32_t seed, const float mean[3],
+float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const float mean[3],
                                  const lidet_plane_t *planes, uint32_t n_sectors)
 {
     if (planes != 0)
@@ -132,7 +159,7 @@ static int mean_height_ok(const lidet_cluster_state_t *c, uint32_t n, uint32_t s
     s->mean[0] = s->sum[0] * inv;
     s->mean[1] = s->sum[1] * inv;
     s->mean[2] = s->sum[2] * inv;
-    s->h = height_above_ground(c, seed, s->mean, planes, n_sectors);
+    s->h = lidet__cluster_height(c, seed, s->mean, planes, n_sectors);
     return s->h <= c->cfg.max_mean_height_m;
 }
 
@@ -158,7 +185,7 @@ static void join_mean(lidet_cluster_state_t *c, uint32_t slot, uint32_t n, const
 static void reheight(lidet_cluster_state_t *c, uint32_t slot, const lidet_plane_t *planes, uint32_t n_sectors)
 {
     lidet_cluster_rec_t *rec = &c->recs[slot];
-    rec->height_m = height_above_ground(c, rec->seed_pixel, rec->mean_m, planes, n_sectors);
+    rec->height_m = lidet__cluster_height(c, rec->seed_pixel, rec->mean_m, planes, n_sectors);
 }
 
 static int rescue_on(const lidet_cluster_state_t *c)
@@ -246,6 +273,20 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     }
 
     run_fills(c, &lk, npix, planes, n_sectors, &st);
+    /* the refinement (lidet_refine.c, issue 15): people cut out of wide clusters, car fragments joined; the
+     * canonical order again when it changed anything */
+    {
+        int changed;
+        memset(c->order, 0, sizeof c->order); /* the cut marks */
+        changed = c->cfg.split_people != 0u && lidet__refine_split(c, planes, n_sectors, &st);
+        changed |= c->cfg.join_cars != 0u && lidet__refine_join(c, planes, n_sectors, &st);
+        if (changed)
+        {
+            canonicalise(c, npix, &st);
+            c->n_recs -= st.n_joined; /* the emptied records, ordered last */
+        }
+    }
+    st.n_kept = c->n_recs;
     c->stats = st;
     return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }

@@ -90,7 +90,9 @@ class Rec:
 
 STAT_KEYS = ["n_candidates", "n_found", "n_fragments", "n_rescue_joined", "n_rescue_pixels", "n_dropped_small",
              "n_dropped_extent", "n_dropped_height", "n_dropped_capacity", "n_kept", "n_pixels_kept",
-             "n_queue_overflow"]
+             "n_queue_overflow",
+             # the float stage's refinement counts (lidet_refine.c); the integer stage has no refinement: always 0
+             "n_split", "n_split_parts", "n_split_skipped", "n_joined"]
 
 
 def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: dict | None = None,

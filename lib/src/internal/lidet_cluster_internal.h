@@ -38,4 +38,22 @@ uint32_t lidet__cluster_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, u
 void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start,
                                 lidet__rescue_t *rs);
 
+/* signed height of `mean` above the ground plane of the sector of pixel `seed`'s column, or the flat
+ * ground (lidet_cluster.c) */
+float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const float mean[3],
+                            const lidet_plane_t *planes, uint32_t n_sectors);
+
+/* The refinement (lidet_refine.c) on the canonical output of a run: cuts person-sized parts off wide
+ * clusters (cfg split_people). Labels and records are left for one more canonical pass; returns 1 when
+ * anything changed */
+int lidet__refine_split(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
+                        lidet_cluster_stats_t *st);
+
+/* The refinement's joins of car fragments (cfg join_cars) on the records after the cuts: a joined
+ * cluster's pixels are relabelled and its record left empty with seed 0xFFFFFFFF (the canonical pass
+ * orders it last; the caller then drops it); order[] holds 1 for clusters the cuts made or cut (they
+ * take part in no join) and gets 2 for the joined ones. Returns 1 when anything joined */
+int lidet__refine_join(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
+                       lidet_cluster_stats_t *st);
+
 #endif
