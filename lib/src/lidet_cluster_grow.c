@@ -75,13 +75,14 @@ static inline int link(float da, float db, float sn, float cs, const lidet__grow
     return 1;
 }
 
-/* Pushes pixel n onto the queue of the current cluster (members[tail]); returns the new tail. */
-static inline uint32_t take(uint16_t *lab, int32_t *mem, uint32_t tail, uint32_t n)
-{
-    lab[n] = (uint16_t)LAB_PENDING;
-    mem[tail] = (int32_t)n;
-    return tail + 1u;
-}
+/* the float stage's parameters of the flood fill template (lidet_cluster_grow_body.h) */
+#define GROW_D_T float
+#define GROW_TAB_T float
+#define GROW_TA(c, t) ((c)->t##_sin)
+#define GROW_TB(c, t) ((c)->t##_cos)
+#define GROW_LINK link
+#define GROW_STATE_T lidet_cluster_state_t
+#define GROW_PARAM_T lidet__grow_t
 
 /* the flood fill on a float image (ranges in metres) */
 #define GROW_RNG_T float

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "internal/lidet_math.h"
+#include "internal/lidet_sort.h"
 #include "lidet/lidet_detector.h"
 
 /* plausible sizes (l, w, h, metres) per class; the KITTI training labels' range with margin
@@ -115,63 +116,6 @@ lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg
 static uint32_t now(const lidet_detector_t *d)
 {
     return d->cfg.clock != 0 ? d->cfg.clock(d->cfg.clock_ctx) : 0u;
-}
-
-/* ---- candidate order: heapsort of (key, index), ties by index (deterministic, no recursion) -------- */
-
-static int before(const float *key, const uint16_t *idx, uint32_t a, uint32_t b)
-{
-    return key[a] < key[b] || (key[a] == key[b] && idx[a] < idx[b]);
-}
-
-static void swap2(float *key, uint16_t *idx, uint32_t a, uint32_t b)
-{
-    const float k = key[a];
-    const uint16_t i = idx[a];
-    key[a] = key[b];
-    idx[a] = idx[b];
-    key[b] = k;
-    idx[b] = i;
-}
-
-static void sift(float *key, uint16_t *idx, uint32_t root, uint32_t n)
-{
-    for (;;)
-    {
-        uint32_t c = 2u * root + 1u;
-        if (c >= n)
-        {
-            return;
-        }
-        if (c + 1u < n && before(key, idx, c, c + 1u))
-        {
-            ++c;
-        }
-        if (!before(key, idx, root, c))
-        {
-            return;
-        }
-        swap2(key, idx, root, c);
-        root = c;
-    }
-}
-
-static void sort_candidates(float *key, uint16_t *idx, uint32_t n)
-{
-    uint32_t i;
-    if (n < 2)
-    {
-        return;
-    }
-    for (i = n / 2u; i-- > 0;)
-    {
-        sift(key, idx, i, n);
-    }
-    for (i = n - 1u; i > 0; --i)
-    {
-        swap2(key, idx, 0, i);
-        sift(key, idx, 0, i);
-    }
 }
 
 /* ---- rotated BEV IoU (convex polygon clipping, Sutherland-Hodgman) ---------------------------------- */
@@ -339,11 +283,11 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
             ++st->n_out_of_range;
             continue;
         }
-        d->key[n_cand] = r2;
+        memcpy(&d->key[n_cand], &r2, sizeof r2); /* r2 >= 0: its bits order as the floats do */
         d->order[n_cand] = (uint16_t)i;
         ++n_cand;
     }
-    sort_candidates(d->key, d->order, n_cand);
+    lidet__sort_u32_u16(d->key, d->order, n_cand);
     if (n_cand > d->cfg.max_proposals)
     {
         for (i = d->cfg.max_proposals; i < n_cand; ++i)

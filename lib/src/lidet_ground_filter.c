@@ -395,13 +395,9 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
         {
             total += (lo - near_start) + (far_end - hi);
         }
-        sc->cell_first[s] = near_start;
-        sc->cell_n[s] = lo - near_start;
-        sc->cell_first[ns + s] = hi;
-        sc->cell_n[ns + s] = far_end - hi;
+        lidet__ground_cell_span(sc->cell_first, sc->cell_n, s, ns, near_start, lo, hi, far_end);
     }
-    g->stats.n_samples = total;
-    g->stats.n_samples_dropped = total - (lo + (LIDET_GROUND_MAX_SAMPLES - hi));
+    lidet__ground_sample_counts(&g->stats, total, lo, hi);
 }
 
 /* Pass 3 (mirrors ref/ground.py: label_pixels, veto_vertical): ground = holds a point and
@@ -576,28 +572,19 @@ lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_sc
                                         const lidet_range_image_t *img)
 {
     rxy_rows_t rr;
+    lidet_status_t st;
     if (g == 0 || scratch == 0 || mask == 0 || img == 0)
     {
         return LIDET_ERR_ARG;
     }
-    if (g->magic != LIDET_INIT_MAGIC)
+    st = lidet__ground_run_check(g->magic == LIDET_INIT_MAGIC,
+                                 lidet__img_compact(img) ? (img->x_4mm != 0 && img->y_4mm != 0 && img->z_4mm != 0)
+                                                         : (img->y_m != 0 && img->z_m != 0),
+                                 img, g->cfg.n_sectors, &g->stats);
+    if (st != LIDET_OK)
     {
-        return LIDET_ERR_STATE;
+        return st;
     }
-    if (lidet__img_compact(img) ? (img->x_4mm == 0 || img->y_4mm == 0 || img->z_4mm == 0)
-                                : (img->y_m == 0 || img->z_m == 0))
-    {
-        return LIDET_ERR_ARG;
-    }
-    if (img->n_rows > LIDET_MAX_ROWS || img->n_cols > LIDET_MAX_COLS)
-    {
-        return LIDET_ERR_BUFFER;
-    }
-    if (img->n_rows < 1u || img->n_cols < 4u || img->n_cols < g->cfg.n_sectors)
-    {
-        return LIDET_ERR_CONFIG;
-    }
-    memset(&g->stats, 0, sizeof g->stats);
     g->n_rows = img->n_rows;
     g->n_cols = img->n_cols;
     g->rng = lidet__rng_seed(g->cfg.seed); /* every run starts from the seed: deterministic per scan */
@@ -655,22 +642,9 @@ const uint8_t *lidet_ground_sector_source(const lidet_ground_t *g)
 lidet_status_t lidet_ground_point_labels_of(const lidet_ground_state_t *g, const uint8_t *mask,
                                             const int32_t *point_pixel, uint32_t n_points, uint8_t *out)
 {
-    uint32_t i, npix;
-    if (g == 0 || mask == 0 || ((point_pixel == 0 || out == 0) && n_points > 0u))
-    {
-        return LIDET_ERR_ARG;
-    }
-    if (g->magic != LIDET_INIT_MAGIC)
-    {
-        return LIDET_ERR_STATE;
-    }
-    npix = (uint32_t)g->n_rows * g->n_cols;
-    for (i = 0; i < n_points; ++i)
-    {
-        const int32_t p = point_pixel[i];
-        out[i] = (p >= 0 && (uint32_t)p < npix) ? mask[p] : 0u;
-    }
-    return LIDET_OK;
+    return g == 0 ? LIDET_ERR_ARG
+                  : lidet__ground_point_labels(g->magic == LIDET_INIT_MAGIC, mask, (uint32_t)g->n_rows * g->n_cols,
+                                               point_pixel, n_points, out);
 }
 
 lidet_status_t lidet_ground_point_labels(const lidet_ground_t *g, const int32_t *point_pixel,

@@ -440,82 +440,45 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
     return 1;
 }
 
+/* the float stage's side of lidet__ground_cells */
+typedef struct
+{
+    lidet_ground_state_t *g;
+    lidet_ground_scratch_t *sc;
+    const lidet_range_image_t *img;
+} fit_ctx_t;
+
+static int fit_cell(void *ctx, uint32_t k)
+{
+    fit_ctx_t *f = (fit_ctx_t *)ctx;
+    const uint32_t a = f->sc->cell_first[k], n = f->sc->cell_n[k];
+    LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
+    return fit_sector(f->g, f->sc, f->img, f->sc->sample_pix + a, n, &f->g->planes[k]);
+}
+
+static void copy_plane(void *ctx, uint32_t dst, int32_t src)
+{
+    lidet_ground_state_t *g = ((fit_ctx_t *)ctx)->g;
+    if (src >= 0)
+    {
+        g->planes[dst] = g->planes[src];
+    }
+    else
+    {
+        g->planes[dst].nx = 0.0f;
+        g->planes[dst].ny = 0.0f;
+        g->planes[dst].nz = 1.0f;
+        g->planes[dst].d_m = g->cfg.mount_height_m;
+    }
+}
+
 void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img)
 {
     const uint32_t ns = g->cfg.n_sectors;
-    const uint32_t n_cells = g->cfg.ring_split_m > 0.0f ? 2u * ns : ns;
-    uint32_t s, k;
-    lidet_plane_t mount;
-    mount.nx = 0.0f;
-    mount.ny = 0.0f;
-    mount.nz = 1.0f;
-    mount.d_m = g->cfg.mount_height_m;
-    /* every cell on its own samples: near cells 0..ns-1, then far cells (the RNG runs in this order) */
-    for (k = 0; k < 2u * ns; ++k)
-    {
-        const uint32_t a = sc->cell_first[k], n = sc->cell_n[k];
-        const int near = k < ns;
-        g->source[k] = near ? LIDET_GROUND_PLANE_MOUNT : LIDET_GROUND_PLANE_NEAR;
-        if (k >= n_cells || n < g->cfg.min_samples)
-        {
-            g->stats.n_sectors_sparse += (uint16_t)near;
-            continue;
-        }
-        LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
-        if (fit_sector(g, sc, img, sc->sample_pix + a, n, &g->planes[k]))
-        {
-            g->source[k] = LIDET_GROUND_PLANE_FITTED;
-            if (near)
-                ++g->stats.n_sectors_fitted;
-            else
-                ++g->stats.n_far_fitted;
-        }
-        else
-        {
-            g->stats.n_sectors_rejected += (uint16_t)near;
-        }
-    }
-    /* near fallback: nearest sector that has its own near plane (never a copied one), else the
-     * mount plane */
-    for (s = 0; s < ns; ++s)
-    {
-        int found = 0;
-        if (g->source[s] == LIDET_GROUND_PLANE_FITTED)
-        {
-            continue;
-        }
-        for (k = 1; k <= g->cfg.fallback_sectors && !found; ++k)
-        {
-            const uint32_t left = (s + ns - (k % ns)) % ns, right = (s + k) % ns;
-            if (g->source[left] == LIDET_GROUND_PLANE_FITTED)
-            {
-                g->planes[s] = g->planes[left];
-                found = 1;
-            }
-            else if (g->source[right] == LIDET_GROUND_PLANE_FITTED)
-            {
-                g->planes[s] = g->planes[right];
-                found = 1;
-            }
-        }
-        if (found)
-        {
-            g->source[s] = LIDET_GROUND_PLANE_NEIGHBOUR; /* never FITTED: not a source for others */
-            ++g->stats.n_sectors_neighbour;
-        }
-        else
-        {
-            g->planes[s] = mount;
-            ++g->stats.n_sectors_mount;
-        }
-    }
-    /* far fallback: the sector's own near plane */
-    for (s = 0; s < ns; ++s)
-    {
-        if (g->source[ns + s] != LIDET_GROUND_PLANE_FITTED)
-        {
-            g->planes[ns + s] = g->planes[s];
-            g->source[ns + s] = LIDET_GROUND_PLANE_NEAR;
-        }
-    }
+    fit_ctx_t f;
+    f.g = g;
+    f.sc = sc;
+    f.img = img;
+    lidet__ground_cells(g->source, sc->cell_n, ns, g->cfg.ring_split_m > 0.0f ? 2u * ns : ns, g->cfg.min_samples,
+                        g->cfg.fallback_sectors, &g->stats, fit_cell, copy_plane, &f);
 }

@@ -6,6 +6,7 @@
 
 #include "internal/lidet_assert.h"
 #include "internal/lidet_math.h"
+#include "internal/lidet_proj_rows.h"
 #include "lidet/lidet_proj.h"
 
 /* keep every accepted elevation away from +-90 deg so its tangent stays finite */
@@ -26,6 +27,13 @@ void lidet_proj_cfg_default(lidet_proj_cfg_t *cfg, const lidet_sensor_t *sensor)
     cfg->min_range_m = 0.1f;
     cfg->max_range_m = 0.0f;
     cfg->fov_margin_rad = 5.0f * LIDET_DEG2RAD_F;
+}
+
+/* lidet__proj_rows_top_down's order on this file's elevations */
+static int beam_above(const void *elev, uint32_t a, uint32_t b)
+{
+    const float *e = (const float *)elev;
+    return e[a] > e[b];
 }
 
 static int in_range(float v, float lo, float hi)
@@ -81,6 +89,7 @@ lidet_status_t lidet_proj_state_init(lidet_proj_state_t *proj, const lidet_proj_
     uint8_t ring_of_row[LIDET_MAX_ROWS];
     float top_rad, bottom_rad, span;
     uint32_t rows, r, k;
+    lidet_status_t status;
 
     if (proj == 0 || cfg == 0)
     {
@@ -88,13 +97,10 @@ lidet_status_t lidet_proj_state_init(lidet_proj_state_t *proj, const lidet_proj_
     }
     proj->magic = 0;
     s = &cfg->sensor;
-    if (s->n_rows == 0 || s->n_cols < 8)
+    status = lidet__proj_check_shape(s->n_rows, s->n_cols);
+    if (status != LIDET_OK)
     {
-        return LIDET_ERR_CONFIG;
-    }
-    if (s->n_rows > LIDET_MAX_ROWS || s->n_cols > LIDET_MAX_COLS)
-    {
-        return LIDET_ERR_BUFFER;
+        return status;
     }
     if (!in_range(cfg->min_range_m, 0.0f, 10.0f) || !in_range(cfg->fov_margin_rad, 0.0f, 0.5f) ||
         !in_range(cfg->max_range_m, 0.0f, 1.0e6f) ||
@@ -133,16 +139,7 @@ lidet_status_t lidet_proj_state_init(lidet_proj_state_t *proj, const lidet_proj_
 
     /* rows = beams sorted top to bottom (insertion sort, stable: equal elevations keep ring order,
      * and are then rejected below) */
-    for (r = 0; r < rows; ++r)
-    {
-        uint32_t j = r;
-        while (j > 0 && elev[ring_of_row[j - 1]] < elev[r])
-        {
-            ring_of_row[j] = ring_of_row[j - 1];
-            --j;
-        }
-        ring_of_row[j] = (uint8_t)r;
-    }
+    lidet__proj_rows_top_down(rows, elev, beam_above, ring_of_row);
     for (r = 0; r < rows; ++r)
     {
         proj->row_elev_rad[r] = elev[ring_of_row[r]];

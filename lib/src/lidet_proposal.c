@@ -7,7 +7,7 @@
 
 #include "internal/lidet_math.h"
 #include "internal/lidet_pixel.h"
-#include "internal/lidet_rng.h"
+#include "internal/lidet_proposal_rule.h"
 #include "lidet/lidet_cluster.h"
 
 
@@ -25,35 +25,6 @@ void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg)
     cfg->range_bin_m = 1.0f;
 }
 
-/* the generator state of one cluster's resampling: the seed mixed with the member count, so clusters
- * of different sizes draw different streams; 0 (xorshift's only fixed point) is replaced by
- * LIDET_RNG_PROPOSAL_ZERO_SEED (the value the reference, ref/cluster.py, uses) */
-static uint32_t rng_start(uint32_t seed, uint32_t n_src)
-{
-    const uint32_t s = seed ^ (n_src * 0x9E3779B9u);
-    return s != 0 ? s : LIDET_RNG_PROPOSAL_ZERO_SEED;
-}
-
-/* member index of output i (0, 1, ... in order; *s is the generator state). n_src <= n_out: every
- * member once, then draws with replacement; else one member from each of n_out equal runs of the
- * member list (stratified, without replacement). */
-static uint32_t next_index(uint32_t *s, uint32_t i, uint32_t n_src, uint32_t n_out)
-{
-    if (n_src <= n_out)
-    {
-        if (i < n_src)
-        {
-            return i;
-        }
-        return lidet__rng_next(s) % n_src;
-    }
-    {
-        const uint32_t b0 = (uint32_t)(((uint64_t)i * n_src) / n_out);
-        const uint32_t b1 = (uint32_t)(((uint64_t)(i + 1u) * n_src) / n_out);
-        return b0 + lidet__rng_next(s) % (b1 - b0); /* b1 > b0 because n_src > n_out */
-    }
-}
-
 lidet_status_t lidet_proposal_indices(uint32_t n_src, uint32_t n_out, uint32_t seed, uint32_t *out)
 {
     uint32_t i, s;
@@ -61,10 +32,10 @@ lidet_status_t lidet_proposal_indices(uint32_t n_src, uint32_t n_out, uint32_t s
     {
         return LIDET_ERR_ARG;
     }
-    s = rng_start(seed, n_src);
+    s = lidet__proposal_rng_start(seed, n_src);
     for (i = 0; i < n_out; ++i)
     {
-        out[i] = next_index(&s, i, n_src, n_out);
+        out[i] = lidet__proposal_next_index(&s, i, n_src, n_out);
     }
     return LIDET_OK;
 }
@@ -120,13 +91,13 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
     rec = &c->recs[cluster_index];
     img = &c->img;
     npix = (uint32_t)img->n_rows * img->n_cols;
-    state = rng_start(cfg->seed, rec->n_points);
+    state = lidet__proposal_rng_start(cfg->seed, rec->n_points);
     mx = rec->mean_m[0];
     my = rec->mean_m[1];
     mz = rec->mean_m[2];
     for (i = 0; i < cfg->n_points; ++i)
     {
-        const int32_t p = c->members[rec->first_member + next_index(&state, i, rec->n_points, cfg->n_points)];
+        const int32_t p = c->members[rec->first_member + lidet__proposal_next_index(&state, i, rec->n_points, cfg->n_points)];
         if (p < 0 || (uint32_t)p >= npix)
         {
             return LIDET_ERR_STATE; /* cannot happen after a run; guards a stale state */

@@ -1,7 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /* Sensor presets. Mirrored by tools/lidet_tools/sensors.py; tests/python/test_bindings_proj.py checks
- * that both give the same beam tables. Elevations in ring order, radians, float32-rounded. */
+ * that both give the same beam tables. Elevations in ring order, radians, float32-rounded. The integer
+ * profiles of the same presets (microradians, millimetres) are in lidet_sensor_q.c. */
 #include "internal/lidet_math.h"
+#include "internal/lidet_str.h"
 #include "lidet/lidet_sensor.h"
 
 /* KITTI HDL-64E, measured on real KITTI scans (median elevation per ring recovered from scan order):
@@ -45,16 +47,6 @@ static const lidet_sensor_t k_presets[] = {
 
 #define N_PRESETS (sizeof(k_presets) / sizeof(k_presets[0]))
 
-static int str_equal(const char *a, const char *b)
-{
-    while (*a != '\0' && *a == *b)
-    {
-        ++a;
-        ++b;
-    }
-    return *a == *b;
-}
-
 const lidet_sensor_t *lidet_sensor_find(const char *name)
 {
     uint32_t i;
@@ -64,7 +56,7 @@ const lidet_sensor_t *lidet_sensor_find(const char *name)
     }
     for (i = 0; i < N_PRESETS; ++i)
     {
-        if (str_equal(name, k_presets[i].name))
+        if (lidet__str_equal(name, k_presets[i].name))
         {
             return &k_presets[i];
         }

@@ -1,11 +1,13 @@
 /* SPDX-License-Identifier: MIT */
 /* Projection benchmark: lidet_proj_run versus a plain libm projection (atan2f for the column,
  * asinf for the elevation, nearest beam by binary search, same closest-wins rule and the same
- * output arrays) on the same scans, in the same run, interleaved. Also measures the angular error of
+ * output arrays) on the same scans, in the same run, interleaved; beside them the compact image a
+ * detector workspace keeps, from the float projection (lidet_proj_run_buffers) and from the integer
+ * one (lidet_proj_q_run on the points in mm, round(1000 x), converted before timing). Also measures the angular error of
  * lidet's azimuth and elevation tests against a double-precision reference, and the row/column
  * agreement with it. Prints one JSON object per scan and a summary object (tools/bench reads them).
  *
- * usage: lidet_bench_proj --sensor hdl64 [--repeat 30] SCAN.bin...
+ * usage: lidet_bench_proj --sensor hdl64 [--repeat 30] [--clock wall|cpu] SCAN.bin...
  */
 #include <math.h>
 #include <stdio.h>
@@ -28,10 +30,19 @@ static int32_t b_idx[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 static int32_t b_pp[LIDET_MAX_POINTS];
 static float b_mid_rad[LIDET_MAX_ROWS]; /* mid-angles between rows, descending */
 
+/* compact images: the float projection's and the integer projection's (same layout) */
+static int16_t c_x[LIDET_MAX_ROWS * LIDET_MAX_COLS], c_y[LIDET_MAX_ROWS * LIDET_MAX_COLS],
+    c_z[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+static uint16_t c_r[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+static lidet_proj_q_state_t g_proj_q;
+
+static clockid_t g_clock = CLOCK_MONOTONIC; /* --clock cpu: CLOCK_PROCESS_CPUTIME_ID (a loaded machine
+                                                preempts the longer runs: wall time then says little) */
+
 static double now_ms(void)
 {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(g_clock, &ts);
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
@@ -123,7 +134,11 @@ int main(int argc, char **argv)
 {
     const char *sensor = "hdl64";
     int repeat = 30, a, n_files = 0;
-    double sum_pts = 0, sum_lidet_ms = 0, sum_base_ms = 0, worst_az_deg = 0, worst_el_deg = 0;
+    double sum_pts = 0, sum_lidet_ms = 0, sum_base_ms = 0, sum_compact_ms = 0, sum_q_ms = 0, worst_az_deg = 0,
+           worst_el_deg = 0;
+    lidet_proj_q_cfg_t cfg_q;
+    lidet_proj_buffers_t cbuf;
+    lidet_proj_q_buffers_t qbuf;
     double agree_row = 0, agree_col = 0, agree_n = 0, fill_sum = 0;
     lidet_proj_cfg_t cfg;
     lidet_range_image_t img;
@@ -136,15 +151,32 @@ int main(int argc, char **argv)
             sensor = argv[++a];
         else if (strcmp(argv[a], "--repeat") == 0 && a + 1 < argc)
             repeat = atoi(argv[++a]);
+        else if (strcmp(argv[a], "--clock") == 0 && a + 1 < argc)
+            g_clock = strcmp(argv[++a], "cpu") == 0 ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC;
     }
     if (repeat < 1 || lidet_sensor_find(sensor) == NULL)
     {
-        fprintf(stderr, "usage: lidet_bench_proj --sensor NAME [--repeat N] SCAN.bin...\n");
+        fprintf(stderr, "usage: lidet_bench_proj --sensor NAME [--repeat N] [--clock wall|cpu] SCAN.bin...\n");
         return 1;
     }
     lidet_proj_cfg_default(&cfg, lidet_sensor_find(sensor));
     if (lidet_proj_init(&g_proj, &cfg) != LIDET_OK)
         return 1;
+    lidet_proj_q_cfg_default(&cfg_q, lidet_sensor_q_find(sensor));
+    if (lidet_proj_q_init(&g_proj_q, &cfg_q) != LIDET_OK)
+        return 1;
+    memset(&cbuf, 0, sizeof cbuf);
+    cbuf.x_4mm = c_x;
+    cbuf.y_4mm = c_y;
+    cbuf.z_4mm = c_z;
+    cbuf.range_4mm = c_r;
+    cbuf.point_idx = b_idx;
+    qbuf.x_4mm = c_x;
+    qbuf.y_4mm = c_y;
+    qbuf.z_4mm = c_z;
+    qbuf.range_4mm = c_r;
+    qbuf.point_idx = b_idx;
+    qbuf.point_pixel = NULL;
     lidet_proj_image(&g_proj, &img);
     rows = img.n_rows;
     cols = img.n_cols;
@@ -159,11 +191,12 @@ int main(int argc, char **argv)
         FILE *f;
         long size;
         float *pts;
+        int32_t *pts_mm;
         uint32_t n, i, np;
-        double *tl, *tb, ml, mb;
+        double *tl, *tb, *tc, *tq, ml, mb, mc, mq;
         const int32_t *pp;
         int k;
-        if (strcmp(argv[a], "--sensor") == 0 || strcmp(argv[a], "--repeat") == 0)
+        if (strcmp(argv[a], "--sensor") == 0 || strcmp(argv[a], "--repeat") == 0 || strcmp(argv[a], "--clock") == 0)
         {
             ++a;
             continue;
@@ -191,8 +224,15 @@ int main(int argc, char **argv)
             return 1;
         }
         fclose(f);
+        pts_mm = (int32_t *)malloc((size_t)size); /* 4 int32 per point: x, y, z in mm, remission unused */
+        if (pts_mm == NULL)
+            return 1;
+        for (i = 0; i < 4u * n; ++i)
+            pts_mm[i] = (int32_t)lround((double)pts[i] * 1000.0);
         tl = (double *)malloc(sizeof(double) * (size_t)repeat);
         tb = (double *)malloc(sizeof(double) * (size_t)repeat);
+        tc = (double *)malloc(sizeof(double) * (size_t)repeat);
+        tq = (double *)malloc(sizeof(double) * (size_t)repeat);
         for (k = 0; k < repeat; ++k) /* interleaved, so both see the same machine state */
         {
             double t0 = now_ms();
@@ -201,11 +241,22 @@ int main(int argc, char **argv)
             t0 = now_ms();
             baseline_run(pts, n, rows, cols, lo_rad, hi_rad);
             tb[k] = now_ms() - t0;
+            t0 = now_ms();
+            lidet_proj_run_buffers(&g_proj.state, &cbuf, pts, n, 4, NULL);
+            tc[k] = now_ms() - t0;
+            t0 = now_ms();
+            lidet_proj_q_run(&g_proj_q, &qbuf, pts_mm, n, 4, NULL);
+            tq[k] = now_ms() - t0;
         }
         ml = median(tl, repeat);
         mb = median(tb, repeat);
+        mc = median(tc, repeat);
+        mq = median(tq, repeat);
         free(tl);
         free(tb);
+        free(tc);
+        free(tq);
+        free(pts_mm);
 
         /* accuracy against double precision */
         pp = lidet_proj_point_pixels(&g_proj, &np);
@@ -250,15 +301,18 @@ int main(int argc, char **argv)
             fill_sum += (double)lidet_proj_stats(&g_proj)->n_pixels_filled / (double)(rows * cols);
             printf("{\"scan\": \"%s\", \"points\": %u, \"projected\": %u, \"fill_ratio\": %.4f, \"lidet_ms\": %.4f, "
                    "\"libm_ms\": %.4f, \"lidet_ns_per_point\": %.2f, \"libm_ns_per_point\": %.2f, \"speedup\": %.2f, "
-                   "\"max_az_err_deg\": %.6f, \"max_el_err_deg\": %.6f, \"row_agree\": %.6f, \"col_agree\": %.6f}\n",
+                   "\"max_az_err_deg\": %.6f, \"max_el_err_deg\": %.6f, \"row_agree\": %.6f, \"col_agree\": %.6f, "
+                   "\"compact_ns_per_point\": %.2f, \"int_ns_per_point\": %.2f}\n",
                    argv[a], n, lidet_proj_stats(&g_proj)->n_projected,
                    (double)lidet_proj_stats(&g_proj)->n_pixels_filled / (double)(rows * cols), ml, mb, ml * 1e6 / n,
                    mb * 1e6 / n, mb / ml, w_az, w_el, cnt ? (double)same_row / cnt : 0.0,
-                   cnt ? (double)same_col / cnt : 0.0);
+                   cnt ? (double)same_col / cnt : 0.0, mc * 1e6 / n, mq * 1e6 / n);
         }
         sum_pts += n;
         sum_lidet_ms += ml;
         sum_base_ms += mb;
+        sum_compact_ms += mc;
+        sum_q_ms += mq;
         ++n_files;
         free(pts);
     }
@@ -266,10 +320,11 @@ int main(int argc, char **argv)
     {
         printf("{\"summary\": true, \"sensor\": \"%s\", \"scans\": %d, \"repeat\": %d, \"lidet_ns_per_point\": %.2f, "
                "\"libm_ns_per_point\": %.2f, \"speedup\": %.2f, \"max_az_err_deg\": %.6f, \"max_el_err_deg\": %.6f, "
-               "\"row_agree\": %.6f, \"col_agree\": %.6f, \"mean_fill_ratio\": %.4f}\n",
+               "\"row_agree\": %.6f, \"col_agree\": %.6f, \"mean_fill_ratio\": %.4f, \"compact_ns_per_point\": %.2f, "
+               "\"int_ns_per_point\": %.2f}\n",
                sensor, n_files, repeat, sum_lidet_ms * 1e6 / sum_pts, sum_base_ms * 1e6 / sum_pts,
                sum_base_ms / sum_lidet_ms, worst_az_deg, worst_el_deg, agree_row / agree_n, agree_col / agree_n,
-               fill_sum / n_files);
+               fill_sum / n_files, sum_compact_ms * 1e6 / sum_pts, sum_q_ms * 1e6 / sum_pts);
     }
     return 0;
 }

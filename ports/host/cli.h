@@ -33,6 +33,9 @@ int cli_load(cli_args_t *a);
 void cli_free(cli_args_t *a);
 /* Monotonic clock in milliseconds. */
 double cli_now_ms(void);
+/* CPU time of the calling thread in ms (wall time where the platform has no thread clock): timings on
+ * a loaded machine, where other processes take the core in the middle of a run */
+double cli_cpu_ms(void);
 /* Median of n values (sorts in place). */
 double cli_median(double *v, int n);
 /* JSON helpers: open object, key/values with separators, close. */
@@ -61,6 +64,9 @@ int cli_split_set(const char *kv, size_t *klen, double *v);
         (c)->name = (type)(v);                                                                       \
         return 0;                                                                                    \
     }
+
+/* `--set KEY=VALUE` on a clustering configuration (cli_cluster.c): 0, or 1 for an unknown key or a bad value */
+int cli_cluster_set(lidet_cluster_cfg_t *c, const char *kv);
 
 /* Subcommands */
 int cli_project(int argc, char **argv);

@@ -75,9 +75,9 @@ static int write_bev_png(const char *path, const float *pts, uint32_t n, const u
     return rc;
 }
 
-/* `--set KEY=VALUE` overrides one lidet_cluster_cfg_t field. Returns 0, or 1 for an unknown key or
- * a bad number. */
-static int apply_set(lidet_cluster_cfg_t *c, const char *kv)
+/* `--set KEY=VALUE` overrides one lidet_cluster_cfg_t field (also `lidet detect --set
+ * stages.cluster.KEY=VALUE`). Returns 0, or 1 for an unknown key or a bad number. */
+int cli_cluster_set(lidet_cluster_cfg_t *c, const char *kv)
 {
     size_t klen;
     double v;
@@ -97,6 +97,21 @@ static int apply_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, min_points, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, rescue_rows, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, rescue_cols, uint32_t, 4294967295.0)
+    CLI_SET_INT(c, kv, klen, v, split_people, uint32_t, 1)
+    CLI_SET_FLOAT(c, kv, klen, v, split_min_width_m)
+    CLI_SET_FLOAT(c, kv, klen, v, split_cell_m)
+    CLI_SET_FLOAT(c, kv, klen, v, split_cell_per_m)
+    CLI_SET_FLOAT(c, kv, klen, v, person_max_width_m)
+    CLI_SET_FLOAT(c, kv, klen, v, person_min_height_m)
+    CLI_SET_FLOAT(c, kv, klen, v, person_min_aspect)
+    CLI_SET_INT(c, kv, klen, v, person_min_cols, uint32_t, 65535)
+    CLI_SET_INT(c, kv, klen, v, join_cars, uint32_t, 1)
+    CLI_SET_FLOAT(c, kv, klen, v, join_gap_m)
+    CLI_SET_FLOAT(c, kv, klen, v, car_max_length_m)
+    CLI_SET_FLOAT(c, kv, klen, v, car_max_width_m)
+    CLI_SET_FLOAT(c, kv, klen, v, car_max_height_m)
+    CLI_SET_FLOAT(c, kv, klen, v, car_min_length_m)
+    CLI_SET_FLOAT(c, kv, klen, v, upright_max_width_m)
     return 1;
 }
 
@@ -124,7 +139,7 @@ int cli_cluster(int argc, char **argv)
     char **rest;
     const char **sets;
     int nrest = 0, nsets = 0, i;
-    double *t_proj, *t_clu, *t_prop, *t_gnd, ms_proj, ms_clu, ms_prop;
+    double *t_proj, *t_clu, *t_prop, *t_gnd, *t_cpu, ms_proj, ms_clu, ms_prop, ms_cpu;
     uint32_t npix, p, n_pp, k, n_rec;
     const int32_t *pp;
     uint32_t *ids;
@@ -152,7 +167,9 @@ int cli_cluster(int argc, char **argv)
         fprintf(stderr, "  --labels   SemanticKITTI .label file: its ground classes are the ground mask\n"
                         "             (default: the ground stage, with its per-sector planes)\n"
                         "  --set KEY=VALUE  override a lidet_cluster_cfg_t field (repeatable), e.g.\n"
-                        "             --set rescue_gap_m=0 (no fragment rescue)\n");
+                        "             --set rescue_gap_m=0 (no fragment rescue),\n"
+                        "             --set split_people=0 (people are not cut out of wide clusters),\n"
+                        "             --set join_cars=0 (car fragments are not joined)\n");
         free(rest);
         free(sets);
         return 1;
@@ -173,7 +190,7 @@ int cli_cluster(int argc, char **argv)
     lidet_cluster_cfg_default(&ccfg, a.sensor_profile);
     for (i = 0; i < nsets; ++i)
     {
-        if (apply_set(&ccfg, sets[i]) != 0)
+        if (cli_cluster_set(&ccfg, sets[i]) != 0)
         {
             fprintf(stderr, "lidet cluster: bad --set '%s' (KEY=VALUE with a lidet_cluster_cfg_t field)\n", sets[i]);
             free(sets);
@@ -187,7 +204,7 @@ int cli_cluster(int argc, char **argv)
         return fail(&a, "cluster init", st);
     lidet_proposal_cfg_default(&prcfg);
 
-    t_proj = (double *)malloc(sizeof(double) * (size_t)a.repeat * 4u);
+    t_proj = (double *)malloc(sizeof(double) * (size_t)a.repeat * 5u);
     ids = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(a.n_points > 0 ? a.n_points : 1));
     if (t_proj == NULL || ids == NULL)
     {
@@ -199,6 +216,7 @@ int cli_cluster(int argc, char **argv)
     t_clu = t_proj + a.repeat;
     t_prop = t_clu + a.repeat;
     t_gnd = t_prop + a.repeat;
+    t_cpu = t_gnd + a.repeat;
 
     /* ground mask of the scan (computed once: it is not this stage's time) */
     st = lidet_proj_run(&g_proj, a.points, a.n_points, 4, a.ring);
@@ -241,7 +259,7 @@ int cli_cluster(int argc, char **argv)
 
     for (i = 0; i < a.repeat; ++i)
     {
-        double t0 = cli_now_ms();
+        double t0 = cli_now_ms(), c0;
         st = lidet_proj_run(&g_proj, a.points, a.n_points, 4, a.ring);
         t_proj[i] = cli_now_ms() - t0;
         if (!LIDET_SUCCEEDED(st))
@@ -258,7 +276,9 @@ int cli_cluster(int argc, char **argv)
             planes = lidet_ground_planes(&g_gnd, &n_sectors);
         }
         t0 = cli_now_ms();
+        c0 = cli_cpu_ms();
         st = lidet_cluster_run(&g_cl, &img, g_ground, planes, n_sectors);
+        t_cpu[i] = cli_cpu_ms() - c0;
         t_clu[i] = cli_now_ms() - t0;
         if (!LIDET_SUCCEEDED(st))
             return fail(&a, "clustering", st);
@@ -274,6 +294,7 @@ int cli_cluster(int argc, char **argv)
     }
     ms_proj = cli_median(t_proj, a.repeat);
     ms_clu = cli_median(t_clu, a.repeat);
+    ms_cpu = cli_median(t_cpu, a.repeat);
     ms_prop = cli_median(t_prop, a.repeat);
     if (use_stage)
         ms_gnd = cli_median(t_gnd, a.repeat);
@@ -317,6 +338,9 @@ int cli_cluster(int argc, char **argv)
         cli_json_int(stdout, "fragments", cs->n_fragments);
         cli_json_int(stdout, "rescue_joined", cs->n_rescue_joined);
         cli_json_int(stdout, "rescue_pixels", cs->n_rescue_pixels);
+        cli_json_int(stdout, "split", cs->n_split);
+        cli_json_int(stdout, "split_parts", cs->n_split_parts);
+        cli_json_int(stdout, "joined", cs->n_joined);
         cli_json_int(stdout, "clusters", cs->n_kept);
         cli_json_int(stdout, "proposals", cs->n_kept);
         cli_json_int(stdout, "proposal_points", prcfg.n_points);
@@ -327,6 +351,7 @@ int cli_cluster(int argc, char **argv)
         if (use_stage)
             cli_json_num(stdout, "ground_ms", ms_gnd);
         cli_json_num(stdout, "cluster_ms", ms_clu);
+        cli_json_num(stdout, "cluster_cpu_ms", ms_cpu);
         cli_json_num(stdout, "proposal_ms", ms_prop);
         cli_json_num(stdout, "total_ms", ms_proj + ms_gnd + ms_clu + ms_prop);
         cli_json_end(stdout);
@@ -341,9 +366,11 @@ int cli_cluster(int argc, char **argv)
                cs->n_dropped_capacity);
         printf("rescue          %u fragments; %u groups joined clusters, %u pixels kept\n", cs->n_fragments,
                cs->n_rescue_joined, cs->n_rescue_pixels);
+        printf("refinement      %u clusters cut into %u more (people); %u car fragments joined\n", cs->n_split,
+               cs->n_split_parts, cs->n_joined);
         printf("proposals       %u x %u points\n", cs->n_kept, prcfg.n_points);
-        printf("cluster_ms      %.3f (median of %d; projection %.3f, proposals %.3f)\n", ms_clu, a.repeat,
-               ms_proj, ms_prop);
+        printf("cluster_ms      %.3f (median of %d; CPU %.3f; projection %.3f, proposals %.3f)\n", ms_clu,
+               a.repeat, ms_cpu, ms_proj, ms_prop);
         if (a.png_path != NULL)
             printf("picture         %s\n", a.png_path);
     }

@@ -414,6 +414,9 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, max_proposals, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, gate1, uint8_t, 1)
     CLI_SET_INT(c, kv, klen, v, gate2, uint8_t, 1)
+    /* any clustering field, the proposal refinement of issue 15 included */
+    if (strncmp(kv, "stages.cluster.", 15) == 0)
+        return cli_cluster_set(&c->stages.cluster, kv + 15);
     return 1;
 }
 
@@ -432,7 +435,9 @@ static void usage_extra(void)
                     "  --gt FILE        ground-truth boxes (lidet's sensor-frame lines) drawn in --png\n"
                     "  --gt-kitti FILE  ground truth as KITTI label_2 (with --calib) drawn in --png\n"
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
-                    "                   nms_iou, max_proposals, gate1, gate2\n"
+                    "                   nms_iou, max_proposals, gate1, gate2; stages.cluster.KEY: a\n"
+                    "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
+                    "                   stages.cluster.split_people=0: no proposal refinement)\n"
                     "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n");
 }
 

@@ -93,12 +93,22 @@ static const py_field_t k_fields[] = {
     FLD(lidet_cluster_cfg_t, max_mean_height_m, 'f'), FLD(lidet_cluster_cfg_t, mount_height_m, 'f'),
     FLD(lidet_cluster_cfg_t, rescue_gap_m, 'f'), FLD(lidet_cluster_cfg_t, rescue_gap_per_m, 'f'),
     FLD(lidet_cluster_cfg_t, rescue_rows, 'u'), FLD(lidet_cluster_cfg_t, rescue_cols, 'u'),
+    FLD(lidet_cluster_cfg_t, split_people, 'u'), FLD(lidet_cluster_cfg_t, split_min_width_m, 'f'),
+    FLD(lidet_cluster_cfg_t, split_cell_m, 'f'), FLD(lidet_cluster_cfg_t, split_cell_per_m, 'f'),
+    FLD(lidet_cluster_cfg_t, person_max_width_m, 'f'), FLD(lidet_cluster_cfg_t, person_min_height_m, 'f'),
+    FLD(lidet_cluster_cfg_t, person_min_aspect, 'f'), FLD(lidet_cluster_cfg_t, person_min_cols, 'u'),
+    FLD(lidet_cluster_cfg_t, join_cars, 'u'), FLD(lidet_cluster_cfg_t, join_gap_m, 'f'),
+    FLD(lidet_cluster_cfg_t, car_max_length_m, 'f'), FLD(lidet_cluster_cfg_t, car_max_width_m, 'f'),
+    FLD(lidet_cluster_cfg_t, car_max_height_m, 'f'), FLD(lidet_cluster_cfg_t, car_min_length_m, 'f'),
+    FLD(lidet_cluster_cfg_t, upright_max_width_m, 'f'),
     FLD(lidet_cluster_stats_t, n_candidates, 'u'), FLD(lidet_cluster_stats_t, n_found, 'u'),
     FLD(lidet_cluster_stats_t, n_fragments, 'u'), FLD(lidet_cluster_stats_t, n_rescue_joined, 'u'),
     FLD(lidet_cluster_stats_t, n_rescue_pixels, 'u'), FLD(lidet_cluster_stats_t, n_dropped_small, 'u'),
     FLD(lidet_cluster_stats_t, n_dropped_extent, 'u'), FLD(lidet_cluster_stats_t, n_dropped_height, 'u'),
     FLD(lidet_cluster_stats_t, n_dropped_capacity, 'u'), FLD(lidet_cluster_stats_t, n_kept, 'u'),
     FLD(lidet_cluster_stats_t, n_pixels_kept, 'u'), FLD(lidet_cluster_stats_t, n_queue_overflow, 'u'),
+    FLD(lidet_cluster_stats_t, n_split, 'u'), FLD(lidet_cluster_stats_t, n_split_parts, 'u'),
+    FLD(lidet_cluster_stats_t, n_split_skipped, 'u'), FLD(lidet_cluster_stats_t, n_joined, 'u'),
     FLD(lidet_proposal_cfg_t, n_points, 'u'), FLD(lidet_proposal_cfg_t, seed, 'u'),
     FLD(lidet_proposal_cfg_t, azimuth_bin_rad, 'f'), FLD(lidet_proposal_cfg_t, elevation_bin_rad, 'f'),
     FLD(lidet_proposal_cfg_t, range_bin_m, 'f'),
@@ -353,7 +363,37 @@ LIDET_PY_API int lidet_py_proj_run(lidet_py_ctx_t *ctx, const float *pts, uint32
     return rc;
 }
 
+/* The context's projection state (NULL before lidet_py_proj_init succeeded): lidet_py_ground_q.c projects
+ * into a compact image with it, as a detector workspace does. */
+LIDET_PY_API lidet_proj_state_t *lidet_py_ctx_proj_state(lidet_py_ctx_t *ctx)
+{
+    return ctx != NULL && ctx->proj_ready ? &ctx->proj.state : NULL;
+}
+
 /* ---- ground stage ----------------------------------------------------------------------------- */
+
+/* The planes (8 n_sectors floats: nx ny nz d, near planes then far planes), sources (2 n_sectors bytes) and
+ * counts of a ground run; any may be NULL. Also used by lidet_py_ground_q.c. */
+void lidet_py_ground_planes_out(const lidet_ground_t *g, float *planes, uint8_t *source, lidet_ground_stats_t *stats)
+{
+    uint32_t ns, s;
+    const lidet_plane_t *pl = lidet_ground_planes(g, &ns);
+    const uint8_t *src = lidet_ground_sector_source(g);
+    for (s = 0; s < 2u * ns; ++s)
+    {
+        if (planes != NULL)
+        {
+            planes[4 * s + 0] = pl[s].nx;
+            planes[4 * s + 1] = pl[s].ny;
+            planes[4 * s + 2] = pl[s].nz;
+            planes[4 * s + 3] = pl[s].d_m;
+        }
+        if (source != NULL)
+            source[s] = src[s];
+    }
+    if (stats != NULL)
+        *stats = *lidet_ground_stats(g);
+}
 
 /* Initialise the context's ground stage with cfg and run it on the context's image. Outputs (any may
  * be NULL): mask_pixel / sample_pixel rows*cols bytes, mask_point n_points bytes (the projection's
@@ -365,7 +405,7 @@ LIDET_PY_API int lidet_py_ground_run(lidet_py_ctx_t *ctx, const lidet_ground_cfg
 {
     lidet_range_image_t img;
     const int32_t *pp;
-    uint32_t npix, np, ns, s;
+    uint32_t npix, np;
     int rc;
     if (ctx == NULL || !ctx->proj_ready)
         return LIDET_ERR_STATE;
@@ -390,24 +430,7 @@ LIDET_PY_API int lidet_py_ground_run(lidet_py_ctx_t *ctx, const lidet_ground_cfg
         if (r2 < 0)
             return r2;
     }
-    {
-        const lidet_plane_t *pl = lidet_ground_planes(&ctx->ground, &ns);
-        const uint8_t *src = lidet_ground_sector_source(&ctx->ground);
-        for (s = 0; s < 2u * ns; ++s)
-        {
-            if (planes != NULL)
-            {
-                planes[4 * s + 0] = pl[s].nx;
-                planes[4 * s + 1] = pl[s].ny;
-                planes[4 * s + 2] = pl[s].nz;
-                planes[4 * s + 3] = pl[s].d_m;
-            }
-            if (source != NULL)
-                source[s] = src[s];
-        }
-    }
-    if (stats != NULL)
-        *stats = *lidet_ground_stats(&ctx->ground);
+    lidet_py_ground_planes_out(&ctx->ground, planes, source, stats);
     return rc;
 }
 

@@ -16,9 +16,11 @@ def test_bench_cluster_runs(root, real_dir):
     spec = importlib.util.spec_from_file_location("bench_cluster", root / "tools" / "bench" / "bench_cluster.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
-    mod._sim_dir = lambda sensor, quick: None
+    mod._sim_dir = lambda sensor, quick, crowd=False: None
     mod._open3d = lambda: None
     md = mod.run(argparse.Namespace(real=real_dir, build=build, quick=True))
     assert md.startswith("## Clustering (issue 6)")
     assert "| real SemanticKITTI 00 (3 labelled scans) | lidet |" in md and "DBSCAN columns skipped" in md
-    assert "| | lidet, no rescue |" in md
+    assert "| | lidet, no rescue |" in md and "| | lidet, no refinement |" in md
+    assert "### Proposal recall (issue 15)" in md
+    assert "| | lidet integer (lidet_cluster_q), same images |" in md

@@ -42,7 +42,8 @@ def props(need_lib):
     """family -> (xyz 4 mm (B, N, 3), mean 4 mm (B, 3), voxel (B, 3)): the simulated sample with 8 resampling
     seeds, two freshly simulated scans (lidet_tools.sim, run seed 16, scans 0 and 1) with two, plus the real KITTI
     scans (one seed) for hdl64 when ../shared/data/real is there. Built from the float proposals rounded to 4 mm
-    steps until the integer proposal stage (lidet_proposal_q_make) lands."""
+    steps, so that the float nets see the same points (test_on_the_integer_chain_bit_for_bit uses the proposals of
+    lidet_proposal_q_make)."""
     from conftest import REAL
     from lidet_tools.sim.simulate import simulate_scan
     real = REAL if (REAL / "kitti").exists() else None
@@ -189,3 +190,26 @@ def test_quantized_layers_follow_the_scheme(qmodels):
                     assert l.out_q16 == (part == "head" and i + 1 == len(layers)), (name, part, i)
                     assert l.out_q16 or (l.relu and l.out_zp == -128)
             assert (st.onehot_b is not None) == st.use_onehot == (qm.kind == "box")
+
+
+@pytest.mark.parametrize("fam", FAMILIES)
+def test_on_the_integer_chain_bit_for_bit(nq, qmodels, fam):
+    """The whole integer chain (compact image, integer ground planes, lidet_cluster_q_run, lidet_proposal_q_make)
+    feeding the int8 nets: C equals the reference on those proposals too."""
+    from lidet_tools import kitti
+    pts = kitti.read_bin(QU.scan_list(fam)[0])
+    scan = nq.compact_scan(pts, fam)
+    n = 0
+    for seed in SEEDS[:2]:
+        cq = nq.cluster_q(scan, nq.planes_to_q(scan.planes), proposal_cfg=dict(seed=seed))
+        q4, m4, vox = cq.prop_xyz, cq.prop_mean, cq.prop_voxel.astype(np.int64)
+        c = nq.pnq_classify(f"cls_{fam}_s8", q4, m4, vox)
+        r = RQ.classify(qmodels[f"cls_{fam}"], q4, m4, vox)
+        for k in ("logits", "prob", "energy", "cls", "passed"):
+            np.testing.assert_array_equal(np.asarray(c[k], np.int64), np.asarray(r[k], np.int64), err_msg=k)
+        b = nq.pnq_box(f"box_{fam}_s8", q4, m4, vox, c["cls"])
+        rb = RQ.box(qmodels[f"box_{fam}"], q4, m4, vox, c["cls"])
+        np.testing.assert_array_equal(np.asarray(b["box"], np.int64), rb["box"])
+        np.testing.assert_array_equal(np.asarray(b["energy"], np.int64), rb["energy"])
+        n += len(q4)
+    assert n >= 20

@@ -128,10 +128,12 @@ static void best_overlap(const uint16_t *a, const uint16_t *b, uint32_t npix, co
 }
 
 /* Tolerances against the float stages, measured on the shipped scans and the 9 real scans of
- * ../shared/data/real (docs/MEMORY.md): the clustering alone agrees on >= 99.93 % of the pixels; the
+ * ../shared/data/real (docs/MEMORY.md): the clustering alone agrees on >= 99.93 % of the pixels
+ * (>= 99.83 % since the refinement of issue 15, which reads x and y, so a 4 mm step can move a point
+ * into the next cell of its grid: KITTI 000000, one cut made differently); the
  * chain agrees on >= 98.7 % (ground) and >= 94.5 % (cluster ids, one real scan where a reseeded float
  * run agrees on 88.7 %), never more than 0.4 point below a reseeded float run. */
-#define MIN_CLUSTER_STAGE_PCT 99.9
+#define MIN_CLUSTER_STAGE_PCT 99.8
 #define MIN_GROUND_PCT 98.5
 #define MIN_CLUSTER_PCT 94.0
 #define SEED_MARGIN_PCT 1.0

@@ -218,17 +218,8 @@ def sim_pairs(sensor, n):
     return pairs[:n]
 
 
-def run(args) -> str:
-    quick = getattr(args, "quick", False)
-    repeat = 10 if quick else 50
-    core = _pin_one_core()
-    build = pathlib.Path(args.build)
-    lines = ["## Ground segmentation (issue 5)", ""]
-    if not _lidet_cli(build).exists():
-        return "\n".join(lines + [f"`{_lidet_cli(build)}` not built: skipped.", ""])
-    missing = [n for n, f in (("Patchwork++ (pypatchworkpp)", _patchwork(None)), ("Open3D", _open3d())) if f is None]
-    if missing:
-        lines += [f"Not importable here, rows skipped: {', '.join(missing)} (`pip install -r requirements-bench.txt`).", ""]
+def _sets(args, quick, lines):
+    """The labeled scan sets: (sensor, mount, pairs, label); notes about missing ones go to lines."""
     real_pairs, _ = ground_eval.find_scans([pathlib.Path(args.real) / "semantickitti"])
     sets = []
     if real_pairs:
@@ -243,6 +234,21 @@ def run(args) -> str:
                          f"--seed {SIM_SEED})"))
         else:
             lines += [f"Simulated {sensor} scans: pending (lidet_tools.sim not available in this checkout).", ""]
+    return sets
+
+
+def run(args) -> str:
+    quick = getattr(args, "quick", False)
+    repeat = 10 if quick else 50
+    core = _pin_one_core()
+    build = pathlib.Path(args.build)
+    lines = ["## Ground segmentation (issue 5)", ""]
+    if not _lidet_cli(build).exists():
+        return "\n".join(lines + [f"`{_lidet_cli(build)}` not built: skipped.", ""])
+    missing = [n for n, f in (("Patchwork++ (pypatchworkpp)", _patchwork(None)), ("Open3D", _open3d())) if f is None]
+    if missing:
+        lines += [f"Not importable here, rows skipped: {', '.join(missing)} (`pip install -r requirements-bench.txt`).", ""]
+    sets = _sets(args, quick, lines)
     results = {}
     filter_sets = []
     for sensor, mount, pairs, label in sets:
@@ -263,10 +269,64 @@ def run(args) -> str:
         lines += [f"**Sample filter: the paper versus the authors' released code, and what each lidet extension "
                   f"adds: {label}** (`--set` overrides of the defaults; \"as published\" = `"
                   + " ".join(PURE) + "`)", ""] + filter_table(build, pairs, "hdl64", max(5, repeat // 5)) + [""]
+    lines += q_table(sets, repeat)
     return "\n".join(lines)
+
+
+def q_table(sets, repeat):
+    """The integer ground stage (lidet_ground_q, issue 16) next to the float one on the same compact images (the
+    float projection's compact path, as a detector workspace): share of points with equal ground labels, IoU of
+    each against the labels, host medians of each stage alone (interleaved in one process)."""
+    try:
+        from lidet_tools import native_q
+        native_q.ground_q_fields()
+    except (ImportError, OSError, FileNotFoundError) as e:
+        return [f"Integer ground stage: bindings not available ({e}): skipped.", ""]
+    lines = ["**Integer ground stage (`lidet_ground_q`) next to the float one, same compact images**", "",
+             "| set | scans | points | ground labels equal | IoU float | IoU integer | float ms (median / min) | "
+             "integer ms (median / min) |",
+             "|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for sensor, _mount, pairs, label in sets:
+        same = total = 0
+        cf = cq = 0
+        tf, tq, mf, mq = [], [], [], []
+        for b, lab in pairs:
+            pts = kitti.read_bin(b)
+            sem, _ = kitti.read_label(lab, len(pts))
+            fm, qm, img, _ = native_q.ground_pair(pts, sensor)
+            same += int(np.count_nonzero(fm == qm))
+            total += len(pts)
+            truth = ground_eval.ground_truth(sem)
+            cf = cf + ground_eval.confusion(fm.astype(bool), truth)
+            cq = cq + ground_eval.confusion(qm.astype(bool), truth)
+            a, b2, c, d = native_q.ground_q_time(img, sensor, repeat)
+            tf.append(a)
+            tq.append(b2)
+            mf.append(c)
+            mq.append(d)
+        lines.append(f"| {label} | {len(pairs)} | {total} | {100 * same / total:.4f} % | "
+                     f"{ground_eval.metrics(cf)['iou']:.4f} | {ground_eval.metrics(cq)['iou']:.4f} | "
+                     f"{statistics.median(tf):.3f} / {statistics.median(mf):.3f} | "
+                     f"{statistics.median(tq):.3f} / {statistics.median(mq):.3f} |")
+    lines += ["", f"Ground labels per input point (a point takes its pixel's label); IoU with ground = SemanticKITTI "
+              f"40, 44, 48, 49, 60, 72; ms: median over the scans of each stage's median and fastest of {repeat} runs "
+              "(`lidet_py_ground_q_time`, the two stages alternating; on a loaded machine the longer integer runs are "
+              "preempted more often, the fastest run is the steadier figure). Alone: "
+              "`python tools/bench/bench_ground.py --q-only`.", ""]
+    return lines
+
+
+def run_q_only(args) -> str:
+    lines = ["## Integer ground stage (issue 16)", ""]
+    sets = _sets(args, args.quick, lines)
+    return "\n".join(lines + q_table(sets, 10 if args.quick else 50))
 
 
 if __name__ == "__main__":
     from run_bench import standalone  # the script's own folder is on sys.path
 
-    standalone(run, __doc__.split("\n\n")[0])
+    if "--q-only" in sys.argv:
+        sys.argv.remove("--q-only")
+        standalone(run_q_only, __doc__.split("\n\n")[0])
+    else:
+        standalone(run, __doc__.split("\n\n")[0])

@@ -162,7 +162,8 @@ def flat_ground(points: np.ndarray, mount_height_m: float, margin_m: float = 0.2
     return np.asarray(points)[:, 2] < -(mount_height_m - margin_m)
 
 
-def evaluate_lidet(data_dir, sensor: str = "hdl64", ground: str = "labels", **cfg) -> list[ObjectResult]:
+def evaluate_lidet(data_dir, sensor: str = "hdl64", ground: str = "labels", thr: float = 0.8,
+                   **cfg) -> list[ObjectResult]:
     """Cluster every scan of data_dir with the C library (bindings) and evaluate."""
     from . import native
     from .sensors import get_sensor
@@ -171,7 +172,7 @@ def evaluate_lidet(data_dir, sensor: str = "hdl64", ground: str = "labels", **cf
     for name, pts, lab in scans(data_dir):
         gm = ground_mask(lab) if ground == "labels" else flat_ground(pts, s.mount_height_m)
         c = native.cluster(pts, sensor, ground=gm, **cfg)
-        out += evaluate_scan(c.point_labels, lab, pts, scan=name)
+        out += evaluate_scan(c.point_labels, lab, pts, scan=name, thr=thr)
     return out
 
 
@@ -186,6 +187,8 @@ def main(argv=None) -> int:
     ap.add_argument("--max-steps", type=int, default=None)
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="any other cluster option, e.g. --set diagonals=0 --set bridge_occluders=0")
+    ap.add_argument("--thr", type=float, default=0.8,
+                    help="precision and recall a recovered object needs (issue 15's proposal recall: 0.7)")
     ap.add_argument("--json", action="store_true", help="print the summary as JSON")
     a = ap.parse_args(argv)
     cfg = {}
@@ -196,7 +199,7 @@ def main(argv=None) -> int:
     for kv in a.set:
         k, _, v = kv.partition("=")
         cfg[k] = float(v) if "." in v or "e" in v.lower() else int(v)
-    res = evaluate_lidet(a.data, a.sensor, a.ground, **cfg)
+    res = evaluate_lidet(a.data, a.sensor, a.ground, a.thr, **cfg)
     if not res:
         print(f"no labelled road users with >= 10 points under {a.data}", file=sys.stderr)
         return 1

@@ -30,6 +30,30 @@ class Sensor:
     beam_elev_rad: np.ndarray = field(repr=False)
     mount_height_m: float
     max_range_m: float
+    #: (fov_up, fov_down) in microradians for a uniform sensor (the integer presets give the fov, not a
+    #: table, as lib/src/lidet_sensor_q.c); None for a sensor with a beam table
+    fov_urad: tuple | None = None
+
+    @property
+    def beam_elev_urad(self) -> np.ndarray:
+        """Beam elevations in ring order, integer microradians (the integer path's profile,
+        lidet_sensor_q_elevations): the table rounded, or the uniform beams computed in integers."""
+        if self.fov_urad is not None:
+            up, down = self.fov_urad
+            span = up - down
+            i = np.arange(self.rows, dtype=np.int64)
+            n = (2 * i + 1) * span  # > 0: round half away from zero = floor(n / d + 1/2)
+            return (up - (n + self.rows) // (2 * self.rows)).astype(np.int32)
+        return np.round(self.beam_elev_rad * 1e6).astype(np.int32)
+
+    @property
+    def mount_height_mm(self) -> int:
+        return int(round(self.mount_height_m * 1000.0))
+
+    @property
+    def max_range_mm(self) -> int:
+        return int(round(self.max_range_m * 1000.0))
+
     #: horizontal angular resolution in radians
     @property
     def az_step_rad(self) -> float:
@@ -78,13 +102,17 @@ _VLP32C = np.array([
     1.333, 1.667, 2.333, 3.333, 4.667, 7.0, 10.333, 15.0,
 ])
 
+def _urad_fov(up_deg: float, down_deg: float) -> tuple:
+    return int(round(np.radians(up_deg) * 1e6)), int(round(np.radians(down_deg) * 1e6))
+
+
 SENSORS: dict[str, Sensor] = {
     "hdl64": Sensor("hdl64", 64, 2048, _deg(_HDL64), 1.73, 120.0),
     "vlp16": Sensor("vlp16", 16, 1800, _deg(_VLP16), 0.5, 100.0),
     "vlp32c": Sensor("vlp32c", 32, 1800, _deg(_VLP32C), 1.0, 200.0),
     # Ouster OS1: uniform +-22.5 deg; ring 0 = top beam (Ouster's convention).
-    "os1-64": Sensor("os1-64", 64, 2048, uniform_beams(22.5, -22.5, 64), 1.0, 120.0),
-    "os1-128": Sensor("os1-128", 128, 2048, uniform_beams(22.5, -22.5, 128), 1.0, 120.0),
+    "os1-64": Sensor("os1-64", 64, 2048, uniform_beams(22.5, -22.5, 64), 1.0, 120.0, _urad_fov(22.5, -22.5)),
+    "os1-128": Sensor("os1-128", 128, 2048, uniform_beams(22.5, -22.5, 128), 1.0, 120.0, _urad_fov(22.5, -22.5)),
 }
 
 
@@ -98,10 +126,12 @@ def get_sensor(name: str) -> Sensor:
 def custom_sensor(name: str, cols: int, beam_elev_deg=None, fov_up_deg=None, fov_down_deg=None,
                   rows=None, mount_height_m=1.0, max_range_m=100.0) -> Sensor:
     """A custom profile from a per-beam table (ring order, degrees) or a uniform fov."""
+    fov = None
     if beam_elev_deg is not None:
         elev = _deg(beam_elev_deg)
     else:
         if fov_up_deg is None or fov_down_deg is None or rows is None:
             raise ValueError("custom sensor needs beam_elev_deg or fov_up_deg, fov_down_deg and rows")
         elev = uniform_beams(fov_up_deg, fov_down_deg, rows)
-    return Sensor(name, len(elev), int(cols), elev, float(mount_height_m), float(max_range_m))
+        fov = _urad_fov(fov_up_deg, fov_down_deg)
+    return Sensor(name, len(elev), int(cols), elev, float(mount_height_m), float(max_range_m), fov)

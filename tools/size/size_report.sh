@@ -9,12 +9,13 @@ root="$(cd "$here/../.." && pwd)"
 cc="${1:-cc}"
 tmp="$(mktemp -d)"
 trap 'rm -rf "$tmp"' EXIT
-# name rows cols points clusters detections
+# name rows cols points clusters detections refine-cells refine-points (the VLP-16 board's refinement caps:
+# ports/firmware/config/vlp16/lidet_user_config.h)
 configs=(
-  "hdl64 64 2048 131072 1024 128"
-  "vlp16 16 1800 30000 64 64"
-  "os1-64 64 2048 131072 1024 128"
-  "host-default 128 2048 262144 1024 128"
+  "hdl64 64 2048 131072 1024 128 4096 4096"
+  "vlp16 16 1800 30000 64 64 2048 2048"
+  "os1-64 64 2048 131072 1024 128 4096 4096"
+  "host-default 128 2048 262144 1024 128 4096 4096"
 )
 kib() { awk -v b="$1" 'BEGIN { printf "%.1f", b / 1024 }'; }
 # sizeof for a 32-bit target (ILP32: the layout an arm-none-eabi build gets for these structs, which hold
@@ -33,9 +34,9 @@ size32() {
 ws_rows=()
 det_rows=()
 for c in "${configs[@]}"; do
-  read -r name rows cols pts cl det <<<"$c"
+  read -r name rows cols pts cl det rcells rpts <<<"$c"
   caps=(-DLIDET_MAX_ROWS="$rows" -DLIDET_MAX_COLS="$cols" -DLIDET_MAX_POINTS="$pts" -DLIDET_MAX_CLUSTERS="$cl"
-        -DLIDET_MAX_DETECTIONS="$det")
+        -DLIDET_MAX_DETECTIONS="$det" -DLIDET_REFINE_MAX_CELLS="$rcells" -DLIDET_REFINE_MAX_POINTS="$rpts")
   "$cc" -std=c99 -O1 -I"$root/lib/include" -I"$root/lib/src" "${caps[@]}" "$here/size_report.c" "$root"/lib/src/*.c \
         "$root"/lib/src/nn/*.c -lm -o "$tmp/sz"
   read -r ws32 det32 <<<"$(size32 "${caps[@]}")"

@@ -80,12 +80,14 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                 theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, diagonals: bool = True,
                 max_gap_m: float = 0.0, max_gap_per_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
                 max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30,
-                rescue_gap_m: float = 0.0, rescue_gap_per_m: float = 0.0, rescue_rows: int = 0, rescue_cols: int = 0):
+                rescue_gap_m: float = 0.0, rescue_gap_per_m: float = 0.0, rescue_rows: int = 0, rescue_cols: int = 0,
+                split_people: bool = False, join_cars: bool = False, **refine):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
     member-pixel arrays per kept cluster in raster order). Float32 tangent and distance tests like the
     C; the filters use float64 means (they can differ from the C's float32 only at a filter's edge).
-    rescue_gap_m > 0 turns the fragment rescue on (lidet_cluster.h)."""
+    rescue_gap_m > 0 turns the fragment rescue on, split_people / join_cars the refinement (refine_ref;
+    lidet_cluster.h)."""
     rows, cols = range_m.shape
     rng = np.asarray(range_m, np.float32).ravel()
     cand = np.asarray(candidate, bool).ravel()
@@ -258,4 +260,145 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
         m = np.sort(np.asarray(m))
         labels[m] = i + 1
         out.append(m)
+    if split_people or join_cars:  # the refinement (refine_ref; its other settings in `refine`)
+        labels = refine_ref(labels.reshape(rows, cols), xyz, min_points=min_points, max_clusters=max_clusters,
+                            split_people=bool(split_people), join_cars=bool(join_cars), **refine).ravel()
+        out = [np.nonzero(labels == i)[0] for i in range(1, int(labels.max(initial=0)) + 1)]
     return labels.reshape(rows, cols), out
+
+
+def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_people: bool = True,
+               split_min_width_m: float = 0.9, split_cell_m: float = 0.12, split_cell_per_m: float = 0.0,
+               person_max_width_m: float = 1.0, person_min_height_m: float = 0.9, person_min_aspect: float = 1.8, person_min_cols: int = 3,
+               max_clusters: int = 1 << 30, max_cells: int = 4096, max_parts: int = 32,
+               max_points: int = 4096, join_cars: bool = True, join_gap_m: float = 0.5,
+               car_max_length_m: float = 5.2, car_max_width_m: float = 2.2, car_max_height_m: float = 2.0,
+               car_min_length_m: float = 2.5, upright_max_width_m: float = 1.3) -> np.ndarray:
+    """The refinement of lib/src/lidet_refine.c (split_people, join_cars; the rules in lidet_cluster.h) on canonical
+    cluster labels (rows, cols) of the clustering without it, with the image's points xyz (rows, cols, 3)
+    float32. Returns the canonical labels the C gives with it: the same float32 operations in the same
+    order (cell size, truncated cell indices, spans), so the decisions match bit for bit."""
+    f32 = np.float32
+    lab = np.asarray(labels).astype(np.int64).ravel().copy()
+    P = np.asarray(xyz, np.float32).reshape(-1, 3)
+    n_cols = np.shape(labels)[1]
+    k0 = int(lab.max(initial=0))
+    n_recs = k0
+    cut = set()
+    for k in range(1, k0 + 1 if split_people else 1):
+        mem = np.nonzero(lab == k)[0]          # raster order, as the C's members
+        if len(mem) == 0 or len(mem) > max_points:
+            continue
+        pts = P[mem]
+        lo, hi = pts.min(0), pts.max(0)
+        ex, ey = f32(hi[0] - lo[0]), f32(hi[1] - lo[1])
+        if not (ex > f32(split_min_width_m)) and not (ey > f32(split_min_width_m)):
+            continue
+        ax = abs(f32(f32(0.5) * f32(lo[0] + hi[0])))
+        ay = abs(f32(f32(0.5) * f32(lo[1] + hi[1])))
+        r = f32(ax + f32(f32(0.5) * ay)) if ax > ay else f32(ay + f32(f32(0.5) * ax))
+        cs = f32(f32(split_cell_m) + f32(f32(split_cell_per_m) * r))
+        inv = f32(f32(1.0) / cs)
+        nx, ny = int(f32(ex * inv)) + 1, int(f32(ey * inv)) + 1
+        if nx > max_cells or ny > max_cells // nx:
+            continue
+        ix = np.minimum(((pts[:, 0] - lo[0]).astype(np.float32) * inv).astype(np.int64), nx - 1)
+        iy = np.minimum(((pts[:, 1] - lo[1]).astype(np.float32) * inv).astype(np.int64), ny - 1)
+        cell = iy * nx + ix
+        # 8-connected parts of the occupied cells, numbered by their first member
+        part_of = {}
+        occ = set(cell.tolist())
+        pid = -1
+        for c0 in cell.tolist():
+            if c0 in part_of:
+                continue
+            pid += 1
+            q = deque([c0])
+            part_of[c0] = pid
+            while q:
+                cc = q.popleft()
+                cx, cy = cc % nx, cc // nx
+                for yy in range(max(cy - 1, 0), min(cy + 1, ny - 1) + 1):
+                    for xx in range(max(cx - 1, 0), min(cx + 1, nx - 1) + 1):
+                        nb = yy * nx + xx
+                        if nb in occ and nb not in part_of:
+                            part_of[nb] = pid
+                            q.append(nb)
+        part = np.array([part_of[c] for c in cell.tolist()])
+        n_parts = int(part.max()) + 1
+        if n_parts > max_parts or n_parts == 1:
+            continue
+        n = np.bincount(part, minlength=n_parts)
+        person = np.zeros(n_parts, bool)
+        for p in range(n_parts):
+            m = part == p
+            wx = f32(f32(int(ix[m].max() - ix[m].min() + 1)) * cs)
+            wy = f32(f32(int(iy[m].max() - iy[m].min() + 1)) * cs)
+            wz = f32(pts[m, 2].max() - pts[m, 2].min())
+            col = mem[m] % n_cols
+            person[p] = (n[p] >= min_points and wx <= f32(person_max_width_m) and wy <= f32(person_max_width_m)
+                         and wz >= f32(person_min_height_m) and wz >= f32(f32(person_min_aspect) * max(wx, wy))
+                         and int(col.max() - col.min()) + 1 >= person_min_cols)
+        if not person.any():
+            continue
+        leave = person.copy()
+        big = n >= min_points
+        if np.all(person[big]):
+            leave[int(np.argmax(n))] = False
+        if n[~leave].sum() < min_points:
+            pers = np.nonzero(person)[0]
+            leave[pers[int(np.argmax(n[pers]))]] = False
+        target = np.full(n_parts, k)
+        for p in range(n_parts):
+            if leave[p] and n_recs < max_clusters:
+                n_recs += 1
+                target[p] = n_recs
+        if not (target != k).any():
+            continue
+        lab[mem] = target[part]
+        cut.update(target.tolist())
+    if join_cars:
+        lab = _join_ref(lab, P, n_recs, cut, f32(join_gap_m), f32(car_max_length_m), f32(car_max_width_m),
+                        f32(car_max_height_m), f32(car_min_length_m), f32(upright_max_width_m),
+                        f32(person_min_height_m))
+    # canonical ids: raster order of each cluster's first pixel
+    ids = np.unique(lab[lab > 0])
+    first = np.array([np.argmax(lab == i) for i in ids])
+    new = np.zeros(int(lab.max(initial=0)) + 1, np.int64)
+    new[ids[np.argsort(first, kind="stable")]] = np.arange(1, len(ids) + 1)
+    return new[lab].reshape(np.shape(labels))
+
+
+def _join_ref(lab, P, n_recs, cut, gap, lmax, wmax, hmax, lmin, umax, pmin):
+    """The joins of lidet_refine.c (join_cars) on slot labels 1..n_recs (slot order: canonical ids, then
+    the cut-off parts); returns the labels with the joined slots renumbered (not yet canonical)."""
+    f32 = np.float32
+    lo = np.zeros((n_recs + 1, 3), np.float32)
+    hi = np.zeros((n_recs + 1, 3), np.float32)
+    for k in range(1, n_recs + 1):
+        m = lab == k
+        lo[k], hi[k] = P[m].min(0), P[m].max(0)
+
+    def piece(k):
+        wx, wy, wz = f32(hi[k, 0] - lo[k, 0]), f32(hi[k, 1] - lo[k, 1]), f32(hi[k, 2] - lo[k, 2])
+        upright = wx <= umax and wy <= umax and wz >= pmin
+        return not upright and wz <= hmax and max(wx, wy) <= lmax and min(wx, wy) <= wmax
+
+    def joinable(a, b):
+        gx = max(f32(lo[b, 0] - hi[a, 0]), f32(lo[a, 0] - hi[b, 0]), f32(0.0))
+        gy = max(f32(lo[b, 1] - hi[a, 1]), f32(lo[a, 1] - hi[b, 1]), f32(0.0))
+        if f32(f32(gx * gx) + f32(gy * gy)) > f32(gap * gap):
+            return False
+        u = [f32(max(hi[a, d], hi[b, d]) - min(lo[a, d], lo[b, d])) for d in range(3)]
+        return u[2] <= hmax and lmin <= max(u[0], u[1]) <= lmax and min(u[0], u[1]) <= wmax
+
+    to = list(range(n_recs + 1))
+    for i in range(1, n_recs + 1):
+        if to[i] != i or i in cut or not piece(i):
+            continue
+        for j in range(i + 1, n_recs + 1):
+            if to[j] != j or j in cut or not piece(j) or not joinable(i, j):
+                continue
+            lo[i], hi[i] = np.minimum(lo[i], lo[j]), np.maximum(hi[i], hi[j])
+            to[j] = i
+    return np.asarray(to)[lab]

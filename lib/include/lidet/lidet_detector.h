@@ -135,7 +135,7 @@ typedef struct
     float pn_scratch[LIDET_DETECTOR_PN_SCRATCH / 4];
     lidet_proposal_t proposal;
     uint16_t order[LIDET_MAX_CLUSTERS];  /* candidate clusters, nearest first */
-    float key[LIDET_MAX_CLUSTERS];       /* their squared horizontal ranges */
+    uint32_t key[LIDET_MAX_CLUSTERS];    /* their squared horizontal ranges (float bits, >= 0) */
     lidet_detection_t det[LIDET_MAX_DETECTIONS + 1]; /* + 1: a candidate before the capacity check */
     uint8_t outcome[LIDET_MAX_CLUSTERS];             /* lidet_det_outcome_t per kept cluster */
     uint32_t n_det;

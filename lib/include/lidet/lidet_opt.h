@@ -50,6 +50,22 @@
 #define LIDET_MAX_CLUSTERS 1024
 #endif
 
+/** Proposal refinement (lidet_refine.c): bird's-eye-view cells of the finer grid one cluster may span
+ *  (a cluster needing more is left whole); 2 B per cell, twice (grid and queue). */
+#ifndef LIDET_REFINE_MAX_CELLS
+#define LIDET_REFINE_MAX_CELLS 4096
+#endif
+
+/** Proposal refinement: member pixels of a cluster it examines (more: left whole); 2 B each. */
+#ifndef LIDET_REFINE_MAX_POINTS
+#define LIDET_REFINE_MAX_POINTS 4096
+#endif
+
+/** Proposal refinement: connected parts one cluster may have on that grid (more: left whole). */
+#ifndef LIDET_REFINE_MAX_PARTS
+#define LIDET_REFINE_MAX_PARTS 32
+#endif
+
 /** Points per proposal handed to the PointNets (resampled). */
 #ifndef LIDET_PROPOSAL_POINTS
 #define LIDET_PROPOSAL_POINTS 128
@@ -151,6 +167,15 @@
 #if LIDET_CLUSTER_MAX_STEPS < 1 || LIDET_CLUSTER_MAX_STEPS > 64
 #error "LIDET_CLUSTER_MAX_STEPS must be in [1, 64]"
 #endif
+#if LIDET_REFINE_MAX_CELLS < 16 || LIDET_REFINE_MAX_CELLS > 65535
+#error "LIDET_REFINE_MAX_CELLS must be in [16, 65535]"
+#endif
+#if LIDET_REFINE_MAX_POINTS < 1 || LIDET_REFINE_MAX_POINTS > 16777216
+#error "LIDET_REFINE_MAX_POINTS must be in [1, 2^24]"
+#endif
+#if LIDET_REFINE_MAX_PARTS < 2 || LIDET_REFINE_MAX_PARTS > 65535
+#error "LIDET_REFINE_MAX_PARTS must be in [2, 65535]"
+#endif
 #if LIDET_PROPOSAL_POINTS < 1 || LIDET_PROPOSAL_POINTS > 4096
 #error "LIDET_PROPOSAL_POINTS must be in [1, 4096]"
 #endif
@@ -178,10 +203,10 @@
 #if ((-1) >> 1) != -1
 #error "lidet needs arithmetic right shifts of negative integers (the fixed-point build relies on them)"
 #endif
-#ifdef LIDET_FIXED_POINT
-#if LIDET_FIXED_POINT
-#error "LIDET_FIXED_POINT is not implemented yet: build the float configuration (LIDET_FIXED_POINT=0)"
-#endif
+/* LIDET_FIXED_POINT 1: the integer-only build (docs/FIXED_POINT.md): CMake compiles only the integer sources;
+ * the float stages' declarations stay visible but are not built. */
+#ifndef LIDET_FIXED_POINT
+#define LIDET_FIXED_POINT 0
 #endif
 
 #endif /* LIDET_OPT_H */

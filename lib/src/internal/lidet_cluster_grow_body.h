@@ -1,17 +1,26 @@
 /* SPDX-License-Identifier: MIT */
-/* The flood fill of the clustering, written once for both image formats: lidet_cluster_grow.c includes
- * this file twice, with GROW_RNG_T float (a float image: ranges in metres) and uint16_t (a compact
- * image: ranges in 4 mm steps, read as floats; the caller scales the gap bound to steps), GROW_RANGES
- * the image's range plane and GROW_FN(name) the copy's function names. Each copy is the code the float
- * stage had before the compact image (reads are (float)rng[n], a no-op for float), so neither pays for
- * the other. Not a public header; include nowhere else. */
+/* The flood fill of the clustering, written once for every image format and arithmetic: lidet_cluster_grow.c
+ * includes this file twice, with GROW_RNG_T float (a float image: ranges in metres) and uint16_t (a compact
+ * image: ranges in 4 mm steps, read as floats; the caller scales the gap bound to steps), and
+ * lidet_cluster_q_grow.c once more for the integer stage (ranges in 4 mm steps read as integers). The
+ * parameters:
+ *   GROW_RNG_T       the range plane's element type, GROW_RANGES(img) the plane;
+ *   GROW_D_T         the type a range is read as (float, or uint32_t for the integer stage);
+ *   GROW_TAB_T       the element type of the join test's two angle tables;
+ *   GROW_TA(c, t), GROW_TB(c, t)  the two tables of kind t (col, row, diag) of state c: float sin and
+ *                    cos of alpha, or the integer stage's sin(alpha + theta) and 4 sin^2(alpha / 2);
+ *   GROW_LINK        the join test link(da, db, ta, tb, g);
+ *   GROW_STATE_T, GROW_PARAM_T  the state and the run's constants (same member names in both stages);
+ *   GROW_FN(name)    the copy's function names.
+ * Each copy is the code the float stage had before the compact image (reads are (GROW_D_T)rng[n], a no-op
+ * for float), so none pays for another. Not a public header; include nowhere else. */
 
 /* One directional search from q (range dq): pixels q + k * step, k = 1..nk, never wrapping (the
  * caller sends the columns within kc of either edge to search_wrap); beam pair sin/cos at
  * sn[(k - 1) * gs], cs[(k - 1) * gs]. Non-candidates are stepped over. */
 static inline uint32_t GROW_FN(search)(uint16_t *lab, int32_t *mem, const GROW_RNG_T *rng, uint32_t tail,
-                                       float dq, uint32_t q, int32_t step, uint32_t nk, const float *sn,
-                                       const float *cs, int32_t gs, const lidet__grow_t *g, int occl)
+                                       GROW_D_T dq, uint32_t q, int32_t step, uint32_t nk, const GROW_TAB_T *sn,
+                                       const GROW_TAB_T *cs, int32_t gs, const GROW_PARAM_T *g, int occl)
 {
     uint32_t k, n = q;
     if (!occl)
@@ -29,9 +38,9 @@ static inline uint32_t GROW_FN(search)(uint16_t *lab, int32_t *mem, const GROW_R
                 break;
             }
         }
-        if (l == LAB_FREE && link(dq, (float)rng[n], sn[(int32_t)k * gs], cs[(int32_t)k * gs], g))
+        if (l == LAB_FREE && GROW_LINK(dq, (GROW_D_T)rng[n], sn[(int32_t)k * gs], cs[(int32_t)k * gs], g))
         {
-            tail = take(lab, mem, tail, n);
+            tail = lidet__cluster_take(lab, mem, tail, n);
         }
         return tail;
     }
@@ -48,12 +57,12 @@ static inline uint32_t GROW_FN(search)(uint16_t *lab, int32_t *mem, const GROW_R
          * that fails it, or a visited one, ends the search unless it is nearer than q and fails the
          * test (an occluder: the search goes on behind it). A visited candidate is only tested when
          * that decides between the two (joining it again would change nothing) */
-        const float dn = (float)rng[n];
+        const GROW_D_T dn = (GROW_D_T)rng[n];
         if (l == LAB_FREE)
         {
-            if (link(dq, dn, *sn, *cs, g))
+            if (GROW_LINK(dq, dn, *sn, *cs, g))
             {
-                tail = take(lab, mem, tail, n);
+                tail = lidet__cluster_take(lab, mem, tail, n);
                 break;
             }
             if (!(dn < dq))
@@ -61,7 +70,7 @@ static inline uint32_t GROW_FN(search)(uint16_t *lab, int32_t *mem, const GROW_R
                 break;
             }
         }
-        else if (!(dn < dq) || link(dq, dn, *sn, *cs, g))
+        else if (!(dn < dq) || GROW_LINK(dq, dn, *sn, *cs, g))
         {
             break;
         }
@@ -70,9 +79,9 @@ static inline uint32_t GROW_FN(search)(uint16_t *lab, int32_t *mem, const GROW_R
 }
 
 /* The same along a row across the wrap (the rare columns within kc of either edge): step k meets
- * rowbase + (col +- k mod cols); angles col_sin/col_cos */
-static uint32_t GROW_FN(search_wrap)(lidet_cluster_state_t *c, uint32_t tail, float dq, uint32_t rowbase,
-                                     uint32_t col, int right, const lidet__grow_t *g, int occl)
+ * rowbase + (col +- k mod cols); angle tables GROW_TA/GROW_TB(c, col) */
+static uint32_t GROW_FN(search_wrap)(GROW_STATE_T *c, uint32_t tail, GROW_D_T dq, uint32_t rowbase,
+                                     uint32_t col, int right, const GROW_PARAM_T *g, int occl)
 {
     uint16_t *lab = c->labels;
     int32_t *mem = c->members;
@@ -89,15 +98,16 @@ static uint32_t GROW_FN(search_wrap)(lidet_cluster_state_t *c, uint32_t tail, fl
         {
             continue;
         }
-        const float dn = (float)rng[n], sn = c->col_sin[k - 1], cs = c->col_cos[k - 1];
-        if (l == LAB_FREE && link(dq, dn, sn, cs, g))
+        const GROW_D_T dn = (GROW_D_T)rng[n];
+        const GROW_TAB_T sn = GROW_TA(c, col)[k - 1], cs = GROW_TB(c, col)[k - 1];
+        if (l == LAB_FREE && GROW_LINK(dq, dn, sn, cs, g))
         {
-            tail = take(lab, mem, tail, n); /* joins, and the search ends */
+            tail = lidet__cluster_take(lab, mem, tail, n); /* joins, and the search ends */
             break;
         }
         /* without occluder bridging any candidate ends the search; with it, one nearer than q that
          * fails the test is stepped over (as in search) */
-        if (!occl || !(dn < dq) || (l != LAB_FREE && link(dq, dn, sn, cs, g)))
+        if (!occl || !(dn < dq) || (l != LAB_FREE && GROW_LINK(dq, dn, sn, cs, g)))
         {
             break;
         }
@@ -109,7 +119,7 @@ static uint32_t GROW_FN(search_wrap)(lidet_cluster_state_t *c, uint32_t tail, fl
  * members[head] for head = start .. tail (the member array is the queue, every pixel is pushed at
  * most once). Returns the new tail. Directions in the reference's order: right, left, down, up, then
  * the diagonals down-left, down-right, up-left, up-right. occl is a constant at each call site. */
-static inline uint32_t GROW_FN(grow)(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start,
+static inline uint32_t GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t start,
                                      uint32_t tail, int occl)
 {
     uint16_t *lab = c->labels;
@@ -122,14 +132,14 @@ static inline uint32_t GROW_FN(grow)(lidet_cluster_state_t *c, const lidet__grow
         const uint32_t q = (uint32_t)mem[head++];
         const uint32_t r = g->row_magic != 0u ? (uint32_t)(((uint64_t)q * g->row_magic) >> 32) : q / cols;
         const uint32_t rowbase = r * cols, col = q - rowbase;
-        const float dq = (float)rng[q];
+        const GROW_D_T dq = (GROW_D_T)rng[q];
         const uint32_t nd = rows - 1u - r < ks ? rows - 1u - r : ks; /* steps that stay in the image */
         const uint32_t nu = r < ks ? r : ks;
         LIDET_ASSERT(tail <= rows * cols);
         /* right, left (wrapping) */
         if (col + kc < cols)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, 1, kc, c->col_sin, c->col_cos, 1, g, occl);
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, 1, kc, GROW_TA(c, col), GROW_TB(c, col), 1, g, occl);
         }
         else
         {
@@ -137,7 +147,7 @@ static inline uint32_t GROW_FN(grow)(lidet_cluster_state_t *c, const lidet__grow
         }
         if (col >= kc)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -1, kc, c->col_sin, c->col_cos, 1, g, occl);
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -1, kc, GROW_TA(c, col), GROW_TB(c, col), 1, g, occl);
         }
         else
         {
@@ -147,13 +157,13 @@ static inline uint32_t GROW_FN(grow)(lidet_cluster_state_t *c, const lidet__grow
          * [(r - k) * STEPS + k - 1] (stored at the upper row), i.e. stride 1 - STEPS from (r - 1) * STEPS */
         if (nd > 0u)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, (int32_t)cols, nd, c->row_sin + r * STEPS,
-                                   c->row_cos + r * STEPS, 1, g, occl);
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, (int32_t)cols, nd, GROW_TA(c, row) + r * STEPS,
+                                   GROW_TB(c, row) + r * STEPS, 1, g, occl);
         }
         if (nu > 0u)
         {
             tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -(int32_t)cols, nu,
-                                   c->row_sin + (r - 1u) * STEPS, c->row_cos + (r - 1u) * STEPS, 1 - STEPS, g,
+                                   GROW_TA(c, row) + (r - 1u) * STEPS, GROW_TB(c, row) + (r - 1u) * STEPS, 1 - STEPS, g,
                                    occl);
         }
         /* diagonals (8-neighbourhood option): direct neighbours only, no bridging; each joins when
@@ -164,27 +174,29 @@ static inline uint32_t GROW_FN(grow)(lidet_cluster_state_t *c, const lidet__grow
             if (r + 1u < rows)
             {
                 const uint32_t dl = rowbase + cols + cl, dr = rowbase + cols + cr;
-                if (lab[dl] == LAB_FREE && link(dq, (float)rng[dl], c->diag_sin[r], c->diag_cos[r], g))
+                if (lab[dl] == LAB_FREE &&
+                    GROW_LINK(dq, (GROW_D_T)rng[dl], GROW_TA(c, diag)[r], GROW_TB(c, diag)[r], g))
                 {
-                    tail = take(lab, mem, tail, dl);
+                    tail = lidet__cluster_take(lab, mem, tail, dl);
                 }
-                if (lab[dr] == LAB_FREE && link(dq, (float)rng[dr], c->diag_sin[r], c->diag_cos[r], g))
+                if (lab[dr] == LAB_FREE &&
+                    GROW_LINK(dq, (GROW_D_T)rng[dr], GROW_TA(c, diag)[r], GROW_TB(c, diag)[r], g))
                 {
-                    tail = take(lab, mem, tail, dr);
+                    tail = lidet__cluster_take(lab, mem, tail, dr);
                 }
             }
             if (r > 0u)
             {
                 const uint32_t ul = rowbase - cols + cl, ur = rowbase - cols + cr;
                 if (lab[ul] == LAB_FREE &&
-                    link(dq, (float)rng[ul], c->diag_sin[r - 1u], c->diag_cos[r - 1u], g))
+                    GROW_LINK(dq, (GROW_D_T)rng[ul], GROW_TA(c, diag)[r - 1u], GROW_TB(c, diag)[r - 1u], g))
                 {
-                    tail = take(lab, mem, tail, ul);
+                    tail = lidet__cluster_take(lab, mem, tail, ul);
                 }
                 if (lab[ur] == LAB_FREE &&
-                    link(dq, (float)rng[ur], c->diag_sin[r - 1u], c->diag_cos[r - 1u], g))
+                    GROW_LINK(dq, (GROW_D_T)rng[ur], GROW_TA(c, diag)[r - 1u], GROW_TB(c, diag)[r - 1u], g))
                 {
-                    tail = take(lab, mem, tail, ur);
+                    tail = lidet__cluster_take(lab, mem, tail, ur);
                 }
             }
         }

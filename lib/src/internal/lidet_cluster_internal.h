@@ -5,17 +5,9 @@
 #ifndef LIDET_CLUSTER_INTERNAL_H
 #define LIDET_CLUSTER_INTERNAL_H
 
+#include "internal/lidet_cluster_common.h"
 #include "internal/lidet_pixel.h"
 #include "lidet/lidet_cluster.h"
-
-/* pixel states in labels[] during a run (ids 1..LIDET_MAX_CLUSTERS are slots + 1) */
-#define LAB_FREE 0u         /* a candidate not visited yet */
-#define LAB_SMALL 0xFFFDu   /* a fragment (component below min_points) waiting for the rescue pass */
-#define LAB_PENDING 0xFFFEu /* visited: current cluster, or a dropped one */
-#define LAB_NONCAND 0xFFFFu /* no point, or ground: bridged over, never joined */
-
-#define STEPS LIDET_CLUSTER_MAX_STEPS
-#define RESCUE_MAX_COLS 15u /* rescue_cols limit (each fragment pixel looks at (2 rows + 1)(2 cols + 1) pixels) */
 
 /* Constants of one run's flood fill. */
 typedef struct
@@ -45,5 +37,23 @@ uint32_t lidet__cluster_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, u
 /* Breadth-first fill of the rescue group seeded at members[start] (lidet_cluster_rescue.c) */
 void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start,
                                 lidet__rescue_t *rs);
+
+/* signed height of `mean` above the ground plane of the sector of pixel `seed`'s column, or the flat
+ * ground (lidet_cluster.c) */
+float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const float mean[3],
+                            const lidet_plane_t *planes, uint32_t n_sectors);
+
+/* The refinement (lidet_refine.c) on the canonical output of a run: cuts person-sized parts off wide
+ * clusters (cfg split_people). Labels and records are left for one more canonical pass; returns 1 when
+ * anything changed */
+int lidet__refine_split(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
+                        lidet_cluster_stats_t *st);
+
+/* The refinement's joins of car fragments (cfg join_cars) on the records after the cuts: a joined
+ * cluster's pixels are relabelled and its record left empty with seed 0xFFFFFFFF (the canonical pass
+ * orders it last; the caller then drops it); order[] holds 1 for clusters the cuts made or cut (they
+ * take part in no join) and gets 2 for the joined ones. Returns 1 when anything joined */
+int lidet__refine_join(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
+                       lidet_cluster_stats_t *st);
 
 #endif

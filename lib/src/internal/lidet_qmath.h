@@ -40,6 +40,9 @@ static inline int64_t lidet__q_div_round(int64_t n, int64_t d)
 /** floor(sqrt(v)), exact */
 uint32_t lidet__q_isqrt64(uint64_t v);
 
+/** floor(sqrt(v)), exact, 32-bit arithmetic only */
+uint32_t lidet__q_isqrt32(uint32_t v);
+
 /** round(sqrt(v)) (halves cannot occur for integers), exact */
 uint32_t lidet__q_sqrt_round64(uint64_t v);
 

@@ -5,6 +5,7 @@
  * requantization per output value. Weights [in][out] as the float kernel: the innermost loop runs over the
  * output channels of one weight row (unit stride; compilers vectorise it on hosts, and x86-64 host builds also
  * get an AVX2 variant, LIDET_NN_KERNEL: integer sums are exact, so every variant gives the same bits). */
+#include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
 #include "internal/lidet_nn.h"
 #include "internal/lidet_pointnet_q_internal.h"
 #include "internal/lidet_qmath.h"

@@ -32,6 +32,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--pitch-deg", type=float, default=None, help="mount pitch (default: random, sigma 0.25 deg)")
     p.add_argument("--roll-deg", type=float, default=None, help="mount roll (default: random, sigma 0.25 deg)")
     p.add_argument("--scene", choices=SCENE_TYPES, default=None, help="force one scene type (default: mixed)")
+    p.add_argument("--crowd", action="store_true",
+                   help="crowded streets (issue 15): groups of people 0.2-1 m apart, people beside cars, poles, bins "
+                        "and walls, cyclists beside parked cars, people pushing bicycles, darker and more broken cars")
     p.add_argument("--range-noise", type=float, default=0.02, help="1-sigma range noise in m")
     p.add_argument("--dropout", type=float, default=0.015, help="random dropout probability")
     p.add_argument("--jobs", type=int, default=1,
@@ -42,7 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _one(a, i):
     r = simulate_scan(a.sensor, a.seed, i, a.mount_height, a.pitch_deg, a.roll_deg, a.scene,
-                      a.range_noise, a.dropout)
+                      a.range_noise, a.dropout, crowd=a.crowd)
     write_scan(a.out, f"{i:06d}", r)
     return i
 

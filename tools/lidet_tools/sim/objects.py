@@ -146,6 +146,23 @@ def collision_cylinders(shape: Shape, x, y, yaw):
     return out
 
 
+def body_cylinders(shape: Shape, x, y, yaw, r_min=0.2):
+    """Collision cylinders of the body alone (no annotation margin) for crowd scenes: circles of radius
+    half the body's width (at least r_min) along its long axis, so people can stand 0.2 m apart and
+    beside a car's flank although their labelled boxes then may overlap."""
+    Rz = rot_z(yaw)
+    lo, hi = shape.extent(all_parts=True)
+    ext = hi - lo
+    c = Rz @ ((lo + hi) / 2)
+    ax = int(np.argmax(ext[:2]))
+    r = max(float(ext[1 - ax]) / 2, r_min)
+    n = max(1, int(np.ceil(float(ext[ax]) / (2 * r))))
+    step = float(ext[ax]) / n
+    d = Rz[:, ax]
+    return [(x + c[0] + d[0] * (-ext[ax] / 2 + step * (k + 0.5)), y + c[1] + d[1] * (-ext[ax] / 2 + step * (k + 0.5)),
+             r, lo[2], hi[2]) for k in range(n)]
+
+
 # ------------------------------------------------------------------------------------------------
 # Vehicles
 
@@ -204,6 +221,22 @@ def car(rng, kind=None) -> Shape:
     for sy in (-1, 1):
         s.add(BOX, [x1 - 0.05, sy * (W / 2 + 0.06), belt + 0.12], [0.08, 0.07, 0.06], albedo=alb, drop=drop)
         s.parts[-1].in_box = False
+    return s
+
+
+def worn(s: Shape, rng) -> Shape:
+    """Crowd scenes (issue 15): a car as real ones at 20-40 m look: more often dark paint (weak returns,
+    more dropout), glass that returns less, wheels and sills that drop out. Changes the parts' albedo and
+    dropout only (the geometry and the box stay)."""
+    dark = rng.random() < 0.35
+    for p in s.parts:
+        if p.transp > 0.0:                   # glass: fewer returns through and off it
+            p.drop = max(p.drop, 0.5)
+        elif p.kind == CYLINDER and p.albedo <= 0.04 + 1e-9:   # tyres
+            p.drop = 0.7
+        elif dark and p.albedo > 0.04:       # dark paint (body, roof, mirrors; not the seats)
+            p.albedo = min(p.albedo, 0.055)
+            p.drop = max(p.drop, 0.45)
     return s
 
 

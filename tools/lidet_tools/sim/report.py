@@ -360,10 +360,18 @@ def main(argv=None) -> int:
     p.add_argument("--seed", type=int, default=1000)
     p.add_argument("--img-dir", default=os.path.join("docs", "img"))
     p.add_argument("--md", default=os.path.join("docs", "SIMULATOR.md"))
+    p.add_argument("--crowd", action="store_true",
+                   help="only the crowded-street rows (issue 15: points and fragments per car, distance between "
+                        "people; default and --crowd scans versus real), their own block of --md (crowd_report.py)")
     a = p.parse_args(argv)
     if not os.path.exists(os.path.join(a.real, "README.md")):
         print(f"sim report: no real scans at {a.real}", file=sys.stderr)
         return 2
+    if a.crowd:
+        from .crowd_report import make_crowd_report
+        for r in make_crowd_report(a.real, a.scans, a.seed, a.md):
+            print(" | ".join(r))
+        return 0
     rows, note = make_report(a.real, a.scans, a.seed, a.img_dir, a.md)
     for r in rows:
         print(" | ".join(str(x) for x in r))

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import objects as ob
+from .crowd import crowds
 from .raycast import HeightField, PrimitiveList
 
 # surface codes of the ground grid -> SemanticKITTI class and remission
@@ -53,22 +54,28 @@ class _Placer:
 
     def __init__(self, keep_out):
         self.c = np.array([[0.0, 0.0, keep_out, -1.0, 3.0]])
+        self.own = np.array([-1])   # owner (object index) of each cylinder, -1 = the sensor
 
-    def free(self, cyl, margin):
+    def free(self, cyl, margin, ignore=None):
+        """ignore: an object index whose cylinders are not tested (crowd scenes: a person beside it)."""
         a = self.c
         c = np.asarray(cyl, dtype=np.float64)
         d = np.hypot(a[None, :, 0] - c[:, None, 0], a[None, :, 1] - c[:, None, 1])
         hit = ((d < a[None, :, 2] + c[:, None, 2] + margin) & (a[None, :, 3] < c[:, None, 4])
                & (a[None, :, 4] > c[:, None, 3]))
+        if ignore is not None:
+            hit &= (self.own != ignore)[None, :]
         return not hit.any()
 
-    def take(self, cyl):
+    def take(self, cyl, owner=-1):
         self.c = np.vstack([self.c, np.asarray(cyl)])
+        self.own = np.concatenate([self.own, np.full(len(cyl), owner)])
 
 
 class SceneBuilder:
-    def __init__(self, rng, mount_height_m, max_range_m, kind=None, robot=False, res=0.3):
+    def __init__(self, rng, mount_height_m, max_range_m, kind=None, robot=False, res=0.3, crowd=False):
         self.rng = rng
+        self.crowd = crowd
         self.H = mount_height_m
         self.kind = kind or str(rng.choice(SCENE_TYPES, p=[0.4, 0.25, 0.15, 0.2]))
         self.robot = robot
@@ -227,14 +234,20 @@ class SceneBuilder:
     # -- placement helpers ---------------------------------------------------------------------
     def put(self, shape: ob.Shape, u, v, yaw_road, check=True, margin=0.25):
         x, y = self.to_level(u, v)
+        yaw = float(np.angle(np.exp(1j * (yaw_road + self.psi))))
+        return self.put_level(shape, x, y, yaw, check, margin)
+
+    def put_level(self, shape: ob.Shape, x, y, yaw, check=True, margin=0.25, body=False, ignore=None):
+        """Place at level-frame (x, y) with a level-frame yaw. body: collide with the body only (crowd
+        scenes: road users may stand closer than their annotation boxes, so boxes may overlap);
+        ignore: an object index not tested (the car or pole a person stands beside)."""
         if abs(x) > self.half - 2 or abs(y) > self.half - 2:
             return None
-        yaw = float(np.angle(np.exp(1j * (yaw_road + self.psi))))
-        cyl = ob.collision_cylinders(shape, x, y, yaw)
-        if check and not self.placer.free(cyl, margin):
+        cyl = ob.body_cylinders(shape, x, y, yaw) if body else ob.collision_cylinders(shape, x, y, yaw)
+        if check and not self.placer.free(cyl, margin, ignore):
             return None
         if check:
-            self.placer.take(cyl)
+            self.placer.take(cyl, len(self.objects))
         zg = float(self.hf.height(np.array([x]), np.array([y]))[0])
         idx = len(self.objects)
         inst = 0
@@ -250,7 +263,7 @@ class SceneBuilder:
     def vehicle(self, moving=True):
         p = self.rng.random()
         if p < (0.82 if moving else 0.9):
-            return ob.car(self.rng)
+            return ob.car(self.rng) if not self.crowd else ob.worn(ob.car(self.rng), self.rng)
         if p < 0.92:
             return ob.van(self.rng)
         return ob.truck(self.rng) if self.rng.random() < 0.6 else ob.bus(self.rng)
@@ -496,9 +509,12 @@ class SceneBuilder:
         self.traffic()
         self.people()
         self.furniture()
+        if self.crowd:
+            crowds(self)
         self.dig_pits()
         return Scene(self.kind, self.hf, self.plist.freeze(), self.objects)
 
 
-def make_scene(rng, mount_height_m, max_range_m, kind=None, robot=False) -> Scene:
-    return SceneBuilder(rng, mount_height_m, max_range_m, kind, robot).build()
+def make_scene(rng, mount_height_m, max_range_m, kind=None, robot=False, crowd=False) -> Scene:
+    """crowd: add the crowded street content of crowd.py (issue 15) after the default content."""
+    return SceneBuilder(rng, mount_height_m, max_range_m, kind, robot, crowd=crowd).build()

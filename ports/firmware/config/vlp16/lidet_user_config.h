@@ -16,5 +16,7 @@
 #define LIDET_MAX_POINTS 30000   /* 16 x 1800 = 28800 returns + margin; more are counted, not read */
 #define LIDET_MAX_CLUSTERS 64    /* proposals per scan (the detector classifies at most this many) */
 #define LIDET_MAX_DETECTIONS 64  /* road users reported per scan (= clusters: never truncated) */
+#define LIDET_REFINE_MAX_CELLS 2048  /* proposal refinement grid: 5.4 x 5.4 m at its 0.12 m cells */
+#define LIDET_REFINE_MAX_POINTS 2048 /* pixels of one examined cluster (16 rings x 128 columns) */
 
 #endif /* LIDET_USER_CONFIG_H */

@@ -1,0 +1,400 @@
+# SPDX-License-Identifier: MIT
+"""Reference of the integer clustering and proposals (lib/src/lidet_cluster_q*.c, lib/src/lidet_proposal_q.c;
+the contract is lib/include/lidet/lidet_cluster_q.h), bit for bit.
+
+Plain Python integers over the compact image (4 mm steps), the angle tables from `ref.qmath` (the C integer
+math mirrored), the flood fill with the C's exact search order and rules (hole and occluder bridging, column
+wrap, diagonals), the filters, the capacity, the fragment rescue and the canonical ids; the proposals reuse
+`ref.cluster.proposal_indices` (the shared resampling rule). Slow (seconds per 64 x 2048 image): for tests.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from lidet_codegen.ref import qmath as qm
+from lidet_codegen.ref.cluster import proposal_indices
+
+FREE, SMALL, PENDING, NONCAND = 0, 0xFFFD, 0xFFFE, 0xFFFF
+STEPS = 16  # LIDET_CLUSTER_MAX_STEPS
+M32 = 0xFFFFFFFF
+
+
+def _i(v) -> int:
+    return int(np.asarray(v).item())
+
+
+def _div_round(n: int, d: int) -> int:
+    """round(n / d), halves away from zero (lidet__q_div_round)."""
+    return (n + d // 2) // d if n >= 0 else -((-n + d // 2) // d)
+
+
+def _h_of(sin_half: int) -> int:
+    """4 sin^2(alpha / 2), Q30, saturated (h_of)."""
+    return min(_i(qm.rshift_round(sin_half * sin_half, 28)), M32)
+
+
+def tables(row_elev_bam, cols: int, theta_urad: int):
+    """The join test's tables (lidet__cluster_q_setup_geometry): sin(theta) Q16 and, per kind, S = sin(alpha +
+    theta) Q16 (clamped at 0) and H = 4 sin^2(alpha / 2) Q30. Returns (sin_t, col_s, col_h, row_s, row_h,
+    diag_s, diag_h) as lists (row tables indexed [r * STEPS + k - 1])."""
+    e = [int(v) for v in row_elev_bam]
+    rows = len(e)
+    theta = _i(qm.urad_to_bam(theta_urad))
+    sin_t = _i(qm.rshift_round(qm.sin(theta), 14))
+
+    def tab(alpha):
+        s = _i(qm.rshift_round(qm.sin(alpha + theta), 14))
+        return max(s, 0), _h_of(_i(qm.sin(alpha >> 1)))
+
+    col_s, col_h, a1 = [], [], 0
+    for k in range(1, STEPS + 1):
+        a = (((k % cols) << 32) + cols // 2) // cols
+        a = (1 << 32) - a if a > (1 << 31) else a
+        a1 = a if k == 1 else a1
+        s, h = tab(a)
+        col_s.append(s)
+        col_h.append(h)
+    row_s, row_h = [], []
+    for r in range(rows):
+        for k in range(1, STEPS + 1):
+            s, h = tab(abs(e[r] - e[r + k]) & M32 if r + k < rows else 0)
+            row_s.append(s)
+            row_h.append(h)
+    diag_s, diag_h = [0] * rows, [0] * rows
+    hc = _h_of(_i(qm.sin(a1 >> 1)))
+    for r in range(rows - 1):
+        h1 = _h_of(_i(qm.sin((abs(e[r] - e[r + 1]) & M32) >> 1)))
+        c12 = _i(qm.rshift_round(_i(qm.cos(e[r])) * _i(qm.cos(e[r + 1])), 30))
+        hh = min(h1 + _i(qm.rshift_round(c12 * hc, 30)), M32)
+        sh = min((_i(qm.isqrt(hh << 30)) + 1) >> 1, 1 << 30)
+        ch = _i(qm.isqrt((1 << 60) - sh * sh))
+        diag_s[r] = tab((_i(qm.atan2(sh, ch)) * 2) & M32)[0]
+        diag_h[r] = hh
+    return sin_t, col_s, col_h, row_s, row_h, diag_s, diag_h
+
+
+@dataclass
+class Rec:
+    n_points: int
+    first_member: int
+    seed_pixel: int
+    n_rescued: int
+    mean: list
+    min: list
+    max: list
+    height: int
+    sums: list = field(default_factory=list)
+
+
+STAT_KEYS = ["n_candidates", "n_found", "n_fragments", "n_rescue_joined", "n_rescue_pixels", "n_dropped_small",
+             "n_dropped_extent", "n_dropped_height", "n_dropped_capacity", "n_kept", "n_pixels_kept",
+             "n_queue_overflow",
+             # the float stage's refinement counts (lidet_refine.c); the integer stage has no refinement: always 0
+             "n_split", "n_split_parts", "n_split_skipped", "n_joined"]
+
+
+def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: dict | None = None,
+                  max_clusters: int = 1024):
+    """Integer clustering of a compact image ((rows, cols) int16 x, y, z, uint16 range, (rows,) BAM32
+    elevations; ground (rows, cols) uint8 or None; planes_q (S, 4) int or None). cfg: lidet_cluster_q_cfg_t
+    fields (all required). Returns (labels (rows, cols) int64, members int64, list of Rec, stats dict)."""
+    c = dict(cfg)
+    rows, cols = np.asarray(rng).shape
+    npix = rows * cols
+    X = [int(v) for v in np.asarray(x).ravel()]
+    Y = [int(v) for v in np.asarray(y).ravel()]
+    Z = [int(v) for v in np.asarray(z).ravel()]
+    R = [int(v) for v in np.asarray(rng).ravel()]
+    G = [0] * npix if ground is None else [int(v) for v in np.asarray(ground).ravel()]
+    PL = None if planes_q is None else [[int(v) for v in p] for p in np.asarray(planes_q).reshape(-1, 4)]
+    sin_t, col_s, col_h, row_s, row_h, diag_s, diag_h = tables(row_elev_bam, cols, c["theta_urad"])
+    ks = c["max_steps"]
+    kc = min(ks, cols - 1)
+    occl, diag = c["bridge_occluders"] != 0, c["diagonals"] != 0
+    gap_on = c["max_gap_mm"] > 0
+    gap, gpm = _div_round(c["max_gap_mm"], 4), c["max_gap_per_m_q16"]
+    rgap, rgpm = _div_round(c["rescue_gap_mm"], 4), c["rescue_gap_per_m_q16"]
+    wr, wc = c["rescue_rows"], min(c["rescue_cols"], (cols - 1) // 2)
+    mount4 = _div_round(c["mount_height_mm"], 4)
+    st = dict.fromkeys(STAT_KEYS, 0)
+
+    lab = [FREE if (R[p] > 0 and G[p] == 0) else NONCAND for p in range(npix)]
+    st["n_candidates"] = sum(1 for v in lab if v == FREE)
+    mem: list = []
+    recs: list = []
+
+    def link(da, db, s, h):
+        d1, d2 = (da, db) if da > db else (db, da)
+        if not d2 * s > d1 * sin_t:
+            return False
+        if gap_on:
+            gg = gap + ((d2 * gpm + 32768) >> 16)
+            dd = d1 - d2
+            if dd > gg:
+                return False
+            cross = ((((d1 * d2) * h) >> 29) + 1) >> 1
+            return dd * dd + cross <= gg * gg
+        return True
+
+    def take(n):
+        lab[n] = PENDING
+        mem.append(n)
+
+    def search(q, dq, step, nk, ta, tb, base, gs):
+        n = q
+        if not occl:
+            k = 0
+            while True:
+                n += step
+                lv = lab[n]
+                if lv != NONCAND:
+                    break
+                k += 1
+                if k >= nk:
+                    break
+            if lv == FREE and link(dq, R[n], ta[base + k * gs], tb[base + k * gs]):
+                take(n)
+            return
+        for k in range(nk):
+            n += step
+            lv = lab[n]
+            if lv == NONCAND:
+                continue
+            dn = R[n]
+            t = base + k * gs
+            if lv == FREE:
+                if link(dq, dn, ta[t], tb[t]):
+                    take(n)
+                    break
+                if not dn < dq:
+                    break
+            elif not dn < dq or link(dq, dn, ta[t], tb[t]):
+                break
+
+    def search_wrap(dq, rowbase, col, right):
+        for k in range(1, kc + 1):
+            n = rowbase + ((col + k) % cols if right else (col - k) % cols)
+            lv = lab[n]
+            if lv == NONCAND:
+                continue
+            dn = R[n]
+            ok = link(dq, dn, col_s[k - 1], col_h[k - 1])
+            if lv == FREE and ok:
+                take(n)
+                break
+            if not occl or not dn < dq or (lv != FREE and ok):
+                break
+
+    def grow(start):
+        head = start
+        while head < len(mem):
+            q = mem[head]
+            head += 1
+            r, col = divmod(q, cols)
+            rowbase = r * cols
+            dq = R[q]
+            nd, nu = min(rows - 1 - r, ks), min(r, ks)
+            if col + kc < cols:
+                search(q, dq, 1, kc, col_s, col_h, 0, 1)
+            else:
+                search_wrap(dq, rowbase, col, True)
+            if col >= kc:
+                search(q, dq, -1, kc, col_s, col_h, 0, 1)
+            else:
+                search_wrap(dq, rowbase, col, False)
+            if nd > 0:
+                search(q, dq, cols, nd, row_s, row_h, r * STEPS, 1)
+            if nu > 0:
+                search(q, dq, -cols, nu, row_s, row_h, (r - 1) * STEPS, 1 - STEPS)
+            if diag:
+                cl = col - 1 if col > 0 else cols - 1
+                cr = col + 1 if col + 1 < cols else 0
+                for rr, t in ((r + 1, r), (r - 1, r - 1)):
+                    if 0 <= rr < rows:
+                        for n in (rr * cols + cl, rr * cols + cr):
+                            if lab[n] == FREE and link(dq, R[n], diag_s[t], diag_h[t]):
+                                take(n)
+
+    def stats_of(ms):
+        out = []
+        for P in (X, Y, Z):
+            v = [P[m] for m in ms]
+            out.append((sum(v), min(v), max(v)))
+        return out
+
+    def height(seed, mean):
+        if PL is not None:
+            ns = len(PL)
+            s = min((seed % cols) * ns // cols, ns - 1)
+            nx, ny, nz, d = PL[s]
+            h = ((nx * mean[0] + ny * mean[1] + nz * mean[2] + (1 << 29)) >> 30) + d
+        else:
+            h = mean[2] + mount4
+        return max(min(h, 0x7FFFFFFF), -0x7FFFFFFF)
+
+    def claim(n, rescue):
+        if len(recs) < max_clusters:
+            recs.append(None)
+            return len(recs) - 1
+        m = 0
+        for i in range(1, len(recs)):
+            a, b = recs[i], recs[m]
+            if a.n_points < b.n_points or (a.n_points == b.n_points and a.seed_pixel > b.seed_pixel):
+                m = i
+        st["n_dropped_capacity"] += 1
+        if rescue or n <= recs[m].n_points:
+            return None
+        for i in range(recs[m].first_member, recs[m].first_member + recs[m].n_points):
+            lab[mem[i]] = PENDING
+        return m
+
+    def finish(start, rescue):
+        ms = mem[start:]
+        n = len(ms)
+        if not rescue:
+            st["n_found"] += 1
+        small = n < c["min_points"]
+        if small and (rescue or c["rescue_gap_mm"] == 0):
+            st["n_dropped_small"] += 1
+            del mem[start:]
+            return
+        sx = stats_of(ms)
+        lim = M32 if small else c["max_extent_mm"]
+        if any((hi - lo) * 4 > lim for _, lo, hi in sx):
+            st["n_dropped_extent"] += 1
+            del mem[start:]
+            return
+        mean = [_div_round(s, n) for s, _, _ in sx]
+        h = height(ms[0], mean)
+        if h * 4 > c["max_mean_height_mm"]:
+            st["n_dropped_height"] += 1
+            del mem[start:]
+            return
+        if small:
+            st["n_fragments"] += 1
+            for m in ms:
+                lab[m] = SMALL
+            del mem[start:]
+            return
+        slot = claim(n, rescue)
+        if slot is None:
+            del mem[start:]
+            return
+        recs[slot] = Rec(n, start, ms[0], n if rescue else 0, mean, [v[1] for v in sx], [v[2] for v in sx], h,
+                         [v[0] for v in sx])
+        if rescue:
+            st["n_rescue_pixels"] += n
+        for m in ms:
+            lab[m] = slot + 1
+
+    def join(slot, start):
+        ms = mem[start:]
+        n = len(ms)
+        rec = recs[slot]
+        sx = stats_of(ms)
+        rec.n_points += n
+        rec.n_rescued += n
+        for a in range(3):
+            rec.sums[a] += sx[a][0]
+            rec.min[a] = min(rec.min[a], sx[a][1])
+            rec.max[a] = max(rec.max[a], sx[a][2])
+        rec.mean = [_div_round(s, rec.n_points) for s in rec.sums]
+        for m in ms:
+            lab[m] = slot + 1
+        rec.seed_pixel = min(rec.seed_pixel, ms[0])
+        rec.height = height(rec.seed_pixel, rec.mean)
+        st["n_rescue_joined"] += 1
+        st["n_rescue_pixels"] += n
+        del mem[start:]
+
+    for p in range(npix):
+        if lab[p] != FREE:
+            continue
+        start = len(mem)
+        take(p)
+        grow(start)
+        finish(start, False)
+
+    if st["n_fragments"] > 0:
+        for p in range(npix):
+            if lab[p] != SMALL:
+                continue
+            start = len(mem)
+            take(p)
+            best, best_d2 = 0, M32
+            head = start
+            while head < len(mem):
+                q = mem[head]
+                head += 1
+                r, col = divmod(q, cols)
+                dq = R[q]
+                c0 = col - wc if col >= wc else col + cols - wc
+                for rr in range(max(r - wr, 0), min(r + wr, rows - 1) + 1):
+                    for k in range(2 * wc + 1):
+                        n = rr * cols + (c0 + k) % cols
+                        lv = lab[n]
+                        if lv >= PENDING or n == q:
+                            continue
+                        dn = R[n]
+                        gg = rgap + ((min(dn, dq) * rgpm + 32768) >> 16)
+                        dx, dy, dz = X[n] - X[q], Y[n] - Y[q], Z[n] - Z[q]
+                        if abs(dn - dq) > gg or abs(dx) > gg or abs(dy) > gg or abs(dz) > gg:
+                            continue
+                        dd = dx * dx + dy * dy + dz * dz
+                        if dd > gg * gg:
+                            continue
+                        if lv == SMALL:
+                            take(n)
+                        elif dd < best_d2:
+                            best, best_d2 = lv, dd
+            if best:
+                join(best - 1, start)
+            else:
+                finish(start, True)
+
+    # canonical ids: records in seed order, members regrouped in raster order
+    order = sorted(range(len(recs)), key=lambda i: recs[i].seed_pixel)
+    slot_id = {s + 1: i + 1 for i, s in enumerate(order)}
+    labels = np.zeros(npix, np.int64)
+    groups: list = [[] for _ in order]
+    for p in range(npix):
+        lv = lab[p]
+        if 0 < lv < SMALL:
+            labels[p] = slot_id[lv]
+            groups[slot_id[lv] - 1].append(p)
+    out_recs, members, first = [], [], 0
+    for i, s in enumerate(order):
+        rec = recs[s]
+        rec.first_member = first
+        first += rec.n_points
+        members.extend(groups[i])
+        out_recs.append(rec)
+    st["n_pixels_kept"] = first
+    st["n_kept"] = len(recs)
+    return labels.reshape(rows, cols), np.asarray(members, np.int64), out_recs, st
+
+
+def _sat16(v: int) -> int:
+    return max(-32768, min(32767, v))
+
+
+def make_proposal_q(rec: Rec, members, x, y, z, cfg: dict):
+    """lidet_proposal_q_make of one record (members: the canonical member array; x, y, z the image's int16
+    planes; cfg: lidet_proposal_q_cfg_t fields). Returns (xyz (n_points, 3) int16, mean (3,) int32, voxel
+    (3,) int16)."""
+    X, Y, Z = (np.asarray(a).ravel() for a in (x, y, z))
+    mx, my, mz = rec.mean
+    idx = proposal_indices(rec.n_points, cfg["n_points"], cfg["seed"])
+    pix = np.asarray(members)[rec.first_member + idx]
+    xyz = np.array([[_sat16(int(P[p]) - m) for P, m in ((X, mx), (Y, my), (Z, mz))] for p in pix], np.int16)
+    rxy2 = mx * mx + my * my
+
+    def b(v, bin_):
+        return _sat16(v // bin_)
+
+    vox = np.array([b(_i(qm.atan2(my, mx)), cfg["azimuth_bin_bam"]),
+                    b(_i(qm.atan2(mz, _i(qm.sqrt_round(rxy2)))), cfg["elevation_bin_bam"]),
+                    b(_i(qm.sqrt_round(rxy2 + mz * mz)), cfg["range_bin_4mm"])], np.int16)
+    return xyz, np.array(rec.mean, np.int32), vox

@@ -1,0 +1,40 @@
+/* SPDX-License-Identifier: MIT */
+/* Shared by the integer clustering's files (never installed): lidet_cluster_q.c (configuration, filters,
+ * records, the run), lidet_cluster_q_grow.c (the angle tables, the join test and the flood fill) and
+ * lidet_cluster_q_rescue.c (the fragment rescue). Integer only. */
+#ifndef LIDET_CLUSTER_Q_INTERNAL_H
+#define LIDET_CLUSTER_Q_INTERNAL_H
+
+#include "internal/lidet_cluster_common.h"
+#include "lidet/lidet_cluster_q.h"
+
+/* Constants of one run's flood fill (the geometry members named as lidet__grow_t's: the templates read
+ * both). Distances in 4 mm steps, ratios Q16. */
+typedef struct
+{
+    uint32_t rows, cols, ks, kc, row_magic;
+    int diag;
+    uint32_t rrows, rcols;
+    uint32_t sin_t;     /* sin(theta), Q16 */
+    uint32_t gap_on;    /* max_gap_mm > 0 */
+    uint32_t gap, gpm;  /* gap bound: gap + (gpm d2 >> 16, rounded) */
+    uint32_t rgap, rgpm; /* rescue distance: rgap + (rgpm min(d1, d2) >> 16, rounded) */
+} lidet__grow_q_t;
+
+/* Running state of one rescue group. */
+typedef struct
+{
+    uint32_t tail;
+    uint32_t best;    /* slot + 1 of the nearest kept cluster met, 0 = none */
+    uint32_t best_d2; /* its squared distance (4 mm steps squared) */
+} lidet__rescue_q_t;
+
+/* S and H of every alpha the search can meet; recomputed only when the geometry changes */
+void lidet__cluster_q_setup_geometry(lidet_cluster_q_state_t *c, const lidet_range_image_t *img);
+
+uint32_t lidet__cluster_q_grow(lidet_cluster_q_state_t *c, const lidet__grow_q_t *g, uint32_t start, uint32_t tail);
+
+void lidet__cluster_q_rescue_grow(lidet_cluster_q_state_t *c, const lidet__grow_q_t *g, uint32_t start,
+                                  lidet__rescue_q_t *rs);
+
+#endif

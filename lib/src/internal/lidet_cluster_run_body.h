@@ -1,0 +1,433 @@
+/* SPDX-License-Identifier: MIT */
+/* The clustering's bookkeeping, written once for the float stage (lidet_cluster.c) and the integer one
+ * (lidet_cluster_q.c), each of which includes this file once: the capacity (the smallest kept cluster,
+ * a slot for a new one), the canonical ids, the searches for the next seed, and the run's driver (first
+ * fill, rescue pass, canonical order). Nothing here reads a coordinate or a range. Parameters:
+ *   RUN_STATE_T, RUN_REC_T       the state and its record type (members n_recs, recs, order, slot_id,
+ *                                labels, members; records n_points, first_member, seed_pixel);
+ *   RUN_MEAN(r), RUN_MIN(r), RUN_MAX(r), RUN_HEIGHT(r)  a record's numeric fields (summary fields: lo, hi,
+ *                                mean, h);
+ *   RUN_PARAM_T, RUN_PLANE_T     the flood fill's constants and the ground plane type;
+ *   RUN_GROW(c, g, start, tail)  the first fill of one component (returns the new tail);
+ *   RUN_RESCUE_T, RUN_RESCUE_FAR  the rescue group's running state and its "no contact yet" distance;
+ *   RUN_RESCUE_GROW(c, g, start, rs);
+ * and the numeric kernels of the filters and records, static functions of the including file:
+ *   RUN_SUMMARY_T                          what one pass over a component's members gives (sums, bounds, mean,
+ *                                          height);
+ *   int summarise(c, start, tail, small, s)  sums and bounds; nonzero when an extent exceeds the limit
+ *                                          (small: no limit);
+ *   int mean_height_ok(c, n, seed, s, planes, n_sectors)  the mean and its height; nonzero when it passes;
+ *   void record_sums(c, slot, s)           what the stage keeps of s beside the record (or nothing);
+ *   void join_mean(c, slot, n, s)          a rescue group of n pixels added to the record's mean (before its
+ *                                          count grows);
+ *   void reheight(c, slot, planes, n_sectors)  the record's height from its mean and seed;
+ *   int rescue_on(c)                       the fragment rescue is configured.
+ * Not a public header; include nowhere else. */
+
+#define RUN_NO_SLOT 0xFFFFFFFFu
+
+/* the smallest kept cluster (ties: the later seed), the one capacity drops first */
+static uint32_t smallest_slot(const RUN_STATE_T *c)
+{
+    uint32_t i, m = 0;
+    for (i = 1; i < c->n_recs; ++i)
+    {
+        const RUN_REC_T *a = &c->recs[i], *b = &c->recs[m];
+        if (a->n_points < b->n_points || (a->n_points == b->n_points && a->seed_pixel > b->seed_pixel))
+        {
+            m = i;
+        }
+    }
+    return m;
+}
+
+/* a slot for a cluster of n pixels that passed the filters, or RUN_NO_SLOT (counted) when the capacity
+ * is full and it does not win one: a first-fill cluster evicts the smallest kept one when it is larger
+ * (the new one has the latest seed, so it loses every tie); a rescue group never evicts. The evicted
+ * cluster's pixels become "visited, dropped"; its member range stays as a hole that the final raster
+ * pass compacts away (only first-fill clusters are evicted, and they own exactly their member range) */
+static uint32_t claim_slot(RUN_STATE_T *c, uint32_t n, int rescue, lidet_cluster_stats_t *st)
+{
+    uint32_t i, m;
+    if (c->n_recs < LIDET_MAX_CLUSTERS)
+    {
+        return c->n_recs++;
+    }
+    m = smallest_slot(c);
+    ++st->n_dropped_capacity;
+    if (rescue || n <= c->recs[m].n_points)
+    {
+        return RUN_NO_SLOT;
+    }
+    for (i = c->recs[m].first_member; i < c->recs[m].first_member + c->recs[m].n_points; ++i)
+    {
+        c->labels[c->members[i]] = (uint16_t)LAB_PENDING;
+    }
+    return m;
+}
+
+/* canonical id of kept pixel i (label slot + 1, or 0 = none), appended to its cluster's members */
+static inline void place_kept(RUN_STATE_T *c, uint16_t *lab, uint32_t i)
+{
+    const uint32_t l = lab[i];
+    if (l != 0u)
+    {
+        const uint32_t id = c->slot_id[l];
+        lab[i] = (uint16_t)id;
+        c->members[c->recs[id - 1u].first_member++] = (int32_t)i;
+    }
+}
+
+/* canonical order: records sorted by seed, labels rewritten, members regrouped in raster order */
+static void canonicalise(RUN_STATE_T *c, uint32_t npix, lidet_cluster_stats_t *st)
+{
+    const uint32_t k = c->n_recs;
+    uint32_t i, j, start;
+    uint16_t *lab = c->labels;
+
+    /* insertion sort of slots by seed: already sorted unless capacity evictions happened or the rescue
+     * added clusters or moved a seed */
+    for (i = 0; i < k; ++i)
+    {
+        const uint16_t s = (uint16_t)i;
+        j = i;
+        while (j > 0 && c->recs[c->order[j - 1]].seed_pixel > c->recs[s].seed_pixel)
+        {
+            c->order[j] = c->order[j - 1];
+            --j;
+        }
+        c->order[j] = s;
+    }
+    c->slot_id[0] = 0;
+    for (i = 0; i < k; ++i)
+    {
+        c->slot_id[c->order[i] + 1u] = (uint16_t)(i + 1u);
+    }
+    /* gather permutation recs[i] = old recs[order[i]], following cycles (order[] is consumed) */
+    for (i = 0; i < k; ++i)
+    {
+        RUN_REC_T tmp;
+        if (c->order[i] == i)
+        {
+            continue;
+        }
+        tmp = c->recs[i];
+        j = i;
+        for (;;)
+        {
+            const uint32_t src = c->order[j];
+            c->order[j] = (uint16_t)j;
+            if (src == i)
+            {
+                c->recs[j] = tmp;
+                break;
+            }
+            c->recs[j] = c->recs[src];
+            j = src;
+        }
+    }
+    start = 0;
+    for (i = 0; i < k; ++i)
+    {
+        c->recs[i].first_member = start; /* a write cursor during the pass below */
+        start += c->recs[i].n_points;
+    }
+    st->n_pixels_kept = start;
+    /* every pixel that is not in a kept cluster (non-candidate, dropped; none is still free) -> 0,
+     * without a branch (it vectorises); kept pixels keep slot + 1 */
+    for (i = 0; i < npix; ++i)
+    {
+        const uint32_t l = lab[i];
+        lab[i] = (uint16_t)(l < LAB_SMALL ? l : 0u);
+    }
+    /* slot + 1 -> id and the members in raster order. Kept pixels are a minority: blocks of four
+     * labels that are all 0 (one 64-bit word, read with memcpy) are skipped at once */
+    for (i = 0; i + 4u <= npix; i += 4u)
+    {
+        uint64_t w;
+        memcpy(&w, &lab[i], sizeof w);
+        if (w != 0u)
+        {
+            place_kept(c, lab, i);
+            place_kept(c, lab, i + 1u);
+            place_kept(c, lab, i + 2u);
+            place_kept(c, lab, i + 3u);
+        }
+    }
+    for (; i < npix; ++i)
+    {
+        place_kept(c, lab, i);
+    }
+    for (i = 0; i < k; ++i)
+    {
+        c->recs[i].first_member -= c->recs[i].n_points;
+    }
+}
+
+/* the first free pixel (label 0) at or after p, npix if none. Seeds are rare once most pixels are
+ * visited: four labels at a time (a 64-bit word, read with memcpy) are skipped when none is 0. The
+ * test (w - 0x0001..) & ~w & 0x8000.. is nonzero exactly when some 16-bit lane of w is zero (a
+ * borrow only starts at a zero lane, and the lowest zero lane always sets its top bit) */
+static inline uint32_t next_free(const uint16_t *lab, uint32_t p, uint32_t npix)
+{
+    for (;;)
+    {
+        while (p + 4u <= npix)
+        {
+            uint64_t w;
+            memcpy(&w, &lab[p], sizeof w);
+            if (((w - 0x0001000100010001u) & ~w & 0x8000800080008000u) != 0u)
+            {
+                break;
+            }
+            p += 4u;
+        }
+        if (p >= npix || lab[p] == LAB_FREE)
+        {
+            return p < npix ? p : npix;
+        }
+        ++p;
+    }
+}
+
+/* the first fragment pixel (LAB_SMALL) at or after p, npix if none: blocks of 64 labels are tested
+ * in a loop without branches (it vectorises), and only a block that holds one is searched */
+static uint32_t next_fragment(const uint16_t *lab, uint32_t p, uint32_t npix)
+{
+    while (p < npix)
+    {
+        const uint32_t e = npix - p < 64u ? npix : p + 64u;
+        uint32_t i;
+        uint16_t any = 0;
+        for (i = p; i < e; ++i)
+        {
+            any |= (uint16_t)(lab[i] == LAB_SMALL);
+        }
+        if (any != 0u)
+        {
+            for (i = p; lab[i] != LAB_SMALL; ++i)
+            {
+            }
+            return i;
+        }
+        p = e;
+    }
+    return npix;
+}
+
+
+/* the end of a successful init: no geometry, run or record yet */
+static lidet_status_t init_done(RUN_STATE_T *c)
+{
+    c->geo_rows = 0;
+    c->geo_cols = 0;
+    c->n_recs = 0;
+    c->labels = 0;
+    c->members = 0;
+    memset(&c->img, 0, sizeof c->img);
+    memset(&c->stats, 0, sizeof c->stats);
+    c->magic = LIDET_INIT_MAGIC;
+    return LIDET_OK;
+}
+
+/* the checks every run starts with (arguments, state, image size) */
+static lidet_status_t run_check(const RUN_STATE_T *c, const uint16_t *labels, const int32_t *members,
+                                const lidet_range_image_t *img, const RUN_PLANE_T *planes, uint32_t n_sectors)
+{
+    if (c == 0 || labels == 0 || members == 0 || img == 0 || (planes != 0 && n_sectors == 0))
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (c->magic != LIDET_INIT_MAGIC)
+    {
+        return LIDET_ERR_STATE;
+    }
+    if (img->n_rows < 1 || img->n_cols < 2 || img->n_rows > LIDET_MAX_ROWS || img->n_cols > LIDET_MAX_COLS)
+    {
+        return LIDET_ERR_BUFFER;
+    }
+    return LIDET_OK;
+}
+
+/* the cluster id of every input point from the last run's per-pixel ids (point_labels of both stages) */
+static lidet_status_t labels_of_points(const RUN_STATE_T *c, const int32_t *point_pixel, uint32_t n_points,
+                                       uint32_t *out)
+{
+    if (c == 0 || ((point_pixel == 0 || out == 0) && n_points > 0))
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (c->magic != LIDET_INIT_MAGIC || c->labels == 0)
+    {
+        return LIDET_ERR_STATE;
+    }
+    lidet__cluster_point_labels(c->labels, (uint32_t)c->img.n_rows * c->img.n_cols, point_pixel, n_points, out);
+    return LIDET_OK;
+}
+
+/* the run's image and buffers bound to the state, the records and counts cleared */
+static void run_bind(RUN_STATE_T *c, uint16_t *labels, int32_t *members, const lidet_range_image_t *img,
+                     lidet_cluster_stats_t *st)
+{
+    c->img = *img;
+    c->labels = labels;
+    c->members = members;
+    c->n_recs = 0;
+    memset(st, 0, sizeof *st);
+}
+
+/* a record's numbers from the summary of its members */
+static void record_numbers(RUN_STATE_T *c, uint32_t slot, const RUN_SUMMARY_T *s)
+{
+    RUN_REC_T *rec = &c->recs[slot];
+    uint32_t i;
+    for (i = 0; i < 3; ++i)
+    {
+        RUN_MEAN(rec)[i] = s->mean[i];
+        RUN_MIN(rec)[i] = s->lo[i];
+        RUN_MAX(rec)[i] = s->hi[i];
+    }
+    RUN_HEIGHT(rec) = s->h;
+    record_sums(c, slot, s);
+}
+
+/* filters + bookkeeping of the component members[start, tail); returns the new tail. rescue = 0:
+ * a component of the first fill (one below min_points becomes a fragment when the rescue is on);
+ * 1: a rescue group that joined no cluster (dropped when small; takes only a free slot) */
+static uint32_t finish_cluster(RUN_STATE_T *c, uint32_t start, uint32_t tail, const RUN_PLANE_T *planes,
+                               uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue)
+{
+    const uint32_t n = tail - start;
+    const int32_t *mem = c->members;
+    RUN_SUMMARY_T sm;
+    uint32_t i, slot;
+    int small;
+    RUN_REC_T *rec;
+
+    if (!rescue)
+    {
+        ++st->n_found;
+    }
+    small = n < c->cfg.min_points;
+    if (small && (rescue || !rescue_on(c)))
+    {
+        ++st->n_dropped_small;
+        return start;
+    }
+    /* the same filters for a fragment-to-be (small: no extent limit), so that one above the height
+     * limit (canopies, wires: nothing a road user would take in) never reaches the rescue; it saves
+     * a third of the rescue's work */
+    if (summarise(c, start, tail, small, &sm))
+    {
+        ++st->n_dropped_extent;
+        return start;
+    }
+    if (!mean_height_ok(c, n, (uint32_t)mem[start], &sm, planes, n_sectors))
+    {
+        ++st->n_dropped_height;
+        return start;
+    }
+    if (small)
+    {
+        ++st->n_fragments;
+        for (i = start; i < tail; ++i)
+        {
+            c->labels[mem[i]] = (uint16_t)LAB_SMALL;
+        }
+        return start;
+    }
+    slot = claim_slot(c, n, rescue, st);
+    if (slot == RUN_NO_SLOT)
+    {
+        return start;
+    }
+    rec = &c->recs[slot];
+    rec->n_points = n;
+    rec->first_member = start;
+    rec->seed_pixel = (uint32_t)mem[start];
+    rec->n_rescued = rescue ? n : 0u;
+    record_numbers(c, slot, &sm);
+    if (rescue)
+    {
+        st->n_rescue_pixels += n;
+    }
+    for (i = start; i < tail; ++i)
+    {
+        c->labels[mem[i]] = (uint16_t)(slot + 1u);
+    }
+    return tail;
+}
+
+/* a rescue group members[start, tail) joins kept cluster `slot`: count, bounds and mean are updated and the
+ * height recomputed (no filter). The group's seed is its first pixel in raster order, so the cluster's first
+ * pixel is the smaller of the two seeds (the height uses that pixel's sector, as for any cluster) */
+static void rescue_join(RUN_STATE_T *c, uint32_t slot, uint32_t start, uint32_t tail, const RUN_PLANE_T *planes,
+                        uint32_t n_sectors, lidet_cluster_stats_t *st)
+{
+    RUN_REC_T *rec = &c->recs[slot];
+    const uint32_t n = tail - start, seed = (uint32_t)c->members[start];
+    RUN_SUMMARY_T sm;
+    uint32_t i;
+    (void)summarise(c, start, tail, 1, &sm);
+    join_mean(c, slot, n, &sm);
+    for (i = 0; i < 3; ++i)
+    {
+        RUN_MIN(rec)[i] = sm.lo[i] < RUN_MIN(rec)[i] ? sm.lo[i] : RUN_MIN(rec)[i];
+        RUN_MAX(rec)[i] = sm.hi[i] > RUN_MAX(rec)[i] ? sm.hi[i] : RUN_MAX(rec)[i];
+    }
+    for (i = start; i < tail; ++i)
+    {
+        c->labels[c->members[i]] = (uint16_t)(slot + 1u);
+    }
+    rec->n_points += n;
+    rec->n_rescued += n;
+    rec->seed_pixel = seed < rec->seed_pixel ? seed : rec->seed_pixel;
+    reheight(c, slot, planes, n_sectors);
+    ++st->n_rescue_joined;
+    st->n_rescue_pixels += n;
+}
+
+/* the whole run after the candidates are marked in labels (FREE / NONCAND) and the stats zeroed but
+ * n_candidates: the first fill in raster order, the rescue pass over the fragments (LAB_SMALL), groups
+ * seeded in raster order (kept pixels, the fragments and the current group are distinct pixels, so the
+ * member array holds them), and the canonical order */
+static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, uint32_t npix, const RUN_PLANE_T *planes,
+                      uint32_t n_sectors, lidet_cluster_stats_t *st)
+{
+    uint16_t *lab = c->labels;
+    int32_t *mem = c->members;
+    uint32_t p, tail = 0;
+    for (p = next_free(lab, 0, npix); p < npix; p = next_free(lab, p + 1u, npix))
+    {
+        const uint32_t start = tail;
+        lab[p] = (uint16_t)LAB_PENDING;
+        mem[tail++] = (int32_t)p;
+        tail = RUN_GROW(c, lk, start, tail);
+        tail = finish_cluster(c, start, tail, planes, n_sectors, st, 0);
+    }
+    if (st->n_fragments > 0u)
+    {
+        for (p = next_fragment(lab, 0, npix); p < npix; p = next_fragment(lab, p + 1u, npix))
+        {
+            RUN_RESCUE_T rs;
+            const uint32_t start = tail;
+            lab[p] = (uint16_t)LAB_PENDING;
+            mem[tail++] = (int32_t)p;
+            rs.tail = tail;
+            rs.best = 0u;
+            rs.best_d2 = RUN_RESCUE_FAR;
+            RUN_RESCUE_GROW(c, lk, start, &rs);
+            if (rs.best != 0u)
+            {
+                rescue_join(c, rs.best - 1u, start, rs.tail, planes, n_sectors, st);
+                tail = start;
+            }
+            else
+            {
+                tail = finish_cluster(c, start, rs.tail, planes, n_sectors, st, 1);
+            }
+        }
+    }
+    canonicalise(c, npix, st);
+    st->n_kept = c->n_recs;
+}

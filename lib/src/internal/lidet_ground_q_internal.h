@@ -1,0 +1,60 @@
+/* SPDX-License-Identifier: MIT */
+/* Shared between lidet_ground_q.c and lidet_ground_q_fit.c (never installed). */
+#ifndef LIDET_GROUND_Q_INTERNAL_H
+#define LIDET_GROUND_Q_INTERNAL_H
+
+#include "lidet/lidet_ground_q.h"
+
+/* R of a pixel in 4 mm / 2^LIDET_GROUND_Q_R_SHIFT steps (1/64 mm) */
+#define LIDET_GROUND_Q_R_SHIFT 8
+/* power iterations on the adjugate of the scatter matrix per refinement */
+#define LIDET_GROUND_Q_POWER_ITERS 4
+/* |c|^2 (4 mm steps, to the 4th) at or below this: a degenerate triple (the float stage's 1e-8 m^4) */
+#define LIDET_GROUND_Q_MIN_CROSS2 39
+
+/* A plane prepared for heights of int16 points with 32-bit products only (a Cortex-M0+ has no 32 x 32 -> 64
+ * multiply): each Q30 normal component n = hi * 2^15 + lo, lo in [-2^14, 2^14), and
+ * n . p = (sum hi p << 15) + sum lo p exactly. The sums fit int32: the hi part is (n . p) / 2^15 within
+ * 1.5 * 2^15, |n . p| <= 2^30 |p| <= 2^30 * 56756 for a unit normal and int16 p, so below 1.87e9 (any partial
+ * sum too); the lo part is at most 3 * 2^29. */
+typedef struct
+{
+    int32_t hi[3], lo[3];
+    int64_t d; /* D, 4 mm / 2^30 */
+} lidet__ground_q_hplane_t;
+
+static inline void lidet__ground_q_hplane(const int32_t n[3], int64_t d, lidet__ground_q_hplane_t *h)
+{
+    int k;
+    for (k = 0; k < 3; ++k)
+    {
+        h->hi[k] = (int32_t)(((int64_t)n[k] + (1 << 14)) >> 15);
+        h->lo[k] = n[k] - (int32_t)((uint32_t)h->hi[k] << 15);
+    }
+    h->d = d;
+}
+
+/* n . p + D in 4 mm / 2^30, exact (as the int64 expression) */
+static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, int32_t x, int32_t y, int32_t z)
+{
+    const int32_t a = h->hi[0] * x + h->hi[1] * y + h->hi[2] * z;
+    const int32_t b = h->lo[0] * x + h->lo[1] * y + h->lo[2] * z;
+    return (int64_t)a * 32768 + b + h->d;
+}
+
+/* The rows of R: 1 = column-wise lanes (each digit step of the square root over the whole row: a compiler
+ * vectorises the column loop on SIMD hosts), 0 = pixel by pixel with root and remainder in registers (cores
+ * without SIMD: fewer loads and stores). Same values either way. */
+#ifndef LIDET_GROUND_Q_SQRT_LANES
+#if defined(__SSE2__) || defined(__ARM_NEON) || defined(__ARM_NEON__) || defined(__AVX2__)
+#define LIDET_GROUND_Q_SQRT_LANES 1
+#else
+#define LIDET_GROUND_Q_SQRT_LANES 0
+#endif
+#endif
+
+/* Fits one plane per cell from the gathered samples, applies the fallback (lidet_ground_q_fit.c). */
+void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                                 const lidet_range_image_t *img);
+
+#endif

@@ -1,0 +1,41 @@
+/* SPDX-License-Identifier: MIT */
+/* The proposals' resampling rule (lidet_cluster.h), integer only: shared by the float proposals
+ * (lidet_proposal.c) and the integer ones (lidet_proposal_q.c), so both take the same members. Mirrored by
+ * codegen/lidet_codegen/ref/cluster.py: proposal_indices. Never installed. */
+#ifndef LIDET_PROPOSAL_RULE_H
+#define LIDET_PROPOSAL_RULE_H
+
+#include <stdint.h>
+
+#include "internal/lidet_rng.h"
+
+/* the generator state of one cluster's resampling: the seed mixed with the member count, so clusters
+ * of different sizes draw different streams; 0 (xorshift's only fixed point) is replaced by
+ * LIDET_RNG_PROPOSAL_ZERO_SEED (the value the reference, ref/cluster.py, uses) */
+static inline uint32_t lidet__proposal_rng_start(uint32_t seed, uint32_t n_src)
+{
+    const uint32_t s = seed ^ (n_src * 0x9E3779B9u);
+    return s != 0 ? s : LIDET_RNG_PROPOSAL_ZERO_SEED;
+}
+
+/* member index of output i (0, 1, ... in order; *s is the generator state). n_src <= n_out: every
+ * member once, then draws with replacement; else one member from each of n_out equal runs of the
+ * member list (stratified, without replacement). */
+static inline uint32_t lidet__proposal_next_index(uint32_t *s, uint32_t i, uint32_t n_src, uint32_t n_out)
+{
+    if (n_src <= n_out)
+    {
+        if (i < n_src)
+        {
+            return i;
+        }
+        return lidet__rng_next(s) % n_src;
+    }
+    {
+        const uint32_t b0 = (uint32_t)(((uint64_t)i * n_src) / n_out);
+        const uint32_t b1 = (uint32_t)(((uint64_t)(i + 1u) * n_src) / n_out);
+        return b0 + lidet__rng_next(s) % (b1 - b0); /* b1 > b0 because n_src > n_out */
+    }
+}
+
+#endif

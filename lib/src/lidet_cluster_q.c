@@ -1,0 +1,231 @@
+/* SPDX-License-Identifier: MIT */
+/* Integer clustering (lidet_cluster_q.h): configuration, the run, the filters and records of each component,
+ * the rescue join, accessors. The bookkeeping and the run's driver are the float stage's
+ * (lidet_cluster_run_body.h); the growth is in lidet_cluster_q_grow.c, the rescue in lidet_cluster_q_rescue.c.
+ * Integer only. The numpy reference is codegen/lidet_codegen/ref/cluster_q.py (bit for bit). */
+#include <string.h>
+
+#include "internal/lidet_assert.h"
+#include "internal/lidet_cluster_q_internal.h"
+#include "internal/lidet_qmath.h"
+
+void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, uint32_t mount_height_mm)
+{
+    /* lidet_cluster_cfg_default's values (measured there, docs/BENCHMARKS.md), rounded to the integer units */
+    const int sparse = n_rows >= 1u && n_rows <= 16u;
+    if (cfg == 0)
+    {
+        return;
+    }
+    memset(cfg, 0, sizeof *cfg);
+    cfg->diagonals = 1u;
+    cfg->max_gap_mm = 700u;
+    cfg->theta_urad = sparse ? 120000u : 180000u;
+    cfg->max_steps = sparse ? 4u : 5u;
+    cfg->max_steps = cfg->max_steps < STEPS ? cfg->max_steps : STEPS;
+    cfg->bridge_occluders = sparse ? 0u : 1u;
+    cfg->max_gap_per_m_q16 = sparse ? 2621u : 1638u; /* 0.04, 0.025 */
+    cfg->min_points = 10u;
+    cfg->max_extent_mm = 6000u;
+    cfg->max_mean_height_mm = 2500;
+    cfg->mount_height_mm = mount_height_mm;
+    cfg->rescue_gap_mm = 800u;
+    cfg->rescue_gap_per_m_q16 = 1966u; /* 0.03 */
+    cfg->rescue_rows = sparse ? 1u : 2u;
+    cfg->rescue_cols = 6u;
+}
+
+/* the members' sums and bounds (lidet_cluster_stats_body.h) on the int16 pixels, int64 sums; the extent
+ * (at most 65535 steps) in mm against the limit */
+static inline void read_q(const lidet_cluster_q_state_t *c, uint32_t p, int32_t *x, int32_t *y, int32_t *z)
+{
+    *x = c->img.x_4mm[p];
+    *y = c->img.y_4mm[p];
+    *z = c->img.z_4mm[p];
+}
+
+#define STATS_STATE_T lidet_cluster_q_state_t
+#define STATS_V_T int32_t
+#define STATS_S_T int64_t
+#define STATS_LIM_T uint32_t
+#define STATS_READ(c, p, compact, x, y, z) read_q(c, p, x, y, z)
+#define STATS_OVER(lo, hi, lim) ((uint32_t)((hi) - (lo)) * 4u > (lim))
+#include "internal/lidet_cluster_stats_body.h"
+
+/* height of `mean` above the plane of the seed column's sector (or the flat ground at -mount), 4 mm steps */
+static int32_t height_q(const lidet_cluster_q_state_t *c, uint32_t seed, const int32_t mean[3],
+                        const lidet_plane_q_t *planes, uint32_t n_sectors)
+{
+    int64_t h;
+    if (planes != 0)
+    {
+        const uint32_t col = seed % c->img.n_cols;
+        uint32_t s = (uint32_t)(((uint64_t)col * n_sectors) / c->img.n_cols);
+        const lidet_plane_q_t *pl;
+        s = s < n_sectors ? s : n_sectors - 1u;
+        pl = &planes[s];
+        /* |mean| <= 2^15, |n| <= 2^31: the sum is below 2^49 */
+        h = lidet__q_rshift_round((int64_t)pl->nx * mean[0] + (int64_t)pl->ny * mean[1] + (int64_t)pl->nz * mean[2],
+                                  30) + pl->d_4mm;
+    }
+    else
+    {
+        h = (int64_t)mean[2] + lidet__q_div_round((int64_t)c->cfg.mount_height_mm, 4);
+    }
+    return h > 0x7FFFFFFF ? 0x7FFFFFFF : (h < -0x7FFFFFFF ? -0x7FFFFFFF : (int32_t)h);
+}
+
+static void mean_of(const int64_t sum[3], uint32_t n, int32_t mean[3])
+{
+    uint32_t a;
+    for (a = 0; a < 3; ++a)
+    {
+        mean[a] = (int32_t)lidet__q_div_round(sum[a], (int64_t)n);
+    }
+}
+
+/* the numeric kernels of the shared filters and records (lidet_cluster_run_body.h), in integers */
+typedef struct
+{
+    int64_t sum[3];
+    int32_t lo[3], hi[3], mean[3], h;
+} summary_q_t;
+
+static int summarise(const lidet_cluster_q_state_t *c, uint32_t start, uint32_t tail, int small, summary_q_t *s)
+{
+    return member_stats_of(c, start, tail, small ? 0xFFFFFFFFu : c->cfg.max_extent_mm, s->sum, s->lo, s->hi, 1);
+}
+
+static int mean_height_ok(const lidet_cluster_q_state_t *c, uint32_t n, uint32_t seed, summary_q_t *s,
+                          const lidet_plane_q_t *planes, uint32_t n_sectors)
+{
+    mean_of(s->sum, n, s->mean);
+    s->h = height_q(c, seed, s->mean, planes, n_sectors);
+    return (int64_t)s->h * 4 <= c->cfg.max_mean_height_mm;
+}
+
+static void record_sums(lidet_cluster_q_state_t *c, uint32_t slot, const summary_q_t *s)
+{
+    uint32_t i;
+    for (i = 0; i < 3; ++i)
+    {
+        c->sums[slot][i] = s->sum[i];
+    }
+}
+
+/* the group's sums are added: the mean is the rounded mean of all members, exactly */
+static void join_mean(lidet_cluster_q_state_t *c, uint32_t slot, uint32_t n, const summary_q_t *s)
+{
+    uint32_t i;
+    for (i = 0; i < 3; ++i)
+    {
+        c->sums[slot][i] += s->sum[i];
+    }
+    mean_of(c->sums[slot], c->recs[slot].n_points + n, c->recs[slot].mean_4mm);
+}
+
+static void reheight(lidet_cluster_q_state_t *c, uint32_t slot, const lidet_plane_q_t *planes, uint32_t n_sectors)
+{
+    lidet_cluster_q_rec_t *rec = &c->recs[slot];
+    rec->height_4mm = height_q(c, rec->seed_pixel, rec->mean_4mm, planes, n_sectors);
+}
+
+static int rescue_on(const lidet_cluster_q_state_t *c)
+{
+    return c->cfg.rescue_gap_mm > 0u;
+}
+
+/* the shared bookkeeping (capacity, filters, records, canonical ids, the run's driver) with the integer
+ * stage's types */
+#define RUN_STATE_T lidet_cluster_q_state_t
+#define RUN_REC_T lidet_cluster_q_rec_t
+#define RUN_PARAM_T lidet__grow_q_t
+#define RUN_PLANE_T lidet_plane_q_t
+#define RUN_SUMMARY_T summary_q_t
+#define RUN_MEAN(r) ((r)->mean_4mm)
+#define RUN_MIN(r) ((r)->min_4mm)
+#define RUN_MAX(r) ((r)->max_4mm)
+#define RUN_HEIGHT(r) ((r)->height_4mm)
+#define RUN_GROW lidet__cluster_q_grow
+#define RUN_RESCUE_T lidet__rescue_q_t
+#define RUN_RESCUE_FAR 0xFFFFFFFFu
+#define RUN_RESCUE_GROW lidet__cluster_q_rescue_grow
+#include "internal/lidet_cluster_run_body.h"
+
+lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lidet_cluster_q_cfg_t *cfg)
+{
+    if (c == 0 || cfg == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    c->magic = 0;
+    if (cfg->theta_urad == 0u || cfg->theta_urad >= 1500000u || cfg->max_steps < 1u || cfg->max_steps > STEPS ||
+        cfg->min_points < 1u || cfg->max_extent_mm == 0u || cfg->max_extent_mm > 1000000u ||
+        cfg->max_gap_mm > 1000000u || cfg->max_gap_per_m_q16 > 65536u || cfg->mount_height_mm > 100000u ||
+        cfg->rescue_gap_mm > 10000u || cfg->rescue_gap_per_m_q16 > 16384u || cfg->rescue_rows > LIDET_MAX_ROWS ||
+        cfg->rescue_cols > RESCUE_MAX_COLS)
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    c->cfg = *cfg;
+    c->theta_bam = lidet__q_urad_to_bam((int32_t)cfg->theta_urad);
+    c->sin_theta_q16 = (uint32_t)lidet__q_rshift_round(lidet__q_sin((uint32_t)c->theta_bam), 14);
+    return init_done(c);
+}
+
+lidet_status_t lidet_cluster_q_init(lidet_cluster_q_t *c, const lidet_cluster_q_cfg_t *cfg)
+{
+    return c == 0 ? LIDET_ERR_ARG : lidet_cluster_q_state_init(&c->state, cfg);
+}
+
+lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t *labels, int32_t *members,
+                                           const lidet_range_image_t *img, const uint8_t *ground_mask,
+                                           const lidet_plane_q_t *planes, uint32_t n_sectors)
+{
+    lidet__grow_q_t lk;
+    lidet_cluster_stats_t st;
+    uint32_t npix;
+    lidet_status_t chk = run_check(c, labels, members, img, planes, n_sectors);
+    /* a compact image with its BAM32 elevations */
+    if (chk == LIDET_OK && (img->x_m != 0 || img->x_4mm == 0 || img->y_4mm == 0 || img->z_4mm == 0 ||
+                            img->range_4mm == 0 || img->row_elev_bam == 0))
+    {
+        chk = LIDET_ERR_ARG;
+    }
+    if (chk != LIDET_OK)
+    {
+        return chk;
+    }
+    npix = (uint32_t)img->n_rows * img->n_cols;
+    lidet__cluster_q_setup_geometry(c, img);
+    run_bind(c, labels, members, img, &st);
+    LIDET__GROW_GEOMETRY(lk, img->n_rows, img->n_cols, c->cfg);
+    lk.sin_t = c->sin_theta_q16;
+    lk.gap_on = c->cfg.max_gap_mm > 0u;
+    lk.gap = (uint32_t)lidet__q_div_round((int64_t)c->cfg.max_gap_mm, 4);
+    lk.gpm = c->cfg.max_gap_per_m_q16;
+    lk.rgap = (uint32_t)lidet__q_div_round((int64_t)c->cfg.rescue_gap_mm, 4);
+    lk.rgpm = c->cfg.rescue_gap_per_m_q16;
+    st.n_candidates = lidet__cluster_mark_4mm(img->range_4mm, ground_mask, npix, labels);
+    run_fills(c, &lk, npix, planes, n_sectors, &st);
+    c->stats = st;
+    return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;
+}
+
+lidet_status_t lidet_cluster_q_run(lidet_cluster_q_t *c, const lidet_range_image_t *img, const uint8_t *ground_mask,
+                                   const lidet_plane_q_t *planes, uint32_t n_sectors)
+{
+    return c == 0 ? LIDET_ERR_ARG
+                  : lidet_cluster_q_run_buffers(&c->state, c->labels, c->members, img, ground_mask, planes, n_sectors);
+}
+
+lidet_status_t lidet_cluster_q_point_labels(const lidet_cluster_q_state_t *c, const int32_t *point_pixel,
+                                            uint32_t n_points, uint32_t *out)
+{
+    return labels_of_points(c, point_pixel, n_points, out);
+}
+
+uint32_t lidet_cluster_q_bytes(void)
+{
+    return (uint32_t)sizeof(lidet_cluster_q_t);
+}

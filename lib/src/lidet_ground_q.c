@@ -1,0 +1,441 @@
+/* SPDX-License-Identifier: MIT */
+/* Integer ground stage: configuration, the sample filter, the sample gathering, the labels and the accessors
+ * (lidet_ground_q.h; the plane fits are in lidet_ground_q_fit.c). Integers only: no <math.h>, no float.
+ * Mirrored bit for bit by codegen/lidet_codegen/ref/ground_q.py. */
+#include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
+
+#include <string.h>
+
+#include "internal/lidet_ground_internal.h"
+#include "internal/lidet_ground_q_internal.h"
+#include "internal/lidet_qmath.h"
+#include "internal/lidet_rng.h"
+
+void lidet_ground_q_cfg_default(lidet_ground_q_cfg_t *cfg, uint32_t n_rows, int32_t mount_height_mm)
+{
+    int low;
+    if (cfg == 0)
+    {
+        return;
+    }
+    memset(cfg, 0, sizeof *cfg);
+    /* the two families of lidet_ground_cfg_default, every value rounded to its integer unit */
+    low = n_rows <= 32u || mount_height_mm < 1000;
+    cfg->fy_max_q16 = 13107u; /* 0.2 */
+    cfg->fx_max_mm = low ? 200u : 1000u;
+    cfg->gate_above_mm = 430;
+    cfg->gate_below_mm = 8270;
+    cfg->mount_height_mm = mount_height_mm;
+    cfg->sample_step = low ? 1u : 4u;
+    cfg->sample_col_step = low ? 1u : 4u;
+    cfg->n_sectors = 32u;
+    cfg->ransac_iters = 16u;
+    cfg->eval_samples = 256u;
+    cfg->confidence_q16 = 64881u; /* 0.99 */
+    cfg->min_samples = 10u;
+    cfg->min_inliers = 8u;
+    cfg->refine_iters = low ? 2u : 1u;
+    cfg->inlier_mm = 200u;
+    cfg->max_tilt_urad = low ? 200000u : 100000u;
+    cfg->max_height_dev_mm = low ? 500u : 1000u;
+    cfg->ring_split_mm = low ? 0u : 15000u;
+    cfg->fallback_sectors = 4u;
+    cfg->seed = 12345u;
+    cfg->ground_mm = low ? 200u : 150u;
+    cfg->ground_per_m_q16 = 0u;
+    cfg->below_factor_q16 = 131072u; /* 2.0 */
+    cfg->veto_slope_q16 = low ? 98304u : 65536u;
+    cfg->veto_min_dz_mm = 50u;
+}
+
+lidet_status_t lidet_ground_q_state_init(lidet_ground_q_state_t *g, const lidet_ground_q_cfg_t *cfg)
+{
+    uint64_t split2;
+    if (g == 0 || cfg == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    g->magic = 0;
+    if (cfg->n_sectors > LIDET_GROUND_MAX_SECTORS)
+    {
+        return LIDET_ERR_BUFFER;
+    }
+    if (cfg->n_sectors < 1u || cfg->ransac_iters < 1u || cfg->ransac_iters > 1000u || cfg->eval_samples < 3u ||
+        cfg->sample_step < 1u || cfg->sample_step > 16u || cfg->sample_col_step < 1u || cfg->sample_col_step > 16u ||
+        cfg->min_samples < 3u || cfg->min_inliers < 3u || cfg->refine_iters > 10u || cfg->fx_on_z > 1u ||
+        cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors)
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    if (cfg->fy_max_q16 > 655360u || cfg->fx_max_mm < 1u || cfg->fx_max_mm > 100000u ||
+        cfg->gate_above_mm < -5000 || cfg->gate_above_mm > 10000 || cfg->gate_below_mm < 0 ||
+        cfg->gate_below_mm > 20000 || cfg->mount_height_mm < 0 || cfg->mount_height_mm > 10000 ||
+        cfg->confidence_q16 > 65535u || cfg->inlier_mm < 1u || cfg->inlier_mm > 5000u || cfg->max_tilt_urad < 1u ||
+        cfg->max_tilt_urad > 1570796u || cfg->max_height_dev_mm < 1u || cfg->max_height_dev_mm > 20000u ||
+        cfg->ring_split_mm > 500000u || cfg->ground_mm < 1u || cfg->ground_mm > 5000u ||
+        cfg->ground_per_m_q16 > 6554u || cfg->below_factor_q16 > 1310720u || cfg->veto_slope_q16 > 6553600u ||
+        cfg->veto_min_dz_mm > 5000u)
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    g->cfg = *cfg;
+    g->rng = lidet__rng_seed(cfg->seed);
+    g->cos_tilt_q30 = lidet__q_cos((uint32_t)lidet__q_urad_to_bam((int32_t)cfg->max_tilt_urad));
+    /* far: 16 (x^2 + y^2) >= split^2 (x, y in 4 mm steps, split in mm), i.e. x^2 + y^2 >= ceil(split^2 / 16);
+     * x^2 + y^2 < 2^31 for int16 coordinates, so a larger threshold means "never far" */
+    split2 = ((uint64_t)cfg->ring_split_mm * cfg->ring_split_mm + 15u) / 16u;
+    g->split_v = cfg->ring_split_mm == 0u || split2 > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)split2;
+    g->n_rows = 0;
+    g->n_cols = 0;
+    memset(&g->stats, 0, sizeof g->stats);
+    g->magic = LIDET_INIT_MAGIC;
+    return LIDET_OK;
+}
+
+lidet_status_t lidet_ground_q_init(lidet_ground_q_t *g, const lidet_ground_q_cfg_t *cfg)
+{
+    return g == 0 ? LIDET_ERR_ARG : lidet_ground_q_state_init(&g->state, cfg);
+}
+
+/* round(sqrt(v) * 256) for v < 2^31, exactly lidet__q_sqrt_round64(v << 16): digit by digit on v * 2^16 with
+ * 32-bit values only (remainder <= 2 root < 2^25), branch-free, no division: 16 integer and 8 fraction
+ * digits. One digit step of one value: */
+#define R_DIGITS (16 + LIDET_GROUND_Q_R_SHIFT)
+static inline void r_digit(uint32_t bits, uint32_t *root, uint32_t *rem)
+{
+    const uint32_t rm = (*rem << 2) | bits, trial = (*root << 2) | 1u, ge = 0u - (uint32_t)(rm >= trial);
+    *rem = rm - (trial & ge);
+    *root = (*root << 1) | (ge & 1u);
+}
+
+static inline uint32_t r_bits(uint32_t v, int i)
+{
+    return i >= 0 ? (v >> i) & 3u : 0u;
+}
+
+/* R of one pixel (the veto's occasional test) */
+static int32_t r_of(uint32_t v)
+{
+    uint32_t root = 0, rem = 0;
+    int i = 30;
+    while (i > 0 && (v >> i) == 0u)
+    {
+        i -= 2; /* a leading zero digit pair leaves root and remainder 0 */
+    }
+    for (; i > 30 - 2 * R_DIGITS; i -= 2)
+    {
+        r_digit(r_bits(v, i), &root, &rem);
+    }
+    return (int32_t)(root + (uint32_t)(rem > root));
+}
+
+/* x^2 + y^2 of a pixel (4 mm steps squared; < 2^31 for int16 values) */
+static inline uint32_t rxy2(const int16_t *x, const int16_t *y, uint32_t p)
+{
+    return (uint32_t)((int32_t)x[p] * x[p]) + (uint32_t)((int32_t)y[p] * y[p]);
+}
+
+/* R of a whole row, digit step by digit step over the columns (the same values as r_of, but the column loops
+ * are independent lanes that a compiler vectorises); v, rem: scratch of cols entries */
+static void r_of_row(const int16_t *x, const int16_t *y, uint32_t cols, int32_t *restrict out, uint32_t *restrict v,
+                     uint32_t *restrict rem)
+{
+    uint32_t *restrict root = (uint32_t *)out;
+    uint32_t c;
+    int i;
+#if !LIDET_GROUND_Q_SQRT_LANES
+    (void)root;
+    (void)v;
+    (void)rem;
+    for (c = 0; c < cols; ++c)
+    {
+        out[c] = r_of(rxy2(x, y, c));
+    }
+    return;
+#endif
+    for (c = 0; c < cols; ++c)
+    {
+        v[c] = rxy2(x, y, c);
+        root[c] = 0u;
+        rem[c] = 0u;
+    }
+    for (i = 30; i > 30 - 2 * R_DIGITS; i -= 2)
+    {
+        for (c = 0; c < cols; ++c)
+        {
+            r_digit(r_bits(v[c], i), &root[c], &rem[c]);
+        }
+    }
+    for (c = 0; c < cols; ++c)
+    {
+        root[c] += (uint32_t)(rem[c] > root[c]);
+    }
+}
+
+/* R of row r into slot r % 2 (once per row) */
+typedef struct
+{
+    const lidet_range_image_t *img;
+    int32_t *slot[2];
+    uint32_t *v, *rem;
+    int32_t row_in[2];
+} r_rows_t;
+
+static void r_rows_init(r_rows_t *rr, lidet_ground_q_scratch_t *sc, const lidet_range_image_t *img)
+{
+    rr->img = img;
+    rr->slot[0] = sc->r_rows[0];
+    rr->slot[1] = sc->r_rows[1];
+    rr->v = sc->r_v;
+    rr->rem = sc->r_rem;
+    rr->row_in[0] = rr->row_in[1] = -1;
+}
+
+static const int32_t *r_row(r_rows_t *rr, uint32_t r)
+{
+    const uint32_t k = r & 1u, cols = rr->img->n_cols;
+    if (rr->row_in[k] != (int32_t)r)
+    {
+        r_of_row(rr->img->x_4mm + (size_t)r * cols, rr->img->y_4mm + (size_t)r * cols, cols, rr->slot[k], rr->v,
+                 rr->rem);
+        rr->row_in[k] = (int32_t)r;
+    }
+    return rr->slot[k];
+}
+
+static inline int32_t abs32(int32_t v)
+{
+    return v < 0 ? -v : v;
+}
+
+/* Pass 1 (ref/ground_q.py: sample_mask): the sample test of lidet_ground_filter.c with integer kernels.
+ * dR in R steps (4 mm / 256), dZ in 4 mm: |dZ| <= fy |dR| is |dZ| * 2^24 <= fy_q16 * |dR|; F_x on R against
+ * fx_max_mm * 64 (R steps), on Z as 4 |F_x| <= fx_max_mm. Every touched pixel holds a point (R > 0). Bitwise &
+ * and no branch, as the float kernel: the column loop vectorises. */
+typedef struct
+{
+    uint64_t fy;
+    int32_t fx_r, fx_mm, z_lo, z_hi;
+    int on_z, desc, gate;
+} filt_q_t;
+
+static inline uint8_t sample_test(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
+                                  uint32_t cm1, uint32_t c, uint32_t cp1, uint32_t cp2, const filt_q_t *f)
+{
+    const int32_t dr = (2 * R0[c] + R0[cp1]) - (2 * R1[c] + R1[cp1]);
+    const int32_t dz = (2 * Z0[c] + Z0[cp1]) - (2 * Z1[c] + Z1[cp1]);
+    const int32_t fxr = (R0[cm1] + 2 * R0[c]) - (2 * R0[cp1] + R0[cp2]);
+    const int32_t fxz = (Z0[cm1] + 2 * Z0[c]) - (2 * Z0[cp1] + Z0[cp2]);
+    const int pts = (R0[cm1] > 0) & (R0[c] > 0) & (R0[cp1] > 0) & (R0[cp2] > 0) & (R1[c] > 0) & (R1[cp1] > 0);
+    const int fy = ((uint64_t)(uint32_t)abs32(dz) << 24) <= f->fy * (uint32_t)abs32(dr);
+    const int fx = f->on_z ? 4 * abs32(fxz) <= f->fx_mm : abs32(fxr) <= f->fx_r;
+    const int opt = ((f->desc == 0) | (dr > 0)) & ((f->gate == 0) | ((4 * Z0[c] >= f->z_lo) & (4 * Z0[c] <= f->z_hi)));
+    return (uint8_t)(pts & fy & fx & opt);
+}
+
+static void filter_rows(const lidet_ground_q_state_t *g, uint8_t *sample, r_rows_t *rr, const lidet_range_image_t *img)
+{
+    const uint32_t rows = img->n_rows, cols = img->n_cols, step = g->cfg.sample_step;
+    filt_q_t f;
+    uint32_t r, c;
+    f.fy = g->cfg.fy_max_q16;
+    f.fx_r = (int32_t)g->cfg.fx_max_mm * (1 << (LIDET_GROUND_Q_R_SHIFT - 2)); /* mm in R steps */
+    f.fx_mm = (int32_t)g->cfg.fx_max_mm;
+    f.on_z = g->cfg.fx_on_z;
+    f.desc = g->cfg.require_descending;
+    f.gate = g->cfg.height_gate;
+    f.z_lo = -g->cfg.mount_height_mm - g->cfg.gate_below_mm;
+    f.z_hi = -g->cfg.mount_height_mm + g->cfg.gate_above_mm;
+    memset(sample, 0, (size_t)rows * cols);
+    for (r = 0; r + 1u < rows; r += step)
+    {
+        const int32_t *R0 = r_row(rr, r), *R1 = r_row(rr, r + 1u);
+        const int16_t *Z0 = img->z_4mm + (size_t)r * cols, *Z1 = Z0 + cols;
+        uint8_t *out = sample + (size_t)r * cols;
+        out[0] = sample_test(R0, R1, Z0, Z1, cols - 1u, 0u, 1u, 2u, &f);
+        for (c = 1; c + 2u < cols; ++c)
+        {
+            out[c] = sample_test(R0, R1, Z0, Z1, c - 1u, c, c + 1u, c + 2u, &f);
+        }
+        out[cols - 2u] = sample_test(R0, R1, Z0, Z1, cols - 3u, cols - 2u, cols - 1u, 0u, &f);
+        out[cols - 1u] = sample_test(R0, R1, Z0, Z1, cols - 2u, cols - 1u, 0u, 1u, &f);
+    }
+}
+
+/* Pass 2 (ref/ground_q.py: gather_samples): the samples of the step grid grouped by cell, near ones from the
+ * buffer's start upwards, far ones from its end downwards (the float stage's order); past the buffer they are
+ * dropped and counted. */
+static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, const lidet_range_image_t *img)
+{
+    const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
+    const uint32_t cstep = g->cfg.sample_col_step, split_v = g->split_v;
+    lidet_ground_sample_t *const si = sc->sample_pix;
+    uint32_t s, r, c, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
+    for (s = 0; s < ns; ++s)
+    {
+        const uint32_t c0 = lidet__ground_sector_col(s, ns, cols), c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+        const uint32_t near_start = lo, far_end = hi;
+        for (r = 0; r + 1u < rows; r += step)
+        {
+            const uint32_t base = r * cols;
+            for (c = c0 + (cstep - c0 % cstep) % cstep; c < c1; c += cstep)
+            {
+                if (sc->sample[base + c] != 0u)
+                {
+                    ++total;
+                    if (lo < hi)
+                    {
+                        const uint32_t k = rxy2(img->x_4mm, img->y_4mm, base + c) >= split_v ? --hi : lo++;
+                        si[k] = (lidet_ground_sample_t)(base + c);
+                    }
+                }
+            }
+        }
+        lidet__ground_cell_span(sc->cell_first, sc->cell_n, s, ns, near_start, lo, hi, far_end);
+    }
+    lidet__ground_sample_counts(&g->stats, total, lo, hi);
+}
+
+/* Pass 3 (ref/ground_q.py: label_pixels): ground = holds a point, -below < h < above with h = n . p + D in
+ * 4 mm / 2^30 (the tolerances in mm are exact in that unit: 1 mm = 2^28), and not vetoed: the pixel above
+ * (row - 1) holds a point, 4 |dz| > veto_min_dz_mm and |dz| * 2^24 > veto_slope_q16 * |dR|. R is computed only
+ * where a test needs it: the veto's slope test of an in-band pixel with a step of more than veto_min_dz_mm
+ * (rare on the ground), or every pixel with a tolerance growing with range. */
+/* R of pixel c of a row through a lazily filled row cache (-1 = not computed yet) */
+static inline int32_t r_cached(int32_t *row, uint32_t c, uint32_t v)
+{
+    if (row[c] < 0)
+    {
+        row[c] = r_of(v);
+    }
+    return row[c];
+}
+
+static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, uint8_t *mask,
+                       const lidet_range_image_t *img)
+{
+    const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, split_v = g->split_v;
+    const int64_t above0 = (int64_t)g->cfg.ground_mm << 28, k = g->cfg.ground_per_m_q16;
+    const int64_t bf = g->cfg.below_factor_q16, slope = g->cfg.veto_slope_q16;
+    const int64_t below0 = lidet__q_rshift_round(bf * above0, 16);
+    const int32_t min_dz = (int32_t)g->cfg.veto_min_dz_mm;
+    const int16_t *X = img->x_4mm, *Y = img->y_4mm, *Z = img->z_4mm;
+    uint32_t r, s, c, n_ground = 0, n_vetoed = 0;
+    for (r = 0; r < rows; ++r)
+    {
+        const uint32_t base = r * cols, up = r > 0u ? cols : 0u; /* row 0 compares with itself: never vetoed */
+        int32_t *Rr = sc->r_rows[r & 1u], *Ru = sc->r_rows[(r & 1u) ^ (r > 0u)];
+        for (c = 0; c < cols; ++c)
+        {
+            Rr[c] = -1;
+        }
+        for (s = 0; s < ns; ++s)
+        {
+            const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+            lidet__ground_q_hplane_t hp[2];
+            int32_t nn[3];
+            for (c = 0; c < 2u; ++c)
+            {
+                const lidet_plane_q_t *pl = &g->planes[c * ns + s];
+                nn[0] = pl->nx;
+                nn[1] = pl->ny;
+                nn[2] = pl->nz;
+                lidet__ground_q_hplane(nn, g->plane_d[c * ns + s], &hp[c]);
+            }
+            for (c = lidet__ground_sector_col(s, ns, cols); c < c1; ++c)
+            {
+                const uint32_t p = base + c, v = rxy2(X, Y, p), vu = rxy2(X, Y, p - up);
+                const int32_t dz = abs32(Z[p - up] - Z[p]);
+                const int64_t h = lidet__ground_q_height(&hp[v >= split_v], X[p], Y[p], Z[p]);
+                int64_t above = above0, below = below0;
+                int in, vt = 0;
+                if (k != 0)
+                {
+                    /* R steps are 1/64 mm: k R / 2^16 mm = (k R) << 6 in 4 mm / 2^30 */
+                    above = above0 + ((k * r_cached(Rr, c, v)) << 6);
+                    below = lidet__q_rshift_round(bf * above, 16);
+                }
+                in = (v != 0u) & (h < above) & (h > -below);
+                if (in & (vu != 0u) & (4 * dz > min_dz) & (slope > 0))
+                {
+                    vt = ((int64_t)dz << 24) > slope * abs32(r_cached(Ru, c, vu) - r_cached(Rr, c, v));
+                }
+                mask[p] = (uint8_t)(in & !vt);
+                n_ground += (uint32_t)(in & !vt);
+                n_vetoed += (uint32_t)vt;
+            }
+        }
+    }
+    g->stats.n_ground = n_ground;
+    g->stats.n_vetoed = n_vetoed;
+}
+
+lidet_status_t lidet_ground_q_run_buffers(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *scratch,
+                                          uint8_t *mask, const lidet_range_image_t *img)
+{
+    r_rows_t rr;
+    lidet_status_t st;
+    if (g == 0 || scratch == 0 || mask == 0 || img == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    /* a compact image only: x, y, z in 4 mm steps */
+    st = lidet__ground_run_check(g->magic == LIDET_INIT_MAGIC,
+                                 img->x_m == 0 && img->x_4mm != 0 && img->y_4mm != 0 && img->z_4mm != 0, img,
+                                 g->cfg.n_sectors, &g->stats);
+    if (st != LIDET_OK)
+    {
+        return st;
+    }
+    g->n_rows = img->n_rows;
+    g->n_cols = img->n_cols;
+    g->rng = lidet__rng_seed(g->cfg.seed);
+    r_rows_init(&rr, scratch, img);
+    filter_rows(g, scratch->sample, &rr, img);
+    gather_samples(g, scratch, img);
+    lidet__ground_q_fit_sectors(g, scratch, img);
+    label_rows(g, scratch, mask, img);
+    return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
+}
+
+lidet_status_t lidet_ground_q_run(lidet_ground_q_t *g, const lidet_range_image_t *img)
+{
+    return g == 0 ? LIDET_ERR_ARG : lidet_ground_q_run_buffers(&g->state, &g->scratch, g->mask, img);
+}
+
+const uint8_t *lidet_ground_q_mask(const lidet_ground_q_t *g)
+{
+    return g == 0 ? 0 : g->mask;
+}
+
+const uint8_t *lidet_ground_q_samples(const lidet_ground_q_t *g)
+{
+    return g == 0 ? 0 : g->scratch.sample;
+}
+
+const lidet_plane_q_t *lidet_ground_q_planes(const lidet_ground_q_t *g, uint32_t *n_sectors)
+{
+    if (g != 0 && n_sectors != 0)
+    {
+        *n_sectors = g->state.cfg.n_sectors;
+    }
+    return g == 0 ? 0 : g->state.planes;
+}
+
+const uint8_t *lidet_ground_q_sector_source(const lidet_ground_q_t *g)
+{
+    return g == 0 ? 0 : g->state.source;
+}
+
+const lidet_ground_stats_t *lidet_ground_q_stats(const lidet_ground_q_t *g)
+{
+    return g == 0 ? 0 : &g->state.stats;
+}
+
+lidet_status_t lidet_ground_q_point_labels_of(const lidet_ground_q_state_t *g, const uint8_t *mask,
+                                              const int32_t *point_pixel, uint32_t n_points, uint8_t *out)
+{
+    return g == 0 ? LIDET_ERR_ARG
+                  : lidet__ground_point_labels(g->magic == LIDET_INIT_MAGIC, mask, (uint32_t)g->n_rows * g->n_cols,
+                                               point_pixel, n_points, out);
+}

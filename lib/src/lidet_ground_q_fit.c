@@ -1,0 +1,415 @@
+/* SPDX-License-Identifier: MIT */
+/* Integer ground stage: RANSAC per cell with exact int64 plane arithmetic, the least-squares refinement by
+ * power iteration on the adjugate of the inliers' scatter matrix, the checks and the fallback
+ * (lidet_ground_q.h). Integers only. Mirrored bit for bit by codegen/lidet_codegen/ref/ground_q.py
+ * (ransac_cell, refine). */
+#include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
+
+#include <string.h>
+
+#include "internal/lidet_assert.h"
+#include "internal/lidet_ground_internal.h"
+#include "internal/lidet_ground_q_internal.h"
+#include "internal/lidet_qmath.h"
+#include "internal/lidet_rng.h"
+
+#define ONE_Q30 ((int64_t)1 << 30)
+
+static inline int64_t abs64(int64_t v)
+{
+    return v < 0 ? -v : v;
+}
+
+/* the smallest s with m >> s < 2^29 (values shifted by s, rounded, stay <= 2^29) */
+static unsigned norm_shift(uint64_t m)
+{
+    unsigned s = 0;
+    while ((m >> s) >= ((uint64_t)1 << 29))
+    {
+        ++s;
+    }
+    return s;
+}
+
+static inline int64_t shr(int64_t v, unsigned s)
+{
+    return s == 0u ? v : lidet__q_rshift_round(v, s);
+}
+
+/* the largest magnitude of n values */
+static uint64_t max_abs(const int64_t *v, int n)
+{
+    uint64_t m = 0;
+    int i;
+    for (i = 0; i < n; ++i)
+    {
+        const uint64_t a = (uint64_t)abs64(v[i]);
+        m = a > m ? a : m;
+    }
+    return m;
+}
+
+/* scales the n values down together (rounded shifts) until the largest magnitude is <= 2^29: products of two
+ * stay below 2^58 */
+static void scale_down(int64_t *v, int n)
+{
+    const unsigned s = norm_shift(max_abs(v, n));
+    int i;
+    for (i = 0; i < n; ++i)
+    {
+        v[i] = shr(v[i], s);
+    }
+}
+
+/* a plane in the stage's internal form: Q30 unit normal, D in 4 mm / 2^30 */
+typedef struct
+{
+    int32_t n[3];
+    int64_t d;
+} qplane_t;
+
+/* v (any length, not all 0) to a Q30 unit vector; 0 when v is 0 */
+static int unit_q30(const int64_t v_in[3], int32_t out[3])
+{
+    int64_t v[3];
+    uint64_t len2;
+    uint32_t len;
+    int i;
+    for (i = 0; i < 3; ++i)
+    {
+        v[i] = v_in[i];
+    }
+    scale_down(v, 3);
+    len2 = (uint64_t)(v[0] * v[0]) + (uint64_t)(v[1] * v[1]) + (uint64_t)(v[2] * v[2]);
+    len = lidet__q_sqrt_round64(len2);
+    if (len == 0u)
+    {
+        return 0;
+    }
+    for (i = 0; i < 3; ++i)
+    {
+        out[i] = (int32_t)lidet__q_div_round(v[i] * ONE_Q30, (int64_t)len);
+    }
+    return 1;
+}
+
+static inline void pixel(const lidet_range_image_t *img, uint32_t p, int32_t q[3])
+{
+    q[0] = img->x_4mm[p];
+    q[1] = img->y_4mm[p];
+    q[2] = img->z_4mm[p];
+}
+
+
+/* The least-squares plane through the inliers (|height| <= thr) of cur among the cell's samples: their
+ * centroid c0 (rounded to 4 mm steps) and scatter matrix about c0 in exact int64 sums, the normal by
+ * power iteration on the adjugate of the scatter matrix starting from cur's normal (the adjugate's dominant
+ * eigenvector is the scatter's least one; the ratio of a ground patch's two smallest spreads makes a few
+ * iterations exact), D through the exact mean. Returns 0 (out untouched) for fewer than 3 inliers or points
+ * (nearly) on a line. */
+static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *idx, uint32_t n, const qplane_t *cur,
+                  int64_t thr, qplane_t *out)
+{
+    int64_t s1[3] = {0, 0, 0}, e[3] = {0, 0, 0}, a[6] = {0, 0, 0, 0, 0, 0}, b[6], v[3], nd;
+    int32_t q[3], first[3], c0[3], nv[3];
+    uint64_t ma, mb;
+    uint32_t i, m = 0;
+    int k, it;
+    lidet__ground_q_hplane_t hp;
+    lidet__ground_q_hplane(cur->n, cur->d, &hp);
+    pixel(img, idx[0], first);
+    for (i = 0; i < n; ++i)
+    {
+        pixel(img, idx[i], q);
+        if (abs64(lidet__ground_q_height(&hp, q[0], q[1], q[2])) <= thr)
+        {
+            ++m;
+            for (k = 0; k < 3; ++k)
+            {
+                s1[k] += q[k] - first[k];
+            }
+        }
+    }
+    if (m < 3u)
+    {
+        return 0;
+    }
+    for (k = 0; k < 3; ++k)
+    {
+        c0[k] = first[k] + (int32_t)lidet__q_div_round(s1[k], (int64_t)m);
+    }
+    for (i = 0; i < n; ++i)
+    {
+        pixel(img, idx[i], q);
+        if (abs64(lidet__ground_q_height(&hp, q[0], q[1], q[2])) <= thr)
+        {
+            const int32_t x = q[0] - c0[0], y = q[1] - c0[1], z = q[2] - c0[2];
+            e[0] += x;
+            e[1] += y;
+            e[2] += z;
+            if (x >= -46340 && x <= 46340 && y >= -46340 && y <= 46340 && z >= -46340 && z <= 46340)
+            {
+                /* the products fit int32 (a core without a 32 x 32 -> 64 multiply saves the wide ones) */
+                a[0] += x * x;
+                a[1] += x * y;
+                a[2] += x * z;
+                a[3] += y * y;
+                a[4] += y * z;
+                a[5] += z * z;
+            }
+            else
+            {
+                a[0] += (int64_t)x * x;
+                a[1] += (int64_t)x * y;
+                a[2] += (int64_t)x * z;
+                a[3] += (int64_t)y * y;
+                a[4] += (int64_t)y * z;
+                a[5] += (int64_t)z * z;
+            }
+        }
+    }
+    /* scatter a = (xx xy xz yy yz zz) scaled to <= 2^29, its adjugate b (entries < 2^59) */
+    scale_down(a, 6);
+    ma = max_abs(a, 6);
+    b[0] = a[3] * a[5] - a[4] * a[4];
+    b[1] = a[2] * a[4] - a[1] * a[5];
+    b[2] = a[1] * a[4] - a[2] * a[3];
+    b[3] = a[0] * a[5] - a[2] * a[2];
+    b[4] = a[1] * a[2] - a[0] * a[4];
+    b[5] = a[0] * a[3] - a[1] * a[1];
+    mb = max_abs(b, 6);
+    /* a line (or a point): the adjugate's largest eigenvalue l2 l3 is below 2^-23 l3^2 */
+    if (mb == 0u || mb < ((ma * ma) >> 23))
+    {
+        return 0;
+    }
+    scale_down(b, 6);
+    nv[0] = cur->n[0];
+    nv[1] = cur->n[1];
+    nv[2] = cur->n[2];
+    for (it = 0; it < LIDET_GROUND_Q_POWER_ITERS; ++it)
+    {
+        v[0] = b[0] * nv[0] + b[1] * nv[1] + b[2] * nv[2];
+        v[1] = b[1] * nv[0] + b[3] * nv[1] + b[4] * nv[2];
+        v[2] = b[2] * nv[0] + b[4] * nv[1] + b[5] * nv[2];
+        if (!unit_q30(v, nv))
+        {
+            return 0;
+        }
+    }
+    if (nv[2] < 0)
+    {
+        nv[0] = -nv[0];
+        nv[1] = -nv[1];
+        nv[2] = -nv[2];
+    }
+    /* D = -(n . mean), mean = c0 + e / m (|e| <= m / 2 per axis) */
+    nd = (int64_t)nv[0] * e[0] + (int64_t)nv[1] * e[1] + (int64_t)nv[2] * e[2];
+    out->n[0] = nv[0];
+    out->n[1] = nv[1];
+    out->n[2] = nv[2];
+    out->d = -((int64_t)nv[0] * c0[0] + (int64_t)nv[1] * c0[1] + (int64_t)nv[2] * c0[2]) -
+             lidet__q_div_round(nd, (int64_t)m);
+    return 1;
+}
+
+/* RANSAC on one cell (ref/ground_q.py: ransac_cell): the float stage's draws and control flow; a hypothesis
+ * is the exact cross product c of two 4 mm difference vectors, a sample its inlier when
+ * 4 |c . (p - p0)| <= inlier_mm * |c|. Returns 1 with *out set when the plane passes every check. */
+static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, const lidet_range_image_t *img,
+                      const lidet_ground_sample_t *idx, uint32_t n, qplane_t *out)
+{
+    const lidet_ground_q_cfg_t *cfg = &g->cfg;
+    const uint32_t stride = (n + cfg->eval_samples - 1u) / cfg->eval_samples;
+    const uint32_t n_eval = (n + stride - 1u) / stride;
+    const int copied = n_eval <= LIDET_GROUND_EVAL_MAX;
+    const int64_t cos_t = g->cos_tilt_q30, inl = cfg->inlier_mm;
+    const int64_t miss_max = (int64_t)(65536u - cfg->confidence_q16) << 14;
+    int64_t best_c[3] = {0, 0, 0};
+    int32_t best_p0[3] = {0, 0, 0};
+    uint32_t best_len = 0, best_cnt = 0, it, r, i;
+    qplane_t best;
+    int have = 0;
+    if (copied)
+    {
+        for (i = 0; i < n_eval; ++i)
+        {
+            const uint32_t p = idx[i * stride];
+            sc->ev_x[i] = img->x_4mm[p];
+            sc->ev_y[i] = img->y_4mm[p];
+            sc->ev_z[i] = img->z_4mm[p];
+        }
+    }
+    for (it = 0; it < cfg->ransac_iters; ++it)
+    {
+        const uint32_t i0 = lidet__rng_below(&g->rng, n);
+        const uint32_t i1 = lidet__rng_below(&g->rng, n);
+        const uint32_t i2 = lidet__rng_below(&g->rng, n);
+        int32_t p0[3], p1[3], p2[3];
+        int64_t c[3], thr_l, len2;
+        uint32_t len, cnt = 0;
+        if (i0 == i1 || i0 == i2 || i1 == i2)
+        {
+            continue;
+        }
+        pixel(img, idx[i0], p0);
+        pixel(img, idx[i1], p1);
+        pixel(img, idx[i2], p2);
+        {
+            const int64_t ux = p1[0] - p0[0], uy = p1[1] - p0[1], uz = p1[2] - p0[2];
+            const int64_t vx = p2[0] - p0[0], vy = p2[1] - p0[1], vz = p2[2] - p0[2];
+            c[0] = uy * vz - uz * vy;
+            c[1] = uz * vx - ux * vz;
+            c[2] = ux * vy - uy * vx;
+        }
+        /* |c| < 2^34; beyond 2^29 (sides of tens of metres both) it is scaled down, rounded */
+        scale_down(c, 3);
+        len2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+        if (len2 <= LIDET_GROUND_Q_MIN_CROSS2)
+        {
+            continue;
+        }
+        len = lidet__q_sqrt_round64((uint64_t)len2);
+        /* tilted beyond max_tilt: |cz| < cos(max_tilt) |c| */
+        if (abs64(c[2]) * ONE_Q30 < cos_t * (int64_t)len)
+        {
+            continue;
+        }
+        ++g->stats.n_hypotheses;
+        thr_l = inl * (int64_t)len;
+        if (copied)
+        {
+            for (i = 0; i < n_eval; ++i)
+            {
+                const int64_t h = c[0] * (sc->ev_x[i] - p0[0]) + c[1] * (sc->ev_y[i] - p0[1]) +
+                                  c[2] * (sc->ev_z[i] - p0[2]);
+                cnt += (uint32_t)(4 * abs64(h) <= thr_l);
+            }
+        }
+        else
+        {
+            for (i = 0; i < n; i += stride)
+            {
+                int32_t q[3];
+                int64_t h;
+                pixel(img, idx[i], q);
+                h = c[0] * (q[0] - p0[0]) + c[1] * (q[1] - p0[1]) + c[2] * (q[2] - p0[2]);
+                cnt += (uint32_t)(4 * abs64(h) <= thr_l);
+            }
+        }
+        if (!have || cnt > best_cnt)
+        {
+            memcpy(best_c, c, sizeof best_c);
+            memcpy(best_p0, p0, sizeof best_p0);
+            best_len = len;
+            best_cnt = cnt;
+            have = 1;
+            /* adaptive stop without log: (1 - w^3)^(it + 1) <= 1 - confidence, all in Q30 (the power is
+             * non-increasing, so the first factor that crosses the bound decides) */
+            if (cfg->confidence_q16 > 0u)
+            {
+                const int64_t w = lidet__q_div_round((int64_t)cnt * ONE_Q30, (int64_t)n_eval);
+                const int64_t q = ONE_Q30 - lidet__q_rshift_round(lidet__q_rshift_round(w * w, 30) * w, 30);
+                int64_t miss = ONE_Q30;
+                uint32_t k;
+                for (k = 0; k <= it && miss > miss_max; ++k)
+                {
+                    miss = lidet__q_rshift_round(miss * q, 30);
+                }
+                if (miss <= miss_max)
+                {
+                    break;
+                }
+            }
+        }
+    }
+    if (!have || best_cnt < cfg->min_inliers)
+    {
+        return 0;
+    }
+    /* the hypothesis as a unit normal (up) and D */
+    for (i = 0; i < 3u; ++i)
+    {
+        const int64_t ci = best_c[2] < 0 ? -best_c[i] : best_c[i];
+        best.n[i] = (int32_t)lidet__q_div_round(ci * ONE_Q30, (int64_t)best_len);
+    }
+    best.d = -((int64_t)best.n[0] * best_p0[0] + (int64_t)best.n[1] * best_p0[1] + (int64_t)best.n[2] * best_p0[2]);
+    for (r = 0; r < cfg->refine_iters; ++r)
+    {
+        qplane_t p;
+        if (!refine(img, idx, n, &best, (int64_t)cfg->inlier_mm << 28, &p) || p.n[2] < cos_t)
+        {
+            break; /* keep the last good plane */
+        }
+        best = p;
+    }
+    if (best.n[2] < cos_t || abs64(best.d - ((int64_t)cfg->mount_height_mm << 28)) > (int64_t)cfg->max_height_dev_mm << 28)
+    {
+        return 0;
+    }
+    *out = best;
+    return 1;
+}
+
+/* the integer stage's side of lidet__ground_cells */
+typedef struct
+{
+    lidet_ground_q_state_t *g;
+    lidet_ground_q_scratch_t *sc;
+    const lidet_range_image_t *img;
+} fit_ctx_t;
+
+static void set_plane(lidet_ground_q_state_t *g, uint32_t k, const qplane_t *p)
+{
+    g->planes[k].nx = p->n[0];
+    g->planes[k].ny = p->n[1];
+    g->planes[k].nz = p->n[2];
+    g->planes[k].d_4mm = (int32_t)lidet__q_rshift_round(p->d, 30);
+    g->plane_d[k] = p->d;
+}
+
+static int fit_cell(void *ctx, uint32_t k)
+{
+    fit_ctx_t *f = (fit_ctx_t *)ctx;
+    const uint32_t a = f->sc->cell_first[k], n = f->sc->cell_n[k];
+    qplane_t p;
+    LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
+    if (!fit_cell_q(f->g, f->sc, f->img, f->sc->sample_pix + a, n, &p))
+    {
+        return 0;
+    }
+    set_plane(f->g, k, &p);
+    return 1;
+}
+
+static void copy_plane(void *ctx, uint32_t dst, int32_t src)
+{
+    lidet_ground_q_state_t *g = ((fit_ctx_t *)ctx)->g;
+    if (src >= 0)
+    {
+        g->planes[dst] = g->planes[src];
+        g->plane_d[dst] = g->plane_d[src];
+    }
+    else
+    {
+        /* the mount plane z = -mount: n = +z, D = mount (mm -> 4 mm / 2^30) */
+        qplane_t m;
+        m.n[0] = 0;
+        m.n[1] = 0;
+        m.n[2] = (int32_t)ONE_Q30;
+        m.d = (int64_t)g->cfg.mount_height_mm << 28;
+        set_plane(g, dst, &m);
+    }
+}
+
+void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                                 const lidet_range_image_t *img)
+{
+    const uint32_t ns = g->cfg.n_sectors;
+    fit_ctx_t f;
+    f.g = g;
+    f.sc = sc;
+    f.img = img;
+    lidet__ground_cells(g->source, sc->cell_n, ns, g->cfg.ring_split_mm > 0u ? 2u * ns : ns, g->cfg.min_samples,
+                        g->cfg.fallback_sectors, &g->stats, fit_cell, copy_plane, &f);
+}

@@ -1,0 +1,94 @@
+/* SPDX-License-Identifier: MIT */
+/* Integer proposals (lidet_cluster_q.h): the float stage's resampling rule (internal/lidet_proposal_rule.h),
+ * points minus the rounded mean in 4 mm steps, the mean's voxel from integer atan2 / square root. Integer
+ * only. Mirrored by codegen/lidet_codegen/ref/cluster_q.py: make_proposal_q. */
+#include <string.h>
+
+#include "internal/lidet_proposal_rule.h"
+#include "internal/lidet_qmath.h"
+#include "lidet/lidet_cluster_q.h"
+
+void lidet_proposal_q_cfg_default(lidet_proposal_q_cfg_t *cfg)
+{
+    if (cfg == 0)
+    {
+        return;
+    }
+    memset(cfg, 0, sizeof *cfg);
+    cfg->n_points = 64u < LIDET_PROPOSAL_POINTS ? 64u : LIDET_PROPOSAL_POINTS;
+    cfg->seed = 0x5EED1234u;
+    cfg->azimuth_bin_bam = 119304647u; /* 10 deg = 2^32 / 36, rounded */
+    cfg->elevation_bin_bam = 119304647u;
+    cfg->range_bin_4mm = 250u; /* 1 m */
+}
+
+/* floor(v / bin) as int16, saturating; bin >= 1 */
+static int16_t bin_q(int64_t v, uint32_t bin)
+{
+    const int64_t f = v >= 0 ? v / (int64_t)bin : -((-v + (int64_t)bin - 1) / (int64_t)bin);
+    return (int16_t)(f < -32768 ? -32768 : (f > 32767 ? 32767 : f));
+}
+
+static int16_t sat16(int32_t v)
+{
+    return (int16_t)(v < -32768 ? -32768 : (v > 32767 ? 32767 : v));
+}
+
+lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t cluster_index,
+                                     const lidet_proposal_q_cfg_t *cfg, lidet_proposal_q_t *out)
+{
+    const lidet_cluster_q_rec_t *rec;
+    const lidet_range_image_t *img;
+    uint32_t i, npix, state;
+    int32_t mx, my, mz;
+    int64_t rxy2;
+
+    if (c == 0 || cfg == 0 || out == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    img = &c->img;
+    if (c->magic != LIDET_INIT_MAGIC || c->members == 0 || img->x_4mm == 0 || img->y_4mm == 0 || img->z_4mm == 0)
+    {
+        return LIDET_ERR_STATE;
+    }
+    if (cfg->n_points < 1u || cfg->n_points > LIDET_PROPOSAL_POINTS || cfg->azimuth_bin_bam == 0u ||
+        cfg->azimuth_bin_bam > LIDET_Q_BAM_HALF || cfg->elevation_bin_bam == 0u ||
+        cfg->elevation_bin_bam > LIDET_Q_BAM_HALF || cfg->range_bin_4mm == 0u)
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    if (cluster_index >= c->n_recs)
+    {
+        return LIDET_ERR_ARG;
+    }
+    rec = &c->recs[cluster_index];
+    npix = (uint32_t)img->n_rows * img->n_cols;
+    state = lidet__proposal_rng_start(cfg->seed, rec->n_points);
+    mx = rec->mean_4mm[0];
+    my = rec->mean_4mm[1];
+    mz = rec->mean_4mm[2];
+    for (i = 0; i < cfg->n_points; ++i)
+    {
+        const int32_t p =
+            c->members[rec->first_member + lidet__proposal_next_index(&state, i, rec->n_points, cfg->n_points)];
+        if (p < 0 || (uint32_t)p >= npix)
+        {
+            return LIDET_ERR_STATE; /* cannot happen after a run; guards a stale state */
+        }
+        out->xyz[i][0] = sat16(img->x_4mm[p] - mx);
+        out->xyz[i][1] = sat16(img->y_4mm[p] - my);
+        out->xyz[i][2] = sat16(img->z_4mm[p] - mz);
+    }
+    out->mean_4mm[0] = mx;
+    out->mean_4mm[1] = my;
+    out->mean_4mm[2] = mz;
+    /* a mean lies within the int16 pixels it averages: the squares fit in 64 bits, the roots in int32 */
+    rxy2 = (int64_t)mx * mx + (int64_t)my * my;
+    out->voxel[0] = bin_q(lidet__q_atan2(my, mx), cfg->azimuth_bin_bam);
+    out->voxel[1] = bin_q(lidet__q_atan2(mz, (int32_t)lidet__q_sqrt_round64((uint64_t)rxy2)), cfg->elevation_bin_bam);
+    out->voxel[2] = bin_q(lidet__q_sqrt_round64((uint64_t)(rxy2 + (int64_t)mz * mz)), cfg->range_bin_4mm);
+    out->n_points = cfg->n_points;
+    out->n_points_src = rec->n_points;
+    return LIDET_OK;
+}

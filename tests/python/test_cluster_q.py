@@ -1,0 +1,268 @@
+# SPDX-License-Identifier: MIT
+"""The integer clustering and proposals (lidet_cluster_q.h): bit for bit against the numpy reference
+(codegen/lidet_codegen/ref/cluster_q.py) and in agreement with the float stage on the same compact images
+(docs/FIXED_POINT.md, "Clustering and proposals"). Scans: the simulated samples, freshly simulated scans of fixed
+seeds and the real KITTI / SemanticKITTI scans (skipped when absent)."""
+from __future__ import annotations
+
+import pathlib
+
+import numpy as np
+import pytest
+
+from lidet_codegen.ref import cluster_q as ref
+from lidet_tools import native, native_q
+from lidet_tools.sim import simulate_scan
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SIM_SAMPLES = [("hdl64", ROOT / "tests/data/sim_hdl64/velodyne/000000.bin"),
+               ("vlp16", ROOT / "tests/data/sim_vlp16/velodyne/000000.bin")]
+#: freshly simulated scans: (sensor, seed, index)
+SIM_FRESH = [("hdl64", 16, 0), ("hdl64", 16, 1), ("vlp16", 16, 0), ("vlp16", 16, 1), ("vlp16", 17, 2)]
+
+
+def _load(path) -> np.ndarray:
+    return np.fromfile(path, np.float32).reshape(-1, 4)
+
+
+def _sim_scans():
+    out = [(s, _load(p)) for s, p in SIM_SAMPLES]
+    out += [(s, simulate_scan(s, seed, i).points) for s, seed, i in SIM_FRESH]
+    return out
+
+
+def _real_scans(real_dir):
+    files = sorted((real_dir / "semantickitti" / "velodyne").glob("*.bin"))
+    files += sorted((real_dir / "kitti" / "training" / "velodyne").glob("*.bin"))
+    return [("hdl64", _load(f)) for f in files]
+
+
+@pytest.fixture(scope="module")
+def sim_scans(need_lib):
+    return _sim_scans()
+
+
+def _recs_equal(recs, c) -> bool:
+    got = np.array([[r.n_points, r.first_member, r.seed_pixel, r.n_rescued, *r.mean, *r.min, *r.max, r.height]
+                    for r in recs], np.int64).reshape(-1, 14)
+    want = np.concatenate([np.stack([c.n_points, c.first_member, c.seed_pixel, c.n_rescued], 1), c.mean, c.min, c.max,
+                           c.height[:, None]], 1).astype(np.int64)
+    return np.array_equal(got, want)
+
+
+def _check_bit_exact(sensor, pts, planes=True, ground=True, **cfg):
+    scan = native_q.compact_scan(pts, sensor)
+    pq = native_q.planes_to_q(scan.planes) if planes else None
+    c = native_q.cluster_q(scan, pq, use_ground=ground, **cfg)
+    dc, dp = native_q.cluster_q_defaults(sensor)
+    dc.update(cfg)
+    lab, mem, recs, st = ref.cluster_q_ref(scan.x, scan.y, scan.z, scan.range, scan.row_elev_bam,
+                                           scan.ground if ground else None, pq, dc,
+                                           native.capacity()["max_clusters"])
+    assert np.array_equal(lab, c.labels), "per-pixel ids differ"
+    assert np.array_equal(mem, c.members), "member arrays differ"
+    assert st == c.stats
+    assert _recs_equal(recs, c), "records differ"
+    for i, r in enumerate(recs):
+        xyz, mean, vox = ref.make_proposal_q(r, mem, scan.x, scan.y, scan.z, dp)
+        assert np.array_equal(xyz, c.prop_xyz[i]) and np.array_equal(mean, c.prop_mean[i])
+        assert np.array_equal(vox, c.prop_voxel[i]), (i, vox, c.prop_voxel[i])
+    return c
+
+
+def test_defaults_are_the_float_defaults_rounded(need_lib):
+    for s in ("hdl64", "vlp16"):
+        f = native.cluster_defaults(s)
+        q, p = native_q.cluster_q_defaults(s)
+        assert q["theta_urad"] == round(f["theta_rad"] * 1e6)
+        assert q["max_gap_mm"] == round(f["max_gap_m"] * 1e3)
+        assert q["max_gap_per_m_q16"] == round(f["max_gap_per_m"] * 65536)
+        assert q["max_extent_mm"] == round(f["max_extent_m"] * 1e3)
+        assert q["max_mean_height_mm"] == round(f["max_mean_height_m"] * 1e3)
+        assert q["mount_height_mm"] == round(f["mount_height_m"] * 1e3)
+        assert q["rescue_gap_mm"] == round(f["rescue_gap_m"] * 1e3)
+        assert q["rescue_gap_per_m_q16"] == round(f["rescue_gap_per_m"] * 65536)
+        for k in ("max_steps", "bridge_occluders", "diagonals", "min_points", "rescue_rows", "rescue_cols"):
+            assert q[k] == f[k], k
+        fp = native.proposal_defaults()
+        assert p["n_points"] == fp["n_points"] and p["seed"] == fp["seed"]
+        # 10 deg exactly (2^32 / 36); the float default is 10 deg rounded to float32 (3 BAM32 off)
+        assert p["azimuth_bin_bam"] == round(2 ** 32 / 36) == p["elevation_bin_bam"]
+        assert abs(p["azimuth_bin_bam"] - fp["azimuth_bin_rad"] / (2 * np.pi) * 2 ** 32) < 8
+        assert abs(p["elevation_bin_bam"] - fp["elevation_bin_rad"] / (2 * np.pi) * 2 ** 32) < 8
+        assert p["range_bin_4mm"] == round(fp["range_bin_m"] / 0.004)
+
+
+def test_bit_exact_simulated(sim_scans):
+    for sensor, pts in sim_scans:
+        c = _check_bit_exact(sensor, pts)
+        assert len(c) > 10 and c.stats["n_rescue_joined"] > 0
+
+
+def test_bit_exact_other_paths(sim_scans):
+    """Flat ground (no planes), no ground mask, the 4-neighbourhood, occluder bridging on a 16-beam image, no
+    gap bound, no rescue, a small extent limit."""
+    sensor, pts = sim_scans[1]
+    _check_bit_exact(sensor, pts, planes=False, bridge_occluders=1, max_steps=6)
+    _check_bit_exact(sensor, pts, ground=False, diagonals=0, max_gap_mm=0, rescue_gap_mm=0)
+    sensor, pts = sim_scans[0]
+    _check_bit_exact(sensor, pts, planes=False, bridge_occluders=0, max_extent_mm=2500, rescue_rows=3,
+                     rescue_cols=9, min_points=20)
+
+
+def test_bit_exact_capacity(sim_scans):
+    """More components than LIDET_MAX_CLUSTERS: the smallest are evicted (first fill) or dropped (rescue groups),
+    counted, LIDET_TRUNCATED; the same in the reference."""
+    sensor, pts = sim_scans[0]
+    c = _check_bit_exact(sensor, pts, min_points=2, theta_urad=800000, max_gap_mm=300, max_gap_per_m_q16=0)
+    assert c.status == 1 and c.stats["n_dropped_capacity"] > 0 and len(c) == native.capacity()["max_clusters"]
+
+
+def test_bit_exact_real(real_dir, need_lib):
+    for sensor, pts in _real_scans(real_dir):
+        _check_bit_exact(sensor, pts)
+
+
+# ---- agreement with the float stage on the same compact images -----------------------------------------
+
+
+def _majority(a: np.ndarray, b: np.ndarray) -> dict:
+    """id in a (> 0) -> the id in b (> 0) holding most of its points (ties: the smaller id); none when all of
+    its points have b = 0"""
+    m = (a > 0) & (b > 0)
+    out = {}
+    if m.any():
+        pairs, counts = np.unique(np.stack([a[m], b[m]], 1), axis=0, return_counts=True)
+        order = np.lexsort((pairs[:, 1], -counts))
+        for (ia, ib), _ in zip(pairs[order], counts[order]):
+            out.setdefault(int(ia), int(ib))
+    return out
+
+
+def id_agreement(qa: np.ndarray, fa: np.ndarray) -> tuple[float, float, int]:
+    """Cluster-id agreement of two labellings of the same points (0 = no cluster): the share of points whose
+    integer cluster maps to the float cluster holding most of its points (points in no cluster agree when they
+    are in none on the other side too), and the same from the float side. Returns (q->f, f->q, points)."""
+    mq, mf = _majority(qa, fa), _majority(fa, qa)
+    to_f = np.array([mq.get(int(v), -1) if v else 0 for v in qa]) == fa
+    to_q = np.array([mf.get(int(v), -1) if v else 0 for v in fa]) == qa
+    return float(to_f.mean()), float(to_q.mean()), len(qa)
+
+
+def agreement(scans) -> dict:
+    """Agreement figures over a list of (sensor, points), summed over scans (docs/FIXED_POINT.md)."""
+    n_pts = qf = fq = 0.0
+    pairs = same_members = same_vox = 0
+    max_dev = 0.0
+    for sensor, pts in scans:
+        scan = native_q.compact_scan(pts, sensor)
+        cq = native_q.cluster_q(scan, native_q.planes_to_q(scan.planes))
+        cf = native_q.cluster_f_compact(scan, scan.planes)
+        pp = scan.point_pixel
+        keep = (pp >= 0)
+        keep[keep] = scan.ground.ravel()[pp[keep]] == 0
+        a, b = cq.labels.ravel()[pp[keep]].astype(np.int64), cf.labels.ravel()[pp[keep]].astype(np.int64)
+        x, y, n = id_agreement(a, b)
+        qf, fq, n_pts = qf + x * n, fq + y * n, n_pts + n
+        # proposals of the clusters matched both ways
+        mq, mf = _majority(cq.labels.ravel(), cf.labels.ravel()), _majority(cf.labels.ravel(), cq.labels.ravel())
+        for iq, i_f in mq.items():
+            if mf.get(i_f) != iq:
+                continue
+            pairs += 1
+            mem_q = cq.members[cq.first_member[iq - 1]:][: cq.n_points[iq - 1]]
+            mem_f = cf.members[cf.first_member[i_f - 1]:][: cf.n_points[i_f - 1]]
+            if not np.array_equal(mem_q, mem_f):
+                continue
+            same_members += 1
+            same_vox += int(np.array_equal(cq.prop_voxel[iq - 1], cf.prop_voxel[i_f - 1]))
+            dev = np.abs(cq.prop_xyz[iq - 1].astype(np.float64) * 0.004 - cf.prop_xyz[i_f - 1]).max()
+            max_dev = max(max_dev, float(dev))
+    return {"points": int(n_pts), "ids_q_to_f": qf / n_pts, "ids_f_to_q": fq / n_pts, "matched_clusters": pairs,
+            "same_members": same_members / pairs, "same_voxel": same_vox / same_members,
+            "max_point_dev_mm": max_dev * 1e3}
+
+
+def _assert_agreement(a: dict):
+    assert a["ids_q_to_f"] >= 0.99 and a["ids_f_to_q"] >= 0.99, a
+    assert a["same_voxel"] >= 0.99, a
+    assert a["max_point_dev_mm"] <= 4.0, a
+
+
+def test_id_agreement_definition():
+    """The measure: a merge costs the smaller part's points (seen from the merged side), a dropped cluster its
+    points (both ways)."""
+    q = np.array([1, 1, 1, 1, 2, 2, 0, 0, 3, 3])
+    f = np.array([5, 5, 5, 5, 5, 5, 0, 0, 0, 0])  # float merged 1 and 2, dropped 3
+    x, y, n = id_agreement(q, f)
+    assert n == 10 and x == pytest.approx(0.8) and y == pytest.approx(0.6)
+    assert id_agreement(q, q)[:2] == (1.0, 1.0)
+
+
+def test_agreement_with_float_simulated(sim_scans):
+    a = agreement(sim_scans)
+    print(f"\nagreement, {len(sim_scans)} simulated scans: {a}")  # the figures of docs/FIXED_POINT.md (pytest -s)
+    _assert_agreement(a)
+
+
+def test_agreement_with_float_real(real_dir, need_lib):
+    scans = _real_scans(real_dir)
+    a = agreement(scans)
+    print(f"\nagreement, {len(scans)} real scans: {a}")
+    _assert_agreement(a)
+
+
+def test_bad_config_refused(sim_scans):
+    sensor, pts = sim_scans[1]
+    scan = native_q.compact_scan(pts, sensor)
+    for bad in (dict(theta_urad=0), dict(max_steps=17), dict(min_points=0), dict(max_extent_mm=0),
+                dict(rescue_gap_per_m_q16=16385), dict(rescue_cols=16)):
+        with pytest.raises(native.LidetError):
+            native_q.cluster_q(scan, **bad)
+    with pytest.raises(native.LidetError):
+        native_q.cluster_q(scan, proposal_cfg=dict(range_bin_4mm=0))
+    with pytest.raises(TypeError):
+        native_q.cluster_q(scan, theta_rad=1)
+
+
+def _integer_chain_scan(sensor, pts):
+    """The integer projection's compact image of the scan (points rounded to mm), with the float ground stage's
+    mask and planes of the float projection of the same scan (the integer ground stage is not there yet)."""
+    s = native_q.compact_scan(pts, sensor)
+    pq = native_q.project_q(np.round(pts[:, :3].astype(np.float64) * 1000).astype(np.int32), sensor)
+    rows, cols = s.shape
+    return native_q.CompactScan(s.sensor, pq["x_4mm"].reshape(rows, cols), pq["y_4mm"].reshape(rows, cols),
+                                pq["z_4mm"].reshape(rows, cols), pq["range_4mm"].reshape(rows, cols),
+                                pq["row_elev_bam"], s.row_elev_rad, pq["point_pixel"], s.ground, s.planes), s
+
+
+def _on_integer_projection(scans, what):
+    """On the integer projection's image (lidet_proj_q): bit for bit with the reference, and the per-point ids of
+    the integer chain (integer projection + integer clustering) against the float chain (float compact
+    projection + float clustering), both with the float ground stage's mask."""
+    n = qf = fq = 0.0
+    for sensor, pts in scans:
+        scan_q, scan_f = _integer_chain_scan(sensor, pts)
+        c = native_q.cluster_q(scan_q, native_q.planes_to_q(scan_q.planes))
+        dc, _ = native_q.cluster_q_defaults(sensor)
+        lab, mem, recs, st = ref.cluster_q_ref(scan_q.x, scan_q.y, scan_q.z, scan_q.range, scan_q.row_elev_bam,
+                                               scan_q.ground, native_q.planes_to_q(scan_q.planes), dc)
+        assert np.array_equal(lab, c.labels) and np.array_equal(mem, c.members) and st == c.stats
+        f = native_q.cluster_f_compact(scan_f, scan_f.planes)
+        ppq, ppf = scan_q.point_pixel, scan_f.point_pixel
+        keep = (ppq >= 0) & (ppf >= 0)
+        keep[keep] = scan_f.ground.ravel()[ppf[keep]] == 0
+        x, y, k = id_agreement(c.labels.ravel()[ppq[keep]].astype(np.int64),
+                               f.labels.ravel()[ppf[keep]].astype(np.int64))
+        n, qf, fq = n + k, qf + x * k, fq + y * k
+    print(f"\nwhole integer chain vs float chain, {len(scans)} {what} scans, {int(n)} points: "
+          f"ids int -> float {qf / n:.5f}, float -> int {fq / n:.5f}")
+    assert qf / n >= 0.99 and fq / n >= 0.99
+
+
+def test_on_integer_projection_simulated(sim_scans):
+    _on_integer_projection(sim_scans, "simulated")
+
+
+def test_on_integer_projection_real(real_dir, need_lib):
+    _on_integer_projection(_real_scans(real_dir), "real")

@@ -1,0 +1,290 @@
+/* SPDX-License-Identifier: MIT */
+/* Unity tests of the integer ground stage (lib/src/lidet_ground_q.c, lidet_ground_q_fit.c) on compact range
+ * images built here: a VLP-16-like fan of beams ray-cast against a ground plane (flat or sloped) and a wall,
+ * rounded to 4 mm steps; plus bad input: arguments, configuration, images at the int16 limits, empty images. */
+#include <math.h>
+#include <string.h>
+
+#include "lidet/lidet.h"
+#include "test_util.h"
+
+#define ROWS 16
+#define COLS 900
+
+LIDET_GUARDED(lidet_ground_q_t, gq);
+static lidet_ground_q_cfg_t cfg;
+static int16_t X[ROWS * COLS], Y[ROWS * COLS], Z[ROWS * COLS];
+static uint16_t RG[ROWS * COLS];
+static uint8_t truth[ROWS * COLS]; /* 1 ground, 2 obstacle higher than 0.3 m above the ground, 0 other / empty */
+static lidet_range_image_t img;
+
+void setUp(void)
+{
+    CANARY_FILL(gq);
+    lidet_ground_q_cfg_default(&cfg, ROWS, 500);
+}
+
+void tearDown(void)
+{
+    CANARY_CHECK(gq);
+}
+
+static int16_t q4(double m)
+{
+    return (int16_t)floor(m / 0.004 + 0.5);
+}
+
+/* ground z = -h + sx * x; a wall x = wall_x (for |y| < 3 m, below z = 1 m) when wall_x > 0 */
+static void cast(double h, double sx, double wall_x)
+{
+    int r, c;
+    memset(&img, 0, sizeof img);
+    memset(truth, 0, sizeof truth);
+    for (r = 0; r < ROWS; ++r)
+    {
+        const double el = (15.0 - 2.0 * r) * M_PI / 180.0;
+        for (c = 0; c < COLS; ++c)
+        {
+            const double az = M_PI - (c + 0.5) * 2.0 * M_PI / COLS;
+            const double d[3] = {cos(el) * cos(az), cos(el) * sin(az), sin(el)};
+            const int p = r * COLS + c;
+            const double den = d[2] - sx * d[0];
+            double t = den < -1e-9 ? -h / den : 1e30, p3[3];
+            int kind = 1;
+            if (wall_x > 0.0 && d[0] > 1e-9)
+            {
+                const double tw = wall_x / d[0];
+                if (tw < t && fabs(tw * d[1]) < 3.0 && tw * d[2] < 1.0)
+                {
+                    t = tw;
+                    kind = 2;
+                }
+            }
+            if (t > 80.0)
+            {
+                X[p] = Y[p] = Z[p] = 0;
+                RG[p] = 0;
+                continue;
+            }
+            p3[0] = t * d[0];
+            p3[1] = t * d[1];
+            p3[2] = t * d[2];
+            X[p] = q4(p3[0]);
+            Y[p] = q4(p3[1]);
+            Z[p] = q4(p3[2]);
+            RG[p] = (uint16_t)floor(t / 0.004 + 0.5);
+            truth[p] = (uint8_t)(kind == 1 ? 1 : (p3[2] > -h + sx * p3[0] + 0.3 ? 2 : 0));
+        }
+    }
+    img.n_rows = ROWS;
+    img.n_cols = COLS;
+    img.x_4mm = X;
+    img.y_4mm = Y;
+    img.z_4mm = Z;
+    img.range_4mm = RG;
+}
+
+static void count(uint32_t *g_ok, uint32_t *g_n, uint32_t *o_ground, uint32_t *o_n)
+{
+    const uint8_t *m = lidet_ground_q_mask(&gq.ws);
+    int p;
+    *g_ok = *g_n = *o_ground = *o_n = 0;
+    for (p = 0; p < ROWS * COLS; ++p)
+    {
+        *g_ok += truth[p] == 1 && m[p];
+        *g_n += truth[p] == 1;
+        *o_ground += truth[p] == 2 && m[p];
+        *o_n += truth[p] == 2;
+        if (RG[p] == 0)
+            TEST_ASSERT_EQUAL_UINT8(0, m[p]);
+    }
+}
+
+static void test_flat_ground_and_wall(void)
+{
+    uint32_t g_ok, g_n, o_g, o_n, s, ns, n_flat = 0;
+    const lidet_plane_q_t *pl;
+    const uint8_t *src;
+    cast(0.5, 0.0, 8.0);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_init(&gq.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_run(&gq.ws, &img));
+    count(&g_ok, &g_n, &o_g, &o_n);
+    TEST_ASSERT_TRUE(g_n > 3000u && o_n > 50u);
+    TEST_ASSERT_TRUE(g_ok >= g_n * 99u / 100u);
+    TEST_ASSERT_EQUAL_UINT32(0, o_g);
+    TEST_ASSERT_EQUAL_UINT32(g_ok, lidet_ground_q_stats(&gq.ws)->n_ground);
+    pl = lidet_ground_q_planes(&gq.ws, &ns);
+    src = lidet_ground_q_sector_source(&gq.ws);
+    TEST_ASSERT_EQUAL_UINT32(cfg.n_sectors, ns);
+    TEST_ASSERT_TRUE(lidet_ground_q_stats(&gq.ws)->n_sectors_fitted >= 28u);
+    for (s = 0; s < ns; ++s)
+    {
+        if (src[s] != LIDET_GROUND_PLANE_FITTED)
+            continue;
+        /* the plane z = -0.5 m: normal +z within 2e-3, d = 125 steps of 4 mm (+-1); the sectors that see the
+         * wall may tilt their plane within max_tilt (the wall's foot lies within inlier_mm of the ground) */
+        n_flat += pl[s].nz >= (int32_t)((1 << 30) - 2200) && pl[s].d_4mm >= 124 && pl[s].d_4mm <= 126;
+        TEST_ASSERT_TRUE(pl[s].nz >= gq.ws.state.cos_tilt_q30);
+    }
+    TEST_ASSERT_TRUE(n_flat >= 26u);
+}
+
+static void test_sloped_ground_normal(void)
+{
+    const double sx = 0.05, len = sqrt(1.0 + sx * sx);
+    uint32_t s, ns, n_fit = 0;
+    const lidet_plane_q_t *pl;
+    cast(0.5, sx, 0.0);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_init(&gq.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_run(&gq.ws, &img));
+    pl = lidet_ground_q_planes(&gq.ws, &ns);
+    for (s = 0; s < ns; ++s)
+    {
+        if (lidet_ground_q_sector_source(&gq.ws)[s] != LIDET_GROUND_PLANE_FITTED)
+            continue;
+        ++n_fit;
+        /* n = (-sx, 0, 1) / len: the least-squares normal of 4 mm-rounded points, within 2e-3 */
+        TEST_ASSERT_CLOSE(-sx / len, pl[s].nx / 1073741824.0, 2e-3, 0.0);
+        TEST_ASSERT_CLOSE(0.0, pl[s].ny / 1073741824.0, 2e-3, 0.0);
+        TEST_ASSERT_CLOSE(1.0 / len, pl[s].nz / 1073741824.0, 2e-3, 0.0);
+    }
+    TEST_ASSERT_TRUE(n_fit >= 24u);
+}
+
+static void test_deterministic_and_point_labels(void)
+{
+    static uint8_t m1[ROWS * COLS], out[4];
+    const int32_t pp[4] = {-1, 5 * COLS + 3, ROWS * COLS, 15 * COLS + 100};
+    lidet_ground_stats_t st;
+    cast(0.5, 0.0, 8.0);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_init(&gq.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_run(&gq.ws, &img));
+    memcpy(m1, lidet_ground_q_mask(&gq.ws), sizeof m1);
+    st = *lidet_ground_q_stats(&gq.ws);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_run(&gq.ws, &img));
+    TEST_ASSERT_EQUAL_MEMORY(m1, lidet_ground_q_mask(&gq.ws), sizeof m1);
+    TEST_ASSERT_EQUAL_MEMORY(&st, lidet_ground_q_stats(&gq.ws), sizeof st);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_point_labels_of(&gq.ws.state, gq.ws.mask, pp, 4, out));
+    TEST_ASSERT_EQUAL_UINT8(0, out[0]);
+    TEST_ASSERT_EQUAL_UINT8(m1[pp[1]], out[1]);
+    TEST_ASSERT_EQUAL_UINT8(0, out[2]);
+    TEST_ASSERT_EQUAL_UINT8(m1[pp[3]], out[3]);
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_ground_q_point_labels_of(&gq.ws.state, gq.ws.mask, NULL, 4, out));
+}
+
+static void test_empty_image_takes_the_mount_plane(void)
+{
+    uint32_t s, ns;
+    const lidet_plane_q_t *pl;
+    cast(0.5, 0.0, 0.0);
+    memset(X, 0, sizeof X);
+    memset(Y, 0, sizeof Y);
+    memset(Z, 0, sizeof Z);
+    memset(RG, 0, sizeof RG);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_init(&gq.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_run(&gq.ws, &img));
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_ground_q_stats(&gq.ws)->n_ground);
+    TEST_ASSERT_EQUAL_UINT32(cfg.n_sectors, lidet_ground_q_stats(&gq.ws)->n_sectors_mount);
+    pl = lidet_ground_q_planes(&gq.ws, &ns);
+    for (s = 0; s < 2u * ns; ++s)
+    {
+        TEST_ASSERT_EQUAL_INT32(1 << 30, pl[s].nz);
+        TEST_ASSERT_EQUAL_INT32(125, pl[s].d_4mm);
+    }
+}
+
+/* coordinates at the int16 limits, every pixel: no overflow (the sanitizer build runs this), sane counts */
+static void test_coordinates_at_the_limits(void)
+{
+    int p, k;
+    const lidet_ground_stats_t *st;
+    cast(0.5, 0.0, 0.0);
+    for (k = 0; k < 3; ++k)
+    {
+        for (p = 0; p < ROWS * COLS; ++p)
+        {
+            const int16_t a = (int16_t)((p + k) % 3 == 0 ? -32768 : ((p + k) % 3 == 1 ? 32767 : (p % 7) - 3));
+            X[p] = a;
+            Y[p] = (int16_t)(k == 0 ? a : -32768);
+            Z[p] = (int16_t)((p / COLS) % 2 ? 32767 : -32768);
+            RG[p] = 65535u;
+        }
+        lidet_ground_q_cfg_default(&cfg, ROWS, 500);
+        cfg.ring_split_mm = k == 2 ? 500000u : 15000u; /* the split threshold past what int16 reaches, and not */
+        cfg.ground_per_m_q16 = k == 1 ? 6554u : 0u;
+        cfg.below_factor_q16 = 1310720u;
+        cfg.fy_max_q16 = 655360u;
+        cfg.fx_max_mm = 100000u;
+        cfg.max_tilt_urad = 1570796u;
+        cfg.max_height_dev_mm = 20000u;
+        cfg.refine_iters = 10u;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_init(&gq.ws, &cfg));
+        TEST_ASSERT_TRUE(lidet_ground_q_run(&gq.ws, &img) >= 0);
+        st = lidet_ground_q_stats(&gq.ws);
+        TEST_ASSERT_TRUE(st->n_ground + st->n_vetoed <= ROWS * COLS);
+        TEST_ASSERT_EQUAL_UINT32(cfg.n_sectors, st->n_sectors_fitted + st->n_sectors_neighbour + st->n_sectors_mount);
+    }
+}
+
+static void test_arguments_and_config(void)
+{
+    static float fx[ROWS * COLS];
+    lidet_range_image_t bad;
+    lidet_ground_q_cfg_t c;
+    cast(0.5, 0.0, 0.0);
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_ground_q_init(NULL, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_ground_q_init(&gq.ws, NULL));
+    memset(&gq.ws.state, 0, sizeof gq.ws.state);
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_ground_q_run(&gq.ws, &img));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_q_init(&gq.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_ground_q_run(&gq.ws, NULL));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_ground_q_run(NULL, &img));
+    bad = img;
+    bad.x_m = fx; /* a float image */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_ground_q_run(&gq.ws, &bad));
+    bad = img;
+    bad.z_4mm = NULL;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_ground_q_run(&gq.ws, &bad));
+    bad = img;
+    bad.n_rows = LIDET_MAX_ROWS + 1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_BUFFER, lidet_ground_q_run(&gq.ws, &bad));
+    bad = img;
+    bad.n_cols = 16; /* fewer columns than sectors */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_q_run(&gq.ws, &bad));
+    c = cfg;
+    c.n_sectors = LIDET_GROUND_MAX_SECTORS + 1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_BUFFER, lidet_ground_q_init(&gq.ws, &c));
+    c = cfg;
+    c.inlier_mm = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_q_init(&gq.ws, &c));
+    c = cfg;
+    c.max_tilt_urad = 1570797u;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_q_init(&gq.ws, &c));
+    c = cfg;
+    c.sample_step = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_q_init(&gq.ws, &c));
+    c = cfg;
+    c.mount_height_mm = -1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_q_init(&gq.ws, &c));
+    /* the defaults' two families */
+    lidet_ground_q_cfg_default(&c, 64, 1730);
+    TEST_ASSERT_EQUAL_UINT16(4, c.sample_step);
+    TEST_ASSERT_EQUAL_UINT32(15000u, c.ring_split_mm);
+    lidet_ground_q_cfg_default(&c, 16, 500);
+    TEST_ASSERT_EQUAL_UINT16(1, c.sample_step);
+    TEST_ASSERT_EQUAL_UINT32(0u, c.ring_split_mm);
+    TEST_ASSERT_NULL(lidet_ground_q_mask(NULL));
+    TEST_ASSERT_NULL(lidet_ground_q_planes(NULL, NULL));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_flat_ground_and_wall);
+    RUN_TEST(test_sloped_ground_normal);
+    RUN_TEST(test_deterministic_and_point_labels);
+    RUN_TEST(test_empty_image_takes_the_mount_plane);
+    RUN_TEST(test_coordinates_at_the_limits);
+    RUN_TEST(test_arguments_and_config);
+    return UNITY_END();
+}

@@ -1,0 +1,368 @@
+/* SPDX-License-Identifier: MIT */
+/* The proposal refinement (lib/src/lidet_refine.c, cfg split_people) on hand-made scenes: a small
+ * ray-cast range image (32 beams 0.5 deg apart from +2 deg, 2048 columns, sensor 1.73 m above a flat
+ * ground that returns nothing) of upright cylinders (people) and boxes (cars). */
+#include <math.h>
+#include <string.h>
+
+#include "lidet/lidet.h"
+#include "unity.h"
+
+#define PI_D 3.14159265358979323846
+#define ROWS 32
+#define COLS 2048
+#define NPIX (ROWS * COLS)
+#define MAXOBJ 4
+
+typedef struct
+{
+    int kind;        /* 0 cylinder (cx, cy, r), 1 box (x0, y0, x1, y1) */
+    double a, b, c, d;
+    double z0, z1;   /* vertical extent (sensor frame) */
+} obj_t;
+
+static float g_x[NPIX], g_y[NPIX], g_z[NPIX], g_r[NPIX], g_rxy[NPIX], g_elev[ROWS];
+static int32_t g_idx[NPIX];
+static uint8_t g_obj[NPIX]; /* object index + 1 of each pixel's return, 0 = none */
+static lidet_range_image_t g_img;
+static lidet_cluster_t g_cl;
+
+static double hit_cylinder(const obj_t *o, double dx, double dy)
+{
+    /* |t d - c|^2 = r^2 in the plane (|d| = 1) */
+    const double b = dx * o->a + dy * o->b, cc = o->a * o->a + o->b * o->b - o->c * o->c;
+    const double disc = b * b - cc;
+    return disc < 0.0 ? -1.0 : b - sqrt(disc);
+}
+
+static double hit_box(const obj_t *o, double dx, double dy)
+{
+    double t0 = 0.0, t1 = 1e9;
+    const double lo[2] = {o->a, o->b}, hi[2] = {o->c, o->d}, d[2] = {dx, dy};
+    int k;
+    for (k = 0; k < 2; ++k)
+    {
+        if (fabs(d[k]) < 1e-12)
+        {
+            if (lo[k] > 0.0 || hi[k] < 0.0)
+                return -1.0;
+            continue;
+        }
+        {
+            const double ta = lo[k] / d[k], tb = hi[k] / d[k];
+            const double t_in = ta < tb ? ta : tb, t_out = ta < tb ? tb : ta; /* entering and leaving the slab */
+            t0 = t_in > t0 ? t_in : t0;
+            t1 = t_out < t1 ? t_out : t1;
+        }
+    }
+    return t0 <= t1 ? t0 : -1.0;
+}
+
+/* ray-cast the scene; `drop(row, col)` nonzero removes that pixel's return (dropouts) */
+static void render(const obj_t *objs, int n, int (*drop)(int row, int col))
+{
+    int r, c, i, np = 0;
+    for (r = 0; r < ROWS; ++r)
+        g_elev[r] = (float)((2.0 - 0.5 * r) * PI_D / 180.0);
+    for (r = 0; r < ROWS; ++r)
+    {
+        const double el = g_elev[r], ce = cos(el), se = sin(el);
+        for (c = 0; c < COLS; ++c)
+        {
+            const int p = r * COLS + c;
+            const double az = PI_D * (1.0 - 2.0 * (c + 0.5) / COLS);
+            const double dx = cos(az), dy = sin(az); /* horizontal unit direction */
+            double best = 1e9;
+            int who = -1;
+            for (i = 0; i < n; ++i)
+            {
+                const double t = objs[i].kind == 0 ? hit_cylinder(&objs[i], dx, dy) : hit_box(&objs[i], dx, dy);
+                const double z = t * se / ce;
+                if (t > 0.0 && t < best && z >= objs[i].z0 && z <= objs[i].z1)
+                {
+                    best = t;
+                    who = i;
+                }
+            }
+            g_idx[p] = -1;
+            g_obj[p] = 0;
+            g_x[p] = g_y[p] = g_z[p] = g_r[p] = g_rxy[p] = 0.0f;
+            if (who < 0 || (drop != 0 && drop(r, c)))
+                continue;
+            g_x[p] = (float)(best * dx);
+            g_y[p] = (float)(best * dy);
+            g_z[p] = (float)(best * se / ce);
+            g_rxy[p] = (float)best;
+            g_r[p] = (float)(best / ce);
+            g_idx[p] = np++;
+            g_obj[p] = (uint8_t)(who + 1);
+        }
+    }
+    memset(&g_img, 0, sizeof g_img);
+    g_img.n_rows = ROWS;
+    g_img.n_cols = COLS;
+    g_img.x_m = g_x;
+    g_img.y_m = g_y;
+    g_img.z_m = g_z;
+    g_img.range_m = g_r;
+    g_img.rxy_m = g_rxy;
+    g_img.point_idx = g_idx;
+    g_img.row_elev_rad = g_elev;
+}
+
+/* the defaults, but joining generously (a small angle, 16 steps of hole bridging: 0.5 m at 10 m), so
+ * that close objects come out of the depth clustering as one cluster, as they do on real streets */
+static uint32_t run_with(const lidet_cluster_cfg_t *cfg)
+{
+    uint32_t n = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g_cl, cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g_cl, &g_img, NULL, NULL, 0));
+    (void)lidet_cluster_records(&g_cl, &n);
+    return n;
+}
+
+static uint32_t run(int split)
+{
+    lidet_cluster_cfg_t cfg;
+    lidet_cluster_cfg_default(&cfg, NULL);
+    cfg.theta_rad = 0.02f;
+    cfg.max_steps = 16u;
+    cfg.split_people = (uint32_t)split;
+    return run_with(&cfg);
+}
+
+/* every cluster holds returns of one object only, and each object's returns lie in one cluster */
+static void assert_one_to_one(int n_obj)
+{
+    const uint16_t *lab = lidet_cluster_labels(&g_cl);
+    uint32_t owner[64], cl_of[MAXOBJ + 1];
+    int p, i;
+    memset(owner, 0, sizeof owner);
+    memset(cl_of, 0, sizeof cl_of);
+    for (p = 0; p < NPIX; ++p)
+    {
+        if (lab[p] == 0)
+            continue;
+        TEST_ASSERT_TRUE(lab[p] < 64);
+        TEST_ASSERT_TRUE(g_obj[p] > 0);
+        if (owner[lab[p]] == 0)
+            owner[lab[p]] = g_obj[p];
+        TEST_ASSERT_EQUAL_UINT32(owner[lab[p]], g_obj[p]); /* one object per cluster */
+        if (cl_of[g_obj[p]] == 0)
+            cl_of[g_obj[p]] = lab[p];
+        TEST_ASSERT_EQUAL_UINT32(cl_of[g_obj[p]], lab[p]); /* one cluster per object */
+    }
+    for (i = 1; i <= n_obj; ++i)
+    {
+        TEST_ASSERT_TRUE(cl_of[i] != 0);
+    }
+}
+
+/* the records match a recount of the labels (counts, bounds, seed in raster order) */
+static void assert_records_consistent(void)
+{
+    uint32_t n = 0, k;
+    const lidet_cluster_rec_t *rec = lidet_cluster_records(&g_cl, &n);
+    const uint16_t *lab = lidet_cluster_labels(&g_cl);
+    const int32_t *mem = lidet_cluster_members(&g_cl);
+    for (k = 0; k < n; ++k)
+    {
+        uint32_t cnt = 0, first = NPIX, i;
+        int p;
+        for (p = 0; p < NPIX; ++p)
+        {
+            if (lab[p] == k + 1u)
+            {
+                ++cnt;
+                first = (uint32_t)p < first ? (uint32_t)p : first;
+                TEST_ASSERT_TRUE(g_x[p] >= rec[k].min_m[0] && g_x[p] <= rec[k].max_m[0]);
+                TEST_ASSERT_TRUE(g_y[p] >= rec[k].min_m[1] && g_y[p] <= rec[k].max_m[1]);
+            }
+        }
+        TEST_ASSERT_EQUAL_UINT32(cnt, rec[k].n_points);
+        TEST_ASSERT_EQUAL_UINT32(first, rec[k].seed_pixel);
+        for (i = 0; i < rec[k].n_points; ++i)
+        {
+            TEST_ASSERT_EQUAL_UINT32(k + 1u, lab[mem[rec[k].first_member + i]]);
+        }
+        if (k > 0)
+        {
+            TEST_ASSERT_TRUE(rec[k - 1].seed_pixel < rec[k].seed_pixel); /* canonical order */
+        }
+    }
+}
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
+}
+
+/* two adults (body radius 0.22 m, 1.75 m tall) 0.4 m apart, 10 m ahead */
+static void test_two_people_0_4m_apart(void)
+{
+    const obj_t s[2] = {{0, 10.0, -0.42, 0.22, 0.0, -1.73, 0.02}, {0, 10.0, 0.42, 0.22, 0.0, -1.73, 0.02}};
+    render(s, 2, 0);
+    TEST_ASSERT_EQUAL_UINT32(1, run(0)); /* the depth clustering merges them */
+    TEST_ASSERT_EQUAL_UINT32(2, run(1));
+    assert_one_to_one(2);
+    assert_records_consistent();
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g_cl)->n_split);
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g_cl)->n_split_parts);
+}
+
+/* a person 0.25 m from a car's side (the car 4.4 x 1.8 x 1.4 m, 8-12.4 m ahead, the person between the
+ * sensor and the car's flank); a person touching the car (closer than one 0.12 m cell) is not cut */
+static void test_person_beside_car(void)
+{
+    const obj_t s[2] = {{1, 8.0, 1.0, 12.4, 2.8, -1.60, -0.25}, {0, 10.0, 0.53, 0.22, 0.0, -1.73, 0.02}};
+    render(s, 2, 0);
+    TEST_ASSERT_EQUAL_UINT32(1, run(0));
+    TEST_ASSERT_EQUAL_UINT32(2, run(1));
+    assert_one_to_one(2);
+    assert_records_consistent();
+}
+
+/* a group of three 0.3-0.5 m apart and a child (1.2 m) 0.3 m from an adult */
+static void test_group_with_child(void)
+{
+    const obj_t s[4] = {{0, 12.0, -0.9, 0.22, 0.0, -1.73, 0.02},
+                        {0, 12.0, -0.1, 0.22, 0.0, -1.73, 0.05},
+                        {0, 12.2, 0.64, 0.22, 0.0, -1.73, 0.0},
+                        {0, 12.0, 1.3, 0.16, 0.0, -1.73, -0.53}};
+    render(s, 4, 0);
+    TEST_ASSERT_TRUE(run(0) < 4);
+    TEST_ASSERT_EQUAL_UINT32(4, run(1));
+    assert_one_to_one(4);
+    assert_records_consistent();
+}
+
+/* a car (4.4 x 1.8 x 1.5 m, 8 m ahead and 1 m to the left: its rear and its right flank seen) with two
+ * bands of five beams lost (dark paint, glass): the depth clustering (defaults) gives three pieces, one
+ * above the other; the refinement joins them into one and cuts nothing */
+static int car_bands(int row, int col)
+{
+    (void)col;
+    return (row >= 12 && row < 17) || (row >= 20 && row < 25);
+}
+
+static uint32_t run_defaults(int split, int join)
+{
+    lidet_cluster_cfg_t cfg;
+    lidet_cluster_cfg_default(&cfg, NULL);
+    cfg.split_people = (uint32_t)split;
+    cfg.join_cars = (uint32_t)join;
+    return run_with(&cfg);
+}
+
+static void test_car_in_three_pieces_joined(void)
+{
+    const obj_t s[1] = {{1, 8.0, 1.0, 12.4, 2.8, -1.70, -0.20}};
+    render(s, 1, car_bands);
+    TEST_ASSERT_EQUAL_UINT32(3, run_defaults(1, 0));
+    TEST_ASSERT_EQUAL_UINT32(1, run_defaults(1, 1));
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_cluster_stats(&g_cl)->n_joined);
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g_cl)->n_split);
+    assert_one_to_one(1);
+    assert_records_consistent();
+}
+
+/* two cars nose to tail 1.2 m apart, the join gap widened to 1.5 m: their union is longer than a car,
+ * so no cluster takes both; allowing a 12 m car joins them (the rule is what keeps them apart) */
+static uint32_t run_join(float gap_m, float max_len_m)
+{
+    lidet_cluster_cfg_t cfg;
+    lidet_cluster_cfg_default(&cfg, NULL);
+    cfg.join_gap_m = gap_m;
+    cfg.car_max_length_m = max_len_m;
+    return run_with(&cfg);
+}
+
+static int cars_mixed(void)
+{
+    const uint16_t *lab = lidet_cluster_labels(&g_cl);
+    uint32_t owner[64], p;
+    memset(owner, 0, sizeof owner);
+    for (p = 0; p < NPIX; ++p)
+    {
+        if (lab[p] == 0)
+        {
+            continue;
+        }
+        TEST_ASSERT_TRUE(lab[p] < 64u);
+        if (owner[lab[p]] == 0)
+        {
+            owner[lab[p]] = g_obj[p];
+        }
+        if (owner[lab[p]] != g_obj[p])
+        {
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static void test_two_cars_not_joined(void)
+{
+    const obj_t s[2] = {{1, 8.0, 1.0, 12.4, 2.8, -1.70, -0.20}, {1, 13.6, 1.0, 18.0, 2.8, -1.70, -0.20}};
+    render(s, 2, 0);
+    TEST_ASSERT_TRUE(run_join(1.5f, 5.2f) >= 2u);
+    TEST_ASSERT_FALSE(cars_mixed());
+    (void)run_join(1.5f, 12.0f);
+    TEST_ASSERT_TRUE(cars_mixed());
+}
+
+/* one car alone is never cut */
+static void test_car_alone_not_cut(void)
+{
+    const obj_t s[1] = {{1, 14.0, -3.0, 18.4, -1.2, -1.60, -0.25}};
+    render(s, 1, 0);
+    TEST_ASSERT_EQUAL_UINT32(1, run(1));
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g_cl)->n_split);
+}
+
+/* a copy of cfg with one field set is refused by init */
+#define REFUSED(field, value)                                                                                \
+    do                                                                                                       \
+    {                                                                                                        \
+        lidet_cluster_cfg_t bad_ = cfg;                                                                      \
+        bad_.field = (value);                                                                                \
+        TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &bad_));                           \
+    } while (0)
+
+/* the same input gives the same labels (deterministic), and bad refinement settings are refused */
+static void test_deterministic_and_config(void)
+{
+    static uint16_t first[NPIX];
+    const obj_t s[2] = {{0, 10.0, -0.42, 0.22, 0.0, -1.73, 0.02}, {0, 10.0, 0.42, 0.22, 0.0, -1.73, 0.02}};
+    lidet_cluster_cfg_t cfg;
+    render(s, 2, 0);
+    (void)run(1);
+    memcpy(first, lidet_cluster_labels(&g_cl), sizeof first);
+    (void)run(1);
+    TEST_ASSERT_EQUAL_MEMORY(first, lidet_cluster_labels(&g_cl), sizeof first);
+    lidet_cluster_cfg_default(&cfg, NULL);
+    TEST_ASSERT_EQUAL_UINT32(1, cfg.split_people);
+    TEST_ASSERT_EQUAL_UINT32(1, cfg.join_cars);
+    REFUSED(split_people, 2u);
+    REFUSED(split_cell_m, 0.0f);
+    REFUSED(person_min_aspect, -1.0f);
+    REFUSED(join_cars, 3u);
+    REFUSED(car_max_width_m, -1.0f);
+    REFUSED(split_min_width_m, (float)NAN);
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_two_people_0_4m_apart);
+    RUN_TEST(test_person_beside_car);
+    RUN_TEST(test_group_with_child);
+    RUN_TEST(test_car_in_three_pieces_joined);
+    RUN_TEST(test_two_cars_not_joined);
+    RUN_TEST(test_car_alone_not_cut);
+    RUN_TEST(test_deterministic_and_config);
+    return UNITY_END();
+}
