@@ -665,3 +665,8 @@ const lidet_pointnet_q_model_t *lidet_pointnet_q_find(const lidet_pointnet_q_ent
     i = lidet__pn_find_index(table, n, sizeof *table, name);
     return i < n ? table[i].model : 0;
 }
+
+int64_t lidet__pnq_exp_neg_q30(int64_t d_q16)
+{
+    return d_q16 <= 0 ? ((int64_t)1 << 30) : exp_neg_q30(d_q16);
+}

@@ -691,3 +691,64 @@ def pnq_time(cls_model: str, box_model: str, xyz_4mm, mean_4mm, voxel, repeats: 
     if st < 0:
         raise native.LidetError(st, "lidet_py_pnq_time")
     return float(ns[0]) * 1e-9 / b, float(ns[1]) * 1e-9 / b
+
+
+# ---- the integer detector (lib/src/lidet_detector_q.c) ---------------------------------------------
+
+DETQ_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
+              "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity", "n_detections"]
+_detq_ready = False
+
+
+def to_mm(points) -> np.ndarray:
+    """(N, >=3) float points in metres -> (N, 3) int32 millimetres, rounded half away from zero (what a driver
+    delivering millimetres gives)."""
+    p = np.asarray(points, dtype=np.float64)[:, :3]
+    return (np.sign(p) * np.floor(np.abs(p) * 1000.0 + 0.5)).astype(np.int32)
+
+
+def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_half_bam: int = 0,
+             max_range_mm: int = 0, nms_iou_q15: int = 3277, max_proposals: int = 0, gate1: bool = True,
+             gate2: bool = True) -> dict:
+    """lidet_detector_q_run on (N, 3) int32 mm points with the int8 models cls_<model>_s8 / box_<model>_s8.
+
+    Returns {'cls', 'score_q15', 'energy_cls_q16', 'energy_box_q16', 'boxes' (N, 7: cx cy cz l w h mm, yaw BAM32),
+    'cluster_id', 'n_points', 'outcome', 'stats', 'status'}."""
+    global _detq_ready
+    L = native.lib()
+    if not _detq_ready:
+        u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
+        u32p = np.ctypeslib.ndpointer(np.uint32, flags="C_CONTIGUOUS")
+        L.lidet_py_detq_run.argtypes = [C.c_char_p, C.c_char_p, C.c_char_p, _i32p, _i32p, C.c_uint32, C.c_uint32,
+                                        _i32p, u32p, u8p, u32p, u32p]
+        L.lidet_py_detq_bytes.restype = C.c_uint32
+        _detq_ready = True
+    pts = np.ascontiguousarray(points_mm, dtype=np.int32)
+    if pts.ndim != 2 or pts.shape[1] < 3:
+        raise ValueError(f"points_mm must be (N, >=3) int32, got {pts.shape}")
+    fam = model or sensor
+    cap = native.capacity()
+    det = np.zeros((cap["max_detections"], 13), np.int32)
+    nd = np.zeros(1, np.uint32)
+    oc = np.zeros(cap["max_clusters"], np.uint8)
+    nc = np.zeros(1, np.uint32)
+    st = np.zeros(len(DETQ_STATS), np.uint32)
+    icfg = np.array([crop_half_bam, max_range_mm, nms_iou_q15, max_proposals, int(bool(gate1)), int(bool(gate2))],
+                    np.int32)
+    n = len(pts)
+    rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
+                             pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st)
+    if rc < 0:
+        raise native.LidetError(rc, "lidet_detector_q")
+    d = det[: int(nd[0])]
+    return {"cls": d[:, 0].copy(), "score_q15": d[:, 1].copy(), "energy_cls_q16": d[:, 2].copy(),
+            "energy_box_q16": d[:, 3].copy(), "boxes": d[:, 4:11].copy(), "cluster_id": d[:, 11].copy(),
+            "n_points": d[:, 12].copy(), "outcome": oc[: int(nc[0])].copy(), "stats": dict(zip(DETQ_STATS, map(int, st))),
+            "status": int(rc)}
+
+
+def detector_q_bytes() -> int:
+    """sizeof(lidet_detector_q_t) of the bindings' build."""
+    L = native.lib()
+    L.lidet_py_detq_bytes.restype = C.c_uint32
+    return int(L.lidet_py_detq_bytes())

@@ -15,7 +15,12 @@
 #ifndef LIDET_DETECTOR_Q_H
 #define LIDET_DETECTOR_Q_H
 
+#include "lidet_cluster_q.h"
+#include "lidet_ground_q.h"
+#include "lidet_pointnet_q.h"
+#include "lidet_proj_q.h"
 #include "lidet_q.h"
+#include "lidet_detector.h" /* lidet_clock_fn, stage indices, outcomes */
 
 #ifdef __cplusplus
 extern "C" {
@@ -68,6 +73,118 @@ void lidet_detections_q_insert(lidet_detection_q_t *det, uint32_t n);
  * @return the number kept; 0 for NULL det.
  */
 uint32_t lidet_detections_q_nms(lidet_detection_q_t *det, uint32_t n, int32_t iou_q15, uint8_t *suppressed);
+
+/* ---- the integer detector ------------------------------------------------------------------------- */
+
+/** @brief Configuration of the integer detector. Fill with lidet_detector_q_cfg_default(). */
+typedef struct
+{
+    lidet_proj_q_cfg_t proj;         /**< projection (holds the sensor) */
+    lidet_ground_q_cfg_t ground;     /**< ground segmentation */
+    lidet_cluster_q_cfg_t cluster;   /**< clustering */
+    lidet_proposal_q_cfg_t proposal; /**< n_points is set from the models by init; seed and PVLE bins used */
+    int32_t crop_half_bam;           /**< 0: 360 degrees; else keep clusters with |azimuth| <= this (BAM32;
+                                          the KITTI camera field of view is 2^29); [0, 2^31 - 1] */
+    int32_t max_range_mm;            /**< clusters whose mean is farther (horizontally) are not classified; 0 =
+                                          no limit; >= 0 */
+    uint32_t max_proposals;          /**< [1, LIDET_MAX_CLUSTERS]: at most this many classified, nearest first */
+    uint8_t gate1;                   /**< 1 (default): drop proposals failing gate 1 */
+    uint8_t gate2;                   /**< 1 (default): drop boxes failing gate 2 */
+    int32_t nms_iou_q15;             /**< [0, 32768]; default 3277 (0.1) */
+    lidet_size_limits_q_t size;      /**< plausible l, w, h per class */
+    lidet_clock_fn clock;            /**< optional timestamp source for stats.ticks (NULL: no timing) */
+    void *clock_ctx;                 /**< passed to clock */
+} lidet_detector_q_cfg_t;
+
+/** @brief Counts of the last run (the fields of lidet_detector_stats_t, the integer stages' counts). */
+typedef struct
+{
+    uint32_t n_clusters, n_out_of_crop, n_out_of_range, n_over_budget, n_classified, n_gate1_rejected, n_boxed,
+        n_gate2_rejected, n_size_rejected, n_nms_suppressed, n_over_capacity, n_detections;
+    uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
+    lidet_proj_stats_t proj;
+    lidet_ground_stats_t ground;
+    lidet_cluster_stats_t cluster;
+} lidet_detector_q_stats_t;
+
+#ifndef LIDET_DETECTOR_Q_PN_SCRATCH
+/** Bytes of int8 PointNet scratch (shared by both models; overlaid with the ground stage's scratch). lidet's
+ *  int8 models need 9.8 KiB. */
+#define LIDET_DETECTOR_Q_PN_SCRATCH 12288
+#endif
+
+/** @brief The integer detector: every buffer of every integer stage. Declare it static. */
+typedef struct
+{
+    uint32_t magic;
+    lidet_detector_q_cfg_t cfg;
+    lidet_proj_q_state_t proj;
+    lidet_ground_q_state_t ground;
+    lidet_cluster_q_state_t cluster;
+    /* per pixel: the compact image, the ground mask, cluster ids and members */
+    int16_t x_4mm[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    int16_t y_4mm[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    int16_t z_4mm[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    uint16_t range_4mm[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    int32_t point_idx[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    uint8_t mask[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    union
+    {
+        lidet_ground_q_scratch_t ground; /* during the ground stage only */
+        int32_t pn[LIDET_DETECTOR_Q_PN_SCRATCH / 4]; /* during the networks only */
+    } scratch;
+    lidet_pointnet_q_t cls, box;
+    lidet_proposal_q_t proposal;
+    uint16_t order[LIDET_MAX_CLUSTERS];                /* candidate clusters, nearest first */
+    uint32_t key[LIDET_MAX_CLUSTERS];                  /* their squared horizontal ranges (4 mm steps) */
+    lidet_detection_q_t det[LIDET_MAX_DETECTIONS + 1]; /* + 1: a candidate before the capacity check */
+    uint8_t outcome[LIDET_MAX_CLUSTERS];               /* lidet_det_outcome_t per kept cluster */
+    uint32_t n_det;
+    lidet_detector_q_stats_t stats;
+} lidet_detector_q_t;
+
+/**
+ * @brief Defaults for an integer sensor profile: each integer stage's defaults, 360 degrees, at most 256
+ *        proposals (128 for <= 16 beams), both gates on, NMS at BEV IoU 0.1, the class size limits (mm).
+ */
+void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_sensor_q_t *sensor);
+
+/**
+ * @brief Initialise the integer stages and bind the two int8 models (checked as lidet_detector_init does).
+ * @return LIDET_OK; LIDET_ERR_ARG; LIDET_ERR_CONFIG (a field out of range) or a stage's init error;
+ *         LIDET_ERR_MODEL (a model fails lidet_pointnet_q_check, different points per proposal, PVLE bins other
+ *         than the proposal configuration's); LIDET_ERR_BUFFER (scratch too small).
+ */
+lidet_status_t lidet_detector_q_init(lidet_detector_q_t *d, const lidet_detector_q_cfg_t *cfg,
+                                     const lidet_pointnet_q_model_t *cls, const lidet_pointnet_q_model_t *box);
+
+/**
+ * @brief Detect road users in one scan of int32 mm points (records of `stride` int32, x y z first).
+ * @param ring        optional ring index per point, or NULL; point_pixel: optional LIDET_MAX_POINTS int32, or NULL.
+ * @return as lidet_detector_run.
+ */
+lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,
+                                    uint32_t stride, const uint16_t *ring, int32_t *point_pixel);
+
+/** @brief Detections of the last run, best score first. */
+const lidet_detection_q_t *lidet_detector_q_detections(const lidet_detector_q_t *d, uint32_t *n_detections);
+
+/** @brief Outcome per kept cluster of the last run (lidet_det_outcome_t, index = cluster id - 1). */
+const uint8_t *lidet_detector_q_outcomes(const lidet_detector_q_t *d, uint32_t *n_clusters);
+
+/** @brief Counts of the last run. */
+const lidet_detector_q_stats_t *lidet_detector_q_stats(const lidet_detector_q_t *d);
+
+/** @brief The compact range image of the last run (views into d). */
+void lidet_detector_q_image(const lidet_detector_q_t *d, lidet_range_image_t *img);
+
+/** @brief sizeof(lidet_detector_q_t). */
+uint32_t lidet_detector_q_bytes(void);
+
+/** @brief score = 1 / (1 + exp(energy - gamma)) in Q15, from Q16 nats: the float detector's score. */
+int32_t lidet_detector_q_score(int32_t energy_q16, int32_t gamma_q16);
 
 #ifdef __cplusplus
 }

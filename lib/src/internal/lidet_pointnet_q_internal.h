@@ -27,4 +27,7 @@ void lidet__nn_requant_q16(const int32_t *acc, uint32_t n_out, const int32_t *mu
 /* vmax[o] = max(vmax[o], acc[r * n + o]) over the rows: the max over the points on the accumulators */
 void lidet__nn_max_rows_s32(const int32_t *acc, uint32_t n_rows, uint32_t n, int32_t *vmax);
 
+/* exp(-d) in Q30 for d in Q16 nats (d <= 0 gives 1.0): the energies' exponential, also the detector's score */
+int64_t lidet__pnq_exp_neg_q30(int64_t d_q16);
+
 #endif

@@ -1,0 +1,385 @@
+/* SPDX-License-Identifier: MIT */
+/* The integer detector (lidet_detector_q.h): the integer stages chained as lidet_detector.c chains the float
+ * ones (same candidate order, budget, gates, size check, score and NMS rules). Integers only; mirrored by
+ * codegen/lidet_codegen/ref/detector_q.py. */
+#include <string.h>
+
+#include "internal/lidet_pointnet_q_internal.h"
+#include "internal/lidet_qmath.h"
+#include "internal/lidet_sort.h"
+#include "lidet/lidet_detector_q.h"
+
+#define NMS_IOU_DEFAULT_Q15 3277 /* 0.1 */
+
+void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_sensor_q_t *sensor)
+{
+    uint32_t rows;
+    int32_t mount;
+    if (cfg == 0)
+    {
+        return;
+    }
+    memset(cfg, 0, sizeof *cfg);
+    rows = sensor != 0 ? sensor->n_rows : 64u;
+    mount = sensor != 0 ? sensor->mount_height_mm : 1730;
+    lidet_proj_q_cfg_default(&cfg->proj, sensor);
+    lidet_ground_q_cfg_default(&cfg->ground, rows, mount);
+    lidet_cluster_q_cfg_default(&cfg->cluster, rows, mount > 0 ? (uint32_t)mount : 0u);
+    lidet_proposal_q_cfg_default(&cfg->proposal);
+    /* as the float detector: 100-300 kept clusters per real HDL-64 scan, 20-50 per simulated VLP-16 scan */
+    cfg->max_proposals = rows <= 16u ? 128u : 256u;
+    if (cfg->max_proposals > LIDET_MAX_CLUSTERS)
+    {
+        cfg->max_proposals = LIDET_MAX_CLUSTERS;
+    }
+    cfg->gate1 = 1u;
+    cfg->gate2 = 1u;
+    cfg->nms_iou_q15 = NMS_IOU_DEFAULT_Q15;
+    lidet_size_limits_q_default(&cfg->size);
+}
+
+static int cfg_ok(const lidet_detector_q_cfg_t *c)
+{
+    uint32_t k, j;
+    if (c->crop_half_bam < 0 || c->max_range_mm < 0 || c->max_proposals < 1u ||
+        c->max_proposals > LIDET_MAX_CLUSTERS || c->gate1 > 1u || c->gate2 > 1u || c->nms_iou_q15 < 0 ||
+        c->nms_iou_q15 > 32768)
+    {
+        return 0;
+    }
+    for (k = 0; k < (uint32_t)LIDET_N_CLASSES; ++k)
+    {
+        for (j = 0; j < 3u; ++j)
+        {
+            if (c->size.min_mm[k][j] < 1 || c->size.min_mm[k][j] > c->size.max_mm[k][j] ||
+                c->size.max_mm[k][j] > LIDET_Q_BOX_MAX_MM)
+            {
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
+/* |a - b| <= b / 1000 + 1: a model's PVLE bin against the configuration's (unit conversions round) */
+static int near(int64_t a, int64_t b)
+{
+    const int64_t d = a > b ? a - b : b - a;
+    return d <= b / 1000 + 1;
+}
+
+lidet_status_t lidet_detector_q_init(lidet_detector_q_t *d, const lidet_detector_q_cfg_t *cfg,
+                                     const lidet_pointnet_q_model_t *cls, const lidet_pointnet_q_model_t *box)
+{
+    lidet_status_t s;
+    if (d == 0 || cfg == 0 || cls == 0 || box == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    d->magic = 0;
+    if (!cfg_ok(cfg))
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    if (lidet_pointnet_q_check(cls, LIDET_PN_CLASSIFIER, 0) != LIDET_OK ||
+        lidet_pointnet_q_check(box, LIDET_PN_BOX, 0) != LIDET_OK || cls->n_points != box->n_points ||
+        cls->n_points > LIDET_PROPOSAL_POINTS)
+    {
+        return LIDET_ERR_MODEL;
+    }
+    /* the voxels the models were trained with: azimuth, elevation in microradians, range in mm */
+    if (!near(lidet__q_urad_to_bam(cls->pvle_bin[0]), cfg->proposal.azimuth_bin_bam) ||
+        !near(lidet__q_urad_to_bam(cls->pvle_bin[1]), cfg->proposal.elevation_bin_bam) ||
+        !near(cls->pvle_bin[2], 4 * (int64_t)cfg->proposal.range_bin_4mm) ||
+        cls->pvle_bin[0] != box->pvle_bin[0] || cls->pvle_bin[1] != box->pvle_bin[1] ||
+        cls->pvle_bin[2] != box->pvle_bin[2])
+    {
+        return LIDET_ERR_MODEL;
+    }
+    d->cfg = *cfg;
+    d->cfg.proposal.n_points = cls->n_points;
+    s = lidet_proj_q_init(&d->proj, &d->cfg.proj);
+    if (s == LIDET_OK)
+    {
+        s = lidet_ground_q_state_init(&d->ground, &d->cfg.ground);
+    }
+    if (s == LIDET_OK)
+    {
+        s = lidet_cluster_q_state_init(&d->cluster, &d->cfg.cluster);
+    }
+    if (s == LIDET_OK)
+    {
+        s = lidet_pointnet_q_init(&d->cls, cls, d->scratch.pn, sizeof d->scratch.pn, 0);
+    }
+    if (s == LIDET_OK)
+    {
+        s = lidet_pointnet_q_init(&d->box, box, d->scratch.pn, sizeof d->scratch.pn, 0);
+    }
+    if (s != LIDET_OK)
+    {
+        return s;
+    }
+    d->n_det = 0;
+    memset(&d->stats, 0, sizeof d->stats);
+    d->magic = LIDET_INIT_MAGIC;
+    return LIDET_OK;
+}
+
+static uint32_t now(const lidet_detector_q_t *d)
+{
+    return d->cfg.clock != 0 ? d->cfg.clock(d->cfg.clock_ctx) : 0u;
+}
+
+int32_t lidet_detector_q_score(int32_t energy_q16, int32_t gamma_q16)
+{
+    /* 1 / (1 + e^t), t = E - gamma: e^-|t| in Q30, then a Q15 quotient */
+    const int64_t t = (int64_t)energy_q16 - gamma_q16;
+    const int64_t e = lidet__pnq_exp_neg_q30(t >= 0 ? t : -t);
+    const int64_t one = (int64_t)1 << 30;
+    return (int32_t)(t >= 0 ? (e << 15) / (one + e) : (one << 15) / (one + e));
+}
+
+void lidet_detector_q_image(const lidet_detector_q_t *d, lidet_range_image_t *img)
+{
+    lidet_proj_q_buffers_t b;
+    if (d == 0 || img == 0)
+    {
+        return;
+    }
+    memset(&b, 0, sizeof b);
+    b.x_4mm = (int16_t *)(uintptr_t)d->x_4mm; /* the image is read-only; the buffers type is shared */
+    b.y_4mm = (int16_t *)(uintptr_t)d->y_4mm;
+    b.z_4mm = (int16_t *)(uintptr_t)d->z_4mm;
+    b.range_4mm = (uint16_t *)(uintptr_t)d->range_4mm;
+    b.point_idx = (int32_t *)(uintptr_t)d->point_idx;
+    lidet_proj_q_image(&d->proj, &b, img);
+}
+
+/* candidates: kept clusters in the azimuth window and range, nearest first, at most max_proposals */
+static uint32_t candidates(lidet_detector_q_t *d, lidet_status_t *worst)
+{
+    lidet_detector_q_stats_t *st = &d->stats;
+    const lidet_cluster_q_rec_t *recs = d->cluster.recs;
+    const uint32_t n_rec = d->cluster.n_recs;
+    const int crop = d->cfg.crop_half_bam > 0;
+    const int64_t cs = crop ? lidet__q_sin((uint32_t)d->cfg.crop_half_bam) : 0;
+    const int64_t cc = crop ? lidet__q_cos((uint32_t)d->cfg.crop_half_bam) : 0;
+    /* max range in 4 mm steps, squared: (mm / 4)^2 compared as 16 r2 > mm^2 */
+    const int64_t max_mm2 = (int64_t)d->cfg.max_range_mm * d->cfg.max_range_mm;
+    uint32_t i, n = 0;
+    for (i = 0; i < n_rec; ++i)
+    {
+        const int64_t x = recs[i].mean_4mm[0], y = recs[i].mean_4mm[1];
+        const int64_t r2 = x * x + y * y; /* < 2^31: |x|, |y| <= 2^15 */
+        /* |atan2(y, x)| <= h  <=>  x sin h >= |y| cos h, for any h in (0, pi) */
+        if (crop && !(x * cs >= (y < 0 ? -y : y) * cc))
+        {
+            d->outcome[i] = LIDET_DET_OUT_CROP;
+            ++st->n_out_of_crop;
+            continue;
+        }
+        if (d->cfg.max_range_mm > 0 && 16 * r2 > max_mm2)
+        {
+            d->outcome[i] = LIDET_DET_OUT_RANGE;
+            ++st->n_out_of_range;
+            continue;
+        }
+        d->key[n] = (uint32_t)r2;
+        d->order[n] = (uint16_t)i;
+        ++n;
+    }
+    lidet__sort_u32_u16(d->key, d->order, n);
+    if (n > d->cfg.max_proposals)
+    {
+        for (i = d->cfg.max_proposals; i < n; ++i)
+        {
+            d->outcome[d->order[i]] = LIDET_DET_OUT_BUDGET;
+        }
+        st->n_over_budget = n - d->cfg.max_proposals;
+        n = d->cfg.max_proposals;
+        *worst = LIDET_TRUNCATED;
+    }
+    return n;
+}
+
+lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,
+                                    uint32_t stride, const uint16_t *ring, int32_t *point_pixel)
+{
+    lidet_detector_q_stats_t *st;
+    lidet_proj_q_buffers_t buf;
+    lidet_range_image_t img;
+    lidet_status_t s, worst = LIDET_OK;
+    uint32_t n_cand, i, t0, t1, box_ticks = 0, n_sectors;
+    uint8_t suppressed[LIDET_MAX_DETECTIONS];
+    if (d == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (d->magic != LIDET_INIT_MAGIC)
+    {
+        return LIDET_ERR_STATE;
+    }
+    st = &d->stats;
+    memset(st, 0, sizeof *st);
+    d->n_det = 0;
+
+    /* the stages */
+    memset(&buf, 0, sizeof buf);
+    buf.x_4mm = d->x_4mm;
+    buf.y_4mm = d->y_4mm;
+    buf.z_4mm = d->z_4mm;
+    buf.range_4mm = d->range_4mm;
+    buf.point_idx = d->point_idx;
+    buf.point_pixel = point_pixel;
+    t0 = now(d);
+    s = lidet_proj_q_run(&d->proj, &buf, points_mm, n_points, stride, ring);
+    st->proj = d->proj.stats;
+    if (!LIDET_SUCCEEDED(s))
+    {
+        return s;
+    }
+    worst = s;
+    lidet_proj_q_image(&d->proj, &buf, &img);
+    t1 = now(d);
+    st->ticks[LIDET_DET_STAGE_PROJECT] = t1 - t0;
+    s = lidet_ground_q_run_buffers(&d->ground, &d->scratch.ground, d->mask, &img);
+    st->ground = d->ground.stats;
+    if (!LIDET_SUCCEEDED(s))
+    {
+        return s;
+    }
+    worst = s != LIDET_OK ? s : worst;
+    t0 = now(d);
+    st->ticks[LIDET_DET_STAGE_GROUND] = t0 - t1;
+    n_sectors = d->cfg.ground.n_sectors;
+    s = lidet_cluster_q_run_buffers(&d->cluster, d->labels, d->members, &img, d->mask, d->ground.planes, n_sectors);
+    st->cluster = d->cluster.stats;
+    if (!LIDET_SUCCEEDED(s))
+    {
+        return s;
+    }
+    worst = s != LIDET_OK ? s : worst;
+    t1 = now(d);
+    st->ticks[LIDET_DET_STAGE_CLUSTER] = t1 - t0;
+
+    /* candidates, proposals, the networks */
+    t0 = t1;
+    st->n_clusters = d->cluster.n_recs;
+    n_cand = candidates(d, &worst);
+    for (i = 0; i < n_cand; ++i)
+    {
+        const uint32_t ci = d->order[i];
+        lidet_pointnet_q_class_out_t co;
+        lidet_pointnet_q_box_out_t bo;
+        lidet_detection_q_t *t;
+        uint32_t tb;
+        s = lidet_proposal_q_make(&d->cluster, ci, &d->cfg.proposal, &d->proposal);
+        if (s == LIDET_OK)
+        {
+            s = lidet_pointnet_q_classify(&d->cls, &d->proposal, &co);
+        }
+        if (s != LIDET_OK)
+        {
+            return s; /* cannot happen after a successful init and run */
+        }
+        ++st->n_classified;
+        if (d->cfg.gate1 && !co.pass)
+        {
+            d->outcome[ci] = LIDET_DET_OUT_GATE1;
+            ++st->n_gate1_rejected;
+            continue;
+        }
+        tb = now(d);
+        s = lidet_pointnet_q_box(&d->box, &d->proposal, co.cls, &bo);
+        box_ticks += now(d) - tb;
+        if (s != LIDET_OK)
+        {
+            return s;
+        }
+        ++st->n_boxed;
+        if (d->cfg.gate2 && !bo.pass)
+        {
+            d->outcome[ci] = LIDET_DET_OUT_GATE2;
+            ++st->n_gate2_rejected;
+            continue;
+        }
+        if (!lidet_size_ok_q(&d->cfg.size, co.cls, &bo.box))
+        {
+            d->outcome[ci] = LIDET_DET_OUT_SIZE;
+            ++st->n_size_rejected;
+            continue;
+        }
+        t = &d->det[d->n_det];
+        t->box = bo.box;
+        t->cls = co.cls;
+        t->reserved = 0;
+        t->score_q15 = lidet_detector_q_score(co.energy_q16, d->cls.model->gamma_q16[co.cls]);
+        t->energy_cls_q16 = co.energy_q16;
+        t->energy_box_q16 = bo.energy_q16;
+        t->cluster_id = (uint16_t)(ci + 1u);
+        t->n_points = d->cluster.recs[ci].n_points;
+        lidet_detections_q_insert(d->det, d->n_det);
+        ++d->n_det;
+        d->outcome[ci] = LIDET_DET_OUT_DETECTED;
+        if (d->n_det > LIDET_MAX_DETECTIONS)
+        {
+            --d->n_det; /* the lowest score goes */
+            d->outcome[d->det[d->n_det].cluster_id - 1u] = LIDET_DET_OUT_CAPACITY;
+            ++st->n_over_capacity;
+            worst = LIDET_TRUNCATED;
+        }
+    }
+    t1 = now(d);
+    st->ticks[LIDET_DET_STAGE_CLASSIFY] = (t1 - t0) - box_ticks;
+    st->ticks[LIDET_DET_STAGE_BOX] = box_ticks;
+
+    /* NMS: the outcome of each dropped detection, in score order */
+    {
+        uint16_t ids[LIDET_MAX_DETECTIONS];
+        const uint32_t n = d->n_det;
+        for (i = 0; i < n; ++i)
+        {
+            ids[i] = d->det[i].cluster_id;
+        }
+        d->n_det = lidet_detections_q_nms(d->det, n, d->cfg.nms_iou_q15, suppressed);
+        for (i = 0; i < n; ++i)
+        {
+            if (suppressed[i])
+            {
+                d->outcome[ids[i] - 1u] = LIDET_DET_OUT_NMS;
+                ++st->n_nms_suppressed;
+            }
+        }
+    }
+    st->n_detections = d->n_det;
+    st->ticks[LIDET_DET_STAGE_POST] = now(d) - t1;
+    return worst;
+}
+
+const lidet_detection_q_t *lidet_detector_q_detections(const lidet_detector_q_t *d, uint32_t *n_detections)
+{
+    if (n_detections != 0)
+    {
+        *n_detections = d != 0 && d->magic == LIDET_INIT_MAGIC ? d->n_det : 0u;
+    }
+    return d != 0 ? d->det : 0;
+}
+
+const uint8_t *lidet_detector_q_outcomes(const lidet_detector_q_t *d, uint32_t *n_clusters)
+{
+    if (n_clusters != 0)
+    {
+        *n_clusters = d != 0 && d->magic == LIDET_INIT_MAGIC ? d->stats.n_clusters : 0u;
+    }
+    return d != 0 ? d->outcome : 0;
+}
+
+const lidet_detector_q_stats_t *lidet_detector_q_stats(const lidet_detector_q_t *d)
+{
+    return d != 0 ? &d->stats : 0;
+}
+
+uint32_t lidet_detector_q_bytes(void)
+{
+    return (uint32_t)sizeof(lidet_detector_q_t);
+}

@@ -1,0 +1,100 @@
+/* SPDX-License-Identifier: MIT */
+/* Flat C entry point over the integer detector (lidet_detector_q.h) for the Python bindings
+ * (tools/lidet_tools/native_q.py: detect_q). Host only: one static detector (not reentrant); each call
+ * initialises it. */
+#include <string.h>
+
+#include "lidet/lidet.h"
+#include "lidet/lidet_detector_q.h"
+#include "lidet_weights.h"
+
+#if defined(_WIN32)
+#define LIDET_PY_API __declspec(dllexport)
+#else
+#define LIDET_PY_API __attribute__((visibility("default")))
+#endif
+
+static lidet_detector_q_t g_detq;
+
+/* icfg: crop_half_bam, max_range_mm, nms_iou_q15, max_proposals (0 = default), gate1, gate2.
+ * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
+ * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 12 uint32 (the
+ * counts of lidet_detector_q_stats_t in order). Returns the run's status. */
+LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, const char *box_name,
+                                   const int32_t *icfg, const int32_t *pts_mm, uint32_t n, uint32_t stride,
+                                   int32_t *out_det, uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters,
+                                   uint32_t *out_stats)
+{
+    const lidet_sensor_q_t *s = lidet_sensor_q_find(sensor);
+    const lidet_pointnet_q_model_t *mc, *mb;
+    lidet_detector_q_cfg_t cfg;
+    const lidet_detection_q_t *d;
+    const lidet_detector_q_stats_t *st;
+    const uint8_t *oc;
+    uint32_t k;
+    int rc;
+    if (s == NULL || icfg == NULL || out_det == NULL || n_det == NULL || out_outcome == NULL || n_clusters == NULL ||
+        out_stats == NULL)
+    {
+        return s == NULL ? LIDET_ERR_NOT_FOUND : LIDET_ERR_ARG;
+    }
+    mc = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, cls_name);
+    mb = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, box_name);
+    if (mc == NULL || mb == NULL)
+    {
+        return LIDET_ERR_NOT_FOUND;
+    }
+    lidet_detector_q_cfg_default(&cfg, s);
+    cfg.crop_half_bam = icfg[0];
+    cfg.max_range_mm = icfg[1];
+    cfg.nms_iou_q15 = icfg[2];
+    if (icfg[3] != 0)
+    {
+        cfg.max_proposals = (uint32_t)icfg[3];
+    }
+    cfg.gate1 = (uint8_t)icfg[4];
+    cfg.gate2 = (uint8_t)icfg[5];
+    rc = lidet_detector_q_init(&g_detq, &cfg, mc, mb);
+    if (rc != LIDET_OK)
+    {
+        return rc;
+    }
+    rc = lidet_detector_q_run(&g_detq, pts_mm, n, stride, NULL, NULL);
+    if (rc < 0)
+    {
+        return rc;
+    }
+    d = lidet_detector_q_detections(&g_detq, n_det);
+    for (k = 0; k < *n_det; ++k)
+    {
+        int32_t *o = out_det + 13u * k;
+        o[0] = d[k].cls;
+        o[1] = d[k].score_q15;
+        o[2] = d[k].energy_cls_q16;
+        o[3] = d[k].energy_box_q16;
+        o[4] = d[k].box.cx_mm;
+        o[5] = d[k].box.cy_mm;
+        o[6] = d[k].box.cz_mm;
+        o[7] = d[k].box.l_mm;
+        o[8] = d[k].box.w_mm;
+        o[9] = d[k].box.h_mm;
+        o[10] = d[k].box.yaw_bam;
+        o[11] = d[k].cluster_id;
+        o[12] = (int32_t)d[k].n_points;
+    }
+    oc = lidet_detector_q_outcomes(&g_detq, n_clusters);
+    memcpy(out_outcome, oc, *n_clusters);
+    st = lidet_detector_q_stats(&g_detq);
+    {
+        const uint32_t v[12] = {st->n_clusters,     st->n_out_of_crop,    st->n_out_of_range,   st->n_over_budget,
+                                st->n_classified,   st->n_gate1_rejected, st->n_boxed,          st->n_gate2_rejected,
+                                st->n_size_rejected, st->n_nms_suppressed, st->n_over_capacity, st->n_detections};
+        memcpy(out_stats, v, sizeof v);
+    }
+    return rc;
+}
+
+LIDET_PY_API uint32_t lidet_py_detq_bytes(void)
+{
+    return lidet_detector_q_bytes();
+}
