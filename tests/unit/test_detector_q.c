@@ -1,0 +1,232 @@
+/* SPDX-License-Identifier: MIT */
+/* Unity tests of the integer detector (lib/src/lidet_detector_q.c) with the generated int8 models on the
+ * shipped simulated VLP-16 scan (converted to millimetres here): init errors, the run's invariants (score
+ * order, size limits, outcomes adding up to the counts), the crop and the budget, determinism, canaries,
+ * and bad points (integer limits, zero range, rings out of range). Agreement with the float detector and the
+ * bit-exact reference are tested in tests/python/test_detector_q.py. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "lidet/lidet.h"
+#include "lidet/lidet_detector_q.h"
+#include "lidet_weights.h"
+#include "test_util.h"
+
+LIDET_GUARDED(lidet_detector_q_t, g);
+
+#define MAX_PTS 60000
+static int32_t pts[MAX_PTS * 3];
+static uint32_t n_pts;
+static const lidet_pointnet_q_model_t *m_cls, *m_box;
+static const lidet_sensor_q_t *sensor;
+
+static void load_scan(void)
+{
+    static float raw[MAX_PTS * 4];
+    FILE *f = fopen(LIDET_SOURCE_DIR "/tests/data/sim_vlp16/velodyne/000000.bin", "rb");
+    size_t n, i;
+    TEST_ASSERT_NOT_NULL(f);
+    n = fread(raw, 4 * sizeof(float), MAX_PTS, f);
+    fclose(f);
+    TEST_ASSERT_TRUE(n > 1000);
+    for (i = 0; i < 3 * n; ++i)
+    {
+        const float v = raw[4 * (i / 3) + i % 3] * 1000.0f;
+        pts[i] = (int32_t)(v >= 0.0f ? v + 0.5f : v - 0.5f);
+    }
+    n_pts = (uint32_t)n;
+}
+
+void setUp(void)
+{
+    sensor = lidet_sensor_q_find("vlp16");
+    m_cls = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, "cls_vlp16_s8");
+    m_box = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, "box_vlp16_s8");
+    if (n_pts == 0)
+    {
+        load_scan();
+    }
+}
+
+void tearDown(void)
+{
+}
+
+static lidet_status_t init_default(lidet_detector_q_cfg_t *cfg)
+{
+    lidet_detector_q_cfg_default(cfg, sensor);
+    return lidet_detector_q_init(&g.ws, cfg, m_cls, m_box);
+}
+
+static void test_init_errors(void)
+{
+    lidet_detector_q_cfg_t cfg;
+    TEST_ASSERT_NOT_NULL(sensor);
+    TEST_ASSERT_NOT_NULL(m_cls);
+    TEST_ASSERT_NOT_NULL(m_box);
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_init(NULL, &cfg, m_cls, m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_init(&g.ws, NULL, m_cls, m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_init(&g.ws, &cfg, NULL, m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_q_init(&g.ws, &cfg, m_box, m_cls)); /* kinds swapped */
+    cfg.nms_iou_q15 = 32769;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.max_proposals = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.size.min_mm[0][0] = 9000; /* min above max */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.proposal.range_bin_4mm = 500; /* 2 m voxels: not what the models were trained with */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    /* a run before a successful init */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_run(NULL, pts, n_pts, 3, NULL, NULL));
+}
+
+static void check_invariants(const lidet_detector_q_cfg_t *cfg)
+{
+    uint32_t n, nc, i, counts[10] = {0};
+    const lidet_detection_q_t *d = lidet_detector_q_detections(&g.ws, &n);
+    const uint8_t *oc = lidet_detector_q_outcomes(&g.ws, &nc);
+    const lidet_detector_q_stats_t *st = lidet_detector_q_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(st->n_detections, n);
+    TEST_ASSERT_EQUAL_UINT32(st->n_clusters, nc);
+    for (i = 0; i < n; ++i)
+    {
+        TEST_ASSERT_TRUE(d[i].score_q15 > 0 && d[i].score_q15 <= 32768);
+        TEST_ASSERT_TRUE(lidet_size_ok_q(&cfg->size, d[i].cls, &d[i].box));
+        TEST_ASSERT_TRUE(d[i].cluster_id >= 1 && d[i].cluster_id <= nc);
+        TEST_ASSERT_EQUAL_UINT8(LIDET_DET_OUT_DETECTED, oc[d[i].cluster_id - 1u]);
+        if (cfg->gate1)
+        {
+            TEST_ASSERT_TRUE(d[i].energy_cls_q16 < m_cls->gamma_q16[d[i].cls]);
+        }
+        if (i > 0)
+        {
+            TEST_ASSERT_TRUE(d[i - 1].score_q15 > d[i].score_q15 ||
+                             (d[i - 1].score_q15 == d[i].score_q15 && d[i - 1].cluster_id < d[i].cluster_id));
+        }
+    }
+    for (i = 0; i < nc; ++i)
+    {
+        TEST_ASSERT_TRUE(oc[i] >= 1 && oc[i] <= 9);
+        ++counts[oc[i]];
+    }
+    TEST_ASSERT_EQUAL_UINT32(st->n_out_of_crop, counts[LIDET_DET_OUT_CROP]);
+    TEST_ASSERT_EQUAL_UINT32(st->n_out_of_range, counts[LIDET_DET_OUT_RANGE]);
+    TEST_ASSERT_EQUAL_UINT32(st->n_over_budget, counts[LIDET_DET_OUT_BUDGET]);
+    TEST_ASSERT_EQUAL_UINT32(st->n_gate1_rejected, counts[LIDET_DET_OUT_GATE1]);
+    TEST_ASSERT_EQUAL_UINT32(st->n_gate2_rejected, counts[LIDET_DET_OUT_GATE2]);
+    TEST_ASSERT_EQUAL_UINT32(st->n_size_rejected, counts[LIDET_DET_OUT_SIZE]);
+    TEST_ASSERT_EQUAL_UINT32(st->n_nms_suppressed, counts[LIDET_DET_OUT_NMS]);
+    TEST_ASSERT_EQUAL_UINT32(n, counts[LIDET_DET_OUT_DETECTED]);
+    TEST_ASSERT_EQUAL_UINT32(st->n_classified, st->n_gate1_rejected + st->n_boxed);
+}
+
+static void test_run_invariants_and_determinism(void)
+{
+    static lidet_detection_q_t first[LIDET_MAX_DETECTIONS];
+    lidet_detector_q_cfg_t cfg;
+    uint32_t n1, n2;
+    CANARY_FILL(g);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, init_default(&cfg));
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL)));
+    check_invariants(&cfg);
+    memcpy(first, lidet_detector_q_detections(&g.ws, &n1), sizeof first);
+    TEST_ASSERT_TRUE(n1 >= 3); /* the sample holds cars and pedestrians the float detector finds */
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL)));
+    TEST_ASSERT_EQUAL_MEMORY(first, lidet_detector_q_detections(&g.ws, &n2), n1 * sizeof first[0]);
+    TEST_ASSERT_EQUAL_UINT32(n1, n2);
+    CANARY_CHECK(g);
+}
+
+static void test_crop_and_budget(void)
+{
+    lidet_detector_q_cfg_t cfg;
+    uint32_t n, i, all;
+    const lidet_detection_q_t *d;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, init_default(&cfg));
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL)));
+    all = lidet_detector_q_stats(&g.ws)->n_clusters;
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.crop_half_bam = 1 << 29; /* 45 degrees */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL)));
+    check_invariants(&cfg);
+    TEST_ASSERT_TRUE(lidet_detector_q_stats(&g.ws)->n_out_of_crop > all / 2u);
+    d = lidet_detector_q_detections(&g.ws, &n);
+    for (i = 0; i < n; ++i) /* the window is on the cluster mean; a box centre stays close to it */
+    {
+        TEST_ASSERT_TRUE(d[i].box.cx_mm > 0);
+        TEST_ASSERT_TRUE(abs(d[i].box.cy_mm) <= d[i].box.cx_mm + 2000);
+    }
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.max_proposals = 3;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL));
+    check_invariants(&cfg);
+    TEST_ASSERT_EQUAL_UINT32(3u, lidet_detector_q_stats(&g.ws)->n_classified);
+    TEST_ASSERT_EQUAL_UINT32(all - 3u, lidet_detector_q_stats(&g.ws)->n_over_budget);
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.gate1 = 0;
+    cfg.gate2 = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL)));
+    check_invariants(&cfg);
+    TEST_ASSERT_EQUAL_UINT32(all, lidet_detector_q_stats(&g.ws)->n_boxed);
+}
+
+static void test_bad_points(void)
+{
+    static int32_t bad[3 * 4000];
+    static uint16_t ring[4000];
+    lidet_detector_q_cfg_t cfg;
+    uint32_t i, n;
+    lidet_status_t s;
+    for (i = 0; i < 4000u; ++i)
+    {
+        const int32_t v[6] = {INT32_MAX, INT32_MIN, 0, 131000, -131001, 1};
+        bad[3 * i] = v[i % 6u];
+        bad[3 * i + 1] = v[(i / 6u) % 6u];
+        bad[3 * i + 2] = v[(i / 36u) % 6u];
+        ring[i] = (uint16_t)(i * 7919u);
+    }
+    CANARY_FILL(g);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, init_default(&cfg));
+    s = lidet_detector_q_run(&g.ws, bad, 4000, 3, NULL, NULL);
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(s));
+    s = lidet_detector_q_run(&g.ws, bad, 4000, 3, ring, NULL);
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(s));
+    TEST_ASSERT_TRUE(lidet_detector_q_stats(&g.ws)->proj.n_bad_ring > 0u);
+    s = lidet_detector_q_run(&g.ws, bad, 0, 3, NULL, NULL); /* empty scan */
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(s));
+    lidet_detector_q_detections(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(0u, n);
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_run(&g.ws, bad, 10, 2, NULL, NULL)); /* stride < 3 */
+    CANARY_CHECK(g);
+}
+
+static void test_score(void)
+{
+    TEST_ASSERT_EQUAL_INT32(16384, lidet_detector_q_score(-5 * 65536, -5 * 65536));
+    TEST_ASSERT_TRUE(lidet_detector_q_score(-9 * 65536, -5 * 65536) > 32000);
+    TEST_ASSERT_TRUE(lidet_detector_q_score(-1 * 65536, -5 * 65536) < 700);
+    TEST_ASSERT_TRUE(lidet_detector_q_score(-6 * 65536, -5 * 65536) > lidet_detector_q_score(-4 * 65536, -5 * 65536));
+    TEST_ASSERT_EQUAL_INT32(0, lidet_detector_q_score(INT32_MAX, INT32_MIN));
+    TEST_ASSERT_EQUAL_INT32(32768, lidet_detector_q_score(INT32_MIN, INT32_MAX));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_init_errors);
+    RUN_TEST(test_run_invariants_and_determinism);
+    RUN_TEST(test_crop_and_budget);
+    RUN_TEST(test_bad_points);
+    RUN_TEST(test_score);
+    return UNITY_END();
+}
