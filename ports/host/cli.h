@@ -73,6 +73,11 @@ int cli_project(int argc, char **argv);
 int cli_ground(int argc, char **argv);
 int cli_cluster(int argc, char **argv);
 int cli_detect(int argc, char **argv);
+/* `lidet detect --fixed` (cli_detect_q.c): the scan through the integer detector, results as float detections;
+ * ms: LIDET_DET_N_STAGES + 1 medians; point_ground / point_cluster optional (n_points entries). */
+int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, const char *family,
+                     lidet_detection_t *det, uint32_t *n_det, lidet_detector_stats_t *ds, double *ms,
+                     uint8_t *point_ground, uint32_t *point_cluster, lidet_status_t *status);
 
 #define M_PI_D 3.14159265358979323846
 

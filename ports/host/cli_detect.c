@@ -434,6 +434,8 @@ static void usage_extra(void)
                     "  --kitti-out FILE label_2 lines in the camera frame (2D box from the projected corners)\n"
                     "  --gt FILE        ground-truth boxes (lidet's sensor-frame lines) drawn in --png\n"
                     "  --gt-kitti FILE  ground truth as KITTI label_2 (with --calib) drawn in --png\n"
+                    "  --fixed          the integer detector (lidet_detector_q.h: int8 models, no float; the scan\n"
+                    "                   converted to millimetres); the same outputs\n"
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
                     "                   nms_iou, max_proposals, gate1, gate2; stages.cluster.KEY: a\n"
                     "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
@@ -485,7 +487,9 @@ int cli_detect(int argc, char **argv)
     char chosen[64];
     char **rest;
     const char **sets;
-    int nrest = 0, nsets = 0, i, crop = 0;
+    int nrest = 0, nsets = 0, i, crop = 0, fixed = 0;
+    static lidet_detection_t det_q[LIDET_MAX_DETECTIONS];
+    static lidet_detector_stats_t ds_q;
     double *t, ms[LIDET_DET_N_STAGES + 1];
     uint32_t n_det = 0, k;
     int32_t *pp = NULL;
@@ -515,6 +519,8 @@ int cli_detect(int argc, char **argv)
             sets[nsets++] = argv[++i];
         else if (strcmp(argv[i], "--crop") == 0)
             crop = 1;
+        else if (strcmp(argv[i], "--fixed") == 0)
+            fixed = 1;
         else
             rest[nrest++] = argv[i];
     }
@@ -557,6 +563,21 @@ int cli_detect(int argc, char **argv)
         }
     }
     free(sets);
+    if (fixed)
+    {
+        /* the integer detector; per-point ground labels for the picture come with it */
+        uint32_t np = a.n_points < LIDET_MAX_POINTS ? a.n_points : LIDET_MAX_POINTS;
+        gp = (uint8_t *)malloc((size_t)np + 1u);
+        if (gp == NULL || cli_detect_q_run(&a, &cfg, chosen, det_q, &n_det, &ds_q, ms, gp, NULL, &st) != 0)
+        {
+            free(gp);
+            cli_free(&a);
+            return 1;
+        }
+        ds = &ds_q;
+        det = det_q;
+        goto outputs;
+    }
     cfg.clock = clock_ns;
     st = lidet_detector_init(&g_det, &cfg, mc, mb);
     if (st != LIDET_OK)
@@ -592,6 +613,7 @@ int cli_detect(int argc, char **argv)
     ds = lidet_detector_stats(&g_det);
     det = lidet_detector_detections(&g_det, &n_det);
 
+outputs:
     if (a.out_path != NULL)
     {
         FILE *f = fopen(a.out_path, "w");
@@ -637,9 +659,12 @@ int cli_detect(int argc, char **argv)
         calib_t gcal;
         uint32_t n_gt = 0, np = a.n_points < LIDET_MAX_POINTS ? a.n_points : LIDET_MAX_POINTS;
         uint32_t *ids = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(np + 1u));
-        gp = (uint8_t *)malloc((size_t)np + 1u);
+        if (gp == NULL)
+            gp = (uint8_t *)malloc((size_t)np + 1u);
+        else
+            fixed = 2; /* the integer run filled gp */
         if (ids == NULL || gp == NULL ||
-            lidet_workspace_point_labels(lidet_detector_workspace(&g_det), pp, np, ids, gp) != LIDET_OK ||
+            (fixed != 2 && lidet_workspace_point_labels(lidet_detector_workspace(&g_det), pp, np, ids, gp) != LIDET_OK) ||
             (gt_path != NULL && read_gt(gt_path, &gt, &n_gt) != 0) ||
             (gt_kitti_path != NULL && (read_calib(calib_path, &gcal) != 0 ||
                                        read_gt_kitti(gt_kitti_path, &gcal, &gt, &n_gt) != 0)) ||

@@ -1,0 +1,151 @@
+/* SPDX-License-Identifier: MIT */
+/* `lidet detect --fixed`: the same scan through the integer detector (lidet_detector_q.h). The scan is
+ * converted to int32 millimetres (rounded half away from zero, as a driver delivering millimetres gives),
+ * the float configuration after --crop/--set to the integer one, and the integer detections back to
+ * lidet_detection_t for the CLI's outputs (lines, KITTI label_2, picture, JSON). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+#include "lidet/lidet_detector_q.h"
+#include "lidet_weights.h"
+
+static lidet_detector_q_t g_detq;
+
+static uint32_t clock_ns_q(void *ctx)
+{
+    (void)ctx;
+    return (uint32_t)(cli_now_ms() * 1e6);
+}
+
+static int32_t round_i32(double v)
+{
+    return (int32_t)(v >= 0.0 ? v + 0.5 : v - 0.5);
+}
+
+int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, const char *family,
+                     lidet_detection_t *det, uint32_t *n_det, lidet_detector_stats_t *ds, double *ms,
+                     uint8_t *point_ground, uint32_t *point_cluster, lidet_status_t *status)
+{
+    const double bam_per_rad = 4294967296.0 / (2.0 * M_PI_D);
+    const lidet_sensor_q_t *s = lidet_sensor_q_find(a->sensor);
+    const lidet_pointnet_q_model_t *mc, *mb;
+    const lidet_detection_q_t *dq;
+    const lidet_detector_q_stats_t *st;
+    lidet_detector_q_cfg_t cfg;
+    char name[80];
+    uint32_t np = a->n_points < LIDET_MAX_POINTS ? a->n_points : LIDET_MAX_POINTS, k;
+    int32_t *pts, *pp;
+    double *t;
+    int i;
+    if (s == NULL)
+    {
+        fprintf(stderr, "lidet detect --fixed: no integer profile for sensor '%s'\n", a->sensor);
+        return 1;
+    }
+    snprintf(name, sizeof name, "cls_%s_s8", family);
+    mc = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, name);
+    snprintf(name, sizeof name, "box_%s_s8", family);
+    mb = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, name);
+    if (mc == NULL || mb == NULL)
+    {
+        fprintf(stderr, "lidet detect --fixed: no int8 models cls_%s_s8 / box_%s_s8 in weights/\n", family, family);
+        return 1;
+    }
+    lidet_detector_q_cfg_default(&cfg, s);
+    cfg.crop_half_bam = fcfg->crop_half_rad >= (float)M_PI_D ? 0x7FFFFFFF
+                                                             : round_i32((double)fcfg->crop_half_rad * bam_per_rad);
+    cfg.max_range_mm = round_i32((double)fcfg->max_range_m * 1000.0);
+    cfg.max_proposals = fcfg->max_proposals;
+    cfg.gate1 = fcfg->gate1;
+    cfg.gate2 = fcfg->gate2;
+    cfg.nms_iou_q15 = round_i32((double)fcfg->nms_iou * 32768.0);
+    cfg.clock = clock_ns_q;
+    *status = lidet_detector_q_init(&g_detq, &cfg, mc, mb);
+    if (*status != LIDET_OK)
+    {
+        fprintf(stderr, "lidet detect --fixed: init (configuration or models): %s\n", lidet_status_str(*status));
+        return 1;
+    }
+    pts = (int32_t *)malloc(sizeof(int32_t) * 3u * (size_t)(np + 1u));
+    pp = (int32_t *)malloc(sizeof(int32_t) * LIDET_MAX_POINTS);
+    t = (double *)malloc(sizeof(double) * (size_t)a->repeat * (LIDET_DET_N_STAGES + 1u));
+    if (pts == NULL || pp == NULL || t == NULL)
+    {
+        free(pts);
+        free(pp);
+        free(t);
+        return 1;
+    }
+    for (k = 0; k < np; ++k)
+    {
+        /* clamped to the int32 range first: a 1e19 m point must stay a (rejected) huge value, not UB */
+        for (i = 0; i < 3; ++i)
+        {
+            const double v = (double)a->points[4u * k + (uint32_t)i] * 1000.0;
+            pts[3u * k + (uint32_t)i] = v != v ? 0 : (v > 2.0e9 ? 2000000000 : (v < -2.0e9 ? -2000000000 : round_i32(v)));
+        }
+    }
+    for (i = 0; i < a->repeat; ++i)
+    {
+        const double t0 = cli_now_ms();
+        *status = lidet_detector_q_run(&g_detq, pts, np, 3, a->ring, i == 0 ? pp : NULL);
+        t[(size_t)LIDET_DET_N_STAGES * (size_t)a->repeat + (size_t)i] = cli_now_ms() - t0;
+        if (!LIDET_SUCCEEDED(*status))
+        {
+            fprintf(stderr, "lidet detect --fixed: %s\n", lidet_status_str(*status));
+            free(pts);
+            free(pp);
+            free(t);
+            return 1;
+        }
+        st = lidet_detector_q_stats(&g_detq);
+        for (k = 0; k < LIDET_DET_N_STAGES; ++k)
+            t[(size_t)k * (size_t)a->repeat + (size_t)i] = (double)st->ticks[k] * 1e-6;
+    }
+    for (k = 0; k <= LIDET_DET_N_STAGES; ++k)
+        ms[k] = cli_median(t + (size_t)k * (size_t)a->repeat, a->repeat);
+    free(t);
+    st = lidet_detector_q_stats(&g_detq);
+    memset(ds, 0, sizeof *ds);
+    ds->n_clusters = st->n_clusters;
+    ds->n_out_of_crop = st->n_out_of_crop;
+    ds->n_out_of_range = st->n_out_of_range;
+    ds->n_over_budget = st->n_over_budget;
+    ds->n_classified = st->n_classified;
+    ds->n_gate1_rejected = st->n_gate1_rejected;
+    ds->n_boxed = st->n_boxed;
+    ds->n_gate2_rejected = st->n_gate2_rejected;
+    ds->n_size_rejected = st->n_size_rejected;
+    ds->n_nms_suppressed = st->n_nms_suppressed;
+    ds->n_over_capacity = st->n_over_capacity;
+    ds->n_detections = st->n_detections;
+    dq = lidet_detector_q_detections(&g_detq, n_det);
+    for (k = 0; k < *n_det; ++k)
+    {
+        det[k].box.cx_m = (float)(dq[k].box.cx_mm * 1e-3);
+        det[k].box.cy_m = (float)(dq[k].box.cy_mm * 1e-3);
+        det[k].box.cz_m = (float)(dq[k].box.cz_mm * 1e-3);
+        det[k].box.l_m = (float)(dq[k].box.l_mm * 1e-3);
+        det[k].box.w_m = (float)(dq[k].box.w_mm * 1e-3);
+        det[k].box.h_m = (float)(dq[k].box.h_mm * 1e-3);
+        det[k].box.yaw_rad = (float)(dq[k].box.yaw_bam / bam_per_rad);
+        det[k].cls = dq[k].cls;
+        det[k].score = (float)(dq[k].score_q15 / 32768.0);
+        det[k].energy_cls = (float)(dq[k].energy_cls_q16 / 65536.0);
+        det[k].energy_box = (float)(dq[k].energy_box_q16 / 65536.0);
+        det[k].cluster_id = dq[k].cluster_id;
+        det[k].n_points = dq[k].n_points;
+    }
+    for (k = 0; k < np; ++k)
+    {
+        const int32_t p = pp[k];
+        if (point_ground != NULL)
+            point_ground[k] = p >= 0 ? g_detq.mask[p] : 0u;
+        if (point_cluster != NULL)
+            point_cluster[k] = p >= 0 ? g_detq.labels[p] : 0u;
+    }
+    free(pts);
+    free(pp);
+    return 0;
+}
