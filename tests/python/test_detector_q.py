@@ -133,3 +133,55 @@ def test_score_matches_the_float_definition(nq):
         s = L.lidet_detector_q_score(int(round(e * 65536)), g) / 32768.0
         assert abs(s - 1.0 / (1.0 + math.exp(e + 8))) < 2e-4
     assert L.lidet_detector_q_score(g, g) == 16384
+
+
+# ---- the integer detector against the chained numpy reference, bit for bit ---------------------------
+
+def _ref_detect(nq, pts_mm, sensor):
+    import json
+    from lidet_codegen import emit as E
+    from lidet_codegen import quant as QU
+    from lidet_codegen.ref import detector_q as RD, post_q, proj_q
+    from lidet_tools import native, sensors
+    s = sensors.get_sensor(sensor)
+    tab = proj_q.init(s.beam_elev_urad, s.cols, fov_margin_urad=87266, fov_urad=s.fov_urad)
+    models = {}
+    for kind in ("cls", "box"):
+        name = f"{kind}_{sensor}"
+        calib = json.loads((ROOT / "weights" / f"{name}.calib.json").read_text())
+        models[kind] = QU.quantize(E.load(ROOT / "weights" / f"{name}.onnx", name), calib)
+    cc, pc = nq.cluster_q_defaults(sensor)
+    cap = native.capacity()
+    det_cfg = dict(crop_half_bam=0, max_range_mm=0, max_proposals=min(128 if s.rows <= 16 else 256, cap["max_clusters"]),
+                   gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM)
+    return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
+                     det_cfg, models["cls"], models["box"], cap["max_clusters"], cap["max_detections"],
+                     cap["max_points"])
+
+
+@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real"])
+def test_bit_exact_with_the_chained_reference(nq, which, request):
+    sensor = "vlp16"
+    if which == "sample":
+        pts = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin")
+    elif which == "fresh":
+        from lidet_tools.sim.simulate import simulate_scan
+        pts = simulate_scan("vlp16", seed=9200, index=0).points
+    elif which == "hdl64":
+        sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
+    else:
+        real = request.getfixturevalue("real_dir")
+        sensor, pts = "hdl64", _load(real / "kitti/training/velodyne/000001.bin")
+    mm = nq.to_mm(pts)
+    c = nq.detect_q(mm, sensor)
+    r = _ref_detect(nq, mm, sensor)
+    assert c["outcome"].tolist() == r["outcome"]
+    for k in ("n_clusters", "n_classified", "n_gate1_rejected", "n_boxed", "n_gate2_rejected", "n_size_rejected",
+              "n_nms_suppressed", "n_detections"):
+        assert c["stats"][k] == r["stats"][k], k
+    assert len(r["detections"]) == len(c["cls"]) > 0
+    for i, d in enumerate(r["detections"]):
+        assert d["cls"] == c["cls"][i] and d["cluster_id"] == c["cluster_id"][i]
+        assert d["score_q15"] == c["score_q15"][i]
+        assert d["energy_cls_q16"] == c["energy_cls_q16"][i] and d["energy_box_q16"] == c["energy_box_q16"][i]
+        assert d["box"] == c["boxes"][i].tolist()

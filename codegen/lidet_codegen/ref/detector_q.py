@@ -1,0 +1,107 @@
+# SPDX-License-Identifier: MIT
+"""The integer detector, bit for bit as lib/src/lidet_detector_q.c: the integer stages' references chained
+(proj_q -> ground_q -> cluster_q -> proposals -> pointnet_q -> post_q) with the detector's own rules (the
+candidate window, range and order, the budget, the gates, the size check, the score and the NMS).
+
+Configurations are the C structs' fields as dicts (tests read the C defaults through the bindings); models are
+the quantized models of lidet_codegen.quant (the same the C descriptors are generated from).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from lidet_codegen.ref import cluster_q, ground_q, pointnet_q, post_q, proj_q, qmath
+
+OUT_CROP, OUT_RANGE, OUT_BUDGET, OUT_GATE1, OUT_GATE2, OUT_SIZE, OUT_NMS, OUT_CAPACITY, OUT_DETECTED = range(1, 10)
+
+
+def score_q15(energy_q16: int, gamma_q16: int) -> int:
+    """1 / (1 + exp(E - gamma)) in Q15 (lidet_detector_q_score)."""
+    t = int(energy_q16) - int(gamma_q16)
+    e = 1 << 30 if t == 0 else int(pointnet_q._exp_neg(np.array([abs(t)], np.int64))[0])
+    one = 1 << 30
+    return (e << 15) // (one + e) if t >= 0 else (one << 15) // (one + e)
+
+
+def candidates(recs, det_cfg: dict, outcome: list) -> tuple[list, bool]:
+    """Kept clusters in the azimuth window and range, nearest first (ties: lower index), at most max_proposals."""
+    h = int(det_cfg["crop_half_bam"])
+    cs = int(qmath.sin(h)) if h > 0 else 0
+    cc = int(qmath.cos(h)) if h > 0 else 0
+    mr = int(det_cfg["max_range_mm"])
+    cand = []
+    for i, r in enumerate(recs):
+        x, y = int(r.mean[0]), int(r.mean[1])
+        r2 = x * x + y * y
+        if h > 0 and not (x * cs >= abs(y) * cc):
+            outcome[i] = OUT_CROP
+            continue
+        if mr > 0 and 16 * r2 > mr * mr:
+            outcome[i] = OUT_RANGE
+            continue
+        cand.append((r2, i))
+    cand.sort()
+    truncated = len(cand) > det_cfg["max_proposals"]
+    for _, i in cand[det_cfg["max_proposals"]:]:
+        outcome[i] = OUT_BUDGET
+    return [i for _, i in cand[: det_cfg["max_proposals"]]], truncated
+
+
+def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, proposal_cfg: dict, det_cfg: dict,
+           cls_model, box_model, max_clusters: int, max_detections: int, max_points: int) -> dict:
+    """The whole integer detector on (N, 3) int32 mm points. det_cfg: crop_half_bam, max_range_mm, max_proposals,
+    gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max. Returns detections (dicts), outcomes, stats."""
+    pj = proj_q.project(points_mm, tab, proj_cfg["min_range_mm"], proj_cfg["max_range_mm"], max_points=max_points)
+    rows, cols = tab.rows, tab.cols
+    X, Y, Z, R = (np.asarray(pj[k], np.int64).reshape(rows, cols) for k in ("x_4mm", "y_4mm", "z_4mm", "range_4mm"))
+    mask, _, planes, _, _, _ = ground_q.ground(X, Y, Z, ground_cfg)
+    ns = int(ground_cfg["n_sectors"])
+    labels, members, recs, _ = cluster_q.cluster_q_ref(X, Y, Z, R, tab.row_elev_bam, mask, planes[:ns], cluster_cfg,
+                                                      max_clusters)
+    pcfg = dict(proposal_cfg, n_points=int(cls_model.n_points))
+    outcome = [0] * len(recs)
+    order, truncated = candidates(recs, det_cfg, outcome)
+    stats = dict(n_clusters=len(recs), n_classified=0, n_gate1_rejected=0, n_boxed=0, n_gate2_rejected=0,
+                 n_size_rejected=0, n_nms_suppressed=0, n_over_capacity=0)
+    dets = []
+    for ci in order:
+        xyz, mean, vox = cluster_q.make_proposal_q(recs[ci], members, X, Y, Z, pcfg)
+        c = pointnet_q.classify(cls_model, xyz[None].astype(np.int64), mean[None], vox[None])
+        cls, energy = int(c["cls"][0]), int(c["energy"][0])
+        stats["n_classified"] += 1
+        if det_cfg["gate1"] and not bool(c["passed"][0]):
+            outcome[ci] = OUT_GATE1
+            stats["n_gate1_rejected"] += 1
+            continue
+        b = pointnet_q.box(box_model, xyz[None].astype(np.int64), mean[None], vox[None], cls)
+        stats["n_boxed"] += 1
+        if det_cfg["gate2"] and not bool(b["passed"][0]):
+            outcome[ci] = OUT_GATE2
+            stats["n_gate2_rejected"] += 1
+            continue
+        box = [int(v) for v in b["box"][0]]
+        if not post_q.size_ok(cls, box, det_cfg["size_min"], det_cfg["size_max"]):
+            outcome[ci] = OUT_SIZE
+            stats["n_size_rejected"] += 1
+            continue
+        d = dict(box=box, cls=cls, score_q15=score_q15(energy, cls_model.gamma_q16[cls]), energy_cls_q16=energy,
+                 energy_box_q16=int(b["energy"][0]), cluster_id=ci + 1, n_points=recs[ci].n_points)
+        # the detector's insertion: after every entry with a higher score or an equal score and a lower id
+        k = len(dets)
+        while k > 0 and (dets[k - 1]["score_q15"] < d["score_q15"] or
+                         (dets[k - 1]["score_q15"] == d["score_q15"] and dets[k - 1]["cluster_id"] > d["cluster_id"])):
+            k -= 1
+        dets.insert(k, d)
+        outcome[ci] = OUT_DETECTED
+        if len(dets) > max_detections:
+            gone = dets.pop()
+            outcome[gone["cluster_id"] - 1] = OUT_CAPACITY
+            stats["n_over_capacity"] += 1
+            truncated = True
+    kept, flags = post_q.nms(dets, int(det_cfg["nms_iou_q15"]))
+    for d, f in zip(dets, flags):
+        if f:
+            outcome[d["cluster_id"] - 1] = OUT_NMS
+            stats["n_nms_suppressed"] += 1
+    stats["n_detections"] = len(kept)
+    return dict(detections=kept, outcome=outcome, stats=stats, truncated=truncated)
