@@ -29,8 +29,17 @@ set(fw_src ${PROJECT_SOURCE_DIR}/ports/firmware)
 # ---- the host references: one per sensor configuration (ports/firmware/config/<sensor>) ------------
 file(GLOB fw_weights_sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/weights/*.c)
 function(lidet_fw_host_ref sensor exe)
+  # optional third argument FIXED: the integer-only build (the integer detector, int8 models, the scan in mm)
   set(lib lidet_fwcap_${sensor})
-  add_library(${lib} STATIC ${LIDET_SOURCES} ${fw_weights_sources})
+  set(srcs ${LIDET_SOURCES} ${fw_weights_sources})
+  set(mm "")
+  if(ARGV2 STREQUAL "FIXED")
+    set(lib lidet_fwcap_${sensor}_q)
+    file(GLOB s8_weights CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/weights/*_s8*.c)
+    set(srcs ${LIDET_FIXED_SOURCES} ${s8_weights})
+    set(mm --mm)
+  endif()
+  add_library(${lib} STATIC ${srcs})
   set_target_properties(${lib} PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
   target_include_directories(${lib} PUBLIC ${PROJECT_SOURCE_DIR}/lib/include ${PROJECT_SOURCE_DIR}/weights
                                            ${fw_src}/config/${sensor} PRIVATE ${PROJECT_SOURCE_DIR}/lib/src)
@@ -38,14 +47,16 @@ function(lidet_fw_host_ref sensor exe)
   # the same numerics as the images: one rounding per operation, no errno, no AVX2 kernel clones
   target_compile_options(${lib} PRIVATE -Wall -Wextra -Wpedantic -Werror -Wdouble-promotion -fno-math-errno
                                         -ffp-contract=off)
-  if(LIDET_HAVE_LIBM)
+  if(ARGV2 STREQUAL "FIXED")
+    target_compile_definitions(${lib} PUBLIC LIDET_FIXED_POINT=1)
+  elseif(LIDET_HAVE_LIBM)
     target_link_libraries(${lib} PUBLIC m)
   endif()
-  set(scan_c ${CMAKE_CURRENT_BINARY_DIR}/fw_host_scan_${sensor}.c)
+  set(scan_c ${CMAKE_CURRENT_BINARY_DIR}/fw_host_scan_${exe}.c)
   set(data ${PROJECT_SOURCE_DIR}/tests/data/sim_${sensor})
   add_custom_command(OUTPUT ${scan_c}
     COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tools/firmware/scan_to_c.py ${data}/velodyne/000000.bin
-            --ring ${data}/ring/000000.bin --name tests/data/sim_${sensor}/000000 --out ${scan_c}
+            --ring ${data}/ring/000000.bin --name tests/data/sim_${sensor}/000000 --out ${scan_c} ${mm}
     DEPENDS ${PROJECT_SOURCE_DIR}/tools/firmware/scan_to_c.py ${data}/velodyne/000000.bin ${data}/ring/000000.bin
     VERBATIM)
   add_executable(${exe} ${fw_src}/fw_detect.c ${fw_src}/fw_host_port.c ${scan_c})
@@ -59,9 +70,10 @@ function(lidet_fw_host_ref sensor exe)
 endfunction()
 lidet_fw_host_ref(vlp16 fw_host_ref)
 lidet_fw_host_ref(hdl64 fw_host_ref_hdl64)
+lidet_fw_host_ref(vlp16 fw_host_ref_q FIXED)
 
 # ---- the images --------------------------------------------------------------------------------
-add_custom_target(firmware DEPENDS fw_host_ref fw_host_ref_hdl64)
+add_custom_target(firmware DEPENDS fw_host_ref fw_host_ref_hdl64 fw_host_ref_q)
 # image name | board | sensor | toolchain file | compiler | size tool. The HDL-64 (KITTI-like) images need ~4.5 MiB
 # of RAM: QEMU virt, and the AN500's Cortex-M7 with the detector placed in its 16 MiB PSRAM.
 set(fw_images
@@ -71,7 +83,11 @@ set(fw_images
     "mps2-an500|mps2-an500|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
     "mps2-an500-hdl64|mps2-an500|hdl64|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
     "virt-rv32imafc|virt-rv32imafc|vlp16|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size"
-    "virt-rv32imafc-hdl64|virt-rv32imafc|hdl64|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size")
+    "virt-rv32imafc-hdl64|virt-rv32imafc|hdl64|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size"
+    # the integer-only build (issue 16): cores without FPU, compared bit for bit with fw_host_ref_q
+    "mps2-an385-q|mps2-an385|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed"
+    "mps2-an385-m0plus-q|mps2-an385-m0plus|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed"
+    "virt-rv32imac-q|virt-rv32imac|vlp16|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size|fixed")
 foreach(entry IN LISTS fw_images)
   string(REPLACE "|" ";" f "${entry}")
   list(GET f 0 image)
@@ -80,7 +96,14 @@ foreach(entry IN LISTS fw_images)
   list(GET f 3 tc)
   list(GET f 4 cc)
   list(GET f 5 sz)
-  if(sensor STREQUAL "vlp16")
+  list(LENGTH f nf)
+  set(fixed OFF)
+  if(nf GREATER 6)
+    set(fixed ON)
+  endif()
+  if(fixed)
+    set(ref fw_host_ref_q)
+  elseif(sensor STREQUAL "vlp16")
     set(ref fw_host_ref)
   else()
     set(ref fw_host_ref_${sensor})
@@ -100,6 +123,7 @@ foreach(entry IN LISTS fw_images)
     BINARY_DIR ${bdir}
     CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/cmake/toolchains/${tc}.cmake
                -DLIDET_FW_BOARD=${board} -DLIDET_FW_SENSOR=${sensor} -DPython3_EXECUTABLE=${Python3_EXECUTABLE}
+               -DLIDET_FW_FIXED=${fixed}
     BUILD_ALWAYS ON
     INSTALL_COMMAND ""
     BUILD_BYPRODUCTS ${bdir}/lidet_fw.elf)

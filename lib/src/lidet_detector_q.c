@@ -262,8 +262,9 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
     t1 = now(d);
     st->ticks[LIDET_DET_STAGE_CLUSTER] = t1 - t0;
 
-    /* candidates, proposals, the networks */
-    t0 = t1;
+    /* candidates, proposals, the networks (the clock is called as the float detector calls it: a firmware that
+     * rebuilds 64-bit stage counts from the timestamps reads both the same way) */
+    t0 = now(d);
     st->n_clusters = d->cluster.n_recs;
     n_cand = candidates(d, &worst);
     for (i = 0; i < n_cand; ++i)
@@ -334,6 +335,7 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
     st->ticks[LIDET_DET_STAGE_BOX] = box_ticks;
 
     /* NMS: the outcome of each dropped detection, in score order */
+    t1 = now(d);
     {
         uint16_t ids[LIDET_MAX_DETECTIONS];
         const uint32_t n = d->n_det;

@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* The firmware application: the whole detector (lidet_detector.h) on the scan stored in flash (fw_scan.h)
+/* The firmware application: the whole detector (lidet_detector.h; the integer detector lidet_detector_q.h when
+ * built with LIDET_FIXED_POINT, on the scan in millimetres) on the scan stored in flash (fw_scan.h)
  * with the capacities of config/<FW_SENSOR>/lidet_user_config.h, twice: once with the default configuration
  * (gates and size checks as they are) and once with the gates and size checks off, so that many boxes reach
  * the output and the comparison with the host is not vacuous.
@@ -10,7 +11,9 @@
  *   stats run=R status=S clusters=... detections=D      the detector's counts
  *   det R k CLASS CLUSTER NPTS h0 .. h9 # readable      one detection: its cluster id and points, the float32
  *                                                       bits of score, cx, cy, cz, l, w, h, yaw, energy_cls,
- *                                                       energy_box (hex), then decimals for people
+ *                                                       energy_box (hex), then decimals for people; the
+ *                                                       integer build prints its int32 values (score Q15, mm,
+ *                                                       BAM32 yaw, Q16 energies) as 32-bit hex
  *   insn run=R project=.. ground=.. cluster=.. classify=.. box=.. post=.. scan=..   instructions per stage
  *   stack used=N size=S                                 stack high-water (painted at reset)
  *   lidet-fw: PASS | FAIL (...)
@@ -23,14 +26,26 @@
 #include "lidet/lidet_detector.h"
 #include "lidet/lidet_proj.h"
 #include "lidet_weights.h"
+#if LIDET_FIXED_POINT
+#include "lidet/lidet_detector_q.h"
+#endif
 
 /* The detector: ~1 MiB at the VLP-16 capacities (~4.4 MiB for HDL-64), in .bss. A board with several RAM banks
  * places it with a section attribute instead, e.g. -DLIDET_FW_DETECTOR_SECTION='".bss.sram2"' and a matching
  * output section in its linker script (docs/PORTING.md). */
-#ifdef LIDET_FW_DETECTOR_SECTION
-static lidet_detector_t g_det __attribute__((section(LIDET_FW_DETECTOR_SECTION)));
+#if LIDET_FIXED_POINT
+typedef lidet_detector_q_t fw_detector_t;
+typedef lidet_pointnet_q_model_t fw_model_t;
+#define FW_BUILD "fixed"
 #else
-static lidet_detector_t g_det;
+typedef lidet_detector_t fw_detector_t;
+typedef lidet_pn_model_t fw_model_t;
+#define FW_BUILD "float"
+#endif
+#ifdef LIDET_FW_DETECTOR_SECTION
+static fw_detector_t g_det __attribute__((section(LIDET_FW_DETECTOR_SECTION)));
+#else
+static fw_detector_t g_det;
 #endif
 
 static const char *const k_class_names[LIDET_N_CLASSES] = {"Car", "Cyclist", "Pedestrian"};
@@ -87,6 +102,7 @@ static void put_hex(uint32_t v)
         fw_putc("0123456789abcdef"[(v >> k) & 15u]);
 }
 
+#if !LIDET_FIXED_POINT
 static uint32_t bits(float f)
 {
     uint32_t u;
@@ -128,6 +144,8 @@ static void put_f(float f)
     fw_putc((char)('0' + frac % 10u));
 }
 
+#endif
+
 static void put_kv(const char *key, uint32_t v)
 {
     fw_putc(' ');
@@ -151,11 +169,17 @@ static void put_kv(const char *key, uint32_t v)
 #endif
 #define FW_XCAT(a, b) a##b
 #define FW_CAT(a, b) FW_XCAT(a, b)
-static const char *pick_models(const lidet_pn_model_t **cls, const lidet_pn_model_t **box)
+static const char *pick_models(const fw_model_t **cls, const fw_model_t **box)
 {
+#if LIDET_FIXED_POINT
+    *cls = &FW_CAT(FW_CAT(lidet_model_cls_, FW_SENSOR_ID), _s8);
+    *box = &FW_CAT(FW_CAT(lidet_model_box_, FW_SENSOR_ID), _s8);
+    return FW_SENSOR "_s8";
+#else
     *cls = &FW_CAT(lidet_model_cls_, FW_SENSOR_ID);
     *box = &FW_CAT(lidet_model_box_, FW_SENSOR_ID);
     return FW_SENSOR;
+#endif
 }
 
 /* ---- 64-bit stage counts ------------------------------------------------------------------------------ */
@@ -186,11 +210,13 @@ static uint32_t rec_clock(void *ctx)
     return (uint32_t)v;
 }
 
-/* -> 0 and out[] filled, or 1 when the recorded calls do not match the detector's order */
-static int rec_stages(const rec_t *r, const lidet_detector_stats_t *s, uint64_t out[LIDET_DET_N_STAGES])
+/* -> 0 and out[] filled, or 1 when the recorded calls do not match the detector's order (both detectors call
+ * the clock in the same order; s: their stats, which share the field names used here) */
+#define rec_stages(r, s, out) rec_stages_((r), (s)->n_boxed, (s)->ticks, (out))
+static int rec_stages_(const rec_t *r, uint32_t nb, const uint32_t *ticks, uint64_t out[LIDET_DET_N_STAGES])
 {
     uint64_t box = 0u;
-    uint32_t k, nb = s->n_boxed;
+    uint32_t k;
     if (r->n != 8u + 2u * nb || r->n > REC_MAX)
         return 1;
     out[LIDET_DET_STAGE_PROJECT] = r->t[1] - r->t[0];
@@ -202,25 +228,109 @@ static int rec_stages(const rec_t *r, const lidet_detector_stats_t *s, uint64_t 
     out[LIDET_DET_STAGE_CLASSIFY] = (r->t[5u + 2u * nb] - r->t[4]) - box;
     out[LIDET_DET_STAGE_POST] = r->t[7u + 2u * nb] - r->t[6u + 2u * nb];
     for (k = 0; k < LIDET_DET_N_STAGES; ++k)
-        if ((uint32_t)out[k] != s->ticks[k])
+        if ((uint32_t)out[k] != ticks[k])
             return 1;
     return 0;
 }
 
 /* ---- one run ---------------------------------------------------------------------------------------- */
 
-static int run_once(const char *name, const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *mc,
-                    const lidet_pn_model_t *mb)
+#if LIDET_FIXED_POINT
+typedef lidet_detector_q_cfg_t fw_cfg_t;
+typedef lidet_detector_q_stats_t fw_stats_t;
+typedef lidet_detection_q_t fw_detection_t;
+#define fw_init lidet_detector_q_init
+#define fw_run(d) lidet_detector_q_run((d), fw_scan_xyz_mm, fw_scan_n, 3u, fw_scan_has_ring ? fw_scan_ring : 0, 0)
+#define fw_stats lidet_detector_q_stats
+#define fw_detections lidet_detector_q_detections
+#else
+typedef lidet_detector_cfg_t fw_cfg_t;
+typedef lidet_detector_stats_t fw_stats_t;
+typedef lidet_detection_t fw_detection_t;
+#define fw_init lidet_detector_init
+#define fw_run(d) lidet_detector_run((d), fw_scan_xyz, fw_scan_n, 3u, fw_scan_has_ring ? fw_scan_ring : 0, 0)
+#define fw_stats lidet_detector_stats
+#define fw_detections lidet_detector_detections
+#endif
+
+static void put_det(const char *name, uint32_t k, const fw_detection_t *d)
+{
+    uint32_t j;
+#if LIDET_FIXED_POINT
+    const int32_t v[10] = {d->score_q15, d->box.cx_mm, d->box.cy_mm, d->box.cz_mm, d->box.l_mm,
+                           d->box.w_mm,  d->box.h_mm,  d->box.yaw_bam, d->energy_cls_q16, d->energy_box_q16};
+#else
+    const float f[10] = {d->score, d->box.cx_m, d->box.cy_m, d->box.cz_m, d->box.l_m,
+                         d->box.w_m, d->box.h_m, d->box.yaw_rad, d->energy_cls, d->energy_box};
+#endif
+    put_s("det ");
+    put_s(name);
+    fw_putc(' ');
+    put_u(k);
+    fw_putc(' ');
+    put_s(d->cls < LIDET_N_CLASSES ? k_class_names[d->cls] : "?");
+    fw_putc(' ');
+    put_u(d->cluster_id);
+    fw_putc(' ');
+    put_u(d->n_points);
+    for (j = 0; j < 10u; ++j)
+    {
+        fw_putc(' ');
+#if LIDET_FIXED_POINT
+        put_hex((uint32_t)v[j]);
+#else
+        put_hex(bits(f[j]));
+#endif
+    }
+#if LIDET_FIXED_POINT
+    put_s(" # score_q15 ");
+    put_i(d->score_q15);
+    put_s(" xyz_mm ");
+    put_i(d->box.cx_mm);
+    fw_putc(' ');
+    put_i(d->box.cy_mm);
+    fw_putc(' ');
+    put_i(d->box.cz_mm);
+    put_s(" lwh_mm ");
+    put_i(d->box.l_mm);
+    fw_putc(' ');
+    put_i(d->box.w_mm);
+    fw_putc(' ');
+    put_i(d->box.h_mm);
+    put_s(" yaw_bam ");
+    put_i(d->box.yaw_bam);
+#else
+    put_s(" # score ");
+    put_f(d->score);
+    put_s(" xyz ");
+    put_f(d->box.cx_m);
+    fw_putc(' ');
+    put_f(d->box.cy_m);
+    fw_putc(' ');
+    put_f(d->box.cz_m);
+    put_s(" lwh ");
+    put_f(d->box.l_m);
+    fw_putc(' ');
+    put_f(d->box.w_m);
+    fw_putc(' ');
+    put_f(d->box.h_m);
+    put_s(" yaw ");
+    put_f(d->box.yaw_rad);
+#endif
+    fw_putc('\n');
+}
+
+static int run_once(const char *name, const fw_cfg_t *cfg, const fw_model_t *mc, const fw_model_t *mb)
 {
     static const char *const stage_names[LIDET_DET_N_STAGES] = {"project", "ground", "cluster",
                                                                  "classify", "box", "post"};
-    const lidet_detector_stats_t *s;
-    const lidet_detection_t *det;
+    const fw_stats_t *s;
+    const fw_detection_t *det;
     lidet_status_t st;
     uint32_t n_det = 0, k;
     uint64_t t0, t1;
 
-    st = lidet_detector_init(&g_det, cfg, mc, mb);
+    st = fw_init(&g_det, cfg, mc, mb);
     if (st != LIDET_OK)
     {
         put_s("init run=");
@@ -232,10 +342,10 @@ static int run_once(const char *name, const lidet_detector_cfg_t *cfg, const lid
     }
     g_rec.n = 0u;
     t0 = fw_insn64();
-    st = lidet_detector_run(&g_det, fw_scan_xyz, fw_scan_n, 3u, fw_scan_has_ring ? fw_scan_ring : 0, 0);
+    st = fw_run(&g_det);
     t1 = fw_insn64();
-    s = lidet_detector_stats(&g_det);
-    det = lidet_detector_detections(&g_det, &n_det);
+    s = fw_stats(&g_det);
+    det = fw_detections(&g_det, &n_det);
 
     put_s("stats run=");
     put_s(name);
@@ -253,44 +363,7 @@ static int run_once(const char *name, const lidet_detector_cfg_t *cfg, const lid
     put_kv("detections", n_det);
     fw_putc('\n');
     for (k = 0; k < n_det; ++k)
-    {
-        const lidet_detection_t *d = &det[k];
-        const float v[10] = {d->score, d->box.cx_m, d->box.cy_m, d->box.cz_m, d->box.l_m,
-                             d->box.w_m, d->box.h_m, d->box.yaw_rad, d->energy_cls, d->energy_box};
-        uint32_t j;
-        put_s("det ");
-        put_s(name);
-        fw_putc(' ');
-        put_u(k);
-        fw_putc(' ');
-        put_s(d->cls < LIDET_N_CLASSES ? k_class_names[d->cls] : "?");
-        fw_putc(' ');
-        put_u(d->cluster_id);
-        fw_putc(' ');
-        put_u(d->n_points);
-        for (j = 0; j < 10u; ++j)
-        {
-            fw_putc(' ');
-            put_hex(bits(v[j]));
-        }
-        put_s(" # score ");
-        put_f(d->score);
-        put_s(" xyz ");
-        put_f(d->box.cx_m);
-        fw_putc(' ');
-        put_f(d->box.cy_m);
-        fw_putc(' ');
-        put_f(d->box.cz_m);
-        put_s(" lwh ");
-        put_f(d->box.l_m);
-        fw_putc(' ');
-        put_f(d->box.w_m);
-        fw_putc(' ');
-        put_f(d->box.h_m);
-        put_s(" yaw ");
-        put_f(d->box.yaw_rad);
-        fw_putc('\n');
-    }
+        put_det(name, k, &det[k]);
     if (fw_have_counter())
     {
         uint64_t stage64[LIDET_DET_N_STAGES];
@@ -364,9 +437,13 @@ static int calibrate(void)
 
 int fw_main(void)
 {
-    lidet_detector_cfg_t cfg;
-    const lidet_pn_model_t *mc = 0, *mb = 0;
+    fw_cfg_t cfg;
+    const fw_model_t *mc = 0, *mb = 0;
+#if LIDET_FIXED_POINT
+    const lidet_sensor_q_t *sensor = lidet_sensor_q_find(FW_SENSOR);
+#else
     const lidet_sensor_t *sensor = lidet_sensor_find(FW_SENSOR);
+#endif
     const char *family = pick_models(&mc, &mb);
     int bad = 0, c;
 
@@ -374,7 +451,7 @@ int fw_main(void)
     put_s(fw_board_name);
     put_s(" core=");
     put_s(fw_core_name);
-    put_s(" build=float sensor=" FW_SENSOR " models=");
+    put_s(" build=" FW_BUILD " sensor=" FW_SENSOR " models=");
     put_s(family != 0 ? family : "none");
     put_s(" scan=");
     put_s(fw_scan_name);
@@ -382,7 +459,11 @@ int fw_main(void)
     put_kv("ring", (uint32_t)fw_scan_has_ring);
     fw_putc('\n');
     put_s("mem");
+#if LIDET_FIXED_POINT
+    put_kv("detector_bytes", lidet_detector_q_bytes());
+#else
     put_kv("detector_bytes", lidet_detector_bytes());
+#endif
     put_kv("max_rows", LIDET_MAX_ROWS);
     put_kv("max_cols", LIDET_MAX_COLS);
     put_kv("max_points", LIDET_MAX_POINTS);
@@ -400,7 +481,11 @@ int fw_main(void)
     }
 
     /* run 1: the configuration a user gets (gates and size checks on) */
+#if LIDET_FIXED_POINT
+    lidet_detector_q_cfg_default(&cfg, sensor);
+#else
     lidet_detector_cfg_default(&cfg, sensor);
+#endif
     cfg.clock = rec_clock;
     cfg.clock_ctx = &g_rec;
     bad |= run_once("default", &cfg, mc, mb);
@@ -412,8 +497,13 @@ int fw_main(void)
         int j;
         for (j = 0; j < 3; ++j)
         {
+#if LIDET_FIXED_POINT
+            cfg.size.min_mm[c][j] = 1;
+            cfg.size.max_mm[c][j] = LIDET_Q_BOX_MAX_MM;
+#else
             cfg.size_min_m[c][j] = 0.0f;
             cfg.size_max_m[c][j] = 1000.0f;
+#endif
         }
     }
     bad |= run_once("open", &cfg, mc, mb);

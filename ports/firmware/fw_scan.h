@@ -14,7 +14,8 @@ extern "C" {
 #endif
 
 extern const uint32_t fw_scan_n;        /**< points */
-extern const float fw_scan_xyz[];       /**< fw_scan_n records of x, y, z (metres, stride 3) */
+extern const float fw_scan_xyz[];       /**< fw_scan_n records of x, y, z (metres, stride 3); float build */
+extern const int32_t fw_scan_xyz_mm[];  /**< the same in millimetres (scan_to_c.py --mm); integer build */
 extern const uint16_t fw_scan_ring[];   /**< ring index per point (sensor's ring order), if fw_scan_has_ring */
 extern const int fw_scan_has_ring;      /**< 1: fw_scan_ring is given; 0: rows from the elevation */
 extern const char fw_scan_name[];       /**< source file, for the report */

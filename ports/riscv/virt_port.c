@@ -10,6 +10,9 @@
 
 #include "fw_port.h"
 
+/* a CSR read: GCC 12 needs Zicsr enabled for it, which rv32imafc implies and rv32imac does not */
+#define ZICSR(insn) ".option push\n\t.option arch, +zicsr\n\t" insn "\n\t.option pop"
+
 #define UART_THR (*(volatile uint8_t *)0x10000000u)
 #define UART_LSR (*(volatile uint8_t *)0x10000005u)
 #define UART_LSR_THRE 0x20u
@@ -37,7 +40,7 @@ uint32_t fw_clock(void *ctx)
 {
     uint32_t v;
     (void)ctx;
-    __asm__ volatile("csrr %0, minstret" : "=r"(v));
+    __asm__ volatile(ZICSR("csrr %0, minstret") : "=r"(v));
     return v;
 }
 
@@ -46,9 +49,9 @@ uint64_t fw_insn64(void)
     uint32_t hi, lo, hi2;
     do
     {
-        __asm__ volatile("csrr %0, minstreth" : "=r"(hi));
-        __asm__ volatile("csrr %0, minstret" : "=r"(lo));
-        __asm__ volatile("csrr %0, minstreth" : "=r"(hi2));
+        __asm__ volatile(ZICSR("csrr %0, minstreth") : "=r"(hi));
+        __asm__ volatile(ZICSR("csrr %0, minstret") : "=r"(lo));
+        __asm__ volatile(ZICSR("csrr %0, minstreth") : "=r"(hi2));
     } while (hi != hi2);
     return ((uint64_t)hi << 32) | lo;
 }

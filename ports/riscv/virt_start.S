@@ -2,6 +2,8 @@
 /* RISC-V reset for QEMU's `virt` machine (-bios none: QEMU jumps to _start in machine mode on every hart).
  * Hart 0 sets gp, sp, the trap vector and (float builds) the FPU, then calls fw_start (ports/firmware/fw_start.c);
  * other harts park. Written for lidet. */
+    /* CSR instructions (Zicsr): implied by F on rv32imafc, spelled out for rv32imac */
+    .option arch, +zicsr
     .section .text.init, "ax", @progbits
     .globl _start
 _start:

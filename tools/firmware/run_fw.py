@@ -11,7 +11,8 @@
 3. Checks: the image says PASS (its instruction counter matched loops of known length), and for every run
    (gates as they are, and gates + size checks off) the same counts at every step of the detector, the
    same detections (matched by cluster id: same number, same classes), boxes within ATOL_M metres and
-   ATOL_RAD radians, scores within ATOL_SCORE and energies within RTOL_ENERGY (relative).
+   ATOL_RAD radians, scores within ATOL_SCORE and energies within RTOL_ENERGY (relative). The integer build
+   (build=fixed: the integer detector on the scan in millimetres) must match the host bit for bit.
    Why not bit-identical: the host, newlib (Arm) and picolibc (RISC-V) each have their own expf, logf, sinf,
    cosf, tanf and atan2f (each within an ulp or two); everything else is IEEE single precision in the same
    order on both sides (-ffp-contract=off, no reassociation). The report says how many values were
@@ -42,6 +43,7 @@ BOARDS = {
     "mps2-an386": ("qemu-system-arm", ["-M", "mps2-an386"], 8),
     "mps2-an500": ("qemu-system-arm", ["-M", "mps2-an500"], 8),
     "virt-rv32imafc": ("qemu-system-riscv32", ["-M", "virt", "-bios", "none"], 0),
+    "virt-rv32imac": ("qemu-system-riscv32", ["-M", "virt", "-bios", "none"], 0),
 }
 
 FIELDS = ["score", "cx", "cy", "cz", "l", "w", "h", "yaw", "energy_cls", "energy_box"]
@@ -102,8 +104,12 @@ def ang_diff(a, b):
 
 
 def compare(host, fw):
-    """-> (errors, summary lines)."""
+    """-> (errors, summary lines). The integer build (header build=fixed) must match bit for bit."""
     errors, lines = [], []
+    fixed = (fw.get("header") or {}).get("build") == "fixed"
+    if fixed != ((host.get("header") or {}).get("build") == "fixed"):
+        errors.append(f"builds differ: host {host.get('header')} firmware {fw.get('header')}")
+        return errors, lines
     if set(host["stats"]) != set(fw["stats"]) or not host["stats"]:
         errors.append(f"runs differ: host {sorted(host['stats'])} firmware {sorted(fw['stats'])}")
         return errors, lines
@@ -123,6 +129,14 @@ def compare(host, fw):
             if h["cls"] != f["cls"] or h["n_points"] != f["n_points"]:
                 errors.append(f"run {run} cluster {cl}: host {h['cls']}/{h['n_points']} pts, "
                               f"firmware {f['cls']}/{f['n_points']} pts")
+            if fixed:
+                # the integer build: integers only on both sides, so every value must be identical
+                total += len(FIELDS)
+                same_bits += sum(a == b for a, b in zip(h["bits"], f["bits"]))
+                if h["bits"] != f["bits"] or h["rank"] != f["rank"]:
+                    errors.append(f"run {run} cluster {cl}: integer values differ: host {h['bits']} (rank {h['rank']}), "
+                                  f"firmware {f['bits']} (rank {f['rank']})")
+                continue
             for i, name in enumerate(FIELDS):
                 total += 1
                 same_bits += h["bits"][i] == f["bits"][i]
@@ -139,6 +153,10 @@ def compare(host, fw):
                 if not d <= tol:
                     errors.append(f"run {run} cluster {cl}: {name} host {h[name]!r} firmware {f[name]!r} "
                                   f"(|diff| {d:.3g} > {tol:.3g})")
+        if fixed:
+            lines.append(f"run {run}: {len(hd)} detections, counts identical: {hs == fs}; "
+                         f"{same_bits}/{total} integer values identical (the integer build must match exactly)")
+            continue
         lines.append(f"run {run}: {len(hd)} detections, counts identical: {hs == fs}; "
                      f"{same_bits}/{total} values bit-identical; max |diff| box "
                      f"{max(worst[k] for k in ('cx', 'cy', 'cz', 'l', 'w', 'h')):.3g} m, yaw {worst['yaw']:.3g} rad, "

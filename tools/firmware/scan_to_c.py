@@ -10,6 +10,7 @@ literals, so the firmware reads exactly the bits of the file. Standard library o
     python3 tools/firmware/scan_to_c.py SCAN.bin [--ring RING.bin] [--name NAME] --out fw_scan.c
 """
 import argparse
+import math
 import os
 import struct
 import sys
@@ -21,6 +22,9 @@ def main(argv=None):
     ap.add_argument("--ring", help="uint16 ring index per point (same order)")
     ap.add_argument("--name", help="name printed by the firmware (default: the file name)")
     ap.add_argument("--out", required=True, help="C file to write")
+    ap.add_argument("--mm", action="store_true",
+                    help="integer build: x, y, z as int32 millimetres (fw_scan_xyz_mm, rounded half away from zero, "
+                         "as lidet_tools.native_q.to_mm) instead of float metres")
     a = ap.parse_args(argv)
 
     with open(a.scan, "rb") as f:
@@ -49,10 +53,19 @@ def main(argv=None):
         "",
         f"const uint32_t fw_scan_n = {n}u;",
         f'const char fw_scan_name[] = "{name}";',
-        f"const float fw_scan_xyz[{3 * n}] = {{",
     ]
-    for i in range(n):
-        out.append("    " + ", ".join(lit(rec[4 * i + k]) for k in range(3)) + ",")
+    if a.mm:
+        def mm(v):
+            lit(v)  # refuses NaN / Inf
+            r = math.floor(abs(float(v)) * 1000.0 + 0.5)
+            return str(int(-r if v < 0 else r))
+        out.append(f"const int32_t fw_scan_xyz_mm[{3 * n}] = {{")
+        for i in range(n):
+            out.append("    " + ", ".join(mm(rec[4 * i + k]) for k in range(3)) + ",")
+    else:
+        out.append(f"const float fw_scan_xyz[{3 * n}] = {{")
+        for i in range(n):
+            out.append("    " + ", ".join(lit(rec[4 * i + k]) for k in range(3)) + ",")
     out.append("};")
     if ring is not None:
         out.append(f"const uint16_t fw_scan_ring[{n}] = {{")
