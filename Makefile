@@ -60,12 +60,16 @@ demo: build
 	    --calib $(REAL_FRAME)/calib/000000.txt --gt-kitti $(REAL_FRAME)/label_2/000000.txt \
 	    --png out/demo_detect_real.png --repeat 20; \
 	else echo "== (no real KITTI frame at $(REAL_FRAME): skipped)"; fi
+	@echo "== the integer detector (no float: int8 models, the scan in millimetres) on the same VLP-16 scan"
+	$(BUILD)/ports/host/lidet detect tests/data/sim_vlp16/velodyne/000000.bin --sensor vlp16 --fixed \
+	    --gt tests/data/sim_vlp16/boxes/000000.txt --png out/demo_detect_vlp16_fixed.png --repeat 5
 	@echo "== the stages alone: projection, ground segmentation, depth clustering"
 	$(BUILD)/ports/host/lidet project $(SAMPLE) --sensor hdl64 --png out/demo_project.png
 	$(BUILD)/ports/host/lidet ground $(SAMPLE) --sensor hdl64 --png out/demo_ground.png --repeat 20
 	$(BUILD)/ports/host/lidet cluster $(SAMPLE) --sensor hdl64 --png out/demo_cluster.png --repeat 20
 	@echo "demo: pictures in out/ (demo_detect*.png: detections, car red, cyclist cyan, pedestrian yellow;"
-	@echo "      ground truth green; demo_project/ground/cluster.png: the stages)"
+	@echo "      ground truth green; demo_detect_vlp16_fixed.png: the integer detector;"
+	@echo "      demo_project/ground/cluster.png: the stages)"
 
 # Firmware images (ports/firmware: Cortex-M3/M4F/M7 on QEMU's MPS2 boards, RISC-V rv32imafc on QEMU virt), built
 # by the normal build when the cross compilers are installed (make deps installs them); firmware-run runs each

@@ -576,6 +576,7 @@ int cli_detect(int argc, char **argv)
         }
         ds = &ds_q;
         det = det_q;
+        strncat(chosen, " int8", sizeof chosen - strlen(chosen) - 1u);
         goto outputs;
     }
     cfg.clock = clock_ns;
