@@ -109,11 +109,11 @@ lidet_status_t lidet_detector_q_init(lidet_detector_q_t *d, const lidet_detector
     }
     if (s == LIDET_OK)
     {
-        s = lidet_pointnet_q_init(&d->cls, cls, d->scratch.pn, sizeof d->scratch.pn, 0);
+        s = lidet_pointnet_q_init(&d->cls, cls, d->pn_scratch, sizeof d->pn_scratch, 0);
     }
     if (s == LIDET_OK)
     {
-        s = lidet_pointnet_q_init(&d->box, box, d->scratch.pn, sizeof d->scratch.pn, 0);
+        s = lidet_pointnet_q_init(&d->box, box, d->pn_scratch, sizeof d->pn_scratch, 0);
     }
     if (s != LIDET_OK)
     {
@@ -151,8 +151,9 @@ void lidet_detector_q_image(const lidet_detector_q_t *d, lidet_range_image_t *im
     b.y_4mm = (int16_t *)(uintptr_t)d->y_4mm;
     b.z_4mm = (int16_t *)(uintptr_t)d->z_4mm;
     b.range_4mm = (uint16_t *)(uintptr_t)d->range_4mm;
-    b.point_idx = (int32_t *)(uintptr_t)d->point_idx;
+    b.point_idx = 0;
     lidet_proj_q_image(&d->proj, &b, img);
+    img->point_idx = 0; /* overlaid by the later stages' scratch */
 }
 
 /* candidates: kept clusters in the azimuth window and range, nearest first, at most max_proposals */
@@ -229,7 +230,7 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
     buf.y_4mm = d->y_4mm;
     buf.z_4mm = d->z_4mm;
     buf.range_4mm = d->range_4mm;
-    buf.point_idx = d->point_idx;
+    buf.point_idx = d->scratch.point_idx;
     buf.point_pixel = point_pixel;
     t0 = now(d);
     s = lidet_proj_q_run(&d->proj, &buf, points_mm, n_points, stride, ring);
@@ -240,6 +241,7 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
     }
     worst = s;
     lidet_proj_q_image(&d->proj, &buf, &img);
+    img.point_idx = 0; /* the ground stage's scratch overlays it from here on */
     t1 = now(d);
     st->ticks[LIDET_DET_STAGE_PROJECT] = t1 - t0;
     s = lidet_ground_q_run_buffers(&d->ground, &d->scratch.ground, d->mask, &img);
@@ -252,7 +254,7 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
     t0 = now(d);
     st->ticks[LIDET_DET_STAGE_GROUND] = t0 - t1;
     n_sectors = d->cfg.ground.n_sectors;
-    s = lidet_cluster_q_run_buffers(&d->cluster, d->labels, d->members, &img, d->mask, d->ground.planes, n_sectors);
+    s = lidet_cluster_q_run_buffers(&d->cluster, d->scratch.cluster.labels, d->scratch.cluster.members, &img, d->mask, d->ground.planes, n_sectors);
     st->cluster = d->cluster.stats;
     if (!LIDET_SUCCEEDED(s))
     {

@@ -143,7 +143,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
         if (point_ground != NULL)
             point_ground[k] = p >= 0 ? g_detq.mask[p] : 0u;
         if (point_cluster != NULL)
-            point_cluster[k] = p >= 0 ? g_detq.labels[p] : 0u;
+            point_cluster[k] = p >= 0 ? g_detq.scratch.cluster.labels[p] : 0u;
     }
     free(pts);
     free(pp);

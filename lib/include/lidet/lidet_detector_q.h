@@ -126,15 +126,21 @@ typedef struct
     int16_t y_4mm[LIDET_MAX_ROWS * LIDET_MAX_COLS];
     int16_t z_4mm[LIDET_MAX_ROWS * LIDET_MAX_COLS];
     uint16_t range_4mm[LIDET_MAX_ROWS * LIDET_MAX_COLS];
-    int32_t point_idx[LIDET_MAX_ROWS * LIDET_MAX_COLS];
     uint8_t mask[LIDET_MAX_ROWS * LIDET_MAX_COLS];
-    uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];
-    int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    /* overlaid, as the float workspace does: the projection's winning point per pixel (read by nothing after
+     * the projection: per-point outputs come from the caller's point_pixel), the ground stage's scratch (dead
+     * after the ground stage), then the clustering's outputs (written by the clustering, read by the proposals) */
     union
     {
-        lidet_ground_q_scratch_t ground; /* during the ground stage only */
-        int32_t pn[LIDET_DETECTOR_Q_PN_SCRATCH / 4]; /* during the networks only */
+        int32_t point_idx[LIDET_MAX_ROWS * LIDET_MAX_COLS]; /* during the projection only */
+        lidet_ground_q_scratch_t ground;                    /* during the ground stage only */
+        struct
+        {
+            uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+            int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+        } cluster; /* from the clustering on */
     } scratch;
+    int32_t pn_scratch[LIDET_DETECTOR_Q_PN_SCRATCH / 4]; /* the networks' (the members are alive meanwhile) */
     lidet_pointnet_q_t cls, box;
     lidet_proposal_q_t proposal;
     uint16_t order[LIDET_MAX_CLUSTERS];                /* candidate clusters, nearest first */
@@ -177,7 +183,8 @@ const uint8_t *lidet_detector_q_outcomes(const lidet_detector_q_t *d, uint32_t *
 /** @brief Counts of the last run. */
 const lidet_detector_q_stats_t *lidet_detector_q_stats(const lidet_detector_q_t *d);
 
-/** @brief The compact range image of the last run (views into d). */
+/** @brief The compact range image of the last run (views into d; point_idx is NULL: overlaid after the
+ *         projection, per-point results come from lidet_detector_q_run's point_pixel). */
 void lidet_detector_q_image(const lidet_detector_q_t *d, lidet_range_image_t *img);
 
 /** @brief sizeof(lidet_detector_q_t). */
