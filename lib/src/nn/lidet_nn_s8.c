@@ -32,8 +32,8 @@ static inline void rows4_s8(const int8_t *x, uint32_t n_in, const int8_t *w_t, u
     }
 }
 
-LIDET_NN_KERNEL void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                                      const int32_t *b, uint32_t n_out, int32_t *acc)
+LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                                            const int32_t *b, uint32_t n_out, int32_t *acc)
 {
     uint32_t r, i, o;
     for (r = 0; r < n_rows; ++r)
@@ -55,6 +55,153 @@ LIDET_NN_KERNEL void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_
         {
             const int32_t x0 = x[i];
             const int8_t *w0 = w_t + i * n_out;
+            for (o = 0; o < n_out; ++o)
+            {
+                a[o] += x0 * (int32_t)w0[o];
+            }
+        }
+    }
+}
+
+/* The accumulation has four kernels with the same results (int32 sums of exact products: the order does not
+ * matter): lidet__nn_acc_s8_rows4 above (four rows share each weight row, output-inner and unit-stride: what
+ * host compilers vectorise, with an AVX2 clone on x86-64), the plain output-inner loop on a column slice (the
+ * blocked kernels' leftovers), and two register-blocked ones for 32-bit cores, which keep 2 x 2 or 4 x 2 (points x output channels) accumulators in registers and
+ * load each weight once per block of points: 2.75 instead of 4.5 instructions per multiply-add on a Cortex-M3
+ * (2 x 2), 3.5 instead of 6 on RV32IM (4 x 2, more registers), counted in the compilers' inner loops.
+ * ARMv6-M (Cortex-M0+: 8 low registers, no multiply-accumulate) keeps rows4. Override with
+ * -DLIDET_NN_S8_KERNEL=0 (rows4), 22 or 42. tests/unit/test_nn_s8.c checks that all agree. */
+#ifndef LIDET_NN_S8_KERNEL
+#if defined(__riscv)
+#define LIDET_NN_S8_KERNEL 42
+#elif defined(__arm__) && !defined(__ARM_ARCH_6M__)
+#define LIDET_NN_S8_KERNEL 22
+#else
+#define LIDET_NN_S8_KERNEL 0
+#endif
+#endif
+
+void lidet__nn_acc_s8_r2o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
+                           uint32_t n_out, int32_t *acc)
+{
+    uint32_t r, i, o;
+    for (r = 0; r + 2u <= n_rows; r += 2u)
+    {
+        const int8_t *x0 = in + r * n_in, *x1 = x0 + n_in;
+        int32_t *a0 = acc + r * n_out, *a1 = a0 + n_out;
+        for (o = 0; o + 2u <= n_out; o += 2u)
+        {
+            int32_t s00 = b[o], s01 = b[o + 1u], s10 = s00, s11 = s01;
+            const int8_t *w = w_t + o;
+            for (i = 0; i < n_in; ++i, w += n_out)
+            {
+                const int32_t w0 = w[0], w1 = w[1], v0 = x0[i], v1 = x1[i];
+                s00 += v0 * w0;
+                s01 += v0 * w1;
+                s10 += v1 * w0;
+                s11 += v1 * w1;
+            }
+            a0[o] = s00;
+            a0[o + 1u] = s01;
+            a1[o] = s10;
+            a1[o + 1u] = s11;
+        }
+        if (o < n_out) /* an odd last channel */
+        {
+            lidet__nn_acc_s8_cols(x0, 2u, n_in, w_t + o, b + o, 1u, n_out, a0 + o, n_out);
+        }
+    }
+    if (r < n_rows) /* an odd last row */
+    {
+        lidet__nn_acc_s8_cols(in + r * n_in, n_rows - r, n_in, w_t, b, n_out, n_out, acc + r * n_out, n_out);
+    }
+}
+
+void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
+                           uint32_t n_out, int32_t *acc)
+{
+    uint32_t r, i, o;
+    for (r = 0; r + 4u <= n_rows; r += 4u)
+    {
+        const int8_t *x0 = in + r * n_in;
+        int32_t *a0 = acc + r * n_out;
+        for (o = 0; o + 2u <= n_out; o += 2u)
+        {
+            int32_t s0 = b[o], s1 = s0, s2 = s0, s3 = s0, t0 = b[o + 1u], t1 = t0, t2 = t0, t3 = t0;
+            const int8_t *w = w_t + o, *x = x0;
+            for (i = 0; i < n_in; ++i, w += n_out, ++x)
+            {
+                const int32_t w0 = w[0], w1 = w[1];
+                const int32_t v0 = x[0], v1 = x[n_in], v2 = x[2u * n_in], v3 = x[3u * n_in];
+                s0 += v0 * w0;
+                s1 += v1 * w0;
+                s2 += v2 * w0;
+                s3 += v3 * w0;
+                t0 += v0 * w1;
+                t1 += v1 * w1;
+                t2 += v2 * w1;
+                t3 += v3 * w1;
+            }
+            a0[o] = s0;
+            a0[n_out + o] = s1;
+            a0[2u * n_out + o] = s2;
+            a0[3u * n_out + o] = s3;
+            a0[o + 1u] = t0;
+            a0[n_out + o + 1u] = t1;
+            a0[2u * n_out + o + 1u] = t2;
+            a0[3u * n_out + o + 1u] = t3;
+        }
+        if (o < n_out)
+        {
+            lidet__nn_acc_s8_cols(x0, 4u, n_in, w_t + o, b + o, 1u, n_out, a0 + o, n_out);
+        }
+    }
+    if (r < n_rows)
+    {
+        lidet__nn_acc_s8_cols(in + r * n_in, n_rows - r, n_in, w_t, b, n_out, n_out, acc + r * n_out, n_out);
+    }
+}
+
+void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
+                      uint32_t n_out, int32_t *acc)
+{
+#if LIDET_NN_S8_KERNEL == 22
+    lidet__nn_acc_s8_r2o2(in, n_rows, n_in, w_t, b, n_out, acc);
+#elif LIDET_NN_S8_KERNEL == 42
+    lidet__nn_acc_s8_r4o2(in, n_rows, n_in, w_t, b, n_out, acc);
+#else
+    lidet__nn_acc_s8_rows4(in, n_rows, n_in, w_t, b, n_out, acc);
+#endif
+}
+
+/* the output-inner kernel on channels [0, n_out) of a layer whose weight rows are w_stride long and whose
+ * accumulator rows are a_stride long (a column slice, for the blocked kernels' leftovers) */
+void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
+                           uint32_t n_out, uint32_t w_stride, int32_t *acc, uint32_t a_stride)
+{
+    uint32_t r, i, o;
+    for (r = 0; r < n_rows; ++r)
+    {
+        int32_t *a = acc + r * a_stride;
+        const int8_t *x = in + r * n_in;
+        for (o = 0; o < n_out; ++o)
+        {
+            a[o] = b[o];
+        }
+        for (i = 0; i + 2u <= n_in; i += 2u)
+        {
+            const int32_t x0 = x[i], x1 = x[i + 1u];
+            const int8_t *w0 = w_t + i * w_stride;
+            const int8_t *w1 = w0 + w_stride;
+            for (o = 0; o < n_out; ++o)
+            {
+                a[o] += x0 * (int32_t)w0[o] + x1 * (int32_t)w1[o];
+            }
+        }
+        for (; i < n_in; ++i)
+        {
+            const int32_t x0 = x[i];
+            const int8_t *w0 = w_t + i * w_stride;
             for (o = 0; o < n_out; ++o)
             {
                 a[o] += x0 * (int32_t)w0[o];

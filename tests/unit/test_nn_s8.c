@@ -1,0 +1,89 @@
+/* SPDX-License-Identifier: MIT */
+/* The int8 accumulation kernels (lib/src/nn/lidet_nn_s8.c): the host kernel, the output-inner loop and the 2 x 2
+ * and 4 x 2 register-blocked kernels give the same int32 sums on every shape, odd row and channel counts included, and
+ * equal a plain triple loop; the extreme int8 values too. */
+#include <string.h>
+
+#include "internal/lidet_pointnet_q_internal.h"
+#include "test_util.h"
+
+#define MAX_R 11
+#define MAX_I 70
+#define MAX_O 37
+
+static uint32_t g_rng = 12345u;
+
+static uint32_t next(void)
+{
+    g_rng ^= g_rng << 13;
+    g_rng ^= g_rng >> 17;
+    g_rng ^= g_rng << 5;
+    return g_rng;
+}
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
+}
+
+static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extreme)
+{
+    static int8_t in[MAX_R * MAX_I], w[MAX_I * MAX_O];
+    static int32_t b[MAX_O], ref[MAX_R * MAX_O], got[MAX_R * MAX_O];
+    uint32_t r, i, o, k;
+    for (k = 0; k < rows * n_in; ++k)
+        in[k] = extreme ? (int8_t)((k & 1u) ? -128 : 127) : (int8_t)(next() & 0xFFu);
+    for (k = 0; k < n_in * n_out; ++k)
+        w[k] = extreme ? (int8_t)-128 : (int8_t)(next() & 0xFFu);
+    for (o = 0; o < n_out; ++o)
+        b[o] = (int32_t)(next() % 2000001u) - 1000000;
+    for (r = 0; r < rows; ++r)
+        for (o = 0; o < n_out; ++o)
+        {
+            int32_t s = b[o];
+            for (i = 0; i < n_in; ++i)
+                s += (int32_t)in[r * n_in + i] * (int32_t)w[i * n_out + o];
+            ref[r * n_out + o] = s;
+        }
+    memset(got, 0x5A, sizeof got);
+    lidet__nn_acc_s8_cols(in, rows, n_in, w, b, n_out, n_out, got, n_out);
+    TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+    memset(got, 0x5A, sizeof got);
+    lidet__nn_acc_s8_rows4(in, rows, n_in, w, b, n_out, got);
+    TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+    memset(got, 0x5A, sizeof got);
+    lidet__nn_acc_s8_r2o2(in, rows, n_in, w, b, n_out, got);
+    TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+    memset(got, 0x5A, sizeof got);
+    lidet__nn_acc_s8_r4o2(in, rows, n_in, w, b, n_out, got);
+    TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+    memset(got, 0x5A, sizeof got);
+    lidet__nn_acc_s8(in, rows, n_in, w, b, n_out, got);
+    TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+}
+
+static void test_kernels_agree_on_every_shape(void)
+{
+    uint32_t rows, n_in, n_out;
+    for (rows = 1; rows <= MAX_R; ++rows)
+        for (n_in = 1; n_in <= MAX_I; n_in += 7u)
+            for (n_out = 1; n_out <= MAX_O; n_out += 3u)
+                check_shape(rows, n_in, n_out, 0);
+}
+
+static void test_kernels_agree_at_the_extremes(void)
+{
+    check_shape(8, MAX_I, MAX_O, 1);
+    check_shape(9, 64, 33, 1);
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_kernels_agree_on_every_shape);
+    RUN_TEST(test_kernels_agree_at_the_extremes);
+    return UNITY_END();
+}
