@@ -24,6 +24,10 @@ BOARDS = [  # board, core, FPU, QEMU machine
     ("mps2-an500-hdl64", "Cortex-M7, **HDL-64 scan** (config/hdl64; detector in PSRAM)",
      "single precision (fpv5-sp-d16)", "mps2-an500"),
     ("virt-rv32imafc-hdl64", "RV32IMAFC, **HDL-64 scan** (config/hdl64)", "single precision (F)", "virt"),
+    # the integer-only build (LIDET_FW_FIXED: integer detector, int8 models; compared with the host bit for bit)
+    ("mps2-an385-q", "Cortex-M3, **integer build**", "none (no float at all)", "mps2-an385"),
+    ("mps2-an385-m0plus-q", "Cortex-M0+ code, **integer build**", "none (no float at all)", "mps2-an385"),
+    ("virt-rv32imac-q", "RV32IMAC, **integer build**", "none (no F extension)", "virt"),
 ]
 STAGES = ["project", "ground", "cluster", "classify", "box", "post"]
 
