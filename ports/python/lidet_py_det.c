@@ -17,7 +17,8 @@
 static lidet_detector_t g_det;
 static int32_t g_pp[LIDET_MAX_POINTS];
 
-/* fcfg: crop_half_rad, max_range_m, nms_iou; ucfg: max_proposals (0 = the default), gate1, gate2.
+/* fcfg: crop_half_rad, max_range_m, nms_iou; ucfg: max_proposals (0 = the default), gate1, gate2, refine (the
+ * clustering's split_people and join_cars).
  * out_det: LIDET_MAX_DETECTIONS rows of 12 floats (class, score, energy_cls, energy_box, cx, cy, cz, l, w, h,
  * yaw, cluster id); out_outcome: LIDET_MAX_CLUSTERS bytes; out_point_cluster / out_point_ground: n entries
  * (may be NULL); out_stats: 13 uint32 (the lidet_detector_stats_t counts in order, then the status). */
@@ -51,6 +52,8 @@ LIDET_PY_API int lidet_py_det_run(const char *sensor, uint32_t cls_index, uint32
     }
     cfg.gate1 = (uint8_t)ucfg[1];
     cfg.gate2 = (uint8_t)ucfg[2];
+    cfg.stages.cluster.split_people = ucfg[3] != 0u; /* the proposal refinement (lidet_refine.c) */
+    cfg.stages.cluster.join_cars = ucfg[3] != 0u;
     rc = lidet_detector_init(&g_det, &cfg, lidet_weights_models[cls_index].model, lidet_weights_models[box_index].model);
     if (rc != LIDET_OK)
     {
