@@ -261,10 +261,17 @@ float lidet_box_bev_iou(const lidet_box_t *a, const lidet_box_t *b)
 
 /* ---- the run -------------------------------------------------------------------------------------- */
 
+/* a plausible size for the class, and a finite centre and heading (a hostile scan can drive the box net to
+ * Inf/NaN outputs: such a box is dropped here, counted with the impossible sizes) */
 static int size_ok(const lidet_detector_cfg_t *c, uint32_t cls, const lidet_box_t *b)
 {
     const float v[3] = {b->l_m, b->w_m, b->h_m};
     uint32_t j;
+    if (!lidet__isfinite(b->cx_m) || !lidet__isfinite(b->cy_m) || !lidet__isfinite(b->cz_m) ||
+        !lidet__isfinite(b->yaw_rad))
+    {
+        return 0;
+    }
     for (j = 0; j < 3; ++j)
     {
         if (!(v[j] >= c->size_min_m[cls][j] && v[j] <= c->size_max_m[cls][j]))

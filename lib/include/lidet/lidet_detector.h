@@ -18,7 +18,8 @@
  *  3. Per candidate: the proposal (lidet_proposal_make with the models' points per proposal), the
  *     classifier (gate 1: energy < gamma_c[class]), then the box net with that class (gate 2:
  *     heading + size energy < gamma_b[class]). Either gate can be switched off (evaluation).
- *  4. Boxes of impossible size for their class (outside [size_min, size_max] per dimension) are dropped.
+ *  4. Boxes of impossible size for their class (outside [size_min, size_max] per dimension), or with a
+ *     non-finite centre or yaw, are dropped.
  *  5. Non-maximum suppression in bird's-eye view: detections sorted by score (ties: cluster id); one
  *     whose rotated BEV IoU with a kept detection of any class exceeds nms_iou is dropped.
  * Score: 1 / (1 + exp(E_c - gamma_c[class])), monotonic in the classifier energy, 0.5 at gate 1's
@@ -61,7 +62,7 @@ typedef enum
     LIDET_DET_OUT_BUDGET = 3,   /**< past max_proposals */
     LIDET_DET_OUT_GATE1 = 4,    /**< classified, rejected by gate 1 */
     LIDET_DET_OUT_GATE2 = 5,    /**< boxed, rejected by gate 2 */
-    LIDET_DET_OUT_SIZE = 6,     /**< boxed, impossible size for its class */
+    LIDET_DET_OUT_SIZE = 6,     /**< boxed, impossible size for its class (or a non-finite centre or yaw) */
     LIDET_DET_OUT_NMS = 7,      /**< suppressed by the NMS */
     LIDET_DET_OUT_CAPACITY = 8, /**< past LIDET_MAX_DETECTIONS */
     LIDET_DET_OUT_DETECTED = 9  /**< a detection of the output */

@@ -1,0 +1,137 @@
+/* SPDX-License-Identifier: MIT */
+/* Regression tests of the bugs the fuzz harnesses found (issue 19, docs/ROBUSTNESS.md); the crashing
+ * inputs themselves are replayed from tests/fuzz/regressions by the fuzz_replay_* tests. */
+#include <math.h>
+#include <string.h>
+
+#include "lidet/lidet.h"
+#include "test_util.h"
+
+LIDET_GUARDED(lidet_proj_t, g);
+
+void setUp(void)
+{
+    CANARY_FILL(g);
+}
+
+void tearDown(void)
+{
+    CANARY_CHECK(g);
+}
+
+static void init_vlp16(void)
+{
+    lidet_proj_cfg_t cfg;
+    lidet_proj_cfg_default(&cfg, lidet_sensor_find("vlp16"));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_init(&g.ws, &cfg));
+}
+
+/* fuzz_ground: on the ring path, |x|, |y| ~ 1e-20 (a denormal (|x|+|y|) * R) made the pseudo-azimuth +Inf
+ * and the column search walked past the edge table: a pixel outside the image. Such a point lies on the z
+ * axis: it takes the straight-ahead column, as x = y = 0 does. */
+static void test_ring_path_tiny_xy_stays_in_image(void)
+{
+    static const float xs[] = {-2.7e-20f, 2.7e-20f, -1e-21f, 5e-23f, 0.0f};
+    float pts[5 * 3];
+    uint16_t ring[5];
+    const int32_t *pp;
+    uint32_t i, n;
+    init_vlp16();
+    for (i = 0; i < 5; ++i)
+    {
+        pts[3 * i] = xs[i];
+        pts[3 * i + 1] = i == 3 ? -1e-22f : 0.0f;
+        pts[3 * i + 2] = 5.0f;
+        ring[i] = (uint16_t)i;
+    }
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, pts, 5, 3, ring));
+    pp = lidet_proj_point_pixels(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(5, n);
+    for (i = 0; i < 5; ++i)
+    {
+        /* the column of x = y = 0 (i = 4), whatever the tiny x, y */
+        TEST_ASSERT_TRUE(pp[i] >= 0 && pp[i] < 16 * 1800);
+        TEST_ASSERT_EQUAL_INT32(pp[4] % 1800, pp[i] % 1800);
+    }
+}
+
+/* (|x|+|y|) * R overflowing (R > ~1.3e19 m, accepted without a max range) gave 1 / den = 0 and a column of
+ * +-90 degrees whatever the azimuth; now such a point is not projected (counted out of the field of view) */
+static void test_overflowing_denominator_not_projected(void)
+{
+    const float pts[2 * 3] = {1.2e19f, 1.2e19f, 0.0f, 10.0f, 10.0f, 0.0f};
+    const int32_t *pp;
+    uint32_t n;
+    init_vlp16();
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, pts, 2, 3, NULL));
+    pp = lidet_proj_point_pixels(&g.ws, &n);
+    TEST_ASSERT_EQUAL_INT32(-1, pp[0]);
+    TEST_ASSERT_TRUE(pp[1] >= 0);
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_proj_stats(&g.ws)->n_out_of_fov);
+}
+
+/* fuzz_pointnet: a box net whose heading residual is huge (1e30) or infinite never returned (the heading
+ * wrap subtracted 2 pi until it fell in range). A one-layer box net with H = S = 1 whose head bias sets the
+ * residual: the yaw comes back in (-pi, pi] (finite heading) or NaN (infinite one). */
+static const float w_point[3 * 4] = {0};
+static const float b_point[4] = {0};
+static const float w_head[7 * 9] = {0};
+static float b_head[9];
+static const float mean_size[3] = {4.0f, 1.8f, 1.5f};
+static const lidet_pn_layer_t l_point = {3, 4, 1, w_point, b_point};
+static const lidet_pn_layer_t l_head = {7, 9, 0, w_head, b_head};
+
+static void test_box_heading_wrap_terminates(void)
+{
+    static float scratch[2048];
+    static lidet_proposal_t p;
+    /* the heading is residual * pi / H (H = 1): 3e38 overflows to Inf there, like INFINITY itself */
+    static const float residuals[] = {1e30f, -1e37f, 12345.678f, -3e38f, INFINITY};
+    lidet_pn_model_t m;
+    lidet_pn_t pn;
+    lidet_pn_box_out_t out;
+    uint32_t i;
+    memset(&m, 0, sizeof m);
+    m.format_version = LIDET_WEIGHTS_FORMAT_VERSION;
+    m.kind = LIDET_PN_BOX;
+    m.precision = LIDET_PN_F32;
+    m.n_stages = 1;
+    m.n_classes = LIDET_N_CLASSES;
+    m.n_points = 4;
+    m.n_heading_bins = 1;
+    m.n_size_clusters = 1;
+    m.stage[0].point = &l_point;
+    m.stage[0].head = &l_head;
+    m.stage[0].n_point = 1;
+    m.stage[0].n_head = 1;
+    m.stage[0].use_onehot = 1;
+    m.mean_size_m = mean_size;
+    m.energy_t = 1.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_init(&pn, &m, scratch, sizeof scratch, NULL));
+    memset(&p, 0, sizeof p);
+    p.n_points = 4;
+    p.mean_m[0] = 10.0f;
+    for (i = 0; i < sizeof residuals / sizeof residuals[0]; ++i)
+    {
+        memset(b_head, 0, sizeof b_head);
+        b_head[3 + 1] = residuals[i]; /* [3 + H]: the heading residual of bin 0 */
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_box(&pn, &p, 0, &out));
+        if (i >= 3)
+        {
+            TEST_ASSERT_TRUE(isnan(out.box.yaw_rad));
+        }
+        else
+        {
+            TEST_ASSERT_TRUE(out.box.yaw_rad > -3.14159274f && out.box.yaw_rad <= 3.14159274f);
+        }
+    }
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_ring_path_tiny_xy_stays_in_image);
+    RUN_TEST(test_overflowing_denominator_not_projected);
+    RUN_TEST(test_box_heading_wrap_terminates);
+    return UNITY_END();
+}
