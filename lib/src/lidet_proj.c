@@ -177,6 +177,12 @@ lidet_status_t lidet_proj_state_init(lidet_proj_state_t *proj, const lidet_proj_
     proj->tan_lo = tanf(bottom_rad);
     span = proj->tan_hi - proj->tan_lo;
     proj->lut_scale = (float)LIDET_PROJ_ROW_LUT / span;
+    if (!(span > 0.0f) || !lidet__isfinite(proj->lut_scale))
+    {
+        /* a field of view (beams + margin) of zero or denormal width: no bucket size (run() would convert
+         * 0 * Inf to an integer; issue 19, found by fuzz_proj) */
+        return LIDET_ERR_CONFIG;
+    }
 
     /* bucket k covers tan in [lo + k/scale, lo + (k+1)/scale): store the row of its top end, the
      * smallest row any tan in the bucket can have; run() walks down from there (usually 0-1 step) */

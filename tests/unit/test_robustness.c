@@ -70,6 +70,31 @@ static void test_overflowing_denominator_not_projected(void)
     TEST_ASSERT_EQUAL_UINT32(1, lidet_proj_stats(&g.ws)->n_out_of_fov);
 }
 
+/* fuzz_proj: a field of view of zero or denormal width (one beam and no margin; a uniform fov of 2e-41 rad)
+ * was accepted, and run() converted 0 * Inf (the lookup-table scale) to an integer: undefined behaviour */
+static void test_zero_width_field_of_view_rejected(void)
+{
+    static const float one_beam[1] = {-0.1f};
+    lidet_proj_cfg_t cfg;
+    lidet_sensor_t s;
+    memset(&s, 0, sizeof s);
+    s.n_rows = 1;
+    s.n_cols = 64;
+    s.beam_elev_rad = one_beam;
+    lidet_proj_cfg_default(&cfg, &s);
+    cfg.fov_margin_rad = 0.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proj_init(&g.ws, &cfg));
+    cfg.fov_margin_rad = 0.01f; /* the same beam with a margin: fine */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_init(&g.ws, &cfg));
+    s.n_rows = 2;
+    s.beam_elev_rad = NULL;
+    s.fov_up_rad = 2.2e-41f;
+    s.fov_down_rad = 0.0f;
+    lidet_proj_cfg_default(&cfg, &s);
+    cfg.fov_margin_rad = 0.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proj_init(&g.ws, &cfg));
+}
+
 /* fuzz_pointnet: a box net whose heading residual is huge (1e30) or infinite never returned (the heading
  * wrap subtracted 2 pi until it fell in range). A one-layer box net with H = S = 1 whose head bias sets the
  * residual: the yaw comes back in (-pi, pi] (finite heading) or NaN (infinite one). */
@@ -132,6 +157,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_ring_path_tiny_xy_stays_in_image);
     RUN_TEST(test_overflowing_denominator_not_projected);
+    RUN_TEST(test_zero_width_field_of_view_rejected);
     RUN_TEST(test_box_heading_wrap_terminates);
     return UNITY_END();
 }
