@@ -97,6 +97,7 @@ static int apply_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, min_points, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, rescue_rows, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, rescue_cols, uint32_t, 4294967295.0)
+    CLI_SET_INT(c, kv, klen, v, max_fragment_pixels, uint32_t, 4294967295.0)
     return 1;
 }
 
@@ -317,6 +318,8 @@ int cli_cluster(int argc, char **argv)
         cli_json_int(stdout, "fragments", cs->n_fragments);
         cli_json_int(stdout, "rescue_joined", cs->n_rescue_joined);
         cli_json_int(stdout, "rescue_pixels", cs->n_rescue_pixels);
+        cli_json_int(stdout, "fragment_pixels", cs->n_fragment_pixels);
+        cli_json_int(stdout, "dropped_fragment_budget", cs->n_dropped_fragment_budget);
         cli_json_int(stdout, "clusters", cs->n_kept);
         cli_json_int(stdout, "proposals", cs->n_kept);
         cli_json_int(stdout, "proposal_points", prcfg.n_points);
@@ -339,8 +342,10 @@ int cli_cluster(int argc, char **argv)
         printf("clusters        %u kept of %u found (dropped: small %u, extent %u, height %u, capacity %u)\n",
                cs->n_kept, cs->n_found, cs->n_dropped_small, cs->n_dropped_extent, cs->n_dropped_height,
                cs->n_dropped_capacity);
-        printf("rescue          %u fragments; %u groups joined clusters, %u pixels kept\n", cs->n_fragments,
-               cs->n_rescue_joined, cs->n_rescue_pixels);
+        printf("rescue          %u fragments (%u pixels, %u past the budget); %u groups joined clusters, %u pixels "
+               "kept\n",
+               cs->n_fragments, cs->n_fragment_pixels, cs->n_dropped_fragment_budget, cs->n_rescue_joined,
+               cs->n_rescue_pixels);
         printf("proposals       %u x %u points\n", cs->n_kept, prcfg.n_points);
         printf("cluster_ms      %.3f (median of %d; projection %.3f, proposals %.3f)\n", ms_clu, a.repeat,
                ms_proj, ms_prop);

@@ -29,6 +29,7 @@ static void detector_knobs(fz_in_t *in, lidet_detector_cfg_t *c, uint8_t *vlp, u
         c->crop_half_rad = 0.0f;
     }
     c->max_proposals = fz_u8(in) % (LIDET_MAX_CLUSTERS + 2u);
+    c->max_boxes = fz_u8(in) % (LIDET_MAX_CLUSTERS + 2u);
     c->stages.cluster.min_points = 1u + fz_u8(in) % 12u;
     c->stages.ground.n_sectors = (uint16_t)(1u + fz_u8(in) % LIDET_GROUND_MAX_SECTORS);
     fz_poke_f32(in, fl, (uint32_t)(sizeof fl / sizeof fl[0]));
@@ -79,7 +80,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         n_detected += out[i] == LIDET_DET_OUT_DETECTED;
         n_budget += out[i] == LIDET_DET_OUT_BUDGET;
     }
-    FZ_CHECK(n_detected == n_det && n_budget == ds->n_over_budget);
+    FZ_CHECK(n_detected == n_det && n_budget == ds->n_over_budget + ds->n_over_box_budget);
+    FZ_CHECK(ds->n_boxed <= cfg.max_boxes);
     for (i = 0; i < n_det; ++i)
     {
         FZ_CHECK(det[i].cls < LIDET_N_CLASSES && det[i].cluster_id >= 1 && det[i].cluster_id <= n_cl);

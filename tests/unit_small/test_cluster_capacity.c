@@ -102,6 +102,67 @@ static void odd_columns_at_11m(void)
 /* the rescue never evicts: 8 bars of 6 pixels fill the capacity; 12 alternating 10 m / 11 m
  * returns in one row (singletons for the angle test at theta 0.8: beta 0.75) become one rescue
  * group that would be a cluster of its own: dropped for capacity and counted, the bars stay */
+/* the capacity drops keep a heap of the slots (issue 19): on 300 random scenes of 16 bars of random heights
+ * (ties frequent), the kept clusters are exactly the 8 largest, ties to the earlier bar, as a brute-force
+ * selection says */
+static void test_capacity_heap_matches_brute_force(void)
+{
+    static char rows_buf[16][65];
+    const char *art[16];
+    lidet_cluster_cfg_t cfg;
+    uint32_t seed = 12345u, scene;
+    tcu_cfg(&cfg);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    for (scene = 0; scene < 300; ++scene)
+    {
+        int height[16], keep[16], r, b, k, n_keep = 0;
+        const lidet_cluster_rec_t *rec;
+        uint32_t n;
+        for (b = 0; b < 16; ++b)
+        {
+            seed = seed * 1103515245u + 12345u;
+            height[b] = 1 + (int)((seed >> 16) % (scene % 2 ? 4u : 16u)); /* odd scenes: many ties */
+            keep[b] = 0;
+        }
+        /* brute force: 8 times the largest not yet taken, ties to the lower bar index */
+        for (k = 0; k < 8; ++k)
+        {
+            int best = -1;
+            for (b = 0; b < 16; ++b)
+            {
+                if (!keep[b] && (best < 0 || height[b] > height[best]))
+                    best = b;
+            }
+            keep[best] = 1;
+        }
+        for (r = 0; r < 16; ++r)
+        {
+            memset(rows_buf[r], '.', 64);
+            rows_buf[r][64] = '\0';
+            for (b = 0; b < 16; ++b)
+            {
+                if (r < height[b])
+                    rows_buf[r][4 * b + 1] = 'c';
+            }
+            art[r] = rows_buf[r];
+        }
+        tcu_draw(&t, art, 16);
+        TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+        rec = lidet_cluster_records(&g.ws, &n);
+        TEST_ASSERT_EQUAL_UINT32(8, n);
+        TEST_ASSERT_EQUAL_UINT32(8, lidet_cluster_stats(&g.ws)->n_dropped_capacity);
+        for (b = 0; b < 16; ++b)
+        {
+            if (keep[b])
+            {
+                TEST_ASSERT_EQUAL_UINT32((uint32_t)(4 * b + 1), rec[n_keep].seed_pixel);
+                TEST_ASSERT_EQUAL_UINT32((uint32_t)height[b], rec[n_keep].n_points);
+                ++n_keep;
+            }
+        }
+    }
+}
+
 static void test_rescue_never_evicts(void)
 {
     static char rows_buf[6][65];
@@ -168,6 +229,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_capacity_overflow_counted);
+    RUN_TEST(test_capacity_heap_matches_brute_force);
     RUN_TEST(test_rescue_never_evicts);
     RUN_TEST(test_image_too_large);
     return UNITY_END();

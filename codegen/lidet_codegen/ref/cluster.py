@@ -80,12 +80,14 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                 theta_rad: float = 0.2, max_steps: int = 9, bridge_occluders: bool = True, diagonals: bool = True,
                 max_gap_m: float = 0.0, max_gap_per_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
                 max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30,
-                rescue_gap_m: float = 0.0, rescue_gap_per_m: float = 0.0, rescue_rows: int = 0, rescue_cols: int = 0):
+                rescue_gap_m: float = 0.0, rescue_gap_per_m: float = 0.0, rescue_rows: int = 0, rescue_cols: int = 0,
+                max_fragment_pixels: int = 0):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
     member-pixel arrays per kept cluster in raster order). Float32 tangent and distance tests like the
     C; the filters use float64 means (they can differ from the C's float32 only at a filter's edge).
-    rescue_gap_m > 0 turns the fragment rescue on (lidet_cluster.h)."""
+    rescue_gap_m > 0 turns the fragment rescue on (lidet_cluster.h); max_fragment_pixels > 0 is its budget:
+    fragments enter it in raster order while their pixels sum to at most that."""
     rows, cols = range_m.shape
     rng = np.asarray(range_m, np.float32).ravel()
     cand = np.asarray(candidate, bool).ravel()
@@ -183,6 +185,7 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
     state = np.where(cand, 0, -2).astype(np.int64)  # 0 free, -2 non-candidate, -1 visited, -3 fragment
     kc = min(max_steps, cols - 1)
     kept = []  # (n, seed, members)
+    frag_px = 0  # fragment pixels handed to the rescue
     for seed in range(rows * cols):
         if state[seed] != 0:
             continue
@@ -237,7 +240,10 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                         q.append(n)
         m = np.array(mem)
         if len(m) < min_points:
+            if rescue and max_fragment_pixels and frag_px + len(m) > max_fragment_pixels:
+                continue  # past the rescue budget: dropped
             if rescue and P[m][:, 2].mean() + mount_height_m <= max_mean_height_m:
+                frag_px += len(m)
                 state[m] = -3  # a fragment, for the rescue
             continue
         if not _passes(m):

@@ -69,10 +69,12 @@
  * + LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS * 8 B + ~200 B: about 1.6 MiB with the defaults
  * (128 x 2048), 0.17 MiB for a VLP-16 board (16 x 1800, 64 clusters). lidet_cluster_bytes() returns
  * the exact figure. Declare it `static`.
- * Time: O(n_rows * n_cols * max_steps) per run worst case, O(n_rows * n_cols) typical (the rescue
- * looks at (2 rescue_rows + 1)(2 rescue_cols + 1) pixels around each fragment pixel); plus O(K * LIDET_MAX_CLUSTERS)
- * when K clusters overflow the capacity, and at most O(LIDET_MAX_CLUSTERS^2) to order the ids when
- * rescued pixels precede a cluster's seed. No allocation.
+ * Time: O(n_rows * n_cols * max_steps) per run worst case, O(n_rows * n_cols) typical; the rescue
+ * looks at (2 rescue_rows + 1)(2 rescue_cols + 1) pixels around each fragment pixel, at most
+ * max_fragment_pixels of them (the budget that bounds it whatever the scan); plus O(K log LIDET_MAX_CLUSTERS)
+ * when K clusters overflow the capacity (a heap of the slots), and at most O(LIDET_MAX_CLUSTERS^2) to
+ * order the ids when rescued pixels precede a cluster's seed. No allocation. Worst cases measured in
+ * docs/ROBUSTNESS.md.
  */
 #ifndef LIDET_CLUSTER_H
 #define LIDET_CLUSTER_H
@@ -129,6 +131,12 @@ typedef struct
                                   <= LIDET_MAX_ROWS; default 1 (<= 16 beams), 2 (> 16 beams) */
     uint32_t rescue_cols;    /**< columns looked at left and right (wrapping; at most (n_cols - 1) / 2
                                   are used); <= 15; default 6 */
+    uint32_t max_fragment_pixels; /**< rescue budget (bounds the rescue's time whatever the scan): fragments
+                                  enter the rescue in raster order while their pixels sum to at most this;
+                                  one that would exceed it is dropped (stats n_dropped_fragment_budget).
+                                  0 = no limit. Default 4096 (> 16 beams), 2048 (<= 16 beams): about 2x
+                                  the most fragment pixels measured on real KITTI scans (2074) and 2.5x
+                                  the simulated VLP-16 sample's (816; docs/ROBUSTNESS.md) */
 } lidet_cluster_cfg_t;
 
 /** @brief One kept cluster. Coordinates in the sensor frame (metres). */
@@ -162,6 +170,8 @@ typedef struct
     uint32_t n_kept;              /**< clusters in the output */
     uint32_t n_pixels_kept;       /**< pixels labelled with a kept cluster */
     uint32_t n_queue_overflow;    /**< always 0: the queue holds every pixel (kept for the record) */
+    uint32_t n_fragment_pixels;   /**< pixels of the fragments handed to the rescue */
+    uint32_t n_dropped_fragment_budget; /**< fragments dropped past max_fragment_pixels */
 } lidet_cluster_stats_t;
 
 /**
