@@ -44,6 +44,8 @@ test-asan:
 	      -DLIDET_BUILD_CONSUMER_TESTS=OFF $(CMAKE_FLAGS)
 	cmake --build $(ASAN) -j $(JOBS)
 	ctest --test-dir $(ASAN) --output-on-failure -j $(JOBS)
+	# determinism across builds: the Release CLI and the sanitizer CLI write the same bytes
+	LIDET_BUILD_DIR=$(abspath $(BUILD)) LIDET_ASAN_BUILD_DIR=$(abspath $(ASAN)) $(PY) -m pytest -q tests/python/test_determinism.py
 
 # libFuzzer harnesses (tests/fuzz, clang only): the library at small capacities under ASan + UBSan. test-fuzz
 # replays each harness's committed corpus and crash regressions and fuzzes it for a few seconds (ctest);
