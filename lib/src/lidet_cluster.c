@@ -51,6 +51,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->rescue_rows = sensor != 0 && sensor->n_rows <= 16 ? 1u : 2u;
     cfg->rescue_cols = 6u;
     cfg->max_fragment_pixels = sensor != 0 && sensor->n_rows <= 16 ? 2048u : 4096u;
+    cfg->max_bridge_per_pixel = 2.0f;
 }
 
 lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cluster_cfg_t *cfg)
@@ -66,6 +67,7 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
         !lidet__isfinite(cfg->max_mean_height_m) || !lidet__isfinite(cfg->mount_height_m) ||
         cfg->mount_height_m < 0.0f || !lidet__isfinite(cfg->max_gap_m) || cfg->max_gap_m < 0.0f ||
         !lidet__isfinite(cfg->max_gap_per_m) || cfg->max_gap_per_m < 0.0f ||
+        !(cfg->max_bridge_per_pixel >= 0.0f && cfg->max_bridge_per_pixel <= 64.0f) ||
         !lidet__isfinite(cfg->rescue_gap_m) || cfg->rescue_gap_m < 0.0f ||
         !lidet__isfinite(cfg->rescue_gap_per_m) || cfg->rescue_gap_per_m < 0.0f ||
         cfg->rescue_rows > LIDET_MAX_ROWS || cfg->rescue_cols > RESCUE_MAX_COLS)
@@ -554,6 +556,8 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     lk.rgpm = c->cfg.rescue_gap_per_m;
     lk.rrows = c->cfg.rescue_rows;
     lk.rcols = c->cfg.rescue_cols < (cols - 1u) / 2u ? c->cfg.rescue_cols : (cols - 1u) / 2u;
+    lk.bridge_max = 0xFFFFFFFFu; /* set once the candidates are counted */
+    lk.bridged = &st.n_bridge_steps;
     /* row of pixel q without a division: floor(q * m / 2^32) with m = floor(2^32 / cols) + 1 is
      * floor(q / cols) exactly when q * cols < 2^32 (m exceeds 2^32 / cols by e in (0, 1], so the
      * quotient is overestimated by q e / 2^32 < 1 / cols, less than the distance of q / cols to the
@@ -596,6 +600,11 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
             }
         }
         st.n_candidates = n_cand;
+        if (c->cfg.max_bridge_per_pixel > 0.0f)
+        {
+            /* <= 64 * 2^24 * 4: fits */
+            lk.bridge_max = (uint32_t)(c->cfg.max_bridge_per_pixel * (float)n_cand);
+        }
     }
 
     tail = 0;

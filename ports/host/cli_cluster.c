@@ -91,6 +91,7 @@ static int apply_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, mount_height_m)
     CLI_SET_FLOAT(c, kv, klen, v, rescue_gap_m)
     CLI_SET_FLOAT(c, kv, klen, v, rescue_gap_per_m)
+    CLI_SET_FLOAT(c, kv, klen, v, max_bridge_per_pixel)
     CLI_SET_INT(c, kv, klen, v, max_steps, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, bridge_occluders, uint32_t, 1)
     CLI_SET_INT(c, kv, klen, v, diagonals, uint32_t, 1)
@@ -98,6 +99,7 @@ static int apply_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, rescue_rows, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, rescue_cols, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, max_fragment_pixels, uint32_t, 4294967295.0)
+
     return 1;
 }
 
@@ -320,6 +322,7 @@ int cli_cluster(int argc, char **argv)
         cli_json_int(stdout, "rescue_pixels", cs->n_rescue_pixels);
         cli_json_int(stdout, "fragment_pixels", cs->n_fragment_pixels);
         cli_json_int(stdout, "dropped_fragment_budget", cs->n_dropped_fragment_budget);
+        cli_json_int(stdout, "bridge_steps", cs->n_bridge_steps);
         cli_json_int(stdout, "clusters", cs->n_kept);
         cli_json_int(stdout, "proposals", cs->n_kept);
         cli_json_int(stdout, "proposal_points", prcfg.n_points);

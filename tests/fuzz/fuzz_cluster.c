@@ -33,7 +33,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 static void cluster_knobs(fz_in_t *in, lidet_cluster_cfg_t *c, uint8_t *mode)
 {
     float *const fl[] = {&c->theta_rad, &c->max_gap_m, &c->max_gap_per_m, &c->max_extent_m, &c->max_mean_height_m,
-                         &c->mount_height_m, &c->rescue_gap_m, &c->rescue_gap_per_m};
+                         &c->mount_height_m, &c->rescue_gap_m, &c->rescue_gap_per_m,
+                         &c->max_bridge_per_pixel};
     const uint8_t f = fz_u8(in);
     *mode = f & 3u; /* 0: float image + ground stage, 1: float image, no ground, 2: compact + ground, 3: compact */
     c->bridge_occluders = (f >> 2) & 1u;

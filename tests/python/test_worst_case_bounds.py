@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: MIT
 """The caps that bound the worst-case time per stage (issue 19, docs/ROBUSTNESS.md): the clustering's rescue
-budget (max_fragment_pixels, mirrored by the numpy reference) and the detector's box budget (max_boxes)."""
+budget (max_fragment_pixels) and occluder bridging budget (max_bridge_steps), both mirrored by the numpy
+reference, and the detector's box budget (max_boxes)."""
 import json
 import subprocess
 
@@ -40,6 +41,20 @@ def test_rescue_budget_matches_reference():
     assert stats[150]["n_fragments"] < stats[0]["n_fragments"]
 
 
+def test_bridge_budget_matches_reference():
+    pts = _random_range_window("vlp16", 240, seed=1)
+    ground = np.zeros(len(pts), bool)
+    stats = {}
+    for per_pixel in (0.0, 0.25):
+        cfg = {k: v for k, v in native.cluster_defaults("vlp16").items() if k != "mount_height_m"}
+        cfg.update(bridge_occluders=1, max_bridge_per_pixel=per_pixel)
+        stats[per_pixel] = _check_against_ref(pts, ground, cfg, "vlp16", exact=True).stats
+    budget = int(np.float32(0.25) * np.float32(stats[0.25]["n_candidates"]))
+    assert stats[0.0]["n_bridge_steps"] > 2 * budget
+    # the budget is checked per pixel: the last pixel that bridges may pass it by its own few steps
+    assert budget <= stats[0.25]["n_bridge_steps"] < budget + 4 * 16
+
+
 def test_rescue_budget_default_leaves_real_sized_scans_alone(root):
     """the defaults (4096 / 2048 pixels) are well above what the simulated samples hand to the rescue"""
     from lidet_tools import kitti
@@ -47,6 +62,9 @@ def test_rescue_budget_default_leaves_real_sized_scans_alone(root):
         pts = kitti.read_bin(root / f"tests/data/sim_{sensor}/velodyne/000000.bin")
         c = native.cluster(pts, sensor)
         assert c.stats["n_dropped_fragment_budget"] == 0
+        # no ground mask here: the most bridging a scan does; still below the default budget
+        assert c.stats["n_bridge_steps"] < native.cluster_defaults(sensor)["max_bridge_per_pixel"] * c.stats[
+            "n_candidates"] * 0.75
         assert 0 < c.stats["n_fragment_pixels"] <= native.cluster_defaults(sensor)["max_fragment_pixels"] // 2
 
 

@@ -456,7 +456,7 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     (S, 4) (nx, ny, nz, d) per azimuth sector for the height filter (None: flat ground at
     -mount_height_m). cfg: theta_rad, max_steps, bridge_occluders, diagonals, max_gap_m, max_gap_per_m, min_points,
     max_extent_m, max_mean_height_m, mount_height_m, rescue_gap_m, rescue_gap_per_m, rescue_rows, rescue_cols,
-    max_fragment_pixels (defaults: `cluster_defaults(sensor)`).
+    max_fragment_pixels, max_bridge_per_pixel (defaults: `cluster_defaults(sensor)`).
     """
     s, ctx = proj_init(sensor, ctx=context, **(proj_cfg or {}))
     c = cluster_defaults(s)

@@ -131,6 +131,14 @@ typedef struct
                                   <= LIDET_MAX_ROWS; default 1 (<= 16 beams), 2 (> 16 beams) */
     uint32_t rescue_cols;    /**< columns looked at left and right (wrapping; at most (n_cols - 1) / 2
                                   are used); <= 15; default 6 */
+    float max_bridge_per_pixel; /**< occluder bridging budget (bounds the first fill's time whatever the
+                                  scan): the run steps over at most about this many nearer candidates per
+                                  candidate pixel in all (a pixel's searches bridge only while the run's
+                                  count is below max_bridge_per_pixel * n_candidates; then they stop at the
+                                  first candidate, as with bridge_occluders 0). [0, 64], 0 = no limit.
+                                  Default 2: real KITTI scans bridge 0.8 (ground removed) to 1.3 (no
+                                  ground mask) steps per candidate, a scan of random ranges 5
+                                  (docs/ROBUSTNESS.md) */
     uint32_t max_fragment_pixels; /**< rescue budget (bounds the rescue's time whatever the scan): fragments
                                   enter the rescue in raster order while their pixels sum to at most this;
                                   one that would exceed it is dropped (stats n_dropped_fragment_budget).
@@ -172,6 +180,7 @@ typedef struct
     uint32_t n_queue_overflow;    /**< always 0: the queue holds every pixel (kept for the record) */
     uint32_t n_fragment_pixels;   /**< pixels of the fragments handed to the rescue */
     uint32_t n_dropped_fragment_budget; /**< fragments dropped past max_fragment_pixels */
+    uint32_t n_bridge_steps;      /**< nearer candidates stepped over (occluder bridging) */
 } lidet_cluster_stats_t;
 
 /**

@@ -65,6 +65,7 @@ static inline uint32_t GROW_FN(search)(uint16_t *lab, int32_t *mem, const GROW_R
         {
             break;
         }
+        ++*g->bridged; /* stepped over an occluder (the run's bridging budget, max_bridge_steps) */
     }
     return tail;
 }
@@ -101,6 +102,7 @@ static uint32_t GROW_FN(search_wrap)(lidet_cluster_state_t *c, uint32_t tail, fl
         {
             break;
         }
+        ++*g->bridged;
     }
     return tail;
 }
@@ -123,38 +125,40 @@ static inline uint32_t GROW_FN(grow)(lidet_cluster_state_t *c, const lidet__grow
         const uint32_t r = g->row_magic != 0u ? (uint32_t)(((uint64_t)q * g->row_magic) >> 32) : q / cols;
         const uint32_t rowbase = r * cols, col = q - rowbase;
         const float dq = (float)rng[q];
+        /* occluder bridging for this pixel's searches while the run's budget lasts (decided per pixel) */
+        const int oc = occl && *g->bridged < g->bridge_max;
         const uint32_t nd = rows - 1u - r < ks ? rows - 1u - r : ks; /* steps that stay in the image */
         const uint32_t nu = r < ks ? r : ks;
         LIDET_ASSERT(tail <= rows * cols);
         /* right, left (wrapping) */
         if (col + kc < cols)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, 1, kc, c->col_sin, c->col_cos, 1, g, occl);
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, 1, kc, c->col_sin, c->col_cos, 1, g, oc);
         }
         else
         {
-            tail = GROW_FN(search_wrap)(c, tail, dq, rowbase, col, 1, g, occl);
+            tail = GROW_FN(search_wrap)(c, tail, dq, rowbase, col, 1, g, oc);
         }
         if (col >= kc)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -1, kc, c->col_sin, c->col_cos, 1, g, occl);
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -1, kc, c->col_sin, c->col_cos, 1, g, oc);
         }
         else
         {
-            tail = GROW_FN(search_wrap)(c, tail, dq, rowbase, col, 0, g, occl);
+            tail = GROW_FN(search_wrap)(c, tail, dq, rowbase, col, 0, g, oc);
         }
         /* down: rows r and r + k, entry [r * STEPS + k - 1]; up: rows r - k and r, entry
          * [(r - k) * STEPS + k - 1] (stored at the upper row), i.e. stride 1 - STEPS from (r - 1) * STEPS */
         if (nd > 0u)
         {
             tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, (int32_t)cols, nd, c->row_sin + r * STEPS,
-                                   c->row_cos + r * STEPS, 1, g, occl);
+                                   c->row_cos + r * STEPS, 1, g, oc);
         }
         if (nu > 0u)
         {
             tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -(int32_t)cols, nu,
                                    c->row_sin + (r - 1u) * STEPS, c->row_cos + (r - 1u) * STEPS, 1 - STEPS, g,
-                                   occl);
+                                   oc);
         }
         /* diagonals (8-neighbourhood option): direct neighbours only, no bridging; each joins when
          * free and linked (down-left, down-right, up-left, up-right) */
