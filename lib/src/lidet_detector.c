@@ -43,8 +43,8 @@ static int cfg_ok(const lidet_detector_cfg_t *c)
     uint32_t k, j;
     if (!lidet__isfinite(c->crop_half_rad) || c->crop_half_rad < 0.0f || c->crop_half_rad > LIDET_PI_F + 1e-6f ||
         !lidet__isfinite(c->max_range_m) || c->max_range_m < 0.0f || c->max_proposals < 1 ||
-        c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1 || c->max_boxes > LIDET_MAX_CLUSTERS || c->gate1 > 1 || c->gate2 > 1 || !lidet__isfinite(c->nms_iou) ||
-        c->nms_iou < 0.0f || c->nms_iou > 1.0f)
+        c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1 || c->max_boxes > LIDET_MAX_CLUSTERS ||
+        c->gate1 > 1 || c->gate2 > 1 || !lidet__isfinite(c->nms_iou) || c->nms_iou < 0.0f || c->nms_iou > 1.0f)
     {
         return 0;
     }

@@ -13,15 +13,11 @@
 
 #define NPIX (LIDET_MAX_ROWS * LIDET_MAX_COLS)
 static lidet_proj_t g_proj;
-static lidet_proj_state_t g_pstate;
 static lidet_ground_t g_ground;
 static lidet_cluster_t g_cl;
 static lidet_cluster_state_t g_cstate;
 static uint16_t g_labels[NPIX];
 static int32_t g_members[NPIX];
-static int16_t g_x[NPIX], g_y[NPIX], g_z[NPIX];
-static uint16_t g_r[NPIX];
-static int32_t g_idx[NPIX];
 static uint32_t g_point_labels[LIDET_MAX_POINTS];
 #if FZ_PROPOSALS
 static lidet_proposal_t g_prop;
@@ -164,16 +160,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     else
     {
-        lidet_proj_buffers_t buf;
-        memset(&buf, 0, sizeof buf);
-        buf.x_4mm = g_x;
-        buf.y_4mm = g_y;
-        buf.z_4mm = g_z;
-        buf.range_4mm = g_r;
-        buf.point_idx = g_idx;
-        FZ_CHECK(lidet_proj_state_init(&g_pstate, &s.proj) == LIDET_OK);
-        FZ_CHECK(LIDET_SUCCEEDED(lidet_proj_run_buffers(&g_pstate, &buf, s.pts, s.n_points, s.stride, s.ring)));
-        lidet_proj_image_of(&g_pstate, &buf, &img);
+        FZ_CHECK(fz_project_compact(&s, &img, NULL, &st) != NULL && LIDET_SUCCEEDED(st));
     }
     n_pix = (uint32_t)img.n_rows * img.n_cols;
     if ((mode & 1u) == 0 && LIDET_SUCCEEDED(lidet_ground_run(&g_ground, &img)))

@@ -176,6 +176,35 @@ static void fz_scan_points(fz_in_t *in, fz_scan_t *s)
     s->n_points = n * s->tile;
 }
 
+/* The compact projection (what a detector workspace keeps) of the scan into static buffers: the image in
+ * *img, the status in *rc; point_pixel (LIDET_MAX_POINTS entries) may be NULL. Returns the state (its
+ * stats), or NULL when its init fails (*rc says why). */
+static const lidet_proj_state_t *fz_project_compact(const fz_scan_t *s, lidet_range_image_t *img, int32_t *point_pixel,
+                                                    lidet_status_t *rc)
+{
+    static lidet_proj_state_t st;
+    static int16_t x[LIDET_MAX_ROWS * LIDET_MAX_COLS], y[LIDET_MAX_ROWS * LIDET_MAX_COLS],
+        z[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    static uint16_t r[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    static int32_t idx[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    lidet_proj_buffers_t buf;
+    *rc = lidet_proj_state_init(&st, &s->proj);
+    if (*rc != LIDET_OK)
+    {
+        return NULL;
+    }
+    memset(&buf, 0, sizeof buf);
+    buf.x_4mm = x;
+    buf.y_4mm = y;
+    buf.z_4mm = z;
+    buf.range_4mm = r;
+    buf.point_idx = idx;
+    buf.point_pixel = point_pixel;
+    *rc = lidet_proj_run_buffers(&st, &buf, s->pts, s->n_points, s->stride, s->ring);
+    lidet_proj_image_of(&st, &buf, img);
+    return &st;
+}
+
 /* properties of a projection's counts that hold for any input */
 static void fz_check_proj_stats(const lidet_proj_stats_t *st, uint32_t n_points, uint32_t n_pixels)
 {

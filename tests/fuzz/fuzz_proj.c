@@ -5,11 +5,6 @@
 #include "fuzz_common.h"
 
 static lidet_proj_t g_proj;
-static lidet_proj_state_t g_state;
-static int16_t g_x[LIDET_MAX_ROWS * LIDET_MAX_COLS], g_y[LIDET_MAX_ROWS * LIDET_MAX_COLS],
-    g_z[LIDET_MAX_ROWS * LIDET_MAX_COLS];
-static uint16_t g_r[LIDET_MAX_ROWS * LIDET_MAX_COLS];
-static int32_t g_idx[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 static int32_t g_pp[LIDET_MAX_POINTS];
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -19,8 +14,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fz_in_t in = {data, size};
     fz_scan_t s;
     lidet_status_t st;
-    lidet_range_image_t img;
-    lidet_proj_buffers_t buf;
+    lidet_range_image_t img, cimg;
+    const lidet_proj_state_t *cst;
     const int32_t *pp;
     uint32_t i, n, n_pix;
     fz_scan_header(&in, &s);
@@ -49,20 +44,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK((img.range_m[i] > 0.0f) == (img.point_idx[i] >= 0));
     }
     /* compact image into caller buffers (what a detector workspace does) */
-    FZ_CHECK(lidet_proj_state_init(&g_state, &s.proj) == LIDET_OK);
-    memset(&buf, 0, sizeof buf);
-    buf.x_4mm = g_x;
-    buf.y_4mm = g_y;
-    buf.z_4mm = g_z;
-    buf.range_4mm = g_r;
-    buf.point_idx = g_idx;
-    buf.point_pixel = g_pp;
-    st = lidet_proj_run_buffers(&g_state, &buf, s.pts, s.n_points, s.stride, s.ring);
-    FZ_CHECK(LIDET_SUCCEEDED(st));
-    fz_check_proj_stats(&g_state.stats, s.n_points, n_pix);
+    cst = fz_project_compact(&s, &cimg, g_pp, &st);
+    FZ_CHECK(cst != NULL && LIDET_SUCCEEDED(st));
+    fz_check_proj_stats(&cst->stats, s.n_points, n_pix);
     for (i = 0; i < n_pix; ++i)
     {
-        FZ_CHECK((g_r[i] >= 1) == (g_idx[i] >= 0));
+        FZ_CHECK((cimg.range_4mm[i] >= 1) == (cimg.point_idx[i] >= 0));
     }
     for (i = 0; i < n; ++i)
     {

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
-/* Regression tests of the bugs the fuzz harnesses found (issue 19, docs/ROBUSTNESS.md); the crashing
- * inputs themselves are replayed from tests/fuzz/regressions by the fuzz_replay_* tests. */
+/* Regression tests of the projection bugs the fuzz harnesses found (issue 19, docs/ROBUSTNESS.md; the
+ * PointNet one is in test_pointnet.c); the crashing inputs themselves are replayed from
+ * tests/fuzz/regressions by the fuzz_replay_* tests. */
 #include <math.h>
 #include <string.h>
 
@@ -95,69 +96,11 @@ static void test_zero_width_field_of_view_rejected(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proj_init(&g.ws, &cfg));
 }
 
-/* fuzz_pointnet: a box net whose heading residual is huge (1e30) or infinite never returned (the heading
- * wrap subtracted 2 pi until it fell in range). A one-layer box net with H = S = 1 whose head bias sets the
- * residual: the yaw comes back in (-pi, pi] (finite heading) or NaN (infinite one). */
-static const float w_point[3 * 4] = {0};
-static const float b_point[4] = {0};
-static const float w_head[7 * 9] = {0};
-static float b_head[9];
-static const float mean_size[3] = {4.0f, 1.8f, 1.5f};
-static const lidet_pn_layer_t l_point = {3, 4, 1, w_point, b_point};
-static const lidet_pn_layer_t l_head = {7, 9, 0, w_head, b_head};
-
-static void test_box_heading_wrap_terminates(void)
-{
-    static float scratch[2048];
-    static lidet_proposal_t p;
-    /* the heading is residual * pi / H (H = 1): 3e38 overflows to Inf there, like INFINITY itself */
-    static const float residuals[] = {1e30f, -1e37f, 12345.678f, -3e38f, INFINITY};
-    lidet_pn_model_t m;
-    lidet_pn_t pn;
-    lidet_pn_box_out_t out;
-    uint32_t i;
-    memset(&m, 0, sizeof m);
-    m.format_version = LIDET_WEIGHTS_FORMAT_VERSION;
-    m.kind = LIDET_PN_BOX;
-    m.precision = LIDET_PN_F32;
-    m.n_stages = 1;
-    m.n_classes = LIDET_N_CLASSES;
-    m.n_points = 4;
-    m.n_heading_bins = 1;
-    m.n_size_clusters = 1;
-    m.stage[0].point = &l_point;
-    m.stage[0].head = &l_head;
-    m.stage[0].n_point = 1;
-    m.stage[0].n_head = 1;
-    m.stage[0].use_onehot = 1;
-    m.mean_size_m = mean_size;
-    m.energy_t = 1.0f;
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_init(&pn, &m, scratch, sizeof scratch, NULL));
-    memset(&p, 0, sizeof p);
-    p.n_points = 4;
-    p.mean_m[0] = 10.0f;
-    for (i = 0; i < sizeof residuals / sizeof residuals[0]; ++i)
-    {
-        memset(b_head, 0, sizeof b_head);
-        b_head[3 + 1] = residuals[i]; /* [3 + H]: the heading residual of bin 0 */
-        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_box(&pn, &p, 0, &out));
-        if (i >= 3)
-        {
-            TEST_ASSERT_TRUE(isnan(out.box.yaw_rad));
-        }
-        else
-        {
-            TEST_ASSERT_TRUE(out.box.yaw_rad > -3.14159274f && out.box.yaw_rad <= 3.14159274f);
-        }
-    }
-}
-
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_ring_path_tiny_xy_stays_in_image);
     RUN_TEST(test_overflowing_denominator_not_projected);
     RUN_TEST(test_zero_width_field_of_view_rejected);
-    RUN_TEST(test_box_heading_wrap_terminates);
     return UNITY_END();
 }

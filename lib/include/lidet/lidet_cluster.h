@@ -136,9 +136,9 @@ typedef struct
                                   candidate pixel in all (a pixel's searches bridge only while the run's
                                   count is below max_bridge_per_pixel * n_candidates; then they stop at the
                                   first candidate, as with bridge_occluders 0). [0, 64], 0 = no limit.
-                                  Default 2: real KITTI scans bridge 0.8 (ground removed) to 1.3 (no
-                                  ground mask) steps per candidate, a scan of random ranges 5
-                                  (docs/ROBUSTNESS.md) */
+                                  Default 2: real KITTI / SemanticKITTI scans bridge 0.4-1.15 steps per
+                                  candidate with the ground removed, 0.6-1.4 without a ground mask (9
+                                  frames), a scan of random ranges 5 (docs/ROBUSTNESS.md) */
     uint32_t max_fragment_pixels; /**< rescue budget (bounds the rescue's time whatever the scan): fragments
                                   enter the rescue in raster order while their pixels sum to at most this;
                                   one that would exceed it is dropped (stats n_dropped_fragment_budget).
