@@ -93,7 +93,7 @@ static const py_field_t k_fields[] = {
     FLD(lidet_cluster_cfg_t, max_mean_height_m, 'f'), FLD(lidet_cluster_cfg_t, mount_height_m, 'f'),
     FLD(lidet_cluster_cfg_t, rescue_gap_m, 'f'), FLD(lidet_cluster_cfg_t, rescue_gap_per_m, 'f'),
     FLD(lidet_cluster_cfg_t, rescue_rows, 'u'), FLD(lidet_cluster_cfg_t, rescue_cols, 'u'),
-    FLD(lidet_cluster_cfg_t, max_fragment_pixels, 'u'), FLD(lidet_cluster_cfg_t, max_bridge_per_pixel, 'f'),
+    FLD(lidet_cluster_cfg_t, max_bridge_per_pixel, 'f'), FLD(lidet_cluster_cfg_t, max_fragment_pixels, 'u'),
     FLD(lidet_cluster_stats_t, n_candidates, 'u'), FLD(lidet_cluster_stats_t, n_found, 'u'),
     FLD(lidet_cluster_stats_t, n_fragments, 'u'), FLD(lidet_cluster_stats_t, n_rescue_joined, 'u'),
     FLD(lidet_cluster_stats_t, n_rescue_pixels, 'u'), FLD(lidet_cluster_stats_t, n_dropped_small, 'u'),
