@@ -5,12 +5,14 @@ VENV     ?= .venv
 PY       := $(VENV)/bin/python
 BUILD    ?= build
 ASAN     ?= build-asan
+FUZZ     ?= build-fuzz
+FUZZ_SECONDS ?= 60
 JOBS     ?= $(shell nproc 2>/dev/null || echo 2)
 CMAKE_FLAGS ?=
 SAMPLE   ?= tests/data/sim_hdl64/velodyne/000000.bin
 REAL     ?= ../shared/data/real
 
-.PHONY: all deps build test test-c test-py test-asan demo bench weights clean firmware firmware-run
+.PHONY: all deps build test test-c test-py test-asan test-fuzz fuzz fuzz-build demo bench weights clean firmware firmware-run
 
 all: build
 
@@ -29,7 +31,7 @@ build: $(BUILD)/CMakeCache.txt
 test: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DLIDET_BUILD_TESTS=ON $(CMAKE_FLAGS)
 	$(MAKE) --no-print-directory build
-	$(MAKE) --no-print-directory test-c test-py test-asan
+	$(MAKE) --no-print-directory test-c test-py test-asan test-fuzz
 
 test-c:
 	ctest --test-dir $(BUILD) --output-on-failure -j $(JOBS)
@@ -42,6 +44,25 @@ test-asan:
 	      -DLIDET_BUILD_CONSUMER_TESTS=OFF $(CMAKE_FLAGS)
 	cmake --build $(ASAN) -j $(JOBS)
 	ctest --test-dir $(ASAN) --output-on-failure -j $(JOBS)
+	# determinism across builds: the Release CLI and the sanitizer CLI write the same bytes
+	LIDET_BUILD_DIR=$(abspath $(BUILD)) LIDET_ASAN_BUILD_DIR=$(abspath $(ASAN)) $(PY) -m pytest -q tests/python/test_determinism.py
+
+# libFuzzer harnesses (tests/fuzz, clang only): the library at small capacities under ASan + UBSan. test-fuzz
+# replays each harness's committed corpus and crash regressions and fuzzes it for a few seconds (ctest);
+# `make fuzz` runs every harness for FUZZ_SECONDS (default 60). Without clang both say so and skip (the
+# gcc and sanitizer builds still replay the corpus and the regressions: the fuzz_replay_* tests).
+FUZZ_CC ?= clang
+fuzz-build:
+	@if command -v $(FUZZ_CC) >/dev/null 2>&1; then \
+	  cmake -S . -B $(FUZZ) -DCMAKE_C_COMPILER=$(FUZZ_CC) -DCMAKE_BUILD_TYPE=Debug -DLIDET_BUILD_FUZZ=ON \
+	        -DLIDET_BUILD_HOST=OFF -DLIDET_BUILD_TESTS=OFF && cmake --build $(FUZZ) -j $(JOBS); \
+	else echo "fuzz: SKIPPED: $(FUZZ_CC) not found (make deps installs clang; the fuzz_replay_* tests of the other builds still run)"; fi
+
+test-fuzz: fuzz-build
+	@if [ -f $(FUZZ)/CTestTestfile.cmake ]; then ctest --test-dir $(FUZZ) --output-on-failure -j $(JOBS); fi
+
+fuzz: fuzz-build
+	@if [ -d $(FUZZ)/tests/fuzz ]; then FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_JOBS=$(JOBS) tools/scripts/fuzz_run.sh $(FUZZ); fi
 
 # The detector on the simulated scans shipped in the repo (hdl64 and vlp16; ground truth drawn in green),
 # and on a real KITTI frame when ../shared/data/real is there; then the stages one by one with their pictures.
@@ -94,4 +115,4 @@ weights: deps build
 	    --jobs $(JOBS) --threads 1 --real $(REAL)/kitti/training --real-semantickitti $(REAL)/semantickitti $(WEIGHTS_ARGS)
 
 clean:
-	rm -rf $(BUILD) $(ASAN) out
+	rm -rf $(BUILD) $(ASAN) $(FUZZ) out

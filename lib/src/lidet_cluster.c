@@ -50,6 +50,9 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->rescue_gap_per_m = 0.03f;
     cfg->rescue_rows = sensor != 0 && sensor->n_rows <= 16 ? 1u : 2u;
     cfg->rescue_cols = 6u;
+    /* worst-case bounds (issue 19, docs/ROBUSTNESS.md) */
+    cfg->max_fragment_pixels = sensor != 0 && sensor->n_rows <= 16 ? 2048u : 4096u;
+    cfg->max_bridge_per_pixel = 2.0f;
     /* refinement (issue 15), measured on the simulated crowd scenes (docs/BENCHMARKS.md) */
     cfg->split_people = 1u;
     cfg->split_min_width_m = 0.9f;
@@ -83,6 +86,7 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
         !lidet__isfinite(cfg->max_mean_height_m) || !lidet__isfinite(cfg->mount_height_m) ||
         cfg->mount_height_m < 0.0f || !lidet__isfinite(cfg->max_gap_m) || cfg->max_gap_m < 0.0f ||
         !lidet__isfinite(cfg->max_gap_per_m) || cfg->max_gap_per_m < 0.0f ||
+        !(cfg->max_bridge_per_pixel >= 0.0f && cfg->max_bridge_per_pixel <= 64.0f) ||
         !lidet__isfinite(cfg->rescue_gap_m) || cfg->rescue_gap_m < 0.0f ||
         !lidet__isfinite(cfg->rescue_gap_per_m) || cfg->rescue_gap_per_m < 0.0f ||
         cfg->rescue_rows > LIDET_MAX_ROWS || cfg->rescue_cols > RESCUE_MAX_COLS || cfg->split_people > 1u ||
@@ -208,6 +212,7 @@ static int rescue_on(const lidet_cluster_state_t *c)
 #define RUN_RESCUE_T lidet__rescue_t
 #define RUN_RESCUE_FAR 3.0e38f
 #define RUN_RESCUE_GROW lidet__cluster_rescue_grow
+#define RUN_FRAGMENT_BUDGET(c) ((c)->cfg.max_fragment_pixels)
 #include "internal/lidet_cluster_run_body.h"
 
 lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *labels, int32_t *members,
@@ -240,6 +245,8 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     lk.gpm = c->cfg.max_gap_per_m;
     lk.rgap = c->cfg.rescue_gap_m;
     lk.rgpm = c->cfg.rescue_gap_per_m;
+    lk.bridge_max = 0xFFFFFFFFu; /* set once the candidates are counted */
+    lk.bridged = &st.n_bridge_steps;
 
     /* candidates: FREE (0) or NONCAND (0xFFFF) = cand - 1 in 16 bits; no branch, so it vectorises.
      * A pixel holds a point iff its range is > 0 (the image contract; point_idx may be absent) */
@@ -270,6 +277,11 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
             }
         }
         st.n_candidates = n_cand;
+        if (c->cfg.max_bridge_per_pixel > 0.0f)
+        {
+            /* <= 64 * 2^24 * 4: fits */
+            lk.bridge_max = (uint32_t)(c->cfg.max_bridge_per_pixel * (float)n_cand);
+        }
     }
 
     run_fills(c, &lk, npix, planes, n_sectors, &st);

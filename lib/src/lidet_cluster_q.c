@@ -150,6 +150,7 @@ static int rescue_on(const lidet_cluster_q_state_t *c)
 #define RUN_RESCUE_T lidet__rescue_q_t
 #define RUN_RESCUE_FAR 0xFFFFFFFFu
 #define RUN_RESCUE_GROW lidet__cluster_q_rescue_grow
+#define RUN_FRAGMENT_BUDGET(c) 0u /* no rescue budget in the integer stage yet */
 #include "internal/lidet_cluster_run_body.h"
 
 lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lidet_cluster_q_cfg_t *cfg)
@@ -183,6 +184,7 @@ lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t 
                                            const lidet_plane_q_t *planes, uint32_t n_sectors)
 {
     lidet__grow_q_t lk;
+    uint32_t bridged = 0;
     lidet_cluster_stats_t st;
     uint32_t npix;
     lidet_status_t chk = run_check(c, labels, members, img, planes, n_sectors);
@@ -206,6 +208,10 @@ lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t 
     lk.gpm = c->cfg.max_gap_per_m_q16;
     lk.rgap = (uint32_t)lidet__q_div_round((int64_t)c->cfg.rescue_gap_mm, 4);
     lk.rgpm = c->cfg.rescue_gap_per_m_q16;
+    /* no bridging budget in the integer stage yet (the float stage's max_bridge_per_pixel, issue 19): the
+     * counter goes to a local, the stats keep 0 */
+    lk.bridge_max = 0xFFFFFFFFu;
+    lk.bridged = &bridged;
     st.n_candidates = lidet__cluster_mark_4mm(img->range_4mm, ground_mask, npix, labels);
     run_fills(c, &lk, npix, planes, n_sectors, &st);
     c->stats = st;

@@ -30,6 +30,8 @@ void lidet_detector_cfg_default(lidet_detector_cfg_t *cfg, const lidet_sensor_t 
      * every cluster of a typical scan (a budget of 64 lost the road users beyond the 64th cluster) */
     cfg->max_proposals = sensor != 0 && sensor->n_rows <= 16 ? 128u : 256u;
     cfg->max_proposals = cfg->max_proposals < LIDET_MAX_CLUSTERS ? cfg->max_proposals : LIDET_MAX_CLUSTERS;
+    cfg->max_boxes = sensor != 0 && sensor->n_rows <= 16 ? 24u : 48u;
+    cfg->max_boxes = cfg->max_boxes < LIDET_MAX_CLUSTERS ? cfg->max_boxes : LIDET_MAX_CLUSTERS;
     cfg->gate1 = 1;
     cfg->gate2 = 1;
     cfg->nms_iou = 0.1f;
@@ -42,8 +44,8 @@ static int cfg_ok(const lidet_detector_cfg_t *c)
     uint32_t k, j;
     if (!lidet__isfinite(c->crop_half_rad) || c->crop_half_rad < 0.0f || c->crop_half_rad > LIDET_PI_F + 1e-6f ||
         !lidet__isfinite(c->max_range_m) || c->max_range_m < 0.0f || c->max_proposals < 1 ||
-        c->max_proposals > LIDET_MAX_CLUSTERS || c->gate1 > 1 || c->gate2 > 1 || !lidet__isfinite(c->nms_iou) ||
-        c->nms_iou < 0.0f || c->nms_iou > 1.0f)
+        c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1 || c->max_boxes > LIDET_MAX_CLUSTERS ||
+        c->gate1 > 1 || c->gate2 > 1 || !lidet__isfinite(c->nms_iou) || c->nms_iou < 0.0f || c->nms_iou > 1.0f)
     {
         return 0;
     }
@@ -205,10 +207,17 @@ float lidet_box_bev_iou(const lidet_box_t *a, const lidet_box_t *b)
 
 /* ---- the run -------------------------------------------------------------------------------------- */
 
+/* a plausible size for the class, and a finite centre and heading (a hostile scan can drive the box net to
+ * Inf/NaN outputs: such a box is dropped here, counted with the impossible sizes) */
 static int size_ok(const lidet_detector_cfg_t *c, uint32_t cls, const lidet_box_t *b)
 {
     const float v[3] = {b->l_m, b->w_m, b->h_m};
     uint32_t j;
+    if (!lidet__isfinite(b->cx_m) || !lidet__isfinite(b->cy_m) || !lidet__isfinite(b->cz_m) ||
+        !lidet__isfinite(b->yaw_rad))
+    {
+        return 0;
+    }
     for (j = 0; j < 3; ++j)
     {
         if (!(v[j] >= c->size_min_m[cls][j] && v[j] <= c->size_max_m[cls][j]))
@@ -320,6 +329,13 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
         {
             d->outcome[ci] = LIDET_DET_OUT_GATE1;
             ++st->n_gate1_rejected;
+            continue;
+        }
+        if (st->n_boxed == d->cfg.max_boxes)
+        {
+            d->outcome[ci] = LIDET_DET_OUT_BUDGET;
+            ++st->n_over_box_budget;
+            worst = LIDET_TRUNCATED;
             continue;
         }
         tb = now(d);

@@ -445,8 +445,19 @@ lidet_status_t lidet_pn_classify(lidet_pn_t *pn, const lidet_proposal_t *p, lide
     return LIDET_OK;
 }
 
+/* a heading wrapped to (-pi, pi]. fmodf is exact, so the loops below run at most once whatever the
+ * magnitude (a network fed hostile points can output 1e38 or Inf: the loops alone never ended, issue 19,
+ * found by fuzz_pointnet); a non-finite heading is returned as NaN (the box is invalid). */
 static float wrap_pi(float a)
 {
+    if (!lidet__isfinite(a))
+    {
+        return a - a; /* NaN for Inf and NaN */
+    }
+    if (a > TWO_PI_F || a < -TWO_PI_F)
+    {
+        a = fmodf(a, TWO_PI_F);
+    }
     while (a > LIDET_PI_F)
     {
         a -= TWO_PI_F;

@@ -176,6 +176,12 @@ lidet_status_t lidet_proj_state_init(lidet_proj_state_t *proj, const lidet_proj_
     proj->tan_lo = tanf(bottom_rad);
     span = proj->tan_hi - proj->tan_lo;
     proj->lut_scale = (float)LIDET_PROJ_ROW_LUT / span;
+    if (!(span > 0.0f) || !lidet__isfinite(proj->lut_scale))
+    {
+        /* a field of view (beams + margin) of zero or denormal width: no bucket size (run() would convert
+         * 0 * Inf to an integer; issue 19, found by fuzz_proj) */
+        return LIDET_ERR_CONFIG;
+    }
 
     /* bucket k covers tan in [lo + k/scale, lo + (k+1)/scale): store the row of its top end, the
      * smallest row any tan in the bucket can have; run() walks down from there (usually 0-1 step) */
@@ -230,7 +236,7 @@ lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg)
 #define KEY_BLOCK ((uint32_t)LIDET_PROJ_BLOCK) /* lidet_opt.h, 64 by default */
 #define KEY_RANGE_OK 1 /* min2 <= r^2 <= max2 (so x, y, z finite) */
 #define KEY_FOV_OK 2   /* tan(elevation) in [tan_lo, tan_hi] (so not NaN) */
-#define KEY_DEN_OK 4   /* (|x|+|y|) * rxy > 0: t and d are defined */
+#define KEY_DEN_OK 4   /* 1 / ((|x|+|y|) * rxy) finite and > 0: t and d are defined */
 #define KEY_ALL 7
 
 typedef struct
@@ -271,7 +277,11 @@ static inline void key_block(key_block_t *kb, const float *pts, uint32_t m, uint
         const float inv = 1.0f / den;
         const float q = x * rxy * inv;
         const float t = z * s * inv;
-        const float d = (y >= 0.0f ? 1.0f : 3.0f) + (y >= 0.0f ? q : -q); /* 1 + q or 3 - q (= 3 + -q) */
+        const float d0 = (y >= 0.0f ? 1.0f : 3.0f) + (y >= 0.0f ? q : -q); /* 1 + q or 3 - q (= 3 + -q) */
+        /* rounding can put d a few ulp outside [0, 4] (at +-pi: 1 + q with q = -1 - ulp): clamped, so the
+         * column corrections in run() never step past the edge table (issue 19, found by fuzz_ground) */
+        const float d1 = d0 >= 0.0f ? d0 : 0.0f;
+        const float d = d1 <= 4.0f ? d1 : 4.0f;
         const int32_t range_ok = (r2 >= min2) & (r2 <= max2);
         const int32_t fov_ok = (t >= tan_lo) & (t <= tan_hi);
         const float tc0 = t >= tan_lo ? t : tan_lo; /* t itself when fov_ok */
@@ -284,7 +294,10 @@ static inline void key_block(key_block_t *kb, const float *pts, uint32_t m, uint
         kb->r2[j] = r2;
         kb->row_k[j] = (int32_t)((tc - tan_lo) * row_scale); /* in [0, LIDET_PROJ_ROW_LUT] */
         kb->col_k[j] = (int32_t)uc;                          /* in [0, 4 cols] */
-        kb->flags[j] = range_ok | (fov_ok << 1) | ((int32_t)(den > 0.0f) << 2);
+        /* t and d are defined only where 1 / den is finite and non-zero: den 0 (x = y = 0), a denormal den
+         * (|x|, |y| < ~1e-19 m: inv overflows, d would be +-inf and walk the column search out of the table)
+         * and an overflowing den (rxy > ~1.3e19 m: inv 0, t and d meaningless) are all not DEN_OK */
+        kb->flags[j] = range_ok | (fov_ok << 1) | ((int32_t)((inv > 0.0f) & (inv <= 3.4028235e38f)) << 2);
     }
 }
 
@@ -475,7 +488,7 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
                         kb.pix[j] = -1;
                         continue;
                     }
-                    if (!(kb.flags[j] & KEY_DEN_OK)) /* ring path, x = y = 0: straight ahead */
+                    if (!(kb.flags[j] & KEY_DEN_OK)) /* ring path, x = y = 0 (or ~1e-19): straight ahead */
                     {
                         d = 2.0f;
                         col_k = (int32_t)(d * col_scale);

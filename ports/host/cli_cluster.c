@@ -91,6 +91,7 @@ int cli_cluster_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, mount_height_m)
     CLI_SET_FLOAT(c, kv, klen, v, rescue_gap_m)
     CLI_SET_FLOAT(c, kv, klen, v, rescue_gap_per_m)
+    CLI_SET_FLOAT(c, kv, klen, v, max_bridge_per_pixel)
     CLI_SET_INT(c, kv, klen, v, max_steps, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, bridge_occluders, uint32_t, 1)
     CLI_SET_INT(c, kv, klen, v, diagonals, uint32_t, 1)
@@ -112,6 +113,8 @@ int cli_cluster_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, car_max_height_m)
     CLI_SET_FLOAT(c, kv, klen, v, car_min_length_m)
     CLI_SET_FLOAT(c, kv, klen, v, upright_max_width_m)
+    CLI_SET_INT(c, kv, klen, v, max_fragment_pixels, uint32_t, 4294967295.0)
+
     return 1;
 }
 
@@ -341,6 +344,9 @@ int cli_cluster(int argc, char **argv)
         cli_json_int(stdout, "split", cs->n_split);
         cli_json_int(stdout, "split_parts", cs->n_split_parts);
         cli_json_int(stdout, "joined", cs->n_joined);
+        cli_json_int(stdout, "fragment_pixels", cs->n_fragment_pixels);
+        cli_json_int(stdout, "dropped_fragment_budget", cs->n_dropped_fragment_budget);
+        cli_json_int(stdout, "bridge_steps", cs->n_bridge_steps);
         cli_json_int(stdout, "clusters", cs->n_kept);
         cli_json_int(stdout, "proposals", cs->n_kept);
         cli_json_int(stdout, "proposal_points", prcfg.n_points);
@@ -364,8 +370,10 @@ int cli_cluster(int argc, char **argv)
         printf("clusters        %u kept of %u found (dropped: small %u, extent %u, height %u, capacity %u)\n",
                cs->n_kept, cs->n_found, cs->n_dropped_small, cs->n_dropped_extent, cs->n_dropped_height,
                cs->n_dropped_capacity);
-        printf("rescue          %u fragments; %u groups joined clusters, %u pixels kept\n", cs->n_fragments,
-               cs->n_rescue_joined, cs->n_rescue_pixels);
+        printf("rescue          %u fragments (%u pixels, %u past the budget); %u groups joined clusters, %u pixels "
+               "kept\n",
+               cs->n_fragments, cs->n_fragment_pixels, cs->n_dropped_fragment_budget, cs->n_rescue_joined,
+               cs->n_rescue_pixels);
         printf("refinement      %u clusters cut into %u more (people); %u car fragments joined\n", cs->n_split,
                cs->n_split_parts, cs->n_joined);
         printf("proposals       %u x %u points\n", cs->n_kept, prcfg.n_points);

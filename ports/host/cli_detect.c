@@ -412,12 +412,81 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, max_range_m)
     CLI_SET_FLOAT(c, kv, klen, v, nms_iou)
     CLI_SET_INT(c, kv, klen, v, max_proposals, uint32_t, 4294967295.0)
+    CLI_SET_INT(c, kv, klen, v, max_boxes, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, gate1, uint8_t, 1)
     CLI_SET_INT(c, kv, klen, v, gate2, uint8_t, 1)
     /* any clustering field, the proposal refinement of issue 15 included */
     if (strncmp(kv, "stages.cluster.", 15) == 0)
         return cli_cluster_set(&c->stages.cluster, kv + 15);
     return 1;
+}
+
+/* ---- --dump: every result of the scan, bit for bit (determinism tests, issue 19) -------------------- */
+
+static int put_u32(FILE *f, uint32_t v)
+{
+    return fwrite(&v, sizeof v, 1, f) == 1 ? 0 : -1;
+}
+
+static int put_f32(FILE *f, float v)
+{
+    return fwrite(&v, sizeof v, 1, f) == 1 ? 0 : -1;
+}
+
+/* Binary, host byte order: "LDTD", n_points, n_clusters, n_detections (uint32); per point its cluster id
+ * (uint32) then its ground flag (uint8), 0 past LIDET_MAX_POINTS; per kept cluster n_points, seed_pixel,
+ * n_rescued (uint32), mean, min, max (3 float32 each), outcome (uint32), then its proposal (the detector's
+ * proposal configuration: n_points rows of x, y, z float32, the mean, the 3 voxel bins as uint32); per
+ * detection class, cluster id, n_points (uint32), score, energy_cls, energy_box and the box (cx, cy, cz,
+ * l, w, h, yaw) as float32. Written field by field: no struct padding reaches the file. */
+static int write_dump(const char *path, const int32_t *pp, uint32_t n_points)
+{
+    const lidet_workspace_t *ws = lidet_detector_workspace(&g_det);
+    const uint32_t np = n_points < LIDET_MAX_POINTS ? n_points : LIDET_MAX_POINTS;
+    const lidet_cluster_rec_t *recs;
+    const lidet_detection_t *det;
+    const uint8_t *oc;
+    uint32_t n_cl = 0, n_det = 0, n_oc = 0, i, k, *ids;
+    uint8_t *gnd;
+    lidet_proposal_cfg_t pc;
+    static lidet_proposal_t prop;
+    FILE *f;
+    int bad;
+    recs = lidet_workspace_clusters(ws, &n_cl);
+    det = lidet_detector_detections(&g_det, &n_det);
+    oc = lidet_detector_outcomes(&g_det, &n_oc);
+    ids = (uint32_t *)calloc((size_t)n_points + 1u, sizeof *ids);
+    gnd = (uint8_t *)calloc((size_t)n_points + 1u, 1);
+    f = fopen(path, "wb");
+    bad = ids == NULL || gnd == NULL || f == NULL || n_oc != n_cl ||
+          lidet_workspace_point_labels(ws, pp, np, ids, gnd) != LIDET_OK;
+    bad = bad || fwrite("LDTD", 1, 4, f) != 4 || put_u32(f, n_points) || put_u32(f, n_cl) || put_u32(f, n_det);
+    for (i = 0; !bad && i < n_points; ++i)
+        bad = put_u32(f, ids[i]) || fputc(gnd[i], f) == EOF;
+    lidet_proposal_cfg_default(&pc);
+    pc.n_points = g_det.cfg.proposal.n_points;
+    for (k = 0; !bad && k < n_cl; ++k)
+    {
+        bad = put_u32(f, recs[k].n_points) || put_u32(f, recs[k].seed_pixel) || put_u32(f, recs[k].n_rescued) ||
+              put_u32(f, oc[k]);
+        for (i = 0; !bad && i < 3; ++i)
+            bad = put_f32(f, recs[k].mean_m[i]) || put_f32(f, recs[k].min_m[i]) || put_f32(f, recs[k].max_m[i]);
+        bad = bad || lidet_workspace_proposal(ws, k, &pc, &prop) != LIDET_OK ||
+              fwrite(prop.xyz, sizeof(float) * 3u, prop.n_points, f) != prop.n_points;
+        for (i = 0; !bad && i < 3; ++i)
+            bad = put_f32(f, prop.mean_m[i]) || put_u32(f, (uint32_t)(int32_t)prop.voxel[i]);
+    }
+    for (k = 0; !bad && k < n_det; ++k)
+        bad = put_u32(f, det[k].cls) || put_u32(f, det[k].cluster_id) || put_u32(f, det[k].n_points) ||
+              put_f32(f, det[k].score) || put_f32(f, det[k].energy_cls) || put_f32(f, det[k].energy_box) ||
+              put_f32(f, det[k].box.cx_m) || put_f32(f, det[k].box.cy_m) || put_f32(f, det[k].box.cz_m) ||
+              put_f32(f, det[k].box.l_m) || put_f32(f, det[k].box.w_m) || put_f32(f, det[k].box.h_m) ||
+              put_f32(f, det[k].box.yaw_rad);
+    if (f != NULL && fclose(f) != 0)
+        bad = 1;
+    free(ids);
+    free(gnd);
+    return bad ? -1 : 0;
 }
 
 static void usage_extra(void)
@@ -437,10 +506,12 @@ static void usage_extra(void)
                     "  --fixed          the integer detector (lidet_detector_q.h: int8 models, no float; the scan\n"
                     "                   converted to millimetres); the same outputs\n"
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
-                    "                   nms_iou, max_proposals, gate1, gate2; stages.cluster.KEY: a\n"
+                    "                   nms_iou, max_proposals, max_boxes, gate1, gate2; stages.cluster.KEY: a\n"
                     "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
                     "                   stages.cluster.split_people=0: no proposal refinement)\n"
-                    "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n");
+                    "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n"
+                    "  --dump FILE      every result bit for bit (per-point labels, clusters, proposals,\n"
+                    "                   detections; binary, see write_dump in cli_detect.c)\n");
 }
 
 static int pick_models(const char *family, const char *sensor, const lidet_pn_model_t **cls,
@@ -483,7 +554,8 @@ int cli_detect(int argc, char **argv)
     const lidet_detector_stats_t *ds;
     const lidet_detection_t *det;
     lidet_status_t st = LIDET_OK;
-    const char *family = NULL, *calib_path = NULL, *kitti_path = NULL, *gt_path = NULL, *gt_kitti_path = NULL;
+    const char *family = NULL, *calib_path = NULL, *kitti_path = NULL, *gt_path = NULL, *gt_kitti_path = NULL,
+               *dump_path = NULL;
     char chosen[64];
     char **rest;
     const char **sets;
@@ -517,6 +589,8 @@ int cli_detect(int argc, char **argv)
             gt_kitti_path = argv[++i];
         else if (strcmp(argv[i], "--set") == 0 && i + 1 < argc)
             sets[nsets++] = argv[++i];
+        else if (strcmp(argv[i], "--dump") == 0 && i + 1 < argc)
+            dump_path = argv[++i];
         else if (strcmp(argv[i], "--crop") == 0)
             crop = 1;
         else if (strcmp(argv[i], "--fixed") == 0)
@@ -630,6 +704,13 @@ outputs:
             return 1;
         }
     }
+    if (dump_path != NULL && write_dump(dump_path, pp, a.n_points) != 0)
+    {
+        fprintf(stderr, "lidet detect: cannot write '%s'\n", dump_path);
+        free(pp);
+        cli_free(&a);
+        return 1;
+    }
     if (kitti_path != NULL)
     {
         calib_t c;
@@ -696,6 +777,8 @@ outputs:
         cli_json_int(stdout, "classified", ds->n_classified);
         cli_json_int(stdout, "gate1_rejected", ds->n_gate1_rejected);
         cli_json_int(stdout, "boxed", ds->n_boxed);
+        cli_json_int(stdout, "box_budget", cfg.max_boxes);
+        cli_json_int(stdout, "over_box_budget", ds->n_over_box_budget);
         cli_json_int(stdout, "gate2_rejected", ds->n_gate2_rejected);
         cli_json_int(stdout, "size_rejected", ds->n_size_rejected);
         cli_json_int(stdout, "nms_suppressed", ds->n_nms_suppressed);

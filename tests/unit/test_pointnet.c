@@ -131,7 +131,7 @@ static float b_bp_w[3 * 2];
 static const float b_bp_b[2] = {0, 0};
 static float b_bh_w[5 * 11];
 /* centre residual, heading scores (bin 1 wins), heading residuals, size score, size residual */
-static const float b_bh_b[11] = {0.5f, -0.25f, 1.0f, 0.0f, 3.0f, 0.0f, 0.5f, 2.0f, 0.1f, -0.5f, 0.0f};
+static float b_bh_b[11] = {0.5f, -0.25f, 1.0f, 0.0f, 3.0f, 0.0f, 0.5f, 2.0f, 0.1f, -0.5f, 0.0f}; /* [6]: see below */
 static const float b_size[3] = {4.0f, 2.0f, 1.5f};
 static const lidet_pn_layer_t b_tpoint[1] = {{3, 3, 0, b_tp_w, b_tp_b}};
 static const lidet_pn_layer_t b_thead[1] = {{6, 3, 0, b_th_w, b_th_b}};
@@ -429,6 +429,40 @@ void test_find(void)
     TEST_ASSERT_NULL(lidet_pn_find(NULL, 2, "tiny"));
 }
 
+/* fuzz_pointnet (issue 19, docs/ROBUSTNESS.md): a heading residual of 1e30 or Inf (hostile points drive the
+ * box net there) made the heading wrap loop forever. tiny_box's winning bin 1 has its residual at b_bh_b[6];
+ * the yaw comes back in (-pi, pi] (finite heading) or NaN (infinite one: residual * pi / 2 overflows) */
+static void test_box_heading_wrap_terminates(void)
+{
+    static const float residuals[] = {1e30f, -1e37f, 12345.678f, -3e38f, INFINITY};
+    const float saved = b_bh_b[6];
+    const float pts[9] = {1, 2, 3, -1, 0, 0, 0, -2, 1};
+    static lidet_pn_model_t m;
+    lidet_proposal_t p;
+    lidet_pn_box_out_t o;
+    uint32_t i;
+    m = tiny_box();
+    init_ok(&m);
+    memset(&p, 0, sizeof p);
+    p.n_points = 3;
+    p.mean_m[0] = 10.0f;
+    memcpy(&p.xyz[0][0], pts, sizeof pts);
+    for (i = 0; i < sizeof residuals / sizeof residuals[0]; ++i)
+    {
+        b_bh_b[6] = residuals[i];
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_box(&g_pn.ws, &p, LIDET_CLASS_CAR, &o));
+        if (i >= 3)
+        {
+            TEST_ASSERT_TRUE(isnan(o.box.yaw_rad));
+        }
+        else
+        {
+            TEST_ASSERT_TRUE(o.box.yaw_rad > -3.14159274f && o.box.yaw_rad <= 3.14159274f);
+        }
+    }
+    b_bh_b[6] = saved;
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -438,5 +472,6 @@ int main(void)
     RUN_TEST(test_random_model_matches_double_loop);
     RUN_TEST(test_bad_descriptors);
     RUN_TEST(test_find);
+    RUN_TEST(test_box_heading_wrap_terminates);
     return UNITY_END();
 }

@@ -22,25 +22,18 @@ void tearDown(void)
     CANARY_CHECK(g);
 }
 
-/* 12 vertical bars 4 columns apart (never bridged with 3 steps), heights = their sizes */
-static void test_capacity_overflow_counted(void)
+/* n_bars vertical bars 4 columns apart (never bridged with 3 steps), bar b in column 4 b + 1, heights = their
+ * sizes, drawn into t */
+static void draw_bars(const int *height, int n_bars)
 {
-    static const int height[12] = {3, 1, 4, 1, 5, 9, 2, 6, 5, 3, 5, 8};
-    static const int kept_bar[8] = {0, 2, 4, 5, 7, 8, 10, 11};
     static char rows_buf[16][65];
     const char *art[16];
-    lidet_cluster_cfg_t cfg;
-    const lidet_cluster_rec_t *rec;
-    const lidet_cluster_stats_t *st;
-    const uint16_t *lab;
-    uint32_t n, i;
     int r, b;
-    TEST_ASSERT_EQUAL_INT(8, LIDET_MAX_CLUSTERS);
     for (r = 0; r < 16; ++r)
     {
         memset(rows_buf[r], '.', 64);
         rows_buf[r][64] = '\0';
-        for (b = 0; b < 12; ++b)
+        for (b = 0; b < n_bars; ++b)
         {
             if (r < height[b])
                 rows_buf[r][4 * b + 1] = 'c';
@@ -48,6 +41,20 @@ static void test_capacity_overflow_counted(void)
         art[r] = rows_buf[r];
     }
     tcu_draw(&t, art, 16);
+}
+
+/* 12 bars */
+static void test_capacity_overflow_counted(void)
+{
+    static const int height[12] = {3, 1, 4, 1, 5, 9, 2, 6, 5, 3, 5, 8};
+    static const int kept_bar[8] = {0, 2, 4, 5, 7, 8, 10, 11};
+    lidet_cluster_cfg_t cfg;
+    const lidet_cluster_rec_t *rec;
+    const lidet_cluster_stats_t *st;
+    const uint16_t *lab;
+    uint32_t n, i;
+    TEST_ASSERT_EQUAL_INT(8, LIDET_MAX_CLUSTERS);
+    draw_bars(height, 12);
     tcu_cfg(&cfg);
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
     TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
@@ -102,6 +109,54 @@ static void odd_columns_at_11m(void)
 /* the rescue never evicts: 8 bars of 6 pixels fill the capacity; 12 alternating 10 m / 11 m
  * returns in one row (singletons for the angle test at theta 0.8: beta 0.75) become one rescue
  * group that would be a cluster of its own: dropped for capacity and counted, the bars stay */
+/* the capacity drops keep a heap of the slots (issue 19): on 300 random scenes of 16 bars of random heights
+ * (ties frequent), the kept clusters are exactly the 8 largest, ties to the earlier bar, as a brute-force
+ * selection says */
+static void test_capacity_heap_matches_brute_force(void)
+{
+    lidet_cluster_cfg_t cfg;
+    uint32_t seed = 12345u, scene;
+    tcu_cfg(&cfg);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    for (scene = 0; scene < 300; ++scene)
+    {
+        int height[16], keep[16], b, k, n_keep = 0;
+        const lidet_cluster_rec_t *rec;
+        uint32_t n;
+        for (b = 0; b < 16; ++b)
+        {
+            seed = seed * 1103515245u + 12345u;
+            height[b] = 1 + (int)((seed >> 16) % (scene % 2 ? 4u : 16u)); /* odd scenes: many ties */
+            keep[b] = 0;
+        }
+        /* brute force: 8 times the largest not yet taken, ties to the lower bar index */
+        for (k = 0; k < 8; ++k)
+        {
+            int best = -1;
+            for (b = 0; b < 16; ++b)
+            {
+                if (!keep[b] && (best < 0 || height[b] > height[best]))
+                    best = b;
+            }
+            keep[best] = 1;
+        }
+        draw_bars(height, 16);
+        TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, lidet_cluster_run(&g.ws, &t.img, NULL, NULL, 0));
+        rec = lidet_cluster_records(&g.ws, &n);
+        TEST_ASSERT_EQUAL_UINT32(8, n);
+        TEST_ASSERT_EQUAL_UINT32(8, lidet_cluster_stats(&g.ws)->n_dropped_capacity);
+        for (b = 0; b < 16; ++b)
+        {
+            if (keep[b])
+            {
+                TEST_ASSERT_EQUAL_UINT32((uint32_t)(4 * b + 1), rec[n_keep].seed_pixel);
+                TEST_ASSERT_EQUAL_UINT32((uint32_t)height[b], rec[n_keep].n_points);
+                ++n_keep;
+            }
+        }
+    }
+}
+
 static void test_rescue_never_evicts(void)
 {
     static char rows_buf[6][65];
@@ -168,6 +223,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_capacity_overflow_counted);
+    RUN_TEST(test_capacity_heap_matches_brute_force);
     RUN_TEST(test_rescue_never_evicts);
     RUN_TEST(test_image_too_large);
     return UNITY_END();

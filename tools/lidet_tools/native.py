@@ -455,8 +455,8 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     is), e.g. SemanticKITTI ground labels or the ground stage's per-point mask. planes: optional
     (S, 4) (nx, ny, nz, d) per azimuth sector for the height filter (None: flat ground at
     -mount_height_m). cfg: theta_rad, max_steps, bridge_occluders, diagonals, max_gap_m, max_gap_per_m, min_points,
-    max_extent_m, max_mean_height_m, mount_height_m, rescue_gap_m, rescue_gap_per_m, rescue_rows, rescue_cols (defaults:
-    `cluster_defaults(sensor)`).
+    max_extent_m, max_mean_height_m, mount_height_m, rescue_gap_m, rescue_gap_per_m, rescue_rows, rescue_cols,
+    max_fragment_pixels, max_bridge_per_pixel (defaults: `cluster_defaults(sensor)`).
     """
     s, ctx = proj_init(sensor, ctx=context, **(proj_cfg or {}))
     c = cluster_defaults(s)
@@ -700,7 +700,7 @@ OUTCOME = {1: "crop", 2: "range", 3: "budget", 4: "gate1", 5: "gate2", 6: "size"
 CLASSES = ("Car", "Cyclist", "Pedestrian")
 _DET_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity",
-              "n_detections", "status"]
+              "n_detections", "status", "n_over_box_budget"]
 
 
 @dataclass

@@ -81,13 +81,17 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                 max_gap_m: float = 0.0, max_gap_per_m: float = 0.0, min_points: int = 1, max_extent_m: float = 1e30,
                 max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30,
                 rescue_gap_m: float = 0.0, rescue_gap_per_m: float = 0.0, rescue_rows: int = 0, rescue_cols: int = 0,
-                split_people: bool = False, join_cars: bool = False, **refine):
+                max_fragment_pixels: int = 0, max_bridge_per_pixel: float = 0.0, split_people: bool = False,
+                join_cars: bool = False, **refine):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
     member-pixel arrays per kept cluster in raster order). Float32 tangent and distance tests like the
     C; the filters use float64 means (they can differ from the C's float32 only at a filter's edge).
-    rescue_gap_m > 0 turns the fragment rescue on, split_people / join_cars the refinement (refine_ref;
-    lidet_cluster.h)."""
+    rescue_gap_m > 0 turns the fragment rescue on (lidet_cluster.h); max_fragment_pixels > 0 is its budget:
+    fragments enter it in raster order while their pixels sum to at most that. max_bridge_per_pixel > 0
+    sets the occluder bridging budget: a pixel's searches step over nearer candidates only while the run
+    has stepped over fewer than max_bridge_per_pixel * (candidate pixels), in float32 as the C.
+    split_people / join_cars turn the refinement on (refine_ref; lidet_cluster.h)."""
     rows, cols = range_m.shape
     rng = np.asarray(range_m, np.float32).ravel()
     cand = np.asarray(candidate, bool).ravel()
@@ -185,6 +189,10 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
     state = np.where(cand, 0, -2).astype(np.int64)  # 0 free, -2 non-candidate, -1 visited, -3 fragment
     kc = min(max_steps, cols - 1)
     kept = []  # (n, seed, members)
+    frag_px = 0  # fragment pixels handed to the rescue
+    bridged = 0  # nearer candidates stepped over so far (occluder bridging)
+    bridge_max = (int(np.float32(np.float32(max_bridge_per_pixel) * np.float32(int(cand.sum()))))
+                  if max_bridge_per_pixel > 0 else 1 << 62)
     for seed in range(rows * cols):
         if state[seed] != 0:
             continue
@@ -195,6 +203,7 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
             p = q.popleft()
             r, c = divmod(p, cols)
             d = rng[p]
+            occl = bridge_occluders and bridged < bridge_max  # decided per pixel, as the C
             dirs = []
             for k in range(1, kc + 1):
                 dirs.append(("R", k, r * cols + (c + k) % cols))
@@ -221,8 +230,10 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                         state[n] = -1
                         mem.append(n)
                         q.append(n)
-                elif not (bridge_occluders and rng[n] < d):
+                elif not (occl and rng[n] < d):
                     done.add(name)  # a surface behind it: stop; a nearer occluder is stepped over
+                else:
+                    bridged += 1
             if diagonals:  # direct diagonal neighbours: down-left, down-right, up-left, up-right
                 for dr, dc in ((1, -1), (1, 1), (-1, -1), (-1, 1)):
                     rr = r + dr
@@ -239,7 +250,10 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                         q.append(n)
         m = np.array(mem)
         if len(m) < min_points:
+            if rescue and max_fragment_pixels and frag_px + len(m) > max_fragment_pixels:
+                continue  # past the rescue budget: dropped
             if rescue and P[m][:, 2].mean() + mount_height_m <= max_mean_height_m:
+                frag_px += len(m)
                 state[m] = -3  # a fragment, for the rescue
             continue
         if not _passes(m):

@@ -92,7 +92,10 @@ STAT_KEYS = ["n_candidates", "n_found", "n_fragments", "n_rescue_joined", "n_res
              "n_dropped_extent", "n_dropped_height", "n_dropped_capacity", "n_kept", "n_pixels_kept",
              "n_queue_overflow",
              # the float stage's refinement counts (lidet_refine.c); the integer stage has no refinement: always 0
-             "n_split", "n_split_parts", "n_split_skipped", "n_joined"]
+             "n_split", "n_split_parts", "n_split_skipped", "n_joined",
+             # issue 19's bounds: the fragment pixels are counted by the shared run body; the integer stage has
+             # no rescue or bridging budget yet (always 0)
+             "n_fragment_pixels", "n_dropped_fragment_budget", "n_bridge_steps"]
 
 
 def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: dict | None = None,
@@ -273,6 +276,7 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
             del mem[start:]
             return
         if small:
+            st["n_fragment_pixels"] += n
             st["n_fragments"] += 1
             for m in ms:
                 lab[m] = SMALL

@@ -92,12 +92,14 @@
  * * 4 B + LIDET_REFINE_MAX_POINTS * 2 B + LIDET_REFINE_MAX_PARTS * 26 B) + ~200 B: about 1.6 MiB with
  * the defaults (128 x 2048; 1,678,080 B on x86-64), 0.18 MiB for a VLP-16 board (16 x 1800, 64 clusters,
  * refinement caps 2048: 192,448 B). lidet_cluster_bytes() returns the exact figure. Declare it `static`.
- * Time: O(n_rows * n_cols * max_steps) per run worst case, O(n_rows * n_cols) typical (the rescue
- * looks at (2 rescue_rows + 1)(2 rescue_cols + 1) pixels around each fragment pixel); plus O(K * LIDET_MAX_CLUSTERS)
- * when K clusters overflow the capacity, and at most O(LIDET_MAX_CLUSTERS^2) to order the ids when
- * rescued pixels precede a cluster's seed. The refinement: O(members + cells) per examined cluster
- * (cells <= LIDET_REFINE_MAX_CELLS), O(parts * members) for one it cuts, O(K^2) box tests for the joins of
- * K clusters, and one more canonical pass over the image when anything changed. No allocation.
+ * Time: O(n_rows * n_cols * max_steps) per run worst case, O(n_rows * n_cols) typical; the rescue
+ * looks at (2 rescue_rows + 1)(2 rescue_cols + 1) pixels around each fragment pixel, at most
+ * max_fragment_pixels of them (the budget that bounds it whatever the scan); plus O(K log LIDET_MAX_CLUSTERS)
+ * when K clusters overflow the capacity (a heap of the slots), and at most O(LIDET_MAX_CLUSTERS^2) to
+ * order the ids when rescued pixels precede a cluster's seed. The refinement: O(members + cells) per
+ * examined cluster (cells <= LIDET_REFINE_MAX_CELLS), O(parts * members) for one it cuts, O(K^2) box tests
+ * for the joins of K clusters, and one more canonical pass over the image when anything changed. No
+ * allocation. Worst cases measured in docs/ROBUSTNESS.md.
  */
 #ifndef LIDET_CLUSTER_H
 #define LIDET_CLUSTER_H
@@ -190,6 +192,20 @@ typedef struct
     float upright_max_width_m; /**< a cluster spanning at most this in x and in y and at least
                                   person_min_height_m in z is upright (a person, a cyclist, a pole)
                                   and joins nothing; >= 0; default 1.3 m */
+    float max_bridge_per_pixel; /**< occluder bridging budget (bounds the first fill's time whatever the
+                                  scan): the run steps over at most about this many nearer candidates per
+                                  candidate pixel in all (a pixel's searches bridge only while the run's
+                                  count is below max_bridge_per_pixel * n_candidates; then they stop at the
+                                  first candidate, as with bridge_occluders 0). [0, 64], 0 = no limit.
+                                  Default 2: real KITTI / SemanticKITTI scans bridge 0.4-1.15 steps per
+                                  candidate with the ground removed, 0.6-1.4 without a ground mask (9
+                                  frames), a scan of random ranges 5 (docs/ROBUSTNESS.md) */
+    uint32_t max_fragment_pixels; /**< rescue budget (bounds the rescue's time whatever the scan): fragments
+                                  enter the rescue in raster order while their pixels sum to at most this;
+                                  one that would exceed it is dropped (stats n_dropped_fragment_budget).
+                                  0 = no limit. Default 4096 (> 16 beams), 2048 (<= 16 beams): about 2x
+                                  the most fragment pixels measured on real KITTI scans (2074) and 2.5x
+                                  the simulated VLP-16 sample's (816; docs/ROBUSTNESS.md) */
 } lidet_cluster_cfg_t;
 
 /** @brief One kept cluster. Coordinates in the sensor frame (metres). */
@@ -227,6 +243,9 @@ typedef struct
     uint32_t n_split_parts;       /**< refinement: new clusters the cuts made */
     uint32_t n_split_skipped;     /**< refinement: clusters examined but too large for the grid caps */
     uint32_t n_joined;            /**< refinement: clusters joined into another (car fragments) */
+    uint32_t n_fragment_pixels;   /**< pixels of the fragments handed to the rescue */
+    uint32_t n_dropped_fragment_budget; /**< fragments dropped past max_fragment_pixels */
+    uint32_t n_bridge_steps;      /**< nearer candidates stepped over (occluder bridging) */
 } lidet_cluster_stats_t;
 
 /**

@@ -17,8 +17,10 @@
  *     the scan holds. The rest is counted, not classified.
  *  3. Per candidate: the proposal (lidet_proposal_make with the models' points per proposal), the
  *     classifier (gate 1: energy < gamma_c[class]), then the box net with that class (gate 2:
- *     heading + size energy < gamma_b[class]). Either gate can be switched off (evaluation).
- *  4. Boxes of impossible size for their class (outside [size_min, size_max] per dimension) are dropped.
+ *     heading + size energy < gamma_b[class]), for at most max_boxes of them per scan (nearest first).
+ *     Either gate can be switched off (evaluation).
+ *  4. Boxes of impossible size for their class (outside [size_min, size_max] per dimension), or with a
+ *     non-finite centre or yaw, are dropped.
  *  5. Non-maximum suppression in bird's-eye view: detections sorted by score (ties: cluster id); one
  *     whose rotated BEV IoU with a kept detection of any class exceeds nms_iou is dropped.
  * Score: 1 / (1 + exp(E_c - gamma_c[class])), monotonic in the classifier energy, 0.5 at gate 1's
@@ -58,10 +60,10 @@ typedef enum
 {
     LIDET_DET_OUT_CROP = 1,     /**< outside the azimuth window */
     LIDET_DET_OUT_RANGE = 2,    /**< beyond max_range_m */
-    LIDET_DET_OUT_BUDGET = 3,   /**< past max_proposals */
+    LIDET_DET_OUT_BUDGET = 3,   /**< past max_proposals, or passed gate 1 past max_boxes */
     LIDET_DET_OUT_GATE1 = 4,    /**< classified, rejected by gate 1 */
     LIDET_DET_OUT_GATE2 = 5,    /**< boxed, rejected by gate 2 */
-    LIDET_DET_OUT_SIZE = 6,     /**< boxed, impossible size for its class */
+    LIDET_DET_OUT_SIZE = 6,     /**< boxed, impossible size for its class (or a non-finite centre or yaw) */
     LIDET_DET_OUT_NMS = 7,      /**< suppressed by the NMS */
     LIDET_DET_OUT_CAPACITY = 8, /**< past LIDET_MAX_DETECTIONS */
     LIDET_DET_OUT_DETECTED = 9  /**< a detection of the output */
@@ -78,6 +80,12 @@ typedef struct
     uint32_t max_proposals;         /**< at most this many clusters classified per scan, nearest first;
                                          [1, LIDET_MAX_CLUSTERS]; default 256 (> 16 beams), 128 (<= 16 beams),
                                          capped by LIDET_MAX_CLUSTERS */
+    uint32_t max_boxes;             /**< at most this many proposals through the box net per scan (those passing
+                                         gate 1, nearest first); the rest get outcome LIDET_DET_OUT_BUDGET
+                                         (stats n_over_box_budget, status LIDET_TRUNCATED): bounds the box
+                                         net's time whatever the scan. [1, LIDET_MAX_CLUSTERS]; default 48 (> 16
+                                         beams), 24 (<= 16 beams): > 2x the most gate-1 passes seen on a real
+                                         scan (21, docs/ROBUSTNESS.md) */
     uint8_t gate1;                  /**< 1 (default): drop proposals failing gate 1 */
     uint8_t gate2;                  /**< 1 (default): drop boxes failing gate 2 */
     float nms_iou;                  /**< BEV IoU above which the lower-scored detection is dropped; [0, 1],
@@ -115,6 +123,7 @@ typedef struct
     uint32_t n_nms_suppressed; /**< dropped by the NMS */
     uint32_t n_over_capacity;  /**< detections past LIDET_MAX_DETECTIONS (lowest scores) */
     uint32_t n_detections;     /**< in the output */
+    uint32_t n_over_box_budget; /**< passed gate 1 past max_boxes (not boxed) */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_workspace_stats_t stages;     /**< the stages' own counts */
 } lidet_detector_stats_t;

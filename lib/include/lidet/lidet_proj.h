@@ -201,7 +201,8 @@ void lidet_proj_cfg_default(lidet_proj_cfg_t *cfg, const lidet_sensor_t *sensor)
  * @param[in]  cfg  configuration; the sensor's beam table is copied, cfg may be freed afterwards.
  * @return LIDET_OK; LIDET_ERR_ARG (NULL); LIDET_ERR_BUFFER (n_rows > LIDET_MAX_ROWS or
  *         n_cols > LIDET_MAX_COLS); LIDET_ERR_CONFIG (n_rows 0, n_cols < 8, elevations not finite,
- *         outside (-pi/2, pi/2) or not distinct, fov_up <= fov_down, ranges or margin out of range).
+ *         outside (-pi/2, pi/2) or not distinct, fov_up <= fov_down, ranges or margin out of range, a
+ *         field of view (beams + margin) of zero width, e.g. one beam and no margin, or below ~1e-37 rad).
  */
 lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg);
 

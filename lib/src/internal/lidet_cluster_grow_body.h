@@ -74,6 +74,7 @@ static inline uint32_t GROW_FN(search)(uint16_t *lab, int32_t *mem, const GROW_R
         {
             break;
         }
+        ++*g->bridged; /* stepped over an occluder (the run's bridging budget, bridge_max) */
     }
     return tail;
 }
@@ -111,6 +112,7 @@ static uint32_t GROW_FN(search_wrap)(GROW_STATE_T *c, uint32_t tail, GROW_D_T dq
         {
             break;
         }
+        ++*g->bridged;
     }
     return tail;
 }
@@ -131,6 +133,8 @@ static inline uint32_t GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uin
     {
         const uint32_t q = (uint32_t)mem[head++];
         const uint32_t r = g->row_magic != 0u ? (uint32_t)(((uint64_t)q * g->row_magic) >> 32) : q / cols;
+        /* occluder bridging for this pixel's searches while the run's budget lasts (decided per pixel) */
+        const int oc = occl && *g->bridged < g->bridge_max;
         const uint32_t rowbase = r * cols, col = q - rowbase;
         const GROW_D_T dq = (GROW_D_T)rng[q];
         const uint32_t nd = rows - 1u - r < ks ? rows - 1u - r : ks; /* steps that stay in the image */
@@ -139,32 +143,32 @@ static inline uint32_t GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uin
         /* right, left (wrapping) */
         if (col + kc < cols)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, 1, kc, GROW_TA(c, col), GROW_TB(c, col), 1, g, occl);
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, 1, kc, GROW_TA(c, col), GROW_TB(c, col), 1, g, oc);
         }
         else
         {
-            tail = GROW_FN(search_wrap)(c, tail, dq, rowbase, col, 1, g, occl);
+            tail = GROW_FN(search_wrap)(c, tail, dq, rowbase, col, 1, g, oc);
         }
         if (col >= kc)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -1, kc, GROW_TA(c, col), GROW_TB(c, col), 1, g, occl);
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -1, kc, GROW_TA(c, col), GROW_TB(c, col), 1, g, oc);
         }
         else
         {
-            tail = GROW_FN(search_wrap)(c, tail, dq, rowbase, col, 0, g, occl);
+            tail = GROW_FN(search_wrap)(c, tail, dq, rowbase, col, 0, g, oc);
         }
         /* down: rows r and r + k, entry [r * STEPS + k - 1]; up: rows r - k and r, entry
          * [(r - k) * STEPS + k - 1] (stored at the upper row), i.e. stride 1 - STEPS from (r - 1) * STEPS */
         if (nd > 0u)
         {
             tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, (int32_t)cols, nd, GROW_TA(c, row) + r * STEPS,
-                                   GROW_TB(c, row) + r * STEPS, 1, g, occl);
+                                   GROW_TB(c, row) + r * STEPS, 1, g, oc);
         }
         if (nu > 0u)
         {
             tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -(int32_t)cols, nu,
                                    GROW_TA(c, row) + (r - 1u) * STEPS, GROW_TB(c, row) + (r - 1u) * STEPS, 1 - STEPS, g,
-                                   occl);
+                                   oc);
         }
         /* diagonals (8-neighbourhood option): direct neighbours only, no bridging; each joins when
          * free and linked (down-left, down-right, up-left, up-right) */

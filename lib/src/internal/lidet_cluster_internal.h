@@ -16,6 +16,9 @@ typedef struct
     int diag;
     uint32_t rrows, rcols; /* rescue window half-sizes (2 rcols < cols) */
     float tan_theta, gap, gpm, rgap, rgpm;
+    uint32_t bridge_max; /* occluder bridging budget of the run (max_bridge_per_pixel * candidates; 0xFFFFFFFF:
+                          * none) */
+    uint32_t *bridged;   /* steps bridged so far in the run; a pixel bridges only while below bridge_max */
 } lidet__grow_t;
 
 /* Running state of one rescue group: the queue tail and the nearest kept pixel met so far. */

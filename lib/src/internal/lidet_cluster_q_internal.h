@@ -19,6 +19,8 @@ typedef struct
     uint32_t gap_on;    /* max_gap_mm > 0 */
     uint32_t gap, gpm;  /* gap bound: gap + (gpm d2 >> 16, rounded) */
     uint32_t rgap, rgpm; /* rescue distance: rgap + (rgpm min(d1, d2) >> 16, rounded) */
+    uint32_t bridge_max; /* occluder bridging budget of the run (the shared flood fill reads it) */
+    uint32_t *bridged;   /* steps bridged so far in the run */
 } lidet__grow_q_t;
 
 /* Running state of one rescue group. */
