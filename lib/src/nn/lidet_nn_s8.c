@@ -69,13 +69,16 @@ LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, u
  * blocked kernels' leftovers), and two register-blocked ones for 32-bit cores, which keep 2 x 2 or 4 x 2 (points x output channels) accumulators in registers and
  * load each weight once per block of points: 2.75 instead of 4.5 instructions per multiply-add on a Cortex-M3
  * (2 x 2), 3.5 instead of 6 on RV32IM (4 x 2, more registers), counted in the compilers' inner loops.
- * ARMv6-M (Cortex-M0+: 8 low registers, no multiply-accumulate) keeps rows4. Override with
- * -DLIDET_NN_S8_KERNEL=0 (rows4), 22 or 42. tests/unit/test_nn_s8.c checks that all agree. */
+ * ARMv6-M (Cortex-M0+: 8 low registers, no multiply-accumulate) takes the plain output-inner loop (two
+ * inputs per pass: 6 instructions per multiply-add, rows4 costs more there). Override with
+ * -DLIDET_NN_S8_KERNEL=0 (rows4), 1 (output-inner), 22 or 42. tests/unit/test_nn_s8.c checks that all agree. */
 #ifndef LIDET_NN_S8_KERNEL
 #if defined(__riscv)
 #define LIDET_NN_S8_KERNEL 42
 #elif defined(__arm__) && !defined(__ARM_ARCH_6M__)
 #define LIDET_NN_S8_KERNEL 22
+#elif defined(__ARM_ARCH_6M__)
+#define LIDET_NN_S8_KERNEL 1
 #else
 #define LIDET_NN_S8_KERNEL 0
 #endif
@@ -169,6 +172,8 @@ void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const in
     lidet__nn_acc_s8_r2o2(in, n_rows, n_in, w_t, b, n_out, acc);
 #elif LIDET_NN_S8_KERNEL == 42
     lidet__nn_acc_s8_r4o2(in, n_rows, n_in, w_t, b, n_out, acc);
+#elif LIDET_NN_S8_KERNEL == 1
+    lidet__nn_acc_s8_cols(in, n_rows, n_in, w_t, b, n_out, n_out, acc, n_out);
 #else
     lidet__nn_acc_s8_rows4(in, n_rows, n_in, w_t, b, n_out, acc);
 #endif
