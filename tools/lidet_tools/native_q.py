@@ -15,6 +15,13 @@ from lidet_tools import native
 
 _i32p = np.ctypeslib.ndpointer(np.int32, flags="C_CONTIGUOUS")
 _i64p = np.ctypeslib.ndpointer(np.int64, flags="C_CONTIGUOUS")
+_i16p = np.ctypeslib.ndpointer(np.int16, flags="C_CONTIGUOUS")
+_u16p = np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")
+_u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
+_u32p = np.ctypeslib.ndpointer(np.uint32, flags="C_CONTIGUOUS")
+_f32p = np.ctypeslib.ndpointer(np.float32, flags="C_CONTIGUOUS")
+_u64p = np.ctypeslib.ndpointer(np.uint64, flags="C_CONTIGUOUS")
+
 
 # ---- integer math (lib/src/lidet_qmath.c) ------------------------------------------------------
 
@@ -109,9 +116,6 @@ def post_q(boxes, score_q15, cluster_id, cls, iou_q15: int) -> dict:
     return {"size_ok": size_ok.astype(bool), "kept": order[:k].tolist(), "suppressed": supp.tolist()}
 # ---- integer projection and sensor presets (lib/src/lidet_proj_q.c, lib/src/lidet_sensor_q.c) ---------------
 
-_u16p = np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")
-_i16p = np.ctypeslib.ndpointer(np.int16, flags="C_CONTIGUOUS")
-_u32p = np.ctypeslib.ndpointer(np.uint32, flags="C_CONTIGUOUS")
 _proj_q_ready = False
 PROJ_Q_STATS = ("n_points_in", "n_projected", "n_pixels_filled", "n_nonfinite", "n_too_close", "n_too_far",
                 "n_out_of_fov", "n_bad_ring", "n_truncated")
@@ -200,11 +204,6 @@ def isqrt32(v) -> np.ndarray:
 # ---- ground (lib/src/lidet_ground_q.c, lidet_ground_q_fit.c) ---------------------------------------
 
 _ground_q_ready = False
-_i16p = np.ctypeslib.ndpointer(np.int16, flags="C_CONTIGUOUS")
-_u16p = np.ctypeslib.ndpointer(np.uint16, flags="C_CONTIGUOUS")
-_u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
-_f32p = np.ctypeslib.ndpointer(np.float32, flags="C_CONTIGUOUS")
-_u64p = np.ctypeslib.ndpointer(np.uint64, flags="C_CONTIGUOUS")
 
 
 def _ground_q_lib():
