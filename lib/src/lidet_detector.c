@@ -296,17 +296,12 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
         d->order[n_cand] = (uint16_t)i;
         ++n_cand;
     }
-    lidet__sort_u32_u16(d->key, d->order, n_cand);
     if (n_cand > d->cfg.max_proposals)
     {
-        for (i = d->cfg.max_proposals; i < n_cand; ++i)
-        {
-            d->outcome[d->order[i]] = LIDET_DET_OUT_BUDGET;
-        }
-        st->n_over_budget = n_cand - d->cfg.max_proposals;
-        n_cand = d->cfg.max_proposals;
         worst = LIDET_TRUNCATED;
     }
+    n_cand = lidet__nearest_first(d->key, d->order, n_cand, d->cfg.max_proposals, d->outcome, LIDET_DET_OUT_BUDGET,
+                                  &st->n_over_budget);
 
     for (i = 0; i < n_cand; ++i)
     {

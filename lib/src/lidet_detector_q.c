@@ -189,18 +189,12 @@ static uint32_t candidates(lidet_detector_q_t *d, lidet_status_t *worst)
         d->order[n] = (uint16_t)i;
         ++n;
     }
-    lidet__sort_u32_u16(d->key, d->order, n);
     if (n > d->cfg.max_proposals)
     {
-        for (i = d->cfg.max_proposals; i < n; ++i)
-        {
-            d->outcome[d->order[i]] = LIDET_DET_OUT_BUDGET;
-        }
-        st->n_over_budget = n - d->cfg.max_proposals;
-        n = d->cfg.max_proposals;
         *worst = LIDET_TRUNCATED;
     }
-    return n;
+    return lidet__nearest_first(d->key, d->order, n, d->cfg.max_proposals, d->outcome, LIDET_DET_OUT_BUDGET,
+                                &st->n_over_budget);
 }
 
 lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,

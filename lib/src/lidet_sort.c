@@ -56,3 +56,20 @@ void lidet__sort_u32_u16(uint32_t *key, uint16_t *idx, uint32_t n)
         sift(key, idx, 0, i);
     }
 }
+
+uint32_t lidet__nearest_first(uint32_t *key, uint16_t *idx, uint32_t n, uint32_t max, uint8_t *outcome, uint8_t code,
+                              uint32_t *n_over)
+{
+    uint32_t i;
+    lidet__sort_u32_u16(key, idx, n);
+    if (n <= max)
+    {
+        return n;
+    }
+    for (i = max; i < n; ++i)
+    {
+        outcome[idx[i]] = code;
+    }
+    *n_over = n - max;
+    return max;
+}

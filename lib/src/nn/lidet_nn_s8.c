@@ -35,31 +35,22 @@ static inline void rows4_s8(const int8_t *x, uint32_t n_in, const int8_t *w_t, u
 LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                                             const int32_t *b, uint32_t n_out, int32_t *acc)
 {
-    uint32_t r, i, o;
-    for (r = 0; r < n_rows; ++r)
+    const uint32_t n4 = n_rows & ~3u;
+    uint32_t r, o;
+    for (r = 0; r < n4; ++r)
     {
         for (o = 0; o < n_out; ++o)
         {
             acc[r * n_out + o] = b[o];
         }
     }
-    for (r = 0; r + 4u <= n_rows; r += 4u)
+    for (r = 0; r < n4; r += 4u)
     {
         rows4_s8(in + r * n_in, n_in, w_t, n_out, acc + r * n_out);
     }
-    for (; r < n_rows; ++r)
+    if (n4 < n_rows) /* the last rows: the output-inner loop */
     {
-        int32_t *a = acc + r * n_out;
-        const int8_t *x = in + r * n_in;
-        for (i = 0; i < n_in; ++i)
-        {
-            const int32_t x0 = x[i];
-            const int8_t *w0 = w_t + i * n_out;
-            for (o = 0; o < n_out; ++o)
-            {
-                a[o] += x0 * (int32_t)w0[o];
-            }
-        }
+        lidet__nn_acc_s8_cols(in + n4 * n_in, n_rows - n4, n_in, w_t, b, n_out, n_out, acc + n4 * n_out, n_out);
     }
 }
 
