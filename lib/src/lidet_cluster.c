@@ -69,6 +69,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->car_max_height_m = 2.0f;
     cfg->car_min_length_m = 2.5f;
     cfg->upright_max_width_m = 1.3f;
+    cfg->max_join_pieces = 256u;
 }
 
 static lidet_status_t init_done(lidet_cluster_state_t *c); /* lidet_cluster_run_body.h */

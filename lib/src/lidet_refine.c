@@ -342,17 +342,34 @@ static int joinable(const lidet_cluster_cfg_t *cfg, const lidet_cluster_rec_t *a
            (ux > uy ? ux : uy) >= cfg->car_min_length_m && (ux > uy ? uy : ux) <= cfg->car_max_width_m;
 }
 
+#define JOIN_PIECE 4u
+
 int lidet__refine_join(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
                        lidet_cluster_stats_t *st)
 {
     const lidet_cluster_cfg_t *cfg = &c->cfg;
     const uint32_t k = c->n_recs;
-    uint32_t i, j, n_joined = 0;
+    uint32_t i, j, n_joined = 0, n_pieces = 0;
+    /* order[]: 1 = cut by the split, 2 = joined into an earlier cluster, JOIN_PIECE = a car piece within the
+     * budget. A record changes only at its own turn (it takes) or when it is taken (then it is skipped), so
+     * whether it is a car piece is decided once, here, as the pair loop would decide it at its turn */
+    for (i = 0; i < k; ++i)
+    {
+        if (c->order[i] == 0u && car_piece(cfg, &c->recs[i]))
+        {
+            if (cfg->max_join_pieces != 0u && n_pieces >= cfg->max_join_pieces)
+            {
+                ++st->n_join_skipped;
+                continue;
+            }
+            c->order[i] = JOIN_PIECE;
+            ++n_pieces;
+        }
+    }
     for (i = 0; i < k; ++i)
     {
         lidet_cluster_rec_t *a = &c->recs[i];
-        /* order[]: 1 = cut by the split, 2 = joined into an earlier cluster */
-        if (c->order[i] != 0u || !car_piece(cfg, a))
+        if (c->order[i] != JOIN_PIECE)
         {
             continue;
         }
@@ -361,7 +378,7 @@ int lidet__refine_join(lidet_cluster_state_t *c, const lidet_plane_t *planes, ui
             lidet_cluster_rec_t *b = &c->recs[j];
             uint32_t d, m;
             float inv;
-            if (c->order[j] != 0u || !car_piece(cfg, b) || !joinable(cfg, a, b))
+            if (c->order[j] != JOIN_PIECE || !joinable(cfg, a, b))
             {
                 continue;
             }

@@ -114,6 +114,7 @@ int cli_cluster_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, car_min_length_m)
     CLI_SET_FLOAT(c, kv, klen, v, upright_max_width_m)
     CLI_SET_INT(c, kv, klen, v, max_fragment_pixels, uint32_t, 4294967295.0)
+    CLI_SET_INT(c, kv, klen, v, max_join_pieces, uint32_t, 4294967295.0)
 
     return 1;
 }
@@ -344,6 +345,7 @@ int cli_cluster(int argc, char **argv)
         cli_json_int(stdout, "split", cs->n_split);
         cli_json_int(stdout, "split_parts", cs->n_split_parts);
         cli_json_int(stdout, "joined", cs->n_joined);
+        cli_json_int(stdout, "join_skipped", cs->n_join_skipped);
         cli_json_int(stdout, "fragment_pixels", cs->n_fragment_pixels);
         cli_json_int(stdout, "dropped_fragment_budget", cs->n_dropped_fragment_budget);
         cli_json_int(stdout, "bridge_steps", cs->n_bridge_steps);

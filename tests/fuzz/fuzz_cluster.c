@@ -44,6 +44,7 @@ static void cluster_knobs(fz_in_t *in, lidet_cluster_cfg_t *c, uint8_t *mode)
     c->rescue_rows = fz_u8(in) % 6u;
     c->rescue_cols = fz_u8(in) % 18u;
     c->max_fragment_pixels = 8u * fz_u8(in); /* 0: no budget */
+    c->max_join_pieces = fz_u8(in) % 8u; /* 0: no budget */
     fz_poke_f32(in, fl, (uint32_t)(sizeof fl / sizeof fl[0]));
 }
 

@@ -69,9 +69,10 @@ KNOBS = {
     # flags (require_descending), sectors 8, iters 20, steps 1, 1, eval 128, min samples / inliers 10,
     # refine 1, fallback 2, seed, no poke
     "ground": lambda: struct.pack("<BBBBBBBBBBI", 0x04, 7, 19, 0, 0, 126, 8, 8, 1, 2, 7) + NO_POKE,
-    # mode (float + ground), max_steps 5, min_points 5, rescue window 2 x 6, rescue budget 8 x 16 pixels, no poke
-    "cluster": lambda: struct.pack("<BBBBBB", 0x08, 5, 5, 2, 6, 16) + NO_POKE,
-    "proposal": lambda: struct.pack("<BBBBBB", 0x08, 5, 5, 2, 6, 16) + NO_POKE + struct.pack("<HI", 64, 0x5EED1234)
+    # mode (float + ground), max_steps 5, min_points 5, rescue window 2 x 6, rescue budget 8 x 16 pixels, join
+    # budget 0 (none), no poke
+    "cluster": lambda: struct.pack("<BBBBBBB", 0x08, 5, 5, 2, 6, 16, 0) + NO_POKE,
+    "proposal": lambda: struct.pack("<BBBBBBB", 0x08, 5, 5, 2, 6, 16, 0) + NO_POKE + struct.pack("<HI", 64, 0x5EED1234)
     + NO_POKE + struct.pack("<IH", 100, 64),
     # gates on, max proposals 16, max boxes 8, min_points 5, 8 ground sectors, no poke (hdl64 models; vlp16 for
     # the vlp16 scan)

@@ -157,6 +157,26 @@ def test_committed_weights_are_regenerated_exactly(tmp_path):
             f"weights/{n} differs from what codegen makes (regenerate: {' '.join(cmd[1:])})"
 
 
+def test_fuzz_models_are_regenerated_exactly(tmp_path):
+    """The fuzz harnesses' tiny models (tests/fuzz/make_models.sh): their C is what codegen makes from their
+    committed ONNX and calibration files, float and int8."""
+    src = ROOT / "tests" / "fuzz" / "models"
+    dst = tmp_path / "tests" / "fuzz" / "models"
+    dst.mkdir(parents=True)
+    stems = sorted(f.stem for f in src.glob("*.onnx"))
+    assert len(stems) == 4, stems
+    for f in sorted(src.glob("*.onnx")) + sorted(src.glob("*.calib.json")):
+        shutil.copy(f, dst / f.name)
+    for stem in stems:  # as make_models.sh runs them
+        for extra in ([], ["--int8", "--no-report"]):
+            subprocess.run([sys.executable, "-m", "lidet_codegen", "emit", *extra, "--out", "tests/fuzz/models",
+                            f"tests/fuzz/models/{stem}.onnx"], cwd=tmp_path, check=True, capture_output=True)
+    made = sorted(p.name for p in dst.glob("*.[ch]"))
+    assert made == sorted(p.name for p in src.glob("*.[ch]"))
+    for n in made:
+        assert (dst / n).read_text() == (src / n).read_text(), f"tests/fuzz/models/{n}: run tests/fuzz/make_models.sh"
+
+
 # ---- codegen refuses what the C side cannot run ---------------------------------------------------
 
 def _graph(nodes, inits, outputs, meta=None, inputs=("points", "voxel")):

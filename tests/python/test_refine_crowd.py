@@ -37,6 +37,24 @@ def test_each_rule_alone_matches_reference(split, join):
                                   ref.refine_ref(plain.pixel_labels, xyz, split_people=bool(split), join_cars=bool(join)))
 
 
+@pytest.mark.parametrize("cap", [3, 12])
+def test_join_budget_matches_reference(cap):
+    """max_join_pieces: only the first `cap` car pieces (slot order) join; the C and the reference agree, the
+    budget binds (pieces were skipped) and costs joins against no budget."""
+    r = simulate_scan("hdl64", seed=15, index=3, crowd=True)
+    g = ce.ground_mask(r.sem.astype(np.uint32))
+    plain = native.cluster(r.points, "hdl64", ground=g, split_people=0, join_cars=0, with_image=True)
+    free = native.cluster(r.points, "hdl64", ground=g, split_people=0, max_join_pieces=0)
+    capped = native.cluster(r.points, "hdl64", ground=g, split_people=0, max_join_pieces=cap)
+    assert capped.stats["n_join_skipped"] > 0 and free.stats["n_join_skipped"] == 0
+    assert capped.stats["n_joined"] < free.stats["n_joined"]
+    xyz = np.stack([plain.image.x, plain.image.y, plain.image.z], -1)
+    np.testing.assert_array_equal(capped.pixel_labels, ref.refine_ref(plain.pixel_labels, xyz, split_people=False,
+                                                                       max_join_pieces=cap))
+    np.testing.assert_array_equal(free.pixel_labels, ref.refine_ref(plain.pixel_labels, xyz, split_people=False,
+                                                                     max_join_pieces=0))
+
+
 def test_refine_off_is_the_plain_clustering():
     r = simulate_scan("hdl64", seed=15, index=0, crowd=True)
     g = ce.ground_mask(r.sem.astype(np.uint32))

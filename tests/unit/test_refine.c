@@ -269,6 +269,29 @@ static void test_car_in_three_pieces_joined(void)
     assert_records_consistent();
 }
 
+/* the join budget: with max_join_pieces 2 only the first two pieces (slot order) take part, the third joins
+ * nothing and is counted; 0 lifts the budget; validation of the field is not needed (any value is valid) */
+static void test_join_budget(void)
+{
+    const obj_t s[1] = {{1, 8.0, 1.0, 12.4, 2.8, -1.70, -0.20}};
+    lidet_cluster_cfg_t cfg;
+    render(s, 1, car_bands);
+    lidet_cluster_cfg_default(&cfg, NULL);
+    TEST_ASSERT_EQUAL_UINT32(256u, cfg.max_join_pieces);
+    cfg.max_join_pieces = 2u;
+    TEST_ASSERT_EQUAL_UINT32(2, run_with(&cfg));
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g_cl)->n_joined);
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g_cl)->n_join_skipped);
+    assert_records_consistent();
+    cfg.max_join_pieces = 1u;
+    TEST_ASSERT_EQUAL_UINT32(3, run_with(&cfg));
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g_cl)->n_joined);
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_cluster_stats(&g_cl)->n_join_skipped);
+    cfg.max_join_pieces = 0u;
+    TEST_ASSERT_EQUAL_UINT32(1, run_with(&cfg));
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g_cl)->n_join_skipped);
+}
+
 /* two cars nose to tail 1.2 m apart, the join gap widened to 1.5 m: their union is longer than a car,
  * so no cluster takes both; allowing a 12 m car joins them (the rule is what keeps them apart) */
 static uint32_t run_join(float gap_m, float max_len_m)
@@ -361,6 +384,7 @@ int main(void)
     RUN_TEST(test_person_beside_car);
     RUN_TEST(test_group_with_child);
     RUN_TEST(test_car_in_three_pieces_joined);
+    RUN_TEST(test_join_budget);
     RUN_TEST(test_two_cars_not_joined);
     RUN_TEST(test_car_alone_not_cut);
     RUN_TEST(test_deterministic_and_config);

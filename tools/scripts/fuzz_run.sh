@@ -46,10 +46,10 @@ pids=()
 for h in "${harnesses[@]}"; do
   run_one "$h" &
   pids+=($!)
-  if [ ${#pids[@]} -ge "$JOBS" ]; then
-    wait "${pids[0]}" || fail=1
-    pids=("${pids[@]:1}")
-  fi
+  # a free slot as soon as any harness ends (not the oldest: a long one would hold the others back)
+  while [ "$(jobs -rp | wc -l)" -ge "$JOBS" ]; do
+    wait -n || fail=1
+  done
 done
 for p in "${pids[@]}"; do wait "$p" || fail=1; done
 exit $fail

@@ -287,7 +287,8 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_
                max_clusters: int = 1 << 30, max_cells: int = 4096, max_parts: int = 32,
                max_points: int = 4096, join_cars: bool = True, join_gap_m: float = 0.5,
                car_max_length_m: float = 5.2, car_max_width_m: float = 2.2, car_max_height_m: float = 2.0,
-               car_min_length_m: float = 2.5, upright_max_width_m: float = 1.3) -> np.ndarray:
+               car_min_length_m: float = 2.5, upright_max_width_m: float = 1.3,
+               max_join_pieces: int = 256) -> np.ndarray:
     """The refinement of lib/src/lidet_refine.c (split_people, join_cars; the rules in lidet_cluster.h) on canonical
     cluster labels (rows, cols) of the clustering without it, with the image's points xyz (rows, cols, 3)
     float32. Returns the canonical labels the C gives with it: the same float32 operations in the same
@@ -374,7 +375,7 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_
     if join_cars:
         lab = _join_ref(lab, P, n_recs, cut, f32(join_gap_m), f32(car_max_length_m), f32(car_max_width_m),
                         f32(car_max_height_m), f32(car_min_length_m), f32(upright_max_width_m),
-                        f32(person_min_height_m))
+                        f32(person_min_height_m), int(max_join_pieces))
     # canonical ids: raster order of each cluster's first pixel
     ids = np.unique(lab[lab > 0])
     first = np.array([np.argmax(lab == i) for i in ids])
@@ -383,7 +384,7 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_
     return new[lab].reshape(np.shape(labels))
 
 
-def _join_ref(lab, P, n_recs, cut, gap, lmax, wmax, hmax, lmin, umax, pmin):
+def _join_ref(lab, P, n_recs, cut, gap, lmax, wmax, hmax, lmin, umax, pmin, max_pieces=0):
     """The joins of lidet_refine.c (join_cars) on slot labels 1..n_recs (slot order: canonical ids, then
     the cut-off parts); returns the labels with the joined slots renumbered (not yet canonical)."""
     f32 = np.float32
@@ -406,12 +407,17 @@ def _join_ref(lab, P, n_recs, cut, gap, lmax, wmax, hmax, lmin, umax, pmin):
         u = [f32(max(hi[a, d], hi[b, d]) - min(lo[a, d], lo[b, d])) for d in range(3)]
         return u[2] <= hmax and lmin <= max(u[0], u[1]) <= lmax and min(u[0], u[1]) <= wmax
 
+    # the car pieces, decided once in slot order; past max_pieces (0 = no limit) they join nothing
+    pieces = [k for k in range(1, n_recs + 1) if k not in cut and piece(k)]
+    if max_pieces:
+        pieces = pieces[:max_pieces]
+    is_piece = set(pieces)
     to = list(range(n_recs + 1))
     for i in range(1, n_recs + 1):
-        if to[i] != i or i in cut or not piece(i):
+        if to[i] != i or i not in is_piece:
             continue
         for j in range(i + 1, n_recs + 1):
-            if to[j] != j or j in cut or not piece(j) or not joinable(i, j):
+            if to[j] != j or j not in is_piece or not joinable(i, j):
                 continue
             lo[i], hi[i] = np.minimum(lo[i], lo[j]), np.maximum(hi[i], hi[j])
             to[j] = i
