@@ -36,6 +36,11 @@ double cli_now_ms(void);
 /* CPU time of the calling thread in ms (wall time where the platform has no thread clock): timings on
  * a loaded machine, where other processes take the core in the middle of a run */
 double cli_cpu_ms(void);
+/* the detectors' stage clock (cfg.clock): nanoseconds modulo 2^32 of the monotonic clock, or of this thread's
+ * CPU time after `lidet detect --cpu-clock` set cli_stage_clock_cpu (stage times a busy machine does not
+ * inflate) */
+extern int cli_stage_clock_cpu;
+uint32_t cli_stage_clock_ns(void *ctx);
 /* Median of n values (sorts in place). */
 double cli_median(double *v, int n);
 /* JSON helpers: open object, key/values with separators, close. */

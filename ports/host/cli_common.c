@@ -189,6 +189,20 @@ double cli_now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
+int cli_stage_clock_cpu = 0;
+
+uint32_t cli_stage_clock_ns(void *ctx)
+{
+    struct timespec ts;
+    (void)ctx;
+#ifdef CLOCK_THREAD_CPUTIME_ID
+    clock_gettime(cli_stage_clock_cpu ? CLOCK_THREAD_CPUTIME_ID : CLOCK_MONOTONIC, &ts);
+#else
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+#endif
+    return (uint32_t)((uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec);
+}
+
 double cli_cpu_ms(void)
 {
 #ifdef CLOCK_THREAD_CPUTIME_ID

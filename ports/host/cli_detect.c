@@ -15,13 +15,6 @@ static lidet_detector_t g_det;
 
 static const char *const k_class_names[LIDET_N_CLASSES] = {"Car", "Cyclist", "Pedestrian"};
 
-static uint32_t clock_ns(void *ctx)
-{
-    struct timespec ts;
-    (void)ctx;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (uint32_t)((uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec);
-}
 
 /* ---- KITTI calibration and label_2 output ------------------------------------------------------ */
 
@@ -505,6 +498,8 @@ static void usage_extra(void)
                     "  --gt-kitti FILE  ground truth as KITTI label_2 (with --calib) drawn in --png\n"
                     "  --fixed          the integer detector (lidet_detector_q.h: int8 models, no float; the scan\n"
                     "                   converted to millimetres); the same outputs\n"
+                    "  --cpu-clock      stage and total times (--json *_ms) in this thread's CPU time, not wall time\n"
+                    "                   (what other processes on a busy machine do not inflate)\n"
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
                     "                   nms_iou, max_proposals, max_boxes, gate1, gate2; stages.cluster.KEY: a\n"
                     "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
@@ -595,6 +590,8 @@ int cli_detect(int argc, char **argv)
             crop = 1;
         else if (strcmp(argv[i], "--fixed") == 0)
             fixed = 1;
+        else if (strcmp(argv[i], "--cpu-clock") == 0)
+            cli_stage_clock_cpu = 1;
         else
             rest[nrest++] = argv[i];
     }
@@ -653,7 +650,7 @@ int cli_detect(int argc, char **argv)
         strncat(chosen, " int8", sizeof chosen - strlen(chosen) - 1u);
         goto outputs;
     }
-    cfg.clock = clock_ns;
+    cfg.clock = cli_stage_clock_ns;
     st = lidet_detector_init(&g_det, &cfg, mc, mb);
     if (st != LIDET_OK)
         return fail(&a, "init (configuration or models)", st);
@@ -669,9 +666,9 @@ int cli_detect(int argc, char **argv)
     }
     for (i = 0; i < a.repeat; ++i)
     {
-        const double t0 = cli_now_ms();
+        const double t0 = cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms();
         st = lidet_detector_run(&g_det, a.points, a.n_points, 4, a.ring, i == 0 ? pp : NULL);
-        t[(size_t)LIDET_DET_N_STAGES * (size_t)a.repeat + (size_t)i] = cli_now_ms() - t0;
+        t[(size_t)LIDET_DET_N_STAGES * (size_t)a.repeat + (size_t)i] = (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - t0;
         if (!LIDET_SUCCEEDED(st))
         {
             free(t);

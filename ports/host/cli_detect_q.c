@@ -12,11 +12,6 @@
 
 static lidet_detector_q_t g_detq;
 
-static uint32_t clock_ns_q(void *ctx)
-{
-    (void)ctx;
-    return (uint32_t)(cli_now_ms() * 1e6);
-}
 
 static int32_t round_i32(double v)
 {
@@ -60,7 +55,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     cfg.gate1 = fcfg->gate1;
     cfg.gate2 = fcfg->gate2;
     cfg.nms_iou_q15 = round_i32((double)fcfg->nms_iou * 32768.0);
-    cfg.clock = clock_ns_q;
+    cfg.clock = cli_stage_clock_ns;
     *status = lidet_detector_q_init(&g_detq, &cfg, mc, mb);
     if (*status != LIDET_OK)
     {
@@ -88,9 +83,9 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     }
     for (i = 0; i < a->repeat; ++i)
     {
-        const double t0 = cli_now_ms();
+        const double t0 = cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms();
         *status = lidet_detector_q_run(&g_detq, pts, np, 3, a->ring, i == 0 ? pp : NULL);
-        t[(size_t)LIDET_DET_N_STAGES * (size_t)a->repeat + (size_t)i] = cli_now_ms() - t0;
+        t[(size_t)LIDET_DET_N_STAGES * (size_t)a->repeat + (size_t)i] = (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - t0;
         if (!LIDET_SUCCEEDED(*status))
         {
             fprintf(stderr, "lidet detect --fixed: %s\n", lidet_status_str(*status));
