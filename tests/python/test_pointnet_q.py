@@ -141,7 +141,10 @@ def agreement(fam, props):
     bq[:, 6] *= 2 * math.pi / 2.0 ** 32
     iou = iou_bev_pairs(bq, fb["box"])
     kept = fc["passed"]
-    return dict(n=len(q4), cls=float((fc["cls"] == qc["cls"]).mean()),
+    # the detector-level class decision: the class where gate 1 keeps the proposal, "rejected" (3) otherwise
+    dec_f = np.where(fc["passed"], fc["cls"], 3)
+    dec_q = np.where(qc["passed"], qc["cls"], 3)
+    return dict(n=len(q4), cls=float((fc["cls"] == qc["cls"]).mean()), decision=float((dec_f == dec_q).mean()),
                 n_kept=int(kept.sum()), cls_kept=float((fc["cls"] == qc["cls"])[kept].mean()),
                 gate1=float((fc["passed"] == qc["passed"]).mean()),
                 gate2=float((fb["passed"] == qb["passed"]).mean()), iou=float(iou.mean()),
@@ -151,20 +154,22 @@ def agreement(fam, props):
 
 def test_int8_agrees_with_float(props):
     """int8 against float over all test proposals (figures in docs/FIXED_POINT.md). Issue 16 asks class >= 99 %
-    of proposals and mean BEV IoU >= 0.95: the IoU is met; the class agreement over all proposals is 98.3-99.0 %
-    (the int8 activations of the shared layers cost about 0.08 of a logit on average, and 3 % of the proposals
-    have their two best logits within 0.2), so it is asserted at 98.5 % here, and at 99 % on the proposals the
-    float gate 1 keeps (the ones that can become detections). The gates agree on >= 98 % (a gate flips where the
-    energy sits within the quantization error of its threshold)."""
+    of proposals and mean BEV IoU >= 0.95: the IoU is met; the raw argmax agreement over all proposals is
+    98.3-99.0 % (the int8 activations of the shared layers cost about 0.08 of a logit on average, and 3 % of the
+    proposals have their two best logits within 0.2), so it is asserted at 98.5 % here. The detector's class
+    decision (the class where gate 1 keeps the proposal, "rejected" otherwise: what a detection can carry) is
+    asserted at 99 %, and the class on the proposals the float gate 1 keeps at 99 %. The gates agree on >= 98 %
+    (a gate flips where the energy sits within the quantization error of its threshold)."""
     res = {fam: agreement(fam, props[fam]) for fam in FAMILIES}
     n = sum(r["n"] for r in res.values())
     nk = sum(r["n_kept"] for r in res.values())
-    tot = {k: sum(r[k] * r["n"] for r in res.values()) / n for k in ("cls", "gate1", "gate2", "iou")}
+    tot = {k: sum(r[k] * r["n"] for r in res.values()) / n for k in ("cls", "decision", "gate1", "gate2", "iou")}
     tot["cls_kept"] = sum(r["cls_kept"] * r["n_kept"] for r in res.values()) / nk
     print(res, tot)
     assert tot["iou"] >= 0.95, res
     assert tot["cls"] >= 0.985, res
     assert tot["cls_kept"] >= 0.99, res
+    assert tot["decision"] >= 0.99, res
     assert tot["gate1"] >= 0.98 and tot["gate2"] >= 0.98, res
 
 
