@@ -9,6 +9,7 @@
 #include "lidet/lidet.h"
 #include "lidet/lidet_detector_q.h"
 #include "lidet_weights.h"
+#include "lidet_py_detq.h"
 
 #if defined(_WIN32)
 #define LIDET_PY_API __declspec(dllexport)
@@ -18,6 +19,49 @@
 
 static lidet_detector_t g_acc_det;
 static lidet_detector_q_t g_acc_detq;
+static lidet_proposal_t g_prop;
+static lidet_proposal_q_t g_prop_q;
+
+static int make_f(uint32_t ci, void *prop)
+{
+    return lidet_workspace_proposal(lidet_detector_workspace(&g_acc_det), ci, &g_acc_det.cfg.proposal,
+                                    (lidet_proposal_t *)prop);
+}
+
+static int make_q(uint32_t ci, void *prop)
+{
+    return lidet_proposal_q_make(&g_acc_detq.cluster, ci, &g_acc_detq.cfg.proposal, (lidet_proposal_q_t *)prop);
+}
+
+/* After a run with status rc (returned as is when < 0): the proposal of each of the n candidates order[0..n)
+ * made by make() into *prop, whose points (np x 3 of elem bytes), mean and voxel (pts, pmean, pvox: inside *prop)
+ * are copied into the k-th output rows. Returns rc, or make()'s error. */
+static int put_cands(int rc, uint32_t n, uint32_t np, const uint16_t *order, int (*make)(uint32_t, void *),
+                     void *prop, const void *pts, size_t elem, const void *pmean, size_t mean_bytes,
+                     const int16_t *pvox, void *xyz, void *mean, int16_t *voxel, uint32_t *cluster_id,
+                     uint32_t *n_cand, uint32_t *n_points)
+{
+    uint32_t k;
+    if (rc < 0)
+    {
+        return rc;
+    }
+    *n_cand = n;
+    *n_points = np;
+    for (k = 0; k < n; ++k)
+    {
+        const int r = make(order[k], prop);
+        if (r != LIDET_OK)
+        {
+            return r;
+        }
+        memcpy((char *)xyz + k * np * 3u * elem, pts, np * 3u * elem);
+        memcpy((char *)mean + k * mean_bytes, pmean, mean_bytes);
+        memcpy(voxel + 3u * k, pvox, 3u * sizeof(int16_t));
+        cluster_id[k] = order[k] + 1u;
+    }
+    return rc;
+}
 
 /* fcfg: crop_half_rad, max_range_m; ucfg: max_proposals (0 = the default), refine. Per candidate k (at most
  * LIDET_MAX_CLUSTERS): xyz[k] n_points x 3 floats (metres, minus the mean), mean[k] 3 floats, voxel[k] 3 int16,
@@ -29,7 +73,6 @@ LIDET_PY_API int lidet_py_acc_cands(const char *sensor, uint32_t cls_index, uint
 {
     const lidet_sensor_t *s = lidet_sensor_find(sensor);
     lidet_detector_cfg_t cfg;
-    uint32_t k, np;
     int rc;
     if (s == NULL || cls_index >= LIDET_WEIGHTS_N_MODELS || box_index >= LIDET_WEIGHTS_N_MODELS)
     {
@@ -50,28 +93,9 @@ LIDET_PY_API int lidet_py_acc_cands(const char *sensor, uint32_t cls_index, uint
     {
         rc = lidet_detector_run(&g_acc_det, pts, n, stride, NULL, NULL);
     }
-    if (rc < 0)
-    {
-        return rc;
-    }
-    np = g_acc_det.cfg.proposal.n_points;
-    *n_points = np;
-    *n_cand = lidet_detector_stats(&g_acc_det)->n_classified;
-    for (k = 0; k < *n_cand; ++k)
-    {
-        const uint32_t ci = g_acc_det.order[k];
-        lidet_proposal_t p;
-        const int r2 = lidet_workspace_proposal(lidet_detector_workspace(&g_acc_det), ci, &g_acc_det.cfg.proposal, &p);
-        if (r2 != LIDET_OK)
-        {
-            return r2;
-        }
-        memcpy(xyz + (size_t)k * np * 3u, p.xyz, sizeof(float) * np * 3u);
-        memcpy(mean + 3u * k, p.mean_m, sizeof p.mean_m);
-        memcpy(voxel + 3u * k, p.voxel, sizeof p.voxel);
-        cluster_id[k] = ci + 1u;
-    }
-    return rc;
+    return put_cands(rc, lidet_detector_stats(&g_acc_det)->n_classified, g_acc_det.cfg.proposal.n_points,
+                     g_acc_det.order, make_f, &g_prop, g_prop.xyz, sizeof(float), g_prop.mean_m, sizeof g_prop.mean_m,
+                     g_prop.voxel, xyz, mean, voxel, cluster_id, n_cand, n_points);
 }
 
 /* The integer detector's candidates: icfg: crop_half_bam, max_range_mm, max_proposals (0 = the default);
@@ -81,53 +105,9 @@ LIDET_PY_API int lidet_py_acc_cands_q(const char *sensor, const char *cls_name, 
                                       int16_t *xyz, int32_t *mean, int16_t *voxel, uint32_t *cluster_id,
                                       uint32_t *n_cand, uint32_t *n_points)
 {
-    const lidet_sensor_q_t *s = lidet_sensor_q_find(sensor);
-    const lidet_pointnet_q_model_t *mc, *mb;
-    lidet_detector_q_cfg_t cfg;
-    uint32_t k, np;
-    int rc;
-    if (s == NULL)
-    {
-        return LIDET_ERR_NOT_FOUND;
-    }
-    mc = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, cls_name);
-    mb = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, box_name);
-    if (mc == NULL || mb == NULL)
-    {
-        return LIDET_ERR_NOT_FOUND;
-    }
-    lidet_detector_q_cfg_default(&cfg, s);
-    cfg.crop_half_bam = icfg[0];
-    cfg.max_range_mm = icfg[1];
-    if (icfg[2] != 0)
-    {
-        cfg.max_proposals = (uint32_t)icfg[2];
-    }
-    rc = lidet_detector_q_init(&g_acc_detq, &cfg, mc, mb);
-    if (rc == LIDET_OK)
-    {
-        rc = lidet_detector_q_run(&g_acc_detq, pts_mm, n, stride, NULL, NULL);
-    }
-    if (rc < 0)
-    {
-        return rc;
-    }
-    np = g_acc_detq.cfg.proposal.n_points;
-    *n_points = np;
-    *n_cand = lidet_detector_q_stats(&g_acc_detq)->n_classified;
-    for (k = 0; k < *n_cand; ++k)
-    {
-        const uint32_t ci = g_acc_detq.order[k];
-        lidet_proposal_q_t p;
-        const int r2 = lidet_proposal_q_make(&g_acc_detq.cluster, ci, &g_acc_detq.cfg.proposal, &p);
-        if (r2 != LIDET_OK)
-        {
-            return r2;
-        }
-        memcpy(xyz + (size_t)k * np * 3u, p.xyz, sizeof(int16_t) * np * 3u);
-        memcpy(mean + 3u * k, p.mean_4mm, sizeof p.mean_4mm);
-        memcpy(voxel + 3u * k, p.voxel, sizeof p.voxel);
-        cluster_id[k] = ci + 1u;
-    }
-    return rc;
+    const int32_t cfg6[6] = {icfg[0], icfg[1], 3277, icfg[2], 1, 1}; /* NMS and gates: the defaults (unused) */
+    const int rc = lidet_py__detq_init_run(&g_acc_detq, sensor, cls_name, box_name, cfg6, pts_mm, n, stride);
+    return put_cands(rc, lidet_detector_q_stats(&g_acc_detq)->n_classified, g_acc_detq.cfg.proposal.n_points,
+                     g_acc_detq.order, make_q, &g_prop_q, g_prop_q.xyz, sizeof(int16_t), g_prop_q.mean_4mm,
+                     sizeof g_prop_q.mean_4mm, g_prop_q.voxel, xyz, mean, voxel, cluster_id, n_cand, n_points);
 }
