@@ -23,6 +23,7 @@ Scheme (TFLite / CMSIS-NN conventions):
 """
 from __future__ import annotations
 
+import copy
 import hashlib
 import json
 import math
@@ -204,8 +205,27 @@ def _act_scale(rng_max: float, relu: bool) -> float:
     return r / 255.0 if relu else r / 127.0
 
 
+def with_refit(model: Model, calib: dict) -> Model:
+    """The model with the classifier's last layer the calibration file's `head_refit` (see `refit`), else as is."""
+    r = calib.get("head_refit")
+    if r is None:
+        return model
+    if model.kind != "classifier":
+        raise EmitError("head_refit: classifiers only")
+    m = copy.deepcopy(model)
+    last = m.stages[0].head[-1]
+    w, b = np.asarray(r["w"], np.float64), np.asarray(r["b"], np.float64)
+    if w.shape != last.w.shape or b.shape != last.b.shape:
+        raise EmitError(f"head_refit {w.shape} does not fit the last layer {last.w.shape}: refit again")
+    last.w, last.b = w, b
+    return m
+
+
 def quantize(model: Model, calib: dict) -> QModel:
-    """Model (float64 layers) + calibration ranges -> QModel."""
+    """Model (float64 layers) + calibration ranges (+ the classifier's refit last layer) -> QModel. Its `source`
+    stays the float model (the reference every error is measured against)."""
+    source = model
+    model = with_refit(model, calib)
     rng = calib["ranges"]
     names = iter(layer_names(model))
     stages = []
@@ -265,7 +285,7 @@ def quantize(model: Model, calib: dict) -> QModel:
         heading_res_bam=_rha(2.0 ** 31 / nh) if nh else 0,
         pvle_bin=(_rha(model.pvle_bins[0] * 1e6), _rha(model.pvle_bins[1] * 1e6), _rha(model.pvle_bins[2] * 1e3)),
         energy_t_q16=_rha(model.energy_t * 65536.0), gamma_q16=[_rha(g * 65536.0) for g in model.gamma],
-        classes=model.classes, source=model)
+        classes=model.classes, source=source)
 
 
 # ---- calibration set --------------------------------------------------------------------------
@@ -354,6 +374,51 @@ def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS) -> dict:
             "sensor": sensor, "seeds": [int(s) for s in seeds], "percentile": CALIB_PERCENTILE,
             "scans": [rel(p) for p in scans],
             "n_proposals": int(len(xyz)), "ranges": ranges}
+
+
+#: the classifier's last-layer refit (`calibrate --refit`): fresh simulated scans (seed 3016: neither training,
+#: the benchmarks nor the tests use it) added to the calibration proposals, and the ridge weight toward the float
+#: layer. Measured on the test proposals of tests/python/test_pointnet_q.py (docs/FIXED_POINT.md).
+REFIT_SIM_SEED, REFIT_N_SIM, REFIT_MU = 3016, 8, 0.1
+
+
+def refit(onnx_path, calib: dict, real_dir=None) -> dict:
+    """The calibration file with `head_refit`: the classifier's last layer (linear, Q16 logits) refitted by
+    ridge regression so that, on the int8 network's own dequantized inputs, it reproduces the float network's
+    logits: minimises mean |x W^T + b - logits_float|^2 + mu |(W, b) - (W0, b0)|^2 over the calibration
+    proposals plus REFIT_N_SIM fresh simulated scans. It absorbs the systematic part of the error the int8
+    activations leave in the logits; the layer is then quantized as any other (per-channel int8 weights)."""
+    from lidet_tools.sim.simulate import simulate_scan
+
+    from .ref import pointnet_q as RQ
+    onnx_path = pathlib.Path(onnx_path)
+    model = load(onnx_path, onnx_path.stem)
+    if model.kind != "classifier" or len(model.stages[0].head) < 2:
+        raise EmitError(f"{onnx_path}: refit needs a classifier with two head layers or more")
+    if calib.get("onnx_sha256") != hashlib.sha256(onnx_path.read_bytes()).hexdigest():
+        raise EmitError(f"{onnx_path}: the calibration file is of another model: recalibrate")
+    base = {k: v for k, v in calib.items() if k != "head_refit"}
+    data = calib_set(base, real_dir)
+    if data is None:
+        raise EmitError("refit: the calibration scans are not available")
+    sims = [simulate_scan(calib["sensor"], REFIT_SIM_SEED, k).points for k in range(REFIT_N_SIM)]
+    extra = proposals_of(sims, calib["sensor"], calib["seeds"], model.n_points)
+    xyz, mean, vox = (np.concatenate([a, b]) for a, b in zip(data, extra))
+    qm = quantize(model, base)
+    q4, m4 = int_proposals(xyz, mean)
+    c, s = RQ.frame_cs(m4)
+    tr = []
+    RQ.forward(qm, q4, vox.astype(np.int64), None, c, s, trace=tr)
+    prev = qm.stages[0].head[-2]
+    x = (tr[-2] - prev.out_zp) * prev.s_out
+    y = float_trace(model, float_inputs(xyz, mean), vox.astype(np.float64), None)[-1]
+    n, d = x.shape
+    xa = np.hstack([x, np.ones((n, 1))])
+    last = model.stages[0].head[-1]
+    w0 = np.hstack([last.w, last.b[:, None]])
+    w = np.linalg.solve(xa.T @ xa + n * REFIT_MU * np.eye(d + 1), xa.T @ y + n * REFIT_MU * w0.T).T
+    return dict(base, head_refit={"sim_seed": REFIT_SIM_SEED, "n_sim": REFIT_N_SIM, "mu": REFIT_MU,
+                                  "n_proposals": int(n), "w": w[:, :d].tolist(), "b": w[:, d].tolist()})
 
 
 def calib_set(calib: dict, real_dir=None):
@@ -510,15 +575,23 @@ def main(argv=None) -> int:
     ap.add_argument("--real", default=str(ROOT.parent / "shared" / "data" / "real"),
                     help="real scans folder (used when present; KITTI HDL-64 scans for hdl64 models)")
     ap.add_argument("--out", help="calibration file (default: beside the model, <name>.calib.json)")
+    ap.add_argument("--refit", action="store_true",
+                    help="classifiers: keep the calibration file's ranges and add the refitted last layer "
+                         "(head_refit; lidet_codegen.quant.refit)")
     a = ap.parse_args(argv)
     real = pathlib.Path(a.real) if (pathlib.Path(a.real) / "kitti").exists() else None
     for p in a.onnx:
         p = pathlib.Path(p)
         sensor = a.sensor or p.stem.split("_")[-1]
-        cal = calibrate(p, sensor, real)
         out = pathlib.Path(a.out) if a.out and len(a.onnx) == 1 else p.with_suffix(".calib.json")
+        if a.refit:
+            cal = refit(p, json.loads(p.with_suffix(".calib.json").read_text()), real)
+            print(f"{p} -> {out}: last layer refitted on {cal['head_refit']['n_proposals']} proposals")
+        else:
+            cal = calibrate(p, sensor, real)
+            print(f"{p} -> {out}: {cal['n_proposals']} proposals of {len(cal['scans'])} scans x "
+                  f"{len(cal['seeds'])} seeds")
         out.write_text(json.dumps(cal, indent=1, sort_keys=True) + "\n")
-        print(f"{p} -> {out}: {cal['n_proposals']} proposals of {len(cal['scans'])} scans x {len(cal['seeds'])} seeds")
     return 0
 
 

@@ -7,6 +7,7 @@
 #include "lidet/lidet.h"
 #include "lidet/lidet_detector_q.h"
 #include "lidet_weights.h"
+#include "lidet_py_detq.h"
 
 #if defined(_WIN32)
 #define LIDET_PY_API __declspec(dllexport)
@@ -16,27 +17,17 @@
 
 static lidet_detector_q_t g_detq;
 
-/* icfg: crop_half_bam, max_range_mm, nms_iou_q15, max_proposals (0 = default), gate1, gate2.
- * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
- * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 12 uint32 (the
- * counts of lidet_detector_q_stats_t in order). Returns the run's status. */
-LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, const char *box_name,
-                                   const int32_t *icfg, const int32_t *pts_mm, uint32_t n, uint32_t stride,
-                                   int32_t *out_det, uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters,
-                                   uint32_t *out_stats)
+int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const char *cls_name,
+                            const char *box_name, const int32_t *icfg, const int32_t *pts_mm, uint32_t n,
+                            uint32_t stride)
 {
     const lidet_sensor_q_t *s = lidet_sensor_q_find(sensor);
     const lidet_pointnet_q_model_t *mc, *mb;
     lidet_detector_q_cfg_t cfg;
-    const lidet_detection_q_t *d;
-    const lidet_detector_q_stats_t *st;
-    const uint8_t *oc;
-    uint32_t k;
     int rc;
-    if (s == NULL || icfg == NULL || out_det == NULL || n_det == NULL || out_outcome == NULL || n_clusters == NULL ||
-        out_stats == NULL)
+    if (s == NULL)
     {
-        return s == NULL ? LIDET_ERR_NOT_FOUND : LIDET_ERR_ARG;
+        return LIDET_ERR_NOT_FOUND;
     }
     mc = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, cls_name);
     mb = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, box_name);
@@ -54,12 +45,30 @@ LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, con
     }
     cfg.gate1 = (uint8_t)icfg[4];
     cfg.gate2 = (uint8_t)icfg[5];
-    rc = lidet_detector_q_init(&g_detq, &cfg, mc, mb);
-    if (rc != LIDET_OK)
+    rc = lidet_detector_q_init(det, &cfg, mc, mb);
+    return rc != LIDET_OK ? rc : lidet_detector_q_run(det, pts_mm, n, stride, NULL, NULL);
+}
+
+/* lidet_py_detq_run: icfg: crop_half_bam, max_range_mm, nms_iou_q15, max_proposals (0 = default), gate1, gate2.
+ * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
+ * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 12 uint32 (the
+ * counts of lidet_detector_q_stats_t in order). Returns the run's status. */
+LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, const char *box_name,
+                                   const int32_t *icfg, const int32_t *pts_mm, uint32_t n, uint32_t stride,
+                                   int32_t *out_det, uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters,
+                                   uint32_t *out_stats)
+{
+    const lidet_detection_q_t *d;
+    const lidet_detector_q_stats_t *st;
+    const uint8_t *oc;
+    uint32_t k;
+    int rc;
+    if (lidet_sensor_q_find(sensor) == NULL || icfg == NULL || out_det == NULL || n_det == NULL ||
+        out_outcome == NULL || n_clusters == NULL || out_stats == NULL)
     {
-        return rc;
+        return lidet_sensor_q_find(sensor) == NULL ? LIDET_ERR_NOT_FOUND : LIDET_ERR_ARG;
     }
-    rc = lidet_detector_q_run(&g_detq, pts_mm, n, stride, NULL, NULL);
+    rc = lidet_py__detq_init_run(&g_detq, sensor, cls_name, box_name, icfg, pts_mm, n, stride);
     if (rc < 0)
     {
         return rc;

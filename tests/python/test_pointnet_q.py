@@ -141,7 +141,10 @@ def agreement(fam, props):
     bq[:, 6] *= 2 * math.pi / 2.0 ** 32
     iou = iou_bev_pairs(bq, fb["box"])
     kept = fc["passed"]
-    return dict(n=len(q4), cls=float((fc["cls"] == qc["cls"]).mean()),
+    # the detector-level class decision: the class where gate 1 keeps the proposal, "rejected" (3) otherwise
+    dec_f = np.where(fc["passed"], fc["cls"], 3)
+    dec_q = np.where(qc["passed"], qc["cls"], 3)
+    return dict(n=len(q4), cls=float((fc["cls"] == qc["cls"]).mean()), decision=float((dec_f == dec_q).mean()),
                 n_kept=int(kept.sum()), cls_kept=float((fc["cls"] == qc["cls"])[kept].mean()),
                 gate1=float((fc["passed"] == qc["passed"]).mean()),
                 gate2=float((fb["passed"] == qb["passed"]).mean()), iou=float(iou.mean()),
@@ -151,20 +154,23 @@ def agreement(fam, props):
 
 def test_int8_agrees_with_float(props):
     """int8 against float over all test proposals (figures in docs/FIXED_POINT.md). Issue 16 asks class >= 99 %
-    of proposals and mean BEV IoU >= 0.95: the IoU is met; the class agreement over all proposals is 98.3-99.0 %
-    (the int8 activations of the shared layers cost about 0.08 of a logit on average, and 3 % of the proposals
-    have their two best logits within 0.2), so it is asserted at 98.5 % here, and at 99 % on the proposals the
-    float gate 1 keeps (the ones that can become detections). The gates agree on >= 98 % (a gate flips where the
-    energy sits within the quantization error of its threshold)."""
+    of proposals and mean BEV IoU >= 0.95. The raw argmax agreement over all proposals is asserted at 99 %
+    (99.3 % with the classifiers' refitted last layer, `calibrate --refit`; 98.9 % without: the int8 activations
+    of the shared layers cost about 0.08 of a logit on average, and 3 % of the proposals have their two best
+    logits within 0.2), the detector's class decision (the class where gate 1 keeps the proposal, "rejected"
+    otherwise: what a detection can carry) at 99 %, the class on the proposals the float gate 1 keeps at 99 %.
+    The gates agree on >= 98 % (a gate flips where the energy sits within the quantization error of its
+    threshold)."""
     res = {fam: agreement(fam, props[fam]) for fam in FAMILIES}
     n = sum(r["n"] for r in res.values())
     nk = sum(r["n_kept"] for r in res.values())
-    tot = {k: sum(r[k] * r["n"] for r in res.values()) / n for k in ("cls", "gate1", "gate2", "iou")}
+    tot = {k: sum(r[k] * r["n"] for r in res.values()) / n for k in ("cls", "decision", "gate1", "gate2", "iou")}
     tot["cls_kept"] = sum(r["cls_kept"] * r["n_kept"] for r in res.values()) / nk
     print(res, tot)
     assert tot["iou"] >= 0.95, res
-    assert tot["cls"] >= 0.985, res
+    assert tot["cls"] >= 0.99, res
     assert tot["cls_kept"] >= 0.99, res
+    assert tot["decision"] >= 0.99, res
     assert tot["gate1"] >= 0.98 and tot["gate2"] >= 0.98, res
 
 
@@ -213,3 +219,46 @@ def test_on_the_integer_chain_bit_for_bit(nq, qmodels, fam):
         np.testing.assert_array_equal(np.asarray(b["energy"], np.int64), rb["energy"])
         n += len(q4)
     assert n >= 20
+
+
+def test_refit_replaces_only_the_classifiers_last_layer(qmodels):
+    """quantize applies a calibration file's head_refit to the classifier's last layer only (the other layers'
+    int8 arrays are those of the plain calibration), refuses it on a box net and a refit of another shape."""
+    name = "cls_vlp16"
+    cal = json.loads((WEIGHTS / f"{name}.calib.json").read_text())
+    assert "head_refit" in cal
+    model = E.load(WEIGHTS / f"{name}.onnx", name)
+    plain = QU.quantize(model, {k: v for k, v in cal.items() if k != "head_refit"})
+    refit = qmodels[name]
+    a = [l for st in plain.stages for l in st.point + st.pvle + st.head]
+    b = [l for st in refit.stages for l in st.point + st.pvle + st.head]
+    for la, lb in zip(a[:-1], b[:-1]):
+        np.testing.assert_array_equal(la.w_q, lb.w_q)
+        np.testing.assert_array_equal(la.b, lb.b)
+    assert not np.array_equal(a[-1].w_q, b[-1].w_q)
+    np.testing.assert_array_equal(refit.source.stages[0].head[-1].w, model.stages[0].head[-1].w)  # float kept
+    bad = dict(cal, head_refit=dict(cal["head_refit"], w=np.zeros((3, 5)).tolist()))
+    with pytest.raises(E.EmitError, match="does not fit"):
+        QU.quantize(model, bad)
+    box = E.load(WEIGHTS / "box_vlp16.onnx", "box_vlp16")
+    with pytest.raises(E.EmitError, match="classifiers only"):
+        QU.with_refit(box, cal)
+
+
+def test_refit_brings_the_int8_logits_closer_to_float(props, need_lib):
+    """The refit, recomputed from its committed command's inputs (VLP-16: simulated scans only), lowers the mean
+    squared difference between the int8 and the float logits on the test proposals (none of them in its set)."""
+    from lidet_tools import native
+    name = "cls_vlp16"
+    cal = json.loads((WEIGHTS / f"{name}.calib.json").read_text())
+    base = {k: v for k, v in cal.items() if k != "head_refit"}
+    fresh = QU.refit(WEIGHTS / f"{name}.onnx", base)
+    model = E.load(WEIGHTS / f"{name}.onnx", name)
+    q4, m4, vox = props["vlp16"]
+    f = native.pn_classify(name, q4 * 0.004, m4 * 0.004, vox)["logits"]
+    err = {}
+    for tag, c in (("plain", base), ("refit", fresh)):
+        lo = RQ.classify(QU.quantize(model, c), q4, m4, vox)["logits"] / 65536.0
+        err[tag] = float(((lo - f) ** 2).mean())
+    print(err)
+    assert err["refit"] < 0.95 * err["plain"], err

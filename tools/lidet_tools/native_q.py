@@ -751,3 +751,66 @@ def detector_q_bytes() -> int:
     L = native.lib()
     L.lidet_py_detq_bytes.restype = C.c_uint32
     return int(L.lidet_py_detq_bytes())
+
+
+# ---- the detectors' candidate proposals, for the int8 accuracy ablations (ports/python/lidet_py_acc_q.c) ----
+
+_acc_ready = False
+
+
+def _acc_lib():
+    global _acc_ready
+    L = native.lib()
+    if not _acc_ready:
+        L.lidet_py_acc_cands.argtypes = [C.c_char_p, C.c_uint32, C.c_uint32, _f32p, _u32p, _f32p, C.c_uint32,
+                                         C.c_uint32, _f32p, _f32p, _i16p, _u32p, _u32p, _u32p]
+        L.lidet_py_acc_cands_q.argtypes = [C.c_char_p, C.c_char_p, C.c_char_p, _i32p, _i32p, C.c_uint32, C.c_uint32,
+                                           _i16p, _i32p, _i16p, _u32p, _u32p, _u32p]
+        _acc_ready = True
+    return L
+
+
+def candidates_float(points, sensor: str = "hdl64", model: str | None = None, crop_half_rad: float = 0.0,
+                     max_range_m: float = 0.0, refine: bool = False) -> dict:
+    """The float detector's classified candidates of one scan, nearest first: {'xyz' (K, N, 3) m centred,
+    'mean' (K, 3) m, 'voxel' (K, 3), 'cluster_id' (K,)}: the proposals its classifier sees."""
+    L = _acc_lib()
+    fam = model or sensor
+    ms = native.pn_models()
+    pts, stride = native._as_points(points)
+    n = len(pts)
+    cap = native.capacity()["max_clusters"]
+    npt = ms[f"cls_{fam}"].n_points
+    xyz, mean = np.zeros((cap, npt, 3), np.float32), np.zeros((cap, 3), np.float32)
+    vox, cid = np.zeros((cap, 3), np.int16), np.zeros(cap, np.uint32)
+    nc, npo = np.zeros(1, np.uint32), np.zeros(1, np.uint32)
+    rc = L.lidet_py_acc_cands(sensor.encode(), ms[f"cls_{fam}"].index, ms[f"box_{fam}"].index,
+                              np.array([crop_half_rad, max_range_m], np.float32),
+                              np.array([0, int(bool(refine))], np.uint32), pts if n else np.zeros((1, 4), np.float32),
+                              n, stride, xyz, mean, vox, cid, nc, npo)
+    if rc < 0:
+        raise native.LidetError(rc, "lidet_py_acc_cands")
+    k = int(nc[0])
+    return dict(xyz=xyz[:k], mean=mean[:k], voxel=vox[:k], cluster_id=cid[:k])
+
+
+def candidates_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_half_bam: int = 0,
+                 max_range_mm: int = 0) -> dict:
+    """The integer detector's classified candidates of one scan (int32 mm points), nearest first: {'xyz'
+    (K, N, 3) 4 mm centred, 'mean' (K, 3) 4 mm, 'voxel' (K, 3), 'cluster_id' (K,)}."""
+    L = _acc_lib()
+    fam = model or sensor
+    pts = np.ascontiguousarray(points_mm, dtype=np.int32)
+    n = len(pts)
+    cap = native.capacity()["max_clusters"]
+    npt = _pnq(f"cls_{fam}_s8")["n_points"]
+    xyz, mean = np.zeros((cap, npt, 3), np.int16), np.zeros((cap, 3), np.int32)
+    vox, cid = np.zeros((cap, 3), np.int16), np.zeros(cap, np.uint32)
+    nc, npo = np.zeros(1, np.uint32), np.zeros(1, np.uint32)
+    rc = L.lidet_py_acc_cands_q(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(),
+                                np.array([crop_half_bam, max_range_mm, 0], np.int32),
+                                pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], xyz, mean, vox, cid, nc, npo)
+    if rc < 0:
+        raise native.LidetError(rc, "lidet_py_acc_cands_q")
+    k = int(nc[0])
+    return dict(xyz=xyz[:k], mean=mean[:k], voxel=vox[:k], cluster_id=cid[:k])
