@@ -155,7 +155,7 @@ def _ref_detect(nq, pts_mm, sensor):
     cc, pc = nq.cluster_q_defaults(sensor)
     cap = native.capacity()
     det_cfg = dict(crop_half_bam=0, max_range_mm=0, max_proposals=min(128 if s.rows <= 16 else 256, cap["max_clusters"]),
-                   gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM)
+                   max_boxes=min(24 if s.rows <= 16 else 48, cap["max_clusters"]), gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM)
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
                      det_cfg, models["cls"], models["box"], cap["max_clusters"], cap["max_detections"],
                      cap["max_points"])

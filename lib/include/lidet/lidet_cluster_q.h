@@ -66,6 +66,28 @@ typedef struct
     uint32_t rescue_gap_per_m_q16; /**< <= 16384 (0.25 per metre); default 1966 (0.03) */
     uint32_t rescue_rows;          /**< <= LIDET_MAX_ROWS; default 1 (<= 16 beams), 2 */
     uint32_t rescue_cols;          /**< <= 15; default 6 */
+    /* worst-case bounds (issue 19): lidet_cluster_cfg_t's, same semantics */
+    uint32_t max_fragment_pixels;  /**< rescue budget in fragment pixels (0 = none); default 4096 (> 16 beams),
+                                        2048 */
+    uint32_t max_bridge_per_pixel_q16; /**< occluder bridging budget per candidate pixel, Q16, <= 64 << 16 (0 =
+                                        none); the run bridges while its count is below
+                                        (this * candidates) >> 16; default 131072 (2.0) */
+    /* the proposal refinement (lidet_refine.c's rules in integer units; lidet_cluster_cfg_t's defaults rounded) */
+    uint32_t split_people;         /**< 0/1; default 1 */
+    uint32_t split_min_width_mm;   /**< (0, 1000000]; default 900 */
+    uint32_t split_cell_mm;        /**< (0, 100000]; default 120 */
+    uint32_t split_cell_per_m_q16; /**< <= 65536; default 0 */
+    uint32_t person_max_width_mm;  /**< (0, 1000000]; default 1000 */
+    uint32_t person_min_height_mm; /**< <= 1000000; default 900 */
+    uint32_t person_min_aspect_q16; /**< <= 100 << 16; default 117965 (1.8) */
+    uint32_t person_min_cols;      /**< default 3 */
+    uint32_t join_cars;            /**< 0/1; default 1 */
+    uint32_t join_gap_mm;          /**< <= 1000000; default 500 */
+    uint32_t car_max_length_mm;    /**< (0, 1000000]; default 5200 */
+    uint32_t car_max_width_mm;     /**< (0, 1000000]; default 2200 */
+    uint32_t car_max_height_mm;    /**< (0, 1000000]; default 2000 */
+    uint32_t car_min_length_mm;    /**< <= 1000000; default 2500 */
+    uint32_t upright_max_width_mm; /**< <= 1000000; default 1300 */
 } lidet_cluster_q_cfg_t;
 
 /** @brief One kept cluster, 4 mm steps. */
@@ -106,6 +128,15 @@ typedef struct
     int32_t *members;
     uint32_t n_recs;
     lidet_cluster_stats_t stats;
+    /* scratch of the refinement (lidet_cluster_q_refine.c; as lidet_cluster_state_t's, z in 4 mm steps) */
+    uint16_t rf_grid[LIDET_REFINE_MAX_CELLS];
+    uint16_t rf_queue[LIDET_REFINE_MAX_CELLS];
+    uint16_t rf_cell[LIDET_REFINE_MAX_POINTS];
+    uint16_t rf_target[LIDET_REFINE_MAX_PARTS];
+    uint32_t rf_n[LIDET_REFINE_MAX_PARTS];
+    uint16_t rf_box[LIDET_REFINE_MAX_PARTS][4];
+    int32_t rf_z[LIDET_REFINE_MAX_PARTS][2];
+    uint16_t rf_col[LIDET_REFINE_MAX_PARTS][2];
 } lidet_cluster_q_state_t;
 
 /** @brief The integer clustering with its per-pixel buffers (declare it static). */
