@@ -23,6 +23,16 @@
  *    or mean z + round(mount_height_mm / 4) without planes. A rescue group that joins a cluster adds its sums
  *    (the mean is the rounded mean of all members, exactly). Filters: extent (max - min) * 4 > max_extent_mm,
  *    height * 4 > max_mean_height_mm.
+ *  - worst-case budgets (issue 19) as the float stage's: the rescue takes fragments while their pixels sum to at
+ *    most max_fragment_pixels (n_dropped_fragment_budget), a pixel's searches bridge occluders while the run's
+ *    count is below (max_bridge_per_pixel_q16 * candidates) >> 16 (n_bridge_steps);
+ *  - refinement (split_people, join_cars; the rules of lidet_cluster.h, the control flow shared with the float
+ *    stage in internal/lidet_refine_body.h), lib/src/lidet_cluster_q_refine.c: spans compared in mm (4 times the
+ *    4 mm span); cell = split_cell_mm + round(split_cell_per_m_q16 r_mm / 2^16), r_mm = max(|cx|, |cy|) +
+ *    min(|cx|, |cy|) / 2 of the box centre (floored); a member's cell floor(4 (x - lo) / cell) by one product with
+ *    ceil(2^40 / cell) and a shift (exact); person aspect wz 2^16 >= person_min_aspect_q16 max(wx, wy); joins:
+ *    (4 gx)^2 + (4 gy)^2 > join_gap_mm^2 rejects, in uint64; records from int64 member sums (a join adds the
+ *    joined cluster's sums: the mean stays the rounded mean of all members).
  * Per point: no division, no square root; one 32x32 -> 64 bit product per gap test. Tables: sin/cos/atan2/
  * isqrt at init (recomputed when the image geometry changes). The numpy reference is
  * codegen/lidet_codegen/ref/cluster_q.py (bit for bit).
@@ -33,7 +43,7 @@
  * floor(round(sqrt(x^2 + y^2 + z^2)) / range_bin) (4 mm), clamped to int16.
  *
  * Memory: as lidet_cluster.h (uint16 label + int32 member per pixel) plus the records (56 B) and their sums
- * (24 B) per cluster slot; lidet_cluster_q_bytes().
+ * (24 B) per cluster slot and the refinement's scratch (as lidet_cluster.h's); lidet_cluster_q_bytes().
  */
 #ifndef LIDET_CLUSTER_Q_H
 #define LIDET_CLUSTER_Q_H
