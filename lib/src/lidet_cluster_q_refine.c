@@ -71,54 +71,18 @@ static int refine_person(const lidet_cluster_q_cfg_t *cfg, const geom_q_t *g, ui
            (wz << 16) >= (uint64_t)cfg->person_min_aspect_q16 * (wx > wy ? wx : wy) && ncols >= cfg->person_min_cols;
 }
 
-/* record of the members of cluster `src` (contiguous range) now labelled `slot` + 1 */
-static void refine_rebuild(lidet_cluster_q_state_t *c, uint32_t slot, const lidet_cluster_q_rec_t *src,
-                           const lidet_plane_q_t *planes, uint32_t n_sectors)
+/* the rounded mean of the member sums (kept for the joins) and its height */
+static void refine_mean(lidet_cluster_q_state_t *c, uint32_t slot, const int64_t sum[3], const lidet_plane_q_t *planes,
+                        uint32_t n_sectors)
 {
     lidet_cluster_q_rec_t *r = &c->recs[slot];
-    int64_t sum[3] = {0, 0, 0};
-    int32_t lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
-    uint32_t i, n = 0, seed = 0;
-    for (i = src->first_member; i < src->first_member + src->n_points; ++i)
-    {
-        const uint32_t p = (uint32_t)c->members[i];
-        int32_t v[3];
-        uint32_t k;
-        if (c->labels[p] != slot + 1u)
-        {
-            continue;
-        }
-        v[0] = c->img.x_4mm[p];
-        v[1] = c->img.y_4mm[p];
-        v[2] = c->img.z_4mm[p];
-        if (n == 0u)
-        {
-            seed = p;
-            for (k = 0; k < 3u; ++k)
-            {
-                lo[k] = v[k];
-                hi[k] = v[k];
-            }
-        }
-        for (k = 0; k < 3u; ++k)
-        {
-            sum[k] += v[k];
-            lo[k] = v[k] < lo[k] ? v[k] : lo[k];
-            hi[k] = v[k] > hi[k] ? v[k] : hi[k];
-        }
-        ++n;
-    }
-    r->n_points = n;
-    r->first_member = src->first_member; /* rewritten by the canonical pass */
-    r->seed_pixel = seed;
+    uint32_t i;
     for (i = 0; i < 3u; ++i)
     {
         c->sums[slot][i] = sum[i];
-        r->mean_4mm[i] = (int32_t)lidet__q_div_round(sum[i], (int64_t)n);
-        r->min_4mm[i] = lo[i];
-        r->max_4mm[i] = hi[i];
+        r->mean_4mm[i] = (int32_t)lidet__q_div_round(sum[i], (int64_t)r->n_points);
     }
-    r->height_4mm = lidet__cluster_q_height(c, seed, r->mean_4mm, planes, n_sectors);
+    r->height_4mm = lidet__cluster_q_height(c, r->seed_pixel, r->mean_4mm, planes, n_sectors);
 }
 
 static int refine_car_piece(const lidet_cluster_q_cfg_t *cfg, const lidet_cluster_q_rec_t *r)
@@ -172,15 +136,12 @@ static void sums_of(const lidet_cluster_q_state_t *c, const lidet_cluster_q_rec_
 
 /* b's sums into a's (a's from its members at its first join: the run's sums are by slot, the canonical pass
  * reordered the records): the mean is the rounded mean of all members, exactly */
-static void refine_join_numbers(lidet_cluster_q_state_t *c, uint32_t i, uint32_t j, int first,
-                                const lidet_plane_q_t *planes, uint32_t n_sectors)
+static void refine_join_mean(lidet_cluster_q_state_t *c, uint32_t i, uint32_t j, int first)
 {
     lidet_cluster_q_rec_t *a = &c->recs[i];
     const lidet_cluster_q_rec_t *b = &c->recs[j];
     int64_t sb[3];
     uint32_t d;
-    (void)planes;
-    (void)n_sectors;
     if (first)
     {
         sums_of(c, a, c->sums[i]);
@@ -190,8 +151,6 @@ static void refine_join_numbers(lidet_cluster_q_state_t *c, uint32_t i, uint32_t
     {
         c->sums[i][d] += sb[d];
         a->mean_4mm[d] = (int32_t)lidet__q_div_round(c->sums[i][d], (int64_t)(a->n_points + b->n_points));
-        a->min_4mm[d] = b->min_4mm[d] < a->min_4mm[d] ? b->min_4mm[d] : a->min_4mm[d];
-        a->max_4mm[d] = b->max_4mm[d] > a->max_4mm[d] ? b->max_4mm[d] : a->max_4mm[d];
     }
 }
 
@@ -209,6 +168,11 @@ static void refine_reheight(lidet_cluster_q_state_t *c, uint32_t i, const lidet_
 #define REFINE_GEOM_T geom_q_t
 #define REFINE_Z_T int32_t
 #define REFINE_Z_FAR 0x7FFFFFFF
+#define REFINE_V_T int32_t
+#define REFINE_S_T int64_t
+#define REFINE_READ(c, p, v) ((v)[0] = (c)->img.x_4mm[p], (v)[1] = (c)->img.y_4mm[p], (v)[2] = (c)->img.z_4mm[p])
+#define REFINE_MIN(r) ((r)->min_4mm)
+#define REFINE_MAX(r) ((r)->max_4mm)
 #include "internal/lidet_refine_body.h"
 
 int lidet__refine_q_split(lidet_cluster_q_state_t *c, const lidet_plane_q_t *planes, uint32_t n_sectors,

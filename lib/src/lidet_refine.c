@@ -77,51 +77,17 @@ static int refine_person(const lidet_cluster_cfg_t *cfg, const geom_t *g, uint32
            wz >= cfg->person_min_aspect * (wx > wy ? wx : wy) && ncols >= cfg->person_min_cols;
 }
 
-/* record of the members of cluster `src` (contiguous range) now labelled `slot` + 1 */
-static void refine_rebuild(lidet_cluster_state_t *c, uint32_t slot, const lidet_cluster_rec_t *src,
-                           const lidet_plane_t *planes, uint32_t n_sectors)
+/* the mean of the member sums (float) and its height */
+static void refine_mean(lidet_cluster_state_t *c, uint32_t slot, const float sum[3], const lidet_plane_t *planes,
+                        uint32_t n_sectors)
 {
     lidet_cluster_rec_t *r = &c->recs[slot];
-    const int compact = lidet__img_compact(&c->img);
-    float sum[3] = {0.0f, 0.0f, 0.0f}, lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {0.0f, 0.0f, 0.0f};
-    uint32_t i, n = 0, seed = 0;
-    for (i = src->first_member; i < src->first_member + src->n_points; ++i)
-    {
-        const uint32_t p = (uint32_t)c->members[i];
-        float v[3];
-        uint32_t k;
-        if (c->labels[p] != slot + 1u)
-        {
-            continue;
-        }
-        lidet__img_xyz(&c->img, p, compact, &v[0], &v[1], &v[2]);
-        if (n == 0u)
-        {
-            seed = p;
-            for (k = 0; k < 3u; ++k)
-            {
-                lo[k] = v[k];
-                hi[k] = v[k];
-            }
-        }
-        for (k = 0; k < 3u; ++k)
-        {
-            sum[k] += v[k];
-            lo[k] = v[k] < lo[k] ? v[k] : lo[k];
-            hi[k] = v[k] > hi[k] ? v[k] : hi[k];
-        }
-        ++n;
-    }
-    r->n_points = n;
-    r->first_member = src->first_member; /* rewritten by the canonical pass */
-    r->seed_pixel = seed;
+    uint32_t i;
     for (i = 0; i < 3u; ++i)
     {
-        r->mean_m[i] = sum[i] / (float)n;
-        r->min_m[i] = lo[i];
-        r->max_m[i] = hi[i];
+        r->mean_m[i] = sum[i] / (float)r->n_points;
     }
-    r->height_m = lidet__cluster_height(c, seed, r->mean_m, planes, n_sectors);
+    r->height_m = lidet__cluster_height(c, r->seed_pixel, r->mean_m, planes, n_sectors);
 }
 
 /* a join candidate by its own box: not upright (a person, a cyclist, a pole: narrow in x and y, tall),
@@ -160,22 +126,17 @@ static int refine_joinable(const lidet_cluster_cfg_t *cfg, const lidet_cluster_r
            (ux > uy ? ux : uy) >= cfg->car_min_length_m && (ux > uy ? uy : ux) <= cfg->car_max_width_m;
 }
 
-/* b's mean (float, weighted by the counts) and bounds into a's */
-static void refine_join_numbers(lidet_cluster_state_t *c, uint32_t i, uint32_t j, int first,
-                                const lidet_plane_t *planes, uint32_t n_sectors)
+/* b's mean into a's (float, weighted by the counts) */
+static void refine_join_mean(lidet_cluster_state_t *c, uint32_t i, uint32_t j, int first)
 {
     lidet_cluster_rec_t *a = &c->recs[i];
     const lidet_cluster_rec_t *b = &c->recs[j];
     const float inv = 1.0f / (float)(a->n_points + b->n_points);
     uint32_t d;
     (void)first;
-    (void)planes;
-    (void)n_sectors;
     for (d = 0; d < 3u; ++d)
     {
         a->mean_m[d] = (a->mean_m[d] * (float)a->n_points + b->mean_m[d] * (float)b->n_points) * inv;
-        a->min_m[d] = b->min_m[d] < a->min_m[d] ? b->min_m[d] : a->min_m[d];
-        a->max_m[d] = b->max_m[d] > a->max_m[d] ? b->max_m[d] : a->max_m[d];
     }
 }
 
@@ -193,6 +154,11 @@ static void refine_reheight(lidet_cluster_state_t *c, uint32_t i, const lidet_pl
 #define REFINE_GEOM_T geom_t
 #define REFINE_Z_T float
 #define REFINE_Z_FAR 3.0e38f
+#define REFINE_V_T float
+#define REFINE_S_T float
+#define REFINE_READ(c, p, v) lidet__img_xyz(&(c)->img, p, lidet__img_compact(&(c)->img), &(v)[0], &(v)[1], &(v)[2])
+#define REFINE_MIN(r) ((r)->min_m)
+#define REFINE_MAX(r) ((r)->max_m)
 #include "internal/lidet_refine_body.h"
 
 int lidet__refine_split(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,

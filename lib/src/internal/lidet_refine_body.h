@@ -9,6 +9,9 @@
  *   REFINE_PLANE_T                 the ground plane type;
  *   REFINE_GEOM_T                  one examined cluster's grid (its corner, cell size);
  *   REFINE_Z_T, REFINE_Z_FAR       a z coordinate and a bound no z reaches;
+ *   REFINE_V_T, REFINE_S_T         a coordinate and a sum of coordinates; REFINE_READ(c, p, v) pixel p's x, y, z
+ *                                  into v[3];
+ *   REFINE_MIN(r), REFINE_MAX(r)   a record's bounds;
  * and the numeric kernels, static functions of the including file:
  *   int refine_examined(cfg, rec)  wider than split_min_width in x or y, and at least person_min_height in z;
  *   int refine_grid(cfg, rec, geom, nx, ny)  the grid of the cluster: its cells along x and y (0 when a count
@@ -17,11 +20,11 @@
  *   REFINE_Z_T refine_z(c, p)      the z of pixel p;
  *   int refine_person(cfg, geom, n, sx, sy, zlo, zhi, ncols)  a part of n points spanning sx, sy cells, z in
  *                                  [zlo, zhi], over ncols image columns, is person-sized;
- *   void refine_rebuild(c, slot, src, planes, n_sectors)  record `slot` from the members of src's range now
- *                                  labelled slot + 1 (n_points, first_member, seed, mean, bounds, height);
+ *   void refine_mean(c, slot, sum, planes, n_sectors)  record `slot`'s mean from the sums of its n_points
+ *                                  members and its height (its seed set);
  *   int refine_car_piece(cfg, rec), int refine_joinable(cfg, a, b)  the joins' box tests;
- *   void refine_join_numbers(c, i, j, first, planes, n_sectors)  cluster j's numbers (mean, bounds) into
- *                                  cluster i's (first: i's first join of the pass), before the counts grow;
+ *   void refine_join_mean(c, i, j, first)  cluster j's mean into cluster i's (first: i's first join of the
+ *                                  pass), before the counts grow;
  *   void refine_reheight(c, i, planes, n_sectors)  cluster i's height from its mean and seed.
  * Defines refine_split and refine_join (lidet_cluster_internal.h). Not a public header; include nowhere else. */
 
@@ -69,6 +72,53 @@ static uint32_t refine_label_parts(REFINE_STATE_T *c, uint32_t n, uint32_t nx, u
         ++n_parts;
     }
     return n_parts;
+}
+
+/* record `slot` from the members of src's (contiguous) range now labelled slot + 1: count, seed (its first
+ * pixel), bounds, mean and height */
+static void refine_rebuild(REFINE_STATE_T *c, uint32_t slot, const REFINE_REC_T *src, const REFINE_PLANE_T *planes,
+                           uint32_t n_sectors)
+{
+    REFINE_REC_T *r = &c->recs[slot];
+    REFINE_S_T sum[3] = {0, 0, 0};
+    REFINE_V_T lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+    uint32_t i, n = 0, seed = 0;
+    for (i = src->first_member; i < src->first_member + src->n_points; ++i)
+    {
+        const uint32_t p = (uint32_t)c->members[i];
+        REFINE_V_T v[3];
+        uint32_t k;
+        if (c->labels[p] != slot + 1u)
+        {
+            continue;
+        }
+        REFINE_READ(c, p, v);
+        if (n == 0u)
+        {
+            seed = p;
+            for (k = 0; k < 3u; ++k)
+            {
+                lo[k] = v[k];
+                hi[k] = v[k];
+            }
+        }
+        for (k = 0; k < 3u; ++k)
+        {
+            sum[k] += v[k];
+            lo[k] = v[k] < lo[k] ? v[k] : lo[k];
+            hi[k] = v[k] > hi[k] ? v[k] : hi[k];
+        }
+        ++n;
+    }
+    r->n_points = n;
+    r->first_member = src->first_member; /* rewritten by the canonical pass */
+    r->seed_pixel = seed;
+    for (i = 0; i < 3u; ++i)
+    {
+        REFINE_MIN(r)[i] = lo[i];
+        REFINE_MAX(r)[i] = hi[i];
+    }
+    refine_mean(c, slot, sum, planes, n_sectors);
 }
 
 /* cut cluster k; returns 1 when it was cut */
@@ -260,8 +310,14 @@ static int refine_join(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t
             /* b joins a: count, bounds, mean, seed, height. b was neither cut nor has it taken anything (later
              * clusters take only at their own turn), so its record is the canonical one: its members are
              * members[first_member, + n_points) */
-            refine_join_numbers(c, i, j, first, planes, n_sectors);
+            uint32_t d;
+            refine_join_mean(c, i, j, first);
             first = 0;
+            for (d = 0; d < 3u; ++d)
+            {
+                REFINE_MIN(a)[d] = REFINE_MIN(b)[d] < REFINE_MIN(a)[d] ? REFINE_MIN(b)[d] : REFINE_MIN(a)[d];
+                REFINE_MAX(a)[d] = REFINE_MAX(b)[d] > REFINE_MAX(a)[d] ? REFINE_MAX(b)[d] : REFINE_MAX(a)[d];
+            }
             for (m = b->first_member; m < b->first_member + b->n_points; ++m)
             {
                 c->labels[c->members[m]] = (uint16_t)(i + 1u);
