@@ -71,9 +71,8 @@ static int refine_person(const lidet_cluster_q_cfg_t *cfg, const geom_q_t *g, ui
            (wz << 16) >= (uint64_t)cfg->person_min_aspect_q16 * (wx > wy ? wx : wy) && ncols >= cfg->person_min_cols;
 }
 
-/* the rounded mean of the member sums (kept for the joins) and its height */
-static void refine_mean(lidet_cluster_q_state_t *c, uint32_t slot, const int64_t sum[3], const lidet_plane_q_t *planes,
-                        uint32_t n_sectors)
+/* the rounded mean of the member sums (the sums kept beside it) */
+static void refine_mean(lidet_cluster_q_state_t *c, uint32_t slot, const int64_t sum[3])
 {
     lidet_cluster_q_rec_t *r = &c->recs[slot];
     uint32_t i;
@@ -82,7 +81,6 @@ static void refine_mean(lidet_cluster_q_state_t *c, uint32_t slot, const int64_t
         c->sums[slot][i] = sum[i];
         r->mean_4mm[i] = (int32_t)lidet__q_div_round(sum[i], (int64_t)r->n_points);
     }
-    r->height_4mm = lidet__cluster_q_height(c, r->seed_pixel, r->mean_4mm, planes, n_sectors);
 }
 
 static int refine_car_piece(const lidet_cluster_q_cfg_t *cfg, const lidet_cluster_q_rec_t *r)
@@ -154,12 +152,6 @@ static void refine_join_mean(lidet_cluster_q_state_t *c, uint32_t i, uint32_t j,
     }
 }
 
-static void refine_reheight(lidet_cluster_q_state_t *c, uint32_t i, const lidet_plane_q_t *planes, uint32_t n_sectors)
-{
-    lidet_cluster_q_rec_t *a = &c->recs[i];
-    a->height_4mm = lidet__cluster_q_height(c, a->seed_pixel, a->mean_4mm, planes, n_sectors);
-}
-
 /* the control flow (lidet_refine_body.h) on the integer stage's types */
 #define REFINE_STATE_T lidet_cluster_q_state_t
 #define REFINE_REC_T lidet_cluster_q_rec_t
@@ -173,16 +165,9 @@ static void refine_reheight(lidet_cluster_q_state_t *c, uint32_t i, const lidet_
 #define REFINE_READ(c, p, v) ((v)[0] = (c)->img.x_4mm[p], (v)[1] = (c)->img.y_4mm[p], (v)[2] = (c)->img.z_4mm[p])
 #define REFINE_MIN(r) ((r)->min_4mm)
 #define REFINE_MAX(r) ((r)->max_4mm)
+#define REFINE_MEAN(r) ((r)->mean_4mm)
+#define REFINE_H(r) ((r)->height_4mm)
+#define REFINE_HEIGHT lidet__cluster_q_height
+#define REFINE_SPLIT_FN lidet__refine_q_split
+#define REFINE_JOIN_FN lidet__refine_q_join
 #include "internal/lidet_refine_body.h"
-
-int lidet__refine_q_split(lidet_cluster_q_state_t *c, const lidet_plane_q_t *planes, uint32_t n_sectors,
-                          lidet_cluster_stats_t *st)
-{
-    return refine_split(c, planes, n_sectors, st);
-}
-
-int lidet__refine_q_join(lidet_cluster_q_state_t *c, const lidet_plane_q_t *planes, uint32_t n_sectors,
-                         lidet_cluster_stats_t *st)
-{
-    return refine_join(c, planes, n_sectors, st);
-}

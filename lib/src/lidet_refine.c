@@ -77,9 +77,8 @@ static int refine_person(const lidet_cluster_cfg_t *cfg, const geom_t *g, uint32
            wz >= cfg->person_min_aspect * (wx > wy ? wx : wy) && ncols >= cfg->person_min_cols;
 }
 
-/* the mean of the member sums (float) and its height */
-static void refine_mean(lidet_cluster_state_t *c, uint32_t slot, const float sum[3], const lidet_plane_t *planes,
-                        uint32_t n_sectors)
+/* the mean of the member sums (float) */
+static void refine_mean(lidet_cluster_state_t *c, uint32_t slot, const float sum[3])
 {
     lidet_cluster_rec_t *r = &c->recs[slot];
     uint32_t i;
@@ -87,7 +86,6 @@ static void refine_mean(lidet_cluster_state_t *c, uint32_t slot, const float sum
     {
         r->mean_m[i] = sum[i] / (float)r->n_points;
     }
-    r->height_m = lidet__cluster_height(c, r->seed_pixel, r->mean_m, planes, n_sectors);
 }
 
 /* a join candidate by its own box: not upright (a person, a cyclist, a pole: narrow in x and y, tall),
@@ -140,12 +138,6 @@ static void refine_join_mean(lidet_cluster_state_t *c, uint32_t i, uint32_t j, i
     }
 }
 
-static void refine_reheight(lidet_cluster_state_t *c, uint32_t i, const lidet_plane_t *planes, uint32_t n_sectors)
-{
-    lidet_cluster_rec_t *a = &c->recs[i];
-    a->height_m = lidet__cluster_height(c, a->seed_pixel, a->mean_m, planes, n_sectors);
-}
-
 /* the control flow (lidet_refine_body.h) on the float stage's types */
 #define REFINE_STATE_T lidet_cluster_state_t
 #define REFINE_REC_T lidet_cluster_rec_t
@@ -159,16 +151,9 @@ static void refine_reheight(lidet_cluster_state_t *c, uint32_t i, const lidet_pl
 #define REFINE_READ(c, p, v) lidet__img_xyz(&(c)->img, p, lidet__img_compact(&(c)->img), &(v)[0], &(v)[1], &(v)[2])
 #define REFINE_MIN(r) ((r)->min_m)
 #define REFINE_MAX(r) ((r)->max_m)
+#define REFINE_MEAN(r) ((r)->mean_m)
+#define REFINE_H(r) ((r)->height_m)
+#define REFINE_HEIGHT lidet__cluster_height
+#define REFINE_SPLIT_FN lidet__refine_split
+#define REFINE_JOIN_FN lidet__refine_join
 #include "internal/lidet_refine_body.h"
-
-int lidet__refine_split(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
-                        lidet_cluster_stats_t *st)
-{
-    return refine_split(c, planes, n_sectors, st);
-}
-
-int lidet__refine_join(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
-                       lidet_cluster_stats_t *st)
-{
-    return refine_join(c, planes, n_sectors, st);
-}

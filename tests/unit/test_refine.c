@@ -32,33 +32,6 @@ static uint32_t run(int split)
     return run_with(&cfg);
 }
 
-/* every cluster holds returns of one object only, and each object's returns lie in one cluster */
-static void assert_one_to_one(int n_obj)
-{
-    const uint16_t *lab = lidet_cluster_labels(&g_cl);
-    uint32_t owner[64], cl_of[MAXOBJ + 1];
-    int p, i;
-    memset(owner, 0, sizeof owner);
-    memset(cl_of, 0, sizeof cl_of);
-    for (p = 0; p < NPIX; ++p)
-    {
-        if (lab[p] == 0)
-            continue;
-        TEST_ASSERT_TRUE(lab[p] < 64);
-        TEST_ASSERT_TRUE(g_obj[p] > 0);
-        if (owner[lab[p]] == 0)
-            owner[lab[p]] = g_obj[p];
-        TEST_ASSERT_EQUAL_UINT32(owner[lab[p]], g_obj[p]); /* one object per cluster */
-        if (cl_of[g_obj[p]] == 0)
-            cl_of[g_obj[p]] = lab[p];
-        TEST_ASSERT_EQUAL_UINT32(cl_of[g_obj[p]], lab[p]); /* one cluster per object */
-    }
-    for (i = 1; i <= n_obj; ++i)
-    {
-        TEST_ASSERT_TRUE(cl_of[i] != 0);
-    }
-}
-
 /* the records match a recount of the labels (counts, bounds, seed in raster order) */
 static void assert_records_consistent(void)
 {
@@ -108,7 +81,7 @@ static void test_two_people_0_4m_apart(void)
     render(s, 2, 0);
     TEST_ASSERT_EQUAL_UINT32(1, run(0)); /* the depth clustering merges them */
     TEST_ASSERT_EQUAL_UINT32(2, run(1));
-    assert_one_to_one(2);
+    scene_one_to_one(lidet_cluster_labels(&g_cl), 2);
     assert_records_consistent();
     TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g_cl)->n_split);
     TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g_cl)->n_split_parts);
@@ -122,7 +95,7 @@ static void test_person_beside_car(void)
     render(s, 2, 0);
     TEST_ASSERT_EQUAL_UINT32(1, run(0));
     TEST_ASSERT_EQUAL_UINT32(2, run(1));
-    assert_one_to_one(2);
+    scene_one_to_one(lidet_cluster_labels(&g_cl), 2);
     assert_records_consistent();
 }
 
@@ -136,7 +109,7 @@ static void test_group_with_child(void)
     render(s, 4, 0);
     TEST_ASSERT_TRUE(run(0) < 4);
     TEST_ASSERT_EQUAL_UINT32(4, run(1));
-    assert_one_to_one(4);
+    scene_one_to_one(lidet_cluster_labels(&g_cl), 4);
     assert_records_consistent();
 }
 
@@ -161,7 +134,7 @@ static void test_car_in_three_pieces_joined(void)
     TEST_ASSERT_EQUAL_UINT32(1, run_defaults(1, 1));
     TEST_ASSERT_EQUAL_UINT32(2, lidet_cluster_stats(&g_cl)->n_joined);
     TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g_cl)->n_split);
-    assert_one_to_one(1);
+    scene_one_to_one(lidet_cluster_labels(&g_cl), 1);
     assert_records_consistent();
 }
 

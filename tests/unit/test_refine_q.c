@@ -82,33 +82,6 @@ static uint32_t run_generous(int split)
     return run_with(&cfg);
 }
 
-/* every cluster holds returns of one object only, and each object's returns lie in one cluster */
-static void assert_one_to_one(int n_obj)
-{
-    const uint16_t *lab = g.ws.labels;
-    uint32_t owner[64], cl_of[MAXOBJ + 1];
-    int p, i;
-    memset(owner, 0, sizeof owner);
-    memset(cl_of, 0, sizeof cl_of);
-    for (p = 0; p < NPIX; ++p)
-    {
-        if (lab[p] == 0)
-            continue;
-        TEST_ASSERT_TRUE(lab[p] < 64);
-        TEST_ASSERT_TRUE(g_obj[p] > 0);
-        if (owner[lab[p]] == 0)
-            owner[lab[p]] = g_obj[p];
-        TEST_ASSERT_EQUAL_UINT32(owner[lab[p]], g_obj[p]);
-        if (cl_of[g_obj[p]] == 0)
-            cl_of[g_obj[p]] = lab[p];
-        TEST_ASSERT_EQUAL_UINT32(cl_of[g_obj[p]], lab[p]);
-    }
-    for (i = 1; i <= n_obj; ++i)
-    {
-        TEST_ASSERT_TRUE(cl_of[i] != 0);
-    }
-}
-
 /* the records match a recount of the labels: counts, seeds, bounds, the rounded mean, canonical order */
 static void assert_records_consistent(void)
 {
@@ -167,7 +140,7 @@ static void test_two_people_0_4m_apart(void)
     TEST_ASSERT_EQUAL_UINT32(1, run_generous(0)); /* the depth clustering merges them */
     TEST_ASSERT_EQUAL_UINT32(0, g.ws.state.stats.n_split);
     TEST_ASSERT_EQUAL_UINT32(2, run_generous(1));
-    assert_one_to_one(2);
+    scene_one_to_one(g.ws.labels, 2);
     assert_records_consistent();
     TEST_ASSERT_EQUAL_UINT32(1, g.ws.state.stats.n_split);
     TEST_ASSERT_EQUAL_UINT32(1, g.ws.state.stats.n_split_parts);
@@ -181,7 +154,7 @@ static void test_person_beside_car(void)
     compact();
     TEST_ASSERT_EQUAL_UINT32(1, run_generous(0));
     TEST_ASSERT_EQUAL_UINT32(2, run_generous(1));
-    assert_one_to_one(2);
+    scene_one_to_one(g.ws.labels, 2);
     assert_records_consistent();
 }
 
@@ -198,7 +171,7 @@ static void test_car_in_three_pieces_joined(void)
     TEST_ASSERT_EQUAL_UINT32(2, g.ws.state.stats.n_joined);
     TEST_ASSERT_EQUAL_UINT32(0, g.ws.state.stats.n_split);
     TEST_ASSERT_EQUAL_UINT32(1, g.ws.state.stats.n_kept);
-    assert_one_to_one(1);
+    scene_one_to_one(g.ws.labels, 1);
     assert_records_consistent();
     /* the rule is what joins them: a union that must be longer than any car joins nothing */
     cfg.car_min_length_mm = 6000;

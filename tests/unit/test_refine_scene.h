@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "lidet/lidet.h"
+#include "unity.h"
 
 #define PI_D 3.14159265358979323846
 #define ROWS 32
@@ -117,6 +118,32 @@ static int car_bands(int row, int col)
 {
     (void)col;
     return (row >= 12 && row < 17) || (row >= 20 && row < 25);
+}
+
+/* every cluster holds returns of one object only, and each object's returns lie in one cluster */
+static void scene_one_to_one(const uint16_t *lab, int n_obj)
+{
+    uint32_t owner[64], cl_of[MAXOBJ + 1];
+    int p, i;
+    memset(owner, 0, sizeof owner);
+    memset(cl_of, 0, sizeof cl_of);
+    for (p = 0; p < NPIX; ++p)
+    {
+        if (lab[p] == 0)
+            continue;
+        TEST_ASSERT_TRUE(lab[p] < 64);
+        TEST_ASSERT_TRUE(g_obj[p] > 0);
+        if (owner[lab[p]] == 0)
+            owner[lab[p]] = g_obj[p];
+        TEST_ASSERT_EQUAL_UINT32(owner[lab[p]], g_obj[p]); /* one object per cluster */
+        if (cl_of[g_obj[p]] == 0)
+            cl_of[g_obj[p]] = lab[p];
+        TEST_ASSERT_EQUAL_UINT32(cl_of[g_obj[p]], lab[p]); /* one cluster per object */
+    }
+    for (i = 1; i <= n_obj; ++i)
+    {
+        TEST_ASSERT_TRUE(cl_of[i] != 0);
+    }
 }
 
 #endif

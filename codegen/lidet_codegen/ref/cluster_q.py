@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lidet_codegen.ref import qmath as qm
-from lidet_codegen.ref.cluster import proposal_indices
+from lidet_codegen.ref.cluster import grid_parts, proposal_indices
 
 FREE, SMALL, PENDING, NONCAND = 0, 0xFFFD, 0xFFFE, 0xFFFF
 STEPS = 16  # LIDET_CLUSTER_MAX_STEPS
@@ -369,13 +369,20 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
             else:
                 finish(start, True)
 
-    # canonical ids: records in seed order, members regrouped in raster order
+    labels, members, out_recs = _canonical(lab, recs, st)
+    if c["split_people"] or c["join_cars"]:
+        labels, members, out_recs = refine_q(labels, members, out_recs, X, Y, Z, cols, c, st, height, max_clusters)
+    return labels.reshape(rows, cols), np.asarray(members, np.int64), out_recs, st
+
+
+def _canonical(lab, recs, st: dict):
+    """The canonical pass (canonicalise): records in seed order (stable), per-pixel slot labels (1..; 0 or >= SMALL:
+    none) to ids, members regrouped in raster order. Returns (labels (npix,) int64, members list, records)."""
     order = sorted(range(len(recs)), key=lambda i: recs[i].seed_pixel)
     slot_id = {s + 1: i + 1 for i, s in enumerate(order)}
-    labels = np.zeros(npix, np.int64)
+    labels = np.zeros(len(lab), np.int64)
     groups: list = [[] for _ in order]
-    for p in range(npix):
-        lv = lab[p]
+    for p, lv in enumerate(lab):
         if 0 < lv < SMALL:
             labels[p] = slot_id[lv]
             groups[slot_id[lv] - 1].append(p)
@@ -388,9 +395,7 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
         out_recs.append(rec)
     st["n_pixels_kept"] = first
     st["n_kept"] = len(recs)
-    if c["split_people"] or c["join_cars"]:
-        labels, members, out_recs = refine_q(labels, members, out_recs, X, Y, Z, cols, c, st, height, max_clusters)
-    return labels.reshape(rows, cols), np.asarray(members, np.int64), out_recs, st
+    return labels, members, out_recs
 
 
 def _sat16(v: int) -> int:
@@ -471,33 +476,13 @@ def refine_q(labels, members, recs, X, Y, Z, cols: int, c: dict, st: dict, heigh
             ix = min((_span_mm(rec.min[0], X[p]) * inv) >> 40, nx - 1)
             iy = min((_span_mm(rec.min[1], Y[p]) * inv) >> 40, ny - 1)
             cell.append(iy * nx + ix)
-        occ = set(cell)
-        part_of: dict = {}
-        n_parts = 0
-        for c0 in cell:
-            if c0 in part_of:
-                continue
-            if n_parts == REFINE_MAX_PARTS:
-                n_parts = 0
-                break
-            part_of[c0] = n_parts
-            queue = [c0]
-            while queue:
-                cc = queue.pop()
-                cx, cy = cc % nx, cc // nx
-                for yy in range(max(cy - 1, 0), min(cy + 1, ny - 1) + 1):
-                    for xx in range(max(cx - 1, 0), min(cx + 1, nx - 1) + 1):
-                        nb = yy * nx + xx
-                        if nb in occ and nb not in part_of:
-                            part_of[nb] = n_parts
-                            queue.append(nb)
-            n_parts += 1
-        if n_parts == 0:
+        part = grid_parts(cell, nx, ny)
+        n_parts = max(part) + 1
+        if n_parts > REFINE_MAX_PARTS:  # label_parts gives up at the part past the cap
             st["n_split_skipped"] += 1
             continue
         if n_parts == 1:
             continue
-        part = [part_of[cl] for cl in cell]
         pn = [0] * n_parts
         bx = [[nx, -1, ny, -1] for _ in range(n_parts)]
         bz = [[None, None] for _ in range(n_parts)]
@@ -611,23 +596,8 @@ def refine_q(labels, members, recs, X, Y, Z, cols: int, c: dict, st: dict, heigh
     changed = changed or n_joined > 0
     if not changed:
         return np.asarray(lab, np.int64), mem, recs
-    # the canonical pass again (seed order, stable; the emptied records last, then dropped)
-    perm = sorted(range(len(recs)), key=lambda s: recs[s].seed_pixel)
-    slot_id = {s + 1: i + 1 for i, s in enumerate(perm)}
-    groups: list = [[] for _ in perm]
-    out = np.zeros(len(lab), np.int64)
-    for p, lv in enumerate(lab):
-        if lv:
-            out[p] = slot_id[lv]
-            groups[slot_id[lv] - 1].append(p)
-    new_recs, new_mem, first = [], [], 0
-    for i, s in enumerate(perm):
-        r = recs[s]
-        r.first_member = first
-        first += r.n_points
-        new_mem.extend(groups[i])
-        new_recs.append(r)
-    st["n_pixels_kept"] = first
+    # the canonical pass again (the emptied records, seed 0xFFFFFFFF, ordered last, then dropped)
+    out, new_mem, new_recs = _canonical(lab, recs, st)
     new_recs = new_recs[:len(new_recs) - n_joined]
     st["n_kept"] = len(new_recs)
     return out, new_mem, new_recs

@@ -11,7 +11,10 @@
  *   REFINE_Z_T, REFINE_Z_FAR       a z coordinate and a bound no z reaches;
  *   REFINE_V_T, REFINE_S_T         a coordinate and a sum of coordinates; REFINE_READ(c, p, v) pixel p's x, y, z
  *                                  into v[3];
- *   REFINE_MIN(r), REFINE_MAX(r)   a record's bounds;
+ *   REFINE_MIN(r), REFINE_MAX(r), REFINE_MEAN(r), REFINE_H(r)  a record's bounds, mean and height;
+ *   REFINE_HEIGHT(c, seed, mean, planes, n_sectors)  the height of a mean (the clustering's);
+ *   REFINE_SPLIT_FN, REFINE_JOIN_FN  the names of the two entry points this file defines
+ *                                  (lidet_cluster_internal.h, lidet_cluster_q_internal.h);
  * and the numeric kernels, static functions of the including file:
  *   int refine_examined(cfg, rec)  wider than split_min_width in x or y, and at least person_min_height in z;
  *   int refine_grid(cfg, rec, geom, nx, ny)  the grid of the cluster: its cells along x and y (0 when a count
@@ -20,13 +23,11 @@
  *   REFINE_Z_T refine_z(c, p)      the z of pixel p;
  *   int refine_person(cfg, geom, n, sx, sy, zlo, zhi, ncols)  a part of n points spanning sx, sy cells, z in
  *                                  [zlo, zhi], over ncols image columns, is person-sized;
- *   void refine_mean(c, slot, sum, planes, n_sectors)  record `slot`'s mean from the sums of its n_points
- *                                  members and its height (its seed set);
+ *   void refine_mean(c, slot, sum)  record `slot`'s mean from the sums of its n_points members;
  *   int refine_car_piece(cfg, rec), int refine_joinable(cfg, a, b)  the joins' box tests;
  *   void refine_join_mean(c, i, j, first)  cluster j's mean into cluster i's (first: i's first join of the
- *                                  pass), before the counts grow;
- *   void refine_reheight(c, i, planes, n_sectors)  cluster i's height from its mean and seed.
- * Defines refine_split and refine_join (lidet_cluster_internal.h). Not a public header; include nowhere else. */
+ *                                  pass), before the counts grow.
+ * Not a public header; include nowhere else. */
 
 #define REFINE_CELL_OCC 0xFFFFu
 
@@ -118,7 +119,8 @@ static void refine_rebuild(REFINE_STATE_T *c, uint32_t slot, const REFINE_REC_T 
         REFINE_MIN(r)[i] = lo[i];
         REFINE_MAX(r)[i] = hi[i];
     }
-    refine_mean(c, slot, sum, planes, n_sectors);
+    refine_mean(c, slot, sum);
+    REFINE_H(r) = REFINE_HEIGHT(c, seed, REFINE_MEAN(r), planes, n_sectors);
 }
 
 /* cut cluster k; returns 1 when it was cut */
@@ -273,7 +275,7 @@ static int refine_split_one(REFINE_STATE_T *c, uint32_t k, const REFINE_PLANE_T 
     return 1;
 }
 
-static int refine_split(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t n_sectors, lidet_cluster_stats_t *st)
+int REFINE_SPLIT_FN(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t n_sectors, lidet_cluster_stats_t *st)
 {
     const uint32_t k0 = c->n_recs;
     uint32_t k;
@@ -285,7 +287,7 @@ static int refine_split(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_
     return changed;
 }
 
-static int refine_join(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t n_sectors, lidet_cluster_stats_t *st)
+int REFINE_JOIN_FN(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t n_sectors, lidet_cluster_stats_t *st)
 {
     const REFINE_CFG_T *cfg = &c->cfg;
     const uint32_t k = c->n_recs;
@@ -325,7 +327,7 @@ static int refine_join(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t
             a->n_points += b->n_points;
             a->n_rescued += b->n_rescued;
             a->seed_pixel = b->seed_pixel < a->seed_pixel ? b->seed_pixel : a->seed_pixel;
-            refine_reheight(c, i, planes, n_sectors);
+            REFINE_H(a) = REFINE_HEIGHT(c, a->seed_pixel, REFINE_MEAN(a), planes, n_sectors);
             /* b is left empty with the largest seed: the canonical pass puts it last, then it is dropped */
             b->n_points = 0;
             b->seed_pixel = 0xFFFFFFFFu;
