@@ -153,19 +153,25 @@ static void fz_scan_header(fz_in_t *in, fz_scan_t *s)
 static void fz_scan_points(fz_in_t *in, fz_scan_t *s)
 {
     const uint32_t rec = 4u * s->stride + ((s->flags & FZ_FLAG_RINGS) ? 2u : 0u);
-    uint32_t n = (uint32_t)(in->n / rec), i, k, t;
+    uint32_t n = (uint32_t)(in->n / rec), i, t;
     if (n > FZ_MAX_IN / s->tile)
     {
         n = FZ_MAX_IN / s->tile;
     }
+    /* n whole records are there: copied without fz_u8's per-byte bound check, whose comparisons the
+     * fuzzer would otherwise trace for every byte of every input (little-endian, as fz_u32 composes them) */
     for (i = 0; i < n; ++i)
     {
-        for (k = 0; k < s->stride; ++k)
+        memcpy(&fz_pts[i * s->stride], in->p, 4u * s->stride);
+        in->p += 4u * s->stride;
+        fz_ring[i] = 0u;
+        if (s->flags & FZ_FLAG_RINGS)
         {
-            fz_pts[i * s->stride + k] = fz_f32(in);
+            fz_ring[i] = (uint16_t)(in->p[0] | (in->p[1] << 8));
+            in->p += 2;
         }
-        fz_ring[i] = (s->flags & FZ_FLAG_RINGS) ? fz_u16(in) : 0u;
     }
+    in->n -= (size_t)n * rec;
     for (t = 1; t < s->tile; ++t)
     {
         memcpy(&fz_pts[t * n * s->stride], fz_pts, (size_t)n * s->stride * sizeof(float));

@@ -99,6 +99,59 @@ def proposal_seed(sensor: str, model_index: int, cls: int) -> bytes:
     return out
 
 
+def scan_parts_q(sensor: str, table: bool, rings: bool, stride: int, tile: int, seed: int):
+    """(header, payload) of an integer scan input (fuzz_detector_q.c): microradians and int32 millimetres."""
+    s = get_sensor(sensor)
+    pts, ring, _ = load(sensor)
+    elev = np.asarray(s.beam_elev_rad, dtype=np.float64)
+    keep_rings = np.argsort(elev)[:ROWS]
+    sel = np.flatnonzero(np.isin(ring, keep_rings) & (np.hypot(pts[:, 0], pts[:, 1]) < 40.0))
+    rng = np.random.default_rng(seed)
+    sel = np.sort(rng.choice(sel, size=min(NPTS, sel.size), replace=False))
+    new_ring = np.searchsorted(np.sort(keep_rings), ring[sel]).astype(np.uint16)
+    flags = (FLAG_TABLE if table else 0) | (FLAG_RINGS if rings else 0) | ((stride - 3) << 2)
+    head = struct.pack("<BBBB", ROWS - 1, COLS - 8, flags, tile - 1)
+    urad = np.round(elev * 1e6).astype(np.int64)
+    if table:
+        head += b"".join(struct.pack("<i", int(urad[r])) for r in np.sort(keep_rings))
+    else:
+        head += struct.pack("<ii", int(urad[keep_rings].max()) + 10000, int(urad[keep_rings].min()) - 10000)
+    head += struct.pack("<B", int(round(s.mount_height_m / 0.25)))
+    rec = np.zeros((sel.size, stride), dtype=np.int32)
+    rec[:, :3] = np.round(pts[sel, :3].astype(np.float64) * 1000.0).astype(np.int32)
+    if stride > 3:
+        rec[:, 3] = np.round(pts[sel, 3] * 255.0).astype(np.int32)
+    body = b""
+    for i in range(sel.size):
+        body += rec[i].tobytes()
+        if rings:
+            body += struct.pack("<H", int(new_ring[i]))
+    return head, body
+
+
+# fuzz_detector_q.c: flags (gates on, diagonals), max proposals 16, min_points 5, 8 sectors, 5 steps, no poke;
+# bit 0 of the flags (64 points per proposal) set for the vlp16 scan
+KNOBS_Q = struct.pack("<BBBBB", 0x4C, 16, 4, 7, 5) + struct.pack("<BI", 255, 0)
+
+
+def proposal_seed_q(sensor: str, mode: int, cls: int) -> bytes:
+    """pointnet_q input (mode 0): a car's points in mm about their mean, its voxel and its mean in 4 mm."""
+    pts, _, boxes = load(sensor)
+    cx, cy = (float(v) for v in boxes[0][1:3])
+    near = pts[np.hypot(pts[:, 0] - cx, pts[:, 1] - cy) < 2.0][:, :3].astype(np.float64)
+    rng = np.random.default_rng(2)
+    idx = rng.choice(near.shape[0], size=128, replace=near.shape[0] < 128)
+    mean = near.mean(axis=0)
+    xyz = np.round((near[idx] - mean) * 1000.0).astype(np.int16)
+    vox = [int(np.floor(np.arctan2(mean[1], mean[0]) / np.radians(10))),
+           int(np.floor(np.arctan2(mean[2], np.hypot(mean[0], mean[1])) / np.radians(10))),
+           int(np.floor(np.linalg.norm(mean)))]
+    out = struct.pack("<BBB", mode, 0, cls) + struct.pack("<hhh", *vox) + xyz.tobytes()
+    for i in range(3):
+        out += struct.pack("<ih", int(round(mean[i] * 250.0)), vox[i])
+    return out
+
+
 def main() -> None:
     OUT.mkdir(parents=True, exist_ok=True)
     for harness, knobs in KNOBS.items():
@@ -110,9 +163,28 @@ def main() -> None:
             if harness == "detector" and sensor == "vlp16":
                 k = bytes([k[0] | 1]) + k[1:]
             (d / f"{name}.bin").write_bytes(head + k + body)
+    d = OUT / "detector_q"
+    d.mkdir(exist_ok=True)
+    for name, (sensor, table, rings, stride, tile) in SCANS.items():
+        head, body = scan_parts_q(sensor, table, rings, stride, tile, seed=len(name))
+        k = KNOBS_Q if sensor != "vlp16" else bytes([KNOBS_Q[0] | 1]) + KNOBS_Q[1:]
+        (d / f"{name}.bin").write_bytes(head + k + body)
+    d = OUT / "pointnet_q"
+    d.mkdir(exist_ok=True)
+    # mode: bit 0 descriptor mutation, bit 1 box net, bit 2 64 points (fuzz_pointnet_q.c)
+    for mode in (0, 2, 4, 6):
+        (d / f"mode{mode}_car.bin").write_bytes(proposal_seed_q("hdl64", mode, 0))
+    mut_q = {"valid": [], "wrong_version": [(0, 2)], "zero_width": [(18, 0)], "huge_width": [(18, 5000)],
+             "null_weights": [(22, 0)], "bad_shift": [(25, 0)], "zero_temperature": [(10, 0)]}
+    for mode in (1, 3, 5, 7):
+        for name, ms in mut_q.items():
+            b = struct.pack("<BBBBB", mode, 0, 0, len(ms), 0)
+            for sel, v in ms:
+                b += struct.pack("<BI", sel, v)
+            (d / f"mode{mode}_{name}.bin").write_bytes(b + b"\x00\x00")
     d = OUT / "pointnet"
     d.mkdir(exist_ok=True)
-    # the model index picks lidet_weights_models[i % 4] (weights/lidet_weights.c)
+    # the model byte picks a tiny model: bit 0 box net, bit 1 64 points (fuzz_models.h)
     for i in range(4):
         (d / f"model{i}_car.bin").write_bytes(proposal_seed("hdl64", i, 0))
     d = OUT / "pn_check"

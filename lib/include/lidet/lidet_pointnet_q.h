@@ -173,7 +173,8 @@ lidet_status_t lidet_pointnet_q_init(lidet_pointnet_q_t *pn, const lidet_pointne
 lidet_status_t lidet_pointnet_q_forward(lidet_pointnet_q_t *pn, const int16_t *points_mm, uint32_t n_points,
                                         const int16_t voxel[3], uint32_t cls, int32_t *out, uint32_t n_out);
 
-/** @brief Classify an integer proposal (frame, forward, energy, scores, gate 1). */
+/** @brief Classify an integer proposal (frame, forward, energy, scores, gate 1). LIDET_ERR_ARG when its
+ *         n_points is not the model's or its mean is farther than LIDET_Q_COORD_MAX_MM (+ 4 mm) on an axis. */
 lidet_status_t lidet_pointnet_q_classify(lidet_pointnet_q_t *pn, const lidet_proposal_q_t *p,
                                          lidet_pointnet_q_class_out_t *out);
 

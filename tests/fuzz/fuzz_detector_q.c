@@ -1,0 +1,167 @@
+/* SPDX-License-Identifier: MIT */
+/* libFuzzer harness: the integer detector (lidet_detector_q_init with fuzzed knobs, lidet_detector_q_run:
+ * integer projection, ground, clustering, proposals, the int8 PointNets (the tiny models of
+ * tests/fuzz/models), gates, size check, NMS) on any integer sensor and any int32 millimetre scan the input
+ * describes (INT32_MIN/MAX coordinates, zero range, rings out of range). Checks the counts and outcomes agree,
+ * the detections are sorted, in range and of Q15 score, per-point pixels in range.
+ *
+ * Input: rows, cols, flags, tile (as fuzz_common.h; flags 0x01 beam table, 0x02 rings, bits 2-3 stride - 3,
+ * 0x20 rows/cols raw, 0x40 raw projection limits), the beam table (n_rows int32 microradians) or fov_up,
+ * fov_down (int32 microradians), one mount-height byte (x 250 mm), [min range mm, max range mm, fov margin
+ * urad as int32], the knobs (detector_q_knobs), then the points: records of `stride` int32 (mm), any value. */
+#include "fuzz_common.h"
+#include "fuzz_models.h"
+#include "lidet/lidet_detector_q.h"
+#include "lidet/lidet_sensor_q.h"
+
+static lidet_detector_q_t g_det;
+static int32_t g_pts[FZ_MAX_IN * FZ_MAX_STRIDE];
+static int32_t g_pp[LIDET_MAX_POINTS];
+static int32_t g_elev[256];
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+static void sensor_q(fz_in_t *in, fz_scan_t *s, lidet_sensor_q_t *q, lidet_proj_q_cfg_t *pc)
+{
+    const uint8_t b_rows = fz_u8(in), b_cols = fz_u8(in);
+    uint32_t i;
+    memset(s, 0, sizeof *s);
+    memset(q, 0, sizeof *q);
+    s->flags = fz_u8(in);
+    s->stride = 3u + ((s->flags >> 2) & 3u);
+    s->tile = 1u + (fz_u8(in) % FZ_MAX_TILE);
+    q->name = "fuzz";
+    if (s->flags & FZ_FLAG_RAW_DIM)
+    {
+        q->n_rows = b_rows;
+        q->n_cols = (uint16_t)(4u * b_cols);
+    }
+    else
+    {
+        q->n_rows = (uint16_t)(1u + b_rows % LIDET_MAX_ROWS);
+        q->n_cols = (uint16_t)(8u + b_cols % (LIDET_MAX_COLS - 7u));
+    }
+    if (s->flags & FZ_FLAG_TABLE)
+    {
+        for (i = 0; i < q->n_rows && i < 256u; ++i)
+        {
+            g_elev[i] = (int32_t)fz_u32(in);
+        }
+        q->beam_elev_urad = g_elev;
+    }
+    else
+    {
+        q->fov_up_urad = (int32_t)fz_u32(in);
+        q->fov_down_urad = (int32_t)fz_u32(in);
+    }
+    q->mount_height_mm = 250 * (int32_t)(fz_u8(in) % 17u); /* 0 .. 4 m */
+    q->max_range_mm = 100000;
+    lidet_proj_q_cfg_default(pc, q);
+    if (s->flags & FZ_FLAG_RAW_CFG)
+    {
+        pc->min_range_mm = (int32_t)fz_u32(in);
+        pc->max_range_mm = (int32_t)fz_u32(in);
+        pc->fov_margin_urad = (int32_t)fz_u32(in);
+    }
+}
+
+/* one of the configuration's 32-bit fields overwritten with a raw value: the init's validation */
+static void poke_u32(fz_in_t *in, uint32_t *const *fields, uint32_t n_fields)
+{
+    const uint8_t sel = fz_u8(in);
+    const uint32_t v = fz_u32(in);
+    if (sel < n_fields)
+    {
+        *fields[sel] = v;
+    }
+}
+
+static void detector_q_knobs(fz_in_t *in, lidet_detector_q_cfg_t *c, uint8_t *p64, uint8_t *per_point)
+{
+    uint32_t *const f32[] = {
+        (uint32_t *)&c->crop_half_bam, (uint32_t *)&c->max_range_mm, (uint32_t *)&c->nms_iou_q15,
+        (uint32_t *)&c->size.min_mm[0][0], (uint32_t *)&c->size.max_mm[1][2], &c->proposal.range_bin_4mm,
+        &c->proposal.azimuth_bin_bam, &c->cluster.theta_urad, &c->cluster.max_gap_mm,
+        &c->cluster.max_gap_per_m_q16, &c->cluster.max_extent_mm, (uint32_t *)&c->cluster.max_mean_height_mm,
+        &c->cluster.rescue_gap_mm, &c->cluster.rescue_cols, &c->ground.inlier_mm, &c->ground.max_tilt_urad,
+        &c->ground.confidence_q16, &c->ground.ground_mm, &c->ground.veto_slope_q16, &c->ground.ring_split_mm,
+        &c->ground.seed, &c->proposal.seed};
+    const uint8_t f = fz_u8(in);
+    *p64 = f & 1u;
+    *per_point = (f >> 1) & 1u;
+    c->gate1 = (f >> 2) & 1u;
+    c->gate2 = (f >> 3) & 1u;
+    if (f & 0x10u)
+    {
+        c->crop_half_bam = 0;
+    }
+    c->cluster.bridge_occluders = (f >> 5) & 1u;
+    c->cluster.diagonals = (f >> 6) & 1u;
+    c->max_proposals = fz_u8(in) % (LIDET_MAX_CLUSTERS + 2u);
+    c->cluster.min_points = 1u + fz_u8(in) % 12u;
+    c->ground.n_sectors = (uint16_t)(1u + fz_u8(in) % LIDET_GROUND_MAX_SECTORS);
+    c->cluster.max_steps = fz_u8(in) % (LIDET_CLUSTER_MAX_STEPS + 2u);
+    poke_u32(in, f32, (uint32_t)(sizeof f32 / sizeof f32[0]));
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
+{
+    fz_in_t in = {data, size};
+    fz_scan_t s;
+    lidet_sensor_q_t sensor;
+    lidet_detector_q_cfg_t cfg;
+    const lidet_detector_q_stats_t *ds;
+    const lidet_detection_q_t *det;
+    const uint8_t *out;
+    uint8_t p64, per_point;
+    uint32_t n_det, n_cl, i, n_detected = 0, n_pix;
+    lidet_status_t st;
+    lidet_proj_q_cfg_t pc;
+    sensor_q(&in, &s, &sensor, &pc);
+    lidet_detector_q_cfg_default(&cfg, &sensor);
+    cfg.proj = pc;
+    detector_q_knobs(&in, &cfg, &p64, &per_point);
+    fz_scan_points(&in, &s); /* raw 4-byte values: read back as int32 */
+    memcpy(g_pts, s.pts, (size_t)s.n_points * s.stride * sizeof(int32_t));
+    st = lidet_detector_q_init(&g_det, &cfg, tiny_s8_model(0, p64), tiny_s8_model(1, p64));
+    if (st != LIDET_OK)
+    {
+        FZ_CHECK(st < 0);
+        FZ_CHECK(lidet_detector_q_run(&g_det, g_pts, s.n_points, s.stride, s.ring, NULL) == LIDET_ERR_STATE);
+        return 0;
+    }
+    st = lidet_detector_q_run(&g_det, g_pts, s.n_points, s.stride, s.ring, per_point ? g_pp : NULL);
+    FZ_CHECK(LIDET_SUCCEEDED(st) || st == LIDET_ERR_CONFIG); /* CONFIG: fewer columns than ground sectors */
+    if (!LIDET_SUCCEEDED(st))
+    {
+        return 0;
+    }
+    ds = lidet_detector_q_stats(&g_det);
+    det = lidet_detector_q_detections(&g_det, &n_det);
+    out = lidet_detector_q_outcomes(&g_det, &n_cl);
+    n_pix = (uint32_t)sensor.n_rows * sensor.n_cols;
+    FZ_CHECK(n_det == ds->n_detections && n_det <= LIDET_MAX_DETECTIONS && n_cl == ds->n_clusters);
+    fz_check_proj_stats(&ds->proj, s.n_points, n_pix);
+    FZ_CHECK(ds->n_classified <= cfg.max_proposals && ds->n_boxed <= ds->n_classified);
+    for (i = 0; i < n_cl; ++i)
+    {
+        FZ_CHECK(out[i] >= 1 && out[i] <= LIDET_DET_OUT_DETECTED);
+        n_detected += out[i] == LIDET_DET_OUT_DETECTED;
+    }
+    FZ_CHECK(n_detected == n_det);
+    for (i = 0; i < n_det; ++i)
+    {
+        FZ_CHECK(det[i].cls < LIDET_N_CLASSES && det[i].cluster_id >= 1 && det[i].cluster_id <= n_cl);
+        FZ_CHECK(det[i].score_q15 >= 0 && det[i].score_q15 <= 32768);
+        FZ_CHECK(i == 0 || det[i].score_q15 <= det[i - 1].score_q15);
+    }
+    if (per_point)
+    {
+        const uint32_t n = s.n_points < LIDET_MAX_POINTS ? s.n_points : LIDET_MAX_POINTS;
+        for (i = 0; i < n; ++i)
+        {
+            FZ_CHECK(g_pp[i] >= -1 && g_pp[i] < (int32_t)n_pix);
+        }
+    }
+    return 0;
+}
