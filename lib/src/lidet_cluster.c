@@ -214,6 +214,8 @@ static int rescue_on(const lidet_cluster_state_t *c)
 #define RUN_RESCUE_FAR 3.0e38f
 #define RUN_RESCUE_GROW lidet__cluster_rescue_grow
 #define RUN_FRAGMENT_BUDGET(c) ((c)->cfg.max_fragment_pixels)
+#define RUN_REFINE_SPLIT lidet__refine_split
+#define RUN_REFINE_JOIN lidet__refine_join
 #include "internal/lidet_cluster_run_body.h"
 
 lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *labels, int32_t *members,
@@ -286,20 +288,7 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     }
 
     run_fills(c, &lk, npix, planes, n_sectors, &st);
-    /* the refinement (lidet_refine.c, issue 15): people cut out of wide clusters, car fragments joined; the
-     * canonical order again when it changed anything */
-    {
-        int changed;
-        memset(c->order, 0, sizeof c->order); /* the cut marks */
-        changed = c->cfg.split_people != 0u && lidet__refine_split(c, planes, n_sectors, &st);
-        changed |= c->cfg.join_cars != 0u && lidet__refine_join(c, planes, n_sectors, &st);
-        if (changed)
-        {
-            canonicalise(c, npix, &st);
-            c->n_recs -= st.n_joined; /* the emptied records, ordered last */
-        }
-    }
-    st.n_kept = c->n_recs;
+    run_refine(c, npix, planes, n_sectors, &st); /* lidet_refine.c, issue 15 */
     c->stats = st;
     return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }

@@ -33,6 +33,26 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     cfg->rescue_gap_per_m_q16 = 1966u; /* 0.03 */
     cfg->rescue_rows = sparse ? 1u : 2u;
     cfg->rescue_cols = 6u;
+    /* worst-case bounds (issue 19) */
+    cfg->max_fragment_pixels = sparse ? 2048u : 4096u;
+    cfg->max_bridge_per_pixel_q16 = 131072u; /* 2.0 */
+    /* the refinement (issue 15) */
+    cfg->split_people = 1u;
+    cfg->split_min_width_mm = 900u;
+    cfg->split_cell_mm = 120u;
+    cfg->split_cell_per_m_q16 = 0u;
+    cfg->person_max_width_mm = 1000u;
+    cfg->person_min_height_mm = 900u;
+    cfg->person_min_aspect_q16 = 117965u; /* 1.8 */
+    cfg->person_min_cols = 3u;
+    cfg->join_cars = 1u;
+    cfg->join_gap_mm = 500u;
+    cfg->car_max_length_mm = 5200u;
+    cfg->car_max_width_mm = 2200u;
+    cfg->car_max_height_mm = 2000u;
+    cfg->car_min_length_mm = 2500u;
+    cfg->upright_max_width_mm = 1300u;
+    cfg->max_join_pieces = 256u;
 }
 
 /* the members' sums and bounds (lidet_cluster_stats_body.h) on the int16 pixels, int64 sums; the extent
@@ -53,8 +73,8 @@ static inline void read_q(const lidet_cluster_q_state_t *c, uint32_t p, int32_t 
 #include "internal/lidet_cluster_stats_body.h"
 
 /* height of `mean` above the plane of the seed column's sector (or the flat ground at -mount), 4 mm steps */
-static int32_t height_q(const lidet_cluster_q_state_t *c, uint32_t seed, const int32_t mean[3],
-                        const lidet_plane_q_t *planes, uint32_t n_sectors)
+int32_t lidet__cluster_q_height(const lidet_cluster_q_state_t *c, uint32_t seed, const int32_t mean[3],
+                                const lidet_plane_q_t *planes, uint32_t n_sectors)
 {
     int64_t h;
     if (planes != 0)
@@ -100,7 +120,7 @@ static int mean_height_ok(const lidet_cluster_q_state_t *c, uint32_t n, uint32_t
                           const lidet_plane_q_t *planes, uint32_t n_sectors)
 {
     mean_of(s->sum, n, s->mean);
-    s->h = height_q(c, seed, s->mean, planes, n_sectors);
+    s->h = lidet__cluster_q_height(c, seed, s->mean, planes, n_sectors);
     return (int64_t)s->h * 4 <= c->cfg.max_mean_height_mm;
 }
 
@@ -127,7 +147,7 @@ static void join_mean(lidet_cluster_q_state_t *c, uint32_t slot, uint32_t n, con
 static void reheight(lidet_cluster_q_state_t *c, uint32_t slot, const lidet_plane_q_t *planes, uint32_t n_sectors)
 {
     lidet_cluster_q_rec_t *rec = &c->recs[slot];
-    rec->height_4mm = height_q(c, rec->seed_pixel, rec->mean_4mm, planes, n_sectors);
+    rec->height_4mm = lidet__cluster_q_height(c, rec->seed_pixel, rec->mean_4mm, planes, n_sectors);
 }
 
 static int rescue_on(const lidet_cluster_q_state_t *c)
@@ -150,7 +170,9 @@ static int rescue_on(const lidet_cluster_q_state_t *c)
 #define RUN_RESCUE_T lidet__rescue_q_t
 #define RUN_RESCUE_FAR 0xFFFFFFFFu
 #define RUN_RESCUE_GROW lidet__cluster_q_rescue_grow
-#define RUN_FRAGMENT_BUDGET(c) 0u /* no rescue budget in the integer stage yet */
+#define RUN_FRAGMENT_BUDGET(c) ((c)->cfg.max_fragment_pixels)
+#define RUN_REFINE_SPLIT lidet__refine_q_split
+#define RUN_REFINE_JOIN lidet__refine_q_join
 #include "internal/lidet_cluster_run_body.h"
 
 lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lidet_cluster_q_cfg_t *cfg)
@@ -164,7 +186,14 @@ lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lide
         cfg->min_points < 1u || cfg->max_extent_mm == 0u || cfg->max_extent_mm > 1000000u ||
         cfg->max_gap_mm > 1000000u || cfg->max_gap_per_m_q16 > 65536u || cfg->mount_height_mm > 100000u ||
         cfg->rescue_gap_mm > 10000u || cfg->rescue_gap_per_m_q16 > 16384u || cfg->rescue_rows > LIDET_MAX_ROWS ||
-        cfg->rescue_cols > RESCUE_MAX_COLS)
+        cfg->rescue_cols > RESCUE_MAX_COLS || cfg->max_bridge_per_pixel_q16 > (64u << 16) || cfg->split_people > 1u ||
+        cfg->split_min_width_mm == 0u || cfg->split_min_width_mm > 1000000u || cfg->split_cell_mm == 0u ||
+        cfg->split_cell_mm > 100000u || cfg->split_cell_per_m_q16 > 65536u || cfg->person_max_width_mm == 0u ||
+        cfg->person_max_width_mm > 1000000u || cfg->person_min_height_mm > 1000000u ||
+        cfg->person_min_aspect_q16 > (100u << 16) || cfg->join_cars > 1u || cfg->join_gap_mm > 1000000u ||
+        cfg->car_max_length_mm == 0u || cfg->car_max_length_mm > 1000000u || cfg->car_max_width_mm == 0u ||
+        cfg->car_max_width_mm > 1000000u || cfg->car_max_height_mm == 0u || cfg->car_max_height_mm > 1000000u ||
+        cfg->car_min_length_mm > 1000000u || cfg->upright_max_width_mm > 1000000u)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -184,7 +213,6 @@ lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t 
                                            const lidet_plane_q_t *planes, uint32_t n_sectors)
 {
     lidet__grow_q_t lk;
-    uint32_t bridged = 0;
     lidet_cluster_stats_t st;
     uint32_t npix;
     lidet_status_t chk = run_check(c, labels, members, img, planes, n_sectors);
@@ -208,12 +236,14 @@ lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t 
     lk.gpm = c->cfg.max_gap_per_m_q16;
     lk.rgap = (uint32_t)lidet__q_div_round((int64_t)c->cfg.rescue_gap_mm, 4);
     lk.rgpm = c->cfg.rescue_gap_per_m_q16;
-    /* no bridging budget in the integer stage yet (the float stage's max_bridge_per_pixel, issue 19): the
-     * counter goes to a local, the stats keep 0 */
-    lk.bridge_max = 0xFFFFFFFFu;
-    lk.bridged = &bridged;
+    lk.bridged = &st.n_bridge_steps;
     st.n_candidates = lidet__cluster_mark_4mm(img->range_4mm, ground_mask, npix, labels);
+    /* the bridging budget (issue 19, as the float stage's max_bridge_per_pixel): <= 2^22 * 2^18 >> 16, fits */
+    lk.bridge_max = c->cfg.max_bridge_per_pixel_q16 > 0u
+                        ? (uint32_t)(((uint64_t)c->cfg.max_bridge_per_pixel_q16 * st.n_candidates) >> 16)
+                        : 0xFFFFFFFFu;
     run_fills(c, &lk, npix, planes, n_sectors, &st);
+    run_refine(c, npix, planes, n_sectors, &st); /* lidet_cluster_q_refine.c */
     c->stats = st;
     return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }

@@ -32,6 +32,11 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     {
         cfg->max_proposals = LIDET_MAX_CLUSTERS;
     }
+    cfg->max_boxes = rows <= 16u ? 24u : 48u;
+    if (cfg->max_boxes > LIDET_MAX_CLUSTERS)
+    {
+        cfg->max_boxes = LIDET_MAX_CLUSTERS;
+    }
     cfg->gate1 = 1u;
     cfg->gate2 = 1u;
     cfg->nms_iou_q15 = NMS_IOU_DEFAULT_Q15;
@@ -42,7 +47,7 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
 {
     uint32_t k, j;
     if (c->crop_half_bam < 0 || c->max_range_mm < 0 || c->max_proposals < 1u ||
-        c->max_proposals > LIDET_MAX_CLUSTERS || c->gate1 > 1u || c->gate2 > 1u || c->nms_iou_q15 < 0 ||
+        c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1u || c->max_boxes > LIDET_MAX_CLUSTERS || c->gate1 > 1u || c->gate2 > 1u || c->nms_iou_q15 < 0 ||
         c->nms_iou_q15 > 32768)
     {
         return 0;
@@ -284,6 +289,13 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
         {
             d->outcome[ci] = LIDET_DET_OUT_GATE1;
             ++st->n_gate1_rejected;
+            continue;
+        }
+        if (st->n_boxed == d->cfg.max_boxes)
+        {
+            d->outcome[ci] = LIDET_DET_OUT_BUDGET;
+            ++st->n_over_box_budget;
+            worst = LIDET_TRUNCATED;
             continue;
         }
         tb = now(d);

@@ -52,6 +52,10 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
                                                              : round_i32((double)fcfg->crop_half_rad * bam_per_rad);
     cfg.max_range_mm = round_i32((double)fcfg->max_range_m * 1000.0);
     cfg.max_proposals = fcfg->max_proposals;
+    cfg.max_boxes = fcfg->max_boxes;
+    /* the refinement's switches (its thresholds stay the integer defaults) */
+    cfg.cluster.split_people = fcfg->stages.cluster.split_people;
+    cfg.cluster.join_cars = fcfg->stages.cluster.join_cars;
     cfg.gate1 = fcfg->gate1;
     cfg.gate2 = fcfg->gate2;
     cfg.nms_iou_q15 = round_i32((double)fcfg->nms_iou * 32768.0);
@@ -114,6 +118,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     ds->n_size_rejected = st->n_size_rejected;
     ds->n_nms_suppressed = st->n_nms_suppressed;
     ds->n_over_capacity = st->n_over_capacity;
+    ds->n_over_box_budget = st->n_over_box_budget;
     ds->n_detections = st->n_detections;
     dq = lidet_detector_q_detections(&g_detq, n_det);
     for (k = 0; k < *n_det; ++k)

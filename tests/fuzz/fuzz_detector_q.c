@@ -85,7 +85,9 @@ static void detector_q_knobs(fz_in_t *in, lidet_detector_q_cfg_t *c, uint8_t *p6
         &c->cluster.max_gap_per_m_q16, &c->cluster.max_extent_mm, (uint32_t *)&c->cluster.max_mean_height_mm,
         &c->cluster.rescue_gap_mm, &c->cluster.rescue_cols, &c->ground.inlier_mm, &c->ground.max_tilt_urad,
         &c->ground.confidence_q16, &c->ground.ground_mm, &c->ground.veto_slope_q16, &c->ground.ring_split_mm,
-        &c->ground.seed, &c->proposal.seed};
+        &c->ground.seed, &c->proposal.seed, &c->max_boxes, &c->cluster.max_fragment_pixels,
+        &c->cluster.max_bridge_per_pixel_q16, &c->cluster.split_cell_mm, &c->cluster.split_min_width_mm,
+        &c->cluster.person_min_aspect_q16, &c->cluster.join_gap_mm, &c->cluster.car_min_length_mm};
     const uint8_t f = fz_u8(in);
     *p64 = f & 1u;
     *per_point = (f >> 1) & 1u;
@@ -97,6 +99,11 @@ static void detector_q_knobs(fz_in_t *in, lidet_detector_q_cfg_t *c, uint8_t *p6
     }
     c->cluster.bridge_occluders = (f >> 5) & 1u;
     c->cluster.diagonals = (f >> 6) & 1u;
+    if (f & 0x80u)
+    {
+        c->cluster.split_people = 0u; /* the refinement off (default on) */
+        c->cluster.join_cars = 0u;
+    }
     c->max_proposals = fz_u8(in) % (LIDET_MAX_CLUSTERS + 2u);
     c->cluster.min_points = 1u + fz_u8(in) % 12u;
     c->ground.n_sectors = (uint16_t)(1u + fz_u8(in) % LIDET_GROUND_MAX_SECTORS);
@@ -143,6 +150,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FZ_CHECK(n_det == ds->n_detections && n_det <= LIDET_MAX_DETECTIONS && n_cl == ds->n_clusters);
     fz_check_proj_stats(&ds->proj, s.n_points, n_pix);
     FZ_CHECK(ds->n_classified <= cfg.max_proposals && ds->n_boxed <= ds->n_classified);
+    FZ_CHECK(ds->n_boxed <= cfg.max_boxes && ds->n_classified == ds->n_gate1_rejected + ds->n_over_box_budget +
+                                                                  ds->n_boxed);
     for (i = 0; i < n_cl; ++i)
     {
         FZ_CHECK(out[i] >= 1 && out[i] <= LIDET_DET_OUT_DETECTED);

@@ -82,8 +82,15 @@ def test_defaults_are_the_float_defaults_rounded(need_lib):
         assert q["mount_height_mm"] == round(f["mount_height_m"] * 1e3)
         assert q["rescue_gap_mm"] == round(f["rescue_gap_m"] * 1e3)
         assert q["rescue_gap_per_m_q16"] == round(f["rescue_gap_per_m"] * 65536)
-        for k in ("max_steps", "bridge_occluders", "diagonals", "min_points", "rescue_rows", "rescue_cols"):
+        for k in ("max_steps", "bridge_occluders", "diagonals", "min_points", "rescue_rows", "rescue_cols",
+                  "max_fragment_pixels", "split_people", "join_cars", "person_min_cols", "max_join_pieces"):
             assert q[k] == f[k], k
+        assert q["max_bridge_per_pixel_q16"] == round(f["max_bridge_per_pixel"] * 65536)
+        assert q["split_cell_per_m_q16"] == round(f["split_cell_per_m"] * 65536)
+        assert q["person_min_aspect_q16"] == round(f["person_min_aspect"] * 65536)
+        for k in ("split_min_width", "split_cell", "person_max_width", "person_min_height", "join_gap", "car_max_length",
+                  "car_max_width", "car_max_height", "car_min_length", "upright_max_width"):
+            assert q[k + "_mm"] == round(f[k + "_m"] * 1e3), k
         fp = native.proposal_defaults()
         assert p["n_points"] == fp["n_points"] and p["seed"] == fp["seed"]
         # 10 deg exactly (2^32 / 36); the float default is 10 deg rounded to float32 (3 BAM32 off)
@@ -114,8 +121,60 @@ def test_bit_exact_capacity(sim_scans):
     """More components than LIDET_MAX_CLUSTERS: the smallest are evicted (first fill) or dropped (rescue groups),
     counted, LIDET_TRUNCATED; the same in the reference."""
     sensor, pts = sim_scans[0]
-    c = _check_bit_exact(sensor, pts, min_points=2, theta_urad=800000, max_gap_mm=300, max_gap_per_m_q16=0)
+    c = _check_bit_exact(sensor, pts, min_points=2, theta_urad=800000, max_gap_mm=300, max_gap_per_m_q16=0,
+                         join_cars=0)  # (joins would free slots; cuts find none free and leave clusters whole)
     assert c.status == 1 and c.stats["n_dropped_capacity"] > 0 and len(c) == native.capacity()["max_clusters"]
+
+
+#: fresh crowd scenes (lidet-sim --crowd): (sensor, seed, index)
+SIM_CROWD = [("hdl64", 4242, 0), ("hdl64", 4242, 1), ("vlp16", 4242, 0), ("vlp16", 4242, 1)]
+
+
+@pytest.fixture(scope="module")
+def crowd_scans(need_lib):
+    return [(s, simulate_scan(s, seed, i, crowd=True).points) for s, seed, i in SIM_CROWD]
+
+
+def test_bit_exact_crowd(crowd_scans):
+    """Crowd scenes: the refinement cuts people out of groups (and joins car pieces), bit for bit."""
+    n_split = n_joined = 0
+    for sensor, pts in crowd_scans:
+        c = _check_bit_exact(sensor, pts)
+        n_split += c.stats["n_split"]
+        n_joined += c.stats["n_joined"]
+    assert n_split > 0 and n_joined > 0, (n_split, n_joined)
+
+
+def test_bit_exact_refinement_paths(sim_scans):
+    """The refinement off, each rule alone, a growing cell and a tight part cap (coarse cells)."""
+    sensor, pts = sim_scans[0]
+    c = _check_bit_exact(sensor, pts, split_people=0, join_cars=0)
+    assert c.stats["n_split"] == c.stats["n_joined"] == 0
+    c = _check_bit_exact(sensor, pts, join_cars=0)
+    assert c.stats["n_split"] > 0 and c.stats["n_joined"] == 0
+    c = _check_bit_exact(sensor, pts, split_people=0)
+    assert c.stats["n_split"] == 0 and c.stats["n_joined"] > 0
+    _check_bit_exact(sensor, pts, split_cell_per_m_q16=655, split_min_width_mm=600, person_min_aspect_q16=65536)
+    c = _check_bit_exact(sim_scans[1][0], sim_scans[1][1], split_cell_mm=5)  # grids past LIDET_REFINE_MAX_CELLS
+    assert c.stats["n_split_skipped"] > 0
+
+
+def test_bit_exact_budgets(sim_scans):
+    """Issue 19's bounds in the integer stage: the rescue budget (fragments past max_fragment_pixels dropped and
+    counted) and the bridging budget (occluder bridging stops once the run has stepped over
+    max_bridge_per_pixel * candidates), the same as the reference; 0 disables each."""
+    sensor, pts = sim_scans[1]
+    free = _check_bit_exact(sensor, pts, max_fragment_pixels=0)
+    assert free.stats["n_dropped_fragment_budget"] == 0 and free.stats["n_fragment_pixels"] > 200
+    c = _check_bit_exact(sensor, pts, max_fragment_pixels=200)
+    assert c.stats["n_dropped_fragment_budget"] > 0 and c.stats["n_fragment_pixels"] <= 200
+    assert c.stats["n_rescue_pixels"] < free.stats["n_rescue_pixels"]
+    sensor, pts = sim_scans[0]  # hdl64: occluder bridging on by default
+    free = _check_bit_exact(sensor, pts, max_bridge_per_pixel_q16=0)
+    c = _check_bit_exact(sensor, pts, max_bridge_per_pixel_q16=3277)  # 0.05 steps per candidate
+    bound = (3277 * c.stats["n_candidates"]) >> 16
+    # the budget is checked per pixel: one pixel's searches (4 directions of max_steps) may cross it
+    assert bound <= c.stats["n_bridge_steps"] <= bound + 4 * 16 < free.stats["n_bridge_steps"]
 
 
 def test_bit_exact_real(real_dir, need_lib):
@@ -205,6 +264,12 @@ def test_agreement_with_float_simulated(sim_scans):
     _assert_agreement(a)
 
 
+def test_agreement_with_float_crowd(crowd_scans):
+    a = agreement(crowd_scans)
+    print(f"\nagreement, {len(crowd_scans)} crowd scans: {a}")
+    _assert_agreement(a)
+
+
 def test_agreement_with_float_real(real_dir, need_lib):
     scans = _real_scans(real_dir)
     a = agreement(scans)
@@ -216,7 +281,8 @@ def test_bad_config_refused(sim_scans):
     sensor, pts = sim_scans[1]
     scan = native_q.compact_scan(pts, sensor)
     for bad in (dict(theta_urad=0), dict(max_steps=17), dict(min_points=0), dict(max_extent_mm=0),
-                dict(rescue_gap_per_m_q16=16385), dict(rescue_cols=16)):
+                dict(rescue_gap_per_m_q16=16385), dict(rescue_cols=16), dict(split_people=2), dict(split_cell_mm=0),
+                dict(car_max_width_mm=0), dict(max_bridge_per_pixel_q16=(64 << 16) + 1)):
         with pytest.raises(native.LidetError):
             native_q.cluster_q(scan, **bad)
     with pytest.raises(native.LidetError):

@@ -2,8 +2,8 @@
 """The integer detector (lidet_detector_q): agreement with the float detector on the same scans (simulated
 samples, freshly simulated scans, the real KITTI / SemanticKITTI scans when present), determinism, bad input.
 
-Agreement (issue 16): against the float detector with the same clustering (its proposal refinement,
-lidet_refine.c, off: the integer clustering does not have it yet); detections matched by class and BEV centre
+Agreement (issue 16): against the default float detector (both with the proposal refinement, lidet_refine.c and
+lidet_cluster_q_refine.c); detections matched by class and BEV centre
 distance (< 1 m); on the matched pairs the mean
 BEV IoU of the integer box against the float box >= 0.95; the detections of either build left unmatched are
 <= 10 % of all (both builds classify a few hundred proposals per scan; a proposal near a gate threshold may pass in
@@ -42,7 +42,7 @@ def _agreement(nq, scans):
     ious, n_f, n_q, n_match, cls_same = [], 0, 0, 0, 0
     for sensor, path in scans:
         pts = _load(path)
-        f = native.detect(pts, sensor, refine=False)  # the integer clustering has no refinement yet
+        f = native.detect(pts, sensor)  # the defaults: the refinement on in both
         q = nq.detect_q(nq.to_mm(pts), sensor)
         assert q["status"] >= 0
         n_f += len(f.cls)
@@ -139,7 +139,7 @@ def test_score_matches_the_float_definition(nq):
 
 # ---- the integer detector against the chained numpy reference, bit for bit ---------------------------
 
-def _ref_detect(nq, pts_mm, sensor):
+def _ref_detect(nq, pts_mm, sensor, max_boxes=0):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -155,16 +155,18 @@ def _ref_detect(nq, pts_mm, sensor):
     cc, pc = nq.cluster_q_defaults(sensor)
     cap = native.capacity()
     det_cfg = dict(crop_half_bam=0, max_range_mm=0, max_proposals=min(128 if s.rows <= 16 else 256, cap["max_clusters"]),
-                   gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM)
+                   max_boxes=max_boxes or min(24 if s.rows <= 16 else 48, cap["max_clusters"]), gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM)
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
                      det_cfg, models["cls"], models["box"], cap["max_clusters"], cap["max_detections"],
                      cap["max_points"])
 
 
-@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real"])
+@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget"])
 def test_bit_exact_with_the_chained_reference(nq, which, request):
-    sensor = "vlp16"
-    if which == "sample":
+    sensor, max_boxes = "vlp16", 0
+    if which == "box_budget":  # the box budget hit: 3 boxed, the rest counted, LIDET_TRUNCATED
+        pts, max_boxes = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"), 3
+    elif which == "sample":
         pts = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin")
     elif which == "fresh":
         from lidet_tools.sim.simulate import simulate_scan
@@ -175,11 +177,14 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
         real = request.getfixturevalue("real_dir")
         sensor, pts = "hdl64", _load(real / "kitti/training/velodyne/000001.bin")
     mm = nq.to_mm(pts)
-    c = nq.detect_q(mm, sensor)
-    r = _ref_detect(nq, mm, sensor)
+    c = nq.detect_q(mm, sensor, max_boxes=max_boxes)
+    r = _ref_detect(nq, mm, sensor, max_boxes)
+    if max_boxes:
+        assert c["status"] == 1 and r["truncated"]
+        assert c["stats"]["n_boxed"] == max_boxes and c["stats"]["n_over_box_budget"] > 0
     assert c["outcome"].tolist() == r["outcome"]
     for k in ("n_clusters", "n_classified", "n_gate1_rejected", "n_boxed", "n_gate2_rejected", "n_size_rejected",
-              "n_nms_suppressed", "n_detections"):
+              "n_nms_suppressed", "n_detections", "n_over_box_budget"):
         assert c["stats"][k] == r["stats"][k], k
     assert len(r["detections"]) == len(c["cls"]) > 0
     for i, d in enumerate(r["detections"]):

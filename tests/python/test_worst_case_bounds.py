@@ -1,11 +1,12 @@
 # SPDX-License-Identifier: MIT
 """The caps that bound the worst-case time per stage (issue 19, docs/ROBUSTNESS.md): the clustering's rescue
 budget (max_fragment_pixels) and occluder bridging budget (max_bridge_steps), both mirrored by the numpy
-reference, and the detector's box budget (max_boxes)."""
+reference, and the detector's box budget (max_boxes), in the float and the integer detector."""
 import json
 import subprocess
 
 import numpy as np
+import pytest
 
 from lidet_tools import native
 from lidet_tools.sensors import get_sensor
@@ -68,12 +69,13 @@ def test_rescue_budget_default_leaves_real_sized_scans_alone(root):
         assert 0 < c.stats["n_fragment_pixels"] <= native.cluster_defaults(sensor)["max_fragment_pixels"] // 2
 
 
-def test_box_budget(cli, root):
+@pytest.mark.parametrize("fixed", [False, True], ids=["float", "integer"])
+def test_box_budget(cli, root, fixed):
     scan = root / "tests/data/sim_hdl64/velodyne/000000.bin"
 
     def run(*extra):
-        r = subprocess.run([str(cli), "detect", str(scan), "--sensor", "hdl64", "--json", *extra], check=True,
-                           capture_output=True, text=True)
+        r = subprocess.run([str(cli), "detect", str(scan), "--sensor", "hdl64", "--json", *extra,
+                            *(["--fixed"] if fixed else [])], check=True, capture_output=True, text=True)
         return json.loads(r.stdout)
 
     full = run()

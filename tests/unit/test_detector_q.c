@@ -118,13 +118,14 @@ static void check_invariants(const lidet_detector_q_cfg_t *cfg)
     }
     TEST_ASSERT_EQUAL_UINT32(st->n_out_of_crop, counts[LIDET_DET_OUT_CROP]);
     TEST_ASSERT_EQUAL_UINT32(st->n_out_of_range, counts[LIDET_DET_OUT_RANGE]);
-    TEST_ASSERT_EQUAL_UINT32(st->n_over_budget, counts[LIDET_DET_OUT_BUDGET]);
+    TEST_ASSERT_EQUAL_UINT32(st->n_over_budget + st->n_over_box_budget, counts[LIDET_DET_OUT_BUDGET]);
     TEST_ASSERT_EQUAL_UINT32(st->n_gate1_rejected, counts[LIDET_DET_OUT_GATE1]);
     TEST_ASSERT_EQUAL_UINT32(st->n_gate2_rejected, counts[LIDET_DET_OUT_GATE2]);
     TEST_ASSERT_EQUAL_UINT32(st->n_size_rejected, counts[LIDET_DET_OUT_SIZE]);
     TEST_ASSERT_EQUAL_UINT32(st->n_nms_suppressed, counts[LIDET_DET_OUT_NMS]);
     TEST_ASSERT_EQUAL_UINT32(n, counts[LIDET_DET_OUT_DETECTED]);
-    TEST_ASSERT_EQUAL_UINT32(st->n_classified, st->n_gate1_rejected + st->n_boxed);
+    TEST_ASSERT_EQUAL_UINT32(st->n_classified, st->n_gate1_rejected + st->n_over_box_budget + st->n_boxed);
+    TEST_ASSERT_TRUE(st->n_boxed <= cfg->max_boxes);
 }
 
 static void test_run_invariants_and_determinism(void)
@@ -174,10 +175,23 @@ static void test_crop_and_budget(void)
     lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.gate1 = 0;
     cfg.gate2 = 0;
+    cfg.max_boxes = LIDET_MAX_CLUSTERS;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL)));
     check_invariants(&cfg);
     TEST_ASSERT_EQUAL_UINT32(all, lidet_detector_q_stats(&g.ws)->n_boxed);
+    /* the box budget (issue 19): gate 1 off, so every candidate reaches it; the first max_boxes nearest are
+     * boxed, the rest counted, LIDET_TRUNCATED */
+    cfg.max_boxes = 2;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL));
+    check_invariants(&cfg);
+    TEST_ASSERT_EQUAL_UINT32(2u, lidet_detector_q_stats(&g.ws)->n_boxed);
+    TEST_ASSERT_EQUAL_UINT32(all - 2u, lidet_detector_q_stats(&g.ws)->n_over_box_budget);
+    cfg.max_boxes = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.max_boxes = LIDET_MAX_CLUSTERS + 1u;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
 }
 
 static void test_bad_points(void)

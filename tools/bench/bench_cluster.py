@@ -226,8 +226,9 @@ def run(args) -> str:
               f"min_points=10)` on the non-ground points, median of {rep_d}, OMP_NUM_THREADS=1, point-cloud "
               "construction included. Integer versus float (docs/FIXED_POINT.md): both clusterings on the same "
               "compact image with the ground stage's mask and planes (Q30 for the integer one), through the bindings "
-              f"(lidet_tools.native_q: cluster_f_compact, cluster_q), the stage alone (the integer stage has no "
-              f"refinement yet), median of {rep_l} runs per scan, then the median over the scans. Whole table: "
+              f"(lidet_tools.native_q: cluster_f_compact, cluster_q), the stage alone with its defaults (both with "
+              f"the refinement and the worst-case budgets), median of {rep_l} runs per scan, then the median over the "
+              "scans. Whole table: "
               "`python tools/bench/bench_cluster.py` (or `make bench`).", ""]
     lines += ["### Proposal recall (issue 15)", "",
               f"One kept cluster holds >= {100 * RECALL_THR:.0f} % of the object's non-ground points and the object is "

@@ -364,7 +364,11 @@ def ground_pair(points, sensor="hdl64"):
 #: lidet_cluster_q_cfg_t / lidet_proposal_q_cfg_t fields in declaration order (all 32-bit: passed as arrays)
 CLUSTER_Q_FIELDS = ["theta_urad", "max_steps", "bridge_occluders", "diagonals", "max_gap_mm", "max_gap_per_m_q16",
                     "min_points", "max_extent_mm", "max_mean_height_mm", "mount_height_mm", "rescue_gap_mm",
-                    "rescue_gap_per_m_q16", "rescue_rows", "rescue_cols"]
+                    "rescue_gap_per_m_q16", "rescue_rows", "rescue_cols", "max_fragment_pixels",
+                    "max_bridge_per_pixel_q16", "split_people", "split_min_width_mm", "split_cell_mm",
+                    "split_cell_per_m_q16", "person_max_width_mm", "person_min_height_mm", "person_min_aspect_q16",
+                    "person_min_cols", "join_cars", "join_gap_mm", "car_max_length_mm", "car_max_width_mm",
+                    "car_max_height_mm", "car_min_length_mm", "upright_max_width_mm", "max_join_pieces"]
 PROPOSAL_Q_FIELDS = ["n_points", "seed", "azimuth_bin_bam", "elevation_bin_bam", "range_bin_4mm"]
 _cq_ready = False
 
@@ -695,7 +699,8 @@ def pnq_time(cls_model: str, box_model: str, xyz_4mm, mean_4mm, voxel, repeats: 
 # ---- the integer detector (lib/src/lidet_detector_q.c) ---------------------------------------------
 
 DETQ_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
-              "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity", "n_detections"]
+              "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity", "n_detections",
+              "n_over_box_budget"]
 _detq_ready = False
 
 
@@ -708,7 +713,7 @@ def to_mm(points) -> np.ndarray:
 
 def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_half_bam: int = 0,
              max_range_mm: int = 0, nms_iou_q15: int = 3277, max_proposals: int = 0, gate1: bool = True,
-             gate2: bool = True) -> dict:
+             gate2: bool = True, max_boxes: int = 0) -> dict:
     """lidet_detector_q_run on (N, 3) int32 mm points with the int8 models cls_<model>_s8 / box_<model>_s8.
 
     Returns {'cls', 'score_q15', 'energy_cls_q16', 'energy_box_q16', 'boxes' (N, 7: cx cy cz l w h mm, yaw BAM32),
@@ -732,8 +737,8 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     oc = np.zeros(cap["max_clusters"], np.uint8)
     nc = np.zeros(1, np.uint32)
     st = np.zeros(len(DETQ_STATS), np.uint32)
-    icfg = np.array([crop_half_bam, max_range_mm, nms_iou_q15, max_proposals, int(bool(gate1)), int(bool(gate2))],
-                    np.int32)
+    icfg = np.array([crop_half_bam, max_range_mm, nms_iou_q15, max_proposals, int(bool(gate1)), int(bool(gate2)),
+                     max_boxes], np.int32)
     n = len(pts)
     rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
                              pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st)

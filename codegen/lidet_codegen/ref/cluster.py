@@ -281,6 +281,30 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
     return labels.reshape(rows, cols), out
 
 
+def grid_parts(cells: list, nx: int, ny: int) -> list:
+    """The part (8-connected component of the occupied cells of an nx x ny grid) of each member's cell, parts
+    numbered in the order their first member is met (the refinement's label_parts, both stages)."""
+    part_of: dict = {}
+    occ = set(cells)
+    pid = -1
+    for c0 in cells:
+        if c0 in part_of:
+            continue
+        pid += 1
+        q = deque([c0])
+        part_of[c0] = pid
+        while q:
+            cc = q.popleft()
+            cx, cy = cc % nx, cc // nx
+            for yy in range(max(cy - 1, 0), min(cy + 1, ny - 1) + 1):
+                for xx in range(max(cx - 1, 0), min(cx + 1, nx - 1) + 1):
+                    nb = yy * nx + xx
+                    if nb in occ and nb not in part_of:
+                        part_of[nb] = pid
+                        q.append(nb)
+    return [part_of[c] for c in cells]
+
+
 def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_people: bool = True,
                split_min_width_m: float = 0.9, split_cell_m: float = 0.12, split_cell_per_m: float = 0.0,
                person_max_width_m: float = 1.0, person_min_height_m: float = 0.9, person_min_aspect: float = 1.8, person_min_cols: int = 3,
@@ -320,26 +344,7 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_
         ix = np.minimum(((pts[:, 0] - lo[0]).astype(np.float32) * inv).astype(np.int64), nx - 1)
         iy = np.minimum(((pts[:, 1] - lo[1]).astype(np.float32) * inv).astype(np.int64), ny - 1)
         cell = iy * nx + ix
-        # 8-connected parts of the occupied cells, numbered by their first member
-        part_of = {}
-        occ = set(cell.tolist())
-        pid = -1
-        for c0 in cell.tolist():
-            if c0 in part_of:
-                continue
-            pid += 1
-            q = deque([c0])
-            part_of[c0] = pid
-            while q:
-                cc = q.popleft()
-                cx, cy = cc % nx, cc // nx
-                for yy in range(max(cy - 1, 0), min(cy + 1, ny - 1) + 1):
-                    for xx in range(max(cx - 1, 0), min(cx + 1, nx - 1) + 1):
-                        nb = yy * nx + xx
-                        if nb in occ and nb not in part_of:
-                            part_of[nb] = pid
-                            q.append(nb)
-        part = np.array([part_of[c] for c in cell.tolist()])
+        part = np.array(grid_parts(cell.tolist(), nx, ny))
         n_parts = int(part.max()) + 1
         if n_parts > max_parts or n_parts == 1:
             continue

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lidet_codegen.ref import qmath as qm
-from lidet_codegen.ref.cluster import proposal_indices
+from lidet_codegen.ref.cluster import grid_parts, proposal_indices
 
 FREE, SMALL, PENDING, NONCAND = 0, 0xFFFD, 0xFFFE, 0xFFFF
 STEPS = 16  # LIDET_CLUSTER_MAX_STEPS
@@ -91,11 +91,12 @@ class Rec:
 STAT_KEYS = ["n_candidates", "n_found", "n_fragments", "n_rescue_joined", "n_rescue_pixels", "n_dropped_small",
              "n_dropped_extent", "n_dropped_height", "n_dropped_capacity", "n_kept", "n_pixels_kept",
              "n_queue_overflow",
-             # the float stage's refinement counts (lidet_refine.c); the integer stage has no refinement: always 0
-             "n_split", "n_split_parts", "n_split_skipped", "n_joined",
-             # issue 19's bounds: the fragment pixels are counted by the shared run body; the integer stage has
-             # no rescue or bridging budget yet (always 0)
+             # the refinement (refine_q; lidet_cluster_q_refine.c)
+             "n_split", "n_split_parts", "n_split_skipped", "n_joined", "n_join_skipped",
+             # issue 19's bounds: the rescue budget (max_fragment_pixels) and the bridging budget
+             # (max_bridge_per_pixel_q16)
              "n_fragment_pixels", "n_dropped_fragment_budget", "n_bridge_steps"]
+REFINE_MAX_CELLS, REFINE_MAX_POINTS, REFINE_MAX_PARTS = 4096, 4096, 32  # lidet_opt.h defaults
 
 
 def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: dict | None = None,
@@ -125,6 +126,8 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
 
     lab = [FREE if (R[p] > 0 and G[p] == 0) else NONCAND for p in range(npix)]
     st["n_candidates"] = sum(1 for v in lab if v == FREE)
+    bq = c["max_bridge_per_pixel_q16"]
+    bridge_max = (bq * st["n_candidates"]) >> 16 if bq > 0 else M32
     mem: list = []
     recs: list = []
 
@@ -145,7 +148,7 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
         lab[n] = PENDING
         mem.append(n)
 
-    def search(q, dq, step, nk, ta, tb, base, gs):
+    def search(q, dq, step, nk, ta, tb, base, gs, occl):
         n = q
         if not occl:
             k = 0
@@ -175,8 +178,9 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
                     break
             elif not dn < dq or link(dq, dn, ta[t], tb[t]):
                 break
+            st["n_bridge_steps"] += 1
 
-    def search_wrap(dq, rowbase, col, right):
+    def search_wrap(dq, rowbase, col, right, occl):
         for k in range(1, kc + 1):
             n = rowbase + ((col + k) % cols if right else (col - k) % cols)
             lv = lab[n]
@@ -189,6 +193,7 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
                 break
             if not occl or not dn < dq or (lv != FREE and ok):
                 break
+            st["n_bridge_steps"] += 1
 
     def grow(start):
         head = start
@@ -199,18 +204,19 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
             rowbase = r * cols
             dq = R[q]
             nd, nu = min(rows - 1 - r, ks), min(r, ks)
+            oc = occl and st["n_bridge_steps"] < bridge_max  # the bridging budget, decided per pixel
             if col + kc < cols:
-                search(q, dq, 1, kc, col_s, col_h, 0, 1)
+                search(q, dq, 1, kc, col_s, col_h, 0, 1, oc)
             else:
-                search_wrap(dq, rowbase, col, True)
+                search_wrap(dq, rowbase, col, True, oc)
             if col >= kc:
-                search(q, dq, -1, kc, col_s, col_h, 0, 1)
+                search(q, dq, -1, kc, col_s, col_h, 0, 1, oc)
             else:
-                search_wrap(dq, rowbase, col, False)
+                search_wrap(dq, rowbase, col, False, oc)
             if nd > 0:
-                search(q, dq, cols, nd, row_s, row_h, r * STEPS, 1)
+                search(q, dq, cols, nd, row_s, row_h, r * STEPS, 1, oc)
             if nu > 0:
-                search(q, dq, -cols, nu, row_s, row_h, (r - 1) * STEPS, 1 - STEPS)
+                search(q, dq, -cols, nu, row_s, row_h, (r - 1) * STEPS, 1 - STEPS, oc)
             if diag:
                 cl = col - 1 if col > 0 else cols - 1
                 cr = col + 1 if col + 1 < cols else 0
@@ -261,6 +267,11 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
         small = n < c["min_points"]
         if small and (rescue or c["rescue_gap_mm"] == 0):
             st["n_dropped_small"] += 1
+            del mem[start:]
+            return
+        budget = c["max_fragment_pixels"]
+        if small and budget != 0 and st["n_fragment_pixels"] + n > budget:
+            st["n_dropped_fragment_budget"] += 1
             del mem[start:]
             return
         sx = stats_of(ms)
@@ -358,13 +369,20 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
             else:
                 finish(start, True)
 
-    # canonical ids: records in seed order, members regrouped in raster order
+    labels, members, out_recs = _canonical(lab, recs, st)
+    if c["split_people"] or c["join_cars"]:
+        labels, members, out_recs = refine_q(labels, members, out_recs, X, Y, Z, cols, c, st, height, max_clusters)
+    return labels.reshape(rows, cols), np.asarray(members, np.int64), out_recs, st
+
+
+def _canonical(lab, recs, st: dict):
+    """The canonical pass (canonicalise): records in seed order (stable), per-pixel slot labels (1..; 0 or >= SMALL:
+    none) to ids, members regrouped in raster order. Returns (labels (npix,) int64, members list, records)."""
     order = sorted(range(len(recs)), key=lambda i: recs[i].seed_pixel)
     slot_id = {s + 1: i + 1 for i, s in enumerate(order)}
-    labels = np.zeros(npix, np.int64)
+    labels = np.zeros(len(lab), np.int64)
     groups: list = [[] for _ in order]
-    for p in range(npix):
-        lv = lab[p]
+    for p, lv in enumerate(lab):
         if 0 < lv < SMALL:
             labels[p] = slot_id[lv]
             groups[slot_id[lv] - 1].append(p)
@@ -377,7 +395,7 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
         out_recs.append(rec)
     st["n_pixels_kept"] = first
     st["n_kept"] = len(recs)
-    return labels.reshape(rows, cols), np.asarray(members, np.int64), out_recs, st
+    return labels, members, out_recs
 
 
 def _sat16(v: int) -> int:
@@ -402,3 +420,193 @@ def make_proposal_q(rec: Rec, members, x, y, z, cfg: dict):
                     b(_i(qm.atan2(mz, _i(qm.sqrt_round(rxy2)))), cfg["elevation_bin_bam"]),
                     b(_i(qm.sqrt_round(rxy2 + mz * mz)), cfg["range_bin_4mm"])], np.int16)
     return xyz, np.array(rec.mean, np.int32), vox
+
+
+def _span_mm(lo: int, hi: int) -> int:
+    return (hi - lo) * 4
+
+
+def refine_q(labels, members, recs, X, Y, Z, cols: int, c: dict, st: dict, height, max_clusters: int):
+    """The refinement of lib/src/lidet_cluster_q_refine.c (control flow: lib/src/internal/lidet_refine_body.h) on
+    the canonical output (labels: per-pixel canonical ids; members; recs in id order), then the canonical pass
+    again when it changed anything. Updates st; returns (labels, members, recs)."""
+    lab = [int(v) for v in labels]
+    mem = [int(v) for v in members]
+    recs = list(recs)
+    mp = c["min_points"]
+    order = [0] * len(recs)
+    changed = False
+
+    def rebuild(slot, src_first, src_n):
+        ms = [p for p in mem[src_first:src_first + src_n] if lab[p] == slot + 1]
+        n = len(ms)
+        sums = [sum(P[p] for p in ms) for P in (X, Y, Z)]
+        mean = [_div_round(v, n) for v in sums]
+        r = Rec(n, src_first, ms[0], 0, mean, [min(P[p] for p in ms) for P in (X, Y, Z)],
+                [max(P[p] for p in ms) for P in (X, Y, Z)], height(ms[0], mean), sums)
+        if slot < len(recs):
+            recs[slot] = r
+        else:
+            recs.append(r)
+            order.append(0)
+        return r
+
+    # the cuts (split_people)
+    k0 = len(recs)
+    for k in range(k0 if c["split_people"] else 0):
+        rec = recs[k]
+        n0, f0 = rec.n_points, rec.first_member
+        if n0 < 2 * mp or n0 > REFINE_MAX_POINTS:
+            continue
+        ex, ey = _span_mm(rec.min[0], rec.max[0]), _span_mm(rec.min[1], rec.max[1])
+        if not ((ex > c["split_min_width_mm"] or ey > c["split_min_width_mm"])
+                and _span_mm(rec.min[2], rec.max[2]) >= c["person_min_height_mm"]):
+            continue
+        ax, ay = abs(rec.min[0] + rec.max[0]), abs(rec.min[1] + rec.max[1])
+        r_mm = 2 * (ax + (ay >> 1) if ax > ay else ay + (ax >> 1))
+        cs = c["split_cell_mm"] + ((c["split_cell_per_m_q16"] * r_mm + 32768) >> 16)
+        inv = ((1 << 40) + cs - 1) // cs
+        nx, ny = ex // cs + 1, ey // cs + 1
+        if nx > REFINE_MAX_CELLS or ny > REFINE_MAX_CELLS // nx:
+            st["n_split_skipped"] += 1
+            continue
+        ms = mem[f0:f0 + n0]
+        cell = []
+        for p in ms:
+            ix = min((_span_mm(rec.min[0], X[p]) * inv) >> 40, nx - 1)
+            iy = min((_span_mm(rec.min[1], Y[p]) * inv) >> 40, ny - 1)
+            cell.append(iy * nx + ix)
+        part = grid_parts(cell, nx, ny)
+        n_parts = max(part) + 1
+        if n_parts > REFINE_MAX_PARTS:  # label_parts gives up at the part past the cap
+            st["n_split_skipped"] += 1
+            continue
+        if n_parts == 1:
+            continue
+        pn = [0] * n_parts
+        bx = [[nx, -1, ny, -1] for _ in range(n_parts)]
+        bz = [[None, None] for _ in range(n_parts)]
+        bc = [[cols, -1] for _ in range(n_parts)]
+        for p, cl, q in zip(ms, cell, part):
+            pn[q] += 1
+            cx, cy, col = cl % nx, cl // nx, p % cols
+            b = bx[q]
+            b[0], b[1], b[2], b[3] = min(b[0], cx), max(b[1], cx), min(b[2], cy), max(b[3], cy)
+            z = Z[p]
+            bz[q][0] = z if bz[q][0] is None else min(bz[q][0], z)
+            bz[q][1] = z if bz[q][1] is None else max(bz[q][1], z)
+            bc[q][0], bc[q][1] = min(bc[q][0], col), max(bc[q][1], col)
+        person = []
+        for q in range(n_parts):
+            wx, wy = (bx[q][1] - bx[q][0] + 1) * cs, (bx[q][3] - bx[q][2] + 1) * cs
+            wz = _span_mm(bz[q][0], bz[q][1])
+            person.append(pn[q] >= mp and wx <= c["person_max_width_mm"] and wy <= c["person_max_width_mm"]
+                          and wz >= c["person_min_height_mm"] and (wz << 16) >= c["person_min_aspect_q16"] * max(wx, wy)
+                          and bc[q][1] - bc[q][0] + 1 >= c["person_min_cols"])
+        if not any(person):
+            continue
+        largest = 0
+        largest_person = None
+        for q in range(n_parts):
+            if pn[q] > pn[largest]:
+                largest = q
+            if person[q] and (largest_person is None or pn[q] > pn[largest_person]):
+                largest_person = q
+        target = [1 if person[q] else 0 for q in range(n_parts)]
+        if all(person[q] for q in range(n_parts) if pn[q] >= mp):
+            target[largest] = 0
+        if sum(pn[q] for q in range(n_parts) if target[q] == 0) < mp:
+            target[largest_person] = 0
+        n_new, n_slots = 0, len(recs)
+        for q in range(n_parts):
+            if target[q] == 0:
+                target[q] = k
+            elif n_slots < max_clusters:
+                target[q] = n_slots
+                n_slots += 1
+                n_new += 1
+            else:
+                target[q] = k
+        if n_new == 0:
+            continue
+        for p, q in zip(ms, part):
+            lab[p] = target[q] + 1
+        rk = rebuild(k, f0, n0)
+        rk.n_rescued = min(rec.n_rescued, rk.n_points)
+        for q in range(n_parts):
+            if target[q] != k:
+                rebuild(target[q], f0, n0).n_rescued = 0
+        order[k] = 1
+        for q in range(n_parts):
+            order[target[q]] = 1
+        st["n_split"] += 1
+        st["n_split_parts"] += n_new
+        changed = True
+
+    # the joins (join_cars)
+    def piece(r):
+        wx, wy, wz = (_span_mm(r.min[d], r.max[d]) for d in range(3))
+        upright = wx <= c["upright_max_width_mm"] and wy <= c["upright_max_width_mm"] and wz >= c["person_min_height_mm"]
+        return (not upright and wz <= c["car_max_height_mm"] and max(wx, wy) <= c["car_max_length_mm"]
+                and min(wx, wy) <= c["car_max_width_mm"])
+
+    def joinable(a, b):
+        gx = max(b.min[0] - a.max[0], a.min[0] - b.max[0], 0) * 4
+        gy = max(b.min[1] - a.max[1], a.min[1] - b.max[1], 0) * 4
+        if gx * gx + gy * gy > c["join_gap_mm"] ** 2:
+            return False
+        ux, uy, uz = (_span_mm(min(a.min[d], b.min[d]), max(a.max[d], b.max[d])) for d in range(3))
+        return (uz <= c["car_max_height_mm"] and c["car_min_length_mm"] <= max(ux, uy) <= c["car_max_length_mm"]
+                and min(ux, uy) <= c["car_max_width_mm"])
+
+    def member_sums(r):
+        ms = mem[r.first_member:r.first_member + r.n_points]
+        return [sum(P[p] for p in ms) for P in (X, Y, Z)]
+
+    n_joined = 0
+    kk = len(recs)
+    # the car pieces, decided once in slot order; past max_join_pieces (0 = no limit) they join nothing
+    n_pieces = 0
+    for i in range(kk if c["join_cars"] else 0):
+        if order[i] == 0 and piece(recs[i]):
+            if c.get("max_join_pieces", 0) and n_pieces >= c["max_join_pieces"]:
+                st["n_join_skipped"] += 1
+                continue
+            order[i] = 4
+            n_pieces += 1
+    for i in range(kk if c["join_cars"] else 0):
+        a = recs[i]
+        if order[i] != 4:
+            continue
+        sums = None
+        for j in range(i + 1, kk):
+            b = recs[j]
+            if order[j] != 4 or not joinable(a, b):
+                continue
+            if sums is None:
+                sums = member_sums(a)
+            sb = member_sums(b)
+            n = a.n_points + b.n_points
+            sums = [u + v for u, v in zip(sums, sb)]
+            a.mean = [_div_round(v, n) for v in sums]
+            a.min = [min(u, v) for u, v in zip(a.min, b.min)]
+            a.max = [max(u, v) for u, v in zip(a.max, b.max)]
+            for p in mem[b.first_member:b.first_member + b.n_points]:
+                lab[p] = i + 1
+            a.n_points = n
+            a.n_rescued += b.n_rescued
+            a.seed_pixel = min(a.seed_pixel, b.seed_pixel)
+            a.height = height(a.seed_pixel, a.mean)
+            b.n_points = 0
+            b.seed_pixel = M32
+            order[j] = 2
+            n_joined += 1
+    st["n_joined"] += n_joined
+    changed = changed or n_joined > 0
+    if not changed:
+        return np.asarray(lab, np.int64), mem, recs
+    # the canonical pass again (the emptied records, seed 0xFFFFFFFF, ordered last, then dropped)
+    out, new_mem, new_recs = _canonical(lab, recs, st)
+    new_recs = new_recs[:len(new_recs) - n_joined]
+    st["n_kept"] = len(new_recs)
+    return out, new_mem, new_recs

@@ -50,7 +50,7 @@ def candidates(recs, det_cfg: dict, outcome: list) -> tuple[list, bool]:
 def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, proposal_cfg: dict, det_cfg: dict,
            cls_model, box_model, max_clusters: int, max_detections: int, max_points: int) -> dict:
     """The whole integer detector on (N, 3) int32 mm points. det_cfg: crop_half_bam, max_range_mm, max_proposals,
-    gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max. Returns detections (dicts), outcomes, stats."""
+    max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max. Returns detections (dicts), outcomes, stats."""
     pj = proj_q.project(points_mm, tab, proj_cfg["min_range_mm"], proj_cfg["max_range_mm"], max_points=max_points)
     rows, cols = tab.rows, tab.cols
     X, Y, Z, R = (np.asarray(pj[k], np.int64).reshape(rows, cols) for k in ("x_4mm", "y_4mm", "z_4mm", "range_4mm"))
@@ -62,7 +62,7 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     outcome = [0] * len(recs)
     order, truncated = candidates(recs, det_cfg, outcome)
     stats = dict(n_clusters=len(recs), n_classified=0, n_gate1_rejected=0, n_boxed=0, n_gate2_rejected=0,
-                 n_size_rejected=0, n_nms_suppressed=0, n_over_capacity=0)
+                 n_size_rejected=0, n_nms_suppressed=0, n_over_capacity=0, n_over_box_budget=0)
     dets = []
     for ci in order:
         xyz, mean, vox = cluster_q.make_proposal_q(recs[ci], members, X, Y, Z, pcfg)
@@ -72,6 +72,11 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
         if det_cfg["gate1"] and not bool(c["passed"][0]):
             outcome[ci] = OUT_GATE1
             stats["n_gate1_rejected"] += 1
+            continue
+        if stats["n_boxed"] == det_cfg["max_boxes"]:  # the box budget
+            outcome[ci] = OUT_BUDGET
+            stats["n_over_box_budget"] += 1
+            truncated = True
             continue
         b = pointnet_q.box(box_model, xyz[None].astype(np.int64), mean[None], vox[None], cls)
         stats["n_boxed"] += 1

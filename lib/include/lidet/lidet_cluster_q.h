@@ -23,6 +23,16 @@
  *    or mean z + round(mount_height_mm / 4) without planes. A rescue group that joins a cluster adds its sums
  *    (the mean is the rounded mean of all members, exactly). Filters: extent (max - min) * 4 > max_extent_mm,
  *    height * 4 > max_mean_height_mm.
+ *  - worst-case budgets (issue 19) as the float stage's: the rescue takes fragments while their pixels sum to at
+ *    most max_fragment_pixels (n_dropped_fragment_budget), a pixel's searches bridge occluders while the run's
+ *    count is below (max_bridge_per_pixel_q16 * candidates) >> 16 (n_bridge_steps);
+ *  - refinement (split_people, join_cars; the rules of lidet_cluster.h, the control flow shared with the float
+ *    stage in internal/lidet_refine_body.h), lib/src/lidet_cluster_q_refine.c: spans compared in mm (4 times the
+ *    4 mm span); cell = split_cell_mm + round(split_cell_per_m_q16 r_mm / 2^16), r_mm = max(|cx|, |cy|) +
+ *    min(|cx|, |cy|) / 2 of the box centre (floored); a member's cell floor(4 (x - lo) / cell) by one product with
+ *    ceil(2^40 / cell) and a shift (exact); person aspect wz 2^16 >= person_min_aspect_q16 max(wx, wy); joins:
+ *    (4 gx)^2 + (4 gy)^2 > join_gap_mm^2 rejects, in uint64; records from int64 member sums (a join adds the
+ *    joined cluster's sums: the mean stays the rounded mean of all members).
  * Per point: no division, no square root; one 32x32 -> 64 bit product per gap test. Tables: sin/cos/atan2/
  * isqrt at init (recomputed when the image geometry changes). The numpy reference is
  * codegen/lidet_codegen/ref/cluster_q.py (bit for bit).
@@ -33,7 +43,7 @@
  * floor(round(sqrt(x^2 + y^2 + z^2)) / range_bin) (4 mm), clamped to int16.
  *
  * Memory: as lidet_cluster.h (uint16 label + int32 member per pixel) plus the records (56 B) and their sums
- * (24 B) per cluster slot; lidet_cluster_q_bytes().
+ * (24 B) per cluster slot and the refinement's scratch (as lidet_cluster.h's); lidet_cluster_q_bytes().
  */
 #ifndef LIDET_CLUSTER_Q_H
 #define LIDET_CLUSTER_Q_H
@@ -66,6 +76,29 @@ typedef struct
     uint32_t rescue_gap_per_m_q16; /**< <= 16384 (0.25 per metre); default 1966 (0.03) */
     uint32_t rescue_rows;          /**< <= LIDET_MAX_ROWS; default 1 (<= 16 beams), 2 */
     uint32_t rescue_cols;          /**< <= 15; default 6 */
+    /* worst-case bounds (issue 19): lidet_cluster_cfg_t's, same semantics */
+    uint32_t max_fragment_pixels;  /**< rescue budget in fragment pixels (0 = none); default 4096 (> 16 beams),
+                                        2048 */
+    uint32_t max_bridge_per_pixel_q16; /**< occluder bridging budget per candidate pixel, Q16, <= 64 << 16 (0 =
+                                        none); the run bridges while its count is below
+                                        (this * candidates) >> 16; default 131072 (2.0) */
+    /* the proposal refinement (lidet_refine.c's rules in integer units; lidet_cluster_cfg_t's defaults rounded) */
+    uint32_t split_people;         /**< 0/1; default 1 */
+    uint32_t split_min_width_mm;   /**< (0, 1000000]; default 900 */
+    uint32_t split_cell_mm;        /**< (0, 100000]; default 120 */
+    uint32_t split_cell_per_m_q16; /**< <= 65536; default 0 */
+    uint32_t person_max_width_mm;  /**< (0, 1000000]; default 1000 */
+    uint32_t person_min_height_mm; /**< <= 1000000; default 900 */
+    uint32_t person_min_aspect_q16; /**< <= 100 << 16; default 117965 (1.8) */
+    uint32_t person_min_cols;      /**< default 3 */
+    uint32_t join_cars;            /**< 0/1; default 1 */
+    uint32_t join_gap_mm;          /**< <= 1000000; default 500 */
+    uint32_t car_max_length_mm;    /**< (0, 1000000]; default 5200 */
+    uint32_t car_max_width_mm;     /**< (0, 1000000]; default 2200 */
+    uint32_t car_max_height_mm;    /**< (0, 1000000]; default 2000 */
+    uint32_t car_min_length_mm;    /**< <= 1000000; default 2500 */
+    uint32_t upright_max_width_mm; /**< <= 1000000; default 1300 */
+    uint32_t max_join_pieces;      /**< join budget as lidet_cluster_cfg_t's; 0 = no limit; default 256 */
 } lidet_cluster_q_cfg_t;
 
 /** @brief One kept cluster, 4 mm steps. */
@@ -106,6 +139,15 @@ typedef struct
     int32_t *members;
     uint32_t n_recs;
     lidet_cluster_stats_t stats;
+    /* scratch of the refinement (lidet_cluster_q_refine.c; as lidet_cluster_state_t's, z in 4 mm steps) */
+    uint16_t rf_grid[LIDET_REFINE_MAX_CELLS];
+    uint16_t rf_queue[LIDET_REFINE_MAX_CELLS];
+    uint16_t rf_cell[LIDET_REFINE_MAX_POINTS];
+    uint16_t rf_target[LIDET_REFINE_MAX_PARTS];
+    uint32_t rf_n[LIDET_REFINE_MAX_PARTS];
+    uint16_t rf_box[LIDET_REFINE_MAX_PARTS][4];
+    int32_t rf_z[LIDET_REFINE_MAX_PARTS][2];
+    uint16_t rf_col[LIDET_REFINE_MAX_PARTS][2];
 } lidet_cluster_q_state_t;
 
 /** @brief The integer clustering with its per-pixel buffers (declare it static). */

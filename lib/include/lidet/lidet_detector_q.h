@@ -88,6 +88,10 @@ typedef struct
     int32_t max_range_mm;            /**< clusters whose mean is farther (horizontally) are not classified; 0 =
                                           no limit; >= 0 */
     uint32_t max_proposals;          /**< [1, LIDET_MAX_CLUSTERS]: at most this many classified, nearest first */
+    uint32_t max_boxes;              /**< [1, LIDET_MAX_CLUSTERS]: at most this many through the box net per scan
+                                          (those passing gate 1, nearest first; the rest: outcome
+                                          LIDET_DET_OUT_BUDGET, stats n_over_box_budget, LIDET_TRUNCATED); default
+                                          48 (> 16 beams), 24: the float detector's max_boxes */
     uint8_t gate1;                   /**< 1 (default): drop proposals failing gate 1 */
     uint8_t gate2;                   /**< 1 (default): drop boxes failing gate 2 */
     int32_t nms_iou_q15;             /**< [0, 32768]; default 3277 (0.1) */
@@ -101,6 +105,7 @@ typedef struct
 {
     uint32_t n_clusters, n_out_of_crop, n_out_of_range, n_over_budget, n_classified, n_gate1_rejected, n_boxed,
         n_gate2_rejected, n_size_rejected, n_nms_suppressed, n_over_capacity, n_detections;
+    uint32_t n_over_box_budget; /**< passed gate 1 past max_boxes (not boxed) */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_proj_stats_t proj;
     lidet_ground_stats_t ground;

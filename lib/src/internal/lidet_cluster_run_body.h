@@ -12,6 +12,8 @@
  *   RUN_RESCUE_T, RUN_RESCUE_FAR  the rescue group's running state and its "no contact yet" distance;
  *   RUN_RESCUE_GROW(c, g, start, rs);
  *   RUN_FRAGMENT_BUDGET(c)      the rescue budget in fragment pixels (0: none);
+ *   RUN_REFINE_SPLIT(c, planes, n_sectors, st), RUN_REFINE_JOIN(...)  the stage's refinement (cuts, joins;
+ *                                returns nonzero when it changed anything);
  * and the numeric kernels of the filters and records, static functions of the including file:
  *   RUN_SUMMARY_T                          what one pass over a component's members gives (sums, bounds, mean,
  *                                          height);
@@ -490,5 +492,23 @@ static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, uint32_t npix, cons
         }
     }
     canonicalise(c, npix, st);
+    st->n_kept = c->n_recs;
+}
+
+/* the refinement after the fills (cfg split_people, join_cars): people cut out of wide clusters, car fragments
+ * joined; the canonical order again when it changed anything, then the joined (emptied) records, ordered last,
+ * are dropped */
+static void run_refine(RUN_STATE_T *c, uint32_t npix, const RUN_PLANE_T *planes, uint32_t n_sectors,
+                       lidet_cluster_stats_t *st)
+{
+    int changed;
+    memset(c->order, 0, sizeof c->order); /* the cut marks */
+    changed = c->cfg.split_people != 0u && RUN_REFINE_SPLIT(c, planes, n_sectors, st);
+    changed |= c->cfg.join_cars != 0u && RUN_REFINE_JOIN(c, planes, n_sectors, st);
+    if (changed)
+    {
+        canonicalise(c, npix, st);
+        c->n_recs -= st->n_joined;
+    }
     st->n_kept = c->n_recs;
 }
