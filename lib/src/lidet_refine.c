@@ -44,6 +44,13 @@ static int refine_grid(const lidet_cluster_cfg_t *cfg, const lidet_cluster_rec_t
     g->inv = 1.0f / g->cs;
     g->lo[0] = rec->min_m[0];
     g->lo[1] = rec->min_m[1];
+    /* a grid of LIDET_REFINE_MAX_CELLS cells or more along a side is refused before the conversion (a tiny
+     * configured cell would otherwise convert an out-of-range float to an integer: undefined; found by
+     * fuzz_proposal). The same decision as the caller's cap on nx, ny */
+    if (!(ex * g->inv < (float)LIDET_REFINE_MAX_CELLS) || !(ey * g->inv < (float)LIDET_REFINE_MAX_CELLS))
+    {
+        return 0;
+    }
     *nx = (uint32_t)(ex * g->inv) + 1u;
     *ny = (uint32_t)(ey * g->inv) + 1u;
     return 1;
