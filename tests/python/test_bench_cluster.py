@@ -23,4 +23,8 @@ def test_bench_cluster_runs(root, real_dir):
     assert "| real SemanticKITTI 00 (3 labelled scans) | lidet |" in md and "DBSCAN columns skipped" in md
     assert "| | lidet, no rescue |" in md and "| | lidet, no refinement |" in md
     assert "### Proposal recall (issue 15)" in md
+    # the KITTI object frames, scored from their label_2 boxes (the pedestrian of 000000 within 40 m)
+    row = [ln for ln in md.splitlines() if ln.startswith("| real KITTI object frames (3 frames, label_2 boxes")]
+    assert len(row) == 2 and "| lidet |" in row[0]  # the clustering table and the proposal-recall table
+    assert "(1) /" in row[1].split("|")[4]  # its person cell: recall (1 object) / merged / split / missed
     assert "| | lidet integer (lidet_cluster_q), same images |" in md

@@ -157,6 +157,60 @@ def scans(data_dir: pathlib.Path):
         yield f.stem, pts, lab
 
 
+#: KITTI label_2 types scored on the object frames -> the SemanticKITTI class they are scored as; Truck, Tram,
+#: Misc and DontCare are not scored (their points stay unlabelled: neither ground nor an object)
+KITTI_TYPES = {"Car": 10, "Van": 10, "Pedestrian": 30, "Person_sitting": 30, "Cyclist": 31}
+#: an object's points on the KITTI frames: inside its label_2 box grown by BOX_MARGIN_M in length, width and at
+#: the top, at least BOX_FLOOR_M above the box's bottom (the ground it stands on stays out), not ground
+BOX_MARGIN_M = 0.1
+BOX_FLOOR_M = 0.1
+
+
+def kitti_box_labels(points: np.ndarray, objects, calib, ground: np.ndarray, margin_m: float = BOX_MARGIN_M,
+                     floor_m: float = BOX_FLOOR_M) -> np.ndarray:
+    """SemanticKITTI-style labels (uint32 per point) for `evaluate_scan` from KITTI label_2 boxes: ground points
+    (the (N,) mask given, e.g. the ground stage's) get class 40; the points of each Car / Van, Pedestrian /
+    Person_sitting and Cyclist box (KITTI_TYPES; camera frame -> sensor frame through calib) that are inside it
+    grown by margin_m along its length, its width and above its top, at least floor_m above its bottom and not
+    ground get its class, instance = 1 + the object's line index; a point inside two boxes goes to the first."""
+    from .kitti import kitti_to_box
+    xyz = np.asarray(points)[:, :3].astype(np.float64)
+    ground = np.asarray(ground).astype(bool)
+    if len(ground) != len(xyz):
+        raise ValueError(f"{len(ground)} ground flags for {len(xyz)} points")
+    sem = np.where(ground, 40, 0).astype(np.uint32)
+    inst = np.zeros(len(xyz), np.uint32)
+    for i, o in enumerate(objects):
+        cls = KITTI_TYPES.get(o.type)
+        if cls is None:
+            continue
+        b = kitti_to_box(o, calib)
+        c, s = np.cos(b.yaw), np.sin(b.yaw)
+        d = xyz - np.array([b.x, b.y, b.z])
+        u = c * d[:, 0] + s * d[:, 1]
+        v = -s * d[:, 0] + c * d[:, 1]
+        inside = ((np.abs(u) <= b.l / 2 + margin_m) & (np.abs(v) <= b.w / 2 + margin_m) &
+                  (d[:, 2] >= -b.h / 2 + floor_m) & (d[:, 2] <= b.h / 2 + margin_m) & ~ground & (inst == 0))
+        sem[inside] = cls
+        inst[inside] = i + 1
+    return (inst << 16) | sem
+
+
+def kitti_scans(kitti_dir: pathlib.Path, sensor: str = "hdl64"):
+    """(name, points (N, 4), labels (N,)) for every velodyne/*.bin of a KITTI object folder with label_2/ and
+    calib/: `kitti_box_labels` with the ground stage's mask (the C ground stage, its defaults for `sensor`; what
+    `lidet cluster` without --labels uses)."""
+    from . import kitti, native
+    kitti_dir = pathlib.Path(kitti_dir)
+    for f in sorted((kitti_dir / "velodyne").glob("*.bin")):
+        lf, cf = kitti_dir / "label_2" / f"{f.stem}.txt", kitti_dir / "calib" / f"{f.stem}.txt"
+        if not (lf.exists() and cf.exists()):
+            continue
+        pts = kitti.read_bin(f)
+        g = native.ground(pts, sensor).mask_point.astype(bool)
+        yield f.stem, pts, kitti_box_labels(pts, kitti.read_label2(lf), kitti.read_calib(cf), g)
+
+
 def flat_ground(points: np.ndarray, mount_height_m: float, margin_m: float = 0.25) -> np.ndarray:
     """The CLI's fallback ground: z below -(mount height - margin)."""
     return np.asarray(points)[:, 2] < -(mount_height_m - margin_m)
