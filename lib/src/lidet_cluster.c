@@ -137,7 +137,9 @@ float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const
     {
         /* seed < rows * cols so the product fits in 64 bits */
         const uint32_t col = seed % c->img.n_cols;
-        uint32_t s = (uint32_t)(((uint64_t)col * n_sectors) / c->img.n_cols);
+        /* col < 2^16: a 32-bit product for up to 2^16 sectors (a 64-bit division costs 2-4x a 32-bit one) */
+        uint32_t s = n_sectors <= 0xFFFFu ? (col * n_sectors) / c->img.n_cols
+                                          : (uint32_t)(((uint64_t)col * n_sectors) / c->img.n_cols);
         const lidet_plane_t *pl;
         s = s < n_sectors ? s : n_sectors - 1;
         pl = &planes[s];
