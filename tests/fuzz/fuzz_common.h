@@ -78,6 +78,32 @@ static void fz_poke_f32(fz_in_t *in, float *const *fields, uint32_t n_fields)
     }
 }
 
+/* static uint64_t name(const model_t *c): the multiply-adds of one forward pass of a descriptor the checks
+ * accepted (float lidet_pn_model_t or int8 lidet_pointnet_q_model_t: the same member names) */
+#define FZ_DEFINE_MACS(name, model_t, stage_t)                                                       \
+    static uint64_t name(const model_t *c)                                                           \
+    {                                                                                                \
+        uint64_t n = 0;                                                                              \
+        uint32_t s, i;                                                                               \
+        for (s = 0; s < c->n_stages && s < 2u; ++s)                                                  \
+        {                                                                                            \
+            const stage_t *st = &c->stage[s];                                                        \
+            for (i = 0; i < st->n_point; ++i)                                                        \
+            {                                                                                        \
+                n += (uint64_t)c->n_points * st->point[i].n_in * st->point[i].n_out;                 \
+            }                                                                                        \
+            for (i = 0; i < st->n_pvle; ++i)                                                         \
+            {                                                                                        \
+                n += (uint64_t)st->pvle[i].n_in * st->pvle[i].n_out;                                 \
+            }                                                                                        \
+            for (i = 0; i < st->n_head; ++i)                                                         \
+            {                                                                                        \
+                n += (uint64_t)st->head[i].n_in * st->head[i].n_out;                                 \
+            }                                                                                        \
+        }                                                                                            \
+        return n;                                                                                    \
+    }
+
 /* ---- scans ---------------------------------------------------------------------------------- */
 
 #define FZ_MAX_STRIDE 6u

@@ -95,29 +95,7 @@ static void mutate(fz_in_t *in, lidet_pn_model_t *c)
     }
 }
 
-/* multiply-adds of one forward pass of an accepted descriptor */
-static uint64_t macs(const lidet_pn_model_t *c)
-{
-    uint64_t n = 0;
-    uint32_t s, i;
-    for (s = 0; s < c->n_stages && s < 2u; ++s)
-    {
-        const lidet_pn_stage_t *st = &c->stage[s];
-        for (i = 0; i < st->n_point; ++i)
-        {
-            n += (uint64_t)c->n_points * st->point[i].n_in * st->point[i].n_out;
-        }
-        for (i = 0; i < st->n_pvle; ++i)
-        {
-            n += (uint64_t)st->pvle[i].n_in * st->pvle[i].n_out;
-        }
-        for (i = 0; i < st->n_head; ++i)
-        {
-            n += (uint64_t)st->head[i].n_in * st->head[i].n_out;
-        }
-    }
-    return n;
-}
+FZ_DEFINE_MACS(macs, lidet_pn_model_t, lidet_pn_stage_t)
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {

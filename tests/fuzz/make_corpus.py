@@ -31,18 +31,27 @@ def load(sensor: str):
     return pts, ring, boxes
 
 
-def scan_parts(sensor: str, table: bool, rings: bool, stride: int, tile: int, seed: int):
-    """(header, payload) of a scan input: the header ends before the harness's knobs."""
+def _selection(sensor, table, rings, stride, tile, seed):
+    """What both scan layouts take: the sensor, its points, its beam elevations (float64), the lowest ROWS beams
+    (ground and road users), NPTS points of them within 40 m (seeded), their rings renumbered, and the four
+    header bytes (rows, cols, flags, tile)."""
     s = get_sensor(sensor)
     pts, ring, _ = load(sensor)
-    elev = np.asarray(s.beam_elev_rad, dtype=np.float32)
-    keep_rings = np.argsort(elev)[:ROWS]  # the lowest beams: ground and road users
+    elev = np.asarray(s.beam_elev_rad, dtype=np.float64)
+    keep_rings = np.argsort(elev)[:ROWS]
     sel = np.flatnonzero(np.isin(ring, keep_rings) & (np.hypot(pts[:, 0], pts[:, 1]) < 40.0))
     rng = np.random.default_rng(seed)
     sel = np.sort(rng.choice(sel, size=min(NPTS, sel.size), replace=False))
     new_ring = np.searchsorted(np.sort(keep_rings), ring[sel]).astype(np.uint16)
     flags = (FLAG_TABLE if table else 0) | (FLAG_RINGS if rings else 0) | ((stride - 3) << 2)
     head = struct.pack("<BBBB", ROWS - 1, COLS - 8, flags, tile - 1)
+    return s, pts, elev, keep_rings, sel, new_ring, head
+
+
+def scan_parts(sensor: str, table: bool, rings: bool, stride: int, tile: int, seed: int):
+    """(header, payload) of a scan input: the header ends before the harness's knobs."""
+    s, pts, elev, keep_rings, sel, new_ring, head = _selection(sensor, table, rings, stride, tile, seed)
+    elev = elev.astype(np.float32)
     if table:
         head += b"".join(struct.pack("<f", float(elev[r])) for r in np.sort(keep_rings))
     else:
@@ -102,16 +111,7 @@ def proposal_seed(sensor: str, model_index: int, cls: int) -> bytes:
 
 def scan_parts_q(sensor: str, table: bool, rings: bool, stride: int, tile: int, seed: int):
     """(header, payload) of an integer scan input (fuzz_detector_q.c): microradians and int32 millimetres."""
-    s = get_sensor(sensor)
-    pts, ring, _ = load(sensor)
-    elev = np.asarray(s.beam_elev_rad, dtype=np.float64)
-    keep_rings = np.argsort(elev)[:ROWS]
-    sel = np.flatnonzero(np.isin(ring, keep_rings) & (np.hypot(pts[:, 0], pts[:, 1]) < 40.0))
-    rng = np.random.default_rng(seed)
-    sel = np.sort(rng.choice(sel, size=min(NPTS, sel.size), replace=False))
-    new_ring = np.searchsorted(np.sort(keep_rings), ring[sel]).astype(np.uint16)
-    flags = (FLAG_TABLE if table else 0) | (FLAG_RINGS if rings else 0) | ((stride - 3) << 2)
-    head = struct.pack("<BBBB", ROWS - 1, COLS - 8, flags, tile - 1)
+    s, pts, elev, keep_rings, sel, new_ring, head = _selection(sensor, table, rings, stride, tile, seed)
     urad = np.round(elev * 1e6).astype(np.int64)
     if table:
         head += b"".join(struct.pack("<i", int(urad[r])) for r in np.sort(keep_rings))
