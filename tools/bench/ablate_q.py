@@ -4,8 +4,8 @@ proposals) and its networks swapped one at a time, on the simulated HDL-64 bench
 
     python tools/bench/ablate_q.py [SIM_DIR] [--out DIR] [--scans N]
 
-Four detectors over the same scans, camera crop, no proposal refinement (the integer clustering has none):
-  float geometry + float nets   the float detector (lidet detect --crop, refinement off)
+Four detectors over the same scans, camera crop, both with the proposal refinement (their defaults):
+  float geometry + float nets   the float detector (lidet detect --crop)
   float geometry + int8 nets    its candidate proposals rounded to 4 mm steps (lidet_codegen.quant.int_proposals)
   integer geometry + float nets the integer detector's proposals in metres (4 mm steps x 0.004)
   integer geometry + int8 nets  the integer detector (lidet detect --fixed)
@@ -99,7 +99,7 @@ def run(sim: pathlib.Path, out: pathlib.Path, n_scans: int, fam: str = "hdl64", 
     for p in scans:
         pts = kitti.read_bin(p)
         calib = kitti.read_calib(sim / "calib" / f"{p.stem}.txt")
-        cf = nq.candidates_float(pts, fam, crop_half_rad=math.pi / 4, refine=False)
+        cf = nq.candidates_float(pts, fam, crop_half_rad=math.pi / 4, refine=True)
         cq = nq.candidates_q(nq.to_mm(pts), fam, crop_half_bam=1 << 29)
         f_q4, f_m4 = QU.int_proposals(cf["xyz"], cf["mean"]) if len(cf["xyz"]) else (cf["xyz"], cf["mean"])
         res = {
