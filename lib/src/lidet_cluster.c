@@ -97,8 +97,9 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
         !lidet__isfinite(cfg->person_max_width_m) || !(cfg->person_max_width_m > 0.0f) ||
         !lidet__isfinite(cfg->person_min_height_m) || cfg->person_min_height_m < 0.0f ||
         !lidet__isfinite(cfg->person_min_aspect) || cfg->person_min_aspect < 0.0f || cfg->join_cars > 1u ||
-        !lidet__isfinite(cfg->join_gap_m) || cfg->join_gap_m < 0.0f || !lidet__isfinite(cfg->car_max_length_m) ||
-        !(cfg->car_max_length_m > 0.0f) || !lidet__isfinite(cfg->car_max_width_m) || !(cfg->car_max_width_m > 0.0f) ||
+        !lidet__isfinite(cfg->join_gap_m) || cfg->join_gap_m < 0.0f ||
+        !lidet__isfinite(cfg->car_max_length_m) || !(cfg->car_max_length_m > 0.0f) ||
+        !lidet__isfinite(cfg->car_max_width_m) || !(cfg->car_max_width_m > 0.0f) ||
         !lidet__isfinite(cfg->car_max_height_m) || !(cfg->car_max_height_m > 0.0f) ||
         !lidet__isfinite(cfg->car_min_length_m) || cfg->car_min_length_m < 0.0f ||
         !lidet__isfinite(cfg->upright_max_width_m) || cfg->upright_max_width_m < 0.0f)
@@ -110,8 +111,6 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
     return init_done(c);
 }
 
-
-
 /* the members' sums and bounds (lidet_cluster_stats_body.h) on float values */
 #define STATS_STATE_T lidet_cluster_state_t
 #define STATS_V_T float
@@ -122,8 +121,8 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
 #include "internal/lidet_cluster_stats_body.h"
 
 /* member_stats_of with the image format a constant in each copy */
-static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, float max_extent, float sum[3],
-                        float lo[3], float hi[3])
+static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t tail, float max_extent,
+                        float sum[3], float lo[3], float hi[3])
 {
     return lidet__img_compact(&c->img) ? member_stats_of(c, start, tail, max_extent, sum, lo, hi, 1)
                                        : member_stats_of(c, start, tail, max_extent, sum, lo, hi, 0);
@@ -131,7 +130,7 @@ static int member_stats(const lidet_cluster_state_t *c, uint32_t start, uint32_t
 
 /* height of `mean` above the ground plane of the sector of the seed's column (or the flat ground) */
 float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const float mean[3],
-                                 const lidet_plane_t *planes, uint32_t n_sectors)
+                            const lidet_plane_t *planes, uint32_t n_sectors)
 {
     if (planes != 0)
     {
@@ -300,8 +299,8 @@ lidet_status_t lidet_cluster_init(lidet_cluster_t *c, const lidet_cluster_cfg_t 
     return c == 0 ? LIDET_ERR_ARG : lidet_cluster_state_init(&c->state, cfg);
 }
 
-lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *img, const uint8_t *ground_mask,
-                                 const lidet_plane_t *planes, uint32_t n_sectors)
+lidet_status_t lidet_cluster_run(lidet_cluster_t *c, const lidet_range_image_t *img,
+                                 const uint8_t *ground_mask, const lidet_plane_t *planes, uint32_t n_sectors)
 {
     if (c == 0)
     {

@@ -85,8 +85,9 @@ int32_t lidet__cluster_q_height(const lidet_cluster_q_state_t *c, uint32_t seed,
         s = s < n_sectors ? s : n_sectors - 1u;
         pl = &planes[s];
         /* |mean| <= 2^15, |n| <= 2^31: the sum is below 2^49 */
-        h = lidet__q_rshift_round((int64_t)pl->nx * mean[0] + (int64_t)pl->ny * mean[1] + (int64_t)pl->nz * mean[2],
-                                  30) + pl->d_4mm;
+        h = lidet__q_rshift_round(
+                (int64_t)pl->nx * mean[0] + (int64_t)pl->ny * mean[1] + (int64_t)pl->nz * mean[2], 30) +
+            pl->d_4mm;
     }
     else
     {
@@ -111,9 +112,11 @@ typedef struct
     int32_t lo[3], hi[3], mean[3], h;
 } summary_q_t;
 
-static int summarise(const lidet_cluster_q_state_t *c, uint32_t start, uint32_t tail, int small, summary_q_t *s)
+static int summarise(const lidet_cluster_q_state_t *c, uint32_t start, uint32_t tail, int small,
+                     summary_q_t *s)
 {
-    return member_stats_of(c, start, tail, small ? 0xFFFFFFFFu : c->cfg.max_extent_mm, s->sum, s->lo, s->hi, 1);
+    return member_stats_of(c, start, tail, small ? 0xFFFFFFFFu : c->cfg.max_extent_mm, s->sum, s->lo, s->hi,
+                           1);
 }
 
 static int mean_height_ok(const lidet_cluster_q_state_t *c, uint32_t n, uint32_t seed, summary_q_t *s,
@@ -144,7 +147,8 @@ static void join_mean(lidet_cluster_q_state_t *c, uint32_t slot, uint32_t n, con
     mean_of(c->sums[slot], c->recs[slot].n_points + n, c->recs[slot].mean_4mm);
 }
 
-static void reheight(lidet_cluster_q_state_t *c, uint32_t slot, const lidet_plane_q_t *planes, uint32_t n_sectors)
+static void reheight(lidet_cluster_q_state_t *c, uint32_t slot, const lidet_plane_q_t *planes,
+                     uint32_t n_sectors)
 {
     lidet_cluster_q_rec_t *rec = &c->recs[slot];
     rec->height_4mm = lidet__cluster_q_height(c, rec->seed_pixel, rec->mean_4mm, planes, n_sectors);
@@ -182,18 +186,21 @@ lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lide
         return LIDET_ERR_ARG;
     }
     c->magic = 0;
-    if (cfg->theta_urad == 0u || cfg->theta_urad >= 1500000u || cfg->max_steps < 1u || cfg->max_steps > STEPS ||
-        cfg->min_points < 1u || cfg->max_extent_mm == 0u || cfg->max_extent_mm > 1000000u ||
-        cfg->max_gap_mm > 1000000u || cfg->max_gap_per_m_q16 > 65536u || cfg->mount_height_mm > 100000u ||
-        cfg->rescue_gap_mm > 10000u || cfg->rescue_gap_per_m_q16 > 16384u || cfg->rescue_rows > LIDET_MAX_ROWS ||
-        cfg->rescue_cols > RESCUE_MAX_COLS || cfg->max_bridge_per_pixel_q16 > (64u << 16) || cfg->split_people > 1u ||
+    if (cfg->theta_urad == 0u || cfg->theta_urad >= 1500000u || cfg->max_steps < 1u ||
+        cfg->max_steps > STEPS || cfg->min_points < 1u || cfg->max_extent_mm == 0u ||
+        cfg->max_extent_mm > 1000000u || cfg->max_gap_mm > 1000000u || cfg->max_gap_per_m_q16 > 65536u ||
+        cfg->mount_height_mm > 100000u || cfg->rescue_gap_mm > 10000u || cfg->rescue_gap_per_m_q16 > 16384u ||
+        cfg->rescue_rows > LIDET_MAX_ROWS || cfg->rescue_cols > RESCUE_MAX_COLS ||
+        cfg->max_bridge_per_pixel_q16 > (64u << 16) || cfg->split_people > 1u ||
         cfg->split_min_width_mm == 0u || cfg->split_min_width_mm > 1000000u || cfg->split_cell_mm == 0u ||
-        cfg->split_cell_mm > 100000u || cfg->split_cell_per_m_q16 > 65536u || cfg->person_max_width_mm == 0u ||
-        cfg->person_max_width_mm > 1000000u || cfg->person_min_height_mm > 1000000u ||
-        cfg->person_min_aspect_q16 > (100u << 16) || cfg->join_cars > 1u || cfg->join_gap_mm > 1000000u ||
-        cfg->car_max_length_mm == 0u || cfg->car_max_length_mm > 1000000u || cfg->car_max_width_mm == 0u ||
-        cfg->car_max_width_mm > 1000000u || cfg->car_max_height_mm == 0u || cfg->car_max_height_mm > 1000000u ||
-        cfg->car_min_length_mm > 1000000u || cfg->upright_max_width_mm > 1000000u)
+        cfg->split_cell_mm > 100000u || cfg->split_cell_per_m_q16 > 65536u ||
+        cfg->person_max_width_mm == 0u || cfg->person_max_width_mm > 1000000u ||
+        cfg->person_min_height_mm > 1000000u || cfg->person_min_aspect_q16 > (100u << 16) ||
+        cfg->join_cars > 1u || cfg->join_gap_mm > 1000000u || cfg->car_max_length_mm == 0u ||
+        cfg->car_max_length_mm > 1000000u || cfg->car_max_width_mm == 0u ||
+        cfg->car_max_width_mm > 1000000u || cfg->car_max_height_mm == 0u ||
+        cfg->car_max_height_mm > 1000000u || cfg->car_min_length_mm > 1000000u ||
+        cfg->upright_max_width_mm > 1000000u)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -248,11 +255,13 @@ lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t 
     return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }
 
-lidet_status_t lidet_cluster_q_run(lidet_cluster_q_t *c, const lidet_range_image_t *img, const uint8_t *ground_mask,
-                                   const lidet_plane_q_t *planes, uint32_t n_sectors)
+lidet_status_t lidet_cluster_q_run(lidet_cluster_q_t *c, const lidet_range_image_t *img,
+                                   const uint8_t *ground_mask, const lidet_plane_q_t *planes,
+                                   uint32_t n_sectors)
 {
     return c == 0 ? LIDET_ERR_ARG
-                  : lidet_cluster_q_run_buffers(&c->state, c->labels, c->members, img, ground_mask, planes, n_sectors);
+                  : lidet_cluster_q_run_buffers(&c->state, c->labels, c->members, img, ground_mask, planes,
+                                                n_sectors);
 }
 
 lidet_status_t lidet_cluster_q_point_labels(const lidet_cluster_q_state_t *c, const int32_t *point_pixel,

@@ -65,15 +65,16 @@ void lidet__cluster_q_setup_geometry(lidet_cluster_q_state_t *c, const lidet_ran
         for (r = 0; r + 1u < rows; ++r)
         {
             const uint32_t h1 = h_of(lidet__q_sin(bam_diff(e[r], e[r + 1u]) >> 1));
-            const int64_t c12 = lidet__q_rshift_round((int64_t)lidet__q_cos((uint32_t)e[r]) *
-                                                          lidet__q_cos((uint32_t)e[r + 1u]), 30);
+            const int64_t c12 = lidet__q_rshift_round(
+                (int64_t)lidet__q_cos((uint32_t)e[r]) * lidet__q_cos((uint32_t)e[r + 1u]), 30);
             const uint64_t h = (uint64_t)h1 + (uint64_t)lidet__q_rshift_round(c12 * hc, 30);
             const uint32_t hh = h > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)h;
             uint32_t sh = (lidet__q_isqrt64((uint64_t)hh << 30) + 1u) >> 1; /* sin(alpha / 2), Q30 */
             uint32_t ch, dummy;
             sh = sh > (uint32_t)LIDET_Q_ONE_Q30 ? (uint32_t)LIDET_Q_ONE_Q30 : sh;
             ch = lidet__q_isqrt64(((uint64_t)1 << 60) - (uint64_t)sh * sh);
-            tab_of(c->theta_bam, (uint32_t)lidet__q_atan2((int32_t)sh, (int32_t)ch) * 2u, &c->diag_s[r], &dummy);
+            tab_of(c->theta_bam, (uint32_t)lidet__q_atan2((int32_t)sh, (int32_t)ch) * 2u, &c->diag_s[r],
+                   &dummy);
             c->diag_h[r] = hh;
         }
     }
@@ -120,7 +121,8 @@ static inline int link_q(uint32_t da, uint32_t db, uint32_t s, uint32_t h, const
 #define GROW_FN(name) name##_q
 #include "internal/lidet_cluster_grow_body.h"
 
-uint32_t lidet__cluster_q_grow(lidet_cluster_q_state_t *c, const lidet__grow_q_t *g, uint32_t start, uint32_t tail)
+uint32_t lidet__cluster_q_grow(lidet_cluster_q_state_t *c, const lidet__grow_q_t *g, uint32_t start,
+                               uint32_t tail)
 {
     return c->cfg.bridge_occluders != 0 ? grow_q(c, g, start, tail, 1) : grow_q(c, g, start, tail, 0);
 }

@@ -33,10 +33,11 @@ static int refine_examined(const lidet_cluster_q_cfg_t *cfg, const lidet_cluster
            span_mm(rec->min_4mm[2], rec->max_4mm[2]) >= cfg->person_min_height_mm;
 }
 
-static int refine_grid(const lidet_cluster_q_cfg_t *cfg, const lidet_cluster_q_rec_t *rec, geom_q_t *g, uint32_t *nx,
-                       uint32_t *ny)
+static int refine_grid(const lidet_cluster_q_cfg_t *cfg, const lidet_cluster_q_rec_t *rec, geom_q_t *g,
+                       uint32_t *nx, uint32_t *ny)
 {
-    const int32_t sx = rec->min_4mm[0] + rec->max_4mm[0], sy = rec->min_4mm[1] + rec->max_4mm[1]; /* 2 mm steps */
+    const int32_t sx = rec->min_4mm[0] + rec->max_4mm[0],
+                  sy = rec->min_4mm[1] + rec->max_4mm[1]; /* 2 mm steps */
     const uint32_t ax = (uint32_t)(sx < 0 ? -sx : sx), ay = (uint32_t)(sy < 0 ? -sy : sy);
     const uint32_t r_mm = 2u * (ax > ay ? ax + (ay >> 1) : ay + (ax >> 1)); /* < 2^19 */
     g->cs = cfg->split_cell_mm + (uint32_t)(((uint64_t)cfg->split_cell_per_m_q16 * r_mm + 32768u) >> 16);
@@ -48,7 +49,8 @@ static int refine_grid(const lidet_cluster_q_cfg_t *cfg, const lidet_cluster_q_r
     return 1;
 }
 
-static uint32_t refine_cell(const lidet_cluster_q_state_t *c, uint32_t p, const geom_q_t *g, uint32_t nx, uint32_t ny)
+static uint32_t refine_cell(const lidet_cluster_q_state_t *c, uint32_t p, const geom_q_t *g, uint32_t nx,
+                            uint32_t ny)
 {
     uint32_t ix = (uint32_t)(((uint64_t)span_mm(g->lo[0], c->img.x_4mm[p]) * g->inv) >> 40);
     uint32_t iy = (uint32_t)(((uint64_t)span_mm(g->lo[1], c->img.y_4mm[p]) * g->inv) >> 40);
@@ -62,13 +64,15 @@ static int32_t refine_z(const lidet_cluster_q_state_t *c, uint32_t p)
     return c->img.z_4mm[p];
 }
 
-static int refine_person(const lidet_cluster_q_cfg_t *cfg, const geom_q_t *g, uint32_t n, uint32_t sx, uint32_t sy,
-                         int32_t zlo, int32_t zhi, uint32_t ncols)
+static int refine_person(const lidet_cluster_q_cfg_t *cfg, const geom_q_t *g, uint32_t n, uint32_t sx,
+                         uint32_t sy, int32_t zlo, int32_t zhi, uint32_t ncols)
 {
     const uint64_t wx = (uint64_t)sx * g->cs, wy = (uint64_t)sy * g->cs, wz = span_mm(zlo, zhi);
     (void)n;
-    return wx <= cfg->person_max_width_mm && wy <= cfg->person_max_width_mm && wz >= cfg->person_min_height_mm &&
-           (wz << 16) >= (uint64_t)cfg->person_min_aspect_q16 * (wx > wy ? wx : wy) && ncols >= cfg->person_min_cols;
+    return wx <= cfg->person_max_width_mm && wy <= cfg->person_max_width_mm &&
+           wz >= cfg->person_min_height_mm &&
+           (wz << 16) >= (uint64_t)cfg->person_min_aspect_q16 * (wx > wy ? wx : wy) &&
+           ncols >= cfg->person_min_cols;
 }
 
 /* the rounded mean of the member sums (the sums kept beside it) */
@@ -162,7 +166,8 @@ static void refine_join_mean(lidet_cluster_q_state_t *c, uint32_t i, uint32_t j,
 #define REFINE_Z_FAR 0x7FFFFFFF
 #define REFINE_V_T int32_t
 #define REFINE_S_T int64_t
-#define REFINE_READ(c, p, v) ((v)[0] = (c)->img.x_4mm[p], (v)[1] = (c)->img.y_4mm[p], (v)[2] = (c)->img.z_4mm[p])
+#define REFINE_READ(c, p, v)                                                                                 \
+    ((v)[0] = (c)->img.x_4mm[p], (v)[1] = (c)->img.y_4mm[p], (v)[2] = (c)->img.z_4mm[p])
 #define REFINE_MIN(r) ((r)->min_4mm)
 #define REFINE_MAX(r) ((r)->max_4mm)
 #define REFINE_MEAN(r) ((r)->mean_4mm)

@@ -13,8 +13,8 @@ typedef struct
     uint32_t q, dq;
 } window_q_t;
 
-static inline void window_set_q(const lidet_cluster_q_state_t *c, window_q_t *w, uint32_t q, const lidet__grow_q_t *g,
-                                int compact)
+static inline void window_set_q(const lidet_cluster_q_state_t *c, window_q_t *w, uint32_t q,
+                                const lidet__grow_q_t *g, int compact)
 {
     (void)g;
     (void)compact;
@@ -47,8 +47,10 @@ static inline void probe_q(lidet_cluster_q_state_t *c, lidet__rescue_q_t *rs, co
     dn = img->range_4mm[n];
     lo = dn < w->dq ? dn : w->dq;
     gg = g->rgap + ((lo * g->rgpm + 32768u) >> 16);
-    if ((dn < w->dq ? w->dq - dn : dn - w->dq) > gg || !near_q(img->x_4mm[n], img->x_4mm[w->q], (int32_t)gg) ||
-        !near_q(img->y_4mm[n], img->y_4mm[w->q], (int32_t)gg) || !near_q(img->z_4mm[n], img->z_4mm[w->q], (int32_t)gg))
+    if ((dn < w->dq ? w->dq - dn : dn - w->dq) > gg ||
+        !near_q(img->x_4mm[n], img->x_4mm[w->q], (int32_t)gg) ||
+        !near_q(img->y_4mm[n], img->y_4mm[w->q], (int32_t)gg) ||
+        !near_q(img->z_4mm[n], img->z_4mm[w->q], (int32_t)gg))
     {
         return;
     }

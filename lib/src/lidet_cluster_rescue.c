@@ -10,8 +10,8 @@
 /* One pixel n (label l < LAB_PENDING, range dn) of the window of group pixel q (range dq): the two returns'
  * distance (from their coordinates) against gg = rgap + rgpm * (nearer range). Within it a fragment
  * pixel joins and a kept pixel is a contact (the nearest one wins, ties: the first met). */
-static inline void rescue_link(lidet_cluster_state_t *c, lidet__rescue_t *rs, uint32_t n, uint32_t l, float dn, uint32_t q,
-                               float dq, const lidet__grow_t *g, int compact)
+static inline void rescue_link(lidet_cluster_state_t *c, lidet__rescue_t *rs, uint32_t n, uint32_t l,
+                               float dn, uint32_t q, float dq, const lidet__grow_t *g, int compact)
 {
     const lidet_range_image_t *img = &c->img;
     const float gg = g->rgap + g->rgpm * (dq < dn ? dq : dn);
@@ -72,7 +72,8 @@ static inline void rescue_probe(lidet_cluster_state_t *c, lidet__rescue_t *rs, c
 #define RESCUE_PROBE(c, rs, lab, n, win, g, compact) rescue_probe(c, rs, lab, &(c)->img, n, win, g, compact)
 #include "internal/lidet_cluster_rescue_body.h"
 
-void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start, lidet__rescue_t *rs)
+void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start,
+                                lidet__rescue_t *rs)
 {
     /* two copies, with the image format a constant in each */
     if (lidet__img_compact(&c->img))

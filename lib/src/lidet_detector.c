@@ -11,8 +11,10 @@
 /* plausible sizes (l, w, h, metres) per class; the KITTI training labels' range with margin
  * (docs/DETECTOR.md): car 2.0-7.5 x 1.2-3.0 x 0.9-3.2, cyclist 0.8-2.6 x 0.2-1.5 x 0.8-2.4,
  * pedestrian 0.2-1.6 x 0.2-1.6 x 0.7-2.4 */
-static const float CLASS_SIZE_MIN[LIDET_N_CLASSES][3] = {{2.0f, 1.2f, 0.9f}, {0.8f, 0.2f, 0.8f}, {0.2f, 0.2f, 0.7f}};
-static const float CLASS_SIZE_MAX[LIDET_N_CLASSES][3] = {{7.5f, 3.0f, 3.2f}, {2.6f, 1.5f, 2.4f}, {1.6f, 1.6f, 2.4f}};
+static const float CLASS_SIZE_MIN[LIDET_N_CLASSES][3] = {
+    {2.0f, 1.2f, 0.9f}, {0.8f, 0.2f, 0.8f}, {0.2f, 0.2f, 0.7f}};
+static const float CLASS_SIZE_MAX[LIDET_N_CLASSES][3] = {
+    {7.5f, 3.0f, 3.2f}, {2.6f, 1.5f, 2.4f}, {1.6f, 1.6f, 2.4f}};
 
 void lidet_detector_cfg_default(lidet_detector_cfg_t *cfg, const lidet_sensor_t *sensor)
 {
@@ -42,10 +44,11 @@ void lidet_detector_cfg_default(lidet_detector_cfg_t *cfg, const lidet_sensor_t 
 static int cfg_ok(const lidet_detector_cfg_t *c)
 {
     uint32_t k, j;
-    if (!lidet__isfinite(c->crop_half_rad) || c->crop_half_rad < 0.0f || c->crop_half_rad > LIDET_PI_F + 1e-6f ||
-        !lidet__isfinite(c->max_range_m) || c->max_range_m < 0.0f || c->max_proposals < 1 ||
-        c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1 || c->max_boxes > LIDET_MAX_CLUSTERS ||
-        c->gate1 > 1 || c->gate2 > 1 || !lidet__isfinite(c->nms_iou) || c->nms_iou < 0.0f || c->nms_iou > 1.0f)
+    if (!lidet__isfinite(c->crop_half_rad) || c->crop_half_rad < 0.0f ||
+        c->crop_half_rad > LIDET_PI_F + 1e-6f || !lidet__isfinite(c->max_range_m) || c->max_range_m < 0.0f ||
+        c->max_proposals < 1 || c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1 ||
+        c->max_boxes > LIDET_MAX_CLUSTERS || c->gate1 > 1 || c->gate2 > 1 || !lidet__isfinite(c->nms_iou) ||
+        c->nms_iou < 0.0f || c->nms_iou > 1.0f)
     {
         return 0;
     }
@@ -63,8 +66,8 @@ static int cfg_ok(const lidet_detector_cfg_t *c)
     return 1;
 }
 
-lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *cls,
-                                   const lidet_pn_model_t *box)
+lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg_t *cfg,
+                                   const lidet_pn_model_t *cls, const lidet_pn_model_t *box)
 {
     lidet_status_t st;
     uint32_t k;
@@ -77,8 +80,8 @@ lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg
     {
         return LIDET_ERR_CONFIG;
     }
-    if (lidet_pn_check(cls, LIDET_PN_CLASSIFIER, 0) != LIDET_OK || lidet_pn_check(box, LIDET_PN_BOX, 0) != LIDET_OK ||
-        cls->n_points != box->n_points)
+    if (lidet_pn_check(cls, LIDET_PN_CLASSIFIER, 0) != LIDET_OK ||
+        lidet_pn_check(box, LIDET_PN_BOX, 0) != LIDET_OK || cls->n_points != box->n_points)
     {
         return LIDET_ERR_MODEL;
     }
@@ -86,8 +89,9 @@ lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg
     {
         /* the models were trained on voxels of these sizes: another proposal configuration would feed
          * them bins they never saw */
-        const float p = k == 0 ? cfg->proposal.azimuth_bin_rad : k == 1 ? cfg->proposal.elevation_bin_rad
-                                                                         : cfg->proposal.range_bin_m;
+        const float p = k == 0   ? cfg->proposal.azimuth_bin_rad
+                        : k == 1 ? cfg->proposal.elevation_bin_rad
+                                 : cfg->proposal.range_bin_m;
         if (cls->pvle_bin[k] != p || box->pvle_bin[k] != p)
         {
             return LIDET_ERR_MODEL;
@@ -242,15 +246,16 @@ static void insert_sorted(lidet_detection_t *det, uint32_t n)
     det[i] = t;
 }
 
-lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint32_t n_points, uint32_t stride,
-                                  const uint16_t *ring, int32_t *point_pixel)
+lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint32_t n_points,
+                                  uint32_t stride, const uint16_t *ring, int32_t *point_pixel)
 {
     const lidet_cluster_rec_t *recs;
     lidet_detector_stats_t *st;
     lidet_status_t s, worst;
     uint32_t n_rec = 0, n_cand = 0, i, t0, t1, cls_ticks = 0, box_ticks = 0;
     const int crop = d != 0 && d->cfg.crop_half_rad > 0.0f && d->cfg.crop_half_rad < LIDET_PI_F;
-    const float crop_s = crop ? sinf(d->cfg.crop_half_rad) : 0.0f, crop_c = crop ? cosf(d->cfg.crop_half_rad) : 0.0f;
+    const float crop_s = crop ? sinf(d->cfg.crop_half_rad) : 0.0f,
+                crop_c = crop ? cosf(d->cfg.crop_half_rad) : 0.0f;
     if (d == 0)
     {
         return LIDET_ERR_ARG;
@@ -300,8 +305,8 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
     {
         worst = LIDET_TRUNCATED;
     }
-    n_cand = lidet__nearest_first(d->key, d->order, n_cand, d->cfg.max_proposals, d->outcome, LIDET_DET_OUT_BUDGET,
-                                  &st->n_over_budget);
+    n_cand = lidet__nearest_first(d->key, d->order, n_cand, d->cfg.max_proposals, d->outcome,
+                                  LIDET_DET_OUT_BUDGET, &st->n_over_budget);
 
     for (i = 0; i < n_cand; ++i)
     {

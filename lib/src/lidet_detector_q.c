@@ -47,8 +47,8 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
 {
     uint32_t k, j;
     if (c->crop_half_bam < 0 || c->max_range_mm < 0 || c->max_proposals < 1u ||
-        c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1u || c->max_boxes > LIDET_MAX_CLUSTERS || c->gate1 > 1u || c->gate2 > 1u || c->nms_iou_q15 < 0 ||
-        c->nms_iou_q15 > 32768)
+        c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1u || c->max_boxes > LIDET_MAX_CLUSTERS ||
+        c->gate1 > 1u || c->gate2 > 1u || c->nms_iou_q15 < 0 || c->nms_iou_q15 > 32768)
     {
         return 0;
     }
@@ -253,7 +253,8 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
     t0 = now(d);
     st->ticks[LIDET_DET_STAGE_GROUND] = t0 - t1;
     n_sectors = d->cfg.ground.n_sectors;
-    s = lidet_cluster_q_run_buffers(&d->cluster, d->scratch.cluster.labels, d->scratch.cluster.members, &img, d->mask, d->ground.planes, n_sectors);
+    s = lidet_cluster_q_run_buffers(&d->cluster, d->scratch.cluster.labels, d->scratch.cluster.members, &img,
+                                    d->mask, d->ground.planes, n_sectors);
     st->cluster = d->cluster.stats;
     if (!LIDET_SUCCEEDED(s))
     {

@@ -85,18 +85,17 @@ lidet_status_t lidet_ground_state_init(lidet_ground_state_t *g, const lidet_grou
     }
     if (cfg->n_sectors < 1u || cfg->ransac_iters < 1u || cfg->ransac_iters > 1000u ||
         cfg->eval_samples < 3u || cfg->sample_step < 1u || cfg->sample_step > 16u ||
-        cfg->sample_col_step < 1u || cfg->sample_col_step > 16u ||
-        cfg->min_samples < 3u || cfg->min_inliers < 3u || cfg->refine_iters > 10u || cfg->fx_on_z > 1u ||
+        cfg->sample_col_step < 1u || cfg->sample_col_step > 16u || cfg->min_samples < 3u ||
+        cfg->min_inliers < 3u || cfg->refine_iters > 10u || cfg->fx_on_z > 1u ||
         cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors)
     {
         return LIDET_ERR_CONFIG;
     }
     if (!in_range(cfg->fy_max, 0.0f, 10.0f) || !in_range(cfg->fx_max_m, 0.0f, 100.0f) ||
-        cfg->fx_max_m <= 0.0f ||
-        !in_range(cfg->gate_above_m, -5.0f, 10.0f) || !in_range(cfg->gate_below_m, 0.0f, 20.0f) ||
-        !in_range(cfg->mount_height_m, 0.0f, 10.0f) || !in_range(cfg->inlier_m, 0.0f, 5.0f) ||
-        cfg->inlier_m <= 0.0f || !in_range(cfg->max_tilt_rad, 0.0f, LIDET_HALF_PI_F) ||
-        cfg->max_tilt_rad <= 0.0f ||
+        cfg->fx_max_m <= 0.0f || !in_range(cfg->gate_above_m, -5.0f, 10.0f) ||
+        !in_range(cfg->gate_below_m, 0.0f, 20.0f) || !in_range(cfg->mount_height_m, 0.0f, 10.0f) ||
+        !in_range(cfg->inlier_m, 0.0f, 5.0f) || cfg->inlier_m <= 0.0f ||
+        !in_range(cfg->max_tilt_rad, 0.0f, LIDET_HALF_PI_F) || cfg->max_tilt_rad <= 0.0f ||
         cfg->max_tilt_rad >= LIDET_HALF_PI_F || !in_range(cfg->max_height_dev_m, 0.0f, 20.0f) ||
         cfg->max_height_dev_m <= 0.0f || !in_range(cfg->ground_m, 0.0f, 5.0f) || cfg->ground_m <= 0.0f ||
         !in_range(cfg->ground_m_per_m, 0.0f, 0.1f) || !in_range(cfg->below_factor, 0.0f, 20.0f) ||
@@ -152,8 +151,8 @@ static inline uint8_t sample_test(const float *R0, const float *R1, const float 
 
 /* one row of the sample mask; columns wrap around: the first and the last two columns take their
  * neighbours modulo cols */
-static inline void filter_row(const float *R0, const float *R1, const float *Z0, const float *Z1, const float *F0,
-                              uint32_t cols, const filt_t *f, uint8_t *out, int opt)
+static inline void filter_row(const float *R0, const float *R1, const float *Z0, const float *Z1,
+                              const float *F0, uint32_t cols, const filt_t *f, uint8_t *out, int opt)
 {
     uint32_t c;
     out[0] = sample_test(R0, R1, Z0, Z1, F0, cols - 1u, 0u, 1u, 2u, f, opt);
@@ -290,7 +289,8 @@ static void xy_row(rxy_rows_t *rr, uint32_t r, const float **X, const float **Y)
 }
 
 /* Pass 1 (mirrors ref/ground.py: sample_mask): the sample mask, row by row. */
-static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, rxy_rows_t *rr, const lidet_range_image_t *img)
+static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, rxy_rows_t *rr,
+                        const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols;
     const uint32_t step = g->cfg.sample_step;
@@ -340,7 +340,8 @@ static inline float pixel_rxy(const lidet_range_image_t *img, uint32_t p)
     return lidet__rxy(lidet__img_x(img, p), lidet__img_y(img, p));
 }
 
-static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img)
+static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc,
+                           const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
     const uint32_t cstep = g->cfg.sample_col_step;
@@ -423,7 +424,7 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, 
 typedef struct
 {
     float split, slope, min_dz, mid, half; /* constant tolerance: |h - mid| < half */
-    float g0, k, bf;                        /* general tolerance: -bf (g0 + k R) < h < g0 + k R */
+    float g0, k, bf;                       /* general tolerance: -bf (g0 + k R) < h < g0 + k R */
 } label_par_t;
 
 /* veto word of pixel c: -1 when vetoed */
@@ -466,9 +467,9 @@ static uint32_t label_one(const float *X, const float *Y, const float *Z, const 
 /* near plane p below split, far plane q from it (both d shifted by -mid), constant tolerance; or,
  * general != 0, the tolerance growing with range (ground_m_per_m > 0, planes unshifted). general is
  * a constant at both calls. Returns the vetoed count. */
-static inline uint32_t label_two(const float *X, const float *Y, const float *Z, const float *R, const float *Ru,
-                                 const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p, lidet_plane_t q,
-                                 const label_par_t *lp, int32_t *restrict o, int general)
+static inline uint32_t label_two(const float *X, const float *Y, const float *Z, const float *R,
+                                 const float *Ru, const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p,
+                                 lidet_plane_t q, const label_par_t *lp, int32_t *restrict o, int general)
 {
     uint32_t j, nv = 0;
     for (j = 0; j < n; ++j)
@@ -476,8 +477,10 @@ static inline uint32_t label_two(const float *X, const float *Y, const float *Z,
         const uint32_t c = c0 + j;
         const float hn = height(&p, X, Y, Z, c), hf = height(&q, X, Y, Z, c);
         const float above = lp->g0 + lp->k * R[c], below = -lp->bf * above;
-        const int32_t in_n = general ? -(int32_t)((hn < above) & (hn > below)) : -(int32_t)(fabsf(hn) < lp->half);
-        const int32_t in_f = general ? -(int32_t)((hf < above) & (hf > below)) : -(int32_t)(fabsf(hf) < lp->half);
+        const int32_t in_n =
+            general ? -(int32_t)((hn < above) & (hn > below)) : -(int32_t)(fabsf(hn) < lp->half);
+        const int32_t in_f =
+            general ? -(int32_t)((hf < above) & (hf > below)) : -(int32_t)(fabsf(hf) < lp->half);
         const int32_t in = pick(R[c], lp->split, in_n, in_f), vt = veto(R, Z, Ru, Zu, c, lp);
         o[j] = in & ~vt;
         nv -= (uint32_t)(in & vt);
@@ -568,8 +571,8 @@ static void label_rows(lidet_ground_state_t *g, uint8_t *mask, rxy_rows_t *rr, c
     g->stats.n_vetoed = n_vetoed;
 }
 
-lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_scratch_t *scratch, uint8_t *mask,
-                                        const lidet_range_image_t *img)
+lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_scratch_t *scratch,
+                                        uint8_t *mask, const lidet_range_image_t *img)
 {
     rxy_rows_t rr;
     lidet_status_t st;
@@ -578,8 +581,9 @@ lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_sc
         return LIDET_ERR_ARG;
     }
     st = lidet__ground_run_check(g->magic == LIDET_INIT_MAGIC,
-                                 lidet__img_compact(img) ? (img->x_4mm != 0 && img->y_4mm != 0 && img->z_4mm != 0)
-                                                         : (img->y_m != 0 && img->z_m != 0),
+                                 lidet__img_compact(img)
+                                     ? (img->x_4mm != 0 && img->y_4mm != 0 && img->z_4mm != 0)
+                                     : (img->y_m != 0 && img->z_m != 0),
                                  img, g->cfg.n_sectors, &g->stats);
     if (st != LIDET_OK)
     {
@@ -643,14 +647,15 @@ lidet_status_t lidet_ground_point_labels_of(const lidet_ground_state_t *g, const
                                             const int32_t *point_pixel, uint32_t n_points, uint8_t *out)
 {
     return g == 0 ? LIDET_ERR_ARG
-                  : lidet__ground_point_labels(g->magic == LIDET_INIT_MAGIC, mask, (uint32_t)g->n_rows * g->n_cols,
-                                               point_pixel, n_points, out);
+                  : lidet__ground_point_labels(g->magic == LIDET_INIT_MAGIC, mask,
+                                               (uint32_t)g->n_rows * g->n_cols, point_pixel, n_points, out);
 }
 
 lidet_status_t lidet_ground_point_labels(const lidet_ground_t *g, const int32_t *point_pixel,
                                          uint32_t n_points, uint8_t *out)
 {
-    return g == 0 ? LIDET_ERR_ARG : lidet_ground_point_labels_of(&g->state, g->mask, point_pixel, n_points, out);
+    return g == 0 ? LIDET_ERR_ARG
+                  : lidet_ground_point_labels_of(&g->state, g->mask, point_pixel, n_points, out);
 }
 
 const lidet_ground_stats_t *lidet_ground_stats(const lidet_ground_t *g)

@@ -60,9 +60,10 @@ lidet_status_t lidet_ground_q_state_init(lidet_ground_q_state_t *g, const lidet_
     {
         return LIDET_ERR_BUFFER;
     }
-    if (cfg->n_sectors < 1u || cfg->ransac_iters < 1u || cfg->ransac_iters > 1000u || cfg->eval_samples < 3u ||
-        cfg->sample_step < 1u || cfg->sample_step > 16u || cfg->sample_col_step < 1u || cfg->sample_col_step > 16u ||
-        cfg->min_samples < 3u || cfg->min_inliers < 3u || cfg->refine_iters > 10u || cfg->fx_on_z > 1u ||
+    if (cfg->n_sectors < 1u || cfg->ransac_iters < 1u || cfg->ransac_iters > 1000u ||
+        cfg->eval_samples < 3u || cfg->sample_step < 1u || cfg->sample_step > 16u ||
+        cfg->sample_col_step < 1u || cfg->sample_col_step > 16u || cfg->min_samples < 3u ||
+        cfg->min_inliers < 3u || cfg->refine_iters > 10u || cfg->fx_on_z > 1u ||
         cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors)
     {
         return LIDET_ERR_CONFIG;
@@ -70,11 +71,11 @@ lidet_status_t lidet_ground_q_state_init(lidet_ground_q_state_t *g, const lidet_
     if (cfg->fy_max_q16 > 655360u || cfg->fx_max_mm < 1u || cfg->fx_max_mm > 100000u ||
         cfg->gate_above_mm < -5000 || cfg->gate_above_mm > 10000 || cfg->gate_below_mm < 0 ||
         cfg->gate_below_mm > 20000 || cfg->mount_height_mm < 0 || cfg->mount_height_mm > 10000 ||
-        cfg->confidence_q16 > 65535u || cfg->inlier_mm < 1u || cfg->inlier_mm > 5000u || cfg->max_tilt_urad < 1u ||
-        cfg->max_tilt_urad > 1570796u || cfg->max_height_dev_mm < 1u || cfg->max_height_dev_mm > 20000u ||
-        cfg->ring_split_mm > 500000u || cfg->ground_mm < 1u || cfg->ground_mm > 5000u ||
-        cfg->ground_per_m_q16 > 6554u || cfg->below_factor_q16 > 1310720u || cfg->veto_slope_q16 > 6553600u ||
-        cfg->veto_min_dz_mm > 5000u)
+        cfg->confidence_q16 > 65535u || cfg->inlier_mm < 1u || cfg->inlier_mm > 5000u ||
+        cfg->max_tilt_urad < 1u || cfg->max_tilt_urad > 1570796u || cfg->max_height_dev_mm < 1u ||
+        cfg->max_height_dev_mm > 20000u || cfg->ring_split_mm > 500000u || cfg->ground_mm < 1u ||
+        cfg->ground_mm > 5000u || cfg->ground_per_m_q16 > 6554u || cfg->below_factor_q16 > 1310720u ||
+        cfg->veto_slope_q16 > 6553600u || cfg->veto_min_dz_mm > 5000u)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -137,8 +138,8 @@ static inline uint32_t rxy2(const int16_t *x, const int16_t *y, uint32_t p)
 
 /* R of a whole row, digit step by digit step over the columns (the same values as r_of, but the column loops
  * are independent lanes that a compiler vectorises); v, rem: scratch of cols entries */
-static void r_of_row(const int16_t *x, const int16_t *y, uint32_t cols, int32_t *restrict out, uint32_t *restrict v,
-                     uint32_t *restrict rem)
+static void r_of_row(const int16_t *x, const int16_t *y, uint32_t cols, int32_t *restrict out,
+                     uint32_t *restrict v, uint32_t *restrict rem)
 {
     uint32_t *restrict root = (uint32_t *)out;
     uint32_t c;
@@ -196,8 +197,8 @@ static const int32_t *r_row(r_rows_t *rr, uint32_t r)
     const uint32_t k = r & 1u, cols = rr->img->n_cols;
     if (rr->row_in[k] != (int32_t)r)
     {
-        r_of_row(rr->img->x_4mm + (size_t)r * cols, rr->img->y_4mm + (size_t)r * cols, cols, rr->slot[k], rr->v,
-                 rr->rem);
+        r_of_row(rr->img->x_4mm + (size_t)r * cols, rr->img->y_4mm + (size_t)r * cols, cols, rr->slot[k],
+                 rr->v, rr->rem);
         rr->row_in[k] = (int32_t)r;
     }
     return rr->slot[k];
@@ -229,11 +230,13 @@ static inline uint8_t sample_test(const int32_t *R0, const int32_t *R1, const in
     const int pts = (R0[cm1] > 0) & (R0[c] > 0) & (R0[cp1] > 0) & (R0[cp2] > 0) & (R1[c] > 0) & (R1[cp1] > 0);
     const int fy = ((uint64_t)(uint32_t)abs32(dz) << 24) <= f->fy * (uint32_t)abs32(dr);
     const int fx = f->on_z ? 4 * abs32(fxz) <= f->fx_mm : abs32(fxr) <= f->fx_r;
-    const int opt = ((f->desc == 0) | (dr > 0)) & ((f->gate == 0) | ((4 * Z0[c] >= f->z_lo) & (4 * Z0[c] <= f->z_hi)));
+    const int opt =
+        ((f->desc == 0) | (dr > 0)) & ((f->gate == 0) | ((4 * Z0[c] >= f->z_lo) & (4 * Z0[c] <= f->z_hi)));
     return (uint8_t)(pts & fy & fx & opt);
 }
 
-static void filter_rows(const lidet_ground_q_state_t *g, uint8_t *sample, r_rows_t *rr, const lidet_range_image_t *img)
+static void filter_rows(const lidet_ground_q_state_t *g, uint8_t *sample, r_rows_t *rr,
+                        const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, step = g->cfg.sample_step;
     filt_q_t f;
@@ -265,7 +268,8 @@ static void filter_rows(const lidet_ground_q_state_t *g, uint8_t *sample, r_rows
 /* Pass 2 (ref/ground_q.py: gather_samples): the samples of the step grid grouped by cell, near ones from the
  * buffer's start upwards, far ones from its end downwards (the float stage's order); past the buffer they are
  * dropped and counted. */
-static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, const lidet_range_image_t *img)
+static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                           const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
     const uint32_t cstep = g->cfg.sample_col_step, split_v = g->split_v;
@@ -273,7 +277,8 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
     uint32_t s, r, c, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
     for (s = 0; s < ns; ++s)
     {
-        const uint32_t c0 = lidet__ground_sector_col(s, ns, cols), c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+        const uint32_t c0 = lidet__ground_sector_col(s, ns, cols),
+                       c1 = lidet__ground_sector_col(s + 1u, ns, cols);
         const uint32_t near_start = lo, far_end = hi;
         for (r = 0; r + 1u < rows; r += step)
         {
@@ -323,7 +328,8 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
     uint32_t r, s, c, n_ground = 0, n_vetoed = 0;
     for (r = 0; r < rows; ++r)
     {
-        const uint32_t base = r * cols, up = r > 0u ? cols : 0u; /* row 0 compares with itself: never vetoed */
+        const uint32_t base = r * cols,
+                       up = r > 0u ? cols : 0u; /* row 0 compares with itself: never vetoed */
         int32_t *Rr = sc->r_rows[r & 1u], *Ru = sc->r_rows[(r & 1u) ^ (r > 0u)];
         for (c = 0; c < cols; ++c)
         {
@@ -436,6 +442,6 @@ lidet_status_t lidet_ground_q_point_labels_of(const lidet_ground_q_state_t *g, c
                                               const int32_t *point_pixel, uint32_t n_points, uint8_t *out)
 {
     return g == 0 ? LIDET_ERR_ARG
-                  : lidet__ground_point_labels(g->magic == LIDET_INIT_MAGIC, mask, (uint32_t)g->n_rows * g->n_cols,
-                                               point_pixel, n_points, out);
+                  : lidet__ground_point_labels(g->magic == LIDET_INIT_MAGIC, mask,
+                                               (uint32_t)g->n_rows * g->n_cols, point_pixel, n_points, out);
 }

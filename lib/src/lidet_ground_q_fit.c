@@ -100,15 +100,14 @@ static inline void pixel(const lidet_range_image_t *img, uint32_t p, int32_t q[3
     q[2] = img->z_4mm[p];
 }
 
-
 /* The least-squares plane through the inliers (|height| <= thr) of cur among the cell's samples: their
  * centroid c0 (rounded to 4 mm steps) and scatter matrix about c0 in exact int64 sums, the normal by
  * power iteration on the adjugate of the scatter matrix starting from cur's normal (the adjugate's dominant
  * eigenvector is the scatter's least one; the ratio of a ground patch's two smallest spreads makes a few
  * iterations exact), D through the exact mean. Returns 0 (out untouched) for fewer than 3 inliers or points
  * (nearly) on a line. */
-static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *idx, uint32_t n, const qplane_t *cur,
-                  int64_t thr, qplane_t *out)
+static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *idx, uint32_t n,
+                  const qplane_t *cur, int64_t thr, qplane_t *out)
 {
     int64_t s1[3] = {0, 0, 0}, e[3] = {0, 0, 0}, a[6] = {0, 0, 0, 0, 0, 0}, b[6], v[3], nd;
     int32_t q[3], first[3], c0[3], nv[3];
@@ -333,7 +332,8 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, c
         const int64_t ci = best_c[2] < 0 ? -best_c[i] : best_c[i];
         best.n[i] = (int32_t)lidet__q_div_round(ci * ONE_Q30, (int64_t)best_len);
     }
-    best.d = -((int64_t)best.n[0] * best_p0[0] + (int64_t)best.n[1] * best_p0[1] + (int64_t)best.n[2] * best_p0[2]);
+    best.d = -((int64_t)best.n[0] * best_p0[0] + (int64_t)best.n[1] * best_p0[1] +
+               (int64_t)best.n[2] * best_p0[2]);
     for (r = 0; r < cfg->refine_iters; ++r)
     {
         qplane_t p;
@@ -343,7 +343,8 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, c
         }
         best = p;
     }
-    if (best.n[2] < cos_t || abs64(best.d - ((int64_t)cfg->mount_height_mm << 28)) > (int64_t)cfg->max_height_dev_mm << 28)
+    if (best.n[2] < cos_t ||
+        abs64(best.d - ((int64_t)cfg->mount_height_mm << 28)) > (int64_t)cfg->max_height_dev_mm << 28)
     {
         return 0;
     }
@@ -410,6 +411,6 @@ void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scrat
     f.g = g;
     f.sc = sc;
     f.img = img;
-    lidet__ground_cells(g->source, sc->cell_n, ns, g->cfg.ring_split_mm > 0u ? 2u * ns : ns, g->cfg.min_samples,
-                        g->cfg.fallback_sectors, &g->stats, fit_cell, copy_plane, &f);
+    lidet__ground_cells(g->source, sc->cell_n, ns, g->cfg.ring_split_mm > 0u ? 2u * ns : ns,
+                        g->cfg.min_samples, g->cfg.fallback_sectors, &g->stats, fit_cell, copy_plane, &f);
 }

@@ -472,13 +472,14 @@ static void copy_plane(void *ctx, uint32_t dst, int32_t src)
     }
 }
 
-void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img)
+void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc,
+                               const lidet_range_image_t *img)
 {
     const uint32_t ns = g->cfg.n_sectors;
     fit_ctx_t f;
     f.g = g;
     f.sc = sc;
     f.img = img;
-    lidet__ground_cells(g->source, sc->cell_n, ns, g->cfg.ring_split_m > 0.0f ? 2u * ns : ns, g->cfg.min_samples,
-                        g->cfg.fallback_sectors, &g->stats, fit_cell, copy_plane, &f);
+    lidet__ground_cells(g->source, sc->cell_n, ns, g->cfg.ring_split_m > 0.0f ? 2u * ns : ns,
+                        g->cfg.min_samples, g->cfg.fallback_sectors, &g->stats, fit_cell, copy_plane, &f);
 }

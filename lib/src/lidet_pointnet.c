@@ -74,8 +74,8 @@ static lidet_status_t check_widths(const lidet_pn_model_t *m, uint16_t *wp, uint
     *wp = 3;
     *wv = 8;
     if (m->format_version != LIDET_WEIGHTS_FORMAT_VERSION || m->precision != LIDET_PN_F32 ||
-        !lidet__pn_dims_ok(m->kind, m->n_stages, m->n_classes, m->n_points, m->n_heading_bins, m->n_size_clusters,
-                           m->mean_size_m != 0) ||
+        !lidet__pn_dims_ok(m->kind, m->n_stages, m->n_classes, m->n_points, m->n_heading_bins,
+                           m->n_size_clusters, m->mean_size_m != 0) ||
         !lidet__isfinite(m->energy_t) || !(m->energy_t > 0.0f))
     {
         return LIDET_ERR_MODEL;
@@ -128,8 +128,8 @@ uint32_t lidet_pn_n_outputs(const lidet_pn_model_t *model)
     return model->kind == LIDET_PN_BOX ? 3u + box_outputs(model) : model->n_classes;
 }
 
-lidet_status_t lidet_pn_init(lidet_pn_t *pn, const lidet_pn_model_t *model, void *scratch, uint32_t scratch_bytes,
-                             uint32_t *required)
+lidet_status_t lidet_pn_init(lidet_pn_t *pn, const lidet_pn_model_t *model, void *scratch,
+                             uint32_t scratch_bytes, uint32_t *required)
 {
     uint16_t wp, wv;
     uint32_t need;
@@ -244,18 +244,19 @@ static void max_init(const bufs_t *b, uint32_t n)
 #define PNB_FRAME_T frame_t
 #define PNB_MAX_INIT(b, n) max_init(b, n)
 #define PNB_LOAD(b, pts, nb, f) load_block(b, pts, nb, f)
-#define PNB_DENSE(ly, in, nb, b, l)                                                                              \
-    lidet__nn_dense_f32((const float *)(in), nb, (ly)->n_in, (ly)->w_t, (ly)->b, (ly)->n_out, (ly)->relu,       \
-                        (b)->act[(l) & 1u])
+#define PNB_DENSE(ly, in, nb, b, l)                                                                          \
+    lidet__nn_dense_f32((const float *)(in), nb, (ly)->n_in, (ly)->w_t, (ly)->b, (ly)->n_out, (ly)->relu,    \
+                        (b)->act[(l)&1u])
 #define PNB_STORE(ly, nb, b, dst) ((void)0)
-#define PNB_FOLD_MAX(ly, nb, b, l) lidet__nn_max_rows_f32((b)->act[(l) & 1u], nb, (ly)->n_out, (b)->vec[0])
+#define PNB_FOLD_MAX(ly, nb, b, l) lidet__nn_max_rows_f32((b)->act[(l)&1u], nb, (ly)->n_out, (b)->vec[0])
 #include "internal/lidet_pn_points_body.h"
 
 /* One stage (ref: run_stage): the points, rotated into the model frame by cs (cos, sin of the mean's
  * azimuth; NULL: already there) and shifted by minus `shift` (NULL: none) one block at a time, through
  * the shared layers with the fused max over the n points; then [g | onehot | pvle(voxel)] -> head -> out. */
-static void run_stage(const lidet_pn_stage_t *s, const bufs_t *b, const float *points, uint32_t n, const float *cs,
-                      const float *shift, const float voxel[3], const float *onehot, uint32_t n_classes, float *out)
+static void run_stage(const lidet_pn_stage_t *s, const bufs_t *b, const float *points, uint32_t n,
+                      const float *cs, const float *shift, const float voxel[3], const float *onehot,
+                      uint32_t n_classes, float *out)
 {
     const lidet_pn_layer_t *last = &s->point[s->n_point - 1];
     float *g = b->vec[0];
@@ -281,8 +282,8 @@ static void run_stage(const lidet_pn_stage_t *s, const bufs_t *b, const float *p
 }
 
 /* ref: forward. out = [logits] or [tnet(3) | box]; the caller checked the arguments. */
-static void forward(const lidet_pn_t *pn, const float *points, uint32_t n, const float *cs, const float voxel[3],
-                    const float *onehot, float *out)
+static void forward(const lidet_pn_t *pn, const float *points, uint32_t n, const float *cs,
+                    const float voxel[3], const float *onehot, float *out)
 {
     const lidet_pn_model_t *m = pn->model;
     bufs_t b;

@@ -10,10 +10,10 @@
 #include "internal/lidet_qmath.h"
 #include "lidet/lidet_pointnet_q.h"
 
-#define LOG2E_Q30 1549082005  /* round(log2(e) * 2^30) */
-#define LN2_Q24 11629080      /* round(ln(2) * 2^24) */
-#define E_CUT_Q16 (24 << 16)  /* exp(-d) = 0 from d = 24 nats on */
-#define BIAS_LIMIT (1 << 29)  /* |bias|, |one-hot bias| below it: int32 accumulators cannot overflow */
+#define LOG2E_Q30 1549082005       /* round(log2(e) * 2^30) */
+#define LN2_Q24 11629080           /* round(ln(2) * 2^24) */
+#define E_CUT_Q16 (24 << 16)       /* exp(-d) = 0 from d = 24 nats on */
+#define BIAS_LIMIT (1 << 29)       /* |bias|, |one-hot bias| below it: int32 accumulators cannot overflow */
 #define CENTRE_LIMIT_Q16 (1 << 24) /* box centres clamped to +-256 m before decoding */
 
 /* ---- descriptor checks -------------------------------------------------------------------- */
@@ -22,13 +22,15 @@ static int layer_ok(const lidet_pointnet_q_layer_t *l, uint32_t n_in, int last_o
 {
     uint32_t o;
     if (l->n_in != n_in || l->n_out == 0 || l->n_out > LIDET_PN_MAX_WIDTH || l->w_t == 0 || l->b == 0 ||
-        l->mult == 0 || l->shift == 0 || l->relu > 1 || l->out != (last_of_head ? LIDET_PNQ_OUT_Q16 : LIDET_PNQ_OUT_S8))
+        l->mult == 0 || l->shift == 0 || l->relu > 1 ||
+        l->out != (last_of_head ? LIDET_PNQ_OUT_Q16 : LIDET_PNQ_OUT_S8))
     {
         return 0;
     }
     for (o = 0; o < l->n_out; ++o)
     {
-        if (l->shift[o] < 1 || l->shift[o] > 62 || l->mult[o] < 0 || l->b[o] <= -BIAS_LIMIT || l->b[o] >= BIAS_LIMIT)
+        if (l->shift[o] < 1 || l->shift[o] > 62 || l->mult[o] < 0 || l->b[o] <= -BIAS_LIMIT ||
+            l->b[o] >= BIAS_LIMIT)
         {
             return 0;
         }
@@ -100,8 +102,8 @@ static lidet_status_t check_widths(const lidet_pointnet_q_model_t *m, uint16_t *
     *wp = 3;
     *wv = 8;
     if (m->format_version != LIDET_WEIGHTS_FORMAT_VERSION || m->precision != LIDET_PN_S8 ||
-        !lidet__pn_dims_ok(m->kind, m->n_stages, m->n_classes, m->n_points, m->n_heading_bins, m->n_size_clusters,
-                           m->mean_size_mm != 0 && m->heading_bam != 0) ||
+        !lidet__pn_dims_ok(m->kind, m->n_stages, m->n_classes, m->n_points, m->n_heading_bins,
+                           m->n_size_clusters, m->mean_size_mm != 0 && m->heading_bam != 0) ||
         m->energy_t_q16 <= 0 || m->pvle_bin[0] <= 0 || m->pvle_bin[1] <= 0 || m->pvle_bin[2] <= 0)
     {
         return LIDET_ERR_MODEL;
@@ -154,8 +156,8 @@ uint32_t lidet_pointnet_q_n_outputs(const lidet_pointnet_q_model_t *model)
     return model->kind == LIDET_PN_BOX ? 3u + box_outputs(model) : model->n_classes;
 }
 
-lidet_status_t lidet_pointnet_q_init(lidet_pointnet_q_t *pn, const lidet_pointnet_q_model_t *model, void *scratch,
-                                     uint32_t scratch_bytes, uint32_t *required)
+lidet_status_t lidet_pointnet_q_init(lidet_pointnet_q_t *pn, const lidet_pointnet_q_model_t *model,
+                                     void *scratch, uint32_t scratch_bytes, uint32_t *required)
 {
     uint16_t wp, wv;
     uint32_t need;
@@ -225,8 +227,8 @@ static int16_t sat16(int64_t v)
 /* rotation and shift of one proposal's points into the model frame (ref: model_frame) */
 typedef struct
 {
-    int32_t c, s;  /* Q30 cos, sin of the mean's azimuth */
-    int rotate;    /* 0: the points are in the model frame (mm) already */
+    int32_t c, s;            /* Q30 cos, sin of the mean's azimuth */
+    int rotate;              /* 0: the points are in the model frame (mm) already */
     const int32_t *shift_mm; /* T-Net centre, or NULL */
 } frame_t;
 
@@ -256,13 +258,15 @@ static const void *load_block(const bufs_t *b, const int16_t *xyz, uint32_t nb, 
 
 static void requant_s8(const lidet_pointnet_q_layer_t *l, const int32_t *acc, uint32_t n_rows, int8_t *out)
 {
-    lidet__nn_requant_s8(acc, n_rows, l->n_out, l->mult, l->shift, l->out_zp, l->relu ? l->out_zp : -128, out);
+    lidet__nn_requant_s8(acc, n_rows, l->n_out, l->mult, l->shift, l->out_zp, l->relu ? l->out_zp : -128,
+                         out);
 }
 
 /* PVLE or head layers on one vector: in (int8, or the int16 voxel for a PVLE's first layer) -> tmp0/tmp1
  * alternately -> out_s8 (int8) or out_q16 (the last head layer). onehot_b: added to layer 0's accumulators. */
-static void run_vec_layers(const lidet_pointnet_q_layer_t *l, uint32_t n, const int16_t *in16, const int8_t *in8,
-                           const int32_t *onehot_b, const bufs_t *b, int8_t *out_s8, int32_t *out_q16)
+static void run_vec_layers(const lidet_pointnet_q_layer_t *l, uint32_t n, const int16_t *in16,
+                           const int8_t *in8, const int32_t *onehot_b, const bufs_t *b, int8_t *out_s8,
+                           int32_t *out_q16)
 {
     uint32_t i, o;
     const int8_t *cur = in8;
@@ -304,7 +308,8 @@ static void max_init(const bufs_t *b, uint32_t n)
 }
 
 /* layer l into the int32 accumulators: int16 x int8 for the first (the points in mm), int8 x int8 after */
-static void dense_acc(const lidet_pointnet_q_layer_t *ly, const void *in, uint32_t nb, const bufs_t *b, uint32_t l)
+static void dense_acc(const lidet_pointnet_q_layer_t *ly, const void *in, uint32_t nb, const bufs_t *b,
+                      uint32_t l)
 {
     if (l == 0)
     {
@@ -333,7 +338,8 @@ static void dense_acc(const lidet_pointnet_q_layer_t *ly, const void *in, uint32
 /* One stage (ref: run_stage): blocks of points -> model frame (int16 mm) -> shared layers, the last one's
  * accumulators folded into a running max; requantized once -> g; [g | pvle(voxel)] -> head -> out (Q16). */
 static void run_stage(const lidet_pointnet_q_stage_t *s, const bufs_t *b, const int16_t *xyz, uint32_t n,
-                      const frame_t *f, const int16_t voxel[3], uint32_t cls, uint32_t n_classes, int32_t *out)
+                      const frame_t *f, const int16_t voxel[3], uint32_t cls, uint32_t n_classes,
+                      int32_t *out)
 {
     const lidet_pointnet_q_layer_t *last = &s->point[s->n_point - 1];
     (void)n_classes;
@@ -343,8 +349,8 @@ static void run_stage(const lidet_pointnet_q_stage_t *s, const bufs_t *b, const 
     {
         run_vec_layers(s->pvle, s->n_pvle, voxel, 0, 0, b, b->vec[0] + last->n_out, 0);
     }
-    run_vec_layers(s->head, s->n_head, 0, b->vec[0], s->use_onehot ? s->onehot_b + cls * s->head[0].n_out : 0, b,
-                   0, out);
+    run_vec_layers(s->head, s->n_head, 0, b->vec[0], s->use_onehot ? s->onehot_b + cls * s->head[0].n_out : 0,
+                   b, 0, out);
 }
 
 /* ref: forward. out = [logits] or [tnet(3) | box] (Q16); the caller checked the arguments. */
@@ -603,7 +609,8 @@ static void decode_box(const lidet_pointnet_q_model_t *m, const int32_t *raw, co
     out->box.cy_mm = (int32_t)((int64_t)p->mean_4mm[1] * 4 +
                                lidet__q_rshift_round((int64_t)f->s * cm8[0] + (int64_t)f->c * cm8[1], 38));
     out->box.cz_mm = (int32_t)((int64_t)p->mean_4mm[2] * 4 + lidet__q_rshift_round(cen[2] * 1000, 16));
-    yaw = (uint32_t)m->heading_bam[hb] + (uint32_t)lidet__q_rshift_round((int64_t)hr[hb] * m->heading_res_bam, 16) +
+    yaw = (uint32_t)m->heading_bam[hb] +
+          (uint32_t)lidet__q_rshift_round((int64_t)hr[hb] * m->heading_res_bam, 16) +
           (uint32_t)lidet__q_atan2(p->mean_4mm[1], p->mean_4mm[0]);
     out->box.yaw_bam = (int32_t)(yaw >= 0x80000000u ? -(int32_t)(0xFFFFFFFFu - yaw) - 1 : (int32_t)yaw);
     for (k = 0; k < 3u; ++k)

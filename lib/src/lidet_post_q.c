@@ -8,7 +8,8 @@
 
 /* the float detector's limits (lidet_detector.c) in mm */
 static const int32_t SIZE_MIN_MM[LIDET_N_CLASSES][3] = {{2000, 1200, 900}, {800, 200, 800}, {200, 200, 700}};
-static const int32_t SIZE_MAX_MM[LIDET_N_CLASSES][3] = {{7500, 3000, 3200}, {2600, 1500, 2400}, {1600, 1600, 2400}};
+static const int32_t SIZE_MAX_MM[LIDET_N_CLASSES][3] = {
+    {7500, 3000, 3200}, {2600, 1500, 2400}, {1600, 1600, 2400}};
 
 #define MAX_CENTRE_MM (1 << 20) /* centres farther apart never overlap (and keep the IoU's int64 bounded) */
 #define MAX_VERTS 16

@@ -56,8 +56,9 @@ static void init_columns(lidet_proj_state_t *proj, uint32_t cols)
         const float sn = sinf(t), cs = cosf(t);
         proj->col_edge_key[c] = (float)quadrant + sn / (sn + cs);
     }
-    proj->col_edge_key[0] = -1.0f;   /* below any D (which may be -1 ulp): ends the downward correction */
-    proj->col_edge_key[cols] = 5.0f; /* D <= 4 < 5: ends the upward correction (D = 4 stays in the last column) */
+    proj->col_edge_key[0] = -1.0f; /* below any D (which may be -1 ulp): ends the downward correction */
+    proj->col_edge_key[cols] =
+        5.0f; /* D <= 4 < 5: ends the upward correction (D = 4 stays in the last column) */
     /* bucket k covers D in [k/cols, (k+1)/cols); one more entry takes D = 4 exactly. A column is at
      * least pi/cols wide in D (dD/du is in [pi, 2 pi]), i.e. > 3 buckets, so a bucket's guess is off
      * by at most one column even when float rounding puts D into a neighbouring bucket. */
@@ -126,7 +127,8 @@ lidet_status_t lidet_proj_state_init(lidet_proj_state_t *proj, const lidet_proj_
     {
         float step;
         if (!in_range(s->fov_up_rad, -MAX_ABS_ELEV_RAD, MAX_ABS_ELEV_RAD) ||
-            !in_range(s->fov_down_rad, -MAX_ABS_ELEV_RAD, MAX_ABS_ELEV_RAD) || s->fov_up_rad <= s->fov_down_rad)
+            !in_range(s->fov_down_rad, -MAX_ABS_ELEV_RAD, MAX_ABS_ELEV_RAD) ||
+            s->fov_up_rad <= s->fov_down_rad)
         {
             return LIDET_ERR_CONFIG;
         }
@@ -234,9 +236,9 @@ lidet_status_t lidet_proj_init(lidet_proj_t *proj, const lidet_proj_cfg_t *cfg)
  * lookups and the closest-point test in one loop per point, and 20.6 with (a) apart but (b) and (c)
  * in one loop: (c)'s read-modify-writes of the image stall when interleaved with (b)'s table loads. */
 #define KEY_BLOCK ((uint32_t)LIDET_PROJ_BLOCK) /* lidet_opt.h, 64 by default */
-#define KEY_RANGE_OK 1 /* min2 <= r^2 <= max2 (so x, y, z finite) */
-#define KEY_FOV_OK 2   /* tan(elevation) in [tan_lo, tan_hi] (so not NaN) */
-#define KEY_DEN_OK 4   /* 1 / ((|x|+|y|) * rxy) finite and > 0: t and d are defined */
+#define KEY_RANGE_OK 1                         /* min2 <= r^2 <= max2 (so x, y, z finite) */
+#define KEY_FOV_OK 2                           /* tan(elevation) in [tan_lo, tan_hi] (so not NaN) */
+#define KEY_DEN_OK 4                           /* 1 / ((|x|+|y|) * rxy) finite and > 0: t and d are defined */
 #define KEY_ALL 7
 
 typedef struct
@@ -375,8 +377,9 @@ static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *poin
     return filled;
 }
 
-lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj_buffers_t *buf, const float *points,
-                                      uint32_t n_points, uint32_t stride, const uint16_t *ring)
+lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj_buffers_t *buf,
+                                      const float *points, uint32_t n_points, uint32_t stride,
+                                      const uint16_t *ring)
 {
     uint32_t n, rows, cols, npix, pix;
     float min2, max2;
@@ -388,8 +391,7 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
         return LIDET_ERR_ARG;
     }
     compact = buf->x_m == 0;
-    if (buf->point_idx == 0 ||
-        (!compact && (buf->y_m == 0 || buf->z_m == 0 || buf->range_m == 0)) ||
+    if (buf->point_idx == 0 || (!compact && (buf->y_m == 0 || buf->z_m == 0 || buf->range_m == 0)) ||
         (compact && (buf->x_4mm == 0 || buf->y_4mm == 0 || buf->z_4mm == 0 || buf->range_4mm == 0)))
     {
         return LIDET_ERR_ARG;
@@ -443,8 +445,8 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
         const uint8_t *const ring_to_row = proj->ring_to_row;
         int32_t *const point_idx = buf->point_idx;
         int32_t *const point_pixel = buf->point_pixel; /* may be NULL: per-point outputs not wanted */
-        float *const best = buf->range_m;      /* float image: squared range of the winner */
-        uint16_t *const key_hi = buf->range_4mm; /* compact image: its bits, high and low halves */
+        float *const best = buf->range_m;              /* float image: squared range of the winner */
+        uint16_t *const key_hi = buf->range_4mm;       /* compact image: its bits, high and low halves */
         int16_t *const key_lo = buf->z_4mm;
         uint32_t base, projected = 0;
         key_block_t kb;
@@ -676,7 +678,8 @@ lidet_status_t lidet_proj_run(lidet_proj_t *proj, const float *points, uint32_t 
     return lidet_proj_run_buffers(&proj->state, &b, points, n_points, stride, ring);
 }
 
-void lidet_proj_image_of(const lidet_proj_state_t *st, const lidet_proj_buffers_t *buf, lidet_range_image_t *img)
+void lidet_proj_image_of(const lidet_proj_state_t *st, const lidet_proj_buffers_t *buf,
+                         lidet_range_image_t *img)
 {
     if (st == 0 || buf == 0 || img == 0)
     {

@@ -10,8 +10,8 @@
 
 #define MAX_R2_MM2 ((uint64_t)131000u * 131000u) /* the compact image's range limit, mm^2 */
 #define COORD_SPAN ((uint32_t)LIDET_Q_COORD_MAX_MM)
-#define BOUND_N_LIMIT (1u << 27)                 /* n < 2^27 (n * (x^2 + y^2) < 2^62) */
-#define EDGE_ONE (1u << 29)                      /* 1.0 of the column edges (Q29) */
+#define BOUND_N_LIMIT (1u << 27) /* n < 2^27 (n * (x^2 + y^2) < 2^62) */
+#define EDGE_ONE (1u << 29)      /* 1.0 of the column edges (Q29) */
 
 void lidet_proj_q_cfg_default(lidet_proj_q_cfg_t *cfg, const lidet_sensor_q_t *sensor)
 {
@@ -71,7 +71,8 @@ static inline int cmp_tan(int32_t z, uint64_t z2, uint64_t rxy2, const lidet_pro
         /* n rxy2 with rxy2 < 2^35 as n (low 32 bits) + (n (high bits)) 2^32 (n (high bits) < 2^30): a 32 x 32 -> 64
          * product and a 32-bit one, not a 64 x 64 one */
         const uint64_t lhs = z2 << b->q;
-        const uint64_t rhs = (uint64_t)b->n * (uint32_t)rxy2 + ((uint64_t)(b->n * (uint32_t)(rxy2 >> 32)) << 32);
+        const uint64_t rhs =
+            (uint64_t)b->n * (uint32_t)rxy2 + ((uint64_t)(b->n * (uint32_t)(rxy2 >> 32)) << 32);
         mag = (lhs > rhs) - (lhs < rhs);
     }
     return sz > 0 ? mag : -mag;
@@ -98,8 +99,9 @@ static int beam_above(const void *elev, uint32_t a, uint32_t b)
 
 static int32_t clamp_elev(int64_t urad)
 {
-    return urad > LIDET_Q_MAX_ELEV_URAD ? LIDET_Q_MAX_ELEV_URAD
-                                        : (urad < -LIDET_Q_MAX_ELEV_URAD ? -LIDET_Q_MAX_ELEV_URAD : (int32_t)urad);
+    return urad > LIDET_Q_MAX_ELEV_URAD
+               ? LIDET_Q_MAX_ELEV_URAD
+               : (urad < -LIDET_Q_MAX_ELEV_URAD ? -LIDET_Q_MAX_ELEV_URAD : (int32_t)urad);
 }
 
 /* Column edges: column c starts at u = c / cols of the turn (u = (pi - azimuth) / 2 pi); with 4u = quadrant + f,
@@ -268,16 +270,17 @@ static inline int16_t to_4mm(int32_t v)
     return (int16_t)((v + 2) >> 2);
 }
 
-lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf, const int32_t *points,
-                                uint32_t n_points, uint32_t stride, const uint16_t *ring)
+lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                                const int32_t *points, uint32_t n_points, uint32_t stride,
+                                const uint16_t *ring)
 {
     uint32_t n, i, rows, cols, npix, pix, row_guess = 0, col_guess = 0;
     uint64_t min2, max2;
     const uint32_t *edge;
     lidet_proj_stats_t sts;
 
-    if (st == 0 || buf == 0 || stride < 3 || (points == 0 && n_points > 0) || buf->x_4mm == 0 || buf->y_4mm == 0 ||
-        buf->z_4mm == 0 || buf->range_4mm == 0 || buf->point_idx == 0)
+    if (st == 0 || buf == 0 || stride < 3 || (points == 0 && n_points > 0) || buf->x_4mm == 0 ||
+        buf->y_4mm == 0 || buf->z_4mm == 0 || buf->range_4mm == 0 || buf->point_idx == 0)
     {
         return LIDET_ERR_ARG;
     }
@@ -295,7 +298,8 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     sts.n_truncated = n_points - n;
     min2 = (uint64_t)st->cfg.min_range_mm * (uint64_t)st->cfg.min_range_mm;
     min2 = min2 > 0u ? min2 : 1u; /* zero range is always too close */
-    max2 = st->cfg.max_range_mm > 0 ? (uint64_t)st->cfg.max_range_mm * (uint64_t)st->cfg.max_range_mm : MAX_R2_MM2;
+    max2 = st->cfg.max_range_mm > 0 ? (uint64_t)st->cfg.max_range_mm * (uint64_t)st->cfg.max_range_mm
+                                    : MAX_R2_MM2;
     max2 = max2 < MAX_R2_MM2 ? max2 : MAX_R2_MM2;
 
     /* pass 1, point by point: range, row, column, the closest point per pixel (key above, all ones = empty) */
@@ -383,7 +387,7 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
         {
             const uint64_t dn = (uint64_t)num << 29; /* D in Q29, times sum */
             const uint32_t num11 = num << 11;        /* num <= 4 sum < 2^20 */
-            int lo_ok, hi_ok; /* E[col] <= D, D < E[col + 1] */
+            int lo_ok, hi_ok;                        /* E[col] <= D, D < E[col + 1] */
             col = col_guess;
             lo_ok = edge_le(edge[col], sum, num11, dn);
             hi_ok = !edge_le(edge[col + 1u], sum, num11, dn);
@@ -393,7 +397,8 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
                 lo_ok = edge_le(edge[col], sum, num11, dn);
                 hi_ok = 1;
             }
-            else if (!hi_ok) /* one up: its lower edge is the old upper one (the sentinel stops it at cols - 1) */
+            else if (
+                !hi_ok) /* one up: its lower edge is the old upper one (the sentinel stops it at cols - 1) */
             {
                 ++col;
                 lo_ok = 1;
@@ -456,7 +461,8 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     return sts.n_truncated > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }
 
-void lidet_proj_q_image(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf, lidet_range_image_t *img)
+void lidet_proj_q_image(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                        lidet_range_image_t *img)
 {
     if (st == 0 || buf == 0 || img == 0)
     {

@@ -10,7 +10,6 @@
 #include "internal/lidet_proposal_rule.h"
 #include "lidet/lidet_cluster.h"
 
-
 void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg)
 {
     if (cfg == 0)
@@ -97,7 +96,8 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
     mz = rec->mean_m[2];
     for (i = 0; i < cfg->n_points; ++i)
     {
-        const int32_t p = c->members[rec->first_member + lidet__proposal_next_index(&state, i, rec->n_points, cfg->n_points)];
+        const int32_t p = c->members[rec->first_member +
+                                     lidet__proposal_next_index(&state, i, rec->n_points, cfg->n_points)];
         if (p < 0 || (uint32_t)p >= npix)
         {
             return LIDET_ERR_STATE; /* cannot happen after a run; guards a stale state */

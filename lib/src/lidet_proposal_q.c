@@ -48,7 +48,8 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
         return LIDET_ERR_ARG;
     }
     img = &c->img;
-    if (c->magic != LIDET_INIT_MAGIC || c->members == 0 || img->x_4mm == 0 || img->y_4mm == 0 || img->z_4mm == 0)
+    if (c->magic != LIDET_INIT_MAGIC || c->members == 0 || img->x_4mm == 0 || img->y_4mm == 0 ||
+        img->z_4mm == 0)
     {
         return LIDET_ERR_STATE;
     }
@@ -70,8 +71,8 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
     mz = rec->mean_4mm[2];
     for (i = 0; i < cfg->n_points; ++i)
     {
-        const int32_t p =
-            c->members[rec->first_member + lidet__proposal_next_index(&state, i, rec->n_points, cfg->n_points)];
+        const int32_t p = c->members[rec->first_member +
+                                     lidet__proposal_next_index(&state, i, rec->n_points, cfg->n_points)];
         if (p < 0 || (uint32_t)p >= npix)
         {
             return LIDET_ERR_STATE; /* cannot happen after a run; guards a stale state */
@@ -86,7 +87,8 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
     /* a mean lies within the int16 pixels it averages: the squares fit in 64 bits, the roots in int32 */
     rxy2 = (int64_t)mx * mx + (int64_t)my * my;
     out->voxel[0] = bin_q(lidet__q_atan2(my, mx), cfg->azimuth_bin_bam);
-    out->voxel[1] = bin_q(lidet__q_atan2(mz, (int32_t)lidet__q_sqrt_round64((uint64_t)rxy2)), cfg->elevation_bin_bam);
+    out->voxel[1] =
+        bin_q(lidet__q_atan2(mz, (int32_t)lidet__q_sqrt_round64((uint64_t)rxy2)), cfg->elevation_bin_bam);
     out->voxel[2] = bin_q(lidet__q_sqrt_round64((uint64_t)(rxy2 + (int64_t)mz * mz)), cfg->range_bin_4mm);
     out->n_points = cfg->n_points;
     out->n_points_src = rec->n_points;

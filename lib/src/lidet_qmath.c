@@ -51,7 +51,7 @@ uint32_t lidet__q_sqrt_round64(uint64_t v)
 /* sin of p in [0, 2^30] (a quarter turn, both ends included), Q30 */
 static int32_t quarter_sin(uint32_t p)
 {
-    uint32_t i = p >> 20;                /* 1024 steps of 2^20 */
+    uint32_t i = p >> 20; /* 1024 steps of 2^20 */
     int64_t frac = (int64_t)(p & 0xFFFFFu);
     int64_t s0 = lidet__q_sin_q30[i];
     if (i == LIDET_Q_SIN_STEPS)

@@ -32,8 +32,8 @@ static int refine_examined(const lidet_cluster_cfg_t *cfg, const lidet_cluster_r
 }
 
 /* the cell grows with the range of the box centre, max(|x|, |y|) + min(|x|, |y|) / 2 (no sqrt) */
-static int refine_grid(const lidet_cluster_cfg_t *cfg, const lidet_cluster_rec_t *rec, geom_t *g, uint32_t *nx,
-                       uint32_t *ny)
+static int refine_grid(const lidet_cluster_cfg_t *cfg, const lidet_cluster_rec_t *rec, geom_t *g,
+                       uint32_t *nx, uint32_t *ny)
 {
     const float ex = rec->max_m[0] - rec->min_m[0], ey = rec->max_m[1] - rec->min_m[1];
     float ax = 0.5f * (rec->min_m[0] + rec->max_m[0]), ay = 0.5f * (rec->min_m[1] + rec->max_m[1]), r;
@@ -58,7 +58,8 @@ static int refine_grid(const lidet_cluster_cfg_t *cfg, const lidet_cluster_rec_t
 
 /* cell of member pixel p: its x, y relative to the box corner, times the inverse cell, truncated and
  * clamped to the grid */
-static uint32_t refine_cell(const lidet_cluster_state_t *c, uint32_t p, const geom_t *g, uint32_t nx, uint32_t ny)
+static uint32_t refine_cell(const lidet_cluster_state_t *c, uint32_t p, const geom_t *g, uint32_t nx,
+                            uint32_t ny)
 {
     float x, y, z;
     uint32_t ix, iy;
@@ -75,8 +76,8 @@ static float refine_z(const lidet_cluster_state_t *c, uint32_t p)
     return lidet__img_z(&c->img, p);
 }
 
-static int refine_person(const lidet_cluster_cfg_t *cfg, const geom_t *g, uint32_t n, uint32_t sx, uint32_t sy,
-                         float zlo, float zhi, uint32_t ncols)
+static int refine_person(const lidet_cluster_cfg_t *cfg, const geom_t *g, uint32_t n, uint32_t sx,
+                         uint32_t sy, float zlo, float zhi, uint32_t ncols)
 {
     const float wx = (float)sx * g->cs, wy = (float)sy * g->cs, wz = zhi - zlo;
     (void)n;
@@ -99,14 +100,17 @@ static void refine_mean(lidet_cluster_state_t *c, uint32_t slot, const float sum
  * and it fits a car */
 static int refine_car_piece(const lidet_cluster_cfg_t *cfg, const lidet_cluster_rec_t *r)
 {
-    const float wx = r->max_m[0] - r->min_m[0], wy = r->max_m[1] - r->min_m[1], wz = r->max_m[2] - r->min_m[2];
-    const int upright = wx <= cfg->upright_max_width_m && wy <= cfg->upright_max_width_m && wz >= cfg->person_min_height_m;
+    const float wx = r->max_m[0] - r->min_m[0], wy = r->max_m[1] - r->min_m[1],
+                wz = r->max_m[2] - r->min_m[2];
+    const int upright =
+        wx <= cfg->upright_max_width_m && wy <= cfg->upright_max_width_m && wz >= cfg->person_min_height_m;
     return !upright && wz <= cfg->car_max_height_m && (wx > wy ? wx : wy) <= cfg->car_max_length_m &&
            (wx > wy ? wy : wx) <= cfg->car_max_width_m;
 }
 
 /* can cluster b join a (boxes): near enough, and the union fits a car */
-static int refine_joinable(const lidet_cluster_cfg_t *cfg, const lidet_cluster_rec_t *a, const lidet_cluster_rec_t *b)
+static int refine_joinable(const lidet_cluster_cfg_t *cfg, const lidet_cluster_rec_t *a,
+                           const lidet_cluster_rec_t *b)
 {
     float gx = b->min_m[0] - a->max_m[0], gy = b->min_m[1] - a->max_m[1], ux, uy, uz, lo, hi;
     const float g2 = cfg->join_gap_m * cfg->join_gap_m;
@@ -155,7 +159,8 @@ static void refine_join_mean(lidet_cluster_state_t *c, uint32_t i, uint32_t j, i
 #define REFINE_Z_FAR 3.0e38f
 #define REFINE_V_T float
 #define REFINE_S_T float
-#define REFINE_READ(c, p, v) lidet__img_xyz(&(c)->img, p, lidet__img_compact(&(c)->img), &(v)[0], &(v)[1], &(v)[2])
+#define REFINE_READ(c, p, v)                                                                                 \
+    lidet__img_xyz(&(c)->img, p, lidet__img_compact(&(c)->img), &(v)[0], &(v)[1], &(v)[2])
 #define REFINE_MIN(r) ((r)->min_m)
 #define REFINE_MAX(r) ((r)->max_m)
 #define REFINE_MEAN(r) ((r)->mean_m)

@@ -57,8 +57,8 @@ void lidet__sort_u32_u16(uint32_t *key, uint16_t *idx, uint32_t n)
     }
 }
 
-uint32_t lidet__nearest_first(uint32_t *key, uint16_t *idx, uint32_t n, uint32_t max, uint8_t *outcome, uint8_t code,
-                              uint32_t *n_over)
+uint32_t lidet__nearest_first(uint32_t *key, uint16_t *idx, uint32_t n, uint32_t max, uint8_t *outcome,
+                              uint8_t code, uint32_t *n_over)
 {
     uint32_t i;
     lidet__sort_u32_u16(key, idx, n);

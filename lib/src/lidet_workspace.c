@@ -63,8 +63,8 @@ static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
     img->row_elev_bam = ws->proj.row_elev_bam;
 }
 
-lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, uint32_t n_points, uint32_t stride,
-                                   const uint16_t *ring, int32_t *point_pixel)
+lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, uint32_t n_points,
+                                   uint32_t stride, const uint16_t *ring, int32_t *point_pixel)
 {
     return lidet_workspace_run_timed(ws, points, n_points, stride, ring, point_pixel, 0, 0, 0);
 }
@@ -129,8 +129,8 @@ lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *poi
         return st;
     }
     worst = st > worst ? st : worst;
-    st = lidet_cluster_run_buffers(&ws->cluster, ws->overlay.cluster.labels, ws->overlay.cluster.members, &img,
-                                   ws->ground_mask, ws->ground.planes, ws->ground.cfg.n_sectors);
+    st = lidet_cluster_run_buffers(&ws->cluster, ws->overlay.cluster.labels, ws->overlay.cluster.members,
+                                   &img, ws->ground_mask, ws->ground.planes, ws->ground.cfg.n_sectors);
     ticks[2] = tick(clock, clock_ctx) - t0;
     if (st < 0)
     {

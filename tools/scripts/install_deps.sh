@@ -10,6 +10,8 @@ PKGS="cmake make gcc g++ libeigen3-dev python3 python3-venv ca-certificates"
 # libFuzzer harnesses (tests/fuzz, make test-fuzz / make fuzz): clang with its compiler-rt (libFuzzer, ASan,
 # UBSan runtimes); the host CLI's PNG output: libpng (ports/host/lidet_png.c)
 PKGS="$PKGS clang libclang-rt-dev libpng-dev"
+# the formatting check of lib/ (ctest clang_format, .clang-format)
+PKGS="$PKGS clang-format"
 # Firmware images under QEMU (issue 17, tests/firmware.cmake): Arm and RISC-V cross compilers with their C
 # libraries, and the two QEMU system emulators. ~1 min to install on a Debian 12 CI runner once the package
 # lists are fresh (docs/BENCHMARKS.md). LIDET_NO_FIRMWARE=1 leaves them out; the firmware tests then skip.

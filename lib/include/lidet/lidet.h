@@ -18,20 +18,20 @@
 #define LIDET_VERSION_PATCH 0
 #define LIDET_VERSION_STRING "0.1.0"
 
-#include "lidet_opt.h"
-#include "lidet_types.h"
-#include "lidet_q.h"
-#include "lidet_sensor.h"
-#include "lidet_proj.h"
-#include "lidet_sensor_q.h"
-#include "lidet_proj_q.h"
-#include "lidet_ground.h"
-#include "lidet_ground_q.h"
 #include "lidet_cluster.h"
 #include "lidet_cluster_q.h"
+#include "lidet_detector.h"
+#include "lidet_ground.h"
+#include "lidet_ground_q.h"
+#include "lidet_opt.h"
 #include "lidet_pointnet.h"
 #include "lidet_pointnet_q.h"
-#include "lidet_detector.h"
+#include "lidet_proj.h"
+#include "lidet_proj_q.h"
+#include "lidet_q.h"
+#include "lidet_sensor.h"
+#include "lidet_sensor_q.h"
+#include "lidet_types.h"
 
 #ifdef __cplusplus
 extern "C" {

@@ -116,12 +116,12 @@ extern "C" {
 /** @brief Runtime configuration of the clustering. Fill with lidet_cluster_cfg_default(). */
 typedef struct
 {
-    float theta_rad;         /**< join when beta > theta; (0, pi/2). Defaults per profile (measured with
+    float theta_rad;           /**< join when beta > theta; (0, pi/2). Defaults per profile (measured with
                                   the gap bound below, docs/BENCHMARKS.md): > 16 beams (hdl64, vlp32c,
                                   os1) 0.18 rad, <= 16 beams (vlp16) 0.12 rad (without the gap bound
                                   0.35 / 0.30 were best: smaller angles merged parked cars); the
                                   authors used 0.4 / 0.15 */
-    uint32_t max_steps;      /**< hole bridging: search up to this many pixels away in each direction
+    uint32_t max_steps;        /**< hole bridging: search up to this many pixels away in each direction
                                   (1 = direct neighbours only); [1, LIDET_CLUSTER_MAX_STEPS]; default 5
                                   (> 16 beams), 4 (<= 16 beams: 5 with occluder bridging recovered a
                                   few more cars but fell below 100x the speed of DBSCAN); the authors
@@ -131,69 +131,69 @@ typedef struct
                                   object), so objects seen through occluders stay whole; 0: stop at
                                   the first candidate (the authors' variant). Default 1 for > 16 beams,
                                   0 for <= 16 beams (measured; speed) */
-    uint32_t diagonals;      /**< 1 (default, measured): also test the 4 diagonal neighbours
+    uint32_t diagonals;        /**< 1 (default, measured): also test the 4 diagonal neighbours
                                   (8-neighbourhood; no bridging on them); 0: the 4-neighbourhood of
                                   the paper and of depth_clustering */
-    float max_gap_m;         /**< 0: the angle test alone; > 0: neighbours also need a distance along
+    float max_gap_m;           /**< 0: the angle test alone; > 0: neighbours also need a distance along
                                   their beams <= max_gap_m + max_gap_per_m * (nearer range) to join.
                                   Default 0.7 m (measured: simulated hdl64 cars within 40 m 79 -> 87 %,
                                   vlp16 58 -> 77 %, real 81 -> 89 %, under-segmented real cars 14 -> 6 %,
                                   with the angles above; docs/BENCHMARKS.md) */
-    float max_gap_per_m;     /**< growth of the gap bound per metre of the nearer range; >= 0; default
+    float max_gap_per_m;       /**< growth of the gap bound per metre of the nearer range; >= 0; default
                                   0.025 (> 16 beams), 0.04 (<= 16 beams): 1.45 m / 2.3 m at 30 m
                                   (measured with max_gap_m; a fixed bound of 1 m split far simulated
                                   cars, 71-81 % at 0.15-0.35 rad; 1.5 m merged real parked cars) */
-    uint32_t min_points;     /**< drop clusters with fewer pixels; >= 1, default 10 */
-    float max_extent_m;      /**< drop clusters wider than this in x, y or z; > 0, default 6 m */
-    float max_mean_height_m; /**< drop clusters whose mean lies higher above the ground plane; default
+    uint32_t min_points;       /**< drop clusters with fewer pixels; >= 1, default 10 */
+    float max_extent_m;        /**< drop clusters wider than this in x, y or z; > 0, default 6 m */
+    float max_mean_height_m;   /**< drop clusters whose mean lies higher above the ground plane; default
                                   2.5 m; a huge value (e.g. 1e30) disables the filter */
-    float mount_height_m;    /**< sensor height above a flat ground, used when no planes are given
+    float mount_height_m;      /**< sensor height above a flat ground, used when no planes are given
                                   (copied from the sensor profile); >= 0 */
-    float rescue_gap_m;      /**< fragment rescue (file comment): 0 disables it; > 0: fragments below
+    float rescue_gap_m;        /**< fragment rescue (file comment): 0 disables it; > 0: fragments below
                                   min_points join each other and the nearest kept cluster within
                                   rescue_gap_m + rescue_gap_per_m * (nearer range). Default 0.8 m */
-    float rescue_gap_per_m;  /**< growth of the rescue distance per metre of range; >= 0; default 0.03 */
-    uint32_t rescue_rows;    /**< rescue window: rows looked at above and below a fragment pixel;
+    float rescue_gap_per_m;    /**< growth of the rescue distance per metre of range; >= 0; default 0.03 */
+    uint32_t rescue_rows;      /**< rescue window: rows looked at above and below a fragment pixel;
                                   <= LIDET_MAX_ROWS; default 1 (<= 16 beams), 2 (> 16 beams) */
-    uint32_t rescue_cols;    /**< columns looked at left and right (wrapping; at most (n_cols - 1) / 2
+    uint32_t rescue_cols;      /**< columns looked at left and right (wrapping; at most (n_cols - 1) / 2
                                   are used); <= 15; default 6 */
     /* proposal refinement after the clustering (lib/src/lidet_refine.c, issue 15) */
-    uint32_t split_people;   /**< 1 (default): a cluster wider than split_min_width_m is cut into its
+    uint32_t split_people;    /**< 1 (default): a cluster wider than split_min_width_m is cut into its
                                   connected parts on a finer bird's-eye-view grid, and every part that
                                   is person-sized becomes a cluster of its own (people in groups, a
                                   person beside a car, a pole or a wall); 0: off */
-    float split_min_width_m; /**< clusters whose x or y extent exceeds this are examined; > 0; default 0.9 */
-    float split_cell_m;      /**< cell of the finer grid at range 0; > 0; default 0.12 m */
-    float split_cell_per_m;  /**< its growth per metre of range (range of the cluster's box centre,
+    float split_min_width_m;  /**< clusters whose x or y extent exceeds this are examined; > 0; default 0.9 */
+    float split_cell_m;       /**< cell of the finer grid at range 0; > 0; default 0.12 m */
+    float split_cell_per_m;   /**< its growth per metre of range (range of the cluster's box centre,
                                   max(|x|,|y|) + min(|x|,|y|) / 2); >= 0; default 0 (measured: a
                                   growth of 0.002-0.008 m/m recovered fewer people in crowds) */
     float person_max_width_m; /**< a part is person-sized when its cells span at most this in x and in
                                   y; > 0; default 1.0 m */
-    float person_min_height_m; /**< ... its points at least this in z; >= 0; default 0.9 m */
-    float person_min_aspect; /**< ... and at least this times its wider cell span in z (people are
+    float person_min_height_m;    /**< ... its points at least this in z; >= 0; default 0.9 m */
+    float person_min_aspect;      /**< ... and at least this times its wider cell span in z (people are
                                   slender; the end of a car cut off by dropouts is not); >= 0; default 1.8
                                   (measured: 0 cut simulated cars, 1.8 none more than without the
                                   refinement) */
-    uint32_t person_min_cols; /**< ... and its pixels span at least this many image columns (a slice of a
+    uint32_t person_min_cols;     /**< ... and its pixels span at least this many image columns (a slice of a
                                   car's flank or a wall seen at a grazing angle, one column per cell, is
                                   not a person); default 3 */
-    uint32_t join_cars;      /**< 1 (default): after the cuts, two clusters whose boxes lie within
+    uint32_t join_cars;           /**< 1 (default): after the cuts, two clusters whose boxes lie within
                                   join_gap_m of each other in x-y and whose union fits a car (x-y
                                   spans at most car_max_length_m and car_max_width_m, z span at most
                                   car_max_height_m), neither upright, become one (a car cut by dark
                                   paint, glass or wheel dropouts); 0: off */
-    float join_gap_m;        /**< >= 0; default 0.5 m (measured: 0.8 joined a cyclist to a car) */
-    float car_max_length_m;  /**< > 0; default 5.2 m */
-    float car_max_width_m;   /**< > 0; default 2.2 m (measured: 2.3-2.4 joined neighbouring real parked
+    float join_gap_m;             /**< >= 0; default 0.5 m (measured: 0.8 joined a cyclist to a car) */
+    float car_max_length_m;       /**< > 0; default 5.2 m */
+    float car_max_width_m;        /**< > 0; default 2.2 m (measured: 2.3-2.4 joined neighbouring real parked
                                   cars, real SemanticKITTI cars within 40 m 94 -> 89 %) */
-    float car_max_height_m;  /**< > 0; default 2.0 m */
-    float car_min_length_m;  /**< ... and the union's longer x-y side at least this (two people or a
+    float car_max_height_m;       /**< > 0; default 2.0 m */
+    float car_min_length_m;       /**< ... and the union's longer x-y side at least this (two people or a
                                   person and a bin seen by a few rings do not make a car); >= 0;
                                   default 2.5 m */
-    float upright_max_width_m; /**< a cluster spanning at most this in x and in y and at least
+    float upright_max_width_m;    /**< a cluster spanning at most this in x and in y and at least
                                   person_min_height_m in z is upright (a person, a cyclist, a pole)
                                   and joins nothing; >= 0; default 1.3 m */
-    uint32_t max_join_pieces; /**< join budget (bounds the joins' time whatever the scan): only the first
+    uint32_t max_join_pieces;     /**< join budget (bounds the joins' time whatever the scan): only the first
                                   max_join_pieces car pieces in slot order take part in the joins, the rest
                                   join nothing (stats n_join_skipped); the joins then test at most
                                   max_join_pieces x LIDET_MAX_CLUSTERS pairs instead of
@@ -201,7 +201,7 @@ typedef struct
                                   pieces measured on real scans (KITTI 25-113, 3 frames; SemanticKITTI
                                   43-61, 5; simulated HDL-64 39-101, 5); a VLP-16 scan of 2,400 tiny
                                   clusters: 1.9 -> 0.8 ms of clustering (docs/ROBUSTNESS.md) */
-    float max_bridge_per_pixel; /**< occluder bridging budget (bounds the first fill's time whatever the
+    float max_bridge_per_pixel;   /**< occluder bridging budget (bounds the first fill's time whatever the
                                   scan): the run steps over at most about this many nearer candidates per
                                   candidate pixel in all (a pixel's searches bridge only while the run's
                                   count is below max_bridge_per_pixel * n_candidates; then they stop at the
@@ -228,34 +228,34 @@ typedef struct
     float mean_m[3];       /**< mean of the member pixels' points (x, y, z) */
     float min_m[3];        /**< axis-aligned bounds */
     float max_m[3];
-    float height_m;        /**< mean's signed height above the ground plane used by the filter */
+    float height_m; /**< mean's signed height above the ground plane used by the filter */
 } lidet_cluster_rec_t;
 
 /** @brief Counts of the last run (each dropped cluster is counted once, by the first filter it fails). */
 typedef struct
 {
-    uint32_t n_candidates;        /**< non-ground pixels holding a point */
-    uint32_t n_found;             /**< connected components of the first flood fill (before any filter) */
-    uint32_t n_fragments;         /**< of them, below min_points and handed to the rescue (0 when it is off) */
-    uint32_t n_rescue_joined;     /**< rescue groups that joined a kept cluster */
-    uint32_t n_rescue_pixels;     /**< fragment pixels the rescue put into kept clusters (joined or new) */
-    uint32_t n_dropped_small;     /**< fewer than min_points pixels: components of the first fill when
+    uint32_t n_candidates;       /**< non-ground pixels holding a point */
+    uint32_t n_found;            /**< connected components of the first flood fill (before any filter) */
+    uint32_t n_fragments;        /**< of them, below min_points and handed to the rescue (0 when it is off) */
+    uint32_t n_rescue_joined;    /**< rescue groups that joined a kept cluster */
+    uint32_t n_rescue_pixels;    /**< fragment pixels the rescue put into kept clusters (joined or new) */
+    uint32_t n_dropped_small;    /**< fewer than min_points pixels: components of the first fill when
                                        the rescue is off; rescue groups that joined nothing when it is on */
-    uint32_t n_dropped_extent;    /**< extent above max_extent_m */
-    uint32_t n_dropped_height;    /**< mean height above max_mean_height_m */
-    uint32_t n_dropped_capacity;  /**< passed the filters but dropped for LIDET_MAX_CLUSTERS (rescue
+    uint32_t n_dropped_extent;   /**< extent above max_extent_m */
+    uint32_t n_dropped_height;   /**< mean height above max_mean_height_m */
+    uint32_t n_dropped_capacity; /**< passed the filters but dropped for LIDET_MAX_CLUSTERS (rescue
                                        groups included) */
-    uint32_t n_kept;              /**< clusters in the output */
-    uint32_t n_pixels_kept;       /**< pixels labelled with a kept cluster */
-    uint32_t n_queue_overflow;    /**< always 0: the queue holds every pixel (kept for the record) */
-    uint32_t n_split;             /**< refinement: clusters cut into parts */
-    uint32_t n_split_parts;       /**< refinement: new clusters the cuts made */
-    uint32_t n_split_skipped;     /**< refinement: clusters examined but too large for the grid caps */
-    uint32_t n_joined;            /**< refinement: clusters joined into another (car fragments) */
-    uint32_t n_join_skipped;      /**< refinement: car pieces past max_join_pieces (joined nothing) */
-    uint32_t n_fragment_pixels;   /**< pixels of the fragments handed to the rescue */
+    uint32_t n_kept;             /**< clusters in the output */
+    uint32_t n_pixels_kept;      /**< pixels labelled with a kept cluster */
+    uint32_t n_queue_overflow;   /**< always 0: the queue holds every pixel (kept for the record) */
+    uint32_t n_split;            /**< refinement: clusters cut into parts */
+    uint32_t n_split_parts;      /**< refinement: new clusters the cuts made */
+    uint32_t n_split_skipped;    /**< refinement: clusters examined but too large for the grid caps */
+    uint32_t n_joined;           /**< refinement: clusters joined into another (car fragments) */
+    uint32_t n_join_skipped;     /**< refinement: car pieces past max_join_pieces (joined nothing) */
+    uint32_t n_fragment_pixels;  /**< pixels of the fragments handed to the rescue */
     uint32_t n_dropped_fragment_budget; /**< fragments dropped past max_fragment_pixels */
-    uint32_t n_bridge_steps;      /**< nearer candidates stepped over (occluder bridging) */
+    uint32_t n_bridge_steps;            /**< nearer candidates stepped over (occluder bridging) */
 } lidet_cluster_stats_t;
 
 /**
@@ -273,28 +273,28 @@ typedef struct
     uint16_t geo_rows, geo_cols;
     float geo_elev[LIDET_MAX_ROWS];
     float col_sin[LIDET_CLUSTER_MAX_STEPS], col_cos[LIDET_CLUSTER_MAX_STEPS]; /* alpha = k 2pi/cols */
-    float row_sin[LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS];  /* [r * STEPS + k - 1]: rows r, r + k */
+    float row_sin[LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS]; /* [r * STEPS + k - 1]: rows r, r + k */
     float row_cos[LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS];
     float diag_sin[LIDET_MAX_ROWS], diag_cos[LIDET_MAX_ROWS]; /* [r]: rows r, r + 1, one column apart */
     /* outputs of the last run */
     lidet_cluster_rec_t recs[LIDET_MAX_CLUSTERS];
-    uint16_t order[LIDET_MAX_CLUSTERS];                  /* scratch: slots in seed order; during the
+    uint16_t order[LIDET_MAX_CLUSTERS];       /* scratch: slots in seed order; during the
                                                             refinement 1 = a slot the cuts made or cut */
-    uint16_t slot_id[LIDET_MAX_CLUSTERS + 1];            /* scratch: slot + 1 -> canonical id */
-    lidet_range_image_t img;                             /* the image of the last run (a view) */
-    uint16_t *labels;                                    /* the last run's per-pixel ids (its buffer) */
-    int32_t *members;                                    /* the last run's member pixels (its buffer) */
+    uint16_t slot_id[LIDET_MAX_CLUSTERS + 1]; /* scratch: slot + 1 -> canonical id */
+    lidet_range_image_t img;                  /* the image of the last run (a view) */
+    uint16_t *labels;                         /* the last run's per-pixel ids (its buffer) */
+    int32_t *members;                         /* the last run's member pixels (its buffer) */
     uint32_t n_recs;
     lidet_cluster_stats_t stats;
     /* scratch of the refinement (lidet_refine.c) */
-    uint16_t rf_grid[LIDET_REFINE_MAX_CELLS];            /* cell -> part + 1 (0 = empty, 0xFFFF = occupied) */
-    uint16_t rf_queue[LIDET_REFINE_MAX_CELLS];           /* cells of the part being filled */
-    uint16_t rf_cell[LIDET_REFINE_MAX_POINTS];           /* cell of each member of the examined cluster */
-    uint16_t rf_target[LIDET_REFINE_MAX_PARTS];          /* part -> slot it goes to */
-    uint32_t rf_n[LIDET_REFINE_MAX_PARTS];               /* points per part */
-    uint16_t rf_box[LIDET_REFINE_MAX_PARTS][4];          /* cell bounds: ix0, ix1, iy0, iy1 */
-    float rf_z[LIDET_REFINE_MAX_PARTS][2];               /* z bounds of its points */
-    uint16_t rf_col[LIDET_REFINE_MAX_PARTS][2];          /* image column bounds of its pixels */
+    uint16_t rf_grid[LIDET_REFINE_MAX_CELLS];   /* cell -> part + 1 (0 = empty, 0xFFFF = occupied) */
+    uint16_t rf_queue[LIDET_REFINE_MAX_CELLS];  /* cells of the part being filled */
+    uint16_t rf_cell[LIDET_REFINE_MAX_POINTS];  /* cell of each member of the examined cluster */
+    uint16_t rf_target[LIDET_REFINE_MAX_PARTS]; /* part -> slot it goes to */
+    uint32_t rf_n[LIDET_REFINE_MAX_PARTS];      /* points per part */
+    uint16_t rf_box[LIDET_REFINE_MAX_PARTS][4]; /* cell bounds: ix0, ix1, iy0, iy1 */
+    float rf_z[LIDET_REFINE_MAX_PARTS][2];      /* z bounds of its points */
+    uint16_t rf_col[LIDET_REFINE_MAX_PARTS][2]; /* image column bounds of its pixels */
 } lidet_cluster_state_t;
 
 /** @brief Clustering with every buffer inside (the standalone form): the state plus its per-pixel
@@ -302,8 +302,8 @@ typedef struct
 typedef struct
 {
     lidet_cluster_state_t state;
-    uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];    /* per pixel, canonical id, 0 = none */
-    int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];    /* member pixels, cluster after cluster */
+    uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS]; /* per pixel, canonical id, 0 = none */
+    int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS]; /* member pixels, cluster after cluster */
 } lidet_cluster_t;
 
 /**
@@ -404,10 +404,10 @@ uint32_t lidet_cluster_state_bytes(void);
 /** @brief How proposals are built. Fill with lidet_proposal_cfg_default(). */
 typedef struct
 {
-    uint32_t n_points;       /**< points per proposal, [1, LIDET_PROPOSAL_POINTS]; default 64 (or the
+    uint32_t n_points;     /**< points per proposal, [1, LIDET_PROPOSAL_POINTS]; default 64 (or the
                                   capacity when smaller) */
-    uint32_t seed;           /**< resampling seed; default 0x5EED1234 */
-    float azimuth_bin_rad;   /**< voxel sizes (> 0); defaults 10 deg, 10 deg, 1 m (the paper) */
+    uint32_t seed;         /**< resampling seed; default 0x5EED1234 */
+    float azimuth_bin_rad; /**< voxel sizes (> 0); defaults 10 deg, 10 deg, 1 m (the paper) */
     float elevation_bin_rad;
     float range_bin_m;
 } lidet_proposal_cfg_t;

@@ -61,44 +61,45 @@ extern "C" {
  *         (lidet_cluster_q_cfg_default) are the float defaults rounded. */
 typedef struct
 {
-    uint32_t theta_urad;           /**< theta, microradians, (0, 1500000); default 180000 (> 16 beams), 120000 */
-    uint32_t max_steps;            /**< [1, LIDET_CLUSTER_MAX_STEPS]; default 5 (> 16 beams), 4 */
-    uint32_t bridge_occluders;     /**< 0/1; default 1 (> 16 beams), 0 */
-    uint32_t diagonals;            /**< 0/1; default 1 */
-    uint32_t max_gap_mm;           /**< 0: angle test alone; <= 1000000; default 700 */
-    uint32_t max_gap_per_m_q16;    /**< growth per metre of range (Q16 ratio), <= 65536; default 1638 (0.025,
+    uint32_t theta_urad;        /**< theta, microradians, (0, 1500000); default 180000 (> 16 beams), 120000 */
+    uint32_t max_steps;         /**< [1, LIDET_CLUSTER_MAX_STEPS]; default 5 (> 16 beams), 4 */
+    uint32_t bridge_occluders;  /**< 0/1; default 1 (> 16 beams), 0 */
+    uint32_t diagonals;         /**< 0/1; default 1 */
+    uint32_t max_gap_mm;        /**< 0: angle test alone; <= 1000000; default 700 */
+    uint32_t max_gap_per_m_q16; /**< growth per metre of range (Q16 ratio), <= 65536; default 1638 (0.025,
                                         > 16 beams), 2621 (0.04) */
-    uint32_t min_points;           /**< >= 1; default 10 */
-    uint32_t max_extent_mm;        /**< (0, 1000000]; default 6000 */
-    int32_t max_mean_height_mm;    /**< default 2500; INT32_MAX disables the filter */
-    uint32_t mount_height_mm;      /**< flat ground at -mount when no planes; <= 100000 */
-    uint32_t rescue_gap_mm;        /**< 0 disables the rescue; <= 10000; default 800 */
+    uint32_t min_points;        /**< >= 1; default 10 */
+    uint32_t max_extent_mm;     /**< (0, 1000000]; default 6000 */
+    int32_t max_mean_height_mm; /**< default 2500; INT32_MAX disables the filter */
+    uint32_t mount_height_mm;   /**< flat ground at -mount when no planes; <= 100000 */
+    uint32_t rescue_gap_mm;     /**< 0 disables the rescue; <= 10000; default 800 */
     uint32_t rescue_gap_per_m_q16; /**< <= 16384 (0.25 per metre); default 1966 (0.03) */
     uint32_t rescue_rows;          /**< <= LIDET_MAX_ROWS; default 1 (<= 16 beams), 2 */
     uint32_t rescue_cols;          /**< <= 15; default 6 */
     /* worst-case bounds (issue 19): lidet_cluster_cfg_t's, same semantics */
-    uint32_t max_fragment_pixels;  /**< rescue budget in fragment pixels (0 = none); default 4096 (> 16 beams),
+    uint32_t max_fragment_pixels; /**< rescue budget in fragment pixels (0 = none); default 4096 (> 16 beams),
                                         2048 */
-    uint32_t max_bridge_per_pixel_q16; /**< occluder bridging budget per candidate pixel, Q16, <= 64 << 16 (0 =
+    uint32_t
+        max_bridge_per_pixel_q16; /**< occluder bridging budget per candidate pixel, Q16, <= 64 << 16 (0 =
                                         none); the run bridges while its count is below
                                         (this * candidates) >> 16; default 131072 (2.0) */
     /* the proposal refinement (lidet_refine.c's rules in integer units; lidet_cluster_cfg_t's defaults rounded) */
-    uint32_t split_people;         /**< 0/1; default 1 */
-    uint32_t split_min_width_mm;   /**< (0, 1000000]; default 900 */
-    uint32_t split_cell_mm;        /**< (0, 100000]; default 120 */
-    uint32_t split_cell_per_m_q16; /**< <= 65536; default 0 */
-    uint32_t person_max_width_mm;  /**< (0, 1000000]; default 1000 */
-    uint32_t person_min_height_mm; /**< <= 1000000; default 900 */
+    uint32_t split_people;          /**< 0/1; default 1 */
+    uint32_t split_min_width_mm;    /**< (0, 1000000]; default 900 */
+    uint32_t split_cell_mm;         /**< (0, 100000]; default 120 */
+    uint32_t split_cell_per_m_q16;  /**< <= 65536; default 0 */
+    uint32_t person_max_width_mm;   /**< (0, 1000000]; default 1000 */
+    uint32_t person_min_height_mm;  /**< <= 1000000; default 900 */
     uint32_t person_min_aspect_q16; /**< <= 100 << 16; default 117965 (1.8) */
-    uint32_t person_min_cols;      /**< default 3 */
-    uint32_t join_cars;            /**< 0/1; default 1 */
-    uint32_t join_gap_mm;          /**< <= 1000000; default 500 */
-    uint32_t car_max_length_mm;    /**< (0, 1000000]; default 5200 */
-    uint32_t car_max_width_mm;     /**< (0, 1000000]; default 2200 */
-    uint32_t car_max_height_mm;    /**< (0, 1000000]; default 2000 */
-    uint32_t car_min_length_mm;    /**< <= 1000000; default 2500 */
-    uint32_t upright_max_width_mm; /**< <= 1000000; default 1300 */
-    uint32_t max_join_pieces;      /**< join budget as lidet_cluster_cfg_t's; 0 = no limit; default 256 */
+    uint32_t person_min_cols;       /**< default 3 */
+    uint32_t join_cars;             /**< 0/1; default 1 */
+    uint32_t join_gap_mm;           /**< <= 1000000; default 500 */
+    uint32_t car_max_length_mm;     /**< (0, 1000000]; default 5200 */
+    uint32_t car_max_width_mm;      /**< (0, 1000000]; default 2200 */
+    uint32_t car_max_height_mm;     /**< (0, 1000000]; default 2000 */
+    uint32_t car_min_length_mm;     /**< <= 1000000; default 2500 */
+    uint32_t upright_max_width_mm;  /**< <= 1000000; default 1300 */
+    uint32_t max_join_pieces;       /**< join budget as lidet_cluster_cfg_t's; 0 = no limit; default 256 */
 } lidet_cluster_q_cfg_t;
 
 /** @brief One kept cluster, 4 mm steps. */
@@ -111,7 +112,7 @@ typedef struct
     int32_t mean_4mm[3];   /**< mean of the members, rounded half away from zero */
     int32_t min_4mm[3];    /**< axis-aligned bounds */
     int32_t max_4mm[3];
-    int32_t height_4mm;    /**< the mean's height above the ground plane used by the filter */
+    int32_t height_4mm; /**< the mean's height above the ground plane used by the filter */
 } lidet_cluster_q_rec_t;
 
 /** @brief State of the integer clustering (configuration, tables, records of the last run). */
@@ -187,8 +188,9 @@ lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *st, uint16_t
                                            const lidet_plane_q_t *planes, uint32_t n_sectors);
 
 /** @brief lidet_cluster_q_run_buffers on the standalone form's buffers. */
-lidet_status_t lidet_cluster_q_run(lidet_cluster_q_t *c, const lidet_range_image_t *img, const uint8_t *ground_mask,
-                                   const lidet_plane_q_t *planes, uint32_t n_sectors);
+lidet_status_t lidet_cluster_q_run(lidet_cluster_q_t *c, const lidet_range_image_t *img,
+                                   const uint8_t *ground_mask, const lidet_plane_q_t *planes,
+                                   uint32_t n_sectors);
 
 /** @brief Cluster id of every input point (point_pixel -1 or outside the image -> 0); as
  *         lidet_cluster_point_labels. @return LIDET_OK; LIDET_ERR_ARG; LIDET_ERR_STATE (never run). */

@@ -72,58 +72,58 @@ typedef enum
 /** @brief Configuration. Fill with lidet_detector_cfg_default(). */
 typedef struct
 {
-    lidet_workspace_cfg_t stages;   /**< projection, ground, clustering */
-    lidet_proposal_cfg_t proposal;  /**< n_points is set from the models by init; seed and PVLE bins used */
-    float crop_half_rad;            /**< 0: 360 degrees; else keep clusters with |azimuth| <= this (KITTI
+    lidet_workspace_cfg_t stages;  /**< projection, ground, clustering */
+    lidet_proposal_cfg_t proposal; /**< n_points is set from the models by init; seed and PVLE bins used */
+    float crop_half_rad;           /**< 0: 360 degrees; else keep clusters with |azimuth| <= this (KITTI
                                          camera field of view: pi/4); (0, pi] */
-    float max_range_m;              /**< clusters whose mean is farther are not classified; 0 = no limit */
-    uint32_t max_proposals;         /**< at most this many clusters classified per scan, nearest first;
+    float max_range_m;             /**< clusters whose mean is farther are not classified; 0 = no limit */
+    uint32_t max_proposals;        /**< at most this many clusters classified per scan, nearest first;
                                          [1, LIDET_MAX_CLUSTERS]; default 256 (> 16 beams), 128 (<= 16 beams),
                                          capped by LIDET_MAX_CLUSTERS */
-    uint32_t max_boxes;             /**< at most this many proposals through the box net per scan (those passing
+    uint32_t max_boxes; /**< at most this many proposals through the box net per scan (those passing
                                          gate 1, nearest first); the rest get outcome LIDET_DET_OUT_BUDGET
                                          (stats n_over_box_budget, status LIDET_TRUNCATED): bounds the box
                                          net's time whatever the scan. [1, LIDET_MAX_CLUSTERS]; default 48 (> 16
                                          beams), 24 (<= 16 beams): > 2x the most gate-1 passes seen on a real
                                          scan (21, docs/ROBUSTNESS.md) */
-    uint8_t gate1;                  /**< 1 (default): drop proposals failing gate 1 */
-    uint8_t gate2;                  /**< 1 (default): drop boxes failing gate 2 */
-    float nms_iou;                  /**< BEV IoU above which the lower-scored detection is dropped; [0, 1],
+    uint8_t gate1;      /**< 1 (default): drop proposals failing gate 1 */
+    uint8_t gate2;      /**< 1 (default): drop boxes failing gate 2 */
+    float nms_iou;      /**< BEV IoU above which the lower-scored detection is dropped; [0, 1],
                                          default 0.1 (detections come from disjoint clusters) */
     float size_min_m[LIDET_N_CLASSES][3]; /**< plausible l, w, h per class (lidet_class_t order) */
     float size_max_m[LIDET_N_CLASSES][3];
-    lidet_clock_fn clock;           /**< optional timestamp source for stats.ticks (NULL: no timing) */
-    void *clock_ctx;                /**< passed to clock */
+    lidet_clock_fn clock; /**< optional timestamp source for stats.ticks (NULL: no timing) */
+    void *clock_ctx;      /**< passed to clock */
 } lidet_detector_cfg_t;
 
 /** @brief One detection (sensor frame). */
 typedef struct
 {
-    lidet_box_t box;      /**< centre, l w h, yaw */
-    uint8_t cls;          /**< lidet_class_t */
-    float score;          /**< (0, 1), see the file comment */
-    float energy_cls;     /**< classifier energy (gate 1) */
-    float energy_box;     /**< box net energy, heading + size (gate 2) */
-    uint32_t cluster_id;  /**< 1-based id of its cluster in the last run (lidet_workspace_labels) */
-    uint32_t n_points;    /**< member pixels of that cluster */
+    lidet_box_t box;     /**< centre, l w h, yaw */
+    uint8_t cls;         /**< lidet_class_t */
+    float score;         /**< (0, 1), see the file comment */
+    float energy_cls;    /**< classifier energy (gate 1) */
+    float energy_box;    /**< box net energy, heading + size (gate 2) */
+    uint32_t cluster_id; /**< 1-based id of its cluster in the last run (lidet_workspace_labels) */
+    uint32_t n_points;   /**< member pixels of that cluster */
 } lidet_detection_t;
 
 /** @brief Counts of the last run. */
 typedef struct
 {
-    uint32_t n_clusters;       /**< kept clusters */
-    uint32_t n_out_of_crop;    /**< outside the azimuth window */
-    uint32_t n_out_of_range;   /**< beyond max_range_m */
-    uint32_t n_over_budget;    /**< past max_proposals (farthest first) */
-    uint32_t n_classified;     /**< proposals through the classifier */
-    uint32_t n_gate1_rejected; /**< failed gate 1 */
-    uint32_t n_boxed;          /**< proposals through the box net */
-    uint32_t n_gate2_rejected; /**< failed gate 2 */
-    uint32_t n_size_rejected;  /**< boxes of impossible size */
-    uint32_t n_nms_suppressed; /**< dropped by the NMS */
-    uint32_t n_over_capacity;  /**< detections past LIDET_MAX_DETECTIONS (lowest scores) */
-    uint32_t n_detections;     /**< in the output */
-    uint32_t n_over_box_budget; /**< passed gate 1 past max_boxes (not boxed) */
+    uint32_t n_clusters;                /**< kept clusters */
+    uint32_t n_out_of_crop;             /**< outside the azimuth window */
+    uint32_t n_out_of_range;            /**< beyond max_range_m */
+    uint32_t n_over_budget;             /**< past max_proposals (farthest first) */
+    uint32_t n_classified;              /**< proposals through the classifier */
+    uint32_t n_gate1_rejected;          /**< failed gate 1 */
+    uint32_t n_boxed;                   /**< proposals through the box net */
+    uint32_t n_gate2_rejected;          /**< failed gate 2 */
+    uint32_t n_size_rejected;           /**< boxes of impossible size */
+    uint32_t n_nms_suppressed;          /**< dropped by the NMS */
+    uint32_t n_over_capacity;           /**< detections past LIDET_MAX_DETECTIONS (lowest scores) */
+    uint32_t n_detections;              /**< in the output */
+    uint32_t n_over_box_budget;         /**< passed gate 1 past max_boxes (not boxed) */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_workspace_stats_t stages;     /**< the stages' own counts */
 } lidet_detector_stats_t;
@@ -143,8 +143,8 @@ typedef struct
     lidet_pn_t cls, box;
     float pn_scratch[LIDET_DETECTOR_PN_SCRATCH / 4];
     lidet_proposal_t proposal;
-    uint16_t order[LIDET_MAX_CLUSTERS];  /* candidate clusters, nearest first */
-    uint32_t key[LIDET_MAX_CLUSTERS];    /* their squared horizontal ranges (float bits, >= 0) */
+    uint16_t order[LIDET_MAX_CLUSTERS];              /* candidate clusters, nearest first */
+    uint32_t key[LIDET_MAX_CLUSTERS];                /* their squared horizontal ranges (float bits, >= 0) */
     lidet_detection_t det[LIDET_MAX_DETECTIONS + 1]; /* + 1: a candidate before the capacity check */
     uint8_t outcome[LIDET_MAX_CLUSTERS];             /* lidet_det_outcome_t per kept cluster */
     uint32_t n_det;
@@ -170,8 +170,8 @@ void lidet_detector_cfg_default(lidet_detector_cfg_t *cfg, const lidet_sensor_t 
  *         proposal, or PVLE bins other than the proposal configuration's); LIDET_ERR_BUFFER (a model
  *         needs more than LIDET_DETECTOR_PN_SCRATCH bytes of scratch).
  */
-lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *cls,
-                                   const lidet_pn_model_t *box);
+lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg_t *cfg,
+                                   const lidet_pn_model_t *cls, const lidet_pn_model_t *box);
 
 /**
  * @brief Detect road users in one scan.
@@ -184,8 +184,8 @@ lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg
  * @return LIDET_OK; LIDET_TRUNCATED when a stage truncated, clusters were over the proposal budget or
  *         detections over capacity (stats say which); a stage's error (nothing detected).
  */
-lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint32_t n_points, uint32_t stride,
-                                  const uint16_t *ring, int32_t *point_pixel);
+lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint32_t n_points,
+                                  uint32_t stride, const uint16_t *ring, int32_t *point_pixel);
 
 /** @brief Detections of the last run, best score first (valid until the next run). */
 const lidet_detection_t *lidet_detector_detections(const lidet_detector_t *d, uint32_t *n_detections);

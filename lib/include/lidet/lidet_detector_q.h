@@ -16,11 +16,11 @@
 #define LIDET_DETECTOR_Q_H
 
 #include "lidet_cluster_q.h"
+#include "lidet_detector.h" /* lidet_clock_fn, stage indices, outcomes */
 #include "lidet_ground_q.h"
 #include "lidet_pointnet_q.h"
 #include "lidet_proj_q.h"
 #include "lidet_q.h"
-#include "lidet_detector.h" /* lidet_clock_fn, stage indices, outcomes */
 
 #ifdef __cplusplus
 extern "C" {
@@ -32,14 +32,14 @@ extern "C" {
 /** @brief One detection of the integer path. */
 typedef struct
 {
-    lidet_box_q_t box;        /**< sensor frame, mm, BAM32 yaw */
-    int32_t score_q15;        /**< (0, 32768) */
-    int32_t energy_cls_q16;   /**< classifier energy (gate 1), Q16 nats */
-    int32_t energy_box_q16;   /**< box net energy (gate 2), Q16 nats */
-    uint16_t cluster_id;      /**< 1-based id of the cluster it came from */
-    uint8_t cls;              /**< lidet_class_t */
+    lidet_box_q_t box;      /**< sensor frame, mm, BAM32 yaw */
+    int32_t score_q15;      /**< (0, 32768) */
+    int32_t energy_cls_q16; /**< classifier energy (gate 1), Q16 nats */
+    int32_t energy_box_q16; /**< box net energy (gate 2), Q16 nats */
+    uint16_t cluster_id;    /**< 1-based id of the cluster it came from */
+    uint8_t cls;            /**< lidet_class_t */
     uint8_t reserved;
-    uint32_t n_points;        /**< member points of that cluster */
+    uint32_t n_points; /**< member points of that cluster */
 } lidet_detection_q_t;
 
 /** @brief Plausible sizes per class (lidet_class_t order), l, w, h in mm. */
@@ -85,27 +85,27 @@ typedef struct
     lidet_proposal_q_cfg_t proposal; /**< n_points is set from the models by init; seed and PVLE bins used */
     int32_t crop_half_bam;           /**< 0: 360 degrees; else keep clusters with |azimuth| <= this (BAM32;
                                           the KITTI camera field of view is 2^29); [0, 2^31 - 1] */
-    int32_t max_range_mm;            /**< clusters whose mean is farther (horizontally) are not classified; 0 =
+    int32_t max_range_mm;       /**< clusters whose mean is farther (horizontally) are not classified; 0 =
                                           no limit; >= 0 */
-    uint32_t max_proposals;          /**< [1, LIDET_MAX_CLUSTERS]: at most this many classified, nearest first */
-    uint32_t max_boxes;              /**< [1, LIDET_MAX_CLUSTERS]: at most this many through the box net per scan
+    uint32_t max_proposals;     /**< [1, LIDET_MAX_CLUSTERS]: at most this many classified, nearest first */
+    uint32_t max_boxes;         /**< [1, LIDET_MAX_CLUSTERS]: at most this many through the box net per scan
                                           (those passing gate 1, nearest first; the rest: outcome
                                           LIDET_DET_OUT_BUDGET, stats n_over_box_budget, LIDET_TRUNCATED); default
                                           48 (> 16 beams), 24: the float detector's max_boxes */
-    uint8_t gate1;                   /**< 1 (default): drop proposals failing gate 1 */
-    uint8_t gate2;                   /**< 1 (default): drop boxes failing gate 2 */
-    int32_t nms_iou_q15;             /**< [0, 32768]; default 3277 (0.1) */
-    lidet_size_limits_q_t size;      /**< plausible l, w, h per class */
-    lidet_clock_fn clock;            /**< optional timestamp source for stats.ticks (NULL: no timing) */
-    void *clock_ctx;                 /**< passed to clock */
+    uint8_t gate1;              /**< 1 (default): drop proposals failing gate 1 */
+    uint8_t gate2;              /**< 1 (default): drop boxes failing gate 2 */
+    int32_t nms_iou_q15;        /**< [0, 32768]; default 3277 (0.1) */
+    lidet_size_limits_q_t size; /**< plausible l, w, h per class */
+    lidet_clock_fn clock;       /**< optional timestamp source for stats.ticks (NULL: no timing) */
+    void *clock_ctx;            /**< passed to clock */
 } lidet_detector_q_cfg_t;
 
 /** @brief Counts of the last run (the fields of lidet_detector_stats_t, the integer stages' counts). */
 typedef struct
 {
-    uint32_t n_clusters, n_out_of_crop, n_out_of_range, n_over_budget, n_classified, n_gate1_rejected, n_boxed,
-        n_gate2_rejected, n_size_rejected, n_nms_suppressed, n_over_capacity, n_detections;
-    uint32_t n_over_box_budget; /**< passed gate 1 past max_boxes (not boxed) */
+    uint32_t n_clusters, n_out_of_crop, n_out_of_range, n_over_budget, n_classified, n_gate1_rejected,
+        n_boxed, n_gate2_rejected, n_size_rejected, n_nms_suppressed, n_over_capacity, n_detections;
+    uint32_t n_over_box_budget;         /**< passed gate 1 past max_boxes (not boxed) */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_proj_stats_t proj;
     lidet_ground_stats_t ground;
@@ -169,7 +169,8 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
  *         than the proposal configuration's); LIDET_ERR_BUFFER (scratch too small).
  */
 lidet_status_t lidet_detector_q_init(lidet_detector_q_t *d, const lidet_detector_q_cfg_t *cfg,
-                                     const lidet_pointnet_q_model_t *cls, const lidet_pointnet_q_model_t *box);
+                                     const lidet_pointnet_q_model_t *cls,
+                                     const lidet_pointnet_q_model_t *box);
 
 /**
  * @brief Detect road users in one scan of int32 mm points (records of `stride` int32, x y z first).

@@ -65,7 +65,7 @@ extern "C" {
 /** @brief Where a sector's plane came from (lidet_ground_sector_source). */
 typedef enum
 {
-    LIDET_GROUND_PLANE_FITTED = 0,   /**< RANSAC (+ refinement) on the sector's own samples */
+    LIDET_GROUND_PLANE_FITTED = 0,    /**< RANSAC (+ refinement) on the sector's own samples */
     LIDET_GROUND_PLANE_NEIGHBOUR = 1, /**< copied from the nearest fitted sector */
     LIDET_GROUND_PLANE_MOUNT = 2,     /**< the mount plane z = -mount_height_m */
     LIDET_GROUND_PLANE_NEAR = 3       /**< far part of a sector without its own plane: the sector's
@@ -79,83 +79,83 @@ typedef enum
 typedef struct
 {
     /* ---- sample filter ---- */
-    float fy_max;             /**< f_th1: max |F_y| = |S_v*Z / S_v*R|, the slope dz/dR between two
+    float fy_max;               /**< f_th1: max |F_y| = |S_v*Z / S_v*R|, the slope dz/dR between two
                                    beams (dimensionless); [0, 10], typical 0.1-0.3 (0.2 ~ 11 deg) */
-    float fx_max_m;           /**< f_th2: max |F_x| = |S_u*R| (or |S_u*Z|), metres; (0, 100],
+    float fx_max_m;             /**< f_th2: max |F_x| = |S_u*R| (or |S_u*Z|), metres; (0, 100],
                                    typical 0.3-2 m */
-    uint8_t fx_on_z;          /**< 0: F_x = S_u*R (paper), 1: F_x = S_u*Z (authors' released code) */
+    uint8_t fx_on_z;            /**< 0: F_x = S_u*R (paper), 1: F_x = S_u*Z (authors' released code) */
     uint8_t require_descending; /**< 1: also require dR > 0 (the lower beam lands closer, true on
                                    any ground the sensor looks down on); 0: the paper's |F_y| only */
-    uint8_t height_gate;      /**< 1: samples must also pass the height gate (released code) */
-    float gate_above_m;       /**< gate: max height above the nominal ground z = -mount_height_m,
+    uint8_t height_gate;        /**< 1: samples must also pass the height gate (released code) */
+    float gate_above_m;         /**< gate: max height above the nominal ground z = -mount_height_m,
                                    metres; [-5, 10], typical 0.3-0.5 (released KITTI: 0.43) */
-    float gate_below_m;       /**< gate: max depth below the nominal ground, metres; [0, 20],
+    float gate_below_m;         /**< gate: max depth below the nominal ground, metres; [0, 20],
                                    typical 1-8 (released KITTI: 8.27, i.e. z > -10 m) */
-    float mount_height_m;     /**< sensor optical centre above the ground, metres; [0, 10]; from the
+    float mount_height_m;       /**< sensor optical centre above the ground, metres; [0, 10]; from the
                                    sensor profile. Used by the gate, the height check and the
                                    mount-plane fallback */
     /* ---- RANSAC per sector ---- */
-    uint16_t n_sectors;       /**< azimuth sectors over 360 deg; [1, min(n_cols, LIDET_GROUND_MAX_SECTORS)],
+    uint16_t n_sectors;        /**< azimuth sectors over 360 deg; [1, min(n_cols, LIDET_GROUND_MAX_SECTORS)],
                                    default 32 (11.25 deg) */
-    uint16_t ransac_iters;    /**< hypotheses per sector; [1, 1000], typical 8-30 */
-    uint16_t sample_step;     /**< the filter runs on rows 0, step, 2 step, ... only: a speed knob
+    uint16_t ransac_iters;     /**< hypotheses per sector; [1, 1000], typical 8-30 */
+    uint16_t sample_step;      /**< the filter runs on rows 0, step, 2 step, ... only: a speed knob
                                    (planes need far fewer points than the image holds); [1, 16],
                                    1 = every row (paper), typical 1-4 */
-    uint16_t sample_col_step; /**< RANSAC takes the samples of columns 0, k, 2k, ... of the filtered
+    uint16_t sample_col_step;  /**< RANSAC takes the samples of columns 0, k, 2k, ... of the filtered
                                    rows only (a speed knob); [1, 16], 1 = every sample (paper),
                                    typical 1-4 */
-    uint16_t eval_samples;    /**< samples a hypothesis is scored on (evenly strided subset);
+    uint16_t eval_samples;     /**< samples a hypothesis is scored on (evenly strided subset);
                                    [3, 65535], typical 64-512 */
-    uint16_t min_samples;     /**< fewer samples in a sector: fallback; [3, 65535], typical 10-30 */
-    uint16_t min_inliers;     /**< fewer inliers (among the scored subset): fallback; [3, 65535] */
-    float confidence;         /**< adaptive RANSAC stop: after a new best plane with inlier share w,
+    uint16_t min_samples;      /**< fewer samples in a sector: fallback; [3, 65535], typical 10-30 */
+    uint16_t min_inliers;      /**< fewer inliers (among the scored subset): fallback; [3, 65535] */
+    float confidence;          /**< adaptive RANSAC stop: after a new best plane with inlier share w,
                                    stop once (1 - w^3)^(hypotheses drawn) <= 1 - confidence;
                                    [0, 0.999999], 0 = always ransac_iters, typical 0.99 */
-    uint8_t refine_iters;     /**< least-squares refinements on the inliers; [0, 10], 0 = plain RANSAC */
-    float inlier_m;           /**< RANSAC inlier distance, metres; (0, 5], typical 0.1-0.3 */
-    float max_tilt_rad;       /**< max angle between a plane normal and +z, radians; (0, pi/2),
+    uint8_t refine_iters;      /**< least-squares refinements on the inliers; [0, 10], 0 = plain RANSAC */
+    float inlier_m;            /**< RANSAC inlier distance, metres; (0, 5], typical 0.1-0.3 */
+    float max_tilt_rad;        /**< max angle between a plane normal and +z, radians; (0, pi/2),
                                    typical 0.1-0.35 (the released code used 0.1) */
-    float max_height_dev_m;   /**< accepted |sensor height above the plane - mount_height_m|,
+    float max_height_dev_m;    /**< accepted |sensor height above the plane - mount_height_m|,
                                    metres; (0, 20], typical 0.5-1.5 */
-    float ring_split_m;       /**< each sector is split at this horizontal range (metres) into a
+    float ring_split_m;        /**< each sector is split at this horizontal range (metres) into a
                                    near and a far part with a plane each (ground is rarely one plane
                                    from 3 m to 70 m); 0 = one plane per sector (paper); [0, 500],
                                    typical 10-20 m */
-    uint16_t fallback_sectors;/**< how far (in sectors, either side) a fitted neighbour may be;
+    uint16_t fallback_sectors; /**< how far (in sectors, either side) a fitted neighbour may be;
                                    [0, n_sectors] */
-    uint32_t seed;            /**< xorshift32 seed (0 is replaced by a fixed non-zero value);
+    uint32_t seed;             /**< xorshift32 seed (0 is replaced by a fixed non-zero value);
                                    re-applied at every run, so runs are deterministic */
     /* ---- labelling ---- */
-    float ground_m;           /**< p_th: max height above the sector plane for ground, metres;
+    float ground_m;       /**< p_th: max height above the sector plane for ground, metres;
                                    (0, 5], typical 0.1-0.3 */
-    float ground_m_per_m;     /**< p_th grows by this much per metre of horizontal range (far
+    float ground_m_per_m; /**< p_th grows by this much per metre of horizontal range (far
                                    ground is noisier and the plane is extrapolated); [0, 0.1],
                                    typical 0-0.01; 0 = the paper's constant p_th */
-    float below_factor;       /**< the tolerance below the plane is below_factor * the one above;
+    float below_factor;   /**< the tolerance below the plane is below_factor * the one above;
                                    [0, 20], 1 = symmetric (paper) */
-    float veto_slope;         /**< vertical veto (a lidet extension): a pixel within the tolerance
+    float veto_slope;     /**< vertical veto (a lidet extension): a pixel within the tolerance
                                    is not ground when it and the pixel above it (next beam up)
                                    are steeper than this, |dz| > veto_slope * |dR| (wall feet,
                                    kerb faces, bumpers, trunks); 0 = off (paper); [0, 100],
                                    typical 1-2 (1 = 45 deg) */
-    float veto_min_dz_m;      /**< ... and only when |dz| > this (metres; ignores range noise on
+    float veto_min_dz_m;  /**< ... and only when |dz| > this (metres; ignores range noise on
                                    flat ground); [0, 5], typical 0.03-0.1 */
 } lidet_ground_cfg_t;
 
 /** @brief Counts of the last run. */
 typedef struct
 {
-    uint32_t n_samples;          /**< samples handed to RANSAC (passed the filter, on the step grid) */
-    uint32_t n_samples_dropped;  /**< samples past LIDET_GROUND_MAX_SAMPLES (not used; status TRUNCATED) */
-    uint32_t n_ground;           /**< pixels labelled ground */
-    uint16_t n_sectors_fitted;   /**< near cells (whole sectors when ring_split_m is 0) with own plane */
-    uint16_t n_sectors_neighbour;/**< near cells that took a neighbour's plane */
-    uint16_t n_sectors_mount;    /**< near cells that took the mount plane */
-    uint16_t n_sectors_sparse;   /**< near cells with fewer than min_samples samples */
-    uint16_t n_sectors_rejected; /**< near cells whose best plane failed the inlier/tilt/height checks */
-    uint16_t n_far_fitted;       /**< far cells with their own plane (0 when ring_split_m is 0) */
-    uint32_t n_vetoed;           /**< pixels within the plane tolerance removed by the vertical veto */
-    uint32_t n_hypotheses;       /**< RANSAC hypotheses scored (after degenerate/tilt rejection) */
+    uint32_t n_samples;           /**< samples handed to RANSAC (passed the filter, on the step grid) */
+    uint32_t n_samples_dropped;   /**< samples past LIDET_GROUND_MAX_SAMPLES (not used; status TRUNCATED) */
+    uint32_t n_ground;            /**< pixels labelled ground */
+    uint16_t n_sectors_fitted;    /**< near cells (whole sectors when ring_split_m is 0) with own plane */
+    uint16_t n_sectors_neighbour; /**< near cells that took a neighbour's plane */
+    uint16_t n_sectors_mount;     /**< near cells that took the mount plane */
+    uint16_t n_sectors_sparse;    /**< near cells with fewer than min_samples samples */
+    uint16_t n_sectors_rejected;  /**< near cells whose best plane failed the inlier/tilt/height checks */
+    uint16_t n_far_fitted;        /**< far cells with their own plane (0 when ring_split_m is 0) */
+    uint32_t n_vetoed;            /**< pixels within the plane tolerance removed by the vertical veto */
+    uint32_t n_hypotheses;        /**< RANSAC hypotheses scored (after degenerate/tilt rejection) */
 } lidet_ground_stats_t;
 
 /**
@@ -166,10 +166,10 @@ typedef struct
 {
     uint32_t magic;
     lidet_ground_cfg_t cfg;
-    uint32_t rng;                                        /* xorshift32 state */
-    uint16_t n_rows, n_cols;                             /* of the last image */
+    uint32_t rng;                                       /* xorshift32 state */
+    uint16_t n_rows, n_cols;                            /* of the last image */
     lidet_plane_t planes[2 * LIDET_GROUND_MAX_SECTORS]; /* near planes, then far planes */
-    uint8_t source[2 * LIDET_GROUND_MAX_SECTORS];        /* lidet_ground_plane_source_t, same order */
+    uint8_t source[2 * LIDET_GROUND_MAX_SECTORS];       /* lidet_ground_plane_source_t, same order */
     lidet_ground_stats_t stats;
 } lidet_ground_state_t;
 
@@ -192,9 +192,9 @@ typedef uint32_t lidet_ground_sample_t;
  */
 typedef struct
 {
-    uint8_t sample[LIDET_MAX_ROWS * LIDET_MAX_COLS];     /* 1 sample of the filter */
+    uint8_t sample[LIDET_MAX_ROWS * LIDET_MAX_COLS];            /* 1 sample of the filter */
     lidet_ground_sample_t sample_pix[LIDET_GROUND_MAX_SAMPLES]; /* samples (their pixels), grouped by cell */
-    float ev_x_m[LIDET_GROUND_EVAL_MAX];                 /* a cell's strided scoring subset */
+    float ev_x_m[LIDET_GROUND_EVAL_MAX];                        /* a cell's strided scoring subset */
     float ev_y_m[LIDET_GROUND_EVAL_MAX];
     float ev_z_m[LIDET_GROUND_EVAL_MAX];
     /* cells: k = s (near part of sector s) and k = n_sectors + s (far part); the samples of cell k
@@ -304,8 +304,8 @@ lidet_status_t lidet_ground_state_init(lidet_ground_state_t *st, const lidet_gro
  *                        row by row from x and y, exactly as the projection would: same results).
  * @return as lidet_ground_run.
  */
-lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *st, lidet_ground_scratch_t *scratch, uint8_t *mask,
-                                        const lidet_range_image_t *img);
+lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *st, lidet_ground_scratch_t *scratch,
+                                        uint8_t *mask, const lidet_range_image_t *img);
 
 /** @brief Per-point labels from a state and the mask it produced (lidet_ground_point_labels). */
 lidet_status_t lidet_ground_point_labels_of(const lidet_ground_state_t *st, const uint8_t *mask,

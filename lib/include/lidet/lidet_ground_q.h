@@ -46,34 +46,34 @@ extern "C" {
  */
 typedef struct
 {
-    uint32_t fy_max_q16;         /**< f_th1, Q16; [0, 655360] (0.2 -> 13107) */
-    uint32_t fx_max_mm;          /**< f_th2, mm; (0, 100000] */
-    uint8_t fx_on_z;             /**< 0: F_x = S_u*R, 1: S_u*Z */
-    uint8_t require_descending;  /**< 1: also dR > 0 */
-    uint8_t height_gate;         /**< 1: z within [-mount - gate_below, -mount + gate_above] */
-    uint8_t refine_iters;        /**< least-squares refinements; [0, 10] */
-    int32_t gate_above_mm;       /**< [-5000, 10000] */
-    int32_t gate_below_mm;       /**< [0, 20000] */
-    int32_t mount_height_mm;     /**< [0, 10000] */
-    uint16_t n_sectors;          /**< [1, min(n_cols, LIDET_GROUND_MAX_SECTORS)] */
-    uint16_t ransac_iters;       /**< [1, 1000] */
-    uint16_t sample_step;        /**< [1, 16] */
-    uint16_t sample_col_step;    /**< [1, 16] */
-    uint16_t eval_samples;       /**< [3, 65535] */
-    uint16_t min_samples;        /**< [3, 65535] */
-    uint16_t min_inliers;        /**< [3, 65535] */
-    uint16_t fallback_sectors;   /**< [0, n_sectors] */
-    uint32_t confidence_q16;     /**< adaptive stop, Q16; [0, 65535], 0 = always ransac_iters (0.99 -> 64881) */
-    uint32_t inlier_mm;          /**< (0, 5000] */
-    uint32_t max_tilt_urad;      /**< (0, 1570796] */
-    uint32_t max_height_dev_mm;  /**< (0, 20000] */
-    uint32_t ring_split_mm;      /**< [0, 500000], 0 = one plane per sector */
-    uint32_t seed;               /**< xorshift32 seed (0 -> fixed non-zero) */
-    uint32_t ground_mm;          /**< p_th, mm; (0, 5000] */
-    uint32_t ground_per_m_q16;   /**< p_th growth per metre of range (mm/mm), Q16; [0, 6554] */
-    uint32_t below_factor_q16;   /**< below tolerance = this * above, Q16; [0, 1310720] */
-    uint32_t veto_slope_q16;     /**< vertical veto slope, Q16; [0, 6553600], 0 = off */
-    uint32_t veto_min_dz_mm;     /**< [0, 5000] */
+    uint32_t fy_max_q16;        /**< f_th1, Q16; [0, 655360] (0.2 -> 13107) */
+    uint32_t fx_max_mm;         /**< f_th2, mm; (0, 100000] */
+    uint8_t fx_on_z;            /**< 0: F_x = S_u*R, 1: S_u*Z */
+    uint8_t require_descending; /**< 1: also dR > 0 */
+    uint8_t height_gate;        /**< 1: z within [-mount - gate_below, -mount + gate_above] */
+    uint8_t refine_iters;       /**< least-squares refinements; [0, 10] */
+    int32_t gate_above_mm;      /**< [-5000, 10000] */
+    int32_t gate_below_mm;      /**< [0, 20000] */
+    int32_t mount_height_mm;    /**< [0, 10000] */
+    uint16_t n_sectors;         /**< [1, min(n_cols, LIDET_GROUND_MAX_SECTORS)] */
+    uint16_t ransac_iters;      /**< [1, 1000] */
+    uint16_t sample_step;       /**< [1, 16] */
+    uint16_t sample_col_step;   /**< [1, 16] */
+    uint16_t eval_samples;      /**< [3, 65535] */
+    uint16_t min_samples;       /**< [3, 65535] */
+    uint16_t min_inliers;       /**< [3, 65535] */
+    uint16_t fallback_sectors;  /**< [0, n_sectors] */
+    uint32_t confidence_q16; /**< adaptive stop, Q16; [0, 65535], 0 = always ransac_iters (0.99 -> 64881) */
+    uint32_t inlier_mm;      /**< (0, 5000] */
+    uint32_t max_tilt_urad;  /**< (0, 1570796] */
+    uint32_t max_height_dev_mm; /**< (0, 20000] */
+    uint32_t ring_split_mm;     /**< [0, 500000], 0 = one plane per sector */
+    uint32_t seed;              /**< xorshift32 seed (0 -> fixed non-zero) */
+    uint32_t ground_mm;         /**< p_th, mm; (0, 5000] */
+    uint32_t ground_per_m_q16;  /**< p_th growth per metre of range (mm/mm), Q16; [0, 6554] */
+    uint32_t below_factor_q16;  /**< below tolerance = this * above, Q16; [0, 1310720] */
+    uint32_t veto_slope_q16;    /**< vertical veto slope, Q16; [0, 6553600], 0 = off */
+    uint32_t veto_min_dz_mm;    /**< [0, 5000] */
 } lidet_ground_q_cfg_t;
 
 /** @brief What lives across runs: configuration, tables from init, planes, sources, counts. */
@@ -83,11 +83,11 @@ typedef struct
     lidet_ground_q_cfg_t cfg;
     uint32_t rng;
     uint16_t n_rows, n_cols;
-    int32_t cos_tilt_q30;   /* cos(max_tilt), from init */
-    uint32_t split_v;       /* far: x^2 + y^2 >= split_v (4 mm steps squared); UINT32_MAX: no split */
+    int32_t cos_tilt_q30; /* cos(max_tilt), from init */
+    uint32_t split_v;     /* far: x^2 + y^2 >= split_v (4 mm steps squared); UINT32_MAX: no split */
     lidet_plane_q_t planes[2 * LIDET_GROUND_MAX_SECTORS]; /* near planes, then far planes */
-    int64_t plane_d[2 * LIDET_GROUND_MAX_SECTORS];      /* D of each plane, 4 mm / 2^30 (the labels use it) */
-    uint8_t source[2 * LIDET_GROUND_MAX_SECTORS];       /* lidet_ground_plane_source_t */
+    int64_t plane_d[2 * LIDET_GROUND_MAX_SECTORS]; /* D of each plane, 4 mm / 2^30 (the labels use it) */
+    uint8_t source[2 * LIDET_GROUND_MAX_SECTORS];  /* lidet_ground_plane_source_t */
     lidet_ground_stats_t stats;
 } lidet_ground_q_state_t;
 
@@ -100,7 +100,7 @@ typedef struct
     uint32_t cell_first[2 * LIDET_GROUND_MAX_SECTORS];
     uint32_t cell_n[2 * LIDET_GROUND_MAX_SECTORS];
     int32_t r_rows[2][LIDET_MAX_COLS]; /* R of two rows, 4 mm / 256 */
-    uint32_t r_v[LIDET_MAX_COLS];      /* x^2 + y^2 and the square root's remainder of the row being computed */
+    uint32_t r_v[LIDET_MAX_COLS]; /* x^2 + y^2 and the square root's remainder of the row being computed */
     uint32_t r_rem[LIDET_MAX_COLS];
 } lidet_ground_q_scratch_t;
 

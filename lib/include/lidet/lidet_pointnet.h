@@ -51,7 +51,7 @@ extern "C" {
  * flash section). */
 
 /** Scratch bytes for a model whose widest shared layer has wp channels and widest vector wv. */
-#define LIDET_PN_SCRATCH_BYTES(wp, wv) \
+#define LIDET_PN_SCRATCH_BYTES(wp, wv)                                                                       \
     (4u * (2u * LIDET_PN_BLOCK * (uint32_t)(wp) + 3u * (uint32_t)(wv) + 3u * LIDET_PN_BLOCK + 8u))
 
 /** @brief One dense layer y = act(W x + b); W stored transposed, w_t[i * n_out + o]. */
@@ -67,9 +67,10 @@ typedef struct
 /** @brief One PointNet stage. */
 typedef struct
 {
-    const lidet_pn_layer_t *point; /**< shared per-point layers; the first has n_in 3; max-pool after the last */
-    const lidet_pn_layer_t *pvle;  /**< PVLE layers (first n_in 3), or NULL */
-    const lidet_pn_layer_t *head;  /**< head layers; the first takes [g | onehot | p] */
+    const lidet_pn_layer_t
+        *point; /**< shared per-point layers; the first has n_in 3; max-pool after the last */
+    const lidet_pn_layer_t *pvle; /**< PVLE layers (first n_in 3), or NULL */
+    const lidet_pn_layer_t *head; /**< head layers; the first takes [g | onehot | p] */
     uint8_t n_point, n_pvle, n_head;
     uint8_t use_onehot; /**< 1: the class one-hot (n_classes) sits between g and p */
 } lidet_pn_stage_t;
@@ -86,12 +87,12 @@ typedef struct
     uint8_t n_heading_bins;  /**< box net: H */
     uint8_t n_size_clusters; /**< box net: S */
     lidet_pn_stage_t stage[2];
-    const float *mean_size_m;   /**< box net: S x 3 size templates (l, w, h), else NULL */
-    float pvle_bin[3];          /**< voxel sizes the model was trained with: azimuth, elevation (rad), range (m) */
-    float energy_t;             /**< temperature T (> 0) */
+    const float *mean_size_m; /**< box net: S x 3 size templates (l, w, h), else NULL */
+    float pvle_bin[3]; /**< voxel sizes the model was trained with: azimuth, elevation (rad), range (m) */
+    float energy_t;    /**< temperature T (> 0) */
     float gamma[LIDET_N_CLASSES]; /**< gate threshold per class: keep when energy < gamma[class] */
-    const char *name;           /**< model name given to codegen */
-    const char *class_names;    /**< comma-separated, lidet_class_t order */
+    const char *name;             /**< model name given to codegen */
+    const char *class_names;      /**< comma-separated, lidet_class_t order */
 } lidet_pn_model_t;
 
 /** @brief A model with its scratch buffer, ready to run. */
@@ -123,7 +124,7 @@ typedef struct
     float energy;         /**< energy_heading + energy_size: the gate-2 energy */
     uint8_t heading_bin;
     uint8_t size_cluster;
-    uint8_t pass;         /**< gate 2: energy < gamma[class] */
+    uint8_t pass; /**< gate 2: energy < gamma[class] */
 } lidet_pn_box_out_t;
 
 /**
@@ -151,8 +152,8 @@ uint32_t lidet_pn_scratch_bytes(const lidet_pn_model_t *model);
  * @return LIDET_OK; LIDET_ERR_ARG (NULL pn/model, misaligned buffer); LIDET_ERR_MODEL (see
  *         lidet_pn_check); LIDET_ERR_BUFFER (scratch NULL or smaller than required).
  */
-lidet_status_t lidet_pn_init(lidet_pn_t *pn, const lidet_pn_model_t *model, void *scratch, uint32_t scratch_bytes,
-                             uint32_t *required);
+lidet_status_t lidet_pn_init(lidet_pn_t *pn, const lidet_pn_model_t *model, void *scratch,
+                             uint32_t scratch_bytes, uint32_t *required);
 
 /**
  * @brief The raw network: points already in the model frame.

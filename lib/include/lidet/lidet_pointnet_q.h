@@ -41,9 +41,9 @@ extern "C" {
 
 #define LIDET_PNQ_ALIGN4(v) (((uint32_t)(v) + 3u) & ~3u)
 /** Scratch bytes for a model whose widest shared layer has wp channels and widest vector wv. */
-#define LIDET_POINTNET_Q_SCRATCH_BYTES(wp, wv)                                                                   \
-    (4u * LIDET_PN_BLOCK * ((uint32_t)(wp) > (uint32_t)(wv) ? (uint32_t)(wp) : (uint32_t)(wv)) +                 \
-     4u * (uint32_t)(wp) + LIDET_PNQ_ALIGN4(2u * LIDET_PN_BLOCK * (uint32_t)(wp)) +                              \
+#define LIDET_POINTNET_Q_SCRATCH_BYTES(wp, wv)                                                               \
+    (4u * LIDET_PN_BLOCK * ((uint32_t)(wp) > (uint32_t)(wv) ? (uint32_t)(wp) : (uint32_t)(wv)) +             \
+     4u * (uint32_t)(wp) + LIDET_PNQ_ALIGN4(2u * LIDET_PN_BLOCK * (uint32_t)(wp)) +                          \
      LIDET_PNQ_ALIGN4(3u * (uint32_t)(wv)) + LIDET_PNQ_ALIGN4(6u * LIDET_PN_BLOCK))
 
 /** @brief Output format of a layer. */
@@ -58,13 +58,13 @@ typedef struct
 {
     uint16_t n_in;
     uint16_t n_out;
-    uint8_t relu;          /**< 1: ReLU (the clamp at the zero point) */
-    uint8_t out;           /**< lidet_pnq_out_t */
-    int8_t out_zp;         /**< int8 output zero point (-128 after a ReLU, else 0) */
-    const int8_t *w_t;     /**< n_in * n_out, [in][out] */
-    const int32_t *b;      /**< n_out, input zero point folded in */
-    const int32_t *mult;   /**< n_out, in [0, 2^31) */
-    const uint8_t *shift;  /**< n_out, in [1, 62] */
+    uint8_t relu;         /**< 1: ReLU (the clamp at the zero point) */
+    uint8_t out;          /**< lidet_pnq_out_t */
+    int8_t out_zp;        /**< int8 output zero point (-128 after a ReLU, else 0) */
+    const int8_t *w_t;    /**< n_in * n_out, [in][out] */
+    const int32_t *b;     /**< n_out, input zero point folded in */
+    const int32_t *mult;  /**< n_out, in [0, 2^31) */
+    const uint8_t *shift; /**< n_out, in [1, 62] */
 } lidet_pointnet_q_layer_t;
 
 /** @brief One stage: points -> shared layers -> max; [g | p]; the one-hot folded into head[0]'s bias. */
@@ -73,7 +73,7 @@ typedef struct
     const lidet_pointnet_q_layer_t *point; /**< the first takes 3 int16 inputs (mm) */
     const lidet_pointnet_q_layer_t *pvle;  /**< the first takes the 3 int16 voxel bins; or NULL */
     const lidet_pointnet_q_layer_t *head;  /**< the first takes [g | p] (int8, one scale) */
-    const int32_t *onehot_b;               /**< use_onehot: n_classes x head[0].n_out added to the accumulators */
+    const int32_t *onehot_b; /**< use_onehot: n_classes x head[0].n_out added to the accumulators */
     uint8_t n_point, n_pvle, n_head;
     uint8_t use_onehot;
 } lidet_pointnet_q_stage_t;
@@ -93,8 +93,8 @@ typedef struct
     const int32_t *mean_size_mm; /**< box net: S x 3 (l, w, h) */
     const int32_t *heading_bam;  /**< box net: H bin angles, BAM32 */
     int32_t heading_res_bam;     /**< box net: pi / H in BAM32 (a residual of 1.0) */
-    int32_t pvle_bin[3];         /**< voxel sizes the model was trained with: azimuth, elevation (urad), range (mm) */
-    int32_t energy_t_q16;        /**< temperature, Q16 (> 0) */
+    int32_t pvle_bin[3]; /**< voxel sizes the model was trained with: azimuth, elevation (urad), range (mm) */
+    int32_t energy_t_q16;               /**< temperature, Q16 (> 0) */
     int32_t gamma_q16[LIDET_N_CLASSES]; /**< gate thresholds, Q16 nats: keep when energy < gamma[class] */
     const char *name;
     const char *class_names;
@@ -146,7 +146,8 @@ typedef struct
  *         chain, NULL arrays, shifts outside [1, 62], multipliers < 0, too many layers, points per proposal,
  *         PVLE bins <= 0, temperature <= 0).
  */
-lidet_status_t lidet_pointnet_q_check(const lidet_pointnet_q_model_t *model, uint32_t kind, uint32_t n_points);
+lidet_status_t lidet_pointnet_q_check(const lidet_pointnet_q_model_t *model, uint32_t kind,
+                                      uint32_t n_points);
 
 /** @brief Scratch bytes of a model (0 for one lidet_pointnet_q_check rejects). */
 uint32_t lidet_pointnet_q_scratch_bytes(const lidet_pointnet_q_model_t *model);
@@ -159,8 +160,8 @@ uint32_t lidet_pointnet_q_n_outputs(const lidet_pointnet_q_model_t *model);
  * @return LIDET_OK; LIDET_ERR_ARG (NULL, misaligned); LIDET_ERR_MODEL; LIDET_ERR_BUFFER (too small; *required
  *         receives the size when not NULL).
  */
-lidet_status_t lidet_pointnet_q_init(lidet_pointnet_q_t *pn, const lidet_pointnet_q_model_t *model, void *scratch,
-                                     uint32_t scratch_bytes, uint32_t *required);
+lidet_status_t lidet_pointnet_q_init(lidet_pointnet_q_t *pn, const lidet_pointnet_q_model_t *model,
+                                     void *scratch, uint32_t scratch_bytes, uint32_t *required);
 
 /**
  * @brief The raw network on points already in the model frame.

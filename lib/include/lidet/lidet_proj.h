@@ -100,21 +100,21 @@ typedef struct
 {
     uint16_t n_rows;
     uint16_t n_cols;
-    const float *x_m;          /**< x of the pixel's point; NULL for a compact image */
-    const float *y_m;          /**< y */
-    const float *z_m;          /**< z */
-    const float *range_m;      /**< sqrt(x^2 + y^2 + z^2); > 0 exactly for valid pixels */
-    const int16_t *x_4mm;      /**< compact image only (x_m NULL): x in 4 mm steps */
-    const int16_t *y_4mm;      /**< compact: y */
-    const int16_t *z_4mm;      /**< compact: z */
-    const uint16_t *range_4mm; /**< compact: the range (of the float point, then rounded); >= 1 exactly
+    const float *x_m;            /**< x of the pixel's point; NULL for a compact image */
+    const float *y_m;            /**< y */
+    const float *z_m;            /**< z */
+    const float *range_m;        /**< sqrt(x^2 + y^2 + z^2); > 0 exactly for valid pixels */
+    const int16_t *x_4mm;        /**< compact image only (x_m NULL): x in 4 mm steps */
+    const int16_t *y_4mm;        /**< compact: y */
+    const int16_t *z_4mm;        /**< compact: z */
+    const uint16_t *range_4mm;   /**< compact: the range (of the float point, then rounded); >= 1 exactly
                                     for valid pixels */
-    const float *rxy_m;        /**< R = sqrt(x^2 + y^2), the horizontal range; may be NULL (a detector
+    const float *rxy_m;          /**< R = sqrt(x^2 + y^2), the horizontal range; may be NULL (a detector
                                     workspace does not keep it: the ground stage computes it) */
-    const int32_t *point_idx;  /**< index of the winning input point, -1 = empty; may be NULL (a
+    const int32_t *point_idx;    /**< index of the winning input point, -1 = empty; may be NULL (a
                                     workspace overlays it with later scratch). Validity is range_m > 0,
                                     which the later stages read (the two agree on every image) */
-    const float *row_elev_rad; /**< n_rows beam elevations in row order (row 0 = top) */
+    const float *row_elev_rad;   /**< n_rows beam elevations in row order (row 0 = top) */
     const int32_t *row_elev_bam; /**< the same elevations as signed BAM32 (lidet_q.h: 2^32 a turn), what the
                                       integer stages read; the float projection rounds its float ones */
 } lidet_range_image_t;
@@ -130,15 +130,15 @@ typedef struct
     uint32_t magic;
     lidet_proj_cfg_t cfg;
     /* derived in init */
-    float row_elev_rad[LIDET_MAX_ROWS];     /* beam elevations, row order (descending) */
-    int32_t row_elev_bam[LIDET_MAX_ROWS];   /* the same in BAM32, for the integer stages */
+    float row_elev_rad[LIDET_MAX_ROWS];      /* beam elevations, row order (descending) */
+    int32_t row_elev_bam[LIDET_MAX_ROWS];    /* the same in BAM32, for the integer stages */
     float row_bound_tan[LIDET_MAX_ROWS + 1]; /* [r] = tan of the mid-angle between rows r-1 and r;
                                                sentinels [0] = +big, [n_rows] = -big */
-    uint8_t ring_to_row[LIDET_MAX_ROWS];    /* ring index -> row */
+    uint8_t ring_to_row[LIDET_MAX_ROWS];     /* ring index -> row */
     uint8_t row_lut[LIDET_PROJ_ROW_LUT + 1]; /* tan(elevation) bucket -> row of its top end */
-    float tan_lo, tan_hi, lut_scale;        /* accepted tan(elevation) range, buckets per unit */
-    uint8_t row_single_step;                /* 1: boundaries > 2 buckets apart, one correction step is exact */
-    uint8_t col_single_step;                /* same for the column edges */
+    float tan_lo, tan_hi, lut_scale;         /* accepted tan(elevation) range, buckets per unit */
+    uint8_t row_single_step; /* 1: boundaries > 2 buckets apart, one correction step is exact */
+    uint8_t col_single_step; /* same for the column edges */
     float col_edge_key[LIDET_MAX_COLS + 1];   /* pseudo-azimuth D of the left edge of each column;
                                                  [n_cols] = 5 (> any D), a sentinel */
     uint16_t col_lut[4 * LIDET_MAX_COLS + 1]; /* D bucket (width 1/n_cols) -> column of its low end */
@@ -154,20 +154,20 @@ typedef struct
  */
 typedef struct
 {
-    float *x_m, *y_m, *z_m; /**< the winning point's coordinates (0 for empty pixels); required for a
+    float *x_m, *y_m, *z_m;         /**< the winning point's coordinates (0 for empty pixels); required for a
                                  float image; all NULL for a compact image */
-    float *range_m;         /**< float image: its range, > 0 exactly for valid pixels, else 0 */
+    float *range_m;                 /**< float image: its range, > 0 exactly for valid pixels, else 0 */
     int16_t *x_4mm, *y_4mm, *z_4mm; /**< compact image (x_m NULL): the coordinates in 4 mm steps; points
                                          beyond LIDET_PIXEL_MAX_RANGE_M are then dropped (n_too_far) */
-    uint16_t *range_4mm;    /**< compact image: the range in 4 mm steps, >= 1 for valid pixels, else 0 */
-    float *rxy_m;           /**< optional (NULL: not produced), float image only (a compact run does not
+    uint16_t *range_4mm;  /**< compact image: the range in 4 mm steps, >= 1 for valid pixels, else 0 */
+    float *rxy_m;         /**< optional (NULL: not produced), float image only (a compact run does not
                                  write it): R = sqrt(x^2 + y^2); the ground stage computes it itself when
                                  the image has none */
-    int32_t *point_idx;     /**< required: the winning input point of each pixel, -1 = empty. The run
+    int32_t *point_idx;   /**< required: the winning input point of each pixel, -1 = empty. The run
                                  needs it as scratch; keep it only if per-pixel -> point is wanted.
                                  A compact run uses its bytes as scratch for the squared ranges too:
                                  it holds the winners' indices again when the run returns */
-    int32_t *point_pixel;   /**< optional (NULL: not produced): LIDET_MAX_POINTS entries, the pixel of
+    int32_t *point_pixel; /**< optional (NULL: not produced): LIDET_MAX_POINTS entries, the pixel of
                                  each input point (per-point outputs: 4 B per point) */
 } lidet_proj_buffers_t;
 
@@ -253,14 +253,16 @@ lidet_status_t lidet_proj_state_init(lidet_proj_state_t *st, const lidet_proj_cf
  *        optional). Same results, bit for bit, as lidet_proj_run.
  * @return as lidet_proj_run; LIDET_ERR_ARG also when a required buffer is NULL.
  */
-lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *st, const lidet_proj_buffers_t *buf, const float *points,
-                                      uint32_t n_points, uint32_t stride, const uint16_t *ring);
+lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *st, const lidet_proj_buffers_t *buf,
+                                      const float *points, uint32_t n_points, uint32_t stride,
+                                      const uint16_t *ring);
 
 /**
  * @brief The range image view of buffers filled by lidet_proj_run_buffers (rxy_m and point_idx as
  *        given, possibly NULL: pass NULL there when the array no longer holds this run's values).
  */
-void lidet_proj_image_of(const lidet_proj_state_t *st, const lidet_proj_buffers_t *buf, lidet_range_image_t *img);
+void lidet_proj_image_of(const lidet_proj_state_t *st, const lidet_proj_buffers_t *buf,
+                         lidet_range_image_t *img);
 
 /** @brief sizeof(lidet_proj_state_t): the bytes that live across runs (tables and counts). */
 uint32_t lidet_proj_state_bytes(void);

@@ -44,8 +44,8 @@ extern "C" {
 typedef struct
 {
     lidet_sensor_q_t sensor; /**< the sensor (its table is copied by init) */
-    int32_t min_range_mm;    /**< closer points are dropped (zero range always is); [0, 10 000], default 100 */
-    int32_t max_range_mm;    /**< farther points are dropped; [0, 1e9], 0 = no limit (default); at most 131 000
+    int32_t min_range_mm; /**< closer points are dropped (zero range always is); [0, 10 000], default 100 */
+    int32_t max_range_mm; /**< farther points are dropped; [0, 1e9], 0 = no limit (default); at most 131 000
                                   takes effect (the compact image's limit) */
     int32_t fov_margin_urad; /**< as lidet_proj_cfg_t.fov_margin_rad; [0, 500 000], default 87 266 (5 deg) */
 } lidet_proj_q_cfg_t;
@@ -64,15 +64,15 @@ typedef struct
 {
     uint32_t magic;
     lidet_proj_q_cfg_t cfg;
-    int32_t row_elev_urad[LIDET_MAX_ROWS];               /* beam elevations, row order (descending) */
-    int32_t row_elev_bam[LIDET_MAX_ROWS];                /* the same in BAM32 */
-    lidet_proj_q_bound_t row_bound[LIDET_MAX_ROWS + 1];  /* [r] = mid-angle between rows r-1 and r, r >= 1 */
-    lidet_proj_q_bound_t fov_hi, fov_lo;                 /* accepted elevation range (margin included) */
-    uint8_t ring_to_row[LIDET_MAX_ROWS];                 /* ring index -> row */
-    uint32_t col_edge_q29[LIDET_MAX_COLS + 1];           /* D of each column's left edge, Q29; [n_cols] = 5 */
-    uint16_t col_lut[4 * LIDET_MAX_COLS + 1];            /* bucket floor(D n_cols) -> column of its low end */
-    uint32_t n_points;                                   /* points of the last run (<= LIDET_MAX_POINTS) */
-    lidet_proj_stats_t stats;                            /* counts of the last run (n_nonfinite always 0) */
+    int32_t row_elev_urad[LIDET_MAX_ROWS];              /* beam elevations, row order (descending) */
+    int32_t row_elev_bam[LIDET_MAX_ROWS];               /* the same in BAM32 */
+    lidet_proj_q_bound_t row_bound[LIDET_MAX_ROWS + 1]; /* [r] = mid-angle between rows r-1 and r, r >= 1 */
+    lidet_proj_q_bound_t fov_hi, fov_lo;                /* accepted elevation range (margin included) */
+    uint8_t ring_to_row[LIDET_MAX_ROWS];                /* ring index -> row */
+    uint32_t col_edge_q29[LIDET_MAX_COLS + 1];          /* D of each column's left edge, Q29; [n_cols] = 5 */
+    uint16_t col_lut[4 * LIDET_MAX_COLS + 1];           /* bucket floor(D n_cols) -> column of its low end */
+    uint32_t n_points;                                  /* points of the last run (<= LIDET_MAX_POINTS) */
+    lidet_proj_stats_t stats;                           /* counts of the last run (n_nonfinite always 0) */
 } lidet_proj_q_state_t;
 
 /** @brief Caller-owned outputs of a run: n_rows * n_cols pixels each unless noted. */
@@ -81,7 +81,7 @@ typedef struct
     int16_t *x_4mm, *y_4mm, *z_4mm; /**< required: the winner's coordinates in 4 mm steps (0 when empty) */
     uint16_t *range_4mm;            /**< required: its range in 4 mm steps, >= 1 when valid, else 0 */
     int32_t *point_idx;             /**< required: winning input point, -1 = empty */
-    int32_t *point_pixel;           /**< optional (NULL = not produced): LIDET_MAX_POINTS entries, the pixel of
+    int32_t *point_pixel; /**< optional (NULL = not produced): LIDET_MAX_POINTS entries, the pixel of
                                          each input point, -1 = not projected */
 } lidet_proj_q_buffers_t;
 
@@ -103,11 +103,13 @@ lidet_status_t lidet_proj_q_init(lidet_proj_q_state_t *st, const lidet_proj_q_cf
  * @return LIDET_OK; LIDET_TRUNCATED (points past LIDET_MAX_POINTS not looked at, n_truncated); LIDET_ERR_ARG
  *         (NULL state/buffers/points, stride < 3); LIDET_ERR_STATE (not initialised).
  */
-lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf, const int32_t *points,
-                                 uint32_t n_points, uint32_t stride, const uint16_t *ring);
+lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                                const int32_t *points, uint32_t n_points, uint32_t stride,
+                                const uint16_t *ring);
 
 /** @brief The compact range image of buffers filled by lidet_proj_q_run (row_elev_rad NULL, row_elev_bam set). */
-void lidet_proj_q_image(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf, lidet_range_image_t *img);
+void lidet_proj_q_image(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                        lidet_range_image_t *img);
 
 /** @brief Counts of the last run (NULL for a NULL state). */
 const lidet_proj_stats_t *lidet_proj_q_stats(const lidet_proj_q_state_t *st);

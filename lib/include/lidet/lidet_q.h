@@ -46,11 +46,12 @@ typedef struct
 /** @brief One proposal of the integer path: what the int8 PointNets see. */
 typedef struct
 {
-    int16_t xyz[LIDET_PROPOSAL_POINTS][3]; /**< first n_points rows used: member points minus mean_4mm, 4 mm */
-    int32_t mean_4mm[3];                   /**< the cluster mean (sensor frame), 4 mm steps, rounded */
-    int16_t voxel[3];                      /**< azimuth, elevation, range bins of the mean (signed) */
-    uint32_t n_points;                     /**< rows of xyz filled */
-    uint32_t n_points_src;                 /**< member pixels of the cluster */
+    int16_t xyz[LIDET_PROPOSAL_POINTS]
+               [3];        /**< first n_points rows used: member points minus mean_4mm, 4 mm */
+    int32_t mean_4mm[3];   /**< the cluster mean (sensor frame), 4 mm steps, rounded */
+    int16_t voxel[3];      /**< azimuth, elevation, range bins of the mean (signed) */
+    uint32_t n_points;     /**< rows of xyz filled */
+    uint32_t n_points_src; /**< member pixels of the cluster */
 } lidet_proposal_q_t;
 
 /** @brief An oriented 3D box of the integer path (geometric centre, as lidet_box_t). */

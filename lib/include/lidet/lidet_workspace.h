@@ -89,7 +89,7 @@ typedef struct
     union
     {
         int32_t proj_point_idx[LIDET__WS_PIXELS]; /* projection: winning point per pixel */
-        lidet_ground_scratch_t ground; /* sample mask, samples, two rows of R */
+        lidet_ground_scratch_t ground;            /* sample mask, samples, two rows of R */
         struct
         {
             int32_t members[LIDET__WS_PIXELS]; /* clustering outputs, read by the proposals */
@@ -105,11 +105,11 @@ typedef struct
     uint32_t image;                                   /**< x, y, z, range planes (int16, 4 mm steps) */
     uint32_t ground_mask;                             /**< the ground mask */
     uint32_t overlay_proj;                            /**< projection scratch (point_idx) */
-    uint32_t overlay_ground;                          /**< ground scratch (sample mask, samples, two rows of R) */
-    uint32_t overlay_cluster;                         /**< cluster labels and members */
-    uint32_t overlay;                                 /**< the overlay: the largest of the three */
-    uint32_t total;                                   /**< sizeof(lidet_workspace_t) */
-    uint32_t stages_standalone;                       /**< lidet_proj_bytes() + lidet_ground_bytes() +
+    uint32_t overlay_ground;    /**< ground scratch (sample mask, samples, two rows of R) */
+    uint32_t overlay_cluster;   /**< cluster labels and members */
+    uint32_t overlay;           /**< the overlay: the largest of the three */
+    uint32_t total;             /**< sizeof(lidet_workspace_t) */
+    uint32_t stages_standalone; /**< lidet_proj_bytes() + lidet_ground_bytes() +
                                                            lidet_cluster_bytes(), for comparison */
 } lidet_workspace_sizes_t;
 
@@ -139,8 +139,8 @@ lidet_status_t lidet_workspace_init(lidet_workspace_t *ws, const lidet_workspace
  * @return LIDET_OK; LIDET_TRUNCATED when a stage truncated (stats say which); the first error of a
  *         stage (LIDET_ERR_ARG, _STATE, _BUFFER, _CONFIG): later stages then did not run.
  */
-lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, uint32_t n_points, uint32_t stride,
-                                   const uint16_t *ring, int32_t *point_pixel);
+lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, uint32_t n_points,
+                                   uint32_t stride, const uint16_t *ring, int32_t *point_pixel);
 
 /** @brief A timestamp source (e.g. a cycle counter or a monotonic clock); ticks in the caller's unit. */
 typedef uint32_t (*lidet_clock_fn)(void *ctx);

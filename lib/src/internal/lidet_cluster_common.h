@@ -16,7 +16,8 @@
 #define LAB_NONCAND 0xFFFFu /* no point, or ground: bridged over, never joined */
 
 #define STEPS LIDET_CLUSTER_MAX_STEPS
-#define RESCUE_MAX_COLS 15u /* rescue_cols limit (each fragment pixel looks at (2 rows + 1)(2 cols + 1) pixels) */
+#define RESCUE_MAX_COLS                                                                                      \
+    15u /* rescue_cols limit (each fragment pixel looks at (2 rows + 1)(2 cols + 1) pixels) */
 
 /* Pushes pixel n onto the queue of the current cluster (members[tail]); returns the new tail. */
 static inline uint32_t lidet__cluster_take(uint16_t *lab, int32_t *mem, uint32_t tail, uint32_t n)
@@ -48,42 +49,42 @@ static inline uint32_t lidet__cluster_mark_4mm(const uint16_t *rng, const uint8_
  * q * cols < 2^32 (m exceeds 2^32 / cols by e in (0, 1], so the quotient is overestimated by q e / 2^32
  * < 1 / cols, less than the distance of q / cols to the next integer). q < npix, so npix * cols <= 2^32
  * suffices (128 x 2048: 2^29); else row_magic is 0 and the fill divides. */
-#define LIDET__GROW_GEOMETRY(lk, n_rows, n_cols, cfg)                                                             \
-    do                                                                                                         \
-    {                                                                                                          \
-        (lk).rows = (n_rows);                                                                                  \
-        (lk).cols = (n_cols);                                                                                  \
-        (lk).ks = (cfg).max_steps;                                                                             \
-        (lk).kc = (lk).ks < (lk).cols - 1u ? (lk).ks : (lk).cols - 1u; /* never wrap onto itself */            \
-        (lk).diag = (cfg).diagonals != 0;                                                                      \
-        (lk).rrows = (cfg).rescue_rows;                                                                        \
-        (lk).rcols = (cfg).rescue_cols < ((lk).cols - 1u) / 2u ? (cfg).rescue_cols : ((lk).cols - 1u) / 2u;    \
+#define LIDET__GROW_GEOMETRY(lk, n_rows, n_cols, cfg)                                                        \
+    do                                                                                                       \
+    {                                                                                                        \
+        (lk).rows = (n_rows);                                                                                \
+        (lk).cols = (n_cols);                                                                                \
+        (lk).ks = (cfg).max_steps;                                                                           \
+        (lk).kc = (lk).ks < (lk).cols - 1u ? (lk).ks : (lk).cols - 1u; /* never wrap onto itself */          \
+        (lk).diag = (cfg).diagonals != 0;                                                                    \
+        (lk).rrows = (cfg).rescue_rows;                                                                      \
+        (lk).rcols = (cfg).rescue_cols < ((lk).cols - 1u) / 2u ? (cfg).rescue_cols : ((lk).cols - 1u) / 2u;  \
         (lk).row_magic = (uint64_t)(lk).rows * (lk).cols * (lk).cols <= 0xFFFFFFFFu                          \
-                             ? (uint32_t)(0xFFFFFFFFu / (lk).cols) + 1u                                        \
-                             : 0u;                                                                             \
+                             ? (uint32_t)(0xFFFFFFFFu / (lk).cols) + 1u                                      \
+                             : 0u;                                                                           \
     } while (0)
 
 /* The rescue's verdict on window pixel n (label l) whose return lies within the rescue distance (dd its
  * squared distance, in the stage's units): a fragment pixel joins the group (queued), a kept pixel is a
  * contact (the nearest one wins, ties: the first met). For both stages' rescue_link / probe. */
-#define LIDET__RESCUE_ACCEPT(c, rs, n, l, dd)                                                                  \
-    do                                                                                                         \
-    {                                                                                                          \
-        if ((l) == LAB_SMALL)                                                                                  \
-        {                                                                                                      \
-            (c)->labels[n] = (uint16_t)LAB_PENDING;                                                            \
-            (c)->members[(rs)->tail++] = (int32_t)(n);                                                         \
-        }                                                                                                      \
-        else if ((dd) < (rs)->best_d2)                                                                         \
-        {                                                                                                      \
-            (rs)->best_d2 = (dd);                                                                              \
-            (rs)->best = (l);                                                                                  \
-        }                                                                                                      \
+#define LIDET__RESCUE_ACCEPT(c, rs, n, l, dd)                                                                \
+    do                                                                                                       \
+    {                                                                                                        \
+        if ((l) == LAB_SMALL)                                                                                \
+        {                                                                                                    \
+            (c)->labels[n] = (uint16_t)LAB_PENDING;                                                          \
+            (c)->members[(rs)->tail++] = (int32_t)(n);                                                       \
+        }                                                                                                    \
+        else if ((dd) < (rs)->best_d2)                                                                       \
+        {                                                                                                    \
+            (rs)->best_d2 = (dd);                                                                            \
+            (rs)->best = (l);                                                                                \
+        }                                                                                                    \
     } while (0)
 
 /* Cluster id of every input point from the per-pixel ids (shared by both stages' point_labels). */
-static inline void lidet__cluster_point_labels(const uint16_t *labels, uint32_t npix, const int32_t *point_pixel,
-                                               uint32_t n_points, uint32_t *out)
+static inline void lidet__cluster_point_labels(const uint16_t *labels, uint32_t npix,
+                                               const int32_t *point_pixel, uint32_t n_points, uint32_t *out)
 {
     uint32_t i;
     for (i = 0; i < n_points; ++i)

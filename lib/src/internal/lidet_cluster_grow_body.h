@@ -19,8 +19,9 @@
  * caller sends the columns within kc of either edge to search_wrap); beam pair sin/cos at
  * sn[(k - 1) * gs], cs[(k - 1) * gs]. Non-candidates are stepped over. */
 static inline uint32_t GROW_FN(search)(uint16_t *lab, int32_t *mem, const GROW_RNG_T *rng, uint32_t tail,
-                                       GROW_D_T dq, uint32_t q, int32_t step, uint32_t nk, const GROW_TAB_T *sn,
-                                       const GROW_TAB_T *cs, int32_t gs, const GROW_PARAM_T *g, int occl)
+                                       GROW_D_T dq, uint32_t q, int32_t step, uint32_t nk,
+                                       const GROW_TAB_T *sn, const GROW_TAB_T *cs, int32_t gs,
+                                       const GROW_PARAM_T *g, int occl)
 {
     uint32_t k, n = q;
     if (!occl)
@@ -121,8 +122,8 @@ static uint32_t GROW_FN(search_wrap)(GROW_STATE_T *c, uint32_t tail, GROW_D_T dq
  * members[head] for head = start .. tail (the member array is the queue, every pixel is pushed at
  * most once). Returns the new tail. Directions in the reference's order: right, left, down, up, then
  * the diagonals down-left, down-right, up-left, up-right. occl is a constant at each call site. */
-static inline uint32_t GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t start,
-                                     uint32_t tail, int occl)
+static inline uint32_t GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t start, uint32_t tail,
+                                     int occl)
 {
     uint16_t *lab = c->labels;
     int32_t *mem = c->members;
@@ -143,7 +144,8 @@ static inline uint32_t GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uin
         /* right, left (wrapping) */
         if (col + kc < cols)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, 1, kc, GROW_TA(c, col), GROW_TB(c, col), 1, g, oc);
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, 1, kc, GROW_TA(c, col), GROW_TB(c, col), 1, g,
+                                   oc);
         }
         else
         {
@@ -151,7 +153,8 @@ static inline uint32_t GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uin
         }
         if (col >= kc)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -1, kc, GROW_TA(c, col), GROW_TB(c, col), 1, g, oc);
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -1, kc, GROW_TA(c, col), GROW_TB(c, col), 1, g,
+                                   oc);
         }
         else
         {
@@ -167,8 +170,8 @@ static inline uint32_t GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uin
         if (nu > 0u)
         {
             tail = GROW_FN(search)(lab, mem, rng, tail, dq, q, -(int32_t)cols, nu,
-                                   GROW_TA(c, row) + (r - 1u) * STEPS, GROW_TB(c, row) + (r - 1u) * STEPS, 1 - STEPS, g,
-                                   oc);
+                                   GROW_TA(c, row) + (r - 1u) * STEPS, GROW_TB(c, row) + (r - 1u) * STEPS,
+                                   1 - STEPS, g, oc);
         }
         /* diagonals (8-neighbourhood option): direct neighbours only, no bridging; each joins when
          * free and linked (down-left, down-right, up-left, up-right) */

@@ -16,17 +16,18 @@ typedef struct
     int diag;
     uint32_t rrows, rcols; /* rescue window half-sizes (2 rcols < cols) */
     float tan_theta, gap, gpm, rgap, rgpm;
-    uint32_t bridge_max; /* occluder bridging budget of the run (max_bridge_per_pixel * candidates; 0xFFFFFFFF:
+    uint32_t
+        bridge_max;    /* occluder bridging budget of the run (max_bridge_per_pixel * candidates; 0xFFFFFFFF:
                           * none) */
-    uint32_t *bridged;   /* steps bridged so far in the run; a pixel bridges only while below bridge_max */
+    uint32_t *bridged; /* steps bridged so far in the run; a pixel bridges only while below bridge_max */
 } lidet__grow_t;
 
 /* Running state of one rescue group: the queue tail and the nearest kept pixel met so far. */
 typedef struct
 {
     uint32_t tail;
-    uint32_t best;  /* slot + 1 of the nearest kept cluster met, 0 = none */
-    float best_d2;  /* its squared distance */
+    uint32_t best; /* slot + 1 of the nearest kept cluster met, 0 = none */
+    float best_d2; /* its squared distance */
 } lidet__rescue_t;
 
 /* sin/cos of every alpha the search can meet; recomputed only when the image geometry changes

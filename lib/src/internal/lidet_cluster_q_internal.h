@@ -15,9 +15,9 @@ typedef struct
     uint32_t rows, cols, ks, kc, row_magic;
     int diag;
     uint32_t rrows, rcols;
-    uint32_t sin_t;     /* sin(theta), Q16 */
-    uint32_t gap_on;    /* max_gap_mm > 0 */
-    uint32_t gap, gpm;  /* gap bound: gap + (gpm d2 >> 16, rounded) */
+    uint32_t sin_t;      /* sin(theta), Q16 */
+    uint32_t gap_on;     /* max_gap_mm > 0 */
+    uint32_t gap, gpm;   /* gap bound: gap + (gpm d2 >> 16, rounded) */
     uint32_t rgap, rgpm; /* rescue distance: rgap + (rgpm min(d1, d2) >> 16, rounded) */
     uint32_t bridge_max; /* occluder bridging budget of the run (the shared flood fill reads it) */
     uint32_t *bridged;   /* steps bridged so far in the run */
@@ -34,7 +34,8 @@ typedef struct
 /* S and H of every alpha the search can meet; recomputed only when the geometry changes */
 void lidet__cluster_q_setup_geometry(lidet_cluster_q_state_t *c, const lidet_range_image_t *img);
 
-uint32_t lidet__cluster_q_grow(lidet_cluster_q_state_t *c, const lidet__grow_q_t *g, uint32_t start, uint32_t tail);
+uint32_t lidet__cluster_q_grow(lidet_cluster_q_state_t *c, const lidet__grow_q_t *g, uint32_t start,
+                               uint32_t tail);
 
 void lidet__cluster_q_rescue_grow(lidet_cluster_q_state_t *c, const lidet__grow_q_t *g, uint32_t start,
                                   lidet__rescue_q_t *rs);

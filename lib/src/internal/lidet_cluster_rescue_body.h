@@ -66,4 +66,3 @@ static inline void rescue_grow(RESCUE_STATE_T *c, const RESCUE_PARAM_T *g, uint3
         }
     }
 }
-

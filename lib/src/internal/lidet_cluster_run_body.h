@@ -266,7 +266,6 @@ static uint32_t next_fragment(const uint16_t *lab, uint32_t p, uint32_t npix)
     return npix;
 }
 
-
 /* the end of a successful init: no geometry, run or record yet */
 static lidet_status_t init_done(RUN_STATE_T *c)
 {
@@ -312,7 +311,8 @@ static lidet_status_t labels_of_points(const RUN_STATE_T *c, const int32_t *poin
     {
         return LIDET_ERR_STATE;
     }
-    lidet__cluster_point_labels(c->labels, (uint32_t)c->img.n_rows * c->img.n_cols, point_pixel, n_points, out);
+    lidet__cluster_point_labels(c->labels, (uint32_t)c->img.n_rows * c->img.n_cols, point_pixel, n_points,
+                                out);
     return LIDET_OK;
 }
 
@@ -424,8 +424,8 @@ static uint32_t finish_cluster(RUN_STATE_T *c, uint32_t start, uint32_t tail, co
 /* a rescue group members[start, tail) joins kept cluster `slot`: count, bounds and mean are updated and the
  * height recomputed (no filter). The group's seed is its first pixel in raster order, so the cluster's first
  * pixel is the smaller of the two seeds (the height uses that pixel's sector, as for any cluster) */
-static void rescue_join(RUN_STATE_T *c, uint32_t slot, uint32_t start, uint32_t tail, const RUN_PLANE_T *planes,
-                        uint32_t n_sectors, lidet_cluster_stats_t *st)
+static void rescue_join(RUN_STATE_T *c, uint32_t slot, uint32_t start, uint32_t tail,
+                        const RUN_PLANE_T *planes, uint32_t n_sectors, lidet_cluster_stats_t *st)
 {
     RUN_REC_T *rec = &c->recs[slot];
     const uint32_t n = tail - start, seed = (uint32_t)c->members[start];

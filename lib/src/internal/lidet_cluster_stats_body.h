@@ -9,8 +9,9 @@
 /* sums, min and max of the coordinates of members[start, tail) (tail > start). Returns 1 (the sums then
  * incomplete) as soon as an x, y or z extent exceeds max_extent: the test runs after every block of
  * 64 members, so a wall stops early instead of being summed to its end */
-static inline int member_stats_of(const STATS_STATE_T *c, uint32_t start, uint32_t tail, STATS_LIM_T max_extent,
-                                  STATS_S_T sum[3], STATS_V_T lo[3], STATS_V_T hi[3], int compact)
+static inline int member_stats_of(const STATS_STATE_T *c, uint32_t start, uint32_t tail,
+                                  STATS_LIM_T max_extent, STATS_S_T sum[3], STATS_V_T lo[3], STATS_V_T hi[3],
+                                  int compact)
 {
     const int32_t *mem = c->members;
     (void)compact; /* read by the float stage's STATS_READ only */

@@ -16,8 +16,9 @@ static inline uint32_t lidet__ground_sector_col(uint32_t s, uint32_t n_sectors, 
 /* The checks of both stages' runs, in this order: LIDET_ERR_STATE (not initialised), LIDET_ERR_ARG (the image
  * lacks a plane the stage reads), LIDET_ERR_BUFFER (larger than the build's capacity), LIDET_ERR_CONFIG (no row,
  * fewer than 4 columns or fewer columns than sectors); else LIDET_OK, and the stage's counts are zeroed. */
-static inline lidet_status_t lidet__ground_run_check(int inited, int planes_ok, const lidet_range_image_t *img,
-                                                     uint32_t n_sectors, lidet_ground_stats_t *stats)
+static inline lidet_status_t lidet__ground_run_check(int inited, int planes_ok,
+                                                     const lidet_range_image_t *img, uint32_t n_sectors,
+                                                     lidet_ground_stats_t *stats)
 {
     if (!inited)
     {
@@ -51,7 +52,8 @@ static inline void lidet__ground_cell_span(uint32_t *cell_first, uint32_t *cell_
     cell_n[ns + s] = far_end - hi;
 }
 
-static inline void lidet__ground_sample_counts(lidet_ground_stats_t *stats, uint32_t total, uint32_t lo, uint32_t hi)
+static inline void lidet__ground_sample_counts(lidet_ground_stats_t *stats, uint32_t total, uint32_t lo,
+                                               uint32_t hi)
 {
     stats->n_samples = total;
     stats->n_samples_dropped = total - (lo + (LIDET_GROUND_MAX_SAMPLES - hi));
@@ -61,7 +63,8 @@ static inline void lidet__ground_sample_counts(lidet_ground_stats_t *stats, uint
  * label, 0 when it has none (-1) or the index is outside the image. inited: the stage's state is initialised.
  * LIDET_ERR_ARG (NULL mask, NULL arrays with n_points > 0), LIDET_ERR_STATE, else LIDET_OK. */
 static inline lidet_status_t lidet__ground_point_labels(int inited, const uint8_t *mask, uint32_t npix,
-                                                        const int32_t *point_pixel, uint32_t n_points, uint8_t *out)
+                                                        const int32_t *point_pixel, uint32_t n_points,
+                                                        uint8_t *out)
 {
     uint32_t i;
     if (mask == 0 || ((point_pixel == 0 || out == 0) && n_points > 0u))
@@ -157,6 +160,7 @@ static inline void lidet__ground_cells(uint8_t *source, const uint32_t *cell_n, 
 /* Fits one plane per cell from the samples sc->sample_pix (pixels of img) grouped by sc->cell_first /
  * cell_n, applies the fallback, fills g->planes, g->source and the sector counts of g->stats
  * (lidet_ground_ransac.c). */
-void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img);
+void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc,
+                               const lidet_range_image_t *img);
 
 #endif

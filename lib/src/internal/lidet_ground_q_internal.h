@@ -35,7 +35,8 @@ static inline void lidet__ground_q_hplane(const int32_t n[3], int64_t d, lidet__
 }
 
 /* n . p + D in 4 mm / 2^30, exact (as the int64 expression) */
-static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, int32_t x, int32_t y, int32_t z)
+static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, int32_t x, int32_t y,
+                                             int32_t z)
 {
     const int32_t a = h->hi[0] * x + h->hi[1] * y + h->hi[2] * z;
     const int32_t b = h->lo[0] * x + h->lo[1] * y + h->lo[2] * z;

@@ -10,7 +10,8 @@
 /* Host builds on x86-64 (CMake option LIDET_NN_CLONES, on by default there): GCC/clang also compile the kernels
  * marked LIDET_NN_KERNEL for AVX2 and pick the variant when the program loads (ifunc). Same C source, same
  * results. Firmware builds never define it. */
-#if defined(LIDET_NN_CLONES) && LIDET_NN_CLONES && (defined(__GNUC__) || defined(__clang__)) && defined(__x86_64__)
+#if defined(LIDET_NN_CLONES) && LIDET_NN_CLONES && (defined(__GNUC__) || defined(__clang__)) &&              \
+    defined(__x86_64__)
 #define LIDET_NN_KERNEL __attribute__((target_clones("avx2", "default")))
 #else
 #define LIDET_NN_KERNEL

@@ -30,8 +30,8 @@ static inline int lidet__pn_dims_ok(uint32_t kind, uint32_t n_stages, uint32_t n
     {
         return n_stages == 1;
     }
-    return kind == LIDET_PN_BOX && n_stages >= 1 && n_stages <= 2 && nh >= 1 && nh <= LIDET_PN_MAX_HEADING_BINS &&
-           ns >= 1 && ns <= LIDET_PN_MAX_SIZE_CLUSTERS && has_box_tables;
+    return kind == LIDET_PN_BOX && n_stages >= 1 && n_stages <= 2 && nh >= 1 &&
+           nh <= LIDET_PN_MAX_HEADING_BINS && ns >= 1 && ns <= LIDET_PN_MAX_SIZE_CLUSTERS && has_box_tables;
 }
 
 /* the widest vector: the concatenation, the PVLE and the head layers */
@@ -63,7 +63,7 @@ static inline lidet_status_t lidet__pn_match(uint32_t model_kind, uint32_t model
                                              uint32_t n_points)
 {
     return (kind != 0 && model_kind != kind) || (n_points != 0 && n_points != model_points) ? LIDET_ERR_MODEL
-                                                                                             : LIDET_OK;
+                                                                                            : LIDET_OK;
 }
 
 /* index of name in a table of n entries of `stride` bytes whose first member is the name; n when absent */

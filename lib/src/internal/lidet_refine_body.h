@@ -77,8 +77,8 @@ static uint32_t refine_label_parts(REFINE_STATE_T *c, uint32_t n, uint32_t nx, u
 
 /* record `slot` from the members of src's (contiguous) range now labelled slot + 1: count, seed (its first
  * pixel), bounds, mean and height */
-static void refine_rebuild(REFINE_STATE_T *c, uint32_t slot, const REFINE_REC_T *src, const REFINE_PLANE_T *planes,
-                           uint32_t n_sectors)
+static void refine_rebuild(REFINE_STATE_T *c, uint32_t slot, const REFINE_REC_T *src,
+                           const REFINE_PLANE_T *planes, uint32_t n_sectors)
 {
     REFINE_REC_T *r = &c->recs[slot];
     REFINE_S_T sum[3] = {0, 0, 0};
@@ -136,11 +136,13 @@ static int refine_split_one(REFINE_STATE_T *c, uint32_t k, const REFINE_PLANE_T 
     /* examined: wider than one person. Two early outs that change no decision, only the time: a cut
      * needs two parts of min_points each, and no part spans more in z than the whole (measured: a limit
      * on the cluster's height, skipping walls and trees, saved no time and lost people beside poles) */
-    if (rec.n_points < 2u * cfg->min_points || rec.n_points > LIDET_REFINE_MAX_POINTS || !refine_examined(cfg, &rec))
+    if (rec.n_points < 2u * cfg->min_points || rec.n_points > LIDET_REFINE_MAX_POINTS ||
+        !refine_examined(cfg, &rec))
     {
         return 0;
     }
-    if (!refine_grid(cfg, &rec, &geo, &nx, &ny) || nx > LIDET_REFINE_MAX_CELLS || ny > LIDET_REFINE_MAX_CELLS / nx)
+    if (!refine_grid(cfg, &rec, &geo, &nx, &ny) || nx > LIDET_REFINE_MAX_CELLS ||
+        ny > LIDET_REFINE_MAX_CELLS / nx)
     {
         ++st->n_split_skipped;
         return 0;
@@ -196,10 +198,11 @@ static int refine_split_one(REFINE_STATE_T *c, uint32_t k, const REFINE_PLANE_T 
     largest_person = n_parts;
     for (p = 0; p < n_parts; ++p)
     {
-        const int person = c->rf_n[p] >= cfg->min_points &&
-                           refine_person(cfg, &geo, c->rf_n[p], (uint32_t)(c->rf_box[p][1] - c->rf_box[p][0]) + 1u,
-                                         (uint32_t)(c->rf_box[p][3] - c->rf_box[p][2]) + 1u, c->rf_z[p][0],
-                                         c->rf_z[p][1], (uint32_t)(c->rf_col[p][1] - c->rf_col[p][0]) + 1u);
+        const int person =
+            c->rf_n[p] >= cfg->min_points &&
+            refine_person(cfg, &geo, c->rf_n[p], (uint32_t)(c->rf_box[p][1] - c->rf_box[p][0]) + 1u,
+                          (uint32_t)(c->rf_box[p][3] - c->rf_box[p][2]) + 1u, c->rf_z[p][0], c->rf_z[p][1],
+                          (uint32_t)(c->rf_col[p][1] - c->rf_col[p][0]) + 1u);
         c->rf_target[p] = (uint16_t)(person ? 1u : 0u);
         any_person |= person;
         if (c->rf_n[p] >= cfg->min_points)
@@ -253,7 +256,8 @@ static int refine_split_one(REFINE_STATE_T *c, uint32_t k, const REFINE_PLANE_T 
     }
     for (i = 0; i < rec.n_points; ++i)
     {
-        c->labels[c->members[rec.first_member + i]] = (uint16_t)(c->rf_target[c->rf_grid[c->rf_cell[i]] - 1u] + 1u);
+        c->labels[c->members[rec.first_member + i]] =
+            (uint16_t)(c->rf_target[c->rf_grid[c->rf_cell[i]] - 1u] + 1u);
     }
     refine_rebuild(c, k, &rec, planes, n_sectors);
     c->recs[k].n_rescued = rec.n_rescued < c->recs[k].n_points ? rec.n_rescued : c->recs[k].n_points;
@@ -275,7 +279,8 @@ static int refine_split_one(REFINE_STATE_T *c, uint32_t k, const REFINE_PLANE_T 
     return 1;
 }
 
-int REFINE_SPLIT_FN(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t n_sectors, lidet_cluster_stats_t *st)
+int REFINE_SPLIT_FN(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t n_sectors,
+                    lidet_cluster_stats_t *st)
 {
     const uint32_t k0 = c->n_recs;
     uint32_t k;
@@ -289,7 +294,8 @@ int REFINE_SPLIT_FN(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t n_
 
 #define REFINE_JOIN_PIECE 4u
 
-int REFINE_JOIN_FN(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t n_sectors, lidet_cluster_stats_t *st)
+int REFINE_JOIN_FN(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t n_sectors,
+                   lidet_cluster_stats_t *st)
 {
     const REFINE_CFG_T *cfg = &c->cfg;
     const uint32_t k = c->n_recs;

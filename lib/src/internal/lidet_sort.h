@@ -12,7 +12,7 @@ void lidet__sort_u32_u16(uint32_t *key, uint16_t *idx, uint32_t n);
 
 /** the detectors' candidate order: sort key[0..n) (ties by idx), then keep the first `max`; each one past it
  *  gets outcome[idx] = code and is counted in *n_over. Returns the number kept (min(n, max)). */
-uint32_t lidet__nearest_first(uint32_t *key, uint16_t *idx, uint32_t n, uint32_t max, uint8_t *outcome, uint8_t code,
-                              uint32_t *n_over);
+uint32_t lidet__nearest_first(uint32_t *key, uint16_t *idx, uint32_t n, uint32_t max, uint8_t *outcome,
+                              uint8_t code, uint32_t *n_over);
 
 #endif

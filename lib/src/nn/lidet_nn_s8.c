@@ -5,13 +5,14 @@
  * requantization per output value. Weights [in][out] as the float kernel: the innermost loop runs over the
  * output channels of one weight row (unit stride; compilers vectorise it on hosts, and x86-64 host builds also
  * get an AVX2 variant, LIDET_NN_KERNEL: integer sums are exact, so every variant gives the same bits). */
-#include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
 #include "internal/lidet_nn.h"
 #include "internal/lidet_pointnet_q_internal.h"
+#include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
 #include "internal/lidet_qmath.h"
 
 /* rows r..r+3 of acc += in rows * W: four rows share each weight load */
-static inline void rows4_s8(const int8_t *x, uint32_t n_in, const int8_t *w_t, uint32_t n_out, int32_t *restrict a0)
+static inline void rows4_s8(const int8_t *x, uint32_t n_in, const int8_t *w_t, uint32_t n_out,
+                            int32_t *restrict a0)
 {
     int32_t *restrict a1 = a0 + n_out;
     int32_t *restrict a2 = a1 + n_out;
@@ -32,8 +33,8 @@ static inline void rows4_s8(const int8_t *x, uint32_t n_in, const int8_t *w_t, u
     }
 }
 
-LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                                            const int32_t *b, uint32_t n_out, int32_t *acc)
+LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, uint32_t n_in,
+                                            const int8_t *w_t, const int32_t *b, uint32_t n_out, int32_t *acc)
 {
     const uint32_t n4 = n_rows & ~3u;
     uint32_t r, o;
@@ -50,7 +51,8 @@ LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, u
     }
     if (n4 < n_rows) /* the last rows: the output-inner loop */
     {
-        lidet__nn_acc_s8_cols(in + n4 * n_in, n_rows - n4, n_in, w_t, b, n_out, n_out, acc + n4 * n_out, n_out);
+        lidet__nn_acc_s8_cols(in + n4 * n_in, n_rows - n4, n_in, w_t, b, n_out, n_out, acc + n4 * n_out,
+                              n_out);
     }
 }
 
@@ -75,8 +77,8 @@ LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, u
 #endif
 #endif
 
-void lidet__nn_acc_s8_r2o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
-                           uint32_t n_out, int32_t *acc)
+void lidet__nn_acc_s8_r2o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                           const int32_t *b, uint32_t n_out, int32_t *acc)
 {
     uint32_t r, i, o;
     for (r = 0; r + 2u <= n_rows; r += 2u)
@@ -111,8 +113,8 @@ void lidet__nn_acc_s8_r2o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
     }
 }
 
-void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
-                           uint32_t n_out, int32_t *acc)
+void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                           const int32_t *b, uint32_t n_out, int32_t *acc)
 {
     uint32_t r, i, o;
     for (r = 0; r + 4u <= n_rows; r += 4u)
@@ -172,8 +174,9 @@ void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const in
 
 /* the output-inner kernel on channels [0, n_out) of a layer whose weight rows are w_stride long and whose
  * accumulator rows are a_stride long (a column slice, for the blocked kernels' leftovers) */
-void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
-                           uint32_t n_out, uint32_t w_stride, int32_t *acc, uint32_t a_stride)
+void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                           const int32_t *b, uint32_t n_out, uint32_t w_stride, int32_t *acc,
+                           uint32_t a_stride)
 {
     uint32_t r, i, o;
     for (r = 0; r < n_rows; ++r)
