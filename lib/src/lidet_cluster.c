@@ -70,6 +70,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->car_min_length_m = 2.5f;
     cfg->upright_max_width_m = 1.3f;
     cfg->max_join_pieces = 256u;
+    cfg->azimuth_half_rad = 0.0f;
 }
 
 static lidet_status_t init_done(lidet_cluster_state_t *c); /* lidet_cluster_run_body.h */
@@ -97,12 +98,14 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
         !lidet__isfinite(cfg->person_max_width_m) || !(cfg->person_max_width_m > 0.0f) ||
         !lidet__isfinite(cfg->person_min_height_m) || cfg->person_min_height_m < 0.0f ||
         !lidet__isfinite(cfg->person_min_aspect) || cfg->person_min_aspect < 0.0f || cfg->join_cars > 1u ||
-        !lidet__isfinite(cfg->join_gap_m) || cfg->join_gap_m < 0.0f ||
-        !lidet__isfinite(cfg->car_max_length_m) || !(cfg->car_max_length_m > 0.0f) ||
-        !lidet__isfinite(cfg->car_max_width_m) || !(cfg->car_max_width_m > 0.0f) ||
-        !lidet__isfinite(cfg->car_max_height_m) || !(cfg->car_max_height_m > 0.0f) ||
-        !lidet__isfinite(cfg->car_min_length_m) || cfg->car_min_length_m < 0.0f ||
-        !lidet__isfinite(cfg->upright_max_width_m) || cfg->upright_max_width_m < 0.0f)
+        !lidet__isfinite(cfg->azimuth_half_rad) || cfg->azimuth_half_rad < 0.0f ||
+        cfg->azimuth_half_rad > LIDET_PI_F + 1e-6f || !lidet__isfinite(cfg->join_gap_m) ||
+        cfg->join_gap_m < 0.0f || !lidet__isfinite(cfg->car_max_length_m) ||
+        !(cfg->car_max_length_m > 0.0f) || !lidet__isfinite(cfg->car_max_width_m) ||
+        !(cfg->car_max_width_m > 0.0f) || !lidet__isfinite(cfg->car_max_height_m) ||
+        !(cfg->car_max_height_m > 0.0f) || !lidet__isfinite(cfg->car_min_length_m) ||
+        cfg->car_min_length_m < 0.0f || !lidet__isfinite(cfg->upright_max_width_m) ||
+        cfg->upright_max_width_m < 0.0f)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -145,6 +148,38 @@ float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const
         return pl->nx * mean[0] + pl->ny * mean[1] + pl->nz * mean[2] + pl->d_m;
     }
     return mean[2] + c->cfg.mount_height_m;
+}
+
+/* the azimuth window (cfg azimuth_half_rad): column c spans azimuths pi (1 - 2 (c + 1) / n) .. pi (1 - 2 c / n),
+ * straight ahead at c = n / 2; the candidates of the columns outside the window (one more column on each side)
+ * become non-candidates. Returns how many candidates it took away. */
+static uint32_t window_out(const lidet_cluster_cfg_t *cfg, uint32_t rows, uint32_t cols, uint16_t *lab)
+{
+    float half, lo, hi;
+    uint32_t c_lo, c_hi, r, col, out = 0;
+    if (!(cfg->azimuth_half_rad > 0.0f && cfg->azimuth_half_rad < LIDET_PI_F))
+    {
+        return 0;
+    }
+    half = cfg->azimuth_half_rad * (float)cols / (2.0f * LIDET_PI_F);
+    lo = 0.5f * (float)cols - half - 1.0f;
+    hi = 0.5f * (float)cols + half + 1.0f;
+    c_lo = lo > 0.0f ? (uint32_t)lo : 0u;
+    c_hi = hi < (float)cols ? (uint32_t)hi + 1u : cols;
+    for (r = 0; r < rows; ++r)
+    {
+        uint16_t *row = lab + (size_t)r * cols;
+        for (col = 0; col < cols; ++col)
+        {
+            if (col >= c_lo && col < c_hi)
+            {
+                continue;
+            }
+            out += (uint32_t)(row[col] == (uint16_t)LAB_FREE);
+            row[col] = (uint16_t)LAB_NONCAND;
+        }
+    }
+    return out;
 }
 
 /* the numeric kernels of the shared filters and records (lidet_cluster_run_body.h) */
@@ -280,6 +315,7 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
                 n_cand += cand;
             }
         }
+        n_cand -= window_out(&c->cfg, img->n_rows, img->n_cols, lab);
         st.n_candidates = n_cand;
         if (c->cfg.max_bridge_per_pixel > 0.0f)
         {

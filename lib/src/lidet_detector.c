@@ -11,6 +11,9 @@
 /* plausible sizes (l, w, h, metres) per class; the KITTI training labels' range with margin
  * (docs/DETECTOR.md): car 2.0-7.5 x 1.2-3.0 x 0.9-3.2, cyclist 0.8-2.6 x 0.2-1.5 x 0.8-2.4,
  * pedestrian 0.2-1.6 x 0.2-1.6 x 0.7-2.4 */
+/* how far beyond the crop the projection keeps points (30 deg: a car 5 m away spans 40 deg of azimuth) */
+#define LIDET_DET_CROP_MARGIN_RAD 0.5236f
+
 static const float CLASS_SIZE_MIN[LIDET_N_CLASSES][3] = {
     {2.0f, 1.2f, 0.9f}, {0.8f, 0.2f, 0.8f}, {0.2f, 0.2f, 0.7f}};
 static const float CLASS_SIZE_MAX[LIDET_N_CLASSES][3] = {
@@ -97,7 +100,20 @@ lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg
             return LIDET_ERR_MODEL;
         }
     }
-    st = lidet_workspace_init(&d->ws, &cfg->stages);
+    {
+        /* the crop: the clustering takes candidates in the crop's columns and a margin only (an object whose
+         * mean lies inside the crop stays whole up to LIDET_DET_CROP_MARGIN_RAD beyond it); the projection and
+         * the ground stage still see the whole scan (the ground's planes, and so every label, stay those of
+         * the 360-degree run). A window set by the caller is kept */
+        lidet_workspace_cfg_t ws_cfg = cfg->stages;
+        if (cfg->crop_half_rad > 0.0f && cfg->crop_half_rad < LIDET_PI_F &&
+            ws_cfg.cluster.azimuth_half_rad == 0.0f)
+        {
+            const float w = cfg->crop_half_rad + LIDET_DET_CROP_MARGIN_RAD;
+            ws_cfg.cluster.azimuth_half_rad = w < LIDET_PI_F ? w : LIDET_PI_F;
+        }
+        st = lidet_workspace_init(&d->ws, &ws_cfg);
+    }
     if (st != LIDET_OK)
     {
         return st;

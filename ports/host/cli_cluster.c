@@ -115,6 +115,7 @@ int cli_cluster_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, upright_max_width_m)
     CLI_SET_INT(c, kv, klen, v, max_fragment_pixels, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, max_join_pieces, uint32_t, 4294967295.0)
+    CLI_SET_FLOAT(c, kv, klen, v, azimuth_half_rad)
 
     return 1;
 }

@@ -133,6 +133,30 @@ def test_rescue_matches_reference_on_sample(root):
     assert np.all(np.diff(c.seed_pixel.astype(np.int64)) > 0)
 
 
+@pytest.mark.parametrize("sensor,half", [("vlp16", 0.8), ("hdl64", 1.3090)])
+def test_azimuth_window_matches_reference(root, sensor, half):
+    """azimuth_half_rad (what the detector's crop sets): only the columns within it are candidates, in C and in
+    the reference; the clusters inside it are those of the whole image, the pixels outside it unlabelled."""
+    d = root / "tests" / "data" / f"sim_{sensor}"
+    pts = np.fromfile(d / "velodyne" / "000000.bin", np.float32).reshape(-1, 4)
+    lab = np.fromfile(d / "labels" / "000000.label", np.uint32)
+    ground = np.isin(lab & 0xFFFF, GROUND)
+    defaults = {k: v for k, v in native.cluster_defaults(sensor).items() if k != "mount_height_m"}
+    win = _check_against_ref(pts, ground, dict(defaults, azimuth_half_rad=half), sensor, exact=True)
+    full = native.cluster(pts, sensor, ground=ground, with_image=True)
+    assert 0 < win.stats["n_candidates"] < full.stats["n_candidates"]
+    cols = win.pixel_labels.shape[1]
+    az = np.pi * (1.0 - 2.0 * (np.arange(cols) + 0.5) / cols)  # column centres
+    assert not win.pixel_labels[:, np.abs(az) > half + 4 * np.pi / cols].any()
+    # a cluster of the whole image with every pixel well inside the window is there, the same pixels
+    inside = np.abs(az) < half - np.radians(20)
+    for k in range(1, int(full.pixel_labels.max()) + 1):
+        m = full.pixel_labels == k
+        if inside[np.nonzero(m)[1]].all():
+            ids = np.unique(win.pixel_labels[m])
+            assert len(ids) == 1 and ids[0] > 0 and (win.pixel_labels == ids[0]).sum() == m.sum()
+
+
 def _check_against_ref(pts, ground, cfg, sensor="hdl64", exact=False):
     c = native.cluster(pts, sensor, ground=ground, with_image=True, **cfg)
     img = c.image

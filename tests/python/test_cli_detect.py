@@ -39,9 +39,13 @@ def test_json_contract(cli):
 def test_crop_keeps_the_front(cli):
     full = json.loads(_run(cli, SCAN, "--json").stdout)
     crop = json.loads(_run(cli, SCAN, "--json", "--crop").stdout)
-    assert crop["out_of_crop"] > 0 and full["out_of_crop"] == 0
-    assert crop["clusters"] == full["clusters"]
-    assert crop["classified"] == min(crop["clusters"] - crop["out_of_crop"], crop["budget"])
+    # without the clustering's window (pi) every cluster is made and the crop leaves the rear ones out
+    nowin = json.loads(_run(cli, SCAN, "--json", "--crop", "--set", "stages.cluster.azimuth_half_rad=3.14159").stdout)
+    assert nowin["out_of_crop"] > 0 and full["out_of_crop"] == 0 and nowin["clusters"] == full["clusters"]
+    # with it (the default: crop + 30 deg) the rear is never clustered; the same proposals are classified
+    assert crop["clusters"] < full["clusters"] and crop["out_of_crop"] < nowin["out_of_crop"]
+    assert crop["classified"] == nowin["classified"] == min(crop["clusters"] - crop["out_of_crop"], crop["budget"])
+    assert crop["detections"] == nowin["detections"]
 
 
 def test_outputs_agree_with_python_conversion(cli, tmp_path):

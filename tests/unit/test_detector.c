@@ -174,11 +174,43 @@ void test_crop_budget_range_and_gates(void)
     uint32_t n = 0;
     scene();
     cfg.crop_half_rad = 0.25f * 3.14159265f;
+    /* the crop's window on the clustering lifted (pi): C is clustered, then left out by the crop */
+    cfg.stages.cluster.azimuth_half_rad = 3.14159265f;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
     s = lidet_detector_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(3, s->n_clusters);
     TEST_ASSERT_EQUAL_UINT32(1, s->n_out_of_crop); /* C, behind */
     TEST_ASSERT_EQUAL_UINT32(2, s->n_classified);
+    {
+        /* the default: the crop sets the clustering's window (crop + 30 deg), C's pixels are no candidates,
+         * the same two detections come out, bit for bit */
+        lidet_detection_t both[2];
+        uint32_t n2 = 0, k, cand_all = s->stages.cluster.n_candidates;
+        d = lidet_detector_detections(&g.ws, &n);
+        TEST_ASSERT_EQUAL_UINT32(2, n);
+        memcpy(both, d, sizeof both);
+        cfg.stages.cluster.azimuth_half_rad = 0.0f;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+        s = lidet_detector_stats(&g.ws);
+        TEST_ASSERT_EQUAL_UINT32(2, s->n_clusters);
+        TEST_ASSERT_EQUAL_UINT32(0, s->n_out_of_crop);
+        TEST_ASSERT_TRUE(s->stages.cluster.n_candidates < cand_all);
+        d = lidet_detector_detections(&g.ws, &n2);
+        TEST_ASSERT_EQUAL_UINT32(2, n2);
+        {
+            /* the same detections; only the cluster ids differ (C, no longer a cluster, had one of them) */
+            lidet_detection_t win[2];
+            memcpy(win, d, sizeof win);
+            for (k = 0; k < 2u; ++k)
+            {
+                TEST_ASSERT_TRUE(win[k].cluster_id >= 1 && win[k].cluster_id <= 2);
+                win[k].cluster_id = both[k].cluster_id;
+            }
+            TEST_ASSERT_EQUAL_MEMORY(both, win, sizeof both);
+        }
+    }
 
     /* budget of one: the nearest (B at 10 m, before A at ~10 m? B is at sqrt(100) = 10, A at 10): the
      * range ties break by cluster id; the other is over the budget and the status says so */

@@ -82,7 +82,7 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                 max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30,
                 rescue_gap_m: float = 0.0, rescue_gap_per_m: float = 0.0, rescue_rows: int = 0, rescue_cols: int = 0,
                 max_fragment_pixels: int = 0, max_bridge_per_pixel: float = 0.0, split_people: bool = False,
-                join_cars: bool = False, **refine):
+                join_cars: bool = False, azimuth_half_rad: float = 0.0, **refine):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
     member-pixel arrays per kept cluster in raster order). Float32 tangent and distance tests like the
@@ -95,6 +95,17 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
     rows, cols = range_m.shape
     rng = np.asarray(range_m, np.float32).ravel()
     cand = np.asarray(candidate, bool).ravel()
+    w = np.float32(azimuth_half_rad)
+    if np.float32(0.0) < w < np.float32(np.pi):
+        # the azimuth window (lidet_cluster.c window_out): the columns within w of straight ahead, one more each side
+        half = np.float32(np.float32(w * np.float32(cols)) / np.float32(2.0 * np.float32(np.pi)))
+        lo = np.float32(np.float32(np.float32(0.5) * np.float32(cols)) - half) - np.float32(1.0)
+        hi = np.float32(np.float32(np.float32(0.5) * np.float32(cols)) + half) + np.float32(1.0)
+        c_lo = int(lo) if lo > 0 else 0
+        c_hi = int(hi) + 1 if hi < cols else cols
+        keep = np.zeros(cols, bool)
+        keep[c_lo:c_hi] = True
+        cand = cand & np.tile(keep, rows)
     P = np.asarray(xyz, np.float64).reshape(-1, 3)
     tan_t = np.float32(np.tan(np.float32(theta_rad)))
     elev = np.asarray(row_elev_rad, np.float32)

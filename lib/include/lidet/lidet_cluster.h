@@ -193,6 +193,11 @@ typedef struct
     float upright_max_width_m;    /**< a cluster spanning at most this in x and in y and at least
                                   person_min_height_m in z is upright (a person, a cyclist, a pole)
                                   and joins nothing; >= 0; default 1.3 m */
+    float azimuth_half_rad;       /**< 0 (default): the whole image; in (0, pi): only pixels whose column lies
+                                       within this azimuth of straight ahead (+x; one column more on each
+                                       side) are candidates (the others are not counted in n_candidates). The
+                                       detector's crop sets it to the crop + 30 deg, so a cropped scan is
+                                       clustered on that part only; pi: no limit */
     uint32_t max_join_pieces;     /**< join budget (bounds the joins' time whatever the scan): only the first
                                   max_join_pieces car pieces in slot order take part in the joins, the rest
                                   join nothing (stats n_join_skipped); the joins then test at most

@@ -111,19 +111,20 @@ typedef struct
 /** @brief Counts of the last run. */
 typedef struct
 {
-    uint32_t n_clusters;                /**< kept clusters */
-    uint32_t n_out_of_crop;             /**< outside the azimuth window */
-    uint32_t n_out_of_range;            /**< beyond max_range_m */
-    uint32_t n_over_budget;             /**< past max_proposals (farthest first) */
-    uint32_t n_classified;              /**< proposals through the classifier */
-    uint32_t n_gate1_rejected;          /**< failed gate 1 */
-    uint32_t n_boxed;                   /**< proposals through the box net */
-    uint32_t n_gate2_rejected;          /**< failed gate 2 */
-    uint32_t n_size_rejected;           /**< boxes of impossible size */
-    uint32_t n_nms_suppressed;          /**< dropped by the NMS */
-    uint32_t n_over_capacity;           /**< detections past LIDET_MAX_DETECTIONS (lowest scores) */
-    uint32_t n_detections;              /**< in the output */
-    uint32_t n_over_box_budget;         /**< passed gate 1 past max_boxes (not boxed) */
+    uint32_t n_clusters;        /**< kept clusters */
+    uint32_t n_out_of_crop;     /**< clusters whose mean lies outside the crop (the crop + 30 deg window
+                                             of the clustering keeps the rest of the scan out) */
+    uint32_t n_out_of_range;    /**< beyond max_range_m */
+    uint32_t n_over_budget;     /**< past max_proposals (farthest first) */
+    uint32_t n_classified;      /**< proposals through the classifier */
+    uint32_t n_gate1_rejected;  /**< failed gate 1 */
+    uint32_t n_boxed;           /**< proposals through the box net */
+    uint32_t n_gate2_rejected;  /**< failed gate 2 */
+    uint32_t n_size_rejected;   /**< boxes of impossible size */
+    uint32_t n_nms_suppressed;  /**< dropped by the NMS */
+    uint32_t n_over_capacity;   /**< detections past LIDET_MAX_DETECTIONS (lowest scores) */
+    uint32_t n_detections;      /**< in the output */
+    uint32_t n_over_box_budget; /**< passed gate 1 past max_boxes (not boxed) */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_workspace_stats_t stages;     /**< the stages' own counts */
 } lidet_detector_stats_t;
