@@ -262,6 +262,28 @@ static void insert_sorted(lidet_detection_t *det, uint32_t n)
     det[i] = t;
 }
 
+/* the per-candidate loop (internal/lidet_detector_body.h), with the float detector's types and numbers */
+static void fill_detection(const lidet_detector_t *d, lidet_detection_t *t, uint32_t ci,
+                           const lidet_pn_class_out_t *co, const lidet_pn_box_out_t *bo)
+{
+    t->score = 1.0f / (1.0f + expf(co->energy - d->cls.model->gamma[co->cls]));
+    t->energy_cls = co->energy;
+    t->energy_box = bo->energy;
+    t->n_points = d->ws.cluster.recs[ci].n_points;
+}
+#define DET_T lidet_detector_t
+#define DET_CLS_OUT_T lidet_pn_class_out_t
+#define DET_BOX_OUT_T lidet_pn_box_out_t
+#define DET_DETECTION_T lidet_detection_t
+#define DET_PROPOSAL(d, ci) lidet_workspace_proposal(&(d)->ws, (ci), &(d)->cfg.proposal, &(d)->proposal)
+#define DET_CLASSIFY(d, co) lidet_pn_classify(&(d)->cls, &(d)->proposal, (co))
+#define DET_BOX(d, cls, bo) lidet_pn_box(&(d)->box, &(d)->proposal, (cls), (bo))
+#define DET_SIZE_OK(d, cls, box) size_ok(&(d)->cfg, (cls), (box))
+#define DET_FILL fill_detection
+#define DET_INSERT insert_sorted
+#define DET_NOW now
+#include "internal/lidet_detector_body.h"
+
 lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint32_t n_points,
                                   uint32_t stride, const uint16_t *ring, int32_t *point_pixel)
 {
@@ -324,74 +346,10 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
     n_cand = lidet__nearest_first(d->key, d->order, n_cand, d->cfg.max_proposals, d->outcome,
                                   LIDET_DET_OUT_BUDGET, &st->n_over_budget);
 
-    for (i = 0; i < n_cand; ++i)
+    s = det_candidates(d, n_cand, &worst, &box_ticks);
+    if (s != LIDET_OK)
     {
-        const uint32_t ci = d->order[i];
-        lidet_pn_class_out_t co;
-        lidet_pn_box_out_t bo;
-        lidet_detection_t *t;
-        uint32_t tb;
-        s = lidet_workspace_proposal(&d->ws, ci, &d->cfg.proposal, &d->proposal);
-        if (s == LIDET_OK)
-        {
-            s = lidet_pn_classify(&d->cls, &d->proposal, &co);
-        }
-        if (s != LIDET_OK)
-        {
-            return s; /* cannot happen after a successful init and run */
-        }
-        ++st->n_classified;
-        if (d->cfg.gate1 && !co.pass)
-        {
-            d->outcome[ci] = LIDET_DET_OUT_GATE1;
-            ++st->n_gate1_rejected;
-            continue;
-        }
-        if (st->n_boxed == d->cfg.max_boxes)
-        {
-            d->outcome[ci] = LIDET_DET_OUT_BUDGET;
-            ++st->n_over_box_budget;
-            worst = LIDET_TRUNCATED;
-            continue;
-        }
-        tb = now(d);
-        s = lidet_pn_box(&d->box, &d->proposal, co.cls, &bo);
-        box_ticks += now(d) - tb;
-        if (s != LIDET_OK)
-        {
-            return s;
-        }
-        ++st->n_boxed;
-        if (d->cfg.gate2 && !bo.pass)
-        {
-            d->outcome[ci] = LIDET_DET_OUT_GATE2;
-            ++st->n_gate2_rejected;
-            continue;
-        }
-        if (!size_ok(&d->cfg, co.cls, &bo.box))
-        {
-            d->outcome[ci] = LIDET_DET_OUT_SIZE;
-            ++st->n_size_rejected;
-            continue;
-        }
-        t = &d->det[d->n_det];
-        t->box = bo.box;
-        t->cls = co.cls;
-        t->score = 1.0f / (1.0f + expf(co.energy - d->cls.model->gamma[co.cls]));
-        t->energy_cls = co.energy;
-        t->energy_box = bo.energy;
-        t->cluster_id = ci + 1u;
-        t->n_points = recs[ci].n_points;
-        insert_sorted(d->det, d->n_det);
-        ++d->n_det;
-        d->outcome[ci] = LIDET_DET_OUT_DETECTED;
-        if (d->n_det > LIDET_MAX_DETECTIONS)
-        {
-            --d->n_det; /* the lowest score goes */
-            d->outcome[d->det[d->n_det].cluster_id - 1u] = LIDET_DET_OUT_CAPACITY;
-            ++st->n_over_capacity;
-            worst = LIDET_TRUNCATED;
-        }
+        return s; /* cannot happen after a successful init and run */
     }
     t1 = now(d);
     cls_ticks = (t1 - t0) - box_ticks;

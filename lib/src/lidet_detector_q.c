@@ -202,6 +202,29 @@ static uint32_t candidates(lidet_detector_q_t *d, lidet_status_t *worst)
                                 &st->n_over_budget);
 }
 
+/* the per-candidate loop (internal/lidet_detector_body.h), with the integer detector's types and numbers */
+static void fill_detection(const lidet_detector_q_t *d, lidet_detection_q_t *t, uint32_t ci,
+                           const lidet_pointnet_q_class_out_t *co, const lidet_pointnet_q_box_out_t *bo)
+{
+    t->reserved = 0;
+    t->score_q15 = lidet_detector_q_score(co->energy_q16, d->cls.model->gamma_q16[co->cls]);
+    t->energy_cls_q16 = co->energy_q16;
+    t->energy_box_q16 = bo->energy_q16;
+    t->n_points = d->cluster.recs[ci].n_points;
+}
+#define DET_T lidet_detector_q_t
+#define DET_CLS_OUT_T lidet_pointnet_q_class_out_t
+#define DET_BOX_OUT_T lidet_pointnet_q_box_out_t
+#define DET_DETECTION_T lidet_detection_q_t
+#define DET_PROPOSAL(d, ci) lidet_proposal_q_make(&(d)->cluster, (ci), &(d)->cfg.proposal, &(d)->proposal)
+#define DET_CLASSIFY(d, co) lidet_pointnet_q_classify(&(d)->cls, &(d)->proposal, (co))
+#define DET_BOX(d, cls, bo) lidet_pointnet_q_box(&(d)->box, &(d)->proposal, (cls), (bo))
+#define DET_SIZE_OK(d, cls, box) lidet_size_ok_q(&(d)->cfg.size, (cls), (box))
+#define DET_FILL fill_detection
+#define DET_INSERT lidet_detections_q_insert
+#define DET_NOW now
+#include "internal/lidet_detector_body.h"
+
 lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,
                                     uint32_t stride, const uint16_t *ring, int32_t *point_pixel)
 {
@@ -269,75 +292,10 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
     t0 = now(d);
     st->n_clusters = d->cluster.n_recs;
     n_cand = candidates(d, &worst);
-    for (i = 0; i < n_cand; ++i)
+    s = det_candidates(d, n_cand, &worst, &box_ticks);
+    if (s != LIDET_OK)
     {
-        const uint32_t ci = d->order[i];
-        lidet_pointnet_q_class_out_t co;
-        lidet_pointnet_q_box_out_t bo;
-        lidet_detection_q_t *t;
-        uint32_t tb;
-        s = lidet_proposal_q_make(&d->cluster, ci, &d->cfg.proposal, &d->proposal);
-        if (s == LIDET_OK)
-        {
-            s = lidet_pointnet_q_classify(&d->cls, &d->proposal, &co);
-        }
-        if (s != LIDET_OK)
-        {
-            return s; /* cannot happen after a successful init and run */
-        }
-        ++st->n_classified;
-        if (d->cfg.gate1 && !co.pass)
-        {
-            d->outcome[ci] = LIDET_DET_OUT_GATE1;
-            ++st->n_gate1_rejected;
-            continue;
-        }
-        if (st->n_boxed == d->cfg.max_boxes)
-        {
-            d->outcome[ci] = LIDET_DET_OUT_BUDGET;
-            ++st->n_over_box_budget;
-            worst = LIDET_TRUNCATED;
-            continue;
-        }
-        tb = now(d);
-        s = lidet_pointnet_q_box(&d->box, &d->proposal, co.cls, &bo);
-        box_ticks += now(d) - tb;
-        if (s != LIDET_OK)
-        {
-            return s;
-        }
-        ++st->n_boxed;
-        if (d->cfg.gate2 && !bo.pass)
-        {
-            d->outcome[ci] = LIDET_DET_OUT_GATE2;
-            ++st->n_gate2_rejected;
-            continue;
-        }
-        if (!lidet_size_ok_q(&d->cfg.size, co.cls, &bo.box))
-        {
-            d->outcome[ci] = LIDET_DET_OUT_SIZE;
-            ++st->n_size_rejected;
-            continue;
-        }
-        t = &d->det[d->n_det];
-        t->box = bo.box;
-        t->cls = co.cls;
-        t->reserved = 0;
-        t->score_q15 = lidet_detector_q_score(co.energy_q16, d->cls.model->gamma_q16[co.cls]);
-        t->energy_cls_q16 = co.energy_q16;
-        t->energy_box_q16 = bo.energy_q16;
-        t->cluster_id = (uint16_t)(ci + 1u);
-        t->n_points = d->cluster.recs[ci].n_points;
-        lidet_detections_q_insert(d->det, d->n_det);
-        ++d->n_det;
-        d->outcome[ci] = LIDET_DET_OUT_DETECTED;
-        if (d->n_det > LIDET_MAX_DETECTIONS)
-        {
-            --d->n_det; /* the lowest score goes */
-            d->outcome[d->det[d->n_det].cluster_id - 1u] = LIDET_DET_OUT_CAPACITY;
-            ++st->n_over_capacity;
-            worst = LIDET_TRUNCATED;
-        }
+        return s; /* cannot happen after a successful init and run */
     }
     t1 = now(d);
     st->ticks[LIDET_DET_STAGE_CLASSIFY] = (t1 - t0) - box_ticks;

@@ -1,0 +1,95 @@
+/* SPDX-License-Identifier: MIT */
+/* The detector's per-candidate loop, written once for the float detector (lidet_detector.c) and the integer one
+ * (lidet_detector_q.c), each of which includes this file once: for every candidate cluster, nearest first, the
+ * proposal, the classifier and gate 1, the box budget, the box net and gate 2, the class size check, and the
+ * detection (kept sorted by score, the lowest dropped past LIDET_MAX_DETECTIONS), with each cluster's outcome and
+ * the counts. The two builds differ only in their types and numbers, which the includer passes:
+ *   DET_T                     the detector (members cfg.gate1, cfg.gate2, cfg.max_boxes, order, outcome, det,
+ *                             n_det, stats);
+ *   DET_CLS_OUT_T, DET_BOX_OUT_T  the classifier's and the box net's outputs (members cls, pass; box, pass);
+ *   DET_DETECTION_T           one detection (members box, cls, cluster_id);
+ *   DET_PROPOSAL(d, ci)       make cluster ci's proposal, a lidet_status_t;
+ *   DET_CLASSIFY(d, co)       classify it into *co, a lidet_status_t;
+ *   DET_BOX(d, cls, bo)       box it as class cls into *bo, a lidet_status_t;
+ *   DET_SIZE_OK(d, cls, box)  1 when the box's size is plausible for class cls;
+ *   DET_FILL(d, t, ci, co, bo)  the build's own fields of detection *t (score, energies, point count; the loop
+ *                             sets box, cls and cluster_id);
+ *   DET_INSERT(det, n)        move det[n] into det[0..n), kept sorted by score;
+ *   DET_NOW(d)                the detector's clock.
+ * Defines: static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *worst,
+ * uint32_t *box_ticks). An error status (cannot happen after a successful init and run) ends the loop and is
+ * returned; otherwise LIDET_OK, with *worst set to LIDET_TRUNCATED when the box budget or the detection capacity
+ * was reached. Not a public header; include nowhere else. */
+
+static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *worst, uint32_t *box_ticks)
+{
+    uint32_t i;
+    for (i = 0; i < n_cand; ++i)
+    {
+        const uint32_t ci = d->order[i];
+        DET_CLS_OUT_T co;
+        DET_BOX_OUT_T bo;
+        DET_DETECTION_T *t;
+        lidet_status_t s;
+        uint32_t tb;
+        s = DET_PROPOSAL(d, ci);
+        if (s == LIDET_OK)
+        {
+            s = DET_CLASSIFY(d, &co);
+        }
+        if (s != LIDET_OK)
+        {
+            return s;
+        }
+        ++d->stats.n_classified;
+        if (d->cfg.gate1 && !co.pass)
+        {
+            d->outcome[ci] = LIDET_DET_OUT_GATE1;
+            ++d->stats.n_gate1_rejected;
+            continue;
+        }
+        if (d->stats.n_boxed == d->cfg.max_boxes)
+        {
+            d->outcome[ci] = LIDET_DET_OUT_BUDGET;
+            ++d->stats.n_over_box_budget;
+            *worst = LIDET_TRUNCATED;
+            continue;
+        }
+        tb = DET_NOW(d);
+        s = DET_BOX(d, co.cls, &bo);
+        *box_ticks += DET_NOW(d) - tb;
+        if (s != LIDET_OK)
+        {
+            return s;
+        }
+        ++d->stats.n_boxed;
+        if (d->cfg.gate2 && !bo.pass)
+        {
+            d->outcome[ci] = LIDET_DET_OUT_GATE2;
+            ++d->stats.n_gate2_rejected;
+            continue;
+        }
+        if (!DET_SIZE_OK(d, co.cls, &bo.box))
+        {
+            d->outcome[ci] = LIDET_DET_OUT_SIZE;
+            ++d->stats.n_size_rejected;
+            continue;
+        }
+        t = &d->det[d->n_det];
+        t->box = bo.box;
+        t->cls = co.cls;
+        t->cluster_id = ci + 1u;
+        DET_FILL(d, t, ci, &co, &bo);
+        DET_INSERT(d->det, d->n_det);
+        ++d->n_det;
+        d->outcome[ci] = LIDET_DET_OUT_DETECTED;
+        if (d->n_det > LIDET_MAX_DETECTIONS)
+        {
+            --d->n_det; /* the lowest score goes */
+            d->outcome[d->det[d->n_det].cluster_id - 1u] = LIDET_DET_OUT_CAPACITY;
+            ++d->stats.n_over_capacity;
+            *worst = LIDET_TRUNCATED;
+        }
+    }
+    return LIDET_OK;
+}
