@@ -253,16 +253,30 @@ typedef lidet_detection_t fw_detection_t;
 #define fw_detections lidet_detector_detections
 #endif
 
+/* One detection: its 10 values (score, box x y z l w h yaw, both energies) as hex words, which run_fw.py compares
+ * with the host, then the first 8 again in readable form after a '#' (integers in the fixed build). */
+#if LIDET_FIXED_POINT
+typedef int32_t fw_val_t;
+#define FW_VALUES(d)                                                                                               \
+    {(d)->score_q15, (d)->box.cx_mm, (d)->box.cy_mm, (d)->box.cz_mm,  (d)->box.l_mm,                               \
+     (d)->box.w_mm,  (d)->box.h_mm,  (d)->box.yaw_bam, (d)->energy_cls_q16, (d)->energy_box_q16}
+#define FW_PUT_HEX(v) put_hex((uint32_t)(v))
+#define FW_PUT_V put_i
+static const char *const k_val_labels[8] = {" # score_q15 ", " xyz_mm ", " ", " ", " lwh_mm ", " ", " ", " yaw_bam "};
+#else
+typedef float fw_val_t;
+#define FW_VALUES(d)                                                                                               \
+    {(d)->score, (d)->box.cx_m, (d)->box.cy_m, (d)->box.cz_m, (d)->box.l_m,                                        \
+     (d)->box.w_m, (d)->box.h_m, (d)->box.yaw_rad, (d)->energy_cls, (d)->energy_box}
+#define FW_PUT_HEX(v) put_hex(bits(v))
+#define FW_PUT_V put_f
+static const char *const k_val_labels[8] = {" # score ", " xyz ", " ", " ", " lwh ", " ", " ", " yaw "};
+#endif
+
 static void put_det(const char *name, uint32_t k, const fw_detection_t *d)
 {
+    const fw_val_t v[10] = FW_VALUES(d);
     uint32_t j;
-#if LIDET_FIXED_POINT
-    const int32_t v[10] = {d->score_q15, d->box.cx_mm, d->box.cy_mm, d->box.cz_mm, d->box.l_mm,
-                           d->box.w_mm,  d->box.h_mm,  d->box.yaw_bam, d->energy_cls_q16, d->energy_box_q16};
-#else
-    const float f[10] = {d->score, d->box.cx_m, d->box.cy_m, d->box.cz_m, d->box.l_m,
-                         d->box.w_m, d->box.h_m, d->box.yaw_rad, d->energy_cls, d->energy_box};
-#endif
     put_s("det ");
     put_s(name);
     fw_putc(' ');
@@ -276,47 +290,13 @@ static void put_det(const char *name, uint32_t k, const fw_detection_t *d)
     for (j = 0; j < 10u; ++j)
     {
         fw_putc(' ');
-#if LIDET_FIXED_POINT
-        put_hex((uint32_t)v[j]);
-#else
-        put_hex(bits(f[j]));
-#endif
+        FW_PUT_HEX(v[j]);
     }
-#if LIDET_FIXED_POINT
-    put_s(" # score_q15 ");
-    put_i(d->score_q15);
-    put_s(" xyz_mm ");
-    put_i(d->box.cx_mm);
-    fw_putc(' ');
-    put_i(d->box.cy_mm);
-    fw_putc(' ');
-    put_i(d->box.cz_mm);
-    put_s(" lwh_mm ");
-    put_i(d->box.l_mm);
-    fw_putc(' ');
-    put_i(d->box.w_mm);
-    fw_putc(' ');
-    put_i(d->box.h_mm);
-    put_s(" yaw_bam ");
-    put_i(d->box.yaw_bam);
-#else
-    put_s(" # score ");
-    put_f(d->score);
-    put_s(" xyz ");
-    put_f(d->box.cx_m);
-    fw_putc(' ');
-    put_f(d->box.cy_m);
-    fw_putc(' ');
-    put_f(d->box.cz_m);
-    put_s(" lwh ");
-    put_f(d->box.l_m);
-    fw_putc(' ');
-    put_f(d->box.w_m);
-    fw_putc(' ');
-    put_f(d->box.h_m);
-    put_s(" yaw ");
-    put_f(d->box.yaw_rad);
-#endif
+    for (j = 0; j < 8u; ++j)
+    {
+        put_s(k_val_labels[j]);
+        FW_PUT_V(v[j]);
+    }
     fw_putc('\n');
 }
 
