@@ -87,6 +87,9 @@ set(fw_images
     # the integer-only build (issue 16): cores without FPU, compared bit for bit with fw_host_ref_q
     "mps2-an385-q|mps2-an385|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed"
     "mps2-an385-m0plus-q|mps2-an385-m0plus|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed"
+    # ... and cores with the DSP extension (their FPU unused): the int8 kernel with SMLAD
+    "mps2-an386-q|mps2-an386|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed"
+    "mps2-an500-q|mps2-an500|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed"
     "virt-rv32imac-q|virt-rv32imac|vlp16|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size|fixed")
 foreach(entry IN LISTS fw_images)
   string(REPLACE "|" ";" f "${entry}")

@@ -28,6 +28,10 @@ BOARDS = [  # board, core, FPU, QEMU machine
     ("mps2-an385-q", "Cortex-M3, **integer build**", "none (no float at all)", "mps2-an385"),
     ("mps2-an385-m0plus-q", "Cortex-M0+ code, **integer build**", "none (no float at all)", "mps2-an385"),
     ("virt-rv32imac-q", "RV32IMAC, **integer build**", "none (no F extension)", "virt"),
+    ("mps2-an386-q", "Cortex-M4, **integer build** (DSP: SMLAD int8 kernel)", "present, unused (no float at all)",
+     "mps2-an386"),
+    ("mps2-an500-q", "Cortex-M7, **integer build** (DSP: SMLAD int8 kernel)", "present, unused (no float at all)",
+     "mps2-an500"),
 ]
 STAGES = ["project", "ground", "cluster", "classify", "box", "post"]
 
@@ -71,7 +75,7 @@ def run(args) -> str:
         "Images built with GCC 12 (Debian's gcc-arm-none-eabi + newlib-nano, gcc-riscv64-unknown-elf + picolibc), "
         "-O2, and run under QEMU 7.2 with `-icount`. Two runs per image: `default` (the configuration a user gets: "
         "gates and size checks on) and `open` (gates and "
-        "size checks off, so that every classified proposal is boxed and compared). The last two rows of each table "
+        "size checks off, so that every classified proposal is boxed and compared). The rows marked **HDL-64 scan** "
         "are the KITTI-like images: the simulated HDL-64 scan `tests/data/sim_hdl64/000000` (124,205 points) with "
         "the capacities of `ports/firmware/config/hdl64/lidet_user_config.h` (64 x 2048, 131,072 points, 1024 "
         "clusters). Its detector (4.4 MiB) does not fit "

@@ -16,7 +16,7 @@ extern const int32_t lidet__pnq_log2_q30[LIDET_PNQ_TABLE_STEPS + 1];
 void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
                       uint32_t n_out, int32_t *acc);
 /* the kernels behind lidet__nn_acc_s8 (nn/lidet_nn_s8.c: which one a target uses), exposed for their test:
- * the host kernel (4 rows per weight row), 2 x 2 and 4 x 2 register blocks, and the output-inner loop on a column slice of a layer (weight rows
+ * the host kernel (4 rows per weight row), 2 x 2 and 4 x 2 register blocks, the DSP one, and the output-inner loop on a column slice of a layer (weight rows
  * w_stride long, accumulator rows a_stride long) */
 void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                             const int32_t *b, uint32_t n_out, int32_t *acc);
@@ -27,6 +27,9 @@ void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
 void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, uint32_t w_stride, int32_t *acc,
                            uint32_t a_stride);
+/* 2 x 2 blocks, 4 inputs per step with SMLAD (Cortex-M4/M7 DSP extension; a C model of it elsewhere) */
+void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                          const int32_t *b, uint32_t n_out, int32_t *acc);
 /* the same with int16 inputs (the first layer: points in mm, voxel bins) */
 void lidet__nn_acc_s16(const int16_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
                        uint32_t n_out, int32_t *acc);

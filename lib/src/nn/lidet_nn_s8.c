@@ -63,11 +63,16 @@ LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, u
  * load each weight once per block of points: 2.75 instead of 4.5 instructions per multiply-add on a Cortex-M3
  * (2 x 2), 3.5 instead of 6 on RV32IM (4 x 2, more registers), counted in the compilers' inner loops.
  * ARMv6-M (Cortex-M0+: 8 low registers, no multiply-accumulate) takes the plain output-inner loop (two
- * inputs per pass: 6 instructions per multiply-add, rows4 costs more there). Override with
- * -DLIDET_NN_S8_KERNEL=0 (rows4), 1 (output-inner), 22 or 42. tests/unit/test_nn_s8.c checks that all agree. */
+ * inputs per pass: 6 instructions per multiply-add, rows4 costs more there). Cores with the DSP extension
+ * (Cortex-M4, M7, M33 with DSP: __ARM_FEATURE_DSP) take lidet__nn_acc_s8_dsp below, two multiply-adds per
+ * SMLAD. Override with -DLIDET_NN_S8_KERNEL=0 (rows4), 1 (output-inner), 2 (dsp), 22 or 42.
+ * tests/unit/test_nn_s8.c checks that all agree (on the host the DSP kernel runs on a C model of the three
+ * instructions it uses). */
 #ifndef LIDET_NN_S8_KERNEL
 #if defined(__riscv)
 #define LIDET_NN_S8_KERNEL 42
+#elif defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
+#define LIDET_NN_S8_KERNEL 2
 #elif defined(__arm__) && !defined(__ARM_ARCH_6M__)
 #define LIDET_NN_S8_KERNEL 22
 #elif defined(__ARM_ARCH_6M__)
@@ -158,10 +163,116 @@ void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
     }
 }
 
+/* The DSP kernel: 2 x 2 (points x output channels) accumulators, 4 inputs per step. One 32-bit load brings 4 int8
+ * inputs of a point; SXTB16 widens bytes 0 and 2 (and, rotated by 8, bytes 1 and 3) into two int16 halves:
+ * inputs (i, i + 2) and (i + 1, i + 3). The weights lie [in][out]: one halfword load brings channels o, o + 1 of
+ * one input, two of them (inputs i and i + 2) make a word whose SXTB16 is channel o's (w_i, w_i+2) and, rotated,
+ * channel o + 1's. SMLAD adds both halves' products to an accumulator: 8 SMLAD for 16 multiply-adds, with 6
+ * instructions for the inputs and 10 for the weights. Exact int32 sums, so the results equal the other kernels'.
+ * Off the DSP cores the three instructions are modelled in C (the host test runs it). */
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
+#include <arm_acle.h>
+#define S8_SXTB16(v) ((uint32_t)__sxtb16((int32_t)(v)))
+#define S8_SXTB16_ROR8(v) ((uint32_t)__sxtb16((int32_t)(((v) >> 8) | ((v) << 24))))
+#define S8_SMLAD(a, b, acc) __smlad((int32_t)(a), (int32_t)(b), (acc))
+#else
+static inline uint32_t s8_half(int32_t v)
+{
+    return (uint32_t)v & 0xFFFFu;
+}
+static inline uint32_t S8_SXTB16(uint32_t v)
+{
+    return s8_half((int8_t)(v & 0xFFu)) | (s8_half((int8_t)((v >> 16) & 0xFFu)) << 16);
+}
+static inline uint32_t S8_SXTB16_ROR8(uint32_t v)
+{
+    return S8_SXTB16((v >> 8) | (v << 24));
+}
+static inline int32_t S8_SMLAD(uint32_t a, uint32_t b, int32_t acc)
+{
+    const int32_t alo = (int16_t)(a & 0xFFFFu), ahi = (int16_t)(a >> 16);
+    const int32_t blo = (int16_t)(b & 0xFFFFu), bhi = (int16_t)(b >> 16);
+    return acc + alo * blo + ahi * bhi;
+}
+#endif
+
+/* 4 int8 inputs, little endian (a 32-bit load where the core allows unaligned ones) */
+static inline uint32_t s8_load4(const int8_t *p)
+{
+    return (uint32_t)(uint8_t)p[0] | ((uint32_t)(uint8_t)p[1] << 8) | ((uint32_t)(uint8_t)p[2] << 16) |
+           ((uint32_t)(uint8_t)p[3] << 24);
+}
+
+/* 2 int8 weights as 16 bits, little endian (a halfword load) */
+static inline uint32_t s8_load2(const int8_t *p)
+{
+    return (uint32_t)(uint8_t)p[0] | ((uint32_t)(uint8_t)p[1] << 8);
+}
+
+void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                          const int32_t *b, uint32_t n_out, int32_t *acc)
+{
+    const uint32_t n4 = n_in & ~3u;
+    uint32_t r, i, o;
+    for (r = 0; r + 2u <= n_rows; r += 2u)
+    {
+        const int8_t *x0 = in + r * n_in, *x1 = x0 + n_in;
+        int32_t *a0 = acc + r * n_out, *a1 = a0 + n_out;
+        for (o = 0; o + 2u <= n_out; o += 2u)
+        {
+            int32_t s00 = b[o], s01 = b[o + 1u], s10 = s00, s11 = s01;
+            const int8_t *w = w_t + o;
+            for (i = 0; i < n4; i += 4u, w += 4u * n_out)
+            {
+                const uint32_t u0 = s8_load4(x0 + i), u1 = s8_load4(x1 + i);
+                const uint32_t p02 = S8_SXTB16(u0), p13 = S8_SXTB16_ROR8(u0);
+                const uint32_t q02 = S8_SXTB16(u1), q13 = S8_SXTB16_ROR8(u1);
+                /* channels o, o + 1 of inputs i and i + 2: bytes (w_i,o, w_i,o+1, w_i+2,o, w_i+2,o+1) */
+                uint32_t c = s8_load2(w) | (s8_load2(w + 2u * n_out) << 16), h = S8_SXTB16(c);
+                s00 = S8_SMLAD(p02, h, s00);
+                s10 = S8_SMLAD(q02, h, s10);
+                h = S8_SXTB16_ROR8(c);
+                s01 = S8_SMLAD(p02, h, s01);
+                s11 = S8_SMLAD(q02, h, s11);
+                /* inputs i + 1 and i + 3 */
+                c = s8_load2(w + n_out) | (s8_load2(w + 3u * n_out) << 16);
+                h = S8_SXTB16(c);
+                s00 = S8_SMLAD(p13, h, s00);
+                s10 = S8_SMLAD(q13, h, s10);
+                h = S8_SXTB16_ROR8(c);
+                s01 = S8_SMLAD(p13, h, s01);
+                s11 = S8_SMLAD(q13, h, s11);
+            }
+            for (; i < n_in; ++i, w += n_out)
+            {
+                const int32_t w0 = w[0], w1 = w[1], v0 = x0[i], v1 = x1[i];
+                s00 += v0 * w0;
+                s01 += v0 * w1;
+                s10 += v1 * w0;
+                s11 += v1 * w1;
+            }
+            a0[o] = s00;
+            a0[o + 1u] = s01;
+            a1[o] = s10;
+            a1[o + 1u] = s11;
+        }
+        if (o < n_out) /* an odd last channel */
+        {
+            lidet__nn_acc_s8_cols(x0, 2u, n_in, w_t + o, b + o, 1u, n_out, a0 + o, n_out);
+        }
+    }
+    if (r < n_rows) /* an odd last row */
+    {
+        lidet__nn_acc_s8_cols(in + r * n_in, n_rows - r, n_in, w_t, b, n_out, n_out, acc + r * n_out, n_out);
+    }
+}
+
 void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
                       uint32_t n_out, int32_t *acc)
 {
-#if LIDET_NN_S8_KERNEL == 22
+#if LIDET_NN_S8_KERNEL == 2
+    lidet__nn_acc_s8_dsp(in, n_rows, n_in, w_t, b, n_out, acc);
+#elif LIDET_NN_S8_KERNEL == 22
     lidet__nn_acc_s8_r2o2(in, n_rows, n_in, w_t, b, n_out, acc);
 #elif LIDET_NN_S8_KERNEL == 42
     lidet__nn_acc_s8_r4o2(in, n_rows, n_in, w_t, b, n_out, acc);
