@@ -82,42 +82,6 @@ LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, u
 #endif
 #endif
 
-void lidet__nn_acc_s8_r2o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                           const int32_t *b, uint32_t n_out, int32_t *acc)
-{
-    uint32_t r, i, o;
-    for (r = 0; r + 2u <= n_rows; r += 2u)
-    {
-        const int8_t *x0 = in + r * n_in, *x1 = x0 + n_in;
-        int32_t *a0 = acc + r * n_out, *a1 = a0 + n_out;
-        for (o = 0; o + 2u <= n_out; o += 2u)
-        {
-            int32_t s00 = b[o], s01 = b[o + 1u], s10 = s00, s11 = s01;
-            const int8_t *w = w_t + o;
-            for (i = 0; i < n_in; ++i, w += n_out)
-            {
-                const int32_t w0 = w[0], w1 = w[1], v0 = x0[i], v1 = x1[i];
-                s00 += v0 * w0;
-                s01 += v0 * w1;
-                s10 += v1 * w0;
-                s11 += v1 * w1;
-            }
-            a0[o] = s00;
-            a0[o + 1u] = s01;
-            a1[o] = s10;
-            a1[o + 1u] = s11;
-        }
-        if (o < n_out) /* an odd last channel */
-        {
-            lidet__nn_acc_s8_cols(x0, 2u, n_in, w_t + o, b + o, 1u, n_out, a0 + o, n_out);
-        }
-    }
-    if (r < n_rows) /* an odd last row */
-    {
-        lidet__nn_acc_s8_cols(in + r * n_in, n_rows - r, n_in, w_t, b, n_out, n_out, acc + r * n_out, n_out);
-    }
-}
-
 void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, int32_t *acc)
 {
@@ -209,10 +173,17 @@ static inline uint32_t s8_load2(const int8_t *p)
     return (uint32_t)(uint8_t)p[0] | ((uint32_t)(uint8_t)p[1] << 8);
 }
 
-void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                          const int32_t *b, uint32_t n_out, int32_t *acc)
+/* 2 x 2 (points x output channels) accumulators in registers; the first n_simd inputs (a multiple of 4) 4 at a
+ * time with SMLAD (the DSP kernel below; 0 elsewhere: a constant, so the loop vanishes; inlined into both, so each
+ * is compiled for its own case), the rest one at a time */
+#if defined(__GNUC__)
+#define S8_ALWAYS_INLINE static inline __attribute__((always_inline))
+#else
+#define S8_ALWAYS_INLINE static inline
+#endif
+S8_ALWAYS_INLINE void acc_s8_2x2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                                 const int32_t *b, uint32_t n_out, int32_t *acc, uint32_t n_simd)
 {
-    const uint32_t n4 = n_in & ~3u;
     uint32_t r, i, o;
     for (r = 0; r + 2u <= n_rows; r += 2u)
     {
@@ -222,7 +193,7 @@ void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, cons
         {
             int32_t s00 = b[o], s01 = b[o + 1u], s10 = s00, s11 = s01;
             const int8_t *w = w_t + o;
-            for (i = 0; i < n4; i += 4u, w += 4u * n_out)
+            for (i = 0; i < n_simd; i += 4u, w += 4u * n_out)
             {
                 const uint32_t u0 = s8_load4(x0 + i), u1 = s8_load4(x1 + i);
                 const uint32_t p02 = S8_SXTB16(u0), p13 = S8_SXTB16_ROR8(u0);
@@ -243,7 +214,7 @@ void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, cons
                 s01 = S8_SMLAD(p13, h, s01);
                 s11 = S8_SMLAD(q13, h, s11);
             }
-            for (; i < n_in; ++i, w += n_out)
+            for (i = n_simd; i < n_in; ++i, w += n_out)
             {
                 const int32_t w0 = w[0], w1 = w[1], v0 = x0[i], v1 = x1[i];
                 s00 += v0 * w0;
@@ -265,6 +236,18 @@ void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, cons
     {
         lidet__nn_acc_s8_cols(in + r * n_in, n_rows - r, n_in, w_t, b, n_out, n_out, acc + r * n_out, n_out);
     }
+}
+
+void lidet__nn_acc_s8_r2o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                           const int32_t *b, uint32_t n_out, int32_t *acc)
+{
+    acc_s8_2x2(in, n_rows, n_in, w_t, b, n_out, acc, 0u);
+}
+
+void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                          const int32_t *b, uint32_t n_out, int32_t *acc)
+{
+    acc_s8_2x2(in, n_rows, n_in, w_t, b, n_out, acc, n_in & ~3u);
 }
 
 void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
