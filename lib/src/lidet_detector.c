@@ -39,6 +39,8 @@ void lidet_detector_cfg_default(lidet_detector_cfg_t *cfg, const lidet_sensor_t 
     cfg->max_boxes = cfg->max_boxes < LIDET_MAX_CLUSTERS ? cfg->max_boxes : LIDET_MAX_CLUSTERS;
     cfg->gate1 = 1;
     cfg->gate2 = 1;
+    cfg->gate1_margin = 0.0f;
+    cfg->gate2_margin = 0.0f;
     cfg->nms_iou = 0.1f;
     memcpy(cfg->size_min_m, CLASS_SIZE_MIN, sizeof CLASS_SIZE_MIN);
     memcpy(cfg->size_max_m, CLASS_SIZE_MAX, sizeof CLASS_SIZE_MAX);
@@ -51,7 +53,9 @@ static int cfg_ok(const lidet_detector_cfg_t *c)
         c->crop_half_rad > LIDET_PI_F + 1e-6f || !lidet__isfinite(c->max_range_m) || c->max_range_m < 0.0f ||
         c->max_proposals < 1 || c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1 ||
         c->max_boxes > LIDET_MAX_CLUSTERS || c->gate1 > 1 || c->gate2 > 1 || !lidet__isfinite(c->nms_iou) ||
-        c->nms_iou < 0.0f || c->nms_iou > 1.0f)
+        c->nms_iou < 0.0f || c->nms_iou > 1.0f || !lidet__isfinite(c->gate1_margin) ||
+        c->gate1_margin < -20.0f || c->gate1_margin > 20.0f || !lidet__isfinite(c->gate2_margin) ||
+        c->gate2_margin < -20.0f || c->gate2_margin > 20.0f)
     {
         return 0;
     }
@@ -279,6 +283,8 @@ static void fill_detection(const lidet_detector_t *d, lidet_detection_t *t, uint
 #define DET_CLASSIFY(d, co) lidet_pn_classify(&(d)->cls, &(d)->proposal, (co))
 #define DET_BOX(d, cls, bo) lidet_pn_box(&(d)->box, &(d)->proposal, (cls), (bo))
 #define DET_SIZE_OK(d, cls, box) size_ok(&(d)->cfg, (cls), (box))
+#define DET_GATE1_PASS(d, co) ((co)->energy < (d)->cls.model->gamma[(co)->cls] + (d)->cfg.gate1_margin)
+#define DET_GATE2_PASS(d, cls, bo) ((bo)->energy < (d)->box.model->gamma[(cls)] + (d)->cfg.gate2_margin)
 #define DET_FILL fill_detection
 #define DET_INSERT insert_sorted
 #define DET_NOW now

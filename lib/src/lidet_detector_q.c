@@ -39,16 +39,23 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     }
     cfg->gate1 = 1u;
     cfg->gate2 = 1u;
+    cfg->gate1_margin_q16 = 0;
+    cfg->gate2_margin_q16 = 0;
     cfg->nms_iou_q15 = NMS_IOU_DEFAULT_Q15;
     lidet_size_limits_q_default(&cfg->size);
 }
+
+/* the gates' margins: within +-20 nats, as the float detector's */
+#define MARGIN_MAX_Q16 (20 * 65536)
 
 static int cfg_ok(const lidet_detector_q_cfg_t *c)
 {
     uint32_t k, j;
     if (c->crop_half_bam < 0 || c->max_range_mm < 0 || c->max_proposals < 1u ||
         c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1u || c->max_boxes > LIDET_MAX_CLUSTERS ||
-        c->gate1 > 1u || c->gate2 > 1u || c->nms_iou_q15 < 0 || c->nms_iou_q15 > 32768)
+        c->gate1 > 1u || c->gate2 > 1u || c->nms_iou_q15 < 0 || c->nms_iou_q15 > 32768 ||
+        c->gate1_margin_q16 < -MARGIN_MAX_Q16 || c->gate1_margin_q16 > MARGIN_MAX_Q16 ||
+        c->gate2_margin_q16 < -MARGIN_MAX_Q16 || c->gate2_margin_q16 > MARGIN_MAX_Q16)
     {
         return 0;
     }
@@ -220,6 +227,10 @@ static void fill_detection(const lidet_detector_q_t *d, lidet_detection_q_t *t, 
 #define DET_CLASSIFY(d, co) lidet_pointnet_q_classify(&(d)->cls, &(d)->proposal, (co))
 #define DET_BOX(d, cls, bo) lidet_pointnet_q_box(&(d)->box, &(d)->proposal, (cls), (bo))
 #define DET_SIZE_OK(d, cls, box) lidet_size_ok_q(&(d)->cfg.size, (cls), (box))
+#define DET_GATE1_PASS(d, co)                                                                                \
+    ((int64_t)(co)->energy_q16 < (int64_t)(d)->cls.model->gamma_q16[(co)->cls] + (d)->cfg.gate1_margin_q16)
+#define DET_GATE2_PASS(d, cls, bo)                                                                           \
+    ((int64_t)(bo)->energy_q16 < (int64_t)(d)->box.model->gamma_q16[(cls)] + (d)->cfg.gate2_margin_q16)
 #define DET_FILL fill_detection
 #define DET_INSERT lidet_detections_q_insert
 #define DET_NOW now

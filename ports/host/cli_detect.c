@@ -408,6 +408,8 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, max_boxes, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, gate1, uint8_t, 1)
     CLI_SET_INT(c, kv, klen, v, gate2, uint8_t, 1)
+    CLI_SET_FLOAT(c, kv, klen, v, gate1_margin)
+    CLI_SET_FLOAT(c, kv, klen, v, gate2_margin)
     /* any clustering field, the proposal refinement of issue 15 included */
     if (strncmp(kv, "stages.cluster.", 15) == 0)
         return cli_cluster_set(&c->stages.cluster, kv + 15);
@@ -501,7 +503,8 @@ static void usage_extra(void)
                     "  --cpu-clock      stage and total times (--json *_ms) in this thread's CPU time, not wall time\n"
                     "                   (what other processes on a busy machine do not inflate)\n"
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
-                    "                   nms_iou, max_proposals, max_boxes, gate1, gate2; stages.cluster.KEY: a\n"
+                    "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
+                    "                   gate2_margin (nats added to the models' gates); stages.cluster.KEY: a\n"
                     "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
                     "                   stages.cluster.split_people=0: no proposal refinement)\n"
                     "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n"

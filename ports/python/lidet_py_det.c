@@ -17,7 +17,7 @@
 static lidet_detector_t g_det;
 static int32_t g_pp[LIDET_MAX_POINTS];
 
-/* fcfg: crop_half_rad, max_range_m, nms_iou; ucfg: max_proposals (0 = the default), gate1, gate2, refine (the
+/* fcfg: crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin; ucfg: max_proposals (0 = the default), gate1, gate2, refine (the
  * clustering's split_people and join_cars).
  * out_det: LIDET_MAX_DETECTIONS rows of 12 floats (class, score, energy_cls, energy_box, cx, cy, cz, l, w, h,
  * yaw, cluster id); out_outcome: LIDET_MAX_CLUSTERS bytes; out_point_cluster / out_point_ground: n entries
@@ -47,6 +47,8 @@ LIDET_PY_API int lidet_py_det_run(const char *sensor, uint32_t cls_index, uint32
     cfg.crop_half_rad = fcfg[0];
     cfg.max_range_m = fcfg[1];
     cfg.nms_iou = fcfg[2];
+    cfg.gate1_margin = fcfg[3];
+    cfg.gate2_margin = fcfg[4];
     if (ucfg[0] != 0) /* 0: the C default for the sensor */
     {
         cfg.max_proposals = ucfg[0];

@@ -49,12 +49,14 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
     {
         cfg.max_boxes = (uint32_t)icfg[6];
     }
+    cfg.gate1_margin_q16 = icfg[7];
+    cfg.gate2_margin_q16 = icfg[8];
     rc = lidet_detector_q_init(det, &cfg, mc, mb);
     return rc != LIDET_OK ? rc : lidet_detector_q_run(det, pts_mm, n, stride, NULL, NULL);
 }
 
 /* lidet_py_detq_run: icfg: crop_half_bam, max_range_mm, nms_iou_q15, max_proposals (0 = default), gate1, gate2,
- * max_boxes (0 = default).
+ * max_boxes (0 = default), gate1_margin_q16, gate2_margin_q16.
  * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
  * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 13 uint32 (the
  * counts of lidet_detector_q_stats_t in order, then n_over_box_budget). Returns the run's status. */

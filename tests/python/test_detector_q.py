@@ -139,7 +139,7 @@ def test_score_matches_the_float_definition(nq):
 
 # ---- the integer detector against the chained numpy reference, bit for bit ---------------------------
 
-def _ref_detect(nq, pts_mm, sensor, max_boxes=0):
+def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0)):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -155,16 +155,19 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0):
     cc, pc = nq.cluster_q_defaults(sensor)
     cap = native.capacity()
     det_cfg = dict(crop_half_bam=0, max_range_mm=0, max_proposals=min(128 if s.rows <= 16 else 256, cap["max_clusters"]),
-                   max_boxes=max_boxes or min(24 if s.rows <= 16 else 48, cap["max_clusters"]), gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM)
+                   max_boxes=max_boxes or min(24 if s.rows <= 16 else 48, cap["max_clusters"]), gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM,
+                   gate1_margin_q16=margins[0], gate2_margin_q16=margins[1])
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
                      det_cfg, models["cls"], models["box"], cap["max_clusters"], cap["max_detections"],
                      cap["max_points"])
 
 
-@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget"])
+@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins"])
 def test_bit_exact_with_the_chained_reference(nq, which, request):
-    sensor, max_boxes = "vlp16", 0
-    if which == "box_budget":  # the box budget hit: 3 boxed, the rest counted, LIDET_TRUNCATED
+    sensor, max_boxes, margins = "vlp16", 0, (0, 0)
+    if which == "margins":  # the gates' operating points moved: gate 1 looser by 1 nat, gate 2 stricter by 0.5
+        pts, margins = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"), (65536, -32768)
+    elif which == "box_budget":  # the box budget hit: 3 boxed, the rest counted, LIDET_TRUNCATED
         pts, max_boxes = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"), 3
     elif which == "sample":
         pts = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin")
@@ -177,8 +180,12 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
         real = request.getfixturevalue("real_dir")
         sensor, pts = "hdl64", _load(real / "kitti/training/velodyne/000001.bin")
     mm = nq.to_mm(pts)
-    c = nq.detect_q(mm, sensor, max_boxes=max_boxes)
-    r = _ref_detect(nq, mm, sensor, max_boxes)
+    c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1])
+    r = _ref_detect(nq, mm, sensor, max_boxes, margins)
+    if margins != (0, 0):  # the margins bite: fewer gate-1 rejections, more gate-2 ones than at the models' gammas
+        c0 = nq.detect_q(mm, sensor)
+        assert c["stats"]["n_gate1_rejected"] < c0["stats"]["n_gate1_rejected"]
+        assert c["stats"]["n_gate2_rejected"] > c0["stats"]["n_gate2_rejected"]
     if max_boxes:
         assert c["status"] == 1 and r["truncated"]
         assert c["stats"]["n_boxed"] == max_boxes and c["stats"]["n_over_box_budget"] > 0

@@ -252,8 +252,39 @@ void test_crop_budget_range_and_gates(void)
     cfg.gate1 = 0;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
-    lidet_detector_detections(&g.ws, &n);
-    TEST_ASSERT_EQUAL_UINT32(3, n);
+    {
+        /* the operating points: every gate-1 energy lies at or above gamma (-6); a margin that lifts gamma above
+         * the largest lets all three through with the gate on, and gate 2 with its gamma 0.5 above the largest
+         * box energy keeps all, then with a margin of -1 rejects at least that one */
+        const lidet_detection_t *dd = lidet_detector_detections(&g.ws, &n);
+        float e1 = -1e30f, e2 = -1e30f;
+        uint32_t k;
+        for (k = 0; k < n; ++k)
+        {
+            e1 = dd[k].energy_cls > e1 ? dd[k].energy_cls : e1;
+            e2 = dd[k].energy_box > e2 ? dd[k].energy_box : e2;
+        }
+        TEST_ASSERT_EQUAL_UINT32(3, n);
+        TEST_ASSERT_TRUE(e1 >= -6.0f && e1 < 12.0f);
+        cfg.gate1 = 1;
+        cfg.gate1_margin = e1 + 6.0f + 0.5f;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+        TEST_ASSERT_EQUAL_UINT32(0, lidet_detector_stats(&g.ws)->n_gate1_rejected);
+        lidet_detector_detections(&g.ws, &n);
+        TEST_ASSERT_EQUAL_UINT32(3, n);
+        m_box.gamma[0] = e2 + 0.5f;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+        TEST_ASSERT_EQUAL_UINT32(0, lidet_detector_stats(&g.ws)->n_gate2_rejected);
+        cfg.gate2_margin = -1.0f;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+        TEST_ASSERT_TRUE(lidet_detector_stats(&g.ws)->n_gate2_rejected >= 1u);
+        cfg.gate1_margin = 0.0f;
+        cfg.gate2_margin = 0.0f;
+        cfg.gate1 = 0;
+    }
     /* gate 2 and the size check */
     m_box.gamma[0] = -100.0f;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
@@ -350,6 +381,12 @@ void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c = cfg;
     c.nms_iou = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
+    c.gate1_margin = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
+    c.gate2_margin = 20.5f;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c = cfg;
     c.size_min_m[1][2] = 5.0f;

@@ -74,6 +74,13 @@ static void test_init_errors(void)
     cfg.nms_iou_q15 = 32769;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.gate1_margin_q16 = 20 * 65536 + 1; /* the gates' margins: within +-20 nats */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.gate1_margin_q16 = 20 * 65536;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.gate2_margin_q16 = INT32_MIN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.max_proposals = 0;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);

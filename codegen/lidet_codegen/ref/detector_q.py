@@ -50,7 +50,8 @@ def candidates(recs, det_cfg: dict, outcome: list) -> tuple[list, bool]:
 def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, proposal_cfg: dict, det_cfg: dict,
            cls_model, box_model, max_clusters: int, max_detections: int, max_points: int) -> dict:
     """The whole integer detector on (N, 3) int32 mm points. det_cfg: crop_half_bam, max_range_mm, max_proposals,
-    max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max. Returns detections (dicts), outcomes, stats."""
+    max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max, and optionally gate1_margin_q16 / gate2_margin_q16
+    (0 when absent: the models' gammas). Returns detections (dicts), outcomes, stats."""
     pj = proj_q.project(points_mm, tab, proj_cfg["min_range_mm"], proj_cfg["max_range_mm"], max_points=max_points)
     rows, cols = tab.rows, tab.cols
     X, Y, Z, R = (np.asarray(pj[k], np.int64).reshape(rows, cols) for k in ("x_4mm", "y_4mm", "z_4mm", "range_4mm"))
@@ -69,7 +70,7 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
         c = pointnet_q.classify(cls_model, xyz[None].astype(np.int64), mean[None], vox[None])
         cls, energy = int(c["cls"][0]), int(c["energy"][0])
         stats["n_classified"] += 1
-        if det_cfg["gate1"] and not bool(c["passed"][0]):
+        if det_cfg["gate1"] and not energy < int(cls_model.gamma_q16[cls]) + int(det_cfg.get("gate1_margin_q16", 0)):
             outcome[ci] = OUT_GATE1
             stats["n_gate1_rejected"] += 1
             continue
@@ -80,7 +81,8 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
             continue
         b = pointnet_q.box(box_model, xyz[None].astype(np.int64), mean[None], vox[None], cls)
         stats["n_boxed"] += 1
-        if det_cfg["gate2"] and not bool(b["passed"][0]):
+        e_box = int(b["energy"][0])
+        if det_cfg["gate2"] and not e_box < int(box_model.gamma_q16[cls]) + int(det_cfg.get("gate2_margin_q16", 0)):
             outcome[ci] = OUT_GATE2
             stats["n_gate2_rejected"] += 1
             continue

@@ -88,6 +88,12 @@ typedef struct
                                          scan (21, docs/ROBUSTNESS.md) */
     uint8_t gate1;      /**< 1 (default): drop proposals failing gate 1 */
     uint8_t gate2;      /**< 1 (default): drop boxes failing gate 2 */
+    float
+        gate1_margin; /**< the operating point of gate 1: a proposal passes when its energy < the model's gamma
+                                         + this (nats); 0 (default): the model's threshold, which keeps 95 % of
+                                         the validation road users; > 0 keeps more of them and more clutter
+                                         (measured: docs/DETECTOR.md); [-20, 20] */
+    float gate2_margin; /**< the same for gate 2 (the box net's gamma); [-20, 20], default 0 */
     float nms_iou;      /**< BEV IoU above which the lower-scored detection is dropped; [0, 1],
                                          default 0.1 (detections come from disjoint clusters) */
     float size_min_m[LIDET_N_CLASSES][3]; /**< plausible l, w, h per class (lidet_class_t order) */

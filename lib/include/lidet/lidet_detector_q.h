@@ -85,16 +85,19 @@ typedef struct
     lidet_proposal_q_cfg_t proposal; /**< n_points is set from the models by init; seed and PVLE bins used */
     int32_t crop_half_bam;           /**< 0: 360 degrees; else keep clusters with |azimuth| <= this (BAM32;
                                           the KITTI camera field of view is 2^29); [0, 2^31 - 1] */
-    int32_t max_range_mm;       /**< clusters whose mean is farther (horizontally) are not classified; 0 =
+    int32_t max_range_mm;     /**< clusters whose mean is farther (horizontally) are not classified; 0 =
                                           no limit; >= 0 */
-    uint32_t max_proposals;     /**< [1, LIDET_MAX_CLUSTERS]: at most this many classified, nearest first */
-    uint32_t max_boxes;         /**< [1, LIDET_MAX_CLUSTERS]: at most this many through the box net per scan
+    uint32_t max_proposals;   /**< [1, LIDET_MAX_CLUSTERS]: at most this many classified, nearest first */
+    uint32_t max_boxes;       /**< [1, LIDET_MAX_CLUSTERS]: at most this many through the box net per scan
                                           (those passing gate 1, nearest first; the rest: outcome
                                           LIDET_DET_OUT_BUDGET, stats n_over_box_budget, LIDET_TRUNCATED); default
                                           48 (> 16 beams), 24: the float detector's max_boxes */
-    uint8_t gate1;              /**< 1 (default): drop proposals failing gate 1 */
-    uint8_t gate2;              /**< 1 (default): drop boxes failing gate 2 */
-    int32_t nms_iou_q15;        /**< [0, 32768]; default 3277 (0.1) */
+    uint8_t gate1;            /**< 1 (default): drop proposals failing gate 1 */
+    uint8_t gate2;            /**< 1 (default): drop boxes failing gate 2 */
+    int32_t gate1_margin_q16; /**< gate 1 passes when energy_q16 < the model's gamma_q16 + this (Q16 nats; the
+                                          float detector's gate1_margin); [-20 * 65536, 20 * 65536], default 0 */
+    int32_t gate2_margin_q16; /**< the same for gate 2; default 0 */
+    int32_t nms_iou_q15;      /**< [0, 32768]; default 3277 (0.1) */
     lidet_size_limits_q_t size; /**< plausible l, w, h per class */
     lidet_clock_fn clock;       /**< optional timestamp source for stats.ticks (NULL: no timing) */
     void *clock_ctx;            /**< passed to clock */

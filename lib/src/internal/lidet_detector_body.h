@@ -12,6 +12,8 @@
  *   DET_CLASSIFY(d, co)       classify it into *co, a lidet_status_t;
  *   DET_BOX(d, cls, bo)       box it as class cls into *bo, a lidet_status_t;
  *   DET_SIZE_OK(d, cls, box)  1 when the box's size is plausible for class cls;
+ *   DET_GATE1_PASS(d, co), DET_GATE2_PASS(d, cls, bo)  1 when the energy lies below the model's gamma of the
+ *                             class plus the configured margin (the outputs' own `pass` is the margin-0 decision);
  *   DET_FILL(d, t, ci, co, bo)  the build's own fields of detection *t (score, energies, point count; the loop
  *                             sets box, cls and cluster_id);
  *   DET_INSERT(det, n)        move det[n] into det[0..n), kept sorted by score;
@@ -42,7 +44,7 @@ static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *
             return s;
         }
         ++d->stats.n_classified;
-        if (d->cfg.gate1 && !co.pass)
+        if (d->cfg.gate1 && !DET_GATE1_PASS(d, &co))
         {
             d->outcome[ci] = LIDET_DET_OUT_GATE1;
             ++d->stats.n_gate1_rejected;
@@ -63,7 +65,7 @@ static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *
             return s;
         }
         ++d->stats.n_boxed;
-        if (d->cfg.gate2 && !bo.pass)
+        if (d->cfg.gate2 && !DET_GATE2_PASS(d, co.cls, &bo))
         {
             d->outcome[ci] = LIDET_DET_OUT_GATE2;
             ++d->stats.n_gate2_rejected;
