@@ -117,7 +117,7 @@ def accounting(folder, sensor, n_scans, max_range=40.0, crop=False):
 
 #: SemanticKITTI label ids of each detector class (moving variants included)
 SK_IDS = {"Car": (10, 13, 18, 20, 252, 256, 257, 258, 259), "Pedestrian": (30, 254), "Cyclist": (11, 31, 253)}
-GATE_MARGINS = ((0.0, 0.0), (0.0, 0.5), (0.0, 1.0), (0.5, 0.0), (0.5, 0.5), (1.0, 1.0))
+GATE_MARGINS = ((0.0, 0.0), (0.0, 0.5), (0.0, 1.0), (0.5, 0.0), (0.5, 0.5), (1.0, 1.0), (-0.5, 0.0), (-0.5, 0.5))
 
 
 def _sk_right(pts, lab, d, cls_name):
