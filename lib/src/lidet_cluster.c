@@ -13,6 +13,8 @@
 
 void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *sensor)
 {
+    /* <= 16 beams: some defaults of their own, measured on sparse scans (docs/BENCHMARKS.md) */
+    const int sparse = sensor != 0 && sensor->n_rows <= 16;
     if (cfg == 0)
     {
         return;
@@ -29,7 +31,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     if (sensor != 0 && sensor->n_rows <= 16)
     {
         cfg->theta_rad = 0.12f;
-        cfg->max_steps = 4u;
+        cfg->max_steps = 5u; /* 4 before issue 15's crowd scenes (time: +1 %, docs/BENCHMARKS.md) */
         cfg->bridge_occluders = 0;
         cfg->max_gap_per_m = 0.04f;
     }
@@ -41,21 +43,24 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
         cfg->max_gap_per_m = 0.025f;
     }
     cfg->max_steps = cfg->max_steps < STEPS ? cfg->max_steps : STEPS;
-    cfg->min_points = 10;
+    /* 16-beam images: 8 (issue 15: far people and cars on 8-9 pixels; the refinement's parts need min_points) */
+    cfg->min_points = sparse ? 8u : 10u;
     cfg->max_extent_m = 6.0f;
     cfg->max_mean_height_m = 2.5f;
     cfg->mount_height_m = sensor != 0 ? sensor->mount_height_m : 1.73f;
     /* measured (docs/BENCHMARKS.md): see lidet_cluster.h */
-    cfg->rescue_gap_m = 0.8f;
+    cfg->rescue_gap_m = sparse ? 1.0f : 0.8f;
     cfg->rescue_gap_per_m = 0.03f;
-    cfg->rescue_rows = sensor != 0 && sensor->n_rows <= 16 ? 1u : 2u;
+    cfg->rescue_rows = sparse ? 1u : 2u;
     cfg->rescue_cols = 6u;
     /* worst-case bounds (issue 19, docs/ROBUSTNESS.md) */
-    cfg->max_fragment_pixels = sensor != 0 && sensor->n_rows <= 16 ? 2048u : 4096u;
+    cfg->max_fragment_pixels = sparse ? 2048u : 4096u;
     cfg->max_bridge_per_pixel = 2.0f;
-    /* refinement (issue 15), measured on the simulated crowd scenes (docs/BENCHMARKS.md) */
+    /* refinement (issue 15), measured on the simulated crowd scenes (docs/BENCHMARKS.md); 16 beams: wider
+     * clusters examined, a longer join gap (issue 15: simulated VLP-16 crowd cars within 40 m, 80 scans,
+     * 90.1 -> 94.0 % with min_points, max_steps and rescue_gap_m above; lidet_cluster.h) */
     cfg->split_people = 1u;
-    cfg->split_min_width_m = 0.9f;
+    cfg->split_min_width_m = sparse ? 0.7f : 0.9f;
     cfg->split_cell_m = 0.12f;
     cfg->split_cell_per_m = 0.0f;
     cfg->person_max_width_m = 1.0f;
@@ -63,7 +68,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->person_min_aspect = 1.8f;
     cfg->person_min_cols = 3u;
     cfg->join_cars = 1u;
-    cfg->join_gap_m = 0.5f;
+    cfg->join_gap_m = sparse ? 0.8f : 0.5f;
     cfg->car_max_length_m = 5.2f;
     cfg->car_max_width_m = 2.2f;
     cfg->car_max_height_m = 2.0f;

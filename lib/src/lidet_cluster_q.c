@@ -21,15 +21,15 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     cfg->diagonals = 1u;
     cfg->max_gap_mm = 700u;
     cfg->theta_urad = sparse ? 120000u : 180000u;
-    cfg->max_steps = sparse ? 4u : 5u;
+    cfg->max_steps = 5u;
     cfg->max_steps = cfg->max_steps < STEPS ? cfg->max_steps : STEPS;
     cfg->bridge_occluders = sparse ? 0u : 1u;
     cfg->max_gap_per_m_q16 = sparse ? 2621u : 1638u; /* 0.04, 0.025 */
-    cfg->min_points = 10u;
+    cfg->min_points = sparse ? 8u : 10u;
     cfg->max_extent_mm = 6000u;
     cfg->max_mean_height_mm = 2500;
     cfg->mount_height_mm = mount_height_mm;
-    cfg->rescue_gap_mm = 800u;
+    cfg->rescue_gap_mm = sparse ? 1000u : 800u;
     cfg->rescue_gap_per_m_q16 = 1966u; /* 0.03 */
     cfg->rescue_rows = sparse ? 1u : 2u;
     cfg->rescue_cols = 6u;
@@ -38,7 +38,7 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     cfg->max_bridge_per_pixel_q16 = 131072u; /* 2.0 */
     /* the refinement (issue 15) */
     cfg->split_people = 1u;
-    cfg->split_min_width_mm = 900u;
+    cfg->split_min_width_mm = sparse ? 700u : 900u;
     cfg->split_cell_mm = 120u;
     cfg->split_cell_per_m_q16 = 0u;
     cfg->person_max_width_mm = 1000u;
@@ -46,7 +46,7 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     cfg->person_min_aspect_q16 = 117965u; /* 1.8 */
     cfg->person_min_cols = 3u;
     cfg->join_cars = 1u;
-    cfg->join_gap_mm = 500u;
+    cfg->join_gap_mm = sparse ? 800u : 500u;
     cfg->car_max_length_mm = 5200u;
     cfg->car_max_width_mm = 2200u;
     cfg->car_max_height_mm = 2000u;

@@ -72,9 +72,13 @@ def test_defaults_and_options():
     assert d["rescue_gap_m"] == f(0.8) and d["rescue_gap_per_m"] == f(0.03) and d["rescue_rows"] == 2
     assert d["rescue_cols"] == 6 and d["mount_height_m"] == f(1.73)
     v = native.cluster_defaults("vlp16")
-    assert v["theta_rad"] == f(0.12) and v["max_steps"] == 4 and v["bridge_occluders"] == 0
+    assert v["theta_rad"] == f(0.12) and v["max_steps"] == 5 and v["bridge_occluders"] == 0
     assert v["max_gap_per_m"] == f(0.04)
     assert v["rescue_rows"] == 1
+    # issue 15: the 16-beam values of their own (simulated VLP-16 crowd scenes); the dense ones unchanged
+    assert v["min_points"] == 8 and v["rescue_gap_m"] == f(1.0) and v["join_gap_m"] == f(0.8)
+    assert v["split_min_width_m"] == f(0.7)
+    assert d["join_gap_m"] == f(0.5) and d["split_min_width_m"] == f(0.9)
     pts, ground, _, _ = _synthetic()
     a = native.cluster(pts, "hdl64", ground=ground, min_points=100000, rescue_gap_m=0.0)
     assert a.stats["n_kept"] == 0 and a.stats["n_dropped_small"] == a.stats["n_found"]

@@ -3,6 +3,8 @@
 (codegen/lidet_codegen/ref/cluster.py: refine_ref): the C's labels without the refinement, refined in
 numpy, equal the C's labels with it, on simulated crowd scans (issue 15) of both sensor kinds; and the
 crowd scenes of lidet-sim (close people; the default scenes unchanged)."""
+import inspect
+
 import numpy as np
 import pytest
 
@@ -12,14 +14,22 @@ from lidet_tools import native
 from lidet_tools.sim.simulate import simulate_scan
 
 
-@pytest.mark.parametrize("sensor,index", [("hdl64", 0), ("hdl64", 3), ("vlp16", 1)])
+def _refine_defaults(sensor):
+    """the sensor's C defaults of the settings refine_ref takes (16-beam profiles have values of their own)"""
+    names = inspect.signature(ref.refine_ref).parameters
+    return {k: v for k, v in native.cluster_defaults(sensor).items() if k in names}
+
+
+@pytest.mark.parametrize("sensor,index", [("hdl64", 0), ("hdl64", 3), ("vlp16", 1), ("vlp16", 3)])
 def test_refine_matches_reference(sensor, index):
     r = simulate_scan(sensor, seed=15, index=index, crowd=True)
     g = ce.ground_mask(r.sem.astype(np.uint32))
     plain = native.cluster(r.points, sensor, ground=g, split_people=0, join_cars=0, with_image=True)
     refined = native.cluster(r.points, sensor, ground=g)
     xyz = np.stack([plain.image.x, plain.image.y, plain.image.z], -1)
-    want = ref.refine_ref(plain.pixel_labels, xyz)
+    cfg = _refine_defaults(sensor)
+    assert cfg["min_points"] == (8 if sensor == "vlp16" else 10) and "join_gap_m" in cfg
+    want = ref.refine_ref(plain.pixel_labels, xyz, **cfg)
     assert refined.stats["n_split"] > 0          # the scene has groups to cut (else the test shows nothing)
     np.testing.assert_array_equal(refined.pixel_labels, want)
     assert len(refined) == len(plain) + refined.stats["n_split_parts"] - refined.stats["n_joined"]

@@ -206,6 +206,28 @@ static void test_two_cars_not_joined(void)
     TEST_ASSERT_TRUE(cars_mixed());
 }
 
+/* a car seen as two slices (issue 15, the VLP-16 defaults): the low body (8-10 m ahead, up to 0.7 m above the
+ * ground) and, 0.65 m further and six empty beams higher, the cabin (10.65-12.4 m): no pixel path joins them
+ * (more empty rows than max_steps), their boxes lie 0.65 m apart in x-y. The dense sensors' defaults (join gap
+ * 0.5 m) keep two clusters; the 16-beam defaults (0.8 m) join them into one */
+static uint32_t run_profile(const char *sensor)
+{
+    lidet_cluster_cfg_t cfg;
+    lidet_cluster_cfg_default(&cfg, lidet_sensor_find(sensor));
+    return run_with(&cfg);
+}
+
+static void test_car_slices_joined_16_beams(void)
+{
+    const obj_t s[2] = {{1, 8.0, 1.0, 10.0, 2.8, -1.70, -1.00}, {1, 10.65, 1.0, 12.4, 2.8, -0.50, 0.00}};
+    render(s, 2, 0);
+    TEST_ASSERT_EQUAL_UINT32(2, run_profile("hdl64"));
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g_cl)->n_joined);
+    TEST_ASSERT_EQUAL_UINT32(1, run_profile("vlp16"));
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g_cl)->n_joined);
+    assert_records_consistent();
+}
+
 /* one car alone is never cut */
 static void test_car_alone_not_cut(void)
 {
@@ -255,6 +277,7 @@ int main(void)
     RUN_TEST(test_car_in_three_pieces_joined);
     RUN_TEST(test_join_budget);
     RUN_TEST(test_two_cars_not_joined);
+    RUN_TEST(test_car_slices_joined_16_beams);
     RUN_TEST(test_car_alone_not_cut);
     RUN_TEST(test_deterministic_and_config);
     return UNITY_END();

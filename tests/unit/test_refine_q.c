@@ -188,6 +188,48 @@ static void test_car_alone_not_cut(void)
     TEST_ASSERT_EQUAL_UINT32(0, g.ws.state.stats.n_split);
 }
 
+/* the car seen as two slices of test_refine.c (0.65 m apart in x-y, six empty beams between them): the dense
+ * sensors' defaults keep two clusters, the 16-beam defaults (join gap 800 mm) join them */
+static uint32_t run_rows(uint32_t n_rows)
+{
+    lidet_cluster_q_cfg_t cfg;
+    lidet_cluster_q_cfg_default(&cfg, n_rows, 1730);
+    return run_with(&cfg);
+}
+
+static void test_car_slices_joined_16_beams(void)
+{
+    const obj_t s[2] = {{1, 8.0, 1.0, 10.0, 2.8, -1.70, -1.00}, {1, 10.65, 1.0, 12.4, 2.8, -0.50, 0.00}};
+    render(s, 2, 0);
+    compact();
+    TEST_ASSERT_EQUAL_UINT32(2, run_rows(64));
+    TEST_ASSERT_EQUAL_UINT32(0, g.ws.state.stats.n_joined);
+    TEST_ASSERT_EQUAL_UINT32(1, run_rows(16));
+    TEST_ASSERT_EQUAL_UINT32(1, g.ws.state.stats.n_joined);
+    assert_records_consistent();
+}
+
+/* the per-profile defaults (issue 15) equal the float stage's for both kinds of sensor */
+static void test_defaults_per_profile(void)
+{
+    static const char *const names[2] = {"hdl64", "vlp16"};
+    int k;
+    for (k = 0; k < 2; ++k)
+    {
+        const lidet_sensor_t *s = lidet_sensor_find(names[k]);
+        lidet_cluster_q_cfg_t q;
+        lidet_cluster_cfg_t f;
+        TEST_ASSERT_NOT_NULL(s);
+        lidet_cluster_q_cfg_default(&q, s->n_rows, 1730);
+        lidet_cluster_cfg_default(&f, s);
+        TEST_ASSERT_EQUAL_UINT32(f.min_points, q.min_points);
+        TEST_ASSERT_EQUAL_UINT32(f.max_steps, q.max_steps);
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.rescue_gap_m * 1000.0f), q.rescue_gap_mm);
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.split_min_width_m * 1000.0f), q.split_min_width_mm);
+        TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.join_gap_m * 1000.0f), q.join_gap_mm);
+    }
+}
+
 #define REFUSED(field, value)                                                                                \
     do                                                                                                       \
     {                                                                                                        \
@@ -232,6 +274,8 @@ int main(void)
     RUN_TEST(test_person_beside_car);
     RUN_TEST(test_car_in_three_pieces_joined);
     RUN_TEST(test_car_alone_not_cut);
+    RUN_TEST(test_car_slices_joined_16_beams);
+    RUN_TEST(test_defaults_per_profile);
     RUN_TEST(test_defaults_and_config);
     return UNITY_END();
 }
