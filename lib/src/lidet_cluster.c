@@ -25,7 +25,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
      * car bodies together on every profile; a small angle joins the fragments of car bodies (grazing
      * hoods and roofs, dropouts) and the gap bound, growing with range, keeps neighbouring parked cars
      * apart (the merges the angle test alone made on real scans). Dense sensors (> 16 beams) also
-     * bridge occluders; 16-beam images use one step less and no occluder rule (speed: >= 100x DBSCAN) */
+     * bridge occluders; 16-beam images use no occluder rule (speed: >= 100x DBSCAN) */
     cfg->diagonals = 1;
     cfg->max_gap_m = 0.7f;
     if (sensor != 0 && sensor->n_rows <= 16)

@@ -69,7 +69,12 @@
  *    coordinates, integer cells and counts: the integer build has an exact counterpart. Measured
  *    (docs/BENCHMARKS.md, issue 15's proposal recall within 40 m): simulated crowd scenes people
  *    65 -> 85 % (hdl64), 71 -> 85 % (vlp16), cars 92 -> 93 %, 89 -> 91 %; default scenes and real
- *    SemanticKITTI cars no worse;
+ *    SemanticKITTI cars no worse. Profiles of <= 16 beams have defaults of their own, chosen on 80 simulated
+ *    VLP-16 crowd scans (seed 2) and checked on 60 of other seeds (21-23) and the default VLP-16 scenes:
+ *    min_points 8, max_steps 5, rescue_gap_m 1.0, join_gap_m 0.8, split_min_width_m 0.7. Measured (issue 15's
+ *    proposal recall within 40 m, docs/BENCHMARKS.md): cars 90.1 -> 94.0 % (80 scans) and 91.7 -> 93.2 %
+ *    (unseen seeds), people 84.7 -> 88.4 % and 88.9 -> 92.5 %, cyclists 92.5 -> 88.7 % and 87.5 -> 87.5 %;
+ *    default VLP-16 scenes cars 94.3 -> 95.9 %, people and cyclists unchanged;
  *  - output ids are canonical: 1-based in raster order of each kept cluster's first pixel;
  *    0 = no cluster. Each cluster's member pixels are listed contiguously, in raster order.
  * The BFS queue is the member array itself (every pixel is pushed at most once), so it cannot
@@ -123,9 +128,9 @@ typedef struct
                                   authors used 0.4 / 0.15 */
     uint32_t max_steps;        /**< hole bridging: search up to this many pixels away in each direction
                                   (1 = direct neighbours only); [1, LIDET_CLUSTER_MAX_STEPS]; default 5
-                                  (> 16 beams), 4 (<= 16 beams: 5 with occluder bridging recovered a
-                                  few more cars but fell below 100x the speed of DBSCAN); the authors
-                                  used 9 */
+                                  (both kinds of profile; <= 16 beams used 4 before issue 15's crowd
+                                  scenes: 5 without occluder bridging costs about 1 % of the clustering's
+                                  time there); the authors used 9 */
     uint32_t bridge_occluders; /**< 1: the search also steps over a candidate that fails the test and is
                                   nearer than the current pixel (a pole or branch in front of the
                                   object), so objects seen through occluders stay whole; 0: stop at
@@ -143,7 +148,9 @@ typedef struct
                                   0.025 (> 16 beams), 0.04 (<= 16 beams): 1.45 m / 2.3 m at 30 m
                                   (measured with max_gap_m; a fixed bound of 1 m split far simulated
                                   cars, 71-81 % at 0.15-0.35 rad; 1.5 m merged real parked cars) */
-    uint32_t min_points;       /**< drop clusters with fewer pixels; >= 1, default 10 */
+    uint32_t min_points;       /**< drop clusters with fewer pixels; >= 1, default 10 (> 16 beams), 8 (<= 16
+                                  beams: far people and car pieces of 8-9 pixels, and the refinement's
+                                  person-sized parts need min_points; issue 15, below) */
     float max_extent_m;        /**< drop clusters wider than this in x, y or z; > 0, default 6 m */
     float max_mean_height_m;   /**< drop clusters whose mean lies higher above the ground plane; default
                                   2.5 m; a huge value (e.g. 1e30) disables the filter */
@@ -151,7 +158,8 @@ typedef struct
                                   (copied from the sensor profile); >= 0 */
     float rescue_gap_m;        /**< fragment rescue (file comment): 0 disables it; > 0: fragments below
                                   min_points join each other and the nearest kept cluster within
-                                  rescue_gap_m + rescue_gap_per_m * (nearer range). Default 0.8 m */
+                                  rescue_gap_m + rescue_gap_per_m * (nearer range). Default 0.8 m
+                                  (> 16 beams), 1.0 m (<= 16 beams; issue 15, below) */
     float rescue_gap_per_m;    /**< growth of the rescue distance per metre of range; >= 0; default 0.03 */
     uint32_t rescue_rows;      /**< rescue window: rows looked at above and below a fragment pixel;
                                   <= LIDET_MAX_ROWS; default 1 (<= 16 beams), 2 (> 16 beams) */
@@ -162,7 +170,9 @@ typedef struct
                                   connected parts on a finer bird's-eye-view grid, and every part that
                                   is person-sized becomes a cluster of its own (people in groups, a
                                   person beside a car, a pole or a wall); 0: off */
-    float split_min_width_m;  /**< clusters whose x or y extent exceeds this are examined; > 0; default 0.9 */
+    float split_min_width_m;  /**< clusters whose x or y extent exceeds this are examined; > 0; default 0.9
+                                  (> 16 beams), 0.7 (<= 16 beams: two people seen by a few rings span
+                                  less; issue 15, below) */
     float split_cell_m;       /**< cell of the finer grid at range 0; > 0; default 0.12 m */
     float split_cell_per_m;   /**< its growth per metre of range (range of the cluster's box centre,
                                   max(|x|,|y|) + min(|x|,|y|) / 2); >= 0; default 0 (measured: a
@@ -182,7 +192,9 @@ typedef struct
                                   spans at most car_max_length_m and car_max_width_m, z span at most
                                   car_max_height_m), neither upright, become one (a car cut by dark
                                   paint, glass or wheel dropouts); 0: off */
-    float join_gap_m;             /**< >= 0; default 0.5 m (measured: 0.8 joined a cyclist to a car) */
+    float join_gap_m;             /**< >= 0; default 0.5 m (> 16 beams; measured: 0.8 joined a cyclist to a
+                                  car), 0.8 m (<= 16 beams: the rings of a car's body and cabin lie up to
+                                  0.8 m apart; issue 15, below) */
     float car_max_length_m;       /**< > 0; default 5.2 m */
     float car_max_width_m;        /**< > 0; default 2.2 m (measured: 2.3-2.4 joined neighbouring real parked
                                   cars, real SemanticKITTI cars within 40 m 94 -> 89 %) */

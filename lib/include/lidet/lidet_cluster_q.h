@@ -62,17 +62,17 @@ extern "C" {
 typedef struct
 {
     uint32_t theta_urad;        /**< theta, microradians, (0, 1500000); default 180000 (> 16 beams), 120000 */
-    uint32_t max_steps;         /**< [1, LIDET_CLUSTER_MAX_STEPS]; default 5 (> 16 beams), 4 */
+    uint32_t max_steps;         /**< [1, LIDET_CLUSTER_MAX_STEPS]; default 5 */
     uint32_t bridge_occluders;  /**< 0/1; default 1 (> 16 beams), 0 */
     uint32_t diagonals;         /**< 0/1; default 1 */
     uint32_t max_gap_mm;        /**< 0: angle test alone; <= 1000000; default 700 */
     uint32_t max_gap_per_m_q16; /**< growth per metre of range (Q16 ratio), <= 65536; default 1638 (0.025,
                                         > 16 beams), 2621 (0.04) */
-    uint32_t min_points;        /**< >= 1; default 10 */
+    uint32_t min_points;        /**< >= 1; default 10 (> 16 rows), 8 (<= 16 rows) */
     uint32_t max_extent_mm;     /**< (0, 1000000]; default 6000 */
     int32_t max_mean_height_mm; /**< default 2500; INT32_MAX disables the filter */
     uint32_t mount_height_mm;   /**< flat ground at -mount when no planes; <= 100000 */
-    uint32_t rescue_gap_mm;     /**< 0 disables the rescue; <= 10000; default 800 */
+    uint32_t rescue_gap_mm;     /**< 0 disables the rescue; <= 10000; default 800 (> 16 rows), 1000 (<= 16) */
     uint32_t rescue_gap_per_m_q16; /**< <= 16384 (0.25 per metre); default 1966 (0.03) */
     uint32_t rescue_rows;          /**< <= LIDET_MAX_ROWS; default 1 (<= 16 beams), 2 */
     uint32_t rescue_cols;          /**< <= 15; default 6 */
@@ -85,7 +85,7 @@ typedef struct
                                         (this * candidates) >> 16; default 131072 (2.0) */
     /* the proposal refinement (lidet_refine.c's rules in integer units; lidet_cluster_cfg_t's defaults rounded) */
     uint32_t split_people;          /**< 0/1; default 1 */
-    uint32_t split_min_width_mm;    /**< (0, 1000000]; default 900 */
+    uint32_t split_min_width_mm;    /**< (0, 1000000]; default 900 (> 16 rows), 700 (<= 16 rows) */
     uint32_t split_cell_mm;         /**< (0, 100000]; default 120 */
     uint32_t split_cell_per_m_q16;  /**< <= 65536; default 0 */
     uint32_t person_max_width_mm;   /**< (0, 1000000]; default 1000 */
@@ -93,7 +93,7 @@ typedef struct
     uint32_t person_min_aspect_q16; /**< <= 100 << 16; default 117965 (1.8) */
     uint32_t person_min_cols;       /**< default 3 */
     uint32_t join_cars;             /**< 0/1; default 1 */
-    uint32_t join_gap_mm;           /**< <= 1000000; default 500 */
+    uint32_t join_gap_mm;           /**< <= 1000000; default 500 (> 16 rows), 800 (<= 16 rows) */
     uint32_t car_max_length_mm;     /**< (0, 1000000]; default 5200 */
     uint32_t car_max_width_mm;      /**< (0, 1000000]; default 2200 */
     uint32_t car_max_height_mm;     /**< (0, 1000000]; default 2000 */
