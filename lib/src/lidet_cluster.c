@@ -43,8 +43,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
         cfg->max_gap_per_m = 0.025f;
     }
     cfg->max_steps = cfg->max_steps < STEPS ? cfg->max_steps : STEPS;
-    /* 16-beam images: 8 (issue 15: far people and cars on 8-9 pixels; the refinement's parts need min_points) */
-    cfg->min_points = sparse ? 8u : 10u;
+    cfg->min_points = 10;
     cfg->max_extent_m = 6.0f;
     cfg->max_mean_height_m = 2.5f;
     cfg->mount_height_m = sensor != 0 ? sensor->mount_height_m : 1.73f;
@@ -57,8 +56,8 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->max_fragment_pixels = sparse ? 2048u : 4096u;
     cfg->max_bridge_per_pixel = 2.0f;
     /* refinement (issue 15), measured on the simulated crowd scenes (docs/BENCHMARKS.md); 16 beams: wider
-     * clusters examined, a longer join gap (issue 15: simulated VLP-16 crowd cars within 40 m, 80 scans,
-     * 90.1 -> 94.0 % with min_points, max_steps and rescue_gap_m above; lidet_cluster.h) */
+     * clusters examined, person-sized parts cut off from 9 pixels, a longer join gap (with max_steps and
+     * rescue_gap_m above, measured on simulated VLP-16 crowd scenes: lidet_cluster.h) */
     cfg->split_people = 1u;
     cfg->split_min_width_m = sparse ? 0.7f : 0.9f;
     cfg->split_cell_m = 0.12f;
@@ -67,6 +66,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->person_min_height_m = 0.9f;
     cfg->person_min_aspect = 1.8f;
     cfg->person_min_cols = 3u;
+    cfg->person_min_points = sparse ? 9u : 10u;
     cfg->join_cars = 1u;
     cfg->join_gap_m = sparse ? 0.8f : 0.5f;
     cfg->car_max_length_m = 5.2f;
@@ -103,6 +103,7 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
         !lidet__isfinite(cfg->person_max_width_m) || !(cfg->person_max_width_m > 0.0f) ||
         !lidet__isfinite(cfg->person_min_height_m) || cfg->person_min_height_m < 0.0f ||
         !lidet__isfinite(cfg->person_min_aspect) || cfg->person_min_aspect < 0.0f || cfg->join_cars > 1u ||
+        cfg->person_min_points < 1u || cfg->person_min_points > 1000000u ||
         !lidet__isfinite(cfg->azimuth_half_rad) || cfg->azimuth_half_rad < 0.0f ||
         cfg->azimuth_half_rad > LIDET_PI_F + 1e-6f || !lidet__isfinite(cfg->join_gap_m) ||
         cfg->join_gap_m < 0.0f || !lidet__isfinite(cfg->car_max_length_m) ||

@@ -25,7 +25,7 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     cfg->max_steps = cfg->max_steps < STEPS ? cfg->max_steps : STEPS;
     cfg->bridge_occluders = sparse ? 0u : 1u;
     cfg->max_gap_per_m_q16 = sparse ? 2621u : 1638u; /* 0.04, 0.025 */
-    cfg->min_points = sparse ? 8u : 10u;
+    cfg->min_points = 10u;
     cfg->max_extent_mm = 6000u;
     cfg->max_mean_height_mm = 2500;
     cfg->mount_height_mm = mount_height_mm;
@@ -45,6 +45,7 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     cfg->person_min_height_mm = 900u;
     cfg->person_min_aspect_q16 = 117965u; /* 1.8 */
     cfg->person_min_cols = 3u;
+    cfg->person_min_points = sparse ? 9u : 10u;
     cfg->join_cars = 1u;
     cfg->join_gap_mm = sparse ? 800u : 500u;
     cfg->car_max_length_mm = 5200u;
@@ -196,6 +197,7 @@ lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lide
         cfg->split_cell_mm > 100000u || cfg->split_cell_per_m_q16 > 65536u ||
         cfg->person_max_width_mm == 0u || cfg->person_max_width_mm > 1000000u ||
         cfg->person_min_height_mm > 1000000u || cfg->person_min_aspect_q16 > (100u << 16) ||
+        cfg->person_min_points < 1u || cfg->person_min_points > 1000000u ||
         cfg->join_cars > 1u || cfg->join_gap_mm > 1000000u || cfg->car_max_length_mm == 0u ||
         cfg->car_max_length_mm > 1000000u || cfg->car_max_width_mm == 0u ||
         cfg->car_max_width_mm > 1000000u || cfg->car_max_height_mm == 0u ||

@@ -97,6 +97,7 @@ static const py_field_t k_fields[] = {
     FLD(lidet_cluster_cfg_t, split_cell_m, 'f'), FLD(lidet_cluster_cfg_t, split_cell_per_m, 'f'),
     FLD(lidet_cluster_cfg_t, person_max_width_m, 'f'), FLD(lidet_cluster_cfg_t, person_min_height_m, 'f'),
     FLD(lidet_cluster_cfg_t, person_min_aspect, 'f'), FLD(lidet_cluster_cfg_t, person_min_cols, 'u'),
+    FLD(lidet_cluster_cfg_t, person_min_points, 'u'),
     FLD(lidet_cluster_cfg_t, join_cars, 'u'), FLD(lidet_cluster_cfg_t, join_gap_m, 'f'),
     FLD(lidet_cluster_cfg_t, car_max_length_m, 'f'), FLD(lidet_cluster_cfg_t, car_max_width_m, 'f'),
     FLD(lidet_cluster_cfg_t, car_max_height_m, 'f'), FLD(lidet_cluster_cfg_t, car_min_length_m, 'f'),

@@ -76,7 +76,8 @@ def test_defaults_and_options():
     assert v["max_gap_per_m"] == f(0.04)
     assert v["rescue_rows"] == 1
     # issue 15: the 16-beam values of their own (simulated VLP-16 crowd scenes); the dense ones unchanged
-    assert v["min_points"] == 8 and v["rescue_gap_m"] == f(1.0) and v["join_gap_m"] == f(0.8)
+    assert v["min_points"] == 10 and v["person_min_points"] == 9 and d["person_min_points"] == 10
+    assert v["rescue_gap_m"] == f(1.0) and v["join_gap_m"] == f(0.8)
     assert v["split_min_width_m"] == f(0.7)
     assert d["join_gap_m"] == f(0.5) and d["split_min_width_m"] == f(0.9)
     pts, ground, _, _ = _synthetic()

@@ -83,7 +83,8 @@ def test_defaults_are_the_float_defaults_rounded(need_lib):
         assert q["rescue_gap_mm"] == round(f["rescue_gap_m"] * 1e3)
         assert q["rescue_gap_per_m_q16"] == round(f["rescue_gap_per_m"] * 65536)
         for k in ("max_steps", "bridge_occluders", "diagonals", "min_points", "rescue_rows", "rescue_cols",
-                  "max_fragment_pixels", "split_people", "join_cars", "person_min_cols", "max_join_pieces"):
+                  "max_fragment_pixels", "split_people", "join_cars", "person_min_cols", "person_min_points",
+                  "max_join_pieces"):
             assert q[k] == f[k], k
         assert q["max_bridge_per_pixel_q16"] == round(f["max_bridge_per_pixel"] * 65536)
         assert q["split_cell_per_m_q16"] == round(f["split_cell_per_m"] * 65536)

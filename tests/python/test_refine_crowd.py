@@ -28,7 +28,7 @@ def test_refine_matches_reference(sensor, index):
     refined = native.cluster(r.points, sensor, ground=g)
     xyz = np.stack([plain.image.x, plain.image.y, plain.image.z], -1)
     cfg = _refine_defaults(sensor)
-    assert cfg["min_points"] == (8 if sensor == "vlp16" else 10) and "join_gap_m" in cfg
+    assert cfg["person_min_points"] == (9 if sensor == "vlp16" else 10) and "join_gap_m" in cfg
     want = ref.refine_ref(plain.pixel_labels, xyz, **cfg)
     assert refined.stats["n_split"] > 0          # the scene has groups to cut (else the test shows nothing)
     np.testing.assert_array_equal(refined.pixel_labels, want)

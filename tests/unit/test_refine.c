@@ -206,6 +206,48 @@ static void test_two_cars_not_joined(void)
     TEST_ASSERT_TRUE(cars_mixed());
 }
 
+/* person_min_points: the two people of the test above, each below min_points (raised above their pixel
+ * counts, their union still above it): with person_min_points = min_points nothing is cut (no part is big
+ * enough to leave); with person_min_points at most a person's pixels one of them is cut off and kept as a
+ * cluster of its own below min_points; one more than the smaller person's pixels cuts nothing again */
+static void test_person_min_points(void)
+{
+    const obj_t s[2] = {{0, 10.0, -0.42, 0.22, 0.0, -1.73, 0.02}, {0, 10.0, 0.42, 0.22, 0.0, -1.73, 0.02}};
+    lidet_cluster_cfg_t cfg;
+    uint32_t n_a, n_b, n_small, i, n;
+    const lidet_cluster_rec_t *r;
+    render(s, 2, 0);
+    TEST_ASSERT_EQUAL_UINT32(2, run(1));
+    r = lidet_cluster_records(&g_cl, &n);
+    n_a = r[0].n_points;
+    n_b = r[1].n_points;
+    n_small = n_a < n_b ? n_a : n_b;
+    lidet_cluster_cfg_default(&cfg, NULL);
+    cfg.theta_rad = 0.02f;
+    cfg.max_steps = 16u;
+    cfg.min_points = (n_a > n_b ? n_a : n_b) + 1u;
+    TEST_ASSERT_TRUE(n_a + n_b >= cfg.min_points);
+    cfg.person_min_points = cfg.min_points;
+    TEST_ASSERT_EQUAL_UINT32(1, run_with(&cfg));
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g_cl)->n_split);
+    cfg.person_min_points = n_small;
+    TEST_ASSERT_EQUAL_UINT32(2, run_with(&cfg));
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g_cl)->n_split);
+    scene_one_to_one(lidet_cluster_labels(&g_cl), 2);
+    assert_records_consistent();
+    r = lidet_cluster_records(&g_cl, &n);
+    for (i = 0; i < n; ++i)
+    {
+        TEST_ASSERT_TRUE(r[i].n_points < cfg.min_points);
+    }
+    cfg.person_min_points = n_small + 1u; /* the larger one could leave, but it is the one that stays */
+    TEST_ASSERT_EQUAL_UINT32(1, run_with(&cfg));
+    cfg.person_min_points = 0u;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &cfg));
+    cfg.person_min_points = 1000001u;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g_cl, &cfg));
+}
+
 /* a car seen as two slices (issue 15, the VLP-16 defaults): the low body (8-10 m ahead, up to 0.7 m above the
  * ground) and, 0.65 m further and six empty beams higher, the cabin (10.65-12.4 m): no pixel path joins them
  * (more empty rows than max_steps), their boxes lie 0.65 m apart in x-y. The dense sensors' defaults (join gap
@@ -278,6 +320,7 @@ int main(void)
     RUN_TEST(test_join_budget);
     RUN_TEST(test_two_cars_not_joined);
     RUN_TEST(test_car_slices_joined_16_beams);
+    RUN_TEST(test_person_min_points);
     RUN_TEST(test_car_alone_not_cut);
     RUN_TEST(test_deterministic_and_config);
     return UNITY_END();

@@ -209,6 +209,40 @@ static void test_car_slices_joined_16_beams(void)
     assert_records_consistent();
 }
 
+/* person_min_points (test_refine.c's test): the two people each below min_points are cut apart only when a
+ * part of person_min_points pixels may leave */
+static void test_person_min_points(void)
+{
+    const obj_t s[2] = {{0, 10.0, -0.42, 0.22, 0.0, -1.73, 0.02}, {0, 10.0, 0.42, 0.22, 0.0, -1.73, 0.02}};
+    lidet_cluster_q_cfg_t cfg;
+    uint32_t n_a, n_b, n_small;
+    render(s, 2, 0);
+    compact();
+    TEST_ASSERT_EQUAL_UINT32(2, run_generous(1));
+    n_a = g.ws.state.recs[0].n_points;
+    n_b = g.ws.state.recs[1].n_points;
+    n_small = n_a < n_b ? n_a : n_b;
+    cfg_of(&cfg, 1, 1);
+    cfg.theta_urad = 20000;
+    cfg.max_steps = 16;
+    cfg.min_points = (n_a > n_b ? n_a : n_b) + 1u;
+    cfg.person_min_points = cfg.min_points;
+    TEST_ASSERT_EQUAL_UINT32(1, run_with(&cfg));
+    TEST_ASSERT_EQUAL_UINT32(0, g.ws.state.stats.n_split);
+    cfg.person_min_points = n_small;
+    TEST_ASSERT_EQUAL_UINT32(2, run_with(&cfg));
+    TEST_ASSERT_EQUAL_UINT32(1, g.ws.state.stats.n_split);
+    scene_one_to_one(g.ws.labels, 2);
+    assert_records_consistent();
+    TEST_ASSERT_TRUE(g.ws.state.recs[0].n_points < cfg.min_points && g.ws.state.recs[1].n_points < cfg.min_points);
+    cfg.person_min_points = n_small + 1u;
+    TEST_ASSERT_EQUAL_UINT32(1, run_with(&cfg));
+    cfg.person_min_points = 0u;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_q_init(&g.ws, &cfg));
+    cfg.person_min_points = 1000001u;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_q_init(&g.ws, &cfg));
+}
+
 /* the per-profile defaults (issue 15) equal the float stage's for both kinds of sensor */
 static void test_defaults_per_profile(void)
 {
@@ -224,6 +258,7 @@ static void test_defaults_per_profile(void)
         lidet_cluster_cfg_default(&f, s);
         TEST_ASSERT_EQUAL_UINT32(f.min_points, q.min_points);
         TEST_ASSERT_EQUAL_UINT32(f.max_steps, q.max_steps);
+        TEST_ASSERT_EQUAL_UINT32(f.person_min_points, q.person_min_points);
         TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.rescue_gap_m * 1000.0f), q.rescue_gap_mm);
         TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.split_min_width_m * 1000.0f), q.split_min_width_mm);
         TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.join_gap_m * 1000.0f), q.join_gap_mm);
@@ -275,6 +310,7 @@ int main(void)
     RUN_TEST(test_car_in_three_pieces_joined);
     RUN_TEST(test_car_alone_not_cut);
     RUN_TEST(test_car_slices_joined_16_beams);
+    RUN_TEST(test_person_min_points);
     RUN_TEST(test_defaults_per_profile);
     RUN_TEST(test_defaults_and_config);
     return UNITY_END();

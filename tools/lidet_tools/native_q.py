@@ -367,7 +367,7 @@ CLUSTER_Q_FIELDS = ["theta_urad", "max_steps", "bridge_occluders", "diagonals", 
                     "rescue_gap_per_m_q16", "rescue_rows", "rescue_cols", "max_fragment_pixels",
                     "max_bridge_per_pixel_q16", "split_people", "split_min_width_mm", "split_cell_mm",
                     "split_cell_per_m_q16", "person_max_width_mm", "person_min_height_mm", "person_min_aspect_q16",
-                    "person_min_cols", "join_cars", "join_gap_mm", "car_max_length_mm", "car_max_width_mm",
+                    "person_min_cols", "person_min_points", "join_cars", "join_gap_mm", "car_max_length_mm", "car_max_width_mm",
                     "car_max_height_mm", "car_min_length_mm", "upright_max_width_mm", "max_join_pieces"]
 PROPOSAL_Q_FIELDS = ["n_points", "seed", "azimuth_bin_bam", "elevation_bin_bam", "range_bin_4mm"]
 _cq_ready = False

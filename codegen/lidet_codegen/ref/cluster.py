@@ -319,7 +319,7 @@ def grid_parts(cells: list, nx: int, ny: int) -> list:
 def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_people: bool = True,
                split_min_width_m: float = 0.9, split_cell_m: float = 0.12, split_cell_per_m: float = 0.0,
                person_max_width_m: float = 1.0, person_min_height_m: float = 0.9, person_min_aspect: float = 1.8, person_min_cols: int = 3,
-               max_clusters: int = 1 << 30, max_cells: int = 4096, max_parts: int = 32,
+               person_min_points: int | None = None, max_clusters: int = 1 << 30, max_cells: int = 4096, max_parts: int = 32,
                max_points: int = 4096, join_cars: bool = True, join_gap_m: float = 0.5,
                car_max_length_m: float = 5.2, car_max_width_m: float = 2.2, car_max_height_m: float = 2.0,
                car_min_length_m: float = 2.5, upright_max_width_m: float = 1.3,
@@ -329,6 +329,7 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_
     float32. Returns the canonical labels the C gives with it: the same float32 operations in the same
     order (cell size, truncated cell indices, spans), so the decisions match bit for bit."""
     f32 = np.float32
+    pmin = min_points if person_min_points is None else person_min_points  # None: min_points (> 16 beams' default)
     lab = np.asarray(labels).astype(np.int64).ravel().copy()
     P = np.asarray(xyz, np.float32).reshape(-1, 3)
     n_cols = np.shape(labels)[1]
@@ -367,7 +368,7 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_
             wy = f32(f32(int(iy[m].max() - iy[m].min() + 1)) * cs)
             wz = f32(pts[m, 2].max() - pts[m, 2].min())
             col = mem[m] % n_cols
-            person[p] = (n[p] >= min_points and wx <= f32(person_max_width_m) and wy <= f32(person_max_width_m)
+            person[p] = (n[p] >= pmin and wx <= f32(person_max_width_m) and wy <= f32(person_max_width_m)
                          and wz >= f32(person_min_height_m) and wz >= f32(f32(person_min_aspect) * max(wx, wy))
                          and int(col.max() - col.min()) + 1 >= person_min_cols)
         if not person.any():

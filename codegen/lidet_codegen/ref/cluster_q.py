@@ -434,6 +434,7 @@ def refine_q(labels, members, recs, X, Y, Z, cols: int, c: dict, st: dict, heigh
     mem = [int(v) for v in members]
     recs = list(recs)
     mp = c["min_points"]
+    pmin = c["person_min_points"]  # a person-sized part needs this many pixels (lidet_cluster.h)
     order = [0] * len(recs)
     changed = False
 
@@ -456,7 +457,7 @@ def refine_q(labels, members, recs, X, Y, Z, cols: int, c: dict, st: dict, heigh
     for k in range(k0 if c["split_people"] else 0):
         rec = recs[k]
         n0, f0 = rec.n_points, rec.first_member
-        if n0 < 2 * mp or n0 > REFINE_MAX_POINTS:
+        if n0 < pmin + min(pmin, mp) or n0 > REFINE_MAX_POINTS:
             continue
         ex, ey = _span_mm(rec.min[0], rec.max[0]), _span_mm(rec.min[1], rec.max[1])
         if not ((ex > c["split_min_width_mm"] or ey > c["split_min_width_mm"])
@@ -500,7 +501,7 @@ def refine_q(labels, members, recs, X, Y, Z, cols: int, c: dict, st: dict, heigh
         for q in range(n_parts):
             wx, wy = (bx[q][1] - bx[q][0] + 1) * cs, (bx[q][3] - bx[q][2] + 1) * cs
             wz = _span_mm(bz[q][0], bz[q][1])
-            person.append(pn[q] >= mp and wx <= c["person_max_width_mm"] and wy <= c["person_max_width_mm"]
+            person.append(pn[q] >= pmin and wx <= c["person_max_width_mm"] and wy <= c["person_max_width_mm"]
                           and wz >= c["person_min_height_mm"] and (wz << 16) >= c["person_min_aspect_q16"] * max(wx, wy)
                           and bc[q][1] - bc[q][0] + 1 >= c["person_min_cols"])
         if not any(person):

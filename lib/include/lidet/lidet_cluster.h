@@ -52,10 +52,10 @@
  *    split_cell_m + split_cell_per_m * r (r = max(|cx|, |cy|) + min(|cx|, |cy|) / 2 of its box centre:
  *    no sqrt) and cut into the 8-connected parts of its occupied cells. Parts spanning at most
  *    person_max_width_m in x and y whose points span at least person_min_height_m and
- *    person_min_aspect times that span in z, over at least person_min_cols image columns
- *    (person-sized), become clusters of their own; the other parts stay together in the cluster (when
- *    every part is person-sized the largest stays; parts below min_points stay, and when what stays
- *    would be below min_points the largest person-sized part stays with it). Records are recomputed,
+ *    person_min_aspect times that span in z, over at least person_min_cols image columns, with at least
+ *    person_min_points pixels (person-sized), become clusters of their own; the other parts stay together
+ *    in the cluster (when every part of min_points pixels or more is person-sized the largest part stays;
+ *    when what stays would be below min_points the largest person-sized part stays with it). Records are recomputed,
  *    slots come from the free ones (none free: the rest stays). Clusters needing more than
  *    LIDET_REFINE_MAX_CELLS cells or LIDET_REFINE_MAX_PARTS parts, or holding more than
  *    LIDET_REFINE_MAX_POINTS pixels, stay whole. Joins (join_cars, the default): in slot order (the
@@ -71,10 +71,10 @@
  *    65 -> 85 % (hdl64), 71 -> 85 % (vlp16), cars 92 -> 93 %, 89 -> 91 %; default scenes and real
  *    SemanticKITTI cars no worse. Profiles of <= 16 beams have defaults of their own, chosen on 80 simulated
  *    VLP-16 crowd scans (seed 2) and checked on 60 of other seeds (21-23) and the default VLP-16 scenes:
- *    min_points 8, max_steps 5, rescue_gap_m 1.0, join_gap_m 0.8, split_min_width_m 0.7. Measured (issue 15's
- *    proposal recall within 40 m, docs/BENCHMARKS.md): cars 90.1 -> 94.0 % (80 scans) and 91.7 -> 93.2 %
- *    (unseen seeds), people 84.7 -> 88.4 % and 88.9 -> 92.5 %, cyclists 92.5 -> 88.7 % and 87.5 -> 87.5 %;
- *    default VLP-16 scenes cars 94.3 -> 95.9 %, people and cyclists unchanged;
+ *    max_steps 5, rescue_gap_m 1.0, split_min_width_m 0.7, person_min_points 9, join_gap_m 0.8. Measured
+ *    (issue 15's proposal recall within 40 m, docs/BENCHMARKS.md): cars 90.1 -> 93.2 % (80 scans) and
+ *    91.7 -> 92.7 % (unseen seeds), people 84.7 -> 86.5 % and 88.9 -> 90.2 %, cyclists 92.5 -> 90.6 % and
+ *    87.5 -> 87.5 %; default VLP-16 scenes cars 94.3 -> 95.1 %, people and cyclists unchanged;
  *  - output ids are canonical: 1-based in raster order of each kept cluster's first pixel;
  *    0 = no cluster. Each cluster's member pixels are listed contiguously, in raster order.
  * The BFS queue is the member array itself (every pixel is pushed at most once), so it cannot
@@ -148,9 +148,7 @@ typedef struct
                                   0.025 (> 16 beams), 0.04 (<= 16 beams): 1.45 m / 2.3 m at 30 m
                                   (measured with max_gap_m; a fixed bound of 1 m split far simulated
                                   cars, 71-81 % at 0.15-0.35 rad; 1.5 m merged real parked cars) */
-    uint32_t min_points;       /**< drop clusters with fewer pixels; >= 1, default 10 (> 16 beams), 8 (<= 16
-                                  beams: far people and car pieces of 8-9 pixels, and the refinement's
-                                  person-sized parts need min_points; issue 15, below) */
+    uint32_t min_points;       /**< drop clusters with fewer pixels; >= 1, default 10 */
     float max_extent_m;        /**< drop clusters wider than this in x, y or z; > 0, default 6 m */
     float max_mean_height_m;   /**< drop clusters whose mean lies higher above the ground plane; default
                                   2.5 m; a huge value (e.g. 1e30) disables the filter */
@@ -187,6 +185,14 @@ typedef struct
     uint32_t person_min_cols;     /**< ... and its pixels span at least this many image columns (a slice of a
                                   car's flank or a wall seen at a grazing angle, one column per cell, is
                                   not a person); default 3 */
+    uint32_t person_min_points;   /**< ... and it holds at least this many pixels (a part cut off becomes a
+                                  cluster of its own even below min_points, down to this); [1, 1000000];
+                                  default 10 (> 16 beams, = min_points), 9 (<= 16 beams: people in groups
+                                  seen by a few rings; issue 15, below. 8 recovered 2-4 more people of 378
+                                  and 307 but lowered the VLP-16 detector's pedestrian AP by up to 1.8;
+                                  min_points 8 instead recovered more people and raised that AP by 3-7
+                                  points, but made 11-14 % more clusters and the VLP-16 detector 14 %
+                                  slower: docs/BENCHMARKS.md) */
     uint32_t join_cars;           /**< 1 (default): after the cuts, two clusters whose boxes lie within
                                   join_gap_m of each other in x-y and whose union fits a car (x-y
                                   spans at most car_max_length_m and car_max_width_m, z span at most

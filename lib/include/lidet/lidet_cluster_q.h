@@ -68,7 +68,7 @@ typedef struct
     uint32_t max_gap_mm;        /**< 0: angle test alone; <= 1000000; default 700 */
     uint32_t max_gap_per_m_q16; /**< growth per metre of range (Q16 ratio), <= 65536; default 1638 (0.025,
                                         > 16 beams), 2621 (0.04) */
-    uint32_t min_points;        /**< >= 1; default 10 (> 16 rows), 8 (<= 16 rows) */
+    uint32_t min_points;        /**< >= 1; default 10 */
     uint32_t max_extent_mm;     /**< (0, 1000000]; default 6000 */
     int32_t max_mean_height_mm; /**< default 2500; INT32_MAX disables the filter */
     uint32_t mount_height_mm;   /**< flat ground at -mount when no planes; <= 100000 */
@@ -92,6 +92,7 @@ typedef struct
     uint32_t person_min_height_mm;  /**< <= 1000000; default 900 */
     uint32_t person_min_aspect_q16; /**< <= 100 << 16; default 117965 (1.8) */
     uint32_t person_min_cols;       /**< default 3 */
+    uint32_t person_min_points;     /**< [1, 1000000]; default 10 (> 16 rows), 9 (<= 16 rows) */
     uint32_t join_cars;             /**< 0/1; default 1 */
     uint32_t join_gap_mm;           /**< <= 1000000; default 500 (> 16 rows), 800 (<= 16 rows) */
     uint32_t car_max_length_mm;     /**< (0, 1000000]; default 5200 */

@@ -130,14 +130,16 @@ static int refine_split_one(REFINE_STATE_T *c, uint32_t k, const REFINE_PLANE_T 
     const REFINE_CFG_T *cfg = &c->cfg;
     const REFINE_REC_T rec = c->recs[k]; /* a copy: recs[k] is rebuilt below */
     REFINE_GEOM_T geo;
+    const uint32_t pmin = cfg->person_min_points; /* [1, 1000000] (validated) */
     uint32_t nx, ny, n_parts, i, p, largest, largest_person, n_stay, n_new;
     int any_person = 0, all_person = 1;
 
     /* examined: wider than one person. Two early outs that change no decision, only the time: a cut
-     * needs two parts of min_points each, and no part spans more in z than the whole (measured: a limit
-     * on the cluster's height, skipping walls and trees, saved no time and lost people beside poles) */
-    if (rec.n_points < 2u * cfg->min_points || rec.n_points > LIDET_REFINE_MAX_POINTS ||
-        !refine_examined(cfg, &rec))
+     * needs a leaving part of person_min_points and a staying one of min_points or, when a person-sized
+     * part stays, person_min_points; and no part spans more in z than the whole (measured: a limit on the
+     * cluster's height, skipping walls and trees, saved no time and lost people beside poles) */
+    if (rec.n_points < pmin + (pmin < cfg->min_points ? pmin : cfg->min_points) ||
+        rec.n_points > LIDET_REFINE_MAX_POINTS || !refine_examined(cfg, &rec))
     {
         return 0;
     }
@@ -199,7 +201,7 @@ static int refine_split_one(REFINE_STATE_T *c, uint32_t k, const REFINE_PLANE_T 
     for (p = 0; p < n_parts; ++p)
     {
         const int person =
-            c->rf_n[p] >= cfg->min_points &&
+            c->rf_n[p] >= pmin &&
             refine_person(cfg, &geo, c->rf_n[p], (uint32_t)(c->rf_box[p][1] - c->rf_box[p][0]) + 1u,
                           (uint32_t)(c->rf_box[p][3] - c->rf_box[p][2]) + 1u, c->rf_z[p][0], c->rf_z[p][1],
                           (uint32_t)(c->rf_col[p][1] - c->rf_col[p][0]) + 1u);
