@@ -197,10 +197,9 @@ lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lide
         cfg->split_cell_mm > 100000u || cfg->split_cell_per_m_q16 > 65536u ||
         cfg->person_max_width_mm == 0u || cfg->person_max_width_mm > 1000000u ||
         cfg->person_min_height_mm > 1000000u || cfg->person_min_aspect_q16 > (100u << 16) ||
-        cfg->person_min_points < 1u || cfg->person_min_points > 1000000u ||
-        cfg->join_cars > 1u || cfg->join_gap_mm > 1000000u || cfg->car_max_length_mm == 0u ||
-        cfg->car_max_length_mm > 1000000u || cfg->car_max_width_mm == 0u ||
-        cfg->car_max_width_mm > 1000000u || cfg->car_max_height_mm == 0u ||
+        cfg->person_min_points < 1u || cfg->person_min_points > 1000000u || cfg->join_cars > 1u ||
+        cfg->join_gap_mm > 1000000u || cfg->car_max_length_mm == 0u || cfg->car_max_length_mm > 1000000u ||
+        cfg->car_max_width_mm == 0u || cfg->car_max_width_mm > 1000000u || cfg->car_max_height_mm == 0u ||
         cfg->car_max_height_mm > 1000000u || cfg->car_min_length_mm > 1000000u ||
         cfg->upright_max_width_mm > 1000000u)
     {

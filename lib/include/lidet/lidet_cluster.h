@@ -164,28 +164,28 @@ typedef struct
     uint32_t rescue_cols;      /**< columns looked at left and right (wrapping; at most (n_cols - 1) / 2
                                   are used); <= 15; default 6 */
     /* proposal refinement after the clustering (lib/src/lidet_refine.c, issue 15) */
-    uint32_t split_people;    /**< 1 (default): a cluster wider than split_min_width_m is cut into its
+    uint32_t split_people;      /**< 1 (default): a cluster wider than split_min_width_m is cut into its
                                   connected parts on a finer bird's-eye-view grid, and every part that
                                   is person-sized becomes a cluster of its own (people in groups, a
                                   person beside a car, a pole or a wall); 0: off */
-    float split_min_width_m;  /**< clusters whose x or y extent exceeds this are examined; > 0; default 0.9
+    float split_min_width_m;    /**< clusters whose x or y extent exceeds this are examined; > 0; default 0.9
                                   (> 16 beams), 0.7 (<= 16 beams: two people seen by a few rings span
                                   less; issue 15, below) */
-    float split_cell_m;       /**< cell of the finer grid at range 0; > 0; default 0.12 m */
-    float split_cell_per_m;   /**< its growth per metre of range (range of the cluster's box centre,
+    float split_cell_m;         /**< cell of the finer grid at range 0; > 0; default 0.12 m */
+    float split_cell_per_m;     /**< its growth per metre of range (range of the cluster's box centre,
                                   max(|x|,|y|) + min(|x|,|y|) / 2); >= 0; default 0 (measured: a
                                   growth of 0.002-0.008 m/m recovered fewer people in crowds) */
-    float person_max_width_m; /**< a part is person-sized when its cells span at most this in x and in
+    float person_max_width_m;   /**< a part is person-sized when its cells span at most this in x and in
                                   y; > 0; default 1.0 m */
-    float person_min_height_m;    /**< ... its points at least this in z; >= 0; default 0.9 m */
-    float person_min_aspect;      /**< ... and at least this times its wider cell span in z (people are
+    float person_min_height_m;  /**< ... its points at least this in z; >= 0; default 0.9 m */
+    float person_min_aspect;    /**< ... and at least this times its wider cell span in z (people are
                                   slender; the end of a car cut off by dropouts is not); >= 0; default 1.8
                                   (measured: 0 cut simulated cars, 1.8 none more than without the
                                   refinement) */
-    uint32_t person_min_cols;     /**< ... and its pixels span at least this many image columns (a slice of a
+    uint32_t person_min_cols;   /**< ... and its pixels span at least this many image columns (a slice of a
                                   car's flank or a wall seen at a grazing angle, one column per cell, is
                                   not a person); default 3 */
-    uint32_t person_min_points;   /**< ... and it holds at least this many pixels (a part cut off becomes a
+    uint32_t person_min_points; /**< ... and it holds at least this many pixels (a part cut off becomes a
                                   cluster of its own even below min_points, down to this); [1, 1000000];
                                   default 10 (> 16 beams, = min_points), 9 (<= 16 beams: people in groups
                                   seen by a few rings; issue 15, below. 8 recovered 2-4 more people of 378
@@ -193,30 +193,30 @@ typedef struct
                                   min_points 8 instead recovered more people and raised that AP by 3-7
                                   points, but made 11-14 % more clusters and the VLP-16 detector 14 %
                                   slower: docs/BENCHMARKS.md) */
-    uint32_t join_cars;           /**< 1 (default): after the cuts, two clusters whose boxes lie within
+    uint32_t join_cars;         /**< 1 (default): after the cuts, two clusters whose boxes lie within
                                   join_gap_m of each other in x-y and whose union fits a car (x-y
                                   spans at most car_max_length_m and car_max_width_m, z span at most
                                   car_max_height_m), neither upright, become one (a car cut by dark
                                   paint, glass or wheel dropouts); 0: off */
-    float join_gap_m;             /**< >= 0; default 0.5 m (> 16 beams; measured: 0.8 joined a cyclist to a
+    float join_gap_m;           /**< >= 0; default 0.5 m (> 16 beams; measured: 0.8 joined a cyclist to a
                                   car), 0.8 m (<= 16 beams: the rings of a car's body and cabin lie up to
                                   0.8 m apart; issue 15, below) */
-    float car_max_length_m;       /**< > 0; default 5.2 m */
-    float car_max_width_m;        /**< > 0; default 2.2 m (measured: 2.3-2.4 joined neighbouring real parked
+    float car_max_length_m;     /**< > 0; default 5.2 m */
+    float car_max_width_m;      /**< > 0; default 2.2 m (measured: 2.3-2.4 joined neighbouring real parked
                                   cars, real SemanticKITTI cars within 40 m 94 -> 89 %) */
-    float car_max_height_m;       /**< > 0; default 2.0 m */
-    float car_min_length_m;       /**< ... and the union's longer x-y side at least this (two people or a
+    float car_max_height_m;     /**< > 0; default 2.0 m */
+    float car_min_length_m;     /**< ... and the union's longer x-y side at least this (two people or a
                                   person and a bin seen by a few rings do not make a car); >= 0;
                                   default 2.5 m */
-    float upright_max_width_m;    /**< a cluster spanning at most this in x and in y and at least
+    float upright_max_width_m;  /**< a cluster spanning at most this in x and in y and at least
                                   person_min_height_m in z is upright (a person, a cyclist, a pole)
                                   and joins nothing; >= 0; default 1.3 m */
-    float azimuth_half_rad;       /**< 0 (default): the whole image; in (0, pi): only pixels whose column lies
+    float azimuth_half_rad;     /**< 0 (default): the whole image; in (0, pi): only pixels whose column lies
                                        within this azimuth of straight ahead (+x; one column more on each
                                        side) are candidates (the others are not counted in n_candidates). The
                                        detector's crop sets it to the crop + 30 deg, so a cropped scan is
                                        clustered on that part only; pi: no limit */
-    uint32_t max_join_pieces;     /**< join budget (bounds the joins' time whatever the scan): only the first
+    uint32_t max_join_pieces;   /**< join budget (bounds the joins' time whatever the scan): only the first
                                   max_join_pieces car pieces in slot order take part in the joins, the rest
                                   join nothing (stats n_join_skipped); the joins then test at most
                                   max_join_pieces x LIDET_MAX_CLUSTERS pairs instead of
@@ -224,7 +224,7 @@ typedef struct
                                   pieces measured on real scans (KITTI 25-113, 3 frames; SemanticKITTI
                                   43-61, 5; simulated HDL-64 39-101, 5); a VLP-16 scan of 2,400 tiny
                                   clusters: 1.9 -> 0.8 ms of clustering (docs/ROBUSTNESS.md) */
-    float max_bridge_per_pixel;   /**< occluder bridging budget (bounds the first fill's time whatever the
+    float max_bridge_per_pixel; /**< occluder bridging budget (bounds the first fill's time whatever the
                                   scan): the run steps over at most about this many nearer candidates per
                                   candidate pixel in all (a pixel's searches bridge only while the run's
                                   count is below max_bridge_per_pixel * n_candidates; then they stop at the
