@@ -243,28 +243,6 @@ static void test_person_min_points(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_q_init(&g.ws, &cfg));
 }
 
-/* the per-profile defaults (issue 15) equal the float stage's for both kinds of sensor */
-static void test_defaults_per_profile(void)
-{
-    static const char *const names[2] = {"hdl64", "vlp16"};
-    int k;
-    for (k = 0; k < 2; ++k)
-    {
-        const lidet_sensor_t *s = lidet_sensor_find(names[k]);
-        lidet_cluster_q_cfg_t q;
-        lidet_cluster_cfg_t f;
-        TEST_ASSERT_NOT_NULL(s);
-        lidet_cluster_q_cfg_default(&q, s->n_rows, 1730);
-        lidet_cluster_cfg_default(&f, s);
-        TEST_ASSERT_EQUAL_UINT32(f.min_points, q.min_points);
-        TEST_ASSERT_EQUAL_UINT32(f.max_steps, q.max_steps);
-        TEST_ASSERT_EQUAL_UINT32(f.person_min_points, q.person_min_points);
-        TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.rescue_gap_m * 1000.0f), q.rescue_gap_mm);
-        TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.split_min_width_m * 1000.0f), q.split_min_width_mm);
-        TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.join_gap_m * 1000.0f), q.join_gap_mm);
-    }
-}
-
 #define REFUSED(field, value)                                                                                \
     do                                                                                                       \
     {                                                                                                        \
@@ -273,22 +251,40 @@ static void test_defaults_per_profile(void)
         TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_q_init(&g.ws, &bad_));                          \
     } while (0)
 
-/* the defaults are the float defaults rounded; bad settings are refused */
+/* the defaults of a sensor kind (> 16 beams: 64 rows; <= 16: 16) are the float defaults rounded */
+static void check_defaults(lidet_cluster_q_cfg_t *cfg, const char *sensor)
+{
+    const lidet_sensor_t *s = lidet_sensor_find(sensor);
+    lidet_cluster_cfg_t f;
+    TEST_ASSERT_NOT_NULL(s);
+    lidet_cluster_q_cfg_default(cfg, s->n_rows, 1730);
+    lidet_cluster_cfg_default(&f, s);
+    TEST_ASSERT_EQUAL_UINT32(f.split_people, cfg->split_people);
+    TEST_ASSERT_EQUAL_UINT32(f.join_cars, cfg->join_cars);
+    TEST_ASSERT_EQUAL_UINT32(f.person_min_cols, cfg->person_min_cols);
+    TEST_ASSERT_EQUAL_UINT32(f.max_fragment_pixels, cfg->max_fragment_pixels);
+    TEST_ASSERT_EQUAL_UINT32(f.min_points, cfg->min_points);
+    TEST_ASSERT_EQUAL_UINT32(f.max_steps, cfg->max_steps);
+    TEST_ASSERT_EQUAL_UINT32(f.person_min_points, cfg->person_min_points);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.split_cell_m * 1000.0f), cfg->split_cell_mm);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.car_max_length_m * 1000.0f), cfg->car_max_length_mm);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.rescue_gap_m * 1000.0f), cfg->rescue_gap_mm);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.split_min_width_m * 1000.0f), cfg->split_min_width_mm);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.join_gap_m * 1000.0f), cfg->join_gap_mm);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.person_min_aspect * 65536.0f), cfg->person_min_aspect_q16);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.max_bridge_per_pixel * 65536.0f), cfg->max_bridge_per_pixel_q16);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_q_init(&g.ws, cfg));
+}
+
+/* the defaults are the float defaults rounded (both kinds of sensor: issue 15's 16-beam values); bad settings
+ * are refused */
 static void test_defaults_and_config(void)
 {
     lidet_cluster_q_cfg_t cfg;
-    lidet_cluster_cfg_t f;
-    lidet_cluster_q_cfg_default(&cfg, 64, 1730);
-    lidet_cluster_cfg_default(&f, NULL);
-    TEST_ASSERT_EQUAL_UINT32(f.split_people, cfg.split_people);
-    TEST_ASSERT_EQUAL_UINT32(f.join_cars, cfg.join_cars);
-    TEST_ASSERT_EQUAL_UINT32(f.person_min_cols, cfg.person_min_cols);
-    TEST_ASSERT_EQUAL_UINT32(f.max_fragment_pixels, cfg.max_fragment_pixels);
-    TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.split_cell_m * 1000.0f), cfg.split_cell_mm);
-    TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.car_max_length_m * 1000.0f), cfg.car_max_length_mm);
-    TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.person_min_aspect * 65536.0f), cfg.person_min_aspect_q16);
-    TEST_ASSERT_EQUAL_UINT32((uint32_t)lround(f.max_bridge_per_pixel * 65536.0f), cfg.max_bridge_per_pixel_q16);
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_q_init(&g.ws, &cfg));
+    check_defaults(&cfg, "vlp16");
+    TEST_ASSERT_EQUAL_UINT32(9u, cfg.person_min_points);
+    check_defaults(&cfg, "hdl64");
+    TEST_ASSERT_EQUAL_UINT32(10u, cfg.person_min_points);
     REFUSED(split_people, 2u);
     REFUSED(join_cars, 2u);
     REFUSED(split_cell_mm, 0u);
@@ -311,7 +307,6 @@ int main(void)
     RUN_TEST(test_car_alone_not_cut);
     RUN_TEST(test_car_slices_joined_16_beams);
     RUN_TEST(test_person_min_points);
-    RUN_TEST(test_defaults_per_profile);
     RUN_TEST(test_defaults_and_config);
     return UNITY_END();
 }
