@@ -16,7 +16,7 @@ def test_bench_cluster_runs(root, real_dir):
     spec = importlib.util.spec_from_file_location("bench_cluster", root / "tools" / "bench" / "bench_cluster.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
-    mod._sim_dir = lambda sensor, quick, crowd=False: None
+    mod._sim_dir = lambda sensor, quick, crowd=False, seed=None: None
     mod._open3d = lambda: None
     md = mod.run(argparse.Namespace(real=real_dir, build=build, quick=True))
     assert md.startswith("## Clustering (issue 6)")
