@@ -96,7 +96,7 @@
  * member per pixel) + LIDET_MAX_CLUSTERS * (sizeof(lidet_cluster_rec_t) + 6) B
  * + LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS * 8 B + the refinement's scratch (LIDET_REFINE_MAX_CELLS
  * * 4 B + LIDET_REFINE_MAX_POINTS * 2 B + LIDET_REFINE_MAX_PARTS * 26 B) + ~200 B: about 1.6 MiB with
- * the defaults (128 x 2048; 1,678,080 B on x86-64), 0.18 MiB for a VLP-16 board (16 x 1800, 64 clusters,
+ * the defaults (128 x 2048; 1,678,120 B on x86-64), 0.18 MiB for a VLP-16 board (16 x 1800, 64 clusters,
  * refinement caps 2048: 192,448 B). lidet_cluster_bytes() returns the exact figure. Declare it `static`.
  * Time: O(n_rows * n_cols * max_steps) per run worst case, O(n_rows * n_cols) typical; the rescue
  * looks at (2 rescue_rows + 1)(2 rescue_cols + 1) pixels around each fragment pixel, at most
