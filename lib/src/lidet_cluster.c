@@ -55,17 +55,17 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     /* worst-case bounds (issue 19, docs/ROBUSTNESS.md) */
     cfg->max_fragment_pixels = sparse ? 2048u : 4096u;
     cfg->max_bridge_per_pixel = 2.0f;
-    /* refinement (issue 15), measured on the simulated crowd scenes (docs/BENCHMARKS.md); 16 beams: wider
-     * clusters examined, person-sized parts cut off from 9 pixels, a longer join gap (with max_steps and
+    /* refinement (issue 15), measured on the simulated crowd scenes (docs/BENCHMARKS.md); 16 beams:
+     * person-sized parts cut off from 9 pixels, a longer join gap (with max_steps and
      * rescue_gap_m above, measured on simulated VLP-16 crowd scenes: lidet_cluster.h) */
     cfg->split_people = 1u;
-    cfg->split_min_width_m = sparse ? 0.7f : 0.9f;
+    cfg->split_min_width_m = 0.7f;
     cfg->split_cell_m = 0.12f;
     cfg->split_cell_per_m = 0.0f;
     cfg->person_max_width_m = 1.0f;
     cfg->person_min_height_m = 0.9f;
     cfg->person_min_aspect = 1.8f;
-    cfg->person_min_cols = 3u;
+    cfg->person_min_cols = 2u;
     cfg->person_min_points = sparse ? 9u : 10u;
     cfg->join_cars = 1u;
     cfg->join_gap_m = sparse ? 0.8f : 0.5f;

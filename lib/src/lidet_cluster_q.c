@@ -38,13 +38,13 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     cfg->max_bridge_per_pixel_q16 = 131072u; /* 2.0 */
     /* the refinement (issue 15) */
     cfg->split_people = 1u;
-    cfg->split_min_width_mm = sparse ? 700u : 900u;
+    cfg->split_min_width_mm = 700u;
     cfg->split_cell_mm = 120u;
     cfg->split_cell_per_m_q16 = 0u;
     cfg->person_max_width_mm = 1000u;
     cfg->person_min_height_mm = 900u;
     cfg->person_min_aspect_q16 = 117965u; /* 1.8 */
-    cfg->person_min_cols = 3u;
+    cfg->person_min_cols = 2u;
     cfg->person_min_points = sparse ? 9u : 10u;
     cfg->join_cars = 1u;
     cfg->join_gap_mm = sparse ? 800u : 500u;

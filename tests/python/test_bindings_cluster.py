@@ -79,7 +79,7 @@ def test_defaults_and_options():
     assert v["min_points"] == 10 and v["person_min_points"] == 9 and d["person_min_points"] == 10
     assert v["rescue_gap_m"] == f(1.0) and v["join_gap_m"] == f(0.8)
     assert v["split_min_width_m"] == f(0.7)
-    assert d["join_gap_m"] == f(0.5) and d["split_min_width_m"] == f(0.9)
+    assert d["join_gap_m"] == f(0.5) and d["split_min_width_m"] == f(0.7) and d["person_min_cols"] == 2
     pts, ground, _, _ = _synthetic()
     a = native.cluster(pts, "hdl64", ground=ground, min_points=100000, rescue_gap_m=0.0)
     assert a.stats["n_kept"] == 0 and a.stats["n_dropped_small"] == a.stats["n_found"]

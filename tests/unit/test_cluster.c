@@ -548,7 +548,8 @@ static void test_defaults_per_profile(void)
     TEST_ASSERT_TRUE(d.rescue_gap_m > 0.0f);
     TEST_ASSERT_EQUAL_UINT32(2, d.rescue_rows);
     TEST_ASSERT_CLOSE(0.8, d.rescue_gap_m, 1e-6, 0);
-    TEST_ASSERT_CLOSE(0.9, d.split_min_width_m, 1e-6, 0);
+    TEST_ASSERT_CLOSE(0.7, d.split_min_width_m, 1e-6, 0);
+    TEST_ASSERT_EQUAL_UINT32(2, d.person_min_cols);
     TEST_ASSERT_CLOSE(0.5, d.join_gap_m, 1e-6, 0);
     TEST_ASSERT_EQUAL_UINT32(10, d.person_min_points);
     /* <= 16 beams (issue 15, measured on simulated VLP-16 crowd scenes: lidet_cluster.h) */

@@ -317,8 +317,8 @@ def grid_parts(cells: list, nx: int, ny: int) -> list:
 
 
 def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_people: bool = True,
-               split_min_width_m: float = 0.9, split_cell_m: float = 0.12, split_cell_per_m: float = 0.0,
-               person_max_width_m: float = 1.0, person_min_height_m: float = 0.9, person_min_aspect: float = 1.8, person_min_cols: int = 3,
+               split_min_width_m: float = 0.7, split_cell_m: float = 0.12, split_cell_per_m: float = 0.0,
+               person_max_width_m: float = 1.0, person_min_height_m: float = 0.9, person_min_aspect: float = 1.8, person_min_cols: int = 2,
                person_min_points: int | None = None, max_clusters: int = 1 << 30, max_cells: int = 4096, max_parts: int = 32,
                max_points: int = 4096, join_cars: bool = True, join_gap_m: float = 0.5,
                car_max_length_m: float = 5.2, car_max_width_m: float = 2.2, car_max_height_m: float = 2.0,

@@ -85,13 +85,13 @@ typedef struct
                                         (this * candidates) >> 16; default 131072 (2.0) */
     /* the proposal refinement (lidet_refine.c's rules in integer units; lidet_cluster_cfg_t's defaults rounded) */
     uint32_t split_people;          /**< 0/1; default 1 */
-    uint32_t split_min_width_mm;    /**< (0, 1000000]; default 900 (> 16 rows), 700 (<= 16 rows) */
+    uint32_t split_min_width_mm;    /**< (0, 1000000]; default 700 */
     uint32_t split_cell_mm;         /**< (0, 100000]; default 120 */
     uint32_t split_cell_per_m_q16;  /**< <= 65536; default 0 */
     uint32_t person_max_width_mm;   /**< (0, 1000000]; default 1000 */
     uint32_t person_min_height_mm;  /**< <= 1000000; default 900 */
     uint32_t person_min_aspect_q16; /**< <= 100 << 16; default 117965 (1.8) */
-    uint32_t person_min_cols;       /**< default 3 */
+    uint32_t person_min_cols;       /**< default 2 */
     uint32_t person_min_points;     /**< [1, 1000000]; default 10 (> 16 rows), 9 (<= 16 rows) */
     uint32_t join_cars;             /**< 0/1; default 1 */
     uint32_t join_gap_mm;           /**< <= 1000000; default 500 (> 16 rows), 800 (<= 16 rows) */
