@@ -139,7 +139,7 @@ def test_score_matches_the_float_definition(nq):
 
 # ---- the integer detector against the chained numpy reference, bit for bit ---------------------------
 
-def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0)):
+def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -159,12 +159,17 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0)):
                    gate1_margin_q16=margins[0], gate2_margin_q16=margins[1])
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
                      det_cfg, models["cls"], models["box"], cap["max_clusters"], cap["max_detections"],
-                     cap["max_points"])
+                     cap["max_points"], range_only=range_only)
 
 
-@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins"])
+@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "range_only_sample",
+                                   "range_only_fresh", "range_only_real"])
 def test_bit_exact_with_the_chained_reference(nq, which, request):
+    """Both pixels of the integer detector (the range-only one: x, y, z decoded from row, column and range,
+    qmath.decode_pixels) against the chained numpy reference, bit for bit."""
     sensor, max_boxes, margins = "vlp16", 0, (0, 0)
+    range_only = which.startswith("range_only_")
+    which = which.removeprefix("range_only_")
     if which == "margins":  # the gates' operating points moved: gate 1 looser by 1 nat, gate 2 stricter by 0.5
         pts, margins = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"), (65536, -32768)
     elif which == "box_budget":  # the box budget hit: 3 boxed, the rest counted, LIDET_TRUNCATED
@@ -180,8 +185,9 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
         real = request.getfixturevalue("real_dir")
         sensor, pts = "hdl64", _load(real / "kitti/training/velodyne/000001.bin")
     mm = nq.to_mm(pts)
-    c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1])
-    r = _ref_detect(nq, mm, sensor, max_boxes, margins)
+    c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
+                    range_only=range_only)
+    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only)
     if margins != (0, 0):  # the margins bite: fewer gate-1 rejections, more gate-2 ones than at the models' gammas
         c0 = nq.detect_q(mm, sensor)
         assert c["stats"]["n_gate1_rejected"] < c0["stats"]["n_gate1_rejected"]

@@ -73,6 +73,22 @@ def cos(a):
     return sin(np.asarray(a, dtype=np.int64) + QUARTER)
 
 
+def decode_pixels(rng, row_elev_bam):
+    """x, y, z (4 mm steps) of a range-only image's (rows, cols) ranges, as lib/src/internal/lidet_qpix.h decodes
+    them: the row's beam elevation e, the column centre's angle t = floor((2c + 1) 2^31 / cols) from azimuth pi,
+    the ray ux = round(cos e (-cos t) / 2^30), uy = round(cos e sin t / 2^30), uz = sin e (Q30), then each
+    coordinate round(range u / 2^30) (halves up). An empty pixel (range 0) decodes to 0, 0, 0."""
+    r = np.asarray(rng, dtype=np.int64)
+    rows, cols = r.shape
+    e = np.asarray(row_elev_bam, dtype=np.int64)[:rows]
+    ce, se = cos(e)[:, None], sin(e)[:, None]
+    t = ((2 * np.arange(cols, dtype=np.int64) + 1) << 31) // cols
+    ct, st = cos(t)[None, :], sin(t)[None, :]
+    ux = rshift_round(ce * -ct, 30)
+    uy = rshift_round(ce * st, 30)
+    return rshift_round(r * ux, 30), rshift_round(r * uy, 30), rshift_round(r * se, 30)
+
+
 def _octant_atan(n, d):
     d_safe = np.where(d == 0, 1, d)
     t = (n << 24) // d_safe

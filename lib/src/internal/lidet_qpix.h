@@ -1,0 +1,181 @@
+/* SPDX-License-Identifier: MIT */
+/* The integer stages' pixel accessor (docs/FIXED_POINT.md, "The range-only pixel"; docs/MEMORY.md). A compact
+ * image either stores x, y, z (x_4mm, y_4mm, z_4mm non-NULL: read) or only the range (the three NULL: the
+ * range-only image of LIDET_Q_PIXEL_XYZ 0 or lidet_detector_q_cfg_t.range_only): x, y, z are then decoded from
+ * the pixel's row, its column and its range with ONE rule, mirrored bit for bit by
+ * codegen/lidet_codegen/ref/qmath.py (decode_pixels):
+ *   row r:     e = row_elev_bam[r] (the beam's elevation), ce = cos e, se = sin e (Q30, lidet__q_cos/sin);
+ *   column c:  t = floor((2c + 1) 2^31 / n_cols) (BAM32: the column centre's angle from azimuth pi, as the
+ *              projection numbers its columns), ct = cos t, st = sin t (Q30); the azimuth's cosine is -ct, its
+ *              sine st;
+ *   ray:       ux = round(ce (-ct) / 2^30), uy = round(ce st / 2^30), uz = se;
+ *   point:     x = round(range ux / 2^30), y = round(range uy / 2^30), z = round(range uz / 2^30), 4 mm steps,
+ *              every rounding lidet__q_rshift_round (halves up). An empty pixel (range 0) decodes to 0, 0, 0.
+ * The tables the projection builds at init (image row_trig_q30, col_trig_q30) hold exactly these sines and
+ * cosines (the columns' for the first quarter turn: t of column q n_cols/4 + j is q 2^30 + t_j when n_cols is a
+ * multiple of 4, and lidet__q_sin folds quadrants exactly); without them they are computed where read. Integer
+ * only; never installed. */
+#ifndef LIDET_QPIX_H
+#define LIDET_QPIX_H
+
+#include <stdint.h>
+
+#include "lidet/lidet_proj.h"
+#include "lidet_qmath.h"
+
+/** 1 for a range-only compact image (x, y, z decoded), 0 when it stores them */
+static inline int lidet__qpix_range_only(const lidet_range_image_t *img)
+{
+    return img->x_4mm == 0;
+}
+
+/** 1 when a compact image has the coordinates the integer stages read: x, y, z, or none of them and the range
+ *  with the row elevations (a range-only image); and no float arrays */
+static inline int lidet__qpix_image_ok(const lidet_range_image_t *img)
+{
+    const int xyz = img->x_4mm != 0 && img->y_4mm != 0 && img->z_4mm != 0;
+    const int none = img->x_4mm == 0 && img->y_4mm == 0 && img->z_4mm == 0;
+    return img->x_m == 0 && (xyz || (none && img->range_4mm != 0 && img->row_elev_bam != 0));
+}
+
+/** t of column c (above): floor((2c + 1) 2^31 / cols) with 32-bit divisions only (cols <= 2^15) */
+static inline uint32_t lidet__qpix_col_angle(uint32_t c, uint32_t cols)
+{
+    const uint32_t q = 0x80000000u / cols, rem = 0x80000000u % cols, k = 2u * c + 1u;
+    return k * q + (k * rem) / cols; /* k < 2 cols, rem < cols: k rem < 2^31 for cols <= 2^15 */
+}
+
+/** cos, sin (Q30) of row r's elevation (0, 0 for an image that stores x, y, z) */
+typedef struct
+{
+    int32_t ce, se;
+} lidet__qpix_row_t;
+
+static inline lidet__qpix_row_t lidet__qpix_row(const lidet_range_image_t *img, uint32_t r)
+{
+    lidet__qpix_row_t t;
+    if (img->x_4mm != 0) /* stored coordinates: not needed (the elevations may be absent) */
+    {
+        t.ce = 0;
+        t.se = 0;
+    }
+    else if (img->row_trig_q30 != 0)
+    {
+        t.ce = img->row_trig_q30[2u * r];
+        t.se = img->row_trig_q30[2u * r + 1u];
+    }
+    else
+    {
+        t.ce = lidet__q_cos((uint32_t)img->row_elev_bam[r]);
+        t.se = lidet__q_sin((uint32_t)img->row_elev_bam[r]);
+    }
+    return t;
+}
+
+/** cos t, sin t (Q30) of column c's angle t */
+static inline void lidet__qpix_col(const lidet_range_image_t *img, uint32_t c, int32_t *ct, int32_t *st)
+{
+    const uint32_t cols = img->n_cols;
+    if (img->col_trig_q30 != 0)
+    {
+        /* c = quadrant * cols/4 + j: t = quadrant 2^30 + t_j; sin, cos of t_j in the table */
+        const uint32_t qn = cols >> 2, quadrant = c / qn, j = c - quadrant * qn;
+        const int32_t s = img->col_trig_q30[2u * j], k = img->col_trig_q30[2u * j + 1u];
+        switch (quadrant)
+        {
+        case 0u:
+            *st = s;
+            *ct = k;
+            break;
+        case 1u:
+            *st = k;
+            *ct = -s;
+            break;
+        case 2u:
+            *st = -s;
+            *ct = -k;
+            break;
+        default:
+            *st = -k;
+            *ct = s;
+            break;
+        }
+    }
+    else
+    {
+        const uint32_t t = lidet__qpix_col_angle(c, cols);
+        *st = lidet__q_sin(t);
+        *ct = lidet__q_cos(t);
+    }
+}
+
+/** x, y, z (4 mm steps) of a pixel of range rng on row trig rt and column trig ct, st (the rule above) */
+static inline void lidet__qpix_decode(uint32_t rng, lidet__qpix_row_t rt, int32_t ct, int32_t st,
+                                      int32_t v[3])
+{
+    const int64_t ux = lidet__q_rshift_round(-(int64_t)rt.ce * ct, 30);
+    const int64_t uy = lidet__q_rshift_round((int64_t)rt.ce * st, 30);
+    v[0] = (int32_t)lidet__q_rshift_round((int64_t)rng * ux, 30);
+    v[1] = (int32_t)lidet__q_rshift_round((int64_t)rng * uy, 30);
+    v[2] = (int32_t)lidet__q_rshift_round((int64_t)rng * rt.se, 30);
+}
+
+/** x, y, z of pixel p = r n_cols + c with row r's trig already at hand (stored or decoded) */
+static inline void lidet__qpix_xyz_rc(const lidet_range_image_t *img, lidet__qpix_row_t rt, uint32_t c,
+                                      uint32_t p, int32_t v[3])
+{
+    if (img->x_4mm != 0)
+    {
+        v[0] = img->x_4mm[p];
+        v[1] = img->y_4mm[p];
+        v[2] = img->z_4mm[p];
+    }
+    else
+    {
+        int32_t ct, st;
+        lidet__qpix_col(img, c, &ct, &st);
+        lidet__qpix_decode(img->range_4mm[p], rt, ct, st, v);
+    }
+}
+
+/** x, y, z of pixel p (4 mm steps), stored or decoded */
+static inline void lidet__qpix_xyz(const lidet_range_image_t *img, uint32_t p, int32_t v[3])
+{
+    if (img->x_4mm != 0)
+    {
+        v[0] = img->x_4mm[p];
+        v[1] = img->y_4mm[p];
+        v[2] = img->z_4mm[p];
+    }
+    else
+    {
+        const uint32_t r = p / img->n_cols;
+        lidet__qpix_xyz_rc(img, lidet__qpix_row(img, r), p - r * img->n_cols, p, v);
+    }
+}
+
+/** The tables of the rule for rows rows of elevations elev_bam and cols columns: row_trig 2 rows entries,
+ *  col_trig 2 (cols / 4) entries (filled only when cols is a multiple of 4; returns 1 then, else 0) */
+static inline int lidet__qpix_tables(const int32_t *elev_bam, uint32_t rows, uint32_t cols, int32_t *row_trig,
+                                     int32_t *col_trig)
+{
+    uint32_t i;
+    for (i = 0; i < rows; ++i)
+    {
+        row_trig[2u * i] = lidet__q_cos((uint32_t)elev_bam[i]);
+        row_trig[2u * i + 1u] = lidet__q_sin((uint32_t)elev_bam[i]);
+    }
+    if (cols % 4u != 0u)
+    {
+        return 0;
+    }
+    for (i = 0; i < cols / 4u; ++i)
+    {
+        const uint32_t t = lidet__qpix_col_angle(i, cols);
+        col_trig[2u * i] = lidet__q_sin(t);
+        col_trig[2u * i + 1u] = lidet__q_cos(t);
+    }
+    return 1;
+}
+
+#endif /* LIDET_QPIX_H */
