@@ -415,8 +415,7 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
                 uint32_t v, vu;
                 int32_t dz;
                 int64_t h;
-                lidet__qpix_xyz_rc(img, rt, c, p, P); /* stored or decoded (lidet_qpix.h) */
-                lidet__qpix_xyz_rc(img, rtu, c, p - up, U);
+                lidet__qpix_xyz2_rc(img, rt, rtu, c, p, p - up, P, U); /* stored or decoded (lidet_qpix.h) */
                 v = (uint32_t)(P[0] * P[0]) + (uint32_t)(P[1] * P[1]);
                 vu = (uint32_t)(U[0] * U[0]) + (uint32_t)(U[1] * U[1]);
                 dz = abs32(U[2] - P[2]);

@@ -220,7 +220,7 @@ lidet_status_t lidet_proj_q_init(lidet_proj_q_state_t *st, const lidet_proj_q_cf
     }
     /* the range-only image's decoding tables (lidet_qpix.h) */
     st->has_col_trig =
-        (uint8_t)lidet__qpix_tables(st->row_elev_bam, rows, s->n_cols, st->row_trig_q30, st->col_trig_q30);
+        (uint8_t)lidet__qpix_tables(st->row_elev_bam, rows, s->n_cols, st->row_trig_q15, st->col_trig_q15);
     st->cfg = *cfg;
     st->cfg.sensor.beam_elev_urad = 0; /* not retained */
     st->n_points = 0;
@@ -505,8 +505,8 @@ void lidet_proj_q_image(const lidet_proj_q_state_t *st, const lidet_proj_q_buffe
     img->range_4mm = buf->range_4mm;
     img->point_idx = buf->x_4mm != 0 ? buf->point_idx : 0; /* range-only: the buffer held the keys */
     img->row_elev_bam = st->row_elev_bam;
-    img->row_trig_q30 = st->row_trig_q30;
-    img->col_trig_q30 = st->has_col_trig ? st->col_trig_q30 : 0;
+    img->row_trig_q15 = st->row_trig_q15;
+    img->col_trig_q15 = st->has_col_trig ? st->col_trig_q15 : 0;
 }
 
 const lidet_proj_stats_t *lidet_proj_q_stats(const lidet_proj_q_state_t *st)

@@ -76,17 +76,18 @@ def cos(a):
 def decode_pixels(rng, row_elev_bam):
     """x, y, z (4 mm steps) of a range-only image's (rows, cols) ranges, as lib/src/internal/lidet_qpix.h decodes
     them: the row's beam elevation e, the column centre's angle t = floor((2c + 1) 2^31 / cols) from azimuth pi,
-    the ray ux = round(cos e (-cos t) / 2^30), uy = round(cos e sin t / 2^30), uz = sin e (Q30), then each
-    coordinate round(range u / 2^30) (halves up). An empty pixel (range 0) decodes to 0, 0, 0."""
+    their sines and cosines in Q15 (the Q30 values rounded), the ray ux = round(cos e (-cos t) / 2^15),
+    uy = round(cos e sin t / 2^15), uz = sin e (Q15), then each coordinate round(range u / 2^15) (halves up).
+    An empty pixel (range 0) decodes to 0, 0, 0."""
     r = np.asarray(rng, dtype=np.int64)
     rows, cols = r.shape
     e = np.asarray(row_elev_bam, dtype=np.int64)[:rows]
-    ce, se = cos(e)[:, None], sin(e)[:, None]
+    ce, se = rshift_round(cos(e), 15)[:, None], rshift_round(sin(e), 15)[:, None]
     t = ((2 * np.arange(cols, dtype=np.int64) + 1) << 31) // cols
-    ct, st = cos(t)[None, :], sin(t)[None, :]
-    ux = rshift_round(ce * -ct, 30)
-    uy = rshift_round(ce * st, 30)
-    return rshift_round(r * ux, 30), rshift_round(r * uy, 30), rshift_round(r * se, 30)
+    ct, st = rshift_round(cos(t), 15)[None, :], rshift_round(sin(t), 15)[None, :]
+    ux = rshift_round(ce * -ct, 15)
+    uy = rshift_round(ce * st, 15)
+    return rshift_round(r * ux, 15), rshift_round(r * uy, 15), rshift_round(r * se, 15)
 
 
 def _octant_atan(n, d):

@@ -72,11 +72,11 @@ typedef struct
     uint8_t ring_to_row[LIDET_MAX_ROWS];                /* ring index -> row */
     uint32_t col_edge_q29[LIDET_MAX_COLS + 1];          /* D of each column's left edge, Q29; [n_cols] = 5 */
     uint16_t col_lut[4 * LIDET_MAX_COLS + 1];           /* bucket floor(D n_cols) -> column of its low end */
-    int32_t row_trig_q30[2 * LIDET_MAX_ROWS];           /* cos, sin of each row's elevation (Q30) */
-    int32_t col_trig_q30[2 * (LIDET_MAX_COLS / 4)];     /* sin, cos of the first quarter's column centres */
-    uint8_t has_col_trig;                               /* 1: col_trig_q30 filled (n_cols a multiple of 4) */
-    uint32_t n_points;                                  /* points of the last run (<= LIDET_MAX_POINTS) */
-    lidet_proj_stats_t stats;                           /* counts of the last run (n_nonfinite always 0) */
+    int32_t row_trig_q15[2 * LIDET_MAX_ROWS];           /* cos, sin of each row's elevation (Q15) */
+    int32_t col_trig_q15[2 * (LIDET_MAX_COLS / 4)]; /* sin, cos (Q15) of the first quarter's column centres */
+    uint8_t has_col_trig;                           /* 1: col_trig_q15 filled (n_cols a multiple of 4) */
+    uint32_t n_points;                              /* points of the last run (<= LIDET_MAX_POINTS) */
+    lidet_proj_stats_t stats;                       /* counts of the last run (n_nonfinite always 0) */
 } lidet_proj_q_state_t;
 
 /** @brief Caller-owned outputs of a run: n_rows * n_cols pixels each unless noted. */
