@@ -37,13 +37,13 @@ def _load(path):
     return np.fromfile(path, np.float32).reshape(-1, 4)
 
 
-def _agreement(nq, scans):
+def _agreement(nq, scans, range_only=False):
     from lidet_tools import native
     ious, n_f, n_q, n_match, cls_same = [], 0, 0, 0, 0
     for sensor, path in scans:
         pts = _load(path)
         f = native.detect(pts, sensor)  # the defaults: the refinement on in both
-        q = nq.detect_q(nq.to_mm(pts), sensor)
+        q = nq.detect_q(nq.to_mm(pts), sensor, range_only=range_only)
         assert q["status"] >= 0
         n_f += len(f.cls)
         n_q += len(q["cls"])
@@ -84,17 +84,29 @@ def _fresh(tmp_path, n_per_sensor=4):
     return scans
 
 
-def test_agrees_with_float_detector_on_simulated_scans(nq, tmp_path):
-    """The two shipped samples and 8 freshly simulated scans (seed 9100, never used in training)."""
-    a = _agreement(nq, _scans() + _fresh(tmp_path))
-    print("integer vs float detector on simulated scans:", a)
+@pytest.mark.parametrize("range_only", [False, True], ids=["xyz_pixel", "range_only_pixel"])
+def test_agrees_with_float_detector_on_simulated_scans(nq, tmp_path, range_only):
+    """The two shipped samples and 8 freshly simulated scans (seed 9100, never used in training); both pixels of
+    the integer detector (range-only: x, y, z decoded from row, column and range)."""
+    a = _agreement(nq, _scans() + _fresh(tmp_path), range_only)
+    print(f"integer ({'range-only' if range_only else 'xyz'} pixel) vs float detector on simulated scans:", a)
     _check(a)
 
 
-def test_agrees_with_float_detector_on_real_scans(nq, real_dir):
-    a = _agreement(nq, _scans(real_dir)[2:])
-    print("integer vs float detector on the real scans:", a)
-    _check(a)
+@pytest.mark.parametrize("range_only", [False, True], ids=["xyz_pixel", "range_only_pixel"])
+def test_agrees_with_float_detector_on_real_scans(nq, real_dir, range_only):
+    """The range-only pixel puts every return of a row on its beam's nominal elevation and its column's centre:
+    real HDL-64 returns are not there (rows by elevation, no ring ids in KITTI), so it costs detections and box
+    overlap (docs/MEMORY.md, measured: 147 of 202 matched, mean BEV IoU 0.90); pinned here so it cannot silently
+    get worse. VLP-16 firmware, whose returns lie on their ring's elevation, is what the mode is for."""
+    a = _agreement(nq, _scans(real_dir)[2:], range_only)
+    print(f"integer ({'range-only' if range_only else 'xyz'} pixel) vs float detector on the real scans:", a)
+    if not range_only:
+        _check(a)
+        return
+    assert a["class_same"] == a["matched"]
+    assert a["matched"] >= 0.70 * a["n_float"], a
+    assert a["mean_iou"] >= 0.88, a
 
 
 def test_deterministic_and_bad_input(nq):
