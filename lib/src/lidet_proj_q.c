@@ -457,9 +457,14 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     {
         /* the range from the key as below; an empty pixel (all ones) gets 0 */
         const uint32_t k = ((const uint32_t *)buf->point_idx)[pix];
-        const uint32_t rq = (lidet__q_isqrt32(k) + 1u) >> 1;
-        buf->range_4mm[pix] = (uint16_t)(k == 0xFFFFFFFFu ? 0u : (rq > 0u ? rq : 1u));
-        sts.n_pixels_filled += (uint32_t)(k != 0xFFFFFFFFu);
+        uint32_t rq = 0u;
+        if (k != 0xFFFFFFFFu)
+        {
+            rq = (lidet__q_isqrt32(k) + 1u) >> 1;
+            rq = rq > 0u ? rq : 1u;
+            ++sts.n_pixels_filled;
+        }
+        buf->range_4mm[pix] = (uint16_t)rq;
     }
     for (pix = 0; !range_only && pix < npix; ++pix)
     {
