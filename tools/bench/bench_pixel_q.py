@@ -14,8 +14,9 @@ import sys
 
 import numpy as np
 
+import bench_pixel  # the table (tools/bench/bench_pixel.py)
 from lidet_codegen.ref import qmath
-from lidet_tools import cluster_eval, ground_eval, native, native_q
+from lidet_tools import cluster_eval, native, native_q
 
 
 def _image(pts, sensor: str, range_only: bool):
@@ -54,29 +55,13 @@ def cluster_points(pts, lab, sensor: str, range_only: bool) -> np.ndarray:
 
 
 def run(sensor: str, data: str) -> list[str]:
-    pairs, _ = ground_eval.find_scans([data])
-    rows = []
-    for title, ro in (("stored x, y, z, range (8 B)", False), ("range only, x, y, z decoded (2 B)", True)):
-        g = ground_eval.evaluate_scans(pairs, lambda p, ro=ro: ground_points(p, sensor, ro),
-                                       ("with_terrain",))["overall"]["with_terrain"]
-        res = []
-        for name, pts, lab in cluster_eval.scans(data):
-            res += cluster_eval.evaluate_scan(cluster_points(pts, lab, sensor, ro), lab, pts, scan=name)
-        car = cluster_eval.summarize(res)["car"]["0-40"]
-        rows.append(f"| {sensor} | {title} | {100 * g['iou']:.2f} | {100 * car['recovered']:.1f} ({car['n']}) | "
-                    f"{100 * car['over']:.1f} | {100 * car['under']:.1f} |")
-    return rows
+    return [bench_pixel.table_row(sensor, data, title, lambda p, ro=ro: ground_points(p, sensor, ro),
+                                  lambda p, lab, ro=ro: cluster_points(p, lab, sensor, ro))
+            for title, ro in (("stored x, y, z, range (8 B)", False), ("range only, x, y, z decoded (2 B)", True))]
 
 
 def main(argv=None) -> int:
-    argv = sys.argv[1:] if argv is None else argv
-    print("| data | integer pixel | ground IoU % | cars < 40 m recovered % (n) | over-seg % | under-seg % |")
-    print("|---|---|---:|---:|---:|---:|")
-    for arg in argv:
-        sensor, _, d = arg.partition(":")
-        for r in run(sensor, d):
-            print(r, flush=True)
-    return 0
+    return bench_pixel.main(argv, run, "integer pixel")
 
 
 if __name__ == "__main__":

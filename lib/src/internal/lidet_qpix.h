@@ -136,22 +136,26 @@ static inline void lidet__qpix_decode(uint32_t rng, lidet__qpix_row_t rt, int32_
     v[2] = lidet__qpix_rs15(r * rt.se);
 }
 
+/** x, y, z of pixel p of an image that stores them */
+static inline void lidet__qpix_stored(const lidet_range_image_t *img, uint32_t p, int32_t v[3])
+{
+    v[0] = img->x_4mm[p];
+    v[1] = img->y_4mm[p];
+    v[2] = img->z_4mm[p];
+}
+
 /** x, y, z of pixel p = r n_cols + c with row r's trig already at hand (stored or decoded) */
 static inline void lidet__qpix_xyz_rc(const lidet_range_image_t *img, lidet__qpix_row_t rt, uint32_t c,
                                       uint32_t p, int32_t v[3])
 {
+    int32_t ct, st;
     if (img->x_4mm != 0)
     {
-        v[0] = img->x_4mm[p];
-        v[1] = img->y_4mm[p];
-        v[2] = img->z_4mm[p];
+        lidet__qpix_stored(img, p, v);
+        return;
     }
-    else
-    {
-        int32_t ct, st;
-        lidet__qpix_col(img, c, &ct, &st);
-        lidet__qpix_decode(img->range_4mm[p], rt, ct, st, v);
-    }
+    lidet__qpix_col(img, c, &ct, &st);
+    lidet__qpix_decode(img->range_4mm[p], rt, ct, st, v);
 }
 
 /** x, y, z of pixels p (row trig rt) and pu (row trig rtu) of the same column c, stored or decoded */
@@ -159,38 +163,29 @@ static inline void lidet__qpix_xyz2_rc(const lidet_range_image_t *img, lidet__qp
                                        lidet__qpix_row_t rtu, uint32_t c, uint32_t p, uint32_t pu,
                                        int32_t v[3], int32_t vu[3])
 {
+    int32_t ct, st;
     if (img->x_4mm != 0)
     {
-        v[0] = img->x_4mm[p];
-        v[1] = img->y_4mm[p];
-        v[2] = img->z_4mm[p];
-        vu[0] = img->x_4mm[pu];
-        vu[1] = img->y_4mm[pu];
-        vu[2] = img->z_4mm[pu];
+        lidet__qpix_stored(img, p, v);
+        lidet__qpix_stored(img, pu, vu);
+        return;
     }
-    else
-    {
-        int32_t ct, st;
-        lidet__qpix_col(img, c, &ct, &st);
-        lidet__qpix_decode(img->range_4mm[p], rt, ct, st, v);
-        lidet__qpix_decode(img->range_4mm[pu], rtu, ct, st, vu);
-    }
+    lidet__qpix_col(img, c, &ct, &st); /* once for both */
+    lidet__qpix_decode(img->range_4mm[p], rt, ct, st, v);
+    lidet__qpix_decode(img->range_4mm[pu], rtu, ct, st, vu);
 }
 
 /** x, y, z of pixel p (4 mm steps), stored or decoded */
 static inline void lidet__qpix_xyz(const lidet_range_image_t *img, uint32_t p, int32_t v[3])
 {
+    uint32_t r;
     if (img->x_4mm != 0)
     {
-        v[0] = img->x_4mm[p];
-        v[1] = img->y_4mm[p];
-        v[2] = img->z_4mm[p];
+        lidet__qpix_stored(img, p, v);
+        return;
     }
-    else
-    {
-        const uint32_t r = p / img->n_cols;
-        lidet__qpix_xyz_rc(img, lidet__qpix_row(img, r), p - r * img->n_cols, p, v);
-    }
+    r = p / img->n_cols;
+    lidet__qpix_xyz_rc(img, lidet__qpix_row(img, r), p - r * img->n_cols, p, v);
 }
 
 /** The tables of the rule for rows rows of elevations elev_bam and cols columns: row_trig 2 rows entries,
