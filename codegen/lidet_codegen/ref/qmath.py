@@ -79,7 +79,7 @@ def decode_pixels(rng, row_elev_bam):
     their sines and cosines in Q15 (the Q30 values rounded), the ray ux = round(cos e (-cos t) / 2^15),
     uy = round(cos e sin t / 2^15), uz = sin e (Q15), then each coordinate round(range u / 2^15) (halves up).
     An empty pixel (range 0) decodes to 0, 0, 0."""
-    r = np.asarray(rng, dtype=np.int64)
+    r = np.asarray(rng, dtype=np.int64) & 0x7FFF  # valid ranges are <= 32750; the C masks to 15 bits
     rows, cols = r.shape
     e = np.asarray(row_elev_bam, dtype=np.int64)[:rows]
     ce, se = rshift_round(cos(e), 15)[:, None], rshift_round(sin(e), 15)[:, None]

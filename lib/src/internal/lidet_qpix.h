@@ -11,7 +11,8 @@
  *              cosine is -ct, its sine st;
  *   ray:       ux = round(ce (-ct) / 2^15), uy = round(ce st / 2^15), uz = se (Q15);
  *   point:     x = round(range ux / 2^15), y = round(range uy / 2^15), z = round(range uz / 2^15), 4 mm steps;
- *              every rounding halves up ((v + 2^14) >> 15, arithmetic). An empty pixel (range 0) decodes to 0.
+ *              every rounding halves up ((v + 2^14) >> 15, arithmetic), range = its low 15 bits (valid ones are
+ *              <= 32750). An empty pixel (range 0) decodes to 0.
  * Every product fits int32 (|Q15| <= 2^15, range < 2^15): 32-bit multiplications only, no 64-bit helper on a
  * Cortex-M0+. The ray's rounding (2^-16 per component) moves a point by at most ~1 step at the 131 m limit.
  * The tables the projection builds at init (image row_trig_q15, col_trig_q15) hold exactly these sines and
@@ -130,7 +131,10 @@ static inline void lidet__qpix_col(const lidet_range_image_t *img, uint32_t c, i
 static inline void lidet__qpix_decode(uint32_t rng, lidet__qpix_row_t rt, int32_t ct, int32_t st,
                                       int32_t v[3])
 {
-    const int32_t r = (int32_t)rng, ux = lidet__qpix_rs15(-rt.ce * ct), uy = lidet__qpix_rs15(rt.ce * st);
+    /* the low 15 bits: a valid range is <= 32750 (the compact image's limit); a caller's larger value cannot
+     * overflow the products */
+    const int32_t r = (int32_t)(rng & 0x7FFFu), ux = lidet__qpix_rs15(-rt.ce * ct),
+                  uy = lidet__qpix_rs15(rt.ce * st);
     v[0] = lidet__qpix_rs15(r * ux);
     v[1] = lidet__qpix_rs15(r * uy);
     v[2] = lidet__qpix_rs15(r * rt.se);
