@@ -260,7 +260,7 @@ static int rescue_on(const lidet_cluster_state_t *c)
 #define RUN_REFINE_JOIN lidet__refine_join
 #include "internal/lidet_cluster_run_body.h"
 
-lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *labels, int32_t *members,
+lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *labels, lidet_member_t *members,
                                          const lidet_range_image_t *img, const uint8_t *ground_mask,
                                          const lidet_plane_t *planes, uint32_t n_sectors)
 {
@@ -369,7 +369,7 @@ const lidet_cluster_rec_t *lidet_cluster_records(const lidet_cluster_t *c, uint3
     return c->state.recs;
 }
 
-const int32_t *lidet_cluster_members(const lidet_cluster_t *c)
+const lidet_member_t *lidet_cluster_members(const lidet_cluster_t *c)
 {
     return c == 0 ? 0 : c->members;
 }

@@ -8,6 +8,7 @@
 #include "internal/lidet_assert.h"
 #include "internal/lidet_cluster_q_internal.h"
 #include "internal/lidet_qmath.h"
+#include "internal/lidet_qpix.h"
 
 void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, uint32_t mount_height_mm)
 {
@@ -60,9 +61,11 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
  * (at most 65535 steps) in mm against the limit */
 static inline void read_q(const lidet_cluster_q_state_t *c, uint32_t p, int32_t *x, int32_t *y, int32_t *z)
 {
-    *x = c->img.x_4mm[p];
-    *y = c->img.y_4mm[p];
-    *z = c->img.z_4mm[p];
+    int32_t v[3];
+    lidet__qpix_xyz(&c->img, p, v); /* stored or decoded (lidet_qpix.h) */
+    *x = v[0];
+    *y = v[1];
+    *z = v[2];
 }
 
 #define STATS_STATE_T lidet_cluster_q_state_t
@@ -216,17 +219,17 @@ lidet_status_t lidet_cluster_q_init(lidet_cluster_q_t *c, const lidet_cluster_q_
     return c == 0 ? LIDET_ERR_ARG : lidet_cluster_q_state_init(&c->state, cfg);
 }
 
-lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t *labels, int32_t *members,
-                                           const lidet_range_image_t *img, const uint8_t *ground_mask,
-                                           const lidet_plane_q_t *planes, uint32_t n_sectors)
+lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t *labels,
+                                           lidet_member_t *members, const lidet_range_image_t *img,
+                                           const uint8_t *ground_mask, const lidet_plane_q_t *planes,
+                                           uint32_t n_sectors)
 {
     lidet__grow_q_t lk;
     lidet_cluster_stats_t st;
     uint32_t npix;
     lidet_status_t chk = run_check(c, labels, members, img, planes, n_sectors);
     /* a compact image with its BAM32 elevations */
-    if (chk == LIDET_OK && (img->x_m != 0 || img->x_4mm == 0 || img->y_4mm == 0 || img->z_4mm == 0 ||
-                            img->range_4mm == 0 || img->row_elev_bam == 0))
+    if (chk == LIDET_OK && (!lidet__qpix_image_ok(img) || img->range_4mm == 0 || img->row_elev_bam == 0))
     {
         chk = LIDET_ERR_ARG;
     }

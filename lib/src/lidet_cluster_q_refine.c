@@ -12,6 +12,7 @@
 
 #include "internal/lidet_cluster_q_internal.h"
 #include "internal/lidet_qmath.h"
+#include "internal/lidet_qpix.h"
 
 /* one examined cluster's grid: its box corner (4 mm steps), the cell (mm) and ceil(2^40 / cell) */
 typedef struct
@@ -52,8 +53,11 @@ static int refine_grid(const lidet_cluster_q_cfg_t *cfg, const lidet_cluster_q_r
 static uint32_t refine_cell(const lidet_cluster_q_state_t *c, uint32_t p, const geom_q_t *g, uint32_t nx,
                             uint32_t ny)
 {
-    uint32_t ix = (uint32_t)(((uint64_t)span_mm(g->lo[0], c->img.x_4mm[p]) * g->inv) >> 40);
-    uint32_t iy = (uint32_t)(((uint64_t)span_mm(g->lo[1], c->img.y_4mm[p]) * g->inv) >> 40);
+    int32_t v[3];
+    uint32_t ix, iy;
+    lidet__qpix_xyz(&c->img, p, v); /* stored or decoded (lidet_qpix.h) */
+    ix = (uint32_t)(((uint64_t)span_mm(g->lo[0], v[0]) * g->inv) >> 40);
+    iy = (uint32_t)(((uint64_t)span_mm(g->lo[1], v[1]) * g->inv) >> 40);
     ix = ix < nx ? ix : nx - 1u;
     iy = iy < ny ? iy : ny - 1u;
     return iy * nx + ix;
@@ -61,7 +65,9 @@ static uint32_t refine_cell(const lidet_cluster_q_state_t *c, uint32_t p, const 
 
 static int32_t refine_z(const lidet_cluster_q_state_t *c, uint32_t p)
 {
-    return c->img.z_4mm[p];
+    int32_t v[3];
+    lidet__qpix_xyz(&c->img, p, v);
+    return v[2];
 }
 
 static int refine_person(const lidet_cluster_q_cfg_t *cfg, const geom_q_t *g, uint32_t n, uint32_t sx,
@@ -129,10 +135,11 @@ static void sums_of(const lidet_cluster_q_state_t *c, const lidet_cluster_q_rec_
     s[2] = 0;
     for (m = r->first_member; m < r->first_member + r->n_points; ++m)
     {
-        const uint32_t p = (uint32_t)c->members[m];
-        s[0] += c->img.x_4mm[p];
-        s[1] += c->img.y_4mm[p];
-        s[2] += c->img.z_4mm[p];
+        int32_t v[3];
+        lidet__qpix_xyz(&c->img, (uint32_t)c->members[m], v);
+        s[0] += v[0];
+        s[1] += v[1];
+        s[2] += v[2];
     }
 }
 
@@ -166,8 +173,7 @@ static void refine_join_mean(lidet_cluster_q_state_t *c, uint32_t i, uint32_t j,
 #define REFINE_Z_FAR 0x7FFFFFFF
 #define REFINE_V_T int32_t
 #define REFINE_S_T int64_t
-#define REFINE_READ(c, p, v)                                                                                 \
-    ((v)[0] = (c)->img.x_4mm[p], (v)[1] = (c)->img.y_4mm[p], (v)[2] = (c)->img.z_4mm[p])
+#define REFINE_READ(c, p, v) lidet__qpix_xyz(&(c)->img, p, v)
 #define REFINE_MIN(r) ((r)->min_4mm)
 #define REFINE_MAX(r) ((r)->max_4mm)
 #define REFINE_MEAN(r) ((r)->mean_4mm)

@@ -6,11 +6,13 @@
 
 #include "internal/lidet_assert.h"
 #include "internal/lidet_cluster_q_internal.h"
+#include "internal/lidet_qpix.h"
 
 /* group pixel q whose window is looked at, and its range */
 typedef struct
 {
     uint32_t q, dq;
+    int32_t v[3]; /* q's x, y, z (stored or decoded) */
 } window_q_t;
 
 static inline void window_set_q(const lidet_cluster_q_state_t *c, window_q_t *w, uint32_t q,
@@ -20,6 +22,7 @@ static inline void window_set_q(const lidet_cluster_q_state_t *c, window_q_t *w,
     (void)compact;
     w->q = q;
     w->dq = c->img.range_4mm[q];
+    lidet__qpix_xyz(&c->img, q, w->v);
 }
 
 /* |a - b| of two int16 coordinates <= gg (no overflow: int32) */
@@ -39,7 +42,7 @@ static inline void probe_q(lidet_cluster_q_state_t *c, lidet__rescue_q_t *rs, co
     const uint32_t l = lab[n];
     const lidet_range_image_t *img = &c->img;
     uint32_t dn, lo, gg, dd;
-    int32_t dx, dy, dz;
+    int32_t dx, dy, dz, v[3];
     if (l >= LAB_PENDING || n == w->q)
     {
         return;
@@ -47,16 +50,19 @@ static inline void probe_q(lidet_cluster_q_state_t *c, lidet__rescue_q_t *rs, co
     dn = img->range_4mm[n];
     lo = dn < w->dq ? dn : w->dq;
     gg = g->rgap + ((lo * g->rgpm + 32768u) >> 16);
-    if ((dn < w->dq ? w->dq - dn : dn - w->dq) > gg ||
-        !near_q(img->x_4mm[n], img->x_4mm[w->q], (int32_t)gg) ||
-        !near_q(img->y_4mm[n], img->y_4mm[w->q], (int32_t)gg) ||
-        !near_q(img->z_4mm[n], img->z_4mm[w->q], (int32_t)gg))
+    if ((dn < w->dq ? w->dq - dn : dn - w->dq) > gg)
     {
         return;
     }
-    dx = (int32_t)img->x_4mm[n] - img->x_4mm[w->q];
-    dy = (int32_t)img->y_4mm[n] - img->y_4mm[w->q];
-    dz = (int32_t)img->z_4mm[n] - img->z_4mm[w->q];
+    lidet__qpix_xyz(img, n, v); /* stored or decoded (lidet_qpix.h) */
+    if (!near_q(v[0], w->v[0], (int32_t)gg) || !near_q(v[1], w->v[1], (int32_t)gg) ||
+        !near_q(v[2], w->v[2], (int32_t)gg))
+    {
+        return;
+    }
+    dx = v[0] - w->v[0];
+    dy = v[1] - w->v[1];
+    dz = v[2] - w->v[2];
     dd = (uint32_t)(dx * dx) + (uint32_t)(dy * dy) + (uint32_t)(dz * dz);
     if (dd > gg * gg)
     {

@@ -37,6 +37,7 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     {
         cfg->max_boxes = LIDET_MAX_CLUSTERS;
     }
+    cfg->range_only = (uint8_t)!LIDET_Q_PIXEL_XYZ;
     cfg->gate1 = 1u;
     cfg->gate2 = 1u;
     cfg->gate1_margin_q16 = 0;
@@ -55,7 +56,8 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
         c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1u || c->max_boxes > LIDET_MAX_CLUSTERS ||
         c->gate1 > 1u || c->gate2 > 1u || c->nms_iou_q15 < 0 || c->nms_iou_q15 > 32768 ||
         c->gate1_margin_q16 < -MARGIN_MAX_Q16 || c->gate1_margin_q16 > MARGIN_MAX_Q16 ||
-        c->gate2_margin_q16 < -MARGIN_MAX_Q16 || c->gate2_margin_q16 > MARGIN_MAX_Q16)
+        c->gate2_margin_q16 < -MARGIN_MAX_Q16 || c->gate2_margin_q16 > MARGIN_MAX_Q16 || c->range_only > 1u ||
+        (!LIDET_Q_PIXEL_XYZ && c->range_only == 0u))
     {
         return 0;
     }
@@ -137,6 +139,18 @@ lidet_status_t lidet_detector_q_init(lidet_detector_q_t *d, const lidet_detector
     return LIDET_OK;
 }
 
+/* The ground mask: its own array, or (LIDET_Q_PIXEL_XYZ 0, the 256 KiB VLP-16 build) the ground scratch's sample
+ * mask bytes, dead once the samples are gathered; the clustering's members overlay them but are written only
+ * after its candidates are marked from the mask (the labels lie past them in the union) */
+static uint8_t *ground_mask(lidet_detector_q_t *d)
+{
+#if LIDET_Q_PIXEL_XYZ
+    return d->mask;
+#else
+    return d->scratch.ground.sample;
+#endif
+}
+
 static uint32_t now(const lidet_detector_q_t *d)
 {
     return d->cfg.clock != 0 ? d->cfg.clock(d->cfg.clock_ctx) : 0u;
@@ -159,9 +173,14 @@ void lidet_detector_q_image(const lidet_detector_q_t *d, lidet_range_image_t *im
         return;
     }
     memset(&b, 0, sizeof b);
-    b.x_4mm = (int16_t *)(uintptr_t)d->x_4mm; /* the image is read-only; the buffers type is shared */
-    b.y_4mm = (int16_t *)(uintptr_t)d->y_4mm;
-    b.z_4mm = (int16_t *)(uintptr_t)d->z_4mm;
+#if LIDET_Q_PIXEL_XYZ
+    if (!d->cfg.range_only)
+    {
+        b.x_4mm = (int16_t *)(uintptr_t)d->x_4mm; /* the image is read-only; the buffers type is shared */
+        b.y_4mm = (int16_t *)(uintptr_t)d->y_4mm;
+        b.z_4mm = (int16_t *)(uintptr_t)d->z_4mm;
+    }
+#endif
     b.range_4mm = (uint16_t *)(uintptr_t)d->range_4mm;
     b.point_idx = 0;
     lidet_proj_q_image(&d->proj, &b, img);
@@ -259,9 +278,14 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
 
     /* the stages */
     memset(&buf, 0, sizeof buf);
-    buf.x_4mm = d->x_4mm;
-    buf.y_4mm = d->y_4mm;
-    buf.z_4mm = d->z_4mm;
+#if LIDET_Q_PIXEL_XYZ
+    if (!d->cfg.range_only) /* else x, y, z stay NULL: a range-only image */
+    {
+        buf.x_4mm = d->x_4mm;
+        buf.y_4mm = d->y_4mm;
+        buf.z_4mm = d->z_4mm;
+    }
+#endif
     buf.range_4mm = d->range_4mm;
     buf.point_idx = d->scratch.point_idx;
     buf.point_pixel = point_pixel;
@@ -277,7 +301,7 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
     img.point_idx = 0; /* the ground stage's scratch overlays it from here on */
     t1 = now(d);
     st->ticks[LIDET_DET_STAGE_PROJECT] = t1 - t0;
-    s = lidet_ground_q_run_buffers(&d->ground, &d->scratch.ground, d->mask, &img);
+    s = lidet_ground_q_run_buffers(&d->ground, &d->scratch.ground, ground_mask(d), &img);
     st->ground = d->ground.stats;
     if (!LIDET_SUCCEEDED(s))
     {
@@ -287,8 +311,9 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
     t0 = now(d);
     st->ticks[LIDET_DET_STAGE_GROUND] = t0 - t1;
     n_sectors = d->cfg.ground.n_sectors;
+    /* the members (over the mask's bytes) are written after the candidates are marked from the mask */
     s = lidet_cluster_q_run_buffers(&d->cluster, d->scratch.cluster.labels, d->scratch.cluster.members, &img,
-                                    d->mask, d->ground.planes, n_sectors);
+                                    ground_mask(d), d->ground.planes, n_sectors);
     st->cluster = d->cluster.stats;
     if (!LIDET_SUCCEEDED(s))
     {

@@ -9,6 +9,7 @@
 #include "internal/lidet_ground_internal.h"
 #include "internal/lidet_ground_q_internal.h"
 #include "internal/lidet_qmath.h"
+#include "internal/lidet_qpix.h"
 #include "internal/lidet_rng.h"
 
 void lidet_ground_q_cfg_default(lidet_ground_q_cfg_t *cfg, uint32_t n_rows, int32_t mount_height_mm)
@@ -136,27 +137,62 @@ static inline uint32_t rxy2(const int16_t *x, const int16_t *y, uint32_t p)
     return (uint32_t)((int32_t)x[p] * x[p]) + (uint32_t)((int32_t)y[p] * y[p]);
 }
 
-/* R of a whole row, digit step by digit step over the columns (the same values as r_of, but the column loops
- * are independent lanes that a compiler vectorises); v, rem: scratch of cols entries */
-static void r_of_row(const int16_t *x, const int16_t *y, uint32_t cols, int32_t *restrict out,
-                     uint32_t *restrict v, uint32_t *restrict rem)
+/* x^2 + y^2 of pixel p = r cols + c, stored or decoded (rt: row r's trig) */
+static inline uint32_t rxy2_at(const lidet_range_image_t *img, lidet__qpix_row_t rt, uint32_t c, uint32_t p)
+{
+    int32_t q[3];
+    if (!lidet__qpix_range_only(img))
+    {
+        return rxy2(img->x_4mm, img->y_4mm, p);
+    }
+    lidet__qpix_xyz_rc(img, rt, c, p, q);
+    return (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]); /* |q| <= 32750 */
+}
+
+/* x^2 + y^2 of row r's pixels into v */
+static void row_rxy2(const lidet_range_image_t *img, uint32_t r, uint32_t *restrict v)
+{
+    const uint32_t cols = img->n_cols, base = r * cols;
+    uint32_t c;
+    if (!lidet__qpix_range_only(img))
+    {
+        const int16_t *x = img->x_4mm + base, *y = img->y_4mm + base;
+        for (c = 0; c < cols; ++c)
+        {
+            v[c] = rxy2(x, y, c);
+        }
+        return;
+    }
+    {
+        const lidet__qpix_row_t rt = lidet__qpix_row(img, r);
+        for (c = 0; c < cols; ++c)
+        {
+            v[c] = rxy2_at(img, rt, c, base + c);
+        }
+    }
+}
+
+/* R of a whole row r, digit step by digit step over the columns (the same values as r_of, but the column
+ * loops are independent lanes that a compiler vectorises); v, rem: scratch of cols entries */
+static void r_of_row(const lidet_range_image_t *img, uint32_t r, int32_t *restrict out, uint32_t *restrict v,
+                     uint32_t *restrict rem)
 {
     uint32_t *restrict root = (uint32_t *)out;
+    const uint32_t cols = img->n_cols;
     uint32_t c;
     int i;
+    row_rxy2(img, r, v);
 #if !LIDET_GROUND_Q_SQRT_LANES
     (void)root;
-    (void)v;
     (void)rem;
     for (c = 0; c < cols; ++c)
     {
-        out[c] = r_of(rxy2(x, y, c));
+        out[c] = r_of(v[c]);
     }
     return;
 #endif
     for (c = 0; c < cols; ++c)
     {
-        v[c] = rxy2(x, y, c);
         root[c] = 0u;
         rem[c] = 0u;
     }
@@ -187,18 +223,17 @@ static void r_rows_init(r_rows_t *rr, lidet_ground_q_scratch_t *sc, const lidet_
     rr->img = img;
     rr->slot[0] = sc->r_rows[0];
     rr->slot[1] = sc->r_rows[1];
-    rr->v = sc->r_v;
+    rr->v = sc->r_v.v;
     rr->rem = sc->r_rem;
     rr->row_in[0] = rr->row_in[1] = -1;
 }
 
 static const int32_t *r_row(r_rows_t *rr, uint32_t r)
 {
-    const uint32_t k = r & 1u, cols = rr->img->n_cols;
+    const uint32_t k = r & 1u;
     if (rr->row_in[k] != (int32_t)r)
     {
-        r_of_row(rr->img->x_4mm + (size_t)r * cols, rr->img->y_4mm + (size_t)r * cols, cols, rr->slot[k],
-                 rr->v, rr->rem);
+        r_of_row(rr->img, r, rr->slot[k], rr->v, rr->rem);
         rr->row_in[k] = (int32_t)r;
     }
     return rr->slot[k];
@@ -235,9 +270,31 @@ static inline uint8_t sample_test(const int32_t *R0, const int32_t *R1, const in
     return (uint8_t)(pts & fy & fx & opt);
 }
 
-static void filter_rows(const lidet_ground_q_state_t *g, uint8_t *sample, r_rows_t *rr,
+/* z of row r: the image's row, or (range-only) decoded into buf: z depends on the range and the row only */
+static const int16_t *z_row(const lidet_range_image_t *img, uint32_t r, int16_t *buf)
+{
+    const uint32_t cols = img->n_cols;
+    const uint16_t *rng = img->range_4mm + (size_t)r * cols;
+    lidet__qpix_row_t rt;
+    uint32_t c;
+    if (!lidet__qpix_range_only(img))
+    {
+        return img->z_4mm + (size_t)r * cols;
+    }
+    rt = lidet__qpix_row(img, r);
+    for (c = 0; c < cols; ++c)
+    {
+        int32_t q[3];
+        lidet__qpix_decode(rng[c], rt, 0, 0, q);
+        buf[c] = (int16_t)q[2];
+    }
+    return buf;
+}
+
+static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, r_rows_t *rr,
                         const lidet_range_image_t *img)
 {
+    uint8_t *sample = sc->sample;
     const uint32_t rows = img->n_rows, cols = img->n_cols, step = g->cfg.sample_step;
     filt_q_t f;
     uint32_t r, c;
@@ -253,7 +310,8 @@ static void filter_rows(const lidet_ground_q_state_t *g, uint8_t *sample, r_rows
     for (r = 0; r + 1u < rows; r += step)
     {
         const int32_t *R0 = r_row(rr, r), *R1 = r_row(rr, r + 1u);
-        const int16_t *Z0 = img->z_4mm + (size_t)r * cols, *Z1 = Z0 + cols;
+        /* after both rows of R: decoded z rows overlay R's work row (sc->r_v) */
+        const int16_t *Z0 = z_row(img, r, sc->r_v.z[0]), *Z1 = z_row(img, r + 1u, sc->r_v.z[1]);
         uint8_t *out = sample + (size_t)r * cols;
         out[0] = sample_test(R0, R1, Z0, Z1, cols - 1u, 0u, 1u, 2u, &f);
         for (c = 1; c + 2u < cols; ++c)
@@ -283,6 +341,7 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
         for (r = 0; r + 1u < rows; r += step)
         {
             const uint32_t base = r * cols;
+            const lidet__qpix_row_t rt = lidet__qpix_row(img, r);
             for (c = c0 + (cstep - c0 % cstep) % cstep; c < c1; c += cstep)
             {
                 if (sc->sample[base + c] != 0u)
@@ -290,7 +349,7 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
                     ++total;
                     if (lo < hi)
                     {
-                        const uint32_t k = rxy2(img->x_4mm, img->y_4mm, base + c) >= split_v ? --hi : lo++;
+                        const uint32_t k = rxy2_at(img, rt, c, base + c) >= split_v ? --hi : lo++;
                         si[k] = (lidet_ground_sample_t)(base + c);
                     }
                 }
@@ -324,12 +383,13 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
     const int64_t bf = g->cfg.below_factor_q16, slope = g->cfg.veto_slope_q16;
     const int64_t below0 = lidet__q_rshift_round(bf * above0, 16);
     const int32_t min_dz = (int32_t)g->cfg.veto_min_dz_mm;
-    const int16_t *X = img->x_4mm, *Y = img->y_4mm, *Z = img->z_4mm;
     uint32_t r, s, c, n_ground = 0, n_vetoed = 0;
     for (r = 0; r < rows; ++r)
     {
         const uint32_t base = r * cols,
                        up = r > 0u ? cols : 0u; /* row 0 compares with itself: never vetoed */
+        const lidet__qpix_row_t rt = lidet__qpix_row(img, r),
+                                rtu = lidet__qpix_row(img, r > 0u ? r - 1u : 0u);
         int32_t *Rr = sc->r_rows[r & 1u], *Ru = sc->r_rows[(r & 1u) ^ (r > 0u)];
         for (c = 0; c < cols; ++c)
         {
@@ -350,9 +410,16 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
             }
             for (c = lidet__ground_sector_col(s, ns, cols); c < c1; ++c)
             {
-                const uint32_t p = base + c, v = rxy2(X, Y, p), vu = rxy2(X, Y, p - up);
-                const int32_t dz = abs32(Z[p - up] - Z[p]);
-                const int64_t h = lidet__ground_q_height(&hp[v >= split_v], X[p], Y[p], Z[p]);
+                const uint32_t p = base + c;
+                int32_t P[3], U[3];
+                uint32_t v, vu;
+                int32_t dz;
+                int64_t h;
+                lidet__qpix_xyz2_rc(img, rt, rtu, c, p, p - up, P, U); /* stored or decoded (lidet_qpix.h) */
+                v = (uint32_t)(P[0] * P[0]) + (uint32_t)(P[1] * P[1]);
+                vu = (uint32_t)(U[0] * U[0]) + (uint32_t)(U[1] * U[1]);
+                dz = abs32(U[2] - P[2]);
+                h = lidet__ground_q_height(&hp[v >= split_v], P[0], P[1], P[2]);
                 int64_t above = above0, below = below0;
                 int in, vt = 0;
                 if (k != 0)
@@ -386,8 +453,7 @@ lidet_status_t lidet_ground_q_run_buffers(lidet_ground_q_state_t *g, lidet_groun
         return LIDET_ERR_ARG;
     }
     /* a compact image only: x, y, z in 4 mm steps */
-    st = lidet__ground_run_check(g->magic == LIDET_INIT_MAGIC,
-                                 img->x_m == 0 && img->x_4mm != 0 && img->y_4mm != 0 && img->z_4mm != 0, img,
+    st = lidet__ground_run_check(g->magic == LIDET_INIT_MAGIC, lidet__qpix_image_ok(img), img,
                                  g->cfg.n_sectors, &g->stats);
     if (st != LIDET_OK)
     {
@@ -397,7 +463,7 @@ lidet_status_t lidet_ground_q_run_buffers(lidet_ground_q_state_t *g, lidet_groun
     g->n_cols = img->n_cols;
     g->rng = lidet__rng_seed(g->cfg.seed);
     r_rows_init(&rr, scratch, img);
-    filter_rows(g, scratch->sample, &rr, img);
+    filter_rows(g, scratch, &rr, img);
     gather_samples(g, scratch, img);
     lidet__ground_q_fit_sectors(g, scratch, img);
     label_rows(g, scratch, mask, img);

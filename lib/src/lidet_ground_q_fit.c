@@ -11,6 +11,7 @@
 #include "internal/lidet_ground_internal.h"
 #include "internal/lidet_ground_q_internal.h"
 #include "internal/lidet_qmath.h"
+#include "internal/lidet_qpix.h"
 #include "internal/lidet_rng.h"
 
 #define ONE_Q30 ((int64_t)1 << 30)
@@ -95,9 +96,7 @@ static int unit_q30(const int64_t v_in[3], int32_t out[3])
 
 static inline void pixel(const lidet_range_image_t *img, uint32_t p, int32_t q[3])
 {
-    q[0] = img->x_4mm[p];
-    q[1] = img->y_4mm[p];
-    q[2] = img->z_4mm[p];
+    lidet__qpix_xyz(img, p, q); /* stored or decoded (lidet_qpix.h) */
 }
 
 /* The least-squares plane through the inliers (|height| <= thr) of cur among the cell's samples: their
@@ -233,10 +232,11 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, c
     {
         for (i = 0; i < n_eval; ++i)
         {
-            const uint32_t p = idx[i * stride];
-            sc->ev_x[i] = img->x_4mm[p];
-            sc->ev_y[i] = img->y_4mm[p];
-            sc->ev_z[i] = img->z_4mm[p];
+            int32_t q[3];
+            pixel(img, idx[i * stride], q);
+            sc->ev_x[i] = (int16_t)q[0];
+            sc->ev_y[i] = (int16_t)q[1];
+            sc->ev_z[i] = (int16_t)q[2];
         }
     }
     for (it = 0; it < cfg->ransac_iters; ++it)

@@ -6,6 +6,7 @@
 #include "internal/lidet_assert.h"
 #include "internal/lidet_proj_rows.h"
 #include "internal/lidet_qmath.h"
+#include "internal/lidet_qpix.h"
 #include "lidet/lidet_proj_q.h"
 
 #define MAX_R2_MM2 ((uint64_t)131000u * 131000u) /* the compact image's range limit, mm^2 */
@@ -217,6 +218,9 @@ lidet_status_t lidet_proj_q_init(lidet_proj_q_state_t *st, const lidet_proj_q_cf
     {
         return status;
     }
+    /* the range-only image's decoding tables (lidet_qpix.h) */
+    st->has_col_trig =
+        (uint8_t)lidet__qpix_tables(st->row_elev_bam, rows, s->n_cols, st->row_trig_q15, st->col_trig_q15);
     st->cfg = *cfg;
     st->cfg.sensor.beam_elev_urad = 0; /* not retained */
     st->n_points = 0;
@@ -276,11 +280,18 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
 {
     uint32_t n, i, rows, cols, npix, pix, row_guess = 0, col_guess = 0;
     uint64_t min2, max2;
+    int range_only;
     const uint32_t *edge;
     lidet_proj_stats_t sts;
 
-    if (st == 0 || buf == 0 || stride < 3 || (points == 0 && n_points > 0) || buf->x_4mm == 0 ||
-        buf->y_4mm == 0 || buf->z_4mm == 0 || buf->range_4mm == 0 || buf->point_idx == 0)
+    if (st == 0 || buf == 0 || stride < 3 || (points == 0 && n_points > 0) || buf->range_4mm == 0 ||
+        buf->point_idx == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    /* x, y, z all stored, or none (a range-only image) */
+    range_only = buf->x_4mm == 0;
+    if ((buf->y_4mm == 0) != range_only || (buf->z_4mm == 0) != range_only)
     {
         return LIDET_ERR_ARG;
     }
@@ -304,8 +315,11 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
 
     /* pass 1, point by point: range, row, column, the closest point per pixel (key above, all ones = empty) */
     memset(buf->point_idx, 0xFF, (size_t)npix * sizeof buf->point_idx[0]);
-    memset(buf->range_4mm, 0xFF, (size_t)npix * sizeof buf->range_4mm[0]);
-    memset(buf->z_4mm, 0xFF, (size_t)npix * sizeof buf->z_4mm[0]);
+    if (!range_only)
+    {
+        memset(buf->range_4mm, 0xFF, (size_t)npix * sizeof buf->range_4mm[0]);
+        memset(buf->z_4mm, 0xFF, (size_t)npix * sizeof buf->z_4mm[0]);
+    }
     for (i = 0; i < n; ++i)
     {
         const int32_t *pt = points + (size_t)i * stride;
@@ -420,7 +434,13 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
         LIDET_ASSERT(pix < npix);
         out = (int32_t)pix;
         ++sts.n_projected;
-        if ((uint32_t)(r2 >> 2) < key_get(buf, pix)) /* strict: ties keep the earlier point */
+        if (range_only)
+        {
+            /* the key alone, in the point_idx buffer (all ones = empty, as above) */
+            uint32_t *key = (uint32_t *)buf->point_idx; /* int32_t storage read as its unsigned type */
+            key[pix] = (uint32_t)(r2 >> 2) < key[pix] ? (uint32_t)(r2 >> 2) : key[pix];
+        }
+        else if ((uint32_t)(r2 >> 2) < key_get(buf, pix)) /* strict: ties keep the earlier point */
         {
             key_set(buf, pix, (uint32_t)(r2 >> 2));
             buf->point_idx[pix] = (int32_t)i;
@@ -433,7 +453,20 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     }
 
     /* pass 2, over pixels: the winners' coordinates and ranges in 4 mm steps (one isqrt per filled pixel) */
-    for (pix = 0; pix < npix; ++pix)
+    for (pix = 0; range_only && pix < npix; ++pix)
+    {
+        /* the range from the key as below; an empty pixel (all ones) gets 0 */
+        const uint32_t k = ((const uint32_t *)buf->point_idx)[pix];
+        uint32_t rq = 0u;
+        if (k != 0xFFFFFFFFu)
+        {
+            rq = (lidet__q_isqrt32(k) + 1u) >> 1;
+            rq = rq > 0u ? rq : 1u;
+            ++sts.n_pixels_filled;
+        }
+        buf->range_4mm[pix] = (uint16_t)rq;
+    }
+    for (pix = 0; !range_only && pix < npix; ++pix)
     {
         const int32_t k = buf->point_idx[pix];
         if (k < 0)
@@ -475,8 +508,10 @@ void lidet_proj_q_image(const lidet_proj_q_state_t *st, const lidet_proj_q_buffe
     img->y_4mm = buf->y_4mm;
     img->z_4mm = buf->z_4mm;
     img->range_4mm = buf->range_4mm;
-    img->point_idx = buf->point_idx;
+    img->point_idx = buf->x_4mm != 0 ? buf->point_idx : 0; /* range-only: the buffer held the keys */
     img->row_elev_bam = st->row_elev_bam;
+    img->row_trig_q15 = st->row_trig_q15;
+    img->col_trig_q15 = st->has_col_trig ? st->col_trig_q15 : 0;
 }
 
 const lidet_proj_stats_t *lidet_proj_q_stats(const lidet_proj_q_state_t *st)

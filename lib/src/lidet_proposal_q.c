@@ -6,6 +6,7 @@
 
 #include "internal/lidet_proposal_rule.h"
 #include "internal/lidet_qmath.h"
+#include "internal/lidet_qpix.h"
 #include "lidet/lidet_cluster_q.h"
 
 void lidet_proposal_q_cfg_default(lidet_proposal_q_cfg_t *cfg)
@@ -48,8 +49,7 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
         return LIDET_ERR_ARG;
     }
     img = &c->img;
-    if (c->magic != LIDET_INIT_MAGIC || c->members == 0 || img->x_4mm == 0 || img->y_4mm == 0 ||
-        img->z_4mm == 0)
+    if (c->magic != LIDET_INIT_MAGIC || c->members == 0 || !lidet__qpix_image_ok(img))
     {
         return LIDET_ERR_STATE;
     }
@@ -71,15 +71,18 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
     mz = rec->mean_4mm[2];
     for (i = 0; i < cfg->n_points; ++i)
     {
-        const int32_t p = c->members[rec->first_member +
-                                     lidet__proposal_next_index(&state, i, rec->n_points, cfg->n_points)];
+        const int32_t p =
+            (int32_t)c->members[rec->first_member +
+                                lidet__proposal_next_index(&state, i, rec->n_points, cfg->n_points)];
+        int32_t v[3];
         if (p < 0 || (uint32_t)p >= npix)
         {
             return LIDET_ERR_STATE; /* cannot happen after a run; guards a stale state */
         }
-        out->xyz[i][0] = sat16(img->x_4mm[p] - mx);
-        out->xyz[i][1] = sat16(img->y_4mm[p] - my);
-        out->xyz[i][2] = sat16(img->z_4mm[p] - mz);
+        lidet__qpix_xyz(img, (uint32_t)p, v); /* stored or decoded (lidet_qpix.h) */
+        out->xyz[i][0] = sat16(v[0] - mx);
+        out->xyz[i][1] = sat16(v[1] - my);
+        out->xyz[i][2] = sat16(v[2] - mz);
     }
     out->mean_4mm[0] = mx;
     out->mean_4mm[1] = my;

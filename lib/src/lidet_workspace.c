@@ -184,7 +184,7 @@ const uint16_t *lidet_workspace_labels(const lidet_workspace_t *ws)
     return ws == 0 ? 0 : ws->cluster.labels;
 }
 
-const int32_t *lidet_workspace_members(const lidet_workspace_t *ws)
+const lidet_member_t *lidet_workspace_members(const lidet_workspace_t *ws)
 {
     return ws == 0 ? 0 : ws->cluster.members;
 }

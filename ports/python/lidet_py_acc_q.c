@@ -105,7 +105,8 @@ LIDET_PY_API int lidet_py_acc_cands_q(const char *sensor, const char *cls_name, 
                                       int16_t *xyz, int32_t *mean, int16_t *voxel, uint32_t *cluster_id,
                                       uint32_t *n_cand, uint32_t *n_points)
 {
-    const int32_t cfg6[7] = {icfg[0], icfg[1], 3277, icfg[2], 1, 1, 0}; /* NMS, gates, box budget: the defaults */
+    /* NMS, gates, box budget, pixel: the defaults */
+    const int32_t cfg6[10] = {icfg[0], icfg[1], 3277, icfg[2], 1, 1, 0, 0, 0, -1};
     const int rc = lidet_py__detq_init_run(&g_acc_detq, sensor, cls_name, box_name, cfg6, pts_mm, n, stride);
     return put_cands(rc, lidet_detector_q_stats(&g_acc_detq)->n_classified, g_acc_detq.cfg.proposal.n_points,
                      g_acc_detq.order, make_q, &g_prop_q, g_prop_q.xyz, sizeof(int16_t), g_prop_q.mean_4mm,

@@ -17,7 +17,7 @@ static lidet_ground_t g_ground;
 static lidet_cluster_t g_cl;
 static lidet_cluster_state_t g_cstate;
 static uint16_t g_labels[NPIX];
-static int32_t g_members[NPIX];
+static lidet_member_t g_members[NPIX];
 static uint32_t g_point_labels[LIDET_MAX_POINTS];
 #if FZ_PROPOSALS
 static lidet_proposal_t g_prop;
@@ -48,7 +48,7 @@ static void cluster_knobs(fz_in_t *in, lidet_cluster_cfg_t *c, uint8_t *mode)
     fz_poke_f32(in, fl, (uint32_t)(sizeof fl / sizeof fl[0]));
 }
 
-static void check_clusters(const lidet_cluster_state_t *cs, const uint16_t *labels, const int32_t *members,
+static void check_clusters(const lidet_cluster_state_t *cs, const uint16_t *labels, const lidet_member_t *members,
                            uint32_t n_pix)
 {
     uint32_t i, k, total = 0;
@@ -63,7 +63,7 @@ static void check_clusters(const lidet_cluster_state_t *cs, const uint16_t *labe
         FZ_CHECK(r->n_points >= 1 && r->first_member == total);
         for (i = 0; i < r->n_points; ++i)
         {
-            const int32_t px = members[r->first_member + i];
+            const int32_t px = (int32_t)members[r->first_member + i];
             FZ_CHECK(px >= 0 && (uint32_t)px < n_pix && labels[px] == k + 1u);
             FZ_CHECK(i == 0 || px > members[r->first_member + i - 1]);
         }

@@ -37,13 +37,13 @@ def _load(path):
     return np.fromfile(path, np.float32).reshape(-1, 4)
 
 
-def _agreement(nq, scans):
+def _agreement(nq, scans, range_only=False):
     from lidet_tools import native
     ious, n_f, n_q, n_match, cls_same = [], 0, 0, 0, 0
     for sensor, path in scans:
         pts = _load(path)
         f = native.detect(pts, sensor)  # the defaults: the refinement on in both
-        q = nq.detect_q(nq.to_mm(pts), sensor)
+        q = nq.detect_q(nq.to_mm(pts), sensor, range_only=range_only)
         assert q["status"] >= 0
         n_f += len(f.cls)
         n_q += len(q["cls"])
@@ -84,17 +84,29 @@ def _fresh(tmp_path, n_per_sensor=4):
     return scans
 
 
-def test_agrees_with_float_detector_on_simulated_scans(nq, tmp_path):
-    """The two shipped samples and 8 freshly simulated scans (seed 9100, never used in training)."""
-    a = _agreement(nq, _scans() + _fresh(tmp_path))
-    print("integer vs float detector on simulated scans:", a)
+@pytest.mark.parametrize("range_only", [False, True], ids=["xyz_pixel", "range_only_pixel"])
+def test_agrees_with_float_detector_on_simulated_scans(nq, tmp_path, range_only):
+    """The two shipped samples and 8 freshly simulated scans (seed 9100, never used in training); both pixels of
+    the integer detector (range-only: x, y, z decoded from row, column and range)."""
+    a = _agreement(nq, _scans() + _fresh(tmp_path), range_only)
+    print(f"integer ({'range-only' if range_only else 'xyz'} pixel) vs float detector on simulated scans:", a)
     _check(a)
 
 
-def test_agrees_with_float_detector_on_real_scans(nq, real_dir):
-    a = _agreement(nq, _scans(real_dir)[2:])
-    print("integer vs float detector on the real scans:", a)
-    _check(a)
+@pytest.mark.parametrize("range_only", [False, True], ids=["xyz_pixel", "range_only_pixel"])
+def test_agrees_with_float_detector_on_real_scans(nq, real_dir, range_only):
+    """The range-only pixel puts every return of a row on its beam's nominal elevation and its column's centre:
+    real HDL-64 returns are not there (rows by elevation, no ring ids in KITTI), so it costs detections and box
+    overlap (docs/MEMORY.md, measured: 147 of 202 matched, mean BEV IoU 0.90); pinned here so it cannot silently
+    get worse. VLP-16 firmware, whose returns lie on their ring's elevation, is what the mode is for."""
+    a = _agreement(nq, _scans(real_dir)[2:], range_only)
+    print(f"integer ({'range-only' if range_only else 'xyz'} pixel) vs float detector on the real scans:", a)
+    if not range_only:
+        _check(a)
+        return
+    assert a["class_same"] == a["matched"]
+    assert a["matched"] >= 0.70 * a["n_float"], a
+    assert a["mean_iou"] >= 0.88, a
 
 
 def test_deterministic_and_bad_input(nq):
@@ -139,7 +151,7 @@ def test_score_matches_the_float_definition(nq):
 
 # ---- the integer detector against the chained numpy reference, bit for bit ---------------------------
 
-def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0)):
+def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -159,12 +171,17 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0)):
                    gate1_margin_q16=margins[0], gate2_margin_q16=margins[1])
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
                      det_cfg, models["cls"], models["box"], cap["max_clusters"], cap["max_detections"],
-                     cap["max_points"])
+                     cap["max_points"], range_only=range_only)
 
 
-@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins"])
+@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "range_only_sample",
+                                   "range_only_fresh", "range_only_real"])
 def test_bit_exact_with_the_chained_reference(nq, which, request):
+    """Both pixels of the integer detector (the range-only one: x, y, z decoded from row, column and range,
+    qmath.decode_pixels) against the chained numpy reference, bit for bit."""
     sensor, max_boxes, margins = "vlp16", 0, (0, 0)
+    range_only = which.startswith("range_only_")
+    which = which.removeprefix("range_only_")
     if which == "margins":  # the gates' operating points moved: gate 1 looser by 1 nat, gate 2 stricter by 0.5
         pts, margins = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"), (65536, -32768)
     elif which == "box_budget":  # the box budget hit: 3 boxed, the rest counted, LIDET_TRUNCATED
@@ -180,8 +197,9 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
         real = request.getfixturevalue("real_dir")
         sensor, pts = "hdl64", _load(real / "kitti/training/velodyne/000001.bin")
     mm = nq.to_mm(pts)
-    c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1])
-    r = _ref_detect(nq, mm, sensor, max_boxes, margins)
+    c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
+                    range_only=range_only)
+    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only)
     if margins != (0, 0):  # the margins bite: fewer gate-1 rejections, more gate-2 ones than at the models' gammas
         c0 = nq.detect_q(mm, sensor)
         assert c["stats"]["n_gate1_rejected"] < c0["stats"]["n_gate1_rejected"]

@@ -9,18 +9,26 @@
 
 #include "lidet/lidet.h"
 #include "lidet/lidet_detector.h"
+#include "lidet/lidet_detector_q.h"
 #include "test_util.h"
 
 #define BUDGET_BYTES (512u * 1024u)
+#define BUDGET_Q_BYTES (256u * 1024u) /* issue 17/18: the integer build's RAM goal */
 
 #if LIDET_MAX_ROWS != 16 || LIDET_MAX_COLS != 1800 || LIDET_MAX_POINTS != 30000 ||                       \
     LIDET_MAX_CLUSTERS != 64 || LIDET_MAX_DETECTIONS != 64
 #error "test_vlp16_budget must be built with the VLP-16 capacities"
 #endif
+#if LIDET_Q_PIXEL_XYZ
+#error "test_vlp16_budget checks the integer detector with the range-only pixel (LIDET_Q_PIXEL_XYZ 0)"
+#endif
 
 /* compile-time: a negative array size when the detector outgrows the budget (this host's layout, which is
  * at least the 32-bit target's: the structs hold pointers, no 64-bit member) */
 typedef char lidet_vlp16_detector_fits_512_kib[sizeof(lidet_detector_t) <= BUDGET_BYTES ? 1 : -1];
+/* the integer detector with the range-only pixel (ports/firmware/config/vlp16: the integer firmware's RAM is this
+ * plus ~1.3 KB of the application and 4 KiB of stack) within 256 KiB */
+typedef char lidet_vlp16_detector_q_fits_256_kib[sizeof(lidet_detector_q_t) <= BUDGET_Q_BYTES ? 1 : -1];
 
 /* the probe library's port (tests/port/lidet_port.h) counts its asserts here */
 unsigned long lidet_port_test_checks;
@@ -43,6 +51,18 @@ static void test_detector_fits_512_kib(void)
            (unsigned)lidet_detector_bytes(), (unsigned)lidet_workspace_bytes(), BUDGET_BYTES);
     TEST_ASSERT_TRUE(lidet_detector_bytes() <= BUDGET_BYTES);
     TEST_ASSERT_EQUAL_UINT32(2u, sizeof(lidet_ground_sample_t));
+}
+
+static void test_integer_detector_fits_256_kib(void)
+{
+    lidet_detector_q_cfg_t cfg;
+    printf("VLP-16 capacities: integer detector (range-only pixel) %u B, budget %u B\n",
+           (unsigned)lidet_detector_q_bytes(), BUDGET_Q_BYTES);
+    TEST_ASSERT_TRUE(lidet_detector_q_bytes() <= BUDGET_Q_BYTES);
+    TEST_ASSERT_EQUAL_UINT32(2u, sizeof(lidet_member_t));
+    /* the build's default is the range-only pixel */
+    lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("vlp16"));
+    TEST_ASSERT_EQUAL_UINT8(1u, cfg.range_only);
 }
 
 static void test_workspace_runs_at_vlp16_capacities(void)
@@ -76,6 +96,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_detector_fits_512_kib);
+    RUN_TEST(test_integer_detector_fits_256_kib);
     RUN_TEST(test_workspace_runs_at_vlp16_capacities);
     return UNITY_END();
 }

@@ -164,7 +164,7 @@ def run(args) -> str:
         ins, sz = m4["insn"]["default"], m4["size"]
         out += [
             "",
-            "Goals of issue 17 (set for the integer build, which does not exist yet): <= 20 M instructions per "
+            "Goals of issue 17 (set for the integer build): <= 20 M instructions per "
             "scan on Cortex-M, RAM (data + bss + stack) <= 256 KB, flash <= 512 KB with the weights. The float "
             f"build on the M4F, measured the same way: flash {_kib(sz['flash_without_scan'])} "
             f"({'within' if sz['flash_without_scan'] <= 512 * 1024 else 'over'}; weights {_kib(sz['rodata_weights'])}), "
@@ -172,6 +172,22 @@ def run(args) -> str:
             f"{m4['stats']['default']['classified']} proposals through the two PointNets, are "
             f"{100.0 * (ins['classify'] + ins['box']) / ins['scan']:.0f}% of the instructions), "
             f"{sz['ram'] / (256 * 1024):.1f}x the RAM goal (the stage workspace: docs/MEMORY.md).",
+        ]
+    q = reports.get("mps2-an385-q")
+    if q and q.get("size") and "default" in q.get("insn", {}):
+        ins, sz = q["insn"]["default"], q["size"]
+        rams = {b: reports[b]["size"]["ram"] for b in ("mps2-an385-q", "mps2-an385-m0plus-q", "virt-rv32imac-q")
+                if b in reports and reports[b].get("size")}
+        out += [
+            "",
+            "The integer build against the same goals (its images use `ports/firmware/config/vlp16` as they are: the "
+            "range-only pixel, `LIDET_Q_PIXEL_XYZ 0`, and 4 KiB of stack, docs/MEMORY.md): RAM "
+            + ", ".join(f"{_kib(v)} ({v:,} B)" for v in rams.values())
+            + f" on the M3, M0+ and RV32IMAC images ({'within' if max(rams.values()) <= 256 * 1024 else 'over'} "
+            f"256 KiB), flash {_kib(sz['flash_without_scan'])} on the M3 "
+            f"({'within' if sz['flash_without_scan'] <= 512 * 1024 else 'over'} 512 KiB; weights "
+            f"{_kib(sz['rodata_weights'])}), {ins['scan'] / 20e6:.1f}x the instruction goal on the M3 (the two "
+            f"PointNets {100.0 * (ins['classify'] + ins['box']) / ins['scan']:.0f}% of it).",
         ]
     out += [
         "",

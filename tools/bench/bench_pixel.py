@@ -23,26 +23,33 @@ MODELS = [("float (stored today, 16 B)", "float", 0.0), ("s16: x, y, z, range in
           ("range + real azimuth, beam elevation", "real_azimuth", 0.0)]
 
 
-def run(sensor: str, data: str) -> list[str]:
+def table_row(sensor: str, data: str, title: str, ground_points, cluster_points) -> str:
+    """One table row: ground IoU of ground_points(points) (a per-point mask) on the folder's labelled scans, and
+    cars within 40 m recovered by cluster_points(points, labels) (a per-point cluster id)."""
     pairs, _ = ground_eval.find_scans([data])
+    g = ground_eval.evaluate_scans(pairs, ground_points, ("with_terrain",))["overall"]["with_terrain"]
+    res = []
+    for name, pts, lab in cluster_eval.scans(data):
+        res += cluster_eval.evaluate_scan(cluster_points(pts, lab), lab, pts, scan=name)
+    car = cluster_eval.summarize(res)["car"]["0-40"]
+    return (f"| {sensor} | {title} | {100 * g['iou']:.2f} | {100 * car['recovered']:.1f} ({car['n']}) | "
+            f"{100 * car['over']:.1f} | {100 * car['under']:.1f} |")
+
+
+def run(sensor: str, data: str) -> list[str]:
     rows = []
     for title, model, q in MODELS:
-        def predict(pts, model=model, q=q):
-            return native.ground(pts, sensor, context=native.ScanContext(model, q)).mask_point
-        g = ground_eval.evaluate_scans(pairs, predict, ("with_terrain",))["overall"]["with_terrain"]
-        res = []
-        for name, pts, lab in cluster_eval.scans(data):
-            c = native.cluster(pts, sensor, ground=cluster_eval.ground_mask(lab), context=native.ScanContext(model, q))
-            res += cluster_eval.evaluate_scan(c.point_labels, lab, pts, scan=name)
-        car = cluster_eval.summarize(res)["car"]["0-40"]
-        rows.append(f"| {sensor} | {title} | {100 * g['iou']:.2f} | {100 * car['recovered']:.1f} ({car['n']}) | "
-                    f"{100 * car['over']:.1f} | {100 * car['under']:.1f} |")
+        ctx = native.ScanContext(model, q)
+        rows.append(table_row(
+            sensor, data, title, lambda pts, ctx=ctx: native.ground(pts, sensor, context=ctx).mask_point,
+            lambda pts, lab, ctx=ctx: native.cluster(pts, sensor, ground=cluster_eval.ground_mask(lab),
+                                                     context=ctx).point_labels))
     return rows
 
 
-def main(argv=None) -> int:
+def main(argv=None, run=run, what: str = "pixel") -> int:
     argv = sys.argv[1:] if argv is None else argv
-    print("| data | pixel | ground IoU % | cars < 40 m recovered % (n) | over-seg % | under-seg % |")
+    print(f"| data | {what} | ground IoU % | cars < 40 m recovered % (n) | over-seg % | under-seg % |")
     print("|---|---|---:|---:|---:|---:|")
     for arg in argv:
         sensor, _, d = arg.partition(":")

@@ -713,9 +713,11 @@ def to_mm(points) -> np.ndarray:
 
 def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_half_bam: int = 0,
              max_range_mm: int = 0, nms_iou_q15: int = 3277, max_proposals: int = 0, gate1: bool = True,
-             gate2: bool = True, max_boxes: int = 0, gate1_margin_q16: int = 0, gate2_margin_q16: int = 0) -> dict:
+             gate2: bool = True, max_boxes: int = 0, gate1_margin_q16: int = 0, gate2_margin_q16: int = 0,
+             range_only: bool | None = None) -> dict:
     """lidet_detector_q_run on (N, 3) int32 mm points with the int8 models cls_<model>_s8 / box_<model>_s8.
-    gate*_margin_q16: the gates' operating points (lidet_detector_q_cfg_t, Q16 nats).
+    gate*_margin_q16: the gates' operating points (lidet_detector_q_cfg_t, Q16 nats). range_only: the range-only
+    pixel (lidet_detector_q_cfg_t.range_only; None = the build's default).
 
     Returns {'cls', 'score_q15', 'energy_cls_q16', 'energy_box_q16', 'boxes' (N, 7: cx cy cz l w h mm, yaw BAM32),
     'cluster_id', 'n_points', 'outcome', 'stats', 'status'}."""
@@ -739,7 +741,8 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     nc = np.zeros(1, np.uint32)
     st = np.zeros(len(DETQ_STATS), np.uint32)
     icfg = np.array([crop_half_bam, max_range_mm, nms_iou_q15, max_proposals, int(bool(gate1)), int(bool(gate2)),
-                     max_boxes, gate1_margin_q16, gate2_margin_q16], np.int32)
+                     max_boxes, gate1_margin_q16, gate2_margin_q16, -1 if range_only is None else int(bool(range_only))],
+                    np.int32)
     n = len(pts)
     rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
                              pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st)

@@ -31,8 +31,18 @@ size32() {
     echo "n/a n/a"
   fi
 }
+# the integer detector's sizeof for a 32-bit target, one pixel mode (-DLIDET_Q_PIXEL_XYZ=...): "<KiB>" or "n/a"
+size32q() {
+  printf '%s\n' '#include "lidet/lidet_detector_q.h"' 'char sz_q[sizeof(lidet_detector_q_t)];' > "$tmp/q32.c"
+  if "$cc" -m32 -ffreestanding -std=c99 -c -I"$root/lib/include" "$@" "$tmp/q32.c" -o "$tmp/q32.o" 2>/dev/null; then
+    nm -S -t d "$tmp/q32.o" | awk '$4 == "sz_q" { printf "%.1f KiB (%d B)", $2 / 1024, $2 }'
+  else
+    echo "n/a"
+  fi
+}
 ws_rows=()
 det_rows=()
+q_rows=()
 for c in "${configs[@]}"; do
   read -r name rows cols pts cl det rcells rpts <<<"$c"
   caps=(-DLIDET_MAX_ROWS="$rows" -DLIDET_MAX_COLS="$cols" -DLIDET_MAX_POINTS="$pts" -DLIDET_MAX_CLUSTERS="$cl"
@@ -46,6 +56,14 @@ for c in "${configs[@]}"; do
   ws_rows+=("| $name ($rows x $cols, $pts, $cl) | $(kib $states) KiB | $(kib ${v[image]}) KiB | $(kib ${v[ground_mask]}) KiB | $(kib ${v[overlay]}) KiB ($(kib ${v[overlay_proj]}) / $(kib ${v[overlay_ground]}) / $(kib ${v[overlay_cluster]})) | **$(kib ${v[workspace]}) KiB** | $ws32 KiB | $(kib ${v[stages_standalone]}) KiB ($(kib ${v[proj_t]}) + $(kib ${v[ground_t]}) + $(kib ${v[cluster_t]})) |")
   det_rows+=("| $name ($rows x $cols, $pts, $cl, $det) | $(kib ${v[det_workspace]}) KiB | $(kib ${v[det_pn_scratch]}) KiB | $(kib ${v[det_pn_states]}) KiB | $(kib ${v[det_proposal]}) KiB | $(kib ${v[det_detections]}) KiB | $(kib ${v[det_rest]}) KiB | **$(kib ${v[detector]}) KiB** | **$det32 KiB** |")
   unset v
+  for xyz in 1 0; do
+    "$cc" -std=c99 -I"$root/lib/include" "${caps[@]}" -DLIDET_Q_PIXEL_XYZ=$xyz "$here/size_report_q.c" -o "$tmp/szq"
+    declare -A q=()
+    while read -r k n; do q[$k]=$n; done < <("$tmp/szq")
+    pixel=$([ "$xyz" = 1 ] && echo "x, y, z, range (8 B)" || echo "range only (2 B)")
+    q_rows+=("| $name ($rows x $cols, $pts, $cl, $det) | $pixel | $(kib ${q[q_states]}) KiB | $(kib ${q[q_image]}) KiB | $(kib ${q[q_mask]}) KiB | $(kib ${q[q_overlay]}) KiB ($(kib ${q[q_overlay_proj]}) / $(kib ${q[q_overlay_ground]}) / $(kib ${q[q_overlay_cluster]})) | $(kib ${q[q_pn_scratch]}) KiB | $(kib ${q[q_rest]}) KiB | **$(kib ${q[q_detector]}) KiB** | **$(size32q "${caps[@]}" -DLIDET_Q_PIXEL_XYZ=$xyz)** |")
+    unset q
+  done
 done
 echo "Workspace (lidet_workspace_sizes):"
 echo
@@ -58,3 +76,9 @@ echo
 echo "| config (rows x cols, points, clusters, detections) | workspace | PointNet scratch | 2 PointNet states | proposal | detections | rest (cfg, candidate order, outcomes, stats) | **detector** | **detector, 32-bit target** |"
 echo "|---|---|---|---|---|---|---|---|---|"
 printf '%s\n' "${det_rows[@]}"
+echo
+echo "Integer detector (lidet_detector_q_bytes, both pixels: LIDET_Q_PIXEL_XYZ 1 and 0; range-only, the ground mask lives in the ground scratch):"
+echo
+echo "| config (rows x cols, points, clusters, detections) | pixel | proj+ground+cluster states | image | ground mask | overlay (proj / ground / cluster) | PointNet scratch | rest (cfg, PointNet states, proposal, detections, stats) | **integer detector** | **integer detector, 32-bit target** |"
+echo "|---|---|---|---|---|---|---|---|---|---|"
+printf '%s\n' "${q_rows[@]}"

@@ -48,13 +48,17 @@ def candidates(recs, det_cfg: dict, outcome: list) -> tuple[list, bool]:
 
 
 def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, proposal_cfg: dict, det_cfg: dict,
-           cls_model, box_model, max_clusters: int, max_detections: int, max_points: int) -> dict:
+           cls_model, box_model, max_clusters: int, max_detections: int, max_points: int, range_only: bool = False) -> dict:
     """The whole integer detector on (N, 3) int32 mm points. det_cfg: crop_half_bam, max_range_mm, max_proposals,
     max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max, and optionally gate1_margin_q16 / gate2_margin_q16
-    (0 when absent: the models' gammas). Returns detections (dicts), outcomes, stats."""
+    (0 when absent: the models' gammas). range_only: the image keeps only the range, every stage reads x, y, z
+    decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
+    (dicts), outcomes, stats."""
     pj = proj_q.project(points_mm, tab, proj_cfg["min_range_mm"], proj_cfg["max_range_mm"], max_points=max_points)
     rows, cols = tab.rows, tab.cols
     X, Y, Z, R = (np.asarray(pj[k], np.int64).reshape(rows, cols) for k in ("x_4mm", "y_4mm", "z_4mm", "range_4mm"))
+    if range_only:
+        X, Y, Z = qmath.decode_pixels(R, tab.row_elev_bam)
     mask, _, planes, _, _, _ = ground_q.ground(X, Y, Z, ground_cfg)
     ns = int(ground_cfg["n_sectors"])
     labels, members, recs, _ = cluster_q.cluster_q_ref(X, Y, Z, R, tab.row_elev_bam, mask, planes[:ns], cluster_cfg,

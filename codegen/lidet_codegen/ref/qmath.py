@@ -73,6 +73,23 @@ def cos(a):
     return sin(np.asarray(a, dtype=np.int64) + QUARTER)
 
 
+def decode_pixels(rng, row_elev_bam):
+    """x, y, z (4 mm steps) of a range-only image's (rows, cols) ranges, as lib/src/internal/lidet_qpix.h decodes
+    them: the row's beam elevation e, the column centre's angle t = floor((2c + 1) 2^31 / cols) from azimuth pi,
+    their sines and cosines in Q15 (the Q30 values rounded), the ray ux = round(cos e (-cos t) / 2^15),
+    uy = round(cos e sin t / 2^15), uz = sin e (Q15), then each coordinate round(range u / 2^15) (halves up).
+    An empty pixel (range 0) decodes to 0, 0, 0."""
+    r = np.asarray(rng, dtype=np.int64) & 0x7FFF  # valid ranges are <= 32750; the C masks to 15 bits
+    rows, cols = r.shape
+    e = np.asarray(row_elev_bam, dtype=np.int64)[:rows]
+    ce, se = rshift_round(cos(e), 15)[:, None], rshift_round(sin(e), 15)[:, None]
+    t = ((2 * np.arange(cols, dtype=np.int64) + 1) << 31) // cols
+    ct, st = rshift_round(cos(t), 15)[None, :], rshift_round(sin(t), 15)[None, :]
+    ux = rshift_round(ce * -ct, 15)
+    uy = rshift_round(ce * st, 15)
+    return rshift_round(r * ux, 15), rshift_round(r * uy, 15), rshift_round(r * se, 15)
+
+
 def _octant_atan(n, d):
     d_safe = np.where(d == 0, 1, d)
     t = (n << 24) // d_safe

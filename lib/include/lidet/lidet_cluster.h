@@ -313,7 +313,7 @@ typedef struct
     uint16_t slot_id[LIDET_MAX_CLUSTERS + 1]; /* scratch: slot + 1 -> canonical id */
     lidet_range_image_t img;                  /* the image of the last run (a view) */
     uint16_t *labels;                         /* the last run's per-pixel ids (its buffer) */
-    int32_t *members;                         /* the last run's member pixels (its buffer) */
+    lidet_member_t *members;                  /* the last run's member pixels (its buffer) */
     uint32_t n_recs;
     lidet_cluster_stats_t stats;
     /* scratch of the refinement (lidet_refine.c) */
@@ -332,8 +332,8 @@ typedef struct
 typedef struct
 {
     lidet_cluster_state_t state;
-    uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS]; /* per pixel, canonical id, 0 = none */
-    int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS]; /* member pixels, cluster after cluster */
+    uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];        /* per pixel, canonical id, 0 = none */
+    lidet_member_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS]; /* member pixels, cluster after cluster */
 } lidet_cluster_t;
 
 /**
@@ -388,7 +388,7 @@ const lidet_cluster_rec_t *lidet_cluster_records(const lidet_cluster_t *c, uint3
  * @brief The member pixels of the last run: cluster i owns members[first_member .. + n_points),
  *        in raster order. Valid until the next run/init.
  */
-const int32_t *lidet_cluster_members(const lidet_cluster_t *c);
+const lidet_member_t *lidet_cluster_members(const lidet_cluster_t *c);
 
 /** @brief Counts of the last run. */
 const lidet_cluster_stats_t *lidet_cluster_stats(const lidet_cluster_t *c);
@@ -418,7 +418,7 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *st, const lidet_c
  * Both must stay untouched while the records, labels or proposals of this run are read.
  * @return as lidet_cluster_run; LIDET_ERR_ARG also for NULL buffers.
  */
-lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *st, uint16_t *labels, int32_t *members,
+lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *st, uint16_t *labels, lidet_member_t *members,
                                          const lidet_range_image_t *img, const uint8_t *ground_mask,
                                          const lidet_plane_t *planes, uint32_t n_sectors);
 

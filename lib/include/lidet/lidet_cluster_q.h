@@ -138,7 +138,7 @@ typedef struct
     uint16_t slot_id[LIDET_MAX_CLUSTERS + 1]; /* scratch: slot + 1 -> canonical id */
     lidet_range_image_t img;                  /* the image of the last run (a view) */
     uint16_t *labels;
-    int32_t *members;
+    lidet_member_t *members;
     uint32_t n_recs;
     lidet_cluster_stats_t stats;
     /* scratch of the refinement (lidet_cluster_q_refine.c; as lidet_cluster_state_t's, z in 4 mm steps) */
@@ -157,7 +157,7 @@ typedef struct
 {
     lidet_cluster_q_state_t state;
     uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];
-    int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    lidet_member_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 } lidet_cluster_q_t;
 
 /**
@@ -184,9 +184,10 @@ lidet_status_t lidet_cluster_q_init(lidet_cluster_q_t *c, const lidet_cluster_q_
  *         a float image, row_elev_bam NULL, an incomplete image); LIDET_ERR_BUFFER (image size);
  *         LIDET_ERR_STATE (not initialised).
  */
-lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *st, uint16_t *labels, int32_t *members,
-                                           const lidet_range_image_t *img, const uint8_t *ground_mask,
-                                           const lidet_plane_q_t *planes, uint32_t n_sectors);
+lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *st, uint16_t *labels,
+                                           lidet_member_t *members, const lidet_range_image_t *img,
+                                           const uint8_t *ground_mask, const lidet_plane_q_t *planes,
+                                           uint32_t n_sectors);
 
 /** @brief lidet_cluster_q_run_buffers on the standalone form's buffers. */
 lidet_status_t lidet_cluster_q_run(lidet_cluster_q_t *c, const lidet_range_image_t *img,

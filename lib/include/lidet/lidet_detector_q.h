@@ -92,6 +92,9 @@ typedef struct
                                           (those passing gate 1, nearest first; the rest: outcome
                                           LIDET_DET_OUT_BUDGET, stats n_over_box_budget, LIDET_TRUNCATED); default
                                           48 (> 16 beams), 24: the float detector's max_boxes */
+    uint8_t range_only;       /**< 1: the image stores only the range per pixel, x, y, z are decoded from
+                                   row, column and range (lib/src/internal/lidet_qpix.h); default
+                                   !LIDET_Q_PIXEL_XYZ; must be 1 when LIDET_Q_PIXEL_XYZ is 0 */
     uint8_t gate1;            /**< 1 (default): drop proposals failing gate 1 */
     uint8_t gate2;            /**< 1 (default): drop boxes failing gate 2 */
     int32_t gate1_margin_q16; /**< gate 1 passes when energy_q16 < the model's gamma_q16 + this (Q16 nats; the
@@ -129,23 +132,30 @@ typedef struct
     lidet_proj_q_state_t proj;
     lidet_ground_q_state_t ground;
     lidet_cluster_q_state_t cluster;
-    /* per pixel: the compact image, the ground mask, cluster ids and members */
+    /* per pixel: the compact image (LIDET_Q_PIXEL_XYZ 0: the range only, x, y, z decoded where read) */
+#if LIDET_Q_PIXEL_XYZ
     int16_t x_4mm[LIDET_MAX_ROWS * LIDET_MAX_COLS];
     int16_t y_4mm[LIDET_MAX_ROWS * LIDET_MAX_COLS];
     int16_t z_4mm[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+#endif
     uint16_t range_4mm[LIDET_MAX_ROWS * LIDET_MAX_COLS];
-    uint8_t mask[LIDET_MAX_ROWS * LIDET_MAX_COLS];
-    /* overlaid, as the float workspace does: the projection's winning point per pixel (read by nothing after
-     * the projection: per-point outputs come from the caller's point_pixel), the ground stage's scratch (dead
-     * after the ground stage), then the clustering's outputs (written by the clustering, read by the proposals) */
+#if LIDET_Q_PIXEL_XYZ
+    uint8_t mask[LIDET_MAX_ROWS * LIDET_MAX_COLS]; /* the ground mask (LIDET_Q_PIXEL_XYZ 0: overlaid below) */
+#endif
+    /* overlaid, as the float workspace does: the projection's winning point per pixel (range-only: its key;
+     * read by nothing after the projection: per-point outputs come from the caller's point_pixel), the ground
+     * stage's scratch (dead after the ground stage; LIDET_Q_PIXEL_XYZ 0: its sample mask, the first bytes, then
+     * holds the ground mask, a byte per pixel, until the clustering has marked its candidates, so the ground
+     * mask does not outlive the run), then the clustering's outputs
+     * (written by the clustering, read by the proposals; the members, written after the marking, first) */
     union
     {
         int32_t point_idx[LIDET_MAX_ROWS * LIDET_MAX_COLS]; /* during the projection only */
         lidet_ground_q_scratch_t ground;                    /* during the ground stage only */
         struct
         {
+            lidet_member_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];
             uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];
-            int32_t members[LIDET_MAX_ROWS * LIDET_MAX_COLS];
         } cluster; /* from the clustering on */
     } scratch;
     int32_t pn_scratch[LIDET_DETECTOR_Q_PN_SCRATCH / 4]; /* the networks' (the members are alive meanwhile) */
@@ -193,7 +203,8 @@ const uint8_t *lidet_detector_q_outcomes(const lidet_detector_q_t *d, uint32_t *
 const lidet_detector_q_stats_t *lidet_detector_q_stats(const lidet_detector_q_t *d);
 
 /** @brief The compact range image of the last run (views into d; point_idx is NULL: overlaid after the
- *         projection, per-point results come from lidet_detector_q_run's point_pixel). */
+ *         projection, per-point results come from lidet_detector_q_run's point_pixel; range-only: x_4mm,
+ *         y_4mm, z_4mm NULL, the decoding tables set). */
 void lidet_detector_q_image(const lidet_detector_q_t *d, lidet_range_image_t *img);
 
 /** @brief sizeof(lidet_detector_q_t). */

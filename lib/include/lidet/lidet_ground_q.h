@@ -100,7 +100,11 @@ typedef struct
     uint32_t cell_first[2 * LIDET_GROUND_MAX_SECTORS];
     uint32_t cell_n[2 * LIDET_GROUND_MAX_SECTORS];
     int32_t r_rows[2][LIDET_MAX_COLS]; /* R of two rows, 4 mm / 256 */
-    uint32_t r_v[LIDET_MAX_COLS]; /* x^2 + y^2 and the square root's remainder of the row being computed */
+    union
+    {
+        uint32_t v[LIDET_MAX_COLS]; /* x^2 + y^2 and the square root's remainder of the row being computed */
+        int16_t z[2][LIDET_MAX_COLS]; /* range-only image: the filter's two rows of z (decoded) */
+    } r_v;
     uint32_t r_rem[LIDET_MAX_COLS];
 } lidet_ground_q_scratch_t;
 
@@ -127,8 +131,10 @@ lidet_status_t lidet_ground_q_state_init(lidet_ground_q_state_t *st, const lidet
 lidet_status_t lidet_ground_q_init(lidet_ground_q_t *g, const lidet_ground_q_cfg_t *cfg);
 
 /**
- * @brief Segment the ground of one compact range image (x_m NULL; x_4mm, y_4mm, z_4mm read; a pixel holds a
- *        point when x^2 + y^2 > 0, as the float stage's R > 0).
+ * @brief Segment the ground of one compact range image (x_m NULL; x_4mm, y_4mm, z_4mm read, or decoded from
+ *        range_4mm and the row elevations when all three are NULL: lib/src/internal/lidet_qpix.h; a pixel holds
+ *        a point when x^2 + y^2 > 0, as the float stage's R > 0). mask may be scratch->sample (the sample mask
+ *        is dead once the samples are gathered; the integer detector overlays them so).
  * @return LIDET_OK; LIDET_TRUNCATED (samples past LIDET_GROUND_MAX_SAMPLES, counted); LIDET_ERR_ARG (NULL, a
  *         float image, missing coordinates); LIDET_ERR_STATE; LIDET_ERR_BUFFER (image too large);
  *         LIDET_ERR_CONFIG (fewer than 4 columns or than n_sectors).

@@ -81,6 +81,16 @@
 #define LIDET_MAX_DETECTIONS 128
 #endif
 
+/** The integer detector's pixel (lidet_detector_q.h, docs/MEMORY.md): 1 (default) stores x, y, z and the range
+ *  (int16 / uint16 in 4 mm steps, 8 B a pixel); 0 stores only the range (2 B a pixel) and the integer stages
+ *  decode x, y, z from the pixel's row (the beam's elevation), its column's centre azimuth and the range
+ *  (lib/src/internal/lidet_qpix.h). 0 is what fits a VLP-16 integer detector in 256 KiB; exact for a sensor
+ *  whose returns lie on their beam's elevation. With 1 the range-only path stays available at run time
+ *  (lidet_detector_q_cfg_t.range_only). */
+#ifndef LIDET_Q_PIXEL_XYZ
+#define LIDET_Q_PIXEL_XYZ 1
+#endif
+
 /** Entries of the row lookup table of the projection (elevation -> candidate row). */
 #ifndef LIDET_PROJ_ROW_LUT
 #define LIDET_PROJ_ROW_LUT 1024

@@ -117,6 +117,11 @@ typedef struct
     const float *row_elev_rad;   /**< n_rows beam elevations in row order (row 0 = top) */
     const int32_t *row_elev_bam; /**< the same elevations as signed BAM32 (lidet_q.h: 2^32 a turn), what the
                                       integer stages read; the float projection rounds its float ones */
+    const int32_t *row_trig_q15; /**< integer range-only image (x_4mm, y_4mm, z_4mm NULL): cos, sin of each
+                                      row's elevation (Q15, 2 per row), or NULL (computed where read) */
+    const int32_t *col_trig_q15; /**< the same: sin, cos (Q15) of the first quarter's column-centre angles
+                                      (n_cols / 4 pairs, n_cols a multiple of 4), or NULL (computed where
+                                      read); lib/src/internal/lidet_qpix.h */
 } lidet_range_image_t;
 
 /**

@@ -24,8 +24,9 @@
  * image's limit) count as n_too_far; closer than min_range_mm, or at zero range, as n_too_close; n_nonfinite
  * stays 0. No float anywhere, no 64-bit division per point.
  *
- * Memory: lidet_proj_q_state_t (the tables) is about 25 B per row + 12 B per column + ~130 B (VLP-16 build:
- * 22 KiB); the buffers are the caller's (lidet_proj_q_buffers_t), 12 B per pixel + optionally 4 B per point.
+ * Memory: lidet_proj_q_state_t (the tables) is about 33 B per row + 14 B per column + ~130 B (VLP-16 build:
+ * 25 KiB, of which 3.6 KiB are the range-only image's column table); the buffers are the caller's
+ * (lidet_proj_q_buffers_t), 12 B per pixel (range-only: 6 B, of which 4 B scratch) + optionally 4 B per point.
  * Time: O(n_points log2(n_rows) + n_rows n_cols) per run (Cortex-M0+ code: 16.0 M instructions for the 23 252
  * points of the simulated VLP-16 sample, docs/FIXED_POINT.md); no allocation, no recursion, little stack.
  */
@@ -71,16 +72,23 @@ typedef struct
     uint8_t ring_to_row[LIDET_MAX_ROWS];                /* ring index -> row */
     uint32_t col_edge_q29[LIDET_MAX_COLS + 1];          /* D of each column's left edge, Q29; [n_cols] = 5 */
     uint16_t col_lut[4 * LIDET_MAX_COLS + 1];           /* bucket floor(D n_cols) -> column of its low end */
-    uint32_t n_points;                                  /* points of the last run (<= LIDET_MAX_POINTS) */
-    lidet_proj_stats_t stats;                           /* counts of the last run (n_nonfinite always 0) */
+    int32_t row_trig_q15[2 * LIDET_MAX_ROWS];           /* cos, sin of each row's elevation (Q15) */
+    int32_t col_trig_q15[2 * (LIDET_MAX_COLS / 4)]; /* sin, cos (Q15) of the first quarter's column centres */
+    uint8_t has_col_trig;                           /* 1: col_trig_q15 filled (n_cols a multiple of 4) */
+    uint32_t n_points;                              /* points of the last run (<= LIDET_MAX_POINTS) */
+    lidet_proj_stats_t stats;                       /* counts of the last run (n_nonfinite always 0) */
 } lidet_proj_q_state_t;
 
 /** @brief Caller-owned outputs of a run: n_rows * n_cols pixels each unless noted. */
 typedef struct
 {
-    int16_t *x_4mm, *y_4mm, *z_4mm; /**< required: the winner's coordinates in 4 mm steps (0 when empty) */
-    uint16_t *range_4mm;            /**< required: its range in 4 mm steps, >= 1 when valid, else 0 */
-    int32_t *point_idx;             /**< required: winning input point, -1 = empty */
+    /** the winner's coordinates in 4 mm steps (0 when empty); all three NULL: a range-only image (the later
+     *  integer stages decode x, y, z from row, column and range: lib/src/internal/lidet_qpix.h) */
+    int16_t *x_4mm, *y_4mm, *z_4mm;
+    uint16_t *range_4mm; /**< required: its range in 4 mm steps, >= 1 when valid, else 0 */
+    /** required: winning input point, -1 = empty; range-only: the run's scratch (each pixel's winner key), not
+     *  an output (the image's point_idx is NULL) */
+    int32_t *point_idx;
     int32_t *point_pixel; /**< optional (NULL = not produced): LIDET_MAX_POINTS entries, the pixel of
                                          each input point, -1 = not projected */
 } lidet_proj_q_buffers_t;

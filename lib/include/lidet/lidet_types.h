@@ -19,6 +19,15 @@
 extern "C" {
 #endif
 
+/** A cluster's member pixel (its pixel index, row * n_cols + col): 2 B when every pixel index of the build fits
+ *  16 bits (LIDET_MAX_ROWS * LIDET_MAX_COLS <= 65536, e.g. VLP-16 16 x 1800), else 4 B. The clusterings' members
+ *  arrays (float and integer) hold this type. */
+#if LIDET_MAX_ROWS * LIDET_MAX_COLS <= 65536L
+typedef uint16_t lidet_member_t;
+#else
+typedef int32_t lidet_member_t;
+#endif
+
 /**
  * @brief Result of every lidet call. 0 is success, positive values are success with a remark,
  *        negative values are errors (nothing useful was produced).

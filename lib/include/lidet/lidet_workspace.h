@@ -92,7 +92,7 @@ typedef struct
         lidet_ground_scratch_t ground;            /* sample mask, samples, two rows of R */
         struct
         {
-            int32_t members[LIDET__WS_PIXELS]; /* clustering outputs, read by the proposals */
+            lidet_member_t members[LIDET__WS_PIXELS]; /* clustering outputs, read by the proposals */
             uint16_t labels[LIDET__WS_PIXELS];
         } cluster;
     } overlay;
@@ -171,7 +171,7 @@ const lidet_cluster_rec_t *lidet_workspace_clusters(const lidet_workspace_t *ws,
 const uint16_t *lidet_workspace_labels(const lidet_workspace_t *ws);
 
 /** @brief Member pixels of the last run (as lidet_cluster_members). */
-const int32_t *lidet_workspace_members(const lidet_workspace_t *ws);
+const lidet_member_t *lidet_workspace_members(const lidet_workspace_t *ws);
 
 /** @brief The proposal of kept cluster `cluster_index` of the last run (as lidet_proposal_make). */
 lidet_status_t lidet_workspace_proposal(const lidet_workspace_t *ws, uint32_t cluster_index,

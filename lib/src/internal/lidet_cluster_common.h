@@ -7,7 +7,7 @@
 
 #include <stdint.h>
 
-#include "lidet/lidet_opt.h"
+#include "lidet/lidet_types.h" /* lidet_member_t */
 
 /* pixel states in labels[] during a run (ids 1..LIDET_MAX_CLUSTERS are slots + 1) */
 #define LAB_FREE 0u         /* a candidate not visited yet */
@@ -20,7 +20,7 @@
     15u /* rescue_cols limit (each fragment pixel looks at (2 rows + 1)(2 cols + 1) pixels) */
 
 /* Pushes pixel n onto the queue of the current cluster (members[tail]); returns the new tail. */
-static inline uint32_t lidet__cluster_take(uint16_t *lab, int32_t *mem, uint32_t tail, uint32_t n)
+static inline uint32_t lidet__cluster_take(uint16_t *lab, lidet_member_t *mem, uint32_t tail, uint32_t n)
 {
     lab[n] = (uint16_t)LAB_PENDING;
     mem[tail] = (int32_t)n;
@@ -73,7 +73,7 @@ static inline uint32_t lidet__cluster_mark_4mm(const uint16_t *rng, const uint8_
         if ((l) == LAB_SMALL)                                                                                \
         {                                                                                                    \
             (c)->labels[n] = (uint16_t)LAB_PENDING;                                                          \
-            (c)->members[(rs)->tail++] = (int32_t)(n);                                                       \
+            (c)->members[(rs)->tail++] = (lidet_member_t)(n);                                                \
         }                                                                                                    \
         else if ((dd) < (rs)->best_d2)                                                                       \
         {                                                                                                    \

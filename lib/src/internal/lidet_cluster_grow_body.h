@@ -18,8 +18,8 @@
 /* One directional search from q (range dq): pixels q + k * step, k = 1..nk, never wrapping (the
  * caller sends the columns within kc of either edge to search_wrap); beam pair sin/cos at
  * sn[(k - 1) * gs], cs[(k - 1) * gs]. Non-candidates are stepped over. */
-static inline uint32_t GROW_FN(search)(uint16_t *lab, int32_t *mem, const GROW_RNG_T *rng, uint32_t tail,
-                                       GROW_D_T dq, uint32_t q, int32_t step, uint32_t nk,
+static inline uint32_t GROW_FN(search)(uint16_t *lab, lidet_member_t *mem, const GROW_RNG_T *rng,
+                                       uint32_t tail, GROW_D_T dq, uint32_t q, int32_t step, uint32_t nk,
                                        const GROW_TAB_T *sn, const GROW_TAB_T *cs, int32_t gs,
                                        const GROW_PARAM_T *g, int occl)
 {
@@ -86,7 +86,7 @@ static uint32_t GROW_FN(search_wrap)(GROW_STATE_T *c, uint32_t tail, GROW_D_T dq
                                      uint32_t col, int right, const GROW_PARAM_T *g, int occl)
 {
     uint16_t *lab = c->labels;
-    int32_t *mem = c->members;
+    lidet_member_t *mem = c->members;
     const GROW_RNG_T *rng = GROW_RANGES(&c->img);
     const uint32_t cols = g->cols;
     uint32_t k;
@@ -126,7 +126,7 @@ static inline uint32_t GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uin
                                      int occl)
 {
     uint16_t *lab = c->labels;
-    int32_t *mem = c->members;
+    lidet_member_t *mem = c->members;
     const GROW_RNG_T *rng = GROW_RANGES(&c->img);
     const uint32_t rows = g->rows, cols = g->cols, ks = g->ks, kc = g->kc;
     uint32_t head = start;

@@ -16,7 +16,7 @@
 static inline void rescue_grow(RESCUE_STATE_T *c, const RESCUE_PARAM_T *g, uint32_t start, RESCUE_RS_T *rs,
                                int compact)
 {
-    const int32_t *mem = c->members;
+    const lidet_member_t *mem = c->members;
     const uint16_t *lab = c->labels;
     const uint32_t rows = g->rows, cols = g->cols, wr = g->rrows, wc = g->rcols;
     uint32_t head = start;

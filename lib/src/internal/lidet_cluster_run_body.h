@@ -125,7 +125,7 @@ static inline void place_kept(RUN_STATE_T *c, uint16_t *lab, uint32_t i)
     {
         const uint32_t id = c->slot_id[l];
         lab[i] = (uint16_t)id;
-        c->members[c->recs[id - 1u].first_member++] = (int32_t)i;
+        c->members[c->recs[id - 1u].first_member++] = (lidet_member_t)i;
     }
 }
 
@@ -281,7 +281,7 @@ static lidet_status_t init_done(RUN_STATE_T *c)
 }
 
 /* the checks every run starts with (arguments, state, image size) */
-static lidet_status_t run_check(const RUN_STATE_T *c, const uint16_t *labels, const int32_t *members,
+static lidet_status_t run_check(const RUN_STATE_T *c, const uint16_t *labels, const lidet_member_t *members,
                                 const lidet_range_image_t *img, const RUN_PLANE_T *planes, uint32_t n_sectors)
 {
     if (c == 0 || labels == 0 || members == 0 || img == 0 || (planes != 0 && n_sectors == 0))
@@ -317,8 +317,8 @@ static lidet_status_t labels_of_points(const RUN_STATE_T *c, const int32_t *poin
 }
 
 /* the run's image and buffers bound to the state, the records and counts cleared */
-static void run_bind(RUN_STATE_T *c, uint16_t *labels, int32_t *members, const lidet_range_image_t *img,
-                     lidet_cluster_stats_t *st)
+static void run_bind(RUN_STATE_T *c, uint16_t *labels, lidet_member_t *members,
+                     const lidet_range_image_t *img, lidet_cluster_stats_t *st)
 {
     c->img = *img;
     c->labels = labels;
@@ -349,7 +349,7 @@ static uint32_t finish_cluster(RUN_STATE_T *c, uint32_t start, uint32_t tail, co
                                uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue)
 {
     const uint32_t n = tail - start;
-    const int32_t *mem = c->members;
+    const lidet_member_t *mem = c->members;
     RUN_SUMMARY_T sm;
     uint32_t i, slot;
     int small, evicted;
@@ -458,7 +458,7 @@ static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, uint32_t npix, cons
                       uint32_t n_sectors, lidet_cluster_stats_t *st)
 {
     uint16_t *lab = c->labels;
-    int32_t *mem = c->members;
+    lidet_member_t *mem = c->members;
     uint32_t p, tail = 0;
     for (p = next_free(lab, 0, npix); p < npix; p = next_free(lab, p + 1u, npix))
     {

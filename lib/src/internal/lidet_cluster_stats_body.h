@@ -13,7 +13,7 @@ static inline int member_stats_of(const STATS_STATE_T *c, uint32_t start, uint32
                                   STATS_LIM_T max_extent, STATS_S_T sum[3], STATS_V_T lo[3], STATS_V_T hi[3],
                                   int compact)
 {
-    const int32_t *mem = c->members;
+    const lidet_member_t *mem = c->members;
     (void)compact; /* read by the float stage's STATS_READ only */
     STATS_S_T sx = 0, sy = 0, sz = 0;
     STATS_V_T lx, ly, lz, hx, hy, hz;

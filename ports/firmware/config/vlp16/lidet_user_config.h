@@ -18,5 +18,9 @@
 #define LIDET_MAX_DETECTIONS 64  /* road users reported per scan (= clusters: never truncated) */
 #define LIDET_REFINE_MAX_CELLS 2048  /* proposal refinement grid: 5.4 x 5.4 m at its 0.12 m cells */
 #define LIDET_REFINE_MAX_POINTS 2048 /* pixels of one examined cluster (16 rings x 128 columns) */
+/* the integer detector's pixel: the range only, x, y, z decoded from row, column and range where the stages read
+ * them (exact for a VLP-16, whose returns lie on their ring's elevation): lidet_detector_q_t 255,728 B instead of
+ * 457,328 B, within issue 17's 256 KiB of RAM (docs/MEMORY.md). The float detector is not affected. */
+#define LIDET_Q_PIXEL_XYZ 0
 
 #endif /* LIDET_USER_CONFIG_H */

@@ -1,0 +1,180 @@
+/* SPDX-License-Identifier: MIT */
+/* The integer path's range-only pixel (lib/src/internal/lidet_qpix.h): the projection's tables give exactly the
+ * values computed without them; a point projected into a range-only image decodes back to itself within the
+ * rounding (points cast on the beam elevations and column centres, both sensors' geometries); empty pixels decode
+ * to 0; which images the integer stages accept. */
+#include <math.h>
+#include <string.h>
+
+#include "internal/lidet_qpix.h"
+#include "lidet/lidet_proj_q.h"
+#include "test_util.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static lidet_proj_q_state_t g_st;
+static uint16_t g_rng[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+static int32_t g_key[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+static int32_t g_pts[LIDET_MAX_ROWS * LIDET_MAX_COLS * 3];
+static uint16_t g_ring[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
+}
+
+static void init_sensor(const char *name)
+{
+    lidet_proj_q_cfg_t cfg;
+    lidet_proj_q_cfg_default(&cfg, lidet_sensor_q_find(name));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_q_init(&g_st, &cfg));
+}
+
+/* the tables hold exactly what is computed without them: every column, every row, two ranges */
+static void check_tables_match(const char *name)
+{
+    lidet_range_image_t with, without;
+    lidet_proj_q_buffers_t b;
+    uint32_t r, c, rows, cols;
+    init_sensor(name);
+    memset(&b, 0, sizeof b);
+    b.range_4mm = g_rng;
+    lidet_proj_q_image(&g_st, &b, &with);
+    TEST_ASSERT_NOT_NULL(with.row_trig_q15);
+    TEST_ASSERT_NOT_NULL(with.col_trig_q15); /* both sensors' column counts are multiples of 4 */
+    without = with;
+    without.row_trig_q15 = 0;
+    without.col_trig_q15 = 0;
+    rows = with.n_rows;
+    cols = with.n_cols;
+    for (r = 0; r < rows; ++r)
+    {
+        for (c = 0; c < cols; ++c)
+        {
+            g_rng[r * cols + c] = (uint16_t)((r + c) % 2u == 0u ? 32750u : 1u + (c * 7u) % 9000u);
+        }
+    }
+    for (r = 0; r < rows * cols; ++r)
+    {
+        int32_t a[3], d[3];
+        lidet__qpix_xyz(&with, r, a);
+        lidet__qpix_xyz(&without, r, d);
+        TEST_ASSERT_EQUAL_INT32(d[0], a[0]);
+        TEST_ASSERT_EQUAL_INT32(d[1], a[1]);
+        TEST_ASSERT_EQUAL_INT32(d[2], a[2]);
+    }
+}
+
+static void test_tables_match_the_computed_values(void)
+{
+    check_tables_match("vlp16");
+    check_tables_match("hdl64");
+}
+
+/* points on every beam and column centre at 5-100 m, projected range-only with their rings, decode back within
+ * the rounding: 4 mm steps of the range and the Q15 ray (<= 2 steps) */
+static void check_round_trip(const char *name)
+{
+    lidet_proj_q_buffers_t b;
+    lidet_range_image_t img;
+    uint32_t r, c, rows, cols, n = 0, worst = 0;
+    init_sensor(name);
+    rows = g_st.cfg.sensor.n_rows;
+    cols = g_st.cfg.sensor.n_cols;
+    for (r = 0; r < rows; ++r)
+    {
+        const double el = g_st.row_elev_urad[r] * 1e-6;
+        uint32_t ring = 0;
+        while (g_st.ring_to_row[ring] != r)
+        {
+            ++ring;
+        }
+        for (c = 0; c < cols; ++c)
+        {
+            const double az = M_PI - (c + 0.5) * 2.0 * M_PI / cols, d = 5000.0 + 95000.0 * ((c * 37u + r) % 101u) / 100.0;
+            g_pts[3 * n] = (int32_t)floor(d * cos(el) * cos(az) + 0.5);
+            g_pts[3 * n + 1] = (int32_t)floor(d * cos(el) * sin(az) + 0.5);
+            g_pts[3 * n + 2] = (int32_t)floor(d * sin(el) + 0.5);
+            g_ring[n] = (uint16_t)ring;
+            ++n;
+        }
+    }
+    memset(&b, 0, sizeof b);
+    b.range_4mm = g_rng;
+    b.point_idx = g_key;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_q_run(&g_st, &b, g_pts, n, 3, g_ring));
+    TEST_ASSERT_EQUAL_UINT32(n, g_st.stats.n_pixels_filled);
+    lidet_proj_q_image(&g_st, &b, &img);
+    TEST_ASSERT_NULL(img.x_4mm);
+    TEST_ASSERT_NULL(img.point_idx); /* the buffer held the keys */
+    TEST_ASSERT_TRUE(lidet__qpix_image_ok(&img));
+    for (r = 0; r < n; ++r)
+    {
+        const uint32_t row = g_st.ring_to_row[g_ring[r]], col = r % cols, p = row * cols + col;
+        int32_t v[3], k;
+        lidet__qpix_xyz(&img, p, v);
+        for (k = 0; k < 3; ++k)
+        {
+            const int32_t e = v[k] * 4 - g_pts[3 * r + k];
+            const uint32_t ae = (uint32_t)(e < 0 ? -e : e);
+            worst = ae > worst ? ae : worst;
+        }
+    }
+    /* 2 mm of the range's and the coordinates' rounding, the Q15 ray's at 100 m (~4 mm) */
+    TEST_ASSERT_TRUE_MESSAGE(worst <= 12u, name);
+    TEST_ASSERT_TRUE(worst > 0u); /* the comparison looked at something */
+}
+
+static void test_projected_points_decode_back(void)
+{
+    check_round_trip("vlp16");
+    check_round_trip("hdl64");
+}
+
+static void test_empty_pixels_and_accepted_images(void)
+{
+    lidet_proj_q_buffers_t b;
+    lidet_range_image_t img, bad;
+    int16_t x[4];
+    int32_t v[3];
+    init_sensor("vlp16");
+    memset(&b, 0, sizeof b);
+    memset(g_rng, 0, sizeof g_rng);
+    b.range_4mm = g_rng;
+    lidet_proj_q_image(&g_st, &b, &img);
+    lidet__qpix_xyz(&img, 5u * img.n_cols + 451u, v);
+    TEST_ASSERT_EQUAL_INT32(0, v[0]);
+    TEST_ASSERT_EQUAL_INT32(0, v[1]);
+    TEST_ASSERT_EQUAL_INT32(0, v[2]);
+    TEST_ASSERT_TRUE(lidet__qpix_image_ok(&img));
+    bad = img;
+    bad.row_elev_bam = 0; /* nothing to decode from */
+    TEST_ASSERT_FALSE(lidet__qpix_image_ok(&bad));
+    bad = img;
+    bad.range_4mm = 0;
+    TEST_ASSERT_FALSE(lidet__qpix_image_ok(&bad));
+    bad = img;
+    bad.x_4mm = x; /* x without y, z */
+    TEST_ASSERT_FALSE(lidet__qpix_image_ok(&bad));
+    bad.y_4mm = x;
+    bad.z_4mm = x;
+    TEST_ASSERT_TRUE(lidet__qpix_image_ok(&bad));
+    /* the projection: x, y, z all given or none */
+    b.x_4mm = x;
+    b.point_idx = g_key;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proj_q_run(&g_st, &b, g_pts, 0, 3, 0));
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_tables_match_the_computed_values);
+    RUN_TEST(test_projected_points_decode_back);
+    RUN_TEST(test_empty_pixels_and_accepted_images);
+    return UNITY_END();
+}
