@@ -158,7 +158,8 @@ typedef struct
             uint16_t labels[LIDET_MAX_ROWS * LIDET_MAX_COLS];
         } cluster; /* from the clustering on */
     } scratch;
-    int32_t pn_scratch[LIDET_DETECTOR_Q_PN_SCRATCH / 4]; /* the networks' (the members are alive meanwhile) */
+    /* the networks' (the members are alive meanwhile); 32-byte aligned as lidet_detector_t's */
+    int32_t pn_scratch[LIDET_DETECTOR_Q_PN_SCRATCH / 4] LIDET_ALIGN(32);
     lidet_pointnet_q_t cls, box;
     lidet_proposal_q_t proposal;
     uint16_t order[LIDET_MAX_CLUSTERS];                /* candidate clusters, nearest first */
