@@ -106,7 +106,13 @@ static void detector_q_knobs(fz_in_t *in, lidet_detector_q_cfg_t *c, uint8_t *p6
         c->cluster.join_cars = 0u;
     }
     c->max_proposals = fz_u8(in) % (LIDET_MAX_CLUSTERS + 2u);
-    c->cluster.min_points = 1u + fz_u8(in) % 12u;
+    {
+        /* one byte: min_points from its value, the range-only pixel (x, y, z decoded, lidet_qpix.h) from its top bit
+         * (the input's byte layout, and so the corpus, unchanged) */
+        const uint8_t b = fz_u8(in);
+        c->cluster.min_points = 1u + b % 12u;
+        c->range_only = (uint8_t)(b >> 7);
+    }
     c->ground.n_sectors = (uint16_t)(1u + fz_u8(in) % LIDET_GROUND_MAX_SECTORS);
     c->cluster.max_steps = fz_u8(in) % (LIDET_CLUSTER_MAX_STEPS + 2u);
     poke_u32(in, f32, (uint32_t)(sizeof f32 / sizeof f32[0]));
