@@ -174,7 +174,7 @@ typedef struct
                                   person beside a car, a pole or a wall); 0: off */
     float split_min_width_m;    /**< clusters whose x or y extent exceeds this are examined; > 0; default 0.7
                                   (two people seen by a few rings span less than 0.9 m; issue 15, below;
-                                  0.9 before stop 23, when the simulated HDL-64 crowd persons were 84.5 %) */
+                                  0.9 before, when the simulated HDL-64 crowd persons were 84.5 %) */
     float split_cell_m;         /**< cell of the finer grid at range 0; > 0; default 0.12 m */
     float split_cell_per_m;     /**< its growth per metre of range (range of the cluster's box centre,
                                   max(|x|,|y|) + min(|x|,|y|) / 2); >= 0; default 0 (measured: a
@@ -188,7 +188,7 @@ typedef struct
                                   refinement) */
     uint32_t person_min_cols;   /**< ... and its pixels span at least this many image columns (a slice of a
                                   car's flank or a wall seen at a grazing angle, one column per cell, is
-                                  not a person); default 2 (3 before stop 23; 2 and split_min_width_m 0.7
+                                  not a person); default 2 (3 before; 2 and split_min_width_m 0.7
                                   took the simulated HDL-64 crowd persons from 197 to 199 of 233 and,
                                   on unseen crowd scenes (seed 11), from 275 to 283 of 313, cars and the
                                   VLP-16 figures unchanged) */
