@@ -566,12 +566,11 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
                 {
                     const uint32_t p = (uint32_t)kb.row_k[j];
                     const uint32_t jj = (uint32_t)kb.col_k[j];
-                    const uint32_t khi = key_hi[p];
+                    const uint32_t key = ((uint32_t)key_hi[p] << 16) | (uint16_t)key_lo[p];
                     uint32_t r2;
                     memcpy(&r2, &kb.r2[jj], sizeof r2);
-                    /* r2 < the key, as unsigned 32-bit values (r2 >= 0 here: the range test passed); the
-                     * low half is read only on a tie of the high halves */
-                    if ((r2 >> 16) < khi || ((r2 >> 16) == khi && (r2 & 0xFFFFu) < (uint16_t)key_lo[p]))
+                    /* r2 < the key, as unsigned 32-bit values (r2 >= 0 here: the range test passed) */
+                    if (r2 < key)
                     {
                         key_hi[p] = (uint16_t)(r2 >> 16);
                         key_lo[p] = (int16_t)(uint16_t)(r2 & 0xFFFFu); /* two's complement: C99 int16_t */
