@@ -9,6 +9,7 @@
 #include "internal/lidet_math.h"
 #include "internal/lidet_pixel.h"
 #include "internal/lidet_rng.h"
+#include "internal/lidet_simd.h"
 
 /* Defaults measured by tools/bench/bench_ground.py and coordinate-descent sweeps (docs/GROUND.md) on
  * the real SemanticKITTI scans and 20 simulated scans per profile. Two families:
@@ -170,6 +171,46 @@ static inline void filter_row(const float *R0, const float *R1, const float *Z0,
  * row. R is always the projection's expression (lidet__rxy) on the float coordinates the stage reads:
  * for a float image the same bits as a stored R; for a compact image, on the decoded 4 mm values. A pass
  * over the rows in increasing order computes each row once. */
+
+/* The compact image's row decoding (streaming loops: AVX2 variants on x86-64 hosts, internal/lidet_simd.h) */
+/* out[c] = R of the decoded x, y (4 mm steps) */
+LIDET_CLONES_AVX2 static void decode_rxy(const int16_t *x, const int16_t *y, uint32_t cols, float *out)
+{
+    uint32_t c;
+    for (c = 0; c < cols; ++c)
+    {
+        out[c] = lidet__rxy(lidet__pix_m(x[c]), lidet__pix_m(y[c]));
+    }
+}
+/* out[c] = R of float x, y */
+LIDET_CLONES_AVX2 static void rxy_of(const float *x, const float *y, uint32_t cols, float *out)
+{
+    uint32_t c;
+    for (c = 0; c < cols; ++c)
+    {
+        out[c] = lidet__rxy(x[c], y[c]);
+    }
+}
+/* out[c] = z decoded */
+LIDET_CLONES_AVX2 static void decode_z(const int16_t *z, uint32_t cols, float *out)
+{
+    uint32_t c;
+    for (c = 0; c < cols; ++c)
+    {
+        out[c] = lidet__pix_m(z[c]);
+    }
+}
+/* x and y decoded */
+LIDET_CLONES_AVX2 static void decode_xy(const int16_t *x, const int16_t *y, uint32_t cols, float *ox,
+                                        float *oy)
+{
+    uint32_t c;
+    for (c = 0; c < cols; ++c)
+    {
+        ox[c] = lidet__pix_m(x[c]);
+        oy[c] = lidet__pix_m(y[c]);
+    }
+}
 typedef struct
 {
     const lidet_range_image_t *img;
@@ -220,19 +261,11 @@ static const float *rxy_row(rxy_rows_t *rr, uint32_t r)
         else if (rr->xyrow_in == (int32_t)r)
         {
             /* x and y of this row are decoded already (the label pass decodes them first) */
-            const float *x = rr->xrow, *y = rr->yrow;
-            for (c = 0; c < cols; ++c)
-            {
-                out[c] = lidet__rxy(x[c], y[c]);
-            }
+            rxy_of(rr->xrow, rr->yrow, cols, out);
         }
         else
         {
-            const int16_t *x = rr->img->x_4mm + base, *y = rr->img->y_4mm + base;
-            for (c = 0; c < cols; ++c)
-            {
-                out[c] = lidet__rxy(lidet__pix_m(x[c]), lidet__pix_m(y[c]));
-            }
+            decode_rxy(rr->img->x_4mm + base, rr->img->y_4mm + base, cols, out);
         }
         rr->row_in[k] = (int32_t)r;
     }
@@ -250,13 +283,7 @@ static const float *z_row(rxy_rows_t *rr, uint32_t r)
     }
     if (rr->zrow_in[k] != (int32_t)r)
     {
-        const int16_t *z = rr->img->z_4mm + base;
-        float *out = rr->zslot[k];
-        uint32_t c;
-        for (c = 0; c < cols; ++c)
-        {
-            out[c] = lidet__pix_m(z[c]);
-        }
+        decode_z(rr->img->z_4mm + base, cols, rr->zslot[k]);
         rr->zrow_in[k] = (int32_t)r;
     }
     return rr->zslot[k];
@@ -275,13 +302,7 @@ static void xy_row(rxy_rows_t *rr, uint32_t r, const float **X, const float **Y)
     }
     if (rr->xyrow_in != (int32_t)r)
     {
-        const int16_t *x = rr->img->x_4mm + base, *y = rr->img->y_4mm + base;
-        uint32_t c;
-        for (c = 0; c < cols; ++c)
-        {
-            rr->xrow[c] = lidet__pix_m(x[c]);
-            rr->yrow[c] = lidet__pix_m(y[c]);
-        }
+        decode_xy(rr->img->x_4mm + base, rr->img->y_4mm + base, cols, rr->xrow, rr->yrow);
         rr->xyrow_in = (int32_t)r;
     }
     *X = rr->xrow;
@@ -360,13 +381,28 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc,
         {
             const size_t base = (size_t)r * cols;
             const uint8_t *m = sc->sample + base;
-            /* R decides near or far only with a split: the image's, else computed for this pixel */
+            /* R decides near or far only with a split: the image's, else computed for the sector's columns of
+             * this row into a scratch row (free between the filter and the label pass), at the same columns */
             const float *R = !lidet__img_compact(img) && img->rxy_m != 0 ? img->rxy_m + base : 0;
+            if (two && R == 0 && roomy && cstart < c1)
+            {
+                float *tmp = sc->rxy_rows[0];
+                if (lidet__img_compact(img))
+                {
+                    decode_rxy(img->x_4mm + base + cstart, img->y_4mm + base + cstart, c1 - cstart,
+                               tmp + cstart);
+                }
+                else
+                {
+                    rxy_of(img->x_m + base + cstart, img->y_m + base + cstart, c1 - cstart, tmp + cstart);
+                }
+                R = tmp;
+            }
             if (roomy)
             {
                 for (c = cstart; c < c1; c += cstep)
                 {
-                    const float rc = !two ? 0.0f : (R != 0 ? R[c] : pixel_rxy(img, (uint32_t)base + c));
+                    const float rc = !two ? 0.0f : R[c];
                     const uint32_t far = (uint32_t)(rc >= split), take = m[c];
                     const uint32_t k = far ? hi - 1u : lo; /* lo < hi: roomy leaves a slot per candidate */
                     si[k] = (lidet_ground_sample_t)(base + c);

@@ -7,6 +7,7 @@
 #include "internal/lidet_assert.h"
 #include "internal/lidet_math.h"
 #include "internal/lidet_proj_rows.h"
+#include "internal/lidet_simd.h"
 #include "lidet/lidet_proj.h"
 
 /* keep every accepted elevation away from +-90 deg so its tangent stays finite */
@@ -321,6 +322,25 @@ static inline int32_t to_4mm(float v)
     return i - (int32_t)(t < (float)i);
 }
 
+/* (b) of pass2_compact: the rounding of one block, a loop without branches or indexed loads (an AVX2 variant on
+ * x86-64 hosts, internal/lidet_simd.h; the gather (a) stays a plain loop: compiled for AVX2 it becomes hardware
+ * gathers, measured slower) */
+LIDET_CLONES_AVX2 static void round_block(const float *bx, const float *by, const float *bz, const float *b2,
+                                          uint32_t m, int16_t *xo, int16_t *yo, int16_t *zo, uint16_t *ro)
+{
+    uint32_t j;
+    for (j = 0; j < m; ++j)
+    {
+        /* b2: a winner's squared range (<= max2 <= 131^2 m^2 by the range test) or 0 (empty) */
+        const float r = sqrtf(b2[j]);
+        const int32_t rq = to_4mm(r);
+        xo[j] = (int16_t)to_4mm(bx[j]);
+        yo[j] = (int16_t)to_4mm(by[j]);
+        zo[j] = (int16_t)to_4mm(bz[j]);
+        ro[j] = (uint16_t)(rq + (int32_t)((r > 0.0f) & (rq == 0)));
+    }
+}
+
 /* Pass 2 of a compact image (see pass 2 below for the float one): each winner's coordinates and range,
  * rounded to 4 mm steps; the range is the float path's sqrtf of the same squared range (kept in the two
  * 16-bit halves), so the compact image is the float image rounded. A valid pixel's range is >= 1 step
@@ -363,16 +383,7 @@ static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *poin
             memcpy(&b2[j], &key, sizeof key);
             filled += keep & 1u;
         }
-        for (j = 0; j < m; ++j)
-        {
-            /* b2: a winner's squared range (<= max2 <= 131^2 m^2 by the range test) or 0 (empty) */
-            const float r = sqrtf(b2[j]);
-            const int32_t rq = to_4mm(r);
-            xo[base + j] = (int16_t)to_4mm(bx[j]);
-            yo[base + j] = (int16_t)to_4mm(by[j]);
-            zo[base + j] = (int16_t)to_4mm(bz[j]);
-            ro[base + j] = (uint16_t)(rq + (int32_t)((r > 0.0f) & (rq == 0)));
-        }
+        round_block(bx, by, bz, b2, m, xo + base, yo + base, zo + base, ro + base);
     }
     return filled;
 }

@@ -7,21 +7,14 @@
 
 #include <stdint.h>
 
-/* Host builds on x86-64 (CMake option LIDET_NN_CLONES, on by default there): GCC/clang also compile the kernels
- * marked LIDET_NN_KERNEL for AVX2 (LIDET_NN_KERNEL_F32: also AVX-512) and pick the variant when the program
- * loads (ifunc). Same C source, same results (no FMA contraction: -ffp-contract=off; each output's sum in the
- * same order at every vector width). Firmware builds never define it. */
-#if defined(LIDET_NN_CLONES) && LIDET_NN_CLONES && (defined(__GNUC__) || defined(__clang__)) &&              \
-    defined(__x86_64__)
-#define LIDET_NN_KERNEL __attribute__((target_clones("avx2", "default")))
-/* the float dense kernel also gets an AVX-512 variant: measured on an AMD EPYC (Zen 4) host, the VLP-16 sample's
- * classifier 0.86 -> 0.58 ms and box net 0.36 -> 0.24 ms per scan (lidet detect --cpu-clock). The int8 kernels
- * do not: their AVX-512 variant measured 7-12 % slower there than the AVX2 one. */
-#define LIDET_NN_KERNEL_F32 __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define LIDET_NN_KERNEL
-#define LIDET_NN_KERNEL_F32
-#endif
+#include "internal/lidet_simd.h"
+
+/* Host builds on x86-64 (internal/lidet_simd.h): the kernels marked LIDET_NN_KERNEL get an AVX2 variant,
+ * LIDET_NN_KERNEL_F32 (the float dense kernel) also an AVX-512 one: measured on an AMD EPYC (Zen 4) host, the
+ * VLP-16 sample's classifier 0.86 -> 0.58 ms and box net 0.36 -> 0.24 ms per scan (lidet detect --cpu-clock).
+ * The int8 kernels do not: their AVX-512 variant measured 7-12 % slower there than the AVX2 one. */
+#define LIDET_NN_KERNEL LIDET_CLONES_AVX2
+#define LIDET_NN_KERNEL_F32 LIDET_CLONES_AVX512
 
 /* out[r * n_out + o] = act(b[o] + sum_i in[r * n_in + i] * w_t[i * n_out + o]), r < n_rows.
  * in and out may not alias. relu: 1 = max(0, .) after the bias. */

@@ -1,0 +1,21 @@
+/* SPDX-License-Identifier: MIT */
+/* Host builds on x86-64 (CMake option LIDET_NN_CLONES, on by default there, set on the sources that use these):
+ * GCC/clang also compile the functions marked below for AVX2 (and AVX-512) and pick the variant when the
+ * program loads (ifunc), the way onnxruntime dispatches its kernels. Same C source, same results: every
+ * marked function is a loop whose lanes are independent (no reduction reordered, no FMA contraction:
+ * -ffp-contract=off), so each value is computed by the same IEEE operations at every vector width. Only
+ * streaming loops are marked: a loop with indexed loads would become hardware gathers, slower than scalar
+ * loads on the hosts measured. Firmware builds never define LIDET_NN_CLONES: the macros are empty there. */
+#ifndef LIDET_SIMD_H
+#define LIDET_SIMD_H
+
+#if defined(LIDET_NN_CLONES) && LIDET_NN_CLONES && (defined(__GNUC__) || defined(__clang__)) &&              \
+    defined(__x86_64__)
+#define LIDET_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
+#define LIDET_CLONES_AVX512 __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define LIDET_CLONES_AVX2
+#define LIDET_CLONES_AVX512
+#endif
+
+#endif

@@ -1,0 +1,262 @@
+/* SPDX-License-Identifier: MIT */
+/* Memory-model benchmark (issue 18, docs/MEMORY.md): the same scan through the two memory models of the
+ * library, in the same run, interleaved, on one thread:
+ *   stages     - the standalone stage objects (lidet_proj_t, lidet_ground_t, lidet_cluster_t: every table,
+ *                output and scratch buffer of a stage in its own object, float image with R, the pixel of
+ *                every input point), chained as a caller chains them (cluster height filter on the ground
+ *                stage's planes): the memory model before issue 18;
+ *   workspace  - lidet_workspace_run: one object, scratch overlaid, the compact 4 mm image, nothing per
+ *                input point (what the detector runs);
+ *   workspace+ - lidet_workspace_run with the per-point outputs asked for (point_pixel, then
+ *                lidet_workspace_point_labels for the cluster id and the ground bit of every point), the
+ *                outputs the stage objects always make.
+ * Each is timed in CPU time of this thread (CLOCK_THREAD_CPUTIME_ID), projection + ground + clustering,
+ * median over --repeat runs. Also prints the bytes each model holds and how far their results agree
+ * (ground labels and cluster membership per valid pixel: the compact image rounds coordinates to 4 mm).
+ * One JSON object per scan on stdout (tools/bench/bench_memory.py reads them).
+ *
+ * usage: lidet_bench_memory --sensor hdl64 [--repeat 30] [--only stages|workspace] SCAN.bin...
+ * (--only: run that model alone, for a profiler; its medians only are meaningful)
+ */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "lidet/lidet.h"
+#include "lidet/lidet_workspace.h"
+
+static lidet_proj_t g_proj;
+static lidet_ground_t g_ground;
+static lidet_cluster_t g_cluster;
+static lidet_workspace_t g_ws;
+static int32_t g_pp[LIDET_MAX_POINTS];
+static uint32_t g_ids[LIDET_MAX_POINTS];
+static uint8_t g_gnd[LIDET_MAX_POINTS];
+static uint32_t g_ids_ref[LIDET_MAX_POINTS];
+static uint8_t g_gnd_ref[LIDET_MAX_POINTS];
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+static int cmpd(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n)
+{
+    qsort(v, (size_t)n, sizeof v[0], cmpd);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static float *read_scan(const char *path, uint32_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    long sz;
+    float *p;
+    if (f == NULL || fseek(f, 0, SEEK_END) != 0 || (sz = ftell(f)) < 0 || sz % 16 != 0 || fseek(f, 0, SEEK_SET) != 0)
+    {
+        if (f)
+            fclose(f);
+        return NULL;
+    }
+    p = (float *)malloc((size_t)sz + 16u);
+    if (p == NULL || fread(p, 1, (size_t)sz, f) != (size_t)sz)
+    {
+        free(p);
+        fclose(f);
+        return NULL;
+    }
+    fclose(f);
+    *n = (uint32_t)(sz / 16);
+    return p;
+}
+
+/* thread CPU time in ns, wrapping (differences of < 4 s are exact) */
+static uint32_t clock_ns(void *ctx)
+{
+    struct timespec ts;
+    (void)ctx;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (uint32_t)((uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec);
+}
+
+/* ticks: ns of projection, ground, clustering */
+static lidet_status_t run_stages(const float *pts, uint32_t n, uint32_t ticks[3])
+{
+    lidet_range_image_t img;
+    const lidet_plane_t *planes;
+    uint32_t ns, t0 = clock_ns(NULL), t1, t2;
+    lidet_status_t st = lidet_proj_run(&g_proj, pts, n, 4, NULL);
+    if (!LIDET_SUCCEEDED(st))
+        return st;
+    lidet_proj_image(&g_proj, &img);
+    t1 = clock_ns(NULL);
+    st = lidet_ground_run(&g_ground, &img);
+    if (!LIDET_SUCCEEDED(st))
+        return st;
+    t2 = clock_ns(NULL);
+    planes = lidet_ground_planes(&g_ground, &ns);
+    st = lidet_cluster_run(&g_cluster, &img, lidet_ground_mask(&g_ground), planes, ns);
+    ticks[0] = t1 - t0;
+    ticks[1] = t2 - t1;
+    ticks[2] = clock_ns(NULL) - t2;
+    return st;
+}
+
+static lidet_status_t run_workspace(const float *pts, uint32_t n, int per_point, uint32_t ticks[3])
+{
+    lidet_status_t st = lidet_workspace_run_timed(&g_ws, pts, n, 4, NULL, per_point ? g_pp : NULL, clock_ns, NULL,
+                                                  ticks);
+    if (!LIDET_SUCCEEDED(st) || !per_point)
+        return st;
+    return lidet_workspace_point_labels(&g_ws, g_pp, n < LIDET_MAX_POINTS ? n : LIDET_MAX_POINTS, g_ids, g_gnd);
+}
+
+/* share of points valid in both (projected, the same in both up to 131 m) whose ground bit agrees, and whose
+ * cluster membership agrees up to renaming: two points share a cluster in one result iff they do in the other,
+ * checked against each point's first partner (the first point seen with its id) */
+static void agreement(uint32_t n, double *ground_pct, double *cluster_pct)
+{
+    static uint32_t first_ref[LIDET_MAX_POINTS], first_ws[LIDET_MAX_POINTS];
+    static uint32_t seen_ref[LIDET_MAX_CLUSTERS + 2u], seen_ws[LIDET_MAX_CLUSTERS + 2u];
+    uint32_t i, both = 0, g_ok = 0, c_ok = 0;
+    memset(seen_ref, 0xFF, sizeof seen_ref);
+    memset(seen_ws, 0xFF, sizeof seen_ws);
+    for (i = 0; i < n; ++i)
+    {
+        const uint32_t a = g_ids_ref[i], b = g_ids[i];
+        first_ref[i] = a == 0 || a > LIDET_MAX_CLUSTERS ? i : (seen_ref[a] == 0xFFFFFFFFu ? (seen_ref[a] = i) : seen_ref[a]);
+        first_ws[i] = b == 0 || b > LIDET_MAX_CLUSTERS ? i : (seen_ws[b] == 0xFFFFFFFFu ? (seen_ws[b] = i) : seen_ws[b]);
+    }
+    for (i = 0; i < n; ++i)
+    {
+        if (g_pp[i] < 0 || lidet_proj_point_pixels(&g_proj, NULL)[i] < 0)
+            continue;
+        ++both;
+        g_ok += g_gnd[i] == g_gnd_ref[i];
+        /* the same partner in both, and clustered in both or in neither */
+        c_ok += (g_ids[i] == 0) == (g_ids_ref[i] == 0) && first_ref[i] == first_ws[i];
+    }
+    *ground_pct = both ? 100.0 * g_ok / both : 100.0;
+    *cluster_pct = both ? 100.0 * c_ok / both : 100.0;
+}
+
+int main(int argc, char **argv)
+{
+    const char *sensor_name = "hdl64";
+    const lidet_sensor_t *sensor;
+    lidet_workspace_cfg_t cfg;
+    lidet_workspace_sizes_t sz;
+    int repeat = 30, a, rc = 0, only = -1;
+    double *t;
+
+    for (a = 1; a < argc && argv[a][0] == '-'; ++a)
+    {
+        if (!strcmp(argv[a], "--sensor") && a + 1 < argc)
+            sensor_name = argv[++a];
+        else if (!strcmp(argv[a], "--repeat") && a + 1 < argc)
+            repeat = atoi(argv[++a]);
+        else if (!strcmp(argv[a], "--only") && a + 1 < argc)
+        {
+            ++a;
+            only = !strcmp(argv[a], "stages") ? 0 : !strcmp(argv[a], "workspace") ? 1 : -2;
+            if (only == -2)
+            {
+                fprintf(stderr, "lidet_bench_memory: --only stages or --only workspace\n");
+                return 2;
+            }
+        }
+        else
+        {
+            fprintf(stderr, "usage: lidet_bench_memory --sensor S [--repeat N] [--only stages|workspace] SCAN.bin...\n");
+            return 2;
+        }
+    }
+    sensor = lidet_sensor_find(sensor_name);
+    if (sensor == NULL || repeat < 1 || a >= argc)
+    {
+        fprintf(stderr, "lidet_bench_memory: %s\n", sensor == NULL ? "unknown sensor" : "need scans and --repeat >= 1");
+        return 2;
+    }
+    lidet_workspace_cfg_default(&cfg, sensor);
+    if (lidet_workspace_init(&g_ws, &cfg) != LIDET_OK || lidet_proj_init(&g_proj, &cfg.proj) != LIDET_OK ||
+        lidet_ground_init(&g_ground, &cfg.ground) != LIDET_OK || lidet_cluster_init(&g_cluster, &cfg.cluster) != LIDET_OK)
+    {
+        fprintf(stderr, "lidet_bench_memory: init failed (capacities too small for %s?)\n", sensor_name);
+        return 1;
+    }
+    lidet_workspace_sizes(&sz);
+    t = (double *)malloc(sizeof(double) * (size_t)repeat * 12u);
+    if (t == NULL)
+        return 1;
+    for (; a < argc; ++a)
+    {
+        uint32_t n = 0, m;
+        float *pts = read_scan(argv[a], &n);
+        double ms[3][4], ag, ac;
+        uint32_t tk[3];
+        int i, k, s;
+        if (pts == NULL)
+        {
+            fprintf(stderr, "lidet_bench_memory: cannot read %s (missing, or not records of 4 floats)\n", argv[a]);
+            rc = 1;
+            continue;
+        }
+        m = n < LIDET_MAX_POINTS ? n : LIDET_MAX_POINTS;
+        /* warm-up, and the results compared */
+        if (!LIDET_SUCCEEDED(run_stages(pts, n, tk)) || !LIDET_SUCCEEDED(run_workspace(pts, n, 1, tk)) ||
+            !LIDET_SUCCEEDED(lidet_cluster_point_labels(&g_cluster, lidet_proj_point_pixels(&g_proj, NULL), m, g_ids_ref)) ||
+            !LIDET_SUCCEEDED(lidet_ground_point_labels(&g_ground, lidet_proj_point_pixels(&g_proj, NULL), m, g_gnd_ref)))
+        {
+            fprintf(stderr, "lidet_bench_memory: a stage failed on %s\n", argv[a]);
+            free(pts);
+            rc = 1;
+            continue;
+        }
+        agreement(m, &ag, &ac);
+        /* interleaved: one run of each model per round; t[(model * 4 + part) * repeat + round], part 3 = the
+         * whole call (per-point labels included for workspace+) */
+        for (i = 0; i < repeat; ++i)
+        {
+            for (k = 0; k < 3; ++k)
+            {
+                double t0;
+                if (only >= 0 && k != only)
+                    continue;
+                t0 = now_ms();
+                if (k == 0)
+                    (void)run_stages(pts, n, tk);
+                else
+                    (void)run_workspace(pts, n, k == 2, tk);
+                t[(k * 4 + 3) * repeat + i] = now_ms() - t0;
+                for (s = 0; s < 3; ++s)
+                    t[(k * 4 + s) * repeat + i] = (double)tk[s] * 1e-6;
+            }
+        }
+        for (k = 0; k < 3; ++k)
+            for (s = 0; s < 4; ++s)
+                ms[k][s] = median(t + (k * 4 + s) * repeat, repeat);
+        printf("{\"scan\": \"%s\", \"sensor\": \"%s\", \"points\": %u, \"repeat\": %d, ", argv[a], sensor_name,
+               (unsigned)n, repeat);
+        for (k = 0; k < 3; ++k)
+        {
+            static const char *const name[3] = {"stages", "workspace", "workspace_per_point"};
+            printf("\"%s_ms\": %.4f, \"%s_project_ms\": %.4f, \"%s_ground_ms\": %.4f, \"%s_cluster_ms\": %.4f, ",
+                   name[k], ms[k][3], name[k], ms[k][0], name[k], ms[k][1], name[k], ms[k][2]);
+        }
+        printf("\"stages_bytes\": %u, \"workspace_bytes\": %u, \"ground_agree_pct\": %.3f, "
+               "\"cluster_agree_pct\": %.3f}\n",
+               (unsigned)sz.stages_standalone, (unsigned)sz.total, ag, ac);
+        fflush(stdout);
+        free(pts);
+    }
+    free(t);
+    return rc;
+}
