@@ -200,15 +200,17 @@ LIDET_CLONES_AVX2 static void decode_z(const int16_t *z, uint32_t cols, float *o
         out[c] = lidet__pix_m(z[c]);
     }
 }
-/* x and y decoded */
-LIDET_CLONES_AVX2 static void decode_xy(const int16_t *x, const int16_t *y, uint32_t cols, float *ox,
-                                        float *oy)
+/* x and y decoded, and R from them */
+LIDET_CLONES_AVX2 static void decode_xyr(const int16_t *x, const int16_t *y, uint32_t cols, float *ox,
+                                         float *oy, float *orxy)
 {
     uint32_t c;
     for (c = 0; c < cols; ++c)
     {
-        ox[c] = lidet__pix_m(x[c]);
-        oy[c] = lidet__pix_m(y[c]);
+        const float xm = lidet__pix_m(x[c]), ym = lidet__pix_m(y[c]);
+        ox[c] = xm;
+        oy[c] = ym;
+        orxy[c] = lidet__rxy(xm, ym);
     }
 }
 typedef struct
@@ -249,19 +251,9 @@ static const float *rxy_row(rxy_rows_t *rr, uint32_t r)
     if (rr->row_in[k] != (int32_t)r)
     {
         const size_t base = (size_t)r * cols;
-        uint32_t c;
         if (!rr->compact)
         {
-            const float *x = rr->img->x_m + base, *y = rr->img->y_m + base;
-            for (c = 0; c < cols; ++c)
-            {
-                out[c] = lidet__rxy(x[c], y[c]);
-            }
-        }
-        else if (rr->xyrow_in == (int32_t)r)
-        {
-            /* x and y of this row are decoded already (the label pass decodes them first) */
-            rxy_of(rr->xrow, rr->yrow, cols, out);
+            rxy_of(rr->img->x_m + base, rr->img->y_m + base, cols, out);
         }
         else
         {
@@ -289,7 +281,8 @@ static const float *z_row(rxy_rows_t *rr, uint32_t r)
     return rr->zslot[k];
 }
 
-/* x and y of row r: the image's rows, or (compact image) decoded into the one x and y scratch row */
+/* x and y of row r: the image's rows, or (compact image) decoded into the one x and y scratch row, with R of
+ * row r into its slot in the same loop (the label pass asks for x and y first, then R) */
 static void xy_row(rxy_rows_t *rr, uint32_t r, const float **X, const float **Y)
 {
     const uint32_t cols = rr->cols;
@@ -302,8 +295,9 @@ static void xy_row(rxy_rows_t *rr, uint32_t r, const float **X, const float **Y)
     }
     if (rr->xyrow_in != (int32_t)r)
     {
-        decode_xy(rr->img->x_4mm + base, rr->img->y_4mm + base, cols, rr->xrow, rr->yrow);
+        decode_xyr(rr->img->x_4mm + base, rr->img->y_4mm + base, cols, rr->xrow, rr->yrow, rr->slot[r & 1u]);
         rr->xyrow_in = (int32_t)r;
+        rr->row_in[r & 1u] = (int32_t)r;
     }
     *X = rr->xrow;
     *Y = rr->yrow;

@@ -10,6 +10,9 @@
  *   workspace+ - lidet_workspace_run with the per-point outputs asked for (point_pixel, then
  *                lidet_workspace_point_labels for the cluster id and the ground bit of every point), the
  *                outputs the stage objects always make.
+ * Beside them, the clustering stage alone on the same ground mask (the stage objects'), once on the workspace's
+ * compact image and once on the float image: the chains' clustering times differ also because their ground
+ * masks do (RANSAC on 4 mm coordinates draws other planes), this pair compares the code on one input.
  * Each is timed in CPU time of this thread (CLOCK_THREAD_CPUTIME_ID), projection + ground + clustering,
  * median over --repeat runs. Also prints the bytes each model holds and how far their results agree
  * (ground labels and cluster membership per valid pixel: the compact image rounds coordinates to 4 mm).
@@ -30,6 +33,8 @@ static lidet_proj_t g_proj;
 static lidet_ground_t g_ground;
 static lidet_cluster_t g_cluster;
 static lidet_workspace_t g_ws;
+static lidet_cluster_t g_cluster_same; /* the clustering alone on both images, the same mask */
+static uint8_t g_mask[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 static int32_t g_pp[LIDET_MAX_POINTS];
 static uint32_t g_ids[LIDET_MAX_POINTS];
 static uint8_t g_gnd[LIDET_MAX_POINTS];
@@ -60,7 +65,8 @@ static float *read_scan(const char *path, uint32_t *n)
     FILE *f = fopen(path, "rb");
     long sz;
     float *p;
-    if (f == NULL || fseek(f, 0, SEEK_END) != 0 || (sz = ftell(f)) < 0 || sz % 16 != 0 || fseek(f, 0, SEEK_SET) != 0)
+    if (f == NULL || fseek(f, 0, SEEK_END) != 0 || (sz = ftell(f)) < 0 || sz % 16 != 0 ||
+        fseek(f, 0, SEEK_SET) != 0)
     {
         if (f)
             fclose(f);
@@ -112,11 +118,12 @@ static lidet_status_t run_stages(const float *pts, uint32_t n, uint32_t ticks[3]
 
 static lidet_status_t run_workspace(const float *pts, uint32_t n, int per_point, uint32_t ticks[3])
 {
-    lidet_status_t st = lidet_workspace_run_timed(&g_ws, pts, n, 4, NULL, per_point ? g_pp : NULL, clock_ns, NULL,
-                                                  ticks);
+    lidet_status_t st =
+        lidet_workspace_run_timed(&g_ws, pts, n, 4, NULL, per_point ? g_pp : NULL, clock_ns, NULL, ticks);
     if (!LIDET_SUCCEEDED(st) || !per_point)
         return st;
-    return lidet_workspace_point_labels(&g_ws, g_pp, n < LIDET_MAX_POINTS ? n : LIDET_MAX_POINTS, g_ids, g_gnd);
+    return lidet_workspace_point_labels(&g_ws, g_pp, n < LIDET_MAX_POINTS ? n : LIDET_MAX_POINTS, g_ids,
+                                        g_gnd);
 }
 
 /* share of points valid in both (projected, the same in both up to 131 m) whose ground bit agrees, and whose
@@ -132,8 +139,12 @@ static void agreement(uint32_t n, double *ground_pct, double *cluster_pct)
     for (i = 0; i < n; ++i)
     {
         const uint32_t a = g_ids_ref[i], b = g_ids[i];
-        first_ref[i] = a == 0 || a > LIDET_MAX_CLUSTERS ? i : (seen_ref[a] == 0xFFFFFFFFu ? (seen_ref[a] = i) : seen_ref[a]);
-        first_ws[i] = b == 0 || b > LIDET_MAX_CLUSTERS ? i : (seen_ws[b] == 0xFFFFFFFFu ? (seen_ws[b] = i) : seen_ws[b]);
+        first_ref[i] = a == 0 || a > LIDET_MAX_CLUSTERS
+                           ? i
+                           : (seen_ref[a] == 0xFFFFFFFFu ? (seen_ref[a] = i) : seen_ref[a]);
+        first_ws[i] = b == 0 || b > LIDET_MAX_CLUSTERS
+                          ? i
+                          : (seen_ws[b] == 0xFFFFFFFFu ? (seen_ws[b] = i) : seen_ws[b]);
     }
     for (i = 0; i < n; ++i)
     {
@@ -146,6 +157,30 @@ static void agreement(uint32_t n, double *ground_pct, double *cluster_pct)
     }
     *ground_pct = both ? 100.0 * g_ok / both : 100.0;
     *cluster_pct = both ? 100.0 * c_ok / both : 100.0;
+}
+
+/* medians of the clustering alone on the compact and on the float image, the stage objects' ground mask and
+ * planes (run_stages and run_workspace ran on this scan last); t: 2 * repeat doubles */
+static void cluster_same_mask(int repeat, double *t, double *ms_compact, double *ms_float)
+{
+    lidet_range_image_t wimg, fimg;
+    uint32_t ns = 0;
+    const lidet_plane_t *planes = lidet_ground_planes(&g_ground, &ns);
+    int i;
+    lidet_workspace_image(&g_ws, &wimg);
+    lidet_proj_image(&g_proj, &fimg);
+    memcpy(g_mask, lidet_ground_mask(&g_ground), (size_t)fimg.n_rows * fimg.n_cols);
+    for (i = 0; i < repeat; ++i)
+    {
+        double t0 = now_ms();
+        (void)lidet_cluster_run(&g_cluster_same, &wimg, g_mask, planes, ns);
+        t[i] = now_ms() - t0;
+        t0 = now_ms();
+        (void)lidet_cluster_run(&g_cluster_same, &fimg, g_mask, planes, ns);
+        t[repeat + i] = now_ms() - t0;
+    }
+    *ms_compact = median(t, repeat);
+    *ms_float = median(t + repeat, repeat);
 }
 
 int main(int argc, char **argv)
@@ -175,19 +210,24 @@ int main(int argc, char **argv)
         }
         else
         {
-            fprintf(stderr, "usage: lidet_bench_memory --sensor S [--repeat N] [--only stages|workspace] SCAN.bin...\n");
+            fprintf(
+                stderr,
+                "usage: lidet_bench_memory --sensor S [--repeat N] [--only stages|workspace] SCAN.bin...\n");
             return 2;
         }
     }
     sensor = lidet_sensor_find(sensor_name);
     if (sensor == NULL || repeat < 1 || a >= argc)
     {
-        fprintf(stderr, "lidet_bench_memory: %s\n", sensor == NULL ? "unknown sensor" : "need scans and --repeat >= 1");
+        fprintf(stderr, "lidet_bench_memory: %s\n",
+                sensor == NULL ? "unknown sensor" : "need scans and --repeat >= 1");
         return 2;
     }
     lidet_workspace_cfg_default(&cfg, sensor);
     if (lidet_workspace_init(&g_ws, &cfg) != LIDET_OK || lidet_proj_init(&g_proj, &cfg.proj) != LIDET_OK ||
-        lidet_ground_init(&g_ground, &cfg.ground) != LIDET_OK || lidet_cluster_init(&g_cluster, &cfg.cluster) != LIDET_OK)
+        lidet_ground_init(&g_ground, &cfg.ground) != LIDET_OK ||
+        lidet_cluster_init(&g_cluster, &cfg.cluster) != LIDET_OK ||
+        lidet_cluster_init(&g_cluster_same, &cfg.cluster) != LIDET_OK)
     {
         fprintf(stderr, "lidet_bench_memory: init failed (capacities too small for %s?)\n", sensor_name);
         return 1;
@@ -200,20 +240,23 @@ int main(int argc, char **argv)
     {
         uint32_t n = 0, m;
         float *pts = read_scan(argv[a], &n);
-        double ms[3][4], ag, ac;
+        double ms[3][4], ag, ac, same_c, same_f;
         uint32_t tk[3];
         int i, k, s;
         if (pts == NULL)
         {
-            fprintf(stderr, "lidet_bench_memory: cannot read %s (missing, or not records of 4 floats)\n", argv[a]);
+            fprintf(stderr, "lidet_bench_memory: cannot read %s (missing, or not records of 4 floats)\n",
+                    argv[a]);
             rc = 1;
             continue;
         }
         m = n < LIDET_MAX_POINTS ? n : LIDET_MAX_POINTS;
         /* warm-up, and the results compared */
         if (!LIDET_SUCCEEDED(run_stages(pts, n, tk)) || !LIDET_SUCCEEDED(run_workspace(pts, n, 1, tk)) ||
-            !LIDET_SUCCEEDED(lidet_cluster_point_labels(&g_cluster, lidet_proj_point_pixels(&g_proj, NULL), m, g_ids_ref)) ||
-            !LIDET_SUCCEEDED(lidet_ground_point_labels(&g_ground, lidet_proj_point_pixels(&g_proj, NULL), m, g_gnd_ref)))
+            !LIDET_SUCCEEDED(lidet_cluster_point_labels(&g_cluster, lidet_proj_point_pixels(&g_proj, NULL), m,
+                                                        g_ids_ref)) ||
+            !LIDET_SUCCEEDED(
+                lidet_ground_point_labels(&g_ground, lidet_proj_point_pixels(&g_proj, NULL), m, g_gnd_ref)))
         {
             fprintf(stderr, "lidet_bench_memory: a stage failed on %s\n", argv[a]);
             free(pts);
@@ -243,14 +286,20 @@ int main(int argc, char **argv)
         for (k = 0; k < 3; ++k)
             for (s = 0; s < 4; ++s)
                 ms[k][s] = median(t + (k * 4 + s) * repeat, repeat);
-        printf("{\"scan\": \"%s\", \"sensor\": \"%s\", \"points\": %u, \"repeat\": %d, ", argv[a], sensor_name,
-               (unsigned)n, repeat);
+        printf("{\"scan\": \"%s\", \"sensor\": \"%s\", \"points\": %u, \"repeat\": %d, ", argv[a],
+               sensor_name, (unsigned)n, repeat);
         for (k = 0; k < 3; ++k)
         {
             static const char *const name[3] = {"stages", "workspace", "workspace_per_point"};
-            printf("\"%s_ms\": %.4f, \"%s_project_ms\": %.4f, \"%s_ground_ms\": %.4f, \"%s_cluster_ms\": %.4f, ",
-                   name[k], ms[k][3], name[k], ms[k][0], name[k], ms[k][1], name[k], ms[k][2]);
+            printf(
+                "\"%s_ms\": %.4f, \"%s_project_ms\": %.4f, \"%s_ground_ms\": %.4f, \"%s_cluster_ms\": %.4f, ",
+                name[k], ms[k][3], name[k], ms[k][0], name[k], ms[k][1], name[k], ms[k][2]);
         }
+        (void)run_stages(pts, n, tk);
+        (void)run_workspace(pts, n, 0, tk);
+        cluster_same_mask(repeat, t, &same_c, &same_f);
+        printf("\"same_mask_cluster_compact_ms\": %.4f, \"same_mask_cluster_float_ms\": %.4f, ", same_c,
+               same_f);
         printf("\"stages_bytes\": %u, \"workspace_bytes\": %u, \"ground_agree_pct\": %.3f, "
                "\"cluster_agree_pct\": %.3f}\n",
                (unsigned)sz.stages_standalone, (unsigned)sz.total, ag, ac);

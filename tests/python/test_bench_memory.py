@@ -21,6 +21,7 @@ def test_both_models_run_and_agree(root, cli, sensor):
     mod = _mod(root)
     scan = root / "tests" / "data" / f"sim_{sensor}" / "velodyne" / "000000.bin"
     (r,) = mod.measure(cli.parents[2], sensor, [scan], 2)
+    assert r["same_mask_cluster_compact_ms"] > 0 and r["same_mask_cluster_float_ms"] > 0
     for model in ("stages", "workspace", "workspace_per_point"):
         parts = [r[f"{model}_{p}_ms"] for p in mod.PARTS]
         assert all(t > 0 for t in parts), (model, parts)
