@@ -200,9 +200,9 @@ LIDET_CLONES_AVX2 static void decode_z(const int16_t *z, uint32_t cols, float *o
         out[c] = lidet__pix_m(z[c]);
     }
 }
-/* x and y decoded, and R from them */
-LIDET_CLONES_AVX2 static void decode_xyr(const int16_t *x, const int16_t *y, uint32_t cols, float *ox,
-                                         float *oy, float *orxy)
+/* x, y and z decoded, and R from x and y */
+LIDET_CLONES_AVX2 static void decode_xyzr(const int16_t *x, const int16_t *y, const int16_t *z, uint32_t cols,
+                                          float *ox, float *oy, float *oz, float *orxy)
 {
     uint32_t c;
     for (c = 0; c < cols; ++c)
@@ -210,7 +210,19 @@ LIDET_CLONES_AVX2 static void decode_xyr(const int16_t *x, const int16_t *y, uin
         const float xm = lidet__pix_m(x[c]), ym = lidet__pix_m(y[c]);
         ox[c] = xm;
         oy[c] = ym;
+        oz[c] = lidet__pix_m(z[c]);
         orxy[c] = lidet__rxy(xm, ym);
+    }
+}
+/* R of the decoded x, y, and z decoded */
+LIDET_CLONES_AVX2 static void decode_rz(const int16_t *x, const int16_t *y, const int16_t *z, uint32_t cols,
+                                        float *orxy, float *oz)
+{
+    uint32_t c;
+    for (c = 0; c < cols; ++c)
+    {
+        orxy[c] = lidet__rxy(lidet__pix_m(x[c]), lidet__pix_m(y[c]));
+        oz[c] = lidet__pix_m(z[c]);
     }
 }
 typedef struct
@@ -281,11 +293,12 @@ static const float *z_row(rxy_rows_t *rr, uint32_t r)
     return rr->zslot[k];
 }
 
-/* x and y of row r: the image's rows, or (compact image) decoded into the one x and y scratch row, with R of
- * row r into its slot in the same loop (the label pass asks for x and y first, then R) */
+/* x and y of row r: the image's rows, or (compact image) decoded into the one x and y scratch row; a compact
+ * image's z and R of row r go to their slots in the same loop (the label pass asks for x and y first, then z
+ * and R) */
 static void xy_row(rxy_rows_t *rr, uint32_t r, const float **X, const float **Y)
 {
-    const uint32_t cols = rr->cols;
+    const uint32_t cols = rr->cols, k = r & 1u;
     const size_t base = (size_t)r * cols;
     if (!rr->compact)
     {
@@ -295,12 +308,32 @@ static void xy_row(rxy_rows_t *rr, uint32_t r, const float **X, const float **Y)
     }
     if (rr->xyrow_in != (int32_t)r)
     {
-        decode_xyr(rr->img->x_4mm + base, rr->img->y_4mm + base, cols, rr->xrow, rr->yrow, rr->slot[r & 1u]);
+        const lidet_range_image_t *img = rr->img;
+        decode_xyzr(img->x_4mm + base, img->y_4mm + base, img->z_4mm + base, cols, rr->xrow, rr->yrow,
+                    rr->zslot[k], rr->slot[k]);
         rr->xyrow_in = (int32_t)r;
-        rr->row_in[r & 1u] = (int32_t)r;
+        rr->zrow_in[k] = (int32_t)r;
+        rr->row_in[k] = (int32_t)r;
     }
     *X = rr->xrow;
     *Y = rr->yrow;
+}
+
+/* R and z of row r (the filter pass): a compact image's two decoded in one loop when neither is held */
+static void rz_row(rxy_rows_t *rr, uint32_t r, const float **R, const float **Z)
+{
+    const uint32_t k = r & 1u;
+    if (rr->compact && rr->row_in[k] != (int32_t)r && rr->zrow_in[k] != (int32_t)r)
+    {
+        const size_t base = (size_t)r * rr->cols;
+        const lidet_range_image_t *img = rr->img;
+        decode_rz(img->x_4mm + base, img->y_4mm + base, img->z_4mm + base, rr->cols, rr->slot[k],
+                  rr->zslot[k]);
+        rr->row_in[k] = (int32_t)r;
+        rr->zrow_in[k] = (int32_t)r;
+    }
+    *R = rxy_row(rr, r);
+    *Z = z_row(rr, r);
 }
 
 /* Pass 1 (mirrors ref/ground.py: sample_mask): the sample mask, row by row. */
@@ -321,11 +354,10 @@ static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, rxy_rows
     memset(sample, 0, (size_t)rows * cols);
     for (r = 0; r + 1u < rows; r += step)
     {
-        const float *R0 = rxy_row(rr, r);
-        const float *R1 = rxy_row(rr, r + 1u);
-        const float *Z0 = z_row(rr, r);
-        const float *Z1 = z_row(rr, r + 1u);
-        const float *F0 = g->cfg.fx_on_z ? Z0 : R0;
+        const float *R0, *R1, *Z0, *Z1, *F0;
+        rz_row(rr, r, &R0, &Z0);
+        rz_row(rr, r + 1u, &R1, &Z1);
+        F0 = g->cfg.fx_on_z ? Z0 : R0;
         uint8_t *out = sample + (size_t)r * cols;
         const filt_t fl = f;
         if (opt)
@@ -539,7 +571,7 @@ static void label_rows(lidet_ground_state_t *g, uint8_t *mask, rxy_rows_t *rr, c
         const size_t base = (size_t)r * cols;
         const float *X, *Y, *Z, *R, *Ru, *Zu;
         uint8_t *out = mask + base;
-        xy_row(rr, r, &X, &Y); /* first: a compact image's R of row r is then computed from them */
+        xy_row(rr, r, &X, &Y); /* first: a compact image's z and R of row r are decoded with them */
         Z = z_row(rr, r);
         R = rxy_row(rr, r);
         Ru = r > 0u ? rxy_row(rr, r - 1u) : R;

@@ -325,14 +325,15 @@ static inline int32_t to_4mm(float v)
 /* (b) of pass2_compact: the rounding of one block, a loop without branches or indexed loads (an AVX2 variant on
  * x86-64 hosts, internal/lidet_simd.h; the gather (a) stays a plain loop: compiled for AVX2 it becomes hardware
  * gathers, measured slower) */
-LIDET_CLONES_AVX2 static void round_block(const float *bx, const float *by, const float *bz, const float *b2,
-                                          uint32_t m, int16_t *xo, int16_t *yo, int16_t *zo, uint16_t *ro)
+LIDET_CLONES_AVX2 static void round_block(const float *bx, const float *by, const float *bz, uint32_t m,
+                                          int16_t *xo, int16_t *yo, int16_t *zo, uint16_t *ro)
 {
     uint32_t j;
     for (j = 0; j < m; ++j)
     {
-        /* b2: a winner's squared range (<= max2 <= 131^2 m^2 by the range test) or 0 (empty) */
-        const float r = sqrtf(b2[j]);
+        /* a winner's squared range, the very expression of pass 1 (key_block: x^2 + y^2, then + z^2; no
+         * contraction), so the same bits (<= max2 <= 131^2 m^2 by the range test); 0 for an empty pixel */
+        const float r = sqrtf((bx[j] * bx[j] + by[j] * by[j]) + bz[j] * bz[j]);
         const int32_t rq = to_4mm(r);
         xo[j] = (int16_t)to_4mm(bx[j]);
         yo[j] = (int16_t)to_4mm(by[j]);
@@ -342,11 +343,12 @@ LIDET_CLONES_AVX2 static void round_block(const float *bx, const float *by, cons
 }
 
 /* Pass 2 of a compact image (see pass 2 below for the float one): each winner's coordinates and range,
- * rounded to 4 mm steps; the range is the float path's sqrtf of the same squared range (kept in the two
- * 16-bit halves), so the compact image is the float image rounded. A valid pixel's range is >= 1 step
+ * rounded to 4 mm steps; the range is the float path's sqrtf of the same squared range (recomputed from the
+ * gathered coordinates by pass 1's expression, so pass 2 need not read pass 1's keys back), so the compact
+ * image is the float image rounded. A valid pixel's range is >= 1 step
  * (a point closer than 2 mm, possible with min_range_m 0, would otherwise read as empty). In blocks of
- * COMPACT_BLOCK pixels (3 KiB of stack): (a) a branch-free gather of the winners' coordinates and
- * squared ranges (an empty pixel reads record 0 masked to +0); (b) the rounding, in a loop without
+ * COMPACT_BLOCK pixels (2.25 KiB of stack): (a) a branch-free gather of the winners' coordinates (an
+ * empty pixel reads record 0 masked to +0); (b) the rounding, in a loop without
  * branches that compilers vectorise. */
 #define COMPACT_BLOCK 192u
 static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *points, uint32_t stride,
@@ -357,7 +359,7 @@ static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *poin
     const int32_t *const idx = buf->point_idx;
     int16_t *const xo = buf->x_4mm, *const yo = buf->y_4mm, *const zo = buf->z_4mm;
     uint16_t *const ro = buf->range_4mm;
-    float bx[COMPACT_BLOCK], by[COMPACT_BLOCK], bz[COMPACT_BLOCK], b2[COMPACT_BLOCK];
+    float bx[COMPACT_BLOCK], by[COMPACT_BLOCK], bz[COMPACT_BLOCK];
     uint32_t base, filled = 0;
     for (base = 0; base < npix; base += COMPACT_BLOCK)
     {
@@ -369,21 +371,19 @@ static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *poin
             const int32_t k = idx[pix];
             const uint32_t keep = 0u - (uint32_t)(k >= 0);
             const float *pt = src + (size_t)((uint32_t)k & keep) * stride;
-            uint32_t ux, uy, uz, key = ((uint32_t)ro[pix] << 16) | (uint16_t)zo[pix];
+            uint32_t ux, uy, uz;
             memcpy(&ux, &pt[0], sizeof ux);
             memcpy(&uy, &pt[1], sizeof uy);
             memcpy(&uz, &pt[2], sizeof uz);
             ux &= keep;
             uy &= keep;
             uz &= keep;
-            key &= keep; /* empty: 0, i.e. range 0 */
             memcpy(&bx[j], &ux, sizeof ux);
             memcpy(&by[j], &uy, sizeof uy);
             memcpy(&bz[j], &uz, sizeof uz);
-            memcpy(&b2[j], &key, sizeof key);
             filled += keep & 1u;
         }
-        round_block(bx, by, bz, b2, m, xo + base, yo + base, zo + base, ro + base);
+        round_block(bx, by, bz, m, xo + base, yo + base, zo + base, ro + base);
     }
     return filled;
 }
