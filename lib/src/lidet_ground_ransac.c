@@ -425,7 +425,12 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
         float z_first;
         lidet__img_xyz(img, idx[0], compact, &shift[0], &shift[1], &z_first);
         shift[2] = best.nz > 0.0f ? -(best.nx * shift[0] + best.ny * shift[1] + best.d_m) / best.nz : z_first;
-        if (accumulate_idx(img, compact, idx, n, &best, cfg->inlier_m, shift, cov, centroid) < 3u ||
+        /* every sample is in the scoring copy when its stride is 1 (a cell of at most eval_samples): the
+         * contiguous sums, bit for bit those of the gathered blocks, without gathering (and decoding) again */
+        if ((copied && stride == 1u
+                 ? accumulate(sc->ev_x_m, sc->ev_y_m, sc->ev_z_m, n, &best, cfg->inlier_m, shift, cov,
+                              centroid)
+                 : accumulate_idx(img, compact, idx, n, &best, cfg->inlier_m, shift, cov, centroid)) < 3u ||
             !plane_from_cov(cov, centroid, &p, 0) || !(p.nz * p.nz >= cos2))
         {
             break; /* keep the last good plane */
