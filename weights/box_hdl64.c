@@ -8,7 +8,7 @@
 #endif
 
 /* tnet.point[0] weights, shape [3][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_point0_w[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_point0_w[96] = {
     -0.12130354f, -1.3836021f, -0.29781598f, 1.0414637f, -1.2184793f, -0.037132498f, -0.94080067f, 1.1455154f,
     -0.32503867f, -1.2107707f, -0.6046355f, -0.6809745f, -0.9544723f, 1.2306606f, 0.20423482f, -1.240154f,
     -1.1887513f, 1.3929782f, 1.0323817f, -1.1915512f, 0.7557461f, 0.67570865f, -0.0012658671f, 1.1331486f,
@@ -23,14 +23,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_point0_w[96] = {
     1.3024002f, -1.2326924f, -1.580834f, -1.3328729f, -1.0443423f, -1.3501514f, 1.2967446f, -0.77114505f
 };
 /* tnet.point[0] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_point0_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_point0_b[32] = {
     -0.029369634f, 0.048418436f, -0.044250548f, 0.03505852f, -0.0009981319f, -0.0012469781f, -0.02689187f, 0.08781272f,
     0.0013390805f, 0.16488296f, 0.10909783f, 0.0068424037f, 0.006682144f, 0.011881106f, 0.017787836f, 0.038884707f,
     0.12240021f, 0.05275895f, 0.120689176f, 0.06488844f, 0.0898964f, 0.096712396f, 0.17017414f, 0.05419547f,
     -0.045066692f, 0.035194494f, 0.043008443f, 0.0050366195f, -0.034149278f, 0.15746956f, 0.1978911f, 0.009569028f
 };
 /* tnet.point[1] weights, shape [32][64] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_point1_w[2048] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_point1_w[2048] = {
     -0.44349328f, -0.038123425f, -0.47264773f, -0.37888134f, -0.5134828f, -0.09837983f, 0.0680461f, -0.037761383f,
     0.045642868f, -0.19063921f, -0.11365644f, -0.31012514f, -0.13621418f, -0.14788528f, 0.016132154f, -0.20809485f,
     -0.1222752f, -0.09421573f, -0.2976577f, 0.053217333f, -0.38350075f, 0.23867354f, -0.11995585f, 0.3124076f,
@@ -289,7 +289,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_point1_w[2048] = 
     0.027672656f, 0.027450774f, -0.00791515f, -0.37683982f, -0.30286247f, -0.2023541f, -0.25512034f, 0.211784f
 };
 /* tnet.point[1] bias, shape [64], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_point1_b[64] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_point1_b[64] = {
     0.9043745f, 0.009201141f, 0.049922753f, 0.06735937f, 0.4934332f, 1.156861f, -0.9566597f, -0.044760596f,
     -0.85912955f, 0.90288f, 0.15008965f, 0.052113805f, 0.24568228f, 0.5174853f, -0.11063522f, -0.12115492f,
     -0.15390375f, 0.5327841f, 0.21290918f, 0.011962627f, 0.62500536f, -0.19575511f, 0.17165792f, 0.29969877f,
@@ -305,7 +305,7 @@ static const lidet_pn_layer_t box_hdl64_tnet_point[2] = {
 };
 
 /* tnet.pvle[0] weights, shape [3][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_pvle0_w[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_pvle0_w[96] = {
     -0.009962505f, -0.060434245f, -0.090780996f, -0.035552252f, 0.09587709f, -0.012187461f, -0.09133075f, -0.08287865f,
     0.08939497f, 0.03777342f, 0.06602725f, 0.028066712f, -0.027467458f, 0.04985991f, -0.020397434f, -0.07002964f,
     -0.06577924f, 0.045384347f, 0.08215888f, 0.018180434f, -0.048623748f, 0.03798436f, 0.032805566f, 0.0088166f,
@@ -320,14 +320,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_pvle0_w[96] = {
     0.02209663f, -0.027638258f, -0.047504414f, -0.006323279f, 0.0015907168f, 0.029825985f, -0.059215885f, 0.019976927f
 };
 /* tnet.pvle[0] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_pvle0_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_pvle0_b[32] = {
     1.5894454f, -1.1727346f, 0.13193178f, -1.4351423f, 0.13421278f, 1.5163474f, 0.025431752f, -0.5776014f,
     -0.5985521f, 1.4845798f, -0.7986116f, -1.5216618f, -1.6731012f, 1.4599164f, -1.4892237f, -1.1066657f,
     -1.0291277f, -0.9527557f, -0.63514507f, 1.627147f, 1.2221994f, 1.320953f, -1.466596f, -1.447764f,
     -0.527479f, 0.7394441f, 1.1707526f, 0.18699725f, -0.11886436f, -0.72086495f, 1.5504142f, -0.5776393f
 };
 /* tnet.pvle[1] weights, shape [32][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_pvle1_w[1024] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_pvle1_w[1024] = {
     0.22592431f, 0.49645072f, 0.05216974f, 0.27671298f, 0.34069857f, 0.045493606f, -0.3081538f, -0.1684943f,
     0.019248374f, -0.087419376f, 0.11291997f, -0.08923643f, -0.16663292f, -0.17769037f, -0.5214258f, 0.001523213f,
     -0.12315194f, 0.19365685f, -0.13392083f, 0.20907433f, 0.7193687f, -0.17716515f, 0.29185694f, 0.26684818f,
@@ -458,7 +458,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_pvle1_w[1024] = {
     -0.13287085f, -0.30108008f, -0.09953885f, -0.13799717f, 0.16876338f, -0.0788634f, -0.00763744f, -0.11547544f
 };
 /* tnet.pvle[1] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_pvle1_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_pvle1_b[32] = {
     -0.09623992f, 0.6684251f, -0.9034834f, 0.53120875f, 0.6018378f, 0.32090074f, 0.69285065f, 0.16603096f,
     -0.10879801f, 0.18981232f, 0.16479398f, 0.45512494f, -0.010004322f, 0.5931606f, 0.92357117f, 0.6341042f,
     -0.6772044f, 0.55369157f, 0.10664979f, 0.0807643f, -1.6690334f, 0.23235232f, -0.09756158f, 0.9742035f,
@@ -470,7 +470,7 @@ static const lidet_pn_layer_t box_hdl64_tnet_pvle[2] = {
 };
 
 /* tnet.head[0] weights, shape [99][64] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_head0_w[6336] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_head0_w[6336] = {
     0.10259169f, -0.029305127f, 0.07132712f, 0.15479776f, 0.03513976f, 0.013675177f, 0.102765866f, 0.05390537f,
     -0.20653805f, 0.05787852f, -0.029227927f, -0.05256011f, 0.08619861f, 0.00017367951f, -0.08429295f, 0.008874061f,
     0.005381028f, -0.0030914687f, 0.05125249f, 0.032292698f, -0.024869472f, -0.075471655f, -0.09190754f, -0.105107896f,
@@ -1265,7 +1265,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_head0_w[6336] = {
     0.0027890704f, -0.08017102f, 0.0060712565f, 0.05014173f, -0.049374547f, 0.04430662f, 0.01727621f, 0.0066937553f
 };
 /* tnet.head[0] bias, shape [64], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_head0_b[64] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_head0_b[64] = {
     1.8186698f, 1.2328794f, 0.3284399f, -1.4703645f, -1.9698476f, 1.3472743f, -0.8013991f, -1.4910669f,
     1.3703724f, 0.20540467f, -1.5265326f, 1.4975375f, 1.188439f, 0.94849193f, -0.6032073f, 1.3659372f,
     0.28827342f, -1.8773273f, 1.5513248f, 1.4673197f, -1.5088012f, 1.9001184f, 0.118258506f, 1.416182f,
@@ -1276,7 +1276,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_head0_b[64] = {
     -1.4777764f, 0.8760226f, 1.1901895f, -1.1494867f, -0.5533603f, 0.599044f, 0.45521733f, 0.9377934f
 };
 /* tnet.head[1] weights, shape [64][3] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_head1_w[192] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_head1_w[192] = {
     0.07508899f, -0.0066945744f, -0.12718144f, -0.07863755f, 0.09018072f, 0.031153036f, 0.0105873495f, 0.063497745f,
     -0.041027702f, -0.02251437f, -0.0055429516f, -0.06161818f, 0.0847836f, -0.04678278f, 0.03477628f, -0.059407208f,
     -0.05963344f, 0.01671446f, -0.025803838f, -0.006187113f, 0.097204745f, -0.025849864f, -0.021065587f, 0.10258619f,
@@ -1303,7 +1303,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_head1_w[192] = {
     -0.079881825f, -0.001884764f, 0.07065846f, 0.033817302f, 0.033227205f, 0.11368304f, -0.027152648f, 0.06806189f
 };
 /* tnet.head[1] bias, shape [3], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_tnet_head1_b[3] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_tnet_head1_b[3] = {
     0.03160162f, 0.0908747f, 0.029317642f
 };
 static const lidet_pn_layer_t box_hdl64_tnet_head[2] = {
@@ -1312,7 +1312,7 @@ static const lidet_pn_layer_t box_hdl64_tnet_head[2] = {
 };
 
 /* box.point[0] weights, shape [3][48] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_point0_w[144] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_point0_w[144] = {
     1.1805296f, -0.052511666f, -0.58505917f, 0.99182075f, -1.3688353f, -0.7312936f, -0.1706364f, -0.5622203f,
     1.0475395f, -1.4011742f, -1.2144045f, 0.6648564f, 0.3632488f, -1.1620568f, 0.13073489f, -0.8086492f,
     0.39389536f, -0.5738855f, 0.7068839f, 0.62964296f, 0.73438483f, -1.3957502f, -1.3708735f, 0.8001649f,
@@ -1333,7 +1333,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_point0_w[144] = {
     0.5207341f, 1.5694195f, 0.81388533f, -1.2746655f, -1.3078334f, -0.9626082f, 0.23717201f, 1.7983544f
 };
 /* box.point[0] bias, shape [48], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_point0_b[48] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_point0_b[48] = {
     0.51726586f, -0.09404409f, -0.17231394f, 0.3222962f, -0.40579927f, -0.28670293f, 0.03301134f, -0.0693085f,
     0.42891005f, -0.4911028f, -0.38719127f, 0.28487676f, 0.11046054f, -0.31945243f, 0.14512971f, -0.22097513f,
     0.2025333f, -0.18839917f, 0.4259261f, 0.28476816f, 0.28345972f, -0.6058045f, -0.48096302f, 0.33520216f,
@@ -1342,7 +1342,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_point0_b[48] = {
     -0.4268553f, -0.013897868f, 0.3400473f, 0.5313947f, 0.20059553f, -0.39074314f, -0.23233008f, 0.11734359f
 };
 /* box.point[1] weights, shape [48][96] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_point1_w[4608] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_point1_w[4608] = {
     0.17104656f, -0.19745357f, 0.10594075f, 0.19095172f, 0.16639435f, 0.1655301f, -0.19402286f, -0.22273949f,
     0.16807415f, -0.14816323f, -0.19967711f, 0.037048895f, 0.35924423f, 0.0049812845f, 0.26488465f, 0.025896994f,
     -0.0779548f, -0.15606765f, -0.029369516f, -0.1849577f, -0.14139178f, -0.011480534f, -0.003661277f, 0.2522506f,
@@ -1921,7 +1921,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_point1_w[4608] = {
     0.26092076f, 0.074987896f, 0.082168765f, 0.48836964f, 0.028596038f, 0.1719755f, 0.22993778f, 0.30961424f
 };
 /* box.point[1] bias, shape [96], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_point1_b[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_point1_b[96] = {
     0.28371653f, 1.3458353f, -0.94665945f, 0.23036893f, 0.36964235f, -0.46983156f, 0.17718434f, 0.9678892f,
     -0.39806575f, -0.44024646f, 0.8716664f, 0.69812536f, 1.0567968f, 1.0179123f, -0.8041391f, -0.50077707f,
     -0.87189853f, -1.307761f, 0.40237272f, 0.85989416f, 0.5573378f, 0.43108088f, 0.526857f, -1.6402888f,
@@ -1936,7 +1936,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_point1_b[96] = {
     1.1506703f, 0.5976024f, -0.4055213f, 0.7034428f, 0.6657929f, -0.57883346f, 0.5908147f, 1.030785f
 };
 /* box.point[2] weights, shape [96][160] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_point2_w[15360] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_point2_w[15360] = {
     -0.046760555f, -0.0163311f, 0.13360584f, 0.004285609f, -0.098421246f, 0.13183892f, 0.07749243f, -0.034278236f,
     0.03459644f, -0.113664955f, -0.011000325f, -0.015336863f, -0.034510672f, 0.104649045f, 0.042609874f, 0.08132366f,
     -0.061664395f, -0.030162143f, 0.06982508f, -0.31918707f, 0.114419326f, 0.16770682f, 0.10174052f, 0.09644439f,
@@ -3859,7 +3859,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_point2_w[15360] = 
     -0.03683214f, 0.19126338f, -0.036813766f, -0.18061435f, -0.071398854f, -0.31700256f, -0.014984895f, 0.21378686f
 };
 /* box.point[2] bias, shape [160], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_point2_b[160] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_point2_b[160] = {
     1.6947939f, 0.986626f, 0.88063234f, 0.56395304f, 0.68827057f, 0.6063114f, 0.4151087f, -0.5306498f,
     0.85881877f, -0.42732996f, 1.0812306f, 1.1385238f, 1.1857139f, -0.59932697f, 1.2251625f, 0.5238401f,
     0.2416755f, -0.7325297f, 0.6097281f, 0.30292228f, 0.2563627f, -0.7717054f, 0.40331107f, 0.68770146f,
@@ -3888,7 +3888,7 @@ static const lidet_pn_layer_t box_hdl64_box_point[3] = {
 };
 
 /* box.pvle[0] weights, shape [3][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_pvle0_w[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_pvle0_w[96] = {
     0.0036936812f, -0.042375434f, -0.04002517f, 0.023848869f, 0.08665447f, 0.07629571f, -0.062825195f, -0.069795914f,
     0.0861941f, 0.036288448f, 0.053411778f, -0.08319092f, 0.032352246f, 0.060791146f, 0.090109944f, -0.059545804f,
     0.039616786f, -0.0036597843f, -0.020137032f, -0.053088948f, 0.08784729f, -0.06842787f, 0.02577847f, 0.044399004f,
@@ -3903,14 +3903,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_pvle0_w[96] = {
     0.05398148f, -0.011304558f, -0.030233396f, -0.017095229f, -0.009970962f, 0.0021925464f, -0.04685837f, -0.049920846f
 };
 /* box.pvle[0] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_pvle0_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_pvle0_b[32] = {
     1.5012347f, -1.4571321f, -1.5841725f, 1.5552429f, 0.11054442f, -0.7146511f, 1.0314515f, -0.97565275f,
     -0.53652f, -1.6881056f, -1.2309285f, -0.6910684f, -1.4778688f, 1.2272406f, 0.0012352034f, -1.1713518f,
     -1.5579562f, -1.5344466f, -1.592491f, -1.2314938f, -0.15600157f, -0.87161124f, 1.4357522f, 1.2937679f,
     -1.5072656f, 0.35990128f, 0.87784475f, 0.49227136f, 0.23750016f, -0.049823094f, 1.2499326f, 1.1611456f
 };
 /* box.pvle[1] weights, shape [32][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_pvle1_w[1024] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_pvle1_w[1024] = {
     0.21676263f, -0.47941628f, 0.2189037f, -0.12075595f, -0.13053598f, -0.21882404f, 0.09130162f, -0.4970655f,
     -0.2733451f, 0.18118827f, 0.06903557f, -0.38181293f, 0.19953324f, -0.010684159f, 0.12509082f, 0.054394726f,
     0.15330538f, -0.176375f, 0.19368978f, -0.09370322f, -0.117371276f, 0.28074986f, -0.11446455f, -0.28801337f,
@@ -4041,7 +4041,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_pvle1_w[1024] = {
     -0.024515651f, 0.0077326894f, -0.37295052f, 0.05491193f, 0.26560307f, 0.36582145f, -0.124390125f, 0.19685051f
 };
 /* box.pvle[1] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_pvle1_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_pvle1_b[32] = {
     0.3111659f, 0.46834463f, 0.3045279f, -0.14934856f, 0.13800725f, 0.9394435f, 0.42348358f, 0.32652298f,
     -1.4071333f, -1.1325065f, 0.2905326f, -0.16412804f, 0.22484462f, 0.58169913f, 0.32019326f, 0.5433222f,
     -0.9403689f, 0.7723652f, 0.20712435f, -1.3047646f, 0.509883f, 0.33927175f, 0.8307895f, 0.7036786f,
@@ -4053,7 +4053,7 @@ static const lidet_pn_layer_t box_hdl64_box_pvle[2] = {
 };
 
 /* box.head[0] weights, shape [195][128] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_head0_w[24960] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_head0_w[24960] = {
     0.00864058f, -0.046783168f, 0.013616381f, -0.0012288602f, -0.024220236f, 0.15009233f, -0.18398617f, 0.11314106f,
     -0.0852354f, -0.05942757f, -0.09752993f, 0.11530991f, -0.06928341f, 0.043817718f, -0.13622773f, -0.025150867f,
     -0.09919736f, 0.06090439f, -0.09190984f, 0.08536692f, 0.013989154f, -0.018643826f, -0.08768479f, -0.19523697f,
@@ -7176,7 +7176,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_head0_w[24960] = {
     0.04803546f, -0.05443542f, -0.015020672f, -0.0011477079f, -0.0055579324f, -0.048068352f, 0.044858683f, 0.024432044f
 };
 /* box.head[0] bias, shape [128], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_head0_b[128] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_head0_b[128] = {
     -0.01531254f, 1.7622917f, 1.2812052f, 3.0688746f, -0.2611898f, 0.8292165f, -0.2560545f, -1.5886681f,
     0.37431428f, -0.7416409f, 0.9651315f, -0.5850435f, -0.8654127f, -0.24362539f, -0.5207136f, 0.7453384f,
     1.6700681f, -0.10479859f, -0.40152466f, 0.2613574f, -1.2414515f, 0.88539076f, -1.0954356f, -1.5839154f,
@@ -7195,7 +7195,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_head0_b[128] = {
     -0.38017455f, 0.53229773f, -0.37107688f, 0.12935002f, -1.1475449f, -1.0881573f, -1.5491575f, 1.434662f
 };
 /* box.head[1] weights, shape [128][64] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_head1_w[8192] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_head1_w[8192] = {
     -0.00085564714f, -0.12070195f, 0.13876894f, -0.096011505f, 0.13112059f, -0.052678872f, -0.026347315f, 0.023217991f,
     0.08873973f, -0.08479652f, -0.0008871664f, 0.1836095f, -0.022293078f, 0.1494906f, -0.01415217f, 0.22045498f,
     0.067792624f, 0.08843469f, -0.08417944f, 0.014098095f, -0.024233276f, 0.06462018f, -0.005283626f, -0.013013842f,
@@ -8222,7 +8222,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_head1_w[8192] = {
     -0.12475574f, -0.03629466f, 0.033303194f, -0.3021074f, -0.024899574f, -0.15785764f, 0.048285853f, -0.119957864f
 };
 /* box.head[1] bias, shape [64], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_head1_b[64] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_head1_b[64] = {
     0.44882584f, 0.4453283f, -0.51753f, 0.7966535f, -0.21483122f, 0.82025266f, 0.34428513f, 1.2106965f,
     0.55757546f, 0.08459817f, 0.6578879f, -0.4858892f, 0.90361226f, -0.13232738f, 0.31355682f, -0.22013292f,
     0.9344525f, 0.40612084f, -0.067189f, 0.7131613f, 0.45833442f, -0.17234342f, -0.2060284f, -1.0117929f,
@@ -8233,7 +8233,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_head1_b[64] = {
     0.22717133f, 0.18285444f, 0.82734495f, 0.408013f, 0.14451835f, 0.48946366f, 0.62204856f, 0.94584125f
 };
 /* box.head[2] weights, shape [64][39] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_head2_w[2496] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_head2_w[2496] = {
     -0.105679676f, 0.0020743378f, 0.10567773f, 0.05097194f, -0.22086465f, 0.14121766f, 0.16307096f, 0.14225464f,
     -0.18915206f, -0.4991092f, -0.15152682f, 0.16350882f, 0.18597415f, 0.21554045f, 0.009989972f, -0.015107765f,
     -0.04642332f, 0.17218551f, -0.07105722f, -0.04021243f, -0.0049141743f, 0.048889536f, 0.0644727f, 0.12618044f,
@@ -8548,7 +8548,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_head2_w[2496] = {
     0.019776905f, 0.026303422f, 0.023492662f, -0.01121123f, -0.014204075f, 0.12182468f, 0.032916736f, -0.030864567f
 };
 /* box.head[2] bias, shape [39], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_box_head2_b[39] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_box_head2_b[39] = {
     -0.00039061706f, 0.011185573f, -0.031340964f, -0.036486123f, -0.04649277f, -0.13504842f, 0.062326558f, -0.023121677f,
     0.1456349f, 0.06094418f, -0.022318603f, -0.037222356f, -0.17439766f, 0.011121398f, -0.039907984f, 0.09827628f,
     -0.014938158f, 0.04471349f, 0.123422556f, -0.034567963f, -0.032034796f, 0.02949185f, -0.119546555f, -0.06744637f,
@@ -8562,7 +8562,7 @@ static const lidet_pn_layer_t box_hdl64_box_head[3] = {
 };
 
 /* size templates, shape [3][3] (l, w, h), metres */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_hdl64_mean_size[9] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_hdl64_mean_size[9] = {
     3.883f, 1.629f, 1.526f, 1.763f, 0.597f, 1.737f, 0.844f, 0.661f,
     1.763f
 };

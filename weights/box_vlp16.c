@@ -8,7 +8,7 @@
 #endif
 
 /* tnet.point[0] weights, shape [3][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_point0_w[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_point0_w[96] = {
     -0.030603059f, -1.6631545f, -0.2571152f, 1.1122327f, -1.418283f, -0.09524222f, -1.0615178f, 1.1893018f,
     -0.14777355f, -1.391154f, -0.70222867f, -0.8159706f, -1.079566f, 1.3855554f, 0.18904881f, -1.2753754f,
     -1.165615f, 1.6455673f, 1.2566098f, -1.2636808f, 0.95285904f, 0.7402602f, 0.16482116f, 1.1973685f,
@@ -23,14 +23,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_point0_w[96] = {
     1.2001969f, -1.282531f, -1.4137437f, -1.1595862f, -1.2128862f, -1.0942489f, 1.2952104f, -0.9543669f
 };
 /* tnet.point[0] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_point0_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_point0_b[32] = {
     -0.04899554f, 0.08112959f, -0.023689704f, 0.0069592237f, -0.020050896f, -0.09841927f, 0.06515516f, -0.09595085f,
     -0.050291672f, 0.0068164496f, 0.056444846f, 0.17334828f, 0.09272779f, 0.0545823f, -0.044685803f, 0.08515181f,
     -0.015504208f, 0.22419651f, 0.04578166f, 0.069624f, 0.039716057f, 0.15220967f, 0.114553295f, 0.07777836f,
     0.048531767f, 0.046178903f, 0.014526596f, 0.008090556f, 0.09414577f, 0.101825126f, 0.025935223f, 0.1038532f
 };
 /* tnet.point[1] weights, shape [32][64] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_point1_w[2048] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_point1_w[2048] = {
     -0.1774091f, -0.14497001f, -0.8437401f, -0.32504368f, -0.5052637f, -0.27777144f, 0.069596f, -0.076810114f,
     0.25375617f, -0.17035487f, -0.025132988f, -0.20238581f, -0.15066323f, 0.042388152f, -0.06668483f, -0.24037074f,
     -0.13792956f, -0.064870596f, -0.23101707f, 0.08384889f, -0.15748328f, 0.1482323f, 0.023412319f, 0.28277773f,
@@ -289,7 +289,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_point1_w[2048] = 
     0.11700509f, -0.009751379f, -0.042325012f, -0.16930915f, -0.17194293f, -0.240227f, -0.23867464f, 0.22262621f
 };
 /* tnet.point[1] bias, shape [64], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_point1_b[64] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_point1_b[64] = {
     0.29147333f, 0.031331092f, 1.0082854f, 0.29207188f, 0.49962753f, 0.66024864f, -1.1160816f, -0.07990586f,
     -1.2967708f, 0.8102748f, 0.32941487f, -0.28183624f, 0.19955194f, 0.2849904f, -0.0018731058f, -0.4454153f,
     0.17565128f, -0.14563993f, 0.21220215f, 0.18297595f, 0.59693354f, -0.21098834f, -0.31322137f, 0.18969722f,
@@ -305,7 +305,7 @@ static const lidet_pn_layer_t box_vlp16_tnet_point[2] = {
 };
 
 /* tnet.pvle[0] weights, shape [3][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_pvle0_w[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_pvle0_w[96] = {
     -0.005009161f, -0.08129274f, -0.09640348f, -0.056251053f, 0.09124069f, -0.0148964f, -0.089588195f, -0.09700446f,
     0.086390935f, 0.08081604f, 0.08032233f, 0.046293177f, -0.049315106f, 0.087674886f, -0.04457523f, -0.093124695f,
     -0.08662806f, 0.03812643f, 0.07581451f, 0.0401266f, -0.06504541f, 0.053750128f, 0.05280307f, 0.029563675f,
@@ -320,14 +320,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_pvle0_w[96] = {
     0.023948481f, -0.028318983f, -0.0710322f, -0.0025490462f, 0.003116882f, 0.033382215f, -0.09154099f, 0.02250479f
 };
 /* tnet.pvle[0] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_pvle0_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_pvle0_b[32] = {
     1.3550411f, -0.86231965f, -0.07126503f, -1.2024369f, 0.14551908f, 1.4199089f, -0.28677505f, -0.30379045f,
     -0.4407439f, 0.8803012f, -0.44520286f, -1.1403979f, -1.3676311f, 0.47733214f, -1.4157296f, -0.6794164f,
     -0.81757426f, -0.80634415f, -0.72063166f, 1.4219033f, 0.9335835f, 1.2398894f, -1.1389306f, -1.3843948f,
     -0.3794362f, 0.3914879f, 1.0480866f, 0.150357f, -0.09231467f, -0.5014966f, 1.2697095f, -0.4179809f
 };
 /* tnet.pvle[1] weights, shape [32][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_pvle1_w[1024] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_pvle1_w[1024] = {
     0.38709491f, 0.24868263f, -0.06121521f, 0.43576157f, 0.117282234f, -0.051097482f, -0.19407646f, -0.1870079f,
     0.04817611f, -0.21908917f, 0.19316289f, -0.2047052f, -0.12872551f, -0.015545463f, -0.57032055f, -0.14609158f,
     -0.072042644f, 0.08935736f, -0.20610315f, 0.48915082f, 0.29453805f, -0.11553505f, 0.14829953f, 0.24215645f,
@@ -458,7 +458,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_pvle1_w[1024] = {
     -0.121011816f, -0.28256103f, -0.060476325f, -0.25003773f, 0.092778675f, -0.13520262f, 0.049902342f, -0.17517188f
 };
 /* tnet.pvle[1] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_pvle1_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_pvle1_b[32] = {
     1.2959759f, 0.81091917f, 0.35973272f, 1.1797322f, 0.56148225f, 0.65195185f, -0.9292749f, 0.55978817f,
     -0.8289629f, -0.33512208f, 0.05930701f, 0.5789398f, -0.013011311f, 0.88187236f, 1.2905679f, 1.2021728f,
     -1.0930449f, 0.20942889f, -0.12583783f, -0.28966472f, -0.07577049f, -0.1846737f, 0.41194475f, 0.69951415f,
@@ -470,7 +470,7 @@ static const lidet_pn_layer_t box_vlp16_tnet_pvle[2] = {
 };
 
 /* tnet.head[0] weights, shape [99][64] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_head0_w[6336] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_head0_w[6336] = {
     0.05593972f, -0.025798533f, -0.003353818f, 0.19214526f, 0.03814808f, 0.034216445f, 0.111693785f, 0.063056655f,
     -0.07602349f, 0.074424565f, -0.020194039f, -0.12280073f, 0.057500497f, -0.029862242f, -0.045365006f, -0.008276447f,
     0.010620878f, 0.0042501944f, 0.08347355f, 0.028808467f, -0.034549758f, -0.10028102f, -0.09361145f, -0.048101317f,
@@ -1265,7 +1265,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_head0_w[6336] = {
     0.014590591f, -0.06992231f, -0.026027242f, 0.08705826f, -0.07886006f, 0.03251475f, 0.02443458f, -0.004777603f
 };
 /* tnet.head[0] bias, shape [64], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_head0_b[64] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_head0_b[64] = {
     1.6645418f, 1.2803556f, 1.1845492f, -0.61649066f, -1.7367233f, 1.3258632f, 0.18668824f, -1.3390679f,
     1.3858713f, -0.5156801f, -1.3631666f, 0.58902586f, -0.857366f, 0.7521963f, -1.221264f, 1.1814448f,
     0.3002458f, -1.4567974f, 1.0730857f, 1.2439166f, -1.1197101f, 0.76604146f, 0.7961724f, 1.5446286f,
@@ -1276,7 +1276,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_head0_b[64] = {
     -1.5487834f, 1.0849144f, 1.1551571f, -0.8480831f, -0.93331337f, 0.70014703f, 0.5641785f, 0.23909853f
 };
 /* tnet.head[1] weights, shape [64][3] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_head1_w[192] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_head1_w[192] = {
     0.09595541f, 0.008007385f, -0.112231895f, -0.053669367f, 0.08464465f, 0.04293485f, 0.04256842f, 0.070292085f,
     -0.03908701f, -0.014568398f, 0.034069527f, -0.058176097f, 0.06911057f, -0.047679495f, 0.018354522f, -0.060729608f,
     -0.06754215f, 0.022599667f, -0.0111439405f, -0.022204975f, 0.12237999f, -0.024295194f, -0.019063257f, 0.09127957f,
@@ -1303,7 +1303,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_head1_w[192] = {
     -0.12802386f, 0.0071950825f, 0.06967015f, 0.048601493f, 0.031901844f, 0.07923583f, -0.04440861f, 0.057386316f
 };
 /* tnet.head[1] bias, shape [3], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_tnet_head1_b[3] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_tnet_head1_b[3] = {
     0.028999556f, 0.09925417f, 0.051618297f
 };
 static const lidet_pn_layer_t box_vlp16_tnet_head[2] = {
@@ -1312,7 +1312,7 @@ static const lidet_pn_layer_t box_vlp16_tnet_head[2] = {
 };
 
 /* box.point[0] weights, shape [3][48] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_point0_w[144] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_point0_w[144] = {
     1.4826854f, 0.08955643f, -0.49033254f, 1.1669219f, -1.5846494f, -0.88359153f, -0.51589274f, -0.7209956f,
     1.191615f, -1.7249327f, -1.3856467f, 0.6725905f, 0.2200932f, -1.3217385f, 0.18308717f, -0.82680094f,
     0.51355875f, -0.489692f, 0.7437637f, 0.6700708f, 0.6653311f, -1.741553f, -1.5237768f, 1.0918169f,
@@ -1333,7 +1333,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_point0_w[144] = {
     0.69292766f, 1.4181058f, 0.8758557f, -1.5425917f, -1.3439814f, -1.045866f, 0.2519292f, 1.5433539f
 };
 /* box.point[0] bias, shape [48], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_point0_b[48] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_point0_b[48] = {
     0.6506605f, -0.016373804f, -0.16010287f, 0.57587814f, -0.60774714f, -0.3139422f, -0.19220883f, -0.3074772f,
     0.6224692f, -0.5946393f, -0.50639904f, 0.33486462f, 0.13932201f, -0.3911087f, 0.10544042f, -0.30667824f,
     0.220795f, -0.17013913f, 0.26128867f, 0.34013835f, 0.2861387f, -0.7193328f, -0.69483113f, 0.46059325f,
@@ -1342,7 +1342,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_point0_b[48] = {
     -0.4761493f, 0.02397281f, 0.26824555f, 0.42470473f, 0.17360184f, -0.5784812f, -0.27972424f, 0.29258946f
 };
 /* box.point[1] weights, shape [48][96] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_point1_w[4608] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_point1_w[4608] = {
     0.086313814f, -0.3693348f, -0.005643663f, 0.31003606f, 0.26929742f, 0.3178f, -0.27576473f, -0.19178069f,
     0.22741021f, -0.14630435f, -0.15177791f, 0.11861101f, 0.22546694f, 0.035423987f, 0.11870027f, 0.14152458f,
     -0.060510002f, -0.13742694f, 0.0039267163f, -0.16703194f, -0.19639835f, -0.016371526f, 0.051692877f, 0.2983187f,
@@ -1921,7 +1921,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_point1_w[4608] = {
     0.19475073f, 0.02455135f, -0.022135645f, 0.21931614f, 0.031294495f, 0.14673044f, 0.2702993f, 0.2914819f
 };
 /* box.point[1] bias, shape [96], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_point1_b[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_point1_b[96] = {
     0.81305104f, 1.6081855f, -0.72946155f, 0.5414181f, 1.1032606f, -0.39488223f, 0.36368427f, 1.2444373f,
     -1.0149578f, -0.2225911f, 0.038471352f, 0.25514978f, 1.2797141f, 1.3402494f, 0.56465065f, -0.9841496f,
     -1.2037117f, -1.4363041f, 0.29301873f, -1.3752655f, 0.92162f, -0.15830734f, 0.49026018f, -1.4567523f,
@@ -1936,7 +1936,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_point1_b[96] = {
     1.250682f, 1.1432929f, 0.7650394f, 1.2058117f, 1.4499304f, -0.010322884f, 0.96538097f, 1.1262451f
 };
 /* box.point[2] weights, shape [96][160] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_point2_w[15360] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_point2_w[15360] = {
     -0.066324785f, -0.026327742f, 0.008112795f, 0.118700914f, -0.101870455f, 0.23765168f, 0.13490501f, 0.026961844f,
     0.06489209f, -0.13816f, 0.16331315f, -0.21281967f, -0.10300946f, 0.20509417f, 0.068165f, 0.1342778f,
     -0.0049742893f, -0.040962968f, 0.064534925f, 0.08668312f, 0.08030752f, 0.3429867f, 0.024447339f, -0.0058655194f,
@@ -3859,7 +3859,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_point2_w[15360] = 
     0.13471983f, -0.003889779f, -0.06672427f, -0.16988964f, -0.26769614f, -0.15044822f, -0.100471325f, 0.057158947f
 };
 /* box.point[2] bias, shape [160], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_point2_b[160] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_point2_b[160] = {
     1.1489029f, 0.9350699f, 0.5583045f, -0.66897964f, 1.1794584f, 0.25646743f, -0.24342586f, 0.46836722f,
     0.39521223f, -0.4630259f, 1.0874648f, -0.041080087f, -0.028125258f, -0.33729938f, 0.84909123f, 0.5688325f,
     0.1454788f, -0.32737714f, 0.17036268f, -0.11927964f, 1.081062f, -0.84637594f, 1.3465481f, 0.7697288f,
@@ -3888,7 +3888,7 @@ static const lidet_pn_layer_t box_vlp16_box_point[3] = {
 };
 
 /* box.pvle[0] weights, shape [3][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_pvle0_w[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_pvle0_w[96] = {
     -0.0096518025f, -0.065607995f, -0.06525179f, 0.028021252f, 0.06988166f, 0.08644491f, -0.06686071f, -0.05848631f,
     0.08492742f, 0.06994585f, 0.06811357f, -0.08315206f, 0.0516144f, 0.06455917f, 0.06779883f, -0.083691575f,
     0.047257062f, -0.010206487f, -0.04688975f, -0.0675902f, 0.09196407f, -0.0515175f, 0.051435515f, 0.06600029f,
@@ -3903,14 +3903,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_pvle0_w[96] = {
     0.085283145f, 0.002647574f, -0.059626643f, -0.0361169f, -0.027589314f, 0.020784322f, -0.058746826f, -0.030571185f
 };
 /* box.pvle[0] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_pvle0_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_pvle0_b[32] = {
     1.5048918f, -1.0882862f, -1.0710902f, 1.4672118f, 0.9025431f, -0.50627816f, 0.95143265f, -1.2590946f,
     -0.542751f, -0.92585415f, -0.91924167f, -0.76061535f, -1.0848463f, 1.2170662f, -0.4207443f, -0.8484527f,
     -1.2687417f, -1.3447461f, -1.3190607f, -1.0269699f, -0.07607096f, -1.4775505f, 1.2928851f, 1.057895f,
     -1.3174889f, -0.11260088f, 0.8798027f, 0.5108734f, 0.46715403f, -0.2726447f, 0.9397632f, 0.15605736f
 };
 /* box.pvle[1] weights, shape [32][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_pvle1_w[1024] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_pvle1_w[1024] = {
     0.11072485f, -0.7591974f, 0.1548511f, -0.31451342f, 0.012997048f, -0.23945054f, 0.022495901f, -0.5390725f,
     -0.22922082f, -0.061800625f, 0.12247091f, -0.5031871f, 0.35080543f, -0.07373954f, 0.6597014f, 0.08333151f,
     0.07751747f, -0.48595303f, 0.0792362f, -0.20416522f, -0.22109938f, 0.35041344f, -0.1332055f, -0.2895728f,
@@ -4041,7 +4041,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_pvle1_w[1024] = {
     -0.07095894f, -0.12677895f, -0.5029534f, 0.24728346f, 0.38901797f, 0.10248796f, -0.30727485f, 0.20453691f
 };
 /* box.pvle[1] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_pvle1_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_pvle1_b[32] = {
     0.558253f, 0.6118867f, 0.5368083f, -0.18001083f, 0.674816f, 1.063903f, 0.9840865f, 0.006987928f,
     -1.5818295f, 0.09387918f, 0.23175234f, -0.6168522f, 0.35527688f, 0.98572606f, 0.6414641f, 0.38447362f,
     0.08988759f, 0.8072193f, 0.56782895f, -1.2085857f, 0.75602883f, 0.6403575f, 1.0761418f, 0.4673669f,
@@ -4053,7 +4053,7 @@ static const lidet_pn_layer_t box_vlp16_box_pvle[2] = {
 };
 
 /* box.head[0] weights, shape [195][128] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_head0_w[24960] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_head0_w[24960] = {
     -0.1264782f, -0.049613543f, 0.048747532f, -0.020100268f, -0.018881248f, 0.021067634f, -0.056376286f, 0.07918813f,
     -0.1518121f, -0.094473034f, 0.012099669f, -0.0040472597f, -0.050067376f, 0.16100755f, -0.07808161f, -0.098133035f,
     -0.12430707f, -0.036562547f, -0.039896227f, 0.12290462f, 0.071256585f, 0.020704199f, -0.06285799f, -0.11018982f,
@@ -7176,7 +7176,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_head0_w[24960] = {
     0.011422473f, -0.059545375f, -0.052216887f, -0.06095392f, -0.029883621f, -0.055807434f, -0.0038047256f, 0.006359951f
 };
 /* box.head[0] bias, shape [128], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_head0_b[128] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_head0_b[128] = {
     -1.0014371f, 2.4266436f, 0.6498645f, 0.14913557f, 0.082843214f, -0.15799026f, -1.0209286f, -0.30419955f,
     0.6907592f, -0.7217311f, -0.83260924f, -0.33352882f, -0.26275378f, 0.8047805f, 0.95167565f, -0.03504677f,
     1.5654293f, 1.5296966f, -2.0078902f, -0.24595091f, -2.4639735f, 0.68866986f, -1.1183404f, 0.864352f,
@@ -7195,7 +7195,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_head0_b[128] = {
     -0.07493353f, 0.92441684f, -1.0615991f, -0.16271764f, 0.17199428f, -2.3019652f, -1.1975974f, -1.3259813f
 };
 /* box.head[1] weights, shape [128][64] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_head1_w[8192] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_head1_w[8192] = {
     0.056925427f, -0.0664048f, 0.11790799f, -0.05416634f, 0.080575444f, -0.08737559f, -0.084723525f, -0.04217136f,
     0.020448077f, 0.012520075f, 0.03536636f, 0.07878985f, -0.10230881f, 0.050418112f, 0.07094665f, 0.10367133f,
     0.06896707f, -0.01662572f, -0.09161127f, 0.07370535f, -0.14696187f, 0.12867716f, -0.03977714f, 0.028825821f,
@@ -8222,7 +8222,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_head1_w[8192] = {
     0.0757333f, 0.0061878394f, -0.039205175f, -0.2779382f, 0.043137237f, -0.11972489f, -0.063441485f, -0.20072994f
 };
 /* box.head[1] bias, shape [64], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_head1_b[64] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_head1_b[64] = {
     0.418946f, 0.3207452f, -0.19135493f, 0.26836568f, 0.376295f, 0.7997698f, 0.3169587f, 1.4382721f,
     0.37029114f, 0.5280354f, 0.60621256f, -0.23846631f, 0.96435004f, 1.5373724f, 0.3280864f, 0.58119065f,
     0.80463994f, 0.5768676f, -0.0052607423f, 0.69534254f, 1.046383f, 0.17157051f, 1.0779362f, 0.5160613f,
@@ -8233,7 +8233,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_head1_b[64] = {
     0.4400328f, 0.6556144f, -0.2530874f, 0.4077195f, 0.10070466f, 0.60137725f, 0.70742244f, 1.4444551f
 };
 /* box.head[2] weights, shape [64][39] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_head2_w[2496] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_head2_w[2496] = {
     -0.101737306f, 0.0033987754f, 0.09853899f, -0.25743556f, -0.19588746f, 0.19983274f, 0.2721893f, 0.14335091f,
     -0.35045302f, -0.27362826f, -0.11502768f, 0.23742776f, 0.20975403f, 0.22782002f, -0.21692954f, 0.07093774f,
     -0.035039812f, 0.1509424f, -0.08695957f, -0.12074436f, 0.007891075f, 0.08449244f, 0.10143952f, 0.1315078f,
@@ -8548,7 +8548,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_head2_w[2496] = {
     0.016760077f, 0.028952878f, -0.013326715f, 0.035275478f, -0.03750995f, 0.0858342f, 0.010021571f, 0.0038657929f
 };
 /* box.head[2] bias, shape [39], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_box_head2_b[39] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_box_head2_b[39] = {
     -0.0029579152f, 0.014731796f, -0.026736682f, -0.06530474f, 0.011980753f, -0.08789428f, 0.114091925f, -0.051311847f,
     0.1251697f, -0.004099346f, -0.042602297f, -0.007846952f, -0.022186924f, -0.0016110108f, -0.0056563476f, 0.11075692f,
     -0.025754431f, 0.022230146f, 0.112724565f, -0.0767333f, -0.031537842f, 0.022581017f, -0.12295568f, -0.070791334f,
@@ -8562,7 +8562,7 @@ static const lidet_pn_layer_t box_vlp16_box_head[3] = {
 };
 
 /* size templates, shape [3][3] (l, w, h), metres */
-LIDET_ALIGN(16) LIDET_RODATA static const float box_vlp16_mean_size[9] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float box_vlp16_mean_size[9] = {
     3.883f, 1.629f, 1.526f, 1.763f, 0.597f, 1.737f, 0.844f, 0.661f,
     1.763f
 };

@@ -8,7 +8,7 @@
 #endif
 
 /* cls.point[0] weights, shape [3][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_point0_w[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_point0_w[96] = {
     -0.26779327f, -1.3697598f, -0.18402816f, 0.7388563f, -1.1042881f, 0.15599543f, -1.1181488f, 1.0526257f,
     -0.2744124f, -1.2849936f, -0.7261114f, -0.70680094f, -1.1097794f, 1.2295878f, 0.09227131f, -0.9923948f,
     -1.0244597f, 1.4091134f, 1.0966481f, -0.9948163f, 1.0721537f, 0.6659758f, 0.353682f, 1.1939269f,
@@ -23,14 +23,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_point0_w[96] = {
     1.211851f, -1.3441983f, -1.8679453f, -1.1628429f, -0.4057205f, -1.0531721f, 1.2352151f, -0.7646254f
 };
 /* cls.point[0] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_point0_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_point0_b[32] = {
     0.016169293f, 0.11953075f, 0.11081656f, 0.09894852f, -0.04311539f, 0.03028152f, 0.04574069f, 0.064589836f,
     -0.02852127f, 0.15036792f, 0.11706925f, -0.019463724f, 0.06501497f, 0.011433263f, 0.038347706f, 0.08158872f,
     0.042172186f, -0.040812273f, 0.10454621f, 0.14711036f, 0.06689228f, 0.045694783f, 0.107345656f, 0.10887202f,
     0.05050671f, 0.00921633f, 0.002004859f, 0.006073673f, 0.029589437f, 0.0151448045f, -0.103129186f, -0.040440194f
 };
 /* cls.point[1] weights, shape [32][64] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_point1_w[2048] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_point1_w[2048] = {
     -0.19991043f, -0.13971205f, -0.6217152f, -0.2866915f, -0.44646955f, -0.1310859f, 0.09981935f, 0.021499775f,
     0.1285919f, -0.12060859f, 0.02879817f, -0.37164554f, -0.1147557f, 0.10884253f, -0.08200519f, -0.12556987f,
     -0.13892728f, -0.100467965f, -0.3403089f, -0.014474934f, -0.20157605f, 0.123288706f, 0.1037016f, 0.2929839f,
@@ -289,7 +289,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_point1_w[2048] = {
     0.014215654f, 0.13516033f, 0.02911594f, -0.12399266f, -0.2573569f, -0.29466885f, -0.22899683f, 0.1951861f
 };
 /* cls.point[1] bias, shape [64], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_point1_b[64] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_point1_b[64] = {
     1.0976897f, -0.09872377f, 0.8989226f, 0.32460314f, 0.9867001f, 1.0408692f, -1.0482689f, 0.050836436f,
     -0.76849717f, 0.9700953f, 0.5739461f, 0.31267834f, 0.9505821f, 0.37958866f, -0.092721134f, 0.43897542f,
     0.07997294f, -0.33371896f, 0.4264323f, 0.4873542f, 0.76169205f, -0.2325379f, -0.52978796f, -0.23395696f,
@@ -300,7 +300,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_point1_b[64] = {
     0.5934018f, 0.92427623f, -0.7056756f, -0.7371838f, 0.5647613f, 1.2676848f, 0.3459089f, 0.6532688f
 };
 /* cls.point[2] weights, shape [64][128] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_point2_w[8192] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_point2_w[8192] = {
     -0.043406546f, -0.3669945f, 0.24115808f, -0.5551385f, 0.11800668f, -0.26032412f, -0.29506603f, 0.050857052f,
     0.050737374f, -0.18361835f, -0.03200781f, -0.10491159f, 0.37568694f, 0.20775388f, 0.086417615f, -0.4771589f,
     0.7956413f, -0.14300267f, -0.2752193f, -0.098523416f, 0.27991846f, -0.03229574f, 0.09435463f, 0.12923242f,
@@ -1327,7 +1327,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_point2_w[8192] = {
     -0.29399768f, -0.079810746f, -0.255938f, 0.27790177f, 0.4998882f, 0.18086323f, 0.23665579f, -0.36725375f
 };
 /* cls.point[2] bias, shape [128], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_point2_b[128] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_point2_b[128] = {
     0.24289012f, 0.55646306f, 1.1115142f, 1.0059853f, 1.2812303f, 0.4700273f, 0.9743626f, 1.3682678f,
     0.88778937f, 0.43030673f, -0.20643191f, -0.1575888f, -0.35633716f, 0.14010936f, 0.80252695f, 1.2823533f,
     -0.21629417f, 0.83623713f, 0.75198114f, 1.4822537f, 0.49672434f, 1.539056f, -0.23980777f, 0.83026195f,
@@ -1352,7 +1352,7 @@ static const lidet_pn_layer_t cls_hdl64_cls_point[3] = {
 };
 
 /* cls.pvle[0] weights, shape [3][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_pvle0_w[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_pvle0_w[96] = {
     0.09202717f, -0.009757384f, -0.024687784f, -0.0769573f, 0.032152064f, -0.05326201f, -0.030471647f, -0.04556518f,
     0.01858168f, 0.06291523f, -0.051157486f, -0.042756174f, -0.0026567988f, 0.016907042f, -0.020253522f, 0.068511166f,
     0.032803267f, 0.081777535f, -0.026120385f, -0.04124811f, 0.045803864f, 0.08107711f, 0.027871056f, 0.09037865f,
@@ -1367,14 +1367,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_pvle0_w[96] = {
     0.051866733f, -0.056575287f, 0.061787058f, -0.0687865f, -0.059094965f, -0.045895852f, 0.060246132f, 0.031934243f
 };
 /* cls.pvle[0] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_pvle0_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_pvle0_b[32] = {
     -0.23634404f, -1.6276684f, 1.6945904f, -0.76843774f, -1.6020795f, -1.3127905f, -1.5388416f, 1.3921376f,
     1.7281992f, -1.0186379f, 1.184883f, -1.5130397f, -1.6842469f, 1.4372578f, 1.4757179f, -1.1107169f,
     -1.4439038f, 0.9258854f, -1.5986172f, 1.5950034f, -1.4254159f, 0.71636873f, -1.5535343f, 0.099204704f,
     -1.3381076f, 1.5344912f, -1.9171023f, 2.9911532f, 1.5699054f, 1.1352323f, -1.6099524f, -0.9537258f
 };
 /* cls.pvle[1] weights, shape [32][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_pvle1_w[1024] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_pvle1_w[1024] = {
     -0.15242706f, -0.58263725f, -0.011779411f, 0.07771241f, 0.05308822f, 0.113220766f, 0.15424877f, 0.117464885f,
     0.13064754f, -0.26371324f, -0.18042853f, 0.2566104f, 0.02459161f, 0.19299483f, 0.060367834f, -0.036359034f,
     0.37807462f, -0.12046932f, 0.0048708306f, 0.23198014f, 0.4378716f, 0.11824862f, 0.0007117212f, -0.37040803f,
@@ -1505,7 +1505,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_pvle1_w[1024] = {
     -0.19587418f, -0.3935659f, 0.7846535f, -0.35569876f, 0.100508325f, -0.32138363f, 0.30242625f, 0.124178864f
 };
 /* cls.pvle[1] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_pvle1_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_pvle1_b[32] = {
     0.38745427f, 1.1845441f, 0.69542897f, 0.9974842f, 0.6723079f, 0.6461584f, -0.037851095f, -0.23217294f,
     0.5599442f, 0.41558376f, -0.035087258f, -1.6237462f, -0.79267806f, 0.66854584f, 0.18546073f, 0.81448436f,
     -1.138941f, -0.8213336f, 0.31537133f, -0.9088012f, -0.7069991f, -0.647978f, 0.8238714f, 0.86876744f,
@@ -1517,7 +1517,7 @@ static const lidet_pn_layer_t cls_hdl64_cls_pvle[2] = {
 };
 
 /* cls.head[0] weights, shape [160][64] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_head0_w[10240] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_head0_w[10240] = {
     0.06861703f, 0.054063145f, 0.048377506f, -0.14558388f, 0.0715993f, 0.20564513f, -0.11198445f, -0.06509509f,
     -0.042967543f, 0.0826687f, -0.2364015f, -0.22889778f, -0.045053784f, 0.021266522f, 0.05084369f, 0.055908997f,
     0.07987747f, -0.25738552f, -0.006801634f, 0.08289519f, -0.3790018f, -0.1074076f, 0.02514311f, 0.11564567f,
@@ -2800,7 +2800,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_head0_w[10240] = {
     0.12416406f, 0.058860872f, 0.041908797f, -0.2504649f, -0.16176476f, 0.1706331f, -0.19380385f, -0.1909602f
 };
 /* cls.head[0] bias, shape [64], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_head0_b[64] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_head0_b[64] = {
     -0.5956872f, -1.5900896f, -2.7679844f, -4.932245f, -4.856502f, 0.9775981f, 1.6769775f, -3.2850418f,
     4.142955f, 0.28869787f, -0.48126283f, -5.1470547f, 3.8115258f, 0.63142747f, 3.1894066f, -6.445512f,
     -1.5002855f, -5.806656f, -1.5647568f, -2.1129801f, 0.13816512f, 6.0044823f, 2.6530955f, -1.3486683f,
@@ -2811,7 +2811,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_head0_b[64] = {
     -1.6222792f, 4.5698266f, -4.620102f, -1.54401f, 0.059192218f, -5.2397633f, -0.7319429f, -0.25696048f
 };
 /* cls.head[1] weights, shape [64][3] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_head1_w[192] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_head1_w[192] = {
     0.23055579f, -0.19813181f, -0.07337351f, 0.18882741f, -0.2574308f, -0.19178031f, 0.174978f, -0.27768373f,
     -0.08977493f, 0.20220253f, 0.24043791f, -0.14701426f, 0.024146684f, 0.18573771f, -0.23244381f, 0.23988678f,
     -0.24514449f, 0.041849144f, 0.22758387f, -0.014238444f, -0.0002504526f, 0.15102395f, 0.01805021f, -0.3116191f,
@@ -2838,7 +2838,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_head1_w[192] = {
     0.2581063f, -0.26582488f, -0.09526749f, 0.18234736f, 0.19280702f, 0.238216f, -0.0191181f, -0.0029260286f
 };
 /* cls.head[1] bias, shape [3], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_hdl64_cls_head1_b[3] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_hdl64_cls_head1_b[3] = {
     0.05639175f, -0.048951883f, 0.05503408f
 };
 static const lidet_pn_layer_t cls_hdl64_cls_head[2] = {

@@ -8,7 +8,7 @@
 #endif
 
 /* cls.point[0] weights, shape [3][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_point0_w[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_point0_w[96] = {
     -0.16839965f, -1.4802586f, -0.12661421f, 0.7413025f, -1.4077408f, 0.2286965f, -1.2297759f, 1.3011587f,
     -0.49477983f, -1.4006045f, -0.6904679f, -0.6551821f, -1.1714401f, 1.263612f, 0.20598206f, -1.028718f,
     -1.2202467f, 1.6833206f, 1.1837273f, -1.1488441f, 1.0853008f, 0.8082707f, 0.31997716f, 1.2217242f,
@@ -23,14 +23,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_point0_w[96] = {
     1.1619382f, -1.3080215f, -1.8912948f, -1.14342f, -0.49636433f, -1.4548753f, 1.3538873f, -0.97423804f
 };
 /* cls.point[0] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_point0_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_point0_b[32] = {
     0.00553465f, 0.08490554f, 0.040110283f, 0.014073082f, 0.024625959f, -7.8563346e-05f, 0.015570552f, 0.025734797f,
     -0.015359768f, 0.093483716f, 0.088399045f, 0.08807121f, 0.058860105f, -0.011890352f, 0.014693035f, 0.047353115f,
     0.030401725f, 0.041390233f, -0.015602766f, 0.118489414f, 0.027281033f, 0.060717624f, 0.025042804f, 0.08997144f,
     0.014679247f, 0.0005097046f, 0.011298355f, 0.07568419f, 0.095519535f, 0.03186616f, -0.06126873f, -0.045180995f
 };
 /* cls.point[1] weights, shape [32][64] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_point1_w[2048] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_point1_w[2048] = {
     -0.19052982f, -0.10268635f, -0.6189693f, -0.44690803f, -0.6005244f, -0.21719238f, 0.09840823f, 0.013301358f,
     0.08334291f, -0.10173704f, -0.0697979f, -0.23921873f, -0.16802517f, 0.2051072f, -0.09229484f, -0.27287757f,
     -0.10604021f, -0.1983218f, -0.2904922f, -0.118086934f, -0.17484008f, 0.073580265f, 0.065232f, 0.27577215f,
@@ -289,7 +289,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_point1_w[2048] = {
     0.035159428f, 0.180885f, -0.023876302f, -0.13515437f, -0.22507228f, -0.14095987f, -0.23954761f, 0.1806267f
 };
 /* cls.point[1] bias, shape [64], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_point1_b[64] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_point1_b[64] = {
     0.7856933f, 0.39647403f, 0.72327405f, 0.05072073f, 0.72448313f, 1.0052327f, -1.1104615f, 0.24038443f,
     -0.9049404f, 0.84690833f, 0.8117131f, 0.03725507f, 0.92282045f, 0.032965217f, -0.07234754f, 0.4944393f,
     0.22122517f, -0.37138313f, 0.5764552f, 0.65391695f, 0.5013977f, 0.12551324f, 0.36539063f, -0.3677351f,
@@ -300,7 +300,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_point1_b[64] = {
     0.9095461f, 0.9460354f, -0.3164807f, 0.16021408f, 0.5254972f, 0.99863696f, 0.34060064f, 0.4482446f
 };
 /* cls.point[2] weights, shape [64][128] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_point2_w[8192] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_point2_w[8192] = {
     -0.01718497f, -0.4134985f, 0.1386955f, -0.27397794f, 0.15795518f, -0.2969303f, -0.113425344f, 0.07654615f,
     -0.040618256f, -0.23733002f, 0.03123859f, -0.042368848f, 0.2346677f, 0.24271546f, 0.06804137f, -0.4375861f,
     0.2358155f, -0.29162997f, -0.5489121f, -0.22252588f, 0.38419813f, -0.2003109f, -0.0826415f, 0.046542376f,
@@ -1327,7 +1327,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_point2_w[8192] = {
     -0.58963245f, -0.11584274f, -0.24093893f, 0.336561f, 0.40536714f, 0.19799267f, 0.052574392f, -0.4465558f
 };
 /* cls.point[2] bias, shape [128], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_point2_b[128] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_point2_b[128] = {
     0.47809297f, -0.29569736f, 1.0980091f, 0.532685f, 1.3207369f, 1.1693852f, 0.5245578f, 1.1792018f,
     0.42260644f, 1.1427609f, -0.5544801f, 1.1034317f, 0.14956784f, -0.08169643f, 1.1548016f, 1.0198194f,
     0.22679007f, 0.8458033f, 0.81545615f, 1.5967962f, 0.6576094f, 0.9848913f, 0.48552188f, 0.23388864f,
@@ -1352,7 +1352,7 @@ static const lidet_pn_layer_t cls_vlp16_cls_point[3] = {
 };
 
 /* cls.pvle[0] weights, shape [3][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_pvle0_w[96] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_pvle0_w[96] = {
     0.095735826f, -0.01780739f, -0.00417902f, -0.09735658f, 0.053576406f, -0.061802287f, -0.037178397f, -0.076914236f,
     0.014072493f, 0.07523405f, -0.0597952f, -0.068648644f, -0.029850688f, 0.034752645f, -0.02573668f, 0.073997304f,
     0.052166615f, 0.094257064f, -0.038962718f, -0.051919088f, 0.07481365f, 0.087875254f, 0.04340328f, 0.093054466f,
@@ -1367,14 +1367,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_pvle0_w[96] = {
     0.058439158f, -0.08702815f, 0.09781805f, -0.10255511f, -0.102609366f, -0.07933941f, 0.09564181f, 0.04353371f
 };
 /* cls.pvle[0] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_pvle0_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_pvle0_b[32] = {
     0.008522656f, -1.5049013f, 1.7459059f, -0.32953617f, -1.2669424f, -1.1766888f, -1.4834552f, 0.71440107f,
     1.3870614f, -0.7930941f, 0.8690414f, -1.1985317f, -1.4343612f, 1.351985f, 1.4649274f, -0.8197134f,
     -1.1228944f, 0.13461004f, -1.3856779f, 1.169279f, -0.7663074f, -0.070569694f, -1.2390639f, 0.16814707f,
     -0.86885095f, 1.2757602f, -1.5490078f, 1.710379f, 1.6240302f, 1.1347859f, -1.3721339f, -0.6903658f
 };
 /* cls.pvle[1] weights, shape [32][32] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_pvle1_w[1024] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_pvle1_w[1024] = {
     -0.11927131f, -0.6947064f, -0.02638343f, 0.27024263f, 0.14988585f, 0.14370023f, 0.22008191f, 0.2978382f,
     0.14911588f, -0.30182898f, -0.20282564f, 0.16781197f, -0.08165509f, 0.23633222f, -0.1243069f, -0.020242723f,
     0.33859837f, -0.10565976f, 0.036207933f, 0.41444615f, 0.29373348f, 0.13498586f, -0.04749197f, -0.2084376f,
@@ -1505,7 +1505,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_pvle1_w[1024] = {
     -0.22236854f, -0.56877977f, 0.12195659f, -0.09504596f, 0.07119659f, -0.1976709f, 0.4863234f, 0.25782531f
 };
 /* cls.pvle[1] bias, shape [32], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_pvle1_b[32] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_pvle1_b[32] = {
     0.2768063f, 1.1849067f, 0.15198784f, -0.23976788f, 0.40766275f, 0.6373501f, 0.092702635f, -0.9165734f,
     0.3981485f, -1.7106707f, -0.32673854f, -0.7730502f, -1.0688379f, 0.8874707f, 0.4496141f, 1.0189939f,
     -1.3344584f, -0.5297878f, 1.3543786f, -1.7196885f, -0.9862036f, -0.35659766f, 0.9214003f, 0.42569378f,
@@ -1517,7 +1517,7 @@ static const lidet_pn_layer_t cls_vlp16_cls_pvle[2] = {
 };
 
 /* cls.head[0] weights, shape [160][64] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_head0_w[10240] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_head0_w[10240] = {
     0.059921857f, -0.0805488f, 0.0044858498f, 0.01118782f, 0.1824663f, 0.15970989f, -0.14494482f, -0.115322046f,
     -0.13659397f, 0.024814487f, -0.19361532f, -0.150179f, -0.1262019f, -0.0071350406f, 0.06970757f, -0.06500849f,
     0.18263268f, -0.16007635f, -0.013025384f, 0.12741292f, -0.24751002f, -0.1039261f, 0.05167251f, -0.03770218f,
@@ -2800,7 +2800,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_head0_w[10240] = {
     0.037389632f, 0.032168284f, 0.11808332f, -0.15513547f, -0.2802379f, 0.14837417f, -0.23255014f, -0.02244306f
 };
 /* cls.head[0] bias, shape [64], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_head0_b[64] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_head0_b[64] = {
     -1.894111f, -2.3909328f, -0.42965895f, -3.4234884f, -6.8446956f, 3.0860536f, -1.713027f, -6.4531846f,
     3.6292903f, -2.686504f, 1.0809427f, -6.5673633f, 5.598581f, -1.1295878f, -2.029457f, 1.8894936f,
     2.8666706f, -6.4748344f, -6.7153196f, 0.40819925f, -0.30301145f, -3.6110802f, -2.0335846f, 5.257599f,
@@ -2811,7 +2811,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_head0_b[64] = {
     -2.2329092f, -4.0692277f, -0.4710287f, -1.719463f, 0.13075206f, -3.2588372f, -1.737691f, -0.6213786f
 };
 /* cls.head[1] weights, shape [64][3] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_head1_w[192] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_head1_w[192] = {
     0.2086785f, -0.29727226f, -0.16498342f, 0.19803898f, -0.26785204f, -0.19061893f, 0.14260028f, -0.30435637f,
     -0.10603758f, 0.26752847f, 0.18432708f, -0.026327953f, -0.006737207f, 0.2334124f, -0.27011022f, 0.23725995f,
     -0.19565472f, 0.012481478f, 0.19864202f, -0.06059973f, -0.05969801f, 0.029805869f, 0.1317192f, -0.2977825f,
@@ -2838,7 +2838,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_head1_w[192] = {
     0.16001411f, -0.2513312f, -0.12748705f, 0.17452383f, 0.18756518f, 0.22334696f, -0.10825893f, -0.046662454f
 };
 /* cls.head[1] bias, shape [3], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float cls_vlp16_cls_head1_b[3] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float cls_vlp16_cls_head1_b[3] = {
     0.025087742f, -0.046636004f, 0.0368752f
 };
 static const lidet_pn_layer_t cls_vlp16_cls_head[2] = {

@@ -251,6 +251,9 @@ void lidet_workspace_sizes(lidet_workspace_sizes_t *out)
     out->overlay_ground = (uint32_t)sizeof w->overlay.ground;
     out->overlay_cluster = (uint32_t)sizeof w->overlay.cluster;
     out->overlay = (uint32_t)sizeof w->overlay;
+#ifdef LIDET__WS_ALIAS_GAP
+    out->alias_gap = (uint32_t)sizeof w->alias_gap;
+#endif
     out->total = (uint32_t)sizeof(lidet_workspace_t);
     out->stages_standalone = lidet_proj_bytes() + lidet_ground_bytes() + lidet_cluster_bytes();
 }

@@ -446,8 +446,20 @@ static void test_workspace_sizes(void)
     big = s.overlay_proj > s.overlay_ground ? s.overlay_proj : s.overlay_ground;
     big = big > s.overlay_cluster ? big : s.overlay_cluster;
     TEST_ASSERT_TRUE(s.overlay >= big && s.overlay < big + 16u);
-    TEST_ASSERT_TRUE(s.total >= s.proj_state + s.ground_state + s.cluster_state + s.image + s.ground_mask + s.overlay);
-    TEST_ASSERT_TRUE(s.total < s.proj_state + s.ground_state + s.cluster_state + s.image + s.ground_mask + s.overlay + 64u);
+    TEST_ASSERT_TRUE(s.total >= s.proj_state + s.ground_state + s.cluster_state + s.image + s.ground_mask +
+                                    s.alias_gap + s.overlay);
+    TEST_ASSERT_TRUE(s.total < s.proj_state + s.ground_state + s.cluster_state + s.image + s.ground_mask +
+                                   s.alias_gap + s.overlay + 64u);
+#if defined(__x86_64__)
+    {
+        /* the gap puts a pixel's label 2 KiB + 64 B (+ alignment) from its range, modulo 4 KiB */
+        const size_t d = (size_t)((const uint8_t *)&g_ws.ws.overlay.cluster.labels[0] - (const uint8_t *)&g_ws.ws.range_4mm[0]);
+        TEST_ASSERT_TRUE(s.alias_gap >= 64u && s.alias_gap < 4096u + 64u);
+        TEST_ASSERT_TRUE(d % 4096u >= 2048u && d % 4096u < 2048u + 64u + 16u);
+    }
+#else
+    TEST_ASSERT_EQUAL_UINT32(0u, s.alias_gap);
+#endif
     TEST_ASSERT_EQUAL_UINT32(lidet_proj_bytes() + lidet_ground_bytes() + lidet_cluster_bytes(), s.stages_standalone);
     TEST_ASSERT_TRUE(s.total < s.stages_standalone);
 }

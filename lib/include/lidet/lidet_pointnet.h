@@ -47,8 +47,8 @@
 extern "C" {
 #endif
 
-/* Generated arrays are declared with LIDET_ALIGN(16) LIDET_RODATA (lidet_opt.h: a port may place them in a
- * flash section). */
+/* Generated arrays are declared with LIDET_ALIGN(64) LIDET_RODATA (float; the int8 ones LIDET_ALIGN(16)) (lidet_opt.h:
+ * a port may place them in a flash section). */
 
 /** Scratch bytes for a model whose widest shared layer has wp channels and widest vector wv. */
 #define LIDET_PN_SCRATCH_BYTES(wp, wv)                                                                       \

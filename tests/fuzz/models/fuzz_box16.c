@@ -8,13 +8,13 @@
 #endif
 
 /* tnet.point[0] weights, shape [3][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_tnet_point0_w[24] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_tnet_point0_w[24] = {
     -0.048256543f, 0.121168554f, 0.1892736f, 0.29915503f, 0.11729917f, -0.46061748f, -0.48135987f, -0.54039973f,
     -0.3758319f, -0.12707037f, -0.35562092f, -0.4044962f, 0.18629849f, 0.59036356f, -0.06991033f, -0.4165328f,
     -0.06649233f, -0.5185807f, 0.31874365f, 0.26202157f, 0.0789775f, 0.42427906f, 0.2057755f, 0.38124374f
 };
 /* tnet.point[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_tnet_point0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_tnet_point0_b[8] = {
     0.2057253f, -0.20456849f, -0.17990929f, 0.09887592f, 0.07241658f, 0.080717266f, -0.059627093f, 0.3000849f
 };
 static const lidet_pn_layer_t fuzz_box16_tnet_point[1] = {
@@ -22,12 +22,12 @@ static const lidet_pn_layer_t fuzz_box16_tnet_point[1] = {
 };
 
 /* tnet.pvle[0] weights, shape [3][4] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_tnet_pvle0_w[12] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_tnet_pvle0_w[12] = {
     -0.06297534f, -0.079264745f, -0.11546524f, -0.07490111f, -0.084579624f, 0.036072016f, 0.08065665f, -0.038511492f,
     -0.08593034f, -0.08145933f, 0.07367375f, -0.08386448f
 };
 /* tnet.pvle[0] bias, shape [4], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_tnet_pvle0_b[4] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_tnet_pvle0_b[4] = {
     0.91268134f, 0.8699424f, -0.70557404f, 0.8322097f
 };
 static const lidet_pn_layer_t fuzz_box16_tnet_pvle[1] = {
@@ -35,7 +35,7 @@ static const lidet_pn_layer_t fuzz_box16_tnet_pvle[1] = {
 };
 
 /* tnet.head[0] weights, shape [15][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_tnet_head0_w[120] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_tnet_head0_w[120] = {
     -0.100227475f, 0.1599459f, 0.021972692f, -0.1432555f, 0.2158003f, 0.06645418f, -0.26405323f, 0.15052825f,
     0.27289888f, 0.10690363f, 0.13456792f, 0.10622489f, -0.025698273f, -0.26128426f, -0.11963992f, -0.08779248f,
     0.23629522f, 0.0514745f, 0.038784213f, 0.09501818f, 0.024024833f, 0.026899684f, -0.025699334f, -0.25624457f,
@@ -53,17 +53,17 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_tnet_head0_w[120] = {
     0.21573758f, 0.2905797f, 0.041560613f, 0.12986074f, 0.12580025f, 0.1515408f, 0.1934274f, 0.24403873f
 };
 /* tnet.head[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_tnet_head0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_tnet_head0_b[8] = {
     -0.67594606f, -0.41661274f, -0.07012112f, 0.30792686f, 0.19552852f, -0.25368086f, -0.090150416f, 0.23046738f
 };
 /* tnet.head[1] weights, shape [8][3] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_tnet_head1_w[24] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_tnet_head1_w[24] = {
     0.20218736f, -0.12848847f, -0.051976f, -0.034175195f, -0.2877925f, -0.11660452f, 0.07984101f, -0.0418726f,
     -0.010318644f, -0.04724653f, 0.34315675f, -0.22661766f, -0.2836485f, -0.09511713f, 0.009047917f, 0.09800204f,
     -0.104564644f, 0.045626577f, 0.30075833f, 0.24163163f, 0.06299883f, -0.07061169f, -0.28810918f, -0.21100895f
 };
 /* tnet.head[1] bias, shape [3], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_tnet_head1_b[3] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_tnet_head1_b[3] = {
     0.08170284f, -0.3089668f, 0.007017998f
 };
 static const lidet_pn_layer_t fuzz_box16_tnet_head[2] = {
@@ -72,17 +72,17 @@ static const lidet_pn_layer_t fuzz_box16_tnet_head[2] = {
 };
 
 /* box.point[0] weights, shape [3][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_point0_w[24] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_box_point0_w[24] = {
     0.07764881f, 0.0034284112f, -0.54524356f, 0.56716144f, -0.30799243f, 0.51869345f, -0.23360194f, 0.14240402f,
     -0.18894477f, 0.36156118f, 0.46707615f, 0.5188054f, 0.44592053f, -0.26546165f, -0.49534208f, 0.5403505f,
     -0.056717973f, 0.60668296f, 0.20534639f, -0.20094198f, 0.38278073f, 0.15582463f, 0.4161334f, 0.3395199f
 };
 /* box.point[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_point0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_box_point0_b[8] = {
     -0.2857772f, -0.30724344f, -0.002965763f, 0.25891122f, -0.48073637f, 0.4595695f, 0.30411196f, -0.13372573f
 };
 /* box.point[1] weights, shape [8][16] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_point1_w[128] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_box_point1_w[128] = {
     -0.3997666f, 0.0011724764f, 0.029685784f, -0.15293218f, 0.061648756f, -0.37448466f, -0.12411843f, 0.16214934f,
     -0.034971036f, 0.013248287f, 0.19766021f, -0.081261665f, 0.3446282f, 0.16372047f, 0.027628757f, -0.1449587f,
     -0.17590013f, -0.056485444f, -0.124208964f, 0.27940792f, -0.049929198f, 0.14197701f, 0.14653632f, 0.15862772f,
@@ -101,7 +101,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_point1_w[128] = {
     -0.3240033f, -0.3474558f, -0.16281438f, -0.272407f, -0.21391927f, -0.06544006f, 0.024640866f, 0.38040832f
 };
 /* box.point[1] bias, shape [16], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_point1_b[16] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_box_point1_b[16] = {
     0.38911244f, -0.06349659f, 0.009635111f, -0.20282815f, -0.2802812f, -0.3461477f, 0.10312758f, 0.122947596f,
     0.29501638f, 0.15004279f, 0.1123552f, 0.37747604f, 0.036326997f, 0.008232912f, 0.002904924f, -0.1515101f
 };
@@ -111,12 +111,12 @@ static const lidet_pn_layer_t fuzz_box16_box_point[2] = {
 };
 
 /* box.pvle[0] weights, shape [3][4] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_pvle0_w[12] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_box_pvle0_w[12] = {
     0.12745328f, 0.013430628f, 0.07287982f, -0.02526306f, 0.08268135f, -0.3781084f, 0.048107475f, 0.1391774f,
     -0.06587702f, 0.062466457f, -0.09283247f, 0.09266787f
 };
 /* box.pvle[0] bias, shape [4], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_pvle0_b[4] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_box_pvle0_b[4] = {
     0.836697f, -0.49913466f, 1.0205855f, -1.061925f
 };
 static const lidet_pn_layer_t fuzz_box16_box_pvle[1] = {
@@ -124,7 +124,7 @@ static const lidet_pn_layer_t fuzz_box16_box_pvle[1] = {
 };
 
 /* box.head[0] weights, shape [23][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_head0_w[184] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_box_head0_w[184] = {
     0.14883915f, -0.18005297f, -0.24400334f, -0.04233085f, -0.16839162f, -0.18543234f, -0.06357685f, -0.1968185f,
     0.15840934f, -0.11765831f, 0.087460116f, -0.23790063f, 0.21199214f, -0.11377478f, -0.1489987f, -0.20810856f,
     -0.096132375f, 0.04978423f, 0.06198929f, 0.21365765f, 0.055311423f, 0.17592561f, 0.13944602f, 0.14632052f,
@@ -150,11 +150,11 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_head0_w[184] = {
     -0.17015508f, -0.1905481f, -0.13258612f, 0.07756621f, -0.014762905f, 0.08931861f, -0.013323215f, 0.024497282f
 };
 /* box.head[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_head0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_box_head0_b[8] = {
     0.020773256f, 0.53777295f, -0.086246066f, -0.24285571f, -0.024066707f, -0.11039086f, -0.35800493f, -0.086386375f
 };
 /* box.head[1] weights, shape [8][39] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_head1_w[312] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_box_head1_w[312] = {
     -0.064785056f, -0.105178215f, 0.310046f, 0.17338485f, 0.08066923f, -0.021738838f, 0.2641166f, 0.3123124f,
     0.19586909f, 0.07978622f, -0.26386502f, -0.0627403f, 0.09596479f, 0.14229698f, -0.228455f, -0.26460546f,
     -0.114001326f, -0.14831121f, 0.28152397f, -0.16269805f, -0.27223197f, 0.15927036f, -0.30191815f, -0.32899842f,
@@ -196,7 +196,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_head1_w[312] = {
     0.24791919f, -0.20020945f, -0.07760701f, 0.2666354f, 0.059478305f, 0.051889386f, -0.1648088f, -0.16645405f
 };
 /* box.head[1] bias, shape [39], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_box_head1_b[39] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_box_head1_b[39] = {
     0.016206685f, 0.23405042f, -0.31876832f, -0.055830326f, 0.04471064f, -0.10519171f, -0.06467219f, 0.07611299f,
     0.33066797f, 0.1547381f, -0.009623474f, 0.2180243f, 0.03788365f, 0.2206006f, -0.043098778f, -0.047530644f,
     -0.20392103f, 0.26591718f, -0.2062054f, 0.13138647f, -0.16251087f, -0.16866384f, 0.14336647f, 0.06991248f,
@@ -209,7 +209,7 @@ static const lidet_pn_layer_t fuzz_box16_box_head[2] = {
 };
 
 /* size templates, shape [3][3] (l, w, h), metres */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box16_mean_size[9] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box16_mean_size[9] = {
     3.883f, 1.629f, 1.526f, 1.763f, 0.597f, 1.737f, 0.844f, 0.661f,
     1.763f
 };

@@ -8,13 +8,13 @@
 #endif
 
 /* tnet.point[0] weights, shape [3][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_tnet_point0_w[24] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_tnet_point0_w[24] = {
     -0.04826698f, 0.12120674f, 0.18957274f, 0.29987112f, 0.11729026f, -0.4623925f, -0.4814217f, -0.5397845f,
     -0.3759132f, -0.1271104f, -0.356183f, -0.40546447f, 0.18628433f, 0.5926386f, -0.06991931f, -0.4160586f,
     -0.066506706f, -0.51874405f, 0.31924742f, 0.2626488f, 0.078971505f, 0.42591408f, 0.20580195f, 0.38080972f
 };
 /* tnet.point[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_tnet_point0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_tnet_point0_b[8] = {
     0.20534186f, -0.20826267f, -0.18012564f, 0.09811857f, 0.07225869f, 0.086870186f, -0.055512875f, 0.30479613f
 };
 static const lidet_pn_layer_t fuzz_box64_tnet_point[1] = {
@@ -22,12 +22,12 @@ static const lidet_pn_layer_t fuzz_box64_tnet_point[1] = {
 };
 
 /* tnet.pvle[0] weights, shape [3][4] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_tnet_pvle0_w[12] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_tnet_pvle0_w[12] = {
     -0.063593976f, -0.0815575f, -0.10810495f, -0.07647054f, -0.08541048f, 0.037115406f, 0.07551522f, -0.039318435f,
     -0.08677447f, -0.08381555f, 0.06897744f, -0.085621715f
 };
 /* tnet.pvle[0] bias, shape [4], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_tnet_pvle0_b[4] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_tnet_pvle0_b[4] = {
     0.8311881f, 0.8046512f, -0.6057489f, 0.758573f
 };
 static const lidet_pn_layer_t fuzz_box64_tnet_pvle[1] = {
@@ -35,7 +35,7 @@ static const lidet_pn_layer_t fuzz_box64_tnet_pvle[1] = {
 };
 
 /* tnet.head[0] weights, shape [15][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_tnet_head0_w[120] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_tnet_head0_w[120] = {
     -0.10074691f, 0.15974078f, 0.022009254f, -0.14405376f, 0.2163395f, 0.06672438f, -0.26535866f, 0.15108797f,
     0.2743132f, 0.10676653f, 0.13479184f, 0.1068168f, -0.025762482f, -0.26234663f, -0.12023139f, -0.088118926f,
     0.23751983f, 0.051408492f, 0.03884875f, 0.09554765f, 0.02408486f, 0.027009057f, -0.025826385f, -0.25719738f,
@@ -53,17 +53,17 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_tnet_head0_w[120] = {
     0.21685565f, 0.29020706f, 0.04162977f, 0.13058436f, 0.12611456f, 0.15215695f, 0.19438365f, 0.24494615f
 };
 /* tnet.head[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_tnet_head0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_tnet_head0_b[8] = {
     -0.89866525f, -0.52263826f, -0.08955364f, 0.37777954f, 0.24238469f, -0.28502008f, -0.115960196f, 0.3354141f
 };
 /* tnet.head[1] weights, shape [8][3] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_tnet_head1_w[24] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_tnet_head1_w[24] = {
     0.20218736f, -0.12848847f, -0.051976f, -0.034175195f, -0.2877925f, -0.11660452f, 0.07984101f, -0.0418726f,
     -0.010318644f, -0.04724653f, 0.34315675f, -0.22661766f, -0.2836485f, -0.09511713f, 0.009047917f, 0.09800204f,
     -0.104564644f, 0.045626577f, 0.30075833f, 0.24163163f, 0.06299883f, -0.07061169f, -0.28810918f, -0.21100895f
 };
 /* tnet.head[1] bias, shape [3], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_tnet_head1_b[3] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_tnet_head1_b[3] = {
     0.08170284f, -0.3089668f, 0.007017998f
 };
 static const lidet_pn_layer_t fuzz_box64_tnet_head[2] = {
@@ -72,17 +72,17 @@ static const lidet_pn_layer_t fuzz_box64_tnet_head[2] = {
 };
 
 /* box.point[0] weights, shape [3][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_point0_w[24] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_box_point0_w[24] = {
     0.07766314f, 0.003427244f, -0.5466996f, 0.56751686f, -0.30835846f, 0.5195939f, -0.23391578f, 0.14238472f,
     -0.18897964f, 0.3614381f, 0.46832344f, 0.5191305f, 0.44645044f, -0.2659225f, -0.49600753f, 0.54027724f,
     -0.056728438f, 0.6064764f, 0.20589475f, -0.20106791f, 0.38323563f, 0.15609515f, 0.41669247f, 0.33947387f
 };
 /* box.point[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_point0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_box_point0_b[8] = {
     -0.2865058f, -0.30533868f, 0.0009628538f, 0.2553463f, -0.47827822f, 0.457672f, 0.30690393f, -0.13341527f
 };
 /* box.point[1] weights, shape [8][16] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_point1_w[128] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_box_point1_w[128] = {
     -0.3995927f, 0.0011734758f, 0.029704362f, -0.15296498f, 0.061691f, -0.37446123f, -0.12423634f, 0.16209577f,
     -0.034986265f, 0.013253877f, 0.19780606f, -0.08118512f, 0.34475785f, 0.1637203f, 0.027628105f, -0.14497662f,
     -0.17582361f, -0.056533586f, -0.1242867f, 0.27946785f, -0.04996341f, 0.14196813f, 0.14667551f, 0.15857531f,
@@ -101,7 +101,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_point1_w[128] = {
     -0.3241444f, -0.3476024f, -0.16293451f, -0.27215037f, -0.21399973f, -0.065439984f, 0.024640283f, 0.38045532f
 };
 /* box.point[1] bias, shape [16], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_point1_b[16] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_box_point1_b[16] = {
     0.38917774f, -0.06345781f, 0.008982405f, -0.20328556f, -0.28038353f, -0.34641102f, 0.10325201f, 0.12302766f,
     0.29514185f, 0.15032479f, 0.111609f, 0.37720996f, 0.036113087f, 0.008307695f, 0.0032557205f, -0.15106481f
 };
@@ -111,12 +111,12 @@ static const lidet_pn_layer_t fuzz_box64_box_point[2] = {
 };
 
 /* box.pvle[0] weights, shape [3][4] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_pvle0_w[12] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_box_pvle0_w[12] = {
     0.11832839f, 0.013324561f, 0.06731781f, -0.024122708f, 0.07676186f, -0.3751223f, 0.04443603f, 0.13289505f,
     -0.061160617f, 0.061973132f, -0.085747726f, 0.08848493f
 };
 /* box.pvle[0] bias, shape [4], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_pvle0_b[4] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_box_pvle0_b[4] = {
     0.7294605f, -0.43066165f, 0.86625993f, -0.93163455f
 };
 static const lidet_pn_layer_t fuzz_box64_box_pvle[1] = {
@@ -124,7 +124,7 @@ static const lidet_pn_layer_t fuzz_box64_box_pvle[1] = {
 };
 
 /* box.head[0] weights, shape [23][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_head0_w[184] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_box_head0_w[184] = {
     0.14894111f, -0.18103692f, -0.24496175f, -0.04238086f, -0.16886683f, -0.18635178f, -0.06351997f, -0.19704251f,
     0.15851787f, -0.118301295f, 0.08780365f, -0.23818168f, 0.2125904f, -0.114338905f, -0.1488654f, -0.20834541f,
     -0.09619823f, 0.05005629f, 0.062232774f, 0.21391006f, 0.055467516f, 0.1767979f, 0.13932128f, 0.14648706f,
@@ -150,11 +150,11 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_head0_w[184] = {
     -0.17027165f, -0.19158942f, -0.1331069f, 0.07765784f, -0.014804567f, 0.08976148f, -0.013311296f, 0.024525164f
 };
 /* box.head[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_head0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_box_head0_b[8] = {
     0.047652777f, 0.71612f, -0.13772804f, -0.3527981f, 0.01485385f, -0.22452202f, -0.49142733f, -0.079714276f
 };
 /* box.head[1] weights, shape [8][39] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_head1_w[312] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_box_head1_w[312] = {
     -0.064785056f, -0.105178215f, 0.310046f, 0.17338485f, 0.08066923f, -0.021738838f, 0.2641166f, 0.3123124f,
     0.19586909f, 0.07978622f, -0.26386502f, -0.0627403f, 0.09596479f, 0.14229698f, -0.228455f, -0.26460546f,
     -0.114001326f, -0.14831121f, 0.28152397f, -0.16269805f, -0.27223197f, 0.15927036f, -0.30191815f, -0.32899842f,
@@ -196,7 +196,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_head1_w[312] = {
     0.24791919f, -0.20020945f, -0.07760701f, 0.2666354f, 0.059478305f, 0.051889386f, -0.1648088f, -0.16645405f
 };
 /* box.head[1] bias, shape [39], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_box_head1_b[39] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_box_head1_b[39] = {
     0.016206685f, 0.23405042f, -0.31876832f, -0.055830326f, 0.04471064f, -0.10519171f, -0.06467219f, 0.07611299f,
     0.33066797f, 0.1547381f, -0.009623474f, 0.2180243f, 0.03788365f, 0.2206006f, -0.043098778f, -0.047530644f,
     -0.20392103f, 0.26591718f, -0.2062054f, 0.13138647f, -0.16251087f, -0.16866384f, 0.14336647f, 0.06991248f,
@@ -209,7 +209,7 @@ static const lidet_pn_layer_t fuzz_box64_box_head[2] = {
 };
 
 /* size templates, shape [3][3] (l, w, h), metres */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_box64_mean_size[9] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_box64_mean_size[9] = {
     3.883f, 1.629f, 1.526f, 1.763f, 0.597f, 1.737f, 0.844f, 0.661f,
     1.763f
 };

@@ -8,17 +8,17 @@
 #endif
 
 /* cls.point[0] weights, shape [3][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_point0_w[24] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls16_cls_point0_w[24] = {
     -0.4485379f, -0.43504897f, 0.115057066f, 0.5270309f, -0.3104784f, 0.0033419007f, 0.3949904f, 0.30092424f,
     -0.017185602f, 0.110131666f, -0.5145444f, -0.28614604f, -0.050044324f, -0.54757345f, 0.3452231f, 0.4538844f,
     0.6206937f, 0.25399724f, 0.0998764f, 0.35039943f, 0.36358547f, 0.35815993f, 0.4826458f, 0.110658415f
 };
 /* cls.point[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_point0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls16_cls_point0_b[8] = {
     0.2873487f, -0.3762278f, -0.06432706f, -0.050767098f, -0.21061815f, 0.11608236f, 0.32088092f, -0.29921246f
 };
 /* cls.point[1] weights, shape [8][16] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_point1_w[128] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls16_cls_point1_w[128] = {
     -0.22155148f, -0.17441504f, 0.073503405f, -0.21208857f, 0.23171374f, 0.07560205f, -0.16994584f, -0.39530912f,
     0.3429252f, -0.24194634f, -0.16439855f, -0.36798817f, -0.016048124f, -0.08029055f, -0.28815535f, -0.30002743f,
     -0.13994312f, 0.30107558f, -0.27144548f, 0.023267694f, 0.2595457f, 0.25683334f, -0.4252225f, 0.029455403f,
@@ -37,7 +37,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_point1_w[128] = {
     -0.050133947f, -0.052310426f, -0.013986998f, -0.25055695f, -0.17877355f, 0.060596164f, 0.3647001f, -0.014589578f
 };
 /* cls.point[1] bias, shape [16], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_point1_b[16] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls16_cls_point1_b[16] = {
     0.27921426f, 0.15654477f, -0.025285207f, 0.16261491f, -0.09145546f, -0.06265168f, -0.18248591f, -0.09341547f,
     -0.37833276f, 0.28762195f, -0.2758531f, 0.034077425f, -0.18254873f, 0.042616297f, -0.15047203f, 0.16682176f
 };
@@ -47,12 +47,12 @@ static const lidet_pn_layer_t fuzz_cls16_cls_point[2] = {
 };
 
 /* cls.pvle[0] weights, shape [3][4] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_pvle0_w[12] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls16_cls_pvle0_w[12] = {
     0.087874345f, 0.0083318595f, -0.14224467f, -0.11384571f, -0.057562973f, 0.07949029f, 0.20121075f, 0.006408657f,
     -0.08137044f, 0.09597824f, -0.040474467f, -0.06581615f
 };
 /* cls.pvle[0] bias, shape [4], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_pvle0_b[4] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls16_cls_pvle0_b[4] = {
     0.8413199f, -0.98025405f, 0.3594177f, 0.57902545f
 };
 static const lidet_pn_layer_t fuzz_cls16_cls_pvle[1] = {
@@ -60,7 +60,7 @@ static const lidet_pn_layer_t fuzz_cls16_cls_pvle[1] = {
 };
 
 /* cls.head[0] weights, shape [20][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_head0_w[160] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls16_cls_head0_w[160] = {
     0.07082983f, -0.24404037f, 0.068297096f, 0.06956793f, -0.1201206f, -0.0520744f, 0.21232466f, -0.049299248f,
     -0.029206628f, 0.24566619f, 0.018932607f, 0.21588811f, 0.027182642f, 0.16454764f, 0.008262871f, -0.25969473f,
     -0.009664019f, 0.23781534f, -0.13742952f, 0.24926494f, -0.25931242f, 0.23176794f, 0.026977351f, -0.119941406f,
@@ -83,17 +83,17 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_head0_w[160] = {
     0.15388231f, 0.2055821f, 0.041376993f, -0.2004674f, -0.24456306f, -0.09888866f, 0.11754629f, -0.14805074f
 };
 /* cls.head[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_head0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls16_cls_head0_b[8] = {
     0.023360616f, -0.1183786f, 0.16051905f, -0.048521675f, -0.18298215f, -0.35747907f, 0.2525999f, 0.6087055f
 };
 /* cls.head[1] weights, shape [8][3] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_head1_w[24] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls16_cls_head1_w[24] = {
     -0.30742913f, -0.002217767f, 0.004045212f, -0.039441187f, 0.24550703f, 0.18008539f, 0.1816721f, 0.229621f,
     -0.07278756f, -0.11673703f, 0.17546985f, 0.09513091f, 0.19360167f, -0.3314269f, 0.15717462f, -0.10976468f,
     -0.26575235f, -0.20661978f, -0.10436318f, -0.27204588f, 0.04744648f, 0.22905698f, 0.18919969f, -0.17148288f
 };
 /* cls.head[1] bias, shape [3], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls16_cls_head1_b[3] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls16_cls_head1_b[3] = {
     -0.06118108f, 0.10793188f, 0.067485996f
 };
 static const lidet_pn_layer_t fuzz_cls16_cls_head[2] = {

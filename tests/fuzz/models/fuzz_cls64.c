@@ -8,17 +8,17 @@
 #endif
 
 /* cls.point[0] weights, shape [3][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_point0_w[24] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls64_cls_point0_w[24] = {
     -0.4474347f, -0.43461317f, 0.115075685f, 0.52718014f, -0.31014448f, 0.0033413814f, 0.394109f, 0.30039868f,
     -0.017143333f, 0.11002134f, -0.5146277f, -0.28622708f, -0.049990505f, -0.5474884f, 0.34445277f, 0.45309165f,
     0.61916703f, 0.25374278f, 0.099892564f, 0.35049865f, 0.36319444f, 0.3581043f, 0.4815688f, 0.11046514f
 };
 /* cls.point[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_point0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls64_cls_point0_b[8] = {
     0.2817392f, -0.38015512f, -0.06199651f, -0.046719223f, -0.21349506f, 0.11701383f, 0.32077545f, -0.29821137f
 };
 /* cls.point[1] weights, shape [8][16] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_point1_w[128] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls64_cls_point1_w[128] = {
     -0.22154047f, -0.17442906f, 0.07349595f, -0.21208212f, 0.2316669f, 0.07561016f, -0.16993718f, -0.39526126f,
     0.34298941f, -0.2419531f, -0.16436319f, -0.36802614f, -0.016056007f, -0.08027931f, -0.28818226f, -0.30005765f,
     -0.13993618f, 0.3010998f, -0.27141795f, 0.023266986f, 0.25949323f, 0.25686088f, -0.42520082f, 0.029451836f,
@@ -37,7 +37,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_point1_w[128] = {
     -0.05014333f, -0.05231189f, -0.01398399f, -0.25058278f, -0.17886135f, 0.06058769f, 0.36473417f, -0.014591047f
 };
 /* cls.point[1] bias, shape [16], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_point1_b[16] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls64_cls_point1_b[16] = {
     0.2788762f, 0.15648441f, -0.025138166f, 0.16221444f, -0.09123377f, -0.06256575f, -0.18228984f, -0.09303719f,
     -0.37854716f, 0.2873735f, -0.27573672f, 0.033921566f, -0.18265004f, 0.042986907f, -0.15033378f, 0.16695282f
 };
@@ -47,12 +47,12 @@ static const lidet_pn_layer_t fuzz_cls64_cls_point[2] = {
 };
 
 /* cls.pvle[0] weights, shape [3][4] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_pvle0_w[12] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls64_cls_pvle0_w[12] = {
     0.085456684f, 0.008480127f, -0.14684595f, -0.11935866f, -0.05597926f, 0.08090484f, 0.20771945f, 0.006718994f,
     -0.07913172f, 0.097686194f, -0.04178372f, -0.06900328f
 };
 /* cls.pvle[0] bias, shape [4], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_pvle0_b[4] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls64_cls_pvle0_b[4] = {
     0.83242035f, -1.0171446f, 0.38223356f, 0.6228076f
 };
 static const lidet_pn_layer_t fuzz_cls64_cls_pvle[1] = {
@@ -60,7 +60,7 @@ static const lidet_pn_layer_t fuzz_cls64_cls_pvle[1] = {
 };
 
 /* cls.head[0] weights, shape [20][8] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_head0_w[160] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls64_cls_head0_w[160] = {
     0.07131849f, -0.24572606f, 0.06852025f, 0.06980387f, -0.12085011f, -0.05301497f, 0.21472268f, -0.049684916f,
     -0.029408127f, 0.24736312f, 0.018994467f, 0.2166203f, 0.027347727f, 0.16751972f, 0.008356192f, -0.26172632f,
     -0.009730692f, 0.23945802f, -0.13787855f, 0.2501103f, -0.26088724f, 0.23595415f, 0.027282033f, -0.12087971f,
@@ -83,17 +83,17 @@ LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_head0_w[160] = {
     0.15494397f, 0.20700213f, 0.041512184f, -0.20114727f, -0.24604833f, -0.1006748f, 0.118873864f, -0.14920895f
 };
 /* cls.head[0] bias, shape [8], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_head0_b[8] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls64_cls_head0_b[8] = {
     0.063085005f, -0.1493272f, 0.286259f, -0.09884594f, -0.2575916f, -0.46568227f, 0.32749066f, 0.8616921f
 };
 /* cls.head[1] weights, shape [8][3] (in, out: transposed, BN folded), float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_head1_w[24] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls64_cls_head1_w[24] = {
     -0.30742913f, -0.002217767f, 0.004045212f, -0.039441187f, 0.24550703f, 0.18008539f, 0.1816721f, 0.229621f,
     -0.07278756f, -0.11673703f, 0.17546985f, 0.09513091f, 0.19360167f, -0.3314269f, 0.15717462f, -0.10976468f,
     -0.26575235f, -0.20661978f, -0.10436318f, -0.27204588f, 0.04744648f, 0.22905698f, 0.18919969f, -0.17148288f
 };
 /* cls.head[1] bias, shape [3], float32 */
-LIDET_ALIGN(16) LIDET_RODATA static const float fuzz_cls64_cls_head1_b[3] = {
+LIDET_ALIGN(64) LIDET_RODATA static const float fuzz_cls64_cls_head1_b[3] = {
     -0.06118108f, 0.10793188f, 0.067485996f
 };
 static const lidet_pn_layer_t fuzz_cls64_cls_head[2] = {
