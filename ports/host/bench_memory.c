@@ -24,8 +24,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
+#include "cli.h"
 #include "lidet/lidet.h"
 #include "lidet/lidet_workspace.h"
 
@@ -40,25 +40,6 @@ static uint32_t g_ids[LIDET_MAX_POINTS];
 static uint8_t g_gnd[LIDET_MAX_POINTS];
 static uint32_t g_ids_ref[LIDET_MAX_POINTS];
 static uint8_t g_gnd_ref[LIDET_MAX_POINTS];
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
-
-static int cmpd(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n)
-{
-    qsort(v, (size_t)n, sizeof v[0], cmpd);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 static float *read_scan(const char *path, uint32_t *n)
 {
@@ -84,42 +65,33 @@ static float *read_scan(const char *path, uint32_t *n)
     return p;
 }
 
-/* thread CPU time in ns, wrapping (differences of < 4 s are exact) */
-static uint32_t clock_ns(void *ctx)
-{
-    struct timespec ts;
-    (void)ctx;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-    return (uint32_t)((uint64_t)ts.tv_sec * 1000000000u + (uint64_t)ts.tv_nsec);
-}
-
 /* ticks: ns of projection, ground, clustering */
 static lidet_status_t run_stages(const float *pts, uint32_t n, uint32_t ticks[3])
 {
     lidet_range_image_t img;
     const lidet_plane_t *planes;
-    uint32_t ns, t0 = clock_ns(NULL), t1, t2;
+    uint32_t ns, t0 = cli_stage_clock_ns(NULL), t1, t2;
     lidet_status_t st = lidet_proj_run(&g_proj, pts, n, 4, NULL);
     if (!LIDET_SUCCEEDED(st))
         return st;
     lidet_proj_image(&g_proj, &img);
-    t1 = clock_ns(NULL);
+    t1 = cli_stage_clock_ns(NULL);
     st = lidet_ground_run(&g_ground, &img);
     if (!LIDET_SUCCEEDED(st))
         return st;
-    t2 = clock_ns(NULL);
+    t2 = cli_stage_clock_ns(NULL);
     planes = lidet_ground_planes(&g_ground, &ns);
     st = lidet_cluster_run(&g_cluster, &img, lidet_ground_mask(&g_ground), planes, ns);
     ticks[0] = t1 - t0;
     ticks[1] = t2 - t1;
-    ticks[2] = clock_ns(NULL) - t2;
+    ticks[2] = cli_stage_clock_ns(NULL) - t2;
     return st;
 }
 
 static lidet_status_t run_workspace(const float *pts, uint32_t n, int per_point, uint32_t ticks[3])
 {
-    lidet_status_t st =
-        lidet_workspace_run_timed(&g_ws, pts, n, 4, NULL, per_point ? g_pp : NULL, clock_ns, NULL, ticks);
+    lidet_status_t st = lidet_workspace_run_timed(&g_ws, pts, n, 4, NULL, per_point ? g_pp : NULL,
+                                                  cli_stage_clock_ns, NULL, ticks);
     if (!LIDET_SUCCEEDED(st) || !per_point)
         return st;
     return lidet_workspace_point_labels(&g_ws, g_pp, n < LIDET_MAX_POINTS ? n : LIDET_MAX_POINTS, g_ids,
@@ -172,15 +144,15 @@ static void cluster_same_mask(int repeat, double *t, double *ms_compact, double 
     memcpy(g_mask, lidet_ground_mask(&g_ground), (size_t)fimg.n_rows * fimg.n_cols);
     for (i = 0; i < repeat; ++i)
     {
-        double t0 = now_ms();
+        double t0 = cli_cpu_ms();
         (void)lidet_cluster_run(&g_cluster_same, &wimg, g_mask, planes, ns);
-        t[i] = now_ms() - t0;
-        t0 = now_ms();
+        t[i] = cli_cpu_ms() - t0;
+        t0 = cli_cpu_ms();
         (void)lidet_cluster_run(&g_cluster_same, &fimg, g_mask, planes, ns);
-        t[repeat + i] = now_ms() - t0;
+        t[repeat + i] = cli_cpu_ms() - t0;
     }
-    *ms_compact = median(t, repeat);
-    *ms_float = median(t + repeat, repeat);
+    *ms_compact = cli_median(t, repeat);
+    *ms_float = cli_median(t + repeat, repeat);
 }
 
 int main(int argc, char **argv)
@@ -216,6 +188,7 @@ int main(int argc, char **argv)
             return 2;
         }
     }
+    cli_stage_clock_cpu = 1; /* the workspace's stage clock in this thread's CPU time */
     sensor = lidet_sensor_find(sensor_name);
     if (sensor == NULL || repeat < 1 || a >= argc)
     {
@@ -273,19 +246,19 @@ int main(int argc, char **argv)
                 double t0;
                 if (only >= 0 && k != only)
                     continue;
-                t0 = now_ms();
+                t0 = cli_cpu_ms();
                 if (k == 0)
                     (void)run_stages(pts, n, tk);
                 else
                     (void)run_workspace(pts, n, k == 2, tk);
-                t[(k * 4 + 3) * repeat + i] = now_ms() - t0;
+                t[(k * 4 + 3) * repeat + i] = cli_cpu_ms() - t0;
                 for (s = 0; s < 3; ++s)
                     t[(k * 4 + s) * repeat + i] = (double)tk[s] * 1e-6;
             }
         }
         for (k = 0; k < 3; ++k)
             for (s = 0; s < 4; ++s)
-                ms[k][s] = median(t + (k * 4 + s) * repeat, repeat);
+                ms[k][s] = cli_median(t + (k * 4 + s) * repeat, repeat);
         printf("{\"scan\": \"%s\", \"sensor\": \"%s\", \"points\": %u, \"repeat\": %d, ", argv[a],
                sensor_name, (unsigned)n, repeat);
         for (k = 0; k < 3; ++k)
