@@ -161,17 +161,12 @@ float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const
  * become non-candidates. Returns how many candidates it took away. */
 static uint32_t window_out(const lidet_cluster_cfg_t *cfg, uint32_t rows, uint32_t cols, uint16_t *lab)
 {
-    float half, lo, hi;
     uint32_t c_lo, c_hi, r, col, out = 0;
     if (!(cfg->azimuth_half_rad > 0.0f && cfg->azimuth_half_rad < LIDET_PI_F))
     {
         return 0;
     }
-    half = cfg->azimuth_half_rad * (float)cols / (2.0f * LIDET_PI_F);
-    lo = 0.5f * (float)cols - half - 1.0f;
-    hi = 0.5f * (float)cols + half + 1.0f;
-    c_lo = lo > 0.0f ? (uint32_t)lo : 0u;
-    c_hi = hi < (float)cols ? (uint32_t)hi + 1u : cols;
+    lidet__azimuth_window_cols(cfg->azimuth_half_rad, cols, &c_lo, &c_hi);
     for (r = 0; r < rows; ++r)
     {
         uint16_t *row = lab + (size_t)r * cols;

@@ -60,6 +60,7 @@ void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sen
     cfg->ring_split_m = low ? 0.0f : 15.0f;
     cfg->fallback_sectors = 4u;
     cfg->seed = 12345u;
+    cfg->seed_per_cell = 0u;
     /* labelling */
     cfg->ground_m = low ? 0.2f : 0.15f;
     cfg->ground_m_per_m = 0.0f;
@@ -88,7 +89,8 @@ lidet_status_t lidet_ground_state_init(lidet_ground_state_t *g, const lidet_grou
         cfg->eval_samples < 3u || cfg->sample_step < 1u || cfg->sample_step > 16u ||
         cfg->sample_col_step < 1u || cfg->sample_col_step > 16u || cfg->min_samples < 3u ||
         cfg->min_inliers < 3u || cfg->refine_iters > 10u || cfg->fx_on_z > 1u ||
-        cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors)
+        cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors ||
+        cfg->seed_per_cell > 1u)
     {
         return LIDET_ERR_CONFIG;
     }

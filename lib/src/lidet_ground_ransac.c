@@ -458,6 +458,10 @@ static int fit_cell(void *ctx, uint32_t k)
     fit_ctx_t *f = (fit_ctx_t *)ctx;
     const uint32_t a = f->sc->cell_first[k], n = f->sc->cell_n[k];
     LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
+    if (f->g->cfg.seed_per_cell)
+    {
+        f->g->rng = lidet__rng_cell(f->g->cfg.seed, k);
+    }
     return fit_sector(f->g, f->sc, f->img, f->sc->sample_pix + a, n, &f->g->planes[k]);
 }
 

@@ -28,6 +28,7 @@ void lidet_proj_cfg_default(lidet_proj_cfg_t *cfg, const lidet_sensor_t *sensor)
     cfg->min_range_m = 0.1f;
     cfg->max_range_m = 0.0f;
     cfg->fov_margin_rad = 5.0f * LIDET_DEG2RAD_F;
+    cfg->azimuth_half_rad = 0.0f;
 }
 
 /* lidet__proj_rows_top_down's order on this file's elevations */
@@ -106,7 +107,8 @@ lidet_status_t lidet_proj_state_init(lidet_proj_state_t *proj, const lidet_proj_
     }
     if (!in_range(cfg->min_range_m, 0.0f, 10.0f) || !in_range(cfg->fov_margin_rad, 0.0f, 0.5f) ||
         !in_range(cfg->max_range_m, 0.0f, 1.0e6f) ||
-        (cfg->max_range_m > 0.0f && cfg->max_range_m <= cfg->min_range_m))
+        (cfg->max_range_m > 0.0f && cfg->max_range_m <= cfg->min_range_m) ||
+        !in_range(cfg->azimuth_half_rad, 0.0f, LIDET_PI_F + 1e-6f))
     {
         return LIDET_ERR_CONFIG;
     }
@@ -210,6 +212,7 @@ lidet_status_t lidet_proj_state_init(lidet_proj_state_t *proj, const lidet_proj_
         }
     }
     init_columns(proj, s->n_cols);
+    lidet__azimuth_window_cols(cfg->azimuth_half_rad, s->n_cols, &proj->win_lo, &proj->win_hi);
     proj->cfg = *cfg;
     proj->cfg.sensor.beam_elev_rad = 0; /* not retained: the caller's table may go away */
     proj->n_points = 0;
@@ -352,7 +355,7 @@ LIDET_CLONES_AVX2 static void round_block(const float *bx, const float *by, cons
  * branches that compilers vectorise. */
 #define COMPACT_BLOCK 192u
 static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *points, uint32_t stride,
-                              uint32_t npix, int any)
+                              uint32_t begin, uint32_t end, int any)
 {
     static const float zero_rec[3] = {0.0f, 0.0f, 0.0f};
     const float *const src = any ? points : zero_rec;
@@ -361,9 +364,9 @@ static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *poin
     uint16_t *const ro = buf->range_4mm;
     float bx[COMPACT_BLOCK], by[COMPACT_BLOCK], bz[COMPACT_BLOCK];
     uint32_t base, filled = 0;
-    for (base = 0; base < npix; base += COMPACT_BLOCK)
+    for (base = begin; base < end; base += COMPACT_BLOCK)
     {
-        const uint32_t m = npix - base < COMPACT_BLOCK ? npix - base : COMPACT_BLOCK;
+        const uint32_t m = end - base < COMPACT_BLOCK ? end - base : COMPACT_BLOCK;
         uint32_t j;
         for (j = 0; j < m; ++j)
         {
@@ -386,6 +389,83 @@ static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *poin
         round_block(bx, by, bz, m, xo + base, yo + base, zo + base, ro + base);
     }
     return filled;
+}
+
+/* Pass 2 of a float image over pixels [begin, end), in blocks that stay in L1 (see run()) */
+static uint32_t pass2_float(const lidet_proj_buffers_t *buf, const float *points, uint32_t stride,
+                            uint32_t begin, uint32_t end, float max2, int any)
+{
+    static const float zero_rec[3] = {0.0f, 0.0f, 0.0f};
+    const float *const src = any ? points : zero_rec; /* points may be NULL if n = 0 */
+    float *const xo = buf->x_m, *const yo = buf->y_m, *const zo = buf->z_m;
+    float *const ro = buf->rxy_m, *const rng = buf->range_m; /* ro may be NULL */
+    const int32_t *const idx = buf->point_idx;
+    uint32_t filled = 0, base, pix;
+    for (base = begin; base < end; base += PASS2_BLOCK)
+    {
+        const uint32_t stop = end - base < PASS2_BLOCK ? end : base + PASS2_BLOCK;
+        for (pix = base; pix < stop; ++pix)
+        {
+            const int32_t k = idx[pix];
+            const uint32_t keep = 0u - (uint32_t)(k >= 0); /* all ones for a winner, else 0 */
+            const float *pt = src + (size_t)((uint32_t)k & keep) * stride;
+            uint32_t ux, uy, uz;
+            memcpy(&ux, &pt[0], sizeof ux);
+            memcpy(&uy, &pt[1], sizeof uy);
+            memcpy(&uz, &pt[2], sizeof uz);
+            ux &= keep;
+            uy &= keep;
+            uz &= keep;
+            memcpy(&xo[pix], &ux, sizeof ux);
+            memcpy(&yo[pix], &uy, sizeof uy);
+            memcpy(&zo[pix], &uz, sizeof uz);
+            filled += keep & 1u;
+        }
+        if (ro != 0)
+        {
+            for (pix = base; pix < stop; ++pix)
+            {
+                const float x = xo[pix], y = yo[pix], b = rng[pix];
+                ro[pix] = lidet__rxy(x, y);
+                rng[pix] = b <= max2 ? sqrtf(b) : 0.0f;
+            }
+        }
+        else
+        {
+            for (pix = base; pix < stop; ++pix)
+            {
+                const float b = rng[pix];
+                rng[pix] = b <= max2 ? sqrtf(b) : 0.0f;
+            }
+        }
+    }
+    return filled;
+}
+
+/* The pixels [begin, end) of every plane of the output image set to empty (0) */
+static void clear_pixels(const lidet_proj_buffers_t *buf, int compact, uint32_t begin, uint32_t end)
+{
+    const size_t n = (size_t)(end - begin);
+    if (n == 0u)
+    {
+        return;
+    }
+    if (compact)
+    {
+        memset(buf->x_4mm + begin, 0, n * sizeof buf->x_4mm[0]);
+        memset(buf->y_4mm + begin, 0, n * sizeof buf->y_4mm[0]);
+        memset(buf->z_4mm + begin, 0, n * sizeof buf->z_4mm[0]);
+        memset(buf->range_4mm + begin, 0, n * sizeof buf->range_4mm[0]);
+        return;
+    }
+    memset(buf->x_m + begin, 0, n * sizeof buf->x_m[0]);
+    memset(buf->y_m + begin, 0, n * sizeof buf->y_m[0]);
+    memset(buf->z_m + begin, 0, n * sizeof buf->z_m[0]);
+    memset(buf->range_m + begin, 0, n * sizeof buf->range_m[0]);
+    if (buf->rxy_m != 0)
+    {
+        memset(buf->rxy_m + begin, 0, n * sizeof buf->rxy_m[0]);
+    }
 }
 
 lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj_buffers_t *buf,
@@ -449,6 +529,7 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
         const float col_scale = proj->col_lut_scale;
         const float last_col_bucket = (float)(4u * cols);
         const int row_single = proj->row_single_step, col_single = proj->col_single_step;
+        const uint32_t win_lo = proj->win_lo, win_n = proj->win_hi - proj->win_lo;
         const float *const row_bound = proj->row_bound_tan;
         const float *const col_edge = proj->col_edge_key;
         const uint8_t *const row_lut = proj->row_lut;
@@ -548,6 +629,13 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
                     while (col_edge[col + 1] <= d)
                         ++col;
                 }
+                if ((uint32_t)col - win_lo >=
+                    win_n) /* outside the azimuth window (unsigned: below win_lo too) */
+                {
+                    ++st.n_out_of_window;
+                    kb.pix[j] = -1;
+                    continue;
+                }
                 pix = (uint32_t)row * cols + (uint32_t)col;
                 LIDET_ASSERT(pix < npix);
                 kb.pix[j] = (int32_t)pix;
@@ -604,57 +692,30 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
      * the squared range (0x7F7F7F7F > max2 marks an empty pixel). Writing the coordinates here rather
      * than on every win in pass 1 keeps pass 1's working set at two arrays (index + squared range):
      * measured 16.6 vs 17.8 ns/point on real KITTI scans, six scattered 512 KiB arrays overflow L2. */
-    if (compact)
+    if (proj->win_lo > 0u || proj->win_hi < cols)
     {
-        st.n_pixels_filled = pass2_compact(buf, points, stride, npix, st.n_projected > 0);
+        /* an azimuth window: pass 2 over its columns only, the pixels beside it cleared (no point reached them) */
+        const int any = st.n_projected > 0;
+        uint32_t r, filled = 0;
+        for (r = 0; r < rows; ++r)
+        {
+            const uint32_t base = r * cols;
+            clear_pixels(buf, compact, base, base + proj->win_lo);
+            clear_pixels(buf, compact, base + proj->win_hi, base + cols);
+            filled +=
+                compact
+                    ? pass2_compact(buf, points, stride, base + proj->win_lo, base + proj->win_hi, any)
+                    : pass2_float(buf, points, stride, base + proj->win_lo, base + proj->win_hi, max2, any);
+        }
+        st.n_pixels_filled = filled;
+    }
+    else if (compact)
+    {
+        st.n_pixels_filled = pass2_compact(buf, points, stride, 0u, npix, st.n_projected > 0);
     }
     else
     {
-        static const float zero_rec[3] = {0.0f, 0.0f, 0.0f};
-        const float *const src = st.n_projected > 0 ? points : zero_rec; /* points may be NULL if n = 0 */
-        float *const xo = buf->x_m, *const yo = buf->y_m, *const zo = buf->z_m;
-        float *const ro = buf->rxy_m, *const rng = buf->range_m; /* ro may be NULL */
-        const int32_t *const idx = buf->point_idx;
-        uint32_t filled = 0, base;
-        for (base = 0; base < npix; base += PASS2_BLOCK)
-        {
-            const uint32_t end = npix - base < PASS2_BLOCK ? npix : base + PASS2_BLOCK;
-            for (pix = base; pix < end; ++pix)
-            {
-                const int32_t k = idx[pix];
-                const uint32_t keep = 0u - (uint32_t)(k >= 0); /* all ones for a winner, else 0 */
-                const float *pt = src + (size_t)((uint32_t)k & keep) * stride;
-                uint32_t ux, uy, uz;
-                memcpy(&ux, &pt[0], sizeof ux);
-                memcpy(&uy, &pt[1], sizeof uy);
-                memcpy(&uz, &pt[2], sizeof uz);
-                ux &= keep;
-                uy &= keep;
-                uz &= keep;
-                memcpy(&xo[pix], &ux, sizeof ux);
-                memcpy(&yo[pix], &uy, sizeof uy);
-                memcpy(&zo[pix], &uz, sizeof uz);
-                filled += keep & 1u;
-            }
-            if (ro != 0)
-            {
-                for (pix = base; pix < end; ++pix)
-                {
-                    const float x = xo[pix], y = yo[pix], b = rng[pix];
-                    ro[pix] = lidet__rxy(x, y);
-                    rng[pix] = b <= max2 ? sqrtf(b) : 0.0f;
-                }
-            }
-            else
-            {
-                for (pix = base; pix < end; ++pix)
-                {
-                    const float b = rng[pix];
-                    rng[pix] = b <= max2 ? sqrtf(b) : 0.0f;
-                }
-            }
-        }
-        st.n_pixels_filled = filled;
+        st.n_pixels_filled = pass2_float(buf, points, stride, 0u, npix, max2, st.n_projected > 0);
     }
     proj->n_points = n;
     proj->stats = st;

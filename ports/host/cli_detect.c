@@ -410,6 +410,8 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, gate2, uint8_t, 1)
     CLI_SET_FLOAT(c, kv, klen, v, gate1_margin)
     CLI_SET_FLOAT(c, kv, klen, v, gate2_margin)
+    CLI_SET_FLOAT(c, kv, klen, v, stages.proj.azimuth_half_rad)
+    CLI_SET_INT(c, kv, klen, v, stages.ground.seed_per_cell, uint8_t, 1)
     /* any clustering field, the proposal refinement of issue 15 included */
     if (strncmp(kv, "stages.cluster.", 15) == 0)
         return cli_cluster_set(&c->stages.cluster, kv + 15);
@@ -506,7 +508,10 @@ static void usage_extra(void)
                     "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
                     "                   gate2_margin (nats added to the models' gates); stages.cluster.KEY: a\n"
                     "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
-                    "                   stages.cluster.split_people=0: no proposal refinement)\n"
+                    "                   stages.cluster.split_people=0: no proposal refinement);\n"
+                    "                   stages.proj.azimuth_half_rad: the projection's window and\n"
+                    "                   stages.ground.seed_per_cell: a RANSAC stream per ground cell (the crop\n"
+                    "                   sets both: the clustering's window + one ground sector, and 1)\n"
                     "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n"
                     "  --dump FILE      every result bit for bit (per-point labels, clusters, proposals,\n"
                     "                   detections; binary, see write_dump in cli_detect.c)\n");

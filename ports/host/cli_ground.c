@@ -108,6 +108,7 @@ static int apply_set(lidet_ground_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, min_inliers, uint16_t, 65535)
     CLI_SET_INT(c, kv, klen, v, fallback_sectors, uint16_t, 65535)
     CLI_SET_INT(c, kv, klen, v, seed, uint32_t, 4294967295.0)
+    CLI_SET_INT(c, kv, klen, v, seed_per_cell, uint8_t, 1)
     return 1;
 }
 

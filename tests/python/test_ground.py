@@ -62,7 +62,8 @@ def test_rng_matches_known_sequence():
                                      {"require_descending": 1, "eval_samples": 300},
                                      {"sample_step": 1, "sample_col_step": 1, "n_sectors": 16, "refine_iters": 0,
                                       "ring_split_m": 0.0},
-                                     {"ring_split_m": 25.0, "ground_m_per_m": 0.003, "sample_step": 3, "sample_col_step": 2}])
+                                     {"ring_split_m": 25.0, "ground_m_per_m": 0.003, "sample_step": 3, "sample_col_step": 2},
+                                     {"seed_per_cell": 1}])
 def test_c_matches_numpy_reference(variant):
     rng = np.random.default_rng(3)
     pts = _scene(rng)
@@ -84,6 +85,25 @@ def test_c_matches_numpy_reference(variant):
     z = pts[:, 2] - 0.02 * pts[:, 1]
     assert res.mask_point[z < -1.73 + 0.05].mean() > 0.99
     assert res.mask_point[z > -1.73 + 0.3].mean() < 0.001
+
+
+def test_seed_per_cell_planes_do_not_depend_on_other_sectors():
+    """seed_per_cell: a sector's plane depends on its own samples only, so a scan cut to the front half gets the
+    front sectors' planes of the whole scan (one stream: their draws depend on the sectors before them)."""
+    from lidet_codegen.ref.rng import cell, seed
+    assert cell(12345, 0) != cell(12345, 1) and cell(0, 3) == seed(cell(0, 3)) != 0
+    pts = _scene(np.random.default_rng(5), n_cars=40)
+    front = pts[np.abs(np.arctan2(pts[:, 1], pts[:, 0])) < np.pi / 2]
+    for per_cell in (1, 0):
+        whole = native.ground(pts, "hdl64", seed_per_cell=per_cell)
+        cut = native.ground(front, "hdl64", seed_per_cell=per_cell)
+        ns = len(whole.planes)
+        # sectors wholly inside the front half (32 sectors: 8 .. 23 span azimuths -90 .. +90 degrees), but for
+        # the two at its edges (their filter reads the columns beside them)
+        inner = [s for s in range(ns // 4 + 1, 3 * ns // 4 - 1) if whole.source[s] == 0]  # fitted ones
+        assert len(inner) > 8
+        same = all(np.array_equal(whole.planes[s], cut.planes[s]) for s in inner)
+        assert same == bool(per_cell), per_cell
 
 
 def test_fit_plane_binding():

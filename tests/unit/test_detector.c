@@ -182,9 +182,10 @@ void test_crop_budget_range_and_gates(void)
     TEST_ASSERT_EQUAL_UINT32(3, s->n_clusters);
     TEST_ASSERT_EQUAL_UINT32(1, s->n_out_of_crop); /* C, behind */
     TEST_ASSERT_EQUAL_UINT32(2, s->n_classified);
+    TEST_ASSERT_EQUAL_UINT32(0, s->stages.proj.n_out_of_window); /* the projection's window follows: none */
     {
-        /* the default: the crop sets the clustering's window (crop + 30 deg), C's pixels are no candidates,
-         * the same two detections come out, bit for bit */
+        /* the default: the crop sets the clustering's window (crop + 15 deg) and the projection's (one ground
+         * sector more): C's points are not projected, the same two detections come out, bit for bit */
         lidet_detection_t both[2];
         uint32_t n2 = 0, k, cand_all = s->stages.cluster.n_candidates;
         d = lidet_detector_detections(&g.ws, &n);
@@ -197,6 +198,7 @@ void test_crop_budget_range_and_gates(void)
         TEST_ASSERT_EQUAL_UINT32(2, s->n_clusters);
         TEST_ASSERT_EQUAL_UINT32(0, s->n_out_of_crop);
         TEST_ASSERT_TRUE(s->stages.cluster.n_candidates < cand_all);
+        TEST_ASSERT_TRUE(s->stages.proj.n_out_of_window > 0u); /* C, behind, is not projected */
         d = lidet_detector_detections(&g.ws, &n2);
         TEST_ASSERT_EQUAL_UINT32(2, n2);
         {

@@ -486,6 +486,97 @@ static void test_blocks_and_strides_agree(void)
     }
 }
 
+/* the azimuth window (cfg azimuth_half_rad): the points of its columns land where they land without it, the
+ * others are counted and leave their pixels empty; pi is the whole scan; bad values are refused */
+static void test_azimuth_window(void)
+{
+    const uint32_t cols = 2048u, npix = 64u * 2048u;
+    const float w = 0.25f * 3.14159265f;
+    const float half = w * (float)cols / (2.0f * 3.14159265f);
+    const uint32_t lo = (uint32_t)(0.5f * (float)cols - half - 1.0f),
+                   hi = (uint32_t)(0.5f * (float)cols + half + 1.0f) + 1u;
+    lidet_range_image_t img;
+    const int32_t *pp;
+    uint32_t i, n, out = 0, inside = 0;
+    uint32_t seed = 777u;
+    for (i = 0; i < NB; ++i)
+    {
+        double az, el;
+        seed = seed * 1664525u + 1013904223u;
+        az = -M_PI + 2.0 * M_PI * (double)(seed >> 8) / 16777216.0;
+        seed = seed * 1664525u + 1013904223u;
+        el = -0.4 + 0.42 * (double)(seed >> 8) / 16777216.0;
+        put(&pts[4 * i], 5.0 + 0.1 * (double)i, az, el);
+    }
+    init_sensor("hdl64");
+    lidet_proj_image(&g.ws, &img);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, pts, NB, 4, NULL));
+    TEST_ASSERT_EQUAL_UINT32(NB, lidet_proj_stats(&g.ws)->n_projected);
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_proj_stats(&g.ws)->n_out_of_window);
+    pp = lidet_proj_point_pixels(&g.ws, &n);
+    memcpy(ref_pp, pp, sizeof ref_pp);
+    memcpy(ref_x, img.x_m, sizeof ref_x);
+    memcpy(ref_range, img.range_m, sizeof ref_range);
+    memcpy(ref_rxy, img.rxy_m, sizeof ref_rxy);
+    memcpy(ref_idx, img.point_idx, sizeof ref_idx);
+
+    cfg.azimuth_half_rad = w;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, pts, NB, 4, NULL));
+    for (i = 0; i < NB; ++i)
+    {
+        const uint32_t c = (uint32_t)ref_pp[i] % cols;
+        if (c >= lo && c < hi)
+        {
+            TEST_ASSERT_EQUAL_INT32(ref_pp[i], pp[i]);
+            ++inside;
+        }
+        else
+        {
+            TEST_ASSERT_EQUAL_INT32(-1, pp[i]);
+            ++out;
+        }
+    }
+    TEST_ASSERT_TRUE(inside > 40u && out > 150u); /* a quarter of the points or so inside */
+    TEST_ASSERT_EQUAL_UINT32(out, lidet_proj_stats(&g.ws)->n_out_of_window);
+    TEST_ASSERT_EQUAL_UINT32(inside, lidet_proj_stats(&g.ws)->n_projected);
+    for (i = 0; i < npix; ++i)
+    {
+        const uint32_t c = i % cols;
+        if (c >= lo && c < hi)
+        {
+            TEST_ASSERT_EQUAL_FLOAT(ref_x[i], img.x_m[i]);
+            TEST_ASSERT_EQUAL_FLOAT(ref_range[i], img.range_m[i]);
+            TEST_ASSERT_EQUAL_FLOAT(ref_rxy[i], img.rxy_m[i]);
+            TEST_ASSERT_EQUAL_INT32(ref_idx[i], img.point_idx[i]);
+        }
+        else
+        {
+            TEST_ASSERT_EQUAL_FLOAT(0.0f, img.x_m[i]);
+            TEST_ASSERT_EQUAL_FLOAT(0.0f, img.range_m[i]);
+            TEST_ASSERT_EQUAL_FLOAT(0.0f, img.rxy_m[i]);
+            TEST_ASSERT_EQUAL_INT32(-1, img.point_idx[i]);
+        }
+    }
+    /* a run without points still leaves the pixels beside the window empty (not the previous scan's) */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, pts, 0, 4, NULL));
+    for (i = 0; i < npix; ++i)
+    {
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, img.range_m[i]);
+    }
+
+    cfg.azimuth_half_rad = 3.14159265f; /* pi: the whole scan */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, pts, NB, 4, NULL));
+    TEST_ASSERT_EQUAL_INT32_ARRAY(ref_pp, pp, NB);
+    cfg.azimuth_half_rad = -0.1f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proj_init(&g.ws, &cfg));
+    cfg.azimuth_half_rad = 4.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proj_init(&g.ws, &cfg));
+    cfg.azimuth_half_rad = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proj_init(&g.ws, &cfg));
+}
+
 /* ring path: a point straight above or below the sensor (x = y = 0) has no azimuth; it goes to the
  * straight-ahead column of its ring's row */
 static void test_ring_path_vertical_point(void)
@@ -522,6 +613,7 @@ int main(void)
     RUN_TEST(test_argument_and_config_errors);
     RUN_TEST(test_custom_ring_order);
     RUN_TEST(test_blocks_and_strides_agree);
+    RUN_TEST(test_azimuth_window);
     RUN_TEST(test_ring_path_vertical_point);
     return UNITY_END();
 }

@@ -282,7 +282,7 @@ def _as_per_point(values, n: int, what: str, dtype, lo: int, hi: int) -> np.ndar
 
 
 def proj_defaults() -> dict:
-    """lidet_proj_cfg_default's tunables (min_range_m, max_range_m, fov_margin_rad), from C."""
+    """lidet_proj_cfg_default's tunables (min_range_m, max_range_m, fov_margin_rad, azimuth_half_rad), from C."""
     rec = _record("lidet_proj_cfg_t")
     lib().lidet_py_proj_default(_addr(rec))
     return _to_dict(rec)

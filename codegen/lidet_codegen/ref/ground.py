@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .rng import XorShift32
+from .rng import XorShift32, cell
 
 F = np.float32
 FITTED, NEIGHBOUR, MOUNT, NEAR = 0, 1, 2, 3
@@ -158,9 +158,13 @@ def fit_sectors(cells, cfg: dict):
     rng = XorShift32(int(cfg["seed"]))
     planes = np.zeros((2 * ns, 4))
     src = np.array([MOUNT] * ns + [NEAR] * ns, np.uint8)
+    per_cell = bool(cfg.get("seed_per_cell", 0))
     for k in range(n_cells):
         if len(cells[k]) < int(cfg["min_samples"]):
             continue
+        if per_cell:  # a stream of its own per cell (lidet__rng_cell)
+            rng = XorShift32(0)
+            rng.state = cell(int(cfg["seed"]), k)
         p, _ = ransac_sector(cells[k], rng, cfg)
         if p is not None:
             planes[k], src[k] = p, FITTED

@@ -12,6 +12,17 @@ def seed(s: int) -> int:
     return s if s else DEFAULT_SEED
 
 
+def cell(s: int, k: int) -> int:
+    """The start state of cell k (lidet__rng_cell): seed and cell index mixed by MurmurHash3's finaliser."""
+    h = (s ^ (k * 0x9E3779B9)) & _M
+    h ^= h >> 16
+    h = (h * 0x85EBCA6B) & _M
+    h ^= h >> 13
+    h = (h * 0xC2B2AE35) & _M
+    h ^= h >> 16
+    return seed(h)
+
+
 class XorShift32:
     """Deterministic generator mirroring lidet__rng_next / lidet__rng_below."""
 

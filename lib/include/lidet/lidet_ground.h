@@ -125,6 +125,11 @@ typedef struct
                                    [0, n_sectors] */
     uint32_t seed;             /**< xorshift32 seed (0 is replaced by a fixed non-zero value);
                                    re-applied at every run, so runs are deterministic */
+    uint8_t seed_per_cell;     /**< 0 (default): one random stream through the cells in order; 1: each
+                                   cell draws from a stream of its own (seed mixed with the cell index), so
+                                   a cell's plane depends on its own samples alone and a windowed scan
+                                   (lidet_proj_cfg_t azimuth_half_rad) gets, inside the window, the planes
+                                   of the whole scan (the detector's crop sets it) */
     /* ---- labelling ---- */
     float ground_m;       /**< p_th: max height above the sector plane for ground, metres;
                                    (0, 5], typical 0.1-0.3 */

@@ -49,16 +49,20 @@ extern "C" {
 /** @brief Runtime configuration of the projection. Fill with lidet_proj_cfg_default(). */
 typedef struct
 {
-    lidet_sensor_t sensor; /**< the sensor (its table is copied by init) */
-    float min_range_m;     /**< points closer than this are dropped (zero range included);
+    lidet_sensor_t sensor;  /**< the sensor (its table is copied by init) */
+    float min_range_m;      /**< points closer than this are dropped (zero range included);
                                 [0, 10], default 0.1 m */
-    float max_range_m;     /**< points farther are dropped; [0, 1e6], 0 = no limit (default) */
-    float fov_margin_rad;  /**< how far above the top beam / below the bottom beam a point may lie
+    float max_range_m;      /**< points farther are dropped; [0, 1e6], 0 = no limit (default) */
+    float fov_margin_rad;   /**< how far above the top beam / below the bottom beam a point may lie
                                 and still map to the edge row; [0, 0.5], default 5 deg (0.0873): the
                                 lasers sit centimetres off the optical centre, so close returns appear
                                 degrees outside the table (real KITTI: top-beam points at 4 m show up
                                 to 2.5 deg above it). For a uniform fov (table NULL) the margin is
                                 added to fov_up / fov_down. */
+    float azimuth_half_rad; /**< 0 (default): the whole scan; in (0, pi): only points whose column lies within
+                                 this of straight ahead (+x), one more column each side, are projected, the
+                                 others counted in n_out_of_window (the pixels outside stay empty); >= pi: the
+                                 whole scan. The detector's crop sets it (lidet_detector.h) */
 } lidet_proj_cfg_t;
 
 /** @brief Why points were not projected (counts of the last run). */
@@ -73,6 +77,7 @@ typedef struct
     uint32_t n_out_of_fov;    /**< elevation outside the beams (+ margin) */
     uint32_t n_bad_ring;      /**< ring index >= n_rows (ring path only) */
     uint32_t n_truncated;     /**< points past LIDET_MAX_POINTS, not looked at */
+    uint32_t n_out_of_window; /**< column outside the azimuth window (cfg azimuth_half_rad) */
 } lidet_proj_stats_t;
 
 /** @brief Unit of the compact image (a detector workspace's pixels, lidet_workspace.h): 4 mm, so int16
@@ -148,7 +153,8 @@ typedef struct
                                                  [n_cols] = 5 (> any D), a sentinel */
     uint16_t col_lut[4 * LIDET_MAX_COLS + 1]; /* D bucket (width 1/n_cols) -> column of its low end */
     float col_lut_scale;                      /* n_cols: buckets per unit of D */
-    uint32_t n_points;                        /* points of the last run (<= LIDET_MAX_POINTS) */
+    uint32_t win_lo, win_hi; /* the azimuth window's columns [win_lo, win_hi) (0, n_cols: all) */
+    uint32_t n_points;       /* points of the last run (<= LIDET_MAX_POINTS) */
     lidet_proj_stats_t stats;
 } lidet_proj_state_t;
 

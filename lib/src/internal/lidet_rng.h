@@ -17,6 +17,19 @@ static inline uint32_t lidet__rng_seed(uint32_t seed)
     return seed != 0u ? seed : LIDET_RNG_DEFAULT_SEED;
 }
 
+/* the start state of cell k of a stage seeded with seed: a 32-bit mix (the finaliser of MurmurHash3) of both,
+ * so every cell draws from a stream of its own, whatever the other cells held */
+static inline uint32_t lidet__rng_cell(uint32_t seed, uint32_t k)
+{
+    uint32_t h = seed ^ (k * 0x9E3779B9u);
+    h ^= h >> 16;
+    h *= 0x85EBCA6Bu;
+    h ^= h >> 13;
+    h *= 0xC2B2AE35u;
+    h ^= h >> 16;
+    return lidet__rng_seed(h);
+}
+
 /* advances *state and returns the new value (never 0 for a non-zero state) */
 static inline uint32_t lidet__rng_next(uint32_t *state)
 {
