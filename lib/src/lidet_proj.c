@@ -529,9 +529,10 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
         const float col_scale = proj->col_lut_scale;
         const float last_col_bucket = (float)(4u * cols);
         const int row_single = proj->row_single_step, col_single = proj->col_single_step;
-        const uint32_t win_lo = proj->win_lo, win_n = proj->win_hi - proj->win_lo;
         const float *const row_bound = proj->row_bound_tan;
         const float *const col_edge = proj->col_edge_key;
+        const float win_dlo = col_edge[proj->win_lo],
+                    win_dhi = col_edge[proj->win_hi]; /* [n_cols]: > any d */
         const uint8_t *const row_lut = proj->row_lut;
         const uint16_t *const col_lut = proj->col_lut;
         const uint8_t *const ring_to_row = proj->ring_to_row;
@@ -588,14 +589,22 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
                         col_k = (int32_t)(d * col_scale);
                     }
                 }
+                if (ring != 0 && ring[i] >= rows)
+                {
+                    ++st.n_bad_ring;
+                    kb.pix[j] = -1;
+                    continue;
+                }
+                /* the azimuth window, before the row and column searches: column c holds exactly the keys
+                 * col_edge[c] <= d < col_edge[c + 1], so this is the test of the column the search would find */
+                if (!(d >= win_dlo && d < win_dhi))
+                {
+                    ++st.n_out_of_window;
+                    kb.pix[j] = -1;
+                    continue;
+                }
                 if (ring != 0)
                 {
-                    if (ring[i] >= rows)
-                    {
-                        ++st.n_bad_ring;
-                        kb.pix[j] = -1;
-                        continue;
-                    }
                     row = ring_to_row[ring[i]];
                 }
                 else
@@ -629,13 +638,7 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
                     while (col_edge[col + 1] <= d)
                         ++col;
                 }
-                if ((uint32_t)col - win_lo >=
-                    win_n) /* outside the azimuth window (unsigned: below win_lo too) */
-                {
-                    ++st.n_out_of_window;
-                    kb.pix[j] = -1;
-                    continue;
-                }
+                LIDET_ASSERT((uint32_t)col >= proj->win_lo && (uint32_t)col < proj->win_hi);
                 pix = (uint32_t)row * cols + (uint32_t)col;
                 LIDET_ASSERT(pix < npix);
                 kb.pix[j] = (int32_t)pix;

@@ -221,7 +221,7 @@ typedef struct
     float azimuth_half_rad;     /**< 0 (default): the whole image; in (0, pi): only pixels whose column lies
                                        within this azimuth of straight ahead (+x; one column more on each
                                        side) are candidates (the others are not counted in n_candidates). The
-                                       detector's crop sets it to the crop + 30 deg, so a cropped scan is
+                                       detector's crop sets it to the crop + 15 deg, so a cropped scan is
                                        clustered on that part only; pi: no limit */
     uint32_t max_join_pieces;   /**< join budget (bounds the joins' time whatever the scan): only the first
                                   max_join_pieces car pieces in slot order take part in the joins, the rest

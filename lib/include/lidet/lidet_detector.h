@@ -75,7 +75,10 @@ typedef struct
     lidet_workspace_cfg_t stages;  /**< projection, ground, clustering */
     lidet_proposal_cfg_t proposal; /**< n_points is set from the models by init; seed and PVLE bins used */
     float crop_half_rad;           /**< 0: 360 degrees; else keep clusters with |azimuth| <= this (KITTI
-                                         camera field of view: pi/4); (0, pi] */
+                                         camera field of view: pi/4); (0, pi]. It also sets the stages'
+                                         windows (docs/DETECTOR.md, Crop): the clustering's (crop + 15 deg),
+                                         the projection's (one ground sector more), and the ground's
+                                         seed_per_cell */
     float max_range_m;             /**< clusters whose mean is farther are not classified; 0 = no limit */
     uint32_t max_proposals;        /**< at most this many clusters classified per scan, nearest first;
                                          [1, LIDET_MAX_CLUSTERS]; default 256 (> 16 beams), 128 (<= 16 beams),
@@ -118,7 +121,7 @@ typedef struct
 typedef struct
 {
     uint32_t n_clusters;        /**< kept clusters */
-    uint32_t n_out_of_crop;     /**< clusters whose mean lies outside the crop (the crop + 30 deg window
+    uint32_t n_out_of_crop;     /**< clusters whose mean lies outside the crop (the crop + 15 deg window
                                              of the clustering keeps the rest of the scan out) */
     uint32_t n_out_of_range;    /**< beyond max_range_m */
     uint32_t n_over_budget;     /**< past max_proposals (farthest first) */
