@@ -244,7 +244,7 @@ static void fz_check_proj_stats(const lidet_proj_stats_t *st, uint32_t n_points,
     FZ_CHECK(st->n_pixels_filled <= n_pixels);
     FZ_CHECK(st->n_pixels_filled <= st->n_projected);
     FZ_CHECK((uint64_t)st->n_projected + st->n_nonfinite + st->n_too_close + st->n_too_far + st->n_out_of_fov +
-                 st->n_bad_ring + st->n_truncated ==
+                 st->n_bad_ring + st->n_out_of_window + st->n_truncated ==
              n_points);
     FZ_CHECK(st->n_truncated == (n_points > LIDET_MAX_POINTS ? n_points - LIDET_MAX_POINTS : 0u));
 }
