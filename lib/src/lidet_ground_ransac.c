@@ -416,7 +416,27 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
     {
         return 0;
     }
-    /* least-squares refinement on the inliers of the current plane (all samples of the sector) */
+    /* least-squares refinement on the inliers of the current plane (all samples of the sector), on a
+     * contiguous copy of them: the scoring copy when it holds them all (stride 1), else, when they fit, the
+     * row scratch of the label pass (free until that pass: x_row, y_row, z_rows[0]) filled once here, so the
+     * iterations neither gather nor decode again; the sums are those of the gathered blocks, bit for bit */
+    const float *rx = 0, *ry = 0, *rz = 0;
+    if (copied && stride == 1u)
+    {
+        rx = sc->ev_x_m;
+        ry = sc->ev_y_m;
+        rz = sc->ev_z_m;
+    }
+    else if (n <= (uint32_t)LIDET_MAX_COLS && cfg->refine_iters > 1u)
+    {
+        for (i = 0; i < n; ++i)
+        {
+            lidet__img_xyz(img, idx[i], compact, &sc->x_row[i], &sc->y_row[i], &sc->z_rows[0][i]);
+        }
+        rx = sc->x_row;
+        ry = sc->y_row;
+        rz = sc->z_rows[0];
+    }
     for (r = 0; r < cfg->refine_iters; ++r)
     {
         float cov[3][3], centroid[3], shift[3];
@@ -425,11 +445,8 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
         float z_first;
         lidet__img_xyz(img, idx[0], compact, &shift[0], &shift[1], &z_first);
         shift[2] = best.nz > 0.0f ? -(best.nx * shift[0] + best.ny * shift[1] + best.d_m) / best.nz : z_first;
-        /* every sample is in the scoring copy when its stride is 1 (a cell of at most eval_samples): the
-         * contiguous sums, bit for bit those of the gathered blocks, without gathering (and decoding) again */
-        if ((copied && stride == 1u
-                 ? accumulate(sc->ev_x_m, sc->ev_y_m, sc->ev_z_m, n, &best, cfg->inlier_m, shift, cov,
-                              centroid)
+        if ((rx != 0
+                 ? accumulate(rx, ry, rz, n, &best, cfg->inlier_m, shift, cov, centroid)
                  : accumulate_idx(img, compact, idx, n, &best, cfg->inlier_m, shift, cov, centroid)) < 3u ||
             !plane_from_cov(cov, centroid, &p, 0) || !(p.nz * p.nz >= cos2))
         {
