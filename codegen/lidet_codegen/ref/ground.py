@@ -162,9 +162,8 @@ def fit_sectors(cells, cfg: dict):
     for k in range(n_cells):
         if len(cells[k]) < int(cfg["min_samples"]):
             continue
-        if per_cell:  # a stream of its own per cell (lidet__rng_cell)
-            rng = XorShift32(0)
-            rng.state = cell(int(cfg["seed"]), k)
+        if per_cell:  # a stream of its own per cell (lidet__rng_cell; never 0, so XorShift32 keeps it)
+            rng = XorShift32(cell(int(cfg["seed"]), k))
         p, _ = ransac_sector(cells[k], rng, cfg)
         if p is not None:
             planes[k], src[k] = p, FITTED
