@@ -19,11 +19,13 @@ typedef struct
     const char *ring_path;  /* --ring FILE (uint16 per point) */
     int json;               /* --json */
     int repeat;             /* --repeat N (>= 1) */
+    double mount_height_m;  /* --mount-height M: the sensor's height above the ground, m (< 0: the profile's) */
     /* loaded by cli_load */
     float *points;          /* n_points * 4 floats (x, y, z, remission) */
     uint32_t n_points;
     uint16_t *ring;         /* NULL unless --ring */
-    const lidet_sensor_t *sensor_profile;
+    const lidet_sensor_t *sensor_profile; /* the preset, or sensor_mounted when --mount-height is given */
+    lidet_sensor_t sensor_mounted;        /* the preset with the --mount-height of the command line */
 } cli_args_t;
 
 /* Parses argv (after the subcommand). Returns 0, or prints usage/error to stderr and returns 1. */

@@ -11,12 +11,14 @@ static void usage(const char *cmd)
 {
     fprintf(stderr,
             "usage: lidet %s SCAN.bin [--sensor NAME] [--ring RING.bin] [--out FILE] [--png FILE] [--json]\n"
-            "                 [--repeat N]\n"
+            "                 [--repeat N] [--mount-height M]\n"
             "  SCAN.bin   KITTI velodyne scan: float32 records x, y, z, remission (metres, sensor frame)\n"
             "  --sensor   hdl64 (default), vlp16, vlp32c, os1-64, os1-128\n"
             "  --ring     optional uint16 ring index per point (sensor's ring order) instead of elevation\n"
             "  --json     print one JSON object (stage timings as <stage>_ms)\n"
-            "  --repeat   run the stage N times and report the median time (file reading excluded)\n",
+            "  --repeat   run the stage N times and report the median time (file reading excluded)\n"
+            "  --mount-height  the sensor's height above the ground in metres, in [0, 10] (default: the\n"
+            "             profile's: hdl64 1.73, vlp16 0.5, ...); the ground and clustering stages use it\n",
             cmd);
 }
 
@@ -26,6 +28,7 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
     memset(a, 0, sizeof *a);
     a->sensor = "hdl64";
     a->repeat = 1;
+    a->mount_height_m = -1.0;
     for (i = 0; i < argc; ++i)
     {
         const char *s = argv[i];
@@ -35,7 +38,7 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
             a->json = 1;
         }
         else if ((strcmp(s, "--sensor") == 0 || strcmp(s, "--out") == 0 || strcmp(s, "--png") == 0 ||
-                  strcmp(s, "--repeat") == 0 || strcmp(s, "--ring") == 0))
+                  strcmp(s, "--repeat") == 0 || strcmp(s, "--ring") == 0 || strcmp(s, "--mount-height") == 0))
         {
             if (!has_val)
             {
@@ -50,6 +53,18 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
                 a->png_path = argv[++i];
             else if (strcmp(s, "--ring") == 0)
                 a->ring_path = argv[++i];
+            else if (strcmp(s, "--mount-height") == 0)
+            {
+                char *end;
+                const double v = strtod(argv[++i], &end);
+                /* !(v >= 0 && v <= 10) also refuses NaN */
+                if (end == argv[i] || *end != '\0' || !(v >= 0.0 && v <= 10.0))
+                {
+                    fprintf(stderr, "lidet %s: --mount-height needs metres in [0, 10], got '%s'\n", cmd, argv[i]);
+                    return 1;
+                }
+                a->mount_height_m = v;
+            }
             else
             {
                 char *end;
@@ -94,6 +109,12 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
         fprintf(stderr, "lidet %s: unknown sensor '%s' (known: hdl64, vlp16, vlp32c, os1-64, os1-128)\n", cmd,
                 a->sensor);
         return 1;
+    }
+    if (a->mount_height_m >= 0.0)
+    {
+        a->sensor_mounted = *a->sensor_profile;
+        a->sensor_mounted.mount_height_m = (float)a->mount_height_m;
+        a->sensor_profile = &a->sensor_mounted;
     }
     return 0;
 }

@@ -768,6 +768,21 @@ outputs:
         free(ids);
         free(gt);
     }
+    if (!fixed)
+    {
+        /* a mount height far from the real one makes the ground stage refuse most sectors' planes (their
+         * height is checked against it) and fall back to planes at the wrong height: the ground is then
+         * left in the clusters and whole road users are lost (docs/DETECTOR.md, Mount height) */
+        const lidet_ground_stats_t *gs = &ds->stages.ground;
+        const uint32_t ns = cfg.stages.ground.n_sectors;
+        if (2u * (uint32_t)gs->n_sectors_rejected > ns)
+            fprintf(stderr,
+                    "lidet detect: warning: the ground stage refused the planes of %u of %u sectors (each is "
+                    "checked against a ground %.2f m below the sensor, +-%.2f m): is the mount height right? "
+                    "(--mount-height M)\n",
+                    (unsigned)gs->n_sectors_rejected, (unsigned)ns, (double)cfg.stages.ground.mount_height_m,
+                    (double)cfg.stages.ground.max_height_dev_m);
+    }
     if (a.json)
     {
         cli_json_begin(stdout);

@@ -24,6 +24,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
 {
     const double bam_per_rad = 4294967296.0 / (2.0 * M_PI_D);
     const lidet_sensor_q_t *s = lidet_sensor_q_find(a->sensor);
+    lidet_sensor_q_t mounted;
     const lidet_pointnet_q_model_t *mc, *mb;
     const lidet_detection_q_t *dq;
     const lidet_detector_q_stats_t *st;
@@ -46,6 +47,12 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     {
         fprintf(stderr, "lidet detect --fixed: no int8 models cls_%s_s8 / box_%s_s8 in weights/\n", family, family);
         return 1;
+    }
+    if (a->mount_height_m >= 0.0) /* --mount-height, in mm as the integer profile holds it */
+    {
+        mounted = *s;
+        mounted.mount_height_mm = round_i32(a->mount_height_m * 1000.0);
+        s = &mounted;
     }
     lidet_detector_q_cfg_default(&cfg, s);
     cfg.crop_half_bam = fcfg->crop_half_rad >= (float)M_PI_D ? 0x7FFFFFFF

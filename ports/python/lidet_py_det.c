@@ -17,8 +17,8 @@
 static lidet_detector_t g_det;
 static int32_t g_pp[LIDET_MAX_POINTS];
 
-/* fcfg: crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin; ucfg: max_proposals (0 = the default), gate1, gate2, refine (the
- * clustering's split_people and join_cars).
+/* fcfg: crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin, mount_height_m (< 0: the profile's);
+ * ucfg: max_proposals (0 = the default), gate1, gate2, refine (the clustering's split_people and join_cars).
  * out_det: LIDET_MAX_DETECTIONS rows of 12 floats (class, score, energy_cls, energy_box, cx, cy, cz, l, w, h,
  * yaw, cluster id); out_outcome: LIDET_MAX_CLUSTERS bytes; out_point_cluster / out_point_ground: n entries
  * (may be NULL); out_stats: 14 uint32 (the lidet_detector_stats_t counts in order, the status, then
@@ -29,6 +29,7 @@ LIDET_PY_API int lidet_py_det_run(const char *sensor, uint32_t cls_index, uint32
                                   uint32_t *out_point_cluster, uint8_t *out_point_ground, uint32_t *out_stats)
 {
     const lidet_sensor_t *s = lidet_sensor_find(sensor);
+    lidet_sensor_t mounted;
     lidet_detector_cfg_t cfg;
     const lidet_detection_t *d;
     const lidet_detector_stats_t *st;
@@ -42,6 +43,12 @@ LIDET_PY_API int lidet_py_det_run(const char *sensor, uint32_t cls_index, uint32
     if (cls_index >= LIDET_WEIGHTS_N_MODELS || box_index >= LIDET_WEIGHTS_N_MODELS)
     {
         return LIDET_ERR_NOT_FOUND;
+    }
+    if (fcfg[5] >= 0.0f) /* the sensor's height above the ground; < 0: the profile's */
+    {
+        mounted = *s;
+        mounted.mount_height_m = fcfg[5];
+        s = &mounted;
     }
     lidet_detector_cfg_default(&cfg, s);
     cfg.crop_half_rad = fcfg[0];

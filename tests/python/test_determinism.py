@@ -84,3 +84,17 @@ def test_release_and_sanitizer_builds_identical(cli, tmp_path, sensor, scan, cmd
         subprocess.run([str(exe), cmd, str(scan), "--sensor", sensor, opt, str(p)], check=True, capture_output=True)
         outs.append(p.read_bytes())
     assert len(outs[0]) > 0 and outs[0] == outs[1]
+
+
+def test_detect_mount_height_argument():
+    """native.detect(mount_height_m=...): the profile's own height changes nothing, a bad one is refused."""
+    from lidet_tools import kitti, native
+    pts = kitti.read_bin(ROOT / "tests" / "data" / "sim_vlp16" / "velodyne" / "000000.bin")
+    a = native.detect(pts, "vlp16")
+    b = native.detect(pts, "vlp16", mount_height_m=0.5)
+    assert np.array_equal(a.box, b.box) and np.array_equal(a.point_ground, b.point_ground)
+    c = native.detect(pts, "vlp16", mount_height_m=1.2)
+    assert not np.array_equal(a.point_ground, c.point_ground)
+    for bad in (float("nan"), -0.5, 11.0):
+        with pytest.raises(ValueError, match="mount_height_m"):
+            native.detect(pts, "vlp16", mount_height_m=bad)

@@ -2,7 +2,7 @@
 """Run the detector (`lidet detect`, the host CLI: exactly what the firmware computes) over a KITTI-format
 folder and write a prediction folder that `lidet-eval kitti` / `lidet-eval boxes` score.
 
-    python -m lidet_tools.detect KITTI_DIR --out PRED_DIR [--sensor hdl64] [--crop] [--model NAME] [--fixed] [--jobs 2]
+    python -m lidet_tools.detect KITTI_DIR --out PRED_DIR [--sensor hdl64] [--crop] [--model NAME] [--fixed] [--mount-height M] [--jobs 2]
 
 KITTI_DIR holds velodyne/<id>.bin and, for label_2 output, calib/<id>.txt. PRED_DIR receives label_2/<id>.txt
 (camera frame, 2D box from the projected corners; only when calib/ exists), boxes/<id>.txt (lidet's
@@ -95,8 +95,12 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=1, help="frames in parallel (one process each)")
     ap.add_argument("--set", action="append", default=[], help="KEY=VALUE passed to lidet detect --set")
     ap.add_argument("--fixed", action="store_true", help="the integer detector (lidet detect --fixed: int8 models)")
+    ap.add_argument("--mount-height", type=float, metavar="M",
+                    help="the sensor's height above the ground in m (default: the sensor profile's)")
     a = ap.parse_args(argv)
     extra = [x for kv in a.set for x in ("--set", kv)] + (["--fixed"] if a.fixed else [])
+    if a.mount_height is not None:
+        extra += ["--mount-height", repr(a.mount_height)]
     try:
         res = run_folder(a.kitti_dir, a.out, a.sensor, a.crop, a.model, a.jobs, extra)
     except (FileNotFoundError, RuntimeError) as e:

@@ -720,12 +720,14 @@ class Detections:
 
 def detect(points, sensor: str = "hdl64", model: str | None = None, crop_half_rad: float = 0.0,
            max_range_m: float = 0.0, nms_iou: float = 0.1, max_proposals: int | None = None, gate1: bool = True,
-           gate2: bool = True, refine: bool = True, gate1_margin: float = 0.0, gate2_margin: float = 0.0) -> Detections:
+           gate2: bool = True, refine: bool = True, gate1_margin: float = 0.0, gate2_margin: float = 0.0,
+           mount_height_m: float | None = None) -> Detections:
     """lidet_detector_run on (N, >=3) points with the models cls_<model> / box_<model> compiled into the bindings
     (default: the sensor's family if present, else hdl64). A preset sensor name only. max_proposals None: the
     C default for the sensor (lidet_detector_cfg_default). refine False: the clustering without its refinement
     (split_people, join_cars: lidet_refine.c), as the integer detector runs it today. gate1_margin / gate2_margin:
-    the gates' operating points (lidet_detector_cfg_t, nats added to the models' gammas)."""
+    the gates' operating points (lidet_detector_cfg_t, nats added to the models' gammas). mount_height_m: the
+    sensor's height above the ground in m, [0, 10] (None: the profile's; `lidet detect --mount-height`)."""
     if max_proposals is not None and not (isinstance(max_proposals, (int, np.integer)) and max_proposals >= 1):
         raise ValueError(f"max_proposals must be a positive integer, got {max_proposals!r}")
     ms = pn_models()
@@ -748,7 +750,10 @@ def detect(points, sensor: str = "hdl64", model: str | None = None, crop_half_ra
     pc = np.zeros(max(n, 1), np.uint32)
     pg = np.zeros(max(n, 1), np.uint8)
     st = np.zeros(len(_DET_STATS), np.uint32)
-    fc = np.array([crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin], np.float32)
+    if mount_height_m is not None and not (0.0 <= float(mount_height_m) <= 10.0):
+        raise ValueError(f"mount_height_m must be metres in [0, 10], got {mount_height_m!r}")
+    fc = np.array([crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin,
+                   -1.0 if mount_height_m is None else mount_height_m], np.float32)
     uc = np.array([max_proposals or 0, int(bool(gate1)), int(bool(gate2)), int(bool(refine))], np.uint32)
     rc = L.lidet_py_det_run(sensor.encode(), ms[f"cls_{fam}"].index, ms[f"box_{fam}"].index, fc, uc,
                             pts if n else np.zeros((1, 4), np.float32), n, stride, det, nd, oc, nc, pc, pg, st)
