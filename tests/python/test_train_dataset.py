@@ -88,3 +88,20 @@ def test_jobs_do_not_change_the_dataset(need_lib, tmp_path):
     for k in ("points", "voxel", "label", "box", "split", "scan"):
         np.testing.assert_array_equal(a[k], b[k])
     assert sorted(set(a["split"].tolist())) == [0, 1, 2]
+
+
+def test_sim_scans_run_the_stages_at_their_mount_height(monkeypatch, need_lib):
+    """A simulated robot mount is processed with that mount height (as `lidet detect --mount-height` configures
+    the detector on that robot), a scan at the profile's height with the profile."""
+    from lidet_tools import native
+    seen = []
+    real_ground = native.ground
+
+    def spy(points, sensor="hdl64", *a, **k):
+        seen.append(sensor.mount_height_m)
+        return real_ground(points, sensor, *a, **k)
+    monkeypatch.setattr(native, "ground", spy)
+    out = D._job(("sim", 0, 2000, 0, 1.0), "vlp16", dict(D.DEFAULTS))
+    D._job(("sim", 0, 2000, 1, None), "vlp16", dict(D.DEFAULTS))
+    assert seen == [1.0, 0.5]
+    assert len(out["label"]) > 0 and (out["label"] >= 0).any()
