@@ -768,7 +768,6 @@ outputs:
         free(ids);
         free(gt);
     }
-    if (!fixed)
     {
         /* a mount height far from the real one makes the ground stage refuse most sectors' planes (their
          * height is checked against it) and fall back to planes at the wrong height: the ground is then

@@ -129,6 +129,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     ds->n_over_capacity = st->n_over_capacity;
     ds->n_over_box_budget = st->n_over_box_budget;
     ds->n_detections = st->n_detections;
+    ds->stages.ground = st->ground; /* the same counts (lidet detect's mount-height warning reads them) */
     dq = lidet_detector_q_detections(&g_detq, n_det);
     for (k = 0; k < *n_det; ++k)
     {

@@ -164,7 +164,8 @@ def test_mount_height_option(cli, tmp_path):
     assert same["boxes"] == jp["boxes"]
     # the integer detector takes it too
     fx = _run(cli, scan, "--sensor", "vlp16", "--json", "--fixed", "--mount-height", "1.0")
-    assert cars(json.loads(fx.stdout)) >= cars(jp)
+    assert cars(json.loads(fx.stdout)) >= cars(jp) and "warning" not in fx.stderr
+    assert "is the mount height right?" in _run(cli, scan, "--sensor", "vlp16", "--json", "--fixed").stderr
     for bad in ("nan", "-0.1", "10.5", "abc", ""):
         r = _run(cli, scan, "--sensor", "vlp16", "--mount-height", bad, ok=False)
         assert r.returncode == 1 and "--mount-height needs metres in [0, 10]" in r.stderr, bad
