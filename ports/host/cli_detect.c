@@ -778,7 +778,7 @@ outputs:
             fprintf(stderr,
                     "lidet detect: warning: the ground stage refused the planes of %u of %u sectors (each is "
                     "checked against a ground %.2f m below the sensor, +-%.2f m): is the mount height right? "
-                    "(--mount-height M)\n",
+                    "(--mount-height M; python -m lidet_tools.mount SCANS estimates it)\n",
                     (unsigned)gs->n_sectors_rejected, (unsigned)ns, (double)cfg.stages.ground.mount_height_m,
                     (double)cfg.stages.ground.max_height_dev_m);
     }
