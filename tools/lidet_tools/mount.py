@@ -12,7 +12,7 @@ planes' offsets: a plane n.p + d = 0 with a unit normal lies d metres below the 
 scans is the estimate. Record a few scans where the robot stands on open, level ground.
 
 Measured (20 simulated VLP-16 scans per mount; `lidet-sim --mount-height`): 0.31 / 0.53 / 0.74 / 1.04 m at 0.3 /
-0.5 / 0.7 / 1.0 m mounts, single scans within 0.07-0.2 m; the 9 labelled KITTI / SemanticKITTI scans of
+0.5 / 0.7 / 1.0 m mounts, single scans within 0.05 (0.3 m) to 0.2 m (0.7 m) of it; the 9 labelled KITTI / SemanticKITTI scans of
 ../shared/data/real give 1.67-1.81 m, median 1.80 m (KITTI's HDL-64 is mounted at 1.73 m).
 """
 from __future__ import annotations
