@@ -8,6 +8,7 @@
 #include "internal/lidet_ground_internal.h"
 #include "internal/lidet_math.h"
 #include "internal/lidet_pixel.h"
+#include "internal/lidet_pixel_rxy.h"
 #include "internal/lidet_rng.h"
 #include "internal/lidet_simd.h"
 
@@ -175,15 +176,6 @@ static inline void filter_row(const float *R0, const float *R1, const float *Z0,
  * over the rows in increasing order computes each row once. */
 
 /* The compact image's row decoding (streaming loops: AVX2 variants on x86-64 hosts, internal/lidet_simd.h) */
-/* out[c] = R of the decoded x, y (4 mm steps) */
-LIDET_CLONES_AVX2 static void decode_rxy(const int16_t *x, const int16_t *y, uint32_t cols, float *out)
-{
-    uint32_t c;
-    for (c = 0; c < cols; ++c)
-    {
-        out[c] = lidet__rxy(lidet__pix_m(x[c]), lidet__pix_m(y[c]));
-    }
-}
 /* out[c] = R of float x, y */
 LIDET_CLONES_AVX2 static void rxy_of(const float *x, const float *y, uint32_t cols, float *out)
 {
@@ -216,6 +208,18 @@ LIDET_CLONES_AVX2 static void decode_xyzr(const int16_t *x, const int16_t *y, co
         orxy[c] = lidet__rxy(xm, ym);
     }
 }
+/* x, y and z decoded (a compact image that keeps R) */
+LIDET_CLONES_AVX2 static void decode_xyz(const int16_t *x, const int16_t *y, const int16_t *z, uint32_t cols,
+                                         float *ox, float *oy, float *oz)
+{
+    uint32_t c;
+    for (c = 0; c < cols; ++c)
+    {
+        ox[c] = lidet__pix_m(x[c]);
+        oy[c] = lidet__pix_m(y[c]);
+        oz[c] = lidet__pix_m(z[c]);
+    }
+}
 /* R of the decoded x, y, and z decoded */
 LIDET_CLONES_AVX2 static void decode_rz(const int16_t *x, const int16_t *y, const int16_t *z, uint32_t cols,
                                         float *orxy, float *oz)
@@ -241,7 +245,8 @@ static void rxy_rows_init(rxy_rows_t *rr, lidet_ground_scratch_t *sc, const lide
 {
     rr->img = img;
     rr->compact = lidet__img_compact(img);
-    rr->img_rxy = rr->compact ? 0 : img->rxy_m;
+    rr->img_rxy =
+        img->rxy_m; /* a float image's R, or a compact image's (the same expression on its values) */
     rr->slot[0] = sc->rxy_rows[0];
     rr->slot[1] = sc->rxy_rows[1];
     rr->zslot[0] = sc->z_rows[0];
@@ -271,7 +276,7 @@ static const float *rxy_row(rxy_rows_t *rr, uint32_t r)
         }
         else
         {
-            decode_rxy(rr->img->x_4mm + base, rr->img->y_4mm + base, cols, out);
+            lidet__rxy_4mm(rr->img->x_4mm + base, rr->img->y_4mm + base, cols, out);
         }
         rr->row_in[k] = (int32_t)r;
     }
@@ -311,11 +316,19 @@ static void xy_row(rxy_rows_t *rr, uint32_t r, const float **X, const float **Y)
     if (rr->xyrow_in != (int32_t)r)
     {
         const lidet_range_image_t *img = rr->img;
-        decode_xyzr(img->x_4mm + base, img->y_4mm + base, img->z_4mm + base, cols, rr->xrow, rr->yrow,
-                    rr->zslot[k], rr->slot[k]);
+        if (rr->img_rxy != 0)
+        {
+            decode_xyz(img->x_4mm + base, img->y_4mm + base, img->z_4mm + base, cols, rr->xrow, rr->yrow,
+                       rr->zslot[k]);
+        }
+        else
+        {
+            decode_xyzr(img->x_4mm + base, img->y_4mm + base, img->z_4mm + base, cols, rr->xrow, rr->yrow,
+                        rr->zslot[k], rr->slot[k]);
+            rr->row_in[k] = (int32_t)r;
+        }
         rr->xyrow_in = (int32_t)r;
         rr->zrow_in[k] = (int32_t)r;
-        rr->row_in[k] = (int32_t)r;
     }
     *X = rr->xrow;
     *Y = rr->yrow;
@@ -325,7 +338,7 @@ static void xy_row(rxy_rows_t *rr, uint32_t r, const float **X, const float **Y)
 static void rz_row(rxy_rows_t *rr, uint32_t r, const float **R, const float **Z)
 {
     const uint32_t k = r & 1u;
-    if (rr->compact && rr->row_in[k] != (int32_t)r && rr->zrow_in[k] != (int32_t)r)
+    if (rr->compact && rr->img_rxy == 0 && rr->row_in[k] != (int32_t)r && rr->zrow_in[k] != (int32_t)r)
     {
         const size_t base = (size_t)r * rr->cols;
         const lidet_range_image_t *img = rr->img;
@@ -411,14 +424,14 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc,
             const uint8_t *m = sc->sample + base;
             /* R decides near or far only with a split: the image's, else computed for the sector's columns of
              * this row into a scratch row (free between the filter and the label pass), at the same columns */
-            const float *R = !lidet__img_compact(img) && img->rxy_m != 0 ? img->rxy_m + base : 0;
+            const float *R = img->rxy_m != 0 ? img->rxy_m + base : 0;
             if (two && R == 0 && roomy && cstart < c1)
             {
                 float *tmp = sc->rxy_rows[0];
                 if (lidet__img_compact(img))
                 {
-                    decode_rxy(img->x_4mm + base + cstart, img->y_4mm + base + cstart, c1 - cstart,
-                               tmp + cstart);
+                    lidet__rxy_4mm(img->x_4mm + base + cstart, img->y_4mm + base + cstart, c1 - cstart,
+                                   tmp + cstart);
                 }
                 else
                 {

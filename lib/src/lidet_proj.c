@@ -6,6 +6,7 @@
 
 #include "internal/lidet_assert.h"
 #include "internal/lidet_math.h"
+#include "internal/lidet_pixel_rxy.h"
 #include "internal/lidet_proj_rows.h"
 #include "internal/lidet_simd.h"
 #include "lidet/lidet_proj.h"
@@ -391,6 +392,7 @@ static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *poin
     const int32_t *const idx = buf->point_idx;
     int16_t *const xo = buf->x_4mm, *const yo = buf->y_4mm, *const zo = buf->z_4mm;
     uint16_t *const ro = buf->range_4mm;
+    float *const rxy = buf->rxy_m; /* optional: R of the rounded x, y */
     float bx[COMPACT_BLOCK], by[COMPACT_BLOCK], bz[COMPACT_BLOCK];
     uint32_t base, filled = 0;
     for (base = begin; base < end; base += COMPACT_BLOCK)
@@ -398,6 +400,11 @@ static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *poin
         const uint32_t m = end - base < COMPACT_BLOCK ? end - base : COMPACT_BLOCK;
         filled += gather_winners(idx + base, src, stride, m, bx, by, bz);
         round_block(bx, by, bz, m, xo + base, yo + base, zo + base, ro + base);
+        if (rxy !=
+            0) /* a second streaming loop: fused into round_block it did not vectorise (0.18 -> 0.27 ms) */
+        {
+            lidet__rxy_4mm(xo + base, yo + base, m, rxy + base);
+        }
     }
     return filled;
 }
@@ -450,12 +457,14 @@ static void clear_pixels(const lidet_proj_buffers_t *buf, int compact, uint32_t 
         memset(buf->y_4mm + begin, 0, n * sizeof buf->y_4mm[0]);
         memset(buf->z_4mm + begin, 0, n * sizeof buf->z_4mm[0]);
         memset(buf->range_4mm + begin, 0, n * sizeof buf->range_4mm[0]);
-        return;
     }
-    memset(buf->x_m + begin, 0, n * sizeof buf->x_m[0]);
-    memset(buf->y_m + begin, 0, n * sizeof buf->y_m[0]);
-    memset(buf->z_m + begin, 0, n * sizeof buf->z_m[0]);
-    memset(buf->range_m + begin, 0, n * sizeof buf->range_m[0]);
+    else
+    {
+        memset(buf->x_m + begin, 0, n * sizeof buf->x_m[0]);
+        memset(buf->y_m + begin, 0, n * sizeof buf->y_m[0]);
+        memset(buf->z_m + begin, 0, n * sizeof buf->z_m[0]);
+        memset(buf->range_m + begin, 0, n * sizeof buf->range_m[0]);
+    }
     if (buf->rxy_m != 0)
     {
         memset(buf->rxy_m + begin, 0, n * sizeof buf->rxy_m[0]);
@@ -763,7 +772,7 @@ void lidet_proj_image_of(const lidet_proj_state_t *st, const lidet_proj_buffers_
     img->y_4mm = buf->y_4mm;
     img->z_4mm = buf->z_4mm;
     img->range_4mm = buf->range_4mm;
-    img->rxy_m = buf->x_m != 0 ? buf->rxy_m : 0;
+    img->rxy_m = buf->rxy_m;
     img->point_idx = buf->point_idx;
     img->row_elev_rad = st->row_elev_rad;
     img->row_elev_bam = st->row_elev_bam;

@@ -43,8 +43,8 @@ lidet_status_t lidet_workspace_init(lidet_workspace_t *ws, const lidet_workspace
     return LIDET_OK;
 }
 
-/* the image the later stages read: no R (the ground stage recomputes it into its scratch) and no
- * point_idx (the overlay reuses it once the projection is done) */
+/* the image the later stages read: R only with LIDET_WORKSPACE_KEEP_R (else the ground stage recomputes it
+ * into its scratch), no point_idx (the overlay reuses it once the projection is done) */
 static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
 {
     img->n_rows = ws->proj.cfg.sensor.n_rows;
@@ -57,7 +57,11 @@ static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
     img->y_4mm = ws->y_4mm;
     img->z_4mm = ws->z_4mm;
     img->range_4mm = ws->range_4mm;
+#if LIDET_WORKSPACE_KEEP_R
+    img->rxy_m = ws->rxy_m;
+#else
     img->rxy_m = 0;
+#endif
     img->point_idx = 0;
     img->row_elev_rad = ws->proj.row_elev_rad;
     img->row_elev_bam = ws->proj.row_elev_bam;
@@ -103,7 +107,11 @@ lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *poi
     b.y_4mm = ws->y_4mm;
     b.z_4mm = ws->z_4mm;
     b.range_4mm = ws->range_4mm;
+#if LIDET_WORKSPACE_KEEP_R
+    b.rxy_m = ws->rxy_m;
+#else
     b.rxy_m = 0;
+#endif
     b.point_idx = ws->overlay.proj_point_idx;
     b.point_pixel = point_pixel;
     if (ticks == 0)
@@ -246,6 +254,9 @@ void lidet_workspace_sizes(lidet_workspace_sizes_t *out)
     out->ground_state = (uint32_t)sizeof w->ground;
     out->cluster_state = (uint32_t)sizeof w->cluster;
     out->image = (uint32_t)(sizeof w->x_4mm + sizeof w->y_4mm + sizeof w->z_4mm + sizeof w->range_4mm);
+#if LIDET_WORKSPACE_KEEP_R
+    out->image += (uint32_t)sizeof w->rxy_m;
+#endif
     out->ground_mask = (uint32_t)sizeof w->ground_mask;
     out->overlay_proj = (uint32_t)sizeof w->overlay.proj_point_idx;
     out->overlay_ground = (uint32_t)sizeof w->overlay.ground;

@@ -250,10 +250,25 @@ static void compare_on(const char *rel, const char *sensor_name)
     TEST_ASSERT_EQUAL_INT(st_ws, lidet_workspace_run(&g_ws.ws, g_points, n, 4, NULL, g_pp));
     CANARY_CHECK(g_ws);
     lidet_workspace_image(&g_ws.ws, &wimg);
-    TEST_ASSERT_NULL(wimg.rxy_m);
     TEST_ASSERT_NULL(wimg.point_idx);
     TEST_ASSERT_NULL(wimg.x_m);
     npix = (uint32_t)wimg.n_rows * wimg.n_cols;
+#if LIDET_WORKSPACE_KEEP_R
+    /* R kept: exactly the ground stage's own expression on the decoded 4 mm values (so the stages chained by hand
+     * below, on a compact image without R, must give the same bits) */
+    TEST_ASSERT_NOT_NULL(wimg.rxy_m);
+    {
+        uint32_t p;
+        for (p = 0; p < npix; ++p)
+        {
+            const float x = (float)wimg.x_4mm[p] * LIDET_PIXEL_M, y = (float)wimg.y_4mm[p] * LIDET_PIXEL_M;
+            const float r = sqrtf(x * x + y * y);
+            TEST_ASSERT_EQUAL_MEMORY(&r, &wimg.rxy_m[p], sizeof r);
+        }
+    }
+#else
+    TEST_ASSERT_NULL(wimg.rxy_m);
+#endif
 
     /* 1. the float stages (the reference): agreement within the tolerances */
     against_float(rel, &cfg, n);
@@ -437,7 +452,8 @@ static void test_workspace_sizes(void)
     TEST_ASSERT_EQUAL_UINT32(lidet_proj_state_bytes(), s.proj_state);
     TEST_ASSERT_EQUAL_UINT32(lidet_ground_state_bytes(), s.ground_state);
     TEST_ASSERT_EQUAL_UINT32(lidet_cluster_state_bytes(), s.cluster_state);
-    TEST_ASSERT_EQUAL_UINT32(8u * LIDET_MAX_ROWS * LIDET_MAX_COLS, s.image); /* int16 x, y, z, range */
+    /* int16 x, y, z, range, and float R when kept */
+    TEST_ASSERT_EQUAL_UINT32((8u + 4u * LIDET_WORKSPACE_KEEP_R) * LIDET_MAX_ROWS * LIDET_MAX_COLS, s.image);
     TEST_ASSERT_EQUAL_UINT32(LIDET_MAX_ROWS * LIDET_MAX_COLS, s.ground_mask);
     TEST_ASSERT_EQUAL_UINT32(4u * LIDET_MAX_ROWS * LIDET_MAX_COLS, s.overlay_proj);
     TEST_ASSERT_EQUAL_UINT32(6u * LIDET_MAX_ROWS * LIDET_MAX_COLS, s.overlay_cluster);

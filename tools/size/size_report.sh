@@ -67,7 +67,7 @@ for c in "${configs[@]}"; do
 done
 echo "Workspace (lidet_workspace_sizes):"
 echo
-echo "| config (rows x cols, points, clusters) | proj+ground+cluster states | image x,y,z,range | ground mask | overlay (proj / ground / cluster) | **workspace** | workspace, 32-bit target | standalone stages (proj + ground + cluster) |"
+echo "| config (rows x cols, points, clusters) | proj+ground+cluster states | image x,y,z,range (+ R: 64-bit, > 65536 pixels) | ground mask | overlay (proj / ground / cluster) | **workspace** | workspace, 32-bit target | standalone stages (proj + ground + cluster) |"
 echo "|---|---|---|---|---|---|---|---|"
 printf '%s\n' "${ws_rows[@]}"
 echo

@@ -91,6 +91,23 @@
 #define LIDET_Q_PIXEL_XYZ 1
 #endif
 
+/** The detector workspace keeps R (the horizontal range, a float per pixel) in its image: the projection
+ *  writes it once (from the 4 mm values) and the ground stage reads it, where it otherwise computes it, a square
+ *  root per pixel, in its filter and in its label pass. 4 B a pixel (HDL-64 capacities: 512 KiB) for about 2 % of
+ *  a VLP-16 scan's projection + ground + clustering (docs/MEMORY.md). Default: kept on 64-bit targets (hosts and
+ *  application processors, whose memory is not the limit) for images of more than 65536 pixels (HDL-64-class
+ *  capacities, this project's host builds); not on 32-bit microcontrollers and not at VLP-16 capacities (the
+ *  512 KiB budget). The results are the same bits either way. Define it the same for the library and its
+ *  callers (it changes lidet_workspace_t). */
+#if (defined(__SIZEOF_POINTER__) && __SIZEOF_POINTER__ >= 8) || defined(_WIN64)
+#define LIDET__TARGET_64BIT 1
+#else
+#define LIDET__TARGET_64BIT 0
+#endif
+#ifndef LIDET_WORKSPACE_KEEP_R
+#define LIDET_WORKSPACE_KEEP_R (LIDET__TARGET_64BIT && LIDET_MAX_ROWS * LIDET_MAX_COLS > 65536L)
+#endif
+
 /** Entries of the row lookup table of the projection (elevation -> candidate row). */
 #ifndef LIDET_PROJ_ROW_LUT
 #define LIDET_PROJ_ROW_LUT 1024

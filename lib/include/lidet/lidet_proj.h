@@ -114,8 +114,9 @@ typedef struct
     const int16_t *z_4mm;        /**< compact: z */
     const uint16_t *range_4mm;   /**< compact: the range (of the float point, then rounded); >= 1 exactly
                                     for valid pixels */
-    const float *rxy_m;          /**< R = sqrt(x^2 + y^2), the horizontal range; may be NULL (a detector
-                                    workspace does not keep it: the ground stage computes it) */
+    const float *rxy_m;          /**< R = sqrt(x^2 + y^2), the horizontal range (of a compact image's
+                                    decoded values); may be NULL (a detector workspace keeps it only with
+                                    LIDET_WORKSPACE_KEEP_R: else the ground stage computes it) */
     const int32_t *point_idx;    /**< index of the winning input point, -1 = empty; may be NULL (a
                                     workspace overlays it with later scratch). Validity is range_m > 0,
                                     which the later stages read (the two agree on every image) */
@@ -171,9 +172,10 @@ typedef struct
     int16_t *x_4mm, *y_4mm, *z_4mm; /**< compact image (x_m NULL): the coordinates in 4 mm steps; points
                                          beyond LIDET_PIXEL_MAX_RANGE_M are then dropped (n_too_far) */
     uint16_t *range_4mm;  /**< compact image: the range in 4 mm steps, >= 1 for valid pixels, else 0 */
-    float *rxy_m;         /**< optional (NULL: not produced), float image only (a compact run does not
-                                 write it): R = sqrt(x^2 + y^2); the ground stage computes it itself when
-                                 the image has none */
+    float *rxy_m;         /**< optional (NULL: not produced): R = sqrt(x^2 + y^2) of the float
+                                 coordinates, or of a compact image's decoded 4 mm values (the ground
+                                 stage's expression: the same bits as it computes); the ground stage
+                                 computes it itself when the image has none */
     int32_t *point_idx;   /**< required: the winning input point of each pixel, -1 = empty. The run
                                  needs it as scratch; keep it only if per-pixel -> point is wanted.
                                  A compact run uses its bytes as scratch for the squared ranges too:

@@ -17,8 +17,9 @@
  * Stages run one after the other, so the workspace overlays (a union) the projection's scratch, the
  * ground stage's scratch and the clustering's outputs, none of which is alive while another is.
  * What the workspace does not keep, by design (a firmware that wants boxes pays for none of it):
- *  - R = sqrt(x^2 + y^2) per pixel: the ground stage recomputes it row by row (two rows of scratch),
- *    from the decoded coordinates;
+ *  - R = sqrt(x^2 + y^2) per pixel (unless LIDET_WORKSPACE_KEEP_R, the default on 64-bit targets with more
+ *    than 65536 pixels: lidet_opt.h): the ground stage recomputes it row by row (two rows of scratch), from the
+ *    decoded coordinates, with the expression the projection uses when it keeps R (the same bits);
  *  - the winning point's index per pixel (point_idx): scratch of the projection; validity is range > 0;
  *  - per-point outputs (the pixel of every input point, 4 B per point): only when the caller passes
  *    a buffer of LIDET_MAX_POINTS entries to lidet_workspace_run; per-point labels are then derived
@@ -64,7 +65,10 @@ extern "C" {
  * callers agree on the layout; other targets have no gap (their cores do not pay for it). */
 #if defined(__x86_64__) || defined(_M_X64)
 #define LIDET__WS_ALIAS_GAP                                                                                  \
-    (64u + (6144u - ((3u + (uint32_t)sizeof(lidet_member_t)) * (uint32_t)LIDET__WS_PIXELS) % 4096u) % 4096u)
+    (64u + (6144u - ((3u + 4u * LIDET_WORKSPACE_KEEP_R + (uint32_t)sizeof(lidet_member_t)) *                 \
+                     (uint32_t)LIDET__WS_PIXELS) %                                                           \
+                        4096u) %                                                                             \
+               4096u)
 #endif
 
 /** @brief Configuration of every stage the workspace runs. Fill with lidet_workspace_cfg_default(). */
@@ -97,6 +101,10 @@ typedef struct
     int16_t z_4mm[LIDET__WS_PIXELS];
     uint16_t range_4mm[LIDET__WS_PIXELS];
     uint8_t ground_mask[LIDET__WS_PIXELS];
+#if LIDET_WORKSPACE_KEEP_R
+    float
+        rxy_m[LIDET__WS_PIXELS]; /* R of each pixel's x, y (LIDET_WORKSPACE_KEEP_R: hosts; see lidet_opt.h) */
+#endif
 #ifdef LIDET__WS_ALIAS_GAP
     uint8_t alias_gap[LIDET__WS_ALIAS_GAP]; /* never read or written: see LIDET__WS_ALIAS_GAP */
 #endif
@@ -117,9 +125,10 @@ typedef struct
 typedef struct
 {
     uint32_t proj_state, ground_state, cluster_state; /**< the three states (tables, small outputs) */
-    uint32_t image;                                   /**< x, y, z, range planes (int16, 4 mm steps) */
-    uint32_t ground_mask;                             /**< the ground mask */
-    uint32_t overlay_proj;                            /**< projection scratch (point_idx) */
+    uint32_t
+        image; /**< x, y, z, range planes (int16, 4 mm steps), and R (float) with LIDET_WORKSPACE_KEEP_R */
+    uint32_t ground_mask;       /**< the ground mask */
+    uint32_t overlay_proj;      /**< projection scratch (point_idx) */
     uint32_t overlay_ground;    /**< ground scratch (sample mask, samples, two rows of R) */
     uint32_t overlay_cluster;   /**< cluster labels and members */
     uint32_t overlay;           /**< the overlay: the largest of the three */
