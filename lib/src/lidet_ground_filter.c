@@ -245,8 +245,8 @@ static void rxy_rows_init(rxy_rows_t *rr, lidet_ground_scratch_t *sc, const lide
 {
     rr->img = img;
     rr->compact = lidet__img_compact(img);
-    rr->img_rxy =
-        img->rxy_m; /* a float image's R, or a compact image's (the same expression on its values) */
+    /* a float image's R, or a compact image's (the same expression on its decoded values) */
+    rr->img_rxy = img->rxy_m;
     rr->slot[0] = sc->rxy_rows[0];
     rr->slot[1] = sc->rxy_rows[1];
     rr->zslot[0] = sc->z_rows[0];

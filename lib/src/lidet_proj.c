@@ -400,8 +400,8 @@ static uint32_t pass2_compact(const lidet_proj_buffers_t *buf, const float *poin
         const uint32_t m = end - base < COMPACT_BLOCK ? end - base : COMPACT_BLOCK;
         filled += gather_winners(idx + base, src, stride, m, bx, by, bz);
         round_block(bx, by, bz, m, xo + base, yo + base, zo + base, ro + base);
-        if (rxy !=
-            0) /* a second streaming loop: fused into round_block it did not vectorise (0.18 -> 0.27 ms) */
+        /* R in a second streaming loop: fused into round_block it did not vectorise (VLP-16 0.18 -> 0.27 ms) */
+        if (rxy != 0)
         {
             lidet__rxy_4mm(xo + base, yo + base, m, rxy + base);
         }

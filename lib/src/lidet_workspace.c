@@ -43,6 +43,13 @@ lidet_status_t lidet_workspace_init(lidet_workspace_t *ws, const lidet_workspace
     return LIDET_OK;
 }
 
+/* the workspace's R plane, or NULL (the ground stage then computes R itself) */
+#if LIDET_WORKSPACE_KEEP_R
+#define WS_RXY(ws) ((ws)->rxy_m)
+#else
+#define WS_RXY(ws) 0
+#endif
+
 /* the image the later stages read: R only with LIDET_WORKSPACE_KEEP_R (else the ground stage recomputes it
  * into its scratch), no point_idx (the overlay reuses it once the projection is done) */
 static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
@@ -57,11 +64,7 @@ static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
     img->y_4mm = ws->y_4mm;
     img->z_4mm = ws->z_4mm;
     img->range_4mm = ws->range_4mm;
-#if LIDET_WORKSPACE_KEEP_R
-    img->rxy_m = ws->rxy_m;
-#else
-    img->rxy_m = 0;
-#endif
+    img->rxy_m = WS_RXY(ws);
     img->point_idx = 0;
     img->row_elev_rad = ws->proj.row_elev_rad;
     img->row_elev_bam = ws->proj.row_elev_bam;
@@ -107,11 +110,7 @@ lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *poi
     b.y_4mm = ws->y_4mm;
     b.z_4mm = ws->z_4mm;
     b.range_4mm = ws->range_4mm;
-#if LIDET_WORKSPACE_KEEP_R
-    b.rxy_m = ws->rxy_m;
-#else
-    b.rxy_m = 0;
-#endif
+    b.rxy_m = WS_RXY(ws);
     b.point_idx = ws->overlay.proj_point_idx;
     b.point_pixel = point_pixel;
     if (ticks == 0)

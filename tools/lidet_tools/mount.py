@@ -58,8 +58,9 @@ def main(argv=None) -> int:
     ap.add_argument("--json", action="store_true", help="print one JSON object")
     a = ap.parse_args(argv)
     from . import kitti, native
-    if a.sensor not in native.c_sensors():
-        print(f"lidet_tools.mount: error: unknown sensor '{a.sensor}' (known: {', '.join(native.c_sensors())})",
+    presets = native.c_sensors()
+    if a.sensor not in presets:
+        print(f"lidet_tools.mount: error: unknown sensor '{a.sensor}' (known: {', '.join(presets)})",
               file=sys.stderr)
         return 1
     files = _scans(a.scans)
@@ -82,7 +83,7 @@ def main(argv=None) -> int:
               file=sys.stderr)
         return 1
     med = float(np.median(hs[ok]))
-    profile = native.c_sensors()[a.sensor][3]
+    profile = presets[a.sensor][3]
     if a.json:
         print(json.dumps({"sensor": a.sensor, "mount_height_m": round(med, 3), "profile_mount_height_m": profile,
                           "scans": [{"scan": s, "mount_height_m": None if not np.isfinite(h) else round(h, 3),

@@ -102,8 +102,8 @@ typedef struct
     uint16_t range_4mm[LIDET__WS_PIXELS];
     uint8_t ground_mask[LIDET__WS_PIXELS];
 #if LIDET_WORKSPACE_KEEP_R
-    float
-        rxy_m[LIDET__WS_PIXELS]; /* R of each pixel's x, y (LIDET_WORKSPACE_KEEP_R: hosts; see lidet_opt.h) */
+    /* R of each pixel's decoded x, y (LIDET_WORKSPACE_KEEP_R: 64-bit targets, large images; lidet_opt.h) */
+    float rxy_m[LIDET__WS_PIXELS];
 #endif
 #ifdef LIDET__WS_ALIAS_GAP
     uint8_t alias_gap[LIDET__WS_ALIAS_GAP]; /* never read or written: see LIDET__WS_ALIAS_GAP */
@@ -125,8 +125,8 @@ typedef struct
 typedef struct
 {
     uint32_t proj_state, ground_state, cluster_state; /**< the three states (tables, small outputs) */
-    uint32_t
-        image; /**< x, y, z, range planes (int16, 4 mm steps), and R (float) with LIDET_WORKSPACE_KEEP_R */
+    /** x, y, z, range planes (int16, 4 mm steps), and R (float) with LIDET_WORKSPACE_KEEP_R */
+    uint32_t image;
     uint32_t ground_mask;       /**< the ground mask */
     uint32_t overlay_proj;      /**< projection scratch (point_idx) */
     uint32_t overlay_ground;    /**< ground scratch (sample mask, samples, two rows of R) */
