@@ -26,7 +26,7 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     cfg->max_steps = cfg->max_steps < STEPS ? cfg->max_steps : STEPS;
     cfg->bridge_occluders = sparse ? 0u : 1u;
     cfg->max_gap_per_m_q16 = sparse ? 2621u : 1638u; /* 0.04, 0.025 */
-    cfg->min_points = 10u;
+    cfg->min_points = 8u;
     cfg->max_extent_mm = 6000u;
     cfg->max_mean_height_mm = 2500;
     cfg->mount_height_mm = mount_height_mm;

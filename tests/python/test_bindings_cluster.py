@@ -67,7 +67,7 @@ def test_synthetic_objects_are_separate_clusters():
 def test_defaults_and_options():
     f = np.float32  # the defaults come from C: float32 values
     d = native.cluster_defaults("hdl64")
-    assert d["min_points"] == 10 and d["max_steps"] == 5 and d["theta_rad"] == f(0.18) and d["diagonals"] == 1
+    assert d["min_points"] == 8 and d["max_steps"] == 5 and d["theta_rad"] == f(0.18) and d["diagonals"] == 1
     assert d["max_gap_m"] == f(0.7) and d["max_gap_per_m"] == f(0.025) and d["bridge_occluders"] == 1
     assert d["rescue_gap_m"] == f(0.8) and d["rescue_gap_per_m"] == f(0.03) and d["rescue_rows"] == 2
     assert d["rescue_cols"] == 6 and d["mount_height_m"] == f(1.73)
@@ -76,7 +76,7 @@ def test_defaults_and_options():
     assert v["max_gap_per_m"] == f(0.04)
     assert v["rescue_rows"] == 1
     # issue 15: the 16-beam values of their own (simulated VLP-16 crowd scenes); the dense ones unchanged
-    assert v["min_points"] == 10 and v["person_min_points"] == 9 and d["person_min_points"] == 10
+    assert v["min_points"] == 8 and v["person_min_points"] == 9 and d["person_min_points"] == 10
     assert v["rescue_gap_m"] == f(1.0) and v["join_gap_m"] == f(0.8)
     assert v["split_min_width_m"] == f(0.7)
     assert d["join_gap_m"] == f(0.5) and d["split_min_width_m"] == f(0.7) and d["person_min_cols"] == 2

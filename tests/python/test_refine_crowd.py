@@ -44,7 +44,8 @@ def test_each_rule_alone_matches_reference(split, join):
     assert one.stats["n_split" if split else "n_joined"] > 0 and one.stats["n_joined" if split else "n_split"] == 0
     xyz = np.stack([plain.image.x, plain.image.y, plain.image.z], -1)
     np.testing.assert_array_equal(one.pixel_labels,
-                                  ref.refine_ref(plain.pixel_labels, xyz, split_people=bool(split), join_cars=bool(join)))
+                                  ref.refine_ref(plain.pixel_labels, xyz, **{**_refine_defaults("hdl64"),
+                                                 "split_people": bool(split), "join_cars": bool(join)}))
 
 
 @pytest.mark.parametrize("cap", [3, 12])

@@ -117,3 +117,30 @@ def test_augment_keeps_box_consistent():
         p, b = C.augment(rng, pts[None].astype(np.float32), box)
         inside = D.points_in_box(p[0], b[0], margin=0.035)
         assert inside.all()
+
+
+def test_occlude_hides_part_recentres_and_moves_the_box():
+    """common.occlude: a hit proposal loses 15-45 % of its distinct points on one side, is re-centred on the mean
+    of what stays, and its box target moves by the same offset; p = 0 draws nothing (earlier models' batches)."""
+    rng = np.random.default_rng(5)
+    B, N = 64, 64
+    pts = rng.uniform(-1.0, 1.0, (B, N, 3)).astype(np.float32)
+    pts -= pts.mean(1, keepdims=True)
+    box = np.tile(np.array([[0.2, -0.1, 0.05, 4.0, 1.6, 1.5, 0.3]], np.float32), (B, 1))
+    p, b = pts.copy(), box.copy()
+    C.occlude(rng, p, b, 1.0)
+    changed = 0
+    for i in range(B):
+        kept = np.unique(p[i] - (b[i, :3] - box[i, :3]), axis=0)  # undo the re-centring
+        d = np.abs(kept[:, None, :] - pts[i][None, :, :]).max(-1).min(1)
+        assert d.max() < 1e-5  # only original points, nothing invented
+        np.testing.assert_allclose(p[i].mean(0), 0.0, atol=1e-5)  # centred on its own mean
+        if len(kept) < N:
+            changed += 1
+            assert 8 <= len(kept) <= int(np.ceil(0.86 * N))
+    assert changed == B  # every proposal was hit (p = 1), each lost at least 14 % of its points
+    # p = 0: no random draw, the generator's stream is untouched
+    r1, r2 = np.random.default_rng(9), np.random.default_rng(9)
+    a1, _ = C.augment(r1, pts, box)
+    a2, _ = C.augment(r2, pts, box, occlusion=0.0)
+    np.testing.assert_array_equal(a1, a2)

@@ -538,7 +538,7 @@ static void test_defaults_per_profile(void)
 {
     lidet_cluster_cfg_t d;
     lidet_cluster_cfg_default(&d, lidet_sensor_find("hdl64"));
-    TEST_ASSERT_EQUAL_UINT32(10, d.min_points);
+    TEST_ASSERT_EQUAL_UINT32(8, d.min_points);
     TEST_ASSERT_EQUAL_UINT32(5, d.max_steps);
     TEST_ASSERT_EQUAL_UINT32(1, d.bridge_occluders);
     TEST_ASSERT_EQUAL_UINT32(1, d.diagonals);
@@ -557,7 +557,7 @@ static void test_defaults_per_profile(void)
     TEST_ASSERT_EQUAL_UINT32(1, d.rescue_rows);
     TEST_ASSERT_TRUE(d.theta_rad > 0.0f && d.theta_rad < 0.8f);
     TEST_ASSERT_EQUAL_UINT32(5, d.max_steps);
-    TEST_ASSERT_EQUAL_UINT32(10, d.min_points);
+    TEST_ASSERT_EQUAL_UINT32(8, d.min_points);
     TEST_ASSERT_EQUAL_UINT32(9, d.person_min_points);
     TEST_ASSERT_CLOSE(1.0, d.rescue_gap_m, 1e-6, 0);
     TEST_ASSERT_CLOSE(0.7, d.split_min_width_m, 1e-6, 0);

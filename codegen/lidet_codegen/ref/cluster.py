@@ -316,7 +316,7 @@ def grid_parts(cells: list, nx: int, ny: int) -> list:
     return [part_of[c] for c in cells]
 
 
-def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_people: bool = True,
+def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 8, split_people: bool = True,
                split_min_width_m: float = 0.7, split_cell_m: float = 0.12, split_cell_per_m: float = 0.0,
                person_max_width_m: float = 1.0, person_min_height_m: float = 0.9, person_min_aspect: float = 1.8, person_min_cols: int = 2,
                person_min_points: int | None = None, max_clusters: int = 1 << 30, max_cells: int = 4096, max_parts: int = 32,
@@ -329,7 +329,7 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 10, split_
     float32. Returns the canonical labels the C gives with it: the same float32 operations in the same
     order (cell size, truncated cell indices, spans), so the decisions match bit for bit."""
     f32 = np.float32
-    pmin = min_points if person_min_points is None else person_min_points  # None: min_points (> 16 beams' default)
+    pmin = 10 if person_min_points is None else person_min_points  # None: the C default of > 16 beams
     lab = np.asarray(labels).astype(np.int64).ravel().copy()
     P = np.asarray(xyz, np.float32).reshape(-1, 3)
     n_cols = np.shape(labels)[1]

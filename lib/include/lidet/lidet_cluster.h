@@ -152,7 +152,8 @@ typedef struct
                                   0.025 (> 16 beams), 0.04 (<= 16 beams): 1.45 m / 2.3 m at 30 m
                                   (measured with max_gap_m; a fixed bound of 1 m split far simulated
                                   cars, 71-81 % at 0.15-0.35 rad; 1.5 m merged real parked cars) */
-    uint32_t min_points;       /**< drop clusters with fewer pixels; >= 1, default 10 */
+    uint32_t min_points;       /**< drop clusters with fewer pixels; >= 1, default 8: measured end to end,
+                                  docs/DETECTOR.md (10 before: sparse far and VLP-16 pedestrians lost) */
     float max_extent_m;        /**< drop clusters wider than this in x, y or z; > 0, default 6 m */
     float max_mean_height_m;   /**< drop clusters whose mean lies higher above the ground plane; default
                                   2.5 m; a huge value (e.g. 1e30) disables the filter */

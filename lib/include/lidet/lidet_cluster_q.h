@@ -68,7 +68,7 @@ typedef struct
     uint32_t max_gap_mm;        /**< 0: angle test alone; <= 1000000; default 700 */
     uint32_t max_gap_per_m_q16; /**< growth per metre of range (Q16 ratio), <= 65536; default 1638 (0.025,
                                         > 16 beams), 2621 (0.04) */
-    uint32_t min_points;        /**< >= 1; default 10 */
+    uint32_t min_points;        /**< >= 1; default 8 (as the float build) */
     uint32_t max_extent_mm;     /**< (0, 1000000]; default 6000 */
     int32_t max_mean_height_mm; /**< default 2500; INT32_MAX disables the filter */
     uint32_t mount_height_mm;   /**< flat ground at -mount when no planes; <= 100000 */

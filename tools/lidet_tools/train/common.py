@@ -39,11 +39,48 @@ def device(name: str) -> torch.device:
     return torch.device(name)
 
 
-def augment(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None = None):
-    """Augment a batch: pts (B, N, 3) model frame, box (B, 7) model-frame targets (or None). Copies."""
+def occlude(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None, p: float) -> None:
+    """In place, with probability p per proposal: hide a part of it as real scans do, then re-centre.
+    One of three, equally likely: a lateral band (an occluder in front hides a range of azimuths: in the
+    model frame, whose x axis is the ray to the mean, the points on one side of y = t), the lower part
+    (a kerb, a bonnet or a low wall in front: z below t) or a horizontal band in the upper half (windows,
+    which return little on real cars). t hides 15-45 % of the points; at least 8 stay. The C proposal is
+    centred on the mean of the points it holds, so the kept points are re-centred on their own mean and
+    the box target moves with them (the rotation about the new mean's azimuth is left to the +-5 deg
+    rotation of `augment`)."""
+    B, N, _ = pts.shape
+    hit = np.nonzero(rng.random(B) < p)[0]
+    kind = rng.integers(0, 3, len(hit))
+    frac = rng.uniform(0.15, 0.45, len(hit))
+    side = rng.random(len(hit)) < 0.5
+    for i, kd, f, sd in zip(hit, kind, frac, side):
+        q = pts[i]
+        if kd == 0:
+            v = q[:, 1] if sd else -q[:, 1]
+            hide = v < np.quantile(v, f)
+        elif kd == 1:
+            hide = q[:, 2] < np.quantile(q[:, 2], f)
+        else:
+            lo = np.quantile(q[:, 2], 0.5 + 0.1 * sd)
+            hide = (q[:, 2] >= lo) & (q[:, 2] < np.quantile(q[:, 2], min(1.0, 0.5 + 0.1 * sd + f)))
+        keep = np.nonzero(~hide)[0]
+        if len(keep) < 8:
+            continue
+        q = q[keep[rng.integers(0, len(keep), N)]]
+        c = q.mean(0)
+        pts[i] = q - c
+        if box is not None:
+            box[i, 0:3] -= c
+
+
+def augment(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None = None, occlusion: float = 0.0):
+    """Augment a batch: pts (B, N, 3) model frame, box (B, 7) model-frame targets (or None). Copies.
+    occlusion: the probability of `occlude` per proposal (0: no draw, the batches of earlier models)."""
     pts = pts.copy()
     B, N, _ = pts.shape
     box = None if box is None else box.copy()
+    if occlusion > 0.0:
+        occlude(rng, pts, box, occlusion)
     # dropout by resampling
     keep = rng.uniform(0.6, 1.0, B)
     for i in range(B):

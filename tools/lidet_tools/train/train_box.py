@@ -114,6 +114,8 @@ def add_args(ap):
     ap.add_argument("--batch", type=int, default=64)
     ap.add_argument("--lam", type=float, default=0.1)
     ap.add_argument("--min-gap", type=float, default=3.0)
+    ap.add_argument("--occlusion", type=float, default=0.0,
+                    help="probability per training proposal of hiding a part of it (common.occlude); 0 = off")
     ap.add_argument("--no-pvle", action="store_true")
     ap.add_argument("--no-tnet", action="store_true")
     ap.add_argument("--seed", type=int, default=0)
@@ -146,6 +148,8 @@ def train(a) -> dict:
     state_path = a.work / "state.pt"
     args_key = {k: (str(v) if isinstance(v, pathlib.Path) else v) for k, v in vars(a).items()
                 if k not in ("no_progress", "threads", "device", "work", "out", "onnx", "command")}
+    if not args_key.get("occlusion"):
+        args_key.pop("occlusion", None)  # states made before the option resume as before
     if dd:
         args_key["world_size"] = dd.world  # the shards depend on it: resume with the same number of ranks
     st = dict(epoch=0, history=[], best_box=None, best_en=None, margins=None, args=args_key)
@@ -204,12 +208,12 @@ def train(a) -> dict:
         nsteps = len(ids) // a.batch
         for _ in C.progress(range(nsteps), main and not a.no_progress, desc=f"box {phase} {ep + 1}/{E1 + E2}", leave=False):
             idx = ids[rng.choice(len(ids), a.batch, p=p_ids)]
-            p, bx = C.augment(rng, tr["points"][idx], tr["box"][idx])
+            p, bx = C.augment(rng, tr["points"][idx], tr["box"][idx], a.occlusion)
             cls = tr["label"][idx].astype(np.int64)
             T = Targets(bx, cls, dev)
             if phase == "energy":
                 oi = ood[rng.integers(0, len(ood), 2 * a.batch)]
-                po, _ = C.augment(rng, tr["points"][oi])
+                po, _ = C.augment(rng, tr["points"][oi], occlusion=a.occlusion)
                 pts, vox = C.tensors(tr, np.concatenate([idx, oi]), dev, np.concatenate([p, po]))
                 cls_all = np.concatenate([cls, rng.integers(0, M.N_CLASSES, len(oi))])
             else:
