@@ -144,3 +144,9 @@ def test_occlude_hides_part_recentres_and_moves_the_box():
     a1, _ = C.augment(r1, pts, box)
     a2, _ = C.augment(r2, pts, box, occlusion=0.0)
     np.testing.assert_array_equal(a1, a2)
+
+
+def test_occlusion_out_of_range_is_refused(tmp_path, capsys):
+    rc = train_box.main(["--data", str(tmp_path / "none.npz"), "--work", str(tmp_path / "w"), "--out",
+                         str(tmp_path / "b.pt"), "--occlusion", "1.5", "--no-progress"])
+    assert rc != 0 and "--occlusion must be a probability" in capsys.readouterr().err

@@ -71,6 +71,7 @@ def accounting(folder, sensor, n_scans, max_range=40.0, crop=False, mount_height
               "wrong class", "box off", "detected"]
     counts = {c: dict.fromkeys(stages, 0) for c in THR}
     scans = sorted((pathlib.Path(folder) / "velodyne").glob("*.bin"))[:n_scans]
+    few = int(native.cluster_defaults(sensor)["min_points"])  # below it no cluster can hold the object
     for p in scans:
         pts = kitti.read_bin(p)
         gts = [b for b in kitti.read_boxes(pathlib.Path(folder) / "boxes" / f"{p.stem}.txt") if b.cls in THR]
@@ -81,11 +82,11 @@ def accounting(folder, sensor, n_scans, max_range=40.0, crop=False, mount_height
             if np.hypot(g.x, g.y) > max_range or (crop and abs(np.arctan2(g.y, g.x)) > np.pi / 4):
                 continue
             m = _in_box(pts, b)
-            if m.sum() < 10:
+            if m.sum() < few:
                 counts[g.cls]["too few points"] += 1
                 continue
             ng = m & (d.point_ground == 0)
-            if ng.sum() < 10:
+            if ng.sum() < few:
                 counts[g.cls]["ground"] += 1
                 continue
             ids = d.point_cluster[ng]
@@ -295,7 +296,8 @@ def run(args) -> str:
     lines += [f"### Where road users are lost (simulated HDL-64, first {n_sc} scans of the set above, 360 degrees, "
               "within 40 m)", "",
               "Each object (points inside its box + 0.1 m) is followed through the detector (`native.detect`, "
-              "per-cluster outcomes): too few points (< 10 in the box), ground (< 10 non-ground), clustering (no "
+              "per-cluster outcomes): too few points (fewer than the clustering's `min_points`, "
+              f"{native.cluster_defaults('hdl64')['min_points']}, in the box), ground (as few non-ground), clustering (no "
               "cluster holds >= 70 % of its non-ground points while being >= 70 % object), budget/crop, gate 1, "
               "gate 2, size check, NMS, wrong class, box off (3D IoU below 0.7 car / 0.5 others), detected.", "",
               "| class | " + " | ".join(stages) + " |", "|---|" + "---:|" * len(stages)]

@@ -12,6 +12,8 @@ Augmentation (training batches only, model frame; `augment`):
 * point jitter N(0, 0.01 m) clipped at 0.03 m (range noise);
 * point dropout by resampling: keep a random 60-100 % of the 64 points and draw the 64 again from them
   with replacement, as the C resampling does for a sparse cluster.
+* optional (`train_box --occlusion P`, default off): in a share P of the proposals, a part hidden as real
+  scans hide it (`occlude`), before the dropout.
 """
 from __future__ import annotations
 

@@ -127,6 +127,8 @@ def add_args(ap):
 
 
 def train(a) -> dict:
+    if not 0.0 <= a.occlusion <= 1.0:
+        raise ValueError(f"--occlusion must be a probability in [0, 1], got {a.occlusion}")
     C.setup(a.seed, a.threads)
     dd = C.dist_from_env(a.device)  # None without torchrun: the single-process path below is unchanged
     main = dd is None or dd.main
