@@ -202,7 +202,7 @@ def run(args) -> str:
                      f"{', '.join(map(str, UNSEEN_SEEDS))})", unseen, "vlp16", False))
     lines = ["## Clustering (issue 6)", "",
              "lidet depth clustering (per-profile defaults, 8-neighbourhood, gap bound 0.7 m + a share of the range: "
-             "> 16 beams theta 0.18 rad, 5 steps, occluder bridging, + 0.025 m/m, min_points 10; 16 beams theta 0.12 "
+             "> 16 beams theta 0.18 rad, 5 steps, occluder bridging, + 0.025 m/m, min_points 8; 16 beams theta 0.12 "
              "rad, 5 steps, + 0.04 m/m, min_points 8; fragment rescue 0.8 m (> 16 beams) or 1.0 m (16 beams) + 0.03 m/m "
              "over 2 (> 16 beams) or 1 (16 beams) rows and 6 columns; refinement: clusters wider than 0.9 m (> 16 "
              "beams) or 0.7 m (16 beams) examined, join gap 0.5 m (> 16 beams) or 0.8 m (16 beams)) "
