@@ -43,6 +43,7 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     cfg->gate1_margin_q16 = 0;
     cfg->gate2_margin_q16 = 0;
     cfg->nms_iou_q15 = NMS_IOU_DEFAULT_Q15;
+    cfg->max_height_extent_mm = 2500; /* the float detector's max_height_extent_m */
     lidet_size_limits_q_default(&cfg->size);
 }
 
@@ -52,11 +53,12 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
 static int cfg_ok(const lidet_detector_q_cfg_t *c)
 {
     uint32_t k, j;
-    if (c->crop_half_bam < 0 || c->max_range_mm < 0 || c->max_proposals < 1u ||
-        c->max_proposals > LIDET_MAX_CLUSTERS || c->max_boxes < 1u || c->max_boxes > LIDET_MAX_CLUSTERS ||
-        c->gate1 > 1u || c->gate2 > 1u || c->nms_iou_q15 < 0 || c->nms_iou_q15 > 32768 ||
-        c->gate1_margin_q16 < -MARGIN_MAX_Q16 || c->gate1_margin_q16 > MARGIN_MAX_Q16 ||
-        c->gate2_margin_q16 < -MARGIN_MAX_Q16 || c->gate2_margin_q16 > MARGIN_MAX_Q16 || c->range_only > 1u ||
+    if (c->crop_half_bam < 0 || c->max_range_mm < 0 || c->max_height_extent_mm < 0 ||
+        c->max_height_extent_mm > 100000 || c->max_proposals < 1u || c->max_proposals > LIDET_MAX_CLUSTERS ||
+        c->max_boxes < 1u || c->max_boxes > LIDET_MAX_CLUSTERS || c->gate1 > 1u || c->gate2 > 1u ||
+        c->nms_iou_q15 < 0 || c->nms_iou_q15 > 32768 || c->gate1_margin_q16 < -MARGIN_MAX_Q16 ||
+        c->gate1_margin_q16 > MARGIN_MAX_Q16 || c->gate2_margin_q16 < -MARGIN_MAX_Q16 ||
+        c->gate2_margin_q16 > MARGIN_MAX_Q16 || c->range_only > 1u ||
         (!LIDET_Q_PIXEL_XYZ && c->range_only == 0u))
     {
         return 0;
@@ -208,6 +210,14 @@ static uint32_t candidates(lidet_detector_q_t *d, lidet_status_t *worst)
         {
             d->outcome[i] = LIDET_DET_OUT_CROP;
             ++st->n_out_of_crop;
+            continue;
+        }
+        /* z extent in 4 mm steps against the limit in mm: 4 (max - min) > limit (|max - min| < 2^17) */
+        if (d->cfg.max_height_extent_mm > 0 &&
+            4 * (int64_t)(recs[i].max_4mm[2] - recs[i].min_4mm[2]) > d->cfg.max_height_extent_mm)
+        {
+            d->outcome[i] = LIDET_DET_OUT_TALL;
+            ++st->n_too_tall;
             continue;
         }
         if (d->cfg.max_range_mm > 0 && 16 * r2 > max_mm2)

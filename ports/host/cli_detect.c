@@ -403,6 +403,7 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
         return 1;
     CLI_SET_FLOAT(c, kv, klen, v, crop_half_rad)
     CLI_SET_FLOAT(c, kv, klen, v, max_range_m)
+    CLI_SET_FLOAT(c, kv, klen, v, max_height_extent_m)
     CLI_SET_FLOAT(c, kv, klen, v, nms_iou)
     CLI_SET_INT(c, kv, klen, v, max_proposals, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, max_boxes, uint32_t, 4294967295.0)
@@ -505,6 +506,7 @@ static void usage_extra(void)
                     "  --cpu-clock      stage and total times (--json *_ms) in this thread's CPU time, not wall time\n"
                     "                   (what other processes on a busy machine do not inflate)\n"
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
+                    "                   max_height_extent_m (0: classify tall clusters too),\n"
                     "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
                     "                   gate2_margin (nats added to the models' gates); stages.cluster.KEY: a\n"
                     "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
@@ -791,6 +793,7 @@ outputs:
         cli_json_int(stdout, "clusters", ds->n_clusters);
         cli_json_int(stdout, "out_of_crop", ds->n_out_of_crop);
         cli_json_int(stdout, "out_of_range", ds->n_out_of_range);
+        cli_json_int(stdout, "too_tall", ds->n_too_tall);
         cli_json_int(stdout, "over_budget", ds->n_over_budget);
         cli_json_int(stdout, "budget", cfg.max_proposals);
         cli_json_int(stdout, "classified", ds->n_classified);
@@ -827,9 +830,10 @@ outputs:
     else
     {
         printf("scan         %s (%s, models %s)\n", a.scan_path, a.sensor, chosen);
-        printf("clusters     %u: %u classified (%u outside the crop, %u beyond range, %u over the budget of %u)\n",
-               ds->n_clusters, ds->n_classified, ds->n_out_of_crop, ds->n_out_of_range, ds->n_over_budget,
-               cfg.max_proposals);
+        printf("clusters     %u: %u classified (%u outside the crop, %u taller than %.1f m, %u beyond range, %u over "
+               "the budget of %u)\n",
+               ds->n_clusters, ds->n_classified, ds->n_out_of_crop, ds->n_too_tall, (double)cfg.max_height_extent_m,
+               ds->n_out_of_range, ds->n_over_budget, cfg.max_proposals);
         printf("gates        %u rejected by gate 1, %u by gate 2; %u impossible sizes, %u suppressed by NMS\n",
                ds->n_gate1_rejected, ds->n_gate2_rejected, ds->n_size_rejected, ds->n_nms_suppressed);
         printf("time (ms)    project %.3f  ground %.3f  cluster %.3f  classify %.3f  box %.3f  total %.3f"

@@ -58,6 +58,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     cfg.crop_half_bam = fcfg->crop_half_rad >= (float)M_PI_D ? 0x7FFFFFFF
                                                              : round_i32((double)fcfg->crop_half_rad * bam_per_rad);
     cfg.max_range_mm = round_i32((double)fcfg->max_range_m * 1000.0);
+    cfg.max_height_extent_mm = round_i32((double)fcfg->max_height_extent_m * 1000.0);
     cfg.max_proposals = fcfg->max_proposals;
     cfg.max_boxes = fcfg->max_boxes;
     /* the refinement's switches (its thresholds stay the integer defaults) */
@@ -128,6 +129,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     ds->n_nms_suppressed = st->n_nms_suppressed;
     ds->n_over_capacity = st->n_over_capacity;
     ds->n_over_box_budget = st->n_over_box_budget;
+    ds->n_too_tall = st->n_too_tall;
     ds->n_detections = st->n_detections;
     ds->stages.ground = st->ground; /* the same counts (lidet detect's mount-height warning reads them) */
     dq = lidet_detector_q_detections(&g_detq, n_det);

@@ -21,8 +21,8 @@ static int32_t g_pp[LIDET_MAX_POINTS];
  * ucfg: max_proposals (0 = the default), gate1, gate2, refine (the clustering's split_people and join_cars).
  * out_det: LIDET_MAX_DETECTIONS rows of 12 floats (class, score, energy_cls, energy_box, cx, cy, cz, l, w, h,
  * yaw, cluster id); out_outcome: LIDET_MAX_CLUSTERS bytes; out_point_cluster / out_point_ground: n entries
- * (may be NULL); out_stats: 14 uint32 (the lidet_detector_stats_t counts in order, the status, then
- * n_over_box_budget). */
+ * (may be NULL); out_stats: 15 uint32 (the lidet_detector_stats_t counts in order, the status, then
+ * n_over_box_budget and n_too_tall). */
 LIDET_PY_API int lidet_py_det_run(const char *sensor, uint32_t cls_index, uint32_t box_index, const float *fcfg,
                                   const uint32_t *ucfg, const float *pts, uint32_t n, uint32_t stride,
                                   float *out_det, uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters,
@@ -125,5 +125,6 @@ LIDET_PY_API int lidet_py_det_run(const char *sensor, uint32_t cls_index, uint32
     out_stats[11] = st->n_detections;
     out_stats[12] = (uint32_t)rc;
     out_stats[13] = st->n_over_box_budget;
+    out_stats[14] = st->n_too_tall;
     return rc;
 }

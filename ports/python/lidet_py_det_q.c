@@ -62,8 +62,8 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
 /* lidet_py_detq_run: icfg: crop_half_bam, max_range_mm, nms_iou_q15, max_proposals (0 = default), gate1, gate2,
  * max_boxes (0 = default), gate1_margin_q16, gate2_margin_q16, range_only (-1 = the build's default, 0, 1).
  * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
- * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 13 uint32 (the
- * counts of lidet_detector_q_stats_t in order, then n_over_box_budget). Returns the run's status. */
+ * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 14 uint32 (the
+ * counts of lidet_detector_q_stats_t in order, then n_over_box_budget and n_too_tall). Returns the run's status. */
 LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, const char *box_name,
                                    const int32_t *icfg, const int32_t *pts_mm, uint32_t n, uint32_t stride,
                                    int32_t *out_det, uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters,
@@ -106,10 +106,10 @@ LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, con
     memcpy(out_outcome, oc, *n_clusters);
     st = lidet_detector_q_stats(&g_detq);
     {
-        const uint32_t v[13] = {st->n_clusters,     st->n_out_of_crop,    st->n_out_of_range,   st->n_over_budget,
+        const uint32_t v[14] = {st->n_clusters,     st->n_out_of_crop,    st->n_out_of_range,   st->n_over_budget,
                                 st->n_classified,   st->n_gate1_rejected, st->n_boxed,          st->n_gate2_rejected,
                                 st->n_size_rejected, st->n_nms_suppressed, st->n_over_capacity, st->n_detections,
-                                st->n_over_box_budget};
+                                st->n_over_box_budget, st->n_too_tall};
         memcpy(out_stats, v, sizeof v);
     }
     return rc;

@@ -29,7 +29,9 @@ def test_json_contract(cli):
         assert k in js and js[k] >= 0, k
     assert js["points"] == len(kitti.read_bin(SCAN))
     assert js["budget"] == 256  # hdl64 default
-    assert js["classified"] == min(js["clusters"] - js["out_of_crop"] - js["out_of_range"], js["budget"])
+    assert js["too_tall"] > 0  # the sample's trees and poles: not classified (max_height_extent_m 2.5)
+    assert js["classified"] == min(js["clusters"] - js["out_of_crop"] - js["too_tall"] - js["out_of_range"],
+                                   js["budget"])
     assert js["classified"] == js["gate1_rejected"] + js["boxed"]
     assert js["boxed"] == js["gate2_rejected"] + js["size_rejected"] + js["nms_suppressed"] + js["detections"]
     assert len(js["boxes"]) == js["detections"]
@@ -47,7 +49,8 @@ def test_crop_keeps_the_front(cli):
     # with them (the default: crop + 15 deg, the projection one ground sector more) the rear is neither
     # projected nor clustered; the same proposals are classified, the same detections come out
     assert crop["clusters"] < full["clusters"] and crop["out_of_crop"] < nowin["out_of_crop"]
-    assert crop["classified"] == nowin["classified"] == min(crop["clusters"] - crop["out_of_crop"], crop["budget"])
+    assert crop["classified"] == nowin["classified"] == min(crop["clusters"] - crop["out_of_crop"] - crop["too_tall"],
+                                                            crop["budget"])
     assert crop["detections"] == nowin["detections"] > 0
     strip = [{k: v for k, v in b.items() if k != "cluster"} for b in crop["boxes"]]
     assert strip == [{k: v for k, v in b.items() if k != "cluster"} for b in nowin["boxes"]]

@@ -124,6 +124,50 @@ void tearDown(void)
     CANARY_CHECK(g);
 }
 
+/* a cluster taller than max_height_extent_m (a 3.5 m pole beside the three objects) is not classified */
+void test_tall_clusters_are_not_classified(void)
+{
+    const lidet_detector_stats_t *s;
+    const lidet_cluster_rec_t *recs;
+    const uint8_t *oc;
+    uint32_t nc = 0, k, n_tall = 0;
+    scene();
+    face(28.0f, -10.0f, 0.4f, 3.5f, 3000); /* at 30 m the top beam (+2 deg) still sees 2.7 m of it */
+    TEST_ASSERT_CLOSE(2.5, cfg.max_height_extent_m, 1e-6, 0);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    s = lidet_detector_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(4, s->n_clusters);
+    TEST_ASSERT_EQUAL_UINT32(1, s->n_too_tall);
+    TEST_ASSERT_EQUAL_UINT32(3, s->n_classified);
+    oc = lidet_detector_outcomes(&g.ws, &nc);
+    recs = lidet_workspace_clusters(lidet_detector_workspace(&g.ws), NULL);
+    for (k = 0; k < nc; ++k)
+    {
+        const float zext = recs[k].max_m[2] - recs[k].min_m[2];
+        TEST_ASSERT_EQUAL_INT(zext > 2.5f, oc[k] == LIDET_DET_OUT_TALL);
+        n_tall += oc[k] == LIDET_DET_OUT_TALL;
+    }
+    TEST_ASSERT_EQUAL_UINT32(1, n_tall);
+    /* 0: no limit, the pole is classified too; a limit above it: the same */
+    cfg.max_height_extent_m = 0.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_detector_stats(&g.ws)->n_too_tall);
+    TEST_ASSERT_EQUAL_UINT32(4, lidet_detector_stats(&g.ws)->n_classified);
+    cfg.max_height_extent_m = 4.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    TEST_ASSERT_EQUAL_UINT32(4, lidet_detector_stats(&g.ws)->n_classified);
+    /* out of range or not finite: refused */
+    cfg.max_height_extent_m = -0.5f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    cfg.max_height_extent_m = 100.5f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    cfg.max_height_extent_m = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+}
+
 void test_three_objects_three_cars(void)
 {
     const lidet_detection_t *d;
@@ -429,6 +473,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_three_objects_three_cars);
+    RUN_TEST(test_tall_clusters_are_not_classified);
     RUN_TEST(test_crop_budget_range_and_gates);
     RUN_TEST(test_nms_drops_overlapping_boxes);
     RUN_TEST(test_deterministic_and_empty);

@@ -84,6 +84,13 @@ static void test_init_errors(void)
     cfg.max_proposals = 0;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.max_height_extent_mm = -1; /* [0, 100000] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.max_height_extent_mm = 100001;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.max_height_extent_mm = 0; /* no limit */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.size.min_mm[0][0] = 9000; /* min above max */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);
@@ -96,7 +103,7 @@ static void test_init_errors(void)
 
 static void check_invariants(const lidet_detector_q_cfg_t *cfg)
 {
-    uint32_t n, nc, i, counts[10] = {0};
+    uint32_t n, nc, i, counts[11] = {0};
     const lidet_detection_q_t *d = lidet_detector_q_detections(&g.ws, &n);
     const uint8_t *oc = lidet_detector_q_outcomes(&g.ws, &nc);
     const lidet_detector_q_stats_t *st = lidet_detector_q_stats(&g.ws);
@@ -120,7 +127,7 @@ static void check_invariants(const lidet_detector_q_cfg_t *cfg)
     }
     for (i = 0; i < nc; ++i)
     {
-        TEST_ASSERT_TRUE(oc[i] >= 1 && oc[i] <= 9);
+        TEST_ASSERT_TRUE(oc[i] >= 1 && oc[i] <= LIDET_DET_OUT_TALL);
         ++counts[oc[i]];
     }
     TEST_ASSERT_EQUAL_UINT32(st->n_out_of_crop, counts[LIDET_DET_OUT_CROP]);
@@ -131,6 +138,7 @@ static void check_invariants(const lidet_detector_q_cfg_t *cfg)
     TEST_ASSERT_EQUAL_UINT32(st->n_size_rejected, counts[LIDET_DET_OUT_SIZE]);
     TEST_ASSERT_EQUAL_UINT32(st->n_nms_suppressed, counts[LIDET_DET_OUT_NMS]);
     TEST_ASSERT_EQUAL_UINT32(n, counts[LIDET_DET_OUT_DETECTED]);
+    TEST_ASSERT_EQUAL_UINT32(st->n_too_tall, counts[LIDET_DET_OUT_TALL]);
     TEST_ASSERT_EQUAL_UINT32(st->n_classified, st->n_gate1_rejected + st->n_over_box_budget + st->n_boxed);
     TEST_ASSERT_TRUE(st->n_boxed <= cfg->max_boxes);
 }
@@ -159,7 +167,10 @@ static void test_crop_and_budget(void)
     const lidet_detection_q_t *d;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, init_default(&cfg));
     TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL)));
-    all = lidet_detector_q_stats(&g.ws)->n_clusters;
+    /* the candidates: every cluster not taller than max_height_extent_mm (the sample has such clusters) */
+    TEST_ASSERT_EQUAL_INT32(2500, cfg.max_height_extent_mm);
+    TEST_ASSERT_TRUE(lidet_detector_q_stats(&g.ws)->n_too_tall > 0u);
+    all = lidet_detector_q_stats(&g.ws)->n_clusters - lidet_detector_q_stats(&g.ws)->n_too_tall;
     lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.crop_half_bam = 1 << 29; /* 45 degrees */
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));

@@ -101,7 +101,8 @@ def accounting(folder, sensor, n_scans, max_range=40.0, crop=False, mount_height
                 continue
             oc = native.OUTCOME[int(d.outcome[cid - 1])]
             key = {"crop": "budget/crop", "range": "budget/crop", "budget": "budget/crop", "gate1": "gate 1",
-                   "gate2": "gate 2", "size": "size", "nms": "nms", "capacity": "budget/crop"}.get(oc)
+                   "gate2": "gate 2", "size": "size", "nms": "nms", "capacity": "budget/crop",
+                   "tall": "budget/crop"}.get(oc)
             if key is not None:
                 counts[g.cls][key] += 1
                 continue

@@ -696,11 +696,11 @@ def pn_time(cls_model, box_model, xyz, mean, voxel, repeats: int = 5) -> tuple[f
 
 #: lidet_det_outcome_t values
 OUTCOME = {1: "crop", 2: "range", 3: "budget", 4: "gate1", 5: "gate2", 6: "size", 7: "nms", 8: "capacity",
-           9: "detected"}
+           9: "detected", 10: "tall"}
 CLASSES = ("Car", "Cyclist", "Pedestrian")
 _DET_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity",
-              "n_detections", "status", "n_over_box_budget"]
+              "n_detections", "status", "n_over_box_budget", "n_too_tall"]
 
 
 @dataclass

@@ -700,7 +700,7 @@ def pnq_time(cls_model: str, box_model: str, xyz_4mm, mean_4mm, voxel, repeats: 
 
 DETQ_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity", "n_detections",
-              "n_over_box_budget"]
+              "n_over_box_budget", "n_too_tall"]
 _detq_ready = False
 
 

@@ -12,7 +12,7 @@ import numpy as np
 
 from lidet_codegen.ref import cluster_q, ground_q, pointnet_q, post_q, proj_q, qmath
 
-OUT_CROP, OUT_RANGE, OUT_BUDGET, OUT_GATE1, OUT_GATE2, OUT_SIZE, OUT_NMS, OUT_CAPACITY, OUT_DETECTED = range(1, 10)
+OUT_CROP, OUT_RANGE, OUT_BUDGET, OUT_GATE1, OUT_GATE2, OUT_SIZE, OUT_NMS, OUT_CAPACITY, OUT_DETECTED, OUT_TALL = range(1, 11)
 
 
 def score_q15(energy_q16: int, gamma_q16: int) -> int:
@@ -24,17 +24,22 @@ def score_q15(energy_q16: int, gamma_q16: int) -> int:
 
 
 def candidates(recs, det_cfg: dict, outcome: list) -> tuple[list, bool]:
-    """Kept clusters in the azimuth window and range, nearest first (ties: lower index), at most max_proposals."""
+    """Kept clusters in the azimuth window, not taller than max_height_extent_mm (0: no limit; the z span in 4 mm
+    steps times 4) and in range, nearest first (ties: lower index), at most max_proposals."""
     h = int(det_cfg["crop_half_bam"])
     cs = int(qmath.sin(h)) if h > 0 else 0
     cc = int(qmath.cos(h)) if h > 0 else 0
     mr = int(det_cfg["max_range_mm"])
+    tall = int(det_cfg.get("max_height_extent_mm", 2500))
     cand = []
     for i, r in enumerate(recs):
         x, y = int(r.mean[0]), int(r.mean[1])
         r2 = x * x + y * y
         if h > 0 and not (x * cs >= abs(y) * cc):
             outcome[i] = OUT_CROP
+            continue
+        if tall > 0 and 4 * (int(r.max[2]) - int(r.min[2])) > tall:
+            outcome[i] = OUT_TALL
             continue
         if mr > 0 and 16 * r2 > mr * mr:
             outcome[i] = OUT_RANGE
@@ -66,7 +71,7 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     pcfg = dict(proposal_cfg, n_points=int(cls_model.n_points))
     outcome = [0] * len(recs)
     order, truncated = candidates(recs, det_cfg, outcome)
-    stats = dict(n_clusters=len(recs), n_classified=0, n_gate1_rejected=0, n_boxed=0, n_gate2_rejected=0,
+    stats = dict(n_clusters=len(recs), n_too_tall=outcome.count(OUT_TALL), n_classified=0, n_gate1_rejected=0, n_boxed=0, n_gate2_rejected=0,
                  n_size_rejected=0, n_nms_suppressed=0, n_over_capacity=0, n_over_box_budget=0)
     dets = []
     for ci in order:

@@ -66,7 +66,8 @@ typedef enum
     LIDET_DET_OUT_SIZE = 6,     /**< boxed, impossible size for its class (or a non-finite centre or yaw) */
     LIDET_DET_OUT_NMS = 7,      /**< suppressed by the NMS */
     LIDET_DET_OUT_CAPACITY = 8, /**< past LIDET_MAX_DETECTIONS */
-    LIDET_DET_OUT_DETECTED = 9  /**< a detection of the output */
+    LIDET_DET_OUT_DETECTED = 9, /**< a detection of the output */
+    LIDET_DET_OUT_TALL = 10     /**< taller than max_height_extent_m: no road user, not classified */
 } lidet_det_outcome_t;
 
 /** @brief Configuration. Fill with lidet_detector_cfg_default(). */
@@ -80,6 +81,9 @@ typedef struct
                                          the projection's (one ground sector more), and the ground's
                                          seed_per_cell */
     float max_range_m;             /**< clusters whose mean is farther are not classified; 0 = no limit */
+    float max_height_extent_m;     /**< clusters whose points span more than this in z (a tree, a pole, a
+                                         wall) are not classified: no road user is that tall; 0 = no limit;
+                                         [0, 100]; default 2.5 (measured: docs/DETECTOR.md, "Tall clusters") */
     uint32_t max_proposals;        /**< at most this many clusters classified per scan, nearest first;
                                          [1, LIDET_MAX_CLUSTERS]; default 256 (> 16 beams), 128 (<= 16 beams),
                                          capped by LIDET_MAX_CLUSTERS */
@@ -134,6 +138,7 @@ typedef struct
     uint32_t n_over_capacity;   /**< detections past LIDET_MAX_DETECTIONS (lowest scores) */
     uint32_t n_detections;      /**< in the output */
     uint32_t n_over_box_budget; /**< passed gate 1 past max_boxes (not boxed) */
+    uint32_t n_too_tall;        /**< taller than max_height_extent_m (not classified) */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_workspace_stats_t stages;     /**< the stages' own counts */
 } lidet_detector_stats_t;

@@ -85,18 +85,20 @@ typedef struct
     lidet_proposal_q_cfg_t proposal; /**< n_points is set from the models by init; seed and PVLE bins used */
     int32_t crop_half_bam;           /**< 0: 360 degrees; else keep clusters with |azimuth| <= this (BAM32;
                                           the KITTI camera field of view is 2^29); [0, 2^31 - 1] */
-    int32_t max_range_mm;     /**< clusters whose mean is farther (horizontally) are not classified; 0 =
+    int32_t max_range_mm;         /**< clusters whose mean is farther (horizontally) are not classified; 0 =
                                           no limit; >= 0 */
-    uint32_t max_proposals;   /**< [1, LIDET_MAX_CLUSTERS]: at most this many classified, nearest first */
-    uint32_t max_boxes;       /**< [1, LIDET_MAX_CLUSTERS]: at most this many through the box net per scan
+    int32_t max_height_extent_mm; /**< clusters spanning more than this in z are not classified (outcome
+                                          LIDET_DET_OUT_TALL); 0 = no limit; [0, 100000]; default 2500 */
+    uint32_t max_proposals;       /**< [1, LIDET_MAX_CLUSTERS]: at most this many classified, nearest first */
+    uint32_t max_boxes;           /**< [1, LIDET_MAX_CLUSTERS]: at most this many through the box net per scan
                                           (those passing gate 1, nearest first; the rest: outcome
                                           LIDET_DET_OUT_BUDGET, stats n_over_box_budget, LIDET_TRUNCATED); default
                                           48 (> 16 beams), 24: the float detector's max_boxes */
-    uint8_t range_only;       /**< 1: the image stores only the range per pixel, x, y, z are decoded from
+    uint8_t range_only;           /**< 1: the image stores only the range per pixel, x, y, z are decoded from
                                    row, column and range (lib/src/internal/lidet_qpix.h); default
                                    !LIDET_Q_PIXEL_XYZ; must be 1 when LIDET_Q_PIXEL_XYZ is 0 */
-    uint8_t gate1;            /**< 1 (default): drop proposals failing gate 1 */
-    uint8_t gate2;            /**< 1 (default): drop boxes failing gate 2 */
+    uint8_t gate1;                /**< 1 (default): drop proposals failing gate 1 */
+    uint8_t gate2;                /**< 1 (default): drop boxes failing gate 2 */
     int32_t gate1_margin_q16; /**< gate 1 passes when energy_q16 < the model's gamma_q16 + this (Q16 nats; the
                                           float detector's gate1_margin); [-20 * 65536, 20 * 65536], default 0 */
     int32_t gate2_margin_q16; /**< the same for gate 2; default 0 */
@@ -112,6 +114,7 @@ typedef struct
     uint32_t n_clusters, n_out_of_crop, n_out_of_range, n_over_budget, n_classified, n_gate1_rejected,
         n_boxed, n_gate2_rejected, n_size_rejected, n_nms_suppressed, n_over_capacity, n_detections;
     uint32_t n_over_box_budget;         /**< passed gate 1 past max_boxes (not boxed) */
+    uint32_t n_too_tall;                /**< taller than max_height_extent_mm (not classified) */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_proj_stats_t proj;
     lidet_ground_stats_t ground;
