@@ -364,9 +364,10 @@ def calib_classes(model, xyz, mean, vox):
 CALIB_SIM_SEED, CALIB_N_SIM = 3015, 8
 
 
-def _sim_scans(sensor: str, seed: int, n: int) -> list:
+def _sim_scans(sensor: str, seed: int, n: int, first: int = 0) -> list:
+    """The points of simulated scans first .. first + n - 1 of a run seed (calibration and refit sets)."""
     from lidet_tools.sim.simulate import simulate_scan
-    return [simulate_scan(sensor, seed, k).points for k in range(n)]
+    return [simulate_scan(sensor, seed, k).points for k in range(first, first + n)]
 
 
 def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS) -> dict:
@@ -400,8 +401,6 @@ def refit(onnx_path, calib: dict, real_dir=None) -> dict:
     logits: minimises mean |x W^T + b - logits_float|^2 + mu |(W, b) - (W0, b0)|^2 over the calibration
     proposals plus REFIT_N_SIM fresh simulated scans. It absorbs the systematic part of the error the int8
     activations leave in the logits; the layer is then quantized as any other (per-channel int8 weights)."""
-    from lidet_tools.sim.simulate import simulate_scan
-
     from .ref import pointnet_q as RQ
     onnx_path = pathlib.Path(onnx_path)
     model = load(onnx_path, onnx_path.stem)
@@ -413,7 +412,7 @@ def refit(onnx_path, calib: dict, real_dir=None) -> dict:
     data = calib_set(base, real_dir)
     if data is None:
         raise EmitError("refit: the calibration scans are not available")
-    sims = [simulate_scan(calib["sensor"], REFIT_SIM_SEED, k).points for k in range(REFIT_N_SIM)]
+    sims = _sim_scans(calib["sensor"], REFIT_SIM_SEED, REFIT_N_SIM)
     extra = proposals_of(sims, calib["sensor"], calib["seeds"], model.n_points)
     xyz, mean, vox = (np.concatenate([a, b]) for a, b in zip(data, extra))
     qm = quantize(model, base)
@@ -448,9 +447,8 @@ def calib_set(calib: dict, real_dir=None):
             paths.append(ROOT / s)
     if not all(p.exists() for p in paths):
         return None
-    from lidet_tools.sim.simulate import simulate_scan
-    return proposals_of(paths + [simulate_scan(calib["sensor"], seed, k).points for seed, k in sims], calib["sensor"],
-                        calib["seeds"])
+    sim_pts = [p for seed, k in sims for p in _sim_scans(calib["sensor"], seed, 1, first=k)]
+    return proposals_of(paths + sim_pts, calib["sensor"], calib["seeds"])
 
 
 def layer_errors(qm: QModel, xyz, mean, vox):

@@ -30,7 +30,7 @@ def candidates(recs, det_cfg: dict, outcome: list) -> tuple[list, bool]:
     cs = int(qmath.sin(h)) if h > 0 else 0
     cc = int(qmath.cos(h)) if h > 0 else 0
     mr = int(det_cfg["max_range_mm"])
-    tall = int(det_cfg.get("max_height_extent_mm", 2500))
+    tall = int(det_cfg["max_height_extent_mm"])
     cand = []
     for i, r in enumerate(recs):
         x, y = int(r.mean[0]), int(r.mean[1])
@@ -54,8 +54,8 @@ def candidates(recs, det_cfg: dict, outcome: list) -> tuple[list, bool]:
 
 def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, proposal_cfg: dict, det_cfg: dict,
            cls_model, box_model, max_clusters: int, max_detections: int, max_points: int, range_only: bool = False) -> dict:
-    """The whole integer detector on (N, 3) int32 mm points. det_cfg: crop_half_bam, max_range_mm, max_proposals,
-    max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max, and optionally gate1_margin_q16 / gate2_margin_q16
+    """The whole integer detector on (N, 3) int32 mm points. det_cfg: crop_half_bam, max_range_mm, max_height_extent_mm,
+    max_proposals, max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max, and optionally gate1_margin_q16 / gate2_margin_q16
     (0 when absent: the models' gammas). range_only: the image keeps only the range, every stage reads x, y, z
     decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
     (dicts), outcomes, stats."""
@@ -71,8 +71,9 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     pcfg = dict(proposal_cfg, n_points=int(cls_model.n_points))
     outcome = [0] * len(recs)
     order, truncated = candidates(recs, det_cfg, outcome)
-    stats = dict(n_clusters=len(recs), n_too_tall=outcome.count(OUT_TALL), n_classified=0, n_gate1_rejected=0, n_boxed=0, n_gate2_rejected=0,
-                 n_size_rejected=0, n_nms_suppressed=0, n_over_capacity=0, n_over_box_budget=0)
+    stats = dict(n_clusters=len(recs), n_too_tall=outcome.count(OUT_TALL), n_classified=0, n_gate1_rejected=0,
+                 n_boxed=0, n_gate2_rejected=0, n_size_rejected=0, n_nms_suppressed=0, n_over_capacity=0,
+                 n_over_box_budget=0)
     dets = []
     for ci in order:
         xyz, mean, vox = cluster_q.make_proposal_q(recs[ci], members, X, Y, Z, pcfg)
