@@ -154,14 +154,12 @@ def agreement(fam, props):
 
 def test_int8_agrees_with_float(props):
     """int8 against float over all test proposals (figures in docs/FIXED_POINT.md). Issue 16 asks class >= 99 %
-    of proposals and mean BEV IoU >= 0.95. Asserted at 99 %: the detector's class decision (the class where gate 1
-    keeps the proposal, "rejected" otherwise: what a detection can carry) and the class on the proposals the float
-    gate 1 keeps. The raw argmax over all proposals, most of them clutter that both gates 1 reject, is asserted at
-    98.5 %: 99.3 % with the clusters of 10 points or more (before min_points 8), 98.8 % since (49 of 4,240
-    proposals differ, none kept by either gate 1; 98.6 % of 2,516 without the real scans; their float top-2
-    margins reach 2.6 nats: the first shared layer saturates on some clutter, which changes the argmax of a
-    proposal that gate 1 rejects but no detection). The gates agree on >= 98 % (a gate flips where the energy
-    sits within the quantization error of its threshold)."""
+    of proposals and mean BEV IoU >= 0.95. Asserted at 99 %: the raw argmax over all proposals (most of them clutter
+    that both gates 1 reject; 99.46 %, 23 of 4,240 differ, 99.48 % without the real scans, since the classifiers'
+    activations have one range per channel; 98.84 % with one per tensor), the detector's class decision (the class
+    where gate 1 keeps the proposal, "rejected" otherwise: what a detection can carry) and the class on the
+    proposals the float gate 1 keeps. The gates agree on >= 98 % (a gate flips where the energy sits within the
+    quantization error of its threshold)."""
     res = {fam: agreement(fam, props[fam]) for fam in FAMILIES}
     n = sum(r["n"] for r in res.values())
     nk = sum(r["n_kept"] for r in res.values())
@@ -169,7 +167,7 @@ def test_int8_agrees_with_float(props):
     tot["cls_kept"] = sum(r["cls_kept"] * r["n_kept"] for r in res.values()) / nk
     print(res, tot)
     assert tot["iou"] >= 0.95, res
-    assert tot["cls"] >= 0.985, res
+    assert tot["cls"] >= 0.99, res
     assert tot["cls_kept"] >= 0.99, res
     assert tot["decision"] >= 0.99, res
     assert tot["gate1"] >= 0.98 and tot["gate2"] >= 0.98, res
@@ -183,6 +181,35 @@ def test_emit_int8_refuses_a_calibration_of_another_model(tmp_path):
     with pytest.raises(E.EmitError, match="recalibrate"):
         QU.emit_s8(WEIGHTS / "cls_vlp16.onnx", p, tmp_path, "cmd", report=False)
     assert not list(tmp_path.glob("*.c"))
+
+
+def test_calibration_ranges_per_channel_and_per_tensor():
+    """The classifiers' calibration files hold one range per channel, the box nets' one per tensor
+    (quant.CALIB_RULE). A per-channel file whose channels share one range quantizes to exactly the per-tensor
+    model (the per-channel scales only change the requantization multipliers and the next layer's folded weight
+    columns), and distinct per-channel ranges change only those: the kernel's zero points and layer shapes stay."""
+    for name in ("cls_vlp16", "box_vlp16"):
+        cal = json.loads((WEIGHTS / f"{name}.calib.json").read_text())
+        per = QU.CALIB_RULE["classifier" if name.startswith("cls") else "box"][0]
+        assert cal["ranges_per"] == per
+        assert all(isinstance(v, list) == (per == "channel") for v in cal["ranges"].values()), name
+    model = E.load(WEIGHTS / "box_vlp16.onnx", "box_vlp16")
+    cal = json.loads((WEIGHTS / "box_vlp16.calib.json").read_text())
+    trace = QU.float_trace(model, np.zeros((1, 4, 3)), np.zeros((1, 3)), np.zeros(1, np.int64))
+    widths = {nm: t.shape[-1] for nm, t in zip(QU.layer_names(model), trace)}
+    spread = dict(cal, ranges={nm: [r] * widths[nm] for nm, r in cal["ranges"].items()})
+    a, b = QU.quantize(model, cal), QU.quantize(model, spread)
+    la = [l for st in a.stages for l in st.point + st.pvle + st.head]
+    lb = [l for st in b.stages for l in st.point + st.pvle + st.head]
+    for x, y in zip(la, lb):
+        for k in ("w_q", "b", "mult", "shift"):
+            np.testing.assert_array_equal(getattr(x, k), getattr(y, k))
+    rng = np.random.default_rng(7)
+    varied = dict(cal, ranges={nm: (r * rng.uniform(0.5, 2.0, widths[nm])).tolist() for nm, r in cal["ranges"].items()})
+    c = QU.quantize(model, varied)
+    lc = [l for st in c.stages for l in st.point + st.pvle + st.head]
+    assert any(not np.array_equal(x.mult, z.mult) for x, z in zip(la, lc))
+    assert all(x.w_q.shape == z.w_q.shape and x.out_zp == z.out_zp for x, z in zip(la, lc))
 
 
 def test_quantized_layers_follow_the_scheme(qmodels):
