@@ -114,6 +114,12 @@ lidet_status_t lidet_detector_q_init(lidet_detector_q_t *d, const lidet_detector
     }
     d->cfg = *cfg;
     d->cfg.proposal.n_points = cls->n_points;
+    if (cfg->crop_half_bam > 0)
+    {
+        /* the crop: the ground's RANSAC draws a stream per cell, as the float detector's crop does, so that
+         * both builds draw the same samples of a sector (the float detector needs it for its windows) */
+        d->cfg.ground.seed_per_cell = 1u;
+    }
     s = lidet_proj_q_init(&d->proj, &d->cfg.proj);
     if (s == LIDET_OK)
     {

@@ -42,6 +42,7 @@ void lidet_ground_q_cfg_default(lidet_ground_q_cfg_t *cfg, uint32_t n_rows, int3
     cfg->ring_split_mm = low ? 0u : 15000u;
     cfg->fallback_sectors = 4u;
     cfg->seed = 12345u;
+    cfg->seed_per_cell = 0u;
     cfg->ground_mm = low ? 200u : 150u;
     cfg->ground_per_m_q16 = 0u;
     cfg->below_factor_q16 = 131072u; /* 2.0 */
@@ -65,7 +66,8 @@ lidet_status_t lidet_ground_q_state_init(lidet_ground_q_state_t *g, const lidet_
         cfg->eval_samples < 3u || cfg->sample_step < 1u || cfg->sample_step > 16u ||
         cfg->sample_col_step < 1u || cfg->sample_col_step > 16u || cfg->min_samples < 3u ||
         cfg->min_inliers < 3u || cfg->refine_iters > 10u || cfg->fx_on_z > 1u ||
-        cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors)
+        cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors ||
+        cfg->seed_per_cell > 1u)
     {
         return LIDET_ERR_CONFIG;
     }

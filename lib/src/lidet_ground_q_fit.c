@@ -375,6 +375,10 @@ static int fit_cell(void *ctx, uint32_t k)
     const uint32_t a = f->sc->cell_first[k], n = f->sc->cell_n[k];
     qplane_t p;
     LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
+    if (f->g->cfg.seed_per_cell)
+    {
+        f->g->rng = lidet__rng_cell(f->g->cfg.seed, k);
+    }
     if (!fit_cell_q(f->g, f->sc, f->img, f->sc->sample_pix + a, n, &p))
     {
         return 0;

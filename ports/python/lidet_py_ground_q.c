@@ -69,7 +69,7 @@ typedef struct
 #define QF(f, sg) {#f, (uint32_t)offsetof(lidet_ground_q_cfg_t, f), (uint32_t)sizeof(((lidet_ground_q_cfg_t *)0)->f), sg}
 static const qfield_t k_cfg_fields[] = {
     QF(fy_max_q16, 0), QF(fx_max_mm, 0), QF(fx_on_z, 0), QF(require_descending, 0), QF(height_gate, 0),
-    QF(refine_iters, 0), QF(gate_above_mm, 1), QF(gate_below_mm, 1), QF(mount_height_mm, 1), QF(n_sectors, 0),
+    QF(refine_iters, 0), QF(seed_per_cell, 0), QF(gate_above_mm, 1), QF(gate_below_mm, 1), QF(mount_height_mm, 1), QF(n_sectors, 0),
     QF(ransac_iters, 0), QF(sample_step, 0), QF(sample_col_step, 0), QF(eval_samples, 0), QF(min_samples, 0),
     QF(min_inliers, 0), QF(fallback_sectors, 0), QF(confidence_q16, 0), QF(inlier_mm, 0), QF(max_tilt_urad, 0),
     QF(max_height_dev_mm, 0), QF(ring_split_mm, 0), QF(seed, 0), QF(ground_mm, 0), QF(ground_per_m_q16, 0),

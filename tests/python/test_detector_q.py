@@ -151,7 +151,7 @@ def test_score_matches_the_float_definition(nq):
 
 # ---- the integer detector against the chained numpy reference, bit for bit ---------------------------
 
-def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False):
+def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False, crop_half_bam=0):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -166,7 +166,7 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
         models[kind] = QU.quantize(E.load(ROOT / "weights" / f"{name}.onnx", name), calib)
     cc, pc = nq.cluster_q_defaults(sensor)
     cap = native.capacity()
-    det_cfg = dict(crop_half_bam=0, max_range_mm=0, max_height_extent_mm=2500, max_proposals=min(128 if s.rows <= 16 else 256, cap["max_clusters"]),
+    det_cfg = dict(crop_half_bam=crop_half_bam, max_range_mm=0, max_height_extent_mm=2500, max_proposals=min(128 if s.rows <= 16 else 256, cap["max_clusters"]),
                    max_boxes=max_boxes or min(24 if s.rows <= 16 else 48, cap["max_clusters"]), gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM,
                    gate1_margin_q16=margins[0], gate2_margin_q16=margins[1])
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
@@ -175,13 +175,14 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
 
 
 @pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "range_only_sample",
-                                   "range_only_fresh", "range_only_real"])
+                                   "range_only_fresh", "range_only_real", "crop_hdl64", "crop_real"])
 def test_bit_exact_with_the_chained_reference(nq, which, request):
     """Both pixels of the integer detector (the range-only one: x, y, z decoded from row, column and range,
     qmath.decode_pixels) against the chained numpy reference, bit for bit."""
     sensor, max_boxes, margins = "vlp16", 0, (0, 0)
     range_only = which.startswith("range_only_")
-    which = which.removeprefix("range_only_")
+    crop = (1 << 29) if which.startswith("crop_") else 0  # the camera crop: a RANSAC stream per ground cell too
+    which = which.removeprefix("range_only_").removeprefix("crop_")
     if which == "margins":  # the gates' operating points moved: gate 1 looser by 1 nat, gate 2 stricter by 0.5
         pts, margins = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"), (65536, -32768)
     elif which == "box_budget":  # the box budget hit: 3 boxed, the rest counted, LIDET_TRUNCATED
@@ -198,8 +199,10 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
         sensor, pts = "hdl64", _load(real / "kitti/training/velodyne/000001.bin")
     mm = nq.to_mm(pts)
     c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
-                    range_only=range_only)
-    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only)
+                    range_only=range_only, crop_half_bam=crop)
+    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop)
+    if crop:
+        assert c["stats"]["n_out_of_crop"] > 0
     if margins != (0, 0):  # the margins bite: fewer gate-1 rejections, more gate-2 ones than at the models' gammas
         c0 = nq.detect_q(mm, sensor)
         assert c["stats"]["n_gate1_rejected"] < c0["stats"]["n_gate1_rejected"]

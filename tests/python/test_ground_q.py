@@ -79,7 +79,7 @@ def test_defaults_are_the_float_defaults_rounded():
             assert q[k + "_mm"] == round(f[k + "_m"] * 1000), k
         for k in ("fx_on_z", "require_descending", "height_gate", "refine_iters", "n_sectors", "ransac_iters",
                   "sample_step", "sample_col_step", "eval_samples", "min_samples", "min_inliers", "fallback_sectors",
-                  "seed"):
+                  "seed", "seed_per_cell"):
             assert q[k] == f[k], k
 
 
@@ -102,7 +102,8 @@ def test_c_matches_reference_on_samples(i):
                                       "ring_split_mm": 0},
                                      {"ring_split_mm": 25000, "ground_per_m_q16": 197, "sample_step": 3,
                                       "sample_col_step": 2, "confidence_q16": 0, "refine_iters": 3},
-                                     {"veto_slope_q16": 0, "max_tilt_urad": 350000, "n_sectors": 7}])
+                                     {"veto_slope_q16": 0, "max_tilt_urad": 350000, "n_sectors": 7},
+                                     {"seed_per_cell": 1}, {"seed_per_cell": 1, "ring_split_mm": 25000}])
 def test_c_matches_reference_variants(variant):
     sensor, pts, _ = _sample_scans()[0]
     _bit_exact(sensor, pts, **variant)
@@ -118,12 +119,12 @@ def test_c_matches_reference_on_real_scans(real_dir):
         _bit_exact(sensor, pts)
 
 
-def _agreement(scans):
+def _agreement(scans, seed_per_cell=0):
     """(share of points with equal ground labels, float IoU, integer IoU) over all points of the scans."""
     same = total = 0
     conf_f = conf_q = 0
     for sensor, pts, sem in scans:
-        fm, qm, _, _ = native_q.ground_pair(pts, sensor)
+        fm, qm, _, _ = native_q.ground_pair(pts, sensor, seed_per_cell=seed_per_cell)
         same += int(np.count_nonzero(fm == qm))
         total += len(pts)
         if sem is not None:
@@ -134,13 +135,29 @@ def _agreement(scans):
     return same / total, iou(conf_f), iou(conf_q)
 
 
-def test_agreement_with_float_stage_simulated():
-    agree, iou_f, iou_q = _agreement(_sample_scans() + _fresh_scans())
+@pytest.mark.parametrize("seed_per_cell", [0, 1])
+def test_agreement_with_float_stage_simulated(seed_per_cell):
+    agree, iou_f, iou_q = _agreement(_sample_scans() + _fresh_scans(), seed_per_cell)
+    print(f"seed_per_cell {seed_per_cell}: labels agree on {agree:.5f}, IoU float {iou_f:.4f} integer {iou_q:.4f}")
     assert agree >= 0.995, agree
     assert abs(iou_q - iou_f) <= 0.005, (iou_f, iou_q)
 
 
-def test_agreement_with_float_stage_real(real_dir):
-    agree, iou_f, iou_q = _agreement(_real_scans(real_dir))
+def test_seed_per_cell_draws_other_samples():
+    """The switch is live: a stream per cell gives other planes than one stream through the cells (the same
+    samples, other RANSAC draws), and the integer stage refuses a value other than 0 or 1."""
+    sensor, pts, _ = _sample_scans()[0]
+    img = native_q.project_compact(pts, sensor)
+    a, b = native_q.ground_q(img, sensor), native_q.ground_q(img, sensor, seed_per_cell=1)
+    assert np.array_equal(a.sample, b.sample)
+    assert not np.array_equal(a.plane_d, b.plane_d)
+    with pytest.raises(native.LidetError):
+        native_q.ground_q(img, sensor, seed_per_cell=2)
+
+
+@pytest.mark.parametrize("seed_per_cell", [0, 1])
+def test_agreement_with_float_stage_real(real_dir, seed_per_cell):
+    agree, iou_f, iou_q = _agreement(_real_scans(real_dir), seed_per_cell)
+    print(f"seed_per_cell {seed_per_cell}: labels agree on {agree:.5f}, IoU float {iou_f:.4f} integer {iou_q:.4f}")
     assert agree >= 0.995, agree
     assert iou_q > 0.89 and abs(iou_q - iou_f) <= 0.005, (iou_f, iou_q)

@@ -266,6 +266,9 @@ static void test_arguments_and_config(void)
     c = cfg;
     c.mount_height_mm = -1;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_q_init(&gq.ws, &c));
+    c = cfg;
+    c.seed_per_cell = 2u;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_q_init(&gq.ws, &c));
     /* the defaults' two families */
     lidet_ground_q_cfg_default(&c, 64, 1730);
     TEST_ASSERT_EQUAL_UINT16(4, c.sample_step);

@@ -347,13 +347,13 @@ def ground_q_time(img: CompactImage, sensor="hdl64", repeats=100) -> tuple[float
     return tuple(float(v) / 1e6 for v in out)
 
 
-def ground_pair(points, sensor="hdl64"):
+def ground_pair(points, sensor="hdl64", seed_per_cell: int = 0):
     """Both ground stages on one compact image of `points`: (float per-point mask, integer per-point mask, the
     image, the integer result); per-point masks in input order (a point takes its pixel's label, 0 when it has
-    none)."""
+    none). seed_per_cell: both stages' RANSAC with one stream per cell (as the detectors' crop)."""
     img = project_compact(points, sensor)
-    q = ground_q(img, sensor)
-    fm = ground_float_compact(img, sensor)[0]
+    q = ground_q(img, sensor, seed_per_cell=seed_per_cell)
+    fm = ground_float_compact(img, sensor, seed_per_cell=seed_per_cell)[0]
     pp = img.point_pixel
 
     def per_point(mask):

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import qmath
-from .rng import XorShift32
+from .rng import XorShift32, cell
 
 FITTED, NEIGHBOUR, MOUNT, NEAR = 0, 1, 2, 3
 R_SHIFT = 8  # R in 4 mm / 2^8 steps (1/64 mm)
@@ -233,6 +233,7 @@ def fit_sectors(cells, XYZ, cfg, stats):
     ns = int(cfg["n_sectors"])
     n_cells = 2 * ns if int(cfg["ring_split_mm"]) > 0 else ns
     rng = XorShift32(int(cfg["seed"]))
+    per_cell = bool(cfg.get("seed_per_cell", 0))
     N = np.zeros((2 * ns, 3), np.int64)
     D = np.zeros(2 * ns, np.int64)
     src = np.array([MOUNT] * ns + [NEAR] * ns, np.uint8)
@@ -241,6 +242,8 @@ def fit_sectors(cells, XYZ, cfg, stats):
         if k >= n_cells or len(cells[k]) < int(cfg["min_samples"]):
             stats["n_sectors_sparse"] += near
             continue
+        if per_cell:  # a stream of its own per cell (lidet__rng_cell), as the float stage's seed_per_cell
+            rng = XorShift32(cell(int(cfg["seed"]), k))
         p = ransac_cell(XYZ[cells[k]], rng, cfg, stats)
         if p is not None:
             N[k], D[k], src[k] = p[0], p[1], FITTED

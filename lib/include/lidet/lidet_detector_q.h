@@ -84,7 +84,9 @@ typedef struct
     lidet_cluster_q_cfg_t cluster;   /**< clustering */
     lidet_proposal_q_cfg_t proposal; /**< n_points is set from the models by init; seed and PVLE bins used */
     int32_t crop_half_bam;           /**< 0: 360 degrees; else keep clusters with |azimuth| <= this (BAM32;
-                                          the KITTI camera field of view is 2^29); [0, 2^31 - 1] */
+                                          the KITTI camera field of view is 2^29); [0, 2^31 - 1]. A crop also
+                                          sets ground.seed_per_cell (a RANSAC stream per ground cell, as the
+                                          float detector's crop) */
     int32_t max_range_mm;         /**< clusters whose mean is farther (horizontally) are not classified; 0 =
                                           no limit; >= 0 */
     int32_t max_height_extent_mm; /**< clusters spanning more than this in z are not classified (outcome

@@ -52,6 +52,8 @@ typedef struct
     uint8_t require_descending; /**< 1: also dR > 0 */
     uint8_t height_gate;        /**< 1: z within [-mount - gate_below, -mount + gate_above] */
     uint8_t refine_iters;       /**< least-squares refinements; [0, 10] */
+    uint8_t seed_per_cell;      /**< 0: one random stream through the cells in order; 1: a stream per cell
+                                     (lidet_ground_cfg_t.seed_per_cell: the same streams as the float stage) */
     int32_t gate_above_mm;      /**< [-5000, 10000] */
     int32_t gate_below_mm;      /**< [0, 20000] */
     int32_t mount_height_mm;    /**< [0, 10000] */
