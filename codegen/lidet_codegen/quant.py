@@ -538,9 +538,16 @@ def emit_c_s8(qm: QModel, onnx_path, calib_path, cmd: str, src_sha: str, calib_s
                 c.append(_ints(base + "_b", "int32_t", l.b, f"{tag}.{pn}[{i}] bias int32 (input zero point folded)"))
                 c.append(_ints(base + "_m", "int32_t", l.mult, f"{tag}.{pn}[{i}] requantization multipliers"))
                 c.append(_ints(base + "_s", "uint8_t", l.shift, f"{tag}.{pn}[{i}] requantization shifts"))
+                oi = "0"
+                if not l.in_s16:  # the int8 x int8 layers: [out][in] too, for the DSP kernel (LIDET_PNQ_WEIGHTS_OI)
+                    c.append("#if LIDET_PNQ_WEIGHTS_OI\n" + _ints(base + "_woi", "int8_t", l.w_q,
+                                                                 f"{tag}.{pn}[{i}] weights [{l.n_out}][{l.n_in}] int8, "
+                                                                 f"the same as _w in [out][in] order")
+                             + "#endif\n")
+                    oi = f"LIDET_PNQ_OI({base}_woi)"
                 kind = "LIDET_PNQ_OUT_Q16" if l.out_q16 else "LIDET_PNQ_OUT_S8"
                 entries.append(f"    {{{l.n_in}u, {l.n_out}u, {1 if l.relu else 0}u, {kind}, {l.out_zp}, "
-                               f"{base}_w, {base}_b, {base}_m, {base}_s}}")
+                               f"{base}_w, {base}_b, {base}_m, {base}_s, {oi}}}")
             arr = f"{n}_{tag}_{pn}"
             c.append(f"static const lidet_pointnet_q_layer_t {arr}[{len(layers)}] = {{\n" + ",\n".join(entries)
                      + "\n};\n\n")

@@ -256,6 +256,20 @@ static const void *load_block(const bufs_t *b, const int16_t *xyz, uint32_t nb, 
     return out;
 }
 
+/* an int8 x int8 layer into the accumulators: the [out][in] copy of its weights where the model has one (cores
+ * with the DSP extension, LIDET_PNQ_WEIGHTS_OI), else the [in][out] weights; the same int32 sums either way */
+static void acc_s8(const lidet_pointnet_q_layer_t *ly, const int8_t *in, uint32_t n_rows, int32_t *acc)
+{
+    if (ly->w_oi != 0)
+    {
+        lidet__nn_acc_s8_oi(in, n_rows, ly->n_in, ly->w_oi, ly->w_t, ly->b, ly->n_out, acc);
+    }
+    else
+    {
+        lidet__nn_acc_s8(in, n_rows, ly->n_in, ly->w_t, ly->b, ly->n_out, acc);
+    }
+}
+
 static void requant_s8(const lidet_pointnet_q_layer_t *l, const int32_t *acc, uint32_t n_rows, int8_t *out)
 {
     lidet__nn_requant_s8(acc, n_rows, l->n_out, l->mult, l->shift, l->out_zp, l->relu ? l->out_zp : -128,
@@ -279,7 +293,7 @@ static void run_vec_layers(const lidet_pointnet_q_layer_t *l, uint32_t n, const 
         }
         else
         {
-            lidet__nn_acc_s8(cur, 1u, l[i].n_in, l[i].w_t, l[i].b, l[i].n_out, b->acc);
+            acc_s8(&l[i], cur, 1u, b->acc);
         }
         if (i == 0 && onehot_b != 0)
         {
@@ -317,7 +331,7 @@ static void dense_acc(const lidet_pointnet_q_layer_t *ly, const void *in, uint32
     }
     else
     {
-        lidet__nn_acc_s8((const int8_t *)in, nb, ly->n_in, ly->w_t, ly->b, ly->n_out, b->acc);
+        acc_s8(ly, (const int8_t *)in, nb, b->acc);
     }
 }
 

@@ -31,7 +31,7 @@ void tearDown(void)
 
 static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extreme)
 {
-    static int8_t in[MAX_R * MAX_I], w[MAX_I * MAX_O];
+    static int8_t in[MAX_R * MAX_I], w[MAX_I * MAX_O], w_oi[MAX_I * MAX_O];
     static int32_t b[MAX_O], ref[MAX_R * MAX_O], got[MAX_R * MAX_O];
     uint32_t r, i, o, k;
     for (k = 0; k < rows * n_in; ++k)
@@ -65,6 +65,12 @@ static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extrem
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
     memset(got, 0x5A, sizeof got);
     lidet__nn_acc_s8(in, rows, n_in, w, b, n_out, got);
+    TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+    for (o = 0; o < n_out; ++o) /* the [out][in] copy of the weights */
+        for (i = 0; i < n_in; ++i)
+            w_oi[o * n_in + i] = w[i * n_out + o];
+    memset(got, 0x5A, sizeof got);
+    lidet__nn_acc_s8_oi(in, rows, n_in, w_oi, w, b, n_out, got);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
 }
 

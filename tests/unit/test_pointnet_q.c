@@ -37,8 +37,8 @@ static lidet_pointnet_q_model_t g_model;
 
 static void make_model(void)
 {
-    const lidet_pointnet_q_layer_t p = {3, 2, 1, LIDET_PNQ_OUT_S8, -128, k_w0, k_b0, k_m0, k_s0};
-    const lidet_pointnet_q_layer_t h = {2, 3, 0, LIDET_PNQ_OUT_Q16, 0, k_w1, k_b1, k_m1, k_s1};
+    const lidet_pointnet_q_layer_t p = {3, 2, 1, LIDET_PNQ_OUT_S8, -128, k_w0, k_b0, k_m0, k_s0, 0};
+    const lidet_pointnet_q_layer_t h = {2, 3, 0, LIDET_PNQ_OUT_Q16, 0, k_w1, k_b1, k_m1, k_s1, 0};
     g_point[0] = p;
     g_head[0] = h;
     memset(&g_model, 0, sizeof g_model);

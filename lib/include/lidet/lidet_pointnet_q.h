@@ -65,7 +65,27 @@ typedef struct
     const int32_t *b;     /**< n_out, input zero point folded in */
     const int32_t *mult;  /**< n_out, in [0, 2^31) */
     const uint8_t *shift; /**< n_out, in [1, 62] */
+    const int8_t *w_oi;   /**< optional: the same weights [out][in] (n_out * n_in), which the DSP kernel reads
+                               a word (4 weights) at a time; NULL: w_t only. The generated models fill it
+                               where LIDET_PNQ_WEIGHTS_OI is 1 (the default on cores with the DSP extension:
+                               Cortex-M4, M7, M33) and leave it NULL elsewhere (no second copy in flash) */
 } lidet_pointnet_q_layer_t;
+
+/** 1: the generated int8 models carry their weights a second time, [out][in] (lidet_pointnet_q_layer_t.w_oi:
+ *  about 1.4 instead of 2.4 instructions per multiply-add on a Cortex-M4 / M7, for twice the weights' flash).
+ *  Default: 1 where the compiler targets the Arm DSP extension, else 0. */
+#ifndef LIDET_PNQ_WEIGHTS_OI
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
+#define LIDET_PNQ_WEIGHTS_OI 1
+#else
+#define LIDET_PNQ_WEIGHTS_OI 0
+#endif
+#endif
+#if LIDET_PNQ_WEIGHTS_OI
+#define LIDET_PNQ_OI(a) (a)
+#else
+#define LIDET_PNQ_OI(a) 0
+#endif
 
 /** @brief One stage: points -> shared layers -> max; [g | p]; the one-hot folded into head[0]'s bias. */
 typedef struct

@@ -137,7 +137,13 @@ void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
 #if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
 #include <arm_acle.h>
 #define S8_SXTB16(v) ((uint32_t)__sxtb16((int32_t)(v)))
-#define S8_SXTB16_ROR8(v) ((uint32_t)__sxtb16((int32_t)(((v) >> 8) | ((v) << 24))))
+/* SXTB16 with its rotate operand: one instruction (GCC does not fold a separate ROR into it) */
+static inline uint32_t S8_SXTB16_ROR8(uint32_t v)
+{
+    uint32_t r;
+    __asm__("sxtb16 %0, %1, ror #8" : "=r"(r) : "r"(v));
+    return r;
+}
 #define S8_SMLAD(a, b, acc) __smlad((int32_t)(a), (int32_t)(b), (acc))
 #else
 static inline uint32_t s8_half(int32_t v)
@@ -248,6 +254,68 @@ void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, cons
                           const int32_t *b, uint32_t n_out, int32_t *acc)
 {
     acc_s8_2x2(in, n_rows, n_in, w_t, b, n_out, acc, n_in & ~3u);
+}
+
+/* The DSP kernel on the weights' second layout, [out][in] (lidet_pointnet_q_layer_t.w_oi): one 32-bit load brings
+ * 4 weights of a channel, as 4 inputs of a point, and one SXTB16 (plain and rotated) widens either into the pairs
+ * (i, i + 2), (i + 1, i + 3). Per 4 inputs of a 2 x 2 block: 4 word loads, 8 SXTB16, 8 SMLAD for 16
+ * multiply-adds (the [in][out] kernel above: 6 instructions more, the halfword loads and their packing). The
+ * leftovers (n_in not a multiple of 4, an odd last channel or row) take w_t. */
+S8_ALWAYS_INLINE void acc_s8_2x2_oi(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_oi,
+                                    const int8_t *w_t, const int32_t *b, uint32_t n_out, int32_t *acc)
+{
+    const uint32_t n4 = n_in & ~3u;
+    uint32_t r, i, o;
+    for (r = 0; r + 2u <= n_rows; r += 2u)
+    {
+        const int8_t *x0 = in + r * n_in, *x1 = x0 + n_in;
+        int32_t *a0 = acc + r * n_out, *a1 = a0 + n_out;
+        for (o = 0; o + 2u <= n_out; o += 2u)
+        {
+            int32_t s00 = b[o], s01 = b[o + 1u], s10 = s00, s11 = s01;
+            const int8_t *w0 = w_oi + o * n_in, *w1 = w0 + n_in;
+            const int8_t *p0 = x0, *p1 = x1, *q0 = w0, *q1 = w1, *const end = x0 + n4;
+            /* four pointers stepped together (post-increment loads), one bound */
+            for (; p0 != end; p0 += 4, p1 += 4, q0 += 4, q1 += 4)
+            {
+                const uint32_t u0 = s8_load4(p0), u1 = s8_load4(p1);
+                const uint32_t v0 = s8_load4(q0), v1 = s8_load4(q1);
+                const uint32_t p = S8_SXTB16(u0), q = S8_SXTB16(u1), h0 = S8_SXTB16(v0), h1 = S8_SXTB16(v1);
+                const uint32_t pr = S8_SXTB16_ROR8(u0), qr = S8_SXTB16_ROR8(u1);
+                const uint32_t h0r = S8_SXTB16_ROR8(v0), h1r = S8_SXTB16_ROR8(v1);
+                s00 = S8_SMLAD(pr, h0r, S8_SMLAD(p, h0, s00));
+                s01 = S8_SMLAD(pr, h1r, S8_SMLAD(p, h1, s01));
+                s10 = S8_SMLAD(qr, h0r, S8_SMLAD(q, h0, s10));
+                s11 = S8_SMLAD(qr, h1r, S8_SMLAD(q, h1, s11));
+            }
+            for (i = n4; i < n_in; ++i)
+            {
+                const int32_t c0 = w0[i], c1 = w1[i], v0 = x0[i], v1 = x1[i];
+                s00 += v0 * c0;
+                s01 += v0 * c1;
+                s10 += v1 * c0;
+                s11 += v1 * c1;
+            }
+            a0[o] = s00;
+            a0[o + 1u] = s01;
+            a1[o] = s10;
+            a1[o + 1u] = s11;
+        }
+        if (o < n_out) /* an odd last channel */
+        {
+            lidet__nn_acc_s8_cols(x0, 2u, n_in, w_t + o, b + o, 1u, n_out, a0 + o, n_out);
+        }
+    }
+    if (r < n_rows) /* an odd last row */
+    {
+        lidet__nn_acc_s8_cols(in + r * n_in, n_rows - r, n_in, w_t, b, n_out, n_out, acc + r * n_out, n_out);
+    }
+}
+
+void lidet__nn_acc_s8_oi(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_oi,
+                         const int8_t *w_t, const int32_t *b, uint32_t n_out, int32_t *acc)
+{
+    acc_s8_2x2_oi(in, n_rows, n_in, w_oi, w_t, b, n_out, acc);
 }
 
 void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
