@@ -47,6 +47,10 @@ void lidet_detector_cfg_default(lidet_detector_cfg_t *cfg, const lidet_sensor_t 
     cfg->gate2 = 1;
     cfg->gate1_margin = 0.0f;
     cfg->gate2_margin = 0.0f;
+    /* chosen on simulated validation scans (lidet-sim seed 1001), docs/DETECTOR.md "Score" */
+    cfg->score_box_weight[LIDET_CLASS_CAR] = 0.5f;
+    cfg->score_box_weight[LIDET_CLASS_CYCLIST] = 0.0f;
+    cfg->score_box_weight[LIDET_CLASS_PEDESTRIAN] = 0.0f;
     cfg->nms_iou = 0.1f;
     memcpy(cfg->size_min_m, CLASS_SIZE_MIN, sizeof CLASS_SIZE_MIN);
     memcpy(cfg->size_max_m, CLASS_SIZE_MAX, sizeof CLASS_SIZE_MAX);
@@ -68,6 +72,11 @@ static int cfg_ok(const lidet_detector_cfg_t *c)
     }
     for (k = 0; k < LIDET_N_CLASSES; ++k)
     {
+        if (!lidet__isfinite(c->score_box_weight[k]) || c->score_box_weight[k] < 0.0f ||
+            c->score_box_weight[k] > 4.0f)
+        {
+            return 0;
+        }
         for (j = 0; j < 3; ++j)
         {
             if (!lidet__isfinite(c->size_min_m[k][j]) || !lidet__isfinite(c->size_max_m[k][j]) ||
@@ -290,7 +299,9 @@ static void insert_sorted(lidet_detection_t *det, uint32_t n)
 static void fill_detection(const lidet_detector_t *d, lidet_detection_t *t, uint32_t ci,
                            const lidet_pn_class_out_t *co, const lidet_pn_box_out_t *bo)
 {
-    t->score = 1.0f / (1.0f + expf(co->energy - d->cls.model->gamma[co->cls]));
+    const float w = d->cfg.score_box_weight[co->cls];
+    t->score = 1.0f / (1.0f + expf((co->energy - d->cls.model->gamma[co->cls]) +
+                                   w * (bo->energy - d->box.model->gamma[co->cls])));
     t->energy_cls = co->energy;
     t->energy_box = bo->energy;
     t->n_points = d->ws.cluster.recs[ci].n_points;

@@ -42,6 +42,9 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     cfg->gate2 = 1u;
     cfg->gate1_margin_q16 = 0;
     cfg->gate2_margin_q16 = 0;
+    cfg->score_box_weight_q16[LIDET_CLASS_CAR] = 32768; /* the float detector's 0.5 */
+    cfg->score_box_weight_q16[LIDET_CLASS_CYCLIST] = 0;
+    cfg->score_box_weight_q16[LIDET_CLASS_PEDESTRIAN] = 0;
     cfg->nms_iou_q15 = NMS_IOU_DEFAULT_Q15;
     cfg->max_height_extent_mm = 2500; /* the float detector's max_height_extent_m */
     lidet_size_limits_q_default(&cfg->size);
@@ -65,6 +68,10 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
     }
     for (k = 0; k < (uint32_t)LIDET_N_CLASSES; ++k)
     {
+        if (c->score_box_weight_q16[k] < 0 || c->score_box_weight_q16[k] > 4 * 65536)
+        {
+            return 0;
+        }
         for (j = 0; j < 3u; ++j)
         {
             if (c->size.min_mm[k][j] < 1 || c->size.min_mm[k][j] > c->size.max_mm[k][j] ||
@@ -249,7 +256,12 @@ static void fill_detection(const lidet_detector_q_t *d, lidet_detection_q_t *t, 
                            const lidet_pointnet_q_class_out_t *co, const lidet_pointnet_q_box_out_t *bo)
 {
     t->reserved = 0;
-    t->score_q15 = lidet_detector_q_score(co->energy_q16, d->cls.model->gamma_q16[co->cls]);
+    /* the score's energy: E1 + round(w (E2 - gamma2)) (Q16, |.| < 2^51 before the shift), saturated to int32 */
+    const int64_t m2 = (int64_t)bo->energy_q16 - d->box.model->gamma_q16[co->cls];
+    int64_t e =
+        (int64_t)co->energy_q16 + lidet__q_rshift_round(m2 * d->cfg.score_box_weight_q16[co->cls], 16);
+    e = e < INT32_MIN ? INT32_MIN : (e > INT32_MAX ? INT32_MAX : e);
+    t->score_q15 = lidet_detector_q_score((int32_t)e, d->cls.model->gamma_q16[co->cls]);
     t->energy_cls_q16 = co->energy_q16;
     t->energy_box_q16 = bo->energy_q16;
     t->n_points = d->cluster.recs[ci].n_points;

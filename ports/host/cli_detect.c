@@ -411,6 +411,22 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, gate2, uint8_t, 1)
     CLI_SET_FLOAT(c, kv, klen, v, gate1_margin)
     CLI_SET_FLOAT(c, kv, klen, v, gate2_margin)
+    {
+        /* score_box_weight.car / .cyclist / .pedestrian */
+        static const char *const names[LIDET_N_CLASSES] = {"score_box_weight.car", "score_box_weight.cyclist",
+                                                           "score_box_weight.pedestrian"};
+        static const lidet_class_t cls[LIDET_N_CLASSES] = {LIDET_CLASS_CAR, LIDET_CLASS_CYCLIST,
+                                                           LIDET_CLASS_PEDESTRIAN};
+        int k;
+        for (k = 0; k < LIDET_N_CLASSES; ++k)
+        {
+            if (klen == strlen(names[k]) && strncmp(kv, names[k], klen) == 0)
+            {
+                c->score_box_weight[cls[k]] = (float)v;
+                return 0;
+            }
+        }
+    }
     CLI_SET_FLOAT(c, kv, klen, v, stages.proj.azimuth_half_rad)
     CLI_SET_INT(c, kv, klen, v, stages.ground.seed_per_cell, uint8_t, 1)
     /* any clustering field, the proposal refinement of issue 15 included */
@@ -508,7 +524,9 @@ static void usage_extra(void)
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
                     "                   max_height_extent_m (0: classify tall clusters too),\n"
                     "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
-                    "                   gate2_margin (nats added to the models' gates); stages.cluster.KEY: a\n"
+                    "                   gate2_margin (nats added to the models' gates),\n"
+                    "                   score_box_weight.car|cyclist|pedestrian (the score's weight on gate 2's\n"
+                    "                   margin); stages.cluster.KEY: a\n"
                     "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
                     "                   stages.cluster.split_people=0: no proposal refinement);\n"
                     "                   stages.proj.azimuth_half_rad: the projection's window and\n"

@@ -88,6 +88,16 @@ static void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     cfg.max_height_extent_mm = 100001;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor); /* the score's weight on gate 2's margin: [0, 4] in Q16 */
+    TEST_ASSERT_EQUAL_INT32(32768, cfg.score_box_weight_q16[LIDET_CLASS_CAR]);
+    TEST_ASSERT_EQUAL_INT32(0, cfg.score_box_weight_q16[LIDET_CLASS_PEDESTRIAN]);
+    cfg.score_box_weight_q16[LIDET_CLASS_CYCLIST] = 4 * 65536;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.score_box_weight_q16[LIDET_CLASS_CYCLIST] = 4 * 65536 + 1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.score_box_weight_q16[LIDET_CLASS_CYCLIST] = -1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.max_height_extent_mm = 0; /* no limit */
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);

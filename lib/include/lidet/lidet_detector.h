@@ -101,7 +101,13 @@ typedef struct
                                          the validation road users; > 0 keeps more of them and more clutter
                                          (measured: docs/DETECTOR.md); [-20, 20] */
     float gate2_margin; /**< the same for gate 2 (the box net's gamma); [-20, 20], default 0 */
-    float nms_iou;      /**< BEV IoU above which the lower-scored detection is dropped; [0, 1],
+    float score_box_weight
+        [LIDET_N_CLASSES]; /**< the detection score is 1 / (1 + e^-(m1 + w m2)), m1 = gamma1 - E1
+                                                  and m2 = gamma2 - E2 the two gates' margins (the models' gammas),
+                                                  w this, per class (lidet_class_t order); [0, 4]. Default car
+                                                  0.5, cyclist and pedestrian 0: the box net's confidence ranks
+                                                  cars' boxes better (docs/DETECTOR.md, Score) */
+    float nms_iou;         /**< BEV IoU above which the lower-scored detection is dropped; [0, 1],
                                          default 0.1 (detections come from disjoint clusters) */
     float size_min_m[LIDET_N_CLASSES][3]; /**< plausible l, w, h per class (lidet_class_t order) */
     float size_max_m[LIDET_N_CLASSES][3];

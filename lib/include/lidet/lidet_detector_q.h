@@ -104,10 +104,14 @@ typedef struct
     int32_t gate1_margin_q16; /**< gate 1 passes when energy_q16 < the model's gamma_q16 + this (Q16 nats; the
                                           float detector's gate1_margin); [-20 * 65536, 20 * 65536], default 0 */
     int32_t gate2_margin_q16; /**< the same for gate 2; default 0 */
-    int32_t nms_iou_q15;      /**< [0, 32768]; default 3277 (0.1) */
-    lidet_size_limits_q_t size; /**< plausible l, w, h per class */
-    lidet_clock_fn clock;       /**< optional timestamp source for stats.ticks (NULL: no timing) */
-    void *clock_ctx;            /**< passed to clock */
+    int32_t
+        score_box_weight_q16[LIDET_N_CLASSES]; /**< the float detector's score_box_weight in Q16: the score
+                                                       is lidet_detector_q_score(E1 + round(w (E2 - gamma2)),
+                                                       gamma1); [0, 4 * 65536]; default car 32768, others 0 */
+    int32_t nms_iou_q15;                       /**< [0, 32768]; default 3277 (0.1) */
+    lidet_size_limits_q_t size;                /**< plausible l, w, h per class */
+    lidet_clock_fn clock; /**< optional timestamp source for stats.ticks (NULL: no timing) */
+    void *clock_ctx;      /**< passed to clock */
 } lidet_detector_q_cfg_t;
 
 /** @brief Counts of the last run (the fields of lidet_detector_stats_t, the integer stages' counts). */
