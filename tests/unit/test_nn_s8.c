@@ -89,10 +89,51 @@ static void test_kernels_agree_at_the_extremes(void)
     check_shape(9, 64, 33, 1);
 }
 
+/* the requantization's fast paths (shift > 32, = 32) against the plain int64 rule, on every shift and the
+ * accumulators' extremes: round_half_up(acc * m / 2^s), then zp and the clamp (int8) or the int32 saturation */
+static void test_requant_equals_the_int64_rule(void)
+{
+    enum
+    {
+        N = 64
+    };
+    static const int32_t edge[] = {0, 1, -1, 2, -2, INT32_MAX, INT32_MIN, INT32_MAX - 1, INT32_MIN + 1,
+                                   1 << 30, -(1 << 30), 12345, -12345, 1 << 20, -(1 << 20), 65535};
+    int32_t acc[N], mult[N], q16[N];
+    uint8_t shift[N];
+    int8_t out[N];
+    uint32_t s, k, rep;
+    for (rep = 0; rep < 40u; ++rep)
+    {
+        for (s = 1; s <= 62u; ++s)
+        {
+            for (k = 0; k < N; ++k)
+            {
+                acc[k] = k < sizeof edge / sizeof edge[0] ? edge[k] : (int32_t)next();
+                mult[k] = (int32_t)(((uint32_t)1 << 30) | (next() & 0x3FFFFFFFu)); /* [2^30, 2^31) */
+                if (k == N - 1u)
+                    mult[k] = INT32_MAX;
+                shift[k] = (uint8_t)s;
+            }
+            lidet__nn_requant_s8(acc, 1u, N, mult, shift, -128, -128, out);
+            lidet__nn_requant_q16(acc, N, mult, shift, q16);
+            for (k = 0; k < N; ++k)
+            {
+                const int64_t v = ((int64_t)acc[k] * mult[k] + ((int64_t)1 << (s - 1u))) >> s;
+                const int64_t y = v - 128 < -128 ? -128 : (v - 128 > 127 ? 127 : v - 128);
+                const int64_t z = v < INT32_MIN ? INT32_MIN : (v > INT32_MAX ? INT32_MAX : v);
+                TEST_ASSERT_EQUAL_INT32((int32_t)y, out[k]);
+                TEST_ASSERT_EQUAL_INT32((int32_t)z, q16[k]);
+            }
+        }
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_kernels_agree_on_every_shape);
     RUN_TEST(test_kernels_agree_at_the_extremes);
+    RUN_TEST(test_requant_equals_the_int64_rule);
     return UNITY_END();
 }
