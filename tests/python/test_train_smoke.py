@@ -146,6 +146,37 @@ def test_occlude_hides_part_recentres_and_moves_the_box():
     np.testing.assert_array_equal(a1, a2)
 
 
+def test_narrower_nets_train_and_count_fewer_macs(tiny, tmp_path):
+    """--widths (box net) and --point / --pvle / --head (classifier): the layers take those widths, the export
+    carries them, and the graphs count the multiply-adds of those widths (a firmware's smaller models)."""
+    path, _ = tiny
+    b = train_box.add_args(__import__("argparse").ArgumentParser()).parse_args(
+        ["--data", str(path), "--work", str(tmp_path / "bw"), "--out", str(tmp_path / "box.pt"), "--onnx",
+         str(tmp_path / "box.onnx"), "--epochs-box", "1", "--epochs-energy", "1", "--batch", "8", "--no-progress",
+         "--widths", '{"tnet_point": [16, 32], "tnet_head": [32], "point": [24, 48, 80], "head": [64, 32], '
+                     '"pvle": [16, 16]}'])
+    ckb = train_box.train(b)
+    assert ckb["cfg"]["point"] == (24, 48, 80) and ckb["cfg"]["tnet_head"] == (32,) and ckb["cfg"]["pvle"] == (16, 16)
+    a = train_cls.add_args(__import__("argparse").ArgumentParser()).parse_args(
+        ["--data", str(path), "--work", str(tmp_path / "cw"), "--out", str(tmp_path / "cls.pt"), "--onnx",
+         str(tmp_path / "cls.onnx"), "--epochs-ce", "1", "--epochs-energy", "1", "--batch", "8", "--no-progress",
+         "--point", "16,32,64", "--pvle", "16,16", "--head", "32"])
+    ck = train_cls.train(a)
+    assert ck["cfg"]["pvle"] == (16, 16) and ck["cfg"]["point"] == (16, 32, 64)
+    n = int(np.load(path)["points"].shape[1])
+    # per point: 3*24 + 24*48 + 48*80 (box) + 3*16 + 16*32 (T-Net); per point: 3*16 + 16*32 + 32*64 (classifier)
+    assert macs.count(tmp_path / "box.onnx")["macs"] >= n * (3 * 24 + 24 * 48 + 48 * 80 + 3 * 16 + 16 * 32)
+    assert macs.count(tmp_path / "box.onnx")["macs"] < n * 6000
+    assert n * (3 * 16 + 16 * 32 + 32 * 64) <= macs.count(tmp_path / "cls.onnx")["macs"] < n * 2700
+
+
+@pytest.mark.parametrize("bad", ['{"point": [0]}', '{"nope": [8]}', '[8]', '{"head": []}', 'not json'])
+def test_bad_widths_are_refused(tmp_path, capsys, bad):
+    rc = train_box.main(["--data", str(tmp_path / "none.npz"), "--work", str(tmp_path / "w"), "--out",
+                         str(tmp_path / "b.pt"), "--widths", bad, "--no-progress"])
+    assert rc != 0 and "--widths" in capsys.readouterr().err
+
+
 def test_occlusion_out_of_range_is_refused(tmp_path, capsys):
     rc = train_box.main(["--data", str(tmp_path / "none.npz"), "--work", str(tmp_path / "w"), "--out",
                          str(tmp_path / "b.pt"), "--occlusion", "1.5", "--no-progress"])

@@ -30,6 +30,7 @@ sys.path[:0] = [str(ROOT / "tools"), str(ROOT / "codegen")]
 
 from lidet_codegen import quant as QU  # noqa: E402
 from lidet_codegen.ref import detector_q as RD  # noqa: E402
+from lidet_codegen.ref import qmath as RQM  # noqa: E402
 from lidet_tools import kitti, native, native_q as nq  # noqa: E402
 from lidet_tools.eval import kitti_ap as K  # noqa: E402
 
@@ -38,11 +39,16 @@ COMBOS = ("float+float", "float+int8", "int+float", "int+int8")  # geometry + ne
 SIZE_MIN_M = np.array(RD.post_q.SIZE_MIN_MM) / 1000.0
 SIZE_MAX_M = np.array(RD.post_q.SIZE_MAX_MM) / 1000.0
 BAM = 2.0 * math.pi / 2.0 ** 32
+#: the score's weight on gate 2's margin per class (car, cyclist, pedestrian): the defaults of
+#: lidet_detector_cfg_default (score_box_weight) and lidet_detector_q_cfg_default (score_box_weight_q16 = w 2^16);
+#: tests/python/test_ablate_q.py checks that these rules reproduce both detectors
+SCORE_BOX_WEIGHT = (0.5, 0.0, 0.0)
 
 
 def nets_float(fam, xyz, mean, vox, cid, max_boxes):
     """Float nets on proposals in metres, the float detector's rules: (cls, score, box (m, rad)) kept."""
     m = native.pn_models()[f"cls_{fam}"]
+    mb = native.pn_models()[f"box_{fam}"]
     c = native.pn_classify(f"cls_{fam}", xyz, mean, vox)
     b = native.pn_box(f"box_{fam}", xyz, mean, vox, c["cls"])
     dets, n_boxed = [], 0
@@ -57,7 +63,9 @@ def nets_float(fam, xyz, mean, vox, cid, max_boxes):
         cl, bx = int(c["cls"][k]), b["box"][k]
         if not (np.all(bx[3:6] >= SIZE_MIN_M[cl]) and np.all(bx[3:6] <= SIZE_MAX_M[cl])):
             continue
-        s = np.float32(1.0) / (np.float32(1.0) + np.exp(np.float32(c["energy"][k] - m.gamma[cl])))
+        t = np.float32(c["energy"][k] - m.gamma[cl]) + np.float32(SCORE_BOX_WEIGHT[cl]) * np.float32(
+            b["energy"][k] - mb.gamma[cl])
+        s = np.float32(1.0) / (np.float32(1.0) + np.exp(np.float32(t)))
         dets.append((float(s), int(cid[k]), cl, bx.astype(np.float64)))
     dets.sort(key=lambda d: (-d[0], d[1]))
     kept = []
@@ -70,13 +78,19 @@ def nets_float(fam, xyz, mean, vox, cid, max_boxes):
 def nets_int8(fam, q4, m4, vox, cid):
     """int8 nets on 4 mm proposals, the integer detector's rules: (cls, score, box (m, rad)) kept."""
     gam = nq.pnq_models()[f"cls_{fam}_s8"]["gamma_q16"]
+    gam_b = nq.pnq_models()[f"box_{fam}_s8"]["gamma_q16"]
     c = nq.pnq_classify(f"cls_{fam}_s8", q4, m4, vox)
     b = nq.pnq_box(f"box_{fam}_s8", q4, m4, vox, c["cls"])
     keep = np.flatnonzero(c["passed"] & b["passed"])
     if len(keep) == 0:
         return []
     cls = c["cls"][keep]
-    score = np.array([RD.score_q15(int(c["energy"][k]), int(gam[c["cls"][k]])) for k in keep], np.int32)
+    def score(k):
+        cl = int(c["cls"][k])
+        w = int(round(SCORE_BOX_WEIGHT[cl] * 65536))
+        e = int(c["energy"][k]) + int(RQM.rshift_round((int(b["energy"][k]) - int(gam_b[cl])) * w, 16))
+        return RD.score_q15(min(max(e, -(1 << 31)), (1 << 31) - 1), int(gam[cl]))
+    score = np.array([score(k) for k in keep], np.int32)
     boxes = b["box"][keep]
     ok = nq.post_q(boxes, score, cid[keep], cls, 3277)
     # post_q returns the kept cluster ids in order (size check applied first)

@@ -25,6 +25,7 @@ Selection: lowest validation (FPR95 of gate 2 - mean IoU). gamma_b per class: th
 """
 from __future__ import annotations
 
+import json
 import math
 import pathlib
 import sys
@@ -104,6 +105,25 @@ def box_loss(dc1, out, T: Targets, use_tnet=True):
                        sres=l_sr.item(), corner=l_k.item())
 
 
+WIDTH_KEYS = ("tnet_point", "tnet_head", "point", "head", "pvle")
+
+
+def widths_arg(text: str) -> dict:
+    """--widths JSON -> BoxNet keyword arguments (lists of positive ints); a clear error otherwise."""
+    if not text:
+        return {}
+    try:
+        w = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise ValueError(f"--widths: not JSON ({e})") from None
+    if not isinstance(w, dict) or set(w) - set(WIDTH_KEYS):
+        raise ValueError(f"--widths: a JSON object with keys among {WIDTH_KEYS}, got {text!r}")
+    for k, v in w.items():
+        if not isinstance(v, list) or not v or not all(isinstance(x, int) and 0 < x <= 1024 for x in v):
+            raise ValueError(f"--widths: {k} must be a non-empty list of widths in [1, 1024], got {v!r}")
+    return {k: tuple(v) for k, v in w.items()}
+
+
 def add_args(ap):
     ap.add_argument("--data", type=pathlib.Path, required=True)
     ap.add_argument("--work", type=pathlib.Path, required=True)
@@ -118,6 +138,9 @@ def add_args(ap):
                     help="probability per training proposal of hiding a part of it (common.occlude); 0 = off")
     ap.add_argument("--no-pvle", action="store_true")
     ap.add_argument("--no-tnet", action="store_true")
+    ap.add_argument("--widths", default="",
+                    help='layer widths, JSON, any of tnet_point, tnet_head, point, head, pvle (e.g. \'{"point": [24, 48, '
+                         '80], "head": [64, 32]}\'; default: models.BoxNet\'s (48, 96, 160) ...)')
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--device", default="cpu")
@@ -129,6 +152,7 @@ def add_args(ap):
 def train(a) -> dict:
     if not 0.0 <= a.occlusion <= 1.0:
         raise ValueError(f"--occlusion must be a probability in [0, 1], got {a.occlusion}")
+    widths = widths_arg(a.widths)
     C.setup(a.seed, a.threads)
     dd = C.dist_from_env(a.device)  # None without torchrun: the single-process path below is unchanged
     main = dd is None or dd.main
@@ -145,7 +169,7 @@ def train(a) -> dict:
     counts = np.bincount(tr["label"][tr_id], minlength=M.N_CLASSES).astype(np.float64)
     pw = 1.0 / np.sqrt(np.maximum(counts, 1))[tr["label"][tr_id]]
     pw /= pw.sum()
-    cfg = dict(use_pvle=not a.no_pvle, use_tnet=not a.no_tnet)
+    cfg = dict(use_pvle=not a.no_pvle, use_tnet=not a.no_tnet, **widths)
     model = M.BoxNet(**cfg).to(dev)
     state_path = a.work / "state.pt"
     args_key = {k: (str(v) if isinstance(v, pathlib.Path) else v) for k, v in vars(a).items()

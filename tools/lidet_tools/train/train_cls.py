@@ -55,6 +55,7 @@ def add_args(ap):
     ap.add_argument("--no-pvle", action="store_true", help="ablation: no PVLE branch")
     ap.add_argument("--point", default="32,64,128", help="shared MLP widths")
     ap.add_argument("--head", default="64", help="FC widths")
+    ap.add_argument("--pvle", default="32,32", help="PVLE widths")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--device", default="cpu")
@@ -83,7 +84,7 @@ def train(a) -> dict:
     counts = np.bincount(tr["label"][tr_id], minlength=M.N_CLASSES).astype(np.float64)
     w = np.sqrt(counts.sum() / (M.N_CLASSES * np.maximum(counts, 1)))
     cw = torch.tensor(w, dtype=torch.float32, device=dev)
-    cfg = dict(point=_ints(a.point), head=_ints(a.head), use_pvle=not a.no_pvle)
+    cfg = dict(point=_ints(a.point), head=_ints(a.head), pvle=_ints(a.pvle), use_pvle=not a.no_pvle)
     model = M.ClassifierNet(**cfg).to(dev)
     state_path = a.work / "state.pt"
     args_key = {k: (str(v) if isinstance(v, pathlib.Path) else v) for k, v in vars(a).items()
