@@ -409,7 +409,7 @@ def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS) -> dict:
     return {"model": onnx_path.stem, "onnx_sha256": hashlib.sha256(onnx_path.read_bytes()).hexdigest(),
             "sensor": sensor, "seeds": [int(s) for s in seeds], "percentile": pct, "ranges_per": per,
             "scans": [rel(p) for p in scans] + [f"sim/{CALIB_SIM_SEED}/{k}" for k in range(CALIB_N_SIM)],
-            "n_proposals": int(len(xyz)), "ranges": ranges}
+            "n_proposals": int(len(xyz)), "n_points": int(model.n_points), "ranges": ranges}
 
 
 #: the classifier's last-layer refit (`calibrate --refit`): fresh simulated scans (seed 3016: neither training,
@@ -456,7 +456,8 @@ def refit(onnx_path, calib: dict, real_dir=None) -> dict:
 
 
 def calib_set(calib: dict, real_dir=None):
-    """Regenerate the calibration proposals a calibration file names (None when a scan is missing)."""
+    """Regenerate the calibration proposals a calibration file names (None when a scan is missing), with the
+    model's points per proposal (`n_points`; 64 in files written before it was recorded)."""
     paths, sims = [], []
     for s in calib["scans"]:
         if s.startswith("sim/"):  # a freshly simulated scan: sim/<seed>/<index>
@@ -471,7 +472,7 @@ def calib_set(calib: dict, real_dir=None):
     if not all(p.exists() for p in paths):
         return None
     sim_pts = [p for seed, k in sims for p in _sim_scans(calib["sensor"], seed, 1, first=k)]
-    return proposals_of(paths + sim_pts, calib["sensor"], calib["seeds"])
+    return proposals_of(paths + sim_pts, calib["sensor"], calib["seeds"], int(calib.get("n_points", 64)))
 
 
 def layer_errors(qm: QModel, xyz, mean, vox):

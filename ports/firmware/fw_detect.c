@@ -163,22 +163,27 @@ static void put_kv(const char *key, uint32_t v)
 
 /* The sensor's own models (weights/cls_<sensor>, box_<sensor>), referenced by name: only these two are
  * linked (each model is its own object in the weights archive; the index lidet_weights_models, which
- * would pull in every model, is not referenced). FW_SENSOR_ID is the sensor as an identifier. */
+ * would pull in every model, is not referenced). FW_SENSOR_ID is the sensor as an identifier; FW_MODELS_ID the
+ * model family (LIDET_FW_MODELS; the sensor's own by default). */
 #ifndef FW_SENSOR_ID
 #define FW_SENSOR_ID vlp16
+#endif
+#ifndef FW_MODELS_ID
+#define FW_MODELS_ID FW_SENSOR_ID
+#define FW_MODELS FW_SENSOR
 #endif
 #define FW_XCAT(a, b) a##b
 #define FW_CAT(a, b) FW_XCAT(a, b)
 static const char *pick_models(const fw_model_t **cls, const fw_model_t **box)
 {
 #if LIDET_FIXED_POINT
-    *cls = &FW_CAT(FW_CAT(lidet_model_cls_, FW_SENSOR_ID), _s8);
-    *box = &FW_CAT(FW_CAT(lidet_model_box_, FW_SENSOR_ID), _s8);
-    return FW_SENSOR "_s8";
+    *cls = &FW_CAT(FW_CAT(lidet_model_cls_, FW_MODELS_ID), _s8);
+    *box = &FW_CAT(FW_CAT(lidet_model_box_, FW_MODELS_ID), _s8);
+    return FW_MODELS "_s8";
 #else
-    *cls = &FW_CAT(lidet_model_cls_, FW_SENSOR_ID);
-    *box = &FW_CAT(lidet_model_box_, FW_SENSOR_ID);
-    return FW_SENSOR;
+    *cls = &FW_CAT(lidet_model_cls_, FW_MODELS_ID);
+    *box = &FW_CAT(lidet_model_box_, FW_MODELS_ID);
+    return FW_MODELS;
 #endif
 }
 

@@ -183,6 +183,16 @@ def test_emit_int8_refuses_a_calibration_of_another_model(tmp_path):
     assert not list(tmp_path.glob("*.c"))
 
 
+def test_calib_set_takes_the_models_points_per_proposal(need_lib):
+    """A calibration file records its model's points per proposal, and the proposals it names are rebuilt with
+    that many (a 32-point model's refit and error report once got 64-point proposals)."""
+    cal = json.loads((WEIGHTS / "cls_vlp16.calib.json").read_text())
+    assert cal["n_points"] == 64
+    one = dict(cal, scans=[s for s in cal["scans"] if s.startswith("tests/")][:1])
+    assert QU.calib_set(one)[0].shape[1] == 64
+    assert QU.calib_set(dict(one, n_points=32))[0].shape[1] == 32
+
+
 def test_calibration_ranges_per_channel_and_per_tensor():
     """The classifiers' calibration files hold one range per channel, the box nets' one per tensor
     (quant.CALIB_RULE). A per-channel file whose channels share one range quantizes to exactly the per-tensor
