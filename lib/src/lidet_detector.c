@@ -51,6 +51,9 @@ void lidet_detector_cfg_default(lidet_detector_cfg_t *cfg, const lidet_sensor_t 
     cfg->score_box_weight[LIDET_CLASS_CAR] = 0.5f;
     cfg->score_box_weight[LIDET_CLASS_CYCLIST] = 0.0f;
     cfg->score_box_weight[LIDET_CLASS_PEDESTRIAN] = 0.0f;
+    cfg->score_points_weight[LIDET_CLASS_CAR] = 0.1f;
+    cfg->score_points_weight[LIDET_CLASS_CYCLIST] = 0.0f;
+    cfg->score_points_weight[LIDET_CLASS_PEDESTRIAN] = 0.0f;
     cfg->nms_iou = 0.1f;
     memcpy(cfg->size_min_m, CLASS_SIZE_MIN, sizeof CLASS_SIZE_MIN);
     memcpy(cfg->size_max_m, CLASS_SIZE_MAX, sizeof CLASS_SIZE_MAX);
@@ -73,7 +76,8 @@ static int cfg_ok(const lidet_detector_cfg_t *c)
     for (k = 0; k < LIDET_N_CLASSES; ++k)
     {
         if (!lidet__isfinite(c->score_box_weight[k]) || c->score_box_weight[k] < 0.0f ||
-            c->score_box_weight[k] > 4.0f)
+            c->score_box_weight[k] > 4.0f || !lidet__isfinite(c->score_points_weight[k]) ||
+            c->score_points_weight[k] < 0.0f || c->score_points_weight[k] > 4.0f)
         {
             return 0;
         }
@@ -299,12 +303,15 @@ static void insert_sorted(lidet_detection_t *det, uint32_t n)
 static void fill_detection(const lidet_detector_t *d, lidet_detection_t *t, uint32_t ci,
                            const lidet_pn_class_out_t *co, const lidet_pn_box_out_t *bo)
 {
-    const float w = d->cfg.score_box_weight[co->cls];
+    const float w = d->cfg.score_box_weight[co->cls], v = d->cfg.score_points_weight[co->cls];
+    const uint32_t n = d->ws.cluster.recs[ci].n_points;
+    /* ln(n / 64) only where its weight is not 0 (the other classes' scores need no logf) */
+    const float ln_n = v != 0.0f ? logf((float)(n > 0u ? n : 1u)) - 4.15888309f : 0.0f;
     t->score = 1.0f / (1.0f + expf((co->energy - d->cls.model->gamma[co->cls]) +
-                                   w * (bo->energy - d->box.model->gamma[co->cls])));
+                                   w * (bo->energy - d->box.model->gamma[co->cls]) - v * ln_n));
     t->energy_cls = co->energy;
     t->energy_box = bo->energy;
-    t->n_points = d->ws.cluster.recs[ci].n_points;
+    t->n_points = n;
 }
 #define DET_T lidet_detector_t
 #define DET_CLS_OUT_T lidet_pn_class_out_t

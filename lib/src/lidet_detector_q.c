@@ -45,11 +45,16 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     cfg->score_box_weight_q16[LIDET_CLASS_CAR] = 32768; /* the float detector's 0.5 */
     cfg->score_box_weight_q16[LIDET_CLASS_CYCLIST] = 0;
     cfg->score_box_weight_q16[LIDET_CLASS_PEDESTRIAN] = 0;
+    cfg->score_points_weight_q16[LIDET_CLASS_CAR] = 6554; /* the float detector's 0.1 */
+    cfg->score_points_weight_q16[LIDET_CLASS_CYCLIST] = 0;
+    cfg->score_points_weight_q16[LIDET_CLASS_PEDESTRIAN] = 0;
     cfg->nms_iou_q15 = NMS_IOU_DEFAULT_Q15;
     cfg->max_height_extent_mm = 2500; /* the float detector's max_height_extent_m */
     lidet_size_limits_q_default(&cfg->size);
 }
 
+/* round(ln(64) * 2^16): the score's point count is ln(n / 64) */
+#define LN64_Q16 272557
 /* the gates' margins: within +-20 nats, as the float detector's */
 #define MARGIN_MAX_Q16 (20 * 65536)
 
@@ -68,7 +73,8 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
     }
     for (k = 0; k < (uint32_t)LIDET_N_CLASSES; ++k)
     {
-        if (c->score_box_weight_q16[k] < 0 || c->score_box_weight_q16[k] > 4 * 65536)
+        if (c->score_box_weight_q16[k] < 0 || c->score_box_weight_q16[k] > 4 * 65536 ||
+            c->score_points_weight_q16[k] < 0 || c->score_points_weight_q16[k] > 4 * 65536)
         {
             return 0;
         }
@@ -256,15 +262,19 @@ static void fill_detection(const lidet_detector_q_t *d, lidet_detection_q_t *t, 
                            const lidet_pointnet_q_class_out_t *co, const lidet_pointnet_q_box_out_t *bo)
 {
     t->reserved = 0;
-    /* the score's energy: E1 + round(w (E2 - gamma2)) (Q16, |.| < 2^51 before the shift), saturated to int32 */
+    /* the score's energy: E1 + round(w (E2 - gamma2)) - round(v ln(n / 64)) (Q16, |.| < 2^51 before the
+     * shifts), saturated to int32 */
     const int64_t m2 = (int64_t)bo->energy_q16 - d->box.model->gamma_q16[co->cls];
-    int64_t e =
-        (int64_t)co->energy_q16 + lidet__q_rshift_round(m2 * d->cfg.score_box_weight_q16[co->cls], 16);
+    const uint32_t n = d->cluster.recs[ci].n_points;
+    const int64_t ln_n = lidet__pnq_ln_q16((int64_t)(n > 0u ? n : 1u) << 30) - LN64_Q16;
+    int64_t e = (int64_t)co->energy_q16 +
+                lidet__q_rshift_round(m2 * d->cfg.score_box_weight_q16[co->cls], 16) -
+                lidet__q_rshift_round(ln_n * d->cfg.score_points_weight_q16[co->cls], 16);
     e = e < INT32_MIN ? INT32_MIN : (e > INT32_MAX ? INT32_MAX : e);
     t->score_q15 = lidet_detector_q_score((int32_t)e, d->cls.model->gamma_q16[co->cls]);
     t->energy_cls_q16 = co->energy_q16;
     t->energy_box_q16 = bo->energy_q16;
-    t->n_points = d->cluster.recs[ci].n_points;
+    t->n_points = n;
 }
 #define DET_T lidet_detector_q_t
 #define DET_CLS_OUT_T lidet_pointnet_q_class_out_t

@@ -457,7 +457,7 @@ static int64_t exp_neg_q30(int64_t d)
 }
 
 /* ln(S / 2^30) in Q16 for a sum S >= 2^30 (Q30): S = m 2^e, m in [2^30, 2^31); log2 m from the table */
-static int64_t ln_q16(int64_t sum)
+int64_t lidet__pnq_ln_q16(int64_t sum)
 {
     int64_t m = sum, fr, l2;
     int32_t e = 0, j, t0;
@@ -503,7 +503,7 @@ static int32_t energy_parts(const int32_t *v, uint32_t n, int32_t t_q16, int64_t
     {
         *sum_out = sum;
     }
-    lse = mx + ln_q16(sum);
+    lse = mx + lidet__pnq_ln_q16(sum);
     return sat32(t_q16 == 65536 ? -lse : -lidet__q_rshift_round((int64_t)t_q16 * lse, 16));
 }
 

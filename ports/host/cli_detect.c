@@ -415,6 +415,8 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
         /* score_box_weight.car / .cyclist / .pedestrian */
         static const char *const names[LIDET_N_CLASSES] = {"score_box_weight.car", "score_box_weight.cyclist",
                                                            "score_box_weight.pedestrian"};
+        static const char *const pnames[LIDET_N_CLASSES] = {"score_points_weight.car", "score_points_weight.cyclist",
+                                                            "score_points_weight.pedestrian"};
         static const lidet_class_t cls[LIDET_N_CLASSES] = {LIDET_CLASS_CAR, LIDET_CLASS_CYCLIST,
                                                            LIDET_CLASS_PEDESTRIAN};
         int k;
@@ -423,6 +425,11 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
             if (klen == strlen(names[k]) && strncmp(kv, names[k], klen) == 0)
             {
                 c->score_box_weight[cls[k]] = (float)v;
+                return 0;
+            }
+            if (klen == strlen(pnames[k]) && strncmp(kv, pnames[k], klen) == 0)
+            {
+                c->score_points_weight[cls[k]] = (float)v;
                 return 0;
             }
         }
@@ -526,7 +533,8 @@ static void usage_extra(void)
                     "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
                     "                   gate2_margin (nats added to the models' gates),\n"
                     "                   score_box_weight.car|cyclist|pedestrian (the score's weight on gate 2's\n"
-                    "                   margin); stages.cluster.KEY: a\n"
+                    "                   margin), score_points_weight.CLASS (on ln(points / 64));\n"
+                    "                   stages.cluster.KEY: a\n"
                     "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
                     "                   stages.cluster.split_people=0: no proposal refinement);\n"
                     "                   stages.proj.azimuth_half_rad: the projection's window and\n"

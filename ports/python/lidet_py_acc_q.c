@@ -112,3 +112,35 @@ LIDET_PY_API int lidet_py_acc_cands_q(const char *sensor, const char *cls_name, 
                      g_acc_detq.order, make_q, &g_prop_q, g_prop_q.xyz, sizeof(int16_t), g_prop_q.mean_4mm,
                      sizeof g_prop_q.mean_4mm, g_prop_q.voxel, xyz, mean, voxel, cluster_id, n_cand, n_points);
 }
+
+/* The cluster size (lidet_cluster_rec_t / _q_t n_points: what the detectors' score reads) of the last run's
+ * candidates, in the same order: q = 0 the float detector's (lidet_py_acc_cands), 1 the integer one's. */
+LIDET_PY_API int lidet_py_acc_cand_points(int q, uint32_t n_cand, uint32_t *out)
+{
+    uint32_t k;
+    if (q)
+    {
+        if (n_cand > lidet_detector_q_stats(&g_acc_detq)->n_classified)
+        {
+            return LIDET_ERR_ARG;
+        }
+        for (k = 0; k < n_cand; ++k)
+        {
+            out[k] = g_acc_detq.cluster.recs[g_acc_detq.order[k]].n_points;
+        }
+        return LIDET_OK;
+    }
+    if (n_cand > lidet_detector_stats(&g_acc_det)->n_classified)
+    {
+        return LIDET_ERR_ARG;
+    }
+    {
+        uint32_t nc = 0;
+        const lidet_cluster_rec_t *recs = lidet_workspace_clusters(lidet_detector_workspace(&g_acc_det), &nc);
+        for (k = 0; k < n_cand; ++k)
+        {
+            out[k] = recs[g_acc_det.order[k]].n_points;
+        }
+    }
+    return LIDET_OK;
+}

@@ -33,7 +33,7 @@ def test_pure_combinations_reproduce_the_detectors(ab, fam, crop):
     cq = nq.candidates_q(nq.to_mm(pts), fam, crop_half_bam=(1 << 29) if crop else 0)
     dq = nq.detect_q(nq.to_mm(pts), fam, crop_half_bam=(1 << 29) if crop else 0)
     assert len(cq["xyz"]) == dq["stats"]["n_classified"] > 0
-    got = ab.nets_int8(fam, cq["xyz"], cq["mean"], cq["voxel"], cq["cluster_id"])
+    got = ab.nets_int8(fam, cq["xyz"], cq["mean"], cq["voxel"], cq["cluster_id"], cq["n_points"])
     assert len(got) == len(dq["cls"]) > 0
     np.testing.assert_array_equal([g[0] for g in got], dq["cls"])
     np.testing.assert_array_equal(np.rint([g[1] * 32768 for g in got]), dq["score_q15"])
@@ -42,7 +42,7 @@ def test_pure_combinations_reproduce_the_detectors(ab, fam, crop):
     cf = nq.candidates_float(pts, fam, crop_half_rad=math.pi / 4 if crop else 0.0)
     df = native.detect(pts, fam, crop_half_rad=math.pi / 4 if crop else 0.0, refine=False)
     assert len(cf["xyz"]) == df.stats["n_classified"]
-    got = ab.nets_float(fam, cf["xyz"], cf["mean"], cf["voxel"], cf["cluster_id"], max_boxes)
+    got = ab.nets_float(fam, cf["xyz"], cf["mean"], cf["voxel"], cf["cluster_id"], max_boxes, cf["n_points"])
     assert len(got) == len(df.cls) > 0
     np.testing.assert_array_equal([g[0] for g in got], df.cls)
     np.testing.assert_allclose([g[1] for g in got], df.score, rtol=1e-6)
@@ -59,3 +59,7 @@ def test_candidates_follow_the_detectors_order(need_lib):
     cf = nq.candidates_float(pts, "vlp16")
     r2 = (cf["mean"][:, :2].astype(np.float64) ** 2).sum(1)
     assert np.all(np.diff(r2) >= -1e-6) and len(np.unique(cf["cluster_id"])) == len(cf["cluster_id"])
+    # the cluster sizes the score reads: those of the detections of the same run
+    d = nq.detect_q(nq.to_mm(pts), "vlp16")
+    size = dict(zip(cq["cluster_id"].tolist(), cq["n_points"].tolist()))
+    assert len(d["cluster_id"]) > 0 and all(size[int(c)] == int(n) for c, n in zip(d["cluster_id"], d["n_points"]))

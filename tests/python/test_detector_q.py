@@ -166,7 +166,7 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
         models[kind] = QU.quantize(E.load(ROOT / "weights" / f"{name}.onnx", name), calib)
     cc, pc = nq.cluster_q_defaults(sensor)
     cap = native.capacity()
-    det_cfg = dict(crop_half_bam=crop_half_bam, max_range_mm=0, max_height_extent_mm=2500, score_box_weight_q16=[32768, 0, 0], max_proposals=min(128 if s.rows <= 16 else 256, cap["max_clusters"]),
+    det_cfg = dict(crop_half_bam=crop_half_bam, max_range_mm=0, max_height_extent_mm=2500, score_box_weight_q16=[32768, 0, 0], score_points_weight_q16=[6554, 0, 0], max_proposals=min(128 if s.rows <= 16 else 256, cap["max_clusters"]),
                    max_boxes=max_boxes or min(24 if s.rows <= 16 else 48, cap["max_clusters"]), gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM,
                    gate1_margin_q16=margins[0], gate2_margin_q16=margins[1])
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,

@@ -205,11 +205,12 @@ void test_three_objects_three_cars(void)
         TEST_ASSERT_CLOSE(az, d[k].box.yaw_rad, 1e-4, 0);
         TEST_ASSERT_CLOSE(3.883, d[k].box.l_m, 1e-5, 0);
         TEST_ASSERT_EQUAL_UINT32(r->n_points, d[k].n_points);
-        /* score = 1 / (1 + exp((E1 - gamma1) + w (E2 - gamma2))), E1 = -(5 + log(1 + 2 exp(-5))), w = 0.5 for
-         * cars (score_box_weight's default) */
+        /* score = 1 / (1 + exp((E1 - gamma1) + w (E2 - gamma2) - v ln(n / 64))), E1 = -(5 + log(1 + 2 exp(-5))),
+         * w = 0.5 and v = 0.1 for cars (score_box_weight's and score_points_weight's defaults) */
         TEST_ASSERT_CLOSE(0.5f, cfg.score_box_weight[LIDET_CLASS_CAR], 0.0, 0);
         TEST_ASSERT_CLOSE(1.0 / (1.0 + exp(-(5.0 + log(1.0 + 2.0 * exp(-5.0))) +
-                                          0.5 * ((double)d[k].energy_box - (double)m_box.gamma[0]))),
+                                          0.5 * ((double)d[k].energy_box - (double)m_box.gamma[0]) -
+                                          0.1 * log((double)d[k].n_points / 64.0))),
                           d[k].score, 1e-5, 0);
         TEST_ASSERT_TRUE(k == 0 || d[k - 1].cluster_id < d[k].cluster_id); /* equal scores: id order */
     }
@@ -217,6 +218,7 @@ void test_three_objects_three_cars(void)
         /* weight 0: the classifier's energy alone; out of [0, 4]: refused */
         lidet_detector_cfg_t c = cfg;
         c.score_box_weight[LIDET_CLASS_CAR] = 0.0f;
+        c.score_points_weight[LIDET_CLASS_CAR] = 0.0f;
         TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
         TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
         d = lidet_detector_detections(&g.ws, &n);
@@ -225,6 +227,9 @@ void test_three_objects_three_cars(void)
         c.score_box_weight[LIDET_CLASS_PEDESTRIAN] = 4.5f;
         TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
         c.score_box_weight[LIDET_CLASS_PEDESTRIAN] = -0.1f;
+        TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+        c.score_box_weight[LIDET_CLASS_PEDESTRIAN] = 0.0f;
+        c.score_points_weight[LIDET_CLASS_CYCLIST] = 4.01f;
         TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     }
 }

@@ -97,6 +97,10 @@ static void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     cfg.score_box_weight_q16[LIDET_CLASS_CYCLIST] = -1;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.score_box_weight_q16[LIDET_CLASS_CYCLIST] = 0;
+    TEST_ASSERT_EQUAL_INT32(6554, cfg.score_points_weight_q16[LIDET_CLASS_CAR]);
+    cfg.score_points_weight_q16[LIDET_CLASS_PEDESTRIAN] = 4 * 65536 + 1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.max_height_extent_mm = 0; /* no limit */
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));

@@ -30,6 +30,7 @@ sys.path[:0] = [str(ROOT / "tools"), str(ROOT / "codegen")]
 
 from lidet_codegen import quant as QU  # noqa: E402
 from lidet_codegen.ref import detector_q as RD  # noqa: E402
+from lidet_codegen.ref import pointnet_q as RQ  # noqa: E402
 from lidet_codegen.ref import qmath as RQM  # noqa: E402
 from lidet_tools import kitti, native, native_q as nq  # noqa: E402
 from lidet_tools.eval import kitti_ap as K  # noqa: E402
@@ -43,9 +44,10 @@ BAM = 2.0 * math.pi / 2.0 ** 32
 #: lidet_detector_cfg_default (score_box_weight) and lidet_detector_q_cfg_default (score_box_weight_q16 = w 2^16);
 #: tests/python/test_ablate_q.py checks that these rules reproduce both detectors
 SCORE_BOX_WEIGHT = (0.5, 0.0, 0.0)
+SCORE_POINTS_WEIGHT = (0.1, 0.0, 0.0)  # score_points_weight (_q16 = round(v 2^16))
 
 
-def nets_float(fam, xyz, mean, vox, cid, max_boxes):
+def nets_float(fam, xyz, mean, vox, cid, max_boxes, npts):
     """Float nets on proposals in metres, the float detector's rules: (cls, score, box (m, rad)) kept."""
     m = native.pn_models()[f"cls_{fam}"]
     mb = native.pn_models()[f"box_{fam}"]
@@ -65,6 +67,9 @@ def nets_float(fam, xyz, mean, vox, cid, max_boxes):
             continue
         t = np.float32(c["energy"][k] - m.gamma[cl]) + np.float32(SCORE_BOX_WEIGHT[cl]) * np.float32(
             b["energy"][k] - mb.gamma[cl])
+        if SCORE_POINTS_WEIGHT[cl] != 0.0:  # - v ln(n / 64), in float32 as lidet_detector.c
+            ln_n = np.float32(np.log(np.float32(max(int(npts[k]), 1)))) - np.float32(4.15888309)
+            t = np.float32(t - np.float32(SCORE_POINTS_WEIGHT[cl]) * ln_n)
         s = np.float32(1.0) / (np.float32(1.0) + np.exp(np.float32(t)))
         dets.append((float(s), int(cid[k]), cl, bx.astype(np.float64)))
     dets.sort(key=lambda d: (-d[0], d[1]))
@@ -75,7 +80,7 @@ def nets_float(fam, xyz, mean, vox, cid, max_boxes):
     return [(d[2], d[0], d[3]) for d in kept]
 
 
-def nets_int8(fam, q4, m4, vox, cid):
+def nets_int8(fam, q4, m4, vox, cid, npts):
     """int8 nets on 4 mm proposals, the integer detector's rules: (cls, score, box (m, rad)) kept."""
     gam = nq.pnq_models()[f"cls_{fam}_s8"]["gamma_q16"]
     gam_b = nq.pnq_models()[f"box_{fam}_s8"]["gamma_q16"]
@@ -88,7 +93,10 @@ def nets_int8(fam, q4, m4, vox, cid):
     def score(k):
         cl = int(c["cls"][k])
         w = int(round(SCORE_BOX_WEIGHT[cl] * 65536))
-        e = int(c["energy"][k]) + int(RQM.rshift_round((int(b["energy"][k]) - int(gam_b[cl])) * w, 16))
+        v = int(round(SCORE_POINTS_WEIGHT[cl] * 65536))
+        ln_n = int(RQ._ln_q16(np.int64(max(int(npts[k]), 1)) << 30)) - RD.LN64_Q16
+        e = (int(c["energy"][k]) + int(RQM.rshift_round((int(b["energy"][k]) - int(gam_b[cl])) * w, 16))
+             - int(RQM.rshift_round(ln_n * v, 16)))
         return RD.score_q15(min(max(e, -(1 << 31)), (1 << 31) - 1), int(gam[cl]))
     score = np.array([score(k) for k in keep], np.int32)
     boxes = b["box"][keep]
@@ -117,11 +125,12 @@ def run(sim: pathlib.Path, out: pathlib.Path, n_scans: int, fam: str = "hdl64", 
         cq = nq.candidates_q(nq.to_mm(pts), fam, crop_half_bam=1 << 29)
         f_q4, f_m4 = QU.int_proposals(cf["xyz"], cf["mean"]) if len(cf["xyz"]) else (cf["xyz"], cf["mean"])
         res = {
-            "float+float": nets_float(fam, cf["xyz"], cf["mean"], cf["voxel"], cf["cluster_id"], max_boxes),
-            "float+int8": nets_int8(fam, f_q4, f_m4, cf["voxel"], cf["cluster_id"]),
+            "float+float": nets_float(fam, cf["xyz"], cf["mean"], cf["voxel"], cf["cluster_id"], max_boxes,
+                                      cf["n_points"]),
+            "float+int8": nets_int8(fam, f_q4, f_m4, cf["voxel"], cf["cluster_id"], cf["n_points"]),
             "int+float": nets_float(fam, cq["xyz"] * np.float32(0.004), cq["mean"] * np.float32(0.004), cq["voxel"],
-                                    cq["cluster_id"], max_boxes),
-            "int+int8": nets_int8(fam, cq["xyz"], cq["mean"], cq["voxel"], cq["cluster_id"]),
+                                    cq["cluster_id"], max_boxes, cq["n_points"]),
+            "int+int8": nets_int8(fam, cq["xyz"], cq["mean"], cq["voxel"], cq["cluster_id"], cq["n_points"]),
         }
         for combo, dets in res.items():
             objs = [kitti.box_to_kitti(kitti.Box3D(CLASSES[cl], *map(float, bx), float(s)), calib, score=float(s))

@@ -775,6 +775,7 @@ def _acc_lib():
                                          C.c_uint32, _f32p, _f32p, _i16p, _u32p, _u32p, _u32p]
         L.lidet_py_acc_cands_q.argtypes = [C.c_char_p, C.c_char_p, C.c_char_p, _i32p, _i32p, C.c_uint32, C.c_uint32,
                                            _i16p, _i32p, _i16p, _u32p, _u32p, _u32p]
+        L.lidet_py_acc_cand_points.argtypes = [C.c_int, C.c_uint32, _u32p]
         _acc_ready = True
     return L
 
@@ -782,7 +783,8 @@ def _acc_lib():
 def candidates_float(points, sensor: str = "hdl64", model: str | None = None, crop_half_rad: float = 0.0,
                      max_range_m: float = 0.0, refine: bool = False) -> dict:
     """The float detector's classified candidates of one scan, nearest first: {'xyz' (K, N, 3) m centred,
-    'mean' (K, 3) m, 'voxel' (K, 3), 'cluster_id' (K,)}: the proposals its classifier sees."""
+    'mean' (K, 3) m, 'voxel' (K, 3), 'cluster_id' (K,), 'n_points' (K,) the cluster's size}: the proposals its
+    classifier sees."""
     L = _acc_lib()
     fam = model or sensor
     ms = native.pn_models()
@@ -800,13 +802,13 @@ def candidates_float(points, sensor: str = "hdl64", model: str | None = None, cr
     if rc < 0:
         raise native.LidetError(rc, "lidet_py_acc_cands")
     k = int(nc[0])
-    return dict(xyz=xyz[:k], mean=mean[:k], voxel=vox[:k], cluster_id=cid[:k])
+    return dict(xyz=xyz[:k], mean=mean[:k], voxel=vox[:k], cluster_id=cid[:k], n_points=_cand_points(L, 0, k))
 
 
 def candidates_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_half_bam: int = 0,
                  max_range_mm: int = 0) -> dict:
     """The integer detector's classified candidates of one scan (int32 mm points), nearest first: {'xyz'
-    (K, N, 3) 4 mm centred, 'mean' (K, 3) 4 mm, 'voxel' (K, 3), 'cluster_id' (K,)}."""
+    (K, N, 3) 4 mm centred, 'mean' (K, 3) 4 mm, 'voxel' (K, 3), 'cluster_id' (K,), 'n_points' (K,)}."""
     L = _acc_lib()
     fam = model or sensor
     pts = np.ascontiguousarray(points_mm, dtype=np.int32)
@@ -822,4 +824,13 @@ def candidates_q(points_mm, sensor: str = "hdl64", model: str | None = None, cro
     if rc < 0:
         raise native.LidetError(rc, "lidet_py_acc_cands_q")
     k = int(nc[0])
-    return dict(xyz=xyz[:k], mean=mean[:k], voxel=vox[:k], cluster_id=cid[:k])
+    return dict(xyz=xyz[:k], mean=mean[:k], voxel=vox[:k], cluster_id=cid[:k], n_points=_cand_points(L, 1, k))
+
+
+def _cand_points(L, q: int, k: int) -> np.ndarray:
+    """The cluster sizes (points) of the last candidates_float (q 0) / candidates_q (q 1) run's k candidates."""
+    out = np.zeros(max(k, 1), np.uint32)
+    rc = L.lidet_py_acc_cand_points(int(q), int(k), out)
+    if rc < 0:
+        raise native.LidetError(rc, "lidet_py_acc_cand_points")
+    return out[:k]

@@ -15,6 +15,9 @@ from lidet_codegen.ref import cluster_q, ground_q, pointnet_q, post_q, proj_q, q
 OUT_CROP, OUT_RANGE, OUT_BUDGET, OUT_GATE1, OUT_GATE2, OUT_SIZE, OUT_NMS, OUT_CAPACITY, OUT_DETECTED, OUT_TALL = range(1, 11)
 
 
+LN64_Q16 = 272557  # round(ln(64) * 2^16)
+
+
 def score_q15(energy_q16: int, gamma_q16: int) -> int:
     """1 / (1 + exp(E - gamma)) in Q15 (lidet_detector_q_score)."""
     t = int(energy_q16) - int(gamma_q16)
@@ -55,7 +58,7 @@ def candidates(recs, det_cfg: dict, outcome: list) -> tuple[list, bool]:
 def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, proposal_cfg: dict, det_cfg: dict,
            cls_model, box_model, max_clusters: int, max_detections: int, max_points: int, range_only: bool = False) -> dict:
     """The whole integer detector on (N, 3) int32 mm points. det_cfg: crop_half_bam, max_range_mm, max_height_extent_mm,
-    max_proposals, max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max, score_box_weight_q16 (3), and optionally gate1_margin_q16 / gate2_margin_q16
+    max_proposals, max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max, score_box_weight_q16 (3), score_points_weight_q16 (3), and optionally gate1_margin_q16 / gate2_margin_q16
     (0 when absent: the models' gammas). range_only: the image keeps only the range, every stage reads x, y, z
     decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
     (dicts), outcomes, stats."""
@@ -103,9 +106,13 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
             outcome[ci] = OUT_SIZE
             stats["n_size_rejected"] += 1
             continue
-        # the score's energy: E1 + round(w (E2 - gamma2)), saturated to int32 (lidet_detector_q.c fill_detection)
+        # the score's energy: E1 + round(w (E2 - gamma2)) - round(v ln(n / 64)), saturated to int32
+        # (lidet_detector_q.c fill_detection)
         w = int(det_cfg["score_box_weight_q16"][cls])
-        e_s = energy + int(qmath.rshift_round((e_box - int(box_model.gamma_q16[cls])) * w, 16))
+        v = int(det_cfg["score_points_weight_q16"][cls])
+        ln_n = int(pointnet_q._ln_q16(np.int64(max(recs[ci].n_points, 1)) << 30)) - LN64_Q16
+        e_s = (energy + int(qmath.rshift_round((e_box - int(box_model.gamma_q16[cls])) * w, 16))
+               - int(qmath.rshift_round(ln_n * v, 16)))
         e_s = min(max(e_s, -(1 << 31)), (1 << 31) - 1)
         d = dict(box=box, cls=cls, score_q15=score_q15(e_s, cls_model.gamma_q16[cls]), energy_cls_q16=energy,
                  energy_box_q16=int(b["energy"][0]), cluster_id=ci + 1, n_points=recs[ci].n_points)

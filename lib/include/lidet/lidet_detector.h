@@ -107,7 +107,10 @@ typedef struct
                                                   w this, per class (lidet_class_t order); [0, 4]. Default car
                                                   0.5, cyclist and pedestrian 0: the box net's confidence ranks
                                                   cars' boxes better (docs/DETECTOR.md, Score) */
-    float nms_iou;         /**< BEV IoU above which the lower-scored detection is dropped; [0, 1],
+    float score_points_weight[LIDET_N_CLASSES]; /**< and + v ln(n / 64) inside the exponent, n the cluster's
+                                                     points, v this per class; [0, 4]. Default car 0.1, others
+                                                     0: among cars the ones with more points have better boxes */
+    float nms_iou; /**< BEV IoU above which the lower-scored detection is dropped; [0, 1],
                                          default 0.1 (detections come from disjoint clusters) */
     float size_min_m[LIDET_N_CLASSES][3]; /**< plausible l, w, h per class (lidet_class_t order) */
     float size_max_m[LIDET_N_CLASSES][3];

@@ -108,8 +108,12 @@ typedef struct
         score_box_weight_q16[LIDET_N_CLASSES]; /**< the float detector's score_box_weight in Q16: the score
                                                        is lidet_detector_q_score(E1 + round(w (E2 - gamma2)),
                                                        gamma1); [0, 4 * 65536]; default car 32768, others 0 */
-    int32_t nms_iou_q15;                       /**< [0, 32768]; default 3277 (0.1) */
-    lidet_size_limits_q_t size;                /**< plausible l, w, h per class */
+    int32_t
+        score_points_weight_q16[LIDET_N_CLASSES]; /**< the float detector's score_points_weight in Q16: minus
+                                                          round(v (ln n - ln 64)) in that energy, ln n in Q16 from
+                                                          the energies' log table; default car 6554, others 0 */
+    int32_t nms_iou_q15;                          /**< [0, 32768]; default 3277 (0.1) */
+    lidet_size_limits_q_t size;                   /**< plausible l, w, h per class */
     lidet_clock_fn clock; /**< optional timestamp source for stats.ticks (NULL: no timing) */
     void *clock_ctx;      /**< passed to clock */
 } lidet_detector_q_cfg_t;

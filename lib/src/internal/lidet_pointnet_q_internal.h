@@ -30,6 +30,8 @@ void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
 /* 2 x 2 blocks, 4 inputs per step with SMLAD (Cortex-M4/M7 DSP extension; a C model of it elsewhere) */
 void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                           const int32_t *b, uint32_t n_out, int32_t *acc);
+/* ln(S / 2^30) in Q16 for S >= 2^30 (the energies' log: S = m 2^e, log2 m from the table, interpolated) */
+int64_t lidet__pnq_ln_q16(int64_t sum);
 /* the DSP kernel on the weights [out][in] (w_oi, the generated models' second layout on cores with the DSP
  * extension); w_t ([in][out], the same weights) for the leftovers */
 void lidet__nn_acc_s8_oi(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_oi,
