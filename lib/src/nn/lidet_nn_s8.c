@@ -180,15 +180,59 @@ static inline uint32_t s8_load2(const int8_t *p)
 }
 
 /* 2 x 2 (points x output channels) accumulators in registers; the first n_simd inputs (a multiple of 4) 4 at a
- * time with SMLAD (the DSP kernel below; 0 elsewhere: a constant, so the loop vanishes; inlined into both, so each
- * is compiled for its own case), the rest one at a time */
+ * time with SMLAD (the DSP kernels below; 0 elsewhere: a constant, so the loop vanishes; inlined into each, so each
+ * is compiled for its own case), the rest one at a time. w_oi (NULL or the same weights [out][in]) picks the
+ * inner loop's layout, also a constant per caller. */
 #if defined(__GNUC__)
 #define S8_ALWAYS_INLINE static inline __attribute__((always_inline))
 #else
 #define S8_ALWAYS_INLINE static inline
 #endif
+
+/* 4 inputs of points x0, x1 against channels o, o + 1: [in][out] weights at w (row stride n_out) */
+S8_ALWAYS_INLINE void step4_io(const int8_t *x0, const int8_t *x1, const int8_t *w, uint32_t n_out,
+                               int32_t *s)
+{
+    const uint32_t u0 = s8_load4(x0), u1 = s8_load4(x1);
+    const uint32_t p02 = S8_SXTB16(u0), p13 = S8_SXTB16_ROR8(u0);
+    const uint32_t q02 = S8_SXTB16(u1), q13 = S8_SXTB16_ROR8(u1);
+    /* channels o, o + 1 of inputs i and i + 2: bytes (w_i,o, w_i,o+1, w_i+2,o, w_i+2,o+1) */
+    uint32_t c = s8_load2(w) | (s8_load2(w + 2u * n_out) << 16), h = S8_SXTB16(c);
+    s[0] = S8_SMLAD(p02, h, s[0]);
+    s[2] = S8_SMLAD(q02, h, s[2]);
+    h = S8_SXTB16_ROR8(c);
+    s[1] = S8_SMLAD(p02, h, s[1]);
+    s[3] = S8_SMLAD(q02, h, s[3]);
+    /* inputs i + 1 and i + 3 */
+    c = s8_load2(w + n_out) | (s8_load2(w + 3u * n_out) << 16);
+    h = S8_SXTB16(c);
+    s[0] = S8_SMLAD(p13, h, s[0]);
+    s[2] = S8_SMLAD(q13, h, s[2]);
+    h = S8_SXTB16_ROR8(c);
+    s[1] = S8_SMLAD(p13, h, s[1]);
+    s[3] = S8_SMLAD(q13, h, s[3]);
+}
+
+/* The same on [out][in] weights (w0, w1: the two channels' rows): one word load brings 4 weights of a channel,
+ * as 4 inputs of a point, and one SXTB16 (plain and rotated) widens either into the pairs (i, i + 2), (i + 1,
+ * i + 3): 4 word loads, 8 SXTB16 and 8 SMLAD for 16 multiply-adds (the [in][out] step: 6 instructions more, the
+ * halfword loads and their packing) */
+S8_ALWAYS_INLINE void step4_oi(const int8_t *x0, const int8_t *x1, const int8_t *w0, const int8_t *w1,
+                               int32_t *s)
+{
+    const uint32_t u0 = s8_load4(x0), u1 = s8_load4(x1), v0 = s8_load4(w0), v1 = s8_load4(w1);
+    const uint32_t p = S8_SXTB16(u0), q = S8_SXTB16(u1), h0 = S8_SXTB16(v0), h1 = S8_SXTB16(v1);
+    const uint32_t pr = S8_SXTB16_ROR8(u0), qr = S8_SXTB16_ROR8(u1);
+    const uint32_t h0r = S8_SXTB16_ROR8(v0), h1r = S8_SXTB16_ROR8(v1);
+    s[0] = S8_SMLAD(pr, h0r, S8_SMLAD(p, h0, s[0]));
+    s[1] = S8_SMLAD(pr, h1r, S8_SMLAD(p, h1, s[1]));
+    s[2] = S8_SMLAD(qr, h0r, S8_SMLAD(q, h0, s[2]));
+    s[3] = S8_SMLAD(qr, h1r, S8_SMLAD(q, h1, s[3]));
+}
+
 S8_ALWAYS_INLINE void acc_s8_2x2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                                 const int32_t *b, uint32_t n_out, int32_t *acc, uint32_t n_simd)
+                                 const int8_t *w_oi, const int32_t *b, uint32_t n_out, int32_t *acc,
+                                 uint32_t n_simd)
 {
     uint32_t r, i, o;
     for (r = 0; r + 2u <= n_rows; r += 2u)
@@ -197,41 +241,47 @@ S8_ALWAYS_INLINE void acc_s8_2x2(const int8_t *in, uint32_t n_rows, uint32_t n_i
         int32_t *a0 = acc + r * n_out, *a1 = a0 + n_out;
         for (o = 0; o + 2u <= n_out; o += 2u)
         {
-            int32_t s00 = b[o], s01 = b[o + 1u], s10 = s00, s11 = s01;
-            const int8_t *w = w_t + o;
-            for (i = 0; i < n_simd; i += 4u, w += 4u * n_out)
+            int32_t s[4];
+            s[0] = s[2] = b[o];
+            s[1] = s[3] = b[o + 1u];
+            if (w_oi != 0)
             {
-                const uint32_t u0 = s8_load4(x0 + i), u1 = s8_load4(x1 + i);
-                const uint32_t p02 = S8_SXTB16(u0), p13 = S8_SXTB16_ROR8(u0);
-                const uint32_t q02 = S8_SXTB16(u1), q13 = S8_SXTB16_ROR8(u1);
-                /* channels o, o + 1 of inputs i and i + 2: bytes (w_i,o, w_i,o+1, w_i+2,o, w_i+2,o+1) */
-                uint32_t c = s8_load2(w) | (s8_load2(w + 2u * n_out) << 16), h = S8_SXTB16(c);
-                s00 = S8_SMLAD(p02, h, s00);
-                s10 = S8_SMLAD(q02, h, s10);
-                h = S8_SXTB16_ROR8(c);
-                s01 = S8_SMLAD(p02, h, s01);
-                s11 = S8_SMLAD(q02, h, s11);
-                /* inputs i + 1 and i + 3 */
-                c = s8_load2(w + n_out) | (s8_load2(w + 3u * n_out) << 16);
-                h = S8_SXTB16(c);
-                s00 = S8_SMLAD(p13, h, s00);
-                s10 = S8_SMLAD(q13, h, s10);
-                h = S8_SXTB16_ROR8(c);
-                s01 = S8_SMLAD(p13, h, s01);
-                s11 = S8_SMLAD(q13, h, s11);
+                const int8_t *w0 = w_oi + o * n_in, *w1 = w0 + n_in;
+                const int8_t *p0 = x0, *p1 = x1, *q0 = w0, *q1 = w1, *const end = x0 + n_simd;
+                /* four pointers stepped together (post-increment loads), one bound */
+                for (; p0 != end; p0 += 4, p1 += 4, q0 += 4, q1 += 4)
+                {
+                    step4_oi(p0, p1, q0, q1, s);
+                }
+                for (i = n_simd; i < n_in; ++i)
+                {
+                    const int32_t c0 = w0[i], c1 = w1[i], v0 = x0[i], v1 = x1[i];
+                    s[0] += v0 * c0;
+                    s[1] += v0 * c1;
+                    s[2] += v1 * c0;
+                    s[3] += v1 * c1;
+                }
             }
-            for (i = n_simd; i < n_in; ++i, w += n_out)
+            else
             {
-                const int32_t w0 = w[0], w1 = w[1], v0 = x0[i], v1 = x1[i];
-                s00 += v0 * w0;
-                s01 += v0 * w1;
-                s10 += v1 * w0;
-                s11 += v1 * w1;
+                const int8_t *w = w_t + o;
+                for (i = 0; i < n_simd; i += 4u, w += 4u * n_out)
+                {
+                    step4_io(x0 + i, x1 + i, w, n_out, s);
+                }
+                for (i = n_simd; i < n_in; ++i, w += n_out)
+                {
+                    const int32_t w0 = w[0], w1 = w[1], v0 = x0[i], v1 = x1[i];
+                    s[0] += v0 * w0;
+                    s[1] += v0 * w1;
+                    s[2] += v1 * w0;
+                    s[3] += v1 * w1;
+                }
             }
-            a0[o] = s00;
-            a0[o + 1u] = s01;
-            a1[o] = s10;
-            a1[o + 1u] = s11;
+            a0[o] = s[0];
+            a0[o + 1u] = s[1];
+            a1[o] = s[2];
+            a1[o + 1u] = s[3];
         }
         if (o < n_out) /* an odd last channel */
         {
@@ -247,75 +297,21 @@ S8_ALWAYS_INLINE void acc_s8_2x2(const int8_t *in, uint32_t n_rows, uint32_t n_i
 void lidet__nn_acc_s8_r2o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, int32_t *acc)
 {
-    acc_s8_2x2(in, n_rows, n_in, w_t, b, n_out, acc, 0u);
+    acc_s8_2x2(in, n_rows, n_in, w_t, 0, b, n_out, acc, 0u);
 }
 
 void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                           const int32_t *b, uint32_t n_out, int32_t *acc)
 {
-    acc_s8_2x2(in, n_rows, n_in, w_t, b, n_out, acc, n_in & ~3u);
+    acc_s8_2x2(in, n_rows, n_in, w_t, 0, b, n_out, acc, n_in & ~3u);
 }
 
-/* The DSP kernel on the weights' second layout, [out][in] (lidet_pointnet_q_layer_t.w_oi): one 32-bit load brings
- * 4 weights of a channel, as 4 inputs of a point, and one SXTB16 (plain and rotated) widens either into the pairs
- * (i, i + 2), (i + 1, i + 3). Per 4 inputs of a 2 x 2 block: 4 word loads, 8 SXTB16, 8 SMLAD for 16
- * multiply-adds (the [in][out] kernel above: 6 instructions more, the halfword loads and their packing). The
- * leftovers (n_in not a multiple of 4, an odd last channel or row) take w_t. */
-S8_ALWAYS_INLINE void acc_s8_2x2_oi(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_oi,
-                                    const int8_t *w_t, const int32_t *b, uint32_t n_out, int32_t *acc)
-{
-    const uint32_t n4 = n_in & ~3u;
-    uint32_t r, i, o;
-    for (r = 0; r + 2u <= n_rows; r += 2u)
-    {
-        const int8_t *x0 = in + r * n_in, *x1 = x0 + n_in;
-        int32_t *a0 = acc + r * n_out, *a1 = a0 + n_out;
-        for (o = 0; o + 2u <= n_out; o += 2u)
-        {
-            int32_t s00 = b[o], s01 = b[o + 1u], s10 = s00, s11 = s01;
-            const int8_t *w0 = w_oi + o * n_in, *w1 = w0 + n_in;
-            const int8_t *p0 = x0, *p1 = x1, *q0 = w0, *q1 = w1, *const end = x0 + n4;
-            /* four pointers stepped together (post-increment loads), one bound */
-            for (; p0 != end; p0 += 4, p1 += 4, q0 += 4, q1 += 4)
-            {
-                const uint32_t u0 = s8_load4(p0), u1 = s8_load4(p1);
-                const uint32_t v0 = s8_load4(q0), v1 = s8_load4(q1);
-                const uint32_t p = S8_SXTB16(u0), q = S8_SXTB16(u1), h0 = S8_SXTB16(v0), h1 = S8_SXTB16(v1);
-                const uint32_t pr = S8_SXTB16_ROR8(u0), qr = S8_SXTB16_ROR8(u1);
-                const uint32_t h0r = S8_SXTB16_ROR8(v0), h1r = S8_SXTB16_ROR8(v1);
-                s00 = S8_SMLAD(pr, h0r, S8_SMLAD(p, h0, s00));
-                s01 = S8_SMLAD(pr, h1r, S8_SMLAD(p, h1, s01));
-                s10 = S8_SMLAD(qr, h0r, S8_SMLAD(q, h0, s10));
-                s11 = S8_SMLAD(qr, h1r, S8_SMLAD(q, h1, s11));
-            }
-            for (i = n4; i < n_in; ++i)
-            {
-                const int32_t c0 = w0[i], c1 = w1[i], v0 = x0[i], v1 = x1[i];
-                s00 += v0 * c0;
-                s01 += v0 * c1;
-                s10 += v1 * c0;
-                s11 += v1 * c1;
-            }
-            a0[o] = s00;
-            a0[o + 1u] = s01;
-            a1[o] = s10;
-            a1[o + 1u] = s11;
-        }
-        if (o < n_out) /* an odd last channel */
-        {
-            lidet__nn_acc_s8_cols(x0, 2u, n_in, w_t + o, b + o, 1u, n_out, a0 + o, n_out);
-        }
-    }
-    if (r < n_rows) /* an odd last row */
-    {
-        lidet__nn_acc_s8_cols(in + r * n_in, n_rows - r, n_in, w_t, b, n_out, n_out, acc + r * n_out, n_out);
-    }
-}
-
+/* The DSP kernel on the weights' second layout, [out][in] (lidet_pointnet_q_layer_t.w_oi; step4_oi); the
+ * leftovers (n_in not a multiple of 4, an odd last channel or row) take w_t */
 void lidet__nn_acc_s8_oi(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_oi,
                          const int8_t *w_t, const int32_t *b, uint32_t n_out, int32_t *acc)
 {
-    acc_s8_2x2_oi(in, n_rows, n_in, w_oi, w_t, b, n_out, acc);
+    acc_s8_2x2(in, n_rows, n_in, w_t, w_oi, b, n_out, acc, n_in & ~3u);
 }
 
 void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
