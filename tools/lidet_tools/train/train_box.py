@@ -176,6 +176,8 @@ def train(a) -> dict:
                 if k not in ("no_progress", "threads", "device", "work", "out", "onnx", "command")}
     if not args_key.get("occlusion"):
         args_key.pop("occlusion", None)  # states made before the option resume as before
+    if not args_key.get("widths"):
+        args_key.pop("widths", None)  # the same for --widths at its default
     if dd:
         args_key["world_size"] = dd.world  # the shards depend on it: resume with the same number of ranks
     st = dict(epoch=0, history=[], best_box=None, best_en=None, margins=None, args=args_key)

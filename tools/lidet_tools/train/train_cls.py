@@ -89,6 +89,8 @@ def train(a) -> dict:
     state_path = a.work / "state.pt"
     args_key = {k: (str(v) if isinstance(v, pathlib.Path) else v) for k, v in vars(a).items()
                 if k not in ("no_progress", "threads", "device", "work", "out", "onnx", "command")}
+    if args_key.get("pvle") == "32,32":
+        args_key.pop("pvle")  # states made before --pvle (at its default) resume as before
     if dd:
         args_key["world_size"] = dd.world  # the shards depend on it: resume with the same number of ranks
     st = dict(epoch=0, history=[], best_ce=None, best_en=None, margins=None, args=args_key)
