@@ -263,13 +263,16 @@ static void fill_detection(const lidet_detector_q_t *d, lidet_detection_q_t *t, 
 {
     t->reserved = 0;
     /* the score's energy: E1 + round(w (E2 - gamma2)) - round(v ln(n / 64)) (Q16, |.| < 2^51 before the
-     * shifts), saturated to int32 */
+     * shifts), saturated to int32; ln n only where v is not 0, as the float detector */
     const int64_t m2 = (int64_t)bo->energy_q16 - d->box.model->gamma_q16[co->cls];
+    const int32_t v = d->cfg.score_points_weight_q16[co->cls];
     const uint32_t n = d->cluster.recs[ci].n_points;
-    const int64_t ln_n = lidet__pnq_ln_q16((int64_t)(n > 0u ? n : 1u) << 30) - LN64_Q16;
-    int64_t e = (int64_t)co->energy_q16 +
-                lidet__q_rshift_round(m2 * d->cfg.score_box_weight_q16[co->cls], 16) -
-                lidet__q_rshift_round(ln_n * d->cfg.score_points_weight_q16[co->cls], 16);
+    int64_t e =
+        (int64_t)co->energy_q16 + lidet__q_rshift_round(m2 * d->cfg.score_box_weight_q16[co->cls], 16);
+    if (v != 0)
+    {
+        e -= lidet__q_rshift_round((lidet__pnq_ln_q16((int64_t)(n > 0u ? n : 1u) << 30) - LN64_Q16) * v, 16);
+    }
     e = e < INT32_MIN ? INT32_MIN : (e > INT32_MAX ? INT32_MAX : e);
     t->score_q15 = lidet_detector_q_score((int32_t)e, d->cls.model->gamma_q16[co->cls]);
     t->energy_cls_q16 = co->energy_q16;

@@ -412,24 +412,22 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, gate1_margin)
     CLI_SET_FLOAT(c, kv, klen, v, gate2_margin)
     {
-        /* score_box_weight.car / .cyclist / .pedestrian */
+        /* score_box_weight.CLASS / score_points_weight.CLASS, in lidet_class_t order */
         static const char *const names[LIDET_N_CLASSES] = {"score_box_weight.car", "score_box_weight.cyclist",
                                                            "score_box_weight.pedestrian"};
         static const char *const pnames[LIDET_N_CLASSES] = {"score_points_weight.car", "score_points_weight.cyclist",
                                                             "score_points_weight.pedestrian"};
-        static const lidet_class_t cls[LIDET_N_CLASSES] = {LIDET_CLASS_CAR, LIDET_CLASS_CYCLIST,
-                                                           LIDET_CLASS_PEDESTRIAN};
         int k;
         for (k = 0; k < LIDET_N_CLASSES; ++k)
         {
             if (klen == strlen(names[k]) && strncmp(kv, names[k], klen) == 0)
             {
-                c->score_box_weight[cls[k]] = (float)v;
+                c->score_box_weight[k] = (float)v;
                 return 0;
             }
             if (klen == strlen(pnames[k]) && strncmp(kv, pnames[k], klen) == 0)
             {
-                c->score_points_weight[cls[k]] = (float)v;
+                c->score_points_weight[k] = (float)v;
                 return 0;
             }
         }

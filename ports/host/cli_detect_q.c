@@ -68,17 +68,11 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     cfg.gate2 = fcfg->gate2;
     cfg.gate1_margin_q16 = round_i32((double)fcfg->gate1_margin * 65536.0);
     cfg.gate2_margin_q16 = round_i32((double)fcfg->gate2_margin * 65536.0);
-    cfg.score_box_weight_q16[LIDET_CLASS_CAR] = round_i32((double)fcfg->score_box_weight[LIDET_CLASS_CAR] * 65536.0);
-    cfg.score_box_weight_q16[LIDET_CLASS_CYCLIST] =
-        round_i32((double)fcfg->score_box_weight[LIDET_CLASS_CYCLIST] * 65536.0);
-    cfg.score_box_weight_q16[LIDET_CLASS_PEDESTRIAN] =
-        round_i32((double)fcfg->score_box_weight[LIDET_CLASS_PEDESTRIAN] * 65536.0);
-    cfg.score_points_weight_q16[LIDET_CLASS_CAR] =
-        round_i32((double)fcfg->score_points_weight[LIDET_CLASS_CAR] * 65536.0);
-    cfg.score_points_weight_q16[LIDET_CLASS_CYCLIST] =
-        round_i32((double)fcfg->score_points_weight[LIDET_CLASS_CYCLIST] * 65536.0);
-    cfg.score_points_weight_q16[LIDET_CLASS_PEDESTRIAN] =
-        round_i32((double)fcfg->score_points_weight[LIDET_CLASS_PEDESTRIAN] * 65536.0);
+    for (k = 0; k < LIDET_N_CLASSES; ++k)
+    {
+        cfg.score_box_weight_q16[k] = round_i32((double)fcfg->score_box_weight[k] * 65536.0);
+        cfg.score_points_weight_q16[k] = round_i32((double)fcfg->score_points_weight[k] * 65536.0);
+    }
     cfg.nms_iou_q15 = round_i32((double)fcfg->nms_iou * 32768.0);
     cfg.clock = cli_stage_clock_ns;
     *status = lidet_detector_q_init(&g_detq, &cfg, mc, mb);

@@ -30,8 +30,6 @@ sys.path[:0] = [str(ROOT / "tools"), str(ROOT / "codegen")]
 
 from lidet_codegen import quant as QU  # noqa: E402
 from lidet_codegen.ref import detector_q as RD  # noqa: E402
-from lidet_codegen.ref import pointnet_q as RQ  # noqa: E402
-from lidet_codegen.ref import qmath as RQM  # noqa: E402
 from lidet_tools import kitti, native, native_q as nq  # noqa: E402
 from lidet_tools.eval import kitti_ap as K  # noqa: E402
 
@@ -90,15 +88,10 @@ def nets_int8(fam, q4, m4, vox, cid, npts):
     if len(keep) == 0:
         return []
     cls = c["cls"][keep]
-    def score(k):
-        cl = int(c["cls"][k])
-        w = int(round(SCORE_BOX_WEIGHT[cl] * 65536))
-        v = int(round(SCORE_POINTS_WEIGHT[cl] * 65536))
-        ln_n = int(RQ._ln_q16(np.int64(max(int(npts[k]), 1)) << 30)) - RD.LN64_Q16
-        e = (int(c["energy"][k]) + int(RQM.rshift_round((int(b["energy"][k]) - int(gam_b[cl])) * w, 16))
-             - int(RQM.rshift_round(ln_n * v, 16)))
-        return RD.score_q15(min(max(e, -(1 << 31)), (1 << 31) - 1), int(gam[cl]))
-    score = np.array([score(k) for k in keep], np.int32)
+    score = np.array([RD.detection_score_q15(int(c["energy"][k]), int(b["energy"][k]), int(npts[k]),
+                                             int(gam[c["cls"][k]]), int(gam_b[c["cls"][k]]),
+                                             round(SCORE_BOX_WEIGHT[c["cls"][k]] * 65536),
+                                             round(SCORE_POINTS_WEIGHT[c["cls"][k]] * 65536)) for k in keep], np.int32)
     boxes = b["box"][keep]
     ok = nq.post_q(boxes, score, cid[keep], cls, 3277)
     # post_q returns the kept cluster ids in order (size check applied first)

@@ -26,6 +26,17 @@ def score_q15(energy_q16: int, gamma_q16: int) -> int:
     return (e << 15) // (one + e) if t >= 0 else (one << 15) // (one + e)
 
 
+def detection_score_q15(e_cls: int, e_box: int, n_points: int, gamma_cls: int, gamma_box: int, w_q16: int,
+                        v_q16: int) -> int:
+    """A detection's score (lidet_detector_q.c fill_detection): score_q15 of E1 + round(w (E2 - gamma2)) -
+    round(v ln(n / 64)) (Q16, saturated to int32) against gamma1; the ln term only where v is not 0."""
+    e = e_cls + int(qmath.rshift_round((e_box - gamma_box) * w_q16, 16))
+    if v_q16:
+        ln_n = int(pointnet_q._ln_q16(np.int64(max(n_points, 1)) << 30)) - LN64_Q16
+        e -= int(qmath.rshift_round(ln_n * v_q16, 16))
+    return score_q15(min(max(e, -(1 << 31)), (1 << 31) - 1), gamma_cls)
+
+
 def candidates(recs, det_cfg: dict, outcome: list) -> tuple[list, bool]:
     """Kept clusters in the azimuth window, not taller than max_height_extent_mm (0: no limit; the z span in 4 mm
     steps times 4) and in range, nearest first (ties: lower index), at most max_proposals."""
@@ -106,15 +117,10 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
             outcome[ci] = OUT_SIZE
             stats["n_size_rejected"] += 1
             continue
-        # the score's energy: E1 + round(w (E2 - gamma2)) - round(v ln(n / 64)), saturated to int32
-        # (lidet_detector_q.c fill_detection)
-        w = int(det_cfg["score_box_weight_q16"][cls])
-        v = int(det_cfg["score_points_weight_q16"][cls])
-        ln_n = int(pointnet_q._ln_q16(np.int64(max(recs[ci].n_points, 1)) << 30)) - LN64_Q16
-        e_s = (energy + int(qmath.rshift_round((e_box - int(box_model.gamma_q16[cls])) * w, 16))
-               - int(qmath.rshift_round(ln_n * v, 16)))
-        e_s = min(max(e_s, -(1 << 31)), (1 << 31) - 1)
-        d = dict(box=box, cls=cls, score_q15=score_q15(e_s, cls_model.gamma_q16[cls]), energy_cls_q16=energy,
+        sc = detection_score_q15(energy, e_box, recs[ci].n_points, int(cls_model.gamma_q16[cls]),
+                                 int(box_model.gamma_q16[cls]), int(det_cfg["score_box_weight_q16"][cls]),
+                                 int(det_cfg["score_points_weight_q16"][cls]))
+        d = dict(box=box, cls=cls, score_q15=sc, energy_cls_q16=energy,
                  energy_box_q16=int(b["energy"][0]), cluster_id=ci + 1, n_points=recs[ci].n_points)
         # the detector's insertion: after every entry with a higher score or an equal score and a lower id
         k = len(dets)
