@@ -540,7 +540,9 @@ def emit_c_s8(qm: QModel, onnx_path, calib_path, cmd: str, src_sha: str, calib_s
                 c.append(_ints(base + "_m", "int32_t", l.mult, f"{tag}.{pn}[{i}] requantization multipliers"))
                 c.append(_ints(base + "_s", "uint8_t", l.shift, f"{tag}.{pn}[{i}] requantization shifts"))
                 oi = "0"
-                if not l.in_s16:  # the int8 x int8 layers: [out][in] too, for the DSP kernel (LIDET_PNQ_WEIGHTS_OI)
+                # the shared per-point int8 x int8 layers: [out][in] too, for the DSP kernel (LIDET_PNQ_WEIGHTS_OI);
+                # the PVLE and head layers run on one vector (one row), which the kernel does with w_t anyway
+                if pn == "point" and not l.in_s16:
                     c.append("#if LIDET_PNQ_WEIGHTS_OI\n" + _ints(base + "_woi", "int8_t", l.w_q,
                                                                  f"{tag}.{pn}[{i}] weights [{l.n_out}][{l.n_in}] int8, "
                                                                  f"the same as _w in [out][in] order")

@@ -67,7 +67,8 @@ typedef struct
     const uint8_t *shift; /**< n_out, in [1, 62] */
     const int8_t *w_oi;   /**< optional: the same weights [out][in] (n_out * n_in), which the DSP kernel reads
                                a word (4 weights) at a time; NULL: w_t only. The generated models fill it
-                               where LIDET_PNQ_WEIGHTS_OI is 1 (the default on cores with the DSP extension:
+                               for the shared per-point layers (the ones run on blocks of points) where
+                               LIDET_PNQ_WEIGHTS_OI is 1 (the default on cores with the DSP extension:
                                Cortex-M4, M7, M33) and leave it NULL elsewhere (no second copy in flash) */
 } lidet_pointnet_q_layer_t;
 

@@ -70,17 +70,6 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_box16_s8_tnet_head0_m[8] 
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box16_s8_tnet_head0_s[8] = {
     38, 37, 38, 38, 38, 37, 37, 37
 };
-#if LIDET_PNQ_WEIGHTS_OI
-/* tnet.head[0] weights [8][12] int8, the same as _w in [out][in] order */
-LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_box16_s8_tnet_head0_woi[96] = {
-    -19, 52, 45, 56, 16, 44, 51, -44, 17, 112, -127, 108, 27, 18, 9, -12,
-    23, 42, 6, -23, -82, 38, -110, 127, 5, 33, 10, -63, 39, -39, -7, 39,
-    127, 23, 122, 27, -31, 23, 21, -44, -51, -66, 66, 10, 127, 111, -123, 73,
-    70, -8, 8, 19, -84, -65, 91, -96, -32, 19, -127, 106, 12, -46, 5, 48,
-    46, -25, 32, -39, -106, -49, -127, 69, -45, -20, -4, 22, 14, 16, 42, 1,
-    -114, 87, 127, 86, 27, -16, -46, 53, -17, -21, -41, -36, -127, -19, -121, 113
-};
-#endif
 /* tnet.head[1] weights [8][3] int8 (per-channel scale) */
 LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_box16_s8_tnet_head1_w[24] = {
     85, -48, -29, -14, -107, -65, 34, -15, -6, -20, 127, -127, -120, -35, 5, 41,
@@ -98,16 +87,9 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_box16_s8_tnet_head1_m[3] 
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box16_s8_tnet_head1_s[3] = {
     31, 30, 31
 };
-#if LIDET_PNQ_WEIGHTS_OI
-/* tnet.head[1] weights [3][8] int8, the same as _w in [out][in] order */
-LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_box16_s8_tnet_head1_woi[24] = {
-    85, -14, 34, -20, -120, 41, 127, -30, -48, -107, -15, 127, -35, -39, 89, -107,
-    -29, -65, -6, -127, 5, 26, 35, -118
-};
-#endif
 static const lidet_pointnet_q_layer_t fuzz_box16_s8_tnet_head[2] = {
-    {12u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box16_s8_tnet_head0_w, fuzz_box16_s8_tnet_head0_b, fuzz_box16_s8_tnet_head0_m, fuzz_box16_s8_tnet_head0_s, LIDET_PNQ_OI(fuzz_box16_s8_tnet_head0_woi)},
-    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box16_s8_tnet_head1_w, fuzz_box16_s8_tnet_head1_b, fuzz_box16_s8_tnet_head1_m, fuzz_box16_s8_tnet_head1_s, LIDET_PNQ_OI(fuzz_box16_s8_tnet_head1_woi)}
+    {12u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box16_s8_tnet_head0_w, fuzz_box16_s8_tnet_head0_b, fuzz_box16_s8_tnet_head0_m, fuzz_box16_s8_tnet_head0_s, 0},
+    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box16_s8_tnet_head1_w, fuzz_box16_s8_tnet_head1_b, fuzz_box16_s8_tnet_head1_m, fuzz_box16_s8_tnet_head1_s, 0}
 };
 
 /* tnet: class one-hot folded into head[0], [class][out] int32 */
@@ -218,21 +200,6 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_box16_s8_box_head0_m[8] =
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box16_s8_box_head0_s[8] = {
     37, 37, 37, 38, 37, 37, 37, 37
 };
-#if LIDET_PNQ_WEIGHTS_OI
-/* box.head[0] weights [8][20] int8, the same as _w in [out][in] order */
-LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_box16_s8_box_head0_woi[160] = {
-    25, 26, -16, 21, 20, -31, -9, -18, 5, -22, -12, 19, 24, -34, -13, 29,
-    34, 104, 127, -106, -32, -21, 9, -42, -29, -4, -4, -3, -8, 4, -26, 30,
-    30, -24, 20, 8, 0, -56, 127, -127, -54, 19, 14, 16, 20, 25, 25, -41,
-    28, 34, -27, 13, 38, 20, 3, -28, -127, 75, 55, -111, -11, -62, 55, 3,
-    35, -7, 6, 31, 41, -2, -47, -41, 15, -8, 0, 55, -12, -127, -72, 76,
-    -23, 29, 8, 22, -10, 26, 5, -3, 14, -27, -15, -22, -16, -20, 16, -24,
-    55, 50, 127, -8, -37, -23, 35, 26, 30, -40, -40, 24, 6, -33, 22, -10,
-    -1, 5, 35, 46, 84, 67, -127, 68, -9, -21, 20, -19, -20, -16, 18, 33,
-    20, -16, 20, 5, 34, 10, 23, 19, 127, -121, 87, -7, -35, -37, 26, -40,
-    9, -35, 21, -20, -17, 40, -13, 18, 22, 33, 37, 27, -26, -127, 74, 16
-};
-#endif
 /* box.head[1] weights [8][39] int8 (per-channel scale) */
 LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_box16_s8_box_head1_w[312] = {
     -24, -46, 127, 63, 30, -9, 118, 127, 80, 31, -103, -32, 37, 53, -83, -126,
@@ -274,34 +241,9 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box16_s8_box_head1_s[39] 
     31, 31, 32, 32, 31, 31, 31, 31, 32, 31, 31, 32, 32, 31, 32, 32,
     32, 31, 32, 32, 32, 32, 31
 };
-#if LIDET_PNQ_WEIGHTS_OI
-/* box.head[1] weights [39][8] int8, the same as _w in [out][in] order */
-LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_box16_s8_box_head1_woi[312] = {
-    -24, 60, 63, -61, -56, -127, -61, -11, -46, 121, 27, 89, 46, 82, 69, 127,
-    127, 84, -48, 93, -12, 15, 98, -93, 63, 15, 85, -36, 86, 96, 127, 67,
-    30, 88, 74, -115, -127, 112, -96, -12, -9, 7, -48, -127, -118, -51, 109, -100,
-    118, 63, -14, -20, -127, 83, -4, 20, 127, -23, -62, -107, 48, 124, -66, -97,
-    80, 102, -22, 118, -6, -127, 60, -1, 31, 24, -127, -6, -95, 55, 9, -120,
-    -103, -121, 61, -16, -127, 21, 60, -37, -32, 59, 33, -80, 54, -19, -127, 43,
-    37, 127, -51, -63, -34, -61, 18, -69, 53, -56, -36, -12, 75, -64, -39, -127,
-    -83, 8, -50, -127, -53, 122, -36, -14, -126, 119, -73, 112, -127, 98, 34, -30,
-    -48, -113, -117, 73, -119, -67, -1, -127, -56, -127, -8, -28, -105, 1, 112, -103,
-    127, 67, 19, -58, -88, -49, -112, -87, -88, 52, -119, 73, -38, 70, 127, 65,
-    -109, 18, -84, 84, -37, 58, 127, -34, 64, -32, 95, -79, 121, -44, -127, -37,
-    -127, 67, 52, -33, -73, 59, 20, 18, -127, -20, -58, 46, 88, 116, -88, 1,
-    -127, 49, 64, 114, -124, -12, 118, 27, -52, 40, 68, 110, -127, -28, 103, -127,
-    122, -114, 13, 53, 30, -99, -127, -49, 54, 127, -69, -15, 77, -70, -71, 48,
-    26, 41, -43, -95, 110, 127, -38, 12, 127, -69, 111, -127, -1, 72, -75, -5,
-    -84, -60, 127, 23, -112, -95, -81, -112, 93, -56, 33, -115, -111, -19, -127, 109,
-    106, -24, -26, 70, -35, -102, -127, -91, 94, -21, 43, 52, 27, -127, 67, -29,
-    67, 11, -38, 85, 107, -127, -70, 116, 127, 110, -16, 56, 36, 58, -105, 26,
-    6, 33, 21, 115, 21, 64, -127, 27, 86, -16, 54, -108, -97, 3, 127, -75,
-    61, 111, 127, -32, 45, -23, -52, -61
-};
-#endif
 static const lidet_pointnet_q_layer_t fuzz_box16_s8_box_head[2] = {
-    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box16_s8_box_head0_w, fuzz_box16_s8_box_head0_b, fuzz_box16_s8_box_head0_m, fuzz_box16_s8_box_head0_s, LIDET_PNQ_OI(fuzz_box16_s8_box_head0_woi)},
-    {8u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box16_s8_box_head1_w, fuzz_box16_s8_box_head1_b, fuzz_box16_s8_box_head1_m, fuzz_box16_s8_box_head1_s, LIDET_PNQ_OI(fuzz_box16_s8_box_head1_woi)}
+    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box16_s8_box_head0_w, fuzz_box16_s8_box_head0_b, fuzz_box16_s8_box_head0_m, fuzz_box16_s8_box_head0_s, 0},
+    {8u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box16_s8_box_head1_w, fuzz_box16_s8_box_head1_b, fuzz_box16_s8_box_head1_m, fuzz_box16_s8_box_head1_s, 0}
 };
 
 /* box: class one-hot folded into head[0], [class][out] int32 */

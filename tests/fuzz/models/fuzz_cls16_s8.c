@@ -111,21 +111,6 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_cls16_s8_cls_head0_m[8] =
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_cls16_s8_cls_head0_s[8] = {
     37, 37, 36, 37, 35, 32, 39, 38
 };
-#if LIDET_PNQ_WEIGHTS_OI
-/* cls.head[0] weights [8][20] int8, the same as _w in [out][in] order */
-LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls16_s8_cls_head0_woi[160] = {
-    3, -1, -1, 1, 16, -25, -3, -36, -6, -1, 21, 5, -14, 24, -10, -1,
-    -42, 127, -19, 47, -16, 9, 26, -9, 82, 34, 2, 36, -28, 10, -40, -21,
-    42, -41, -36, 2, 2, 127, -34, 85, 5, 1, -18, 13, -25, 1, -9, -13,
-    71, 15, -37, -1, -20, -30, -6, 0, -29, -24, -127, 20, 3, 5, 18, -7,
-    13, -21, 3, -3, -30, 9, 1, 11, -2, -32, 18, -2, -9, 127, -32, -53,
-    -8, 1, -31, 3, 21, -68, 7, 23, -10, 15, 12, 7, 45, 21, -12, 3,
-    3, -127, 6, -108, -2, 3, 13, 3, -33, -2, 6, 8, 21, -4, -10, -8,
-    4, 16, 11, -2, 26, -127, -1, -20, 23, 1, 5, 6, 32, 9, 9, -9,
-    -110, -16, 30, -31, -46, 15, -10, -3, 103, -26, 127, 81, -3, -8, -11, 4,
-    -9, -38, -3, 48, -57, 1, 9, -7, -26, 29, -39, -4, -3, 127, 37, -52
-};
-#endif
 /* cls.head[1] weights [8][3] int8 (per-channel scale) */
 LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls16_s8_cls_head1_w[24] = {
     -127, -1, 2, -13, 84, 82, 23, 30, -13, -45, 71, 51, 8, -14, 9, -2,
@@ -143,16 +128,9 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_cls16_s8_cls_head1_m[3] =
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_cls16_s8_cls_head1_s[3] = {
     31, 31, 32
 };
-#if LIDET_PNQ_WEIGHTS_OI
-/* cls.head[1] weights [3][8] int8, the same as _w in [out][in] order */
-LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls16_s8_cls_head1_woi[24] = {
-    -127, -13, 23, -45, 8, -2, -46, 120, -1, 84, 30, 71, -14, -6, -127, 105,
-    2, 82, -13, 51, 9, -6, 30, -127
-};
-#endif
 static const lidet_pointnet_q_layer_t fuzz_cls16_s8_cls_head[2] = {
-    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls16_s8_cls_head0_w, fuzz_cls16_s8_cls_head0_b, fuzz_cls16_s8_cls_head0_m, fuzz_cls16_s8_cls_head0_s, LIDET_PNQ_OI(fuzz_cls16_s8_cls_head0_woi)},
-    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_cls16_s8_cls_head1_w, fuzz_cls16_s8_cls_head1_b, fuzz_cls16_s8_cls_head1_m, fuzz_cls16_s8_cls_head1_s, LIDET_PNQ_OI(fuzz_cls16_s8_cls_head1_woi)}
+    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls16_s8_cls_head0_w, fuzz_cls16_s8_cls_head0_b, fuzz_cls16_s8_cls_head0_m, fuzz_cls16_s8_cls_head0_s, 0},
+    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_cls16_s8_cls_head1_w, fuzz_cls16_s8_cls_head1_b, fuzz_cls16_s8_cls_head1_m, fuzz_cls16_s8_cls_head1_s, 0}
 };
 
 const lidet_pointnet_q_model_t lidet_model_fuzz_cls16_s8 = {

@@ -111,21 +111,6 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_cls64_s8_cls_head0_m[8] =
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_cls64_s8_cls_head0_s[8] = {
     37, 37, 37, 37, 35, 17, 39, 38
 };
-#if LIDET_PNQ_WEIGHTS_OI
-/* cls.head[0] weights [8][20] int8, the same as _w in [out][in] order */
-LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls64_s8_cls_head0_woi[160] = {
-    4, -1, -1, 2, 15, -25, -3, -39, -6, -1, 21, 5, -15, 24, -12, -1,
-    -40, 127, -19, 49, -17, 9, 31, -10, 81, 34, 2, 39, -27, 11, -41, -24,
-    47, -40, -42, 2, 2, 127, -35, 88, 5, 1, -20, 14, -24, 1, -9, -13,
-    70, 16, -37, -1, -21, -28, -7, 0, -27, -23, -127, 20, 3, 5, 21, -8,
-    13, -21, 4, -3, -30, 9, 1, 13, -2, -31, 21, -2, -9, 127, -33, -55,
-    -9, 1, -36, 4, 21, -67, 8, 25, -10, 15, 13, 8, 50, 21, -14, 3,
-    3, -127, 6, -112, -2, 3, 15, 3, -32, -2, 7, 9, 21, -4, -10, -9,
-    5, 16, 13, -2, 25, -127, -1, -21, 25, 0, 6, 7, 31, 9, 10, -10,
-    -107, -16, 30, -34, -50, 14, -11, -3, 97, -25, 127, 83, -3, -8, -13, 4,
-    -9, -37, -3, 52, -57, 1, 9, -9, -28, 29, -44, -4, -3, 127, 38, -54
-};
-#endif
 /* cls.head[1] weights [8][3] int8 (per-channel scale) */
 LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls64_s8_cls_head1_w[24] = {
     -115, -1, 2, -10, 72, 64, 29, 40, -15, -37, 61, 40, 8, -15, 9, 0,
@@ -143,16 +128,9 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_cls64_s8_cls_head1_m[3] =
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_cls64_s8_cls_head1_s[3] = {
     31, 31, 32
 };
-#if LIDET_PNQ_WEIGHTS_OI
-/* cls.head[1] weights [3][8] int8, the same as _w in [out][in] order */
-LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls64_s8_cls_head1_woi[24] = {
-    -115, -10, 29, -37, 8, 0, -44, 127, -1, 72, 40, 61, -15, 0, -127, 116,
-    2, 64, -15, 40, 9, 0, 27, -127
-};
-#endif
 static const lidet_pointnet_q_layer_t fuzz_cls64_s8_cls_head[2] = {
-    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_head0_w, fuzz_cls64_s8_cls_head0_b, fuzz_cls64_s8_cls_head0_m, fuzz_cls64_s8_cls_head0_s, LIDET_PNQ_OI(fuzz_cls64_s8_cls_head0_woi)},
-    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_cls64_s8_cls_head1_w, fuzz_cls64_s8_cls_head1_b, fuzz_cls64_s8_cls_head1_m, fuzz_cls64_s8_cls_head1_s, LIDET_PNQ_OI(fuzz_cls64_s8_cls_head1_woi)}
+    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_head0_w, fuzz_cls64_s8_cls_head0_b, fuzz_cls64_s8_cls_head0_m, fuzz_cls64_s8_cls_head0_s, 0},
+    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_cls64_s8_cls_head1_w, fuzz_cls64_s8_cls_head1_b, fuzz_cls64_s8_cls_head1_m, fuzz_cls64_s8_cls_head1_s, 0}
 };
 
 const lidet_pointnet_q_model_t lidet_model_fuzz_cls64_s8 = {
