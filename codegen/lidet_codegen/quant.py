@@ -11,8 +11,9 @@ Scheme (TFLite / CMSIS-NN conventions):
   range (the classifiers; one per tensor in the box nets, where that measured better). The kernel never sees
   those scales: a layer's output scale of channel c is in its requantization multiplier M_c (per channel
   anyway, as the weight scales are), and the consuming layer folds the input scale of column c into its weight
-  column c before its per-channel weight quantization (the same fold as the concatenation below). A per-tensor scale (TFLite's rule) spends the 8 bits of every channel on the widest
-  channel's range: the raw argmax agreement with float went from 98.7 to 99.2 % (docs/FIXED_POINT.md);
+  column c before its per-channel weight quantization (the same fold as the concatenation below). A per-tensor
+  scale (TFLite's rule) spends the 8 bits of every channel on the widest channel's range: the raw argmax
+  agreement with float went from 98.7 to 99.2 % (docs/FIXED_POINT.md);
 - the first shared layer takes the points as int16 millimetres (model frame) and the first PVLE layer the
   voxel bins as int16 integers: int16 x int8, no input quantization at all;
 - accumulators and biases int32; the input zero point is folded into the bias (b - zp_in sum w);
