@@ -162,24 +162,32 @@ float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const
 
 /* the azimuth window (cfg azimuth_half_rad): column c spans azimuths pi (1 - 2 (c + 1) / n) .. pi (1 - 2 c / n),
  * straight ahead at c = n / 2; the candidates of the columns outside the window (one more column on each side)
- * become non-candidates. Returns how many candidates it took away. */
-static uint32_t window_out(const lidet_cluster_cfg_t *cfg, uint32_t rows, uint32_t cols, uint16_t *lab)
+ * become non-candidates. Sets [*lo, *hi) to the window's columns (every column without one); returns how many
+ * candidates it took away. */
+static uint32_t window_out(const lidet_cluster_cfg_t *cfg, uint32_t rows, uint32_t cols, uint16_t *lab,
+                           uint32_t *lo, uint32_t *hi)
 {
     uint32_t c_lo, c_hi, r, col, out = 0;
+    *lo = 0u;
+    *hi = cols;
     if (!(cfg->azimuth_half_rad > 0.0f && cfg->azimuth_half_rad < LIDET_PI_F))
     {
         return 0;
     }
     lidet__azimuth_window_cols(cfg->azimuth_half_rad, cols, &c_lo, &c_hi);
+    *lo = c_lo;
+    *hi = c_hi;
     for (r = 0; r < rows; ++r)
     {
+        /* the two runs outside [c_lo, c_hi), each a loop without branches (it vectorises) */
         uint16_t *row = lab + (size_t)r * cols;
-        for (col = 0; col < cols; ++col)
+        for (col = 0; col < c_lo; ++col)
         {
-            if (col >= c_lo && col < c_hi)
-            {
-                continue;
-            }
+            out += (uint32_t)(row[col] == (uint16_t)LAB_FREE);
+            row[col] = (uint16_t)LAB_NONCAND;
+        }
+        for (col = c_hi; col < cols; ++col)
+        {
             out += (uint32_t)(row[col] == (uint16_t)LAB_FREE);
             row[col] = (uint16_t)LAB_NONCAND;
         }
@@ -267,6 +275,7 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     uint16_t *lab;
     lidet__grow_t lk;
     lidet_cluster_stats_t st;
+    run_span_t sp;
 
     const lidet_status_t chk = run_check(c, labels, members, img, planes, n_sectors);
     if (chk != LIDET_OK)
@@ -280,6 +289,8 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
         return LIDET_ERR_ARG;
     }
     npix = rows * cols;
+    sp.rows = rows;
+    sp.cols = cols;
     lidet__cluster_setup_geometry(c, img);
     run_bind(c, labels, members, img, &st);
     lab = c->labels;
@@ -320,7 +331,7 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
                 n_cand += cand;
             }
         }
-        n_cand -= window_out(&c->cfg, img->n_rows, img->n_cols, lab);
+        n_cand -= window_out(&c->cfg, img->n_rows, img->n_cols, lab, &sp.lo, &sp.hi);
         st.n_candidates = n_cand;
         if (c->cfg.max_bridge_per_pixel > 0.0f)
         {
@@ -329,8 +340,8 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
         }
     }
 
-    run_fills(c, &lk, npix, planes, n_sectors, &st);
-    run_refine(c, npix, planes, n_sectors, &st); /* lidet_refine.c, issue 15 */
+    run_fills(c, &lk, &sp, planes, n_sectors, &st);
+    run_refine(c, &sp, planes, n_sectors, &st); /* lidet_refine.c, issue 15 */
     c->stats = st;
     return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }

@@ -227,6 +227,7 @@ lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t 
     lidet__grow_q_t lk;
     lidet_cluster_stats_t st;
     uint32_t npix;
+    run_span_t sp;
     lidet_status_t chk = run_check(c, labels, members, img, planes, n_sectors);
     /* a compact image with its BAM32 elevations */
     if (chk == LIDET_OK && (!lidet__qpix_image_ok(img) || img->range_4mm == 0 || img->row_elev_bam == 0))
@@ -253,8 +254,12 @@ lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t 
     lk.bridge_max = c->cfg.max_bridge_per_pixel_q16 > 0u
                         ? (uint32_t)(((uint64_t)c->cfg.max_bridge_per_pixel_q16 * st.n_candidates) >> 16)
                         : 0xFFFFFFFFu;
-    run_fills(c, &lk, npix, planes, n_sectors, &st);
-    run_refine(c, npix, planes, n_sectors, &st); /* lidet_cluster_q_refine.c */
+    sp.rows = img->n_rows; /* no azimuth window: every column */
+    sp.cols = img->n_cols;
+    sp.lo = 0u;
+    sp.hi = img->n_cols;
+    run_fills(c, &lk, &sp, planes, n_sectors, &st);
+    run_refine(c, &sp, planes, n_sectors, &st); /* lidet_cluster_q_refine.c */
     c->stats = st;
     return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }

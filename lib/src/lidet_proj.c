@@ -308,6 +308,15 @@ static inline void key_block(key_block_t *kb, const float *pts, uint32_t m, uint
     }
 }
 
+/* key_block of KITTI-style records (stride 4), also built for AVX2 on x86-64 hosts (internal/lidet_simd.h):
+ * 8 points per square root and per division; lanes independent, so the same bits at every width */
+LIDET_CLONES_AVX2 static void key_block4(key_block_t *kb, const float *pts, uint32_t m, float min2,
+                                         float max2, float tan_lo, float tan_hi, float row_scale,
+                                         float col_scale, float last_col_bucket)
+{
+    key_block(kb, pts, m, 4u, min2, max2, tan_lo, tan_hi, row_scale, col_scale, last_col_bucket);
+}
+
 float lidet_proj_azimuth_key(float x, float y)
 {
     /* the very arithmetic run() bins on (one point through key_block), so tests measure exactly that */
@@ -553,8 +562,8 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
             uint32_t j, nw = 0;
             /* (a); KITTI-style records (stride 4) get their own copy, with a constant stride */
             if (stride == 4u)
-                key_block(&kb, points + (size_t)base * 4u, m, 4u, min2, max2, tan_lo, tan_hi, row_scale,
-                          col_scale, last_col_bucket);
+                key_block4(&kb, points + (size_t)base * 4u, m, min2, max2, tan_lo, tan_hi, row_scale,
+                           col_scale, last_col_bucket);
             else
                 key_block(&kb, points + (size_t)base * stride, m, stride, min2, max2, tan_lo, tan_hi,
                           row_scale, col_scale, last_col_bucket);

@@ -129,8 +129,46 @@ static inline void place_kept(RUN_STATE_T *c, uint16_t *lab, uint32_t i)
     }
 }
 
+/* the pixels a run can label: columns [lo, hi) of every row (the azimuth window of the float stage's cfg
+ * azimuth_half_rad; every column without one). The pixels outside are non-candidates throughout the run */
+typedef struct
+{
+    uint32_t rows, cols, lo, hi;
+} run_span_t;
+
+/* canonicalise's last pass over pixels [b, e): every pixel not in a kept cluster (non-candidate, dropped;
+ * none is still free) -> 0, kept pixels slot + 1 -> id, appended to their cluster's members */
+static void relabel_pixels(RUN_STATE_T *c, uint16_t *lab, uint32_t b, uint32_t e)
+{
+    uint32_t i;
+    /* without a branch (it vectorises); kept pixels keep slot + 1 */
+    for (i = b; i < e; ++i)
+    {
+        const uint32_t l = lab[i];
+        lab[i] = (uint16_t)(l < LAB_SMALL ? l : 0u);
+    }
+    /* slot + 1 -> id and the members in raster order. Kept pixels are a minority: blocks of four
+     * labels that are all 0 (one 64-bit word, read with memcpy) are skipped at once */
+    for (i = b; i + 4u <= e; i += 4u)
+    {
+        uint64_t w;
+        memcpy(&w, &lab[i], sizeof w);
+        if (w != 0u)
+        {
+            place_kept(c, lab, i);
+            place_kept(c, lab, i + 1u);
+            place_kept(c, lab, i + 2u);
+            place_kept(c, lab, i + 3u);
+        }
+    }
+    for (; i < e; ++i)
+    {
+        place_kept(c, lab, i);
+    }
+}
+
 /* canonical order: records sorted by seed, labels rewritten, members regrouped in raster order */
-static void canonicalise(RUN_STATE_T *c, uint32_t npix, lidet_cluster_stats_t *st)
+static void canonicalise(RUN_STATE_T *c, const run_span_t *sp, lidet_cluster_stats_t *st)
 {
     const uint32_t k = c->n_recs;
     uint32_t i, j, start;
@@ -184,30 +222,22 @@ static void canonicalise(RUN_STATE_T *c, uint32_t npix, lidet_cluster_stats_t *s
         start += c->recs[i].n_points;
     }
     st->n_pixels_kept = start;
-    /* every pixel that is not in a kept cluster (non-candidate, dropped; none is still free) -> 0,
-     * without a branch (it vectorises); kept pixels keep slot + 1 */
-    for (i = 0; i < npix; ++i)
+    /* the labels and members in raster order: over the window's columns only (the columns outside hold
+     * non-candidates: set to 0), row by row, so the members stay in raster order */
+    if (sp->lo == 0u && sp->hi == sp->cols)
     {
-        const uint32_t l = lab[i];
-        lab[i] = (uint16_t)(l < LAB_SMALL ? l : 0u);
+        relabel_pixels(c, lab, 0u, sp->rows * sp->cols);
     }
-    /* slot + 1 -> id and the members in raster order. Kept pixels are a minority: blocks of four
-     * labels that are all 0 (one 64-bit word, read with memcpy) are skipped at once */
-    for (i = 0; i + 4u <= npix; i += 4u)
+    else
     {
-        uint64_t w;
-        memcpy(&w, &lab[i], sizeof w);
-        if (w != 0u)
+        uint32_t r;
+        for (r = 0; r < sp->rows; ++r)
         {
-            place_kept(c, lab, i);
-            place_kept(c, lab, i + 1u);
-            place_kept(c, lab, i + 2u);
-            place_kept(c, lab, i + 3u);
+            const uint32_t row = r * sp->cols;
+            memset(lab + row, 0, sp->lo * sizeof lab[0]);
+            relabel_pixels(c, lab, row + sp->lo, row + sp->hi);
+            memset(lab + row + sp->hi, 0, (sp->cols - sp->hi) * sizeof lab[0]);
         }
-    }
-    for (; i < npix; ++i)
-    {
-        place_kept(c, lab, i);
     }
     for (i = 0; i < k; ++i)
     {
@@ -454,9 +484,10 @@ static void rescue_join(RUN_STATE_T *c, uint32_t slot, uint32_t start, uint32_t 
  * n_candidates: the first fill in raster order, the rescue pass over the fragments (LAB_SMALL), groups
  * seeded in raster order (kept pixels, the fragments and the current group are distinct pixels, so the
  * member array holds them), and the canonical order */
-static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, uint32_t npix, const RUN_PLANE_T *planes,
+static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, const run_span_t *sp, const RUN_PLANE_T *planes,
                       uint32_t n_sectors, lidet_cluster_stats_t *st)
 {
+    const uint32_t npix = sp->rows * sp->cols;
     uint16_t *lab = c->labels;
     lidet_member_t *mem = c->members;
     uint32_t p, tail = 0;
@@ -491,14 +522,14 @@ static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, uint32_t npix, cons
             }
         }
     }
-    canonicalise(c, npix, st);
+    canonicalise(c, sp, st);
     st->n_kept = c->n_recs;
 }
 
 /* the refinement after the fills (cfg split_people, join_cars): people cut out of wide clusters, car fragments
  * joined; the canonical order again when it changed anything, then the joined (emptied) records, ordered last,
  * are dropped */
-static void run_refine(RUN_STATE_T *c, uint32_t npix, const RUN_PLANE_T *planes, uint32_t n_sectors,
+static void run_refine(RUN_STATE_T *c, const run_span_t *sp, const RUN_PLANE_T *planes, uint32_t n_sectors,
                        lidet_cluster_stats_t *st)
 {
     int changed;
@@ -507,7 +538,7 @@ static void run_refine(RUN_STATE_T *c, uint32_t npix, const RUN_PLANE_T *planes,
     changed |= c->cfg.join_cars != 0u && RUN_REFINE_JOIN(c, planes, n_sectors, st);
     if (changed)
     {
-        canonicalise(c, npix, st);
+        canonicalise(c, sp, st);
         c->n_recs -= st->n_joined;
     }
     st->n_kept = c->n_recs;
