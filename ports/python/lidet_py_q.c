@@ -4,6 +4,7 @@
 #include <stddef.h>
 
 #include "lidet/lidet.h"
+#include "internal/lidet_ground_q_internal.h"
 #include "internal/lidet_qmath.h"
 
 #if defined(_WIN32)
@@ -12,11 +13,12 @@
 #define LIDET_PY_API __attribute__((visibility("default")))
 #endif
 
-/* op 0: sin(a), 1: cos(a), 2: atan2(a, b), 3: isqrt(a:b as uint64 hi:lo), 4: sqrt_round(a:b), 5: urad_to_bam(a) */
+/* op 0: sin(a), 1: cos(a), 2: atan2(a, b), 3: isqrt(a:b as uint64 hi:lo), 4: sqrt_round(a:b), 5: urad_to_bam(a),
+ * 6: the ground stage's R of x^2 + y^2 = a (uint32) */
 LIDET_PY_API int lidet_py_qmath(uint32_t op, const int32_t *a, const int32_t *b, uint32_t n, int64_t *out)
 {
     uint32_t i;
-    if (a == NULL || out == NULL || (op >= 2u && op <= 4u && b == NULL) || op > 5u)
+    if (a == NULL || out == NULL || (op >= 2u && op <= 4u && b == NULL) || op > 6u)
     {
         return LIDET_ERR_ARG;
     }
@@ -30,7 +32,8 @@ LIDET_PY_API int lidet_py_qmath(uint32_t op, const int32_t *a, const int32_t *b,
         case 2u: out[i] = lidet__q_atan2(a[i], b[i]); break;
         case 3u: out[i] = lidet__q_isqrt64(wide); break;
         case 4u: out[i] = lidet__q_sqrt_round64(wide); break;
-        default: out[i] = lidet__q_urad_to_bam(a[i]); break;
+        case 5u: out[i] = lidet__q_urad_to_bam(a[i]); break;
+        default: out[i] = lidet__ground_q_r((uint32_t)a[i]); break;
         }
     }
     return LIDET_OK;

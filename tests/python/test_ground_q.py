@@ -64,6 +64,26 @@ def _bit_exact(sensor, pts, **over):
     return res
 
 
+def test_pixel_r_is_the_exact_rounded_root():
+    """R = round(256 sqrt(x^2 + y^2)) of the integer stage (Newton's iteration and the fraction test on cores with a
+    divide, digit by digit below 2^12 and on ARMv6-M) against Python's exact integer root: every value below 2^16,
+    every square of a root up to 46340 and its neighbours (where the floor and the rounding turn), random values up
+    to 2^31 and the ends."""
+    s = np.arange(1, 46341, dtype=np.int64)
+    near = [s * s + d for d in (-1, 0, 1, 2)] + [s * s + s + d for d in (-1, 0, 1)] + [s * s + 2 * s]
+    rnd = np.random.default_rng(16).integers(0, 1 << 31, 100_000)
+    v = np.unique(np.concatenate([np.arange(1 << 16)] + near + [rnd, [4095, 4096, (1 << 31) - 1]]))
+    v = v[(v >= 0) & (v < (1 << 31))]
+
+    def exact(x):
+        w = int(x) << 16
+        r = math.isqrt(w)
+        return r + (w - r * r > r)
+
+    want = np.fromiter((exact(x) for x in v), np.int64, len(v))
+    np.testing.assert_array_equal(native_q.qmath("ground_r", v), want)
+
+
 def test_defaults_are_the_float_defaults_rounded():
     for sensor in ("hdl64", "vlp16", "os1-64", "vlp32c"):
         f = native.ground_defaults(sensor)

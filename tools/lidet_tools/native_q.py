@@ -25,7 +25,7 @@ _u64p = np.ctypeslib.ndpointer(np.uint64, flags="C_CONTIGUOUS")
 
 # ---- integer math (lib/src/lidet_qmath.c) ------------------------------------------------------
 
-_QMATH_OPS = {"sin": 0, "cos": 1, "atan2": 2, "isqrt": 3, "sqrt_round": 4, "urad_to_bam": 5}
+_QMATH_OPS = {"sin": 0, "cos": 1, "atan2": 2, "isqrt": 3, "sqrt_round": 4, "urad_to_bam": 5, "ground_r": 6}
 _qmath_ready = False
 
 
@@ -33,7 +33,8 @@ def qmath(op: str, a, b=None) -> np.ndarray:
     """Evaluate one of lidet's integer math functions in C over arrays (for tests against ref.qmath).
 
     op: sin / cos (a: BAM32 angles, taken modulo 2^32), atan2 (a = y, b = x, int32), isqrt / sqrt_round (a, b:
-    the high and low 32 bits of a uint64), urad_to_bam (a: microradians). Returns int64.
+    the high and low 32 bits of a uint64), urad_to_bam (a: microradians), ground_r (a: x^2 + y^2 as uint32; the
+    ground stage's R, round(256 sqrt(a))). Returns int64.
     """
     global _qmath_ready
     L = native.lib()

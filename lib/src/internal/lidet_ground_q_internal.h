@@ -54,6 +54,10 @@ static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, 
 #endif
 #endif
 
+/* R of a pixel from v = x^2 + y^2 (4 mm steps squared, v < 2^31): round(sqrt(v) 2^LIDET_GROUND_Q_R_SHIFT), exact
+ * (lidet_ground_q.c; exposed for the tests) */
+int32_t lidet__ground_q_r(uint32_t v);
+
 /* Fits one plane per cell from the gathered samples, applies the fallback (lidet_ground_q_fit.c). */
 void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
                                  const lidet_range_image_t *img);
