@@ -181,3 +181,52 @@ def test_occlusion_out_of_range_is_refused(tmp_path, capsys):
     rc = train_box.main(["--data", str(tmp_path / "none.npz"), "--work", str(tmp_path / "w"), "--out",
                          str(tmp_path / "b.pt"), "--occlusion", "1.5", "--no-progress"])
     assert rc != 0 and "--occlusion must be a probability" in capsys.readouterr().err
+
+
+def test_finetune_q_round_trip_emulation_and_training(tiny, tmp_path, capsys):
+    """finetune_q (quantization-aware fine-tuning of a classifier): with no epoch it writes the same network back
+    (identity batch norms); its fake-quantized forward is the int8 build of lidet_codegen.quant up to that build's
+    integer rounding; an epoch changes the weights, keeps the ONNX contract (onnxruntime = the folded float
+    network) and reports the figures; bad input gets a clear error."""
+    from lidet_codegen import emit as E
+    from lidet_codegen import quant as QU
+    from lidet_codegen.ref import pointnet_q as RQ
+    from lidet_tools.train import finetune_q as FQ
+    path, d = tiny
+    a = train_cls.add_args(__import__("argparse").ArgumentParser()).parse_args(
+        ["--data", str(path), "--work", str(tmp_path / "cw"), "--out", str(tmp_path / "cls.pt"), "--onnx",
+         str(tmp_path / "cls.onnx"), "--epochs-ce", "1", "--epochs-energy", "1", "--batch", "8", "--no-progress"])
+    train_cls.train(a)
+    m = E.load(tmp_path / "cls.onnx", "cls")
+    x = QU.float_inputs(d["xyz"], d["mean"])
+    vox = d["voxel"].astype(np.float64)
+    ref = QU.float_trace(m, x, vox, None)[-1]
+    base = ["--onnx", str(tmp_path / "cls.onnx"), "--data", str(path), "--batch", "8"]
+    assert FQ.main(base + ["--out", str(tmp_path / "ft0.onnx"), "--epochs", "0"]) == 0
+    m0 = E.load(tmp_path / "ft0.onnx", "ft0")
+    assert np.abs(QU.float_trace(m0, x, vox, None)[-1] - ref).max() <= 1e-4
+    assert m0.n_points == m.n_points and np.isfinite(m0.gamma).all()
+
+    # the fake-quantized forward against the int8 reference, with the same per-channel ranges
+    fc = FQ.FoldedClassifier(m)
+    pts, vt = torch.tensor(x, dtype=torch.float32), torch.tensor(vox, dtype=torch.float32)
+    rng = fc.ranges(pts, vt, 99.9)
+    qm = QU.quantize(m, {"ranges": {k: v.tolist() for k, v in rng.items()}})
+    q4, m4 = QU.int_proposals(d["xyz"], d["mean"])
+    lq = RQ.classify(qm, q4, m4, d["voxel"].astype(np.int64))["logits"] / 65536.0
+    with torch.no_grad():
+        fq = fc.forward(pts, vt, rng).numpy()
+        ff = fc.forward(pts, vt).numpy()
+    err_fq, err_f = np.abs(fq - lq).mean(), np.abs(ff - lq).mean()
+    assert err_fq <= 0.02 and err_fq < 0.5 * err_f, (err_fq, err_f)  # closer to the int8 build than float is
+
+    capsys.readouterr()
+    assert FQ.main(base + ["--out", str(tmp_path / "ft1.onnx"), "--epochs", "1", "--margins=-6,-3"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert set(res["before"]) == {"bal_acc", "fpr95", "fake_q_disagree"} and res["margins"] == {"m_in": -6.0, "m_out": -3.0}
+    m1 = E.load(tmp_path / "ft1.onnx", "ft1")
+    assert max(np.abs(a.w - b.w).max() for a, b in zip(m1.stages[0].point, m.stages[0].point)) > 1e-6
+    got = _ort(tmp_path / "ft1.onnx", {"points": x.astype(np.float32), "voxel": vox.astype(np.float32)})["logits"]
+    assert np.abs(got - QU.float_trace(m1, x, vox, None)[-1]).max() <= 1e-4
+    assert FQ.main(base + ["--out", str(tmp_path / "x.onnx"), "--data", str(tmp_path / "missing.npz")]) == 2
+    assert "finetune_q:" in capsys.readouterr().err
