@@ -155,13 +155,13 @@ class FoldedClassifier:
         return net.eval()
 
 
-def _logits(fc: FoldedClassifier, d: dict, ranges=None, bs: int = 2048) -> np.ndarray:
+def _logits(fc: FoldedClassifier, d: dict, ranges=None, bs: int = 2048, grid: bool = True) -> np.ndarray:
     out = []
     with torch.no_grad():
         for i in range(0, len(d["label"]), bs):
             idx = np.arange(i, min(i + bs, len(d["label"])))
             p, v = C.tensors(d, idx, "cpu")
-            out.append(fc.forward(torch.round(p / GRID_M) * GRID_M, v, ranges).numpy())
+            out.append(fc.forward(torch.round(p / GRID_M) * GRID_M if grid else p, v, ranges).numpy())
     return np.concatenate(out) if out else np.zeros((0, M.N_CLASSES), np.float32)
 
 
@@ -189,6 +189,12 @@ def add_args(ap):
     ap.add_argument("--percentile", type=float, default=99.9, help="activation ranges (quant.CALIB_RULE's)")
     ap.add_argument("--seed", type=int, default=7)
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--checkpoint", type=pathlib.Path, default=None,
+                    help="the network's checkpoint (train_cls --out): its margins are used unless --margins is given, "
+                    "and it is rewritten with the fine-tuned weights, its training history kept (make weights)")
+    ap.add_argument("--card", type=pathlib.Path, default=None,
+                    help="a model card (weights/MODEL_CARD.md) whose row of --out gets the new gamma and whose "
+                    "section 'Int8 fine-tuning' gets this run (what make weights writes after the same step)")
     return ap
 
 
@@ -219,8 +225,13 @@ def finetune(a) -> dict:
 
     # the margins of the energy hinge: the network's own (weights/MODEL_CARD.md, the checkpoint's meta), else as
     # train_cls takes them, from the network it starts from
+    src = None
+    if a.checkpoint is not None and a.checkpoint.exists():
+        src = torch.load(a.checkpoint, map_location="cpu", weights_only=False)
     if a.margins:
         m_in, m_out = (float(v) for v in a.margins.split(","))
+    elif src is not None and (src["meta"].get("margins") or {}).get("m_in") is not None:
+        m_in, m_out = src["meta"]["margins"]["m_in"], src["meta"]["margins"]["m_out"]
     else:
         e = MX.energy_np(_logits(fc, tr))
         m_in = float(e[tr["label"] >= 0].mean())
@@ -261,15 +272,74 @@ def finetune(a) -> dict:
         print(f"finetune_q epoch {ep + 1}: task {h['task']:.4f} consistency {h['consistency']:.4f} "
               f"margin {h['margin']:.4f}", file=sys.stderr, flush=True)
     after = _figures(fc, va, ranges())
-    lg = _logits(fc, va)
+    lg = _logits(fc, va, grid=False)  # the points as train_cls takes its gamma from them
     idm = va["label"] >= 0
     gamma = C.per_class_gamma(MX.energy_np(lg)[idm], lg.argmax(1)[idm])
     net = fc.to_net()
     meta = dict(n_points=fc.model.n_points, gamma=gamma, energy_T=1.0, trained=1,
                 sensor=data["meta"].get("sensor", ""), data=data["meta"].get("command", str(a.data)),
                 command=getattr(a, "command", None) or "python -m lidet_tools.train.finetune_q")
+    res = dict(before=before, after=after, gamma=gamma, margins=dict(m_in=m_in, m_out=m_out), history=history)
     export_onnx(net, dict(kind="classifier", meta=meta), a.out)
-    return dict(before=before, after=after, gamma=gamma, margins=dict(m_in=m_in, m_out=m_out), history=history)
+    if a.checkpoint is not None:
+        # the training's record kept (margins, best epoch, history, seconds), this step added
+        keep = dict(src["meta"]) if src is not None else dict(margins=dict(m_in=m_in, m_out=m_out), best_epoch=0)
+        keep.update(gamma=gamma, finetune=dict(command=meta["command"], epochs=a.epochs, before=before, after=after))
+        C.save_atomic(dict(kind="classifier", cfg=dict(net.cfg), state_dict=net.state_dict(), meta=keep), a.checkpoint)
+    if a.card is not None:
+        update_card(a.card, a.out.name, gamma, meta["command"], before, after)
+    return res
+
+
+CARD_SECTION = "## Int8 fine-tuning"
+
+
+def card_lines(name: str, command: str, before: dict, after: dict) -> list:
+    """The model card's lines on one fine-tuned classifier (weights.model_card and --card write the same)."""
+    return [f"`{name}` was fine-tuned for the int8 build after its training (`lidet_tools.train.finetune_q`; "
+            "docs/FIXED_POINT.md, \"Quantization-aware fine-tuning\"):", "", f"    {command}", "",
+            "| validation split | balanced accuracy | FPR95 (gate 1) | argmax float vs fake-int8 differs |",
+            "|---|---:|---:|---:|",
+            f"| before | {before['bal_acc']:.3f} | {before['fpr95']:.3f} | {100 * before['fake_q_disagree']:.2f} % |",
+            f"| after | {after['bal_acc']:.3f} | {after['fpr95']:.3f} | {100 * after['fake_q_disagree']:.2f} % |", ""]
+
+
+def update_card(card: pathlib.Path, name: str, gamma, command: str, before: dict, after: dict) -> None:
+    """The row of `name` in the card's file table gets the new gamma; the section CARD_SECTION gets this run's
+    lines (added before "## Known limits", or replacing the ones of the same file)."""
+    lines = card.read_text().split("\n")
+    hit = False
+    for i, l in enumerate(lines):
+        if l.startswith(f"| `{name}` |"):
+            cells = l.split(" | ")
+            cells[7] = ", ".join(f"{g:.3f}" for g in gamma)
+            lines[i] = " | ".join(cells)
+            hit = True
+    if not hit:
+        raise ValueError(f"{card}: no row for {name}")
+    new = card_lines(name, command, before, after)
+    if CARD_SECTION not in lines:
+        at = lines.index("## Known limits") if "## Known limits" in lines else len(lines)
+        lines[at:at] = [CARD_SECTION, ""] + new
+    else:
+        start = lines.index(CARD_SECTION) + 2
+        end = start
+        while end < len(lines) and not lines[end].startswith("## "):
+            end += 1
+        # drop this file's previous lines (from its first line to the blank line after its table)
+        body = lines[start:end]
+        out, i = [], 0
+        while i < len(body):
+            if body[i].startswith(f"`{name}` was fine-tuned"):
+                j = i
+                while j < len(body) and not (body[j] == "" and j > i + 4):
+                    j += 1
+                i = j + 1
+                continue
+            out.append(body[i])
+            i += 1
+        lines[start:end] = out + new
+    card.write_text("\n".join(lines))
 
 
 def main(argv=None) -> int:
