@@ -140,14 +140,17 @@ static int32_t r_of_digits(uint32_t v)
  * (256 s + f)^2 <= 2^16 v, i.e. f (512 s + f) <= 2^16 D, in 64-bit products. The estimate 128 D / s is never
  * below f (f 512 s <= 2^16 D) and exceeds it by at most 255^2 / (512 s) + 1 < 3 for s >= 64: at most three steps
  * down. tests/python/test_ground_q.py compares it with Python's exact integer root */
+#if (defined(__ARM_ARCH) && !defined(__ARM_FEATURE_IDIV)) || (defined(__riscv) && !defined(__riscv_div))
+/* no divide instruction (ARMv6-M: Cortex-M0+; RV32 without M): a library division would cost more than the digits */
+static int32_t r_of(uint32_t v)
+{
+    return r_of_digits(v);
+}
+#else
 static int32_t r_of(uint32_t v)
 {
     uint32_t x, s, d, f;
     uint64_t lhs, rhs;
-#if defined(__ARM_ARCH) && !defined(__ARM_FEATURE_IDIV)
-    /* no divide instruction (ARMv6-M: Cortex-M0+): the library's division would cost more than the digits */
-    return r_of_digits(v);
-#endif
     if (v < (1u << 12))
     {
         return r_of_digits(v);
@@ -181,6 +184,7 @@ static int32_t r_of(uint32_t v)
     /* round half up: the remainder 2^16 v - (256 s + f)^2 against the floor root */
     return (int32_t)(256u * s + f + (uint32_t)(rhs - lhs > 256u * s + f));
 }
+#endif
 
 int32_t lidet__ground_q_r(uint32_t v)
 {
