@@ -230,3 +230,36 @@ def test_finetune_q_round_trip_emulation_and_training(tiny, tmp_path, capsys):
     assert np.abs(got - QU.float_trace(m1, x, vox, None)[-1]).max() <= 1e-4
     assert FQ.main(base + ["--out", str(tmp_path / "x.onnx"), "--data", str(tmp_path / "missing.npz")]) == 2
     assert "finetune_q:" in capsys.readouterr().err
+
+
+def test_finetune_q_checkpoint_and_card(tiny, tmp_path, capsys):
+    """What make weights uses: --checkpoint takes the network's margins from its checkpoint and rewrites it with
+    the fine-tuned weights (the training record kept, the step added; the same network as the ONNX); --card puts
+    the new gamma in the file's row and this run in the section, replacing an earlier run's lines."""
+    from lidet_codegen.export import load_checkpoint, torch_forward
+    from lidet_tools.train import finetune_q as FQ
+    path, d = tiny
+    a = train_cls.add_args(__import__("argparse").ArgumentParser()).parse_args(
+        ["--data", str(path), "--work", str(tmp_path / "cw"), "--out", str(tmp_path / "cls.pt"), "--onnx",
+         str(tmp_path / "cls_t.onnx"), "--epochs-ce", "1", "--epochs-energy", "1", "--batch", "8", "--no-progress"])
+    ck0 = train_cls.train(a)
+    card = tmp_path / "CARD.md"
+    row = "| `cls_t.onnx` | hdl64 | classifier | 64 | 1 | 1 | 1.0 KiB | 9.000, 9.000, 9.000 | -1.00 / 2.00 | 2 |"
+    card.write_text("# card\n\n## Files\n\n" + row + "\n\n## Known limits\n\n- none\n")
+    argv = ["--onnx", str(tmp_path / "cls_t.onnx"), "--data", str(path), "--out", str(tmp_path / "cls_t.onnx"),
+            "--batch", "8", "--epochs", "1", "--checkpoint", str(tmp_path / "cls.pt"), "--card", str(card)]
+    for _ in range(2):
+        capsys.readouterr()
+        assert FQ.main(argv) == 0
+        res = json.loads(capsys.readouterr().out)
+    assert res["margins"] == {k: ck0["meta"]["margins"][k] for k in ("m_in", "m_out")}
+    model, ck = load_checkpoint(tmp_path / "cls.pt")
+    assert ck["meta"]["best_epoch"] == ck0["meta"]["best_epoch"] and ck["meta"]["history"] == ck0["meta"]["history"]
+    assert ck["meta"]["gamma"] == res["gamma"] and ck["meta"]["finetune"]["epochs"] == 1
+    feeds = {"points": d["points"], "voxel": d["voxel"].astype(np.float32)}
+    ref = torch_forward(model, "classifier", feeds["points"], feeds["voxel"])["logits"]
+    assert np.abs(_ort(tmp_path / "cls_t.onnx", feeds)["logits"] - ref).max() <= 1e-4
+    text = card.read_text()
+    assert ", ".join(f"{g:.3f}" for g in res["gamma"]) in text and "9.000" not in text
+    assert text.count(FQ.CARD_SECTION) == 1 and text.count("`cls_t.onnx` was fine-tuned") == 1
+    assert text.index(FQ.CARD_SECTION) < text.index("## Known limits") and "- none" in text
