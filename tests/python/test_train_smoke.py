@@ -263,3 +263,33 @@ def test_finetune_q_checkpoint_and_card(tiny, tmp_path, capsys):
     assert ", ".join(f"{g:.3f}" for g in res["gamma"]) in text and "9.000" not in text
     assert text.count(FQ.CARD_SECTION) == 1 and text.count("`cls_t.onnx` was fine-tuned") == 1
     assert text.index(FQ.CARD_SECTION) < text.index("## Known limits") and "- none" in text
+
+
+def test_make_weights_family_with_int8_fine_tuning(tmp_path, monkeypatch, need_lib):
+    """weights.run_family with a family that has `cls_finetune` (as vlp16 in make weights): the classifier's
+    checkpoint and ONNX are the fine-tuned network, and the model card shows its gamma and the step."""
+    import argparse
+    from lidet_codegen.export import load_checkpoint
+    from lidet_tools.train import weights as Wt
+    d = D.concat([D._job(("sim", s, 1, s, None), "hdl64", dict(D.DEFAULTS)) for s in range(3)])
+    work, wdir = tmp_path / "work", tmp_path / "weights"
+    work.mkdir()
+    np.savez_compressed(work / "tiny.npz", meta=json.dumps({"sensor": "hdl64", "command": "test"}), **d)
+    small = ["--batch", "8"]
+    monkeypatch.setitem(Wt.FAMILIES, "tiny", dict(
+        dataset=[], cls=["--epochs-ce", "1", "--epochs-energy", "1"] + small,
+        box=["--epochs-box", "1", "--epochs-energy", "1"] + small, cls_finetune=["--epochs", "1"] + small))
+    a = argparse.Namespace(work=work, weights=wdir, docs_img=tmp_path / "img", jobs=1, threads=1, device="cpu",
+                           seed=0, no_progress=True)
+    wdir.mkdir()
+    a.docs_img.mkdir()
+    timings = {}
+    res = Wt.run_family("tiny", a, timings)
+    _, ck = load_checkpoint(work / "tiny_cls.pt")
+    assert ck["meta"]["finetune"]["epochs"] == 1 and "finetune_q" in ck["meta"]["finetune"]["command"]
+    g = [float(v) for v in {p.key: p.value for p in __import__("onnx").load(str(wdir / "cls_tiny.onnx")).metadata_props}
+         ["lidet.gamma"].split(",")]
+    np.testing.assert_allclose(g, ck["meta"]["gamma"], rtol=1e-6)
+    card = Wt.model_card(a, {"tiny": res}, {}, dict(timings, total=1.0))
+    assert "## Int8 fine-tuning" in card and "`cls_tiny.onnx` was fine-tuned" in card
+    assert ", ".join(f"{v:.3f}" for v in ck["meta"]["gamma"]) in card
