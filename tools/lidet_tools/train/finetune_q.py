@@ -87,31 +87,35 @@ class FoldedClassifier:
         step = r / 255.0
         return torch.clamp(self._ste_round(torch.minimum(y, r) / step), 0, 255) * step
 
-    def forward(self, pts, vox, ranges=None):
+    def _act(self, y, k, ranges, trace):
+        """Layer k's activation: fake-quantized with `ranges`; float without (then appended to `trace`, if given)."""
+        if ranges is not None:
+            return self._aq(y, ranges[self.names[k]])
+        if trace is not None:
+            trace.append(y)
+        return y
+
+    def forward(self, pts, vox, ranges=None, trace=None):
         """Logits of points (B, N, 3) in metres (model frame) and voxel bins (B, 3); int8 fake quantization
-        with `ranges` (layer name -> per-channel range tensor), float without."""
+        with `ranges` (layer name -> per-channel range tensor), float without. `trace` (float only) collects
+        every layer's output but the last, in `quant.layer_names` order (the last point layer's after the max)."""
         q = ranges is not None
         k, h = 0, pts
         for i in range(self.n_point):
             h = torch.relu(h @ (self._wq(self.w[k]) if q else self.w[k]).T + self.b[k])
-            if i + 1 == self.n_point:
-                h = h.amax(1)
-            h = self._aq(h, ranges[self.names[k]]) if q else h
+            h = self._act(h.amax(1) if i + 1 == self.n_point else h, k, ranges, trace)
             k += 1
         v = vox
         for _ in range(self.n_pvle):
-            v = torch.relu(v @ (self._wq(self.w[k]) if q else self.w[k]).T + self.b[k])
-            v = self._aq(v, ranges[self.names[k]]) if q else v
+            v = self._act(torch.relu(v @ (self._wq(self.w[k]) if q else self.w[k]).T + self.b[k]), k, ranges, trace)
             k += 1
         x = torch.cat([h, v], 1)
         s_in = torch.cat([ranges[self.names[self.n_point - 1]], ranges[self.names[k - 1]]]) / 255.0 if q else None
         for i in range(self.n_head):
             x = x @ (self._wq(self.w[k], s_in) if q else self.w[k]).T + self.b[k]
             if i + 1 < self.n_head:
-                x = torch.relu(x)
-                if q:
-                    x = self._aq(x, ranges[self.names[k]])
-                    s_in = ranges[self.names[k]] / 255.0
+                x = self._act(torch.relu(x), k, ranges, trace)
+                s_in = ranges[self.names[k]] / 255.0 if q else None
             k += 1
         return x
 
@@ -119,21 +123,8 @@ class FoldedClassifier:
     def ranges(self, pts, vox, percentile: float) -> dict:
         """Per-channel activation ranges: `percentile` of each layer's float output (the last point layer's
         after the max over the points), as `quant.calibrate` takes them for classifiers."""
-        outs, k, h = [], 0, pts
-        for i in range(self.n_point):
-            h = torch.relu(h @ self.w[k].T + self.b[k])
-            outs.append(h.amax(1) if i + 1 == self.n_point else h)
-            k += 1
-        v = vox
-        for _ in range(self.n_pvle):
-            v = torch.relu(v @ self.w[k].T + self.b[k])
-            outs.append(v)
-            k += 1
-        x = torch.cat([outs[self.n_point - 1], v], 1)
-        for _ in range(self.n_head - 1):
-            x = torch.relu(x @ self.w[k].T + self.b[k])
-            outs.append(x)
-            k += 1
+        outs = []
+        self.forward(pts, vox, trace=outs)
         return {nm: torch.tensor(np.maximum(np.percentile(t.reshape(-1, t.shape[-1]).numpy(), percentile, axis=0),
                                             1e-6), dtype=torch.float32) for nm, t in zip(self.names, outs)}
 
@@ -328,19 +319,12 @@ def update_card(card: pathlib.Path, name: str, gamma, command: str, before: dict
         end = start
         while end < len(lines) and not lines[end].startswith("## "):
             end += 1
-        # drop this file's previous lines (from its first line to the blank line after its table)
+        # drop this file's previous lines (card_lines writes a fixed number of them)
         body = lines[start:end]
-        out, i = [], 0
-        while i < len(body):
-            if body[i].startswith(f"`{name}` was fine-tuned"):
-                j = i
-                while j < len(body) and not (body[j] == "" and j > i + 4):
-                    j += 1
-                i = j + 1
-                continue
-            out.append(body[i])
-            i += 1
-        lines[start:end] = out + new
+        at = next((i for i, l in enumerate(body) if l.startswith(f"`{name}` was fine-tuned")), None)
+        if at is not None:
+            del body[at:at + len(new)]
+        lines[start:end] = body + new
     card.write_text("\n".join(lines))
 
 
