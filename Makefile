@@ -107,12 +107,15 @@ bench: deps build
 	$(PY) tools/bench/run_bench.py --build $(BUILD) --real $(REAL) --out docs/BENCHMARKS.md
 
 # Trains the PointNets from nothing: simulated proposal datasets (C stages through the bindings),
-# classifier + box net per sensor family, ONNX export, test-split figures and weights/MODEL_CARD.md.
+# classifier + box net per sensor family, ONNX export, test-split figures and weights/MODEL_CARD.md; then the
+# small VLP-16 pair of the integer firmware (family vlp16s, weights/MODEL_CARD_vlp16s.md).
 # Resumable (state under data/train/); about 45 min on a 2-core machine (docs/TRAINING.md).
 WEIGHTS_ARGS ?=
 weights: deps build
 	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \
 	    --jobs $(JOBS) --threads 1 --real $(REAL)/kitti/training --real-semantickitti $(REAL)/semantickitti $(WEIGHTS_ARGS)
+	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \
+	    --jobs $(JOBS) --threads 1 --families vlp16s --card weights/MODEL_CARD_vlp16s.md $(WEIGHTS_ARGS)
 
 clean:
 	rm -rf $(BUILD) $(ASAN) $(FUZZ) out

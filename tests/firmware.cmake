@@ -62,7 +62,13 @@ function(lidet_fw_host_ref sensor exe)
   add_executable(${exe} ${fw_src}/fw_detect.c ${fw_src}/fw_host_port.c ${scan_c})
   set_target_properties(${exe} PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
   target_include_directories(${exe} PRIVATE ${fw_src})
-  target_compile_definitions(${exe} PRIVATE FW_SENSOR="${sensor}" FW_SENSOR_ID=${sensor})
+  # the models of the images it is compared with (ports/firmware/CMakeLists.txt: LIDET_FW_MODELS' default)
+  set(models ${sensor})
+  if(ARGV2 STREQUAL "FIXED" AND sensor STREQUAL "vlp16")
+    set(models vlp16s)
+  endif()
+  target_compile_definitions(${exe} PRIVATE FW_SENSOR="${sensor}" FW_SENSOR_ID=${sensor} FW_MODELS="${models}"
+                                            FW_MODELS_ID=${models})
   target_compile_options(${exe} PRIVATE -Wall -Wextra -Werror -fno-math-errno -ffp-contract=off)
   target_link_libraries(${exe} PRIVATE ${lib})
   add_test(NAME firmware_${exe} COMMAND ${exe})
@@ -120,13 +126,17 @@ foreach(entry IN LISTS fw_images)
     set_tests_properties(firmware_${image} PROPERTIES SKIP_RETURN_CODE 77)
     continue()
   endif()
+  set(models ${sensor}) # as the host reference's (lidet_fw_host_ref above)
+  if(fixed AND sensor STREQUAL "vlp16")
+    set(models vlp16s)
+  endif()
   set(bdir ${CMAKE_BINARY_DIR}/firmware/${image})
   ExternalProject_Add(firmware_${image}
     SOURCE_DIR ${fw_src}
     BINARY_DIR ${bdir}
     CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/cmake/toolchains/${tc}.cmake
                -DLIDET_FW_BOARD=${board} -DLIDET_FW_SENSOR=${sensor} -DPython3_EXECUTABLE=${Python3_EXECUTABLE}
-               -DLIDET_FW_FIXED=${fixed}
+               -DLIDET_FW_FIXED=${fixed} -DLIDET_FW_MODELS=${models}
     BUILD_ALWAYS ON
     INSTALL_COMMAND ""
     BUILD_BYPRODUCTS ${bdir}/lidet_fw.elf)

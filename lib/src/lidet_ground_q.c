@@ -133,14 +133,14 @@ static int32_t r_of_digits(uint32_t v)
     return (int32_t)(root + (uint32_t)(rem > root));
 }
 
-/* R of one pixel, the same value as r_of_digits (round(sqrt(v 2^16)) for v < 2^31) in about a third of its
+/* R of one pixel, the same value as r_of_digits (round(sqrt(v 2^16)) for v < 2^31) in a fraction of its
  * instructions on cores with a divide instruction (the pixel-by-pixel rows of the firmware and the veto's
- * occasional test): s = floor(sqrt(v)) by Newton's iteration from above in 32-bit integers (it ends at the floor
- * exactly), then the root's 8 fraction bits f from the remainder D = v - s^2 and the exact test
- * (256 s + f)^2 <= 2^16 v, i.e. f (512 s + f) <= 2^16 D, in 64-bit products. The estimate 128 D / s is never
- * below f (f 512 s <= 2^16 D) and exceeds it by at most 255^2 / (512 s) + 1 < 3 for s >= 64: at most three steps
- * down. tests/python/test_ground_q.py compares it with Python's exact integer root */
-#if (defined(__ARM_ARCH) && !defined(__ARM_FEATURE_IDIV)) || (defined(__riscv) && !defined(__riscv_div))
+ * occasional test): s = floor(sqrt(v)) (lidet__q_isqrt32_inl: Newton's iteration in 32-bit integers), then the
+ * root's 8 fraction bits f from the remainder D = v - s^2 and the exact test (256 s + f)^2 <= 2^16 v, i.e.
+ * f (512 s + f) <= 2^16 D, in 64-bit products. The estimate 128 D / s is never below f (f 512 s <= 2^16 D) and
+ * exceeds it by at most 255^2 / (512 s) + 1 < 3 for s >= 64: at most three steps down.
+ * tests/python/test_ground_q.py compares it with Python's exact integer root */
+#if !LIDET_Q_HAVE_DIV
 /* no divide instruction (ARMv6-M: Cortex-M0+; RV32 without M): a library division would cost more than the digits */
 static int32_t r_of(uint32_t v)
 {
@@ -149,31 +149,16 @@ static int32_t r_of(uint32_t v)
 #else
 static int32_t r_of(uint32_t v)
 {
-    uint32_t x, s, d, f;
+    uint32_t s, d, f;
     uint64_t lhs, rhs;
     if (v < (1u << 12))
     {
         return r_of_digits(v);
     }
-    /* a power of two >= sqrt(v), at most 4 times the root: Newton from above then needs few steps */
-    x = v >= (1u << 28)   ? 1u << 16
-        : v >= (1u << 24) ? 1u << 14
-        : v >= (1u << 20) ? 1u << 12
-        : v >= (1u << 16) ? 1u << 10
-                          : 1u << 8;
-    for (;;)
-    {
-        const uint32_t y = (x + v / x) >> 1;
-        if (y >= x)
-        {
-            break;
-        }
-        x = y;
-    }
-    s = x;                   /* floor(sqrt(v)) >= 64 */
-    d = v - s * s;           /* <= 2 s < 2^17 */
-    f = (128u * d) / s;      /* 128 d < 2^24 */
-    f = f < 255u ? f : 255u; /* the root is below 256 (s + 1) */
+    s = lidet__q_isqrt32_inl(v); /* >= 64 */
+    d = v - s * s;               /* <= 2 s < 2^17 */
+    f = (128u * d) / s;          /* 128 d < 2^24 */
+    f = f < 255u ? f : 255u;     /* the root is below 256 (s + 1) */
     rhs = (uint64_t)d << 16;
     lhs = (uint64_t)f * (512u * s + f);
     while (lhs > rhs)

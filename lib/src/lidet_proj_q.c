@@ -460,7 +460,7 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
         uint32_t rq = 0u;
         if (k != 0xFFFFFFFFu)
         {
-            rq = (lidet__q_isqrt32(k) + 1u) >> 1;
+            rq = (lidet__q_isqrt32_inl(k) + 1u) >> 1;
             rq = rq > 0u ? rq : 1u;
             ++sts.n_pixels_filled;
         }
@@ -481,7 +481,7 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
             const int32_t *pt = points + (size_t)k * stride;
             /* round(sqrt(r2) / 4) = (floor(sqrt(r2) / 2) + 1) / 2, halves up, and floor(sqrt(r2) / 2) =
              * floor(sqrt(floor(r2 / 4))), the root of the key pass 1 kept (32-bit); >= 1 for a valid pixel */
-            const uint32_t rq = (lidet__q_isqrt32(key_get(buf, pix)) + 1u) >> 1;
+            const uint32_t rq = (lidet__q_isqrt32_inl(key_get(buf, pix)) + 1u) >> 1;
             buf->x_4mm[pix] = to_4mm(pt[0]);
             buf->y_4mm[pix] = to_4mm(pt[1]);
             buf->z_4mm[pix] = to_4mm(pt[2]);

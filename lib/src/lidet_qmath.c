@@ -29,16 +29,7 @@ uint32_t lidet__q_isqrt64(uint64_t v)
 
 uint32_t lidet__q_isqrt32(uint32_t v)
 {
-    /* the root's 16 bits from the top, each kept when its square still fits: one 16 x 16 -> 32 product per bit
-     * (a single instruction on Cortex-M0+), no 64-bit arithmetic */
-    uint32_t r = 0, bit = v < (1u << 24) ? 1u << 11 : 1u << 15; /* v < 2^24: the root < 2^12 */
-    while (bit != 0u)
-    {
-        const uint32_t t = r | bit;
-        r = t * t <= v ? t : r;
-        bit >>= 1;
-    }
-    return r;
+    return lidet__q_isqrt32_inl(v);
 }
 
 uint32_t lidet__q_sqrt_round64(uint64_t v)

@@ -28,35 +28,50 @@ def _pairs():
     return [(f"cls_{f}", f"box_{f}") for f in fams if (WEIGHTS / f"box_{f}.onnx").exists()]
 
 
-def _scan_proposals(path, sensor, seeds):
+def _scan_proposals(path, sensor, seeds, n_points=64):
     pts = kitti.read_bin(path)
     g = native.ground(pts, sensor)
     cl = native.cluster(pts, sensor, ground=g.mask_point, planes=g.planes)
     out = []
     for s in seeds:
-        out.append(native.proposals(cl, n_points=64, seed=s))
+        out.append(native.proposals(cl, n_points=n_points, seed=s))
     return out
 
 
+def _n_points(name):
+    import onnx
+    meta = {p.key: p.value for p in onnx.load(str(WEIGHTS / f"{name}.onnx")).metadata_props}
+    return int(meta["lidet.n_points"])
+
+
 @pytest.fixture(scope="module")
-def proposals(need_lib, real_dir_optional):
-    """>= 1000 proposals: the shipped simulated scans with 8 resampling seeds, plus the real KITTI scans
-    when ../shared/data/real is there."""
-    props = []
-    seeds = [0x5EED1234 + 977 * k for k in range(8)]
-    props += _scan_proposals(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin", "hdl64", seeds)
-    props += _scan_proposals(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin", "vlp16", seeds)
-    n_real = 0
-    if real_dir_optional is not None:
-        for f in sorted((real_dir_optional / "kitti").glob("*/velodyne/*.bin")):
-            p = _scan_proposals(f, "hdl64", seeds[:1])
-            n_real += len(p[0].xyz)
-            props += p
-    xyz = np.concatenate([p.xyz for p in props])
-    mean = np.concatenate([p.mean for p in props])
-    vox = np.concatenate([p.voxel for p in props])
-    assert len(xyz) >= 1000, len(xyz)
-    return xyz, mean, vox, n_real
+def proposals_at(need_lib, real_dir_optional):
+    """proposals_at(n): >= 1000 proposals of n points (the models' own setting: 64, or 32 for the small vlp16s
+    pair): the shipped simulated scans with 8 resampling seeds, plus the real KITTI scans when
+    ../shared/data/real is there."""
+    cache = {}
+
+    def get(n_points):
+        if n_points in cache:
+            return cache[n_points]
+        props = []
+        seeds = [0x5EED1234 + 977 * k for k in range(8)]
+        props += _scan_proposals(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin", "hdl64", seeds, n_points)
+        props += _scan_proposals(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin", "vlp16", seeds, n_points)
+        n_real = 0
+        if real_dir_optional is not None:
+            for f in sorted((real_dir_optional / "kitti").glob("*/velodyne/*.bin")):
+                p = _scan_proposals(f, "hdl64", seeds[:1], n_points)
+                n_real += len(p[0].xyz)
+                props += p
+        xyz = np.concatenate([p.xyz for p in props])
+        mean = np.concatenate([p.mean for p in props])
+        vox = np.concatenate([p.voxel for p in props])
+        assert len(xyz) >= 1000, len(xyz)
+        assert xyz.shape[1] == n_points
+        cache[n_points] = (xyz, mean, vox, n_real)
+        return cache[n_points]
+    return get
 
 
 @pytest.fixture(scope="module")
@@ -72,9 +87,10 @@ def _session(name):
 
 
 @pytest.mark.parametrize("pair", _pairs())
-def test_c_matches_onnxruntime(proposals, pair):
-    xyz, mean, vox, _ = proposals
+def test_c_matches_onnxruntime(proposals_at, pair):
     cls_name, box_name = pair
+    assert _n_points(cls_name) == _n_points(box_name)
+    xyz, mean, vox, _ = proposals_at(_n_points(cls_name))
     mp = to_model_frame(xyz, mean)
     voxf = vox.astype(np.float32)
     # classifier: raw logits, then the whole classify call (rotation in C) and its energy and class
@@ -101,9 +117,9 @@ def test_c_matches_onnxruntime(proposals, pair):
     np.testing.assert_array_equal(bx["heading_bin"], b[:, 3:3 + nh].argmax(1))
 
 
-def test_c_matches_numpy_reference(proposals):
-    xyz, mean, vox, _ = proposals
+def test_c_matches_numpy_reference(proposals_at):
     for cls_name, box_name in _pairs():
+        xyz, mean, vox, _ = proposals_at(_n_points(cls_name))
         mc, mb = E.load(WEIGHTS / f"{cls_name}.onnx"), E.load(WEIGHTS / f"{box_name}.onnx")
         idx = np.linspace(0, len(xyz) - 1, 40).astype(int)
         c = native.pn_classify(cls_name, xyz[idx], mean[idx], vox[idx])

@@ -22,6 +22,13 @@ FAMILIES = sorted(p.name[4:-len(".calib.json")] for p in WEIGHTS.glob("cls_*.cal
 SEEDS = [0x5EED1234 + 977 * k for k in range(8)]
 
 
+def _family(fam):
+    """(sensor, points per proposal) of a model family, from its classifier's calibration file (vlp16s: the
+    small VLP-16 pair, 32 points)"""
+    cal = json.loads((WEIGHTS / f"cls_{fam}.calib.json").read_text())
+    return cal.get("sensor", fam), int(cal.get("n_points", 64))
+
+
 @pytest.fixture(scope="module")
 def nq(need_lib):
     from lidet_tools import native_q
@@ -49,12 +56,13 @@ def props(need_lib):
     real = REAL if (REAL / "kitti").exists() else None
     out = {}
     for fam in FAMILIES:
-        xyz, mean, vox = QU.proposals_of(QU.scan_list(fam)[:1], fam, SEEDS)
+        sensor, npts = _family(fam)
+        xyz, mean, vox = QU.proposals_of(QU.scan_list(sensor)[:1], sensor, SEEDS, npts)
         parts = [(xyz, mean, vox)]
-        fresh = [simulate_scan(fam, 16, k).points for k in range(2)]
-        parts.append(QU.proposals_of(fresh, fam, SEEDS[:2]))
-        if real is not None and fam == "hdl64":
-            parts.append(QU.proposals_of(QU.scan_list(fam, real)[1:], fam, SEEDS[:1]))
+        fresh = [simulate_scan(sensor, 16, k).points for k in range(2)]
+        parts.append(QU.proposals_of(fresh, sensor, SEEDS[:2], npts))
+        if real is not None and sensor == "hdl64":
+            parts.append(QU.proposals_of(QU.scan_list(sensor, real)[1:], sensor, SEEDS[:1], npts))
         xyz = np.concatenate([p[0] for p in parts])
         mean = np.concatenate([p[1] for p in parts])
         vox = np.concatenate([p[2] for p in parts])
@@ -241,11 +249,13 @@ def test_on_the_integer_chain_bit_for_bit(nq, qmodels, fam):
     """The whole integer chain (compact image, integer ground planes, lidet_cluster_q_run, lidet_proposal_q_make)
     feeding the int8 nets: C equals the reference on those proposals too."""
     from lidet_tools import kitti
-    pts = kitti.read_bin(QU.scan_list(fam)[0])
-    scan = nq.compact_scan(pts, fam)
+    sensor, npts = _family(fam)
+    pts = kitti.read_bin(QU.scan_list(sensor)[0])
+    scan = nq.compact_scan(pts, sensor)
     n = 0
     for seed in SEEDS[:2]:
-        cq = nq.cluster_q(scan, nq.planes_to_q(scan.planes), proposal_cfg=dict(seed=seed))
+        cq = nq.cluster_q(scan, nq.planes_to_q(scan.planes), proposal_cfg=dict(seed=seed, n_points=npts))
+        assert cq.prop_xyz.shape[1] == npts
         q4, m4, vox = cq.prop_xyz, cq.prop_mean, cq.prop_voxel.astype(np.int64)
         c = nq.pnq_classify(f"cls_{fam}_s8", q4, m4, vox)
         r = RQ.classify(qmodels[f"cls_{fam}"], q4, m4, vox)

@@ -16,6 +16,7 @@ import argparse
 import json
 import os
 import pathlib
+import shlex
 import sys
 import time
 
@@ -38,6 +39,18 @@ FAMILIES = {
                   # then quantization-aware fine-tuning for the int8 build (finetune_q; docs/FIXED_POINT.md): its int8
                   # classifier disagreed with float on 1.4 % of held-out proposals, 0.5-0.6 % after (seeds 7, 8, 9)
                   cls_finetune=["--epochs", "6", "--seed", "7"]),
+    # vlp16s: the small VLP-16 pair for boards without an FPU (issue 17): 32 points per proposal, 8x fewer
+    # multiply-adds than vlp16 (classifier 86 k, box net 180 k per proposal), the same scans and schedule;
+    # the integer firmware images use it (docs/PORTING.md, "The small VLP-16 pair")
+    "vlp16s": dict(sensor="vlp16",
+                   dataset=["--sensor", "vlp16", "--mounts", "0.3,0.5,0.7,1.0", "--sim", "800,200,200", "--seed", "2000",
+                            "--n-points", "32"],
+                   cls=["--epochs-ce", "20", "--epochs-energy", "25", "--lam", "0.3",
+                        "--point", "16,32,64", "--pvle", "16,16", "--head", "32"],
+                   box=["--epochs-box", "45", "--epochs-energy", "20", "--widths",
+                        '{"tnet_point": [16, 32], "tnet_head": [32], "point": [24, 48, 80], "head": [64, 32], '
+                        '"pvle": [16, 16]}'],
+                   cls_finetune=["--epochs", "6", "--seed", "7"]),
 }
 
 
@@ -57,7 +70,7 @@ def run_family(fam: str, a, timings: dict) -> dict:
         if rc:
             raise RuntimeError(f"dataset for {fam} failed ({rc})")
     timings[f"{fam} dataset"] = time.perf_counter() - t
-    common = ["--threads", str(a.threads), "--device", a.device, "--seed", str(a.seed), "--sensor", fam] + \
+    common = ["--threads", str(a.threads), "--device", a.device, "--seed", str(a.seed), "--sensor", spec.get("sensor", fam)] + \
         (["--no-progress"] if a.no_progress else [])
     out = {}
     for kind, mod, extra in (("cls", train_cls, spec["cls"]), ("box", train_box, spec["box"])):
@@ -67,7 +80,7 @@ def run_family(fam: str, a, timings: dict) -> dict:
         argv = ["--data", str(data), "--work", str(w / f"{fam}_{kind}_state"), "--out", str(ck), "--onnx", str(onnx)] + extra + common
         _log(f"{fam}: {kind} -> {onnx}")
         p = mod.add_args(argparse.ArgumentParser()).parse_args(argv)
-        p.command = f"python -m lidet_tools.train.{mod.__name__.rsplit('.', 1)[1]} " + " ".join(argv)
+        p.command = f"python -m lidet_tools.train.{mod.__name__.rsplit('.', 1)[1]} " + shlex.join(argv)
         mod.train(p)
         if kind == "cls" and spec.get("cls_finetune"):
             from . import finetune_q as FQ
@@ -75,7 +88,7 @@ def run_family(fam: str, a, timings: dict) -> dict:
                      "--threads", str(a.threads)] + spec["cls_finetune"]
             _log(f"{fam}: {kind} fine-tuned for int8 -> {onnx}")
             fp = FQ.add_args(argparse.ArgumentParser()).parse_args(fargv)
-            fp.command = "python -m lidet_tools.train.finetune_q " + " ".join(fargv)
+            fp.command = "python -m lidet_tools.train.finetune_q " + shlex.join(fargv)
             FQ.finetune(fp)
         timings[f"{fam} {kind}"] = time.perf_counter() - t
         out[kind] = ck
@@ -86,9 +99,9 @@ def run_family(fam: str, a, timings: dict) -> dict:
     res["balance"] = D.balance_table(dd)
     res["dataset_meta"] = dd["meta"]
     res["onnx_parity"] = onnx_parity(dd, out, a.weights, fam)
-    (w / f"{fam}_test.json").write_text(json.dumps(res, indent=1, default=float))
     _histograms(fam, w / f"{fam}_energy", a)
-    timings[f"{fam} evaluation"] = time.perf_counter() - t
+    timings[f"{fam} evaluation"] = res["evaluation_seconds"] = time.perf_counter() - t
+    (w / f"{fam}_test.json").write_text(json.dumps(res, indent=1, default=float))
     return res
 
 
@@ -175,9 +188,13 @@ def model_card(a, results: dict, real, timings: dict) -> str:
             L.append(f"| `{p.name}` | {fam} | {c['kind']} | {c['n_points']} | {c['macs']:,} | {c['params']:,} | "
                      f"{c['weight_bytes_fp32'] / 1024:.1f} KiB | {', '.join(f'{g:.3f}' for g in ck['meta']['gamma'])} | "
                      f"{mg.get('m_in', float('nan')):.2f} / {mg.get('m_out', float('nan')):.2f} | {ck['meta']['best_epoch']} |")
+    small = [f for f in results if FAMILIES.get(f, {}).get("sensor", f) != f]
     L += ["", "Budgets per proposal at 64 points: classifier <= 1,000,000 MACs, box net <= 2,000,000 MACs "
           "(counted from the ONNX graphs by `python -m lidet_tools.train.macs`). At 128 points the same "
-          "widths need about twice as many (classifier 1.33 M, box net 2.89 M: over budget), so the models use 64.", "",
+          "widths need about twice as many (classifier 1.33 M, box net 2.89 M: over budget), so the models use 64."
+          + (f" {', '.join(small)}: a smaller pair for cores without an FPU (32 points per proposal, narrower layers: "
+             "about 8x fewer multiply-adds), made for the integer firmware (docs/PORTING.md, \"The small VLP-16 pair\")."
+             if small else ""), "",
           "Gates: gate 1 keeps a proposal when E = -logsumexp(logits) < gamma[predicted class]; gate 2 when "
           "E(heading scores) + E(size scores) < gamma[class] (T = 1). Each gamma keeps 95 % of that class's "
           "validation ID proposals.", ""]
@@ -232,11 +249,13 @@ def model_card(a, results: dict, real, timings: dict) -> str:
         from .finetune_q import CARD_SECTION
         L += [CARD_SECTION, ""] + tuned
     L += ["## Known limits", "",
-          "- Trained on simulated scans only (lidet-sim); the real-frame figures above are the only check on real data.",
+          "- Trained on simulated scans only (lidet-sim); " + ("the real-frame figures above are the only check on real "
+          "data." if real else "the real KITTI frames check only the hdl64 family (weights/MODEL_CARD.md)."),
           "- The box net is evaluated with the true class as its one-hot; in the pipeline the classifier's class is used.",
           "- Heading error counts a box turned by 180 deg as an error (the IoU does not).",
           "- Gate-2 OOD figures use a random class one-hot for each OOD proposal.",
-          "- One model per sensor family; other profiles (vlp32c, os1-*) are untested with these weights.",
+          "- One model family per sensor (and the small vlp16s pair for the integer firmware); other profiles "
+          "(vlp32c, os1-*) are untested with these weights.",
           "- ONNX parity: the classifier logits agree within 1e-5; the box net's heading scores reach |20| and there "
           "the difference is about 1.3e-5, a few float32 ulps (float32 PyTorch is as far from float64).", ""]
     return "\n".join(L)
@@ -248,7 +267,10 @@ def main(argv=None) -> int:
     ap.add_argument("--work", type=pathlib.Path, default=pathlib.Path("data/train"))
     ap.add_argument("--weights", type=pathlib.Path, default=pathlib.Path("weights"))
     ap.add_argument("--docs-img", type=pathlib.Path, default=pathlib.Path("docs/img"))
-    ap.add_argument("--families", default="hdl64,vlp16")
+    ap.add_argument("--families", default="hdl64,vlp16",
+                    help="the families to train (FAMILIES); each invocation writes one card for its families")
+    ap.add_argument("--card", type=pathlib.Path, default=None,
+                    help="the model card to write (default: --weights/MODEL_CARD.md)")
     ap.add_argument("--jobs", type=int, default=max(1, min(2, os.cpu_count() or 1)))
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--device", default="cpu")
@@ -274,8 +296,9 @@ def main(argv=None) -> int:
         print(f"weights: {e}", file=sys.stderr)
         return 2
     timings["total"] = time.perf_counter() - t0
-    (a.weights / "MODEL_CARD.md").write_text(model_card(a, results, real, timings))
-    _log(f"done in {timings['total']:.0f} s: {a.weights}/MODEL_CARD.md")
+    card = a.card or a.weights / "MODEL_CARD.md"
+    card.write_text(model_card(a, results, real, timings))
+    _log(f"done in {timings['total']:.0f} s: {card}")
     return 0
 
 
