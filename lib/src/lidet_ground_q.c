@@ -122,6 +122,10 @@ static int32_t r_of_digits(uint32_t v)
 {
     uint32_t root = 0, rem = 0;
     int i = 30;
+    if (v == 0u)
+    {
+        return 0; /* an empty pixel (most of a VLP-16 image's sky) */
+    }
     while (i > 0 && (v >> i) == 0u)
     {
         i -= 2; /* a leading zero digit pair leaves root and remainder 0 */
@@ -293,15 +297,9 @@ static inline int32_t abs32(int32_t v)
  * dR in R steps (4 mm / 256), dZ in 4 mm: |dZ| <= fy |dR| is |dZ| * 2^24 <= fy_q16 * |dR|; F_x on R against
  * fx_max_mm * 64 (R steps), on Z as 4 |F_x| <= fx_max_mm. Every touched pixel holds a point (R > 0). Bitwise &
  * and no branch, as the float kernel: the column loop vectorises. */
-typedef struct
-{
-    uint64_t fy;
-    int32_t fx_r, fx_mm, z_lo, z_hi;
-    int on_z, desc, gate;
-} filt_q_t;
-
 static inline uint8_t sample_test(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
-                                  uint32_t cm1, uint32_t c, uint32_t cp1, uint32_t cp2, const filt_q_t *f)
+                                  uint32_t cm1, uint32_t c, uint32_t cp1, uint32_t cp2,
+                                  const lidet__ground_q_filt_t *f)
 {
     const int32_t dr = (2 * R0[c] + R0[cp1]) - (2 * R1[c] + R1[cp1]);
     const int32_t dz = (2 * Z0[c] + Z0[cp1]) - (2 * Z1[c] + Z1[cp1]);
@@ -313,6 +311,68 @@ static inline uint8_t sample_test(const int32_t *R0, const int32_t *R1, const in
     const int opt =
         ((f->desc == 0) | (dr > 0)) & ((f->gate == 0) | ((4 * Z0[c] >= f->z_lo) & (4 * Z0[c] <= f->z_hi)));
     return (uint8_t)(pts & fy & fx & opt);
+}
+
+/* The same test, leaving at the first condition that fails (cores without SIMD, where the branch-free form
+ * costs every test on every pixel: most of a VLP-16 image's upper rows are empty and its obstacles fail the
+ * slope test). The cheap tests first: the six pixels hold points, then the descending and height conditions,
+ * the slope F_y, the horizontal F_x. */
+static inline uint8_t sample_test_early(const int32_t *R0, const int32_t *R1, const int16_t *Z0,
+                                        const int16_t *Z1, uint32_t cm1, uint32_t c, uint32_t cp1,
+                                        uint32_t cp2, const lidet__ground_q_filt_t *f)
+{
+    int32_t dr, dz;
+    if (R0[c] <= 0 || R1[c] <= 0 || R0[cp1] <= 0 || R1[cp1] <= 0 || R0[cm1] <= 0 || R0[cp2] <= 0)
+    {
+        return 0;
+    }
+    dr = (2 * R0[c] + R0[cp1]) - (2 * R1[c] + R1[cp1]);
+    if ((f->desc != 0 && dr <= 0) || (f->gate != 0 && (4 * Z0[c] < f->z_lo || 4 * Z0[c] > f->z_hi)))
+    {
+        return 0;
+    }
+    dz = (2 * Z0[c] + Z0[cp1]) - (2 * Z1[c] + Z1[cp1]);
+    if (((uint64_t)(uint32_t)abs32(dz) << 24) > f->fy * (uint32_t)abs32(dr))
+    {
+        return 0;
+    }
+    if (f->on_z)
+    {
+        return (uint8_t)(4 * abs32((Z0[cm1] + 2 * Z0[c]) - (2 * Z0[cp1] + Z0[cp2])) <= f->fx_mm);
+    }
+    return (uint8_t)(abs32((R0[cm1] + 2 * R0[c]) - (2 * R0[cp1] + R0[cp2])) <= f->fx_r);
+}
+
+/* one row pair's tests into out[0 .. cols), columns wrapping around; early: the kernel (a constant where
+ * inlined) */
+static inline void sample_row(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
+                              uint32_t cols, const lidet__ground_q_filt_t *f, uint8_t *out, const int early)
+{
+    uint32_t c;
+#define SAMPLE_TEST(cm1, c0, cp1, cp2)                                                                       \
+    (early ? sample_test_early(R0, R1, Z0, Z1, cm1, c0, cp1, cp2, f)                                         \
+           : sample_test(R0, R1, Z0, Z1, cm1, c0, cp1, cp2, f))
+    out[0] = SAMPLE_TEST(cols - 1u, 0u, 1u, 2u);
+    for (c = 1; c + 2u < cols; ++c)
+    {
+        out[c] = SAMPLE_TEST(c - 1u, c, c + 1u, c + 2u);
+    }
+    out[cols - 2u] = SAMPLE_TEST(cols - 3u, cols - 2u, cols - 1u, 0u);
+    out[cols - 1u] = SAMPLE_TEST(cols - 2u, cols - 1u, 0u, 1u);
+#undef SAMPLE_TEST
+}
+
+void lidet__ground_q_sample_row(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
+                                uint32_t cols, const lidet__ground_q_filt_t *f, uint8_t *out, int early)
+{
+    if (early)
+    {
+        sample_row(R0, R1, Z0, Z1, cols, f, out, 1);
+    }
+    else
+    {
+        sample_row(R0, R1, Z0, Z1, cols, f, out, 0);
+    }
 }
 
 /* z of row r: the image's row, or (range-only) decoded into buf: z depends on the range and the row only */
@@ -341,8 +401,8 @@ static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_
 {
     uint8_t *sample = sc->sample;
     const uint32_t rows = img->n_rows, cols = img->n_cols, step = g->cfg.sample_step;
-    filt_q_t f;
-    uint32_t r, c;
+    lidet__ground_q_filt_t f;
+    uint32_t r;
     f.fy = g->cfg.fy_max_q16;
     f.fx_r = (int32_t)g->cfg.fx_max_mm * (1 << (LIDET_GROUND_Q_R_SHIFT - 2)); /* mm in R steps */
     f.fx_mm = (int32_t)g->cfg.fx_max_mm;
@@ -357,14 +417,7 @@ static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_
         const int32_t *R0 = r_row(rr, r), *R1 = r_row(rr, r + 1u);
         /* after both rows of R: decoded z rows overlay R's work row (sc->r_v) */
         const int16_t *Z0 = z_row(img, r, sc->r_v.z[0]), *Z1 = z_row(img, r + 1u, sc->r_v.z[1]);
-        uint8_t *out = sample + (size_t)r * cols;
-        out[0] = sample_test(R0, R1, Z0, Z1, cols - 1u, 0u, 1u, 2u, &f);
-        for (c = 1; c + 2u < cols; ++c)
-        {
-            out[c] = sample_test(R0, R1, Z0, Z1, c - 1u, c, c + 1u, c + 2u, &f);
-        }
-        out[cols - 2u] = sample_test(R0, R1, Z0, Z1, cols - 3u, cols - 2u, cols - 1u, 0u, &f);
-        out[cols - 1u] = sample_test(R0, R1, Z0, Z1, cols - 2u, cols - 1u, 0u, 1u, &f);
+        sample_row(R0, R1, Z0, Z1, cols, &f, sample + (size_t)r * cols, !LIDET_GROUND_Q_SQRT_LANES);
     }
 }
 

@@ -108,7 +108,7 @@ static inline void pixel(const lidet_range_image_t *img, uint32_t p, int32_t q[3
 static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *idx, uint32_t n,
                   const qplane_t *cur, int64_t thr, qplane_t *out)
 {
-    int64_t s1[3] = {0, 0, 0}, e[3] = {0, 0, 0}, a[6] = {0, 0, 0, 0, 0, 0}, b[6], v[3], nd;
+    int64_t s1[3] = {0, 0, 0}, e[3], a[6] = {0, 0, 0, 0, 0, 0}, dl[3], b[6], v[3], nd, mm;
     int32_t q[3], first[3], c0[3], nv[3];
     uint64_t ma, mb;
     uint32_t i, m = 0;
@@ -116,35 +116,18 @@ static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *i
     lidet__ground_q_hplane_t hp;
     lidet__ground_q_hplane(cur->n, cur->d, &hp);
     pixel(img, idx[0], first);
+    /* one pass over the samples (each decoded once): the inliers' sums S1 = sum d and S2 = sum d d^T of
+     * d = q - first, exact in int64 (|d| < 2^16: below n 2^32 for n samples) */
     for (i = 0; i < n; ++i)
     {
         pixel(img, idx[i], q);
         if (abs64(lidet__ground_q_height(&hp, q[0], q[1], q[2])) <= thr)
         {
+            const int32_t x = q[0] - first[0], y = q[1] - first[1], z = q[2] - first[2];
             ++m;
-            for (k = 0; k < 3; ++k)
-            {
-                s1[k] += q[k] - first[k];
-            }
-        }
-    }
-    if (m < 3u)
-    {
-        return 0;
-    }
-    for (k = 0; k < 3; ++k)
-    {
-        c0[k] = first[k] + (int32_t)lidet__q_div_round(s1[k], (int64_t)m);
-    }
-    for (i = 0; i < n; ++i)
-    {
-        pixel(img, idx[i], q);
-        if (abs64(lidet__ground_q_height(&hp, q[0], q[1], q[2])) <= thr)
-        {
-            const int32_t x = q[0] - c0[0], y = q[1] - c0[1], z = q[2] - c0[2];
-            e[0] += x;
-            e[1] += y;
-            e[2] += z;
+            s1[0] += x;
+            s1[1] += y;
+            s1[2] += z;
             if (x >= -46340 && x <= 46340 && y >= -46340 && y <= 46340 && z >= -46340 && z <= 46340)
             {
                 /* the products fit int32 (a core without a 32 x 32 -> 64 multiply saves the wide ones) */
@@ -166,6 +149,27 @@ static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *i
             }
         }
     }
+    if (m < 3u)
+    {
+        return 0;
+    }
+    /* the centroid rounded to 4 mm steps, c0 = first + dl; about it (exact integer identities, so the same
+     * sums as a second pass over q - c0 would give): e = sum (d - dl) = S1 - m dl and
+     * a = sum (d - dl)(d - dl)^T = S2 - dl S1^T - S1 dl^T + m dl dl^T (|dl| < 2^16: every term below
+     * n 2^33, far inside int64 for any cell the sample buffer holds) */
+    mm = (int64_t)m;
+    for (k = 0; k < 3; ++k)
+    {
+        dl[k] = lidet__q_div_round(s1[k], mm);
+        c0[k] = first[k] + (int32_t)dl[k];
+        e[k] = s1[k] - mm * dl[k];
+    }
+    a[0] += mm * dl[0] * dl[0] - 2 * dl[0] * s1[0];
+    a[1] += mm * dl[0] * dl[1] - dl[0] * s1[1] - s1[0] * dl[1];
+    a[2] += mm * dl[0] * dl[2] - dl[0] * s1[2] - s1[0] * dl[2];
+    a[3] += mm * dl[1] * dl[1] - 2 * dl[1] * s1[1];
+    a[4] += mm * dl[1] * dl[2] - dl[1] * s1[2] - s1[1] * dl[2];
+    a[5] += mm * dl[2] * dl[2] - 2 * dl[2] * s1[2];
     /* scatter a = (xx xy xz yy yz zz) scaled to <= 2^29, its adjugate b (entries < 2^59) */
     scale_down(a, 6);
     ma = max_abs(a, 6);

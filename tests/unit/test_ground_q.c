@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "internal/lidet_ground_q_internal.h"
 #include "lidet/lidet.h"
 #include "test_util.h"
 
@@ -280,6 +281,61 @@ static void test_arguments_and_config(void)
     TEST_ASSERT_NULL(lidet_ground_q_planes(NULL, NULL));
 }
 
+/* The sample test's two kernels (branch-free on SIMD hosts, early exit on cores without SIMD) give the same
+ * samples: random row pairs (empty pixels, ranges and heights near every threshold, rising and falling) under
+ * random settings (F_x on R or z, descending required or not, height gate on or off). The early kernel is what
+ * the firmware images run; this host build runs the other. */
+static uint32_t lcg(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return *s >> 8;
+}
+
+void test_sample_kernels_agree(void)
+{
+    enum
+    {
+        C = 64
+    };
+    static int32_t R0[C], R1[C];
+    static int16_t Z0[C], Z1[C];
+    uint8_t a[C], b[C];
+    uint32_t s = 12345u, trial, c, n_set = 0, n_clear = 0;
+    for (trial = 0; trial < 20000u; ++trial)
+    {
+        const uint32_t cols = 4u + lcg(&s) % (C - 3u);
+        lidet__ground_q_filt_t f;
+        f.fy = (uint64_t)(lcg(&s) % 200000u);
+        f.fx_mm = (int32_t)(lcg(&s) % 1200u);
+        f.fx_r = f.fx_mm * 64;
+        f.on_z = (int)(lcg(&s) & 1u);
+        f.desc = (int)(lcg(&s) & 1u);
+        f.gate = (int)(lcg(&s) & 1u);
+        f.z_lo = -2000 - (int32_t)(lcg(&s) % 2000u);
+        f.z_hi = -2000 + (int32_t)(lcg(&s) % 2000u);
+        for (c = 0; c < cols; ++c)
+        {
+            /* a ground-like fan: R0 beyond R1 by a step, z a little apart; some pixels empty, some noise */
+            const int32_t base = 64 * (int32_t)(500u + lcg(&s) % 4000u);
+            R1[c] = lcg(&s) % 8u == 0u ? 0 : base;
+            R0[c] = lcg(&s) % 8u == 0u ? 0 : base + (int32_t)(lcg(&s) % 4096u) - 1024;
+            Z1[c] = (int16_t)(-500 + (int32_t)(lcg(&s) % 100u));
+            Z0[c] = (int16_t)(Z1[c] + (int32_t)(lcg(&s) % 64u) - 16);
+        }
+        lidet__ground_q_sample_row(R0, R1, Z0, Z1, cols, &f, a, 0);
+        lidet__ground_q_sample_row(R0, R1, Z0, Z1, cols, &f, b, 1);
+        TEST_ASSERT_EQUAL_UINT8_ARRAY(a, b, cols);
+        for (c = 0; c < cols; ++c)
+        {
+            n_set += a[c];
+            n_clear += 1u - a[c];
+        }
+    }
+    /* both outcomes occur often: the test reaches every condition */
+    TEST_ASSERT_GREATER_THAN_UINT32(10000u, n_set);
+    TEST_ASSERT_GREATER_THAN_UINT32(50000u, n_clear);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -289,5 +345,6 @@ int main(void)
     RUN_TEST(test_empty_image_takes_the_mount_plane);
     RUN_TEST(test_coordinates_at_the_limits);
     RUN_TEST(test_arguments_and_config);
+    RUN_TEST(test_sample_kernels_agree);
     return UNITY_END();
 }

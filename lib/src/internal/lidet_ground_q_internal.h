@@ -43,9 +43,10 @@ static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, 
     return (int64_t)a * 32768 + b + h->d;
 }
 
-/* The rows of R: 1 = column-wise lanes (each digit step of the square root over the whole row: a compiler
- * vectorises the column loop on SIMD hosts), 0 = pixel by pixel with root and remainder in registers (cores
- * without SIMD: fewer loads and stores). Same values either way. */
+/* SIMD hosts or not. The rows of R: 1 = column-wise lanes (each digit step of the square root over the whole
+ * row: a compiler vectorises the column loop on SIMD hosts), 0 = pixel by pixel with root and remainder in
+ * registers (cores without SIMD: fewer loads and stores). The sample test: 1 = branch-free, 0 = leaving at the
+ * first failed condition. Same values either way. */
 #ifndef LIDET_GROUND_Q_SQRT_LANES
 #if defined(__SSE2__) || defined(__ARM_NEON) || defined(__ARM_NEON__) || defined(__AVX2__)
 #define LIDET_GROUND_Q_SQRT_LANES 1
@@ -57,6 +58,20 @@ static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, 
 /* R of a pixel from v = x^2 + y^2 (4 mm steps squared, v < 2^31): round(sqrt(v) 2^LIDET_GROUND_Q_R_SHIFT), exact
  * (lidet_ground_q.c; exposed for the tests) */
 int32_t lidet__ground_q_r(uint32_t v);
+
+/* Pass 1's sample test settings (lidet_ground_q.c: the filter's thresholds in the integer units) */
+typedef struct
+{
+    uint64_t fy;
+    int32_t fx_r, fx_mm, z_lo, z_hi;
+    int on_z, desc, gate;
+} lidet__ground_q_filt_t;
+
+/* one row pair's sample tests into out[0 .. cols) (cols >= 4), R of rows r, r + 1 and their z: early = 0 the
+ * branch-free kernel (SIMD hosts; it vectorises), 1 the early-exit one (cores without SIMD); the same values
+ * (tests/unit/test_ground_q.c). The stage picks one with LIDET_GROUND_Q_SQRT_LANES. */
+void lidet__ground_q_sample_row(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
+                                uint32_t cols, const lidet__ground_q_filt_t *f, uint8_t *out, int early);
 
 /* Fits one plane per cell from the gathered samples, applies the fallback (lidet_ground_q_fit.c). */
 void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
