@@ -101,7 +101,7 @@ static void test_requant_equals_the_int64_rule(void)
                                    1 << 30, -(1 << 30), 12345, -12345, 1 << 20, -(1 << 20), 65535};
     int32_t acc[N], mult[N], q16[N];
     uint8_t shift[N];
-    int8_t out[N];
+    int8_t out[N], out_c[N];
     uint32_t s, k, rep;
     for (rep = 0; rep < 40u; ++rep)
     {
@@ -116,6 +116,7 @@ static void test_requant_equals_the_int64_rule(void)
                 shift[k] = (uint8_t)s;
             }
             lidet__nn_requant_s8(acc, 1u, N, mult, shift, -128, -128, out);
+            lidet__nn_requant_s8_by_channel(acc, 1u, N, mult, shift, -128, -128, out_c);
             lidet__nn_requant_q16(acc, N, mult, shift, q16);
             for (k = 0; k < N; ++k)
             {
@@ -123,8 +124,48 @@ static void test_requant_equals_the_int64_rule(void)
                 const int64_t y = v - 128 < -128 ? -128 : (v - 128 > 127 ? 127 : v - 128);
                 const int64_t z = v < INT32_MIN ? INT32_MIN : (v > INT32_MAX ? INT32_MAX : v);
                 TEST_ASSERT_EQUAL_INT32((int32_t)y, out[k]);
+                TEST_ASSERT_EQUAL_INT32((int32_t)y, out_c[k]);
                 TEST_ASSERT_EQUAL_INT32((int32_t)z, q16[k]);
             }
+        }
+    }
+}
+
+/* both requantization loops on several rows, mixed shifts per channel, other zero points and lower bounds */
+static void test_requant_rows_and_channels_agree(void)
+{
+    enum
+    {
+        R = 7,
+        N = 40
+    };
+    int32_t acc[R * N], mult[N];
+    uint8_t shift[N];
+    int8_t a[R * N], b[R * N];
+    uint32_t rep, k, n_rows, n_out;
+    for (rep = 0; rep < 2000u; ++rep)
+    {
+        const int32_t zp = (int32_t)(next() % 256u) - 128, lo = -128 + (int32_t)(next() % 64u);
+        n_rows = 1u + next() % R;
+        n_out = 1u + next() % N;
+        for (k = 0; k < n_out; ++k)
+        {
+            mult[k] = (int32_t)(((uint32_t)1 << 30) | (next() & 0x3FFFFFFFu));
+            shift[k] = (uint8_t)(1u + next() % 62u);
+        }
+        for (k = 0; k < n_rows * n_out; ++k)
+        {
+            acc[k] = (int32_t)next() >> (next() % 24u);
+        }
+        lidet__nn_requant_s8(acc, n_rows, n_out, mult, shift, zp, lo, a);
+        lidet__nn_requant_s8_by_channel(acc, n_rows, n_out, mult, shift, zp, lo, b);
+        for (k = 0; k < n_rows * n_out; ++k)
+        {
+            const uint32_t o = k % n_out, sh = shift[o];
+            const int64_t v = (((int64_t)acc[k] * mult[o] + ((int64_t)1 << (sh - 1u))) >> sh) + zp;
+            const int64_t y = v < lo ? lo : (v > 127 ? 127 : v);
+            TEST_ASSERT_EQUAL_INT32((int32_t)y, a[k]);
+            TEST_ASSERT_EQUAL_INT32((int32_t)y, b[k]);
         }
     }
 }
@@ -135,5 +176,6 @@ int main(void)
     RUN_TEST(test_kernels_agree_on_every_shape);
     RUN_TEST(test_kernels_agree_at_the_extremes);
     RUN_TEST(test_requant_equals_the_int64_rule);
+    RUN_TEST(test_requant_rows_and_channels_agree);
     return UNITY_END();
 }

@@ -39,9 +39,21 @@ void lidet__nn_acc_s8_oi(const int8_t *in, uint32_t n_rows, uint32_t n_in, const
 /* the same with int16 inputs (the first layer: points in mm, voxel bins) */
 void lidet__nn_acc_s16(const int16_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
                        uint32_t n_out, int32_t *acc);
-/* out[r * n_out + o] = clamp(zp + round_half_up(acc * mult[o] / 2^shift[o]), lo, 127) */
+/* out[r * n_out + o] = clamp(zp + round_half_up(acc * mult[o] / 2^shift[o]), lo, 127), lo >= -128 */
 void lidet__nn_requant_s8(const int32_t *acc, uint32_t n_rows, uint32_t n_out, const int32_t *mult,
                           const uint8_t *shift, int32_t zp, int32_t lo, int8_t *out);
+/* the same, channel by channel (what lidet__nn_requant_s8 runs where LIDET_NN_REQUANT_ROWS is 0) */
+void lidet__nn_requant_s8_by_channel(const int32_t *acc, uint32_t n_rows, uint32_t n_out, const int32_t *mult,
+                                     const uint8_t *shift, int32_t zp, int32_t lo, int8_t *out);
+/* 1: the requantization walks rows then channels (SIMD hosts: it vectorises); 0: channel by channel (cores
+ * without SIMD). Same values. */
+#ifndef LIDET_NN_REQUANT_ROWS
+#if defined(__SSE2__) || defined(__ARM_NEON) || defined(__ARM_NEON__) || defined(__AVX2__)
+#define LIDET_NN_REQUANT_ROWS 1
+#else
+#define LIDET_NN_REQUANT_ROWS 0
+#endif
+#endif
 /* out[o] = round_half_up(acc * mult[o] / 2^shift[o]) saturated to int32 (Q16 outputs) */
 void lidet__nn_requant_q16(const int32_t *acc, uint32_t n_out, const int32_t *mult, const uint8_t *shift,
                            int32_t *out);
