@@ -15,8 +15,10 @@ from lidet_tools.train import metrics as MX  # noqa: E402
 from lidet_tools.train import models as M  # noqa: E402
 
 WEIGHTS = pathlib.Path(__file__).resolve().parents[2] / "weights"
-#: family -> (sensor, test-split simulator seed of `make weights`, mounts cycled over the scans)
-FAMILIES = {"hdl64": ("hdl64", 1002, [None]), "vlp16": ("vlp16", 2002, [0.3, 0.5, 0.7, 1.0])}
+#: family -> (sensor, test-split simulator seed of `make weights`, mounts cycled over the scans, points per
+#: proposal); vlp16s: the small VLP-16 pair of the integer firmware
+FAMILIES = {"hdl64": ("hdl64", 1002, [None], 64), "vlp16": ("vlp16", 2002, [0.3, 0.5, 0.7, 1.0], 64),
+            "vlp16s": ("vlp16", 2002, [0.3, 0.5, 0.7, 1.0], 32)}
 
 
 def _meta(path):
@@ -30,7 +32,8 @@ def test_shipped_metadata_and_budget(fam, kind):
     if not p.exists():
         pytest.skip(f"{p} not generated (make weights)")
     m = _meta(p)
-    assert m["lidet.trained"] == "1" and m["lidet.n_points"] == "64" and m["lidet.sensor"] == fam
+    sensor, _, _, npts = FAMILIES[fam]
+    assert m["lidet.trained"] == "1" and m["lidet.n_points"] == str(npts) and m["lidet.sensor"] == sensor
     assert m["lidet.kind"] == ("classifier" if kind == "cls" else "box")
     assert m["lidet.classes"] == ",".join(M.CLASSES)
     g = [float(v) for v in m["lidet.gamma"].split(",")]
@@ -44,8 +47,9 @@ def test_shipped_models_on_fresh_scans(fam, need_lib):
     pc, pb = WEIGHTS / f"cls_{fam}.onnx", WEIGHTS / f"box_{fam}.onnx"
     if not (pc.exists() and pb.exists()):
         pytest.skip("weights not generated (make weights)")
-    sensor, seed, mounts = FAMILIES[fam]
-    d = D.concat([D._job(("sim", 2, seed, i, mounts[i % len(mounts)]), sensor, dict(D.DEFAULTS)) for i in range(4)])
+    sensor, seed, mounts, npts = FAMILIES[fam]
+    d = D.concat([D._job(("sim", 2, seed, i, mounts[i % len(mounts)]), sensor, dict(D.DEFAULTS, n_points=npts))
+                  for i in range(4)])
     idm = d["label"] >= 0
     assert idm.sum() >= 10
     feeds = {"points": d["points"], "voxel": d["voxel"].astype(np.float32)}

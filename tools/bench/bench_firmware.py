@@ -25,12 +25,12 @@ BOARDS = [  # board, core, FPU, QEMU machine
      "single precision (fpv5-sp-d16)", "mps2-an500"),
     ("virt-rv32imafc-hdl64", "RV32IMAFC, **HDL-64 scan** (config/hdl64)", "single precision (F)", "virt"),
     # the integer-only build (LIDET_FW_FIXED: integer detector, int8 models; compared with the host bit for bit)
-    ("mps2-an385-q", "Cortex-M3, **integer build**", "none (no float at all)", "mps2-an385"),
-    ("mps2-an385-m0plus-q", "Cortex-M0+ code, **integer build**", "none (no float at all)", "mps2-an385"),
-    ("virt-rv32imac-q", "RV32IMAC, **integer build**", "none (no F extension)", "virt"),
-    ("mps2-an386-q", "Cortex-M4, **integer build** (DSP: SMLAD int8 kernel)", "present, unused (no float at all)",
+    ("mps2-an385-q", "Cortex-M3, **integer build** (small pair vlp16s)", "none (no float at all)", "mps2-an385"),
+    ("mps2-an385-m0plus-q", "Cortex-M0+ code, **integer build** (vlp16s)", "none (no float at all)", "mps2-an385"),
+    ("virt-rv32imac-q", "RV32IMAC, **integer build** (vlp16s)", "none (no F extension)", "virt"),
+    ("mps2-an386-q", "Cortex-M4, **integer build** (vlp16s; DSP: SMLAD int8 kernel)", "present, unused (no float at all)",
      "mps2-an386"),
-    ("mps2-an500-q", "Cortex-M7, **integer build** (DSP: SMLAD int8 kernel)", "present, unused (no float at all)",
+    ("mps2-an500-q", "Cortex-M7, **integer build** (vlp16s; DSP: SMLAD int8 kernel)", "present, unused (no float at all)",
      "mps2-an500"),
 ]
 STAGES = ["project", "ground", "cluster", "classify", "box", "post"]
@@ -178,16 +178,24 @@ def run(args) -> str:
         ins, sz = q["insn"]["default"], q["size"]
         rams = {b: reports[b]["size"]["ram"] for b in ("mps2-an385-q", "mps2-an385-m0plus-q", "virt-rv32imac-q")
                 if b in reports and reports[b].get("size")}
+        m4q = ""
+        if "default" in reports.get("mps2-an386-q", {}).get("insn", {}):
+            m = reports["mps2-an386-q"]["insn"]["default"]
+            m4q = (f", {m['scan'] / 20e6:.1f}x on the M4 ({_m(m['scan'])}: the ground stage "
+                   f"{100.0 * m['ground'] / m['scan']:.0f}%, the two PointNets "
+                   f"{100.0 * (m['classify'] + m['box']) / m['scan']:.0f}%, projection and clustering "
+                   f"{100.0 * (m['project'] + m['cluster']) / m['scan']:.0f}%)")
         out += [
             "",
             "The integer build against the same goals (its images use `ports/firmware/config/vlp16` as they are: the "
-            "range-only pixel, `LIDET_Q_PIXEL_XYZ 0`, and 4 KiB of stack, docs/MEMORY.md): RAM "
+            "range-only pixel, `LIDET_Q_PIXEL_XYZ 0`, and 4 KiB of stack, docs/MEMORY.md; and the small VLP-16 pair, "
+            f"models `{(q.get('header') or {}).get('models', '?')}`, docs/PORTING.md): RAM "
             + ", ".join(f"{_kib(v)} ({v:,} B)" for v in rams.values())
             + f" on the M3, M0+ and RV32IMAC images ({'within' if max(rams.values()) <= 256 * 1024 else 'over'} "
             f"256 KiB), flash {_kib(sz['flash_without_scan'])} on the M3 "
             f"({'within' if sz['flash_without_scan'] <= 512 * 1024 else 'over'} 512 KiB; weights "
             f"{_kib(sz['rodata_weights'])}), {ins['scan'] / 20e6:.1f}x the instruction goal on the M3 (the two "
-            f"PointNets {100.0 * (ins['classify'] + ins['box']) / ins['scan']:.0f}% of it).",
+            f"PointNets {100.0 * (ins['classify'] + ins['box']) / ins['scan']:.0f}% of it)" + m4q + ".",
         ]
     out += [
         "",
