@@ -243,12 +243,17 @@ static inline void key_set(const lidet_proj_q_buffers_t *b, uint32_t p, uint32_t
     b->z_4mm[p] = (int16_t)(uint16_t)k; /* two's complement: C99 int16_t */
 }
 
-/* a^2 for a < 2^18 (here a <= LIDET_Q_COORD_MAX_MM) from 32-bit products only (a = h 2^16 + l: h^2 2^32 + h l 2^17 + l^2),
- * so a core without a 32 x 32 -> 64 multiply (Cortex-M0+) calls no 64-bit multiplication helper */
+/* a^2 for a < 2^18 (here a <= LIDET_Q_COORD_MAX_MM); on a core without a 32 x 32 -> 64 multiply (Cortex-M0+, RV32
+ * without M) from 32-bit products only (a = h 2^16 + l: h^2 2^32 + h l 2^17 + l^2), so it calls no 64-bit
+ * multiplication helper */
 static inline uint64_t square_17(uint32_t a)
 {
+#if LIDET_Q_HAVE_MUL64
+    return (uint64_t)a * a; /* one UMULL (Cortex-M3 and up) or MUL + MULHU (RV32 with M) */
+#else
     const uint32_t h = a >> 16, l = a & 0xFFFFu;
     return ((uint64_t)(h * h) << 32) + ((uint64_t)(h * l) << 17) + (uint64_t)(l * l);
+#endif
 }
 
 /* E[c] <= D, i.e. e sum <= num 2^29 = dn, exactly. First in 32 bits, where it is decided unless D is within

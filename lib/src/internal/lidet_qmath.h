@@ -51,6 +51,17 @@ uint32_t lidet__q_isqrt64(uint64_t v);
 #endif
 #endif
 
+/** 1 on cores with a 32 x 32 -> 64 multiply instruction (not ARMv6-M, not RV32 without M): the integer path may
+ *  write 64-bit products of 32-bit values directly there; elsewhere it splits them into 32-bit products */
+#ifndef LIDET_Q_HAVE_MUL64
+#if (defined(__ARM_ARCH) && defined(__ARM_ARCH_ISA_THUMB) && __ARM_ARCH_ISA_THUMB == 1) ||                   \
+    (defined(__riscv) && !defined(__riscv_mul))
+#define LIDET_Q_HAVE_MUL64 0
+#else
+#define LIDET_Q_HAVE_MUL64 1
+#endif
+#endif
+
 /** floor(sqrt(v)), exact, 32-bit arithmetic only */
 uint32_t lidet__q_isqrt32(uint32_t v);
 
