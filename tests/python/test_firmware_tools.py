@@ -127,3 +127,65 @@ def test_host_reference_reports_two_runs_with_detections():
     assert len(rep["det"]["open"]) == rep["stats"]["open"]["detections"] > 0
     for d in rep["det"]["open"].values():
         assert d["l"] > 0 and d["w"] > 0 and d["h"] > 0 and 0 < d["score"] < 1
+
+
+cycles = _load("cycles")
+
+
+@pytest.mark.parametrize("insn, core, prev_ls, want", [
+    ("adds r0, r1, #1", "m4", False, (1, 1, "")),
+    ("bics.w r2, r2, r3", "m4", False, (1, 1, "")),
+    ("movs r0, #0", "m4", False, (1, 1, "")),
+    ("lsls r3, r3, #2", "m4", False, (1, 1, "")),
+    ("teq r0, r1", "m4", False, (1, 1, "")),
+    ("sxtble.w r9, r2", "m4", False, (1, 1, "")),
+    ("ssat r2, #8, r2", "m4", False, (1, 1, "")),
+    ("ite ge", "m4", False, (1, 1, "")),
+    ("smlal r0, r1, r2, r3", "m4", False, (1, 1, "")),
+    ("smlal r0, r1, r2, r3", "m3", False, (4, 7, "")),
+    ("umull r0, r1, r2, r3", "m3", False, (3, 5, "")),
+    ("mla r0, r1, r2, r3", "m3", False, (2, 2, "")),
+    ("smlad r0, r1, r2, r3", "m4", False, (1, 1, "")),
+    ("udiv r0, r1, r2", "m4", False, (2, 12, "")),
+    ("ldr.w r8, [r1]", "m4", False, (2, 2, "ls")),
+    ("ldrb.w r3, [r6, #1]!", "m4", True, (1, 2, "ls")),
+    ("strbne r3, [r0]", "m4", True, (1, 2, "ls")),
+    ("ldrd r4, r5, [sp, #84]", "m4", True, (3, 3, "")),
+    ("stmdb sp!, {r4, r5, r6, r7, r8, r9, sl, fp, lr}", "m4", False, (10, 10, "")),
+    ("pop {r4, r5, r6, pc}", "m4", False, (5, 5, "pc")),
+    ("push {r4-r7, lr}", "m4", False, (6, 6, "")),
+    ("bhi.n #0x8b7e", "m4", False, (1, 1, "br")),
+    ("bls #0x100", "m4", False, (1, 1, "br")),
+    ("bl #0xcedc", "m4", False, (1, 1, "br")),
+    ("bx lr", "m4", False, (1, 1, "br")),
+    ("tbb [pc, r3]", "m4", False, (2, 2, "pc")),
+])
+def test_cycle_prices_follow_the_trm(insn, core, prev_ls, want):
+    """tools/firmware/cycles.py prices each instruction with the TRM's counts (zero wait states): condition and
+    flag suffixes stripped, register lists counted, loads pipelined after a load or store (low estimate)."""
+    mn, _, ops = insn.partition(" ")
+    assert cycles.price(mn, ops, core, prev_ls) == want
+
+
+def test_cycle_prices_refuse_an_unknown_instruction():
+    with pytest.raises(ValueError, match="no cycle count"):
+        cycles.price("vfma.f32", "s0, s1, s2", "m4", False)
+
+
+def test_cycle_estimate_of_the_m4_integer_image():
+    """The estimate on the Cortex-M4 integer image: the trace holds the instructions of both runs (within 5 % of
+    the exact counts: the port's counter and console code is left out) and the CPI lies in the range a
+    single-issue core with 1-3 cycle loads, branches and divides can have."""
+    bdir = pathlib.Path(os.environ.get("LIDET_BUILD_DIR", ROOT / "build")) / "firmware" / "mps2-an386-q"
+    elf, rep = bdir / "lidet_fw.elf", bdir / "report.json"
+    if not (elf.exists() and rep.exists()):
+        pytest.skip(f"{elf} or its report not there (make firmware-run)")
+    for tool in ("qemu-system-arm", "arm-none-eabi-nm"):
+        if subprocess.run(["which", tool], capture_output=True).returncode != 0:
+            pytest.skip(f"{tool} not installed")
+    r = cycles.estimate(str(elf), "m4", "arm-none-eabi-nm", timeout=600)
+    import json
+    ins = json.loads(rep.read_text())["insn"]
+    exact = ins["default"]["scan"] + ins["open"]["scan"]
+    assert abs(r["instructions"] - exact) <= 0.05 * exact, (r, exact)
+    assert 1.0 < r["cpi_low"] < r["cpi_high"] < 3.0, r

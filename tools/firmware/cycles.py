@@ -1,0 +1,243 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Estimated cycles of a Cortex-M3 or M4 firmware image: QEMU's trace of the instructions it executes, priced
+with the cycle counts of the core's Technical Reference Manual (instruction set summary, zero wait states).
+
+    python3 tools/firmware/cycles.py --elf build/firmware/mps2-an386-q/lidet_fw.elf --core m4 \\
+        [--report build/firmware/mps2-an386-q/report.json] [--json OUT]
+
+QEMU counts instructions exactly but has no timing model. This tool runs the image once more with
+`-d in_asm,exec,nochain` (every translated block's instructions once, then one line per executed block), limited
+with `-dfilter` to the code of lidet and the application (the port's counter and console routines are left out:
+they are not lidet's, and the counter check loops would swamp the trace), streams the log through a pipe and
+prices every executed instruction:
+
+- data processing, moves, compares, shifts, extends, bit fields, saturation, IT: 1 cycle;
+- multiplies: M4 1 (MUL, MLA, MLS, SMULL, UMULL, SMLAL, UMLAL, the DSP MACs); M3 MUL 1, MLA/MLS 2,
+  SMULL/UMULL 3-5, SMLAL/UMLAL 4-7;
+- SDIV/UDIV: 2-12 (data dependent);
+- single loads and stores: 2, or 1 when they follow another single load or store (the TRM's pipelining of
+  neighbouring loads and stores; the low estimate assumes it always applies there, the high one never);
+  LDRD/STRD 3; LDM/STM/PUSH/POP 1 + N registers;
+- branches: 1 when not taken, 1 + P taken (P, the pipeline refill, 1-3); a block's branch counts as taken
+  when the next executed block does not start right after it; TBB/TBH 2 + P; writes to PC (POP {..., pc},
+  BX, LDR pc) 1 (+ N) + P.
+
+The result is two estimates (low: P = 1, divides 2 cycles, loads pipelined where the TRM allows; high: P = 3,
+divides 12, no pipelining) and the cycles per instruction (CPI) of each. They are estimates on a zero-wait-state
+memory system: flash wait states, bus contention and interrupts add to them. `--report` applies both CPIs to
+the exact per-scan instruction counts of run_fw.py's report.
+"""
+import argparse
+import json
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import threading
+
+SKIP = 77
+QEMU = {"m4": ["qemu-system-arm", "-M", "mps2-an386"], "m3": ["qemu-system-arm", "-M", "mps2-an385"]}
+# symbols left out of the trace: the port (counter, console, exit, faults) and the startup code
+EXCLUDE = re.compile(r"^(fw_(?!main$)|Reset_Handler|Fault_Handler|put_|measure$|rec_clock$)")
+
+DP = {"adc", "add", "addw", "adr", "and", "asr", "bic", "bfc", "bfi", "clz", "cmn", "cmp", "eor", "lsl", "lsr",
+      "mov", "movw", "movt", "mvn", "neg", "orn", "orr", "rbit", "rev", "rev16", "revsh", "ror", "rrx", "rsb", "sbc",
+      "sbfx", "sub", "subw", "sxtb", "sxth", "sxtb16", "sxtab", "sxtah", "sxtab16", "teq", "tst", "ubfx", "uxtb",
+      "uxth", "uxtb16", "uxtab", "uxtah", "uxtab16", "ssat", "usat", "ssat16", "usat16", "it", "nop", "sel",
+      "qadd", "qsub", "qadd16", "qsub16", "qadd8", "qsub8", "sadd16", "ssub16", "uadd16", "usub16", "sadd8",
+      "uadd8", "ssub8", "usub8", "shadd16", "uhadd16", "pkhbt", "pkhtb", "usad8", "usada8", "dmb", "dsb", "isb",
+      "cpsid", "cpsie", "mrs", "msr", "svc", "bkpt", "wfi", "wfe", "sev", "yield"}
+MUL1 = {"mul", "smulbb", "smulbt", "smultb", "smultt", "smulwb", "smulwt", "smmul", "smmulr", "smuad", "smuadx",
+        "smusd", "smusdx"}
+MAC = {"mla", "mls", "smlabb", "smlabt", "smlatb", "smlatt", "smlawb", "smlawt", "smmla", "smmlar", "smmls",
+       "smmlsr", "smlad", "smladx", "smlsd", "smlsdx"}
+LONG = {"smull", "umull"}
+LONGACC = {"smlal", "umlal", "smlald", "smlaldx", "smlsld", "smlsldx", "smlalbb", "smlalbt", "smlaltb", "smlaltt",
+        "umaal"}
+BRANCH = {"b", "bl", "blx", "bx", "cbz", "cbnz"}
+CONDS = ("eq", "ne", "cs", "hs", "cc", "lo", "mi", "pl", "vs", "vc", "hi", "ls", "ge", "lt", "gt", "le", "al")
+
+
+def base_mnemonic(m: str) -> str:
+    """'adds.w' -> 'add', 'ldrbne' -> 'ldrb', 'beq.n' -> 'b', 'it' stays"""
+    m = m.split(".")[0].lower()
+    if m.startswith("it") and set(m[2:]) <= {"t", "e"}:
+        return "it"
+    for c in CONDS:  # a condition suffix (inside an IT block, or a conditional branch)
+        if m.endswith(c) and len(m) > len(c):
+            stem = m[: -len(c)]
+            if stem in BRANCH or stem in DP or stem in MUL1 or stem in MAC or stem.startswith(("ldr", "str", "ld", "st")) \
+                    or stem.rstrip("s") in DP or stem.rstrip("s") in MUL1:
+                m = stem
+                break
+    if m.endswith("s") and m[:-1] in DP | MUL1 | {"mul"}:
+        m = m[:-1]
+    return m
+
+
+def n_regs(ops: str) -> int:
+    """registers in a {...} list: r4, r5, r6 or r4-r7"""
+    m = re.search(r"\{([^}]*)\}", ops)
+    if not m:
+        return 1
+    n = 0
+    for part in m.group(1).split(","):
+        part = part.strip()
+        if "-" in part:
+            a, b = (int(re.sub(r"\D", "", x) or 0) for x in part.split("-"))
+            n += b - a + 1
+        elif part:
+            n += 1
+    return n
+
+
+def price(mn: str, ops: str, core: str, prev_ls: bool):
+    """(low, high) cycles of one instruction, its kind ('ls' single load/store, 'br' branch, 'pc' PC write, '')
+    and the refill it adds when taken (1 = yes)"""
+    m = base_mnemonic(mn)
+    writes_pc = bool(re.match(r"\s*pc\b", ops)) or ("pc}" in ops.replace(" ", "") and m in ("pop", "ldm", "ldmia"))
+    if m in BRANCH:
+        return 1, 1, "br"
+    if m in ("tbb", "tbh"):
+        return 2, 2, "pc"
+    if m in ("udiv", "sdiv"):
+        return 2, 12, ""
+    if m in MUL1:
+        return 1, 1, ""
+    if m in MAC:
+        return (1, 1, "") if core == "m4" else (2, 2, "")
+    if m in LONG:
+        return (1, 1, "") if core == "m4" else (3, 5, "")
+    if m in LONGACC:
+        return (1, 1, "") if core == "m4" else (4, 7, "")
+    if m in ("ldrd", "strd"):
+        return 3, 3, ""
+    if m in ("push", "pop", "stmdb", "stmia", "stm", "ldm", "ldmia", "ldmdb", "stmea", "ldmfd", "stmfd"):
+        n = n_regs(ops)
+        return 1 + n, 1 + n, "pc" if writes_pc else ""
+    if m.startswith(("ldr", "str", "ldrex", "strex")):
+        kind = "pc" if writes_pc else "ls"
+        return (1 if prev_ls else 2), 2, kind
+    if m in DP or m.rstrip("s") in DP:
+        return 1, 1, "pc" if writes_pc and m in ("mov", "add") else ""
+    raise ValueError(f"no cycle count for '{mn} {ops}'")
+
+
+def text_ranges(elf: str, nm: str):
+    out = subprocess.run([nm, "-S", elf], capture_output=True, text=True, check=True).stdout
+    ranges = []
+    for line in out.splitlines():
+        f = line.split()
+        if len(f) == 4 and f[2] in "tT" and not EXCLUDE.match(f[3]):
+            a = int(f[0], 16) & ~1
+            ranges.append((a, a + int(f[1], 16)))
+    return ",".join(f"0x{a:x}..0x{b - 1:x}" for a, b in sorted(ranges))
+
+
+def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800) -> dict:
+    qcmd = [qemu] + QEMU[core][1:] if qemu else QEMU[core]
+    with tempfile.TemporaryDirectory() as td:
+        fifo = os.path.join(td, "trace")
+        os.mkfifo(fifo)
+        cmd = qcmd + ["-icount", "shift=8", "-semihosting-config", "enable=on,target=native", "-display", "none",
+                      "-monitor", "none", "-serial", "null", "-kernel", elf, "-d", "in_asm,exec,nochain",
+                      "-dfilter", text_ranges(elf, nm), "-D", fifo]
+        proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        timer = threading.Timer(timeout, proc.kill)
+        timer.start()
+        blocks = {}  # pc -> (insns, low, high, last (addr, size, kind), n_refill_static)
+        tot_insn = lo = hi = 0
+        pending = None  # the previous executed block's last instruction: (end address, kind)
+        cur = None
+        try:
+            with open(fifo, errors="replace") as f:
+                for line in f:
+                    if line.startswith("IN:"):
+                        cur = []
+                        continue
+                    if cur is not None and line.startswith("0x"):
+                        m = re.match(r"0x([0-9a-f]+):\s+([0-9a-f]+)(?:\s+([0-9a-f]{4}))?\s+(\S+)\s*(.*)", line)
+                        if m:
+                            size = (len(m.group(2)) + (len(m.group(3)) if m.group(3) else 0)) // 2
+                            cur.append((int(m.group(1), 16), size, m.group(4), m.group(5)))
+                        continue
+                    if line.startswith("Trace"):
+                        if cur:
+                            l_ = h_ = 0
+                            prev_ls = False
+                            for a, size, mn, ops in cur:
+                                cl, ch, kind = price(mn, ops, core, prev_ls)
+                                l_ += cl
+                                h_ += ch
+                                prev_ls = kind == "ls"
+                            a, size, mn, ops = cur[-1]
+                            blocks[cur[0][0]] = (len(cur), l_, h_, a + size, price(mn, ops, core, False)[2])
+                        cur = None
+                        pc = int(re.search(r"\[[0-9a-f]+/([0-9a-f]+)/", line).group(1), 16)
+                        b = blocks.get(pc)
+                        if b is None:
+                            continue
+                        # the previous block's branch: taken unless this block starts right after it
+                        if pending is not None:
+                            end, kind = pending
+                            if kind in ("br", "pc") and pc != end:
+                                lo += 1
+                                hi += 3
+                            elif kind == "pc":  # a PC write always refills
+                                lo += 1
+                                hi += 3
+                        n, l_, h_, end, kind = b
+                        tot_insn += n
+                        lo += l_
+                        hi += h_
+                        pending = (end, kind)
+        finally:
+            timer.cancel()
+            proc.wait()
+    if tot_insn == 0:
+        raise RuntimeError("empty trace: QEMU wrote nothing (wrong core or image?)")
+    return dict(core=core, instructions=tot_insn, cycles_low=lo, cycles_high=hi, cpi_low=lo / tot_insn,
+                cpi_high=hi / tot_insn)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--elf", required=True)
+    ap.add_argument("--core", choices=sorted(QEMU), required=True)
+    ap.add_argument("--report", help="run_fw.py's report.json of the same image: cycles per scan from its counts")
+    ap.add_argument("--nm", default="arm-none-eabi-nm")
+    ap.add_argument("--qemu")
+    ap.add_argument("--mhz", type=float, default=None, help="clock for scans per second (default: M4 200, M3 100)")
+    ap.add_argument("--json")
+    a = ap.parse_args(argv)
+    for tool in (a.qemu or QEMU[a.core][0], a.nm):
+        if subprocess.run(["which", tool], capture_output=True).returncode != 0:
+            print(f"cycles: {tool} not found", file=sys.stderr)
+            return SKIP
+    if not os.path.exists(a.elf):
+        print(f"cycles: {a.elf} not found (make firmware)", file=sys.stderr)
+        return 2
+    r = estimate(a.elf, a.core, a.nm, a.qemu)
+    mhz = a.mhz or (200.0 if a.core == "m4" else 100.0)
+    print(f"{a.core}: {r['instructions']:,} instructions traced, estimated {r['cycles_low']:,} to {r['cycles_high']:,} "
+          f"cycles: CPI {r['cpi_low']:.3f} to {r['cpi_high']:.3f}")
+    if a.report:
+        rep = json.load(open(a.report))
+        ins = rep["insn"]["default"]
+        r["scan_instructions"] = ins["scan"]
+        r["scan_cycles_low"] = ins["scan"] * r["cpi_low"]
+        r["scan_cycles_high"] = ins["scan"] * r["cpi_high"]
+        r["mhz"] = mhz
+        print(f"per scan ({ins['scan']:,} instructions, run default): {r['scan_cycles_low'] / 1e6:.1f} to "
+              f"{r['scan_cycles_high'] / 1e6:.1f} M cycles (estimates): {r['scan_cycles_low'] / mhz / 1e3:.0f} to "
+              f"{r['scan_cycles_high'] / mhz / 1e3:.0f} ms at {mhz:.0f} MHz")
+    if a.json:
+        with open(a.json, "w") as f:
+            json.dump(r, f, indent=1)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
