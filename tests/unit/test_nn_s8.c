@@ -170,6 +170,56 @@ static void test_requant_rows_and_channels_agree(void)
     }
 }
 
+/* the int16 first layer and the max over the points: both loop orders against a plain reference, on every small
+ * shape (3 inputs: the special case) and int16 inputs at their limits */
+static void test_s16_layer_and_max_agree(void)
+{
+    enum
+    {
+        R = 9,
+        I = 8,
+        O = 40
+    };
+    static int16_t in[R * I];
+    static int8_t w[I * O];
+    static int32_t b[O], ref[R * O], a1[R * O], a2[R * O], m_ref[O], m1[O], m2[O];
+    uint32_t rows, n_in, n_out, r, i, o, rep;
+    for (rep = 0; rep < 3u; ++rep)
+        for (rows = 1; rows <= R; ++rows)
+            for (n_in = 1; n_in <= I; ++n_in)
+                for (n_out = 1; n_out <= O; n_out += 3u)
+                {
+                    for (i = 0; i < rows * n_in; ++i)
+                        in[i] = rep == 2u ? (int16_t)((i & 1u) ? -32768 : 32767) : (int16_t)(next() & 0xFFFFu);
+                    for (i = 0; i < n_in * n_out; ++i)
+                        w[i] = rep == 2u ? (int8_t)-128 : (int8_t)(next() & 0xFFu);
+                    for (o = 0; o < n_out; ++o)
+                    {
+                        b[o] = (int32_t)(next() % 2000001u) - 1000000;
+                        m_ref[o] = m1[o] = m2[o] = (int32_t)(next() % 2000001u) - 1000000; /* running maxima */
+                    }
+                    for (r = 0; r < rows; ++r)
+                        for (o = 0; o < n_out; ++o)
+                        {
+                            int32_t s = b[o];
+                            for (i = 0; i < n_in; ++i)
+                                s += (int32_t)in[r * n_in + i] * (int32_t)w[i * n_out + o];
+                            ref[r * n_out + o] = s;
+                            m_ref[o] = s > m_ref[o] ? s : m_ref[o];
+                        }
+                    memset(a1, 0x5A, sizeof a1);
+                    memset(a2, 0x5A, sizeof a2);
+                    lidet__nn_acc_s16(in, rows, n_in, w, b, n_out, a1);
+                    lidet__nn_acc_s16_by_out(in, rows, n_in, w, b, n_out, a2);
+                    TEST_ASSERT_EQUAL_INT32_ARRAY(ref, a1, rows * n_out);
+                    TEST_ASSERT_EQUAL_INT32_ARRAY(ref, a2, rows * n_out);
+                    lidet__nn_max_rows_s32(ref, rows, n_out, m1);
+                    lidet__nn_max_rows_s32_by_channel(ref, rows, n_out, m2);
+                    TEST_ASSERT_EQUAL_INT32_ARRAY(m_ref, m1, n_out);
+                    TEST_ASSERT_EQUAL_INT32_ARRAY(m_ref, m2, n_out);
+                }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -177,5 +227,6 @@ int main(void)
     RUN_TEST(test_kernels_agree_at_the_extremes);
     RUN_TEST(test_requant_equals_the_int64_rule);
     RUN_TEST(test_requant_rows_and_channels_agree);
+    RUN_TEST(test_s16_layer_and_max_agree);
     return UNITY_END();
 }

@@ -367,10 +367,44 @@ void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
     }
 }
 
+void lidet__nn_acc_s16_by_out(const int16_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                              const int32_t *b, uint32_t n_out, int32_t *acc)
+{
+    uint32_t r, i, o;
+    for (r = 0; r < n_rows; ++r)
+    {
+        const int16_t *x = in + r * n_in;
+        int32_t *a = acc + r * n_out;
+        if (n_in == 3u) /* the first layer's x, y, z: the inputs in registers too */
+        {
+            const int32_t x0 = x[0], x1 = x[1], x2 = x[2];
+            for (o = 0; o < n_out; ++o)
+            {
+                a[o] = b[o] + x0 * (int32_t)w_t[o] + x1 * (int32_t)w_t[n_out + o] +
+                       x2 * (int32_t)w_t[2u * n_out + o];
+            }
+            continue;
+        }
+        for (o = 0; o < n_out; ++o)
+        {
+            int32_t s = b[o];
+            for (i = 0; i < n_in; ++i)
+            {
+                s += (int32_t)x[i] * (int32_t)w_t[i * n_out + o];
+            }
+            a[o] = s;
+        }
+    }
+}
+
 LIDET_NN_KERNEL void lidet__nn_acc_s16(const int16_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                                        const int32_t *b, uint32_t n_out, int32_t *acc)
 {
     uint32_t r, i, o;
+#if !LIDET_NN_SIMD
+    lidet__nn_acc_s16_by_out(in, n_rows, n_in, w_t, b, n_out, acc);
+    return;
+#endif
     for (r = 0; r < n_rows; ++r)
     {
         int32_t *a = acc + r * n_out;
@@ -467,7 +501,7 @@ LIDET_NN_KERNEL void lidet__nn_requant_s8(const int32_t *acc, uint32_t n_rows, u
                                           int8_t *out)
 {
     uint32_t r, o;
-#if !LIDET_NN_REQUANT_ROWS
+#if !LIDET_NN_SIMD
     lidet__nn_requant_s8_by_channel(acc, n_rows, n_out, mult, shift, zp, lo, out);
     return;
 #endif
@@ -493,9 +527,28 @@ void lidet__nn_requant_q16(const int32_t *acc, uint32_t n_out, const int32_t *mu
     }
 }
 
+void lidet__nn_max_rows_s32_by_channel(const int32_t *acc, uint32_t n_rows, uint32_t n, int32_t *vmax)
+{
+    uint32_t r, o;
+    for (o = 0; o < n; ++o)
+    {
+        const int32_t *a = acc + o;
+        int32_t m = vmax[o];
+        for (r = 0; r < n_rows; ++r, a += n)
+        {
+            m = *a > m ? *a : m;
+        }
+        vmax[o] = m;
+    }
+}
+
 LIDET_NN_KERNEL void lidet__nn_max_rows_s32(const int32_t *acc, uint32_t n_rows, uint32_t n, int32_t *vmax)
 {
     uint32_t r, o;
+#if !LIDET_NN_SIMD
+    lidet__nn_max_rows_s32_by_channel(acc, n_rows, n, vmax);
+    return;
+#endif
     for (r = 0; r < n_rows; ++r)
     {
         const int32_t *a = acc + r * n;
