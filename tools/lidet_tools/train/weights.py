@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: MIT
-"""`make weights`: from nothing to weights/{cls,box}_{hdl64,vlp16}.onnx and weights/MODEL_CARD.md.
+"""`make weights`: from nothing to weights/{cls,box}_{hdl64,vlp16}.onnx and weights/MODEL_CARD.md (and, with
+`--families vlp16s --card weights/MODEL_CARD_vlp16s.md`, the small VLP-16 pair of the integer firmware).
 
     python -m lidet_tools.train.weights [--work data/train] [--weights weights] [--jobs 2] [--threads 1]
                                         [--real ../shared/data/real/kitti/training] [--device cpu]
@@ -40,7 +41,7 @@ FAMILIES = {
                   # classifier disagreed with float on 1.4 % of held-out proposals, 0.5-0.6 % after (seeds 7, 8, 9)
                   cls_finetune=["--epochs", "6", "--seed", "7"]),
     # vlp16s: the small VLP-16 pair for boards without an FPU (issue 17): 32 points per proposal, 8x fewer
-    # multiply-adds than vlp16 (classifier 86 k, box net 180 k per proposal), the same scans and schedule;
+    # multiply-adds than vlp16 (classifier 86 k, box net 192 k per proposal), the same scans and schedule;
     # the integer firmware images use it (docs/PORTING.md, "The small VLP-16 pair")
     "vlp16s": dict(sensor="vlp16",
                    dataset=["--sensor", "vlp16", "--mounts", "0.3,0.5,0.7,1.0", "--sim", "800,200,200", "--seed", "2000",
