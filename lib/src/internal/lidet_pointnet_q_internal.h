@@ -45,16 +45,11 @@ void lidet__nn_requant_s8(const int32_t *acc, uint32_t n_rows, uint32_t n_out, c
 /* the same, channel by channel (what lidet__nn_requant_s8 runs where LIDET_NN_SIMD is 0) */
 void lidet__nn_requant_s8_by_channel(const int32_t *acc, uint32_t n_rows, uint32_t n_out, const int32_t *mult,
                                      const uint8_t *shift, int32_t zp, int32_t lo, int8_t *out);
-/* lidet__nn_acc_s8_cols two outputs at a time, their sums in registers (where LIDET_NN_SIMD is 0: the one-row
- * PVLE and head layers) */
-void lidet__nn_acc_s8_cols_by_out(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                                  const int32_t *b, uint32_t n_out, uint32_t w_stride, int32_t *acc,
-                                  uint32_t a_stride);
 /* lidet__nn_acc_s16 output by output, the sum in a register (where LIDET_NN_SIMD is 0: the first layer has 3
  * inputs, so the row-major loop spends most of its instructions reloading and storing the accumulators) */
 void lidet__nn_acc_s16_by_out(const int16_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                               const int32_t *b, uint32_t n_out, int32_t *acc);
-/* 1 on SIMD hosts: the requantization, the int16 layer and the one-row int8 kernel walk rows then channels (the inner loop over
+/* 1 on SIMD hosts: the requantization and the int16 layer walk rows then channels (the inner loop over
  * the channels vectorises); 0 on cores without SIMD: channel by channel, values in registers. Same values
  * (tests/unit/test_nn_s8.c runs both forms). */
 #ifndef LIDET_NN_SIMD

@@ -332,50 +332,11 @@ void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const in
 
 /* the output-inner kernel on channels [0, n_out) of a layer whose weight rows are w_stride long and whose
  * accumulator rows are a_stride long (a column slice, for the blocked kernels' leftovers) */
-void lidet__nn_acc_s8_cols_by_out(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                                  const int32_t *b, uint32_t n_out, uint32_t w_stride, int32_t *acc,
-                                  uint32_t a_stride)
-{
-    uint32_t r, i, o;
-    for (r = 0; r < n_rows; ++r)
-    {
-        int32_t *a = acc + r * a_stride;
-        const int8_t *x = in + r * n_in;
-        for (o = 0; o + 2u <= n_out; o += 2u)
-        {
-            const int8_t *w = w_t + o;
-            int32_t s0 = b[o], s1 = b[o + 1u];
-            for (i = 0; i < n_in; ++i, w += w_stride)
-            {
-                const int32_t xi = x[i];
-                s0 += xi * (int32_t)w[0];
-                s1 += xi * (int32_t)w[1];
-            }
-            a[o] = s0;
-            a[o + 1u] = s1;
-        }
-        if (o < n_out)
-        {
-            const int8_t *w = w_t + o;
-            int32_t s0 = b[o];
-            for (i = 0; i < n_in; ++i, w += w_stride)
-            {
-                s0 += (int32_t)x[i] * (int32_t)w[0];
-            }
-            a[o] = s0;
-        }
-    }
-}
-
 void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, uint32_t w_stride, int32_t *acc,
                            uint32_t a_stride)
 {
     uint32_t r, i, o;
-#if !LIDET_NN_SIMD
-    lidet__nn_acc_s8_cols_by_out(in, n_rows, n_in, w_t, b, n_out, w_stride, acc, a_stride);
-    return;
-#endif
     for (r = 0; r < n_rows; ++r)
     {
         int32_t *a = acc + r * a_stride;
