@@ -28,6 +28,16 @@ set(fw_src ${PROJECT_SOURCE_DIR}/ports/firmware)
 
 # ---- the host references: one per sensor configuration (ports/firmware/config/<sensor>) ------------
 file(GLOB fw_weights_sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/weights/*.c)
+# the model family of an image and of its host reference (ports/firmware/CMakeLists.txt: LIDET_FW_MODELS'
+# default): the small pair vlp16s for the integer VLP-16 build, the sensor's own models otherwise
+function(lidet_fw_models out sensor fixed)
+  set(m ${sensor})
+  if(fixed AND sensor STREQUAL "vlp16")
+    set(m vlp16s)
+  endif()
+  set(${out} ${m} PARENT_SCOPE)
+endfunction()
+
 function(lidet_fw_host_ref sensor exe)
   # optional third argument FIXED: the integer-only build (the integer detector, int8 models, the scan in mm)
   set(lib lidet_fwcap_${sensor})
@@ -62,11 +72,11 @@ function(lidet_fw_host_ref sensor exe)
   add_executable(${exe} ${fw_src}/fw_detect.c ${fw_src}/fw_host_port.c ${scan_c})
   set_target_properties(${exe} PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
   target_include_directories(${exe} PRIVATE ${fw_src})
-  # the models of the images it is compared with (ports/firmware/CMakeLists.txt: LIDET_FW_MODELS' default)
-  set(models ${sensor})
-  if(ARGV2 STREQUAL "FIXED" AND sensor STREQUAL "vlp16")
-    set(models vlp16s)
+  set(fixed_ref OFF)
+  if(ARGV2 STREQUAL "FIXED")
+    set(fixed_ref ON)
   endif()
+  lidet_fw_models(models ${sensor} ${fixed_ref}) # those of the images it is compared with
   target_compile_definitions(${exe} PRIVATE FW_SENSOR="${sensor}" FW_SENSOR_ID=${sensor} FW_MODELS="${models}"
                                             FW_MODELS_ID=${models})
   target_compile_options(${exe} PRIVATE -Wall -Wextra -Werror -fno-math-errno -ffp-contract=off)
@@ -126,10 +136,7 @@ foreach(entry IN LISTS fw_images)
     set_tests_properties(firmware_${image} PROPERTIES SKIP_RETURN_CODE 77)
     continue()
   endif()
-  set(models ${sensor}) # as the host reference's (lidet_fw_host_ref above)
-  if(fixed AND sensor STREQUAL "vlp16")
-    set(models vlp16s)
-  endif()
+  lidet_fw_models(models ${sensor} ${fixed})
   set(bdir ${CMAKE_BINARY_DIR}/firmware/${image})
   ExternalProject_Add(firmware_${image}
     SOURCE_DIR ${fw_src}

@@ -4,6 +4,7 @@
 #define LIDET_GROUND_Q_INTERNAL_H
 
 #include "lidet/lidet_ground_q.h"
+#include "lidet_simd.h"
 
 /* R of a pixel in 4 mm / 2^LIDET_GROUND_Q_R_SHIFT steps (1/64 mm) */
 #define LIDET_GROUND_Q_R_SHIFT 8
@@ -48,11 +49,7 @@ static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, 
  * registers (cores without SIMD: fewer loads and stores). The sample test: 1 = branch-free, 0 = leaving at the
  * first failed condition. Same values either way. */
 #ifndef LIDET_GROUND_Q_SQRT_LANES
-#if defined(__SSE2__) || defined(__ARM_NEON) || defined(__ARM_NEON__) || defined(__AVX2__)
-#define LIDET_GROUND_Q_SQRT_LANES 1
-#else
-#define LIDET_GROUND_Q_SQRT_LANES 0
-#endif
+#define LIDET_GROUND_Q_SQRT_LANES LIDET_HOST_SIMD
 #endif
 
 /* R of a pixel from v = x^2 + y^2 (4 mm steps squared, v < 2^31): round(sqrt(v) 2^LIDET_GROUND_Q_R_SHIFT), exact

@@ -6,6 +6,8 @@
 
 #include <stdint.h>
 
+#include "lidet_simd.h"
+
 #define LIDET_PNQ_TABLE_STEPS 256
 /* round(2^(-j / 256) * 2^30) and round(log2(1 + j / 256) * 2^30), j = 0..256 */
 extern const int32_t lidet__pnq_exp2_neg_q30[LIDET_PNQ_TABLE_STEPS + 1];
@@ -53,11 +55,7 @@ void lidet__nn_acc_s16_by_out(const int16_t *in, uint32_t n_rows, uint32_t n_in,
  * the channels vectorises); 0 on cores without SIMD: channel by channel, values in registers. Same values
  * (tests/unit/test_nn_s8.c runs both forms). */
 #ifndef LIDET_NN_SIMD
-#if defined(__SSE2__) || defined(__ARM_NEON) || defined(__ARM_NEON__) || defined(__AVX2__)
-#define LIDET_NN_SIMD 1
-#else
-#define LIDET_NN_SIMD 0
-#endif
+#define LIDET_NN_SIMD LIDET_HOST_SIMD
 #endif
 /* out[o] = round_half_up(acc * mult[o] / 2^shift[o]) saturated to int32 (Q16 outputs) */
 void lidet__nn_requant_q16(const int32_t *acc, uint32_t n_out, const int32_t *mult, const uint8_t *shift,

@@ -18,4 +18,16 @@
 #define LIDET_CLONES_AVX512
 #endif
 
+/* 1 on hosts with SIMD (SSE2, AVX2, NEON): the integer kernels keep the loop forms a compiler vectorises (the
+ * inner loop over a row's columns or a layer's channels); 0 on cores without SIMD (Cortex-M, RV32), where the
+ * same kernels keep values in registers or leave early instead (LIDET_GROUND_Q_SQRT_LANES, LIDET_NN_SIMD).
+ * Same values either way. */
+#ifndef LIDET_HOST_SIMD
+#if defined(__SSE2__) || defined(__ARM_NEON) || defined(__ARM_NEON__) || defined(__AVX2__)
+#define LIDET_HOST_SIMD 1
+#else
+#define LIDET_HOST_SIMD 0
+#endif
+#endif
+
 #endif
