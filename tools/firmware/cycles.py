@@ -120,7 +120,7 @@ def price(mn: str, ops: str, core: str, prev_ls: bool):
     if m.startswith(("ldr", "str", "ldrex", "strex")):
         kind = "pc" if writes_pc else "ls"
         return (1 if prev_ls else 2), 2, kind
-    if m in DP or m.rstrip("s") in DP:
+    if m in DP:
         return 1, 1, "pc" if writes_pc and m in ("mov", "add") else ""
     raise ValueError(f"no cycle count for '{mn} {ops}'")
 
