@@ -43,6 +43,8 @@ import numpy as np
 from . import __version__
 from .emit import FORMAT_VERSION, EmitError, Model, load
 
+PNQ_LAYOUT_VERSION = 2  # LIDET_PNQ_LAYOUT_VERSION (lidet_pointnet_q.h): the layer tables' fields (w_pk)
+
 PREC_S8 = 1  # LIDET_PN_S8
 PTS_SCALE = 0.001  # the first shared layer's input: millimetres
 INT32_MAX = (1 << 31) - 1
@@ -497,12 +499,31 @@ def layer_errors(qm: QModel, xyz, mean, vox):
 
 # ---- C emission --------------------------------------------------------------------------------
 
-def _ints(cname, ctype, vals, comment):
+def _ints(cname, ctype, vals, comment, suffix=""):
     vals = [int(v) for v in np.asarray(vals).reshape(-1)]
-    lines = [", ".join(str(v) for v in vals[i:i + 16]) for i in range(0, len(vals), 16)]
+    lines = [", ".join(f"{v}{suffix}" for v in vals[i:i + 16]) for i in range(0, len(vals), 16)]
     body = ",\n    ".join(lines)
     return (f"/* {comment} */\nLIDET_ALIGN(16) LIDET_RODATA static const {ctype} {cname}[{len(vals)}] = {{\n"
             f"    {body}\n}};\n")
+
+
+def pack_pk(w_q: np.ndarray) -> np.ndarray:
+    """The DSP kernel's packed weights (lidet_pointnet_q_layer_t.w_pk; lidet__nn_pack_s8_pk in
+    lib/src/nn/lidet_nn_s8.c writes the same words) from w_q [out][in] int8, n_in a multiple of 4: for each pair of
+    channels (c, c + 1) and group of 4 inputs i..i+3 the uint32 words (w[c][i], w[c][i+2]), (w[c+1][i],
+    w[c+1][i+2]), (w[c][i+1], w[c][i+3]), (w[c+1][i+1], w[c+1][i+3]), the first value in the low half (int16);
+    an odd last channel is left out (the kernel takes it from w_t)."""
+    w = np.asarray(w_q, dtype=np.int64)
+    n_out, n_in = w.shape
+    if n_in % 4:
+        raise ValueError(f"pack_pk: n_in {n_in} is not a multiple of 4")
+    words = []
+    for c in range(0, n_out - 1, 2):
+        for g in range(0, n_in, 4):
+            for k in range(4):
+                o, i = c + (k & 1), g + (k >> 1)
+                words.append((int(w[o, i]) & 0xFFFF) | ((int(w[o, i + 2]) & 0xFFFF) << 16))
+    return np.array(words, dtype=np.uint64)
 
 
 def emit_c_s8(qm: QModel, onnx_path, calib_path, cmd: str, src_sha: str, calib_sha: str) -> tuple[str, str]:
@@ -523,7 +544,10 @@ def emit_c_s8(qm: QModel, onnx_path, calib_path, cmd: str, src_sha: str, calib_s
     c = [banner, f"#include \"{n}.h\"\n\n",
          f"#if LIDET_WEIGHTS_FORMAT_VERSION != {FORMAT_VERSION}\n"
          f"#error \"{n}: generated for weights format {FORMAT_VERSION}; regenerate with python -m lidet_codegen emit\"\n"
-         f"#endif\n\n"]
+         f"#endif\n"
+         f"#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != {PNQ_LAYOUT_VERSION}\n"
+         f"#error \"{n}: generated for the int8 layer layout {PNQ_LAYOUT_VERSION}; regenerate with python -m lidet_codegen "
+         f"emit --int8\"\n#endif\n\n"]
     tags = ["cls"] if qm.kind == "classifier" else (["tnet", "box"] if len(qm.stages) == 2 else ["box"])
     stage_c = []
     for tag, st in zip(tags, qm.stages):
@@ -540,18 +564,18 @@ def emit_c_s8(qm: QModel, onnx_path, calib_path, cmd: str, src_sha: str, calib_s
                 c.append(_ints(base + "_b", "int32_t", l.b, f"{tag}.{pn}[{i}] bias int32 (input zero point folded)"))
                 c.append(_ints(base + "_m", "int32_t", l.mult, f"{tag}.{pn}[{i}] requantization multipliers"))
                 c.append(_ints(base + "_s", "uint8_t", l.shift, f"{tag}.{pn}[{i}] requantization shifts"))
-                oi = "0"
-                # the shared per-point int8 x int8 layers: [out][in] too, for the DSP kernel (LIDET_PNQ_WEIGHTS_OI);
-                # the PVLE and head layers run on one vector (one row), which the kernel does with w_t anyway
-                if pn == "point" and not l.in_s16:
-                    c.append("#if LIDET_PNQ_WEIGHTS_OI\n" + _ints(base + "_woi", "int8_t", l.w_q,
-                                                                 f"{tag}.{pn}[{i}] weights [{l.n_out}][{l.n_in}] int8, "
-                                                                 f"the same as _w in [out][in] order")
+                pk = "0"
+                # every int8 x int8 layer with n_in a multiple of 4 (and two channels or more): the weights again,
+                # widened and packed for the DSP kernel (LIDET_PNQ_WEIGHTS_PK; int16 x int8 first layers take w_t)
+                if not l.in_s16 and l.n_in % 4 == 0 and l.n_out >= 2:
+                    c.append("#if LIDET_PNQ_WEIGHTS_PK\n" + _ints(base + "_wpk", "uint32_t", pack_pk(l.w_q),
+                                                                 f"{tag}.{pn}[{i}] weights int16 pairs packed for "
+                                                                 f"the DSP kernel, the same as _w", suffix="u")
                              + "#endif\n")
-                    oi = f"LIDET_PNQ_OI({base}_woi)"
+                    pk = f"LIDET_PNQ_PK({base}_wpk)"
                 kind = "LIDET_PNQ_OUT_Q16" if l.out_q16 else "LIDET_PNQ_OUT_S8"
                 entries.append(f"    {{{l.n_in}u, {l.n_out}u, {1 if l.relu else 0}u, {kind}, {l.out_zp}, "
-                               f"{base}_w, {base}_b, {base}_m, {base}_s, {oi}}}")
+                               f"{base}_w, {base}_b, {base}_m, {base}_s, {pk}}}")
             arr = f"{n}_{tag}_{pn}"
             c.append(f"static const lidet_pointnet_q_layer_t {arr}[{len(layers)}] = {{\n" + ",\n".join(entries)
                      + "\n};\n\n")

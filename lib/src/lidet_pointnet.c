@@ -248,6 +248,7 @@ static void max_init(const bufs_t *b, uint32_t n)
     lidet__nn_dense_f32((const float *)(in), nb, (ly)->n_in, (ly)->w_t, (ly)->b, (ly)->n_out, (ly)->relu,    \
                         (b)->act[(l)&1u])
 #define PNB_STORE(ly, nb, b, dst) ((void)0)
+#define PNB_FUSED(ly, in, nb, b, l, dst) 0
 #define PNB_FOLD_MAX(ly, nb, b, l) lidet__nn_max_rows_f32((b)->act[(l)&1u], nb, (ly)->n_out, (b)->vec[0])
 #include "internal/lidet_pn_points_body.h"
 

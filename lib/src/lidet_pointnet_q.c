@@ -256,13 +256,13 @@ static const void *load_block(const bufs_t *b, const int16_t *xyz, uint32_t nb, 
     return out;
 }
 
-/* an int8 x int8 layer into the accumulators: the [out][in] copy of its weights where the model has one (cores
- * with the DSP extension, LIDET_PNQ_WEIGHTS_OI), else the [in][out] weights; the same int32 sums either way */
+/* an int8 x int8 layer into the accumulators: the packed copy of its weights where the model has one (cores
+ * with the DSP extension, LIDET_PNQ_WEIGHTS_PK), else the [in][out] weights; the same int32 sums either way */
 static void acc_s8(const lidet_pointnet_q_layer_t *ly, const int8_t *in, uint32_t n_rows, int32_t *acc)
 {
-    if (ly->w_oi != 0)
+    if (ly->w_pk != 0)
     {
-        lidet__nn_acc_s8_oi(in, n_rows, ly->n_in, ly->w_oi, ly->w_t, ly->b, ly->n_out, acc);
+        lidet__nn_acc_s8_pk(in, n_rows, ly->n_in, ly->w_pk, ly->w_t, ly->b, ly->n_out, acc);
     }
     else
     {
@@ -290,6 +290,13 @@ static void run_vec_layers(const lidet_pointnet_q_layer_t *l, uint32_t n, const 
         if (i == 0 && in16 != 0)
         {
             lidet__nn_acc_s16(in16, 1u, l[i].n_in, l[i].w_t, l[i].b, l[i].n_out, b->acc);
+        }
+        else if (!(i == 0 && onehot_b != 0) && l[i].out != LIDET_PNQ_OUT_Q16 && l[i].w_pk != 0 &&
+                 lidet__nn_acc_s8_pk_fused(cur, 1u, l[i].n_in, l[i].w_pk, l[i].b, l[i].n_out, l[i].mult,
+                                           l[i].shift, l[i].out_zp, l[i].relu ? l[i].out_zp : -128, dst, 0))
+        {
+            cur = dst; /* accumulated and requantized in one pass */
+            continue;
         }
         else
         {
@@ -335,6 +342,20 @@ static void dense_acc(const lidet_pointnet_q_layer_t *ly, const void *in, uint32
     }
 }
 
+/* layer l (> 0: int8 inputs) in one pass where the model has the packed weights: requantized into dst, or, for
+ * the last layer (dst NULL), folded into the running maximum; 0 where it does not apply */
+static int fused_s8(const lidet_pointnet_q_layer_t *ly, const void *in, uint32_t nb, const bufs_t *b,
+                    uint32_t l, int8_t *dst)
+{
+    if (l == 0 || ly->w_pk == 0)
+    {
+        return 0;
+    }
+    return lidet__nn_acc_s8_pk_fused((const int8_t *)in, nb, ly->n_in, ly->w_pk, ly->b, ly->n_out, ly->mult,
+                                     ly->shift, ly->out_zp, ly->relu ? ly->out_zp : -128, dst,
+                                     dst == 0 ? b->gmax : 0);
+}
+
 /* the shared layers (internal/lidet_pn_points_body.h): hidden layers requantized into act[l & 1], the last
  * one's accumulators folded into the running maximum gmax (requantized once by run_stage) */
 #define PNB_FN run_points
@@ -347,6 +368,7 @@ static void dense_acc(const lidet_pointnet_q_layer_t *ly, const void *in, uint32
 #define PNB_DENSE(ly, in, nb, b, l) dense_acc(ly, in, nb, b, l)
 #define PNB_STORE(ly, nb, b, dst) requant_s8(ly, (b)->acc, nb, dst)
 #define PNB_FOLD_MAX(ly, nb, b, l) lidet__nn_max_rows_s32((b)->acc, nb, (ly)->n_out, (b)->gmax)
+#define PNB_FUSED(ly, in, nb, b, l, dst) fused_s8(ly, in, nb, b, l, dst)
 #include "internal/lidet_pn_points_body.h"
 
 /* One stage (ref: run_stage): blocks of points -> model frame (int16 mm) -> shared layers, the last one's

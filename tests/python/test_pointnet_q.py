@@ -311,3 +311,41 @@ def test_refit_brings_the_int8_logits_closer_to_float(props, need_lib):
         err[tag] = float(((lo - f) ** 2).mean())
     print(err)
     assert err["refit"] < 0.95 * err["plain"], err
+
+
+def _smlad(a, b, acc):
+    """SMLAD on uint32 words: acc + lo(a) lo(b) + hi(a) hi(b), the halves as int16"""
+    def halves(v):
+        lo, hi = v & 0xFFFF, (v >> 16) & 0xFFFF
+        return (lo - 0x10000 if lo & 0x8000 else lo), (hi - 0x10000 if hi & 0x8000 else hi)
+    (al, ah), (bl, bh) = halves(int(a)), halves(int(b))
+    return acc + al * bl + ah * bh
+
+
+@pytest.mark.parametrize("n_out,n_in", [(2, 4), (7, 12), (16, 48), (33, 68)])
+def test_pack_pk_is_what_the_dsp_kernel_reads(n_out, n_in):
+    """codegen's packed weights (w_pk) read as lib/src/nn/lidet_nn_s8.c's DSP kernel reads them (inputs widened
+    to (x_i, x_i+2), (x_i+1, x_i+3) as SXTB16 does; per channel pair and group of 4 inputs the words c0 A,
+    c1 A, c0 B, c1 B) give w_q @ x for every channel pair; an odd last channel is left out (the kernel takes
+    it from w_t). A wrong word order or half fails here."""
+    rng = np.random.default_rng(n_out * 100 + n_in)
+    w = rng.integers(-128, 128, size=(n_out, n_in))
+    w[0, :4] = [-128, 127, -1, 0]  # sign extension of both halves
+    x = rng.integers(-128, 128, size=n_in)
+    words = QU.pack_pk(w.astype(np.int8))
+    assert len(words) == n_in * (n_out // 2 * 2) // 2
+    n_g = n_in // 4
+    got = []
+    for c in range(n_out // 2):
+        s0 = s1 = 0
+        for g in range(n_g):
+            xi = x[4 * g: 4 * g + 4]
+            a = (int(xi[0]) & 0xFFFF) | ((int(xi[2]) & 0xFFFF) << 16)
+            b = (int(xi[1]) & 0xFFFF) | ((int(xi[3]) & 0xFFFF) << 16)
+            wd = words[(c * n_g + g) * 4: (c * n_g + g) * 4 + 4]
+            s0 = _smlad(b, wd[2], _smlad(a, wd[0], s0))
+            s1 = _smlad(b, wd[3], _smlad(a, wd[1], s1))
+        got += [s0, s1]
+    assert got == [int(v) for v in (w @ x)[: n_out // 2 * 2]]
+    with pytest.raises(ValueError, match="multiple of 4"):
+        QU.pack_pk(np.zeros((2, 6), dtype=np.int8))

@@ -8,7 +8,7 @@
 #include "test_util.h"
 
 #define MAX_R 11
-#define MAX_I 70
+#define MAX_I 140
 #define MAX_O 37
 
 static uint32_t g_rng = 12345u;
@@ -31,7 +31,8 @@ void tearDown(void)
 
 static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extreme)
 {
-    static int8_t in[MAX_R * MAX_I], w[MAX_I * MAX_O], w_oi[MAX_I * MAX_O];
+    static int8_t in[MAX_R * MAX_I], w[MAX_I * MAX_O];
+    static uint32_t w_pk[MAX_I * MAX_O / 2u + 1u];
     static int32_t b[MAX_O], ref[MAX_R * MAX_O], got[MAX_R * MAX_O];
     uint32_t r, i, o, k;
     for (k = 0; k < rows * n_in; ++k)
@@ -66,11 +67,12 @@ static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extrem
     memset(got, 0x5A, sizeof got);
     lidet__nn_acc_s8(in, rows, n_in, w, b, n_out, got);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
-    for (o = 0; o < n_out; ++o) /* the [out][in] copy of the weights */
-        for (i = 0; i < n_in; ++i)
-            w_oi[o * n_in + i] = w[i * n_out + o];
+    /* the packed DSP kernel (n_in not a multiple of 4: it takes w_t, never reading w_pk) */
+    memset(w_pk, 0xA5, sizeof w_pk);
+    if (n_in % 4u == 0u)
+        lidet__nn_pack_s8_pk(w, n_in, n_out, w_pk);
     memset(got, 0x5A, sizeof got);
-    lidet__nn_acc_s8_oi(in, rows, n_in, w_oi, w, b, n_out, got);
+    lidet__nn_acc_s8_pk(in, rows, n_in, w_pk, w, b, n_out, got);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
 }
 
@@ -83,8 +85,73 @@ static void test_kernels_agree_on_every_shape(void)
                 check_shape(rows, n_in, n_out, 0);
 }
 
+/* the packed kernel's cases: one group, several, exactly one 64-input pass, two and three passes */
+static void test_packed_kernel_on_multiples_of_4(void)
+{
+    static const uint32_t n_ins[] = {4u, 12u, 64u, 68u, 136u};
+    uint32_t rows, k, n_out;
+    for (k = 0; k < sizeof n_ins / sizeof n_ins[0]; ++k)
+        for (rows = 1; rows <= MAX_R; ++rows)
+            for (n_out = 1; n_out <= MAX_O; n_out += 4u)
+                check_shape(rows, n_ins[k], n_out, 0);
+}
+
+/* the fused pass (requantized, or folded into a running maximum) equals the accumulation followed by
+ * lidet__nn_requant_s8 or lidet__nn_max_rows_s32, on every row count, both shift paths and both clamps; and it
+ * declines (touching nothing) where it does not apply */
+static void test_fused_pass_equals_acc_then_requant_or_max(void)
+{
+    static int8_t in[MAX_R * 64], w[64 * 32], out[MAX_R * 32], ref8[MAX_R * 32];
+    static uint32_t w_pk[64 * 32 / 2];
+    static int32_t b[32], acc[MAX_R * 32], mult[32], vmax[32], refmax[32];
+    static uint8_t shift[32];
+    static const uint32_t n_ins[] = {4u, 16u, 48u, 64u};
+    uint32_t k, rows, n_out, i, rep;
+    for (rep = 0; rep < 4u; ++rep)
+        for (k = 0; k < sizeof n_ins / sizeof n_ins[0]; ++k)
+            for (rows = 1; rows <= MAX_R; ++rows)
+                for (n_out = 2; n_out <= 32u; n_out += 10u)
+                {
+                    const uint32_t n_in = n_ins[k];
+                    const int32_t zp = rep & 1u ? -128 : 0, lo = rep & 2u ? zp : -128;
+                    for (i = 0; i < rows * n_in; ++i)
+                        in[i] = (int8_t)(next() & 0xFFu);
+                    for (i = 0; i < n_in * n_out; ++i)
+                        w[i] = (int8_t)(next() & 0xFFu);
+                    for (i = 0; i < n_out; ++i)
+                    {
+                        b[i] = (int32_t)(next() % 200001u) - 100000;
+                        mult[i] = (int32_t)(((uint32_t)1 << 30) | (next() & 0x3FFFFFFFu));
+                        shift[i] = (uint8_t)(20u + next() % 24u); /* both sides of 32 */
+                        refmax[i] = vmax[i] = (int32_t)(next() % 2000001u) - 1000000;
+                    }
+                    lidet__nn_pack_s8_pk(w, n_in, n_out, w_pk);
+                    lidet__nn_acc_s8(in, rows, n_in, w, b, n_out, acc);
+                    lidet__nn_requant_s8(acc, rows, n_out, mult, shift, zp, lo, ref8);
+                    lidet__nn_max_rows_s32(acc, rows, n_out, refmax);
+                    memset(out, 0x5A, sizeof out);
+                    TEST_ASSERT_EQUAL_INT(1, lidet__nn_acc_s8_pk_fused(in, rows, n_in, w_pk, b, n_out, mult, shift,
+                                                                       zp, lo, out, 0));
+                    TEST_ASSERT_EQUAL_INT8_ARRAY(ref8, out, rows * n_out);
+                    TEST_ASSERT_EQUAL_INT(1, lidet__nn_acc_s8_pk_fused(in, rows, n_in, w_pk, b, n_out, mult, shift,
+                                                                       zp, lo, 0, vmax));
+                    TEST_ASSERT_EQUAL_INT32_ARRAY(refmax, vmax, n_out);
+                }
+    /* declined: odd n_out, n_in not a multiple of 4 or above 64, no weights, neither or both outputs */
+    memset(out, 0x5A, sizeof out);
+    TEST_ASSERT_EQUAL_INT(0, lidet__nn_acc_s8_pk_fused(in, 2u, 16u, w_pk, b, 3u, mult, shift, 0, -128, out, 0));
+    TEST_ASSERT_EQUAL_INT(0, lidet__nn_acc_s8_pk_fused(in, 2u, 18u, w_pk, b, 4u, mult, shift, 0, -128, out, 0));
+    TEST_ASSERT_EQUAL_INT(0, lidet__nn_acc_s8_pk_fused(in, 2u, 68u, w_pk, b, 4u, mult, shift, 0, -128, out, 0));
+    TEST_ASSERT_EQUAL_INT(0, lidet__nn_acc_s8_pk_fused(in, 2u, 16u, 0, b, 4u, mult, shift, 0, -128, out, 0));
+    TEST_ASSERT_EQUAL_INT(0, lidet__nn_acc_s8_pk_fused(in, 2u, 16u, w_pk, b, 4u, mult, shift, 0, -128, 0, 0));
+    TEST_ASSERT_EQUAL_INT(0, lidet__nn_acc_s8_pk_fused(in, 2u, 16u, w_pk, b, 4u, mult, shift, 0, -128, out, vmax));
+    for (i = 0; i < sizeof out; ++i)
+        TEST_ASSERT_EQUAL_INT8((int8_t)0x5A, out[i]);
+}
+
 static void test_kernels_agree_at_the_extremes(void)
 {
+    check_shape(8, 136, MAX_O, 1);
     check_shape(8, MAX_I, MAX_O, 1);
     check_shape(9, 64, 33, 1);
 }
@@ -222,6 +289,8 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_kernels_agree_on_every_shape);
+    RUN_TEST(test_packed_kernel_on_multiples_of_4);
+    RUN_TEST(test_fused_pass_equals_acc_then_requant_or_max);
     RUN_TEST(test_kernels_agree_at_the_extremes);
     RUN_TEST(test_requant_equals_the_int64_rule);
     RUN_TEST(test_requant_rows_and_channels_agree);

@@ -65,28 +65,34 @@ typedef struct
     const int32_t *b;     /**< n_out, input zero point folded in */
     const int32_t *mult;  /**< n_out, in [0, 2^31) */
     const uint8_t *shift; /**< n_out, in [1, 62] */
-    const int8_t *w_oi;   /**< optional: the same weights [out][in] (n_out * n_in), which the DSP kernel reads
-                               a word (4 weights) at a time; NULL: w_t only. The generated models fill it
-                               for the shared per-point layers (the ones run on blocks of points) where
-                               LIDET_PNQ_WEIGHTS_OI is 1 (the default on cores with the DSP extension:
+    const uint32_t
+        *w_pk; /**< optional: the same weights widened to int16 and packed two to a word in the order
+                               the DSP kernel reads them (n_in * (n_out & ~1) / 2 words, n_in a multiple of 4;
+                               lidet__nn_pack_s8_pk in nn/lidet_nn_s8.c defines the order); NULL: w_t only. The
+                               generated models fill it for every int8 x int8 layer with n_in a multiple of 4
+                               where LIDET_PNQ_WEIGHTS_PK is 1 (the default on cores with the DSP extension:
                                Cortex-M4, M7, M33) and leave it NULL elsewhere (no second copy in flash) */
 } lidet_pointnet_q_layer_t;
 
-/** 1: the generated int8 models carry their weights a second time, [out][in] (lidet_pointnet_q_layer_t.w_oi:
- *  about 1.4 instead of 2.4 instructions per multiply-add on a Cortex-M4 / M7, for twice the weights' flash).
- *  Default: 1 where the compiler targets the Arm DSP extension, else 0. */
-#ifndef LIDET_PNQ_WEIGHTS_OI
+/** 1: the generated int8 models carry their weights a second time, widened to int16 and packed for the DSP
+ *  kernel (lidet_pointnet_q_layer_t.w_pk: about 0.9 instead of 1.6 instructions per multiply-add on a
+ *  Cortex-M4 / M7, for three times the weights' flash). Default: 1 where the compiler targets the Arm DSP
+ *  extension, else 0. */
+#ifndef LIDET_PNQ_WEIGHTS_PK
 #if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
-#define LIDET_PNQ_WEIGHTS_OI 1
+#define LIDET_PNQ_WEIGHTS_PK 1
 #else
-#define LIDET_PNQ_WEIGHTS_OI 0
+#define LIDET_PNQ_WEIGHTS_PK 0
 #endif
 #endif
-#if LIDET_PNQ_WEIGHTS_OI
-#define LIDET_PNQ_OI(a) (a)
+#if LIDET_PNQ_WEIGHTS_PK
+#define LIDET_PNQ_PK(a) (a)
 #else
-#define LIDET_PNQ_OI(a) 0
+#define LIDET_PNQ_PK(a) 0
 #endif
+/** The layout of the generated int8 layer tables (2: w_pk, from stop 29; 1 had an int8 [out][in] copy,
+ *  w_oi): the generated files refuse to compile against another. */
+#define LIDET_PNQ_LAYOUT_VERSION 2
 
 /** @brief One stage: points -> shared layers -> max; [g | p]; the one-hot folded into head[0]'s bias. */
 typedef struct

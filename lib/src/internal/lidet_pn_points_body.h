@@ -11,6 +11,8 @@
  *   PNB_DENSE(ly, in, nb, b, l) layer l on the block `in` (the loaded points when l == 0)
  *   PNB_STORE(ly, nb, b, dst)   write layer l's output (hidden layers) to dst, the next layer's input
  *   PNB_FOLD_MAX(ly, nb, b, l)  fold the last layer's output into the running maximum
+ *   PNB_FUSED(ly, in, nb, b, l, dst)  optional: the whole layer in one pass (DENSE and STORE to dst, or DENSE and
+ *                               FOLD_MAX when dst is NULL); nonzero when it did, 0 to take DENSE and STORE/FOLD_MAX
  * The float kernel writes its output in PNB_DENSE (STORE does nothing); the int8 one accumulates in int32
  * (DENSE), requantizes hidden layers (STORE) and takes the maximum on the accumulators (FOLD_MAX).
  * Not a public header; include nowhere else. */
@@ -27,14 +29,21 @@ static void PNB_FN(const PNB_LAYER_T *layers, uint32_t n_layers, const PNB_BUFS_
         for (l = 0; l < n_layers; ++l)
         {
             const PNB_LAYER_T *ly = &layers[l];
-            PNB_DENSE(ly, cur, nb, b, l);
-            if (l + 1u == n_layers)
+            const int last = l + 1u == n_layers;
+            if (!PNB_FUSED(ly, cur, nb, b, l, last ? 0 : b->act[l & 1u]))
             {
-                PNB_FOLD_MAX(ly, nb, b, l);
+                PNB_DENSE(ly, cur, nb, b, l);
+                if (last)
+                {
+                    PNB_FOLD_MAX(ly, nb, b, l);
+                }
+                else
+                {
+                    PNB_STORE(ly, nb, b, b->act[l & 1u]);
+                }
             }
-            else
+            if (!last)
             {
-                PNB_STORE(ly, nb, b, b->act[l & 1u]);
                 cur = b->act[l & 1u];
             }
         }

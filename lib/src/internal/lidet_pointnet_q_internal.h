@@ -34,10 +34,23 @@ void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, cons
                           const int32_t *b, uint32_t n_out, int32_t *acc);
 /* ln(S / 2^30) in Q16 for S >= 2^30 (the energies' log: S = m 2^e, log2 m from the table, interpolated) */
 int64_t lidet__pnq_ln_q16(int64_t sum);
-/* the DSP kernel on the weights [out][in] (w_oi, the generated models' second layout on cores with the DSP
- * extension); w_t ([in][out], the same weights) for the leftovers */
-void lidet__nn_acc_s8_oi(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_oi,
+/* the packed DSP kernel (the generated models' second layout on cores with the DSP extension,
+ * lidet_pointnet_q_layer_t.w_pk: the weights widened to int16, in the order the kernel reads them); w_t
+ * ([in][out], the same weights) for an odd last channel, and for everything when n_in is not a multiple of 4 */
+void lidet__nn_acc_s8_pk(const int8_t *in, uint32_t n_rows, uint32_t n_in, const uint32_t *w_pk,
                          const int8_t *w_t, const int32_t *b, uint32_t n_out, int32_t *acc);
+/* w_pk from w_t (n_in a multiple of 4; n_in * (n_out & ~1) / 2 words): for each pair of channels (c, c + 1)
+ * and group of 4 inputs i..i+3 the words (w[i][c], w[i+2][c]), (w[i][c+1], w[i+2][c+1]), (w[i+1][c],
+ * w[i+3][c]), (w[i+1][c+1], w[i+3][c+1]), each the first value in the low half (int16). codegen's quant.py
+ * (_pack_pk) writes the same words */
+void lidet__nn_pack_s8_pk(const int8_t *w_t, uint32_t n_in, uint32_t n_out, uint32_t *w_pk);
+/* a whole int8 x int8 layer with the packed weights in one pass, the sums never stored: requantized into out
+ * (lidet__nn_requant_s8's rule; vmax NULL), or folded into the running maximum vmax (lidet__nn_max_rows_s32;
+ * out NULL). Returns 0, touching nothing, where it does not apply (w_pk NULL, n_in not a multiple of 4 or above
+ * 64, n_out odd): the caller then takes lidet__nn_acc_s8_pk and the separate requantization or maximum */
+int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, const uint32_t *w_pk,
+                              const int32_t *b, uint32_t n_out, const int32_t *mult, const uint8_t *shift,
+                              int32_t zp, int32_t lo, int8_t *out, int32_t *vmax);
 /* the same with int16 inputs (the first layer: points in mm, voxel bins) */
 void lidet__nn_acc_s16(const int16_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
                        uint32_t n_out, int32_t *acc);

@@ -181,8 +181,7 @@ static inline uint32_t s8_load2(const int8_t *p)
 
 /* 2 x 2 (points x output channels) accumulators in registers; the first n_simd inputs (a multiple of 4) 4 at a
  * time with SMLAD (the DSP kernels below; 0 elsewhere: a constant, so the loop vanishes; inlined into each, so each
- * is compiled for its own case), the rest one at a time. w_oi (NULL or the same weights [out][in]) picks the
- * inner loop's layout, also a constant per caller. */
+ * is compiled for its own case), the rest one at a time. */
 #if defined(__GNUC__)
 #define S8_ALWAYS_INLINE static inline __attribute__((always_inline))
 #else
@@ -213,26 +212,8 @@ S8_ALWAYS_INLINE void step4_io(const int8_t *x0, const int8_t *x1, const int8_t 
     s[3] = S8_SMLAD(q13, h, s[3]);
 }
 
-/* The same on [out][in] weights (w0, w1: the two channels' rows): one word load brings 4 weights of a channel,
- * as 4 inputs of a point, and one SXTB16 (plain and rotated) widens either into the pairs (i, i + 2), (i + 1,
- * i + 3): 4 word loads, 8 SXTB16 and 8 SMLAD for 16 multiply-adds (the [in][out] step: 6 instructions more, the
- * halfword loads and their packing) */
-S8_ALWAYS_INLINE void step4_oi(const int8_t *x0, const int8_t *x1, const int8_t *w0, const int8_t *w1,
-                               int32_t *s)
-{
-    const uint32_t u0 = s8_load4(x0), u1 = s8_load4(x1), v0 = s8_load4(w0), v1 = s8_load4(w1);
-    const uint32_t p = S8_SXTB16(u0), q = S8_SXTB16(u1), h0 = S8_SXTB16(v0), h1 = S8_SXTB16(v1);
-    const uint32_t pr = S8_SXTB16_ROR8(u0), qr = S8_SXTB16_ROR8(u1);
-    const uint32_t h0r = S8_SXTB16_ROR8(v0), h1r = S8_SXTB16_ROR8(v1);
-    s[0] = S8_SMLAD(pr, h0r, S8_SMLAD(p, h0, s[0]));
-    s[1] = S8_SMLAD(pr, h1r, S8_SMLAD(p, h1, s[1]));
-    s[2] = S8_SMLAD(qr, h0r, S8_SMLAD(q, h0, s[2]));
-    s[3] = S8_SMLAD(qr, h1r, S8_SMLAD(q, h1, s[3]));
-}
-
 S8_ALWAYS_INLINE void acc_s8_2x2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                                 const int8_t *w_oi, const int32_t *b, uint32_t n_out, int32_t *acc,
-                                 uint32_t n_simd)
+                                 const int32_t *b, uint32_t n_out, int32_t *acc, uint32_t n_simd)
 {
     uint32_t r, i, o;
     for (r = 0; r + 2u <= n_rows; r += 2u)
@@ -241,42 +222,21 @@ S8_ALWAYS_INLINE void acc_s8_2x2(const int8_t *in, uint32_t n_rows, uint32_t n_i
         int32_t *a0 = acc + r * n_out, *a1 = a0 + n_out;
         for (o = 0; o + 2u <= n_out; o += 2u)
         {
+            const int8_t *w = w_t + o;
             int32_t s[4];
             s[0] = s[2] = b[o];
             s[1] = s[3] = b[o + 1u];
-            if (w_oi != 0)
+            for (i = 0; i < n_simd; i += 4u, w += 4u * n_out)
             {
-                const int8_t *w0 = w_oi + o * n_in, *w1 = w0 + n_in;
-                const int8_t *p0 = x0, *p1 = x1, *q0 = w0, *q1 = w1, *const end = x0 + n_simd;
-                /* four pointers stepped together (post-increment loads), one bound */
-                for (; p0 != end; p0 += 4, p1 += 4, q0 += 4, q1 += 4)
-                {
-                    step4_oi(p0, p1, q0, q1, s);
-                }
-                for (i = n_simd; i < n_in; ++i)
-                {
-                    const int32_t c0 = w0[i], c1 = w1[i], v0 = x0[i], v1 = x1[i];
-                    s[0] += v0 * c0;
-                    s[1] += v0 * c1;
-                    s[2] += v1 * c0;
-                    s[3] += v1 * c1;
-                }
+                step4_io(x0 + i, x1 + i, w, n_out, s);
             }
-            else
+            for (i = n_simd; i < n_in; ++i, w += n_out)
             {
-                const int8_t *w = w_t + o;
-                for (i = 0; i < n_simd; i += 4u, w += 4u * n_out)
-                {
-                    step4_io(x0 + i, x1 + i, w, n_out, s);
-                }
-                for (i = n_simd; i < n_in; ++i, w += n_out)
-                {
-                    const int32_t w0 = w[0], w1 = w[1], v0 = x0[i], v1 = x1[i];
-                    s[0] += v0 * w0;
-                    s[1] += v0 * w1;
-                    s[2] += v1 * w0;
-                    s[3] += v1 * w1;
-                }
+                const int32_t w0 = w[0], w1 = w[1], v0 = x0[i], v1 = x1[i];
+                s[0] += v0 * w0;
+                s[1] += v0 * w1;
+                s[2] += v1 * w0;
+                s[3] += v1 * w1;
             }
             a0[o] = s[0];
             a0[o + 1u] = s[1];
@@ -297,21 +257,222 @@ S8_ALWAYS_INLINE void acc_s8_2x2(const int8_t *in, uint32_t n_rows, uint32_t n_i
 void lidet__nn_acc_s8_r2o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, int32_t *acc)
 {
-    acc_s8_2x2(in, n_rows, n_in, w_t, 0, b, n_out, acc, 0u);
+    acc_s8_2x2(in, n_rows, n_in, w_t, b, n_out, acc, 0u);
 }
 
 void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                           const int32_t *b, uint32_t n_out, int32_t *acc)
 {
-    acc_s8_2x2(in, n_rows, n_in, w_t, 0, b, n_out, acc, n_in & ~3u);
+    acc_s8_2x2(in, n_rows, n_in, w_t, b, n_out, acc, n_in & ~3u);
 }
 
-/* The DSP kernel on the weights' second layout, [out][in] (lidet_pointnet_q_layer_t.w_oi; step4_oi); the
- * leftovers (n_in not a multiple of 4, an odd last channel or row) take w_t */
-void lidet__nn_acc_s8_oi(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_oi,
+/* The packed DSP kernel: the weights widened to int16 and ordered as the loop reads them
+ * (lidet_pointnet_q_layer_t.w_pk, lidet__nn_pack_s8_pk), two points' inputs widened once per pass into a
+ * stack buffer. Per 4 inputs of a pair of points and a pair of channels: 4 words of inputs, 4 of weights and 8
+ * SMLAD; no SXTB16 in the inner loop (the [out][in] int8 layout of stop 28 widened inputs and weights there:
+ * 23 instructions per 16 multiply-adds on a Cortex-M4, against about 14 here). */
+#define PK_CHUNK_GROUPS 16u /* 64 inputs per pass: 256 bytes of widened inputs on the stack */
+
+/* groups g0..g0+n_g of points x0 and x1 (x1 NULL: one point, [A, B] per group; else [A0, A1, B0, B1]),
+ * A = (x_i, x_i+2), B = (x_i+1, x_i+3) as SXTB16 widens them */
+static void pk_widen(const int8_t *x0, const int8_t *x1, uint32_t n_g, uint32_t *xw)
+{
+    uint32_t g;
+    for (g = 0; g < n_g; ++g)
+    {
+        const uint32_t u = s8_load4(x0 + 4u * g);
+        if (x1 == 0)
+        {
+            xw[2u * g] = S8_SXTB16(u);
+            xw[2u * g + 1u] = S8_SXTB16_ROR8(u);
+        }
+        else
+        {
+            const uint32_t v = s8_load4(x1 + 4u * g);
+            xw[4u * g] = S8_SXTB16(u);
+            xw[4u * g + 1u] = S8_SXTB16(v);
+            xw[4u * g + 2u] = S8_SXTB16_ROR8(u);
+            xw[4u * g + 3u] = S8_SXTB16_ROR8(v);
+        }
+    }
+}
+
+/* s[0..3] (point 0 channel 0, point 0 channel 1, point 1 channel 0, point 1 channel 1) += n_g >= 1 groups;
+ * returns w past them. On the DSP cores in assembly: GCC neither pairs the loads into LDRD nor keeps the four
+ * sums in registers across the loop's back edge without copies (19 instructions per group, 13 here) */
+S8_ALWAYS_INLINE const uint32_t *pk_pair(const uint32_t *xw, uint32_t n_g, const uint32_t *w, int32_t *s)
+{
+    int32_t s00 = s[0], s01 = s[1], s10 = s[2], s11 = s[3];
+    const uint32_t *const end = xw + 4u * n_g;
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && defined(__GNUC__) && !defined(LIDET_NN_PK_NO_ASM)
+    uint32_t a0, a1, c0, c1;
+    __asm__ volatile("1:\n\t"
+                     "ldrd %[a0], %[a1], [%[x]], #8\n\t"
+                     "ldrd %[c0], %[c1], [%[w]], #8\n\t"
+                     "smlad %[s00], %[a0], %[c0], %[s00]\n\t"
+                     "smlad %[s01], %[a0], %[c1], %[s01]\n\t"
+                     "smlad %[s10], %[a1], %[c0], %[s10]\n\t"
+                     "smlad %[s11], %[a1], %[c1], %[s11]\n\t"
+                     "ldrd %[a0], %[a1], [%[x]], #8\n\t"
+                     "ldrd %[c0], %[c1], [%[w]], #8\n\t"
+                     "smlad %[s00], %[a0], %[c0], %[s00]\n\t"
+                     "smlad %[s01], %[a0], %[c1], %[s01]\n\t"
+                     "smlad %[s10], %[a1], %[c0], %[s10]\n\t"
+                     "smlad %[s11], %[a1], %[c1], %[s11]\n\t"
+                     "cmp %[x], %[end]\n\t"
+                     "bne 1b\n\t"
+                     : [s00] "+r"(s00), [s01] "+r"(s01), [s10] "+r"(s10), [s11] "+r"(s11), [x] "+r"(xw),
+                       [w] "+r"(w), [a0] "=&r"(a0), [a1] "=&r"(a1), [c0] "=&r"(c0), [c1] "=&r"(c1)
+                     : [end] "r"(end)
+                     : "cc", "memory");
+#else
+    do
+    {
+        const uint32_t a0 = xw[0], a1 = xw[1], c0 = w[0], c1 = w[1];
+        const uint32_t b0 = xw[2], b1 = xw[3], d0 = w[2], d1 = w[3];
+        s00 = S8_SMLAD(a0, c0, s00);
+        s01 = S8_SMLAD(a0, c1, s01);
+        s10 = S8_SMLAD(a1, c0, s10);
+        s11 = S8_SMLAD(a1, c1, s11);
+        s00 = S8_SMLAD(b0, d0, s00);
+        s01 = S8_SMLAD(b0, d1, s01);
+        s10 = S8_SMLAD(b1, d0, s10);
+        s11 = S8_SMLAD(b1, d1, s11);
+        xw += 4;
+        w += 4;
+    } while (xw != end);
+#endif
+    s[0] = s00;
+    s[1] = s01;
+    s[2] = s10;
+    s[3] = s11;
+    return w;
+}
+
+/* one point: s[0], s[1] (channels 0, 1) += n_g >= 1 groups; returns w past them */
+S8_ALWAYS_INLINE const uint32_t *pk_one(const uint32_t *xw, uint32_t n_g, const uint32_t *w, int32_t *s)
+{
+    int32_t s0 = s[0], s1 = s[1];
+    const uint32_t *const end = xw + 2u * n_g;
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && defined(__GNUC__) && !defined(LIDET_NN_PK_NO_ASM)
+    uint32_t a, b, c0, c1;
+    __asm__ volatile("1:\n\t"
+                     "ldrd %[a], %[b], [%[x]], #8\n\t"
+                     "ldrd %[c0], %[c1], [%[w]], #8\n\t"
+                     "smlad %[s0], %[a], %[c0], %[s0]\n\t"
+                     "smlad %[s1], %[a], %[c1], %[s1]\n\t"
+                     "ldrd %[c0], %[c1], [%[w]], #8\n\t"
+                     "smlad %[s0], %[b], %[c0], %[s0]\n\t"
+                     "smlad %[s1], %[b], %[c1], %[s1]\n\t"
+                     "cmp %[x], %[end]\n\t"
+                     "bne 1b\n\t"
+                     : [s0] "+r"(s0), [s1] "+r"(s1), [x] "+r"(xw), [w] "+r"(w), [a] "=&r"(a), [b] "=&r"(b),
+                       [c0] "=&r"(c0), [c1] "=&r"(c1)
+                     : [end] "r"(end)
+                     : "cc", "memory");
+#else
+    do
+    {
+        const uint32_t a = xw[0], b = xw[1];
+        s0 = S8_SMLAD(a, w[0], s0);
+        s1 = S8_SMLAD(a, w[1], s1);
+        s0 = S8_SMLAD(b, w[2], s0);
+        s1 = S8_SMLAD(b, w[3], s1);
+        xw += 2;
+        w += 4;
+    } while (xw != end);
+#endif
+    s[0] = s0;
+    s[1] = s1;
+    return w;
+}
+
+/* the channel pairs of one pass (ng groups from group g0 of n_g; first: the sums start from the bias, else
+ * from a0 / a1) for two points (a1 != NULL) or one */
+static void pk_pass(const uint32_t *xw, uint32_t ng, uint32_t n_g, uint32_t g0, const uint32_t *w_pk,
+                    const int32_t *b, uint32_t n_pairs, int32_t *a0, int32_t *a1)
+{
+    const uint32_t skip = 4u * (n_g - ng); /* to the next channel pair's words of this pass */
+    const int32_t *i0 = g0 == 0u ? b : a0, *i1 = g0 == 0u ? b : a1;
+    const uint32_t *w = w_pk + 4u * g0;
+    uint32_t o;
+    if (a1 != 0)
+    {
+        for (o = 0; o < 2u * n_pairs; o += 2u)
+        {
+            int32_t s[4];
+            s[0] = i0[o];
+            s[1] = i0[o + 1u];
+            s[2] = i1[o];
+            s[3] = i1[o + 1u];
+            w = pk_pair(xw, ng, w, s) + skip;
+            a0[o] = s[0];
+            a0[o + 1u] = s[1];
+            a1[o] = s[2];
+            a1[o + 1u] = s[3];
+        }
+    }
+    else
+    {
+        for (o = 0; o < 2u * n_pairs; o += 2u)
+        {
+            int32_t s[2];
+            s[0] = i0[o];
+            s[1] = i0[o + 1u];
+            w = pk_one(xw, ng, w, s) + skip;
+            a0[o] = s[0];
+            a0[o + 1u] = s[1];
+        }
+    }
+}
+
+void lidet__nn_pack_s8_pk(const int8_t *w_t, uint32_t n_in, uint32_t n_out, uint32_t *w_pk)
+{
+    const uint32_t n_g = n_in / 4u;
+    uint32_t c, g, k;
+    for (c = 0; c + 1u < n_out; c += 2u)
+    {
+        for (g = 0; g < n_g; ++g)
+        {
+            for (k = 0; k < 4u; ++k) /* c0 A, c1 A, c0 B, c1 B */
+            {
+                const uint32_t o = c + (k & 1u), i = 4u * g + (k >> 1);
+                const uint32_t lo = (uint32_t)(uint16_t)(int16_t)w_t[i * n_out + o];
+                const uint32_t hi = (uint32_t)(uint16_t)(int16_t)w_t[(i + 2u) * n_out + o];
+                *w_pk++ = lo | (hi << 16);
+            }
+        }
+    }
+}
+
+void lidet__nn_acc_s8_pk(const int8_t *in, uint32_t n_rows, uint32_t n_in, const uint32_t *w_pk,
                          const int8_t *w_t, const int32_t *b, uint32_t n_out, int32_t *acc)
 {
-    acc_s8_2x2(in, n_rows, n_in, w_t, w_oi, b, n_out, acc, n_in & ~3u);
+    uint32_t xw[4u * PK_CHUNK_GROUPS];
+    const uint32_t n_g = n_in / 4u, n_pairs = n_out / 2u;
+    uint32_t r, g0;
+    if (n_in % 4u != 0u || n_in == 0u || n_pairs == 0u)
+    {
+        lidet__nn_acc_s8(in, n_rows, n_in, w_t, b, n_out, acc);
+        return;
+    }
+    for (r = 0; r < n_rows; r += 2u)
+    {
+        const int two = r + 1u < n_rows;
+        const int8_t *x0 = in + r * n_in;
+        int32_t *a0 = acc + r * n_out;
+        for (g0 = 0; g0 < n_g; g0 += PK_CHUNK_GROUPS)
+        {
+            const uint32_t ng = n_g - g0 < PK_CHUNK_GROUPS ? n_g - g0 : PK_CHUNK_GROUPS;
+            pk_widen(x0 + 4u * g0, two ? x0 + n_in + 4u * g0 : 0, ng, xw);
+            pk_pass(xw, ng, n_g, g0, w_pk, b, n_pairs, a0, two ? a0 + n_out : 0);
+        }
+        if (n_out & 1u) /* an odd last channel: the [in][out] weights */
+        {
+            lidet__nn_acc_s8_cols(x0, two ? 2u : 1u, n_in, w_t + n_out - 1u, b + n_out - 1u, 1u, n_out,
+                                  a0 + n_out - 1u, n_out);
+        }
+    }
 }
 
 void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
@@ -538,4 +699,75 @@ LIDET_NN_KERNEL void lidet__nn_max_rows_s32(const int32_t *acc, uint32_t n_rows,
             vmax[o] = a[o] > vmax[o] ? a[o] : vmax[o];
         }
     }
+}
+
+/* one value of lidet__nn_requant_s8 (the same rule and fast path as lidet__nn_requant_s8_by_channel) */
+S8_ALWAYS_INLINE int8_t rq_one(int32_t a, int32_t m, uint32_t s, int32_t zp, int32_t lo)
+{
+    if (s > 32u)
+    {
+        const uint32_t k = s - 32u;
+        const int32_t hi = (int32_t)(((int64_t)a * m) >> 32);
+        return clamp_s8(((hi + ((int32_t)1 << (k - 1u))) >> k) + zp, lo);
+    }
+    {
+        int64_t v = requant_round(a, m, s) + zp;
+        v = v < lo ? lo : (v > 127 ? 127 : v);
+        return (int8_t)v;
+    }
+}
+
+int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, const uint32_t *w_pk,
+                              const int32_t *b, uint32_t n_out, const int32_t *mult, const uint8_t *shift,
+                              int32_t zp, int32_t lo, int8_t *out, int32_t *vmax)
+{
+    uint32_t xw[4u * PK_CHUNK_GROUPS];
+    const uint32_t n_g = n_in / 4u;
+    uint32_t r, o;
+    if (w_pk == 0 || n_in % 4u != 0u || n_g == 0u || n_g > PK_CHUNK_GROUPS || n_out % 2u != 0u ||
+        n_out == 0u || (out == 0) == (vmax == 0))
+    {
+        return 0;
+    }
+    for (r = 0; r < n_rows; r += 2u)
+    {
+        const int two = r + 1u < n_rows;
+        const int8_t *x0 = in + r * n_in;
+        const uint32_t *w = w_pk;
+        int8_t *d = out != 0 ? out + r * n_out : 0;
+        pk_widen(x0, two ? x0 + n_in : 0, n_g, xw);
+        for (o = 0; o < n_out; o += 2u)
+        {
+            int32_t s[4];
+            s[0] = s[2] = b[o];
+            s[1] = s[3] = b[o + 1u];
+            w = two ? pk_pair(xw, n_g, w, s) : pk_one(xw, n_g, w, s);
+            if (d != 0)
+            {
+                const int32_t m0 = mult[o], m1 = mult[o + 1u];
+                const uint32_t h0 = shift[o], h1 = shift[o + 1u];
+                d[o] = rq_one(s[0], m0, h0, zp, lo);
+                d[o + 1u] = rq_one(s[1], m1, h1, zp, lo);
+                if (two)
+                {
+                    d[n_out + o] = rq_one(s[2], m0, h0, zp, lo);
+                    d[n_out + o + 1u] = rq_one(s[3], m1, h1, zp, lo);
+                }
+            }
+            else
+            {
+                int32_t v0 = vmax[o], v1 = vmax[o + 1u];
+                v0 = s[0] > v0 ? s[0] : v0;
+                v1 = s[1] > v1 ? s[1] : v1;
+                if (two)
+                {
+                    v0 = s[2] > v0 ? s[2] : v0;
+                    v1 = s[3] > v1 ? s[3] : v1;
+                }
+                vmax[o] = v0;
+                vmax[o + 1u] = v1;
+            }
+        }
+    }
+    return 1;
 }

@@ -7,6 +7,9 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "fuzz_box64_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
+#error "fuzz_box64_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#endif
 
 /* tnet.point[0] weights [3][8] int8 (per-channel scale) */
 LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_box64_s8_tnet_point0_w[24] = {
@@ -70,6 +73,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_box64_s8_tnet_head0_m[8] 
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box64_s8_tnet_head0_s[8] = {
     38, 37, 38, 38, 38, 37, 37, 37
 };
+#if LIDET_PNQ_WEIGHTS_PK
+/* tnet.head[0] weights int16 pairs packed for the DSP kernel, the same as _w */
+LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_box64_s8_tnet_head0_wpk[48] = {
+    3276779u, 589853u, 3932216u, 4294115347u, 3604497u, 458777u, 4291821615u, 4293328941u, 4286644241u, 4287823790u, 7078000u, 8323110u, 655366u, 1507295u, 4290510884u, 4291887129u,
+    4294508586u, 4718537u, 2818006u, 786361u, 7995519u, 4286906495u, 1769495u, 4784239u, 524363u, 327693u, 1376247u, 3473359u, 6487974u, 2228273u, 4288282554u, 4292280293u,
+    4286709728u, 4286709654u, 6946835u, 4587471u, 4294705103u, 4291756061u, 1638378u, 3801071u, 2949135u, 4292083694u, 65553u, 4292476905u, 8388494u, 4287102849u, 5636183u, 7471085u
+};
+#endif
 /* tnet.head[1] weights [8][3] int8 (per-channel scale) */
 LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_box64_s8_tnet_head1_w[24] = {
     85, -48, -29, -14, -107, -65, 34, -15, -6, -20, 127, -127, -120, -35, 5, 41,
@@ -87,9 +98,15 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_box64_s8_tnet_head1_m[3] 
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box64_s8_tnet_head1_s[3] = {
     31, 30, 31
 };
+#if LIDET_PNQ_WEIGHTS_PK
+/* tnet.head[1] weights int16 pairs packed for the DSP kernel, the same as _w */
+LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_box64_s8_tnet_head1_wpk[8] = {
+    2228309u, 4294049744u, 4293722098u, 8388501u, 8388488u, 5898205u, 4293001257u, 4288020441u
+};
+#endif
 static const lidet_pointnet_q_layer_t fuzz_box64_s8_tnet_head[2] = {
-    {12u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_tnet_head0_w, fuzz_box64_s8_tnet_head0_b, fuzz_box64_s8_tnet_head0_m, fuzz_box64_s8_tnet_head0_s, 0},
-    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box64_s8_tnet_head1_w, fuzz_box64_s8_tnet_head1_b, fuzz_box64_s8_tnet_head1_m, fuzz_box64_s8_tnet_head1_s, 0}
+    {12u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_tnet_head0_w, fuzz_box64_s8_tnet_head0_b, fuzz_box64_s8_tnet_head0_m, fuzz_box64_s8_tnet_head0_s, LIDET_PNQ_PK(fuzz_box64_s8_tnet_head0_wpk)},
+    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box64_s8_tnet_head1_w, fuzz_box64_s8_tnet_head1_b, fuzz_box64_s8_tnet_head1_m, fuzz_box64_s8_tnet_head1_s, LIDET_PNQ_PK(fuzz_box64_s8_tnet_head1_wpk)}
 };
 
 /* tnet: class one-hot folded into head[0], [class][out] int32 */
@@ -137,22 +154,18 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_box64_s8_box_point1_m[16]
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box64_s8_box_point1_s[16] = {
     38, 38, 38, 38, 38, 38, 39, 38, 39, 39, 38, 38, 38, 38, 39, 38
 };
-#if LIDET_PNQ_WEIGHTS_OI
-/* box.point[1] weights [16][8] int8, the same as _w in [out][in] order */
-LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_box64_s8_box_point1_woi[128] = {
-    -127, -56, 92, 45, 21, -112, -125, -116, 0, -18, -72, 123, -127, -122, -114, -64,
-    9, -39, 10, 102, -101, -61, 127, -29, -46, 84, 118, -42, -96, 127, 108, 49,
-    19, -15, -72, -117, 127, 45, 118, 117, -120, 46, -94, 85, 124, 127, 97, 37,
-    -47, 55, -94, -2, 95, -127, 29, 127, 54, 53, 45, -72, 78, 85, -29, -127,
-    -13, 96, 12, 95, -85, -97, -127, -121, 5, -89, -113, -47, 37, -89, 22, -127,
-    65, -79, 127, 118, -91, -113, 125, -53, -28, -23, 88, -127, -69, -118, 36, -94,
-    111, 127, -114, 68, -102, -101, -8, -69, 51, 79, -24, -16, 127, 111, -27, -20,
-    10, 52, 24, -127, -57, -60, -66, 9, -43, -102, -124, -119, 86, 127, 70, 114
+#if LIDET_PNQ_WEIGHTS_PK
+/* box.point[1] weights int16 pairs packed for the DSP kernel, the same as _w */
+LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_box64_s8_box_point1_wpk[64] = {
+    6094721u, 4290248704u, 3014600u, 8126446u, 4286775317u, 4287561601u, 4287430544u, 4290838406u, 655369u, 7798738u, 6750169u, 4292214868u, 8388507u, 7143328u, 4293132227u, 3211391u,
+    4290248723u, 4288872328u, 4287365105u, 5570606u, 7733375u, 6357116u, 7667757u, 2424959u, 4288872401u, 2949174u, 4294836279u, 4290248757u, 1900639u, 4293066830u, 8388481u, 4286644309u,
+    851955u, 4287561733u, 6226016u, 4291952551u, 4286709675u, 1441829u, 4287102879u, 4286709671u, 8323137u, 5832676u, 7798705u, 4286709737u, 8257445u, 2424763u, 4291559311u, 4288872330u,
+    4287496303u, 4293394483u, 4456575u, 4293918799u, 4294508442u, 4293197951u, 4290510747u, 4293656687u, 1572874u, 4286906325u, 4286644276u, 4287233946u, 4290707399u, 4587606u, 655300u, 7471231u
 };
 #endif
 static const lidet_pointnet_q_layer_t fuzz_box64_s8_box_point[2] = {
     {3u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_point0_w, fuzz_box64_s8_box_point0_b, fuzz_box64_s8_box_point0_m, fuzz_box64_s8_box_point0_s, 0},
-    {8u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_point1_w, fuzz_box64_s8_box_point1_b, fuzz_box64_s8_box_point1_m, fuzz_box64_s8_box_point1_s, LIDET_PNQ_OI(fuzz_box64_s8_box_point1_woi)}
+    {8u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_point1_w, fuzz_box64_s8_box_point1_b, fuzz_box64_s8_box_point1_m, fuzz_box64_s8_box_point1_s, LIDET_PNQ_PK(fuzz_box64_s8_box_point1_wpk)}
 };
 
 /* box.pvle[0] weights [3][4] int8 (per-channel scale) */
@@ -200,6 +213,16 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_box64_s8_box_head0_m[8] =
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box64_s8_box_head0_s[8] = {
     37, 37, 38, 38, 37, 37, 37, 37
 };
+#if LIDET_PNQ_WEIGHTS_PK
+/* box.head[0] weights int16 pairs packed for the DSP kernel, the same as _w */
+LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_box64_s8_box_head0_wpk[80] = {
+    4293853211u, 655326u, 1507356u, 4292083690u, 4294311958u, 4294770657u, 4293787615u, 4294836219u, 4294115333u, 4293197815u, 1441769u, 2097156u, 4294049818u, 1441824u, 2097115u, 655334u,
+    8323106u, 8323072u, 4288020584u, 4286709704u, 1048518u, 3997684u, 1179669u, 262077u, 1769494u, 458789u, 4292083739u, 2228216u, 4293066782u, 4291625005u, 917541u, 4292149246u,
+    196649u, 16u, 4292935702u, 3932151u, 3669889u, 4290314228u, 4287692875u, 5046145u, 589799u, 2555864u, 1572895u, 1900519u, 393205u, 4292149280u, 4294770716u, 1703893u,
+    4293853199u, 1572871u, 4293525475u, 4294311901u, 1179630u, 2555903u, 4293328874u, 3211270u, 8323127u, 4286644308u, 4294443058u, 4456515u, 1507318u, 1900507u, 4293722089u, 4292214744u,
+    1376235u, 1507337u, 2359279u, 4293591003u, 1441813u, 4294115309u, 393198u, 1245227u, 1638436u, 2621463u, 1376267u, 1900580u, 5701759u, 4915174u, 4294573959u, 1113985u
+};
+#endif
 /* box.head[1] weights [8][39] int8 (per-channel scale) */
 LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_box64_s8_box_head1_w[312] = {
     -24, -46, 127, 63, 30, -9, 118, 127, 80, 31, -103, -32, 37, 53, -83, -126,
@@ -241,9 +264,24 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box64_s8_box_head1_s[39] 
     31, 31, 31, 32, 31, 31, 31, 31, 31, 31, 31, 31, 32, 31, 31, 31,
     31, 31, 31, 31, 32, 31, 31
 };
+#if LIDET_PNQ_WEIGHTS_PK
+/* box.head[1] weights int16 pairs packed for the DSP kernel, the same as _w */
+LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_box64_s8_box_head1_wpk[152] = {
+    4194280u, 1834962u, 4290969660u, 5832825u, 4291035080u, 4522030u, 4294311809u, 8323154u, 4291821695u, 5570623u, 6094932u, 4292608015u, 6488052u, 8323158u, 4288872463u, 4391008u,
+    4849694u, 4291887095u, 4287430744u, 4286644231u, 4288741249u, 7208842u, 4294180976u, 4288479181u, 4294049910u, 4290904191u, 4293656639u, 4288020457u, 4294770561u, 4290641968u, 1310803u, 4288610428u,
+    4293525584u, 4286644255u, 7733350u, 4294574104u, 3997690u, 655265u, 4294967169u, 4287103031u, 4063129u, 2228192u, 4293984135u, 4289724475u, 3997569u, 4286644278u, 4292542485u, 2883565u,
+    4291624997u, 4292608053u, 4290838655u, 4294246344u, 1245150u, 4292411467u, 4290510787u, 4286709696u, 4291755949u, 4290248578u, 4286644232u, 7340151u, 4292673483u, 2293633u, 4294049914u, 4293001314u,
+    4287365072u, 4294508488u, 4849551u, 4293197697u, 4294967177u, 7405463u, 4286709693u, 4288217089u, 1245311u, 4287233960u, 4291166275u, 4784180u, 4287692712u, 8388570u, 4289331151u, 4259910u,
+    4289527699u, 6225984u, 5505042u, 4289855456u, 8388571u, 4286644345u, 4292739130u, 4292607956u, 3473281u, 4291231617u, 4292804675u, 3080172u, 1376183u, 4289200216u, 1179707u, 65652u,
+    4259713u, 4521932u, 7471153u, 7209000u, 7798660u, 6815617u, 1834996u, 4286709732u, 852090u, 4290445366u, 3538830u, 4293984383u, 4286644254u, 4290314317u, 4291821469u, 3211194u,
+    4292149274u, 7274623u, 4288741417u, 4286709691u, 4292477038u, 4290117631u, 786559u, 4294639688u, 8388524u, 2162781u, 1572804u, 4287496136u, 4289724304u, 4286709649u, 4287692705u, 7208941u,
+    4293263466u, 2818142u, 4653032u, 3473387u, 4286709725u, 4390939u, 4289068954u, 4293132161u, 4292476995u, 4293918847u, 5570571u, 3670126u, 4290379883u, 4288086052u, 7667585u, 1703994u,
+    1376262u, 3539030u, 7536673u, 4287954928u, 4286644245u, 8388511u, 1769536u, 4290052099u
+};
+#endif
 static const lidet_pointnet_q_layer_t fuzz_box64_s8_box_head[2] = {
-    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_head0_w, fuzz_box64_s8_box_head0_b, fuzz_box64_s8_box_head0_m, fuzz_box64_s8_box_head0_s, 0},
-    {8u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box64_s8_box_head1_w, fuzz_box64_s8_box_head1_b, fuzz_box64_s8_box_head1_m, fuzz_box64_s8_box_head1_s, 0}
+    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_head0_w, fuzz_box64_s8_box_head0_b, fuzz_box64_s8_box_head0_m, fuzz_box64_s8_box_head0_s, LIDET_PNQ_PK(fuzz_box64_s8_box_head0_wpk)},
+    {8u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box64_s8_box_head1_w, fuzz_box64_s8_box_head1_b, fuzz_box64_s8_box_head1_m, fuzz_box64_s8_box_head1_s, LIDET_PNQ_PK(fuzz_box64_s8_box_head1_wpk)}
 };
 
 /* box: class one-hot folded into head[0], [class][out] int32 */

@@ -7,6 +7,9 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "fuzz_cls16_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
+#error "fuzz_cls16_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#endif
 
 /* cls.point[0] weights [3][8] int8 (per-channel scale) */
 LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls16_s8_cls_point0_w[24] = {
@@ -48,22 +51,18 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_cls16_s8_cls_point1_m[16]
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_cls16_s8_cls_point1_s[16] = {
     37, 36, 38, 36, 38, 38, 36, 38, 39, 36, 38, 37, 38, 38, 38, 36
 };
-#if LIDET_PNQ_WEIGHTS_OI
-/* cls.point[1] weights [16][8] int8, the same as _w in [out][in] order */
-LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls16_s8_cls_point1_woi[128] = {
-    -102, -22, 76, -127, 84, -82, -29, -14, -111, 66, -6, -127, -65, 24, 61, -88,
-    66, -85, -3, 127, -14, -75, -13, 80, -77, 3, 51, -1, 44, -95, -127, -41,
-    74, 29, -51, 39, -11, 27, 127, -78, 30, 35, 7, -76, -13, -34, 127, 88,
-    -78, -68, -32, -83, 73, 127, 101, -10, -127, 3, -25, 1, -26, -9, 73, 76,
-    127, -29, 50, 76, 27, 99, 12, -11, -92, -12, 29, -86, 14, -29, -127, -12,
-    -66, 53, -41, 127, 43, 114, -1, -3, -127, 20, 48, -10, -2, -7, 76, -51,
-    -7, 13, 41, 127, -72, 26, 41, -48, -25, -11, -52, -80, -3, 58, 127, 11,
-    -127, -20, 18, 33, 12, -48, 40, 94, -127, -18, -55, -57, 71, 56, -11, -4
+#if LIDET_PNQ_WEIGHTS_PK
+/* cls.point[1] weights int16 pairs packed for the DSP kernel, the same as _w */
+LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_cls16_s8_cls_point1_wpk[64] = {
+    5046170u, 4294639505u, 4286709738u, 4286644290u, 4293066836u, 4063167u, 4294115246u, 4289200152u, 4294770754u, 3407795u, 8388523u, 4294901763u, 4294180850u, 4286644268u, 5308341u, 4292345761u,
+    4291625034u, 458782u, 2555933u, 4289986595u, 8388597u, 8388595u, 4289855515u, 5832670u, 4292935602u, 4293394305u, 4289593276u, 65539u, 6619209u, 4849638u, 4294312063u, 5046263u,
+    3276927u, 1965988u, 5046243u, 4289396724u, 786459u, 4286644238u, 4294246499u, 4294246371u, 4292345790u, 3211137u, 8323125u, 4294311956u, 4294901803u, 5046270u, 4294770802u, 4291690489u,
+    2752505u, 4291624935u, 8323085u, 4289789941u, 2752440u, 8388605u, 4291821594u, 720954u, 1245057u, 4291428225u, 2228204u, 4291297262u, 2621452u, 4294246471u, 6225872u, 4294705208u
 };
 #endif
 static const lidet_pointnet_q_layer_t fuzz_cls16_s8_cls_point[2] = {
     {3u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls16_s8_cls_point0_w, fuzz_cls16_s8_cls_point0_b, fuzz_cls16_s8_cls_point0_m, fuzz_cls16_s8_cls_point0_s, 0},
-    {8u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls16_s8_cls_point1_w, fuzz_cls16_s8_cls_point1_b, fuzz_cls16_s8_cls_point1_m, fuzz_cls16_s8_cls_point1_s, LIDET_PNQ_OI(fuzz_cls16_s8_cls_point1_woi)}
+    {8u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls16_s8_cls_point1_w, fuzz_cls16_s8_cls_point1_b, fuzz_cls16_s8_cls_point1_m, fuzz_cls16_s8_cls_point1_s, LIDET_PNQ_PK(fuzz_cls16_s8_cls_point1_wpk)}
 };
 
 /* cls.pvle[0] weights [3][4] int8 (per-channel scale) */
@@ -111,6 +110,16 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_cls16_s8_cls_head0_m[8] =
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_cls16_s8_cls_head0_s[8] = {
     37, 37, 36, 37, 35, 32, 39, 38
 };
+#if LIDET_PNQ_WEIGHTS_PK
+/* cls.head[0] weights int16 pairs packed for the DSP kernel, the same as _w */
+LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_cls16_s8_cls_head0_wpk[80] = {
+    4294901763u, 1769456u, 131071u, 4294377481u, 4294770704u, 131154u, 4292673511u, 2359330u, 1441786u, 4292411364u, 393215u, 4293591050u, 4294377458u, 4292608042u, 4294901784u, 196567u,
+    4293787606u, 4292739074u, 3080319u, 5570687u, 4293787653u, 1179651u, 851969u, 4294508549u, 4294442983u, 196621u, 4294115329u, 4294836203u, 4292542535u, 131042u, 4294901775u, 720905u,
+    4294639596u, 1245182u, 65506u, 4294901728u, 4286709731u, 4292935671u, 1376232u, 4291494015u, 4293001208u, 917502u, 196609u, 196611u, 458773u, 458719u, 1572796u, 589822u,
+    851958u, 4294311957u, 458767u, 4294508540u, 4294180909u, 720900u, 196629u, 4294836240u, 393219u, 4294901786u, 4287954817u, 4293721985u, 327703u, 4294311933u, 393217u, 327672u,
+    589856u, 4294836215u, 4294377481u, 3211226u, 2031506u, 655303u, 4293001200u, 4294508545u, 4294377426u, 4292476902u, 4294770703u, 4294705181u, 8323175u, 2490365u, 5373926u, 4291559551u
+};
+#endif
 /* cls.head[1] weights [8][3] int8 (per-channel scale) */
 LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls16_s8_cls_head1_w[24] = {
     -127, -1, 2, -13, 84, 82, 23, 30, -13, -45, 71, 51, 8, -14, 9, -2,
@@ -128,9 +137,15 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_cls16_s8_cls_head1_m[3] =
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_cls16_s8_cls_head1_s[3] = {
     31, 31, 32
 };
+#if LIDET_PNQ_WEIGHTS_PK
+/* cls.head[1] weights int16 pairs packed for the DSP kernel, the same as _w */
+LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_cls16_s8_cls_head1_wpk[8] = {
+    1572737u, 2031615u, 4292083699u, 4653140u, 4291952648u, 4286709746u, 7929854u, 6946810u
+};
+#endif
 static const lidet_pointnet_q_layer_t fuzz_cls16_s8_cls_head[2] = {
-    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls16_s8_cls_head0_w, fuzz_cls16_s8_cls_head0_b, fuzz_cls16_s8_cls_head0_m, fuzz_cls16_s8_cls_head0_s, 0},
-    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_cls16_s8_cls_head1_w, fuzz_cls16_s8_cls_head1_b, fuzz_cls16_s8_cls_head1_m, fuzz_cls16_s8_cls_head1_s, 0}
+    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls16_s8_cls_head0_w, fuzz_cls16_s8_cls_head0_b, fuzz_cls16_s8_cls_head0_m, fuzz_cls16_s8_cls_head0_s, LIDET_PNQ_PK(fuzz_cls16_s8_cls_head0_wpk)},
+    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_cls16_s8_cls_head1_w, fuzz_cls16_s8_cls_head1_b, fuzz_cls16_s8_cls_head1_m, fuzz_cls16_s8_cls_head1_s, LIDET_PNQ_PK(fuzz_cls16_s8_cls_head1_wpk)}
 };
 
 const lidet_pointnet_q_model_t lidet_model_fuzz_cls16_s8 = {

@@ -7,6 +7,9 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "fuzz_cls64_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
+#error "fuzz_cls64_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#endif
 
 /* cls.point[0] weights [3][8] int8 (per-channel scale) */
 LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls64_s8_cls_point0_w[24] = {
@@ -48,22 +51,18 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_cls64_s8_cls_point1_m[16]
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_cls64_s8_cls_point1_s[16] = {
     37, 36, 39, 36, 38, 38, 36, 38, 39, 36, 38, 37, 38, 38, 38, 36
 };
-#if LIDET_PNQ_WEIGHTS_OI
-/* cls.point[1] weights [16][8] int8, the same as _w in [out][in] order */
-LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls64_s8_cls_point1_woi[128] = {
-    -101, -21, 79, -127, 83, -82, -29, -14, -110, 63, -6, -127, -64, 24, 60, -86,
-    66, -81, -3, 127, -14, -75, -13, 77, -77, 3, 53, -1, 43, -94, -127, -40,
-    74, 28, -53, 39, -10, 27, 127, -76, 29, 33, 7, -76, -13, -34, 127, 85,
-    -78, -65, -33, -83, 72, 127, 101, -10, -127, 3, -26, 1, -26, -9, 73, 75,
-    127, -28, 53, 76, 26, 99, 12, -11, -91, -12, 30, -86, 14, -29, -127, -11,
-    -66, 51, -43, 127, 42, 114, -1, -3, -127, 19, 51, -10, -2, -7, 76, -50,
-    -7, 12, 42, 127, -71, 26, 41, -47, -24, -10, -54, -80, -3, 58, 127, 11,
-    -127, -20, 19, 33, 12, -49, 41, 92, -127, -17, -57, -57, 71, 56, -11, -4
+#if LIDET_PNQ_WEIGHTS_PK
+/* cls.point[1] weights int16 pairs packed for the DSP kernel, the same as _w */
+LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_cls64_s8_cls_point1_wpk[64] = {
+    5242779u, 4294639506u, 4286709739u, 4286644287u, 4293066835u, 3997632u, 4294115246u, 4289331224u, 4294770754u, 3538867u, 8388527u, 4294901763u, 4294180850u, 4286644267u, 5111733u, 4292411298u,
+    4291493962u, 458781u, 2555932u, 4289986593u, 8388598u, 8388595u, 4289986587u, 5636062u, 4292870066u, 4293328769u, 4289593279u, 65539u, 6619208u, 4849638u, 4294312063u, 4980727u,
+    3473535u, 2031525u, 5046244u, 4289396724u, 786458u, 4286644238u, 4294246499u, 4294311907u, 4292214718u, 3407745u, 8323123u, 4294311955u, 4294901802u, 5046270u, 4294770802u, 4291756025u,
+    2818041u, 4291493864u, 8323084u, 4289789942u, 2752441u, 8388605u, 4291887130u, 720954u, 1310593u, 4291297153u, 2228204u, 4291297263u, 2686988u, 4294246471u, 6094799u, 4294705208u
 };
 #endif
 static const lidet_pointnet_q_layer_t fuzz_cls64_s8_cls_point[2] = {
     {3u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_point0_w, fuzz_cls64_s8_cls_point0_b, fuzz_cls64_s8_cls_point0_m, fuzz_cls64_s8_cls_point0_s, 0},
-    {8u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_point1_w, fuzz_cls64_s8_cls_point1_b, fuzz_cls64_s8_cls_point1_m, fuzz_cls64_s8_cls_point1_s, LIDET_PNQ_OI(fuzz_cls64_s8_cls_point1_woi)}
+    {8u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_point1_w, fuzz_cls64_s8_cls_point1_b, fuzz_cls64_s8_cls_point1_m, fuzz_cls64_s8_cls_point1_s, LIDET_PNQ_PK(fuzz_cls64_s8_cls_point1_wpk)}
 };
 
 /* cls.pvle[0] weights [3][4] int8 (per-channel scale) */
@@ -111,6 +110,16 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_cls64_s8_cls_head0_m[8] =
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_cls64_s8_cls_head0_s[8] = {
     37, 37, 37, 37, 35, 17, 39, 38
 };
+#if LIDET_PNQ_WEIGHTS_PK
+/* cls.head[0] weights int16 pairs packed for the DSP kernel, the same as _w */
+LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_cls64_s8_cls_head0_wpk[80] = {
+    4294901764u, 2097135u, 196607u, 4294311945u, 4294770703u, 131153u, 4292476903u, 2555938u, 1441786u, 4292345829u, 393215u, 4293394443u, 4294246385u, 4292214831u, 4294901784u, 196568u,
+    4293787608u, 4292673538u, 3211391u, 5767295u, 4293656581u, 1376259u, 917505u, 4294443013u, 4294442984u, 262157u, 4294115329u, 4294836203u, 4292542534u, 131042u, 4294901776u, 851977u,
+    4294574059u, 1441790u, 65508u, 4294901729u, 4286709733u, 4292870135u, 1376233u, 4291362943u, 4292673527u, 1048574u, 262145u, 196611u, 524309u, 524256u, 1703869u, 655358u,
+    917494u, 4294311957u, 524303u, 4294443004u, 4294049842u, 851973u, 196629u, 4294836240u, 393219u, 4294901785u, 4287692673u, 4293656449u, 393241u, 4294180861u, 458752u, 327672u,
+    655391u, 4294836215u, 4294311945u, 3473371u, 2031509u, 655303u, 4292804592u, 4294377473u, 4294311886u, 4292149220u, 4294770702u, 4294705181u, 8323169u, 2555901u, 5504999u, 4291428479u
+};
+#endif
 /* cls.head[1] weights [8][3] int8 (per-channel scale) */
 LIDET_ALIGN(16) LIDET_RODATA static const int8_t fuzz_cls64_s8_cls_head1_w[24] = {
     -115, -1, 2, -10, 72, 64, 29, 40, -15, -37, 61, 40, 8, -15, 9, 0,
@@ -128,9 +137,15 @@ LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_cls64_s8_cls_head1_m[3] =
 LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_cls64_s8_cls_head1_s[3] = {
     31, 31, 32
 };
+#if LIDET_PNQ_WEIGHTS_PK
+/* cls.head[1] weights int16 pairs packed for the DSP kernel, the same as _w */
+LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_cls64_s8_cls_head1_wpk[8] = {
+    1965965u, 2686975u, 4292607990u, 3997768u, 4292083720u, 4286709745u, 8323072u, 7602176u
+};
+#endif
 static const lidet_pointnet_q_layer_t fuzz_cls64_s8_cls_head[2] = {
-    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_head0_w, fuzz_cls64_s8_cls_head0_b, fuzz_cls64_s8_cls_head0_m, fuzz_cls64_s8_cls_head0_s, 0},
-    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_cls64_s8_cls_head1_w, fuzz_cls64_s8_cls_head1_b, fuzz_cls64_s8_cls_head1_m, fuzz_cls64_s8_cls_head1_s, 0}
+    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_head0_w, fuzz_cls64_s8_cls_head0_b, fuzz_cls64_s8_cls_head0_m, fuzz_cls64_s8_cls_head0_s, LIDET_PNQ_PK(fuzz_cls64_s8_cls_head0_wpk)},
+    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_cls64_s8_cls_head1_w, fuzz_cls64_s8_cls_head1_b, fuzz_cls64_s8_cls_head1_m, fuzz_cls64_s8_cls_head1_s, LIDET_PNQ_PK(fuzz_cls64_s8_cls_head1_wpk)}
 };
 
 const lidet_pointnet_q_model_t lidet_model_fuzz_cls64_s8 = {
