@@ -342,12 +342,24 @@ static void dense_acc(const lidet_pointnet_q_layer_t *ly, const void *in, uint32
     }
 }
 
-/* layer l (> 0: int8 inputs) in one pass where the model has the packed weights: requantized into dst, or, for
- * the last layer (dst NULL), folded into the running maximum; 0 where it does not apply */
+/* layer l in one pass: l > 0 (int8 inputs) where the model has the packed weights, requantized into dst or, for
+ * the last layer (dst NULL), folded into the running maximum; the first (int16 x, y, z) on cores without SIMD;
+ * 0 where it does not apply */
 static int fused_s8(const lidet_pointnet_q_layer_t *ly, const void *in, uint32_t nb, const bufs_t *b,
                     uint32_t l, int8_t *dst)
 {
-    if (l == 0 || ly->w_pk == 0)
+    if (l == 0)
+    {
+        /* the points' layer (x, y, z): on cores without SIMD in one pass when it is a hidden layer */
+        if (LIDET_NN_SIMD || ly->n_in != 3u || dst == 0)
+        {
+            return 0;
+        }
+        lidet__nn_acc_s16_3_requant((const int16_t *)in, nb, ly->w_t, ly->b, ly->n_out, ly->mult, ly->shift,
+                                    ly->out_zp, ly->relu ? ly->out_zp : -128, dst);
+        return 1;
+    }
+    if (ly->w_pk == 0)
     {
         return 0;
     }

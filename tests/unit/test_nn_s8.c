@@ -122,7 +122,7 @@ static void test_fused_pass_equals_acc_then_requant_or_max(void)
                     {
                         b[i] = (int32_t)(next() % 200001u) - 100000;
                         mult[i] = (int32_t)(((uint32_t)1 << 30) | (next() & 0x3FFFFFFFu));
-                        shift[i] = (uint8_t)(20u + next() % 24u); /* both sides of 32 */
+                        shift[i] = (uint8_t)(20u + next() % 43u); /* 20..62: every path */
                         refmax[i] = vmax[i] = (int32_t)(next() % 2000001u) - 1000000;
                     }
                     lidet__nn_pack_s8_pk(w, n_in, n_out, w_pk);
@@ -147,6 +147,37 @@ static void test_fused_pass_equals_acc_then_requant_or_max(void)
     TEST_ASSERT_EQUAL_INT(0, lidet__nn_acc_s8_pk_fused(in, 2u, 16u, w_pk, b, 4u, mult, shift, 0, -128, out, vmax));
     for (i = 0; i < sizeof out; ++i)
         TEST_ASSERT_EQUAL_INT8((int8_t)0x5A, out[i]);
+}
+
+/* the first layer in one pass equals lidet__nn_acc_s16 + lidet__nn_requant_s8 (x, y, z up to the int16 limits) */
+static void test_first_layer_in_one_pass(void)
+{
+    static int16_t in[MAX_R * 3];
+    static int8_t w[3 * 40], out[MAX_R * 40], ref8[MAX_R * 40];
+    static int32_t b[40], acc[MAX_R * 40], mult[40];
+    static uint8_t shift[40];
+    uint32_t rows, n_out, i, rep;
+    for (rep = 0; rep < 8u; ++rep)
+        for (rows = 1; rows <= MAX_R; ++rows)
+            for (n_out = 1; n_out <= 40u; n_out += 13u)
+            {
+                const int32_t zp = rep & 1u ? -128 : 0, lo = rep & 2u ? zp : -128;
+                for (i = 0; i < 3u * rows; ++i)
+                    in[i] = rep & 4u ? (int16_t)((i & 1u) ? -32768 : 32767) : (int16_t)(next() & 0xFFFFu);
+                for (i = 0; i < 3u * n_out; ++i)
+                    w[i] = (int8_t)(next() & 0xFFu);
+                for (i = 0; i < n_out; ++i)
+                {
+                    b[i] = (int32_t)(next() % 2000001u) - 1000000;
+                    mult[i] = (int32_t)(((uint32_t)1 << 30) | (next() & 0x3FFFFFFFu));
+                    shift[i] = (uint8_t)(20u + next() % 43u); /* 20..62: both paths and both sides of 32 */
+                }
+                lidet__nn_acc_s16(in, rows, 3u, w, b, n_out, acc);
+                lidet__nn_requant_s8(acc, rows, n_out, mult, shift, zp, lo, ref8);
+                memset(out, 0x5A, sizeof out);
+                lidet__nn_acc_s16_3_requant(in, rows, w, b, n_out, mult, shift, zp, lo, out);
+                TEST_ASSERT_EQUAL_INT8_ARRAY(ref8, out, rows * n_out);
+            }
 }
 
 static void test_kernels_agree_at_the_extremes(void)
@@ -291,6 +322,7 @@ int main(void)
     RUN_TEST(test_kernels_agree_on_every_shape);
     RUN_TEST(test_packed_kernel_on_multiples_of_4);
     RUN_TEST(test_fused_pass_equals_acc_then_requant_or_max);
+    RUN_TEST(test_first_layer_in_one_pass);
     RUN_TEST(test_kernels_agree_at_the_extremes);
     RUN_TEST(test_requant_equals_the_int64_rule);
     RUN_TEST(test_requant_rows_and_channels_agree);

@@ -51,6 +51,11 @@ void lidet__nn_pack_s8_pk(const int8_t *w_t, uint32_t n_in, uint32_t n_out, uint
 int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, const uint32_t *w_pk,
                               const int32_t *b, uint32_t n_out, const int32_t *mult, const uint8_t *shift,
                               int32_t zp, int32_t lo, int8_t *out, int32_t *vmax);
+/* the first layer of the points (3 int16 inputs: x, y, z in mm) accumulated and requantized in one pass:
+ * lidet__nn_acc_s16 then lidet__nn_requant_s8, the sums never stored (cores without SIMD) */
+void lidet__nn_acc_s16_3_requant(const int16_t *in, uint32_t n_rows, const int8_t *w_t, const int32_t *b,
+                                 uint32_t n_out, const int32_t *mult, const uint8_t *shift, int32_t zp,
+                                 int32_t lo, int8_t *out);
 /* the same with int16 inputs (the first layer: points in mm, voxel bins) */
 void lidet__nn_acc_s16(const int16_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
                        uint32_t n_out, int32_t *acc);

@@ -717,6 +717,19 @@ S8_ALWAYS_INLINE int8_t rq_one(int32_t a, int32_t m, uint32_t s, int32_t zp, int
     }
 }
 
+/* rq_one for a shift 32 + k, k in [1, 16], and lo = -128 (the generated models' usual case): the zero point
+ * added before the shift, exactly (floor((v + zp 2^k) / 2^k) = floor(v / 2^k) + zp; |hi| < 2^30 and
+ * |zp| 2^k <= 2^23, so no overflow), the clamp at -128 SSAT's own. c = rq_fast_c(k, zp) */
+static inline int32_t rq_fast_c(uint32_t k, int32_t zp)
+{
+    return ((int32_t)1 << (k - 1u)) + zp * ((int32_t)1 << k);
+}
+
+S8_ALWAYS_INLINE int8_t rq_fast(int32_t a, int32_t m, uint32_t k, int32_t c)
+{
+    return clamp_s8(((int32_t)(((int64_t)a * m) >> 32) + c) >> k, -128);
+}
+
 int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, const uint32_t *w_pk,
                               const int32_t *b, uint32_t n_out, const int32_t *mult, const uint8_t *shift,
                               int32_t zp, int32_t lo, int8_t *out, int32_t *vmax)
@@ -770,4 +783,36 @@ int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, 
         }
     }
     return 1;
+}
+
+void lidet__nn_acc_s16_3_requant(const int16_t *in, uint32_t n_rows, const int8_t *w_t, const int32_t *b,
+                                 uint32_t n_out, const int32_t *mult, const uint8_t *shift, int32_t zp,
+                                 int32_t lo, int8_t *out)
+{
+    uint32_t r, o;
+    /* channel by channel: the channel's weights, bias and requantization stay in registers over the rows */
+    for (o = 0; o < n_out; ++o)
+    {
+        const int32_t w0 = w_t[o], w1 = w_t[n_out + o], w2 = w_t[2u * n_out + o], bo = b[o], m = mult[o];
+        const uint32_t sh = shift[o];
+        const int16_t *x = in;
+        int8_t *d = out + o;
+        if (sh > 32u && sh <= 48u && lo == -128)
+        {
+            /* the usual case (rq_fast) */
+            const uint32_t k = sh - 32u;
+            const int32_t c = rq_fast_c(k, zp);
+            for (r = 0; r < n_rows; ++r, x += 3, d += n_out)
+            {
+                *d = rq_fast(bo + x[0] * w0 + x[1] * w1 + x[2] * w2, m, k, c);
+            }
+        }
+        else
+        {
+            for (r = 0; r < n_rows; ++r, x += 3, d += n_out)
+            {
+                *d = rq_one(bo + x[0] * w0 + x[1] * w1 + x[2] * w2, m, sh, zp, lo);
+            }
+        }
+    }
 }
