@@ -198,6 +198,23 @@ static inline uint32_t rxy2_at(const lidet_range_image_t *img, lidet__qpix_row_t
     return (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]); /* |q| <= 32750 */
 }
 
+/* x^2 + y^2 of one quadrant's qn pixels of a range-only row (table t: sin, cos of the quarter turn's columns):
+ * quadrant 0 ct = cos, st = sin; 1: ct = -sin, st = cos; 2: -cos, -sin; 3: sin, -cos (swap, the signs: constants
+ * where inlined) */
+static inline void rxy2_quadrant(const uint16_t *rng, const int32_t *t, uint32_t qn, lidet__qpix_row_t rt,
+                                 const int swap, const int32_t sgn_c, const int32_t sgn_s,
+                                 uint32_t *restrict v)
+{
+    uint32_t j;
+    for (j = 0; j < qn; ++j)
+    {
+        const int32_t sn = t[2u * j], cs = t[2u * j + 1u];
+        int32_t q[3];
+        lidet__qpix_decode(rng[j], rt, sgn_c * (swap ? sn : cs), sgn_s * (swap ? cs : sn), q);
+        v[j] = (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]);
+    }
+}
+
 /* x^2 + y^2 of row r's pixels into v */
 static void row_rxy2(const lidet_range_image_t *img, uint32_t r, uint32_t *restrict v)
 {
@@ -214,6 +231,17 @@ static void row_rxy2(const lidet_range_image_t *img, uint32_t r, uint32_t *restr
     }
     {
         const lidet__qpix_row_t rt = lidet__qpix_row(img, r);
+        if (img->col_trig_q15 != 0 && cols % 4u == 0u)
+        {
+            /* quadrant by quadrant: lidet__qpix_col's fold of the quarter-turn table, hoisted out of the loop */
+            const uint32_t qn = cols / 4u;
+            const uint16_t *rng = img->range_4mm + base;
+            rxy2_quadrant(rng, img->col_trig_q15, qn, rt, 0, 1, 1, v);
+            rxy2_quadrant(rng + qn, img->col_trig_q15, qn, rt, 1, -1, 1, v + qn);
+            rxy2_quadrant(rng + 2u * qn, img->col_trig_q15, qn, rt, 0, -1, -1, v + 2u * qn);
+            rxy2_quadrant(rng + 3u * qn, img->col_trig_q15, qn, rt, 1, 1, -1, v + 3u * qn);
+            return;
+        }
         for (c = 0; c < cols; ++c)
         {
             v[c] = rxy2_at(img, rt, c, base + c);
@@ -425,8 +453,9 @@ static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_
  * buffer's start upwards, far ones from its end downwards (the float stage's order); past the buffer they are
  * dropped and counted. */
 static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
-                           const lidet_range_image_t *img)
+                           const lidet__ground_q_pix_t *gp)
 {
+    const lidet_range_image_t *img = gp->img;
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
     const uint32_t cstep = g->cfg.sample_col_step, split_v = g->split_v;
     lidet_ground_sample_t *const si = sc->sample_pix;
@@ -447,7 +476,10 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
                     ++total;
                     if (lo < hi)
                     {
-                        const uint32_t k = rxy2_at(img, rt, c, base + c) >= split_v ? --hi : lo++;
+                        int32_t q[3];
+                        uint32_t k;
+                        lidet__ground_q_pix_rc(gp, rt, c, base + c, q);
+                        k = (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]) >= split_v ? --hi : lo++;
                         si[k] = (lidet_ground_sample_t)(base + c);
                     }
                 }
@@ -474,8 +506,9 @@ static inline int32_t r_cached(int32_t *row, uint32_t c, uint32_t v)
 }
 
 static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, uint8_t *mask,
-                       const lidet_range_image_t *img)
+                       const lidet__ground_q_pix_t *gp)
 {
+    const lidet_range_image_t *img = gp->img;
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, split_v = g->split_v;
     const int64_t above0 = (int64_t)g->cfg.ground_mm << 28, k = g->cfg.ground_per_m_q16;
     const int64_t bf = g->cfg.below_factor_q16, slope = g->cfg.veto_slope_q16;
@@ -513,13 +546,16 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
                 uint32_t v, vu;
                 int32_t dz;
                 int64_t h;
-                lidet__qpix_xyz2_rc(img, rt, rtu, c, p, p - up, P, U); /* stored or decoded (lidet_qpix.h) */
-                v = (uint32_t)(P[0] * P[0]) + (uint32_t)(P[1] * P[1]);
-                vu = (uint32_t)(U[0] * U[0]) + (uint32_t)(U[1] * U[1]);
-                dz = abs32(U[2] - P[2]);
-                h = lidet__ground_q_height(&hp[v >= split_v], P[0], P[1], P[2]);
                 int64_t above = above0, below = below0;
                 int in, vt = 0;
+                if (gp->ct != 0 && (img->range_4mm[p] & 0x7FFFu) == 0u)
+                {
+                    mask[p] = 0; /* an empty pixel (x = y = 0): never ground, never vetoed */
+                    continue;
+                }
+                lidet__ground_q_pix_rc(gp, rt, c, p, P); /* stored or decoded (lidet_qpix.h) */
+                v = (uint32_t)(P[0] * P[0]) + (uint32_t)(P[1] * P[1]);
+                h = lidet__ground_q_height(&hp[v >= split_v], P[0], P[1], P[2]);
                 if (k != 0)
                 {
                     /* R steps are 1/64 mm: k R / 2^16 mm = (k R) << 6 in 4 mm / 2^30 */
@@ -527,9 +563,16 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
                     below = lidet__q_rshift_round(bf * above, 16);
                 }
                 in = (v != 0u) & (h < above) & (h > -below);
-                if (in & (vu != 0u) & (4 * dz > min_dz) & (slope > 0))
+                if (in)
                 {
-                    vt = ((int64_t)dz << 24) > slope * abs32(r_cached(Ru, c, vu) - r_cached(Rr, c, v));
+                    /* the pixel above, read only for the veto of an in-band pixel */
+                    lidet__ground_q_pix_rc(gp, rtu, c, p - up, U);
+                    vu = (uint32_t)(U[0] * U[0]) + (uint32_t)(U[1] * U[1]);
+                    dz = abs32(U[2] - P[2]);
+                    if ((vu != 0u) & (4 * dz > min_dz) & (slope > 0))
+                    {
+                        vt = ((int64_t)dz << 24) > slope * abs32(r_cached(Ru, c, vu) - r_cached(Rr, c, v));
+                    }
                 }
                 mask[p] = (uint8_t)(in & !vt);
                 n_ground += (uint32_t)(in & !vt);
@@ -544,6 +587,7 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
 lidet_status_t lidet_ground_q_run_buffers(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *scratch,
                                           uint8_t *mask, const lidet_range_image_t *img)
 {
+    lidet__ground_q_pix_t gp;
     r_rows_t rr;
     lidet_status_t st;
     if (g == 0 || scratch == 0 || mask == 0 || img == 0)
@@ -562,9 +606,10 @@ lidet_status_t lidet_ground_q_run_buffers(lidet_ground_q_state_t *g, lidet_groun
     g->rng = lidet__rng_seed(g->cfg.seed);
     r_rows_init(&rr, scratch, img);
     filter_rows(g, scratch, &rr, img);
-    gather_samples(g, scratch, img);
-    lidet__ground_q_fit_sectors(g, scratch, img);
-    label_rows(g, scratch, mask, img);
+    lidet__ground_q_pix_init(&gp, scratch, img); /* into the filter's scratch, free from here on */
+    gather_samples(g, scratch, &gp);
+    lidet__ground_q_fit_sectors(g, scratch, &gp);
+    label_rows(g, scratch, mask, &gp);
     return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
 }
 

@@ -94,9 +94,9 @@ static int unit_q30(const int64_t v_in[3], int32_t out[3])
     return 1;
 }
 
-static inline void pixel(const lidet_range_image_t *img, uint32_t p, int32_t q[3])
+static inline void pixel(const lidet__ground_q_pix_t *img, uint32_t p, int32_t q[3])
 {
-    lidet__qpix_xyz(img, p, q); /* stored or decoded (lidet_qpix.h) */
+    lidet__ground_q_pix(img, p, q); /* stored or decoded (lidet_qpix.h) */
 }
 
 /* The least-squares plane through the inliers (|height| <= thr) of cur among the cell's samples: their
@@ -105,7 +105,7 @@ static inline void pixel(const lidet_range_image_t *img, uint32_t p, int32_t q[3
  * eigenvector is the scatter's least one; the ratio of a ground patch's two smallest spreads makes a few
  * iterations exact), D through the exact mean. Returns 0 (out untouched) for fewer than 3 inliers or points
  * (nearly) on a line. */
-static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *idx, uint32_t n,
+static int refine(const lidet__ground_q_pix_t *img, const lidet_ground_sample_t *idx, uint32_t n,
                   const qplane_t *cur, int64_t thr, qplane_t *out)
 {
     int64_t s1[3] = {0, 0, 0}, e[3], a[6] = {0, 0, 0, 0, 0, 0}, dl[3], b[6], v[3], nd, mm;
@@ -218,8 +218,9 @@ static int refine(const lidet_range_image_t *img, const lidet_ground_sample_t *i
 /* RANSAC on one cell (ref/ground_q.py: ransac_cell): the float stage's draws and control flow; a hypothesis
  * is the exact cross product c of two 4 mm difference vectors, a sample its inlier when
  * 4 |c . (p - p0)| <= inlier_mm * |c|. Returns 1 with *out set when the plane passes every check. */
-static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, const lidet_range_image_t *img,
-                      const lidet_ground_sample_t *idx, uint32_t n, qplane_t *out)
+static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                      const lidet__ground_q_pix_t *img, const lidet_ground_sample_t *idx, uint32_t n,
+                      qplane_t *out)
 {
     const lidet_ground_q_cfg_t *cfg = &g->cfg;
     const uint32_t stride = (n + cfg->eval_samples - 1u) / cfg->eval_samples;
@@ -361,7 +362,7 @@ typedef struct
 {
     lidet_ground_q_state_t *g;
     lidet_ground_q_scratch_t *sc;
-    const lidet_range_image_t *img;
+    const lidet__ground_q_pix_t *img;
 } fit_ctx_t;
 
 static void set_plane(lidet_ground_q_state_t *g, uint32_t k, const qplane_t *p)
@@ -412,7 +413,7 @@ static void copy_plane(void *ctx, uint32_t dst, int32_t src)
 }
 
 void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
-                                 const lidet_range_image_t *img)
+                                 const lidet__ground_q_pix_t *img)
 {
     const uint32_t ns = g->cfg.n_sectors;
     fit_ctx_t f;

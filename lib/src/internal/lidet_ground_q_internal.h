@@ -4,6 +4,7 @@
 #define LIDET_GROUND_Q_INTERNAL_H
 
 #include "lidet/lidet_ground_q.h"
+#include "lidet_qpix.h"
 #include "lidet_simd.h"
 
 /* R of a pixel in 4 mm / 2^LIDET_GROUND_Q_R_SHIFT steps (1/64 mm) */
@@ -70,8 +71,61 @@ typedef struct
 void lidet__ground_q_sample_row(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
                                 uint32_t cols, const lidet__ground_q_filt_t *f, uint8_t *out, int early);
 
+/* The pixels of the passes after the filter (gathering, fits, labels). A range-only image's columns' cosines
+ * and sines (lidet__qpix_col) are computed once per run into scratch the filter alone uses (r_rem, r_v), so a
+ * decode reads them instead of folding the quarter-turn table's quadrant each time: the same values. */
+typedef struct
+{
+    const lidet_range_image_t *img;
+    const int32_t *ct, *st; /* NULL: an image that stores x, y, z */
+} lidet__ground_q_pix_t;
+
+static inline void lidet__ground_q_pix_init(lidet__ground_q_pix_t *gp, lidet_ground_q_scratch_t *sc,
+                                            const lidet_range_image_t *img)
+{
+    gp->img = img;
+    gp->ct = 0;
+    gp->st = 0;
+    if (lidet__qpix_range_only(img))
+    {
+        int32_t *ct = (int32_t *)sc->r_rem, *st = (int32_t *)sc->r_v.v;
+        uint32_t c;
+        for (c = 0; c < img->n_cols; ++c)
+        {
+            lidet__qpix_col(img, c, &ct[c], &st[c]);
+        }
+        gp->ct = ct;
+        gp->st = st;
+    }
+}
+
+/* x, y, z of pixel p = r cols + c with row r's trig rt at hand */
+static inline void lidet__ground_q_pix_rc(const lidet__ground_q_pix_t *gp, lidet__qpix_row_t rt, uint32_t c,
+                                          uint32_t p, int32_t v[3])
+{
+    if (gp->ct == 0)
+    {
+        lidet__qpix_stored(gp->img, p, v);
+        return;
+    }
+    lidet__qpix_decode(gp->img->range_4mm[p], rt, gp->ct[c], gp->st[c], v);
+}
+
+/* x, y, z of pixel p */
+static inline void lidet__ground_q_pix(const lidet__ground_q_pix_t *gp, uint32_t p, int32_t v[3])
+{
+    uint32_t r;
+    if (gp->ct == 0)
+    {
+        lidet__qpix_stored(gp->img, p, v);
+        return;
+    }
+    r = p / gp->img->n_cols;
+    lidet__ground_q_pix_rc(gp, lidet__qpix_row(gp->img, r), p - r * gp->img->n_cols, p, v);
+}
+
 /* Fits one plane per cell from the gathered samples, applies the fallback (lidet_ground_q_fit.c). */
 void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
-                                 const lidet_range_image_t *img);
+                                 const lidet__ground_q_pix_t *gp);
 
 #endif
