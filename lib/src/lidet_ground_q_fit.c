@@ -283,11 +283,17 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
         thr_l = inl * (int64_t)len;
         if (copied)
         {
-            for (i = 0; i < n_eval; ++i)
+            /* in blocks of 32 samples; a hypothesis that can no longer beat the best count stops (its count
+             * decides nothing else, so the fitted planes are those of the full count) */
+            for (i = 0; i < n_eval && (!have || cnt + (n_eval - i) > best_cnt);)
             {
-                const int64_t h = c[0] * (sc->ev_x[i] - p0[0]) + c[1] * (sc->ev_y[i] - p0[1]) +
-                                  c[2] * (sc->ev_z[i] - p0[2]);
-                cnt += (uint32_t)(4 * abs64(h) <= thr_l);
+                const uint32_t end = n_eval - i > 32u ? i + 32u : n_eval;
+                for (; i < end; ++i)
+                {
+                    const int64_t h = c[0] * (sc->ev_x[i] - p0[0]) + c[1] * (sc->ev_y[i] - p0[1]) +
+                                      c[2] * (sc->ev_z[i] - p0[2]);
+                    cnt += (uint32_t)(4 * abs64(h) <= thr_l);
+                }
             }
         }
         else
