@@ -107,7 +107,7 @@ static void test_fused_pass_equals_acc_then_requant_or_max(void)
     static uint8_t shift[32];
     static const uint32_t n_ins[] = {4u, 16u, 48u, 64u};
     uint32_t k, rows, n_out, i, rep;
-    for (rep = 0; rep < 4u; ++rep)
+    for (rep = 0; rep < 8u; ++rep)
         for (k = 0; k < sizeof n_ins / sizeof n_ins[0]; ++k)
             for (rows = 1; rows <= MAX_R; ++rows)
                 for (n_out = 2; n_out <= 32u; n_out += 10u)
@@ -122,7 +122,8 @@ static void test_fused_pass_equals_acc_then_requant_or_max(void)
                     {
                         b[i] = (int32_t)(next() % 200001u) - 100000;
                         mult[i] = (int32_t)(((uint32_t)1 << 30) | (next() & 0x3FFFFFFFu));
-                        shift[i] = (uint8_t)(20u + next() % 43u); /* 20..62: every path */
+                        /* 20..62: every path; or all in [33, 48], the fast requantization where lo is -128 */
+                        shift[i] = (uint8_t)(rep & 4u ? 33u + next() % 16u : 20u + next() % 43u);
                         refmax[i] = vmax[i] = (int32_t)(next() % 2000001u) - 1000000;
                     }
                     lidet__nn_pack_s8_pk(w, n_in, n_out, w_pk);

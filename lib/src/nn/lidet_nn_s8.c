@@ -730,24 +730,30 @@ S8_ALWAYS_INLINE int8_t rq_fast(int32_t a, int32_t m, uint32_t k, int32_t c)
     return clamp_s8(((int32_t)(((int64_t)a * m) >> 32) + c) >> k, -128);
 }
 
-int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, const uint32_t *w_pk,
-                              const int32_t *b, uint32_t n_out, const int32_t *mult, const uint8_t *shift,
-                              int32_t zp, int32_t lo, int8_t *out, int32_t *vmax)
+/* the fused pass's rows: mode PKF_RQ requantizes with rq_one, PKF_RQ_FAST with rq_fast (every channel's shift in
+ * [33, 48] and lo = -128, checked by the caller), PKF_MAX folds into vmax (a constant where inlined: each mode
+ * is compiled on its own, without the others' branches) */
+enum
+{
+    PKF_RQ,
+    PKF_RQ_FAST,
+    PKF_MAX
+};
+
+S8_ALWAYS_INLINE void pk_fused_rows(const int8_t *in, uint32_t n_rows, uint32_t n_in, const uint32_t *w_pk,
+                                    const int32_t *b, uint32_t n_out, const int32_t *mult,
+                                    const uint8_t *shift, int32_t zp, int32_t lo, int8_t *out, int32_t *vmax,
+                                    const int mode)
 {
     uint32_t xw[4u * PK_CHUNK_GROUPS];
     const uint32_t n_g = n_in / 4u;
     uint32_t r, o;
-    if (w_pk == 0 || n_in % 4u != 0u || n_g == 0u || n_g > PK_CHUNK_GROUPS || n_out % 2u != 0u ||
-        n_out == 0u || (out == 0) == (vmax == 0))
-    {
-        return 0;
-    }
     for (r = 0; r < n_rows; r += 2u)
     {
         const int two = r + 1u < n_rows;
         const int8_t *x0 = in + r * n_in;
         const uint32_t *w = w_pk;
-        int8_t *d = out != 0 ? out + r * n_out : 0;
+        int8_t *d = mode != PKF_MAX ? out + r * n_out : 0;
         pk_widen(x0, two ? x0 + n_in : 0, n_g, xw);
         for (o = 0; o < n_out; o += 2u)
         {
@@ -755,7 +761,20 @@ int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, 
             s[0] = s[2] = b[o];
             s[1] = s[3] = b[o + 1u];
             w = two ? pk_pair(xw, n_g, w, s) : pk_one(xw, n_g, w, s);
-            if (d != 0)
+            if (mode == PKF_RQ_FAST)
+            {
+                const int32_t m0 = mult[o], m1 = mult[o + 1u];
+                const uint32_t k0 = shift[o] - 32u, k1 = shift[o + 1u] - 32u;
+                const int32_t c0 = rq_fast_c(k0, zp), c1 = rq_fast_c(k1, zp);
+                d[o] = rq_fast(s[0], m0, k0, c0);
+                d[o + 1u] = rq_fast(s[1], m1, k1, c1);
+                if (two)
+                {
+                    d[n_out + o] = rq_fast(s[2], m0, k0, c0);
+                    d[n_out + o + 1u] = rq_fast(s[3], m1, k1, c1);
+                }
+            }
+            else if (mode == PKF_RQ)
             {
                 const int32_t m0 = mult[o], m1 = mult[o + 1u];
                 const uint32_t h0 = shift[o], h1 = shift[o + 1u];
@@ -781,6 +800,36 @@ int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, 
                 vmax[o + 1u] = v1;
             }
         }
+    }
+}
+
+int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, const uint32_t *w_pk,
+                              const int32_t *b, uint32_t n_out, const int32_t *mult, const uint8_t *shift,
+                              int32_t zp, int32_t lo, int8_t *out, int32_t *vmax)
+{
+    uint32_t o;
+    int fast = lo == -128;
+    if (w_pk == 0 || n_in % 4u != 0u || n_in == 0u || n_in > 4u * PK_CHUNK_GROUPS || n_out % 2u != 0u ||
+        n_out == 0u || (out == 0) == (vmax == 0))
+    {
+        return 0;
+    }
+    if (vmax != 0)
+    {
+        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, PKF_MAX);
+        return 1;
+    }
+    for (o = 0; o < n_out && fast; ++o)
+    {
+        fast = shift[o] - 33u < 16u; /* shift in [33, 48] */
+    }
+    if (fast)
+    {
+        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, PKF_RQ_FAST);
+    }
+    else
+    {
+        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, PKF_RQ);
     }
     return 1;
 }
