@@ -345,9 +345,12 @@ static inline uint8_t sample_test(const int32_t *R0, const int32_t *R1, const in
  * costs every test on every pixel: most of a VLP-16 image's upper rows are empty and its obstacles fail the
  * slope test). The cheap tests first: the six pixels hold points, then the descending and height conditions,
  * the slope F_y, the horizontal F_x. */
-static inline uint8_t sample_test_early(const int32_t *R0, const int32_t *R1, const int16_t *Z0,
-                                        const int16_t *Z1, uint32_t cm1, uint32_t c, uint32_t cp1,
-                                        uint32_t cp2, const lidet__ground_q_filt_t *f)
+#if defined(__GNUC__)
+__attribute__((always_inline)) /* a call per pixel (nine arguments) cost as much as the test itself */
+#endif
+static inline uint8_t
+sample_test_early(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1, uint32_t cm1,
+                  uint32_t c, uint32_t cp1, uint32_t cp2, const lidet__ground_q_filt_t *f)
 {
     int32_t dr, dz;
     if (R0[c] <= 0 || R1[c] <= 0 || R0[cp1] <= 0 || R1[cp1] <= 0 || R0[cm1] <= 0 || R0[cp2] <= 0)

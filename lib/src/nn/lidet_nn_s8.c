@@ -306,25 +306,36 @@ S8_ALWAYS_INLINE const uint32_t *pk_pair(const uint32_t *xw, uint32_t n_g, const
     const uint32_t *const end = xw + 4u * n_g;
 #if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && defined(__GNUC__) && !defined(LIDET_NN_PK_NO_ASM)
     uint32_t a0, a1, c0, c1;
-    __asm__ volatile("1:\n\t"
-                     "ldrd %[a0], %[a1], [%[x]], #8\n\t"
-                     "ldrd %[c0], %[c1], [%[w]], #8\n\t"
-                     "smlad %[s00], %[a0], %[c0], %[s00]\n\t"
-                     "smlad %[s01], %[a0], %[c1], %[s01]\n\t"
-                     "smlad %[s10], %[a1], %[c0], %[s10]\n\t"
-                     "smlad %[s11], %[a1], %[c1], %[s11]\n\t"
-                     "ldrd %[a0], %[a1], [%[x]], #8\n\t"
-                     "ldrd %[c0], %[c1], [%[w]], #8\n\t"
-                     "smlad %[s00], %[a0], %[c0], %[s00]\n\t"
-                     "smlad %[s01], %[a0], %[c1], %[s01]\n\t"
-                     "smlad %[s10], %[a1], %[c0], %[s10]\n\t"
-                     "smlad %[s11], %[a1], %[c1], %[s11]\n\t"
-                     "cmp %[x], %[end]\n\t"
-                     "bne 1b\n\t"
-                     : [s00] "+r"(s00), [s01] "+r"(s01), [s10] "+r"(s10), [s11] "+r"(s11), [x] "+r"(xw),
-                       [w] "+r"(w), [a0] "=&r"(a0), [a1] "=&r"(a1), [c0] "=&r"(c0), [c1] "=&r"(c1)
-                     : [end] "r"(end)
-                     : "cc", "memory");
+    /* one group: inputs A of both points and the two channels' A weights, 4 SMLAD, then the same for B */
+#define PK_PAIR_GROUP                                                                                        \
+    "ldrd %[a0], %[a1], [%[x]], #8\n\t"                                                                      \
+    "ldrd %[c0], %[c1], [%[w]], #8\n\t"                                                                      \
+    "smlad %[s00], %[a0], %[c0], %[s00]\n\t"                                                                 \
+    "smlad %[s01], %[a0], %[c1], %[s01]\n\t"                                                                 \
+    "smlad %[s10], %[a1], %[c0], %[s10]\n\t"                                                                 \
+    "smlad %[s11], %[a1], %[c1], %[s11]\n\t"                                                                 \
+    "ldrd %[a0], %[a1], [%[x]], #8\n\t"                                                                      \
+    "ldrd %[c0], %[c1], [%[w]], #8\n\t"                                                                      \
+    "smlad %[s00], %[a0], %[c0], %[s00]\n\t"                                                                 \
+    "smlad %[s01], %[a0], %[c1], %[s01]\n\t"                                                                 \
+    "smlad %[s10], %[a1], %[c0], %[s10]\n\t"                                                                 \
+    "smlad %[s11], %[a1], %[c1], %[s11]\n\t"
+#define PK_PAIR_OPERANDS                                                                                     \
+    : [s00] "+r"(s00), [s01] "+r"(s01), [s10] "+r"(s10), [s11] "+r"(s11), [x] "+r"(xw), [w] "+r"(w),          \
+      [a0] "=&r"(a0), [a1] "=&r"(a1), [c0] "=&r"(c0), [c1] "=&r"(c1)                                          \
+    : [end] "r"(end)                                                                                         \
+    : "cc", "memory"
+    if (n_g & 1u) /* an odd group first */
+    {
+        __asm__ volatile(PK_PAIR_GROUP PK_PAIR_OPERANDS);
+    }
+    if (xw != end) /* then two groups per pass: one compare and branch per 32 multiply-adds */
+    {
+        __asm__ volatile("1:\n\t" PK_PAIR_GROUP PK_PAIR_GROUP "cmp %[x], %[end]\n\t"
+                         "bne 1b\n\t" PK_PAIR_OPERANDS);
+    }
+#undef PK_PAIR_GROUP
+#undef PK_PAIR_OPERANDS
 #else
     do
     {
