@@ -94,9 +94,26 @@ static int unit_q30(const int64_t v_in[3], int32_t out[3])
     return 1;
 }
 
-static inline void pixel(const lidet__ground_q_pix_t *img, uint32_t p, int32_t q[3])
+/* a cell's samples: pixel indices, and where the cell fits, their coordinates decoded once (xyz: 3 int32 per
+ * sample, in scratch the fits do not otherwise use) so RANSAC and the refinements read them instead of
+ * decoding each sample up to four times */
+typedef struct
 {
-    lidet__ground_q_pix(img, p, q); /* stored or decoded (lidet_qpix.h) */
+    const lidet__ground_q_pix_t *img;
+    const lidet_ground_sample_t *idx;
+    const int32_t *xyz; /* NULL: decode */
+} cell_src_t;
+
+static inline void pixel(const cell_src_t *src, uint32_t i, int32_t q[3])
+{
+    if (src->xyz != 0)
+    {
+        q[0] = src->xyz[3u * i];
+        q[1] = src->xyz[3u * i + 1u];
+        q[2] = src->xyz[3u * i + 2u];
+        return;
+    }
+    lidet__ground_q_pix(src->img, src->idx[i], q); /* stored or decoded (lidet_qpix.h) */
 }
 
 /* The least-squares plane through the inliers (|height| <= thr) of cur among the cell's samples: their
@@ -105,8 +122,7 @@ static inline void pixel(const lidet__ground_q_pix_t *img, uint32_t p, int32_t q
  * eigenvector is the scatter's least one; the ratio of a ground patch's two smallest spreads makes a few
  * iterations exact), D through the exact mean. Returns 0 (out untouched) for fewer than 3 inliers or points
  * (nearly) on a line. */
-static int refine(const lidet__ground_q_pix_t *img, const lidet_ground_sample_t *idx, uint32_t n,
-                  const qplane_t *cur, int64_t thr, qplane_t *out)
+static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_t thr, qplane_t *out)
 {
     int64_t s1[3] = {0, 0, 0}, e[3], a[6] = {0, 0, 0, 0, 0, 0}, dl[3], b[6], v[3], nd, mm;
     int32_t q[3], first[3], c0[3], nv[3];
@@ -115,12 +131,12 @@ static int refine(const lidet__ground_q_pix_t *img, const lidet_ground_sample_t 
     int k, it;
     lidet__ground_q_hplane_t hp;
     lidet__ground_q_hplane(cur->n, cur->d, &hp);
-    pixel(img, idx[0], first);
+    pixel(img, 0u, first);
     /* one pass over the samples (each decoded once): the inliers' sums S1 = sum d and S2 = sum d d^T of
      * d = q - first, exact in int64 (|d| < 2^16: below n 2^32 for n samples) */
     for (i = 0; i < n; ++i)
     {
-        pixel(img, idx[i], q);
+        pixel(img, i, q);
         if (abs64(lidet__ground_q_height(&hp, q[0], q[1], q[2])) <= thr)
         {
             const int32_t x = q[0] - first[0], y = q[1] - first[1], z = q[2] - first[2];
@@ -219,9 +235,10 @@ static int refine(const lidet__ground_q_pix_t *img, const lidet_ground_sample_t 
  * is the exact cross product c of two 4 mm difference vectors, a sample its inlier when
  * 4 |c . (p - p0)| <= inlier_mm * |c|. Returns 1 with *out set when the plane passes every check. */
 static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
-                      const lidet__ground_q_pix_t *img, const lidet_ground_sample_t *idx, uint32_t n,
+                      const lidet__ground_q_pix_t *gp, const lidet_ground_sample_t *idx, uint32_t n,
                       qplane_t *out)
 {
+    cell_src_t src, *const img = &src;
     const lidet_ground_q_cfg_t *cfg = &g->cfg;
     const uint32_t stride = (n + cfg->eval_samples - 1u) / cfg->eval_samples;
     const uint32_t n_eval = (n + stride - 1u) / stride;
@@ -233,12 +250,25 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
     uint32_t best_len = 0, best_cnt = 0, it, r, i;
     qplane_t best;
     int have = 0;
+    src.img = gp;
+    src.idx = idx;
+    src.xyz = 0;
+    if (gp->ct != 0 &&
+        3u * n <= sizeof sc->r_rows / sizeof(int32_t)) /* a range-only image's cell that fits */
+    {
+        int32_t *xyz = &sc->r_rows[0][0];
+        for (i = 0; i < n; ++i)
+        {
+            pixel(&src, i, xyz + 3u * i);
+        }
+        src.xyz = xyz;
+    }
     if (copied)
     {
         for (i = 0; i < n_eval; ++i)
         {
             int32_t q[3];
-            pixel(img, idx[i * stride], q);
+            pixel(img, i * stride, q);
             sc->ev_x[i] = (int16_t)q[0];
             sc->ev_y[i] = (int16_t)q[1];
             sc->ev_z[i] = (int16_t)q[2];
@@ -256,9 +286,9 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
         {
             continue;
         }
-        pixel(img, idx[i0], p0);
-        pixel(img, idx[i1], p1);
-        pixel(img, idx[i2], p2);
+        pixel(img, i0, p0);
+        pixel(img, i1, p1);
+        pixel(img, i2, p2);
         {
             const int64_t ux = p1[0] - p0[0], uy = p1[1] - p0[1], uz = p1[2] - p0[2];
             const int64_t vx = p2[0] - p0[0], vy = p2[1] - p0[1], vz = p2[2] - p0[2];
@@ -302,7 +332,7 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
             {
                 int32_t q[3];
                 int64_t h;
-                pixel(img, idx[i], q);
+                pixel(img, i, q);
                 h = c[0] * (q[0] - p0[0]) + c[1] * (q[1] - p0[1]) + c[2] * (q[2] - p0[2]);
                 cnt += (uint32_t)(4 * abs64(h) <= thr_l);
             }
@@ -348,7 +378,7 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
     for (r = 0; r < cfg->refine_iters; ++r)
     {
         qplane_t p;
-        if (!refine(img, idx, n, &best, (int64_t)cfg->inlier_mm << 28, &p) || p.n[2] < cos_t)
+        if (!refine(img, n, &best, (int64_t)cfg->inlier_mm << 28, &p) || p.n[2] < cos_t)
         {
             break; /* keep the last good plane */
         }
