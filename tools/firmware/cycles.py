@@ -147,7 +147,10 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
         proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         timer = threading.Timer(timeout, proc.kill)
         timer.start()
-        blocks = {}  # pc -> (insns, low, high, last (addr, size, kind), n_refill_static)
+        # (pc, cflags) -> (insns, low, high, last (addr, size, kind), n_refill_static); also pc -> the first
+        # translation at pc. With -icount QEMU retranslates some blocks shorter (an instruction budget in the
+        # cflags), so one address can have several blocks: each execution line names its translation's flags.
+        blocks = {}
         tot_insn = lo = hi = 0
         pending = None  # the previous executed block's last instruction: (end address, kind)
         cur = None
@@ -164,6 +167,9 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
                             cur.append((int(m.group(1), 16), size, m.group(4), m.group(5)))
                         continue
                     if line.startswith("Trace"):
+                        m = re.search(r"\[[0-9a-f]+/([0-9a-f]+)/[0-9a-f]+/([0-9a-f]+)\]", line)
+                        pc = int(m.group(1), 16)
+                        key = (pc, m.group(2))
                         if cur:
                             l_ = h_ = 0
                             prev_ls = False
@@ -173,10 +179,12 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
                                 h_ += ch
                                 prev_ls = kind == "ls"
                             a, size, mn, ops = cur[-1]
-                            blocks[cur[0][0]] = (len(cur), l_, h_, a + size, price(mn, ops, core, False)[2])
+                            blk = (len(cur), l_, h_, a + size, price(mn, ops, core, False)[2])
+                            if cur[0][0] == pc:  # a block is logged when translated, just before its first run
+                                blocks[key] = blk
+                            blocks.setdefault(cur[0][0], blk)
                         cur = None
-                        pc = int(re.search(r"\[[0-9a-f]+/([0-9a-f]+)/", line).group(1), 16)
-                        b = blocks.get(pc)
+                        b = blocks.get(key) or blocks.get(pc)
                         if b is None:
                             continue
                         # the previous block's branch: taken unless this block starts right after it

@@ -22,7 +22,8 @@
 typedef struct
 {
     int32_t hi[3], lo[3];
-    int64_t d; /* D, 4 mm / 2^30 */
+    int32_t n[3]; /* the normal itself, for cores with a 32 x 32 -> 64 multiply-accumulate */
+    int64_t d;    /* D, 4 mm / 2^30 */
 } lidet__ground_q_hplane_t;
 
 static inline void lidet__ground_q_hplane(const int32_t n[3], int64_t d, lidet__ground_q_hplane_t *h)
@@ -32,6 +33,7 @@ static inline void lidet__ground_q_hplane(const int32_t n[3], int64_t d, lidet__
     {
         h->hi[k] = (int32_t)(((int64_t)n[k] + (1 << 14)) >> 15);
         h->lo[k] = n[k] - (int32_t)((uint32_t)h->hi[k] << 15);
+        h->n[k] = n[k];
     }
     h->d = d;
 }
@@ -40,9 +42,14 @@ static inline void lidet__ground_q_hplane(const int32_t n[3], int64_t d, lidet__
 static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, int32_t x, int32_t y,
                                              int32_t z)
 {
+#if LIDET_Q_HAVE_MUL64
+    /* SMULL and two SMLAL (Cortex-M3 and up): the same exact value */
+    return (int64_t)h->n[0] * x + (int64_t)h->n[1] * y + (int64_t)h->n[2] * z + h->d;
+#else
     const int32_t a = h->hi[0] * x + h->hi[1] * y + h->hi[2] * z;
     const int32_t b = h->lo[0] * x + h->lo[1] * y + h->lo[2] * z;
     return (int64_t)a * 32768 + b + h->d;
+#endif
 }
 
 /* SIMD hosts or not. The rows of R: 1 = column-wise lanes (each digit step of the square root over the whole
