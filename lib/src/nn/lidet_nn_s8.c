@@ -65,9 +65,11 @@ LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, u
  * ARMv6-M (Cortex-M0+: 8 low registers, no multiply-accumulate) takes the plain output-inner loop (two
  * inputs per pass: 6 instructions per multiply-add, rows4 costs more there). Cores with the DSP extension
  * (Cortex-M4, M7, M33 with DSP: __ARM_FEATURE_DSP) take lidet__nn_acc_s8_dsp below, two multiply-adds per
- * SMLAD. Override with -DLIDET_NN_S8_KERNEL=0 (rows4), 1 (output-inner), 2 (dsp), 22 or 42.
- * tests/unit/test_nn_s8.c checks that all agree (on the host the DSP kernel runs on a C model of the three
- * instructions it uses). */
+ * SMLAD. Override with -DLIDET_NN_S8_KERNEL=0 (rows4), 1 (output-inner), 2 (dsp), 22 or 42. Layers whose model
+ * carries the packed int16 copy of the weights (w_pk: the generated models on DSP cores) take the packed kernel
+ * and the fused pass further below instead (about 0.75 instead of 1.5 instructions per multiply-add).
+ * tests/unit/test_nn_s8.c checks that all agree (on the host the DSP kernels run on a C model of the three
+ * instructions they use). */
 #ifndef LIDET_NN_S8_KERNEL
 #if defined(__riscv)
 #define LIDET_NN_S8_KERNEL 42
