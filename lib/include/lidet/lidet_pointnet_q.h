@@ -93,6 +93,8 @@ typedef struct
 /** The layout of the generated int8 layer tables (2: w_pk, from stop 29; 1 had an int8 [out][in] copy,
  *  w_oi): the generated files refuse to compile against another. */
 #define LIDET_PNQ_LAYOUT_VERSION 2
+/* a file of layout 1 names its [out][in] copy through this macro: the compiler's error then names the fix */
+#define LIDET_PNQ_OI(a) lidet_weights_of_layout_1_regenerate_them_with_lidet_codegen_emit_int8
 
 /** @brief One stage: points -> shared layers -> max; [g | p]; the one-hot folded into head[0]'s bias. */
 typedef struct
