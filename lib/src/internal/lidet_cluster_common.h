@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "lidet/lidet_types.h" /* lidet_member_t */
+#include "lidet_simd.h"        /* LIDET_HOST_SIMD */
 
 /* pixel states in labels[] during a run (ids 1..LIDET_MAX_CLUSTERS are slots + 1) */
 #define LAB_FREE 0u         /* a candidate not visited yet */

@@ -141,6 +141,23 @@ typedef struct
 static void relabel_pixels(RUN_STATE_T *c, uint16_t *lab, uint32_t b, uint32_t e)
 {
     uint32_t i;
+#if !LIDET_HOST_SIMD
+    /* cores without SIMD: one pass, a branch per pixel (the two passes below cost a second read and write of
+     * every label there) */
+    for (i = b; i < e; ++i)
+    {
+        const uint32_t l = lab[i];
+        if (l >= LAB_SMALL)
+        {
+            lab[i] = 0u;
+        }
+        else if (l != 0u)
+        {
+            place_kept(c, lab, i);
+        }
+    }
+    return;
+#endif
     /* without a branch (it vectorises); kept pixels keep slot + 1 */
     for (i = b; i < e; ++i)
     {
