@@ -162,23 +162,6 @@ static inline void lidet__qpix_xyz_rc(const lidet_range_image_t *img, lidet__qpi
     lidet__qpix_decode(img->range_4mm[p], rt, ct, st, v);
 }
 
-/** x, y, z of pixels p (row trig rt) and pu (row trig rtu) of the same column c, stored or decoded */
-static inline void lidet__qpix_xyz2_rc(const lidet_range_image_t *img, lidet__qpix_row_t rt,
-                                       lidet__qpix_row_t rtu, uint32_t c, uint32_t p, uint32_t pu,
-                                       int32_t v[3], int32_t vu[3])
-{
-    int32_t ct, st;
-    if (img->x_4mm != 0)
-    {
-        lidet__qpix_stored(img, p, v);
-        lidet__qpix_stored(img, pu, vu);
-        return;
-    }
-    lidet__qpix_col(img, c, &ct, &st); /* once for both */
-    lidet__qpix_decode(img->range_4mm[p], rt, ct, st, v);
-    lidet__qpix_decode(img->range_4mm[pu], rtu, ct, st, vu);
-}
-
 /** x, y, z of pixel p (4 mm steps), stored or decoded */
 static inline void lidet__qpix_xyz(const lidet_range_image_t *img, uint32_t p, int32_t v[3])
 {
