@@ -9,6 +9,7 @@
 #include "internal/lidet_math.h"
 #include "internal/lidet_nn.h"
 #include "internal/lidet_pn_common.h"
+#include "internal/lidet_proposal_rule.h"
 #include "lidet/lidet_pointnet.h"
 
 #define NEG_BIG (-3.0e38f)
@@ -413,6 +414,18 @@ static void frame_of(const lidet_proposal_t *p, float cs[2], float voxel[3])
     voxel[2] = (float)p->voxel[2];
 }
 
+/* the rows the shared layers must see (internal/lidet_proposal_rule.h): the first n_points_src where the rest
+ * repeat them (compared exactly) */
+static uint32_t distinct_rows(const lidet_proposal_t *p)
+{
+    uint32_t n;
+#define ROW_EQ(i, j)                                                                                         \
+    (p->xyz[i][0] == p->xyz[j][0] && p->xyz[i][1] == p->xyz[j][1] && p->xyz[i][2] == p->xyz[j][2])
+    LIDET__PROPOSAL_DISTINCT_ROWS(p->n_points, p->n_points_src, ROW_EQ, n);
+#undef ROW_EQ
+    return n;
+}
+
 lidet_status_t lidet_pn_classify(lidet_pn_t *pn, const lidet_proposal_t *p, lidet_pn_class_out_t *out)
 {
     float voxel[3], cs[2], logits[LIDET_N_CLASSES];
@@ -434,7 +447,7 @@ lidet_status_t lidet_pn_classify(lidet_pn_t *pn, const lidet_proposal_t *p, lide
         return LIDET_ERR_ARG;
     }
     frame_of(p, cs, voxel);
-    forward(pn, &p->xyz[0][0], p->n_points, cs, voxel, 0, logits);
+    forward(pn, &p->xyz[0][0], distinct_rows(p), cs, voxel, 0, logits);
     out->energy = lidet_pn_energy(logits, m->n_classes, m->energy_t);
     out->cls = (uint8_t)argmax(logits, m->n_classes);
     for (i = 0; i < m->n_classes; ++i)
@@ -525,7 +538,7 @@ lidet_status_t lidet_pn_box(lidet_pn_t *pn, const lidet_proposal_t *p, uint32_t 
         onehot[i] = i == cls ? 1.0f : 0.0f;
     }
     frame_of(p, cs, voxel);
-    forward(pn, &p->xyz[0][0], p->n_points, cs, voxel, onehot, raw);
+    forward(pn, &p->xyz[0][0], distinct_rows(p), cs, voxel, onehot, raw);
     decode_box(m, raw, p->mean_m, cs, out);
     out->pass = out->energy < m->gamma[cls] ? 1u : 0u;
     return LIDET_OK;

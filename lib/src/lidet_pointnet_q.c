@@ -7,6 +7,7 @@
 
 #include "internal/lidet_pn_common.h"
 #include "internal/lidet_pointnet_q_internal.h"
+#include "internal/lidet_proposal_rule.h"
 #include "internal/lidet_qmath.h"
 #include "lidet/lidet_pointnet_q.h"
 
@@ -597,6 +598,18 @@ static lidet_status_t check_proposal(const lidet_pointnet_q_model_t *m, const li
     return LIDET_OK;
 }
 
+/* the rows the shared layers must see (internal/lidet_proposal_rule.h): the first n_points_src where the rest
+ * repeat them */
+static uint32_t distinct_rows(const lidet_proposal_q_t *p)
+{
+    uint32_t n;
+#define ROW_EQ(i, j)                                                                                         \
+    (p->xyz[i][0] == p->xyz[j][0] && p->xyz[i][1] == p->xyz[j][1] && p->xyz[i][2] == p->xyz[j][2])
+    LIDET__PROPOSAL_DISTINCT_ROWS(p->n_points, p->n_points_src, ROW_EQ, n);
+#undef ROW_EQ
+    return n;
+}
+
 lidet_status_t lidet_pointnet_q_classify(lidet_pointnet_q_t *pn, const lidet_proposal_q_t *p,
                                          lidet_pointnet_q_class_out_t *out)
 {
@@ -622,7 +635,7 @@ lidet_status_t lidet_pointnet_q_classify(lidet_pointnet_q_t *pn, const lidet_pro
         return st;
     }
     frame_of(p, &f);
-    forward(pn, &p->xyz[0][0], p->n_points, &f, p->voxel, 0, logits);
+    forward(pn, &p->xyz[0][0], distinct_rows(p), &f, p->voxel, 0, logits);
     out->energy_q16 = energy_parts(logits, m->n_classes, m->energy_t_q16, terms, &sum);
     out->cls = (uint8_t)argmax32(logits, m->n_classes);
     for (i = 0; i < m->n_classes; ++i)
@@ -703,7 +716,7 @@ lidet_status_t lidet_pointnet_q_box(lidet_pointnet_q_t *pn, const lidet_proposal
         return st;
     }
     frame_of(p, &f);
-    forward(pn, &p->xyz[0][0], p->n_points, &f, p->voxel, cls, raw);
+    forward(pn, &p->xyz[0][0], distinct_rows(p), &f, p->voxel, cls, raw);
     decode_box(m, raw, p, &f, out);
     out->pass = out->energy_q16 < m->gamma_q16[cls] ? 1u : 0u;
     return LIDET_OK;

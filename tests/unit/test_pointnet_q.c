@@ -262,6 +262,89 @@ void test_generated_int8_models(void)
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pointnet_q_box(&box, &p, co.cls, &bo));
 }
 
+/* A proposal of a cluster of n_src < n_points members repeats rows of its first n_src (the resampling rule):
+ * classify and box run the shared layers on those rows only (internal/lidet_proposal_rule.h). Every generated
+ * model, n_src 1, 5 and n - 1: the outputs equal those of the same rows without the hint (n_points_src 0: every
+ * row); and a last row that is no copy (a proposal made by hand) is still seen: the outputs again equal those
+ * of every row, and differ from the copies' (the far row changes the maximum). */
+static void repeat_rows(lidet_proposal_q_t *p, uint32_t n, uint32_t n_src)
+{
+    uint32_t i;
+    memset(p, 0, sizeof *p);
+    p->n_points = n;
+    for (i = 0; i < n; ++i)
+    {
+        const uint32_t k = i < n_src ? i : (7u * i + 3u) % n_src;
+        p->xyz[i][0] = (int16_t)(37 * (int32_t)(k % 13) - 220); /* 4 mm steps: a blob of about 2 m */
+        p->xyz[i][1] = (int16_t)(29 * (int32_t)(k % 7) - 90);
+        p->xyz[i][2] = (int16_t)(23 * (int32_t)(k % 11) - 110);
+    }
+    p->mean_4mm[0] = 2500; /* 10 m ahead, 2 m left */
+    p->mean_4mm[1] = 500;
+    p->mean_4mm[2] = -100;
+    p->voxel[2] = 10;
+}
+
+static void run_both(lidet_pointnet_q_t *pn, const lidet_proposal_q_t *p, uint32_t cls,
+                     lidet_pointnet_q_class_out_t *co, lidet_pointnet_q_box_out_t *bo)
+{
+    memset(co, 0, sizeof *co);
+    memset(bo, 0, sizeof *bo);
+    if (pn->model->kind == LIDET_PN_CLASSIFIER)
+    {
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pointnet_q_classify(pn, p, co));
+    }
+    else
+    {
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pointnet_q_box(pn, p, cls, bo));
+    }
+}
+
+void test_repeated_rows_are_run_once(void)
+{
+    static lidet_pointnet_q_t pn;
+    static const uint32_t srcs[3] = {1u, 5u, 0u};
+    lidet_pointnet_q_class_out_t c_hint, c_all, c_copy;
+    lidet_pointnet_q_box_out_t b_hint, b_all, b_copy;
+    lidet_proposal_q_t p;
+    uint32_t i, j, cls;
+    for (i = 0; i < LIDET_WEIGHTS_N_MODELS_S8; ++i)
+    {
+        const lidet_pointnet_q_model_t *m = lidet_weights_models_s8[i].model;
+        const uint32_t n = m->n_points;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pointnet_q_init(&pn, m, g_scratch, sizeof g_scratch, NULL));
+        for (j = 0; j < 3u; ++j)
+        {
+            const uint32_t n_src = srcs[j] != 0u ? srcs[j] : n - 1u;
+            for (cls = 0; cls < (m->kind == LIDET_PN_BOX ? (uint32_t)LIDET_N_CLASSES : 1u); ++cls)
+            {
+                repeat_rows(&p, n, n_src);
+                p.n_points_src = n_src;
+                run_both(&pn, &p, cls, &c_hint, &b_hint);
+                p.n_points_src = 0;
+                run_both(&pn, &p, cls, &c_all, &b_all);
+                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&c_all, &c_hint, sizeof c_all, m->name);
+                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&b_all, &b_hint, sizeof b_all, m->name);
+                memcpy(&c_copy, &c_hint, sizeof c_copy);
+                memcpy(&b_copy, &b_hint, sizeof b_copy);
+                /* the last row no copy: far to the right and high */
+                p.xyz[n - 1u][0] = 1500;
+                p.xyz[n - 1u][1] = -2000;
+                p.xyz[n - 1u][2] = 600;
+                p.n_points_src = n_src;
+                run_both(&pn, &p, cls, &c_hint, &b_hint);
+                p.n_points_src = 0;
+                run_both(&pn, &p, cls, &c_all, &b_all);
+                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&c_all, &c_hint, sizeof c_all, m->name);
+                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&b_all, &b_hint, sizeof b_all, m->name);
+                TEST_ASSERT_FALSE_MESSAGE(memcmp(&c_copy, &c_hint, sizeof c_copy) == 0 &&
+                                              memcmp(&b_copy, &b_hint, sizeof b_copy) == 0,
+                                          m->name);
+            }
+        }
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -270,5 +353,6 @@ int main(void)
     RUN_TEST(test_malformed_descriptors);
     RUN_TEST(test_scratch_and_state);
     RUN_TEST(test_generated_int8_models);
+    RUN_TEST(test_repeated_rows_are_run_once);
     return UNITY_END();
 }

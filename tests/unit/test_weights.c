@@ -70,11 +70,92 @@ void test_models_run(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_pn_box(&cls, &p, 0, &bo));
 }
 
+/* Proposals of clusters smaller than n_points repeat their first n_src rows: classify and box run the shared
+ * layers on those rows only (internal/lidet_proposal_rule.h). Every generated model: the same outputs, bit for
+ * bit, as without the hint (n_points_src 0: every row), and a last row that is no copy is still seen. */
+static void repeat_rows(lidet_proposal_t *p, uint32_t n, uint32_t n_src)
+{
+    uint32_t i;
+    memset(p, 0, sizeof *p);
+    p->n_points = n;
+    for (i = 0; i < n; ++i)
+    {
+        const uint32_t k = i < n_src ? i : (7u * i + 3u) % n_src;
+        p->xyz[i][0] = 0.15f * (float)(k % 13) - 0.9f;
+        p->xyz[i][1] = 0.11f * (float)(k % 7) - 0.35f;
+        p->xyz[i][2] = 0.09f * (float)(k % 11) - 0.45f;
+    }
+    p->mean_m[0] = 10.0f;
+    p->mean_m[1] = 2.0f;
+    p->mean_m[2] = -0.4f;
+    p->voxel[2] = 10;
+}
+
+static void run_both(lidet_pn_t *pn, const lidet_proposal_t *p, uint32_t cls, lidet_pn_class_out_t *co,
+                     lidet_pn_box_out_t *bo)
+{
+    memset(co, 0, sizeof *co);
+    memset(bo, 0, sizeof *bo);
+    if (pn->model->kind == LIDET_PN_CLASSIFIER)
+    {
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_classify(pn, p, co));
+    }
+    else
+    {
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_box(pn, p, cls, bo));
+    }
+}
+
+void test_repeated_rows_are_run_once(void)
+{
+    static lidet_pn_t pn;
+    static const uint32_t srcs[3] = {1u, 5u, 0u};
+    lidet_pn_class_out_t c_hint, c_all, c_copy;
+    lidet_pn_box_out_t b_hint, b_all, b_copy;
+    lidet_proposal_t p;
+    uint32_t i, j, cls;
+    for (i = 0; i < LIDET_WEIGHTS_N_MODELS; ++i)
+    {
+        const lidet_pn_model_t *m = lidet_weights_models[i].model;
+        const uint32_t n = m->n_points;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pn_init(&pn, m, g_scratch, sizeof g_scratch, NULL));
+        for (j = 0; j < 3u; ++j)
+        {
+            const uint32_t n_src = srcs[j] != 0u ? srcs[j] : n - 1u;
+            for (cls = 0; cls < (m->kind == LIDET_PN_BOX ? (uint32_t)LIDET_N_CLASSES : 1u); ++cls)
+            {
+                repeat_rows(&p, n, n_src);
+                p.n_points_src = n_src;
+                run_both(&pn, &p, cls, &c_hint, &b_hint);
+                p.n_points_src = 0;
+                run_both(&pn, &p, cls, &c_all, &b_all);
+                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&c_all, &c_hint, sizeof c_all, m->name);
+                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&b_all, &b_hint, sizeof b_all, m->name);
+                memcpy(&c_copy, &c_hint, sizeof c_copy);
+                memcpy(&b_copy, &b_hint, sizeof b_copy);
+                p.xyz[n - 1u][0] = 6.0f; /* the last row no copy: far to the right and high */
+                p.xyz[n - 1u][1] = -8.0f;
+                p.xyz[n - 1u][2] = 2.4f;
+                p.n_points_src = n_src;
+                run_both(&pn, &p, cls, &c_hint, &b_hint);
+                p.n_points_src = 0;
+                run_both(&pn, &p, cls, &c_all, &b_all);
+                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&c_all, &c_hint, sizeof c_all, m->name);
+                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&b_all, &b_hint, sizeof b_all, m->name);
+                TEST_ASSERT_FALSE_MESSAGE(memcmp(&c_copy, &c_hint, sizeof c_copy) == 0 &&
+                                              memcmp(&b_copy, &b_hint, sizeof b_copy) == 0,
+                                          m->name);
+            }
+        }
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_every_model_is_valid);
     RUN_TEST(test_scratch_macros_match);
     RUN_TEST(test_models_run);
+    RUN_TEST(test_repeated_rows_are_run_once);
     return UNITY_END();
 }

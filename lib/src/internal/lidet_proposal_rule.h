@@ -42,4 +42,32 @@ static inline uint32_t lidet__proposal_next_index(uint32_t *s, uint32_t i, uint3
     }
 }
 
+/* The rows a per-point network must see (lidet_pointnet.c, lidet_pointnet_q.c). A cluster of n_src < n_out
+ * members gives a proposal whose rows n_src, ..., n_out - 1 repeat rows of the first n_src (the rule above).
+ * A PointNet's shared layers see each row alone and the rows meet only in a maximum, which a repeated row
+ * cannot change: the first n_src rows give the same result, bit for bit, at n_src / n_out of the cost (about a
+ * third of the simulated VLP-16 proposals' rows). The repeats are checked, not assumed (a proposal filled by a
+ * caller may hold anything): returns n_src where every later row equals one of the first n_src, else n_out.
+ * ROW_EQ(i, j): rows i and j are equal (an exact comparison). */
+#define LIDET__PROPOSAL_DISTINCT_ROWS(n_out, n_src, ROW_EQ, result)                                          \
+    do                                                                                                       \
+    {                                                                                                        \
+        uint32_t pdr_i_, pdr_j_;                                                                             \
+        (result) = (n_out);                                                                                  \
+        if ((n_src) >= 1u && (n_src) < (n_out))                                                              \
+        {                                                                                                    \
+            for (pdr_i_ = (n_src); pdr_i_ < (n_out); ++pdr_i_)                                               \
+            {                                                                                                \
+                for (pdr_j_ = 0; pdr_j_ < (n_src) && !(ROW_EQ(pdr_i_, pdr_j_)); ++pdr_j_)                    \
+                {                                                                                            \
+                }                                                                                            \
+                if (pdr_j_ == (n_src))                                                                       \
+                {                                                                                            \
+                    break; /* a row of its own: every row counts */                                          \
+                }                                                                                            \
+            }                                                                                                \
+            (result) = pdr_i_ == (n_out) ? (n_src) : (n_out);                                                \
+        }                                                                                                    \
+    } while (0)
+
 #endif
