@@ -434,6 +434,11 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     }
     CLI_SET_FLOAT(c, kv, klen, v, stages.proj.azimuth_half_rad)
     CLI_SET_INT(c, kv, klen, v, stages.ground.seed_per_cell, uint8_t, 1)
+    /* the ground stage's speed knobs (lidet_ground.h; the integer detector takes the same values) */
+    CLI_SET_INT(c, kv, klen, v, stages.ground.sample_step, uint16_t, 16)
+    CLI_SET_INT(c, kv, klen, v, stages.ground.sample_col_step, uint16_t, 16)
+    CLI_SET_INT(c, kv, klen, v, stages.ground.ransac_iters, uint16_t, 1000)
+    CLI_SET_INT(c, kv, klen, v, stages.ground.refine_iters, uint8_t, 10)
     /* any clustering field, the proposal refinement of issue 15 included */
     if (strncmp(kv, "stages.cluster.", 15) == 0)
         return cli_cluster_set(&c->stages.cluster, kv + 15);
@@ -538,6 +543,9 @@ static void usage_extra(void)
                     "                   stages.proj.azimuth_half_rad: the projection's window and\n"
                     "                   stages.ground.seed_per_cell: a RANSAC stream per ground cell (the crop\n"
                     "                   sets both: the clustering's window + one ground sector, and 1)\n"
+                    "                   stages.ground.sample_step, sample_col_step, ransac_iters,\n"
+                    "                   refine_iters: the ground stage's speed knobs (lidet_ground.h; --fixed\n"
+                    "                   takes the same values)\n"
                     "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n"
                     "  --dump FILE      every result bit for bit (per-point labels, clusters, proposals,\n"
                     "                   detections; binary, see write_dump in cli_detect.c)\n");

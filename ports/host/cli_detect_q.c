@@ -64,6 +64,10 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     /* the refinement's switches (its thresholds stay the integer defaults) */
     cfg.cluster.split_people = fcfg->stages.cluster.split_people;
     cfg.cluster.join_cars = fcfg->stages.cluster.join_cars;
+    cfg.ground.sample_step = fcfg->stages.ground.sample_step;
+    cfg.ground.sample_col_step = fcfg->stages.ground.sample_col_step;
+    cfg.ground.ransac_iters = fcfg->stages.ground.ransac_iters;
+    cfg.ground.refine_iters = fcfg->stages.ground.refine_iters;
     cfg.gate1 = fcfg->gate1;
     cfg.gate2 = fcfg->gate2;
     cfg.gate1_margin_q16 = round_i32((double)fcfg->gate1_margin * 65536.0);

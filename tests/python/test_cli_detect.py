@@ -175,3 +175,26 @@ def test_mount_height_option(cli, tmp_path):
     r = subprocess.run([str(cli), "ground", str(scan), "--sensor", "vlp16", "--mount-height", "1.0", "--json"],
                        capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
+
+
+def test_ground_speed_knobs_reach_both_detectors(cli):
+    """--set stages.ground.{sample_step, sample_col_step, ransac_iters, refine_iters}: the float detector and
+    --fixed take them (a firmware's speed trade, docs/FIXED_POINT.md); the profile's own value changes nothing,
+    another changes the result, a value out of range is refused."""
+    scan = ROOT / "tests" / "data" / "sim_vlp16" / "velodyne" / "000000.bin"
+
+    def result(*extra):
+        js = json.loads(_run(cli, scan, "--sensor", "vlp16", "--json", *extra).stdout)
+        return {k: v for k, v in js.items() if not k.endswith("_ms")}
+
+    for fixed in ((), ("--fixed",)):
+        base = result(*fixed)
+        # the vlp16 profile's defaults (lidet_ground_cfg_default: a low-row sensor): 2 refinements, every row
+        assert result(*fixed, "--set", "stages.ground.refine_iters=2") == base
+        assert result(*fixed, "--set", "stages.ground.sample_step=1") == base
+        for kv in ("refine_iters=1", "sample_step=2", "ransac_iters=8", "sample_col_step=3"):
+            assert result(*fixed, "--set", f"stages.ground.{kv}") != base, (fixed, kv)
+        r = _run(cli, scan, "--sensor", "vlp16", *fixed, "--set", "stages.ground.sample_step=17", ok=False)
+        assert r.returncode != 0 and "stages.ground.sample_step=17" in r.stderr
+        r = _run(cli, scan, "--sensor", "vlp16", *fixed, "--set", "stages.ground.sample_step=0", ok=False)
+        assert r.returncode != 0 and "LIDET_ERR_CONFIG" in r.stderr
