@@ -9,6 +9,7 @@
 #include "internal/lidet_pointnet_q_internal.h"
 #include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
 #include "internal/lidet_qmath.h"
+#include <string.h>
 
 /* rows r..r+3 of acc += in rows * W: four rows share each weight load */
 static inline void rows4_s8(const int8_t *x, uint32_t n_in, const int8_t *w_t, uint32_t n_out,
@@ -740,7 +741,12 @@ static inline int32_t rq_fast_c(uint32_t k, int32_t zp)
 
 S8_ALWAYS_INLINE int8_t rq_fast(int32_t a, int32_t m, uint32_t k, int32_t c)
 {
-    return clamp_s8(((int32_t)(((int64_t)a * m) >> 32) + c) >> k, -128);
+    const int32_t v = ((int32_t)(((int64_t)a * m) >> 32) + c) >> k;
+#if defined(__ARM_FEATURE_SAT) && __ARM_FEATURE_SAT
+    return (int8_t)__ssat(v, 8); /* SSAT's own -128 (GCC does not drop clamp_s8's second compare after it) */
+#else
+    return clamp_s8(v, -128);
+#endif
 }
 
 /* the fused pass's rows: mode PKF_RQ requantizes with rq_one, PKF_RQ_FAST with rq_fast (every channel's shift in
@@ -864,10 +870,21 @@ void lidet__nn_acc_s16_3_requant(const int16_t *in, uint32_t n_rows, const int8_
             /* the usual case (rq_fast) */
             const uint32_t k = sh - 32u;
             const int32_t c = rq_fast_c(k, zp);
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && !defined(__ARM_BIG_ENDIAN)
+            /* x and y in one (possibly unaligned) little-endian word: one SMLAD for both products */
+            const uint32_t w01 = ((uint32_t)w0 & 0xFFFFu) | ((uint32_t)w1 << 16);
+            for (r = 0; r < n_rows; ++r, x += 3, d += n_out)
+            {
+                uint32_t xy;
+                memcpy(&xy, x, sizeof xy);
+                *d = rq_fast(S8_SMLAD(xy, w01, bo) + x[2] * w2, m, k, c);
+            }
+#else
             for (r = 0; r < n_rows; ++r, x += 3, d += n_out)
             {
                 *d = rq_fast(bo + x[0] * w0 + x[1] * w1 + x[2] * w2, m, k, c);
             }
+#endif
         }
         else
         {
