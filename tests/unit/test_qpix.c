@@ -170,11 +170,47 @@ static void test_empty_pixels_and_accepted_images(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proj_q_run(&g_st, &b, g_pts, 0, 3, 0));
 }
 
+/* lidet__q_div_round (internal/lidet_qmath.h) takes a 32-bit division where the rounded dividend and the divisor
+ * fit 32 bits: the same quotients as the int64 rule round(n / d), halves away from zero, on both sides of that
+ * boundary, for both signs, at the halves and at random */
+static int64_t div_round_ref(int64_t n, int64_t d)
+{
+    return n >= 0 ? (n + d / 2) / d : -((-n + d / 2) / d);
+}
+
+void test_div_round_on_both_sides_of_32_bits(void)
+{
+    static const int64_t ds[] = {1, 2, 3, 7, 250, 65535, 0x7FFFFFFF, 0xFFFFFFFFLL, 0x100000000LL, 0x200000003LL};
+    uint32_t i, j, state = 12345u;
+    for (i = 0; i < sizeof ds / sizeof ds[0]; ++i)
+    {
+        const int64_t d = ds[i], edge = ((int64_t)1 << 32) - d / 2; /* the first |n| past the 32-bit path */
+        const int64_t ns[] = {0, 1, d / 2, d / 2 + 1, d - 1, d, 3 * d / 2, edge - 2, edge - 1, edge, edge + 1,
+                              (int64_t)1 << 40, ((int64_t)1 << 62) - d};
+        for (j = 0; j < sizeof ns / sizeof ns[0]; ++j)
+        {
+            TEST_ASSERT_EQUAL_INT64(div_round_ref(ns[j], d), lidet__q_div_round(ns[j], d));
+            TEST_ASSERT_EQUAL_INT64(div_round_ref(-ns[j], d), lidet__q_div_round(-ns[j], d));
+        }
+        for (j = 0; j < 2000u; ++j)
+        {
+            int64_t n;
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            n = (int64_t)(state >> (j % 8u)) * (j % 3u == 0u ? 1 : (int64_t)(j % 5u) + 1);
+            n = j & 1u ? -n : n;
+            TEST_ASSERT_EQUAL_INT64(div_round_ref(n, d), lidet__q_div_round(n, d));
+        }
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_tables_match_the_computed_values);
     RUN_TEST(test_projected_points_decode_back);
     RUN_TEST(test_empty_pixels_and_accepted_images);
+    RUN_TEST(test_div_round_on_both_sides_of_32_bits);
     return UNITY_END();
 }
