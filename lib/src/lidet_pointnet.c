@@ -415,12 +415,14 @@ static void frame_of(const lidet_proposal_t *p, float cs[2], float voxel[3])
 }
 
 /* the rows the shared layers must see (internal/lidet_proposal_rule.h): the first n_points_src where the rest
- * repeat them (compared exactly) */
+ * repeat them, compared by value and by bits (a NaN row matches none, as its place in the maximum matters; -0
+ * and +0 do not match each other) */
 static uint32_t distinct_rows(const lidet_proposal_t *p)
 {
     uint32_t n;
 #define ROW_EQ(i, j)                                                                                         \
-    (p->xyz[i][0] == p->xyz[j][0] && p->xyz[i][1] == p->xyz[j][1] && p->xyz[i][2] == p->xyz[j][2])
+    (p->xyz[i][0] == p->xyz[j][0] && p->xyz[i][1] == p->xyz[j][1] && p->xyz[i][2] == p->xyz[j][2] &&         \
+     memcmp(p->xyz[i], p->xyz[j], sizeof p->xyz[i]) == 0)
     LIDET__PROPOSAL_DISTINCT_ROWS(p->n_points, p->n_points_src, ROW_EQ, n);
 #undef ROW_EQ
     return n;

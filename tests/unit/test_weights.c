@@ -91,8 +91,7 @@ static void repeat_rows(lidet_proposal_t *p, uint32_t n, uint32_t n_src)
     p->voxel[2] = 10;
 }
 
-static void run_both(lidet_pn_t *pn, const lidet_proposal_t *p, uint32_t cls, lidet_pn_class_out_t *co,
-                     lidet_pn_box_out_t *bo)
+static void run_one(lidet_pn_t *pn, const lidet_proposal_t *p, uint32_t cls, lidet_pn_class_out_t *co, lidet_pn_box_out_t *bo)
 {
     memset(co, 0, sizeof *co);
     memset(bo, 0, sizeof *bo);
@@ -106,12 +105,26 @@ static void run_both(lidet_pn_t *pn, const lidet_proposal_t *p, uint32_t cls, li
     }
 }
 
+/* the outputs with the hint n_points_src = n_src (into co, bo) equal those without it (every row) */
+static void same_with_and_without_hint(lidet_pn_t *pn, lidet_proposal_t *p, uint32_t cls, uint32_t n_src, lidet_pn_class_out_t *co,
+                                       lidet_pn_box_out_t *bo)
+{
+    lidet_pn_class_out_t c_all;
+    lidet_pn_box_out_t b_all;
+    p->n_points_src = 0;
+    run_one(pn, p, cls, &c_all, &b_all);
+    p->n_points_src = n_src;
+    run_one(pn, p, cls, co, bo);
+    TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&c_all, co, sizeof c_all, pn->model->name);
+    TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&b_all, bo, sizeof b_all, pn->model->name);
+}
+
 void test_repeated_rows_are_run_once(void)
 {
     static lidet_pn_t pn;
     static const uint32_t srcs[3] = {1u, 5u, 0u};
-    lidet_pn_class_out_t c_hint, c_all, c_copy;
-    lidet_pn_box_out_t b_hint, b_all, b_copy;
+    lidet_pn_class_out_t c_hint, c_copy;
+    lidet_pn_box_out_t b_hint, b_copy;
     lidet_proposal_t p;
     uint32_t i, j, cls;
     for (i = 0; i < LIDET_WEIGHTS_N_MODELS; ++i)
@@ -125,23 +138,12 @@ void test_repeated_rows_are_run_once(void)
             for (cls = 0; cls < (m->kind == LIDET_PN_BOX ? (uint32_t)LIDET_N_CLASSES : 1u); ++cls)
             {
                 repeat_rows(&p, n, n_src);
-                p.n_points_src = n_src;
-                run_both(&pn, &p, cls, &c_hint, &b_hint);
-                p.n_points_src = 0;
-                run_both(&pn, &p, cls, &c_all, &b_all);
-                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&c_all, &c_hint, sizeof c_all, m->name);
-                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&b_all, &b_hint, sizeof b_all, m->name);
-                memcpy(&c_copy, &c_hint, sizeof c_copy);
-                memcpy(&b_copy, &b_hint, sizeof b_copy);
-                p.xyz[n - 1u][0] = 6.0f; /* the last row no copy: far to the right and high */
+                same_with_and_without_hint(&pn, &p, cls, n_src, &c_copy, &b_copy);
+                /* the last row no copy: far to the right and high */
+                p.xyz[n - 1u][0] = 6.0f;
                 p.xyz[n - 1u][1] = -8.0f;
                 p.xyz[n - 1u][2] = 2.4f;
-                p.n_points_src = n_src;
-                run_both(&pn, &p, cls, &c_hint, &b_hint);
-                p.n_points_src = 0;
-                run_both(&pn, &p, cls, &c_all, &b_all);
-                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&c_all, &c_hint, sizeof c_all, m->name);
-                TEST_ASSERT_EQUAL_MEMORY_MESSAGE(&b_all, &b_hint, sizeof b_all, m->name);
+                same_with_and_without_hint(&pn, &p, cls, n_src, &c_hint, &b_hint);
                 TEST_ASSERT_FALSE_MESSAGE(memcmp(&c_copy, &c_hint, sizeof c_copy) == 0 &&
                                               memcmp(&b_copy, &b_hint, sizeof b_copy) == 0,
                                           m->name);
