@@ -239,10 +239,12 @@ def run(args) -> str:
         "picolibc-riscv64-unknown-elf, qemu-system-misc and their dependencies, 36 packages) took 59 s wall on this "
         "machine after `apt-get update` (314 MB downloaded in 2 s, the rest unpacking; 2.4 GB on disk, most of it "
         "the C libraries' multilib variants: picolibc-riscv64 1.0 GB, newlib-arm 0.37 GB, gcc-arm 0.44 GB). "
-        "Building the seven images adds about a minute to `make build` on 2 cores; running them adds 1.5 to 3 minutes "
-        "to ctest at -j2, almost all of it the two soft-float images (M0+ and M3: 37 G and 16 G instructions under "
-        "QEMU for their two runs; the M0+ image took 72 s alone on an idle core, 178 s within `make test` on this "
-        "shared machine).",
+        f"Building the {len(reports)} images adds about a minute to `make build` on 2 cores; running them adds about "
+        "a minute to ctest at -j2 (48 s of test time in all, stop 30), most of it the two soft-float images"
+        + (" (M0+ and M3: " + " and ".join(f"{sum(r['scan'] for r in reports[b]['insn'].values()) / 1e9:.1f} G"
+                                          for b in ("mps2-an385-m0plus", "mps2-an385"))
+           + " instructions under QEMU for their two runs; 14.6 s and 7.7 s in ctest at -j2, stop 30)"
+           if all(b in reports for b in ("mps2-an385-m0plus", "mps2-an385")) else "") + ".",
         "",
         "Commands: `make firmware` (builds every image; or `cmake --build build --target firmware`), "
         "`make firmware-run` (= `ctest --test-dir build -R '^firmware_' -V`: each image under QEMU, compared with "
