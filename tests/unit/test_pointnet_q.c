@@ -285,7 +285,8 @@ static void repeat_rows(lidet_proposal_q_t *p, uint32_t n, uint32_t n_src)
     p->voxel[2] = 10;
 }
 
-static void run_one(lidet_pointnet_q_t *pn, const lidet_proposal_q_t *p, uint32_t cls, lidet_pointnet_q_class_out_t *co, lidet_pointnet_q_box_out_t *bo)
+static void run_one(lidet_pointnet_q_t *pn, const lidet_proposal_q_t *p, uint32_t cls, lidet_pointnet_q_class_out_t *co,
+                    lidet_pointnet_q_box_out_t *bo)
 {
     memset(co, 0, sizeof *co);
     memset(bo, 0, sizeof *bo);
@@ -300,8 +301,8 @@ static void run_one(lidet_pointnet_q_t *pn, const lidet_proposal_q_t *p, uint32_
 }
 
 /* the outputs with the hint n_points_src = n_src (into co, bo) equal those without it (every row) */
-static void same_with_and_without_hint(lidet_pointnet_q_t *pn, lidet_proposal_q_t *p, uint32_t cls, uint32_t n_src, lidet_pointnet_q_class_out_t *co,
-                                       lidet_pointnet_q_box_out_t *bo)
+static void same_with_and_without_hint(lidet_pointnet_q_t *pn, lidet_proposal_q_t *p, uint32_t cls, uint32_t n_src,
+                                       lidet_pointnet_q_class_out_t *co, lidet_pointnet_q_box_out_t *bo)
 {
     lidet_pointnet_q_class_out_t c_all;
     lidet_pointnet_q_box_out_t b_all;
