@@ -186,67 +186,31 @@ static inline uint32_t rxy2(const int16_t *x, const int16_t *y, uint32_t p)
     return (uint32_t)((int32_t)x[p] * x[p]) + (uint32_t)((int32_t)y[p] * y[p]);
 }
 
-/* x^2 + y^2 of pixel p = r cols + c, stored or decoded (rt: row r's trig) */
-static inline uint32_t rxy2_at(const lidet_range_image_t *img, lidet__qpix_row_t rt, uint32_t c, uint32_t p)
-{
-    int32_t q[3];
-    if (!lidet__qpix_range_only(img))
-    {
-        return rxy2(img->x_4mm, img->y_4mm, p);
-    }
-    lidet__qpix_xyz_rc(img, rt, c, p, q);
-    return (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]); /* |q| <= 32750 */
-}
-
-/* x^2 + y^2 of one quadrant's qn pixels of a range-only row (table t: sin, cos of the quarter turn's columns):
- * quadrant 0 ct = cos, st = sin; 1: ct = -sin, st = cos; 2: -cos, -sin; 3: sin, -cos (swap, the signs: constants
- * where inlined) */
-static inline void rxy2_quadrant(const uint16_t *rng, const int32_t *t, uint32_t qn, lidet__qpix_row_t rt,
-                                 const int swap, const int32_t sgn_c, const int32_t sgn_s,
-                                 uint32_t *restrict v)
-{
-    uint32_t j;
-    for (j = 0; j < qn; ++j)
-    {
-        const int32_t sn = t[2u * j], cs = t[2u * j + 1u];
-        int32_t q[3];
-        lidet__qpix_decode(rng[j], rt, sgn_c * (swap ? sn : cs), sgn_s * (swap ? cs : sn), q);
-        v[j] = (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]);
-    }
-}
-
-/* x^2 + y^2 of row r's pixels into v */
+/* x^2 + y^2 of row r's pixels into v (an image that stores x, y, z) */
 static void row_rxy2(const lidet_range_image_t *img, uint32_t r, uint32_t *restrict v)
 {
     const uint32_t cols = img->n_cols, base = r * cols;
+    const int16_t *x = img->x_4mm + base, *y = img->y_4mm + base;
     uint32_t c;
-    if (!lidet__qpix_range_only(img))
+    for (c = 0; c < cols; ++c)
     {
-        const int16_t *x = img->x_4mm + base, *y = img->y_4mm + base;
-        for (c = 0; c < cols; ++c)
-        {
-            v[c] = rxy2(x, y, c);
-        }
-        return;
+        v[c] = rxy2(x, y, c);
     }
-    {
-        const lidet__qpix_row_t rt = lidet__qpix_row(img, r);
-        if (img->col_trig_q15 != 0 && cols % 4u == 0u)
-        {
-            /* quadrant by quadrant: lidet__qpix_col's fold of the quarter-turn table, hoisted out of the loop */
-            const uint32_t qn = cols / 4u;
-            const uint16_t *rng = img->range_4mm + base;
-            rxy2_quadrant(rng, img->col_trig_q15, qn, rt, 0, 1, 1, v);
-            rxy2_quadrant(rng + qn, img->col_trig_q15, qn, rt, 1, -1, 1, v + qn);
-            rxy2_quadrant(rng + 2u * qn, img->col_trig_q15, qn, rt, 0, -1, -1, v + 2u * qn);
-            rxy2_quadrant(rng + 3u * qn, img->col_trig_q15, qn, rt, 1, 1, -1, v + 3u * qn);
-            return;
-        }
-        for (c = 0; c < cols; ++c)
-        {
-            v[c] = rxy2_at(img, rt, c, base + c);
-        }
-    }
+}
+
+/* R of a range-only image's pixel: its range times the cosine of its row's elevation (ce, Q15), in R steps
+ * (4 mm / 2^8), rounded half up: round(rng ce / 2^7). The horizontal distance of the decoded point without the
+ * square root (the decoded x, y are this ray's, rounded to 4 mm steps); rng < 2^15 and 0 <= ce <= 2^15, so the
+ * product fits 32 bits. ref/ground_q.py: r_of_range */
+static inline int32_t r_of_range(uint32_t rng, int32_t ce)
+{
+    return (int32_t)(((rng & 0x7FFFu) * (uint32_t)ce + 64u) >> 7);
+}
+
+/* R of pixel p (x^2 + y^2 = v) on a row of trig rt: from the range in a range-only image, else from v */
+static inline int32_t r_pixel(const lidet_range_image_t *img, lidet__qpix_row_t rt, uint32_t p, uint32_t v)
+{
+    return lidet__qpix_range_only(img) ? r_of_range(img->range_4mm[p], rt.ce) : r_of(v);
 }
 
 /* R of a whole row r, digit step by digit step over the columns (the same values as r_of, but the column
@@ -258,6 +222,18 @@ static void r_of_row(const lidet_range_image_t *img, uint32_t r, int32_t *restri
     const uint32_t cols = img->n_cols;
     uint32_t c;
     int i;
+    if (lidet__qpix_range_only(img))
+    {
+        const uint16_t *rng = img->range_4mm + (size_t)r * cols;
+        const int32_t ce = lidet__qpix_row(img, r).ce;
+        (void)v;
+        (void)rem;
+        for (c = 0; c < cols; ++c)
+        {
+            out[c] = r_of_range(rng[c], ce);
+        }
+        return;
+    }
     row_rxy2(img, r, v);
 #if !LIDET_GROUND_Q_SQRT_LANES
     (void)root;
@@ -498,12 +474,14 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
  * (row - 1) holds a point, 4 |dz| > veto_min_dz_mm and |dz| * 2^24 > veto_slope_q16 * |dR|. R is computed only
  * where a test needs it: the veto's slope test of an in-band pixel with a step of more than veto_min_dz_mm
  * (rare on the ground), or every pixel with a tolerance growing with range. */
-/* R of pixel c of a row through a lazily filled row cache (-1 = not computed yet) */
-static inline int32_t r_cached(int32_t *row, uint32_t c, uint32_t v)
+/* R of pixel p = r cols + c (row trig rt, x^2 + y^2 = v) through a lazily filled row cache (-1 = not computed
+ * yet) */
+static inline int32_t r_cached(int32_t *row, const lidet_range_image_t *img, lidet__qpix_row_t rt, uint32_t c,
+                               uint32_t p, uint32_t v)
 {
     if (row[c] < 0)
     {
-        row[c] = r_of(v);
+        row[c] = r_pixel(img, rt, p, v);
     }
     return row[c];
 }
@@ -562,7 +540,7 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
                 if (k != 0)
                 {
                     /* R steps are 1/64 mm: k R / 2^16 mm = (k R) << 6 in 4 mm / 2^30 */
-                    above = above0 + ((k * r_cached(Rr, c, v)) << 6);
+                    above = above0 + ((k * r_cached(Rr, img, rt, c, p, v)) << 6);
                     below = lidet__q_rshift_round(bf * above, 16);
                 }
                 in = (v != 0u) & (h < above) & (h > -below);
@@ -574,7 +552,8 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
                     dz = abs32(U[2] - P[2]);
                     if ((vu != 0u) & (4 * dz > min_dz) & (slope > 0))
                     {
-                        vt = ((int64_t)dz << 24) > slope * abs32(r_cached(Ru, c, vu) - r_cached(Rr, c, v));
+                        vt = ((int64_t)dz << 24) > slope * abs32(r_cached(Ru, img, rtu, c, p - up, vu) -
+                                                                 r_cached(Rr, img, rt, c, p, v));
                     }
                 }
                 mask[p] = (uint8_t)(in & !vt);

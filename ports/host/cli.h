@@ -42,6 +42,9 @@ double cli_cpu_ms(void);
  * CPU time after `lidet detect --cpu-clock` set cli_stage_clock_cpu (stage times a busy machine does not
  * inflate) */
 extern int cli_stage_clock_cpu;
+/* `lidet detect --fixed --range-only`: the integer detector with the range-only pixel of the integer firmware
+ * (lidet_detector_q_cfg_t.range_only) */
+extern int cli_fixed_range_only;
 uint32_t cli_stage_clock_ns(void *ctx);
 /* Median of n values (sorts in place). */
 double cli_median(double *v, int n);

@@ -529,6 +529,8 @@ static void usage_extra(void)
                     "  --gt-kitti FILE  ground truth as KITTI label_2 (with --calib) drawn in --png\n"
                     "  --fixed          the integer detector (lidet_detector_q.h: int8 models, no float; the scan\n"
                     "                   converted to millimetres); the same outputs\n"
+                    "  --range-only     with --fixed: the range-only pixel of the integer firmware (x, y, z\n"
+                    "                   decoded from row, column and range; lidet_detector_q_cfg_t.range_only)\n"
                     "  --cpu-clock      stage and total times (--json *_ms) in this thread's CPU time, not wall time\n"
                     "                   (what other processes on a busy machine do not inflate)\n"
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
@@ -632,6 +634,8 @@ int cli_detect(int argc, char **argv)
             crop = 1;
         else if (strcmp(argv[i], "--fixed") == 0)
             fixed = 1;
+        else if (strcmp(argv[i], "--range-only") == 0)
+            cli_fixed_range_only = 1;
         else if (strcmp(argv[i], "--cpu-clock") == 0)
             cli_stage_clock_cpu = 1;
         else
@@ -645,6 +649,12 @@ int cli_detect(int argc, char **argv)
         return 1;
     }
     free(rest);
+    if (cli_fixed_range_only && !fixed)
+    {
+        fprintf(stderr, "lidet detect: --range-only is a setting of the integer detector: add --fixed\n");
+        free(sets);
+        return 1;
+    }
     if ((kitti_path != NULL || gt_kitti_path != NULL) && calib_path == NULL)
     {
         fprintf(stderr, "lidet detect: --kitti-out and --gt-kitti need --calib\n");

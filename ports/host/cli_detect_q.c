@@ -78,6 +78,10 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
         cfg.score_points_weight_q16[k] = round_i32((double)fcfg->score_points_weight[k] * 65536.0);
     }
     cfg.nms_iou_q15 = round_i32((double)fcfg->nms_iou * 32768.0);
+    if (cli_fixed_range_only)
+    {
+        cfg.range_only = 1u; /* the firmware's pixel: x, y, z decoded from row, column and range */
+    }
     cfg.clock = cli_stage_clock_ns;
     *status = lidet_detector_q_init(&g_detq, &cfg, mc, mb);
     if (*status != LIDET_OK)

@@ -2,7 +2,8 @@
 """Run the detector (`lidet detect`, the host CLI: exactly what the firmware computes) over a KITTI-format
 folder and write a prediction folder that `lidet-eval kitti` / `lidet-eval boxes` score.
 
-    python -m lidet_tools.detect KITTI_DIR --out PRED_DIR [--sensor hdl64] [--crop] [--model NAME] [--fixed] [--mount-height M] [--jobs 2]
+    python -m lidet_tools.detect KITTI_DIR --out PRED_DIR [--sensor hdl64] [--crop] [--model NAME] [--fixed [--range-only]] [--ring] [--mount-height M]
+        [--jobs 2]
 
 KITTI_DIR holds velodyne/<id>.bin and, for label_2 output, calib/<id>.txt. PRED_DIR receives label_2/<id>.txt
 (camera frame, 2D box from the projected corners; only when calib/ exists), boxes/<id>.txt (lidet's
@@ -48,7 +49,9 @@ def detect_frame(exe, bin_path, out_dir, calib=None, sensor="hdl64", crop=False,
     return json.loads(r.stdout)
 
 
-def run_folder(kitti_dir, out_dir, sensor="hdl64", crop=False, model=None, jobs=1, extra=(), progress=True) -> list:
+def run_folder(kitti_dir, out_dir, sensor="hdl64", crop=False, model=None, jobs=1, extra=(), progress=True,
+               ring=False) -> list:
+    """Every velodyne/*.bin of kitti_dir; ring: with each scan's ring/<id>.bin (an error where one is missing)."""
     kitti_dir, out_dir = pathlib.Path(kitti_dir), pathlib.Path(out_dir)
     scans = sorted((kitti_dir / "velodyne").glob("*.bin"))
     if not scans:
@@ -63,7 +66,13 @@ def run_folder(kitti_dir, out_dir, sensor="hdl64", crop=False, model=None, jobs=
         calib = kitti_dir / "calib" / f"{p.stem}.txt" if have_calib else None
         if calib is not None and not calib.exists():
             raise FileNotFoundError(f"{calib} missing for {p}")
-        return p.stem, detect_frame(exe, p, out_dir, calib, sensor, crop, model, extra)
+        more = list(extra)
+        if ring:
+            rp = kitti_dir / "ring" / f"{p.stem}.bin"
+            if not rp.exists():
+                raise FileNotFoundError(f"{rp} missing for {p} (--ring)")
+            more += ["--ring", str(rp)]
+        return p.stem, detect_frame(exe, p, out_dir, calib, sensor, crop, model, more)
 
     results = []
     it = scans
@@ -95,14 +104,22 @@ def main(argv=None) -> int:
     ap.add_argument("--jobs", type=int, default=1, help="frames in parallel (one process each)")
     ap.add_argument("--set", action="append", default=[], help="KEY=VALUE passed to lidet detect --set")
     ap.add_argument("--fixed", action="store_true", help="the integer detector (lidet detect --fixed: int8 models)")
+    ap.add_argument("--range-only", action="store_true",
+                    help="with --fixed: the integer firmware's range-only pixel (lidet detect --range-only)")
+    ap.add_argument("--ring", action="store_true",
+                    help="pass each scan's ring indices (KITTI_DIR/ring/<id>.bin, uint16 per point: lidet-sim "
+                         "writes them) as the firmware's driver does (lidet detect --ring)")
     ap.add_argument("--mount-height", type=float, metavar="M",
                     help="the sensor's height above the ground in m (default: the sensor profile's)")
     a = ap.parse_args(argv)
+    if a.range_only and not a.fixed:
+        ap.error("--range-only is a setting of the integer detector: add --fixed")
     extra = [x for kv in a.set for x in ("--set", kv)] + (["--fixed"] if a.fixed else [])
+    extra += ["--range-only"] if a.range_only else []
     if a.mount_height is not None:
         extra += ["--mount-height", repr(a.mount_height)]
     try:
-        res = run_folder(a.kitti_dir, a.out, a.sensor, a.crop, a.model, a.jobs, extra)
+        res = run_folder(a.kitti_dir, a.out, a.sensor, a.crop, a.model, a.jobs, extra, ring=a.ring)
     except (FileNotFoundError, RuntimeError) as e:
         print(f"lidet_tools.detect: error: {e}", file=sys.stderr)
         return 1

@@ -76,11 +76,13 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     pj = proj_q.project(points_mm, tab, proj_cfg["min_range_mm"], proj_cfg["max_range_mm"], max_points=max_points)
     rows, cols = tab.rows, tab.cols
     X, Y, Z, R = (np.asarray(pj[k], np.int64).reshape(rows, cols) for k in ("x_4mm", "y_4mm", "z_4mm", "range_4mm"))
+    RG = None  # the ground stage's R: from x, y, or from the range of a range-only image
     if range_only:
         X, Y, Z = qmath.decode_pixels(R, tab.row_elev_bam)
+        RG = ground_q.r_of_range(R, tab.row_elev_bam)
     if int(det_cfg["crop_half_bam"]) > 0:  # the crop: a RANSAC stream per ground cell (lidet_detector_q_init)
         ground_cfg = dict(ground_cfg, seed_per_cell=1)
-    mask, _, planes, _, _, _ = ground_q.ground(X, Y, Z, ground_cfg)
+    mask, _, planes, _, _, _ = ground_q.ground(X, Y, Z, ground_cfg, RG)
     ns = int(ground_cfg["n_sectors"])
     labels, members, recs, _ = cluster_q.cluster_q_ref(X, Y, Z, R, tab.row_elev_bam, mask, planes[:ns], cluster_cfg,
                                                       max_clusters)

@@ -38,6 +38,15 @@ def r_of(v):
     return qmath.sqrt_round(np.asarray(v, np.int64) << (2 * R_SHIFT))
 
 
+def r_of_range(rng, row_elev_bam):
+    """R of a range-only image's pixels ((rows, cols) ranges): round(range cos(e) / 2^7) with the row's elevation
+    e as lidet_qpix.h's Q15 cosine (lidet_ground_q.c: r_of_range); the image's R when it keeps only the range."""
+    r = np.asarray(rng, np.int64) & 0x7FFF
+    e = np.asarray(row_elev_bam, np.int64)[:r.shape[0]]
+    ce = qmath.rshift_round(qmath.cos(e), 15)[:, None]
+    return (r * ce + 64) >> 7
+
+
 def _rs(v: int, s: int) -> int:
     return (v + (1 << (s - 1))) >> s
 
@@ -67,10 +76,11 @@ def split_v(cfg) -> int:
     return 0xFFFFFFFF if sp == 0 or v > 0xFFFFFFFF else v
 
 
-def sample_mask(X, Y, Z, cfg) -> np.ndarray:
-    """(rows, cols) uint8: the integer sample filter."""
+def sample_mask(X, Y, Z, cfg, R=None) -> np.ndarray:
+    """(rows, cols) uint8: the integer sample filter. R: the pixels' R (r_of_range) for a range-only image; None:
+    from x and y (an image that stores them)."""
     Z = np.asarray(Z, np.int64)
-    R = r_of(rxy2(X, Y))
+    R = r_of(rxy2(X, Y)) if R is None else np.asarray(R, np.int64)
     rows, cols = Z.shape
     out = np.zeros((rows, cols), np.uint8)
     fy = int(cfg["fy_max_q16"])
@@ -274,8 +284,8 @@ def fit_sectors(cells, XYZ, cfg, stats):
     return N, D, src
 
 
-def label_pixels(X, Y, Z, N, D, cfg, stats) -> np.ndarray:
-    """(rows, cols) uint8 ground mask (band test and vertical veto)."""
+def label_pixels(X, Y, Z, N, D, cfg, stats, R=None) -> np.ndarray:
+    """(rows, cols) uint8 ground mask (band test and vertical veto); R as in sample_mask."""
     X, Y, Z = (np.asarray(A, np.int64) for A in (X, Y, Z))
     rows, cols = X.shape
     ns = int(cfg["n_sectors"])
@@ -286,8 +296,9 @@ def label_pixels(X, Y, Z, N, D, cfg, stats) -> np.ndarray:
     above0 = int(cfg["ground_mm"]) << 28
     bf = int(cfg["below_factor_q16"])
     k = int(cfg["ground_per_m_q16"])
+    R = r_of(v) if R is None else np.asarray(R, np.int64)
     if k:
-        above = above0 + ((k * r_of(v)) << 6)
+        above = above0 + ((k * R) << 6)
         below = qmath.rshift_round(bf * above, 16)
     else:
         above, below = above0, _rs(bf * above0, 16)
@@ -295,7 +306,6 @@ def label_pixels(X, Y, Z, N, D, cfg, stats) -> np.ndarray:
     vt = np.zeros_like(inb)
     slope = int(cfg["veto_slope_q16"])
     if slope > 0:
-        R = r_of(v)
         dz = np.abs(Z[:-1] - Z[1:])
         dr = np.abs(R[:-1] - R[1:])
         vt[1:] = inb[1:] & (v[:-1] > 0) & (4 * dz > int(cfg["veto_min_dz_mm"])) & ((dz << 24) > slope * dr)
@@ -304,18 +314,19 @@ def label_pixels(X, Y, Z, N, D, cfg, stats) -> np.ndarray:
     return (inb & ~vt).astype(np.uint8)
 
 
-def ground(X, Y, Z, cfg):
+def ground(X, Y, Z, cfg, R=None):
     """The whole stage: (mask, sample mask, planes (2 ns, 4) int32 as lidet_plane_q_t, D (2 ns,) int64,
-    sources, counts)."""
+    sources, counts). R: r_of_range of a range-only image's ranges (its x, y, z decoded); None for an image that
+    stores x, y, z."""
     X, Y, Z = (np.asarray(A, np.int64) for A in (X, Y, Z))
     stats = dict.fromkeys(("n_samples", "n_samples_dropped", "n_ground", "n_sectors_fitted", "n_sectors_neighbour",
                            "n_sectors_mount", "n_sectors_sparse", "n_sectors_rejected", "n_far_fitted", "n_vetoed",
                            "n_hypotheses"), 0)
-    smp = sample_mask(X, Y, Z, cfg)
+    smp = sample_mask(X, Y, Z, cfg, R)
     cells = gather_samples(smp, X, Y, cfg)
     stats["n_samples"] = int(sum(len(c) for c in cells))
     XYZ = np.stack([X.ravel(), Y.ravel(), Z.ravel()], 1)
     N, D, src = fit_sectors(cells, XYZ, cfg, stats)
-    mask = label_pixels(X, Y, Z, N, D, cfg, stats)
+    mask = label_pixels(X, Y, Z, N, D, cfg, stats, R)
     planes = np.concatenate([N, qmath.rshift_round(D, 30)[:, None]], 1).astype(np.int32)
     return mask, smp, planes, D, src, stats

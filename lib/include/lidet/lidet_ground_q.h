@@ -7,8 +7,10 @@
  * Same steps, order and random draws as the float stage (lidet_ground.h), in integer form
  * (lib/src/lidet_ground_q.c filter, gathering, labels; lib/src/lidet_ground_q_fit.c RANSAC, refinement,
  * fallback; numpy mirror codegen/lidet_codegen/ref/ground_q.py, bit for bit):
- *  - R (horizontal range) of a pixel: round(sqrt(x^2 + y^2) * 256) in 4 mm / 256 steps (1/64 mm), computed
- *    row by row as the rows are needed (an exact integer square root of a 47-bit value);
+ *  - R (horizontal range) of a pixel in 4 mm / 256 steps (1/64 mm), computed row by row as the rows are
+ *    needed: round(sqrt(x^2 + y^2) * 256) in an image that stores x, y, z (an exact integer square root of a
+ *    47-bit value); in a range-only image round(range * ce / 2^7), ce the row elevation's Q15 cosine that its
+ *    x, y, z are decoded with (lidet_qpix.h): the decoded ray's horizontal distance, with no square root;
  *  - sample filter: dZ = S_v*Z (4 mm), dR = S_v*R, |dZ| * 2^24 <= fy_max_q16 * |dR| (cross-multiplied),
  *    F_x = S_u*R (or S_u*Z), |F_x| against fx_max_mm exactly (64 R steps a millimetre);
  *  - near / far: x^2 + y^2 >= ceil(ring_split_mm^2 / 16) (a squared comparison, threshold from init);
