@@ -474,96 +474,169 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
  * (row - 1) holds a point, 4 |dz| > veto_min_dz_mm and |dz| * 2^24 > veto_slope_q16 * |dR|. R is computed only
  * where a test needs it: the veto's slope test of an in-band pixel with a step of more than veto_min_dz_mm
  * (rare on the ground), or every pixel with a tolerance growing with range. */
-/* R of pixel p = r cols + c (row trig rt, x^2 + y^2 = v) through a lazily filled row cache (-1 = not computed
- * yet) */
-static inline int32_t r_cached(int32_t *row, const lidet_range_image_t *img, lidet__qpix_row_t rt, uint32_t c,
-                               uint32_t p, uint32_t v)
+/* the labelling's constants and counts */
+typedef struct
 {
-    if (row[c] < 0)
+    const lidet_range_image_t *img;
+    const lidet__ground_q_pix_t *gp;
+    uint8_t *mask;
+    int32_t *z_up; /* per column: z of the pixel above (row r - 1), NO_POINT where it holds none */
+    int64_t above0, below0, bf, slope, k;
+    int32_t min_dz;
+    uint32_t split_v, n_ground, n_vetoed;
+} label_t;
+
+#define NO_POINT INT32_MIN /* z_up of an empty pixel (a decoded z is within +-2^15) */
+
+/* the veto's slope test of an in-band pixel p (R as needed: rare, as a step of more than veto_min_dz_mm on the
+ * ground is): |dz| * 2^24 > veto_slope_q16 * |R(above) - R(p)| */
+#if defined(__GNUC__)
+__attribute__((noinline)) /* off the labelling loop: its registers stay for the common pixel */
+#endif
+static int
+veto_slope(const label_t *L, lidet__qpix_row_t rt, lidet__qpix_row_t rtu, uint32_t c, uint32_t p, uint32_t up,
+           uint32_t v, int32_t dz)
+{
+    int32_t U[3];
+    uint32_t vu;
+    lidet__ground_q_pix_rc(L->gp, rtu, c, p - up, U);
+    vu = (uint32_t)(U[0] * U[0]) + (uint32_t)(U[1] * U[1]);
+    return ((int64_t)dz << 24) >
+           L->slope * abs32(r_pixel(L->img, rtu, p - up, vu) - r_pixel(L->img, rt, p, v));
+}
+
+/* Columns [c0, c1) of row r (base = r cols) against one cell pair's planes hp (two: far pixels take hp[1]; a
+ * constant where inlined, as is ro, the range-only image). ground = holds a point, -below < h < above with
+ * h = n . p + D, not vetoed; each pixel's z (or NO_POINT) replaces the pixel above's in z_up for the next row. */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void
+label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lidet__qpix_row_t rt,
+           lidet__qpix_row_t rtu, const lidet__ground_q_hplane_t *hp, const int two, const int ro)
+{
+    const uint16_t *rng = L->img->range_4mm;
+    const int32_t *ct = L->gp->ct, *st = L->gp->st;
+    int32_t *z_up = L->z_up;
+    uint8_t *mask = L->mask;
+    uint32_t c, n_ground = 0, n_vetoed = 0;
+    for (c = c0; c < c1; ++c)
     {
-        row[c] = r_pixel(img, rt, p, v);
+        const uint32_t p = base + c;
+        const int32_t zu = z_up[c];
+        int32_t P[3];
+        uint32_t v;
+        int64_t h, above = L->above0, below = L->below0;
+        int in, vt = 0;
+        if (ro)
+        {
+            if ((rng[p] & 0x7FFFu) == 0u)
+            {
+                mask[p] = 0; /* an empty pixel (x = y = 0): never ground, never vetoed */
+                z_up[c] = NO_POINT;
+                continue;
+            }
+            lidet__qpix_decode(rng[p], rt, ct[c], st[c], P);
+        }
+        else
+        {
+            lidet__qpix_stored(L->img, p, P);
+        }
+        v = (uint32_t)(P[0] * P[0]) + (uint32_t)(P[1] * P[1]);
+        h = lidet__ground_q_height(&hp[two && v >= L->split_v], P[0], P[1], P[2]);
+        if (L->k != 0)
+        {
+            /* R steps are 1/64 mm: k R / 2^16 mm = (k R) << 6 in 4 mm / 2^30 */
+            above = L->above0 + ((L->k * r_pixel(L->img, rt, p, v)) << 6);
+            below = lidet__q_rshift_round(L->bf * above, 16);
+        }
+        in = (v != 0u) & (h < above) & (h > -below);
+        z_up[c] = v != 0u ? P[2] : NO_POINT;
+        if (in && zu != NO_POINT)
+        {
+            /* the pixel above holds a point: the veto (a step of more than veto_min_dz_mm, then the slope) */
+            const int32_t dz = abs32(zu - P[2]);
+            if ((4 * dz > L->min_dz) & (L->slope > 0))
+            {
+                vt = veto_slope(L, rt, rtu, c, p, up, v, dz);
+            }
+        }
+        mask[p] = (uint8_t)(in & !vt);
+        n_ground += (uint32_t)(in & !vt);
+        n_vetoed += (uint32_t)vt;
     }
-    return row[c];
+    L->n_ground += n_ground;
+    L->n_vetoed += n_vetoed;
 }
 
 static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, uint8_t *mask,
                        const lidet__ground_q_pix_t *gp)
 {
     const lidet_range_image_t *img = gp->img;
-    const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, split_v = g->split_v;
-    const int64_t above0 = (int64_t)g->cfg.ground_mm << 28, k = g->cfg.ground_per_m_q16;
-    const int64_t bf = g->cfg.below_factor_q16, slope = g->cfg.veto_slope_q16;
-    const int64_t below0 = lidet__q_rshift_round(bf * above0, 16);
-    const int32_t min_dz = (int32_t)g->cfg.veto_min_dz_mm;
-    uint32_t r, s, c, n_ground = 0, n_vetoed = 0;
+    const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors;
+    const int two = g->split_v != 0xFFFFFFFFu, ro = gp->ct != 0;
+    label_t L;
+    uint32_t r, s, c;
+    L.img = img;
+    L.gp = gp;
+    L.mask = mask;
+    L.z_up = sc->r_rows[0]; /* free after the fits */
+    L.above0 = (int64_t)g->cfg.ground_mm << 28;
+    L.k = g->cfg.ground_per_m_q16;
+    L.bf = g->cfg.below_factor_q16;
+    L.slope = g->cfg.veto_slope_q16;
+    L.below0 = lidet__q_rshift_round(L.bf * L.above0, 16);
+    L.min_dz = (int32_t)g->cfg.veto_min_dz_mm;
+    L.split_v = g->split_v;
+    L.n_ground = 0;
+    L.n_vetoed = 0;
+    for (c = 0; c < cols; ++c)
+    {
+        L.z_up[c] = NO_POINT; /* row 0 has no pixel above: never vetoed */
+    }
     for (r = 0; r < rows; ++r)
     {
-        const uint32_t base = r * cols,
-                       up = r > 0u ? cols : 0u; /* row 0 compares with itself: never vetoed */
+        const uint32_t base = r * cols, up = r > 0u ? cols : 0u;
         const lidet__qpix_row_t rt = lidet__qpix_row(img, r),
                                 rtu = lidet__qpix_row(img, r > 0u ? r - 1u : 0u);
-        int32_t *Rr = sc->r_rows[r & 1u], *Ru = sc->r_rows[(r & 1u) ^ (r > 0u)];
-        for (c = 0; c < cols; ++c)
-        {
-            Rr[c] = -1;
-        }
         for (s = 0; s < ns; ++s)
         {
-            const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+            const uint32_t c0 = lidet__ground_sector_col(s, ns, cols),
+                           c1 = lidet__ground_sector_col(s + 1u, ns, cols);
             lidet__ground_q_hplane_t hp[2];
-            int32_t nn[3];
             for (c = 0; c < 2u; ++c)
             {
                 const lidet_plane_q_t *pl = &g->planes[c * ns + s];
+                int32_t nn[3];
                 nn[0] = pl->nx;
                 nn[1] = pl->ny;
                 nn[2] = pl->nz;
                 lidet__ground_q_hplane(nn, g->plane_d[c * ns + s], &hp[c]);
             }
-            for (c = lidet__ground_sector_col(s, ns, cols); c < c1; ++c)
+            /* the four kernels: near and far cells or one, range-only image or stored x, y, z */
+            if (ro)
             {
-                const uint32_t p = base + c;
-                int32_t P[3], U[3];
-                uint32_t v, vu;
-                int32_t dz;
-                int64_t h;
-                int64_t above = above0, below = below0;
-                int in, vt = 0;
-                if (gp->ct != 0 && (img->range_4mm[p] & 0x7FFFu) == 0u)
+                if (two)
                 {
-                    mask[p] = 0; /* an empty pixel (x = y = 0): never ground, never vetoed */
-                    continue;
+                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 1, 1);
                 }
-                lidet__ground_q_pix_rc(gp, rt, c, p, P); /* stored or decoded (lidet_qpix.h) */
-                v = (uint32_t)(P[0] * P[0]) + (uint32_t)(P[1] * P[1]);
-                h = lidet__ground_q_height(&hp[v >= split_v], P[0], P[1], P[2]);
-                if (k != 0)
+                else
                 {
-                    /* R steps are 1/64 mm: k R / 2^16 mm = (k R) << 6 in 4 mm / 2^30 */
-                    above = above0 + ((k * r_cached(Rr, img, rt, c, p, v)) << 6);
-                    below = lidet__q_rshift_round(bf * above, 16);
+                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 1);
                 }
-                in = (v != 0u) & (h < above) & (h > -below);
-                if (in)
-                {
-                    /* the pixel above, read only for the veto of an in-band pixel */
-                    lidet__ground_q_pix_rc(gp, rtu, c, p - up, U);
-                    vu = (uint32_t)(U[0] * U[0]) + (uint32_t)(U[1] * U[1]);
-                    dz = abs32(U[2] - P[2]);
-                    if ((vu != 0u) & (4 * dz > min_dz) & (slope > 0))
-                    {
-                        vt = ((int64_t)dz << 24) > slope * abs32(r_cached(Ru, img, rtu, c, p - up, vu) -
-                                                                 r_cached(Rr, img, rt, c, p, v));
-                    }
-                }
-                mask[p] = (uint8_t)(in & !vt);
-                n_ground += (uint32_t)(in & !vt);
-                n_vetoed += (uint32_t)vt;
+            }
+            else if (two)
+            {
+                label_span(&L, c0, c1, base, up, rt, rtu, hp, 1, 0);
+            }
+            else
+            {
+                label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 0);
             }
         }
     }
-    g->stats.n_ground = n_ground;
-    g->stats.n_vetoed = n_vetoed;
+    g->stats.n_ground = L.n_ground;
+    g->stats.n_vetoed = L.n_vetoed;
 }
 
 lidet_status_t lidet_ground_q_run_buffers(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *scratch,
