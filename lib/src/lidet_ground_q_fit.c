@@ -21,15 +21,23 @@ static inline int64_t abs64(int64_t v)
     return v < 0 ? -v : v;
 }
 
-/* the smallest s with m >> s < 2^29 (values shifted by s, rounded, stay <= 2^29) */
+/* the smallest s with m >> s < 2^29 (values shifted by s, rounded, stay <= 2^29): the bit length of m less 29,
+ * by a count of leading zeros where the core has one, else step by step */
 static unsigned norm_shift(uint64_t m)
 {
+#if defined(__GNUC__) && (defined(__ARM_FEATURE_CLZ) || defined(__x86_64__) || defined(__riscv_zbb))
+    const uint32_t hi = (uint32_t)(m >> 32);
+    const unsigned bits = hi != 0u ? 64u - (unsigned)__builtin_clz(hi)
+                                   : ((uint32_t)m != 0u ? 32u - (unsigned)__builtin_clz((uint32_t)m) : 0u);
+    return bits > 29u ? bits - 29u : 0u;
+#else
     unsigned s = 0;
     while ((m >> s) >= ((uint64_t)1 << 29))
     {
         ++s;
     }
     return s;
+#endif
 }
 
 static inline int64_t shr(int64_t v, unsigned s)
