@@ -222,18 +222,6 @@ static void r_of_row(const lidet_range_image_t *img, uint32_t r, int32_t *restri
     const uint32_t cols = img->n_cols;
     uint32_t c;
     int i;
-    if (lidet__qpix_range_only(img))
-    {
-        const uint16_t *rng = img->range_4mm + (size_t)r * cols;
-        const int32_t ce = lidet__qpix_row(img, r).ce;
-        (void)v;
-        (void)rem;
-        for (c = 0; c < cols; ++c)
-        {
-            out[c] = r_of_range(rng[c], ce);
-        }
-        return;
-    }
     row_rxy2(img, r, v);
 #if !LIDET_GROUND_Q_SQRT_LANES
     (void)root;
@@ -262,11 +250,29 @@ static void r_of_row(const lidet_range_image_t *img, uint32_t r, int32_t *restri
     }
 }
 
-/* R of row r into slot r % 2 (once per row) */
+/* R and z of a range-only image's row r in one pass over its ranges (z as lidet__qpix_decode gives it) */
+static void rz_of_range_row(const lidet_range_image_t *img, uint32_t r, int32_t *restrict out,
+                            int16_t *restrict z)
+{
+    const uint32_t cols = img->n_cols;
+    const uint16_t *rng = img->range_4mm + (size_t)r * cols;
+    const lidet__qpix_row_t rt = lidet__qpix_row(img, r);
+    uint32_t c;
+    for (c = 0; c < cols; ++c)
+    {
+        const uint32_t d = rng[c] & 0x7FFFu;
+        out[c] = r_of_range(d, rt.ce);
+        z[c] = (int16_t)lidet__qpix_rs15((int32_t)d * rt.se);
+    }
+}
+
+/* R (and, in a range-only image, z) of row r into slot r % 2 (once per row) */
 typedef struct
 {
     const lidet_range_image_t *img;
     int32_t *slot[2];
+    int16_t
+        *zslot[2]; /* range-only image: the rows' z (overlaying the square root's work rows, unused there) */
     uint32_t *v, *rem;
     int32_t row_in[2];
 } r_rows_t;
@@ -276,6 +282,8 @@ static void r_rows_init(r_rows_t *rr, lidet_ground_q_scratch_t *sc, const lidet_
     rr->img = img;
     rr->slot[0] = sc->r_rows[0];
     rr->slot[1] = sc->r_rows[1];
+    rr->zslot[0] = sc->r_v.z[0];
+    rr->zslot[1] = sc->r_v.z[1];
     rr->v = sc->r_v.v;
     rr->rem = sc->r_rem;
     rr->row_in[0] = rr->row_in[1] = -1;
@@ -286,10 +294,23 @@ static const int32_t *r_row(r_rows_t *rr, uint32_t r)
     const uint32_t k = r & 1u;
     if (rr->row_in[k] != (int32_t)r)
     {
-        r_of_row(rr->img, r, rr->slot[k], rr->v, rr->rem);
+        if (lidet__qpix_range_only(rr->img))
+        {
+            rz_of_range_row(rr->img, r, rr->slot[k], rr->zslot[k]);
+        }
+        else
+        {
+            r_of_row(rr->img, r, rr->slot[k], rr->v, rr->rem);
+        }
         rr->row_in[k] = (int32_t)r;
     }
     return rr->slot[k];
+}
+
+/* z of row r after r_row(rr, r): the image's row, or the range-only image's decoded one in slot r % 2 */
+static const int16_t *z_row(const r_rows_t *rr, uint32_t r)
+{
+    return lidet__qpix_range_only(rr->img) ? rr->zslot[r & 1u] : rr->img->z_4mm + (size_t)r * rr->img->n_cols;
 }
 
 static inline int32_t abs32(int32_t v)
@@ -382,27 +403,6 @@ void lidet__ground_q_sample_row(const int32_t *R0, const int32_t *R1, const int1
     }
 }
 
-/* z of row r: the image's row, or (range-only) decoded into buf: z depends on the range and the row only */
-static const int16_t *z_row(const lidet_range_image_t *img, uint32_t r, int16_t *buf)
-{
-    const uint32_t cols = img->n_cols;
-    const uint16_t *rng = img->range_4mm + (size_t)r * cols;
-    lidet__qpix_row_t rt;
-    uint32_t c;
-    if (!lidet__qpix_range_only(img))
-    {
-        return img->z_4mm + (size_t)r * cols;
-    }
-    rt = lidet__qpix_row(img, r);
-    for (c = 0; c < cols; ++c)
-    {
-        int32_t q[3];
-        lidet__qpix_decode(rng[c], rt, 0, 0, q);
-        buf[c] = (int16_t)q[2];
-    }
-    return buf;
-}
-
 static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, r_rows_t *rr,
                         const lidet_range_image_t *img)
 {
@@ -422,8 +422,7 @@ static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_
     for (r = 0; r + 1u < rows; r += step)
     {
         const int32_t *R0 = r_row(rr, r), *R1 = r_row(rr, r + 1u);
-        /* after both rows of R: decoded z rows overlay R's work row (sc->r_v) */
-        const int16_t *Z0 = z_row(img, r, sc->r_v.z[0]), *Z1 = z_row(img, r + 1u, sc->r_v.z[1]);
+        const int16_t *Z0 = z_row(rr, r), *Z1 = z_row(rr, r + 1u);
         sample_row(R0, R1, Z0, Z1, cols, &f, sample + (size_t)r * cols, !LIDET_GROUND_Q_SQRT_LANES);
     }
 }
