@@ -371,6 +371,45 @@ sample_test_early(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const
     return (uint8_t)(abs32((R0[cm1] + 2 * R0[c]) - (2 * R0[cp1] + R0[cp2])) <= f->fx_r);
 }
 
+/* The early-exit test with the default switches (no descending condition, no height gate, F_x on R): the
+ * configuration's values in registers, fy (<= 655360, init) as a 32-bit factor of one 32 x 32 -> 64 product */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline uint8_t
+sample_test_plain(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1, uint32_t cm1,
+                  uint32_t c, uint32_t cp1, uint32_t cp2, uint32_t fy, int32_t fx_r)
+{
+    const int32_t r0 = R0[c], r1 = R1[c], r0p = R0[cp1], r1p = R1[cp1];
+    int32_t dr, dz;
+    if (r0 <= 0 || r1 <= 0 || r0p <= 0 || r1p <= 0 || R0[cm1] <= 0 || R0[cp2] <= 0)
+    {
+        return 0;
+    }
+    dr = (2 * r0 + r0p) - (2 * r1 + r1p);
+    dz = (2 * Z0[c] + Z0[cp1]) - (2 * Z1[c] + Z1[cp1]);
+    if (((uint64_t)(uint32_t)abs32(dz) << 24) > (uint64_t)fy * (uint32_t)abs32(dr))
+    {
+        return 0;
+    }
+    return (uint8_t)(abs32((R0[cm1] + 2 * r0) - (2 * r0p + R0[cp2])) <= fx_r);
+}
+
+static void sample_row_plain(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
+                             uint32_t cols, const lidet__ground_q_filt_t *f, uint8_t *out)
+{
+    const uint32_t fy = (uint32_t)f->fy;
+    const int32_t fx_r = f->fx_r;
+    uint32_t c;
+    out[0] = sample_test_plain(R0, R1, Z0, Z1, cols - 1u, 0u, 1u, 2u, fy, fx_r);
+    for (c = 1; c + 2u < cols; ++c)
+    {
+        out[c] = sample_test_plain(R0, R1, Z0, Z1, c - 1u, c, c + 1u, c + 2u, fy, fx_r);
+    }
+    out[cols - 2u] = sample_test_plain(R0, R1, Z0, Z1, cols - 3u, cols - 2u, cols - 1u, 0u, fy, fx_r);
+    out[cols - 1u] = sample_test_plain(R0, R1, Z0, Z1, cols - 2u, cols - 1u, 0u, 1u, fy, fx_r);
+}
+
 /* one row pair's tests into out[0 .. cols), columns wrapping around; early: the kernel (a constant where
  * inlined) */
 static inline void sample_row(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
@@ -393,7 +432,11 @@ static inline void sample_row(const int32_t *R0, const int32_t *R1, const int16_
 void lidet__ground_q_sample_row(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
                                 uint32_t cols, const lidet__ground_q_filt_t *f, uint8_t *out, int early)
 {
-    if (early)
+    if (early && !f->on_z && !f->desc && !f->gate && f->fy <= 0xFFFFFFFFu)
+    {
+        sample_row_plain(R0, R1, Z0, Z1, cols, f, out);
+    }
+    else if (early)
     {
         sample_row(R0, R1, Z0, Z1, cols, f, out, 1);
     }
@@ -423,7 +466,8 @@ static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_
     {
         const int32_t *R0 = r_row(rr, r), *R1 = r_row(rr, r + 1u);
         const int16_t *Z0 = z_row(rr, r), *Z1 = z_row(rr, r + 1u);
-        sample_row(R0, R1, Z0, Z1, cols, &f, sample + (size_t)r * cols, !LIDET_GROUND_Q_SQRT_LANES);
+        lidet__ground_q_sample_row(R0, R1, Z0, Z1, cols, &f, sample + (size_t)r * cols,
+                                   !LIDET_GROUND_Q_SQRT_LANES);
     }
 }
 
