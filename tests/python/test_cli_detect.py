@@ -198,3 +198,55 @@ def test_ground_speed_knobs_reach_both_detectors(cli):
         assert r.returncode != 0 and "stages.ground.sample_step=17" in r.stderr
         r = _run(cli, scan, "--sensor", "vlp16", *fixed, "--set", "stages.ground.sample_step=0", ok=False)
         assert r.returncode != 0 and "LIDET_ERR_CONFIG" in r.stderr
+
+
+def test_range_only_option_is_the_firmware_pixel(cli, tmp_path):
+    """--fixed --range-only: the integer detector with the range-only pixel (lidet_detector_q_cfg_t.range_only),
+    the integer firmware's; its detections are those of the bindings with range_only=True, bit for bit, and
+    differ from the stored pixel's. Without --fixed the option is refused with a message."""
+    from lidet_tools import native_q
+    scan = ROOT / "tests" / "data" / "sim_vlp16" / "velodyne" / "000000.bin"
+    out = tmp_path / "ro.txt"
+    js = json.loads(_run(cli, scan, "--sensor", "vlp16", "--model", "vlp16s", "--fixed", "--range-only", "--json",
+                         "--out", out).stdout)
+    q = native_q.detect_q(native_q.to_mm(kitti.read_bin(scan)), "vlp16", model="vlp16s", range_only=True)
+    assert js["detections"] == len(q["cls"]) > 0
+    got = np.loadtxt(out, usecols=range(1, 8), ndmin=2)
+    np.testing.assert_allclose(got[:, :6], q["boxes"][:, :6] / 1000.0, atol=1e-3)
+    stored = json.loads(_run(cli, scan, "--sensor", "vlp16", "--model", "vlp16s", "--fixed", "--json").stdout)
+    qs = native_q.detect_q(native_q.to_mm(kitti.read_bin(scan)), "vlp16", model="vlp16s", range_only=False)
+    assert stored["detections"] == len(qs["cls"])
+    assert [b["x"] for b in stored["boxes"]] != [b["x"] for b in js["boxes"]]
+    r = _run(cli, scan, "--sensor", "vlp16", "--range-only", ok=False)
+    assert r.returncode != 0 and "--range-only" in r.stderr and "--fixed" in r.stderr
+
+
+def test_batch_script_firmware_options(cli, tmp_path):
+    """python -m lidet_tools.detect --fixed --range-only --ring: each scan with its ring/<id>.bin, as the
+    firmware's driver feeds it; the boxes are those of `lidet detect --fixed --range-only --ring` on the scan. A
+    missing ring file and --range-only without --fixed are errors."""
+    sim = ROOT / "tests" / "data" / "sim_vlp16"
+    env = {**__import__("os").environ, "LIDET_BUILD_DIR": str(pathlib.Path(cli).parents[2])}
+    kd = tmp_path / "kitti"
+    for sub in ("velodyne", "ring"):
+        (kd / sub).mkdir(parents=True)
+        (kd / sub / "000000.bin").write_bytes((sim / sub / "000000.bin").read_bytes())
+    args = ["--sensor", "vlp16", "--model", "vlp16s", "--fixed", "--range-only"]
+    r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(kd), "--out", str(tmp_path / "pred"),
+                        "--ring", *args], capture_output=True, text=True, env=env)
+    assert r.returncode == 0, r.stderr
+    one = tmp_path / "one.txt"
+    _run(cli, kd / "velodyne" / "000000.bin", *args, "--ring", kd / "ring" / "000000.bin", "--out", one)
+    assert (tmp_path / "pred" / "boxes" / "000000.txt").read_text() == one.read_text() != ""
+    # the ring file is read: one of the wrong length fails the frame with the CLI's message
+    (kd / "ring" / "000000.bin").write_bytes((sim / "ring" / "000000.bin").read_bytes()[:-2])
+    r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(kd), "--out", str(tmp_path / "p1"),
+                        "--ring", *args], capture_output=True, text=True, env=env)
+    assert r.returncode == 1 and "ring file" in r.stderr
+    (kd / "ring" / "000000.bin").unlink()
+    r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(kd), "--out", str(tmp_path / "p2"),
+                        "--ring", *args], capture_output=True, text=True, env=env)
+    assert r.returncode == 1 and "ring" in r.stderr and "missing" in r.stderr
+    r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(kd), "--out", str(tmp_path / "p3"),
+                        "--range-only"], capture_output=True, text=True, env=env)
+    assert r.returncode != 0 and "--fixed" in r.stderr
