@@ -35,9 +35,19 @@ static inline uint32_t lidet__cluster_mark_4mm(const uint16_t *rng, const uint8_
                                                uint16_t *lab)
 {
     uint32_t p, n_cand = 0;
+    if (ground_mask == 0)
+    {
+        for (p = 0; p < npix; ++p)
+        {
+            const uint32_t cand = (uint32_t)(rng[p] > 0u);
+            lab[p] = (uint16_t)(cand - 1u);
+            n_cand += cand;
+        }
+        return n_cand;
+    }
     for (p = 0; p < npix; ++p)
     {
-        const uint32_t cand = (uint32_t)(rng[p] > 0u) & (uint32_t)(ground_mask == 0 || ground_mask[p] == 0);
+        const uint32_t cand = (uint32_t)(rng[p] > 0u) & (uint32_t)(ground_mask[p] == 0u);
         lab[p] = (uint16_t)(cand - 1u);
         n_cand += cand;
     }
