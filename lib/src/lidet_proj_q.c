@@ -458,18 +458,25 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     }
 
     /* pass 2, over pixels: the winners' coordinates and ranges in 4 mm steps (one isqrt per filled pixel) */
-    for (pix = 0; range_only && pix < npix; ++pix)
+    if (range_only)
     {
-        /* the range from the key as below; an empty pixel (all ones) gets 0 */
-        const uint32_t k = ((const uint32_t *)buf->point_idx)[pix];
-        uint32_t rq = 0u;
-        if (k != 0xFFFFFFFFu)
+        const uint32_t *key = (const uint32_t *)buf->point_idx;
+        uint16_t *range = buf->range_4mm;
+        uint32_t filled = 0;
+        for (pix = 0; pix < npix; ++pix)
         {
-            rq = (lidet__q_isqrt32_inl(k) + 1u) >> 1;
-            rq = rq > 0u ? rq : 1u;
-            ++sts.n_pixels_filled;
+            /* the range from the key as below; an empty pixel (all ones) gets 0 */
+            const uint32_t k = key[pix];
+            uint32_t rq = 0u;
+            if (k != 0xFFFFFFFFu)
+            {
+                rq = (lidet__q_isqrt32_inl(k) + 1u) >> 1;
+                rq = rq > 0u ? rq : 1u;
+                ++filled;
+            }
+            range[pix] = (uint16_t)rq;
         }
-        buf->range_4mm[pix] = (uint16_t)rq;
+        sts.n_pixels_filled += filled;
     }
     for (pix = 0; !range_only && pix < npix; ++pix)
     {
