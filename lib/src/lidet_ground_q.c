@@ -498,11 +498,14 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
                     ++total;
                     if (lo < hi)
                     {
-                        int32_t q[3];
-                        uint32_t k;
-                        lidet__ground_q_pix_rc(gp, rt, c, base + c, q);
-                        k = (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]) >= split_v ? --hi : lo++;
-                        si[k] = (lidet_ground_sample_t)(base + c);
+                        int far = 0;
+                        if (split_v != 0xFFFFFFFFu) /* else every sample is near (x^2 + y^2 < 2^31) */
+                        {
+                            int32_t q[3];
+                            lidet__ground_q_pix_rc(gp, rt, c, base + c, q);
+                            far = (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]) >= split_v;
+                        }
+                        si[far ? --hi : lo++] = (lidet_ground_sample_t)(base + c);
                     }
                 }
             }
