@@ -569,12 +569,14 @@ __attribute__((always_inline))
 #endif
 static inline void
 label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lidet__qpix_row_t rt,
-           lidet__qpix_row_t rtu, const lidet__ground_q_hplane_t *hp, const int two, const int ro)
+           lidet__qpix_row_t rtu, const lidet__ground_q_hplane_t *hp, const int two, const int ro,
+           const int kz)
 {
     const uint16_t *rng = L->img->range_4mm;
     const int32_t *ct = L->gp->ct, *st = L->gp->st;
     int32_t *z_up = L->z_up;
     uint8_t *mask = L->mask;
+    const int64_t above0 = L->above0, below0 = L->below0;
     uint32_t c, n_ground = 0, n_vetoed = 0;
     for (c = c0; c < c1; ++c)
     {
@@ -582,7 +584,7 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
         const int32_t zu = z_up[c];
         int32_t P[3];
         uint32_t v;
-        int64_t h, above = L->above0, below = L->below0;
+        int64_t h, above = above0, below = below0;
         int in, vt = 0;
         if (ro)
         {
@@ -600,7 +602,7 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
         }
         v = (uint32_t)(P[0] * P[0]) + (uint32_t)(P[1] * P[1]);
         h = lidet__ground_q_height(&hp[two && v >= L->split_v], P[0], P[1], P[2]);
-        if (L->k != 0)
+        if (!kz && L->k != 0)
         {
             /* R steps are 1/64 mm: k R / 2^16 mm = (k R) << 6 in 4 mm / 2^30 */
             above = L->above0 + ((L->k * r_pixel(L->img, rt, p, v)) << 6);
@@ -669,25 +671,30 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
                 nn[2] = pl->nz;
                 lidet__ground_q_hplane(nn, g->plane_d[c * ns + s], &hp[c]);
             }
-            /* the four kernels: near and far cells or one, range-only image or stored x, y, z */
+            /* the kernels: near and far cells or one, range-only image or stored x, y, z; a range-only image's
+             * also with the fixed tolerance (ground_per_m_q16 0) as a constant */
             if (ro)
             {
                 if (two)
                 {
-                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 1, 1);
+                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 1, 1, 0);
+                }
+                else if (L.k == 0)
+                {
+                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 1, 1);
                 }
                 else
                 {
-                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 1);
+                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 1, 0);
                 }
             }
             else if (two)
             {
-                label_span(&L, c0, c1, base, up, rt, rtu, hp, 1, 0);
+                label_span(&L, c0, c1, base, up, rt, rtu, hp, 1, 0, 0);
             }
             else
             {
-                label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 0);
+                label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 0, 0);
             }
         }
     }
