@@ -637,6 +637,14 @@ def emit_s8(onnx_path, calib_path, out_dir, cmd: str, report: bool = True, real_
     return qm
 
 
+def _model_sensor(path) -> str:
+    """The sensor a model was trained for: its ONNX metadata lidet.sensor (the family vlp16s says vlp16), else the
+    name's suffix (cls_hdl64 -> hdl64)."""
+    import onnx
+    meta = {m.key: m.value for m in onnx.load(str(path), load_external_data=False).metadata_props}
+    return meta.get("lidet.sensor") or pathlib.Path(path).stem.split("_")[-1]
+
+
 def main(argv=None) -> int:
     """python -m lidet_codegen calibrate MODEL.onnx --sensor S --out FILE"""
     import argparse
@@ -644,7 +652,8 @@ def main(argv=None) -> int:
                                  description="per-tensor activation ranges of a model on proposals of the simulated "
                                              "sample scan (fixed resampling seeds) and the real scans when present")
     ap.add_argument("onnx", nargs="+")
-    ap.add_argument("--sensor", help="hdl64 or vlp16 (default: the model name's suffix)")
+    ap.add_argument("--sensor", help="hdl64 or vlp16 (default: the model's lidet.sensor metadata, else the model "
+                                     "name's suffix)")
     ap.add_argument("--real", default=str(ROOT.parent / "shared" / "data" / "real"),
                     help="real scans folder (used when present; KITTI HDL-64 scans for hdl64 models)")
     ap.add_argument("--out", help="calibration file (default: beside the model, <name>.calib.json)")
@@ -655,7 +664,7 @@ def main(argv=None) -> int:
     real = pathlib.Path(a.real) if (pathlib.Path(a.real) / "kitti").exists() else None
     for p in a.onnx:
         p = pathlib.Path(p)
-        sensor = a.sensor or p.stem.split("_")[-1]
+        sensor = a.sensor or _model_sensor(p)
         out = pathlib.Path(a.out) if a.out and len(a.onnx) == 1 else p.with_suffix(".calib.json")
         if a.refit:
             cal = refit(p, json.loads(p.with_suffix(".calib.json").read_text()), real)
