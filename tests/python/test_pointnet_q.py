@@ -349,3 +349,12 @@ def test_pack_pk_is_what_the_dsp_kernel_reads(n_out, n_in):
     assert got == [int(v) for v in (w @ x)[: n_out // 2 * 2]]
     with pytest.raises(ValueError, match="multiple of 4"):
         QU.pack_pk(np.zeros((2, 6), dtype=np.int8))
+
+
+def test_calibrate_takes_the_sensor_from_the_model():
+    """`python -m lidet_codegen calibrate` without --sensor: the model's lidet.sensor metadata (the small pair
+    cls_vlp16s was trained on vlp16 scans; its name's suffix names no sensor)."""
+    from lidet_codegen import quant
+    assert quant._model_sensor(ROOT / "weights" / "cls_vlp16s.onnx") == "vlp16"
+    assert quant._model_sensor(ROOT / "weights" / "box_vlp16s.onnx") == "vlp16"
+    assert quant._model_sensor(ROOT / "weights" / "box_hdl64.onnx") == "hdl64"
