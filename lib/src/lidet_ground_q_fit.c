@@ -347,30 +347,40 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
         }
         ++g->stats.n_hypotheses;
         thr_l = inl * (int64_t)len;
-        if (copied)
         {
-            /* in blocks of 32 samples; a hypothesis that can no longer beat the best count stops (its count
-             * decides nothing else, so the fitted planes are those of the full count) */
-            for (i = 0; i < n_eval && (!have || cnt + (n_eval - i) > best_cnt);)
+            /* a sample is an inlier when 4 |h| <= thr_l, i.e. |h| <= t = floor(thr_l / 4), i.e. h + t in [0, 2t]
+             * (one unsigned comparison); c is within 2^29 after scale_down, so each product is one 32 x 32 -> 64
+             * multiply(-accumulate) */
+            const int32_t c0 = (int32_t)c[0], c1 = (int32_t)c[1], c2 = (int32_t)c[2];
+            const int64_t t = thr_l >> 2;
+            const uint64_t t2 = 2u * (uint64_t)t;
+            if (copied)
             {
-                const uint32_t end = n_eval - i > 32u ? i + 32u : n_eval;
-                for (; i < end; ++i)
+                /* in blocks of 32 samples; a hypothesis that can no longer beat the best count stops (its count
+                 * decides nothing else, so the fitted planes are those of the full count) */
+                for (i = 0; i < n_eval && (!have || cnt + (n_eval - i) > best_cnt);)
                 {
-                    const int64_t h = c[0] * (sc->ev_x[i] - p0[0]) + c[1] * (sc->ev_y[i] - p0[1]) +
-                                      c[2] * (sc->ev_z[i] - p0[2]);
-                    cnt += (uint32_t)(4 * abs64(h) <= thr_l);
+                    const uint32_t end = n_eval - i > 32u ? i + 32u : n_eval;
+                    for (; i < end; ++i)
+                    {
+                        const int64_t h = (int64_t)c0 * (sc->ev_x[i] - p0[0]) +
+                                          (int64_t)c1 * (sc->ev_y[i] - p0[1]) +
+                                          (int64_t)c2 * (sc->ev_z[i] - p0[2]);
+                        cnt += (uint32_t)((uint64_t)(h + t) <= t2);
+                    }
                 }
             }
-        }
-        else
-        {
-            for (i = 0; i < n; i += stride)
+            else
             {
-                int32_t q[3];
-                int64_t h;
-                pixel(img, i, q);
-                h = c[0] * (q[0] - p0[0]) + c[1] * (q[1] - p0[1]) + c[2] * (q[2] - p0[2]);
-                cnt += (uint32_t)(4 * abs64(h) <= thr_l);
+                for (i = 0; i < n; i += stride)
+                {
+                    int32_t q[3];
+                    int64_t h;
+                    pixel(img, i, q);
+                    h = (int64_t)c0 * (q[0] - p0[0]) + (int64_t)c1 * (q[1] - p0[1]) +
+                        (int64_t)c2 * (q[2] - p0[2]);
+                    cnt += (uint32_t)((uint64_t)(h + t) <= t2);
+                }
             }
         }
         if (!have || cnt > best_cnt)
