@@ -279,52 +279,36 @@ static inline int16_t to_4mm(int32_t v)
     return (int16_t)((v + 2) >> 2);
 }
 
-lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
-                                const int32_t *points, uint32_t n_points, uint32_t stride,
-                                const uint16_t *ring)
+/* Pass 1 of lidet_proj_q_run over points [0, n): range, row, column, the closest point per pixel (key below, all
+ * ones = empty); range_only a constant where inlined (the range-only image keeps the key alone, in point_idx) */
+typedef struct
 {
-    uint32_t n, i, rows, cols, npix, pix, row_guess = 0, col_guess = 0;
+    const lidet_proj_q_state_t *st;
+    const lidet_proj_q_buffers_t *buf;
+    const int32_t *points;
+    uint32_t stride, rows, cols, npix;
+    const uint16_t *ring;
     uint64_t min2, max2;
-    int range_only;
-    const uint32_t *edge;
-    lidet_proj_stats_t sts;
+} pass1_t;
 
-    if (st == 0 || buf == 0 || stride < 3 || (points == 0 && n_points > 0) || buf->range_4mm == 0 ||
-        buf->point_idx == 0)
-    {
-        return LIDET_ERR_ARG;
-    }
-    /* x, y, z all stored, or none (a range-only image) */
-    range_only = buf->x_4mm == 0;
-    if ((buf->y_4mm == 0) != range_only || (buf->z_4mm == 0) != range_only)
-    {
-        return LIDET_ERR_ARG;
-    }
-    if (st->magic != LIDET_INIT_MAGIC)
-    {
-        return LIDET_ERR_STATE;
-    }
-    rows = st->cfg.sensor.n_rows;
-    cols = st->cfg.sensor.n_cols;
-    npix = rows * cols;
-    edge = st->col_edge_q29;
-    n = n_points > LIDET_MAX_POINTS ? LIDET_MAX_POINTS : n_points;
-    memset(&sts, 0, sizeof sts);
-    sts.n_points_in = n_points;
-    sts.n_truncated = n_points - n;
-    min2 = (uint64_t)st->cfg.min_range_mm * (uint64_t)st->cfg.min_range_mm;
-    min2 = min2 > 0u ? min2 : 1u; /* zero range is always too close */
-    max2 = st->cfg.max_range_mm > 0 ? (uint64_t)st->cfg.max_range_mm * (uint64_t)st->cfg.max_range_mm
-                                    : MAX_R2_MM2;
-    max2 = max2 < MAX_R2_MM2 ? max2 : MAX_R2_MM2;
-
-    /* pass 1, point by point: range, row, column, the closest point per pixel (key above, all ones = empty) */
-    memset(buf->point_idx, 0xFF, (size_t)npix * sizeof buf->point_idx[0]);
-    if (!range_only)
-    {
-        memset(buf->range_4mm, 0xFF, (size_t)npix * sizeof buf->range_4mm[0]);
-        memset(buf->z_4mm, 0xFF, (size_t)npix * sizeof buf->z_4mm[0]);
-    }
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void
+project_points(const pass1_t *P, uint32_t n, lidet_proj_stats_t *stats, const int range_only)
+{
+    const lidet_proj_q_state_t *st = P->st;
+    const lidet_proj_q_buffers_t *buf = P->buf;
+    const int32_t *points = P->points;
+    const uint32_t stride = P->stride, rows = P->rows, cols = P->cols, npix = P->npix;
+    const uint16_t *ring = P->ring;
+    const uint64_t min2 = P->min2, max2 = P->max2;
+    const uint32_t *edge = st->col_edge_q29;
+    int32_t *point_pixel = buf->point_pixel;
+    uint32_t *key = (uint32_t *)buf->point_idx; /* range-only: int32_t storage read as its unsigned type */
+    lidet_proj_stats_t sts = *stats;
+    uint32_t i, pix, row_guess = 0, col_guess = 0;
+    (void)npix;
     for (i = 0; i < n; ++i)
     {
         const int32_t *pt = points + (size_t)i * stride;
@@ -442,7 +426,6 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
         if (range_only)
         {
             /* the key alone, in the point_idx buffer (all ones = empty, as above) */
-            uint32_t *key = (uint32_t *)buf->point_idx; /* int32_t storage read as its unsigned type */
             key[pix] = (uint32_t)(r2 >> 2) < key[pix] ? (uint32_t)(r2 >> 2) : key[pix];
         }
         else if ((uint32_t)(r2 >> 2) < key_get(buf, pix)) /* strict: ties keep the earlier point */
@@ -451,12 +434,80 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
             buf->point_idx[pix] = (int32_t)i;
         }
     next:
-        if (buf->point_pixel != 0)
+        if (point_pixel != 0)
         {
-            buf->point_pixel[i] = out;
+            point_pixel[i] = out;
         }
     }
 
+    *stats = sts;
+}
+
+lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                                const int32_t *points, uint32_t n_points, uint32_t stride,
+                                const uint16_t *ring)
+{
+    uint32_t n, rows, cols, npix, pix;
+    uint64_t min2, max2;
+    int range_only;
+    lidet_proj_stats_t sts;
+
+    if (st == 0 || buf == 0 || stride < 3 || (points == 0 && n_points > 0) || buf->range_4mm == 0 ||
+        buf->point_idx == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    /* x, y, z all stored, or none (a range-only image) */
+    range_only = buf->x_4mm == 0;
+    if ((buf->y_4mm == 0) != range_only || (buf->z_4mm == 0) != range_only)
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (st->magic != LIDET_INIT_MAGIC)
+    {
+        return LIDET_ERR_STATE;
+    }
+    rows = st->cfg.sensor.n_rows;
+    cols = st->cfg.sensor.n_cols;
+    npix = rows * cols;
+    n = n_points > LIDET_MAX_POINTS ? LIDET_MAX_POINTS : n_points;
+    memset(&sts, 0, sizeof sts);
+    sts.n_points_in = n_points;
+    sts.n_truncated = n_points - n;
+    min2 = (uint64_t)st->cfg.min_range_mm * (uint64_t)st->cfg.min_range_mm;
+    min2 = min2 > 0u ? min2 : 1u; /* zero range is always too close */
+    max2 = st->cfg.max_range_mm > 0 ? (uint64_t)st->cfg.max_range_mm * (uint64_t)st->cfg.max_range_mm
+                                    : MAX_R2_MM2;
+    max2 = max2 < MAX_R2_MM2 ? max2 : MAX_R2_MM2;
+
+    /* pass 1, point by point: range, row, column, the closest point per pixel (key above, all ones = empty) */
+    memset(buf->point_idx, 0xFF, (size_t)npix * sizeof buf->point_idx[0]);
+    if (!range_only)
+    {
+        memset(buf->range_4mm, 0xFF, (size_t)npix * sizeof buf->range_4mm[0]);
+        memset(buf->z_4mm, 0xFF, (size_t)npix * sizeof buf->z_4mm[0]);
+    }
+    {
+        pass1_t P;
+        P.st = st;
+        P.buf = buf;
+        P.points = points;
+        P.stride = stride;
+        P.rows = rows;
+        P.cols = cols;
+        P.npix = npix;
+        P.ring = ring;
+        P.min2 = min2;
+        P.max2 = max2;
+        if (range_only)
+        {
+            project_points(&P, n, &sts, 1);
+        }
+        else
+        {
+            project_points(&P, n, &sts, 0);
+        }
+    }
     /* pass 2, over pixels: the winners' coordinates and ranges in 4 mm steps (one isqrt per filled pixel) */
     if (range_only)
     {
