@@ -128,6 +128,7 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
 #define STATS_STATE_T lidet_cluster_state_t
 #define STATS_V_T float
 #define STATS_S_T float
+#define STATS_BLOCK_SUMS 0
 #define STATS_LIM_T float
 #define STATS_READ(c, p, compact, x, y, z) lidet__img_xyz(&(c)->img, p, compact, x, y, z)
 #define STATS_OVER(lo, hi, lim) ((hi) - (lo) > (lim))

@@ -71,6 +71,8 @@ static inline void read_q(const lidet_cluster_q_state_t *c, uint32_t p, int32_t 
 #define STATS_STATE_T lidet_cluster_q_state_t
 #define STATS_V_T int32_t
 #define STATS_S_T int64_t
+#define STATS_BLOCK_SUMS 1
+#define STATS_B_T int32_t /* 64 values within int16 each */
 #define STATS_LIM_T uint32_t
 #define STATS_READ(c, p, compact, x, y, z) read_q(c, p, x, y, z)
 #define STATS_OVER(lo, hi, lim) ((uint32_t)((hi) - (lo)) * 4u > (lim))
