@@ -142,64 +142,73 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
     pixel(img, 0u, first);
     /* one pass over the samples (each decoded once): the inliers' sums S1 = sum d and S2 = sum d d^T of
      * d = q - first, exact in int64 (|d| < 2^16: below n 2^32 for n samples); the cell's decoded copy read
-     * directly where there is one */
-    for (i = 0; i < n; ++i)
+     * directly where there is one. S1 is summed in int32 over blocks of 2^14 samples (|sum| < 2^30), each block
+     * added to the int64 sum: the 64-bit sums stay out of the sample loop */
+    for (i = 0; i < n;)
     {
-        int32_t x, y, z;
-        if (img->xyz != 0)
+        const uint32_t blk_end = n - i > 16384u ? i + 16384u : n;
+        int32_t t0 = 0, t1 = 0, t2 = 0;
+        for (; i < blk_end; ++i)
         {
-            const int32_t *p = img->xyz + 3u * i;
-            x = p[0];
-            y = p[1];
-            z = p[2];
-        }
-        else
-        {
-            pixel(img, i, q);
-            x = q[0];
-            y = q[1];
-            z = q[2];
-        }
-        if (abs64(lidet__ground_q_height(&hp, x, y, z)) > thr)
-        {
-            continue;
-        }
-        x -= first[0];
-        y -= first[1];
-        z -= first[2];
-        ++m;
-        s1[0] += x;
-        s1[1] += y;
-        s1[2] += z;
+            int32_t x, y, z;
+            if (img->xyz != 0)
+            {
+                const int32_t *p = img->xyz + 3u * i;
+                x = p[0];
+                y = p[1];
+                z = p[2];
+            }
+            else
+            {
+                pixel(img, i, q);
+                x = q[0];
+                y = q[1];
+                z = q[2];
+            }
+            if (abs64(lidet__ground_q_height(&hp, x, y, z)) > thr)
+            {
+                continue;
+            }
+            x -= first[0];
+            y -= first[1];
+            z -= first[2];
+            ++m;
+            t0 += x;
+            t1 += y;
+            t2 += z;
 #if LIDET_Q_HAVE_MUL64
-        /* one SMLAL each (Cortex-M3 and up) */
-        a[0] += (int64_t)x * x;
-        a[1] += (int64_t)x * y;
-        a[2] += (int64_t)x * z;
-        a[3] += (int64_t)y * y;
-        a[4] += (int64_t)y * z;
-        a[5] += (int64_t)z * z;
-#else
-        if (x >= -46340 && x <= 46340 && y >= -46340 && y <= 46340 && z >= -46340 && z <= 46340)
-        {
-            /* the products fit int32: no 64-bit multiplication helper */
-            a[0] += x * x;
-            a[1] += x * y;
-            a[2] += x * z;
-            a[3] += y * y;
-            a[4] += y * z;
-            a[5] += z * z;
-        }
-        else
-        {
+            /* one SMLAL each (Cortex-M3 and up) */
             a[0] += (int64_t)x * x;
             a[1] += (int64_t)x * y;
             a[2] += (int64_t)x * z;
             a[3] += (int64_t)y * y;
             a[4] += (int64_t)y * z;
             a[5] += (int64_t)z * z;
-        }
+#else
+            if (x >= -46340 && x <= 46340 && y >= -46340 && y <= 46340 && z >= -46340 && z <= 46340)
+            {
+                /* the products fit int32: no 64-bit multiplication helper */
+                a[0] += x * x;
+                a[1] += x * y;
+                a[2] += x * z;
+                a[3] += y * y;
+                a[4] += y * z;
+                a[5] += z * z;
+            }
+            else
+            {
+                a[0] += (int64_t)x * x;
+                a[1] += (int64_t)x * y;
+                a[2] += (int64_t)x * z;
+                a[3] += (int64_t)y * y;
+                a[4] += (int64_t)y * z;
+                a[5] += (int64_t)z * z;
+            }
 #endif
+        }
+        s1[0] += t0;
+        s1[1] += t1;
+        s1[2] += t2;
     }
     if (m < 3u)
     {
