@@ -40,17 +40,16 @@ FAMILIES = {
                   # then quantization-aware fine-tuning for the int8 build (finetune_q; docs/FIXED_POINT.md): its int8
                   # classifier disagreed with float on 1.4 % of held-out proposals, 0.5-0.6 % after (seeds 7, 8, 9)
                   cls_finetune=["--epochs", "6", "--seed", "7"]),
-    # vlp16s: the small VLP-16 pair for boards without an FPU (issue 17): 32 points per proposal, 10x fewer
-    # multiply-adds than vlp16 (classifier 70 k, box net 152 k per proposal), the same scans and schedule;
-    # the integer firmware images use it (docs/PORTING.md, "The small VLP-16 pair"). Widths chosen at stop 31
-    # (docs/FIXED_POINT.md, "Narrower small pair"): point MLPs 16-32-48 and 24-40-64 (from 16-32-64 and
-    # 24-48-80) kept the integer detector's VLP-16 AP within the seed-to-seed spread; 16-24-40 / 16-32-64,
-    # 16-32-40 / 24-40-56 and 24 points per proposal lost pedestrian AP
+    # vlp16s: the small VLP-16 pair for boards without an FPU (issue 17): 32 points per proposal, 9x fewer
+    # multiply-adds than vlp16 (classifier 86 k, box net 144 k per proposal), the same scans and schedule;
+    # the integer firmware images use it (docs/PORTING.md, "The small VLP-16 pair"). The box net's point MLP
+    # 24-40-64 since stop 31 (24-48-80 before: the same AP, docs/FIXED_POINT.md); the narrower classifiers tried
+    # then (16-32-48 and smaller) lost pedestrian AP or the int8 build's agreement with float at gate 1
     "vlp16s": dict(sensor="vlp16",
                    dataset=["--sensor", "vlp16", "--mounts", "0.3,0.5,0.7,1.0", "--sim", "800,200,200", "--seed", "2000",
                             "--n-points", "32"],
                    cls=["--epochs-ce", "20", "--epochs-energy", "25", "--lam", "0.3",
-                        "--point", "16,32,48", "--pvle", "16,16", "--head", "32"],
+                        "--point", "16,32,64", "--pvle", "16,16", "--head", "32"],
                    box=["--epochs-box", "45", "--epochs-energy", "20", "--widths",
                         '{"tnet_point": [16, 32], "tnet_head": [32], "point": [24, 40, 64], "head": [64, 32], '
                         '"pvle": [16, 16]}'],
@@ -197,7 +196,7 @@ def model_card(a, results: dict, real, timings: dict) -> str:
           "(counted from the ONNX graphs by `python -m lidet_tools.train.macs`). At 128 points the same "
           "widths need about twice as many (classifier 1.33 M, box net 2.89 M: over budget), so the models use 64."
           + (f" {', '.join(small)}: a smaller pair for cores without an FPU (32 points per proposal, narrower layers: "
-             "about 10x fewer multiply-adds), made for the integer firmware (docs/PORTING.md, \"The small VLP-16 pair\")."
+             "about 9x fewer multiply-adds), made for the integer firmware (docs/PORTING.md, \"The small VLP-16 pair\")."
              if small else ""), "",
           "Gates: gate 1 keeps a proposal when E = -logsumexp(logits) < gamma[predicted class]; gate 2 when "
           "E(heading scores) + E(size scores) < gamma[class] (T = 1). Each gamma keeps 95 % of that class's "
