@@ -124,6 +124,21 @@ static inline void pixel(const cell_src_t *src, uint32_t i, int32_t q[3])
     lidet__ground_q_pix(src->img, src->idx[i], q); /* stored or decoded (lidet_qpix.h) */
 }
 
+/* a += the scatter terms (xx xy xz yy yz zz) of one point, 64-bit products */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void
+scatter_add64(int64_t a[6], int32_t x, int32_t y, int32_t z)
+{
+    a[0] += (int64_t)x * x;
+    a[1] += (int64_t)x * y;
+    a[2] += (int64_t)x * z;
+    a[3] += (int64_t)y * y;
+    a[4] += (int64_t)y * z;
+    a[5] += (int64_t)z * z;
+}
+
 /* The least-squares plane through the inliers (|height| <= thr) of cur among the cell's samples: their
  * centroid c0 (rounded to 4 mm steps) and scatter matrix about c0 in exact int64 sums, the normal by
  * power iteration on the adjugate of the scatter matrix starting from cur's normal (the adjugate's dominant
@@ -177,13 +192,7 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
             t1 += y;
             t2 += z;
 #if LIDET_Q_HAVE_MUL64
-            /* one SMLAL each (Cortex-M3 and up) */
-            a[0] += (int64_t)x * x;
-            a[1] += (int64_t)x * y;
-            a[2] += (int64_t)x * z;
-            a[3] += (int64_t)y * y;
-            a[4] += (int64_t)y * z;
-            a[5] += (int64_t)z * z;
+            scatter_add64(a, x, y, z); /* one SMLAL each (Cortex-M3 and up) */
 #else
             if (x >= -46340 && x <= 46340 && y >= -46340 && y <= 46340 && z >= -46340 && z <= 46340)
             {
@@ -197,12 +206,7 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
             }
             else
             {
-                a[0] += (int64_t)x * x;
-                a[1] += (int64_t)x * y;
-                a[2] += (int64_t)x * z;
-                a[3] += (int64_t)y * y;
-                a[4] += (int64_t)y * z;
-                a[5] += (int64_t)z * z;
+                scatter_add64(a, x, y, z);
             }
 #endif
         }
