@@ -271,8 +271,7 @@ typedef struct
 {
     const lidet_range_image_t *img;
     int32_t *slot[2];
-    int16_t
-        *zslot[2]; /* range-only image: the rows' z (overlaying the square root's work rows, unused there) */
+    int16_t *zslot[2]; /* range-only image: the rows' z (over the square root's work rows, unused there) */
     uint32_t *v, *rem;
     int32_t row_in[2];
 } r_rows_t;
@@ -534,8 +533,8 @@ typedef struct
 
 #define NO_POINT INT32_MIN /* z_up of an empty pixel (a decoded z is within +-2^15) */
 
-/* the veto's slope test of an in-band pixel p (R as needed: rare, as a step of more than veto_min_dz_mm on the
- * ground is): |dz| * 2^24 > veto_slope_q16 * |R(above) - R(p)| */
+/* the veto's slope test of an in-band pixel p whose step to the pixel above exceeds veto_min_dz_mm (R is needed
+ * only then): |dz| * 2^24 > veto_slope_q16 * |R(above) - R(p)| */
 #if defined(__GNUC__)
 __attribute__((noinline)) /* off the labelling loop: its registers stay for the common pixel */
 #endif
