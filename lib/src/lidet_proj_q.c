@@ -314,19 +314,20 @@ project_points(const pass1_t *P, uint32_t n, lidet_proj_stats_t *stats, const in
         const int32_t *pt = points + (size_t)i * stride;
         const int32_t x = pt[0], y = pt[1], z = pt[2];
         uint64_t rxy2, z2, r2;
-        uint32_t ax, ay, sum, num, row, col;
+        uint32_t ax, ay, az, sum, num, row, col;
         int32_t out = -1;
-        /* |coordinate| <= LIDET_Q_COORD_MAX_MM, tested on unsigned values (no overflow at the int32 limits) */
-        if ((uint32_t)x + COORD_SPAN > 2u * COORD_SPAN || (uint32_t)y + COORD_SPAN > 2u * COORD_SPAN ||
-            (uint32_t)z + COORD_SPAN > 2u * COORD_SPAN)
+        /* |coordinate| <= LIDET_Q_COORD_MAX_MM on the magnitudes, taken in unsigned arithmetic (INT32_MIN's is
+         * 2^31, no overflow), which the squares reuse */
+        ax = x < 0 ? 0u - (uint32_t)x : (uint32_t)x;
+        ay = y < 0 ? 0u - (uint32_t)y : (uint32_t)y;
+        az = z < 0 ? 0u - (uint32_t)z : (uint32_t)z;
+        if (ax > COORD_SPAN || ay > COORD_SPAN || az > COORD_SPAN)
         {
             ++sts.n_too_far;
             goto next;
         }
-        ax = (uint32_t)(x < 0 ? -x : x);
-        ay = (uint32_t)(y < 0 ? -y : y);
         rxy2 = square_17(ax) + square_17(ay);
-        z2 = square_17((uint32_t)(z < 0 ? -z : z));
+        z2 = square_17(az);
         r2 = rxy2 + z2;
         if (r2 < min2)
         {
