@@ -873,7 +873,16 @@ void lidet__nn_acc_s16_3_requant(const int16_t *in, uint32_t n_rows, const int8_
 #if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && !defined(__ARM_BIG_ENDIAN)
             /* x and y in one (possibly unaligned) little-endian word: one SMLAD for both products */
             const uint32_t w01 = ((uint32_t)w0 & 0xFFFFu) | ((uint32_t)w1 << 16);
-            for (r = 0; r < n_rows; ++r, x += 3, d += n_out)
+            for (r = 0; r + 2u <= n_rows; r += 2u, x += 6, d += 2u * n_out)
+            {
+                /* two rows a pass: the loop's own instructions once for both */
+                uint32_t xy0, xy1;
+                memcpy(&xy0, x, sizeof xy0);
+                memcpy(&xy1, x + 3, sizeof xy1);
+                d[0] = rq_fast(S8_SMLAD(xy0, w01, bo) + x[2] * w2, m, k, c);
+                d[n_out] = rq_fast(S8_SMLAD(xy1, w01, bo) + x[5] * w2, m, k, c);
+            }
+            if (r < n_rows)
             {
                 uint32_t xy;
                 memcpy(&xy, x, sizeof xy);
