@@ -542,22 +542,16 @@ static int
 veto_slope(const label_t *L, lidet__qpix_row_t rt, lidet__qpix_row_t rtu, uint32_t c, uint32_t p, uint32_t up,
            uint32_t v, int32_t dz)
 {
-    int32_t U[3], ru, rp;
-    if (lidet__qpix_range_only(L->img))
+    uint32_t vu = 0;
+    if (!lidet__qpix_range_only(L->img))
     {
-        /* R from the ranges alone */
-        ru = r_of_range(L->img->range_4mm[p - up], rtu.ce);
-        rp = r_of_range(L->img->range_4mm[p], rt.ce);
-        (void)c;
-        (void)v;
-    }
-    else
-    {
+        /* x^2 + y^2 of the pixel above, for its R (a range-only image's R needs its range alone) */
+        int32_t U[3];
         lidet__ground_q_pix_rc(L->gp, rtu, c, p - up, U);
-        ru = r_of((uint32_t)(U[0] * U[0]) + (uint32_t)(U[1] * U[1]));
-        rp = r_of(v);
+        vu = (uint32_t)(U[0] * U[0]) + (uint32_t)(U[1] * U[1]);
     }
-    return ((int64_t)dz << 24) > L->slope * abs32(ru - rp);
+    return ((int64_t)dz << 24) >
+           L->slope * abs32(r_pixel(L->img, rtu, p - up, vu) - r_pixel(L->img, rt, p, v));
 }
 
 /* Columns [c0, c1) of row r (base = r cols) against one cell pair's planes hp (two: far pixels take hp[1]; a
