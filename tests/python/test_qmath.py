@@ -62,6 +62,14 @@ def test_isqrt_exact(nq):
     v = np.concatenate([np.array([0, 1, 2, 3, 4, 15, 16, 17, 2**32 - 1, 2**32, 2**62, 2**63 - 1], dtype=np.uint64),
                         rng.integers(0, 2**63, 50_000, dtype=np.uint64),
                         rng.integers(0, 2**20, 50_000).astype(np.uint64) ** 2])
+    # the 32-bit root plus Newton correction of lidet__q_isqrt64 (v in [2^32, 2^60), cores with a divide): every
+    # bit length, exact squares and their neighbours (where a correction off by one would show), both ends
+    bits = rng.integers(32, 61, 50_000)
+    logu = (rng.integers(0, 2**62, 50_000, dtype=np.uint64) >> (np.uint64(62) - bits.astype(np.uint64))) | (
+        np.uint64(1) << (bits - 1).astype(np.uint64))
+    sq = rng.integers(2**16, 2**30, 20_000).astype(np.uint64) ** 2
+    v = np.concatenate([v, logu, sq, sq - np.uint64(1), sq + np.uint64(1), np.array(
+        [2**60 - 1, 2**60, (2**30 - 1) ** 2, (2**30 - 1) ** 2 - 1, 2**32 + 1, 2**34 - 1], dtype=np.uint64)])
     hi, lo = (v >> np.uint64(32)).astype(np.int64), (v & np.uint64(0xFFFFFFFF)).astype(np.int64)
     c = nq.qmath("isqrt", hi, lo)
     np.testing.assert_array_equal(c, ref.isqrt(v))
