@@ -756,69 +756,91 @@ enum
 {
     PKF_RQ,
     PKF_RQ_FAST,
+    PKF_RQ_FAST_WIDE,
     PKF_MAX
 };
+
+/* PKF_RQ_FAST's per-channel constants, made once per call (not once per pair of points): c = rq_fast_c(k, zp)
+ * and k, for layers of at most PKF_FAST_MAX_OUT channels (the small models' hidden layers; wider ones take the
+ * constants channel by channel, PKF_RQ_FAST_WIDE) */
+#define PKF_FAST_MAX_OUT 48u
+
+/* one pair of points (two: x0 and the row after it), or the last point alone; two and mode are constants where
+ * inlined, so the pairs' loop carries no test for the odd last row */
+S8_ALWAYS_INLINE void pk_fused_block(const int8_t *x0, uint32_t n_in, const uint32_t *w_pk, const int32_t *b,
+                                     uint32_t n_out, const int32_t *mult, const uint8_t *shift, int32_t zp,
+                                     int32_t lo, int8_t *d, int32_t *vmax, const int32_t *cq,
+                                     const uint8_t *kq, uint32_t *xw, const int two, const int mode)
+{
+    const uint32_t n_g = n_in / 4u;
+    const uint32_t *w = w_pk;
+    uint32_t o;
+    pk_widen(x0, two ? x0 + n_in : 0, n_g, xw);
+    for (o = 0; o < n_out; o += 2u)
+    {
+        int32_t s[4];
+        s[0] = s[2] = b[o];
+        s[1] = s[3] = b[o + 1u];
+        w = two ? pk_pair(xw, n_g, w, s) : pk_one(xw, n_g, w, s);
+        if (mode == PKF_RQ_FAST || mode == PKF_RQ_FAST_WIDE)
+        {
+            const int32_t m0 = mult[o], m1 = mult[o + 1u];
+            const uint32_t k0 = mode == PKF_RQ_FAST ? kq[o] : shift[o] - 32u;
+            const uint32_t k1 = mode == PKF_RQ_FAST ? kq[o + 1u] : shift[o + 1u] - 32u;
+            const int32_t c0 = mode == PKF_RQ_FAST ? cq[o] : rq_fast_c(k0, zp);
+            const int32_t c1 = mode == PKF_RQ_FAST ? cq[o + 1u] : rq_fast_c(k1, zp);
+            d[o] = rq_fast(s[0], m0, k0, c0);
+            d[o + 1u] = rq_fast(s[1], m1, k1, c1);
+            if (two)
+            {
+                d[n_out + o] = rq_fast(s[2], m0, k0, c0);
+                d[n_out + o + 1u] = rq_fast(s[3], m1, k1, c1);
+            }
+        }
+        else if (mode == PKF_RQ)
+        {
+            const int32_t m0 = mult[o], m1 = mult[o + 1u];
+            const uint32_t h0 = shift[o], h1 = shift[o + 1u];
+            d[o] = rq_one(s[0], m0, h0, zp, lo);
+            d[o + 1u] = rq_one(s[1], m1, h1, zp, lo);
+            if (two)
+            {
+                d[n_out + o] = rq_one(s[2], m0, h0, zp, lo);
+                d[n_out + o + 1u] = rq_one(s[3], m1, h1, zp, lo);
+            }
+        }
+        else
+        {
+            int32_t v0 = vmax[o], v1 = vmax[o + 1u];
+            v0 = s[0] > v0 ? s[0] : v0;
+            v1 = s[1] > v1 ? s[1] : v1;
+            if (two)
+            {
+                v0 = s[2] > v0 ? s[2] : v0;
+                v1 = s[3] > v1 ? s[3] : v1;
+            }
+            vmax[o] = v0;
+            vmax[o + 1u] = v1;
+        }
+    }
+}
 
 S8_ALWAYS_INLINE void pk_fused_rows(const int8_t *in, uint32_t n_rows, uint32_t n_in, const uint32_t *w_pk,
                                     const int32_t *b, uint32_t n_out, const int32_t *mult,
                                     const uint8_t *shift, int32_t zp, int32_t lo, int8_t *out, int32_t *vmax,
-                                    const int mode)
+                                    const int32_t *cq, const uint8_t *kq, const int mode)
 {
     uint32_t xw[4u * PK_CHUNK_GROUPS];
-    const uint32_t n_g = n_in / 4u;
-    uint32_t r, o;
-    for (r = 0; r < n_rows; r += 2u)
+    uint32_t r;
+    for (r = 0; r + 1u < n_rows; r += 2u)
     {
-        const int two = r + 1u < n_rows;
-        const int8_t *x0 = in + r * n_in;
-        const uint32_t *w = w_pk;
-        int8_t *d = mode != PKF_MAX ? out + r * n_out : 0;
-        pk_widen(x0, two ? x0 + n_in : 0, n_g, xw);
-        for (o = 0; o < n_out; o += 2u)
-        {
-            int32_t s[4];
-            s[0] = s[2] = b[o];
-            s[1] = s[3] = b[o + 1u];
-            w = two ? pk_pair(xw, n_g, w, s) : pk_one(xw, n_g, w, s);
-            if (mode == PKF_RQ_FAST)
-            {
-                const int32_t m0 = mult[o], m1 = mult[o + 1u];
-                const uint32_t k0 = shift[o] - 32u, k1 = shift[o + 1u] - 32u;
-                const int32_t c0 = rq_fast_c(k0, zp), c1 = rq_fast_c(k1, zp);
-                d[o] = rq_fast(s[0], m0, k0, c0);
-                d[o + 1u] = rq_fast(s[1], m1, k1, c1);
-                if (two)
-                {
-                    d[n_out + o] = rq_fast(s[2], m0, k0, c0);
-                    d[n_out + o + 1u] = rq_fast(s[3], m1, k1, c1);
-                }
-            }
-            else if (mode == PKF_RQ)
-            {
-                const int32_t m0 = mult[o], m1 = mult[o + 1u];
-                const uint32_t h0 = shift[o], h1 = shift[o + 1u];
-                d[o] = rq_one(s[0], m0, h0, zp, lo);
-                d[o + 1u] = rq_one(s[1], m1, h1, zp, lo);
-                if (two)
-                {
-                    d[n_out + o] = rq_one(s[2], m0, h0, zp, lo);
-                    d[n_out + o + 1u] = rq_one(s[3], m1, h1, zp, lo);
-                }
-            }
-            else
-            {
-                int32_t v0 = vmax[o], v1 = vmax[o + 1u];
-                v0 = s[0] > v0 ? s[0] : v0;
-                v1 = s[1] > v1 ? s[1] : v1;
-                if (two)
-                {
-                    v0 = s[2] > v0 ? s[2] : v0;
-                    v1 = s[3] > v1 ? s[3] : v1;
-                }
-                vmax[o] = v0;
-                vmax[o + 1u] = v1;
-            }
-        }
+        pk_fused_block(in + r * n_in, n_in, w_pk, b, n_out, mult, shift, zp, lo,
+                       mode != PKF_MAX ? out + r * n_out : 0, vmax, cq, kq, xw, 1, mode);
+    }
+    if (r < n_rows)
+    {
+        pk_fused_block(in + r * n_in, n_in, w_pk, b, n_out, mult, shift, zp, lo,
+                       mode != PKF_MAX ? out + r * n_out : 0, vmax, cq, kq, xw, 0, mode);
     }
 }
 
@@ -835,20 +857,32 @@ int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, 
     }
     if (vmax != 0)
     {
-        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, PKF_MAX);
+        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, 0, 0, PKF_MAX);
         return 1;
     }
     for (o = 0; o < n_out && fast; ++o)
     {
         fast = shift[o] - 33u < 16u; /* shift in [33, 48] */
     }
-    if (fast)
+    if (fast && n_out <= PKF_FAST_MAX_OUT)
     {
-        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, PKF_RQ_FAST);
+        int32_t cq[PKF_FAST_MAX_OUT];
+        uint8_t kq[PKF_FAST_MAX_OUT];
+        for (o = 0; o < n_out; ++o)
+        {
+            kq[o] = (uint8_t)(shift[o] - 32u);
+            cq[o] = rq_fast_c(kq[o], zp);
+        }
+        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, cq, kq, PKF_RQ_FAST);
+    }
+    else if (fast)
+    {
+        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, 0, 0,
+                      PKF_RQ_FAST_WIDE);
     }
     else
     {
-        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, PKF_RQ);
+        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, 0, 0, PKF_RQ);
     }
     return 1;
 }
