@@ -296,8 +296,10 @@ static void fill_detection(const lidet_detector_q_t *d, lidet_detection_q_t *t, 
 #define DET_NOW now
 #include "internal/lidet_detector_body.h"
 
-lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,
-                                    uint32_t stride, const uint16_t *ring, int32_t *point_pixel)
+/* one run on points (use_returns 0) or on returns */
+static lidet_status_t run_scan(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,
+                               uint32_t stride, const uint16_t *ring, const lidet_return_t *returns,
+                               int use_returns, int32_t *point_pixel)
 {
     lidet_detector_q_stats_t *st;
     lidet_proj_q_buffers_t buf;
@@ -331,7 +333,8 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
     buf.point_idx = d->scratch.point_idx;
     buf.point_pixel = point_pixel;
     t0 = now(d);
-    s = lidet_proj_q_run(&d->proj, &buf, points_mm, n_points, stride, ring);
+    s = use_returns ? lidet_proj_q_run_returns(&d->proj, &buf, returns, n_points)
+                    : lidet_proj_q_run(&d->proj, &buf, points_mm, n_points, stride, ring);
     st->proj = d->proj.stats;
     if (!LIDET_SUCCEEDED(s))
     {
@@ -400,6 +403,18 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
     st->n_detections = d->n_det;
     st->ticks[LIDET_DET_STAGE_POST] = now(d) - t1;
     return worst;
+}
+
+lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,
+                                    uint32_t stride, const uint16_t *ring, int32_t *point_pixel)
+{
+    return run_scan(d, points_mm, n_points, stride, ring, 0, 0, point_pixel);
+}
+
+lidet_status_t lidet_detector_q_run_returns(lidet_detector_q_t *d, const lidet_return_t *returns,
+                                            uint32_t n_returns, int32_t *point_pixel)
+{
+    return run_scan(d, 0, n_returns, 0u, 0, returns, 1, point_pixel);
 }
 
 const lidet_detection_q_t *lidet_detector_q_detections(const lidet_detector_q_t *d, uint32_t *n_detections)

@@ -444,6 +444,23 @@ project_points(const pass1_t *P, uint32_t n, lidet_proj_stats_t *stats, const in
     *stats = sts;
 }
 
+/* the runs' checks of the state and buffers; *range_only: the buffers make a range-only image */
+static lidet_status_t check_run(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                                int *range_only)
+{
+    if (st == 0 || buf == 0 || buf->range_4mm == 0 || buf->point_idx == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    /* x, y, z all stored, or none (a range-only image) */
+    *range_only = buf->x_4mm == 0;
+    if ((buf->y_4mm == 0) != *range_only || (buf->z_4mm == 0) != *range_only)
+    {
+        return LIDET_ERR_ARG;
+    }
+    return st->magic != LIDET_INIT_MAGIC ? LIDET_ERR_STATE : LIDET_OK;
+}
+
 lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
                                 const int32_t *points, uint32_t n_points, uint32_t stride,
                                 const uint16_t *ring)
@@ -453,20 +470,14 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     int range_only;
     lidet_proj_stats_t sts;
 
-    if (st == 0 || buf == 0 || stride < 3 || (points == 0 && n_points > 0) || buf->range_4mm == 0 ||
-        buf->point_idx == 0)
+    lidet_status_t s = check_run(st, buf, &range_only);
+    if (s != LIDET_OK)
+    {
+        return s;
+    }
+    if (stride < 3 || (points == 0 && n_points > 0))
     {
         return LIDET_ERR_ARG;
-    }
-    /* x, y, z all stored, or none (a range-only image) */
-    range_only = buf->x_4mm == 0;
-    if ((buf->y_4mm == 0) != range_only || (buf->z_4mm == 0) != range_only)
-    {
-        return LIDET_ERR_ARG;
-    }
-    if (st->magic != LIDET_INIT_MAGIC)
-    {
-        return LIDET_ERR_STATE;
     }
     rows = st->cfg.sensor.n_rows;
     cols = st->cfg.sensor.n_cols;
@@ -553,6 +564,135 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
             ++sts.n_pixels_filled;
         }
     }
+    st->n_points = n;
+    st->stats = sts;
+    return sts.n_truncated > 0 ? LIDET_TRUNCATED : LIDET_OK;
+}
+
+lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                                        const lidet_return_t *returns, uint32_t n_returns)
+{
+    uint32_t n, i, rows, cols, npix, pix, min_mm, max_mm, filled = 0;
+    int32_t *point_pixel;
+    uint32_t *key;
+    int range_only;
+    lidet_proj_stats_t sts;
+    lidet_status_t s = check_run(st, buf, &range_only);
+    if (s != LIDET_OK)
+    {
+        return s;
+    }
+    if (returns == 0 && n_returns > 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    rows = st->cfg.sensor.n_rows;
+    cols = st->cfg.sensor.n_cols;
+    npix = rows * cols;
+    n = n_returns > LIDET_MAX_POINTS ? LIDET_MAX_POINTS : n_returns;
+    memset(&sts, 0, sizeof sts);
+    sts.n_points_in = n_returns;
+    sts.n_truncated = n_returns - n;
+    min_mm =
+        st->cfg.min_range_mm > 0 ? (uint32_t)st->cfg.min_range_mm : 1u; /* zero range is always too close */
+    max_mm = st->cfg.max_range_mm > 0 && (uint32_t)st->cfg.max_range_mm < 131000u
+                 ? (uint32_t)st->cfg.max_range_mm
+                 : 131000u;
+    /* pass 1: the nearest return per pixel, its range in mm as the key (all ones = empty); an image with x, y,
+     * z keeps the winner's index too (point_idx), the key then in its range and z planes (key_set) */
+    memset(buf->point_idx, 0xFF, (size_t)npix * sizeof buf->point_idx[0]);
+    if (!range_only)
+    {
+        memset(buf->range_4mm, 0xFF, (size_t)npix * sizeof buf->range_4mm[0]);
+        memset(buf->z_4mm, 0xFF, (size_t)npix * sizeof buf->z_4mm[0]);
+    }
+    key = (uint32_t *)buf->point_idx; /* range-only: int32_t storage read as its unsigned type */
+    point_pixel = buf->point_pixel;
+    for (i = 0; i < n; ++i)
+    {
+        const uint32_t r = returns[i].range_mm, ring = returns[i].ring;
+        int32_t out = -1;
+        if (r < min_mm)
+        {
+            ++sts.n_too_close;
+        }
+        else if (r > max_mm)
+        {
+            ++sts.n_too_far;
+        }
+        else if (ring >= rows)
+        {
+            ++sts.n_bad_ring;
+        }
+        else
+        {
+            /* u 2^16 = 2^15 - azimuth (mod 2^16); n_cols <= 2^16, so the product fits 32 bits */
+            const uint32_t col = ((uint32_t)(uint16_t)(0x8000u - returns[i].azimuth) * cols) >> 16;
+            pix = (uint32_t)st->ring_to_row[ring] * cols + col;
+            out = (int32_t)pix;
+            ++sts.n_projected;
+            if (range_only)
+            {
+                key[pix] = r < key[pix] ? r : key[pix];
+            }
+            else if (r < key_get(buf, pix)) /* strict: ties keep the earlier return */
+            {
+                key_set(buf, pix, r);
+                buf->point_idx[pix] = (int32_t)i;
+            }
+        }
+        if (point_pixel != 0)
+        {
+            point_pixel[i] = out;
+        }
+    }
+    /* pass 2: range_4mm = round(range_mm / 4) (>= 1); an image with x, y, z decodes them as the range-only
+     * image's readers would (lidet_qpix.h) */
+    if (range_only)
+    {
+        uint16_t *range = buf->range_4mm;
+        for (pix = 0; pix < npix; ++pix)
+        {
+            const uint32_t k = key[pix];
+            uint32_t rq = 0u;
+            if (k != 0xFFFFFFFFu)
+            {
+                rq = (k + 2u) >> 2;
+                rq = rq > 0u ? rq : 1u;
+                ++filled;
+            }
+            range[pix] = (uint16_t)rq;
+        }
+    }
+    else
+    {
+        lidet_range_image_t img;
+        uint32_t r, c;
+        lidet_proj_q_image(st, buf, &img);
+        img.x_4mm = img.y_4mm = img.z_4mm = 0; /* decode */
+        for (r = 0, pix = 0; r < rows; ++r)
+        {
+            const lidet__qpix_row_t rt = lidet__qpix_row(&img, r);
+            for (c = 0; c < cols; ++c, ++pix)
+            {
+                int32_t v[3] = {0, 0, 0}, ct, sn;
+                uint32_t rq = 0u;
+                if (buf->point_idx[pix] >= 0)
+                {
+                    rq = (key_get(buf, pix) + 2u) >> 2;
+                    rq = rq > 0u ? rq : 1u;
+                    lidet__qpix_col(&img, c, &ct, &sn);
+                    lidet__qpix_decode(rq, rt, ct, sn, v);
+                    ++filled;
+                }
+                buf->range_4mm[pix] = (uint16_t)rq;
+                buf->x_4mm[pix] = (int16_t)v[0];
+                buf->y_4mm[pix] = (int16_t)v[1];
+                buf->z_4mm[pix] = (int16_t)v[2];
+            }
+        }
+    }
+    sts.n_pixels_filled = filled;
     st->n_points = n;
     st->stats = sts;
     return sts.n_truncated > 0 ? LIDET_TRUNCATED : LIDET_OK;

@@ -107,7 +107,7 @@ LIDET_PY_API int lidet_py_acc_cands_q(const char *sensor, const char *cls_name, 
 {
     /* NMS, gates, box budget, pixel: the defaults */
     const int32_t cfg6[10] = {icfg[0], icfg[1], 3277, icfg[2], 1, 1, 0, 0, 0, -1};
-    const int rc = lidet_py__detq_init_run(&g_acc_detq, sensor, cls_name, box_name, cfg6, pts_mm, n, stride);
+    const int rc = lidet_py__detq_init_run(&g_acc_detq, sensor, cls_name, box_name, cfg6, pts_mm, n, stride, NULL);
     return put_cands(rc, lidet_detector_q_stats(&g_acc_detq)->n_classified, g_acc_detq.cfg.proposal.n_points,
                      g_acc_detq.order, make_q, &g_prop_q, g_prop_q.xyz, sizeof(int16_t), g_prop_q.mean_4mm,
                      sizeof g_prop_q.mean_4mm, g_prop_q.voxel, xyz, mean, voxel, cluster_id, n_cand, n_points);

@@ -19,7 +19,7 @@ static lidet_detector_q_t g_detq;
 
 int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const char *cls_name,
                             const char *box_name, const int32_t *icfg, const int32_t *pts_mm, uint32_t n,
-                            uint32_t stride)
+                            uint32_t stride, const lidet_return_t *returns)
 {
     const lidet_sensor_q_t *s = lidet_sensor_q_find(sensor);
     const lidet_pointnet_q_model_t *mc, *mb;
@@ -56,18 +56,24 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
         cfg.range_only = (uint8_t)icfg[9];
     }
     rc = lidet_detector_q_init(det, &cfg, mc, mb);
-    return rc != LIDET_OK ? rc : lidet_detector_q_run(det, pts_mm, n, stride, NULL, NULL);
+    if (rc != LIDET_OK)
+    {
+        return rc;
+    }
+    return returns != NULL ? lidet_detector_q_run_returns(det, returns, n, NULL)
+                           : lidet_detector_q_run(det, pts_mm, n, stride, NULL, NULL);
 }
 
 /* lidet_py_detq_run: icfg: crop_half_bam, max_range_mm, nms_iou_q15, max_proposals (0 = default), gate1, gate2,
  * max_boxes (0 = default), gate1_margin_q16, gate2_margin_q16, range_only (-1 = the build's default, 0, 1).
  * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
  * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 14 uint32 (the
- * counts of lidet_detector_q_stats_t in order, then n_over_box_budget and n_too_tall). Returns the run's status. */
+ * counts of lidet_detector_q_stats_t in order, then n_over_box_budget and n_too_tall). returns: n lidet_return_t
+ * instead of the points (lidet_detector_q_run_returns; pts_mm ignored), or NULL. Returns the run's status. */
 LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, const char *box_name,
                                    const int32_t *icfg, const int32_t *pts_mm, uint32_t n, uint32_t stride,
                                    int32_t *out_det, uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters,
-                                   uint32_t *out_stats)
+                                   uint32_t *out_stats, const lidet_return_t *returns)
 {
     const lidet_detection_q_t *d;
     const lidet_detector_q_stats_t *st;
@@ -79,7 +85,7 @@ LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, con
     {
         return lidet_sensor_q_find(sensor) == NULL ? LIDET_ERR_NOT_FOUND : LIDET_ERR_ARG;
     }
-    rc = lidet_py__detq_init_run(&g_detq, sensor, cls_name, box_name, icfg, pts_mm, n, stride);
+    rc = lidet_py__detq_init_run(&g_detq, sensor, cls_name, box_name, icfg, pts_mm, n, stride, returns);
     if (rc < 0)
     {
         return rc;

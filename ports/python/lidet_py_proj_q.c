@@ -38,11 +38,12 @@ LIDET_PY_API int lidet_py_sensor_q(uint32_t index, char *name_buf, uint32_t *row
 /* One integer projection on a heap state and heap buffers. sensor_ints = rows, cols, fov_up, fov_down (used
  * when elev_urad is NULL); cfg_ints = min_range_mm, max_range_mm, fov_margin_urad. Outputs: point_pixel (n,
  * may be NULL), point_idx / range_4mm (rows*cols), xyz_4mm (3*rows*cols: x, y, z planes), stats (9 counts,
- * lidet_proj_stats_t order), row_elev_bam (rows). Returns the run's status (or init's error). */
+ * lidet_proj_stats_t order), row_elev_bam (rows). returns: n lidet_return_t instead of the points
+ * (lidet_proj_q_run_returns; points, stride and ring ignored), or NULL. Returns the run's status (or init's error). */
 LIDET_PY_API int lidet_py_proj_q(const int32_t *sensor_ints, const int32_t *elev_urad, const int32_t *cfg_ints,
                                  const int32_t *points, uint32_t n, uint32_t stride, const uint16_t *ring,
                                  int32_t *point_pixel, int32_t *point_idx, int16_t *xyz_4mm, uint16_t *range_4mm,
-                                 uint32_t *stats, int32_t *row_elev_bam)
+                                 uint32_t *stats, int32_t *row_elev_bam, const lidet_return_t *returns)
 {
     lidet_proj_q_cfg_t cfg;
     lidet_proj_q_buffers_t b;
@@ -75,7 +76,8 @@ LIDET_PY_API int lidet_py_proj_q(const int32_t *sensor_ints, const int32_t *elev
         b.range_4mm = range_4mm;
         b.point_idx = point_idx;
         b.point_pixel = point_pixel;
-        status = lidet_proj_q_run(st, &b, points, n, stride, ring);
+        status = returns != NULL ? lidet_proj_q_run_returns(st, &b, returns, n)
+                                 : lidet_proj_q_run(st, &b, points, n, stride, ring);
         if (status >= 0)
         {
             const lidet_proj_stats_t *s = lidet_proj_q_stats(st);

@@ -155,7 +155,7 @@ def test_score_matches_the_float_definition(nq):
 
 # ---- the integer detector against the chained numpy reference, bit for bit ---------------------------
 
-def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False, crop_half_bam=0):
+def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False, crop_half_bam=0, returns=None):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -175,36 +175,48 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
                    gate1_margin_q16=margins[0], gate2_margin_q16=margins[1])
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
                      det_cfg, models["cls"], models["box"], cap["max_clusters"], cap["max_detections"],
-                     cap["max_points"], range_only=range_only)
+                     cap["max_points"], range_only=range_only, returns=returns)
 
 
 @pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "range_only_sample",
-                                   "range_only_fresh", "range_only_real", "crop_hdl64", "crop_real"])
+                                   "range_only_fresh", "range_only_real", "crop_hdl64", "crop_real",
+                                   "returns_sample", "returns_range_only_sample", "returns_range_only_fresh"])
 def test_bit_exact_with_the_chained_reference(nq, which, request):
     """Both pixels of the integer detector (the range-only one: x, y, z decoded from row, column and range,
-    qmath.decode_pixels) against the chained numpy reference, bit for bit."""
+    qmath.decode_pixels) against the chained numpy reference, bit for bit; and the detector fed the sensor's
+    returns (lidet_detector_q_run_returns: ring, azimuth, range) instead of points."""
+    from lidet_codegen.ref import proj_q
     sensor, max_boxes, margins = "vlp16", 0, (0, 0)
+    use_returns = which.startswith("returns_")
+    which = which.removeprefix("returns_")
     range_only = which.startswith("range_only_")
     crop = (1 << 29) if which.startswith("crop_") else 0  # the camera crop: a RANSAC stream per ground cell too
     which = which.removeprefix("range_only_").removeprefix("crop_")
+    ring = None
     if which == "margins":  # the gates' operating points moved: gate 1 looser by 1 nat, gate 2 stricter by 0.5
         pts, margins = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"), (65536, -32768)
     elif which == "box_budget":  # the box budget hit: 3 boxed, the rest counted, LIDET_TRUNCATED
         pts, max_boxes = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"), 3
     elif which == "sample":
         pts = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin")
+        ring = np.fromfile(ROOT / "tests/data/sim_vlp16/ring/000000.bin", np.uint16)
     elif which == "fresh":
         from lidet_tools.sim.simulate import simulate_scan
-        pts = simulate_scan("vlp16", seed=9200, index=0).points
+        sc = simulate_scan("vlp16", seed=9200, index=0)
+        pts, ring = sc.points, sc.ring
     elif which == "hdl64":
         sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
     else:
         real = request.getfixturevalue("real_dir")
         sensor, pts = "hdl64", _load(real / "kitti/training/velodyne/000001.bin")
     mm = nq.to_mm(pts)
+    rets = proj_q.returns_of_points(mm, ring) if use_returns else None
     c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
-                    range_only=range_only, crop_half_bam=crop)
-    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop)
+                    range_only=range_only, crop_half_bam=crop, returns=None if rets is None else nq.as_returns(*rets))
+    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop, returns=rets)
+    if use_returns:  # the same scan as points gives nearly the same detections (pixels move by rounding only)
+        p = nq.detect_q(mm, sensor, range_only=range_only)
+        assert abs(len(p["cls"]) - len(c["cls"])) <= 2 and c["stats"]["n_clusters"] > 0
     if crop:
         assert c["stats"]["n_out_of_crop"] > 0
     if margins != (0, 0):  # the margins bite: fewer gate-1 rejections, more gate-2 ones than at the models' gammas

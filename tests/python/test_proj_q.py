@@ -172,3 +172,64 @@ def test_real_scans(nq, real_dir):
         agree.append(_agreement(nq, pts, "hdl64"))
     agree = np.array(agree)
     assert agree.min() >= 0.995, agree.min(0)
+
+
+def _check_returns(nq, sensor, rg, az, ri, **cfg):
+    s = sensors.get_sensor(sensor)
+    c = nq.project_q(None, s, returns=nq.as_returns(rg, az, ri), **cfg)
+    tab = ref.init(s.beam_elev_urad, s.cols, fov_margin_urad=87266, fov_urad=s.fov_urad)
+    r = ref.project_returns(rg, az, ri, tab, max_points=native.capacity()["max_points"], **cfg)
+    for k in KEYS:
+        np.testing.assert_array_equal(np.asarray(c[k], dtype=np.int64), np.asarray(r[k], dtype=np.int64), err_msg=k)
+    assert c["stats"] == r["stats"]
+    return c
+
+
+@pytest.mark.parametrize("sensor", ["vlp16", "hdl64"])
+def test_returns_bit_exact_limits_and_ties(nq, sensor):
+    """lidet_proj_q_run_returns (the sensor's returns: range, azimuth, ring) equals ref.project_returns bit for bit:
+    random returns with every limit (zero range, below min_range, at and past 131 000 mm and max_range, rings past
+    the last row, the azimuth's wrap), several returns in one pixel (nearest wins, ties keep the earlier), and the
+    x, y, z an image stores are the range-only image's decoding."""
+    s = sensors.get_sensor(sensor)
+    rng = np.random.default_rng(77)
+    n = 20_000
+    rg = rng.integers(0, 140_000, n)
+    az = rng.integers(0, 65536, n)
+    ri = rng.integers(0, s.rows + 3, n)
+    rg[:12] = [0, 1, 99, 100, 101, 130_999, 131_000, 131_001, 2**32 - 1, 5000, 5000, 4999]
+    az[:12] = [0, 0x8000, 0x7FFF, 0xFFFF, 1, 0x8001, 0, 0, 0, 1234, 1234, 1234]  # the last three: one pixel
+    ri[:12] = [0, 1, 2, 0, 1, 2, 3, 0, 1, 2, 2, 2]
+    c = _check_returns(nq, sensor, rg, az, ri)
+    st = c["stats"]
+    assert st["n_too_close"] >= 3 and st["n_too_far"] >= 2 and st["n_bad_ring"] > 0
+    assert st["n_pixels_filled"] < st["n_projected"]  # pixels with several returns
+    assert c["point_pixel"][9] == c["point_pixel"][10] == c["point_pixel"][11] >= 0
+    assert c["point_idx"][c["point_pixel"][11]] == 11 and c["range_4mm"][c["point_pixel"][11]] == 1250
+    tab = ref.init(s.beam_elev_urad, s.cols, fov_margin_urad=87266, fov_urad=s.fov_urad)
+    x, y, z = qmath.decode_pixels(np.asarray(c["range_4mm"], np.int64).reshape(s.rows, s.cols), tab.row_elev_bam)
+    np.testing.assert_array_equal(c["x_4mm"], x.ravel())
+    np.testing.assert_array_equal(c["z_4mm"], z.ravel())
+    _check_returns(nq, sensor, rg, az, ri, min_range_mm=0, max_range_mm=60_000)
+    _check_returns(nq, sensor, rg[:0], az[:0], ri[:0])  # an empty scan
+
+
+def test_returns_image_matches_the_points_image(nq, root):
+    """The simulated VLP-16 sample as returns (ref.returns_of_points: range rounded to mm, azimuth to BAM16) fills
+    the same pixels as its points with their rings, each range within one 4 mm step."""
+    d = root / "tests/data/sim_vlp16"
+    mm = _mm(kitti.read_bin(d / "velodyne/000000.bin"))
+    ring = np.fromfile(d / "ring/000000.bin", np.uint16)
+    p = nq.project_q(mm, "vlp16", ring=ring)
+    c = _check_returns(nq, "vlp16", *ref.returns_of_points(mm, ring))
+    filled_p, filled_c = p["range_4mm"] > 0, c["range_4mm"] > 0
+    assert filled_p.sum() > 20_000 and (filled_p != filled_c).sum() <= filled_p.sum() // 1000
+    both = filled_p & filled_c
+    assert np.abs(p["range_4mm"][both].astype(np.int64) - c["range_4mm"][both]).max() <= 1
+
+
+def test_returns_bad_arguments(nq):
+    with pytest.raises(ValueError, match="azimuth"):
+        nq.as_returns([1000], [70000], [0])
+    with pytest.raises(ValueError, match="ring"):
+        nq.as_returns([1000, 2000], [0, 1], [0])

@@ -242,6 +242,61 @@ static void test_errors_and_truncation(void)
     TEST_ASSERT_TRUE(lidet_proj_q_state_bytes() == sizeof(lidet_proj_q_state_t));
 }
 
+/* returns (range, azimuth, ring): the ring's row, the column of the azimuth (straight ahead, +x, is the middle
+ * column as in lidet_proj_q_run; +y a quarter turn before), round(range / 4); the nearest of a pixel wins;
+ * limits and bad arguments are counted or refused */
+static void test_returns(void)
+{
+    static lidet_return_t ret[6];
+    const lidet_proj_stats_t *st;
+    uint32_t cols;
+    lidet_proj_q_buffers_t ro = {0, 0, 0, brange, bidx, bpix};
+    init_sensor("vlp16");
+    cols = cfg.sensor.n_cols;
+    ret[0].range_mm = 10001u; /* ahead */
+    ret[0].azimuth = 0u;
+    ret[0].ring = 0u;
+    ret[1].range_mm = 6000u; /* left, +y */
+    ret[1].azimuth = 0x4000u;
+    ret[1].ring = 1u;
+    ret[2] = ret[1]; /* the same pixel, nearer: wins */
+    ret[2].range_mm = 5999u;
+    ret[3].range_mm = 0u; /* no return */
+    ret[4] = ret[0];
+    ret[4].ring = 16u; /* no such ring */
+    ret[5] = ret[0];
+    ret[5].range_mm = 131001u; /* past the compact image */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_q_run_returns(&g.ws, &buf, ret, 6u));
+    st = lidet_proj_q_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(3u, st->n_projected);
+    TEST_ASSERT_EQUAL_UINT32(2u, st->n_pixels_filled);
+    TEST_ASSERT_EQUAL_UINT32(1u, st->n_too_close);
+    TEST_ASSERT_EQUAL_UINT32(1u, st->n_too_far);
+    TEST_ASSERT_EQUAL_UINT32(1u, st->n_bad_ring);
+    TEST_ASSERT_EQUAL_INT32((int32_t)(g.ws.ring_to_row[0] * cols + cols / 2u), bpix[0]);
+    TEST_ASSERT_EQUAL_INT32((int32_t)(g.ws.ring_to_row[1] * cols + cols / 4u), bpix[1]);
+    TEST_ASSERT_EQUAL_INT32(bpix[1], bpix[2]);
+    TEST_ASSERT_EQUAL_INT32(-1, bpix[3]);
+    TEST_ASSERT_EQUAL_UINT16(2500u, brange[bpix[0]]);
+    TEST_ASSERT_EQUAL_UINT16(1500u, brange[bpix[1]]);
+    TEST_ASSERT_EQUAL_INT32(2, bidx[bpix[1]]);
+    /* decoded at the column centre (half a column, 0.1 deg, off the azimuth) and the beam's elevation */
+    TEST_ASSERT_TRUE(bx[bpix[0]] > 2400 && by[bpix[0]] > -10 && by[bpix[0]] < 10);
+    TEST_ASSERT_TRUE(by[bpix[1]] > 1400 && bx[bpix[1]] > -10 && bx[bpix[1]] < 10);
+    /* the range-only image: the same ranges */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_q_run_returns(&g.ws, &ro, ret, 6u));
+    TEST_ASSERT_EQUAL_UINT16(2500u, brange[bpix[0]]);
+    TEST_ASSERT_EQUAL_UINT16(1500u, brange[bpix[1]]);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_q_run_returns(&g.ws, &ro, 0, 0u));
+    TEST_ASSERT_EQUAL_UINT32(0u, lidet_proj_q_stats(&g.ws)->n_pixels_filled);
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proj_q_run_returns(&g.ws, &ro, 0, 1u));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proj_q_run_returns(0, &ro, ret, 1u));
+    ro.y_4mm = by; /* x, y, z all or none */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proj_q_run_returns(&g.ws, &ro, ret, 1u));
+    g.ws.magic = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_proj_q_run_returns(&g.ws, &buf, ret, 1u));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -252,5 +307,6 @@ int main(void)
     RUN_TEST(test_limits_are_counted);
     RUN_TEST(test_ring_path);
     RUN_TEST(test_errors_and_truncation);
+    RUN_TEST(test_returns);
     return UNITY_END();
 }

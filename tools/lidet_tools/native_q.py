@@ -129,7 +129,7 @@ def _proj_q_lib():
         L.lidet_py_sensor_q.argtypes = [C.c_uint32, C.c_char_p, _u32p, _i32p, _i32p]
         L.lidet_py_isqrt32.argtypes = [_u32p, C.c_uint32, _i64p]
         L.lidet_py_proj_q.argtypes = [_i32p, native._opt(_i32p), _i32p, native._opt(_i32p), C.c_uint32, C.c_uint32,
-                                      native._opt(_u16p), native._opt(_i32p), _i32p, _i16p, _u16p, _u32p, _i32p]
+                                      native._opt(_u16p), native._opt(_i32p), _i32p, _i16p, _u16p, _u32p, _i32p, C.c_void_p]
         _proj_q_ready = True
     return L
 
@@ -156,16 +156,36 @@ def sensors_q() -> dict:
         i += 1
 
 
+RETURN_DTYPE = np.dtype([("range_mm", "<u4"), ("azimuth", "<u2"), ("ring", "<u2")])  # lidet_return_t
+
+
+def as_returns(range_mm, azimuth, ring) -> np.ndarray:
+    """Three per-return arrays -> the C array of lidet_return_t (range in mm, azimuth in BAM16, ring)."""
+    rg = np.asarray(range_mm)
+    out = np.zeros(len(rg), RETURN_DTYPE)
+    for k, v, hi in (("range_mm", rg, 0xFFFFFFFF), ("azimuth", azimuth, 0xFFFF), ("ring", ring, 0xFFFF)):
+        v = np.asarray(v)
+        if v.shape != rg.shape or (v.size and (v.min() < 0 or v.max() > hi)):
+            raise ValueError(f"{k}: {v.shape} values in [{v.min() if v.size else 0}, {v.max() if v.size else 0}] "
+                             f"for {rg.shape} returns (need 0..{hi})")
+        out[k] = v
+    return out
+
+
 def project_q(points_mm, sensor="hdl64", ring=None, min_range_mm: int = 100, max_range_mm: int = 0,
-              fov_margin_urad: int = 87266) -> dict:
+              fov_margin_urad: int = 87266, returns=None) -> dict:
     """The C integer projection of (N, >=3) int32 mm points (x, y, z first). sensor: a preset name or a
     sensors.Sensor (its integer profile: beam_elev_urad, or fov_urad for a uniform one). Returns the keys of
     lidet_codegen.ref.proj_q.project (point_pixel, point_idx, x_4mm, y_4mm, z_4mm, range_4mm, stats,
-    row_elev_bam) and status."""
+    row_elev_bam) and status. returns: a RETURN_DTYPE array (as_returns) instead of the points
+    (lidet_proj_q_run_returns; points_mm and ring are then ignored, pass None)."""
     from lidet_tools.sensors import get_sensor
 
     L = _proj_q_lib()
     s = get_sensor(sensor) if isinstance(sensor, str) else sensor
+    if returns is not None:
+        returns = np.ascontiguousarray(returns, dtype=RETURN_DTYPE)
+        points_mm, ring = np.zeros((len(returns), 3), np.int32), None
     pts = np.asarray(points_mm)
     if pts.ndim != 2 or not 3 <= pts.shape[1] <= native.MAX_STRIDE or pts.dtype.kind not in "iu":
         raise ValueError(f"points_mm must be integer (N, 3..{native.MAX_STRIDE}), got {pts.dtype} {pts.shape}")
@@ -185,7 +205,8 @@ def project_q(points_mm, sensor="hdl64", ring=None, min_range_mm: int = 100, max
     stats = np.zeros(9, np.uint32)
     bam = np.zeros(s.rows, np.int32)
     st = L.lidet_py_proj_q(sens, elev, cfg, pts.ravel() if n else None, n, stride, rg,
-                           pp if 0 < n <= cap else None, idx, xyz, rng, stats, bam)
+                           pp if 0 < n <= cap else None, idx, xyz, rng, stats, bam,
+                           None if returns is None else returns.ctypes.data_as(C.c_void_p))
     if st < 0:
         raise native.LidetError(st, "lidet_proj_q")
     return dict(point_pixel=pp, point_idx=idx, x_4mm=xyz[:npix], y_4mm=xyz[npix:2 * npix], z_4mm=xyz[2 * npix:],
@@ -715,8 +736,9 @@ def to_mm(points) -> np.ndarray:
 def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_half_bam: int = 0,
              max_range_mm: int = 0, nms_iou_q15: int = 3277, max_proposals: int = 0, gate1: bool = True,
              gate2: bool = True, max_boxes: int = 0, gate1_margin_q16: int = 0, gate2_margin_q16: int = 0,
-             range_only: bool | None = None) -> dict:
-    """lidet_detector_q_run on (N, 3) int32 mm points with the int8 models cls_<model>_s8 / box_<model>_s8.
+             range_only: bool | None = None, returns=None) -> dict:
+    """lidet_detector_q_run on (N, 3) int32 mm points with the int8 models cls_<model>_s8 / box_<model>_s8
+    (returns: a RETURN_DTYPE array instead, lidet_detector_q_run_returns; points_mm is then ignored).
     gate*_margin_q16: the gates' operating points (lidet_detector_q_cfg_t, Q16 nats). range_only: the range-only
     pixel (lidet_detector_q_cfg_t.range_only; None = the build's default).
 
@@ -728,9 +750,12 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
         u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
         u32p = np.ctypeslib.ndpointer(np.uint32, flags="C_CONTIGUOUS")
         L.lidet_py_detq_run.argtypes = [C.c_char_p, C.c_char_p, C.c_char_p, _i32p, _i32p, C.c_uint32, C.c_uint32,
-                                        _i32p, u32p, u8p, u32p, u32p]
+                                        _i32p, u32p, u8p, u32p, u32p, C.c_void_p]
         L.lidet_py_detq_bytes.restype = C.c_uint32
         _detq_ready = True
+    if returns is not None:
+        returns = np.ascontiguousarray(returns, dtype=RETURN_DTYPE)
+        points_mm = np.zeros((len(returns), 3), np.int32)
     pts = np.ascontiguousarray(points_mm, dtype=np.int32)
     if pts.ndim != 2 or pts.shape[1] < 3:
         raise ValueError(f"points_mm must be (N, >=3) int32, got {pts.shape}")
@@ -746,7 +771,8 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
                     np.int32)
     n = len(pts)
     rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
-                             pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st)
+                             pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st,
+                             None if returns is None else returns.ctypes.data_as(C.c_void_p))
     if rc < 0:
         raise native.LidetError(rc, "lidet_detector_q")
     d = det[: int(nd[0])]

@@ -67,13 +67,19 @@ def candidates(recs, det_cfg: dict, outcome: list) -> tuple[list, bool]:
 
 
 def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, proposal_cfg: dict, det_cfg: dict,
-           cls_model, box_model, max_clusters: int, max_detections: int, max_points: int, range_only: bool = False) -> dict:
+           cls_model, box_model, max_clusters: int, max_detections: int, max_points: int, range_only: bool = False,
+           returns=None) -> dict:
     """The whole integer detector on (N, 3) int32 mm points. det_cfg: crop_half_bam, max_range_mm, max_height_extent_mm,
     max_proposals, max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max, score_box_weight_q16 (3), score_points_weight_q16 (3), and optionally gate1_margin_q16 / gate2_margin_q16
     (0 when absent: the models' gammas). range_only: the image keeps only the range, every stage reads x, y, z
     decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
-    (dicts), outcomes, stats."""
-    pj = proj_q.project(points_mm, tab, proj_cfg["min_range_mm"], proj_cfg["max_range_mm"], max_points=max_points)
+    (dicts), outcomes, stats. returns: (range_mm, azimuth, ring) instead of points_mm (lidet_detector_q_run_returns:
+    proj_q.project_returns)."""
+    if returns is not None:
+        pj = proj_q.project_returns(*returns, tab, proj_cfg["min_range_mm"], proj_cfg["max_range_mm"],
+                                    max_points=max_points)
+    else:
+        pj = proj_q.project(points_mm, tab, proj_cfg["min_range_mm"], proj_cfg["max_range_mm"], max_points=max_points)
     rows, cols = tab.rows, tab.cols
     X, Y, Z, R = (np.asarray(pj[k], np.int64).reshape(rows, cols) for k in ("x_4mm", "y_4mm", "z_4mm", "range_4mm"))
     RG = None  # the ground stage's R: from x, y, or from the range of a range-only image

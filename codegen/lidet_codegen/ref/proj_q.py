@@ -195,3 +195,57 @@ def project(points_mm, tab: Tables, min_range_mm: int = 100, max_range_mm: int =
     stats["n_pixels_filled"] = int(filled.sum())
     return dict(point_pixel=pix, point_idx=point_idx, x_4mm=planes[0], y_4mm=planes[1], z_4mm=planes[2],
                 range_4mm=range_4mm, stats=stats, row_elev_bam=tab.row_elev_bam)
+
+
+def project_returns(range_mm, azimuth, ring, tab: Tables, min_range_mm: int = 100, max_range_mm: int = 0,
+                    max_points: int = 262144):
+    """lidet_proj_q_run_returns: returns (range in mm, azimuth in BAM16 counterclockwise from +x, ring) -> the
+    same dict as project(). The ring's row; column floor(((0x8000 - azimuth) mod 2^16) cols / 2^16); range 0 or
+    below min_range_mm too close, above max_range_mm (when set) or 131 000 mm too far; the nearest return wins a
+    pixel (ties: the earlier); range_4mm = max((range + 2) >> 2, 1); x, y, z decoded from row, column and range
+    (qmath.decode_pixels), the planes an image with coordinates stores."""
+    rg_all = np.asarray(range_mm, dtype=np.int64)
+    n_in = len(rg_all)
+    n = min(n_in, max_points)
+    rg = rg_all[:n]
+    az = np.asarray(azimuth, dtype=np.int64)[:n]
+    ri = np.asarray(ring, dtype=np.int64)[:n]
+    rows, cols, npix = tab.rows, tab.cols, tab.rows * tab.cols
+    lo = max(min_range_mm, 1)
+    hi = min(max_range_mm, COORD_MAX_MM) if max_range_mm > 0 else COORD_MAX_MM
+    stats = dict.fromkeys(STATS, 0)
+    stats["n_points_in"], stats["n_truncated"] = n_in, n_in - n
+    close = rg < lo
+    far = ~close & (rg > hi)
+    bad = ~close & ~far & (ri >= rows)
+    ok = ~close & ~far & ~bad
+    stats["n_too_close"], stats["n_too_far"], stats["n_bad_ring"] = int(close.sum()), int(far.sum()), int(bad.sum())
+    row = tab.ring_to_row[np.clip(ri, 0, rows - 1)]
+    col = (((0x8000 - az) & 0xFFFF) * cols) >> 16
+    pix = np.where(ok, row * cols + col, -1)
+    stats["n_projected"] = int(ok.sum())
+    point_idx = np.full(npix, -1, np.int64)
+    idx = np.nonzero(ok)[0]
+    o = np.lexsort((idx, rg[idx], pix[idx]))
+    sp = pix[idx][o]
+    first = np.ones(len(sp), bool)
+    first[1:] = sp[1:] != sp[:-1]
+    point_idx[sp[first]] = idx[o][first]
+    filled = point_idx >= 0
+    w = np.where(filled, point_idx, 0)
+    range_4mm = np.where(filled, np.maximum((rg[w] + 2) >> 2, 1), 0) if n else np.zeros(npix, np.int64)
+    x, y, z = qmath.decode_pixels(range_4mm.reshape(rows, cols), tab.row_elev_bam)
+    stats["n_pixels_filled"] = int(filled.sum())
+    return dict(point_pixel=pix, point_idx=point_idx, x_4mm=x.ravel(), y_4mm=y.ravel(), z_4mm=z.ravel(),
+                range_4mm=range_4mm, stats=stats, row_elev_bam=tab.row_elev_bam)
+
+
+def returns_of_points(points_mm, ring):
+    """Scan points (int mm) and their rings -> returns (range_mm, azimuth, ring) as a spinning sensor reports
+    them: range = round(sqrt(x^2 + y^2 + z^2)) (exact, halves up), azimuth = round(atan2(y, x) 2^16 / 2 pi)
+    mod 2^16 (float64). A conversion for tests and tools, not part of the mirrored C."""
+    p = np.asarray(points_mm, dtype=np.int64)[:, :3]
+    r2 = (p * p).sum(1)
+    rng = (qmath.isqrt(4 * r2) + 1) >> 1
+    az = np.round(np.arctan2(p[:, 1], p[:, 0]) * (65536.0 / (2.0 * np.pi))).astype(np.int64) & 0xFFFF
+    return rng, az, np.asarray(ring, dtype=np.int64)

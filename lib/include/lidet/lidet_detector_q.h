@@ -207,6 +207,17 @@ lidet_status_t lidet_detector_q_init(lidet_detector_q_t *d, const lidet_detector
 lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,
                                     uint32_t stride, const uint16_t *ring, int32_t *point_pixel);
 
+/**
+ * @brief Detect road users in one scan given as the sensor's returns (ring, azimuth, range: lidet_return_t,
+ *        lidet_proj_q_run_returns): the projection without square roots or column searches, the rest as
+ *        lidet_detector_q_run. The firmware's way in when the driver has the sensor's packets
+ *        (docs/PORTING.md, "Feeding the detector").
+ * @param point_pixel optional LIDET_MAX_POINTS int32 (the pixel of each return, -1 = dropped), or NULL.
+ * @return as lidet_detector_q_run (LIDET_ERR_ARG: NULL returns with n_returns > 0).
+ */
+lidet_status_t lidet_detector_q_run_returns(lidet_detector_q_t *d, const lidet_return_t *returns,
+                                            uint32_t n_returns, int32_t *point_pixel);
+
 /** @brief Detections of the last run, best score first. */
 const lidet_detection_q_t *lidet_detector_q_detections(const lidet_detector_q_t *d, uint32_t *n_detections);
 

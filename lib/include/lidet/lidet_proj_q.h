@@ -115,6 +115,39 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
                                 const int32_t *points, uint32_t n_points, uint32_t stride,
                                 const uint16_t *ring);
 
+/**
+ * @brief One return as a spinning sensor reports it: the laser's ring, the azimuth of its firing and the
+ *        distance along the beam (a VLP-16 packet's block azimuth, laser id and distance, in these units).
+ *
+ * Feeding returns skips what a driver would otherwise compute per point and the projection undo: no sine or
+ * cosine to make x, y, z, no square root and no column search to get them back (docs/PORTING.md, "Feeding the
+ * detector"). 8 bytes per return.
+ */
+typedef struct
+{
+    uint32_t range_mm; /**< distance along the beam in mm; 0 = no return (counted as too close) */
+    uint16_t azimuth;  /**< BAM16: 65 536 per turn, counterclockwise from +x (the angle of atan2(y, x)) */
+    uint16_t ring;     /**< the sensor's ring (laser) index, as the ring argument of lidet_proj_q_run */
+} lidet_return_t;
+
+/**
+ * @brief Project one scan given as returns (lidet_return_t): the same image as lidet_proj_q_run would make of
+ *        the points, up to where a return sits in its pixel.
+ *
+ * Rules (docs/FIXED_POINT.md, "Projection"; codegen/lidet_codegen/ref/proj_q.py project_returns):
+ *  - row: the ring's row; a ring >= n_rows counts as n_bad_ring;
+ *  - column: c = floor(((0x8000 - azimuth) mod 2^16) n_cols / 2^16), the column lidet_proj_q_run numbers by
+ *    u = (pi - azimuth) / 2 pi;
+ *  - range_mm 0 or below min_range_mm: n_too_close; above max_range_mm (when set) or 131 000 mm: n_too_far;
+ *  - the nearest return wins a pixel (ties keep the earlier one); range_4mm = round(range_mm / 4), >= 1;
+ *  - an image that stores x, y, z gets them decoded from row, column and range (the range-only image's rule,
+ *    lib/src/internal/lidet_qpix.h), so both image kinds give the later stages the same coordinates.
+ * About 20 instructions per return on a Cortex-M4 (lidet_proj_q_run: about 150 per point).
+ * @return as lidet_proj_q_run (LIDET_ERR_ARG: NULL state/buffers, or NULL returns with n_returns > 0).
+ */
+lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                                        const lidet_return_t *returns, uint32_t n_returns);
+
 /** @brief The compact range image of buffers filled by lidet_proj_q_run (row_elev_rad NULL, row_elev_bam set). */
 void lidet_proj_q_image(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
                         lidet_range_image_t *img);
