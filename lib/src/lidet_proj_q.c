@@ -569,12 +569,71 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     return sts.n_truncated > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }
 
+/* Pass 1 of lidet_proj_q_run_returns: the nearest return per pixel. A range-only image keeps its range_4mm
+ * directly (0 = empty; nothing else to do); an image with x, y, z keeps the range in mm as the key in its range
+ * and z planes (key_set, all ones = empty) and the winner's index (point_idx), for its second pass. range_only and with_pp (point_pixel given) are constants where inlined: the firmware's loop (a
+ * range-only image, no point_pixel) is about 20 instructions per return on a Cortex-M4. */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void
+returns_pass1(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf, const lidet_return_t *ret,
+              uint32_t n, uint32_t min_mm, uint32_t max_mm, lidet_proj_stats_t *sts, const int range_only,
+              const int with_pp)
+{
+    const uint32_t rows = st->cfg.sensor.n_rows, cols = st->cfg.sensor.n_cols, span = max_mm - min_mm;
+    const uint8_t *ring_to_row = st->ring_to_row;
+    uint16_t *range = buf->range_4mm;
+    int32_t *point_pixel = buf->point_pixel;
+    uint32_t i, n_dropped = 0, filled = 0;
+    for (i = 0; i < n; ++i)
+    {
+        const uint32_t r = ret[i].range_mm, ring = ret[i].ring;
+        uint32_t pix;
+        if (r - min_mm > span || ring >= rows) /* one unsigned compare for both range limits */
+        {
+            /* the rare case: which limit */
+            sts->n_too_close += (uint32_t)(r < min_mm);
+            sts->n_too_far += (uint32_t)(r > max_mm);
+            sts->n_bad_ring += (uint32_t)(r >= min_mm && r <= max_mm);
+            ++n_dropped;
+            if (with_pp)
+            {
+                point_pixel[i] = -1;
+            }
+            continue;
+        }
+        /* u 2^16 = 2^15 - azimuth (mod 2^16); n_cols <= 2^16, so the product fits 32 bits */
+        pix = (uint32_t)ring_to_row[ring] * cols +
+              (((uint32_t)(uint16_t)(0x8000u - ret[i].azimuth) * cols) >> 16);
+        if (with_pp)
+        {
+            point_pixel[i] = (int32_t)pix;
+        }
+        if (range_only)
+        {
+            /* round(r / 4) >= 1, kept where smaller than the pixel's (0: empty, wraps to the largest in the
+             * unsigned test): the minimum of the rounded ranges is the rounded minimum; no second pass */
+            uint32_t rq = (r + 2u) >> 2;
+            const uint32_t cur = range[pix];
+            rq = rq > 0u ? rq : 1u;
+            filled += (uint32_t)(cur == 0u);
+            range[pix] = (uint16_t)(rq - 1u < cur - 1u ? rq : cur);
+        }
+        else if (r < key_get(buf, pix)) /* strict: ties keep the earlier return */
+        {
+            key_set(buf, pix, r);
+            buf->point_idx[pix] = (int32_t)i;
+        }
+    }
+    sts->n_projected = n - n_dropped;
+    sts->n_pixels_filled = filled; /* range-only; the other image counts in its second pass */
+}
+
 lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
                                         const lidet_return_t *returns, uint32_t n_returns)
 {
-    uint32_t n, i, rows, cols, npix, pix, min_mm, max_mm, filled = 0;
-    int32_t *point_pixel;
-    uint32_t *key;
+    uint32_t n, rows, cols, npix, pix, min_mm, max_mm, filled = 0;
     int range_only;
     lidet_proj_stats_t sts;
     lidet_status_t s = check_run(st, buf, &range_only);
@@ -598,73 +657,36 @@ lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_pr
     max_mm = st->cfg.max_range_mm > 0 && (uint32_t)st->cfg.max_range_mm < 131000u
                  ? (uint32_t)st->cfg.max_range_mm
                  : 131000u;
-    /* pass 1: the nearest return per pixel, its range in mm as the key (all ones = empty); an image with x, y,
-     * z keeps the winner's index too (point_idx), the key then in its range and z planes (key_set) */
-    memset(buf->point_idx, 0xFF, (size_t)npix * sizeof buf->point_idx[0]);
+    /* pass 1 (returns_pass1) */
     if (!range_only)
     {
+        memset(buf->point_idx, 0xFF, (size_t)npix * sizeof buf->point_idx[0]);
         memset(buf->range_4mm, 0xFF, (size_t)npix * sizeof buf->range_4mm[0]);
         memset(buf->z_4mm, 0xFF, (size_t)npix * sizeof buf->z_4mm[0]);
     }
-    key = (uint32_t *)buf->point_idx; /* range-only: int32_t storage read as its unsigned type */
-    point_pixel = buf->point_pixel;
-    for (i = 0; i < n; ++i)
+    else
     {
-        const uint32_t r = returns[i].range_mm, ring = returns[i].ring;
-        int32_t out = -1;
-        if (r < min_mm)
-        {
-            ++sts.n_too_close;
-        }
-        else if (r > max_mm)
-        {
-            ++sts.n_too_far;
-        }
-        else if (ring >= rows)
-        {
-            ++sts.n_bad_ring;
-        }
-        else
-        {
-            /* u 2^16 = 2^15 - azimuth (mod 2^16); n_cols <= 2^16, so the product fits 32 bits */
-            const uint32_t col = ((uint32_t)(uint16_t)(0x8000u - returns[i].azimuth) * cols) >> 16;
-            pix = (uint32_t)st->ring_to_row[ring] * cols + col;
-            out = (int32_t)pix;
-            ++sts.n_projected;
-            if (range_only)
-            {
-                key[pix] = r < key[pix] ? r : key[pix];
-            }
-            else if (r < key_get(buf, pix)) /* strict: ties keep the earlier return */
-            {
-                key_set(buf, pix, r);
-                buf->point_idx[pix] = (int32_t)i;
-            }
-        }
-        if (point_pixel != 0)
-        {
-            point_pixel[i] = out;
-        }
+        memset(buf->range_4mm, 0, (size_t)npix * sizeof buf->range_4mm[0]);
     }
-    /* pass 2: range_4mm = round(range_mm / 4) (>= 1); an image with x, y, z decodes them as the range-only
-     * image's readers would (lidet_qpix.h) */
-    if (range_only)
+    if (range_only && buf->point_pixel == 0)
     {
-        uint16_t *range = buf->range_4mm;
-        for (pix = 0; pix < npix; ++pix)
-        {
-            const uint32_t k = key[pix];
-            uint32_t rq = 0u;
-            if (k != 0xFFFFFFFFu)
-            {
-                rq = (k + 2u) >> 2;
-                rq = rq > 0u ? rq : 1u;
-                ++filled;
-            }
-            range[pix] = (uint16_t)rq;
-        }
+        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 1, 0); /* the firmware's case */
+    }
+    else if (range_only)
+    {
+        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 1, 1);
+    }
+    else if (buf->point_pixel == 0)
+    {
+        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 0, 0);
     }
     else
+    {
+        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 0, 1);
+    }
+    /* pass 2, an image with x, y, z: range_4mm = round(range_mm / 4) (>= 1), x, y, z decoded as the range-only
+     * image's readers would (lidet_qpix.h) */
+    if (!range_only)
     {
         lidet_range_image_t img;
         uint32_t r, c;
@@ -692,7 +714,10 @@ lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_pr
             }
         }
     }
-    sts.n_pixels_filled = filled;
+    if (!range_only)
+    {
+        sts.n_pixels_filled = filled;
+    }
     st->n_points = n;
     st->stats = sts;
     return sts.n_truncated > 0 ? LIDET_TRUNCATED : LIDET_OK;

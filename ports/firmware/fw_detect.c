@@ -245,7 +245,13 @@ typedef lidet_detector_q_cfg_t fw_cfg_t;
 typedef lidet_detector_q_stats_t fw_stats_t;
 typedef lidet_detection_q_t fw_detection_t;
 #define fw_init lidet_detector_q_init
-#define fw_run(d) lidet_detector_q_run((d), fw_scan_xyz_mm, fw_scan_n, 3u, fw_scan_has_ring ? fw_scan_ring : 0, 0)
+/* the scan as the sensor's returns where the build has them (the firmware's way in: docs/PORTING.md), else, and
+ * in run "points", as points in mm */
+static int g_points;
+#define fw_run(d)                                                                                                  \
+    (fw_scan_has_returns && !g_points                                                                            \
+         ? lidet_detector_q_run_returns((d), fw_scan_returns, fw_scan_n, 0)                                      \
+         : lidet_detector_q_run((d), fw_scan_xyz_mm, fw_scan_n, 3u, fw_scan_has_ring ? fw_scan_ring : 0, 0))
 #define fw_stats lidet_detector_q_stats
 #define fw_detections lidet_detector_q_detections
 #else
@@ -442,6 +448,9 @@ int fw_main(void)
     put_s(fw_scan_name);
     put_kv("points", fw_scan_n);
     put_kv("ring", (uint32_t)fw_scan_has_ring);
+#if LIDET_FIXED_POINT
+    put_kv("returns", (uint32_t)fw_scan_has_returns);
+#endif
     fw_putc('\n');
     put_s("mem");
 #if LIDET_FIXED_POINT
@@ -492,6 +501,18 @@ int fw_main(void)
         }
     }
     bad |= run_once("open", &cfg, mc, mb);
+#if LIDET_FIXED_POINT
+    if (fw_scan_has_returns)
+    {
+        /* run 3: the configuration of run 1 on the same scan as points in mm (lidet_detector_q_run: the
+         * projection from x, y, z) */
+        lidet_detector_q_cfg_default(&cfg, sensor);
+        cfg.clock = rec_clock;
+        cfg.clock_ctx = &g_rec;
+        g_points = 1;
+        bad |= run_once("points", &cfg, mc, mb);
+    }
+#endif
 
     put_s("stack");
     put_kv("used", fw_stack_used());

@@ -24,7 +24,8 @@ def main(argv=None):
     ap.add_argument("--out", required=True, help="C file to write")
     ap.add_argument("--mm", action="store_true",
                     help="integer build: x, y, z as int32 millimetres (fw_scan_xyz_mm, rounded half away from zero, "
-                         "as lidet_tools.native_q.to_mm) instead of float metres")
+                         "as lidet_tools.native_q.to_mm) instead of float metres, and with --ring the same scan as "
+                         "the sensor's returns (fw_scan_returns: range, azimuth, ring)")
     a = ap.parse_args(argv)
 
     with open(a.scan, "rb") as f:
@@ -75,6 +76,21 @@ def main(argv=None):
     else:
         out.append("const uint16_t fw_scan_ring[1] = {0}; /* no ring file: unused (fw_scan_has_ring 0) */")
     out.append(f"const int fw_scan_has_ring = {1 if ring is not None else 0};")
+    if a.mm:
+        # the integer build also gets the scan as the sensor's returns (lidet_return_t: range in mm, azimuth in
+        # BAM16, ring), as lidet_codegen.ref.proj_q.returns_of_points converts them: range = round(sqrt(x^2 + y^2
+        # + z^2)) of the millimetres (exact, halves up), azimuth = round(atan2(y, x) 2^16 / 2 pi) mod 2^16
+        if ring is not None:
+            out.append(f"const lidet_return_t fw_scan_returns[{n}] = {{")
+            for i in range(n):
+                x, y, z = (int(mm(rec[4 * i + k])) for k in range(3))
+                rng = (math.isqrt(4 * (x * x + y * y + z * z)) + 1) >> 1
+                az = int(round(math.atan2(y, x) * (65536.0 / (2.0 * math.pi)))) & 0xFFFF
+                out.append(f"    {{{rng}u, {az}u, {ring[i]}u}},")
+            out.append("};")
+        else:
+            out.append("const lidet_return_t fw_scan_returns[1] = {{0u, 0u, 0u}}; /* no ring file: unused */")
+        out.append(f"const int fw_scan_has_returns = {1 if ring is not None else 0};")
     tmp = a.out + ".tmp"
     with open(tmp, "w") as f:
         f.write("\n".join(out) + "\n")
