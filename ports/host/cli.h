@@ -45,6 +45,8 @@ extern int cli_stage_clock_cpu;
 /* `lidet detect --fixed --range-only`: the integer detector with the range-only pixel of the integer firmware
  * (lidet_detector_q_cfg_t.range_only) */
 extern int cli_fixed_range_only;
+/* lidet detect --returns: with --fixed and --ring, the scan fed as the sensor's returns (lidet_detector_q_run_returns) */
+extern int cli_fixed_returns;
 uint32_t cli_stage_clock_ns(void *ctx);
 /* Median of n values (sorts in place). */
 double cli_median(double *v, int n);

@@ -212,6 +212,7 @@ double cli_now_ms(void)
 
 int cli_stage_clock_cpu = 0;
 int cli_fixed_range_only = 0;
+int cli_fixed_returns = 0;
 
 uint32_t cli_stage_clock_ns(void *ctx)
 {

@@ -531,6 +531,8 @@ static void usage_extra(void)
                     "                   converted to millimetres); the same outputs\n"
                     "  --range-only     with --fixed: the range-only pixel of the integer firmware (x, y, z\n"
                     "                   decoded from row, column and range; lidet_detector_q_cfg_t.range_only)\n"
+                    "  --returns        with --fixed and --ring: the scan fed as the sensor's returns (range,\n"
+                    "                   azimuth, ring: lidet_detector_q_run_returns), as the firmware takes it\n"
                     "  --cpu-clock      stage and total times (--json *_ms) in this thread's CPU time, not wall time\n"
                     "                   (what other processes on a busy machine do not inflate)\n"
                     "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
@@ -636,6 +638,8 @@ int cli_detect(int argc, char **argv)
             fixed = 1;
         else if (strcmp(argv[i], "--range-only") == 0)
             cli_fixed_range_only = 1;
+        else if (strcmp(argv[i], "--returns") == 0)
+            cli_fixed_returns = 1;
         else if (strcmp(argv[i], "--cpu-clock") == 0)
             cli_stage_clock_cpu = 1;
         else
@@ -649,9 +653,10 @@ int cli_detect(int argc, char **argv)
         return 1;
     }
     free(rest);
-    if (cli_fixed_range_only && !fixed)
+    if ((cli_fixed_range_only || cli_fixed_returns) && !fixed)
     {
-        fprintf(stderr, "lidet detect: --range-only is a setting of the integer detector: add --fixed\n");
+        fprintf(stderr, "lidet detect: --%s is a setting of the integer detector: add --fixed\n",
+                cli_fixed_returns ? "returns" : "range-only");
         free(sets);
         return 1;
     }

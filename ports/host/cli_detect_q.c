@@ -3,6 +3,7 @@
  * converted to int32 millimetres (rounded half away from zero, as a driver delivering millimetres gives),
  * the float configuration after --crop/--set to the integer one, and the integer detections back to
  * lidet_detection_t for the CLI's outputs (lines, KITTI label_2, picture, JSON). */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -16,6 +17,27 @@ static lidet_detector_q_t g_detq;
 static int32_t round_i32(double v)
 {
     return (int32_t)(v >= 0.0 ? v + 0.5 : v - 0.5);
+}
+
+/* a point (mm) and its ring as the sensor reports it (lidet_return_t), the rule of tools/firmware/scan_to_c.py
+ * and lidet_codegen.ref.proj_q.returns_of_points: range = round(sqrt(x^2 + y^2 + z^2)) (exact, halves up: the
+ * float root corrected in integers), azimuth = round(atan2(y, x) 2^16 / 2 pi) mod 2^16 */
+static lidet_return_t return_of_point(const int32_t *p, uint16_t ring)
+{
+    const uint64_t r2x4 = 4u * ((uint64_t)((int64_t)p[0] * p[0]) + (uint64_t)((int64_t)p[1] * p[1]) +
+                                (uint64_t)((int64_t)p[2] * p[2]));
+    uint64_t q = (uint64_t)sqrt((double)r2x4);
+    lidet_return_t r;
+    while (q * q > r2x4)
+        --q;
+    while ((q + 1u) * (q + 1u) <= r2x4)
+        ++q;
+    q = (q + 1u) >> 1;
+    r.range_mm = q > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)q;
+    r.azimuth = (uint16_t)((int64_t)floor(atan2((double)p[1], (double)p[0]) * (65536.0 / (2.0 * M_PI_D)) + 0.5) &
+                           0xFFFF);
+    r.ring = ring;
+    return r;
 }
 
 int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, const char *family,
@@ -32,6 +54,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     char name[80];
     uint32_t np = a->n_points < LIDET_MAX_POINTS ? a->n_points : LIDET_MAX_POINTS, k;
     int32_t *pts, *pp;
+    lidet_return_t *rets = NULL;
     double *t;
     int i;
     if (s == NULL)
@@ -108,10 +131,32 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
             pts[3u * k + (uint32_t)i] = v != v ? 0 : (v > 2.0e9 ? 2000000000 : (v < -2.0e9 ? -2000000000 : round_i32(v)));
         }
     }
+    if (cli_fixed_returns)
+    {
+        if (a->ring == NULL)
+        {
+            fprintf(stderr, "lidet detect --returns: needs the scan's rings (--ring FILE)\n");
+            free(pts);
+            free(pp);
+            free(t);
+            return 1;
+        }
+        rets = (lidet_return_t *)malloc(sizeof(lidet_return_t) * (size_t)(np + 1u));
+        if (rets == NULL)
+        {
+            free(pts);
+            free(pp);
+            free(t);
+            return 1;
+        }
+        for (k = 0; k < np; ++k)
+            rets[k] = return_of_point(pts + 3u * k, a->ring[k]);
+    }
     for (i = 0; i < a->repeat; ++i)
     {
         const double t0 = cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms();
-        *status = lidet_detector_q_run(&g_detq, pts, np, 3, a->ring, i == 0 ? pp : NULL);
+        *status = rets != NULL ? lidet_detector_q_run_returns(&g_detq, rets, np, i == 0 ? pp : NULL)
+                               : lidet_detector_q_run(&g_detq, pts, np, 3, a->ring, i == 0 ? pp : NULL);
         t[(size_t)LIDET_DET_N_STAGES * (size_t)a->repeat + (size_t)i] = (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - t0;
         if (!LIDET_SUCCEEDED(*status))
         {
@@ -119,6 +164,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
             free(pts);
             free(pp);
             free(t);
+            free(rets);
             return 1;
         }
         st = lidet_detector_q_stats(&g_detq);
@@ -172,5 +218,6 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     }
     free(pts);
     free(pp);
+    free(rets);
     return 0;
 }

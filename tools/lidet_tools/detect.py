@@ -2,7 +2,7 @@
 """Run the detector (`lidet detect`, the host CLI: exactly what the firmware computes) over a KITTI-format
 folder and write a prediction folder that `lidet-eval kitti` / `lidet-eval boxes` score.
 
-    python -m lidet_tools.detect KITTI_DIR --out PRED_DIR [--sensor hdl64] [--crop] [--model NAME] [--fixed [--range-only]] [--ring] [--mount-height M]
+    python -m lidet_tools.detect KITTI_DIR --out PRED_DIR [--sensor hdl64] [--crop] [--model NAME] [--fixed [--range-only] [--returns]] [--ring] [--mount-height M]
         [--jobs 2]
 
 KITTI_DIR holds velodyne/<id>.bin and, for label_2 output, calib/<id>.txt. PRED_DIR receives label_2/<id>.txt
@@ -106,6 +106,9 @@ def main(argv=None) -> int:
     ap.add_argument("--fixed", action="store_true", help="the integer detector (lidet detect --fixed: int8 models)")
     ap.add_argument("--range-only", action="store_true",
                     help="with --fixed: the integer firmware's range-only pixel (lidet detect --range-only)")
+    ap.add_argument("--returns", action="store_true",
+                    help="with --fixed and --ring: each scan fed as the sensor's returns (range, azimuth, ring), as "
+                         "the integer firmware takes it (lidet detect --returns)")
     ap.add_argument("--ring", action="store_true",
                     help="pass each scan's ring indices (KITTI_DIR/ring/<id>.bin, uint16 per point: lidet-sim "
                          "writes them) as the firmware's driver does (lidet detect --ring)")
@@ -116,6 +119,9 @@ def main(argv=None) -> int:
         ap.error("--range-only is a setting of the integer detector: add --fixed")
     extra = [x for kv in a.set for x in ("--set", kv)] + (["--fixed"] if a.fixed else [])
     extra += ["--range-only"] if a.range_only else []
+    if a.returns and not (a.fixed and a.ring):
+        ap.error("--returns feeds the integer detector the scan's returns: add --fixed and --ring")
+    extra += ["--returns"] if a.returns else []
     if a.mount_height is not None:
         extra += ["--mount-height", repr(a.mount_height)]
     try:
