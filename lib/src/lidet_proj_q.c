@@ -581,49 +581,55 @@ returns_pass1(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
               uint32_t n, uint32_t min_mm, uint32_t max_mm, lidet_proj_stats_t *sts, const int range_only,
               const int with_pp)
 {
-    const uint32_t rows = st->cfg.sensor.n_rows, cols = st->cfg.sensor.n_cols, span = max_mm - min_mm;
+    const uint32_t rows = st->cfg.sensor.n_rows, cols = st->cfg.sensor.n_cols;
     const uint8_t *ring_to_row = st->ring_to_row;
     uint16_t *range = buf->range_4mm;
     int32_t *point_pixel = buf->point_pixel;
-    uint32_t i, n_dropped = 0, filled = 0;
-    for (i = 0; i < n; ++i)
+    const uint32_t lo2 = min_mm > 2u ? min_mm : 2u; /* r >= 2: round(r / 4) >= 1 without a clamp */
+    const uint32_t span2 = max_mm >= lo2 ? max_mm - lo2 : 0u;
+    const lidet_return_t *p = ret, *const end = ret + n;
+    uint32_t n_dropped = 0, filled = 0;
+    for (; p != end; ++p)
     {
-        const uint32_t r = ret[i].range_mm, ring = ret[i].ring;
-        uint32_t pix;
-        if (r - min_mm > span || ring >= rows) /* one unsigned compare for both range limits */
+        const uint32_t r = p->range_mm, ring = p->ring;
+        uint32_t pix, rq = (r + 2u) >> 2;
+        if (r - lo2 > span2 || ring >= rows) /* one unsigned compare for both range limits */
         {
-            /* the rare case: which limit */
-            sts->n_too_close += (uint32_t)(r < min_mm);
-            sts->n_too_far += (uint32_t)(r > max_mm);
-            sts->n_bad_ring += (uint32_t)(r >= min_mm && r <= max_mm);
-            ++n_dropped;
-            if (with_pp)
+            /* the rare case: which limit (or a valid 1 mm return when min_mm <= 1: round(1 / 4) = 0 -> 1) */
+            const int in = r >= min_mm && r <= max_mm && max_mm >= lo2;
+            if (!in || ring >= rows)
             {
-                point_pixel[i] = -1;
+                sts->n_too_close += (uint32_t)(r < min_mm);
+                sts->n_too_far += (uint32_t)(r > max_mm);
+                sts->n_bad_ring += (uint32_t)in;
+                ++n_dropped;
+                if (with_pp)
+                {
+                    point_pixel[p - ret] = -1;
+                }
+                continue;
             }
-            continue;
+            rq = rq > 0u ? rq : 1u;
         }
         /* u 2^16 = 2^15 - azimuth (mod 2^16); n_cols <= 2^16, so the product fits 32 bits */
-        pix = (uint32_t)ring_to_row[ring] * cols +
-              (((uint32_t)(uint16_t)(0x8000u - ret[i].azimuth) * cols) >> 16);
+        pix =
+            (uint32_t)ring_to_row[ring] * cols + (((uint32_t)(uint16_t)(0x8000u - p->azimuth) * cols) >> 16);
         if (with_pp)
         {
-            point_pixel[i] = (int32_t)pix;
+            point_pixel[p - ret] = (int32_t)pix;
         }
         if (range_only)
         {
             /* round(r / 4) >= 1, kept where smaller than the pixel's (0: empty, wraps to the largest in the
              * unsigned test): the minimum of the rounded ranges is the rounded minimum; no second pass */
-            uint32_t rq = (r + 2u) >> 2;
             const uint32_t cur = range[pix];
-            rq = rq > 0u ? rq : 1u;
             filled += (uint32_t)(cur == 0u);
             range[pix] = (uint16_t)(rq - 1u < cur - 1u ? rq : cur);
         }
         else if (r < key_get(buf, pix)) /* strict: ties keep the earlier return */
         {
             key_set(buf, pix, r);
-            buf->point_idx[pix] = (int32_t)i;
+            buf->point_idx[pix] = (int32_t)(p - ret);
         }
     }
     sts->n_projected = n - n_dropped;
