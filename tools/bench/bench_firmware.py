@@ -115,6 +115,23 @@ def run(args) -> str:
         ins = r["insn"]["default"]
         out.append(f"| {core} | {fpu} | " + " | ".join(_m(ins[s]) for s in STAGES) +
                    f" | **{_m(ins['scan'])}** | {r['stack']['used']:,} B |")
+    pts = [(b, core, fpu) for b, core, fpu, _ in BOARDS if "points" in reports.get(b, {}).get("insn", {})]
+    if pts:
+        out += [
+            "",
+            "The integer images' runs `default` and `open` feed the scan as the sensor's returns (ring, azimuth, "
+            "range: `lidet_detector_q_run_returns`, the way in for a driver with the sensor's packets, "
+            "docs/PORTING.md); their run `points` is run `default`'s configuration on the same scan as x, y, z in "
+            "mm (`lidet_detector_q_run`: the projection finds row and column from the coordinates):",
+            "",
+            "| core (run `points`) | FPU | project | ground | cluster | classify | box net | post | **scan** | "
+            "vs run `default` |",
+            "|---|---|---|---|---|---|---|---|---|---|",
+        ]
+        for board, core, fpu in pts:
+            ins, d = reports[board]["insn"]["points"], reports[board]["insn"]["default"]
+            out.append(f"| {core} | {fpu} | " + " | ".join(_m(ins[s]) for s in STAGES) +
+                       f" | **{_m(ins['scan'])}** | +{_m(ins['scan'] - d['scan'])} |")
     out += [
         "",
         "Run `open` (gates and size checks off) differs only in `post` (size check and NMS on "
