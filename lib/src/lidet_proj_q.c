@@ -444,6 +444,16 @@ project_points(const pass1_t *P, uint32_t n, lidet_proj_stats_t *stats, const in
     *stats = sts;
 }
 
+/* a run's counts zeroed but the inputs and those past LIDET_MAX_POINTS (not looked at); returns the count read */
+static uint32_t begin_stats(lidet_proj_stats_t *sts, uint32_t n_in)
+{
+    const uint32_t n = n_in > LIDET_MAX_POINTS ? LIDET_MAX_POINTS : n_in;
+    memset(sts, 0, sizeof *sts);
+    sts->n_points_in = n_in;
+    sts->n_truncated = n_in - n;
+    return n;
+}
+
 /* the runs' checks of the state and buffers; *range_only: the buffers make a range-only image */
 static lidet_status_t check_run(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
                                 int *range_only)
@@ -482,10 +492,7 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     rows = st->cfg.sensor.n_rows;
     cols = st->cfg.sensor.n_cols;
     npix = rows * cols;
-    n = n_points > LIDET_MAX_POINTS ? LIDET_MAX_POINTS : n_points;
-    memset(&sts, 0, sizeof sts);
-    sts.n_points_in = n_points;
-    sts.n_truncated = n_points - n;
+    n = begin_stats(&sts, n_points);
     min2 = (uint64_t)st->cfg.min_range_mm * (uint64_t)st->cfg.min_range_mm;
     min2 = min2 > 0u ? min2 : 1u; /* zero range is always too close */
     max2 = st->cfg.max_range_mm > 0 ? (uint64_t)st->cfg.max_range_mm * (uint64_t)st->cfg.max_range_mm
@@ -654,10 +661,7 @@ lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_pr
     rows = st->cfg.sensor.n_rows;
     cols = st->cfg.sensor.n_cols;
     npix = rows * cols;
-    n = n_returns > LIDET_MAX_POINTS ? LIDET_MAX_POINTS : n_returns;
-    memset(&sts, 0, sizeof sts);
-    sts.n_points_in = n_returns;
-    sts.n_truncated = n_returns - n;
+    n = begin_stats(&sts, n_returns);
     min_mm =
         st->cfg.min_range_mm > 0 ? (uint32_t)st->cfg.min_range_mm : 1u; /* zero range is always too close */
     max_mm = st->cfg.max_range_mm > 0 && (uint32_t)st->cfg.max_range_mm < 131000u

@@ -123,6 +123,18 @@ def cmp_tan(z, z2, rxy2, n, q, sign):
     return np.where(sz != sign, np.where(sz > sign, 1, -1), same)
 
 
+def _winners(pix, ok, key, npix: int):
+    """The winner of each pixel among the points with ok: the smallest key, ties the earlier point; -1 = empty."""
+    point_idx = np.full(npix, -1, np.int64)
+    idx = np.nonzero(ok)[0]
+    o = np.lexsort((idx, key[idx], pix[idx]))
+    sp = pix[idx][o]
+    first = np.ones(len(sp), bool)
+    first[1:] = sp[1:] != sp[:-1]
+    point_idx[sp[first]] = idx[o][first]
+    return point_idx
+
+
 def project(points_mm, tab: Tables, min_range_mm: int = 100, max_range_mm: int = 0, ring=None,
             max_points: int = 262144):
     """lidet_proj_q_run. Returns dict: point_pixel (n,), point_idx, x_4mm, y_4mm, z_4mm, range_4mm
@@ -179,14 +191,8 @@ def project(points_mm, tab: Tables, min_range_mm: int = 100, max_range_mm: int =
     pix = np.where(ok, row * cols + col, -1)
     stats["n_projected"] = int(ok.sum())
 
-    point_idx = np.full(npix, -1, np.int64)
-    idx = np.nonzero(ok)[0]
     key = r2 >> 2  # the winner test compares floor(r^2 / 4): squared ranges in 4 mm^2 steps
-    o = np.lexsort((idx, key[idx], pix[idx]))
-    sp = pix[idx][o]
-    first = np.ones(len(sp), bool)
-    first[1:] = sp[1:] != sp[:-1]
-    point_idx[sp[first]] = idx[o][first]
+    point_idx = _winners(pix, ok, key, npix)
     filled = point_idx >= 0
     w = np.where(filled, point_idx, 0)
     planes = [np.where(filled, (p[w, k] + 2) >> 2, 0) if n else np.zeros(npix, np.int64) for k in range(3)]
@@ -224,13 +230,7 @@ def project_returns(range_mm, azimuth, ring, tab: Tables, min_range_mm: int = 10
     col = (((0x8000 - az) & 0xFFFF) * cols) >> 16
     pix = np.where(ok, row * cols + col, -1)
     stats["n_projected"] = int(ok.sum())
-    point_idx = np.full(npix, -1, np.int64)
-    idx = np.nonzero(ok)[0]
-    o = np.lexsort((idx, rg[idx], pix[idx]))
-    sp = pix[idx][o]
-    first = np.ones(len(sp), bool)
-    first[1:] = sp[1:] != sp[:-1]
-    point_idx[sp[first]] = idx[o][first]
+    point_idx = _winners(pix, ok, rg, npix)
     filled = point_idx >= 0
     w = np.where(filled, point_idx, 0)
     range_4mm = np.where(filled, np.maximum((rg[w] + 2) >> 2, 1), 0) if n else np.zeros(npix, np.int64)
