@@ -635,6 +635,22 @@ static inline int8_t clamp_s8(int32_t v, int32_t lo)
     return (int8_t)(v < lo ? lo : v);
 }
 
+/* one value of lidet__nn_requant_s8 (the same rule and fast path as lidet__nn_requant_s8_by_channel) */
+S8_ALWAYS_INLINE int8_t rq_one(int32_t a, int32_t m, uint32_t s, int32_t zp, int32_t lo)
+{
+    if (s > 32u)
+    {
+        const uint32_t k = s - 32u;
+        const int32_t hi = (int32_t)(((int64_t)a * m) >> 32);
+        return clamp_s8(((hi + ((int32_t)1 << (k - 1u))) >> k) + zp, lo);
+    }
+    {
+        int64_t v = requant_round(a, m, s) + zp;
+        v = v < lo ? lo : (v > 127 ? 127 : v);
+        return (int8_t)v;
+    }
+}
+
 /* The same values channel by channel: the channel's multiplier, shift and rounding constant stay in registers
  * and the usual case (shift > 32, requant_round's fast path) stays in 32 bits (|v| < 2^30), about 10
  * instructions per value on a Cortex-M4 instead of 24. Cores without SIMD use it; hosts keep the row-major
@@ -643,6 +659,15 @@ void lidet__nn_requant_s8_by_channel(const int32_t *acc, uint32_t n_rows, uint32
                                      const uint8_t *shift, int32_t zp, int32_t lo, int8_t *out)
 {
     uint32_t r, o;
+    if (n_rows == 1u)
+    {
+        /* one vector (the pooled features, the PVLE and head layers): channel after channel, no row loop */
+        for (o = 0; o < n_out; ++o)
+        {
+            out[o] = rq_one(acc[o], mult[o], shift[o], zp, lo);
+        }
+        return;
+    }
     for (o = 0; o < n_out; ++o)
     {
         const int32_t m = mult[o];
@@ -712,22 +737,6 @@ LIDET_NN_KERNEL void lidet__nn_max_rows_s32(const int32_t *acc, uint32_t n_rows,
         {
             vmax[o] = a[o] > vmax[o] ? a[o] : vmax[o];
         }
-    }
-}
-
-/* one value of lidet__nn_requant_s8 (the same rule and fast path as lidet__nn_requant_s8_by_channel) */
-S8_ALWAYS_INLINE int8_t rq_one(int32_t a, int32_t m, uint32_t s, int32_t zp, int32_t lo)
-{
-    if (s > 32u)
-    {
-        const uint32_t k = s - 32u;
-        const int32_t hi = (int32_t)(((int64_t)a * m) >> 32);
-        return clamp_s8(((hi + ((int32_t)1 << (k - 1u))) >> k) + zp, lo);
-    }
-    {
-        int64_t v = requant_round(a, m, s) + zp;
-        v = v < lo ? lo : (v > 127 ? 127 : v);
-        return (int8_t)v;
     }
 }
 
