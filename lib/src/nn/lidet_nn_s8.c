@@ -328,15 +328,17 @@ S8_ALWAYS_INLINE const uint32_t *pk_pair(const uint32_t *xw, uint32_t n_g, const
       [a0] "=&r"(a0), [a1] "=&r"(a1), [c0] "=&r"(c0), [c1] "=&r"(c1)                                          \
     : [end] "r"(end)                                                                                         \
     : "cc", "memory"
-    if (n_g & 1u) /* an odd group first */
-    {
-        __asm__ volatile(PK_PAIR_GROUP PK_PAIR_OPERANDS);
-    }
-    if (xw != end) /* then two groups per pass: one compare and branch per 32 multiply-adds */
-    {
-        __asm__ volatile("1:\n\t" PK_PAIR_GROUP PK_PAIR_GROUP "cmp %[x], %[end]\n\t"
-                         "bne 1b\n\t" PK_PAIR_OPERANDS);
-    }
+    /* one asm statement (two let GCC put the sums in other registers in each, with moves between): an odd group
+     * first (the groups' bytes, 16 each, tested in a0 before it is loaded), then two groups per pass, one compare
+     * and branch per 32 multiply-adds */
+    __asm__ volatile("sub %[a0], %[end], %[x]\n\t"
+                     "tst %[a0], #16\n\t"
+                     "beq 2f\n\t" PK_PAIR_GROUP "2:\n\t"
+                     "cmp %[x], %[end]\n\t"
+                     "beq 3f\n\t"
+                     "1:\n\t" PK_PAIR_GROUP PK_PAIR_GROUP "cmp %[x], %[end]\n\t"
+                     "bne 1b\n\t"
+                     "3:\n\t" PK_PAIR_OPERANDS);
 #undef PK_PAIR_GROUP
 #undef PK_PAIR_OPERANDS
 #else
