@@ -221,6 +221,31 @@ def test_range_only_option_is_the_firmware_pixel(cli, tmp_path):
     assert r.returncode != 0 and "--range-only" in r.stderr and "--fixed" in r.stderr
 
 
+def test_returns_option_feeds_the_sensors_returns(cli, tmp_path):
+    """--fixed --ring R --returns: the scan converted to the sensor's returns (range, azimuth, ring) and fed to
+    lidet_detector_q_run_returns, the integer firmware's way in; the detections are those of the bindings on the
+    returns of ref.proj_q.returns_of_points. Without --fixed, or without the rings, the option is refused."""
+    from lidet_codegen.ref import proj_q
+    from lidet_tools import native_q
+    sim = ROOT / "tests" / "data" / "sim_vlp16"
+    scan, ring = sim / "velodyne" / "000000.bin", sim / "ring" / "000000.bin"
+    out = tmp_path / "ret.txt"
+    js = json.loads(_run(cli, scan, "--sensor", "vlp16", "--model", "vlp16s", "--fixed", "--range-only", "--ring", ring,
+                         "--returns", "--json", "--out", out).stdout)
+    rets = proj_q.returns_of_points(native_q.to_mm(kitti.read_bin(scan)), np.fromfile(ring, np.uint16))
+    q = native_q.detect_q(None, "vlp16", model="vlp16s", range_only=True, returns=native_q.as_returns(*rets))
+    assert js["detections"] == len(q["cls"]) > 0
+    got = np.loadtxt(out, usecols=range(1, 8), ndmin=2)
+    np.testing.assert_allclose(got[:, :6], q["boxes"][:, :6] / 1000.0, atol=1e-3)
+    r = _run(cli, scan, "--sensor", "vlp16", "--ring", ring, "--returns", ok=False)
+    assert r.returncode != 0 and "--returns" in r.stderr and "--fixed" in r.stderr
+    r = _run(cli, scan, "--sensor", "vlp16", "--fixed", "--returns", ok=False)
+    assert r.returncode != 0 and "--ring" in r.stderr
+    r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(tmp_path), "--out", str(tmp_path / "p"),
+                        "--sensor", "vlp16", "--fixed", "--returns"], capture_output=True, text=True)
+    assert r.returncode != 0 and "--ring" in r.stderr
+
+
 def test_batch_script_firmware_options(cli, tmp_path):
     """python -m lidet_tools.detect --fixed --range-only --ring: each scan with its ring/<id>.bin, as the
     firmware's driver feeds it; the boxes are those of `lidet detect --fixed --range-only --ring` on the scan. A
