@@ -1,5 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* libFuzzer harness: the integer detector (lidet_detector_q_init with fuzzed knobs, lidet_detector_q_run:
+/* libFuzzer harness: the integer detector (lidet_detector_q_init with fuzzed knobs, lidet_detector_q_run and,
+ * on the same bytes read as the sensor's returns, lidet_detector_q_run_returns:
  * integer projection, ground, clustering, proposals, the int8 PointNets (the tiny models of
  * tests/fuzz/models), gates, size check, NMS) on any integer sensor and any int32 millimetre scan the input
  * describes (INT32_MIN/MAX coordinates, zero range, rings out of range). Checks the counts and outcomes agree,
@@ -17,6 +18,7 @@
 static lidet_detector_q_t g_det;
 static int32_t g_pts[FZ_MAX_IN * FZ_MAX_STRIDE];
 static int32_t g_pp[LIDET_MAX_POINTS];
+static lidet_return_t g_ret[FZ_MAX_IN]; /* the same bytes read as the sensor's returns */
 static int32_t g_elev[256];
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
@@ -171,6 +173,31 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK(det[i].score_q15 >= 0 && det[i].score_q15 <= 32768);
         FZ_CHECK(i == 0 || det[i].score_q15 <= det[i - 1].score_q15);
     }
+    if (per_point)
+    {
+        const uint32_t n = s.n_points < LIDET_MAX_POINTS ? s.n_points : LIDET_MAX_POINTS;
+        for (i = 0; i < n; ++i)
+        {
+            FZ_CHECK(g_pp[i] >= -1 && g_pp[i] < (int32_t)n_pix);
+        }
+    }
+    /* the same scan's first three values of each record as returns (any range, azimuth and ring; rings past
+     * the sensor's counted): lidet_detector_q_run_returns on the same detector */
+    for (i = 0; i < s.n_points; ++i)
+    {
+        g_ret[i].range_mm = (uint32_t)g_pts[i * s.stride];
+        g_ret[i].azimuth = (uint16_t)g_pts[i * s.stride + 1u];
+        g_ret[i].ring = (uint16_t)g_pts[i * s.stride + 2u];
+    }
+    st = lidet_detector_q_run_returns(&g_det, g_ret, s.n_points, per_point ? g_pp : NULL);
+    FZ_CHECK(LIDET_SUCCEEDED(st));
+    ds = lidet_detector_q_stats(&g_det);
+    det = lidet_detector_q_detections(&g_det, &n_det);
+    FZ_CHECK(n_det == ds->n_detections && n_det <= LIDET_MAX_DETECTIONS);
+    FZ_CHECK(ds->proj.n_projected + ds->proj.n_too_close + ds->proj.n_too_far + ds->proj.n_bad_ring +
+                 ds->proj.n_truncated ==
+             s.n_points);
+    FZ_CHECK(ds->proj.n_pixels_filled <= ds->proj.n_projected && ds->proj.n_pixels_filled <= n_pix);
     if (per_point)
     {
         const uint32_t n = s.n_points < LIDET_MAX_POINTS ? s.n_points : LIDET_MAX_POINTS;
