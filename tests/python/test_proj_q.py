@@ -211,6 +211,13 @@ def test_returns_bit_exact_limits_and_ties(nq, sensor):
     np.testing.assert_array_equal(c["x_4mm"], x.ravel())
     np.testing.assert_array_equal(c["z_4mm"], z.ravel())
     _check_returns(nq, sensor, rg, az, ri, min_range_mm=0, max_range_mm=60_000)
+    # 1 mm returns (round(1 / 4) = 0 -> 1) with a 1 mm range limit: every count accounted for
+    rg1, ri1 = np.r_[rg, 1, 1, 2], np.r_[ri, 0, 0, 1]
+    c = _check_returns(nq, sensor, rg1, np.r_[az, 7, 7, 9], ri1, min_range_mm=0, max_range_mm=1)
+    st = c["stats"]
+    assert st["n_projected"] == int(((rg1 == 1) & (ri1 < s.rows)).sum()) >= 2
+    assert c["range_4mm"][c["point_pixel"][-2]] == 1 and c["point_pixel"][-1] == -1
+    assert st["n_projected"] + st["n_too_close"] + st["n_too_far"] + st["n_bad_ring"] == st["n_points_in"]
     _check_returns(nq, sensor, rg[:0], az[:0], ri[:0])  # an empty scan
 
 
