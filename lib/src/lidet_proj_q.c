@@ -578,32 +578,33 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
 
 /* Pass 1 of lidet_proj_q_run_returns: the nearest return per pixel. A range-only image keeps its range_4mm
  * directly (0 = empty; nothing else to do); an image with x, y, z keeps the range in mm as the key in its range
- * and z planes (key_set, all ones = empty) and the winner's index (point_idx), for its second pass. range_only and with_pp (point_pixel given) are constants where inlined: the firmware's loop (a
- * range-only image, no point_pixel) is about 20 instructions per return on a Cortex-M4. */
+ * and z planes (key_set, all ones = empty) and the winner's index (point_idx), for its second pass. range_only
+ * is a constant where inlined; the firmware's loop (a range-only image) is about 35 instructions per return on a
+ * Cortex-M4. */
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
 static inline void
 returns_pass1(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf, const lidet_return_t *ret,
-              uint32_t n, uint32_t min_mm, uint32_t max_mm, lidet_proj_stats_t *sts, const int range_only,
-              const int with_pp, const int all_rare)
+              uint32_t n, uint32_t min_mm, uint32_t max_mm, lidet_proj_stats_t *sts, const int range_only)
 {
     const uint32_t rows = st->cfg.sensor.n_rows, cols = st->cfg.sensor.n_cols;
     const uint8_t *ring_to_row = st->ring_to_row;
     uint16_t *range = buf->range_4mm;
     int32_t *point_pixel = buf->point_pixel;
-    /* the fast test takes [lo2, max_mm] with lo2 >= 2 (round(r / 4) >= 1 without a clamp); a 1 mm limit
-     * (max_mm < lo2: an empty interval) has its own copy, all_rare, which sends every return to the rare
-     * branch; with_pp 2: point_pixel tested where written (that copy serves both) */
+    /* the fast test takes ranges in [lo2, max_mm] with lo2 >= 2 (round(r / 4) >= 1 without a clamp) and rings
+     * below fast_rows; a 1 mm limit (max_mm < lo2, an empty interval) makes fast_rows 0, so every return takes
+     * the rare branch, which decides with the real limits */
     const uint32_t lo2 = min_mm > 2u ? min_mm : 2u;
     const uint32_t span2 = max_mm >= lo2 ? max_mm - lo2 : 0u;
+    const uint32_t fast_rows = max_mm >= lo2 ? rows : 0u;
     const lidet_return_t *p = ret, *const end = ret + n;
     uint32_t n_dropped = 0, filled = 0;
     for (; p != end; ++p)
     {
         const uint32_t r = p->range_mm, ring = p->ring;
         uint32_t pix, rq = (r + 2u) >> 2;
-        if (r - lo2 > span2 || ring >= rows || all_rare) /* one unsigned compare for both range limits */
+        if (r - lo2 > span2 || ring >= fast_rows) /* one unsigned compare for both range limits */
         {
             /* the rare case: which limit (or a valid 1 mm return when min_mm <= 1: round(1 / 4) = 0 -> 1) */
             const int in = r >= min_mm && r <= max_mm;
@@ -613,7 +614,7 @@ returns_pass1(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
                 sts->n_too_far += (uint32_t)(r > max_mm);
                 sts->n_bad_ring += (uint32_t)in;
                 ++n_dropped;
-                if (with_pp == 1 || (with_pp == 2 && point_pixel != 0))
+                if (point_pixel != 0)
                 {
                     point_pixel[p - ret] = -1;
                 }
@@ -624,7 +625,7 @@ returns_pass1(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
         /* u 2^16 = 2^15 - azimuth (mod 2^16); n_cols <= 2^16, so the product fits 32 bits */
         pix =
             (uint32_t)ring_to_row[ring] * cols + (((uint32_t)(uint16_t)(0x8000u - p->azimuth) * cols) >> 16);
-        if (with_pp == 1 || (with_pp == 2 && point_pixel != 0))
+        if (point_pixel != 0)
         {
             point_pixel[p - ret] = (int32_t)pix;
         }
@@ -681,32 +682,13 @@ lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_pr
     {
         memset(buf->range_4mm, 0, (size_t)npix * sizeof buf->range_4mm[0]);
     }
-    if (max_mm < 2u) /* a 1 mm range limit (max_range_mm 1): every return takes the rare branch */
+    if (range_only)
     {
-        if (range_only)
-        {
-            returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 1, 2, 1);
-        }
-        else
-        {
-            returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 0, 2, 1);
-        }
-    }
-    else if (range_only && buf->point_pixel == 0)
-    {
-        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 1, 0, 0); /* the firmware's case */
-    }
-    else if (range_only)
-    {
-        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 1, 1, 0);
-    }
-    else if (buf->point_pixel == 0)
-    {
-        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 0, 0, 0);
+        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 1); /* the firmware's case */
     }
     else
     {
-        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 0, 1, 0);
+        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 0);
     }
     /* pass 2, an image with x, y, z: range_4mm = round(range_mm / 4) (>= 1), x, y, z decoded as the range-only
      * image's readers would (lidet_qpix.h) */

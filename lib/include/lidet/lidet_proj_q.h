@@ -142,7 +142,7 @@ typedef struct
  *  - the nearest return wins a pixel (ties keep the earlier one); range_4mm = round(range_mm / 4), >= 1;
  *  - an image that stores x, y, z gets them decoded from row, column and range (the range-only image's rule,
  *    lib/src/internal/lidet_qpix.h), so both image kinds give the later stages the same coordinates.
- * About 20 instructions per return on a Cortex-M4 (lidet_proj_q_run: about 150 per point).
+ * About 35 instructions per return on a Cortex-M4 (lidet_proj_q_run: about 160 per point).
  * @return as lidet_proj_q_run (LIDET_ERR_ARG: NULL state/buffers, or NULL returns with n_returns > 0).
  */
 lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
