@@ -59,6 +59,7 @@ void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sen
     cfg->max_tilt_rad = low ? 0.2f : 0.1f;
     cfg->max_height_dev_m = low ? 0.5f : 1.0f;
     cfg->ring_split_m = low ? 0.0f : 15.0f;
+    cfg->far_max_step_m = low ? 0.0f : 0.5f;
     cfg->fallback_sectors = 4u;
     cfg->seed = 12345u;
     cfg->seed_per_cell = 0u;
@@ -104,7 +105,8 @@ lidet_status_t lidet_ground_state_init(lidet_ground_state_t *g, const lidet_grou
         cfg->max_height_dev_m <= 0.0f || !in_range(cfg->ground_m, 0.0f, 5.0f) || cfg->ground_m <= 0.0f ||
         !in_range(cfg->ground_m_per_m, 0.0f, 0.1f) || !in_range(cfg->below_factor, 0.0f, 20.0f) ||
         !in_range(cfg->confidence, 0.0f, 0.999999f) || !in_range(cfg->ring_split_m, 0.0f, 500.0f) ||
-        !in_range(cfg->veto_slope, 0.0f, 100.0f) || !in_range(cfg->veto_min_dz_m, 0.0f, 5.0f))
+        !in_range(cfg->far_max_step_m, 0.0f, 5.0f) || !in_range(cfg->veto_slope, 0.0f, 100.0f) ||
+        !in_range(cfg->veto_min_dz_m, 0.0f, 5.0f))
     {
         return LIDET_ERR_CONFIG;
     }

@@ -40,6 +40,7 @@ void lidet_ground_q_cfg_default(lidet_ground_q_cfg_t *cfg, uint32_t n_rows, int3
     cfg->max_tilt_urad = low ? 200000u : 100000u;
     cfg->max_height_dev_mm = low ? 500u : 1000u;
     cfg->ring_split_mm = low ? 0u : 15000u;
+    cfg->far_max_step_mm = low ? 0u : 500u;
     cfg->fallback_sectors = 4u;
     cfg->seed = 12345u;
     cfg->seed_per_cell = 0u;
@@ -76,9 +77,9 @@ lidet_status_t lidet_ground_q_state_init(lidet_ground_q_state_t *g, const lidet_
         cfg->gate_below_mm > 20000 || cfg->mount_height_mm < 0 || cfg->mount_height_mm > 10000 ||
         cfg->confidence_q16 > 65535u || cfg->inlier_mm < 1u || cfg->inlier_mm > 5000u ||
         cfg->max_tilt_urad < 1u || cfg->max_tilt_urad > 1570796u || cfg->max_height_dev_mm < 1u ||
-        cfg->max_height_dev_mm > 20000u || cfg->ring_split_mm > 500000u || cfg->ground_mm < 1u ||
-        cfg->ground_mm > 5000u || cfg->ground_per_m_q16 > 6554u || cfg->below_factor_q16 > 1310720u ||
-        cfg->veto_slope_q16 > 6553600u || cfg->veto_min_dz_mm > 5000u)
+        cfg->max_height_dev_mm > 20000u || cfg->ring_split_mm > 500000u || cfg->far_max_step_mm > 5000u ||
+        cfg->ground_mm < 1u || cfg->ground_mm > 5000u || cfg->ground_per_m_q16 > 6554u ||
+        cfg->below_factor_q16 > 1310720u || cfg->veto_slope_q16 > 6553600u || cfg->veto_min_dz_mm > 5000u)
     {
         return LIDET_ERR_CONFIG;
     }

@@ -285,7 +285,7 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
  * 4 |c . (p - p0)| <= inlier_mm * |c|. Returns 1 with *out set when the plane passes every check. */
 static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
                       const lidet__ground_q_pix_t *gp, const lidet_ground_sample_t *idx, uint32_t n,
-                      qplane_t *out)
+                      int far_step, qplane_t *out)
 {
     cell_src_t src, *const img = &src;
     const lidet_ground_q_cfg_t *cfg = &g->cfg;
@@ -443,13 +443,38 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
         }
         best = p;
     }
-    if (best.n[2] < cos_t ||
-        abs64(best.d - ((int64_t)cfg->mount_height_mm << 28)) > (int64_t)cfg->max_height_dev_mm << 28)
+    if (best.n[2] < cos_t || (!far_step && abs64(best.d - ((int64_t)cfg->mount_height_mm << 28)) >
+                                               (int64_t)cfg->max_height_dev_mm << 28))
     {
         return 0;
     }
     *out = best;
     return 1;
+}
+
+/* z (4 mm) of the plane (n, d) over the point (x, y) (4 mm): -(n_x x + n_y y + d) / n_z, rounded */
+static int32_t plane_z_at(const int32_t n[3], int64_t d, int32_t x, int32_t y)
+{
+    return (int32_t)lidet__q_div_round(-((int64_t)n[0] * x + (int64_t)n[1] * y + d), (int64_t)n[2]);
+}
+
+/* far cell k's plane p meets its sector's (final) near plane at the split, at the sector's middle azimuth
+ * pi (1 - (2 s + 1) / ns) (BAM32 2^31 - floor((2 s + 1) 2^31 / ns)), within far_max_step_mm: 4 |z_far - z_near|
+ * <= the step (the float stage's far_max_step_m test, lidet_ground_ransac.c) */
+static int far_meets(const lidet_ground_q_state_t *g, uint32_t k, const qplane_t *p)
+{
+    const uint32_t ns = g->cfg.n_sectors, s = k - ns;
+    const uint32_t az = 0x80000000u - (uint32_t)(((uint64_t)(2u * s + 1u) << 31) / ns);
+    const int64_t split = (int64_t)g->cfg.ring_split_mm;
+    const int32_t x = (int32_t)lidet__q_rshift_round(split * lidet__q_cos(az), 32);
+    const int32_t y = (int32_t)lidet__q_rshift_round(split * lidet__q_sin(az), 32);
+    int32_t nn[3];
+    int64_t dz;
+    nn[0] = g->planes[s].nx;
+    nn[1] = g->planes[s].ny;
+    nn[2] = g->planes[s].nz;
+    dz = (int64_t)plane_z_at(p->n, p->d, x, y) - plane_z_at(nn, g->plane_d[s], x, y);
+    return 4 * abs64(dz) <= (int64_t)g->cfg.far_max_step_mm;
 }
 
 /* the integer stage's side of lidet__ground_cells */
@@ -473,13 +498,15 @@ static int fit_cell(void *ctx, uint32_t k)
 {
     fit_ctx_t *f = (fit_ctx_t *)ctx;
     const uint32_t a = f->sc->cell_first[k], n = f->sc->cell_n[k];
+    const int far_step = k >= f->g->cfg.n_sectors && f->g->cfg.far_max_step_mm > 0u;
     qplane_t p;
     LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
     if (f->g->cfg.seed_per_cell)
     {
         f->g->rng = lidet__rng_cell(f->g->cfg.seed, k);
     }
-    if (!fit_cell_q(f->g, f->sc, f->img, f->sc->sample_pix + a, n, &p))
+    if (!fit_cell_q(f->g, f->sc, f->img, f->sc->sample_pix + a, n, far_step, &p) ||
+        (far_step && !far_meets(f->g, k, &p)))
     {
         return 0;
     }

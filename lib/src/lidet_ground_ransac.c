@@ -320,7 +320,8 @@ static uint32_t score_idx(const lidet_range_image_t *img, int compact, const lid
 /* RANSAC on one sector (mirrors ref/ground.py: ransac_sector). Returns 1 with *out set when a
  * plane passes every check. */
 static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img,
-                      const lidet_ground_sample_t *idx, uint32_t n, lidet_plane_t *out)
+                      const lidet_ground_sample_t *idx, uint32_t n, const lidet_plane_t *near, float at_x,
+                      float at_y, lidet_plane_t *out)
 {
     const int compact = lidet__img_compact(img);
     const lidet_ground_cfg_t *cfg = &g->cfg;
@@ -454,7 +455,22 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
         }
         best = p;
     }
-    if (!(best.nz >= cos_tilt) || !(fabsf(best.d_m - cfg->mount_height_m) <= cfg->max_height_dev_m))
+    if (!(best.nz >= cos_tilt))
+    {
+        return 0;
+    }
+    if (near != 0)
+    {
+        /* a far cell with far_max_step_m: its plane meets its sector's near plane at the split (at_x, at_y)
+         * within the step, whatever the sensor's height above it (a road that climbs or falls) */
+        const float hn = -(near->nx * at_x + near->ny * at_y + near->d_m) / near->nz;
+        const float hf = -(best.nx * at_x + best.ny * at_y + best.d_m) / best.nz;
+        if (!(fabsf(hf - hn) <= cfg->far_max_step_m))
+        {
+            return 0;
+        }
+    }
+    else if (!(fabsf(best.d_m - cfg->mount_height_m) <= cfg->max_height_dev_m))
     {
         return 0;
     }
@@ -479,7 +495,17 @@ static int fit_cell(void *ctx, uint32_t k)
     {
         f->g->rng = lidet__rng_cell(f->g->cfg.seed, k);
     }
-    return fit_sector(f->g, f->sc, f->img, f->sc->sample_pix + a, n, &f->g->planes[k]);
+    const lidet_ground_cfg_t *cfg = &f->g->cfg;
+    const uint32_t ns = cfg->n_sectors;
+    if (k >= ns && cfg->far_max_step_m > 0.0f)
+    {
+        /* the split circle at the middle azimuth of sector s (columns s cols / ns ...: azimuth
+         * pi (1 - 2 (s + 1/2) / ns)) */
+        const float az = LIDET_PI_F * (1.0f - (2.0f * (float)(k - ns) + 1.0f) / (float)ns);
+        return fit_sector(f->g, f->sc, f->img, f->sc->sample_pix + a, n, &f->g->planes[k - ns],
+                          cfg->ring_split_m * cosf(az), cfg->ring_split_m * sinf(az), &f->g->planes[k]);
+    }
+    return fit_sector(f->g, f->sc, f->img, f->sc->sample_pix + a, n, 0, 0.0f, 0.0f, &f->g->planes[k]);
 }
 
 static void copy_plane(void *ctx, uint32_t dst, int32_t src)

@@ -79,6 +79,8 @@ int cli_split_set(const char *kv, size_t *klen, double *v);
 
 /* `--set KEY=VALUE` on a clustering configuration (cli_cluster.c): 0, or 1 for an unknown key or a bad value */
 int cli_cluster_set(lidet_cluster_cfg_t *c, const char *kv);
+/* the same on a ground configuration (cli_ground.c) */
+int cli_ground_set(lidet_ground_cfg_t *c, const char *kv);
 
 /* Subcommands */
 int cli_project(int argc, char **argv);

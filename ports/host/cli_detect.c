@@ -439,6 +439,9 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, stages.ground.sample_col_step, uint16_t, 16)
     CLI_SET_INT(c, kv, klen, v, stages.ground.ransac_iters, uint16_t, 1000)
     CLI_SET_INT(c, kv, klen, v, stages.ground.refine_iters, uint8_t, 10)
+    /* any other ground field (the float detector; --fixed takes the speed knobs above only) */
+    if (strncmp(kv, "stages.ground.", 14) == 0)
+        return cli_ground_set(&c->stages.ground, kv + 14);
     /* any clustering field, the proposal refinement of issue 15 included */
     if (strncmp(kv, "stages.cluster.", 15) == 0)
         return cli_cluster_set(&c->stages.cluster, kv + 15);

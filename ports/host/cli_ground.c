@@ -74,7 +74,7 @@ static int write_bev_png(const char *path, const float *pts, uint32_t n, const u
 
 /* `--set KEY=VALUE` overrides one lidet_ground_cfg_t field (for tuning and the filter comparison in
  * tools/bench/bench_ground.py). Returns 0, or 1 for an unknown key or a bad number. */
-static int apply_set(lidet_ground_cfg_t *c, const char *kv)
+int cli_ground_set(lidet_ground_cfg_t *c, const char *kv)
 {
     size_t klen;
     double v;
@@ -93,6 +93,7 @@ static int apply_set(lidet_ground_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, below_factor)
     CLI_SET_FLOAT(c, kv, klen, v, confidence)
     CLI_SET_FLOAT(c, kv, klen, v, ring_split_m)
+    CLI_SET_FLOAT(c, kv, klen, v, far_max_step_m)
     CLI_SET_FLOAT(c, kv, klen, v, veto_slope)
     CLI_SET_FLOAT(c, kv, klen, v, veto_min_dz_m)
     CLI_SET_INT(c, kv, klen, v, fx_on_z, uint8_t, 1)
@@ -155,7 +156,7 @@ int cli_ground(int argc, char **argv)
     lidet_ground_cfg_default(&gcfg, a.sensor_profile);
     for (k = 0; k < n_sets; ++k)
     {
-        if (apply_set(&gcfg, sets[k]) != 0)
+        if (cli_ground_set(&gcfg, sets[k]) != 0)
         {
             fprintf(stderr, "lidet ground: bad --set '%s' (KEY=VALUE with a lidet_ground_cfg_t field)\n", sets[k]);
             free(rest);

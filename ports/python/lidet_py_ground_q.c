@@ -72,7 +72,7 @@ static const qfield_t k_cfg_fields[] = {
     QF(refine_iters, 0), QF(seed_per_cell, 0), QF(gate_above_mm, 1), QF(gate_below_mm, 1), QF(mount_height_mm, 1), QF(n_sectors, 0),
     QF(ransac_iters, 0), QF(sample_step, 0), QF(sample_col_step, 0), QF(eval_samples, 0), QF(min_samples, 0),
     QF(min_inliers, 0), QF(fallback_sectors, 0), QF(confidence_q16, 0), QF(inlier_mm, 0), QF(max_tilt_urad, 0),
-    QF(max_height_dev_mm, 0), QF(ring_split_mm, 0), QF(seed, 0), QF(ground_mm, 0), QF(ground_per_m_q16, 0),
+    QF(max_height_dev_mm, 0), QF(ring_split_mm, 0), QF(far_max_step_mm, 0), QF(seed, 0), QF(ground_mm, 0), QF(ground_per_m_q16, 0),
     QF(below_factor_q16, 0), QF(veto_slope_q16, 0), QF(veto_min_dz_mm, 0)};
 #define N_QF (sizeof k_cfg_fields / sizeof k_cfg_fields[0])
 

@@ -132,9 +132,12 @@ static void best_overlap(const uint16_t *a, const uint16_t *b, uint32_t npix, co
  * (>= 99.83 % since the refinement of issue 15, which reads x and y, so a 4 mm step can move a point
  * into the next cell of its grid: KITTI 000000, one cut made differently); the
  * chain agrees on >= 98.7 % (ground) and >= 94.5 % (cluster ids, one real scan where a reseeded float
- * run agrees on 88.7 %), never more than 0.4 point below a reseeded float run. */
+ * run agrees on 88.7 %), never more than 0.4 point below a reseeded float run. Since far planes are judged
+ * at the split (far_max_step_m), the far cells of a climbing or falling road keep a plane of their own, which
+ * RANSAC draws from fewer, less planar samples: on the shipped HDL-64 scan the chain agrees on 98.0 % (ground)
+ * and a reseeded float run on 97.7 % (both 0.6 point lower than before). */
 #define MIN_CLUSTER_STAGE_PCT 99.8
-#define MIN_GROUND_PCT 98.5
+#define MIN_GROUND_PCT 97.5
 #define MIN_CLUSTER_PCT 94.0
 #define SEED_MARGIN_PCT 1.0
 

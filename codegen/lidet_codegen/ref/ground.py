@@ -98,8 +98,9 @@ def fit_plane_lsq(pts: np.ndarray):
     return np.array([n[0], n[1], n[2], -n @ c]), w
 
 
-def ransac_sector(pts: np.ndarray, rng: XorShift32, cfg: dict):
-    """One sector's plane (float64 array nx, ny, nz, d) or None, and the number of hypotheses scored."""
+def ransac_sector(pts: np.ndarray, rng: XorShift32, cfg: dict, near=None, at=None):
+    """One sector's plane (float64 array nx, ny, nz, d) or None, and the number of hypotheses scored.
+    near, at: a far cell's test with far_max_step_m (its sector's near plane, the split point x, y)."""
     n = len(pts)
     xs, ys, zs = (pts[:, k].astype(F) for k in range(3))
     cos_t = F(np.cos(F(cfg["max_tilt_rad"])))
@@ -146,9 +147,22 @@ def ransac_sector(pts: np.ndarray, rng: XorShift32, cfg: dict):
         if fit is None or not (fit[0][2] ** 2 >= float(cos2)):
             break
         best = fit[0]
-    if not (best[2] >= float(cos_t)) or not (abs(best[3] - cfg["mount_height_m"]) <= cfg["max_height_dev_m"]):
+    if not (best[2] >= float(cos_t)):
+        return None, hyps
+    if near is not None:
+        hn = -(near[0] * at[0] + near[1] * at[1] + near[3]) / near[2]
+        hf = -(best[0] * at[0] + best[1] * at[1] + best[3]) / best[2]
+        if not (abs(hf - hn) <= cfg["far_max_step_m"]):
+            return None, hyps
+    elif not (abs(best[3] - cfg["mount_height_m"]) <= cfg["max_height_dev_m"]):
         return None, hyps
     return best, hyps
+
+
+def split_point(s: int, ns: int, split: float) -> tuple[float, float]:
+    """The split circle at the middle azimuth of sector s, pi (1 - (2 s + 1) / ns) (float32, as lidet_ground_ransac.c)."""
+    az = F(F(np.pi) * (F(1.0) - (F(2.0) * F(s) + F(1.0)) / F(ns)))
+    return float(F(split) * F(np.cos(az))), float(F(split) * F(np.sin(az)))
 
 
 def fit_sectors(cells, cfg: dict):
@@ -159,14 +173,24 @@ def fit_sectors(cells, cfg: dict):
     planes = np.zeros((2 * ns, 4))
     src = np.array([MOUNT] * ns + [NEAR] * ns, np.uint8)
     per_cell = bool(cfg.get("seed_per_cell", 0))
-    for k in range(n_cells):
+    step = float(cfg.get("far_max_step_m", 0.0))
+
+    def fit(k):
         if len(cells[k]) < int(cfg["min_samples"]):
-            continue
+            return
+        nonlocal rng
         if per_cell:  # a stream of its own per cell (lidet__rng_cell; never 0, so XorShift32 keeps it)
             rng = XorShift32(cell(int(cfg["seed"]), k))
-        p, _ = ransac_sector(cells[k], rng, cfg)
+        if k >= ns and step > 0:  # a far cell meets its sector's final near plane at the split
+            p, _ = ransac_sector(cells[k], rng, cfg, planes[k - ns],
+                                 split_point(k - ns, ns, cfg["ring_split_m"]))
+        else:
+            p, _ = ransac_sector(cells[k], rng, cfg)
         if p is not None:
             planes[k], src[k] = p, FITTED
+
+    for k in range(min(n_cells, ns)):
+        fit(k)
     mount = np.array([0.0, 0.0, 1.0, cfg["mount_height_m"]])
     fitted = src[:ns] == FITTED
     for s in range(ns):
@@ -182,6 +206,8 @@ def fit_sectors(cells, cfg: dict):
                 break
         else:
             planes[s] = mount
+    for k in range(ns, n_cells):  # far cells, after the near fallback (no random draw in it: same stream)
+        fit(k)
     for s in range(ns):
         if src[ns + s] != FITTED:
             planes[ns + s], src[ns + s] = planes[s], NEAR

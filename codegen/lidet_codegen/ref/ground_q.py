@@ -177,8 +177,9 @@ def _unit(v):
     return [_div(t * ONE, ln) for t in v]
 
 
-def ransac_cell(P, rng: XorShift32, cfg, stats):
-    """One cell's plane (n (Q30 ints), D) or None; P: (n, 3) int64 samples in buffer order."""
+def ransac_cell(P, rng: XorShift32, cfg, stats, far_step: bool = False):
+    """One cell's plane (n (Q30 ints), D) or None; P: (n, 3) int64 samples in buffer order. far_step: a far
+    cell under far_max_step_mm (no test of the sensor's height; the caller tests the step, far_meets)."""
     n = len(P)
     ev = int(cfg["eval_samples"])
     stride = (n + ev - 1) // ev
@@ -233,9 +234,25 @@ def ransac_cell(P, rng: XorShift32, cfg, stats):
             break
         plane = p
     nv, d = plane
-    if nv[2] < cos_t or abs(d - (int(cfg["mount_height_mm"]) << 28)) > (int(cfg["max_height_dev_mm"]) << 28):
+    if nv[2] < cos_t or (not far_step and
+                         abs(d - (int(cfg["mount_height_mm"]) << 28)) > (int(cfg["max_height_dev_mm"]) << 28)):
         return None
     return plane
+
+
+def _plane_z_at(n, d, x, y) -> int:
+    return int(qmath.div_round(-(int(n[0]) * x + int(n[1]) * y + int(d)), int(n[2])))
+
+
+def far_meets(s: int, ns: int, cfg, plane, near_n, near_d) -> bool:
+    """lidet_ground_q_fit.c far_meets: the far plane meets sector s's near plane at the split, at the sector's
+    middle azimuth (BAM32 2^31 - floor((2 s + 1) 2^31 / ns)), within far_max_step_mm (4 |dz| <= step)."""
+    az = (0x80000000 - (((2 * s + 1) << 31) // ns)) & 0xFFFFFFFF
+    sp = int(cfg["ring_split_mm"])
+    x = int(qmath.rshift_round(sp * int(qmath.cos(az)), 32))
+    y = int(qmath.rshift_round(sp * int(qmath.sin(az)), 32))
+    dz = _plane_z_at(plane[0], plane[1], x, y) - _plane_z_at(near_n, near_d, x, y)
+    return 4 * abs(dz) <= int(cfg["far_max_step_mm"])
 
 
 def fit_sectors(cells, XYZ, cfg, stats):
@@ -247,37 +264,42 @@ def fit_sectors(cells, XYZ, cfg, stats):
     N = np.zeros((2 * ns, 3), np.int64)
     D = np.zeros(2 * ns, np.int64)
     src = np.array([MOUNT] * ns + [NEAR] * ns, np.uint8)
+    step = int(cfg.get("far_max_step_mm", 0)) > 0
     for k in range(2 * ns):
         near = k < ns
+        if k == ns:  # the near fallback before the far fits (lidet__ground_cells): their test reads it
+            for s in range(ns):
+                if src[s] == FITTED:
+                    continue
+                frm = -1
+                for j in range(1, int(cfg["fallback_sectors"]) + 1):
+                    left, right = (s - j) % ns, (s + j) % ns
+                    if src[left] == FITTED:
+                        frm = left
+                        break
+                    if src[right] == FITTED:
+                        frm = right
+                        break
+                if frm >= 0:
+                    N[s], D[s], src[s] = N[frm], D[frm], NEIGHBOUR
+                    stats["n_sectors_neighbour"] += 1
+                else:
+                    N[s], D[s] = (0, 0, ONE), int(cfg["mount_height_mm"]) << 28
+                    stats["n_sectors_mount"] += 1
         if k >= n_cells or len(cells[k]) < int(cfg["min_samples"]):
             stats["n_sectors_sparse"] += near
             continue
         if per_cell:  # a stream of its own per cell (lidet__rng_cell), as the float stage's seed_per_cell
             rng = XorShift32(cell(int(cfg["seed"]), k))
-        p = ransac_cell(XYZ[cells[k]], rng, cfg, stats)
+        far_step = not near and step
+        p = ransac_cell(XYZ[cells[k]], rng, cfg, stats, far_step)
+        if p is not None and far_step and not far_meets(k - ns, ns, cfg, p, N[k - ns], D[k - ns]):
+            p = None
         if p is not None:
             N[k], D[k], src[k] = p[0], p[1], FITTED
             stats["n_sectors_fitted" if near else "n_far_fitted"] += 1
         else:
             stats["n_sectors_rejected"] += near
-    for s in range(ns):
-        if src[s] == FITTED:
-            continue
-        frm = -1
-        for k in range(1, int(cfg["fallback_sectors"]) + 1):
-            left, right = (s - k) % ns, (s + k) % ns
-            if src[left] == FITTED:
-                frm = left
-                break
-            if src[right] == FITTED:
-                frm = right
-                break
-        if frm >= 0:
-            N[s], D[s], src[s] = N[frm], D[frm], NEIGHBOUR
-            stats["n_sectors_neighbour"] += 1
-        else:
-            N[s], D[s] = (0, 0, ONE), int(cfg["mount_height_mm"]) << 28
-            stats["n_sectors_mount"] += 1
     for s in range(ns):
         if src[ns + s] != FITTED:
             N[ns + s], D[ns + s], src[ns + s] = N[s], D[s], NEAR

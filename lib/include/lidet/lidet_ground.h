@@ -95,32 +95,36 @@ typedef struct
                                    sensor profile. Used by the gate, the height check and the
                                    mount-plane fallback */
     /* ---- RANSAC per sector ---- */
-    uint16_t n_sectors;        /**< azimuth sectors over 360 deg; [1, min(n_cols, LIDET_GROUND_MAX_SECTORS)],
+    uint16_t n_sectors;       /**< azimuth sectors over 360 deg; [1, min(n_cols, LIDET_GROUND_MAX_SECTORS)],
                                    default 32 (11.25 deg) */
-    uint16_t ransac_iters;     /**< hypotheses per sector; [1, 1000], typical 8-30 */
-    uint16_t sample_step;      /**< the filter runs on rows 0, step, 2 step, ... only: a speed knob
+    uint16_t ransac_iters;    /**< hypotheses per sector; [1, 1000], typical 8-30 */
+    uint16_t sample_step;     /**< the filter runs on rows 0, step, 2 step, ... only: a speed knob
                                    (planes need far fewer points than the image holds); [1, 16],
                                    1 = every row (paper), typical 1-4 */
-    uint16_t sample_col_step;  /**< RANSAC takes the samples of columns 0, k, 2k, ... of the filtered
+    uint16_t sample_col_step; /**< RANSAC takes the samples of columns 0, k, 2k, ... of the filtered
                                    rows only (a speed knob); [1, 16], 1 = every sample (paper),
                                    typical 1-4 */
-    uint16_t eval_samples;     /**< samples a hypothesis is scored on (evenly strided subset);
+    uint16_t eval_samples;    /**< samples a hypothesis is scored on (evenly strided subset);
                                    [3, 65535], typical 64-512 */
-    uint16_t min_samples;      /**< fewer samples in a sector: fallback; [3, 65535], typical 10-30 */
-    uint16_t min_inliers;      /**< fewer inliers (among the scored subset): fallback; [3, 65535] */
-    float confidence;          /**< adaptive RANSAC stop: after a new best plane with inlier share w,
+    uint16_t min_samples;     /**< fewer samples in a sector: fallback; [3, 65535], typical 10-30 */
+    uint16_t min_inliers;     /**< fewer inliers (among the scored subset): fallback; [3, 65535] */
+    float confidence;         /**< adaptive RANSAC stop: after a new best plane with inlier share w,
                                    stop once (1 - w^3)^(hypotheses drawn) <= 1 - confidence;
                                    [0, 0.999999], 0 = always ransac_iters, typical 0.99 */
-    uint8_t refine_iters;      /**< least-squares refinements on the inliers; [0, 10], 0 = plain RANSAC */
-    float inlier_m;            /**< RANSAC inlier distance, metres; (0, 5], typical 0.1-0.3 */
-    float max_tilt_rad;        /**< max angle between a plane normal and +z, radians; (0, pi/2),
+    uint8_t refine_iters;     /**< least-squares refinements on the inliers; [0, 10], 0 = plain RANSAC */
+    float inlier_m;           /**< RANSAC inlier distance, metres; (0, 5], typical 0.1-0.3 */
+    float max_tilt_rad;       /**< max angle between a plane normal and +z, radians; (0, pi/2),
                                    typical 0.1-0.35 (the released code used 0.1) */
-    float max_height_dev_m;    /**< accepted |sensor height above the plane - mount_height_m|,
+    float max_height_dev_m;   /**< accepted |sensor height above the plane - mount_height_m|,
                                    metres; (0, 20], typical 0.5-1.5 */
-    float ring_split_m;        /**< each sector is split at this horizontal range (metres) into a
+    float ring_split_m;       /**< each sector is split at this horizontal range (metres) into a
                                    near and a far part with a plane each (ground is rarely one plane
                                    from 3 m to 70 m); 0 = one plane per sector (paper); [0, 500],
                                    typical 10-20 m */
+    float far_max_step_m; /**< with ring_split_m > 0 and this > 0, a far plane is accepted when it meets its
+                                   sector's near plane at the split within this height step (metres) instead of
+                                   by the sensor's height above it: a road that climbs or falls beyond the
+                                   split; 0 = the height test for far planes too; [0, 5] */
     uint16_t fallback_sectors; /**< how far (in sectors, either side) a fitted neighbour may be;
                                    [0, n_sectors] */
     uint32_t seed;             /**< xorshift32 seed (0 is replaced by a fixed non-zero value);

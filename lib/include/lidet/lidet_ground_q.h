@@ -72,6 +72,9 @@ typedef struct
     uint32_t max_tilt_urad;  /**< (0, 1570796] */
     uint32_t max_height_dev_mm; /**< (0, 20000] */
     uint32_t ring_split_mm;     /**< [0, 500000], 0 = one plane per sector */
+    uint32_t far_max_step_mm;   /**< [0, 5000]; > 0 with a split: a far plane is accepted when it meets its
+                                     sector's near plane at the split within this step (the float stage's
+                                     far_max_step_m), not by the sensor's height above it */
     uint32_t seed;              /**< xorshift32 seed (0 -> fixed non-zero) */
     uint32_t ground_mm;         /**< p_th, mm; (0, 5000] */
     uint32_t ground_per_m_q16;  /**< p_th growth per metre of range (mm/mm), Q16; [0, 6554] */

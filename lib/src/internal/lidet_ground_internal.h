@@ -102,6 +102,38 @@ static inline void lidet__ground_cells(uint8_t *source, const uint32_t *cell_n, 
     for (k = 0; k < 2u * ns; ++k)
     {
         const int near = k < ns;
+        if (k == ns)
+        {
+            /* the near cells' fallback before the far fits: a far cell's test reads its sector's final near
+             * plane (the fallback draws no random number, so the fits' stream is unchanged) */
+            for (s = 0; s < ns; ++s)
+            {
+                int32_t from = -1;
+                uint32_t j;
+                if (source[s] == LIDET_GROUND_PLANE_FITTED)
+                {
+                    continue;
+                }
+                for (j = 1; j <= reach && from < 0; ++j)
+                {
+                    const uint32_t left = (s + ns - (j % ns)) % ns, right = (s + j) % ns;
+                    if (source[left] == LIDET_GROUND_PLANE_FITTED)
+                        from = (int32_t)left;
+                    else if (source[right] == LIDET_GROUND_PLANE_FITTED)
+                        from = (int32_t)right;
+                }
+                copy(ctx, s, from);
+                if (from >= 0)
+                {
+                    source[s] = LIDET_GROUND_PLANE_NEIGHBOUR; /* never FITTED: not a source for others */
+                    ++stats->n_sectors_neighbour;
+                }
+                else
+                {
+                    ++stats->n_sectors_mount;
+                }
+            }
+        }
         source[k] = near ? LIDET_GROUND_PLANE_MOUNT : LIDET_GROUND_PLANE_NEAR;
         if (k >= n_cells || cell_n[k] < min_samples)
         {
@@ -119,32 +151,6 @@ static inline void lidet__ground_cells(uint8_t *source, const uint32_t *cell_n, 
         else
         {
             stats->n_sectors_rejected += (uint16_t)near;
-        }
-    }
-    for (s = 0; s < ns; ++s)
-    {
-        int32_t from = -1;
-        if (source[s] == LIDET_GROUND_PLANE_FITTED)
-        {
-            continue;
-        }
-        for (k = 1; k <= reach && from < 0; ++k)
-        {
-            const uint32_t left = (s + ns - (k % ns)) % ns, right = (s + k) % ns;
-            if (source[left] == LIDET_GROUND_PLANE_FITTED)
-                from = (int32_t)left;
-            else if (source[right] == LIDET_GROUND_PLANE_FITTED)
-                from = (int32_t)right;
-        }
-        copy(ctx, s, from);
-        if (from >= 0)
-        {
-            source[s] = LIDET_GROUND_PLANE_NEIGHBOUR; /* never FITTED: not a source for others */
-            ++stats->n_sectors_neighbour;
-        }
-        else
-        {
-            ++stats->n_sectors_mount;
         }
     }
     for (s = 0; s < ns; ++s)
