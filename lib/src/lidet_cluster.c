@@ -58,6 +58,10 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->rescue_cols = 6u;
     /* worst-case bounds (issue 19, docs/ROBUSTNESS.md) */
     cfg->max_fragment_pixels = sparse ? 2048u : 4096u;
+    cfg->regrow_gap_m = sparse ? 0.0f : 0.35f;
+    cfg->regrow_gap_per_m = sparse ? 0.0f : 0.02f;
+    cfg->regrow_max_pixels = 2000u;
+    cfg->regrow_max_height_m = 2.5f;
     cfg->max_bridge_per_pixel = 2.0f;
     /* refinement (issue 15), measured on the simulated crowd scenes (docs/BENCHMARKS.md); 16 beams:
      * person-sized parts cut off from 9 pixels, a longer join gap (with max_steps and
@@ -98,6 +102,10 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
         cfg->mount_height_m < 0.0f || !lidet__isfinite(cfg->max_gap_m) || cfg->max_gap_m < 0.0f ||
         !lidet__isfinite(cfg->max_gap_per_m) || cfg->max_gap_per_m < 0.0f ||
         !(cfg->max_bridge_per_pixel >= 0.0f && cfg->max_bridge_per_pixel <= 64.0f) ||
+        !(cfg->regrow_gap_m >= 0.0f && cfg->regrow_gap_m <= 100.0f) ||
+        !(cfg->regrow_gap_per_m >= 0.0f && cfg->regrow_gap_per_m <= 1.0f) ||
+        !(cfg->regrow_max_height_m > 0.0f && cfg->regrow_max_height_m <= 100.0f) ||
+        !(cfg->plane_split_m >= 0.0f && cfg->plane_split_m <= 500.0f) ||
         !lidet__isfinite(cfg->rescue_gap_m) || cfg->rescue_gap_m < 0.0f ||
         !lidet__isfinite(cfg->rescue_gap_per_m) || cfg->rescue_gap_per_m < 0.0f ||
         cfg->rescue_rows > LIDET_MAX_ROWS || cfg->rescue_cols > RESCUE_MAX_COLS || cfg->split_people > 1u ||
@@ -156,6 +164,11 @@ float lidet__cluster_height(const lidet_cluster_state_t *c, uint32_t seed, const
         const lidet_plane_t *pl;
         s = s < n_sectors ? s : n_sectors - 1;
         pl = &planes[s];
+        if (c->cfg.plane_split_m > 0.0f &&
+            mean[0] * mean[0] + mean[1] * mean[1] >= c->cfg.plane_split_m * c->cfg.plane_split_m)
+        {
+            pl = &planes[n_sectors + s]; /* its sector's far plane */
+        }
         return pl->nx * mean[0] + pl->ny * mean[1] + pl->nz * mean[2] + pl->d_m;
     }
     return mean[2] + c->cfg.mount_height_m;
@@ -246,6 +259,25 @@ static void reheight(lidet_cluster_state_t *c, uint32_t slot, const lidet_plane_
 static int rescue_on(const lidet_cluster_state_t *c)
 {
     return c->cfg.rescue_gap_m > 0.0f;
+}
+
+/* a component the regrowth takes: low enough (its full bounds) */
+static int regrow_fits(const lidet_cluster_state_t *c, const summary_t *s)
+{
+    return s->hi[2] - s->lo[2] <= c->cfg.regrow_max_height_m;
+}
+
+/* the regrowth's flood fill constants (cfg regrow_gap_m > 0): the first fill's with the tighter gap bound */
+static int regrow_param(const lidet_cluster_state_t *c, const lidet__grow_t *lk, lidet__grow_t *out)
+{
+    if (!(c->cfg.regrow_gap_m > 0.0f))
+    {
+        return 0;
+    }
+    *out = *lk;
+    out->gap = c->cfg.regrow_gap_m;
+    out->gpm = c->cfg.regrow_gap_per_m;
+    return 1;
 }
 
 /* the shared bookkeeping (capacity, filters, records, canonical ids, the run's driver) with the float

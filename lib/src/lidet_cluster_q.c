@@ -37,6 +37,10 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     /* worst-case bounds (issue 19) */
     cfg->max_fragment_pixels = sparse ? 2048u : 4096u;
     cfg->max_bridge_per_pixel_q16 = 131072u; /* 2.0 */
+    cfg->regrow_gap_mm = sparse ? 0u : 350u;
+    cfg->regrow_gap_per_m_q16 = sparse ? 0u : 1311u; /* 0.02 */
+    cfg->regrow_max_pixels = 2000u;
+    cfg->regrow_max_height_mm = 2500u;
     /* the refinement (issue 15) */
     cfg->split_people = 1u;
     cfg->split_min_width_mm = 700u;
@@ -90,6 +94,11 @@ int32_t lidet__cluster_q_height(const lidet_cluster_q_state_t *c, uint32_t seed,
         const lidet_plane_q_t *pl;
         s = s < n_sectors ? s : n_sectors - 1u;
         pl = &planes[s];
+        if (c->cfg.plane_split_mm > 0u && 16 * ((int64_t)mean[0] * mean[0] + (int64_t)mean[1] * mean[1]) >=
+                                              (int64_t)c->cfg.plane_split_mm * c->cfg.plane_split_mm)
+        {
+            pl = &planes[n_sectors + s]; /* its sector's far plane */
+        }
         /* |mean| <= 2^15, |n| <= 2^31: the sum is below 2^49 */
         h = lidet__q_rshift_round(
                 (int64_t)pl->nx * mean[0] + (int64_t)pl->ny * mean[1] + (int64_t)pl->nz * mean[2], 30) +
@@ -165,6 +174,27 @@ static int rescue_on(const lidet_cluster_q_state_t *c)
     return c->cfg.rescue_gap_mm > 0u;
 }
 
+/* a component the regrowth takes: low enough (its full bounds, 4 mm steps) */
+static int regrow_fits(const lidet_cluster_q_state_t *c, const summary_q_t *s)
+{
+    return 4 * ((int64_t)s->hi[2] - s->lo[2]) <= (int64_t)c->cfg.regrow_max_height_mm;
+}
+
+/* the regrowth's flood fill constants (cfg regrow_gap_mm > 0): the first fill's with the tighter gap bound (in
+ * 4 mm steps, as the first fill's) */
+static int regrow_param(const lidet_cluster_q_state_t *c, const lidet__grow_q_t *lk, lidet__grow_q_t *out)
+{
+    if (c->cfg.regrow_gap_mm == 0u)
+    {
+        return 0;
+    }
+    *out = *lk;
+    out->gap_on = 1;
+    out->gap = (uint32_t)lidet__q_div_round((int64_t)c->cfg.regrow_gap_mm, 4);
+    out->gpm = c->cfg.regrow_gap_per_m_q16;
+    return 1;
+}
+
 /* the shared bookkeeping (capacity, filters, records, canonical ids, the run's driver) with the integer
  * stage's types */
 #define RUN_STATE_T lidet_cluster_q_state_t
@@ -198,13 +228,16 @@ lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lide
         cfg->mount_height_mm > 100000u || cfg->rescue_gap_mm > 10000u || cfg->rescue_gap_per_m_q16 > 16384u ||
         cfg->rescue_rows > LIDET_MAX_ROWS || cfg->rescue_cols > RESCUE_MAX_COLS ||
         cfg->max_bridge_per_pixel_q16 > (64u << 16) || cfg->split_people > 1u ||
-        cfg->split_min_width_mm == 0u || cfg->split_min_width_mm > 1000000u || cfg->split_cell_mm == 0u ||
-        cfg->split_cell_mm > 100000u || cfg->split_cell_per_m_q16 > 65536u ||
-        cfg->person_max_width_mm == 0u || cfg->person_max_width_mm > 1000000u ||
-        cfg->person_min_height_mm > 1000000u || cfg->person_min_aspect_q16 > (100u << 16) ||
-        cfg->person_min_points < 1u || cfg->person_min_points > 1000000u || cfg->join_cars > 1u ||
-        cfg->join_gap_mm > 1000000u || cfg->car_max_length_mm == 0u || cfg->car_max_length_mm > 1000000u ||
-        cfg->car_max_width_mm == 0u || cfg->car_max_width_mm > 1000000u || cfg->car_max_height_mm == 0u ||
+        cfg->regrow_gap_mm > 100000u || cfg->regrow_gap_per_m_q16 > 65536u ||
+        cfg->regrow_max_height_mm == 0u || cfg->regrow_max_height_mm > 100000u ||
+        cfg->plane_split_mm > 500000u || cfg->split_min_width_mm == 0u ||
+        cfg->split_min_width_mm > 1000000u || cfg->split_cell_mm == 0u || cfg->split_cell_mm > 100000u ||
+        cfg->split_cell_per_m_q16 > 65536u || cfg->person_max_width_mm == 0u ||
+        cfg->person_max_width_mm > 1000000u || cfg->person_min_height_mm > 1000000u ||
+        cfg->person_min_aspect_q16 > (100u << 16) || cfg->person_min_points < 1u ||
+        cfg->person_min_points > 1000000u || cfg->join_cars > 1u || cfg->join_gap_mm > 1000000u ||
+        cfg->car_max_length_mm == 0u || cfg->car_max_length_mm > 1000000u || cfg->car_max_width_mm == 0u ||
+        cfg->car_max_width_mm > 1000000u || cfg->car_max_height_mm == 0u ||
         cfg->car_max_height_mm > 1000000u || cfg->car_min_length_mm > 1000000u ||
         cfg->upright_max_width_mm > 1000000u)
     {

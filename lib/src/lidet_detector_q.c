@@ -140,7 +140,10 @@ lidet_status_t lidet_detector_q_init(lidet_detector_q_t *d, const lidet_detector
     }
     if (s == LIDET_OK)
     {
-        s = lidet_cluster_q_state_init(&d->cluster, &d->cfg.cluster);
+        /* the height filter reads the ground's far planes beyond its split (the whole plane table is passed) */
+        lidet_cluster_q_cfg_t ccfg = d->cfg.cluster;
+        ccfg.plane_split_mm = d->cfg.ground.ring_split_mm;
+        s = lidet_cluster_q_state_init(&d->cluster, &ccfg);
     }
     if (s == LIDET_OK)
     {

@@ -34,7 +34,13 @@ lidet_status_t lidet_workspace_init(lidet_workspace_t *ws, const lidet_workspace
     {
         return st;
     }
-    st = lidet_cluster_state_init(&ws->cluster, &cfg->cluster);
+    {
+        /* the clustering's height filter reads the ground's far planes beyond its split (the workspace passes
+         * the whole plane table) */
+        lidet_cluster_cfg_t ccfg = cfg->cluster;
+        ccfg.plane_split_m = cfg->ground.ring_split_m;
+        st = lidet_cluster_state_init(&ws->cluster, &ccfg);
+    }
     if (st != LIDET_OK)
     {
         return st;

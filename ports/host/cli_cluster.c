@@ -92,6 +92,11 @@ int cli_cluster_set(lidet_cluster_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, rescue_gap_m)
     CLI_SET_FLOAT(c, kv, klen, v, rescue_gap_per_m)
     CLI_SET_FLOAT(c, kv, klen, v, max_bridge_per_pixel)
+    CLI_SET_FLOAT(c, kv, klen, v, regrow_gap_m)
+    CLI_SET_FLOAT(c, kv, klen, v, regrow_gap_per_m)
+    CLI_SET_INT(c, kv, klen, v, regrow_max_pixels, uint32_t, 4294967295.0)
+    CLI_SET_FLOAT(c, kv, klen, v, regrow_max_height_m)
+    CLI_SET_FLOAT(c, kv, klen, v, plane_split_m)
     CLI_SET_INT(c, kv, klen, v, max_steps, uint32_t, 4294967295.0)
     CLI_SET_INT(c, kv, klen, v, bridge_occluders, uint32_t, 1)
     CLI_SET_INT(c, kv, klen, v, diagonals, uint32_t, 1)
@@ -194,6 +199,13 @@ int cli_cluster(int argc, char **argv)
         return fail(&a, "projection init", st);
     }
     lidet_cluster_cfg_default(&ccfg, a.sensor_profile);
+    if (labels_path == NULL)
+    {
+        /* the ground stage's planes are passed whole (near, then far): far means take the far plane */
+        lidet_ground_cfg_t g0;
+        lidet_ground_cfg_default(&g0, a.sensor_profile);
+        ccfg.plane_split_m = g0.ring_split_m;
+    }
     for (i = 0; i < nsets; ++i)
     {
         if (cli_cluster_set(&ccfg, sets[i]) != 0)

@@ -107,13 +107,14 @@ def test_real_scan_matches_reference(real_dir):
     defaults = {k: v for k, v in native.cluster_defaults("hdl64").items() if k != "mount_height_m"}
     for cfg in (dict(theta_rad=0.40, max_steps=5, bridge_occluders=True, diagonals=True, min_points=10,
                      max_extent_m=6.0, max_mean_height_m=2.5, max_gap_m=0.0, max_gap_per_m=0.0, rescue_gap_m=0.0,
-                     split_people=0, join_cars=0),
+                     split_people=0, join_cars=0, regrow_gap_m=0.0),
                 dict(theta_rad=0.2, max_steps=9, bridge_occluders=False, diagonals=False, min_points=10,
                      max_extent_m=6.0, max_mean_height_m=2.5, max_gap_m=0.0, max_gap_per_m=0.0, rescue_gap_m=0.0,
-                     split_people=0, join_cars=0),
+                     split_people=0, join_cars=0, regrow_gap_m=0.0),
                 defaults,
                 {**defaults, "rescue_gap_m": 1.0, "rescue_gap_per_m": 0.05, "rescue_rows": 3, "rescue_cols": 9,
-                 "min_points": 20}):
+                 "min_points": 20},
+                {**defaults, "max_extent_m": 3.0, "regrow_max_pixels": 0}):  # many components regrown
         _check_against_ref(pts, ground, cfg)
 
 

@@ -107,6 +107,52 @@ def test_bit_exact_simulated(sim_scans):
         assert len(c) > 10 and c.stats["n_rescue_joined"] > 0
 
 
+def test_bit_exact_regrowth(sim_scans):
+    """Over-extent components grown again with the tighter gap (regrow_gap_mm, on by default above 16 beams): bit for
+    bit with the reference, with the defaults and with a small extent limit that sends most components through it;
+    off, they are dropped."""
+    regrown = 0
+    for sensor, pts in sim_scans:
+        if sensor == "hdl64":
+            c = _check_bit_exact(sensor, pts)
+            regrown += c.stats["n_regrown"]
+    assert regrown > 0
+    sensor, pts = sim_scans[0]
+    on = _check_bit_exact(sensor, pts, max_extent_mm=2500, regrow_max_pixels=0)
+    assert on.stats["n_regrown"] > 5 and on.stats["n_regrow_parts"] > on.stats["n_regrown"]
+    off = _check_bit_exact(sensor, pts, max_extent_mm=2500, regrow_gap_mm=0)
+    assert off.stats["n_regrown"] == 0 and len(off) < len(on)
+    assert native_q.cluster_q_defaults("vlp16")[0]["regrow_gap_mm"] == 0  # off on 16 beams (measured above 16 only)
+
+
+def test_bit_exact_far_planes(sim_scans):
+    """plane_split_mm: the planes hold the near planes then the far ones, and a mean beyond the split takes its
+    sector's far plane (here the near planes lowered by 0.5 m: such heights grow by exactly 125 steps of 4 mm)."""
+    sensor, pts = sim_scans[0]
+    scan = native_q.compact_scan(pts, sensor)
+    near = native_q.planes_to_q(scan.planes)
+    far = near.copy()
+    far[:, 3] += 125
+    both = np.concatenate([near, far])
+    dc, dp = native_q.cluster_q_defaults(sensor)
+    dc["plane_split_mm"] = 15000
+    lab, mem, recs, st = ref.cluster_q_ref(scan.x, scan.y, scan.z, scan.range, scan.row_elev_bam, scan.ground, both,
+                                           dc, native.capacity()["max_clusters"])
+    c = native_q.cluster_q(scan, both, plane_split_mm=15000)
+    assert np.array_equal(lab, c.labels) and st == c.stats and _recs_equal(recs, c)
+    cols, ns = scan.shape[1], len(near)
+
+    def height(seed, mean, table):
+        nx, ny, nz, d = (int(v) for v in table[min(int(seed) % cols * ns // cols, ns - 1)])
+        return ((nx * int(mean[0]) + ny * int(mean[1]) + nz * int(mean[2]) + (1 << 29)) >> 30) + d
+    is_far = [16 * (int(m[0]) ** 2 + int(m[1]) ** 2) >= 15000 ** 2 for m in c.mean]
+    assert sum(is_far) > 5 and not all(is_far)
+    for s, m, h, f in zip(c.seed_pixel, c.mean, c.height, is_far):
+        assert int(h) == height(s, m, far if f else near)
+    with pytest.raises(ValueError):
+        native_q.cluster_q(scan, both[:-1], plane_split_mm=15000)
+
+
 def test_bit_exact_other_paths(sim_scans):
     """Flat ground (no planes), no ground mask, the 4-neighbourhood, occluder bridging on a 16-beam image, no
     gap bound, no rescue, a small extent limit."""
@@ -283,7 +329,8 @@ def test_bad_config_refused(sim_scans):
     scan = native_q.compact_scan(pts, sensor)
     for bad in (dict(theta_urad=0), dict(max_steps=17), dict(min_points=0), dict(max_extent_mm=0),
                 dict(rescue_gap_per_m_q16=16385), dict(rescue_cols=16), dict(split_people=2), dict(split_cell_mm=0),
-                dict(car_max_width_mm=0), dict(max_bridge_per_pixel_q16=(64 << 16) + 1)):
+                dict(car_max_width_mm=0), dict(max_bridge_per_pixel_q16=(64 << 16) + 1), dict(regrow_gap_mm=100001),
+                dict(regrow_max_height_mm=0), dict(plane_split_mm=500001)):
         with pytest.raises(native.LidetError):
             native_q.cluster_q(scan, **bad)
     with pytest.raises(native.LidetError):

@@ -258,6 +258,99 @@ static void test_wraparound_joins(void)
     TEST_ASSERT_EQUAL_UINT32(3, lidet_cluster_stats(&g.ws)->n_kept);
 }
 
+/* the regrowth (regrow_gap_m): two blocks, one at 5 m (a) and one at 7.5 m (b) beside it, chained by a loose gap
+ * bound (2.6 m between them along the beams) into a component too wide for max_extent_m: grown again with a gap
+ * that each block's own returns meet (0.5-0.74 m apart) and the jump does not, it gives the two blocks back */
+static void test_regrow_over_extent(void)
+{
+    static const char *const art[] = {
+        "..........aabb..................................................",
+        "..........aabb..................................................",
+        "..........aabb..................................................",
+        "..........aabb..................................................",
+    };
+    static const char *const want[] = {
+        "0000000000112200000000000000000000000000000000000000000000000000",
+        "0000000000112200000000000000000000000000000000000000000000000000",
+        "0000000000112200000000000000000000000000000000000000000000000000",
+        "0000000000112200000000000000000000000000000000000000000000000000",
+    };
+    const lidet_cluster_stats_t *st;
+    cfg.theta_rad = 0.1f;
+    cfg.max_gap_m = 3.0f;
+    cfg.max_extent_m = 2.0f;
+    run(art, 4, NULL);
+    st = lidet_cluster_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(1, st->n_dropped_extent); /* off: dropped */
+    TEST_ASSERT_EQUAL_UINT32(0, st->n_kept);
+    TEST_ASSERT_EQUAL_UINT32(0, st->n_regrown);
+    cfg.regrow_gap_m = 0.8f;
+    cfg.regrow_gap_per_m = 0.0f;
+    run(art, 4, NULL);
+    expect_labels(want, 4);
+    st = lidet_cluster_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(1, st->n_regrown);
+    TEST_ASSERT_EQUAL_UINT32(2, st->n_regrow_parts);
+    TEST_ASSERT_EQUAL_UINT32(0, st->n_dropped_extent);
+    TEST_ASSERT_EQUAL_UINT32(2, st->n_kept);
+    /* a gap below the blocks' own spacing cuts b into its columns too: a (2 columns, 0.49 m apart at 5 m, but
+     * 0.17 m between rows) stays whole */
+    cfg.regrow_gap_m = 0.6f;
+    run(art, 4, NULL);
+    st = lidet_cluster_stats(&g.ws);
+    TEST_ASSERT_EQUAL_UINT32(3, st->n_regrow_parts);
+    TEST_ASSERT_EQUAL_UINT32(3, st->n_kept);
+    /* too tall (the component spans 0.78 m in z) or too large (16 pixels): dropped as before */
+    cfg.regrow_gap_m = 0.8f;
+    cfg.regrow_max_height_m = 0.5f;
+    run(art, 4, NULL);
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g.ws)->n_dropped_extent);
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g.ws)->n_regrown);
+    cfg.regrow_max_height_m = 2.5f;
+    cfg.regrow_max_pixels = 15u;
+    run(art, 4, NULL);
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g.ws)->n_dropped_extent);
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g.ws)->n_kept);
+    cfg.regrow_max_pixels = 16u;
+    run(art, 4, NULL);
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_cluster_stats(&g.ws)->n_kept);
+    /* bad values refused */
+    cfg.regrow_gap_m = -1.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &cfg));
+    cfg.regrow_gap_m = 0.8f;
+    cfg.regrow_max_height_m = 0.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &cfg));
+}
+
+/* plane_split_m: planes holds the near and the far plane of each sector; a mean at or beyond the split is measured
+ * against the far one (a block at 10 m: 5 m above the near plane here, 1 m above the far one) */
+static void test_far_plane_height(void)
+{
+    static const char *const art[] = {
+        "..............................cc................................",
+        "..............................cc................................",
+        "..............................cc................................",
+    };
+    const lidet_plane_t planes[2] = {{0.0f, 0.0f, 1.0f, 5.0f}, {0.0f, 0.0f, 1.0f, 0.0f}};
+    cfg.max_mean_height_m = 2.5f;
+    tcu_draw(&t, art, 3);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g.ws, &t.img, NULL, planes, 1));
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g.ws)->n_dropped_height); /* near plane only */
+    cfg.plane_split_m = 8.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g.ws, &t.img, NULL, planes, 1));
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_cluster_stats(&g.ws)->n_kept);
+    TEST_ASSERT_CLOSE(lidet_cluster_records(&g.ws, NULL)[0].mean_m[2], lidet_cluster_records(&g.ws, NULL)[0].height_m,
+                      1e-5, 0);
+    cfg.plane_split_m = 12.0f; /* the block lies nearer than the split */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_run(&g.ws, &t.img, NULL, planes, 1));
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g.ws)->n_kept);
+    cfg.plane_split_m = -1.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &cfg));
+}
+
 /* filters: min points, extent, height; each dropped cluster counted once */
 static void test_filters(void)
 {
@@ -669,6 +762,8 @@ int main(void)
     RUN_TEST(test_vertical_hole_and_ground);
     RUN_TEST(test_wraparound_joins);
     RUN_TEST(test_filters);
+    RUN_TEST(test_regrow_over_extent);
+    RUN_TEST(test_far_plane_height);
     RUN_TEST(test_fragment_rescue);
     RUN_TEST(test_records_members_determinism);
     RUN_TEST(test_point_labels);

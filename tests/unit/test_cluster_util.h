@@ -77,6 +77,7 @@ static void tcu_cfg(lidet_cluster_cfg_t *cfg)
     cfg->max_mean_height_m = 1e30f;
     cfg->max_gap_m = 0.0f; /* the angle test alone (the defaults' gap bound is for real-sized images) */
     cfg->max_gap_per_m = 0.0f;
+    cfg->regrow_gap_m = 0.0f; /* over-extent components dropped (the regrowth's gap is for real-sized images) */
 }
 
 /* the rescue scenes: 4-neighbourhood without occluder bridging (every singleton stays one), the

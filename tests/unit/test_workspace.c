@@ -84,8 +84,10 @@ static void chain(lidet_range_image_t *img, const lidet_workspace_cfg_t *cfg)
 {
     const lidet_plane_t *planes;
     uint32_t ns;
+    lidet_cluster_cfg_t ccfg = cfg->cluster;
+    ccfg.plane_split_m = cfg->ground.ring_split_m; /* as the workspace: the whole plane table, far planes too */
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_init(&g_ground.ws, &cfg->ground));
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g_cluster.ws, &cfg->cluster));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g_cluster.ws, &ccfg));
     TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_ground_run(&g_ground.ws, img)));
     planes = lidet_ground_planes(&g_ground.ws, &ns);
     TEST_ASSERT_TRUE(

@@ -447,6 +447,19 @@ class Clusters:
         return len(self.n_points)
 
 
+def plane_sectors(planes, split) -> int:
+    """n_sectors for lidet_cluster_run given a plane table: its length, or half of it with a plane split
+    (plane_split_m / plane_split_mm > 0: near planes, then far planes); 0 without planes. An odd table with a split
+    is refused (the C would read past it)."""
+    if planes is None:
+        return 0
+    if split:
+        if len(planes) % 2:
+            raise ValueError(f"with a plane split the planes hold near then far planes: an even count, got {len(planes)}")
+        return len(planes) // 2
+    return len(planes)
+
+
 def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, with_image: bool = False,
             proj_cfg: dict | None = None, context: ScanContext | None = None, **cfg) -> Clusters:
     """Project `points` (N, >=3) and cluster the non-ground pixels with the C library.
@@ -485,7 +498,7 @@ def cluster(points, sensor: str | Sensor = "hdl64", ground=None, planes=None, wi
     nrec = np.zeros(1, np.uint32)
     stats = _record("lidet_cluster_stats_t")
     st = lib().lidet_py_cluster_run(ctx.ptr, pts if n else None, n, stride, gm if n else None, pl,
-                                    0 if pl is None else len(pl), _addr(_record("lidet_cluster_cfg_t", c)),
+                                    plane_sectors(pl, c["plane_split_m"] > 0), _addr(_record("lidet_cluster_cfg_t", c)),
                                     pl_out if n else None, pix, mem, ru, rf, cap, nrec, _addr(stats))
     if st < 0:
         raise LidetError(st, "lidet_cluster_run")

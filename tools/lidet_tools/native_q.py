@@ -390,7 +390,9 @@ CLUSTER_Q_FIELDS = ["theta_urad", "max_steps", "bridge_occluders", "diagonals", 
                     "max_bridge_per_pixel_q16", "split_people", "split_min_width_mm", "split_cell_mm",
                     "split_cell_per_m_q16", "person_max_width_mm", "person_min_height_mm", "person_min_aspect_q16",
                     "person_min_cols", "person_min_points", "join_cars", "join_gap_mm", "car_max_length_mm", "car_max_width_mm",
-                    "car_max_height_mm", "car_min_length_mm", "upright_max_width_mm", "max_join_pieces"]
+                    "car_max_height_mm", "car_min_length_mm", "upright_max_width_mm", "max_join_pieces",
+                    "regrow_gap_mm", "regrow_gap_per_m_q16", "regrow_max_pixels", "regrow_max_height_mm",
+                    "plane_split_mm"]
 PROPOSAL_Q_FIELDS = ["n_points", "seed", "azimuth_bin_bam", "elevation_bin_bam", "range_bin_4mm"]
 _cq_ready = False
 
@@ -564,7 +566,8 @@ def cluster_q(scan: CompactScan, planes_q=None, use_ground: bool = True, repeat:
     recs = np.zeros((cap, 14), np.int32)
     ns = np.zeros(max(repeat, 1), np.uint64)
     st = L.lidet_py_cluster_q_run(rows, cols, scan.x, scan.y, scan.z, scan.range, scan.row_elev_bam,
-                                  scan.ground if use_ground else None, pl, 0 if pl is None else len(pl), c, p, repeat,
+                                  scan.ground if use_ground else None, pl,
+                                  native.plane_sectors(pl, c[CLUSTER_Q_FIELDS.index("plane_split_mm")] > 0), c, p, repeat,
                                   o["lab"], o["mem"], recs, o["nrec"], native._addr(o["stats"]), o["pxyz"], o["pmean"],
                                   o["pvox"], ns)
     return _result(o, st, "lidet_cluster_q_run", recs, recs[:, 4:14], ns)
@@ -591,7 +594,7 @@ def cluster_f_compact(scan: CompactScan, planes=None, use_ground: bool = True, r
     ns = np.zeros(max(repeat, 1), np.uint64)
     st = L.lidet_py_cluster_f_compact(rows, cols, scan.x, scan.y, scan.z, scan.range, scan.row_elev_rad,
                                       scan.row_elev_bam, scan.ground if use_ground else None, pl,
-                                      0 if pl is None else len(pl),
+                                      native.plane_sectors(pl, c["plane_split_m"] > 0),
                                       native._addr(native._record("lidet_cluster_cfg_t", c)),
                                       native._addr(native._record("lidet_proposal_cfg_t", pc)), repeat, o["lab"],
                                       o["mem"], ru, rf, o["nrec"], native._addr(o["stats"]), o["pxyz"], o["pmean"],

@@ -82,7 +82,9 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                 max_mean_height_m: float = 1e30, mount_height_m: float = 1.73, max_clusters: int = 1 << 30,
                 rescue_gap_m: float = 0.0, rescue_gap_per_m: float = 0.0, rescue_rows: int = 0, rescue_cols: int = 0,
                 max_fragment_pixels: int = 0, max_bridge_per_pixel: float = 0.0, split_people: bool = False,
-                join_cars: bool = False, azimuth_half_rad: float = 0.0, **refine):
+                join_cars: bool = False, azimuth_half_rad: float = 0.0, regrow_gap_m: float = 0.0,
+                regrow_gap_per_m: float = 0.0, regrow_max_pixels: int = 0, regrow_max_height_m: float = 1e30,
+                plane_split_m: float = 0.0, **refine):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
     member-pixel arrays per kept cluster in raster order). Float32 tangent and distance tests like the
@@ -91,7 +93,11 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
     fragments enter it in raster order while their pixels sum to at most that. max_bridge_per_pixel > 0
     sets the occluder bridging budget: a pixel's searches step over nearer candidates only while the run
     has stepped over fewer than max_bridge_per_pixel * (candidate pixels), in float32 as the C.
-    split_people / join_cars turn the refinement on (refine_ref; lidet_cluster.h)."""
+    split_people / join_cars turn the refinement on (refine_ref; lidet_cluster.h). regrow_gap_m > 0: a component
+    past max_extent_m (at most regrow_max_pixels pixels, 0: any; z span at most regrow_max_height_m) is grown again
+    from its own pixels, in its fill order, with the gap bound regrow_gap_m + regrow_gap_per_m * d2, and each part is
+    filtered as a component of its own (lidet_cluster_run_body.h regrow). plane_split_m: no planes here (flat
+    ground), so it changes nothing."""
     rows, cols = range_m.shape
     rng = np.asarray(range_m, np.float32).ravel()
     cand = np.asarray(candidate, bool).ravel()
@@ -126,7 +132,10 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
         cs = np.float32(min(max(cs, -1.0), 1.0))
         return np.float32(np.sqrt(np.float32(1.0) - cs * cs)), cs
 
-    gap, gap_per_m = np.float32(max_gap_m), np.float32(max_gap_per_m)
+    # the gap bound: the first fill's, or the regrowth's while it runs
+    gp = {"gap": np.float32(max_gap_m), "gpm": np.float32(max_gap_per_m)}
+    loose = dict(gp)
+    tight = {"gap": np.float32(regrow_gap_m), "gpm": np.float32(regrow_gap_per_m)}
 
     def link(da, db, sn, cs):
         # angle test; with a gap bound also the distance of the two returns along their beams,
@@ -135,8 +144,8 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
         u, v = np.float32(d1 - np.float32(d2 * cs)), np.float32(d2 * sn)
         if not v > np.float32(tan_t * u):
             return False
-        if gap > 0:
-            g = np.float32(gap + np.float32(gap_per_m * d2))
+        if gp["gap"] > 0:
+            g = np.float32(gp["gap"] + np.float32(gp["gpm"] * d2))
             return bool(np.float32(np.float32(u * u) + np.float32(v * v)) <= np.float32(g * g))
         return True
 
@@ -204,9 +213,9 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
     bridged = 0  # nearer candidates stepped over so far (occluder bridging)
     bridge_max = (int(np.float32(np.float32(max_bridge_per_pixel) * np.float32(int(cand.sum()))))
                   if max_bridge_per_pixel > 0 else 1 << 62)
-    for seed in range(rows * cols):
-        if state[seed] != 0:
-            continue
+    def fill(seed):
+        # the flood fill of one component from a free seed (its members in fill order)
+        nonlocal bridged
         state[seed] = -1
         mem = [seed]
         q = deque([seed])
@@ -259,17 +268,45 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                         state[n] = -1
                         mem.append(n)
                         q.append(n)
+        return mem
+
+    n_cand = int(cand.sum())
+
+    def component(mem, regrow):
+        # the filters of one component (lidet_cluster_run_body.h finish_cluster)
+        nonlocal frag_px
         m = np.array(mem)
         if len(m) < min_points:
             if rescue and max_fragment_pixels and frag_px + len(m) > max_fragment_pixels:
-                continue  # past the rescue budget: dropped
+                return  # past the rescue budget: dropped
             if rescue and P[m][:, 2].mean() + mount_height_m <= max_mean_height_m:
                 frag_px += len(m)
                 state[m] = -3  # a fragment, for the rescue
+            return
+        pts = P[m]
+        if np.any(pts.max(0) - pts.min(0) > max_extent_m):
+            if (regrow and regrow_gap_m > 0 and (regrow_max_pixels == 0 or len(m) <= regrow_max_pixels)
+                    and pts[:, 2].max() - pts[:, 2].min() <= regrow_max_height_m and len(m) <= rows * cols - n_cand):
+                state[m] = 0
+                gp.update(tight)
+                for p in mem:
+                    if state[p] == 0:
+                        part = fill(p)
+                        k = int(np.argmin(part))  # the part's seed: its first pixel in raster order, put first
+                        part[0], part[k] = part[k], part[0]
+                        gp.update(loose)
+                        component(part, False)
+                        gp.update(tight)
+                gp.update(loose)
+            return
+        if pts[:, 2].mean() + mount_height_m > max_mean_height_m:
+            return
+        kept.append([len(m), int(m[0]), m])
+
+    for seed in range(rows * cols):
+        if state[seed] != 0:
             continue
-        if not _passes(m):
-            continue
-        kept.append([len(m), seed, m])
+        component(fill(seed), True)
     if len(kept) > max_clusters:  # smallest dropped first, ties: the later seed
         order = sorted(range(len(kept)), key=lambda i: (-kept[i][0], kept[i][1]))[:max_clusters]
         kept = [kept[i] for i in sorted(order)]

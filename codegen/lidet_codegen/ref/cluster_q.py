@@ -95,7 +95,9 @@ STAT_KEYS = ["n_candidates", "n_found", "n_fragments", "n_rescue_joined", "n_res
              "n_split", "n_split_parts", "n_split_skipped", "n_joined", "n_join_skipped",
              # issue 19's bounds: the rescue budget (max_fragment_pixels) and the bridging budget
              # (max_bridge_per_pixel_q16)
-             "n_fragment_pixels", "n_dropped_fragment_budget", "n_bridge_steps"]
+             "n_fragment_pixels", "n_dropped_fragment_budget", "n_bridge_steps",
+             # the regrowth of over-extent components (regrow_gap_mm)
+             "n_regrown", "n_regrow_parts"]
 REFINE_MAX_CELLS, REFINE_MAX_POINTS, REFINE_MAX_PARTS = 4096, 4096, 32  # lidet_opt.h defaults
 
 
@@ -117,8 +119,10 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
     ks = c["max_steps"]
     kc = min(ks, cols - 1)
     occl, diag = c["bridge_occluders"] != 0, c["diagonals"] != 0
-    gap_on = c["max_gap_mm"] > 0
-    gap, gpm = _div_round(c["max_gap_mm"], 4), c["max_gap_per_m_q16"]
+    # the join test's gap bound: the first fill's, or the regrowth's (regrow_gap_mm) while it runs
+    gp = {"on": c["max_gap_mm"] > 0, "gap": _div_round(c["max_gap_mm"], 4), "gpm": c["max_gap_per_m_q16"]}
+    loose = dict(gp)
+    tight = {"on": True, "gap": _div_round(c.get("regrow_gap_mm", 0), 4), "gpm": c.get("regrow_gap_per_m_q16", 0)}
     rgap, rgpm = _div_round(c["rescue_gap_mm"], 4), c["rescue_gap_per_m_q16"]
     wr, wc = c["rescue_rows"], min(c["rescue_cols"], (cols - 1) // 2)
     mount4 = _div_round(c["mount_height_mm"], 4)
@@ -135,8 +139,8 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
         d1, d2 = (da, db) if da > db else (db, da)
         if not d2 * s > d1 * sin_t:
             return False
-        if gap_on:
-            gg = gap + ((d2 * gpm + 32768) >> 16)
+        if gp["on"]:
+            gg = gp["gap"] + ((d2 * gp["gpm"] + 32768) >> 16)
             dd = d1 - d2
             if dd > gg:
                 return False
@@ -233,10 +237,14 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
             out.append((sum(v), min(v), max(v)))
         return out
 
+    split = int(c.get("plane_split_mm", 0))
+
     def height(seed, mean):
         if PL is not None:
-            ns = len(PL)
+            ns = len(PL) // 2 if split > 0 else len(PL)  # with a split: near planes, then far planes
             s = min((seed % cols) * ns // cols, ns - 1)
+            if split > 0 and 16 * (mean[0] * mean[0] + mean[1] * mean[1]) >= split * split:
+                s += ns  # its sector's far plane
             nx, ny, nz, d = PL[s]
             h = ((nx * mean[0] + ny * mean[1] + nz * mean[2] + (1 << 29)) >> 30) + d
         else:
@@ -259,7 +267,7 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
             lab[mem[i]] = PENDING
         return m
 
-    def finish(start, rescue):
+    def finish(start, rescue, regrow=True):
         ms = mem[start:]
         n = len(ms)
         if not rescue:
@@ -277,6 +285,30 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
         sx = stats_of(ms)
         lim = M32 if small else c["max_extent_mm"]
         if any((hi - lo) * 4 > lim for _, lo, hi in sx):
+            mp = c.get("regrow_max_pixels", 0)
+            if (regrow and not rescue and not small and c.get("regrow_gap_mm", 0) > 0 and (mp == 0 or n <= mp)
+                    and 4 * (sx[2][2] - sx[2][1]) <= c["regrow_max_height_mm"]
+                    and st["n_candidates"] <= npix and n <= npix - st["n_candidates"]):
+                # grown again from its own pixels (in its order) with the tighter gap; each part is filtered
+                del mem[start:]
+                st["n_regrown"] += 1
+                for m in ms:
+                    lab[m] = FREE
+                gp.update(tight)
+                for m in ms:
+                    if lab[m] != FREE:
+                        continue
+                    s0 = len(mem)
+                    take(m)
+                    grow(s0)
+                    st["n_regrow_parts"] += 1
+                    k = min(range(s0, len(mem)), key=lambda i: mem[i])  # the part's seed: its first pixel in raster
+                    mem[s0], mem[k] = mem[k], mem[s0]                  # order, put first (as the C)
+                    gp.update(loose)
+                    finish(s0, False, False)
+                    gp.update(tight)
+                gp.update(loose)
+                return
             st["n_dropped_extent"] += 1
             del mem[start:]
             return

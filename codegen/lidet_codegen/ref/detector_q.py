@@ -90,7 +90,11 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
         ground_cfg = dict(ground_cfg, seed_per_cell=1)
     mask, _, planes, _, _, _ = ground_q.ground(X, Y, Z, ground_cfg, RG)
     ns = int(ground_cfg["n_sectors"])
-    labels, members, recs, _ = cluster_q.cluster_q_ref(X, Y, Z, R, tab.row_elev_bam, mask, planes[:ns], cluster_cfg,
+    # the whole plane table, the far planes beyond the ground's split (lidet_detector_q_init sets plane_split_mm)
+    split = int(ground_cfg["ring_split_mm"])
+    cluster_cfg = dict(cluster_cfg, plane_split_mm=split)
+    labels, members, recs, _ = cluster_q.cluster_q_ref(X, Y, Z, R, tab.row_elev_bam, mask,
+                                                      planes[:2 * ns] if split > 0 else planes[:ns], cluster_cfg,
                                                       max_clusters)
     pcfg = dict(proposal_cfg, n_points=int(cls_model.n_points))
     outcome = [0] * len(recs)

@@ -246,6 +246,23 @@ typedef struct
                                   0 = no limit. Default 4096 (> 16 beams), 2048 (<= 16 beams): about 2x
                                   the most fragment pixels measured on real KITTI scans (2074) and 2.5x
                                   the simulated VLP-16 sample's (816; docs/ROBUSTNESS.md) */
+    float regrow_gap_m; /**< a component whose extent exceeds max_extent_m is not dropped at once but grown
+                                  again from its own pixels with the gap bound regrow_gap_m + regrow_gap_per_m * d2
+                                  (tighter than max_gap_m's: cars parked bumper to bumper, chained by it), and
+                                  each part goes through the filters (stats n_regrown, n_regrow_parts); 0 = off
+                                  (dropped). [0, 100] */
+    float regrow_gap_per_m;     /**< its growth per metre of range; [0, 1] */
+    uint32_t regrow_max_pixels; /**< only components of at most this many pixels are grown again (walls and
+                                  buildings, the large ones, cost the time and hold no car chain); 0 = no limit */
+    float regrow_max_height_m; /**< ... and whose z extent is at most this (a row of cars is low; walls, trees
+                                  and buildings are not); (0, 100] */
+    float plane_split_m;       /**< with planes: 0 (default) measures every mean against its sector's plane,
+                                  planes[s]; > 0: planes holds 2 * n_sectors planes, near then far (the ground
+                                  stage's layout with ring_split_m, lidet_ground_planes), and a mean at or beyond
+                                  this horizontal range is measured against its sector's far plane,
+                                  planes[n_sectors + s] (a car up a climbing road is not "high above" the near
+                                  plane's extension). lidet_workspace and the detectors set it to the ground's
+                                  ring_split_m. [0, 500] */
 } lidet_cluster_cfg_t;
 
 /** @brief One kept cluster. Coordinates in the sensor frame (metres). */
@@ -287,6 +304,8 @@ typedef struct
     uint32_t n_fragment_pixels;  /**< pixels of the fragments handed to the rescue */
     uint32_t n_dropped_fragment_budget; /**< fragments dropped past max_fragment_pixels */
     uint32_t n_bridge_steps;            /**< nearer candidates stepped over (occluder bridging) */
+    uint32_t n_regrown;      /**< over-extent components grown again with the tighter gap (regrow_gap_m) */
+    uint32_t n_regrow_parts; /**< the parts they gave (each then kept, a fragment or dropped by a filter) */
 } lidet_cluster_stats_t;
 
 /**

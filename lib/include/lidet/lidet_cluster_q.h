@@ -101,6 +101,15 @@ typedef struct
     uint32_t car_min_length_mm;     /**< <= 1000000; default 2500 */
     uint32_t upright_max_width_mm;  /**< <= 1000000; default 1300 */
     uint32_t max_join_pieces;       /**< join budget as lidet_cluster_cfg_t's; 0 = no limit; default 256 */
+    /* the regrowth of over-extent components (lidet_cluster_cfg_t regrow_gap_m, regrow_gap_per_m) */
+    uint32_t regrow_gap_mm;        /**< 0 = off (dropped); <= 100000; default 350 (> 16 rows), 0 (<= 16) */
+    uint32_t regrow_gap_per_m_q16; /**< <= 65536; default 1311 (0.02), 0 (<= 16 rows) */
+    uint32_t regrow_max_pixels;    /**< as lidet_cluster_cfg_t's; 0 = no limit */
+    uint32_t regrow_max_height_mm; /**< as lidet_cluster_cfg_t's regrow_max_height_m; (0, 100000] */
+    uint32_t
+        plane_split_mm; /**< lidet_cluster_cfg_t's plane_split_m: > 0, planes holds 2 n_sectors planes and
+                                        a mean with 16 (x^2 + y^2) >= plane_split_mm^2 takes its sector's far plane;
+                                        <= 500000; default 0 (lidet_detector_q sets the ground's ring_split_mm) */
 } lidet_cluster_q_cfg_t;
 
 /** @brief One kept cluster, 4 mm steps. */

@@ -392,8 +392,12 @@ static void record_numbers(RUN_STATE_T *c, uint32_t slot, const RUN_SUMMARY_T *s
 /* filters + bookkeeping of the component members[start, tail); returns the new tail. rescue = 0:
  * a component of the first fill (one below min_points becomes a fragment when the rescue is on);
  * 1: a rescue group that joined no cluster (dropped when small; takes only a free slot) */
+static uint32_t regrow(RUN_STATE_T *c, const RUN_PARAM_T *tight, uint32_t start, uint32_t tail, uint32_t npix,
+                       const RUN_PLANE_T *planes, uint32_t n_sectors, lidet_cluster_stats_t *st);
+
 static uint32_t finish_cluster(RUN_STATE_T *c, uint32_t start, uint32_t tail, const RUN_PLANE_T *planes,
-                               uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue)
+                               uint32_t n_sectors, lidet_cluster_stats_t *st, int rescue,
+                               const RUN_PARAM_T *tight, uint32_t npix)
 {
     const uint32_t n = tail - start;
     const lidet_member_t *mem = c->members;
@@ -424,6 +428,15 @@ static uint32_t finish_cluster(RUN_STATE_T *c, uint32_t start, uint32_t tail, co
      * a third of the rescue's work */
     if (summarise(c, start, tail, small, &sm))
     {
+        if (tight != 0 && !small && (c->cfg.regrow_max_pixels == 0u || n <= c->cfg.regrow_max_pixels))
+        {
+            /* the full bounds (summarise stopped at the first extent past the limit) */
+            (void)summarise(c, start, tail, 1, &sm);
+            if (regrow_fits(c, &sm))
+            {
+                return regrow(c, tight, start, tail, npix, planes, n_sectors, st);
+            }
+        }
         ++st->n_dropped_extent;
         return start;
     }
@@ -468,6 +481,62 @@ static uint32_t finish_cluster(RUN_STATE_T *c, uint32_t start, uint32_t tail, co
     return tail;
 }
 
+/* An over-extent component members[start, tail) grown again from its own pixels with the tighter join test
+ * `tight` (cfg regrow_gap_m: cars parked bumper to bumper, or a car and the hedge behind it, chained by the gap
+ * bound): each part goes through the filters (finish_cluster; no part is regrown again). The component's list is
+ * first moved to the top of the member buffer: below it the run lists each candidate at most once, so while
+ * n_candidates + the component's size fit in the buffer the parts never reach it; else the component is dropped
+ * as before. Parts are seeded in the component's own (fill) order; each part's seed pixel is its first in raster
+ * order. Returns the new tail. */
+static uint32_t regrow(RUN_STATE_T *c, const RUN_PARAM_T *tight, uint32_t start, uint32_t tail, uint32_t npix,
+                       const RUN_PLANE_T *planes, uint32_t n_sectors, lidet_cluster_stats_t *st)
+{
+    lidet_member_t *mem = c->members;
+    uint16_t *lab = c->labels;
+    const uint32_t n = tail - start;
+    uint32_t i, top, w = start;
+    if (st->n_candidates > npix || n > npix - st->n_candidates)
+    {
+        ++st->n_dropped_extent;
+        return start;
+    }
+    top = npix - n;
+    memmove(mem + top, mem + start, n * sizeof *mem);
+    for (i = top; i < npix; ++i)
+    {
+        lab[mem[i]] = (uint16_t)LAB_FREE;
+    }
+    ++st->n_regrown;
+    for (i = top; i < npix; ++i)
+    {
+        const uint32_t p = (uint32_t)mem[i];
+        uint32_t e;
+        if (lab[p] != (uint16_t)LAB_FREE)
+        {
+            continue;
+        }
+        lab[p] = (uint16_t)LAB_PENDING;
+        mem[w] = (lidet_member_t)p;
+        e = RUN_GROW(c, tight, w, w + 1u);
+        ++st->n_regrow_parts;
+        {
+            /* the part's seed is its first pixel in raster order, as every cluster's (the height's sector, the
+             * canonical order): moved to the front of its members */
+            uint32_t j, k = w;
+            lidet_member_t t;
+            for (j = w + 1u; j < e; ++j)
+            {
+                k = mem[j] < mem[k] ? j : k;
+            }
+            t = mem[w];
+            mem[w] = mem[k];
+            mem[k] = t;
+        }
+        w = finish_cluster(c, w, e, planes, n_sectors, st, 0, 0, npix);
+    }
+    return w;
+}
+
 /* a rescue group members[start, tail) joins kept cluster `slot`: count, bounds and mean are updated and the
  * height recomputed (no filter). The group's seed is its first pixel in raster order, so the cluster's first
  * pixel is the smaller of the two seeds (the height uses that pixel's sector, as for any cluster) */
@@ -504,6 +573,8 @@ static void rescue_join(RUN_STATE_T *c, uint32_t slot, uint32_t start, uint32_t 
 static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, const run_span_t *sp, const RUN_PLANE_T *planes,
                       uint32_t n_sectors, lidet_cluster_stats_t *st)
 {
+    RUN_PARAM_T tk;
+    const RUN_PARAM_T *const tight = regrow_param(c, lk, &tk) ? &tk : 0;
     const uint32_t npix = sp->rows * sp->cols;
     uint16_t *lab = c->labels;
     lidet_member_t *mem = c->members;
@@ -514,7 +585,7 @@ static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, const run_span_t *s
         lab[p] = (uint16_t)LAB_PENDING;
         mem[tail++] = (int32_t)p;
         tail = RUN_GROW(c, lk, start, tail);
-        tail = finish_cluster(c, start, tail, planes, n_sectors, st, 0);
+        tail = finish_cluster(c, start, tail, planes, n_sectors, st, 0, tight, npix);
     }
     if (st->n_fragments > 0u)
     {
@@ -535,7 +606,7 @@ static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, const run_span_t *s
             }
             else
             {
-                tail = finish_cluster(c, start, rs.tail, planes, n_sectors, st, 1);
+                tail = finish_cluster(c, start, rs.tail, planes, n_sectors, st, 1, 0, npix);
             }
         }
     }
