@@ -29,6 +29,12 @@
  *     mount_height_m.
  *     With ring_split_m > 0 each sector has two cells, near (R < ring_split_m) and far, each
  *     fitted on its own samples (a lidet extension: real ground bends between 3 m and 70 m).
+ *     With far_max_step_m > 0 (the dense profiles' default, 0.5 m) a far plane is judged where it
+ *     meets the near plane instead: at the split, on the sector's middle azimuth, the two planes'
+ *     heights differ by at most far_max_step_m (the near plane after its fallback: near cells are
+ *     fitted and fall back first). A road that climbs 6 degrees from 17 m ahead has a far plane
+ *     3 m below the sensor at the origin, which the sensor-height test refused: its cars then
+ *     merged with the road into clusters too wide to keep.
  *  3. Fallback for near cells with fewer than min_samples samples or no accepted plane: the plane
  *     of the nearest fitted near cell at most fallback_sectors away (ties: sector s-k before s+k),
  *     else the mount plane z = -mount_height_m (normal +z). A far cell without its own plane takes
