@@ -60,6 +60,7 @@ void lidet_ground_cfg_default(lidet_ground_cfg_t *cfg, const lidet_sensor_t *sen
     cfg->max_height_dev_m = low ? 0.5f : 1.0f;
     cfg->ring_split_m = low ? 0.0f : 15.0f;
     cfg->far_max_step_m = low ? 0.0f : 0.5f;
+    cfg->far2_split_m = low ? 0.0f : 30.0f;
     cfg->fallback_sectors = 4u;
     cfg->seed = 12345u;
     cfg->seed_per_cell = 0u;
@@ -105,10 +106,14 @@ lidet_status_t lidet_ground_state_init(lidet_ground_state_t *g, const lidet_grou
         cfg->max_height_dev_m <= 0.0f || !in_range(cfg->ground_m, 0.0f, 5.0f) || cfg->ground_m <= 0.0f ||
         !in_range(cfg->ground_m_per_m, 0.0f, 0.1f) || !in_range(cfg->below_factor, 0.0f, 20.0f) ||
         !in_range(cfg->confidence, 0.0f, 0.999999f) || !in_range(cfg->ring_split_m, 0.0f, 500.0f) ||
-        !in_range(cfg->far_max_step_m, 0.0f, 5.0f) || !in_range(cfg->veto_slope, 0.0f, 100.0f) ||
-        !in_range(cfg->veto_min_dz_m, 0.0f, 5.0f))
+        !in_range(cfg->far_max_step_m, 0.0f, 5.0f) || !in_range(cfg->far2_split_m, 0.0f, 500.0f) ||
+        !in_range(cfg->veto_slope, 0.0f, 100.0f) || !in_range(cfg->veto_min_dz_m, 0.0f, 5.0f))
     {
         return LIDET_ERR_CONFIG;
+    }
+    if (lidet__ground_far2_on(cfg) && 3u * cfg->n_sectors > 2u * LIDET_GROUND_MAX_SECTORS)
+    {
+        return LIDET_ERR_CONFIG; /* the third cells' planes share the near / far arrays */
     }
     g->cfg = *cfg;
     g->rng = lidet__rng_seed(cfg->seed);
@@ -502,8 +507,8 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc,
 
 typedef struct
 {
-    float split, slope, min_dz, mid, half; /* constant tolerance: |h - mid| < half */
-    float g0, k, bf;                       /* general tolerance: -bf (g0 + k R) < h < g0 + k R */
+    float split, split2, slope, min_dz, mid, half; /* constant tolerance: |h - mid| < half */
+    float g0, k, bf;                               /* general tolerance: -bf (g0 + k R) < h < g0 + k R */
 } label_par_t;
 
 /* veto word of pixel c: -1 when vetoed */
@@ -567,15 +572,45 @@ static inline uint32_t label_two(const float *X, const float *Y, const float *Z,
     return nv;
 }
 
+/* the third cells (far2_split_m): near plane p below split, far plane q below split2, q2 from it; otherwise as
+ * label_two (general a constant at both calls). Returns the vetoed count. */
+static inline uint32_t label_three(const float *X, const float *Y, const float *Z, const float *R,
+                                   const float *Ru, const float *Zu, uint32_t c0, uint32_t n, lidet_plane_t p,
+                                   lidet_plane_t q, lidet_plane_t q2, const label_par_t *lp,
+                                   int32_t *restrict o, int general)
+{
+    uint32_t j, nv = 0;
+    for (j = 0; j < n; ++j)
+    {
+        const uint32_t c = c0 + j;
+        const float hn = height(&p, X, Y, Z, c), hf = height(&q, X, Y, Z, c), h2 = height(&q2, X, Y, Z, c);
+        const float above = lp->g0 + lp->k * R[c], below = -lp->bf * above;
+        const int32_t in_n =
+            general ? -(int32_t)((hn < above) & (hn > below)) : -(int32_t)(fabsf(hn) < lp->half);
+        const int32_t in_f =
+            general ? -(int32_t)((hf < above) & (hf > below)) : -(int32_t)(fabsf(hf) < lp->half);
+        const int32_t in_2 =
+            general ? -(int32_t)((h2 < above) & (h2 > below)) : -(int32_t)(fabsf(h2) < lp->half);
+        const int32_t f2 = -(int32_t)(R[c] >= lp->split2);
+        const int32_t in = pick(R[c], lp->split, in_n, (f2 & in_2) | (~f2 & in_f)),
+                      vt = veto(R, Z, Ru, Zu, c, lp);
+        o[j] = in & ~vt;
+        nv -= (uint32_t)(in & vt);
+    }
+    return nv;
+}
+
 static void label_rows(lidet_ground_state_t *g, uint8_t *mask, rxy_rows_t *rr, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors;
     const float g0 = g->cfg.ground_m, below0 = g->cfg.below_factor * g0;
     const int two = g->cfg.ring_split_m > 0.0f, general = g->cfg.ground_m_per_m > 0.0f;
+    const int three = lidet__ground_far2_on(&g->cfg);
     label_par_t lp;
     int32_t o[LABEL_CHUNK];
     uint32_t r, s, c, j, n_ground = 0, n_vetoed = 0;
     lp.split = two ? g->cfg.ring_split_m : 3.0e38f;
+    lp.split2 = three ? g->cfg.far2_split_m : 3.0e38f;
     lp.slope = g->cfg.veto_slope;
     lp.min_dz = g->cfg.veto_slope > 0.0f ? g->cfg.veto_min_dz_m : 3.0e38f;
     lp.mid = 0.5f * (g0 - below0);
@@ -596,17 +631,22 @@ static void label_rows(lidet_ground_state_t *g, uint8_t *mask, rxy_rows_t *rr, c
         for (s = 0; s < ns; ++s)
         {
             const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
-            lidet_plane_t p = g->planes[s], q = g->planes[ns + s];
+            lidet_plane_t p = g->planes[s], q = g->planes[ns + s], q2 = three ? g->planes[2u * ns + s] : q;
             uint32_t cnt = 0, nv = 0;
             if (!general)
             {
                 p.d_m -= lp.mid;
                 q.d_m -= lp.mid;
+                q2.d_m -= lp.mid;
             }
             for (c = lidet__ground_sector_col(s, ns, cols); c < c1; c += LABEL_CHUNK)
             {
                 const uint32_t n = c1 - c < LABEL_CHUNK ? c1 - c : LABEL_CHUNK;
-                if (general)
+                if (general && three)
+                {
+                    nv += label_three(X, Y, Z, R, Ru, Zu, c, n, p, q, q2, &lp, o, 1);
+                }
+                else if (general)
                 {
                     nv += label_two(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, o, 1);
                 }
@@ -616,24 +656,34 @@ static void label_rows(lidet_ground_state_t *g, uint8_t *mask, rxy_rows_t *rr, c
                 }
                 else
                 {
-                    /* all points near, all far, or mixed (empty pixels count as neither) */
-                    uint32_t n_pts = 0, n_far = 0;
+                    /* all points near, all far, or mixed (empty pixels count as neither); with the third
+                     * cells also all beyond far2_split_m, or a mix with some there */
+                    uint32_t n_pts = 0, n_far = 0, n_far2 = 0;
                     for (j = 0; j < n; ++j)
                     {
                         n_pts += (uint32_t)(R[c + j] > 0.0f);
                         n_far += (uint32_t)(R[c + j] >= lp.split);
+                        n_far2 += (uint32_t)(R[c + j] >= lp.split2);
                     }
                     if (n_far == 0u)
                     {
                         nv += label_one(X, Y, Z, R, Ru, Zu, c, n, p, &lp, o);
                     }
-                    else if (n_far == n_pts)
+                    else if (n_far2 == 0u && n_far == n_pts)
                     {
                         nv += label_one(X, Y, Z, R, Ru, Zu, c, n, q, &lp, o);
                     }
-                    else
+                    else if (n_far2 == 0u)
                     {
                         nv += label_two(X, Y, Z, R, Ru, Zu, c, n, p, q, &lp, o, 0);
+                    }
+                    else if (n_far2 == n_pts)
+                    {
+                        nv += label_one(X, Y, Z, R, Ru, Zu, c, n, q2, &lp, o);
+                    }
+                    else
+                    {
+                        nv += label_three(X, Y, Z, R, Ru, Zu, c, n, p, q, q2, &lp, o, 0);
                     }
                 }
                 for (j = 0; j < n; ++j)

@@ -41,6 +41,7 @@ void lidet_ground_q_cfg_default(lidet_ground_q_cfg_t *cfg, uint32_t n_rows, int3
     cfg->max_height_dev_mm = low ? 500u : 1000u;
     cfg->ring_split_mm = low ? 0u : 15000u;
     cfg->far_max_step_mm = low ? 0u : 500u;
+    cfg->far2_split_mm = low ? 0u : 30000u;
     cfg->fallback_sectors = 4u;
     cfg->seed = 12345u;
     cfg->seed_per_cell = 0u;
@@ -78,10 +79,15 @@ lidet_status_t lidet_ground_q_state_init(lidet_ground_q_state_t *g, const lidet_
         cfg->confidence_q16 > 65535u || cfg->inlier_mm < 1u || cfg->inlier_mm > 5000u ||
         cfg->max_tilt_urad < 1u || cfg->max_tilt_urad > 1570796u || cfg->max_height_dev_mm < 1u ||
         cfg->max_height_dev_mm > 20000u || cfg->ring_split_mm > 500000u || cfg->far_max_step_mm > 5000u ||
-        cfg->ground_mm < 1u || cfg->ground_mm > 5000u || cfg->ground_per_m_q16 > 6554u ||
-        cfg->below_factor_q16 > 1310720u || cfg->veto_slope_q16 > 6553600u || cfg->veto_min_dz_mm > 5000u)
+        cfg->far2_split_mm > 500000u || cfg->ground_mm < 1u || cfg->ground_mm > 5000u ||
+        cfg->ground_per_m_q16 > 6554u || cfg->below_factor_q16 > 1310720u || cfg->veto_slope_q16 > 6553600u ||
+        cfg->veto_min_dz_mm > 5000u)
     {
         return LIDET_ERR_CONFIG;
+    }
+    if (lidet__ground_q_far2_on(cfg) && 3u * cfg->n_sectors > 2u * LIDET_GROUND_MAX_SECTORS)
+    {
+        return LIDET_ERR_CONFIG; /* the third cells' planes share the near / far arrays */
     }
     g->cfg = *cfg;
     g->rng = lidet__rng_seed(cfg->seed);
@@ -90,6 +96,8 @@ lidet_status_t lidet_ground_q_state_init(lidet_ground_q_state_t *g, const lidet_
      * x^2 + y^2 < 2^31 for int16 coordinates, so a larger threshold means "never far" */
     split2 = ((uint64_t)cfg->ring_split_mm * cfg->ring_split_mm + 15u) / 16u;
     g->split_v = cfg->ring_split_mm == 0u || split2 > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)split2;
+    split2 = ((uint64_t)cfg->far2_split_mm * cfg->far2_split_mm + 15u) / 16u;
+    g->split2_v = !lidet__ground_q_far2_on(cfg) || split2 > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)split2;
     g->n_rows = 0;
     g->n_cols = 0;
     memset(&g->stats, 0, sizeof g->stats);
@@ -529,8 +537,15 @@ typedef struct
     int32_t *z_up; /* per column: z of the pixel above (row r - 1), NO_POINT where it holds none */
     int64_t above0, below0, bf, slope, k;
     int32_t min_dz;
-    uint32_t split_v, n_ground, n_vetoed;
+    uint32_t split_v, split2_v, n_ground, n_vetoed;
 } label_t;
+
+/* a sector's third-cell plane (split2_v < UINT32_MAX): its pixels' height in 64 bits, the same exact n . p */
+typedef struct
+{
+    int32_t n[3];
+    int64_t d;
+} far2_plane_t;
 
 #define NO_POINT INT32_MIN /* z_up of an empty pixel (a decoded z is within +-2^15) */
 
@@ -563,8 +578,8 @@ __attribute__((always_inline))
 #endif
 static inline void
 label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lidet__qpix_row_t rt,
-           lidet__qpix_row_t rtu, const lidet__ground_q_hplane_t *hp, const int two, const int ro,
-           const int kz)
+           lidet__qpix_row_t rtu, const lidet__ground_q_hplane_t *hp, const far2_plane_t *f2, const int two,
+           const int ro, const int kz)
 {
     const uint16_t *rng = L->img->range_4mm;
     const int32_t *ct = L->gp->ct, *st = L->gp->st;
@@ -595,7 +610,14 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
             lidet__qpix_stored(L->img, p, P);
         }
         v = (uint32_t)(P[0] * P[0]) + (uint32_t)(P[1] * P[1]);
-        h = lidet__ground_q_height(&hp[two && v >= L->split_v], P[0], P[1], P[2]);
+        if (two && v >= L->split2_v)
+        {
+            h = (int64_t)f2->n[0] * P[0] + (int64_t)f2->n[1] * P[1] + (int64_t)f2->n[2] * P[2] + f2->d;
+        }
+        else
+        {
+            h = lidet__ground_q_height(&hp[two && v >= L->split_v], P[0], P[1], P[2]);
+        }
         if (!kz && L->k != 0)
         {
             /* R steps are 1/64 mm: k R / 2^16 mm = (k R) << 6 in 4 mm / 2^30 */
@@ -621,6 +643,39 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
     L->n_vetoed += n_vetoed;
 }
 
+/* the near / far (/ third) cells' kernels, out of label_rows: their frame is not on the stack of the 16-beam
+ * images, which have one plane per sector (the two-cell copies spilled more on ARMv6-M) */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static void
+label_span_two(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lidet__qpix_row_t rt,
+               lidet__qpix_row_t rtu, const lidet__ground_q_hplane_t *hp, int ro,
+               const lidet_ground_q_state_t *g, uint32_t s)
+{
+    far2_plane_t f2;
+    f2.n[0] = 0;
+    f2.n[1] = 0;
+    f2.n[2] = 0;
+    f2.d = 0;
+    if (L->split2_v != 0xFFFFFFFFu)
+    {
+        const uint32_t k = 2u * g->cfg.n_sectors + s;
+        f2.n[0] = g->planes[k].nx;
+        f2.n[1] = g->planes[k].ny;
+        f2.n[2] = g->planes[k].nz;
+        f2.d = g->plane_d[k];
+    }
+    if (ro)
+    {
+        label_span(L, c0, c1, base, up, rt, rtu, hp, &f2, 1, 1, 0);
+    }
+    else
+    {
+        label_span(L, c0, c1, base, up, rt, rtu, hp, &f2, 1, 0, 0);
+    }
+}
+
 static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, uint8_t *mask,
                        const lidet__ground_q_pix_t *gp)
 {
@@ -640,6 +695,7 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
     L.below0 = lidet__q_rshift_round(L.bf * L.above0, 16);
     L.min_dz = (int32_t)g->cfg.veto_min_dz_mm;
     L.split_v = g->split_v;
+    L.split2_v = g->split2_v;
     L.n_ground = 0;
     L.n_vetoed = 0;
     for (c = 0; c < cols; ++c)
@@ -665,30 +721,27 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
                 nn[2] = pl->nz;
                 lidet__ground_q_hplane(nn, g->plane_d[c * ns + s], &hp[c]);
             }
+
             /* the kernels: near and far cells or one, range-only image or stored x, y, z; a range-only image's
              * also with the fixed tolerance (ground_per_m_q16 0) as a constant */
-            if (ro)
+            if (two)
             {
-                if (two)
+                label_span_two(&L, c0, c1, base, up, rt, rtu, hp, ro, g, s);
+            }
+            else if (ro)
+            {
+                if (L.k == 0)
                 {
-                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 1, 1, 0);
-                }
-                else if (L.k == 0)
-                {
-                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 1, 1);
+                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 0, 1, 1);
                 }
                 else
                 {
-                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 1, 0);
+                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 0, 1, 0);
                 }
-            }
-            else if (two)
-            {
-                label_span(&L, c0, c1, base, up, rt, rtu, hp, 1, 0, 0);
             }
             else
             {
-                label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 0, 0);
+                label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 0, 0, 0);
             }
         }
     }

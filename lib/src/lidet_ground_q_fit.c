@@ -461,19 +461,24 @@ static int32_t plane_z_at(const int32_t n[3], int64_t d, int32_t x, int32_t y)
 /* far cell k's plane p meets its sector's (final) near plane at the split, at the sector's middle azimuth
  * pi (1 - (2 s + 1) / ns) (BAM32 2^31 - floor((2 s + 1) 2^31 / ns)), within far_max_step_mm: 4 |z_far - z_near|
  * <= the step (the float stage's far_max_step_m test, lidet_ground_ransac.c) */
-static int far_meets(const lidet_ground_q_state_t *g, uint32_t k, const qplane_t *p)
+#if defined(__GNUC__)
+__attribute__((noinline)) /* out of fit_cell's frame (the 16-beam images never call it) */
+#endif
+static int
+far_meets(const lidet_ground_q_state_t *g, uint32_t k, const qplane_t *p)
 {
-    const uint32_t ns = g->cfg.n_sectors, s = k - ns;
+    const uint32_t ns = g->cfg.n_sectors, s = k % ns, inner = k - ns;
     const uint32_t az = 0x80000000u - (uint32_t)(((uint64_t)(2u * s + 1u) << 31) / ns);
-    const int64_t split = (int64_t)g->cfg.ring_split_mm;
+    /* a far cell meets its near plane at ring_split_mm; a third cell its far plane at far2_split_mm */
+    const int64_t split = (int64_t)(k < 2u * ns ? g->cfg.ring_split_mm : g->cfg.far2_split_mm);
     const int32_t x = (int32_t)lidet__q_rshift_round(split * lidet__q_cos(az), 32);
     const int32_t y = (int32_t)lidet__q_rshift_round(split * lidet__q_sin(az), 32);
     int32_t nn[3];
     int64_t dz;
-    nn[0] = g->planes[s].nx;
-    nn[1] = g->planes[s].ny;
-    nn[2] = g->planes[s].nz;
-    dz = (int64_t)plane_z_at(p->n, p->d, x, y) - plane_z_at(nn, g->plane_d[s], x, y);
+    nn[0] = g->planes[inner].nx;
+    nn[1] = g->planes[inner].ny;
+    nn[2] = g->planes[inner].nz;
+    dz = (int64_t)plane_z_at(p->n, p->d, x, y) - plane_z_at(nn, g->plane_d[inner], x, y);
     return 4 * abs64(dz) <= (int64_t)g->cfg.far_max_step_mm;
 }
 
@@ -534,6 +539,57 @@ static void copy_plane(void *ctx, uint32_t dst, int32_t src)
     }
 }
 
+/* The third cells (far2_split_mm; the float stage's fit_far2, lidet_ground_ransac.c): sector s's far samples with
+ * x^2 + y^2 >= split2_v moved to the front of its far block (one pass, those keep their order), fitted as cell
+ * 2 ns + s by fit_cell after every other cell (its span in cell_first / cell_n: 3 ns <= 2
+ * LIDET_GROUND_MAX_SECTORS, init checks it), judged where it meets the far plane at far2_split_mm
+ * (far_max_step_mm; the sensor-height test when that is 0); without a plane, or with fewer than min_samples
+ * samples, the far plane. fit_cell_q keeps its one call site (inlined into fit_cell: the 16-beam images' stack). */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static void
+fit_far2(fit_ctx_t *f)
+{
+    lidet_ground_q_state_t *g = f->g;
+    lidet_ground_q_scratch_t *sc = f->sc;
+    const uint32_t ns = g->cfg.n_sectors, cols = f->img->img->n_cols;
+    uint32_t s, i;
+    for (s = 0; s < ns; ++s)
+    {
+        const uint32_t kf = ns + s, k = 2u * ns + s, a = sc->cell_first[kf], n = sc->cell_n[kf];
+        lidet_ground_sample_t *idx = sc->sample_pix + a;
+        uint32_t m = 0;
+        LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
+        for (i = 0; i < n; ++i)
+        {
+            const uint32_t px = (uint32_t)idx[i];
+            int32_t q[3];
+            lidet__ground_q_pix_rc(f->img, lidet__qpix_row(f->img->img, px / cols), px % cols, px, q);
+            if ((uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]) >= g->split2_v)
+            {
+                const lidet_ground_sample_t t = idx[i];
+                idx[i] = idx[m];
+                idx[m] = t;
+                ++m;
+            }
+        }
+        sc->cell_first[k] = a;
+        sc->cell_n[k] = m;
+        g->source[k] = LIDET_GROUND_PLANE_NEAR; /* the cell inside it */
+        if (m >= g->cfg.min_samples && fit_cell(f, k))
+        {
+            g->source[k] = LIDET_GROUND_PLANE_FITTED;
+            ++g->stats.n_far2_fitted;
+        }
+        else
+        {
+            g->planes[k] = g->planes[kf];
+            g->plane_d[k] = g->plane_d[kf];
+        }
+    }
+}
+
 void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
                                  const lidet__ground_q_pix_t *img)
 {
@@ -544,4 +600,8 @@ void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scrat
     f.img = img;
     lidet__ground_cells(g->source, sc->cell_n, ns, g->cfg.ring_split_mm > 0u ? 2u * ns : ns,
                         g->cfg.min_samples, g->cfg.fallback_sectors, &g->stats, fit_cell, copy_plane, &f);
+    if (g->split2_v != 0xFFFFFFFFu)
+    {
+        fit_far2(&f);
+    }
 }

@@ -77,6 +77,7 @@ static const py_field_t k_fields[] = {
     FLD(lidet_ground_cfg_t, refine_iters, 'u'), FLD(lidet_ground_cfg_t, inlier_m, 'f'),
     FLD(lidet_ground_cfg_t, max_tilt_rad, 'f'), FLD(lidet_ground_cfg_t, max_height_dev_m, 'f'),
     FLD(lidet_ground_cfg_t, ring_split_m, 'f'), FLD(lidet_ground_cfg_t, far_max_step_m, 'f'),
+    FLD(lidet_ground_cfg_t, far2_split_m, 'f'),
     FLD(lidet_ground_cfg_t, fallback_sectors, 'u'),
     FLD(lidet_ground_cfg_t, seed, 'u'), FLD(lidet_ground_cfg_t, seed_per_cell, 'u'),
     FLD(lidet_ground_cfg_t, ground_m, 'f'),
@@ -86,7 +87,8 @@ static const py_field_t k_fields[] = {
     FLD(lidet_ground_stats_t, n_ground, 'u'), FLD(lidet_ground_stats_t, n_sectors_fitted, 'u'),
     FLD(lidet_ground_stats_t, n_sectors_neighbour, 'u'), FLD(lidet_ground_stats_t, n_sectors_mount, 'u'),
     FLD(lidet_ground_stats_t, n_sectors_sparse, 'u'), FLD(lidet_ground_stats_t, n_sectors_rejected, 'u'),
-    FLD(lidet_ground_stats_t, n_far_fitted, 'u'), FLD(lidet_ground_stats_t, n_vetoed, 'u'),
+    FLD(lidet_ground_stats_t, n_far_fitted, 'u'),
+    FLD(lidet_ground_stats_t, n_far2_fitted, 'u'), FLD(lidet_ground_stats_t, n_vetoed, 'u'),
     FLD(lidet_ground_stats_t, n_hypotheses, 'u'),
     FLD(lidet_cluster_cfg_t, theta_rad, 'f'), FLD(lidet_cluster_cfg_t, max_steps, 'u'),
     FLD(lidet_cluster_cfg_t, bridge_occluders, 'u'), FLD(lidet_cluster_cfg_t, diagonals, 'u'),
@@ -391,7 +393,10 @@ void lidet_py_ground_planes_out(const lidet_ground_t *g, float *planes, uint8_t 
     uint32_t ns, s;
     const lidet_plane_t *pl = lidet_ground_planes(g, &ns);
     const uint8_t *src = lidet_ground_sector_source(g);
-    for (s = 0; s < 2u * ns; ++s)
+    const lidet_ground_cfg_t *cfg = &g->state.cfg;
+    /* near, far and, with the third cells (far2_split_m beyond ring_split_m), their planes */
+    const uint32_t n_cells = (cfg->ring_split_m > 0.0f && cfg->far2_split_m > cfg->ring_split_m ? 3u : 2u) * ns;
+    for (s = 0; s < n_cells; ++s)
     {
         if (planes != NULL)
         {

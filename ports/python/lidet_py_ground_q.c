@@ -72,7 +72,7 @@ static const qfield_t k_cfg_fields[] = {
     QF(refine_iters, 0), QF(seed_per_cell, 0), QF(gate_above_mm, 1), QF(gate_below_mm, 1), QF(mount_height_mm, 1), QF(n_sectors, 0),
     QF(ransac_iters, 0), QF(sample_step, 0), QF(sample_col_step, 0), QF(eval_samples, 0), QF(min_samples, 0),
     QF(min_inliers, 0), QF(fallback_sectors, 0), QF(confidence_q16, 0), QF(inlier_mm, 0), QF(max_tilt_urad, 0),
-    QF(max_height_dev_mm, 0), QF(ring_split_mm, 0), QF(far_max_step_mm, 0), QF(seed, 0), QF(ground_mm, 0), QF(ground_per_m_q16, 0),
+    QF(max_height_dev_mm, 0), QF(ring_split_mm, 0), QF(far_max_step_mm, 0), QF(far2_split_mm, 0), QF(seed, 0), QF(ground_mm, 0), QF(ground_per_m_q16, 0),
     QF(below_factor_q16, 0), QF(veto_slope_q16, 0), QF(veto_min_dz_mm, 0)};
 #define N_QF (sizeof k_cfg_fields / sizeof k_cfg_fields[0])
 
@@ -174,19 +174,24 @@ LIDET_PY_API int lidet_py_ground_q_run(const int64_t *cfgv, uint32_t rows, uint3
             memcpy(mask, lidet_ground_q_mask(g), npix);
         if (sample != NULL)
             memcpy(sample, lidet_ground_q_samples(g), npix);
-        for (s = 0; s < 2u * c.n_sectors; ++s)
         {
-            if (planes != NULL)
+            /* near, far and, with the third cells, theirs */
+            const uint32_t n_cells =
+                (c.ring_split_mm > 0u && c.far2_split_mm > c.ring_split_mm ? 3u : 2u) * c.n_sectors;
+            for (s = 0; s < n_cells; ++s)
             {
-                planes[4 * s + 0] = g->state.planes[s].nx;
-                planes[4 * s + 1] = g->state.planes[s].ny;
-                planes[4 * s + 2] = g->state.planes[s].nz;
-                planes[4 * s + 3] = g->state.planes[s].d_4mm;
+                if (planes != NULL)
+                {
+                    planes[4 * s + 0] = g->state.planes[s].nx;
+                    planes[4 * s + 1] = g->state.planes[s].ny;
+                    planes[4 * s + 2] = g->state.planes[s].nz;
+                    planes[4 * s + 3] = g->state.planes[s].d_4mm;
+                }
+                if (plane_d != NULL)
+                    plane_d[s] = g->state.plane_d[s];
+                if (source != NULL)
+                    source[s] = g->state.source[s];
             }
-            if (plane_d != NULL)
-                plane_d[s] = g->state.plane_d[s];
-            if (source != NULL)
-                source[s] = g->state.source[s];
         }
         if (stats != NULL)
             *stats = g->state.stats;

@@ -49,6 +49,11 @@ def _scene(rng, n_rows=64, h=1.73, n_cars=6):
     return np.hstack([p, np.zeros((len(p), 1))]).astype(np.float32)
 
 
+def _planes(res):
+    """The C stage's planes in the reference's layout: near, far, and the third cells' when on."""
+    return np.vstack([res.planes, res.planes_far] + ([] if res.planes_far2 is None else [res.planes_far2]))
+
+
 def test_rng_matches_known_sequence():
     r = XorShift32(1)
     # xorshift32 (13, 17, 5) from state 1: the first values of Marsaglia's generator
@@ -74,7 +79,7 @@ def test_c_matches_numpy_reference(variant):
     mask, smp, planes, src = gref.ground(img.x, img.y, img.z, img.rxy, img.valid, cfg)
     assert np.array_equal(smp, res.sample_pixel), "sample masks differ"
     assert np.array_equal(src, res.source)
-    assert np.allclose(planes, np.vstack([res.planes, res.planes_far]), atol=2e-4)
+    assert np.allclose(planes, _planes(res), atol=2e-4)
     agree = (mask == res.mask_pixel).mean()
     assert agree >= 0.999, agree
     # per point: every input point, input order, losers of a pixel take the pixel's label
@@ -106,7 +111,7 @@ def test_c_matches_numpy_reference_on_a_climbing_road(step):
     img = res.image
     mask, smp, planes, src = gref.ground(img.x, img.y, img.z, img.rxy, img.valid, cfg)
     assert np.array_equal(src, res.source)
-    assert np.allclose(planes, np.vstack([res.planes, res.planes_far]), atol=2e-4)
+    assert np.allclose(planes, _planes(res), atol=2e-4)
     assert (mask == res.mask_pixel).mean() >= 0.999
 
 
@@ -133,6 +138,53 @@ def test_far_planes_follow_a_climbing_road():
     for bad in (-0.1, 5.1):
         with pytest.raises(native.LidetError):
             native.ground(pts, "hdl64", far_max_step_m=bad)
+
+
+def _second_bend():
+    """Scan 37 of seed 7600 (simulated HDL-64): the road 32-60 m ahead lies beyond a second grade change, which the
+    far plane (15 m and beyond) does not follow."""
+    from lidet_tools.sim.simulate import simulate_scan
+    r = simulate_scan("hdl64", seed=7600, index=37)
+    return r.points, r.sem
+
+
+@pytest.mark.parametrize("far2", [30.0, 0.0])
+def test_c_matches_numpy_reference_with_third_cells(far2):
+    """far2_split_m (the default 30 m, and 0: off) on a scan whose third cells it decides: same sources (3 n_sectors
+    with them), planes within 2e-4, labels on >= 99.9 % of the pixels."""
+    pts, _ = _second_bend()
+    res = native.ground(pts, "hdl64", far2_split_m=far2)
+    cfg = native.ground_defaults("hdl64")
+    cfg["far2_split_m"] = far2
+    img = res.image
+    mask, smp, planes, src = gref.ground(img.x, img.y, img.z, img.rxy, img.valid, cfg)
+    assert len(src) == (3 if far2 else 2) * len(res.planes) and (res.planes_far2 is None) == (far2 == 0)
+    assert np.array_equal(src, res.source)
+    assert np.allclose(planes, _planes(res), atol=2e-4)
+    assert (mask == res.mask_pixel).mean() >= 0.999
+
+
+def test_third_cells_follow_a_second_bend():
+    """The road 32-60 m ahead of scan 37 (seed 7600): a third of it ground with the far plane alone, nearly all with
+    the third cells (far2_split_m 30 m); the near and far planes are those of the run without them."""
+    pts, sem = _second_bend()
+    road = np.isin(sem, (40, 44)) & (pts[:, 0] > 32) & (pts[:, 0] < 60) & (np.abs(pts[:, 1]) < 6)
+    assert road.sum() > 300
+    assert native.ground_defaults("hdl64")["far2_split_m"] == pytest.approx(30.0)
+    assert native.ground_defaults("vlp16")["far2_split_m"] == 0.0
+    old = native.ground(pts, "hdl64", far2_split_m=0.0)
+    new = native.ground(pts, "hdl64")
+    assert old.mask_point[road].mean() < 0.4
+    assert new.mask_point[road].mean() > 0.95
+    assert new.stats["n_far2_fitted"] > 3 and old.stats["n_far2_fitted"] == 0
+    assert np.array_equal(new.planes, old.planes) and np.array_equal(new.planes_far, old.planes_far)
+    near = np.hypot(pts[:, 0], pts[:, 1]) < 29.0
+    assert np.array_equal(new.mask_point[near], old.mask_point[near])
+    # a far2_split_m inside the split does nothing; 3 n_sectors planes must fit the plane arrays
+    inside = native.ground(pts, "hdl64", far2_split_m=10.0)
+    assert inside.planes_far2 is None and np.array_equal(inside.mask_point, old.mask_point)
+    with pytest.raises(native.LidetError):
+        native.ground(pts, "hdl64", n_sectors=200)
 
 
 def test_seed_per_cell_planes_do_not_depend_on_other_sectors():

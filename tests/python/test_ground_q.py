@@ -95,7 +95,7 @@ def test_defaults_are_the_float_defaults_rounded():
         assert q["ground_per_m_q16"] == round(f["ground_m_per_m"] * 65536)
         assert q["max_tilt_urad"] == round(f["max_tilt_rad"] * 1e6)
         for k in ("fx_max", "gate_above", "gate_below", "mount_height", "inlier", "max_height_dev", "ring_split",
-                  "far_max_step", "ground", "veto_min_dz"):
+                  "far_max_step", "far2_split", "ground", "veto_min_dz"):
             assert q[k + "_mm"] == round(f[k + "_m"] * 1000), k
         for k in ("fx_on_z", "require_descending", "height_gate", "refine_iters", "n_sectors", "ransac_iters",
                   "sample_step", "sample_col_step", "eval_samples", "min_samples", "min_inliers", "fallback_sectors",
@@ -107,7 +107,7 @@ def test_bad_config_refused():
     img = native_q.project_compact(_sample_scans()[0][1], "hdl64")
     for k, v in (("fx_max_mm", 0), ("inlier_mm", 0), ("max_tilt_urad", 1570797), ("confidence_q16", 65536),
                  ("fallback_sectors", 33), ("ground_per_m_q16", 6555), ("gate_above_mm", -5001),
-                 ("far_max_step_mm", 5001)):
+                 ("far_max_step_mm", 5001), ("far2_split_mm", 500001)):
         with pytest.raises(native.LidetError):
             native_q.ground_q(img, "hdl64", **{k: v})
 
@@ -139,6 +139,17 @@ def test_c_matches_reference_on_a_climbing_road(step):
     pts = simulate_scan("hdl64", seed=7000, index=155).points
     res = _bit_exact("hdl64", pts, far_max_step_mm=step)
     assert (res.stats["n_far_fitted"] >= 14) == (step > 0)
+
+
+@pytest.mark.parametrize("far2", [30000, 0])
+def test_c_matches_reference_with_third_cells(far2):
+    """far2_split_mm (the third cells, lidet_ground_q_fit.c fit_far2) on scan 37 of seed 7600, whose road bends a
+    second time beyond 30 m: bit for bit, and they fit planes there."""
+    from lidet_tools.sim.simulate import simulate_scan
+    pts = simulate_scan("hdl64", seed=7600, index=37).points
+    res = _bit_exact("hdl64", pts, far2_split_mm=far2)
+    assert (res.stats["n_far2_fitted"] > 3) == (far2 > 0)
+    assert len(res.source) == (3 if far2 else 2) * 32
 
 
 def test_c_matches_reference_on_fresh_simulated_scans():

@@ -624,6 +624,9 @@ static void test_config_and_arguments(void)
     /* more sectors than columns */
     c = gcfg;
     c.n_sectors = 200;
+    /* the third cells' planes share the near / far arrays: 3 * 200 > 2 * LIDET_GROUND_MAX_SECTORS */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_init(&gg.ws, &c));
+    c.far2_split_m = 0.0f;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_init(&gg.ws, &c));
     img.n_cols = 100;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_run(&gg.ws, &img));

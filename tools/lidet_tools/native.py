@@ -365,9 +365,11 @@ class GroundResult:
     planes_far: np.ndarray   #: (n_sectors, 4) far planes (horizontal range >= ring_split_m)
     stats: dict
     sample_pixel: np.ndarray  #: (rows, cols) uint8: pixels that passed the sample filter
-    source: np.ndarray        #: (2 * n_sectors,) uint8 near then far: 0 fitted, 1 neighbour, 2 mount, 3 near
+    source: np.ndarray        #: (2 * n_sectors,) uint8 near then far (3 * n_sectors with the third cells): 0 fitted,
+                              #: 1 neighbour, 2 mount, 3 the cell inside it
     image: RangeImage
     status: int
+    planes_far2: np.ndarray | None = None  #: (n_sectors, 4) the third cells' planes (far2_split_m), else None
 
     def __iter__(self):
         """Unpacks as (mask_point, mask_pixel, planes, stats)."""
@@ -392,15 +394,25 @@ def ground(points, sensor: str | Sensor = "hdl64", ring=None, proj_cfg: dict | N
     mp = np.zeros((rows, cols), np.uint8)
     sp = np.zeros((rows, cols), np.uint8)
     mpt = np.zeros(n, np.uint8)
-    planes = np.zeros((2 * max(ns, 1), 4), np.float32)
-    src = np.zeros(2 * max(ns, 1), np.uint8)
+    planes = np.zeros((3 * max(ns, 1), 4), np.float32)
+    src = np.zeros(3 * max(ns, 1), np.uint8)
     stats = _record("lidet_ground_stats_t")
     cap = capacity()["max_points"]
     st = lib().lidet_py_ground_run(ctx.ptr, _addr(_record("lidet_ground_cfg_t", full)), mp, sp,
                                    mpt[: min(n, cap)] if n else None, planes, src, _addr(stats))
     if st < 0:
         raise LidetError(st, "lidet_ground_run")
-    return GroundResult(mpt, mp, planes[:ns], planes[ns:2 * ns], _to_dict(stats), sp, src[:2 * ns], img, int(st))
+    three = far2_on(full)
+    return GroundResult(mpt, mp, planes[:ns], planes[ns:2 * ns], _to_dict(stats), sp, src[:(3 if three else 2) * ns], img,
+                        int(st), planes[2 * ns:3 * ns] if three else None)
+
+
+def far2_on(cfg: dict) -> bool:
+    """The ground stage's third cells are on (lidet_ground_cfg_t far2_split_m beyond ring_split_m, or the integer
+    stage's _mm fields)."""
+    if "far2_split_mm" in cfg:
+        return int(cfg["ring_split_mm"]) > 0 and int(cfg["far2_split_mm"]) > int(cfg["ring_split_mm"])
+    return float(cfg.get("ring_split_m", 0.0)) > 0 and float(cfg.get("far2_split_m", 0.0)) > float(cfg["ring_split_m"])
 
 
 def ground_fit_plane(xyz) -> tuple[np.ndarray, np.ndarray]:

@@ -324,7 +324,7 @@ def _ground_outputs(img: CompactImage, cfg: dict):
     rows, cols = img.shape
     ns = int(cfg["n_sectors"])
     return (rows, cols, ns, np.zeros((rows, cols), np.uint8), np.zeros((rows, cols), np.uint8),
-            np.zeros(2 * ns, np.uint8), native._record("lidet_ground_stats_t"))
+            np.zeros(3 * ns, np.uint8), native._record("lidet_ground_stats_t"))
 
 
 def ground_q(img: CompactImage, sensor="hdl64", **cfg) -> GroundQResult:
@@ -332,28 +332,30 @@ def ground_q(img: CompactImage, sensor="hdl64", **cfg) -> GroundQResult:
     full = ground_q_defaults(sensor)
     full.update(cfg)
     rows, cols, ns, mask, smp, src, stats = _ground_outputs(img, full)
-    planes = np.zeros((2 * ns, 4), np.int32)
-    pd = np.zeros(2 * ns, np.int64)
+    planes = np.zeros((3 * ns, 4), np.int32)
+    pd = np.zeros(3 * ns, np.int64)
     st = _ground_q_lib().lidet_py_ground_q_run(_cfg_vec(full), rows, cols, img.x, img.y, img.z, img.range, mask,
                                                smp, planes, pd, src, native._addr(stats))
     if st < 0:
         raise native.LidetError(st, "lidet_ground_q_run")
-    return GroundQResult(mask, smp, planes, pd, src, native._to_dict(stats), int(st))
+    nc = (3 if native.far2_on(full) else 2) * ns  # near, far and the third cells' planes when on
+    return GroundQResult(mask, smp, planes[:nc], pd[:nc], src[:nc], native._to_dict(stats), int(st))
 
 
 def ground_float_compact(img: CompactImage, sensor="hdl64", **cfg):
-    """The float ground stage on the same compact image: (mask, sample, planes (2 ns, 4) float32, source,
-    stats)."""
+    """The float ground stage on the same compact image: (mask, sample, planes (2 ns, 4) float32, 3 ns with the
+    third cells, source, stats)."""
     full = native.ground_defaults(sensor)
     full.update(cfg)
     rows, cols, ns, mask, smp, src, stats = _ground_outputs(img, full)
-    planes = np.zeros((2 * ns, 4), np.float32)
+    planes = np.zeros((3 * ns, 4), np.float32)
     st = _ground_q_lib().lidet_py_ground_float_compact(native._addr(native._record("lidet_ground_cfg_t", full)),
                                                        rows, cols, img.x, img.y, img.z, img.range, mask, smp,
                                                        planes, src, native._addr(stats))
     if st < 0:
         raise native.LidetError(st, "lidet_ground_run")
-    return mask, smp, planes, src, native._to_dict(stats)
+    nc = (3 if native.far2_on(full) else 2) * ns
+    return mask, smp, planes[:nc], src[:nc], native._to_dict(stats)
 
 
 def ground_q_time(img: CompactImage, sensor="hdl64", repeats=100) -> tuple[float, float, float, float]:

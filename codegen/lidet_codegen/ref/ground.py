@@ -211,7 +211,33 @@ def fit_sectors(cells, cfg: dict):
     for s in range(ns):
         if src[ns + s] != FITTED:
             planes[ns + s], src[ns + s] = planes[s], NEAR
+    if not far2_on(cfg):
+        return planes, src
+    # the third cells (lidet_ground_ransac.c fit_far2): each far cell's samples at or beyond far2_split_m, in
+    # their order, fitted after every other cell, judged against the far plane at far2_split_m
+    s2 = F(cfg["far2_split_m"])
+    planes = np.vstack([planes, planes[ns:2 * ns]])
+    src = np.concatenate([src, np.full(ns, NEAR, np.uint8)])
+    for s in range(ns):
+        pts = np.asarray(cells[ns + s], F).reshape(-1, 3)
+        sel = pts[(pts[:, 0] * pts[:, 0] + pts[:, 1] * pts[:, 1]) >= s2 * s2]
+        if len(sel) < int(cfg["min_samples"]):
+            continue
+        if per_cell:
+            rng = XorShift32(cell(int(cfg["seed"]), 2 * ns + s))
+        if step > 0:
+            p, _ = ransac_sector(sel, rng, cfg, planes[ns + s], split_point(s, ns, cfg["far2_split_m"]))
+        else:
+            p, _ = ransac_sector(sel, rng, cfg)
+        if p is not None:
+            planes[2 * ns + s], src[2 * ns + s] = p, FITTED
     return planes, src
+
+
+def far2_on(cfg: dict) -> bool:
+    """The third cells are on: a split, and far2_split_m beyond it."""
+    split = float(cfg.get("ring_split_m", 0.0))
+    return split > 0 and float(cfg.get("far2_split_m", 0.0)) > split
 
 
 def label_pixels(X, Y, Z, R, valid, planes, cfg: dict) -> np.ndarray:
@@ -224,8 +250,12 @@ def label_pixels(X, Y, Z, R, valid, planes, cfg: dict) -> np.ndarray:
     above = F(cfg["ground_m"]) + F(cfg["ground_m_per_m"]) * R
     below = -F(cfg["below_factor"]) * above
     ok = np.zeros((rows, cols), bool)
-    for part, sel in ((0, R < split if split > 0 else np.ones_like(R, bool)),
-                      (1, R >= split if split > 0 else np.zeros_like(R, bool))):
+    s2 = F(cfg["far2_split_m"]) if far2_on(cfg) else F(3.0e38)
+    parts = [(0, R < split if split > 0 else np.ones_like(R, bool)),
+             (1, ((R >= split) & (R < s2)) if split > 0 else np.zeros_like(R, bool))]
+    if far2_on(cfg):
+        parts.append((2, R >= s2))
+    for part, sel in parts:
         pl = np.asarray(planes, F)[part * ns + sec]  # (cols, 4)
         h = pl[:, 0] * np.asarray(X, F) + pl[:, 1] * np.asarray(Y, F) + pl[:, 2] * np.asarray(Z, F) + pl[:, 3]
         ok |= sel & (h < above) & (h > below)

@@ -303,7 +303,41 @@ def fit_sectors(cells, XYZ, cfg, stats):
     for s in range(ns):
         if src[ns + s] != FITTED:
             N[ns + s], D[ns + s], src[ns + s] = N[s], D[s], NEAR
+    if not far2_on(cfg):
+        return N, D, src
+    # the third cells (lidet_ground_q_fit.c fit_far2): each far cell's samples with x^2 + y^2 >= split2_v, in their
+    # order, fitted after every other cell, judged against the far plane at far2_split_mm
+    N = np.vstack([N, N[ns:2 * ns]])
+    D = np.concatenate([D, D[ns:2 * ns]])
+    src = np.concatenate([src, np.full(ns, NEAR, np.uint8)])
+    v2 = split2_v(cfg)
+    for s in range(ns):
+        idx = np.asarray(cells[ns + s], np.int64)
+        P = XYZ[idx]
+        sel = idx[(P[:, 0] * P[:, 0] + P[:, 1] * P[:, 1]) >= v2]
+        if len(sel) < int(cfg["min_samples"]):
+            continue
+        if per_cell:
+            rng = XorShift32(cell(int(cfg["seed"]), 2 * ns + s))
+        p = ransac_cell(XYZ[sel], rng, cfg, stats, step)
+        if p is not None and step and not far_meets(s, ns, dict(cfg, ring_split_mm=cfg["far2_split_mm"]), p,
+                                                    N[ns + s], D[ns + s]):
+            p = None
+        if p is not None:
+            N[2 * ns + s], D[2 * ns + s], src[2 * ns + s] = p[0], p[1], FITTED
+            stats["n_far2_fitted"] += 1
     return N, D, src
+
+
+def far2_on(cfg) -> bool:
+    """The third cells are on: a split, and far2_split_mm beyond it."""
+    return int(cfg["ring_split_mm"]) > 0 and int(cfg.get("far2_split_mm", 0)) > int(cfg["ring_split_mm"])
+
+
+def split2_v(cfg) -> int:
+    sp = int(cfg.get("far2_split_mm", 0))
+    v = (sp * sp + 15) // 16
+    return 0xFFFFFFFF if not far2_on(cfg) or v > 0xFFFFFFFF else v
 
 
 def label_pixels(X, Y, Z, N, D, cfg, stats, R=None) -> np.ndarray:
@@ -314,6 +348,8 @@ def label_pixels(X, Y, Z, N, D, cfg, stats, R=None) -> np.ndarray:
     v = rxy2(X, Y)
     far = v >= split_v(cfg)
     cell = ((np.arange(cols) * ns) // cols)[None, :] + ns * far
+    if int(cfg["ring_split_mm"]) > 0:
+        cell = cell + ns * (v >= split2_v(cfg))  # the third cells (beyond far2_split_mm, when on)
     h = N[cell, 0] * X + N[cell, 1] * Y + N[cell, 2] * Z + D[cell]
     above0 = int(cfg["ground_mm"]) << 28
     bf = int(cfg["below_factor_q16"])
@@ -342,8 +378,8 @@ def ground(X, Y, Z, cfg, R=None):
     stores x, y, z."""
     X, Y, Z = (np.asarray(A, np.int64) for A in (X, Y, Z))
     stats = dict.fromkeys(("n_samples", "n_samples_dropped", "n_ground", "n_sectors_fitted", "n_sectors_neighbour",
-                           "n_sectors_mount", "n_sectors_sparse", "n_sectors_rejected", "n_far_fitted", "n_vetoed",
-                           "n_hypotheses"), 0)
+                           "n_sectors_mount", "n_sectors_sparse", "n_sectors_rejected", "n_far_fitted",
+                           "n_far2_fitted", "n_vetoed", "n_hypotheses"), 0)
     smp = sample_mask(X, Y, Z, cfg, R)
     cells = gather_samples(smp, X, Y, cfg)
     stats["n_samples"] = int(sum(len(c) for c in cells))

@@ -131,6 +131,13 @@ typedef struct
                                    sector's near plane at the split within this height step (metres) instead of
                                    by the sensor's height above it: a road that climbs or falls beyond the
                                    split; 0 = the height test for far planes too; [0, 5] */
+    float far2_split_m; /**< a third cell per sector (stop 33): with ring_split_m > 0 and this beyond it, the
+                                   far cell's samples at or beyond this range get a plane of their own, judged
+                                   where it meets the far plane at this range (far_max_step_m; the sensor-height
+                                   test when that is 0), and the pixels at or beyond it take that plane (else the
+                                   far plane); a road bends more than once over 15-70 m. Needs 3 * n_sectors <=
+                                   2 * LIDET_GROUND_MAX_SECTORS (the planes share the near / far arrays); 0 = off;
+                                   [0, 500]; default 30 on dense profiles, 0 on 16 beams and low mounts */
     uint16_t fallback_sectors; /**< how far (in sectors, either side) a fitted neighbour may be;
                                    [0, n_sectors] */
     uint32_t seed;             /**< xorshift32 seed (0 is replaced by a fixed non-zero value);
@@ -169,6 +176,7 @@ typedef struct
     uint16_t n_sectors_sparse;    /**< near cells with fewer than min_samples samples */
     uint16_t n_sectors_rejected;  /**< near cells whose best plane failed the inlier/tilt/height checks */
     uint16_t n_far_fitted;        /**< far cells with their own plane (0 when ring_split_m is 0) */
+    uint16_t n_far2_fitted;       /**< third cells (far2_split_m) with their own plane */
     uint32_t n_vetoed;            /**< pixels within the plane tolerance removed by the vertical veto */
     uint32_t n_hypotheses;        /**< RANSAC hypotheses scored (after degenerate/tilt rejection) */
 } lidet_ground_stats_t;
@@ -278,9 +286,11 @@ const uint8_t *lidet_ground_samples(const lidet_ground_t *g);
  * @brief Planes of the last run, one per sector (sector of column c = c * n_sectors / n_cols): the
  *        near planes (horizontal range < ring_split_m; the whole sector when ring_split_m is 0).
  *        The far planes follow in the same array: planes[n_sectors + s] (equal to the near plane
- *        when the far part had no plane of its own).
+ *        when the far part had no plane of its own), then, with far2_split_m, the third cells' planes
+ *        planes[2 n_sectors + s] (equal to the far plane when the cell had no plane of its own).
  * @param[out] n_sectors number of sectors (may be NULL).
- * @return a view into g of 2 * n_sectors planes (valid until the next run/init), unit normals, nz > 0.
+ * @return a view into g of 2 * n_sectors planes (3 * n_sectors with far2_split_m; valid until the next
+ *         run/init), unit normals, nz > 0.
  */
 const lidet_plane_t *lidet_ground_planes(const lidet_ground_t *g, uint32_t *n_sectors);
 

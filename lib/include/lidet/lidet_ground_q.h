@@ -75,12 +75,14 @@ typedef struct
     uint32_t far_max_step_mm;   /**< [0, 5000]; > 0 with a split: a far plane is accepted when it meets its
                                      sector's near plane at the split within this step (the float stage's
                                      far_max_step_m), not by the sensor's height above it */
-    uint32_t seed;              /**< xorshift32 seed (0 -> fixed non-zero) */
-    uint32_t ground_mm;         /**< p_th, mm; (0, 5000] */
-    uint32_t ground_per_m_q16;  /**< p_th growth per metre of range (mm/mm), Q16; [0, 6554] */
-    uint32_t below_factor_q16;  /**< below tolerance = this * above, Q16; [0, 1310720] */
-    uint32_t veto_slope_q16;    /**< vertical veto slope, Q16; [0, 6553600], 0 = off */
-    uint32_t veto_min_dz_mm;    /**< [0, 5000] */
+    uint32_t far2_split_mm;    /**< [0, 500000]; the third cells (lidet_ground_cfg_t far2_split_m) when beyond
+                                     ring_split_mm; needs 3 n_sectors <= 2 LIDET_GROUND_MAX_SECTORS */
+    uint32_t seed;             /**< xorshift32 seed (0 -> fixed non-zero) */
+    uint32_t ground_mm;        /**< p_th, mm; (0, 5000] */
+    uint32_t ground_per_m_q16; /**< p_th growth per metre of range (mm/mm), Q16; [0, 6554] */
+    uint32_t below_factor_q16; /**< below tolerance = this * above, Q16; [0, 1310720] */
+    uint32_t veto_slope_q16;   /**< vertical veto slope, Q16; [0, 6553600], 0 = off */
+    uint32_t veto_min_dz_mm;   /**< [0, 5000] */
 } lidet_ground_q_cfg_t;
 
 /** @brief What lives across runs: configuration, tables from init, planes, sources, counts. */
@@ -92,6 +94,7 @@ typedef struct
     uint16_t n_rows, n_cols;
     int32_t cos_tilt_q30; /* cos(max_tilt), from init */
     uint32_t split_v;     /* far: x^2 + y^2 >= split_v (4 mm steps squared); UINT32_MAX: no split */
+    uint32_t split2_v;    /* the third cells: x^2 + y^2 >= split2_v; UINT32_MAX: none */
     lidet_plane_q_t planes[2 * LIDET_GROUND_MAX_SECTORS]; /* near planes, then far planes */
     int64_t plane_d[2 * LIDET_GROUND_MAX_SECTORS]; /* D of each plane, 4 mm / 2^30 (the labels use it) */
     uint8_t source[2 * LIDET_GROUND_MAX_SECTORS];  /* lidet_ground_plane_source_t */

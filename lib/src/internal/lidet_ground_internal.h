@@ -43,6 +43,13 @@ static inline lidet_status_t lidet__ground_run_check(int inited, int planes_ok,
 /* The sample buffer of both stages' gathering: near samples of sector s fill it upwards from near_start to lo,
  * far ones downwards from far_end to hi (cells s and ns + s); after the last sector the counts: `total`
  * samples met, those past the buffer dropped. */
+/* the third cell per sector is on (lidet_ground_cfg_t far2_split_m): a split, and this beyond it */
+#define lidet__ground_far2_on(cfg) ((cfg)->ring_split_m > 0.0f && (cfg)->far2_split_m > (cfg)->ring_split_m)
+
+/* the integer stage's test (mm) */
+#define lidet__ground_q_far2_on(cfg)                                                                         \
+    ((cfg)->ring_split_mm > 0u && (cfg)->far2_split_mm > (cfg)->ring_split_mm)
+
 static inline void lidet__ground_cell_span(uint32_t *cell_first, uint32_t *cell_n, uint32_t s, uint32_t ns,
                                            uint32_t near_start, uint32_t lo, uint32_t hi, uint32_t far_end)
 {
