@@ -539,55 +539,13 @@ static void copy_plane(void *ctx, uint32_t dst, int32_t src)
     }
 }
 
-/* The third cells (far2_split_mm; the float stage's fit_far2, lidet_ground_ransac.c): sector s's far samples with
- * x^2 + y^2 >= split2_v moved to the front of its far block (one pass, those keep their order), fitted as cell
- * 2 ns + s by fit_cell after every other cell (its span in cell_first / cell_n: 3 ns <= 2
- * LIDET_GROUND_MAX_SECTORS, init checks it), judged where it meets the far plane at far2_split_mm
- * (far_max_step_mm; the sensor-height test when that is 0); without a plane, or with fewer than min_samples
- * samples, the far plane. fit_cell_q keeps its one call site (inlined into fit_cell: the 16-beam images' stack). */
-#if defined(__GNUC__)
-__attribute__((noinline))
-#endif
-static void
-fit_far2(fit_ctx_t *f)
+/* a sample with x^2 + y^2 >= split2_v (the third cells) */
+static int beyond_far2(void *ctx, lidet_ground_sample_t p)
 {
-    lidet_ground_q_state_t *g = f->g;
-    lidet_ground_q_scratch_t *sc = f->sc;
-    const uint32_t ns = g->cfg.n_sectors, cols = f->img->img->n_cols;
-    uint32_t s, i;
-    for (s = 0; s < ns; ++s)
-    {
-        const uint32_t kf = ns + s, k = 2u * ns + s, a = sc->cell_first[kf], n = sc->cell_n[kf];
-        lidet_ground_sample_t *idx = sc->sample_pix + a;
-        uint32_t m = 0;
-        LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
-        for (i = 0; i < n; ++i)
-        {
-            const uint32_t px = (uint32_t)idx[i];
-            int32_t q[3];
-            lidet__ground_q_pix_rc(f->img, lidet__qpix_row(f->img->img, px / cols), px % cols, px, q);
-            if ((uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]) >= g->split2_v)
-            {
-                const lidet_ground_sample_t t = idx[i];
-                idx[i] = idx[m];
-                idx[m] = t;
-                ++m;
-            }
-        }
-        sc->cell_first[k] = a;
-        sc->cell_n[k] = m;
-        g->source[k] = LIDET_GROUND_PLANE_NEAR; /* the cell inside it */
-        if (m >= g->cfg.min_samples && fit_cell(f, k))
-        {
-            g->source[k] = LIDET_GROUND_PLANE_FITTED;
-            ++g->stats.n_far2_fitted;
-        }
-        else
-        {
-            g->planes[k] = g->planes[kf];
-            g->plane_d[k] = g->plane_d[kf];
-        }
-    }
+    const fit_ctx_t *f = (const fit_ctx_t *)ctx;
+    int32_t q[3];
+    lidet__ground_q_pix(f->img, (uint32_t)p, q);
+    return (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]) >= f->g->split2_v;
 }
 
 void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
@@ -602,6 +560,8 @@ void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scrat
                         g->cfg.min_samples, g->cfg.fallback_sectors, &g->stats, fit_cell, copy_plane, &f);
     if (g->split2_v != 0xFFFFFFFFu)
     {
-        fit_far2(&f);
+        /* fit_cell stays fit_cell_q's one call site (inlined into it: the 16-beam images' stack) */
+        lidet__ground_far2_cells(g->source, sc->cell_first, sc->cell_n, sc->sample_pix, ns,
+                                 g->cfg.min_samples, &g->stats, beyond_far2, fit_cell, copy_plane, &f);
     }
 }

@@ -489,23 +489,34 @@ typedef struct
 static int fit_cell(void *ctx, uint32_t k)
 {
     fit_ctx_t *f = (fit_ctx_t *)ctx;
-    const uint32_t a = f->sc->cell_first[k], n = f->sc->cell_n[k];
-    LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
-    if (f->g->cfg.seed_per_cell)
-    {
-        f->g->rng = lidet__rng_cell(f->g->cfg.seed, k);
-    }
     const lidet_ground_cfg_t *cfg = &f->g->cfg;
-    const uint32_t ns = cfg->n_sectors;
+    const uint32_t a = f->sc->cell_first[k], n = f->sc->cell_n[k], ns = cfg->n_sectors;
+    LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
+    if (cfg->seed_per_cell)
+    {
+        f->g->rng = lidet__rng_cell(cfg->seed, k);
+    }
     if (k >= ns && cfg->far_max_step_m > 0.0f)
     {
-        /* the split circle at the middle azimuth of sector s (columns s cols / ns ...: azimuth
-         * pi (1 - 2 (s + 1/2) / ns)) */
-        const float az = LIDET_PI_F * (1.0f - (2.0f * (float)(k - ns) + 1.0f) / (float)ns);
+        /* a far cell meets its near plane at ring_split_m, a third cell its far plane at far2_split_m: on the
+         * split circle at the middle azimuth of sector s (columns s cols / ns ...: azimuth pi (1 - 2 (s + 1/2) /
+         * ns)) */
+        const float az = LIDET_PI_F * (1.0f - (2.0f * (float)(k % ns) + 1.0f) / (float)ns);
+        const float split = k < 2u * ns ? cfg->ring_split_m : cfg->far2_split_m;
         return fit_sector(f->g, f->sc, f->img, f->sc->sample_pix + a, n, &f->g->planes[k - ns],
-                          cfg->ring_split_m * cosf(az), cfg->ring_split_m * sinf(az), &f->g->planes[k]);
+                          split * cosf(az), split * sinf(az), &f->g->planes[k]);
     }
     return fit_sector(f->g, f->sc, f->img, f->sc->sample_pix + a, n, 0, 0.0f, 0.0f, &f->g->planes[k]);
+}
+
+/* a sample at or beyond far2_split_m (the third cells) */
+static int beyond_far2(void *ctx, lidet_ground_sample_t p)
+{
+    const fit_ctx_t *f = (const fit_ctx_t *)ctx;
+    const float s2 = f->g->cfg.far2_split_m;
+    float x, y, z;
+    lidet__img_xyz(f->img, p, lidet__img_compact(f->img), &x, &y, &z);
+    return x * x + y * y >= s2 * s2;
 }
 
 static void copy_plane(void *ctx, uint32_t dst, int32_t src)
@@ -524,61 +535,6 @@ static void copy_plane(void *ctx, uint32_t dst, int32_t src)
     }
 }
 
-/* The third cells (far2_split_m), after every near and far plane is final: sector s's far samples at or beyond
- * far2_split_m are moved to the front of its far block (one pass, those keep their order; the far fit is done, so
- * the block's order is free) and fitted as a cell of their own, index 2 ns + s (its random stream with
- * seed_per_cell; else the run's stream goes on), judged where it meets the far plane at far2_split_m on the
- * sector's middle azimuth (far_max_step_m; the sensor-height test when that is 0). Without a plane, or with
- * fewer than min_samples samples, it takes the far plane. */
-static void fit_far2(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img)
-{
-    const lidet_ground_cfg_t *cfg = &g->cfg;
-    const uint32_t ns = cfg->n_sectors;
-    const int compact = lidet__img_compact(img);
-    const float s2 = cfg->far2_split_m, s2sq = s2 * s2;
-    uint32_t s, i;
-    for (s = 0; s < ns; ++s)
-    {
-        const uint32_t kf = ns + s, k = 2u * ns + s, a = sc->cell_first[kf], n = sc->cell_n[kf];
-        lidet_ground_sample_t *idx = sc->sample_pix + a;
-        uint32_t m = 0;
-        LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
-        for (i = 0; i < n; ++i)
-        {
-            float x, y, z;
-            lidet__img_xyz(img, idx[i], compact, &x, &y, &z);
-            if (x * x + y * y >= s2sq)
-            {
-                const lidet_ground_sample_t t = idx[i];
-                idx[i] = idx[m];
-                idx[m] = t;
-                ++m;
-            }
-        }
-        g->planes[k] = g->planes[kf];
-        g->source[k] = LIDET_GROUND_PLANE_NEAR; /* the cell inside it */
-        if (m < cfg->min_samples)
-        {
-            continue;
-        }
-        if (cfg->seed_per_cell)
-        {
-            g->rng = lidet__rng_cell(cfg->seed, k);
-        }
-        {
-            const float az = LIDET_PI_F * (1.0f - (2.0f * (float)s + 1.0f) / (float)ns);
-            lidet_plane_t p;
-            if (fit_sector(g, sc, img, idx, m, cfg->far_max_step_m > 0.0f ? &g->planes[kf] : 0, s2 * cosf(az),
-                           s2 * sinf(az), &p))
-            {
-                g->planes[k] = p;
-                g->source[k] = LIDET_GROUND_PLANE_FITTED;
-                ++g->stats.n_far2_fitted;
-            }
-        }
-    }
-}
-
 void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc,
                                const lidet_range_image_t *img)
 {
@@ -591,6 +547,7 @@ void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *
                         g->cfg.min_samples, g->cfg.fallback_sectors, &g->stats, fit_cell, copy_plane, &f);
     if (lidet__ground_far2_on(&g->cfg))
     {
-        fit_far2(g, sc, img);
+        lidet__ground_far2_cells(g->source, sc->cell_first, sc->cell_n, sc->sample_pix, ns,
+                                 g->cfg.min_samples, &g->stats, beyond_far2, fit_cell, copy_plane, &f);
     }
 }

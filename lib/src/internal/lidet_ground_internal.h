@@ -5,6 +5,7 @@
 
 #include <string.h>
 
+#include "internal/lidet_assert.h"
 #include "lidet/lidet_ground.h"
 
 /* first column of sector s: the smallest c with c * n_sectors / n_cols >= s */
@@ -100,65 +101,75 @@ static inline lidet_status_t lidet__ground_point_labels(int inited, const uint8_
  * cell without its own plane takes its sector's near plane. Fills source and the cell counts of stats. */
 typedef int (*lidet__ground_fit_fn)(void *ctx, uint32_t k);
 typedef void (*lidet__ground_copy_fn)(void *ctx, uint32_t dst, int32_t src);
+/* beyond(ctx, p): sample pixel p lies at or beyond far2_split (the third cells) */
+typedef int (*lidet__ground_beyond_fn)(void *ctx, lidet_ground_sample_t p);
+
+/* cell k (a near one below ns) fitted when it holds min_samples samples; source and counts */
+static inline void lidet__ground_fit_one(uint8_t *source, const uint32_t *cell_n, uint32_t ns,
+                                         uint32_t n_cells, uint32_t min_samples, lidet_ground_stats_t *stats,
+                                         lidet__ground_fit_fn fit, void *ctx, uint32_t k)
+{
+    const int near = k < ns;
+    source[k] = near ? LIDET_GROUND_PLANE_MOUNT : LIDET_GROUND_PLANE_NEAR;
+    if (k >= n_cells || cell_n[k] < min_samples)
+    {
+        stats->n_sectors_sparse += (uint16_t)near;
+        return;
+    }
+    if (fit(ctx, k))
+    {
+        source[k] = LIDET_GROUND_PLANE_FITTED;
+        if (near)
+            ++stats->n_sectors_fitted;
+        else
+            ++stats->n_far_fitted;
+    }
+    else
+    {
+        stats->n_sectors_rejected += (uint16_t)near;
+    }
+}
 
 static inline void lidet__ground_cells(uint8_t *source, const uint32_t *cell_n, uint32_t ns, uint32_t n_cells,
                                        uint32_t min_samples, uint32_t reach, lidet_ground_stats_t *stats,
                                        lidet__ground_fit_fn fit, lidet__ground_copy_fn copy, void *ctx)
 {
     uint32_t s, k;
-    for (k = 0; k < 2u * ns; ++k)
+    for (k = 0; k < ns; ++k)
     {
-        const int near = k < ns;
-        if (k == ns)
+        lidet__ground_fit_one(source, cell_n, ns, n_cells, min_samples, stats, fit, ctx, k);
+    }
+    /* the near cells' fallback before the far fits: a far cell's test reads its sector's final near plane (the
+     * fallback draws no random number, so the fits' stream is the one of fitting every cell first) */
+    for (s = 0; s < ns; ++s)
+    {
+        int32_t from = -1;
+        if (source[s] == LIDET_GROUND_PLANE_FITTED)
         {
-            /* the near cells' fallback before the far fits: a far cell's test reads its sector's final near
-             * plane (the fallback draws no random number, so the fits' stream is unchanged) */
-            for (s = 0; s < ns; ++s)
-            {
-                int32_t from = -1;
-                uint32_t j;
-                if (source[s] == LIDET_GROUND_PLANE_FITTED)
-                {
-                    continue;
-                }
-                for (j = 1; j <= reach && from < 0; ++j)
-                {
-                    const uint32_t left = (s + ns - (j % ns)) % ns, right = (s + j) % ns;
-                    if (source[left] == LIDET_GROUND_PLANE_FITTED)
-                        from = (int32_t)left;
-                    else if (source[right] == LIDET_GROUND_PLANE_FITTED)
-                        from = (int32_t)right;
-                }
-                copy(ctx, s, from);
-                if (from >= 0)
-                {
-                    source[s] = LIDET_GROUND_PLANE_NEIGHBOUR; /* never FITTED: not a source for others */
-                    ++stats->n_sectors_neighbour;
-                }
-                else
-                {
-                    ++stats->n_sectors_mount;
-                }
-            }
-        }
-        source[k] = near ? LIDET_GROUND_PLANE_MOUNT : LIDET_GROUND_PLANE_NEAR;
-        if (k >= n_cells || cell_n[k] < min_samples)
-        {
-            stats->n_sectors_sparse += (uint16_t)near;
             continue;
         }
-        if (fit(ctx, k))
+        for (k = 1; k <= reach && from < 0; ++k)
         {
-            source[k] = LIDET_GROUND_PLANE_FITTED;
-            if (near)
-                ++stats->n_sectors_fitted;
-            else
-                ++stats->n_far_fitted;
+            const uint32_t left = (s + ns - (k % ns)) % ns, right = (s + k) % ns;
+            if (source[left] == LIDET_GROUND_PLANE_FITTED)
+                from = (int32_t)left;
+            else if (source[right] == LIDET_GROUND_PLANE_FITTED)
+                from = (int32_t)right;
+        }
+        copy(ctx, s, from);
+        if (from >= 0)
+        {
+            source[s] = LIDET_GROUND_PLANE_NEIGHBOUR; /* never FITTED: not a source for others */
+            ++stats->n_sectors_neighbour;
         }
         else
         {
-            stats->n_sectors_rejected += (uint16_t)near;
+            ++stats->n_sectors_mount;
         }
+    }
+    for (k = ns; k < 2u * ns; ++k)
+    {
+        lidet__ground_fit_one(source, cell_n, ns, n_cells, min_samples, stats, fit, ctx, k);
     }
     for (s = 0; s < ns; ++s)
     {
@@ -166,6 +177,50 @@ static inline void lidet__ground_cells(uint8_t *source, const uint32_t *cell_n, 
         {
             copy(ctx, ns + s, (int32_t)s);
             source[ns + s] = LIDET_GROUND_PLANE_NEAR;
+        }
+    }
+}
+
+/* The third cells' control flow (far2_split_m / far2_split_mm), after lidet__ground_cells, for both stages: sector
+ * s's far samples that beyond() selects are moved to the front of its far block (one pass; those keep their
+ * order, and the far fit is done, so the block's order is free), become cell 2 ns + s (its span in cell_first /
+ * cell_n: 3 ns <= 2 LIDET_GROUND_MAX_SECTORS, init checks it) and are fitted by fit(ctx, 2 ns + s), which judges a
+ * third cell's plane against the far plane at far2_split (the step) or by the sensor's height; without a plane, or
+ * with fewer than min_samples samples, the cell takes the far plane (copy). */
+static inline void lidet__ground_far2_cells(uint8_t *source, uint32_t *cell_first, uint32_t *cell_n,
+                                            lidet_ground_sample_t *sample_pix, uint32_t ns,
+                                            uint32_t min_samples, lidet_ground_stats_t *stats,
+                                            lidet__ground_beyond_fn beyond, lidet__ground_fit_fn fit,
+                                            lidet__ground_copy_fn copy, void *ctx)
+{
+    uint32_t s, i;
+    for (s = 0; s < ns; ++s)
+    {
+        const uint32_t kf = ns + s, k = 2u * ns + s, a = cell_first[kf], n = cell_n[kf];
+        lidet_ground_sample_t *idx = sample_pix + a;
+        uint32_t m = 0;
+        LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
+        for (i = 0; i < n; ++i)
+        {
+            if (beyond(ctx, idx[i]))
+            {
+                const lidet_ground_sample_t t = idx[i];
+                idx[i] = idx[m];
+                idx[m] = t;
+                ++m;
+            }
+        }
+        cell_first[k] = a;
+        cell_n[k] = m;
+        if (m >= min_samples && fit(ctx, k))
+        {
+            source[k] = LIDET_GROUND_PLANE_FITTED;
+            ++stats->n_far2_fitted;
+        }
+        else
+        {
+            copy(ctx, k, (int32_t)kf);
+            source[k] = LIDET_GROUND_PLANE_NEAR; /* the cell inside it */
         }
     }
 }
