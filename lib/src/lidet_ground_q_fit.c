@@ -543,9 +543,23 @@ static void copy_plane(void *ctx, uint32_t dst, int32_t src)
 static int beyond_far2(void *ctx, lidet_ground_sample_t p)
 {
     const fit_ctx_t *f = (const fit_ctx_t *)ctx;
+    const uint32_t px = (uint32_t)p, cols = f->img->img->n_cols;
     int32_t q[3];
-    lidet__ground_q_pix(f->img, (uint32_t)p, q);
+    lidet__ground_q_pix_rc(f->img, lidet__qpix_row(f->img->img, px / cols), px % cols, px, q);
     return (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]) >= f->g->split2_v;
+}
+
+/* the third cells (lidet__ground_far2_cells), out of line: its loop's frame stays off the 16-beam images' stack,
+ * which never run it */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static void
+fit_far2(fit_ctx_t *f)
+{
+    lidet_ground_q_scratch_t *sc = f->sc;
+    lidet__ground_far2_cells(f->g->source, sc->cell_first, sc->cell_n, sc->sample_pix, f->g->cfg.n_sectors,
+                             f->g->cfg.min_samples, &f->g->stats, beyond_far2, fit_cell, copy_plane, f);
 }
 
 void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
@@ -560,8 +574,6 @@ void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scrat
                         g->cfg.min_samples, g->cfg.fallback_sectors, &g->stats, fit_cell, copy_plane, &f);
     if (g->split2_v != 0xFFFFFFFFu)
     {
-        /* fit_cell stays fit_cell_q's one call site (inlined into it: the 16-beam images' stack) */
-        lidet__ground_far2_cells(g->source, sc->cell_first, sc->cell_n, sc->sample_pix, ns,
-                                 g->cfg.min_samples, &g->stats, beyond_far2, fit_cell, copy_plane, &f);
+        fit_far2(&f);
     }
 }

@@ -130,17 +130,13 @@ static inline void lidet__ground_fit_one(uint8_t *source, const uint32_t *cell_n
     }
 }
 
-static inline void lidet__ground_cells(uint8_t *source, const uint32_t *cell_n, uint32_t ns, uint32_t n_cells,
-                                       uint32_t min_samples, uint32_t reach, lidet_ground_stats_t *stats,
-                                       lidet__ground_fit_fn fit, lidet__ground_copy_fn copy, void *ctx)
+/* the near cells' fallback: a near cell without its own plane takes the nearest FITTED near cell at most `reach`
+ * sectors away (s - k before s + k), else the mount plane */
+static inline void lidet__ground_near_fallback(uint8_t *source, uint32_t ns, uint32_t reach,
+                                               lidet_ground_stats_t *stats, lidet__ground_copy_fn copy,
+                                               void *ctx)
 {
     uint32_t s, k;
-    for (k = 0; k < ns; ++k)
-    {
-        lidet__ground_fit_one(source, cell_n, ns, n_cells, min_samples, stats, fit, ctx, k);
-    }
-    /* the near cells' fallback before the far fits: a far cell's test reads its sector's final near plane (the
-     * fallback draws no random number, so the fits' stream is the one of fitting every cell first) */
     for (s = 0; s < ns; ++s)
     {
         int32_t from = -1;
@@ -167,8 +163,22 @@ static inline void lidet__ground_cells(uint8_t *source, const uint32_t *cell_n, 
             ++stats->n_sectors_mount;
         }
     }
-    for (k = ns; k < 2u * ns; ++k)
+}
+
+static inline void lidet__ground_cells(uint8_t *source, const uint32_t *cell_n, uint32_t ns, uint32_t n_cells,
+                                       uint32_t min_samples, uint32_t reach, lidet_ground_stats_t *stats,
+                                       lidet__ground_fit_fn fit, lidet__ground_copy_fn copy, void *ctx)
+{
+    uint32_t s, k;
+    /* one loop over the cells (one call site of fit: the stages inline it there), near ones first; the near
+     * fallback between them, so a far cell's test reads its sector's final near plane (the fallback draws no
+     * random number: the stream of draws is that of fitting every cell in order) */
+    for (k = 0; k < 2u * ns; ++k)
     {
+        if (k == ns)
+        {
+            lidet__ground_near_fallback(source, ns, reach, stats, copy, ctx);
+        }
         lidet__ground_fit_one(source, cell_n, ns, n_cells, min_samples, stats, fit, ctx, k);
     }
     for (s = 0; s < ns; ++s)
