@@ -92,24 +92,40 @@ def test_c_matches_numpy_reference(variant):
     assert res.mask_point[z > -1.73 + 0.3].mean() < 0.001
 
 
-def _climbing_road():
-    """Scan 155 of the simulated HDL-64 benchmark's seed (7000): the road ahead climbs about 6 degrees from 17 m on,
-    so a far plane (15 m and beyond) passes 3 m or more below the sensor. Points, semantic labels."""
+def _sim_scan(seed, index):
     from lidet_tools.sim.simulate import simulate_scan
-    r = simulate_scan("hdl64", seed=7000, index=155)
+    r = simulate_scan("hdl64", seed=seed, index=index)
     return r.points, r.sem
 
 
-@pytest.mark.parametrize("step", [0.5, 0.0])
-def test_c_matches_numpy_reference_on_a_climbing_road(step):
+def _climbing_road():
+    """Scan 155 of the simulated HDL-64 benchmark's seed (7000): the road ahead climbs about 6 degrees from 17 m on,
+    so a far plane (15 m and beyond) passes 3 m or more below the sensor. Points, semantic labels."""
+    return _sim_scan(7000, 155)
+
+
+def _second_bend():
+    """Scan 37 of seed 7600 (simulated HDL-64): the road 32-60 m ahead lies beyond a second grade change, which the
+    far plane (15 m and beyond) does not follow."""
+    return _sim_scan(7600, 37)
+
+
+@pytest.mark.parametrize("scan,key,value", [(_climbing_road, "far_max_step_m", 0.5),
+                                            (_climbing_road, "far_max_step_m", 0.0),
+                                            (_second_bend, "far2_split_m", 30.0),
+                                            (_second_bend, "far2_split_m", 0.0)])
+def test_c_matches_numpy_reference_on_bends(scan, key, value):
     """far_max_step_m (the default 0.5, and 0: the sensor-height test for far cells too) on a scan whose far planes
-    it decides: same sources, planes within 2e-4, labels on >= 99.9 % of the pixels."""
-    pts, _ = _climbing_road()
-    res = native.ground(pts, "hdl64", far_max_step_m=step)
+    it decides, far2_split_m (the default 30 m, and 0: off) on one whose third cells it decides: same sources
+    (3 n_sectors with the third cells), planes within 2e-4, labels on >= 99.9 % of the pixels."""
+    pts, _ = scan()
+    res = native.ground(pts, "hdl64", **{key: value})
     cfg = native.ground_defaults("hdl64")
-    cfg["far_max_step_m"] = step
+    cfg[key] = value
     img = res.image
     mask, smp, planes, src = gref.ground(img.x, img.y, img.z, img.rxy, img.valid, cfg)
+    if key == "far2_split_m":
+        assert len(src) == (3 if value else 2) * len(res.planes) and (res.planes_far2 is None) == (value == 0)
     assert np.array_equal(src, res.source)
     assert np.allclose(planes, _planes(res), atol=2e-4)
     assert (mask == res.mask_pixel).mean() >= 0.999
@@ -138,30 +154,6 @@ def test_far_planes_follow_a_climbing_road():
     for bad in (-0.1, 5.1):
         with pytest.raises(native.LidetError):
             native.ground(pts, "hdl64", far_max_step_m=bad)
-
-
-def _second_bend():
-    """Scan 37 of seed 7600 (simulated HDL-64): the road 32-60 m ahead lies beyond a second grade change, which the
-    far plane (15 m and beyond) does not follow."""
-    from lidet_tools.sim.simulate import simulate_scan
-    r = simulate_scan("hdl64", seed=7600, index=37)
-    return r.points, r.sem
-
-
-@pytest.mark.parametrize("far2", [30.0, 0.0])
-def test_c_matches_numpy_reference_with_third_cells(far2):
-    """far2_split_m (the default 30 m, and 0: off) on a scan whose third cells it decides: same sources (3 n_sectors
-    with them), planes within 2e-4, labels on >= 99.9 % of the pixels."""
-    pts, _ = _second_bend()
-    res = native.ground(pts, "hdl64", far2_split_m=far2)
-    cfg = native.ground_defaults("hdl64")
-    cfg["far2_split_m"] = far2
-    img = res.image
-    mask, smp, planes, src = gref.ground(img.x, img.y, img.z, img.rxy, img.valid, cfg)
-    assert len(src) == (3 if far2 else 2) * len(res.planes) and (res.planes_far2 is None) == (far2 == 0)
-    assert np.array_equal(src, res.source)
-    assert np.allclose(planes, _planes(res), atol=2e-4)
-    assert (mask == res.mask_pixel).mean() >= 0.999
 
 
 def test_third_cells_follow_a_second_bend():
