@@ -143,7 +143,7 @@ def test_c_matches_reference_on_a_climbing_road(step):
 
 @pytest.mark.parametrize("far2", [30000, 0])
 def test_c_matches_reference_with_third_cells(far2):
-    """far2_split_mm (the third cells, lidet_ground_q_fit.c fit_far2) on scan 37 of seed 7600, whose road bends a
+    """far2_split_mm (the third cells, lidet__ground_far2_cells) on scan 37 of seed 7600, whose road bends a
     second time beyond 30 m: bit for bit, and they fit planes there."""
     from lidet_tools.sim.simulate import simulate_scan
     pts = simulate_scan("hdl64", seed=7600, index=37).points
