@@ -213,8 +213,8 @@ def fit_sectors(cells, cfg: dict):
             planes[ns + s], src[ns + s] = planes[s], NEAR
     if not far2_on(cfg):
         return planes, src
-    # the third cells (lidet__ground_far2_cells, lidet_ground_internal.h): each far cell's samples at or beyond far2_split_m, in
-    # their order, fitted after every other cell, judged against the far plane at far2_split_m
+    # the third cells (lidet__ground_far2_cells, lidet_ground_internal.h): each far cell's samples at or beyond
+    # far2_split_m, in their order, fitted after every other cell, judged against the far plane at far2_split_m
     s2 = F(cfg["far2_split_m"])
     planes = np.vstack([planes, planes[ns:2 * ns]])
     src = np.concatenate([src, np.full(ns, NEAR, np.uint8)])

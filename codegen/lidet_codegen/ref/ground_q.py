@@ -305,8 +305,9 @@ def fit_sectors(cells, XYZ, cfg, stats):
             N[ns + s], D[ns + s], src[ns + s] = N[s], D[s], NEAR
     if not far2_on(cfg):
         return N, D, src
-    # the third cells (lidet__ground_far2_cells, lidet_ground_internal.h): each far cell's samples with x^2 + y^2 >= split2_v, in their
-    # order, fitted after every other cell, judged against the far plane at far2_split_mm
+    # the third cells (lidet__ground_far2_cells, lidet_ground_internal.h): each far cell's samples with
+    # x^2 + y^2 >= split2_v, in their order, fitted after every other cell, judged against the far plane at
+    # far2_split_mm
     N = np.vstack([N, N[ns:2 * ns]])
     D = np.concatenate([D, D[ns:2 * ns]])
     src = np.concatenate([src, np.full(ns, NEAR, np.uint8)])
