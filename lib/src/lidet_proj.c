@@ -32,6 +32,29 @@ void lidet_proj_cfg_default(lidet_proj_cfg_t *cfg, const lidet_sensor_t *sensor)
     cfg->azimuth_half_rad = 0.0f;
 }
 
+/* run()'s block pre-test. Column c spans azimuths (pi - 2 pi (c + 1) / cols, pi - 2 pi c / cols] (u below), so the
+ * window [win_lo, win_hi) spans (a1, a2] = (pi - 2 pi win_hi / cols, pi - 2 pi win_lo / cols]; each edge is turned
+ * WIN_MARGIN_RAD outwards, far more than the rounding of the pseudo-azimuth the exact test reads (~1e-6 rad), so
+ * a point the pre-test puts outside is outside for the exact test too. With the widened window W <= pi a point
+ * lies outside iff cross(v1, p) < 0 or cross(p, v2) < 0 (v1, v2 its edges); wider, iff both are */
+#define WIN_MARGIN_RAD 0.01f
+static void init_window_test(lidet_proj_state_t *proj, uint32_t cols)
+{
+    const float step = 2.0f * LIDET_PI_F / (float)cols;
+    const float a1 = LIDET_PI_F - step * (float)proj->win_hi - WIN_MARGIN_RAD;
+    const float a2 = LIDET_PI_F - step * (float)proj->win_lo + WIN_MARGIN_RAD;
+    proj->win_test = 0u;
+    if ((proj->win_lo == 0u && proj->win_hi >= cols) || a2 - a1 >= 2.0f * LIDET_PI_F - 4.0f * WIN_MARGIN_RAD)
+    {
+        return; /* the whole scan, or a window whose margins would close the gap: no pre-test */
+    }
+    proj->win_edge[0] = cosf(a1);
+    proj->win_edge[1] = sinf(a1);
+    proj->win_edge[2] = cosf(a2);
+    proj->win_edge[3] = sinf(a2);
+    proj->win_test = a2 - a1 <= LIDET_PI_F ? 1u : 2u;
+}
+
 /* lidet__proj_rows_top_down's order on this file's elevations */
 static int beam_above(const void *elev, uint32_t a, uint32_t b)
 {
@@ -214,6 +237,7 @@ lidet_status_t lidet_proj_state_init(lidet_proj_state_t *proj, const lidet_proj_
     }
     init_columns(proj, s->n_cols);
     lidet__azimuth_window_cols(cfg->azimuth_half_rad, s->n_cols, &proj->win_lo, &proj->win_hi);
+    init_window_test(proj, s->n_cols);
     proj->cfg = *cfg;
     proj->cfg.sensor.beam_elev_rad = 0; /* not retained: the caller's table may go away */
     proj->n_points = 0;
@@ -315,6 +339,42 @@ LIDET_CLONES_AVX2 static void key_block4(key_block_t *kb, const float *pts, uint
                                          float col_scale, float last_col_bucket)
 {
     key_block(kb, pts, m, 4u, min2, max2, tan_lo, tan_hi, row_scale, col_scale, last_col_bucket);
+}
+
+/* run()'s pre-test of one block in the azimuth window (init_window_test): returns 1 when every point fails the
+ * range test (the very expression of key_block) or lies surely outside the window, with the count of those in
+ * range in *n_in; 0 otherwise. A point counts as outside only with |x| + |y| >= 1e-15 m and x^2 + y^2 <= 1e36
+ * m^2, where key_block's pseudo-azimuth is defined and accurate (1 / den normal). One loop of selects and two
+ * reductions, which compilers vectorize */
+static inline uint32_t outside_block(const float *pts, uint32_t m, uint32_t stride, float min2, float max2,
+                                     const float *e, int wide, uint32_t *n_in)
+{
+    uint32_t j, all = 1u, nin = 0u;
+    for (j = 0; j < m; ++j)
+    {
+        const float *pt = pts + (size_t)j * stride;
+        const float x = pt[0], y = pt[1], z = pt[2];
+        const float rxy2 = x * x + y * y;
+        const float r2 = rxy2 + z * z;
+        const float s = fabsf(x) + fabsf(y);
+        const float c1 = e[0] * y - e[1] * x; /* cross(v1, p) */
+        const float c2 = x * e[3] - y * e[2]; /* cross(p, v2) */
+        const uint32_t range_ok = (uint32_t)((r2 >= min2) & (r2 <= max2));
+        const uint32_t out =
+            wide ? (uint32_t)((c1 < 0.0f) & (c2 < 0.0f)) : (uint32_t)((c1 < 0.0f) | (c2 < 0.0f));
+        const uint32_t sure = out & (uint32_t)((s >= 1.0e-15f) & (rxy2 <= 1.0e36f));
+        all &= (range_ok ^ 1u) | sure;
+        nin += range_ok;
+    }
+    *n_in = nin;
+    return all;
+}
+
+/* outside_block of KITTI-style records (stride 4), also built for AVX2 (as key_block4) */
+LIDET_CLONES_AVX2 static uint32_t outside_block4(const float *pts, uint32_t m, float min2, float max2,
+                                                 const float *e, int wide, uint32_t *n_in)
+{
+    return outside_block(pts, m, 4u, min2, max2, e, wide, n_in);
 }
 
 float lidet_proj_azimuth_key(float x, float y)
@@ -560,6 +620,38 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
         {
             const uint32_t m = n - base < KEY_BLOCK ? n - base : KEY_BLOCK;
             uint32_t j, nw = 0;
+            /* an azimuth window: a block wholly outside it (a third to two thirds of a scan, whose points
+             * come in azimuth order, with the camera crop) is counted without its keys */
+            if (proj->win_test != 0u)
+            {
+                uint32_t nin;
+                const int wide = proj->win_test == 2u;
+                const uint32_t all = stride == 4u ? outside_block4(points + (size_t)base * 4u, m, min2, max2,
+                                                                   proj->win_edge, wide, &nin)
+                                                  : outside_block(points + (size_t)base * stride, m, stride,
+                                                                  min2, max2, proj->win_edge, wide, &nin);
+                if (all)
+                {
+                    st.n_out_of_window += nin;
+                    for (j = 0; nin < m && j < m; ++j)
+                    {
+                        /* the block's points out of range, classified as in (b) */
+                        const float *pt = points + (size_t)(base + j) * stride;
+                        const float r2 = (pt[0] * pt[0] + pt[1] * pt[1]) + pt[2] * pt[2];
+                        if (!lidet__isfinite(pt[0]) || !lidet__isfinite(pt[1]) || !lidet__isfinite(pt[2]))
+                            ++st.n_nonfinite;
+                        else if (r2 < min2)
+                            ++st.n_too_close;
+                        else if (!(r2 <= max2))
+                            ++st.n_too_far;
+                    }
+                    if (point_pixel != 0)
+                    {
+                        memset(point_pixel + base, 0xFF, m * sizeof point_pixel[0]);
+                    }
+                    continue;
+                }
+            }
             /* (a); KITTI-style records (stride 4) get their own copy, with a constant stride */
             if (stride == 4u)
                 key_block4(&kb, points + (size_t)base * 4u, m, min2, max2, tan_lo, tan_hi, row_scale,
@@ -589,29 +681,34 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
                         kb.pix[j] = -1;
                         continue;
                     }
-                    if (ring == 0) /* elevation outside the beams (+ margin), x = y = 0 included */
+                    if (!(kb.flags[j] & KEY_DEN_OK))
                     {
-                        ++st.n_out_of_fov;
-                        kb.pix[j] = -1;
-                        continue;
-                    }
-                    if (!(kb.flags[j] & KEY_DEN_OK)) /* ring path, x = y = 0 (or ~1e-19): straight ahead */
-                    {
-                        d = 2.0f;
+                        if (ring == 0) /* no azimuth (x = y = 0, or ~1e-19): no elevation either */
+                        {
+                            ++st.n_out_of_fov;
+                            kb.pix[j] = -1;
+                            continue;
+                        }
+                        d = 2.0f; /* ring path: straight ahead */
                         col_k = (int32_t)(d * col_scale);
                     }
                 }
-                if (ring != 0 && ring[i] >= rows)
-                {
-                    ++st.n_bad_ring;
-                    kb.pix[j] = -1;
-                    continue;
-                }
-                /* the azimuth window, before the row and column searches: column c holds exactly the keys
-                 * col_edge[c] <= d < col_edge[c + 1], so this is the test of the column the search would find */
+                /* the azimuth window, before the elevation and ring tests (as the block pre-test) and the row and
+                 * column searches: column c holds exactly the keys col_edge[c] <= d < col_edge[c + 1], so this is
+                 * the test of the column the search would find */
                 if (!(d >= win_dlo && d < win_dhi))
                 {
                     ++st.n_out_of_window;
+                    kb.pix[j] = -1;
+                    continue;
+                }
+                if (ring == 0 ? !(kb.flags[j] & KEY_FOV_OK) : ring[i] >= rows)
+                {
+                    /* elevation outside the beams (+ margin), or a ring index past the rows */
+                    if (ring == 0)
+                        ++st.n_out_of_fov;
+                    else
+                        ++st.n_bad_ring;
                     kb.pix[j] = -1;
                     continue;
                 }

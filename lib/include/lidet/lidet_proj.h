@@ -62,7 +62,8 @@ typedef struct
     float azimuth_half_rad; /**< 0 (default): the whole scan; in (0, pi): only points whose column lies within
                                  this of straight ahead (+x), one more column each side, are projected, the
                                  others counted in n_out_of_window (the pixels outside stay empty); >= pi: the
-                                 whole scan. The detector's crop sets it (lidet_detector.h) */
+                                 whole scan. The detector's crop sets it (lidet_detector.h). Points outside
+                                 the window are counted there before any elevation or ring test */
 } lidet_proj_cfg_t;
 
 /** @brief Why points were not projected (counts of the last run). */
@@ -77,7 +78,8 @@ typedef struct
     uint32_t n_out_of_fov;    /**< elevation outside the beams (+ margin) */
     uint32_t n_bad_ring;      /**< ring index >= n_rows (ring path only) */
     uint32_t n_truncated;     /**< points past LIDET_MAX_POINTS, not looked at */
-    uint32_t n_out_of_window; /**< column outside the azimuth window (cfg azimuth_half_rad) */
+    uint32_t n_out_of_window; /**< finite, in range, column outside the azimuth window (cfg azimuth_half_rad),
+                                   whatever its elevation or ring (not in n_out_of_fov, n_bad_ring) */
 } lidet_proj_stats_t;
 
 /** @brief Unit of the compact image (a detector workspace's pixels, lidet_workspace.h): 4 mm, so int16
@@ -155,6 +157,9 @@ typedef struct
     uint16_t col_lut[4 * LIDET_MAX_COLS + 1]; /* D bucket (width 1/n_cols) -> column of its low end */
     float col_lut_scale;                      /* n_cols: buckets per unit of D */
     uint32_t win_lo, win_hi; /* the azimuth window's columns [win_lo, win_hi) (0, n_cols: all) */
+    float win_edge[4];       /* run()'s block pre-test: directions (x, y) of the window's two edges, each
+                                turned a margin outwards (lidet_proj.c), low azimuth edge first */
+    uint8_t win_test;        /* 0: no pre-test (no window); 1: window + margins <= pi; 2: wider */
     uint32_t n_points;       /* points of the last run (<= LIDET_MAX_POINTS) */
     lidet_proj_stats_t stats;
 } lidet_proj_state_t;

@@ -20,6 +20,12 @@
  * in and out may not alias. relu: 1 = max(0, .) after the bias. */
 void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t, const float *b,
                          uint32_t n_out, int relu, float *out);
+#if LIDET_NN_FMA
+/* x86-64 hosts with FMA dispatch (internal/lidet_simd.h): lidet__nn_dense_f32 is lib/src/nn/lidet_nn_f32_x86.c's
+ * register-tiled FMA kernel, this the portable one (lidet_nn_f32.c), its fallback on CPUs without FMA */
+void lidet__nn_dense_f32_portable(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t,
+                                  const float *b, uint32_t n_out, int relu, float *out);
+#endif
 
 /* vmax[k] = max(vmax[k], in[r * n + k]) over the rows: the max-pool over points, applied block by block
  * (the caller initialises vmax), so no N x C buffer is needed. */

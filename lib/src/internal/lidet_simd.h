@@ -13,9 +13,24 @@
     defined(__x86_64__)
 #define LIDET_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
 #define LIDET_CLONES_AVX512 __attribute__((target_clones("avx512f", "avx2", "default")))
+/* the one exception to "same results": the float dense kernel's FMA variants (lib/src/nn/lidet_nn_f32_x86.c; CMake
+ * LIDET_NN_FMA, on by default, passes 0 when off) */
+#ifndef LIDET_NN_FMA
+#define LIDET_NN_FMA 1
+#endif
+#elif defined(LIDET_NN_FMA_ONLY) && LIDET_NN_FMA_ONLY && (defined(__GNUC__) || defined(__clang__)) &&        \
+    defined(__x86_64__)
+/* the FMA kernel without the clones (tests/CMakeLists.txt: the -O0 CLI of the determinism test, so that it runs
+ * the arithmetic of the build it is compared with) */
+#define LIDET_CLONES_AVX2
+#define LIDET_CLONES_AVX512
+#undef LIDET_NN_FMA
+#define LIDET_NN_FMA 1
 #else
 #define LIDET_CLONES_AVX2
 #define LIDET_CLONES_AVX512
+#undef LIDET_NN_FMA
+#define LIDET_NN_FMA 0
 #endif
 
 /* 1 on hosts with SIMD (SSE2, AVX2, NEON): the integer kernels keep the loop forms a compiler vectorises (the
