@@ -72,7 +72,8 @@ static void test_every_profile_beam_rows(void)
             int pix = r * img.n_cols + col;
             TEST_ASSERT_EQUAL_INT32_MESSAGE(r, img.point_idx[pix], k_names[k]);
             TEST_ASSERT_CLOSE(5.0 + r, img.range_m[pix], 1e-4, 1e-6);
-            TEST_ASSERT_CLOSE(sqrt((double)img.x_m[pix] * (double)img.x_m[pix] + (double)img.y_m[pix] * (double)img.y_m[pix]),
+            TEST_ASSERT_CLOSE(sqrt((double)img.x_m[pix] * (double)img.x_m[pix] +
+                                   (double)img.y_m[pix] * (double)img.y_m[pix]),
                               img.rxy_m[pix], 1e-5, 1e-6);
         }
         /* rows are sorted top to bottom */
@@ -118,8 +119,12 @@ static void test_wraparound(void)
     lidet_proj_image(&g.ws, &img);
     put(&pts[0], 10.0, M_PI - 1e-4, 0.0);  /* just left of straight behind */
     put(&pts[4], 10.0, -M_PI + 1e-4, 0.0); /* just right of straight behind */
-    pts[8] = -10.0f; pts[9] = 0.0f; pts[10] = 0.0f;  /* exactly +180 */
-    pts[12] = -10.0f; pts[13] = -0.0f; pts[14] = 0.5f; /* -0.0: exactly -180 */
+    pts[8] = -10.0f;
+    pts[9] = 0.0f;
+    pts[10] = 0.0f; /* exactly +180 */
+    pts[12] = -10.0f;
+    pts[13] = -0.0f;
+    pts[14] = 0.5f; /* -0.0: exactly -180 */
     put(&pts[16], 10.0, 0.0, 0.0);
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, pts, 5, 4, NULL));
     pp = lidet_proj_point_pixels(&g.ws, &n);
@@ -258,12 +263,12 @@ static void test_invalid_points_counted(void)
     lidet_range_image_t img;
     const float nan = NAN, inf = INFINITY;
     float bad[9][4] = {
-        {nan, 1.0f, 1.0f, 0.0f}, {1.0f, inf, 1.0f, 0.0f}, {1.0f, 1.0f, -inf, 0.0f}, /* non-finite */
-        {0.0f, 0.0f, 0.0f, 0.0f}, {0.01f, 0.0f, 0.0f, 0.0f},                          /* too close */
-        {1.0f, 0.0f, 1.0f, 0.0f},                                                       /* +45 deg: out of fov */
-        {0.0f, 0.0f, -5.0f, 0.0f},                                                      /* straight down */
-        {3e19f, 3e19f, 0.0f, 0.0f},                                                     /* r^2 overflows */
-        {10.0f, 0.0f, -0.5f, 0.0f},                                                     /* valid */
+        {nan, 1.0f, 1.0f, 0.0f},    {1.0f, inf, 1.0f, 0.0f},   {1.0f, 1.0f, -inf, 0.0f}, /* non-finite */
+        {0.0f, 0.0f, 0.0f, 0.0f},   {0.01f, 0.0f, 0.0f, 0.0f},                           /* too close */
+        {1.0f, 0.0f, 1.0f, 0.0f},   /* +45 deg: out of fov */
+        {0.0f, 0.0f, -5.0f, 0.0f},  /* straight down */
+        {3e19f, 3e19f, 0.0f, 0.0f}, /* r^2 overflows */
+        {10.0f, 0.0f, -0.5f, 0.0f}, /* valid */
     };
     init_sensor("hdl64");
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, &bad[0][0], 9, 4, NULL));
@@ -323,7 +328,7 @@ static void test_argument_and_config_errors(void)
     s.n_cols = 360;
     s.beam_elev_rad = dup;
     lidet_proj_cfg_default(&cfg, &s);
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proj_init(&g.ws, &cfg)); /* duplicate elevations */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proj_init(&g.ws, &cfg));          /* duplicate elevations */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_proj_run(&g.ws, pts, 1, 4, NULL)); /* failed init */
     cfg.sensor.beam_elev_rad = ok3;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_init(&g.ws, &cfg));
@@ -359,7 +364,8 @@ static void test_argument_and_config_errors(void)
 /* a custom table in arbitrary ring order is sorted into rows; rings map accordingly */
 static void test_custom_ring_order(void)
 {
-    float elev[4] = {-0.05f, 0.1f, -0.2f, 0.0f}; /* rows: 0.1 (ring1), 0.0 (ring3), -0.05 (ring0), -0.2 (ring2) */
+    float elev[4] = {-0.05f, 0.1f, -0.2f,
+                     0.0f}; /* rows: 0.1 (ring1), 0.0 (ring3), -0.05 (ring0), -0.2 (ring2) */
     uint16_t ring[4] = {0, 1, 2, 3};
     int expect_row[4] = {2, 0, 3, 1};
     lidet_sensor_t s;
@@ -416,9 +422,9 @@ static void test_blocks_and_strides_agree(void)
 {
     const float nan = NAN, inf = INFINITY;
     const int bad_at[8] = {0, 63, 64, 65, 127, 128, 200, 299};
-    const float bad[8][3] = {{nan, 1.0f, 1.0f},    {1.0f, inf, 1.0f},     {0.0f, 0.0f, 0.0f},
-                             {0.0f, 0.0f, -5.0f},  {1.0f, 0.0f, 1.0f},    {3e19f, 3e19f, 0.0f},
-                             {0.01f, 0.0f, 0.0f},  {0.0f, 0.0f, 4.0f}};
+    const float bad[8][3] = {{nan, 1.0f, 1.0f},   {1.0f, inf, 1.0f},  {0.0f, 0.0f, 0.0f},
+                             {0.0f, 0.0f, -5.0f}, {1.0f, 0.0f, 1.0f}, {3e19f, 3e19f, 0.0f},
+                             {0.01f, 0.0f, 0.0f}, {0.0f, 0.0f, 4.0f}};
     const uint32_t npix = 64u * 2048u;
     lidet_proj_stats_t st4, st;
     lidet_range_image_t img;
@@ -484,6 +490,125 @@ static void test_blocks_and_strides_agree(void)
             TEST_ASSERT_EQUAL_FLOAT(ref_rxy[pp[0]], img.rxy_m[pp[0]]);
         }
     }
+}
+
+/* the window's block pre-test (lidet_proj.c outside_block): a sweep in azimuth order (blocks wholly outside the
+ * window are counted without their keys) and the same points shuffled (no such block) give the same pixels and the
+ * same counts, for a narrow, a half-turn and a wide window, on the elevation and the ring paths, with NaN, too
+ * close, too far, out-of-field and bad-ring points inside and outside the window; a point outside the window counts
+ * there whatever else is wrong with it, except NaN and range */
+#define SW 4096u
+static float sw_pts[SW * 4], sh_pts[SW * 5];
+static uint16_t sw_ring[SW], sh_ring[SW];
+static float sw_range[64 * 2048];
+static int32_t sw_pp[SW], sh_pp[SW];
+
+static void sweep_run(const float *p, uint32_t stride, const uint16_t *ring, lidet_proj_stats_t *st,
+                      int32_t *pp, float *range)
+{
+    lidet_range_image_t img;
+    const int32_t *q;
+    uint32_t n;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_run(&g.ws, p, SW, stride, ring));
+    *st = *lidet_proj_stats(&g.ws);
+    q = lidet_proj_point_pixels(&g.ws, &n);
+    TEST_ASSERT_EQUAL_UINT32(SW, n);
+    memcpy(pp, q, SW * sizeof *pp);
+    lidet_proj_image(&g.ws, &img);
+    memcpy(range, img.range_m, (size_t)img.n_rows * img.n_cols * sizeof *range);
+}
+
+static void test_window_pretest_order_independent(void)
+{
+    static const float halves[3] = {0.7854f, 1.5f, 2.6f}; /* 45 deg (+ margins < pi), ~86 deg (> pi), wide */
+    uint32_t perm[SW], i, k, w, path, seed = 4242u;
+    init_sensor("hdl64");
+    for (i = 0; i < SW; ++i)
+    {
+        /* 16 turns of 256 points, like a ring-ordered scan, each turn starting pi / 32 further (so that blocks
+         * end at many distances from the window's edges); every 37th point broken in one of six ways */
+        const double az =
+            M_PI - 2.0 * M_PI * (double)(i % 256u) / 256.0 - M_PI / 32.0 * (double)(i / 256u) - 0.001;
+        float *p = &sw_pts[4 * i];
+        put(p, 4.0 + 0.01 * (double)i, az, -0.3 + 0.02 * (double)(i / 256u));
+        sw_ring[i] = (uint16_t)(i / 256u);
+        switch (i % 37u == 5u ? (i / 37u) % 6u : 9u)
+        {
+        case 0:
+            p[1] = NAN;
+            break;
+        case 1:
+            p[0] = 0.01f;
+            p[1] = 0.02f;
+            p[2] = 0.0f;
+            break; /* too close */
+        case 2:
+            p[0] *= 1.0e6f;
+            p[1] *= 1.0e6f;
+            p[2] *= 1.0e6f;
+            break; /* too far (max_range set below) */
+        case 3:
+            p[2] = 3.0f * sqrtf(p[0] * p[0] + p[1] * p[1]);
+            break; /* above the field of view */
+        case 4:
+            sw_ring[i] = 200u;
+            break; /* a ring past the rows (ring path) */
+        case 5:
+            p[0] = INFINITY;
+            break;
+        default:
+            break;
+        }
+    }
+    for (i = 0; i < SW; ++i)
+        perm[i] = i;
+    for (i = SW - 1u; i > 0u; --i)
+    {
+        uint32_t j, t;
+        seed = seed * 1664525u + 1013904223u;
+        j = (seed >> 8) % (i + 1u);
+        t = perm[i];
+        perm[i] = perm[j];
+        perm[j] = t;
+    }
+    for (w = 0; w < 3u; ++w)
+    {
+        for (path = 0; path < 2u; ++path)
+        {
+            lidet_proj_stats_t a, b;
+            uint32_t stride = path == 0u ? 4u : 5u, sum;
+            cfg.azimuth_half_rad = halves[w];
+            cfg.max_range_m = 200.0f;
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_init(&g.ws, &cfg));
+            for (i = 0; i < SW; ++i)
+            {
+                for (k = 0; k < stride; ++k)
+                    sh_pts[stride * i + k] = k < 4u ? sw_pts[4 * perm[i] + k] : -1.0f;
+                sh_ring[i] = sw_ring[perm[i]];
+            }
+            sweep_run(sw_pts, 4u, path == 1u ? sw_ring : NULL, &a, sw_pp, sw_range);
+            {
+                lidet_range_image_t img;
+                lidet_proj_image(&g.ws, &img);
+                sweep_run(sh_pts, stride, path == 1u ? sh_ring : NULL, &b, sh_pp, ref_range);
+                for (i = 0; i < (uint32_t)img.n_rows * img.n_cols; ++i)
+                    TEST_ASSERT_EQUAL_FLOAT(sw_range[i], ref_range[i]);
+            }
+            for (i = 0; i < SW; ++i)
+                TEST_ASSERT_EQUAL_INT32(sw_pp[perm[i]], sh_pp[i]);
+            TEST_ASSERT_EQUAL_MEMORY(&a, &b, sizeof a);
+            sum = a.n_projected + a.n_nonfinite + a.n_too_close + a.n_too_far + a.n_out_of_fov +
+                  a.n_bad_ring + a.n_out_of_window;
+            TEST_ASSERT_EQUAL_UINT32(SW, sum);
+            TEST_ASSERT_TRUE(a.n_out_of_window > SW / 16u && a.n_projected > SW / 8u);
+            TEST_ASSERT_TRUE(a.n_nonfinite >= 30u && a.n_too_close >= 10u && a.n_too_far >= 10u);
+            /* the broken points inside the window are counted as what is wrong with them */
+            TEST_ASSERT_TRUE(path == 0u ? a.n_out_of_fov > 0u && a.n_bad_ring == 0u
+                                        : a.n_bad_ring > 0u && a.n_out_of_fov == 0u);
+        }
+    }
+    cfg.azimuth_half_rad = 0.0f;
+    cfg.max_range_m = 0.0f;
 }
 
 /* the azimuth window (cfg azimuth_half_rad): the points of its columns land where they land without it, the
@@ -614,6 +739,7 @@ int main(void)
     RUN_TEST(test_custom_ring_order);
     RUN_TEST(test_blocks_and_strides_agree);
     RUN_TEST(test_azimuth_window);
+    RUN_TEST(test_window_pretest_order_independent);
     RUN_TEST(test_ring_path_vertical_point);
     return UNITY_END();
 }

@@ -25,6 +25,11 @@ void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const 
  * register-tiled FMA kernel, this the portable one (lidet_nn_f32.c), its fallback on CPUs without FMA */
 void lidet__nn_dense_f32_portable(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t,
                                   const float *b, uint32_t n_out, int relu, float *out);
+/* its two variants, for the tests (call only on a CPU with AVX-512F, resp. AVX2 and FMA) */
+void lidet__nn_dense_f32_avx512(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t,
+                                const float *b, uint32_t n_out, int relu, float *out);
+void lidet__nn_dense_f32_avx2fma(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t,
+                                 const float *b, uint32_t n_out, int relu, float *out);
 #endif
 
 /* vmax[k] = max(vmax[k], in[r * n + k]) over the rows: the max-pool over points, applied block by block

@@ -141,8 +141,8 @@ static T512 void row_512(const float *x, uint32_t n_in, const float *w_t, const 
     }
 }
 
-static T512 void dense_512(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t, const float *b,
-                           uint32_t n_out, int relu, float *out)
+T512 void lidet__nn_dense_f32_avx512(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t,
+                                     const float *b, uint32_t n_out, int relu, float *out)
 {
     uint32_t r = 0;
     for (; r + 8u <= n_rows; r += 8u)
@@ -274,8 +274,8 @@ static T256 void row_256(const float *x, uint32_t n_in, const float *w_t, const 
     }
 }
 
-static T256 void dense_256(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t, const float *b,
-                           uint32_t n_out, int relu, float *out)
+T256 void lidet__nn_dense_f32_avx2fma(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t,
+                                      const float *b, uint32_t n_out, int relu, float *out)
 {
     uint32_t r = 0;
     for (; r + 4u <= n_rows; r += 4u)
@@ -300,11 +300,11 @@ __attribute__((used, no_sanitize_address)) static dense_fn_t *resolve_dense(void
     __builtin_cpu_init();
     if (__builtin_cpu_supports("avx512f"))
     {
-        return dense_512;
+        return lidet__nn_dense_f32_avx512;
     }
     if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
     {
-        return dense_256;
+        return lidet__nn_dense_f32_avx2fma;
     }
     return lidet__nn_dense_f32_portable;
 }

@@ -1,0 +1,204 @@
+/* SPDX-License-Identifier: MIT */
+/* The float dense kernel lidet__nn_dense_f32 as this build links it: the portable kernel (lib/src/nn/lidet_nn_f32.c),
+ * or on x86-64 hosts with FMA the register-tiled one (lidet_nn_f32_x86.c, 8 x 32 / 4 x 16 tiles and their tails).
+ * On every shape (rows, inputs and outputs around the tile and vector widths) the result is within float rounding of
+ * a double loop, and bit for bit one of the two stated arithmetics, the same one for every shape:
+ *   portable: o = b, then o += x[i] w[i] + x[i+1] w[i+1] + x[i+2] w[i+2] + x[i+3] w[i+3] per four inputs (left to
+ *             right), then o += x[i] w[i] for the rest;
+ *   fused:    o = b, then o = fmaf(x[i], w[i], o) for every input in order.
+ * ReLU maps NaN and -0 to +0 in both. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "internal/lidet_nn.h"
+#include "test_util.h"
+
+#define MAX_R 17
+#define MAX_I 70
+#define MAX_O 133
+
+static uint32_t g_rng = 987654321u;
+
+static float next_f(void)
+{
+    g_rng ^= g_rng << 13;
+    g_rng ^= g_rng >> 17;
+    g_rng ^= g_rng << 5;
+    return (float)(int32_t)(g_rng % 20001u - 10000) / 4096.0f; /* [-2.44, 2.44], many bits */
+}
+
+void setUp(void)
+{
+}
+
+void tearDown(void)
+{
+}
+
+static float portable_one(const float *x, uint32_t n_in, const float *w_t, uint32_t n_out, uint32_t o,
+                          float b)
+{
+    float s = b;
+    uint32_t i = 0;
+    for (; i + 4u <= n_in; i += 4u)
+    {
+        s += x[i] * w_t[i * n_out + o] + x[i + 1u] * w_t[(i + 1u) * n_out + o] +
+             x[i + 2u] * w_t[(i + 2u) * n_out + o] + x[i + 3u] * w_t[(i + 3u) * n_out + o];
+    }
+    for (; i < n_in; ++i)
+    {
+        s += x[i] * w_t[i * n_out + o];
+    }
+    return s;
+}
+
+static float fused_one(const float *x, uint32_t n_in, const float *w_t, uint32_t n_out, uint32_t o, float b)
+{
+    float s = b;
+    uint32_t i;
+    for (i = 0; i < n_in; ++i)
+    {
+        s = fmaf(x[i], w_t[i * n_out + o], s);
+    }
+    return s;
+}
+
+static float relu_of(float v, int relu)
+{
+    return relu && !(v > 0.0f) ? 0.0f : v;
+}
+
+static int g_kind = -1; /* 0 portable, 1 fused: fixed by the first shape whose two arithmetics differ */
+static uint32_t g_shapes, g_decisive;
+
+typedef void dense_fn_t(const float *, uint32_t, uint32_t, const float *, const float *, uint32_t, int,
+                        float *);
+
+/* fn on one shape; want: -1 either arithmetic (the same for every shape), else 0 portable / 1 fused */
+static void check_shape(dense_fn_t *fn, int want, uint32_t rows, uint32_t n_in, uint32_t n_out, int relu)
+{
+    static float in[MAX_R * MAX_I], w[MAX_I * MAX_O], b[MAX_O], out[MAX_R * MAX_O + 1];
+    uint32_t r, i, o, k, same_p = 1, same_f = 1, differ = 0;
+    for (k = 0; k < rows * n_in; ++k)
+        in[k] = next_f();
+    for (k = 0; k < n_in * n_out; ++k)
+        w[k] = next_f();
+    for (k = 0; k < n_out; ++k)
+        b[k] = next_f();
+    out[rows * n_out] = 12345.0f; /* a guard: nothing is written past the rows */
+    fn(in, rows, n_in, w, b, n_out, relu, out);
+    TEST_ASSERT_EQUAL_FLOAT(12345.0f, out[rows * n_out]);
+    for (r = 0; r < rows; ++r)
+    {
+        for (o = 0; o < n_out; ++o)
+        {
+            const float *x = in + r * n_in;
+            const float got = out[r * n_out + o];
+            const float p = relu_of(portable_one(x, n_in, w, n_out, o, b[o]), relu);
+            const float f = relu_of(fused_one(x, n_in, w, n_out, o, b[o]), relu);
+            double s = b[o], mag = fabs((double)b[o]);
+            for (i = 0; i < n_in; ++i)
+            {
+                s += (double)x[i] * (double)w[i * n_out + o];
+                mag += fabs((double)x[i] * (double)w[i * n_out + o]);
+            }
+            s = relu && s < 0.0 ? 0.0 : s;
+            /* float rounding: n_in + 1 roundings of at most half an ulp of the running magnitude each */
+            TEST_ASSERT_TRUE_MESSAGE(fabs((double)got - s) <= 1.2e-7 * (double)(n_in + 2u) * mag + 1e-30,
+                                     "far from the double loop");
+            same_p &= memcmp(&got, &p, sizeof got) == 0;
+            same_f &= memcmp(&got, &f, sizeof got) == 0;
+            differ |= memcmp(&p, &f, sizeof p) != 0;
+        }
+    }
+    ++g_shapes;
+    TEST_ASSERT_TRUE_MESSAGE(same_p || same_f, "neither the portable nor the fused arithmetic, bit for bit");
+    if (differ)
+    {
+        const int kind = same_f ? 1 : 0;
+        ++g_decisive;
+        if (want >= 0)
+        {
+            TEST_ASSERT_EQUAL_INT_MESSAGE(want, kind, "not the stated arithmetic");
+            return;
+        }
+        if (g_kind < 0)
+            g_kind = kind;
+        TEST_ASSERT_EQUAL_INT_MESSAGE(g_kind, kind, "the kernel switched arithmetic between shapes");
+    }
+}
+
+static const uint32_t k_rows[] = {1, 2, 3, 4, 5, 7, 8, 9, 12, 13, 16, 17};
+static const uint32_t k_ins[] = {1, 3, 4, 5, 8, 17, 32, 64, 70};
+static const uint32_t k_outs[] = {1, 3, 7, 8, 9, 15, 16, 17, 24, 31, 32, 33, 48, 63, 64, 65, 96, 128, 133};
+
+static void every_shape(dense_fn_t *fn, int want)
+{
+    uint32_t a, c, d;
+    g_shapes = g_decisive = 0;
+    for (a = 0; a < sizeof k_rows / sizeof k_rows[0]; ++a)
+        for (c = 0; c < sizeof k_ins / sizeof k_ins[0]; ++c)
+            for (d = 0; d < sizeof k_outs / sizeof k_outs[0]; ++d)
+                check_shape(fn, want, k_rows[a], k_ins[c], k_outs[d], (int)((a + c + d) & 1u));
+    TEST_ASSERT_EQUAL_UINT32(12u * 9u * 19u, g_shapes);
+    TEST_ASSERT_TRUE(g_decisive > 100u); /* the two arithmetics told apart on many shapes */
+}
+
+void test_every_shape_one_arithmetic(void)
+{
+    every_shape(lidet__nn_dense_f32, -1);
+    printf("this build's float dense kernel: %s (%u of %u shapes tell the two apart)\n",
+           g_kind == 1 ? "fused (FMA)" : "portable", (unsigned)g_decisive, (unsigned)g_shapes);
+}
+
+/* each variant of the FMA kernel this CPU can run, and the portable one, called directly */
+void test_each_variant(void)
+{
+#if LIDET_NN_FMA
+    every_shape(lidet__nn_dense_f32_portable, 0);
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+        every_shape(lidet__nn_dense_f32_avx2fma, 1);
+    else
+        printf("no AVX2 + FMA here: that variant not run\n");
+    if (__builtin_cpu_supports("avx512f"))
+        every_shape(lidet__nn_dense_f32_avx512, 1);
+    else
+        printf("no AVX-512 here: that variant not run\n");
+#else
+    TEST_IGNORE_MESSAGE("no FMA kernels in this build (LIDET_NN_FMA off, or not an x86-64 GCC/clang host)");
+#endif
+}
+
+void test_relu_of_nan_and_negative_zero(void)
+{
+    /* 3 outputs x 8 rows: NaN input, a sum of exactly -0, a positive sum */
+    float in[8 * 2], w[2 * 3] = {1.0f, -1.0f, 1.0f, 1.0f, 0.0f, 1.0f}, b[3] = {0.0f, -0.0f, 0.5f}, out[8 * 3];
+    uint32_t r;
+    for (r = 0; r < 8u; ++r)
+    {
+        in[2u * r] = r == 3u ? NAN : 0.0f;
+        in[2u * r + 1u] = -0.0f;
+    }
+    lidet__nn_dense_f32(in, 8u, 2u, w, b, 3u, 1, out);
+    for (r = 0; r < 8u; ++r)
+    {
+        TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)signbit(out[3u * r])); /* +0, also from NaN (row 3) */
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, out[3u * r]);
+        TEST_ASSERT_EQUAL_UINT32(0u, (uint32_t)signbit(out[3u * r + 1u])); /* -0 -> +0 */
+        if (r != 3u)
+            TEST_ASSERT_EQUAL_FLOAT(0.5f, out[3u * r + 2u]);
+    }
+    lidet__nn_dense_f32(in, 1u, 2u, w, b, 3u, 0, out); /* no ReLU: the sums themselves */
+    TEST_ASSERT_EQUAL_FLOAT(0.0f, out[0]);
+    TEST_ASSERT_EQUAL_FLOAT(0.5f, out[2]);
+}
+
+int main(void)
+{
+    UNITY_BEGIN();
+    RUN_TEST(test_every_shape_one_arithmetic);
+    RUN_TEST(test_each_variant);
+    RUN_TEST(test_relu_of_nan_and_negative_zero);
+    return UNITY_END();
+}
