@@ -117,7 +117,8 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
         !lidet__isfinite(cfg->person_min_aspect) || cfg->person_min_aspect < 0.0f || cfg->join_cars > 1u ||
         cfg->person_min_points < 1u || cfg->person_min_points > 1000000u ||
         !lidet__isfinite(cfg->azimuth_half_rad) || cfg->azimuth_half_rad < 0.0f ||
-        cfg->azimuth_half_rad > LIDET_PI_F + 1e-6f || !lidet__isfinite(cfg->join_gap_m) ||
+        cfg->azimuth_half_rad > LIDET_PI_F + 1e-6f || !(cfg->seed_half_rad >= 0.0f) ||
+        !(cfg->seed_half_rad <= LIDET_PI_F + 1e-6f) || !lidet__isfinite(cfg->join_gap_m) ||
         cfg->join_gap_m < 0.0f || !lidet__isfinite(cfg->car_max_length_m) ||
         !(cfg->car_max_length_m > 0.0f) || !lidet__isfinite(cfg->car_max_width_m) ||
         !(cfg->car_max_width_m > 0.0f) || !lidet__isfinite(cfg->car_max_height_m) ||
@@ -365,6 +366,10 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
             }
         }
         n_cand -= window_out(&c->cfg, img->n_rows, img->n_cols, lab, &sp.lo, &sp.hi);
+        /* the seed columns (cfg seed_half_rad), within the window */
+        lidet__azimuth_window_cols(c->cfg.seed_half_rad, cols, &sp.seed_lo, &sp.seed_hi);
+        sp.seed_lo = sp.seed_lo > sp.lo ? sp.seed_lo : sp.lo;
+        sp.seed_hi = sp.seed_hi < sp.hi ? sp.seed_hi : sp.hi;
         st.n_candidates = n_cand;
         if (c->cfg.max_bridge_per_pixel > 0.0f)
         {

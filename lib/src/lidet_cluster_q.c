@@ -293,6 +293,8 @@ lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t 
     sp.cols = img->n_cols;
     sp.lo = 0u;
     sp.hi = img->n_cols;
+    sp.seed_lo = 0u;
+    sp.seed_hi = img->n_cols;
     run_fills(c, &lk, &sp, planes, n_sectors, &st);
     run_refine(c, &sp, planes, n_sectors, &st); /* lidet_cluster_q_refine.c */
     c->stats = st;

@@ -126,7 +126,8 @@ lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg
     }
     {
         /* the crop: the clustering takes candidates in the crop's columns and a margin only (an object whose
-         * mean lies inside the crop stays whole up to LIDET_DET_CROP_MARGIN_RAD beyond it), and the projection
+         * mean lies inside the crop stays whole up to LIDET_DET_CROP_MARGIN_RAD beyond it), seeded in the crop's
+         * columns only, and the projection
          * keeps the points of that window and one ground sector more on each side (the ground stage's sectors
          * under the clustering's window keep all their samples; the sectors beyond hold none and take a
          * neighbour's plane). The ground's RANSAC draws a stream per cell (seed_per_cell), so those sectors get
@@ -142,6 +143,13 @@ lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg
                 w = cfg->crop_half_rad + LIDET_DET_CROP_MARGIN_RAD;
                 w = w < LIDET_PI_F ? w : LIDET_PI_F;
                 ws_cfg.cluster.azimuth_half_rad = w;
+                if (ws_cfg.cluster.seed_half_rad == 0.0f)
+                {
+                    /* components start in the crop only: the margin's pixels are visited when they join an object
+                     * that reaches into the crop (a component wholly in the margin has its mean outside the crop,
+                     * so it was never a candidate) */
+                    ws_cfg.cluster.seed_half_rad = cfg->crop_half_rad;
+                }
             }
             if (ws_cfg.proj.azimuth_half_rad == 0.0f && w < LIDET_PI_F && ws_cfg.ground.n_sectors > 0u)
             {

@@ -106,6 +106,7 @@ static const py_field_t k_fields[] = {
     FLD(lidet_cluster_cfg_t, car_max_length_m, 'f'), FLD(lidet_cluster_cfg_t, car_max_width_m, 'f'),
     FLD(lidet_cluster_cfg_t, car_max_height_m, 'f'), FLD(lidet_cluster_cfg_t, car_min_length_m, 'f'),
     FLD(lidet_cluster_cfg_t, upright_max_width_m, 'f'), FLD(lidet_cluster_cfg_t, azimuth_half_rad, 'f'),
+    FLD(lidet_cluster_cfg_t, seed_half_rad, 'f'),
     FLD(lidet_cluster_cfg_t, max_join_pieces, 'u'),
     FLD(lidet_cluster_cfg_t, max_bridge_per_pixel, 'f'), FLD(lidet_cluster_cfg_t, max_fragment_pixels, 'u'),
     FLD(lidet_cluster_cfg_t, regrow_gap_m, 'f'), FLD(lidet_cluster_cfg_t, regrow_gap_per_m, 'f'),

@@ -163,6 +163,42 @@ def test_azimuth_window_matches_reference(root, sensor, half):
             assert len(ids) == 1 and ids[0] > 0 and (win.pixel_labels == ids[0]).sum() == m.sum()
 
 
+@pytest.mark.parametrize("sensor,half,seed", [("vlp16", 1.0, 0.6), ("hdl64", 1.3090, 0.7)])
+def test_seed_window_matches_reference(root, sensor, half, seed):
+    """seed_half_rad (the detector's crop: seeds in the crop, growth over the crop + 15 deg) in C and in the
+    reference; no component lies wholly outside the seed columns, some reach past them, and the components with a
+    pixel well inside the seed columns are those of the window alone."""
+    d = root / "tests" / "data" / f"sim_{sensor}"
+    pts = np.fromfile(d / "velodyne" / "000000.bin", np.float32).reshape(-1, 4)
+    lab = np.fromfile(d / "labels" / "000000.label", np.uint32)
+    ground = np.isin(lab & 0xFFFF, GROUND)
+    defaults = {k: v for k, v in native.cluster_defaults(sensor).items() if k != "mount_height_m"}
+    sw = _check_against_ref(pts, ground, dict(defaults, azimuth_half_rad=half, seed_half_rad=seed), sensor,
+                            exact=True)
+    win = native.cluster(pts, sensor, ground=ground, with_image=True, **dict(defaults, azimuth_half_rad=half))
+    assert sw.stats["n_candidates"] == win.stats["n_candidates"]
+    cols = sw.pixel_labels.shape[1]
+    az = np.pi * (1.0 - 2.0 * (np.arange(cols) + 0.5) / cols)  # column centres
+    past = 0
+    for k in range(1, int(sw.pixel_labels.max()) + 1):
+        c = np.nonzero(sw.pixel_labels == k)[1]
+        assert (np.abs(az[c]) <= seed + 4 * np.pi / cols).any()  # every cluster starts in the seed columns
+        past += bool((np.abs(az[c]) > seed + 4 * np.pi / cols).any())
+    assert past > 0  # and some grow past them
+    # fewer clusters than the window alone (those wholly in its margin are not formed); a cluster of the window
+    # alone that lies well inside the seed columns is there, the same pixels
+    assert 0 < sw.pixel_labels.max() < win.pixel_labels.max()
+    inner = np.abs(az) < seed - np.radians(15)
+    same = 0
+    for k in range(1, int(win.pixel_labels.max()) + 1):
+        m = win.pixel_labels == k
+        if inner[np.nonzero(m)[1]].all():
+            ids = np.unique(sw.pixel_labels[m])
+            same += len(ids) == 1 and ids[0] > 0 and (sw.pixel_labels == ids[0]).sum() == m.sum()
+            assert len(ids) == 1 and ids[0] > 0, "a cluster in the seed columns lost"
+    assert same > 0
+
+
 def _check_against_ref(pts, ground, cfg, sensor="hdl64", exact=False):
     c = native.cluster(pts, sensor, ground=ground, with_image=True, **cfg)
     img = c.image

@@ -84,7 +84,7 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                 max_fragment_pixels: int = 0, max_bridge_per_pixel: float = 0.0, split_people: bool = False,
                 join_cars: bool = False, azimuth_half_rad: float = 0.0, regrow_gap_m: float = 0.0,
                 regrow_gap_per_m: float = 0.0, regrow_max_pixels: int = 0, regrow_max_height_m: float = 1e30,
-                plane_split_m: float = 0.0, **refine):
+                plane_split_m: float = 0.0, seed_half_rad: float = 0.0, **refine):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
     member-pixel arrays per kept cluster in raster order). Float32 tangent and distance tests like the
@@ -97,21 +97,30 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
     past max_extent_m (at most regrow_max_pixels pixels, 0: any; z span at most regrow_max_height_m) is grown again
     from its own pixels, in its fill order, with the gap bound regrow_gap_m + regrow_gap_per_m * d2, and each part is
     filtered as a component of its own (lidet_cluster_run_body.h regrow). plane_split_m: no planes here (flat
-    ground), so it changes nothing."""
+    ground), so it changes nothing. seed_half_rad in (0, pi): components start only at pixels of the columns within
+    it (the window's column rule), in raster order, and still grow over every candidate; a component's seed (its
+    canonical order) is then its first pixel in those columns."""
     rows, cols = range_m.shape
     rng = np.asarray(range_m, np.float32).ravel()
     cand = np.asarray(candidate, bool).ravel()
-    w = np.float32(azimuth_half_rad)
-    if np.float32(0.0) < w < np.float32(np.pi):
-        # the azimuth window (lidet_cluster.c window_out): the columns within w of straight ahead, one more each side
+    def window_cols(w):
+        # the columns within w of straight ahead, one more each side (lidet_math.h lidet__azimuth_window_cols)
+        w = np.float32(w)
+        if not np.float32(0.0) < w < np.float32(np.pi):
+            return 0, cols
         half = np.float32(np.float32(w * np.float32(cols)) / np.float32(2.0 * np.float32(np.pi)))
         lo = np.float32(np.float32(np.float32(0.5) * np.float32(cols)) - half) - np.float32(1.0)
         hi = np.float32(np.float32(np.float32(0.5) * np.float32(cols)) + half) + np.float32(1.0)
-        c_lo = int(lo) if lo > 0 else 0
-        c_hi = int(hi) + 1 if hi < cols else cols
+        return (int(lo) if lo > 0 else 0), (int(hi) + 1 if hi < cols else cols)
+
+    c_lo, c_hi = window_cols(azimuth_half_rad)
+    if (c_lo, c_hi) != (0, cols):
+        # the azimuth window (lidet_cluster.c window_out)
         keep = np.zeros(cols, bool)
         keep[c_lo:c_hi] = True
         cand = cand & np.tile(keep, rows)
+    s_lo, s_hi = window_cols(seed_half_rad)
+    s_lo, s_hi = max(s_lo, c_lo), min(s_hi, c_hi)  # the seed columns, within the window
     P = np.asarray(xyz, np.float64).reshape(-1, 3)
     tan_t = np.float32(np.tan(np.float32(theta_rad)))
     elev = np.asarray(row_elev_rad, np.float32)
@@ -304,7 +313,7 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
         kept.append([len(m), int(m[0]), m])
 
     for seed in range(rows * cols):
-        if state[seed] != 0:
+        if state[seed] != 0 or not s_lo <= seed % cols < s_hi:
             continue
         component(fill(seed), True)
     if len(kept) > max_clusters:  # smallest dropped first, ties: the later seed

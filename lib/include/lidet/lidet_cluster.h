@@ -233,6 +233,16 @@ typedef struct
                                        side) are candidates (the others are not counted in n_candidates). The
                                        detector's crop sets it to the crop + 15 deg, so a cropped scan is
                                        clustered on that part only; pi: no limit */
+    float seed_half_rad;        /**< 0 (default): a component may start anywhere; in (0, pi): components start
+                                       (are seeded, in raster order) only at pixels whose column lies within
+                                       this azimuth of straight ahead (one column more on each side), and
+                                       still grow over every candidate; a component no such seed reaches is
+                                       not formed, and a component's seed pixel (the canonical order, the
+                                       height's sector) is its first pixel in those columns. The detector's
+                                       crop sets it to the crop, with azimuth_half_rad the crop + 15 deg: the
+                                       margin's pixels are visited only when they join an object that reaches
+                                       into the crop (issue 14: clustering 1.08 -> 0.86 ms on real KITTI crops,
+                                       docs/BENCHMARKS.md) */
     uint32_t max_join_pieces;   /**< join budget (bounds the joins' time whatever the scan): only the first
                                   max_join_pieces car pieces in slot order take part in the joins, the rest
                                   join nothing (stats n_join_skipped); the joins then test at most

@@ -134,10 +134,13 @@ static inline void place_kept(RUN_STATE_T *c, uint16_t *lab, uint32_t i)
 typedef struct
 {
     uint32_t rows, cols, lo, hi;
+    uint32_t seed_lo, seed_hi; /* the columns [seed_lo, seed_hi) where components may start (float stage's cfg
+                                  seed_half_rad; lo, hi without one) */
 } run_span_t;
 
-/* canonicalise's last pass over pixels [b, e): every pixel not in a kept cluster (non-candidate, dropped;
- * none is still free) -> 0, kept pixels slot + 1 -> id, appended to their cluster's members */
+/* canonicalise's last pass over pixels [b, e): every pixel not in a kept cluster (non-candidate, dropped, or
+ * still free: no seed of a seed window reached it) -> 0, kept pixels slot + 1 -> id, appended to their cluster's
+ * members */
 static void relabel_pixels(RUN_STATE_T *c, uint16_t *lab, uint32_t b, uint32_t e)
 {
     uint32_t i;
@@ -578,14 +581,22 @@ static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, const run_span_t *s
     const uint32_t npix = sp->rows * sp->cols;
     uint16_t *lab = c->labels;
     lidet_member_t *mem = c->members;
-    uint32_t p, tail = 0;
-    for (p = next_free(lab, 0, npix); p < npix; p = next_free(lab, p + 1u, npix))
+    uint32_t p, r, tail = 0;
+    /* seeds in raster order over the seed columns (all the window's without a seed window: one span per row,
+     * or the whole image at once) */
+    const int rowwise = sp->seed_lo > sp->lo || sp->seed_hi < sp->hi;
+    for (r = 0; r < (rowwise ? sp->rows : 1u); ++r)
     {
-        const uint32_t start = tail;
-        lab[p] = (uint16_t)LAB_PENDING;
-        mem[tail++] = (int32_t)p;
-        tail = RUN_GROW(c, lk, start, tail);
-        tail = finish_cluster(c, start, tail, planes, n_sectors, st, 0, tight, npix);
+        const uint32_t b = rowwise ? r * sp->cols + sp->seed_lo : 0u,
+                       e = rowwise ? r * sp->cols + sp->seed_hi : npix;
+        for (p = next_free(lab, b, e); p < e; p = next_free(lab, p + 1u, e))
+        {
+            const uint32_t start = tail;
+            lab[p] = (uint16_t)LAB_PENDING;
+            mem[tail++] = (int32_t)p;
+            tail = RUN_GROW(c, lk, start, tail);
+            tail = finish_cluster(c, start, tail, planes, n_sectors, st, 0, tight, npix);
+        }
     }
     if (st->n_fragments > 0u)
     {
