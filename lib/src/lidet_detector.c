@@ -155,6 +155,11 @@ lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg
             {
                 const float p = w + 2.0f * LIDET_PI_F / (float)ws_cfg.ground.n_sectors;
                 ws_cfg.proj.azimuth_half_rad = p < LIDET_PI_F ? p : 0.0f;
+                if (ws_cfg.ground.azimuth_half_rad == 0.0f)
+                {
+                    /* the ground stage then works on the sectors of the projection's window only */
+                    ws_cfg.ground.azimuth_half_rad = ws_cfg.proj.azimuth_half_rad;
+                }
             }
         }
         st = lidet_workspace_init(&d->ws, &ws_cfg);

@@ -93,7 +93,7 @@ lidet_status_t lidet_ground_state_init(lidet_ground_state_t *g, const lidet_grou
         cfg->sample_col_step < 1u || cfg->sample_col_step > 16u || cfg->min_samples < 3u ||
         cfg->min_inliers < 3u || cfg->refine_iters > 10u || cfg->fx_on_z > 1u ||
         cfg->require_descending > 1u || cfg->height_gate > 1u || cfg->fallback_sectors > cfg->n_sectors ||
-        cfg->seed_per_cell > 1u)
+        cfg->seed_per_cell > 1u || !in_range(cfg->azimuth_half_rad, 0.0f, LIDET_PI_F + 1e-6f))
     {
         return LIDET_ERR_CONFIG;
     }
@@ -160,12 +160,22 @@ static inline uint8_t sample_test(const float *R0, const float *R1, const float 
     return (uint8_t)(opt ? tests & (dr > f->dr_min) & (Z0[c] >= f->z_lo) & (Z0[c] <= f->z_hi) : tests);
 }
 
-/* one row of the sample mask; columns wrap around: the first and the last two columns take their
- * neighbours modulo cols */
+/* one row of the sample mask over columns [c_lo, c_hi); the whole row (c_lo 0, c_hi cols) wraps around: the
+ * first and the last two columns take their neighbours modulo cols; a window's span lies two columns clear of
+ * the edges (gspan_t), so its neighbours never wrap */
 static inline void filter_row(const float *R0, const float *R1, const float *Z0, const float *Z1,
-                              const float *F0, uint32_t cols, const filt_t *f, uint8_t *out, int opt)
+                              const float *F0, uint32_t cols, uint32_t c_lo, uint32_t c_hi, const filt_t *f,
+                              uint8_t *out, int opt)
 {
     uint32_t c;
+    if (c_lo > 0u)
+    {
+        for (c = c_lo; c < c_hi; ++c)
+        {
+            out[c] = sample_test(R0, R1, Z0, Z1, F0, c - 1u, c, c + 1u, c + 2u, f, opt);
+        }
+        return;
+    }
     out[0] = sample_test(R0, R1, Z0, Z1, F0, cols - 1u, 0u, 1u, 2u, f, opt);
     for (c = 1; c + 2u < cols; ++c)
     {
@@ -245,11 +255,44 @@ typedef struct
     float *slot[2], *zslot[2], *xrow, *yrow;
     int32_t row_in[2], zrow_in[2], xyrow_in; /* row held by each slot, -1 = none */
     uint32_t cols;
+    uint32_t d0, dn; /* the columns decoded: [d0, d0 + dn) (the whole row without a window) */
     int compact;
 } rxy_rows_t;
 
-static void rxy_rows_init(rxy_rows_t *rr, lidet_ground_scratch_t *sc, const lidet_range_image_t *img)
+/* the part of the image a run works on (cfg azimuth_half_rad): sectors [s_lo, s_hi), their columns [c_lo, c_hi);
+ * the whole image without a window, or when the window's sectors come within two columns of the image's edges
+ * (so the filter's neighbours never wrap). Columns outside hold no point (the window's contract). */
+typedef struct
 {
+    uint32_t s_lo, s_hi, c_lo, c_hi;
+    int whole;
+} gspan_t;
+
+static void span_of(const lidet_ground_cfg_t *cfg, uint32_t cols, gspan_t *sp)
+{
+    const uint32_t ns = cfg->n_sectors;
+    uint32_t w_lo, w_hi;
+    lidet__azimuth_window_cols(cfg->azimuth_half_rad, cols, &w_lo, &w_hi);
+    sp->s_lo = (uint32_t)(((uint64_t)w_lo * ns) / cols); /* the sector holding column w_lo */
+    sp->s_hi = (uint32_t)(((uint64_t)(w_hi - 1u) * ns) / cols) + 1u;
+    sp->c_lo = lidet__ground_sector_col(sp->s_lo, ns, cols);
+    sp->c_hi = lidet__ground_sector_col(sp->s_hi, ns, cols);
+    sp->whole = w_lo == 0u || w_hi >= cols || sp->c_lo < 2u || sp->c_hi + 2u > cols;
+    if (sp->whole)
+    {
+        sp->s_lo = 0u;
+        sp->s_hi = ns;
+        sp->c_lo = 0u;
+        sp->c_hi = cols;
+    }
+}
+
+static void rxy_rows_init(rxy_rows_t *rr, lidet_ground_scratch_t *sc, const lidet_range_image_t *img,
+                          const gspan_t *sp)
+{
+    /* a window: its columns and the filter's neighbours (one left, two right), which hold no point */
+    rr->d0 = sp->whole ? 0u : sp->c_lo - 1u;
+    rr->dn = sp->whole ? img->n_cols : sp->c_hi + 2u - rr->d0;
     rr->img = img;
     rr->compact = lidet__img_compact(img);
     /* a float image's R, or a compact image's (the same expression on its decoded values) */
@@ -276,14 +319,14 @@ static const float *rxy_row(rxy_rows_t *rr, uint32_t r)
     }
     if (rr->row_in[k] != (int32_t)r)
     {
-        const size_t base = (size_t)r * cols;
+        const size_t base = (size_t)r * cols + rr->d0;
         if (!rr->compact)
         {
-            rxy_of(rr->img->x_m + base, rr->img->y_m + base, cols, out);
+            rxy_of(rr->img->x_m + base, rr->img->y_m + base, rr->dn, out + rr->d0);
         }
         else
         {
-            lidet__rxy_4mm(rr->img->x_4mm + base, rr->img->y_4mm + base, cols, out);
+            lidet__rxy_4mm(rr->img->x_4mm + base, rr->img->y_4mm + base, rr->dn, out + rr->d0);
         }
         rr->row_in[k] = (int32_t)r;
     }
@@ -301,7 +344,7 @@ static const float *z_row(rxy_rows_t *rr, uint32_t r)
     }
     if (rr->zrow_in[k] != (int32_t)r)
     {
-        decode_z(rr->img->z_4mm + base, cols, rr->zslot[k]);
+        decode_z(rr->img->z_4mm + base + rr->d0, rr->dn, rr->zslot[k] + rr->d0);
         rr->zrow_in[k] = (int32_t)r;
     }
     return rr->zslot[k];
@@ -323,15 +366,17 @@ static void xy_row(rxy_rows_t *rr, uint32_t r, const float **X, const float **Y)
     if (rr->xyrow_in != (int32_t)r)
     {
         const lidet_range_image_t *img = rr->img;
+        const size_t b = base + rr->d0;
+        const uint32_t d0 = rr->d0;
         if (rr->img_rxy != 0)
         {
-            decode_xyz(img->x_4mm + base, img->y_4mm + base, img->z_4mm + base, cols, rr->xrow, rr->yrow,
-                       rr->zslot[k]);
+            decode_xyz(img->x_4mm + b, img->y_4mm + b, img->z_4mm + b, rr->dn, rr->xrow + d0, rr->yrow + d0,
+                       rr->zslot[k] + d0);
         }
         else
         {
-            decode_xyzr(img->x_4mm + base, img->y_4mm + base, img->z_4mm + base, cols, rr->xrow, rr->yrow,
-                        rr->zslot[k], rr->slot[k]);
+            decode_xyzr(img->x_4mm + b, img->y_4mm + b, img->z_4mm + b, rr->dn, rr->xrow + d0, rr->yrow + d0,
+                        rr->zslot[k] + d0, rr->slot[k] + d0);
             rr->row_in[k] = (int32_t)r;
         }
         rr->xyrow_in = (int32_t)r;
@@ -347,10 +392,10 @@ static void rz_row(rxy_rows_t *rr, uint32_t r, const float **R, const float **Z)
     const uint32_t k = r & 1u;
     if (rr->compact && rr->img_rxy == 0 && rr->row_in[k] != (int32_t)r && rr->zrow_in[k] != (int32_t)r)
     {
-        const size_t base = (size_t)r * rr->cols;
+        const size_t base = (size_t)r * rr->cols + rr->d0;
         const lidet_range_image_t *img = rr->img;
-        decode_rz(img->x_4mm + base, img->y_4mm + base, img->z_4mm + base, rr->cols, rr->slot[k],
-                  rr->zslot[k]);
+        decode_rz(img->x_4mm + base, img->y_4mm + base, img->z_4mm + base, rr->dn, rr->slot[k] + rr->d0,
+                  rr->zslot[k] + rr->d0);
         rr->row_in[k] = (int32_t)r;
         rr->zrow_in[k] = (int32_t)r;
     }
@@ -360,7 +405,7 @@ static void rz_row(rxy_rows_t *rr, uint32_t r, const float **R, const float **Z)
 
 /* Pass 1 (mirrors ref/ground.py: sample_mask): the sample mask, row by row. */
 static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, rxy_rows_t *rr,
-                        const lidet_range_image_t *img)
+                        const lidet_range_image_t *img, const gspan_t *sp)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols;
     const uint32_t step = g->cfg.sample_step;
@@ -384,11 +429,11 @@ static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, rxy_rows
         const filt_t fl = f;
         if (opt)
         {
-            filter_row(R0, R1, Z0, Z1, F0, cols, &fl, out, 1);
+            filter_row(R0, R1, Z0, Z1, F0, cols, sp->c_lo, sp->c_hi, &fl, out, 1);
         }
         else
         {
-            filter_row(R0, R1, Z0, Z1, F0, cols, &fl, out, 0);
+            filter_row(R0, R1, Z0, Z1, F0, cols, sp->c_lo, sp->c_hi, &fl, out, 0);
         }
     }
 }
@@ -410,7 +455,7 @@ static inline float pixel_rxy(const lidet_range_image_t *img, uint32_t p)
 }
 
 static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc,
-                           const lidet_range_image_t *img)
+                           const lidet_range_image_t *img, const gspan_t *sp)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
     const uint32_t cstep = g->cfg.sample_col_step;
@@ -425,7 +470,7 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc,
         const uint32_t cstart = c0 + (cstep - c0 % cstep) % cstep;
         const int roomy = hi - lo >= rows * (c1 - c0);
         const uint32_t near_start = lo, far_end = hi;
-        for (r = 0; r + 1u < rows; r += step)
+        for (r = 0; r + 1u < rows && s >= sp->s_lo && s < sp->s_hi; r += step) /* outside a window: none */
         {
             const size_t base = (size_t)r * cols;
             const uint8_t *m = sc->sample + base;
@@ -600,12 +645,14 @@ static inline uint32_t label_three(const float *X, const float *Y, const float *
     return nv;
 }
 
-static void label_rows(lidet_ground_state_t *g, uint8_t *mask, rxy_rows_t *rr, const lidet_range_image_t *img)
+static void label_rows(lidet_ground_state_t *g, uint8_t *mask, rxy_rows_t *rr, const lidet_range_image_t *img,
+                       const gspan_t *sp)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors;
     const float g0 = g->cfg.ground_m, below0 = g->cfg.below_factor * g0;
     const int two = g->cfg.ring_split_m > 0.0f, general = g->cfg.ground_m_per_m > 0.0f;
     const int three = lidet__ground_far2_on(&g->cfg);
+    const uint32_t s_lo = sp->s_lo, s_hi = sp->s_hi, c_lo = sp->c_lo, c_hi = sp->c_hi;
     label_par_t lp;
     int32_t o[LABEL_CHUNK];
     uint32_t r, s, c, j, n_ground = 0, n_vetoed = 0;
@@ -628,8 +675,16 @@ static void label_rows(lidet_ground_state_t *g, uint8_t *mask, rxy_rows_t *rr, c
         R = rxy_row(rr, r);
         Ru = r > 0u ? rxy_row(rr, r - 1u) : R;
         Zu = r > 0u ? z_row(rr, r - 1u) : Z;
+        /* outside a window's sectors: no point, so no ground */
+        memset(out, 0, c_lo);
+        memset(out + c_hi, 0, cols - c_hi);
         for (s = 0; s < ns; ++s)
         {
+            /* (a loop from s_lo measured 2x slower per pixel with GCC 12: kept from 0) */
+            if (s < s_lo || s >= s_hi)
+            {
+                continue;
+            }
             const uint32_t c1 = lidet__ground_sector_col(s + 1u, ns, cols);
             lidet_plane_t p = g->planes[s], q = g->planes[ns + s], q2 = three ? g->planes[2u * ns + s] : q;
             uint32_t cnt = 0, nv = 0;
@@ -704,6 +759,7 @@ lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_sc
                                         uint8_t *mask, const lidet_range_image_t *img)
 {
     rxy_rows_t rr;
+    gspan_t sp;
     lidet_status_t st;
     if (g == 0 || scratch == 0 || mask == 0 || img == 0)
     {
@@ -721,12 +777,13 @@ lidet_status_t lidet_ground_run_buffers(lidet_ground_state_t *g, lidet_ground_sc
     g->n_rows = img->n_rows;
     g->n_cols = img->n_cols;
     g->rng = lidet__rng_seed(g->cfg.seed); /* every run starts from the seed: deterministic per scan */
-    rxy_rows_init(&rr, scratch, img);
-    filter_rows(g, scratch->sample, &rr, img);
-    gather_samples(g, scratch, img);
+    span_of(&g->cfg, img->n_cols, &sp);
+    rxy_rows_init(&rr, scratch, img, &sp);
+    filter_rows(g, scratch->sample, &rr, img, &sp);
+    gather_samples(g, scratch, img, &sp);
     lidet__ground_fit_sectors(g, scratch, img);
-    rxy_rows_init(&rr, scratch, img); /* the label pass recomputes the rows it needs */
-    label_rows(g, mask, &rr, img);
+    rxy_rows_init(&rr, scratch, img, &sp); /* the label pass recomputes the rows it needs */
+    label_rows(g, mask, &rr, img, &sp);
     return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
 }
 

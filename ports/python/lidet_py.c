@@ -80,6 +80,7 @@ static const py_field_t k_fields[] = {
     FLD(lidet_ground_cfg_t, far2_split_m, 'f'),
     FLD(lidet_ground_cfg_t, fallback_sectors, 'u'),
     FLD(lidet_ground_cfg_t, seed, 'u'), FLD(lidet_ground_cfg_t, seed_per_cell, 'u'),
+    FLD(lidet_ground_cfg_t, azimuth_half_rad, 'f'),
     FLD(lidet_ground_cfg_t, ground_m, 'f'),
     FLD(lidet_ground_cfg_t, ground_m_per_m, 'f'), FLD(lidet_ground_cfg_t, below_factor, 'f'),
     FLD(lidet_ground_cfg_t, veto_slope, 'f'), FLD(lidet_ground_cfg_t, veto_min_dz_m, 'f'),

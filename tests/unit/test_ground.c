@@ -49,7 +49,7 @@ typedef struct
 typedef struct
 {
     int kind;
-    double h;     /* sensor height above the (first) ground plane */
+    double h; /* sensor height above the (first) ground plane */
     int n_boxes;
     box_t boxes[4];
 } scene_t;
@@ -490,6 +490,61 @@ static void test_ransac_determinism(void)
     TEST_ASSERT_TRUE(share(1, 1, NULL) >= 0.99);
 }
 
+/* the column window (cfg azimuth_half_rad): on an image a projection with the same window made (no point outside
+ * it), the stage works on the window's sectors only and gives what it gives without the window: the same planes,
+ * sample mask, ground mask and counts, bit for bit; for a narrow, a wide and a near-whole window, on two scenes */
+static void test_azimuth_window_same_result(void)
+{
+    static const float halves[4] = {0.3f, 1.0f, 1.19f, 2.9f};
+    static uint8_t mask_w[64 * 2048], samp_w[64 * 2048];
+    static lidet_plane_t planes_w[2 * LIDET_GROUND_MAX_SECTORS];
+    const int kinds[2] = {SC_RAMP, SC_CURB};
+    uint32_t k, w;
+    for (k = 0; k < 2u; ++k)
+    {
+        for (w = 0; w < 4u; ++w)
+        {
+            scene_t sc = {kinds[k], 1.73, 0, {{{0}, {0}}}};
+            lidet_ground_stats_t st_w;
+            const lidet_plane_t *pl;
+            uint32_t ns = 0, npix;
+            lidet_range_image_t img;
+            init_sensor("hdl64");
+            add_car(&sc, 9.0, -1.5);
+            add_car(&sc, 20.0, 4.0);
+            pcfg.azimuth_half_rad = halves[w];
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proj_init(&gp.ws, &pcfg));
+            cast_scene(&sc, NULL);
+            lidet_proj_image(&gp.ws, &img);
+            npix = (uint32_t)img.n_rows * img.n_cols;
+            gcfg.azimuth_half_rad = halves[w];
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_init(&gg.ws, &gcfg));
+            run_all();
+            memcpy(mask_w, lidet_ground_mask(&gg.ws), npix);
+            memcpy(samp_w, lidet_ground_samples(&gg.ws), npix);
+            pl = lidet_ground_planes(&gg.ws, &ns);
+            memcpy(planes_w, pl, 2u * ns * sizeof planes_w[0]);
+            st_w = *lidet_ground_stats(&gg.ws);
+            TEST_ASSERT_TRUE(st_w.n_ground > 1000u);
+            gcfg.azimuth_half_rad = 0.0f;
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_init(&gg.ws, &gcfg));
+            run_all();
+            TEST_ASSERT_EQUAL_MEMORY(mask_w, lidet_ground_mask(&gg.ws), npix);
+            TEST_ASSERT_EQUAL_MEMORY(samp_w, lidet_ground_samples(&gg.ws), npix);
+            pl = lidet_ground_planes(&gg.ws, &ns);
+            TEST_ASSERT_EQUAL_MEMORY(planes_w, pl, 2u * ns * sizeof planes_w[0]);
+            TEST_ASSERT_EQUAL_MEMORY(&st_w, lidet_ground_stats(&gg.ws), sizeof st_w);
+        }
+    }
+    /* out of range: refused */
+    gcfg.azimuth_half_rad = -0.1f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_init(&gg.ws, &gcfg));
+    gcfg.azimuth_half_rad = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_ground_init(&gg.ws, &gcfg));
+    gcfg.azimuth_half_rad = 0.0f;
+    pcfg.azimuth_half_rad = 0.0f;
+}
+
 static void test_filter_variants(void)
 {
     /* the authors' released filter (S_u on Z + height gate) also finds the flat ground */
@@ -653,6 +708,7 @@ int main(void)
     RUN_TEST(test_ransac_determinism);
     RUN_TEST(test_filter_variants);
     RUN_TEST(test_vertical_veto);
+    RUN_TEST(test_azimuth_window_same_result);
     RUN_TEST(test_fit_plane);
     RUN_TEST(test_config_and_arguments);
     return UNITY_END();

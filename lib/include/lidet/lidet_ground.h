@@ -147,6 +147,13 @@ typedef struct
                                    a cell's plane depends on its own samples alone and a windowed scan
                                    (lidet_proj_cfg_t azimuth_half_rad) gets, inside the window, the planes
                                    of the whole scan (the detector's crop sets it) */
+    float azimuth_half_rad;    /**< 0 (default): the whole image; in (0, pi): the image holds no point outside
+                                   the columns within this azimuth of straight ahead (one more each side: a
+                                   projection with the same azimuth_half_rad, or a smaller one), so the stage
+                                   filters, samples and labels only the sectors those columns touch (the
+                                   others hold no sample and no ground): the same planes and labels as
+                                   without, in the time of the window. Pixels outside those sectors are
+                                   never ground. The detector's crop sets it to the projection's window */
     /* ---- labelling ---- */
     float ground_m;       /**< p_th: max height above the sector plane for ground, metres;
                                    (0, 5], typical 0.1-0.3 */
