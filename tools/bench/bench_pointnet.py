@@ -43,15 +43,16 @@ def _ort_time(sess, feeds, batch, n, repeats):
     return best
 
 
-def _portable_times(args, n_files) -> dict | None:
-    """The same C timing with the AVX2 / AVX-512 variants off (LIDET_NN_CLONES=OFF: the SSE2 baseline every x86-64
-    has), from a second build of the bindings, in a child process. None when it cannot be built."""
+def _portable_times(args, n_files, flags=("-DLIDET_NN_CLONES=OFF",), suffix="-portable") -> dict | None:
+    """The same C timing from a second build of the bindings with other CMake flags, in a child process: by default
+    the AVX2 / AVX-512 variants off (LIDET_NN_CLONES=OFF: the SSE2 baseline every x86-64 has); with
+    -DLIDET_NN_FMA=OFF the clones of the portable kernel without the FMA kernel. None when it cannot be built."""
     import json
     import subprocess
-    bdir = pathlib.Path(args.build).parent / (pathlib.Path(args.build).name + "-portable")
+    bdir = pathlib.Path(args.build).parent / (pathlib.Path(args.build).name + suffix)
     try:
         subprocess.run(["cmake", "-S", str(ROOT), "-B", str(bdir), "-DCMAKE_BUILD_TYPE=Release",
-                        "-DLIDET_NN_CLONES=OFF", "-DLIDET_BUILD_TESTS=OFF"], check=True, capture_output=True)
+                        *flags, "-DLIDET_BUILD_TESTS=OFF"], check=True, capture_output=True)
         subprocess.run(["cmake", "--build", str(bdir), "--target", "lidet_py", "-j", "2"], check=True,
                        capture_output=True)
     except (OSError, subprocess.CalledProcessError) as e:
@@ -118,9 +119,11 @@ def run(args) -> str:
              "| model | MACs | lidet us/proposal | onnxruntime batch 1 | batch 64 | lidet vs batch 1 | lidet vs batch 64 |",
              "|---|---:|---:|---:|---:|---:|---:|"]
     fams = sorted(p.stem[4:] for p in (ROOT / "weights").glob("cls_*.onnx"))
-    portable = {}
-    pc = _portable_times(args, len(fams))
-    if pc is not None:
+
+    def other_build(flags, suffix):
+        pc = _portable_times(args, len(fams), flags, suffix)
+        if pc is None:
+            return {}
         import json
         import subprocess
         import tempfile
@@ -131,9 +134,13 @@ def run(args) -> str:
             r = subprocess.run([sys.executable, "-c", code, str(pathlib.Path(td) / "p.npz"), str(repeats), *fams],
                                capture_output=True, text=True, env=env)
             if r.returncode == 0:
-                portable = json.loads(r.stdout)
-            else:
-                print(r.stderr, file=sys.stderr)
+                return json.loads(r.stdout)
+            print(r.stderr, file=sys.stderr)
+            return {}
+
+    portable = other_build(("-DLIDET_NN_CLONES=OFF",), "-portable")
+    nofma = other_build(("-DLIDET_NN_FMA=OFF",), "-nofma")
+    gmacs = {}
     for fam in fams:
         cls_name, box_name = f"cls_{fam}", f"box_{fam}"
         t_cls, t_box = native.pn_time(cls_name, box_name, xyz, mean, vox, repeats)
@@ -149,23 +156,30 @@ def run(args) -> str:
                                        (f"both ({fam})", mc + mb, t_cls + t_box, o1c + o1b, o64c + o64b)):
             lines.append(f"| {name} | {macs:,} | {t * 1e6:.1f} | {o1 * 1e6:.1f} | {o64 * 1e6:.1f} "
                          f"| **{o1 / t:.2f}x** | {o64 / t:.2f}x |")
-        if fam in portable:
-            pcl, pbx = portable[fam]
-            for name, t, o1, o64 in ((f"{cls_name}, SSE2 only", pcl, o1c, o64c), (f"{box_name}, SSE2 only", pbx, o1b, o64b),
-                                     (f"both ({fam}), SSE2 only", pcl + pbx, o1c + o1b, o64c + o64b)):
-                lines.append(f"| {name} | | {t * 1e6:.1f} | {o1 * 1e6:.1f} | {o64 * 1e6:.1f} | {o1 / t:.2f}x "
-                             f"| {o64 / t:.2f}x |")
+        gmacs[fam] = (mc / t_cls / 1e9, mc / portable[fam][0] / 1e9 if fam in portable else None,
+                      mc / nofma[fam][0] / 1e9 if fam in nofma else None)
+        for other, tag in ((nofma, "clones, no FMA"), (portable, "SSE2 only")):
+            if fam in other:
+                pcl, pbx = other[fam]
+                for name, t, o1, o64 in ((f"{cls_name}, {tag}", pcl, o1c, o64c), (f"{box_name}, {tag}", pbx, o1b, o64b),
+                                         (f"both ({fam}), {tag}", pcl + pbx, o1c + o1b, o64c + o64b)):
+                    lines.append(f"| {name} | | {t * 1e6:.1f} | {o1 * 1e6:.1f} | {o64 * 1e6:.1f} | {o1 / t:.2f}x "
+                                 f"| {o64 / t:.2f}x |")
     lines += _int8_lines(native, xyz, mean, vox, fams, repeats)
+    g = gmacs.get("hdl64") or next(iter(gmacs.values()), (0.0, None, None))
+    speeds = f"{g[0]:.0f} GMAC/s here" + (f", {g[2]:.0f} with the clones without FMA" if g[2] else "") + (
+        f", {g[1]:.0f} with SSE2 only" if g[1] else "")
     lines += ["", "Ratios above 1 mean lidet is faster. The C kernels are portable C99 (lib/src/nn/lidet_nn_f32.c); "
               "on x86-64 hosts the build also compiles them for AVX2 (the float kernel also for AVX-512) and picks "
               "the variant at load time (CMake option LIDET_NN_CLONES, like onnxruntime's own dispatch), with "
-              "identical results. The "
-              "'SSE2 only' rows time a second build with LIDET_NN_CLONES=OFF (the x86-64 baseline instruction set, "
-              "as the portable code compiles without any -march flag) in the same run. Where the time goes: "
-              "the shared per-point layers hold 98 % of the multiply-adds (e.g. 64 points x (3x32 + 32x64 + "
-              "64x128) of the classifier's 673 k); the kernel runs them at about 19 GMAC/s with SSE2 and 39 GMAC/s "
-              "with AVX2 (8 x 64 -> 128 layer, gcc -O3), and the whole classifier at about 70 GMAC/s with "
-              "AVX-512 (673 k MACs in the time above); onnxruntime's MLAS uses AVX-512/AVX2 kernels.",
+              "identical results; on CPUs with FMA the float dense kernel is a register-tiled one with fused "
+              "multiply-adds instead (lib/src/nn/lidet_nn_f32_x86.c, CMake LIDET_NN_FMA; its last bits differ from "
+              "the portable kernel's, docs/POINTNET.md). The 'clones, no FMA' rows time a second build with "
+              "LIDET_NN_FMA=OFF, the 'SSE2 only' rows a third with LIDET_NN_CLONES=OFF (the x86-64 baseline "
+              "instruction set, as the portable code compiles without any -march flag), in the same run. Where the "
+              "time goes: the shared per-point layers hold 98 % of the multiply-adds (e.g. 64 points x (3x32 + "
+              f"32x64 + 64x128) of the classifier's 673 k); the whole classifier runs at {speeds} (its MACs over "
+              "the times above); onnxruntime's MLAS uses AVX-512/AVX2 kernels.",
               "Command: `python tools/bench/bench_pointnet.py` (part of `make bench`).", ""]
     return "\n".join(lines)
 
