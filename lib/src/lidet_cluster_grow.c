@@ -54,14 +54,13 @@ void lidet__cluster_setup_geometry(lidet_cluster_state_t *c, const lidet_range_i
     c->geo_cols = (uint16_t)cols;
 }
 
-/* beta > theta  <=>  d2 sin(a) > tan(theta) (d1 - d2 cos(a)), d1 >= d2 (true when the bracket <= 0).
+/* beta > theta  <=>  d2 sin(a) > tan(theta) (d1 - d2 cos(a)), d1 >= d2 (true when the bracket <= 0), for the
+ * two ranges ordered (d1 the larger).
  * With gap > 0 the two returns must also lie within gap + gap_per_m * d2 of each other; their
  * distance along the two beams is sqrt((d1 - d2 cos a)^2 + (d2 sin a)^2), from the same two terms
  * (no point coordinates are read) */
-static inline int link(float da, float db, float sn, float cs, const lidet__grow_t *g)
+static inline int link_ordered(float d1, float d2, float sn, float cs, const lidet__grow_t *g)
 {
-    const float d1 = da > db ? da : db;
-    const float d2 = da > db ? db : da;
     const float u = d1 - d2 * cs, v = d2 * sn;
     if (!(v > g->tan_theta * u))
     {
@@ -73,6 +72,11 @@ static inline int link(float da, float db, float sn, float cs, const lidet__grow
         return u * u + v * v <= gg * gg;
     }
     return 1;
+}
+
+static inline int link(float da, float db, float sn, float cs, const lidet__grow_t *g)
+{
+    return link_ordered(da > db ? da : db, da > db ? db : da, sn, cs, g);
 }
 
 /* the float stage's parameters of the flood fill template (lidet_cluster_grow_body.h) */
@@ -100,18 +104,7 @@ static inline int link_4mm(uint32_t da, uint32_t db, float sn, float cs, const l
 {
     const uint32_t d1 = da > db ? da : db;
     const uint32_t d2 = da > db ? db : da;
-    const float f1 = (float)d1, f2 = (float)d2;
-    const float u = f1 - f2 * cs, v = f2 * sn;
-    if (!(v > g->tan_theta * u))
-    {
-        return 0;
-    }
-    if (g->gap > 0.0f)
-    {
-        const float gg = g->gap + g->gpm * f2;
-        return u * u + v * v <= gg * gg;
-    }
-    return 1;
+    return link_ordered((float)d1, (float)d2, sn, cs, g);
 }
 #undef GROW_D_T
 #undef GROW_LINK
