@@ -293,9 +293,14 @@ T256 void lidet__nn_dense_f32_avx2fma(const float *in, uint32_t n_rows, uint32_t
 typedef void dense_fn_t(const float *, uint32_t, uint32_t, const float *, const float *, uint32_t, int,
                         float *);
 
-/* the ifunc resolver: runs once, when the program loads, before any sanitizer runtime is set up (so not
- * instrumented) */
-__attribute__((used, no_sanitize_address)) static dense_fn_t *resolve_dense(void)
+/* the ifunc resolver: runs once, when the program loads, before any sanitizer runtime or thread-local storage is
+ * set up, so nothing in it is instrumented (clang's fuzzer coverage would call into libFuzzer and read TLS) */
+#if defined(__clang__)
+#define NN_RESOLVER_ATTR __attribute__((used, no_sanitize("address", "undefined", "coverage")))
+#else
+#define NN_RESOLVER_ATTR __attribute__((used, no_sanitize_address, no_sanitize_undefined))
+#endif
+NN_RESOLVER_ATTR static dense_fn_t *resolve_dense(void)
 {
     __builtin_cpu_init();
     if (__builtin_cpu_supports("avx512f"))
