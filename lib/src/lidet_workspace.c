@@ -3,6 +3,7 @@
  * their states and on buffers placed by lifetime, the scratch of each overlaid with the others'. */
 #include <string.h>
 
+#include "internal/lidet_math.h"
 #include "lidet/lidet_workspace.h"
 
 void lidet_workspace_cfg_default(lidet_workspace_cfg_t *cfg, const lidet_sensor_t *sensor)
@@ -33,6 +34,15 @@ lidet_status_t lidet_workspace_init(lidet_workspace_t *ws, const lidet_workspace
     if (st != LIDET_OK)
     {
         return st;
+    }
+    {
+        /* a ground window works on an image with no point outside it: the projection's window must lie within it
+         * (the same column rule on both, so a smaller or equal half-angle) */
+        const float gw = cfg->ground.azimuth_half_rad, pw = cfg->proj.azimuth_half_rad;
+        if (gw > 0.0f && gw < LIDET_PI_F && !(pw > 0.0f && pw <= gw))
+        {
+            return LIDET_ERR_CONFIG;
+        }
     }
     {
         /* the clustering's height filter reads the ground's far planes beyond its split (the workspace passes

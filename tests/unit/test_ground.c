@@ -492,24 +492,26 @@ static void test_ransac_determinism(void)
 
 /* the column window (cfg azimuth_half_rad): on an image a projection with the same window made (no point outside
  * it), the stage works on the window's sectors only and gives what it gives without the window: the same planes,
- * sample mask, ground mask and counts, bit for bit; for a narrow, a wide and a near-whole window, on two scenes */
+ * sample mask, ground mask and counts, bit for bit; for a narrow, a wide and a near-whole window, on three scenes
+ * and two sensors */
 static void test_azimuth_window_same_result(void)
 {
     static const float halves[4] = {0.3f, 1.0f, 1.19f, 2.9f};
     static uint8_t mask_w[64 * 2048], samp_w[64 * 2048];
     static lidet_plane_t planes_w[2 * LIDET_GROUND_MAX_SECTORS];
-    const int kinds[2] = {SC_RAMP, SC_CURB};
+    const int kinds[3] = {SC_RAMP, SC_CURB, SC_FLAT};
     uint32_t k, w;
-    for (k = 0; k < 2u; ++k)
+    for (k = 0; k < 3u; ++k)
     {
         for (w = 0; w < 4u; ++w)
         {
-            scene_t sc = {kinds[k], 1.73, 0, {{{0}, {0}}}};
+            /* hdl64 on the ramp and the curb; vlp16 (no second plane, its own sectors) on flat ground */
+            scene_t sc = {kinds[k], k == 2u ? 0.5 : 1.73, 0, {{{0}, {0}}}};
             lidet_ground_stats_t st_w;
             const lidet_plane_t *pl;
             uint32_t ns = 0, npix;
             lidet_range_image_t img;
-            init_sensor("hdl64");
+            init_sensor(k == 2u ? "vlp16" : "hdl64");
             add_car(&sc, 9.0, -1.5);
             add_car(&sc, 20.0, 4.0);
             pcfg.azimuth_half_rad = halves[w];

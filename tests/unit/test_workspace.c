@@ -85,7 +85,8 @@ static void chain(lidet_range_image_t *img, const lidet_workspace_cfg_t *cfg)
     const lidet_plane_t *planes;
     uint32_t ns;
     lidet_cluster_cfg_t ccfg = cfg->cluster;
-    ccfg.plane_split_m = cfg->ground.ring_split_m; /* as the workspace: the whole plane table, far planes too */
+    ccfg.plane_split_m =
+        cfg->ground.ring_split_m; /* as the workspace: the whole plane table, far planes too */
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_ground_init(&g_ground.ws, &cfg->ground));
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g_cluster.ws, &ccfg));
     TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_ground_run(&g_ground.ws, img)));
@@ -350,14 +351,14 @@ static void test_workspace_matches_stages_hdl64(void)
 static void test_workspace_real_scans(void)
 {
     static const char *const scans[] = {"../shared/data/real/semantickitti/velodyne/00_000000.bin",
-                                         "../shared/data/real/semantickitti/velodyne/00_000001.bin",
-                                         "../shared/data/real/semantickitti/velodyne/00_000002.bin",
-                                         "../shared/data/real/semantickitti/velodyne/00_000003.bin",
-                                         "../shared/data/real/semantickitti/velodyne/00_000004.bin",
-                                         "../shared/data/real/semantickitti/velodyne/00_000005.bin",
-                                         "../shared/data/real/kitti/training/velodyne/000000.bin",
-                                         "../shared/data/real/kitti/training/velodyne/000001.bin",
-                                         "../shared/data/real/kitti/training/velodyne/000002.bin"};
+                                        "../shared/data/real/semantickitti/velodyne/00_000001.bin",
+                                        "../shared/data/real/semantickitti/velodyne/00_000002.bin",
+                                        "../shared/data/real/semantickitti/velodyne/00_000003.bin",
+                                        "../shared/data/real/semantickitti/velodyne/00_000004.bin",
+                                        "../shared/data/real/semantickitti/velodyne/00_000005.bin",
+                                        "../shared/data/real/kitti/training/velodyne/000000.bin",
+                                        "../shared/data/real/kitti/training/velodyne/000001.bin",
+                                        "../shared/data/real/kitti/training/velodyne/000002.bin"};
     char path[512];
     FILE *f;
     uint32_t i, ran = 0;
@@ -390,6 +391,15 @@ static void test_workspace_errors(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_workspace_init(&g_ws.ws, &cfg));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_workspace_run(&g_ws.ws, g_points, 0, 4, NULL, NULL));
     cfg.cluster.min_points = 10;
+    /* a ground window needs a projection window within it: none, or a wider one, is refused */
+    cfg.ground.azimuth_half_rad = 1.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_workspace_init(&g_ws.ws, &cfg));
+    cfg.proj.azimuth_half_rad = 1.2f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_workspace_init(&g_ws.ws, &cfg));
+    cfg.proj.azimuth_half_rad = 1.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_workspace_init(&g_ws.ws, &cfg));
+    cfg.ground.azimuth_half_rad = 0.0f;
+    cfg.proj.azimuth_half_rad = 0.0f;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_workspace_init(&g_ws.ws, &cfg));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_workspace_proposal(&g_ws.ws, 0, &pcfg, p));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_workspace_point_labels(&g_ws.ws, g_pp, 0, NULL, NULL));
@@ -404,12 +414,11 @@ static void test_workspace_errors(void)
  * never wrapped into int16; points within it keep their coordinates to 2 mm (half a step) */
 static void test_workspace_compact_span(void)
 {
-    static const float far_pts[][4] = {
-        {130.9f, 0.0f, 0.0f, 0.0f},   /* kept: 32725 steps */
-        {0.0f, -130.0f, -1.0f, 0.0f}, /* kept */
-        {131.5f, 0.0f, 0.0f, 0.0f},   /* beyond 131 m: dropped */
-        {-200.0f, 10.0f, 0.0f, 0.0f}, /* dropped (would wrap int16) */
-        {0.0f, 0.0f, 0.05f, 0.0f}};   /* too close */
+    static const float far_pts[][4] = {{130.9f, 0.0f, 0.0f, 0.0f},   /* kept: 32725 steps */
+                                       {0.0f, -130.0f, -1.0f, 0.0f}, /* kept */
+                                       {131.5f, 0.0f, 0.0f, 0.0f},   /* beyond 131 m: dropped */
+                                       {-200.0f, 10.0f, 0.0f, 0.0f}, /* dropped (would wrap int16) */
+                                       {0.0f, 0.0f, 0.05f, 0.0f}};   /* too close */
     lidet_workspace_cfg_t cfg;
     lidet_workspace_stats_t st;
     lidet_range_image_t wimg;
@@ -462,7 +471,8 @@ static void test_workspace_sizes(void)
     TEST_ASSERT_EQUAL_UINT32(LIDET_MAX_ROWS * LIDET_MAX_COLS, s.ground_mask);
     TEST_ASSERT_EQUAL_UINT32(4u * LIDET_MAX_ROWS * LIDET_MAX_COLS, s.overlay_proj);
     TEST_ASSERT_EQUAL_UINT32(6u * LIDET_MAX_ROWS * LIDET_MAX_COLS, s.overlay_cluster);
-    TEST_ASSERT_EQUAL_UINT32(lidet_ground_scratch_bytes(), s.overlay_ground); /* R is not stored: two rows of it */
+    TEST_ASSERT_EQUAL_UINT32(lidet_ground_scratch_bytes(),
+                             s.overlay_ground); /* R is not stored: two rows of it */
     /* the overlay is the peak of its parts, not the sum */
     big = s.overlay_proj > s.overlay_ground ? s.overlay_proj : s.overlay_ground;
     big = big > s.overlay_cluster ? big : s.overlay_cluster;
@@ -474,14 +484,16 @@ static void test_workspace_sizes(void)
 #if defined(__x86_64__)
     {
         /* the gap puts a pixel's label 2 KiB + 64 B (+ alignment) from its range, modulo 4 KiB */
-        const size_t d = (size_t)((const uint8_t *)&g_ws.ws.overlay.cluster.labels[0] - (const uint8_t *)&g_ws.ws.range_4mm[0]);
+        const size_t d = (size_t)((const uint8_t *)&g_ws.ws.overlay.cluster.labels[0] -
+                                  (const uint8_t *)&g_ws.ws.range_4mm[0]);
         TEST_ASSERT_TRUE(s.alias_gap >= 64u && s.alias_gap < 4096u + 64u);
         TEST_ASSERT_TRUE(d % 4096u >= 2048u && d % 4096u < 2048u + 64u + 16u);
     }
 #else
     TEST_ASSERT_EQUAL_UINT32(0u, s.alias_gap);
 #endif
-    TEST_ASSERT_EQUAL_UINT32(lidet_proj_bytes() + lidet_ground_bytes() + lidet_cluster_bytes(), s.stages_standalone);
+    TEST_ASSERT_EQUAL_UINT32(lidet_proj_bytes() + lidet_ground_bytes() + lidet_cluster_bytes(),
+                             s.stages_standalone);
     TEST_ASSERT_TRUE(s.total < s.stages_standalone);
 }
 

@@ -153,7 +153,9 @@ typedef struct
                                    filters, samples and labels only the sectors those columns touch (the
                                    others hold no sample and no ground): the same planes and labels as
                                    without, in the time of the window. Pixels outside those sectors are
-                                   never ground. The detector's crop sets it to the projection's window */
+                                   never ground. The detector's crop sets it to the projection's window; a
+                                   workspace refuses (LIDET_ERR_CONFIG) a projection window wider than it,
+                                   or none */
     /* ---- labelling ---- */
     float ground_m;       /**< p_th: max height above the sector plane for ground, metres;
                                    (0, 5], typical 0.1-0.3 */
