@@ -281,6 +281,28 @@ typedef struct
     int32_t pix[KEY_BLOCK];   /* (b): pixel of each point, -1 = not projected; copied to point_pixel */
 } key_block_t;
 
+/* the terms both key_block and the window's pre-test compute from a point: its squared horizontal range, its
+ * squared range (x^2 + y^2, then + z^2: the range test's exact expression, so both give the same bits) and
+ * |x| + |y| */
+static inline float range_terms(float x, float y, float z, float *rxy2, float *s)
+{
+    *rxy2 = x * x + y * y;
+    *s = fabsf(x) + fabsf(y);
+    return *rxy2 + z * z;
+}
+
+/* the count a point that failed the range test goes to (NaN or Inf, too close, or too far: beyond max_range_m, or
+ * so large that r^2 overflows), r2 its squared range */
+static inline void count_out_of_range(const float *pt, float r2, float min2, lidet_proj_stats_t *st)
+{
+    if (!lidet__isfinite(pt[0]) || !lidet__isfinite(pt[1]) || !lidet__isfinite(pt[2]))
+        ++st->n_nonfinite;
+    else if (r2 < min2)
+        ++st->n_too_close;
+    else
+        ++st->n_too_far;
+}
+
 /* (a) above: the two per-point keys from one division and one square root,
  *   tan(elevation) t = z / rxy, and the pseudo-azimuth ("diamond angle") in [0, 4]
  *   d = 1 + x/(|x|+|y|) for y >= 0, 3 - x/(|x|+|y|) for y < 0,
@@ -300,9 +322,8 @@ static inline void key_block(key_block_t *kb, const float *pts, uint32_t m, uint
     {
         const float *pt = pts + (size_t)j * stride;
         const float x = pt[0], y = pt[1], z = pt[2];
-        const float rxy2 = x * x + y * y;
-        const float r2 = rxy2 + z * z;
-        const float s = fabsf(x) + fabsf(y);
+        float rxy2, s;
+        const float r2 = range_terms(x, y, z, &rxy2, &s);
         const float rxy = sqrtf(rxy2);
         const float den = s * rxy;
         const float inv = 1.0f / den;
@@ -342,7 +363,7 @@ LIDET_CLONES_AVX2 static void key_block4(key_block_t *kb, const float *pts, uint
 }
 
 /* run()'s pre-test of one block in the azimuth window (init_window_test): returns 1 when every point fails the
- * range test (the very expression of key_block) or lies surely outside the window, with the count of those in
+ * range test (range_terms, as key_block) or lies surely outside the window, with the count of those in
  * range in *n_in; 0 otherwise. A point counts as outside only with |x| + |y| >= 1e-15 m and x^2 + y^2 <= 1e36
  * m^2, where key_block's pseudo-azimuth is defined and accurate (1 / den normal). One loop of selects and two
  * reductions, which compilers vectorize */
@@ -354,9 +375,8 @@ static inline uint32_t outside_block(const float *pts, uint32_t m, uint32_t stri
     {
         const float *pt = pts + (size_t)j * stride;
         const float x = pt[0], y = pt[1], z = pt[2];
-        const float rxy2 = x * x + y * y;
-        const float r2 = rxy2 + z * z;
-        const float s = fabsf(x) + fabsf(y);
+        float rxy2, s;
+        const float r2 = range_terms(x, y, z, &rxy2, &s);
         const float c1 = e[0] * y - e[1] * x; /* cross(v1, p) */
         const float c2 = x * e[3] - y * e[2]; /* cross(p, v2) */
         const uint32_t range_ok = (uint32_t)((r2 >= min2) & (r2 <= max2));
@@ -637,13 +657,10 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
                     {
                         /* the block's points out of range, classified as in (b) */
                         const float *pt = points + (size_t)(base + j) * stride;
-                        const float r2 = (pt[0] * pt[0] + pt[1] * pt[1]) + pt[2] * pt[2];
-                        if (!lidet__isfinite(pt[0]) || !lidet__isfinite(pt[1]) || !lidet__isfinite(pt[2]))
-                            ++st.n_nonfinite;
-                        else if (r2 < min2)
-                            ++st.n_too_close;
-                        else if (!(r2 <= max2))
-                            ++st.n_too_far;
+                        float rxy2, sa;
+                        const float r2 = range_terms(pt[0], pt[1], pt[2], &rxy2, &sa);
+                        if (!((r2 >= min2) & (r2 <= max2)))
+                            count_out_of_range(pt, r2, min2, &st);
                     }
                     if (point_pixel != 0)
                     {
@@ -671,13 +688,7 @@ lidet_status_t lidet_proj_run_buffers(lidet_proj_state_t *proj, const lidet_proj
                     /* one test covered NaN, Inf, overflow and both range limits; classify only now */
                     if (!(kb.flags[j] & KEY_RANGE_OK))
                     {
-                        const float *pt = points + (size_t)i * stride;
-                        if (!lidet__isfinite(pt[0]) || !lidet__isfinite(pt[1]) || !lidet__isfinite(pt[2]))
-                            ++st.n_nonfinite;
-                        else if (kb.r2[j] < min2)
-                            ++st.n_too_close;
-                        else
-                            ++st.n_too_far; /* beyond max_range_m, or so large that r^2 overflows */
+                        count_out_of_range(points + (size_t)i * stride, kb.r2[j], min2, &st);
                         kb.pix[j] = -1;
                         continue;
                     }

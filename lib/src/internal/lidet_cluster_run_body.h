@@ -582,13 +582,11 @@ static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, const run_span_t *s
     uint16_t *lab = c->labels;
     lidet_member_t *mem = c->members;
     uint32_t p, r, tail = 0;
-    /* seeds in raster order over the seed columns (all the window's without a seed window: one span per row,
-     * or the whole image at once) */
-    const int rowwise = sp->seed_lo > sp->lo || sp->seed_hi < sp->hi;
-    for (r = 0; r < (rowwise ? sp->rows : 1u); ++r)
+    /* seeds in raster order over the seed columns [seed_lo, seed_hi) of each row (the window's columns without a
+     * seed window, every column without either) */
+    for (r = 0; r < sp->rows; ++r)
     {
-        const uint32_t b = rowwise ? r * sp->cols + sp->seed_lo : 0u,
-                       e = rowwise ? r * sp->cols + sp->seed_hi : npix;
+        const uint32_t b = r * sp->cols + sp->seed_lo, e = r * sp->cols + sp->seed_hi;
         for (p = next_free(lab, b, e); p < e; p = next_free(lab, p + 1u, e))
         {
             const uint32_t start = tail;
