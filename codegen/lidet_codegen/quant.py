@@ -368,10 +368,11 @@ def float_inputs(xyz, mean):
     return _frame_f(q * 0.004, m4 * 0.004)
 
 
-def calib_classes(model, xyz, mean, vox):
-    """The class fed to a box net's one-hot during calibration: the float classifier of the same family."""
+def calib_classes(model, xyz, mean, vox, folder=None):
+    """The class fed to a box net's one-hot during calibration: the float classifier of the same family, the
+    cls_<family>.onnx in the box net's own folder (default weights/)."""
     fam = model.name.split("_", 1)[1] if "_" in model.name else model.name
-    cp = ROOT / "weights" / f"cls_{fam}.onnx"
+    cp = pathlib.Path(folder or ROOT / "weights") / f"cls_{fam}.onnx"
     if model.kind != "box" or not cp.exists():
         return np.zeros(len(xyz), np.int64)
     cm = load(cp, "cls")
@@ -397,7 +398,7 @@ def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS) -> dict:
     scans = scan_list(sensor, real_dir)
     sims = _sim_scans(sensor, CALIB_SIM_SEED, CALIB_N_SIM)
     xyz, mean, vox = proposals_of(scans + sims, sensor, seeds, model.n_points)
-    cls = calib_classes(model, xyz, mean, vox)
+    cls = calib_classes(model, xyz, mean, vox, onnx_path.parent)
     tr = float_trace(model, float_inputs(xyz, mean), vox.astype(np.float64), cls)
     names = layer_names(model)
     per, pct = CALIB_RULE[model.kind]
@@ -478,11 +479,12 @@ def calib_set(calib: dict, real_dir=None):
     return proposals_of(paths + sim_pts, calib["sensor"], calib["seeds"], int(calib.get("n_points", 64)))
 
 
-def layer_errors(qm: QModel, xyz, mean, vox):
-    """[(layer, max abs error, mean abs error)] of every layer's dequantized output against float."""
+def layer_errors(qm: QModel, xyz, mean, vox, folder=None):
+    """[(layer, max abs error, mean abs error)] of every layer's dequantized output against float (a box net fed
+    the classes of the classifier in `folder`, as calib_classes)."""
     from .ref import pointnet_q as RQ
     model = qm.source
-    cls = calib_classes(model, xyz, mean, vox)
+    cls = calib_classes(model, xyz, mean, vox, folder)
     ft = float_trace(model, float_inputs(xyz, mean), vox.astype(np.float64), cls)
     q4, m4 = int_proposals(xyz, mean)
     c, s = RQ.frame_cs(m4)
@@ -632,7 +634,7 @@ def emit_s8(onnx_path, calib_path, out_dir, cmd: str, report: bool = True, real_
         if data is None:
             print("  per-layer error: skipped (calibration scans not available)")
         else:
-            for nm, mx, mn in layer_errors(qm, *data):
+            for nm, mx, mn in layer_errors(qm, *data, folder=onnx_path.parent):
                 print(f"  {nm:12s} max abs error {mx:.5f}  mean abs error {mn:.5f}")
     return qm
 

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
-"""`make weights`: from nothing to weights/{cls,box}_{hdl64,vlp16}.onnx and weights/MODEL_CARD.md (and, with
-`--families vlp16s --card weights/MODEL_CARD_vlp16s.md`, the small VLP-16 pair of the integer firmware).
+"""`make weights`: from nothing to weights/{cls,box}_{hdl64,vlp16}.onnx, their C models and weights/MODEL_CARD.md
+(and, with `--families vlp16s --card weights/MODEL_CARD_vlp16s.md`, the small VLP-16 pair of the integer firmware).
 
     python -m lidet_tools.train.weights [--work data/train] [--weights weights] [--jobs 2] [--threads 1]
                                         [--real ../shared/data/real/kitti/training] [--device cpu]
@@ -8,8 +8,11 @@
 Per sensor family: the proposal dataset (simulator, fixed seeds; skipped when its .npz exists), the
 classifier and the box net (each resumable from its state folder under --work: an interrupted run
 continues where it stopped), the ONNX export, the figures on the test split, the energy histograms
-(`lidet-viz energy`), the classifier on the real KITTI frames (when --real exists), the MAC counts,
-and finally the model card. The same command on the same machine gives the same models.
+(`lidet-viz energy`), the classifier on the real KITTI frames (when --real exists), the MAC counts.
+Then the C models (c_models): the int8 calibration of each new ONNX file (`python -m lidet_codegen calibrate`,
+and `calibrate --refit` for a classifier not fine-tuned for int8) and every float and int8 C file of --weights
+with lidet_weights.{c,h} (`python -m lidet_codegen regen`), and finally the model card. The same command on the
+same machine gives the same models.
 """
 from __future__ import annotations
 
@@ -175,6 +178,27 @@ def run_real(a) -> dict:
     return out
 
 
+def c_models(a, fams) -> list:
+    """The C models of --weights after training: for each family trained, its two new ONNX files calibrated for
+    int8 (`python -m lidet_codegen calibrate`, the classifier first: a box net is calibrated on the classes of the
+    classifier beside it), the classifier's last layer refitted (`calibrate --refit`) unless it was fine-tuned for
+    int8 (cls_finetune; a refit made the fine-tuned ones' gate decisions agree less, docs/FIXED_POINT.md); then
+    every float and int8 C model of the folder and lidet_weights.{c,h} (lidet_codegen.regen.emit_all, the commands
+    of the committed weights/ and of CI's drift check). Returns the emit commands."""
+    from lidet_codegen import quant as Q
+    from lidet_codegen import regen
+    # calibrate takes the folder above kitti/ (its HDL-64 scans join the hdl64 calibration set when present)
+    ra = ["--real", str(a.real.parents[1] if a.real.parent.name == "kitti" else a.real)]
+    for fam in fams:
+        cls, box = ((a.weights / f"{k}_{fam}.onnx").as_posix() for k in ("cls", "box"))
+        _log(f"{fam}: int8 calibration -> {a.weights}/{{cls,box}}_{fam}.calib.json")
+        Q.main([cls, box] + ra)
+        if not FAMILIES[fam].get("cls_finetune"):
+            Q.main(["--refit", cls] + ra)
+    _log(f"C models -> {a.weights}/*.c, *_s8.c, lidet_weights.c")
+    return regen.emit_all(a.weights)
+
+
 def model_card(a, results: dict, real, timings: dict) -> str:
     from lidet_codegen.export import load_checkpoint
     L = ["# lidet PointNet weights: model card", "",
@@ -223,7 +247,8 @@ def model_card(a, results: dict, real, timings: dict) -> str:
             _, ck = load_checkpoint(a.work / f"{fam}_{kind}.pt")
             L.append(f"| {fam} {kind} training | {ck['meta'].get('train_seconds', float('nan')):.0f} |")
         L.append(f"| {fam} evaluation | {timings.get(f'{fam} evaluation', float('nan')):.0f} |")
-    L += [f"| this invocation, in all | {timings.get('total', float('nan')):.0f} |", ""]
+    L += [f"| int8 calibration and C models (all families) | {timings.get('C models', float('nan')):.0f} |",
+          f"| this invocation, in all | {timings.get('total', float('nan')):.0f} |", ""]
     L += ["## Figures on the test split (simulated, scans never seen in training or model selection)", ""]
     for fam, r in results.items():
         L.append(EV.markdown(r, f"{fam}, test split"))
@@ -295,6 +320,9 @@ def main(argv=None) -> int:
         for f in fams:
             results[f] = run_family(f, a, timings)
         real = run_real(a) if "hdl64" in fams else {}
+        t = time.perf_counter()
+        c_models(a, fams)
+        timings["C models"] = time.perf_counter() - t
     except (FileNotFoundError, ValueError, RuntimeError) as e:
         print(f"weights: {e}", file=sys.stderr)
         return 2
