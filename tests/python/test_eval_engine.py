@@ -69,3 +69,27 @@ def test_get_thresholds_matches_literal():
 def test_empty_inputs():
     st = engine.pr_statistics(3, [], [], [], [], [], [], [], [], 0.5)
     assert st["n_gt"] == 0 and st["ap_r40"] == 0.0
+
+
+def test_exact_ap_on_a_small_set():
+    """15 objects, 13 found with precision 1 and 2 false positives scoring lowest: the exact AP|R40 is the
+    share of the 40 recall samples at or below recall 13/15 (34 of them); the devkit's sampling reads one
+    precision per true positive as recall i/40 and stays far below."""
+    from lidet_tools.eval import engine
+    n = 15
+    score = np.r_[np.linspace(0.99, 0.5, 13), 0.3, 0.2]
+    pair_dt = np.arange(13)
+    pair_gt = np.arange(13)
+    pair_ov = np.full(13, 0.9)
+    args = (1, np.zeros(n, np.int64), np.zeros(n, np.int8), np.zeros(15, np.int64), np.zeros(15, np.int8),
+            score, pair_dt, pair_gt, pair_ov, 0.5)
+    ex = engine.pr_statistics(*args, exact=True)
+    assert ex["ap_r40"] == pytest.approx(34 / 40 * 100)
+    assert ex["ap_r11"] == pytest.approx(9 / 11 * 100)  # recall 0, 0.1, ..., 0.8
+    dk = engine.pr_statistics(*args)
+    assert dk["ap_r40"] == pytest.approx(12 / 40 * 100)  # samples 1..12 of the 13 thresholds, precision 1
+    # no detection: 0 both ways
+    none = engine.pr_statistics(1, np.zeros(n, np.int64), np.zeros(n, np.int8), np.zeros(0, np.int64),
+                                np.zeros(0, np.int8), np.zeros(0), np.zeros(0, np.int64), np.zeros(0, np.int64),
+                                np.zeros(0), 0.5, exact=True)
+    assert none["ap_r40"] == 0.0

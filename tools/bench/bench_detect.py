@@ -56,62 +56,34 @@ def _fmt(v):
 # ---- per-stage accounting of misses ------------------------------------------------------------------
 
 def _in_box(xyz, b, margin=0.1):
-    c, s = np.cos(b[6]), np.sin(b[6])
-    d = xyz[:, :3] - np.asarray(b[:3])
-    u = c * d[:, 0] + s * d[:, 1]
-    v = -s * d[:, 0] + c * d[:, 1]
-    return (np.abs(u) <= b[3] / 2 + margin) & (np.abs(v) <= b[4] / 2 + margin) & (np.abs(d[:, 2]) <= b[5] / 2 + margin)
+    from lidet_tools.where_lost import points_in_box
+    return points_in_box(xyz, b, margin)
 
 
 def accounting(folder, sensor, n_scans, max_range=40.0, crop=False, mount_height_m=None):
-    """For every Car / Pedestrian / Cyclist within max_range m (and in the crop): where it was lost."""
+    """For every Car / Pedestrian / Cyclist within max_range m (and in the crop): where it was lost
+    (lidet_tools.where_lost; its split and merged stages summed as clustering)."""
     from lidet_tools import kitti, native
     from lidet_tools.eval.iou import iou_3d_pairs
+    from lidet_tools.where_lost import where_lost
     stages = ["too few points", "ground", "clustering", "budget/crop", "gate 1", "gate 2", "size", "nms",
               "wrong class", "box off", "detected"]
     counts = {c: dict.fromkeys(stages, 0) for c in THR}
     scans = sorted((pathlib.Path(folder) / "velodyne").glob("*.bin"))[:n_scans]
     few = int(native.cluster_defaults(sensor)["min_points"])  # below it no cluster can hold the object
+
+    def hit(db, gb, cls):
+        return float(iou_3d_pairs(db[None], gb[None])[0]) >= THR[cls]
+
     for p in scans:
         pts = kitti.read_bin(p)
         gts = [b for b in kitti.read_boxes(pathlib.Path(folder) / "boxes" / f"{p.stem}.txt") if b.cls in THR]
+        gts = [g for g in gts if np.hypot(g.x, g.y) <= max_range
+               and not (crop and abs(np.arctan2(g.y, g.x)) > np.pi / 4)]
         d = native.detect(pts, sensor, crop_half_rad=np.pi / 4 if crop else 0.0, mount_height_m=mount_height_m)
-        csize = np.bincount(d.point_cluster.astype(np.int64), minlength=len(d.outcome) + 1)
-        for g in gts:
-            b = np.array([g.x, g.y, g.z, g.l, g.w, g.h, g.yaw])
-            if np.hypot(g.x, g.y) > max_range or (crop and abs(np.arctan2(g.y, g.x)) > np.pi / 4):
-                continue
-            m = _in_box(pts, b)
-            if m.sum() < few:
-                counts[g.cls]["too few points"] += 1
-                continue
-            ng = m & (d.point_ground == 0)
-            if ng.sum() < few:
-                counts[g.cls]["ground"] += 1
-                continue
-            ids = d.point_cluster[ng]
-            ids = ids[ids > 0]
-            if len(ids) == 0:
-                counts[g.cls]["clustering"] += 1
-                continue
-            cid = int(np.bincount(ids).argmax())
-            hit = int((ids == cid).sum())
-            if hit < 0.7 * ng.sum() or hit < 0.7 * csize[cid]:
-                counts[g.cls]["clustering"] += 1
-                continue
-            oc = native.OUTCOME[int(d.outcome[cid - 1])]
-            key = {"crop": "budget/crop", "range": "budget/crop", "budget": "budget/crop", "gate1": "gate 1",
-                   "gate2": "gate 2", "size": "size", "nms": "nms", "capacity": "budget/crop",
-                   "tall": "budget/crop"}.get(oc)
-            if key is not None:
-                counts[g.cls][key] += 1
-                continue
-            j = int(np.nonzero(d.cluster_id == cid)[0][0])
-            if native.CLASSES[int(d.cls[j])] != g.cls:
-                counts[g.cls]["wrong class"] += 1
-                continue
-            iou = float(iou_3d_pairs(d.box[j:j + 1].astype(np.float64), b[None])[0])
-            counts[g.cls]["detected" if iou >= THR[g.cls] else "box off"] += 1
+        boxes = np.array([[g.x, g.y, g.z, g.l, g.w, g.h, g.yaw] for g in gts]).reshape(-1, 7)
+        for g, st in zip(gts, where_lost(pts, boxes, [g.cls for g in gts], d, few, hit, native.CLASSES)):
+            counts[g.cls]["clustering" if st in ("split", "merged") else st] += 1
     return stages, counts, len(scans)
 
 

@@ -3,7 +3,7 @@
 
     lidet-eval kitti --gt GT_LABEL_DIR --pred PRED_LABEL_DIR [--classes Car,Pedestrian,Cyclist]
                      [--overlap strict|loose] [--flavour kitti|openpcdet] [--frames IDS.txt] [--json]
-    lidet-eval boxes --gt GT_BOX_DIR --pred PRED_BOX_DIR [--classes ...] [--overlap kitti|0.25] [--json]
+    lidet-eval boxes --gt GT_BOX_DIR --pred PRED_BOX_DIR [--classes ...] [--overlap kitti|0.25|loose] [--json]
 
 ``--json`` prints ``{class: {"3d"|"bev"|"2d": {"R11"|"R40": {"easy", "moderate", "hard"}}}}`` (kitti) or
 the same with the distance bands "0-20", "20-40", "40+", "all" as keys (boxes); AP in percent, null

@@ -69,7 +69,7 @@ def _ranks(frame_of_obj, sel_frames_sorted, mask):
 
 
 def pr_statistics(n_frames, gt_frame, ign_gt, dt_frame, ign_dt, score, pair_dt, pair_gt, pair_ov,
-                  min_overlap, dc_hit=None, n_sample_pts: int = N_SAMPLE_PTS) -> dict:
+                  min_overlap, dc_hit=None, n_sample_pts: int = N_SAMPLE_PTS, exact: bool = False) -> dict:
     """Precision/recall statistics of one (class, difficulty, metric, IoU threshold) over all frames.
 
     gt_frame, dt_frame: frame index of every object, sorted ascending (objects in file order within
@@ -77,6 +77,13 @@ def pr_statistics(n_frames, gt_frame, ign_gt, dt_frame, ign_dt, score, pair_dt, 
     overlaps of same-frame (detection, ground truth) pairs; pairs not listed overlap 0. dc_hit: per
     detection, True where the devkit would assign it to a DontCare region (None: no DontCare handling).
     Returns dict(n_gt, thresholds, tp, fp, fn, precision (41, max to the right), recall (41), ap_r11, ap_r40).
+
+    exact: every true positive's score is a threshold, and the 41 precision samples are the interpolated
+    precision at recall 0, 1/40, ..., 1 (the largest precision at that recall or above). The devkit's
+    thresholds (exact False) take one score per recall step of 1/40 and read the i-th threshold's precision as
+    that of recall i/40, which holds only where the class has many more than 40 objects: with n < 40 objects
+    every true positive adds one sample, so AP|R40 cannot exceed about n / 40 (a set of 15 cars found with
+    precision 1 scores 29). The two agree on large sets; `lidet_tools.eval_real` (a few real frames) uses exact.
     """
     gt_frame = np.asarray(gt_frame, dtype=np.int64)
     dt_frame = np.asarray(dt_frame, dtype=np.int64)
@@ -121,7 +128,7 @@ def pr_statistics(n_frames, gt_frame, ign_gt, dt_frame, ign_dt, score, pair_dt, 
                             cd, cg, co)
         tp_scores.append(_replay_thresholds(dense))
     all_tp = np.concatenate(tp_scores) if tp_scores else np.zeros(0)
-    thr = get_thresholds(all_tp, n_gt, n_sample_pts)
+    thr = np.unique(all_tp)[::-1] if exact else get_thresholds(all_tp, n_gt, n_sample_pts)
     T = len(thr)
 
     # ---------------- per-threshold pass: fast frames in closed form ----------------
@@ -158,7 +165,13 @@ def pr_statistics(n_frames, gt_frame, ign_gt, dt_frame, ign_dt, score, pair_dt, 
 
     prec = np.zeros(n_sample_pts)
     rec = np.zeros(n_sample_pts)
-    if T:
+    if T and exact:
+        p_t, r_t = tp / np.maximum(tp + fp, 1), tp / np.maximum(tp + fn, 1)
+        rec = np.linspace(0.0, 1.0, n_sample_pts)
+        best = np.maximum.accumulate(p_t[np.argsort(r_t)][::-1])[::-1]  # max precision at recall >= r_t (sorted)
+        k = np.searchsorted(np.sort(r_t), rec - 1e-12, side="left")
+        prec = np.where(k < T, best[np.minimum(k, T - 1)], 0.0)
+    elif T:
         prec[:T] = tp / np.maximum(tp + fp, 1)
         rec[:T] = tp / np.maximum(tp + fn, 1)
         prec = np.maximum.accumulate(prec[::-1])[::-1]

@@ -191,10 +191,11 @@ def ignore_flags(gt: LabelSet, dt: LabelSet, cls: str, difficulty: int, flavour:
 
 def evaluate(gt: LabelSet, dt: LabelSet, classes=("Car", "Pedestrian", "Cyclist"), metrics=METRICS,
              overlap: str = "strict", flavour: str = "kitti", dontcare_all_metrics: bool = False,
-             overlaps: Overlaps | None = None) -> dict:
+             overlaps: Overlaps | None = None, exact: bool = False) -> dict:
     """Evaluate detections against ground truth. Returns ``{"ap": {cls: {metric: {"R11"|"R40":
     {difficulty: AP}}}}, "curves": {cls: {metric: {difficulty: stats}}}, ...}`` where stats is the
-    dict of :func:`engine.pr_statistics`."""
+    dict of :func:`engine.pr_statistics`. exact: AP from every true positive's score (engine.pr_statistics; the
+    devkit's sampling caps AP|R40 near n / 40 for a class of n < 40 objects)."""
     if overlap not in MIN_OVERLAP:
         raise ValueError(f"overlap must be one of {sorted(MIN_OVERLAP)}")
     if flavour not in ("kitti", "openpcdet"):
@@ -218,7 +219,7 @@ def evaluate(gt: LabelSet, dt: LabelSet, classes=("Car", "Pedestrian", "Cyclist"
                 if m == "2d" or dontcare_all_metrics:
                     dc_hit = ovl.dc_ioa > thr
                 st = engine.pr_statistics(gt.n_frames, gt.frame, ign_gt, dt.frame, ign_dt, dt.score,
-                                          ovl.pair_dt, ovl.pair_gt, ovl.ov[m], thr, dc_hit)
+                                          ovl.pair_dt, ovl.pair_gt, ovl.ov[m], thr, dc_hit, exact=exact)
                 st["min_overlap"] = thr
                 curves[name][m][dname] = st
                 ok = st["n_gt"] > 0
