@@ -12,7 +12,7 @@ CMAKE_FLAGS ?=
 SAMPLE   ?= tests/data/sim_hdl64/velodyne/000000.bin
 REAL     ?= ../shared/data/real
 
-.PHONY: all deps build test test-c test-py test-asan test-fuzz fuzz fuzz-build demo bench weights clean firmware firmware-run
+.PHONY: all deps build test test-c test-py test-asan test-fuzz fuzz fuzz-build demo bench eval-real weights clean firmware firmware-run
 
 all: build
 
@@ -106,9 +106,19 @@ bench: deps build
 	-$(PY) -m pip install -q -r requirements-bench.txt || echo "bench: peers not installable here; their rows are skipped"
 	$(PY) tools/bench/run_bench.py --build $(BUILD) --real $(REAL) --out docs/BENCHMARKS.md
 
+# The detector on the real labelled frames of ../shared/data/real (validation side of
+# tools/lidet_tools/real/split.txt): recall, precision, AP per source and class, where objects are lost, a BEV
+# picture per frame in out/eval_real/pictures/. EVAL_REAL_ARGS: e.g. --fixed, --side train, --sources kitti.
+EVAL_REAL_ARGS ?=
+eval-real: deps build
+	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.eval_real --root $(REAL) --out out/eval_real $(EVAL_REAL_ARGS)
+
 # Trains the PointNets from nothing: simulated proposal datasets (C stages through the bindings),
 # classifier + box net per sensor family, ONNX export, test-split figures and weights/MODEL_CARD.md; then the
-# small VLP-16 pair of the integer firmware (family vlp16s, weights/MODEL_CARD_vlp16s.md).
+# small VLP-16 pair of the integer firmware (family vlp16s, weights/MODEL_CARD_vlp16s.md). Each run ends with
+# the int8 calibration of the models it trained (weights/*.calib.json) and every C model of weights/ regenerated
+# from the ONNX files (float *.c, int8 *_s8.c, lidet_weights.{c,h}: python -m lidet_codegen regen weights);
+# then the build, so build/ (lidet, the bindings, the tests) runs the new models.
 # Resumable (state under data/train/); about 45 min on a 2-core machine (docs/TRAINING.md).
 WEIGHTS_ARGS ?=
 weights: deps build
@@ -116,6 +126,7 @@ weights: deps build
 	    --jobs $(JOBS) --threads 1 --real $(REAL)/kitti/training --real-semantickitti $(REAL)/semantickitti $(WEIGHTS_ARGS)
 	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \
 	    --jobs $(JOBS) --threads 1 --families vlp16s --card weights/MODEL_CARD_vlp16s.md $(WEIGHTS_ARGS)
+	$(MAKE) --no-print-directory build
 
 clean:
 	rm -rf $(BUILD) $(ASAN) $(FUZZ) out

@@ -18,7 +18,7 @@ import sys
 import traceback
 
 HERE = pathlib.Path(__file__).resolve().parent
-ORDER = ["proj", "sim", "ground", "cluster", "memory", "pointnet", "detect", "adversarial", "eval"]
+ORDER = ["proj", "sim", "ground", "cluster", "memory", "pointnet", "detect", "real", "adversarial", "eval"]
 
 
 def machine() -> str:

@@ -1,0 +1,55 @@
+# SPDX-License-Identifier: MIT
+"""Real labelled frames (issue 36): the float and the integer detector on the validation frames of
+tools/lidet_tools/real/split.txt (`python -m lidet_tools.eval_real`, `make eval-real`), in the same run on the
+same frames; the section says how far the integer build is from the float one. Skipped without ../shared."""
+from __future__ import annotations
+
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+OUT = ROOT / "data" / "bench" / "eval_real"
+
+
+def _run(real, out, *extra):
+    subprocess.run([sys.executable, "-m", "lidet_tools.eval_real", "--root", str(real), "--out", str(out),
+                    "--no-pictures", *extra], check=True, capture_output=True, text=True)
+    rep = json.loads((out / "report.json").read_text())
+    return rep, (out / "report.md").read_text()
+
+
+def run(args) -> str:
+    os.environ.setdefault("LIDET_BUILD_DIR", str(args.build))
+    head = ["## Real labelled frames (issue 36)", ""]
+    if not (pathlib.Path(args.real) / "kitti").is_dir():
+        return "\n".join(head + [f"Skipped: {args.real} is not there (the real frames live in ../shared).", ""])
+    fl, fl_md = _run(args.real, OUT / "float")
+    fx, _ = _run(args.real, OUT / "fixed", "--fixed")
+    lines = head + ["`make eval-real` (`python -m lidet_tools.eval_real`): the validation frames of "
+                    "tools/lidet_tools/real/split.txt, 360 degrees, each source with its sensor preset and mount "
+                    "height; pictures of every frame in out/eval_real/pictures/.", "", fl_md.strip(), "",
+                    "The integer detector on the same frames (`--fixed`), against the float one of this run: "
+                    "AP R40 BEV loose / 3D KITTI within 40 m, all sources together:", "",
+                    "| class | float BEV loose | integer BEV loose | float 3D | integer 3D | float found | integer found |",
+                    "|---|---:|---:|---:|---:|---:|---:|"]
+    a, b = fl["summary"].get("all", next(iter(fl["summary"].values()))), \
+        fx["summary"].get("all", next(iter(fx["summary"].values())))
+
+    def g(v):
+        return "-" if v is None else f"{v:.1f}"
+    for c in ("Car", "Pedestrian", "Cyclist"):
+        ca, cb = a["classes"][c]["40"], b["classes"][c]["40"]
+        lines.append(f"| {c} | {g(a['ap']['loose'][c]['bev']['40 m'])} | {g(b['ap']['loose'][c]['bev']['40 m'])} | "
+                     f"{g(a['ap']['kitti'][c]['3d']['40 m'])} | {g(b['ap']['kitti'][c]['3d']['40 m'])} | "
+                     f"{ca['found']} / {ca['objects']} | {cb['found']} / {cb['objects']} |")
+    lines.append("")
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+    from run_bench import standalone
+    standalone(run, __doc__)

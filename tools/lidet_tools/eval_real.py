@@ -1,0 +1,403 @@
+# SPDX-License-Identifier: MIT
+"""`make eval-real`: the detector on the real labelled frames of ../shared/data/real, scored per source and class.
+
+    python -m lidet_tools.eval_real [--root ../shared/data/real] [--side val] [--sources kitti,pandaset]
+                                    [--out out/eval_real] [--fixed] [--model NAME] [--no-pictures] [--json]
+
+The frames and their side (train / val) come from tools/lidet_tools/real/split.txt, fixed once; the figures of
+docs/BENCHMARKS.md are those of the validation frames. Each frame is read by `lidet_tools.real` (boxes in the
+sensor frame), run through the detector of the bindings (`native.detect`: the float detector, 360 degrees, the
+source's sensor preset and mount height; `--fixed`: the integer detector, `native_q.detect_q`) and scored:
+
+* ground truth: Car, Pedestrian, Cyclist boxes in the source's labelled field of view with at least
+  ``--min-points`` (10) points inside (+ 0.1 m); every other labelled box (fewer points, vans, trucks,
+  motorcycles, DontCare, ...) is an *ignore region*: a detection whose centre lies in one (+ 0.3 m) is neither
+  right nor wrong;
+* detections: in the labelled field of view, outside the ignore regions, of a class the source labels (KITTI-360:
+  cars only);
+* per class and range (within 20 m, within 40 m of the sensor, horizontal range of the box centre): recall and
+  precision at the detector's operating point with the loose BEV overlaps (IoU >= 0.5 car, 0.25 pedestrian and
+  cyclist; a detection matches at most one object, greedily by score), false positives per frame (all classes),
+  AP R40 (`lidet_tools.eval.boxes_ap`: BEV and 3D, KITTI overlaps 0.7 / 0.5 / 0.5 and the loose ones);
+* KITTI's own protocol on the KITTI frames (label_2 with 2D boxes, difficulties): AP R40 3D / BEV moderate;
+* where each object within 40 m was lost (`lidet_tools.where_lost`; float detector only);
+* a BEV picture per frame (ground truth green, detections by class, ignore regions grey) in OUT/pictures/.
+
+Writes OUT/report.md and OUT/report.json and prints the report. Exit status 0; 2 when the folder is missing.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import sys
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from . import kitti, native
+from .eval import boxes_ap, iou, kitti_ap
+from .where_lost import STAGES, points_in_box, where_lost
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+SPLIT = pathlib.Path(__file__).resolve().parent / "real" / "split.txt"
+CLASSES = ("Car", "Pedestrian", "Cyclist")
+#: the loose BEV overlaps of issue 36's recall figures (and the KITTI ones, for AP)
+LOOSE = {"Car": 0.5, "Pedestrian": 0.25, "Cyclist": 0.25}
+RANGES = (20.0, 40.0)
+IGNORE_MARGIN_M = 0.3
+#: sources whose labels cover only some classes: detections of the others cannot be judged and are not scored
+LABELLED_CLASSES = {"kitti360": ("Car",)}
+
+
+def read_split(path=SPLIT) -> list:
+    """[(source, frame_id, side)] in file order; ValueError on a malformed line or a frame listed twice."""
+    out, seen = [], set()
+    for ln, line in enumerate(pathlib.Path(path).read_text().splitlines(), 1):
+        p = line.split("#", 1)[0].split()
+        if not p:
+            continue
+        if len(p) != 3 or p[2] not in ("train", "val"):
+            raise ValueError(f"{path}:{ln}: expected '<source> <frame_id> train|val', got {line.strip()!r}")
+        if (p[0], p[1]) in seen:
+            raise ValueError(f"{path}:{ln}: {p[0]} {p[1]} listed twice")
+        seen.add((p[0], p[1]))
+        out.append((p[0], p[1], p[2]))
+    return out
+
+
+@dataclass
+class FrameResult:
+    source: str
+    frame_id: str
+    n_points: int
+    gt: list                 # evaluated Box3D (the three classes, enough points, in the field of view)
+    gt_points: list          # points inside each
+    ignore: list             # Box3D ignore regions
+    dets: list               # Box3D detections kept for scoring (in the field of view, outside ignore regions)
+    dets_all: list           # every detection of the run
+    lost: list = field(default_factory=list)   # where_lost stage per gt (within 40 m), float detector only
+    ms: float = 0.0
+    calib: object = None     # kitti.Calib for the KITTI frames (official protocol)
+    label2: list = field(default_factory=list)
+
+
+def _in_fov(x, y, fov_half_rad) -> bool:
+    return fov_half_rad is None or abs(float(np.arctan2(y, x))) <= fov_half_rad
+
+
+def _arr(b) -> np.ndarray:
+    return np.array([b.x, b.y, b.z, b.l, b.w, b.h, b.yaw], dtype=np.float64)
+
+
+def _run_detector(fr, fixed: bool, model: str | None):
+    """(detections as Box3D, native.Detections or None, milliseconds)."""
+    t0 = time.perf_counter()
+    if fixed:
+        from . import native_q
+        r = native_q.detect_q(native_q.to_mm(fr.points), fr.sensor, model=model)
+        ms = (time.perf_counter() - t0) * 1e3
+        out = []
+        for c, s, b in zip(r["cls"], r["score_q15"], r["boxes"]):
+            yaw = float(np.int32(b[6])) * (np.pi / 2 ** 31)
+            out.append(kitti.Box3D(native.CLASSES[int(c)], *(float(v) / 1000.0 for v in b[:6]), yaw,
+                                   float(s) / 32768.0))
+        return out, None, ms
+    d = native.detect(fr.points, fr.sensor, model=model, mount_height_m=fr.mount_height_m)
+    ms = (time.perf_counter() - t0) * 1e3
+    out = [kitti.Box3D(native.CLASSES[int(c)], *map(float, b), float(s)) for c, s, b in zip(d.cls, d.score, d.box)]
+    return out, d, ms
+
+
+def evaluate_frame(fr, fixed=False, model=None, min_points=10) -> FrameResult:
+    """Run the detector on one `real.RealFrame` and sort its boxes into ground truth, ignore regions and
+    detections."""
+    xyz = fr.points[:, :3]
+    gt, gt_pts, ignore = [], [], []
+    for b in fr.boxes:
+        if not _in_fov(b.x, b.y, fr.fov_half_rad):
+            continue
+        n = int(points_in_box(xyz, _arr(b)).sum())
+        if b.cls in CLASSES and n >= min_points:
+            gt.append(b)
+            gt_pts.append(n)
+        else:
+            ignore.append(b)
+    dets_all, d, ms = _run_detector(fr, fixed, model)
+    dets = []
+    labelled = LABELLED_CLASSES.get(fr.source, CLASSES)
+    for b in dets_all:
+        if b.cls not in labelled or not _in_fov(b.x, b.y, fr.fov_half_rad):
+            continue
+        c = np.array([[b.x, b.y, b.z]])
+        if any(points_in_box(c, _arr(g), IGNORE_MARGIN_M)[0] for g in ignore):
+            continue
+        dets.append(b)
+    res = FrameResult(fr.source, fr.frame_id, len(fr.points), gt, gt_pts, ignore, dets, dets_all, ms=ms)
+    if d is not None:
+        near = [g for g in gt if np.hypot(g.x, g.y) <= RANGES[-1]]
+        few = int(native.cluster_defaults(fr.sensor)["min_points"])
+
+        def hit(db, gb, cls):
+            return float(iou.iou_bev_pairs(db[None], gb[None])[0]) >= LOOSE[cls]
+
+        stages = where_lost(fr.points, np.array([_arr(g) for g in near]).reshape(-1, 7), [g.cls for g in near], d,
+                            few, hit, native.CLASSES)
+        res.lost = list(zip([g.cls for g in near], stages))
+    return res
+
+
+def match(gt: list, dets: list, cls: str, max_range: float, thr: float) -> tuple[int, int, int, int]:
+    """(objects, found, detections, right) of one class within max_range at BEV IoU >= thr: each detection,
+    strongest first, takes the unmatched object it overlaps most. A detection that overlaps an object of its
+    class beyond max_range (up to 2 m further) is not counted at all."""
+    g = [x for x in gt if x.cls == cls]
+    d = sorted((x for x in dets if x.cls == cls and np.hypot(x.x, x.y) <= max_range), key=lambda x: -x.score)
+    if not d:
+        return int(sum(np.hypot(x.x, x.y) <= max_range for x in g)), 0, 0, 0
+    ov = iou.iou_bev(np.array([_arr(x) for x in d]), np.array([_arr(x) for x in g]).reshape(-1, 7)) if g else \
+        np.zeros((len(d), 0))
+    inr = np.array([np.hypot(x.x, x.y) <= max_range for x in g], dtype=bool)
+    used = np.zeros(len(g), dtype=bool)
+    found = n_det = right = 0
+    for i in range(len(d)):
+        cand = np.where(~used & (ov[i] >= thr))[0] if len(g) else np.zeros(0, np.int64)
+        if len(cand):
+            k = cand[np.argmax(ov[i, cand])]
+            used[k] = True
+            if inr[k]:
+                found += 1
+                right += 1
+                n_det += 1
+            # a match beyond max_range: neither counted nor missed
+            continue
+        n_det += 1
+    return int(inr.sum()), found, n_det, right
+
+
+def _boxset(frames: list) -> boxes_ap.BoxSet:
+    return boxes_ap.boxset_from_frames(frames)
+
+
+def ap_table(results: list) -> dict:
+    """AP R40 per class, metric, overlap and range (boxes_ap.evaluate with the bands 'within 20 m' / 'within 40 m')."""
+    bands = tuple((f"{r:g} m", 0.0, r) for r in RANGES)
+    gt, dt = _boxset([r.gt for r in results]), _boxset([r.dets for r in results])
+    out = {}
+    for ov in ("kitti", "loose"):
+        res = boxes_ap.evaluate(gt, dt, classes=CLASSES, overlap=ov, bands=bands, exact=True)
+        out[ov] = {c: {m: res["ap"][c][m]["R40"] for m in ("bev", "3d")} for c in CLASSES}
+    return out
+
+
+def kitti_official(results: list, exact: bool = True) -> dict | None:
+    """KITTI's protocol (label_2, difficulties) on the KITTI frames: AP R40 moderate per class, 3D and BEV
+    (exact: interpolated at every true positive, see engine.pr_statistics; False: the devkit's sampling)."""
+    ks = [r for r in results if r.calib is not None]
+    if not ks:
+        return None
+    gts, dts = [], []
+    for r in ks:
+        gts.append(r.label2)
+        dts.append([kitti.box_to_kitti(b, r.calib, score=b.score) for b in r.dets_all
+                    if b.x > 0.5 and _in_fov(b.x, b.y, np.radians(45.0))])
+    res = kitti_ap.evaluate(kitti_ap.labelset_from_objects(gts), kitti_ap.labelset_from_objects(dts),
+                            metrics=("3d", "bev", "2d"), exact=exact)
+    return {c: {m: res["ap"][c][m]["R40"] for m in ("3d", "bev")} for c in CLASSES}
+
+
+def summarize(results: list) -> dict:
+    """Per source (and 'all'): frames, objects, recall / precision per class and range, FP per frame, AP, where lost."""
+    groups = {}
+    for r in results:
+        groups.setdefault(r.source, []).append(r)
+    if len(groups) > 1:
+        groups["all"] = list(results)
+    out = {}
+    for src, rs in groups.items():
+        s = {"frames": len(rs), "classes": {}, "fp_per_frame": {}, "ms_median": float(np.median([r.ms for r in rs]))}
+        for rng in RANGES:
+            fp = 0
+            for c in CLASSES:
+                n_obj = found = n_det = right = 0
+                for r in rs:
+                    a, b, cnt, ok = match(r.gt, r.dets, c, rng, LOOSE[c])
+                    n_obj, found, n_det, right = n_obj + a, found + b, n_det + cnt, right + ok
+                fp += n_det - right
+                s["classes"].setdefault(c, {})[f"{rng:g}"] = {
+                    "objects": n_obj, "found": found, "detections": n_det,
+                    "recall": found / n_obj if n_obj else None, "precision": right / n_det if n_det else None}
+            s["fp_per_frame"][f"{rng:g}"] = fp / len(rs)
+        s["ap"] = ap_table(rs)
+        lost = {c: dict.fromkeys(STAGES, 0) for c in CLASSES}
+        for r in rs:
+            for c, st in r.lost:
+                lost[c][st] += 1
+        s["where_lost"] = lost
+        if src != "all":
+            s["kitti_official"] = kitti_official(rs)
+            s["kitti_devkit"] = kitti_official(rs, exact=False)
+        out[src] = s
+    return out
+
+
+def _f(v) -> str:
+    return "-" if v is None else f"{v:.2f}"
+
+
+def _p(v) -> str:
+    """An AP (already in percent)."""
+    return "-" if v is None else f"{v:.1f}"
+
+
+def format_report(summary: dict, meta: dict) -> str:
+    L = [f"Real labelled frames, side `{meta['side']}` of tools/lidet_tools/real/split.txt, detector: "
+         f"{meta['detector']}. Command: `{meta['command']}`.", "",
+         "Recall and precision at the detector's operating point, BEV IoU >= 0.5 car / 0.25 pedestrian and cyclist, "
+         f"objects with >= {meta['min_points']} points in the labelled field of view; FP/frame: detections of any "
+         "class matching no object, per frame.", "",
+         "| source | frames | range | car found | car prec. | ped found | ped prec. | cyc found | cyc prec. | FP/frame | "
+         "ms/frame |", "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for src, s in summary.items():
+        for rng in RANGES:
+            k = f"{rng:g}"
+            row = [src, str(s["frames"]), f"<= {k} m"]
+            for c in CLASSES:
+                v = s["classes"][c][k]
+                row.append(f"{v['found']} / {v['objects']}" + (f" ({_f(v['recall'])})" if v["objects"] else ""))
+                row.append(_f(v["precision"]))
+            row += [f"{s['fp_per_frame'][k]:.2f}", f"{s['ms_median']:.1f}"]
+            L.append("| " + " | ".join(row) + " |")
+    L += ["", "AP R40 (percent; `lidet_tools.eval.boxes_ap`, sensor frame, the objects above within the range; KITTI "
+          "overlaps 0.7 / 0.5 / 0.5, loose 0.5 / 0.25 / 0.25; interpolated at every true positive, `exact`):", "",
+          "| source | range | car 3D | car BEV | car BEV loose | ped 3D | ped BEV | ped BEV loose | cyc 3D | cyc BEV | "
+          "cyc BEV loose |", "|---|---|" + "---:|" * 9]
+    for src, s in summary.items():
+        for rng in RANGES:
+            k = f"{rng:g} m"
+            row = [src, f"<= {k}"]
+            for c in CLASSES:
+                row += [_p(s["ap"]["kitti"][c]["3d"][k]), _p(s["ap"]["kitti"][c]["bev"][k]),
+                        _p(s["ap"]["loose"][c]["bev"][k])]
+            L.append("| " + " | ".join(row) + " |")
+    ko = [(src, s) for src, s in summary.items() if s.get("kitti_official")]
+    if ko:
+        L += ["", "KITTI's protocol on the KITTI frames (label_2, camera frame, difficulties, strict overlaps 0.7 / 0.5 / "
+              "0.5), AP R40 moderate: interpolated at every true positive, and (devkit) with the devkit's 41 score "
+              "thresholds, which cap AP near n / 40 for a class of n < 40 objects:", "",
+              "| source | frames | car 3D | car BEV | ped 3D | ped BEV | cyc 3D | cyc BEV | car 3D (devkit) |",
+              "|---|---:|" + "---:|" * 7]
+        for src, s in ko:
+            k, dk = s["kitti_official"], s["kitti_devkit"]
+            row = [src, str(s["frames"])]
+            for c in CLASSES:
+                row += [_p(k[c]["3d"].get("moderate")), _p(k[c]["bev"].get("moderate"))]
+            row.append(_p(dk["Car"]["3d"].get("moderate")))
+            L.append("| " + " | ".join(row) + " |")
+    if any(sum(sum(v.values()) for v in s["where_lost"].values()) for s in summary.values()):
+        L += ["", "Where the objects within 40 m were lost (`lidet_tools.where_lost`; float detector):", "",
+              "| source | class | " + " | ".join(STAGES) + " |", "|---|---|" + "---:|" * len(STAGES)]
+        for src, s in summary.items():
+            for c in CLASSES:
+                row = s["where_lost"][c]
+                if sum(row.values()):
+                    L.append(f"| {src} | {c} ({sum(row.values())}) | " + " | ".join(str(row[x]) for x in STAGES) + " |")
+    return "\n".join(L) + "\n"
+
+
+def _json_num(v):
+    """numpy scalars in the JSON report."""
+    if isinstance(v, np.generic):
+        return v.item()
+    raise TypeError(f"not JSON serializable: {type(v).__name__}")
+
+
+def picture(r: FrameResult, fr, path) -> None:
+    """BEV of the frame: ground truth (green), every detection of the run (dashed, by class), ignore regions
+    (dark, dashed) and the labelled field of view (dotted wedge)."""
+    import matplotlib.pyplot as plt
+
+    from .viz.bev import box_outline, plot_bev
+    n = {c: sum(g.cls == c for g in r.gt) for c in CLASSES}
+    title = (f"{r.source} {r.frame_id} ({fr.sensor}, {r.n_points} points, {r.ms:.1f} ms)\n"
+             f"ground truth {n['Car']} car / {n['Pedestrian']} ped / {n['Cyclist']} cyc; "
+             f"{len(r.dets_all)} detections, {len(r.dets)} scored; grey: {len(r.ignore)} ignored boxes")
+    fig = plot_bev(fr.points, gt_boxes=r.gt, pred_boxes=r.dets_all, title=title, view_m=45.0, show_gt_class=True)
+    ax = fig.axes[0]
+    for g in r.ignore:
+        if np.hypot(g.x, g.y) < 70 and g.l > 0 and g.w > 0:
+            o = box_outline(g)
+            ax.plot(o[:, 0], o[:, 1], color="#7f7f7f", lw=1.0, ls="-.", zorder=4)
+    if fr.fov_half_rad is not None:
+        for sgn in (-1.0, 1.0):
+            a = sgn * fr.fov_half_rad
+            ax.plot([0, 64 * np.cos(a)], [0, 64 * np.sin(a)], ls=":", lw=1.2, color="#444444", zorder=3)
+    fig.savefig(path)
+    plt.close(fig)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m lidet_tools.eval_real", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--root", default=str(ROOT.parent / "shared" / "data" / "real"),
+                    help="the real frames (default ../shared/data/real beside the repository)")
+    ap.add_argument("--split", default=str(SPLIT), help="the split file (default: the repository's)")
+    ap.add_argument("--side", choices=("val", "train", "all"), default="val")
+    ap.add_argument("--sources", help="comma-separated sources (default: every source in the split)")
+    ap.add_argument("--out", default="out/eval_real", help="report.md, report.json, pictures/")
+    ap.add_argument("--fixed", action="store_true", help="the integer detector (int8 models, millimetres)")
+    ap.add_argument("--model", help="model family (default: the sensor's)")
+    ap.add_argument("--min-points", type=int, default=10, help="objects with fewer points are ignored (default 10)")
+    ap.add_argument("--no-pictures", action="store_true")
+    ap.add_argument("--json", action="store_true", help="print report.json instead of the tables")
+    a = ap.parse_args(argv)
+    from . import real
+    root = pathlib.Path(a.root)
+    if not root.is_dir():
+        print(f"eval_real: {root} not found (the real frames live in ../shared/data/real; nothing to do)",
+              file=sys.stderr)
+        return 2
+    frames = [(s, f) for s, f, side in read_split(a.split) if a.side in ("all", side)]
+    if a.sources:
+        want = a.sources.split(",")
+        bad = sorted(set(want) - set(real.SOURCES))
+        if bad:
+            ap.error(f"unknown source(s) {', '.join(bad)}; sources: {', '.join(real.SOURCES)}")
+        frames = [x for x in frames if x[0] in want]
+    out = pathlib.Path(a.out)
+    (out / "pictures").mkdir(parents=True, exist_ok=True)
+    results = []
+    for src, fid in frames:
+        try:
+            fr = real.load_frame(root, src, fid)
+        except FileNotFoundError as e:
+            print(f"eval_real: skipping {src} {fid}: {e}", file=sys.stderr)
+            continue
+        r = evaluate_frame(fr, a.fixed, a.model, a.min_points)
+        if src == "kitti":
+            base = root / "kitti" / "training"
+            r.calib = kitti.read_calib(base / "calib" / f"{fid}.txt")
+            r.label2 = kitti.read_label2(base / "label_2" / f"{fid}.txt")
+        results.append(r)
+        if not a.no_pictures:
+            picture(r, fr, out / "pictures" / f"{src}_{fid}.png")
+    if not results:
+        print("eval_real: no frames", file=sys.stderr)
+        return 2
+    summary = summarize(results)
+    cmd = "python -m lidet_tools.eval_real" + (f" --side {a.side}" if a.side != "val" else "") + \
+        (" --fixed" if a.fixed else "") + (f" --sources {a.sources}" if a.sources else "")
+    meta = {"side": a.side, "detector": "integer (int8)" if a.fixed else "float", "command": cmd,
+            "min_points": a.min_points}
+    text = format_report(summary, meta)
+    (out / "report.md").write_text(text)
+    per_frame = [{"source": r.source, "frame": r.frame_id, "objects": len(r.gt), "detections": len(r.dets),
+                  "ms": r.ms, "lost": r.lost} for r in results]
+    (out / "report.json").write_text(json.dumps({"meta": meta, "summary": summary, "frames": per_frame}, indent=1, default=_json_num))
+    print(json.dumps(summary, indent=1, default=_json_num) if a.json else text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
