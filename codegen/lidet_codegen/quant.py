@@ -329,9 +329,18 @@ def int_proposals(xyz, mean):
     return np.clip(pix - m4[:, None, :], -32768, 32767), m4
 
 
-def scan_list(sensor: str, real_dir=None):
+def scan_list(sensor: str, real_dir=None, scan_dirs=None):
+    """The calibration scans: the simulated sample of the sensor, then the real ones: with `scan_dirs` (folders
+    holding velodyne/*.bin: a user's own scans, `calibrate --scans`) every scan of those, else for hdl64 the KITTI
+    scans under real_dir/kitti/."""
     scans = [ROOT / f"tests/data/sim_{sensor}/velodyne/000000.bin"]
-    if real_dir is not None and sensor == "hdl64":
+    if scan_dirs:
+        for d in scan_dirs:
+            found = sorted(pathlib.Path(d, "velodyne").glob("*.bin"))
+            if not found:
+                raise EmitError(f"{d}: no velodyne/*.bin scans to calibrate on")
+            scans += [f.resolve() for f in found]
+    elif real_dir is not None and sensor == "hdl64":
         scans += sorted(pathlib.Path(real_dir, "kitti").glob("*/velodyne/*.bin"))
     return scans
 
@@ -392,10 +401,12 @@ def _sim_scans(sensor: str, seed: int, n: int, first: int = 0) -> list:
     return [simulate_scan(sensor, seed, k).points for k in range(first, first + n)]
 
 
-def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS) -> dict:
+def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS, scan_dirs=None) -> dict:
+    """The calibration file of a model (scan_list: with scan_dirs, the user's scans replace the real KITTI ones; they
+    are recorded relative to the repository when inside it, else by absolute path)."""
     onnx_path = pathlib.Path(onnx_path)
     model = load(onnx_path, onnx_path.stem)
-    scans = scan_list(sensor, real_dir)
+    scans = scan_list(sensor, real_dir, scan_dirs)
     sims = _sim_scans(sensor, CALIB_SIM_SEED, CALIB_N_SIM)
     xyz, mean, vox = proposals_of(scans + sims, sensor, seeds, model.n_points)
     cls = calib_classes(model, xyz, mean, vox, onnx_path.parent)
@@ -408,7 +419,9 @@ def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS) -> dict:
     else:
         ranges = {nm: float(np.percentile(np.abs(t), pct)) for nm, t in zip(names, tr)}
     def rel(p):
-        return p.relative_to(ROOT).as_posix() if p.is_relative_to(ROOT) else "real/" + "/".join(p.parts[-3:])
+        if p.is_relative_to(ROOT):
+            return p.relative_to(ROOT).as_posix()
+        return p.as_posix() if scan_dirs else "real/" + "/".join(p.parts[-3:])
 
     return {"model": onnx_path.stem, "onnx_sha256": hashlib.sha256(onnx_path.read_bytes()).hexdigest(),
             "sensor": sensor, "seeds": [int(s) for s in seeds], "percentile": pct, "ranges_per": per,
@@ -471,6 +484,8 @@ def calib_set(calib: dict, real_dir=None):
             if real_dir is None:
                 return None
             paths.append(pathlib.Path(real_dir, "kitti", *s.split("/")[1:]))
+        elif pathlib.PurePosixPath(s).is_absolute():  # a user's scan outside the repository (calibrate --scans)
+            paths.append(pathlib.Path(s))
         else:
             paths.append(ROOT / s)
     if not all(p.exists() for p in paths):
@@ -658,12 +673,18 @@ def main(argv=None) -> int:
                                      "name's suffix)")
     ap.add_argument("--real", default=str(ROOT.parent / "shared" / "data" / "real"),
                     help="real scans folder (used when present; KITTI HDL-64 scans for hdl64 models)")
+    ap.add_argument("--scans", action="append", default=None, metavar="DIR",
+                    help="calibrate on the scans DIR/velodyne/*.bin (repeatable; e.g. the scans a model was fine-tuned "
+                         "on) instead of the real KITTI scans of --real")
     ap.add_argument("--out", help="calibration file (default: beside the model, <name>.calib.json)")
     ap.add_argument("--refit", action="store_true",
                     help="classifiers: keep the calibration file's ranges and add the refitted last layer "
                          "(head_refit; lidet_codegen.quant.refit)")
     a = ap.parse_args(argv)
     real = pathlib.Path(a.real) if (pathlib.Path(a.real) / "kitti").exists() else None
+    for d in a.scans or []:
+        if not any(pathlib.Path(d, "velodyne").glob("*.bin")):
+            ap.error(f"--scans {d}: no velodyne/*.bin scans there")
     for p in a.onnx:
         p = pathlib.Path(p)
         sensor = a.sensor or _model_sensor(p)
@@ -672,7 +693,7 @@ def main(argv=None) -> int:
             cal = refit(p, json.loads(p.with_suffix(".calib.json").read_text()), real)
             print(f"{p} -> {out}: last layer refitted on {cal['head_refit']['n_proposals']} proposals")
         else:
-            cal = calibrate(p, sensor, real)
+            cal = calibrate(p, sensor, real, scan_dirs=a.scans)
             print(f"{p} -> {out}: {cal['n_proposals']} proposals of {len(cal['scans'])} scans x "
                   f"{len(cal['seeds'])} seeds")
         out.write_text(json.dumps(cal, indent=1, sort_keys=True) + "\n")

@@ -62,7 +62,7 @@ def _in_box(xyz, b, margin=0.1):
 
 def accounting(folder, sensor, n_scans, max_range=40.0, crop=False, mount_height_m=None):
     """For every Car / Pedestrian / Cyclist within max_range m (and in the crop): where it was lost
-    (lidet_tools.where_lost; its split and merged stages summed as clustering)."""
+    (lidet_tools.where_lost; its no cluster, split and merged stages summed as clustering)."""
     from lidet_tools import kitti, native
     from lidet_tools.eval.iou import iou_3d_pairs
     from lidet_tools.where_lost import where_lost
@@ -83,7 +83,7 @@ def accounting(folder, sensor, n_scans, max_range=40.0, crop=False, mount_height
         d = native.detect(pts, sensor, crop_half_rad=np.pi / 4 if crop else 0.0, mount_height_m=mount_height_m)
         boxes = np.array([[g.x, g.y, g.z, g.l, g.w, g.h, g.yaw] for g in gts]).reshape(-1, 7)
         for g, st in zip(gts, where_lost(pts, boxes, [g.cls for g in gts], d, few, hit, native.CLASSES)):
-            counts[g.cls]["clustering" if st in ("split", "merged") else st] += 1
+            counts[g.cls]["clustering" if st in ("no cluster", "split", "merged") else st] += 1
     return stages, counts, len(scans)
 
 

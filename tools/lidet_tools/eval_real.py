@@ -20,7 +20,10 @@ source's sensor preset and mount height; `--fixed`: the integer detector, `nativ
   cyclist; a detection matches at most one object, greedily by score), false positives per frame (all classes),
   AP R40 (`lidet_tools.eval.boxes_ap`: BEV and 3D, KITTI overlaps 0.7 / 0.5 / 0.5 and the loose ones);
 * KITTI's own protocol on the KITTI frames (label_2 with 2D boxes, difficulties): AP R40 3D / BEV moderate;
-* where each object within 40 m was lost (`lidet_tools.where_lost`; float detector only);
+* where each object within 40 m was lost (`lidet_tools.where_lost` over the points that won their pixel of the
+  projection, the ones the detector sees; float detector only), and the share of points seen per source: a
+  sensor whose beams the preset does not describe (PandaSet's Pandar64 on `hdl64`, Argoverse's two VLP-32C on
+  `vlp32c`) loses many points to pixel collisions;
 * a BEV picture per frame (ground truth green, detections by class, ignore regions grey) in OUT/pictures/.
 
 Writes OUT/report.md and OUT/report.json and prints the report. Exit status 0; 2 when the folder is missing.
@@ -79,6 +82,7 @@ class FrameResult:
     dets_all: list           # every detection of the run
     lost: list = field(default_factory=list)   # where_lost stage per gt (within 40 m), float detector only
     ms: float = 0.0
+    seen_share: float | None = None   # share of the points that won their pixel (float detector's projection)
     calib: object = None     # kitti.Calib for the KITTI frames (official protocol)
     label2: list = field(default_factory=list)
 
@@ -93,21 +97,36 @@ def _arr(b) -> np.ndarray:
 
 def _run_detector(fr, fixed: bool, model: str | None):
     """(detections as Box3D, native.Detections or None, milliseconds)."""
-    t0 = time.perf_counter()
     if fixed:
-        from . import native_q
-        r = native_q.detect_q(native_q.to_mm(fr.points), fr.sensor, model=model)
-        ms = (time.perf_counter() - t0) * 1e3
-        out = []
-        for c, s, b in zip(r["cls"], r["score_q15"], r["boxes"]):
-            yaw = float(np.int32(b[6])) * (np.pi / 2 ** 31)
-            out.append(kitti.Box3D(native.CLASSES[int(c)], *(float(v) / 1000.0 for v in b[:6]), yaw,
-                                   float(s) / 32768.0))
-        return out, None, ms
+        return _run_fixed(fr, model)
+    t0 = time.perf_counter()
     d = native.detect(fr.points, fr.sensor, model=model, mount_height_m=fr.mount_height_m)
     ms = (time.perf_counter() - t0) * 1e3
     out = [kitti.Box3D(native.CLASSES[int(c)], *map(float, b), float(s)) for c, s, b in zip(d.cls, d.score, d.box)]
     return out, d, ms
+
+
+def _run_fixed(fr, model: str | None):
+    """The integer detector through the host CLI (`lidet detect --fixed`: int8 models, the scan in millimetres),
+    which takes the source's mount height as the float run does; milliseconds are the CLI's total_ms."""
+    import subprocess
+    import tempfile
+
+    from . import native_q
+    from .detect import find_cli
+    fam = model or (fr.sensor if f"cls_{fr.sensor}_s8" in native_q.pnq_models() else "hdl64")
+    with tempfile.TemporaryDirectory() as td:
+        scan = pathlib.Path(td) / "scan.bin"
+        kitti.write_bin(scan, fr.points)
+        cmd = [str(find_cli()), "detect", str(scan), "--sensor", fr.sensor, "--fixed", "--model", fam,
+               "--mount-height", repr(float(fr.mount_height_m)), "--json"]
+        r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)}: {r.stderr.strip()}")
+    js = json.loads(r.stdout)
+    out = [kitti.Box3D(b["class"], b["x"], b["y"], b["z"], b["l"], b["w"], b["h"], b["yaw"], b["score"])
+           for b in js["boxes"]]
+    return out, None, float(js["total_ms"])
 
 
 def evaluate_frame(fr, fixed=False, model=None, min_points=10) -> FrameResult:
@@ -142,8 +161,12 @@ def evaluate_frame(fr, fixed=False, model=None, min_points=10) -> FrameResult:
         def hit(db, gb, cls):
             return float(iou.iou_bev_pairs(db[None], gb[None])[0]) >= LOOSE[cls]
 
+        img = native.project(fr.points, fr.sensor)  # the detector's projection: which points it sees
+        seen = np.zeros(len(fr.points), dtype=bool)
+        seen[img.point_idx[img.point_idx >= 0]] = True
+        res.seen_share = float(seen.mean())
         stages = where_lost(fr.points, np.array([_arr(g) for g in near]).reshape(-1, 7), [g.cls for g in near], d,
-                            few, hit, native.CLASSES)
+                            few, hit, native.CLASSES, seen=seen)
         res.lost = list(zip([g.cls for g in near], stages))
     return res
 
@@ -217,6 +240,8 @@ def summarize(results: list) -> dict:
     out = {}
     for src, rs in groups.items():
         s = {"frames": len(rs), "classes": {}, "fp_per_frame": {}, "ms_median": float(np.median([r.ms for r in rs]))}
+        shares = [r.seen_share for r in rs if r.seen_share is not None]
+        s["seen_share"] = float(np.mean(shares)) if shares else None
         for rng in RANGES:
             fp = 0
             for c in CLASSES:
@@ -256,9 +281,10 @@ def format_report(summary: dict, meta: dict) -> str:
          f"{meta['detector']}. Command: `{meta['command']}`.", "",
          "Recall and precision at the detector's operating point, BEV IoU >= 0.5 car / 0.25 pedestrian and cyclist, "
          f"objects with >= {meta['min_points']} points in the labelled field of view; FP/frame: detections of any "
-         "class matching no object, per frame.", "",
+         "class matching no object, per frame; points seen: the share of the scan's points that win a pixel of the "
+         "projection (the rest collide with another point of the same pixel).", "",
          "| source | frames | range | car found | car prec. | ped found | ped prec. | cyc found | cyc prec. | FP/frame | "
-         "ms/frame |", "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+         "ms/frame | points seen |", "|---|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for src, s in summary.items():
         for rng in RANGES:
             k = f"{rng:g}"
@@ -267,7 +293,8 @@ def format_report(summary: dict, meta: dict) -> str:
                 v = s["classes"][c][k]
                 row.append(f"{v['found']} / {v['objects']}" + (f" ({_f(v['recall'])})" if v["objects"] else ""))
                 row.append(_f(v["precision"]))
-            row += [f"{s['fp_per_frame'][k]:.2f}", f"{s['ms_median']:.1f}"]
+            row += [f"{s['fp_per_frame'][k]:.2f}", f"{s['ms_median']:.1f}",
+                    "-" if s.get("seen_share") is None else f"{100 * s['seen_share']:.0f} %"]
             L.append("| " + " | ".join(row) + " |")
     L += ["", "AP R40 (percent; `lidet_tools.eval.boxes_ap`, sensor frame, the objects above within the range; KITTI "
           "overlaps 0.7 / 0.5 / 0.5, loose 0.5 / 0.25 / 0.25; interpolated at every true positive, `exact`):", "",

@@ -6,8 +6,9 @@ Stages, in the order they are tested (the first that applies is the object's):
 
 * ``too few points``: fewer than the clustering's ``min_points`` points inside the box (+ 0.1 m);
 * ``ground``: as few left once the ground stage's points are taken out;
-* ``split``: no cluster holds >= 70 % of the object's non-ground points (the object came out in pieces, or its
-  points were left out of every cluster);
+* ``no cluster``: none of its non-ground points is in a kept cluster (its component was dropped by the
+  clustering's filters: too wide, too tall, too many points; or it joined such a component);
+* ``split``: no cluster holds >= 70 % of the object's non-ground points (the object came out in pieces);
 * ``merged``: the cluster holding most of them is < 70 % object (the object was joined with a neighbour);
 * ``budget/crop``: the cluster was not classified (proposal budget, crop, range, capacity, too tall);
 * ``gate 1`` / ``gate 2``: rejected by the classifier's / the box net's energy gate;
@@ -25,8 +26,8 @@ from typing import Callable
 
 import numpy as np
 
-STAGES = ("too few points", "ground", "split", "merged", "budget/crop", "gate 1", "gate 2", "size", "nms",
-          "wrong class", "box off", "detected")
+STAGES = ("too few points", "ground", "no cluster", "split", "merged", "budget/crop", "gate 1", "gate 2", "size",
+          "nms", "wrong class", "box off", "detected")
 #: native.OUTCOME name -> stage, for clusters that did not become a detection
 _OUTCOME_STAGE = {"crop": "budget/crop", "range": "budget/crop", "budget": "budget/crop", "capacity": "budget/crop",
                   "tall": "budget/crop", "gate1": "gate 1", "gate2": "gate 2", "size": "size", "nms": "nms"}
@@ -45,16 +46,24 @@ def points_in_box(xyz: np.ndarray, box, margin: float = 0.1) -> np.ndarray:
 
 
 def where_lost(points: np.ndarray, gt_boxes: np.ndarray, gt_cls: list, det, min_points: int,
-               hit: Callable[[np.ndarray, np.ndarray, str], bool], classes=("Car", "Cyclist", "Pedestrian")) -> list:
+               hit: Callable[[np.ndarray, np.ndarray, str], bool], classes=("Car", "Cyclist", "Pedestrian"),
+               seen: np.ndarray | None = None) -> list:
     """The stage (one of STAGES) of each ground-truth box.
 
     points: (N, >=3) the scan the detector ran on; gt_boxes: (K, 7) sensor-frame boxes; gt_cls: their classes;
     det: `native.Detections` of that run; min_points: the clustering's min_points; classes: native.CLASSES (the
-    index order of det.cls); hit(det_box, gt_box, cls) -> True when a detection of the right class counts."""
-    csize = np.bincount(det.point_cluster.astype(np.int64), minlength=len(det.outcome) + 1)
+    index order of det.cls); hit(det_box, gt_box, cls) -> True when a detection of the right class counts.
+    seen: optional (N,) mask of the points that won their pixel (`native.project(...).point_idx`): the detector
+    sees only those, and a point that lost its pixel carries the winner's cluster id (lidet_cluster_point_labels),
+    which can lie metres in front of it; with the mask every count is over the seen points alone. Without it,
+    every point counts (the simulated benchmark's table)."""
+    pc = det.point_cluster if seen is None else np.where(seen, det.point_cluster, 0)
+    csize = np.bincount(pc.astype(np.int64), minlength=len(det.outcome) + 1)
     out = []
     for b, cls in zip(np.asarray(gt_boxes, dtype=np.float64).reshape(-1, 7), gt_cls):
         m = points_in_box(points, b)
+        if seen is not None:
+            m &= seen
         if m.sum() < min_points:
             out.append("too few points")
             continue
@@ -62,10 +71,10 @@ def where_lost(points: np.ndarray, gt_boxes: np.ndarray, gt_cls: list, det, min_
         if ng.sum() < min_points:
             out.append("ground")
             continue
-        ids = det.point_cluster[ng]
+        ids = pc[ng]
         ids = ids[ids > 0]
         if len(ids) == 0:
-            out.append("split")
+            out.append("no cluster")
             continue
         cid = int(np.bincount(ids).argmax())
         held = int((ids == cid).sum())

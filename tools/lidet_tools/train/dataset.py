@@ -19,7 +19,9 @@ the scan's ground-truth boxes:
   pedestrian is not penalised by KITTI, so they must not be taught as negatives. Also excluded:
   clusters whose mean falls in a KITTI `DontCare` 2D region, and for KITTI folders clusters outside
   the camera's field of view (label_2 annotates only what the camera sees: an unlabelled car behind
-  the vehicle must not become a negative).
+  the vehicle must not become a negative), and for sensor-frame folders (`--boxes`) clusters outside
+  their labelled azimuth field of view, clusters mostly in a `DontCare` box, and, in a scan that labels
+  only some classes (KITTI-360: cars only), clusters in no labelled box.
 * **OOD**: every other cluster (poles, trees, walls, bushes, trucks, buses, parked bicycles,
   fragments of road users, groups merged into one cluster, ...).
 
@@ -44,6 +46,20 @@ int16, `label` (K,) int8 (0 Car, 1 Cyclist, 2 Pedestrian, -1 OOD; excluded clust
     python -m lidet_tools.train.dataset --sensor vlp16 --mounts 0.3,0.5,0.7,1.0 --sim 200,50,50 --out ...
     python -m lidet_tools.train.dataset --sensor hdl64 --kitti ../shared/data/real/kitti/training --split test --out real.npz
     python -m lidet_tools.train.dataset --sensor hdl64 --semantickitti DIR --out ...
+    python -m lidet_tools.train.dataset --sensor hdl64 --boxes data/real_train --split train --out ...
+
+Sensor-frame folders (`--boxes DIR`): lidet's own layout, `velodyne/<name>.bin` (float32 x, y, z, intensity) and
+`boxes/<name>.txt` (`<class> x y z l w h yaw score` per line, `kitti.read_boxes`; what `lidet-sim` and
+`python -m lidet_tools.real.export` write). Scans without a boxes file are skipped. An optional `DIR/meta.json`
+gives per-folder defaults and per-scan values (`python -m lidet_tools.real.export` writes one):
+
+    {"fov_half_deg": 45, "mount_height_m": 1.73, "sensor": "hdl64", "classes": ["Car", "Pedestrian", "Cyclist"],
+     "frames": {"<name>": {"fov_half_deg": null, "mount_height_m": 2.05, ...}}}
+
+fov_half_deg: labels exist where |azimuth| <= it (null or absent: all around); clusters outside are excluded, not
+negatives. mount_height_m: the sensor's height above the road (the C stages run with it; absent: the profile's).
+sensor: the profile of the C stages (absent: --sensor). classes: the classes labelled in the scan (absent: all
+three). `--fov-deg` and `--mount-height` give the values for folders and scans that do not state them.
 """
 from __future__ import annotations
 
@@ -120,11 +136,14 @@ class Scan:
     optional per-point SemanticKITTI labels, ring, camera (for KITTI field-of-view and DontCare)."""
 
     def __init__(self, name, points, boxes, sem=None, inst=None, ring=None, calib=None, dontcare=(), fov_only=False,
-                 mount=None):
+                 mount=None, fov_half=None, labelled=None, sensor=None):
         self.name, self.points, self.boxes = name, points, boxes
         self.sem, self.inst, self.ring, self.calib = sem, inst, ring, calib
         self.dontcare, self.fov_only = list(dontcare), fov_only
         self.mount = mount  # the sensor's height above the ground when it is not the profile's (m), else None
+        self.fov_half = fov_half  # labels exist where |azimuth| <= it (rad); None: all around
+        self.labelled = labelled  # the ID classes the scan labels (None: all); other clusters in no box are excluded
+        self.sensor = sensor  # the C stages' sensor profile when it is not the dataset's, else None
 
 
 def sim_scan(sensor: str, seed: int, index: int, mount: float | None) -> Scan:
@@ -166,6 +185,58 @@ def kitti_scan(folder, name: str) -> Scan:
     return Scan(f"kitti:{folder}:{name}", pts, boxes, sem=sem, inst=inst, calib=calib, dontcare=dc, fov_only=True)
 
 
+def boxes_meta(folder) -> dict:
+    """The optional DIR/meta.json of a sensor-frame folder ({} without one); ValueError naming it when malformed."""
+    p = pathlib.Path(folder) / "meta.json"
+    if not p.exists():
+        return {}
+    try:
+        m = json.loads(p.read_text())
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{p}: not JSON ({e})") from None
+    if not isinstance(m, dict) or not isinstance(m.get("frames", {}), dict):
+        raise ValueError(f"{p}: expected an object with optional per-scan values in 'frames'")
+    return m
+
+
+def boxes_scans(folder) -> list[str]:
+    """Scan names of a sensor-frame folder (velodyne/ + boxes/). Raises on a bad folder."""
+    folder = pathlib.Path(folder)
+    for sub in ("velodyne", "boxes"):
+        if not (folder / sub).is_dir():
+            raise FileNotFoundError(f"{folder}: no {sub}/ folder (a sensor-frame folder holds velodyne/ and boxes/)")
+    names = sorted(f.stem for f in (folder / "velodyne").glob("*.bin") if (folder / "boxes" / (f.stem + ".txt")).exists())
+    if not names:
+        raise ValueError(f"{folder}: no velodyne/*.bin with a boxes/*.txt")
+    return names
+
+
+def boxes_settings(folder, name: str, defaults: dict | None = None) -> dict:
+    """fov_half_deg, mount_height_m, sensor, classes of one scan of a sensor-frame folder: its meta.json entry, else
+    the file's folder-level values, else `defaults` (the command line's), else None."""
+    m = boxes_meta(folder)
+    f = m.get("frames", {}).get(name, {})
+    out = {}
+    for k in ("fov_half_deg", "mount_height_m", "sensor", "classes"):
+        out[k] = f[k] if k in f else m[k] if k in m else (defaults or {}).get(k)
+    bad = [c for c in out["classes"] or () if c not in ID_CLASSES]
+    if bad:
+        raise ValueError(f"{folder}/meta.json: {name}: unknown classes {bad} (labelled classes among {list(ID_CLASSES)})")
+    return out
+
+
+def boxes_scan(folder, name: str, defaults: dict | None = None) -> Scan:
+    """One scan of a sensor-frame folder: boxes as written (sensor frame), the folder's settings (boxes_settings)."""
+    folder = pathlib.Path(folder)
+    pts = kitti.read_bin(folder / "velodyne" / f"{name}.bin")
+    boxes = [(b.cls, (b.x, b.y, b.z, b.l, b.w, b.h, b.yaw)) for b in kitti.read_boxes(folder / "boxes" / f"{name}.txt")]
+    s = boxes_settings(folder, name, defaults)
+    fov = None if s["fov_half_deg"] is None else np.radians(float(s["fov_half_deg"]))
+    lab = None if s["classes"] is None or set(s["classes"]) == set(ID_CLASSES) else tuple(s["classes"])
+    return Scan(f"boxes:{folder}:{name}", pts, boxes, mount=None if s["mount_height_m"] is None else float(s["mount_height_m"]),
+                fov_half=fov, labelled=lab, sensor=s["sensor"])
+
+
 def semkitti_scans(folder) -> list[str]:
     folder = pathlib.Path(folder)
     for sub in ("velodyne", "labels"):
@@ -202,7 +273,8 @@ def _objects(scan: Scan, nonground: np.ndarray, margin: float):
             closer = d < best[idx]
             owner[idx[closer]] = j
             best[idx[closer]] = d[closer]
-            role = "id" if cls in ID_CLASSES else ("ignored" if cls in IGNORED_CLASSES else "other")
+            # DontCare boxes (sensor-frame folders: regions an evaluation ignores) are ignored as Van is
+            role = "id" if cls in ID_CLASSES else ("ignored" if cls in IGNORED_CLASSES or cls == "DontCare" else "other")
             objs.append([role, ID_CLASSES.get(cls, -1), np.asarray(box, np.float64), 0])
     elif scan.sem is not None:
         key = scan.sem.astype(np.int64) * 65536 + scan.inst.astype(np.int64)
@@ -255,7 +327,7 @@ def process_scan(scan: Scan, sensor: str, cfg: dict) -> dict:
     # A simulated robot mount runs the stages with that height, as the detector on that robot is configured
     # (lidet detect --mount-height): with the profile's, the ground of a 1.0 m VLP-16 mount is refused
     # sector by sector and stays in the clusters (docs/DETECTOR.md, Mount height)
-    s = get_sensor(sensor) if isinstance(sensor, str) else sensor
+    s = get_sensor(scan.sensor or sensor) if isinstance(scan.sensor or sensor, str) else sensor
     if scan.mount is not None:
         s = dataclasses.replace(s, mount_height_m=float(scan.mount))
     gr = native.ground(pts, s)
@@ -284,6 +356,8 @@ def process_scan(scan: Scan, sensor: str, cfg: dict) -> dict:
                 vals, cnt = np.unique(sc, return_counts=True)
                 sem_dom[c] = int(vals[np.argmax(cnt)])
             if len(o) == 0:
+                if scan.labelled is not None:
+                    keep[c] = False  # in no box of a scan that labels only some classes: it may be an unlabelled one
                 continue
             vals, cnt = np.unique(o, return_counts=True)
             j = int(vals[np.argmax(cnt)])
@@ -301,6 +375,8 @@ def process_scan(scan: Scan, sensor: str, cfg: dict) -> dict:
             if scan.fov_only:
                 keep &= _in_camera(scan.calib, pr.mean.astype(np.float64))
             keep &= ~_in_dontcare(scan.calib, pr.mean.astype(np.float64), scan.dontcare)
+        if scan.fov_half is not None:
+            keep &= np.abs(np.arctan2(pr.mean[:, 1].astype(np.float64), pr.mean[:, 0].astype(np.float64))) <= scan.fov_half
     box_model = np.full((k, 7), np.nan, np.float32)
     ok = ~np.isnan(box[:, 0])
     if ok.any():
@@ -321,6 +397,8 @@ def _job(task, sensor, cfg):
         scan = sim_scan(sensor, a, b, c)
     elif kind == "kitti":
         scan = kitti_scan(a, b)
+    elif kind == "boxes":
+        scan = boxes_scan(a, b, c)
     else:
         scan = semkitti_scan(a, b)
     out = process_scan(scan, sensor, cfg)
@@ -352,6 +430,11 @@ def build_tasks(a) -> list:
     for folder in a.semantickitti or []:
         for n in semkitti_scans(folder):
             tasks.append(("semantickitti", split_of(n), str(folder), n, None))
+    defaults = dict(fov_half_deg=getattr(a, "fov_deg", None), mount_height_m=getattr(a, "mount_height", None))
+    for folder in getattr(a, "boxes", None) or []:
+        for n in boxes_scans(folder):
+            boxes_settings(folder, n, defaults)  # a malformed meta.json fails here, not in a worker
+            tasks.append(("boxes", split_of(n), str(folder), n, defaults))
     return tasks
 
 
@@ -399,6 +482,14 @@ def main(argv=None) -> int:
     ap.add_argument("--mounts", help="simulator mount heights in m, cycled over scans (e.g. 0.3,0.5,0.7,1.0)")
     ap.add_argument("--kitti", action="append", type=pathlib.Path, help="KITTI folder (velodyne/ label_2/ calib/)")
     ap.add_argument("--semantickitti", action="append", type=pathlib.Path, help="SemanticKITTI folder (velodyne/ labels/)")
+    ap.add_argument("--boxes", action="append", type=pathlib.Path,
+                    help="sensor-frame folder (velodyne/ boxes/, optional meta.json; see above)")
+    ap.add_argument("--fov-deg", type=float, default=None,
+                    help="--boxes folders: half the labelled azimuth field of view, degrees, where meta.json does not say "
+                         "(default: all around)")
+    ap.add_argument("--mount-height", type=float, default=None,
+                    help="--boxes folders: the sensor's height above the road, m, where meta.json does not say "
+                         "(default: the profile's)")
     ap.add_argument("--split", choices=SPLITS, help="split of every folder scan (default: hash of the scan name)")
     ap.add_argument("--purity", type=float, default=DEFAULTS["purity"])
     ap.add_argument("--recall", type=float, default=DEFAULTS["recall"])
@@ -408,8 +499,8 @@ def main(argv=None) -> int:
     ap.add_argument("--out", type=pathlib.Path, required=True)
     ap.add_argument("--no-progress", action="store_true")
     a = ap.parse_args(argv)
-    if not a.sim and not a.kitti and not a.semantickitti:
-        ap.error("give at least one source: --sim, --kitti or --semantickitti")
+    if not a.sim and not a.kitti and not a.semantickitti and not a.boxes:
+        ap.error("give at least one source: --sim, --kitti, --semantickitti or --boxes")
     if a.jobs < 1:
         ap.error("--jobs must be >= 1")
     try:
@@ -444,7 +535,7 @@ def main(argv=None) -> int:
         print("dataset: no proposals (empty scans?)", file=sys.stderr)
         return 1
     meta = dict(sensor=a.sensor, sim=a.sim, seed=a.seed, mounts=a.mounts, kitti=[str(p) for p in a.kitti or []],
-                semantickitti=[str(p) for p in a.semantickitti or []], n_excluded=int(sum(p["n_excluded"] for p in parts)),
+                semantickitti=[str(p) for p in a.semantickitti or []], boxes=[str(p) for p in a.boxes or []], n_excluded=int(sum(p["n_excluded"] for p in parts)),
                 n_objects=[int(v) for v in np.sum([p["n_objects"] for p in parts], axis=0)], **cfg,
                 command="python -m lidet_tools.train.dataset " + " ".join(argv if argv is not None else sys.argv[1:]))
     meta["seconds"] = time.perf_counter() - t0
