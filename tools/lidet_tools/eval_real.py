@@ -95,10 +95,10 @@ def _arr(b) -> np.ndarray:
     return np.array([b.x, b.y, b.z, b.l, b.w, b.h, b.yaw], dtype=np.float64)
 
 
-def _run_detector(fr, fixed: bool, model: str | None):
+def _run_detector(fr, fixed: bool, model: str | None, sets=()):
     """(detections as Box3D, native.Detections or None, milliseconds)."""
-    if fixed:
-        return _run_fixed(fr, model)
+    if fixed or sets:
+        return _run_cli(fr, fixed, model, sets)
     t0 = time.perf_counter()
     d = native.detect(fr.points, fr.sensor, model=model, mount_height_m=fr.mount_height_m)
     ms = (time.perf_counter() - t0) * 1e3
@@ -106,20 +106,27 @@ def _run_detector(fr, fixed: bool, model: str | None):
     return out, d, ms
 
 
-def _run_fixed(fr, model: str | None):
-    """The integer detector through the host CLI (`lidet detect --fixed`: int8 models, the scan in millimetres),
-    which takes the source's mount height as the float run does; milliseconds are the CLI's total_ms."""
+def _run_cli(fr, fixed: bool, model: str | None, sets=()):
+    """The detector through the host CLI: the integer one (`lidet detect --fixed`: int8 models, the scan in
+    millimetres), or either with stage settings (`--set KEY=VALUE`, which the bindings do not take); the source's
+    mount height as the float run's. Milliseconds are the CLI's total_ms."""
     import subprocess
     import tempfile
 
     from . import native_q
     from .detect import find_cli
-    fam = model or (fr.sensor if f"cls_{fr.sensor}_s8" in native_q.pnq_models() else "hdl64")
+    if fixed:
+        fam = model or (fr.sensor if f"cls_{fr.sensor}_s8" in native_q.pnq_models() else "hdl64")
+    else:
+        ms = native.pn_models()
+        fam = model or (fr.sensor if f"cls_{fr.sensor}" in ms and f"box_{fr.sensor}" in ms else "hdl64")
     with tempfile.TemporaryDirectory() as td:
         scan = pathlib.Path(td) / "scan.bin"
         kitti.write_bin(scan, fr.points)
-        cmd = [str(find_cli()), "detect", str(scan), "--sensor", fr.sensor, "--fixed", "--model", fam,
-               "--mount-height", repr(float(fr.mount_height_m)), "--json"]
+        cmd = [str(find_cli()), "detect", str(scan), "--sensor", fr.sensor, "--model", fam,
+               "--mount-height", repr(float(fr.mount_height_m)), "--json"] + (["--fixed"] if fixed else [])
+        for kv in sets:
+            cmd += ["--set", kv]
         r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)}: {r.stderr.strip()}")
@@ -129,7 +136,7 @@ def _run_fixed(fr, model: str | None):
     return out, None, float(js["total_ms"])
 
 
-def evaluate_frame(fr, fixed=False, model=None, min_points=10) -> FrameResult:
+def evaluate_frame(fr, fixed=False, model=None, min_points=10, sets=()) -> FrameResult:
     """Run the detector on one `real.RealFrame` and sort its boxes into ground truth, ignore regions and
     detections."""
     xyz = fr.points[:, :3]
@@ -143,7 +150,7 @@ def evaluate_frame(fr, fixed=False, model=None, min_points=10) -> FrameResult:
             gt_pts.append(n)
         else:
             ignore.append(b)
-    dets_all, d, ms = _run_detector(fr, fixed, model)
+    dets_all, d, ms = _run_detector(fr, fixed, model, sets)
     dets = []
     labelled = LABELLED_CLASSES.get(fr.source, CLASSES)
     for b in dets_all:
@@ -376,6 +383,9 @@ def main(argv=None) -> int:
     ap.add_argument("--fixed", action="store_true", help="the integer detector (int8 models, millimetres)")
     ap.add_argument("--model", help="model family (default: the sensor's)")
     ap.add_argument("--min-points", type=int, default=10, help="objects with fewer points are ignored (default 10)")
+    ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                    help="a stage setting (lidet detect --set; the run goes through the CLI, without the where-lost "
+                         "table)")
     ap.add_argument("--no-pictures", action="store_true")
     ap.add_argument("--json", action="store_true", help="print report.json instead of the tables")
     a = ap.parse_args(argv)
@@ -401,7 +411,7 @@ def main(argv=None) -> int:
         except FileNotFoundError as e:
             print(f"eval_real: skipping {src} {fid}: {e}", file=sys.stderr)
             continue
-        r = evaluate_frame(fr, a.fixed, a.model, a.min_points)
+        r = evaluate_frame(fr, a.fixed, a.model, a.min_points, a.set)
         if src == "kitti":
             base = root / "kitti" / "training"
             r.calib = kitti.read_calib(base / "calib" / f"{fid}.txt")
@@ -414,9 +424,10 @@ def main(argv=None) -> int:
         return 2
     summary = summarize(results)
     cmd = "python -m lidet_tools.eval_real" + (f" --side {a.side}" if a.side != "val" else "") + \
-        (" --fixed" if a.fixed else "") + (f" --sources {a.sources}" if a.sources else "")
-    meta = {"side": a.side, "detector": "integer (int8)" if a.fixed else "float", "command": cmd,
-            "min_points": a.min_points}
+        (" --fixed" if a.fixed else "") + (f" --sources {a.sources}" if a.sources else "") + \
+        "".join(f" --set {kv}" for kv in a.set)
+    meta = {"side": a.side, "detector": ("integer (int8)" if a.fixed else "float") +
+            "".join(f", {kv}" for kv in a.set), "command": cmd, "min_points": a.min_points}
     text = format_report(summary, meta)
     (out / "report.md").write_text(text)
     per_frame = [{"source": r.source, "frame": r.frame_id, "objects": len(r.gt), "detections": len(r.dets),
