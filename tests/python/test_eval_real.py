@@ -151,3 +151,20 @@ def test_every_split_frame_exists_and_loads():
     for s, f, _ in eval_real.read_split():
         fr = real.load_frame(REAL, s, f)
         assert len(fr.points) > 1000, (s, f)
+
+
+def test_compare_rows_and_table():
+    """lidet_tools.real.compare on two simulated scans: every road user within 45 m has a row whose points and
+    spans are those of its box, and the table reads them per class and band."""
+    from lidet_tools.real import compare
+    rows = compare.sim_rows(2, 4242)
+    assert rows and {r["cls"] for r in rows} <= set(compare.CLASSES)
+    for r in rows:
+        assert r["range"] < 45 and r["n"] >= 0 and r["stage"] in STAGES
+        if r["n"] >= 5:
+            assert 0 <= r["span"][2] <= 2.6  # no road user is taller
+    cars = [r for r in rows if r["cls"] == "Car" and r["n"] >= 100]
+    assert cars and all(1.0 <= r["span"][0] <= 5.5 for r in cars)
+    t = compare.table(rows, rows)
+    assert "| Car | 0-15 |" in t or "| Car | 15-30 |" in t
+    assert t.count(" / ") >= 9
