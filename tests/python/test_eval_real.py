@@ -168,3 +168,31 @@ def test_compare_rows_and_table():
     t = compare.table(rows, rows)
     assert "| Car | 0-15 |" in t or "| Car | 15-30 |" in t
     assert t.count(" / ") >= 9
+
+
+def test_thin_keeps_the_target_beams():
+    """Points on every HDL-64 beam: thinned to a VLP-16 only the 9 beams it shares with the HDL-64 (-15 to +1 deg)
+    stay, each within 0.25 deg of a VLP-16 beam; to a VLP-32C 26 of its 32."""
+    from lidet_tools.real import thin
+    from lidet_tools.sensors import get_sensor
+    el = np.asarray(get_sensor("hdl64").beam_elev_rad)
+    az = np.linspace(-3, 3, 50)
+    pts = np.array([[10 * np.cos(a) * np.cos(e), 10 * np.sin(a) * np.cos(e), 10 * np.sin(e), 0.5]
+                    for e in el for a in az], np.float32)
+    t = thin.thin(pts, "hdl64", "vlp16")
+    kept = np.unique(np.round(np.degrees(np.arctan2(t[:, 2], np.hypot(t[:, 0], t[:, 1]))), 1))
+    assert len(t) == 9 * len(az) and len(kept) == 9
+    vlp = np.degrees(np.asarray(get_sensor("vlp16").beam_elev_rad))
+    assert all(np.min(np.abs(vlp - k)) <= 0.3 for k in kept)
+    assert len(thin.beam_map("hdl64", "vlp32c")) == 26
+
+
+def test_eval_real_as_vlp16(tmp_path):
+    root, split = _sim_root(tmp_path)
+    out = tmp_path / "o16"
+    assert eval_real.main(["--root", str(root), "--split", str(split), "--out", str(out), "--as-sensor", "vlp16",
+                           "--no-pictures"]) == 0
+    rep = json.loads((out / "report.json").read_text())
+    assert "thinned to vlp16" in rep["meta"]["detector"] and rep["summary"]["kitti"]["frames"] == 2
+    with pytest.raises(SystemExit):
+        eval_real.main(["--root", str(root), "--split", str(split), "--out", str(out), "--as-sensor", "hdl64"])

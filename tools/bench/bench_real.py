@@ -46,6 +46,28 @@ def run(args) -> str:
                      f"{g(a['ap']['kitti'][c]['3d']['40 m'])} | {g(b['ap']['kitti'][c]['3d']['40 m'])} | "
                      f"{ca['found']} / {ca['objects']} | {cb['found']} / {cb['objects']} |")
     lines.append("")
+    # the robot's families on real HDL-64 frames thinned to their beams
+    lines += ["### The robot's sensor families on thinned real scans", "",
+              "No labelled real VLP-16 or VLP-32C scan exists here: the HDL-64 validation frames thinned to the beams "
+              "each sensor shares with the HDL-64 (`--as-sensor NAME`, `lidet_tools.real.thin`: 9 of a VLP-16's 16 "
+              "beams, -15 to +1 degrees; 26 of a VLP-32C's 32), at the HDL-64's height. Within 40 m, all sources "
+              "together (KITTI, KITTI-360, PandaSet, SemanticKITTI, SqueezeSeg):", "",
+              "| sensor, detector | car found | car prec. | ped found | ped prec. | cyc found | FP/frame | car AP BEV loose | "
+              "ped AP BEV loose |", "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for tag, extra in (("vlp16, float (vlp16 models)", ("--as-sensor", "vlp16")),
+                       ("vlp16, integer (vlp16s: the firmware's)", ("--as-sensor", "vlp16", "--fixed", "--model", "vlp16s")),
+                       ("vlp32c, float (hdl64 models)", ("--as-sensor", "vlp32c"))):
+        rep, _ = _run(args.real, OUT / tag.split(",")[0].replace(" ", "") / ("q" if "--fixed" in extra else "f"), *extra)
+        a = rep["summary"].get("all", next(iter(rep["summary"].values())))
+        c = {k: a["classes"][k]["40"] for k in ("Car", "Pedestrian", "Cyclist")}
+
+        def pr(v):
+            return "-" if v is None else f"{v:.2f}"
+        lines.append(f"| {tag} | {c['Car']['found']} / {c['Car']['objects']} | {pr(c['Car']['precision'])} | "
+                     f"{c['Pedestrian']['found']} / {c['Pedestrian']['objects']} | {pr(c['Pedestrian']['precision'])} | "
+                     f"{c['Cyclist']['found']} / {c['Cyclist']['objects']} | {a['fp_per_frame']['40']:.2f} | "
+                     f"{g(a['ap']['loose']['Car']['bev']['40 m'])} | {g(a['ap']['loose']['Pedestrian']['bev']['40 m'])} |")
+    lines.append("")
     # the simulator against the real training frames, as the detector sees them
     from lidet_tools.real import compare
     n_sim = 20 if getattr(args, "quick", False) else 60

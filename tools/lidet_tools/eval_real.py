@@ -31,6 +31,7 @@ Writes OUT/report.md and OUT/report.json and prints the report. Exit status 0; 2
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import pathlib
 import sys
@@ -386,10 +387,18 @@ def main(argv=None) -> int:
     ap.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
                     help="a stage setting (lidet detect --set; the run goes through the CLI, without the where-lost "
                          "table)")
+    ap.add_argument("--as-sensor", metavar="NAME",
+                    help="thin the HDL-64 frames to the beams of this preset (vlp16, vlp32c: lidet_tools.real.thin) and "
+                         "run its detector on them; frames of other sensors are left out")
     ap.add_argument("--no-pictures", action="store_true")
     ap.add_argument("--json", action="store_true", help="print report.json instead of the tables")
     a = ap.parse_args(argv)
     from . import real
+    from .real import thin
+    if a.as_sensor:
+        from .sensors import SENSORS
+        if a.as_sensor not in SENSORS or a.as_sensor == "hdl64":
+            ap.error(f"--as-sensor: a preset sparser than hdl64 ({', '.join(n for n in SENSORS if n != 'hdl64')})")
     root = pathlib.Path(a.root)
     if not root.is_dir():
         print(f"eval_real: {root} not found (the real frames live in ../shared/data/real; nothing to do)",
@@ -411,6 +420,11 @@ def main(argv=None) -> int:
         except FileNotFoundError as e:
             print(f"eval_real: skipping {src} {fid}: {e}", file=sys.stderr)
             continue
+        if a.as_sensor:
+            if fr.sensor != "hdl64":
+                continue
+            fr = dataclasses.replace(fr, points=thin.thin(fr.points, "hdl64", a.as_sensor), sensor=a.as_sensor,
+                                     point_instance=None)
         r = evaluate_frame(fr, a.fixed, a.model, a.min_points, a.set)
         if src == "kitti":
             base = root / "kitti" / "training"
@@ -425,8 +439,10 @@ def main(argv=None) -> int:
     summary = summarize(results)
     cmd = "python -m lidet_tools.eval_real" + (f" --side {a.side}" if a.side != "val" else "") + \
         (" --fixed" if a.fixed else "") + (f" --sources {a.sources}" if a.sources else "") + \
+        (f" --as-sensor {a.as_sensor}" if a.as_sensor else "") + (f" --model {a.model}" if a.model else "") + \
         "".join(f" --set {kv}" for kv in a.set)
     meta = {"side": a.side, "detector": ("integer (int8)" if a.fixed else "float") +
+            (f", HDL-64 frames thinned to {a.as_sensor}" if a.as_sensor else "") + (f", models {a.model}" if a.model else "") +
             "".join(f", {kv}" for kv in a.set), "command": cmd, "min_points": a.min_points}
     text = format_report(summary, meta)
     (out / "report.md").write_text(text)
