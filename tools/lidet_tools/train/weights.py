@@ -178,17 +178,22 @@ def run_real(a) -> dict:
     return out
 
 
-def c_models(a, fams) -> list:
+def c_models(a, fams, scan_dirs=None) -> list:
     """The C models of --weights after training: for each family trained, its two new ONNX files calibrated for
     int8 (`python -m lidet_codegen calibrate`, the classifier first: a box net is calibrated on the classes of the
     classifier beside it), the classifier's last layer refitted (`calibrate --refit`) unless it was fine-tuned for
     int8 (cls_finetune; a refit made the fine-tuned ones' gate decisions agree less, docs/FIXED_POINT.md); then
     every float and int8 C model of the folder and lidet_weights.{c,h} (lidet_codegen.regen.emit_all, the commands
-    of the committed weights/ and of CI's drift check). Returns the emit commands."""
+    of the committed weights/ and of CI's drift check). scan_dirs: folders of scans (velodyne/*.bin) that replace
+    the real KITTI scans of a.real in the calibration (`calibrate --scans`; lidet_tools.train.finetune passes the
+    user's). Returns the emit commands."""
     from lidet_codegen import quant as Q
     from lidet_codegen import regen
-    # calibrate takes the folder above kitti/ (its HDL-64 scans join the hdl64 calibration set when present)
-    ra = ["--real", str(a.real.parents[1] if a.real.parent.name == "kitti" else a.real)]
+    if scan_dirs:
+        ra = [x for d in scan_dirs for x in ("--scans", str(d))]
+    else:
+        # calibrate takes the folder above kitti/ (its HDL-64 scans join the hdl64 calibration set when present)
+        ra = ["--real", str(a.real.parents[1] if a.real.parent.name == "kitti" else a.real)]
     for fam in fams:
         cls, box = ((a.weights / f"{k}_{fam}.onnx").as_posix() for k in ("cls", "box"))
         _log(f"{fam}: int8 calibration -> {a.weights}/{{cls,box}}_{fam}.calib.json")
