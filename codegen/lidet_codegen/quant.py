@@ -332,7 +332,9 @@ def int_proposals(xyz, mean):
 def scan_list(sensor: str, real_dir=None, scan_dirs=None):
     """The calibration scans: the simulated sample of the sensor, then the real ones: with `scan_dirs` (folders
     holding velodyne/*.bin: a user's own scans, `calibrate --scans`) every scan of those, else for hdl64 the KITTI
-    scans under real_dir/kitti/."""
+    scans under real_dir/kitti/ less the validation frames of tools/lidet_tools/real/split.txt (the real-frame
+    figures are measured on those; nothing that builds a model reads them). kitti/unlabeled/ holds KITTI object
+    training scans under their own ids (000006-000010 are the files of training/), so the rule goes by id in both."""
     scans = [ROOT / f"tests/data/sim_{sensor}/velodyne/000000.bin"]
     if scan_dirs:
         for d in scan_dirs:
@@ -341,7 +343,10 @@ def scan_list(sensor: str, real_dir=None, scan_dirs=None):
                 raise EmitError(f"{d}: no velodyne/*.bin scans to calibrate on")
             scans += [f.resolve() for f in found]
     elif real_dir is not None and sensor == "hdl64":
-        scans += sorted(pathlib.Path(real_dir, "kitti").glob("*/velodyne/*.bin"))
+        from lidet_tools.eval_real import read_split
+        val = {f for src, f, side in read_split() if src == "kitti" and side == "val"}
+        scans += [p for p in sorted(pathlib.Path(real_dir, "kitti").glob("*/velodyne/*.bin"))
+                  if p.stem not in val]
     return scans
 
 
