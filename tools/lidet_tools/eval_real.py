@@ -372,12 +372,17 @@ def picture(r: FrameResult, fr, path) -> None:
     plt.close(fig)
 
 
-def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(prog="python -m lidet_tools.eval_real", description=__doc__,
-                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+def add_frame_args(ap: argparse.ArgumentParser) -> None:
+    """--root and --split, as every command over the real frames takes them."""
     ap.add_argument("--root", default=str(ROOT.parent / "shared" / "data" / "real"),
                     help="the real frames (default ../shared/data/real beside the repository)")
     ap.add_argument("--split", default=str(SPLIT), help="the split file (default: the repository's)")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m lidet_tools.eval_real", description=__doc__,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_frame_args(ap)
     ap.add_argument("--side", choices=("val", "train", "all"), default="val")
     ap.add_argument("--sources", help="comma-separated sources (default: every source in the split)")
     ap.add_argument("--out", default="out/eval_real", help="report.md, report.json, pictures/")

@@ -34,7 +34,6 @@ from . import EVAL_CLASSES, load_frame
 
 #: the sources recorded with an HDL-64-like sensor (the hdl64 family's training data)
 SOURCES = ("kitti", "kitti360", "pandaset", "semantickitti", "squeezeseg")
-ROOT = pathlib.Path(__file__).resolve().parents[3]
 
 
 def export(root, frames, out) -> dict:
@@ -60,12 +59,10 @@ def export(root, frames, out) -> dict:
 
 
 def main(argv=None) -> int:
-    from ..eval_real import SPLIT, read_split
+    from ..eval_real import add_frame_args, read_split
     ap = argparse.ArgumentParser(prog="python -m lidet_tools.real.export", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--root", default=str(ROOT.parent / "shared" / "data" / "real"),
-                    help="the real frames (default ../shared/data/real beside the repository)")
-    ap.add_argument("--split", default=str(SPLIT), help="the split file (default: the repository's)")
+    add_frame_args(ap)
     ap.add_argument("--side", choices=("train", "val"), required=True)
     ap.add_argument("--sources", help=f"comma-separated, among {', '.join(SOURCES)} (default: all of them)")
     ap.add_argument("--out", type=pathlib.Path, required=True)

@@ -75,18 +75,30 @@ def occlude(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None, p
             box[i, 0:3] -= c
 
 
-def augment(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None = None, occlusion: float = 0.0):
+#: the trainers' augmentation of simulated proposals (augment's defaults)
+SIM_AUG = dict(keep=(0.6, 1.0), min_keep=4, rot_deg=5.0, scale=None, shift_xy=0.1, shift_z=0.05, jitter=0.01,
+               jitter_clip=0.03)
+
+
+def augment(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None = None, occlusion: float = 0.0,
+            **params):
     """Augment a batch: pts (B, N, 3) model frame, box (B, 7) model-frame targets (or None). Copies.
-    occlusion: the probability of `occlude` per proposal (0: no draw, the batches of earlier models)."""
-    pts = pts.copy()
+    occlusion: the probability of `occlude` per proposal (0: no draw, the batches of earlier models).
+    params: SIM_AUG's settings to change (keep: share of the points kept, min_keep, rot_deg: rotation about z,
+    scale: (lo, hi) about the mean with the box, or None for no draw, shift_xy / shift_z, jitter / jitter_clip)."""
+    unknown = set(params) - set(SIM_AUG)
+    if unknown:
+        raise TypeError(f"unknown augmentation setting(s) {sorted(unknown)}")
+    g = {**SIM_AUG, **params}
+    pts = np.array(pts, np.float32, copy=True)
     B, N, _ = pts.shape
-    box = None if box is None else box.copy()
+    box = None if box is None else np.array(box, np.float32, copy=True)
     if occlusion > 0.0:
         occlude(rng, pts, box, occlusion)
     # dropout by resampling
-    keep = rng.uniform(0.6, 1.0, B)
+    keep = rng.uniform(*g["keep"], B)
     for i in range(B):
-        k = max(4, int(round(keep[i] * N)))
+        k = max(g["min_keep"], int(round(keep[i] * N)))
         src = rng.permutation(N)[:k]
         pts[i] = pts[i, src[rng.integers(0, k, N)]]
     # mirror
@@ -96,21 +108,27 @@ def augment(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None = 
         box[flip, 1] *= -1
         box[flip, 6] *= -1
     # rotation about z through the mean
-    a = rng.uniform(-math.radians(5), math.radians(5), B).astype(np.float32)
+    a = rng.uniform(-math.radians(g["rot_deg"]), math.radians(g["rot_deg"]), B).astype(np.float32)
     c, s = np.cos(a)[:, None], np.sin(a)[:, None]
     x, y = pts[..., 0].copy(), pts[..., 1].copy()
     pts[..., 0], pts[..., 1] = c * x - s * y, s * x + c * y
+    sc = None if g["scale"] is None else rng.uniform(*g["scale"], B).astype(np.float32)
+    if sc is not None:
+        pts *= sc[:, None, None]
     if box is not None:
         bx, by = box[:, 0].copy(), box[:, 1].copy()
         box[:, 0], box[:, 1] = c[:, 0] * bx - s[:, 0] * by, s[:, 0] * bx + c[:, 0] * by
         box[:, 6] += a
+        if sc is not None:
+            box[:, 0:6] *= sc[:, None]
     # translation
-    t = np.concatenate([rng.uniform(-0.1, 0.1, (B, 2)), rng.uniform(-0.05, 0.05, (B, 1))], 1).astype(np.float32)
+    t = np.concatenate([rng.uniform(-g["shift_xy"], g["shift_xy"], (B, 2)),
+                        rng.uniform(-g["shift_z"], g["shift_z"], (B, 1))], 1).astype(np.float32)
     pts += t[:, None, :]
     if box is not None:
         box[:, 0:3] += t
     # jitter
-    pts += np.clip(rng.normal(0, 0.01, pts.shape), -0.03, 0.03).astype(np.float32)
+    pts += np.clip(rng.normal(0, g["jitter"], pts.shape), -g["jitter_clip"], g["jitter_clip"]).astype(np.float32)
     return pts.astype(np.float32), (None if box is None else box.astype(np.float32))
 
 

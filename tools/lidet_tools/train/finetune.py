@@ -316,39 +316,8 @@ def augment_real(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | No
     """Strong augmentation of the user's proposals (B, N, 3) model frame, box (B, 7) targets or None; copies. Hide a
     part (common.occlude, half of them), keep 40-100 % of the points, mirror, rotate about z by up to 10 deg, scale by
     0.9-1.1 about the mean (the box's centre and size follow), shift, jitter (REAL_AUG)."""
-    g = REAL_AUG
-    pts = np.array(pts, np.float32, copy=True)
-    box = None if box is None else np.array(box, np.float32, copy=True)
-    B, N, _ = pts.shape
-    C.occlude(rng, pts, box, g["occlusion"])
-    keep = rng.uniform(*g["keep"], B)
-    for i in range(B):
-        k = max(8, int(round(keep[i] * N)))
-        src = rng.permutation(N)[:k]
-        pts[i] = pts[i, src[rng.integers(0, k, N)]]
-    flip = rng.random(B) < 0.5
-    pts[flip, :, 1] *= -1
-    if box is not None:
-        box[flip, 1] *= -1
-        box[flip, 6] *= -1
-    a = rng.uniform(-math.radians(g["rot_deg"]), math.radians(g["rot_deg"]), B).astype(np.float32)
-    c, s = np.cos(a)[:, None], np.sin(a)[:, None]
-    x, y = pts[..., 0].copy(), pts[..., 1].copy()
-    pts[..., 0], pts[..., 1] = c * x - s * y, s * x + c * y
-    sc = rng.uniform(*g["scale"], B).astype(np.float32)
-    pts *= sc[:, None, None]
-    if box is not None:
-        bx, by = box[:, 0].copy(), box[:, 1].copy()
-        box[:, 0], box[:, 1] = c[:, 0] * bx - s[:, 0] * by, s[:, 0] * bx + c[:, 0] * by
-        box[:, 6] += a
-        box[:, 0:6] *= sc[:, None]
-    t = np.concatenate([rng.uniform(-g["shift_xy"], g["shift_xy"], (B, 2)),
-                        rng.uniform(-g["shift_z"], g["shift_z"], (B, 1))], 1).astype(np.float32)
-    pts += t[:, None, :]
-    if box is not None:
-        box[:, 0:3] += t
-    pts += np.clip(rng.normal(0, g["jitter"], pts.shape), -g["jitter_clip"], g["jitter_clip"]).astype(np.float32)
-    return pts.astype(np.float32), (None if box is None else box.astype(np.float32))
+    g = dict(REAL_AUG)
+    return C.augment(rng, pts, box, occlusion=g.pop("occlusion"), min_keep=8, **g)
 
 
 # ---- training -----------------------------------------------------------------------------------------------------
