@@ -196,3 +196,17 @@ def test_eval_real_as_vlp16(tmp_path):
     assert "thinned to vlp16" in rep["meta"]["detector"] and rep["summary"]["kitti"]["frames"] == 2
     with pytest.raises(SystemExit):
         eval_real.main(["--root", str(root), "--split", str(split), "--out", str(out), "--as-sensor", "hdl64"])
+
+
+def test_fp_kinds_by_point_labels():
+    """A car detection on a bush, one on a wall, one on a labelled car (matched: not wrong) and one on nothing."""
+    pts, sem = [], []
+    for x, y, c in ((10, 0, 70), (20, 5, 50), (15, -5, 10)):
+        p = np.random.default_rng(c).uniform(-0.5, 0.5, (50, 3)) + [x, y, -0.8]
+        pts.append(p)
+        sem += [c] * 50
+    pts = np.vstack(pts)
+    gt = [_box("Car", 15, -5)]
+    dets = [_box("Car", 10, 0), _box("Car", 20, 5), _box("Car", 15.1, -5), _box("Car", 30, 10), _box("Car", 45, 0)]
+    kinds = eval_real.fp_kinds(pts, np.array(sem), gt, dets)
+    assert kinds == ["vegetation, terrain", "building, fence, structure", "empty"]

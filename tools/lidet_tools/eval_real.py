@@ -51,6 +51,11 @@ CLASSES = ("Car", "Pedestrian", "Cyclist")
 LOOSE = {"Car": 0.5, "Pedestrian": 0.25, "Cyclist": 0.25}
 RANGES = (20.0, 40.0)
 IGNORE_MARGIN_M = 0.3
+#: what a false positive covers, by the SemanticKITTI classes of the points in its box (frames with point labels)
+FP_KINDS = (("vegetation, terrain", (70, 71, 72)), ("building, fence, structure", (50, 51, 52)),
+            ("pole, sign, other object", (80, 81, 99)), ("road user (box off, or unlabelled)", tuple(range(10, 33)) +
+                                                           tuple(range(252, 260))),
+            ("ground", (40, 44, 48, 49, 60)))
 #: sources whose labels cover only some classes: detections of the others cannot be judged and are not scored
 LABELLED_CLASSES = {"kitti360": ("Car",)}
 
@@ -84,6 +89,7 @@ class FrameResult:
     lost: list = field(default_factory=list)   # where_lost stage per gt (within 40 m), float detector only
     ms: float = 0.0
     seen_share: float | None = None   # share of the points that won their pixel (float detector's projection)
+    fp_kinds: list = field(default_factory=list)   # with point labels: FP_KINDS name of each wrong detection <= 40 m
     calib: object = None     # kitti.Calib for the KITTI frames (official protocol)
     label2: list = field(default_factory=list)
 
@@ -162,6 +168,8 @@ def evaluate_frame(fr, fixed=False, model=None, min_points=10, sets=()) -> Frame
             continue
         dets.append(b)
     res = FrameResult(fr.source, fr.frame_id, len(fr.points), gt, gt_pts, ignore, dets, dets_all, ms=ms)
+    if getattr(fr, "point_semantic", None) is not None:
+        res.fp_kinds = fp_kinds(fr.points, fr.point_semantic, gt, dets)
     if d is not None:
         near = [g for g in gt if np.hypot(g.x, g.y) <= RANGES[-1]]
         few = int(native.cluster_defaults(fr.sensor)["min_points"])
@@ -177,6 +185,26 @@ def evaluate_frame(fr, fixed=False, model=None, min_points=10, sets=()) -> Frame
                             few, hit, native.CLASSES, seen=seen)
         res.lost = list(zip([g.cls for g in near], stages))
     return res
+
+
+def fp_kinds(points, sem, gt: list, dets: list, max_range: float = RANGES[-1]) -> list:
+    """What each detection within max_range that overlaps no object of its class (loose BEV overlap) covers: the
+    FP_KINDS group holding most labelled points of its box, 'other' for the rest, 'empty' without points."""
+    out = []
+    for d in dets:
+        if np.hypot(d.x, d.y) > max_range:
+            continue
+        g = [x for x in gt if x.cls == d.cls]
+        if g and iou.iou_bev(_arr(d)[None], np.array([_arr(x) for x in g])).max() >= LOOSE[d.cls]:
+            continue
+        lab = np.asarray(sem)[points_in_box(points, _arr(d))]
+        if len(lab) == 0:
+            out.append("empty")
+            continue
+        counts = [(int(np.isin(lab, ids).sum()), name) for name, ids in FP_KINDS]
+        n, name = max(counts)
+        out.append(name if n > 0 else "other")
+    return out
 
 
 def match(gt: list, dets: list, cls: str, max_range: float, thr: float) -> tuple[int, int, int, int]:
@@ -268,6 +296,9 @@ def summarize(results: list) -> dict:
             for c, st in r.lost:
                 lost[c][st] += 1
         s["where_lost"] = lost
+        kinds = [k for r in rs for k in r.fp_kinds]
+        if kinds:
+            s["fp_kinds"] = {k: kinds.count(k) for k in sorted(set(kinds))}
         if src != "all":
             s["kitti_official"] = kitti_official(rs)
             s["kitti_devkit"] = kitti_official(rs, exact=False)
@@ -330,6 +361,15 @@ def format_report(summary: dict, meta: dict) -> str:
                 row += [_p(k[c]["3d"].get("moderate")), _p(k[c]["bev"].get("moderate"))]
             row.append(_p(dk["Car"]["3d"].get("moderate")))
             L.append("| " + " | ".join(row) + " |")
+    fk = [(src, s) for src, s in summary.items() if s.get("fp_kinds") and src != "all"]
+    if fk:
+        L += ["", "What the wrong detections within 40 m cover, on the frames with per-point labels (the labelled class "
+              "group holding most points of the box):", "", "| source | frames | wrong detections | what they cover |",
+              "|---|---:|---:|---|"]
+        for src, s in fk:
+            k = s["fp_kinds"]
+            L.append(f"| {src} | {s['frames']} | {sum(k.values())} | " +
+                     ", ".join(f"{name} {n}" for name, n in sorted(k.items(), key=lambda x: -x[1])) + " |")
     if any(sum(sum(v.values()) for v in s["where_lost"].values()) for s in summary.values()):
         L += ["", "Where the objects within 40 m were lost (`lidet_tools.where_lost`; float detector):", "",
               "| source | class | " + " | ".join(STAGES) + " |", "|---|---|" + "---:|" * len(STAGES)]

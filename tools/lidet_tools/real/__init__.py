@@ -48,6 +48,7 @@ class RealFrame:
     mount_height_m: float     # LiDAR height above the road
     point_instance: np.ndarray | None = None  # (N,) int32 index into boxes per point (-1 none), where labelled
     approx_boxes: bool = False  # boxes fitted to the visible points
+    point_semantic: np.ndarray | None = None  # (N,) SemanticKITTI base class per point (lower 16 bits), where labelled
 
     def class_counts(self) -> dict[str, int]:
         """{class: number of boxes}."""

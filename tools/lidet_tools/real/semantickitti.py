@@ -103,4 +103,5 @@ def load_frame(root: pathlib.Path, frame_id: str) -> RealFrame:
     points, keep = finite_points(raw, vel)
     sem, ins = sem[keep], ins[keep]
     boxes, inst = boxes_from_objects(points, objects_from_labels(points, sem, ins), MIN_POINTS)
-    return RealFrame(SOURCE, frame_id, points, boxes, None, "hdl64", MOUNT_HEIGHT_M, inst, True)
+    return RealFrame(SOURCE, frame_id, points, boxes, None, "hdl64", MOUNT_HEIGHT_M, inst, True,
+                     point_semantic=sem.astype(np.int32))
