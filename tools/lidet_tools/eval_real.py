@@ -469,7 +469,7 @@ def main(argv=None) -> int:
             if fr.sensor != "hdl64":
                 continue
             fr = dataclasses.replace(fr, points=thin.thin(fr.points, "hdl64", a.as_sensor), sensor=a.as_sensor,
-                                     point_instance=None)
+                                     point_instance=None, point_semantic=None)
         r = evaluate_frame(fr, a.fixed, a.model, a.min_points, a.set)
         if src == "kitti":
             base = root / "kitti" / "training"
