@@ -70,12 +70,13 @@ def main(argv=None) -> int:
     mods = sorted(HERE.glob("bench_*.py"), key=lambda p: (ORDER.index(p.stem[6:]) if p.stem[6:] in ORDER
                                                          else len(ORDER), p.stem))
     only = {s for s in args.only.split(",") if s}
-    sections, failed = [], []
+    sections, failed, ran = [], [], []
     for path in mods:
         name = path.stem[6:]
         if only and name not in only:
             continue
         print(f"== bench {name}", flush=True)
+        ran.append(name)
         spec = importlib.util.spec_from_file_location(f"bench_{name}", path)
         mod = importlib.util.module_from_spec(spec)
         try:
@@ -93,10 +94,13 @@ def main(argv=None) -> int:
             "same run and gives the ratio.\n\n")
     if only and args.update and pathlib.Path(args.out).exists():
         text = pathlib.Path(args.out).read_text()
-        for sec in sections:
+        for name, sec in zip(ran, sections):
+            if name in failed:  # keep the section of the last good run (its heading is not the failure's)
+                print(f"bench {name} failed: its section of {args.out} is left as it was", flush=True)
+                continue
             text = splice(text, sec)
         pathlib.Path(args.out).write_text(text)
-        print(f"updated {len(sections)} section(s) of {args.out}")
+        print(f"updated {len(sections) - len(failed)} section(s) of {args.out}")
     elif only and pathlib.Path(args.out).exists():
         print(f"--only given: not overwriting {args.out}; sections printed above")
     else:
