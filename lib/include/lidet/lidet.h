@@ -32,6 +32,7 @@
 #include "lidet_sensor.h"
 #include "lidet_sensor_q.h"
 #include "lidet_types.h"
+#include "lidet_velodyne.h"
 
 #ifdef __cplusplus
 extern "C" {
