@@ -155,6 +155,18 @@ def test_finetune_end_to_end(tmp_path, need_lib, monkeypatch, capsys):
     m0, _, _ = FT.load_onnx(ROOT / "weights" / "cls_hdl64.onnx")
     m1, _, _ = FT.load_onnx(out / "cls_hdl64.onnx")
     assert any(not torch.equal(a, b) for a, b in zip(m0.state_dict().values(), m1.state_dict().values()))
+    # --install's step on a copy of weights/: the pair and its calibration copied, every C model regenerated there
+    w = tmp_path / "weights"
+    shutil.copytree(ROOT / "weights", w)
+    before = (w / "cls_hdl64.c").read_text()
+    FT.install(out, w, "hdl64")
+    assert (w / "cls_hdl64.onnx").read_bytes() == (out / "cls_hdl64.onnx").read_bytes()
+    assert (w / "box_hdl64.calib.json").read_text() == (out / "box_hdl64.calib.json").read_text()
+    after = (w / "cls_hdl64.c").read_text()
+    assert after != before and "cmd: python -m lidet_codegen emit weights/" in after
+    assert (w / "cls_vlp16.c").read_text() == (ROOT / "weights" / "cls_vlp16.c").read_text()  # the others as shipped
+    with pytest.raises(FileNotFoundError, match="lacks"):
+        FT.install(out, w, "vlp16")
 
 
 def test_finetune_errors(tmp_path, capsys):

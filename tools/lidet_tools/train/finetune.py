@@ -55,6 +55,7 @@ import argparse
 import hashlib
 import json
 import math
+import os
 import pathlib
 import shutil
 import sys
@@ -587,6 +588,10 @@ def add_args(ap):
     ap.add_argument("--only-family", action="store_true",
                     help="OUT holds this family's models only (default: the other shipped families' too)")
     ap.add_argument("--weights", type=pathlib.Path, default=WEIGHTS, help="the shipped weights folder")
+    ap.add_argument("--install", action="store_true",
+                    help="then make the fine-tuned pair the shipped one: copy its ONNX and calibration files from OUT "
+                         "into --weights and regenerate every C model there (python -m lidet_codegen regen weights); "
+                         "the next build of the detector, the CLI and the firmware uses them")
     ap.add_argument("--work", type=pathlib.Path, default=None, help="work files (default OUT/work)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--threads", type=int, default=1)
@@ -886,10 +891,34 @@ def main(argv=None) -> int:
     a.command = "python -m lidet_tools.train.finetune " + shlex.join(argv if argv is not None else sys.argv[1:])
     try:
         finetune(a)
+        if a.install:
+            install(a.out_weights, a.weights, a.family)
     except (FileNotFoundError, ValueError, RuntimeError) as e:
         print(f"finetune: {e}", file=sys.stderr)
         return 2
     return 0
+
+
+def install(out: pathlib.Path, weights: pathlib.Path, family: str) -> list:
+    """The fine-tuned pair of `family` in `out` becomes the one in `weights`: its ONNX and calibration files copied,
+    then every C model of `weights` regenerated (lidet_codegen.regen, run from the folder above `weights` so the
+    generated files name it as the committed ones do). Returns the files copied."""
+    from lidet_codegen import regen
+    names = [f"{k}_{family}{ext}" for k in ("cls", "box") for ext in (".onnx", ".calib.json")]
+    missing = [n for n in names if not (out / n).exists()]
+    if missing:
+        raise FileNotFoundError(f"--install: {out} lacks {', '.join(missing)}")
+    for n in names:
+        shutil.copy(out / n, weights / n)
+    cwd = os.getcwd()
+    try:
+        os.chdir(weights.resolve().parent)
+        regen.emit_all(weights.resolve().name)
+    finally:
+        os.chdir(cwd)
+    print(f"finetune: installed {', '.join(names)} into {weights} and regenerated its C models; rebuild "
+          "(make build) to run them", file=sys.stderr)
+    return names
 
 
 if __name__ == "__main__":
