@@ -102,6 +102,12 @@ def test_where_lost_on_the_simulated_scan():
     # with a hit test that never passes, the same objects are "box off" instead
     st0 = where_lost(pts, arr, [g.cls for g in gts], d, few, lambda *a: False, native.CLASSES)
     assert [s if s != "detected" else "box off" for s in st] == st0
+    # counted over the seen points only: none seen, every object has too few; all seen, as without the mask
+    none = np.zeros(len(pts), dtype=bool)
+    assert set(where_lost(pts, arr, [g.cls for g in gts], d, few, lambda *a: True, native.CLASSES, none)) == \
+        {"too few points"}
+    assert where_lost(pts, arr, [g.cls for g in gts], d, few, lambda *a: True, native.CLASSES,
+                      np.ones(len(pts), dtype=bool)) == st
     # an object with no points is "too few points"
     far = np.array([[200.0, 0.0, 0.0, 4.0, 1.8, 1.5, 0.0]])
     assert where_lost(pts, far, ["Car"], d, few, lambda *a: True, native.CLASSES) == ["too few points"]
