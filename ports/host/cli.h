@@ -100,4 +100,19 @@ int lidet_png_write_rgb(const char *path, const uint8_t *rgb, uint32_t width, ui
 /* A perceptual colour map: t in [0, 1] -> rgb. */
 void cli_colormap(float t, uint8_t rgb[3]);
 
+/* One legend entry of a bird's-eye-view picture: a colour swatch and its label. */
+typedef struct
+{
+    const char *label;
+    uint8_t rgb[3];
+} cli_legend_t;
+/* Writes a bird's-eye view (cli_bev.c): the scene (sw x sh RGB pixels of res_m metres, the sensor at the centre,
+ * +x up, +y left) in a larger canvas with the title and subtitle (wrapped at their double spaces where too
+ * wide), axes in metres (ticks every 10 m, labels every 20 m), a 10 m scale bar and the legend (an entry with an
+ * empty label: a swatch sharing the next entry's label). Deterministic for the same inputs. Returns 0 or -1. */
+int cli_bev_write(const char *path, const uint8_t *scene, uint32_t sw, uint32_t sh, float res_m,
+                  const char *title, const char *subtitle, const cli_legend_t *items, int n_items);
+/* the file name of a path (after its last '/') */
+const char *cli_basename(const char *path);
+
 #endif

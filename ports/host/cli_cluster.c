@@ -30,8 +30,14 @@ static void id_colour(uint32_t id, uint8_t rgb[3])
 /* bird's-eye view, +x up, +y left, 80 m x 80 m at 0.1 m per pixel: ground dark, other points grey,
  * clustered points in their cluster's colour */
 static int write_bev_png(const char *path, const float *pts, uint32_t n, const uint32_t *ids,
-                         const int32_t *pp, const uint8_t *ground_pix)
+                         const int32_t *pp, const uint8_t *ground_pix, const char *title,
+                         const char *subtitle)
 {
+    cli_legend_t legend[5] = {{"", {0, 0, 0}},
+                              {"", {0, 0, 0}},
+                              {"clusters (a colour per id)", {0, 0, 0}},
+                              {"other points", {110, 110, 110}},
+                              {"ground", {40, 40, 48}}};
     const uint32_t W = 800, H = 800;
     const float res = 0.1f;
     uint8_t *rgb = (uint8_t *)calloc((size_t)W * H * 3u, 1);
@@ -70,7 +76,10 @@ static int write_bev_png(const char *path, const float *pts, uint32_t n, const u
         px[1] = c[1];
         px[2] = c[2];
     }
-    rc = lidet_png_write_rgb(path, rgb, W, H);
+    id_colour(1, legend[0].rgb);
+    id_colour(2, legend[1].rgb);
+    id_colour(3, legend[2].rgb);
+    rc = cli_bev_write(path, rgb, W, H, res, title, subtitle, legend, 5);
     free(rgb);
     return rc;
 }
@@ -147,6 +156,7 @@ int cli_cluster(int argc, char **argv)
     const lidet_plane_t *planes = NULL;
     uint32_t n_sectors = 0;
     double ms_gnd = 0.0;
+    char title[256], subtitle[160];
     char **rest;
     const char **sets;
     int nrest = 0, nsets = 0, i;
@@ -334,7 +344,16 @@ int cli_cluster(int argc, char **argv)
             return 1;
         }
     }
-    if (a.png_path != NULL && write_bev_png(a.png_path, a.points, n_pp, ids, pp, g_ground) != 0)
+    if (a.png_path != NULL)
+    {
+        snprintf(title, sizeof title, "cluster  %s  %s (ground: %s)  %.1f ms", cli_basename(a.scan_path),
+                 a.sensor, labels_path != NULL ? "labels" : "stage", ms_proj + ms_gnd + ms_clu + ms_prop);
+        if (a.repeat > 1)
+            snprintf(title + strlen(title), sizeof title - strlen(title), ", median of %d", a.repeat);
+        snprintf(subtitle, sizeof subtitle, "%u points  %u clusters", a.n_points, cs->n_kept);
+    }
+    if (a.png_path != NULL &&
+        write_bev_png(a.png_path, a.points, n_pp, ids, pp, g_ground, title, subtitle) != 0)
     {
         fprintf(stderr, "lidet cluster: cannot write '%s'\n", a.png_path);
         free(ids);

@@ -362,10 +362,18 @@ static void draw_box(uint8_t *rgb, const lidet_box_t *b, const uint8_t c[3], int
 }
 
 static const uint8_t k_class_rgb[LIDET_N_CLASSES][3] = {{255, 80, 60}, {60, 220, 255}, {255, 220, 40}};
+static const char *const k_class_legend[LIDET_N_CLASSES] = {"car", "cyclist", "pedestrian"};
 
+/* the picture: points (obstacles grey, ground dark), ground truth, detections; framed by cli_bev_write with a
+ * title (scan, sensor, models, total time, counts per class), axes, scale bar and legend */
 static int write_png(const char *path, const float *pts, uint32_t n, const uint8_t *ground_pp,
-                     const lidet_detection_t *det, uint32_t n_det, const gt_t *gt, uint32_t n_gt)
+                     const lidet_detection_t *det, uint32_t n_det, const gt_t *gt, uint32_t n_gt, int with_gt,
+                     const char *title, uint32_t n_points)
 {
+    cli_legend_t legend[6];
+    char subtitle[192];
+    uint32_t per_class[LIDET_N_CLASSES] = {0};
+    int n_legend = 0, k;
     uint8_t *rgb = (uint8_t *)calloc((size_t)BEV_W * BEV_H * 3u, 1);
     const uint8_t grey[3] = {120, 120, 120}, dark[3] = {45, 45, 55}, green[3] = {60, 230, 90};
     uint32_t i;
@@ -387,8 +395,30 @@ static int write_png(const char *path, const float *pts, uint32_t n, const uint8
     for (i = 0; i < n_gt; ++i)
         draw_box(rgb, &gt[i].box, green, 0);
     for (i = 0; i < n_det; ++i)
+    {
         draw_box(rgb, &det[i].box, k_class_rgb[det[i].cls], 1);
-    rc = lidet_png_write_rgb(path, rgb, BEV_W, BEV_H);
+        per_class[det[i].cls]++;
+    }
+    snprintf(subtitle, sizeof subtitle, "%u points  %u detections: %u car, %u cyclist, %u pedestrian",
+             n_points, n_det, per_class[0], per_class[1], per_class[2]);
+    for (k = 0; k < LIDET_N_CLASSES; ++k)
+    {
+        legend[n_legend].label = k_class_legend[k];
+        memcpy(legend[n_legend++].rgb, k_class_rgb[k], 3);
+    }
+    if (with_gt)
+    {
+        legend[n_legend].label = "ground truth";
+        memcpy(legend[n_legend++].rgb, green, 3);
+    }
+    legend[n_legend].label = "obstacle points";
+    memcpy(legend[n_legend++].rgb, grey, 3);
+    if (ground_pp != NULL)
+    {
+        legend[n_legend].label = "ground points";
+        memcpy(legend[n_legend++].rgb, dark, 3);
+    }
+    rc = cli_bev_write(path, rgb, BEV_W, BEV_H, BEV_RES, title, subtitle, legend, n_legend);
     free(rgb);
     return rc;
 }
@@ -801,16 +831,23 @@ outputs:
         calib_t gcal;
         uint32_t n_gt = 0, np = a.n_points < LIDET_MAX_POINTS ? a.n_points : LIDET_MAX_POINTS;
         uint32_t *ids = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(np + 1u));
+        char title[256];
+        snprintf(title, sizeof title, "detect%s  %s  %s (models %s)  %.1f ms", fixed ? " --fixed" : "",
+                 cli_basename(a.scan_path), a.sensor, chosen, ms[LIDET_DET_N_STAGES]);
+        if (a.repeat > 1)
+            snprintf(title + strlen(title), sizeof title - strlen(title), ", median of %d", a.repeat);
         if (gp == NULL)
             gp = (uint8_t *)malloc((size_t)np + 1u);
         else
             fixed = 2; /* the integer run filled gp */
         if (ids == NULL || gp == NULL ||
-            (fixed != 2 && lidet_workspace_point_labels(lidet_detector_workspace(&g_det), pp, np, ids, gp) != LIDET_OK) ||
+            (fixed != 2 &&
+             lidet_workspace_point_labels(lidet_detector_workspace(&g_det), pp, np, ids, gp) != LIDET_OK) ||
             (gt_path != NULL && read_gt(gt_path, &gt, &n_gt) != 0) ||
-            (gt_kitti_path != NULL && (read_calib(calib_path, &gcal) != 0 ||
-                                       read_gt_kitti(gt_kitti_path, &gcal, &gt, &n_gt) != 0)) ||
-            write_png(a.png_path, a.points, np, gp, det, n_det, gt, n_gt) != 0)
+            (gt_kitti_path != NULL &&
+             (read_calib(calib_path, &gcal) != 0 || read_gt_kitti(gt_kitti_path, &gcal, &gt, &n_gt) != 0)) ||
+            write_png(a.png_path, a.points, np, gp, det, n_det, gt, n_gt,
+                      gt_path != NULL || gt_kitti_path != NULL, title, a.n_points) != 0)
         {
             fprintf(stderr, "lidet detect: cannot write the picture '%s'\n", a.png_path);
             free(ids);

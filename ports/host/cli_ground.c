@@ -15,8 +15,11 @@ static lidet_ground_t g_ground; /* ~3.5 MiB */
 #define BEV_SIZE 800
 #define BEV_HALF_M 40.0f
 
-static int write_bev_png(const char *path, const float *pts, uint32_t n, const uint8_t *label)
+static int write_bev_png(const char *path, const float *pts, uint32_t n, const uint8_t *label,
+                         const char *title, const char *subtitle)
 {
+    static const cli_legend_t legend[3] = {
+        {"ground", {40, 200, 60}}, {"not ground", {170, 170, 170}}, {"sensor", {230, 30, 30}}};
     uint8_t *rgb = (uint8_t *)calloc((size_t)BEV_SIZE * BEV_SIZE * 3u, 1);
     const float scale = (float)BEV_SIZE / (2.0f * BEV_HALF_M);
     uint32_t i;
@@ -67,7 +70,7 @@ static int write_bev_png(const char *path, const float *pts, uint32_t n, const u
             p[2] = 30;
         }
     }
-    rc = lidet_png_write_rgb(path, rgb, BEV_SIZE, BEV_SIZE);
+    rc = cli_bev_write(path, rgb, BEV_SIZE, BEV_SIZE, 1.0f / scale, title, subtitle, legend, 3);
     free(rgb);
     return rc;
 }
@@ -126,6 +129,7 @@ int cli_ground(int argc, char **argv)
     const int32_t *pp;
     uint8_t *label = NULL;
     double *tp = NULL, *tg = NULL, *tt = NULL, proj_ms, ground_ms, total_ms;
+    char title[256], subtitle[160];
     uint32_t np = 0, i, n_ground_points = 0;
     int k, ret = 1;
 
@@ -227,7 +231,16 @@ int cli_ground(int argc, char **argv)
             goto done;
         }
     }
-    if (a.png_path != NULL && write_bev_png(a.png_path, a.points, a.n_points, label) != 0)
+    if (a.png_path != NULL)
+    {
+        snprintf(title, sizeof title, "ground  %s  %s  %.1f ms", cli_basename(a.scan_path), a.sensor,
+                 total_ms);
+        if (a.repeat > 1)
+            snprintf(title + strlen(title), sizeof title - strlen(title), ", median of %d", a.repeat);
+        snprintf(subtitle, sizeof subtitle, "%u points  ground %u (%.1f%%)", a.n_points, n_ground_points,
+                 a.n_points ? 100.0 * n_ground_points / a.n_points : 0.0);
+    }
+    if (a.png_path != NULL && write_bev_png(a.png_path, a.points, a.n_points, label, title, subtitle) != 0)
     {
         fprintf(stderr, "lidet ground: cannot write '%s'\n", a.png_path);
         goto done;
