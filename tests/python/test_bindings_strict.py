@@ -61,3 +61,15 @@ def test_labels_file_of_another_length(cli, root, tmp_path):
     r = subprocess.run([str(cli), "cluster", str(root / SCAN), "--sensor", "vlp16", "--labels", str(lab)],
                        capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
+
+
+def test_status_names_come_from_c():
+    """native.status_names() reads every status of lidet_types.h from the C library (none copied by hand)."""
+    import re
+    from lidet_tools import native
+    import pathlib
+    hdr = (pathlib.Path(__file__).resolve().parents[2] / "lib" / "include" / "lidet" / "lidet_types.h").read_text()
+    enum = {int(v): k for k, v in re.findall(r"\b(LIDET_(?:OK|TRUNCATED|ERR_[A-Z_]+))\s*=\s*(-?\d+)", hdr)}
+    assert enum and native.status_names() == enum
+    e = native.LidetError(-6, "x")
+    assert e.name == "LIDET_ERR_NOT_FOUND" and "no such item" in str(e)

@@ -28,8 +28,21 @@ from .sensors import Sensor, get_sensor
 _ROOT = pathlib.Path(__file__).resolve().parents[2]
 _lib = None
 
-STATUS = {0: "LIDET_OK", 1: "LIDET_TRUNCATED", -1: "LIDET_ERR_ARG", -2: "LIDET_ERR_CONFIG",
-          -3: "LIDET_ERR_BUFFER", -4: "LIDET_ERR_MODEL", -5: "LIDET_ERR_STATE", -6: "LIDET_ERR_NOT_FOUND"}
+_status_names: dict | None = None
+
+
+def status_names() -> dict:
+    """{code: name} of every lidet_status_t, read from the C library's lidet_status_str ("NAME: text"), so the
+    names are never copied by hand (codes -64..64; "unknown lidet status" marks the unused ones)."""
+    global _status_names
+    if _status_names is None:
+        out = {}
+        for code in range(-64, 65):
+            txt = lib().lidet_py_status_str(code).decode()
+            if txt.startswith("LIDET_") and ":" in txt:
+                out[code] = txt.split(":", 1)[0]
+        _status_names = out
+    return dict(_status_names)
 
 
 class LidetError(RuntimeError):
@@ -37,6 +50,7 @@ class LidetError(RuntimeError):
 
     def __init__(self, status: int, what: str):
         self.status = status
+        self.name = status_names().get(status, f"status {status}")
         super().__init__(f"{what}: {lib().lidet_py_status_str(status).decode()}")
 
 
