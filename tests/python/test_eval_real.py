@@ -216,3 +216,16 @@ def test_fp_kinds_by_point_labels():
     dets = [_box("Car", 10, 0), _box("Car", 20, 5), _box("Car", 15.1, -5), _box("Car", 30, 10), _box("Car", 45, 0)]
     kinds = eval_real.fp_kinds(pts, np.array(sem), gt, dets)
     assert kinds == ["vegetation, terrain", "building, fence, structure", "empty"]
+
+
+def test_dontcare_regions_of_kitti_frames():
+    """A detection whose projected 2D box lies in a DontCare region is not scored; elsewhere, or behind the camera,
+    it is; a frame without DontCare lines has no test."""
+    calib = kitti.read_calib(SIM / "calib" / "000000.txt")
+    car = _box("Car", 15, 1)
+    bb = kitti.box_to_kitti(car, calib).bbox
+    dc = kitti.KittiObject("DontCare", -1, -1, -10, np.array([bb[0] - 5, bb[1] - 5, bb[2] + 5, bb[3] + 5]),
+                           -1, -1, -1, np.array([-1000.0, -1000, -1000]), -10)
+    test = eval_real.dontcare_test(calib, [dc])
+    assert test(car) and not test(_box("Car", 15, -8)) and not test(_box("Car", -15, 1))
+    assert eval_real.dontcare_test(calib, []) is None

@@ -13,7 +13,8 @@ source's sensor preset and mount height; `--fixed`: the integer detector, `nativ
   ``--min-points`` (10) points inside (+ 0.1 m); every other labelled box (fewer points, vans, trucks,
   motorcycles, DontCare, ...) is an *ignore region*: a detection whose centre lies in one (+ 0.3 m) is neither
   right nor wrong;
-* detections: in the labelled field of view, outside the ignore regions, of a class the source labels (KITTI-360:
+* detections: in the labelled field of view, outside the ignore regions (on the KITTI frames also outside the
+  DontCare image regions: the projected 2D box at least half inside one), of a class the source labels (KITTI-360:
   cars only);
 * per class and range (within 20 m, within 40 m of the sensor, horizontal range of the box centre): recall and
   precision at the detector's operating point with the loose BEV overlaps (IoU >= 0.5 car, 0.25 pedestrian and
@@ -143,9 +144,33 @@ def _run_cli(fr, fixed: bool, model: str | None, sets=()):
     return out, None, float(js["total_ms"])
 
 
-def evaluate_frame(fr, fixed=False, model=None, min_points=10, sets=()) -> FrameResult:
+def dontcare_test(calib, label2: list, min_ioa: float = 0.5):
+    """For KITTI frames: a test of whether a sensor-frame detection falls in one of the frame's DontCare regions
+    (2D image boxes without a 3D extent): its projected 2D box (kitti.box_to_kitti through P2, clipped to the image)
+    lies at least min_ioa inside one, as the devkit assigns detections to DontCare regions. None without any."""
+    regions = [o.bbox for o in label2 if o.type == "DontCare"]
+    if not regions:
+        return None
+
+    def inside(b) -> bool:
+        if b.x <= 0.5:  # behind or beside the camera: no image box
+            return False
+        x1, y1, x2, y2 = kitti.box_to_kitti(b, calib).bbox
+        area = max(x2 - x1, 0.0) * max(y2 - y1, 0.0)
+        if area <= 0.0:
+            return False
+        for r in regions:
+            w = min(x2, r[2]) - max(x1, r[0])
+            h = min(y2, r[3]) - max(y1, r[1])
+            if w > 0 and h > 0 and w * h >= min_ioa * area:
+                return True
+        return False
+    return inside
+
+
+def evaluate_frame(fr, fixed=False, model=None, min_points=10, sets=(), dontcare=None) -> FrameResult:
     """Run the detector on one `real.RealFrame` and sort its boxes into ground truth, ignore regions and
-    detections."""
+    detections (dontcare: dontcare_test's test, for KITTI frames)."""
     xyz = fr.points[:, :3]
     gt, gt_pts, ignore = [], [], []
     for b in fr.boxes:
@@ -165,6 +190,8 @@ def evaluate_frame(fr, fixed=False, model=None, min_points=10, sets=()) -> Frame
             continue
         c = np.array([[b.x, b.y, b.z]])
         if any(points_in_box(c, _arr(g), IGNORE_MARGIN_M)[0] for g in ignore):
+            continue
+        if dontcare is not None and dontcare(b):
             continue
         dets.append(b)
     res = FrameResult(fr.source, fr.frame_id, len(fr.points), gt, gt_pts, ignore, dets, dets_all, ms=ms)
@@ -470,11 +497,14 @@ def main(argv=None) -> int:
                 continue
             fr = dataclasses.replace(fr, points=thin.thin(fr.points, "hdl64", a.as_sensor), sensor=a.as_sensor,
                                      point_instance=None, point_semantic=None)
-        r = evaluate_frame(fr, a.fixed, a.model, a.min_points, a.set)
+        calib, label2, dc = None, [], None
         if src == "kitti":
             base = root / "kitti" / "training"
-            r.calib = kitti.read_calib(base / "calib" / f"{fid}.txt")
-            r.label2 = kitti.read_label2(base / "label_2" / f"{fid}.txt")
+            calib = kitti.read_calib(base / "calib" / f"{fid}.txt")
+            label2 = kitti.read_label2(base / "label_2" / f"{fid}.txt")
+            dc = dontcare_test(calib, label2)
+        r = evaluate_frame(fr, a.fixed, a.model, a.min_points, a.set, dontcare=dc)
+        r.calib, r.label2 = calib, label2
         results.append(r)
         if not a.no_pictures:
             picture(r, fr, out / "pictures" / f"{src}_{fid}.png")
