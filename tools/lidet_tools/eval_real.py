@@ -43,7 +43,7 @@ import numpy as np
 
 from . import kitti, native
 from .eval import boxes_ap, iou, kitti_ap
-from .where_lost import STAGES, points_in_box, where_lost
+from .where_lost import STAGES, points_in_box, seen_points, where_lost
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SPLIT = pathlib.Path(__file__).resolve().parent / "real" / "split.txt"
@@ -126,8 +126,7 @@ def _run_cli(fr, fixed: bool, model: str | None, sets=()):
     if fixed:
         fam = model or (fr.sensor if f"cls_{fr.sensor}_s8" in native_q.pnq_models() else "hdl64")
     else:
-        ms = native.pn_models()
-        fam = model or (fr.sensor if f"cls_{fr.sensor}" in ms and f"box_{fr.sensor}" in ms else "hdl64")
+        fam = model or native.default_family(fr.sensor)
     with tempfile.TemporaryDirectory() as td:
         scan = pathlib.Path(td) / "scan.bin"
         kitti.write_bin(scan, fr.points)
@@ -204,9 +203,7 @@ def evaluate_frame(fr, fixed=False, model=None, min_points=10, sets=(), dontcare
         def hit(db, gb, cls):
             return float(iou.iou_bev_pairs(db[None], gb[None])[0]) >= LOOSE[cls]
 
-        img = native.project(fr.points, fr.sensor)  # the detector's projection: which points it sees
-        seen = np.zeros(len(fr.points), dtype=bool)
-        seen[img.point_idx[img.point_idx >= 0]] = True
+        seen = seen_points(fr.points, fr.sensor)
         res.seen_share = float(seen.mean())
         stages = where_lost(fr.points, np.array([_arr(g) for g in near]).reshape(-1, 7), [g.cls for g in near], d,
                             few, hit, native.CLASSES, seen=seen)

@@ -757,6 +757,13 @@ class Detections:
     stats: dict
 
 
+def default_family(sensor: str) -> str:
+    """The float model family the detector runs for a preset: the sensor's own when the bindings hold its pair,
+    else hdl64."""
+    ms = pn_models()
+    return sensor if f"cls_{sensor}" in ms and f"box_{sensor}" in ms else "hdl64"
+
+
 def detect(points, sensor: str = "hdl64", model: str | None = None, crop_half_rad: float = 0.0,
            max_range_m: float = 0.0, nms_iou: float = 0.1, max_proposals: int | None = None, gate1: bool = True,
            gate2: bool = True, refine: bool = True, gate1_margin: float = 0.0, gate2_margin: float = 0.0,
@@ -770,7 +777,7 @@ def detect(points, sensor: str = "hdl64", model: str | None = None, crop_half_ra
     if max_proposals is not None and not (isinstance(max_proposals, (int, np.integer)) and max_proposals >= 1):
         raise ValueError(f"max_proposals must be a positive integer, got {max_proposals!r}")
     ms = pn_models()
-    fam = model or (sensor if f"cls_{sensor}" in ms and f"box_{sensor}" in ms else "hdl64")
+    fam = model or default_family(sensor)
     if f"cls_{fam}" not in ms or f"box_{fam}" not in ms:
         raise KeyError(f"models cls_{fam} / box_{fam} are not compiled into the bindings (have: {sorted(ms)})")
     L = lib()

@@ -45,6 +45,15 @@ def points_in_box(xyz: np.ndarray, box, margin: float = 0.1) -> np.ndarray:
     return (np.abs(u) <= b[3] / 2 + margin) & (np.abs(v) <= b[4] / 2 + margin) & (np.abs(d[:, 2]) <= b[5] / 2 + margin)
 
 
+def seen_points(points: np.ndarray, sensor: str) -> np.ndarray:
+    """Mask of the points that win their pixel of the detector's projection (`native.project`): the ones it sees."""
+    from . import native
+    img = native.project(points, sensor)
+    seen = np.zeros(len(points), dtype=bool)
+    seen[img.point_idx[img.point_idx >= 0]] = True
+    return seen
+
+
 def where_lost(points: np.ndarray, gt_boxes: np.ndarray, gt_cls: list, det, min_points: int,
                hit: Callable[[np.ndarray, np.ndarray, str], bool], classes=("Car", "Cyclist", "Pedestrian"),
                seen: np.ndarray | None = None) -> list:

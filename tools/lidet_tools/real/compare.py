@@ -21,7 +21,7 @@ import sys
 import numpy as np
 
 from .. import native
-from ..where_lost import points_in_box, where_lost
+from ..where_lost import points_in_box, seen_points, where_lost
 
 CLASSES = ("Car", "Pedestrian", "Cyclist")
 BANDS = ((0.0, 15.0), (15.0, 30.0), (30.0, 45.0))
@@ -50,13 +50,6 @@ def object_rows(points, boxes, det, seen, sensor: str) -> list:
     return rows
 
 
-def _seen(points, sensor) -> np.ndarray:
-    img = native.project(points, sensor)
-    s = np.zeros(len(points), dtype=bool)
-    s[img.point_idx[img.point_idx >= 0]] = True
-    return s
-
-
 def real_rows(root, side: str = "train") -> list:
     from . import load_frame
     from ..eval_real import read_split
@@ -68,7 +61,7 @@ def real_rows(root, side: str = "train") -> list:
         if fr.sensor != "hdl64":
             continue
         det = native.detect(fr.points, fr.sensor, mount_height_m=fr.mount_height_m)
-        rows += object_rows(fr.points, fr.boxes, det, _seen(fr.points, fr.sensor), fr.sensor)
+        rows += object_rows(fr.points, fr.boxes, det, seen_points(fr.points, fr.sensor), fr.sensor)
     return rows
 
 
@@ -78,7 +71,7 @@ def sim_rows(n_scans: int, seed: int) -> list:
     for i in range(n_scans):
         r = simulate_scan("hdl64", seed, i)
         det = native.detect(r.points, "hdl64")
-        rows += object_rows(r.points, r.boxes, det, _seen(r.points, "hdl64"), "hdl64")
+        rows += object_rows(r.points, r.boxes, det, seen_points(r.points, "hdl64"), "hdl64")
     return rows
 
 
