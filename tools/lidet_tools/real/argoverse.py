@@ -13,7 +13,11 @@ Conventions found (checked with BEV pictures and close-ups of every box, ``show 
 * boxes: label_2 lines (bottom centre, rectified camera frame) -> :func:`lidet_tools.kitti.kitti_to_box`
   with the file's R0_rect (a 4.3 degree rotation) *applied*: without it the boxes miss their points (boxes
   holding >= 80 % of their near points, :func:`lidet_tools.real.fit.box_point_share`: 11 of 50 without,
-  55 of 61 with it); P0 / P1 are zeros and unused. Then shifted like the points.
+  55 of 61 with it); P0 / P1 are zeros and unused. The label_2 location is the cuboid's *centre* (Argoverse's
+  own convention), not KITTI's bottom centre: read as a bottom centre, every box stood h / 2 too high (box tops
+  0.9 m above the highest points of their cars, 1.05 m above those of their pedestrians, median within 40 m; with
+  the centre read as such, 0.07 m and 0.16 m, as on the other sources: :func:`centre_lift`). Then shifted like the
+  points.
 * classes (case-insensitive: the files have 'Car', 'PEDESTRIAN', 'ON_ROAD_OBSTACLE'): car / vehicle -> Car,
   pedestrian -> Pedestrian, cyclist / bicyclist -> Cyclist, large_vehicle / bus / trailer / truck / van /
   emergency_vehicle -> Van, anything else -> Other.
@@ -79,9 +83,19 @@ def estimate_lidar_origin(points_vehicle: np.ndarray, ground_band=(-0.8, 0.0)) -
     return float(cx), float(cy), float(np.median(ring[:, 2]) + rad * math.tan(LOWEST_BEAM_RAD))
 
 
+def centre_lift(calib, h: float) -> np.ndarray:
+    """The sensor-frame vector by which `kio.kitti_to_box` lifts a label_2 location to a box centre (h / 2 along
+    the rectified camera's -y): these files' locations are already the centres, so the reader takes it back."""
+    a, b = calib.cam_to_velo_points(np.array([[0.0, 0.0, 0.0], [0.0, -h / 2.0, 0.0]], dtype=np.float64))
+    return np.asarray(b - a, dtype=np.float64)
+
+
 def load_frame(root: pathlib.Path, frame_id: str) -> RealFrame:
-    points, boxes, _ = read_kitti_frame(root / SUBDIR, frame_id, map_class)
+    points, boxes, calib = read_kitti_frame(root / SUBDIR, frame_id, map_class)
     o = np.array(LIDAR_IN_VEHICLE_M, dtype=np.float64)
     points[:, :3] = (points[:, :3].astype(np.float64) - o).astype(np.float32)
-    moved = [kio.Box3D(b.cls, b.x - o[0], b.y - o[1], b.z - o[2], b.l, b.w, b.h, b.yaw, b.score) for b in boxes]
+    moved = []
+    for b in boxes:
+        c = np.array([b.x, b.y, b.z], dtype=np.float64) - centre_lift(calib, b.h) - o
+        moved.append(kio.Box3D(b.cls, float(c[0]), float(c[1]), float(c[2]), b.l, b.w, b.h, b.yaw, b.score))
     return RealFrame(SOURCE, frame_id, points, moved, FOV_HALF_RAD, "vlp32c", MOUNT_HEIGHT_M)
