@@ -169,7 +169,11 @@ def test_compare_rows_and_table():
         assert r["range"] < 45 and r["n"] >= 0 and r["stage"] in STAGES
         if r["n"] >= 5:
             assert 0 <= r["span"][2] <= 2.6  # no road user is taller
+            # the lowest seen points lie inside the box (0.1 m margin), at most its height above the bottom
+            assert -0.11 <= r["low"] <= 2.6
     cars = [r for r in rows if r["cls"] == "Car" and r["n"] >= 100]
+    # a car seen near by is seen down to its sills: its low 5 % within 0.5 m of the box bottom
+    assert np.median([r["low"] for r in cars]) < 0.5
     assert cars and all(1.0 <= r["span"][0] <= 5.5 for r in cars)
     t = compare.table(rows, rows)
     assert "| Car | 0-15 |" in t or "| Car | 15-30 |" in t

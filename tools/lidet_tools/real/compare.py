@@ -10,7 +10,9 @@ Real: the frames of one side of tools/lidet_tools/real/split.txt whose sensor is
 KITTI-360, PandaSet, SemanticKITTI, SqueezeSeg; the boxes of SemanticKITTI and SqueezeSeg are fitted to the visible
 points, which makes their spans read a little short). Simulated: `lidet-sim --sensor hdl64` scans of a training
 seed. Both run through the same float detector (`native.detect`, 360 degrees, each frame's mount height). The
-PointNets read x, y, z only, so intensity is not compared.
+PointNets read x, y, z only, so intensity is not compared. "seen from" is the 5th percentile of an object's seen
+points above its box bottom (median per band): how much of it is hidden from below, e.g. people behind parked cars.
+`--all-sensors` adds the frames of other sensors (Argoverse), each run on its own preset.
 """
 from __future__ import annotations
 
@@ -46,11 +48,14 @@ def object_rows(points, boxes, det, seen, sensor: str) -> list:
         c, s = np.cos(a[6]), np.sin(a[6])
         u, v = c * p[:, 0] + s * p[:, 1], -s * p[:, 0] + c * p[:, 1]
         span = [float(np.subtract(*np.percentile(q, [95, 5]))) if len(q) >= 5 else np.nan for q in (u, v, p[:, 2])]
-        rows.append(dict(cls=b.cls, range=float(np.hypot(a[0], a[1])), n=int(m.sum()), span=span, stage=st))
+        # how much of the object is hidden from below (a person behind a parked car, a car behind a wall): the
+        # 5th percentile of its seen points' z above the box bottom
+        low = float(np.percentile(p[:, 2], 5) + a[5] / 2) if len(p) >= 5 else np.nan
+        rows.append(dict(cls=b.cls, range=float(np.hypot(a[0], a[1])), n=int(m.sum()), span=span, low=low, stage=st))
     return rows
 
 
-def real_rows(root, side: str = "train") -> list:
+def real_rows(root, side: str = "train", all_sensors: bool = False) -> list:
     from . import load_frame
     from ..eval_real import read_split
     rows = []
@@ -58,7 +63,7 @@ def real_rows(root, side: str = "train") -> list:
         if sd != side:
             continue
         fr = load_frame(root, src, fid)
-        if fr.sensor != "hdl64":
+        if fr.sensor != "hdl64" and not all_sensors:
             continue
         det = native.detect(fr.points, fr.sensor, mount_height_m=fr.mount_height_m)
         rows += object_rows(fr.points, fr.boxes, det, seen_points(fr.points, fr.sensor), fr.sensor)
@@ -89,8 +94,9 @@ def _share(rows, stages) -> str:
 
 def table(sim: list, real: list) -> str:
     """Markdown: per class and band, simulated | real for each quantity."""
-    L = ["| class | band (m) | objects sim / real | points | span l (m) | span w (m) | span h (m) | clean cluster | "
-         "clean: pass gate 1 | clean: pass both gates | clean: detected |", "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    L = ["| class | band (m) | objects sim / real | points | span l (m) | span w (m) | span h (m) | seen from (m) | "
+         "clean cluster | clean: pass gate 1 | clean: pass both gates | clean: detected |",
+         "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
     past1 = ("gate 2", "size", "nms", "wrong class", "box off", "detected")
     past2 = ("size", "nms", "wrong class", "box off", "detected")
     for c in CLASSES:
@@ -103,6 +109,7 @@ def table(sim: list, real: list) -> str:
             cells.append(f"{_med([r['n'] for r in s])} / {_med([r['n'] for r in q])}")
             for k in range(3):
                 cells.append(f"{_med([r['span'][k] for r in s])} / {_med([r['span'][k] for r in q])}")
+            cells.append(f"{_med([r['low'] for r in s])} / {_med([r['low'] for r in q])}")
             for rr in (None, past1, past2, ("detected",)):
                 if rr is None:
                     f = lambda x: "-" if not x else f"{sum(r['stage'] in CLEAN for r in x) / len(x):.2f}"  # noqa: E731
@@ -120,11 +127,13 @@ def main(argv=None) -> int:
     ap.add_argument("--side", choices=("train", "val"), default="train")
     ap.add_argument("--sim-scans", type=int, default=60)
     ap.add_argument("--seed", type=int, default=1000, help="simulator seed (1000: the hdl64 family's training seed)")
+    ap.add_argument("--all-sensors", action="store_true",
+                    help="also the frames of other sensors (Argoverse's VLP-32C), each on its own preset")
     a = ap.parse_args(argv)
     if not pathlib.Path(a.root).is_dir():
         print(f"compare: {a.root} not found", file=sys.stderr)
         return 2
-    print(table(sim_rows(a.sim_scans, a.seed), real_rows(a.root, a.side)))
+    print(table(sim_rows(a.sim_scans, a.seed), real_rows(a.root, a.side, a.all_sensors)))
     return 0
 
 
