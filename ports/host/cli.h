@@ -10,10 +10,29 @@
 
 #include "lidet/lidet.h"
 
+/* A sensor read from a file (--sensor-file: lidet's description, --ouster-meta: Ouster's metadata; cli_sensor.c,
+ * docs/SENSORS.md), as read: the profiles of cli_args_t point into it. */
+typedef struct
+{
+    char name[64];                   /* the description's "name" (Ouster: the product line) */
+    char model[64];                  /* the description's "model", "" when it gives none */
+    char family[64];                 /* the float model family: model, else hdl64 (>= 32 rows) or vlp16 */
+    int uniform;                     /* 1: given as fov_up_deg, fov_down_deg and rows; 0: as a table */
+    double fov_up_deg, fov_down_deg; /* uniform only */
+    double elev_deg[LIDET_MAX_ROWS]; /* ring order: the table as read, or the uniform beam centres */
+    float elev_rad[LIDET_MAX_ROWS];  /* the same in radians, single precision (lidet_sensor_t's table) */
+    int32_t elev_urad[LIDET_MAX_ROWS]; /* and in microradians (lidet_sensor_q_t's table) */
+    uint16_t rows, cols;
+    double mount_height_m, max_range_m;
+} cli_sensor_desc_t;
+
 typedef struct
 {
     const char *scan_path;  /* positional SCAN.bin */
-    const char *sensor;     /* --sensor NAME (default hdl64) */
+    const char *sensor;     /* --sensor NAME (default hdl64); a file's sensor: its name */
+    const char *sensor_file; /* --sensor-file F: a lidet sensor description (JSON) */
+    const char *ouster_meta; /* --ouster-meta M: Ouster's sensor metadata (JSON) */
+    int print_sensor;       /* --print-sensor: print the sensor as a lidet description and stop */
     const char *out_path;   /* --out FILE */
     const char *png_path;   /* --png FILE */
     const char *ring_path;  /* --ring FILE (uint16 per point) */
@@ -24,12 +43,26 @@ typedef struct
     float *points;          /* n_points * 4 floats (x, y, z, remission) */
     uint32_t n_points;
     uint16_t *ring;         /* NULL unless --ring */
-    const lidet_sensor_t *sensor_profile; /* the preset, or sensor_mounted when --mount-height is given */
-    lidet_sensor_t sensor_mounted;        /* the preset with the --mount-height of the command line */
+    const lidet_sensor_t *sensor_profile; /* the preset, or sensor_mounted (--mount-height, a file's sensor) */
+    lidet_sensor_t sensor_mounted;        /* the preset with the --mount-height of the command line, or the
+                                             file's sensor (its table in desc) */
+    /* a file's sensor only (NULL for a preset): its float model family and its integer profile (detect --fixed;
+     * the table in desc) */
+    const char *family;
+    const lidet_sensor_q_t *sensor_q;
+    lidet_sensor_q_t sensor_q_file;
+    cli_sensor_desc_t desc;
 } cli_args_t;
 
-/* Parses argv (after the subcommand). Returns 0, or prints usage/error to stderr and returns 1. */
+/* Parses argv (after the subcommand). Returns 0; 2 after --print-sensor printed the sensor (the command then exits
+ * with 0); 3 when a sensor file could not be used (the message printed: no usage needed); or prints usage/error to
+ * stderr and returns 1. */
 int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a);
+/* Reads a->sensor_file or a->ouster_meta into a->desc and points the profiles at it (cli_sensor.c). Returns 0, or
+ * prints "lidet CMD: FILE: problem" (or that this lidet was built without cJSON) and returns 1. */
+int cli_sensor_load(cli_args_t *a, const char *cmd);
+/* Prints the command's sensor as a lidet sensor description (JSON, version 1) after --mount-height. */
+void cli_sensor_print(const cli_args_t *a, FILE *f);
 /* Reads the scan (and ring file); clear error and 1 on a missing, truncated or odd-sized file. */
 int cli_load(cli_args_t *a);
 void cli_free(cli_args_t *a);

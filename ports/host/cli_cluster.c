@@ -183,7 +183,14 @@ int cli_cluster(int argc, char **argv)
         else
             rest[nrest++] = argv[i];
     }
-    if (cli_parse(nrest, rest, "cluster", &a) != 0)
+    i = cli_parse(nrest, rest, "cluster", &a);
+    if (i == 2 || i == 3) /* --print-sensor done, or a sensor file's error printed */
+    {
+        free(rest);
+        free(sets);
+        return i == 2 ? 0 : 1;
+    }
+    if (i != 0)
     {
         fprintf(stderr, "  --labels   SemanticKITTI .label file: its ground classes are the ground mask\n"
                         "             (default: the ground stage, with its per-sector planes)\n"

@@ -10,21 +10,26 @@
 static void usage(const char *cmd)
 {
     fprintf(stderr,
-            "usage: lidet %s SCAN.bin [--sensor NAME] [--ring RING.bin] [--out FILE] [--png FILE] [--json]\n"
-            "                 [--repeat N] [--mount-height M]\n"
+            "usage: lidet %s SCAN.bin [--sensor NAME | --sensor-file F | --ouster-meta M] [--ring RING.bin]\n"
+            "                 [--out FILE] [--png FILE] [--json] [--repeat N] [--mount-height M]\n"
+            "       lidet %s [--sensor NAME | --sensor-file F | --ouster-meta M] [--mount-height M] --print-sensor\n"
             "  SCAN.bin   KITTI velodyne scan: float32 records x, y, z, remission (metres, sensor frame)\n"
             "  --sensor   hdl64 (default), vlp16, vlp32c, os1-64, os1-128\n"
+            "  --sensor-file  a sensor description (JSON, \"format\": \"lidet-sensor\"; docs/SENSORS.md)\n"
+            "  --ouster-meta  an Ouster sensor's metadata JSON (beam table, columns; mount height 1.0 m\n"
+            "             unless --mount-height)\n"
+            "  --print-sensor  print the sensor as a lidet sensor description (JSON) and stop\n"
             "  --ring     optional uint16 ring index per point (sensor's ring order) instead of elevation\n"
             "  --json     print one JSON object (stage timings as <stage>_ms)\n"
             "  --repeat   run the stage N times and report the median time (file reading excluded)\n"
             "  --mount-height  the sensor's height above the ground in metres, in [0, 10] (default: the\n"
             "             profile's: hdl64 1.73, vlp16 0.5, ...); the ground and clustering stages use it\n",
-            cmd);
+            cmd, cmd);
 }
 
 int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
 {
-    int i;
+    int i, sensor_given = 0;
     memset(a, 0, sizeof *a);
     a->sensor = "hdl64";
     a->repeat = 1;
@@ -37,8 +42,13 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
         {
             a->json = 1;
         }
+        else if (strcmp(s, "--print-sensor") == 0)
+        {
+            a->print_sensor = 1;
+        }
         else if ((strcmp(s, "--sensor") == 0 || strcmp(s, "--out") == 0 || strcmp(s, "--png") == 0 ||
-                  strcmp(s, "--repeat") == 0 || strcmp(s, "--ring") == 0 || strcmp(s, "--mount-height") == 0))
+                  strcmp(s, "--repeat") == 0 || strcmp(s, "--ring") == 0 || strcmp(s, "--mount-height") == 0 ||
+                  strcmp(s, "--sensor-file") == 0 || strcmp(s, "--ouster-meta") == 0))
         {
             if (!has_val)
             {
@@ -46,7 +56,14 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
                 return 1;
             }
             if (strcmp(s, "--sensor") == 0)
+            {
                 a->sensor = argv[++i];
+                sensor_given = 1;
+            }
+            else if (strcmp(s, "--sensor-file") == 0)
+                a->sensor_file = argv[++i];
+            else if (strcmp(s, "--ouster-meta") == 0)
+                a->ouster_meta = argv[++i];
             else if (strcmp(s, "--out") == 0)
                 a->out_path = argv[++i];
             else if (strcmp(s, "--png") == 0)
@@ -98,23 +115,44 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
             return 1;
         }
     }
-    if (a->scan_path == NULL)
+    if (a->scan_path == NULL && !a->print_sensor)
     {
         usage(cmd);
         return 1;
     }
-    a->sensor_profile = lidet_sensor_find(a->sensor);
-    if (a->sensor_profile == NULL)
+    if ((a->sensor_file != NULL) + (a->ouster_meta != NULL) + sensor_given > 1)
     {
-        fprintf(stderr, "lidet %s: unknown sensor '%s' (known: hdl64, vlp16, vlp32c, os1-64, os1-128)\n", cmd,
-                a->sensor);
+        fprintf(stderr, "lidet %s: give one of --sensor, --sensor-file and --ouster-meta\n", cmd);
         return 1;
+    }
+    if (a->sensor_file != NULL || a->ouster_meta != NULL)
+    {
+        /* the file's sensor: a->sensor_mounted (its table in a->desc), its family and integer profile */
+        if (cli_sensor_load(a, cmd) != 0)
+            return 3;
+    }
+    else
+    {
+        a->sensor_profile = lidet_sensor_find(a->sensor);
+        if (a->sensor_profile == NULL)
+        {
+            fprintf(stderr, "lidet %s: unknown sensor '%s' (known: hdl64, vlp16, vlp32c, os1-64, os1-128)\n", cmd,
+                    a->sensor);
+            return 1;
+        }
     }
     if (a->mount_height_m >= 0.0)
     {
-        a->sensor_mounted = *a->sensor_profile;
+        if (a->sensor_profile != &a->sensor_mounted)
+            a->sensor_mounted = *a->sensor_profile;
         a->sensor_mounted.mount_height_m = (float)a->mount_height_m;
         a->sensor_profile = &a->sensor_mounted;
+        a->desc.mount_height_m = a->mount_height_m; /* what --print-sensor prints for a file's sensor */
+    }
+    if (a->print_sensor)
+    {
+        cli_sensor_print(a, stdout);
+        return 2;
     }
     return 0;
 }

@@ -549,7 +549,8 @@ static int write_dump(const char *path, const int32_t *pp, uint32_t n_points)
 static void usage_extra(void)
 {
     fprintf(stderr, "  --model NAME     model family: weights cls_NAME + box_NAME (default: the sensor's family,\n"
-                    "                   else hdl64); available:");
+                    "                   else hdl64; a --sensor-file's \"model\", else hdl64 for >= 32 rows and\n"
+                    "                   vlp16 below); available:");
     {
         uint32_t i;
         for (i = 0; i < LIDET_WEIGHTS_N_MODELS; ++i)
@@ -681,7 +682,14 @@ int cli_detect(int argc, char **argv)
         else
             rest[nrest++] = argv[i];
     }
-    if (cli_parse(nrest, rest, "detect", &a) != 0)
+    i = cli_parse(nrest, rest, "detect", &a);
+    if (i == 2 || i == 3) /* --print-sensor done, or a sensor file's error printed */
+    {
+        free(rest);
+        free(sets);
+        return i == 2 ? 0 : 1;
+    }
+    if (i != 0)
     {
         usage_extra();
         free(rest);
@@ -707,7 +715,8 @@ int cli_detect(int argc, char **argv)
         free(sets);
         return 1;
     }
-    if (pick_models(family, a.sensor, &mc, &mb, chosen, sizeof chosen) != 0)
+    /* a file's sensor: its own family (the description's "model", else by rows), without the fallback */
+    if (pick_models(family != NULL ? family : a.family, a.sensor, &mc, &mb, chosen, sizeof chosen) != 0)
     {
         free(sets);
         cli_free(&a);

@@ -45,7 +45,8 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
                      uint8_t *point_ground, uint32_t *point_cluster, lidet_status_t *status)
 {
     const double bam_per_rad = 4294967296.0 / (2.0 * M_PI_D);
-    const lidet_sensor_q_t *s = lidet_sensor_q_find(a->sensor);
+    /* a file's sensor brings its integer profile (cli_sensor.c) */
+    const lidet_sensor_q_t *s = a->sensor_q != NULL ? a->sensor_q : lidet_sensor_q_find(a->sensor);
     lidet_sensor_q_t mounted;
     const lidet_pointnet_q_model_t *mc, *mb;
     const lidet_detection_q_t *dq;

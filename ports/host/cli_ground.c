@@ -150,13 +150,14 @@ int cli_ground(int argc, char **argv)
         else
             rest[n_rest++] = argv[k];
     }
-    if (cli_parse(n_rest, rest, "ground", &a) != 0 || cli_load(&a) != 0)
+    k = cli_parse(n_rest, rest, "ground", &a);
+    if (k != 0 || cli_load(&a) != 0)
     {
         if (n_rest > 0 && (strcmp(rest[0], "--help") == 0 || strcmp(rest[0], "-h") == 0))
             fprintf(stderr, "  --set KEY=VALUE  override a lidet_ground_cfg_t field (repeatable), e.g. --set ground_m=0.2\n");
         free(rest);
         free(sets);
-        return 1;
+        return k == 2 ? 0 : 1; /* 2: --print-sensor done */
     }
     lidet_proj_cfg_default(&pcfg, a.sensor_profile);
     lidet_ground_cfg_default(&gcfg, a.sensor_profile);

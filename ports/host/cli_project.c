@@ -62,8 +62,9 @@ int cli_project(int argc, char **argv)
     double *times, ms;
     int i;
 
-    if (cli_parse(argc, argv, "project", &a) != 0 || cli_load(&a) != 0)
-        return 1;
+    i = cli_parse(argc, argv, "project", &a);
+    if (i != 0 || cli_load(&a) != 0)
+        return i == 2 ? 0 : 1; /* 2: --print-sensor done */
     lidet_proj_cfg_default(&cfg, a.sensor_profile);
     st = lidet_proj_init(&g_proj, &cfg);
     if (st != LIDET_OK)

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* Flat C entry point over the whole detector (lidet_detector.h) for the Python bindings: one scan in,
- * detections, per-cluster outcomes and per-point labels out. Host only: one static detector, so calls are
- * not reentrant; each call initialises it (the configuration may change between calls). */
+/* Flat C entry points over the whole detector (lidet_detector.h) for the Python bindings: one scan in,
+ * detections, per-cluster outcomes and per-point labels out; the sensor a preset by name (lidet_py_det_run) or a
+ * table (lidet_py_det_run_table: a sensor read from a file, native.detect(points, Sensor)). Host only: one static
+ * detector, so calls are not reentrant; each call initialises it (the configuration may change between calls). */
 #include <stdlib.h>
 #include <string.h>
 
@@ -23,12 +24,11 @@ static int32_t g_pp[LIDET_MAX_POINTS];
  * yaw, cluster id); out_outcome: LIDET_MAX_CLUSTERS bytes; out_point_cluster / out_point_ground: n entries
  * (may be NULL); out_stats: 15 uint32 (the lidet_detector_stats_t counts in order, the status, then
  * n_over_box_budget and n_too_tall). */
-LIDET_PY_API int lidet_py_det_run(const char *sensor, uint32_t cls_index, uint32_t box_index, const float *fcfg,
-                                  const uint32_t *ucfg, const float *pts, uint32_t n, uint32_t stride,
-                                  float *out_det, uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters,
-                                  uint32_t *out_point_cluster, uint8_t *out_point_ground, uint32_t *out_stats)
+static int det_run(const lidet_sensor_t *s, uint32_t cls_index, uint32_t box_index, const float *fcfg,
+                   const uint32_t *ucfg, const float *pts, uint32_t n, uint32_t stride, float *out_det,
+                   uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters, uint32_t *out_point_cluster,
+                   uint8_t *out_point_ground, uint32_t *out_stats)
 {
-    const lidet_sensor_t *s = lidet_sensor_find(sensor);
     lidet_sensor_t mounted;
     lidet_detector_cfg_t cfg;
     const lidet_detection_t *d;
@@ -64,7 +64,8 @@ LIDET_PY_API int lidet_py_det_run(const char *sensor, uint32_t cls_index, uint32
     cfg.gate2 = (uint8_t)ucfg[2];
     cfg.stages.cluster.split_people = ucfg[3] != 0u; /* the proposal refinement (lidet_refine.c) */
     cfg.stages.cluster.join_cars = ucfg[3] != 0u;
-    rc = lidet_detector_init(&g_det, &cfg, lidet_weights_models[cls_index].model, lidet_weights_models[box_index].model);
+    rc = lidet_detector_init(&g_det, &cfg, lidet_weights_models[cls_index].model,
+                             lidet_weights_models[box_index].model);
     if (rc != LIDET_OK)
     {
         return rc;
@@ -127,4 +128,42 @@ LIDET_PY_API int lidet_py_det_run(const char *sensor, uint32_t cls_index, uint32
     out_stats[13] = st->n_over_box_budget;
     out_stats[14] = st->n_too_tall;
     return rc;
+}
+
+LIDET_PY_API int lidet_py_det_run(const char *sensor, uint32_t cls_index, uint32_t box_index,
+                                  const float *fcfg, const uint32_t *ucfg, const float *pts, uint32_t n,
+                                  uint32_t stride, float *out_det, uint32_t *n_det, uint8_t *out_outcome,
+                                  uint32_t *n_clusters, uint32_t *out_point_cluster,
+                                  uint8_t *out_point_ground, uint32_t *out_stats)
+{
+    /* a preset: exactly the profile lidet_sensor_find gives the CLI's --sensor */
+    return det_run(lidet_sensor_find(sensor), cls_index, box_index, fcfg, ucfg, pts, n, stride, out_det,
+                   n_det, out_outcome, n_clusters, out_point_cluster, out_point_ground, out_stats);
+}
+
+/* The same with the sensor given as its table: rows x cols, elev_rad (rows elevations in ring order, radians),
+ * mount height and nominal range in metres (name informational, may be NULL). Errors of the table (count, order,
+ * duplicates) come back from lidet_detector_init as LIDET_ERR_CONFIG. */
+LIDET_PY_API int lidet_py_det_run_table(const char *name, uint32_t rows, uint32_t cols, const float *elev_rad,
+                                        float mount_height_m, float max_range_m, uint32_t cls_index,
+                                        uint32_t box_index, const float *fcfg, const uint32_t *ucfg,
+                                        const float *pts, uint32_t n, uint32_t stride, float *out_det,
+                                        uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters,
+                                        uint32_t *out_point_cluster, uint8_t *out_point_ground,
+                                        uint32_t *out_stats)
+{
+    lidet_sensor_t s;
+    if (elev_rad == NULL || rows == 0u || rows > LIDET_MAX_ROWS || cols > LIDET_MAX_COLS)
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    memset(&s, 0, sizeof s);
+    s.name = name;
+    s.n_rows = (uint16_t)rows;
+    s.n_cols = (uint16_t)cols;
+    s.beam_elev_rad = elev_rad;
+    s.mount_height_m = mount_height_m;
+    s.max_range_m = max_range_m;
+    return det_run(&s, cls_index, box_index, fcfg, ucfg, pts, n, stride, out_det, n_det, out_outcome,
+                   n_clusters, out_point_cluster, out_point_ground, out_stats);
 }

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .sensors import Sensor, get_sensor
+from .sensors import Sensor, get_sensor, model_family
 
 _ROOT = pathlib.Path(__file__).resolve().parents[2]
 _lib = None
@@ -757,25 +757,32 @@ class Detections:
     stats: dict
 
 
-def default_family(sensor: str) -> str:
-    """The float model family the detector runs for a preset: the sensor's own when the bindings hold its pair,
-    else hdl64."""
+def default_family(sensor: str | Sensor) -> str:
+    """The float model family the detector runs for a preset name: the sensor's own when the bindings hold its
+    pair, else hdl64; for a `Sensor` (e.g. read from a file): its model, else hdl64 for >= 32 rows and vlp16 below
+    (`sensors.model_family`)."""
+    if isinstance(sensor, Sensor):
+        return model_family(sensor)
     ms = pn_models()
     return sensor if f"cls_{sensor}" in ms and f"box_{sensor}" in ms else "hdl64"
 
 
-def detect(points, sensor: str = "hdl64", model: str | None = None, crop_half_rad: float = 0.0,
+def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, crop_half_rad: float = 0.0,
            max_range_m: float = 0.0, nms_iou: float = 0.1, max_proposals: int | None = None, gate1: bool = True,
            gate2: bool = True, refine: bool = True, gate1_margin: float = 0.0, gate2_margin: float = 0.0,
            mount_height_m: float | None = None) -> Detections:
     """lidet_detector_run on (N, >=3) points with the models cls_<model> / box_<model> compiled into the bindings
-    (default: the sensor's family if present, else hdl64). A preset sensor name only. max_proposals None: the
+    (default: `default_family(sensor)`). sensor: a preset name (the C preset, lidet_sensor_find, as `lidet detect
+    --sensor`) or a `Sensor` (its table in ring order, e.g. `sensors.load_sensor_file`, `load_ouster_metadata`, as
+    `lidet detect --sensor-file`). max_proposals None: the
     C default for the sensor (lidet_detector_cfg_default). refine False: the clustering without its refinement
     (split_people, join_cars: lidet_refine.c), as the integer detector runs it today. gate1_margin / gate2_margin:
     the gates' operating points (lidet_detector_cfg_t, nats added to the models' gammas). mount_height_m: the
     sensor's height above the ground in m, [0, 10] (None: the profile's; `lidet detect --mount-height`)."""
     if max_proposals is not None and not (isinstance(max_proposals, (int, np.integer)) and max_proposals >= 1):
         raise ValueError(f"max_proposals must be a positive integer, got {max_proposals!r}")
+    if not isinstance(sensor, (str, Sensor)):
+        raise TypeError(f"sensor must be a preset name or a Sensor, got {type(sensor).__name__}")
     ms = pn_models()
     fam = model or default_family(sensor)
     if f"cls_{fam}" not in ms or f"box_{fam}" not in ms:
@@ -783,8 +790,10 @@ def detect(points, sensor: str = "hdl64", model: str | None = None, crop_half_ra
     L = lib()
     if not getattr(L, "_det_ready", False):
         _u8p = np.ctypeslib.ndpointer(np.uint8, flags="C_CONTIGUOUS")
-        L.lidet_py_det_run.argtypes = [C.c_char_p, C.c_uint32, C.c_uint32, _f32p, _u32p, _f32p, C.c_uint32, C.c_uint32,
-                                       _f32p, _u32p, _u8p, _u32p, _opt(_u32p), _opt(_u8p), _u32p]
+        tail = [C.c_uint32, C.c_uint32, _f32p, _u32p, _f32p, C.c_uint32, C.c_uint32, _f32p, _u32p, _u8p, _u32p,
+                _opt(_u32p), _opt(_u8p), _u32p]
+        L.lidet_py_det_run.argtypes = [C.c_char_p] + tail
+        L.lidet_py_det_run_table.argtypes = [C.c_char_p, C.c_uint32, C.c_uint32, _f32p, C.c_float, C.c_float] + tail
         L._det_ready = True
     pts, stride = _as_points(points)
     n = len(pts)
@@ -801,8 +810,16 @@ def detect(points, sensor: str = "hdl64", model: str | None = None, crop_half_ra
     fc = np.array([crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin,
                    -1.0 if mount_height_m is None else mount_height_m], np.float32)
     uc = np.array([max_proposals or 0, int(bool(gate1)), int(bool(gate2)), int(bool(refine))], np.uint32)
-    rc = L.lidet_py_det_run(sensor.encode(), ms[f"cls_{fam}"].index, ms[f"box_{fam}"].index, fc, uc,
-                            pts if n else np.zeros((1, 4), np.float32), n, stride, det, nd, oc, nc, pc, pg, st)
+    args = (ms[f"cls_{fam}"].index, ms[f"box_{fam}"].index, fc, uc, pts if n else np.zeros((1, 4), np.float32), n,
+            stride, det, nd, oc, nc, pc, pg, st)
+    if isinstance(sensor, str):
+        rc = L.lidet_py_det_run(sensor.encode(), *args)
+    else:
+        elev = np.ascontiguousarray(sensor.beam_elev_rad, dtype=np.float32)
+        if elev.shape != (sensor.rows,):
+            raise ValueError(f"sensor {sensor.name!r}: {elev.shape} elevations for {sensor.rows} rows")
+        rc = L.lidet_py_det_run_table(sensor.name.encode(), sensor.rows, sensor.cols, elev, sensor.mount_height_m,
+                                      sensor.max_range_m, *args)
     if rc < 0:
         raise LidetError(rc, "lidet_detector")
     d = det[: int(nd[0])]

@@ -9,9 +9,18 @@ the projection sorts them top to bottom to get image rows (row 0 = highest beam)
 Column convention (same as the SemanticKITTI API): col = floor(0.5 * (1 - azimuth / pi) * cols),
 azimuth = atan2(y, x); so +x (forward) is the middle column, azimuth decreases to the right, and
 the seam (col 0 / cols-1) is straight behind the sensor.
+
+Sensors beyond the presets come from files (docs/SENSORS.md): `load_sensor_file` reads lidet's own
+description (JSON, "format": "lidet-sensor"), `load_ouster_metadata` Ouster's sensor metadata JSON. The
+host CLI reads the same files with the same rules and messages (ports/host/cli_sensor.c,
+`lidet ... --sensor-file F | --ouster-meta M`); tests/python/test_sensor_files.py holds the two together.
 """
 from __future__ import annotations
 
+import json
+import math
+import pathlib
+import re
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,6 +42,13 @@ class Sensor:
     #: (fov_up, fov_down) in microradians for a uniform sensor (the integer presets give the fov, not a
     #: table, as lib/src/lidet_sensor_q.c); None for a sensor with a beam table
     fov_urad: tuple | None = None
+    #: float model family the detector runs (a description file's "model"); None: the rule of `model_family`
+    model: str | None = None
+    #: per-beam azimuth offsets in radians, ring order (Ouster metadata's beam_azimuth_angles); read and
+    #: validated, not used by the projection
+    beam_azimuth_rad: np.ndarray | None = field(default=None, repr=False)
+    #: Ouster metadata's lidar_origin_to_beam_origin_mm; read and validated, not used by the projection
+    beam_origin_mm: float | None = None
 
     @property
     def beam_elev_urad(self) -> np.ndarray:
@@ -135,3 +151,390 @@ def custom_sensor(name: str, cols: int, beam_elev_deg=None, fov_up_deg=None, fov
         elev = uniform_beams(fov_up_deg, fov_down_deg, rows)
         fov = _urad_fov(fov_up_deg, fov_down_deg)
     return Sensor(name, len(elev), int(cols), elev, float(mount_height_m), float(max_range_m), fov)
+
+
+# ---- sensor descriptions from files (docs/SENSORS.md) ---------------------------------------------------
+# ports/host/cli_sensor.c implements the same rules in the same order with the same messages: a change here
+# goes there too (tests/python/test_sensor_files.py compares the two on every test file).
+
+#: "format" and "version" of lidet's sensor description files
+SENSOR_FILE_FORMAT = "lidet-sensor"
+SENSOR_FILE_VERSION = 1
+#: the fields a version-1 description may hold
+SENSOR_FILE_FIELDS = ("format", "version", "name", "cols", "rows", "beam_elevation_deg", "fov_up_deg",
+                      "fov_down_deg", "mount_height_m", "max_range_m", "model")
+#: larger files are refused before parsing
+SENSOR_FILE_MAX_BYTES = 16 << 20
+#: what Ouster's metadata does not say: the mount height (overridable) and the nominal range (informational)
+OUSTER_MOUNT_HEIGHT_M = 1.0
+OUSTER_MAX_RANGE_M = 120.0
+#: a "name" or "model": 1 to 63 of these characters
+_NAME_BYTES = frozenset(b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._+-")
+_NAME_RULE = "must be 1 to 63 characters from A-Z a-z 0-9 . _ + -"
+
+
+class SensorFileError(ValueError):
+    """A sensor description or metadata file that cannot be used; the message starts with the path and names
+    the field ("PATH: \\"cols\\": 4 is outside [8, 2048] (LIDET_MAX_COLS)")."""
+
+
+class _Bad(Exception):
+    """A validation failure inside a loader (the message without the path)."""
+
+
+class _Duplicate(Exception):
+    pass
+
+
+class _Constant(Exception):
+    pass
+
+
+def model_family(sensor: Sensor) -> str:
+    """The float model family the detector runs for a sensor read from a file: its "model", else hdl64 for 32
+    beams or more and vlp16 below (the families trained today; docs/SENSORS.md)."""
+    if sensor.model:
+        return sensor.model
+    return "hdl64" if sensor.rows >= 32 else "vlp16"
+
+
+def _header_limits() -> tuple[int, int]:
+    """LIDET_MAX_ROWS / LIDET_MAX_COLS defaults of lib/include/lidet/lidet_opt.h (when the bindings are not
+    built); the bounds the header's #error checks allow when it is not there either."""
+    opt = pathlib.Path(__file__).resolve().parents[2] / "lib" / "include" / "lidet" / "lidet_opt.h"
+    try:
+        txt = opt.read_text()
+    except OSError:
+        return 256, 16384
+    rows = re.search(r"#define\s+LIDET_MAX_ROWS\s+(\d+)", txt)
+    cols = re.search(r"#define\s+LIDET_MAX_COLS\s+(\d+)", txt)
+    return (int(rows.group(1)) if rows else 256), (int(cols.group(1)) if cols else 16384)
+
+
+def capacity_limits() -> tuple[int, int]:
+    """(LIDET_MAX_ROWS, LIDET_MAX_COLS) of the built library (through the bindings), else lidet_opt.h's
+    defaults: the bounds a description's rows and cols must keep."""
+    try:
+        from . import native
+        c = native.capacity()
+        return c["max_rows"], c["max_cols"]
+    except (FileNotFoundError, OSError, AttributeError):
+        return _header_limits()
+
+
+def _kind(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if v is None:
+        return "null"
+    if isinstance(v, str):
+        return "a string"
+    if isinstance(v, list):
+        return "an array"
+    if isinstance(v, dict):
+        return "an object"
+    return "a number"
+
+
+def _float(v) -> float:
+    try:
+        return float(v)
+    except OverflowError:  # an integer literal beyond double's range
+        return math.inf
+
+
+def _number(v, what: str) -> float:
+    """A finite JSON number (booleans are not numbers)."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise _Bad(f"{what}: expected a number, got {_kind(v)}")
+    x = _float(v)
+    if not math.isfinite(x):
+        raise _Bad(f"{what}: not a finite number")
+    return x
+
+
+def _integer(v, what: str, lo: int, hi: int, macro: str = "") -> int:
+    """A JSON number with an integral value (2048 or 2048.0) in [lo, hi]."""
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise _Bad(f"{what}: expected an integer, got {_kind(v)}")
+    x = _float(v)
+    if not math.isfinite(x):
+        raise _Bad(f"{what}: not a finite number")
+    if x != math.floor(x):
+        raise _Bad(f"{what}: expected an integer, got {x:g}")
+    if not lo <= x <= hi:
+        raise _Bad(f"{what}: {x:g} is outside [{lo}, {hi}]" + (f" ({macro})" if macro else ""))
+    return int(x)
+
+
+def _name(v, what: str) -> str:
+    if not isinstance(v, str):
+        raise _Bad(f"{what}: expected a string, got {_kind(v)}")
+    b = v.encode("utf-8", "surrogatepass")
+    if not 1 <= len(b) <= 63 or any(c not in _NAME_BYTES for c in b):
+        raise _Bad(f"{what}: {_NAME_RULE}")
+    return v
+
+
+def _distinct_rad(deg: np.ndarray) -> int:
+    """Index of the first beam whose single-precision radians equal an earlier beam's, or -1."""
+    rad = np.radians(deg).astype(np.float32)
+    seen: dict = {}
+    for i, r in enumerate(rad.tolist()):
+        if r in seen:
+            return i
+        seen[r] = i
+    return -1
+
+
+def _elevations(v, what: str, max_rows: int) -> np.ndarray:
+    """A beam elevation table in degrees: 1..max_rows finite numbers in (-90, 90), distinct in single precision
+    radians (what the library compares)."""
+    if not isinstance(v, list):
+        raise _Bad(f"{what}: expected an array of numbers, got {_kind(v)}")
+    if not 1 <= len(v) <= max_rows:
+        raise _Bad(f"{what}: {len(v)} beams, outside [1, {max_rows}] (LIDET_MAX_ROWS)")
+    deg = np.empty(len(v), np.float64)
+    for i, e in enumerate(v):
+        x = _number(e, f"{what}[{i}]")
+        if not -90.0 < x < 90.0:
+            raise _Bad(f"{what}[{i}]: {x:g} deg is outside (-90, 90)")
+        deg[i] = x
+    i = _distinct_rad(deg)
+    if i >= 0:
+        rad = np.radians(deg).astype(np.float32)
+        j = int(np.flatnonzero(rad[:i] == rad[i])[0])
+        raise _Bad(f"{what}[{i}]: the same elevation as [{j}] ({deg[i]:g} deg): beams must be distinct")
+    return deg
+
+
+def _read_json(path) -> object:
+    p = pathlib.Path(path)
+    try:
+        data = p.read_bytes()
+    except OSError as e:
+        raise SensorFileError(f"{path}: cannot read: {e.strerror or e}") from None
+    if len(data) > SENSOR_FILE_MAX_BYTES:
+        raise SensorFileError(f"{path}: larger than {SENSOR_FILE_MAX_BYTES >> 20} MiB: not a sensor description")
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError:
+        raise SensorFileError(f"{path}: not valid JSON (not UTF-8 text)") from None
+
+    def pairs(kv):
+        d = {}
+        for k, val in kv:
+            if k in d:
+                raise _Duplicate(k)
+            d[k] = val
+        return d
+
+    def constant(name):
+        raise _Constant(name)
+
+    try:
+        return json.loads(text, object_pairs_hook=pairs, parse_constant=constant)
+    except _Duplicate as e:
+        raise SensorFileError(f'{path}: "{e.args[0]}": given twice') from None
+    except _Constant as e:
+        raise SensorFileError(f"{path}: not valid JSON ({e.args[0]} is not a JSON number)") from None
+    except json.JSONDecodeError as e:
+        raise SensorFileError(f"{path}: not valid JSON ({e.msg} at line {e.lineno} column {e.colno})") from None
+
+
+def _read_object(path) -> dict:
+    root = _read_json(path)
+    if not isinstance(root, dict):
+        raise SensorFileError(f"{path}: the file must hold one JSON object")
+    return root
+
+
+def _description(root: dict, max_rows: int, max_cols: int) -> Sensor:
+    """Validates a version-1 description (the order of the checks is the C loader's)."""
+    if "format" not in root or root["format"] != SENSOR_FILE_FORMAT:
+        hint = ""
+        if "beam_altitude_angles" in root or "beam_intrinsics" in root:
+            hint = ": this looks like Ouster metadata, read it with --ouster-meta (load_ouster_metadata)"
+        problem = "missing (expected \"lidet-sensor\")" if "format" not in root else "expected \"lidet-sensor\""
+        raise _Bad(f'"format": {problem}{hint}')
+    if "version" not in root:
+        raise _Bad('"version": missing')
+    version = _integer(root["version"], '"version"', 0, 1000000)
+    if version != SENSOR_FILE_VERSION:
+        raise _Bad(f'"version": {version} is not supported (this build reads version {SENSOR_FILE_VERSION})')
+    for k in root:
+        if k not in SENSOR_FILE_FIELDS:
+            raise _Bad(f'"{k}": unknown field (known: {", ".join(SENSOR_FILE_FIELDS)})')
+    for k in ("name", "cols"):
+        if k not in root:
+            raise _Bad(f'"{k}": missing')
+    name = _name(root["name"], '"name"')
+    cols = _integer(root["cols"], '"cols"', 8, max_cols, "LIDET_MAX_COLS")
+    table = "beam_elevation_deg" in root
+    if table and ("fov_up_deg" in root or "fov_down_deg" in root):
+        raise _Bad('"beam_elevation_deg": give the beam table or "fov_up_deg", "fov_down_deg" and "rows", not both')
+    fov = None
+    if table:
+        deg = _elevations(root["beam_elevation_deg"], '"beam_elevation_deg"', max_rows)
+        if "rows" in root:
+            rows = _integer(root["rows"], '"rows"', 1, max_rows, "LIDET_MAX_ROWS")
+            if rows != len(deg):
+                raise _Bad(f'"rows": {rows} does not match the {len(deg)} entries of "beam_elevation_deg"')
+    else:
+        if "fov_up_deg" not in root and "fov_down_deg" not in root:
+            raise _Bad('"beam_elevation_deg": missing (or give "fov_up_deg", "fov_down_deg" and "rows")')
+        for k in ("fov_up_deg", "fov_down_deg"):
+            if k not in root:
+                raise _Bad(f'"{k}": missing')
+        if "rows" not in root:
+            raise _Bad('"rows": missing (needed with "fov_up_deg" and "fov_down_deg")')
+        edges = []
+        for k in ("fov_up_deg", "fov_down_deg"):
+            x = _number(root[k], f'"{k}"')
+            if not -90.0 < x < 90.0:
+                raise _Bad(f'"{k}": {x:g} deg is outside (-90, 90)')
+            edges.append(x)
+        up, down = edges
+        if not up > down:
+            raise _Bad(f'"fov_up_deg": {up:g} deg is not above "fov_down_deg" ({down:g} deg)')
+        rows = _integer(root["rows"], '"rows"', 1, max_rows, "LIDET_MAX_ROWS")
+        deg = up - (np.arange(rows) + 0.5) * ((up - down) / rows)  # uniform_beams, in degrees
+        if _distinct_rad(deg) >= 0:
+            raise _Bad(f'"rows": {rows} beams between "fov_down_deg" and "fov_up_deg" are not distinct '
+                       "in single precision")
+        fov = _urad_fov(up, down)
+    for k in ("mount_height_m", "max_range_m"):
+        if k not in root:
+            raise _Bad(f'"{k}": missing')
+    mount = _number(root["mount_height_m"], '"mount_height_m"')
+    if not 0.0 <= mount <= 10.0:
+        raise _Bad(f'"mount_height_m": {mount:g} is outside [0, 10]')
+    max_range = _number(root["max_range_m"], '"max_range_m"')
+    if not 0.0 < max_range <= 1000.0:
+        raise _Bad(f'"max_range_m": {max_range:g} is outside (0, 1000]')
+    model = _name(root["model"], '"model"') if "model" in root else None
+    return Sensor(name, len(deg), cols, _deg(deg), mount, max_range, fov, model=model)
+
+
+def load_sensor_file(path) -> Sensor:
+    """A sensor from a lidet description file (JSON, docs/SENSORS.md): "format": "lidet-sensor", "version": 1,
+    "name", "cols", "beam_elevation_deg" (ring order) or "fov_up_deg" + "fov_down_deg" + "rows",
+    "mount_height_m", "max_range_m", optional "model" (the float model family; `model_family`). Rows and cols
+    must fit the built library (`capacity_limits`). Raises SensorFileError naming the file and the field."""
+    root = _read_object(path)
+    max_rows, max_cols = capacity_limits()
+    try:
+        return _description(root, max_rows, max_cols)
+    except _Bad as e:
+        raise SensorFileError(f"{path}: {e}") from None
+
+
+def _ouster_name(prod_line: str, rows: int) -> str:
+    """lidet's name of an Ouster sensor: the product line in lower case, other characters as '-', at most 63
+    bytes; "ouster-<rows>" without one."""
+    out = bytearray()
+    for c in prod_line.encode("utf-8", "surrogatepass")[:63]:
+        c = c + 32 if 65 <= c <= 90 else c
+        out.append(c if c in _NAME_BYTES else ord("-"))
+    return out.decode("ascii") if out else f"ouster-{rows}"
+
+
+#: where each field of Ouster's metadata lives: the sections of the nested layout (firmware 2.4 on), then the
+#: top level (the older flat layout; 2.x files also nest columns under "data_format")
+_OUSTER_SECTIONS = ("beam_intrinsics", "lidar_data_format", "data_format", "config_params", "sensor_info")
+_OUSTER_MODE = re.compile(r"([0-9]{1,5})x([0-9]{1,3})")
+
+
+def _ouster(root: dict, max_rows: int, max_cols: int, mount_height_m: float) -> Sensor:
+    if root.get("format") == SENSOR_FILE_FORMAT:
+        raise _Bad('"format": this is a lidet sensor description, read it with --sensor-file (load_sensor_file)')
+    if "packet_hash" in root:
+        raise _Bad('"packet_hash": this is an ouster-sdk packet digest (hashes of decoded fields), not sensor '
+                   "metadata")
+    for sec in _OUSTER_SECTIONS:
+        if sec in root and not isinstance(root[sec], dict):
+            raise _Bad(f'"{sec}": expected an object, got {_kind(root[sec])}')
+
+    def find(sections, key):
+        for sec in sections:
+            if sec in root and key in root[sec]:
+                return f"{sec}.{key}", root[sec][key]
+        if key in root:
+            return key, root[key]
+        return None, None
+
+    alt_f, alt = find(("beam_intrinsics",), "beam_altitude_angles")
+    if alt_f is None:
+        raise _Bad('"beam_altitude_angles": missing (neither in "beam_intrinsics" nor at the top level): '
+                   "not Ouster sensor metadata?")
+    deg = _elevations(alt, f'"{alt_f}"', max_rows)
+    rows = len(deg)
+    az_f, az = find(("beam_intrinsics",), "beam_azimuth_angles")
+    az_rad = None
+    if az_f is not None:
+        if not isinstance(az, list):
+            raise _Bad(f'"{az_f}": expected an array of numbers, got {_kind(az)}')
+        if len(az) != rows:
+            raise _Bad(f'"{az_f}": {len(az)} entries for {rows} beams')
+        a = np.empty(rows, np.float64)
+        for i, e in enumerate(az):
+            x = _number(e, f'"{az_f}"[{i}]')
+            if not -180.0 < x < 180.0:
+                raise _Bad(f'"{az_f}"[{i}]: {x:g} deg is outside (-180, 180)')
+            a[i] = x
+        az_rad = np.radians(a)
+    ppc_f, ppc = find(("lidar_data_format", "data_format"), "pixels_per_column")
+    if ppc_f is not None:
+        n = _integer(ppc, f'"{ppc_f}"', 1, 65535)
+        if n != rows:
+            raise _Bad(f'"{ppc_f}": {n} but "{alt_f}" has {rows} entries')
+    cpf_f, cpf = find(("lidar_data_format", "data_format"), "columns_per_frame")
+    mode_f, mode = find(("config_params",), "lidar_mode")
+    cols = None
+    if cpf_f is not None:
+        cols = _integer(cpf, f'"{cpf_f}"', 8, max_cols, "LIDET_MAX_COLS")
+    mode_cols = None
+    if mode_f is not None:
+        m = _OUSTER_MODE.fullmatch(mode) if isinstance(mode, str) else None
+        if m is None:
+            raise _Bad(f'"{mode_f}": expected "<columns>x<rate>" such as "1024x10"')
+        mode_cols = int(m.group(1))
+    if cols is None and mode_cols is None:
+        raise _Bad('"lidar_mode": missing (and no "columns_per_frame")')
+    if cols is not None and mode_cols is not None and cols != mode_cols:
+        raise _Bad(f'"{mode_f}": {mode_cols} columns, but "{cpf_f}" is {cols}')
+    if cols is None:
+        if not 8 <= mode_cols <= max_cols:
+            raise _Bad(f'"{mode_f}": {mode_cols} columns, outside [8, {max_cols}] (LIDET_MAX_COLS)')
+        cols = mode_cols
+    org_f, org = find(("beam_intrinsics",), "lidar_origin_to_beam_origin_mm")
+    origin = _number(org, f'"{org_f}"') if org_f is not None else None
+    prod_f, prod = find(("sensor_info",), "prod_line")
+    name = f"ouster-{rows}"
+    if prod_f is not None:
+        if not isinstance(prod, str):
+            raise _Bad(f'"{prod_f}": expected a string, got {_kind(prod)}')
+        name = _ouster_name(prod, rows)
+    return Sensor(name, rows, cols, _deg(deg), float(mount_height_m), OUSTER_MAX_RANGE_M, None,
+                  beam_azimuth_rad=az_rad, beam_origin_mm=origin)
+
+
+def load_ouster_metadata(path, mount_height_m: float | None = None) -> Sensor:
+    """A sensor from Ouster's sensor metadata JSON (the flat layout of older firmware, the 2.x layout with
+    "data_format", the nested one with "beam_intrinsics" / "lidar_data_format" / "config_params" /
+    "sensor_info"): beam elevations from beam_altitude_angles in Ouster's ring order (top beam first), columns
+    from columns_per_frame or the lidar mode ("1024x10"), the name from the product line. The mount height is
+    not in Ouster's file: `mount_height_m` (metres, [0, 10]; default 1.0). The beam azimuth offsets and the
+    beam-origin offset are read and validated (`Sensor.beam_azimuth_rad`, `Sensor.beam_origin_mm`) but not used
+    by the projection (docs/SENSORS.md). Raises SensorFileError naming the file and the field."""
+    if mount_height_m is None:
+        mount_height_m = OUSTER_MOUNT_HEIGHT_M
+    elif isinstance(mount_height_m, bool) or not isinstance(mount_height_m, (int, float, np.number)) or \
+            not 0.0 <= float(mount_height_m) <= 10.0:
+        raise ValueError(f"mount_height_m must be metres in [0, 10], got {mount_height_m!r}")
+    root = _read_object(path)
+    max_rows, max_cols = capacity_limits()
+    try:
+        return _ouster(root, max_rows, max_cols, float(mount_height_m))
+    except _Bad as e:
+        raise SensorFileError(f"{path}: {e}") from None

@@ -10,6 +10,8 @@ PKGS="cmake make gcc g++ libeigen3-dev python3 python3-venv ca-certificates"
 # libFuzzer harnesses (tests/fuzz, make test-fuzz / make fuzz): clang with its compiler-rt (libFuzzer, ASan,
 # UBSan runtimes); the host CLI's PNG output: libpng (ports/host/lidet_png.c)
 PKGS="$PKGS clang libclang-rt-dev libpng-dev"
+# the host CLI's sensor files (--sensor-file, --ouster-meta: ports/host/cli_sensor.c): cJSON
+PKGS="$PKGS libcjson-dev"
 # the formatting check of lib/ (ctest clang_format, .clang-format)
 PKGS="$PKGS clang-format"
 # Firmware images under QEMU (issue 17, tests/firmware.cmake): Arm and RISC-V cross compilers with their C

@@ -152,12 +152,6 @@ typedef struct
     lidet_workspace_stats_t stages;     /**< the stages' own counts */
 } lidet_detector_stats_t;
 
-#ifndef LIDET_DETECTOR_PN_SCRATCH
-/** Bytes of PointNet scratch in the detector (the classifier and the box net share it); init fails with
- *  LIDET_ERR_BUFFER when a model needs more. lidet's models need 10-13 KiB. */
-#define LIDET_DETECTOR_PN_SCRATCH 16384
-#endif
-
 /** @brief The detector. Caller-owned, fixed size; declare it static. Read results through the functions. */
 typedef struct
 {

@@ -131,12 +131,6 @@ typedef struct
     lidet_cluster_stats_t cluster;
 } lidet_detector_q_stats_t;
 
-#ifndef LIDET_DETECTOR_Q_PN_SCRATCH
-/** Bytes of int8 PointNet scratch (shared by both models; overlaid with the ground stage's scratch). lidet's
- *  int8 models need 9.8 KiB. */
-#define LIDET_DETECTOR_Q_PN_SCRATCH 12288
-#endif
-
 /** @brief The integer detector: every buffer of every integer stage. Declare it static. */
 typedef struct
 {

@@ -74,17 +74,8 @@ typedef struct
                                Cortex-M4, M7, M33) and leave it NULL elsewhere (no second copy in flash) */
 } lidet_pointnet_q_layer_t;
 
-/** 1: the generated int8 models carry their weights a second time, widened to int16 and packed for the DSP
- *  kernel (lidet_pointnet_q_layer_t.w_pk: about 0.9 instead of 1.6 instructions per multiply-add on a
- *  Cortex-M4 / M7, for three times the weights' flash). Default: 1 where the compiler targets the Arm DSP
- *  extension, else 0. */
-#ifndef LIDET_PNQ_WEIGHTS_PK
-#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
-#define LIDET_PNQ_WEIGHTS_PK 1
-#else
-#define LIDET_PNQ_WEIGHTS_PK 0
-#endif
-#endif
+/* the generated int8 layer tables name their packed copy through this macro: NULL where LIDET_PNQ_WEIGHTS_PK
+ * (lidet_opt.h) is 0 */
 #if LIDET_PNQ_WEIGHTS_PK
 #define LIDET_PNQ_PK(a) (a)
 #else

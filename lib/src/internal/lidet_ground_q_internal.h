@@ -52,13 +52,10 @@ static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, 
 #endif
 }
 
-/* SIMD hosts or not. The rows of R: 1 = column-wise lanes (each digit step of the square root over the whole
- * row: a compiler vectorises the column loop on SIMD hosts), 0 = pixel by pixel with root and remainder in
- * registers (cores without SIMD: fewer loads and stores). The sample test: 1 = branch-free, 0 = leaving at the
- * first failed condition. Same values either way. */
-#ifndef LIDET_GROUND_Q_SQRT_LANES
-#define LIDET_GROUND_Q_SQRT_LANES LIDET_HOST_SIMD
-#endif
+/* LIDET_GROUND_Q_SQRT_LANES (lidet_opt.h; SIMD hosts or not). The rows of R: 1 = column-wise lanes (each digit
+ * step of the square root over the whole row: a compiler vectorises the column loop on SIMD hosts), 0 = pixel by
+ * pixel with root and remainder in registers (cores without SIMD: fewer loads and stores). The sample test: 1 =
+ * branch-free, 0 = leaving at the first failed condition. Same values either way. */
 
 /* R of a pixel from v = x^2 + y^2 (4 mm steps squared, v < 2^31): round(sqrt(v) 2^LIDET_GROUND_Q_R_SHIFT), exact
  * (lidet_ground_q.c; exposed for the tests) */

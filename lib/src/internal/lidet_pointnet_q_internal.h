@@ -69,12 +69,9 @@ void lidet__nn_requant_s8_by_channel(const int32_t *acc, uint32_t n_rows, uint32
  * inputs, so the row-major loop spends most of its instructions reloading and storing the accumulators) */
 void lidet__nn_acc_s16_by_out(const int16_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                               const int32_t *b, uint32_t n_out, int32_t *acc);
-/* 1 on SIMD hosts: the requantization and the int16 layer walk rows then channels (the inner loop over
- * the channels vectorises); 0 on cores without SIMD: channel by channel, values in registers. Same values
- * (tests/unit/test_nn_s8.c runs both forms). */
-#ifndef LIDET_NN_SIMD
-#define LIDET_NN_SIMD LIDET_HOST_SIMD
-#endif
+/* LIDET_NN_SIMD (lidet_opt.h): 1 on SIMD hosts, where the requantization and the int16 layer walk rows then
+ * channels (the inner loop over the channels vectorises); 0 on cores without SIMD: channel by channel, values in
+ * registers. Same values (tests/unit/test_nn_s8.c runs both forms). */
 /* out[o] = round_half_up(acc * mult[o] / 2^shift[o]) saturated to int32 (Q16 outputs) */
 void lidet__nn_requant_q16(const int32_t *acc, uint32_t n_out, const int32_t *mult, const uint8_t *shift,
                            int32_t *out);

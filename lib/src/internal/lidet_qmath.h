@@ -17,6 +17,8 @@
 
 #include <stdint.h>
 
+#include "lidet/lidet_opt.h" /* LIDET_Q_HAVE_DIV, LIDET_Q_HAVE_MUL64 */
+
 #define LIDET_Q_SIN_STEPS 1024
 #define LIDET_Q_ONE_Q30 (1 << 30)
 #define LIDET_Q_BAM_QUARTER 0x40000000u /* pi/2 */
@@ -45,27 +47,10 @@ static inline int64_t lidet__q_div_round(int64_t n, int64_t d)
 /** floor(sqrt(v)), exact */
 uint32_t lidet__q_isqrt64(uint64_t v);
 
-/** 1 on cores with a divide instruction (Cortex-M3 and up, RV32 with M, hosts): the integer square roots use
- *  Newton's iteration there, digit by digit elsewhere (ARMv6-M, RV32 without M: a library division would cost
- *  more than the digits). Same values either way. */
-#ifndef LIDET_Q_HAVE_DIV
-#if (defined(__ARM_ARCH) && !defined(__ARM_FEATURE_IDIV)) || (defined(__riscv) && !defined(__riscv_div))
-#define LIDET_Q_HAVE_DIV 0
-#else
-#define LIDET_Q_HAVE_DIV 1
-#endif
-#endif
-
-/** 1 on cores with a 32 x 32 -> 64 multiply instruction (not ARMv6-M, not RV32 without M): the integer path may
- *  write 64-bit products of 32-bit values directly there; elsewhere it splits them into 32-bit products */
-#ifndef LIDET_Q_HAVE_MUL64
-#if (defined(__ARM_ARCH) && defined(__ARM_ARCH_ISA_THUMB) && __ARM_ARCH_ISA_THUMB == 1) ||                   \
-    (defined(__riscv) && !defined(__riscv_mul))
-#define LIDET_Q_HAVE_MUL64 0
-#else
-#define LIDET_Q_HAVE_MUL64 1
-#endif
-#endif
+/* LIDET_Q_HAVE_DIV (lidet_opt.h): 1 on cores with a divide instruction, where the integer square roots use
+ * Newton's iteration; digit by digit elsewhere. LIDET_Q_HAVE_MUL64: 1 where a 32 x 32 -> 64 multiply is one
+ * instruction, which the integer path then writes directly; split into 32-bit products elsewhere. Same values
+ * either way. */
 
 /** floor(sqrt(v)), exact, 32-bit arithmetic only */
 uint32_t lidet__q_isqrt32(uint32_t v);

@@ -66,24 +66,12 @@ LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, u
  * ARMv6-M (Cortex-M0+: 8 low registers, no multiply-accumulate) takes the plain output-inner loop (two
  * inputs per pass: 6 instructions per multiply-add, rows4 costs more there). Cores with the DSP extension
  * (Cortex-M4, M7, M33 with DSP: __ARM_FEATURE_DSP) take lidet__nn_acc_s8_dsp below, two multiply-adds per
- * SMLAD. Override with -DLIDET_NN_S8_KERNEL=0 (rows4), 1 (output-inner), 2 (dsp), 22 or 42. Layers whose model
+ * SMLAD. LIDET_NN_S8_KERNEL (lidet_opt.h) picks one by name: LIDET_NN_S8_KERNEL_ROWS4 (rows4), _COLS
+ * (output-inner), _DSP, _R2O2 (2 x 2) or _R4O2 (4 x 2); its default is the target's as above. Layers whose model
  * carries the packed int16 copy of the weights (w_pk: the generated models on DSP cores) take the packed kernel
  * and the fused pass further below instead (about 0.75 instead of 1.5 instructions per multiply-add).
  * tests/unit/test_nn_s8.c checks that all agree (on the host the DSP kernels run on a C model of the three
  * instructions they use). */
-#ifndef LIDET_NN_S8_KERNEL
-#if defined(__riscv)
-#define LIDET_NN_S8_KERNEL 42
-#elif defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
-#define LIDET_NN_S8_KERNEL 2
-#elif defined(__arm__) && !defined(__ARM_ARCH_6M__)
-#define LIDET_NN_S8_KERNEL 22
-#elif defined(__ARM_ARCH_6M__)
-#define LIDET_NN_S8_KERNEL 1
-#else
-#define LIDET_NN_S8_KERNEL 0
-#endif
-#endif
 
 void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, int32_t *acc)
@@ -301,13 +289,14 @@ static void pk_widen(const int8_t *x0, const int8_t *x1, uint32_t n_g, uint32_t 
 }
 
 /* s[0..3] (point 0 channel 0, point 0 channel 1, point 1 channel 0, point 1 channel 1) += n_g >= 1 groups;
- * returns w past them. On the DSP cores in assembly: GCC neither pairs the loads into LDRD nor keeps the four
- * sums in registers across the loop's back edge without copies (19 instructions per group, 13 here) */
+ * returns w past them. On the DSP cores in assembly (LIDET_NN_PK_ASM, lidet_opt.h; 0: the C loop below): GCC
+ * neither pairs the loads into LDRD nor keeps the four sums in registers across the loop's back edge without
+ * copies (19 instructions per group, 13 here) */
 S8_ALWAYS_INLINE const uint32_t *pk_pair(const uint32_t *xw, uint32_t n_g, const uint32_t *w, int32_t *s)
 {
     int32_t s00 = s[0], s01 = s[1], s10 = s[2], s11 = s[3];
     const uint32_t *const end = xw + 4u * n_g;
-#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && defined(__GNUC__) && !defined(LIDET_NN_PK_NO_ASM)
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && defined(__GNUC__) && LIDET_NN_PK_ASM
     uint32_t a0, a1, c0, c1;
     /* one group: inputs A of both points and the two channels' A weights, 4 SMLAD, then the same for B */
 #define PK_PAIR_GROUP                                                                                        \
@@ -370,7 +359,7 @@ S8_ALWAYS_INLINE const uint32_t *pk_one(const uint32_t *xw, uint32_t n_g, const 
 {
     int32_t s0 = s[0], s1 = s[1];
     const uint32_t *const end = xw + 2u * n_g;
-#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && defined(__GNUC__) && !defined(LIDET_NN_PK_NO_ASM)
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && defined(__GNUC__) && LIDET_NN_PK_ASM
     uint32_t a, b, c0, c1;
     __asm__ volatile("1:\n\t"
                      "ldrd %[a], %[b], [%[x]], #8\n\t"
@@ -494,16 +483,18 @@ void lidet__nn_acc_s8_pk(const int8_t *in, uint32_t n_rows, uint32_t n_in, const
 void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
                       uint32_t n_out, int32_t *acc)
 {
-#if LIDET_NN_S8_KERNEL == 2
+#if LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_DSP
     lidet__nn_acc_s8_dsp(in, n_rows, n_in, w_t, b, n_out, acc);
-#elif LIDET_NN_S8_KERNEL == 22
+#elif LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_R2O2
     lidet__nn_acc_s8_r2o2(in, n_rows, n_in, w_t, b, n_out, acc);
-#elif LIDET_NN_S8_KERNEL == 42
+#elif LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_R4O2
     lidet__nn_acc_s8_r4o2(in, n_rows, n_in, w_t, b, n_out, acc);
-#elif LIDET_NN_S8_KERNEL == 1
+#elif LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_COLS
     lidet__nn_acc_s8_cols(in, n_rows, n_in, w_t, b, n_out, n_out, acc, n_out);
-#else
+#elif LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_ROWS4
     lidet__nn_acc_s8_rows4(in, n_rows, n_in, w_t, b, n_out, acc);
+#else
+#error "LIDET_NN_S8_KERNEL: one of LIDET_NN_S8_KERNEL_ROWS4, _COLS, _DSP, _R2O2, _R4O2 (lidet_opt.h)"
 #endif
 }
 
