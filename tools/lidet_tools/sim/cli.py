@@ -35,6 +35,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--crowd", action="store_true",
                    help="crowded streets (issue 15): groups of people 0.2-1 m apart, people beside cars, poles, bins "
                         "and walls, cyclists beside parked cars, people pushing bicycles, darker and more broken cars")
+    p.add_argument("--behind-cars", type=float, default=0.0, metavar="RATE",
+                   help="mean number of people (alone or 2-4 side by side) standing just behind a parked car per scan, "
+                        "seen from the waist or chest up (default 0: none)")
     p.add_argument("--range-noise", type=float, default=0.02, help="1-sigma range noise in m")
     p.add_argument("--dropout", type=float, default=0.015, help="random dropout probability")
     p.add_argument("--jobs", type=int, default=1,
@@ -45,7 +48,7 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _one(a, i):
     r = simulate_scan(a.sensor, a.seed, i, a.mount_height, a.pitch_deg, a.roll_deg, a.scene,
-                      a.range_noise, a.dropout, crowd=a.crowd)
+                      a.range_noise, a.dropout, crowd=a.crowd, behind_cars=a.behind_cars)
     write_scan(a.out, f"{i:06d}", r)
     return i
 
@@ -54,6 +57,9 @@ def main(argv=None) -> int:
     a = build_parser().parse_args(argv)
     if a.jobs < 1:
         print("lidet-sim: --jobs must be >= 1", file=sys.stderr)
+        return 2
+    if not (0.0 <= a.behind_cars <= 50.0):
+        print("lidet-sim: --behind-cars must be in [0, 50]", file=sys.stderr)
         return 2
     if a.mount_height is not None and not 0.1 <= a.mount_height <= 5.0:
         print("lidet-sim: --mount-height must be in [0.1, 5] m", file=sys.stderr)

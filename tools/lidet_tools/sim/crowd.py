@@ -10,6 +10,12 @@
 - cyclists passing 0.3-1.0 m beside a parked car;
 - pedestrians pushing a bicycle (the bicycle 0.1-0.3 m beside them, class bicycle with an instance).
 
+`behind_cars` (`make_scene(..., behind_cars=RATE)`, `lidet-sim --behind-cars RATE`, the hdl64 family's training
+scans) adds, on its own or on top of either content, people standing on the pavement just behind the parked cars,
+alone or two to four side by side: the view of a street lined with parked cars, where a sensor on the road sees
+them from the waist or the chest up (real validation pedestrians are seen from 0.8-1.2 m above their feet,
+docs/journal/real-streets.md).
+
 Everything within about 40 m of the sensor, where the proposal goals are set. Placement collides
 bodies, not annotation boxes (objects.body_cylinders), so the boxes of close people may overlap and a
 point inside one box may belong to its neighbour (the default scenes keep that invariant; these do
@@ -138,3 +144,37 @@ def crowds(b) -> None:
         _cyclist_by_car(b, r, anchors)
     for _ in range(int(r.poisson(1.0))):
         _pusher(b, r)
+
+
+def _behind_car(b, r, cars):
+    """One person or a row of 2-4 standing 0.1-0.9 m behind a parked car's far flank (the side away from the sensor's
+    road), along the car."""
+    i, (cx, cy, cz, l, w, h, yaw) = cars[int(r.integers(0, len(cars)))]
+    c, s = np.cos(yaw), np.sin(yaw)
+    # the car's flank farther from the sensor: its local +y or -y, whichever points away from the origin
+    far = 1.0 if (-s * cx + c * cy) >= 0.0 else -1.0
+    n = 1 if r.random() < 0.6 else int(r.integers(2, 5))
+    gap = r.uniform(0.1, 0.9)
+    walking = bool(r.random() < 0.4)
+    yaw_p = yaw + (np.pi if r.random() < 0.5 else 0.0) + r.normal(0, 0.2) if walking else float(r.uniform(-np.pi, np.pi))
+    lx0 = r.uniform(-0.45, 0.45) * l
+    for k in range(n):
+        lx = lx0 + (k - (n - 1) / 2.0) * (2 * BODY_R + r.uniform(0.1, 0.5))
+        ly = far * (w / 2 + gap + BODY_R + r.normal(0, 0.1))
+        x, y = cx + c * lx - s * ly, cy + s * lx + c * ly
+        if not _near(x, y):
+            continue
+        sh = ob.pedestrian(r, child=k > 0 and r.random() < 0.2, walking=walking)
+        b.put_level(sh, x, y, yaw_p + r.normal(0, 0.1), margin=0.0, body=True, ignore=i)
+
+
+def behind_cars(b, rate: float) -> None:
+    """Add Poisson(rate) people or rows of people behind parked vehicles within NEAR_M to a SceneBuilder `b` (the
+    parked rows and lots; none when the scene has no parked vehicle)."""
+    r = b.rng
+    cars = [(i, o.box) for i, o in enumerate(b.objects) if o.label in ("Car", "Van", "Truck")
+            and _near(o.box[0], o.box[1]) and i in b.parked]
+    if not cars:
+        return
+    for _ in range(int(r.poisson(rate))):
+        _behind_car(b, r, cars)

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import objects as ob
-from .crowd import crowds
+from .crowd import behind_cars, crowds
 from .raycast import HeightField, PrimitiveList
 
 # surface codes of the ground grid -> SemanticKITTI class and remission
@@ -73,9 +73,12 @@ class _Placer:
 
 
 class SceneBuilder:
-    def __init__(self, rng, mount_height_m, max_range_m, kind=None, robot=False, res=0.3, crowd=False):
+    def __init__(self, rng, mount_height_m, max_range_m, kind=None, robot=False, res=0.3, crowd=False,
+                 behind_cars=0.0):
         self.rng = rng
         self.crowd = crowd
+        self.behind_cars = float(behind_cars)
+        self.parked: set[int] = set()  # object indices of the parked cars (rows and lots)
         self.H = mount_height_m
         self.kind = kind or str(rng.choice(SCENE_TYPES, p=[0.4, 0.25, 0.15, 0.2]))
         self.robot = robot
@@ -294,7 +297,8 @@ class SceneBuilder:
                     u += L / 2
                     if r.random() < fill:
                         yaw = (0.0 if s < 0 else np.pi) + r.normal(0, 0.04) + (np.pi if r.random() < 0.1 else 0)
-                        self.put(sh, u, s * (self.Wr + d["park"] / 2 + r.normal(0, 0.1)), yaw, margin=0.05)
+                        if self.put(sh, u, s * (self.Wr + d["park"] / 2 + r.normal(0, 0.1)), yaw, margin=0.05) is not None:
+                            self.parked.add(len(self.objects) - 1)
                     u += L / 2 + r.uniform(0.6, 2.5)
             lot = d.get("lot")
             if lot is not None:
@@ -309,7 +313,8 @@ class SceneBuilder:
                             if r.random() < 0.75:
                                 sh = ob.car(r) if r.random() < 0.92 else ob.van(r)
                                 yaw = s * np.pi / 2 * rowside + r.normal(0, 0.05)
-                                self.put(sh, u, s * vv, yaw, margin=0.05)
+                                if self.put(sh, u, s * vv, yaw, margin=0.05) is not None:
+                                    self.parked.add(len(self.objects) - 1)
                             u += r.uniform(2.5, 2.9)
                     row_v += 5.2 + 6.5
         # cyclists
@@ -511,10 +516,14 @@ class SceneBuilder:
         self.furniture()
         if self.crowd:
             crowds(self)
+        if self.behind_cars > 0.0:
+            behind_cars(self, self.behind_cars)
         self.dig_pits()
         return Scene(self.kind, self.hf, self.plist.freeze(), self.objects)
 
 
-def make_scene(rng, mount_height_m, max_range_m, kind=None, robot=False, crowd=False) -> Scene:
-    """crowd: add the crowded street content of crowd.py (issue 15) after the default content."""
-    return SceneBuilder(rng, mount_height_m, max_range_m, kind, robot, crowd=crowd).build()
+def make_scene(rng, mount_height_m, max_range_m, kind=None, robot=False, crowd=False, behind_cars=0.0) -> Scene:
+    """crowd: add the crowded street content of crowd.py (issue 15) after the default content. behind_cars: the
+    mean number of people (or rows of people) standing behind parked cars added last (crowd.behind_cars); 0, the
+    default, draws nothing, so the scene is the one it was without the option."""
+    return SceneBuilder(rng, mount_height_m, max_range_m, kind, robot, crowd=crowd, behind_cars=behind_cars).build()

@@ -43,13 +43,16 @@ def _robot(mount_height_m: float) -> bool:
 def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float | None = None,
                   pitch_deg: float | None = None, roll_deg: float | None = None,
                   scene_kind: str | None = None, range_noise_m: float = 0.02,
-                  dropout: float = 0.015, keep_scene: bool = False, crowd: bool = False) -> ScanResult:
+                  dropout: float = 0.015, keep_scene: bool = False, crowd: bool = False,
+                  behind_cars: float = 0.0) -> ScanResult:
     """Simulate scan `index` of run `seed` for a sensor profile (name or Sensor).
 
     mount_height_m defaults to the profile's; pitch/roll default to a random mounting tilt; scene_kind
     forces one of scene.SCENE_TYPES. keep_scene keeps the Scene (ground, primitives, objects) in the
     result for tests and plots. crowd: the crowded street content of crowd.py (issue 15) on top of the
-    default scene (the default, False, gives the same bytes as before it existed)."""
+    default scene (the default, False, gives the same bytes as before it existed). behind_cars: the mean number
+    of people or rows of people standing behind parked cars (crowd.behind_cars; 0, the default, adds none and
+    gives the same bytes as before it existed)."""
     sensor = get_sensor(sensor) if isinstance(sensor, str) else sensor
     H = float(sensor.mount_height_m if mount_height_m is None else mount_height_m)
     ss = np.random.SeedSequence([int(seed), int(index)])
@@ -59,7 +62,7 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
     roll = np.radians(roll_deg) if roll_deg is not None else np.radians(
         np.clip(mount_rng.normal(0, 0.25), -0.6, 0.6))
     robot = _robot(H)
-    scene = make_scene(scene_rng, H, sensor.max_range_m, scene_kind, robot, crowd=crowd)
+    scene = make_scene(scene_rng, H, sensor.max_range_m, scene_kind, robot, crowd=crowd, behind_cars=behind_cars)
     sm = SensorModel(sensor, H, float(pitch), float(roll), range_noise_m=range_noise_m, dropout=dropout,
                      min_range_m=0.3 if robot else 1.0)
     grid, row2ring = sm.ray_grid()

@@ -146,11 +146,14 @@ class Scan:
         self.sensor = sensor  # the C stages' sensor profile when it is not the dataset's, else None
 
 
-def sim_scan(sensor: str, seed: int, index: int, mount: float | None) -> Scan:
+def sim_scan(sensor: str, seed: int, index: int, mount: float | None, behind_cars: float = 0.0) -> Scan:
+    """Simulated scan `index` of run `seed`; behind_cars: `lidet-sim --behind-cars` (people standing behind parked
+    cars, seen from the waist up; 0 = the default scenes)."""
     from ..sim.simulate import simulate_scan
-    r = simulate_scan(sensor, seed, index, mount)
+    r = simulate_scan(sensor, seed, index, mount, behind_cars=behind_cars)
     boxes = [(b.cls, (b.x, b.y, b.z, b.l, b.w, b.h, b.yaw)) for b in r.boxes]
-    return Scan(f"sim:{sensor}:{seed}:{index}:{mount}", r.points, boxes, sem=r.sem.astype(np.int64),
+    name = f"sim:{sensor}:{seed}:{index}:{mount}" + (f":behind{behind_cars:g}" if behind_cars > 0 else "")
+    return Scan(name, r.points, boxes, sem=r.sem.astype(np.int64),
                 inst=r.inst, ring=r.ring, mount=mount)
 
 
@@ -391,10 +394,10 @@ def process_scan(scan: Scan, sensor: str, cfg: dict) -> dict:
 
 # ---- jobs -------------------------------------------------------------------------------------------
 
-def _job(task, sensor, cfg):
+def _job(task, sensor, cfg, behind_cars=0.0):
     kind, split, a, b, c = task
     if kind == "sim":
-        scan = sim_scan(sensor, a, b, c)
+        scan = sim_scan(sensor, a, b, c, behind_cars)
     elif kind == "kitti":
         scan = kitti_scan(a, b)
     elif kind == "boxes":
@@ -480,6 +483,9 @@ def main(argv=None) -> int:
     ap.add_argument("--sim", help="simulated scans per split: TRAIN,VAL,TEST (e.g. 160,40,40)")
     ap.add_argument("--seed", type=int, default=1000, help="simulator run seed of the train split (val +1, test +2)")
     ap.add_argument("--mounts", help="simulator mount heights in m, cycled over scans (e.g. 0.3,0.5,0.7,1.0)")
+    ap.add_argument("--sim-behind-cars", type=float, default=0.0, metavar="RATE",
+                    help="simulated scans: mean number of people (or rows of people) standing behind parked cars "
+                         "per scan (`lidet-sim --behind-cars`; default 0)")
     ap.add_argument("--kitti", action="append", type=pathlib.Path, help="KITTI folder (velodyne/ label_2/ calib/)")
     ap.add_argument("--semantickitti", action="append", type=pathlib.Path, help="SemanticKITTI folder (velodyne/ labels/)")
     ap.add_argument("--boxes", action="append", type=pathlib.Path,
@@ -503,13 +509,15 @@ def main(argv=None) -> int:
         ap.error("give at least one source: --sim, --kitti, --semantickitti or --boxes")
     if a.jobs < 1:
         ap.error("--jobs must be >= 1")
+    if not 0.0 <= a.sim_behind_cars <= 50.0:
+        ap.error("--sim-behind-cars must be in [0, 50]")
     try:
         tasks = build_tasks(a)
     except (FileNotFoundError, ValueError) as e:
         print(f"dataset: {e}", file=sys.stderr)
         return 2
     cfg = dict(DEFAULTS, purity=a.purity, recall=a.recall, margin=a.margin, n_points=a.n_points)
-    job = functools.partial(_job, sensor=a.sensor, cfg=cfg)
+    job = functools.partial(_job, sensor=a.sensor, cfg=cfg, behind_cars=a.sim_behind_cars)
     t0 = time.perf_counter()
     parts = [None] * len(tasks)
     bar = None
@@ -534,7 +542,7 @@ def main(argv=None) -> int:
     if len(d["label"]) == 0:
         print("dataset: no proposals (empty scans?)", file=sys.stderr)
         return 1
-    meta = dict(sensor=a.sensor, sim=a.sim, seed=a.seed, mounts=a.mounts, kitti=[str(p) for p in a.kitti or []],
+    meta = dict(sensor=a.sensor, sim=a.sim, seed=a.seed, mounts=a.mounts, sim_behind_cars=a.sim_behind_cars, kitti=[str(p) for p in a.kitti or []],
                 semantickitti=[str(p) for p in a.semantickitti or []], boxes=[str(p) for p in a.boxes or []], n_excluded=int(sum(p["n_excluded"] for p in parts)),
                 n_objects=[int(v) for v in np.sum([p["n_objects"] for p in parts], axis=0)], **cfg,
                 command="python -m lidet_tools.train.dataset " + " ".join(argv if argv is not None else sys.argv[1:]))
