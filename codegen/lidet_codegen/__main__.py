@@ -17,8 +17,9 @@ def main(argv=None) -> int:
               "          ONNX and calibration files: the commands of the committed weights/\n"
               "  calibrate activation ranges of a model for its int8 version (<name>.calib.json)\n"
               "  macs    multiply-adds and parameters of ONNX models\n"
-              "  qtables the integer math tables of the fixed-point build (lib/src/lidet_qmath_tables.c)\n"
-              "  pnqtables the int8 PointNets' energy tables (lib/src/lidet_pointnet_q_tables.c)", file=sys.stderr)
+              "  qtables the integer math tables of the fixed-point build (lib/src/qmath/lidet_qmath_tables.c)\n"
+              "  pnqtables the int8 PointNets' energy tables (lib/src/pointnet/lidet_pointnet_q_tables.c)",
+              file=sys.stderr)
         return 2
     import importlib
     return importlib.import_module(cmds[argv[0]]).main(argv[1:])

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """ONNX -> lidet model descriptor -> weights/<name>.{c,h} (data only; the forward pass is hand-written
-in lib/src/lidet_pointnet.c).
+in lib/src/pointnet/lidet_pointnet.c).
 
 The graph is read by a small symbolic interpreter: every tensor gets a meaning (the points input, a
 per-point feature chain of dense layers, a max-pooled chain, a vector chain with its concatenated

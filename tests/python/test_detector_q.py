@@ -3,7 +3,7 @@
 samples, freshly simulated scans, the real KITTI / SemanticKITTI scans when present), determinism, bad input.
 
 Agreement (issue 16): against the default float detector (both with the proposal refinement, lidet_refine.c and
-lidet_cluster_q_refine.c); detections matched by class and BEV centre
+lidet_refine_q.c); detections matched by class and BEV centre
 distance (< 1 m); on the matched pairs the mean
 BEV IoU of the integer box against the float box >= 0.95; the detections of either build left unmatched are
 <= 10 % of all (both builds classify a few hundred proposals per scan; a proposal near a gate threshold may pass in

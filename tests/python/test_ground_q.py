@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The integer ground stage (lib/src/lidet_ground_q*.c) through the bindings: bit for bit against its numpy
+"""The integer ground stage (lib/src/ground/*_q.c) through the bindings: bit for bit against its numpy
 reference (codegen ref/ground_q.py) on the simulated samples, freshly simulated scans and the real scans, its
 defaults against the float ones, and its agreement with the float ground stage on the same compact images
 (issue 16: ground labels equal for >= 99.5 % of points) and against the per-point labels."""
@@ -132,7 +132,7 @@ def test_c_matches_reference_variants(variant):
 
 @pytest.mark.parametrize("step", [500, 0])
 def test_c_matches_reference_on_a_climbing_road(step):
-    """far_max_step_mm (the far planes' test at the split, lidet_ground_q_fit.c far_meets; 0: the sensor-height test)
+    """far_max_step_mm (the far planes' test at the split, lidet_ground_ransac_q.c far_meets; 0: the sensor-height test)
     on scan 155 of the simulated benchmark's seed, whose road climbs from 17 m ahead: bit for bit, and the step
     keeps far planes the height test refuses."""
     from lidet_tools.sim.simulate import simulate_scan

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The int8 PointNets (lib/src/lidet_pointnet_q.c): C equals the integer numpy reference
+"""The int8 PointNets (lib/src/pointnet/lidet_pointnet_q.c): C equals the integer numpy reference
 (lidet_codegen.ref.pointnet_q) bit for bit on >= 1000 integer proposals (logits, scores, energies, classes,
 gates, boxes), the int8 nets agree with the float nets (class, gates, BEV IoU of the boxes), the energy tables
 are generated, and quantization follows its documented rules."""
@@ -73,7 +73,7 @@ def props(need_lib):
 
 
 def test_energy_tables_are_generated_from_the_committed_command():
-    assert (ROOT / "lib/src/lidet_pointnet_q_tables.c").read_text() == pnq_tables.render()
+    assert (ROOT / "lib/src/pointnet/lidet_pointnet_q_tables.c").read_text() == pnq_tables.render()
 
 
 def test_multiplier_rule():

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The integer path's post-processing (lib/src/lidet_post_q.c): BEV IoU, size check and NMS equal the numpy
+"""The integer path's post-processing (lib/src/detector/lidet_post_q.c): BEV IoU, size check and NMS equal the numpy
 reference (codegen/lidet_codegen/ref/post_q.py) bit for bit, and agree with the float detector's IoU."""
 import math
 

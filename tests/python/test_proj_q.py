@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The integer projection (lib/src/lidet_proj_q.c) and the integer sensor presets (lib/src/lidet_sensor_q.c):
+"""The integer projection (lib/src/proj/lidet_proj_q.c) and the integer sensor presets (lib/src/proj/lidet_sensor_q.c):
 C equals the numpy reference (codegen/lidet_codegen/ref/proj_q.py) bit for bit on random, simulated and real
 scans, C presets equal tools/lidet_tools/sensors.py, and the integer image agrees with the float projection
 (docs/FIXED_POINT.md, "Projection")."""

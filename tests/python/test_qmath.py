@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The integer math of the fixed-point path: C (lib/src/lidet_qmath.c) equals the numpy reference
+"""The integer math of the fixed-point path: C (lib/src/qmath/lidet_qmath.c) equals the numpy reference
 (codegen/lidet_codegen/ref/qmath.py) bit for bit, both are accurate, and the generated tables are current."""
 import math
 
@@ -23,7 +23,7 @@ def _angles(rng, n):
 
 
 def test_tables_are_generated_from_the_committed_command(root):
-    assert (root / "lib/src/lidet_qmath_tables.c").read_text() == qtables.render()
+    assert (root / "lib/src/qmath/lidet_qmath_tables.c").read_text() == qtables.render()
 
 
 @pytest.mark.parametrize("op", ["sin", "cos"])

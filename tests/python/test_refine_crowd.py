@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The proposal refinement (lib/src/lidet_refine.c, cfg split_people and join_cars) against its numpy reference
+"""The proposal refinement (lib/src/cluster/lidet_refine.c, cfg split_people and join_cars) against its numpy reference
 (codegen/lidet_codegen/ref/cluster.py: refine_ref): the C's labels without the refinement, refined in
 numpy, equal the C's labels with it, on simulated crowd scans (issue 15) of both sensor kinds; and the
 crowd scenes of lidet-sim (close people; the default scenes unchanged)."""

@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
-/* Unity tests of the depth clustering and the proposals (lib/src/lidet_cluster*.c, lidet_proposal.c)
- * on hand-drawn range images (test_cluster_util.h: letters are ranges, '.' empty, 'g' ground). */
+/* Unity tests of the depth clustering and the proposals (lib/src/cluster/lidet_cluster.c,
+ * lidet_cluster_grow.c, lidet_cluster_rescue.c, lidet_proposal.c) on hand-drawn range images
+ * (test_cluster_util.h: letters are ranges, '.' empty, 'g' ground). */
 #include <math.h>
 #include <string.h>
 

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Unity tests of the integer clustering and proposals (lib/src/lidet_cluster_q*.c, lidet_proposal_q.c) on
+/* Unity tests of the integer clustering and proposals (lib/src/cluster/lidet_*_q.c) on
  * hand-drawn images (test_cluster_util.h) turned into compact images: the same labels as the float stage on
  * the same image, records and per-point ids, configuration and input checks, integer limits. */
 #include <math.h>

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* Unity tests of the detector (lib/src/lidet_detector.c): a synthetic scan (flat ground plus vertical
- * faces) through hand-made models whose outputs are known (every proposal a car with the car template,
- * centred on its cluster mean, heading along the azimuth), so the counts, the crop, the budget, the order,
- * the NMS and the decoded boxes can be checked exactly; the rotated BEV IoU by hand; init errors. */
+/* Unity tests of the detector (lib/src/detector/lidet_detector.c): a synthetic scan (flat ground plus
+ * vertical faces) through hand-made models whose outputs are known (every proposal a car with the car
+ * template, centred on its cluster mean, heading along the azimuth), so the counts, the crop, the budget, the
+ * order, the NMS and the decoded boxes can be checked exactly; the rotated BEV IoU by hand; init errors. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>

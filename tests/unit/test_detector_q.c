@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
-/* Unity tests of the integer detector (lib/src/lidet_detector_q.c) with the generated int8 models on the
- * shipped simulated VLP-16 scan (converted to millimetres here): init errors, the run's invariants (score
+/* Unity tests of the integer detector (lib/src/detector/lidet_detector_q.c) with the generated int8 models on
+ * the shipped simulated VLP-16 scan (converted to millimetres here): init errors, the run's invariants (score
  * order, size limits, outcomes adding up to the counts), the crop and the budget, determinism, canaries,
  * and bad points (integer limits, zero range, rings out of range). Agreement with the float detector and the
  * bit-exact reference are tested in tests/python/test_detector_q.py. */

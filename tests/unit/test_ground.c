@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Unity tests of the ground stage (lib/src/lidet_ground_filter.c, lidet_ground_ransac.c).
+/* Unity tests of the ground stage (lib/src/ground/lidet_ground_filter.c, lidet_ground_ransac.c).
  * Scenes are ray-cast analytically: one ray per beam and column centre of the sensor, against
  * piecewise planes (ground) and axis-aligned boxes (obstacles); the points go through the real
  * projection, then the ground stage. Truth per point: which surface the ray hit. */

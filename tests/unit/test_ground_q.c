@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* Unity tests of the integer ground stage (lib/src/lidet_ground_q.c, lidet_ground_q_fit.c) on compact range
- * images built here: a VLP-16-like fan of beams ray-cast against a ground plane (flat or sloped) and a wall,
- * rounded to 4 mm steps; plus bad input: arguments, configuration, images at the int16 limits, empty images. */
+/* Unity tests of the integer ground stage (lib/src/ground/lidet_ground_filter_q.c, lidet_ground_ransac_q.c)
+ * on compact range images built here: a VLP-16-like fan of beams ray-cast against a ground plane (flat or
+ * sloped) and a wall, rounded to 4 mm steps; plus bad input: arguments, configuration, images at the int16
+ * limits, empty images. */
 #include <math.h>
 #include <string.h>
 

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Unity tests of the PointNet forward pass (lib/src/lidet_pointnet.c, lib/src/nn/lidet_nn_f32.c) on
+/* Unity tests of the PointNet forward pass (lib/src/pointnet/lidet_pointnet.c, lib/src/nn/lidet_nn_f32.c) on
  * hand-made tiny models whose outputs are worked out by hand, a random model against a naive double
  * loop (block and tile edges), and malformed descriptors. */
 #include <math.h>

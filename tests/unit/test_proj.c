@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Unity tests of the spherical projection (lib/src/lidet_proj.c). */
+/* Unity tests of the spherical projection (lib/src/proj/lidet_proj.c). */
 #include <math.h>
 #include <string.h>
 

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Unity tests of the integer projection (lib/src/lidet_proj_q.c) and the integer sensor presets. */
+/* Unity tests of the integer projection (lib/src/proj/lidet_proj_q.c) and the integer sensor presets. */
 #include <math.h>
 #include <string.h>
 

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The proposal refinement (lib/src/lidet_refine.c, cfg split_people) on hand-made scenes: a small
+/* The proposal refinement (lib/src/cluster/lidet_refine.c, cfg split_people) on hand-made scenes: a small
  * ray-cast range image (32 beams 0.5 deg apart from +2 deg, 2048 columns, sensor 1.73 m above a flat
  * ground that returns nothing) of upright cylinders (people) and boxes (cars). */
 #include <math.h>

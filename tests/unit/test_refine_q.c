@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* The integer stage's proposal refinement (lib/src/lidet_cluster_q_refine.c) on the hand-made scenes of
+/* The integer stage's proposal refinement (lib/src/cluster/lidet_refine_q.c) on the hand-made scenes of
  * test_refine_scene.h turned into compact images (4 mm steps): two people 0.4 m apart are cut apart, a car in
  * three pieces is joined, a car alone is not cut; the records match a recount of the labels (the mean is the
  * rounded mean of the members, exactly); the refinement's settings are checked. */

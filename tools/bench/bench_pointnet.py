@@ -72,7 +72,7 @@ def _int8_lines(native, xyz, mean, vox, fams, repeats) -> list:
     from lidet_codegen import quant as QU
     from lidet_tools import native_q
     q4, m4 = QU.int_proposals(xyz, mean)
-    out = ["", "int8 (issue 16, lib/src/lidet_pointnet_q.c, portable C99, no float) against float, same proposals "
+    out = ["", "int8 (issue 16, lib/src/pointnet/lidet_pointnet_q.c, portable C99, no float) against float, same proposals "
                "(integer ones: the same points rounded to 4 mm steps), same clock; flash: the bytes of the weight "
                "arrays (float32 weights and biases; int8 weights, int32 biases, multipliers, one-hot biases, "
                "uint8 shifts).", "",

@@ -23,7 +23,7 @@ _f32p = np.ctypeslib.ndpointer(np.float32, flags="C_CONTIGUOUS")
 _u64p = np.ctypeslib.ndpointer(np.uint64, flags="C_CONTIGUOUS")
 
 
-# ---- integer math (lib/src/lidet_qmath.c) ------------------------------------------------------
+# ---- integer math (lib/src/qmath/lidet_qmath.c) ------------------------------------------------------
 
 _QMATH_OPS = {"sin": 0, "cos": 1, "atan2": 2, "isqrt": 3, "sqrt_round": 4, "urad_to_bam": 5, "ground_r": 6}
 _qmath_ready = False
@@ -56,7 +56,7 @@ def qmath(op: str, a, b=None) -> np.ndarray:
     return out
 
 
-# ---- post-processing: size check, BEV IoU, NMS (lib/src/lidet_post_q.c) -------------------------
+# ---- post-processing: size check, BEV IoU, NMS (lib/src/detector/lidet_post_q.c) -------------------------
 
 _post_ready = False
 
@@ -115,7 +115,7 @@ def post_q(boxes, score_q15, cluster_id, cls, iou_q15: int) -> dict:
     if k < 0:
         raise ValueError(f"lidet_py_q_post: status {k} (more than LIDET_MAX_DETECTIONS detections?)")
     return {"size_ok": size_ok.astype(bool), "kept": order[:k].tolist(), "suppressed": supp.tolist()}
-# ---- integer projection and sensor presets (lib/src/lidet_proj_q.c, lib/src/lidet_sensor_q.c) ---------------
+# ---- integer projection and sensor presets (lib/src/proj/lidet_proj_q.c, lidet_sensor_q.c) --------------------
 
 _proj_q_ready = False
 PROJ_Q_STATS = ("n_points_in", "n_projected", "n_pixels_filled", "n_nonfinite", "n_too_close", "n_too_far",
@@ -223,7 +223,7 @@ def isqrt32(v) -> np.ndarray:
     return out
 
 
-# ---- ground (lib/src/lidet_ground_q.c, lidet_ground_q_fit.c) ---------------------------------------
+# ---- ground (lib/src/ground/lidet_ground_filter_q.c, lidet_ground_ransac_q.c) ---------------------------------------
 
 _ground_q_ready = False
 
@@ -603,7 +603,7 @@ def cluster_f_compact(scan: CompactScan, planes=None, use_ground: bool = True, r
                                       o["pvox"], ns)
     return _result(o, st, "lidet_cluster_run (compact)", ru, rf, ns)
 
-# ---- int8 PointNets (lib/src/lidet_pointnet_q.c) over the int8 models of lidet::weights ---------
+# ---- int8 PointNets (lib/src/pointnet/lidet_pointnet_q.c) over the int8 models of lidet::weights ---------
 
 _pnq_ready = False
 
@@ -723,7 +723,7 @@ def pnq_time(cls_model: str, box_model: str, xyz_4mm, mean_4mm, voxel, repeats: 
     return float(ns[0]) * 1e-9 / b, float(ns[1]) * 1e-9 / b
 
 
-# ---- the integer detector (lib/src/lidet_detector_q.c) ---------------------------------------------
+# ---- the integer detector (lib/src/detector/lidet_detector_q.c) ---------------------------------------------
 
 DETQ_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity", "n_detections",

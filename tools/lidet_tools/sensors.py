@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Sensor profiles, mirrored from lib/src/lidet_sensors.c (tests/python/test_bindings_proj.py keeps the
+"""Sensor profiles, mirrored from lib/src/proj/lidet_sensor.c (tests/python/test_bindings_proj.py keeps the
 two identical through the bindings).
 
 Frame: x forward, y left, z up, metres, radians, origin at the sensor's optical centre.
@@ -40,7 +40,7 @@ class Sensor:
     mount_height_m: float
     max_range_m: float
     #: (fov_up, fov_down) in microradians for a uniform sensor (the integer presets give the fov, not a
-    #: table, as lib/src/lidet_sensor_q.c); None for a sensor with a beam table
+    #: table, as lib/src/proj/lidet_sensor_q.c); None for a sensor with a beam table
     fov_urad: tuple | None = None
     #: float model family the detector runs (a description file's "model"); None: the rule of `model_family`
     model: str | None = None

@@ -40,6 +40,11 @@ size32q() {
     echo "n/a"
   fi
 }
+# the library's sources (lib/src/<stage>/*.c, the folders of cmake/lidet_sources.cmake) without the packet decoders
+lib_sources=()
+for f in "$root"/lib/src/*/*.c; do
+  case "$f" in */lib/src/decode/*) ;; *) lib_sources+=("$f") ;; esac
+done
 ws_rows=()
 det_rows=()
 q_rows=()
@@ -47,8 +52,8 @@ for c in "${configs[@]}"; do
   read -r name rows cols pts cl det rcells rpts <<<"$c"
   caps=(-DLIDET_MAX_ROWS="$rows" -DLIDET_MAX_COLS="$cols" -DLIDET_MAX_POINTS="$pts" -DLIDET_MAX_CLUSTERS="$cl"
         -DLIDET_MAX_DETECTIONS="$det" -DLIDET_REFINE_MAX_CELLS="$rcells" -DLIDET_REFINE_MAX_POINTS="$rpts")
-  "$cc" -std=c99 -O1 -I"$root/lib/include" -I"$root/lib/src" "${caps[@]}" "$here/size_report.c" "$root"/lib/src/*.c \
-        "$root"/lib/src/nn/*.c -lm -o "$tmp/sz"
+  "$cc" -std=c99 -O1 -I"$root/lib/include" -I"$root/lib/src" "${caps[@]}" "$here/size_report.c" "${lib_sources[@]}" \
+        -lm -o "$tmp/sz"
   read -r ws32 det32 <<<"$(size32 "${caps[@]}")"
   declare -A v=()
   while read -r k n; do v[$k]=$n; done < <("$tmp/sz")

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: MIT
-"""Reference of the clustering stage and of the proposals (mirrors lib/src/lidet_cluster*.c and
-lib/src/lidet_proposal.c; the contract is written in lib/include/lidet/lidet_cluster.h).
+"""Reference of the clustering stage and of the proposals (mirrors lib/src/cluster/lidet_cluster.c,
+lidet_cluster_grow.c, lidet_cluster_rescue.c and lidet_proposal.c; the contract is written in
+lib/include/lidet/lidet_cluster.h).
 
 - `proposal_indices` / `make_proposal` reproduce the C resampling *exactly* (integer xorshift32):
   training uses them, or the bindings (`lidet_tools.native.proposals`), and both give the same points.
@@ -370,8 +371,8 @@ def refine_ref(labels: np.ndarray, xyz: np.ndarray, min_points: int = 8, split_p
                car_max_length_m: float = 5.2, car_max_width_m: float = 2.2, car_max_height_m: float = 2.0,
                car_min_length_m: float = 2.5, upright_max_width_m: float = 1.3,
                max_join_pieces: int = 256) -> np.ndarray:
-    """The refinement of lib/src/lidet_refine.c (split_people, join_cars; the rules in lidet_cluster.h) on canonical
-    cluster labels (rows, cols) of the clustering without it, with the image's points xyz (rows, cols, 3)
+    """The refinement of lib/src/cluster/lidet_refine.c (split_people, join_cars; the rules in lidet_cluster.h) on
+    canonical cluster labels (rows, cols) of the clustering without it, with the image's points xyz (rows, cols, 3)
     float32. Returns the canonical labels the C gives with it: the same float32 operations in the same
     order (cell size, truncated cell indices, spans), so the decisions match bit for bit."""
     f32 = np.float32

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Reference of the integer clustering and proposals (lib/src/lidet_cluster_q*.c, lib/src/lidet_proposal_q.c;
+"""Reference of the integer clustering and proposals (lib/src/cluster/*_q.c: run, growth, rescue, refinement, proposals;
 the contract is lib/include/lidet/lidet_cluster_q.h), bit for bit.
 
 Plain Python integers over the compact image (4 mm steps), the angle tables from `ref.qmath` (the C integer
@@ -91,7 +91,7 @@ class Rec:
 STAT_KEYS = ["n_candidates", "n_found", "n_fragments", "n_rescue_joined", "n_rescue_pixels", "n_dropped_small",
              "n_dropped_extent", "n_dropped_height", "n_dropped_capacity", "n_kept", "n_pixels_kept",
              "n_queue_overflow",
-             # the refinement (refine_q; lidet_cluster_q_refine.c)
+             # the refinement (refine_q; lidet_refine_q.c)
              "n_split", "n_split_parts", "n_split_skipped", "n_joined", "n_join_skipped",
              # issue 19's bounds: the rescue budget (max_fragment_pixels) and the bridging budget
              # (max_bridge_per_pixel_q16)
@@ -459,7 +459,7 @@ def _span_mm(lo: int, hi: int) -> int:
 
 
 def refine_q(labels, members, recs, X, Y, Z, cols: int, c: dict, st: dict, height, max_clusters: int):
-    """The refinement of lib/src/lidet_cluster_q_refine.c (control flow: lib/src/internal/lidet_refine_body.h) on
+    """The refinement of lib/src/cluster/lidet_refine_q.c (control flow: lib/src/internal/lidet_refine_body.h) on
     the canonical output (labels: per-pixel canonical ids; members; recs in id order), then the canonical pass
     again when it changed anything. Updates st; returns (labels, members, recs)."""
     lab = [int(v) for v in labels]

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The integer detector, bit for bit as lib/src/lidet_detector_q.c: the integer stages' references chained
+"""The integer detector, bit for bit as lib/src/detector/lidet_detector_q.c: the integer stages' references chained
 (proj_q -> ground_q -> cluster_q -> proposals -> pointnet_q -> post_q) with the detector's own rules (the
 candidate window, range and order, the budget, the gates, the size check, the score and the NMS).
 

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""numpy reference of the ground stage (lib/src/lidet_ground_filter.c, lidet_ground_ransac.c).
+"""numpy reference of the ground stage (lib/src/ground/lidet_ground_filter.c, lidet_ground_ransac.c).
 
 Same algorithm, same order, same random draws (ref/rng.py mirrors the C xorshift32):
 

@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: MIT
-"""numpy reference of the integer ground stage (lib/src/lidet_ground_q.c, lidet_ground_q_fit.c), bit for bit.
+"""numpy reference of the integer ground stage (lib/src/ground/lidet_ground_filter_q.c, lidet_ground_ransac_q.c),
+bit for bit.
 
 Input: a compact range image, (rows, cols) int16 x, y, z in 4 mm steps; configuration: a dict with the fields of
 lidet_ground_q_cfg_t (native_q.ground_q_defaults gives the C defaults). Every value is an exact integer: pixel
@@ -40,7 +41,7 @@ def r_of(v):
 
 def r_of_range(rng, row_elev_bam):
     """R of a range-only image's pixels ((rows, cols) ranges): round(range cos(e) / 2^7) with the row's elevation
-    e as lidet_qpix.h's Q15 cosine (lidet_ground_q.c: r_of_range); the image's R when it keeps only the range."""
+    e as lidet_qpix.h's Q15 cosine (lidet_ground_filter_q.c: r_of_range); the image's R when it keeps only the range."""
     r = np.asarray(rng, np.int64) & 0x7FFF
     e = np.asarray(row_elev_bam, np.int64)[:r.shape[0]]
     ce = qmath.rshift_round(qmath.cos(e), 15)[:, None]
@@ -245,7 +246,7 @@ def _plane_z_at(n, d, x, y) -> int:
 
 
 def far_meets(s: int, ns: int, cfg, plane, near_n, near_d) -> bool:
-    """lidet_ground_q_fit.c far_meets: the far plane meets sector s's near plane at the split, at the sector's
+    """lidet_ground_ransac_q.c far_meets: the far plane meets sector s's near plane at the split, at the sector's
     middle azimuth (BAM32 2^31 - floor((2 s + 1) 2^31 / ns)), within far_max_step_mm (4 |dz| <= step)."""
     az = (0x80000000 - (((2 * s + 1) << 31) // ns)) & 0xFFFFFFFF
     sp = int(cfg["ring_split_mm"])

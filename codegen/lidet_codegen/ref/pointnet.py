@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""float64 reference of the PointNet forward pass (mirrors lib/src/lidet_pointnet.c function for function):
+"""float64 reference of the PointNet forward pass (mirrors lib/src/pointnet/lidet_pointnet.c function for function):
 to_model_frame / azimuth_cos_sin, dense, run_stage, forward, energy, decode_box, classify, box.
 
 It runs on the descriptor codegen builds from an ONNX file (`lidet_codegen.emit.load`), i.e. on exactly the

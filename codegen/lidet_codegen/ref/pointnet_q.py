@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Integer reference of the int8 PointNets, bit for bit as lib/src/lidet_pointnet_q.c (docs/FIXED_POINT.md,
+"""Integer reference of the int8 PointNets, bit for bit as lib/src/pointnet/lidet_pointnet_q.c (docs/FIXED_POINT.md,
 section "int8 PointNets"): requant, dense, run_stage, forward, energy, decode_box, classify, box.
 
 Vectorized over a batch of proposals (numpy int64; every value fits as in C). It runs on the quantized

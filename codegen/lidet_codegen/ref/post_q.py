@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The integer path's post-processing, bit for bit as lib/src/lidet_post_q.c (lidet_detector_q.h).
+"""The integer path's post-processing, bit for bit as lib/src/detector/lidet_post_q.c (lidet_detector_q.h).
 
 Boxes are tuples/arrays (cx_mm, cy_mm, cz_mm, l_mm, w_mm, h_mm, yaw_bam); Python integers throughout.
 """

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Reference spherical projection in float64 numpy (mirrors lib/src/lidet_proj.c's contract:
+"""Reference spherical projection in float64 numpy (mirrors lib/src/proj/lidet_proj.c's contract:
 nearest beam in angle, column = floor(0.5 * (1 - atan2(y, x)/pi) * cols) with wrap-around, the
 closest point wins a pixel and ties keep the earlier point)."""
 from __future__ import annotations

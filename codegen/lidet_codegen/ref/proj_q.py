@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The integer projection, bit for bit as lib/src/lidet_proj_q.c (docs/FIXED_POINT.md, "Projection").
+"""The integer projection, bit for bit as lib/src/proj/lidet_proj_q.c (docs/FIXED_POINT.md, "Projection").
 
 Init in Python integers (exact, as the C init's int64), the per-point work vectorized over numpy int64 (every
 intermediate fits: z^2 2^q is formed only below 2^63, n (x^2 + y^2) < 2^62, column products < 2^50).

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Integer math of the fixed-point build, bit for bit as lib/src/lidet_qmath.c (docs/FIXED_POINT.md).
+"""Integer math of the fixed-point build, bit for bit as lib/src/qmath/lidet_qmath.c (docs/FIXED_POINT.md).
 
 Vectorized over numpy int64 arrays (every intermediate fits: the C code uses int64/uint64 the same way).
 Floor division and arithmetic right shifts in numpy equal C's on the values used here: right shifts of

@@ -56,9 +56,9 @@
  *    and the far side 1-2 m behind it, and the angle test cuts it into singletons that min_points
  *    dropped. Measured (docs/BENCHMARKS.md): simulated cars within 40 m recovered as one cluster
  *    vlp16 77 -> 90 %, hdl64 87 -> 94 %, real SemanticKITTI 89 -> 92 %;
- *  - refinement, after the rescue (lib/src/lidet_refine.c; issue 15). Cuts (split_people, the default):
- *    a kept cluster wider than split_min_width_m in x or y is drawn on a bird's-eye-view grid of cell
- *    split_cell_m + split_cell_per_m * r (r = max(|cx|, |cy|) + min(|cx|, |cy|) / 2 of its box centre:
+ *  - refinement, after the rescue (lib/src/cluster/lidet_refine.c; issue 15). Cuts (split_people, the
+ *    default): a kept cluster wider than split_min_width_m in x or y is drawn on a bird's-eye-view grid of
+ *    cell split_cell_m + split_cell_per_m * r (r = max(|cx|, |cy|) + min(|cx|, |cy|) / 2 of its box centre:
  *    no sqrt) and cut into the 8-connected parts of its occupied cells. Parts spanning at most
  *    person_max_width_m in x and y whose points span at least person_min_height_m and
  *    person_min_aspect times that span in z, over at least person_min_cols image columns, with at least
@@ -177,7 +177,7 @@ typedef struct
                                   <= LIDET_MAX_ROWS; default 1 (<= 16 beams), 2 (> 16 beams) */
     uint32_t rescue_cols;      /**< columns looked at left and right (wrapping; at most (n_cols - 1) / 2
                                   are used); <= 15; default 6 */
-    /* proposal refinement after the clustering (lib/src/lidet_refine.c, issue 15) */
+    /* proposal refinement after the clustering (lib/src/cluster/lidet_refine.c, issue 15) */
     uint32_t split_people;      /**< 1 (default): a cluster wider than split_min_width_m is cut into its
                                   connected parts on a finer bird's-eye-view grid, and every part that
                                   is person-sized becomes a cluster of its own (people in groups, a

@@ -27,8 +27,8 @@
  *    most max_fragment_pixels (n_dropped_fragment_budget), a pixel's searches bridge occluders while the run's
  *    count is below (max_bridge_per_pixel_q16 * candidates) >> 16 (n_bridge_steps);
  *  - refinement (split_people, join_cars; the rules of lidet_cluster.h, the control flow shared with the float
- *    stage in internal/lidet_refine_body.h), lib/src/lidet_cluster_q_refine.c: spans compared in mm (4 times the
- *    4 mm span); cell = split_cell_mm + round(split_cell_per_m_q16 r_mm / 2^16), r_mm = max(|cx|, |cy|) +
+ *    stage in internal/lidet_refine_body.h), lib/src/cluster/lidet_refine_q.c: spans compared in mm (4 times
+ *    the 4 mm span); cell = split_cell_mm + round(split_cell_per_m_q16 r_mm / 2^16), r_mm = max(|cx|, |cy|) +
  *    min(|cx|, |cy|) / 2 of the box centre (floored); a member's cell floor(4 (x - lo) / cell) by one product with
  *    ceil(2^40 / cell) and a shift (exact); person aspect wz 2^16 >= person_min_aspect_q16 max(wx, wy); joins:
  *    (4 gx)^2 + (4 gy)^2 > join_gap_mm^2 rejects, in uint64; records from int64 member sums (a join adds the
@@ -150,7 +150,7 @@ typedef struct
     lidet_member_t *members;
     uint32_t n_recs;
     lidet_cluster_stats_t stats;
-    /* scratch of the refinement (lidet_cluster_q_refine.c; as lidet_cluster_state_t's, z in 4 mm steps) */
+    /* scratch of the refinement (lidet_refine_q.c; as lidet_cluster_state_t's, z in 4 mm steps) */
     uint16_t rf_grid[LIDET_REFINE_MAX_CELLS];
     uint16_t rf_queue[LIDET_REFINE_MAX_CELLS];
     uint16_t rf_cell[LIDET_REFINE_MAX_POINTS];

@@ -4,7 +4,7 @@
  * @brief Ground segmentation on the range image: Sobel-inspired sample filter + one RANSAC plane
  *        per azimuth sector (Seppänen et al., "No GPU? No problem", section on ground removal).
  *
- * Algorithm (lib/src/lidet_ground_filter.c, lib/src/lidet_ground_ransac.c; numpy mirror in
+ * Algorithm (lib/src/ground/lidet_ground_filter.c, lib/src/ground/lidet_ground_ransac.c; numpy mirror in
  * codegen/lidet_codegen/ref/ground.py):
  *  1. Sample filter over the projection's R (horizontal range) and Z images. For pixel (r, c), with
  *     row r+1 the beam below and columns wrapping around:

@@ -213,10 +213,11 @@
 #endif
 #endif
 
-/** The integer ground stage (lib/src/lidet_ground_q.c): R row by row, 1 = column-wise lanes (each digit step of
- *  the square root over the whole row: a compiler vectorises the column loop on SIMD hosts), 0 = pixel by pixel
- *  with root and remainder in registers (cores without SIMD: fewer loads and stores); its sample test, 1 =
- *  branch-free, 0 = leaving at the first failed condition. 0 or 1. Default LIDET_HOST_SIMD. */
+/** The integer ground stage (lib/src/ground/lidet_ground_filter_q.c): R row by row, 1 = column-wise lanes
+ *  (each digit step of the square root over the whole row: a compiler vectorises the column loop on SIMD
+ *  hosts), 0 = pixel by pixel with root and remainder in registers (cores without SIMD: fewer loads and
+ *  stores); its sample test, 1 = branch-free, 0 = leaving at the first failed condition. 0 or 1. Default
+ *  LIDET_HOST_SIMD. */
 #ifndef LIDET_GROUND_Q_SQRT_LANES
 #define LIDET_GROUND_Q_SQRT_LANES LIDET_HOST_SIMD
 #endif

@@ -22,11 +22,11 @@
  *     the scan in progress is closed as aborted. A forward step across seam_cdeg closes it as a scan.
  *  4. Distances of 0 (no return) are skipped; in dual mode the return filter picks the last, the strongest, or
  *     both (the second block's return when it differs from the last one).
- * Ring numbers are those of the lidet sensor presets (lib/src/lidet_sensors.c: "vlp16", "vlp32c"): ring 0 = the
- * lowest beam, upwards by elevation (HDL-32E likewise: -30.67 deg .. +10.67 deg; its tables are the manual's, not
- * yet checked on a real HDL-32E capture). Azimuths are BAM16 counterclockwise from +x (x forward, y left, z up),
- * i.e. the Velodyne azimuth (clockwise) negated. A scan boundary falls between blocks (a column is a block: a
- * block's returns all belong to one scan).
+ * Ring numbers are those of the lidet sensor presets (lib/src/proj/lidet_sensor.c: "vlp16", "vlp32c"):
+ * ring 0 = the lowest beam, upwards by elevation (HDL-32E likewise: -30.67 deg .. +10.67 deg; its tables are
+ * the manual's, not yet checked on a real HDL-32E capture). Azimuths are BAM16 counterclockwise from +x (x
+ * forward, y left, z up), i.e. the Velodyne azimuth (clockwise) negated. A scan boundary falls between blocks
+ * (a column is a block: a block's returns all belong to one scan).
  *
  * Memory: lidet_velodyne_t is 92 B, lidet_velodyne_attr_t 8 B per return; ~0.5 KiB of const tables; no
  * allocation, no recursion. Time: O(384) per packet, two 32-bit divisions per data point. Outputs go into the

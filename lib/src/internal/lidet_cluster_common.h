@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* What the float clustering (lidet_cluster*.c) and the integer one (lidet_cluster_q*.c) share that holds no
- * number format: the pixel states, the queue push, the candidates of a compact image, the flood fill's
- * geometry constants, the per-point ids. Integer only (the integer-only build compiles it). Never installed. */
+/* What the float clustering (cluster/lidet_cluster.c, lidet_cluster_grow.c, lidet_cluster_rescue.c) and the
+ * integer one (their _q twins) share that holds no number format: the pixel states, the queue push, the
+ * candidates of a compact image, the flood fill's geometry constants, the per-point ids. Integer only (the
+ * integer-only build compiles it). Never installed. */
 #ifndef LIDET_CLUSTER_COMMON_H
 #define LIDET_CLUSTER_COMMON_H
 

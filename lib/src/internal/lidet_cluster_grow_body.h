@@ -2,7 +2,7 @@
 /* The flood fill of the clustering, written once for every image format and arithmetic: lidet_cluster_grow.c
  * includes this file twice, with GROW_RNG_T float (a float image: ranges in metres) and uint16_t (a compact
  * image: ranges in 4 mm steps, read as floats; the caller scales the gap bound to steps), and
- * lidet_cluster_q_grow.c once more for the integer stage (ranges in 4 mm steps read as integers). The
+ * lidet_cluster_grow_q.c once more for the integer stage (ranges in 4 mm steps read as integers). The
  * parameters:
  *   GROW_RNG_T       the range plane's element type, GROW_RANGES(img) the plane;
  *   GROW_D_T         the type a range is read as (float, or uint32_t for the integer stage);

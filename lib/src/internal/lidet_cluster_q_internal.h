@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Shared by the integer clustering's files (never installed): lidet_cluster_q.c (configuration, filters,
- * records, the run), lidet_cluster_q_grow.c (the angle tables, the join test and the flood fill) and
- * lidet_cluster_q_rescue.c (the fragment rescue), lidet_cluster_q_refine.c (the refinement). Integer only. */
+ * records, the run), lidet_cluster_grow_q.c (the angle tables, the join test and the flood fill) and
+ * lidet_cluster_rescue_q.c (the fragment rescue), lidet_refine_q.c (the refinement). Integer only. */
 #ifndef LIDET_CLUSTER_Q_INTERNAL_H
 #define LIDET_CLUSTER_Q_INTERNAL_H
 
@@ -45,7 +45,7 @@ void lidet__cluster_q_rescue_grow(lidet_cluster_q_state_t *c, const lidet__grow_
 int32_t lidet__cluster_q_height(const lidet_cluster_q_state_t *c, uint32_t seed, const int32_t mean[3],
                                 const lidet_plane_q_t *planes, uint32_t n_sectors);
 
-/* The refinement (lidet_cluster_q_refine.c) on the canonical output of a run, as lidet__refine_split and
+/* The refinement (lidet_refine_q.c) on the canonical output of a run, as lidet__refine_split and
  * lidet__refine_join (lidet_cluster_internal.h) */
 int lidet__refine_q_split(lidet_cluster_q_state_t *c, const lidet_plane_q_t *planes, uint32_t n_sectors,
                           lidet_cluster_stats_t *st);

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* The fragment rescue's window walk, written once for the float stage (lidet_cluster_rescue.c) and the
- * integer one (lidet_cluster_q_rescue.c), each of which includes this file once. Parameters:
+ * integer one (lidet_cluster_rescue_q.c), each of which includes this file once. Parameters:
  *   RESCUE_STATE_T, RESCUE_PARAM_T, RESCUE_RS_T  the state, the run's constants, the group's running state;
  *   RESCUE_WIN_T, RESCUE_WIN_SET(c, win, q, g, compact)  what the stage derives from group pixel q before its
  *                window is looked at (its range and the range bounds of a possible partner);

@@ -92,7 +92,7 @@ static inline lidet_status_t lidet__ground_point_labels(int inited, const uint8_
 }
 
 /* The per-cell control flow of both ground stages (the float one, lidet_ground_ransac.c, and the integer one,
- * lidet_ground_q_fit.c); numeric-agnostic, the planes are the caller's. Cells: k < ns the near part of
+ * lidet_ground_ransac_q.c); numeric-agnostic, the planes are the caller's. Cells: k < ns the near part of
  * sector k, k >= ns the far part of sector k - ns; only the first n_cells (ns, or 2 ns with a split) are
  * fitted, each with at least min_samples samples, in this order (the RNG runs in it). fit(ctx, k) fits cell
  * k and returns 1 when its plane passed the checks; copy(ctx, dst, src) sets the plane of cell dst to that

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Shared between lidet_ground_q.c and lidet_ground_q_fit.c (never installed). */
+/* Shared between lidet_ground_filter_q.c and lidet_ground_ransac_q.c (never installed). */
 #ifndef LIDET_GROUND_Q_INTERNAL_H
 #define LIDET_GROUND_Q_INTERNAL_H
 
@@ -58,10 +58,10 @@ static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, 
  * branch-free, 0 = leaving at the first failed condition. Same values either way. */
 
 /* R of a pixel from v = x^2 + y^2 (4 mm steps squared, v < 2^31): round(sqrt(v) 2^LIDET_GROUND_Q_R_SHIFT), exact
- * (lidet_ground_q.c; exposed for the tests) */
+ * (lidet_ground_filter_q.c; exposed for the tests) */
 int32_t lidet__ground_q_r(uint32_t v);
 
-/* Pass 1's sample test settings (lidet_ground_q.c: the filter's thresholds in the integer units) */
+/* Pass 1's sample test settings (lidet_ground_filter_q.c: the filter's thresholds in the integer units) */
 typedef struct
 {
     uint64_t fy;
@@ -128,7 +128,7 @@ static inline void lidet__ground_q_pix(const lidet__ground_q_pix_t *gp, uint32_t
     lidet__ground_q_pix_rc(gp, lidet__qpix_row(gp->img, r), p - r * gp->img->n_cols, p, v);
 }
 
-/* Fits one plane per cell from the gathered samples, applies the fallback (lidet_ground_q_fit.c). */
+/* Fits one plane per cell from the gathered samples, applies the fallback (lidet_ground_ransac_q.c). */
 void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
                                  const lidet__ground_q_pix_t *gp);
 

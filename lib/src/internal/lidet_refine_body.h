@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* The proposal refinement's control flow (issue 15; the rules in lidet_cluster.h, cfg split_people, join_cars),
- * written once for the float stage (lidet_refine.c) and the integer one (lidet_cluster_q_refine.c), each of
+ * written once for the float stage (lidet_refine.c) and the integer one (lidet_refine_q.c), each of
  * which includes this file once: which clusters are examined, the bird's-eye-view grid and its 8-connected
  * parts, the choice of the parts that leave and their slots, the relabelling, and the joins' loop. Nothing here
  * reads a coordinate. Parameters:

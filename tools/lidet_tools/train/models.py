@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """The two PointNets of lidet (PyTorch), sized for a microcontroller, and the contract their ONNX
-export keeps with the C side (codegen/lidet_codegen/emit.py, lib/src/lidet_pointnet.c).
+export keeps with the C side (codegen/lidet_codegen/emit.py, lib/src/pointnet/lidet_pointnet.c).
 
 Both nets see a proposal in the *model frame*: the cluster's resampled points centred on the cluster
 mean and rotated about +z by minus the mean's azimuth, so the sensor looks along +x at every object

@@ -10,7 +10,7 @@
  * (a cluster needing more is left whole and counted); all scratch is in the state. Deterministic: parts
  * are numbered in the order of the cluster's members, cells filled breadth-first. Decisions use
  * subtractions, one product by the inverse cell size, truncation to a cell index and compares: the
- * integer stage does the same in 4 mm steps (lidet_cluster_q_refine.c). The control flow is shared with it
+ * integer stage does the same in 4 mm steps (lidet_refine_q.c). The control flow is shared with it
  * (internal/lidet_refine_body.h); this file holds the float kernels. The numpy reference is refine_ref in
  * codegen/lidet_codegen/ref/cluster.py. */
 #include <string.h>

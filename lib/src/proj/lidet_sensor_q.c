@@ -1,12 +1,12 @@
 /* SPDX-License-Identifier: MIT */
-/* Integer sensor presets (lidet_sensor_q.h): the presets of lidet_sensors.c in microradians and millimetres,
+/* Integer sensor presets (lidet_sensor_q.h): the presets of lidet_sensor.c in microradians and millimetres,
  * the float values rounded to the nearest unit. tests/python/test_proj_q.py checks these literals against
  * tools/lidet_tools/sensors.py (Sensor.beam_elev_urad) and against the float presets. No float here. */
 #include "lidet/lidet_sensor_q.h"
 #include "internal/lidet_qmath.h"
 #include "internal/lidet_str.h"
 
-/* KITTI HDL-64E (see lidet_sensors.c): ring order top to bottom */
+/* KITTI HDL-64E (see lidet_sensor.c): ring order top to bottom */
 static const int32_t k_hdl64_elev_urad[64] = {
     43633,   37891,   32148,   26405,   20662,   14920,   9177,    3434,    -2308,   -8051,   -13794,
     -19536,  -25279,  -31022,  -36765,  -42507,  -48250,  -53993,  -59735,  -65478,  -71221,  -76963,

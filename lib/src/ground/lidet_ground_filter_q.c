@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Integer ground stage: configuration, the sample filter, the sample gathering, the labels and the accessors
- * (lidet_ground_q.h; the plane fits are in lidet_ground_q_fit.c). Integers only: no <math.h>, no float.
+ * (lidet_ground_q.h; the plane fits are in lidet_ground_ransac_q.c). Integers only: no <math.h>, no float.
  * Mirrored bit for bit by codegen/lidet_codegen/ref/ground_q.py. */
 #include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
 

@@ -2,9 +2,9 @@
 /* Sensor presets. Mirrored by tools/lidet_tools/sensors.py; tests/python/test_bindings_proj.py checks
  * that both give the same beam tables. Elevations in ring order, radians, float32-rounded. The integer
  * profiles of the same presets (microradians, millimetres) are in lidet_sensor_q.c. */
+#include "lidet/lidet_sensor.h"
 #include "internal/lidet_math.h"
 #include "internal/lidet_str.h"
-#include "lidet/lidet_sensor.h"
 
 /* KITTI HDL-64E, measured on real KITTI scans (median elevation per ring recovered from scan order):
  * upper block +2.5 .. -7.7 deg in 32 equal steps, lower block -8.25 .. -23.5 deg in 32 steps.

@@ -1,8 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /* Integer clustering (lidet_cluster_q.h): configuration, the run, the filters and records of each component,
  * the rescue join, accessors. The bookkeeping and the run's driver are the float stage's
- * (lidet_cluster_run_body.h); the growth is in lidet_cluster_q_grow.c, the rescue in lidet_cluster_q_rescue.c.
- * Integer only. The numpy reference is codegen/lidet_codegen/ref/cluster_q.py (bit for bit). */
+ * (lidet_cluster_run_body.h); the growth is in lidet_cluster_grow_q.c, the rescue in
+ * lidet_cluster_rescue_q.c. Integer only. The numpy reference is codegen/lidet_codegen/ref/cluster_q.py (bit
+ * for bit). */
 #include <string.h>
 
 #include "internal/lidet_assert.h"
@@ -296,7 +297,7 @@ lidet_status_t lidet_cluster_q_run_buffers(lidet_cluster_q_state_t *c, uint16_t 
     sp.seed_lo = 0u;
     sp.seed_hi = img->n_cols;
     run_fills(c, &lk, &sp, planes, n_sectors, &st);
-    run_refine(c, &sp, planes, n_sectors, &st); /* lidet_cluster_q_refine.c */
+    run_refine(c, &sp, planes, n_sectors, &st); /* lidet_refine_q.c */
     c->stats = st;
     return st.n_dropped_capacity > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }
