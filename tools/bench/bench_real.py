@@ -74,7 +74,8 @@ def run(args) -> str:
     lines += ["### Simulated against real road users (the training side)", "",
               f"`python -m lidet_tools.real.compare --sim-scans {n_sim}`: per class and distance band, simulated / real: "
               "objects, median points that win their pixel, median span of those points along the box's length, width "
-              "and height (5-95 %), the share whose cluster was clean (not merged, split or dropped), and of those the "
+              "and height (5-95 %), where the object is seen from (the 5th percentile of those points above its box "
+              "bottom: how much of it is hidden from below), the share whose cluster was clean (not merged, split or dropped), and of those the "
               "share past gate 1, past both gates, and detected (loose BEV overlap). Real: the training frames of the "
               f"HDL-64-profile sources; simulated: {n_sim} `lidet-sim --sensor hdl64` scans of the hdl64 family's training "
               "seed 1000. Same float detector.", "",
