@@ -125,6 +125,10 @@ int cli_detect(int argc, char **argv);
 int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, const char *family,
                      lidet_detection_t *det, uint32_t *n_det, lidet_detector_stats_t *ds, double *ms,
                      uint8_t *point_ground, uint32_t *point_cluster, lidet_status_t *status);
+/* `lidet detect --fixed --dump FILE` (cli_detect_q.c): the last integer run's results bit for bit (format at
+ * cli_detect_q_dump); point_cluster / point_ground: n_points entries as cli_detect_q_run filled them. 0 or -1. */
+int cli_detect_q_dump(const char *path, uint32_t n_points, const uint32_t *point_cluster,
+                      const uint8_t *point_ground);
 
 #define M_PI_D 3.14159265358979323846
 

@@ -589,7 +589,9 @@ static void usage_extra(void)
                     "                   split_people, join_cars and regrow_* fields, in integer units\n"
                     "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n"
                     "  --dump FILE      every result bit for bit (per-point labels, clusters, proposals,\n"
-                    "                   detections; binary, see write_dump in cli_detect.c)\n");
+                    "                   detections; binary, see write_dump in cli_detect.c; with --fixed the\n"
+                    "                   integer detector's labels, outcomes, counts and detections,\n"
+                    "                   cli_detect_q_dump in cli_detect_q.c)\n");
 }
 
 static int pick_models(const char *family, const char *sensor, const lidet_pn_model_t **cls,
@@ -644,6 +646,7 @@ int cli_detect(int argc, char **argv)
     uint32_t n_det = 0, k;
     int32_t *pp = NULL;
     uint8_t *gp = NULL;
+    uint32_t *gp_ids = NULL; /* --fixed --dump: the integer run's per-point cluster labels */
 
     rest = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
     sets = (const char **)malloc(sizeof(char *) * (size_t)(argc + 1));
@@ -741,9 +744,13 @@ int cli_detect(int argc, char **argv)
         /* the integer detector; per-point ground labels for the picture come with it */
         uint32_t np = a.n_points < LIDET_MAX_POINTS ? a.n_points : LIDET_MAX_POINTS;
         gp = (uint8_t *)malloc((size_t)np + 1u);
-        if (gp == NULL || cli_detect_q_run(&a, &cfg, chosen, det_q, &n_det, &ds_q, ms, gp, NULL, &st) != 0)
+        if (dump_path != NULL) /* the per-point cluster labels too */
+            gp_ids = (uint32_t *)malloc(sizeof(uint32_t) * ((size_t)np + 1u));
+        if (gp == NULL || (dump_path != NULL && gp_ids == NULL) ||
+            cli_detect_q_run(&a, &cfg, chosen, det_q, &n_det, &ds_q, ms, gp, gp_ids, &st) != 0)
         {
             free(gp);
+            free(gp_ids);
             cli_free(&a);
             return 1;
         }
@@ -798,18 +805,23 @@ outputs:
         if (f == NULL || fclose(f) != 0)
         {
             fprintf(stderr, "lidet detect: cannot write '%s'\n", a.out_path);
+            free(gp_ids);
             free(pp);
             cli_free(&a);
             return 1;
         }
     }
-    if (dump_path != NULL && write_dump(dump_path, pp, a.n_points) != 0)
+    if (dump_path != NULL && (fixed ? cli_detect_q_dump(dump_path, a.n_points, gp_ids, gp)
+                                    : write_dump(dump_path, pp, a.n_points)) != 0)
     {
         fprintf(stderr, "lidet detect: cannot write '%s'\n", dump_path);
+        free(gp_ids);
         free(pp);
         cli_free(&a);
         return 1;
     }
+    free(gp_ids);
+    gp_ids = NULL;
     if (kitti_path != NULL)
     {
         calib_t c;

@@ -275,3 +275,35 @@ def test_batch_script_firmware_options(cli, tmp_path):
     r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(kd), "--out", str(tmp_path / "p3"),
                         "--range-only"], capture_output=True, text=True, env=env)
     assert r.returncode != 0 and "--fixed" in r.stderr
+
+
+def test_fixed_dump_is_the_integer_run(cli, tmp_path):
+    """--fixed --dump: the integer detector's per-point labels, outcomes, counts and detections in integer units
+    (cli_detect_q_dump in ports/host/cli_detect_q.c); the same bytes on a second run, the same counts and boxes
+    as --json (which converts them to metres, nats and [0, 1])."""
+    scan = ROOT / "tests" / "data" / "sim_vlp16" / "velodyne" / "000000.bin"
+    dumps = []
+    for k in range(2):
+        r = _run(cli, scan, "--sensor", "vlp16", "--fixed", "--json", "--dump", tmp_path / f"q{k}.bin")
+        dumps.append((tmp_path / f"q{k}.bin").read_bytes())
+    js = json.loads(r.stdout)
+    b = dumps[0]
+    assert b == dumps[1] and b[:4] == b"LDTQ"
+    n, n_cl, n_det = np.frombuffer(b, "<u4", 3, 4)
+    assert n == js["points"] == len(kitti.read_bin(scan)) and n_det == js["detections"] > 0
+    off = 16
+    pts = np.frombuffer(b, np.dtype([("id", "<u4"), ("g", "u1")]), int(n), off)
+    off += int(n) * 5
+    outcome = np.frombuffer(b, "<u4", int(n_cl), off)
+    off += int(n_cl) * 4
+    counts = np.frombuffer(b, "<u4", 14, off)
+    off += 14 * 4
+    det = np.frombuffer(b, np.dtype([("u", "<u4", 3), ("i", "<i4", 10)]), int(n_det), off)
+    assert off + int(n_det) * 52 == len(b)
+    assert pts["id"].max() > 0 and 0 < pts["g"].sum() < n and len(outcome) == n_cl
+    assert list(counts[[0, 4, 5, 6, 11]]) == [js[k] for k in ("clusters", "classified", "gate1_rejected", "boxed",
+                                                               "detections")]
+    for d, box in zip(det, js["boxes"]):
+        assert d["u"][1] == box["cluster"] and d["u"][2] == box["cluster_points"]
+        assert round(d["i"][0] / 32768.0, 5) == box["score"]
+        assert [round(float(v) / 1000.0, 4) for v in d["i"][3:9]] == [box[k] for k in ("x", "y", "z", "l", "w", "h")]

@@ -149,10 +149,14 @@ static inline uint32_t S8_SXTB16_ROR8(uint32_t v)
 {
     return S8_SXTB16((v >> 8) | (v << 24));
 }
+/* The halves sign-extended by shifts (arithmetic, lidet_opt.h), not through int16_t: from int16 x int16 products
+ * summed into int32, GCC 12.2 for aarch64 at -O3 makes pk_pair's loop a vectorised widening reduction that drops
+ * half the products (clang and -fno-tree-loop-vectorize sum right; test_nn_s8 under qemu-aarch64 found it,
+ * tests/aarch64.cmake). Same sums, no int16 in the loop. */
 static inline int32_t S8_SMLAD(uint32_t a, uint32_t b, int32_t acc)
 {
-    const int32_t alo = (int16_t)(a & 0xFFFFu), ahi = (int16_t)(a >> 16);
-    const int32_t blo = (int16_t)(b & 0xFFFFu), bhi = (int16_t)(b >> 16);
+    const int32_t alo = (int32_t)(a << 16) >> 16, ahi = (int32_t)a >> 16;
+    const int32_t blo = (int32_t)(b << 16) >> 16, bhi = (int32_t)b >> 16;
     return acc + alo * blo + ahi * bhi;
 }
 #endif

@@ -1,0 +1,229 @@
+#!/usr/bin/env python3
+# SPDX-License-Identifier: MIT
+"""Run the aarch64 Linux cross build under qemu-aarch64 and compare its CLI with the host's (ctest aarch64_linux).
+
+    python3 tests/aarch64/run_aarch64.py --build build/aarch64 --tests proj,proj_q,... --src . \\
+        --host-cli build/ports/host/lidet --host-cli-portable build/tests/lidet_cli_portable [--qemu qemu-aarch64]
+
+The cross build (tests/aarch64.cmake: this repository configured with cmake/toolchains/aarch64-linux-gnu.cmake,
+targets lidet_unit_tests and lidet_cli) is made by the normal build. This script:
+1. runs every Unity test binary of tests/unit under qemu-aarch64 (-L the cross sysroot); each must exit 0;
+2. runs the aarch64 CLI and the host CLI on the simulated scans of tests/data (`lidet detect --dump`):
+   - the integer detector (`--fixed`, and `--fixed --returns` with the rings): the dumps must be byte-identical;
+   - the float detector, against the host CLI built with the portable float dense kernel (LIDET_NN_FMA off; the
+     x86 FMA kernel differs in the last bits): per-point labels and ground flags, cluster records' counts and
+     outcomes, voxel bins, detections' classes, cluster ids and point counts identical; floats within the
+     tolerances of the firmware comparison (tools/firmware/run_fw.py: positions 1e-3 m, yaw 1e-3 rad, score
+     1e-4, energies 1e-4 relative), since glibc's expf/logf/sinf/cosf/atan2f are separate builds on the two
+     architectures; everything else is IEEE single precision in the same order (-ffp-contract=off). The report
+     says how many values were bit-identical.
+Exit status: 0 pass, 1 fail, 77 skipped (qemu-aarch64 or the cross build missing: ctest reports it skipped).
+"""
+import argparse
+import math
+import os
+import shutil
+import struct
+import subprocess
+import sys
+import time
+
+SKIP = 77
+ATOL_M = 1e-3
+ATOL_RAD = 1e-3
+ATOL_SCORE = 1e-4
+RTOL_ENERGY = 1e-4
+SCANS = ("vlp16", "hdl64")
+
+
+def run(cmd, cwd=None, timeout=600.0):
+    t0 = time.monotonic()
+    r = subprocess.run(cmd, cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, timeout=timeout)
+    return r.returncode, r.stdout.decode("utf-8", "replace"), time.monotonic() - t0
+
+
+def parse_float_dump(b):
+    """cli_detect.c write_dump -> (discrete bytes per part, float values per kind)."""
+    if b[:4] != b"LDTD":
+        raise ValueError("not a float detector dump (LDTD)")
+    n, n_cl, n_det = struct.unpack_from("<3I", b, 4)
+    off = 16
+    points = b[off:off + 5 * n]
+    off += 5 * n
+    det_bytes = 52 * n_det
+    rest = len(b) - off - det_bytes
+    if n_cl == 0:
+        per_cl = 0
+    else:
+        per_cl = rest // n_cl
+        if per_cl * n_cl != rest or (per_cl - 16 - 36 - 24) % 12 != 0:
+            raise ValueError("cluster records of an unexpected size")
+    rows = (per_cl - 16 - 36 - 24) // 12 if n_cl else 0
+    discrete, floats = [], {"m": [], "score": [], "energy": [], "yaw": []}
+    for _ in range(n_cl):
+        discrete.append(b[off:off + 16])  # n_points, seed_pixel, n_rescued, outcome
+        off += 16
+        floats["m"] += struct.unpack_from("<9f", b, off)  # mean, min, max (interleaved)
+        off += 36
+        floats["m"] += struct.unpack_from(f"<{3 * rows}f", b, off)  # proposal points
+        off += 12 * rows
+        for _ in range(3):
+            floats["m"].append(struct.unpack_from("<f", b, off)[0])  # proposal mean
+            discrete.append(b[off + 4:off + 8])  # voxel bin
+            off += 8
+    for _ in range(n_det):
+        discrete.append(b[off:off + 12])  # class, cluster id, n_points
+        score, e_cls, e_box, cx, cy, cz, l, w, h, yaw = struct.unpack_from("<10f", b, off + 12)
+        floats["score"].append(score)
+        floats["energy"] += [e_cls, e_box]
+        floats["m"] += [cx, cy, cz, l, w, h]
+        floats["yaw"].append(yaw)
+        off += 52
+    return (n, n_cl, n_det), points, discrete, floats
+
+
+def ang_diff(a, b):
+    d = math.fmod(a - b, 2.0 * math.pi)
+    if d > math.pi:
+        d -= 2.0 * math.pi
+    elif d < -math.pi:
+        d += 2.0 * math.pi
+    return abs(d)
+
+
+def compare_float(host, arm):
+    """-> (ok, message)"""
+    hc, hp, hd, hf = parse_float_dump(host)
+    ac, ap, ad, af = parse_float_dump(arm)
+    if hc != ac:
+        return False, f"counts differ: host (points, clusters, detections) {hc}, aarch64 {ac}"
+    if hp != ap:
+        return False, "per-point cluster ids or ground flags differ"
+    if hd != ad:
+        return False, "cluster records (counts, outcomes, voxel bins) or detections (class, cluster, points) differ"
+    n_vals = n_same = 0
+    worst = {}
+    bad = []
+    for kind, tol in (("m", ATOL_M), ("score", ATOL_SCORE), ("energy", RTOL_ENERGY), ("yaw", ATOL_RAD)):
+        for x, y in zip(hf[kind], af[kind]):
+            n_vals += 1
+            if struct.pack("<f", x) == struct.pack("<f", y):
+                n_same += 1
+                continue
+            if kind == "yaw":
+                d = ang_diff(x, y)
+            else:
+                d = abs(x - y)
+            lim = tol * max(1.0, abs(x)) if kind == "energy" else tol
+            worst[kind] = max(worst.get(kind, 0.0), d)
+            if not d <= lim:
+                bad.append(f"{kind}: host {x!r} aarch64 {y!r}")
+    msg = f"{n_same}/{n_vals} float values bit-identical"
+    if worst:
+        msg += "; max |diff| " + ", ".join(f"{k} {v:.3g}" for k, v in sorted(worst.items()))
+    if bad:
+        return False, msg + "; beyond the tolerances: " + "; ".join(bad[:5])
+    return True, msg
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--build", help="the aarch64 build folder")
+    ap.add_argument("--tests", default="", help="comma-separated unit test names (tests/unit/test_<name>.c)")
+    ap.add_argument("--src", help="the repository")
+    ap.add_argument("--host-cli", help="this build's lidet (the integer comparison)")
+    ap.add_argument("--host-cli-portable", help="a host lidet with the portable float dense kernel")
+    ap.add_argument("--qemu", default="qemu-aarch64")
+    ap.add_argument("--sysroot", default="/usr/aarch64-linux-gnu")
+    ap.add_argument("--work", help="folder for the dumps (default: <build>/cli_compare)")
+    ap.add_argument("--timeout", type=float, default=600.0, help="seconds per program")
+    ap.add_argument("--skip", help="print this reason and exit 77 (ctest: skipped)")
+    a = ap.parse_args(argv)
+    if a.skip:
+        print(f"SKIPPED aarch64_linux: {a.skip}")
+        return SKIP
+    qemu = shutil.which(a.qemu)
+    if qemu is None:
+        print(f"SKIPPED aarch64_linux: {a.qemu} not found (tools/scripts/install_deps.sh installs qemu-user)")
+        return SKIP
+    if not a.build or not os.path.isdir(a.build):
+        print(f"aarch64_linux: no cross build at {a.build} (cmake --build the main build first)")
+        return 1
+    emu = [qemu, "-L", a.sysroot]
+    failed = []
+    t_all = time.monotonic()
+
+    # 1. the unit tests
+    tdir = os.path.join(a.build, "tests")
+    names = [n for n in a.tests.split(",") if n]
+    t_unit = 0.0
+    for n in names:
+        exe = os.path.join(tdir, f"test_{n}")
+        if not os.path.exists(exe):
+            print(f"FAIL unity_{n}: {exe} not built")
+            failed.append(f"unity_{n}")
+            continue
+        rc, out, dt = run(emu + [exe], cwd=tdir, timeout=a.timeout)
+        t_unit += dt
+        tail = [ln for ln in out.splitlines() if ln.strip()][-2:]
+        print(f"{'ok  ' if rc == 0 else 'FAIL'} unity_{n:<14} {dt:6.2f} s  {' / '.join(tail)}")
+        if rc != 0:
+            print(out)
+            failed.append(f"unity_{n}")
+    print(f"unit tests under qemu-aarch64: {len(names) - sum(f.startswith('unity_') for f in failed)}/{len(names)} "
+          f"passed in {t_unit:.1f} s")
+
+    # 2. the CLI against the host's
+    cli = os.path.join(a.build, "ports", "host", "lidet")
+    if a.host_cli and a.src:
+        work = a.work or os.path.join(a.build, "cli_compare")
+        os.makedirs(work, exist_ok=True)
+        if not os.path.exists(cli):
+            print(f"FAIL cli: {cli} not built")
+            failed.append("cli")
+        for sensor in SCANS if os.path.exists(cli) else ():
+            data = os.path.join(a.src, "tests", "data", f"sim_{sensor}")
+            scan = os.path.join(data, "velodyne", "000000.bin")
+            ring = os.path.join(data, "ring", "000000.bin")
+            runs = [("fixed", ["--fixed"], a.host_cli)]
+            if sensor == "vlp16" and os.path.exists(ring):
+                runs.append(("fixed-returns", ["--fixed", "--ring", ring, "--returns"], a.host_cli))
+            if a.host_cli_portable:
+                runs.append(("float", [], a.host_cli_portable))
+            for label, opts, host in runs:
+                dumps = {}
+                for side, cmd in (("host", [host]), ("aarch64", emu + [cli])):
+                    path = os.path.join(work, f"{sensor}_{label}_{side}.bin")
+                    rc, out, dt = run(cmd + ["detect", scan, "--sensor", sensor, *opts, "--dump", path],
+                                      timeout=a.timeout)
+                    if rc != 0 or not os.path.exists(path):
+                        print(f"FAIL cli {sensor} {label}: {side} run failed ({rc}):\n{out}")
+                        break
+                    with open(path, "rb") as f:
+                        dumps[side] = f.read()
+                if len(dumps) < 2:
+                    failed.append(f"cli {sensor} {label}")
+                    continue
+                if label.startswith("fixed"):
+                    ok = dumps["host"] == dumps["aarch64"]
+                    msg = (f"{len(dumps['host'])} bytes identical" if ok else
+                           f"dumps differ ({work}/{sensor}_{label}_{{host,aarch64}}.bin)")
+                else:
+                    try:
+                        ok, msg = compare_float(dumps["host"], dumps["aarch64"])
+                    except ValueError as e:
+                        ok, msg = False, str(e)
+                print(f"{'ok  ' if ok else 'FAIL'} cli {sensor} detect {' '.join(o for o in opts if '/' not in o) or '(float)'}"
+                      f" vs host{' (portable float kernel)' if label == 'float' else ''}: {msg}")
+                if not ok:
+                    failed.append(f"cli {sensor} {label}")
+    print(f"aarch64_linux: {time.monotonic() - t_all:.1f} s")
+    if failed:
+        print("aarch64_linux: FAIL: " + ", ".join(failed))
+        return 1
+    print("aarch64_linux: PASS")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
