@@ -83,21 +83,9 @@ endif()
 # the host CLI with the portable float dense kernel (this build's, where it has no FMA kernel)
 if(LIDET_NN_CLONES AND LIDET_NN_FMA AND CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64"
    AND CMAKE_C_COMPILER_ID MATCHES "GNU|Clang")
-  file(GLOB a64_cli_sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/ports/host/cli_*.c)
-  file(GLOB a64_weights CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/weights/*.c)
-  add_executable(lidet_cli_portable ${a64_cli_sources} ${PROJECT_SOURCE_DIR}/ports/host/lidet_png.c ${LIDET_SOURCES}
-                                    ${a64_weights})
-  set_target_properties(lidet_cli_portable PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
-  target_include_directories(lidet_cli_portable PRIVATE ${PROJECT_SOURCE_DIR}/lib/include ${PROJECT_SOURCE_DIR}/lib/src
-                                                        ${PROJECT_SOURCE_DIR}/weights ${PROJECT_SOURCE_DIR}/ports/host)
-  target_compile_definitions(lidet_cli_portable PRIVATE _POSIX_C_SOURCE=200809L)
-  lidet_opt_definitions(lidet_cli_portable PRIVATE)
+  lidet_add_cli_copy(lidet_cli_portable)
   # the library's numerics; LIDET_NN_CLONES and LIDET_NN_FMA keep lidet_opt.h's default 0: portable kernels
   target_compile_options(lidet_cli_portable PRIVATE -fno-math-errno -ffp-contract=off)
-  if(LIDET_HAVE_LIBM)
-    target_link_libraries(lidet_cli_portable PRIVATE m)
-  endif()
-  target_link_libraries(lidet_cli_portable PRIVATE lidet_cli_json)
   set(a64_portable $<TARGET_FILE:lidet_cli_portable>)
 else()
   set(a64_portable $<TARGET_FILE:lidet_cli>)

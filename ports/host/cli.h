@@ -89,6 +89,10 @@ void cli_json_num(FILE *f, const char *key, double v);
 void cli_json_int(FILE *f, const char *key, long long v);
 void cli_json_str(FILE *f, const char *key, const char *v);
 void cli_json_end(FILE *f);
+/* one uint32 / float in host byte order into a binary --dump file (detect --dump, --fixed --dump): 0, or -1 when
+ * the write fails */
+int cli_put_u32(FILE *f, uint32_t v);
+int cli_put_f32(FILE *f, float v);
 
 /* `--set KEY=VALUE` overrides of one configuration struct's fields. cli_split_set splits kv into the
  * key length and the number; 0, or 1 when there is no '=' or the value is not a number. Inside a

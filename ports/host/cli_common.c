@@ -340,3 +340,13 @@ void cli_json_end(FILE *f)
 {
     fputs("}\n", f);
 }
+
+int cli_put_u32(FILE *f, uint32_t v)
+{
+    return fwrite(&v, sizeof v, 1, f) == 1 ? 0 : -1;
+}
+
+int cli_put_f32(FILE *f, float v)
+{
+    return fwrite(&v, sizeof v, 1, f) == 1 ? 0 : -1;
+}

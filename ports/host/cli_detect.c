@@ -480,16 +480,6 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
 
 /* ---- --dump: every result of the scan, bit for bit (determinism tests, issue 19) -------------------- */
 
-static int put_u32(FILE *f, uint32_t v)
-{
-    return fwrite(&v, sizeof v, 1, f) == 1 ? 0 : -1;
-}
-
-static int put_f32(FILE *f, float v)
-{
-    return fwrite(&v, sizeof v, 1, f) == 1 ? 0 : -1;
-}
-
 /* Binary, host byte order: "LDTD", n_points, n_clusters, n_detections (uint32); per point its cluster id
  * (uint32) then its ground flag (uint8), 0 past LIDET_MAX_POINTS; per kept cluster n_points, seed_pixel,
  * n_rescued (uint32), mean, min, max (3 float32 each), outcome (uint32), then its proposal (the detector's
@@ -517,28 +507,28 @@ static int write_dump(const char *path, const int32_t *pp, uint32_t n_points)
     f = fopen(path, "wb");
     bad = ids == NULL || gnd == NULL || f == NULL || n_oc != n_cl ||
           lidet_workspace_point_labels(ws, pp, np, ids, gnd) != LIDET_OK;
-    bad = bad || fwrite("LDTD", 1, 4, f) != 4 || put_u32(f, n_points) || put_u32(f, n_cl) || put_u32(f, n_det);
+    bad = bad || fwrite("LDTD", 1, 4, f) != 4 || cli_put_u32(f, n_points) || cli_put_u32(f, n_cl) || cli_put_u32(f, n_det);
     for (i = 0; !bad && i < n_points; ++i)
-        bad = put_u32(f, ids[i]) || fputc(gnd[i], f) == EOF;
+        bad = cli_put_u32(f, ids[i]) || fputc(gnd[i], f) == EOF;
     lidet_proposal_cfg_default(&pc);
     pc.n_points = g_det.cfg.proposal.n_points;
     for (k = 0; !bad && k < n_cl; ++k)
     {
-        bad = put_u32(f, recs[k].n_points) || put_u32(f, recs[k].seed_pixel) || put_u32(f, recs[k].n_rescued) ||
-              put_u32(f, oc[k]);
+        bad = cli_put_u32(f, recs[k].n_points) || cli_put_u32(f, recs[k].seed_pixel) || cli_put_u32(f, recs[k].n_rescued) ||
+              cli_put_u32(f, oc[k]);
         for (i = 0; !bad && i < 3; ++i)
-            bad = put_f32(f, recs[k].mean_m[i]) || put_f32(f, recs[k].min_m[i]) || put_f32(f, recs[k].max_m[i]);
+            bad = cli_put_f32(f, recs[k].mean_m[i]) || cli_put_f32(f, recs[k].min_m[i]) || cli_put_f32(f, recs[k].max_m[i]);
         bad = bad || lidet_workspace_proposal(ws, k, &pc, &prop) != LIDET_OK ||
               fwrite(prop.xyz, sizeof(float) * 3u, prop.n_points, f) != prop.n_points;
         for (i = 0; !bad && i < 3; ++i)
-            bad = put_f32(f, prop.mean_m[i]) || put_u32(f, (uint32_t)(int32_t)prop.voxel[i]);
+            bad = cli_put_f32(f, prop.mean_m[i]) || cli_put_u32(f, (uint32_t)(int32_t)prop.voxel[i]);
     }
     for (k = 0; !bad && k < n_det; ++k)
-        bad = put_u32(f, det[k].cls) || put_u32(f, det[k].cluster_id) || put_u32(f, det[k].n_points) ||
-              put_f32(f, det[k].score) || put_f32(f, det[k].energy_cls) || put_f32(f, det[k].energy_box) ||
-              put_f32(f, det[k].box.cx_m) || put_f32(f, det[k].box.cy_m) || put_f32(f, det[k].box.cz_m) ||
-              put_f32(f, det[k].box.l_m) || put_f32(f, det[k].box.w_m) || put_f32(f, det[k].box.h_m) ||
-              put_f32(f, det[k].box.yaw_rad);
+        bad = cli_put_u32(f, det[k].cls) || cli_put_u32(f, det[k].cluster_id) || cli_put_u32(f, det[k].n_points) ||
+              cli_put_f32(f, det[k].score) || cli_put_f32(f, det[k].energy_cls) || cli_put_f32(f, det[k].energy_box) ||
+              cli_put_f32(f, det[k].box.cx_m) || cli_put_f32(f, det[k].box.cy_m) || cli_put_f32(f, det[k].box.cz_m) ||
+              cli_put_f32(f, det[k].box.l_m) || cli_put_f32(f, det[k].box.w_m) || cli_put_f32(f, det[k].box.h_m) ||
+              cli_put_f32(f, det[k].box.yaw_rad);
     if (f != NULL && fclose(f) != 0)
         bad = 1;
     free(ids);

@@ -234,11 +234,6 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
 /* ---- --fixed --dump: the integer detector's results bit for bit (the float detector's: write_dump in
  * cli_detect.c) ---------------------------------------------------------------------------------------- */
 
-static int put_u32(FILE *f, uint32_t v)
-{
-    return fwrite(&v, sizeof v, 1, f) == 1 ? 0 : -1;
-}
-
 /* Binary, host byte order: "LDTQ", n_points, n_clusters, n_detections (uint32); per point its cluster label
  * (uint32) then its ground flag (uint8), 0 past LIDET_MAX_POINTS; per kept cluster its outcome
  * (lidet_det_outcome_t, uint32); the run's counts (lidet_detector_q_stats_t from n_clusters to n_too_tall, 14
@@ -259,24 +254,24 @@ int cli_detect_q_dump(const char *path, uint32_t n_points, const uint32_t *point
     oc = lidet_detector_q_outcomes(&g_detq, &n_oc);
     bad = f == NULL || dq == NULL || oc == NULL || point_cluster == NULL || point_ground == NULL;
     bad =
-        bad || fwrite("LDTQ", 1, 4, f) != 4 || put_u32(f, n_points) || put_u32(f, n_oc) || put_u32(f, n_det);
+        bad || fwrite("LDTQ", 1, 4, f) != 4 || cli_put_u32(f, n_points) || cli_put_u32(f, n_oc) || cli_put_u32(f, n_det);
     for (i = 0; !bad && i < n_points; ++i)
-        bad = put_u32(f, i < np ? point_cluster[i] : 0u) || fputc(i < np ? point_ground[i] : 0, f) == EOF;
+        bad = cli_put_u32(f, i < np ? point_cluster[i] : 0u) || fputc(i < np ? point_ground[i] : 0, f) == EOF;
     for (i = 0; !bad && i < n_oc; ++i)
-        bad = put_u32(f, oc[i]);
-    bad = bad || put_u32(f, st->n_clusters) || put_u32(f, st->n_out_of_crop) ||
-          put_u32(f, st->n_out_of_range) || put_u32(f, st->n_over_budget) || put_u32(f, st->n_classified) ||
-          put_u32(f, st->n_gate1_rejected) || put_u32(f, st->n_boxed) || put_u32(f, st->n_gate2_rejected) ||
-          put_u32(f, st->n_size_rejected) || put_u32(f, st->n_nms_suppressed) ||
-          put_u32(f, st->n_over_capacity) || put_u32(f, st->n_detections) ||
-          put_u32(f, st->n_over_box_budget) || put_u32(f, st->n_too_tall);
+        bad = cli_put_u32(f, oc[i]);
+    bad = bad || cli_put_u32(f, st->n_clusters) || cli_put_u32(f, st->n_out_of_crop) ||
+          cli_put_u32(f, st->n_out_of_range) || cli_put_u32(f, st->n_over_budget) || cli_put_u32(f, st->n_classified) ||
+          cli_put_u32(f, st->n_gate1_rejected) || cli_put_u32(f, st->n_boxed) || cli_put_u32(f, st->n_gate2_rejected) ||
+          cli_put_u32(f, st->n_size_rejected) || cli_put_u32(f, st->n_nms_suppressed) ||
+          cli_put_u32(f, st->n_over_capacity) || cli_put_u32(f, st->n_detections) ||
+          cli_put_u32(f, st->n_over_box_budget) || cli_put_u32(f, st->n_too_tall);
     for (i = 0; !bad && i < n_det; ++i)
-        bad = put_u32(f, dq[i].cls) || put_u32(f, dq[i].cluster_id) || put_u32(f, dq[i].n_points) ||
-              put_u32(f, (uint32_t)dq[i].score_q15) || put_u32(f, (uint32_t)dq[i].energy_cls_q16) ||
-              put_u32(f, (uint32_t)dq[i].energy_box_q16) || put_u32(f, (uint32_t)dq[i].box.cx_mm) ||
-              put_u32(f, (uint32_t)dq[i].box.cy_mm) || put_u32(f, (uint32_t)dq[i].box.cz_mm) ||
-              put_u32(f, (uint32_t)dq[i].box.l_mm) || put_u32(f, (uint32_t)dq[i].box.w_mm) ||
-              put_u32(f, (uint32_t)dq[i].box.h_mm) || put_u32(f, (uint32_t)dq[i].box.yaw_bam);
+        bad = cli_put_u32(f, dq[i].cls) || cli_put_u32(f, dq[i].cluster_id) || cli_put_u32(f, dq[i].n_points) ||
+              cli_put_u32(f, (uint32_t)dq[i].score_q15) || cli_put_u32(f, (uint32_t)dq[i].energy_cls_q16) ||
+              cli_put_u32(f, (uint32_t)dq[i].energy_box_q16) || cli_put_u32(f, (uint32_t)dq[i].box.cx_mm) ||
+              cli_put_u32(f, (uint32_t)dq[i].box.cy_mm) || cli_put_u32(f, (uint32_t)dq[i].box.cz_mm) ||
+              cli_put_u32(f, (uint32_t)dq[i].box.l_mm) || cli_put_u32(f, (uint32_t)dq[i].box.w_mm) ||
+              cli_put_u32(f, (uint32_t)dq[i].box.h_mm) || cli_put_u32(f, (uint32_t)dq[i].box.yaw_bam);
     if (f != NULL && fclose(f) != 0)
         bad = 1;
     return bad ? -1 : 0;

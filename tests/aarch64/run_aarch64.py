@@ -20,19 +20,19 @@ targets lidet_unit_tests and lidet_cli) is made by the normal build. This script
 Exit status: 0 pass, 1 fail, 77 skipped (qemu-aarch64 or the cross build missing: ctest reports it skipped).
 """
 import argparse
-import math
 import os
+import pathlib
 import shutil
 import struct
 import subprocess
 import sys
 import time
 
+# the firmware comparison's tolerances and angle difference (one definition for both comparisons)
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[2] / "tools" / "firmware"))
+from run_fw import ATOL_M, ATOL_RAD, ATOL_SCORE, RTOL_ENERGY, ang_diff  # noqa: E402
+
 SKIP = 77
-ATOL_M = 1e-3
-ATOL_RAD = 1e-3
-ATOL_SCORE = 1e-4
-RTOL_ENERGY = 1e-4
 SCANS = ("vlp16", "hdl64")
 
 
@@ -80,15 +80,6 @@ def parse_float_dump(b):
         floats["yaw"].append(yaw)
         off += 52
     return (n, n_cl, n_det), points, discrete, floats
-
-
-def ang_diff(a, b):
-    d = math.fmod(a - b, 2.0 * math.pi)
-    if d > math.pi:
-        d -= 2.0 * math.pi
-    elif d < -math.pi:
-        d += 2.0 * math.pi
-    return abs(d)
 
 
 def compare_float(host, arm):

@@ -44,6 +44,12 @@ def _sidewalk_point(b, r):
     return r.uniform(-35, 35), s * r.uniform(d["v_curb"] + 0.4, max(d["v_curb"] + 0.5, d["v_walk_out"] - 0.3))
 
 
+def _box_point(cx, cy, yaw, lx, ly):
+    """Level-frame (x, y) of the point (lx, ly) in the frame of a box centred at (cx, cy) turned by yaw."""
+    c, s = np.cos(yaw), np.sin(yaw)
+    return cx + c * lx - s * ly, cy + s * lx + c * ly
+
+
 def _group(b, r):
     u, v = _sidewalk_point(b, r)
     x0, y0 = b.to_level(u, v)
@@ -98,8 +104,7 @@ def _beside(b, r, anchors):
         lx, ly = r.uniform(-0.45, 0.45) * l, (w / 2 + gap + BODY_R) * r.choice([1, -1])
     else:
         lx, ly = (l / 2 + gap + BODY_R) * r.choice([1, -1]), r.uniform(-0.4, 0.4) * w
-    c, s = np.cos(yaw), np.sin(yaw)
-    x, y = cx + c * lx - s * ly, cy + s * lx + c * ly
+    x, y = _box_point(cx, cy, yaw, lx, ly)
     b.put_level(sh, x, y, float(r.uniform(-np.pi, np.pi)), margin=0.0, body=True, ignore=i)
 
 
@@ -112,8 +117,7 @@ def _cyclist_by_car(b, r, anchors):
     gap = r.uniform(0.3, 1.0)
     side = r.choice([1, -1])
     lx, ly = r.uniform(-0.5, 0.5) * l, side * (w / 2 + gap + 0.3)
-    c, s = np.cos(yaw), np.sin(yaw)
-    x, y = cx + c * lx - s * ly, cy + s * lx + c * ly
+    x, y = _box_point(cx, cy, yaw, lx, ly)
     b.put_level(sh, x, y, yaw + (np.pi if r.random() < 0.5 else 0.0) + r.normal(0, 0.05), margin=0.0, body=True,
                 ignore=i)
 
@@ -161,7 +165,7 @@ def _behind_car(b, r, cars):
     for k in range(n):
         lx = lx0 + (k - (n - 1) / 2.0) * (2 * BODY_R + r.uniform(0.1, 0.5))
         ly = far * (w / 2 + gap + BODY_R + r.normal(0, 0.1))
-        x, y = cx + c * lx - s * ly, cy + s * lx + c * ly
+        x, y = _box_point(cx, cy, yaw, lx, ly)
         if not _near(x, y):
             continue
         sh = ob.pedestrian(r, child=k > 0 and r.random() < 0.2, walking=walking)
