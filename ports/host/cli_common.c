@@ -14,7 +14,8 @@ static void usage(const char *cmd)
             "                 [--out FILE] [--png FILE] [--json] [--repeat N] [--mount-height M]\n"
             "       lidet %s [--sensor NAME | --sensor-file F | --ouster-meta M] [--mount-height M] --print-sensor\n"
             "  SCAN.bin   KITTI velodyne scan: float32 records x, y, z, remission (metres, sensor frame)\n"
-            "  --sensor   hdl64 (default), vlp16, vlp32c, os1-64, os1-128\n"
+            "  --sensor   hdl64 (default), vlp16, vlp32c, hdl32, os0-32, os0-64, os0-128, os1-32, os1-64,\n"
+            "             os1-128, os2-32, os2-64, os2-128 (docs/SENSORS.md)\n"
             "  --sensor-file  a sensor description (JSON, \"format\": \"lidet-sensor\"; docs/SENSORS.md)\n"
             "  --ouster-meta  an Ouster sensor's metadata JSON (beam table, columns; mount height 1.0 m\n"
             "             unless --mount-height)\n"
@@ -136,8 +137,11 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
         a->sensor_profile = lidet_sensor_find(a->sensor);
         if (a->sensor_profile == NULL)
         {
-            fprintf(stderr, "lidet %s: unknown sensor '%s' (known: hdl64, vlp16, vlp32c, os1-64, os1-128)\n", cmd,
-                    a->sensor);
+            uint32_t k;
+            fprintf(stderr, "lidet %s: unknown sensor '%s' (known:", cmd, a->sensor);
+            for (k = 0; lidet_sensor_at(k) != NULL; ++k)
+                fprintf(stderr, "%s %s", k ? "," : "", lidet_sensor_at(k)->name);
+            fprintf(stderr, ")\n");
             return 1;
         }
     }

@@ -106,7 +106,8 @@ Result check_profile(const char *name, std::mt19937 &gen)
 
 int main()
 {
-    const char *names[] = {"hdl64", "vlp16", "vlp32c", "os1-64", "os1-128"};
+    const char *names[] = {"hdl64", "vlp16", "vlp32c", "os1-64", "os1-128", "hdl32", "os0-32",
+                           "os0-64", "os0-128", "os1-32", "os2-32", "os2-64", "os2-128"};
     std::mt19937 gen(12345);
     int failures = 0;
     for (const char *name : names)
@@ -119,6 +120,6 @@ int main()
                     name, r.checked, agree_row, agree_col, r.bad, ok ? "OK" : "FAIL");
         failures += !ok;
     }
-    std::printf("%d passed, %d failed\n", 5 - failures, failures);
+    std::printf("%d passed, %d failed\n", (int)(sizeof names / sizeof names[0]) - failures, failures);
     return failures == 0 ? 0 : 1;
 }

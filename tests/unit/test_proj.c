@@ -10,7 +10,8 @@ LIDET_GUARDED(lidet_proj_t, g);
 static lidet_proj_cfg_t cfg;
 static float pts[4096 * 4];
 
-static const char *const k_names[] = {"hdl64", "vlp16", "vlp32c", "os1-64", "os1-128"};
+static const char *const k_names[] = {"hdl64",  "vlp16",  "vlp32c", "os1-64", "os1-128", "hdl32",  "os0-32",
+                                      "os0-64", "os0-128", "os1-32", "os2-32", "os2-64",  "os2-128"};
 
 void setUp(void)
 {
@@ -356,7 +357,8 @@ static void test_argument_and_config_errors(void)
     TEST_ASSERT_NULL(lidet_sensor_find("nope"));
     TEST_ASSERT_NULL(lidet_sensor_find(NULL));
     TEST_ASSERT_NOT_NULL(lidet_sensor_at(0));
-    TEST_ASSERT_NULL(lidet_sensor_at(5));
+    TEST_ASSERT_NOT_NULL(lidet_sensor_at(sizeof k_names / sizeof k_names[0] - 1));
+    TEST_ASSERT_NULL(lidet_sensor_at(sizeof k_names / sizeof k_names[0]));
     TEST_ASSERT_TRUE(strlen(lidet_status_str(LIDET_ERR_CONFIG)) > 0);
     TEST_ASSERT_EQUAL_UINT32(sizeof(lidet_proj_t), lidet_proj_bytes());
 }

@@ -110,6 +110,13 @@ _HDL64 = np.concatenate([np.linspace(2.5, -7.7, 32), np.linspace(-8.25, -23.5, 3
 # ring 0 = lowest beam.
 _VLP16 = np.arange(-15.0, 15.0 + 1e-9, 2.0)
 
+# Velodyne HDL-32E: -30.67 .. +10.67 deg every 4/3 deg, as its manual lists them (two decimals); ring 0 = lowest.
+_HDL32 = np.array([
+    -30.67, -29.33, -28.00, -26.67, -25.33, -24.00, -22.67, -21.33, -20.00, -18.67, -17.33, -16.00,
+    -14.67, -13.33, -12.00, -10.67, -9.33, -8.00, -6.67, -5.33, -4.00, -2.67, -1.33, 0.00,
+    1.33, 2.67, 4.00, 5.33, 6.67, 8.00, 9.33, 10.67,
+])
+
 # Velodyne VLP-32C: its real non-uniform table (dense around the horizon), ring 0 = lowest.
 _VLP32C = np.array([
     -25.0, -15.639, -11.31, -8.843, -7.254, -6.148, -5.333, -4.667,
@@ -129,6 +136,13 @@ SENSORS: dict[str, Sensor] = {
     # Ouster OS1: uniform +-22.5 deg; ring 0 = top beam (Ouster's convention).
     "os1-64": Sensor("os1-64", 64, 2048, uniform_beams(22.5, -22.5, 64), 1.0, 120.0, _urad_fov(22.5, -22.5)),
     "os1-128": Sensor("os1-128", 128, 2048, uniform_beams(22.5, -22.5, 128), 1.0, 120.0, _urad_fov(22.5, -22.5)),
+    # Velodyne HDL-32E at nuScenes' 20 Hz (a firing cycle every 46.08 us: 1085 per revolution), roof mount 1.84 m.
+    "hdl32": Sensor("hdl32", 32, 1085, _deg(_HDL32), 1.84, 100.0),
+    # Ouster OS0 (+-45 deg), OS1 (+-22.5), OS2 (+-11.25), uniform, at the factory default lidar mode 1024x10.
+    **{f"os{k}-{n}": Sensor(f"os{k}-{n}", n, 1024, uniform_beams(fov, -fov, n), 1.0, rng, _urad_fov(fov, -fov))
+       for k, n, fov, rng in ((0, 32, 45.0, 100.0), (0, 64, 45.0, 100.0), (0, 128, 45.0, 100.0),
+                              (1, 32, 22.5, 120.0), (2, 32, 11.25, 240.0), (2, 64, 11.25, 240.0),
+                              (2, 128, 11.25, 240.0))},
 }
 
 

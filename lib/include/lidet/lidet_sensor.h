@@ -13,7 +13,10 @@
  *
  * Presets (lidet_sensor_find): "hdl64" (KITTI HDL-64E, table measured on real KITTI scans, 2048
  * cols, 1.73 m), "vlp16" (+-15 deg, 1800 cols, 0.5 m robot mount), "vlp32c" (its real
- * non-uniform table, 1800 cols), "os1-64" and "os1-128" (+-22.5 deg uniform, 2048 cols).
+ * non-uniform table, 1800 cols), "os1-64" and "os1-128" (+-22.5 deg uniform, 2048 cols), "hdl32" (HDL-32E,
+ * -30.67 .. +10.67 deg, 1085 cols: nuScenes' 20 Hz, 1.84 m), and the Ouster presets at 1024 cols "os0-32",
+ * "os0-64", "os0-128" (+-45 deg), "os1-32" (+-22.5 deg), "os2-32", "os2-64", "os2-128" (+-11.25 deg), uniform,
+ * 1.0 m. lidet_sensor_at(i) lists them in this order (docs/SENSORS.md).
  * tools/lidet_tools/sensors.py mirrors these tables (tests keep the two identical).
  */
 #ifndef LIDET_SENSOR_H
@@ -41,7 +44,7 @@ typedef struct
 } lidet_sensor_t;
 
 /**
- * @brief Look up a preset by name ("hdl64", "vlp16", "vlp32c", "os1-64", "os1-128").
+ * @brief Look up a preset by name ("hdl64", "vlp16", "os1-64", ...; the file comment).
  * @param[in] name NUL-terminated profile name; may be NULL.
  * @return the preset (static storage, never modify it), or NULL when unknown.
  */

@@ -38,7 +38,8 @@ typedef struct
 } lidet_sensor_q_t;
 
 /**
- * @brief Look up an integer preset by name ("hdl64", "vlp16", "vlp32c", "os1-64", "os1-128").
+ * @brief Look up an integer preset by name (the names of lidet_sensor_find: "hdl64", "vlp16", "vlp32c", "hdl32",
+ *        "os1-64", ...).
  * @return the preset (static storage), or NULL when unknown or name is NULL.
  */
 const lidet_sensor_q_t *lidet_sensor_q_find(const char *name);

@@ -40,6 +40,17 @@ static const float k_vlp32c_elev_rad[32] = {
     0.180344865f,   0.261799395f,
 };
 
+/* Velodyne HDL-32E (nuScenes' sensor): -30.67 .. +10.67 deg every 4/3 deg as its manual lists them (two
+ * decimals), ring 0 = lowest (velodyne_pointcloud's ring). */
+static const float k_hdl32_elev_rad[32] = {
+    -0.535292506f, -0.511905074f,  -0.488692194f,  -0.465479314f,  -0.442091912f, -0.418879032f,
+    -0.395666152f, -0.37227872f,   -0.34906584f,   -0.32585296f,   -0.302465558f, -0.279252678f,
+    -0.256039798f, -0.232652396f,  -0.209439516f,  -0.186226636f,  -0.162839219f, -0.139626339f,
+    -0.116413459f, -0.0930260494f, -0.0698131695f, -0.0466002896f, -0.0232128799f, 0.0f,
+    0.0232128799f, 0.0466002896f,  0.0698131695f,  0.0930260494f,  0.116413459f,  0.139626339f,
+    0.162839219f,  0.186226636f,
+};
+
 #define DEG(d) ((float)(d)*LIDET_DEG2RAD_F)
 
 static const lidet_sensor_t k_presets[] = {
@@ -49,6 +60,17 @@ static const lidet_sensor_t k_presets[] = {
     /* Ouster OS1: uniform +-22.5 deg; ring 0 = top beam (Ouster's convention) */
     {"os1-64", 64u, 2048u, 0, DEG(22.5), DEG(-22.5), 1.0f, 120.0f},
     {"os1-128", 128u, 2048u, 0, DEG(22.5), DEG(-22.5), 1.0f, 120.0f},
+    /* HDL-32E at nuScenes' 20 Hz: a firing cycle every 46.08 us, 1085 per revolution; roof mount 1.84 m */
+    {"hdl32", 32u, 1085u, k_hdl32_elev_rad, 0.0f, 0.0f, 1.84f, 100.0f},
+    /* Ouster OS0 (+-45 deg), OS1 (+-22.5 deg, as os1-64), OS2 (+-11.25 deg), uniform, at the factory default
+     * lidar mode 1024x10; ring 0 = top beam */
+    {"os0-32", 32u, 1024u, 0, DEG(45.0), DEG(-45.0), 1.0f, 100.0f},
+    {"os0-64", 64u, 1024u, 0, DEG(45.0), DEG(-45.0), 1.0f, 100.0f},
+    {"os0-128", 128u, 1024u, 0, DEG(45.0), DEG(-45.0), 1.0f, 100.0f},
+    {"os1-32", 32u, 1024u, 0, DEG(22.5), DEG(-22.5), 1.0f, 120.0f},
+    {"os2-32", 32u, 1024u, 0, DEG(11.25), DEG(-11.25), 1.0f, 240.0f},
+    {"os2-64", 64u, 1024u, 0, DEG(11.25), DEG(-11.25), 1.0f, 240.0f},
+    {"os2-128", 128u, 1024u, 0, DEG(11.25), DEG(-11.25), 1.0f, 240.0f},
 };
 
 #define N_PRESETS (sizeof(k_presets) / sizeof(k_presets[0]))

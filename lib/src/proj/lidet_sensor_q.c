@@ -29,7 +29,16 @@ static const int32_t k_vlp32c_elev_urad[32] = {
     11641,   17453,   23265,   29095,   40719,   58172,   81455,  122173, 180345, 261799,
 };
 
+/* Velodyne HDL-32E (see lidet_sensor.c), ring 0 = lowest */
+static const int32_t k_hdl32_elev_urad[32] = {
+    -535292, -511905, -488692, -465479, -442092, -418879, -395666, -372279, -349066, -325853, -302466,
+    -279253, -256040, -232652, -209440, -186227, -162839, -139626, -116413, -93026,  -69813,  -46600,
+    -23213,  0,       23213,   46600,   69813,   93026,   116413,  139626,  162839,  186227,
+};
+
+#define OS0_FOV_URAD 785398 /* 45 deg */
 #define OS1_FOV_URAD 392699 /* 22.5 deg */
+#define OS2_FOV_URAD 196350 /* 11.25 deg */
 
 static const lidet_sensor_q_t k_presets_q[] = {
     {"hdl64", 64u, 2048u, k_hdl64_elev_urad, 0, 0, 1730, 120000},
@@ -37,6 +46,14 @@ static const lidet_sensor_q_t k_presets_q[] = {
     {"vlp32c", 32u, 1800u, k_vlp32c_elev_urad, 0, 0, 1000, 200000},
     {"os1-64", 64u, 2048u, 0, OS1_FOV_URAD, -OS1_FOV_URAD, 1000, 120000},
     {"os1-128", 128u, 2048u, 0, OS1_FOV_URAD, -OS1_FOV_URAD, 1000, 120000},
+    {"hdl32", 32u, 1085u, k_hdl32_elev_urad, 0, 0, 1840, 100000},
+    {"os0-32", 32u, 1024u, 0, OS0_FOV_URAD, -OS0_FOV_URAD, 1000, 100000},
+    {"os0-64", 64u, 1024u, 0, OS0_FOV_URAD, -OS0_FOV_URAD, 1000, 100000},
+    {"os0-128", 128u, 1024u, 0, OS0_FOV_URAD, -OS0_FOV_URAD, 1000, 100000},
+    {"os1-32", 32u, 1024u, 0, OS1_FOV_URAD, -OS1_FOV_URAD, 1000, 120000},
+    {"os2-32", 32u, 1024u, 0, OS2_FOV_URAD, -OS2_FOV_URAD, 1000, 240000},
+    {"os2-64", 64u, 1024u, 0, OS2_FOV_URAD, -OS2_FOV_URAD, 1000, 240000},
+    {"os2-128", 128u, 1024u, 0, OS2_FOV_URAD, -OS2_FOV_URAD, 1000, 240000},
 };
 
 #define N_PRESETS_Q (sizeof(k_presets_q) / sizeof(k_presets_q[0]))
