@@ -257,10 +257,10 @@ def run(args) -> str:
         "machine after `apt-get update` (314 MB downloaded in 2 s, the rest unpacking; 2.4 GB on disk, most of it "
         "the C libraries' multilib variants: picolibc-riscv64 1.0 GB, newlib-arm 0.37 GB, gcc-arm 0.44 GB). "
         f"Building the {len(reports)} images adds about a minute to `make build` on 2 cores; running them adds about "
-        "a minute to ctest at -j2 (48 s of test time in all, stop 30), most of it the two soft-float images"
+        "a minute to ctest at -j2 (48 s of test time in all), most of it the two soft-float images"
         + (" (M0+ and M3: " + " and ".join(f"{sum(r['scan'] for r in reports[b]['insn'].values()) / 1e9:.1f} G"
                                           for b in ("mps2-an385-m0plus", "mps2-an385"))
-           + " instructions under QEMU for their two runs; 14.6 s and 7.7 s in ctest at -j2, stop 30)"
+           + " instructions under QEMU for their two runs; 14.6 s and 7.7 s in ctest at -j2)"
            if all(b in reports for b in ("mps2-an385-m0plus", "mps2-an385")) else "") + ".",
         "",
         "Commands: `make firmware` (builds every image; or `cmake --build build --target firmware`), "

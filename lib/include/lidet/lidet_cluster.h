@@ -242,7 +242,7 @@ typedef struct
                                        crop sets it to the crop, with azimuth_half_rad the crop + 15 deg: the
                                        margin's pixels are visited only when they join an object that reaches
                                        into the crop (issue 14: clustering 1.02 -> 0.93 ms on the 11 real KITTI
-                                       crops, one pair of runs; docs/DETECTOR.md, "The crop's speed, stop 34") */
+                                       crops, one pair of runs; docs/DETECTOR.md, "The crop's speed") */
     uint32_t max_join_pieces;   /**< join budget (bounds the joins' time whatever the scan): only the first
                                   max_join_pieces car pieces in slot order take part in the joins, the rest
                                   join nothing (stats n_join_skipped); the joins then test at most

@@ -96,6 +96,17 @@
 #define LIDET_MAX_DETECTIONS 128
 #endif
 
+/** Tracker (docs/TRACKING.md): the most tracks it holds. Range [1, 1024]. Default 64. */
+#ifndef LIDET_TRACK_MAX_TRACKS
+#define LIDET_TRACK_MAX_TRACKS 64
+#endif
+
+/** Tracker: the most detections one update takes (the rest are counted and dropped); with
+ *  LIDET_TRACK_MAX_TRACKS it sizes the assignment's cost matrix. Range [1, 1024]. Default 64. */
+#ifndef LIDET_TRACK_MAX_DETS
+#define LIDET_TRACK_MAX_DETS 64
+#endif
+
 /** Bytes of PointNet scratch in the float detector (lidet_detector_t.pn_scratch; the classifier and the box net
  *  share it); init fails with LIDET_ERR_BUFFER when a model needs more (codegen prints <MODEL>_SCRATCH_BYTES).
  *  Range [64, 2^28], a multiple of 4 (an array of floats). Default 16384: lidet's models need 10-13 KiB. */
@@ -384,6 +395,12 @@
 #endif
 #if LIDET_MAX_DETECTIONS < 1 || LIDET_MAX_DETECTIONS > LIDET_MAX_CLUSTERS
 #error "LIDET_MAX_DETECTIONS must be in [1, LIDET_MAX_CLUSTERS]"
+#endif
+#if LIDET_TRACK_MAX_TRACKS < 1 || LIDET_TRACK_MAX_TRACKS > 1024
+#error "LIDET_TRACK_MAX_TRACKS must be in [1, 1024]"
+#endif
+#if LIDET_TRACK_MAX_DETS < 1 || LIDET_TRACK_MAX_DETS > 1024
+#error "LIDET_TRACK_MAX_DETS must be in [1, 1024]"
 #endif
 #if LIDET_DETECTOR_PN_SCRATCH < 64 || LIDET_DETECTOR_PN_SCRATCH > 268435456 ||                               \
     LIDET_DETECTOR_PN_SCRATCH % 4 != 0

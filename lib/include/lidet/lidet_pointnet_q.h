@@ -81,7 +81,7 @@ typedef struct
 #else
 #define LIDET_PNQ_PK(a) 0
 #endif
-/** The layout of the generated int8 layer tables (2: w_pk, from stop 29; 1 had an int8 [out][in] copy,
+/** The layout of the generated int8 layer tables (2: w_pk; 1 had an int8 [out][in] copy,
  *  w_oi): the generated files refuse to compile against another. */
 #define LIDET_PNQ_LAYOUT_VERSION 2
 /* a file of layout 1 names its [out][in] copy through this macro: the compiler's error then names the fix */

@@ -264,7 +264,7 @@ void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, cons
 /* The packed DSP kernel: the weights widened to int16 and ordered as the loop reads them
  * (lidet_pointnet_q_layer_t.w_pk, lidet__nn_pack_s8_pk), two points' inputs widened once per pass into a
  * stack buffer. Per 4 inputs of a pair of points and a pair of channels: 4 words of inputs, 4 of weights and 8
- * SMLAD; no SXTB16 in the inner loop (the [out][in] int8 layout of stop 28 widened inputs and weights there:
+ * SMLAD; no SXTB16 in the inner loop (the former [out][in] int8 layout widened inputs and weights there:
  * 23 instructions per 16 multiply-adds on a Cortex-M4, against about 14 here). */
 #define PK_CHUNK_GROUPS 16u /* 64 inputs per pass: 256 bytes of widened inputs on the stack */
 

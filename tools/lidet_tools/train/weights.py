@@ -46,8 +46,8 @@ FAMILIES = {
     # vlp16s: the small VLP-16 pair for boards without an FPU (issue 17): 32 points per proposal, 9x fewer
     # multiply-adds than vlp16 (classifier 86 k, box net 144 k per proposal), the same scans and schedule;
     # the integer firmware images use it (docs/PORTING.md, "The small VLP-16 pair"). The box net's point MLP
-    # 24-40-64 since stop 31 (24-48-80 before: the same AP, docs/FIXED_POINT.md); the narrower classifiers tried
-    # then (16-32-48 and smaller) lost pedestrian AP or the int8 build's agreement with float at gate 1
+    # is 24-40-64 (24-48-80 gives the same AP, docs/FIXED_POINT.md); the narrower classifiers tried
+    # (16-32-48 and smaller) lost pedestrian AP or the int8 build's agreement with float at gate 1
     "vlp16s": dict(sensor="vlp16",
                    dataset=["--sensor", "vlp16", "--mounts", "0.3,0.5,0.7,1.0", "--sim", "800,200,200", "--seed", "2000",
                             "--n-points", "32"],
