@@ -131,7 +131,7 @@ typedef struct
                                    sector's near plane at the split within this height step (metres) instead of
                                    by the sensor's height above it: a road that climbs or falls beyond the
                                    split; 0 = the height test for far planes too; [0, 5] */
-    float far2_split_m; /**< a third cell per sector: with ring_split_m > 0 and this beyond it, the
+    float far2_split_m;   /**< a third cell per sector: with ring_split_m > 0 and this beyond it, the
                                    far cell's samples at or beyond this range get a plane of their own, judged
                                    where it meets the far plane at this range (far_max_step_m; the sensor-height
                                    test when that is 0), and the pixels at or beyond it take that plane (else the
