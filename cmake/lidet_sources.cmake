@@ -15,7 +15,7 @@
 # images leave it out.
 get_filename_component(LIDET_SRC_DIR "${CMAKE_CURRENT_LIST_DIR}/../lib/src" ABSOLUTE)
 
-set(LIDET_SRC_FOLDERS PROJ GROUND CLUSTER POINTNET DETECTOR NN QMATH COMMON DECODE)
+set(LIDET_SRC_FOLDERS PROJ GROUND CLUSTER POINTNET DETECTOR TRACK NN QMATH COMMON DECODE)
 
 # projection and the sensor presets
 set(LIDET_SRC_PROJ_FLOAT proj/lidet_proj.c proj/lidet_sensor.c)
@@ -34,6 +34,9 @@ set(LIDET_SRC_POINTNET_INT pointnet/lidet_pointnet_q.c pointnet/lidet_pointnet_q
 # the detectors: the float workspace and detector; the integer detector and its post-processing (size check, NMS)
 set(LIDET_SRC_DETECTOR_FLOAT detector/lidet_detector.c detector/lidet_workspace.c)
 set(LIDET_SRC_DETECTOR_INT detector/lidet_detector_q.c detector/lidet_post_q.c)
+# the tracker after the detector (docs/TRACKING.md)
+set(LIDET_SRC_TRACK_FLOAT track/lidet_track.c)
+set(LIDET_SRC_TRACK_INT track/lidet_track_q.c)
 # PointNet kernels: float (portable, x86 clones) and int8
 set(LIDET_SRC_NN_FLOAT nn/lidet_nn_f32.c nn/lidet_nn_f32_x86.c)
 set(LIDET_SRC_NN_INT nn/lidet_nn_s8.c)

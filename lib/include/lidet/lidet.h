@@ -4,7 +4,8 @@
  * @brief lidet: road-user detection in one LiDAR scan on one CPU core or a microcontroller.
  *
  * Umbrella header. The pipeline, each stage callable alone over caller-owned memory:
- *   points -> lidet_proj (range image) -> ground mask -> clusters (proposals) -> PointNets.
+ *   points -> lidet_proj (range image) -> ground mask -> clusters (proposals) -> PointNets
+ *   -> lidet_tracker (tracks across scans, lidet_track.h).
  * Frame: x forward, y left, z up, metres, radians (lidet_types.h). No allocation, no stdio, no
  * double anywhere in the library; capacities are compile-time (lidet_opt.h).
  * Method: Seppänen et al., "No GPU? No problem: an ultra fast 3D detection of road users with a
@@ -31,6 +32,9 @@
 #include "lidet_q.h"
 #include "lidet_sensor.h"
 #include "lidet_sensor_q.h"
+#include "lidet_track.h"
+#include "lidet_track_common.h"
+#include "lidet_track_q.h"
 #include "lidet_types.h"
 #include "lidet_velodyne.h"
 
