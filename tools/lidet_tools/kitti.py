@@ -249,6 +249,45 @@ def write_label2(path, objs: list[KittiObject]) -> None:
             f.write(o.to_line() + "\n")
 
 
+def truncation_level(truncated: float) -> int:
+    """label_2's truncation (a fraction) -> KITTI tracking's level: 0 (<= 0.1), 1 (<= 0.5), 2 (more)."""
+    t = float(truncated)
+    return 0 if t <= 0.1 else (1 if t <= 0.5 else 2)
+
+
+def write_label02(path, rows) -> None:
+    """KITTI tracking labels (label_02/<seq>.txt): one line per (frame, track id, KittiObject) row,
+    `frame id type truncated occluded alpha x1 y1 x2 y2 h w l tx ty tz ry [score]` in the rectified camera frame,
+    truncation as the tracking benchmark's integer level (`truncation_level`), DontCare with id -1."""
+    _ensure_dir(path)
+    with open(path, "w") as f:
+        for frame, tid, o in rows:
+            rest = o.to_line().split(" ", 2)[2]           # the fields after type and truncated
+            f.write(f"{int(frame)} {int(tid)} {o.type} {truncation_level(o.truncated)} {rest}\n")
+
+
+def read_label02(path) -> list[tuple[int, int, KittiObject]]:
+    """Read a KITTI tracking label file: [(frame, track id, KittiObject)] (17 fields, 18 with a score)."""
+    out = []
+    with open(path) as f:
+        for ln, line in enumerate(f, 1):
+            p = line.split()
+            if not p:
+                continue
+            if len(p) not in (17, 18):
+                raise ValueError(f"{path}:{ln}: expected 17 or 18 fields, got {len(p)}")
+            try:
+                frame, tid = int(p[0]), int(p[1])
+                v = [float(x) for x in p[3:]]
+            except ValueError:
+                raise ValueError(f"{path}:{ln}: non-numeric field") from None
+            if not np.all(np.isfinite(v)):
+                raise ValueError(f"{path}:{ln}: non-finite field (nan or inf)")
+            out.append((frame, tid, KittiObject(p[2], v[0], int(v[1]), v[2], np.array(v[3:7]), v[7], v[8], v[9],
+                                                np.array(v[10:13]), v[13], v[14] if len(v) == 15 else None)))
+    return out
+
+
 def _wrap(a):
     return (a + np.pi) % (2.0 * np.pi) - np.pi
 

@@ -4,10 +4,13 @@
     lidet-eval kitti --gt GT_LABEL_DIR --pred PRED_LABEL_DIR [--classes Car,Pedestrian,Cyclist]
                      [--overlap strict|loose] [--flavour kitti|openpcdet] [--frames IDS.txt] [--json]
     lidet-eval boxes --gt GT_BOX_DIR --pred PRED_BOX_DIR [--classes ...] [--overlap kitti|0.25|loose] [--json]
+    lidet-eval track --gt SEQ_DIR [SEQ_DIR ...] --pred PRED_DIR [--range 40] [--min-points 10] [--json]
 
 ``--json`` prints ``{class: {"3d"|"bev"|"2d": {"R11"|"R40": {"easy", "moderate", "hard"}}}}`` (kitti) or
 the same with the distance bands "0-20", "20-40", "40+", "all" as keys (boxes); AP in percent, null
-where a class has no valid ground truth. Without ``--json`` a table is printed.
+where a class has no valid ground truth. Without ``--json`` a table is printed. ``track`` (lidet_tools.track.eval):
+MOTA, MOTP, IDF1, id switches, fragmentations, mostly tracked / lost (py-motmetrics) and velocity errors, per class
+and overall, of tracks matched to the sequences' ground truth by BEV centre distance.
 """
 from __future__ import annotations
 
@@ -53,6 +56,16 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--overlap", choices=sorted(boxes_ap.MIN_OVERLAP), default="kitti",
                    help="kitti: Car 0.7, Ped/Cyc 0.5; 0.25: every class 0.25")
     b.add_argument("--json", action="store_true", help="print the AP dictionary as JSON")
+    t = sub.add_parser("track", help="tracking: CLEAR MOT / IDF1 (py-motmetrics) and velocity errors of sequences")
+    t.add_argument("--gt", required=True, nargs="+", help="sequence folders (lidet-sim --sequence: tracks/, ...)")
+    t.add_argument("--pred", required=True,
+                   help="prediction folder: PRED/<seq>/tracks/<frame>.txt (or PRED/tracks/ for one sequence)")
+    t.add_argument("--classes", default="Car,Pedestrian,Cyclist", type=_classes)
+    t.add_argument("--range", type=float, default=40.0, help="ground truth farther than this (m, BEV) is ignored")
+    t.add_argument("--min-points", type=int, default=10, help="ground truth with fewer points is ignored")
+    t.add_argument("--match", default="", metavar="CLS=M,...",
+                   help="centre-distance thresholds (default Car=2,Pedestrian=1,Cyclist=1.5)")
+    t.add_argument("--json", action="store_true", help="print the results as JSON")
     return p
 
 
@@ -60,6 +73,21 @@ def main(argv=None) -> int:
     args = build_parser().parse_args(argv)
     t0 = time.perf_counter()
     try:
+        if args.cmd == "track":
+            from ..track import eval as tev
+            match = {}
+            for kv in _classes(args.match):
+                k, _, v = kv.partition("=")
+                match[k.strip()] = float(v)
+            res = tev.evaluate_dirs(args.gt, args.pred, classes=tuple(args.classes), match_dist=match,
+                                    max_range_m=args.range, min_points=args.min_points)
+            if args.json:
+                print(tev.to_json(res))
+            else:
+                print(tev.format_table(res, f"Tracking evaluation: {len(args.gt)} sequences, range {args.range:g} m, "
+                                            f">= {args.min_points} points, BEV centre distance"))
+                print(f"({time.perf_counter() - t0:.2f} s)")
+            return 0
         if args.cmd == "kitti":
             bad = set(args.metrics) - set(kitti_ap.METRICS)
             if bad:

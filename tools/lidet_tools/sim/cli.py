@@ -2,9 +2,11 @@
 """lidet-sim: write simulated LiDAR scans with labels in KITTI's folder layout.
 
     lidet-sim --sensor hdl64 --scenes 200 --seed 0 --out data/sim/hdl64
+    lidet-sim --sequence 50 --sensor hdl64 --scenes 4 --seed 0 --out data/sim/seq_hdl64 [--ego-speed 8]
 
 Scan i of a run is fully determined by (--seed, i, options): the same command gives the same bytes,
-and `--start` lets several processes share one long run.
+and `--start` lets several processes share one long run. With --sequence FRAMES, --scenes counts sequences of
+FRAMES scans each whose road users move, ids kept (sequence.py; out/<seq:04d>/...).
 """
 from __future__ import annotations
 
@@ -40,6 +42,16 @@ def build_parser() -> argparse.ArgumentParser:
                         "seen from the waist or chest up (default 0: none)")
     p.add_argument("--range-noise", type=float, default=0.02, help="1-sigma range noise in m")
     p.add_argument("--dropout", type=float, default=0.015, help="random dropout probability")
+    g = p.add_argument_group("sequences (sequence.py)")
+    g.add_argument("--sequence", type=int, default=None, metavar="FRAMES",
+                   help="write --scenes sequences of FRAMES scans each (moving road users, ids kept, tracks/, "
+                        "label_02/, poses.txt) instead of independent scans")
+    g.add_argument("--rate", type=float, default=None, metavar="HZ",
+                   help="scan rate (default the profile's: 10 Hz; vlp16 and vlp32c also 20, hdl32 20)")
+    g.add_argument("--ego-speed", type=float, default=0.0, metavar="M_S",
+                   help="the sensor drives along its lane (a robot: its sidewalk) at this speed (default 0: it stands)")
+    g.add_argument("--ego-yaw-rate", type=float, default=0.05, metavar="RAD_S",
+                   help="peak yaw rate of the driving sensor's gentle weave (default 0.05 rad/s)")
     p.add_argument("--jobs", type=int, default=1,
                    help="worker processes (each scan is independent: the bytes do not depend on --jobs)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -63,6 +75,12 @@ def main(argv=None) -> int:
         return 2
     if a.mount_height is not None and not 0.1 <= a.mount_height <= 5.0:
         print("lidet-sim: --mount-height must be in [0.1, 5] m", file=sys.stderr)
+        return 2
+    if a.sequence is not None:
+        from .sequence import main_from_args
+        return main_from_args(a)
+    if a.rate is not None or a.ego_speed != 0.0:
+        print("lidet-sim: --rate and --ego-speed need --sequence FRAMES", file=sys.stderr)
         return 2
     idx = range(a.start, a.start + a.scenes)
     job = functools.partial(_one, a)

@@ -33,6 +33,8 @@ class ScanResult:
     calib: kitti.Calib
     scene: Scene = field(repr=False, default=None)
     n_points_obj: np.ndarray = field(repr=False, default=None)
+    box_obj: list = field(repr=False, default=None)      # scene object index of each entry of boxes
+    label2_obj: list = field(repr=False, default=None)   # scene object index of each entry of label2
 
 
 def _robot(mount_height_m: float) -> bool:
@@ -65,6 +67,14 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
     scene = make_scene(scene_rng, H, sensor.max_range_m, scene_kind, robot, crowd=crowd, behind_cars=behind_cars)
     sm = SensorModel(sensor, H, float(pitch), float(roll), range_noise_m=range_noise_m, dropout=dropout,
                      min_range_m=0.3 if robot else 1.0)
+    return cast_scene(scene, sm, noise_rng, keep_scene)
+
+
+def cast_scene(scene: Scene, sm: SensorModel, noise_rng, keep_scene: bool = False) -> ScanResult:
+    """Ray cast a built scene (sensor at the origin of its level frame) with a sensor model; noise_rng draws
+    the see-through surfaces and the return model, in that order. `simulate_scan` is make_scene + this; the
+    sequences (sequence.py) call it once per scan with the scene moved into that scan's sensor frame."""
+    sensor = sm.sensor
     grid, row2ring = sm.ray_grid()
     dirs = grid.dirs
     t_max = sensor.max_range_m + 1.0
@@ -146,18 +156,20 @@ def simulate_scan(sensor, seed: int = 0, index: int = 0, mount_height_m: float |
 
     calib = kitti.Calib()
     Rm = sm.R_mount
-    boxes, label2 = [], []
+    boxes, label2, box_obj, label2_obj = [], [], [], []
     for o in scene.objects:
         if not o.label or n_pts_obj[o.obj] == 0:
             continue
         b = _to_sensor_box(o, Rm)
         boxes.append(b)
+        box_obj.append(o.obj)
         vis = vis_cnt[o.obj] / max(any_cnt[o.obj], 1)
         ko = _label2(b, calib, vis)
         if ko is not None:
             label2.append(ko)
+            label2_obj.append(o.obj)
     return ScanResult(pts, sem_k, inst_k, ring_k, boxes, label2, calib,
-                      scene if keep_scene else None, n_pts_obj)
+                      scene if keep_scene else None, n_pts_obj, box_obj, label2_obj)
 
 
 def _to_sensor_box(o, Rm) -> kitti.Box3D:
