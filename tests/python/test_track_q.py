@@ -138,7 +138,7 @@ def quantised(scans):
 def test_cfg_default_matches_c(nq):
     np.testing.assert_array_equal(nq.cfg_default_c(), ref.cfg_to_array(ref.cfg_default()))
     # the float defaults converted give the integer defaults
-    si = dict(meas_sigma_m=[0.30, 0.25, 0.20], accel_sigma_mps2=[4.0, 2.5, 1.5], init_vel_sigma_mps=[10, 6, 3],
+    si = dict(meas_sigma_m=[0.30, 0.25, 0.20], accel_sigma_mps2=[2.0, 2.5, 1.5], init_vel_sigma_mps=[10, 6, 3],
               gate_max_m=[4.0, 3.0, 2.0], gate_chi2=9.21, class_penalty=2.0, birth_min_score=0.0, yaw_alpha=0.5,
               size_alpha=0.3, heading_speed_mps=1.0)
     assert ref.cfg_from(**si) == ref.cfg_default()

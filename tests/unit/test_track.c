@@ -160,7 +160,8 @@ static void test_misses_coast_then_die(void)
     lidet_tracker_cfg_t cfg;
     uint32_t t, n;
     lidet_tracker_cfg_default(&cfg);
-    TEST_ASSERT_EQUAL_UINT32(3, cfg.max_misses);
+    TEST_ASSERT_EQUAL_UINT32(12, cfg.max_misses);
+    cfg.max_misses = 3;
     init_default(&cfg);
     dets[0] = det(LIDET_CLASS_PEDESTRIAN, 5.0f, 1.0f, 0.0f, 0.7f);
     for (t = 0; t < 5u; ++t)

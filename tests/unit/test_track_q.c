@@ -313,7 +313,10 @@ static void test_misses_deaths_confirmation(void)
     const lidet_tracker_q_stats_t *st = lidet_tracker_q_stats(&g.ws);
     uint32_t k, n;
     NEED_CAPACITY();
-    init_default();
+    lidet_tracker_q_cfg_default(&cfg);
+    TEST_ASSERT_EQUAL_UINT32(12u, cfg.max_misses);
+    cfg.max_misses = 3; /* short, to count the misses below */
+    init_cfg(&cfg);
     det[0] = make_det(LIDET_CLASS_CAR, 20000, 0, 0, 30000);
     det[1] = make_det(LIDET_CLASS_CYCLIST, -20000, 5000, 0, 20000);
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_tracker_q_update(&g.ws, det, 2, 100, NULL));
@@ -628,7 +631,7 @@ static void test_extreme_values(void)
     det[0] = make_det(LIDET_CLASS_CAR, 0, 0, 0, 30000);
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_tracker_q_update(&g.ws, det, 1, 100, NULL));
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_tracker_q_update(&g.ws, det, 1, 100, NULL));
-    for (k = 0; k < 3u; ++k)
+    for (k = 0; k < 8u; ++k)
     {
         TEST_ASSERT_EQUAL_INT(LIDET_OK,
                               lidet_tracker_q_update(&g.ws, NULL, 0, LIDET_TRACK_Q_DT_MAX_MS, NULL));

@@ -51,14 +51,14 @@ def cfg_default() -> dict:
     """lidet_tracker_cfg_default (the C field names)."""
     return {
         "meas_sigma_m": [0.30, 0.25, 0.20],
-        "accel_sigma_mps2": [4.0, 2.5, 1.5],
+        "accel_sigma_mps2": [2.0, 2.5, 1.5],
         "init_vel_sigma_mps": [10.0, 6.0, 3.0],
         "gate_max_m": [4.0, 3.0, 2.0],
         "gate_chi2": 9.21,
         "class_penalty": 2.0,
         "assign": ASSIGN_OPTIMAL,
         "confirm_hits": 2,
-        "max_misses": 3,
+        "max_misses": 12,
         "birth_min_score": 0.0,
         "yaw_alpha": 0.5,
         "size_alpha": 0.3,

@@ -119,14 +119,14 @@ def cfg_default() -> dict:
     """lidet_tracker_q_cfg_default (the C field names)."""
     return {
         "meas_sigma_mm": [300, 250, 200],
-        "accel_sigma_mmps2": [4000, 2500, 1500],
+        "accel_sigma_mmps2": [2000, 2500, 1500],
         "init_vel_sigma_mmps": [10000, 6000, 3000],
         "gate_max_mm": [4000, 3000, 2000],
         "gate_chi2_q16": 603587,
         "class_penalty_q16": 2 * ONE_Q16,
         "assign": ASSIGN_OPTIMAL,
         "confirm_hits": 2,
-        "max_misses": 3,
+        "max_misses": 12,
         "birth_min_score_q15": 0,
         "yaw_alpha_q15": 16384,
         "size_alpha_q15": 9830,

@@ -61,7 +61,7 @@ typedef struct
 {
     float meas_sigma_m[LIDET_N_CLASSES];     /**< detection centre noise per axis, metres; [0.001, 100];
                                                     default 0.30, 0.25, 0.20 */
-    float accel_sigma_mps2[LIDET_N_CLASSES]; /**< white-noise acceleration, m/s^2; [0, 100]; default 4.0, 2.5,
+    float accel_sigma_mps2[LIDET_N_CLASSES]; /**< white-noise acceleration, m/s^2; [0, 100]; default 2.0, 2.5,
                                                     1.5 */
     float init_vel_sigma_mps[LIDET_N_CLASSES]; /**< a new track's velocity standard deviation, m/s; [0, 100];
                                                     default 10, 6, 3 */
@@ -72,7 +72,7 @@ typedef struct
     uint32_t assign;                /**< lidet_track_assign_t; default LIDET_TRACK_ASSIGN_OPTIMAL */
     uint32_t confirm_hits;          /**< hits that confirm a tentative track; [1, 1000]; default 2 */
     uint32_t max_misses;            /**< misses in a row a confirmed track survives; [0, 1000];
-                                                    default 3 */
+                                                    default 12 */
     float birth_min_score;          /**< detections scored below start no track; [0, 1]; default 0 */
     float yaw_alpha;                /**< weight of a new yaw in the average; [0, 1]; default 0.5 */
     float size_alpha;               /**< weight of a new z, l, w, h; [0, 1]; default 0.3 */

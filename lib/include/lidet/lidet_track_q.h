@@ -156,9 +156,9 @@ typedef struct
     uint8_t used[LIDET_TRACK_Q_ASSIGN_N + 1];
 } lidet_tracker_q_t;
 
-/** @brief docs/TRACKING.md's defaults in integer units: meas_sigma 300, 250, 200 mm; accel_sigma 4000, 2500,
+/** @brief docs/TRACKING.md's defaults in integer units: meas_sigma 300, 250, 200 mm; accel_sigma 2000, 2500,
  *         1500 mm/s^2; init_vel_sigma 10000, 6000, 3000 mm/s; gate_max 4000, 3000, 2000 mm; gate_chi2 603587
- *         (9.21); class_penalty 131072 (2.0); optimal; confirm_hits 2; max_misses 3; birth_min_score 0;
+ *         (9.21); class_penalty 131072 (2.0); optimal; confirm_hits 2; max_misses 12; birth_min_score 0;
  *         yaw_alpha 16384 (0.5); size_alpha 9830 (0.3); heading_speed 1000 mm/s; pedestrian and cyclist.
  *  @param[out] cfg filled; ignored when NULL. */
 void lidet_tracker_q_cfg_default(lidet_tracker_q_cfg_t *cfg);

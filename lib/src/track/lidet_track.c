@@ -20,7 +20,7 @@
 void lidet_tracker_cfg_default(lidet_tracker_cfg_t *cfg)
 {
     static const float meas[LIDET_N_CLASSES] = {0.30f, 0.25f, 0.20f};
-    static const float accel[LIDET_N_CLASSES] = {4.0f, 2.5f, 1.5f};
+    static const float accel[LIDET_N_CLASSES] = {2.0f, 2.5f, 1.5f};
     static const float vel[LIDET_N_CLASSES] = {10.0f, 6.0f, 3.0f};
     static const float gate[LIDET_N_CLASSES] = {4.0f, 3.0f, 2.0f};
     if (cfg == 0)
@@ -36,7 +36,7 @@ void lidet_tracker_cfg_default(lidet_tracker_cfg_t *cfg)
     cfg->class_penalty = 2.0f;
     cfg->assign = (uint32_t)LIDET_TRACK_ASSIGN_OPTIMAL;
     cfg->confirm_hits = 2u;
-    cfg->max_misses = 3u;
+    cfg->max_misses = 12u;
     cfg->birth_min_score = 0.0f;
     cfg->yaw_alpha = 0.5f;
     cfg->size_alpha = 0.3f;

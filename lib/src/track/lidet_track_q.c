@@ -91,7 +91,7 @@ static int32_t blend(int32_t x, int32_t v, int32_t alpha_q15)
 void lidet_tracker_q_cfg_default(lidet_tracker_q_cfg_t *cfg)
 {
     static const int32_t meas[LIDET_N_CLASSES] = {300, 250, 200};
-    static const int32_t accel[LIDET_N_CLASSES] = {4000, 2500, 1500};
+    static const int32_t accel[LIDET_N_CLASSES] = {2000, 2500, 1500};
     static const int32_t vel[LIDET_N_CLASSES] = {10000, 6000, 3000};
     static const int32_t gate[LIDET_N_CLASSES] = {4000, 3000, 2000};
     if (cfg == 0)
@@ -107,7 +107,7 @@ void lidet_tracker_q_cfg_default(lidet_tracker_q_cfg_t *cfg)
     cfg->class_penalty_q16 = 2 * ONE_Q16;
     cfg->assign = (uint32_t)LIDET_TRACK_ASSIGN_OPTIMAL;
     cfg->confirm_hits = 2;
-    cfg->max_misses = 3;
+    cfg->max_misses = 12;
     cfg->birth_min_score_q15 = 0;
     cfg->yaw_alpha_q15 = 16384; /* 0.5 */
     cfg->size_alpha_q15 = 9830; /* 0.3 */
