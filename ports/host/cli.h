@@ -66,6 +66,9 @@ void cli_sensor_print(const cli_args_t *a, FILE *f);
 /* Reads the scan (and ring file); clear error and 1 on a missing, truncated or odd-sized file. */
 int cli_load(cli_args_t *a);
 void cli_free(cli_args_t *a);
+/* the running subcommand's name (cli_main.c sets it; default "detect"): the shared helpers' messages read
+ * "lidet <cmd>: ..." */
+extern const char *cli_cmd;
 /* Monotonic clock in milliseconds. */
 double cli_now_ms(void);
 /* CPU time of the calling thread in ms (wall time where the platform has no thread clock): timings on
@@ -119,11 +122,62 @@ int cli_cluster_set(lidet_cluster_cfg_t *c, const char *kv);
 /* the same on a ground configuration (cli_ground.c) */
 int cli_ground_set(lidet_ground_cfg_t *c, const char *kv);
 
+/* ---- the detector as `lidet detect` runs it, shared with `lidet track` (cli_detect.c, cli_detect_q.c) ---- */
+/* the class names of lidet_class_t (KITTI's: Car, Cyclist, Pedestrian) */
+extern const char *const cli_class_names[LIDET_N_CLASSES];
+/* the detector's command-line options */
+typedef struct
+{
+    const char *family; /* --model NAME (NULL: the sensor's family) */
+    const char **sets;  /* --set KEY=VALUE: n_sets of them; the caller gives room for argc */
+    int n_sets;
+    int crop;  /* --crop */
+    int fixed; /* --fixed: the integer detector */
+} cli_det_opts_t;
+/* argv[*i] when it is a detector option (--model NAME, --set KEY=VALUE, --crop, --fixed, --range-only,
+ * --cpu-clock): taken into o (or the globals below), *i moved past its value, 1; else 0 */
+int cli_det_option(cli_det_opts_t *o, int argc, char **argv, int *i);
+/* the usage lines of those options */
+void cli_det_usage(FILE *f);
+/* the float configuration of the sensor (a->sensor_profile) with --crop and --set, and the models (--model,
+ * else the sensor's family); --range-only / --returns without --fixed refused. 0, or 1 with a message. */
+int cli_det_config(const cli_args_t *a, const cli_det_opts_t *o, lidet_detector_cfg_t *cfg,
+                   const lidet_pn_model_t **mc, const lidet_pn_model_t **mb, char *chosen, size_t chosen_len);
+/* the float detector (one static lidet_detector_t): init with cfg (its clock set to cli_stage_clock_ns), then
+ * any number of runs on a->points (a->repeat times: ms[] the medians of the LIDET_DET_N_STAGES stage times and
+ * the total); pp (LIDET_MAX_POINTS entries, or NULL) gets each point's pixel for cli_detect_f_ground. det, ds:
+ * the detector's own arrays, valid until the next run. 0, or 1 with a message. */
+int cli_detect_f_init(const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *mc, const lidet_pn_model_t *mb);
+int cli_detect_f_run(const cli_args_t *a, int32_t *pp, double *ms, const lidet_detection_t **det, uint32_t *n_det,
+                     const lidet_detector_stats_t **ds, lidet_status_t *status);
+/* the last float run's ground flag per point (min(n_points, LIDET_MAX_POINTS) entries) from its pp: 0 or 1 */
+int cli_detect_f_ground(const int32_t *pp, uint32_t n_points, uint8_t *point_ground);
+/* the last cli_detect_q_run's detections in integer units (the integer detector's array) */
+const lidet_detection_q_t *cli_detect_q_detections(uint32_t *n_det);
+
+/* ---- KITTI calibration and boxes in the camera frame (cli_detect.c) ---- */
+typedef struct
+{
+    double P2[12], R0[9], Tr[12];
+    int have_p2, have_tr;
+} cli_calib_t;
+/* a KITTI calib file (P2, R0_rect, Tr_velo_to_cam): 0, or 1 with a message */
+int cli_read_calib(const char *path, cli_calib_t *c);
+/* a box in KITTI's label terms: observation angle, 2D box (x1 y1 x2 y2 in the 1242 x 375 image), bottom centre
+ * in the rectified camera frame, rotation_y */
+typedef struct
+{
+    double alpha, bbox[4], loc[3], ry;
+} cli_kitti_t;
+/* a sensor-frame box in the camera frame: 0, or 1 when a corner is behind the camera (z < 0.1 m) */
+int cli_kitti_box(const cli_calib_t *c, const lidet_box_t *b, cli_kitti_t *out);
+
 /* Subcommands */
 int cli_project(int argc, char **argv);
 int cli_ground(int argc, char **argv);
 int cli_cluster(int argc, char **argv);
 int cli_detect(int argc, char **argv);
+int cli_track(int argc, char **argv);
 /* `lidet detect --fixed` (cli_detect_q.c): the scan through the integer detector, results as float detections;
  * ms: LIDET_DET_N_STAGES + 1 medians; point_ground / point_cluster optional (n_points entries). */
 int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, const char *family,
@@ -153,6 +207,24 @@ typedef struct
  * empty label: a swatch sharing the next entry's label). Deterministic for the same inputs. Returns 0 or -1. */
 int cli_bev_write(const char *path, const uint8_t *scene, uint32_t sw, uint32_t sh, float res_m,
                   const char *title, const char *subtitle, const cli_legend_t *items, int n_items);
+/* A scene of a bird's-eye view: w x h RGB pixels of res_m metres, the sensor at the centre, +x up, +y left
+ * (cli_bev.c). Drawing clips at its edges. */
+typedef struct
+{
+    uint8_t *rgb;
+    uint32_t w, h;
+    float res_m;
+} cli_scene_t;
+/* the points' colours: obstacle (grey) and ground (dark) */
+extern const uint8_t cli_rgb_obstacle[3], cli_rgb_ground[3];
+void cli_scene_put(const cli_scene_t *s, int u, int v, const uint8_t c[3]);
+/* a line between two sensor-frame points, two pixels wide */
+void cli_scene_line(const cli_scene_t *s, float x0, float y0, float x1, float y1, const uint8_t c[3]);
+/* a box's outline, with heading: a tick from its centre to its front */
+void cli_scene_box(const cli_scene_t *s, const lidet_box_t *b, const uint8_t c[3], int heading);
+/* points (x, y, z, remission records) as `lidet detect --png` draws them: obstacles grey, ground (ground[i] != 0;
+ * ground NULL: none) dark where no other point is */
+void cli_scene_points(const cli_scene_t *s, const float *pts, uint32_t n, const uint8_t *ground);
 /* the file name of a path (after its last '/') */
 const char *cli_basename(const char *path);
 

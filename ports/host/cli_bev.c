@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The frame of the CLI's bird's-eye-view pictures (cli.h, cli_bev_write): the scene a command drew, put in a
  * larger canvas with a title, axes in metres, a scale bar and a legend, written as a PNG. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -220,6 +221,84 @@ int cli_bev_write(const char *path, const uint8_t *scene, uint32_t sw, uint32_t 
     rc = lidet_png_write_rgb(path, cv.rgb, cv.w, cv.h);
     free(cv.rgb);
     return rc;
+}
+
+/* ---- drawing in a scene (sensor frame -> pixels: +x up, +y left, the sensor at the centre) ---------------- */
+
+const uint8_t cli_rgb_obstacle[3] = {120, 120, 120};
+const uint8_t cli_rgb_ground[3] = {45, 45, 55};
+
+void cli_scene_put(const cli_scene_t *s, int u, int v, const uint8_t c[3])
+{
+    if (u >= 0 && v >= 0 && u < (int)s->w && v < (int)s->h)
+    {
+        uint8_t *p = s->rgb + ((size_t)v * s->w + (size_t)u) * 3u;
+        p[0] = c[0];
+        p[1] = c[1];
+        p[2] = c[2];
+    }
+}
+
+void cli_scene_line(const cli_scene_t *s, float x0, float y0, float x1, float y1, const uint8_t c[3])
+{
+    const float u0 = (float)s->w * 0.5f - y0 / s->res_m, v0 = (float)s->h * 0.5f - x0 / s->res_m;
+    const float u1 = (float)s->w * 0.5f - y1 / s->res_m, v1 = (float)s->h * 0.5f - x1 / s->res_m;
+    const float du = u1 - u0, dv = v1 - v0;
+    int steps, i;
+    /* a line far outside (or not finite: the comparisons fail) is not drawn */
+    if (!(fabsf(du) <= 4.0f * (float)s->w && fabsf(dv) <= 4.0f * (float)s->w))
+        return;
+    steps = (int)(fabsf(du) > fabsf(dv) ? fabsf(du) : fabsf(dv)) + 1;
+    if (steps > 4 * (int)s->w)
+        return;
+    for (i = 0; i <= steps; ++i)
+    {
+        const float t = (float)i / (float)steps;
+        const int u = (int)floorf(u0 + t * du), v = (int)floorf(v0 + t * dv);
+        cli_scene_put(s, u, v, c);
+        cli_scene_put(s, u + 1, v, c);
+    }
+}
+
+void cli_scene_box(const cli_scene_t *s, const lidet_box_t *b, const uint8_t c[3], int heading)
+{
+    const float cy = cosf(b->yaw_rad), sy = sinf(b->yaw_rad);
+    float x[4], y[4];
+    int k;
+    for (k = 0; k < 4; ++k)
+    {
+        const float dx = (k == 0 || k == 3 ? 0.5f : -0.5f) * b->l_m, dy = (k < 2 ? 0.5f : -0.5f) * b->w_m;
+        x[k] = b->cx_m + cy * dx - sy * dy;
+        y[k] = b->cy_m + sy * dx + cy * dy;
+    }
+    for (k = 0; k < 4; ++k)
+        cli_scene_line(s, x[k], y[k], x[(k + 1) % 4], y[(k + 1) % 4], c);
+    if (heading) /* a tick from the centre to the front */
+        cli_scene_line(s, b->cx_m, b->cy_m, 0.5f * (x[0] + x[3]), 0.5f * (y[0] + y[3]), c);
+}
+
+void cli_scene_points(const cli_scene_t *s, const float *pts, uint32_t n, const uint8_t *ground)
+{
+    uint32_t i;
+    for (i = 0; i < n; ++i)
+    {
+        const float x = pts[4 * i], y = pts[4 * i + 1];
+        const float uf = floorf((float)s->w * 0.5f - y / s->res_m);
+        const float vf = floorf((float)s->h * 0.5f - x / s->res_m);
+        int u, v;
+        /* outside the scene (or not finite): nothing to draw, and no float-to-int conversion out of range */
+        if (!(uf >= 0.0f && vf >= 0.0f && uf < (float)s->w && vf < (float)s->h))
+            continue;
+        u = (int)uf;
+        v = (int)vf;
+        if (ground != NULL && ground[i])
+        {
+            if (s->rgb[((size_t)v * s->w + (size_t)u) * 3u] == 0)
+                cli_scene_put(s, u, v, cli_rgb_ground);
+        }
+        else
+            cli_scene_put(s, u, v, cli_rgb_obstacle);
+    }
 }
 
 const char *cli_basename(const char *path)

@@ -252,6 +252,7 @@ double cli_now_ms(void)
     return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
 }
 
+const char *cli_cmd = "detect";
 int cli_stage_clock_cpu = 0;
 int cli_fixed_range_only = 0;
 int cli_fixed_returns = 0;

@@ -2,7 +2,9 @@
 /* `lidet detect`: the whole detector (lidet_detector.h) on one scan, with the models of lidet::weights.
  * Outputs: a table (or --json), lidet's sensor-frame box lines (--out), KITTI label_2 lines in the camera
  * frame with the 2D box of the projected corners (--calib + --kitti-out, so lidet-eval kitti scores them),
- * and a bird's-eye view with the detections and, given --gt, the ground-truth boxes (--png). */
+ * and a bird's-eye view with the detections and, given --gt, the ground-truth boxes (--png). The options, the
+ * configuration and the float run are shared with `lidet track` (cli.h: cli_det_option, cli_det_config,
+ * cli_detect_f_init / _run / _ground), as are the calibration and the camera-frame conversion. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -13,18 +15,12 @@
 
 static lidet_detector_t g_det;
 
-static const char *const k_class_names[LIDET_N_CLASSES] = {"Car", "Cyclist", "Pedestrian"};
+const char *const cli_class_names[LIDET_N_CLASSES] = {"Car", "Cyclist", "Pedestrian"};
 
 
-/* ---- KITTI calibration and label_2 output ------------------------------------------------------ */
+/* ---- KITTI calibration and label_2 output (cli_read_calib, cli_kitti_box: lidet track's label_02 too) ---------- */
 
-typedef struct
-{
-    double P2[12], R0[9], Tr[12];
-    int have_p2, have_tr;
-} calib_t;
-
-static int read_calib(const char *path, calib_t *c)
+int cli_read_calib(const char *path, cli_calib_t *c)
 {
     FILE *f = fopen(path, "r");
     char line[1024];
@@ -33,7 +29,7 @@ static int read_calib(const char *path, calib_t *c)
     c->R0[0] = c->R0[4] = c->R0[8] = 1.0;
     if (f == NULL)
     {
-        fprintf(stderr, "lidet detect: cannot open calibration '%s'\n", path);
+        fprintf(stderr, "lidet %s: cannot open calibration '%s'\n", cli_cmd, path);
         return 1;
     }
     while (fgets(line, sizeof line, f) != NULL)
@@ -76,7 +72,7 @@ static int read_calib(const char *path, calib_t *c)
         }
         if (n != want)
         {
-            fprintf(stderr, "lidet detect: %s:%d: %s needs %d numbers\n", path, ln, line, want);
+            fprintf(stderr, "lidet %s: %s:%d: %s needs %d numbers\n", cli_cmd, path, ln, line, want);
             fclose(f);
             return 1;
         }
@@ -84,14 +80,14 @@ static int read_calib(const char *path, calib_t *c)
     fclose(f);
     if (!c->have_p2 || !c->have_tr)
     {
-        fprintf(stderr, "lidet detect: %s: P2 and Tr_velo_to_cam are required\n", path);
+        fprintf(stderr, "lidet %s: %s: P2 and Tr_velo_to_cam are required\n", cli_cmd, path);
         return 1;
     }
     return 0;
 }
 
 /* sensor frame -> rectified camera frame: R0 (Tr p) */
-static void velo_to_rect(const calib_t *c, const double p[3], double out[3])
+static void velo_to_rect(const cli_calib_t *c, const double p[3], double out[3])
 {
     double q[3];
     int i;
@@ -110,19 +106,17 @@ static double wrap_pi(double a)
     return a;
 }
 
-/* One label_2 line; 0, or 1 when the box is behind the camera (not written). Image 1242 x 375. */
-static int kitti_line(FILE *f, const calib_t *c, const lidet_detection_t *d)
+int cli_kitti_box(const cli_calib_t *c, const lidet_box_t *b, cli_kitti_t *out)
 {
-    const lidet_box_t *b = &d->box;
     const double cy = cos(b->yaw_rad), sy = sin(b->yaw_rad);
-    double ctr[3], loc[3], dir_s[3], dir_r[3], zero[3] = {0, 0, 0}, o_r[3], ry, alpha;
+    double ctr[3], dir_s[3], dir_r[3], zero[3] = {0, 0, 0}, o_r[3];
     double x1 = 1e30, y1 = 1e30, x2 = -1e30, y2 = -1e30;
     int k;
     ctr[0] = b->cx_m;
     ctr[1] = b->cy_m;
     ctr[2] = b->cz_m;
-    velo_to_rect(c, ctr, loc);
-    loc[1] += 0.5 * b->h_m; /* KITTI stores the bottom centre; camera y points down */
+    velo_to_rect(c, ctr, out->loc);
+    out->loc[1] += 0.5 * b->h_m; /* KITTI stores the bottom centre; camera y points down */
     /* heading direction through the rotation part only */
     dir_s[0] = cy;
     dir_s[1] = sy;
@@ -131,8 +125,8 @@ static int kitti_line(FILE *f, const calib_t *c, const lidet_detection_t *d)
     velo_to_rect(c, zero, o_r);
     for (k = 0; k < 3; ++k)
         dir_r[k] -= o_r[k];
-    ry = wrap_pi(atan2(-dir_r[2], dir_r[0]));
-    alpha = wrap_pi(ry - atan2(loc[0], loc[2]));
+    out->ry = wrap_pi(atan2(-dir_r[2], dir_r[0]));
+    out->alpha = wrap_pi(out->ry - atan2(out->loc[0], out->loc[2]));
     for (k = 0; k < 8; ++k)
     {
         const double dx = ((k & 3) == 0 || (k & 3) == 3 ? 0.5 : -0.5) * b->l_m;
@@ -155,13 +149,23 @@ static int kitti_line(FILE *f, const calib_t *c, const lidet_detection_t *d)
         y1 = v < y1 ? v : y1;
         y2 = v > y2 ? v : y2;
     }
-    x1 = x1 < 0 ? 0 : (x1 > 1241 ? 1241 : x1);
-    x2 = x2 < 0 ? 0 : (x2 > 1241 ? 1241 : x2);
-    y1 = y1 < 0 ? 0 : (y1 > 374 ? 374 : y1);
-    y2 = y2 < 0 ? 0 : (y2 > 374 ? 374 : y2);
-    fprintf(f, "%s 0.00 0 %.2f %.2f %.2f %.2f %.2f %.3f %.3f %.3f %.3f %.3f %.3f %.4f %.4f\n", k_class_names[d->cls],
-            alpha, x1, y1, x2, y2, (double)b->h_m, (double)b->w_m, (double)b->l_m, loc[0], loc[1], loc[2], ry,
-            (double)d->score);
+    out->bbox[0] = x1 < 0 ? 0 : (x1 > 1241 ? 1241 : x1);
+    out->bbox[2] = x2 < 0 ? 0 : (x2 > 1241 ? 1241 : x2);
+    out->bbox[1] = y1 < 0 ? 0 : (y1 > 374 ? 374 : y1);
+    out->bbox[3] = y2 < 0 ? 0 : (y2 > 374 ? 374 : y2);
+    return 0;
+}
+
+/* One label_2 line; 0, or 1 when the box is behind the camera (not written). Image 1242 x 375. */
+static int kitti_line(FILE *f, const cli_calib_t *c, const lidet_detection_t *d)
+{
+    const lidet_box_t *b = &d->box;
+    cli_kitti_t k;
+    if (cli_kitti_box(c, b, &k) != 0)
+        return 1;
+    fprintf(f, "%s 0.00 0 %.2f %.2f %.2f %.2f %.2f %.3f %.3f %.3f %.3f %.3f %.3f %.4f %.4f\n", cli_class_names[d->cls],
+            k.alpha, k.bbox[0], k.bbox[1], k.bbox[2], k.bbox[3], (double)b->h_m, (double)b->w_m, (double)b->l_m,
+            k.loc[0], k.loc[1], k.loc[2], k.ry, (double)d->score);
     return 0;
 }
 
@@ -240,7 +244,7 @@ static int read_gt(const char *path, gt_t **out, uint32_t *n)
 }
 
 /* rectified camera frame -> sensor frame: v = Tr_R^T (R0^T r - Tr_t) (both rotations orthonormal) */
-static void rect_to_velo(const calib_t *c, const double r[3], double v[3])
+static void rect_to_velo(const cli_calib_t *c, const double r[3], double v[3])
 {
     double q[3];
     int i;
@@ -251,7 +255,7 @@ static void rect_to_velo(const calib_t *c, const double r[3], double v[3])
 }
 
 /* KITTI label_2 (camera frame, bottom centre) -> sensor-frame boxes; DontCare lines skipped */
-static int read_gt_kitti(const char *path, const calib_t *c, gt_t **out, uint32_t *n)
+static int read_gt_kitti(const char *path, const cli_calib_t *c, gt_t **out, uint32_t *n)
 {
     FILE *f = fopen(path, "r");
     char line[512];
@@ -314,53 +318,6 @@ static int read_gt_kitti(const char *path, const calib_t *c, gt_t **out, uint32_
 #define BEV_H 800u
 #define BEV_RES 0.1f
 
-static void put(uint8_t *rgb, int u, int v, const uint8_t c[3])
-{
-    if (u >= 0 && v >= 0 && u < (int)BEV_W && v < (int)BEV_H)
-    {
-        uint8_t *p = rgb + ((size_t)v * BEV_W + (size_t)u) * 3u;
-        p[0] = c[0];
-        p[1] = c[1];
-        p[2] = c[2];
-    }
-}
-
-static void line_px(uint8_t *rgb, float x0, float y0, float x1, float y1, const uint8_t c[3])
-{
-    /* sensor (x, y) -> pixel (u, v): +x up, +y left */
-    const float u0 = (float)BEV_W * 0.5f - y0 / BEV_RES, v0 = (float)BEV_H * 0.5f - x0 / BEV_RES;
-    const float u1 = (float)BEV_W * 0.5f - y1 / BEV_RES, v1 = (float)BEV_H * 0.5f - x1 / BEV_RES;
-    const float du = u1 - u0, dv = v1 - v0;
-    const int steps = (int)(fabsf(du) > fabsf(dv) ? fabsf(du) : fabsf(dv)) + 1;
-    int i;
-    if (steps > 4 * (int)BEV_W)
-        return;
-    for (i = 0; i <= steps; ++i)
-    {
-        const float t = (float)i / (float)steps;
-        const int u = (int)floorf(u0 + t * du), v = (int)floorf(v0 + t * dv);
-        put(rgb, u, v, c);
-        put(rgb, u + 1, v, c);
-    }
-}
-
-static void draw_box(uint8_t *rgb, const lidet_box_t *b, const uint8_t c[3], int heading)
-{
-    const float cy = cosf(b->yaw_rad), sy = sinf(b->yaw_rad);
-    float x[4], y[4];
-    int k;
-    for (k = 0; k < 4; ++k)
-    {
-        const float dx = (k == 0 || k == 3 ? 0.5f : -0.5f) * b->l_m, dy = (k < 2 ? 0.5f : -0.5f) * b->w_m;
-        x[k] = b->cx_m + cy * dx - sy * dy;
-        y[k] = b->cy_m + sy * dx + cy * dy;
-    }
-    for (k = 0; k < 4; ++k)
-        line_px(rgb, x[k], y[k], x[(k + 1) % 4], y[(k + 1) % 4], c);
-    if (heading) /* a tick from the centre to the front */
-        line_px(rgb, b->cx_m, b->cy_m, 0.5f * (x[0] + x[3]), 0.5f * (y[0] + y[3]), c);
-}
-
 static const uint8_t k_class_rgb[LIDET_N_CLASSES][3] = {{255, 80, 60}, {60, 220, 255}, {255, 220, 40}};
 static const char *const k_class_legend[LIDET_N_CLASSES] = {"car", "cyclist", "pedestrian"};
 
@@ -375,28 +332,22 @@ static int write_png(const char *path, const float *pts, uint32_t n, const uint8
     uint32_t per_class[LIDET_N_CLASSES] = {0};
     int n_legend = 0, k;
     uint8_t *rgb = (uint8_t *)calloc((size_t)BEV_W * BEV_H * 3u, 1);
-    const uint8_t grey[3] = {120, 120, 120}, dark[3] = {45, 45, 55}, green[3] = {60, 230, 90};
+    const uint8_t *grey = cli_rgb_obstacle, *dark = cli_rgb_ground, green[3] = {60, 230, 90};
+    cli_scene_t sc;
     uint32_t i;
     int rc;
     if (rgb == NULL)
         return -1;
-    for (i = 0; i < n; ++i)
-    {
-        const float x = pts[4 * i], y = pts[4 * i + 1];
-        const int u = (int)floorf((float)BEV_W * 0.5f - y / BEV_RES), v = (int)floorf((float)BEV_H * 0.5f - x / BEV_RES);
-        if (ground_pp != NULL && ground_pp[i])
-        {
-            if (u >= 0 && v >= 0 && u < (int)BEV_W && v < (int)BEV_H && rgb[((size_t)v * BEV_W + (size_t)u) * 3u] == 0)
-                put(rgb, u, v, dark);
-        }
-        else
-            put(rgb, u, v, grey);
-    }
+    sc.rgb = rgb;
+    sc.w = BEV_W;
+    sc.h = BEV_H;
+    sc.res_m = BEV_RES;
+    cli_scene_points(&sc, pts, n, ground_pp);
     for (i = 0; i < n_gt; ++i)
-        draw_box(rgb, &gt[i].box, green, 0);
+        cli_scene_box(&sc, &gt[i].box, green, 0);
     for (i = 0; i < n_det; ++i)
     {
-        draw_box(rgb, &det[i].box, k_class_rgb[det[i].cls], 1);
+        cli_scene_box(&sc, &det[i].box, k_class_rgb[det[i].cls], 1);
         per_class[det[i].cls]++;
     }
     snprintf(subtitle, sizeof subtitle, "%u points  %u detections: %u car, %u cyclist, %u pedestrian",
@@ -536,52 +487,78 @@ static int write_dump(const char *path, const int32_t *pp, uint32_t n_points)
     return bad ? -1 : 0;
 }
 
-static void usage_extra(void)
+void cli_det_usage(FILE *f)
 {
-    fprintf(stderr, "  --model NAME     model family: weights cls_NAME + box_NAME (default: the sensor's family,\n"
-                    "                   else hdl64; a --sensor-file's \"model\", else hdl64 for >= 32 rows and\n"
-                    "                   vlp16 below); available:");
+    fprintf(f, "  --model NAME     model family: weights cls_NAME + box_NAME (default: the sensor's family,\n"
+               "                   else hdl64; a --sensor-file's \"model\", else hdl64 for >= 32 rows and\n"
+               "                   vlp16 below); available:");
     {
         uint32_t i;
         for (i = 0; i < LIDET_WEIGHTS_N_MODELS; ++i)
-            fprintf(stderr, " %s", lidet_weights_models[i].name);
+            fprintf(f, " %s", lidet_weights_models[i].name);
     }
-    fprintf(stderr, "\n  --crop           keep the KITTI camera field of view only (|azimuth| <= 45 deg)\n"
-                    "  --calib FILE     KITTI calibration (P2, R0_rect, Tr_velo_to_cam) for --kitti-out\n"
+    fprintf(f, "\n  --crop           keep the KITTI camera field of view only (|azimuth| <= 45 deg)\n"
+               "  --fixed          the integer detector (lidet_detector_q.h: int8 models, no float; the scan\n"
+               "                   converted to millimetres); the same outputs\n"
+               "  --range-only     with --fixed: the range-only pixel of the integer firmware (x, y, z\n"
+               "                   decoded from row, column and range; lidet_detector_q_cfg_t.range_only)\n"
+               "  --cpu-clock      stage and total times (--json *_ms) in this thread's CPU time, not wall time\n"
+               "                   (what other processes on a busy machine do not inflate)\n"
+               "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
+               "                   max_height_extent_m (0: classify tall clusters too),\n"
+               "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
+               "                   gate2_margin (nats added to the models' gates),\n"
+               "                   score_box_weight.car|cyclist|pedestrian (the score's weight on gate 2's\n"
+               "                   margin), score_points_weight.CLASS (on ln(points / 64));\n"
+               "                   stages.cluster.KEY: a\n"
+               "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
+               "                   stages.cluster.split_people=0: no proposal refinement);\n"
+               "                   stages.proj.azimuth_half_rad: the projection's window and\n"
+               "                   stages.ground.seed_per_cell: a RANSAC stream per ground cell (the crop\n"
+               "                   sets both: the clustering's window + one ground sector, and 1)\n"
+               "                   stages.ground.KEY: a lidet_ground_cfg_t field as in lidet ground\n"
+               "                   --set (e.g. stages.ground.far_max_step_m=0: far planes judged by the\n"
+               "                   sensor's height); --fixed takes sample_step, sample_col_step,\n"
+               "                   ransac_iters, refine_iters, far_max_step_m, far2_split_m and the\n"
+               "                   clustering's\n"
+               "                   split_people, join_cars and regrow_* fields, in integer units\n");
+}
+
+static void usage_extra(void)
+{
+    cli_det_usage(stderr);
+    fprintf(stderr, "  --calib FILE     KITTI calibration (P2, R0_rect, Tr_velo_to_cam) for --kitti-out\n"
                     "  --kitti-out FILE label_2 lines in the camera frame (2D box from the projected corners)\n"
                     "  --gt FILE        ground-truth boxes (lidet's sensor-frame lines) drawn in --png\n"
                     "  --gt-kitti FILE  ground truth as KITTI label_2 (with --calib) drawn in --png\n"
-                    "  --fixed          the integer detector (lidet_detector_q.h: int8 models, no float; the scan\n"
-                    "                   converted to millimetres); the same outputs\n"
-                    "  --range-only     with --fixed: the range-only pixel of the integer firmware (x, y, z\n"
-                    "                   decoded from row, column and range; lidet_detector_q_cfg_t.range_only)\n"
                     "  --returns        with --fixed and --ring: the scan fed as the sensor's returns (range,\n"
                     "                   azimuth, ring: lidet_detector_q_run_returns), as the firmware takes it\n"
-                    "  --cpu-clock      stage and total times (--json *_ms) in this thread's CPU time, not wall time\n"
-                    "                   (what other processes on a busy machine do not inflate)\n"
-                    "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
-                    "                   max_height_extent_m (0: classify tall clusters too),\n"
-                    "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
-                    "                   gate2_margin (nats added to the models' gates),\n"
-                    "                   score_box_weight.car|cyclist|pedestrian (the score's weight on gate 2's\n"
-                    "                   margin), score_points_weight.CLASS (on ln(points / 64));\n"
-                    "                   stages.cluster.KEY: a\n"
-                    "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
-                    "                   stages.cluster.split_people=0: no proposal refinement);\n"
-                    "                   stages.proj.azimuth_half_rad: the projection's window and\n"
-                    "                   stages.ground.seed_per_cell: a RANSAC stream per ground cell (the crop\n"
-                    "                   sets both: the clustering's window + one ground sector, and 1)\n"
-                    "                   stages.ground.KEY: a lidet_ground_cfg_t field as in lidet ground\n"
-                    "                   --set (e.g. stages.ground.far_max_step_m=0: far planes judged by the\n"
-                    "                   sensor's height); --fixed takes sample_step, sample_col_step,\n"
-                    "                   ransac_iters, refine_iters, far_max_step_m, far2_split_m and the\n"
-                    "                   clustering's\n"
-                    "                   split_people, join_cars and regrow_* fields, in integer units\n"
                     "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n"
                     "  --dump FILE      every result bit for bit (per-point labels, clusters, proposals,\n"
                     "                   detections; binary, see write_dump in cli_detect.c; with --fixed the\n"
                     "                   integer detector's labels, outcomes, counts and detections,\n"
                     "                   cli_detect_q_dump in cli_detect_q.c)\n");
+}
+
+int cli_det_option(cli_det_opts_t *o, int argc, char **argv, int *i)
+{
+    const char *s = argv[*i];
+    const int has_val = *i + 1 < argc;
+    if (strcmp(s, "--model") == 0 && has_val)
+        o->family = argv[++*i];
+    else if (strcmp(s, "--set") == 0 && has_val)
+        o->sets[o->n_sets++] = argv[++*i];
+    else if (strcmp(s, "--crop") == 0)
+        o->crop = 1;
+    else if (strcmp(s, "--fixed") == 0)
+        o->fixed = 1;
+    else if (strcmp(s, "--range-only") == 0)
+        cli_fixed_range_only = 1;
+    else if (strcmp(s, "--cpu-clock") == 0)
+        cli_stage_clock_cpu = 1;
+    else
+        return 0;
+    return 1;
 }
 
 static int pick_models(const char *family, const char *sensor, const lidet_pn_model_t **cls,
@@ -604,16 +581,98 @@ static int pick_models(const char *family, const char *sensor, const lidet_pn_mo
             return 0;
         }
     }
-    fprintf(stderr, "lidet detect: no models cls_%s / box_%s in weights/ (lidet detect --help lists them)\n",
-            fams[0], fams[0]);
+    fprintf(stderr, "lidet %s: no models cls_%s / box_%s in weights/ (lidet %s --help lists them)\n", cli_cmd,
+            fams[0], fams[0], cli_cmd);
     return 1;
 }
 
-static int fail(cli_args_t *a, const char *what, lidet_status_t st)
+int cli_det_config(const cli_args_t *a, const cli_det_opts_t *o, lidet_detector_cfg_t *cfg,
+                   const lidet_pn_model_t **mc, const lidet_pn_model_t **mb, char *chosen, size_t chosen_len)
 {
-    fprintf(stderr, "lidet detect: %s: %s\n", what, lidet_status_str(st));
-    cli_free(a);
-    return 1;
+    int i;
+    if ((cli_fixed_range_only || cli_fixed_returns) && !o->fixed)
+    {
+        fprintf(stderr, "lidet %s: --%s is a setting of the integer detector: add --fixed\n", cli_cmd,
+                cli_fixed_returns ? "returns" : "range-only");
+        return 1;
+    }
+    /* a file's sensor: its own family (the description's "model", else by rows), without the fallback */
+    if (pick_models(o->family != NULL ? o->family : a->family, a->sensor, mc, mb, chosen, chosen_len) != 0)
+        return 1;
+    lidet_detector_cfg_default(cfg, a->sensor_profile);
+    if (o->crop)
+        cfg->crop_half_rad = (float)(M_PI_D / 4.0);
+    for (i = 0; i < o->n_sets; ++i)
+    {
+        if (apply_set(cfg, o->sets[i]) != 0)
+        {
+            fprintf(stderr, "lidet %s: bad --set '%s' (KEY=VALUE with a lidet_detector_cfg_t field)\n", cli_cmd,
+                    o->sets[i]);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+int cli_detect_f_init(const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *mc, const lidet_pn_model_t *mb)
+{
+    lidet_detector_cfg_t c = *cfg;
+    lidet_status_t st;
+    c.clock = cli_stage_clock_ns;
+    st = lidet_detector_init(&g_det, &c, mc, mb);
+    if (st != LIDET_OK)
+    {
+        fprintf(stderr, "lidet %s: init (configuration or models): %s\n", cli_cmd, lidet_status_str(st));
+        return 1;
+    }
+    return 0;
+}
+
+int cli_detect_f_run(const cli_args_t *a, int32_t *pp, double *ms, const lidet_detection_t **det, uint32_t *n_det,
+                     const lidet_detector_stats_t **ds, lidet_status_t *status)
+{
+    const int repeat = a->repeat > 0 ? a->repeat : 1;
+    const lidet_detector_stats_t *s;
+    double *t = (double *)malloc(sizeof(double) * (size_t)repeat * (LIDET_DET_N_STAGES + 1u));
+    uint32_t k;
+    int i;
+    if (t == NULL)
+    {
+        fprintf(stderr, "lidet %s: out of memory\n", cli_cmd);
+        return 1;
+    }
+    for (i = 0; i < repeat; ++i)
+    {
+        const double t0 = cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms();
+        *status = lidet_detector_run(&g_det, a->points, a->n_points, 4, a->ring, i == 0 ? pp : NULL);
+        t[(size_t)LIDET_DET_N_STAGES * (size_t)repeat + (size_t)i] =
+            (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - t0;
+        if (!LIDET_SUCCEEDED(*status))
+        {
+            fprintf(stderr, "lidet %s: detector: %s\n", cli_cmd, lidet_status_str(*status));
+            free(t);
+            return 1;
+        }
+        s = lidet_detector_stats(&g_det);
+        for (k = 0; k < LIDET_DET_N_STAGES; ++k)
+            t[(size_t)k * (size_t)repeat + (size_t)i] = (double)s->ticks[k] * 1e-6;
+    }
+    for (k = 0; k <= LIDET_DET_N_STAGES; ++k)
+        ms[k] = cli_median(t + (size_t)k * (size_t)repeat, repeat);
+    free(t);
+    *ds = lidet_detector_stats(&g_det);
+    *det = lidet_detector_detections(&g_det, n_det);
+    return 0;
+}
+
+int cli_detect_f_ground(const int32_t *pp, uint32_t n_points, uint8_t *point_ground)
+{
+    const uint32_t np = n_points < LIDET_MAX_POINTS ? n_points : LIDET_MAX_POINTS;
+    uint32_t *ids = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(np + 1u));
+    int rc = ids == NULL ||
+             lidet_workspace_point_labels(lidet_detector_workspace(&g_det), pp, np, ids, point_ground) != LIDET_OK;
+    free(ids);
+    return rc;
 }
 
 int cli_detect(int argc, char **argv)
@@ -624,33 +683,33 @@ int cli_detect(int argc, char **argv)
     const lidet_detector_stats_t *ds;
     const lidet_detection_t *det;
     lidet_status_t st = LIDET_OK;
-    const char *family = NULL, *calib_path = NULL, *kitti_path = NULL, *gt_path = NULL, *gt_kitti_path = NULL,
-               *dump_path = NULL;
+    const char *calib_path = NULL, *kitti_path = NULL, *gt_path = NULL, *gt_kitti_path = NULL, *dump_path = NULL;
     char chosen[64];
     char **rest;
-    const char **sets;
-    int nrest = 0, nsets = 0, i, crop = 0, fixed = 0;
+    cli_det_opts_t o;
+    int nrest = 0, i, fixed = 0;
     static lidet_detection_t det_q[LIDET_MAX_DETECTIONS];
     static lidet_detector_stats_t ds_q;
-    double *t, ms[LIDET_DET_N_STAGES + 1];
+    double ms[LIDET_DET_N_STAGES + 1];
     uint32_t n_det = 0, k;
     int32_t *pp = NULL;
     uint8_t *gp = NULL;
     uint32_t *gp_ids = NULL; /* --fixed --dump: the integer run's per-point cluster labels */
 
+    memset(&o, 0, sizeof o);
     rest = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
-    sets = (const char **)malloc(sizeof(char *) * (size_t)(argc + 1));
-    if (rest == NULL || sets == NULL)
+    o.sets = (const char **)malloc(sizeof(char *) * (size_t)(argc + 1));
+    if (rest == NULL || o.sets == NULL)
     {
         free(rest);
-        free(sets);
+        free((void *)o.sets);
         return 1;
     }
     for (i = 0; i < argc; ++i)
     {
-        if (strcmp(argv[i], "--model") == 0 && i + 1 < argc)
-            family = argv[++i];
-        else if (strcmp(argv[i], "--calib") == 0 && i + 1 < argc)
+        if (cli_det_option(&o, argc, argv, &i))
+            continue;
+        if (strcmp(argv[i], "--calib") == 0 && i + 1 < argc)
             calib_path = argv[++i];
         else if (strcmp(argv[i], "--kitti-out") == 0 && i + 1 < argc)
             kitti_path = argv[++i];
@@ -658,77 +717,41 @@ int cli_detect(int argc, char **argv)
             gt_path = argv[++i];
         else if (strcmp(argv[i], "--gt-kitti") == 0 && i + 1 < argc)
             gt_kitti_path = argv[++i];
-        else if (strcmp(argv[i], "--set") == 0 && i + 1 < argc)
-            sets[nsets++] = argv[++i];
         else if (strcmp(argv[i], "--dump") == 0 && i + 1 < argc)
             dump_path = argv[++i];
-        else if (strcmp(argv[i], "--crop") == 0)
-            crop = 1;
-        else if (strcmp(argv[i], "--fixed") == 0)
-            fixed = 1;
-        else if (strcmp(argv[i], "--range-only") == 0)
-            cli_fixed_range_only = 1;
         else if (strcmp(argv[i], "--returns") == 0)
             cli_fixed_returns = 1;
-        else if (strcmp(argv[i], "--cpu-clock") == 0)
-            cli_stage_clock_cpu = 1;
         else
             rest[nrest++] = argv[i];
     }
+    fixed = o.fixed;
     i = cli_parse(nrest, rest, "detect", &a);
     if (i == 2 || i == 3) /* --print-sensor done, or a sensor file's error printed */
     {
         free(rest);
-        free(sets);
+        free((void *)o.sets);
         return i == 2 ? 0 : 1;
     }
     if (i != 0)
     {
         usage_extra();
         free(rest);
-        free(sets);
+        free((void *)o.sets);
         return 1;
     }
     free(rest);
-    if ((cli_fixed_range_only || cli_fixed_returns) && !fixed)
-    {
-        fprintf(stderr, "lidet detect: --%s is a setting of the integer detector: add --fixed\n",
-                cli_fixed_returns ? "returns" : "range-only");
-        free(sets);
+    /* --range-only / --returns without --fixed, the models, --crop and --set */
+    i = cli_det_config(&a, &o, &cfg, &mc, &mb, chosen, sizeof chosen);
+    free((void *)o.sets);
+    if (i != 0)
         return 1;
-    }
     if ((kitti_path != NULL || gt_kitti_path != NULL) && calib_path == NULL)
     {
         fprintf(stderr, "lidet detect: --kitti-out and --gt-kitti need --calib\n");
-        free(sets);
         return 1;
     }
     if (cli_load(&a) != 0)
-    {
-        free(sets);
         return 1;
-    }
-    /* a file's sensor: its own family (the description's "model", else by rows), without the fallback */
-    if (pick_models(family != NULL ? family : a.family, a.sensor, &mc, &mb, chosen, sizeof chosen) != 0)
-    {
-        free(sets);
-        cli_free(&a);
-        return 1;
-    }
-    lidet_detector_cfg_default(&cfg, a.sensor_profile);
-    if (crop)
-        cfg.crop_half_rad = (float)(M_PI_D / 4.0);
-    for (i = 0; i < nsets; ++i)
-    {
-        if (apply_set(&cfg, sets[i]) != 0)
-        {
-            fprintf(stderr, "lidet detect: bad --set '%s' (KEY=VALUE with a lidet_detector_cfg_t field)\n", sets[i]);
-            free(sets);
-            cli_free(&a);
-            return 1;
-        }
-    }
-    free(sets);
     if (fixed)
     {
         /* the integer detector; per-point ground labels for the picture come with it */
@@ -749,47 +772,21 @@ int cli_detect(int argc, char **argv)
         strncat(chosen, " int8", sizeof chosen - strlen(chosen) - 1u);
         goto outputs;
     }
-    cfg.clock = cli_stage_clock_ns;
-    st = lidet_detector_init(&g_det, &cfg, mc, mb);
-    if (st != LIDET_OK)
-        return fail(&a, "init (configuration or models)", st);
-
-    t = (double *)malloc(sizeof(double) * (size_t)a.repeat * (LIDET_DET_N_STAGES + 1u));
     pp = (int32_t *)malloc(sizeof(int32_t) * LIDET_MAX_POINTS);
-    if (t == NULL || pp == NULL)
+    if (pp == NULL || cli_detect_f_init(&cfg, mc, mb) != 0 ||
+        cli_detect_f_run(&a, pp, ms, &det, &n_det, &ds, &st) != 0)
     {
-        free(t);
         free(pp);
         cli_free(&a);
         return 1;
     }
-    for (i = 0; i < a.repeat; ++i)
-    {
-        const double t0 = cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms();
-        st = lidet_detector_run(&g_det, a.points, a.n_points, 4, a.ring, i == 0 ? pp : NULL);
-        t[(size_t)LIDET_DET_N_STAGES * (size_t)a.repeat + (size_t)i] = (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - t0;
-        if (!LIDET_SUCCEEDED(st))
-        {
-            free(t);
-            free(pp);
-            return fail(&a, "detector", st);
-        }
-        ds = lidet_detector_stats(&g_det);
-        for (k = 0; k < LIDET_DET_N_STAGES; ++k)
-            t[(size_t)k * (size_t)a.repeat + (size_t)i] = (double)ds->ticks[k] * 1e-6;
-    }
-    for (k = 0; k <= LIDET_DET_N_STAGES; ++k)
-        ms[k] = cli_median(t + (size_t)k * (size_t)a.repeat, a.repeat);
-    free(t);
-    ds = lidet_detector_stats(&g_det);
-    det = lidet_detector_detections(&g_det, &n_det);
 
 outputs:
     if (a.out_path != NULL)
     {
         FILE *f = fopen(a.out_path, "w");
         for (k = 0; f != NULL && k < n_det; ++k)
-            fprintf(f, "%s %.4f %.4f %.4f %.4f %.4f %.4f %.5f %.4f\n", k_class_names[det[k].cls],
+            fprintf(f, "%s %.4f %.4f %.4f %.4f %.4f %.4f %.5f %.4f\n", cli_class_names[det[k].cls],
                     (double)det[k].box.cx_m, (double)det[k].box.cy_m, (double)det[k].box.cz_m, (double)det[k].box.l_m,
                     (double)det[k].box.w_m, (double)det[k].box.h_m, (double)det[k].box.yaw_rad, (double)det[k].score);
         if (f == NULL || fclose(f) != 0)
@@ -814,10 +811,10 @@ outputs:
     gp_ids = NULL;
     if (kitti_path != NULL)
     {
-        calib_t c;
+        cli_calib_t c;
         FILE *f;
         uint32_t written = 0;
-        if (read_calib(calib_path, &c) != 0)
+        if (cli_read_calib(calib_path, &c) != 0)
         {
             free(pp);
             cli_free(&a);
@@ -839,9 +836,8 @@ outputs:
     if (a.png_path != NULL)
     {
         gt_t *gt = NULL;
-        calib_t gcal;
+        cli_calib_t gcal;
         uint32_t n_gt = 0, np = a.n_points < LIDET_MAX_POINTS ? a.n_points : LIDET_MAX_POINTS;
-        uint32_t *ids = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(np + 1u));
         char title[256];
         snprintf(title, sizeof title, "detect%s  %s  %s (models %s)  %.1f ms", fixed ? " --fixed" : "",
                  cli_basename(a.scan_path), a.sensor, chosen, ms[LIDET_DET_N_STAGES]);
@@ -851,24 +847,20 @@ outputs:
             gp = (uint8_t *)malloc((size_t)np + 1u);
         else
             fixed = 2; /* the integer run filled gp */
-        if (ids == NULL || gp == NULL ||
-            (fixed != 2 &&
-             lidet_workspace_point_labels(lidet_detector_workspace(&g_det), pp, np, ids, gp) != LIDET_OK) ||
+        if (gp == NULL || (fixed != 2 && cli_detect_f_ground(pp, a.n_points, gp) != 0) ||
             (gt_path != NULL && read_gt(gt_path, &gt, &n_gt) != 0) ||
             (gt_kitti_path != NULL &&
-             (read_calib(calib_path, &gcal) != 0 || read_gt_kitti(gt_kitti_path, &gcal, &gt, &n_gt) != 0)) ||
+             (cli_read_calib(calib_path, &gcal) != 0 || read_gt_kitti(gt_kitti_path, &gcal, &gt, &n_gt) != 0)) ||
             write_png(a.png_path, a.points, np, gp, det, n_det, gt, n_gt,
                       gt_path != NULL || gt_kitti_path != NULL, title, a.n_points) != 0)
         {
             fprintf(stderr, "lidet detect: cannot write the picture '%s'\n", a.png_path);
-            free(ids);
             free(gp);
             free(gt);
             free(pp);
             cli_free(&a);
             return 1;
         }
-        free(ids);
         free(gt);
     }
     {
@@ -921,7 +913,7 @@ outputs:
                     "%s{\"class\": \"%s\", \"score\": %.5f, \"energy_cls\": %.4f, \"energy_box\": %.4f, "
                     "\"x\": %.4f, \"y\": %.4f, \"z\": %.4f, \"l\": %.4f, \"w\": %.4f, \"h\": %.4f, \"yaw\": %.5f, "
                     "\"cluster\": %u, \"cluster_points\": %u}",
-                    k ? ", " : "", k_class_names[det[k].cls], (double)det[k].score, (double)det[k].energy_cls,
+                    k ? ", " : "", cli_class_names[det[k].cls], (double)det[k].score, (double)det[k].energy_cls,
                     (double)det[k].energy_box, (double)det[k].box.cx_m, (double)det[k].box.cy_m,
                     (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m, (double)det[k].box.h_m,
                     (double)det[k].box.yaw_rad, det[k].cluster_id, det[k].n_points);
@@ -947,7 +939,7 @@ outputs:
                    "y", "z", "l", "w", "h", "yaw", "points");
         for (k = 0; k < n_det; ++k)
             printf("  %-10s %6.3f %8.3f %8.3f %7.2f %7.2f %7.2f %5.2f %5.2f %5.2f %7.3f %6u\n",
-                   k_class_names[det[k].cls], (double)det[k].score, (double)det[k].energy_cls,
+                   cli_class_names[det[k].cls], (double)det[k].score, (double)det[k].energy_cls,
                    (double)det[k].energy_box, (double)det[k].box.cx_m, (double)det[k].box.cy_m,
                    (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m, (double)det[k].box.h_m,
                    (double)det[k].box.yaw_rad, det[k].n_points);

@@ -60,7 +60,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     int i;
     if (s == NULL)
     {
-        fprintf(stderr, "lidet detect --fixed: no integer profile for sensor '%s'\n", a->sensor);
+        fprintf(stderr, "lidet %s --fixed: no integer profile for sensor '%s'\n", cli_cmd, a->sensor);
         return 1;
     }
     snprintf(name, sizeof name, "cls_%s_s8", family);
@@ -69,7 +69,8 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     mb = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, name);
     if (mc == NULL || mb == NULL)
     {
-        fprintf(stderr, "lidet detect --fixed: no int8 models cls_%s_s8 / box_%s_s8 in weights/\n", family, family);
+        fprintf(stderr, "lidet %s --fixed: no int8 models cls_%s_s8 / box_%s_s8 in weights/\n", cli_cmd, family,
+                family);
         return 1;
     }
     if (a->mount_height_m >= 0.0) /* --mount-height, in mm as the integer profile holds it */
@@ -118,7 +119,8 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     *status = lidet_detector_q_init(&g_detq, &cfg, mc, mb);
     if (*status != LIDET_OK)
     {
-        fprintf(stderr, "lidet detect --fixed: init (configuration or models): %s\n", lidet_status_str(*status));
+        fprintf(stderr, "lidet %s --fixed: init (configuration or models): %s\n", cli_cmd,
+                lidet_status_str(*status));
         return 1;
     }
     pts = (int32_t *)malloc(sizeof(int32_t) * 3u * (size_t)(np + 1u));
@@ -169,7 +171,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
         t[(size_t)LIDET_DET_N_STAGES * (size_t)a->repeat + (size_t)i] = (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - t0;
         if (!LIDET_SUCCEEDED(*status))
         {
-            fprintf(stderr, "lidet detect --fixed: %s\n", lidet_status_str(*status));
+            fprintf(stderr, "lidet %s --fixed: %s\n", cli_cmd, lidet_status_str(*status));
             free(pts);
             free(pp);
             free(t);
@@ -229,6 +231,11 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     free(pp);
     free(rets);
     return 0;
+}
+
+const lidet_detection_q_t *cli_detect_q_detections(uint32_t *n_det)
+{
+    return lidet_detector_q_detections(&g_detq, n_det);
 }
 
 /* ---- --fixed --dump: the integer detector's results bit for bit (the float detector's: write_dump in

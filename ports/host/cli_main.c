@@ -16,6 +16,7 @@ static const cli_cmd_t k_cmds[] = {
     {"ground", cli_ground, "ground segmentation: points -> ground mask per point"},
     {"cluster", cli_cluster, "depth clustering + proposals: non-ground pixels -> clusters"},
     {"detect", cli_detect, "the whole detector: points -> road users with 3D boxes"},
+    {"track", cli_track, "detector + tracker over a sequence of scans: ids, velocities (docs/TRACKING.md)"},
 };
 
 int main(int argc, char **argv)
@@ -32,12 +33,14 @@ int main(int argc, char **argv)
         {
             if (strcmp(argv[1], k_cmds[i].name) == 0)
             {
+                cli_cmd = k_cmds[i].name;
                 return k_cmds[i].fn(argc - 2, argv + 2);
             }
         }
         fprintf(stderr, "lidet: unknown command '%s'\n", argv[1]);
     }
-    fprintf(stderr, "usage: lidet COMMAND SCAN.bin [options]   (lidet COMMAND --help)\ncommands:\n");
+    fprintf(stderr, "usage: lidet COMMAND SCAN.bin [options]   (lidet COMMAND --help; lidet track SCANS... | DIR)\n"
+                    "commands:\n");
     for (i = 0; i < sizeof k_cmds / sizeof k_cmds[0]; ++i)
     {
         fprintf(stderr, "  %-10s %s\n", k_cmds[i].name, k_cmds[i].help);

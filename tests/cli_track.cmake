@@ -1,0 +1,45 @@
+# SPDX-License-Identifier: MIT
+# `lidet track` (ports/host/cli_track.c, docs/TRACKING.md) smoke test: the simulated HDL-64 scan three times (a
+# standing scene) gives confirmed tracks at the second scan; two CLIs (this build's and the -O0 one) write the same
+# track files and KITTI tracking labels, float and --fixed, and a picture.
+# Usage: cmake -DA=cli_a -DB=cli_b -DSRC=<repo> -DWORK=<dir> -P cli_track.cmake
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK}/seq/velodyne ${WORK}/seq/calib)
+foreach(k 000000 000001 000002)
+  configure_file(${SRC}/tests/data/sim_hdl64/velodyne/000000.bin ${WORK}/seq/velodyne/${k}.bin COPYONLY)
+  configure_file(${SRC}/tests/data/sim_hdl64/calib/000000.txt ${WORK}/seq/calib/${k}.txt COPYONLY)
+endforeach()
+foreach(mode float fixed)
+  if(mode STREQUAL "fixed")
+    set(opt --fixed)
+  else()
+    set(opt)
+  endif()
+  foreach(side A B)
+    execute_process(COMMAND ${${side}} track ${WORK}/seq ${opt} --out ${WORK}/${mode}_${side}
+                            --png ${WORK}/${mode}_${side}.png
+                    RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR "${${side}} track ${WORK}/seq ${opt} failed (${rc}): ${err}")
+    endif()
+  endforeach()
+  file(STRINGS ${WORK}/${mode}_A/000001.txt lines)
+  list(LENGTH lines n)
+  if(n LESS 1)
+    message(FATAL_ERROR "track ${mode}: no confirmed track at the second scan of a standing scene")
+  endif()
+  foreach(f 000000.txt 000001.txt 000002.txt tracks/000002.txt label_02.txt)
+    execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/${mode}_A/${f} ${WORK}/${mode}_B/${f}
+                    RESULT_VARIABLE same)
+    if(NOT same EQUAL 0)
+      message(FATAL_ERROR "track ${mode}: ${A} and ${B} write different ${f} (${WORK}/${mode}_[AB])")
+    endif()
+  endforeach()
+  # the pictures: made (their bytes differ where one CLI has libpng and the other the uncompressed writer)
+  foreach(side A B)
+    if(NOT EXISTS ${WORK}/${mode}_${side}.png)
+      message(FATAL_ERROR "track ${mode}: ${${side}} wrote no picture")
+    endif()
+  endforeach()
+  message(STATUS "track ${mode}: ${n} tracks at the second scan, the same files from both CLIs")
+endforeach()
