@@ -15,6 +15,19 @@
  *                                                       integer build prints its int32 values (score Q15, mm,
  *                                                       BAM32 yaw, Q16 energies) as 32-bit hex
  *   insn run=R project=.. ground=.. cluster=.. classify=.. box=.. post=.. scan=..   instructions per stage
+ *   track run=R dets=N updates=U insn_...=.. tracks=T confirmed=C births=.. ...   the tracker after the detector
+ *                                                       (lidet_tracker_q with LIDET_FIXED_POINT, else lidet_tracker):
+ *                                                       run "default" = two updates on run default's detections
+ *                                                       (the same scan twice, dt 0.1 s), run "synthetic" = 32 road
+ *                                                       users over 20 scans at 10 Hz with ego motion, generated
+ *                                                       here (track_scene): instructions per update (first: the
+ *                                                       births; max, mean, min over the updates once every track
+ *                                                       is confirmed; total: every update) and the last update's
+ *                                                       counts
+ *   trk R k ID CLASS STATE h0 .. h12 HITS MISSES AGE DET # readable   one track after run R's last update, in id
+ *                                                       order (coasting and tentative ones too): the float32 bits
+ *                                                       (integer build: the int32 values) of cx, cy, cz, l, w, h,
+ *                                                       yaw, vx, vy, p_pp, p_pv, p_vv, score (hex)
  *   stack used=N size=S                                 stack high-water (painted at reset)
  *   lidet-fw: PASS | FAIL (...)
  * No stdio: the few number formats needed are here, so the image carries no printf. */
@@ -28,6 +41,9 @@
 #include "lidet_weights.h"
 #if LIDET_FIXED_POINT
 #include "lidet/lidet_detector_q.h"
+#include "lidet/lidet_track_q.h"
+#else
+#include "lidet/lidet_track.h"
 #endif
 
 /* The detector: ~1 MiB at the VLP-16 capacities (~4.4 MiB for HDL-64), in .bss. A board with several RAM banks
@@ -42,11 +58,52 @@ typedef lidet_detector_t fw_detector_t;
 typedef lidet_pn_model_t fw_model_t;
 #define FW_BUILD "float"
 #endif
-#ifdef LIDET_FW_DETECTOR_SECTION
-static fw_detector_t g_det __attribute__((section(LIDET_FW_DETECTOR_SECTION)));
+/* The tracker after the detector (lidet_track_q.h / lidet_track.h; its capacities LIDET_TRACK_MAX_TRACKS and
+ * LIDET_TRACK_MAX_DETS in config/<sensor>/lidet_user_config.h): state and workspace, ~8 KiB at 32 tracks and 32
+ * detections, its own static object as a firmware would hold it. */
+#if LIDET_FIXED_POINT
+typedef lidet_tracker_q_t fw_tracker_t;
+typedef lidet_tracker_q_cfg_t fw_tracker_cfg_t;
+typedef lidet_track_q_t fw_track_t;
+typedef lidet_ego_q_t fw_ego_t;
+typedef lidet_detection_q_t fw_tdet_t;
 #else
-static fw_detector_t g_det;
+typedef lidet_tracker_t fw_tracker_t;
+typedef lidet_tracker_cfg_t fw_tracker_cfg_t;
+typedef lidet_track_t fw_track_t;
+typedef lidet_ego_t fw_ego_t;
+typedef lidet_detection_t fw_tdet_t;
 #endif
+static fw_tracker_t g_trk;
+
+/* The tracker benchmark's road users (scene_det, track_scene): 32, over 20 scans at 10 Hz */
+#define FW_TRK_OBJECTS 32u
+#define FW_TRK_SCANS 20u
+#define FW_TRK_DT_MS 100u
+#if LIDET_TRACK_MAX_TRACKS < 32 || LIDET_TRACK_MAX_DETS < 32
+#error "fw_detect.c's tracker benchmark needs LIDET_TRACK_MAX_TRACKS and LIDET_TRACK_MAX_DETS >= 32"
+#endif
+
+/* The test harness's own buffers of the tracker runs (one scan's generated detections, the tracks read back),
+ * ~4 KiB: test data, not what a product holds, so they reuse the detector's memory once its last run is done
+ * (fw_main reads the tracks and runs the benchmark after the last detector run). */
+typedef struct
+{
+    fw_tdet_t det[FW_TRK_OBJECTS];
+    fw_track_t out[LIDET_TRACK_MAX_TRACKS];
+} fw_trk_bufs_t;
+typedef union
+{
+    fw_detector_t det;
+    fw_trk_bufs_t trk;
+} fw_mem_t;
+#ifdef LIDET_FW_DETECTOR_SECTION
+static fw_mem_t g_mem __attribute__((section(LIDET_FW_DETECTOR_SECTION)));
+#else
+static fw_mem_t g_mem;
+#endif
+#define g_det (g_mem.det)
+#define g_tb (g_mem.trk)
 
 static const char *const k_class_names[LIDET_N_CLASSES] = {"Car", "Cyclist", "Pedestrian"};
 
@@ -381,6 +438,336 @@ static int run_once(const char *name, const fw_cfg_t *cfg, const fw_model_t *mc,
     return LIDET_SUCCEEDED(st) ? 0 : 1;
 }
 
+/* ---- the tracker after the detector ------------------------------------------------------------------ */
+
+#if LIDET_FIXED_POINT
+typedef lidet_tracker_q_stats_t fw_trk_stats_t;
+#define fw_trk_cfg_default lidet_tracker_q_cfg_default
+#define fw_trk_init lidet_tracker_q_init
+#define fw_trk_update(t, d, n, ego) lidet_tracker_q_update((t), (d), (n), FW_TRK_DT_MS, (ego))
+#define fw_trk_tracks lidet_tracker_q_tracks
+#define fw_trk_stats lidet_tracker_q_stats
+#define fw_trk_bytes lidet_tracker_q_bytes
+#else
+typedef lidet_tracker_stats_t fw_trk_stats_t;
+#define fw_trk_cfg_default lidet_tracker_cfg_default
+#define fw_trk_init lidet_tracker_init
+#define fw_trk_update(t, d, n, ego) lidet_tracker_update((t), (d), (n), 0.1f, (ego))
+#define fw_trk_tracks lidet_tracker_tracks
+#define fw_trk_stats lidet_tracker_stats
+#define fw_trk_bytes lidet_tracker_bytes
+#endif
+
+/* The benchmark's scene, in integers only (so that both builds, on every core and on the host, see the same
+ * scans): 32 road users in 4 lanes 8 m apart along the world's x (cars at +8 and -6 m/s, cyclists at +4,
+ * pedestrians at -1.2; +-0.3 m/s along and +-0.1 m/s across by road user), 9 m apart in their lane, seen by a
+ * sensor that moves 0.5 m forward and turns 2 pi / 512 (0.7 deg) to the left per scan (5 m/s, 7 deg/s), which the
+ * tracker is given as its ego motion. Each detection's centre carries +-5 cm of uniform noise, its yaw +-0.02 rad,
+ * its score is in [0.5, 0.87) (xorshift32), and the detections come in a different order every scan. */
+#define FW_TRK_EGO_DX_MM 500
+#define FW_TRK_EGO_DYAW_BAM 8388608   /* 2^23: 2 pi / 512 */
+#define FW_TRK_EGO_COS_Q30 1073660973 /* round(cos(2 pi / 512) 2^30) */
+#define FW_TRK_EGO_SIN_Q30 13176464   /* round(sin(2 pi / 512) 2^30) */
+
+typedef struct
+{
+    int64_t px_q8, py_q8; /* the sensor's position in the world, 1/256 mm */
+    int64_t c_q30, s_q30; /* cos, sin of its heading */
+    uint32_t yaw_bam;     /* its heading */
+    uint32_t rng;         /* xorshift32 state */
+} fw_scene_t;
+
+/* round(v / 2^s), halves away from zero (no shift of a negative value) */
+static int64_t rsh_round(int64_t v, unsigned s)
+{
+    const int64_t h = (int64_t)1 << (s - 1u);
+    return v >= 0 ? (v + h) >> s : -((-v + h) >> s);
+}
+
+static uint32_t xorshift32(uint32_t *st)
+{
+    uint32_t x = *st;
+    x ^= x << 13;
+    x ^= x >> 17;
+    x ^= x << 5;
+    *st = x;
+    return x;
+}
+
+/* uint32 -> int32 two's complement without the implementation-defined conversion */
+static int32_t wrap_i32(uint32_t a)
+{
+    return a < 0x80000000u ? (int32_t)a : (int32_t)(a - 0x80000000u) - INT32_MAX - 1;
+}
+
+static void scene_start(fw_scene_t *sc)
+{
+    sc->px_q8 = 0;
+    sc->py_q8 = 0;
+    sc->c_q30 = (int64_t)1 << 30;
+    sc->s_q30 = 0;
+    sc->yaw_bam = 0u;
+    sc->rng = 0x2545f491u;
+}
+
+/* the sensor's motion to the next scan: 0.5 m along its heading, then the turn */
+static void scene_advance(fw_scene_t *sc)
+{
+    const int64_t c = sc->c_q30, sn = sc->s_q30;
+    sc->px_q8 += rsh_round(c * (FW_TRK_EGO_DX_MM * 256), 30);
+    sc->py_q8 += rsh_round(sn * (FW_TRK_EGO_DX_MM * 256), 30);
+    sc->c_q30 = rsh_round(c * FW_TRK_EGO_COS_Q30 - sn * FW_TRK_EGO_SIN_Q30, 30);
+    sc->s_q30 = rsh_round(sn * FW_TRK_EGO_COS_Q30 + c * FW_TRK_EGO_SIN_Q30, 30);
+    sc->yaw_bam += (uint32_t)FW_TRK_EGO_DYAW_BAM;
+}
+
+/* detection j of scan `scan` in the sensor frame: mm, BAM32, Q15 (the integer detection's units) */
+typedef struct
+{
+    int32_t cx_mm, cy_mm, cz_mm, l_mm, w_mm, h_mm, yaw_bam, score_q15;
+    uint8_t cls;
+} fw_gen_det_t;
+
+static void scene_det(fw_scene_t *sc, uint32_t scan, uint32_t j, fw_gen_det_t *o)
+{
+    static const int32_t lane_y[4] = {-12000, -4000, 4000, 12000};
+    static const int32_t lane_vx[4] = {8000, 4000, -1200, -6000};
+    static const uint8_t lane_cls[4] = {LIDET_CLASS_CAR, LIDET_CLASS_CYCLIST, LIDET_CLASS_PEDESTRIAN,
+                                        LIDET_CLASS_CAR};
+    static const int32_t size[LIDET_N_CLASSES][4] = {
+        {-700, 4200, 1800, 1600}, {-900, 1800, 600, 1700}, {-900, 600, 600, 1750}}; /* cz, l, w, h */
+    const uint32_t k = (j + 5u * scan) % FW_TRK_OBJECTS, lane = k / 8u, i = k % 8u;
+    const int32_t vx = lane_vx[lane] + ((int32_t)(i % 3u) - 1) * 300, vy = (i & 1u) != 0u ? 100 : -100;
+    /* the road user in the world (mm; exact: the speeds are multiples of 10 mm/s), then in the sensor frame */
+    const int64_t xw = -31500 + 9000 * (int64_t)i + (int64_t)vx * scan / 10;
+    const int64_t yw = lane_y[lane] + (int64_t)vy * scan / 10;
+    const int64_t dx = xw * 256 - sc->px_q8, dy = yw * 256 - sc->py_q8;
+    const uint8_t cls = lane_cls[lane];
+    o->cx_mm = (int32_t)rsh_round(sc->c_q30 * dx + sc->s_q30 * dy, 38);
+    o->cy_mm = (int32_t)rsh_round(sc->c_q30 * dy - sc->s_q30 * dx, 38);
+    o->cx_mm += (int32_t)(xorshift32(&sc->rng) % 101u) - 50;
+    o->cy_mm += (int32_t)(xorshift32(&sc->rng) % 101u) - 50;
+    o->cz_mm = size[cls][0];
+    o->l_mm = size[cls][1];
+    o->w_mm = size[cls][2];
+    o->h_mm = size[cls][3];
+    o->yaw_bam = wrap_i32((vx > 0 ? 0u : 0x80000000u) - sc->yaw_bam +
+                          (uint32_t)((int32_t)(xorshift32(&sc->rng) % 27340001u) - 13670000)); /* +-0.02 rad */
+    o->score_q15 = 16384 + (int32_t)(xorshift32(&sc->rng) % 12000u);
+    o->cls = cls;
+}
+
+#if LIDET_FIXED_POINT
+static const fw_ego_t k_trk_ego = {FW_TRK_EGO_DX_MM, 0, FW_TRK_EGO_DYAW_BAM};
+
+static void to_tdet(const fw_gen_det_t *g, uint32_t j, fw_tdet_t *d)
+{
+    memset(d, 0, sizeof *d);
+    d->box.cx_mm = g->cx_mm;
+    d->box.cy_mm = g->cy_mm;
+    d->box.cz_mm = g->cz_mm;
+    d->box.l_mm = g->l_mm;
+    d->box.w_mm = g->w_mm;
+    d->box.h_mm = g->h_mm;
+    d->box.yaw_bam = g->yaw_bam;
+    d->score_q15 = g->score_q15;
+    d->cls = g->cls;
+    d->cluster_id = (uint16_t)(j + 1u);
+}
+#else
+#define FW_BAM_RAD 1.46291807926715968e-9f /* 2 pi / 2^32 */
+static const fw_ego_t k_trk_ego = {0.5f, 0.0f, FW_BAM_RAD * FW_TRK_EGO_DYAW_BAM}; /* FW_TRK_EGO_DX_MM, _DYAW_BAM */
+
+/* the same scene in metres and radians (IEEE single precision: the same bits on every core) */
+static void to_tdet(const fw_gen_det_t *g, uint32_t j, fw_tdet_t *d)
+{
+    memset(d, 0, sizeof *d);
+    d->box.cx_m = (float)g->cx_mm * 0.001f;
+    d->box.cy_m = (float)g->cy_mm * 0.001f;
+    d->box.cz_m = (float)g->cz_mm * 0.001f;
+    d->box.l_m = (float)g->l_mm * 0.001f;
+    d->box.w_m = (float)g->w_mm * 0.001f;
+    d->box.h_m = (float)g->h_mm * 0.001f;
+    d->box.yaw_rad = (float)g->yaw_bam * FW_BAM_RAD;
+    d->score = (float)g->score_q15 * (1.0f / 32768.0f);
+    d->cls = g->cls;
+    d->cluster_id = j + 1u;
+}
+#endif
+
+/* One track: its 13 values (cx, cy, cz, l, w, h, yaw, vx, vy, p_pp, p_pv, p_vv, score) as hex words, which
+ * run_fw.py compares with the host, hits, misses, age and detection index, then x, y, vx, vy readable. */
+#if LIDET_FIXED_POINT
+#define FW_TRACK_VALUES(t)                                                                                         \
+    {(t)->box.cx_mm, (t)->box.cy_mm, (t)->box.cz_mm, (t)->box.l_mm, (t)->box.w_mm, (t)->box.h_mm,                 \
+     (t)->box.yaw_bam, (t)->vx_mmps, (t)->vy_mmps, (t)->p_pp, (t)->p_pv, (t)->p_vv, (t)->score_q15}
+#else
+#define FW_TRACK_VALUES(t)                                                                                         \
+    {(t)->box.cx_m, (t)->box.cy_m, (t)->box.cz_m, (t)->box.l_m, (t)->box.w_m, (t)->box.h_m, (t)->box.yaw_rad,      \
+     (t)->vx_mps, (t)->vy_mps, (t)->p_pp_m2, (t)->p_pv, (t)->p_vv, (t)->score}
+#endif
+
+static void put_track(const char *run, uint32_t k, const fw_track_t *t)
+{
+    static const char *const state_names[3] = {"tentative", "confirmed", "coasting"};
+    const fw_val_t v[13] = FW_TRACK_VALUES(t);
+    uint32_t j;
+    put_s("trk ");
+    put_s(run);
+    fw_putc(' ');
+    put_u(k);
+    fw_putc(' ');
+    put_u(t->id);
+    fw_putc(' ');
+    put_s(t->cls < LIDET_N_CLASSES ? k_class_names[t->cls] : "?");
+    fw_putc(' ');
+    put_s(t->state < 3u ? state_names[t->state] : "?");
+    for (j = 0; j < 13u; ++j)
+    {
+        fw_putc(' ');
+        FW_PUT_HEX(v[j]);
+    }
+    fw_putc(' ');
+    put_u(t->hits);
+    fw_putc(' ');
+    put_u(t->misses);
+    fw_putc(' ');
+    put_u(t->age);
+    fw_putc(' ');
+    put_i(t->det_index);
+    put_s(" # xy ");
+    FW_PUT_V(v[0]);
+    fw_putc(' ');
+    FW_PUT_V(v[1]);
+    put_s(" v ");
+    FW_PUT_V(v[7]);
+    fw_putc(' ');
+    FW_PUT_V(v[8]);
+    fw_putc('\n');
+}
+
+/* the summary line of one tracker run (insn: n_insn named counts, printed only with a counter) and its tracks,
+ * read back into the harness's buffer (the detector's memory: called after the last detector run) */
+static void put_tracker_run(const char *run, uint32_t n_det, uint32_t n_upd, lidet_status_t st,
+                            const char *const *insn_names, const uint64_t *insn, uint32_t n_insn)
+{
+    const fw_trk_stats_t *ts = fw_trk_stats(&g_trk);
+    uint32_t k, n;
+    put_s("track run=");
+    put_s(run);
+    put_kv("dets", n_det);
+    put_kv("updates", n_upd);
+    for (k = 0; k < n_insn && fw_have_counter(); ++k)
+    {
+        put_s(" insn_");
+        put_s(insn_names[k]);
+        fw_putc('=');
+        put_u64(insn[k]);
+    }
+    put_s(" status=");
+    put_i((int32_t)st);
+    put_kv("tracks", ts->n_tracks);
+    put_kv("confirmed", ts->n_confirmed);
+    put_kv("births", ts->n_births);
+    put_kv("births_dropped", ts->n_births_dropped);
+    put_kv("deaths", ts->n_deaths);
+    put_kv("matched", ts->n_matched);
+    put_kv("feasible", ts->n_feasible_pairs);
+    put_kv("dets_dropped", ts->n_dets_dropped);
+    put_kv("bad_dets", ts->n_bad_dets);
+    fw_putc('\n');
+    n = fw_trk_tracks(&g_trk, g_tb.out, LIDET_TRACK_MAX_TRACKS, LIDET_TRACK_OUT_COASTING | LIDET_TRACK_OUT_TENTATIVE);
+    for (k = 0; k < n; ++k)
+        put_track(run, k, &g_tb.out[k]);
+}
+
+/* Run default's detections into the tracker, twice (the same scan 0.1 s later, the sensor still): the tracker
+ * as a firmware runs it, on the detector's output in place. Its tracks are read at the end (put_tracker_run).
+ * track_detections and track_scene are not inlined: their locals stay off fw_main's frame, which is under the
+ * detector's deepest stack (the integer images reserve 4 KiB, run_fw.py fails above 80 % of it). */
+static uint64_t g_trk_det_insn[3]; /* first, second update, both */
+static uint32_t g_trk_det_n;
+static lidet_status_t g_trk_det_st;
+
+static __attribute__((noinline)) int track_detections(void)
+{
+    fw_tracker_cfg_t tc;
+    const fw_detection_t *det;
+    uint32_t u;
+    fw_trk_cfg_default(&tc);
+    if (fw_trk_init(&g_trk, &tc) != LIDET_OK)
+        return 1;
+    det = fw_detections(&g_det, &g_trk_det_n);
+    for (u = 0; u < 2u; ++u)
+    {
+        const uint64_t t0 = fw_insn64();
+        g_trk_det_st = fw_trk_update(&g_trk, det, g_trk_det_n, 0);
+        g_trk_det_insn[u] = fw_insn64() - t0;
+        g_trk_det_insn[2] += g_trk_det_insn[u];
+        if (!LIDET_SUCCEEDED(g_trk_det_st))
+            return 1;
+    }
+    return 0;
+}
+
+/* The benchmark: the scene's 20 scans; instructions of every update; the updates from the third scan on have
+ * 32 confirmed tracks and 32 detections (checked: else the image fails). The tracker's state from
+ * track_detections is read out first. */
+static __attribute__((noinline)) int track_scene(void)
+{
+    static const char *const det_names[3] = {"first", "second", "total"};
+    static const char *const names[6] = {"first", "second", "max", "mean", "min", "total"};
+    fw_tracker_cfg_t tc;
+    fw_scene_t sc;
+    fw_gen_det_t g;
+    uint64_t insn[6] = {0u, 0u, 0u, 0u, UINT64_MAX, 0u}, sum = 0u;
+    uint32_t scan, j, n_meas = 0u;
+    lidet_status_t st = LIDET_OK;
+    int bad = 0;
+
+    put_tracker_run("default", g_trk_det_n, 2u, g_trk_det_st, det_names, g_trk_det_insn, 3u);
+
+    fw_trk_cfg_default(&tc);
+    if (fw_trk_init(&g_trk, &tc) != LIDET_OK)
+        return 1;
+    scene_start(&sc);
+    for (scan = 0; scan < FW_TRK_SCANS; ++scan)
+    {
+        const fw_trk_stats_t *ts;
+        uint64_t t0, d;
+        for (j = 0; j < FW_TRK_OBJECTS; ++j)
+        {
+            scene_det(&sc, scan, j, &g);
+            to_tdet(&g, j, &g_tb.det[j]);
+        }
+        t0 = fw_insn64();
+        st = fw_trk_update(&g_trk, g_tb.det, FW_TRK_OBJECTS, scan > 0u ? &k_trk_ego : 0);
+        d = fw_insn64() - t0;
+        ts = fw_trk_stats(&g_trk);
+        insn[5] += d;
+        bad |= st != LIDET_OK;
+        if (scan < 2u)
+        {
+            insn[scan] = d;
+        }
+        else
+        {
+            bad |= ts->n_tracks != FW_TRK_OBJECTS || ts->n_confirmed != FW_TRK_OBJECTS ||
+                   ts->n_matched != FW_TRK_OBJECTS;
+            insn[2] = d > insn[2] ? d : insn[2];
+            insn[4] = d < insn[4] ? d : insn[4];
+            sum += d;
+            ++n_meas;
+        }
+        scene_advance(&sc);
+    }
+    insn[3] = n_meas > 0u ? (sum + n_meas / 2u) / n_meas : 0u;
+    put_tracker_run("synthetic", FW_TRK_OBJECTS, FW_TRK_SCANS, st, names, insn, 6u);
+    if (bad)
+        put_s("track run=synthetic FAIL: not 32 confirmed tracks matched in every update from the third scan\n");
+    return bad;
+}
+
 /* The counter against loops of known length. measure() is one function whatever n is (n arrives in a
  * register), so the instructions around the loop are the same in every call; the difference of two loops
  * removes them (and the clock calls), so measured must equal expected exactly. */
@@ -462,6 +849,9 @@ int fw_main(void)
     put_kv("max_cols", LIDET_MAX_COLS);
     put_kv("max_points", LIDET_MAX_POINTS);
     put_kv("max_clusters", LIDET_MAX_CLUSTERS);
+    put_kv("tracker_bytes", fw_trk_bytes());
+    put_kv("track_max_tracks", LIDET_TRACK_MAX_TRACKS);
+    put_kv("track_max_dets", LIDET_TRACK_MAX_DETS);
     fw_putc('\n');
     if (family == 0 || sensor == 0)
     {
@@ -483,6 +873,8 @@ int fw_main(void)
     cfg.clock = rec_clock;
     cfg.clock_ctx = &g_rec;
     bad |= run_once("default", &cfg, mc, mb);
+    /* the tracker after it, on its detections (read out at the end) */
+    bad |= track_detections();
     /* run 2: gates and size checks off, so that every classified proposal is boxed and reported */
     cfg.gate1 = 0u;
     cfg.gate2 = 0u;
@@ -513,11 +905,14 @@ int fw_main(void)
         bad |= run_once("points", &cfg, mc, mb);
     }
 #endif
+    /* the detector's work is done: the tracker runs' tracks and the benchmark (its buffers reuse the detector's
+     * memory) */
+    bad |= track_scene();
 
     put_s("stack");
     put_kv("used", fw_stack_used());
     put_kv("size", fw_stack_size());
     fw_putc('\n');
-    put_s(bad ? "lidet-fw: FAIL (a detector run failed)\n" : "lidet-fw: PASS\n");
+    put_s(bad ? "lidet-fw: FAIL (a detector or tracker run failed)\n" : "lidet-fw: PASS\n");
     return bad;
 }

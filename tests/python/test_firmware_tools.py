@@ -129,6 +129,102 @@ def test_host_reference_reports_two_runs_with_detections():
         assert d["l"] > 0 and d["w"] > 0 and d["h"] > 0 and 0 < d["score"] < 1
 
 
+def _trk_report(tracks, fixed=False, counts=None, run="synthetic"):
+    """A firmware-style report with one tracker run: tracks = [(id, class, state, [13 values], [4 ints])]."""
+    counts = counts or {"dets": len(tracks), "updates": 20, "status": 0, "tracks": len(tracks),
+                        "confirmed": len(tracks), "matched": len(tracks)}
+    word = (lambda v: "%08x" % (v & 0xffffffff)) if fixed else _bits
+    lines = [f"lidet-fw board=x core=y build={'fixed' if fixed else 'float'}", "mem detector_bytes=100 max_rows=16",
+             f"track run={run} insn_max=123 insn_mean=100 " + " ".join(f"{k}={v}" for k, v in counts.items())]
+    for k, (tid, cls, state, vals, ints) in enumerate(tracks):
+        lines.append(f"trk {run} {k} {tid} {cls} {state} " + " ".join(word(v) for v in vals) + " "
+                     + " ".join(str(v) for v in ints) + " # xy 1 2 v 3 4")
+    lines.append("lidet-fw: PASS")
+    return "\n".join(lines) + "\n"
+
+
+TRKS = [(1, "Car", "confirmed", [10.0, -2.0, -0.7, 4.2, 1.8, 1.6, 0.3, 7.5, -1.9, 0.02, 0.05, 0.2, 0.6], [20, 0, 19, 1]),
+        (2, "Pedestrian", "coasting", [4.0, 1.0, -0.9, 0.6, 0.6, 1.75, -3.1415, -1.2, 0.2, 0.01, 0.03, 0.1, 0.5],
+         [5, 1, 6, -1])]
+TRKS_Q = [(1, "Car", "confirmed", [10000, -2000, -700, 4200, 1800, 1600, -12345, 7500, -1900, 20000, 50000, 200000,
+                                   19660], [20, 0, 19, 1])]
+
+
+def test_tracker_lines_parse_and_compare():
+    host = run_fw.parse(_trk_report(TRKS))
+    assert host["track"]["synthetic"]["insn_max"] == 123 and host["track"]["synthetic"]["tracks"] == 2
+    t = host["trk"]["synthetic"]
+    assert [(r["id"], r["cls"], r["state"], r["det_index"]) for r in t] == [(1, "Car", "confirmed", 1),
+                                                                              (2, "Pedestrian", "coasting", -1)]
+    assert abs(t[0]["vx"] - 7.5) < 1e-6 and abs(t[1]["yaw"] + 3.1415) < 1e-6
+    # the instruction counts are the image's own: not compared
+    fw = run_fw.parse(_trk_report(TRKS).replace("insn_max=123", "insn_max=456"))
+    errors, lines = run_fw.compare_tracks(host, fw)
+    assert errors == [] and "26/26 values bit-identical" in lines[0]
+    near = copy.deepcopy(TRKS)
+    near[0][3][0] += 2e-4  # 0.2 mm
+    near[1][3][6] = 3.1415  # the same yaw across the +-pi seam
+    assert run_fw.compare_tracks(host, run_fw.parse(_trk_report(near)))[0] == []
+    hq = run_fw.parse(_trk_report(TRKS_Q, fixed=True))
+    assert hq["trk"]["synthetic"][0]["bits"][6] == "%08x" % (-12345 & 0xffffffff)
+    errors, lines = run_fw.compare_tracks(hq, run_fw.parse(_trk_report(TRKS_Q, fixed=True)))
+    assert errors == [] and "13/13 integer values identical" in lines[0]
+
+
+@pytest.mark.parametrize("fixed, mutate, message", [
+    (False, lambda t: t[0][3].__setitem__(1, t[0][3][1] + 5e-3), "cy"),     # 5 mm off
+    (False, lambda t: t[0][3].__setitem__(9, t[0][3][9] * 1.01), "p_pp"),   # 1 % off
+    (False, lambda t: t.__setitem__(1, (3,) + t[1][1:]), "id, cls, state"),    # another id
+    (False, lambda t: t.__setitem__(1, t[1][:2] + ("confirmed",) + t[1][3:]), "id, cls, state"),
+    (False, lambda t: t[1][4].__setitem__(3, 0), "id, cls, state"),            # another detection
+    (False, lambda t: t.pop(), "tracks on the host"),
+    (True, lambda t: t[0][3].__setitem__(7, t[0][3][7] + 1), "integer values differ"),  # 1 mm/s: exact or fail
+])
+def test_tracker_compare_rejects(fixed, mutate, message):
+    base = TRKS_Q if fixed else TRKS
+    host = run_fw.parse(_trk_report(base, fixed))
+    bad = copy.deepcopy(base)
+    mutate(bad)
+    errors, _ = run_fw.compare_tracks(host, run_fw.parse(_trk_report(bad, fixed, counts=None if len(bad) == len(
+        base) else {"dets": 2, "updates": 20, "status": 0, "tracks": 2, "confirmed": 2, "matched": 2})))
+    assert errors and any(message in e for e in errors), errors
+
+
+def test_tracker_compare_rejects_different_counts_and_an_unconfirmed_scene():
+    host = run_fw.parse(_trk_report(TRKS))
+    fw = run_fw.parse(_trk_report(TRKS, counts={"dets": 2, "updates": 20, "status": 0, "tracks": 2, "confirmed": 2,
+                                                "matched": 1}))
+    assert any("counts differ" in e for e in run_fw.compare_tracks(host, fw)[0])
+    # the benchmark's premise: every road user tracked and confirmed at the end
+    weak = {"dets": 2, "updates": 20, "status": 0, "tracks": 2, "confirmed": 1, "matched": 2}
+    errors, _ = run_fw.compare_tracks(run_fw.parse(_trk_report(TRKS, counts=weak)),
+                                      run_fw.parse(_trk_report(TRKS, counts=weak)))
+    assert any("not every road user" in e for e in errors)
+    # a run missing on one side
+    assert any("tracker runs differ" in e for e in run_fw.compare_tracks(host, run_fw.parse(_report(BASE)))[0])
+
+
+@pytest.mark.parametrize("exe_name", ["fw_host_ref", "fw_host_ref_q"])
+def test_host_reference_runs_the_tracker(exe_name):
+    """The host build runs the tracker after the detector: run default's detections twice, and the generated
+    scene's 32 road users, all tracked and confirmed at the firmware capacities (32 tracks, 32 detections)."""
+    exe = pathlib.Path(os.environ.get("LIDET_BUILD_DIR", ROOT / "build")) / "tests" / exe_name
+    if not exe.exists():
+        pytest.skip(f"{exe} not built")
+    p = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stdout + p.stderr
+    rep = run_fw.parse(p.stdout)
+    assert rep["mem"]["track_max_tracks"] == 32 and rep["mem"]["track_max_dets"] == 32
+    syn, det = rep["track"]["synthetic"], rep["track"]["default"]
+    assert syn["dets"] == syn["tracks"] == syn["confirmed"] == syn["matched"] == 32 and syn["status"] == 0
+    assert not any(k.startswith("insn_") for k in syn)  # the host counts no instructions
+    assert [t["id"] for t in rep["trk"]["synthetic"]] == list(range(1, 33))
+    assert all(t["state"] == "confirmed" and t["hits"] == 20 and t["misses"] == 0 for t in rep["trk"]["synthetic"])
+    assert det["dets"] == rep["stats"]["default"]["detections"] == det["tracks"] == det["confirmed"] > 0
+    assert sorted(t["det_index"] for t in rep["trk"]["default"]) == list(range(det["dets"]))
+    assert run_fw.compare_tracks(rep, copy.deepcopy(rep))[0] == []
+
+
 cycles = _load("cycles")
 
 
@@ -173,9 +269,9 @@ def test_cycle_prices_refuse_an_unknown_instruction():
 
 
 def test_cycle_estimate_of_the_m4_integer_image():
-    """The estimate on the Cortex-M4 integer image: the trace holds the instructions of all runs (within 5 % of
-    the exact counts: the port's counter and console code is left out) and the CPI lies in the range a
-    single-issue core with 1-3 cycle loads, branches and divides can have."""
+    """The estimate on the Cortex-M4 integer image: the trace holds the instructions of all runs, the detector's
+    and the tracker's updates (within 5 % of the exact counts: the port's counter and console code is left out)
+    and the CPI lies in the range a single-issue core with 1-3 cycle loads, branches and divides can have."""
     bdir = pathlib.Path(os.environ.get("LIDET_BUILD_DIR", ROOT / "build")) / "firmware" / "mps2-an386-q"
     elf, rep = bdir / "lidet_fw.elf", bdir / "report.json"
     if not (elf.exists() and rep.exists()):
@@ -185,7 +281,9 @@ def test_cycle_estimate_of_the_m4_integer_image():
             pytest.skip(f"{tool} not installed")
     r = cycles.estimate(str(elf), "m4", "arm-none-eabi-nm", timeout=600)
     import json
-    ins = json.loads(rep.read_text())["insn"]
+    report = json.loads(rep.read_text())
+    ins = report["insn"]
     exact = sum(run["scan"] for run in ins.values())  # every run (the integer images: default, open, points)
+    exact += sum(run.get("insn_total", 0) for run in report.get("track", {}).values())  # and the tracker's updates
     assert abs(r["instructions"] - exact) <= 0.05 * exact, (r, exact)
     assert 1.0 < r["cpi_low"] < r["cpi_high"] < 3.0, r

@@ -26,8 +26,9 @@
 /* compile-time: a negative array size when the detector outgrows the budget (this host's layout, which is
  * at least the 32-bit target's: the structs hold pointers, no 64-bit member) */
 typedef char lidet_vlp16_detector_fits_512_kib[sizeof(lidet_detector_t) <= BUDGET_BYTES ? 1 : -1];
-/* the integer detector with the range-only pixel (ports/firmware/config/vlp16: the integer firmware's RAM is this
- * plus ~1.3 KB of the application and 4 KiB of stack) within 256 KiB */
+/* the integer detector with the range-only pixel within 256 KiB (ports/firmware/config/vlp16: the integer
+ * firmware's RAM is this less 8,160 B of int8 PointNet scratch its small models do not need, plus the tracker,
+ * 8,264 B, ~1.3 KB of the application and 4 KiB of stack; docs/MEMORY.md) */
 typedef char lidet_vlp16_detector_q_fits_256_kib[sizeof(lidet_detector_q_t) <= BUDGET_Q_BYTES ? 1 : -1];
 
 /* the probe library's port (tests/port/lidet_port.h) counts its asserts here */

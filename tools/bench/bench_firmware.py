@@ -143,7 +143,8 @@ def run(args) -> str:
         "",
         "**Size** (bytes, `size -A` of the linked image; the scan is test data and not part of a product's flash):",
         "",
-        "| core | .text | weights (.rodata) | other .rodata | .data | .bss (of which the detector) | stack reserved | "
+        "| core | .text | weights (.rodata) | other .rodata | .data | .bss (of which the detector; the tracker) | "
+        "stack reserved | "
         "**flash** (text + rodata + data, no scan) | **RAM** (data + bss + stack) | scan in flash |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
@@ -153,8 +154,50 @@ def run(args) -> str:
             continue
         s = r["size"]
         out.append(f"| {core} | {s['text']:,} | {s['rodata_weights']:,} | {s['rodata_other']:,} | {s['data']:,} | "
-                   f"{s['bss']:,} ({r['mem']['detector_bytes']:,}) | {s['stack_reserved']:,} | "
+                   f"{s['bss']:,} ({r['mem']['detector_bytes']:,}"
+                   + (f"; {r['mem']['tracker_bytes']:,}" if "tracker_bytes" in r["mem"] else "")
+                   + f") | {s['stack_reserved']:,} | "
                    f"**{_kib(s['flash_without_scan'])}** | **{_kib(s['ram'])}** | {_kib(s['rodata_scan'])} |")
+    trk = [(b, core, fpu) for b, core, fpu, _ in BOARDS
+           if "synthetic" in reports.get(b, {}).get("track", {}) and "insn_max" in reports[b]["track"]["synthetic"]]
+    if trk:
+        syn0 = reports[trk[0][0]]["track"]["synthetic"]
+        out += [
+            "",
+            "**The tracker after the detector** (issue 38; docs/TRACKING.md, \"On the board\"): the integer images run "
+            "`lidet_tracker_q`, the float images `lidet_tracker`, with the image's capacities (VLP-16: "
+            f"`LIDET_TRACK_MAX_TRACKS` {mem.get('track_max_tracks')}, `LIDET_TRACK_MAX_DETS` "
+            f"{mem.get('track_max_dets')}, config/vlp16; HDL-64: the library's 64 and 64), default configuration "
+            "(optimal assignment). Its cost per update on a scene the image generates (integers only, the same on "
+            f"every core and on the host): {syn0['dets']} road users in 4 lanes (cars, cyclists, pedestrians at "
+            "-1.2 to +8 m/s), +-5 cm of noise on the centres, a sensor that moves at 5 m/s and turns at 7 deg/s (the "
+            f"tracker gets it as its ego motion), {syn0['updates']} scans at 10 Hz; every update from the third on "
+            f"has {syn0['dets']} confirmed tracks and {syn0['dets']} detections, all matched (the image fails "
+            "otherwise). Instructions of one `lidet_tracker_q_update` / `lidet_tracker_update` call: the maximum, "
+            f"mean and minimum over those {syn0['updates'] - 2} updates, the first update (no track yet: "
+            f"{syn0['dets']} births) and the second (the first assignment); then the tracker on run `default`'s "
+            "own detections (the same scan twice, dt 0.1 s): its second update. Goal: <= 0.5 M instructions per "
+            "update on the M4 for 32 tracks.",
+            "",
+            f"| core | tracker (sizeof) | **per update, {syn0['dets']} tracks: max** | mean | min | first update "
+            "(births) | second update | run `default`'s detections: second update |",
+            "|---|---|---|---|---|---|---|---|",
+        ]
+        for board, core, _ in trk:
+            r = reports[board]
+            sy, dt = r["track"]["synthetic"], r["track"].get("default", {})
+            out.append(f"| {core} | {r['mem'].get('tracker_bytes', 0):,} B | **{sy['insn_max'] / 1e6:.3f} M** | "
+                       f"{sy['insn_mean'] / 1e6:.3f} M | {sy['insn_min'] / 1e6:.3f} M | {sy['insn_first']:,} | "
+                       f"{sy['insn_second']:,} | "
+                       + (f"{dt['insn_second']:,} ({dt['dets']} detections, {dt['tracks']} tracks)"
+                          if "insn_second" in dt else "-") + " |")
+        m4q = reports.get("mps2-an386-q", {}).get("track", {}).get("synthetic")
+        if m4q and "insn_max" in m4q:
+            out += ["", f"On the Cortex-M4 (integer build) the tracker takes at most {m4q['insn_max']:,} instructions per "
+                    f"update with {m4q['dets']} tracks ({100.0 * m4q['insn_max'] / 500000:.0f}% of the 0.5 M goal; "
+                    f"{100.0 * m4q['insn_max'] / reports['mps2-an386-q']['insn']['default']['scan']:.2f}% of the "
+                    "detector's scan). The tracker runs after the detector's stages: their counts above and the detections "
+                    "are the same as without it; its state is in the RAM figures below."]
     out += [
         "",
         f"`sizeof(lidet_detector_t)` = `lidet_detector_bytes()` = {any_rep['mem']['detector_bytes']:,} B "
@@ -164,7 +207,8 @@ def run(args) -> str:
         "",
         "**Against the host build** (`fw_host_ref`: the same program built for x86-64 against lidet with the same "
         "capacities, on the same generated scan; `tools/firmware/run_fw.py` compares every count of the detector "
-        "and every detection, matched by cluster id):",
+        "and every detection, matched by cluster id, and for the tracker the counts of its last update and every "
+        "track in id order):",
         "",
     ]
     for board, core, *_ in BOARDS:
@@ -175,7 +219,9 @@ def run(args) -> str:
     out += [
         "",
         "Tolerances (the test fails beyond them): boxes 1e-3 m, yaw 1e-3 rad, score 1e-4, energies 1e-4 "
-        "relative; counts, classes, cluster ids and point counts must be identical. Only expf/logf/sinf/cosf/"
+        "relative (the tracker's values: 1e-3 m, m/s and rad, covariances 1e-4 relative, the integer images' exactly); "
+        "counts, classes, cluster ids and point counts, the tracks' ids, states, hits and detection indices must be "
+        "identical. Only expf/logf/sinf/cosf/"
         "tanf/atan2f differ between glibc, newlib and picolibc (an ulp or two); every other operation is IEEE "
         "single precision in the same order on both sides (-ffp-contract=off), soft float included.",
         "",
@@ -240,8 +286,10 @@ def run(args) -> str:
         out += [
             "",
             "The integer build against the same goals (its images use `ports/firmware/config/vlp16` as they are: the "
-            "range-only pixel, `LIDET_Q_PIXEL_XYZ 0`, and 4 KiB of stack, docs/MEMORY.md; and the small VLP-16 pair, "
-            f"models `{(q.get('header') or {}).get('models', '?')}`, docs/PORTING.md): RAM "
+            "range-only pixel, `LIDET_Q_PIXEL_XYZ 0`, and 4 KiB of stack, docs/MEMORY.md; the small VLP-16 pair, "
+            f"models `{(q.get('header') or {}).get('models', '?')}`, docs/PORTING.md, with the int8 scratch that pair "
+            "needs, `LIDET_DETECTOR_Q_PN_SCRATCH` 4,128 B; and the tracker, "
+            f"{(q.get('mem') or {}).get('tracker_bytes', 0):,} B at 32 tracks, docs/TRACKING.md): RAM "
             + ", ".join(f"{_kib(v)} ({v:,} B)" for v in rams.values())
             + f" on the M3, M0+ and RV32IMAC images ({'within' if max(rams.values()) <= 256 * 1024 else 'over'} "
             f"256 KiB), flash {_kib(sz['flash_without_scan'])} on the M3 "

@@ -17,7 +17,14 @@
    cosf, tanf and atan2f (each within an ulp or two); everything else is IEEE single precision in the same
    order on both sides (-ffp-contract=off, no reassociation). The report says how many values were
    bit-identical and the largest differences.
-4. Prints the instruction counts per stage, the stack high-water and a size report (`size -A`).
+   The tracker after the detector (`track` and `trk` lines: run `default` = two updates on run default's
+   detections, run `synthetic` = the image's generated 32 road users over 20 scans with ego motion): the same
+   counts of the last update, the same tracks in the same order (ids, classes, states, hits, misses, ages,
+   detection indices), their values bit for bit in the integer build, within the tolerances below in the float
+   build (ATOL_M on positions, sizes and velocities, ATOL_RAD on yaws, RTOL_COV on covariances, ATOL_SCORE);
+   the synthetic run must end with all its road users tracked and confirmed.
+4. Prints the instruction counts per stage and per tracker update, the stack high-water and a size report
+   (`size -A`); the integer VLP-16 images must keep their RAM (data + bss + stack) within RAM_BUDGET_Q.
 Exit status: 0 pass, 1 fail, 77 skipped (a tool is missing: ctest reports the test as skipped).
 """
 import argparse
@@ -33,6 +40,8 @@ ATOL_M = 1e-3
 ATOL_RAD = 1e-3
 ATOL_SCORE = 1e-4
 RTOL_ENERGY = 1e-4
+RTOL_COV = 1e-4
+RAM_BUDGET_Q = 256 * 1024  # issue 17: the integer VLP-16 images' RAM (data + bss + stack)
 SKIP = 77
 
 BOARDS = {
@@ -47,6 +56,9 @@ BOARDS = {
 }
 
 FIELDS = ["score", "cx", "cy", "cz", "l", "w", "h", "yaw", "energy_cls", "energy_box"]
+# a track's values on its `trk` line (fw_detect.c: put_track), then hits, misses, age, detection index
+TRK_FIELDS = ["cx", "cy", "cz", "l", "w", "h", "yaw", "vx", "vy", "p_pp", "p_pv", "p_vv", "score"]
+TRK_INTS = ["hits", "misses", "age", "det_index"]
 
 
 def qemu_cmd(board, qemu, elf):
@@ -64,8 +76,10 @@ def f32(hexbits):
 
 
 def parse(text):
-    """-> dict: header, mem, calib list, stats{run: {k: v}}, det{run: {cluster: rec}}, insn{run: {}}, stack."""
-    out = {"stats": {}, "det": {}, "insn": {}, "calib": [], "pass": False, "lines": text.splitlines()}
+    """-> dict: header, mem, calib list, stats{run: {k: v}}, det{run: {cluster: rec}}, insn{run: {}}, stack,
+    track{run: {k: v}} (the tracker's counts and instructions), trk{run: [track rec in output order]}."""
+    out = {"stats": {}, "det": {}, "insn": {}, "calib": [], "track": {}, "trk": {}, "pass": False,
+           "lines": text.splitlines()}
     for line in out["lines"]:
         tok = line.split("#")[0].split()
         if not tok:
@@ -85,6 +99,16 @@ def parse(text):
         elif tok[0] == "insn":
             run = kv.pop("run")
             out["insn"][run] = {k: int(v) for k, v in kv.items()}
+        elif tok[0] == "track":
+            run = kv.pop("run")
+            out["track"][run] = {k: int(v) for k, v in kv.items()}
+        elif tok[0] == "trk":
+            run, k, tid, cls, state = tok[1], int(tok[2]), int(tok[3]), tok[4], tok[5]
+            n = len(TRK_FIELDS)
+            rec = {"rank": k, "id": tid, "cls": cls, "state": state, "bits": tok[6:6 + n]}
+            rec.update(dict(zip(TRK_FIELDS, (f32(h) for h in tok[6:6 + n]))))
+            rec.update(dict(zip(TRK_INTS, (int(v) for v in tok[6 + n:6 + n + len(TRK_INTS)]))))
+            out["trk"].setdefault(run, []).append(rec)
         elif tok[0] == "det":
             run, k, cls, cluster, npts = tok[1], int(tok[2]), tok[3], int(tok[4]), int(tok[5])
             vals = [f32(h) for h in tok[6:16]]
@@ -164,6 +188,66 @@ def compare(host, fw):
     return errors, lines
 
 
+def compare_tracks(host, fw):
+    """The tracker runs (`track`, `trk` lines) -> (errors, summary lines): the same counts (instructions aside), the
+    same tracks in the same order with the same ids, classes, states, hits, misses, ages and detection indices; the
+    values bit for bit in the integer build, within tolerances in the float build (libm's sinf / cosf / atan2f
+    differ between the host and the boards: the ego rotation, the reported heading)."""
+    errors, lines = [], []
+    fixed = (fw.get("header") or {}).get("build") == "fixed"
+    if set(host["track"]) != set(fw["track"]) or "synthetic" not in host["track"]:
+        errors.append(f"tracker runs differ: host {sorted(host['track'])} firmware {sorted(fw['track'])}")
+        return errors, lines
+    syn = fw["track"]["synthetic"]
+    if not syn.get("dets") or syn.get("tracks") != syn.get("dets") or syn.get("confirmed") != syn.get("dets"):
+        errors.append(f"tracker run synthetic: not every road user tracked and confirmed: {syn}")
+    for run in sorted(host["track"]):
+        n_err = len(errors)
+        counts = lambda m: {k: v for k, v in m.items() if not k.startswith("insn_")}
+        hc, fc = counts(host["track"][run]), counts(fw["track"][run])
+        if hc != fc:
+            diff = {k: (hc.get(k), fc.get(k)) for k in set(hc) | set(fc) if hc.get(k) != fc.get(k)}
+            errors.append(f"tracker run {run}: counts differ (host, firmware): {diff}")
+        ht, ft = host["trk"].get(run, []), fw["trk"].get(run, [])
+        if len(ht) != len(ft) or len(ht) != hc.get("tracks"):
+            errors.append(f"tracker run {run}: {len(ht)} tracks on the host, {len(ft)} on the firmware "
+                          f"({hc.get('tracks')} counted)")
+            continue
+        same_bits = total = 0
+        worst = {"pos": 0.0, "vel": 0.0, "yaw": 0.0, "cov": 0.0}
+        for h, f in zip(ht, ft):
+            keys = ["id", "cls", "state"] + TRK_INTS
+            if [h[k] for k in keys] != [f[k] for k in keys]:
+                errors.append(f"tracker run {run} track {h['rank']}: host {[h[k] for k in keys]}, firmware "
+                              f"{[f[k] for k in keys]} ({', '.join(keys)})")
+            total += len(TRK_FIELDS)
+            same_bits += sum(a == b for a, b in zip(h["bits"], f["bits"]))
+            if fixed:
+                if h["bits"] != f["bits"]:
+                    errors.append(f"tracker run {run} track id {h['id']}: integer values differ: host {h['bits']}, "
+                                  f"firmware {f['bits']} ({', '.join(TRK_FIELDS)})")
+                continue
+            for name in TRK_FIELDS:
+                if name == "yaw":
+                    d, tol, grp = ang_diff(h[name], f[name]), ATOL_RAD, "yaw"
+                elif name.startswith("p_"):
+                    d, tol, grp = abs(h[name] - f[name]), RTOL_COV * max(1.0, abs(h[name])), "cov"
+                elif name == "score":
+                    d, tol, grp = abs(h[name] - f[name]), ATOL_SCORE, "pos"
+                else:
+                    d, tol, grp = abs(h[name] - f[name]), ATOL_M, "vel" if name in ("vx", "vy") else "pos"
+                worst[grp] = max(worst[grp], d / max(1.0, abs(h[name])) if grp == "cov" else d)
+                if not d <= tol:
+                    errors.append(f"tracker run {run} track id {h['id']}: {name} host {h[name]!r} firmware "
+                                  f"{f[name]!r} (|diff| {d:.3g} > {tol:.3g})")
+        what = (f"{same_bits}/{total} integer values identical" if fixed else
+                f"{same_bits}/{total} values bit-identical; max |diff| position/size {worst['pos']:.3g} m, velocity "
+                f"{worst['vel']:.3g} m/s, yaw {worst['yaw']:.3g} rad, covariance {worst['cov']:.3g} relative")
+        lines.append(f"tracker run {run}: {len(ht)} tracks ({hc.get('confirmed')} confirmed), ids, states and "
+                     f"counts identical: {len(errors) == n_err}; {what}")
+    return errors, lines
+
+
 def size_report(size_tool, elf):
     out = subprocess.run([size_tool, "-A", elf], check=True, capture_output=True, text=True).stdout
     sec = {}
@@ -237,8 +321,9 @@ def main(argv=None):
         errors.append(f"the image failed (QEMU exit {fw_p.returncode}, PASS line {'seen' if fw['pass'] else 'missing'})")
     if len(fw["calib"]) < 3 or any(c["measured"] != c["expected"] for c in fw["calib"]):
         errors.append(f"instruction counter calibration: {fw['calib']}")
-    # the capacities must agree; sizeof(lidet_detector_t) may not (pointers are 8 bytes on the host)
-    caps = lambda m: {k: v for k, v in (m or {}).items() if k != "detector_bytes"}
+    # the capacities must agree; sizeof(lidet_detector_t) and of the tracker may not (pointers are 8 bytes on the
+    # host)
+    caps = lambda m: {k: v for k, v in (m or {}).items() if not k.endswith("_bytes")}
     if not caps(fw.get("mem")) or caps(fw.get("mem")) != caps(host.get("mem")):
         errors.append(f"capacities differ: host {host.get('mem')} firmware {fw.get('mem')}")
     if "open" not in fw["det"] or not fw["det"]["open"]:
@@ -252,6 +337,9 @@ def main(argv=None):
                           "a stage count is wrong")
     cerr, summary = compare(host, fw)
     errors += cerr
+    terr, tsummary = compare_tracks(host, fw)
+    errors += terr
+    summary += tsummary
     # the painted stack must keep a margin: an image whose reserved stack is trimmed to its measured high-water
     # (the integer VLP-16 build, ports/firmware/CMakeLists.txt) fails here before it overflows
     st = fw.get("stack") or {}
@@ -263,16 +351,23 @@ def main(argv=None):
         print(line)
     for run, ins in sorted(fw["insn"].items()):
         print(f"instructions run {run}: " + ", ".join(f"{k} {v:,}" for k, v in ins.items()))
+    for run, tr in sorted(fw["track"].items()):
+        print(f"tracker run {run} ({tr.get('dets')} detections, {tr.get('updates')} updates), instructions per update: "
+              + (", ".join(f"{k[5:]} {v:,}" for k, v in tr.items() if k.startswith("insn_")) or "not counted"))
     if "stack" in fw:
         print(f"stack high-water: {fw['stack']['used']} of {fw['stack']['size']} bytes")
     rep = None
     if a.size and shutil.which(a.size):
         rep = size_report(shutil.which(a.size), a.elf)
         print("size (bytes): " + ", ".join(f"{k} {v:,}" for k, v in rep.items()))
+        hdr = fw.get("header") or {}
+        if hdr.get("build") == "fixed" and hdr.get("sensor") == "vlp16" and rep["ram"] > RAM_BUDGET_Q:
+            errors.append(f"RAM (data + bss + stack) {rep['ram']:,} B is over the integer VLP-16 image's budget of "
+                          f"{RAM_BUDGET_Q:,} B (docs/MEMORY.md)")
     if a.json:
         with open(a.json, "w") as f:
             json.dump({"board": a.board, "header": fw.get("header"), "mem": fw.get("mem"), "insn": fw["insn"],
-                       "stack": fw.get("stack"), "stats": fw["stats"], "size": rep, "qemu": cmd,
+                       "stack": fw.get("stack"), "stats": fw["stats"], "track": fw["track"], "size": rep, "qemu": cmd,
                        "comparison": summary, "errors": errors}, f, indent=1)
     if errors:
         for e in errors:
