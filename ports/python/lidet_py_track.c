@@ -5,7 +5,8 @@
  *
  * The configuration crosses as LIDET_PY_TRACK_NCFG floats in this order: meas_sigma_m[3], accel_sigma_mps2[3],
  * init_vel_sigma_mps[3], gate_max_m[3], gate_chi2, class_penalty, assign, confirm_hits, max_misses,
- * birth_min_score, yaw_alpha, size_alpha, heading_speed_mps, heading_from_velocity (the integers as floats).
+ * birth_min_score, yaw_alpha, size_alpha, heading_speed_mps, heading_from_velocity, report_misses[3] (the
+ * integers as floats).
  * Detections: n rows of `stride` (>= 9) floats cls, x, y, z, l, w, h, yaw, score (a class that is not exactly 0,
  * 1 or 2 reaches the tracker as 255: a bad detection). Tracks: rows of LIDET_PY_TRACK_NF floats x, y, z, l, w,
  * h, yaw, vx, vy, p_pp, p_pv, p_vv, score and of LIDET_PY_TRACK_NI int32 id (as uint32 bits), cls, state, hits,
@@ -21,7 +22,7 @@
 #define LIDET_PY_API __attribute__((visibility("default")))
 #endif
 
-#define LIDET_PY_TRACK_NCFG 22u
+#define LIDET_PY_TRACK_NCFG 25u
 #define LIDET_PY_TRACK_NF 13u
 #define LIDET_PY_TRACK_NI 7u
 
@@ -79,6 +80,10 @@ LIDET_PY_API void lidet_py_track_cfg_default(float *f)
     f[19] = c.size_alpha;
     f[20] = c.heading_speed_mps;
     f[21] = (float)c.heading_from_velocity;
+    for (k = 0; k < 3u; ++k)
+    {
+        f[22u + k] = (float)c.report_misses[k];
+    }
 }
 
 /* lidet_tracker_init with the flat configuration; an integer field that is no integer in [0, 2^24] is
@@ -102,7 +107,9 @@ LIDET_PY_API int lidet_py_track_init(void *t, const float *f)
     c.gate_chi2 = f[12];
     c.class_penalty = f[13];
     if (!as_uint(f[14], 1u << 24, &c.assign) || !as_uint(f[15], 1u << 24, &c.confirm_hits) ||
-        !as_uint(f[16], 1u << 24, &c.max_misses) || !as_uint(f[21], 1u << 24, &c.heading_from_velocity))
+        !as_uint(f[16], 1u << 24, &c.max_misses) || !as_uint(f[21], 1u << 24, &c.heading_from_velocity) ||
+        !as_uint(f[22], 1u << 24, &c.report_misses[0]) || !as_uint(f[23], 1u << 24, &c.report_misses[1]) ||
+        !as_uint(f[24], 1u << 24, &c.report_misses[2]))
     {
         return LIDET_ERR_CONFIG;
     }

@@ -16,7 +16,7 @@
 #endif
 
 /* the flat configuration: ref/track_q.py CFG_FIELDS */
-#define CFG_LEN 22u
+#define CFG_LEN 25u
 /* one output track: ref/track_q.py TRACK_Q_FIELDS */
 #define TRACK_LEN 20u
 
@@ -80,6 +80,10 @@ LIDET_PY_API int lidet_py_track_q_cfg_default(int64_t *out)
     out[n++] = c.size_alpha_q15;
     out[n++] = c.heading_speed_mmps;
     out[n++] = c.heading_from_velocity;
+    for (k = 0; k < 3u; ++k)
+    {
+        out[n++] = c.report_misses[k];
+    }
     return (int)n;
 }
 
@@ -109,6 +113,10 @@ LIDET_PY_API int lidet_py_track_q_init(void *tp, const int64_t *cfg, uint32_t n_
     c.size_alpha_q15 = sat32(cfg[n++]);
     c.heading_speed_mmps = sat32(cfg[n++]);
     c.heading_from_velocity = satu32(cfg[n++]);
+    for (k = 0; k < 3u; ++k)
+    {
+        c.report_misses[k] = satu32(cfg[n++]);
+    }
     return lidet_tracker_q_init((lidet_tracker_q_t *)tp, &c);
 }
 

@@ -272,8 +272,23 @@ def test_reset_and_flags(tn):
     assert len(t.update(d, 0.1)) == 1                       # second hit: confirmed
     assert len(t.tracks()) == 1
     t.update(np.zeros((0, 9), np.float32), 0.1)
+    # a car that missed one scan is still reported (report_misses 1, 1, 0), as coasting, without a detection
+    out = t.tracks()
+    assert len(out) == 1 and out["state"][0] == tn.COASTING and out["det"][0] == -1
+    t.update(np.zeros((0, 9), np.float32), 0.1)
     assert len(t.tracks()) == 0 and len(t.tracks(tn.OUT_COASTING)) == 1
     assert t.tracks(tn.OUT_COASTING)["det"][0] == -1
+    # a pedestrian is not (report_misses 0), nor a car with report_misses 0
+    for cls, rep in ((2, None), (0, [0, 1, 0])):
+        t = tn.Tracker() if rep is None else tn.Tracker(report_misses=rep)
+        dp = d.copy()
+        dp[0, 0] = cls
+        t.update(dp, 0.1)
+        t.update(dp, 0.1)
+        t.update(np.zeros((0, 9), np.float32), 0.1)
+        assert len(t.tracks()) == 0 and len(t.tracks(tn.OUT_COASTING)) == 1
+    with pytest.raises(ValueError):
+        tn.Tracker(report_misses=0.5)
     t.reset()
     assert len(t.tracks(3)) == 0
     out = t.update(d, 0.1, flags=tn.OUT_TENTATIVE)

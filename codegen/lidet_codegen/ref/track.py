@@ -59,6 +59,7 @@ def cfg_default() -> dict:
         "assign": ASSIGN_OPTIMAL,
         "confirm_hits": 2,
         "max_misses": 12,
+        "report_misses": [1, 1, 0],
         "birth_min_score": 0.0,
         "yaw_alpha": 0.5,
         "size_alpha": 0.3,
@@ -82,6 +83,8 @@ def cfg_ok(c: dict) -> bool:
     if int(c["assign"]) not in (ASSIGN_OPTIMAL, ASSIGN_GREEDY):
         return False
     if not (1 <= int(c["confirm_hits"]) <= 1000 and 0 <= int(c["max_misses"]) <= 1000):
+        return False
+    if not all(0 <= int(v) <= 1000 for v in c["report_misses"]):
         return False
     if not (rng(c["birth_min_score"], 0, 1) and rng(c["yaw_alpha"], 0, 1) and rng(c["size_alpha"], 0, 1)
             and rng(c["heading_speed_mps"], 0, 100)):
@@ -411,7 +414,8 @@ class Tracker:
         """lidet_tracker_tracks: the tracks in id order (TRACK_DTYPE)."""
         keep = self.used.copy()
         if not flags & OUT_COASTING:
-            keep &= self.state != COASTING
+            rep = np.asarray(self.cfg["report_misses"], np.int64)[np.minimum(self.cls, 2).astype(np.int64)]
+            keep &= (self.state != COASTING) | (self.misses.astype(np.int64) <= rep)
         if not flags & OUT_TENTATIVE:
             keep &= self.state != TENTATIVE
         s = np.flatnonzero(keep)

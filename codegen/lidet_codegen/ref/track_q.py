@@ -44,7 +44,7 @@ OK, TRUNCATED, ERR_ARG, ERR_CONFIG, ERR_STATE = 0, 1, -1, -2, -5
 CFG_FIELDS = (("meas_sigma_mm", 3), ("accel_sigma_mmps2", 3), ("init_vel_sigma_mmps", 3), ("gate_max_mm", 3),
               ("gate_chi2_q16", 1), ("class_penalty_q16", 1), ("assign", 1), ("confirm_hits", 1), ("max_misses", 1),
               ("birth_min_score_q15", 1), ("yaw_alpha_q15", 1), ("size_alpha_q15", 1), ("heading_speed_mmps", 1),
-              ("heading_from_velocity", 1))
+              ("heading_from_velocity", 1), ("report_misses", 3))
 CFG_LEN = sum(n for _, n in CFG_FIELDS)
 
 #: one output track (lidet_track_q_t), the bindings' flat rows
@@ -127,6 +127,7 @@ def cfg_default() -> dict:
         "assign": ASSIGN_OPTIMAL,
         "confirm_hits": 2,
         "max_misses": 12,
+        "report_misses": [1, 1, 0],
         "birth_min_score_q15": 0,
         "yaw_alpha_q15": 16384,
         "size_alpha_q15": 9830,
@@ -207,7 +208,8 @@ def cfg_ok(c: dict) -> bool:
             and int(c["assign"]) in (ASSIGN_OPTIMAL, ASSIGN_GREEDY) and rng(c["confirm_hits"], 1, 1000)
             and rng(c["max_misses"], 0, 1000) and rng(c["birth_min_score_q15"], 0, 32768)
             and rng(c["yaw_alpha_q15"], 0, 32768) and rng(c["size_alpha_q15"], 0, 32768)
-            and rng(c["heading_speed_mmps"], 0, VMAX_MMPS) and rng(c["heading_from_velocity"], 0, 7))
+            and rng(c["heading_speed_mmps"], 0, VMAX_MMPS) and rng(c["heading_from_velocity"], 0, 7)
+            and all(rng(v, 0, 1000) for v in c["report_misses"]))
 
 
 def tracks_to_si(rows) -> np.ndarray:
@@ -529,7 +531,9 @@ class TrackerQ:
 
     def tracks(self, flags: int = 0, cap: int | None = None) -> np.ndarray:
         """lidet_tracker_q_tracks: int64 rows of TRACK_Q_FIELDS in id order (the lowest cap ids)."""
-        keep = self.active & ((self.state == CONFIRMED) | ((self.state == COASTING) & bool(flags & OUT_COASTING))
+        rep = np.asarray(self.cfg["report_misses"], np.int64)[np.minimum(self.cls, 2).astype(np.int64)]
+        coast = bool(flags & OUT_COASTING) | (self.misses.astype(np.int64) <= rep)
+        keep = self.active & ((self.state == CONFIRMED) | ((self.state == COASTING) & coast)
                               | ((self.state == TENTATIVE) & bool(flags & OUT_TENTATIVE)))
         s = np.flatnonzero(keep)
         s = s[np.argsort(self.id[s], kind="stable")]

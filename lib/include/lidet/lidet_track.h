@@ -67,18 +67,22 @@ typedef struct
                                                     default 10, 6, 3 */
     float gate_max_m[LIDET_N_CLASSES];         /**< no association beyond this centre distance (the track's
                                                     class), metres; (0, 1000]; default 4.0, 3.0, 2.0 */
-    float gate_chi2;                /**< Mahalanobis gate (2 dof); (0, 1000]; default 9.21 (99 %) */
-    float class_penalty;            /**< cost added when the classes differ; [0, 1000]; default 2 */
-    uint32_t assign;                /**< lidet_track_assign_t; default LIDET_TRACK_ASSIGN_OPTIMAL */
-    uint32_t confirm_hits;          /**< hits that confirm a tentative track; [1, 1000]; default 2 */
-    uint32_t max_misses;            /**< misses in a row a confirmed track survives; [0, 1000];
+    float gate_chi2;                         /**< Mahalanobis gate (2 dof); (0, 1000]; default 9.21 (99 %) */
+    float class_penalty;                     /**< cost added when the classes differ; [0, 1000]; default 2 */
+    uint32_t assign;                         /**< lidet_track_assign_t; default LIDET_TRACK_ASSIGN_OPTIMAL */
+    uint32_t confirm_hits;                   /**< hits that confirm a tentative track; [1, 1000]; default 2 */
+    uint32_t max_misses;                     /**< misses in a row a confirmed track survives; [0, 1000];
                                                     default 12 */
-    float birth_min_score;          /**< detections scored below start no track; [0, 1]; default 0 */
-    float yaw_alpha;                /**< weight of a new yaw in the average; [0, 1]; default 0.5 */
-    float size_alpha;               /**< weight of a new z, l, w, h; [0, 1]; default 0.3 */
-    float heading_speed_mps;        /**< speed from which the reported heading follows the motion,
+    uint32_t report_misses[LIDET_N_CLASSES]; /**< lidet_tracker_tracks without LIDET_TRACK_OUT_COASTING still
+                                                    reports a confirmed track of the class that has missed at
+                                                    most this many scans in a row (its predicted box, state
+                                                    COASTING, det_index -1); [0, 1000]; default 1, 1, 0 */
+    float birth_min_score;                   /**< detections scored below start no track; [0, 1]; default 0 */
+    float yaw_alpha;                         /**< weight of a new yaw in the average; [0, 1]; default 0.5 */
+    float size_alpha;                        /**< weight of a new z, l, w, h; [0, 1]; default 0.3 */
+    float heading_speed_mps;                 /**< speed from which the reported heading follows the motion,
                                                     m/s; [0, 100]; default 1.0 */
-    uint32_t heading_from_velocity; /**< classes (bits 1 << lidet_class_t) whose reported heading
+    uint32_t heading_from_velocity;          /**< classes (bits 1 << lidet_class_t) whose reported heading
                                                     is the direction of motion; no bit >= LIDET_N_CLASSES;
                                                     default LIDET_TRACK_HEADING_FROM_VELOCITY_DEFAULT */
 } lidet_tracker_cfg_t;
@@ -202,8 +206,9 @@ lidet_status_t lidet_tracker_update(lidet_tracker_t *t, const lidet_detection_t 
                                     float dt_s, const lidet_ego_t *ego);
 
 /**
- * @brief Copy the tracks in id order: confirmed tracks updated by the last update always, confirmed tracks that
- *        missed it with LIDET_TRACK_OUT_COASTING, tentative ones with LIDET_TRACK_OUT_TENTATIVE.
+ * @brief Copy the tracks in id order: confirmed tracks updated by the last update always, and those that missed
+ *        at most cfg.report_misses[class] scans in a row; every confirmed track that missed it with
+ *        LIDET_TRACK_OUT_COASTING, tentative ones with LIDET_TRACK_OUT_TENTATIVE.
  * @param[in]  t     tracker (0 for NULL or not initialised).
  * @param[out] out   cap tracks; may be NULL when cap is 0.
  * @param[in]  cap   entries of out; the tracks past it (highest ids) are not copied.

@@ -65,6 +65,7 @@ typedef struct
     uint32_t assign;                              /**< lidet_track_assign_t */
     uint32_t confirm_hits;                        /**< [1, 1000] */
     uint32_t max_misses;                          /**< [0, 1000] */
+    uint32_t report_misses[LIDET_N_CLASSES];      /**< as lidet_tracker_cfg_t's; [0, 1000] */
     int32_t birth_min_score_q15;                  /**< [0, 32768] */
     int32_t yaw_alpha_q15;                        /**< weight of a new yaw; [0, 32768] */
     int32_t size_alpha_q15;                       /**< weight of a new z, l, w, h; [0, 32768] */
@@ -158,7 +159,7 @@ typedef struct
 
 /** @brief docs/TRACKING.md's defaults in integer units: meas_sigma 300, 250, 200 mm; accel_sigma 2000, 2500,
  *         1500 mm/s^2; init_vel_sigma 10000, 6000, 3000 mm/s; gate_max 4000, 3000, 2000 mm; gate_chi2 603587
- *         (9.21); class_penalty 131072 (2.0); optimal; confirm_hits 2; max_misses 12; birth_min_score 0;
+ *         (9.21); class_penalty 131072 (2.0); optimal; confirm_hits 2; max_misses 12; report_misses 1, 1, 0; birth_min_score 0;
  *         yaw_alpha 16384 (0.5); size_alpha 9830 (0.3); heading_speed 1000 mm/s; pedestrian and cyclist.
  *  @param[out] cfg filled; ignored when NULL. */
 void lidet_tracker_q_cfg_default(lidet_tracker_q_cfg_t *cfg);

@@ -37,6 +37,9 @@ void lidet_tracker_cfg_default(lidet_tracker_cfg_t *cfg)
     cfg->assign = (uint32_t)LIDET_TRACK_ASSIGN_OPTIMAL;
     cfg->confirm_hits = 2u;
     cfg->max_misses = 12u;
+    cfg->report_misses[LIDET_CLASS_CAR] = 1u;
+    cfg->report_misses[LIDET_CLASS_CYCLIST] = 1u;
+    cfg->report_misses[LIDET_CLASS_PEDESTRIAN] = 0u;
     cfg->birth_min_score = 0.0f;
     cfg->yaw_alpha = 0.5f;
     cfg->size_alpha = 0.3f;
@@ -74,6 +77,13 @@ static int cfg_ok(const lidet_tracker_cfg_t *c)
     if (c->confirm_hits < 1u || c->confirm_hits > 1000u || c->max_misses > 1000u)
     {
         return 0;
+    }
+    for (k = 0; k < (uint32_t)LIDET_N_CLASSES; ++k)
+    {
+        if (c->report_misses[k] > 1000u)
+        {
+            return 0;
+        }
     }
     if (!in_range(c->birth_min_score, 0.0f, 1.0f) || !in_range(c->yaw_alpha, 0.0f, 1.0f) ||
         !in_range(c->size_alpha, 0.0f, 1.0f) || !in_range(c->heading_speed_mps, 0.0f, 100.0f))
@@ -643,7 +653,8 @@ uint32_t lidet_tracker_tracks(const lidet_tracker_t *t, lidet_track_t *out, uint
             {
                 continue;
             }
-            if ((k->state == (uint8_t)LIDET_TRACK_COASTING && !(flags & LIDET_TRACK_OUT_COASTING)) ||
+            if ((k->state == (uint8_t)LIDET_TRACK_COASTING && !(flags & LIDET_TRACK_OUT_COASTING) &&
+                 k->misses > t->cfg.report_misses[k->cls]) ||
                 (k->state == (uint8_t)LIDET_TRACK_TENTATIVE && !(flags & LIDET_TRACK_OUT_TENTATIVE)))
             {
                 continue;

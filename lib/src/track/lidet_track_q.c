@@ -108,6 +108,9 @@ void lidet_tracker_q_cfg_default(lidet_tracker_q_cfg_t *cfg)
     cfg->assign = (uint32_t)LIDET_TRACK_ASSIGN_OPTIMAL;
     cfg->confirm_hits = 2;
     cfg->max_misses = 12;
+    cfg->report_misses[LIDET_CLASS_CAR] = 1u;
+    cfg->report_misses[LIDET_CLASS_CYCLIST] = 1u;
+    cfg->report_misses[LIDET_CLASS_PEDESTRIAN] = 0u;
     cfg->birth_min_score_q15 = 0;
     cfg->yaw_alpha_q15 = 16384; /* 0.5 */
     cfg->size_alpha_q15 = 9830; /* 0.3 */
@@ -134,7 +137,8 @@ static int cfg_ok(const lidet_tracker_q_cfg_t *c)
            in_range(c->birth_min_score_q15, 0, 32768) && in_range(c->yaw_alpha_q15, 0, 32768) &&
            in_range(c->size_alpha_q15, 0, 32768) &&
            in_range(c->heading_speed_mmps, 0, LIDET_TRACK_Q_VMAX_MMPS) &&
-           c->heading_from_velocity < (1u << LIDET_N_CLASSES);
+           c->heading_from_velocity < (1u << LIDET_N_CLASSES) && c->report_misses[0] <= 1000u &&
+           c->report_misses[1] <= 1000u && c->report_misses[2] <= 1000u;
 }
 
 lidet_status_t lidet_tracker_q_init(lidet_tracker_q_t *t, const lidet_tracker_q_cfg_t *cfg)
@@ -678,11 +682,12 @@ static void report(const lidet_tracker_q_cfg_t *cfg, const lidet_track_q_slot_t 
     o->det_index = s->det_index;
 }
 
-static int wanted(const lidet_track_q_slot_t *s, uint32_t flags)
+static int wanted(const lidet_tracker_q_cfg_t *cfg, const lidet_track_q_slot_t *s, uint32_t flags)
 {
     return s->active &&
            (s->state == (uint8_t)LIDET_TRACK_CONFIRMED ||
-            (s->state == (uint8_t)LIDET_TRACK_COASTING && (flags & LIDET_TRACK_OUT_COASTING) != 0u) ||
+            (s->state == (uint8_t)LIDET_TRACK_COASTING &&
+             ((flags & LIDET_TRACK_OUT_COASTING) != 0u || s->misses <= cfg->report_misses[s->cls])) ||
             (s->state == (uint8_t)LIDET_TRACK_TENTATIVE && (flags & LIDET_TRACK_OUT_TENTATIVE) != 0u));
 }
 
@@ -701,7 +706,7 @@ uint32_t lidet_tracker_q_tracks(const lidet_tracker_q_t *t, lidet_track_q_t *out
         for (i = 0; i < (uint32_t)LIDET_TRACK_MAX_TRACKS; ++i)
         {
             const lidet_track_q_slot_t *s = &t->slot[i];
-            if (wanted(s, flags) && s->id > last &&
+            if (wanted(&t->cfg, s, flags) && s->id > last &&
                 (best == LIDET_TRACK_MAX_TRACKS || s->id < t->slot[best].id))
             {
                 best = i;

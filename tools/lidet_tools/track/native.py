@@ -35,8 +35,8 @@ STATS = ("n_tracks", "n_confirmed", "n_births", "n_births_dropped", "n_deaths", 
 _CFG = (("meas_sigma_m", 3), ("accel_sigma_mps2", 3), ("init_vel_sigma_mps", 3), ("gate_max_m", 3),
         ("gate_chi2", 1), ("class_penalty", 1), ("assign", 1), ("confirm_hits", 1), ("max_misses", 1),
         ("birth_min_score", 1), ("yaw_alpha", 1), ("size_alpha", 1), ("heading_speed_mps", 1),
-        ("heading_from_velocity", 1))
-_INT_FIELDS = {"assign", "confirm_hits", "max_misses", "heading_from_velocity"}
+        ("heading_from_velocity", 1), ("report_misses", 3))
+_INT_FIELDS = {"assign", "confirm_hits", "max_misses", "heading_from_velocity", "report_misses"}
 # docs/TRACKING.md's names (without the unit suffix) are accepted too
 _ALIASES = {"meas_sigma": "meas_sigma_m", "accel_sigma": "accel_sigma_mps2", "init_vel_sigma": "init_vel_sigma_mps",
             "gate_max": "gate_max_m", "heading_speed": "heading_speed_mps"}
@@ -114,7 +114,9 @@ def _flat_cfg(overrides: dict) -> tuple[dict, np.ndarray]:
             v = sum(1 << (CLASSES.index(c) if isinstance(c, str) else int(c)) for c in v)
         if isinstance(cfg[name], list):
             arr = np.broadcast_to(np.asarray(v, dtype=np.float64), (3,))
-            v = [float(x) for x in arr]
+            if name in _INT_FIELDS and not np.all(arr == np.floor(arr)):
+                raise ValueError(f"{name}: expected integers, got {v!r}")
+            v = [int(x) for x in arr] if name in _INT_FIELDS else [float(x) for x in arr]
         elif name in _INT_FIELDS:
             if isinstance(v, (bool, np.bool_)) or float(v) != int(v):
                 raise ValueError(f"{name}: expected an integer, got {v!r}")
