@@ -46,9 +46,9 @@ set(LIDET_SRC_QMATH_INT qmath/lidet_qmath.c qmath/lidet_qmath_tables.c)
 # status strings, sort
 set(LIDET_SRC_COMMON_FLOAT)
 set(LIDET_SRC_COMMON_INT common/lidet_status.c common/lidet_sort.c)
-# Velodyne packet decoding: the x, y, z of returns (float); the decoder itself (integer)
+# packet decoding: the Velodyne returns' x, y, z (float); the Velodyne and Ouster decoders (integer)
 set(LIDET_SRC_DECODE_FLOAT decode/lidet_velodyne_xyz.c)
-set(LIDET_SRC_DECODE_INT decode/lidet_velodyne.c)
+set(LIDET_SRC_DECODE_INT decode/lidet_velodyne.c decode/lidet_ouster.c)
 
 set(LIDET_FLOAT_SOURCES)
 set(LIDET_FIXED_SOURCES)

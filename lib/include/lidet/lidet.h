@@ -25,6 +25,7 @@
 #include "lidet_ground.h"
 #include "lidet_ground_q.h"
 #include "lidet_opt.h"
+#include "lidet_ouster.h"
 #include "lidet_pointnet.h"
 #include "lidet_pointnet_q.h"
 #include "lidet_proj.h"
