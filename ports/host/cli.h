@@ -30,6 +30,7 @@ typedef struct
 {
     const char *scan_path;  /* positional SCAN.bin */
     const char *sensor;     /* --sensor NAME (default hdl64); a file's sensor: its name */
+    int sensor_given;       /* --sensor was on the command line (--pcap: else the packets say) */
     const char *sensor_file; /* --sensor-file F: a lidet sensor description (JSON) */
     const char *ouster_meta; /* --ouster-meta M: Ouster's sensor metadata (JSON) */
     int print_sensor;       /* --print-sensor: print the sensor as a lidet description and stop */
@@ -61,6 +62,21 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a);
 /* Reads a->sensor_file or a->ouster_meta into a->desc and points the profiles at it (cli_sensor.c). Returns 0, or
  * prints "lidet CMD: FILE: problem" (or that this lidet was built without cJSON) and returns 1. */
 int cli_sensor_load(cli_args_t *a, const char *cmd);
+/* The packet format of Ouster's metadata (--ouster-meta; the rules of tools/lidet_tools/ouster.py load_metadata):
+ * what lidet_ouster_cfg_t takes besides the beam count and columns (a->desc) */
+typedef struct
+{
+    int profile;                 /* lidet_ouster_profile_t (udp_profile_lidar; absent: LEGACY) */
+    int header;                  /* lidet_ouster_header_t (header_type; absent: STANDARD) */
+    uint16_t columns_per_packet; /* absent: 16 */
+    uint16_t azimuth_offset_bam; /* the turn of lidar_to_sensor_transform about z (absent: ouster-sdk's half turn) */
+    uint32_t init_id;            /* initialization_id (0: unknown, not checked) */
+    uint64_t prod_sn;            /* prod_sn (0: unknown, not checked) */
+    uint32_t udp_port_lidar;     /* absent: 7502 */
+    int32_t beam_azimuth_mdeg[LIDET_MAX_ROWS]; /* beam_azimuth_angles (absent: 0) */
+} cli_ouster_fmt_t;
+/* Reads it from a->ouster_meta (a->desc already loaded): 0, or 1 with a message. */
+int cli_ouster_format(const cli_args_t *a, cli_ouster_fmt_t *o);
 /* Prints the command's sensor as a lidet sensor description (JSON, version 1) after --mount-height. */
 void cli_sensor_print(const cli_args_t *a, FILE *f);
 /* Reads the scan (and ring file); clear error and 1 on a missing, truncated or odd-sized file. */
@@ -179,14 +195,66 @@ int cli_cluster(int argc, char **argv);
 int cli_detect(int argc, char **argv);
 int cli_track(int argc, char **argv);
 /* `lidet detect --fixed` (cli_detect_q.c): the scan through the integer detector, results as float detections;
- * ms: LIDET_DET_N_STAGES + 1 medians; point_ground / point_cluster optional (n_points entries). */
+ * ms: LIDET_DET_N_STAGES + 1 medians; point_ground / point_cluster optional (n_points entries). returns: NULL (the
+ * scan's points, or with --returns their returns), or a->n_points returns the sensor gave (--pcap), fed as they
+ * are (lidet_detector_q_run_returns). */
 int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, const char *family,
                      lidet_detection_t *det, uint32_t *n_det, lidet_detector_stats_t *ds, double *ms,
-                     uint8_t *point_ground, uint32_t *point_cluster, lidet_status_t *status);
+                     uint8_t *point_ground, uint32_t *point_cluster, lidet_status_t *status,
+                     const lidet_return_t *returns);
 /* `lidet detect --fixed --dump FILE` (cli_detect_q.c): the last integer run's results bit for bit (format at
  * cli_detect_q_dump); point_cluster / point_ground: n_points entries as cli_detect_q_run filled them. 0 or -1. */
 int cli_detect_q_dump(const char *path, uint32_t n_points, const uint32_t *point_cluster,
                       const uint8_t *point_ground);
+
+/* ---- packet captures: lidet detect --pcap, lidet track --pcap (cli_pcap.c, docs/DECODING.md) ---- */
+typedef struct
+{
+    const char *path;  /* --pcap FILE (NULL: scans from files) */
+    const char *lidar; /* --lidar velodyne (default) | ouster (with --ouster-meta M) */
+    int port;          /* --port N: the data port (0: the lidar's: Velodyne 2368, Ouster the metadata's, 7502) */
+    int force_sensor;  /* --force-sensor: every packet decoded as --sensor's model (lidet_velodyne_cfg_t.force_model) */
+    const char *dual;  /* --dual: both | last | strongest (Velodyne), both | first | second (Ouster); NULL: both */
+    int partial;       /* --partial: also the scans that are not one whole rotation */
+    long png_scan;     /* --png-scan K (detect): the scan drawn by --png (-1: the last) */
+} cli_pcap_opts_t;
+/* one scan of a capture */
+typedef struct
+{
+    uint32_t index;                   /* K: its number among the scans run, from 0 */
+    uint8_t kind;                     /* lidet_velodyne_scan_t (lidet_ouster_scan_t alike): COMPLETE; with --partial
+                                         also PARTIAL, ABORTED and NONE (unfinished at the end of the capture) */
+    uint32_t first_frame, last_frame; /* P..Q: the frames of the file (from 0) that hold its returns */
+    uint32_t n_returns;               /* returns in the scan (<= LIDET_MAX_POINTS) */
+    uint32_t n_excess;                /* returns past LIDET_MAX_POINTS: counted, dropped */
+    int64_t t_us;     /* the sensor's time of its first packet, us (Velodyne: the payload's timestamp, unwrapped
+                         across the hour; Ouster: its first valid column's timestamp) */
+    double capture_s; /* the capture's (pcap) timestamp of that packet, s */
+} cli_scan_info_t;
+typedef struct cli_capture cli_capture_t;
+void cli_pcap_opts_default(cli_pcap_opts_t *o);
+/* argv[*i] when it is a capture option (--pcap, --lidar, --port, --force-sensor, --dual, --partial, --png-scan):
+ * taken into o, *i moved past its value, 1; 0 when it is not one; -1 after a message (a bad value) */
+int cli_pcap_option(cli_pcap_opts_t *o, int argc, char **argv, int *i);
+/* their usage lines (detect: with --png-scan and the output format) */
+void cli_pcap_usage(FILE *f, int detect);
+/* Reads the whole capture once (frames counted, the decoder run, the scans listed) and, when --sensor was not
+ * given, sets a's sensor (and its --mount-height) to the packets' model. 0 and *c; or 1 with a message (no libpcap
+ * in this build, not a capture, no packet, none on the port, no data the decoder takes, no scan to run). */
+int cli_capture_open(const cli_pcap_opts_t *o, cli_args_t *a, cli_capture_t **c);
+/* the scans listed by cli_capture_open (the number cli_capture_next gives) */
+uint32_t cli_capture_n_scans(const cli_capture_t *c);
+/* scan k of those (k < cli_capture_n_scans), as pass 1 listed it; NULL past them */
+const cli_scan_info_t *cli_capture_info(const cli_capture_t *c, uint32_t k);
+/* The next scan: 1 with a->points (x, y, z, 0), a->ring, a->n_points and *returns (the decoder's) pointing into c
+ * (valid until the next call; not to be freed) and *info; 0 after the last; -1 with a message. */
+int cli_capture_next(cli_capture_t *c, cli_args_t *a, const lidet_return_t **returns, cli_scan_info_t *info);
+/* The summary (frames, decoder counts, scans, time: det_ms[n_run] the detector's per scan, may be NULL). 1 when
+ * the capture was damaged or cut short (said), else 0: the command's exit status. */
+int cli_capture_summary(const cli_capture_t *c, FILE *f, const double *det_ms, uint32_t n_run);
+void cli_capture_close(cli_capture_t *c);
+/* "complete", "partial", "aborted", "unfinished" */
+const char *cli_scan_kind(uint8_t kind);
 
 #define M_PI_D 3.14159265358979323846
 
@@ -225,6 +293,8 @@ void cli_scene_box(const cli_scene_t *s, const lidet_box_t *b, const uint8_t c[3
 /* points (x, y, z, remission records) as `lidet detect --png` draws them: obstacles grey, ground (ground[i] != 0;
  * ground NULL: none) dark where no other point is */
 void cli_scene_points(const cli_scene_t *s, const float *pts, uint32_t n, const uint8_t *ground);
+/* makes a folder and the folders above it that are missing (mkdir -p; cli_track.c): 0, or 1 with a message */
+int cli_make_dir(const char *path);
 /* the file name of a path (after its last '/') */
 const char *cli_basename(const char *path);
 

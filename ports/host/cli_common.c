@@ -121,6 +121,7 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
         usage(cmd);
         return 1;
     }
+    a->sensor_given = sensor_given;
     if ((a->sensor_file != NULL) + (a->ouster_meta != NULL) + sensor_given > 1)
     {
         fprintf(stderr, "lidet %s: give one of --sensor, --sensor-file and --ouster-meta\n", cmd);

@@ -374,6 +374,76 @@ static int write_png(const char *path, const float *pts, uint32_t n, const uint8
     return rc;
 }
 
+/* the detections as lidet's sensor-frame lines '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' (--out) */
+static void box_lines(FILE *f, const lidet_detection_t *det, uint32_t n_det)
+{
+    uint32_t k;
+    for (k = 0; k < n_det; ++k)
+        fprintf(f, "%s %.4f %.4f %.4f %.4f %.4f %.4f %.5f %.4f\n", cli_class_names[det[k].cls], (double)det[k].box.cx_m,
+                (double)det[k].box.cy_m, (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m,
+                (double)det[k].box.h_m, (double)det[k].box.yaw_rad, (double)det[k].score);
+}
+
+/* the JSON object of a run (one line); scan: the capture's scan (--pcap: its number, kind, frames, returns and times
+ * first), or NULL */
+static void json_result(const cli_args_t *a, const char *chosen, const lidet_detector_cfg_t *cfg,
+                        const lidet_detector_stats_t *ds, const lidet_detection_t *det, uint32_t n_det, lidet_status_t st,
+                        const double *ms, const cli_scan_info_t *scan)
+{
+    uint32_t k;
+    cli_json_begin(stdout);
+    if (scan != NULL)
+    {
+        cli_json_int(stdout, "scan", scan->index);
+        cli_json_str(stdout, "kind", cli_scan_kind(scan->kind));
+        cli_json_int(stdout, "first_packet", scan->first_frame);
+        cli_json_int(stdout, "last_packet", scan->last_frame);
+        cli_json_int(stdout, "returns", scan->n_returns);
+        cli_json_int(stdout, "excess_returns", scan->n_excess);
+        fprintf(stdout, ", \"sensor_time_s\": %.6f, \"capture_time_s\": %.6f", (double)scan->t_us * 1e-6,
+                scan->capture_s);
+    }
+    cli_json_str(stdout, "sensor", a->sensor);
+    cli_json_str(stdout, "model", chosen);
+    cli_json_int(stdout, "points", a->n_points);
+    cli_json_int(stdout, "clusters", ds->n_clusters);
+    cli_json_int(stdout, "out_of_crop", ds->n_out_of_crop);
+    cli_json_int(stdout, "out_of_range", ds->n_out_of_range);
+    cli_json_int(stdout, "too_tall", ds->n_too_tall);
+    cli_json_int(stdout, "over_budget", ds->n_over_budget);
+    cli_json_int(stdout, "budget", cfg->max_proposals);
+    cli_json_int(stdout, "classified", ds->n_classified);
+    cli_json_int(stdout, "gate1_rejected", ds->n_gate1_rejected);
+    cli_json_int(stdout, "boxed", ds->n_boxed);
+    cli_json_int(stdout, "box_budget", cfg->max_boxes);
+    cli_json_int(stdout, "over_box_budget", ds->n_over_box_budget);
+    cli_json_int(stdout, "gate2_rejected", ds->n_gate2_rejected);
+    cli_json_int(stdout, "size_rejected", ds->n_size_rejected);
+    cli_json_int(stdout, "nms_suppressed", ds->n_nms_suppressed);
+    cli_json_int(stdout, "detections", n_det);
+    cli_json_int(stdout, "status", st);
+    cli_json_int(stdout, "repeat", a->repeat);
+    cli_json_num(stdout, "project_ms", ms[LIDET_DET_STAGE_PROJECT]);
+    cli_json_num(stdout, "ground_ms", ms[LIDET_DET_STAGE_GROUND]);
+    cli_json_num(stdout, "cluster_ms", ms[LIDET_DET_STAGE_CLUSTER]);
+    cli_json_num(stdout, "classify_ms", ms[LIDET_DET_STAGE_CLASSIFY]);
+    cli_json_num(stdout, "box_ms", ms[LIDET_DET_STAGE_BOX]);
+    cli_json_num(stdout, "post_ms", ms[LIDET_DET_STAGE_POST]);
+    cli_json_num(stdout, "total_ms", ms[LIDET_DET_N_STAGES]);
+    fprintf(stdout, ", \"boxes\": [");
+    for (k = 0; k < n_det; ++k)
+        fprintf(stdout,
+                "%s{\"class\": \"%s\", \"score\": %.5f, \"energy_cls\": %.4f, \"energy_box\": %.4f, "
+                "\"x\": %.4f, \"y\": %.4f, \"z\": %.4f, \"l\": %.4f, \"w\": %.4f, \"h\": %.4f, \"yaw\": %.5f, "
+                "\"cluster\": %u, \"cluster_points\": %u}",
+                k ? ", " : "", cli_class_names[det[k].cls], (double)det[k].score, (double)det[k].energy_cls,
+                (double)det[k].energy_box, (double)det[k].box.cx_m, (double)det[k].box.cy_m,
+                (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m, (double)det[k].box.h_m,
+                (double)det[k].box.yaw_rad, det[k].cluster_id, det[k].n_points);
+    fprintf(stdout, "]");
+    cli_json_end(stdout);
+}
+
 /* ---- options -------------------------------------------------------------------------------------- */
 
 static int apply_set(lidet_detector_cfg_t *c, const char *kv)
@@ -537,7 +607,9 @@ static void usage_extra(void)
                     "  --dump FILE      every result bit for bit (per-point labels, clusters, proposals,\n"
                     "                   detections; binary, see write_dump in cli_detect.c; with --fixed the\n"
                     "                   integer detector's labels, outcomes, counts and detections,\n"
-                    "                   cli_detect_q_dump in cli_detect_q.c)\n");
+                    "                   cli_detect_q_dump in cli_detect_q.c)\n"
+                    "  lidet detect --pcap FILE [options]: the scans of a packet capture (Velodyne):\n");
+    cli_pcap_usage(stderr, 1);
 }
 
 int cli_det_option(cli_det_opts_t *o, int argc, char **argv, int *i)
@@ -675,6 +747,178 @@ int cli_detect_f_ground(const int32_t *pp, uint32_t n_points, uint8_t *point_gro
     return rc;
 }
 
+/* ---- --pcap: every scan of a capture (cli_pcap.c) ------------------------------------------------------- */
+
+/* --save-scans DIR: the scan as KITTI files, DIR/velodyne/<K:06d>.bin (float32 x, y, z, 0) and DIR/ring/<K:06d>.bin
+ * (uint16 ring per point): what `lidet detect FILE --ring RING` and the Python tools read. 0, or 1 with a message. */
+static int save_scan(const char *dir, uint32_t k, const cli_args_t *a)
+{
+    const size_t len = strlen(dir) + 32u;
+    char *path = (char *)malloc(len);
+    int bad = path == NULL, sub;
+    for (sub = 0; sub < 2 && !bad; ++sub)
+    {
+        FILE *f;
+        snprintf(path, len, "%s/%s/%06u.bin", dir, sub ? "ring" : "velodyne", k);
+        f = fopen(path, "wb");
+        bad = f == NULL ||
+              (sub ? fwrite(a->ring, sizeof(uint16_t), a->n_points, f) : fwrite(a->points, 4u * sizeof(float),
+                                                                                a->n_points, f)) != a->n_points;
+        if (f != NULL && fclose(f) != 0)
+            bad = 1;
+        if (bad)
+            fprintf(stderr, "lidet detect: cannot write '%s'\n", path);
+    }
+    free(path);
+    return bad;
+}
+
+/* `lidet detect --pcap FILE`: per scan of the capture a header line and its box lines (or a JSON object), --out
+ * DIR/<K:06d>.txt, --png the last scan (or --png-scan K); the capture's summary on stderr. */
+static int detect_pcap(cli_args_t *a, const cli_det_opts_t *o, const cli_pcap_opts_t *po, const char *save_dir)
+{
+    static lidet_detection_t det_q[LIDET_MAX_DETECTIONS];
+    static lidet_detector_stats_t ds_q;
+    cli_capture_t *cap = NULL;
+    lidet_detector_cfg_t cfg;
+    const lidet_pn_model_t *mc = NULL, *mb = NULL;
+    const lidet_return_t *rets;
+    cli_scan_info_t info;
+    char chosen[64], label[80];
+    int32_t *pp = NULL;
+    uint8_t *gp = NULL;
+    double *det_ms = NULL;
+    uint32_t n_scans, png_k, n_run = 0;
+    int rc = 1, got, warned = 0;
+
+    if (cli_capture_open(po, a, &cap) != 0)
+        return 1;
+    n_scans = cli_capture_n_scans(cap);
+    if (po->png_scan >= 0 && (uint32_t)po->png_scan >= n_scans)
+    {
+        fprintf(stderr, "lidet detect: --png-scan %ld: the capture gives %u scans (0..%u)\n", po->png_scan, n_scans,
+                n_scans - 1u);
+        goto done;
+    }
+    png_k = po->png_scan >= 0 ? (uint32_t)po->png_scan : n_scans - 1u;
+    if (cli_det_config(a, o, &cfg, &mc, &mb, chosen, sizeof chosen) != 0)
+        goto done;
+    snprintf(label, sizeof label, "%s%s", chosen, o->fixed ? " int8" : "");
+    if (a->out_path != NULL && cli_make_dir(a->out_path) != 0)
+        goto done;
+    if (save_dir != NULL)
+    {
+        const size_t len = strlen(save_dir) + 16u;
+        char *sub = (char *)malloc(len);
+        int bad = sub == NULL;
+        if (!bad)
+        {
+            snprintf(sub, len, "%s/velodyne", save_dir);
+            bad = cli_make_dir(sub) != 0;
+        }
+        if (!bad)
+        {
+            snprintf(sub, len, "%s/ring", save_dir);
+            bad = cli_make_dir(sub) != 0;
+        }
+        free(sub);
+        if (bad)
+            goto done;
+    }
+    pp = (int32_t *)malloc(sizeof(int32_t) * LIDET_MAX_POINTS);
+    gp = (uint8_t *)malloc((size_t)LIDET_MAX_POINTS + 1u);
+    det_ms = (double *)malloc(sizeof(double) * n_scans);
+    if (pp == NULL || gp == NULL || det_ms == NULL)
+        goto done;
+    if (!o->fixed && cli_detect_f_init(&cfg, mc, mb) != 0)
+        goto done;
+    while ((got = cli_capture_next(cap, a, &rets, &info)) == 1)
+    {
+        const int draw = a->png_path != NULL && info.index == png_k;
+        const lidet_detector_stats_t *ds;
+        const lidet_detection_t *det;
+        lidet_status_t st = LIDET_OK;
+        double ms[LIDET_DET_N_STAGES + 1];
+        uint32_t n_det = 0;
+        if (o->fixed)
+        {
+            if (cli_detect_q_run(a, &cfg, chosen, det_q, &n_det, &ds_q, ms, draw ? gp : NULL, NULL, &st, rets) != 0)
+                goto done;
+            det = det_q;
+            ds = &ds_q;
+        }
+        else if (cli_detect_f_run(a, pp, ms, &det, &n_det, &ds, &st) != 0)
+            goto done;
+        det_ms[n_run++] = ms[LIDET_DET_N_STAGES];
+        if (!warned && 2u * (uint32_t)ds->stages.ground.n_sectors_rejected > cfg.stages.ground.n_sectors)
+        {
+            fprintf(stderr,
+                    "lidet detect: warning: scan %u: the ground stage refused the planes of %u of %u sectors: is the "
+                    "mount height right? (--mount-height M; noted once)\n",
+                    info.index, (unsigned)ds->stages.ground.n_sectors_rejected, (unsigned)cfg.stages.ground.n_sectors);
+            warned = 1;
+        }
+        if (a->json)
+            json_result(a, label, &cfg, ds, det, n_det, st, ms, &info);
+        else
+        {
+            printf("# scan %u: %u returns, %u detections, packets %u..%u", info.index, info.n_returns, n_det,
+                   info.first_frame, info.last_frame);
+            if (info.kind != LIDET_VELODYNE_SCAN_COMPLETE)
+                printf(" (%s)", cli_scan_kind(info.kind));
+            if (info.n_excess > 0u)
+                printf("; %u returns past LIDET_MAX_POINTS dropped", info.n_excess);
+            printf("\n");
+            box_lines(stdout, det, n_det);
+        }
+        if (a->out_path != NULL)
+        {
+            const size_t len = strlen(a->out_path) + 16u;
+            char *path = (char *)malloc(len);
+            FILE *f;
+            if (path == NULL)
+                goto done;
+            snprintf(path, len, "%s/%06u.txt", a->out_path, info.index);
+            f = fopen(path, "w");
+            if (f != NULL)
+                box_lines(f, det, n_det);
+            if (f == NULL || fclose(f) != 0)
+            {
+                fprintf(stderr, "lidet detect: cannot write '%s'\n", path);
+                free(path);
+                goto done;
+            }
+            free(path);
+        }
+        if (save_dir != NULL && save_scan(save_dir, info.index, a) != 0)
+            goto done;
+        if (draw)
+        {
+            char title[256];
+            snprintf(title, sizeof title, "detect%s  %s scan %u (packets %u..%u)  %s (models %s)  %.1f ms",
+                     o->fixed ? " --fixed" : "", cli_basename(po->path), info.index, info.first_frame,
+                     info.last_frame, a->sensor, label, ms[LIDET_DET_N_STAGES]);
+            if ((!o->fixed && cli_detect_f_ground(pp, a->n_points, gp) != 0) ||
+                write_png(a->png_path, a->points, a->n_points, gp, det, n_det, NULL, 0, 0, title, a->n_points) != 0)
+            {
+                fprintf(stderr, "lidet detect: cannot write the picture '%s'\n", a->png_path);
+                goto done;
+            }
+        }
+    }
+    if (got < 0 || fflush(stdout) != 0)
+        goto done;
+    rc = cli_capture_summary(cap, stderr, det_ms, n_run);
+done:
+    a->points = NULL; /* the capture's buffers */
+    a->ring = NULL;
+    cli_capture_close(cap);
+    free(pp);
+    free(gp);
+    free(det_ms);
+    return rc;
+}
+
 int cli_detect(int argc, char **argv)
 {
     cli_args_t a;
@@ -683,10 +927,12 @@ int cli_detect(int argc, char **argv)
     const lidet_detector_stats_t *ds;
     const lidet_detection_t *det;
     lidet_status_t st = LIDET_OK;
-    const char *calib_path = NULL, *kitti_path = NULL, *gt_path = NULL, *gt_kitti_path = NULL, *dump_path = NULL;
+    const char *calib_path = NULL, *kitti_path = NULL, *gt_path = NULL, *gt_kitti_path = NULL, *dump_path = NULL,
+               *save_dir = NULL;
     char chosen[64];
     char **rest;
     cli_det_opts_t o;
+    cli_pcap_opts_t po;
     int nrest = 0, i, fixed = 0;
     static lidet_detection_t det_q[LIDET_MAX_DETECTIONS];
     static lidet_detector_stats_t ds_q;
@@ -705,9 +951,20 @@ int cli_detect(int argc, char **argv)
         free((void *)o.sets);
         return 1;
     }
+    cli_pcap_opts_default(&po);
     for (i = 0; i < argc; ++i)
     {
+        int taken;
         if (cli_det_option(&o, argc, argv, &i))
+            continue;
+        taken = cli_pcap_option(&po, argc, argv, &i);
+        if (taken < 0)
+        {
+            free(rest);
+            free((void *)o.sets);
+            return 1;
+        }
+        if (taken)
             continue;
         if (strcmp(argv[i], "--calib") == 0 && i + 1 < argc)
             calib_path = argv[++i];
@@ -719,12 +976,53 @@ int cli_detect(int argc, char **argv)
             gt_kitti_path = argv[++i];
         else if (strcmp(argv[i], "--dump") == 0 && i + 1 < argc)
             dump_path = argv[++i];
+        else if (strcmp(argv[i], "--save-scans") == 0 && i + 1 < argc)
+            save_dir = argv[++i];
         else if (strcmp(argv[i], "--returns") == 0)
             cli_fixed_returns = 1;
         else
             rest[nrest++] = argv[i];
     }
     fixed = o.fixed;
+    if (po.path == NULL && (po.port != 0 || po.force_sensor || po.partial || po.png_scan >= 0 ||
+                            po.dual != NULL || strcmp(po.lidar, "velodyne") != 0 || save_dir != NULL))
+    {
+        fprintf(stderr, "lidet detect: --lidar, --port, --force-sensor, --dual, --partial, --png-scan and --save-scans "
+                        "go with --pcap FILE\n");
+        free(rest);
+        free((void *)o.sets);
+        return 1;
+    }
+    if (po.path != NULL)
+    {
+        const char *one = calib_path != NULL      ? "--calib"
+                          : kitti_path != NULL    ? "--kitti-out"
+                          : gt_path != NULL       ? "--gt"
+                          : gt_kitti_path != NULL ? "--gt-kitti"
+                          : dump_path != NULL     ? "--dump"
+                                                  : NULL;
+        for (i = 0; one == NULL && i < nrest; ++i)
+            if (strcmp(rest[i], "--ring") == 0)
+                one = "--ring";
+            else if (rest[i][0] != '-' && (i == 0 || (strcmp(rest[i - 1], "--sensor") != 0 &&
+                                                      strcmp(rest[i - 1], "--out") != 0 &&
+                                                      strcmp(rest[i - 1], "--png") != 0 &&
+                                                      strcmp(rest[i - 1], "--repeat") != 0 &&
+                                                      strcmp(rest[i - 1], "--mount-height") != 0 &&
+                                                      strcmp(rest[i - 1], "--sensor-file") != 0 &&
+                                                      strcmp(rest[i - 1], "--ouster-meta") != 0)))
+                one = rest[i];
+        if (one != NULL)
+        {
+            fprintf(stderr, "lidet detect: %s goes with one scan file, not with --pcap (its scans are the capture's)\n",
+                    one);
+            free(rest);
+            free((void *)o.sets);
+            return 1;
+        }
+        rest[nrest++] = (char *)po.path; /* cli_parse's positional: the scans' source */
+        cli_fixed_returns = 0;           /* --fixed feeds the decoded returns as they are */
+    }
     i = cli_parse(nrest, rest, "detect", &a);
     if (i == 2 || i == 3) /* --print-sensor done, or a sensor file's error printed */
     {
@@ -740,6 +1038,12 @@ int cli_detect(int argc, char **argv)
         return 1;
     }
     free(rest);
+    if (po.path != NULL)
+    {
+        i = detect_pcap(&a, &o, &po, save_dir);
+        free((void *)o.sets);
+        return i;
+    }
     /* --range-only / --returns without --fixed, the models, --crop and --set */
     i = cli_det_config(&a, &o, &cfg, &mc, &mb, chosen, sizeof chosen);
     free((void *)o.sets);
@@ -760,7 +1064,7 @@ int cli_detect(int argc, char **argv)
         if (dump_path != NULL) /* the per-point cluster labels too */
             gp_ids = (uint32_t *)malloc(sizeof(uint32_t) * ((size_t)np + 1u));
         if (gp == NULL || (dump_path != NULL && gp_ids == NULL) ||
-            cli_detect_q_run(&a, &cfg, chosen, det_q, &n_det, &ds_q, ms, gp, gp_ids, &st) != 0)
+            cli_detect_q_run(&a, &cfg, chosen, det_q, &n_det, &ds_q, ms, gp, gp_ids, &st, NULL) != 0)
         {
             free(gp);
             free(gp_ids);
@@ -785,10 +1089,8 @@ outputs:
     if (a.out_path != NULL)
     {
         FILE *f = fopen(a.out_path, "w");
-        for (k = 0; f != NULL && k < n_det; ++k)
-            fprintf(f, "%s %.4f %.4f %.4f %.4f %.4f %.4f %.5f %.4f\n", cli_class_names[det[k].cls],
-                    (double)det[k].box.cx_m, (double)det[k].box.cy_m, (double)det[k].box.cz_m, (double)det[k].box.l_m,
-                    (double)det[k].box.w_m, (double)det[k].box.h_m, (double)det[k].box.yaw_rad, (double)det[k].score);
+        if (f != NULL)
+            box_lines(f, det, n_det);
         if (f == NULL || fclose(f) != 0)
         {
             fprintf(stderr, "lidet detect: cannot write '%s'\n", a.out_path);
@@ -878,48 +1180,7 @@ outputs:
                     (double)cfg.stages.ground.max_height_dev_m);
     }
     if (a.json)
-    {
-        cli_json_begin(stdout);
-        cli_json_str(stdout, "sensor", a.sensor);
-        cli_json_str(stdout, "model", chosen);
-        cli_json_int(stdout, "points", a.n_points);
-        cli_json_int(stdout, "clusters", ds->n_clusters);
-        cli_json_int(stdout, "out_of_crop", ds->n_out_of_crop);
-        cli_json_int(stdout, "out_of_range", ds->n_out_of_range);
-        cli_json_int(stdout, "too_tall", ds->n_too_tall);
-        cli_json_int(stdout, "over_budget", ds->n_over_budget);
-        cli_json_int(stdout, "budget", cfg.max_proposals);
-        cli_json_int(stdout, "classified", ds->n_classified);
-        cli_json_int(stdout, "gate1_rejected", ds->n_gate1_rejected);
-        cli_json_int(stdout, "boxed", ds->n_boxed);
-        cli_json_int(stdout, "box_budget", cfg.max_boxes);
-        cli_json_int(stdout, "over_box_budget", ds->n_over_box_budget);
-        cli_json_int(stdout, "gate2_rejected", ds->n_gate2_rejected);
-        cli_json_int(stdout, "size_rejected", ds->n_size_rejected);
-        cli_json_int(stdout, "nms_suppressed", ds->n_nms_suppressed);
-        cli_json_int(stdout, "detections", n_det);
-        cli_json_int(stdout, "status", st);
-        cli_json_int(stdout, "repeat", a.repeat);
-        cli_json_num(stdout, "project_ms", ms[LIDET_DET_STAGE_PROJECT]);
-        cli_json_num(stdout, "ground_ms", ms[LIDET_DET_STAGE_GROUND]);
-        cli_json_num(stdout, "cluster_ms", ms[LIDET_DET_STAGE_CLUSTER]);
-        cli_json_num(stdout, "classify_ms", ms[LIDET_DET_STAGE_CLASSIFY]);
-        cli_json_num(stdout, "box_ms", ms[LIDET_DET_STAGE_BOX]);
-        cli_json_num(stdout, "post_ms", ms[LIDET_DET_STAGE_POST]);
-        cli_json_num(stdout, "total_ms", ms[LIDET_DET_N_STAGES]);
-        fprintf(stdout, ", \"boxes\": [");
-        for (k = 0; k < n_det; ++k)
-            fprintf(stdout,
-                    "%s{\"class\": \"%s\", \"score\": %.5f, \"energy_cls\": %.4f, \"energy_box\": %.4f, "
-                    "\"x\": %.4f, \"y\": %.4f, \"z\": %.4f, \"l\": %.4f, \"w\": %.4f, \"h\": %.4f, \"yaw\": %.5f, "
-                    "\"cluster\": %u, \"cluster_points\": %u}",
-                    k ? ", " : "", cli_class_names[det[k].cls], (double)det[k].score, (double)det[k].energy_cls,
-                    (double)det[k].energy_box, (double)det[k].box.cx_m, (double)det[k].box.cy_m,
-                    (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m, (double)det[k].box.h_m,
-                    (double)det[k].box.yaw_rad, det[k].cluster_id, det[k].n_points);
-        fprintf(stdout, "]");
-        cli_json_end(stdout);
-    }
+        json_result(&a, chosen, &cfg, ds, det, n_det, st, ms, NULL);
     else
     {
         printf("scan         %s (%s, models %s)\n", a.scan_path, a.sensor, chosen);

@@ -42,7 +42,8 @@ static lidet_return_t return_of_point(const int32_t *p, uint16_t ring)
 
 int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, const char *family,
                      lidet_detection_t *det, uint32_t *n_det, lidet_detector_stats_t *ds, double *ms,
-                     uint8_t *point_ground, uint32_t *point_cluster, lidet_status_t *status)
+                     uint8_t *point_ground, uint32_t *point_cluster, lidet_status_t *status,
+                     const lidet_return_t *returns)
 {
     const double bam_per_rad = 4294967296.0 / (2.0 * M_PI_D);
     /* a file's sensor brings its integer profile (cli_sensor.c) */
@@ -56,6 +57,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     uint32_t np = a->n_points < LIDET_MAX_POINTS ? a->n_points : LIDET_MAX_POINTS, k;
     int32_t *pts, *pp;
     lidet_return_t *rets = NULL;
+    const lidet_return_t *run_rets = returns;
     double *t;
     int i;
     if (s == NULL)
@@ -133,7 +135,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
         free(t);
         return 1;
     }
-    for (k = 0; k < np; ++k)
+    for (k = 0; returns == NULL && k < np; ++k)
     {
         /* clamped to the int32 range first: a 1e19 m point must stay a (rejected) huge value, not UB */
         for (i = 0; i < 3; ++i)
@@ -142,7 +144,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
             pts[3u * k + (uint32_t)i] = v != v ? 0 : (v > 2.0e9 ? 2000000000 : (v < -2.0e9 ? -2000000000 : round_i32(v)));
         }
     }
-    if (cli_fixed_returns)
+    if (cli_fixed_returns && returns == NULL)
     {
         if (a->ring == NULL)
         {
@@ -162,11 +164,12 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
         }
         for (k = 0; k < np; ++k)
             rets[k] = return_of_point(pts + 3u * k, a->ring[k]);
+        run_rets = rets;
     }
     for (i = 0; i < a->repeat; ++i)
     {
         const double t0 = cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms();
-        *status = rets != NULL ? lidet_detector_q_run_returns(&g_detq, rets, np, i == 0 ? pp : NULL)
+        *status = run_rets != NULL ? lidet_detector_q_run_returns(&g_detq, run_rets, np, i == 0 ? pp : NULL)
                                : lidet_detector_q_run(&g_detq, pts, np, 3, a->ring, i == 0 ? pp : NULL);
         t[(size_t)LIDET_DET_N_STAGES * (size_t)a->repeat + (size_t)i] = (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - t0;
         if (!LIDET_SUCCEEDED(*status))

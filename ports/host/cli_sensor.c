@@ -591,6 +591,126 @@ int cli_sensor_load(cli_args_t *a, const char *cmd)
     return 0;
 }
 
+/* ---- the packet format of Ouster's metadata (lidet detect / track --pcap --lidar ouster; ouster.py: load_metadata) */
+
+static const char *const k_profiles[] = {"LEGACY", "RNG19_RFL8_SIG16_NIR16_DUAL", "RNG19_RFL8_SIG16_NIR16",
+                                         "RNG15_RFL8_NIR8"};
+
+/* a string field that must be one of names (absent, null or "": dflt); its index, or -1 with the message */
+static int one_of(const cJSON *v, const char *what, const char *const *names, int n, int dflt, char *err)
+{
+    int i;
+    if (v == NULL || cJSON_IsNull(v) || (cJSON_IsString(v) && v->valuestring[0] == '\0'))
+        return dflt;
+    if (!cJSON_IsString(v))
+        return bad(err, "%s: expected a string, got %s", what, kind(v)) - 2;
+    for (i = 0; i < n; ++i)
+        if (strcmp(v->valuestring, names[i]) == 0)
+            return i;
+    return bad(err, "%s: '%s' is not decoded", what, v->valuestring) - 2;
+}
+
+static int read_ouster_format(const cJSON *root, const cli_sensor_desc_t *d, cli_ouster_fmt_t *o, char *err)
+{
+    static const char *const headers[] = {"STANDARD", "FUSA"};
+    static const char *const beam[] = {"beam_intrinsics"};
+    static const char *const fmt[] = {"lidar_data_format", "data_format"};
+    static const char *const fmt_cfg[] = {"lidar_data_format", "data_format", "config_params"};
+    static const char *const cfg[] = {"config_params"};
+    static const char *const info[] = {"sensor_info"};
+    static const char *const intr[] = {"lidar_intrinsics"};
+    char f[96];
+    const cJSON *v;
+    long n;
+    int i;
+    memset(o, 0, sizeof *o);
+    i = one_of(find(root, fmt_cfg, 3, "udp_profile_lidar", f, sizeof f), f, k_profiles, 4, 0, err);
+    if (i < 0)
+        return 1;
+    o->profile = i + 1; /* lidet_ouster_profile_t: LEGACY 1 .. RNG15_RFL8_NIR8 4 */
+    o->columns_per_packet = 16;
+    v = find(root, fmt, 2, "columns_per_packet", f, sizeof f);
+    if (v != NULL && !cJSON_IsNull(v))
+    {
+        if (integer(v, f, 1.0, 16.0, "", &n, err) != 0)
+            return 1;
+        o->columns_per_packet = (uint16_t)n;
+    }
+    i = one_of(find(root, fmt_cfg, 3, "header_type", f, sizeof f), f, headers, 2, 0, err);
+    if (i < 0)
+        return 1;
+    o->header = i;
+    v = find(root, beam, 1, "beam_azimuth_angles", f, sizeof f);
+    if (v != NULL) /* validated by read_ouster: an array of rows numbers in (-180, 180) */
+    {
+        const cJSON *e;
+        i = 0;
+        cJSON_ArrayForEach(e, v)
+        {
+            if (i < (int)d->rows && i < LIDET_MAX_ROWS)
+                o->beam_azimuth_mdeg[i] = (int32_t)floor(e->valuedouble * 1000.0 + 0.5);
+            ++i;
+        }
+    }
+    o->azimuth_offset_bam = 32768u; /* ouster-sdk's default lidar_to_sensor_transform: half a turn about z */
+    v = find(root, intr, 1, "lidar_to_sensor_transform", f, sizeof f);
+    if (v != NULL && !cJSON_IsNull(v))
+    {
+        double m[16], yaw;
+        const cJSON *e;
+        if (!cJSON_IsArray(v) || cJSON_GetArraySize(v) != 16)
+            return bad(err, "%s: expected 16 finite numbers (a 4 x 4 matrix)", f);
+        i = 0;
+        cJSON_ArrayForEach(e, v)
+        {
+            if (number(e, f, &m[i++], err) != 0)
+                return 1;
+        }
+        if (fabs(m[8]) > 1e-6 || fabs(m[9]) > 1e-6 || fabs(m[10] - 1.0) > 1e-6 || fabs(m[2]) > 1e-6 ||
+            fabs(m[6]) > 1e-6)
+            return bad(err, "%s: not a turn about z: the decoder's azimuth cannot say it", f);
+        yaw = atan2(m[4], m[0]);
+        o->azimuth_offset_bam = (uint16_t)((long)floor(yaw / (2.0 * M_PI_D) * 65536.0 + 0.5) & 0xFFFF);
+    }
+    v = find(root, info, 1, "initialization_id", f, sizeof f);
+    if (cJSON_IsNumber(v) && v->valuedouble >= 0.0 && v->valuedouble < 16777216.0)
+        o->init_id = (uint32_t)v->valuedouble;
+    v = find(root, info, 1, "prod_sn", f, sizeof f);
+    if (cJSON_IsNumber(v) && v->valuedouble >= 0.0 && v->valuedouble < 1099511627776.0)
+        o->prod_sn = (uint64_t)v->valuedouble;
+    else if (cJSON_IsString(v))
+    {
+        char *end;
+        const unsigned long long sn = strtoull(v->valuestring, &end, 10);
+        if (end != v->valuestring && *end == '\0' && sn < 1099511627776ULL)
+            o->prod_sn = (uint64_t)sn;
+    }
+    o->udp_port_lidar = 7502u;
+    v = find(root, cfg, 1, "udp_port_lidar", f, sizeof f);
+    if (v != NULL && !cJSON_IsNull(v) && !(cJSON_IsNumber(v) && v->valuedouble == 0.0))
+    {
+        if (integer(v, f, 1.0, 65535.0, "", &n, err) != 0)
+            return 1;
+        o->udp_port_lidar = (uint32_t)n;
+    }
+    return 0;
+}
+
+int cli_ouster_format(const cli_args_t *a, cli_ouster_fmt_t *o)
+{
+    char err[ERR_LEN];
+    cJSON *root;
+    int rc;
+    err[0] = '\0';
+    rc = read_json(a->ouster_meta, &root, err);
+    if (rc == 0)
+        rc = read_ouster_format(root, &a->desc, o, err);
+    cJSON_Delete(root);
+    if (rc != 0)
+        fprintf(stderr, "lidet %s: %s: %s\n", cli_cmd, a->ouster_meta, err);
+    return rc;
+}
+
 #else /* built without cJSON */
 
 int cli_sensor_load(cli_args_t *a, const char *cmd)
@@ -600,6 +720,14 @@ int cli_sensor_load(cli_args_t *a, const char *cmd)
         "lidet %s: %s needs cJSON, and this lidet was built without it (apt-get install libcjson-dev, then "
         "reconfigure and rebuild)\n",
         cmd, a->sensor_file != NULL ? "--sensor-file" : "--ouster-meta");
+    return 1;
+}
+
+int cli_ouster_format(const cli_args_t *a, cli_ouster_fmt_t *o)
+{
+    (void)a;
+    memset(o, 0, sizeof *o);
+    fprintf(stderr, "lidet %s: --ouster-meta needs cJSON, and this lidet was built without it\n", cli_cmd);
     return 1;
 }
 

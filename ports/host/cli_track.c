@@ -58,7 +58,7 @@ static void usage(void)
 {
     fprintf(
         stderr,
-        "usage: lidet track SCANS... | DIR [--sensor NAME | --sensor-file F | --ouster-meta M] "
+        "usage: lidet track SCANS... | DIR | --pcap FILE [--sensor NAME | --sensor-file F | --ouster-meta M] "
         "[--mount-height M]\n"
         "                   [--model NAME] [--crop] [--fixed] [--set KEY=VALUE] [--rate HZ | --dt-file F]\n"
         "                   [--ego FILE | --ego none] [--calib FILE] [--out DIR] [--png FILE] [--json]\n"
@@ -119,6 +119,13 @@ static void usage(void)
         "  (lidet detect --help). The detector's options, as lidet detect:\n",
         TAIL_LEN);
     cli_det_usage(stderr);
+    fprintf(stderr,
+            "  lidet track --pcap FILE [options]: the complete rotations of a packet capture, in order, as the\n"
+            "  scans (named FILE#K, frame K, --out DIR/<K:06d>.txt); dt from the scans' first packets' sensor\n"
+            "  timestamps (Velodyne: the payload's microseconds, unwrapped at the hour; clamped to [0.001, 10] s)\n"
+            "  unless --rate or --dt-file; no ego motion unless --ego FILE (a line per scan); no calibration\n"
+            "  unless --calib:\n");
+    cli_pcap_usage(stderr, 0);
 }
 
 /* ---- small helpers ----------------------------------------------------------------------------------------- */
@@ -250,7 +257,8 @@ static int list_bins(const char *dir, char ***list, uint32_t *n, uint32_t *cap)
         (*list)[(*n)++] = p;
     }
     closedir(d);
-    qsort(*list + first, *n - first, sizeof(char *), cmp_str);
+    if (*n > first) /* an empty folder: *list may still be NULL, which qsort must not get */
+        qsort(*list + first, *n - first, sizeof(char *), cmp_str);
     return 0;
 }
 
@@ -808,14 +816,13 @@ static void seq_free(seq_t *q)
     memset(q, 0, sizeof *q);
 }
 
-/* makes a folder and the folders above it that are missing (mkdir -p): 0, or 1 with a message */
-static int make_dir(const char *path)
+int cli_make_dir(const char *path)
 {
     char *p, *c;
     int rc = 0;
     if (path[0] == '\0')
     {
-        fprintf(stderr, "lidet track: --out needs a folder name\n");
+        fprintf(stderr, "lidet %s: --out needs a folder name\n", cli_cmd);
         return 1;
     }
     p = str_cat3(path, "", "");
@@ -829,7 +836,7 @@ static int make_dir(const char *path)
         *c = '\0';
         if (mkdir(p, 0777) != 0 && errno != EEXIST)
         {
-            fprintf(stderr, "lidet track: cannot make the folder '%s': %s\n", p, strerror(errno));
+            fprintf(stderr, "lidet %s: cannot make the folder '%s': %s\n", cli_cmd, p, strerror(errno));
             rc = 1;
         }
         *c = keep;
@@ -839,7 +846,7 @@ static int make_dir(const char *path)
     free(p);
     if (rc == 0 && !is_dir(path))
     {
-        fprintf(stderr, "lidet track: '%s' is not a folder\n", path);
+        fprintf(stderr, "lidet %s: '%s' is not a folder\n", cli_cmd, path);
         rc = 1;
     }
     return rc;
@@ -879,8 +886,13 @@ int cli_track(int argc, char **argv)
     FILE *label02 = NULL;
     cli_calib_t calib;
     int have_calib = 0, print_sensor = 0;
+    cli_pcap_opts_t po;
+    cli_capture_t *capt = NULL;
+    const lidet_return_t *rets = NULL;
+    double *det_ms = NULL;
 
     memset(&o, 0, sizeof o);
+    cli_pcap_opts_default(&po);
     memset(&q, 0, sizeof q);
     memset(&a, 0, sizeof a);
     rest = (char **)malloc(sizeof(char *) * (size_t)(argc + 2));
@@ -894,6 +906,18 @@ int cli_track(int argc, char **argv)
         const int has_val = i + 1 < argc;
         if (cli_det_option(&o, argc, argv, &i))
             continue;
+        if (strcmp(s, "--png-scan") == 0)
+        {
+            fprintf(stderr, "lidet track: --png draws the last scan (--png-scan is lidet detect's)\n");
+            goto done;
+        }
+        {
+            const int taken = cli_pcap_option(&po, argc, argv, &i);
+            if (taken < 0)
+                goto done;
+            if (taken)
+                continue;
+        }
         if (strcmp(s, "-h") == 0 || strcmp(s, "--help") == 0)
         {
             usage();
@@ -966,14 +990,27 @@ int cli_track(int argc, char **argv)
         fprintf(stderr, "lidet track: give --rate or --dt-file, not both\n");
         goto done;
     }
-    if (npos == 0 && !print_sensor)
+    if (po.path == NULL && (po.port != 0 || po.force_sensor || po.partial || po.dual != NULL ||
+                            strcmp(po.lidar, "velodyne") != 0))
+    {
+        fprintf(stderr, "lidet track: --lidar, --port, --force-sensor, --dual and --partial go with --pcap FILE\n");
+        goto done;
+    }
+    if (po.path != NULL && npos > 0)
+    {
+        fprintf(stderr, "lidet track: give scans (SCANS... | DIR) or --pcap FILE, not both ('%s')\n", pos[0]);
+        goto done;
+    }
+    if (npos == 0 && !print_sensor && po.path == NULL)
     {
         usage();
         goto done;
     }
-    /* the sensor: cli_parse with the first scan (or --print-sensor alone) */
+    /* the sensor: cli_parse with the first scan (or the capture, or --print-sensor alone) */
     if (npos > 0)
         rest[nrest++] = pos[0];
+    else if (po.path != NULL)
+        rest[nrest++] = (char *)po.path;
     i = cli_parse(nrest, rest, "track", &a);
     if (i == 2)
     {
@@ -986,10 +1023,31 @@ int cli_track(int argc, char **argv)
             fprintf(stderr, "(lidet track --help: the options of lidet track)\n");
         goto done;
     }
+    /* a capture: read once (its scans listed, the sensor from the packets unless --sensor) */
+    if (po.path != NULL && cli_capture_open(&po, &a, &capt) != 0)
+        goto done;
     if (cli_det_config(&a, &o, &cfg, &mc, &mb, chosen, sizeof chosen) != 0)
         goto done;
 
     /* the scans */
+    if (capt != NULL)
+    {
+        /* named FILE#K, --out files <K:06d>.txt, frame K */
+        const size_t len = strlen(po.path) + 16u;
+        q.n = cli_capture_n_scans(capt);
+        q.scans = (char **)calloc((size_t)q.n + 1u, sizeof(char *));
+        det_ms = (double *)malloc(sizeof(double) * ((size_t)q.n + 1u));
+        if (q.scans == NULL || det_ms == NULL)
+            goto done;
+        for (k = 0; k < q.n; ++k)
+        {
+            q.scans[k] = (char *)malloc(len);
+            if (q.scans[k] == NULL)
+                goto done;
+            snprintf(q.scans[k], len, "%s#%u", po.path, k);
+        }
+    }
+    else
     {
         char *dir_in = NULL;
         if (npos == 1 && is_dir(pos[0]))
@@ -1052,7 +1110,14 @@ int cli_track(int argc, char **argv)
     for (k = 0; k < q.n; ++k)
     {
         const char *s;
-        q.stems[k] = stem_of(q.scans[k]);
+        if (capt != NULL)
+        {
+            q.stems[k] = (char *)malloc(16u);
+            if (q.stems[k] != NULL)
+                snprintf(q.stems[k], 16u, "%06u", k);
+        }
+        else
+            q.stems[k] = stem_of(q.scans[k]);
         if (q.stems[k] == NULL)
             goto done;
         s = q.stems[k];
@@ -1094,6 +1159,22 @@ int cli_track(int argc, char **argv)
         if (read_dt(dt_path, q.n, q.dt) != 0)
             goto done;
     }
+    else if (capt != NULL && !rate_given)
+    {
+        /* the capture's: the difference of the scans' first packets' sensor times (cli_scan_info_t.t_us) */
+        uint32_t n_clamped = 0;
+        for (k = 1; k < q.n; ++k)
+        {
+            const double dt = (double)(cli_capture_info(capt, k)->t_us - cli_capture_info(capt, k - 1u)->t_us) * 1e-6;
+            q.dt[k] = dt < DT_MIN_S ? DT_MIN_S : (dt > DT_MAX_S ? DT_MAX_S : dt);
+            n_clamped += q.dt[k] != dt;
+        }
+        if (n_clamped > 0u)
+            fprintf(stderr,
+                    "lidet track: note: %u scans are less than %g s or more than %g s after the one before (the "
+                    "packets' timestamps): dt clamped to that range\n",
+                    n_clamped, DT_MIN_S, DT_MAX_S);
+    }
     else
     {
         for (k = 0; k < q.n; ++k)
@@ -1110,7 +1191,7 @@ int cli_track(int argc, char **argv)
                 goto done;
             have_calib = 1;
         }
-        else
+        else if (capt == NULL) /* a capture has no calibration folder: --calib only */
         {
             if (find_calibs(q.scans, q.stems, q.n, &q.calib_paths, &q.one_calib) != 0)
                 goto done;
@@ -1122,11 +1203,11 @@ int cli_track(int argc, char **argv)
             }
             have_calib |= q.calib_paths != NULL;
         }
-        if (make_dir(out_dir) != 0)
+        if (cli_make_dir(out_dir) != 0)
             goto done;
         {
             char *tracks = str_cat3(out_dir, "/tracks", "");
-            if (tracks == NULL || make_dir(tracks) != 0)
+            if (tracks == NULL || cli_make_dir(tracks) != 0)
             {
                 free(tracks);
                 goto done;
@@ -1185,10 +1266,19 @@ int cli_track(int argc, char **argv)
         uint32_t n_det = 0, j;
         const double *e = q.ego != NULL && k > 0 ? q.ego + 3u * (size_t)k : NULL;
 
-        cli_free(&a);
-        a.scan_path = q.scans[k];
-        if (cli_load(&a) != 0)
-            goto done;
+        if (capt != NULL)
+        {
+            cli_scan_info_t info;
+            if (cli_capture_next(capt, &a, &rets, &info) != 1)
+                goto done;
+        }
+        else
+        {
+            cli_free(&a);
+            a.scan_path = q.scans[k];
+            if (cli_load(&a) != 0)
+                goto done;
+        }
         if (o.fixed)
         {
             const uint32_t np = a.n_points < LIDET_MAX_POINTS ? a.n_points : LIDET_MAX_POINTS;
@@ -1199,7 +1289,7 @@ int cli_track(int argc, char **argv)
             gp = NULL;
             if (last && png_path != NULL && (gp = (uint8_t *)malloc((size_t)np + 1u)) == NULL)
                 goto done;
-            if (cli_detect_q_run(&a, &cfg, chosen, g_det_q, &n_det, &ds_q, ms, gp, NULL, &det_st) != 0)
+            if (cli_detect_q_run(&a, &cfg, chosen, g_det_q, &n_det, &ds_q, ms, gp, NULL, &det_st, rets) != 0)
                 goto done;
             det = g_det_q;
             ds = &ds_q;
@@ -1250,6 +1340,8 @@ int cli_track(int argc, char **argv)
             trk_ms = (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - t0;
             ts = lidet_tracker_stats(&g_trk);
         }
+        if (det_ms != NULL)
+            det_ms[k] = ms[LIDET_DET_N_STAGES];
         if (!LIDET_SUCCEEDED(trk_st))
         {
             fprintf(stderr, "lidet track: %s: the tracker: %s\n", q.scans[k], lidet_status_str(trk_st));
@@ -1386,10 +1478,17 @@ int cli_track(int argc, char **argv)
     }
     if (fflush(stdout) != 0)
         goto done;
-    rc = 0;
+    rc = capt != NULL ? cli_capture_summary(capt, stderr, det_ms, q.n) : 0;
 done:
     if (label02 != NULL)
         fclose(label02);
+    if (capt != NULL)
+    {
+        a.points = NULL; /* the capture's buffers */
+        a.ring = NULL;
+        cli_capture_close(capt);
+    }
+    free(det_ms);
     cli_free(&a);
     seq_free(&q);
     free(t_dt);

@@ -110,3 +110,98 @@ def decode(payloads, model="auto", filt="both", seam_cdeg=0, max_step_cdeg=1000,
     k = len(payloads)
     return Decoded(**{c: a[:n] for c, a in arr.items()}, xyz=xyz[:n], scan_event=events[:k] & 0xFF,
                    reject=events[:k] >> 8, scan_end=scan_end[:k], stats=dict(zip(STATS, stats.tolist())))
+
+
+# ---- writing: synthetic VLP-16 packets and classic pcap files (tests of `lidet detect --pcap`) ----------------------
+
+# VLP-16 lasers in packet order: their elevations (deg) and lidet rings (ring 0 = the lowest beam, the sensor preset's)
+VLP16_LASER_ELEV_DEG = (-15, 1, -13, 3, -11, 5, -9, 7, -7, 9, -5, 11, -3, 13, -1, 15)
+VLP16_LASER_RING = tuple((e + 15) // 2 for e in VLP16_LASER_ELEV_DEG)
+VLP16_COLS = 1800          # firing sequences per rotation at 0.2 deg (600 rpm)
+VLP16_PACKET_US = 1327     # 12 blocks of 110.592 us
+HOUR_US = 3_600_000_000
+
+
+def vlp16_grid(points, ring) -> np.ndarray:
+    """A VLP-16 scene as the sensor sees it: (VLP16_COLS, 16) ranges in mm (0: no return), column c covering the
+    Velodyne azimuths (clockwise from +x) [0.2 c, 0.2 (c + 1)) deg, by lidet ring; the nearest point of a cell kept."""
+    p = np.asarray(points, dtype=np.float64)[:, :3]
+    ring = np.asarray(ring, dtype=np.int64)
+    cw_cdeg = np.mod(-np.degrees(np.arctan2(p[:, 1], p[:, 0])) * 100.0, 36000.0)
+    col = np.floor(cw_cdeg / (36000.0 / VLP16_COLS)).astype(np.int64) % VLP16_COLS
+    rng = np.round(np.linalg.norm(p, axis=1) * 1000.0).astype(np.int64)
+    ok = (ring >= 0) & (ring < 16) & (rng > 0) & (rng < 2 * 65535)
+    grid = np.zeros((VLP16_COLS, 16), np.int64)
+    order = np.argsort(-rng[ok], kind="stable")  # far first: the nearest written last wins
+    grid[col[ok][order], ring[ok][order]] = rng[ok][order]
+    return grid
+
+
+def vlp16_payload(block_cdeg, dist_2mm, time_us, intensity=100, mode=0x37, product=0x22) -> bytes:
+    """One VLP-16 data payload (1206 bytes): 12 blocks at the azimuths block_cdeg (0.01 deg, clockwise), distances
+    dist_2mm (12, 32) in 2 mm units (a block's two firing sequences of 16 lasers, packet order), the timestamp
+    (microseconds past the hour) and the factory bytes."""
+    d = np.asarray(dist_2mm, dtype=np.int64).reshape(12, 32)
+    out = bytearray()
+    for b in range(12):
+        out += struct.pack("<HH", 0xEEFF, int(block_cdeg[b]) % 36000)
+        for j in range(32):
+            out += struct.pack("<HB", int(d[b, j]), intensity)
+    out += struct.pack("<IBB", int(time_us) % HOUR_US, mode, product)
+    assert len(out) == 1206
+    return bytes(out)
+
+
+def vlp16_packets(scenes, n_packets, start_cdeg=0, t0_us=0, packet_us=VLP16_PACKET_US):
+    """Strongest-return VLP-16 payloads of a sensor turning 0.4 deg a block over a scene per rotation: scenes[r]
+    (a vlp16_grid) is what rotation r sees (the last one past the list), a rotation counted from the seam (0 deg);
+    the first block at start_cdeg (a multiple of 40). Returns [(time_us, payload)], time_us unwrapped (the payload
+    holds it modulo the hour)."""
+    if start_cdeg % 40:
+        raise ValueError("start_cdeg must be a multiple of 40 (0.4 deg blocks)")
+    lasers = np.array(VLP16_LASER_RING)
+    out = []
+    for k in range(n_packets):
+        cdeg, dist = [], np.zeros((12, 32), np.int64)
+        for b in range(12):
+            a = start_cdeg + 40 * (12 * k + b)
+            grid = scenes[min(a // 36000, len(scenes) - 1)]
+            c0 = (a % 36000) // 20
+            dist[b, :16] = grid[c0, lasers] // 2
+            dist[b, 16:] = grid[(c0 + 1) % VLP16_COLS, lasers] // 2
+            cdeg.append(a % 36000)
+        t = t0_us + k * packet_us
+        out.append((t, vlp16_payload(cdeg, dist, t)))
+    return out
+
+
+def _ip_checksum(h: bytes) -> int:
+    s = sum(struct.unpack(f">{len(h) // 2}H", h))
+    while s >> 16:
+        s = (s & 0xFFFF) + (s >> 16)
+    return ~s & 0xFFFF
+
+
+def udp_frame(payload: bytes, dport=2368, sport=2368, src="192.168.1.201", dst="255.255.255.255", flags_frag=0x4000,
+              ip_total=None) -> bytes:
+    """An Ethernet / IPv4 / UDP frame carrying payload (flags_frag: the IPv4 flags and fragment offset field, 0x4000 =
+    don't fragment; ip_total: a wrong IPv4 total length for malformed frames)."""
+    udp = struct.pack(">HHHH", sport, dport, 8 + len(payload), 0) + payload
+    ips = bytes(int(x) for x in src.split(".")) + bytes(int(x) for x in dst.split("."))
+    total = 20 + len(udp) if ip_total is None else ip_total
+    h = struct.pack(">BBHHHBBH", 0x45, 0, total, 0, flags_frag, 64, 17, 0) + ips
+    h = h[:10] + struct.pack(">H", _ip_checksum(h)) + h[12:]
+    return b"\xff" * 6 + b"\x60\x76\x88\x00\x00\x01" + b"\x08\x00" + h + udp
+
+
+def write_pcap(path, frames, times_s=None, snaplen=65535, linktype=1):
+    """A classic little-endian microsecond pcap file. frames: bytes, or (bytes, original length) for a frame the
+    capture cut short; times_s: one timestamp per frame (default 1 ms apart)."""
+    with open(path, "wb") as f:
+        f.write(struct.pack("<IHHiIII", 0xA1B2C3D4, 2, 4, 0, 0, snaplen, linktype))
+        for i, fr in enumerate(frames):
+            data, orig = (fr, len(fr)) if isinstance(fr, (bytes, bytearray)) else fr
+            t = times_s[i] if times_s is not None else 1_700_000_000 + i * 1e-3
+            sec = int(t)
+            f.write(struct.pack("<IIII", sec, int(round((t - sec) * 1e6)), len(data), orig))
+            f.write(data)
