@@ -21,7 +21,7 @@
  *
  * Memory: sizeof(lidet_tracker_q_t) = LIDET_TRACK_MAX_TRACKS * (90 + 4 LIDET_TRACK_MAX_DETS) + 2 LIDET_TRACK_MAX_DETS
  * + 33 max(LIDET_TRACK_MAX_TRACKS, LIDET_TRACK_MAX_DETS) + ~160 B (88 B a track slot, an int32 cost per track and
- * detection, the assignment's int64 potentials and distances): 24,552 B at the defaults (64, 64), on x86-64 and
+ * detection, the assignment's int64 potentials and distances): 24,560 B at the defaults (64, 64), on x86-64 and
  * Cortex-M alike; lidet_tracker_q_bytes().
  * Time per update: O(T D) costs with T tracks and D detections, then O(n^3) for the optimal assignment
  * (n = max(T, D)) or O(min(T, D) T D) for the greedy one. No allocation, no recursion.

@@ -36,7 +36,7 @@
 /* the tracker after the detector (docs/TRACKING.md, "On the board"): 32 tracks; 32 detections per update, above
  * what the detector gives for this sensor (at most max_boxes = 24 boxes per scan by default for <= 16 beams; with
  * more, the tracker takes the 32 best and counts the rest) and the 32 road users of the images' tracker benchmark
- * (fw_detect.c). lidet_tracker_q_t 8,264 B, lidet_tracker_t 7,832 B. */
+ * (fw_detect.c). lidet_tracker_q_t 8,272 B, lidet_tracker_t 7,844 B. */
 #define LIDET_TRACK_MAX_TRACKS 32
 #define LIDET_TRACK_MAX_DETS 32
 
