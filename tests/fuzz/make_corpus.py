@@ -153,6 +153,214 @@ def proposal_seed_q(sensor: str, mode: int, cls: int) -> bytes:
     return out
 
 
+# ---- tracker streams (fuzz_track.c, fuzz_track_q.c: their file comments give the layout) ----------------------
+# One encoder for both harnesses: objects are (cls, x m, y m, z m, l m, w m, h m, yaw rad, score); the float harness
+# packs x, y in cm (i16), z in dm (i8), sizes in 5 cm (u8), yaw in pi / 128 (i8), score in 1 / 255 (u8); the
+# integer one x, y in 10 mm, z in 100 mm, sizes in 20 mm, yaw in 2^24 BAM, score in 129 (Q15).
+TRACK_FLOAT = dict(xy=0.01, z=0.1, size=0.05, score=255.0, shift=0.05, ego_xy=0.1)
+TRACK_INT = dict(xy=0.01, z=0.1, size=0.02, score=32768.0 / 129.0, shift=0.05, ego_xy=0.1)
+SRC_LIST, SRC_SHIFT, SRC_RAW_N, SRC_NONE = 0, 1, 2, 3
+
+
+def track_cfg(greedy=False, confirm_hits=2, max_misses=12, pokes=()):
+    """cfg byte, poke count, pokes (selector, u32)."""
+    b = struct.pack("<BB", int(greedy) | ((confirm_hits - 1) << 1) | (max_misses << 3), len(pokes))
+    for sel, v in pokes:
+        b += struct.pack("<BI", sel, v & 0xFFFFFFFF)
+    return b
+
+
+def track_det(obj, unit, special=None, raw=None):
+    """One detection: kind byte, [raw class], compact fields (or raw 32-bit words), [special byte]."""
+    cls = obj[0]
+    kind = (cls if cls < 3 else 3) | (4 if raw is not None else 0) | (8 if special is not None else 0)
+    b = struct.pack("<B", kind)
+    if cls >= 3:
+        b += struct.pack("<B", cls)
+    if raw is not None:
+        b += struct.pack("<8I", *(w & 0xFFFFFFFF for w in raw))
+    else:
+        x, y, z, l, w, h, yaw, score = obj[1:]
+        q = lambda v, s, lo, hi: max(lo, min(hi, int(round(v / s))))  # noqa: E731
+        b += struct.pack("<hhbBBBbB", q(x, unit["xy"], -32768, 32767), q(y, unit["xy"], -32768, 32767),
+                         q(z, unit["z"], -128, 127), q(l, unit["size"], 0, 255), q(w, unit["size"], 0, 255),
+                         q(h, unit["size"], 0, 255), q(yaw, np.pi / 128.0, -128, 127),
+                         q(score * unit["score"], 1.0, 0, 255))
+    if special is not None:
+        b += struct.pack("<B", special)
+    return b
+
+
+def track_update(unit, dets=None, shift=None, raw_n=None, dt=None, ego=None, reset=False, null_det=False,
+                 out_flags=3, cap=15, out_null=False):
+    """One update: op, out, [dt], [ego], then the detections. dt: None (the default 0.1 s / 100 ms),
+    ("step", u8), ("raw", u32 bits) or ("special", u8); ego: None, ("small", dx m, dy m, dyaw rad), ("raw", 3 u32)
+    or ("special", 3 u8); dets: a list of encoded detections (track_det) or shift (dx m, dy m) or raw_n."""
+    dt_kind = {None: 0, "step": 1, "raw": 2, "special": 3}[dt[0] if dt else None]
+    ego_kind = {None: 0, "small": 1, "raw": 2, "special": 3}[ego[0] if ego else None]
+    src = SRC_LIST if dets is not None else SRC_SHIFT if shift is not None else SRC_RAW_N if raw_n is not None \
+        else SRC_NONE
+    op = dt_kind | (ego_kind << 2) | (0x10 if reset else 0) | (0x20 if null_det else 0) | (src << 6)
+    out = (out_flags & 3) | ((cap & 15) << 2) | (0x40 if out_null else 0)
+    b = struct.pack("<BB", op, out)
+    if dt_kind == 1 or dt_kind == 3:
+        b += struct.pack("<B", dt[1])
+    elif dt_kind == 2:
+        b += struct.pack("<I", dt[1] & 0xFFFFFFFF)
+    if ego_kind == 1:
+        b += struct.pack("<bbb", int(round(ego[1] / unit["ego_xy"])), int(round(ego[2] / unit["ego_xy"])),
+                         int(round(ego[3] / (np.pi / 128.0))))
+    elif ego_kind == 2:
+        b += struct.pack("<3I", *(w & 0xFFFFFFFF for w in ego[1:]))
+    elif ego_kind == 3:
+        b += struct.pack("<3B", *ego[1:])
+    if src == SRC_LIST:
+        b += struct.pack("<B", len(dets)) + b"".join(dets)
+    elif src == SRC_SHIFT:
+        b += struct.pack("<bb", int(round(shift[0] / unit["shift"])), int(round(shift[1] / unit["shift"])))
+    elif src == SRC_RAW_N:
+        b += struct.pack("<I", raw_n & 0xFFFFFFFF)
+    return b
+
+
+CAR = (0, 4.2, 1.8, 1.6)
+PED = (2, 0.6, 0.6, 1.7)
+CYC = (1, 1.8, 0.6, 1.7)
+
+
+def obj(kind, x, y, yaw=0.0, score=0.8, z=-0.8):
+    cls, l, w, h = kind
+    return (cls, x, y, z, l, w, h, yaw, score)
+
+
+def f32_bits(v: float) -> int:
+    return struct.unpack("<I", struct.pack("<f", v))[0]
+
+
+def track_seeds(unit, integer: bool):
+    """name -> bytes, the same scenarios for both harnesses."""
+    d = lambda *a, **k: track_det(obj(*a, **k), unit)  # noqa: E731
+    seeds = {}
+    # one car at 10 m/s along x (0.1 s scans: 1 m a scan), reported with every flag
+    s = track_cfg() + track_update(unit, dets=[d(CAR, 10.0, 2.0)])
+    s += b"".join(track_update(unit, shift=(1.0, 0.0)) for _ in range(20))
+    seeds["car_constant_velocity"] = s
+    # a car and a pedestrian crossing (greedy and optimal), the pedestrian missed twice (coasting)
+    for greedy in (False, True):
+        s = track_cfg(greedy=greedy)
+        for k in range(16):
+            dd = [d(CAR, 5.0 + 0.8 * k, -6.0 + 0.8 * k, yaw=0.785), d(PED, 12.0 - 0.15 * k, 0.0, yaw=3.14)]
+            if k in (7, 8):
+                dd = dd[:1]
+            s += track_update(unit, dets=dd, out_flags=1 if k % 2 else 3)
+        seeds["crossing_greedy" if greedy else "crossing_optimal"] = s
+    # ego motion: the sensor drives forward and turns; two parked cars stay put over the ground
+    s = track_cfg(confirm_hits=3)
+    x1, y1, x2, y2 = 15.0, 3.0, 25.0, -4.0
+    for k in range(14):
+        s += track_update(unit, dets=[d(CAR, x1, y1, yaw=0.3), d(CYC, x2, y2, yaw=-1.0)],
+                          ego=("small", 0.5, 0.0, 0.0) if k else None)
+        x1 -= 0.5
+        x2 -= 0.5
+    for k in range(6):
+        c, sn = np.cos(0.05), np.sin(0.05)
+        x1, y1 = c * (x1 - 0.3) + sn * y1, c * y1 - sn * (x1 - 0.3)
+        x2, y2 = c * (x2 - 0.3) + sn * y2, c * y2 - sn * (x2 - 0.3)
+        s += track_update(unit, dets=[d(CAR, x1, y1, yaw=0.3 - 0.05 * (k + 1)), d(CYC, x2, y2)],
+                          ego=("small", 0.3, 0.0, 0.05))
+    seeds["ego_motion_turn"] = s
+    # capacity: 9 detections (> 6) confirmed into tracks, then 6 new ones with 2 free slots (births dropped),
+    # then a raw count of 0xFFFFFFFF over the same list, then a reset and a smaller cap
+    far = [d(CAR, 10.0 * i - 40.0, 20.0) for i in range(9)]
+    other = [d(PED, 10.0 * i - 40.0, -20.0) for i in range(6)]
+    s = track_cfg(max_misses=3) + track_update(unit, dets=far) + track_update(unit, dets=far)
+    s += track_update(unit, dets=other) + track_update(unit, dets=other)
+    s += track_update(unit, raw_n=0xFFFFFFFF) + track_update(unit, raw_n=7, cap=3)
+    s += track_update(unit, reset=True, dets=far[:3], cap=2) + track_update(unit, dets=far[:3], out_flags=0)
+    s += b"".join(track_update(unit, dets=[], out_flags=1) for _ in range(5))
+    seeds["capacity_overflow"] = s
+    # bad arguments between good updates: dt 0, negative / NaN / huge (float) or > 10 s (integer), NULL
+    # detections with n > 0 and with n 0, an ego motion out of range
+    s = track_cfg(confirm_hits=1) + track_update(unit, dets=[d(CAR, 8.0, 0.0)])
+    s += track_update(unit, shift=(0.5, 0.0), dt=("special", 0))  # dt 0
+    s += track_update(unit, shift=(0.5, 0.0), dt=("special", 3))  # 10 s (float) / 10.001 s (integer)
+    s += track_update(unit, shift=(0.5, 0.0), dt=("raw", f32_bits(-0.1) if not integer else 0xFFFFFFFF))
+    s += track_update(unit, shift=(0.5, 0.0), dt=("special", 192 if not integer else 4))  # NaN / 2^32 - 1 ms
+    s += track_update(unit, shift=(0.5, 0.0), null_det=True)
+    s += track_update(unit, dets=[], null_det=True)
+    s += track_update(unit, shift=(0.5, 0.0), ego=("special", 0, 1, 2) if not integer else ("special", 1, 0, 0))
+    s += track_update(unit, shift=(0.5, 0.0), ego=("raw", f32_bits(1000.5), 0, 0) if not integer
+                      else ("raw", 1048577, 0, 0))
+    s += track_update(unit, shift=(0.5, 0.0), ego=("raw", 0, 0, f32_bits(3.1416)) if not integer
+                      else ("raw", 0, 0, 0x80000000))
+    s += track_update(unit, shift=(0.5, 0.0), dt=("step", 255))
+    s += track_update(unit, out_null=True, cap=0) + track_update(unit, out_null=True, cap=5)
+    seeds["bad_arguments"] = s
+    # bad detections: class 3 and 255, zero / negative / huge sizes, non-finite or extreme fields
+    base = obj(CAR, 6.0, 1.0)
+    bad = [track_det((3,) + base[1:], unit), track_det((255,) + base[1:], unit),
+           track_det(base[:4] + (0.0,) + base[5:], unit)]
+    for sp in range(19 if not integer else 16):
+        bad.append(track_det(base, unit, special=(sp << 3) | (sp % 8)))
+    if integer:
+        raw = [[0x80000000, 0x7FFFFFFF, 0, 1000, 1000, 1000, 0, 100],
+               [1048576, -1048576, 1048576, 100000, 100000, 100000, 0x40000000, 32768],
+               [1048577, 0, 0, 100001, 1, 1, 0, 32769]]
+    else:
+        raw = [[0x7FC00000, 0, 0, f32_bits(1.0), f32_bits(1.0), f32_bits(1.0), 0, f32_bits(0.5)],
+               [f32_bits(1e4), f32_bits(-1e4), f32_bits(1e4), f32_bits(100.0), f32_bits(100.0), f32_bits(100.0),
+                f32_bits(1e30), f32_bits(3e38)],
+               [f32_bits(10000.001), 0, 0, f32_bits(-1.0), f32_bits(1e-45), f32_bits(1.0), 0, f32_bits(-1.0)]]
+    bad += [track_det(base, unit, raw=r) for r in raw]
+    s = track_cfg()
+    for k in range(0, len(bad), 5):
+        s += track_update(unit, dets=[track_det(obj(CAR, 6.0 + 0.5 * k, 1.0), unit)] + bad[k:k + 5])
+    seeds["bad_detections"] = s
+    # configurations: the extremes of every range (accepted) and just outside (refused: the harness stops)
+    upd = track_update(unit, dets=[d(CAR, 5.0, 0.0), d(PED, 5.5, 0.3)]) + track_update(unit, shift=(0.2, 0.1))
+    if integer:
+        edge = [(0, 1), (3, 100000), (6, 46340), (9, 1000000), (12, 1), (13, 1000 * 65536), (15, 1000), (16, 1000),
+                (18, 0), (19, 32768), (20, 100000), (21, 7)]
+        top = [(17, 32768)]
+        top_score = 32768
+        out = [(0, 0), (3, -1), (6, 46341), (9, 0), (12, 0), (13, 1000 * 65536 + 1), (14, 2), (15, 0), (16, 1001),
+               (17, 32769), (18, -1), (19, 32769), (20, 100001), (21, 8), (0x80 | 2, 0)]
+    else:
+        sc = lambda v: int(round(v * 65536)) & 0xFFFFFFFF  # noqa: E731
+        edge = [(0, sc(100.0)), (3, sc(100.0)), (6, 0), (9, sc(1000.0)), (12, sc(1000.0)), (13, 0),
+                (15, 0), (16, sc(1.0)), (17, sc(100.0)), (19, 1000), (20, 1000), (21, 7), (0x80 | 1, f32_bits(0.001))]
+        top = [(14, sc(1.0))]
+        top_score = f32_bits(1.0)
+        out = [(0, 0), (0x80 | 0, 0x7FC00000), (3, sc(-1.0)), (6, sc(100.5)), (9, 0), (12, sc(1000.5)),
+               (0x80 | 13, 0x7F800000), (14, sc(1.5)), (16, sc(-0.5)), (18, 2), (19, 0), (20, 1001), (21, 8)]
+    s = track_cfg(greedy=True, pokes=edge[:7]) + upd
+    seeds["cfg_edges_a"] = s
+    seeds["cfg_edges_b"] = track_cfg(pokes=edge[7:]) + upd
+
+    def one(x: float, score: int) -> bytes:
+        """A car at (x, 0) with the raw score word `score` (float bits or Q15): the birth threshold's edge."""
+        if integer:
+            raw = [int(round(x * 1000)), 0, 0, 4000, 1800, 1600, 0, score]
+        else:
+            raw = [f32_bits(x), 0, 0, f32_bits(4.0), f32_bits(1.8), f32_bits(1.6), 0, score]
+        return track_det(obj(CAR, x, 0.0), unit, raw=raw)
+
+    # birth_min_score 1: only a score of exactly 1.0 (32768) starts a track, one ulp (1) below does not
+    s = track_cfg(confirm_hits=1, pokes=top) + track_update(unit, dets=[one(5.0, top_score), one(10.0, top_score - 1)])
+    seeds["cfg_birth_min_score_max"] = s + track_update(unit, dets=[one(5.2, top_score - 1), one(10.0, top_score)])
+    for i, p in enumerate(out):
+        seeds[f"cfg_refused_{i:02d}"] = track_cfg(pokes=[p]) + upd
+    return seeds
+
+
+def write_track_corpora() -> None:
+    for harness, unit, integer in (("track", TRACK_FLOAT, False), ("track_q", TRACK_INT, True)):
+        d = OUT / harness
+        d.mkdir(exist_ok=True)
+        for name, b in track_seeds(unit, integer).items():
+            (d / f"{name}.bin").write_bytes(b)
+
+
 def main() -> None:
     OUT.mkdir(parents=True, exist_ok=True)
     for harness, knobs in KNOBS.items():
@@ -205,6 +413,7 @@ def main() -> None:
             for sel, v in ms:
                 b += struct.pack("<BI", sel, v)
             (d / f"model{i}_{name}.bin").write_bytes(b + b"\x00\x00")
+    write_track_corpora()
     for p in sorted(OUT.rglob("*.bin")):
         print(p.relative_to(ROOT), p.stat().st_size)
 

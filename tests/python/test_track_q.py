@@ -151,9 +151,9 @@ def test_cfg_default_matches_c(nq):
 def test_cfg_validation_matches_c(nq):
     rng = np.random.default_rng(3)
     base = ref.cfg_to_array(ref.cfg_default())
-    lo = np.array([1] * 3 + [0] * 3 + [0] * 3 + [1] * 3 + [1, 0, 0, 1, 0, 0, 0, 0, 0, 0])
+    lo = np.array([1] * 3 + [0] * 3 + [0] * 3 + [1] * 3 + [1, 0, 0, 1, 0, 0, 0, 0, 0, 0] + [0] * 3)
     hi = np.array([10000] * 3 + [100000] * 3 + [46340] * 3 + [1000000] * 3
-                  + [1000 * 65536, 1000 * 65536, 1, 1000, 1000, 32768, 32768, 32768, 100000, 7])
+                  + [1000 * 65536, 1000 * 65536, 1, 1000, 1000, 32768, 32768, 32768, 100000, 7] + [1000] * 3)
     names = [n for n, k in ref.CFG_FIELDS for _ in range(k)]
     n_bad = 0
     for trial in range(400):

@@ -3,7 +3,8 @@
  * constant-velocity object (stable id, converging velocity), two crossing objects (ids kept), coasting and death,
  * confirmation, the heading flip and the reported heading, ego motion (a static object seen from a moving,
  * turning sensor has no ground velocity), capacities, bad detections, the configuration checks, optimal against
- * greedy assignment, output order and reset. The numpy reference's parity is tests/python/test_track.py. */
+ * greedy assignment, output order and reset, the covariance kept positive semi-definite. The numpy reference's
+ * parity is tests/python/test_track.py. */
 #include <math.h>
 #include <string.h>
 
@@ -598,6 +599,41 @@ static void test_class_vote(void)
     TEST_ASSERT_EQUAL_UINT32(10, out[0].hits);
 }
 
+/* fuzz_track's finding (tests/fuzz/regressions/track/covariance_not_psd_after_update.bin): a car born with the
+ * smallest meas_sigma and no process noise has a nearly singular covariance after a long prediction; the update by a
+ * cyclist's or pedestrian's detection (r >> the car's, still << p_pp) lost the digits of 1 - kp and p_vv - kv p_pv
+ * and left p_pv^2 up to 3x p_pp p_vv, or p_pv > 0 with p_vv 0. The update now clamps |p_pv| to sqrt(p_pp p_vv). */
+static void test_covariance_stays_positive_semidefinite(void)
+{
+    lidet_tracker_cfg_t cfg;
+    uint32_t b, k;
+    lidet_tracker_cfg_default(&cfg);
+    cfg.meas_sigma_m[LIDET_CLASS_CAR] = 0.001f;
+    cfg.accel_sigma_mps2[LIDET_CLASS_CAR] = 0.0f;
+    cfg.init_vel_sigma_mps[LIDET_CLASS_CAR] = 91.0f;
+    cfg.gate_max_m[LIDET_CLASS_CAR] = 1000.0f;
+    cfg.gate_chi2 = 1000.0f;
+    for (k = LIDET_CLASS_CYCLIST; k <= LIDET_CLASS_PEDESTRIAN; ++k)
+    {
+        for (b = 1; b <= 200u; ++b) /* dt 0.05 .. 10 s */
+        {
+            double pp, pv, vv;
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_tracker_init(&g.ws, &cfg));
+            dets[0] = det(LIDET_CLASS_CAR, 0.0f, 0.0f, 0.0f, 0.5f);
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_tracker_update(&g.ws, dets, 1, 0.1f, NULL));
+            dets[0] = det((uint8_t)k, 1.0f, 0.0f, 0.0f, 0.5f);
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_tracker_update(&g.ws, dets, 1, 0.05f * (float)b, NULL));
+            TEST_ASSERT_EQUAL_UINT32(1, lidet_tracker_tracks(&g.ws, out, LIDET_TRACK_MAX_TRACKS, 0));
+            TEST_ASSERT_EQUAL_UINT32(2, out[0].hits);
+            pp = (double)out[0].p_pp_m2;
+            pv = (double)out[0].p_pv;
+            vv = (double)out[0].p_vv;
+            TEST_ASSERT_TRUE(pp >= 0.0 && vv >= 0.0);
+            TEST_ASSERT_TRUE(pv * pv <= pp * vv * (1.0 + 1e-6) + 1e-30);
+        }
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -613,5 +649,6 @@ int main(void)
     RUN_TEST(test_optimal_beats_greedy);
     RUN_TEST(test_id_order_and_reset);
     RUN_TEST(test_class_vote);
+    RUN_TEST(test_covariance_stays_positive_semidefinite);
     return UNITY_END();
 }

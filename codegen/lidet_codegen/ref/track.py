@@ -357,6 +357,10 @@ class Tracker:
         self.p_vv[s] = vv if vv > 0 else F(0.0)
         self.p_pp[s] = (F(1.0) - kp) * self.p_pp[s]
         self.p_pv[s] = (F(1.0) - kp) * self.p_pv[s]
+        pp, pv, vv = self.p_pp[s], self.p_pv[s], self.p_vv[s]
+        if pv * pv > pp * vv:  # |p_pv| <= sqrt(p_pp p_vv) (rounding with r << p_pp and a nearly singular prior)
+            lim = np.sqrt(pp * vv)
+            self.p_pv[s] = -lim if pv < 0 else lim
         dyaw = wrap_pi(d[7] - self.yaw[s])
         if dyaw > HALF_PI:
             dyaw = dyaw - PI

@@ -17,8 +17,9 @@
  *  5. assignment: optimal (Hungarian method, shortest augmenting paths, on the square matrix of size
  *     max(tracks, detections) padded with gate_chi2 + class_penalty + 1) or greedy (cheapest feasible pair
  *     first; ties: lower slot, then lower detection index); assigned infeasible pairs are dropped;
- *  6. Kalman update of the assigned tracks; the detection's yaw (turned by pi when more than pi / 2 off: the
- *     box net's heading flip) and z, l, w, h averaged in; a class vote (sum of scores per class);
+ *  6. Kalman update of the assigned tracks (then |p_pv| clamped to sqrt(p_pp p_vv) against rounding); the
+ *     detection's yaw (turned by pi when more than pi / 2 off: the box net's heading flip) and z, l, w, h
+ *     averaged in; a class vote (sum of scores per class);
  *  7. misses: a tentative track dies at its first miss, a confirmed one after more than max_misses in a row;
  *  8. births: each unassigned detection with score >= birth_min_score starts a tentative track in the lowest
  *     free slot (ids from 1, wrapping to 1 after 2^32 - 1); no free slot: counted, LIDET_TRUNCATED;
@@ -29,7 +30,7 @@
  *
  * Memory: sizeof(lidet_tracker_t) = LIDET_TRACK_MAX_TRACKS * (88 + 4 LIDET_TRACK_MAX_DETS + 4) B
  * + LIDET_TRACK_MAX_DETS * 3 B + (max(LIDET_TRACK_MAX_TRACKS, LIDET_TRACK_MAX_DETS) + 1) * 17 B + ~140 B:
- * 23,704 B at the defaults (64 tracks, 64 detections; x86-64 and 32-bit targets alike), of which 16 KiB is the
+ * 23,716 B at the defaults (64 tracks, 64 detections; x86-64 and 32-bit targets alike), of which 16 KiB is the
  * cost matrix;
  * lidet_tracker_bytes() gives the exact figure. Declare it static.
  * Time per update: O(T D) for the costs (T tracks, D detections) plus O(N^3) for the optimal assignment

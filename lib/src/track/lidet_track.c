@@ -430,6 +430,14 @@ static void update_track(const lidet_tracker_cfg_t *cfg, lidet_tracker_slot_t *k
     k->p_vv = vv > 0.0f ? vv : 0.0f; /* >= 0 exactly; rounding could go below when r << p_pp */
     k->p_pp = (1.0f - kp) * k->p_pp;
     k->p_pv = (1.0f - kp) * k->p_pv;
+    /* |p_pv| <= sqrt(p_pp p_vv), as the integer build's cov_guard: with r << p_pp and a nearly singular prior (a
+     * tiny meas_sigma, no process noise, a long dt), 1 - kp and p_vv - kv p_pv lose most of their digits and could
+     * leave p_pv^2 above p_pp p_vv (tests/fuzz/regressions/track/covariance_not_psd_after_update.bin) */
+    if (k->p_pv * k->p_pv > k->p_pp * k->p_vv)
+    {
+        const float lim = sqrtf(k->p_pp * k->p_vv);
+        k->p_pv = k->p_pv < 0.0f ? -lim : lim;
+    }
     dyaw = wrap_pi(d->box.yaw_rad - k->yaw_rad);
     if (dyaw > LIDET_HALF_PI_F)
     {
