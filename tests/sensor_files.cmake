@@ -3,9 +3,12 @@
 # without Python: a description repeating a preset's table detects bit for bit as the preset; --print-sensor
 # writes a description that reads back to the same print; bad files exit 1 with a message naming the field;
 # Ouster's metadata files of ../shared/data/packets load (when that folder is there); a CLI built without cJSON
-# says so. (tests/python/test_sensor_files.py compares the CLI with the Python loader message for message.)
-# Usage: cmake -DCLI=lidet [-DNOJSON=lidet_without_cjson] -DHAVE_CJSON=ON|OFF -DSRC=<repo> -DWORK=<dir>
-#        -P sensor_files.cmake
+# says so. Velodyne calibrations (--velodyne-calib, cli_velodyne_calib.c): the hand-made VLP-16 calibrations (XML and
+# YAML) detect bit for bit as the vlp16 preset, bad ones are refused, a CLI built without libxml2 / libyaml says so.
+# (tests/python/test_sensor_files.py and test_velodyne_calib.py compare the CLI with the Python loaders message for
+# message.)
+# Usage: cmake -DCLI=lidet [-DNOJSON=lidet_without_cjson_libxml2_libyaml] -DHAVE_CJSON=ON|OFF -DHAVE_LIBXML2=ON|OFF
+#        -DHAVE_LIBYAML=ON|OFF -DSRC=<repo> -DWORK=<dir> -P sensor_files.cmake
 cmake_policy(SET CMP0054 NEW) # if(x STREQUAL "preset"): a quoted string, never a variable
 file(MAKE_DIRECTORY ${WORK})
 set(data ${SRC}/tests/data/sensors)
@@ -21,7 +24,71 @@ endfunction()
 if(NOJSON)
   expect_error(${NOJSON} --sensor-file ${data}/vlp16.json "--sensor-file needs cJSON, and this lidet was built without it")
   expect_error(${NOJSON} --ouster-meta ${data}/ouster_nested.json "--ouster-meta needs cJSON")
+  expect_error(${NOJSON} --velodyne-calib ${data}/vlp16_db.xml
+               "--velodyne-calib needs libxml2 to read this XML calibration, and this lidet was built without it")
+  expect_error(${NOJSON} --velodyne-calib ${data}/vlp16.yaml
+               "--velodyne-calib needs libyaml to read this YAML calibration, and this lidet was built without it")
 endif()
+
+# ---- Velodyne calibrations (need neither cJSON nor Python) ----
+set(n_calib 0)
+foreach(calib vlp16_db.xml vlp16.yaml)
+  if(calib MATCHES "xml$")
+    set(have ${HAVE_LIBXML2})
+    set(lib libxml2)
+  else()
+    set(have ${HAVE_LIBYAML})
+    set(lib libyaml)
+  endif()
+  if(NOT have)
+    expect_error(${CLI} --velodyne-calib ${data}/${calib} "needs ${lib} .* built without it")
+    message(STATUS "lidet was built without ${lib}: ${calib} refused, saying so")
+    continue()
+  endif()
+  # the hand-made VLP-16 calibration (lasers in firing order, the preset's elevations) at the preset's mount height
+  set(scan ${SRC}/tests/data/sim_vlp16/velodyne/000000.bin)
+  foreach(side preset calib)
+    if(side STREQUAL "preset")
+      set(opt --sensor vlp16)
+    else()
+      set(opt --velodyne-calib ${data}/${calib} --mount-height 0.5)
+    endif()
+    execute_process(COMMAND ${CLI} detect ${scan} ${opt} --ring ${SRC}/tests/data/sim_vlp16/ring/000000.bin
+                            --dump ${WORK}/${calib}_${side}.bin
+                    RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+    if(NOT rc EQUAL 0)
+      message(FATAL_ERROR "${CLI} detect ${scan} ${opt} failed (${rc}): ${err}")
+    endif()
+  endforeach()
+  execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${WORK}/${calib}_preset.bin ${WORK}/${calib}_calib.bin
+                  RESULT_VARIABLE same)
+  if(NOT same EQUAL 0)
+    message(FATAL_ERROR "detect --velodyne-calib ${data}/${calib} differs from --sensor vlp16 "
+                        "(${WORK}/${calib}_[preset|calib].bin)")
+  endif()
+  execute_process(COMMAND ${CLI} project --velodyne-calib ${data}/${calib} --print-sensor
+                  RESULT_VARIABLE rc OUTPUT_VARIABLE printed ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0 OR NOT printed MATCHES "\"name\": \"velodyne-16\",\n  \"cols\": 1800,\n  \"beam_elevation_deg\": \\[-1[45]")
+    message(FATAL_ERROR "${CLI} project --velodyne-calib ${data}/${calib} --print-sensor (${rc}): ${err}${printed}")
+  endif()
+  math(EXPR n_calib "${n_calib} + 1")
+endforeach()
+if(HAVE_LIBXML2)
+  file(WRITE ${WORK}/bad_calib.xml "<boost_serialization><DB><points_><item><px><id_>0</id_><rotCorrection_>0"
+                                   "</rotCorrection_><vertCorrection_>95</vertCorrection_></px></item></points_></DB>"
+                                   "</boost_serialization>")
+  expect_error(${CLI} --velodyne-calib ${WORK}/bad_calib.xml
+               "bad_calib.xml: \"points_\"\\[0\\].vertCorrection_: 95 deg is outside \\(-90, 90\\)")
+  file(WRITE ${WORK}/entity_calib.xml "<!DOCTYPE b [<!ENTITY a \"x\">]><boost_serialization/>")
+  expect_error(${CLI} --velodyne-calib ${WORK}/entity_calib.xml "entity declarations are refused")
+endif()
+if(HAVE_LIBYAML)
+  file(WRITE ${WORK}/bad_calib.yaml "num_lasers: 2\nlasers:\n  - {laser_id: 0, rot_correction: 0, vert_correction: 0}\n")
+  expect_error(${CLI} --velodyne-calib ${WORK}/bad_calib.yaml "\"num_lasers\": 2 but \"lasers\" has 1 entries")
+  file(WRITE ${WORK}/alias_calib.yaml "a: &x 1\nb: *x\n")
+  expect_error(${CLI} --velodyne-calib ${WORK}/alias_calib.yaml "YAML aliases are not supported \\(line 2\\)")
+endif()
+message(STATUS "Velodyne calibrations: ${n_calib} detected bit for bit as the vlp16 preset")
 if(NOT HAVE_CJSON)
   expect_error(${CLI} --sensor-file ${data}/vlp16.json "built without it")
   message(STATUS "SKIPPED: lidet was built without cJSON (apt-get install libcjson-dev): its error checked only")

@@ -10,8 +10,9 @@
 
 #include "lidet/lidet.h"
 
-/* A sensor read from a file (--sensor-file: lidet's description, --ouster-meta: Ouster's metadata; cli_sensor.c,
- * docs/SENSORS.md), as read: the profiles of cli_args_t point into it. */
+/* A sensor read from a file (--sensor-file: lidet's description, --ouster-meta: Ouster's metadata; cli_sensor.c;
+ * --velodyne-calib: a Velodyne calibration, cli_velodyne_calib.c; docs/SENSORS.md), as read: the profiles of
+ * cli_args_t point into it. */
 typedef struct
 {
     char name[64];                   /* the description's "name" (Ouster: the product line) */
@@ -19,7 +20,10 @@ typedef struct
     char family[64];                 /* the float model family: model, else hdl64 (>= 32 rows) or vlp16 */
     int uniform;                     /* 1: given as fov_up_deg, fov_down_deg and rows; 0: as a table */
     double fov_up_deg, fov_down_deg; /* uniform only */
-    double elev_deg[LIDET_MAX_ROWS]; /* ring order: the table as read, or the uniform beam centres */
+    double elev_deg[LIDET_MAX_ROWS]; /* ring order: the table as read, or the uniform beam centres (a YAML
+                                        calibration: its radians x 180 / pi), what --print-sensor prints */
+    int have_rad;                    /* 1: the file gave radians (elev_rad_d), the table's source */
+    double elev_rad_d[LIDET_MAX_ROWS]; /* ring order, radians as read (have_rad only) */
     float elev_rad[LIDET_MAX_ROWS];  /* the same in radians, single precision (lidet_sensor_t's table) */
     int32_t elev_urad[LIDET_MAX_ROWS]; /* and in microradians (lidet_sensor_q_t's table) */
     uint16_t rows, cols;
@@ -33,6 +37,8 @@ typedef struct
     int sensor_given;       /* --sensor was on the command line (--pcap: else the packets say) */
     const char *sensor_file; /* --sensor-file F: a lidet sensor description (JSON) */
     const char *ouster_meta; /* --ouster-meta M: Ouster's sensor metadata (JSON) */
+    const char *velodyne_calib; /* --velodyne-calib C: a Velodyne calibration (db.xml / VeloView XML, or YAML) */
+    long velodyne_cols;     /* --cols N with --velodyne-calib (0: the default for its laser count) */
     int print_sensor;       /* --print-sensor: print the sensor as a lidet description and stop */
     const char *out_path;   /* --out FILE */
     const char *png_path;   /* --png FILE */
@@ -62,6 +68,12 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a);
 /* Reads a->sensor_file or a->ouster_meta into a->desc and points the profiles at it (cli_sensor.c). Returns 0, or
  * prints "lidet CMD: FILE: problem" (or that this lidet was built without cJSON) and returns 1. */
 int cli_sensor_load(cli_args_t *a, const char *cmd);
+/* The same for a->velodyne_calib (cli_velodyne_calib.c, the rules of sensors.py load_velodyne_calibration): the
+ * table in ring order (lowest beam first), columns a->velodyne_cols or the laser count's default. 0, or 1 after
+ * "lidet CMD: FILE: problem" (or that this lidet was built without libxml2 / libyaml). */
+int cli_velodyne_calib_load(cli_args_t *a, const char *cmd);
+/* Points a's profiles (float, integer, family) at a->desc once a loader has filled it (cli_sensor.c). */
+void cli_sensor_use_desc(cli_args_t *a);
 /* The packet format of Ouster's metadata (--ouster-meta; the rules of tools/lidet_tools/ouster.py load_metadata):
  * what lidet_ouster_cfg_t takes besides the beam count and columns (a->desc) */
 typedef struct

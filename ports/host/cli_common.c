@@ -10,15 +10,20 @@
 static void usage(const char *cmd)
 {
     fprintf(stderr,
-            "usage: lidet %s SCAN.bin [--sensor NAME | --sensor-file F | --ouster-meta M] [--ring RING.bin]\n"
-            "                 [--out FILE] [--png FILE] [--json] [--repeat N] [--mount-height M]\n"
-            "       lidet %s [--sensor NAME | --sensor-file F | --ouster-meta M] [--mount-height M] --print-sensor\n"
+            "usage: lidet %s SCAN.bin [--sensor NAME | --sensor-file F | --ouster-meta M |\n"
+            "                 --velodyne-calib C [--cols N]]\n"
+            "                 [--ring RING.bin] [--out FILE] [--png FILE] [--json] [--repeat N] [--mount-height M]\n"
+            "       lidet %s [--sensor NAME | --sensor-file F | --ouster-meta M | --velodyne-calib C [--cols N]]\n"
+            "                 [--mount-height M] --print-sensor\n"
             "  SCAN.bin   KITTI velodyne scan: float32 records x, y, z, remission (metres, sensor frame)\n"
             "  --sensor   hdl64 (default), vlp16, vlp32c, hdl32, os0-32, os0-64, os0-128, os1-32, os1-64,\n"
             "             os1-128, os2-32, os2-64, os2-128 (docs/SENSORS.md)\n"
             "  --sensor-file  a sensor description (JSON, \"format\": \"lidet-sensor\"; docs/SENSORS.md)\n"
             "  --ouster-meta  an Ouster sensor's metadata JSON (beam table, columns; mount height 1.0 m\n"
             "             unless --mount-height)\n"
+            "  --velodyne-calib  a Velodyne calibration: db.xml / VeloView XML, or velodyne_pointcloud's YAML\n"
+            "             (beam table in ring order, lowest beam first; mount height 1.0 m unless --mount-height)\n"
+            "  --cols     with --velodyne-calib: columns per revolution (default 1800; 2048 for 64 lasers)\n"
             "  --print-sensor  print the sensor as a lidet sensor description (JSON) and stop\n"
             "  --ring     optional uint16 ring index per point (sensor's ring order) instead of elevation\n"
             "  --json     print one JSON object (stage timings as <stage>_ms)\n"
@@ -49,7 +54,8 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
         }
         else if ((strcmp(s, "--sensor") == 0 || strcmp(s, "--out") == 0 || strcmp(s, "--png") == 0 ||
                   strcmp(s, "--repeat") == 0 || strcmp(s, "--ring") == 0 || strcmp(s, "--mount-height") == 0 ||
-                  strcmp(s, "--sensor-file") == 0 || strcmp(s, "--ouster-meta") == 0))
+                  strcmp(s, "--sensor-file") == 0 || strcmp(s, "--ouster-meta") == 0 ||
+                  strcmp(s, "--velodyne-calib") == 0 || strcmp(s, "--cols") == 0))
         {
             if (!has_val)
             {
@@ -65,6 +71,20 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
                 a->sensor_file = argv[++i];
             else if (strcmp(s, "--ouster-meta") == 0)
                 a->ouster_meta = argv[++i];
+            else if (strcmp(s, "--velodyne-calib") == 0)
+                a->velodyne_calib = argv[++i];
+            else if (strcmp(s, "--cols") == 0)
+            {
+                char *end;
+                const long v = strtol(argv[++i], &end, 10);
+                if (end == argv[i] || *end != '\0' || v < 8 || v > LIDET_MAX_COLS)
+                {
+                    fprintf(stderr, "lidet %s: --cols needs an integer in [8, %d] (LIDET_MAX_COLS), got '%s'\n", cmd,
+                            LIDET_MAX_COLS, argv[i]);
+                    return 1;
+                }
+                a->velodyne_cols = v;
+            }
             else if (strcmp(s, "--out") == 0)
                 a->out_path = argv[++i];
             else if (strcmp(s, "--png") == 0)
@@ -122,15 +142,21 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
         return 1;
     }
     a->sensor_given = sensor_given;
-    if ((a->sensor_file != NULL) + (a->ouster_meta != NULL) + sensor_given > 1)
+    if ((a->sensor_file != NULL) + (a->ouster_meta != NULL) + (a->velodyne_calib != NULL) + sensor_given > 1)
     {
-        fprintf(stderr, "lidet %s: give one of --sensor, --sensor-file and --ouster-meta\n", cmd);
+        fprintf(stderr, "lidet %s: give one of --sensor, --sensor-file, --ouster-meta and --velodyne-calib\n", cmd);
         return 1;
     }
-    if (a->sensor_file != NULL || a->ouster_meta != NULL)
+    if (a->velodyne_cols > 0 && a->velodyne_calib == NULL)
+    {
+        fprintf(stderr, "lidet %s: --cols goes with --velodyne-calib (the presets and the other files give their "
+                        "columns)\n", cmd);
+        return 1;
+    }
+    if (a->sensor_file != NULL || a->ouster_meta != NULL || a->velodyne_calib != NULL)
     {
         /* the file's sensor: a->sensor_mounted (its table in a->desc), its family and integer profile */
-        if (cli_sensor_load(a, cmd) != 0)
+        if ((a->velodyne_calib != NULL ? cli_velodyne_calib_load(a, cmd) : cli_sensor_load(a, cmd)) != 0)
             return 3;
     }
     else

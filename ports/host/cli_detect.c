@@ -1010,7 +1010,9 @@ int cli_detect(int argc, char **argv)
                                                       strcmp(rest[i - 1], "--repeat") != 0 &&
                                                       strcmp(rest[i - 1], "--mount-height") != 0 &&
                                                       strcmp(rest[i - 1], "--sensor-file") != 0 &&
-                                                      strcmp(rest[i - 1], "--ouster-meta") != 0)))
+                                                      strcmp(rest[i - 1], "--ouster-meta") != 0 &&
+                                                      strcmp(rest[i - 1], "--velodyne-calib") != 0 &&
+                                                      strcmp(rest[i - 1], "--cols") != 0)))
                 one = rest[i];
         if (one != NULL)
         {

@@ -447,12 +447,15 @@ static int vel_model_of(const char *sensor)
 
 static int vel_setup(cli_capture_t *c, cli_args_t *a)
 {
-    if (a->sensor_file != NULL || a->ouster_meta != NULL)
+    if (a->sensor_file != NULL || a->ouster_meta != NULL || a->velodyne_calib != NULL)
     {
         fprintf(stderr,
                 "lidet %s: --pcap with --lidar velodyne takes the sensor from the packets or --sensor (vlp16, "
                 "vlp32c, hdl32), not %s\n",
-                cli_cmd, a->sensor_file != NULL ? "--sensor-file" : "--ouster-meta (--lidar ouster reads it)");
+                cli_cmd,
+                a->sensor_file != NULL   ? "--sensor-file"
+                : a->ouster_meta != NULL ? "--ouster-meta (--lidar ouster reads it)"
+                                         : "--velodyne-calib (the decoder has its own laser tables: docs/SENSORS.md)");
         return 1;
     }
     if (c->o.dual != NULL && strcmp(c->o.dual, "both") != 0 && strcmp(c->o.dual, "last") != 0 &&

@@ -6,7 +6,9 @@
  *
  * The rules, their order and the messages are those of tools/lidet_tools/sensors.py (load_sensor_file,
  * load_ouster_metadata): a change here goes there too; tests/python/test_sensor_files.py compares the two on every
- * test file. Built without cJSON (LIDET_HAVE_CJSON unset) the two options exit with an error saying so. */
+ * test file. Built without cJSON (LIDET_HAVE_CJSON unset) the two options exit with an error saying so.
+ * `--velodyne-calib C` (Velodyne's calibrations, libxml2 / libyaml) is cli_velodyne_calib.c's; it hands its table to
+ * cli_sensor_use_desc below, as these loaders do. */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -22,27 +24,6 @@
 
 #define DEG2RAD_D (M_PI_D / 180.0)
 
-#ifdef LIDET_HAVE_CJSON
-
-/* what the loaders cannot use: the message without the path */
-#define ERR_LEN 512
-
-static int bad(char *err, const char *fmt, ...)
-{
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(err, ERR_LEN, fmt, ap);
-    va_end(ap);
-    return 1;
-}
-
-/* a "name" or "model": 1 to 63 of these bytes (printed into JSON and titles without escaping) */
-static int name_byte(unsigned char c)
-{
-    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' ||
-           c == '_' || c == '+' || c == '-';
-}
-
 static void set_family(cli_sensor_desc_t *d)
 {
     /* the description's "model", else hdl64 for 32 beams or more and vlp16 below (sensors.py: model_family) */
@@ -52,9 +33,9 @@ static void set_family(cli_sensor_desc_t *d)
                                  : "vlp16");
 }
 
-/* Points the command's profiles at the description just read: the float one (the table in radians), the integer
- * one (microradians rounded half to even, as numpy's round: sensors.py Sensor.beam_elev_urad / _urad_fov). */
-static void use_desc(cli_args_t *a)
+/* Points the command's profiles at the sensor just read (a->desc; cli.h): the float one (the table in radians), the
+ * integer one (microradians rounded half to even, as numpy's round: sensors.py Sensor.beam_elev_urad / _urad_fov). */
+void cli_sensor_use_desc(cli_args_t *a)
 {
     cli_sensor_desc_t *d = &a->desc;
     lidet_sensor_t *s = &a->sensor_mounted;
@@ -62,7 +43,8 @@ static void use_desc(cli_args_t *a)
     uint16_t i;
     for (i = 0; i < d->rows; ++i)
     {
-        const double rad = d->elev_deg[i] * DEG2RAD_D;
+        /* the file's radians when it gives radians (a velodyne_pointcloud YAML), else its degrees converted */
+        const double rad = d->have_rad ? d->elev_rad_d[i] : d->elev_deg[i] * DEG2RAD_D;
         d->elev_rad[i] = (float)rad;
         d->elev_urad[i] = (int32_t)rint(rad * 1e6);
     }
@@ -94,6 +76,27 @@ static void use_desc(cli_args_t *a)
     a->family = d->family;
     a->sensor_profile = s;
     a->sensor_q = q;
+}
+
+#ifdef LIDET_HAVE_CJSON
+
+/* what the loaders cannot use: the message without the path */
+#define ERR_LEN 512
+
+static int bad(char *err, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(err, ERR_LEN, fmt, ap);
+    va_end(ap);
+    return 1;
+}
+
+/* a "name" or "model": 1 to 63 of these bytes (printed into JSON and titles without escaping) */
+static int name_byte(unsigned char c)
+{
+    return (c >= 'A' && c <= 'Z') || (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '.' ||
+           c == '_' || c == '+' || c == '-';
 }
 
 /* index of the first beam whose single-precision radians equal an earlier one's (*j: that one), or -1 */
@@ -489,7 +492,7 @@ static int read_ouster(const cJSON *root, cli_sensor_desc_t *d, char *err)
     if (elevations(v, alt_f, d->elev_deg, &d->rows, err) != 0)
         return 1;
     v = find(root, beam, 1, "beam_azimuth_angles", f, sizeof f);
-    if (v != NULL) /* read and validated; the projection does not use them (docs/SENSORS.md) */
+    if (v != NULL) /* read and validated; the Ouster decoder takes them (cli_ouster_format), the projection not */
     {
         const cJSON *e;
         char w[128];
@@ -587,7 +590,7 @@ int cli_sensor_load(cli_args_t *a, const char *cmd)
         fprintf(stderr, "lidet %s: %s: %s\n", cmd, path, err);
         return 1;
     }
-    use_desc(a);
+    cli_sensor_use_desc(a);
     return 0;
 }
 

@@ -58,8 +58,8 @@ static void usage(void)
 {
     fprintf(
         stderr,
-        "usage: lidet track SCANS... | DIR | --pcap FILE [--sensor NAME | --sensor-file F | --ouster-meta M] "
-        "[--mount-height M]\n"
+        "usage: lidet track SCANS... | DIR | --pcap FILE [--sensor NAME | --sensor-file F | --ouster-meta M |\n"
+        "                   --velodyne-calib C [--cols N]] [--mount-height M]\n"
         "                   [--model NAME] [--crop] [--fixed] [--set KEY=VALUE] [--rate HZ | --dt-file F]\n"
         "                   [--ego FILE | --ego none] [--calib FILE] [--out DIR] [--png FILE] [--json]\n"
         "                   [--coasting] [--tentative]\n"
@@ -115,7 +115,8 @@ static void usage(void)
         "    yaw in rad), the velocity over the ground in m/s, the last detection's score, the track's "
         "hits;\n"
         "    frame: the scan's number when its name (stem) is digits, else its index from 0\n"
-        "  --sensor, --sensor-file, --ouster-meta, --mount-height, --print-sensor: as lidet detect\n"
+        "  --sensor, --sensor-file, --ouster-meta, --velodyne-calib, --cols, --mount-height, --print-sensor: as\n"
+        "  lidet detect\n"
         "  (lidet detect --help). The detector's options, as lidet detect:\n",
         TAIL_LEN);
     cli_det_usage(stderr);
@@ -935,7 +936,8 @@ int cli_track(int argc, char **argv)
             print_sensor = 1;
         }
         else if (strcmp(s, "--sensor") == 0 || strcmp(s, "--sensor-file") == 0 ||
-                 strcmp(s, "--ouster-meta") == 0 || strcmp(s, "--mount-height") == 0)
+                 strcmp(s, "--ouster-meta") == 0 || strcmp(s, "--velodyne-calib") == 0 ||
+                 strcmp(s, "--cols") == 0 || strcmp(s, "--mount-height") == 0)
         {
             rest[nrest++] = argv[i]; /* cli_parse reads them (and says when the value is missing) */
             if (has_val)

@@ -375,7 +375,7 @@ def test_cli_missing_file_and_option_conflicts(cli_json, tmp_path):
         f"{tmp_path / 'nope.json'}: cannot read: No such file or directory"
     r = subprocess.run([str(cli_json), "detect", "x.bin", "--sensor", "hdl64", "--sensor-file", DATA / "hdl64.json"],
                        capture_output=True, text=True)
-    assert r.returncode == 1 and "give one of --sensor, --sensor-file and --ouster-meta" in r.stderr
+    assert r.returncode == 1 and "give one of --sensor, --sensor-file, --ouster-meta and --velodyne-calib" in r.stderr
 
 
 def _good_files(tmp_path):

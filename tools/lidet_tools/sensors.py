@@ -11,9 +11,12 @@ azimuth = atan2(y, x); so +x (forward) is the middle column, azimuth decreases t
 the seam (col 0 / cols-1) is straight behind the sensor.
 
 Sensors beyond the presets come from files (docs/SENSORS.md): `load_sensor_file` reads lidet's own
-description (JSON, "format": "lidet-sensor"), `load_ouster_metadata` Ouster's sensor metadata JSON. The
-host CLI reads the same files with the same rules and messages (ports/host/cli_sensor.c,
-`lidet ... --sensor-file F | --ouster-meta M`); tests/python/test_sensor_files.py holds the two together.
+description (JSON, "format": "lidet-sensor"), `load_ouster_metadata` Ouster's sensor metadata JSON,
+`load_velodyne_calibration` a Velodyne calibration (db.xml / VeloView XML, or velodyne_pointcloud's YAML);
+`description_json` writes a Sensor as a description. The host CLI reads the same files with the same rules and
+messages (ports/host/cli_sensor.c, cli_velodyne_calib.c: `lidet ... --sensor-file F | --ouster-meta M |
+--velodyne-calib C`) and prints what it read as `description_json` writes it (`--print-sensor`);
+tests/python/test_sensor_files.py and test_velodyne_calib.py hold the two together.
 """
 from __future__ import annotations
 
@@ -31,6 +34,27 @@ def _deg(a):
 
 
 @dataclass(frozen=True)
+class VelodyneCorrections:
+    """What a Velodyne calibration gives besides the elevations and azimuth offsets (load_velodyne_calibration),
+    per laser in the Sensor's ring order (lowest beam first), in metres as velodyne_pointcloud's YAML has them
+    (db.xml's centimetres times 0.01). Read and validated; neither the projection nor the packet decoder
+    (lidet_velodyne.h, whose laser tables are built in) uses them (docs/SENSORS.md)."""
+    #: "xml" (db.xml / VeloView) or "yaml" (velodyne_pointcloud)
+    source: str
+    #: each ring's laser: its id (id_ / laser_id), the laser's place in the packet's data block
+    laser_id: np.ndarray = field(repr=False)
+    dist_correction_m: np.ndarray = field(repr=False)
+    dist_correction_x_m: np.ndarray = field(repr=False)
+    dist_correction_y_m: np.ndarray = field(repr=False)
+    vert_offset_m: np.ndarray = field(repr=False)
+    horiz_offset_m: np.ndarray = field(repr=False)
+    focal_distance_m: np.ndarray = field(repr=False)
+    focal_slope: np.ndarray = field(repr=False)
+    #: distance_resolution (YAML, m) or distLSB_ (db.xml, cm, times 0.01); 0.002 when the file gives none
+    distance_resolution_m: float = 0.002
+
+
+@dataclass(frozen=True)
 class Sensor:
     name: str
     rows: int
@@ -44,11 +68,18 @@ class Sensor:
     fov_urad: tuple | None = None
     #: float model family the detector runs (a description file's "model"); None: the rule of `model_family`
     model: str | None = None
-    #: per-beam azimuth offsets in radians, ring order (Ouster metadata's beam_azimuth_angles); read and
-    #: validated, not used by the projection
+    #: per-beam azimuth offsets in radians, ring order, as the file gives them: Ouster metadata's
+    #: beam_azimuth_angles (the Ouster packet decoder takes them: lidet_tools.ouster, `lidet detect --pcap --lidar
+    #: ouster`), a Velodyne calibration's rot_correction (read, not used); the projection never uses them
     beam_azimuth_rad: np.ndarray | None = field(default=None, repr=False)
     #: Ouster metadata's lidar_origin_to_beam_origin_mm; read and validated, not used by the projection
     beam_origin_mm: float | None = None
+    #: the elevation table in degrees as the file gives it (ring order; a velodyne_pointcloud YAML's radians times
+    #: 180 / pi): what `description_json` and `lidet ... --print-sensor` write; None for a preset and a uniform
+    #: description
+    beam_elev_deg: np.ndarray | None = field(default=None, repr=False)
+    #: a Velodyne calibration's other corrections (load_velodyne_calibration); None otherwise
+    velodyne: VelodyneCorrections | None = field(default=None, repr=False)
 
     @property
     def beam_elev_urad(self) -> np.ndarray:
@@ -427,7 +458,8 @@ def _description(root: dict, max_rows: int, max_cols: int) -> Sensor:
     if not 0.0 < max_range <= 1000.0:
         raise _Bad(f'"max_range_m": {max_range:g} is outside (0, 1000]')
     model = _name(root["model"], '"model"') if "model" in root else None
-    return Sensor(name, len(deg), cols, _deg(deg), mount, max_range, fov, model=model)
+    return Sensor(name, len(deg), cols, _deg(deg), mount, max_range, fov, model=model,
+                  beam_elev_deg=deg if fov is None else None)
 
 
 def load_sensor_file(path) -> Sensor:
@@ -530,7 +562,7 @@ def _ouster(root: dict, max_rows: int, max_cols: int, mount_height_m: float) -> 
             raise _Bad(f'"{prod_f}": expected a string, got {_kind(prod)}')
         name = _ouster_name(prod, rows)
     return Sensor(name, rows, cols, _deg(deg), float(mount_height_m), OUSTER_MAX_RANGE_M, None,
-                  beam_azimuth_rad=az_rad, beam_origin_mm=origin)
+                  beam_azimuth_rad=az_rad, beam_origin_mm=origin, beam_elev_deg=deg)
 
 
 def load_ouster_metadata(path, mount_height_m: float | None = None) -> Sensor:
@@ -539,8 +571,9 @@ def load_ouster_metadata(path, mount_height_m: float | None = None) -> Sensor:
     "sensor_info"): beam elevations from beam_altitude_angles in Ouster's ring order (top beam first), columns
     from columns_per_frame or the lidar mode ("1024x10"), the name from the product line. The mount height is
     not in Ouster's file: `mount_height_m` (metres, [0, 10]; default 1.0). The beam azimuth offsets and the
-    beam-origin offset are read and validated (`Sensor.beam_azimuth_rad`, `Sensor.beam_origin_mm`) but not used
-    by the projection (docs/SENSORS.md). Raises SensorFileError naming the file and the field."""
+    beam-origin offset are read and validated (`Sensor.beam_azimuth_rad`, `Sensor.beam_origin_mm`): the projection
+    does not use them; the Ouster packet decoder takes the azimuth offsets and `lidet_tools.ouster.xyz` both
+    (docs/SENSORS.md). Raises SensorFileError naming the file and the field."""
     if mount_height_m is None:
         mount_height_m = OUSTER_MOUNT_HEIGHT_M
     elif isinstance(mount_height_m, bool) or not isinstance(mount_height_m, (int, float, np.number)) or \
@@ -552,3 +585,482 @@ def load_ouster_metadata(path, mount_height_m: float | None = None) -> Sensor:
         return _ouster(root, max_rows, max_cols, float(mount_height_m))
     except _Bad as e:
         raise SensorFileError(f"{path}: {e}") from None
+
+
+# ---- a Sensor as a description (what `lidet ... --print-sensor` prints) -----------------------------------------
+
+_DEG2RAD = math.pi / 180.0  # the C loaders' DEG2RAD_D (M_PI / 180), numpy's radians()
+
+
+def _shortest_double(v: float) -> str:
+    """The shortest of %.15g .. %.17g that reads back as v (cli_sensor.c: put_double)."""
+    for p in (15, 16, 17):
+        t = "%.*g" % (p, v)
+        if float(t) == v:
+            break
+    return t
+
+
+def _shortest_float32(v) -> str:
+    """A single-precision value, the shortest of %.6g .. %.9g that reads back as it (put_float)."""
+    f = np.float32(v)
+    for p in range(6, 10):
+        t = "%.*g" % (p, float(f))
+        if np.float32(float(t)) == f:
+            break
+    return t
+
+
+def _deg_of_float32(rad) -> str:
+    """A single-precision angle in degrees, the shortest that a description turns back into it (put_deg_of)."""
+    r = np.float32(rad)
+    for p in range(6, 18):
+        t = "%.*g" % (p, float(r) / _DEG2RAD)
+        if np.float32(float(t) * _DEG2RAD) == r:
+            break
+    return t
+
+
+def description_json(sensor: Sensor) -> str:
+    """The sensor as a version-1 description (JSON text, docs/SENSORS.md), laid out as `lidet ... --print-sensor`
+    prints it. A sensor read from a file (`beam_elev_deg` set: a description with a table, Ouster metadata, a
+    Velodyne calibration) is written as read: each elevation, the mount height and the range as the shortest
+    decimal that reads back as the same double, the model when it has one; the CLI prints the same text for the
+    same file and options. Any other sensor (a preset, a uniform description) is written as its beam table: the
+    shortest degrees that give back its single-precision radians, as the CLI prints a table preset (the CLI prints
+    a uniform sensor as its field of view instead)."""
+    from_file = sensor.beam_elev_deg is not None
+    if from_file:
+        elev = [_shortest_double(float(d)) for d in sensor.beam_elev_deg]
+        mount, rng = _shortest_double(float(sensor.mount_height_m)), _shortest_double(float(sensor.max_range_m))
+    else:
+        elev = [_deg_of_float32(r) for r in np.asarray(sensor.beam_elev_rad, np.float32)]
+        mount, rng = _shortest_float32(sensor.mount_height_m), _shortest_float32(sensor.max_range_m)
+    table = "".join(("" if i == 0 else ",\n    " if i % 8 == 0 else ", ") + e for i, e in enumerate(elev))
+    out = ('{\n  "format": "lidet-sensor",\n  "version": 1,\n'
+           f'  "name": "{sensor.name}",\n  "cols": {int(sensor.cols)},\n'
+           f'  "beam_elevation_deg": [{table}],\n'
+           f'  "mount_height_m": {mount},\n  "max_range_m": {rng}')
+    if from_file and sensor.model:
+        out += f',\n  "model": "{sensor.model}"'
+    return out + "\n}\n"
+
+
+def write_sensor_file(sensor: Sensor, path) -> None:
+    """Writes `description_json(sensor)` to path (read it back with load_sensor_file)."""
+    pathlib.Path(path).write_text(description_json(sensor))
+
+
+# ---- Velodyne calibrations (docs/SENSORS.md, "Velodyne calibration files") -----------------------------------
+# ports/host/cli_velodyne_calib.c reads them with libxml2 and libyaml by the same rules, in the same order, with
+# the same messages (tests/python/test_velodyne_calib.py).
+
+#: what a Velodyne calibration does not say: the mount height (overridable), the nominal range (informational)
+VELODYNE_MOUNT_HEIGHT_M = 1.0
+VELODYNE_MAX_RANGE_M = 100.0
+#: the distance resolution when the file gives none (velodyne_pointcloud's default: 2 mm)
+VELODYNE_DISTANCE_RESOLUTION_M = 0.002
+#: a YAML calibration nested deeper than this is refused
+_YAML_MAX_DEPTH = 32
+#: the optional per-laser corrections: (db.xml element, its scale to metres, YAML key)
+_VELODYNE_OPTIONAL = (("distCorrection_", 0.01, "dist_correction"), ("distCorrectionX_", 0.01, "dist_correction_x"),
+                      ("distCorrectionY_", 0.01, "dist_correction_y"),
+                      ("vertOffsetCorrection_", 0.01, "vert_offset_correction"),
+                      ("horizOffsetCorrection_", 0.01, "horiz_offset_correction"),
+                      ("focalDistance_", 0.01, "focal_distance"), ("focalSlope_", 1.0, "focal_slope"))
+#: a number in a calibration: db.xml's element text (trimmed), a plain YAML scalar
+_CAL_NUMBER = re.compile(r"[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?")
+_YAML_INF = re.compile(r"[-+]?\.(?:inf|Inf|INF)")
+_YAML_NAN = re.compile(r"\.(?:nan|NaN|NAN)")
+
+
+def velodyne_default_cols(n_lasers: int, max_cols: int | None = None) -> int:
+    """Columns per revolution when the caller gives none: 2048 for 64 lasers (the hdl64 preset's, KITTI's HDL-64E),
+    else 1800 (VLP-16, VLP-32C at 600 rpm: 0.2 deg a column; the presets' vlp16, vlp32c), at most LIDET_MAX_COLS."""
+    if max_cols is None:
+        max_cols = capacity_limits()[1]
+    return min(2048 if n_lasers == 64 else 1800, max_cols)
+
+
+def _xml_child(parent, tag: str, what: str):
+    """The one child element named tag (None when absent); given twice is an error."""
+    found = [c for c in parent if c.tag == tag]
+    if len(found) > 1:
+        raise _Bad(f"{what}: given twice")
+    return found[0] if found else None
+
+
+def _xml_number(el, what: str) -> float:
+    """An element's text as a number: no child element, the text (XML white space trimmed) a decimal number."""
+    t = None if len(el) else (el.text or "").strip(" \t\r\n")
+    if t is None or not _CAL_NUMBER.fullmatch(t):
+        raise _Bad(f"{what}: not a number")
+    x = float(t)
+    if not math.isfinite(x):
+        raise _Bad(f"{what}: not a finite number")
+    return x
+
+
+def _xml_integer(el, what: str, lo: int, hi: int) -> int:
+    x = _xml_number(el, what)
+    if x != math.floor(x):
+        raise _Bad(f"{what}: expected an integer, got {x:g}")
+    if not lo <= x <= hi:
+        raise _Bad(f"{what}: {x:g} is outside [{lo}, {hi}]")
+    return int(x)
+
+
+def _xml_items(parent, name: str) -> list:
+    """The <item> children of a boost-serialized list; its <count>, when given, must say how many."""
+    items = [c for c in parent if c.tag == "item"]
+    c = _xml_child(parent, "count", f'"{name}.count"')
+    if c is not None:
+        k = _xml_integer(c, f'"{name}.count"', 0, 1000000)
+        if k != len(items):
+            raise _Bad(f'"{name}.count": {k} but "{name}" has {len(items)} items')
+    return items
+
+
+def _first_same_f32(rad: np.ndarray) -> tuple[int, int]:
+    """(i, j): the first beam whose single-precision radians equal an earlier beam j's; (-1, -1) when none."""
+    seen: dict = {}
+    for i, r in enumerate(np.asarray(rad, np.float64).astype(np.float32).tolist()):
+        if r in seen:
+            return i, seen[r]
+        seen[r] = i
+    return -1, -1
+
+
+def _velodyne_xml(data: bytes, max_rows: int) -> tuple:
+    """db.xml / VeloView XML: (entry names, laser ids, elevations deg, rot corrections deg, optional (n x 7,
+    metres), distance resolution m), in the file's order of the enabled lasers."""
+    try:
+        import defusedxml
+        import defusedxml.ElementTree as det
+    except ImportError as e:  # requirements.txt pins it
+        raise ImportError("reading a Velodyne XML calibration needs defusedxml (pip install defusedxml)") from e
+    try:
+        root = det.fromstring(data)
+    except det.ParseError as e:
+        msg = re.sub(r": line [0-9]+, column [0-9]+$", "", str(e))
+        raise _Bad(f"not valid XML (line {e.position[0]}: {msg})") from None
+    except defusedxml.DefusedXmlException:
+        raise _Bad("not valid XML for a calibration (entity declarations are refused)") from None
+    db = root if root.tag == "DB" else _xml_child(root, "DB", '"DB"') if root.tag == "boost_serialization" else None
+    if db is None:
+        raise _Bad('"DB": missing (<boost_serialization><DB>...</DB>): not a Velodyne calibration (db.xml)?')
+    res = VELODYNE_DISTANCE_RESOLUTION_M
+    el = _xml_child(db, "distLSB_", '"distLSB_"')
+    if el is not None:
+        x = _xml_number(el, '"distLSB_"')
+        if not 0.0 < x <= 100.0:
+            raise _Bad(f'"distLSB_": {x:g} is outside (0, 100] (centimetres)')
+        res = x * 0.01
+    enabled = None
+    en = _xml_child(db, "enabled_", '"enabled_"')
+    if en is not None:
+        enabled = []
+        for i, it in enumerate(_xml_items(en, "enabled_")):
+            x = _xml_number(it, f'"enabled_"[{i}]')
+            if x != 0.0 and x != 1.0:
+                raise _Bad(f'"enabled_"[{i}]: expected 0 or 1, got {x:g}')
+            enabled.append(x == 1.0)
+    pts = _xml_child(db, "points_", '"points_"')
+    if pts is None:
+        raise _Bad('"points_": missing: not a Velodyne calibration (db.xml)?')
+    items = _xml_items(pts, "points_")
+    n = sum(enabled) if enabled is not None else len(items)
+    if not 1 <= n <= max_rows:
+        where = f'"enabled_": {n} lasers enabled' if enabled is not None else f'"points_": {n} lasers'
+        raise _Bad(f"{where}, outside [1, {max_rows}] (LIDET_MAX_ROWS)")
+    id_hi = (len(enabled) if enabled is not None else len(items)) - 1
+    seen: dict = {}
+    names, ids, vert, rot, opt = [], [], [], [], []
+    for k, it in enumerate(items):
+        w = f'"points_"[{k}]'
+        px = _xml_child(it, "px", f"{w}.px")
+        if px is None:
+            raise _Bad(f'{w}: no "px"')
+        el = _xml_child(px, "id_", f"{w}.id_")
+        if el is None:
+            raise _Bad(f"{w}.id_: missing")
+        lid = _xml_integer(el, f"{w}.id_", 0, id_hi)
+        if lid in seen:
+            raise _Bad(f'{w}.id_: {lid} given twice (also "points_"[{seen[lid]}])')
+        seen[lid] = k
+        if enabled is not None and not enabled[lid]:
+            continue  # a laser the unit does not have (db.xml lists 64)
+        vals = []
+        for tag, lim in (("vertCorrection_", 90.0), ("rotCorrection_", 180.0)):
+            el = _xml_child(px, tag, f"{w}.{tag}")
+            if el is None:
+                raise _Bad(f"{w}.{tag}: missing")
+            x = _xml_number(el, f"{w}.{tag}")
+            if not -lim < x < lim:
+                raise _Bad(f"{w}.{tag}: {x:g} deg is outside ({-lim:g}, {lim:g})")
+            vals.append(x)
+        o = []
+        for tag, scale, _ in _VELODYNE_OPTIONAL:
+            el = _xml_child(px, tag, f"{w}.{tag}")
+            o.append(_xml_number(el, f"{w}.{tag}") * scale if el is not None else 0.0)
+        names.append(w)
+        ids.append(lid)
+        vert.append(vals[0])
+        rot.append(vals[1])
+        opt.append(o)
+    if enabled is not None:
+        for i, e in enumerate(enabled):
+            if e and i not in seen:
+                raise _Bad(f'"enabled_"[{i}]: laser {i} is enabled, but "points_" has no px with id_ {i}')
+    deg = np.array(vert, np.float64)
+    i, j = _first_same_f32(np.radians(deg))
+    if i >= 0:
+        raise _Bad(f"{names[i]}.vertCorrection_: the same elevation as {names[j]} ({deg[i]:g} deg): beams must be "
+                   "distinct")
+    return ids, deg, np.radians(deg), np.radians(np.array(rot, np.float64)), np.array(opt, np.float64), res
+
+
+def _yaml_value(raw: str, plain: bool):
+    """A YAML scalar as lidet reads it (the C loader's rule, whatever the tags say): quoted, literal or folded: a
+    string; plain: null (empty, ~, null), a boolean (true, false), a decimal number, .inf / .nan, else a string."""
+    if not plain:
+        return raw
+    if raw in ("", "~", "null", "Null", "NULL"):
+        return None
+    if raw in ("true", "True", "TRUE"):
+        return True
+    if raw in ("false", "False", "FALSE"):
+        return False
+    if _CAL_NUMBER.fullmatch(raw):
+        return float(raw)
+    if _YAML_INF.fullmatch(raw):
+        return -math.inf if raw[0] == "-" else math.inf
+    if _YAML_NAN.fullmatch(raw):
+        return math.nan
+    return raw
+
+
+def _yaml_path(parent: str, key) -> str:
+    """The name of a member in messages: "key" at the top, parent.key below, parent[i] in a list."""
+    if isinstance(key, int):
+        return f"{parent}[{key}]"
+    return f'"{key}"' if parent == "" else f"{parent}.{key}"
+
+
+def _yaml_tree(data: bytes):
+    """The YAML document as dicts, lists and scalars (`_yaml_value`), built from the parser's events as the C
+    loader builds its tree: one document; aliases, non-scalar keys, a key given twice and nesting deeper than
+    _YAML_MAX_DEPTH are refused."""
+    try:
+        import yaml
+    except ImportError as e:  # requirements.txt pins it
+        raise ImportError("reading a Velodyne YAML calibration needs PyYAML (pip install pyyaml)") from e
+    loader = getattr(yaml, "CSafeLoader", None) or yaml.SafeLoader  # CSafeLoader: libyaml, as the CLI
+    root = None
+    docs = 0
+    stack: list = []  # [container, its path, the key waiting for its value (mappings)]
+
+    def put(value, raw, line):
+        nonlocal root
+        if not stack:
+            root = value
+            return
+        top = stack[-1]
+        c = top[0]
+        if isinstance(c, list):
+            c.append(value)
+        elif top[2] is None:
+            if raw is None:
+                raise _Bad(f"a mapping key must be a scalar (line {line})")
+            if raw in c:
+                raise _Bad(f"{_yaml_path(top[1], raw)}: given twice")
+            top[2] = raw
+            c[raw] = None
+        else:
+            c[top[2]] = value
+            top[2] = None
+
+    try:
+        for ev in yaml.parse(data, Loader=loader):
+            line = ev.start_mark.line + 1 if ev.start_mark is not None else 0
+            if isinstance(ev, yaml.DocumentStartEvent):
+                docs += 1
+                if docs > 1:
+                    raise _Bad("the file must hold one YAML document")
+            elif isinstance(ev, yaml.AliasEvent):
+                raise _Bad(f"YAML aliases are not supported (line {line})")
+            elif isinstance(ev, yaml.ScalarEvent):
+                put(_yaml_value(ev.value, ev.style in (None, "")), ev.value, line)
+            elif isinstance(ev, (yaml.SequenceStartEvent, yaml.MappingStartEvent)):
+                if len(stack) >= _YAML_MAX_DEPTH:
+                    raise _Bad(f"nested deeper than {_YAML_MAX_DEPTH} levels (line {line})")
+                c = [] if isinstance(ev, yaml.SequenceStartEvent) else {}
+                if stack:
+                    top = stack[-1]
+                    path = _yaml_path(top[1], len(top[0]) if isinstance(top[0], list) else top[2])
+                else:
+                    path = ""
+                put(c, None, line)
+                stack.append([c, path, None])
+            elif isinstance(ev, (yaml.SequenceEndEvent, yaml.MappingEndEvent)):
+                stack.pop()
+    except yaml.reader.ReaderError as e:
+        raise _Bad(f"not valid YAML (byte {e.position}: {e.reason})") from None
+    except yaml.MarkedYAMLError as e:
+        m = e.problem_mark
+        where = f"line {m.line + 1} column {m.column + 1}: " if m is not None else ""
+        raise _Bad(f"not valid YAML ({where}{e.problem})") from None
+    except yaml.YAMLError as e:
+        raise _Bad(f"not valid YAML ({e})") from None
+    return root
+
+
+def _ykind(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if v is None:
+        return "null"
+    if isinstance(v, str):
+        return "a string"
+    if isinstance(v, list):
+        return "a list"
+    if isinstance(v, dict):
+        return "a mapping"
+    return "a number"
+
+
+def _ynumber(v, what: str) -> float:
+    if isinstance(v, bool) or not isinstance(v, float):
+        raise _Bad(f"{what}: expected a number, got {_ykind(v)}")
+    if not math.isfinite(v):
+        raise _Bad(f"{what}: not a finite number")
+    return v
+
+
+def _yinteger(v, what: str, lo: int, hi: int, macro: str = "") -> int:
+    if isinstance(v, bool) or not isinstance(v, float):
+        raise _Bad(f"{what}: expected an integer, got {_ykind(v)}")
+    if not math.isfinite(v):
+        raise _Bad(f"{what}: not a finite number")
+    if v != math.floor(v):
+        raise _Bad(f"{what}: expected an integer, got {v:g}")
+    if not lo <= v <= hi:
+        raise _Bad(f"{what}: {v:g} is outside [{lo}, {hi}]" + (f" ({macro})" if macro else ""))
+    return int(v)
+
+
+def _velodyne_yaml(data: bytes, max_rows: int) -> tuple:
+    """velodyne_pointcloud's YAML: the same tuple as _velodyne_xml (elevations in degrees = radians x 180 / pi)."""
+    root = _yaml_tree(data)
+    if not isinstance(root, dict):
+        raise _Bad("the file must hold one YAML mapping")
+    if "lasers" not in root:
+        raise _Bad('"lasers": missing: not a velodyne_pointcloud calibration?')
+    lasers = root["lasers"]
+    if not isinstance(lasers, list):
+        raise _Bad(f'"lasers": expected a list, got {_ykind(lasers)}')
+    if "num_lasers" not in root:
+        raise _Bad('"num_lasers": missing')
+    n = _yinteger(root["num_lasers"], '"num_lasers"', 1, max_rows, "LIDET_MAX_ROWS")
+    if len(lasers) != n:
+        raise _Bad(f'"num_lasers": {n} but "lasers" has {len(lasers)} entries')
+    res = VELODYNE_DISTANCE_RESOLUTION_M
+    if "distance_resolution" in root:
+        res = _ynumber(root["distance_resolution"], '"distance_resolution"')
+        if not 0.0 < res <= 1.0:
+            raise _Bad(f'"distance_resolution": {res:g} is outside (0, 1] (metres)')
+    seen: dict = {}
+    names, ids, vert, rot, opt = [], [], [], [], []
+    for i, las in enumerate(lasers):
+        w = f'"lasers"[{i}]'
+        if not isinstance(las, dict):
+            raise _Bad(f"{w}: expected a mapping, got {_ykind(las)}")
+        if "laser_id" not in las:
+            raise _Bad(f"{w}.laser_id: missing")
+        lid = _yinteger(las["laser_id"], f"{w}.laser_id", 0, n - 1)
+        if lid in seen:
+            raise _Bad(f'{w}.laser_id: {lid} given twice (also "lasers"[{seen[lid]}])')
+        seen[lid] = i
+        vals = []
+        for key, lim in (("vert_correction", 90.0), ("rot_correction", 180.0)):
+            if key not in las:
+                raise _Bad(f"{w}.{key}: missing")
+            x = _ynumber(las[key], f"{w}.{key}")
+            d = x * (180.0 / math.pi)
+            if not -lim < d < lim:
+                raise _Bad(f"{w}.{key}: {x:g} rad ({d:g} deg) is outside ({-lim:g}, {lim:g}) deg")
+            vals.append(x)
+        opt.append([_ynumber(las[key], f"{w}.{key}") if key in las else 0.0 for _, _, key in _VELODYNE_OPTIONAL])
+        names.append(w)
+        ids.append(lid)
+        vert.append(vals[0])
+        rot.append(vals[1])
+    rad = np.array(vert, np.float64)
+    i, j = _first_same_f32(rad)
+    if i >= 0:
+        raise _Bad(f"{names[i]}.vert_correction: the same elevation as {names[j]} ({rad[i]:g} rad): beams must be "
+                   "distinct")
+    deg = np.array([x * (180.0 / math.pi) for x in vert], np.float64)
+    return ids, deg, rad, np.array(rot, np.float64), np.array(opt, np.float64), res
+
+
+def velodyne_calibration_kind(data: bytes) -> str:
+    """"xml" when the first character after a UTF-8 byte-order mark and white space is '<', else "yaml"."""
+    i = 3 if data.startswith(b"\xef\xbb\xbf") else 0
+    while i < len(data) and data[i] in b" \t\r\n":
+        i += 1
+    return "xml" if i < len(data) and data[i] == ord("<") else "yaml"
+
+
+def load_velodyne_calibration(path, mount_height_m: float | None = None, cols: int | None = None,
+                              name: str | None = None) -> Sensor:
+    """A sensor from a Velodyne calibration file (docs/SENSORS.md): the db.xml / VeloView XML (boost-serialized
+    <DB>: points_ / item / px with id_, vertCorrection_, rotCorrection_ in degrees, the other corrections in cm;
+    enabled_, distLSB_) or velodyne_pointcloud's YAML (num_lasers, lasers: laser_id, vert_correction,
+    rot_correction in radians, the other corrections in metres; distance_resolution), told apart by the first
+    character ('<': XML).
+
+    The elevation table is in **ring order**: the lasers sorted by elevation, lowest first, as velodyne_pointcloud
+    numbers its rings and as lidet's Velodyne decoder and presets do (ring 0 = the lowest beam), whatever the
+    file's laser order (a VLP-16's lasers alternate -15, +1, -13, +3 ... deg). `Sensor.velodyne.laser_id` gives
+    each ring's laser; `Sensor.beam_azimuth_rad` its rot_correction, `Sensor.velodyne` the other corrections: read
+    and validated, not used by the projection (elevations only) nor by the packet decoder (built-in tables).
+
+    mount_height_m: metres in [0, 10] (default 1.0: not in the file). cols: columns per revolution, an integer in
+    [8, LIDET_MAX_COLS] (default `velodyne_default_cols`: 1800, or 2048 for 64 lasers). name: the sensor's name
+    (default "velodyne-<lasers>"). The model family follows `model_family` (vlp16 below 32 lasers, else hdl64).
+    Raises SensorFileError naming the file and the field; ValueError for a bad argument."""
+    max_rows, max_cols = capacity_limits()
+    if mount_height_m is None:
+        mount_height_m = VELODYNE_MOUNT_HEIGHT_M
+    elif isinstance(mount_height_m, bool) or not isinstance(mount_height_m, (int, float, np.number)) or \
+            not 0.0 <= float(mount_height_m) <= 10.0:
+        raise ValueError(f"mount_height_m must be metres in [0, 10], got {mount_height_m!r}")
+    if cols is not None and (isinstance(cols, bool) or not isinstance(cols, (int, np.integer)) or
+                             not 8 <= int(cols) <= max_cols):
+        raise ValueError(f"cols must be an integer in [8, {max_cols}] (LIDET_MAX_COLS), got {cols!r}")
+    if name is not None:
+        try:
+            _name(name, "name")
+        except _Bad as e:
+            raise ValueError(str(e)) from None
+    p = pathlib.Path(path)
+    try:
+        data = p.read_bytes()
+    except OSError as e:
+        raise SensorFileError(f"{path}: cannot read: {e.strerror or e}") from None
+    if len(data) > SENSOR_FILE_MAX_BYTES:
+        raise SensorFileError(f"{path}: larger than {SENSOR_FILE_MAX_BYTES >> 20} MiB: not a Velodyne calibration")
+    kind = velodyne_calibration_kind(data)
+    try:
+        ids, deg, rad, rot, opt, res = (_velodyne_xml if kind == "xml" else _velodyne_yaml)(data, max_rows)
+    except _Bad as e:
+        raise SensorFileError(f"{path}: {e}") from None
+    n = len(ids)
+    order = np.argsort(rad, kind="stable")  # ring order: lowest beam first (distinct, so any sort agrees)
+    ring = lambda a: np.ascontiguousarray(np.asarray(a)[order])  # noqa: E731
+    corr = VelodyneCorrections(kind, ring(np.array(ids, np.int32)), *(ring(opt[:, k]) for k in range(7)),
+                               distance_resolution_m=float(res))
+    return Sensor(name or f"velodyne-{n}", n, int(cols) if cols is not None else velodyne_default_cols(n, max_cols),
+                  ring(rad), float(mount_height_m), VELODYNE_MAX_RANGE_M, None, beam_azimuth_rad=ring(rot),
+                  beam_elev_deg=ring(deg), velodyne=corr)

@@ -12,6 +12,9 @@ PKGS="cmake make gcc g++ libeigen3-dev python3 python3-venv ca-certificates"
 PKGS="$PKGS clang libclang-rt-dev libpng-dev"
 # the host CLI's sensor files (--sensor-file, --ouster-meta: ports/host/cli_sensor.c): cJSON
 PKGS="$PKGS libcjson-dev"
+# the host CLI's Velodyne calibrations (--velodyne-calib: ports/host/cli_velodyne_calib.c): libxml2 (db.xml / VeloView
+# XML) and libyaml (velodyne_pointcloud's YAML)
+PKGS="$PKGS libxml2-dev libyaml-dev"
 # the host CLI's packet captures (lidet detect / track --pcap: ports/host/cli_pcap.c): libpcap
 PKGS="$PKGS libpcap-dev"
 # the formatting check of lib/ (ctest clang_format, .clang-format)
