@@ -267,7 +267,8 @@ def capacity_limits() -> tuple[int, int]:
         return _header_limits()
 
 
-def _kind(v) -> str:
+def _kind(v, yaml: bool = False) -> str:
+    """How a JSON (or, yaml=True, a YAML) value is named in the loaders' messages."""
     if isinstance(v, bool):
         return "true" if v else "false"
     if v is None:
@@ -275,9 +276,9 @@ def _kind(v) -> str:
     if isinstance(v, str):
         return "a string"
     if isinstance(v, list):
-        return "an array"
+        return "a list" if yaml else "an array"
     if isinstance(v, dict):
-        return "an object"
+        return "a mapping" if yaml else "an object"
     return "a number"
 
 
@@ -915,23 +916,9 @@ def _yaml_tree(data: bytes):
     return root
 
 
-def _ykind(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if v is None:
-        return "null"
-    if isinstance(v, str):
-        return "a string"
-    if isinstance(v, list):
-        return "a list"
-    if isinstance(v, dict):
-        return "a mapping"
-    return "a number"
-
-
 def _ynumber(v, what: str) -> float:
     if isinstance(v, bool) or not isinstance(v, float):
-        raise _Bad(f"{what}: expected a number, got {_ykind(v)}")
+        raise _Bad(f"{what}: expected a number, got {_kind(v, yaml=True)}")
     if not math.isfinite(v):
         raise _Bad(f"{what}: not a finite number")
     return v
@@ -939,7 +926,7 @@ def _ynumber(v, what: str) -> float:
 
 def _yinteger(v, what: str, lo: int, hi: int, macro: str = "") -> int:
     if isinstance(v, bool) or not isinstance(v, float):
-        raise _Bad(f"{what}: expected an integer, got {_ykind(v)}")
+        raise _Bad(f"{what}: expected an integer, got {_kind(v, yaml=True)}")
     if not math.isfinite(v):
         raise _Bad(f"{what}: not a finite number")
     if v != math.floor(v):
@@ -958,7 +945,7 @@ def _velodyne_yaml(data: bytes, max_rows: int) -> tuple:
         raise _Bad('"lasers": missing: not a velodyne_pointcloud calibration?')
     lasers = root["lasers"]
     if not isinstance(lasers, list):
-        raise _Bad(f'"lasers": expected a list, got {_ykind(lasers)}')
+        raise _Bad(f'"lasers": expected a list, got {_kind(lasers, yaml=True)}')
     if "num_lasers" not in root:
         raise _Bad('"num_lasers": missing')
     n = _yinteger(root["num_lasers"], '"num_lasers"', 1, max_rows, "LIDET_MAX_ROWS")
@@ -974,7 +961,7 @@ def _velodyne_yaml(data: bytes, max_rows: int) -> tuple:
     for i, las in enumerate(lasers):
         w = f'"lasers"[{i}]'
         if not isinstance(las, dict):
-            raise _Bad(f"{w}: expected a mapping, got {_ykind(las)}")
+            raise _Bad(f"{w}: expected a mapping, got {_kind(las, yaml=True)}")
         if "laser_id" not in las:
             raise _Bad(f"{w}.laser_id: missing")
         lid = _yinteger(las["laser_id"], f"{w}.laser_id", 0, n - 1)
