@@ -295,3 +295,53 @@ def test_make_weights_family_with_int8_fine_tuning(tmp_path, monkeypatch, need_l
     card = Wt.model_card(a, {"tiny": res}, {}, dict(timings, total=1.0))
     assert "## Int8 fine-tuning" in card and "`cls_tiny.onnx` was fine-tuned" in card
     assert ", ".join(f"{v:.3f}" for v in ck["meta"]["gamma"]) in card
+
+
+def test_occlude_from_above_keeps_the_top_recentres_and_moves_the_box():
+    """common.occlude_from_above: a hit proposal keeps only its points above a cut at 35-70 % of its z extent (a
+    person seen over a parked car's roof), re-centred on their own mean, the box target moved by the same offset;
+    a proposal that would keep fewer than 8 distinct points is left as it was."""
+    rng = np.random.default_rng(3)
+    B, N = 32, 64
+    pts = rng.uniform(-0.3, 0.3, (B, N, 3)).astype(np.float32)
+    pts[..., 2] = rng.uniform(-0.9, 0.9, (B, N))
+    pts -= pts.mean(1, keepdims=True)
+    box = np.tile(np.array([[0.0, 0.0, 0.0, 0.8, 0.6, 1.8, 0.0]], np.float32), (B, 1))
+    p, b = pts.copy(), box.copy()
+    C.occlude_from_above(rng, p, b, 1.0)
+    for i in range(B):
+        off = b[i, :3] - box[i, :3]
+        orig = p[i] - off  # undo the re-centring
+        d = np.abs(orig[:, None, :] - pts[i][None, :, :]).max(-1).min(1)
+        assert d.max() < 1e-5  # only original points
+        np.testing.assert_allclose(p[i].mean(0), 0.0, atol=1e-5)
+        z0, z1 = pts[i, :, 2].min(), pts[i, :, 2].max()
+        cut = orig[:, 2].min()
+        assert cut >= z0 + 0.35 * (z1 - z0) - 1e-5  # the lower 35 % at least is gone (resampled: the top may be too)
+        assert off[2] < -0.1  # the mean rose: the box target sits lower relative to the kept points
+    # too few points above any cut: left untouched
+    few = np.zeros((1, N, 3), np.float32)
+    few[0, :, 2] = np.where(np.arange(N) < N - 3, -1.0, np.linspace(0.5, 1.0, N)[:N])  # 3 distinct points on top
+    f2 = few.copy()
+    C.occlude_from_above(rng, f2, None, 1.0)
+    np.testing.assert_array_equal(f2, few)
+
+
+def test_top_occlusion_touches_only_cyclists_and_pedestrians():
+    """finetune._aug with top_occlusion: only Cyclist and Pedestrian rows are cut from above (their highest point
+    stays the highest, their lowest rises); Car and OOD rows get the plain augmentation."""
+    from lidet_tools.train import finetune as FT
+    rng = np.random.default_rng(1)
+    K, N = 40, 64
+    pts = rng.uniform(-0.3, 0.3, (K, N, 3)).astype(np.float32)
+    pts[..., 2] = rng.uniform(-0.8, 0.8, (K, N))
+    tr = dict(points=pts, label=np.array([0, 1, 2, -1] * 10, np.int8), src=np.zeros(K, np.int8),
+              box=np.zeros((K, 7), np.float32))
+    idx = np.arange(K)
+    a, _ = FT._aug(np.random.default_rng(7), tr, idx, False, 1.0)
+    b, _ = FT._aug(np.random.default_rng(7), tr, idx, False, 0.0)
+    span_a = a[..., 2].max(1) - a[..., 2].min(1)
+    span_b = b[..., 2].max(1) - b[..., 2].min(1)
+    vru = np.isin(tr["label"], (1, 2))
+    assert (span_a[vru] < 0.75 * span_b[vru]).all()
+    assert (span_a[~vru] > 0.8 * span_b[~vru]).mean() > 0.9

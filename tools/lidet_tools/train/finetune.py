@@ -364,15 +364,28 @@ class Mixer:
         return np.concatenate(parts)
 
 
-def _aug(rng, tr, idx, with_box):
+def _aug(rng, tr, idx, with_box, top_occlusion: float = 0.0):
     """Augmented points (and box targets) of rows idx: the user's strongly (augment_real), the simulated ones as
-    their trainer does (common.augment)."""
+    their trainer does (common.augment). top_occlusion: first, the share of the cyclists' and pedestrians' rows
+    (both sources) seen only from above (common.occlude_from_above)."""
     pts = np.empty((len(idx),) + tr["points"].shape[1:], np.float32)
     box = np.empty((len(idx), 7), np.float32) if with_box else None
+    src_pts = tr["points"][idx]
+    src_box = tr["box"][idx] if with_box else None
+    if top_occlusion > 0.0:
+        src_pts = np.array(src_pts, np.float32, copy=True)
+        src_box = None if src_box is None else np.array(src_box, np.float32, copy=True)
+        vru = np.nonzero(np.isin(tr["label"][idx], (M.CLASSES.index("Cyclist"), M.CLASSES.index("Pedestrian"))))[0]
+        if len(vru):
+            p, b = src_pts[vru], (None if src_box is None else src_box[vru])
+            C.occlude_from_above(rng, p, b, top_occlusion)
+            src_pts[vru] = p
+            if b is not None:
+                src_box[vru] = b
     u = tr["src"][idx] == 1
     for m, fn in ((u, augment_real), (~u, C.augment)):
         if m.any():
-            p, b = fn(rng, tr["points"][idx[m]], tr["box"][idx[m]] if with_box else None)
+            p, b = fn(rng, src_pts[m], src_box[m] if with_box else None)
             pts[m] = p
             if with_box:
                 box[m] = b
@@ -479,10 +492,10 @@ def finetune_net(kind: str, model, tr: dict, vals: dict, a, lam: float) -> dict:
         tot = 0.0
         for st in C.progress(range(steps), a.progress, desc=f"{name} {phase} {ep + 1}/{E1 + E2}", leave=False):
             idx = ids.batch(rng, order, st)
-            p, bx = _aug(rng, tr, idx, is_box)
+            p, bx = _aug(rng, tr, idx, is_box, a.top_occlusion)
             if phase == "energy":
                 oi = oods.batch(rng, rng.permutation(oods.user), 0)
-                po, _ = _aug(rng, tr, oi, False)
+                po, _ = _aug(rng, tr, oi, False, a.top_occlusion)
                 pts, vox = C.tensors(tr, np.concatenate([idx, oi]), "cpu", np.concatenate([p, po]))
             else:
                 oi = np.zeros(0, np.int64)
@@ -582,6 +595,9 @@ def add_args(ap):
                     help="sensor-frame folders: half the labelled azimuth field of view, where meta.json does not say")
     ap.add_argument("--mount-height", type=float, default=None,
                     help="sensor-frame folders: the sensor's height above the road (m), where meta.json does not say")
+    ap.add_argument("--top-occlusion", type=float, default=0.0,
+                    help="share of the cyclist and pedestrian proposals seen only from above a cut (people behind "
+                         "parked cars; common.occlude_from_above; default 0)")
     ap.add_argument("--lr", type=float, default=1e-4, help="Adam learning rate of the first phase (energy: half)")
     ap.add_argument("--batch", type=int, default=64)
     ap.add_argument("--min-gap", type=float, default=3.0, help="least m_out - m_in (the trainers')")
@@ -612,6 +628,8 @@ def check_args(a) -> tuple[str, dict]:
                          f"({', '.join(sorted(FAMILIES))})")
     if not 0.0 <= a.sim_mix < 1.0:
         raise ValueError(f"--sim-mix must be in [0, 1), got {a.sim_mix}")
+    if not 0.0 <= a.top_occlusion <= 1.0:
+        raise ValueError(f"--top-occlusion must be a probability in [0, 1], got {a.top_occlusion}")
     if not 0.0 <= a.val_share < 1.0:
         raise ValueError(f"--val-share must be in [0, 1), got {a.val_share}")
     if a.epochs < 0 or a.epochs_energy < 0 or a.epochs + a.epochs_energy == 0:
@@ -820,7 +838,9 @@ def card(r: dict, a) -> str:
           f"user OOD proposals. {rc['steps']} batches per epoch (classifier), {rb['steps']} (box net); "
           f"{a.epochs} epochs of the first loss, then {a.epochs_energy} of the energy phase; Adam from lr {a.lr} "
           f"(energy phase {a.lr / 2}), cosine; seed {a.seed}. Augmentation of the user's proposals: "
-          + ", ".join(f"{k} {v}" for k, v in REAL_AUG.items()) + "; of the simulated ones the trainers' (common.augment).",
+          + ", ".join(f"{k} {v}" for k, v in REAL_AUG.items()) + "; of the simulated ones the trainers' (common.augment)."
+          + (f" First, {100 * a.top_occlusion:.0f} % of the cyclists and pedestrians of both sources seen only from "
+             "above a cut (`--top-occlusion`, common.occlude_from_above)." if a.top_occlusion > 0 else ""),
           "", "| net | margins m_in / m_out | kept epoch | gamma shipped (Car, Cyclist, Pedestrian) | gamma now |",
           "|---|---|---:|---|---|"]
     for k in ("cls", "box"):
