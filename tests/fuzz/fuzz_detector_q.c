@@ -1,6 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* libFuzzer harness: the integer detector (lidet_detector_q_init with fuzzed knobs, lidet_detector_q_run and,
- * on the same bytes read as the sensor's returns, lidet_detector_q_run_returns:
+ * on the same bytes read as the sensor's returns, lidet_detector_q_run_returns and the same returns streamed in
+ * chunks, lidet_detector_q_stream_*, which must give the same results bit for bit:
  * integer projection, ground, clustering, proposals, the int8 PointNets (the tiny models of
  * tests/fuzz/models), gates, size check, NMS) on any integer sensor and any int32 millimetre scan the input
  * describes (INT32_MIN/MAX coordinates, zero range, rings out of range). Checks the counts and outcomes agree,
@@ -205,6 +206,40 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         {
             FZ_CHECK(g_pp[i] >= -1 && g_pp[i] < (int32_t)n_pix);
         }
+    }
+    /* the same returns streamed in chunks whose sizes the scan's own bytes pick (0 .. 511): the detections, the
+     * outcomes and the counts equal run_returns' bit for bit (lidet_detector_q_stream_*) */
+    {
+        static lidet_detection_q_t d0[LIDET_MAX_DETECTIONS];
+        static uint8_t o0[LIDET_MAX_CLUSTERS];
+        static lidet_detector_q_stats_t s0;
+        uint32_t n0 = n_det, nc0 = 0, at = 0, k = 0, n1, nc1;
+        const uint8_t *o = lidet_detector_q_outcomes(&g_det, &nc0);
+        memcpy(d0, det, n0 * sizeof d0[0]);
+        memcpy(o0, o, nc0);
+        s0 = *ds;
+        FZ_CHECK(lidet_detector_q_stream_begin(&g_det) == LIDET_OK);
+        while (at < s.n_points)
+        {
+            uint32_t m = (uint32_t)g_pts[(k++ * 7u) % (s.n_points * s.stride)] & 511u;
+            m = m < s.n_points - at ? m : s.n_points - at;
+            FZ_CHECK(LIDET_SUCCEEDED(lidet_detector_q_stream_returns(&g_det, g_ret + at, m, NULL)));
+            at += m;
+            if (k > 4u * s.n_points + 8u) /* chunks of 0 only: the rest in one */
+            {
+                FZ_CHECK(LIDET_SUCCEEDED(
+                    lidet_detector_q_stream_returns(&g_det, g_ret + at, s.n_points - at, NULL)));
+                at = s.n_points;
+            }
+        }
+        FZ_CHECK(lidet_detector_q_stream_end(&g_det) == st);
+        det = lidet_detector_q_detections(&g_det, &n1);
+        o = lidet_detector_q_outcomes(&g_det, &nc1);
+        ds = lidet_detector_q_stats(&g_det);
+        FZ_CHECK(n1 == n0 && nc1 == nc0);
+        FZ_CHECK(memcmp(det, d0, n0 * sizeof d0[0]) == 0 && memcmp(o, o0, nc0) == 0);
+        FZ_CHECK(memcmp(&ds->proj, &s0.proj, sizeof s0.proj) == 0 && ds->n_detections == s0.n_detections &&
+                 ds->n_classified == s0.n_classified && ds->n_boxed == s0.n_boxed);
     }
     return 0;
 }

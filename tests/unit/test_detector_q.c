@@ -256,6 +256,158 @@ static void test_bad_points(void)
     CANARY_CHECK(g);
 }
 
+/* the scan as the sensor's returns (ring by elevation order of the vlp16 profile, as the simulator wrote it) */
+#define MAX_RET (LIDET_MAX_POINTS + 4096)
+static lidet_return_t ret[MAX_RET];
+static int32_t pix_all[LIDET_MAX_POINTS], pix_chunk[MAX_RET];
+
+static uint32_t make_returns(void)
+{
+    static uint16_t ring[MAX_PTS];
+    FILE *f = fopen(LIDET_SOURCE_DIR "/tests/data/sim_vlp16/ring/000000.bin", "rb");
+    uint32_t i;
+    size_t n;
+    TEST_ASSERT_NOT_NULL(f);
+    n = fread(ring, sizeof ring[0], MAX_PTS, f);
+    fclose(f);
+    TEST_ASSERT_EQUAL_UINT32(n_pts, (uint32_t)n);
+    for (i = 0; i < n_pts; ++i)
+    {
+        const double x = pts[3 * i], y = pts[3 * i + 1], z = pts[3 * i + 2];
+        const double a = atan2(y, x) * 65536.0 / (2.0 * 3.14159265358979323846);
+        ret[i].range_mm = (uint32_t)(sqrt(x * x + y * y + z * z) + 0.5);
+        ret[i].azimuth = (uint16_t)(int32_t)floor(a + 0.5);
+        ret[i].ring = ring[i];
+    }
+    return n_pts;
+}
+
+/* everything a run leaves behind, but the clock */
+typedef struct
+{
+    lidet_status_t s;
+    uint32_t n_det, n_out;
+    lidet_detection_q_t det[LIDET_MAX_DETECTIONS];
+    uint8_t out[LIDET_MAX_CLUSTERS];
+    lidet_detector_q_stats_t st;
+    uint16_t range[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+} run_t;
+
+static void keep(run_t *r, lidet_status_t s)
+{
+    const lidet_detection_q_t *d = lidet_detector_q_detections(&g.ws, &r->n_det);
+    const uint8_t *o = lidet_detector_q_outcomes(&g.ws, &r->n_out);
+    memset(r->det, 0, sizeof r->det);
+    memset(r->out, 0, sizeof r->out);
+    r->s = s;
+    memcpy(r->det, d, r->n_det * sizeof d[0]);
+    memcpy(r->out, o, r->n_out);
+    r->st = *lidet_detector_q_stats(&g.ws);
+    memset(r->st.ticks, 0, sizeof r->st.ticks);
+    memcpy(r->range, g.ws.range_4mm, sizeof r->range);
+}
+
+static void same_run(const run_t *a, const run_t *b)
+{
+    TEST_ASSERT_EQUAL_INT(a->s, b->s);
+    TEST_ASSERT_EQUAL_UINT32(a->n_det, b->n_det);
+    TEST_ASSERT_EQUAL_UINT32(a->n_out, b->n_out);
+    TEST_ASSERT_EQUAL_MEMORY(a->det, b->det, sizeof a->det);
+    TEST_ASSERT_EQUAL_MEMORY(a->out, b->out, sizeof a->out);
+    TEST_ASSERT_EQUAL_MEMORY(&a->st, &b->st, sizeof a->st);
+    TEST_ASSERT_EQUAL_MEMORY(a->range, b->range, sizeof a->range);
+}
+
+/* the returns streamed in chunks of the sizes cycled from sizes[] (0 included): each chunk's pixels into its own
+ * slice of pix_chunk */
+static lidet_status_t stream(uint32_t n, const uint32_t *sizes, uint32_t n_sizes)
+{
+    uint32_t at = 0, k = 0;
+    lidet_status_t s, worst = LIDET_OK;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_stream_begin(&g.ws));
+    while (at < n)
+    {
+        uint32_t m = sizes[k++ % n_sizes];
+        m = m < n - at ? m : n - at;
+        s = lidet_detector_q_stream_returns(&g.ws, ret + at, m, pix_chunk + at);
+        TEST_ASSERT_TRUE(LIDET_SUCCEEDED(s));
+        worst = s != LIDET_OK ? s : worst;
+        at += m;
+    }
+    s = lidet_detector_q_stream_end(&g.ws);
+    TEST_ASSERT_TRUE(s == worst || (worst == LIDET_OK && LIDET_SUCCEEDED(s)));
+    return s;
+}
+
+static void test_streamed_returns_equal_the_whole_scan(void)
+{
+    static run_t whole, part;
+    static const uint32_t packets[] = {384u};                   /* a VLP-16 payload's returns */
+    static const uint32_t odd[] = {1u, 0u, 7u, 1000u, 3u, 5000u}; /* empty and uneven chunks */
+    lidet_detector_q_cfg_t cfg;
+    uint32_t n = make_returns(), mode, i;
+    for (mode = 0; mode < 2; ++mode) /* the range-only image (the firmware's), then x, y, z stored */
+    {
+        lidet_detector_q_cfg_default(&cfg, sensor);
+        cfg.range_only = (uint8_t)(mode == 0);
+        CANARY_FILL(g);
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+        keep(&whole, lidet_detector_q_run_returns(&g.ws, ret, n, pix_all));
+        TEST_ASSERT_TRUE(LIDET_SUCCEEDED(whole.s));
+        TEST_ASSERT_TRUE(whole.n_det >= 3);
+        keep(&part, stream(n, packets, 1));
+        same_run(&whole, &part);
+        TEST_ASSERT_EQUAL_MEMORY(pix_all, pix_chunk, n * sizeof pix_all[0]);
+        memset(pix_chunk, 0x5A, sizeof pix_chunk);
+        keep(&part, stream(n, odd, 6));
+        same_run(&whole, &part);
+        TEST_ASSERT_EQUAL_MEMORY(pix_all, pix_chunk, n * sizeof pix_all[0]);
+        /* the scan in reverse order of its packets (a seam elsewhere): the same image and detections */
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_stream_begin(&g.ws));
+        for (i = (n + 383u) / 384u; i-- > 0;)
+        {
+            const uint32_t a = 384u * i, m = n - a < 384u ? n - a : 384u;
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_stream_returns(&g.ws, ret + a, m, NULL));
+        }
+        keep(&part, lidet_detector_q_stream_end(&g.ws));
+        same_run(&whole, &part);
+        CANARY_CHECK(g);
+    }
+}
+
+static void test_stream_states_and_truncation(void)
+{
+    static run_t whole, part;
+    static const uint32_t sizes[] = {4096u};
+    lidet_detector_q_cfg_t cfg;
+    uint32_t n = make_returns(), i;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, init_default(&cfg));
+    /* no stream open: before begin, after end, after a run in between */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_detector_q_stream_returns(&g.ws, ret, 10u, NULL));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_detector_q_stream_end(&g.ws));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_stream_begin(&g.ws));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_stream_returns(&g.ws, NULL, 1u, NULL));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_stream_returns(&g.ws, NULL, 0u, NULL));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_stream_returns(NULL, ret, 1u, NULL));
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL)));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_detector_q_stream_returns(&g.ws, ret, 10u, NULL));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_stream_begin(&g.ws));
+    TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_detector_q_stream_end(&g.ws))); /* an empty scan */
+    TEST_ASSERT_EQUAL_UINT32(0u, lidet_detector_q_stats(&g.ws)->n_detections);
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_detector_q_stream_end(&g.ws));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_stream_begin(NULL));
+    /* more returns than LIDET_MAX_POINTS: the scan repeated; the same truncation as one run on them all */
+    for (i = n; i < MAX_RET; ++i)
+    {
+        ret[i] = ret[i % n];
+    }
+    keep(&whole, lidet_detector_q_run_returns(&g.ws, ret, MAX_RET, NULL));
+    TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, whole.s);
+    TEST_ASSERT_EQUAL_UINT32(MAX_RET - LIDET_MAX_POINTS, whole.st.proj.n_truncated);
+    keep(&part, stream(MAX_RET, sizes, 1));
+    same_run(&whole, &part);
+}
+
 static void test_score(void)
 {
     TEST_ASSERT_EQUAL_INT32(16384, lidet_detector_q_score(-5 * 65536, -5 * 65536));
@@ -273,6 +425,8 @@ int main(void)
     RUN_TEST(test_run_invariants_and_determinism);
     RUN_TEST(test_crop_and_budget);
     RUN_TEST(test_bad_points);
+    RUN_TEST(test_streamed_returns_equal_the_whole_scan);
+    RUN_TEST(test_stream_states_and_truncation);
     RUN_TEST(test_score);
     return UNITY_END();
 }

@@ -175,6 +175,7 @@ typedef struct
     uint8_t outcome[LIDET_MAX_CLUSTERS];               /* lidet_det_outcome_t per kept cluster */
     uint32_t n_det;
     lidet_detector_q_stats_t stats;
+    uint32_t stream_ticks; /* a stream's projection ticks so far (lidet_detector_q_stream_*) */
 } lidet_detector_q_t;
 
 /**
@@ -211,6 +212,30 @@ lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points
  */
 lidet_status_t lidet_detector_q_run_returns(lidet_detector_q_t *d, const lidet_return_t *returns,
                                             uint32_t n_returns, int32_t *point_pixel);
+
+/**
+ * @brief The sensor's returns streamed into the detector a chunk (a packet) at a time, so a board needs no buffer
+ *        for the scan (docs/PORTING.md, "Streaming the returns"): begin clears the image, each call of
+ *        lidet_detector_q_stream_returns projects one chunk into it (about 35 instructions per return on a
+ *        Cortex-M4), end runs the ground stage, the clustering, the networks and the NMS on the finished image.
+ *
+ * The detections, outcomes, stats and image equal lidet_detector_q_run_returns' on the chunks' concatenation, bit
+ * for bit, however the scan is cut (lidet_proj_q_returns_begin). stats.ticks[PROJECT] sums the three calls'
+ * projection time; the rest of the stages run inside end, so the latency from a scan's last packet to its
+ * detections is end's time. Nothing else may run on the detector between begin and end: a run
+ * (lidet_detector_q_run, _run_returns) or a new begin drops an open stream.
+ * @param point_pixel optional: n_returns int32 for *this chunk* (each return's pixel, -1 = dropped), or NULL.
+ * @return begin: LIDET_OK; LIDET_ERR_ARG (NULL); LIDET_ERR_STATE (not initialised). stream_returns: LIDET_OK;
+ *         LIDET_TRUNCATED (the scan passed LIDET_MAX_POINTS returns: the rest are counted, not projected);
+ *         LIDET_ERR_ARG (NULL d, NULL returns with n_returns > 0); LIDET_ERR_STATE (no stream open). end: as
+ *         lidet_detector_q_run_returns; LIDET_ERR_STATE (no stream open).
+ */
+lidet_status_t lidet_detector_q_stream_begin(lidet_detector_q_t *d);
+/** @brief One chunk of the open stream's returns (lidet_detector_q_stream_begin). */
+lidet_status_t lidet_detector_q_stream_returns(lidet_detector_q_t *d, const lidet_return_t *returns,
+                                               uint32_t n_returns, int32_t *point_pixel);
+/** @brief Detect road users in the open stream's scan (lidet_detector_q_stream_begin). */
+lidet_status_t lidet_detector_q_stream_end(lidet_detector_q_t *d);
 
 /** @brief Detections of the last run, best score first. */
 const lidet_detection_q_t *lidet_detector_q_detections(const lidet_detector_q_t *d, uint32_t *n_detections);

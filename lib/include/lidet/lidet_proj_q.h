@@ -77,6 +77,7 @@ typedef struct
     uint8_t has_col_trig;                           /* 1: col_trig_q15 filled (n_cols a multiple of 4) */
     uint32_t n_points;                              /* points of the last run (<= LIDET_MAX_POINTS) */
     lidet_proj_stats_t stats;                       /* counts of the last run (n_nonfinite always 0) */
+    uint8_t stream_open;                            /* 1: between lidet_proj_q_returns_begin and _end */
 } lidet_proj_q_state_t;
 
 /** @brief Caller-owned outputs of a run: n_rows * n_cols pixels each unless noted. */
@@ -147,6 +148,32 @@ typedef struct
  */
 lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
                                         const lidet_return_t *returns, uint32_t n_returns);
+
+/**
+ * @brief Project one scan's returns as they arrive (a packet at a time), without holding the scan: begin clears
+ *        the image, each add projects a chunk into it, end finishes it. The image, the stats and n_points equal
+ *        lidet_proj_q_run_returns' on the chunks' concatenation, bit for bit, however the scan is cut (its first
+ *        pass is order-independent: the nearest return per pixel, ties to the earlier one).
+ *
+ * The same buffers (the same image arrays) must be given to every call of one scan; buf->point_pixel may differ per
+ * call: when set, it receives the pixel of each return of *that* chunk (n_returns entries, -1 = dropped), so a
+ * caller without a scan buffer still gets per-return labels chunk by chunk (entries of returns past
+ * LIDET_MAX_POINTS are not written). point_idx (an image that stores x, y, z)
+ * numbers the returns across the whole scan. As in lidet_proj_q_run_returns, returns past LIDET_MAX_POINTS in
+ * one scan are counted in n_truncated and not looked at. lidet_proj_q_run and lidet_proj_q_run_returns close an
+ * open stream (its returns are lost).
+ * @return begin: LIDET_OK; LIDET_ERR_ARG (NULL state/buffers, x / y / z not all set or all NULL); LIDET_ERR_STATE
+ *         (not initialised). add: LIDET_OK; LIDET_TRUNCATED (this chunk crossed LIDET_MAX_POINTS); LIDET_ERR_ARG
+ *         (as begin, or NULL returns with n_returns > 0); LIDET_ERR_STATE (no stream open). end: LIDET_OK or
+ *         LIDET_TRUNCATED (the scan's returns past LIDET_MAX_POINTS were dropped); LIDET_ERR_ARG; LIDET_ERR_STATE
+ *         (no stream open).
+ */
+lidet_status_t lidet_proj_q_returns_begin(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf);
+/** @brief One chunk of the open scan (lidet_proj_q_returns_begin). */
+lidet_status_t lidet_proj_q_returns_add(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                                        const lidet_return_t *returns, uint32_t n_returns);
+/** @brief Finish the open scan (lidet_proj_q_returns_begin): the image and the stats are those of the scan. */
+lidet_status_t lidet_proj_q_returns_end(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf);
 
 /** @brief The compact range image of buffers filled by lidet_proj_q_run (row_elev_rad NULL, row_elev_bam set). */
 void lidet_proj_q_image(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,

@@ -299,55 +299,62 @@ static void fill_detection(const lidet_detector_q_t *d, lidet_detection_q_t *t, 
 #define DET_NOW now
 #include "internal/lidet_detector_body.h"
 
-/* one run on points (use_returns 0) or on returns */
-static lidet_status_t run_scan(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,
-                               uint32_t stride, const uint16_t *ring, const lidet_return_t *returns,
-                               int use_returns, int32_t *point_pixel)
+/* a detector to run: LIDET_OK, LIDET_ERR_ARG (NULL) or LIDET_ERR_STATE (not initialised) */
+static lidet_status_t det_check(const lidet_detector_q_t *d)
 {
-    lidet_detector_q_stats_t *st;
-    lidet_proj_q_buffers_t buf;
-    lidet_range_image_t img;
-    lidet_status_t s, worst = LIDET_OK;
-    uint32_t n_cand, i, t0, t1, box_ticks = 0, n_sectors;
-    uint8_t suppressed[LIDET_MAX_DETECTIONS];
     if (d == 0)
     {
         return LIDET_ERR_ARG;
     }
-    if (d->magic != LIDET_INIT_MAGIC)
-    {
-        return LIDET_ERR_STATE;
-    }
-    st = &d->stats;
-    memset(st, 0, sizeof *st);
-    d->n_det = 0;
+    return d->magic != LIDET_INIT_MAGIC ? LIDET_ERR_STATE : LIDET_OK;
+}
 
-    /* the stages */
-    memset(&buf, 0, sizeof buf);
-#if LIDET_Q_PIXEL_XYZ
-    if (!d->cfg.range_only) /* else x, y, z stay NULL: a range-only image */
-    {
-        buf.x_4mm = d->x_4mm;
-        buf.y_4mm = d->y_4mm;
-        buf.z_4mm = d->z_4mm;
-    }
-#endif
-    buf.range_4mm = d->range_4mm;
-    buf.point_idx = d->scratch.point_idx;
-    buf.point_pixel = point_pixel;
-    t0 = now(d);
-    s = use_returns ? lidet_proj_q_run_returns(&d->proj, &buf, returns, n_points)
-                    : lidet_proj_q_run(&d->proj, &buf, points_mm, n_points, stride, ring);
-    st->proj = d->proj.stats;
-    if (!LIDET_SUCCEEDED(s))
+/* the start of a run (or a stream): checks, counts cleared */
+static lidet_status_t det_start(lidet_detector_q_t *d)
+{
+    const lidet_status_t s = det_check(d);
+    if (s != LIDET_OK)
     {
         return s;
     }
-    worst = s;
-    lidet_proj_q_image(&d->proj, &buf, &img);
+    memset(&d->stats, 0, sizeof d->stats);
+    d->n_det = 0;
+    return LIDET_OK;
+}
+
+/* the projection's buffers: the detector's image and scratch, the caller's point_pixel */
+static void det_buffers(lidet_detector_q_t *d, lidet_proj_q_buffers_t *buf, int32_t *point_pixel)
+{
+    memset(buf, 0, sizeof *buf);
+#if LIDET_Q_PIXEL_XYZ
+    if (!d->cfg.range_only) /* else x, y, z stay NULL: a range-only image */
+    {
+        buf->x_4mm = d->x_4mm;
+        buf->y_4mm = d->y_4mm;
+        buf->z_4mm = d->z_4mm;
+    }
+#endif
+    buf->range_4mm = d->range_4mm;
+    buf->point_idx = d->scratch.point_idx;
+    buf->point_pixel = point_pixel;
+}
+
+/* the stages after the projection (whose status is s, begun at clock t_proj after proj_ticks of earlier calls)
+ * on the finished image; the clock is read where run_scan always read it, so a firmware that rebuilds 64-bit
+ * stage counts from the timestamps sees the same sequence */
+static lidet_status_t det_after_projection(lidet_detector_q_t *d, const lidet_proj_q_buffers_t *buf,
+                                           lidet_status_t s, uint32_t t_proj, uint32_t proj_ticks)
+{
+    lidet_detector_q_stats_t *st = &d->stats;
+    lidet_range_image_t img;
+    lidet_status_t worst = s;
+    uint32_t n_cand, i, t0, t1, box_ticks = 0, n_sectors;
+    uint8_t suppressed[LIDET_MAX_DETECTIONS];
+
+    lidet_proj_q_image(&d->proj, buf, &img);
     img.point_idx = 0; /* the ground stage's scratch overlays it from here on */
     t1 = now(d);
-    st->ticks[LIDET_DET_STAGE_PROJECT] = t1 - t0;
+    st->ticks[LIDET_DET_STAGE_PROJECT] = proj_ticks + (t1 - t_proj);
     s = lidet_ground_q_run_buffers(&d->ground, &d->scratch.ground, ground_mask(d), &img);
     st->ground = d->ground.stats;
     if (!LIDET_SUCCEEDED(s))
@@ -408,6 +415,30 @@ static lidet_status_t run_scan(lidet_detector_q_t *d, const int32_t *points_mm, 
     return worst;
 }
 
+/* one run on points (use_returns 0) or on returns */
+static lidet_status_t run_scan(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,
+                               uint32_t stride, const uint16_t *ring, const lidet_return_t *returns,
+                               int use_returns, int32_t *point_pixel)
+{
+    lidet_proj_q_buffers_t buf;
+    lidet_status_t s = det_start(d);
+    uint32_t t0;
+    if (s != LIDET_OK)
+    {
+        return s;
+    }
+    det_buffers(d, &buf, point_pixel);
+    t0 = now(d);
+    s = use_returns ? lidet_proj_q_run_returns(&d->proj, &buf, returns, n_points)
+                    : lidet_proj_q_run(&d->proj, &buf, points_mm, n_points, stride, ring);
+    d->stats.proj = d->proj.stats;
+    if (!LIDET_SUCCEEDED(s))
+    {
+        return s;
+    }
+    return det_after_projection(d, &buf, s, t0, 0u);
+}
+
 lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,
                                     uint32_t stride, const uint16_t *ring, int32_t *point_pixel)
 {
@@ -418,6 +449,59 @@ lidet_status_t lidet_detector_q_run_returns(lidet_detector_q_t *d, const lidet_r
                                             uint32_t n_returns, int32_t *point_pixel)
 {
     return run_scan(d, 0, n_returns, 0u, 0, returns, 1, point_pixel);
+}
+
+lidet_status_t lidet_detector_q_stream_begin(lidet_detector_q_t *d)
+{
+    lidet_proj_q_buffers_t buf;
+    lidet_status_t s = det_start(d);
+    uint32_t t0;
+    if (s != LIDET_OK)
+    {
+        return s;
+    }
+    det_buffers(d, &buf, 0);
+    t0 = now(d);
+    s = lidet_proj_q_returns_begin(&d->proj, &buf);
+    d->stream_ticks = now(d) - t0;
+    return s;
+}
+
+lidet_status_t lidet_detector_q_stream_returns(lidet_detector_q_t *d, const lidet_return_t *returns,
+                                               uint32_t n_returns, int32_t *point_pixel)
+{
+    lidet_proj_q_buffers_t buf;
+    lidet_status_t s = det_check(d);
+    uint32_t t0;
+    if (s != LIDET_OK)
+    {
+        return s;
+    }
+    det_buffers(d, &buf, point_pixel);
+    t0 = now(d);
+    s = lidet_proj_q_returns_add(&d->proj, &buf, returns, n_returns);
+    d->stream_ticks += now(d) - t0;
+    return s;
+}
+
+lidet_status_t lidet_detector_q_stream_end(lidet_detector_q_t *d)
+{
+    lidet_proj_q_buffers_t buf;
+    lidet_status_t s = det_check(d);
+    uint32_t t0;
+    if (s != LIDET_OK)
+    {
+        return s;
+    }
+    det_buffers(d, &buf, 0);
+    t0 = now(d);
+    s = lidet_proj_q_returns_end(&d->proj, &buf);
+    d->stats.proj = d->proj.stats;
+    if (!LIDET_SUCCEEDED(s))
+    {
+        return s;
+    }
+    return det_after_projection(d, &buf, s, t0, d->stream_ticks);
 }
 
 const lidet_detection_q_t *lidet_detector_q_detections(const lidet_detector_q_t *d, uint32_t *n_detections)

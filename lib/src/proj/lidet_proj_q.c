@@ -225,6 +225,7 @@ lidet_status_t lidet_proj_q_init(lidet_proj_q_state_t *st, const lidet_proj_q_cf
     st->cfg.sensor.beam_elev_urad = 0; /* not retained */
     st->n_points = 0;
     memset(&st->stats, 0, sizeof st->stats);
+    st->stream_open = 0;
     st->magic = LIDET_INIT_MAGIC;
     return LIDET_OK;
 }
@@ -489,6 +490,7 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     {
         return LIDET_ERR_ARG;
     }
+    st->stream_open = 0; /* a run closes an open stream of returns */
     rows = st->cfg.sensor.n_rows;
     cols = st->cfg.sensor.n_cols;
     npix = rows * cols;
@@ -576,9 +578,11 @@ lidet_status_t lidet_proj_q_run(lidet_proj_q_state_t *st, const lidet_proj_q_buf
     return sts.n_truncated > 0 ? LIDET_TRUNCATED : LIDET_OK;
 }
 
-/* Pass 1 of lidet_proj_q_run_returns: the nearest return per pixel. A range-only image keeps its range_4mm
- * directly (0 = empty; nothing else to do); an image with x, y, z keeps the range in mm as the key in its range
- * and z planes (key_set, all ones = empty) and the winner's index (point_idx), for its second pass. range_only
+/* Pass 1 of lidet_proj_q_run_returns, over one chunk of the scan: the nearest return per pixel. A range-only
+ * image keeps its range_4mm directly (0 = empty; nothing else to do); an image with x, y, z keeps the range in
+ * mm as the key in its range and z planes (key_set, all ones = empty) and the winner's index in the scan (base +
+ * its index in the chunk: point_idx), for its second pass. point_pixel, when set, is the chunk's. The counts
+ * are added to sts (a chunk at a time). range_only
  * is a constant where inlined; the firmware's loop (a range-only image) is about 35 instructions per return on a
  * Cortex-M4. */
 #if defined(__GNUC__)
@@ -586,7 +590,8 @@ __attribute__((always_inline))
 #endif
 static inline void
 returns_pass1(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf, const lidet_return_t *ret,
-              uint32_t n, uint32_t min_mm, uint32_t max_mm, lidet_proj_stats_t *sts, const int range_only)
+              uint32_t n, uint32_t base, uint32_t min_mm, uint32_t max_mm, lidet_proj_stats_t *sts,
+              const int range_only)
 {
     const uint32_t rows = st->cfg.sensor.n_rows, cols = st->cfg.sensor.n_cols;
     const uint8_t *ring_to_row = st->ring_to_row;
@@ -640,38 +645,47 @@ returns_pass1(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
         else if (r < key_get(buf, pix)) /* strict: ties keep the earlier return */
         {
             key_set(buf, pix, r);
-            buf->point_idx[pix] = (int32_t)(p - ret);
+            buf->point_idx[pix] = (int32_t)(base + (uint32_t)(p - ret));
         }
     }
-    sts->n_projected = n - n_dropped;
-    sts->n_pixels_filled = filled; /* range-only; the other image counts in its second pass */
+    sts->n_projected += n - n_dropped;
+    sts->n_pixels_filled += filled; /* range-only; the other image counts in its second pass */
 }
 
-lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
-                                        const lidet_return_t *returns, uint32_t n_returns)
+/* check_run, and a stream open (lidet_proj_q_returns_begin): else LIDET_ERR_STATE */
+static lidet_status_t check_stream(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                                   int *range_only)
 {
-    uint32_t n, rows, cols, npix, pix, min_mm, max_mm, filled = 0;
-    int range_only;
-    lidet_proj_stats_t sts;
-    lidet_status_t s = check_run(st, buf, &range_only);
+    const lidet_status_t s = check_run(st, buf, range_only);
     if (s != LIDET_OK)
     {
         return s;
     }
-    if (returns == 0 && n_returns > 0)
-    {
-        return LIDET_ERR_ARG;
-    }
-    rows = st->cfg.sensor.n_rows;
-    cols = st->cfg.sensor.n_cols;
-    npix = rows * cols;
-    n = begin_stats(&sts, n_returns);
-    min_mm =
+    return st->stream_open ? LIDET_OK : LIDET_ERR_STATE;
+}
+
+/* the returns' range limits, mm: [min_mm, max_mm] */
+static void returns_limits(const lidet_proj_q_state_t *st, uint32_t *min_mm, uint32_t *max_mm)
+{
+    *min_mm =
         st->cfg.min_range_mm > 0 ? (uint32_t)st->cfg.min_range_mm : 1u; /* zero range is always too close */
-    max_mm = st->cfg.max_range_mm > 0 && (uint32_t)st->cfg.max_range_mm < 131000u
-                 ? (uint32_t)st->cfg.max_range_mm
-                 : 131000u;
-    /* pass 1 (returns_pass1) */
+    *max_mm = st->cfg.max_range_mm > 0 && (uint32_t)st->cfg.max_range_mm < 131000u
+                  ? (uint32_t)st->cfg.max_range_mm
+                  : 131000u;
+}
+
+lidet_status_t lidet_proj_q_returns_begin(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf)
+{
+    uint32_t npix;
+    int range_only;
+    const lidet_status_t s = check_run(st, buf, &range_only);
+    if (s != LIDET_OK)
+    {
+        return s;
+    }
+    npix = st->cfg.sensor.n_rows * st->cfg.sensor.n_cols;
+    (void)begin_stats(&st->stats, 0u);
+    st->n_points = 0;
     if (!range_only)
     {
         memset(buf->point_idx, 0xFF, (size_t)npix * sizeof buf->point_idx[0]);
@@ -682,14 +696,54 @@ lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_pr
     {
         memset(buf->range_4mm, 0, (size_t)npix * sizeof buf->range_4mm[0]);
     }
+    st->stream_open = 1;
+    return LIDET_OK;
+}
+
+lidet_status_t lidet_proj_q_returns_add(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                                        const lidet_return_t *returns, uint32_t n_returns)
+{
+    uint32_t room, n, min_mm, max_mm;
+    int range_only;
+    const lidet_status_t s = check_stream(st, buf, &range_only);
+    if (s != LIDET_OK)
+    {
+        return s;
+    }
+    if (returns == 0 && n_returns > 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    /* n_points counts the returns looked at so far (the scan's first LIDET_MAX_POINTS) */
+    room = LIDET_MAX_POINTS - st->n_points;
+    n = n_returns < room ? n_returns : room;
+    st->stats.n_points_in += n_returns;
+    st->stats.n_truncated += n_returns - n;
+    returns_limits(st, &min_mm, &max_mm);
     if (range_only)
     {
-        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 1); /* the firmware's case */
+        returns_pass1(st, buf, returns, n, st->n_points, min_mm, max_mm, &st->stats, 1); /* the firmware's case */
     }
     else
     {
-        returns_pass1(st, buf, returns, n, min_mm, max_mm, &sts, 0);
+        returns_pass1(st, buf, returns, n, st->n_points, min_mm, max_mm, &st->stats, 0);
     }
+    st->n_points += n;
+    return n < n_returns ? LIDET_TRUNCATED : LIDET_OK;
+}
+
+lidet_status_t lidet_proj_q_returns_end(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf)
+{
+    uint32_t rows, cols, pix, filled = 0;
+    int range_only;
+    const lidet_status_t s = check_stream(st, buf, &range_only);
+    if (s != LIDET_OK)
+    {
+        return s;
+    }
+    st->stream_open = 0;
+    rows = st->cfg.sensor.n_rows;
+    cols = st->cfg.sensor.n_cols;
     /* pass 2, an image with x, y, z: range_4mm = round(range_mm / 4) (>= 1), x, y, z decoded as the range-only
      * image's readers would (lidet_qpix.h) */
     if (!range_only)
@@ -719,14 +773,36 @@ lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_pr
                 buf->z_4mm[pix] = (int16_t)v[2];
             }
         }
+        st->stats.n_pixels_filled = filled;
     }
-    if (!range_only)
+    return st->stats.n_truncated > 0 ? LIDET_TRUNCATED : LIDET_OK;
+}
+
+lidet_status_t lidet_proj_q_run_returns(lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
+                                        const lidet_return_t *returns, uint32_t n_returns)
+{
+    int range_only;
+    lidet_status_t s = check_run(st, buf, &range_only);
+    if (s != LIDET_OK)
     {
-        sts.n_pixels_filled = filled;
+        return s;
     }
-    st->n_points = n;
-    st->stats = sts;
-    return sts.n_truncated > 0 ? LIDET_TRUNCATED : LIDET_OK;
+    if (returns == 0 && n_returns > 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    s = lidet_proj_q_returns_begin(st, buf);
+    if (s != LIDET_OK)
+    {
+        return s;
+    }
+    s = lidet_proj_q_returns_add(st, buf, returns, n_returns);
+    if (!LIDET_SUCCEEDED(s))
+    {
+        st->stream_open = 0;
+        return s;
+    }
+    return lidet_proj_q_returns_end(st, buf);
 }
 
 void lidet_proj_q_image(const lidet_proj_q_state_t *st, const lidet_proj_q_buffers_t *buf,
