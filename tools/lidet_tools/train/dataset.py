@@ -3,7 +3,7 @@
 
 Every scan goes through projection -> ground stage -> depth clustering (with the ground stage's
 per-sector planes for the height filter) -> `lidet_proposal_make` (64 resampled points, mean, PVLE
-voxel), exactly what `lidet_detect` does on the device. Each kept cluster is then labelled against
+voxel), exactly what the detector (`lidet_detector_run`) does on the device. Each kept cluster is then labelled against
 the scan's ground-truth boxes:
 
 * **ID of class c** (Car, Cyclist, Pedestrian): the cluster is *mostly one object* and *holds most of
