@@ -155,45 +155,92 @@ static void cluster_same_mask(int repeat, double *t, double *ms_compact, double 
     *ms_float = cli_median(t + repeat, repeat);
 }
 
+/* the options (cli_options.c) */
+enum
+{
+    OPT_SENSOR,
+    OPT_REPEAT,
+    OPT_ONLY
+};
+
+static const cli_opt_t k_opts[] = {{"sensor", required_argument, OPT_SENSOR, "S: a sensor preset"},
+                                   {"repeat", required_argument, OPT_REPEAT, "N: runs per scan, >= 1"},
+                                   {"only", required_argument, OPT_ONLY, "stages or workspace"},
+                                   {NULL, 0, 0, NULL}};
+
+typedef struct
+{
+    const char *sensor;
+    int repeat;
+    int only; /* -1 both, 0 stages, 1 workspace */
+} bench_opts_t;
+
+static int take(void *ctx, int id, const char *v)
+{
+    bench_opts_t *o = (bench_opts_t *)ctx;
+    char *end;
+    long n;
+    switch (id)
+    {
+    case OPT_SENSOR:
+        o->sensor = v;
+        return 0;
+    case OPT_ONLY:
+        if (strcmp(v, "stages") != 0 && strcmp(v, "workspace") != 0)
+        {
+            fprintf(stderr, "lidet_bench_memory: --only stages or --only workspace, not '%s'\n", v);
+            return 1;
+        }
+        o->only = strcmp(v, "workspace") == 0;
+        return 0;
+    default: /* OPT_REPEAT */
+        n = strtol(v, &end, 10);
+        if (end == v || *end != '\0' || n < 1 || n > 1000000)
+        {
+            fprintf(stderr, "lidet_bench_memory: --repeat needs an integer in [1, 1000000], got '%s'\n", v);
+            return 1;
+        }
+        o->repeat = (int)n;
+        return 0;
+    }
+}
+
 int main(int argc, char **argv)
 {
-    const char *sensor_name = "hdl64";
+    const char *sensor_name;
     const lidet_sensor_t *sensor;
     lidet_workspace_cfg_t cfg;
     lidet_workspace_sizes_t sz;
-    int repeat = 30, a, rc = 0, only = -1;
+    int repeat, a, rc = 0, only, n_pos = 0;
     double *t;
+    char **pos = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
+    bench_opts_t o;
+    cli_optset_t set;
 
-    for (a = 1; a < argc && argv[a][0] == '-'; ++a)
+    if (pos == NULL)
+        return 1;
+    o.sensor = "hdl64";
+    o.repeat = 30;
+    o.only = -1;
+    set = cli_optset(k_opts, take, &o);
+    a = cli_options_parse(argc, argv, "lidet_bench_memory", &set, 1, pos, &n_pos);
+    if (a != CLI_PARSE_OK)
     {
-        if (!strcmp(argv[a], "--sensor") && a + 1 < argc)
-            sensor_name = argv[++a];
-        else if (!strcmp(argv[a], "--repeat") && a + 1 < argc)
-            repeat = atoi(argv[++a]);
-        else if (!strcmp(argv[a], "--only") && a + 1 < argc)
-        {
-            ++a;
-            only = !strcmp(argv[a], "stages") ? 0 : !strcmp(argv[a], "workspace") ? 1 : -2;
-            if (only == -2)
-            {
-                fprintf(stderr, "lidet_bench_memory: --only stages or --only workspace\n");
-                return 2;
-            }
-        }
-        else
-        {
-            fprintf(
-                stderr,
-                "usage: lidet_bench_memory --sensor S [--repeat N] [--only stages|workspace] SCAN.bin...\n");
-            return 2;
-        }
+        if (a == CLI_PARSE_USAGE)
+            fprintf(stderr,
+                    "usage: lidet_bench_memory --sensor S [--repeat N] [--only stages|workspace] SCAN.bin...\n");
+        free(pos);
+        return 2;
     }
+    sensor_name = o.sensor;
+    repeat = o.repeat;
+    only = o.only;
     cli_stage_clock_cpu = 1; /* the workspace's stage clock in this thread's CPU time */
     sensor = lidet_sensor_find(sensor_name);
-    if (sensor == NULL || repeat < 1 || a >= argc)
+    if (sensor == NULL || n_pos == 0)
     {
-        fprintf(stderr, "lidet_bench_memory: %s\n",
-                sensor == NULL ? "unknown sensor" : "need scans and --repeat >= 1");
+        fprintf(stderr, "lidet_bench_memory: %s\n", sensor == NULL ? "unknown sensor" : "need scans");
+        free(pos);
         return 2;
     }
     lidet_workspace_cfg_default(&cfg, sensor);
@@ -209,17 +256,17 @@ int main(int argc, char **argv)
     t = (double *)malloc(sizeof(double) * (size_t)repeat * 12u);
     if (t == NULL)
         return 1;
-    for (; a < argc; ++a)
+    for (a = 0; a < n_pos; ++a)
     {
         uint32_t n = 0, m;
-        float *pts = read_scan(argv[a], &n);
+        float *pts = read_scan(pos[a], &n);
         double ms[3][4], ag, ac, same_c, same_f;
         uint32_t tk[3];
         int i, k, s;
         if (pts == NULL)
         {
             fprintf(stderr, "lidet_bench_memory: cannot read %s (missing, or not records of 4 floats)\n",
-                    argv[a]);
+                    pos[a]);
             rc = 1;
             continue;
         }
@@ -231,7 +278,7 @@ int main(int argc, char **argv)
             !LIDET_SUCCEEDED(
                 lidet_ground_point_labels(&g_ground, lidet_proj_point_pixels(&g_proj, NULL), m, g_gnd_ref)))
         {
-            fprintf(stderr, "lidet_bench_memory: a stage failed on %s\n", argv[a]);
+            fprintf(stderr, "lidet_bench_memory: a stage failed on %s\n", pos[a]);
             free(pts);
             rc = 1;
             continue;
@@ -259,7 +306,7 @@ int main(int argc, char **argv)
         for (k = 0; k < 3; ++k)
             for (s = 0; s < 4; ++s)
                 ms[k][s] = cli_median(t + (k * 4 + s) * repeat, repeat);
-        printf("{\"scan\": \"%s\", \"sensor\": \"%s\", \"points\": %u, \"repeat\": %d, ", argv[a],
+        printf("{\"scan\": \"%s\", \"sensor\": \"%s\", \"points\": %u, \"repeat\": %d, ", pos[a],
                sensor_name, (unsigned)n, repeat);
         for (k = 0; k < 3; ++k)
         {
@@ -280,5 +327,6 @@ int main(int argc, char **argv)
         free(pts);
     }
     free(t);
+    free(pos);
     return rc;
 }

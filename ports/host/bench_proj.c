@@ -15,6 +15,7 @@
 #include <string.h>
 #include <time.h>
 
+#include "cli.h"
 #include "lidet/lidet.h"
 
 #ifndef M_PI
@@ -130,10 +131,62 @@ static void baseline_run(const float *pts, uint32_t n, int rows, int cols, float
     }
 }
 
+/* the options (cli_options.c) */
+enum
+{
+    OPT_SENSOR,
+    OPT_REPEAT,
+    OPT_CLOCK
+};
+
+static const cli_opt_t k_opts[] = {{"sensor", required_argument, OPT_SENSOR, "NAME: a sensor preset"},
+                                   {"repeat", required_argument, OPT_REPEAT, "N: runs per scan, >= 1"},
+                                   {"clock", required_argument, OPT_CLOCK, "wall or cpu"},
+                                   {NULL, 0, 0, NULL}};
+
+typedef struct
+{
+    const char *sensor;
+    int repeat;
+} bench_opts_t;
+
+static int take(void *ctx, int id, const char *v)
+{
+    bench_opts_t *o = (bench_opts_t *)ctx;
+    char *end;
+    long n;
+    switch (id)
+    {
+    case OPT_SENSOR:
+        o->sensor = v;
+        return 0;
+    case OPT_CLOCK:
+        if (strcmp(v, "wall") != 0 && strcmp(v, "cpu") != 0)
+        {
+            fprintf(stderr, "lidet_bench_proj: --clock wall or cpu, not '%s'\n", v);
+            return 1;
+        }
+        g_clock = strcmp(v, "cpu") == 0 ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC;
+        return 0;
+    default: /* OPT_REPEAT */
+        n = strtol(v, &end, 10);
+        if (end == v || *end != '\0' || n < 1 || n > 1000000)
+        {
+            fprintf(stderr, "lidet_bench_proj: --repeat needs an integer in [1, 1000000], got '%s'\n", v);
+            return 1;
+        }
+        o->repeat = (int)n;
+        return 0;
+    }
+}
+
 int main(int argc, char **argv)
 {
-    const char *sensor = "hdl64";
-    int repeat = 30, a, n_files = 0;
+    const char *sensor;
+    int repeat, a, n_files = 0, n_pos = 0;
+    char **pos;
+    bench_opts_t o;
+    cli_optset_t set;
     double sum_pts = 0, sum_lidet_ms = 0, sum_base_ms = 0, sum_compact_ms = 0, sum_q_ms = 0, worst_az_deg = 0,
            worst_el_deg = 0;
     lidet_proj_q_cfg_t cfg_q;
@@ -145,18 +198,25 @@ int main(int argc, char **argv)
     int rows, cols, r;
     float lo_rad, hi_rad;
 
-    for (a = 1; a < argc; ++a)
+    pos = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
+    if (pos == NULL)
+        return 1;
+    set = cli_optset(k_opts, take, &o);
+    o.sensor = "hdl64";
+    o.repeat = 30;
+    a = cli_options_parse(argc, argv, "lidet_bench_proj", &set, 1, pos, &n_pos);
+    sensor = o.sensor;
+    repeat = o.repeat;
+    if (a == CLI_PARSE_OK && lidet_sensor_find(sensor) == NULL)
     {
-        if (strcmp(argv[a], "--sensor") == 0 && a + 1 < argc)
-            sensor = argv[++a];
-        else if (strcmp(argv[a], "--repeat") == 0 && a + 1 < argc)
-            repeat = atoi(argv[++a]);
-        else if (strcmp(argv[a], "--clock") == 0 && a + 1 < argc)
-            g_clock = strcmp(argv[++a], "cpu") == 0 ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC;
+        fprintf(stderr, "lidet_bench_proj: unknown sensor '%s'\n", sensor);
+        a = CLI_PARSE_USAGE;
     }
-    if (repeat < 1 || lidet_sensor_find(sensor) == NULL)
+    if (a != CLI_PARSE_OK)
     {
-        fprintf(stderr, "usage: lidet_bench_proj --sensor NAME [--repeat N] [--clock wall|cpu] SCAN.bin...\n");
+        if (a == CLI_PARSE_USAGE)
+            fprintf(stderr, "usage: lidet_bench_proj --sensor NAME [--repeat N] [--clock wall|cpu] SCAN.bin...\n");
+        free(pos);
         return 1;
     }
     lidet_proj_cfg_default(&cfg, lidet_sensor_find(sensor));
@@ -186,8 +246,9 @@ int main(int argc, char **argv)
     hi_rad = img.row_elev_rad[0] + cfg.fov_margin_rad;
     lo_rad = img.row_elev_rad[rows - 1] - cfg.fov_margin_rad;
 
-    for (a = 1; a < argc; ++a)
+    for (a = 0; a < n_pos; ++a)
     {
+        const char *path = pos[a];
         FILE *f;
         long size;
         float *pts;
@@ -196,15 +257,10 @@ int main(int argc, char **argv)
         double *tl, *tb, *tc, *tq, ml, mb, mc, mq;
         const int32_t *pp;
         int k;
-        if (strcmp(argv[a], "--sensor") == 0 || strcmp(argv[a], "--repeat") == 0 || strcmp(argv[a], "--clock") == 0)
-        {
-            ++a;
-            continue;
-        }
-        f = fopen(argv[a], "rb");
+        f = fopen(path, "rb");
         if (f == NULL)
         {
-            fprintf(stderr, "cannot open %s\n", argv[a]);
+            fprintf(stderr, "cannot open %s\n", path);
             return 1;
         }
         fseek(f, 0, SEEK_END);
@@ -212,7 +268,7 @@ int main(int argc, char **argv)
         fseek(f, 0, SEEK_SET);
         if (size <= 0 || size % 16 != 0)
         {
-            fprintf(stderr, "%s: not a KITTI scan\n", argv[a]);
+            fprintf(stderr, "%s: not a KITTI scan\n", path);
             fclose(f);
             return 1;
         }
@@ -303,7 +359,7 @@ int main(int argc, char **argv)
                    "\"libm_ms\": %.4f, \"lidet_ns_per_point\": %.2f, \"libm_ns_per_point\": %.2f, \"speedup\": %.2f, "
                    "\"max_az_err_deg\": %.6f, \"max_el_err_deg\": %.6f, \"row_agree\": %.6f, \"col_agree\": %.6f, "
                    "\"compact_ns_per_point\": %.2f, \"int_ns_per_point\": %.2f}\n",
-                   argv[a], n, lidet_proj_stats(&g_proj)->n_projected,
+                   path, n, lidet_proj_stats(&g_proj)->n_projected,
                    (double)lidet_proj_stats(&g_proj)->n_pixels_filled / (double)(rows * cols), ml, mb, ml * 1e6 / n,
                    mb * 1e6 / n, mb / ml, w_az, w_el, cnt ? (double)same_row / cnt : 0.0,
                    cnt ? (double)same_col / cnt : 0.0, mc * 1e6 / n, mq * 1e6 / n);
@@ -326,5 +382,6 @@ int main(int argc, char **argv)
                sum_base_ms / sum_lidet_ms, worst_az_deg, worst_el_deg, agree_row / agree_n, agree_col / agree_n,
                fill_sum / n_files, sum_compact_ms * 1e6 / sum_pts, sum_q_ms * 1e6 / sum_pts);
     }
+    free(pos);
     return 0;
 }

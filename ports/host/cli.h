@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include <getopt.h>
+
 #include "lidet/lidet.h"
 
 /* A sensor read from a file (--sensor-file: lidet's description, --ouster-meta: Ouster's metadata; cli_sensor.c;
@@ -61,10 +63,73 @@ typedef struct
     cli_sensor_desc_t desc;
 } cli_args_t;
 
-/* Parses argv (after the subcommand). Returns 0; 2 after --print-sensor printed the sensor (the command then exits
- * with 0); 3 when a sensor file could not be used (the message printed: no usage needed); or prints usage/error to
- * stderr and returns 1. */
-int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a);
+/* ---- command-line options (cli_options.c: getopt_long over option sets; the rules at the top of that file) ---- */
+/* One long option of a set: its name (without "--"), has_arg (getopt.h: no_argument for a flag, required_argument,
+ * optional_argument: only as --name=VALUE), the set's own number for it (what take receives), and what its value
+ * is, for "--NAME needs a value (VALUE)" (NULL for a flag). A set's table ends with an entry whose name is NULL. */
+typedef struct
+{
+    const char *name;
+    int has_arg;
+    int id;
+    const char *value;
+} cli_opt_t;
+/* an option set: its table and the function that takes its options, in the order given, into ctx: take(ctx, id,
+ * value) returns 0, or 1 after a message saying what was wrong with the value (value: NULL for a flag) */
+typedef struct
+{
+    const cli_opt_t *opts;
+    int (*take)(void *ctx, int id, const char *value);
+    void *ctx;
+} cli_optset_t;
+/* the set of opts taken by take into ctx */
+cli_optset_t cli_optset(const cli_opt_t *opts, int (*take)(void *ctx, int id, const char *value), void *ctx);
+/* what cli_options_parse, cli_args_finish and cli_parse return */
+#define CLI_PARSE_OK 0
+#define CLI_PARSE_ERROR 1       /* said: the command exits with 1 */
+#define CLI_PARSE_PRINTED 2     /* --print-sensor printed the sensor: the command exits with 0 */
+#define CLI_PARSE_SENSOR_FILE 3 /* a sensor file could not be used (said): exit 1 */
+#define CLI_PARSE_USAGE 4       /* -h / --help, or no scan: the command prints its usage and exits with 1 */
+/* Parses argv[1..argc) (argv[0]: the subcommand's or the program's name, as getopt_long expects) with the options of
+ * the n_sets sets: one getopt_long table built from them (a name declared twice is an internal error), each option
+ * handed to its set's take in the order given; the positional arguments, in order, into pos (room for argc
+ * entries) and their count into *n_pos. Messages start with who ("lidet detect"). Returns CLI_PARSE_OK,
+ * CLI_PARSE_ERROR (an unknown option, a value missing or refused: said) or CLI_PARSE_USAGE (-h, --help). */
+int cli_options_parse(int argc, char **argv, const char *who, const cli_optset_t *sets, int n_sets, char **pos,
+                      int *n_pos);
+/* the values of a repeatable option (--set KEY=VALUE) in the order given: v has room for argc of them */
+typedef struct
+{
+    const char **v;
+    int n;
+} cli_list_t;
+/* a take that appends value to the cli_list_t ctx, whatever the id */
+int cli_list_take(void *list, int id, const char *value);
+
+/* The shared option sets of cli_args_t (cli_common.c), taken by cli_args_take: the sensor (--sensor NAME,
+ * --sensor-file F, --ouster-meta M, --mount-height M, --print-sensor) and the scan's files and output (--out FILE,
+ * --png FILE, --ring FILE, --json, --repeat N); cli_velodyne_calib.c's --velodyne-calib C and --cols N, taken by
+ * cli_velodyne_calib_take. */
+extern const cli_opt_t cli_opts_sensor[];
+extern const cli_opt_t cli_opts_io[];
+extern const cli_opt_t cli_opts_velodyne_calib[];
+int cli_args_take(void *a, int id, const char *value);
+int cli_velodyne_calib_take(void *a, int id, const char *value);
+/* a's defaults (sensor hdl64, repeat 1, the profile's mount height) */
+void cli_args_default(cli_args_t *a);
+/* the shared sets over a into sets[]: the sensor and the Velodyne calibration, and with io also cli_opts_io;
+ * returns how many (2 or 3) */
+int cli_args_optsets(cli_args_t *a, int io, cli_optset_t *sets);
+/* After the options: the scan from the positional arguments (one; none only with --print-sensor; a second is
+ * "unexpected argument"), then the sensor: one of --sensor / --sensor-file / --ouster-meta / --velodyne-calib, the
+ * file read or the preset found, --mount-height applied, --print-sensor printed. Returns CLI_PARSE_OK,
+ * CLI_PARSE_ERROR, CLI_PARSE_PRINTED, CLI_PARSE_SENSOR_FILE or CLI_PARSE_USAGE (no scan). */
+int cli_args_finish(cli_args_t *a, char *const *pos, int n_pos, const char *cmd);
+/* The whole of it for a command that takes one scan: cli_args_default, cli_options_parse with the shared sets (io
+ * included) and the command's own n_own sets, cli_args_finish. Returns as cli_args_finish. */
+int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a, const cli_optset_t *own, int n_own);
+/* the usage lines of the shared options (lidet CMD SCAN.bin ...) */
+void cli_usage(FILE *f, const char *cmd);
 /* Reads a->sensor_file or a->ouster_meta into a->desc and points the profiles at it (cli_sensor.c). Returns 0, or
  * prints "lidet CMD: FILE: problem" (or that this lidet was built without cJSON) and returns 1. */
 int cli_sensor_load(cli_args_t *a, const char *cmd);
@@ -162,9 +227,10 @@ typedef struct
     int crop;  /* --crop */
     int fixed; /* --fixed: the integer detector */
 } cli_det_opts_t;
-/* argv[*i] when it is a detector option (--model NAME, --set KEY=VALUE, --crop, --fixed, --range-only,
- * --cpu-clock): taken into o (or the globals below), *i moved past its value, 1; else 0 */
-int cli_det_option(cli_det_opts_t *o, int argc, char **argv, int *i);
+/* the detector's option set (lidet detect, lidet track): --model NAME, --set KEY=VALUE, --crop, --fixed,
+ * --range-only, --cpu-clock; cli_det_take takes them into a cli_det_opts_t (the last two: the globals below) */
+extern const cli_opt_t cli_opts_det[];
+int cli_det_take(void *o, int id, const char *value);
 /* the usage lines of those options */
 void cli_det_usage(FILE *f);
 /* the float configuration of the sensor (a->sensor_profile) with --crop and --set, and the models (--model,
@@ -200,7 +266,7 @@ typedef struct
 /* a sensor-frame box in the camera frame: 0, or 1 when a corner is behind the camera (z < 0.1 m) */
 int cli_kitti_box(const cli_calib_t *c, const lidet_box_t *b, cli_kitti_t *out);
 
-/* Subcommands */
+/* Subcommands: argc, argv from the subcommand's name on (argv[0] "detect", ...) */
 int cli_project(int argc, char **argv);
 int cli_ground(int argc, char **argv);
 int cli_cluster(int argc, char **argv);
@@ -245,9 +311,11 @@ typedef struct
 } cli_scan_info_t;
 typedef struct cli_capture cli_capture_t;
 void cli_pcap_opts_default(cli_pcap_opts_t *o);
-/* argv[*i] when it is a capture option (--pcap, --lidar, --port, --force-sensor, --dual, --partial, --png-scan):
- * taken into o, *i moved past its value, 1; 0 when it is not one; -1 after a message (a bad value) */
-int cli_pcap_option(cli_pcap_opts_t *o, int argc, char **argv, int *i);
+/* the capture's option set (--pcap FILE, --lidar NAME, --port N, --force-sensor, --dual MODE, --partial) and
+ * lidet detect's --png-scan K, both taken by cli_pcap_take into a cli_pcap_opts_t (a bad value: its message, 1) */
+extern const cli_opt_t cli_opts_pcap[];
+extern const cli_opt_t cli_opts_pcap_png_scan[];
+int cli_pcap_take(void *o, int id, const char *value);
 /* their usage lines (detect: with --png-scan and the output format) */
 void cli_pcap_usage(FILE *f, int detect);
 /* Reads the whole capture once (frames counted, the decoder run, the scans listed) and, when --sensor was not

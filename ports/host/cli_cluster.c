@@ -142,6 +142,35 @@ static int fail(cli_args_t *a, const char *what, lidet_status_t st)
     return 1;
 }
 
+/* lidet cluster's own options: --labels FILE, --set KEY=VALUE (repeatable, checked once the configuration is made) */
+enum
+{
+    OPT_LABELS,
+    OPT_SET
+};
+
+static const cli_opt_t k_cluster_opts[] = {
+    {"labels", required_argument, OPT_LABELS, "FILE: a SemanticKITTI .label file"},
+    {"set", required_argument, OPT_SET, "KEY=VALUE"},
+    {NULL, 0, 0, NULL}};
+
+typedef struct
+{
+    const char *labels;
+    cli_list_t set;
+} cluster_opts_t;
+
+static int cluster_take(void *ctx, int id, const char *v)
+{
+    cluster_opts_t *o = (cluster_opts_t *)ctx;
+    if (id == OPT_LABELS)
+    {
+        o->labels = v;
+        return 0;
+    }
+    return cli_list_take(&o->set, id, v);
+}
+
 int cli_cluster(int argc, char **argv)
 {
     cli_args_t a;
@@ -157,52 +186,40 @@ int cli_cluster(int argc, char **argv)
     uint32_t n_sectors = 0;
     double ms_gnd = 0.0;
     char title[256], subtitle[160];
-    char **rest;
     const char **sets;
-    int nrest = 0, nsets = 0, i;
+    cluster_opts_t own;
+    cli_optset_t own_set;
+    int nsets = 0, i;
     double *t_proj, *t_clu, *t_prop, *t_gnd, *t_cpu, ms_proj, ms_clu, ms_prop, ms_cpu;
     uint32_t npix, p, n_pp, k, n_rec;
     const int32_t *pp;
     uint32_t *ids;
 
-    /* our own options first; the rest goes to the shared parser */
-    rest = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
     sets = (const char **)malloc(sizeof(char *) * (size_t)(argc + 1));
-    if (rest == NULL || sets == NULL)
-    {
-        free(rest);
-        free(sets);
+    if (sets == NULL)
         return 1;
-    }
-    for (i = 0; i < argc; ++i)
+    own.set.v = sets;
+    own.set.n = 0;
+    own.labels = NULL;
+    own_set = cli_optset(k_cluster_opts, cluster_take, &own);
+    i = cli_parse(argc, argv, "cluster", &a, &own_set, 1);
+    labels_path = own.labels;
+    nsets = own.set.n;
+    if (i != CLI_PARSE_OK)
     {
-        if (strcmp(argv[i], "--labels") == 0 && i + 1 < argc)
-            labels_path = argv[++i];
-        else if (strcmp(argv[i], "--set") == 0 && i + 1 < argc)
-            sets[nsets++] = argv[++i];
-        else
-            rest[nrest++] = argv[i];
-    }
-    i = cli_parse(nrest, rest, "cluster", &a);
-    if (i == 2 || i == 3) /* --print-sensor done, or a sensor file's error printed */
-    {
-        free(rest);
+        if (i == CLI_PARSE_USAGE)
+        {
+            cli_usage(stderr, "cluster");
+            fprintf(stderr, "  --labels   SemanticKITTI .label file: its ground classes are the ground mask\n"
+                            "             (default: the ground stage, with its per-sector planes)\n"
+                            "  --set KEY=VALUE  override a lidet_cluster_cfg_t field (repeatable), e.g.\n"
+                            "             --set rescue_gap_m=0 (no fragment rescue),\n"
+                            "             --set split_people=0 (people are not cut out of wide clusters),\n"
+                            "             --set join_cars=0 (car fragments are not joined)\n");
+        }
         free(sets);
-        return i == 2 ? 0 : 1;
+        return i == CLI_PARSE_PRINTED ? 0 : 1;
     }
-    if (i != 0)
-    {
-        fprintf(stderr, "  --labels   SemanticKITTI .label file: its ground classes are the ground mask\n"
-                        "             (default: the ground stage, with its per-sector planes)\n"
-                        "  --set KEY=VALUE  override a lidet_cluster_cfg_t field (repeatable), e.g.\n"
-                        "             --set rescue_gap_m=0 (no fragment rescue),\n"
-                        "             --set split_people=0 (people are not cut out of wide clusters),\n"
-                        "             --set join_cars=0 (car fragments are not joined)\n");
-        free(rest);
-        free(sets);
-        return 1;
-    }
-    free(rest);
     if (cli_load(&a) != 0)
     {
         free(sets);

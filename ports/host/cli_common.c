@@ -7,9 +7,9 @@
 
 #include "cli.h"
 
-static void usage(const char *cmd)
+void cli_usage(FILE *f, const char *cmd)
 {
-    fprintf(stderr,
+    fprintf(f,
             "usage: lidet %s SCAN.bin [--sensor NAME | --sensor-file F | --ouster-meta M |\n"
             "                 --velodyne-calib C [--cols N]]\n"
             "                 [--ring RING.bin] [--out FILE] [--png FILE] [--json] [--repeat N] [--mount-height M]\n"
@@ -29,135 +29,148 @@ static void usage(const char *cmd)
             "  --json     print one JSON object (stage timings as <stage>_ms)\n"
             "  --repeat   run the stage N times and report the median time (file reading excluded)\n"
             "  --mount-height  the sensor's height above the ground in metres, in [0, 10] (default: the\n"
-            "             profile's: hdl64 1.73, vlp16 0.5, ...); the ground and clustering stages use it\n",
+            "             profile's: hdl64 1.73, vlp16 0.5, ...); the ground and clustering stages use it\n"
+            "  Options go before or after SCAN.bin, as --name VALUE or --name=VALUE; -- ends them.\n",
             cmd, cmd);
 }
 
-int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
+/* ---- the shared options (cli_options.c): the sensor, the scan's files and output ---- */
+
+enum
 {
-    int i, sensor_given = 0;
+    OPT_SENSOR,
+    OPT_SENSOR_FILE,
+    OPT_OUSTER_META,
+    OPT_MOUNT_HEIGHT,
+    OPT_PRINT_SENSOR,
+    OPT_OUT,
+    OPT_PNG,
+    OPT_RING,
+    OPT_JSON,
+    OPT_REPEAT
+};
+
+const cli_opt_t cli_opts_sensor[] = {
+    {"sensor", required_argument, OPT_SENSOR, "NAME: a sensor preset"},
+    {"sensor-file", required_argument, OPT_SENSOR_FILE, "F: a lidet sensor description"},
+    {"ouster-meta", required_argument, OPT_OUSTER_META, "M: an Ouster sensor's metadata"},
+    {"mount-height", required_argument, OPT_MOUNT_HEIGHT, "M: metres in [0, 10]"},
+    {"print-sensor", no_argument, OPT_PRINT_SENSOR, NULL},
+    {NULL, 0, 0, NULL}};
+
+const cli_opt_t cli_opts_io[] = {
+    {"out", required_argument, OPT_OUT, "FILE; with --pcap a folder"},
+    {"png", required_argument, OPT_PNG, "FILE"},
+    {"ring", required_argument, OPT_RING, "RING.bin: a uint16 ring index per point"},
+    {"json", no_argument, OPT_JSON, NULL},
+    {"repeat", required_argument, OPT_REPEAT, "N: an integer in [1, 100000]"},
+    {NULL, 0, 0, NULL}};
+
+int cli_args_take(void *ctx, int id, const char *v)
+{
+    cli_args_t *a = (cli_args_t *)ctx;
+    char *end;
+    switch (id)
+    {
+    case OPT_SENSOR:
+        a->sensor = v;
+        a->sensor_given = 1;
+        break;
+    case OPT_SENSOR_FILE:
+        a->sensor_file = v;
+        break;
+    case OPT_OUSTER_META:
+        a->ouster_meta = v;
+        break;
+    case OPT_MOUNT_HEIGHT:
+    {
+        const double m = strtod(v, &end);
+        /* !(m >= 0 && m <= 10) also refuses NaN */
+        if (end == v || *end != '\0' || !(m >= 0.0 && m <= 10.0))
+        {
+            fprintf(stderr, "lidet %s: --mount-height needs metres in [0, 10], got '%s'\n", cli_cmd, v);
+            return 1;
+        }
+        a->mount_height_m = m;
+        break;
+    }
+    case OPT_PRINT_SENSOR:
+        a->print_sensor = 1;
+        break;
+    case OPT_OUT:
+        a->out_path = v;
+        break;
+    case OPT_PNG:
+        a->png_path = v;
+        break;
+    case OPT_RING:
+        a->ring_path = v;
+        break;
+    case OPT_JSON:
+        a->json = 1;
+        break;
+    default: /* OPT_REPEAT */
+    {
+        const long n = strtol(v, &end, 10);
+        if (end == v || *end != '\0' || n < 1 || n > 100000)
+        {
+            fprintf(stderr, "lidet %s: --repeat needs an integer in [1, 100000], got '%s'\n", cli_cmd, v);
+            return 1;
+        }
+        a->repeat = (int)n;
+        break;
+    }
+    }
+    return 0;
+}
+
+void cli_args_default(cli_args_t *a)
+{
     memset(a, 0, sizeof *a);
     a->sensor = "hdl64";
     a->repeat = 1;
     a->mount_height_m = -1.0;
-    for (i = 0; i < argc; ++i)
+}
+
+int cli_args_optsets(cli_args_t *a, int io, cli_optset_t *sets)
+{
+    int n = 0;
+    sets[n++] = cli_optset(cli_opts_sensor, cli_args_take, a);
+    sets[n++] = cli_optset(cli_opts_velodyne_calib, cli_velodyne_calib_take, a);
+    if (io)
     {
-        const char *s = argv[i];
-        const int has_val = i + 1 < argc;
-        if (strcmp(s, "--json") == 0)
-        {
-            a->json = 1;
-        }
-        else if (strcmp(s, "--print-sensor") == 0)
-        {
-            a->print_sensor = 1;
-        }
-        else if ((strcmp(s, "--sensor") == 0 || strcmp(s, "--out") == 0 || strcmp(s, "--png") == 0 ||
-                  strcmp(s, "--repeat") == 0 || strcmp(s, "--ring") == 0 || strcmp(s, "--mount-height") == 0 ||
-                  strcmp(s, "--sensor-file") == 0 || strcmp(s, "--ouster-meta") == 0 ||
-                  strcmp(s, "--velodyne-calib") == 0 || strcmp(s, "--cols") == 0))
-        {
-            if (!has_val)
-            {
-                fprintf(stderr, "lidet %s: %s needs a value\n", cmd, s);
-                return 1;
-            }
-            if (strcmp(s, "--sensor") == 0)
-            {
-                a->sensor = argv[++i];
-                sensor_given = 1;
-            }
-            else if (strcmp(s, "--sensor-file") == 0)
-                a->sensor_file = argv[++i];
-            else if (strcmp(s, "--ouster-meta") == 0)
-                a->ouster_meta = argv[++i];
-            else if (strcmp(s, "--velodyne-calib") == 0)
-                a->velodyne_calib = argv[++i];
-            else if (strcmp(s, "--cols") == 0)
-            {
-                char *end;
-                const long v = strtol(argv[++i], &end, 10);
-                if (end == argv[i] || *end != '\0' || v < 8 || v > LIDET_MAX_COLS)
-                {
-                    fprintf(stderr, "lidet %s: --cols needs an integer in [8, %d] (LIDET_MAX_COLS), got '%s'\n", cmd,
-                            LIDET_MAX_COLS, argv[i]);
-                    return 1;
-                }
-                a->velodyne_cols = v;
-            }
-            else if (strcmp(s, "--out") == 0)
-                a->out_path = argv[++i];
-            else if (strcmp(s, "--png") == 0)
-                a->png_path = argv[++i];
-            else if (strcmp(s, "--ring") == 0)
-                a->ring_path = argv[++i];
-            else if (strcmp(s, "--mount-height") == 0)
-            {
-                char *end;
-                const double v = strtod(argv[++i], &end);
-                /* !(v >= 0 && v <= 10) also refuses NaN */
-                if (end == argv[i] || *end != '\0' || !(v >= 0.0 && v <= 10.0))
-                {
-                    fprintf(stderr, "lidet %s: --mount-height needs metres in [0, 10], got '%s'\n", cmd, argv[i]);
-                    return 1;
-                }
-                a->mount_height_m = v;
-            }
-            else
-            {
-                char *end;
-                long v = strtol(argv[++i], &end, 10);
-                if (*end != '\0' || v < 1 || v > 100000)
-                {
-                    fprintf(stderr, "lidet %s: --repeat needs an integer in [1, 100000]\n", cmd);
-                    return 1;
-                }
-                a->repeat = (int)v;
-            }
-        }
-        else if (strcmp(s, "-h") == 0 || strcmp(s, "--help") == 0)
-        {
-            usage(cmd);
-            return 1;
-        }
-        else if (s[0] == '-' && s[1] != '\0')
-        {
-            fprintf(stderr, "lidet %s: unknown option %s\n", cmd, s);
-            usage(cmd);
-            return 1;
-        }
-        else if (a->scan_path == NULL)
-        {
-            a->scan_path = s;
-        }
-        else
-        {
-            fprintf(stderr, "lidet %s: unexpected argument %s\n", cmd, s);
-            return 1;
-        }
+        sets[n++] = cli_optset(cli_opts_io, cli_args_take, a);
     }
+    return n;
+}
+
+int cli_args_finish(cli_args_t *a, char *const *pos, int n_pos, const char *cmd)
+{
+    if (n_pos > 1)
+    {
+        fprintf(stderr, "lidet %s: unexpected argument %s\n", cmd, pos[1]);
+        return CLI_PARSE_ERROR;
+    }
+    if (n_pos == 1)
+        a->scan_path = pos[0];
     if (a->scan_path == NULL && !a->print_sensor)
-    {
-        usage(cmd);
-        return 1;
-    }
-    a->sensor_given = sensor_given;
-    if ((a->sensor_file != NULL) + (a->ouster_meta != NULL) + (a->velodyne_calib != NULL) + sensor_given > 1)
+        return CLI_PARSE_USAGE;
+    if ((a->sensor_file != NULL) + (a->ouster_meta != NULL) + (a->velodyne_calib != NULL) + a->sensor_given > 1)
     {
         fprintf(stderr, "lidet %s: give one of --sensor, --sensor-file, --ouster-meta and --velodyne-calib\n", cmd);
-        return 1;
+        return CLI_PARSE_ERROR;
     }
     if (a->velodyne_cols > 0 && a->velodyne_calib == NULL)
     {
         fprintf(stderr, "lidet %s: --cols goes with --velodyne-calib (the presets and the other files give their "
                         "columns)\n", cmd);
-        return 1;
+        return CLI_PARSE_ERROR;
     }
     if (a->sensor_file != NULL || a->ouster_meta != NULL || a->velodyne_calib != NULL)
     {
         /* the file's sensor: a->sensor_mounted (its table in a->desc), its family and integer profile */
         if ((a->velodyne_calib != NULL ? cli_velodyne_calib_load(a, cmd) : cli_sensor_load(a, cmd)) != 0)
-            return 3;
+            return CLI_PARSE_SENSOR_FILE;
     }
     else
     {
@@ -169,7 +182,7 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
             for (k = 0; lidet_sensor_at(k) != NULL; ++k)
                 fprintf(stderr, "%s %s", k ? "," : "", lidet_sensor_at(k)->name);
             fprintf(stderr, ")\n");
-            return 1;
+            return CLI_PARSE_ERROR;
         }
     }
     if (a->mount_height_m >= 0.0)
@@ -183,9 +196,32 @@ int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a)
     if (a->print_sensor)
     {
         cli_sensor_print(a, stdout);
-        return 2;
+        return CLI_PARSE_PRINTED;
     }
-    return 0;
+    return CLI_PARSE_OK;
+}
+
+int cli_parse(int argc, char **argv, const char *cmd, cli_args_t *a, const cli_optset_t *own, int n_own)
+{
+    cli_optset_t sets[8];
+    char who[64];
+    char **pos = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
+    int n, k, n_pos = 0, rc;
+    cli_args_default(a);
+    if (pos == NULL)
+    {
+        fprintf(stderr, "lidet %s: out of memory\n", cmd);
+        return CLI_PARSE_ERROR;
+    }
+    n = cli_args_optsets(a, 1, sets);
+    for (k = 0; k < n_own && n < (int)(sizeof sets / sizeof sets[0]); ++k)
+        sets[n++] = own[k];
+    snprintf(who, sizeof who, "lidet %s", cmd);
+    rc = cli_options_parse(argc, argv, who, sets, n, pos, &n_pos);
+    if (rc == CLI_PARSE_OK)
+        rc = cli_args_finish(a, pos, n_pos, cmd);
+    free(pos);
+    return rc;
 }
 
 /* Reads a whole file whose size must be a multiple of `unit` bytes. */

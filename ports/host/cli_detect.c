@@ -612,25 +612,49 @@ static void usage_extra(void)
     cli_pcap_usage(stderr, 1);
 }
 
-int cli_det_option(cli_det_opts_t *o, int argc, char **argv, int *i)
+enum
 {
-    const char *s = argv[*i];
-    const int has_val = *i + 1 < argc;
-    if (strcmp(s, "--model") == 0 && has_val)
-        o->family = argv[++*i];
-    else if (strcmp(s, "--set") == 0 && has_val)
-        o->sets[o->n_sets++] = argv[++*i];
-    else if (strcmp(s, "--crop") == 0)
+    OPT_MODEL,
+    OPT_SET,
+    OPT_CROP,
+    OPT_FIXED,
+    OPT_RANGE_ONLY,
+    OPT_CPU_CLOCK
+};
+
+const cli_opt_t cli_opts_det[] = {{"model", required_argument, OPT_MODEL, "NAME: a model family of weights/"},
+                                  {"set", required_argument, OPT_SET, "KEY=VALUE"},
+                                  {"crop", no_argument, OPT_CROP, NULL},
+                                  {"fixed", no_argument, OPT_FIXED, NULL},
+                                  {"range-only", no_argument, OPT_RANGE_ONLY, NULL},
+                                  {"cpu-clock", no_argument, OPT_CPU_CLOCK, NULL},
+                                  {NULL, 0, 0, NULL}};
+
+int cli_det_take(void *ctx, int id, const char *v)
+{
+    cli_det_opts_t *o = (cli_det_opts_t *)ctx;
+    switch (id)
+    {
+    case OPT_MODEL:
+        o->family = v;
+        break;
+    case OPT_SET: /* checked by cli_det_config, against the configuration */
+        o->sets[o->n_sets++] = v;
+        break;
+    case OPT_CROP:
         o->crop = 1;
-    else if (strcmp(s, "--fixed") == 0)
+        break;
+    case OPT_FIXED:
         o->fixed = 1;
-    else if (strcmp(s, "--range-only") == 0)
+        break;
+    case OPT_RANGE_ONLY:
         cli_fixed_range_only = 1;
-    else if (strcmp(s, "--cpu-clock") == 0)
+        break;
+    default: /* OPT_CPU_CLOCK */
         cli_stage_clock_cpu = 1;
-    else
-        return 0;
-    return 1;
+        break;
+    }
+    return 0;
 }
 
 static int pick_models(const char *family, const char *sensor, const lidet_pn_model_t **cls,
@@ -919,6 +943,62 @@ done:
     return rc;
 }
 
+/* lidet detect's own options (beside the shared sets: cli_options.c) */
+enum
+{
+    OPT_CALIB,
+    OPT_KITTI_OUT,
+    OPT_GT,
+    OPT_GT_KITTI,
+    OPT_DUMP,
+    OPT_SAVE_SCANS,
+    OPT_RETURNS
+};
+
+static const cli_opt_t k_detect_opts[] = {{"calib", required_argument, OPT_CALIB, "FILE: a KITTI calibration"},
+                                          {"kitti-out", required_argument, OPT_KITTI_OUT, "FILE"},
+                                          {"gt", required_argument, OPT_GT, "FILE: ground-truth boxes"},
+                                          {"gt-kitti", required_argument, OPT_GT_KITTI, "FILE: KITTI label_2 lines"},
+                                          {"dump", required_argument, OPT_DUMP, "FILE"},
+                                          {"save-scans", required_argument, OPT_SAVE_SCANS, "DIR"},
+                                          {"returns", no_argument, OPT_RETURNS, NULL},
+                                          {NULL, 0, 0, NULL}};
+
+typedef struct
+{
+    const char *calib, *kitti_out, *gt, *gt_kitti, *dump, *save_dir;
+} detect_paths_t;
+
+static int detect_take(void *ctx, int id, const char *v)
+{
+    detect_paths_t *d = (detect_paths_t *)ctx;
+    switch (id)
+    {
+    case OPT_CALIB:
+        d->calib = v;
+        break;
+    case OPT_KITTI_OUT:
+        d->kitti_out = v;
+        break;
+    case OPT_GT:
+        d->gt = v;
+        break;
+    case OPT_GT_KITTI:
+        d->gt_kitti = v;
+        break;
+    case OPT_DUMP:
+        d->dump = v;
+        break;
+    case OPT_SAVE_SCANS:
+        d->save_dir = v;
+        break;
+    default: /* OPT_RETURNS */
+        cli_fixed_returns = 1;
+        break;
+    }
+    return 0;
+}
+
 int cli_detect(int argc, char **argv)
 {
     cli_args_t a;
@@ -927,13 +1007,14 @@ int cli_detect(int argc, char **argv)
     const lidet_detector_stats_t *ds;
     const lidet_detection_t *det;
     lidet_status_t st = LIDET_OK;
-    const char *calib_path = NULL, *kitti_path = NULL, *gt_path = NULL, *gt_kitti_path = NULL, *dump_path = NULL,
-               *save_dir = NULL;
+    const char *calib_path, *kitti_path, *gt_path, *gt_kitti_path, *dump_path, *save_dir;
     char chosen[64];
-    char **rest;
+    char **pos;
     cli_det_opts_t o;
     cli_pcap_opts_t po;
-    int nrest = 0, i, fixed = 0;
+    detect_paths_t paths;
+    cli_optset_t sets[8];
+    int n_pos = 0, n_sets, i, fixed = 0;
     static lidet_detection_t det_q[LIDET_MAX_DETECTIONS];
     static lidet_detector_stats_t ds_q;
     double ms[LIDET_DET_N_STAGES + 1];
@@ -943,103 +1024,72 @@ int cli_detect(int argc, char **argv)
     uint32_t *gp_ids = NULL; /* --fixed --dump: the integer run's per-point cluster labels */
 
     memset(&o, 0, sizeof o);
-    rest = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
+    memset(&paths, 0, sizeof paths);
+    cli_pcap_opts_default(&po);
+    cli_args_default(&a);
+    pos = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
     o.sets = (const char **)malloc(sizeof(char *) * (size_t)(argc + 1));
-    if (rest == NULL || o.sets == NULL)
+    if (pos == NULL || o.sets == NULL)
     {
-        free(rest);
+        free(pos);
         free((void *)o.sets);
         return 1;
     }
-    cli_pcap_opts_default(&po);
-    for (i = 0; i < argc; ++i)
-    {
-        int taken;
-        if (cli_det_option(&o, argc, argv, &i))
-            continue;
-        taken = cli_pcap_option(&po, argc, argv, &i);
-        if (taken < 0)
-        {
-            free(rest);
-            free((void *)o.sets);
-            return 1;
-        }
-        if (taken)
-            continue;
-        if (strcmp(argv[i], "--calib") == 0 && i + 1 < argc)
-            calib_path = argv[++i];
-        else if (strcmp(argv[i], "--kitti-out") == 0 && i + 1 < argc)
-            kitti_path = argv[++i];
-        else if (strcmp(argv[i], "--gt") == 0 && i + 1 < argc)
-            gt_path = argv[++i];
-        else if (strcmp(argv[i], "--gt-kitti") == 0 && i + 1 < argc)
-            gt_kitti_path = argv[++i];
-        else if (strcmp(argv[i], "--dump") == 0 && i + 1 < argc)
-            dump_path = argv[++i];
-        else if (strcmp(argv[i], "--save-scans") == 0 && i + 1 < argc)
-            save_dir = argv[++i];
-        else if (strcmp(argv[i], "--returns") == 0)
-            cli_fixed_returns = 1;
-        else
-            rest[nrest++] = argv[i];
-    }
+    /* the sensor, the scan's files and output, the detector, the capture, then ours */
+    n_sets = cli_args_optsets(&a, 1, sets);
+    sets[n_sets++] = cli_optset(cli_opts_det, cli_det_take, &o);
+    sets[n_sets++] = cli_optset(cli_opts_pcap, cli_pcap_take, &po);
+    sets[n_sets++] = cli_optset(cli_opts_pcap_png_scan, cli_pcap_take, &po);
+    sets[n_sets++] = cli_optset(k_detect_opts, detect_take, &paths);
+    i = cli_options_parse(argc, argv, "lidet detect", sets, n_sets, pos, &n_pos);
+    calib_path = paths.calib;
+    kitti_path = paths.kitti_out;
+    gt_path = paths.gt;
+    gt_kitti_path = paths.gt_kitti;
+    dump_path = paths.dump;
+    save_dir = paths.save_dir;
     fixed = o.fixed;
-    if (po.path == NULL && (po.port != 0 || po.force_sensor || po.partial || po.png_scan >= 0 ||
-                            po.dual != NULL || strcmp(po.lidar, "velodyne") != 0 || save_dir != NULL))
+    if (i == CLI_PARSE_OK && po.path == NULL &&
+        (po.port != 0 || po.force_sensor || po.partial || po.png_scan >= 0 || po.dual != NULL ||
+         strcmp(po.lidar, "velodyne") != 0 || save_dir != NULL))
     {
         fprintf(stderr, "lidet detect: --lidar, --port, --force-sensor, --dual, --partial, --png-scan and --save-scans "
                         "go with --pcap FILE\n");
-        free(rest);
-        free((void *)o.sets);
-        return 1;
+        i = CLI_PARSE_ERROR;
     }
-    if (po.path != NULL)
+    if (i == CLI_PARSE_OK && po.path != NULL)
     {
         const char *one = calib_path != NULL      ? "--calib"
                           : kitti_path != NULL    ? "--kitti-out"
                           : gt_path != NULL       ? "--gt"
                           : gt_kitti_path != NULL ? "--gt-kitti"
                           : dump_path != NULL     ? "--dump"
+                          : a.ring_path != NULL   ? "--ring"
+                          : n_pos > 0             ? pos[0]
                                                   : NULL;
-        for (i = 0; one == NULL && i < nrest; ++i)
-            if (strcmp(rest[i], "--ring") == 0)
-                one = "--ring";
-            else if (rest[i][0] != '-' && (i == 0 || (strcmp(rest[i - 1], "--sensor") != 0 &&
-                                                      strcmp(rest[i - 1], "--out") != 0 &&
-                                                      strcmp(rest[i - 1], "--png") != 0 &&
-                                                      strcmp(rest[i - 1], "--repeat") != 0 &&
-                                                      strcmp(rest[i - 1], "--mount-height") != 0 &&
-                                                      strcmp(rest[i - 1], "--sensor-file") != 0 &&
-                                                      strcmp(rest[i - 1], "--ouster-meta") != 0 &&
-                                                      strcmp(rest[i - 1], "--velodyne-calib") != 0 &&
-                                                      strcmp(rest[i - 1], "--cols") != 0)))
-                one = rest[i];
         if (one != NULL)
         {
             fprintf(stderr, "lidet detect: %s goes with one scan file, not with --pcap (its scans are the capture's)\n",
                     one);
-            free(rest);
-            free((void *)o.sets);
-            return 1;
+            i = CLI_PARSE_ERROR;
         }
-        rest[nrest++] = (char *)po.path; /* cli_parse's positional: the scans' source */
-        cli_fixed_returns = 0;           /* --fixed feeds the decoded returns as they are */
+        pos[0] = (char *)po.path; /* the scans' source */
+        n_pos = 1;
+        cli_fixed_returns = 0; /* --fixed feeds the decoded returns as they are */
     }
-    i = cli_parse(nrest, rest, "detect", &a);
-    if (i == 2 || i == 3) /* --print-sensor done, or a sensor file's error printed */
+    if (i == CLI_PARSE_OK)
+        i = cli_args_finish(&a, pos, n_pos, "detect");
+    free(pos);
+    if (i != CLI_PARSE_OK)
     {
-        free(rest);
+        if (i == CLI_PARSE_USAGE)
+        {
+            cli_usage(stderr, "detect");
+            usage_extra();
+        }
         free((void *)o.sets);
-        return i == 2 ? 0 : 1;
+        return i == CLI_PARSE_PRINTED ? 0 : 1;
     }
-    if (i != 0)
-    {
-        usage_extra();
-        free(rest);
-        free((void *)o.sets);
-        return 1;
-    }
-    free(rest);
     if (po.path != NULL)
     {
         i = detect_pcap(&a, &o, &po, save_dir);

@@ -118,6 +118,9 @@ int cli_ground_set(lidet_ground_cfg_t *c, const char *kv)
     return 1;
 }
 
+/* lidet ground's own option: --set KEY=VALUE, repeatable, gathered in order (checked once the configuration is made) */
+static const cli_opt_t k_ground_opts[] = {{"set", required_argument, 0, "KEY=VALUE"}, {NULL, 0, 0, NULL}};
+
 int cli_ground(int argc, char **argv)
 {
     cli_args_t a;
@@ -133,46 +136,38 @@ int cli_ground(int argc, char **argv)
     uint32_t np = 0, i, n_ground_points = 0;
     int k, ret = 1;
 
-    char **rest = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
     const char **sets = (const char **)malloc(sizeof(char *) * (size_t)(argc + 1));
-    int n_rest = 0, n_sets = 0;
-    if (rest == NULL || sets == NULL)
-    {
-        free(rest);
-        free(sets);
+    cli_list_t set_list;
+    cli_optset_t own;
+    set_list.v = sets;
+    set_list.n = 0;
+    own = cli_optset(k_ground_opts, cli_list_take, &set_list);
+    if (sets == NULL)
         return 1;
-    }
-    /* --set KEY=VALUE pairs are ours; everything else goes to the shared parser */
-    for (k = 0; k < argc; ++k)
+    k = cli_parse(argc, argv, "ground", &a, &own, 1);
+    if (k == CLI_PARSE_USAGE)
     {
-        if (strcmp(argv[k], "--set") == 0 && k + 1 < argc)
-            sets[n_sets++] = argv[++k];
-        else
-            rest[n_rest++] = argv[k];
+        cli_usage(stderr, "ground");
+        fprintf(stderr,
+                "  --set KEY=VALUE  override a lidet_ground_cfg_t field (repeatable), e.g. --set ground_m=0.2\n");
     }
-    k = cli_parse(n_rest, rest, "ground", &a);
-    if (k != 0 || cli_load(&a) != 0)
+    if (k != CLI_PARSE_OK || cli_load(&a) != 0)
     {
-        if (n_rest > 0 && (strcmp(rest[0], "--help") == 0 || strcmp(rest[0], "-h") == 0))
-            fprintf(stderr, "  --set KEY=VALUE  override a lidet_ground_cfg_t field (repeatable), e.g. --set ground_m=0.2\n");
-        free(rest);
         free(sets);
-        return k == 2 ? 0 : 1; /* 2: --print-sensor done */
+        return k == CLI_PARSE_PRINTED ? 0 : 1;
     }
     lidet_proj_cfg_default(&pcfg, a.sensor_profile);
     lidet_ground_cfg_default(&gcfg, a.sensor_profile);
-    for (k = 0; k < n_sets; ++k)
+    for (k = 0; k < set_list.n; ++k)
     {
         if (cli_ground_set(&gcfg, sets[k]) != 0)
         {
             fprintf(stderr, "lidet ground: bad --set '%s' (KEY=VALUE with a lidet_ground_cfg_t field)\n", sets[k]);
-            free(rest);
             free(sets);
             cli_free(&a);
             return 1;
         }
     }
-    free(rest);
     free(sets);
     st = lidet_proj_init(&g_proj, &pcfg);
     if (st == LIDET_OK)

@@ -34,7 +34,8 @@ int main(int argc, char **argv)
             if (strcmp(argv[1], k_cmds[i].name) == 0)
             {
                 cli_cmd = k_cmds[i].name;
-                return k_cmds[i].fn(argc - 2, argv + 2);
+                /* argv[0] the subcommand's name, as getopt_long takes it (cli_options.c) */
+                return k_cmds[i].fn(argc - 1, argv + 1);
             }
         }
         fprintf(stderr, "lidet: unknown command '%s'\n", argv[1]);

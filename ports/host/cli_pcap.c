@@ -41,70 +41,81 @@ void cli_pcap_opts_default(cli_pcap_opts_t *o)
     o->png_scan = -1;
 }
 
-int cli_pcap_option(cli_pcap_opts_t *o, int argc, char **argv, int *i)
+enum
 {
-    const char *s = argv[*i];
-    const char *v = *i + 1 < argc ? argv[*i + 1] : NULL;
-    const int takes = strcmp(s, "--pcap") == 0 || strcmp(s, "--port") == 0 || strcmp(s, "--lidar") == 0 ||
-                      strcmp(s, "--dual") == 0 || strcmp(s, "--png-scan") == 0;
-    if (strcmp(s, "--force-sensor") == 0)
+    OPT_PCAP,
+    OPT_LIDAR,
+    OPT_PORT,
+    OPT_FORCE_SENSOR,
+    OPT_DUAL,
+    OPT_PARTIAL,
+    OPT_PNG_SCAN
+};
+
+const cli_opt_t cli_opts_pcap[] = {
+    {"pcap", required_argument, OPT_PCAP, "FILE: a packet capture"},
+    {"lidar", required_argument, OPT_LIDAR, "NAME: velodyne or ouster"},
+    {"port", required_argument, OPT_PORT, "N: a UDP port in [1, 65535]"},
+    {"force-sensor", no_argument, OPT_FORCE_SENSOR, NULL},
+    {"dual", required_argument, OPT_DUAL, "MODE: both, last, strongest, first or second"},
+    {"partial", no_argument, OPT_PARTIAL, NULL},
+    {NULL, 0, 0, NULL}};
+
+const cli_opt_t cli_opts_pcap_png_scan[] = {{"png-scan", required_argument, OPT_PNG_SCAN, "K: a scan number (from 0)"},
+                                            {NULL, 0, 0, NULL}};
+
+int cli_pcap_take(void *ctx, int id, const char *v)
+{
+    cli_pcap_opts_t *o = (cli_pcap_opts_t *)ctx;
+    switch (id)
     {
-        o->force_sensor = 1;
-        return 1;
-    }
-    if (strcmp(s, "--partial") == 0)
-    {
-        o->partial = 1;
-        return 1;
-    }
-    if (!takes)
-        return 0;
-    if (v == NULL)
-    {
-        fprintf(stderr, "lidet %s: %s needs a value\n", cli_cmd, s);
-        return -1;
-    }
-    ++*i;
-    if (strcmp(s, "--pcap") == 0)
+    case OPT_PCAP:
         o->path = v;
-    else if (strcmp(s, "--lidar") == 0)
-    {
+        break;
+    case OPT_FORCE_SENSOR:
+        o->force_sensor = 1;
+        break;
+    case OPT_PARTIAL:
+        o->partial = 1;
+        break;
+    case OPT_LIDAR:
         if (strcmp(v, "velodyne") != 0 && strcmp(v, "ouster") != 0)
         {
             fprintf(stderr, "lidet %s: --lidar velodyne or ouster, not '%s'\n", cli_cmd, v);
-            return -1;
+            return 1;
         }
         o->lidar = v;
-    }
-    else if (strcmp(s, "--dual") == 0)
-    {
+        break;
+    case OPT_DUAL:
         if (strcmp(v, "both") != 0 && strcmp(v, "last") != 0 && strcmp(v, "strongest") != 0 &&
             strcmp(v, "first") != 0 && strcmp(v, "second") != 0)
         {
             fprintf(stderr,
                     "lidet %s: --dual both, last or strongest (velodyne), first or second (ouster), not '%s'\n",
                     cli_cmd, v);
-            return -1;
+            return 1;
         }
         o->dual = v;
-    }
-    else
+        break;
+    default: /* OPT_PORT, OPT_PNG_SCAN */
     {
         char *end;
         const long n = strtol(v, &end, 10);
-        const int port = strcmp(s, "--port") == 0;
+        const int port = id == OPT_PORT;
         if (end == v || *end != '\0' || n < (port ? 1 : 0) || n > (port ? 65535 : 100000000L))
         {
-            fprintf(stderr, "lidet %s: %s needs %s, got '%s'\n", cli_cmd, s,
+            fprintf(stderr, "lidet %s: --%s needs %s, got '%s'\n", cli_cmd, port ? "port" : "png-scan",
                     port ? "a UDP port in [1, 65535]" : "a scan number (from 0)", v);
-            return -1;
+            return 1;
         }
         if (port)
             o->port = (int)n;
         else
             o->png_scan = n;
+        break;
     }
-    return 1;
+    }
+    return 0;
 }
 
 void cli_pcap_usage(FILE *f, int detect)

@@ -62,9 +62,11 @@ int cli_project(int argc, char **argv)
     double *times, ms;
     int i;
 
-    i = cli_parse(argc, argv, "project", &a);
-    if (i != 0 || cli_load(&a) != 0)
-        return i == 2 ? 0 : 1; /* 2: --print-sensor done */
+    i = cli_parse(argc, argv, "project", &a, NULL, 0);
+    if (i == CLI_PARSE_USAGE)
+        cli_usage(stderr, "project");
+    if (i != CLI_PARSE_OK || cli_load(&a) != 0)
+        return i == CLI_PARSE_PRINTED ? 0 : 1;
     lidet_proj_cfg_default(&cfg, a.sensor_profile);
     st = lidet_proj_init(&g_proj, &cfg);
     if (st != LIDET_OK)

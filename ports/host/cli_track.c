@@ -115,6 +115,7 @@ static void usage(void)
         "    yaw in rad), the velocity over the ground in m/s, the last detection's score, the track's "
         "hits;\n"
         "    frame: the scan's number when its name (stem) is digits, else its index from 0\n"
+        "  Options go before, between or after the scans, as --name VALUE or --name=VALUE; -- ends them.\n"
         "  --sensor, --sensor-file, --ouster-meta, --velodyne-calib, --cols, --mount-height, --print-sensor: as\n"
         "  lidet detect\n"
         "  (lidet detect --help). The detector's options, as lidet detect:\n",
@@ -868,6 +869,91 @@ static FILE *open_out(const char *dir, const char *sub, const char *name)
     return f;
 }
 
+/* lidet track's own options (beside the shared sets: cli_options.c) */
+enum
+{
+    OPT_JSON,
+    OPT_COASTING,
+    OPT_TENTATIVE,
+    OPT_RATE,
+    OPT_DT_FILE,
+    OPT_EGO,
+    OPT_OUT,
+    OPT_PNG,
+    OPT_CALIB,
+    OPT_PNG_SCAN
+};
+
+static const cli_opt_t k_track_opts[] = {{"json", no_argument, OPT_JSON, NULL},
+                                         {"coasting", no_argument, OPT_COASTING, NULL},
+                                         {"tentative", no_argument, OPT_TENTATIVE, NULL},
+                                         {"rate", required_argument, OPT_RATE, "HZ: a scan rate in [0.1, 1000]"},
+                                         {"dt-file", required_argument, OPT_DT_FILE, "F: one dt per scan"},
+                                         {"ego", required_argument, OPT_EGO, "FILE, or none"},
+                                         {"out", required_argument, OPT_OUT, "DIR"},
+                                         {"png", required_argument, OPT_PNG, "FILE"},
+                                         {"calib", required_argument, OPT_CALIB, "FILE: a KITTI calibration"},
+                                         /* lidet detect's, refused with a word on what --png draws here */
+                                         {"png-scan", optional_argument, OPT_PNG_SCAN, NULL},
+                                         {NULL, 0, 0, NULL}};
+
+typedef struct
+{
+    const char *ego_path, *dt_path, *out_dir, *png_path, *calib_path;
+    double rate;
+    int json, rate_given, ego_none;
+    uint32_t flags;
+} track_opts_t;
+
+static int track_take(void *ctx, int id, const char *v)
+{
+    track_opts_t *t = (track_opts_t *)ctx;
+    switch (id)
+    {
+    case OPT_JSON:
+        t->json = 1;
+        break;
+    case OPT_COASTING:
+        t->flags |= LIDET_TRACK_OUT_COASTING;
+        break;
+    case OPT_TENTATIVE:
+        t->flags |= LIDET_TRACK_OUT_TENTATIVE;
+        break;
+    case OPT_RATE:
+    {
+        char *end;
+        t->rate = strtod(v, &end);
+        if (end == v || *end != '\0' || !(t->rate >= 0.1 && t->rate <= 1000.0))
+        {
+            fprintf(stderr, "lidet track: --rate needs a scan rate in [0.1, 1000] Hz, got '%s'\n", v);
+            return 1;
+        }
+        t->rate_given = 1;
+        break;
+    }
+    case OPT_DT_FILE:
+        t->dt_path = v;
+        break;
+    case OPT_EGO:
+        t->ego_none = strcmp(v, "none") == 0;
+        t->ego_path = t->ego_none ? NULL : v;
+        break;
+    case OPT_OUT:
+        t->out_dir = v;
+        break;
+    case OPT_PNG:
+        t->png_path = v;
+        break;
+    case OPT_CALIB:
+        t->calib_path = v;
+        break;
+    default: /* OPT_PNG_SCAN */
+        fprintf(stderr, "lidet track: --png draws the last scan (--png-scan is lidet detect's)\n");
+        return 1;
+    }
+    return 0;
+}
+
 int cli_track(int argc, char **argv)
 {
     cli_args_t a;
@@ -875,118 +961,56 @@ int cli_track(int argc, char **argv)
     seq_t q;
     lidet_detector_cfg_t cfg;
     const lidet_pn_model_t *mc = NULL, *mb = NULL;
-    char chosen[64], **rest = NULL, **pos = NULL, *poses = NULL;
-    const char *ego_path = NULL, *dt_path = NULL, *out_dir = NULL, *png_path = NULL, *calib_path = NULL;
-    double rate = 10.0;
+    char chosen[64], **pos = NULL, *poses = NULL;
+    const char *ego_path, *dt_path, *out_dir, *png_path, *calib_path;
+    double rate;
     double *t_dt = NULL;
-    int nrest = 0, npos = 0, i, json = 0, rate_given = 0, ego_none = 0, rc = 1, warned_mount = 0,
-        warned_trunc = 0;
-    uint32_t flags = 0, k, cap = 0, n_tr = 0;
+    int npos = 0, i, json, rate_given, ego_none, rc = 1, warned_mount = 0, warned_trunc = 0;
+    uint32_t flags, k, cap = 0, n_tr = 0;
     int32_t *pp = NULL;
     uint8_t *gp = NULL;
     FILE *label02 = NULL;
     cli_calib_t calib;
-    int have_calib = 0, print_sensor = 0;
+    int have_calib = 0, print_sensor;
     cli_pcap_opts_t po;
     cli_capture_t *capt = NULL;
     const lidet_return_t *rets = NULL;
     double *det_ms = NULL;
+    track_opts_t topt;
+    cli_optset_t sets[8];
+    int n_sets;
 
     memset(&o, 0, sizeof o);
+    memset(&topt, 0, sizeof topt);
+    topt.rate = 10.0;
     cli_pcap_opts_default(&po);
     memset(&q, 0, sizeof q);
-    memset(&a, 0, sizeof a);
-    rest = (char **)malloc(sizeof(char *) * (size_t)(argc + 2));
+    cli_args_default(&a);
     pos = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
     o.sets = (const char **)malloc(sizeof(char *) * (size_t)(argc + 1));
-    if (rest == NULL || pos == NULL || o.sets == NULL)
+    if (pos == NULL || o.sets == NULL)
         goto done;
-    for (i = 0; i < argc; ++i)
-    {
-        const char *s = argv[i];
-        const int has_val = i + 1 < argc;
-        if (cli_det_option(&o, argc, argv, &i))
-            continue;
-        if (strcmp(s, "--png-scan") == 0)
-        {
-            fprintf(stderr, "lidet track: --png draws the last scan (--png-scan is lidet detect's)\n");
-            goto done;
-        }
-        {
-            const int taken = cli_pcap_option(&po, argc, argv, &i);
-            if (taken < 0)
-                goto done;
-            if (taken)
-                continue;
-        }
-        if (strcmp(s, "-h") == 0 || strcmp(s, "--help") == 0)
-        {
-            usage();
-            goto done;
-        }
-        if (strcmp(s, "--json") == 0)
-            json = 1;
-        else if (strcmp(s, "--coasting") == 0)
-            flags |= LIDET_TRACK_OUT_COASTING;
-        else if (strcmp(s, "--tentative") == 0)
-            flags |= LIDET_TRACK_OUT_TENTATIVE;
-        else if (strcmp(s, "--print-sensor") == 0)
-        {
-            rest[nrest++] = argv[i];
-            print_sensor = 1;
-        }
-        else if (strcmp(s, "--sensor") == 0 || strcmp(s, "--sensor-file") == 0 ||
-                 strcmp(s, "--ouster-meta") == 0 || strcmp(s, "--velodyne-calib") == 0 ||
-                 strcmp(s, "--cols") == 0 || strcmp(s, "--mount-height") == 0)
-        {
-            rest[nrest++] = argv[i]; /* cli_parse reads them (and says when the value is missing) */
-            if (has_val)
-                rest[nrest++] = argv[++i];
-        }
-        else if (strcmp(s, "--rate") == 0 || strcmp(s, "--dt-file") == 0 || strcmp(s, "--ego") == 0 ||
-                 strcmp(s, "--out") == 0 || strcmp(s, "--png") == 0 || strcmp(s, "--calib") == 0 ||
-                 strcmp(s, "--model") == 0 || strcmp(s, "--set") == 0)
-        {
-            if (!has_val)
-            {
-                fprintf(stderr, "lidet track: %s needs a value\n", s);
-                goto done;
-            }
-            ++i;
-            if (strcmp(s, "--rate") == 0)
-            {
-                char *end;
-                rate = strtod(argv[i], &end);
-                if (end == argv[i] || *end != '\0' || !(rate >= 0.1 && rate <= 1000.0))
-                {
-                    fprintf(stderr, "lidet track: --rate needs a scan rate in [0.1, 1000] Hz, got '%s'\n",
-                            argv[i]);
-                    goto done;
-                }
-                rate_given = 1;
-            }
-            else if (strcmp(s, "--dt-file") == 0)
-                dt_path = argv[i];
-            else if (strcmp(s, "--ego") == 0)
-            {
-                ego_none = strcmp(argv[i], "none") == 0;
-                ego_path = ego_none ? NULL : argv[i];
-            }
-            else if (strcmp(s, "--out") == 0)
-                out_dir = argv[i];
-            else if (strcmp(s, "--png") == 0)
-                png_path = argv[i];
-            else
-                calib_path = argv[i];
-        }
-        else if (s[0] == '-' && s[1] != '\0')
-        {
-            fprintf(stderr, "lidet track: unknown option %s (lidet track --help)\n", s);
-            goto done;
-        }
-        else
-            pos[npos++] = argv[i];
-    }
+    /* the sensor (no scan-file options: --out, --png and --json are ours), the detector, the capture, then ours */
+    n_sets = cli_args_optsets(&a, 0, sets);
+    sets[n_sets++] = cli_optset(cli_opts_det, cli_det_take, &o);
+    sets[n_sets++] = cli_optset(cli_opts_pcap, cli_pcap_take, &po);
+    sets[n_sets++] = cli_optset(k_track_opts, track_take, &topt);
+    i = cli_options_parse(argc, argv, "lidet track", sets, n_sets, pos, &npos);
+    if (i == CLI_PARSE_USAGE)
+        usage();
+    if (i != CLI_PARSE_OK)
+        goto done;
+    ego_path = topt.ego_path;
+    dt_path = topt.dt_path;
+    out_dir = topt.out_dir;
+    png_path = topt.png_path;
+    calib_path = topt.calib_path;
+    rate = topt.rate;
+    json = topt.json;
+    rate_given = topt.rate_given;
+    ego_none = topt.ego_none;
+    flags = topt.flags;
+    print_sensor = a.print_sensor;
     if (rate_given && dt_path != NULL)
     {
         fprintf(stderr, "lidet track: give --rate or --dt-file, not both\n");
@@ -1008,20 +1032,19 @@ int cli_track(int argc, char **argv)
         usage();
         goto done;
     }
-    /* the sensor: cli_parse with the first scan (or the capture, or --print-sensor alone) */
-    if (npos > 0)
-        rest[nrest++] = pos[0];
-    else if (po.path != NULL)
-        rest[nrest++] = (char *)po.path;
-    i = cli_parse(nrest, rest, "track", &a);
-    if (i == 2)
+    /* the sensor: as lidet detect's, with the first scan (or the capture, or --print-sensor alone) */
+    {
+        char *first = npos > 0 ? pos[0] : (char *)po.path;
+        i = cli_args_finish(&a, &first, first != NULL ? 1 : 0, "track");
+    }
+    if (i == CLI_PARSE_PRINTED)
     {
         rc = 0;
         goto done;
     }
-    if (i != 0)
+    if (i != CLI_PARSE_OK)
     {
-        if (i == 1)
+        if (i == CLI_PARSE_ERROR)
             fprintf(stderr, "(lidet track --help: the options of lidet track)\n");
         goto done;
     }
@@ -1497,7 +1520,6 @@ done:
     free(poses);
     free(pp);
     free(gp);
-    free(rest);
     free(pos);
     free((void *)o.sets);
     return rc;

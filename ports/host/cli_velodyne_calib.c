@@ -926,6 +926,39 @@ static int read_yaml(const char *buf, size_t size, vel_lasers_t *L, char *err)
 
 /* ============================================ the command's sensor ============================================ */
 
+/* the options (cli_options.c; every command that takes a sensor): --velodyne-calib C, --cols N */
+enum
+{
+    OPT_VELODYNE_CALIB,
+    OPT_COLS
+};
+
+const cli_opt_t cli_opts_velodyne_calib[] = {
+    {"velodyne-calib", required_argument, OPT_VELODYNE_CALIB, "C: a Velodyne calibration, db.xml or YAML"},
+    {"cols", required_argument, OPT_COLS, "N: columns per revolution"},
+    {NULL, 0, 0, NULL}};
+
+int cli_velodyne_calib_take(void *ctx, int id, const char *v)
+{
+    cli_args_t *a = (cli_args_t *)ctx;
+    char *end;
+    long n;
+    if (id == OPT_VELODYNE_CALIB)
+    {
+        a->velodyne_calib = v;
+        return 0;
+    }
+    n = strtol(v, &end, 10);
+    if (end == v || *end != '\0' || n < 8 || n > LIDET_MAX_COLS)
+    {
+        fprintf(stderr, "lidet %s: --cols needs an integer in [8, %d] (LIDET_MAX_COLS), got '%s'\n", cli_cmd,
+                LIDET_MAX_COLS, v);
+        return 1;
+    }
+    a->velodyne_cols = n;
+    return 0;
+}
+
 /* reads the whole file (at most 16 MiB); the caller frees *buf */
 static int read_file(const char *path, char **buf, size_t *size, char *err)
 {
