@@ -17,7 +17,7 @@ void cli_usage(FILE *f, const char *cmd)
             "                 [--mount-height M] --print-sensor\n"
             "  SCAN.bin   KITTI velodyne scan: float32 records x, y, z, remission (metres, sensor frame)\n"
             "  --sensor   hdl64 (default), vlp16, vlp32c, hdl32, os0-32, os0-64, os0-128, os1-32, os1-64,\n"
-            "             os1-128, os2-32, os2-64, os2-128 (docs/SENSORS.md)\n"
+            "             os1-128, os2-32, os2-64, os2-128, pandar64 (docs/SENSORS.md)\n"
             "  --sensor-file  a sensor description (JSON, \"format\": \"lidet-sensor\"; docs/SENSORS.md)\n"
             "  --ouster-meta  an Ouster sensor's metadata JSON (beam table, columns; mount height 1.0 m\n"
             "             unless --mount-height)\n"

@@ -107,7 +107,7 @@ Result check_profile(const char *name, std::mt19937 &gen)
 int main()
 {
     const char *names[] = {"hdl64", "vlp16", "vlp32c", "os1-64", "os1-128", "hdl32", "os0-32",
-                           "os0-64", "os0-128", "os1-32", "os2-32", "os2-64", "os2-128"};
+                           "os0-64", "os0-128", "os1-32", "os2-32", "os2-64", "os2-128", "pandar64"};
     std::mt19937 gen(12345);
     int failures = 0;
     for (const char *name : names)

@@ -11,7 +11,7 @@ static lidet_proj_cfg_t cfg;
 static float pts[4096 * 4];
 
 static const char *const k_names[] = {"hdl64",  "vlp16",  "vlp32c", "os1-64", "os1-128", "hdl32",  "os0-32",
-                                      "os0-64", "os0-128", "os1-32", "os2-32", "os2-64",  "os2-128"};
+                                      "os0-64", "os0-128", "os1-32", "os2-32", "os2-64",  "os2-128", "pandar64"};
 
 void setUp(void)
 {

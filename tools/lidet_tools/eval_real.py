@@ -23,8 +23,8 @@ source's sensor preset and mount height; `--fixed`: the integer detector, `nativ
 * KITTI's own protocol on the KITTI frames (label_2 with 2D boxes, difficulties): AP R40 3D / BEV moderate;
 * where each object within 40 m was lost (`lidet_tools.where_lost` over the points that won their pixel of the
   projection, the ones the detector sees; float detector only), and the share of points seen per source: a
-  sensor whose beams the preset does not describe (PandaSet's Pandar64 on `hdl64`, Argoverse's two VLP-32C on
-  `vlp32c`) loses many points to pixel collisions;
+  sensor whose beams the preset does not describe (Argoverse's two stacked VLP-32C on `vlp32c`) loses many points
+  to pixel collisions;
 * a BEV picture per frame (ground truth green, detections by class, ignore regions grey) in OUT/pictures/.
 
 Writes OUT/report.md and OUT/report.json and prints the report. Exit status 0; 2 when the folder is missing.
@@ -457,8 +457,8 @@ def main(argv=None) -> int:
                     help="a stage setting (lidet detect --set; the run goes through the CLI, without the where-lost "
                          "table)")
     ap.add_argument("--as-sensor", metavar="NAME",
-                    help="thin the HDL-64 frames to the beams of this preset (vlp16, vlp32c: lidet_tools.real.thin) and "
-                         "run its detector on them; frames of other sensors are left out")
+                    help="thin the 64-beam frames (hdl64, pandar64) to the beams of this preset (vlp16, vlp32c: "
+                         "lidet_tools.real.thin) and run its detector on them; frames of other sensors are left out")
     ap.add_argument("--no-pictures", action="store_true")
     ap.add_argument("--json", action="store_true", help="print report.json instead of the tables")
     a = ap.parse_args(argv)
@@ -466,8 +466,9 @@ def main(argv=None) -> int:
     from .real import thin
     if a.as_sensor:
         from .sensors import SENSORS
-        if a.as_sensor not in SENSORS or a.as_sensor == "hdl64":
-            ap.error(f"--as-sensor: a preset sparser than hdl64 ({', '.join(n for n in SENSORS if n != 'hdl64')})")
+        if a.as_sensor not in SENSORS or a.as_sensor in real.HDL64_LIKE:
+            ap.error(f"--as-sensor: a preset sparser than hdl64 "
+                     f"({', '.join(n for n in SENSORS if n not in real.HDL64_LIKE)})")
     root = pathlib.Path(a.root)
     if not root.is_dir():
         print(f"eval_real: {root} not found (the real frames live in ../shared/data/real; nothing to do)",
@@ -490,9 +491,9 @@ def main(argv=None) -> int:
             print(f"eval_real: skipping {src} {fid}: {e}", file=sys.stderr)
             continue
         if a.as_sensor:
-            if fr.sensor != "hdl64":
+            if fr.sensor not in real.HDL64_LIKE:
                 continue
-            fr = dataclasses.replace(fr, points=thin.thin(fr.points, "hdl64", a.as_sensor), sensor=a.as_sensor,
+            fr = dataclasses.replace(fr, points=thin.thin(fr.points, fr.sensor, a.as_sensor), sensor=a.as_sensor,
                                      point_instance=None, point_semantic=None)
         calib, label2, dc = None, [], None
         if src == "kitti":

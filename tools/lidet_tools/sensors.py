@@ -156,6 +156,17 @@ _VLP32C = np.array([
     1.333, 1.667, 2.333, 3.333, 4.667, 7.0, 10.333, 15.0,
 ])
 
+# Hesai Pandar64 (PandaSet's sensor): the nominal channel elevations Hesai publishes, ring r = channel r + 1 (ring 0 =
+# the top beam, Hesai's order); 0.167 deg apart between +2.028 and -6.061 deg.
+_PANDAR64 = np.array([
+    14.882, 11.032, 8.059, 5.057, 3.040, 2.028, 1.860, 1.688, 1.522, 1.351, 1.184, 1.013, 0.846, 0.675, 0.508, 0.337,
+    0.169, 0.000, -0.169, -0.337, -0.508, -0.675, -0.845, -1.013, -1.184, -1.351, -1.522, -1.688, -1.860, -2.028,
+    -2.198, -2.365, -2.536, -2.700, -2.873, -3.040, -3.210, -3.375, -3.548, -3.712, -3.884, -4.050, -4.221, -4.385,
+    -4.558, -4.720, -4.892, -5.057, -5.229, -5.391, -5.565, -5.726, -5.898, -6.061, -7.063, -8.059, -9.060, -9.885,
+    -11.032, -12.006, -12.974, -13.930, -18.889, -24.897,
+])
+
+
 def _urad_fov(up_deg: float, down_deg: float) -> tuple:
     return int(round(np.radians(up_deg) * 1e6)), int(round(np.radians(down_deg) * 1e6))
 
@@ -174,6 +185,8 @@ SENSORS: dict[str, Sensor] = {
        for k, n, fov, rng in ((0, 32, 45.0, 100.0), (0, 64, 45.0, 100.0), (0, 128, 45.0, 100.0),
                               (1, 32, 22.5, 120.0), (2, 32, 11.25, 240.0), (2, 64, 11.25, 240.0),
                               (2, 128, 11.25, 240.0))},
+    # Pandar64 at 10 Hz (0.2 deg a column), PandaSet's roof mount 2.05 m (lidet_tools.real.pandaset).
+    "pandar64": Sensor("pandar64", 64, 1800, _deg(_PANDAR64), 2.05, 200.0),
 }
 
 

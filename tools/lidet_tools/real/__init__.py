@@ -28,6 +28,9 @@ import numpy as np
 SOURCES = ("kitti", "kitti360", "pandaset", "argoverse", "semantickitti", "squeezeseg")
 
 #: classes an evaluation scores; every other class name of a RealFrame box is ignored
+#: presets of 64-beam sensors like KITTI's HDL-64E: their frames are the hdl64 family's kind of data (real.compare,
+#: eval_real --as-sensor, real.export)
+HDL64_LIKE = ("hdl64", "pandar64")
 EVAL_CLASSES = ("Car", "Pedestrian", "Cyclist")
 #: classes of objects that must be ignored (neither matched nor counted as false positives)
 IGNORED_CLASSES = ("Van", "Person_sitting", "DontCare", "Other")

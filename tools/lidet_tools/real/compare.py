@@ -24,6 +24,7 @@ import numpy as np
 
 from .. import native
 from ..where_lost import points_in_box, seen_points, where_lost
+from . import HDL64_LIKE
 
 CLASSES = ("Car", "Pedestrian", "Cyclist")
 BANDS = ((0.0, 15.0), (15.0, 30.0), (30.0, 45.0))
@@ -63,7 +64,7 @@ def real_rows(root, side: str = "train", all_sensors: bool = False) -> list:
         if sd != side:
             continue
         fr = load_frame(root, src, fid)
-        if fr.sensor != "hdl64" and not all_sensors:
+        if fr.sensor not in HDL64_LIKE and not all_sensors:
             continue
         det = native.detect(fr.points, fr.sensor, mount_height_m=fr.mount_height_m)
         rows += object_rows(fr.points, fr.boxes, det, seen_points(fr.points, fr.sensor), fr.sensor)

@@ -34,6 +34,9 @@ all 5 frames, and numerically as stated):
     degrees) only L + W is known: it is split in the class prior's ratio.
   Boxes are then normalised to l >= w (no heading is known: the converter's yaw points along the length
   edge either way; yaw in [-pi, pi)).
+* sensor: the `pandar64` preset (Hesai's nominal channel elevations, 0.167 deg apart near the horizon; 1800
+  columns at 10 Hz): with it the projection keeps 86 % of the training frames' points in a pixel of their own,
+  with `hdl64`'s table 60 %, and the ground stage finds samples in every sector.
 * 000000.txt names classes TYPE_VEHICLE / TYPE_PEDESTRIAN / TYPE_CYCLIST (Waymo style) and has a 10th
   column: the number of points inside the box as written (it matches the count on 000000.bin exactly for all
   218 lines), so the boxes belong to this scan and the file is usable. Its boxes follow the corner format.
@@ -75,6 +78,11 @@ RIDDEN_MIN_H_M = 1.5
 RIDER_Z_M = 1.2
 #: |cos 2 yaw| below this: extents do not separate length and width
 EXTENT_MIN_DET = 0.25
+
+
+#: the lidet preset of the Hesai Pandar64: its own beam table (the hdl64 one, used before, kept 60 % of the training
+#: frames' points in their own pixel, this one 86 %; docs/SENSORS.md)
+SENSOR = "pandar64"
 
 
 def list_frames(root: pathlib.Path) -> list[str]:
@@ -199,4 +207,4 @@ def load_frame(root: pathlib.Path, frame_id: str) -> RealFrame:
     points[:, 2] += np.float32(dz)
     for b in boxes:
         b.z += dz
-    return RealFrame(SOURCE, frame_id, points, boxes, None, "hdl64", MOUNT_HEIGHT_M)
+    return RealFrame(SOURCE, frame_id, points, boxes, None, SENSOR, MOUNT_HEIGHT_M)
