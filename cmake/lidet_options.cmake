@@ -2,8 +2,8 @@
 # The compile-time options of lib/include/lidet/lidet_opt.h as CMake cache variables of the same names (STRING,
 # empty = the header's default), read by the main CMakeLists.txt and by ports/firmware/CMakeLists.txt.
 # docs/PORTING.md ("Every compile-time option") lists them with their defaults and ranges; lidet_opt.h checks each
-# value (#error), so a bad one fails the first compile. Three options are CMake options (ON/OFF) instead, because
-# they also choose sources or per-source flags: LIDET_FIXED_POINT, LIDET_NN_CLONES, LIDET_NN_FMA.
+# value (#error), so a bad one fails the first compile. Four options are CMake options (ON/OFF) instead, because
+# they also choose sources or per-source flags: LIDET_FIXED_POINT, LIDET_NN_CLONES, LIDET_NN_FMA, LIDET_NN_NEON.
 # tests/python/test_opt_knobs.py holds this list, lidet_opt.h and the docs to each other.
 #
 #   cmake -S . -B build -DLIDET_MAX_POINTS=30000 -DLIDET_NN_S8_KERNEL=LIDET_NN_S8_KERNEL_COLS

@@ -9,9 +9,12 @@
 #   as on a host without them). No fuzz harnesses, benchmarks, firmware or bindings.
 # - lidet_cli_portable: the host CLI with the portable float dense kernel, where this build's CLI has the x86
 #   FMA kernel (LIDET_NN_FMA, whose last bits differ); the float detector is compared with it.
-# - ctest aarch64_linux (tests/aarch64/run_aarch64.py): every unit test under qemu-aarch64, then the aarch64 CLI
-#   against the host's on the simulated scans: the integer detector byte for byte, the float one within the
-#   firmware comparison's tolerances (the report says how many values are bit-identical).
+# - ctest aarch64_linux (tests/aarch64/run_aarch64.py): every unit test under qemu-aarch64 (test_nn_f32 checks the
+#   NEON float dense kernel, lib/src/nn/lidet_nn_f32_neon.c, against the portable one), then the aarch64 CLI
+#   against the host's on the simulated scans: the integer detector byte for byte; the float one (NEON kernel)
+#   byte for byte against this build's CLI where it has the x86 FMA kernel and the host CPU has FMA (the same
+#   chain of fused multiply-adds; skipped with a note on other CPUs), and within the firmware comparison's
+#   tolerances against the portable build (the report says how many values are bit-identical).
 # Without the cross compiler or qemu-aarch64 the test reports itself skipped with the reason. Not in the
 # sanitizer build (the same cross build as the normal one) nor in a build that is itself cross or aarch64.
 include(ExternalProject)
@@ -65,7 +68,7 @@ ExternalProject_Add(aarch64_linux
   CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/cmake/toolchains/aarch64-linux-gnu.cmake
              -DCMAKE_BUILD_TYPE=Release -DLIDET_BUILD_TESTS=ON -DLIDET_BUILD_CONSUMER_TESTS=OFF
              -DLIDET_BUILD_FIRMWARE=OFF -DLIDET_BUILD_AARCH64=OFF -DUNITY_ROOT=${UNITY_ROOT}
-             -DLIDET_CROSS_SYSROOT=${LIDET_AARCH64_SYSROOT}
+             -DLIDET_CROSS_SYSROOT=${LIDET_AARCH64_SYSROOT} -DLIDET_NN_NEON=${LIDET_NN_NEON}
              -DPython3_EXECUTABLE=${Python3_EXECUTABLE}
   BUILD_COMMAND ${a64_build_cmd}
   BUILD_ALWAYS ON
@@ -87,13 +90,20 @@ if(LIDET_NN_CLONES AND LIDET_NN_FMA AND CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|A
   # the library's numerics; LIDET_NN_CLONES and LIDET_NN_FMA keep lidet_opt.h's default 0: portable kernels
   target_compile_options(lidet_cli_portable PRIVATE -fno-math-errno -ffp-contract=off)
   set(a64_portable $<TARGET_FILE:lidet_cli_portable>)
+  # this build's CLI has the x86 FMA kernel: the aarch64 float dumps (NEON kernel) must equal its own byte for byte
+  if(LIDET_NN_NEON)
+    set(a64_fma --host-cli-fma $<TARGET_FILE:lidet_cli>)
+  else()
+    set(a64_fma "")
+  endif()
 else()
   set(a64_portable $<TARGET_FILE:lidet_cli>)
+  set(a64_fma "")
 endif()
 
 add_test(NAME aarch64_linux
          COMMAND ${Python3_EXECUTABLE} ${a64_run} --build ${a64_bdir} --tests ${a64_tests} --src ${PROJECT_SOURCE_DIR}
-                 --host-cli $<TARGET_FILE:lidet_cli> --host-cli-portable ${a64_portable}
+                 --host-cli $<TARGET_FILE:lidet_cli> --host-cli-portable ${a64_portable} ${a64_fma}
                  --qemu ${LIDET_AARCH64_QEMU} --sysroot ${LIDET_AARCH64_SYSROOT})
 set_tests_properties(aarch64_linux PROPERTIES SKIP_RETURN_CODE 77 SKIP_REGULAR_EXPRESSION "SKIPPED" TIMEOUT 900
                                               LABELS aarch64)

@@ -88,6 +88,24 @@ lidet_fw_host_ref(vlp16 fw_host_ref)
 lidet_fw_host_ref(hdl64 fw_host_ref_hdl64)
 lidet_fw_host_ref(vlp16 fw_host_ref_q FIXED)
 
+# ---- the bare-metal aarch64 image's own C library functions (ports/aarch64/virt_libc.c: no C library there), built
+# for the host under other names and compared with the host's (tests/aarch64/test_virt_libc.c) ----
+set(virt_libc_defs "")
+foreach(f expf logf sinf cosf sincosf tanf atan2f fmodf memcpy memmove memset memcmp strcmp)
+  list(APPEND virt_libc_defs ${f}=port_${f})
+endforeach()
+add_executable(test_virt_libc ${PROJECT_SOURCE_DIR}/tests/aarch64/test_virt_libc.c
+                              ${PROJECT_SOURCE_DIR}/ports/aarch64/virt_libc.c)
+set_target_properties(test_virt_libc PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
+set_source_files_properties(${PROJECT_SOURCE_DIR}/ports/aarch64/virt_libc.c PROPERTIES
+                            COMPILE_DEFINITIONS "${virt_libc_defs}" COMPILE_OPTIONS "-ffreestanding;-fno-builtin")
+target_compile_options(test_virt_libc PRIVATE -Wall -Wextra -Werror)
+if(LIDET_HAVE_LIBM)
+  target_link_libraries(test_virt_libc PRIVATE m)
+endif()
+add_test(NAME firmware_virt_libc COMMAND test_virt_libc)
+set_tests_properties(firmware_virt_libc PROPERTIES PASS_REGULAR_EXPRESSION "virt_libc: PASS")
+
 # ---- the images --------------------------------------------------------------------------------
 add_custom_target(firmware DEPENDS fw_host_ref fw_host_ref_hdl64 fw_host_ref_q)
 # image name | board | sensor | toolchain file | compiler | size tool. The HDL-64 (KITTI-like) images need ~4.5 MiB
@@ -106,7 +124,11 @@ set(fw_images
     # ... and cores with the DSP extension (their FPU unused): the int8 kernel with SMLAD
     "mps2-an386-q|mps2-an386|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed"
     "mps2-an500-q|mps2-an500|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed"
-    "virt-rv32imac-q|virt-rv32imac|vlp16|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size|fixed")
+    "virt-rv32imac-q|virt-rv32imac|vlp16|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size|fixed"
+    # 64-bit Arm bare metal (QEMU virt, Cortex-A72; ports/aarch64): the float image with the NEON dense kernel, the
+    # integer image compared bit for bit
+    "virt-aarch64|virt-aarch64|vlp16|aarch64-bare-metal|aarch64-linux-gnu-gcc|aarch64-linux-gnu-size"
+    "virt-aarch64-q|virt-aarch64|vlp16|aarch64-bare-metal|aarch64-linux-gnu-gcc|aarch64-linux-gnu-size|fixed")
 foreach(entry IN LISTS fw_images)
   string(REPLACE "|" ";" f "${entry}")
   list(GET f 0 image)

@@ -3,7 +3,7 @@
  * @file fw_port.h
  * @brief What a board gives the firmware application (fw_detect.c): a console, an instruction counter,
  *        exit, and the stack bounds for the high-water mark. Implemented by ports/cortex-m/mps2_port.c,
- *        ports/riscv/virt_port.c and, for the host reference program, fw_host_port.c.
+ *        ports/riscv/virt_port.c, ports/aarch64/virt_port.c and, for the host reference program, fw_host_port.c.
  */
 #ifndef LIDET_FW_PORT_H
 #define LIDET_FW_PORT_H

@@ -1,9 +1,9 @@
 /* SPDX-License-Identifier: MIT */
 /* What every bare-metal image does between reset and fw_main, whatever the core: copy .data from flash,
  * zero .bss, paint the stack; then fw_exit(fw_main()). The core's reset code (ports/cortex-m/mps2_startup.c,
- * ports/riscv/virt_start.S) sets the stack pointer (and the FPU, gp) first, then calls fw_start.
- * Symbols from the board's linker script (ports/cortex-m/mps2_an38x.ld / mps2_an500.ld with
- * mps2_sections.ld, ports/riscv/virt.ld). */
+ * ports/riscv/virt_start.S, ports/aarch64/virt_start.S) sets the stack pointer (and the FPU, gp; the MMU on
+ * aarch64) first, then calls fw_start. Symbols from the board's linker script (ports/cortex-m/mps2_an38x.ld /
+ * mps2_an500.ld with mps2_sections.ld, ports/riscv/virt.ld, ports/aarch64/virt.ld). */
 #include <stdint.h>
 
 #include "fw_port.h"

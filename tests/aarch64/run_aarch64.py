@@ -3,20 +3,26 @@
 """Run the aarch64 Linux cross build under qemu-aarch64 and compare its CLI with the host's (ctest aarch64_linux).
 
     python3 tests/aarch64/run_aarch64.py --build build/aarch64 --tests proj,proj_q,... --src . \\
-        --host-cli build/ports/host/lidet --host-cli-portable build/tests/lidet_cli_portable [--qemu qemu-aarch64]
+        --host-cli build/ports/host/lidet --host-cli-portable build/tests/lidet_cli_portable \\
+        [--host-cli-fma build/ports/host/lidet] [--qemu qemu-aarch64]
 
 The cross build (tests/aarch64.cmake: this repository configured with cmake/toolchains/aarch64-linux-gnu.cmake,
 targets lidet_unit_tests and lidet_cli) is made by the normal build. This script:
 1. runs every Unity test binary of tests/unit under qemu-aarch64 (-L the cross sysroot); each must exit 0;
 2. runs the aarch64 CLI and the host CLI on the simulated scans of tests/data (`lidet detect --dump`):
    - the integer detector (`--fixed`, and `--fixed --returns` with the rings): the dumps must be byte-identical;
-   - the float detector, against the host CLI built with the portable float dense kernel (LIDET_NN_FMA off; the
-     x86 FMA kernel differs in the last bits): per-point labels and ground flags, cluster records' counts and
-     outcomes, voxel bins, detections' classes, cluster ids and point counts identical; floats within the
-     tolerances of the firmware comparison (tools/firmware/run_fw.py: positions 1e-3 m, yaw 1e-3 rad, score
-     1e-4, energies 1e-4 relative), since glibc's expf/logf/sinf/cosf/atan2f are separate builds on the two
-     architectures; everything else is IEEE single precision in the same order (-ffp-contract=off). The report
-     says how many values were bit-identical.
+   - the float detector (the aarch64 build's float dense kernel is the NEON one, lib/src/nn/lidet_nn_f32_neon.c,
+     unless it was configured with LIDET_NN_NEON=OFF):
+     - against the host CLI with the x86 FMA kernel (--host-cli-fma; only where the host CPU has FMA, the
+       comparison is skipped with a note elsewhere): byte for byte, since both kernels compute each output by the
+       same chain of fused multiply-adds;
+     - against the host CLI built with the portable float dense kernel (LIDET_NN_FMA off), whose last bits differ:
+       per-point labels and ground flags, cluster records' counts and outcomes, voxel bins, detections' classes,
+       cluster ids and point counts identical; floats within the tolerances of the firmware comparison
+       (tools/firmware/run_fw.py: positions 1e-3 m, yaw 1e-3 rad, score 1e-4, energies 1e-4 relative), since
+       glibc's expf/logf/sinf/cosf/atan2f are separate builds on the two architectures; everything else is IEEE
+       single precision in the same order (-ffp-contract=off). The report says how many values were
+       bit-identical.
 Exit status: 0 pass, 1 fail, 77 skipped (qemu-aarch64 or the cross build missing: ctest reports it skipped).
 """
 import argparse
@@ -117,6 +123,22 @@ def compare_float(host, arm):
     return True, msg
 
 
+def host_has_fma(cpuinfo="/proc/cpuinfo"):
+    """-> (bool, why): whether the x86 FMA kernel runs on this host (lidet_nn_f32_x86.c's resolver: AVX-512F, or
+    AVX2 and FMA)."""
+    try:
+        with open(cpuinfo) as f:
+            flags = set()
+            for line in f:
+                if line.startswith("flags"):
+                    flags |= set(line.split(":", 1)[1].split())
+    except OSError as e:
+        return False, f"cannot read {cpuinfo}: {e}"
+    if "avx512f" in flags or {"avx2", "fma"} <= flags:
+        return True, ""
+    return False, "the host CPU has no FMA (neither AVX-512F nor AVX2 + FMA in /proc/cpuinfo)"
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--build", help="the aarch64 build folder")
@@ -124,6 +146,8 @@ def main(argv=None):
     ap.add_argument("--src", help="the repository")
     ap.add_argument("--host-cli", help="this build's lidet (the integer comparison)")
     ap.add_argument("--host-cli-portable", help="a host lidet with the portable float dense kernel")
+    ap.add_argument("--host-cli-fma", help="a host lidet with the x86 FMA float dense kernel (compared byte for byte "
+                    "where the host CPU has FMA)")
     ap.add_argument("--qemu", default="qemu-aarch64")
     ap.add_argument("--sysroot", default="/usr/aarch64-linux-gnu")
     ap.add_argument("--work", help="folder for the dumps (default: <build>/cli_compare)")
@@ -166,6 +190,7 @@ def main(argv=None):
 
     # 2. the CLI against the host's
     cli = os.path.join(a.build, "ports", "host", "lidet")
+    fma_ok, fma_why = host_has_fma()
     if a.host_cli and a.src:
         work = a.work or os.path.join(a.build, "cli_compare")
         os.makedirs(work, exist_ok=True)
@@ -176,15 +201,27 @@ def main(argv=None):
             data = os.path.join(a.src, "tests", "data", f"sim_{sensor}")
             scan = os.path.join(data, "velodyne", "000000.bin")
             ring = os.path.join(data, "ring", "000000.bin")
-            runs = [("fixed", ["--fixed"], a.host_cli)]
+            # (label, options, host CLI, aarch64 dump's name: the float one is run once for both comparisons)
+            runs = [("fixed", ["--fixed"], a.host_cli, "fixed")]
             if sensor == "vlp16" and os.path.exists(ring):
-                runs.append(("fixed-returns", ["--fixed", "--ring", ring, "--returns"], a.host_cli))
+                runs.append(("fixed-returns", ["--fixed", "--ring", ring, "--returns"], a.host_cli, "fixed-returns"))
+            if a.host_cli_fma:
+                if fma_ok:
+                    runs.append(("float-fma", [], a.host_cli_fma, "float"))
+                else:
+                    print(f"skip cli {sensor} detect (float) vs host (x86 FMA kernel), byte for byte: {fma_why}")
             if a.host_cli_portable:
-                runs.append(("float", [], a.host_cli_portable))
-            for label, opts, host in runs:
+                runs.append(("float", [], a.host_cli_portable, "float"))
+            arm_dumps = {}
+            for label, opts, host, arm_name in runs:
                 dumps = {}
-                for side, cmd in (("host", [host]), ("aarch64", emu + [cli])):
-                    path = os.path.join(work, f"{sensor}_{label}_{side}.bin")
+                sides = [("host", [host], label)]
+                if arm_name not in arm_dumps:
+                    sides.append(("aarch64", emu + [cli], arm_name))
+                else:
+                    dumps["aarch64"] = arm_dumps[arm_name]
+                for side, cmd, name in sides:
+                    path = os.path.join(work, f"{sensor}_{name}_{side}.bin")
                     rc, out, dt = run(cmd + ["detect", scan, "--sensor", sensor, *opts, "--dump", path],
                                       timeout=a.timeout)
                     if rc != 0 or not os.path.exists(path):
@@ -192,20 +229,29 @@ def main(argv=None):
                         break
                     with open(path, "rb") as f:
                         dumps[side] = f.read()
+                    if side == "aarch64":
+                        arm_dumps[arm_name] = dumps[side]
                 if len(dumps) < 2:
                     failed.append(f"cli {sensor} {label}")
                     continue
-                if label.startswith("fixed"):
+                if label != "float":
+                    # the integer detector, and the float one against the x86 FMA kernel: byte for byte
                     ok = dumps["host"] == dumps["aarch64"]
                     msg = (f"{len(dumps['host'])} bytes identical" if ok else
-                           f"dumps differ ({work}/{sensor}_{label}_{{host,aarch64}}.bin)")
+                           f"dumps differ ({work}/{sensor}_{label}_host.bin, {sensor}_{arm_name}_aarch64.bin)")
+                    if not ok and label == "float-fma":
+                        try:
+                            msg += " (" + compare_float(dumps["host"], dumps["aarch64"])[1] + ")"
+                        except ValueError as e:
+                            msg += f" ({e})"
                 else:
                     try:
                         ok, msg = compare_float(dumps["host"], dumps["aarch64"])
                     except ValueError as e:
                         ok, msg = False, str(e)
+                what = {"float": " (portable float kernel)", "float-fma": " (x86 FMA kernel), byte for byte"}
                 print(f"{'ok  ' if ok else 'FAIL'} cli {sensor} detect {' '.join(o for o in opts if '/' not in o) or '(float)'}"
-                      f" vs host{' (portable float kernel)' if label == 'float' else ''}: {msg}")
+                      f" vs host{what.get(label, '')}: {msg}")
                 if not ok:
                     failed.append(f"cli {sensor} {label}")
     print(f"aarch64_linux: {time.monotonic() - t_all:.1f} s")

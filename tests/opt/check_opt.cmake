@@ -76,7 +76,8 @@ set(bad_cases
     "LIDET_PNQ_WEIGHTS_PK=2|LIDET_PNQ_WEIGHTS_PK must be 0 or 1"
     "LIDET_NN_PK_ASM=2|LIDET_NN_PK_ASM must be 0 or 1"
     "LIDET_NN_CLONES=2|LIDET_NN_CLONES must be 0 or 1"
-    "LIDET_NN_FMA=2|LIDET_NN_FMA must be 0, or 1")
+    "LIDET_NN_FMA=2|LIDET_NN_FMA must be 0, or 1"
+    "LIDET_NN_NEON=2|LIDET_NN_NEON must be 0, or 1")
 foreach(entry IN LISTS bad_cases)
   string(REPLACE "|" ";" f "${entry}")
   list(GET f 0 def)
@@ -99,6 +100,13 @@ opt_case(OK ${CC} "${c_std}" ${kernel} -DLIDET_NN_SIMD=0 -DLIDET_NN_PK_ASM=0)
 opt_case("LIDET_NN_FMA must be 0, or 1 on an x86-64" ${CC} "${c_std}" ${probe} -ffreestanding -U__x86_64__
          -DLIDET_NN_FMA=1)
 opt_case(OK ${CC} "${c_std}" ${SRC}/lib/src/nn/lidet_nn_f32.c -ffreestanding -U__x86_64__ -DLIDET_NN_CLONES=1)
+# the NEON kernel exists only on aarch64: LIDET_NN_NEON=1 is refused on any other target (this compiler's, unless it
+# targets aarch64 itself), and the kernel's file is an empty unit there
+execute_process(COMMAND ${CC} -dumpmachine OUTPUT_VARIABLE cc_target ERROR_QUIET)
+if(NOT cc_target MATCHES "^(aarch64|arm64)")
+  opt_case("LIDET_NN_NEON must be 0, or 1 on an aarch64" ${CC} "${c_std}" ${probe} -DLIDET_NN_NEON=1)
+endif()
+opt_case(OK ${CC} "${c_std}" ${SRC}/lib/src/nn/lidet_nn_f32_neon.c)
 if(NOT "${CXX}" STREQUAL "")
   opt_case(OK ${CXX} "-x;c++;-std=c++11" ${probe})
   opt_case(OK ${CXX} "-x;c++;-std=c++11" ${probe} -DLIDET_MAX_ROWS=16 -DLIDET_MAX_COLS=1800 -DLIDET_Q_PIXEL_XYZ=0

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """Every compile-time option lives in lib/include/lidet/lidet_opt.h with its #error check, its CMake variable
-(cmake/lidet_options.cmake, or one of the three CMake options), a bad-value case in tests/opt/check_opt.cmake and
+(cmake/lidet_options.cmake, or one of the four CMake options), a bad-value case in tests/opt/check_opt.cmake and
 a row in docs/PORTING.md; no other file of lib/ defaults a LIDET_ macro, and no selector compares one with a bare
 number (kernel variants are named). Reads the sources only; no build needed."""
 import re
@@ -12,7 +12,7 @@ PORT_HOOKS = {"LIDET_ASSERT", "LIDET_ALIGN", "LIDET_WORKSPACE_SECTION", "LIDET_R
 # switches of the configuration mechanism itself, not options: the user header, the port header
 MECHANISM = {"LIDET_USER_CONFIG", "LIDET_PORT"}
 # CMake option() (ON/OFF) rather than a cache string: they also choose sources or per-source flags
-CMAKE_OPTIONS = {"LIDET_FIXED_POINT", "LIDET_NN_CLONES", "LIDET_NN_FMA"}
+CMAKE_OPTIONS = {"LIDET_FIXED_POINT", "LIDET_NN_CLONES", "LIDET_NN_FMA", "LIDET_NN_NEON"}
 
 IFNDEF = re.compile(r"^\s*#\s*ifndef\s+(LIDET_\w+)", re.M)
 DEFINED = re.compile(r"(?:#\s*ifdef\s+|defined\s*\(?\s*)(LIDET_\w+)")

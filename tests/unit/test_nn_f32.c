@@ -1,12 +1,14 @@
 /* SPDX-License-Identifier: MIT */
 /* The float dense kernel lidet__nn_dense_f32 as this build links it: the portable kernel (lib/src/nn/lidet_nn_f32.c),
- * or on x86-64 hosts with FMA the register-tiled one (lidet_nn_f32_x86.c, 8 x 32 / 4 x 16 tiles and their tails).
+ * on x86-64 hosts with FMA the register-tiled one (lidet_nn_f32_x86.c, 8 x 32 / 4 x 16 tiles and their tails), on
+ * aarch64 the NEON one (lidet_nn_f32_neon.c, 8 x 8 / 8 x 4 tiles, single rows by 16, 4, 2, 1).
  * On every shape (rows, inputs and outputs around the tile and vector widths) the result is within float rounding of
  * a double loop, and bit for bit one of the two stated arithmetics, the same one for every shape:
  *   portable: o = b, then o += x[i] w[i] + x[i+1] w[i+1] + x[i+2] w[i+2] + x[i+3] w[i+3] per four inputs (left to
  *             right), then o += x[i] w[i] for the rest;
  *   fused:    o = b, then o = fmaf(x[i], w[i], o) for every input in order.
- * ReLU maps NaN and -0 to +0 in both. */
+ * ReLU maps NaN and -0 to +0 in both. The kernels with fused multiply-adds (x86-64 FMA, aarch64 NEON) are also
+ * compared with the portable kernel itself on the layer shapes of the shipped models, and on NaN and -0 inputs. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -15,8 +17,8 @@
 #include "test_util.h"
 
 #define MAX_R 17
-#define MAX_I 70
-#define MAX_O 133
+#define MAX_I 200
+#define MAX_O 160
 
 static uint32_t g_rng = 987654321u;
 
@@ -152,7 +154,8 @@ void test_every_shape_one_arithmetic(void)
            g_kind == 1 ? "fused (FMA)" : "portable", (unsigned)g_decisive, (unsigned)g_shapes);
 }
 
-/* each variant of the FMA kernel this CPU can run, and the portable one, called directly */
+/* each variant of the FMA kernel this CPU can run (x86-64) or the NEON kernel (aarch64), and the portable one,
+ * called directly */
 void test_each_variant(void)
 {
 #if LIDET_NN_FMA
@@ -165,9 +168,159 @@ void test_each_variant(void)
         every_shape(lidet__nn_dense_f32_avx512, 1);
     else
         printf("no AVX-512 here: that variant not run\n");
+#elif LIDET_NN_NEON
+    every_shape(lidet__nn_dense_f32_portable, 0);
+    every_shape(lidet__nn_dense_f32, 1); /* the NEON kernel */
+    printf("aarch64: the portable and the NEON kernel run\n");
 #else
-    TEST_IGNORE_MESSAGE("no FMA kernels in this build (LIDET_NN_FMA off, or not an x86-64 GCC/clang host)");
+    TEST_IGNORE_MESSAGE("no FMA or NEON kernels in this build (LIDET_NN_FMA / LIDET_NN_NEON off, or another target)");
 #endif
+}
+
+/* the fused kernel of this build (x86-64 with FMA, aarch64 with NEON) and the portable one, called directly; NULL
+ * where the build has no fused kernel */
+static dense_fn_t *fused_kernel(void)
+{
+#if LIDET_NN_FMA
+    if (__builtin_cpu_supports("avx512f"))
+        return lidet__nn_dense_f32_avx512;
+    if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+        return lidet__nn_dense_f32_avx2fma;
+    return 0;
+#elif LIDET_NN_NEON
+    return lidet__nn_dense_f32;
+#else
+    return 0;
+#endif
+}
+
+#if LIDET_NN_FMA || LIDET_NN_NEON
+#define PORTABLE_KERNEL lidet__nn_dense_f32_portable
+#else
+#define PORTABLE_KERNEL lidet__nn_dense_f32
+#endif
+
+/* fn and the portable kernel on one shape: each output within the float tolerance of the other (twice the
+ * rounding bound of check_shape: each side within one bound of the exact sum) */
+static void near_portable(dense_fn_t *fn, uint32_t rows, uint32_t n_in, uint32_t n_out, int relu)
+{
+    static float in[MAX_R * MAX_I], w[MAX_I * MAX_O], b[MAX_O], got[MAX_R * MAX_O], ref[MAX_R * MAX_O];
+    uint32_t r, i, o, k;
+    for (k = 0; k < rows * n_in; ++k)
+        in[k] = next_f();
+    for (k = 0; k < n_in * n_out; ++k)
+        w[k] = next_f();
+    for (k = 0; k < n_out; ++k)
+        b[k] = next_f();
+    fn(in, rows, n_in, w, b, n_out, relu, got);
+    PORTABLE_KERNEL(in, rows, n_in, w, b, n_out, relu, ref);
+    for (r = 0; r < rows; ++r)
+    {
+        for (o = 0; o < n_out; ++o)
+        {
+            double mag = fabs((double)b[o]);
+            for (i = 0; i < n_in; ++i)
+                mag += fabs((double)in[r * n_in + i] * (double)w[i * n_out + o]);
+            TEST_ASSERT_TRUE_MESSAGE(fabs((double)got[r * n_out + o] - (double)ref[r * n_out + o]) <=
+                                         2.4e-7 * (double)(n_in + 2u) * mag + 1e-30,
+                                     "beyond the float tolerance of the portable kernel");
+        }
+    }
+}
+
+/* the layers of the shipped models (weights/: n_in x n_out of the classifiers and box nets of the hdl64, vlp16 and
+ * vlp16s families), at the row counts the forward pass uses (LIDET_PN_BLOCK 8, the heads' single vectors) and
+ * around them (a short last block, a band plus a row) */
+static const uint32_t k_model_layers[][2] = {
+    {3, 32},   {32, 64},  {64, 128}, {32, 32},  {160, 64},  {64, 3},   {99, 64}, {3, 48},  {48, 96},
+    {96, 160}, {195, 128}, {128, 64}, {64, 39},  {3, 3},     {3, 16},   {16, 32}, {32, 64}, {16, 16},
+    {80, 32},  {32, 3},   {51, 32},  {3, 24},   {24, 40},   {40, 64},  {83, 64}, {64, 32}, {32, 39}};
+static const uint32_t k_model_rows[] = {1, 3, 7, 8, 9, 16};
+
+void test_model_shapes(void)
+{
+    dense_fn_t *fused = fused_kernel();
+    uint32_t l, r;
+    g_shapes = g_decisive = 0;
+    for (l = 0; l < sizeof k_model_layers / sizeof k_model_layers[0]; ++l)
+    {
+        for (r = 0; r < sizeof k_model_rows / sizeof k_model_rows[0]; ++r)
+        {
+            const int relu = (int)((l + r) & 1u);
+            check_shape(lidet__nn_dense_f32, -1, k_model_rows[r], k_model_layers[l][0], k_model_layers[l][1], relu);
+            if (fused != 0)
+            {
+                check_shape(fused, 1, k_model_rows[r], k_model_layers[l][0], k_model_layers[l][1], relu);
+                near_portable(fused, k_model_rows[r], k_model_layers[l][0], k_model_layers[l][1], relu);
+                near_portable(fused, k_model_rows[r], k_model_layers[l][0], k_model_layers[l][1], !relu);
+            }
+        }
+    }
+    if (fused == 0)
+        printf("no fused kernel in this build or on this CPU: the model shapes checked on the portable kernel\n");
+}
+
+/* NaN and -0 through every tile and tail of the fused kernel: 10 rows (a band of 8, two single rows) x 31 outputs
+ * (band: 3 x 8, 4, 3 row by row; row: 16, 8 as 2 x 4, 2, 1) x 6 inputs (4 by lanes, 2 one by one). Weights
+ * positive, so a row of -0 inputs with a -0 bias sums to -0. Without the ReLU each output is the fused chain bit for
+ * bit (NaN for NaN); with it, +0 for NaN, -0 and every sum not above 0. */
+void test_fused_nan_and_negative_zero(void)
+{
+    enum
+    {
+        R = 10,
+        I = 6,
+        O = 31
+    };
+    static float in[R * I], w[I * O], b[O], out[R * O + 1];
+    dense_fn_t *fused = fused_kernel();
+    uint32_t r, i, o, k, n_neg0 = 0, n_nan = 0;
+    int relu;
+    if (fused == 0)
+        TEST_IGNORE_MESSAGE("no fused kernel in this build or on this CPU");
+    for (k = 0; k < R * I; ++k)
+        in[k] = next_f();
+    for (k = 0; k < I * O; ++k)
+        w[k] = fabsf(next_f()) + 0.125f;
+    for (k = 0; k < O; ++k)
+        b[k] = k % 3u == 0u ? -0.0f : next_f();
+    in[2u * I + 1u] = NAN; /* the band, an input taken by lane */
+    in[8u * I + 5u] = NAN; /* a single row, an input taken one by one */
+    for (i = 0; i < I; ++i)
+    {
+        in[5u * I + i] = -0.0f; /* -0 sums where the bias is -0: in the band, */
+        in[9u * I + i] = -0.0f; /* and in a single row */
+    }
+    for (relu = 0; relu <= 1; ++relu)
+    {
+        out[R * O] = 12345.0f;
+        fused(in, R, I, w, b, O, relu, out);
+        TEST_ASSERT_EQUAL_FLOAT(12345.0f, out[R * O]);
+        for (r = 0; r < R; ++r)
+        {
+            for (o = 0; o < O; ++o)
+            {
+                const float want = fused_one(in + r * I, I, w, O, o, b[o]), got = out[r * O + o];
+                if (relu)
+                {
+                    const float z = 0.0f, rw = want > 0.0f ? want : z;
+                    TEST_ASSERT_TRUE_MESSAGE(memcmp(&got, &rw, sizeof got) == 0, "ReLU: not v > 0 ? v : +0");
+                }
+                else if (want != want)
+                {
+                    TEST_ASSERT_TRUE_MESSAGE(got != got, "a NaN input did not give NaN");
+                    ++n_nan;
+                }
+                else
+                {
+                    TEST_ASSERT_TRUE_MESSAGE(memcmp(&got, &want, sizeof got) == 0, "not the fused chain bit for bit");
+                    n_neg0 += want == 0.0f && signbit(want);
+                }
+            }
+        }
+    }
+    TEST_ASSERT_TRUE(n_nan >= 2u * O);   /* rows 2 and 8 */
+    TEST_ASSERT_TRUE(n_neg0 >= 2u * 11u); /* rows 5 and 9 where the bias is -0 */
 }
 
 void test_relu_of_nan_and_negative_zero(void)
@@ -199,6 +352,8 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_every_shape_one_arithmetic);
     RUN_TEST(test_each_variant);
+    RUN_TEST(test_model_shapes);
+    RUN_TEST(test_fused_nan_and_negative_zero);
     RUN_TEST(test_relu_of_nan_and_negative_zero);
     return UNITY_END();
 }

@@ -20,6 +20,10 @@ BOARDS = [  # board, core, FPU, QEMU machine
     ("mps2-an386", "Cortex-M4F", "single precision", "mps2-an386"),
     ("mps2-an500", "Cortex-M7", "single precision (fpv5-sp-d16)", "mps2-an500"),
     ("virt-rv32imafc", "RV32IMAFC", "single precision (F)", "virt"),
+    # 64-bit Arm bare metal (ports/aarch64): the float dense layers in NEON (lib/src/nn/lidet_nn_f32_neon.c), and the
+    # same image with the portable kernel (built and run here: _aarch64_portable)
+    ("virt-aarch64", "Cortex-A72 (aarch64; NEON float dense kernel)", "double precision + NEON", "virt"),
+    ("virt-aarch64-portable", "Cortex-A72 (aarch64; portable float dense kernel)", "double precision + NEON", "virt"),
     ("mps2-an385", "Cortex-M3", "none (soft float)", "mps2-an385"),
     ("mps2-an385-m0plus", "Cortex-M0+ code (ARMv6-M) on the AN385's M3", "none (soft float)", "mps2-an385"),
     ("mps2-an500-hdl64", "Cortex-M7, **HDL-64 scan** (config/hdl64; detector in PSRAM)",
@@ -33,7 +37,10 @@ BOARDS = [  # board, core, FPU, QEMU machine
      "mps2-an386"),
     ("mps2-an500-q", "Cortex-M7, **integer build** (vlp16s; DSP: SMLAD int8 kernel)", "present, unused (no float at all)",
      "mps2-an500"),
+    ("virt-aarch64-q", "Cortex-A72 (aarch64), **integer build** (vlp16s)", "present, unused (NEON integer lanes only)",
+     "virt"),
 ]
+AARCH64_PORTABLE = "virt-aarch64-portable"
 STAGES = ["project", "ground", "cluster", "classify", "box", "post"]
 
 
@@ -64,6 +71,37 @@ def _cycle_estimates(build, reports):
     return out
 
 
+def _aarch64_portable(build, reports):
+    """The virt-aarch64 float image with the portable float dense kernel (-DLIDET_NN_NEON=OFF), for the ratio of the
+    NEON kernel to it: configured, built and run here next to the build's images (tests/firmware.cmake builds only
+    the NEON one, to keep CI short), compared with the host like them (tools/firmware/run_fw.py). -> its report, or
+    None (no aarch64 image in this build, or a step failed)."""
+    bdir = build / "firmware" / AARCH64_PORTABLE
+    rep = bdir / "report.json"
+    if os.environ.get("LIDET_BENCH_FW_REUSE") == "1":
+        return json.loads(rep.read_text()) if rep.exists() else None
+    ref = build / "tests" / "fw_host_ref"
+    if "virt-aarch64" not in reports or not ref.exists():
+        return None
+    steps = [
+        ["cmake", "-S", str(ROOT / "ports" / "firmware"), "-B", str(bdir),
+         f"-DCMAKE_TOOLCHAIN_FILE={ROOT / 'cmake' / 'toolchains' / 'aarch64-bare-metal.cmake'}",
+         "-DLIDET_FW_BOARD=virt-aarch64", "-DLIDET_FW_SENSOR=vlp16", "-DLIDET_NN_NEON=OFF",
+         f"-DPython3_EXECUTABLE={sys.executable}"],
+        ["cmake", "--build", str(bdir), "-j", "2"],
+        [sys.executable, str(ROOT / "tools" / "firmware" / "run_fw.py"), "--board", "virt-aarch64", "--label",
+         AARCH64_PORTABLE, "--elf", str(bdir / "lidet_fw.elf"), "--host-ref", str(ref), "--size",
+         "aarch64-linux-gnu-size", "--json", str(rep)],
+    ]
+    for cmd in steps:
+        p = subprocess.run(cmd, capture_output=True, text=True)
+        if p.returncode != 0:
+            print(f"bench_firmware: {AARCH64_PORTABLE}: {' '.join(cmd[:3])} failed:\n{p.stdout[-2000:]}{p.stderr[-2000:]}",
+                  file=sys.stderr)
+            break
+    return json.loads(rep.read_text()) if rep.exists() else None
+
+
 def run(args) -> str:
     build = pathlib.Path(args.build)
     if os.environ.get("LIDET_BENCH_FW_REUSE") == "1":  # the reports of the last ctest run, as they are
@@ -74,8 +112,11 @@ def run(args) -> str:
     reports = {}
     for board, *_ in BOARDS:
         f = build / "firmware" / board / "report.json"
-        if f.exists():
+        if f.exists() and board != AARCH64_PORTABLE:
             reports[board] = json.loads(f.read_text())
+    a64p = _aarch64_portable(build, reports)
+    if a64p:
+        reports[AARCH64_PORTABLE] = a64p
     out = ["## Firmware: Cortex-M and RISC-V under QEMU (issue 17)", ""]
     if not reports:
         out += ["Not measured in this run: no firmware image was built (the cross toolchains and QEMU come with "
@@ -92,7 +133,8 @@ def run(args) -> str:
         f"VLP-16 scan stored in flash (`{hdr.get('scan', '?')}`, {hdr.get('points', '?')} points with their ring "
         f"indices), capacities of `ports/firmware/config/vlp16/lidet_user_config.h` ({mem.get('max_rows')} x "
         f"{mem.get('max_cols')} pixels, {mem.get('max_points'):,} points, {mem.get('max_clusters')} clusters). "
-        "Images built with GCC 12 (Debian's gcc-arm-none-eabi + newlib-nano, gcc-riscv64-unknown-elf + picolibc), "
+        "Images built with GCC 12 (Debian's gcc-arm-none-eabi + newlib-nano, gcc-riscv64-unknown-elf + picolibc, "
+        "gcc-aarch64-linux-gnu without a C library: ports/aarch64/virt_libc.c), "
         "-O2, and run under QEMU 7.2 with `-icount`. Two runs per image: `default` (the configuration a user gets: "
         "gates and size checks on) and `open` (gates and "
         "size checks off, so that every classified proposal is boxed and compared). The rows marked **HDL-64 scan** "
@@ -132,6 +174,34 @@ def run(args) -> str:
             ins, d = reports[board]["insn"]["points"], reports[board]["insn"]["default"]
             out.append(f"| {core} | {fpu} | " + " | ".join(_m(ins[s]) for s in STAGES) +
                        f" | **{_m(ins['scan'])}** | +{_m(ins['scan'] - d['scan'])} |")
+    a64, a64p = reports.get("virt-aarch64"), reports.get(AARCH64_PORTABLE)
+    if a64 and a64p and "default" in a64.get("insn", {}) and "default" in a64p.get("insn", {}):
+        n, p = a64["insn"]["default"], a64p["insn"]["default"]
+        both = lambda m: m["classify"] + m["box"]
+        out += [
+            "",
+            "**aarch64: the NEON float dense kernel against the portable one.** `virt-aarch64` is QEMU's Arm `virt` "
+            "machine with a Cortex-A72 (the cores of a Raspberry Pi 4) run bare metal (ports/aarch64: EL1, MMU on, "
+            "console on the PL011, exit through semihosting); its float image runs the PointNets' dense layers with "
+            "the NEON kernel (lib/src/nn/lidet_nn_f32_neon.c: 8 x 8 register tiles of fused multiply-adds, the x86 "
+            "FMA kernel's arithmetic), the same image built with `-DLIDET_NN_NEON=OFF` the portable kernel (at -O2, "
+            "as every image: GCC 12 leaves its loops scalar there). Instructions per scan, run `default` (the stages "
+            "before the networks are the same code in both):",
+            "",
+            "| float dense kernel | classify | box net | classify + box net | **scan** |",
+            "|---|---|---|---|---|",
+            f"| NEON | {n['classify']:,} | {n['box']:,} | {both(n):,} | **{n['scan']:,}** |",
+            f"| portable | {p['classify']:,} | {p['box']:,} | {both(p):,} | **{p['scan']:,}** |",
+            f"| NEON / portable | {n['classify'] / p['classify']:.3f} | {n['box'] / p['box']:.3f} | "
+            f"{both(n) / both(p):.3f} | **{n['scan'] / p['scan']:.3f}** |",
+            "",
+            f"Run `open` (every classified proposal boxed): scan {a64['insn']['open']['scan']:,} against "
+            f"{a64p['insn']['open']['scan']:,} ({a64['insn']['open']['scan'] / a64p['insn']['open']['scan']:.3f}). "
+            "Instruction counts, not time: how many cycles each takes on a Cortex-A72 or A76 (dual-issue, out of order) "
+            "is not measured here. The NEON image's detections agree with the host's within the firmware comparison's "
+            "tolerances below (its kernel fuses the multiply-adds: the last bits differ from the portable "
+            "arithmetic); the portable image's only differ where libm's do.",
+        ]
     out += [
         "",
         "Run `open` (gates and size checks off) differs only in `post` (size check and NMS on "
@@ -139,7 +209,9 @@ def run(args) -> str:
         f"{reports.get('virt-rv32imafc-hdl64', any_rep)['stats']['open']['boxed']}): "
         + "; ".join(f"{core.split(' ')[0].rstrip(',')}{' HDL-64' if b.endswith('hdl64') else ''} "
                     f"{r['insn']['open']['post']:,}"
-                    for b, core, *_ in BOARDS if (r := reports.get(b)) and "open" in r.get("insn", {})) + " instructions.",
+                    for b, core, *_ in BOARDS
+                    if (r := reports.get(b)) and "open" in r.get("insn", {}) and b != AARCH64_PORTABLE)
+        + " instructions.",
         "",
         "**Size** (bytes, `size -A` of the linked image; the scan is test data and not part of a product's flash):",
         "",
@@ -222,12 +294,15 @@ def run(args) -> str:
         "relative (the tracker's values: 1e-3 m, m/s and rad, covariances 1e-4 relative, the integer images' exactly); "
         "counts, classes, cluster ids and point counts, the tracks' ids, states, hits and detection indices must be "
         "identical. Only expf/logf/sinf/cosf/"
-        "tanf/atan2f differ between glibc, newlib and picolibc (an ulp or two); every other operation is IEEE "
-        "single precision in the same order on both sides (-ffp-contract=off), soft float included.",
+        "tanf/atan2f differ between glibc, newlib, picolibc and the aarch64 image's own (an ulp or two); every other "
+        "operation is IEEE single precision in the same order on both sides (-ffp-contract=off), soft float included, "
+        "but for the aarch64 float image's dense layers (fused multiply-adds, above).",
         "",
         "**Method.** Instruction counts are QEMU's own (`-icount`: the virtual clock advances exactly 2^shift ns per "
         "executed guest instruction). RISC-V: `-icount shift=0` and the `minstret` CSR, which QEMU then derives from "
-        "that count. MPS2: `-icount shift=8` and CMSDK timer 0 at the board's 25 MHz (6.4 ticks per instruction, "
+        "that count. aarch64 (`virt-aarch64`): `-icount shift=0` and the PMU's event counter 0 on event 0x08, "
+        "INST_RETIRED, which QEMU counts from that same instruction count (32 bits, extended to 64 in software). "
+        "MPS2: `-icount shift=8` and CMSDK timer 0 at the board's 25 MHz (6.4 ticks per instruction, "
         "rounded back exactly; its wrap interrupt extends it to 64 bits). The detector's `clock` hook records 64-bit "
         "timestamps, from which the stages are rebuilt (their low 32 bits must equal the detector's own uint32 "
         "ticks). Every image first measures hand-written loops of known length (2n+1 instructions) and fails unless "
@@ -304,12 +379,17 @@ def run(args) -> str:
         "picolibc-riscv64-unknown-elf, qemu-system-misc and their dependencies, 36 packages) took 59 s wall on this "
         "machine after `apt-get update` (314 MB downloaded in 2 s, the rest unpacking; 2.4 GB on disk, most of it "
         "the C libraries' multilib variants: picolibc-riscv64 1.0 GB, newlib-arm 0.37 GB, gcc-arm 0.44 GB). "
-        f"Building the {len(reports)} images adds about a minute to `make build` on 2 cores; running them adds about "
+        f"Building the {len([b for b in reports if b != AARCH64_PORTABLE])} images adds about a minute to `make build` "
+        "on 2 cores; running them adds about "
         "a minute to ctest at -j2 (48 s of test time in all), most of it the two soft-float images"
         + (" (M0+ and M3: " + " and ".join(f"{sum(r['scan'] for r in reports[b]['insn'].values()) / 1e9:.1f} G"
                                           for b in ("mps2-an385-m0plus", "mps2-an385"))
            + " instructions under QEMU for their two runs; 14.6 s and 7.7 s in ctest at -j2)"
-           if all(b in reports for b in ("mps2-an385-m0plus", "mps2-an385")) else "") + ".",
+           if all(b in reports for b in ("mps2-an385-m0plus", "mps2-an385")) else "") + ". "
+        "The two virt-aarch64 images (float with the NEON kernel, integer) need no package beyond those of the aarch64 "
+        "Linux test (gcc-aarch64-linux-gnu) and qemu-system-arm (which has qemu-system-aarch64): 15 s and 7 s to "
+        "build at -j1, about 3 s each to run; the portable-kernel image of the comparison above is built by this "
+        "benchmark only (20 s).",
         "",
         "Commands: `make firmware` (builds every image; or `cmake --build build --target firmware`), "
         "`make firmware-run` (= `ctest --test-dir build -R '^firmware_' -V`: each image under QEMU, compared with "
@@ -317,7 +397,10 @@ def run(args) -> str:
         "`qemu-system-arm -M mps2-an386 -icount shift=8 -semihosting-config enable=on,target=native -display none "
         "-monitor none -serial null -kernel build/firmware/mps2-an386/lidet_fw.elf` or `qemu-system-riscv32 -M virt "
         "-bios none -icount shift=0 -display none -monitor none -serial stdio -kernel "
-        "build/firmware/virt-rv32imafc/lidet_fw.elf`.",
+        "build/firmware/virt-rv32imafc/lidet_fw.elf` or `qemu-system-aarch64 -M virt -cpu cortex-a72 -nic none "
+        "-semihosting-config enable=on,target=native -icount shift=0 -display none -monitor none -serial stdio "
+        "-kernel build/firmware/virt-aarch64/lidet_fw.elf`. This section: `.venv/bin/python tools/bench/run_bench.py "
+        "--only firmware --update` (it also builds and runs the portable-kernel aarch64 image).",
         "",
     ]
     return "\n".join(out) + "\n"

@@ -209,8 +209,8 @@
 #endif
 
 /* ==== per target: kernel forms and instruction-set choices (CMake: the cache variable of the same name,
- * except LIDET_NN_CLONES and LIDET_NN_FMA). The results are the same bits with every value (the FMA dense kernel
- * excepted); the defaults follow what the compiler says about the target. ================================= */
+ * except LIDET_NN_CLONES, LIDET_NN_FMA and LIDET_NN_NEON). The results are the same bits with every value (the
+ * FMA and NEON dense kernels excepted); the defaults follow what the compiler says about the target. ========= */
 
 /** 1 on hosts with SIMD (SSE2, AVX2, NEON): the integer kernels keep the loop forms a compiler vectorises (the
  *  inner loop over a row's columns or a layer's channels); 0 on cores without SIMD (Cortex-M, RV32), where the
@@ -337,6 +337,21 @@
  *  kernel's intrinsics exist only there). Default: with the clones (LIDET_NN_CLONES) on such a target. */
 #ifndef LIDET_NN_FMA
 #define LIDET_NN_FMA (LIDET_NN_CLONES && LIDET__TARGET_X86_64_GNU)
+#endif
+
+#if defined(__aarch64__) && defined(__ARM_NEON) && defined(__ARM_FEATURE_FMA)
+#define LIDET__TARGET_AARCH64_NEON 1
+#else
+#define LIDET__TARGET_AARCH64_NEON 0
+#endif
+
+/** aarch64 targets (Raspberry Pi 4/5, Jetson, any Armv8-A core): 1 makes the float dense kernel the register-tiled
+ *  NEON one with fused multiply-adds (lib/src/nn/lidet_nn_f32_neon.c: the x86-64 FMA kernel's arithmetic, so the
+ *  same bits as the x86-64 hosts with FMA; its last bits differ from the portable kernel's); 0 keeps the portable
+ *  kernel. CMake option LIDET_NN_NEON (ON) leaves the default; OFF defines it as 0. 0 or 1; 1 only on an aarch64
+ *  target with NEON and FMA (the kernel's intrinsics exist only there). Default: 1 on such a target, else 0. */
+#ifndef LIDET_NN_NEON
+#define LIDET_NN_NEON LIDET__TARGET_AARCH64_NEON
 #endif
 
 /* ==== port hooks (defaults; a port header overrides them) ============================================= */
@@ -474,6 +489,9 @@
 #endif
 #if LIDET_NN_FMA != 0 && (LIDET_NN_FMA != 1 || !LIDET__TARGET_X86_64_GNU)
 #error "LIDET_NN_FMA must be 0, or 1 on an x86-64 GCC/clang target"
+#endif
+#if LIDET_NN_NEON != 0 && (LIDET_NN_NEON != 1 || !LIDET__TARGET_AARCH64_NEON)
+#error "LIDET_NN_NEON must be 0, or 1 on an aarch64 target with NEON and FMA"
 #endif
 #if ((-1) >> 1) != -1
 #error "lidet needs arithmetic right shifts of negative integers (the fixed-point build relies on them)"

@@ -20,11 +20,14 @@
  * in and out may not alias. relu: 1 = max(0, .) after the bias. */
 void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t, const float *b,
                          uint32_t n_out, int relu, float *out);
-#if LIDET_NN_FMA
+#if LIDET_NN_FMA || LIDET_NN_NEON
 /* x86-64 hosts with FMA dispatch (internal/lidet_simd.h): lidet__nn_dense_f32 is lib/src/nn/lidet_nn_f32_x86.c's
- * register-tiled FMA kernel, this the portable one (lidet_nn_f32.c), its fallback on CPUs without FMA */
+ * register-tiled FMA kernel, this the portable one (lidet_nn_f32.c), its fallback on CPUs without FMA; aarch64
+ * (LIDET_NN_NEON): lidet__nn_dense_f32 is lidet_nn_f32_neon.c's NEON kernel, this the portable one, for the tests */
 void lidet__nn_dense_f32_portable(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t,
                                   const float *b, uint32_t n_out, int relu, float *out);
+#endif
+#if LIDET_NN_FMA
 /* its two variants, for the tests (call only on a CPU with AVX-512F, resp. AVX2 and FMA) */
 void lidet__nn_dense_f32_avx512(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t,
                                 const float *b, uint32_t n_out, int relu, float *out);

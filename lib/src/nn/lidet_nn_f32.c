@@ -17,7 +17,8 @@
  * contraction (-ffp-contract=off), each sum in the same order (the four trained models' outputs on 300 random
  * proposals each are bit-identical with a build without the clones). Measured (8 x 64 -> 128): 19 GMAC/s SSE2,
  * 39 GMAC/s AVX2; the whole classifier and box net 1.5x faster with AVX-512 than with AVX2 on a Zen 4 host.
- * Firmware builds never define it. Hosts with FMA run lidet_nn_f32_x86.c's kernel instead (LIDET_NN_FMA). */
+ * Firmware builds never define it. Hosts with FMA run lidet_nn_f32_x86.c's kernel instead (LIDET_NN_FMA), aarch64
+ * targets lidet_nn_f32_neon.c's (LIDET_NN_NEON). */
 
 /* rows r..r+3 of out += in rows * W over inputs [0, n_in), 4 inputs per pass */
 static inline void rows4(const float *x, uint32_t n_in, const float *w_t, uint32_t n_out, float *restrict o0)
@@ -89,8 +90,9 @@ static inline void rows1(const float *x, uint32_t n_in, const float *w_t, uint32
 }
 
 /* on x86-64 hosts with FMA dispatch (LIDET_NN_FMA) lidet_nn_f32_x86.c defines lidet__nn_dense_f32 and falls back
- * to this kernel, under another name, on CPUs without FMA */
-#if LIDET_NN_FMA
+ * to this kernel, under another name, on CPUs without FMA; on aarch64 (LIDET_NN_NEON) lidet_nn_f32_neon.c defines it,
+ * and this kernel stays under that name for the tests */
+#if LIDET_NN_FMA || LIDET_NN_NEON
 #define NN_DENSE_F32 lidet__nn_dense_f32_portable
 #else
 #define NN_DENSE_F32 lidet__nn_dense_f32
