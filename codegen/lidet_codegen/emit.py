@@ -148,7 +148,7 @@ def parse(model_proto, name: str | None = None) -> Model:
     meta = {p.key: p.value for p in model_proto.metadata_props}
     kind = meta.get("lidet.kind")
     if kind not in KIND:
-        raise EmitError(f"metadata lidet.kind is {kind!r}: expected 'classifier' or 'box' (export with lidet_codegen)")
+        raise EmitError(f"metadata lidet.kind is {kind!r}: expected 'classifier' or 'box' (export with lidet_tools.train.export)")
     if int(meta.get("lidet.format", -1)) != FORMAT_VERSION:
         raise EmitError(f"metadata lidet.format is {meta.get('lidet.format')!r}, this codegen writes {FORMAT_VERSION}")
     consts = {i.name: numpy_helper.to_array(i).astype(np.float64) for i in g.initializer}
@@ -552,7 +552,7 @@ def main(argv=None) -> int:
     import argparse
     ap = argparse.ArgumentParser(prog="python -m lidet_codegen emit",
                                  description="ONNX model -> weights/<name>.{c,h} (const arrays + a lidet_pn_model_t)")
-    ap.add_argument("onnx", nargs="+", help="model(s) exported by lidet_codegen export (or lidet's training)")
+    ap.add_argument("onnx", nargs="+", help="model(s) exported by lidet's training (lidet_tools.train.export)")
     ap.add_argument("--name", help="C name of the model (default: the file's stem); one model only")
     ap.add_argument("--out", default="weights", help="output folder (default weights/)")
     ap.add_argument("--index", action="store_true",
@@ -560,9 +560,8 @@ def main(argv=None) -> int:
                          "<name>_s8 model of every <name>.calib.json there)")
     ap.add_argument("--int8", action="store_true",
                     help="write the int8 model weights/<name>_s8.{c,h} instead (needs a calibration file)")
-    ap.add_argument("--calib", help="--int8: calibration file (python -m lidet_codegen calibrate); default "
+    ap.add_argument("--calib", help="--int8: calibration file (python -m lidet_tools.train.calibrate); default "
                                     "<name>.calib.json beside the model")
-    ap.add_argument("--no-report", action="store_true", help="--int8: skip the per-layer error against float")
     a = ap.parse_args(argv)
     if a.name and len(a.onnx) > 1:
         ap.error("--name needs exactly one model")
@@ -575,7 +574,7 @@ def main(argv=None) -> int:
                 cal = a.calib or pathlib.Path(p).with_suffix(".calib.json").as_posix()
                 cmd = (f"python -m lidet_codegen emit --int8 --calib {cal} {pathlib.Path(p).as_posix()} "
                        f"--out {pathlib.Path(a.out).as_posix()}")
-                quant.emit_s8(p, cal, a.out, cmd, report=not a.no_report)
+                quant.emit_s8(p, cal, a.out, cmd)
             return 0
         for p in a.onnx:
             name = a.name or pathlib.Path(p).stem

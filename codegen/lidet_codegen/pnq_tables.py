@@ -3,29 +3,20 @@
 
     python -m lidet_codegen pnqtables --out lib/src/pointnet/lidet_pointnet_q_tables.c
 
-Two 257-entry Q30 tables, computed in float64 and rounded half away from zero (qtables' rule):
+Two 257-entry Q30 tables, computed in float64 (lidet_ref.tables) and rounded half away from zero:
 - EXP2_NEG_Q30[j] = round(2^(-j / 256) * 2^30): 2^-f for the fraction f of a base-2 exponent, interpolated;
 - LOG2_Q30[j] = round(log2(1 + j / 256) * 2^30): log2 of a mantissa in [1, 2], interpolated.
-The numpy reference (lidet_codegen.ref.pointnet_q) uses these same functions, and a test regenerates the C
-file and compares it byte for byte.
+The functions are the numpy reference's (lidet_ref.tables, read by lidet_ref.pointnet_q), and a test
+regenerates the C file and compares it byte for byte.
 """
 from __future__ import annotations
 
 import argparse
-import math
 import pathlib
 
-from .qtables import _array, _round_half_away
+from lidet_ref.tables import STEPS, exp2_neg_q30, log2_q30
 
-STEPS = 256
-
-
-def exp2_neg_q30() -> list[int]:
-    return [_round_half_away(2.0 ** (-j / STEPS) * (1 << 30)) for j in range(STEPS + 1)]
-
-
-def log2_q30() -> list[int]:
-    return [_round_half_away(math.log2(1.0 + j / STEPS) * (1 << 30)) for j in range(STEPS + 1)]
+from .qtables import _array
 
 
 def render() -> str:

@@ -3,31 +3,18 @@
 
     python -m lidet_codegen qtables --out lib/src/qmath/lidet_qmath_tables.c
 
-Two tables, both computed here in float64 and rounded half away from zero to integers:
+Two tables, both computed in float64 (lidet_ref.tables) and rounded half away from zero to integers:
 - SIN_Q30[i] = round(sin(i * (pi/2) / 1024) * 2^30), i = 0..1024 (a quarter wave, end point included);
 - ATAN_BAM[i] = round(atan(i / 1024) * 2^32 / (2 pi)), i = 0..1024 (atan on [0, 1] in BAM32 units: 2^32 a turn).
-The numpy reference (lidet_codegen.ref.qmath) uses these same functions, and a test regenerates the C file and
-compares it byte for byte, so C and reference can never use different tables.
+The functions are the numpy reference's (lidet_ref.tables, read by lidet_ref.qmath), and a test regenerates the C
+file and compares it byte for byte, so C and reference can never use different tables.
 """
 from __future__ import annotations
 
 import argparse
-import math
 import pathlib
 
-N = 1024  # table steps per quarter wave / per unit of tan
-
-
-def _round_half_away(v: float) -> int:
-    return int(math.floor(v + 0.5)) if v >= 0 else -int(math.floor(-v + 0.5))
-
-
-def sin_q30() -> list[int]:
-    return [_round_half_away(math.sin(i * (math.pi / 2) / N) * (1 << 30)) for i in range(N + 1)]
-
-
-def atan_bam() -> list[int]:
-    return [_round_half_away(math.atan(i / N) * (1 << 32) / (2 * math.pi)) for i in range(N + 1)]
+from lidet_ref.tables import N, atan_bam, sin_q30
 
 
 def _array(name: str, ctype: str, values: list[int]) -> str:

@@ -1,8 +1,12 @@
 # SPDX-License-Identifier: MIT
 """int8 quantization of lidet's PointNets (docs/FIXED_POINT.md, section "int8 PointNets").
 
-    python -m lidet_codegen calibrate weights/cls_hdl64.onnx --sensor hdl64 --out weights/cls_hdl64.calib.json
+    python -m lidet_tools.train.calibrate weights/cls_hdl64.onnx --sensor hdl64 --out weights/cls_hdl64.calib.json
     python -m lidet_codegen emit --int8 --calib weights/cls_hdl64.calib.json weights/cls_hdl64.onnx --out weights
+
+This module is the quantization itself (ranges, refit and int8 layers from calibration proposals, the C emission);
+the calibration proposals come from scans read through the bindings and simulated scans, in lidet_tools
+(lidet_tools.train.calibrate), which writes the calibration file (<name>.calib.json) emit --int8 reads.
 
 Scheme (TFLite / CMSIS-NN conventions):
 - weights: per output channel, symmetric int8 in [-127, 127], scale max|w| / 127;
@@ -17,7 +21,7 @@ Scheme (TFLite / CMSIS-NN conventions):
 - the first shared layer takes the points as int16 millimetres (model frame) and the first PVLE layer the
   voxel bins as int16 integers: int16 x int8, no input quantization at all;
 - accumulators and biases int32; the input zero point is folded into the bias (b - zp_in sum w);
-- activation ranges: a percentile of |activation| on the calibration set (`calibrate`, `CALIB_RULE`): per
+- activation ranges: a percentile of |activation| on the calibration set (`activation_ranges`, `CALIB_RULE`): per
   channel, the 99.9th, in the classifiers; per tensor, the 99.95th, in the box nets;
 - the concatenation [g | onehot | p]: g and p keep their own scales, folded into the first head layer's weight
   columns before its per-channel quantization (one int8 input vector for the kernel), and the class one-hot is
@@ -35,7 +39,6 @@ import hashlib
 import json
 import math
 import pathlib
-import sys
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -300,10 +303,12 @@ def quantize(model: Model, calib: dict) -> QModel:
         classes=model.classes, source=source)
 
 
-# ---- calibration set --------------------------------------------------------------------------
+# ---- calibration: ranges and refit from proposals ------------------------------------------------
+# (the proposals themselves, from scans through the bindings and the simulator: lidet_tools.train.calibrate,
+# `python -m lidet_tools.train.calibrate`, which writes the calibration files emit --int8 reads)
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-CALIB_SEEDS = [0xCA11B000 + 7919 * k for k in range(4)]
+
 #: the range of a tensor (or of each of its channels): a percentile of |activation| over the calibration set (values
 #: above it saturate), per model kind: (granularity, percentile). Measured on the 4,240 test proposals of
 #: test_pointnet_q.py and 2,654 held-out ones (simulated run seed 4242: 6 HDL-64 + 16 VLP-16 scans, two resampling
@@ -327,44 +332,6 @@ def int_proposals(xyz, mean):
     m4 = np.rint(mean / 0.004).astype(np.int64)
     pix = np.rint((xyz + mean[:, None, :]) / 0.004).astype(np.int64)
     return np.clip(pix - m4[:, None, :], -32768, 32767), m4
-
-
-def scan_list(sensor: str, real_dir=None, scan_dirs=None):
-    """The calibration scans: the simulated sample of the sensor, then the real ones: with `scan_dirs` (folders
-    holding velodyne/*.bin: a user's own scans, `calibrate --scans`) every scan of those, else for hdl64 the KITTI
-    scans under real_dir/kitti/ less the validation frames of tools/lidet_tools/real/split.txt (the real-frame
-    figures are measured on those; nothing that builds a model reads them). kitti/unlabeled/ holds KITTI object
-    training scans under their own ids (000006-000010 are the files of training/), so the rule goes by id in both."""
-    scans = [ROOT / f"tests/data/sim_{sensor}/velodyne/000000.bin"]
-    if scan_dirs:
-        for d in scan_dirs:
-            found = sorted(pathlib.Path(d, "velodyne").glob("*.bin"))
-            if not found:
-                raise EmitError(f"{d}: no velodyne/*.bin scans to calibrate on")
-            scans += [f.resolve() for f in found]
-    elif real_dir is not None and sensor == "hdl64":
-        from lidet_tools.eval_real import read_split
-        val = {f for src, f, side in read_split() if src == "kitti" and side == "val"}
-        scans += [p for p in sorted(pathlib.Path(real_dir, "kitti").glob("*/velodyne/*.bin"))
-                  if p.stem not in val]
-    return scans
-
-
-def proposals_of(scans, sensor: str, seeds, n_points: int = 64):
-    """(xyz (B, N, 3) float32, mean (B, 3), voxel (B, 3) int16) of the scans (paths of KITTI .bin files, or
-    point arrays) with every resampling seed."""
-    from lidet_tools import kitti, native
-    xs, ms, vs = [], [], []
-    for path in scans:
-        pts = path if isinstance(path, np.ndarray) else kitti.read_bin(path)
-        g = native.ground(pts, sensor)
-        cl = native.cluster(pts, sensor, ground=g.mask_point, planes=g.planes)
-        for s in seeds:
-            p = native.proposals(cl, n_points=n_points, seed=s)
-            xs.append(p.xyz)
-            ms.append(p.mean)
-            vs.append(p.voxel)
-    return np.concatenate(xs), np.concatenate(ms), np.concatenate(vs)
 
 
 def _frame_f(xyz, mean):
@@ -394,28 +361,13 @@ def calib_classes(model, xyz, mean, vox, folder=None):
     return tr[-1].argmax(1)
 
 
-#: freshly simulated scans added to the calibration set (seed 3015: neither training, the benchmarks, the tests
-#: nor the refit use it): the shipped sample alone gave the VLP-16 232 proposals. With them and the refit on 32
-#: scans, the raw argmax agreement of tests/python/test_pointnet_q.py went from 98.66 to 98.84 % (docs/FIXED_POINT.md)
-CALIB_SIM_SEED, CALIB_N_SIM = 3015, 8
-
-
-def _sim_scans(sensor: str, seed: int, n: int, first: int = 0) -> list:
-    """The points of simulated scans first .. first + n - 1 of a run seed (calibration and refit sets)."""
-    from lidet_tools.sim.simulate import simulate_scan
-    return [simulate_scan(sensor, seed, k).points for k in range(first, first + n)]
-
-
-def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS, scan_dirs=None) -> dict:
-    """The calibration file of a model (scan_list: with scan_dirs, the user's scans replace the real KITTI ones; they
-    are recorded relative to the repository when inside it, else by absolute path)."""
-    onnx_path = pathlib.Path(onnx_path)
-    model = load(onnx_path, onnx_path.stem)
-    scans = scan_list(sensor, real_dir, scan_dirs)
-    sims = _sim_scans(sensor, CALIB_SIM_SEED, CALIB_N_SIM)
-    xyz, mean, vox = proposals_of(scans + sims, sensor, seeds, model.n_points)
-    cls = calib_classes(model, xyz, mean, vox, onnx_path.parent)
-    tr = float_trace(model, float_inputs(xyz, mean), vox.astype(np.float64), cls)
+def activation_ranges(model: Model, xyz, mean, vox, folder=None) -> dict:
+    """The ranges part of a calibration file: every layer's activation range (CALIB_RULE: per channel or per tensor,
+    a percentile of |activation|) over calibration proposals (xyz (B, N, 3) centred points, mean (B, 3) metres,
+    vox (B, 3) PVLE bins, as lidet_proposal_t holds them; a box net fed the classes of the classifier in `folder`,
+    calib_classes). Returns {"percentile", "ranges_per", "ranges"}."""
+    cls = calib_classes(model, xyz, mean, vox, folder)
+    tr = float_trace(model, float_inputs(xyz, mean), np.asarray(vox).astype(np.float64), cls)
     names = layer_names(model)
     per, pct = CALIB_RULE[model.kind]
     if per == "channel":
@@ -423,43 +375,32 @@ def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS, scan_dir
                   for nm, t in zip(names, tr)}
     else:
         ranges = {nm: float(np.percentile(np.abs(t), pct)) for nm, t in zip(names, tr)}
-    def rel(p):
-        if p.is_relative_to(ROOT):
-            return p.relative_to(ROOT).as_posix()
-        return p.as_posix() if scan_dirs else "real/" + "/".join(p.parts[-3:])
-
-    return {"model": onnx_path.stem, "onnx_sha256": hashlib.sha256(onnx_path.read_bytes()).hexdigest(),
-            "sensor": sensor, "seeds": [int(s) for s in seeds], "percentile": pct, "ranges_per": per,
-            "scans": [rel(p) for p in scans] + [f"sim/{CALIB_SIM_SEED}/{k}" for k in range(CALIB_N_SIM)],
-            "n_proposals": int(len(xyz)), "n_points": int(model.n_points), "ranges": ranges}
+    return {"percentile": pct, "ranges_per": per, "ranges": ranges}
 
 
-#: the classifier's last-layer refit (`calibrate --refit`): fresh simulated scans (seed 3016: neither training,
-#: the benchmarks nor the tests use it) added to the calibration proposals, and the ridge weight toward the float
-#: layer. Measured on the test proposals of tests/python/test_pointnet_q.py (docs/FIXED_POINT.md).
-REFIT_SIM_SEED, REFIT_N_SIM, REFIT_MU = 3016, 32, 0.1
+#: the ridge weight toward the float layer of the classifier's last-layer refit (head_refit). Measured on the test
+#: proposals of tests/python/test_pointnet_q.py (docs/FIXED_POINT.md).
+REFIT_MU = 0.1
 
 
-def refit(onnx_path, calib: dict, real_dir=None) -> dict:
-    """The calibration file with `head_refit`: the classifier's last layer (linear, Q16 logits) refitted by
-    ridge regression so that, on the int8 network's own dequantized inputs, it reproduces the float network's
-    logits: minimises mean |x W^T + b - logits_float|^2 + mu |(W, b) - (W0, b0)|^2 over the calibration
-    proposals plus REFIT_N_SIM fresh simulated scans. It absorbs the systematic part of the error the int8
-    activations leave in the logits; the layer is then quantized as any other (per-channel int8 weights)."""
-    from .ref import pointnet_q as RQ
-    onnx_path = pathlib.Path(onnx_path)
-    model = load(onnx_path, onnx_path.stem)
+def refit_check(model: Model, name) -> None:
+    """Raises EmitError unless `model` is a classifier whose last layer head_refit can refit."""
     if model.kind != "classifier" or len(model.stages[0].head) < 2:
-        raise EmitError(f"{onnx_path}: refit needs a classifier with two head layers or more")
-    if calib.get("onnx_sha256") != hashlib.sha256(onnx_path.read_bytes()).hexdigest():
-        raise EmitError(f"{onnx_path}: the calibration file is of another model: recalibrate")
+        raise EmitError(f"{name}: refit needs a classifier with two head layers or more")
+
+
+def head_refit(model: Model, calib: dict, xyz, mean, vox, mu: float = REFIT_MU) -> dict:
+    """The classifier's last layer (linear, Q16 logits) refitted by ridge regression so that, on the int8 network's
+    own dequantized inputs, it reproduces the float network's logits: minimises mean |x W^T + b - logits_float|^2
+    + mu |(W, b) - (W0, b0)|^2 over the proposals given (xyz, mean, vox as activation_ranges takes them), the int8
+    network quantized with the ranges of `calib` (its head_refit ignored). It absorbs the systematic part of the
+    error the int8 activations leave in the logits; the layer is then quantized as any other (per-channel int8
+    weights). Returns {"mu", "n_proposals", "w", "b"}: a calibration file's head_refit, less where the proposals
+    came from (lidet_tools.train.calibrate.refit adds that)."""
+    from lidet_ref import pointnet_q as RQ
+    refit_check(model, model.name)
     base = {k: v for k, v in calib.items() if k != "head_refit"}
-    data = calib_set(base, real_dir)
-    if data is None:
-        raise EmitError("refit: the calibration scans are not available")
-    sims = _sim_scans(calib["sensor"], REFIT_SIM_SEED, REFIT_N_SIM)
-    extra = proposals_of(sims, calib["sensor"], calib["seeds"], model.n_points)
-    xyz, mean, vox = (np.concatenate([a, b]) for a, b in zip(data, extra))
+    vox = np.asarray(vox)
     qm = quantize(model, base)
     q4, m4 = int_proposals(xyz, mean)
     c, s = RQ.frame_cs(m4)
@@ -472,37 +413,14 @@ def refit(onnx_path, calib: dict, real_dir=None) -> dict:
     xa = np.hstack([x, np.ones((n, 1))])
     last = model.stages[0].head[-1]
     w0 = np.hstack([last.w, last.b[:, None]])
-    w = np.linalg.solve(xa.T @ xa + n * REFIT_MU * np.eye(d + 1), xa.T @ y + n * REFIT_MU * w0.T).T
-    return dict(base, head_refit={"sim_seed": REFIT_SIM_SEED, "n_sim": REFIT_N_SIM, "mu": REFIT_MU,
-                                  "n_proposals": int(n), "w": w[:, :d].tolist(), "b": w[:, d].tolist()})
-
-
-def calib_set(calib: dict, real_dir=None):
-    """Regenerate the calibration proposals a calibration file names (None when a scan is missing), with the
-    model's points per proposal (`n_points`; 64 in files written before it was recorded)."""
-    paths, sims = [], []
-    for s in calib["scans"]:
-        if s.startswith("sim/"):  # a freshly simulated scan: sim/<seed>/<index>
-            _, seed, k = s.split("/")
-            sims.append((int(seed), int(k)))
-        elif s.startswith("real/"):
-            if real_dir is None:
-                return None
-            paths.append(pathlib.Path(real_dir, "kitti", *s.split("/")[1:]))
-        elif pathlib.PurePosixPath(s).is_absolute():  # a user's scan outside the repository (calibrate --scans)
-            paths.append(pathlib.Path(s))
-        else:
-            paths.append(ROOT / s)
-    if not all(p.exists() for p in paths):
-        return None
-    sim_pts = [p for seed, k in sims for p in _sim_scans(calib["sensor"], seed, 1, first=k)]
-    return proposals_of(paths + sim_pts, calib["sensor"], calib["seeds"], int(calib.get("n_points", 64)))
+    w = np.linalg.solve(xa.T @ xa + n * mu * np.eye(d + 1), xa.T @ y + n * mu * w0.T).T
+    return {"mu": mu, "n_proposals": int(n), "w": w[:, :d].tolist(), "b": w[:, d].tolist()}
 
 
 def layer_errors(qm: QModel, xyz, mean, vox, folder=None):
     """[(layer, max abs error, mean abs error)] of every layer's dequantized output against float (a box net fed
     the classes of the classifier in `folder`, as calib_classes)."""
-    from .ref import pointnet_q as RQ
+    from lidet_ref import pointnet_q as RQ
     model = qm.source
     cls = calib_classes(model, xyz, mean, vox, folder)
     ft = float_trace(model, float_inputs(xyz, mean), vox.astype(np.float64), cls)
@@ -632,7 +550,9 @@ def emit_c_s8(qm: QModel, onnx_path, calib_path, cmd: str, src_sha: str, calib_s
     return "".join(h), "".join(c)
 
 
-def emit_s8(onnx_path, calib_path, out_dir, cmd: str, report: bool = True, real_dir=None):
+def emit_s8(onnx_path, calib_path, out_dir, cmd: str):
+    """The int8 model <name>_s8.{c,h} of an ONNX file and its calibration file, in out_dir. Returns the QModel.
+    (Each layer's error against float on the calibration proposals: python -m lidet_tools.train.calibrate --report.)"""
     onnx_path, calib_path = pathlib.Path(onnx_path), pathlib.Path(calib_path)
     calib = json.loads(calib_path.read_text())
     name = onnx_path.stem
@@ -647,63 +567,4 @@ def emit_s8(onnx_path, calib_path, out_dir, cmd: str, report: bool = True, real_
     (out_dir / f"{qm.name}.c").write_text(c)
     print(f"{onnx_path} + {calib_path} -> {out_dir / (qm.name + '.c')}: int8 {qm.kind}, "
           f"{qm.flash_bytes()} B of weights, scratch {qm.scratch_bytes()} B")
-    if report:
-        if real_dir is None and (ROOT.parent / "shared" / "data" / "real" / "kitti").exists():
-            real_dir = ROOT.parent / "shared" / "data" / "real"
-        data = calib_set(calib, real_dir)
-        if data is None:
-            print("  per-layer error: skipped (calibration scans not available)")
-        else:
-            for nm, mx, mn in layer_errors(qm, *data, folder=onnx_path.parent):
-                print(f"  {nm:12s} max abs error {mx:.5f}  mean abs error {mn:.5f}")
     return qm
-
-
-def _model_sensor(path) -> str:
-    """The sensor a model was trained for: its ONNX metadata lidet.sensor (the family vlp16s says vlp16), else the
-    name's suffix (cls_hdl64 -> hdl64)."""
-    import onnx
-    meta = {m.key: m.value for m in onnx.load(str(path), load_external_data=False).metadata_props}
-    return meta.get("lidet.sensor") or pathlib.Path(path).stem.split("_")[-1]
-
-
-def main(argv=None) -> int:
-    """python -m lidet_codegen calibrate MODEL.onnx --sensor S --out FILE"""
-    import argparse
-    ap = argparse.ArgumentParser(prog="python -m lidet_codegen calibrate",
-                                 description="per-tensor activation ranges of a model on proposals of the simulated "
-                                             "sample scan (fixed resampling seeds) and the real scans when present")
-    ap.add_argument("onnx", nargs="+")
-    ap.add_argument("--sensor", help="hdl64 or vlp16 (default: the model's lidet.sensor metadata, else the model "
-                                     "name's suffix)")
-    ap.add_argument("--real", default=str(ROOT.parent / "shared" / "data" / "real"),
-                    help="real scans folder (used when present; KITTI HDL-64 scans for hdl64 models)")
-    ap.add_argument("--scans", action="append", default=None, metavar="DIR",
-                    help="calibrate on the scans DIR/velodyne/*.bin (repeatable; e.g. the scans a model was fine-tuned "
-                         "on) instead of the real KITTI scans of --real")
-    ap.add_argument("--out", help="calibration file (default: beside the model, <name>.calib.json)")
-    ap.add_argument("--refit", action="store_true",
-                    help="classifiers: keep the calibration file's ranges and add the refitted last layer "
-                         "(head_refit; lidet_codegen.quant.refit)")
-    a = ap.parse_args(argv)
-    real = pathlib.Path(a.real) if (pathlib.Path(a.real) / "kitti").exists() else None
-    for d in a.scans or []:
-        if not any(pathlib.Path(d, "velodyne").glob("*.bin")):
-            ap.error(f"--scans {d}: no velodyne/*.bin scans there")
-    for p in a.onnx:
-        p = pathlib.Path(p)
-        sensor = a.sensor or _model_sensor(p)
-        out = pathlib.Path(a.out) if a.out and len(a.onnx) == 1 else p.with_suffix(".calib.json")
-        if a.refit:
-            cal = refit(p, json.loads(p.with_suffix(".calib.json").read_text()), real)
-            print(f"{p} -> {out}: last layer refitted on {cal['head_refit']['n_proposals']} proposals")
-        else:
-            cal = calibrate(p, sensor, real, scan_dirs=a.scans)
-            print(f"{p} -> {out}: {cal['n_proposals']} proposals of {len(cal['scans'])} scans x "
-                  f"{len(cal['seeds'])} seeds")
-        out.write_text(json.dumps(cal, indent=1, sort_keys=True) + "\n")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

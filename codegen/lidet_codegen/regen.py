@@ -13,9 +13,10 @@ tests/python/test_pointnet.py, replays):
 
 No data and no training: deterministic, and the folder's path as given is what the files' `cmd:` lines say (run it
 from the repository root with `weights` for the committed files). The calibration files come first: `make weights`
-(lidet_tools.train.weights) writes them with `python -m lidet_codegen calibrate` (and `calibrate --refit`) for the
-models it trained, then calls emit_all. A calibration file of another ONNX file than the one beside it is refused
-(`emit --int8`: "recalibrate").
+(lidet_tools.train.weights) writes them with `python -m lidet_tools.train.calibrate` (and `calibrate --refit`) for
+the models it trained, then calls emit_all (each int8 layer's error against float on the calibration proposals:
+`python -m lidet_tools.train.calibrate --report`). A calibration file of another ONNX file than the one beside it is
+refused (`emit --int8`: "recalibrate").
 """
 from __future__ import annotations
 
@@ -37,16 +38,14 @@ def commands(folder="weights") -> list[list[str]]:
     return out
 
 
-def emit_all(folder="weights", report: bool = False) -> list[list[str]]:
-    """Run commands(folder) (the int8 ones with --no-report unless `report`: the per-layer error against float is
-    printed only, the files are the same). Raises RuntimeError on the first that fails; returns the commands."""
+def emit_all(folder="weights") -> list[list[str]]:
+    """Run commands(folder). Raises RuntimeError on the first that fails; returns the commands."""
     from . import emit as E
     cmds = commands(folder)
     if not cmds:
         raise RuntimeError(f"{folder}: no *.onnx models")
     for argv in cmds:
-        extra = ["--no-report"] if argv[0] == "--int8" and not report else []
-        rc = E.main(argv + extra)
+        rc = E.main(argv)
         if rc:
             raise RuntimeError(f"python -m lidet_codegen emit {' '.join(argv)}: failed ({rc})")
     return cmds
@@ -57,11 +56,9 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m lidet_codegen regen", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("folder", nargs="?", default="weights", help="weights folder (default weights)")
-    ap.add_argument("--report", action="store_true",
-                    help="int8: print each layer's error against float on the calibration set (needs its scans)")
     a = ap.parse_args(argv)
     try:
-        emit_all(a.folder, a.report)
+        emit_all(a.folder)
     except RuntimeError as e:
         print(f"lidet_codegen regen: error: {e}", file=sys.stderr)
         return 2

@@ -20,7 +20,7 @@ static int32_t round_i32(double v)
 }
 
 /* a point (mm) and its ring as the sensor reports it (lidet_return_t), the rule of tools/firmware/scan_to_c.py
- * and lidet_codegen.ref.proj_q.returns_of_points: range = round(sqrt(x^2 + y^2 + z^2)) (exact, halves up: the
+ * and lidet_ref.proj_q.returns_of_points: range = round(sqrt(x^2 + y^2 + z^2)) (exact, halves up: the
  * float root corrected in integers), azimuth = round(atan2(y, x) 2^16 / 2 pi) mod 2^16 */
 static lidet_return_t return_of_point(const int32_t *p, uint16_t ring)
 {

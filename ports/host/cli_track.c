@@ -2,7 +2,7 @@
 /* `lidet track`: the detector and the tracker (docs/TRACKING.md) over a sequence of scans. Each scan goes through
  * the detector exactly as `lidet detect` runs it (float, or the integer detector with --fixed: cli_detect.c,
  * cli_detect_q.c), then through lidet_tracker_update (--fixed: lidet_tracker_q_update, with dt in ms and the ego
- * motion in mm and BAM32, converted here once, rounded half away from zero as lidet_codegen.ref.track_q does).
+ * motion in mm and BAM32, converted here once, rounded half away from zero as lidet_ref.track_q does).
  * Outputs: track lines (stdout, --out DIR/<stem>.txt), lidet-eval track's prediction files (--out
  * DIR/tracks/<stem>.txt), KITTI tracking labels in the camera frame (--out DIR/label_02.txt, with a calibration),
  * one JSON object per scan (--json) and a bird's-eye view after the last scan with each track's tail, box and
@@ -751,7 +751,7 @@ static void json_scan(FILE *f, uint32_t frame, const char *scan, uint32_t n_poin
     fprintf(f, "]}\n");
 }
 
-/* the integer tracker's tracks in SI units (lidet_codegen.ref.track_q.tracks_to_si) */
+/* the integer tracker's tracks in SI units (lidet_ref.track_q.tracks_to_si) */
 static void tracks_from_q(const lidet_track_q_t *q, uint32_t n, lidet_track_t *out)
 {
     uint32_t i;

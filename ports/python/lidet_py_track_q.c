@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Flat C entry points over the integer tracker (lidet_track_q.h) for the Python bindings
  * (tools/lidet_tools/track/native_q.py); tests/python/test_track_q.py compares them with
- * codegen/lidet_codegen/ref/track_q.py. Host only: each tracker is allocated on the heap. */
+ * codegen/lidet_ref/track_q.py. Host only: each tracker is allocated on the heap. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -15,9 +15,9 @@
 #define LIDET_PY_API __attribute__((visibility("default")))
 #endif
 
-/* the flat configuration: ref/track_q.py CFG_FIELDS */
+/* the flat configuration: lidet_ref/track_q.py CFG_FIELDS */
 #define CFG_LEN 25u
-/* one output track: ref/track_q.py TRACK_Q_FIELDS */
+/* one output track: lidet_ref/track_q.py TRACK_Q_FIELDS */
 #define TRACK_LEN 20u
 
 /* int64 -> int32 / uint32, saturated (an out-of-range value stays out of range for init's checks) */
@@ -171,7 +171,7 @@ LIDET_PY_API int lidet_py_track_q_update(void *tp, const int32_t *det, uint32_t 
     return st;
 }
 
-/* up to cap tracks as rows of TRACK_LEN int64 (ref/track_q.py TRACK_Q_FIELDS); returns the count */
+/* up to cap tracks as rows of TRACK_LEN int64 (lidet_ref/track_q.py TRACK_Q_FIELDS); returns the count */
 LIDET_PY_API int lidet_py_track_q_tracks(const void *tp, uint32_t cap, uint32_t flags, int64_t *out)
 {
     lidet_track_q_t *tr;

@@ -14,14 +14,14 @@ export PYTHONPATH=tools:codegen${PYTHONPATH:+:$PYTHONPATH}
 out=tests/fuzz/models
 mkdir -p "$out"
 for n in 16 64; do
-  "$PY" -m lidet_codegen export --untrained classifier --seed 11 --n-points $n \
+  "$PY" -m lidet_tools.train.export --untrained classifier --seed 11 --n-points $n \
     --cfg '{"point": [8, 16], "pvle": [4], "head": [8]}' --out "$out/fuzz_cls$n.onnx"
-  "$PY" -m lidet_codegen export --untrained box --seed 12 --n-points $n \
+  "$PY" -m lidet_tools.train.export --untrained box --seed 12 --n-points $n \
     --cfg '{"tnet_point": [8], "tnet_head": [8], "point": [8, 16], "head": [8], "pvle": [4]}' \
     --out "$out/fuzz_box$n.onnx"
 done
 for m in fuzz_cls16 fuzz_box16 fuzz_cls64 fuzz_box64; do
   "$PY" -m lidet_codegen emit --out "$out" "$out/$m.onnx"
-  "$PY" -m lidet_codegen calibrate --sensor vlp16 --real none "$out/$m.onnx"
-  "$PY" -m lidet_codegen emit --int8 --no-report --out "$out" "$out/$m.onnx"
+  "$PY" -m lidet_tools.train.calibrate --sensor vlp16 --real none "$out/$m.onnx"
+  "$PY" -m lidet_codegen emit --int8 --out "$out" "$out/$m.onnx"
 done

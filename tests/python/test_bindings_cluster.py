@@ -1,9 +1,9 @@
 # SPDX-License-Identifier: MIT
-"""Clustering + proposals through the bindings against the numpy reference (codegen ref/cluster.py)."""
+"""Clustering + proposals through the bindings against the numpy reference (codegen/lidet_ref/cluster.py)."""
 import numpy as np
 import pytest
 
-from lidet_codegen.ref import cluster as ref
+from lidet_ref import cluster as ref
 from lidet_tools import native
 
 GROUND = [40, 44, 48, 49, 60, 72]

@@ -6,7 +6,7 @@ import re
 import numpy as np
 import pytest
 
-from lidet_codegen.ref import cluster as ref
+from lidet_ref import cluster as ref
 from lidet_tools import native
 
 pytestmark = pytest.mark.usefixtures("need_lib")

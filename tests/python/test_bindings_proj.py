@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from lidet_codegen.ref.proj import project_ref
+from lidet_ref.proj import project_ref
 from lidet_tools import kitti, native, sensors
 
 

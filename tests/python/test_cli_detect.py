@@ -225,7 +225,7 @@ def test_returns_option_feeds_the_sensors_returns(cli, tmp_path):
     """--fixed --ring R --returns: the scan converted to the sensor's returns (range, azimuth, ring) and fed to
     lidet_detector_q_run_returns, the integer firmware's way in; the detections are those of the bindings on the
     returns of ref.proj_q.returns_of_points. Without --fixed, or without the rings, the option is refused."""
-    from lidet_codegen.ref import proj_q
+    from lidet_ref import proj_q
     from lidet_tools import native_q
     sim = ROOT / "tests" / "data" / "sim_vlp16"
     scan, ring = sim / "velodyne" / "000000.bin", sim / "ring" / "000000.bin"

@@ -298,7 +298,7 @@ def test_track_fixed_is_the_integer_pipeline(pcli, cap):
     the integer tracker with dt from the payloads' timestamps (0.199 s a rotation across the hour's wrap, not the
     capture's 1 ms stamps nor the default 10 Hz), no ego motion: the Python pipeline's lines; the scene moving
     +0.4 m a rotation gives about +2 m/s."""
-    from lidet_codegen.ref import track_q as ref
+    from lidet_ref import track_q as ref
     from lidet_tools import native_q
     try:
         from lidet_tools.track.native_q import TrackerQ

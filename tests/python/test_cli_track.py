@@ -208,7 +208,7 @@ def _tracker_q():
 def test_fixed_is_the_integer_tracker(cli, need_lib, request, which):
     """--fixed: the integer detector's detections (native_q.detect_q, as lidet detect --fixed) into the integer
     tracker with dt in ms and the ego motion in mm / BAM32 (ref.track_q.quantise_dt, quantise_ego)."""
-    from lidet_codegen.ref import track_q as ref
+    from lidet_ref import track_q as ref
     from lidet_tools import native_q
     seq = request.getfixturevalue(which)
     sensor = "hdl64" if which == "turning" else "vlp16"

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """The integer clustering and proposals (lidet_cluster_q.h): bit for bit against the numpy reference
-(codegen/lidet_codegen/ref/cluster_q.py) and in agreement with the float stage on the same compact images
+(codegen/lidet_ref/cluster_q.py) and in agreement with the float stage on the same compact images
 (docs/FIXED_POINT.md, "Clustering and proposals"). Scans: the simulated samples, freshly simulated scans of fixed
 seeds and the real KITTI / SemanticKITTI scans (skipped when absent)."""
 from __future__ import annotations
@@ -10,7 +10,7 @@ import pathlib
 import numpy as np
 import pytest
 
-from lidet_codegen.ref import cluster_q as ref
+from lidet_ref import cluster_q as ref
 from lidet_tools import native, native_q
 from lidet_tools.sim import simulate_scan
 

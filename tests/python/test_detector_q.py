@@ -159,7 +159,7 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
-    from lidet_codegen.ref import detector_q as RD, post_q, proj_q
+    from lidet_ref import detector_q as RD, post_q, proj_q
     from lidet_tools import native, sensors
     s = sensors.get_sensor(sensor)
     tab = proj_q.init(s.beam_elev_urad, s.cols, fov_margin_urad=87266, fov_urad=s.fov_urad)
@@ -185,7 +185,7 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     """Both pixels of the integer detector (the range-only one: x, y, z decoded from row, column and range,
     qmath.decode_pixels) against the chained numpy reference, bit for bit; and the detector fed the sensor's
     returns (lidet_detector_q_run_returns: ring, azimuth, range) instead of points."""
-    from lidet_codegen.ref import proj_q
+    from lidet_ref import proj_q
     sensor, max_boxes, margins = "vlp16", 0, (0, 0)
     use_returns = which.startswith("returns_")
     which = which.removeprefix("returns_")

@@ -8,7 +8,7 @@ or indented), links and, for the first two rules, the plain text:
 1. paths. A word with a '/' whose first part is a top-level entry of the repository (`lib/...`, `tools/...`,
    `weights/MODEL_CARD.md`, also in plain text: docs/X.md) exists in the tree (tracked or not ignored); a link
    target ([text](X.md), (../lib/...)) exists relative to the doc's own folder. In code: a shorter path of a
-   source file that starts with a folder name of the tree (`internal/x.h`, `ref/track.py`) is the end of some path
+   source file that starts with a folder name of the tree (`internal/x.h`, `lidet_ref/track.py`) is the end of some path
    of the tree, and a bare file name with a source extension (`lidet_refine.c`, `peer.py`) is the name of some
    file (other projects' files: EXTERNAL_FILES). A glob (`*`, `{a,b}`) matches at least one path. Not checked:
    outputs and user data (out/, data/, build*/, /tmp, ~, ../shared or anything else outside the repository, the
@@ -27,8 +27,8 @@ or indented), links and, for the first two rules, the plain text:
 5. `lidet SUBCOMMAND` (the host CLI, at the start of a code span or shell line): a command of the table in
    ports/host/cli_main.c, and every --option of that command line (usage lines continued with indented
    [--options] included) is a string of ports/host/*.c ("--name", or "name" in a getopt_long table).
-6. Python names of the project: `lidet_tools.x.y`, `lidet_codegen.x` and `module.name` for a module of theirs
-   (`native.detect`, `sensors.load_sensor_file`): the module exists and the name occurs in it.
+6. Python names of the project: `lidet_tools.x.y`, `lidet_codegen.x`, `lidet_ref.x` and `module.name` for a module
+   of theirs (`native.detect`, `sensors.load_sensor_file`): the module exists and the name occurs in it.
 
 Journal pages (docs/journal/) are history and may name old functions, options and commands on purpose: there
 only paths (1) and make targets (3) are checked. Commands (3-5) are not looked for in blocks of another language
@@ -523,7 +523,7 @@ def _check_python(tree, doc, scripts, problems):
 def _py_modules(tree):
     """{'lidet_tools.track.eval': [its files], ...} for every module and package of tools/ and codegen/."""
     mods = {}
-    for top in ("tools/lidet_tools", "codegen/lidet_codegen"):
+    for top in ("tools/lidet_tools", "codegen/lidet_codegen", "codegen/lidet_ref"):
         for f in tree.files:
             if f.startswith(top + "/") and f.endswith(".py") and not f.endswith("/__main__.py"):
                 parts = [top.split("/")[1]] + f[len(top) + 1:-3].split("/")
@@ -543,14 +543,14 @@ def _check_py_names(tree, doc, mods, problems):
     for m in mods:
         if "." in m:
             short.setdefault(m.rsplit(".", 1)[1], []).append(m)
-    rx = re.compile(r"(?<![\w./-])((?:lidet_tools|lidet_codegen|%s)(?:\.[A-Za-z_]\w*)+)"
+    rx = re.compile(r"(?<![\w./-])((?:lidet_tools|lidet_codegen|lidet_ref|%s)(?:\.[A-Za-z_]\w*)+)"
                     % "|".join(map(re.escape, short)))
     for n, text, _ in doc.code():
         for m in rx.finditer(text):
             if re.search(r"\." + FILE_EXT + r"$", m.group(1)):
                 continue  # a file name (report.json, qmath.py): the path rules check those
             parts = m.group(1).split(".")
-            full = parts[0] in ("lidet_tools", "lidet_codegen")
+            full = parts[0] in ("lidet_tools", "lidet_codegen", "lidet_ref")
             found = False
             for base in ([parts[0]] if full else short[parts[0]]):
                 p = base.split(".") + parts[1:]

@@ -127,9 +127,9 @@ def _run(argv):
 def test_finetune_end_to_end(tmp_path, need_lib, monkeypatch, capsys):
     """One epoch of each phase on three copies of the shipped simulated scan, with a tiny simulated mix: OUT holds both
     ONNX models (trained, with the export's metadata), their calibration and C models, the index and the card."""
-    from lidet_codegen import quant as Q
-    monkeypatch.setattr(Q, "CALIB_N_SIM", 1)  # the calibration's extra simulated scans: one (speed only)
-    monkeypatch.setattr(Q, "REFIT_N_SIM", 1)
+    from lidet_tools.train import calibrate as CB
+    monkeypatch.setattr(CB, "CALIB_N_SIM", 1)  # the calibration's extra simulated scans: one (speed only)
+    monkeypatch.setattr(CB, "REFIT_N_SIM", 1)
     d = _folder(tmp_path)
     out = tmp_path / "out"
     rc = _run([d, "--family", "hdl64", "--out-weights", out, "--epochs", 1, "--epochs-energy", 1, "--steps", 2,

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The C ground stage through the bindings: against the numpy reference (codegen ref/ground.py),
+"""The C ground stage through the bindings: against the numpy reference (codegen/lidet_ref/ground.py),
 the xorshift32 mirror, the evaluation tool's metrics, the CLI, and the real SemanticKITTI scans
 (skipped when ../shared/data/real is absent)."""
 import json
@@ -10,8 +10,8 @@ import subprocess
 import numpy as np
 import pytest
 
-from lidet_codegen.ref import ground as gref
-from lidet_codegen.ref.rng import XorShift32
+from lidet_ref import ground as gref
+from lidet_ref.rng import XorShift32
 from lidet_tools import ground_eval, kitti, native
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -182,7 +182,7 @@ def test_third_cells_follow_a_second_bend():
 def test_seed_per_cell_planes_do_not_depend_on_other_sectors():
     """seed_per_cell: a sector's plane depends on its own samples only, so a scan cut to the front half gets the
     front sectors' planes of the whole scan (one stream: their draws depend on the sectors before them)."""
-    from lidet_codegen.ref.rng import cell, seed
+    from lidet_ref.rng import cell, seed
     assert cell(12345, 0) != cell(12345, 1) and cell(0, 3) == seed(cell(0, 3)) != 0
     pts = _scene(np.random.default_rng(5), n_cars=40)
     front = pts[np.abs(np.arctan2(pts[:, 1], pts[:, 0])) < np.pi / 2]

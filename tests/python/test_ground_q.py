@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """The integer ground stage (lib/src/ground/*_q.c) through the bindings: bit for bit against its numpy
-reference (codegen ref/ground_q.py) on the simulated samples, freshly simulated scans and the real scans, its
+reference (codegen/lidet_ref/ground_q.py) on the simulated samples, freshly simulated scans and the real scans, its
 defaults against the float ones, and its agreement with the float ground stage on the same compact images
 (issue 16: ground labels equal for >= 99.5 % of points) and against the per-point labels."""
 import glob
@@ -10,7 +10,7 @@ import pathlib
 import numpy as np
 import pytest
 
-from lidet_codegen.ref import ground_q as gq
+from lidet_ref import ground_q as gq
 from lidet_tools import ground_eval, kitti, native, native_q
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]

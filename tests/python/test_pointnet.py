@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """The C PointNet forward pass (through the bindings) against onnxruntime on the committed ONNX models, and
-against the float64 numpy reference of lidet_codegen.ref.pointnet; codegen drift and refusals; export."""
+against the float64 numpy reference of lidet_ref.pointnet; codegen drift and refusals; export."""
 import pathlib
 import shutil
 import subprocess
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from lidet_codegen import emit as E
-from lidet_codegen.ref import pointnet as R
+from lidet_ref import pointnet as R
 from lidet_tools import kitti, native
 from lidet_tools.train.models import to_model_frame
 
@@ -179,7 +179,7 @@ def test_fuzz_models_are_regenerated_exactly(tmp_path):
     for f in sorted(src.glob("*.onnx")) + sorted(src.glob("*.calib.json")):
         shutil.copy(f, dst / f.name)
     for stem in stems:  # as make_models.sh runs them
-        for extra in ([], ["--int8", "--no-report"]):
+        for extra in ([], ["--int8"]):
             subprocess.run([sys.executable, "-m", "lidet_codegen", "emit", *extra, "--out", "tests/fuzz/models",
                             f"tests/fuzz/models/{stem}.onnx"], cwd=tmp_path, check=True, capture_output=True)
     made = sorted(p.name for p in dst.glob("*.[ch]"))
@@ -261,7 +261,7 @@ def test_emit_cli_reports_errors(tmp_path):
 def test_export_matches_pytorch(tmp_path):
     """PyTorch -> ONNX: onnxruntime equals the PyTorch model (max abs diff <= 1e-5) on both kinds."""
     pytest.importorskip("torch")
-    from lidet_codegen import export as X
+    from lidet_tools.train import export as X
     rng = np.random.default_rng(3)
     pts = rng.normal(size=(16, 64, 3)).astype(np.float32)
     vox = rng.integers(-5, 40, (16, 3)).astype(np.float32)

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """The int8 PointNets (lib/src/pointnet/lidet_pointnet_q.c): C equals the integer numpy reference
-(lidet_codegen.ref.pointnet_q) bit for bit on >= 1000 integer proposals (logits, scores, energies, classes,
+(lidet_ref.pointnet_q) bit for bit on >= 1000 integer proposals (logits, scores, energies, classes,
 gates, boxes), the int8 nets agree with the float nets (class, gates, BEV IoU of the boxes), the energy tables
 are generated, and quantization follows its documented rules."""
 import json
@@ -13,12 +13,13 @@ import pytest
 from lidet_codegen import emit as E
 from lidet_codegen import pnq_tables
 from lidet_codegen import quant as QU
-from lidet_codegen.ref import pointnet_q as RQ
+from lidet_ref import pointnet_q as RQ
+from lidet_tools.train import calibrate as CB
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 WEIGHTS = ROOT / "weights"
 FAMILIES = sorted(p.name[4:-len(".calib.json")] for p in WEIGHTS.glob("cls_*.calib.json"))
-#: resampling seeds of the test proposals (not the calibration's, lidet_codegen.quant.CALIB_SEEDS)
+#: resampling seeds of the test proposals (not the calibration's, lidet_tools.train.calibrate.CALIB_SEEDS)
 SEEDS = [0x5EED1234 + 977 * k for k in range(8)]
 
 
@@ -57,12 +58,12 @@ def props(need_lib):
     out = {}
     for fam in FAMILIES:
         sensor, npts = _family(fam)
-        xyz, mean, vox = QU.proposals_of(QU.scan_list(sensor)[:1], sensor, SEEDS, npts)
+        xyz, mean, vox = CB.proposals_of(CB.scan_list(sensor)[:1], sensor, SEEDS, npts)
         parts = [(xyz, mean, vox)]
         fresh = [simulate_scan(sensor, 16, k).points for k in range(2)]
-        parts.append(QU.proposals_of(fresh, sensor, SEEDS[:2], npts))
+        parts.append(CB.proposals_of(fresh, sensor, SEEDS[:2], npts))
         if real is not None and sensor == "hdl64":
-            parts.append(QU.proposals_of(QU.scan_list(sensor, real)[1:], sensor, SEEDS[:1], npts))
+            parts.append(CB.proposals_of(CB.scan_list(sensor, real)[1:], sensor, SEEDS[:1], npts))
         xyz = np.concatenate([p[0] for p in parts])
         mean = np.concatenate([p[1] for p in parts])
         vox = np.concatenate([p[2] for p in parts])
@@ -187,7 +188,7 @@ def test_emit_int8_refuses_a_calibration_of_another_model(tmp_path):
     p = tmp_path / "cls_vlp16.calib.json"
     p.write_text(json.dumps(cal))
     with pytest.raises(E.EmitError, match="recalibrate"):
-        QU.emit_s8(WEIGHTS / "cls_vlp16.onnx", p, tmp_path, "cmd", report=False)
+        QU.emit_s8(WEIGHTS / "cls_vlp16.onnx", p, tmp_path, "cmd")
     assert not list(tmp_path.glob("*.c"))
 
 
@@ -197,8 +198,8 @@ def test_calib_set_takes_the_models_points_per_proposal(need_lib):
     cal = json.loads((WEIGHTS / "cls_vlp16.calib.json").read_text())
     assert cal["n_points"] == 64
     one = dict(cal, scans=[s for s in cal["scans"] if s.startswith("tests/")][:1])
-    assert QU.calib_set(one)[0].shape[1] == 64
-    assert QU.calib_set(dict(one, n_points=32))[0].shape[1] == 32
+    assert CB.calib_set(one)[0].shape[1] == 64
+    assert CB.calib_set(dict(one, n_points=32))[0].shape[1] == 32
 
 
 def test_calibration_ranges_per_channel_and_per_tensor():
@@ -250,7 +251,7 @@ def test_on_the_integer_chain_bit_for_bit(nq, qmodels, fam):
     feeding the int8 nets: C equals the reference on those proposals too."""
     from lidet_tools import kitti
     sensor, npts = _family(fam)
-    pts = kitti.read_bin(QU.scan_list(sensor)[0])
+    pts = kitti.read_bin(CB.scan_list(sensor)[0])
     scan = nq.compact_scan(pts, sensor)
     n = 0
     for seed in SEEDS[:2]:
@@ -301,7 +302,7 @@ def test_refit_brings_the_int8_logits_closer_to_float(props, need_lib):
     name = "cls_vlp16"
     cal = json.loads((WEIGHTS / f"{name}.calib.json").read_text())
     base = {k: v for k, v in cal.items() if k != "head_refit"}
-    fresh = QU.refit(WEIGHTS / f"{name}.onnx", base)
+    fresh = CB.refit(WEIGHTS / f"{name}.onnx", base)
     model = E.load(WEIGHTS / f"{name}.onnx", name)
     q4, m4, vox = props["vlp16"]
     f = native.pn_classify(name, q4 * 0.004, m4 * 0.004, vox)["logits"]
@@ -352,9 +353,8 @@ def test_pack_pk_is_what_the_dsp_kernel_reads(n_out, n_in):
 
 
 def test_calibrate_takes_the_sensor_from_the_model():
-    """`python -m lidet_codegen calibrate` without --sensor: the model's lidet.sensor metadata (the small pair
+    """`python -m lidet_tools.train.calibrate` without --sensor: the model's lidet.sensor metadata (the small pair
     cls_vlp16s was trained on vlp16 scans; its name's suffix names no sensor)."""
-    from lidet_codegen import quant
-    assert quant._model_sensor(ROOT / "weights" / "cls_vlp16s.onnx") == "vlp16"
-    assert quant._model_sensor(ROOT / "weights" / "box_vlp16s.onnx") == "vlp16"
-    assert quant._model_sensor(ROOT / "weights" / "box_hdl64.onnx") == "hdl64"
+    assert CB._model_sensor(ROOT / "weights" / "cls_vlp16s.onnx") == "vlp16"
+    assert CB._model_sensor(ROOT / "weights" / "box_vlp16s.onnx") == "vlp16"
+    assert CB._model_sensor(ROOT / "weights" / "box_hdl64.onnx") == "hdl64"

@@ -1,12 +1,12 @@
 # SPDX-License-Identifier: MIT
 """The integer path's post-processing (lib/src/detector/lidet_post_q.c): BEV IoU, size check and NMS equal the numpy
-reference (codegen/lidet_codegen/ref/post_q.py) bit for bit, and agree with the float detector's IoU."""
+reference (codegen/lidet_ref/post_q.py) bit for bit, and agree with the float detector's IoU."""
 import math
 
 import numpy as np
 import pytest
 
-from lidet_codegen.ref import post_q as ref
+from lidet_ref import post_q as ref
 
 BAM = 2**32 / (2 * math.pi)
 

@@ -1,13 +1,13 @@
 # SPDX-License-Identifier: MIT
 """The integer projection (lib/src/proj/lidet_proj_q.c) and the integer sensor presets (lib/src/proj/lidet_sensor_q.c):
-C equals the numpy reference (codegen/lidet_codegen/ref/proj_q.py) bit for bit on random, simulated and real
+C equals the numpy reference (codegen/lidet_ref/proj_q.py) bit for bit on random, simulated and real
 scans, C presets equal tools/lidet_tools/sensors.py, and the integer image agrees with the float projection
 (docs/FIXED_POINT.md, "Projection")."""
 import numpy as np
 import pytest
 
-from lidet_codegen.ref import proj_q as ref
-from lidet_codegen.ref import qmath
+from lidet_ref import proj_q as ref
+from lidet_ref import qmath
 from lidet_tools import kitti, native, sensors
 from lidet_tools.sim import simulate_scan
 

@@ -1,13 +1,13 @@
 # SPDX-License-Identifier: MIT
 """The integer math of the fixed-point path: C (lib/src/qmath/lidet_qmath.c) equals the numpy reference
-(codegen/lidet_codegen/ref/qmath.py) bit for bit, both are accurate, and the generated tables are current."""
+(codegen/lidet_ref/qmath.py) bit for bit, both are accurate, and the generated tables are current."""
 import math
 
 import numpy as np
 import pytest
 
 from lidet_codegen import qtables
-from lidet_codegen.ref import qmath as ref
+from lidet_ref import qmath as ref
 
 
 @pytest.fixture(scope="module")

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """The proposal refinement (lib/src/cluster/lidet_refine.c, cfg split_people and join_cars) against its numpy reference
-(codegen/lidet_codegen/ref/cluster.py: refine_ref): the C's labels without the refinement, refined in
+(codegen/lidet_ref/cluster.py: refine_ref): the C's labels without the refinement, refined in
 numpy, equal the C's labels with it, on simulated crowd scans (issue 15) of both sensor kinds; and the
 crowd scenes of lidet-sim (close people; the default scenes unchanged)."""
 import inspect
@@ -8,7 +8,7 @@ import inspect
 import numpy as np
 import pytest
 
-from lidet_codegen.ref import cluster as ref
+from lidet_ref import cluster as ref
 from lidet_tools import cluster_eval as ce
 from lidet_tools import native
 from lidet_tools.sim.simulate import simulate_scan

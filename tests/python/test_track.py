@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """The float tracker (lib/src/track/lidet_track.c) through its bindings (lidet_tools.track) against the numpy
-reference (codegen/lidet_codegen/ref/track.py) on random sequences: births, deaths, crossings, clutter, heading
+reference (codegen/lidet_ref/track.py) on random sequences: births, deaths, crossings, clutter, heading
 flips, bad detections, ego motion, both assignment modes, capacity. Ids, states, classes, counters, detection
 indices and statuses are identical; the floats agree bit for bit without ego motion (the reported yaw aside: the
 C's atan2f against the reference's correctly rounded atan2, within TOL_YAW) and within TOL_ATOL + TOL_RTOL |ref|
@@ -12,7 +12,7 @@ import math
 import numpy as np
 import pytest
 
-from lidet_codegen.ref import track as ref
+from lidet_ref import track as ref
 
 TOL_ATOL = 1e-4   # metres, m/s, covariances, radians: with ego motion
 TOL_RTOL = 1e-5

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """The integer tracker (lib/src/track/lidet_track_q.c) through its bindings (lidet_tools.track.native_q) against
-the numpy reference (codegen/lidet_codegen/ref/track_q.py), bit for bit: every output row, status and counter of
+the numpy reference (codegen/lidet_ref/track_q.py), bit for bit: every output row, status and counter of
 every scan of random sequences (births, deaths, crossings, clutter, heading flips, bad detections, ego motion,
 both assignment modes, capacity overflow, extreme values and configurations). The assignment alone: C and
 reference identical, and the Hungarian method's total cost equal to brute force and to
@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from lidet_codegen.ref import track_q as ref
+from lidet_ref import track_q as ref
 
 # integer vs float tracker on the simulated-like sequence (inputs quantised to mm, BAM32, Q15; covariances and
 # gains in integers): measured max |dp| 1.6 mm, |dv| 9 mm/s, |dyaw| 1e-3 rad (test_integer_agrees_with_float

@@ -105,3 +105,27 @@ def test_sim_scans_run_the_stages_at_their_mount_height(monkeypatch, need_lib):
     D._job(("sim", 0, 2000, 1, None), "vlp16", dict(D.DEFAULTS))
     assert seen == [1.0, 0.5]
     assert len(out["label"]) > 0 and (out["label"] >= 0).any()
+
+
+def test_sim_sensors_mix_presets_at_every_mount(need_lib, tmp_path):
+    """--sim-sensors: the simulated scans cycle over the presets (fastest) and the mounts, each scan made and run
+    through the C stages as its own sensor; unknown presets and --sim-sensors without --sim are refused."""
+    import argparse
+    a = argparse.Namespace(sim="4,0,0", mounts="0.7,1.4", seed=9, sim_sensors="vlp32c,os1-32", kitti=None,
+                           semantickitti=None, boxes=None, split=None)
+    tasks = D.build_tasks(a)
+    assert [(t[4], t[5]) for t in tasks] == [(0.7, "vlp32c"), (0.7, "os1-32"), (1.4, "vlp32c"), (1.4, "os1-32")]
+    out = tmp_path / "mix.npz"
+    assert D.main(["--sensor", "vlp32c", "--sim-sensors", "vlp32c,os1-32", "--mounts", "1.0", "--sim", "2,0,0",
+                   "--seed", "9", "--out", str(out), "--no-progress"]) == 0
+    d = D.load(out)
+    names = [str(n) for n in d["scan_names"]]
+    assert names[0].startswith("sim:vlp32c:") and names[1].startswith("sim:os1-32:")
+    assert d["meta"]["sim_sensors"] == "vlp32c,os1-32"
+    # each scan's proposals are those of its own preset: the os1-32 scan alone gives the same proposals
+    one = D._job(("sim", 0, 9, 1, 1.0, "os1-32"), "vlp32c", dict(D.DEFAULTS))
+    np.testing.assert_array_equal(d["points"][d["scan"] == 1], one["points"])
+    with pytest.raises(SystemExit):
+        D.main(["--sim-sensors", "vlp32c,nope", "--sim", "1,0,0", "--out", str(out), "--no-progress"])
+    with pytest.raises(SystemExit):
+        D.main(["--sim-sensors", "vlp32c", "--kitti", str(tmp_path), "--out", str(out), "--no-progress"])

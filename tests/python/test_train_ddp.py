@@ -68,7 +68,7 @@ def test_torchrun_two_ranks_gloo(tiny, tmp_path, kind):
         assert a and b and not (a & b) and len(a) + len(b) == 2 * (n_id // 2)
         assert set(e0["ood"]) != set(e1["ood"]) and len(set(e0["ood"]) | set(e1["ood"])) == n_ood
     # the exported graph is the checkpoint's model
-    from lidet_codegen.export import load_checkpoint, torch_forward
+    from lidet_tools.train.export import load_checkpoint, torch_forward
     model, _ = load_checkpoint(tmp_path / "o" / f"{kind}.pt")
     feeds = {"points": d["points"], "voxel": d["voxel"].astype(np.float32)}
     s = ort.InferenceSession(str(tmp_path / "o" / f"{kind}.onnx"), providers=["CPUExecutionProvider"])

@@ -39,7 +39,7 @@ def test_train_export_onnx_parity(tiny, tmp_path):
     ck = train_cls.train(a)
     assert ck["meta"]["trained"] == 1 and len(ck["meta"]["gamma"]) == 3 and np.isfinite(ck["meta"]["gamma"]).all()
     assert ck["meta"]["margins"]["m_out"] >= ck["meta"]["margins"]["m_in"] + 3.0 - 1e-9
-    from lidet_codegen.export import load_checkpoint, torch_forward
+    from lidet_tools.train.export import load_checkpoint, torch_forward
     model, _ = load_checkpoint(tmp_path / "cls.pt")
     feeds = {"points": d["points"], "voxel": d["voxel"].astype(np.float32)}
     ref = torch_forward(model, "classifier", feeds["points"], feeds["voxel"])
@@ -82,7 +82,7 @@ def test_train_export_onnx_parity(tiny, tmp_path):
 
 def test_macs_hand_count(tmp_path):
     """The counter against the MACs computed by hand from the default widths at 64 points."""
-    from lidet_codegen.export import export_onnx, untrained
+    from lidet_tools.train.export import export_onnx, untrained
     m, ck = untrained("classifier")
     export_onnx(m, ck, tmp_path / "c.onnx")
     n = 64
@@ -190,7 +190,7 @@ def test_finetune_q_round_trip_emulation_and_training(tiny, tmp_path, capsys):
     network) and reports the figures; bad input gets a clear error."""
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
-    from lidet_codegen.ref import pointnet_q as RQ
+    from lidet_ref import pointnet_q as RQ
     from lidet_tools.train import finetune_q as FQ
     path, d = tiny
     a = train_cls.add_args(__import__("argparse").ArgumentParser()).parse_args(
@@ -236,7 +236,7 @@ def test_finetune_q_checkpoint_and_card(tiny, tmp_path, capsys):
     """What make weights uses: --checkpoint takes the network's margins from its checkpoint and rewrites it with
     the fine-tuned weights (the training record kept, the step added; the same network as the ONNX); --card puts
     the new gamma in the file's row and this run in the section, replacing an earlier run's lines."""
-    from lidet_codegen.export import load_checkpoint, torch_forward
+    from lidet_tools.train.export import load_checkpoint, torch_forward
     from lidet_tools.train import finetune_q as FQ
     path, d = tiny
     a = train_cls.add_args(__import__("argparse").ArgumentParser()).parse_args(
@@ -269,7 +269,7 @@ def test_make_weights_family_with_int8_fine_tuning(tmp_path, monkeypatch, need_l
     """weights.run_family with a family that has `cls_finetune` (as vlp16 in make weights): the classifier's
     checkpoint and ONNX are the fine-tuned network, and the model card shows its gamma and the step."""
     import argparse
-    from lidet_codegen.export import load_checkpoint
+    from lidet_tools.train.export import load_checkpoint
     from lidet_tools.train import weights as Wt
     d = D.concat([D._job(("sim", s, 1, s, None), "hdl64", dict(D.DEFAULTS)) for s in range(3)])
     work, wdir = tmp_path / "work", tmp_path / "weights"

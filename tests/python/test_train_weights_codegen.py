@@ -14,6 +14,7 @@ pytest.importorskip("onnxruntime")
 
 from lidet_codegen import quant as Q  # noqa: E402
 from lidet_codegen import regen  # noqa: E402
+from lidet_tools.train import calibrate as CB  # noqa: E402
 from lidet_tools.train import weights as W  # noqa: E402
 
 #: one HDL-64 scan per split, one epoch per phase; the classifier not fine-tuned for int8, so it gets the refit
@@ -30,8 +31,8 @@ def _sha(p):
 def test_make_weights_regenerates_the_c_models(tmp_path, monkeypatch, need_lib):
     monkeypatch.setitem(W.FAMILIES, "tiny", TINY)
     # the calibration and refit sets, smaller (the commands and the files are the same otherwise)
-    monkeypatch.setattr(Q, "CALIB_N_SIM", 1)
-    monkeypatch.setattr(Q, "REFIT_N_SIM", 1)
+    monkeypatch.setattr(CB, "CALIB_N_SIM", 1)
+    monkeypatch.setattr(CB, "REFIT_N_SIM", 1)
     monkeypatch.chdir(tmp_path)
     wd = tmp_path / "weights"
     wd.mkdir()
@@ -79,9 +80,9 @@ def test_box_calibration_takes_the_classifier_beside_it(tmp_path, need_lib):
     """A box net is calibrated on the classes of cls_<family>.onnx in its own folder (a --weights folder other than
     weights/ holds the classifier trained with it), not on weights/'s."""
     import json
-    root = Q.ROOT
+    root = CB.ROOT
     cal = json.loads((root / "weights" / "box_vlp16.calib.json").read_text())
-    xyz, mean, vox = Q.calib_set(dict(cal, scans=[s for s in cal["scans"] if s.startswith("tests/")][:1]))
+    xyz, mean, vox = CB.calib_set(dict(cal, scans=[s for s in cal["scans"] if s.startswith("tests/")][:1]))
     box = Q.load(root / "weights" / "box_vlp16.onnx", "box_vlp16")
     committed = Q.calib_classes(box, xyz, mean, vox)
     assert committed.any()  # the committed classifier's classes, not all 0

@@ -685,7 +685,7 @@ static void test_proposal_indices(void)
     /* another seed gives another pattern */
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(1000, 128, 8, b));
     TEST_ASSERT_TRUE(memcmp(a, b, 128 * sizeof a[0]) != 0);
-    /* golden values (codegen/lidet_codegen/ref/cluster.py: proposal_indices must give the same) */
+    /* golden values (codegen/lidet_ref/cluster.py: proposal_indices must give the same) */
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(5, 8, 0x5EED1234u, a));
     TEST_ASSERT_EQUAL_UINT32(0, a[0]);
     TEST_ASSERT_EQUAL_UINT32(4, a[4]);

@@ -29,7 +29,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path[:0] = [str(ROOT / "tools"), str(ROOT / "codegen")]
 
 from lidet_codegen import quant as QU  # noqa: E402
-from lidet_codegen.ref import detector_q as RD  # noqa: E402
+from lidet_ref import detector_q as RD  # noqa: E402
 from lidet_tools import kitti, native, native_q as nq  # noqa: E402
 from lidet_tools.eval import kitti_ap as K  # noqa: E402
 

@@ -15,7 +15,7 @@ import sys
 import numpy as np
 
 import bench_pixel  # the table (tools/bench/bench_pixel.py)
-from lidet_codegen.ref import qmath
+from lidet_ref import qmath
 from lidet_tools import cluster_eval, native, native_q
 
 

@@ -3,7 +3,7 @@
 in the same pixel and of pixels with the same winning point, with the integer input round(1000 x) mm and the float
 input either the same points (x = mm / 1000: the two algorithms alone) or the original float32 points (the mm
 quantization of the input included); and where the two disagree, which one the float64 reference
-(codegen/lidet_codegen/ref/proj.py) sides with. Speed: bench_proj.py."""
+(codegen/lidet_ref/proj.py) sides with. Speed: bench_proj.py."""
 from __future__ import annotations
 
 import pathlib
@@ -31,7 +31,7 @@ def _scan_sets(real: pathlib.Path):
 def measure(points, sensor: str) -> dict:
     """Counts for one scan: points, same pixel / same winner for both float inputs, and for the points whose
     pixel differs with the same input, how many the float64 reference puts where the integer path does."""
-    from lidet_codegen.ref.proj import project_ref
+    from lidet_ref.proj import project_ref
     from lidet_tools import native, native_q, sensors
     s = sensors.get_sensor(sensor)
     mm = np.round(np.asarray(points, dtype=np.float64)[:, :3] * 1000.0).astype(np.int32)

@@ -78,7 +78,7 @@ def main(argv=None):
     out.append(f"const int fw_scan_has_ring = {1 if ring is not None else 0};")
     if a.mm:
         # the integer build also gets the scan as the sensor's returns (lidet_return_t: range in mm, azimuth in
-        # BAM16, ring), as lidet_codegen.ref.proj_q.returns_of_points converts them: range = round(sqrt(x^2 + y^2
+        # BAM16, ring), as lidet_ref.proj_q.returns_of_points converts them: range = round(sqrt(x^2 + y^2
         # + z^2)) of the millimetres (exact, halves up), azimuth = round(atan2(y, x) 2^16 / 2 pi) mod 2^16
         if ring is not None:
             out.append(f"const lidet_return_t fw_scan_returns[{n}] = {{")

@@ -176,7 +176,7 @@ def project_q(points_mm, sensor="hdl64", ring=None, min_range_mm: int = 100, max
               fov_margin_urad: int = 87266, returns=None) -> dict:
     """The C integer projection of (N, >=3) int32 mm points (x, y, z first). sensor: a preset name or a
     sensors.Sensor (its integer profile: beam_elev_urad, or fov_urad for a uniform one). Returns the keys of
-    lidet_codegen.ref.proj_q.project (point_pixel, point_idx, x_4mm, y_4mm, z_4mm, range_4mm, stats,
+    lidet_ref.proj_q.project (point_pixel, point_idx, x_4mm, y_4mm, z_4mm, range_4mm, stats,
     row_elev_bam) and status. returns: a RETURN_DTYPE array (as_returns) instead of the points
     (lidet_proj_q_run_returns; points_mm and ring are then ignored, pass None)."""
     from lidet_tools.sensors import get_sensor

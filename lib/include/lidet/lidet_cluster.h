@@ -94,7 +94,7 @@
  * overflow; there is no recursion.
  *
  * Proposals (lidet_proposal_make): a kept cluster resampled to N points (N <= LIDET_PROPOSAL_POINTS)
- * by a deterministic rule that codegen/lidet_codegen/ref/cluster.py reproduces exactly:
+ * by a deterministic rule that codegen/lidet_ref/cluster.py reproduces exactly:
  *  - n_src <= N: every member once (member order), then N - n_src members drawn with replacement
  *    by an xorshift32 generator;
  *  - n_src > N: stratified without replacement: output i takes member b_i + (r_i mod (b_{i+1} - b_i))

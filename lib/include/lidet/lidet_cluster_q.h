@@ -35,7 +35,7 @@
  *    joined cluster's sums: the mean stays the rounded mean of all members).
  * Per point: no division, no square root; one 32x32 -> 64 bit product per gap test. Tables: sin/cos/atan2/
  * isqrt at init (recomputed when the image geometry changes). The numpy reference is
- * codegen/lidet_codegen/ref/cluster_q.py (bit for bit).
+ * codegen/lidet_ref/cluster_q.py (bit for bit).
  *
  * Proposals (lidet_proposal_q_make): the same resampled member indices as lidet_proposal_make
  * (lidet_proposal_indices), points minus the record's rounded mean (4 mm, int16, saturating), and the mean's

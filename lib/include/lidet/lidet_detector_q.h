@@ -10,7 +10,7 @@
  * relative to the first box's centre (Q30 sin/cos of the BAM32 yaw, rounded), Sutherland-Hodgman clipping with
  * int64 cross products (intersection points rounded to the millimetre), twice the areas by the shoelace
  * formula, IoU = 2 A_inter * 2^15 / (2 A_a + 2 A_b - 2 A_inter) rounded down. Mirrored bit for bit by
- * codegen/lidet_codegen/ref/post_q.py.
+ * codegen/lidet_ref/post_q.py.
  */
 #ifndef LIDET_DETECTOR_Q_H
 #define LIDET_DETECTOR_Q_H

@@ -5,7 +5,7 @@
  *        per azimuth sector (Seppänen et al., "No GPU? No problem", section on ground removal).
  *
  * Algorithm (lib/src/ground/lidet_ground_filter.c, lib/src/ground/lidet_ground_ransac.c; numpy mirror in
- * codegen/lidet_codegen/ref/ground.py):
+ * codegen/lidet_ref/ground.py):
  *  1. Sample filter over the projection's R (horizontal range) and Z images. For pixel (r, c), with
  *     row r+1 the beam below and columns wrapping around:
  *       S_v = [[2, 1], [-2, -1]] on rows r, r+1 and cols c, c+1:  dZ = S_v*Z, dR = S_v*R;

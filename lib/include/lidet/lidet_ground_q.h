@@ -6,7 +6,7 @@
  *
  * Same steps, order and random draws as the float stage (lidet_ground.h), in integer form
  * (lib/src/ground/lidet_ground_filter_q.c filter, gathering, labels; lib/src/ground/lidet_ground_ransac_q.c
- * RANSAC, refinement, fallback; numpy mirror codegen/lidet_codegen/ref/ground_q.py, bit for bit):
+ * RANSAC, refinement, fallback; numpy mirror codegen/lidet_ref/ground_q.py, bit for bit):
  *  - R (horizontal range) of a pixel in 4 mm / 256 steps (1/64 mm), computed row by row as the rows are
  *    needed: round(sqrt(x^2 + y^2) * 256) in an image that stores x, y, z (an exact integer square root of a
  *    47-bit value); in a range-only image round(range * ce / 2^7), ce the row elevation's Q15 cosine that its

@@ -28,7 +28,7 @@
  * [3+H:3+2H] heading residuals normalised by pi/H, then S size scores and 3S size residuals
  * normalised by the template. Centre = mean + R(azimuth) (tnet + residual); yaw = bin * 2pi/H +
  * residual * pi/H + azimuth, wrapped to (-pi, pi]; size = template * (1 + residual).
- * Mirrored in float64 by codegen/lidet_codegen/ref/pointnet.py (function for function).
+ * Mirrored in float64 by codegen/lidet_ref/pointnet.py (function for function).
  *
  * Memory: the caller provides scratch of lidet_pn_scratch_bytes(model) bytes (also emitted as
  * <NAME>_SCRATCH_BYTES by codegen): 4 B * (2 * LIDET_PN_BLOCK * W_point + 3 * W_vec + 3 * LIDET_PN_BLOCK

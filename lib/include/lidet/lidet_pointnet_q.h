@@ -20,7 +20,7 @@
  * Frame: cos, sin of the mean's azimuth are (x, y) / r in Q30 with r = round(sqrt(x^2 + y^2)) (no angle).
  * Energies: -T logsumexp(v / T) in Q16 nats from a 2^-x table and a log2 table (lidet_pointnet_q_tables.c,
  * generated); scores Q15. Box: centre and size in mm, yaw in BAM32.
- * Mirrored bit for bit by codegen/lidet_codegen/ref/pointnet_q.py.
+ * Mirrored bit for bit by codegen/lidet_ref/pointnet_q.py.
  *
  * Memory: scratch of lidet_pointnet_q_scratch_bytes(model) bytes (LIDET_POINTNET_Q_SCRATCH_BYTES, also
  * emitted as <NAME>_SCRATCH_BYTES): 4 * BLOCK * max(wp, wv) + 4 * wp + 2 * BLOCK * wp + 3 * wv + 6 * BLOCK

@@ -135,7 +135,7 @@ typedef struct
  * @brief Project one scan given as returns (lidet_return_t): the same image as lidet_proj_q_run would make of
  *        the points, up to where a return sits in its pixel.
  *
- * Rules (docs/FIXED_POINT.md, "Projection"; codegen/lidet_codegen/ref/proj_q.py project_returns):
+ * Rules (docs/FIXED_POINT.md, "Projection"; codegen/lidet_ref/proj_q.py project_returns):
  *  - row: the ring's row; a ring >= n_rows counts as n_bad_ring;
  *  - column: c = floor(((0x8000 - azimuth) mod 2^16) n_cols / 2^16), the column lidet_proj_q_run numbers by
  *    u = (pi - azimuth) / 2 pi;

@@ -26,7 +26,7 @@
  *  9. a tentative track with confirm_hits hits is confirmed.
  * The reported yaw follows the motion (heading_from_velocity classes) or is turned by pi when it points
  * against it, once the speed is at least heading_speed and known (|v|^2 >= 4 p_vv).
- * Numpy mirror: codegen/lidet_codegen/ref/track.py (same float32 operations in the same order).
+ * Numpy mirror: codegen/lidet_ref/track.py (same float32 operations in the same order).
  *
  * Memory: sizeof(lidet_tracker_t) = LIDET_TRACK_MAX_TRACKS * (88 + 4 LIDET_TRACK_MAX_DETS + 4) B
  * + LIDET_TRACK_MAX_DETS * 3 B + (max(LIDET_TRACK_MAX_TRACKS, LIDET_TRACK_MAX_DETS) + 1) * 17 B + ~140 B:

@@ -17,7 +17,7 @@
  *    (exact) and d^2 <= gate_max^2; class_penalty and the infeasible cost gate_chi2 + class_penalty + 2^16 in Q16;
  *  - the class vote: the sum of the Q15 scores per class (uint32), all three halved when one reaches 2^30;
  *  - every division rounds half away from zero (lidet__q_div_round), every dropped fraction of a shift half up.
- * Mirrored bit for bit by codegen/lidet_codegen/ref/track_q.py.
+ * Mirrored bit for bit by codegen/lidet_ref/track_q.py.
  *
  * Memory: sizeof(lidet_tracker_q_t) = LIDET_TRACK_MAX_TRACKS * (90 + 4 LIDET_TRACK_MAX_DETS) + 2 LIDET_TRACK_MAX_DETS
  * + 33 max(LIDET_TRACK_MAX_TRACKS, LIDET_TRACK_MAX_DETS) + ~160 B (88 B a track slot, an int32 cost per track and

@@ -2,7 +2,7 @@
 /* Depth clustering (see lidet_cluster.h for the algorithm and memory): configuration, the run (candidates,
  * first fill, rescue pass), the filters and records of each component, canonical ids, accessors. The
  * growth is in lidet_cluster_grow.c, the fragment rescue in lidet_cluster_rescue.c.
- * The numpy reference is codegen/lidet_codegen/ref/cluster.py: cluster_ref (these three files) and
+ * The numpy reference is codegen/lidet_ref/cluster.py: cluster_ref (these three files) and
  * proposal_indices / make_proposal (lidet_proposal.c). */
 #include <math.h>
 #include <string.h>

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Clustering, the growth (see lidet_cluster.h): the join test of two neighbouring returns, the
  * directional searches with hole and occluder bridging, and the breadth-first flood fill. The hot
- * loop of the stage and the unit a port overrides. Mirrors codegen/lidet_codegen/ref/cluster.py:
+ * loop of the stage and the unit a port overrides. Mirrors codegen/lidet_ref/cluster.py:
  * cluster_ref (link, search, grow). */
 #include <math.h>
 #include <string.h>

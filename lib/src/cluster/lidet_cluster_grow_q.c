@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Integer clustering, the growth (lidet_cluster_q.h): the angle tables of the image geometry, the integer
  * join test and the flood fill (the float stage's, lidet_cluster_grow_body.h, with integer ranges and
- * tables). Mirrors codegen/lidet_codegen/ref/cluster_q.py: tables, link. */
+ * tables). Mirrors codegen/lidet_ref/cluster_q.py: tables, link. */
 #include <string.h>
 
 #include "internal/lidet_assert.h"

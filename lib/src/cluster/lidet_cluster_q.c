@@ -2,7 +2,7 @@
 /* Integer clustering (lidet_cluster_q.h): configuration, the run, the filters and records of each component,
  * the rescue join, accessors. The bookkeeping and the run's driver are the float stage's
  * (lidet_cluster_run_body.h); the growth is in lidet_cluster_grow_q.c, the rescue in
- * lidet_cluster_rescue_q.c. Integer only. The numpy reference is codegen/lidet_codegen/ref/cluster_q.py (bit
+ * lidet_cluster_rescue_q.c. Integer only. The numpy reference is codegen/lidet_ref/cluster_q.py (bit
  * for bit). */
 #include <string.h>
 

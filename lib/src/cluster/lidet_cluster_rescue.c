@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Clustering, the fragment rescue (see lidet_cluster.h): components below min_points joined to each
  * other and to the nearest kept cluster by the 3D distance of their returns. Mirrors
- * codegen/lidet_codegen/ref/cluster.py: cluster_ref (rescue pass). */
+ * codegen/lidet_ref/cluster.py: cluster_ref (rescue pass). */
 #include <string.h>
 
 #include "internal/lidet_assert.h"

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Integer clustering, the fragment rescue (lidet_cluster_q.h): the float stage's window walk
  * (lidet_cluster_rescue_body.h) with the integer distance test. Mirrors
- * codegen/lidet_codegen/ref/cluster_q.py (rescue pass). */
+ * codegen/lidet_ref/cluster_q.py (rescue pass). */
 #include <string.h>
 
 #include "internal/lidet_assert.h"

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Proposals: a kept cluster resampled to N centred points plus its mean's spherical voxel (see
- * lidet_cluster.h). Mirrored exactly by codegen/lidet_codegen/ref/cluster.py: proposal_indices,
+ * lidet_cluster.h). Mirrored exactly by codegen/lidet_ref/cluster.py: proposal_indices,
  * make_proposal; training reads proposals through the Python bindings of these functions. */
 #include <math.h>
 #include <string.h>

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Integer proposals (lidet_cluster_q.h): the float stage's resampling rule (internal/lidet_proposal_rule.h),
  * points minus the rounded mean in 4 mm steps, the mean's voxel from integer atan2 / square root. Integer
- * only. Mirrored by codegen/lidet_codegen/ref/cluster_q.py: make_proposal_q. */
+ * only. Mirrored by codegen/lidet_ref/cluster_q.py: make_proposal_q. */
 #include <string.h>
 
 #include "internal/lidet_proposal_rule.h"

@@ -12,7 +12,7 @@
  * subtractions, one product by the inverse cell size, truncation to a cell index and compares: the
  * integer stage does the same in 4 mm steps (lidet_refine_q.c). The control flow is shared with it
  * (internal/lidet_refine_body.h); this file holds the float kernels. The numpy reference is refine_ref in
- * codegen/lidet_codegen/ref/cluster.py. */
+ * codegen/lidet_ref/cluster.py. */
 #include <string.h>
 
 #include "internal/lidet_cluster_internal.h"

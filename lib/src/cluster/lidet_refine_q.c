@@ -7,7 +7,7 @@
  * ceil(2^40 / cs) and a shift (exact: 4 (x - lo) < 2^18, cs < 2^22); the aspect test wz 2^16 >= aspect_q16
  * max(wx, wy) and the joins' gap test (4 gx)^2 + (4 gy)^2 > gap_mm^2 in uint64 (no square root, no division
  * per point). Records: int64 member sums, the mean rounded (lidet__q_div_round), the height of lidet_cluster_q.c.
- * Integer only. Mirrored bit for bit by refine_q in codegen/lidet_codegen/ref/cluster_q.py. */
+ * Integer only. Mirrored bit for bit by refine_q in codegen/lidet_ref/cluster_q.py. */
 #include <string.h>
 
 #include "internal/lidet_cluster_q_internal.h"

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The integer detector (lidet_detector_q.h): the integer stages chained as lidet_detector.c chains the float
  * ones (same candidate order, budget, gates, size check, score and NMS rules). Integers only; mirrored by
- * codegen/lidet_codegen/ref/detector_q.py. */
+ * codegen/lidet_ref/detector_q.py. */
 #include <string.h>
 
 #include "internal/lidet_pointnet_q_internal.h"

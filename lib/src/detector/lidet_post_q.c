@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* The integer path's post-processing (lidet_detector_q.h): size check, rotated BEV IoU, score order, NMS.
- * Integers only; mirrored bit for bit by codegen/lidet_codegen/ref/post_q.py. */
+ * Integers only; mirrored bit for bit by codegen/lidet_ref/post_q.py. */
 #include <string.h>
 
 #include "internal/lidet_qmath.h"

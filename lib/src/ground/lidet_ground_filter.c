@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Ground stage: configuration, the Sobel-inspired sample filter, the per-pixel labelling and the
  * accessors (algorithm in lidet_ground.h). The plane fits live in lidet_ground_ransac.c.
- * Mirrored by codegen/lidet_codegen/ref/ground.py (sample_mask, label_pixels). */
+ * Mirrored by codegen/lidet_ref/ground.py (sample_mask, label_pixels). */
 #include <string.h>
 
 #include "internal/lidet_assert.h"
@@ -403,7 +403,7 @@ static void rz_row(rxy_rows_t *rr, uint32_t r, const float **R, const float **Z)
     *Z = z_row(rr, r);
 }
 
-/* Pass 1 (mirrors ref/ground.py: sample_mask): the sample mask, row by row. */
+/* Pass 1 (mirrors lidet_ref/ground.py: sample_mask): the sample mask, row by row. */
 static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, rxy_rows_t *rr,
                         const lidet_range_image_t *img, const gspan_t *sp)
 {
@@ -438,7 +438,7 @@ static void filter_rows(const lidet_ground_state_t *g, uint8_t *sample, rxy_rows
     }
 }
 
-/* Pass 2 (mirrors ref/ground.py: gather_samples): the samples' pixels grouped by cell, so each cell's
+/* Pass 2 (mirrors lidet_ref/ground.py: gather_samples): the samples' pixels grouped by cell, so each cell's
  * RANSAC reads one contiguous block of indices (4 B a sample, where a copy of the coordinates took 12 B:
  * RANSAC reads them from the image). Only columns on the column grid (c % sample_col_step
  * == 0) of the filtered rows are taken (hdl64 defaults: every 4th row, every 4th column). Near
@@ -530,7 +530,7 @@ static void gather_samples(lidet_ground_state_t *g, lidet_ground_scratch_t *sc,
     lidet__ground_sample_counts(&g->stats, total, lo, hi);
 }
 
-/* Pass 3 (mirrors ref/ground.py: label_pixels, veto_vertical): ground = holds a point and
+/* Pass 3 (mirrors lidet_ref/ground.py: label_pixels, veto_vertical): ground = holds a point and
  * -below < height < above, height above the pixel's cell plane (near or far part of its sector),
  * and not vetoed. Empty pixels are excluded by R > 0 (the image contract: empty pixels are exactly
  * 0, and their coordinates 0 may lie within ground_m of a plane).

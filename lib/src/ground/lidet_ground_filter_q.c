@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Integer ground stage: configuration, the sample filter, the sample gathering, the labels and the accessors
  * (lidet_ground_q.h; the plane fits are in lidet_ground_ransac_q.c). Integers only: no <math.h>, no float.
- * Mirrored bit for bit by codegen/lidet_codegen/ref/ground_q.py. */
+ * Mirrored bit for bit by codegen/lidet_ref/ground_q.py. */
 #include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
 
 #include <string.h>
@@ -210,7 +210,7 @@ static void row_rxy2(const lidet_range_image_t *img, uint32_t r, uint32_t *restr
 /* R of a range-only image's pixel: its range times the cosine of its row's elevation (ce, Q15), in R steps
  * (4 mm / 2^8), rounded half up: round(rng ce / 2^7). The horizontal distance of the decoded point without the
  * square root (the decoded x, y are this ray's, rounded to 4 mm steps); rng < 2^15 and 0 <= ce <= 2^15, so the
- * product fits 32 bits. ref/ground_q.py: r_of_range */
+ * product fits 32 bits. lidet_ref/ground_q.py: r_of_range */
 static inline int32_t r_of_range(uint32_t rng, int32_t ce)
 {
     return (int32_t)(((rng & 0x7FFFu) * (uint32_t)ce + 64u) >> 7);
@@ -326,7 +326,7 @@ static inline int32_t abs32(int32_t v)
     return v < 0 ? -v : v;
 }
 
-/* Pass 1 (ref/ground_q.py: sample_mask): the sample test of lidet_ground_filter.c with integer kernels.
+/* Pass 1 (lidet_ref/ground_q.py: sample_mask): the sample test of lidet_ground_filter.c with integer kernels.
  * dR in R steps (4 mm / 256), dZ in 4 mm: |dZ| <= fy |dR| is |dZ| * 2^24 <= fy_q16 * |dR|; F_x on R against
  * fx_max_mm * 64 (R steps), on Z as 4 |F_x| <= fx_max_mm. Every touched pixel holds a point (R > 0). Bitwise &
  * and no branch, as the float kernel: the column loop vectorises. */
@@ -479,7 +479,7 @@ static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_
     }
 }
 
-/* Pass 2 (ref/ground_q.py: gather_samples): the samples of the step grid grouped by cell, near ones from the
+/* Pass 2 (lidet_ref/ground_q.py: gather_samples): the samples of the step grid grouped by cell, near ones from the
  * buffer's start upwards, far ones from its end downwards (the float stage's order); past the buffer they are
  * dropped and counted. */
 static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
@@ -523,7 +523,7 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
     lidet__ground_sample_counts(&g->stats, total, lo, hi);
 }
 
-/* Pass 3 (ref/ground_q.py: label_pixels): ground = holds a point, -below < h < above with h = n . p + D in
+/* Pass 3 (lidet_ref/ground_q.py: label_pixels): ground = holds a point, -below < h < above with h = n . p + D in
  * 4 mm / 2^30 (the tolerances in mm are exact in that unit: 1 mm = 2^28), and not vetoed: the pixel above
  * (row - 1) holds a point, 4 |dz| > veto_min_dz_mm and |dz| * 2^24 > veto_slope_q16 * |dR|. R is computed only
  * where a test needs it: the veto's slope test of an in-band pixel with a step of more than veto_min_dz_mm

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Ground stage: one RANSAC plane per azimuth sector, least-squares refinement, fallback
- * (algorithm in lidet_ground.h). Mirrored by codegen/lidet_codegen/ref/ground.py (fit_sectors,
+ * (algorithm in lidet_ground.h). Mirrored by codegen/lidet_ref/ground.py (fit_sectors,
  * fit_plane_lsq). */
 #include <string.h>
 
@@ -317,7 +317,7 @@ static uint32_t score_idx(const lidet_range_image_t *img, int compact, const lid
     return cnt;
 }
 
-/* RANSAC on one sector (mirrors ref/ground.py: ransac_sector). Returns 1 with *out set when a
+/* RANSAC on one sector (mirrors lidet_ref/ground.py: ransac_sector). Returns 1 with *out set when a
  * plane passes every check. */
 static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img,
                       const lidet_ground_sample_t *idx, uint32_t n, const lidet_plane_t *near, float at_x,

@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Integer ground stage: RANSAC per cell with exact int64 plane arithmetic, the least-squares refinement by
  * power iteration on the adjugate of the inliers' scatter matrix, the checks and the fallback
- * (lidet_ground_q.h). Integers only. Mirrored bit for bit by codegen/lidet_codegen/ref/ground_q.py
+ * (lidet_ground_q.h). Integers only. Mirrored bit for bit by codegen/lidet_ref/ground_q.py
  * (ransac_cell, refine). */
 #include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
 
@@ -280,7 +280,7 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
     return 1;
 }
 
-/* RANSAC on one cell (ref/ground_q.py: ransac_cell): the float stage's draws and control flow; a hypothesis
+/* RANSAC on one cell (lidet_ref/ground_q.py: ransac_cell): the float stage's draws and control flow; a hypothesis
  * is the exact cross product c of two 4 mm difference vectors, a sample its inlier when
  * 4 |c . (p - p0)| <= inlier_mm * |c|. Returns 1 with *out set when the plane passes every check. */
 static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,

@@ -23,7 +23,7 @@ static inline int lidet__isfinite(float v)
 /* The azimuth window of half-width half_rad around straight ahead, as columns [*c_lo, *c_hi) of an image of cols
  * columns (column c spans azimuths pi (1 - 2 (c + 1) / n) .. pi (1 - 2 c / n), straight ahead at c = n / 2),
  * one more column on each side; half_rad outside (0, pi): every column. The projection's window and the
- * clustering's use this one rule (mirrored by ref/cluster.py). */
+ * clustering's use this one rule (mirrored by lidet_ref/cluster.py). */
 static inline void lidet__azimuth_window_cols(float half_rad, uint32_t cols, uint32_t *c_lo, uint32_t *c_hi)
 {
     float half, lo, hi;

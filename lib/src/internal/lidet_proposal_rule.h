@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* The proposals' resampling rule (lidet_cluster.h), integer only: shared by the float proposals
  * (lidet_proposal.c) and the integer ones (lidet_proposal_q.c), so both take the same members. Mirrored by
- * codegen/lidet_codegen/ref/cluster.py: proposal_indices. Never installed. */
+ * codegen/lidet_ref/cluster.py: proposal_indices. Never installed. */
 #ifndef LIDET_PROPOSAL_RULE_H
 #define LIDET_PROPOSAL_RULE_H
 
@@ -11,7 +11,7 @@
 
 /* the generator state of one cluster's resampling: the seed mixed with the member count, so clusters
  * of different sizes draw different streams; 0 (xorshift's only fixed point) is replaced by
- * LIDET_RNG_PROPOSAL_ZERO_SEED (the value the reference, ref/cluster.py, uses) */
+ * LIDET_RNG_PROPOSAL_ZERO_SEED (the value the reference, lidet_ref/cluster.py, uses) */
 static inline uint32_t lidet__proposal_rng_start(uint32_t seed, uint32_t n_src)
 {
     const uint32_t s = seed ^ (n_src * 0x9E3779B9u);

@@ -2,7 +2,7 @@
 /* Integer math of the fixed-point stages (docs/FIXED_POINT.md), shared by every integer kernel. No float:
  * these functions are compiled in both builds and are the only trig/sqrt the integer path uses.
  *
- * Conventions (the numpy reference codegen/lidet_codegen/ref/qmath.py mirrors them bit for bit):
+ * Conventions (the numpy reference codegen/lidet_ref/qmath.py mirrors them bit for bit):
  * - BAM32 angles: 2^32 is one full turn; uint32 for "any angle" (wraps), int32 for a signed one
  *   (-2^31 = -pi .. 2^31 - 1). 1 BAM32 = 1.46e-9 rad.
  * - sin/cos in Q30 (2^30 = 1.0) from a 1025-entry quarter-wave table (lidet_qmath_tables.c, generated) with

@@ -3,7 +3,7 @@
  * detector in 256 KiB"). A compact image either stores x, y, z (x_4mm, y_4mm, z_4mm non-NULL: read) or only the
  * range (the three NULL: the range-only image of LIDET_Q_PIXEL_XYZ 0 or lidet_detector_q_cfg_t.range_only): x, y,
  * z are then decoded from the pixel's row, its column and its range with ONE rule, mirrored bit for bit by
- * codegen/lidet_codegen/ref/qmath.py (decode_pixels):
+ * codegen/lidet_ref/qmath.py (decode_pixels):
  *   row r:     e = row_elev_bam[r] (the beam's elevation), ce = cos e, se = sin e in Q15, each the Q30 value of
  *              lidet__q_cos/sin rounded: round(v / 2^15);
  *   column c:  t = floor((2c + 1) 2^31 / n_cols) (BAM32: the column centre's angle from azimuth pi, as the

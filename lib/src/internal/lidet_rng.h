@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* xorshift32 (Marsaglia 2003, shifts 13, 17, 5): the one deterministic generator of every randomised
  * stage (the ground RANSAC, lidet_ground_ransac.c; the proposal resampling, lidet_proposal.c). Mirrored
- * bit for bit by codegen/lidet_codegen/ref/rng.py and ref/cluster.py. Never installed. */
+ * bit for bit by codegen/lidet_ref/rng.py and lidet_ref/cluster.py. Never installed. */
 #ifndef LIDET_RNG_H
 #define LIDET_RNG_H
 

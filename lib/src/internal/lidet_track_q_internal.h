@@ -9,7 +9,7 @@
 /* Assign the n_rows x n_cols costs in t->cost (row stride LIDET_TRACK_MAX_DETS; costs in [0, big], big: no pair)
  * with lidet_track_assign_t mode: t->row_col[r] = the column of row r, or -1 (no column, or only at cost big);
  * t->col_row the inverse. n_rows <= LIDET_TRACK_MAX_TRACKS, n_cols <= LIDET_TRACK_MAX_DETS, big < 2^31.
- * codegen/lidet_codegen/ref/track_q.py: hungarian, greedy. */
+ * codegen/lidet_ref/track_q.py: hungarian, greedy. */
 void lidet__track_q_assign(lidet_tracker_q_t *t, uint32_t n_rows, uint32_t n_cols, int32_t big,
                            uint32_t mode);
 

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Portable float32 dense kernels (see internal/lidet_nn.h); reference: codegen/lidet_codegen/ref/pointnet.py
+/* Portable float32 dense kernels (see internal/lidet_nn.h); reference: codegen/lidet_ref/pointnet.py
  * dense(). Plain C99, no intrinsics: the port layer may replace this file, and it stays the test oracle.
  *
  * Why this shape (measured on the host, gcc -O3, SSE2 only, 8 rows x 64 -> 128 layer): the weights are

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Portable int8 dense kernels of the integer PointNets (internal/lidet_pointnet_q_internal.h); reference:
- * codegen/lidet_codegen/ref/pointnet_q.py (dense_acc, requant). Plain C99, integers only: int8 x int8 (or
+ * codegen/lidet_ref/pointnet_q.py (dense_acc, requant). Plain C99, integers only: int8 x int8 (or
  * int16 x int8) products summed in int32 (one 32-bit multiply-add per weight on a Cortex-M0+), one 64-bit
  * requantization per output value. Weights [in][out] as the float kernel: the innermost loop runs over the
  * output channels of one weight row (unit stride; compilers vectorise it on hosts, and x86-64 host builds also

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* PointNet forward pass, energies and box decoding (see lidet_pointnet.h). Mirrored function for
- * function by codegen/lidet_codegen/ref/pointnet.py: check -> (descriptor checks in emit.py),
+ * function by codegen/lidet_ref/pointnet.py: check -> (descriptor checks in emit.py),
  * run_stage -> run_stage, lidet_pn_energy -> energy, decode_box -> decode_box,
  * lidet_pn_to_model_frame -> to_model_frame. */
 #include <math.h>

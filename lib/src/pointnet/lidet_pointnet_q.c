@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* The int8 PointNets (see lidet_pointnet_q.h). Integers only: no <math.h>, no float. Mirrored bit for bit
- * by codegen/lidet_codegen/ref/pointnet_q.py: run_stage -> run_stage, forward -> forward, frame_cs ->
+ * by codegen/lidet_ref/pointnet_q.py: run_stage -> run_stage, forward -> forward, frame_cs ->
  * frame_cs, load_block -> model_frame, lidet_pointnet_q_energy -> energy, decode_box -> decode_box. */
 #include "internal/lidet_q_gpr.h" /* first: no FPU register for 64-bit integers */
 #include <string.h>

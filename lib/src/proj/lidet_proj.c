@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Spherical projection (see lidet_proj.h for the algorithm and memory).
- * Mirrored by codegen/lidet_codegen/ref/proj.py (the numpy reference used by the tests). */
+ * Mirrored by codegen/lidet_ref/proj.py (the numpy reference used by the tests). */
 #include <math.h>
 #include <string.h>
 

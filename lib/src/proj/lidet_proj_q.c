@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Spherical projection of the integer path (see lidet_proj_q.h for the rules and docs/FIXED_POINT.md).
- * Mirrored bit for bit by codegen/lidet_codegen/ref/proj_q.py. No float here. */
+ * Mirrored bit for bit by codegen/lidet_ref/proj_q.py. No float here. */
 #include <string.h>
 
 #include "internal/lidet_assert.h"
@@ -720,9 +720,9 @@ lidet_status_t lidet_proj_q_returns_add(lidet_proj_q_state_t *st, const lidet_pr
     st->stats.n_points_in += n_returns;
     st->stats.n_truncated += n_returns - n;
     returns_limits(st, &min_mm, &max_mm);
-    if (range_only)
+    if (range_only) /* the firmware's case */
     {
-        returns_pass1(st, buf, returns, n, st->n_points, min_mm, max_mm, &st->stats, 1); /* the firmware's case */
+        returns_pass1(st, buf, returns, n, st->n_points, min_mm, max_mm, &st->stats, 1);
     }
     else
     {

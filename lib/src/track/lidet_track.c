@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* The tracker, float build (lidet_track.h, docs/TRACKING.md). Mirrored operation for operation by
- * codegen/lidet_codegen/ref/track.py (float32 numpy): every expression below is written in the order the
+ * codegen/lidet_ref/track.py (float32 numpy): every expression below is written in the order the
  * reference evaluates it (one rounding per operation: the library is built with -ffp-contract=off), so the two
  * agree to the last bit except where libm's sinf / cosf / atan2f round differently from the reference's
  * correctly rounded values (tests/python/test_track.py states the tolerance). */

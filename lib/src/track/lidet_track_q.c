@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* The integer tracker (lidet_track_q.h, docs/TRACKING.md "Integer build"). Integers only. Mirrored bit for bit
- * by codegen/lidet_codegen/ref/track_q.py (the function of each step is named where it starts).
+ * by codegen/lidet_ref/track_q.py (the function of each step is named where it starts).
  *
  * Why every product below fits int64 (the bounds init and update enforce):
  * - positions |x| <= 2^28 (Q8 mm), detection centres the same, so a difference is < 2^30 and d^2 < 2^61;

@@ -4,7 +4,7 @@
 `Tracker()` runs the C float tracker (ports/python/lidet_py_track.c) of the same shared library as
 lidet_tools.native (liblidet_py.so, found by native.lib()); `Tracker(fixed=True)` the integer one
 (lidet_tools.track.native_q.TrackerQ) behind the same interface. The numpy reference of the float tracker is
-lidet_codegen.ref.track.
+lidet_ref.track.
 """
 from __future__ import annotations
 

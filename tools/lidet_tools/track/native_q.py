@@ -3,7 +3,7 @@
 (ports/python/lidet_py_track_q.c), loaded by lidet_tools.native's loader ($LIDET_LIB, $LIDET_BUILD_DIR, build/).
 
 `TrackerQ(**cfg)` takes the float tracker's configuration fields in SI units (meas_sigma_m=..., gate_chi2=...) or
-the integer ones (meas_sigma_mm=..., gate_chi2_q16=...), converted by codegen/lidet_codegen/ref/track_q.py's
+the integer ones (meas_sigma_mm=..., gate_chi2_q16=...), converted by codegen/lidet_ref/track_q.py's
 cfg_from. `update` quantises float detections exactly as the detector's integer path has them
 (ref.track_q.quantise_dets) and returns TRACK_DTYPE records in SI units; `update_q` takes and returns the raw
 integer rows (ref.track_q.TRACK_Q_FIELDS).
@@ -14,7 +14,7 @@ import ctypes as C
 
 import numpy as np
 
-from lidet_codegen.ref import track_q as ref
+from lidet_ref import track_q as ref
 from lidet_tools import native
 
 _i32p = np.ctypeslib.ndpointer(np.int32, flags="C_CONTIGUOUS")

@@ -45,7 +45,7 @@ def _train(mod, fam, kind, flag, a):
 
 
 def run(a) -> dict:
-    from lidet_codegen.export import load_checkpoint
+    from .export import load_checkpoint
     from . import train_box, train_cls
     fam = a.family
     data = D.load(a.work / f"{fam}.npz")

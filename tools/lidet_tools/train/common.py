@@ -373,7 +373,7 @@ def write_outputs(ck: dict, model, a, main: bool, dd) -> dict:
     if main:
         save_atomic(ck, a.out)
         if a.onnx:
-            from lidet_codegen.export import export_onnx
+            from .export import export_onnx
             export_onnx(model.cpu(), ck, a.onnx)
     if dd:
         dd.barrier()

@@ -395,7 +395,8 @@ def process_scan(scan: Scan, sensor: str, cfg: dict) -> dict:
 # ---- jobs -------------------------------------------------------------------------------------------
 
 def _job(task, sensor, cfg, behind_cars=0.0):
-    kind, split, a, b, c = task
+    kind, split, a, b, c = task[:5]
+    sensor = task[5] if len(task) > 5 else sensor  # a simulated scan of a mixed set names its own sensor
     if kind == "sim":
         scan = sim_scan(sensor, a, b, c, behind_cars)
     elif kind == "kitti":
@@ -423,9 +424,14 @@ def build_tasks(a) -> list:
         if len(counts) != 3 or min(counts) < 0:
             raise ValueError("--sim takes three counts: train,val,test")
         mounts = [float(v) for v in a.mounts.split(",")] if a.mounts else [None]
+        sensors = [v for v in (a.sim_sensors or "").split(",") if v]
         for s, n in enumerate(counts):
             for i in range(n):
-                tasks.append(("sim", s, a.seed + s, i, mounts[i % len(mounts)]))
+                if sensors:  # every sensor at every mount: sensors cycle fastest, then the mounts
+                    k = len(sensors)
+                    tasks.append(("sim", s, a.seed + s, i, mounts[(i // k) % len(mounts)], sensors[i % k]))
+                else:
+                    tasks.append(("sim", s, a.seed + s, i, mounts[i % len(mounts)]))
     split_of = (lambda n: SPLITS.index(a.split)) if a.split else hash_split
     for folder in a.kitti or []:
         for n in kitti_scans(folder):
@@ -483,6 +489,9 @@ def main(argv=None) -> int:
     ap.add_argument("--sim", help="simulated scans per split: TRAIN,VAL,TEST (e.g. 160,40,40)")
     ap.add_argument("--seed", type=int, default=1000, help="simulator run seed of the train split (val +1, test +2)")
     ap.add_argument("--mounts", help="simulator mount heights in m, cycled over scans (e.g. 0.3,0.5,0.7,1.0)")
+    ap.add_argument("--sim-sensors", metavar="A,B,...",
+                    help="simulated scans of several sensor presets (e.g. vlp32c,hdl32,os1-32), cycled over the scans "
+                         "(every sensor at every --mounts height), each through its own C stages; default: --sensor")
     ap.add_argument("--sim-behind-cars", type=float, default=0.0, metavar="RATE",
                     help="simulated scans: mean number of people (or rows of people) standing behind parked cars "
                          "per scan (`lidet-sim --behind-cars`; default 0)")
@@ -509,6 +518,11 @@ def main(argv=None) -> int:
         ap.error("give at least one source: --sim, --kitti, --semantickitti or --boxes")
     if a.jobs < 1:
         ap.error("--jobs must be >= 1")
+    if a.sim_sensors:
+        from ..sensors import SENSORS
+        bad = [v for v in a.sim_sensors.split(",") if v not in SENSORS]
+        if bad or not a.sim:
+            ap.error(f"--sim-sensors: presets ({', '.join(SENSORS)}) with --sim" + (f"; unknown: {', '.join(bad)}" if bad else ""))
     if not 0.0 <= a.sim_behind_cars <= 50.0:
         ap.error("--sim-behind-cars must be in [0, 50]")
     try:
@@ -542,7 +556,7 @@ def main(argv=None) -> int:
     if len(d["label"]) == 0:
         print("dataset: no proposals (empty scans?)", file=sys.stderr)
         return 1
-    meta = dict(sensor=a.sensor, sim=a.sim, seed=a.seed, mounts=a.mounts, sim_behind_cars=a.sim_behind_cars, kitti=[str(p) for p in a.kitti or []],
+    meta = dict(sensor=a.sensor, sim_sensors=a.sim_sensors, sim=a.sim, seed=a.seed, mounts=a.mounts, sim_behind_cars=a.sim_behind_cars, kitti=[str(p) for p in a.kitti or []],
                 semantickitti=[str(p) for p in a.semantickitti or []], boxes=[str(p) for p in a.boxes or []], n_excluded=int(sum(p["n_excluded"] for p in parts)),
                 n_objects=[int(v) for v in np.sum([p["n_objects"] for p in parts], axis=0)], **cfg,
                 command="python -m lidet_tools.train.dataset " + " ".join(argv if argv is not None else sys.argv[1:]))

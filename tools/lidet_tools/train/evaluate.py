@@ -28,7 +28,7 @@ from . import models as M
 
 def evaluate(data: dict, split: int, cls_ck=None, box_ck=None, energies_dir=None, cls_model=None, box_model=None) -> dict:
     """cls_ck/box_ck: checkpoint paths (or give loaded models with their gamma via *_model=(model, gamma))."""
-    from lidet_codegen.export import load_checkpoint
+    from .export import load_checkpoint
     from . import common as C
     d = C.split(data, split)
     out = dict(n=int(len(d["label"])), n_scans=int(len(np.unique(d["scan"]))) if len(d["label"]) else 0)

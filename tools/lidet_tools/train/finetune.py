@@ -143,7 +143,7 @@ def load_onnx(path):
                    use_pvle=bool(widths("pvle")), use_tnet=use_tnet)
         if use_tnet:
             cfg.update(tnet_point=widths("tnet_point"), tnet_head=widths("tnet_head")[:-1])
-    from lidet_codegen.export import build_model
+    from .export import build_model
     model = build_model(kind, cfg)
     sd = model.state_dict()
     want = {k for k in sd if not k.endswith("num_batches_tracked")}
@@ -195,7 +195,7 @@ def load_onnx(path):
 def onnx_parity(model, kind: str, onnx_path, points: np.ndarray, voxel: np.ndarray, cls=None) -> dict:
     """{output: (max abs difference, largest |output|)} of the PyTorch model against onnxruntime on one batch."""
     import onnxruntime as ort
-    from lidet_codegen.export import torch_forward
+    from .export import torch_forward
     feeds = {"points": np.ascontiguousarray(points, np.float32), "voxel": np.ascontiguousarray(voxel, np.float32)}
     if kind == "box":
         feeds["onehot"] = np.eye(M.N_CLASSES, dtype=np.float32)[np.asarray(cls, np.int64)]
@@ -654,7 +654,7 @@ def _sha(p) -> str:
 
 
 def finetune(a) -> dict:
-    from lidet_codegen.export import export_onnx
+    from .export import export_onnx
     t_all = time.perf_counter()
     timings = {}
     sensor, spec = check_args(a)
@@ -882,7 +882,7 @@ def card(r: dict, a) -> str:
     L += ["## C models", "",
           f"`{a.out_weights}` holds the fine-tuned `cls_{fam}` and `box_{fam}`"
           + ("" if a.only_family else " and the other shipped families unchanged")
-          + f", their int8 calibration on the user's scans (`python -m lidet_codegen calibrate ... --scans "
+          + f", their int8 calibration on the user's scans (`python -m lidet_tools.train.calibrate ... --scans "
           + " --scans ".join(r["data"]) + "`) and every C model (`python -m lidet_codegen regen "
           f"{a.out_weights}`). Build the detector with them:", "",
           f"    cmake -S . -B build_ft -DCMAKE_BUILD_TYPE=Release -DLIDET_WEIGHTS_DIR={a.out_weights.resolve()}",

@@ -122,7 +122,7 @@ class FoldedClassifier:
     @torch.no_grad()
     def ranges(self, pts, vox, percentile: float) -> dict:
         """Per-channel activation ranges: `percentile` of each layer's float output (the last point layer's
-        after the max over the points), as `quant.calibrate` takes them for classifiers."""
+        after the max over the points), as `quant.activation_ranges` takes them for classifiers."""
         outs = []
         self.forward(pts, vox, trace=outs)
         return {nm: torch.tensor(np.maximum(np.percentile(t.reshape(-1, t.shape[-1]).numpy(), percentile, axis=0),
@@ -193,7 +193,7 @@ def add_args(ap):
 
 def finetune(a) -> dict:
     from lidet_codegen.emit import load
-    from lidet_codegen.export import export_onnx
+    from .export import export_onnx
     C.setup(a.seed, a.threads)
     # torch's deterministic kernels made an epoch 25x slower here (50 s against 2 s on the VLP-16 set); the CPU
     # kernels this loop uses give the same result run to run with one thread (tests/python/test_train_smoke.py)

@@ -25,7 +25,7 @@ ONNX contract (opset 17; fixed names; batch axis "batch" dynamic, N fixed at exp
     classifier: inputs points [B, N, 3], voxel [B, 3]                 -> output logits [B, 3]
     box:        inputs points [B, N, 3], voxel [B, 3], onehot [B, 3]  -> outputs center_tnet [B, 3], box [B, 39]
     voxel holds the integer bins as float32. Energies, gates and box decoding are not in the graph: the
-    C forward pass and `lidet_codegen.ref.pointnet` compute them from these outputs.
+    C forward pass and `lidet_ref.pointnet` compute them from these outputs.
     metadata_props (all strings): lidet.kind (classifier|box), lidet.format, lidet.n_points, lidet.classes,
     lidet.frame (azimuth), lidet.pvle_bins (az rad, el rad, range m), lidet.energy_T, lidet.gamma (one per
     class), lidet.trained (0|1), and for the box net lidet.n_heading_bins, lidet.mean_sizes (l w h per class).
@@ -167,7 +167,7 @@ def heading_to_bin(yaw):
 
 def decode_box(center_tnet: np.ndarray, box: np.ndarray):
     """Raw outputs -> (centre (B, 3) model frame, yaw (B,) model frame, size (B, 3) l w h, heading bin,
-    size class). float64 numpy; lidet_codegen.ref.pointnet mirrors the C decode exactly."""
+    size class). float64 numpy; lidet_ref.pointnet mirrors the C decode exactly."""
     box = np.asarray(box, np.float64)
     c = np.asarray(center_tnet, np.float64) + box[:, 0:3]
     hb = np.argmax(box[:, 3:3 + N_HEADING_BINS], axis=1)

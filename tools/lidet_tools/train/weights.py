@@ -9,7 +9,7 @@ Per sensor family: the proposal dataset (simulator, fixed seeds; skipped when it
 classifier and the box net (each resumable from its state folder under --work: an interrupted run
 continues where it stopped), the ONNX export, the figures on the test split, the energy histograms
 (`lidet-viz energy`), the classifier on the real KITTI frames (when --real exists), the MAC counts.
-Then the C models (c_models): the int8 calibration of each new ONNX file (`python -m lidet_codegen calibrate`,
+Then the C models (c_models): the int8 calibration of each new ONNX file (`python -m lidet_tools.train.calibrate`,
 and `calibrate --refit` for a classifier not fine-tuned for int8) and every float and int8 C file of --weights
 with lidet_weights.{c,h} (`python -m lidet_codegen regen`), and finally the model card. The same command on the
 same machine gives the same models.
@@ -34,6 +34,13 @@ FAMILIES = {
     "hdl64": dict(dataset=["--sensor", "hdl64", "--sim", "600,150,150", "--seed", "1000"],
                   cls=["--epochs-ce", "20", "--epochs-energy", "10"],
                   box=["--epochs-box", "30", "--epochs-energy", "10"]),
+    # vlp32c: the 32-beam family (issue 37, item 5), one pair for every 32-beam preset: simulated scans of the five
+    # presets (VLP-32C, HDL-32E, Ouster OS0 / OS1 / OS2 at 32 beams) at four mount heights, each through its own C
+    # stages; the hdl64 family's schedule
+    "vlp32c": dict(dataset=["--sensor", "vlp32c", "--sim-sensors", "vlp32c,hdl32,os0-32,os1-32,os2-32",
+                            "--mounts", "0.7,1.0,1.4,1.84", "--sim", "800,200,200", "--seed", "3000"],
+                   cls=["--epochs-ce", "20", "--epochs-energy", "10"],
+                   box=["--epochs-box", "30", "--epochs-energy", "10"]),
     # vlp16: 25 energy epochs with lam 0.3 (chosen on validation: FPR95 + 1 - balanced accuracy 0.127,
     # against 0.136 for 25 epochs at lam 0.1 and 0.197 for 10 epochs at lam 0.1)
     "vlp16": dict(dataset=["--sensor", "vlp16", "--mounts", "0.3,0.5,0.7,1.0", "--sim", "800,200,200", "--seed", "2000"],
@@ -115,7 +122,7 @@ def onnx_parity(dd: dict, cks: dict, wdir, fam: str) -> dict:
     """Max abs difference onnxruntime vs PyTorch over every test-split proposal, per output."""
     import numpy as np
     import onnxruntime as ort
-    from lidet_codegen.export import load_checkpoint, torch_forward
+    from .export import load_checkpoint, torch_forward
     from . import common as C
     te = C.split(dd, 2)
     feeds = {"points": te["points"].astype(np.float32), "voxel": te["voxel"].astype(np.float32)}
@@ -144,7 +151,7 @@ def onnx_parity(dd: dict, cks: dict, wdir, fam: str) -> dict:
 def _histograms(fam, edir, a):
     from ..viz import cli as viz
     import numpy as np
-    from lidet_codegen.export import load_checkpoint
+    from .export import load_checkpoint
     for kind, title in (("cls", "gate 1 (classifier)"), ("box", "gate 2 (box net)")):
         if not (edir / f"{kind}_id.npy").exists():
             continue
@@ -180,15 +187,16 @@ def run_real(a) -> dict:
 
 def c_models(a, fams, scan_dirs=None) -> list:
     """The C models of --weights after training: for each family trained, its two new ONNX files calibrated for
-    int8 (`python -m lidet_codegen calibrate`, the classifier first: a box net is calibrated on the classes of the
+    int8 (`python -m lidet_tools.train.calibrate`, the classifier first: a box net is calibrated on the classes of the
     classifier beside it), the classifier's last layer refitted (`calibrate --refit`) unless it was fine-tuned for
     int8 (cls_finetune; a refit made the fine-tuned ones' gate decisions agree less, docs/FIXED_POINT.md); then
     every float and int8 C model of the folder and lidet_weights.{c,h} (lidet_codegen.regen.emit_all, the commands
     of the committed weights/ and of CI's drift check). scan_dirs: folders of scans (velodyne/*.bin) that replace
     the real KITTI scans of a.real in the calibration (`calibrate --scans`; lidet_tools.train.finetune passes the
     user's). Returns the emit commands."""
-    from lidet_codegen import quant as Q
     from lidet_codegen import regen
+
+    from . import calibrate as CB
     if scan_dirs:
         ra = [x for d in scan_dirs for x in ("--scans", str(d))]
     else:
@@ -197,15 +205,15 @@ def c_models(a, fams, scan_dirs=None) -> list:
     for fam in fams:
         cls, box = ((a.weights / f"{k}_{fam}.onnx").as_posix() for k in ("cls", "box"))
         _log(f"{fam}: int8 calibration -> {a.weights}/{{cls,box}}_{fam}.calib.json")
-        Q.main([cls, box] + ra)
+        CB.main([cls, box] + ra)
         if not FAMILIES[fam].get("cls_finetune"):
-            Q.main(["--refit", cls] + ra)
+            CB.main(["--refit", cls] + ra)
     _log(f"C models -> {a.weights}/*.c, *_s8.c, lidet_weights.c")
     return regen.emit_all(a.weights)
 
 
 def model_card(a, results: dict, real, timings: dict) -> str:
-    from lidet_codegen.export import load_checkpoint
+    from .export import load_checkpoint
     L = ["# lidet PointNet weights: model card", "",
          "Generated by `make weights` (`python -m lidet_tools.train.weights`); do not edit by hand. Method,",
          "choices and the ablation: docs/TRAINING.md.", ""]

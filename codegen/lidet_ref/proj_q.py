@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lidet_codegen.ref import qmath
+from lidet_ref import qmath
 
 COORD_MAX_MM = 131000
 MAX_R2 = 131000 * 131000

@@ -13,8 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lidet_codegen.ref import qmath as qm
-from lidet_codegen.ref.cluster import grid_parts, proposal_indices
+from lidet_ref import qmath as qm
+from lidet_ref.cluster import grid_parts, proposal_indices
 
 FREE, SMALL, PENDING, NONCAND = 0, 0xFFFD, 0xFFFE, 0xFFFF
 STEPS = 16  # LIDET_CLUSTER_MAX_STEPS

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lidet_codegen.qtables import N, atan_bam, sin_q30
+from lidet_ref.tables import N, atan_bam, sin_q30
 
 SIN_Q30 = np.asarray(sin_q30(), dtype=np.int64)
 ATAN_BAM = np.asarray(atan_bam(), dtype=np.int64)

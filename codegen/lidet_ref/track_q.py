@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from lidet_codegen.ref import qmath as Q
+from lidet_ref import qmath as Q
 
 COORD_MAX_MM = 1 << 20          # LIDET_TRACK_Q_COORD_MAX_MM
 SIZE_MAX_MM = 100000            # LIDET_TRACK_Q_SIZE_MAX_MM
@@ -51,7 +51,7 @@ CFG_LEN = sum(n for _, n in CFG_FIELDS)
 TRACK_Q_FIELDS = ("id", "cls", "state", "cx_mm", "cy_mm", "cz_mm", "l_mm", "w_mm", "h_mm", "yaw_bam", "vx_mmps",
                   "vy_mmps", "p_pp", "p_pv", "p_vv", "score_q15", "hits", "misses", "age", "det")
 
-#: the same tracks in SI units: the layout of codegen/lidet_codegen/ref/track.py's TRACK_DTYPE
+#: the same tracks in SI units: the layout of codegen/lidet_ref/track.py's TRACK_DTYPE
 TRACK_DTYPE = np.dtype([
     ("id", "<u4"), ("cls", "u1"), ("state", "u1"),
     ("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("l", "<f4"), ("w", "<f4"), ("h", "<f4"), ("yaw", "<f4"),

@@ -5,7 +5,7 @@ Boxes are tuples/arrays (cx_mm, cy_mm, cz_mm, l_mm, w_mm, h_mm, yaw_bam); Python
 """
 from __future__ import annotations
 
-from lidet_codegen.ref import qmath
+from lidet_ref import qmath
 
 SIZE_MIN_MM = ((2000, 1200, 900), (800, 200, 800), (200, 200, 700))
 SIZE_MAX_MM = ((7500, 3000, 3200), (2600, 1500, 2400), (1600, 1600, 2400))

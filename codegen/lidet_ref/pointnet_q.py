@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from lidet_codegen.pnq_tables import exp2_neg_q30, log2_q30
-from lidet_codegen.ref import qmath as Q
+from lidet_ref import qmath as Q
+from lidet_ref.tables import exp2_neg_q30, log2_q30
 
 EXP2 = np.asarray(exp2_neg_q30(), np.int64)
 LOG2 = np.asarray(log2_q30(), np.int64)

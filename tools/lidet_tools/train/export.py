@@ -1,17 +1,23 @@
 # SPDX-License-Identifier: MIT
 """PyTorch checkpoint -> ONNX (opset 17) with lidet's metadata: the contract of
-tools/lidet_tools/train/models.py (input/output names, shapes, metadata keys).
+tools/lidet_tools/train/models.py (input/output names, shapes, metadata keys), which lidet_codegen reads.
+
+    python -m lidet_tools.train.export CHECKPOINT.pt --out weights/<name>.onnx [--name NAME]
+    python -m lidet_tools.train.export --untrained classifier|box --out X.onnx [--seed S] [--n-points N] [--cfg JSON]
 
 Checkpoint format (torch.save of a dict): {"kind": "classifier"|"box", "cfg": model.cfg,
 "state_dict": ..., "meta": {"n_points": 64, "gamma": [3 floats], "energy_T": 1.0, "trained": 1, ...}}.
 `untrained()` builds one from a seeded initialisation (batch-norm statistics set from random
-proposal-like inputs, so folding is exercised) to unblock codegen before training lands.
+proposal-like inputs, so folding is exercised): models for codegen's tests without training.
 """
 from __future__ import annotations
 
+import argparse
 import hashlib
 import io
+import json
 import pathlib
+import sys
 import warnings
 
 import numpy as np
@@ -23,7 +29,7 @@ def _torch():
 
 
 def build_model(kind: str, cfg: dict):
-    from lidet_tools.train import models as M
+    from . import models as M
     if kind == "classifier":
         return M.ClassifierNet(**cfg)
     if kind == "box":
@@ -67,8 +73,9 @@ def untrained(kind: str, n_points: int = 64, seed: int = 0, cfg: dict | None = N
 def export_onnx(model, ck: dict, out_path, name: str | None = None) -> pathlib.Path:
     """Export `model` (eval mode) with the contract's names and metadata. Returns the path."""
     torch = _torch()
-    from lidet_tools.train import models as M
     import onnx
+
+    from . import models as M
 
     kind = ck["kind"]
     meta = ck["meta"]
@@ -129,6 +136,8 @@ def export_onnx(model, ck: dict, out_path, name: str | None = None) -> pathlib.P
     for k in sorted(props):
         e = om.metadata_props.add()
         e.key, e.value = k, props[k]
+    # the producer the committed ONNX files name: an export of the same checkpoint gives the same bytes (the C models
+    # carry their sha256)
     om.producer_name, om.producer_version = "lidet_codegen", ""
     out_path = pathlib.Path(out_path)
     out_path.parent.mkdir(parents=True, exist_ok=True)
@@ -151,3 +160,45 @@ def torch_forward(model, kind, points: np.ndarray, voxel: np.ndarray, onehot: np
         o = torch.from_numpy(np.ascontiguousarray(onehot, np.float32))
         dc, box = model(p, v, o)
         return {"center_tnet": dc.numpy(), "box": box.numpy()}
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(prog="python -m lidet_tools.train.export",
+                                 description="PyTorch checkpoint -> ONNX (opset 17) with lidet's metadata")
+    src = ap.add_mutually_exclusive_group(required=True)
+    src.add_argument("checkpoint", nargs="?", help="checkpoint .pt written by lidet's training")
+    src.add_argument("--untrained", choices=["classifier", "box"],
+                     help="a seeded untrained model (to exercise codegen before training)")
+    ap.add_argument("--out", required=True, help="output .onnx")
+    ap.add_argument("--name", help="model name stored in the metadata (default: the output's stem)")
+    ap.add_argument("--seed", type=int, default=0, help="seed of --untrained (default 0)")
+    ap.add_argument("--n-points", type=int, default=64, help="points per proposal of --untrained (default 64)")
+    ap.add_argument("--cfg", metavar="JSON",
+                    help="layer widths of --untrained as the model's constructor arguments, e.g. "
+                         "'{\"point\": [8, 16], \"pvle\": [4], \"head\": [8]}' (default: the trained models' widths)")
+    a = ap.parse_args(argv)
+    cfg = None
+    if a.cfg is not None:
+        if not a.untrained:
+            ap.error("--cfg needs --untrained (a checkpoint carries its own widths)")
+        try:
+            cfg = json.loads(a.cfg)
+        except json.JSONDecodeError as e:
+            ap.error(f"--cfg: not JSON: {e}")
+        if not isinstance(cfg, dict):
+            ap.error("--cfg: a JSON object of constructor arguments")
+    try:
+        if a.untrained:
+            model, ck = untrained(a.untrained, a.n_points, a.seed, cfg)
+        else:
+            model, ck = load_checkpoint(a.checkpoint)
+    except (OSError, ValueError, TypeError) as e:
+        print(f"lidet_tools.train.export: error: {e}", file=sys.stderr)
+        return 2
+    p = export_onnx(model, ck, a.out, a.name)
+    print(f"{p}: {ck['kind']}, sha256 {sha256(p)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from lidet_codegen.ref import cluster_q, ground_q, pointnet_q, post_q, proj_q, qmath
+from lidet_ref import cluster_q, ground_q, pointnet_q, post_q, proj_q, qmath
 
 OUT_CROP, OUT_RANGE, OUT_BUDGET, OUT_GATE1, OUT_GATE2, OUT_SIZE, OUT_NMS, OUT_CAPACITY, OUT_DETECTED, OUT_TALL = range(1, 11)
 
