@@ -13,18 +13,21 @@
 #endif
 
 /* Decode n_packets payloads (concatenated in `bytes`, lens[i] bytes each) with cfg = model, filter, seam_cdeg,
- * max_step_cdeg, force_model. Per return (at most cap): range_mm, azimuth (BAM16), ring, t_ns, azimuth_cdeg, intensity, flags,
- * the packet's index, the scan number (0 = the scan in progress at the start; +1 at each scan event) and, when xyz
- * is not NULL, x y z (float, metres). Per packet: event (scan_event | reject << 8), scan_end. stats: the 16 counts
- * of lidet_velodyne_stats_t in order. Returns the number of returns, or a negative status. */
+ * max_step_cdeg, force_model, ring_top_first and, when calib is not NULL, the calibration calib = n_lasers, then per
+ * laser id vert_mdeg, rot_cdeg, dist_mm (int32; at most LIDET_VELODYNE_MAX_LASERS lasers). Per return (at most
+ * cap): range_mm, azimuth (BAM16), ring, t_ns, azimuth_cdeg, intensity, flags, the packet's index, the scan number
+ * (0 = the scan in progress at the start; +1 at each scan event) and, when xyz is not NULL, x y z (float, metres,
+ * the decoder's elevations: lidet_velodyne_decoder_xyz). Per packet: event (scan_event | reject << 8), scan_end.
+ * stats: the 18 counts of lidet_velodyne_stats_t in order. Returns the number of returns, or a negative status. */
 LIDET_PY_API int64_t lidet_py_velodyne_decode(const uint8_t *bytes, const uint32_t *lens, uint32_t n_packets,
-                                              const uint32_t *cfg_u32, uint32_t cap, uint32_t *range_mm,
-                                              uint16_t *azimuth, uint16_t *ring, uint32_t *t_ns,
-                                              uint16_t *azimuth_cdeg, uint8_t *intensity, uint8_t *flags,
-                                              uint32_t *packet, uint32_t *scan, float *xyz, uint32_t *events,
-                                              uint32_t *scan_end, uint32_t *stats)
+                                              const uint32_t *cfg_u32, const int32_t *calib, uint32_t cap,
+                                              uint32_t *range_mm, uint16_t *azimuth, uint16_t *ring,
+                                              uint32_t *t_ns, uint16_t *azimuth_cdeg, uint8_t *intensity,
+                                              uint8_t *flags, uint32_t *packet, uint32_t *scan, float *xyz,
+                                              uint32_t *events, uint32_t *scan_end, uint32_t *stats)
 {
     lidet_velodyne_cfg_t cfg;
+    lidet_velodyne_calib_t cal;
     lidet_velodyne_t st;
     lidet_return_t out[LIDET_VELODYNE_MAX_RETURNS];
     lidet_velodyne_attr_t attr[LIDET_VELODYNE_MAX_RETURNS];
@@ -37,6 +40,24 @@ LIDET_PY_API int64_t lidet_py_velodyne_decode(const uint8_t *bytes, const uint32
     cfg.seam_cdeg = (uint16_t)cfg_u32[2];
     cfg.max_step_cdeg = (uint16_t)cfg_u32[3];
     cfg.force_model = (uint8_t)cfg_u32[4];
+    cfg.ring_top_first = (uint8_t)cfg_u32[5];
+    if (calib != NULL)
+    {
+        uint32_t k;
+        memset(&cal, 0, sizeof cal);
+        cal.n_lasers = (uint32_t)calib[0];
+        if (cal.n_lasers > LIDET_VELODYNE_MAX_LASERS)
+        {
+            return LIDET_ERR_CONFIG;
+        }
+        for (k = 0; k < cal.n_lasers; ++k)
+        {
+            cal.laser[k].vert_mdeg = calib[1u + 3u * k];
+            cal.laser[k].rot_cdeg = (int16_t)calib[2u + 3u * k];
+            cal.laser[k].dist_mm = (int16_t)calib[3u + 3u * k];
+        }
+        cfg.calib = &cal;
+    }
     status = lidet_velodyne_init(&st, &cfg);
     if (status != LIDET_OK)
     {
@@ -57,8 +78,7 @@ LIDET_PY_API int64_t lidet_py_velodyne_decode(const uint8_t *bytes, const uint32
         }
         if (xyz != NULL && res.n_returns > 0u && n + res.n_returns <= cap)
         {
-            (void)lidet_velodyne_xyz(cfg.force_model ? cfg.model : (lidet_velodyne_model_t)res.model, out,
-                                     res.n_returns, xyz + 3u * (uint64_t)n, 3u);
+            (void)lidet_velodyne_decoder_xyz(&st, out, res.n_returns, xyz + 3u * (uint64_t)n, 3u);
         }
         for (i = 0; i < res.n_returns && n < cap; ++i, ++n)
         {

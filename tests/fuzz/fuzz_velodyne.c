@@ -1,15 +1,21 @@
 /* SPDX-License-Identifier: MIT */
 /* libFuzzer harness: the Velodyne packet decoder (lidet_velodyne_init, lidet_velodyne_packet) on a stream of
  * payloads the input describes. Layout: 7 header bytes (model, filter, seam u16, max step u16, flags: bit 0
- * force_model, bit 1 repair), then packets of [u16 length (mod 1400)][u8 room][length bytes]. With repair, a
- * 1206-byte payload gets valid flags, azimuths, factory bytes and dual pairs, so the decoding paths are reached.
- * Checks: nothing past the room, scan_end <= n_returns, rings and azimuths in range, counts that add up. */
+ * force_model, bit 1 repair, bit 2 a zero-length packet is NULL, bit 3 the model is the HDL-64E whatever the model
+ * byte says, bit 4 a calibration follows, bit 5 ring_top_first), with bit 4 a calibration of the model's lasers
+ * (per laser: elevation i16 x 3 mdeg, rotational correction i16 (0.01 deg), distance correction i16 (mm); out of
+ * range values included), then packets of [u16 length (mod 1400)][u8 room][length bytes]. With repair, a 1206-byte
+ * payload gets valid flags, azimuths, factory bytes and dual pairs (HDL-64E: alternating banks, a firing's blocks
+ * at one azimuth, one in eight a dual layout), so the decoding paths are reached. Checks: init refuses exactly the
+ * invalid configurations, nothing past the room, scan_end <= n_returns, rings (the model's lasers), ranges and
+ * azimuths in range, counts that add up. */
 #include "fuzz_common.h"
 
 static lidet_velodyne_t g_dec;
 static lidet_return_t g_out[LIDET_VELODYNE_MAX_RETURNS + 1];
 static lidet_velodyne_attr_t g_attr[LIDET_VELODYNE_MAX_RETURNS + 1];
 static uint8_t g_pkt[1400];
+static lidet_velodyne_calib_t g_cal;
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -35,6 +41,24 @@ static void repair(uint8_t *p, uint32_t sel)
     p[1205] = products[(sel / 3u) % 3u];
 }
 
+/* the HDL-64E layout: upper and lower banks alternating, a firing's blocks at the first one's azimuth (two blocks,
+ * or four for the dual layout the decoder refuses) */
+static void repair_hdl64e(uint8_t *p, uint32_t sel)
+{
+    const uint32_t per_firing = sel % 8u == 0u ? 4u : 2u;
+    uint32_t b;
+    for (b = 0; b < 12u; ++b)
+    {
+        uint8_t *blk = p + 100u * b;
+        const uint8_t *src = p + 100u * (b / per_firing * per_firing);
+        const uint32_t az = ((uint32_t)src[2] | ((uint32_t)src[3] << 8)) % 36000u;
+        blk[0] = 0xFFu;
+        blk[1] = (b & 1u) ? 0xDDu : 0xEEu;
+        blk[2] = (uint8_t)(az & 0xFFu);
+        blk[3] = (uint8_t)(az >> 8);
+    }
+}
+
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
 {
     static const lidet_velodyne_model_t models[4] = {LIDET_VELODYNE_AUTO, LIDET_VELODYNE_HDL32E,
@@ -43,7 +67,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     lidet_velodyne_cfg_t cfg;
     lidet_velodyne_result_t res;
     const lidet_velodyne_stats_t *s;
-    uint32_t flags, n_packets = 0, sum, i;
+    uint32_t flags, n_packets = 0, sum, i, n_rings;
+    int cal_ok = 1;
+    lidet_status_t init;
     lidet_velodyne_cfg_default(&cfg);
     cfg.model = models[fz_u8(&in) % 4u];
     cfg.filter = (lidet_velodyne_filter_t)(fz_u8(&in) % 3u);
@@ -51,11 +77,33 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     cfg.max_step_cdeg = (uint16_t)(1u + fz_u16(&in) % 18000u);
     flags = fz_u8(&in);
     cfg.force_model = (uint8_t)(flags & 1u);
-    if (lidet_velodyne_init(&g_dec, &cfg) != LIDET_OK)
+    cfg.ring_top_first = (uint8_t)((flags >> 5) & 1u);
+    if (flags & 8u)
     {
-        FZ_CHECK(cfg.force_model && cfg.model == LIDET_VELODYNE_AUTO);
+        cfg.model = LIDET_VELODYNE_HDL64E;
+    }
+    if (flags & 16u)
+    {
+        g_cal.n_lasers = lidet_velodyne_n_rings(cfg.model);
+        for (i = 0; i < g_cal.n_lasers; ++i)
+        {
+            g_cal.laser[i].vert_mdeg = 3 * (int32_t)(int16_t)fz_u16(&in);
+            g_cal.laser[i].rot_cdeg = (int16_t)fz_u16(&in);
+            g_cal.laser[i].dist_mm = (int16_t)fz_u16(&in);
+            cal_ok &= g_cal.laser[i].vert_mdeg > -90000 && g_cal.laser[i].vert_mdeg < 90000 &&
+                      g_cal.laser[i].rot_cdeg >= -18000 && g_cal.laser[i].rot_cdeg <= 18000;
+        }
+        cal_ok &= cfg.model != LIDET_VELODYNE_AUTO;
+        cfg.calib = &g_cal;
+    }
+    init = lidet_velodyne_init(&g_dec, &cfg);
+    FZ_CHECK((init == LIDET_OK) == (cal_ok && !(cfg.force_model && cfg.model == LIDET_VELODYNE_AUTO)));
+    if (init != LIDET_OK)
+    {
+        FZ_CHECK(init == LIDET_ERR_CONFIG);
         return 0;
     }
+    FZ_CHECK(g_dec.cfg.calib == 0);
     while (in.n > 0 && n_packets < 64u)
     {
         const uint32_t len = fz_u16(&in) % 1400u;
@@ -68,7 +116,15 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
         if ((flags & 2u) && len == LIDET_VELODYNE_PAYLOAD_BYTES)
         {
-            repair(g_pkt, g_pkt[1204]);
+            if (cfg.model == LIDET_VELODYNE_HDL64E ||
+                (cfg.model == LIDET_VELODYNE_AUTO && g_pkt[1205] % 4u == 0u))
+            {
+                repair_hdl64e(g_pkt, g_pkt[1204]);
+            }
+            else
+            {
+                repair(g_pkt, g_pkt[1204]);
+            }
         }
         g_out[room].range_mm = 0xA5A5A5A5u;
         st = lidet_velodyne_packet(&g_dec, len == 0u && (flags & 4u) ? NULL : g_pkt, len, g_out, g_attr, room,
@@ -79,10 +135,23 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK((st == LIDET_ERR_MODEL) == (res.reject != LIDET_VELODYNE_REJECT_NONE));
         FZ_CHECK(res.n_returns <= room && res.scan_end <= res.n_returns);
         FZ_CHECK(res.scan_event <= LIDET_VELODYNE_SCAN_ABORTED);
+        FZ_CHECK(res.reject < LIDET_VELODYNE_N_REJECT);
+        if (st == LIDET_ERR_MODEL)
+        {
+            continue;
+        }
+        n_rings = lidet_velodyne_decoder_n_rings(&g_dec);
+        FZ_CHECK(n_rings == lidet_velodyne_n_rings((lidet_velodyne_model_t)g_dec.model));
+        FZ_CHECK(g_dec.model != LIDET_VELODYNE_HDL64E ||
+                 (res.model == LIDET_VELODYNE_HDL64E && res.return_mode == 0u));
         for (i = 0; i < res.n_returns; ++i)
         {
-            FZ_CHECK(g_out[i].ring < 32u && g_out[i].range_mm > 0u && g_out[i].range_mm <= 4u * 65535u);
+            int32_t e;
+            FZ_CHECK(g_out[i].ring < n_rings && g_out[i].range_mm > 0u &&
+                     g_out[i].range_mm <= 4u * 65535u + (cfg.calib != 0 ? 32767u : 0u));
             FZ_CHECK(g_attr[i].azimuth_cdeg < 36000u && g_attr[i].t_ns < 1400000u);
+            FZ_CHECK(lidet_velodyne_decoder_elev_mdeg(&g_dec, g_out[i].ring, &e) == LIDET_OK);
+            FZ_CHECK(e > -90000 && e < 90000);
         }
     }
     s = lidet_velodyne_stats(&g_dec);
@@ -93,5 +162,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     }
     FZ_CHECK(s->n_packets == n_packets && sum == n_packets);
     FZ_CHECK(s->n_scans + s->n_partial + s->n_aborted <= 12u * n_packets);
+    FZ_CHECK(cfg.calib != 0 || s->n_short_range == 0u);
     return 0;
 }

@@ -1,6 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* Unity tests of the Velodyne packet decoder (lib/src/decode/lidet_velodyne.c) on payloads built here: every
- * rejection reason, the firing-time interpolation, the seam, dual-return filters, truncation, jumps. */
+ * rejection reason, the firing-time interpolation, the seam, dual-return filters, truncation, jumps; the HDL-64E's
+ * two banks, its ring order against the hdl64 preset, its refused dual layout; calibrations (rings by their
+ * elevations, rotational and distance corrections) on every model. */
 #include <math.h>
 #include <string.h>
 
@@ -540,6 +542,470 @@ static void test_xyz_of_returns(void)
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_xyz(LIDET_VELODYNE_VLP16, 0, 0u, 0, 3u));
 }
 
+/* ---- HDL-64E -------------------------------------------------------------------------------------------------- */
+
+/* the lasers of the published HDL-64E calibrations sorted by elevation, lowest first (upper bank: lasers 0..31,
+ * lower bank: 32..63) */
+static const uint8_t k_hdl64e_ascending[64] = {
+    38, 39, 42, 43, 32, 33, 36, 37, 40, 41, 46, 47, 50, 51, 54, 55, 44, 45, 48, 49, 52, 53,
+    58, 59, 62, 63, 34, 35, 56, 57, 60, 61, 6,  7,  10, 11, 0,  1,  4,  5,  8,  9,  14, 15,
+    18, 19, 22, 23, 12, 13, 16, 17, 20, 21, 26, 27, 30, 31, 2,  3,  24, 25, 28, 29};
+
+/* An HDL-64E single-return payload: firing f (blocks 2f upper, 2f + 1 lower) at (az0 + f * step) mod 36000, data
+ * point j of block b at distance dist + j + 32 (b & 1) (2 mm), intensity j + b; timestamp 1000 us; status 'H', 7. */
+static void make64(uint32_t az0, uint32_t step, uint32_t dist)
+{
+    uint32_t b, j;
+    memset(pkt, 0, sizeof pkt);
+    for (b = 0; b < 12u; ++b)
+    {
+        uint8_t *blk = pkt + 100u * b;
+        blk[0] = 0xFFu;
+        blk[1] = (b & 1u) ? 0xDDu : 0xEEu;
+        put16(blk + 2, (az0 + (b / 2u) * step) % 36000u);
+        for (j = 0; j < 32u; ++j)
+        {
+            put16(blk + 4u + 3u * j, dist + j + 32u * (b & 1u));
+            blk[4u + 3u * j + 2u] = (uint8_t)(j + b);
+        }
+    }
+    pkt[1200] = 0xE8u;
+    pkt[1201] = 0x03u;
+    pkt[1204] = 0x48u;
+    pkt[1205] = 7u;
+}
+
+/* The interpolation rule: the firing's azimuth plus step x (time into the firing / its length) in 1/240 of 0.01
+ * deg (rounded), minus the rotational correction, then rounded to 0.01 deg. */
+static uint16_t rule_cdeg(uint32_t az, uint32_t step, uint32_t off_units, uint32_t firing_units,
+                          int32_t rot_cdeg)
+{
+    const int64_t fine = (int64_t)az * 240 +
+                         ((int64_t)step * 240 * off_units + firing_units / 2u) / firing_units -
+                         (int64_t)rot_cdeg * 240 + 36000 * 240;
+    return (uint16_t)(((fine % (36000 * 240)) + 120) / 240 % 36000);
+}
+
+/* a - b in BAM16 steps, across the wrap: [-32768, 32767] */
+static int32_t bam_diff(uint16_t a, uint16_t b)
+{
+    return (int32_t)(int16_t)(uint16_t)(a - b);
+}
+
+/* the time of data point j into its HDL-64E firing: groups of four every 6 us, at 0, 1.26, 2.46, 3.66 us */
+static uint32_t hdl64e_off_ns(uint32_t j)
+{
+    static const uint32_t in_group[4] = {0u, 1260u, 2460u, 3660u};
+    return (j / 4u) * 6000u + in_group[j % 4u];
+}
+
+static void test_hdl64e_banks_timing_and_rings(void)
+{
+    uint32_t f, bank, j, n = 0, r;
+    uint32_t seen[64];
+    cfg.model = LIDET_VELODYNE_HDL64E;
+    init();
+    make64(35900u, 18u, 1000u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT32(384u, res.n_returns);
+    TEST_ASSERT_EQUAL_UINT8(LIDET_VELODYNE_HDL64E, res.model);
+    TEST_ASSERT_EQUAL_UINT8(0u, res.return_mode); /* the HDL-64E's payload has no return-mode byte */
+    TEST_ASSERT_EQUAL_UINT32(1000u, res.time_us);
+    memset(seen, 0, sizeof seen);
+    for (f = 0; f < 6u; ++f)
+    {
+        for (bank = 0; bank < 2u; ++bank)
+        {
+            for (j = 0; j < 32u; ++j, ++n)
+            {
+                const uint32_t laser = 32u * bank + j, off_ns = hdl64e_off_ns(j);
+                const uint32_t az = (35900u + 18u * f) % 36000u;
+                const uint16_t cdeg = rule_cdeg(az, 18u, off_ns / 60u, 800u, 0);
+                uint32_t rank = 0;
+                while (k_hdl64e_ascending[rank] != laser)
+                {
+                    ++rank;
+                }
+                /* upper block then lower block of each firing, in packet order; the lower bank's laser j fires with
+                 * the upper bank's laser j */
+                TEST_ASSERT_EQUAL_UINT32(2u * (1000u + j + 32u * bank), g_out.ws[n].range_mm);
+                TEST_ASSERT_EQUAL_UINT16(rank, g_out.ws[n].ring);
+                TEST_ASSERT_EQUAL_UINT32(f * 48000u + off_ns, attr[n].t_ns);
+                TEST_ASSERT_EQUAL_UINT16(cdeg, attr[n].azimuth_cdeg);
+                TEST_ASSERT_INT_WITHIN(1, 0, bam_diff(bam_of_cdeg(cdeg), g_out.ws[n].azimuth));
+                TEST_ASSERT_EQUAL_UINT8(2u * f + bank + j, attr[n].intensity);
+                TEST_ASSERT_EQUAL_UINT8(0u, attr[n].flags); /* the payload does not say which return */
+                ++seen[rank];
+            }
+        }
+    }
+    for (r = 0; r < 64u; ++r)
+    {
+        TEST_ASSERT_EQUAL_UINT32(6u, seen[r]); /* every ring once per firing */
+    }
+    /* the last laser of a firing: 45.66 us into 48 us of an 0.18 deg step */
+    TEST_ASSERT_EQUAL_UINT16((35900u + 17u) % 36000u, attr[63].azimuth_cdeg);
+    /* the nominal table: the lower block -24.333 .. -8.833 deg every 0.5 deg, the upper -8.333 .. +2 every 1/3 */
+    TEST_ASSERT_EQUAL_UINT32(64u, lidet_velodyne_n_rings(LIDET_VELODYNE_HDL64E));
+    TEST_ASSERT_EQUAL_UINT32(64u, lidet_velodyne_decoder_n_rings(&g.ws));
+    for (r = 0; r < 64u; ++r)
+    {
+        int32_t e, ed;
+        const int32_t want = r < 32u ? -24333 + 500 * (int32_t)r : 2000 - ((63 - (int32_t)r) * 1000 + 1) / 3;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_ring_elev_mdeg(LIDET_VELODYNE_HDL64E, r, &e));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_decoder_elev_mdeg(&g.ws, r, &ed));
+        TEST_ASSERT_INT_WITHIN(1, want, e);
+        TEST_ASSERT_EQUAL_INT32(e, ed);
+    }
+}
+
+/* The hdl64 preset numbers its rings top to bottom (KITTI's order): ring_top_first gives that order, and the
+ * nominal elevations lie within 1 deg of the preset's KITTI-measured ones, ring by ring. */
+static void test_hdl64e_ring_order_matches_hdl64_preset(void)
+{
+    const lidet_sensor_t *s = lidet_sensor_find("hdl64");
+    uint32_t r, i;
+    TEST_ASSERT_NOT_NULL(s);
+    TEST_ASSERT_EQUAL_UINT32(64u, s->n_rows);
+    cfg.model = LIDET_VELODYNE_HDL64E;
+    cfg.ring_top_first = 1u;
+    init();
+    make64(1000u, 18u, 1000u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    for (r = 0; r < 64u; ++r)
+    {
+        int32_t e, up;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_decoder_elev_mdeg(&g.ws, r, &e));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_ring_elev_mdeg(LIDET_VELODYNE_HDL64E, 63u - r, &up));
+        TEST_ASSERT_EQUAL_INT32(up, e);
+        TEST_ASSERT_CLOSE(s->beam_elev_rad[r], e * (M_PI / 180000.0), 1.0 * M_PI / 180.0, 0.0);
+        if (r > 0u)
+        {
+            TEST_ASSERT_TRUE(s->beam_elev_rad[r] < s->beam_elev_rad[r - 1u]);
+        }
+    }
+    /* the first return, upper laser 0: nominal ring 36 from the bottom, 27 from the top */
+    TEST_ASSERT_EQUAL_UINT16(27u, g_out.ws[0].ring);
+    for (i = 0; i < 64u; ++i) /* firing 0: upper lasers 0..31, then lower lasers 32..63 */
+    {
+        TEST_ASSERT_EQUAL_UINT8(i, k_hdl64e_ascending[63u - g_out.ws[i].ring]);
+    }
+}
+
+static void test_hdl64e_auto_and_rejections(void)
+{
+    uint32_t b;
+    /* AUTO recognises it by its lower-bank flags and locks on it */
+    init();
+    make64(1000u, 18u, 500u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT8(LIDET_VELODYNE_HDL64E, res.model);
+    TEST_ASSERT_EQUAL_UINT32(64u, lidet_velodyne_decoder_n_rings(&g.ws));
+    make(0x22u, 0x37u, 1108u, 40u, 500u);
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_PRODUCT); /* a VLP-16 now */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_reset(&g.ws));
+    TEST_ASSERT_EQUAL_UINT32(0u, lidet_velodyne_decoder_n_rings(&g.ws));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT8(0x22u, res.model);
+    make64(1200u, 18u, 500u);
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES,
+                  LIDET_VELODYNE_REJECT_PRODUCT); /* status byte 7: no product */
+    /* configured: every malformation counted by reason, the rotation state untouched */
+    cfg.model = LIDET_VELODYNE_HDL64E;
+    init();
+    make64(1000u, 18u, 500u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    make64(1108u, 18u, 500u);
+    expect_reject(pkt, 1205u, LIDET_VELODYNE_REJECT_SIZE);
+    expect_reject(pkt, 512u, LIDET_VELODYNE_REJECT_SIZE);
+    expect_reject(0, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_NULL);
+    pkt[100u * 3u + 1u] = 0xEEu; /* two upper blocks in a row */
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_FLAG);
+    pkt[100u * 3u + 1u] = 0xCCu; /* a VLS-128 bank */
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_FLAG);
+    pkt[100u * 3u + 1u] = 0xDDu;
+    pkt[0] = 0xFEu;
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_FLAG);
+    make64(1108u, 18u, 500u);
+    for (b = 0; b < 12u; ++b) /* lower bank first */
+    {
+        pkt[100u * b + 1u] = (b & 1u) ? 0xEEu : 0xDDu;
+    }
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_FLAG);
+    make64(1108u, 18u, 500u);
+    put16(pkt + 100u * 7u + 2u, 1108u + 3u * 18u + 1u); /* a firing's lower block at another azimuth */
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_AZIMUTH);
+    make64(1108u, 18u, 500u);
+    put16(pkt + 100u * 4u + 2u, 36000u);
+    put16(pkt + 100u * 5u + 2u, 36000u);
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_AZIMUTH);
+    make64(1108u, 0u, 500u); /* dual return (or a head standing still): four blocks a firing at one azimuth */
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_UNSUPPORTED);
+    make64(1108u, 18u, 500u);
+    for (b = 0; b < 12u; ++b) /* a real dual layout: firings of four blocks */
+    {
+        put16(pkt + 100u * b + 2u, 1108u + (b / 4u) * 21u);
+    }
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_UNSUPPORTED);
+    make(0x22u, 0x37u, 1108u, 40u, 500u); /* a VLP-16 payload to an HDL-64E decoder */
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_PRODUCT);
+    pkt[1205] = 0x99u; /* no known product: its flags are not the HDL-64E's */
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_FLAG);
+    make64(1108u, 18u, 500u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT32(0u, g.ws.stats.n_jumps);
+    TEST_ASSERT_EQUAL_UINT32(2u, g.ws.stats.n_decoded);
+    /* an HDL-64E payload to a VLP-16 decoder: its status byte is no product */
+    cfg.model = LIDET_VELODYNE_VLP16;
+    init();
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_PRODUCT);
+    /* forced HDL-64E: a VLP-16 payload's flags are still not the HDL-64E's */
+    cfg.model = LIDET_VELODYNE_HDL64E;
+    cfg.force_model = 1u;
+    init();
+    make(0x22u, 0x37u, 1108u, 40u, 500u);
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_FLAG);
+    make64(1108u, 18u, 500u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+}
+
+static void test_hdl64e_seam_and_jumps(void)
+{
+    uint32_t p, az = 35100u, n_complete = 0, fill = 0, last = 0;
+    cfg.model = LIDET_VELODYNE_HDL64E;
+    init();
+    for (p = 0; p < 600u; ++p) /* 6 firings of 0.18 deg a packet: 2000 firings a turn */
+    {
+        make64(az, 18u, 1000u);
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+        if (res.scan_event != LIDET_VELODYNE_SCAN_NONE)
+        {
+            const uint32_t f = res.scan_end / 64u; /* the firing that crossed the seam starts the next scan */
+            TEST_ASSERT_EQUAL_UINT32(0u, res.scan_end % 64u);
+            TEST_ASSERT_TRUE((az + 18u * f) % 36000u < 18u);
+            if (res.scan_event == LIDET_VELODYNE_SCAN_COMPLETE)
+            {
+                TEST_ASSERT_EQUAL_UINT32(2000u * 64u, fill + res.scan_end);
+                ++n_complete;
+            }
+            last = fill + res.scan_end;
+            fill = res.n_returns - res.scan_end;
+        }
+        else
+        {
+            fill += res.n_returns;
+        }
+        az = (az + 108u) % 36000u;
+    }
+    TEST_ASSERT_EQUAL_UINT32(1u, n_complete); /* 600 x 1.08 deg = 648 deg from 351 deg */
+    TEST_ASSERT_EQUAL_UINT32(1u, g.ws.stats.n_partial);
+    TEST_ASSERT_EQUAL_UINT32(2000u * 64u, last);
+    /* the same payload again: a jump back, the scan in progress aborted */
+    make64((az + 36000u - 108u) % 36000u, 18u, 1000u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT8(LIDET_VELODYNE_SCAN_ABORTED, res.scan_event);
+    TEST_ASSERT_EQUAL_UINT32(1u, g.ws.stats.n_jumps);
+}
+
+/* ---- calibrations --------------------------------------------------------------------------------------------- */
+
+static lidet_velodyne_calib_t cal;
+
+static void test_calibration_validated_and_copied(void)
+{
+    lidet_velodyne_t st;
+    lidet_velodyne_cfg_t c;
+    uint32_t i;
+    memset(&cal, 0, sizeof cal);
+    cal.n_lasers = 16u;
+    for (i = 0; i < 16u; ++i)
+    {
+        cal.laser[i].vert_mdeg = -15000 + 2000 * (int32_t)i;
+    }
+    c = cfg;
+    c.calib = &cal; /* needs a model */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_velodyne_init(&st, &c));
+    c.model = LIDET_VELODYNE_VLP32C; /* 32 lasers */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_velodyne_init(&st, &c));
+    c.model = LIDET_VELODYNE_VLP16;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_init(&st, &c));
+    TEST_ASSERT_NULL(st.cfg.calib); /* not kept */
+    cal.laser[3].vert_mdeg = 90000;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_velodyne_init(&st, &c));
+    cal.laser[3].vert_mdeg = -90000;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_velodyne_init(&st, &c));
+    cal.laser[3].vert_mdeg = 0;
+    cal.laser[5].rot_cdeg = 18001;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_velodyne_init(&st, &c));
+    cal.laser[5].rot_cdeg = -18000;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_init(&st, &c));
+    c.ring_top_first = 2u;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_velodyne_init(&st, &c));
+    /* decoder tables before AUTO's lock: none */
+    c = cfg;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_init(&st, &c));
+    {
+        int32_t e;
+        TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_velodyne_decoder_elev_mdeg(&st, 0u, &e));
+        TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_velodyne_decoder_elev_mdeg(&st, 0u, 0));
+        TEST_ASSERT_EQUAL_UINT32(0u, lidet_velodyne_decoder_n_rings(&st));
+        TEST_ASSERT_EQUAL_UINT32(0u, lidet_velodyne_decoder_n_rings(0));
+    }
+}
+
+/* A VLP-16 calibration that reorders the rings (laser 0 made the highest beam), shifts each laser's azimuth and
+ * distance, and takes one laser's ranges below zero: every return as the rule says. */
+static void test_calibration_vlp16_applied_exactly(void)
+{
+    uint32_t b, j, n = 0, i;
+    int32_t rank_of[16];
+    memset(&cal, 0, sizeof cal);
+    cal.n_lasers = 16u;
+    for (i = 0; i < 16u; ++i)
+    {
+        cal.laser[i].vert_mdeg = (i % 2u) ? 1000 + 2000 * (int32_t)(i / 2u) : -15000 + 1000 * (int32_t)i;
+        cal.laser[i].rot_cdeg = (int16_t)(37 * (int32_t)i - 300);
+        cal.laser[i].dist_mm = (int16_t)(11 * (int32_t)i - 60);
+    }
+    cal.laser[0].vert_mdeg = 20000; /* now the highest: ring 15, the others move down one */
+    cal.laser[6].dist_mm = -32767;  /* every range of laser 6 (< 2.2 m here) left below zero */
+    cal.laser[9].rot_cdeg = -18000; /* half a turn */
+    for (i = 0; i < 16u; ++i)
+    {
+        uint32_t k;
+        rank_of[i] = 0;
+        for (k = 0; k < 16u; ++k)
+        {
+            rank_of[i] += cal.laser[k].vert_mdeg < cal.laser[i].vert_mdeg;
+        }
+    }
+    TEST_ASSERT_EQUAL_INT32(15, rank_of[0]);
+    cfg.model = LIDET_VELODYNE_VLP16;
+    cfg.calib = &cal;
+    init();
+    memset(&cal, 0xA5, sizeof cal); /* read by init only */
+    make(0x22u, 0x37u, 35990u, 40u, 1000u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT32(384u - 24u, res.n_returns);
+    TEST_ASSERT_EQUAL_UINT32(24u, g.ws.stats.n_short_range);
+    TEST_ASSERT_EQUAL_UINT32(384u - 24u, g.ws.stats.n_returns);
+    for (b = 0; b < 12u; ++b)
+    {
+        for (j = 0; j < 32u; ++j)
+        {
+            const uint32_t laser = j % 16u, off = (j / 16u) * 24u + laser;
+            const int32_t rot = laser == 9u ? -18000 : 37 * (int32_t)laser - 300;
+            const int32_t dist = 11 * (int32_t)laser - 60;
+            const uint16_t cdeg = rule_cdeg((35990u + 40u * b) % 36000u, 40u, off, 48u, rot);
+            int32_t e;
+            if (laser == 6u)
+            {
+                continue; /* dropped: counted in n_short_range */
+            }
+            TEST_ASSERT_EQUAL_UINT32((uint32_t)(2 * (int32_t)(1000u + j) + dist), g_out.ws[n].range_mm);
+            TEST_ASSERT_EQUAL_UINT16((uint16_t)rank_of[laser], g_out.ws[n].ring);
+            TEST_ASSERT_EQUAL_UINT16(cdeg, attr[n].azimuth_cdeg);
+            TEST_ASSERT_INT_WITHIN(1, 0, bam_diff(bam_of_cdeg(cdeg), g_out.ws[n].azimuth));
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_decoder_elev_mdeg(&g.ws, g_out.ws[n].ring, &e));
+            TEST_ASSERT_EQUAL_INT32(laser == 0u    ? 20000
+                                    : (laser % 2u) ? 1000 + 2000 * (int32_t)(laser / 2u)
+                                                   : -15000 + 1000 * (int32_t)laser,
+                                    e);
+            ++n;
+        }
+    }
+    TEST_ASSERT_EQUAL_UINT32(n, res.n_returns);
+    /* x, y, z from the calibration's elevations */
+    {
+        float xyz[3];
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_decoder_xyz(&g.ws, g_out.ws, 1u, xyz, 3u));
+        TEST_ASSERT_CLOSE((2000.0 - 60.0) / 1000.0 * sin(20.0 * M_PI / 180.0), xyz[2], 1e-5, 1e-5);
+    }
+    /* ring_top_first numbers the same rings from the top */
+    memset(&cal, 0, sizeof cal);
+    cal.n_lasers = 16u;
+    for (i = 0; i < 16u; ++i)
+    {
+        cal.laser[i].vert_mdeg = (i % 2u) ? 1000 + 2000 * (int32_t)(i / 2u) : -15000 + 1000 * (int32_t)i;
+    }
+    cfg.ring_top_first = 1u;
+    init();
+    make(0x22u, 0x37u, 1000u, 40u, 1000u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT16(15u, g_out.ws[0].ring); /* laser 0, -15 deg: the lowest */
+    TEST_ASSERT_EQUAL_UINT16(7u, g_out.ws[1].ring);  /* laser 1, +1 deg */
+}
+
+/* A calibration equal to a model's nominal tables decodes bit for bit as no calibration (VLP-32C: its azimuth
+ * offsets are a rotational correction of the opposite sign), and one HDL-64E laser's corrections move its returns
+ * only. */
+static void test_calibration_of_nominal_tables_is_identity(void)
+{
+    static lidet_return_t ref[CAP];
+    static lidet_velodyne_attr_t ref_attr[CAP];
+    static const int16_t delta[32] = {140,  -420, 140,  -140, 140,  -140, 420,  -140, 140,  -420, 140,
+                                      -140, 420,  -140, 420,  -140, 140,  -420, 140,  -420, 420,  -140,
+                                      140,  -140, 140,  -140, 140,  -420, 420,  -140, 140,  -140};
+    static const uint8_t ring32[32] = {0, 17, 15, 1, 2,  20, 18, 3,  4,  21, 19, 5,  6,  24, 22, 8,
+                                       7, 25, 23, 9, 10, 27, 26, 12, 11, 29, 28, 13, 14, 31, 30, 16};
+    uint32_t i, n;
+    cfg.model = LIDET_VELODYNE_VLP32C;
+    init();
+    make(0x28u, 0x37u, 35950u, 20u, 1000u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    n = res.n_returns;
+    memcpy(ref, g_out.ws, sizeof ref);
+    memcpy(ref_attr, attr, sizeof ref_attr);
+    memset(&cal, 0, sizeof cal);
+    cal.n_lasers = 32u;
+    for (i = 0; i < 32u; ++i)
+    {
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_ring_elev_mdeg(LIDET_VELODYNE_VLP32C, ring32[i],
+                                                                      &cal.laser[i].vert_mdeg));
+        cal.laser[i].rot_cdeg = (int16_t)-delta[i];
+    }
+    cfg.calib = &cal;
+    init();
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT32(n, res.n_returns);
+    TEST_ASSERT_EQUAL_MEMORY(ref, g_out.ws, n * sizeof ref[0]);
+    TEST_ASSERT_EQUAL_MEMORY(ref_attr, attr, n * sizeof ref_attr[0]);
+    /* HDL-64E: the nominal table as a calibration, then laser 40 (lower bank, point 8) moved */
+    cfg.model = LIDET_VELODYNE_HDL64E;
+    cfg.calib = 0;
+    init();
+    make64(500u, 18u, 2000u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    memcpy(ref, g_out.ws, sizeof ref);
+    memcpy(ref_attr, attr, sizeof ref_attr);
+    memset(&cal, 0, sizeof cal);
+    cal.n_lasers = 64u;
+    for (i = 0; i < 64u; ++i)
+    {
+        uint32_t r = 0;
+        while (k_hdl64e_ascending[r] != i)
+        {
+            ++r;
+        }
+        TEST_ASSERT_EQUAL_INT(
+            LIDET_OK, lidet_velodyne_ring_elev_mdeg(LIDET_VELODYNE_HDL64E, r, &cal.laser[i].vert_mdeg));
+    }
+    cal.laser[40].rot_cdeg = 250;
+    cal.laser[40].dist_mm = 1234;
+    cfg.calib = &cal;
+    init();
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT32(384u, res.n_returns);
+    for (i = 0; i < 384u; ++i)
+    {
+        const int moved = (i % 64u) == 32u + 8u;
+        TEST_ASSERT_EQUAL_UINT16(ref[i].ring, g_out.ws[i].ring);
+        TEST_ASSERT_EQUAL_UINT32(ref[i].range_mm + (moved ? 1234u : 0u), g_out.ws[i].range_mm);
+        TEST_ASSERT_EQUAL_UINT16((ref_attr[i].azimuth_cdeg + (moved ? 36000u - 250u : 0u)) % 36000u,
+                                 attr[i].azimuth_cdeg);
+    }
+}
+
 /* the library's bytes-as-packets robustness: random payloads of the right length, every byte pattern of the header
  * fields; counted, never out of bounds (the canaries and ASan builds check) */
 static void test_random_payloads(void)
@@ -590,6 +1056,67 @@ static void test_random_payloads(void)
     TEST_ASSERT_TRUE(g.ws.stats.n_decoded > 0u && g.ws.stats.n_decoded < 2000u);
 }
 
+/* random payloads repaired into the HDL-64E layout (alternating banks, a firing's blocks at one azimuth, one in
+ * eight a dual layout), decoded by AUTO, an HDL-64E decoder and a calibrated one: counted, never out of bounds */
+static void test_random_hdl64e_payloads(void)
+{
+    uint32_t seed = 64u, p, i, k;
+    memset(&cal, 0, sizeof cal);
+    cal.n_lasers = 64u;
+    for (i = 0; i < 64u; ++i)
+    {
+        cal.laser[i].vert_mdeg = (int32_t)(i % 7u) * 1000 - 3000; /* ties: rings by laser id */
+        cal.laser[i].rot_cdeg = (int16_t)((int32_t)i * 561 - 18000);
+        cal.laser[i].dist_mm = (int16_t)((int32_t)i * 1000 - 32000);
+    }
+    for (k = 0; k < 3u; ++k)
+    {
+        lidet_velodyne_cfg_default(&cfg);
+        cfg.model = k == 0u ? LIDET_VELODYNE_AUTO : LIDET_VELODYNE_HDL64E;
+        cfg.calib = k == 2u ? &cal : 0;
+        cfg.ring_top_first = (uint8_t)(k == 2u);
+        init();
+        for (p = 0; p < 1000u; ++p)
+        {
+            for (i = 0; i < LIDET_VELODYNE_PAYLOAD_BYTES; ++i)
+            {
+                seed ^= seed << 13;
+                seed ^= seed >> 17;
+                seed ^= seed << 5;
+                pkt[i] = (uint8_t)seed;
+            }
+            if (p % 2u)
+            {
+                for (i = 0; i < 12u; ++i)
+                {
+                    const uint32_t src = (p % 16u == 1u) ? i / 4u * 4u : i / 2u * 2u;
+                    pkt[100u * i] = 0xFFu;
+                    pkt[100u * i + 1u] = (i & 1u) ? 0xDDu : 0xEEu;
+                    put16(pkt + 100u * i + 2u,
+                          (uint32_t)(pkt[100u * src + 2u] | (pkt[100u * src + 3u] << 8)) % 36000u);
+                }
+            }
+            (void)lidet_velodyne_packet(&g.ws, pkt, LIDET_VELODYNE_PAYLOAD_BYTES, g_out.ws, attr,
+                                        1u + p % CAP, &res);
+            TEST_ASSERT_TRUE(res.n_returns <= 1u + p % CAP);
+            TEST_ASSERT_TRUE(res.scan_end <= res.n_returns);
+            for (i = 0; i < res.n_returns; ++i)
+            {
+                TEST_ASSERT_TRUE(g_out.ws[i].ring < 64u);
+                TEST_ASSERT_TRUE(g_out.ws[i].range_mm > 0u && g_out.ws[i].range_mm <= 2u * 65535u + 32767u);
+                TEST_ASSERT_TRUE(attr[i].azimuth_cdeg < 36000u && attr[i].t_ns < 288000u);
+            }
+        }
+        TEST_ASSERT_EQUAL_UINT32(1000u, g.ws.stats.n_packets);
+        TEST_ASSERT_TRUE(g.ws.stats.n_decoded > 300u && g.ws.stats.n_decoded < 500u);
+        TEST_ASSERT_TRUE(g.ws.stats.n_rejected[LIDET_VELODYNE_REJECT_UNSUPPORTED] > 20u);
+        if (k == 2u)
+        {
+            TEST_ASSERT_TRUE(g.ws.stats.n_short_range > 0u);
+        }
+    }
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -603,6 +1130,14 @@ int main(void)
     RUN_TEST(test_dual_returns);
     RUN_TEST(test_truncation_never_writes_past_cap);
     RUN_TEST(test_xyz_of_returns);
+    RUN_TEST(test_hdl64e_banks_timing_and_rings);
+    RUN_TEST(test_hdl64e_ring_order_matches_hdl64_preset);
+    RUN_TEST(test_hdl64e_auto_and_rejections);
+    RUN_TEST(test_hdl64e_seam_and_jumps);
+    RUN_TEST(test_calibration_validated_and_copied);
+    RUN_TEST(test_calibration_vlp16_applied_exactly);
+    RUN_TEST(test_calibration_of_nominal_tables_is_identity);
     RUN_TEST(test_random_payloads);
+    RUN_TEST(test_random_hdl64e_payloads);
     return UNITY_END();
 }
