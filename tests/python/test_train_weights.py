@@ -18,7 +18,9 @@ WEIGHTS = pathlib.Path(__file__).resolve().parents[2] / "weights"
 #: family -> (sensor, test-split simulator seed of `make weights`, mounts cycled over the scans, points per
 #: proposal); vlp16s: the small VLP-16 pair of the integer firmware
 FAMILIES = {"hdl64": ("hdl64", 1002, [None], 64), "vlp16": ("vlp16", 2002, [0.3, 0.5, 0.7, 1.0], 64),
-            "vlp16s": ("vlp16", 2002, [0.3, 0.5, 0.7, 1.0], 32)}
+            "vlp16s": ("vlp16", 2002, [0.3, 0.5, 0.7, 1.0], 32), "beams32": ("vlp32c", 3002, [0.7, 1.0, 1.4, 1.84], 64)}
+#: the presets a family's simulated scans cycle over (dataset --sim-sensors); the others: its own sensor
+SIM_SENSORS = {"beams32": ["vlp32c", "hdl32", "os0-32", "os1-32", "os2-32"]}
 
 
 def _meta(path):
@@ -48,8 +50,10 @@ def test_shipped_models_on_fresh_scans(fam, need_lib):
     if not (pc.exists() and pb.exists()):
         pytest.skip("weights not generated (make weights)")
     sensor, seed, mounts, npts = FAMILIES[fam]
-    d = D.concat([D._job(("sim", 2, seed, i, mounts[i % len(mounts)]), sensor, dict(D.DEFAULTS, n_points=npts))
-                  for i in range(4)])
+    sims = SIM_SENSORS.get(fam, [sensor])
+    d = D.concat([D._job(("sim", 2, seed, i, mounts[(i // len(sims)) % len(mounts)], sims[i % len(sims)]), sensor,
+                         dict(D.DEFAULTS, n_points=npts))
+                  for i in range(max(4, len(sims)))])
     idm = d["label"] >= 0
     assert idm.sum() >= 10
     feeds = {"points": d["points"], "voxel": d["voxel"].astype(np.float32)}

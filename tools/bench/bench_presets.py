@@ -1,6 +1,8 @@
 # SPDX-License-Identifier: MIT
 """The detector on every sensor preset (issue 37, item 5): simulated AP per preset against the matching model
-family on its own sensor (hdl64 on hdl64 for the presets of 32 beams or more, vlp16 on vlp16), same run.
+family on its own sensor (the preset's default family, `native.default_family`: hdl64 on hdl64 for 32 beams or more,
+vlp16 on vlp16), same run; for the 32-beam presets also the beams32 family (trained on simulated scans of all five
+32-beam presets; not a default: docs/SENSORS.md, "Model families"), against itself on vlp32c.
 
 Contract of tools/bench/run_bench.py: `run(args) -> str` returns a markdown section (args.build: the CMake build
 with the host CLI; args.quick: fewer scans). Alone: `python tools/bench/bench_presets.py [--quick]`.
@@ -11,6 +13,7 @@ evaluation `lidet_tools.eval.boxes_ap` (AP R40, KITTI overlaps 0.7 / 0.5 / 0.5, 
 """
 from __future__ import annotations
 
+import json
 import os
 import pathlib
 import subprocess
@@ -20,6 +23,9 @@ import tempfile
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SEED = 9100
 CLASSES = ("Car", "Pedestrian", "Cyclist")
+#: families for a beam class besides the default one: rows -> family; the preset each is measured against
+ALT = {32: "beams32"}
+ALT_OWN = {"beams32": "vlp32c"}
 COLS = (("Car", "0-20"), ("Car", "20-40"), ("Pedestrian", "0-20"), ("Pedestrian", "20-40"), ("Cyclist", "0-20"))
 
 
@@ -30,44 +36,69 @@ def _ap(gt_dir, pred_dir) -> dict:
     return {(c, b): ap.get(c, {}).get("3d", {}).get("R40", {}).get(b) for c, b in COLS}
 
 
-def measure(sensor: str, scans: int, build: pathlib.Path, tmp: pathlib.Path) -> dict:
-    env = dict(os.environ, LIDET_BUILD_DIR=str(build), OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1",
-               PYTHONPATH=str(ROOT / "tools") + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    sim, pred = tmp / f"sim_{sensor}", tmp / f"pred_{sensor}"
-    subprocess.run([sys.executable, "-m", "lidet_tools.sim.cli", "--sensor", sensor, "--scenes", str(scans),
-                    "--seed", str(SEED), "--out", str(sim), "--no-progress"], env=env, check=True,
-                   capture_output=True)
-    subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(sim), "--sensor", sensor, "--out", str(pred)],
-                   env=env, check=True, capture_output=True)
+def _env(build: pathlib.Path) -> dict:
+    return dict(os.environ, LIDET_BUILD_DIR=str(build), OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1",
+                PYTHONPATH=str(ROOT / "tools") + os.pathsep + os.environ.get("PYTHONPATH", ""))
+
+
+def measure(sensor: str, scans: int, build: pathlib.Path, tmp: pathlib.Path, model: str | None = None) -> dict:
+    """AP of the preset's default family (model None) or of `model` on simulated scans of the preset (made once)."""
+    env = _env(build)
+    sim, pred = tmp / f"sim_{sensor}", tmp / f"pred_{sensor}_{model or 'default'}"
+    if not sim.exists():
+        subprocess.run([sys.executable, "-m", "lidet_tools.sim.cli", "--sensor", sensor, "--scenes", str(scans),
+                        "--seed", str(SEED), "--out", str(sim), "--no-progress"], env=env, check=True,
+                       capture_output=True)
+    subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(sim), "--sensor", sensor, "--out", str(pred)] +
+                   (["--model", model] if model else []), env=env, check=True, capture_output=True)
     return _ap(sim / "boxes", pred / "boxes")
+
+
+def default_families(build: pathlib.Path) -> dict:
+    """{preset: the float family its detector runs by default} (native.default_family, from the build's models)."""
+    code = ("import json; from lidet_tools import native; from lidet_tools.sensors import SENSORS; "
+            "print(json.dumps({s: native.default_family(s) for s in SENSORS}))")
+    r = subprocess.run([sys.executable, "-c", code], env=_env(build), check=True, capture_output=True, text=True)
+    return json.loads(r.stdout)
 
 
 def run(args=None) -> str:
     sys.path.insert(0, str(ROOT / "tools"))
-    from lidet_tools.sensors import SENSORS, model_family
+    from lidet_tools.sensors import SENSORS
     build = pathlib.Path(getattr(args, "build", ROOT / "build"))
     scans = 10 if getattr(args, "quick", False) else 40
+    fams = default_families(build)
     rows = []
     with tempfile.TemporaryDirectory() as t:
         res = {s: measure(s, scans, build, pathlib.Path(t)) for s in SENSORS}
+        res_alt = {s: measure(s, scans, build, pathlib.Path(t), ALT[sen.rows]) for s, sen in SENSORS.items()
+                   if sen.rows in ALT}
     fmt = lambda v: "-" if v is None else f"{v:.1f}"  # noqa: E731
-    for s, sen in SENSORS.items():
-        fam = "vlp16" if s == "vlp16" else model_family(sen)
-        ref = "vlp16" if fam == "vlp16" else "hdl64"
-        cells = []
+
+    def cells(got, ref, own, base=None):
+        out = []
         for k in COLS:
-            v, r = res[s][k], res[ref][k]
-            d = "" if v is None or r is None or s == ref else f" ({v - r:+.1f})"
-            cells.append(fmt(v) + d)
-        rows.append(f"| {s} | {sen.rows} x {sen.cols} | {sen.mount_height_m:g} m | {fam} | " + " | ".join(cells) + " |")
+            v, r = got[k], (base or res)[ref][k]
+            out.append(fmt(v) + ("" if v is None or r is None or own else f" ({v - r:+.1f})"))
+        return " | ".join(out)
+
+    for s, sen in SENSORS.items():
+        fam = fams[s]
+        ref = fam if fam in SENSORS else "hdl64"  # a family is named after the sensor it is measured on
+        rows.append(f"| {s} | {sen.rows} x {sen.cols} | {sen.mount_height_m:g} m | {fam} | "
+                    + cells(res[s], ref, s == ref) + " |")
+        if s in res_alt:
+            alt, own = ALT[sen.rows], ALT_OWN[ALT[sen.rows]]
+            rows.append(f"| {s} | | | {alt} | " + cells(res_alt[s], own, s == own, res_alt) + " |")
     return "\n".join([
         "## Sensor presets (issue 37)", "",
         f"The detector on simulated scans of every preset ({scans} scans each, `lidet-sim --sensor S --seed {SEED}`, "
         "360 degrees, the preset's mount height), with the preset's default model family, against that family on "
-        "its own sensor in the same run (hdl64 for 32 beams or more, vlp16): 3D AP R40 by distance band of the box "
+        "its own sensor in the same run (hdl64 for 32 beams or more, vlp16); on the 32-beam presets a second row gives "
+        "the beams32 family (`--model beams32`), against itself on vlp32c: 3D AP R40 by distance band of the box "
         "centre, sensor frame, KITTI overlaps (car 0.7, pedestrian and cyclist 0.5); '-' where a band holds no "
         "object of the class; in brackets the difference from the "
-        "family's own sensor (goal: within 5 AP). Command: `python tools/bench/bench_presets.py`.", "",
+        "family on its own sensor (goal: within 5 AP). Command: `python tools/bench/bench_presets.py`.", "",
         "| preset | rows x cols | mount | family | car 0-20 m | car 20-40 m | ped 0-20 m | ped 20-40 m | cyc 0-20 m |",
         "|---|---|---|---|---:|---:|---:|---:|---:|", *rows, ""])
 

@@ -44,8 +44,11 @@ def scan_list(sensor: str, real_dir=None, scan_dirs=None):
     holding velodyne/*.bin: a user's own scans, `calibrate --scans`) every scan of those, else for hdl64 the KITTI
     scans under real_dir/kitti/ less the validation frames of tools/lidet_tools/real/split.txt (the real-frame
     figures are measured on those; nothing that builds a model reads them). kitti/unlabeled/ holds KITTI object
-    training scans under their own ids (000006-000010 are the files of training/), so the rule goes by id in both."""
-    scans = [ROOT / f"tests/data/sim_{sensor}/velodyne/000000.bin"]
+    training scans under their own ids (000006-000010 are the files of training/), so the rule goes by id in both.
+    A sensor without a shipped sample (tests/data/sim_<sensor>: hdl64 and vlp16 have one) calibrates on the freshly
+    simulated scans alone."""
+    sample = ROOT / f"tests/data/sim_{sensor}/velodyne/000000.bin"
+    scans = [sample] if sample.exists() else []
     if scan_dirs:
         for d in scan_dirs:
             found = sorted(pathlib.Path(d, "velodyne").glob("*.bin"))
