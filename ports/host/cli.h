@@ -32,11 +32,28 @@ typedef struct
     double mount_height_m, max_range_m;
 } cli_sensor_desc_t;
 
+/* A Velodyne calibration's per-laser corrections (--velodyne-calib, cli_velodyne_calib.c), in the description's ring
+ * order (lowest beam first) and in the units sensors.py's load_velodyne_calibration holds them: what the packet
+ * decoder takes (lidet_velodyne_calib_t, through cli_velodyne_calib_table: `lidet detect / track --pcap`). */
+typedef struct
+{
+    int n;                            /* lasers (0: no calibration read) */
+    double distance_resolution_m;     /* distLSB_ x 0.01 / distance_resolution; 0.002 when the file gives none */
+    int laser_id[LIDET_MAX_ROWS];     /* id_ / laser_id: the laser's place in the packet's data block */
+    double rot_rad[LIDET_MAX_ROWS];   /* rotCorrection_ x pi / 180 / rot_correction (radians) */
+    double dist_m[LIDET_MAX_ROWS];    /* distCorrection_ x 0.01 / dist_correction (metres); 0 when absent */
+} cli_velodyne_corr_t;
+
 typedef struct
 {
     const char *scan_path;  /* positional SCAN.bin */
     const char *sensor;     /* --sensor NAME (default hdl64); a file's sensor: its name */
     int sensor_given;       /* --sensor was on the command line (--pcap: else the packets say) */
+    const char *sensor_arg; /* --sensor NAME as given (a file's sensor replaces a->sensor: --pcap --velodyne-calib
+                               --sensor NAME names the decoder's model) */
+    int capture;            /* set by detect / track before cli_args_finish when --pcap is given: --sensor may go
+                               with --velodyne-calib (the model of the calibrated unit), and --print-sensor waits for
+                               the capture's sensor (cli_capture_print_sensor) */
     const char *sensor_file; /* --sensor-file F: a lidet sensor description (JSON) */
     const char *ouster_meta; /* --ouster-meta M: Ouster's sensor metadata (JSON) */
     const char *velodyne_calib; /* --velodyne-calib C: a Velodyne calibration (db.xml / VeloView XML, or YAML) */
@@ -61,6 +78,7 @@ typedef struct
     const lidet_sensor_q_t *sensor_q;
     lidet_sensor_q_t sensor_q_file;
     cli_sensor_desc_t desc;
+    cli_velodyne_corr_t vcorr; /* --velodyne-calib: the corrections beside the elevations (desc) */
 } cli_args_t;
 
 /* ---- command-line options (cli_options.c: getopt_long over option sets; the rules at the top of that file) ---- */
@@ -121,8 +139,9 @@ void cli_args_default(cli_args_t *a);
  * returns how many (2 or 3) */
 int cli_args_optsets(cli_args_t *a, int io, cli_optset_t *sets);
 /* After the options: the scan from the positional arguments (one; none only with --print-sensor; a second is
- * "unexpected argument"), then the sensor: one of --sensor / --sensor-file / --ouster-meta / --velodyne-calib, the
- * file read or the preset found, --mount-height applied, --print-sensor printed. Returns CLI_PARSE_OK,
+ * "unexpected argument"), then the sensor: one of --sensor / --sensor-file / --ouster-meta / --velodyne-calib (with
+ * a->capture --sensor may go with --velodyne-calib), the file read or the preset found, --mount-height applied,
+ * --print-sensor printed (with a->capture not: the command prints the capture's sensor). Returns CLI_PARSE_OK,
  * CLI_PARSE_ERROR, CLI_PARSE_PRINTED, CLI_PARSE_SENSOR_FILE or CLI_PARSE_USAGE (no scan). */
 int cli_args_finish(cli_args_t *a, char *const *pos, int n_pos, const char *cmd);
 /* The whole of it for a command that takes one scan: cli_args_default, cli_options_parse with the shared sets (io
@@ -134,9 +153,17 @@ void cli_usage(FILE *f, const char *cmd);
  * prints "lidet CMD: FILE: problem" (or that this lidet was built without cJSON) and returns 1. */
 int cli_sensor_load(cli_args_t *a, const char *cmd);
 /* The same for a->velodyne_calib (cli_velodyne_calib.c, the rules of sensors.py load_velodyne_calibration): the
- * table in ring order (lowest beam first), columns a->velodyne_cols or the laser count's default. 0, or 1 after
- * "lidet CMD: FILE: problem" (or that this lidet was built without libxml2 / libyaml). */
+ * table in ring order (lowest beam first), columns a->velodyne_cols or the laser count's default; the other
+ * corrections into a->vcorr. 0, or 1 after "lidet CMD: FILE: problem" (or that this lidet was built without
+ * libxml2 / libyaml). */
 int cli_velodyne_calib_load(cli_args_t *a, const char *cmd);
+/* The Velodyne decoder's calibration table of the calibration loaded into a (desc, vcorr) for a model
+ * (lidet_velodyne_model_t other than AUTO), by the rules of tools/lidet_tools/velodyne.py calibration_table: per
+ * laser id the elevation (mdeg), rotational correction (0.01 deg) and distance correction (mm), each rounded to the
+ * nearest (half to even, as numpy). 0; or 1 with calibration_table's message in err (another number of lasers,
+ * laser ids other than 0 .. n-1, a distance resolution other than the packets' unit, a distance correction beyond
+ * +-32.767 m). */
+int cli_velodyne_calib_table(const cli_args_t *a, int model, lidet_velodyne_calib_t *t, char *err, size_t err_len);
 /* Points a's profiles (float, integer, family) at a->desc once a loader has filled it (cli_sensor.c). */
 void cli_sensor_use_desc(cli_args_t *a);
 /* The packet format of Ouster's metadata (--ouster-meta; the rules of tools/lidet_tools/ouster.py load_metadata):
@@ -322,6 +349,11 @@ void cli_pcap_usage(FILE *f, int detect);
  * given, sets a's sensor (and its --mount-height) to the packets' model. 0 and *c; or 1 with a message (no libpcap
  * in this build, not a capture, no packet, none on the port, no data the decoder takes, no scan to run). */
 int cli_capture_open(const cli_pcap_opts_t *o, cli_args_t *a, cli_capture_t **c);
+/* --print-sensor with --pcap: the sensor the capture's scans are decoded as (--sensor's model, else the first
+ * decoded packet's; --velodyne-calib: the calibration's; --lidar ouster: the metadata's), printed on stdout as
+ * cli_sensor_print does, after reading the capture as cli_capture_open does (it need not hold a whole rotation).
+ * 0, or 1 with cli_capture_open's messages. */
+int cli_capture_print_sensor(const cli_pcap_opts_t *o, cli_args_t *a);
 /* the scans listed by cli_capture_open (the number cli_capture_next gives) */
 uint32_t cli_capture_n_scans(const cli_capture_t *c);
 /* scan k of those (k < cli_capture_n_scans), as pass 1 listed it; NULL past them */

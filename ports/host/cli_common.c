@@ -74,6 +74,7 @@ int cli_args_take(void *ctx, int id, const char *v)
     {
     case OPT_SENSOR:
         a->sensor = v;
+        a->sensor_arg = v;
         a->sensor_given = 1;
         break;
     case OPT_SENSOR_FILE:
@@ -155,7 +156,10 @@ int cli_args_finish(cli_args_t *a, char *const *pos, int n_pos, const char *cmd)
         a->scan_path = pos[0];
     if (a->scan_path == NULL && !a->print_sensor)
         return CLI_PARSE_USAGE;
-    if ((a->sensor_file != NULL) + (a->ouster_meta != NULL) + (a->velodyne_calib != NULL) + a->sensor_given > 1)
+    /* a capture's --sensor names the decoder's model, which a --velodyne-calib needs (cli_pcap.c) */
+    if ((a->sensor_file != NULL) + (a->ouster_meta != NULL) + (a->velodyne_calib != NULL) +
+            (a->sensor_given && !(a->capture && a->velodyne_calib != NULL)) >
+        1)
     {
         fprintf(stderr, "lidet %s: give one of --sensor, --sensor-file, --ouster-meta and --velodyne-calib\n", cmd);
         return CLI_PARSE_ERROR;
@@ -193,7 +197,7 @@ int cli_args_finish(cli_args_t *a, char *const *pos, int n_pos, const char *cmd)
         a->sensor_profile = &a->sensor_mounted;
         a->desc.mount_height_m = a->mount_height_m; /* what --print-sensor prints for a file's sensor */
     }
-    if (a->print_sensor)
+    if (a->print_sensor && !a->capture) /* a capture's sensor: cli_capture_print_sensor, once it is known */
     {
         cli_sensor_print(a, stdout);
         return CLI_PARSE_PRINTED;

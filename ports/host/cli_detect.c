@@ -1076,6 +1076,7 @@ int cli_detect(int argc, char **argv)
         pos[0] = (char *)po.path; /* the scans' source */
         n_pos = 1;
         cli_fixed_returns = 0; /* --fixed feeds the decoded returns as they are */
+        a.capture = 1;         /* --sensor may name a --velodyne-calib's model; --print-sensor: the capture's */
     }
     if (i == CLI_PARSE_OK)
         i = cli_args_finish(&a, pos, n_pos, "detect");
@@ -1092,7 +1093,7 @@ int cli_detect(int argc, char **argv)
     }
     if (po.path != NULL)
     {
-        i = detect_pcap(&a, &o, &po, save_dir);
+        i = a.print_sensor ? cli_capture_print_sensor(&po, &a) : detect_pcap(&a, &o, &po, save_dir);
         free((void *)o.sets);
         return i;
     }

@@ -14,9 +14,12 @@
  * counted and dropped, never written. The decoder writes each payload's returns into a buffer for a whole packet
  * first, so a boundary inside a full scan still gives the next scan its first returns.
  *
- * The decoders: a small table (k_lidars) chosen by --lidar: velodyne (the model from the product byte or --sensor)
- * and ouster (the packet format and beams from --ouster-meta). Another is one more entry: its options checked, its
- * decoder, its counts, its x, y, z.
+ * The decoders: a small table (k_lidars) chosen by --lidar: velodyne (the model from the product byte, an HDL-64E's
+ * lower-bank flag, or --sensor; the hdl64 preset's rings from the top; with --velodyne-calib the unit's calibration
+ * in the decoder and its description as the scans' sensor) and ouster (the packet format and beams from
+ * --ouster-meta). Another is one more entry: its options checked, its decoder, its counts, its x, y, z.
+ *
+ * --print-sensor (cli_capture_print_sensor): pass 1 alone, then the scans' sensor printed (the one resolve set).
  *
  * Built without libpcap (LIDET_HAVE_PCAP unset: ports/host/CMakeLists.txt) --pcap exits with an error saying so. */
 #define _DEFAULT_SOURCE 1 /* libpcap's headers use the BSD types (u_int, u_char) */
@@ -125,14 +128,21 @@ void cli_pcap_usage(FILE *f, int detect)
                "                   (docs/DECODING.md), the detector run on each complete rotation;\n"
                "                   partial rotations (the capture's first and last) skipped; a summary\n"
                "                   on stderr (frames, decoder rejects, scans, time)\n"
-               "  --lidar NAME     the sensor family: velodyne (default; VLP-16, VLP-32C, HDL-32E; the\n"
-               "                   model from the packets or --sensor) or ouster (OS0/OS1/OS2, every\n"
-               "                   packet profile; needs --ouster-meta M: its packet format and beams)\n"
+               "  --lidar NAME     the sensor family: velodyne (default; VLP-16, VLP-32C, HDL-32E,\n"
+               "                   HDL-64E S2/S3 single return; the model from the packets or --sensor)\n"
+               "                   or ouster (OS0/OS1/OS2, every packet profile; needs --ouster-meta M:\n"
+               "                   its packet format and beams)\n"
                "  --port N         the sensor's data port (default: velodyne 2368, ouster the\n"
                "                   metadata's udp_port_lidar, else 7502)\n"
-               "  --sensor NAME    velodyne: vlp16, vlp32c or hdl32; default: the packets' product byte\n"
+               "  --sensor NAME    velodyne: vlp16, vlp32c, hdl32 or hdl64; default: the packets' product\n"
+               "                   byte (HDL-64E: its lower-bank flag)\n"
+               "  --velodyne-calib C  velodyne, with --sensor: the unit's calibration (db.xml or YAML)\n"
+               "                   applied by the decoder (rings by its elevations, rotational and\n"
+               "                   distance corrections); the detector projects with its elevations\n"
                "  --force-sensor   velodyne: decode every packet as --sensor's model whatever its\n"
                "                   product byte\n"
+               "  --print-sensor   the sensor the capture is decoded as (the packets' model, or the\n"
+               "                   calibration), as a description; then stop\n"
                "  --dual MODE      dual-return packets: velodyne both (default: the last return, and\n"
                "                   the strongest where it differs), last or strongest; ouster both\n"
                "                   (default), first or second\n"
@@ -149,7 +159,8 @@ void cli_pcap_usage(FILE *f, int detect)
                    "  as --out lines; --json: one object per scan; --out DIR: DIR/<K:06d>.txt per scan;\n"
                    "  --png: the last scan (or --png-scan K). --fixed runs the integer detector on the\n"
                    "  decoded returns (lidet_detector_q_run_returns), the float detector their x, y, z\n"
-                   "  (lidet_velodyne_xyz; Ouster: the metadata's beam altitudes) with their rings\n");
+                   "  (lidet_velodyne_decoder_xyz: the decoder's elevations; Ouster: the metadata's beam\n"
+                   "  altitudes) with their rings\n");
 }
 
 const char *cli_scan_kind(uint8_t kind)
@@ -172,6 +183,11 @@ int cli_capture_open(const cli_pcap_opts_t *o, cli_args_t *a, cli_capture_t **ou
             "deps installs it)\n",
             cli_cmd);
     return 1;
+}
+int cli_capture_print_sensor(const cli_pcap_opts_t *o, cli_args_t *a)
+{
+    cli_capture_t *c = NULL;
+    return cli_capture_open(o, a, &c); /* says that this lidet was built without libpcap */
 }
 uint32_t cli_capture_n_scans(const cli_capture_t *c)
 {
@@ -359,6 +375,9 @@ struct cli_capture
     /* the Velodyne decoder */
     lidet_velodyne_t vd;
     lidet_velodyne_stats_t vstats; /* pass 1's */
+    int calibrated;                /* --velodyne-calib: the unit's calibration (vcal) given to the decoder */
+    const char *calib_path;
+    lidet_velodyne_calib_t vcal;
     uint8_t return_mode;
     uint32_t t_prev_raw;
     int64_t t_us;
@@ -440,6 +459,8 @@ static const char *vel_sensor_of(int model)
         return "vlp32c";
     case LIDET_VELODYNE_HDL32E:
         return "hdl32";
+    case LIDET_VELODYNE_HDL64E:
+        return "hdl64"; /* the preset numbers its rings from the top: the decoder's ring_top_first */
     default:
         return NULL;
     }
@@ -453,20 +474,27 @@ static int vel_model_of(const char *sensor)
         return LIDET_VELODYNE_VLP32C;
     if (strcmp(sensor, "hdl32") == 0)
         return LIDET_VELODYNE_HDL32E;
+    if (strcmp(sensor, "hdl64") == 0)
+        return LIDET_VELODYNE_HDL64E;
     return 0;
 }
 
 static int vel_setup(cli_capture_t *c, cli_args_t *a)
 {
-    if (a->sensor_file != NULL || a->ouster_meta != NULL || a->velodyne_calib != NULL)
+    if (a->sensor_file != NULL || a->ouster_meta != NULL)
     {
         fprintf(stderr,
                 "lidet %s: --pcap with --lidar velodyne takes the sensor from the packets or --sensor (vlp16, "
-                "vlp32c, hdl32), not %s\n",
-                cli_cmd,
-                a->sensor_file != NULL   ? "--sensor-file"
-                : a->ouster_meta != NULL ? "--ouster-meta (--lidar ouster reads it)"
-                                         : "--velodyne-calib (the decoder has its own laser tables: docs/SENSORS.md)");
+                "vlp32c, hdl32, hdl64; with --velodyne-calib the unit's calibration), not %s\n",
+                cli_cmd, a->sensor_file != NULL ? "--sensor-file" : "--ouster-meta (--lidar ouster reads it)");
+        return 1;
+    }
+    if (a->velodyne_calib != NULL && !a->sensor_given)
+    {
+        fprintf(stderr,
+                "lidet %s: --velodyne-calib with --pcap needs --sensor vlp16, vlp32c, hdl32 or hdl64: the model of "
+                "the calibrated unit (the decoder applies the calibration from the first packet on)\n",
+                cli_cmd);
         return 1;
     }
     if (c->o.dual != NULL && strcmp(c->o.dual, "both") != 0 && strcmp(c->o.dual, "last") != 0 &&
@@ -478,16 +506,30 @@ static int vel_setup(cli_capture_t *c, cli_args_t *a)
     }
     if (a->sensor_given)
     {
-        c->model = c->dec_model = vel_model_of(a->sensor);
+        const char *name = a->sensor_arg != NULL ? a->sensor_arg : a->sensor;
+        c->model = c->dec_model = vel_model_of(name);
         if (c->model == 0)
         {
             fprintf(stderr,
-                    "lidet %s: --sensor %s: the velodyne decoder's returns are those of vlp16, vlp32c or hdl32 (or "
-                    "leave --sensor out: the packets say)\n",
-                    cli_cmd, a->sensor);
+                    "lidet %s: --sensor %s: the velodyne decoder's returns are those of vlp16, vlp32c, hdl32 or hdl64 "
+                    "(or leave --sensor out: the packets say)\n",
+                    cli_cmd, name);
             return 1;
         }
-        c->sensor = a->sensor;
+        c->sensor = vel_sensor_of(c->model);
+        if (a->velodyne_calib != NULL)
+        {
+            /* the unit's table for the decoder (calibration_table's rules); the scans' sensor is the calibration's
+             * description (cli_args_finish loaded it), its rings lowest first as the decoder numbers them */
+            char err[256];
+            if (cli_velodyne_calib_table(a, c->model, &c->vcal, err, sizeof err) != 0)
+            {
+                fprintf(stderr, "lidet %s: %s: %s (--sensor %s)\n", cli_cmd, a->velodyne_calib, err, name);
+                return 1;
+            }
+            c->calibrated = 1;
+            c->calib_path = a->velodyne_calib;
+        }
     }
     else if (c->o.force_sensor)
     {
@@ -508,10 +550,16 @@ static int vel_init(cli_capture_t *c)
                  : strcmp(c->o.dual, "last") == 0                    ? LIDET_VELODYNE_RETURN_LAST
                                                                      : LIDET_VELODYNE_RETURN_STRONGEST;
     cfg.force_model = (uint8_t)(c->o.force_sensor != 0);
+    /* the hdl64 preset numbers its rings from the top (c->model: known in pass 2 also under AUTO, where pass 1 locked
+     * it; pass 1 reads no ring); a calibration's description from the bottom, as the decoder by default */
+    cfg.ring_top_first = (uint8_t)(c->model == LIDET_VELODYNE_HDL64E && !c->calibrated);
+    cfg.calib = c->calibrated ? &c->vcal : NULL;
     st = lidet_velodyne_init(&c->vd, &cfg);
     if (st != LIDET_OK)
     {
-        fprintf(stderr, "lidet %s: the Velodyne decoder: %s\n", cli_cmd, lidet_status_str(st));
+        fprintf(stderr, "lidet %s: the Velodyne decoder%s%s: %s\n", cli_cmd,
+                c->calibrated ? " refused the calibration " : "", c->calibrated ? c->calib_path : "",
+                lidet_status_str(st));
         return 1;
     }
     c->have_t = 0;
@@ -578,7 +626,8 @@ static int vel_whole_at_end(const cli_capture_t *c)
 static int vel_xyz(const cli_capture_t *c, const lidet_return_t *r, uint32_t n, float *xyz)
 {
     uint32_t i;
-    if (lidet_velodyne_xyz((lidet_velodyne_model_t)c->model, r, n, xyz, 4u) != LIDET_OK)
+    /* the decoder's own elevations: the model's nominal table or the calibration's, in its ring order */
+    if (lidet_velodyne_decoder_xyz(&c->vd, r, n, xyz, 4u) != LIDET_OK)
         return 1;
     for (i = 0; i < n; ++i)
         xyz[4u * i + 3u] = 0.0f; /* no remission: the detector reads x, y, z */
@@ -588,21 +637,28 @@ static int vel_xyz(const cli_capture_t *c, const lidet_return_t *r, uint32_t n, 
 static void vel_report(const cli_capture_t *c, FILE *f)
 {
     const lidet_velodyne_stats_t *s = &c->vstats;
-    const char *mode = c->return_mode == 0x37u   ? "strongest return"
-                       : c->return_mode == 0x38u ? "last return"
-                       : c->return_mode == 0x39u ? "dual return"
-                                                 : "no data";
+    /* the HDL-64E's payload has no return-mode byte: the decoder takes its single-return layout only */
+    const char *mode = c->model == LIDET_VELODYNE_HDL64E && s->n_decoded > 0u ? "single return"
+                       : c->return_mode == 0x37u                            ? "strongest return"
+                       : c->return_mode == 0x38u                            ? "last return"
+                       : c->return_mode == 0x39u                            ? "dual return"
+                                                                            : "no data";
     uint32_t k, rej = 0;
     for (k = 1; k < LIDET_VELODYNE_N_REJECT; ++k)
         rej += s->n_rejected[k];
     fprintf(f,
-            "lidet %s: decoder velodyne %s (%s%s): %u packets: %u decoded, %u rejected (size %u, product %u, mode "
-            "%u, flag %u, azimuth %u); %u azimuth jumps; %u returns between two boundaries of a packet dropped\n",
+            "lidet %s: decoder velodyne %s (%s%s%s%s): %u packets: %u decoded, %u rejected (size %u, product %u, "
+            "mode %u, flag %u, azimuth %u, unsupported %u); %u azimuth jumps; %u returns between two boundaries of a "
+            "packet dropped",
             cli_cmd, c->sensor != NULL ? c->sensor : "?", mode, c->o.force_sensor ? ", --force-sensor" : "",
-            s->n_packets, s->n_decoded, rej, s->n_rejected[LIDET_VELODYNE_REJECT_SIZE],
-            s->n_rejected[LIDET_VELODYNE_REJECT_PRODUCT], s->n_rejected[LIDET_VELODYNE_REJECT_MODE],
-            s->n_rejected[LIDET_VELODYNE_REJECT_FLAG], s->n_rejected[LIDET_VELODYNE_REJECT_AZIMUTH], s->n_jumps,
-            s->n_fragment);
+            c->calibrated ? ", calibration " : "", c->calibrated ? c->calib_path : "", s->n_packets, s->n_decoded,
+            rej, s->n_rejected[LIDET_VELODYNE_REJECT_SIZE], s->n_rejected[LIDET_VELODYNE_REJECT_PRODUCT],
+            s->n_rejected[LIDET_VELODYNE_REJECT_MODE], s->n_rejected[LIDET_VELODYNE_REJECT_FLAG],
+            s->n_rejected[LIDET_VELODYNE_REJECT_AZIMUTH], s->n_rejected[LIDET_VELODYNE_REJECT_UNSUPPORTED],
+            s->n_jumps, s->n_fragment);
+    if (c->calibrated)
+        fprintf(f, "; %u returns the distance correction left at or below 0 m dropped", s->n_short_range);
+    fprintf(f, "\n");
 }
 
 static void vel_no_data(const cli_capture_t *c, FILE *f)
@@ -613,13 +669,13 @@ static void vel_no_data(const cli_capture_t *c, FILE *f)
     if (c->model != 0)
         fprintf(f, "the model of --sensor %s", vel_sensor_of(c->model));
     else
-        fprintf(f, "a known model (VLP-16, VLP-32C, HDL-32E)");
+        fprintf(f, "a known model (VLP-16, VLP-32C, HDL-32E, HDL-64E)");
     fprintf(f,
             "; the decoder rejected them: size %u (a data payload is 1206 bytes), product byte %u, return mode "
-            "%u, block flag %u, azimuth %u%s\n",
+            "%u, block flag %u, azimuth %u, unsupported %u (HDL-64E dual return)%s\n",
             s->n_rejected[LIDET_VELODYNE_REJECT_SIZE], s->n_rejected[LIDET_VELODYNE_REJECT_PRODUCT],
             s->n_rejected[LIDET_VELODYNE_REJECT_MODE], s->n_rejected[LIDET_VELODYNE_REJECT_FLAG],
-            s->n_rejected[LIDET_VELODYNE_REJECT_AZIMUTH],
+            s->n_rejected[LIDET_VELODYNE_REJECT_AZIMUTH], s->n_rejected[LIDET_VELODYNE_REJECT_UNSUPPORTED],
             s->n_rejected[LIDET_VELODYNE_REJECT_PRODUCT] > 0u && c->model != 0
                 ? " (--force-sensor decodes them as --sensor's model; without --sensor the packets' model is used)"
                 : "");
@@ -1007,7 +1063,9 @@ void cli_capture_close(cli_capture_t *c)
     free(c);
 }
 
-int cli_capture_open(const cli_pcap_opts_t *o, cli_args_t *a, cli_capture_t **out)
+/* pass 1 (cli_capture_open): the capture read once, frames counted, the scans listed, the sensor resolved into a;
+ * need_scans 0 (--print-sensor): a capture without a scan to run is no error. 0 and *out, or 1 with a message. */
+static int capture_read(const cli_pcap_opts_t *o, cli_args_t *a, cli_capture_t **out, int need_scans)
 {
     cli_capture_t *c;
     cli_scan_info_t info;
@@ -1100,7 +1158,7 @@ int cli_capture_open(const cli_pcap_opts_t *o, cli_args_t *a, cli_capture_t **ou
         return 1;
     }
     c->lidar->resolve(c, a);
-    if (c->n_scans == 0u)
+    if (c->n_scans == 0u && need_scans)
     {
         (void)cli_capture_summary(c, stderr, NULL, 0);
         fprintf(stderr,
@@ -1115,6 +1173,23 @@ int cli_capture_open(const cli_pcap_opts_t *o, cli_args_t *a, cli_capture_t **ou
     c->h = NULL;
     *out = c;
     return 0;
+}
+
+int cli_capture_open(const cli_pcap_opts_t *o, cli_args_t *a, cli_capture_t **out)
+{
+    return capture_read(o, a, out, 1);
+}
+
+int cli_capture_print_sensor(const cli_pcap_opts_t *o, cli_args_t *a)
+{
+    cli_capture_t *c = NULL;
+    /* the decoder run over the capture as for the scans: the model locked by the first decoded packet under AUTO,
+     * and a capture the decoder takes nothing of refused with the same message */
+    if (capture_read(o, a, &c, 0) != 0)
+        return 1;
+    cli_capture_close(c);
+    cli_sensor_print(a, stdout);
+    return fflush(stdout) != 0;
 }
 
 uint32_t cli_capture_n_scans(const cli_capture_t *c)

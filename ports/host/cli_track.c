@@ -1035,6 +1035,7 @@ int cli_track(int argc, char **argv)
     /* the sensor: as lidet detect's, with the first scan (or the capture, or --print-sensor alone) */
     {
         char *first = npos > 0 ? pos[0] : (char *)po.path;
+        a.capture = po.path != NULL; /* --sensor may name a --velodyne-calib's model; --print-sensor: the capture's */
         i = cli_args_finish(&a, &first, first != NULL ? 1 : 0, "track");
     }
     if (i == CLI_PARSE_PRINTED)
@@ -1046,6 +1047,11 @@ int cli_track(int argc, char **argv)
     {
         if (i == CLI_PARSE_ERROR)
             fprintf(stderr, "(lidet track --help: the options of lidet track)\n");
+        goto done;
+    }
+    if (po.path != NULL && print_sensor) /* the sensor the capture is decoded as */
+    {
+        rc = cli_capture_print_sensor(&po, &a);
         goto done;
     }
     /* a capture: read once (its scans listed, the sensor from the packets unless --sensor) */

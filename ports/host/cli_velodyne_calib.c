@@ -4,8 +4,10 @@
  * distLSB_; degrees and centimetres) read with libxml2, or velodyne_pointcloud's YAML (num_lasers, lasers,
  * distance_resolution; radians and metres) read with libyaml. The first character tells them apart ('<': XML).
  * The elevation table goes to cli_sensor_use_desc in ring order (the lasers sorted by elevation, lowest first, as
- * velodyne_pointcloud numbers its rings and lidet's Velodyne decoder and presets do); the other corrections are
- * validated, not used.
+ * velodyne_pointcloud numbers its rings and lidet's Velodyne decoder and presets do). Each laser's id, rotational
+ * and distance correction and the distance resolution are kept (cli_args_t.vcorr) for the packet decoder
+ * (`--pcap`: cli_velodyne_calib_table, the rules and messages of tools/lidet_tools/velodyne.py calibration_table);
+ * the other corrections are validated, not used.
  *
  * The rules, their order and the messages are those of tools/lidet_tools/sensors.py (load_velodyne_calibration):
  * a change here goes there too; tests/python/test_velodyne_calib.py compares the two message for message and
@@ -47,6 +49,12 @@ typedef struct
     int entry[LIDET_MAX_ROWS];  /* its entry: points_ item (XML), lasers index (YAML) */
     double vert[LIDET_MAX_ROWS]; /* the elevation as read: degrees (XML), radians (YAML) */
     double rad[LIDET_MAX_ROWS];  /* the elevation in radians */
+    int id[LIDET_MAX_ROWS];      /* id_ / laser_id */
+    /* the rotational correction in radians (XML: its degrees x pi / 180, numpy's radians) */
+    double rot_rad[LIDET_MAX_ROWS];
+    /* the distance correction in metres (XML: its centimetres x 0.01), 0 when absent */
+    double dist_m[LIDET_MAX_ROWS];
+    double res_m; /* the distance resolution, metres (VEL_RESOLUTION_M when not given) */
 } vel_lasers_t;
 
 static int bad(char *err, const char *fmt, ...)
@@ -300,6 +308,7 @@ static int read_xml_doc(const xmlNode *db, vel_lasers_t *L, unsigned char *enabl
             return 1;
         if (!(x > 0.0 && x <= 100.0))
             return bad(err, "\"distLSB_\": %g is outside (0, 100] (centimetres)", x);
+        L->res_m = x * 0.01;
     }
     if (xml_child(db, "enabled_", "\"enabled_\"", &en, err) != 0)
         return 1;
@@ -348,7 +357,7 @@ static int read_xml_doc(const xmlNode *db, vel_lasers_t *L, unsigned char *enabl
         static const char *const tags[2] = {"vertCorrection_", "rotCorrection_"};
         static const double lim[2] = {90.0, 180.0};
         const xmlNode *px;
-        double v[2] = {0.0, 0.0};
+        double v[2] = {0.0, 0.0}, dist = 0.0;
         long id = 0;
         int t;
         if (!is_elem(c, "item"))
@@ -390,10 +399,15 @@ static int read_xml_doc(const xmlNode *db, vel_lasers_t *L, unsigned char *enabl
                 return 1;
             if (el != NULL && xml_number(el, f, &x, err) != 0)
                 return 1;
+            if (el != NULL && t == 0)
+                dist = x * 0.01; /* distCorrection_, cm -> m (sensors.py: _VELODYNE_OPTIONAL's scale) */
         }
         L->entry[L->n] = k - 1;
         L->vert[L->n] = v[0];
         L->rad[L->n] = v[0] * DEG2RAD_D;
+        L->id[L->n] = (int)id;
+        L->rot_rad[L->n] = v[1] * DEG2RAD_D;
+        L->dist_m[L->n] = dist;
         ++L->n;
     }
     for (i = 0; en != NULL && i < n_enabled_items; ++i)
@@ -849,6 +863,7 @@ static int read_yaml_tree(const ynode_t *root, vel_lasers_t *L, char *err)
             return 1;
         if (!(x > 0.0 && x <= 1.0))
             return bad(err, "\"distance_resolution\": %g is outside (0, 1] (metres)", x);
+        L->res_m = x;
     }
     memset(seen, 0, sizeof seen);
     L->n = 0;
@@ -857,7 +872,7 @@ static int read_yaml_tree(const ynode_t *root, vel_lasers_t *L, char *err)
         static const char *const keys[2] = {"vert_correction", "rot_correction"};
         static const double lim[2] = {90.0, 180.0};
         const ynode_t *las = lasers->kids[i];
-        double val[2] = {0.0, 0.0};
+        double val[2] = {0.0, 0.0}, dist = 0.0;
         long id = 0;
         int t;
         snprintf(w, sizeof w, "\"lasers\"[%zu]", i);
@@ -891,10 +906,15 @@ static int read_yaml_tree(const ynode_t *root, vel_lasers_t *L, char *err)
             v = y_get(las, k_yaml_optional[t]);
             if (v != NULL && y_number(v, f, &x, err) != 0)
                 return 1;
+            if (v != NULL && t == 0)
+                dist = x; /* dist_correction, metres */
         }
         L->entry[L->n] = (int)i;
         L->vert[L->n] = val[0];
         L->rad[L->n] = val[0];
+        L->id[L->n] = (int)id;
+        L->rot_rad[L->n] = val[1];
+        L->dist_m[L->n] = dist;
         ++L->n;
     }
     k = first_same(L, &j);
@@ -1009,7 +1029,9 @@ int cli_velodyne_calib_load(cli_args_t *a, const char *cmd)
     size_t size = 0;
     int rc, xml = 0, order[LIDET_MAX_ROWS], i, j;
     memset(d, 0, sizeof *d);
+    memset(&a->vcorr, 0, sizeof a->vcorr);
     memset(&L, 0, sizeof L);
+    L.res_m = VEL_RESOLUTION_M;
     err[0] = '\0';
     rc = read_file(path, &buf, &size, err);
     if (rc == 0)
@@ -1064,9 +1086,96 @@ int cli_velodyne_calib_load(cli_args_t *a, const char *cmd)
         const int k = order[i];
         d->elev_rad_d[i] = L.rad[k];
         d->elev_deg[i] = xml ? L.vert[k] : L.rad[k] * RAD2DEG_D;
+        a->vcorr.laser_id[i] = L.id[k];
+        a->vcorr.rot_rad[i] = L.rot_rad[k];
+        a->vcorr.dist_m[i] = L.dist_m[k];
     }
+    a->vcorr.n = L.n;
+    a->vcorr.distance_resolution_m = L.res_m;
     d->mount_height_m = VEL_MOUNT_HEIGHT_M; /* --mount-height overrides it (cli_parse) */
     d->max_range_m = VEL_MAX_RANGE_M;
     cli_sensor_use_desc(a);
+    return 0;
+}
+
+/* ========================================= the packet decoder's table ========================================= */
+
+/* velodyne.py's name of a model (N_LASERS, DIST_UNIT_MM), its lasers and its packets' distance unit (mm) */
+static const char *vel_model_name(int model, uint32_t *n, uint32_t *unit_mm)
+{
+    *unit_mm = model == LIDET_VELODYNE_VLP32C ? 4u : 2u;
+    *n = lidet_velodyne_n_rings((lidet_velodyne_model_t)model);
+    switch (model)
+    {
+    case LIDET_VELODYNE_HDL32E:
+        return "hdl32e";
+    case LIDET_VELODYNE_VLP16:
+        return "vlp16";
+    case LIDET_VELODYNE_VLP32C:
+        return "vlp32c";
+    case LIDET_VELODYNE_HDL64E:
+        return "hdl64e";
+    default:
+        return NULL;
+    }
+}
+
+int cli_velodyne_calib_table(const cli_args_t *a, int model, lidet_velodyne_calib_t *t, char *err, size_t err_len)
+{
+    const cli_velodyne_corr_t *v = &a->vcorr;
+    uint32_t n = 0, unit = 0;
+    const char *name = vel_model_name(model, &n, &unit);
+    unsigned char seen[LIDET_VELODYNE_MAX_LASERS];
+    char res[64];
+    int i;
+    memset(t, 0, sizeof *t);
+    if (name == NULL || n == 0u)
+    {
+        snprintf(err, err_len, "a calibration needs the model (one of hdl32e, vlp16, vlp32c, hdl64e)");
+        return 1;
+    }
+    if (v->n != (int)n)
+    {
+        snprintf(err, err_len, "calibration: %d lasers, the %s has %u", v->n, name, n);
+        return 1;
+    }
+    memset(seen, 0, sizeof seen);
+    for (i = 0; i < v->n; ++i)
+    {
+        if (v->laser_id[i] < 0 || v->laser_id[i] >= (int)n || seen[v->laser_id[i]])
+        {
+            snprintf(err, err_len, "calibration: the laser ids are not 0 .. %u", n - 1u);
+            return 1;
+        }
+        seen[v->laser_id[i]] = 1;
+    }
+    /* round(res x 1000, 6) as Python rounds: the correctly rounded 6-decimal value (glibc's printf rounds alike) */
+    snprintf(res, sizeof res, "%.6f", v->distance_resolution_m * 1000.0);
+    if (strtod(res, NULL) != (double)unit)
+    {
+        snprintf(err, err_len, "calibration: distance resolution %g mm, the %s's packets count %u mm",
+                 v->distance_resolution_m * 1000.0, name, unit);
+        return 1;
+    }
+    t->n_lasers = n;
+    for (i = 0; i < v->n; ++i)
+    {
+        /* calibration_table: the elevation in degrees as the Sensor holds it (desc.elev_deg: XML's as read, YAML's
+         * radians x 180 / pi), numpy's degrees (x * (180 / pi)), the metres x 1000; np.round: half to even (rint) */
+        const double vert = rint(a->desc.elev_deg[i] * 1000.0);
+        const double rot = rint(v->rot_rad[i] * RAD2DEG_D * 100.0);
+        const double dist = rint(v->dist_m[i] * 1000.0);
+        lidet_velodyne_laser_calib_t *l = &t->laser[v->laser_id[i]];
+        if (fabs(dist) > 32767.0)
+        {
+            snprintf(err, err_len, "calibration: a distance correction beyond +-32.767 m");
+            return 1;
+        }
+        /* the loaders keep elevations in (-90, 90) deg and rotations in (-180, 180) deg: these fit (an elevation
+         * rounded to +-90 000 mdeg is refused by lidet_velodyne_init) */
+        l->vert_mdeg = (int32_t)vert;
+        l->rot_cdeg = (int16_t)rot;
+        l->dist_mm = (int16_t)dist;
+    }
     return 0;
 }

@@ -61,10 +61,10 @@ def _summary(err):
         s.update(zip(("frames", "port", "other_port", "not_udp", "truncated", "malformed", "fragments"),
                      map(int, m.groups())))
     m = re.search(r"(\d+) packets: (\d+) decoded, (\d+) rejected \(size (\d+), product (\d+), mode (\d+), flag (\d+), "
-                  r"azimuth (\d+)\); (\d+) azimuth jumps; (\d+) returns between", err)
+                  r"azimuth (\d+), unsupported (\d+)\); (\d+) azimuth jumps; (\d+) returns between", err)
     if m:
-        s.update(zip(("packets", "decoded", "rejected", "size", "product", "mode", "flag", "azimuth", "jumps",
-                      "fragment_returns"), map(int, m.groups())))
+        s.update(zip(("packets", "decoded", "rejected", "size", "product", "mode", "flag", "azimuth", "unsupported",
+                      "jumps", "fragment_returns"), map(int, m.groups())))
     m = re.search(r"scans: (\d+) complete; (?:skipped|also run): (\d+) partial .*?, (\d+) aborted .*?, (\d+) unfinished "
                   r"at the end \((\d+) returns\); (\d+) returns past LIDET_MAX_POINTS \((\d+)\) dropped in (\d+) scans",
                   err)
@@ -429,7 +429,9 @@ def test_errors_are_clear(pcli, cap, tmp_path):
     r = _run(pcli, "detect", "--pcap", cap.path, "--sensor", "vlp32c", ok=False)
     assert r.returncode == 1 and "is Velodyne data of the model of --sensor vlp32c" in r.stderr
     for args, msg in (
-        (["--sensor", "hdl64"], "vlp16, vlp32c or hdl32"),
+        (["--sensor", "os1-64"], "vlp16, vlp32c, hdl32 or hdl64"),
+        (["--sensor", "hdl64"], "is Velodyne data of the model of --sensor hdl64"),  # VLP-16 payloads: no 0xDDFF
+        (["--velodyne-calib", str(ROOT / "tests" / "data" / "sensors" / "vlp16.yaml")], "needs --sensor"),
         (["--force-sensor"], "--force-sensor needs --sensor"),
         (["--lidar", "lumotive"], "velodyne or ouster"),
         (["--port", "0"], "[1, 65535]"),

@@ -37,8 +37,9 @@ def _deg(a):
 class VelodyneCorrections:
     """What a Velodyne calibration gives besides the elevations and azimuth offsets (load_velodyne_calibration),
     per laser in the Sensor's ring order (lowest beam first), in metres as velodyne_pointcloud's YAML has them
-    (db.xml's centimetres times 0.01). Read and validated; neither the projection nor the packet decoder
-    (lidet_velodyne.h, whose laser tables are built in) uses them (docs/SENSORS.md)."""
+    (db.xml's centimetres times 0.01). Read and validated; the packet decoder applies the distance correction
+    (lidet_velodyne.h's lidet_velodyne_calib_t: `velodyne.calibration_table`, `lidet ... --pcap --velodyne-calib`),
+    the projection none of them; the offsets and focal corrections are not applied (docs/SENSORS.md)."""
     #: "xml" (db.xml / VeloView) or "yaml" (velodyne_pointcloud)
     source: str
     #: each ring's laser: its id (id_ / laser_id), the laser's place in the packet's data block
@@ -70,7 +71,8 @@ class Sensor:
     model: str | None = None
     #: per-beam azimuth offsets in radians, ring order, as the file gives them: Ouster metadata's
     #: beam_azimuth_angles (the Ouster packet decoder takes them: lidet_tools.ouster, `lidet detect --pcap --lidar
-    #: ouster`), a Velodyne calibration's rot_correction (read, not used); the projection never uses them
+    #: ouster`), a Velodyne calibration's rot_correction (the Velodyne packet decoder takes it with
+    #: `--velodyne-calib`: velodyne.calibration_table); the projection never uses them
     beam_azimuth_rad: np.ndarray | None = field(default=None, repr=False)
     #: Ouster metadata's lidar_origin_to_beam_origin_mm; read and validated, not used by the projection
     beam_origin_mm: float | None = None
@@ -1024,7 +1026,8 @@ def load_velodyne_calibration(path, mount_height_m: float | None = None, cols: i
     numbers its rings and as lidet's Velodyne decoder and presets do (ring 0 = the lowest beam), whatever the
     file's laser order (a VLP-16's lasers alternate -15, +1, -13, +3 ... deg). `Sensor.velodyne.laser_id` gives
     each ring's laser; `Sensor.beam_azimuth_rad` its rot_correction, `Sensor.velodyne` the other corrections: read
-    and validated, not used by the projection (elevations only) nor by the packet decoder (built-in tables).
+    and validated; the packet decoder takes the rotational and distance corrections (velodyne.calibration_table,
+    `lidet ... --pcap --velodyne-calib`), the projection the elevations only.
 
     mount_height_m: metres in [0, 10] (default 1.0: not in the file). cols: columns per revolution, an integer in
     [8, LIDET_MAX_COLS] (default `velodyne_default_cols`: 1800, or 2048 for 64 lasers). name: the sensor's name
