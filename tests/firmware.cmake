@@ -88,6 +88,28 @@ lidet_fw_host_ref(vlp16 fw_host_ref)
 lidet_fw_host_ref(hdl64 fw_host_ref_hdl64)
 lidet_fw_host_ref(vlp16 fw_host_ref_q FIXED)
 
+# the packet application's reference (ports/firmware/fw_packets.c with FW_PACKETS_HOST_REF): the same VLP-16
+# payloads (tools/firmware/packets_to_c.py) decoded on the host into a buffer of the whole scan, the completed scan
+# given to lidet_detector_q_run_returns at once; the images stream them instead (lidet_detector_q_stream_*)
+set(fw_pkt_c ${CMAKE_CURRENT_BINARY_DIR}/fw_host_pkt.c)
+set(fw_pkt_data ${PROJECT_SOURCE_DIR}/tests/data/sim_vlp16)
+add_custom_command(OUTPUT ${fw_pkt_c}
+  COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tools/firmware/packets_to_c.py ${fw_pkt_data}/velodyne/000000.bin
+          --ring ${fw_pkt_data}/ring/000000.bin --name tests/data/sim_vlp16/000000 --out ${fw_pkt_c}
+  DEPENDS ${PROJECT_SOURCE_DIR}/tools/firmware/packets_to_c.py ${fw_pkt_data}/velodyne/000000.bin
+          ${fw_pkt_data}/ring/000000.bin
+  VERBATIM)
+add_executable(fw_host_ref_pkt ${fw_src}/fw_packets.c ${fw_src}/fw_host_port.c ${fw_pkt_c})
+set_target_properties(fw_host_ref_pkt PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
+target_include_directories(fw_host_ref_pkt PRIVATE ${fw_src})
+lidet_fw_models(fw_pkt_models vlp16 ON)
+target_compile_definitions(fw_host_ref_pkt PRIVATE FW_PACKETS_HOST_REF=1 FW_SENSOR="vlp16" FW_SENSOR_ID=vlp16
+                                                   FW_MODELS="${fw_pkt_models}" FW_MODELS_ID=${fw_pkt_models})
+target_compile_options(fw_host_ref_pkt PRIVATE -Wall -Wextra -Werror)
+target_link_libraries(fw_host_ref_pkt PRIVATE lidet_fwcap_vlp16_q)
+add_test(NAME firmware_fw_host_ref_pkt COMMAND fw_host_ref_pkt)
+set_tests_properties(firmware_fw_host_ref_pkt PROPERTIES PASS_REGULAR_EXPRESSION "lidet-fw: PASS")
+
 # ---- the bare-metal aarch64 image's own C library functions (ports/aarch64/virt_libc.c: no C library there), built
 # for the host under other names and compared with the host's (tests/aarch64/test_virt_libc.c) ----
 set(virt_libc_defs "")
@@ -107,9 +129,10 @@ add_test(NAME firmware_virt_libc COMMAND test_virt_libc)
 set_tests_properties(firmware_virt_libc PROPERTIES PASS_REGULAR_EXPRESSION "virt_libc: PASS")
 
 # ---- the images --------------------------------------------------------------------------------
-add_custom_target(firmware DEPENDS fw_host_ref fw_host_ref_hdl64 fw_host_ref_q)
-# image name | board | sensor | toolchain file | compiler | size tool. The HDL-64 (KITTI-like) images need ~4.5 MiB
-# of RAM: QEMU virt, and the AN500's Cortex-M7 with the detector placed in its 16 MiB PSRAM.
+add_custom_target(firmware DEPENDS fw_host_ref fw_host_ref_hdl64 fw_host_ref_q fw_host_ref_pkt)
+# image name | board | sensor | toolchain file | compiler | size tool [| fixed [| application]]. The HDL-64
+# (KITTI-like) images need ~4.5 MiB of RAM: QEMU virt, and the AN500's Cortex-M7 with the detector placed in its
+# 16 MiB PSRAM. The application is fw_detect.c unless an eighth field names another (LIDET_FW_APP).
 set(fw_images
     "mps2-an385|mps2-an385|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
     "mps2-an385-m0plus|mps2-an385-m0plus|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
@@ -125,6 +148,11 @@ set(fw_images
     "mps2-an386-q|mps2-an386|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed"
     "mps2-an500-q|mps2-an500|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed"
     "virt-rv32imac-q|virt-rv32imac|vlp16|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size|fixed"
+    # VLP-16 payloads in flash decoded (lidet_velodyne_packet) and streamed into the integer detector
+    # (ports/firmware/fw_packets.c), compared bit for bit with fw_host_ref_pkt (issue 37)
+    "mps2-an386-q-packets|mps2-an386|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed|packets"
+    "mps2-an385-m0plus-q-packets|mps2-an385-m0plus|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed|packets"
+    "virt-rv32imac-q-packets|virt-rv32imac|vlp16|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size|fixed|packets"
     # 64-bit Arm bare metal (QEMU virt, Cortex-A72; ports/aarch64): the float image with the NEON dense kernel, the
     # integer image compared bit for bit
     "virt-aarch64|virt-aarch64|vlp16|aarch64-bare-metal|aarch64-linux-gnu-gcc|aarch64-linux-gnu-size"
@@ -142,7 +170,13 @@ foreach(entry IN LISTS fw_images)
   if(nf GREATER 6)
     set(fixed ON)
   endif()
-  if(fixed)
+  set(app detect)
+  if(nf GREATER 7)
+    list(GET f 7 app)
+  endif()
+  if(app STREQUAL "packets")
+    set(ref fw_host_ref_pkt)
+  elseif(fixed)
     set(ref fw_host_ref_q)
   elseif(sensor STREQUAL "vlp16")
     set(ref fw_host_ref)
@@ -165,7 +199,7 @@ foreach(entry IN LISTS fw_images)
     BINARY_DIR ${bdir}
     CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/cmake/toolchains/${tc}.cmake
                -DLIDET_FW_BOARD=${board} -DLIDET_FW_SENSOR=${sensor} -DPython3_EXECUTABLE=${Python3_EXECUTABLE}
-               -DLIDET_FW_FIXED=${fixed} -DLIDET_FW_MODELS=${models}
+               -DLIDET_FW_FIXED=${fixed} -DLIDET_FW_MODELS=${models} -DLIDET_FW_APP=${app}
     BUILD_ALWAYS ON
     INSTALL_COMMAND ""
     BUILD_BYPRODUCTS ${bdir}/lidet_fw.elf)

@@ -287,3 +287,96 @@ def test_cycle_estimate_of_the_m4_integer_image():
     exact += sum(run.get("insn_total", 0) for run in report.get("track", {}).values())  # and the tracker's updates
     assert abs(r["instructions"] - exact) <= 0.05 * exact, (r, exact)
     assert 1.0 < r["cpi_low"] < r["cpi_high"] < 3.0, r
+
+
+# ---- the packet application (LIDET_FW_APP=packets, ports/firmware/fw_packets.c; issue 37) -----------------------
+
+packets_to_c = _load("packets_to_c")
+SIM_VLP16 = ROOT / "tests" / "data" / "sim_vlp16"
+
+
+def test_packets_to_c_writes_lidet_tools_payloads(tmp_path):
+    """packets_to_c.py (standard library only: the build runs it before any venv) writes, byte for byte, the payloads
+    of lidet_tools.velodyne.vlp16_packets over vlp16_grid of the shipped scan, in the C file and in the pcap."""
+    np = pytest.importorskip("numpy")
+    from lidet_tools import velodyne as V
+    out, pcap = tmp_path / "fw_scan.c", tmp_path / "p.pcap"
+    assert packets_to_c.main([str(SIM_VLP16 / "velodyne" / "000000.bin"), "--ring", str(SIM_VLP16 / "ring" / "000000.bin"),
+                              "--name", "sim", "--out", str(out), "--pcap", str(pcap)]) == 0
+    pts = np.fromfile(SIM_VLP16 / "velodyne" / "000000.bin", np.float32).reshape(-1, 4)
+    ring = np.fromfile(SIM_VLP16 / "ring" / "000000.bin", np.uint16)
+    want = [p for _, p in V.vlp16_packets([V.vlp16_grid(pts, ring)], 76, start_cdeg=35760)]
+    text = out.read_text()
+    assert "const uint32_t fw_pkt_n = 76u;" in text and "fw_pkt_start_cdeg = 35760u;" in text
+    body = text.split("[LIDET_VELODYNE_PAYLOAD_BYTES] = {")[1].rsplit("};", 1)[0]
+    got = [bytes(int(v) for v in blk.replace("\n", "").split(",") if v.strip())
+           for blk in body.replace("{", "").split("}")[:-1]]
+    assert got == want
+    assert [p for _, _, p in V.read_pcap_payloads(pcap)] == want
+    V.write_pcap(tmp_path / "ref.pcap", [V.udp_frame(p) for p in want])
+    assert (tmp_path / "ref.pcap").read_bytes() == pcap.read_bytes()
+
+
+def test_packets_to_c_closes_one_rotation(tmp_path, need_lib):
+    """The payloads begin half a packet before the seam and end in the one crossing it again: decoded, a PARTIAL
+    scan, then one COMPLETE rotation holding every cell of the scene (the simulated scan's 23,252 points)."""
+    from lidet_tools import velodyne as V
+    pcap = tmp_path / "p.pcap"
+    packets_to_c.main([str(SIM_VLP16 / "velodyne" / "000000.bin"), "--ring", str(SIM_VLP16 / "ring" / "000000.bin"),
+                       "--out", str(tmp_path / "fw_scan.c"), "--pcap", str(pcap)])
+    d = V.decode([p for _, _, p in V.read_pcap_payloads(pcap)], model="vlp16")
+    assert d.scan_kinds() == [V.SCAN_PARTIAL, V.SCAN_COMPLETE, V.SCAN_NONE]
+    assert int((d.scan == 1).sum()) == 23252 and sum(d.stats[f"n_rejected_{r}"] for r in V.REJECTS) == 0
+
+
+def test_packets_to_c_rejects_bad_arguments(tmp_path):
+    scan, ring = SIM_VLP16 / "velodyne" / "000000.bin", SIM_VLP16 / "ring" / "000000.bin"
+    with pytest.raises(SystemExit):
+        packets_to_c.main([str(scan), "--ring", str(ring), "--start-cdeg", "30", "--out", str(tmp_path / "x.c")])
+    short = tmp_path / "r.bin"
+    short.write_bytes(b"\0" * 4)
+    with pytest.raises(SystemExit):
+        packets_to_c.main([str(scan), "--ring", str(short), "--out", str(tmp_path / "x.c")])
+
+
+PKT_LINES = """lidet-fw board=b core=c build=fixed app=packets sensor=vlp16 models=vlp16s_s8 scan=s packets=76
+mem detector_bytes=1 decoder_bytes=2 buffer_bytes=3 max_rows=16 max_cols=1800 max_points=30000 max_clusters=64
+stats run=default status=0 clusters=3 detections=1 proj_in=100
+det default 0 Car 1 50 00004000 00000001 00000002 00000003 00000004 00000005 00000006 00000007 00000008 00000009
+decode run=default packets=76 decoded=76 returns=300 partial=1 complete=1 aborted=0 first=0 last=75 scan_returns=280
+stats run=open status=0 clusters=3 detections=1 proj_in=100
+det open 0 Car 1 50 00004000 00000001 00000002 00000003 00000004 00000005 00000006 00000007 00000008 00000009
+decode run=open packets=76 decoded=76 returns=300 partial=1 complete=1 aborted=0 first=0 last=75 scan_returns=280
+digest run=default returns=280 fnv1a=0123abcd
+lidet-fw: PASS
+"""
+
+
+def test_packet_lines_parse_and_compare():
+    """run_fw.py reads the packet application's decode / digest / pktinsn lines, and its comparison needs them
+    identical on both sides (the detections bit for bit as for every integer image; no tracker)."""
+    rep = run_fw.parse(PKT_LINES + "insn run=default decode=5 project=1 ground=2 cluster=3 classify=4 box=5 post=6 "
+                       "scan=26\npktinsn run=default decode_max=9 stream_max=8 end=7 counter=3\n")
+    assert rep["header"]["app"] == "packets" and rep["decode"]["default"]["scan_returns"] == 280
+    assert rep["digest"]["default"] == {"returns": "280", "fnv1a": "0123abcd"}
+    assert rep["insn"]["default"]["decode"] == 5 and rep["pktinsn"]["default"]["end"] == 7
+    assert run_fw.compare(rep, copy.deepcopy(rep))[0] == []
+    bad = run_fw.parse(PKT_LINES.replace("00000009\ndecode run=open", "0000000a\ndecode run=open"))
+    assert any("integer values differ" in e for e in run_fw.compare(rep, bad)[0])
+
+
+def test_host_reference_of_the_packet_application():
+    """fw_host_ref_pkt: the payloads decoded on the host, the completed scan through lidet_detector_q_run_returns:
+    both runs, detections in the open run, one partial then one complete scan, its digest."""
+    exe = pathlib.Path(os.environ.get("LIDET_BUILD_DIR", ROOT / "build")) / "tests" / "fw_host_ref_pkt"
+    if not exe.exists():
+        pytest.skip(f"{exe} not built")
+    p = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stdout + p.stderr
+    rep = run_fw.parse(p.stdout)
+    assert rep["pass"] and rep["header"]["app"] == "packets" and set(rep["stats"]) == {"default", "open"}
+    assert len(rep["det"]["open"]) == rep["stats"]["open"]["detections"] > 0 and not rep["track"]
+    for run in ("default", "open"):
+        d = rep["decode"][run]
+        assert (d["packets"], d["decoded"], d["partial"], d["complete"], d["aborted"]) == (76, 76, 1, 1, 0)
+        assert d["scan_returns"] == rep["stats"][run]["proj_in"] == int(rep["digest"]["default"]["returns"]) == 23252

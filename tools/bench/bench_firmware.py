@@ -41,6 +41,15 @@ BOARDS = [  # board, core, FPU, QEMU machine
      "virt"),
 ]
 AARCH64_PORTABLE = "virt-aarch64-portable"
+# the packet application (LIDET_FW_APP=packets, ports/firmware/fw_packets.c; issue 37): VLP-16 payloads in flash
+# decoded and streamed into the integer detector; image, core, the fw_detect.c image fed the same scan's returns
+PACKET_BOARDS = [
+    ("mps2-an386-q-packets", "Cortex-M4, integer build (vlp16s; DSP)", "mps2-an386-q"),
+    ("mps2-an385-m0plus-q-packets", "Cortex-M0+ code, integer build (vlp16s)", "mps2-an385-m0plus-q"),
+    ("virt-rv32imac-q-packets", "RV32IMAC, integer build (vlp16s)", "virt-rv32imac-q"),
+]
+DECODE_GOAL = 1_000_000  # issue 37: decoding adds at most 1 M instructions to a VLP-16 scan
+VLP16_PAYLOADS_PER_TURN = 75  # 900 blocks of 0.4 deg (600 rpm), 12 a payload
 STAGES = ["project", "ground", "cluster", "classify", "box", "post"]
 
 
@@ -102,6 +111,74 @@ def _aarch64_portable(build, reports):
     return json.loads(rep.read_text()) if rep.exists() else None
 
 
+def _packets_section(reports) -> list:
+    """The packet images' table (PACKET_BOARDS): decoding, projection, the rest, per scan; RAM and flash."""
+    rows = [(b, core, det) for b, core, det in PACKET_BOARDS if "default" in reports.get(b, {}).get("insn", {})]
+    if not rows:
+        return []
+    r0 = reports[rows[0][0]]
+    d0 = r0["decode"]["default"]
+    out = [
+        "",
+        "**Packets from flash** (issue 37; `LIDET_FW_APP=packets`, ports/firmware/fw_packets.c, docs/PORTING.md "
+        "\"Streaming the returns\"): the images `*-q-packets` hold the scan above as "
+        f"{d0['packets']} VLP-16 data payloads ({(r0.get('header') or {}).get('packets', '?')} x 1206 bytes of const "
+        "data, made at build time by tools/firmware/packets_to_c.py: lidet_tools.velodyne's vlp16_grid and "
+        "vlp16_packets, strongest return, 0.4 deg a block, the first payload half a packet before the seam), decode "
+        "them one at a time with `lidet_velodyne_packet` into a buffer of `LIDET_VELODYNE_MAX_RETURNS` (384) returns "
+        "and stream each into the integer detector (`lidet_detector_q_stream_begin` at the first seam, "
+        "`_stream_returns` per payload, `_stream_end` when the decoder reports the rotation `COMPLETE`), with no "
+        f"buffer for the scan: {d0['scan_returns']:,} returns from payloads {d0['first']}..{d0['last']} (the "
+        "simulated scan's points, one per 0.2 deg cell and ring, their azimuths now the firing times' and their "
+        "ranges in 2 mm steps, so the stages' counts differ a little from the `-q` images'). Compared with `fw_host_ref_pkt` (the same payloads "
+        "decoded on the host into a buffer of the whole scan, `lidet_detector_q_run_returns` on it) by "
+        "tools/firmware/run_fw.py: detections, counts, the decoder's counts and a digest of the scan's returns "
+        "identical. Run `default`; decode = `lidet_velodyne_packet` over all "
+        f"{d0['packets']} payloads (the counter reads' own instructions subtracted), projection = "
+        "`stream_begin` + every `stream_returns` + the projection's end inside `stream_end`, rest = ground, "
+        "clustering, networks and NMS (the rest of `stream_end`), total = the first payload to the detections:",
+        "",
+        "| core | **decode** (per payload: mean / largest) | projection (largest `stream_returns`) | rest | "
+        "**total per scan** | fw_detect.c's `-q` image (the scan's points as returns in RAM) | flash (no payloads) | "
+        "payloads in flash | **RAM** (data + bss + stack) | stack used |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for board, core, det in rows:
+        r = reports[board]
+        ins, pk, d, sz = r["insn"]["default"], r.get("pktinsn", {}).get("default", {}), r["decode"]["default"], r["size"]
+        rest = sum(ins[k] for k in ("ground", "cluster", "classify", "box", "post"))
+        ref = reports.get(det, {}).get("insn", {}).get("default")
+        out.append(
+            f"| {core} | **{_m(ins['decode'])}** ({ins['decode'] / d['packets'] / 1e3:,.1f} k / "
+            f"{pk.get('decode_max', 0) / 1e3:,.1f} k) | {_m(ins['project'])} ({pk.get('stream_max', 0) / 1e3:,.1f} k) "
+            f"| {_m(rest)} | **{_m(ins['scan'])}** | " + (f"{_m(ref['scan'])}" if ref else "-") +
+            f" | {_kib(sz['flash_without_scan'])} | {_kib(sz['rodata_scan'])} | **{_kib(sz['ram'])}** "
+            f"({sz['ram']:,} B) | {r['stack']['used']:,} B |")
+    m4 = reports.get("mps2-an386-q-packets")
+    if m4 and "default" in m4.get("insn", {}):
+        ins, d = m4["insn"]["default"], m4["decode"]["default"]
+        turn = ins["decode"] * VLP16_PAYLOADS_PER_TURN / d["packets"]
+        per_ret = ins["decode"] / max(d["returns"], 1)
+        out += [
+            "",
+            f"Goal (issue 37): decoding adds at most 1 M instructions to a VLP-16 scan. On the Cortex-M4 "
+            f"`lidet_velodyne_packet` takes {ins['decode']:,} instructions for the {d['packets']} payloads "
+            f"({turn / 1e6:.2f} M for the {VLP16_PAYLOADS_PER_TURN} payloads of one rotation; {per_ret:.0f} per "
+            f"return of the {d['returns']:,} decoded): "
+            + ("**the goal holds**." if turn <= DECODE_GOAL else
+               f"**the goal does not hold** ({turn / DECODE_GOAL:.1f}x; docs/DECODING.md).")
+            + f" With decoding the scan takes {_m(ins['scan'])} from the first payload to the detections; the "
+            f"latency from the last payload to them is `stream_end`'s {_m(m4['pktinsn']['default']['end'])}.",
+        ]
+    out += ["", "Measured by `ctest --test-dir build -R q-packets` (tools/firmware/run_fw.py writes "
+            "`build/firmware/<image>/report.json`), tabulated by this benchmark (tools/bench/bench_firmware.py).", ""]
+    for b, core, _ in rows:
+        r = reports[b]
+        out.append(f"- {core}, against `fw_host_ref_pkt`: " + " / ".join(r.get("comparison", [])[:2]) +
+                   (" **FAILED: " + "; ".join(r["errors"]) + "**" if r.get("errors") else ""))
+    return out
+
+
 def run(args) -> str:
     build = pathlib.Path(args.build)
     if os.environ.get("LIDET_BENCH_FW_REUSE") == "1":  # the reports of the last ctest run, as they are
@@ -113,6 +190,10 @@ def run(args) -> str:
     for board, *_ in BOARDS:
         f = build / "firmware" / board / "report.json"
         if f.exists() and board != AARCH64_PORTABLE:
+            reports[board] = json.loads(f.read_text())
+    for board, *_ in PACKET_BOARDS:
+        f = build / "firmware" / board / "report.json"
+        if f.exists():
             reports[board] = json.loads(f.read_text())
     a64p = _aarch64_portable(build, reports)
     if a64p:
@@ -372,6 +453,7 @@ def run(args) -> str:
             f"{_kib(sz['rodata_weights'])}), {ins['scan'] / 20e6:.1f}x the instruction goal on the M3 (the two "
             f"PointNets {100.0 * (ins['classify'] + ins['box']) / ins['scan']:.0f}% of it)" + m4q + ".",
         ]
+    out += _packets_section(reports)
     out += [
         "",
         "**Cost in CI.** Installing the toolchains and QEMU (`tools/scripts/install_deps.sh`, Debian 12: "

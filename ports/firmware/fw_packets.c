@@ -1,0 +1,608 @@
+/* SPDX-License-Identifier: MIT */
+/* The packet application (LIDET_FW_APP=packets; integer build only): what a board does with a VLP-16's UDP stream.
+ * The payloads of one rotation and a bit (fw_packets.h, in flash) are decoded one at a time with
+ * lidet_velodyne_packet into a buffer of LIDET_VELODYNE_MAX_RETURNS returns and streamed into the integer detector
+ * (lidet_detector_q_stream_begin at the first seam, _returns per payload, _end when the decoder reports the
+ * rotation COMPLETE): no buffer for the scan (docs/PORTING.md, "Streaming the returns"). Two runs, as fw_detect.c:
+ * `default` (the configuration a user gets) and `open` (gates and size checks off, so that many boxes are compared).
+ * No tracker: its 8 KiB do not fit beside the decoder's buffers in the integer image's 256 KiB (run_fw.py).
+ *
+ * Built for the host with FW_PACKETS_HOST_REF=1 (fw_host_ref_pkt, tests/firmware.cmake) it is the reference the
+ * images are compared with: the same payloads decoded into a buffer of the whole scan (docs/DECODING.md, "Use")
+ * and the completed scan given to lidet_detector_q_run_returns at once. Lines (tools/firmware/run_fw.py):
+ *   lidet-fw board=... core=... build=fixed app=packets sensor=vlp16 models=... scan=... packets=N
+ *   mem detector_bytes=.. decoder_bytes=.. buffer_bytes=.. max_rows=.. ...   sizes, capacities
+ *   calib n=N expected=E measured=M                  the instruction counter against loops of known length
+ *   stats run=R status=S clusters=... detections=D proj_in=..   the detector's counts (fw_detect.c's, + projection)
+ *   det R k CLASS CLUSTER NPTS h0 .. h9 # readable   one detection, int32 values as hex (fw_detect.c's format)
+ *   decode run=R packets=.. decoded=.. returns=.. partial=.. complete=.. aborted=.. first=P last=Q scan_returns=N
+ *                                                    the decoder's counts; the completed scan: payloads P..Q, returns
+ *   digest run=default returns=N fnv1a=H             FNV-1a of the completed scan's returns (range, azimuth, ring),
+ *                                                    from a second, untimed pass
+ *   insn run=R decode=.. project=.. ground=.. cluster=.. classify=.. box=.. post=.. scan=..   instructions: decode =
+ *                                                    lidet_velodyne_packet over every payload, project = stream_begin,
+ *                                                    every stream_returns and the projection's end, scan = all of it
+ *   pktinsn run=R decode_max=.. stream_max=.. end=.. counter=..   the largest payload's decoding and stream_returns
+ *                                                    call, stream_end (latency from the last packet), the counter
+ *                                                    reads' own cost subtracted from decode
+ *   stack used=N size=S
+ *   lidet-fw: PASS | FAIL (...) */
+#include <stdint.h>
+#include <string.h>
+
+#include "fw_packets.h"
+#include "fw_port.h"
+#include "lidet/lidet_detector_q.h"
+#include "lidet/lidet_velodyne.h"
+#include "lidet_weights.h"
+
+#if !LIDET_FIXED_POINT
+#error "fw_packets.c: the integer build only (LIDET_FW_FIXED=ON): the streaming API is the integer detector's"
+#endif
+#ifndef FW_PACKETS_HOST_REF
+#define FW_PACKETS_HOST_REF 0
+#endif
+#ifndef FW_SENSOR
+#define FW_SENSOR "vlp16"
+#endif
+#ifndef FW_MODELS_ID
+#define FW_MODELS_ID vlp16s
+#define FW_MODELS "vlp16s"
+#endif
+#define FW_XCAT(a, b) a##b
+#define FW_CAT(a, b) FW_XCAT(a, b)
+
+/* What a product holds: the detector, the decoder and one payload's returns. */
+static lidet_detector_q_t g_det;
+static lidet_velodyne_t g_vlp;
+static lidet_return_t g_out[LIDET_VELODYNE_MAX_RETURNS];
+#if FW_PACKETS_HOST_REF
+/* the host reference's scan buffer (docs/DECODING.md, "Use"): a whole scan, then one more payload's returns */
+static lidet_return_t g_scan[LIDET_MAX_POINTS + LIDET_VELODYNE_MAX_RETURNS];
+#endif
+
+static const char *const k_class_names[LIDET_N_CLASSES] = {"Car", "Cyclist", "Pedestrian"};
+
+/* ---- output (no stdio) ----------------------------------------------------------------------------- */
+
+static void put_s(const char *s)
+{
+    while (*s != '\0')
+        fw_putc(*s++);
+}
+
+static void put_u64(uint64_t v)
+{
+    char b[21];
+    int n = 0;
+    do
+    {
+        b[n++] = (char)('0' + (unsigned)(v % 10u));
+        v /= 10u;
+    } while (v != 0u);
+    while (n > 0)
+        fw_putc(b[--n]);
+}
+
+static void put_u(uint32_t v)
+{
+    put_u64(v);
+}
+
+static void put_i(int32_t v)
+{
+    if (v < 0)
+    {
+        fw_putc('-');
+        put_u((uint32_t)(-(v + 1)) + 1u);
+    }
+    else
+        put_u((uint32_t)v);
+}
+
+static void put_hex(uint32_t v)
+{
+    int k;
+    for (k = 28; k >= 0; k -= 4)
+        fw_putc("0123456789abcdef"[(v >> k) & 15u]);
+}
+
+static void put_kv(const char *key, uint32_t v)
+{
+    fw_putc(' ');
+    put_s(key);
+    fw_putc('=');
+    put_u(v);
+}
+
+static void put_kv64(const char *key, uint64_t v)
+{
+    fw_putc(' ');
+    put_s(key);
+    fw_putc('=');
+    put_u64(v);
+}
+
+/* one detection: fw_detect.c's `det` line (the integer build's int32 values as hex, then readable) */
+static void put_det(const char *run, uint32_t k, const lidet_detection_q_t *d)
+{
+    static const char *const labels[8] = {" # score_q15 ", " xyz_mm ", " ", " ",
+                                          " lwh_mm ",      " ",        " ", " yaw_bam "};
+    const int32_t v[10] = {d->score_q15, d->box.cx_mm, d->box.cy_mm,   d->box.cz_mm,      d->box.l_mm,
+                           d->box.w_mm,  d->box.h_mm,  d->box.yaw_bam, d->energy_cls_q16, d->energy_box_q16};
+    uint32_t j;
+    put_s("det ");
+    put_s(run);
+    fw_putc(' ');
+    put_u(k);
+    fw_putc(' ');
+    put_s(d->cls < LIDET_N_CLASSES ? k_class_names[d->cls] : "?");
+    fw_putc(' ');
+    put_u(d->cluster_id);
+    fw_putc(' ');
+    put_u(d->n_points);
+    for (j = 0; j < 10u; ++j)
+    {
+        fw_putc(' ');
+        put_hex((uint32_t)v[j]);
+    }
+    for (j = 0; j < 8u; ++j)
+    {
+        put_s(labels[j]);
+        put_i(v[j]);
+    }
+    fw_putc('\n');
+}
+
+/* ---- the detector's clock hook: 64-bit stage counts without a timestamp buffer ---------------------------- */
+
+/* The stages' ticks are uint32 (lidet_detector_q_stats_t); the hook rebuilds them in 64 bits as it is called,
+ * from the order the streaming detector calls it in. While streaming, in pairs: stream_begin and each
+ * stream_returns around their projection work. Then stream_end: k = 0 before the projection's end, 1 after it,
+ * 2 after the ground stage, 3 after the clustering, 4 at the classification's start, then a pair per box net, the
+ * classification's end, the post-processing's start and end (8 + 2 boxes calls, as lidet_detector_q_run's).
+ * From k = 5 on, the intervals of odd k are the classification's and of even k the box nets', but for the last
+ * two: the gap before the post-processing (even) and the post-processing (odd). So two sums and the last two
+ * intervals suffice (fw_detect.c keeps every timestamp instead: 1 KiB of RAM a product would not hold). */
+typedef struct
+{
+    uint64_t prev;    /* the last timestamp */
+    uint64_t project; /* the projection's intervals */
+    uint64_t ground, cluster;
+    uint64_t odd, even;  /* stream_end's intervals from k = 5 on, by the parity of k */
+    uint64_t last[2];    /* the last two of them: [1] the last */
+    uint64_t stream_max; /* the largest stream_returns interval */
+    uint32_t n;          /* calls in this phase */
+    uint32_t end_phase;  /* 0: streaming, 1: inside stream_end */
+} seq_t;
+
+static seq_t g_seq;
+
+static uint32_t seq_clock(void *ctx)
+{
+    seq_t *q = (seq_t *)ctx;
+    const uint64_t v = fw_insn64();
+    const uint64_t d = v - q->prev;
+    if (!q->end_phase)
+    {
+        if ((q->n & 1u) != 0u)
+        {
+            q->project += d;
+            q->stream_max = q->n > 1u && d > q->stream_max ? d : q->stream_max; /* not stream_begin's */
+        }
+    }
+    else if (q->n == 1u)
+        q->project += d;
+    else if (q->n == 2u)
+        q->ground = d;
+    else if (q->n == 3u)
+        q->cluster = d;
+    else if (q->n >= 5u)
+    {
+        if ((q->n & 1u) != 0u)
+            q->odd += d;
+        else
+            q->even += d;
+        q->last[0] = q->last[1];
+        q->last[1] = d;
+    }
+    q->prev = v;
+    ++q->n;
+    return (uint32_t)v;
+}
+
+/* -> 0 and out[] filled (LIDET_DET_STAGE_* order), or 1 when the calls do not match the detector's order: the
+ * count of stream_end's calls, and the low 32 bits of every rebuilt stage against the detector's own ticks */
+static int seq_stages(const seq_t *q, const lidet_detector_q_stats_t *s, uint64_t out[LIDET_DET_N_STAGES])
+{
+    uint32_t k;
+    if (!q->end_phase || q->n != 8u + 2u * s->n_boxed)
+        return 1;
+    out[LIDET_DET_STAGE_PROJECT] = q->project;
+    out[LIDET_DET_STAGE_GROUND] = q->ground;
+    out[LIDET_DET_STAGE_CLUSTER] = q->cluster;
+    out[LIDET_DET_STAGE_CLASSIFY] = q->odd - q->last[1];
+    out[LIDET_DET_STAGE_BOX] = q->even - q->last[0];
+    out[LIDET_DET_STAGE_POST] = q->last[1];
+    for (k = 0; k < LIDET_DET_N_STAGES; ++k)
+        if ((uint32_t)out[k] != s->ticks[k])
+            return 1;
+    return 0;
+}
+
+/* ---- one run ----------------------------------------------------------------------------------------- */
+
+typedef struct
+{
+    uint32_t n_partial, n_complete, n_aborted; /* scan events seen */
+    uint32_t first, last;                      /* payloads holding the completed scan's returns */
+    uint32_t scan_returns;                     /* its returns */
+    uint64_t counter;                          /* instructions of two back-to-back counter reads */
+    uint64_t decode, decode_max;               /* lidet_velodyne_packet: every payload, the largest */
+    uint64_t end;                              /* lidet_detector_q_stream_end */
+} pkt_t;
+
+static void count_event(pkt_t *p, uint32_t ev)
+{
+    p->n_partial += ev == LIDET_VELODYNE_SCAN_PARTIAL;
+    p->n_complete += ev == LIDET_VELODYNE_SCAN_COMPLETE;
+    p->n_aborted += ev == LIDET_VELODYNE_SCAN_ABORTED;
+}
+
+/* decode payload k into g_out, its instructions added to p (minus the counter's own) */
+static lidet_status_t decode_one(uint32_t k, pkt_t *p, lidet_velodyne_result_t *r)
+{
+    const uint64_t t0 = fw_insn64();
+    const lidet_status_t s = lidet_velodyne_packet(&g_vlp, fw_pkt_payload[k], LIDET_VELODYNE_PAYLOAD_BYTES,
+                                                   g_out, 0, LIDET_VELODYNE_MAX_RETURNS, r);
+    const uint64_t d = fw_insn64() - t0 - p->counter;
+    p->decode += d;
+    p->decode_max = d > p->decode_max ? d : p->decode_max;
+    count_event(p, r->scan_event);
+    return s;
+}
+
+#if !FW_PACKETS_HOST_REF
+/* The board: each payload decoded and streamed; the scan ends inside the payload whose event is COMPLETE. Before
+ * the first seam no stream is open (the partial rotation's returns are dropped, as a product drops them). */
+static __attribute__((noinline)) lidet_status_t run_packets(pkt_t *p)
+{
+    int open = 0;
+    uint32_t k, from;
+    for (k = 0; k < fw_pkt_n; ++k)
+    {
+        lidet_velodyne_result_t r;
+        lidet_status_t s = decode_one(k, p, &r);
+        if (s != LIDET_OK)
+            return s < 0 ? s : LIDET_ERR_STATE; /* a rejected or truncated payload: none is expected here */
+        if (r.scan_event == LIDET_VELODYNE_SCAN_COMPLETE && open)
+        {
+            s = lidet_detector_q_stream_returns(&g_det, g_out, r.scan_end, 0);
+            if (!LIDET_SUCCEEDED(s))
+                return s;
+            p->scan_returns += r.scan_end;
+            p->last = k;
+            g_seq.end_phase = 1u;
+            g_seq.n = 0u;
+            p->end = fw_insn64();
+            s = lidet_detector_q_stream_end(&g_det);
+            p->end = fw_insn64() - p->end - p->counter;
+            return s;
+        }
+        /* without an event every return is the scan's (scan_end = n_returns); with one, those from scan_end on */
+        from = 0u;
+        if (r.scan_event != LIDET_VELODYNE_SCAN_NONE)
+        {
+            /* a new rotation begins at the seam (after a partial, aborted or, in a product, a completed one) */
+            s = lidet_detector_q_stream_begin(&g_det);
+            if (s != LIDET_OK)
+                return s;
+            open = 1;
+            from = r.scan_end;
+            p->first = k;
+            p->scan_returns = 0u;
+        }
+        if (open)
+        {
+            s = lidet_detector_q_stream_returns(&g_det, g_out + from, r.n_returns - from, 0);
+            if (!LIDET_SUCCEEDED(s))
+                return s;
+            p->scan_returns += r.n_returns - from;
+        }
+    }
+    return LIDET_ERR_STATE; /* no complete rotation */
+}
+#else
+/* The host reference: docs/DECODING.md's loop, each payload decoded into a buffer of the whole scan, the completed
+ * scan given to lidet_detector_q_run_returns at once. */
+static lidet_status_t run_packets(pkt_t *p)
+{
+    int open = 0;
+    uint32_t k, fill = 0u;
+    for (k = 0; k < fw_pkt_n; ++k)
+    {
+        lidet_velodyne_result_t r;
+        lidet_status_t s = decode_one(k, p, &r);
+        if (s != LIDET_OK)
+            return s < 0 ? s : LIDET_ERR_STATE;
+        if (fill + r.n_returns > LIDET_MAX_POINTS + LIDET_VELODYNE_MAX_RETURNS)
+            return LIDET_ERR_BUFFER; /* not with these payloads: the comparison needs the whole scan */
+        memcpy(g_scan + fill, g_out, r.n_returns * sizeof g_out[0]);
+        if (r.scan_event == LIDET_VELODYNE_SCAN_COMPLETE && open)
+        {
+            p->scan_returns = fill + r.scan_end;
+            p->last = k;
+            return lidet_detector_q_run_returns(&g_det, g_scan, fill + r.scan_end, 0);
+        }
+        if (r.scan_event != LIDET_VELODYNE_SCAN_NONE)
+        {
+            memmove(g_scan, g_scan + fill + r.scan_end, (r.n_returns - r.scan_end) * sizeof g_scan[0]);
+            fill = r.n_returns - r.scan_end; /* the next scan's first returns */
+            p->first = k;
+            open = 1;
+        }
+        else
+            fill += r.n_returns;
+    }
+    return LIDET_ERR_STATE;
+}
+#endif
+
+static const lidet_pointnet_q_model_t *const k_cls = &FW_CAT(FW_CAT(lidet_model_cls_, FW_MODELS_ID), _s8);
+static const lidet_pointnet_q_model_t *const k_box = &FW_CAT(FW_CAT(lidet_model_box_, FW_MODELS_ID), _s8);
+
+/* the counts and instructions of a run (not inlined: its frame stays off the detector's deepest stack) */
+static __attribute__((noinline)) int report(const char *name, lidet_status_t st, const pkt_t *p,
+                                            uint64_t scan)
+{
+    static const char *const stage_names[LIDET_DET_N_STAGES] = {"project",  "ground", "cluster",
+                                                                "classify", "box",    "post"};
+    const lidet_detector_q_stats_t *s = lidet_detector_q_stats(&g_det);
+    const lidet_velodyne_stats_t *vs = lidet_velodyne_stats(&g_vlp);
+    uint32_t n_det = 0, k;
+    const lidet_detection_q_t *det = lidet_detector_q_detections(&g_det, &n_det);
+    uint64_t stage64[LIDET_DET_N_STAGES];
+
+    put_s("stats run=");
+    put_s(name);
+    put_s(" status=");
+    put_i((int32_t)st);
+    put_kv("clusters", s->n_clusters);
+    put_kv("classified", s->n_classified);
+    put_kv("gate1_rejected", s->n_gate1_rejected);
+    put_kv("boxed", s->n_boxed);
+    put_kv("gate2_rejected", s->n_gate2_rejected);
+    put_kv("size_rejected", s->n_size_rejected);
+    put_kv("nms_suppressed", s->n_nms_suppressed);
+    put_kv("over_budget", s->n_over_budget);
+    put_kv("over_capacity", s->n_over_capacity);
+    put_kv("detections", n_det);
+    put_kv("proj_in", s->proj.n_points_in);
+    put_kv("proj_projected", s->proj.n_projected);
+    put_kv("proj_filled", s->proj.n_pixels_filled);
+    put_kv("proj_truncated", s->proj.n_truncated);
+    fw_putc('\n');
+    for (k = 0; k < n_det; ++k)
+        put_det(name, k, &det[k]);
+    put_s("decode run=");
+    put_s(name);
+    put_kv("packets", vs->n_packets);
+    put_kv("decoded", vs->n_decoded);
+    put_kv("returns", vs->n_returns);
+    put_kv("partial", p->n_partial);
+    put_kv("complete", p->n_complete);
+    put_kv("aborted", p->n_aborted);
+    put_kv("first", p->first);
+    put_kv("last", p->last);
+    put_kv("scan_returns", p->scan_returns);
+    fw_putc('\n');
+    if (!fw_have_counter() || FW_PACKETS_HOST_REF)
+        return LIDET_SUCCEEDED(st) ? 0 : 1;
+    if (!LIDET_SUCCEEDED(st) || seq_stages(&g_seq, s, stage64) != 0)
+    {
+        put_s("insn run=");
+        put_s(name);
+        put_s(" FAIL: the clock calls do not match the streaming detector's order (fw_packets.c: "
+              "seq_stages)\n");
+        return 1;
+    }
+    put_s("insn run=");
+    put_s(name);
+    put_kv64("decode", p->decode);
+    for (k = 0; k < LIDET_DET_N_STAGES; ++k)
+        put_kv64(stage_names[k], stage64[k]);
+    put_kv64("scan", scan);
+    fw_putc('\n');
+    put_s("pktinsn run=");
+    put_s(name);
+    put_kv64("decode_max", p->decode_max);
+    put_kv64("stream_max", g_seq.stream_max);
+    put_kv64("end", p->end);
+    put_kv64("counter", p->counter);
+    fw_putc('\n');
+    return 0;
+}
+
+static pkt_t g_pkt;
+
+static int run_once(const char *name, lidet_detector_q_cfg_t *cfg)
+{
+    lidet_velodyne_cfg_t vc;
+    lidet_status_t st;
+    uint64_t t0, t1;
+
+    cfg->clock = seq_clock;
+    cfg->clock_ctx = &g_seq;
+    lidet_velodyne_cfg_default(&vc);
+    vc.model = LIDET_VELODYNE_VLP16;
+    st = lidet_detector_q_init(&g_det, cfg, k_cls, k_box);
+    if (st == LIDET_OK)
+        st = lidet_velodyne_init(&g_vlp, &vc);
+    if (st != LIDET_OK)
+    {
+        put_s("init run=");
+        put_s(name);
+        put_s(" failed status=");
+        put_i((int32_t)st);
+        fw_putc('\n');
+        return 1;
+    }
+    memset(&g_seq, 0, sizeof g_seq);
+    memset(&g_pkt, 0, sizeof g_pkt);
+    t0 = fw_insn64();
+    t1 = fw_insn64();
+    g_pkt.counter = t1 - t0;
+    g_seq.prev = t0 = fw_insn64();
+    st = run_packets(&g_pkt);
+    t1 = fw_insn64();
+    return report(name, st, &g_pkt, t1 - t0);
+}
+
+/* ---- the completed scan's returns, as this core decodes them ------------------------------------------ */
+
+/* FNV-1a (32 bits) over each return's range (4 bytes), azimuth and ring (2 each), little-endian */
+static uint32_t fnv_return(uint32_t h, const lidet_return_t *r)
+{
+    const uint32_t w[3] = {r->range_mm, r->azimuth, r->ring};
+    const uint32_t nb[3] = {4u, 2u, 2u};
+    uint32_t j, b;
+    for (j = 0; j < 3u; ++j)
+        for (b = 0; b < nb[j]; ++b)
+        {
+            h ^= (w[j] >> (8u * b)) & 0xFFu;
+            h *= 16777619u;
+        }
+    return h;
+}
+
+/* A second, untimed pass over the payloads (a fresh decoder): the digest of the completed scan's returns, which
+ * run_fw.py compares with the host's, so a decoding difference shows before the detector's. -> 0, or 1. */
+static __attribute__((noinline)) int scan_digest(const char *name)
+{
+    lidet_velodyne_cfg_t vc;
+    uint32_t k, i, h = 2166136261u, n = 0u;
+    int open = 0, done = 0;
+    lidet_velodyne_cfg_default(&vc);
+    vc.model = LIDET_VELODYNE_VLP16;
+    if (lidet_velodyne_init(&g_vlp, &vc) != LIDET_OK)
+        return 1;
+    for (k = 0; k < fw_pkt_n && !done; ++k)
+    {
+        lidet_velodyne_result_t r;
+        uint32_t from = 0u, to;
+        if (lidet_velodyne_packet(&g_vlp, fw_pkt_payload[k], LIDET_VELODYNE_PAYLOAD_BYTES, g_out, 0,
+                                  LIDET_VELODYNE_MAX_RETURNS, &r) != LIDET_OK)
+            return 1;
+        to = r.n_returns;
+        if (r.scan_event == LIDET_VELODYNE_SCAN_COMPLETE && open)
+        {
+            to = r.scan_end;
+            done = 1;
+        }
+        else if (r.scan_event != LIDET_VELODYNE_SCAN_NONE)
+        {
+            open = 1;
+            h = 2166136261u;
+            n = 0u;
+            from = r.scan_end;
+        }
+        for (i = from; open && i < to; ++i)
+            h = fnv_return(h, &g_out[i]);
+        n += open ? to - from : 0u;
+    }
+    put_s("digest run=");
+    put_s(name);
+    put_kv("returns", n);
+    put_s(" fnv1a=");
+    put_hex(h);
+    fw_putc('\n');
+    return !done;
+}
+
+/* ---- the counter's calibration (fw_detect.c's) ----------------------------------------------------------- */
+
+static __attribute__((noinline)) uint32_t measure(uint32_t n)
+{
+    const uint32_t t0 = fw_clock(0);
+    fw_spin(n);
+    return fw_clock(0) - t0;
+}
+
+static int calibrate(void)
+{
+    static volatile uint32_t lens[4] = {1u, 1000u, 12345u, 1000000u}; /* volatile: no constant folding */
+    uint32_t base, k;
+    int bad = 0;
+    base = measure(lens[0]);
+    for (k = 1; k < 4u; ++k)
+    {
+        const uint32_t n = lens[k];
+        const uint32_t measured = measure(n) - base;
+        const uint32_t expected = fw_spin_insn(n) - fw_spin_insn(lens[0]);
+        put_s("calib");
+        put_kv("n", n);
+        put_kv("expected", expected);
+        put_kv("measured", measured);
+        fw_putc('\n');
+        bad |= measured != expected;
+    }
+    return bad;
+}
+
+int fw_main(void)
+{
+    const lidet_sensor_q_t *sensor = lidet_sensor_q_find(FW_SENSOR);
+    lidet_detector_q_cfg_t cfg;
+    int bad = 0, c, j;
+
+    put_s("lidet-fw board=");
+    put_s(fw_board_name);
+    put_s(" core=");
+    put_s(fw_core_name);
+    put_s(" build=fixed app=packets sensor=" FW_SENSOR " models=" FW_MODELS "_s8 scan=");
+    put_s(fw_pkt_name);
+    put_kv("packets", fw_pkt_n);
+    put_kv("start_cdeg", fw_pkt_start_cdeg);
+    fw_putc('\n');
+    put_s("mem");
+    put_kv("detector_bytes", lidet_detector_q_bytes());
+    put_kv("decoder_bytes", (uint32_t)sizeof g_vlp);
+    put_kv("buffer_bytes", (uint32_t)sizeof g_out);
+    put_kv("max_rows", LIDET_MAX_ROWS);
+    put_kv("max_cols", LIDET_MAX_COLS);
+    put_kv("max_points", LIDET_MAX_POINTS);
+    put_kv("max_clusters", LIDET_MAX_CLUSTERS);
+    put_kv("max_returns", LIDET_VELODYNE_MAX_RETURNS);
+    fw_putc('\n');
+    if (sensor == 0)
+    {
+        put_s("lidet-fw: FAIL (no " FW_SENSOR " sensor profile)\n");
+        return 1;
+    }
+    if (fw_have_counter() && calibrate() != 0)
+    {
+        put_s("lidet-fw: FAIL (instruction counter does not match the calibration loop)\n");
+        return 1;
+    }
+    /* run 1: the configuration a user gets */
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    bad |= run_once("default", &cfg);
+    /* run 2: gates and size checks off, so that every classified proposal is boxed and reported */
+    cfg.gate1 = 0u;
+    cfg.gate2 = 0u;
+    for (c = 0; c < LIDET_N_CLASSES; ++c)
+        for (j = 0; j < 3; ++j)
+        {
+            cfg.size.min_mm[c][j] = 1;
+            cfg.size.max_mm[c][j] = LIDET_Q_BOX_MAX_MM;
+        }
+    bad |= run_once("open", &cfg);
+    bad |= scan_digest("default");
+
+    put_s("stack");
+    put_kv("used", fw_stack_used());
+    put_kv("size", fw_stack_size());
+    fw_putc('\n');
+    put_s(bad ? "lidet-fw: FAIL (a run failed)\n" : "lidet-fw: PASS\n");
+    return bad;
+}
