@@ -8,11 +8,12 @@
  * payload gets valid flags, azimuths, factory bytes and dual pairs (HDL-64E: alternating banks, a firing's blocks
  * at one azimuth, one in eight a dual layout), so the decoding paths are reached. Checks: init refuses exactly the
  * invalid configurations, nothing past the room, scan_end <= n_returns, rings (the model's lasers), ranges and
- * azimuths in range, counts that add up. */
+ * azimuths in range, counts that add up; and a second decoder, fed the same payloads without the attribute array
+ * (which takes the per-block fast path of single-return VLP-16 blocks), gives the same returns, results and counts. */
 #include "fuzz_common.h"
 
-static lidet_velodyne_t g_dec;
-static lidet_return_t g_out[LIDET_VELODYNE_MAX_RETURNS + 1];
+static lidet_velodyne_t g_dec, g_dec2;
+static lidet_return_t g_out[LIDET_VELODYNE_MAX_RETURNS + 1], g_out2[LIDET_VELODYNE_MAX_RETURNS + 1];
 static lidet_velodyne_attr_t g_attr[LIDET_VELODYNE_MAX_RETURNS + 1];
 static uint8_t g_pkt[1400];
 static lidet_velodyne_calib_t g_cal;
@@ -104,6 +105,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         return 0;
     }
     FZ_CHECK(g_dec.cfg.calib == 0);
+    FZ_CHECK(lidet_velodyne_init(&g_dec2, &cfg) == LIDET_OK);
     while (in.n > 0 && n_packets < 64u)
     {
         const uint32_t len = fz_u16(&in) % 1400u;
@@ -130,6 +132,13 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         st = lidet_velodyne_packet(&g_dec, len == 0u && (flags & 4u) ? NULL : g_pkt, len, g_out, g_attr, room,
                                    &res);
         ++n_packets;
+        {
+            lidet_velodyne_result_t res2;
+            const lidet_status_t st2 = lidet_velodyne_packet(
+                &g_dec2, len == 0u && (flags & 4u) ? NULL : g_pkt, len, g_out2, NULL, room, &res2);
+            FZ_CHECK(st2 == st && memcmp(&res2, &res, sizeof res) == 0);
+            FZ_CHECK(memcmp(g_out2, g_out, res.n_returns * sizeof g_out[0]) == 0);
+        }
         FZ_CHECK(g_out[room].range_mm == 0xA5A5A5A5u);
         FZ_CHECK(st == LIDET_OK || st == LIDET_TRUNCATED || st == LIDET_ERR_MODEL);
         FZ_CHECK((st == LIDET_ERR_MODEL) == (res.reject != LIDET_VELODYNE_REJECT_NONE));
@@ -155,6 +164,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
     }
     s = lidet_velodyne_stats(&g_dec);
+    FZ_CHECK(memcmp(s, lidet_velodyne_stats(&g_dec2), sizeof *s) == 0);
     sum = s->n_decoded;
     for (i = 1; i < LIDET_VELODYNE_N_REJECT; ++i)
     {
