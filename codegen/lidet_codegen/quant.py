@@ -312,7 +312,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 #: the range of a tensor (or of each of its channels): a percentile of |activation| over the calibration set (values
 #: above it saturate), per model kind: (granularity, percentile). Measured on the 4,240 test proposals of
 #: test_pointnet_q.py and 2,654 held-out ones (simulated run seed 4242: 6 HDL-64 + 16 VLP-16 scans, two resampling
-#: seeds; docs/FIXED_POINT.md):
+#: seeds; docs/journal/fixed-point.md, "Per-channel activation ranges"):
 #: - classifiers, raw argmax proposals differing from float (test / held-out): per tensor 99.95 % 49 / 38; per channel
 #:   100 % 43 / 38, 99.99 % 54 / 32, 99.95 % 40 / 28, 99.9 % 23 / 30, 99.8 % 45 / 33. An MSE-optimal range per
 #:   channel (the percentile among 99 .. 100 % with the least squared quantization error) 42 / 39. Most of what is
@@ -379,7 +379,7 @@ def activation_ranges(model: Model, xyz, mean, vox, folder=None) -> dict:
 
 
 #: the ridge weight toward the float layer of the classifier's last-layer refit (head_refit). Measured on the test
-#: proposals of tests/python/test_pointnet_q.py (docs/FIXED_POINT.md).
+#: proposals of tests/python/test_pointnet_q.py (docs/journal/fixed-point.md, "The classifier's last layer, refitted").
 REFIT_MU = 0.1
 
 

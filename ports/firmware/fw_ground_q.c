@@ -6,7 +6,8 @@
  * for where its instructions go. One line:
  *   ground_q core=C status_q=S status_f=S insn_q=N insn_f=N insn_q_norefine=N insn_q_1hyp=N insn_q_noveto=N
  *            ground_q=N ground_f=N same=N pixels=N
- * (same: pixels whose labels agree). Build and run (Cortex-M0+ code on QEMU's AN385, docs/FIXED_POINT.md):
+ * (same: pixels whose labels agree). Build and run (Cortex-M0+ code on QEMU's AN385, docs/journal/fixed-point.md,
+ * "Cost on a Cortex-M (the ground_q image)"):
  *   cmake -S ports/firmware -B build-fw/gq-m0 -DLIDET_FW_BOARD=mps2-an385-m0plus -DLIDET_FW_APP=ground_q \
  *         -DCMAKE_TOOLCHAIN_FILE=$PWD/cmake/toolchains/arm-none-eabi.cmake && cmake --build build-fw/gq-m0
  *   qemu-system-arm -M mps2-an385 -icount shift=8 -display none -monitor none -kernel build-fw/gq-m0/lidet_fw.elf \

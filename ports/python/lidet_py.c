@@ -239,7 +239,8 @@ LIDET_PY_API int lidet_py_sensor(uint32_t index, char *name_buf, uint32_t *rows_
 
 /* ---- pixel models: measuring what a more compact pixel than float x, y, z, range would cost ------
  * After each projection the context's image is rewritten as a pixel stored another way would decode
- * (the stages then run unchanged on it): the accuracy a storage choice costs (docs/MEMORY.md). */
+ * (the stages then run unchanged on it): the accuracy a storage choice costs (docs/journal/memory.md, "What a compact
+ * pixel would cost"). */
 enum
 {
     LIDET_PY_PIXEL_FLOAT = 0,        /* the real point (what the library stores) */

@@ -126,7 +126,8 @@ def test_defaults_and_stats_come_from_c():
 
 
 def test_pixel_models_rewrite_the_image_as_stored():
-    """The measurement hook of docs/MEMORY.md: an image decoded from another pixel storage."""
+    """The measurement hook of docs/journal/memory.md ("What a compact pixel would cost"): an image decoded from
+    another pixel storage."""
     pts, _ = _scene(6, (10.0, 0.0, -0.9), (8.0, 4.0, -0.85))
     ref_img = native.project(pts, "vlp16")
     ctx = native.ScanContext("s16", 0.004)

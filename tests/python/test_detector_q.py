@@ -101,7 +101,8 @@ def test_agrees_with_float_detector_on_real_scans(nq, real_dir, range_only):
     here so it cannot silently get worse. VLP-16 firmware, whose returns lie on their ring's elevation, is what the
     mode is for. The count moves by a few with any change of the ground planes: frame 000013 has more clusters
     than the 256 proposals the budget classifies, so which ones reach the networks follows the planes (R from
-    the range, docs/FIXED_POINT.md: 6 -> 3 matched there, the same in all but two other frames, while the ground IoU
+    the range, docs/journal/fixed-point.md, "R from the range": 6 -> 3 matched there, the same in all but two other
+    frames, while the ground IoU
     against the SemanticKITTI labels stayed 0.938 / 0.929 / 0.923 on the three labelled scans)."""
     a = _agreement(nq, _scans(real_dir)[2:], range_only)
     print(f"integer ({'range-only' if range_only else 'xyz'} pixel) vs float detector on the real scans:", a)

@@ -1,5 +1,6 @@
 # SPDX-License-Identifier: MIT
-"""What a more compact pixel than float x, y, z, range would cost in accuracy (issue 18, docs/MEMORY.md).
+"""What a more compact pixel than float x, y, z, range would cost in accuracy (issue 18, docs/journal/memory.md, "What
+a compact pixel would cost").
 
 For each pixel model of the bindings (native.ScanContext: the image rewritten after the projection as a
 pixel stored that way would decode, the stages unchanged), on labelled scan folders (velodyne/ +

@@ -7,7 +7,8 @@ Contract of tools/bench/run_bench.py: `run(args) -> str` returns a markdown sect
 with liblidet_py.so; args.quick: fewer sequences). Alone: `python tools/bench/bench_track.py [--quick]`.
 
 Sets (`lidet-sim --sequence FRAMES --scenes N --seed S`, cached in data/bench/track_*; the tracker's defaults were
-chosen on seeds 100-102, docs/TRACKING.md): HDL-64 street scenes with the sensor standing and driving at 8 m/s, and
+chosen on seeds 100-102, docs/journal/tracking.md, "How the defaults were chosen"): HDL-64 street scenes with the
+sensor standing and driving at 8 m/s, and
 VLP-16 crowded streets with the robot walking at 1 m/s. Scored by `lidet_tools.track.eval` (py-motmetrics, BEV
 centre distance, objects within 40 m with >= 10 points).
 """

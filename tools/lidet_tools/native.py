@@ -200,7 +200,8 @@ class ScanContext:
     """One scan's C states (lidet_py_ctx_t): the projection, ground and clustering of that scan only.
     Freed when the last object referring to it goes away.
 
-    pixel_model (measurement only, docs/MEMORY.md): after each projection the image is rewritten as a
+    pixel_model (measurement only, docs/journal/memory.md, "What a compact pixel would cost"): after each projection
+    the image is rewritten as a
     pixel stored another way would decode: "float" (the library), "s16" (x, y, z, range rounded to
     multiples of q_m), "recompute" (x, y, z from the range, the beam's elevation and the column
     centre), "real_elev" / "real_azimuth" (one of the two angles kept exact)."""

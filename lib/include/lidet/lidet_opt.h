@@ -176,7 +176,8 @@
 /** The detector workspace keeps R (the horizontal range, a float per pixel) in its image: the projection
  *  writes it once (from the 4 mm values) and the ground stage reads it, where it otherwise computes it, a square
  *  root per pixel, in its filter and in its label pass. 4 B a pixel (HDL-64 capacities: 512 KiB) for about 2 % of
- *  a VLP-16 scan's projection + ground + clustering (docs/MEMORY.md). Default: kept on 64-bit targets (hosts and
+ *  a VLP-16 scan's projection + ground + clustering (docs/journal/memory.md, "Speed against the stage objects, in
+ *  time"). Default: kept on 64-bit targets (hosts and
  *  application processors, whose memory is not the limit) for images of more than 65536 pixels (HDL-64-class
  *  capacities, this project's host builds); not on 32-bit microcontrollers and not at VLP-16 capacities (the
  *  512 KiB budget). The results are the same bits either way. 0 or 1. */

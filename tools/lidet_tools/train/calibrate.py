@@ -29,13 +29,14 @@ CALIB_SEEDS = [0xCA11B000 + 7919 * k for k in range(4)]
 
 #: freshly simulated scans added to the calibration set (seed 3015: neither training, the benchmarks, the tests
 #: nor the refit use it): the shipped sample alone gave the VLP-16 232 proposals. With them and the refit on 32
-#: scans, the raw argmax agreement of tests/python/test_pointnet_q.py went from 98.66 to 98.84 % (docs/FIXED_POINT.md)
+#: scans, the raw argmax agreement of tests/python/test_pointnet_q.py went from 98.66 to 98.84 %
+#: (docs/journal/fixed-point.md, "Agreement with float, and what was tried for it")
 CALIB_SIM_SEED, CALIB_N_SIM = 3015, 8
 
 #: the classifier's last-layer refit (`calibrate --refit`): fresh simulated scans (seed 3016: neither training,
 #: the benchmarks nor the tests use it) added to the calibration proposals; the ridge weight toward the float layer
 #: is lidet_codegen.quant.REFIT_MU. Measured on the test proposals of tests/python/test_pointnet_q.py
-#: (docs/FIXED_POINT.md).
+#: (docs/journal/fixed-point.md, "The classifier's last layer, refitted").
 REFIT_SIM_SEED, REFIT_N_SIM = 3016, 32
 
 

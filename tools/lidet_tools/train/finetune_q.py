@@ -6,7 +6,7 @@
 
 Why: the int8 classifier (`python -m lidet_codegen emit --int8`) and the float one disagree on the class of a
 proposal where the float network's two best logits lie closer than the int8 activations' error. Calibration
-cannot remove that (docs/FIXED_POINT.md, "Per-channel activation ranges"): the VLP-16 classifier has 4.6 % of
+cannot remove that (docs/journal/fixed-point.md, "Per-channel activation ranges"): the VLP-16 classifier has 4.6 % of
 its proposals within 0.2 nats of a tie, and its int8 build disagrees on about 1.4 % of held-out proposals.
 
 What: a few epochs from the trained (folded) network, every layer a linear map + ReLU, with
@@ -24,7 +24,7 @@ The points are rounded to the 4 mm steps the integer detector sees. Adam, cosine
 ONNX of the same contract (models.ClassifierNet, batch norms set to identity) with gamma recomputed on the
 validation split as `train_cls` does (95 % of each class's ID proposals).
 
-Measured on the shipped VLP-16 classifier (docs/FIXED_POINT.md, "Quantization-aware fine-tuning"): int8
+Measured on the shipped VLP-16 classifier (docs/journal/fixed-point.md, "Quantization-aware fine-tuning"): int8
 disagreements on 12,662 held-out simulated proposals 171 -> 69-77 (seeds 7, 8, 9; calibrate and quantize as
 shipped, no refit), validation balanced accuracy 0.966-0.971 (0.971 before), FPR95 0.083-0.086 (0.091 before).
 `make weights` runs it on the VLP-16 classifier after `train_cls` (lidet_tools.train.weights); then calibrate and

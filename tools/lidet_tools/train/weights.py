@@ -48,8 +48,9 @@ FAMILIES = {
                   cls=["--epochs-ce", "20", "--epochs-energy", "25", "--lam", "0.3"],
                   # 45 + 20 epochs: validation score (FPR95 - mean IoU) -0.545 against -0.442 for 30 + 10
                   box=["--epochs-box", "45", "--epochs-energy", "20"],
-                  # then quantization-aware fine-tuning for the int8 build (finetune_q; docs/FIXED_POINT.md): its int8
-                  # classifier disagreed with float on 1.4 % of held-out proposals, 0.5-0.6 % after (seeds 7, 8, 9)
+                  # then quantization-aware fine-tuning for the int8 build (finetune_q; docs/journal/fixed-point.md,
+                  # "Quantization-aware fine-tuning"): its int8 classifier disagreed with float on 1.4 % of held-out
+                  # proposals, 0.5-0.6 % after (seeds 7, 8, 9)
                   cls_finetune=["--epochs", "6", "--seed", "7"]),
     # vlp16s: the small VLP-16 pair for boards without an FPU (issue 17): 32 points per proposal, 9x fewer
     # multiply-adds than vlp16 (classifier 86 k, box net 144 k per proposal), the same scans and schedule;
@@ -190,7 +191,8 @@ def c_models(a, fams, scan_dirs=None) -> list:
     """The C models of --weights after training: for each family trained, its two new ONNX files calibrated for
     int8 (`python -m lidet_tools.train.calibrate`, the classifier first: a box net is calibrated on the classes of the
     classifier beside it), the classifier's last layer refitted (`calibrate --refit`) unless it was fine-tuned for
-    int8 (cls_finetune; a refit made the fine-tuned ones' gate decisions agree less, docs/FIXED_POINT.md); then
+    int8 (cls_finetune; a refit made the fine-tuned ones' gate decisions agree less, docs/journal/fixed-point.md,
+    "Quantization-aware fine-tuning"); then
     every float and int8 C model of the folder and lidet_weights.{c,h} (lidet_codegen.regen.emit_all, the commands
     of the committed weights/ and of CI's drift check). scan_dirs: folders of scans (velodyne/*.bin) that replace
     the real KITTI scans of a.real in the calibration (`calibrate --scans`; lidet_tools.train.finetune passes the
