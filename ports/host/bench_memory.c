@@ -155,54 +155,20 @@ static void cluster_same_mask(int repeat, double *t, double *ms_compact, double 
     *ms_float = cli_median(t + repeat, repeat);
 }
 
-/* the options (cli_options.c) */
-enum
-{
-    OPT_SENSOR,
-    OPT_REPEAT,
-    OPT_ONLY
-};
+/* the options (cli_options.c): the benchmarks' shared set (cli_opts_bench: --sensor, --repeat) and --only */
+static const cli_opt_t k_opts[] = {{"only", required_argument, 0, "stages or workspace"}, {NULL, 0, 0, NULL}};
 
-static const cli_opt_t k_opts[] = {{"sensor", required_argument, OPT_SENSOR, "S: a sensor preset"},
-                                   {"repeat", required_argument, OPT_REPEAT, "N: runs per scan, >= 1"},
-                                   {"only", required_argument, OPT_ONLY, "stages or workspace"},
-                                   {NULL, 0, 0, NULL}};
-
-typedef struct
+static int take_only(void *ctx, int id, const char *v)
 {
-    const char *sensor;
-    int repeat;
-    int only; /* -1 both, 0 stages, 1 workspace */
-} bench_opts_t;
-
-static int take(void *ctx, int id, const char *v)
-{
-    bench_opts_t *o = (bench_opts_t *)ctx;
-    char *end;
-    long n;
-    switch (id)
+    int *only = (int *)ctx;
+    (void)id;
+    if (strcmp(v, "stages") != 0 && strcmp(v, "workspace") != 0)
     {
-    case OPT_SENSOR:
-        o->sensor = v;
-        return 0;
-    case OPT_ONLY:
-        if (strcmp(v, "stages") != 0 && strcmp(v, "workspace") != 0)
-        {
-            fprintf(stderr, "lidet_bench_memory: --only stages or --only workspace, not '%s'\n", v);
-            return 1;
-        }
-        o->only = strcmp(v, "workspace") == 0;
-        return 0;
-    default: /* OPT_REPEAT */
-        n = strtol(v, &end, 10);
-        if (end == v || *end != '\0' || n < 1 || n > 1000000)
-        {
-            fprintf(stderr, "lidet_bench_memory: --repeat needs an integer in [1, 1000000], got '%s'\n", v);
-            return 1;
-        }
-        o->repeat = (int)n;
-        return 0;
+        fprintf(stderr, "lidet_bench_memory: --only stages or --only workspace, not '%s'\n", v);
+        return 1;
     }
+    *only = strcmp(v, "workspace") == 0;
+    return 0;
 }
 
 int main(int argc, char **argv)
@@ -214,27 +180,29 @@ int main(int argc, char **argv)
     int repeat, a, rc = 0, only, n_pos = 0;
     double *t;
     char **pos = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
-    bench_opts_t o;
-    cli_optset_t set;
+    cli_bench_opts_t o;
+    cli_optset_t sets[2];
 
     if (pos == NULL)
         return 1;
+    o.who = "lidet_bench_memory";
     o.sensor = "hdl64";
     o.repeat = 30;
-    o.only = -1;
-    set = cli_optset(k_opts, take, &o);
-    a = cli_options_parse(argc, argv, "lidet_bench_memory", &set, 1, pos, &n_pos);
+    only = -1;
+    sets[0] = cli_optset(cli_opts_bench, cli_bench_take, &o);
+    sets[1] = cli_optset(k_opts, take_only, &only);
+    a = cli_options_parse(argc, argv, "lidet_bench_memory", sets, 2, pos, &n_pos);
     if (a != CLI_PARSE_OK)
     {
         if (a == CLI_PARSE_USAGE)
-            fprintf(stderr,
-                    "usage: lidet_bench_memory --sensor S [--repeat N] [--only stages|workspace] SCAN.bin...\n");
+            fprintf(
+                stderr,
+                "usage: lidet_bench_memory --sensor S [--repeat N] [--only stages|workspace] SCAN.bin...\n");
         free(pos);
         return 2;
     }
     sensor_name = o.sensor;
     repeat = o.repeat;
-    only = o.only;
     cli_stage_clock_cpu = 1; /* the workspace's stage clock in this thread's CPU time */
     sensor = lidet_sensor_find(sensor_name);
     if (sensor == NULL || n_pos == 0)
@@ -306,8 +274,8 @@ int main(int argc, char **argv)
         for (k = 0; k < 3; ++k)
             for (s = 0; s < 4; ++s)
                 ms[k][s] = cli_median(t + (k * 4 + s) * repeat, repeat);
-        printf("{\"scan\": \"%s\", \"sensor\": \"%s\", \"points\": %u, \"repeat\": %d, ", pos[a],
-               sensor_name, (unsigned)n, repeat);
+        printf("{\"scan\": \"%s\", \"sensor\": \"%s\", \"points\": %u, \"repeat\": %d, ", pos[a], sensor_name,
+               (unsigned)n, repeat);
         for (k = 0; k < 3; ++k)
         {
             static const char *const name[3] = {"stages", "workspace", "workspace_per_point"};

@@ -26,7 +26,8 @@ static lidet_proj_t g_proj;
 
 /* baseline state (same sizes as lidet's) */
 static float b_x[LIDET_MAX_ROWS * LIDET_MAX_COLS], b_y[LIDET_MAX_ROWS * LIDET_MAX_COLS],
-    b_z[LIDET_MAX_ROWS * LIDET_MAX_COLS], b_r[LIDET_MAX_ROWS * LIDET_MAX_COLS], b_rxy[LIDET_MAX_ROWS * LIDET_MAX_COLS];
+    b_z[LIDET_MAX_ROWS * LIDET_MAX_COLS], b_r[LIDET_MAX_ROWS * LIDET_MAX_COLS],
+    b_rxy[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 static int32_t b_idx[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 static int32_t b_pp[LIDET_MAX_POINTS];
 static float b_mid_rad[LIDET_MAX_ROWS]; /* mid-angles between rows, descending */
@@ -131,53 +132,20 @@ static void baseline_run(const float *pts, uint32_t n, int rows, int cols, float
     }
 }
 
-/* the options (cli_options.c) */
-enum
-{
-    OPT_SENSOR,
-    OPT_REPEAT,
-    OPT_CLOCK
-};
+/* the options (cli_options.c): the benchmarks' shared set (cli_opts_bench: --sensor, --repeat) and --clock */
+static const cli_opt_t k_opts[] = {{"clock", required_argument, 0, "wall or cpu"}, {NULL, 0, 0, NULL}};
 
-static const cli_opt_t k_opts[] = {{"sensor", required_argument, OPT_SENSOR, "NAME: a sensor preset"},
-                                   {"repeat", required_argument, OPT_REPEAT, "N: runs per scan, >= 1"},
-                                   {"clock", required_argument, OPT_CLOCK, "wall or cpu"},
-                                   {NULL, 0, 0, NULL}};
-
-typedef struct
+static int take_clock(void *ctx, int id, const char *v)
 {
-    const char *sensor;
-    int repeat;
-} bench_opts_t;
-
-static int take(void *ctx, int id, const char *v)
-{
-    bench_opts_t *o = (bench_opts_t *)ctx;
-    char *end;
-    long n;
-    switch (id)
+    (void)ctx;
+    (void)id;
+    if (strcmp(v, "wall") != 0 && strcmp(v, "cpu") != 0)
     {
-    case OPT_SENSOR:
-        o->sensor = v;
-        return 0;
-    case OPT_CLOCK:
-        if (strcmp(v, "wall") != 0 && strcmp(v, "cpu") != 0)
-        {
-            fprintf(stderr, "lidet_bench_proj: --clock wall or cpu, not '%s'\n", v);
-            return 1;
-        }
-        g_clock = strcmp(v, "cpu") == 0 ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC;
-        return 0;
-    default: /* OPT_REPEAT */
-        n = strtol(v, &end, 10);
-        if (end == v || *end != '\0' || n < 1 || n > 1000000)
-        {
-            fprintf(stderr, "lidet_bench_proj: --repeat needs an integer in [1, 1000000], got '%s'\n", v);
-            return 1;
-        }
-        o->repeat = (int)n;
-        return 0;
+        fprintf(stderr, "lidet_bench_proj: --clock wall or cpu, not '%s'\n", v);
+        return 1;
     }
+    g_clock = strcmp(v, "cpu") == 0 ? CLOCK_PROCESS_CPUTIME_ID : CLOCK_MONOTONIC;
+    return 0;
 }
 
 int main(int argc, char **argv)
@@ -185,8 +153,8 @@ int main(int argc, char **argv)
     const char *sensor;
     int repeat, a, n_files = 0, n_pos = 0;
     char **pos;
-    bench_opts_t o;
-    cli_optset_t set;
+    cli_bench_opts_t o;
+    cli_optset_t sets[2];
     double sum_pts = 0, sum_lidet_ms = 0, sum_base_ms = 0, sum_compact_ms = 0, sum_q_ms = 0, worst_az_deg = 0,
            worst_el_deg = 0;
     lidet_proj_q_cfg_t cfg_q;
@@ -201,10 +169,12 @@ int main(int argc, char **argv)
     pos = (char **)malloc(sizeof(char *) * (size_t)(argc + 1));
     if (pos == NULL)
         return 1;
-    set = cli_optset(k_opts, take, &o);
+    o.who = "lidet_bench_proj";
     o.sensor = "hdl64";
     o.repeat = 30;
-    a = cli_options_parse(argc, argv, "lidet_bench_proj", &set, 1, pos, &n_pos);
+    sets[0] = cli_optset(cli_opts_bench, cli_bench_take, &o);
+    sets[1] = cli_optset(k_opts, take_clock, NULL);
+    a = cli_options_parse(argc, argv, "lidet_bench_proj", sets, 2, pos, &n_pos);
     sensor = o.sensor;
     repeat = o.repeat;
     if (a == CLI_PARSE_OK && lidet_sensor_find(sensor) == NULL)
@@ -215,7 +185,8 @@ int main(int argc, char **argv)
     if (a != CLI_PARSE_OK)
     {
         if (a == CLI_PARSE_USAGE)
-            fprintf(stderr, "usage: lidet_bench_proj --sensor NAME [--repeat N] [--clock wall|cpu] SCAN.bin...\n");
+            fprintf(stderr,
+                    "usage: lidet_bench_proj --sensor NAME [--repeat N] [--clock wall|cpu] SCAN.bin...\n");
         free(pos);
         return 1;
     }
@@ -332,7 +303,9 @@ int main(int argc, char **argv)
                 az_err = az_err > M_PI ? 2.0 * M_PI - az_err : az_err;
                 /* lidet decides the row on tan(el) = z / rxy computed in float */
                 el = atan2(z, rxy);
-                el_err = fabs(atan((double)(pts[4 * i + 2] / sqrtf(pts[4 * i] * pts[4 * i] + pts[4 * i + 1] * pts[4 * i + 1]))) - el);
+                el_err = fabs(atan((double)(pts[4 * i + 2] / sqrtf(pts[4 * i] * pts[4 * i] +
+                                                                   pts[4 * i + 1] * pts[4 * i + 1]))) -
+                              el);
                 w_az = az_err > w_az ? az_err : w_az;
                 w_el = el_err > w_el ? el_err : w_el;
                 /* double-precision reference pixel */
@@ -355,13 +328,16 @@ int main(int argc, char **argv)
             agree_col += same_col;
             agree_n += cnt;
             fill_sum += (double)lidet_proj_stats(&g_proj)->n_pixels_filled / (double)(rows * cols);
-            printf("{\"scan\": \"%s\", \"points\": %u, \"projected\": %u, \"fill_ratio\": %.4f, \"lidet_ms\": %.4f, "
-                   "\"libm_ms\": %.4f, \"lidet_ns_per_point\": %.2f, \"libm_ns_per_point\": %.2f, \"speedup\": %.2f, "
-                   "\"max_az_err_deg\": %.6f, \"max_el_err_deg\": %.6f, \"row_agree\": %.6f, \"col_agree\": %.6f, "
+            printf("{\"scan\": \"%s\", \"points\": %u, \"projected\": %u, \"fill_ratio\": %.4f, "
+                   "\"lidet_ms\": %.4f, "
+                   "\"libm_ms\": %.4f, \"lidet_ns_per_point\": %.2f, \"libm_ns_per_point\": %.2f, "
+                   "\"speedup\": %.2f, "
+                   "\"max_az_err_deg\": %.6f, \"max_el_err_deg\": %.6f, \"row_agree\": %.6f, \"col_agree\": "
+                   "%.6f, "
                    "\"compact_ns_per_point\": %.2f, \"int_ns_per_point\": %.2f}\n",
                    path, n, lidet_proj_stats(&g_proj)->n_projected,
-                   (double)lidet_proj_stats(&g_proj)->n_pixels_filled / (double)(rows * cols), ml, mb, ml * 1e6 / n,
-                   mb * 1e6 / n, mb / ml, w_az, w_el, cnt ? (double)same_row / cnt : 0.0,
+                   (double)lidet_proj_stats(&g_proj)->n_pixels_filled / (double)(rows * cols), ml, mb,
+                   ml * 1e6 / n, mb * 1e6 / n, mb / ml, w_az, w_el, cnt ? (double)same_row / cnt : 0.0,
                    cnt ? (double)same_col / cnt : 0.0, mc * 1e6 / n, mq * 1e6 / n);
         }
         sum_pts += n;
@@ -374,13 +350,17 @@ int main(int argc, char **argv)
     }
     if (n_files > 0)
     {
-        printf("{\"summary\": true, \"sensor\": \"%s\", \"scans\": %d, \"repeat\": %d, \"lidet_ns_per_point\": %.2f, "
-               "\"libm_ns_per_point\": %.2f, \"speedup\": %.2f, \"max_az_err_deg\": %.6f, \"max_el_err_deg\": %.6f, "
-               "\"row_agree\": %.6f, \"col_agree\": %.6f, \"mean_fill_ratio\": %.4f, \"compact_ns_per_point\": %.2f, "
+        printf("{\"summary\": true, \"sensor\": \"%s\", \"scans\": %d, \"repeat\": %d, "
+               "\"lidet_ns_per_point\": %.2f, "
+               "\"libm_ns_per_point\": %.2f, \"speedup\": %.2f, \"max_az_err_deg\": %.6f, "
+               "\"max_el_err_deg\": %.6f, "
+               "\"row_agree\": %.6f, \"col_agree\": %.6f, \"mean_fill_ratio\": %.4f, "
+               "\"compact_ns_per_point\": %.2f, "
                "\"int_ns_per_point\": %.2f}\n",
                sensor, n_files, repeat, sum_lidet_ms * 1e6 / sum_pts, sum_base_ms * 1e6 / sum_pts,
-               sum_base_ms / sum_lidet_ms, worst_az_deg, worst_el_deg, agree_row / agree_n, agree_col / agree_n,
-               fill_sum / n_files, sum_compact_ms * 1e6 / sum_pts, sum_q_ms * 1e6 / sum_pts);
+               sum_base_ms / sum_lidet_ms, worst_az_deg, worst_el_deg, agree_row / agree_n,
+               agree_col / agree_n, fill_sum / n_files, sum_compact_ms * 1e6 / sum_pts,
+               sum_q_ms * 1e6 / sum_pts);
     }
     free(pos);
     return 0;

@@ -17,16 +17,16 @@
  * cli_args_t point into it. */
 typedef struct
 {
-    char name[64];                   /* the description's "name" (Ouster: the product line) */
-    char model[64];                  /* the description's "model", "" when it gives none */
-    char family[64];                 /* the float model family: model, else hdl64 (>= 32 rows) or vlp16 */
-    int uniform;                     /* 1: given as fov_up_deg, fov_down_deg and rows; 0: as a table */
-    double fov_up_deg, fov_down_deg; /* uniform only */
-    double elev_deg[LIDET_MAX_ROWS]; /* ring order: the table as read, or the uniform beam centres (a YAML
+    char name[64];                     /* the description's "name" (Ouster: the product line) */
+    char model[64];                    /* the description's "model", "" when it gives none */
+    char family[64];                   /* the float model family: model, else hdl64 (>= 32 rows) or vlp16 */
+    int uniform;                       /* 1: given as fov_up_deg, fov_down_deg and rows; 0: as a table */
+    double fov_up_deg, fov_down_deg;   /* uniform only */
+    double elev_deg[LIDET_MAX_ROWS];   /* ring order: the table as read, or the uniform beam centres (a YAML
                                         calibration: its radians x 180 / pi), what --print-sensor prints */
-    int have_rad;                    /* 1: the file gave radians (elev_rad_d), the table's source */
+    int have_rad;                      /* 1: the file gave radians (elev_rad_d), the table's source */
     double elev_rad_d[LIDET_MAX_ROWS]; /* ring order, radians as read (have_rad only) */
-    float elev_rad[LIDET_MAX_ROWS];  /* the same in radians, single precision (lidet_sensor_t's table) */
+    float elev_rad[LIDET_MAX_ROWS];    /* the same in radians, single precision (lidet_sensor_t's table) */
     int32_t elev_urad[LIDET_MAX_ROWS]; /* and in microradians (lidet_sensor_q_t's table) */
     uint16_t rows, cols;
     double mount_height_m, max_range_m;
@@ -37,40 +37,44 @@ typedef struct
  * decoder takes (lidet_velodyne_calib_t, through cli_velodyne_calib_table: `lidet detect / track --pcap`). */
 typedef struct
 {
-    int n;                            /* lasers (0: no calibration read) */
-    double distance_resolution_m;     /* distLSB_ x 0.01 / distance_resolution; 0.002 when the file gives none */
-    int laser_id[LIDET_MAX_ROWS];     /* id_ / laser_id: the laser's place in the packet's data block */
-    double rot_rad[LIDET_MAX_ROWS];   /* rotCorrection_ x pi / 180 / rot_correction (radians) */
-    double dist_m[LIDET_MAX_ROWS];    /* distCorrection_ x 0.01 / dist_correction (metres); 0 when absent */
+    int n;                        /* lasers (0: no calibration read) */
+    double distance_resolution_m; /* distLSB_ x 0.01 / distance_resolution; 0.002 when the file gives none */
+    int laser_id[LIDET_MAX_ROWS]; /* id_ / laser_id: the laser's place in the packet's data block */
+    double rot_rad[LIDET_MAX_ROWS]; /* rotCorrection_ x pi / 180 / rot_correction (radians) */
+    double dist_m[LIDET_MAX_ROWS];  /* distCorrection_ x 0.01 / dist_correction (metres); 0 when absent */
 } cli_velodyne_corr_t;
 
 typedef struct
 {
-    const char *scan_path;  /* positional SCAN.bin */
-    const char *sensor;     /* --sensor NAME (default hdl64); a file's sensor: its name */
-    int sensor_given;       /* --sensor was on the command line (--pcap: else the packets say) */
-    const char *sensor_arg; /* --sensor NAME as given (a file's sensor replaces a->sensor: --pcap --velodyne-calib
+    const char *scan_path; /* positional SCAN.bin */
+    const char *sensor;    /* --sensor NAME (default hdl64); a file's sensor: its name */
+    int sensor_given;      /* --sensor was on the command line (--pcap: else the packets say) */
+    const char
+        *sensor_arg; /* --sensor NAME as given (a file's sensor replaces a->sensor: --pcap --velodyne-calib
                                --sensor NAME names the decoder's model) */
-    int capture;            /* set by detect / track before cli_args_finish when --pcap is given: --sensor may go
+    int capture;     /* set by detect / track before cli_args_finish when --pcap is given: --sensor may go
                                with --velodyne-calib (the model of the calibrated unit), and --print-sensor waits for
                                the capture's sensor (cli_capture_print_sensor) */
     const char *sensor_file; /* --sensor-file F: a lidet sensor description (JSON) */
     const char *ouster_meta; /* --ouster-meta M: Ouster's sensor metadata (JSON) */
-    const char *velodyne_calib; /* --velodyne-calib C: a Velodyne calibration (db.xml / VeloView XML, or YAML) */
-    long velodyne_cols;     /* --cols N with --velodyne-calib (0: the default for its laser count) */
-    int print_sensor;       /* --print-sensor: print the sensor as a lidet description and stop */
-    const char *out_path;   /* --out FILE */
-    const char *png_path;   /* --png FILE */
-    const char *ring_path;  /* --ring FILE (uint16 per point) */
-    int json;               /* --json */
-    int repeat;             /* --repeat N (>= 1) */
-    double mount_height_m;  /* --mount-height M: the sensor's height above the ground, m (< 0: the profile's) */
+    const char
+        *velodyne_calib;   /* --velodyne-calib C: a Velodyne calibration (db.xml / VeloView XML, or YAML) */
+    long velodyne_cols;    /* --cols N with --velodyne-calib (0: the default for its laser count) */
+    int print_sensor;      /* --print-sensor: print the sensor as a lidet description and stop */
+    const char *out_path;  /* --out FILE */
+    const char *png_path;  /* --png FILE */
+    const char *ring_path; /* --ring FILE (uint16 per point) */
+    int json;              /* --json */
+    int repeat;            /* --repeat N (>= 1) */
+    double
+        mount_height_m; /* --mount-height M: the sensor's height above the ground, m (< 0: the profile's) */
     /* loaded by cli_load */
-    float *points;          /* n_points * 4 floats (x, y, z, remission) */
+    float *points; /* n_points * 4 floats (x, y, z, remission) */
     uint32_t n_points;
-    uint16_t *ring;         /* NULL unless --ring */
-    const lidet_sensor_t *sensor_profile; /* the preset, or sensor_mounted (--mount-height, a file's sensor) */
-    lidet_sensor_t sensor_mounted;        /* the preset with the --mount-height of the command line, or the
+    uint16_t *ring; /* NULL unless --ring */
+    const lidet_sensor_t
+        *sensor_profile;           /* the preset, or sensor_mounted (--mount-height, a file's sensor) */
+    lidet_sensor_t sensor_mounted; /* the preset with the --mount-height of the command line, or the
                                              file's sensor (its table in desc) */
     /* a file's sensor only (NULL for a preset): its float model family and its integer profile (detect --fixed;
      * the table in desc) */
@@ -113,8 +117,8 @@ cli_optset_t cli_optset(const cli_opt_t *opts, int (*take)(void *ctx, int id, co
  * handed to its set's take in the order given; the positional arguments, in order, into pos (room for argc
  * entries) and their count into *n_pos. Messages start with who ("lidet detect"). Returns CLI_PARSE_OK,
  * CLI_PARSE_ERROR (an unknown option, a value missing or refused: said) or CLI_PARSE_USAGE (-h, --help). */
-int cli_options_parse(int argc, char **argv, const char *who, const cli_optset_t *sets, int n_sets, char **pos,
-                      int *n_pos);
+int cli_options_parse(int argc, char **argv, const char *who, const cli_optset_t *sets, int n_sets,
+                      char **pos, int *n_pos);
 /* the values of a repeatable option (--set KEY=VALUE) in the order given: v has room for argc of them */
 typedef struct
 {
@@ -123,6 +127,17 @@ typedef struct
 } cli_list_t;
 /* a take that appends value to the cli_list_t ctx, whatever the id */
 int cli_list_take(void *list, int id, const char *value);
+
+/* The benchmarks' shared options (lidet_bench_proj, lidet_bench_memory): --sensor NAME and --repeat N (an integer in
+ * [1, 1000000]), taken into a cli_bench_opts_t by cli_bench_take; `who` names the program in its messages. */
+typedef struct
+{
+    const char *who;
+    const char *sensor;
+    int repeat;
+} cli_bench_opts_t;
+extern const cli_opt_t cli_opts_bench[];
+int cli_bench_take(void *opts, int id, const char *value);
 
 /* The shared option sets of cli_args_t (cli_common.c), taken by cli_args_take: the sensor (--sensor NAME,
  * --sensor-file F, --ouster-meta M, --mount-height M, --print-sensor) and the scan's files and output (--out FILE,
@@ -163,7 +178,8 @@ int cli_velodyne_calib_load(cli_args_t *a, const char *cmd);
  * nearest (half to even, as numpy). 0; or 1 with calibration_table's message in err (another number of lasers,
  * laser ids other than 0 .. n-1, a distance resolution other than the packets' unit, a distance correction beyond
  * +-32.767 m). */
-int cli_velodyne_calib_table(const cli_args_t *a, int model, lidet_velodyne_calib_t *t, char *err, size_t err_len);
+int cli_velodyne_calib_table(const cli_args_t *a, int model, lidet_velodyne_calib_t *t, char *err,
+                             size_t err_len);
 /* Points a's profiles (float, integer, family) at a->desc once a loader has filled it (cli_sensor.c). */
 void cli_sensor_use_desc(cli_args_t *a);
 /* The packet format of Ouster's metadata (--ouster-meta; the rules of tools/lidet_tools/ouster.py load_metadata):
@@ -173,10 +189,11 @@ typedef struct
     int profile;                 /* lidet_ouster_profile_t (udp_profile_lidar; absent: LEGACY) */
     int header;                  /* lidet_ouster_header_t (header_type; absent: STANDARD) */
     uint16_t columns_per_packet; /* absent: 16 */
-    uint16_t azimuth_offset_bam; /* the turn of lidar_to_sensor_transform about z (absent: ouster-sdk's half turn) */
-    uint32_t init_id;            /* initialization_id (0: unknown, not checked) */
-    uint64_t prod_sn;            /* prod_sn (0: unknown, not checked) */
-    uint32_t udp_port_lidar;     /* absent: 7502 */
+    uint16_t
+        azimuth_offset_bam; /* the turn of lidar_to_sensor_transform about z (absent: ouster-sdk's half turn) */
+    uint32_t init_id;       /* initialization_id (0: unknown, not checked) */
+    uint64_t prod_sn;       /* prod_sn (0: unknown, not checked) */
+    uint32_t udp_port_lidar;                   /* absent: 7502 */
     int32_t beam_azimuth_mdeg[LIDET_MAX_ROWS]; /* beam_azimuth_angles (absent: 0) */
 } cli_ouster_fmt_t;
 /* Reads it from a->ouster_meta (a->desc already loaded): 0, or 1 with a message. */
@@ -222,19 +239,19 @@ int cli_put_f32(FILE *f, float v);
  * function `int apply(cfg_t *c, const char *kv)` that has called it (locals klen, v), CLI_SET_FLOAT
  * and CLI_SET_INT return 0 when the key names that field (1 for an integer out of [0, maxv]). */
 int cli_split_set(const char *kv, size_t *klen, double *v);
-#define CLI_SET_FLOAT(c, kv, klen, v, name)                                                          \
-    if ((klen) == sizeof #name - 1 && strncmp((kv), #name, (klen)) == 0)                             \
-    {                                                                                                \
-        (c)->name = (float)(v);                                                                      \
-        return 0;                                                                                    \
+#define CLI_SET_FLOAT(c, kv, klen, v, name)                                                                  \
+    if ((klen) == sizeof #name - 1 && strncmp((kv), #name, (klen)) == 0)                                     \
+    {                                                                                                        \
+        (c)->name = (float)(v);                                                                              \
+        return 0;                                                                                            \
     }
-#define CLI_SET_INT(c, kv, klen, v, name, type, maxv)                                                \
-    if ((klen) == sizeof #name - 1 && strncmp((kv), #name, (klen)) == 0)                             \
-    {                                                                                                \
-        if ((v) < 0.0 || (v) > (double)(maxv) || (v) != (double)(long long)(v))                      \
-            return 1;                                                                                \
-        (c)->name = (type)(v);                                                                       \
-        return 0;                                                                                    \
+#define CLI_SET_INT(c, kv, klen, v, name, type, maxv)                                                        \
+    if ((klen) == sizeof #name - 1 && strncmp((kv), #name, (klen)) == 0)                                     \
+    {                                                                                                        \
+        if ((v) < 0.0 || (v) > (double)(maxv) || (v) != (double)(long long)(v))                              \
+            return 1;                                                                                        \
+        (c)->name = (type)(v);                                                                               \
+        return 0;                                                                                            \
     }
 
 /* `--set KEY=VALUE` on a clustering configuration (cli_cluster.c): 0, or 1 for an unknown key or a bad value */
@@ -268,9 +285,10 @@ int cli_det_config(const cli_args_t *a, const cli_det_opts_t *o, lidet_detector_
  * any number of runs on a->points (a->repeat times: ms[] the medians of the LIDET_DET_N_STAGES stage times and
  * the total); pp (LIDET_MAX_POINTS entries, or NULL) gets each point's pixel for cli_detect_f_ground. det, ds:
  * the detector's own arrays, valid until the next run. 0, or 1 with a message. */
-int cli_detect_f_init(const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *mc, const lidet_pn_model_t *mb);
-int cli_detect_f_run(const cli_args_t *a, int32_t *pp, double *ms, const lidet_detection_t **det, uint32_t *n_det,
-                     const lidet_detector_stats_t **ds, lidet_status_t *status);
+int cli_detect_f_init(const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *mc,
+                      const lidet_pn_model_t *mb);
+int cli_detect_f_run(const cli_args_t *a, int32_t *pp, double *ms, const lidet_detection_t **det,
+                     uint32_t *n_det, const lidet_detector_stats_t **ds, lidet_status_t *status);
 /* the last float run's ground flag per point (min(n_points, LIDET_MAX_POINTS) entries) from its pp: 0 or 1 */
 int cli_detect_f_ground(const int32_t *pp, uint32_t n_points, uint8_t *point_ground);
 /* the last cli_detect_q_run's detections in integer units (the integer detector's array) */
@@ -317,22 +335,23 @@ typedef struct
 {
     const char *path;  /* --pcap FILE (NULL: scans from files) */
     const char *lidar; /* --lidar velodyne (default) | ouster (with --ouster-meta M) */
-    int port;          /* --port N: the data port (0: the lidar's: Velodyne 2368, Ouster the metadata's, 7502) */
-    int force_sensor;  /* --force-sensor: every packet decoded as --sensor's model (lidet_velodyne_cfg_t.force_model) */
-    const char *dual;  /* --dual: both | last | strongest (Velodyne), both | first | second (Ouster); NULL: both */
-    int partial;       /* --partial: also the scans that are not one whole rotation */
-    long png_scan;     /* --png-scan K (detect): the scan drawn by --png (-1: the last) */
+    int port; /* --port N: the data port (0: the lidar's: Velodyne 2368, Ouster the metadata's, 7502) */
+    int force_sensor; /* --force-sensor: every packet decoded as --sensor's model (lidet_velodyne_cfg_t.force_model) */
+    const char
+        *dual;   /* --dual: both | last | strongest (Velodyne), both | first | second (Ouster); NULL: both */
+    int partial; /* --partial: also the scans that are not one whole rotation */
+    long png_scan; /* --png-scan K (detect): the scan drawn by --png (-1: the last) */
 } cli_pcap_opts_t;
 /* one scan of a capture */
 typedef struct
 {
-    uint32_t index;                   /* K: its number among the scans run, from 0 */
-    uint8_t kind;                     /* lidet_velodyne_scan_t (lidet_ouster_scan_t alike): COMPLETE; with --partial
+    uint32_t index; /* K: its number among the scans run, from 0 */
+    uint8_t kind;   /* lidet_velodyne_scan_t (lidet_ouster_scan_t alike): COMPLETE; with --partial
                                          also PARTIAL, ABORTED and NONE (unfinished at the end of the capture) */
     uint32_t first_frame, last_frame; /* P..Q: the frames of the file (from 0) that hold its returns */
     uint32_t n_returns;               /* returns in the scan (<= LIDET_MAX_POINTS) */
     uint32_t n_excess;                /* returns past LIDET_MAX_POINTS: counted, dropped */
-    int64_t t_us;     /* the sensor's time of its first packet, us (Velodyne: the payload's timestamp, unwrapped
+    int64_t t_us; /* the sensor's time of its first packet, us (Velodyne: the payload's timestamp, unwrapped
                          across the hour; Ouster: its first valid column's timestamp) */
     double capture_s; /* the capture's (pcap) timestamp of that packet, s */
 } cli_scan_info_t;

@@ -40,8 +40,8 @@ static int spells(const char *arg, const char *name)
     return strncmp(arg, "--", 2) == 0 && n == strlen(name) && strncmp(arg + 2, name, n) == 0;
 }
 
-int cli_options_parse(int argc, char **argv, const char *who, const cli_optset_t *sets, int n_sets, char **pos,
-                      int *n_pos)
+int cli_options_parse(int argc, char **argv, const char *who, const cli_optset_t *sets, int n_sets,
+                      char **pos, int *n_pos)
 {
     struct option table[MAX_OPTS + 1];
     const cli_opt_t *entry[MAX_OPTS]; /* NULL: --help */
@@ -140,5 +140,35 @@ int cli_list_take(void *ctx, int id, const char *value)
     cli_list_t *l = (cli_list_t *)ctx;
     (void)id;
     l->v[l->n++] = value;
+    return 0;
+}
+
+enum
+{
+    OPT_BENCH_SENSOR,
+    OPT_BENCH_REPEAT
+};
+
+const cli_opt_t cli_opts_bench[] = {{"sensor", required_argument, OPT_BENCH_SENSOR, "NAME: a sensor preset"},
+                                    {"repeat", required_argument, OPT_BENCH_REPEAT, "N: runs per scan, >= 1"},
+                                    {NULL, 0, 0, NULL}};
+
+int cli_bench_take(void *ctx, int id, const char *v)
+{
+    cli_bench_opts_t *o = (cli_bench_opts_t *)ctx;
+    char *end;
+    long n;
+    if (id == OPT_BENCH_SENSOR)
+    {
+        o->sensor = v;
+        return 0;
+    }
+    n = strtol(v, &end, 10);
+    if (end == v || *end != '\0' || n < 1 || n > 1000000)
+    {
+        fprintf(stderr, "%s: --repeat needs an integer in [1, 1000000], got '%s'\n", o->who, v);
+        return 1;
+    }
+    o->repeat = (int)n;
     return 0;
 }
