@@ -104,7 +104,7 @@ firmware: $(BUILD)/CMakeCache.txt
 firmware-run: firmware
 	ctest --test-dir $(BUILD) -R '^firmware_' -V
 
-# Benchmarks against peers measured in the same run; results go to docs/BENCHMARKS.md.
+# Benchmarks against peers measured in the same run; results go to docs/benchmarks/<name>.md, indexed by docs/BENCHMARKS.md.
 bench: deps build
 	-$(PY) -m pip install -q -r requirements-bench.txt || echo "bench: peers not installable here; their rows are skipped"
 	$(PY) tools/bench/run_bench.py --build $(BUILD) --real $(REAL) --out docs/BENCHMARKS.md

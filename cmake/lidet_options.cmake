@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 # The compile-time options of lib/include/lidet/lidet_opt.h as CMake cache variables of the same names (STRING,
 # empty = the header's default), read by the main CMakeLists.txt and by ports/firmware/CMakeLists.txt.
-# docs/PORTING.md ("Every compile-time option") lists them with their defaults and ranges; lidet_opt.h checks each
+# docs/OPTIONS.md ("Every compile-time option") lists them with their defaults and ranges; lidet_opt.h checks each
 # value (#error), so a bad one fails the first compile. Four options are CMake options (ON/OFF) instead, because
 # they also choose sources or per-source flags: LIDET_FIXED_POINT, LIDET_NN_CLONES, LIDET_NN_FMA, LIDET_NN_NEON.
 # tests/python/test_opt_knobs.py holds this list, lidet_opt.h and the docs to each other.
@@ -23,7 +23,7 @@ set(LIDET_TARGET_OPTIONS
 set(LIDET_OPT_OPTIONS ${LIDET_CAPACITY_OPTIONS} ${LIDET_LAYOUT_OPTIONS} ${LIDET_TARGET_OPTIONS})
 
 foreach(opt IN LISTS LIDET_OPT_OPTIONS)
-  set(${opt} "" CACHE STRING "Override ${opt} of lidet_opt.h (empty: its default; docs/PORTING.md)")
+  set(${opt} "" CACHE STRING "Override ${opt} of lidet_opt.h (empty: its default; docs/OPTIONS.md)")
 endforeach()
 set_property(CACHE LIDET_NN_S8_KERNEL PROPERTY STRINGS "" LIDET_NN_S8_KERNEL_ROWS4 LIDET_NN_S8_KERNEL_COLS
              LIDET_NN_S8_KERNEL_DSP LIDET_NN_S8_KERNEL_R2O2 LIDET_NN_S8_KERNEL_R4O2)

@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 # 64-bit Arm Linux (Raspberry Pi, Jetson): the library, the Unity unit tests and the host CLI cross-built and run
-# under qemu-aarch64 (docs/PORTING.md, "Linux on ARM (aarch64)").
+# under qemu-aarch64 (docs/FIRMWARE.md, "Linux on ARM (aarch64)").
 #
 # - aarch64_linux (ExternalProject, part of the normal build when aarch64-linux-gnu-gcc is installed;
 #   tools/scripts/install_deps.sh installs it): this repository configured again in <build>/aarch64 with

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-# `lidet detect / track --pcap` (ports/host/cli_pcap.c, docs/DECODING.md "From a capture") smoke test, without Python:
+# `lidet detect / track --pcap` (ports/host/cli_pcap.c, docs/CAPTURES.md "From a capture") smoke test, without Python:
 # files that are no capture exit 1 with their message, a CLI built without libpcap says so; where the real captures
 # of ../shared/data/packets are there, vlp16_strongest.pcap gives its 12 complete rotations and two CLIs (this
 # build's and the -O0 one) write the same box files (float and --fixed) and track files from it.

@@ -69,7 +69,7 @@ function(lidet_fw_host_ref sensor exe)
             --ring ${data}/ring/000000.bin --name tests/data/sim_${sensor}/000000 --out ${scan_c} ${mm}
     DEPENDS ${PROJECT_SOURCE_DIR}/tools/firmware/scan_to_c.py ${data}/velodyne/000000.bin ${data}/ring/000000.bin
     VERBATIM)
-  add_executable(${exe} ${fw_src}/fw_detect.c ${fw_src}/fw_host_port.c ${scan_c})
+  add_executable(${exe} ${fw_src}/fw_detect.c ${fw_src}/fw_out.c ${fw_src}/fw_host_port.c ${scan_c})
   set_target_properties(${exe} PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
   target_include_directories(${exe} PRIVATE ${fw_src})
   set(fixed_ref OFF)
@@ -99,7 +99,7 @@ add_custom_command(OUTPUT ${fw_pkt_c}
   DEPENDS ${PROJECT_SOURCE_DIR}/tools/firmware/packets_to_c.py ${fw_pkt_data}/velodyne/000000.bin
           ${fw_pkt_data}/ring/000000.bin
   VERBATIM)
-add_executable(fw_host_ref_pkt ${fw_src}/fw_packets.c ${fw_src}/fw_host_port.c ${fw_pkt_c})
+add_executable(fw_host_ref_pkt ${fw_src}/fw_packets.c ${fw_src}/fw_out.c ${fw_src}/fw_host_port.c ${fw_pkt_c})
 set_target_properties(fw_host_ref_pkt PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
 target_include_directories(fw_host_ref_pkt PRIVATE ${fw_src})
 lidet_fw_models(fw_pkt_models vlp16 ON)

@@ -8578,5 +8578,6 @@ const lidet_pn_model_t lidet_model_box_beams32 = {
     1.0f, /* energy temperature */
     {-5.909552f, -5.892334f, -6.361609f}, /* gate thresholds per class */
     "box_beams32",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

@@ -8578,5 +8578,6 @@ const lidet_pn_model_t lidet_model_box_hdl64 = {
     1.0f, /* energy temperature */
     {-6.318652f, -7.339359f, -7.248903f}, /* gate thresholds per class */
     "box_hdl64",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

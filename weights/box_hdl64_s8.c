@@ -6661,5 +6661,6 @@ const lidet_pointnet_q_model_t lidet_model_box_hdl64_s8 = {
     65536, /* energy temperature, Q16 */
     {-414099, -480992, -475064}, /* gate thresholds per class, Q16 nats */
     "box_hdl64_s8",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

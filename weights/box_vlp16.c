@@ -8578,5 +8578,6 @@ const lidet_pn_model_t lidet_model_box_vlp16 = {
     1.0f, /* energy temperature */
     {-6.1746435f, -6.6176095f, -6.4261327f}, /* gate thresholds per class */
     "box_vlp16",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

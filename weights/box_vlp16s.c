@@ -2079,5 +2079,6 @@ const lidet_pn_model_t lidet_model_box_vlp16s = {
     1.0f, /* energy temperature */
     {-5.5498962f, -5.0921707f, -5.9819384f}, /* gate thresholds per class */
     "box_vlp16s",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

@@ -1769,5 +1769,6 @@ const lidet_pointnet_q_model_t lidet_model_box_vlp16s_s8 = {
     65536, /* energy temperature, Q16 */
     {-363718, -333721, -392032}, /* gate thresholds per class, Q16 nats */
     "box_vlp16s_s8",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

@@ -2858,5 +2858,6 @@ const lidet_pn_model_t lidet_model_cls_beams32 = {
     1.0f, /* energy temperature */
     {-4.1034474f, -3.139674f, -3.3261409f}, /* gate thresholds per class */
     "cls_beams32",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

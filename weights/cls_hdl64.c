@@ -2858,5 +2858,6 @@ const lidet_pn_model_t lidet_model_cls_hdl64 = {
     1.0f, /* energy temperature */
     {-5.801671f, -6.897447f, -6.342511f}, /* gate thresholds per class */
     "cls_hdl64",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

@@ -2261,5 +2261,6 @@ const lidet_pointnet_q_model_t lidet_model_cls_hdl64_s8 = {
     65536, /* energy temperature, Q16 */
     {-380218, -452031, -415663}, /* gate thresholds per class, Q16 nats */
     "cls_hdl64_s8",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

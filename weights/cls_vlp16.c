@@ -2858,5 +2858,6 @@ const lidet_pn_model_t lidet_model_cls_vlp16 = {
     1.0f, /* energy temperature */
     {-3.5728104f, -4.0531883f, -2.7437444f}, /* gate thresholds per class */
     "cls_vlp16",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

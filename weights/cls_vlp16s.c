@@ -796,5 +796,6 @@ const lidet_pn_model_t lidet_model_cls_vlp16s = {
     1.0f, /* energy temperature */
     {-1.9821621f, -1.4843177f, -1.4990373f}, /* gate thresholds per class */
     "cls_vlp16s",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

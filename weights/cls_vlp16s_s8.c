@@ -702,5 +702,6 @@ const lidet_pointnet_q_model_t lidet_model_cls_vlp16s_s8 = {
     65536, /* energy temperature, Q16 */
     {-129903, -97276, -98241}, /* gate thresholds per class, Q16 nats */
     "cls_vlp16s_s8",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

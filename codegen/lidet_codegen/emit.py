@@ -22,6 +22,8 @@ import numpy as np
 from . import __version__
 
 FORMAT_VERSION = 1  # LIDET_WEIGHTS_FORMAT_VERSION
+#: ONNX metadata lidet.z_origin values, in lidet_proposal_z_origin_t order (absent: "mean")
+Z_ORIGINS = ("mean", "ground")
 KIND = {"classifier": 1, "box": 2}
 
 
@@ -67,6 +69,7 @@ class Model:
     gamma: tuple = (0.0, 0.0, 0.0)
     classes: str = "Car,Cyclist,Pedestrian"
     meta: dict = field(default_factory=dict)
+    z_origin: int = 0  #: lidet_proposal_z_origin_t the model was trained with (0 the cluster mean, 1 the ground)
 
     def widths(self):
         wp, wv = 3, 8
@@ -359,6 +362,10 @@ def parse(model_proto, name: str | None = None) -> Model:
                   classes=meta.get("lidet.classes", "Car,Cyclist,Pedestrian"), meta=meta)
     if common["energy_t"] <= 0:
         raise EmitError("metadata lidet.energy_T must be > 0")
+    z_origin = meta.get("lidet.z_origin", "mean")
+    if z_origin not in Z_ORIGINS:
+        raise EmitError(f"metadata lidet.z_origin {z_origin!r}: expected one of {', '.join(Z_ORIGINS)}")
+    common["z_origin"] = Z_ORIGINS.index(z_origin)
     if kind == "classifier":
         if outs != ["logits"]:
             raise EmitError(f"classifier outputs {outs}: expected ['logits']")
@@ -496,7 +503,8 @@ def emit_c(m: Model, onnx_path, cmd: str, src_sha: str) -> tuple[str, str]:
              f"    {{{', '.join(_f32(b) for b in m.pvle_bins)}}}, /* PVLE bins: azimuth, elevation (rad), range (m) */\n"
              f"    {_f32(m.energy_t)}, /* energy temperature */\n"
              f"    {{{', '.join(_f32(g) for g in m.gamma)}}}, /* gate thresholds per class */\n"
-             f"    \"{n}\",\n    \"{m.classes}\"\n}};\n")
+             f"    \"{n}\",\n    \"{m.classes}\",\n"
+             f"    {m.z_origin}u /* proposal z origin: {Z_ORIGINS[m.z_origin]} */\n}};\n")
     return "".join(h), "".join(c)
 
 

@@ -44,7 +44,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import __version__
-from .emit import FORMAT_VERSION, EmitError, Model, load
+from .emit import FORMAT_VERSION, Z_ORIGINS, EmitError, Model, load
 
 PNQ_LAYOUT_VERSION = 2  # LIDET_PNQ_LAYOUT_VERSION (lidet_pointnet_q.h): the layer tables' fields (w_pk)
 
@@ -95,6 +95,7 @@ class QModel:
     gamma_q16: list
     classes: str
     source: Model = field(repr=False, default=None)
+    z_origin: int = 0  #: lidet_proposal_z_origin_t, as the float model's
 
     def widths(self):
         wp, wv = 3, 8
@@ -300,7 +301,7 @@ def quantize(model: Model, calib: dict) -> QModel:
         heading_res_bam=_rha(2.0 ** 31 / nh) if nh else 0,
         pvle_bin=(_rha(model.pvle_bins[0] * 1e6), _rha(model.pvle_bins[1] * 1e6), _rha(model.pvle_bins[2] * 1e3)),
         energy_t_q16=_rha(model.energy_t * 65536.0), gamma_q16=[_rha(g * 65536.0) for g in model.gamma],
-        classes=model.classes, source=source)
+        classes=model.classes, source=source, z_origin=model.z_origin)
 
 
 # ---- calibration: ranges and refit from proposals ------------------------------------------------
@@ -546,7 +547,8 @@ def emit_c_s8(qm: QModel, onnx_path, calib_path, cmd: str, src_sha: str, calib_s
              "/* PVLE bins: azimuth, elevation (urad), range (mm) */\n"
              f"    {qm.energy_t_q16}, /* energy temperature, Q16 */\n"
              f"    {{{', '.join(str(g) for g in qm.gamma_q16)}}}, /* gate thresholds per class, Q16 nats */\n"
-             f"    \"{n}\",\n    \"{qm.classes}\"\n}};\n")
+             f"    \"{n}\",\n    \"{qm.classes}\",\n"
+             f"    {qm.z_origin}u /* proposal z origin: {Z_ORIGINS[qm.z_origin]} */\n}};\n")
     return "".join(h), "".join(c)
 
 

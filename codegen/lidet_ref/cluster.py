@@ -66,15 +66,21 @@ def voxel_of(mean, azimuth_bin_rad=np.float32(np.radians(10.0)), elevation_bin_r
 
 def make_proposal(member_xyz: np.ndarray, mean=None, n_points: int = 64, seed: int = 0x5EED1234,
                   azimuth_bin_rad=np.float32(np.radians(10.0)), elevation_bin_rad=np.float32(np.radians(10.0)),
-                  range_bin_m: float = 1.0):
+                  range_bin_m: float = 1.0, height_m=None):
     """A proposal from a cluster's member points (n_src, 3) in member order (raster order of their
     pixels, as lidet_cluster_members lists them). mean: the cluster mean (default: the float64 mean of
-    the members). Returns (xyz (n_points, 3) float32 centred on the mean, mean float32 (3,), voxel int16 (3,))."""
+    the members). height_m: None for LIDET_PROPOSAL_Z_MEAN; else the record's height above its ground plane
+    (lidet_cluster_rec_t height_m) and z is measured from the ground under the mean (LIDET_PROPOSAL_Z_GROUND),
+    which is the returned mean's z. Returns (xyz (n_points, 3) float32 centred on the mean, mean float32 (3,),
+    voxel int16 (3,): the voxel of the cluster mean either way)."""
     pts = np.asarray(member_xyz, np.float32)
     mean32 = (pts.astype(np.float64).mean(0) if mean is None else np.asarray(mean, np.float64)).astype(np.float32)
+    origin = mean32.copy()
+    if height_m is not None:
+        origin[2] = mean32[2] - np.float32(height_m)  # float32 - float32, as in C
     idx = proposal_indices(len(pts), n_points, seed)
-    xyz = pts[idx] - mean32  # float32 - float32, as in C
-    return xyz, mean32, voxel_of(mean32, azimuth_bin_rad, elevation_bin_rad, range_bin_m)
+    xyz = pts[idx] - origin  # float32 - float32, as in C
+    return xyz, origin, voxel_of(mean32, azimuth_bin_rad, elevation_bin_rad, range_bin_m)
 
 
 def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.ndarray, xyz: np.ndarray,

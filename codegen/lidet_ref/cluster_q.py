@@ -437,12 +437,14 @@ def _sat16(v: int) -> int:
 def make_proposal_q(rec: Rec, members, x, y, z, cfg: dict):
     """lidet_proposal_q_make of one record (members: the canonical member array; x, y, z the image's int16
     planes; cfg: lidet_proposal_q_cfg_t fields). Returns (xyz (n_points, 3) int16, mean (3,) int32, voxel
-    (3,) int16)."""
+    (3,) int16). cfg z_origin 1 (LIDET_PROPOSAL_Z_GROUND): z from the ground under the mean (mean z minus the
+    record's height), which is then the returned mean's z."""
     X, Y, Z = (np.asarray(a).ravel() for a in (x, y, z))
     mx, my, mz = rec.mean
+    zo = mz - rec.height if int(cfg.get("z_origin", 0)) == 1 else mz
     idx = proposal_indices(rec.n_points, cfg["n_points"], cfg["seed"])
     pix = np.asarray(members)[rec.first_member + idx]
-    xyz = np.array([[_sat16(int(P[p]) - m) for P, m in ((X, mx), (Y, my), (Z, mz))] for p in pix], np.int16)
+    xyz = np.array([[_sat16(int(P[p]) - m) for P, m in ((X, mx), (Y, my), (Z, zo))] for p in pix], np.int16)
     rxy2 = mx * mx + my * my
 
     def b(v, bin_):
@@ -451,7 +453,7 @@ def make_proposal_q(rec: Rec, members, x, y, z, cfg: dict):
     vox = np.array([b(_i(qm.atan2(my, mx)), cfg["azimuth_bin_bam"]),
                     b(_i(qm.atan2(mz, _i(qm.sqrt_round(rxy2)))), cfg["elevation_bin_bam"]),
                     b(_i(qm.sqrt_round(rxy2 + mz * mz)), cfg["range_bin_4mm"])], np.int16)
-    return xyz, np.array(rec.mean, np.int32), vox
+    return xyz, np.array([mx, my, zo], np.int32), vox
 
 
 def _span_mm(lo: int, hi: int) -> int:

@@ -96,7 +96,7 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     labels, members, recs, _ = cluster_q.cluster_q_ref(X, Y, Z, R, tab.row_elev_bam, mask,
                                                       planes[:2 * ns] if split > 0 else planes[:ns], cluster_cfg,
                                                       max_clusters)
-    pcfg = dict(proposal_cfg, n_points=int(cls_model.n_points))
+    pcfg = dict(proposal_cfg, n_points=int(cls_model.n_points), z_origin=int(getattr(cls_model, "z_origin", 0)))
     outcome = [0] * len(recs)
     order, truncated = candidates(recs, det_cfg, outcome)
     stats = dict(n_clusters=len(recs), n_too_tall=outcome.count(OUT_TALL), n_classified=0, n_gate1_rejected=0,

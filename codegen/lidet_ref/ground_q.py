@@ -3,7 +3,7 @@
 bit for bit.
 
 Input: a compact range image, (rows, cols) int16 x, y, z in 4 mm steps; configuration: a dict with the fields of
-lidet_ground_q_cfg_t (native_q.ground_q_defaults gives the C defaults). Every value is an exact integer: pixel
+lidet_ground_q_cfg_t (native.ground_q_defaults gives the C defaults). Every value is an exact integer: pixel
 arrays in numpy int64 (no intermediate exceeds 2^63 here, as in the C code), per-cell scalars in Python ints
 (the C code never overflows its int64, so unbounded ints give the same values). The same random draws as the C
 stage (ref/rng.py). Steps: `sample_mask`, `gather_samples`, `ransac_cell` (+ `refine`), `fit_sectors`,

@@ -34,6 +34,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "fw_out.h"
 #include "fw_port.h"
 #include "fw_scan.h"
 #include "lidet/lidet_detector.h"
@@ -105,59 +106,7 @@ static fw_mem_t g_mem;
 #define g_det (g_mem.det)
 #define g_tb (g_mem.trk)
 
-static const char *const k_class_names[LIDET_N_CLASSES] = {"Car", "Cyclist", "Pedestrian"};
-
 /* ---- output ---------------------------------------------------------------------------------------- */
-
-static void put_s(const char *s)
-{
-    while (*s != '\0')
-        fw_putc(*s++);
-}
-
-static void put_u(uint32_t v)
-{
-    char b[11];
-    int n = 0;
-    do
-    {
-        b[n++] = (char)('0' + v % 10u);
-        v /= 10u;
-    } while (v != 0u);
-    while (n > 0)
-        fw_putc(b[--n]);
-}
-
-static void put_u64(uint64_t v)
-{
-    char b[21];
-    int n = 0;
-    do
-    {
-        b[n++] = (char)('0' + (unsigned)(v % 10u));
-        v /= 10u;
-    } while (v != 0u);
-    while (n > 0)
-        fw_putc(b[--n]);
-}
-
-static void put_i(int32_t v)
-{
-    if (v < 0)
-    {
-        fw_putc('-');
-        put_u((uint32_t)(-(v + 1)) + 1u);
-    }
-    else
-        put_u((uint32_t)v);
-}
-
-static void put_hex(uint32_t v)
-{
-    int k;
-    for (k = 28; k >= 0; k -= 4)
-        fw_putc("0123456789abcdef"[(v >> k) & 15u]);
-}
 
 #if !LIDET_FIXED_POINT
 static uint32_t bits(float f)
@@ -167,49 +116,7 @@ static uint32_t bits(float f)
     return u;
 }
 
-/* fixed-point decimal with 4 digits (readability only; the comparison reads the hex bits) */
-static void put_f(float f)
-{
-    uint32_t whole, frac;
-    if (!(f == f))
-    {
-        put_s("nan");
-        return;
-    }
-    if (f < 0.0f)
-    {
-        fw_putc('-');
-        f = -f;
-    }
-    if (f >= 1.0e6f)
-    {
-        put_s("big");
-        return;
-    }
-    whole = (uint32_t)f;
-    frac = (uint32_t)((f - (float)whole) * 10000.0f + 0.5f);
-    if (frac >= 10000u)
-    {
-        ++whole;
-        frac -= 10000u;
-    }
-    put_u(whole);
-    fw_putc('.');
-    fw_putc((char)('0' + frac / 1000u));
-    fw_putc((char)('0' + frac / 100u % 10u));
-    fw_putc((char)('0' + frac / 10u % 10u));
-    fw_putc((char)('0' + frac % 10u));
-}
-
 #endif
-
-static void put_kv(const char *key, uint32_t v)
-{
-    fw_putc(' ');
-    put_s(key);
-    fw_putc('=');
-    put_u(v);
-}
 
 /* ---- models ---------------------------------------------------------------------------------------- */
 
@@ -328,16 +235,16 @@ typedef int32_t fw_val_t;
 #define FW_VALUES(d)                                                                                               \
     {(d)->score_q15, (d)->box.cx_mm, (d)->box.cy_mm, (d)->box.cz_mm,  (d)->box.l_mm,                               \
      (d)->box.w_mm,  (d)->box.h_mm,  (d)->box.yaw_bam, (d)->energy_cls_q16, (d)->energy_box_q16}
-#define FW_PUT_HEX(v) put_hex((uint32_t)(v))
-#define FW_PUT_V put_i
+#define FW_PUT_HEX(v) fw_put_hex((uint32_t)(v))
+#define FW_PUT_V fw_put_i
 static const char *const k_val_labels[8] = {" # score_q15 ", " xyz_mm ", " ", " ", " lwh_mm ", " ", " ", " yaw_bam "};
 #else
 typedef float fw_val_t;
 #define FW_VALUES(d)                                                                                               \
     {(d)->score, (d)->box.cx_m, (d)->box.cy_m, (d)->box.cz_m, (d)->box.l_m,                                        \
      (d)->box.w_m, (d)->box.h_m, (d)->box.yaw_rad, (d)->energy_cls, (d)->energy_box}
-#define FW_PUT_HEX(v) put_hex(bits(v))
-#define FW_PUT_V put_f
+#define FW_PUT_HEX(v) fw_put_hex(bits(v))
+#define FW_PUT_V fw_put_f
 static const char *const k_val_labels[8] = {" # score ", " xyz ", " ", " ", " lwh ", " ", " ", " yaw "};
 #endif
 
@@ -345,16 +252,16 @@ static void put_det(const char *name, uint32_t k, const fw_detection_t *d)
 {
     const fw_val_t v[10] = FW_VALUES(d);
     uint32_t j;
-    put_s("det ");
-    put_s(name);
+    fw_put_s("det ");
+    fw_put_s(name);
     fw_putc(' ');
-    put_u(k);
+    fw_put_u(k);
     fw_putc(' ');
-    put_s(d->cls < LIDET_N_CLASSES ? k_class_names[d->cls] : "?");
+    fw_put_s(d->cls < LIDET_N_CLASSES ? fw_class_names[d->cls] : "?");
     fw_putc(' ');
-    put_u(d->cluster_id);
+    fw_put_u(d->cluster_id);
     fw_putc(' ');
-    put_u(d->n_points);
+    fw_put_u(d->n_points);
     for (j = 0; j < 10u; ++j)
     {
         fw_putc(' ');
@@ -362,7 +269,7 @@ static void put_det(const char *name, uint32_t k, const fw_detection_t *d)
     }
     for (j = 0; j < 8u; ++j)
     {
-        put_s(k_val_labels[j]);
+        fw_put_s(k_val_labels[j]);
         FW_PUT_V(v[j]);
     }
     fw_putc('\n');
@@ -381,10 +288,10 @@ static int run_once(const char *name, const fw_cfg_t *cfg, const fw_model_t *mc,
     st = fw_init(&g_det, cfg, mc, mb);
     if (st != LIDET_OK)
     {
-        put_s("init run=");
-        put_s(name);
-        put_s(" failed status=");
-        put_i((int32_t)st);
+        fw_put_s("init run=");
+        fw_put_s(name);
+        fw_put_s(" failed status=");
+        fw_put_i((int32_t)st);
         fw_putc('\n');
         return 1;
     }
@@ -395,20 +302,20 @@ static int run_once(const char *name, const fw_cfg_t *cfg, const fw_model_t *mc,
     s = fw_stats(&g_det);
     det = fw_detections(&g_det, &n_det);
 
-    put_s("stats run=");
-    put_s(name);
-    put_s(" status=");
-    put_i((int32_t)st);
-    put_kv("clusters", s->n_clusters);
-    put_kv("classified", s->n_classified);
-    put_kv("gate1_rejected", s->n_gate1_rejected);
-    put_kv("boxed", s->n_boxed);
-    put_kv("gate2_rejected", s->n_gate2_rejected);
-    put_kv("size_rejected", s->n_size_rejected);
-    put_kv("nms_suppressed", s->n_nms_suppressed);
-    put_kv("over_budget", s->n_over_budget);
-    put_kv("over_capacity", s->n_over_capacity);
-    put_kv("detections", n_det);
+    fw_put_s("stats run=");
+    fw_put_s(name);
+    fw_put_s(" status=");
+    fw_put_i((int32_t)st);
+    fw_put_kv("clusters", s->n_clusters);
+    fw_put_kv("classified", s->n_classified);
+    fw_put_kv("gate1_rejected", s->n_gate1_rejected);
+    fw_put_kv("boxed", s->n_boxed);
+    fw_put_kv("gate2_rejected", s->n_gate2_rejected);
+    fw_put_kv("size_rejected", s->n_size_rejected);
+    fw_put_kv("nms_suppressed", s->n_nms_suppressed);
+    fw_put_kv("over_budget", s->n_over_budget);
+    fw_put_kv("over_capacity", s->n_over_capacity);
+    fw_put_kv("detections", n_det);
     fw_putc('\n');
     for (k = 0; k < n_det; ++k)
         put_det(name, k, &det[k]);
@@ -417,22 +324,22 @@ static int run_once(const char *name, const fw_cfg_t *cfg, const fw_model_t *mc,
         uint64_t stage64[LIDET_DET_N_STAGES];
         if (rec_stages(&g_rec, s, stage64) != 0)
         {
-            put_s("insn run=");
-            put_s(name);
-            put_s(" FAIL: the clock calls do not match the detector's stage order (fw_detect.c: rec_stages)\n");
+            fw_put_s("insn run=");
+            fw_put_s(name);
+            fw_put_s(" FAIL: the clock calls do not match the detector's stage order (fw_detect.c: rec_stages)\n");
             return 1;
         }
-        put_s("insn run=");
-        put_s(name);
+        fw_put_s("insn run=");
+        fw_put_s(name);
         for (k = 0; k < LIDET_DET_N_STAGES; ++k)
         {
             fw_putc(' ');
-            put_s(stage_names[k]);
+            fw_put_s(stage_names[k]);
             fw_putc('=');
-            put_u64(stage64[k]);
+            fw_put_u64(stage64[k]);
         }
-        put_s(" scan="); /* 64 bits: the stages' uint32 counts are checked against it (run_fw.py) */
-        put_u64(t1 - t0);
+        fw_put_s(" scan="); /* 64 bits: the stages' uint32 counts are checked against it (run_fw.py) */
+        fw_put_u64(t1 - t0);
         fw_putc('\n');
     }
     return LIDET_SUCCEEDED(st) ? 0 : 1;
@@ -612,34 +519,34 @@ static void put_track(const char *run, uint32_t k, const fw_track_t *t)
     static const char *const state_names[3] = {"tentative", "confirmed", "coasting"};
     const fw_val_t v[13] = FW_TRACK_VALUES(t);
     uint32_t j;
-    put_s("trk ");
-    put_s(run);
+    fw_put_s("trk ");
+    fw_put_s(run);
     fw_putc(' ');
-    put_u(k);
+    fw_put_u(k);
     fw_putc(' ');
-    put_u(t->id);
+    fw_put_u(t->id);
     fw_putc(' ');
-    put_s(t->cls < LIDET_N_CLASSES ? k_class_names[t->cls] : "?");
+    fw_put_s(t->cls < LIDET_N_CLASSES ? fw_class_names[t->cls] : "?");
     fw_putc(' ');
-    put_s(t->state < 3u ? state_names[t->state] : "?");
+    fw_put_s(t->state < 3u ? state_names[t->state] : "?");
     for (j = 0; j < 13u; ++j)
     {
         fw_putc(' ');
         FW_PUT_HEX(v[j]);
     }
     fw_putc(' ');
-    put_u(t->hits);
+    fw_put_u(t->hits);
     fw_putc(' ');
-    put_u(t->misses);
+    fw_put_u(t->misses);
     fw_putc(' ');
-    put_u(t->age);
+    fw_put_u(t->age);
     fw_putc(' ');
-    put_i(t->det_index);
-    put_s(" # xy ");
+    fw_put_i(t->det_index);
+    fw_put_s(" # xy ");
     FW_PUT_V(v[0]);
     fw_putc(' ');
     FW_PUT_V(v[1]);
-    put_s(" v ");
+    fw_put_s(" v ");
     FW_PUT_V(v[7]);
     fw_putc(' ');
     FW_PUT_V(v[8]);
@@ -653,28 +560,28 @@ static void put_tracker_run(const char *run, uint32_t n_det, uint32_t n_upd, lid
 {
     const fw_trk_stats_t *ts = fw_trk_stats(&g_trk);
     uint32_t k, n;
-    put_s("track run=");
-    put_s(run);
-    put_kv("dets", n_det);
-    put_kv("updates", n_upd);
+    fw_put_s("track run=");
+    fw_put_s(run);
+    fw_put_kv("dets", n_det);
+    fw_put_kv("updates", n_upd);
     for (k = 0; k < n_insn && fw_have_counter(); ++k)
     {
-        put_s(" insn_");
-        put_s(insn_names[k]);
+        fw_put_s(" insn_");
+        fw_put_s(insn_names[k]);
         fw_putc('=');
-        put_u64(insn[k]);
+        fw_put_u64(insn[k]);
     }
-    put_s(" status=");
-    put_i((int32_t)st);
-    put_kv("tracks", ts->n_tracks);
-    put_kv("confirmed", ts->n_confirmed);
-    put_kv("births", ts->n_births);
-    put_kv("births_dropped", ts->n_births_dropped);
-    put_kv("deaths", ts->n_deaths);
-    put_kv("matched", ts->n_matched);
-    put_kv("feasible", ts->n_feasible_pairs);
-    put_kv("dets_dropped", ts->n_dets_dropped);
-    put_kv("bad_dets", ts->n_bad_dets);
+    fw_put_s(" status=");
+    fw_put_i((int32_t)st);
+    fw_put_kv("tracks", ts->n_tracks);
+    fw_put_kv("confirmed", ts->n_confirmed);
+    fw_put_kv("births", ts->n_births);
+    fw_put_kv("births_dropped", ts->n_births_dropped);
+    fw_put_kv("deaths", ts->n_deaths);
+    fw_put_kv("matched", ts->n_matched);
+    fw_put_kv("feasible", ts->n_feasible_pairs);
+    fw_put_kv("dets_dropped", ts->n_dets_dropped);
+    fw_put_kv("bad_dets", ts->n_bad_dets);
     fw_putc('\n');
     n = fw_trk_tracks(&g_trk, g_tb.out, LIDET_TRACK_MAX_TRACKS, LIDET_TRACK_OUT_COASTING | LIDET_TRACK_OUT_TENTATIVE);
     for (k = 0; k < n; ++k)
@@ -764,52 +671,7 @@ static __attribute__((noinline)) int track_scene(void)
     insn[3] = n_meas > 0u ? (sum + n_meas / 2u) / n_meas : 0u;
     put_tracker_run("synthetic", FW_TRK_OBJECTS, FW_TRK_SCANS, st, names, insn, 6u);
     if (bad)
-        put_s("track run=synthetic FAIL: not 32 confirmed tracks matched in every update from the third scan\n");
-    return bad;
-}
-
-/* The counter against loops of known length. measure() is one function whatever n is (n arrives in a
- * register), so the instructions around the loop are the same in every call; the difference of two loops
- * removes them (and the clock calls), so measured must equal expected exactly. */
-static __attribute__((noinline)) uint32_t measure(uint32_t n)
-{
-    const uint32_t t0 = fw_clock(0);
-    fw_spin(n);
-    return fw_clock(0) - t0;
-}
-
-static int calibrate(void)
-{
-    static volatile uint32_t lens[4] = {1u, 1000u, 12345u, 1000000u}; /* volatile: no constant folding */
-    uint32_t base, k;
-    int bad = 0;
-    base = measure(lens[0]);
-    for (k = 1; k < 4u; ++k)
-    {
-        const uint32_t n = lens[k];
-        const uint32_t measured = measure(n) - base;
-        const uint32_t expected = fw_spin_insn(n) - fw_spin_insn(lens[0]);
-        put_s("calib");
-        put_kv("n", n);
-        put_kv("expected", expected);
-        put_kv("measured", measured);
-        fw_putc('\n');
-        bad |= measured != expected;
-    }
-    /* a loop longer than a 32-bit tick counter can hold at 6.4 ticks per instruction (MPS2: 671 M): the
-     * counter must be extended past its wrap. Here the wrap handler's few instructions count too. */
-    {
-        static volatile uint32_t long_n = 350000000u;
-        const uint32_t n = long_n;
-        const uint32_t measured = measure(n) - base;
-        const uint32_t expected = fw_spin_insn(n) - fw_spin_insn(lens[0]);
-        put_s("calib_long");
-        put_kv("n", n);
-        put_kv("expected", expected);
-        put_kv("measured", measured);
-        fw_putc('\n');
-        bad |= measured < expected || measured - expected > 64u;
-    }
+        fw_put_s("track run=synthetic FAIL: not 32 confirmed tracks matched in every update from the third scan\n");
     return bad;
 }
 
@@ -825,42 +687,42 @@ int fw_main(void)
     const char *family = pick_models(&mc, &mb);
     int bad = 0, c;
 
-    put_s("lidet-fw board=");
-    put_s(fw_board_name);
-    put_s(" core=");
-    put_s(fw_core_name);
-    put_s(" build=" FW_BUILD " sensor=" FW_SENSOR " models=");
-    put_s(family != 0 ? family : "none");
-    put_s(" scan=");
-    put_s(fw_scan_name);
-    put_kv("points", fw_scan_n);
-    put_kv("ring", (uint32_t)fw_scan_has_ring);
+    fw_put_s("lidet-fw board=");
+    fw_put_s(fw_board_name);
+    fw_put_s(" core=");
+    fw_put_s(fw_core_name);
+    fw_put_s(" build=" FW_BUILD " sensor=" FW_SENSOR " models=");
+    fw_put_s(family != 0 ? family : "none");
+    fw_put_s(" scan=");
+    fw_put_s(fw_scan_name);
+    fw_put_kv("points", fw_scan_n);
+    fw_put_kv("ring", (uint32_t)fw_scan_has_ring);
 #if LIDET_FIXED_POINT
-    put_kv("returns", (uint32_t)fw_scan_has_returns);
+    fw_put_kv("returns", (uint32_t)fw_scan_has_returns);
 #endif
     fw_putc('\n');
-    put_s("mem");
+    fw_put_s("mem");
 #if LIDET_FIXED_POINT
-    put_kv("detector_bytes", lidet_detector_q_bytes());
+    fw_put_kv("detector_bytes", lidet_detector_q_bytes());
 #else
-    put_kv("detector_bytes", lidet_detector_bytes());
+    fw_put_kv("detector_bytes", lidet_detector_bytes());
 #endif
-    put_kv("max_rows", LIDET_MAX_ROWS);
-    put_kv("max_cols", LIDET_MAX_COLS);
-    put_kv("max_points", LIDET_MAX_POINTS);
-    put_kv("max_clusters", LIDET_MAX_CLUSTERS);
-    put_kv("tracker_bytes", fw_trk_bytes());
-    put_kv("track_max_tracks", LIDET_TRACK_MAX_TRACKS);
-    put_kv("track_max_dets", LIDET_TRACK_MAX_DETS);
+    fw_put_kv("max_rows", LIDET_MAX_ROWS);
+    fw_put_kv("max_cols", LIDET_MAX_COLS);
+    fw_put_kv("max_points", LIDET_MAX_POINTS);
+    fw_put_kv("max_clusters", LIDET_MAX_CLUSTERS);
+    fw_put_kv("tracker_bytes", fw_trk_bytes());
+    fw_put_kv("track_max_tracks", LIDET_TRACK_MAX_TRACKS);
+    fw_put_kv("track_max_dets", LIDET_TRACK_MAX_DETS);
     fw_putc('\n');
     if (family == 0 || sensor == 0)
     {
-        put_s("lidet-fw: FAIL (no models or no " FW_SENSOR " sensor profile)\n");
+        fw_put_s("lidet-fw: FAIL (no models or no " FW_SENSOR " sensor profile)\n");
         return 1;
     }
-    if (fw_have_counter() && calibrate() != 0)
+    if (fw_have_counter() && fw_calibrate(1) != 0)
     {
-        put_s("lidet-fw: FAIL (instruction counter does not match the calibration loop)\n");
+        fw_put_s("lidet-fw: FAIL (instruction counter does not match the calibration loop)\n");
         return 1;
     }
 
@@ -909,10 +771,10 @@ int fw_main(void)
      * memory) */
     bad |= track_scene();
 
-    put_s("stack");
-    put_kv("used", fw_stack_used());
-    put_kv("size", fw_stack_size());
+    fw_put_s("stack");
+    fw_put_kv("used", fw_stack_used());
+    fw_put_kv("size", fw_stack_size());
     fw_putc('\n');
-    put_s(bad ? "lidet-fw: FAIL (a detector or tracker run failed)\n" : "lidet-fw: PASS\n");
+    fw_put_s(bad ? "lidet-fw: FAIL (a detector or tracker run failed)\n" : "lidet-fw: PASS\n");
     return bad;
 }

@@ -15,6 +15,7 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "fw_out.h"
 #include "fw_port.h"
 #include "fw_scan.h"
 #include "lidet/lidet.h"
@@ -27,34 +28,12 @@ static int32_t g_idx[LIDET_MAX_ROWS * LIDET_MAX_COLS];
 static lidet_ground_q_t g_q;
 static lidet_ground_t g_f;
 
-static void put_s(const char *s)
-{
-    while (*s != '\0')
-        fw_putc(*s++);
-}
-
-static void put_i(int64_t v)
-{
-    char b[21];
-    int n = 0;
-    uint64_t u = v < 0 ? (uint64_t)(-(v + 1)) + 1u : (uint64_t)v;
-    if (v < 0)
-        fw_putc('-');
-    do
-    {
-        b[n++] = (char)('0' + (unsigned)(u % 10u));
-        u /= 10u;
-    } while (u != 0u);
-    while (n > 0)
-        fw_putc(b[--n]);
-}
-
 static void field(const char *name, int64_t v)
 {
-    put_s(" ");
-    put_s(name);
-    put_s("=");
-    put_i(v);
+    fw_put_s(" ");
+    fw_put_s(name);
+    fw_put_s("=");
+    fw_put_i64(v);
 }
 
 int fw_main(void)
@@ -80,7 +59,7 @@ int fw_main(void)
     if (lidet_proj_state_init(&g_proj, &pc) != LIDET_OK ||
         lidet_proj_run_buffers(&g_proj, &b, fw_scan_xyz, fw_scan_n, 3, fw_scan_has_ring ? fw_scan_ring : 0) < 0)
     {
-        put_s("ground_q: FAIL (projection)\n");
+        fw_put_s("ground_q: FAIL (projection)\n");
         return 1;
     }
     lidet_proj_image_of(&g_proj, &b, &img);
@@ -88,7 +67,7 @@ int fw_main(void)
     lidet_ground_cfg_default(&fc, sensor);
     if (lidet_ground_q_init(&g_q, &qc) != LIDET_OK || lidet_ground_init(&g_f, &fc) != LIDET_OK)
     {
-        put_s("ground_q: FAIL (init)\n");
+        fw_put_s("ground_q: FAIL (init)\n");
         return 1;
     }
     t0 = fw_insn64();
@@ -118,8 +97,8 @@ int fw_main(void)
             part[v] = t1 - t0;
         }
     }
-    put_s("ground_q core=");
-    put_s(fw_core_name);
+    fw_put_s("ground_q core=");
+    fw_put_s(fw_core_name);
     field("status_q", rq);
     field("status_f", rf);
     field("insn_q", (int64_t)insn_q);
@@ -131,6 +110,6 @@ int fw_main(void)
     field("ground_f", g_f.state.stats.n_ground);
     field("same", same);
     field("pixels", npix);
-    put_s("\n");
+    fw_put_s("\n");
     return rq < 0 || rf < 0;
 }

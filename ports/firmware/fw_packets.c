@@ -31,6 +31,7 @@
 #include <string.h>
 
 #include "fw_packets.h"
+#include "fw_out.h"
 #include "fw_port.h"
 #include "lidet/lidet_detector_q.h"
 #include "lidet/lidet_velodyne.h"
@@ -61,67 +62,7 @@ static lidet_return_t g_out[LIDET_VELODYNE_MAX_RETURNS];
 static lidet_return_t g_scan[LIDET_MAX_POINTS + LIDET_VELODYNE_MAX_RETURNS];
 #endif
 
-static const char *const k_class_names[LIDET_N_CLASSES] = {"Car", "Cyclist", "Pedestrian"};
-
 /* ---- output (no stdio) ----------------------------------------------------------------------------- */
-
-static void put_s(const char *s)
-{
-    while (*s != '\0')
-        fw_putc(*s++);
-}
-
-static void put_u64(uint64_t v)
-{
-    char b[21];
-    int n = 0;
-    do
-    {
-        b[n++] = (char)('0' + (unsigned)(v % 10u));
-        v /= 10u;
-    } while (v != 0u);
-    while (n > 0)
-        fw_putc(b[--n]);
-}
-
-static void put_u(uint32_t v)
-{
-    put_u64(v);
-}
-
-static void put_i(int32_t v)
-{
-    if (v < 0)
-    {
-        fw_putc('-');
-        put_u((uint32_t)(-(v + 1)) + 1u);
-    }
-    else
-        put_u((uint32_t)v);
-}
-
-static void put_hex(uint32_t v)
-{
-    int k;
-    for (k = 28; k >= 0; k -= 4)
-        fw_putc("0123456789abcdef"[(v >> k) & 15u]);
-}
-
-static void put_kv(const char *key, uint32_t v)
-{
-    fw_putc(' ');
-    put_s(key);
-    fw_putc('=');
-    put_u(v);
-}
-
-static void put_kv64(const char *key, uint64_t v)
-{
-    fw_putc(' ');
-    put_s(key);
-    fw_putc('=');
-    put_u64(v);
-}
 
 /* one detection: fw_detect.c's `det` line (the integer build's int32 values as hex, then readable) */
 static void put_det(const char *run, uint32_t k, const lidet_detection_q_t *d)
@@ -131,25 +72,25 @@ static void put_det(const char *run, uint32_t k, const lidet_detection_q_t *d)
     const int32_t v[10] = {d->score_q15, d->box.cx_mm, d->box.cy_mm,   d->box.cz_mm,      d->box.l_mm,
                            d->box.w_mm,  d->box.h_mm,  d->box.yaw_bam, d->energy_cls_q16, d->energy_box_q16};
     uint32_t j;
-    put_s("det ");
-    put_s(run);
+    fw_put_s("det ");
+    fw_put_s(run);
     fw_putc(' ');
-    put_u(k);
+    fw_put_u(k);
     fw_putc(' ');
-    put_s(d->cls < LIDET_N_CLASSES ? k_class_names[d->cls] : "?");
+    fw_put_s(d->cls < LIDET_N_CLASSES ? fw_class_names[d->cls] : "?");
     fw_putc(' ');
-    put_u(d->cluster_id);
+    fw_put_u(d->cluster_id);
     fw_putc(' ');
-    put_u(d->n_points);
+    fw_put_u(d->n_points);
     for (j = 0; j < 10u; ++j)
     {
         fw_putc(' ');
-        put_hex((uint32_t)v[j]);
+        fw_put_hex((uint32_t)v[j]);
     }
     for (j = 0; j < 8u; ++j)
     {
-        put_s(labels[j]);
-        put_i(v[j]);
+        fw_put_s(labels[j]);
+        fw_put_i(v[j]);
     }
     fw_putc('\n');
 }
@@ -363,62 +304,62 @@ static __attribute__((noinline)) int report(const char *name, lidet_status_t st,
     const lidet_detection_q_t *det = lidet_detector_q_detections(&g_det, &n_det);
     uint64_t stage64[LIDET_DET_N_STAGES];
 
-    put_s("stats run=");
-    put_s(name);
-    put_s(" status=");
-    put_i((int32_t)st);
-    put_kv("clusters", s->n_clusters);
-    put_kv("classified", s->n_classified);
-    put_kv("gate1_rejected", s->n_gate1_rejected);
-    put_kv("boxed", s->n_boxed);
-    put_kv("gate2_rejected", s->n_gate2_rejected);
-    put_kv("size_rejected", s->n_size_rejected);
-    put_kv("nms_suppressed", s->n_nms_suppressed);
-    put_kv("over_budget", s->n_over_budget);
-    put_kv("over_capacity", s->n_over_capacity);
-    put_kv("detections", n_det);
-    put_kv("proj_in", s->proj.n_points_in);
-    put_kv("proj_projected", s->proj.n_projected);
-    put_kv("proj_filled", s->proj.n_pixels_filled);
-    put_kv("proj_truncated", s->proj.n_truncated);
+    fw_put_s("stats run=");
+    fw_put_s(name);
+    fw_put_s(" status=");
+    fw_put_i((int32_t)st);
+    fw_put_kv("clusters", s->n_clusters);
+    fw_put_kv("classified", s->n_classified);
+    fw_put_kv("gate1_rejected", s->n_gate1_rejected);
+    fw_put_kv("boxed", s->n_boxed);
+    fw_put_kv("gate2_rejected", s->n_gate2_rejected);
+    fw_put_kv("size_rejected", s->n_size_rejected);
+    fw_put_kv("nms_suppressed", s->n_nms_suppressed);
+    fw_put_kv("over_budget", s->n_over_budget);
+    fw_put_kv("over_capacity", s->n_over_capacity);
+    fw_put_kv("detections", n_det);
+    fw_put_kv("proj_in", s->proj.n_points_in);
+    fw_put_kv("proj_projected", s->proj.n_projected);
+    fw_put_kv("proj_filled", s->proj.n_pixels_filled);
+    fw_put_kv("proj_truncated", s->proj.n_truncated);
     fw_putc('\n');
     for (k = 0; k < n_det; ++k)
         put_det(name, k, &det[k]);
-    put_s("decode run=");
-    put_s(name);
-    put_kv("packets", vs->n_packets);
-    put_kv("decoded", vs->n_decoded);
-    put_kv("returns", vs->n_returns);
-    put_kv("partial", p->n_partial);
-    put_kv("complete", p->n_complete);
-    put_kv("aborted", p->n_aborted);
-    put_kv("first", p->first);
-    put_kv("last", p->last);
-    put_kv("scan_returns", p->scan_returns);
+    fw_put_s("decode run=");
+    fw_put_s(name);
+    fw_put_kv("packets", vs->n_packets);
+    fw_put_kv("decoded", vs->n_decoded);
+    fw_put_kv("returns", vs->n_returns);
+    fw_put_kv("partial", p->n_partial);
+    fw_put_kv("complete", p->n_complete);
+    fw_put_kv("aborted", p->n_aborted);
+    fw_put_kv("first", p->first);
+    fw_put_kv("last", p->last);
+    fw_put_kv("scan_returns", p->scan_returns);
     fw_putc('\n');
     if (!fw_have_counter() || FW_PACKETS_HOST_REF)
         return LIDET_SUCCEEDED(st) ? 0 : 1;
     if (!LIDET_SUCCEEDED(st) || seq_stages(&g_seq, s, stage64) != 0)
     {
-        put_s("insn run=");
-        put_s(name);
-        put_s(" FAIL: the clock calls do not match the streaming detector's order (fw_packets.c: "
+        fw_put_s("insn run=");
+        fw_put_s(name);
+        fw_put_s(" FAIL: the clock calls do not match the streaming detector's order (fw_packets.c: "
               "seq_stages)\n");
         return 1;
     }
-    put_s("insn run=");
-    put_s(name);
-    put_kv64("decode", p->decode);
+    fw_put_s("insn run=");
+    fw_put_s(name);
+    fw_put_kv64("decode", p->decode);
     for (k = 0; k < LIDET_DET_N_STAGES; ++k)
-        put_kv64(stage_names[k], stage64[k]);
-    put_kv64("scan", scan);
+        fw_put_kv64(stage_names[k], stage64[k]);
+    fw_put_kv64("scan", scan);
     fw_putc('\n');
-    put_s("pktinsn run=");
-    put_s(name);
-    put_kv64("decode_max", p->decode_max);
-    put_kv64("stream_max", g_seq.stream_max);
-    put_kv64("end", p->end);
-    put_kv64("counter", p->counter);
+    fw_put_s("pktinsn run=");
+    fw_put_s(name);
+    fw_put_kv64("decode_max", p->decode_max);
+    fw_put_kv64("stream_max", g_seq.stream_max);
+    fw_put_kv64("end", p->end);
+    fw_put_kv64("counter", p->counter);
     fw_putc('\n');
     return 0;
 }
@@ -440,10 +381,10 @@ static int run_once(const char *name, lidet_detector_q_cfg_t *cfg)
         st = lidet_velodyne_init(&g_vlp, &vc);
     if (st != LIDET_OK)
     {
-        put_s("init run=");
-        put_s(name);
-        put_s(" failed status=");
-        put_i((int32_t)st);
+        fw_put_s("init run=");
+        fw_put_s(name);
+        fw_put_s(" failed status=");
+        fw_put_i((int32_t)st);
         fw_putc('\n');
         return 1;
     }
@@ -510,43 +451,13 @@ static __attribute__((noinline)) int scan_digest(const char *name)
             h = fnv_return(h, &g_out[i]);
         n += open ? to - from : 0u;
     }
-    put_s("digest run=");
-    put_s(name);
-    put_kv("returns", n);
-    put_s(" fnv1a=");
-    put_hex(h);
+    fw_put_s("digest run=");
+    fw_put_s(name);
+    fw_put_kv("returns", n);
+    fw_put_s(" fnv1a=");
+    fw_put_hex(h);
     fw_putc('\n');
     return !done;
-}
-
-/* ---- the counter's calibration (fw_detect.c's) ----------------------------------------------------------- */
-
-static __attribute__((noinline)) uint32_t measure(uint32_t n)
-{
-    const uint32_t t0 = fw_clock(0);
-    fw_spin(n);
-    return fw_clock(0) - t0;
-}
-
-static int calibrate(void)
-{
-    static volatile uint32_t lens[4] = {1u, 1000u, 12345u, 1000000u}; /* volatile: no constant folding */
-    uint32_t base, k;
-    int bad = 0;
-    base = measure(lens[0]);
-    for (k = 1; k < 4u; ++k)
-    {
-        const uint32_t n = lens[k];
-        const uint32_t measured = measure(n) - base;
-        const uint32_t expected = fw_spin_insn(n) - fw_spin_insn(lens[0]);
-        put_s("calib");
-        put_kv("n", n);
-        put_kv("expected", expected);
-        put_kv("measured", measured);
-        fw_putc('\n');
-        bad |= measured != expected;
-    }
-    return bad;
 }
 
 int fw_main(void)
@@ -555,33 +466,33 @@ int fw_main(void)
     lidet_detector_q_cfg_t cfg;
     int bad = 0, c, j;
 
-    put_s("lidet-fw board=");
-    put_s(fw_board_name);
-    put_s(" core=");
-    put_s(fw_core_name);
-    put_s(" build=fixed app=packets sensor=" FW_SENSOR " models=" FW_MODELS "_s8 scan=");
-    put_s(fw_pkt_name);
-    put_kv("packets", fw_pkt_n);
-    put_kv("start_cdeg", fw_pkt_start_cdeg);
+    fw_put_s("lidet-fw board=");
+    fw_put_s(fw_board_name);
+    fw_put_s(" core=");
+    fw_put_s(fw_core_name);
+    fw_put_s(" build=fixed app=packets sensor=" FW_SENSOR " models=" FW_MODELS "_s8 scan=");
+    fw_put_s(fw_pkt_name);
+    fw_put_kv("packets", fw_pkt_n);
+    fw_put_kv("start_cdeg", fw_pkt_start_cdeg);
     fw_putc('\n');
-    put_s("mem");
-    put_kv("detector_bytes", lidet_detector_q_bytes());
-    put_kv("decoder_bytes", (uint32_t)sizeof g_vlp);
-    put_kv("buffer_bytes", (uint32_t)sizeof g_out);
-    put_kv("max_rows", LIDET_MAX_ROWS);
-    put_kv("max_cols", LIDET_MAX_COLS);
-    put_kv("max_points", LIDET_MAX_POINTS);
-    put_kv("max_clusters", LIDET_MAX_CLUSTERS);
-    put_kv("max_returns", LIDET_VELODYNE_MAX_RETURNS);
+    fw_put_s("mem");
+    fw_put_kv("detector_bytes", lidet_detector_q_bytes());
+    fw_put_kv("decoder_bytes", (uint32_t)sizeof g_vlp);
+    fw_put_kv("buffer_bytes", (uint32_t)sizeof g_out);
+    fw_put_kv("max_rows", LIDET_MAX_ROWS);
+    fw_put_kv("max_cols", LIDET_MAX_COLS);
+    fw_put_kv("max_points", LIDET_MAX_POINTS);
+    fw_put_kv("max_clusters", LIDET_MAX_CLUSTERS);
+    fw_put_kv("max_returns", LIDET_VELODYNE_MAX_RETURNS);
     fw_putc('\n');
     if (sensor == 0)
     {
-        put_s("lidet-fw: FAIL (no " FW_SENSOR " sensor profile)\n");
+        fw_put_s("lidet-fw: FAIL (no " FW_SENSOR " sensor profile)\n");
         return 1;
     }
-    if (fw_have_counter() && calibrate() != 0)
+    if (fw_have_counter() && fw_calibrate(0) != 0)
     {
-        put_s("lidet-fw: FAIL (instruction counter does not match the calibration loop)\n");
+        fw_put_s("lidet-fw: FAIL (instruction counter does not match the calibration loop)\n");
         return 1;
     }
     /* run 1: the configuration a user gets */
@@ -599,10 +510,10 @@ int fw_main(void)
     bad |= run_once("open", &cfg);
     bad |= scan_digest("default");
 
-    put_s("stack");
-    put_kv("used", fw_stack_used());
-    put_kv("size", fw_stack_size());
+    fw_put_s("stack");
+    fw_put_kv("used", fw_stack_used());
+    fw_put_kv("size", fw_stack_size());
     fw_putc('\n');
-    put_s(bad ? "lidet-fw: FAIL (a run failed)\n" : "lidet-fw: PASS\n");
+    fw_put_s(bad ? "lidet-fw: FAIL (a run failed)\n" : "lidet-fw: PASS\n");
     return bad;
 }

@@ -330,7 +330,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
 int cli_detect_q_dump(const char *path, uint32_t n_points, const uint32_t *point_cluster,
                       const uint8_t *point_ground);
 
-/* ---- packet captures: lidet detect --pcap, lidet track --pcap (cli_pcap.c, docs/DECODING.md) ---- */
+/* ---- packet captures: lidet detect --pcap, lidet track --pcap (cli_pcap.c, docs/CAPTURES.md) ---- */
 typedef struct
 {
     const char *path;  /* --pcap FILE (NULL: scans from files) */

@@ -2,7 +2,7 @@
 /* `lidet detect --pcap FILE`, `lidet track --pcap FILE`: a packet capture read with libpcap, the UDP datagrams to
  * the sensor's data port taken out of their Ethernet / IPv4 / UDP headers (every frame counted by kind), each payload
  * decoded (lidet_velodyne.h, lidet_ouster.h: one call per payload), and the decoder's returns gathered into scans
- * (docs/DECODING.md, "From a capture: lidet detect --pcap").
+ * (docs/CAPTURES.md, "From a capture: lidet detect --pcap").
  *
  * Two passes over the file: the first counts the frames, runs the decoder alone and lists the scans to run (and
  * learns the Velodyne model from the packets when --sensor is not given); the second decodes again and hands the

@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* `--velodyne-calib C` for every command (docs/SENSORS.md, "Velodyne calibration files"): a Velodyne unit from its
+/* `--velodyne-calib C` for every command (docs/VELODYNE_CALIBRATION.md): a Velodyne unit from its
  * factory calibration, Velodyne's db.xml / VeloView XML (boost-serialized <DB>: points_ / item / px, enabled_,
  * distLSB_; degrees and centimetres) read with libxml2, or velodyne_pointcloud's YAML (num_lasers, lasers,
  * distance_resolution; radians and metres) read with libyaml. The first character tells them apart ('<': XML).
@@ -392,7 +392,7 @@ static int read_xml_doc(const xmlNode *db, vel_lasers_t *L, unsigned char *enabl
             if (!(v[t] > -lim[t] && v[t] < lim[t]))
                 return bad(err, "%s: %g deg is outside (%g, %g)", f, v[t], -lim[t], lim[t]);
         }
-        for (t = 0; t < N_OPTIONAL; ++t) /* read and validated, not used (docs/SENSORS.md) */
+        for (t = 0; t < N_OPTIONAL; ++t) /* read and validated, not used (docs/VELODYNE_CALIBRATION.md) */
         {
             snprintf(f, sizeof f, "%s.%s", w, k_xml_optional[t]);
             if (xml_child(px, k_xml_optional[t], f, &el, err) != 0)
@@ -900,7 +900,7 @@ static int read_yaml_tree(const ynode_t *root, vel_lasers_t *L, char *err)
             if (!(d > -lim[t] && d < lim[t]))
                 return bad(err, "%s: %g rad (%g deg) is outside (%g, %g) deg", f, val[t], d, -lim[t], lim[t]);
         }
-        for (t = 0; t < N_OPTIONAL; ++t) /* read and validated, not used (docs/SENSORS.md) */
+        for (t = 0; t < N_OPTIONAL; ++t) /* read and validated, not used (docs/VELODYNE_CALIBRATION.md) */
         {
             snprintf(f, sizeof f, "%s.%s", w, k_yaml_optional[t]);
             v = y_get(las, k_yaml_optional[t]);

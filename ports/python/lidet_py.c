@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Flat C entry points for the Python bindings (tools/lidet_tools/native.py, ctypes).
+/* Flat C entry points for the Python bindings (tools/lidet_tools/native/, ctypes).
  *
  * Every call works on an explicit scan context (lidet_py_ctx_new): the stages' states of one scan,
  * allocated on the host heap (this is a host port, not lib/). Nothing is global, so a call on one
@@ -127,7 +127,7 @@ static const py_field_t k_fields[] = {
     FLD(lidet_cluster_stats_t, n_regrow_parts, 'u'),
     FLD(lidet_proposal_cfg_t, n_points, 'u'), FLD(lidet_proposal_cfg_t, seed, 'u'),
     FLD(lidet_proposal_cfg_t, azimuth_bin_rad, 'f'), FLD(lidet_proposal_cfg_t, elevation_bin_rad, 'f'),
-    FLD(lidet_proposal_cfg_t, range_bin_m, 'f'),
+    FLD(lidet_proposal_cfg_t, range_bin_m, 'f'), FLD(lidet_proposal_cfg_t, z_origin, 'u'),
 };
 
 typedef struct

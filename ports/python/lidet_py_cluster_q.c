@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* Flat C entry points over the integer clustering and proposals (lidet_cluster_q.h) for the Python bindings
- * (tools/lidet_tools/native_q.py: compact_scan, cluster_q, cluster_f_compact): a scan projected into a compact
- * image with the float ground stage on it (what the integer clustering reads until the integer projection and
- * ground land), the integer clustering on it, and the float clustering on the same image (the agreement tests
+ * (tools/lidet_tools/native/_cluster.py: compact_scan, cluster_q, cluster_f_compact): a scan projected into a
+ * compact image with the float ground stage on it (what the integer clustering reads until the integer projection
+ * and ground land), the integer clustering on it, and the float clustering on the same image (the agreement tests
  * and tools/bench/bench_cluster.py). Each call allocates its states on the heap and frees them. */
 #include <stdlib.h>
 #include <string.h>

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Flat C entry point over the integer detector (lidet_detector_q.h) for the Python bindings
- * (tools/lidet_tools/native_q.py: detect_q). Host only: one static detector (not reentrant); each call
+ * (tools/lidet_tools/native/_detector.py: detect_q). Host only: one static detector (not reentrant); each call
  * initialises it. */
 #include <string.h>
 

@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
-/* Flat C entry points of the integer ground stage for the Python bindings (tools/lidet_tools/native_q.py,
- * section "ground"): a compact image from a context's projection (as a detector workspace makes it), the
- * integer stage and the float stage on that same image, and their host timing. Host only (heap). */
+/* Flat C entry points of the integer ground stage for the Python bindings (tools/lidet_tools/native/_ground.py;
+ * project_compact in tools/lidet_tools/native/_proj.py): a compact image from a context's projection (as a
+ * detector workspace makes it), the integer stage and the float stage on that same image, and their host timing.
+ * Host only (heap). */
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>

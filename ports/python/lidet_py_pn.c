@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Flat C entry points over the PointNet forward pass for the Python bindings (tools/lidet_tools/native.py):
+/* Flat C entry points over the PointNet forward pass for the Python bindings (tools/lidet_tools/native/_pointnet.py):
  * the models of lidet::weights by index, batches of proposals looped in C. Host only: one static
  * scratch buffer, so calls are not reentrant. */
 #include <string.h>

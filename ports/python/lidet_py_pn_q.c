@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Flat C entry points over the int8 PointNets (lidet_pointnet_q.h) for the Python bindings
- * (tools/lidet_tools/native_q.py, section "int8 PointNets"): the int8 models of lidet::weights by index,
+ * (tools/lidet_tools/native/_pointnet.py, section "int8"): the int8 models of lidet::weights by index,
  * batches of integer proposals looped in C. Host only: one static scratch, not reentrant. */
 #include <string.h>
 #include <time.h>

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Flat C entry points over the integer post-processing (lidet_detector_q.h) and the float BEV IoU, for
- * tests/python/test_post_q.py (through tools/lidet_tools/native_q.py). */
+ * tests/python/test_post_q.py (through tools/lidet_tools/native/_detector.py). */
 #include <stddef.h>
 
 #include "lidet/lidet.h"

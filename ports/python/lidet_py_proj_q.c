@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Flat C entry points over the integer projection and the integer sensor presets for the Python bindings
- * (tools/lidet_tools/native_q.py: sensor_q, project_q); tests compare them with codegen/lidet_ref/proj_q.py. */
+ * (tools/lidet_tools/native/_proj.py: sensors_q, project_q); tests compare them with codegen/lidet_ref/proj_q.py. */
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>

@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* Flat C entry points over the integer math of the fixed-point path for the Python bindings
- * (tools/lidet_tools/native.py: qmath); tests compare them with codegen/lidet_ref/qmath.py. */
+ * (tools/lidet_tools/native/_qmath.py: qmath); tests compare them with codegen/lidet_ref/qmath.py. */
 #include <stddef.h>
 
 #include "lidet/lidet.h"

@@ -239,3 +239,28 @@ def test_proposals_match_reference(real_dir):
         if small.any():
             j = int(np.nonzero(small)[0][0])
             assert np.all(np.abs(p.xyz[j, :c.n_points[j]].mean(0)) < 1e-3)
+
+
+def test_proposals_from_the_ground_match_reference(need_lib):
+    """z_origin LIDET_PROPOSAL_Z_GROUND: z measured from the ground under the cluster mean (the mean's z minus its
+    height above the plane), bit for bit as lidet_ref.cluster.make_proposal; x, y and the voxel as the mean's origin."""
+    from lidet_tools.sim import simulate_scan
+    pts = simulate_scan("hdl64", 16, 0).points
+    gr = native.ground(pts, "hdl64")
+    c = native.cluster(pts, "hdl64", ground=gr.mask_point, planes=gr.planes, with_image=True)
+    assert len(c) > 10
+    a = native.proposals(c, n_points=64)
+    b = native.proposals(c, n_points=64, z_origin=1)
+    xyz = np.stack([c.image.x, c.image.y, c.image.z], -1).reshape(-1, 3)
+    for i in range(len(c)):
+        m = c.members[c.first_member[i]:c.first_member[i] + c.n_points[i]]
+        rx, rmean, rvox = ref.make_proposal(xyz[m], c.mean[i], n_points=64, height_m=c.height[i])
+        np.testing.assert_array_equal(b.xyz[i], rx)
+        np.testing.assert_array_equal(b.mean[i], rmean)
+    np.testing.assert_array_equal(a.voxel, b.voxel)
+    np.testing.assert_array_equal(a.xyz[..., :2], b.xyz[..., :2])
+    np.testing.assert_allclose(b.mean[:, 2], c.mean[:, 2] - c.height, atol=1e-6)
+    # upright objects standing on the road start near z = 0 in the ground frame
+    assert np.median(b.xyz[:, :, 2].min(1)) < 0.5
+    with pytest.raises(native.LidetError):
+        native.proposals(c, n_points=64, z_origin=2)

@@ -128,11 +128,12 @@ def test_defaults_and_stats_come_from_c():
 def test_pixel_models_rewrite_the_image_as_stored():
     """The measurement hook of docs/journal/memory.md ("What a compact pixel would cost"): an image decoded from
     another pixel storage."""
+    from lidet_tools.native._proj import _project_into  # projects on a given context (project() makes its own)
     pts, _ = _scene(6, (10.0, 0.0, -0.9), (8.0, 4.0, -0.85))
     ref_img = native.project(pts, "vlp16")
     ctx = native.ScanContext("s16", 0.004)
     s, ctx = native.proj_init("vlp16", ctx=ctx)
-    q = native._project_into(ctx, s, pts)
+    q = _project_into(ctx, s, pts)
     v = ref_img.valid
     np.testing.assert_array_equal(q.valid, v)
     for a, b in ((q.x, ref_img.x), (q.y, ref_img.y), (q.z, ref_img.z), (q.range, ref_img.range)):
@@ -141,7 +142,7 @@ def test_pixel_models_rewrite_the_image_as_stored():
         assert np.max(np.abs(k - np.round(k))) < 1e-2  # multiples of 4 mm
     ctx = native.ScanContext("recompute")
     s, ctx = native.proj_init("vlp16", ctx=ctx)
-    r = native._project_into(ctx, s, pts)
+    r = _project_into(ctx, s, pts)
     np.testing.assert_array_equal(r.range, ref_img.range)
     el = np.arcsin(np.clip(r.z / np.where(v, r.range, 1), -1, 1))
     rows = np.broadcast_to(r.row_elev[:, None], r.shape)

@@ -204,17 +204,17 @@ def test_range_only_option_is_the_firmware_pixel(cli, tmp_path):
     """--fixed --range-only: the integer detector with the range-only pixel (lidet_detector_q_cfg_t.range_only),
     the integer firmware's; its detections are those of the bindings with range_only=True, bit for bit, and
     differ from the stored pixel's. Without --fixed the option is refused with a message."""
-    from lidet_tools import native_q
+    from lidet_tools import native
     scan = ROOT / "tests" / "data" / "sim_vlp16" / "velodyne" / "000000.bin"
     out = tmp_path / "ro.txt"
     js = json.loads(_run(cli, scan, "--sensor", "vlp16", "--model", "vlp16s", "--fixed", "--range-only", "--json",
                          "--out", out).stdout)
-    q = native_q.detect_q(native_q.to_mm(kitti.read_bin(scan)), "vlp16", model="vlp16s", range_only=True)
+    q = native.detect_q(native.to_mm(kitti.read_bin(scan)), "vlp16", model="vlp16s", range_only=True)
     assert js["detections"] == len(q["cls"]) > 0
     got = np.loadtxt(out, usecols=range(1, 8), ndmin=2)
     np.testing.assert_allclose(got[:, :6], q["boxes"][:, :6] / 1000.0, atol=1e-3)
     stored = json.loads(_run(cli, scan, "--sensor", "vlp16", "--model", "vlp16s", "--fixed", "--json").stdout)
-    qs = native_q.detect_q(native_q.to_mm(kitti.read_bin(scan)), "vlp16", model="vlp16s", range_only=False)
+    qs = native.detect_q(native.to_mm(kitti.read_bin(scan)), "vlp16", model="vlp16s", range_only=False)
     assert stored["detections"] == len(qs["cls"])
     assert [b["x"] for b in stored["boxes"]] != [b["x"] for b in js["boxes"]]
     r = _run(cli, scan, "--sensor", "vlp16", "--range-only", ok=False)
@@ -226,14 +226,14 @@ def test_returns_option_feeds_the_sensors_returns(cli, tmp_path):
     lidet_detector_q_run_returns, the integer firmware's way in; the detections are those of the bindings on the
     returns of ref.proj_q.returns_of_points. Without --fixed, or without the rings, the option is refused."""
     from lidet_ref import proj_q
-    from lidet_tools import native_q
+    from lidet_tools import native
     sim = ROOT / "tests" / "data" / "sim_vlp16"
     scan, ring = sim / "velodyne" / "000000.bin", sim / "ring" / "000000.bin"
     out = tmp_path / "ret.txt"
     js = json.loads(_run(cli, scan, "--sensor", "vlp16", "--model", "vlp16s", "--fixed", "--range-only", "--ring", ring,
                          "--returns", "--json", "--out", out).stdout)
-    rets = proj_q.returns_of_points(native_q.to_mm(kitti.read_bin(scan)), np.fromfile(ring, np.uint16))
-    q = native_q.detect_q(None, "vlp16", model="vlp16s", range_only=True, returns=native_q.as_returns(*rets))
+    rets = proj_q.returns_of_points(native.to_mm(kitti.read_bin(scan)), np.fromfile(ring, np.uint16))
+    q = native.detect_q(None, "vlp16", model="vlp16s", range_only=True, returns=native.as_returns(*rets))
     assert js["detections"] == len(q["cls"]) > 0
     got = np.loadtxt(out, usecols=range(1, 8), ndmin=2)
     np.testing.assert_allclose(got[:, :6], q["boxes"][:, :6] / 1000.0, atol=1e-3)

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""`lidet detect --pcap FILE` and `lidet track --pcap FILE` (ports/host/cli_pcap.c; docs/DECODING.md, "From a capture:
+"""`lidet detect --pcap FILE` and `lidet track --pcap FILE` (ports/host/cli_pcap.c; docs/CAPTURES.md, "From a capture:
 lidet detect --pcap"): a packet capture read with libpcap, the UDP datagrams to the Velodyne data port decoded
 (lib/src/decode/lidet_velodyne.c), the detector run on every complete rotation.
 
@@ -9,7 +9,7 @@ synthetic VLP-16 packets (lidet_tools.velodyne.vlp16_packets) turning over the s
 fragment, a frame the capture cut short, one whose IPv4 length is wrong, a VLAN tag, two payloads the decoder
 rejects); the payloads' clock is 2.654 ms a packet (a rotation in 0.2 s) and wraps at the hour inside the capture,
 the capture's own timestamps are 1 ms apart. On it: per complete rotation the boxes are those of the bindings on the
-same decoded returns (--fixed: native_q.detect_q(returns=...); float: `lidet detect` on their x, y, z with their
+same decoded returns (--fixed: native.detect_q(returns=...); float: `lidet detect` on their x, y, z with their
 rings); `lidet track --pcap --fixed` is the integer detector + tracker with dt from the payloads' timestamps; the
 counts of the summary; outputs (--out DIR, --json, --png); link types; a scan past LIDET_MAX_POINTS; random frames;
 bad files. The real captures of ../shared/data/packets/velodyne (skipped when absent) decode into the expected
@@ -177,9 +177,9 @@ class Capture:
         self.last_payload = {s: int(ev[s]) for s in range(len(kinds) - 1)}
 
     def returns(self, s):
-        from lidet_tools import native_q
+        from lidet_tools import native
         sel = self.d.scan == s
-        return native_q.as_returns(self.d.range_mm[sel], self.d.azimuth[sel], self.d.ring[sel])
+        return native.as_returns(self.d.range_mm[sel], self.d.azimuth[sel], self.d.ring[sel])
 
     def scan_time_us(self, s):
         return int(self.times_us[self.first_payload[s]])
@@ -209,9 +209,9 @@ def test_summary_counts_every_frame(pcli, cap):
 
 def test_fixed_is_the_bindings_on_the_same_returns(pcli, cap):
     """--fixed: per complete rotation the integer detector on the decoder's returns as they are: the detections of
-    native_q.detect_q(returns=...) on the bindings' decoding of the same payloads; the header's returns and packets
+    native.detect_q(returns=...) on the bindings' decoding of the same payloads; the header's returns and packets
     (frames of the file) are the decoding's."""
-    from lidet_tools import native_q
+    from lidet_tools import native
     scans = _scans(_run(pcli, "detect", "--pcap", cap.path, "--fixed").stdout)
     n_boxes = 0
     for k, s in enumerate(cap.complete):
@@ -219,7 +219,7 @@ def test_fixed_is_the_bindings_on_the_same_returns(pcli, cap):
         rets = cap.returns(s)
         assert got["k"] == k and got["kind"] == "complete" and got["returns"] == len(rets)
         assert got["first"] == cap.frame_of[cap.first_payload[s]] and got["last"] == cap.frame_of[cap.last_payload[s]]
-        q = native_q.detect_q(None, "vlp16", returns=rets)
+        q = native.detect_q(None, "vlp16", returns=rets)
         assert got["n_det"] == len(q["cls"])
         assert list(got["cls"]) == [int(c) for c in q["cls"]]
         np.testing.assert_allclose(got["boxes"][:, :6], q["boxes"][:, :6] / 1000.0, rtol=0, atol=6e-5)
@@ -299,7 +299,7 @@ def test_track_fixed_is_the_integer_pipeline(pcli, cap):
     capture's 1 ms stamps nor the default 10 Hz), no ego motion: the Python pipeline's lines; the scene moving
     +0.4 m a rotation gives about +2 m/s."""
     from lidet_ref import track_q as ref
-    from lidet_tools import native_q
+    from lidet_tools import native
     try:
         from lidet_tools.track.native_q import TrackerQ
         tq = TrackerQ()
@@ -311,7 +311,7 @@ def test_track_fixed_is_the_integer_pipeline(pcli, cap):
     assert all(abs(x - 0.19905) < 1e-6 for x in dt)
     want = []
     for k, s in enumerate(cap.complete):
-        q = native_q.detect_q(None, "vlp16", returns=cap.returns(s))
+        q = native.detect_q(None, "vlp16", returns=cap.returns(s))
         rows = np.column_stack([q["cls"], q["boxes"], q["score_q15"]])
         for tr in ref.tracks_to_si(tq.update_q(rows, ref.quantise_dt(dt[k]), None)):
             want.append((k, int(tr["id"]), CLASSES[tr["cls"]], tuple(float(tr[f]) for f in

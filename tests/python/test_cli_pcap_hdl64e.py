@@ -1,11 +1,11 @@
 # SPDX-License-Identifier: MIT
 """`lidet detect / track --pcap` on HDL-64E captures and with a unit's calibration (ports/host/cli_pcap.c,
-cli_velodyne_calib.c; docs/DECODING.md, "From a capture"): no real HDL-64E capture is available, so the capture is
+cli_velodyne_calib.c; docs/CAPTURES.md, "From a capture"): no real HDL-64E capture is available, so the capture is
 written here: lidet_tools.velodyne.hdl64e_packets turning 0.18 deg a firing over the simulated HDL-64 scan of
 tests/data/sim_hdl64 (moved 0.3 m a rotation), with a position packet and an ARP frame between.
 
 - `--sensor hdl64` and AUTO (the payloads' 0xDDFF flags) decode it into the hdl64 preset, rings from the top: per
-  complete rotation `--fixed` gives native_q.detect_q(returns=...) on the bindings' decoding (velodyne.decode with
+  complete rotation `--fixed` gives native.detect_q(returns=...) on the bindings' decoding (velodyne.decode with
   ring_top_first), the float run the x, y, z and rings of that decoding (--save-scans, bit for bit) and the lines of
   `lidet detect` on them; `lidet track --pcap` runs the same rotations.
 - `--velodyne-calib C --sensor hdl64` (a YAML and the same unit as db.xml, written here: rotational and distance
@@ -202,9 +202,9 @@ class H64:
 
     @staticmethod
     def returns(d, s):
-        from lidet_tools import native_q
+        from lidet_tools import native
         sel = d.scan == s
-        return native_q.as_returns(d.range_mm[sel], d.azimuth[sel], d.ring[sel])
+        return native.as_returns(d.range_mm[sel], d.azimuth[sel], d.ring[sel])
 
 
 @pytest.fixture(scope="module")
@@ -221,9 +221,9 @@ def _saved(folder, k):
 
 def test_hdl64e_fixed_is_the_bindings(pcli, h64):
     """--fixed: per complete rotation the integer detector with the hdl64 preset on the decoder's returns, rings from
-    the top: native_q.detect_q(returns=...) on velodyne.decode(ring_top_first=True) of the same payloads; AUTO (no
+    the top: native.detect_q(returns=...) on velodyne.decode(ring_top_first=True) of the same payloads; AUTO (no
     --sensor: the 0xDDFF flags) gives the same lines and the same summary."""
-    from lidet_tools import native_q
+    from lidet_tools import native
     r = _run(pcli, "detect", "--pcap", h64.path, "--sensor", "hdl64", "--fixed")
     assert _decoder_line(r.stderr) == ("hdl64", "single return", N_PK, 0)
     assert re.search(rf"scans: {N_ROT} complete; skipped: 1 partial", r.stderr)
@@ -233,7 +233,7 @@ def test_hdl64e_fixed_is_the_bindings(pcli, h64):
     for k, s in enumerate(h64.complete):
         rets = h64.returns(h64.d, s)
         assert scans[k]["returns"] == len(rets)
-        q = native_q.detect_q(None, "hdl64", returns=rets)
+        q = native.detect_q(None, "hdl64", returns=rets)
         assert scans[k]["cls"] == [int(c) for c in q["cls"]]
         np.testing.assert_allclose(scans[k]["boxes"][:, :6], q["boxes"][:, :6] / 1000.0, rtol=0, atol=6e-5)
         np.testing.assert_allclose(scans[k]["boxes"][:, 7], q["score_q15"] / 32768.0, rtol=0, atol=6e-5)

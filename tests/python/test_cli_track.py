@@ -3,7 +3,7 @@
 
 Its track lines are those of the Python pipeline on the same scans (lidet_tools.native.detect, then
 lidet_tools.track.Tracker with the same dt and ego motion), its --fixed lines those of the integer detector
-(native_q.detect_q) and the integer tracker (track.native_q.TrackerQ); a scene that moves at a known speed gets
+(native.detect_q) and the integer tracker (track.native_q.TrackerQ); a scene that moves at a known speed gets
 that velocity; --out writes the same lines, lidet-eval track's prediction files and KITTI tracking labels; the
 picture is deterministic; bad inputs are clear errors. Sequences: one scene moved by hand (the simulated HDL-64
 scan as a sensor driving at 5 m/s, straight or turning) and, where the sequence simulator is there, a simulated
@@ -206,17 +206,17 @@ def _tracker_q():
 
 @pytest.mark.parametrize("which", ["turning", "simseq"])
 def test_fixed_is_the_integer_tracker(cli, need_lib, request, which):
-    """--fixed: the integer detector's detections (native_q.detect_q, as lidet detect --fixed) into the integer
+    """--fixed: the integer detector's detections (native.detect_q, as lidet detect --fixed) into the integer
     tracker with dt in ms and the ego motion in mm / BAM32 (ref.track_q.quantise_dt, quantise_ego)."""
     from lidet_ref import track_q as ref
-    from lidet_tools import native_q
+    from lidet_tools import native
     seq = request.getfixturevalue(which)
     sensor = "hdl64" if which == "turning" else "vlp16"
     tq = _tracker_q()
     P = _poses(seq)
     frames = []
     for k, scan in enumerate(sorted((seq / "velodyne").glob("*.bin"))):
-        d = native_q.detect_q(native_q.to_mm(kitti.read_bin(scan)), sensor)
+        d = native.detect_q(native.to_mm(kitti.read_bin(scan)), sensor)
         rows = np.column_stack([d["cls"], d["boxes"], d["score_q15"]])
         ego = ref.quantise_ego(P[k, 5:8]) if k else None
         frames.append(ref.tracks_to_si(tq.update_q(rows, ref.quantise_dt(_dt(P, k)), ego)))

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from lidet_ref import cluster_q as ref
-from lidet_tools import native, native_q
+from lidet_tools import native
 from lidet_tools.sim import simulate_scan
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -51,10 +51,10 @@ def _recs_equal(recs, c) -> bool:
 
 
 def _check_bit_exact(sensor, pts, planes=True, ground=True, **cfg):
-    scan = native_q.compact_scan(pts, sensor)
-    pq = native_q.planes_to_q(scan.planes) if planes else None
-    c = native_q.cluster_q(scan, pq, use_ground=ground, **cfg)
-    dc, dp = native_q.cluster_q_defaults(sensor)
+    scan = native.compact_scan(pts, sensor)
+    pq = native.planes_to_q(scan.planes) if planes else None
+    c = native.cluster_q(scan, pq, use_ground=ground, **cfg)
+    dc, dp = native.cluster_q_defaults(sensor)
     dc.update(cfg)
     lab, mem, recs, st = ref.cluster_q_ref(scan.x, scan.y, scan.z, scan.range, scan.row_elev_bam,
                                            scan.ground if ground else None, pq, dc,
@@ -73,7 +73,7 @@ def _check_bit_exact(sensor, pts, planes=True, ground=True, **cfg):
 def test_defaults_are_the_float_defaults_rounded(need_lib):
     for s in ("hdl64", "vlp16"):
         f = native.cluster_defaults(s)
-        q, p = native_q.cluster_q_defaults(s)
+        q, p = native.cluster_q_defaults(s)
         assert q["theta_urad"] == round(f["theta_rad"] * 1e6)
         assert q["max_gap_mm"] == round(f["max_gap_m"] * 1e3)
         assert q["max_gap_per_m_q16"] == round(f["max_gap_per_m"] * 65536)
@@ -122,23 +122,23 @@ def test_bit_exact_regrowth(sim_scans):
     assert on.stats["n_regrown"] > 5 and on.stats["n_regrow_parts"] > on.stats["n_regrown"]
     off = _check_bit_exact(sensor, pts, max_extent_mm=2500, regrow_gap_mm=0)
     assert off.stats["n_regrown"] == 0 and len(off) < len(on)
-    assert native_q.cluster_q_defaults("vlp16")[0]["regrow_gap_mm"] == 0  # off on 16 beams (measured above 16 only)
+    assert native.cluster_q_defaults("vlp16")[0]["regrow_gap_mm"] == 0  # off on 16 beams (measured above 16 only)
 
 
 def test_bit_exact_far_planes(sim_scans):
     """plane_split_mm: the planes hold the near planes then the far ones, and a mean beyond the split takes its
     sector's far plane (here the near planes lowered by 0.5 m: such heights grow by exactly 125 steps of 4 mm)."""
     sensor, pts = sim_scans[0]
-    scan = native_q.compact_scan(pts, sensor)
-    near = native_q.planes_to_q(scan.planes)
+    scan = native.compact_scan(pts, sensor)
+    near = native.planes_to_q(scan.planes)
     far = near.copy()
     far[:, 3] += 125
     both = np.concatenate([near, far])
-    dc, dp = native_q.cluster_q_defaults(sensor)
+    dc, dp = native.cluster_q_defaults(sensor)
     dc["plane_split_mm"] = 15000
     lab, mem, recs, st = ref.cluster_q_ref(scan.x, scan.y, scan.z, scan.range, scan.row_elev_bam, scan.ground, both,
                                            dc, native.capacity()["max_clusters"])
-    c = native_q.cluster_q(scan, both, plane_split_mm=15000)
+    c = native.cluster_q(scan, both, plane_split_mm=15000)
     assert np.array_equal(lab, c.labels) and st == c.stats and _recs_equal(recs, c)
     cols, ns = scan.shape[1], len(near)
 
@@ -150,7 +150,7 @@ def test_bit_exact_far_planes(sim_scans):
     for s, m, h, f in zip(c.seed_pixel, c.mean, c.height, is_far):
         assert int(h) == height(s, m, far if f else near)
     with pytest.raises(ValueError):
-        native_q.cluster_q(scan, both[:-1], plane_split_mm=15000)
+        native.cluster_q(scan, both[:-1], plane_split_mm=15000)
 
 
 def test_bit_exact_other_paths(sim_scans):
@@ -261,9 +261,9 @@ def agreement(scans) -> dict:
     pairs = same_members = same_vox = 0
     max_dev = 0.0
     for sensor, pts in scans:
-        scan = native_q.compact_scan(pts, sensor)
-        cq = native_q.cluster_q(scan, native_q.planes_to_q(scan.planes))
-        cf = native_q.cluster_f_compact(scan, scan.planes)
+        scan = native.compact_scan(pts, sensor)
+        cq = native.cluster_q(scan, native.planes_to_q(scan.planes))
+        cf = native.cluster_f_compact(scan, scan.planes)
         pp = scan.point_pixel
         keep = (pp >= 0)
         keep[keep] = scan.ground.ravel()[pp[keep]] == 0
@@ -326,28 +326,28 @@ def test_agreement_with_float_real(real_dir, need_lib):
 
 def test_bad_config_refused(sim_scans):
     sensor, pts = sim_scans[1]
-    scan = native_q.compact_scan(pts, sensor)
+    scan = native.compact_scan(pts, sensor)
     for bad in (dict(theta_urad=0), dict(max_steps=17), dict(min_points=0), dict(max_extent_mm=0),
                 dict(rescue_gap_per_m_q16=16385), dict(rescue_cols=16), dict(split_people=2), dict(split_cell_mm=0),
                 dict(car_max_width_mm=0), dict(max_bridge_per_pixel_q16=(64 << 16) + 1), dict(regrow_gap_mm=100001),
                 dict(regrow_max_height_mm=0), dict(plane_split_mm=500001)):
         with pytest.raises(native.LidetError):
-            native_q.cluster_q(scan, **bad)
+            native.cluster_q(scan, **bad)
     with pytest.raises(native.LidetError):
-        native_q.cluster_q(scan, proposal_cfg=dict(range_bin_4mm=0))
+        native.cluster_q(scan, proposal_cfg=dict(range_bin_4mm=0))
     with pytest.raises(TypeError):
-        native_q.cluster_q(scan, theta_rad=1)
+        native.cluster_q(scan, theta_rad=1)
 
 
 def _integer_chain_scan(sensor, pts):
     """The integer projection's compact image of the scan (points rounded to mm), with the float ground stage's
     mask and planes of the float projection of the same scan (the integer ground stage is not there yet)."""
-    s = native_q.compact_scan(pts, sensor)
-    pq = native_q.project_q(np.round(pts[:, :3].astype(np.float64) * 1000).astype(np.int32), sensor)
+    s = native.compact_scan(pts, sensor)
+    pq = native.project_q(np.round(pts[:, :3].astype(np.float64) * 1000).astype(np.int32), sensor)
     rows, cols = s.shape
-    return native_q.CompactScan(s.sensor, pq["x_4mm"].reshape(rows, cols), pq["y_4mm"].reshape(rows, cols),
-                                pq["z_4mm"].reshape(rows, cols), pq["range_4mm"].reshape(rows, cols),
-                                pq["row_elev_bam"], s.row_elev_rad, pq["point_pixel"], s.ground, s.planes), s
+    return native.CompactScan(s.sensor, pq["x_4mm"].reshape(rows, cols), pq["y_4mm"].reshape(rows, cols),
+                              pq["z_4mm"].reshape(rows, cols), pq["range_4mm"].reshape(rows, cols),
+                              pq["row_elev_bam"], s.row_elev_rad, pq["point_pixel"], s.ground, s.planes), s
 
 
 def _on_integer_projection(scans, what):
@@ -357,12 +357,12 @@ def _on_integer_projection(scans, what):
     n = qf = fq = 0.0
     for sensor, pts in scans:
         scan_q, scan_f = _integer_chain_scan(sensor, pts)
-        c = native_q.cluster_q(scan_q, native_q.planes_to_q(scan_q.planes))
-        dc, _ = native_q.cluster_q_defaults(sensor)
+        c = native.cluster_q(scan_q, native.planes_to_q(scan_q.planes))
+        dc, _ = native.cluster_q_defaults(sensor)
         lab, mem, recs, st = ref.cluster_q_ref(scan_q.x, scan_q.y, scan_q.z, scan_q.range, scan_q.row_elev_bam,
-                                               scan_q.ground, native_q.planes_to_q(scan_q.planes), dc)
+                                               scan_q.ground, native.planes_to_q(scan_q.planes), dc)
         assert np.array_equal(lab, c.labels) and np.array_equal(mem, c.members) and st == c.stats
-        f = native_q.cluster_f_compact(scan_f, scan_f.planes)
+        f = native.cluster_f_compact(scan_f, scan_f.planes)
         ppq, ppf = scan_q.point_pixel, scan_f.point_pixel
         keep = (ppq >= 0) & (ppf >= 0)
         keep[keep] = scan_f.ground.ravel()[ppf[keep]] == 0
@@ -380,3 +380,25 @@ def test_on_integer_projection_simulated(sim_scans):
 
 def test_on_integer_projection_real(real_dir, need_lib):
     _on_integer_projection(_real_scans(real_dir), "real")
+
+
+def test_proposals_from_the_ground_bit_exact(sim_scans):
+    """lidet_proposal_q_make with z_origin LIDET_PROPOSAL_Z_GROUND against lidet_ref, and against the mean's origin:
+    the same x, y and voxels, z shifted up by each record's height (4 mm steps)."""
+    sensor, pts = sim_scans[0]
+    scan = native.compact_scan(pts, sensor)
+    pq = native.planes_to_q(scan.planes)
+    a = native.cluster_q(scan, pq)
+    b = native.cluster_q(scan, pq, proposal_cfg=dict(z_origin=1))
+    dc, dp = native.cluster_q_defaults(sensor)
+    lab, mem, recs, st = ref.cluster_q_ref(scan.x, scan.y, scan.z, scan.range, scan.row_elev_bam, scan.ground, pq, dc,
+                                           native.capacity()["max_clusters"])
+    assert len(recs) > 10
+    for i, r in enumerate(recs):
+        xyz, mean, vox = ref.make_proposal_q(r, mem, scan.x, scan.y, scan.z, dict(dp, z_origin=1))
+        assert np.array_equal(xyz, b.prop_xyz[i]) and np.array_equal(mean, b.prop_mean[i])
+        assert np.array_equal(b.prop_voxel[i], a.prop_voxel[i])
+        assert mean[2] == r.mean[2] - r.height
+    assert np.array_equal(a.prop_xyz[..., :2], b.prop_xyz[..., :2])
+    with pytest.raises(native.LidetError):
+        native.cluster_q(scan, pq, proposal_cfg=dict(z_origin=2))

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 """Every file, function, option and command the docs name still exists (issue 39, item 4).
 
-Reads README.md, docs/*.md, docs/journal/*.md and every other README.md of the repository (outside build*/,
+Reads README.md, docs/*.md, docs/journal/*.md, docs/benchmarks/*.md and every other README.md of the repository (outside build*/,
 data/, out/, third_party/ and hidden folders such as .venv/) and checks code spans (`...`), code blocks (fenced
 or indented), links and, for the first two rules, the plain text:
 
@@ -116,7 +116,7 @@ class Tree:
 
 def _doc_files(tree):
     docs = ["README.md", "lib/src/README.md"]
-    docs += sorted(f for f in tree.files if re.fullmatch(r"docs/(journal/)?[^/]+\.md", f))
+    docs += sorted(f for f in tree.files if re.fullmatch(r"docs/(journal/|benchmarks/)?[^/]+\.md", f))
     for f in tree.files:  # every other README.md outside outputs, data and vendored code
         parts = f.split("/")
         if parts[-1] == "README.md" and len(parts) > 1 and not _skipped_top(parts[0]) \

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from lidet_ref import ground_q as gq
-from lidet_tools import ground_eval, kitti, native, native_q
+from lidet_tools import ground_eval, kitti, native
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 pytestmark = pytest.mark.usefixtures("need_lib")
@@ -49,9 +49,9 @@ def _real_scans(real_dir):
 
 
 def _bit_exact(sensor, pts, **over):
-    img = native_q.project_compact(pts, sensor)
-    res = native_q.ground_q(img, sensor, **over)
-    cfg = native_q.ground_q_defaults(sensor)
+    img = native.project_compact(pts, sensor)
+    res = native.ground_q(img, sensor, **over)
+    cfg = native.ground_q_defaults(sensor)
     cfg.update(over)
     mask, smp, planes, d, src, stats = gq.ground(img.x, img.y, img.z, cfg)
     assert np.array_equal(smp, res.sample), "sample masks differ"
@@ -81,13 +81,13 @@ def test_pixel_r_is_the_exact_rounded_root():
         return r + (w - r * r > r)
 
     want = np.fromiter((exact(x) for x in v), np.int64, len(v))
-    np.testing.assert_array_equal(native_q.qmath("ground_r", v), want)
+    np.testing.assert_array_equal(native.qmath("ground_r", v), want)
 
 
 def test_defaults_are_the_float_defaults_rounded():
     for sensor in ("hdl64", "vlp16", "os1-64", "vlp32c"):
         f = native.ground_defaults(sensor)
-        q = native_q.ground_q_defaults(sensor)
+        q = native.ground_q_defaults(sensor)
         assert q["fy_max_q16"] == round(f["fy_max"] * 65536)
         assert q["confidence_q16"] == round(f["confidence"] * 65536)
         assert q["below_factor_q16"] == round(f["below_factor"] * 65536)
@@ -104,12 +104,12 @@ def test_defaults_are_the_float_defaults_rounded():
 
 
 def test_bad_config_refused():
-    img = native_q.project_compact(_sample_scans()[0][1], "hdl64")
+    img = native.project_compact(_sample_scans()[0][1], "hdl64")
     for k, v in (("fx_max_mm", 0), ("inlier_mm", 0), ("max_tilt_urad", 1570797), ("confidence_q16", 65536),
                  ("fallback_sectors", 33), ("ground_per_m_q16", 6555), ("gate_above_mm", -5001),
                  ("far_max_step_mm", 5001), ("far2_split_mm", 500001)):
         with pytest.raises(native.LidetError):
-            native_q.ground_q(img, "hdl64", **{k: v})
+            native.ground_q(img, "hdl64", **{k: v})
 
 
 @pytest.mark.parametrize("i", range(len(_sample_scans())))
@@ -167,7 +167,7 @@ def _agreement(scans, seed_per_cell=0):
     same = total = 0
     conf_f = conf_q = 0
     for sensor, pts, sem in scans:
-        fm, qm, _, _ = native_q.ground_pair(pts, sensor, seed_per_cell=seed_per_cell)
+        fm, qm, _, _ = native.ground_pair(pts, sensor, seed_per_cell=seed_per_cell)
         same += int(np.count_nonzero(fm == qm))
         total += len(pts)
         if sem is not None:
@@ -190,12 +190,12 @@ def test_seed_per_cell_draws_other_samples():
     """The switch is live: a stream per cell gives other planes than one stream through the cells (the same
     samples, other RANSAC draws), and the integer stage refuses a value other than 0 or 1."""
     sensor, pts, _ = _sample_scans()[0]
-    img = native_q.project_compact(pts, sensor)
-    a, b = native_q.ground_q(img, sensor), native_q.ground_q(img, sensor, seed_per_cell=1)
+    img = native.project_compact(pts, sensor)
+    a, b = native.ground_q(img, sensor), native.ground_q(img, sensor, seed_per_cell=1)
     assert np.array_equal(a.sample, b.sample)
     assert not np.array_equal(a.plane_d, b.plane_d)
     with pytest.raises(native.LidetError):
-        native_q.ground_q(img, sensor, seed_per_cell=2)
+        native.ground_q(img, sensor, seed_per_cell=2)
 
 
 @pytest.mark.parametrize("seed_per_cell", [0, 1])

@@ -1,7 +1,7 @@
 # SPDX-License-Identifier: MIT
 """Every compile-time option lives in lib/include/lidet/lidet_opt.h with its #error check, its CMake variable
 (cmake/lidet_options.cmake, or one of the four CMake options), a bad-value case in tests/opt/check_opt.cmake and
-a row in docs/PORTING.md; no other file of lib/ defaults a LIDET_ macro, and no selector compares one with a bare
+a row in docs/OPTIONS.md; no other file of lib/ defaults a LIDET_ macro, and no selector compares one with a bare
 number (kernel variants are named). Reads the sources only; no build needed."""
 import re
 
@@ -119,10 +119,10 @@ def test_every_option_has_a_compile_fail_case(root, options):
 
 
 def test_every_option_is_documented(root, options):
-    doc = _text(root / "docs" / "PORTING.md")
+    doc = _text(root / "docs" / "OPTIONS.md")
     rows = set(re.findall(r"^\| `(LIDET_\w+)` \|", doc, re.M))
-    assert sorted(options - rows) == [], "options missing from docs/PORTING.md's option table"
-    assert sorted(rows - options) == [], "rows of docs/PORTING.md's option table that are no option"
+    assert sorted(options - rows) == [], "options missing from docs/OPTIONS.md's option table"
+    assert sorted(rows - options) == [], "rows of docs/OPTIONS.md's option table that are no option"
 
 
 def test_kernel_variants_are_named(root, opt):

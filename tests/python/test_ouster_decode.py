@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""The Ouster packet decoder (lib/src/decode/lidet_ouster.c, docs/DECODING.md "Ouster").
+"""The Ouster packet decoder (lib/src/decode/lidet_ouster.c, docs/OUSTER.md).
 
 Always run (packets made here by lidet_tools.ouster.write_packet): every profile at 16/32/64/128 beams and
 512/1024/2048 columns decoded exactly (ring, measurement id, range, return, attributes, the azimuth's integer rule),

@@ -248,6 +248,19 @@ def test_emit_refuses_wider_conv_and_bad_metadata():
         E.parse(_graph(nodes, inits, ["logits"], meta={"lidet.kind": "classifier", "lidet.format": "9"}))
 
 
+def test_emit_z_origin_metadata():
+    """lidet.z_origin (the proposals' z origin the model was trained on) reaches the C model; absent means the mean."""
+    nodes, inits = _tiny_nodes()
+    base = {"lidet.kind": "classifier", "lidet.format": "1", "lidet.n_points": "8", "lidet.gamma": "0,0,0"}
+    assert E.parse(_graph(nodes, inits, ["logits"], meta=base)).z_origin == 0
+    m = E.parse(_graph(nodes, inits, ["logits"], meta=dict(base, **{"lidet.z_origin": "ground"})))
+    assert m.z_origin == 1
+    _, c = E.emit_c(m, "t.onnx", "cmd", "0" * 64)
+    assert "1u /* proposal z origin: ground */" in c
+    with pytest.raises(E.EmitError, match="lidet.z_origin 'floor'"):
+        E.parse(_graph(nodes, inits, ["logits"], meta=dict(base, **{"lidet.z_origin": "floor"})))
+
+
 def test_emit_cli_reports_errors(tmp_path):
     nodes, inits = _tiny_nodes("Tanh")
     p = tmp_path / "bad.onnx"

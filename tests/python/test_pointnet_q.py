@@ -45,8 +45,8 @@ def _sample(sensor):
 
 @pytest.fixture(scope="module")
 def nq(need_lib):
-    from lidet_tools import native_q
-    return native_q
+    from lidet_tools import native
+    return native
 
 
 @pytest.fixture(scope="module")
@@ -151,13 +151,13 @@ def _float_boxes(native, fam, q4, m4, vox, cls):
 def agreement(fam, props):
     """int8 (C) against float (C) on the same integer proposals: class, gate 1, gate 2, mean BEV IoU of the
     boxes (both nets given the float classifier's class). Also used by docs/FIXED_POINT.md's figures."""
-    from lidet_tools import native, native_q as nq
+    from lidet_tools import native
     from lidet_tools.eval.iou import iou_bev_pairs
     q4, m4, vox = props
     fc = native.pn_classify(f"cls_{fam}", q4 * 0.004, m4 * 0.004, vox)
-    qc = nq.pnq_classify(f"cls_{fam}_s8", q4, m4, vox)
+    qc = native.pnq_classify(f"cls_{fam}_s8", q4, m4, vox)
     fb = _float_boxes(native, fam, q4, m4, vox, fc["cls"])
-    qb = nq.pnq_box(f"box_{fam}_s8", q4, m4, vox, fc["cls"])
+    qb = native.pnq_box(f"box_{fam}_s8", q4, m4, vox, fc["cls"])
     bq = qb["box"].astype(np.float64)
     bq[:, :6] /= 1000.0
     bq[:, 6] *= 2 * math.pi / 2.0 ** 32

@@ -13,8 +13,8 @@ BAM = 2**32 / (2 * math.pi)
 
 @pytest.fixture(scope="module")
 def nq(need_lib):
-    from lidet_tools import native_q
-    return native_q
+    from lidet_tools import native
+    return native
 
 
 def _random_pairs(rng, n):

@@ -16,8 +16,8 @@ KEYS = ("point_pixel", "point_idx", "x_4mm", "y_4mm", "z_4mm", "range_4mm", "row
 
 @pytest.fixture(scope="module")
 def nq(need_lib):
-    from lidet_tools import native_q
-    return native_q
+    from lidet_tools import native
+    return native
 
 
 def _mm(pts):

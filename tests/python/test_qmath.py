@@ -12,8 +12,8 @@ from lidet_ref import qmath as ref
 
 @pytest.fixture(scope="module")
 def nq(need_lib):
-    from lidet_tools import native_q
-    return native_q
+    from lidet_tools import native
+    return native
 
 
 def _angles(rng, n):

@@ -1,5 +1,5 @@
 # SPDX-License-Identifier: MIT
-"""Velodyne calibrations as sensors (docs/SENSORS.md, "Velodyne calibration files"): Velodyne's db.xml / VeloView XML
+"""Velodyne calibrations as sensors (docs/VELODYNE_CALIBRATION.md): Velodyne's db.xml / VeloView XML
 and velodyne_pointcloud's YAML, read by lidet_tools.sensors.load_velodyne_calibration and by the host CLI
 (`--velodyne-calib C`, ports/host/cli_velodyne_calib.c). Hand-made files of both formats give their tables in ring
 order; every bad file gives its message naming the entry and field, word for word the same from both loaders; the

@@ -381,19 +381,19 @@ def test_hdl64e_feeds_the_hdl64_preset(vdec):
     """The decoded complete rotation, rings numbered from the top (ring_top_first), through the integer detector with
     the hdl64 preset: the detections of the simulated scan itself (same classes, centres within 0.3 m); numbered
     from the bottom (the preset's rows upside down), most of them are lost."""
-    from lidet_tools import native_q
+    from lidet_tools import native
     vd = vdec
     pts, ring = _sim64()
     grid = vd.hdl64e_grid(pts, ring)
     pay = [p for _, p in vd.hdl64e_packets([grid], 700, start_cdeg=START64)]
-    ref = native_q.detect_q(np.round(pts[:, :3] * 1000).astype(np.int32), "hdl64")
+    ref = native.detect_q(np.round(pts[:, :3] * 1000).astype(np.int32), "hdl64")
     assert len(ref["cls"]) >= 5
 
     def matched(top_first):
         d = vd.decode(pay, ring_top_first=top_first)
         sel = d.scan == 1
-        q = native_q.detect_q(None, "hdl64", returns=native_q.as_returns(d.range_mm[sel], d.azimuth[sel],
-                                                                          d.ring[sel]))
+        q = native.detect_q(None, "hdl64", returns=native.as_returns(d.range_mm[sel], d.azimuth[sel],
+                                                                     d.ring[sel]))
         n = 0
         for c, b in zip(ref["cls"], ref["boxes"]):
             dist = np.linalg.norm(q["boxes"][:, :2] - b[None, :2], axis=1) if len(q["cls"]) else np.array([1e9])

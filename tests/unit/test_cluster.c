@@ -745,7 +745,24 @@ static void test_proposal_centred(void)
     TEST_ASSERT_EQUAL_INT16((int16_t)floor(el / (10.0 * M_PI / 180.0)), a.voxel[1]);
     TEST_ASSERT_EQUAL_INT16((int16_t)floor(rr), a.voxel[2]);
     TEST_ASSERT_TRUE(a.voxel[0] < 0); /* right of +x: negative azimuth */
+    /* z from the ground under the mean: the same points, shifted up by the record's height; the same voxel */
+    TEST_ASSERT_EQUAL_UINT32(LIDET_PROPOSAL_Z_MEAN, pc.z_origin);
+    pc.z_origin = LIDET_PROPOSAL_Z_GROUND;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_make(&g.ws, 0, &pc, &b));
+    TEST_ASSERT_TRUE(rec[0].height_m > 0.5f);
+    TEST_ASSERT_EQUAL_FLOAT(rec[0].mean_m[2] - rec[0].height_m, b.mean_m[2]);
+    TEST_ASSERT_EQUAL_MEMORY(a.voxel, b.voxel, sizeof a.voxel);
+    for (i = 0; i < 64; ++i)
+    {
+        TEST_ASSERT_EQUAL_FLOAT(a.xyz[i][0], b.xyz[i][0]);
+        TEST_ASSERT_EQUAL_FLOAT(a.xyz[i][1], b.xyz[i][1]);
+        TEST_ASSERT_CLOSE(a.xyz[i][2] + rec[0].height_m, b.xyz[i][2], 1e-5, 0);
+        TEST_ASSERT_CLOSE(a.xyz[i][2] + a.mean_m[2], b.xyz[i][2] + b.mean_m[2], 1e-5, 0);
+    }
     /* errors */
+    pc.z_origin = LIDET_PROPOSAL_Z_GROUND + 1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proposal_make(&g.ws, 0, &pc, &a));
+    pc.z_origin = LIDET_PROPOSAL_Z_MEAN;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proposal_make(&g.ws, 1, &pc, &a));
     pc.n_points = LIDET_PROPOSAL_POINTS + 1;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proposal_make(&g.ws, 0, &pc, &a));

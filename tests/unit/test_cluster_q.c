@@ -352,6 +352,19 @@ static void test_proposal(void)
         TEST_ASSERT_EQUAL_INT16(cy[px] - rec->mean_4mm[1], pr.xyz[i][1]);
         TEST_ASSERT_EQUAL_INT16(cz[px] - rec->mean_4mm[2], pr.xyz[i][2]);
     }
+    /* z from the ground under the mean: the mean's height above its plane added to every z, mean z lowered by it */
+    pc.z_origin = LIDET_PROPOSAL_Z_GROUND;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_q_make(&g.ws.state, 0, &pc, &pr));
+    TEST_ASSERT_TRUE(rec->height_4mm > 100);
+    TEST_ASSERT_EQUAL_INT32(rec->mean_4mm[2] - rec->height_4mm, pr.mean_4mm[2]);
+    for (i = 0; i < pc.n_points; ++i)
+    {
+        const int32_t px = g.ws.members[rec->first_member + idx[i]];
+        TEST_ASSERT_EQUAL_INT16(cx[px] - rec->mean_4mm[0], pr.xyz[i][0]);
+        TEST_ASSERT_EQUAL_INT16(cz[px] - rec->mean_4mm[2] + rec->height_4mm, pr.xyz[i][2]);
+    }
+    pc.z_origin = LIDET_PROPOSAL_Z_GROUND + 1u;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proposal_q_make(&g.ws.state, 0, &pc, &pr));
 }
 
 int main(void)

@@ -432,7 +432,7 @@ void test_deterministic_and_empty(void)
 void test_init_errors(void)
 {
     lidet_detector_cfg_t c;
-    lidet_pn_model_t other;
+    lidet_pn_model_t other, other_box;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_init(NULL, &cfg, &m_cls, &m_box));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_init(&g.ws, &cfg, NULL, &m_box));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_init(&g.ws, &cfg, &m_box, &m_cls)); /* kinds swapped */
@@ -442,6 +442,13 @@ void test_init_errors(void)
     other = m_box;
     other.pvle_bin[2] = 2.0f; /* trained on other voxels */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_init(&g.ws, &cfg, &m_cls, &other));
+    other = m_box;
+    other.z_origin = (uint8_t)(m_cls.z_origin ^ 1u); /* trained on proposals from another z origin */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_init(&g.ws, &cfg, &m_cls, &other));
+    other = m_cls;
+    other_box = m_box;
+    other.z_origin = other_box.z_origin = 2u; /* not a lidet_proposal_z_origin_t */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_init(&g.ws, &cfg, &other, &other_box));
     other = m_cls;
     other.format_version = 99;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_init(&g.ws, &cfg, &other, &m_box));

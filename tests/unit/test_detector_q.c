@@ -110,6 +110,22 @@ static void test_init_errors(void)
     lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.proposal.range_bin_4mm = 500; /* 2 m voxels: not what the models were trained with */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    {
+        /* models trained on proposals from different z origins, or from none lidet knows */
+        static lidet_pointnet_q_model_t zc, zb;
+        zc = *m_cls;
+        zb = *m_box;
+        zb.z_origin = (uint8_t)(zc.z_origin ^ 1u);
+        TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_q_init(&g.ws, &cfg, &zc, &zb));
+        zc.z_origin = zb.z_origin = 2u;
+        TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_q_init(&g.ws, &cfg, &zc, &zb));
+        zc.z_origin = zb.z_origin = LIDET_PROPOSAL_Z_GROUND; /* both from the ground: accepted */
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, &zc, &zb));
+        TEST_ASSERT_EQUAL_UINT32(LIDET_PROPOSAL_Z_GROUND, g.ws.cfg.proposal.z_origin);
+        zb.z_origin = LIDET_PROPOSAL_Z_MEAN; /* a failed init leaves the state unusable again */
+        TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_q_init(&g.ws, &cfg, &zc, &zb));
+    }
     /* a run before a successful init */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_detector_q_run(&g.ws, pts, n_pts, 3, NULL, NULL));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_run(NULL, pts, n_pts, 3, NULL, NULL));

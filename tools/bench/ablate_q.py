@@ -10,7 +10,7 @@ Four detectors over the same scans, camera crop, both with the proposal refineme
   integer geometry + float nets the integer detector's proposals in metres (4 mm steps x 0.004)
   integer geometry + int8 nets  the integer detector (lidet detect --fixed)
 The candidates (classified clusters, nearest first) come from each detector's own run
-(lidet_tools.native_q.candidates_float / candidates_q); the networks, gates, size check, score and NMS are
+(lidet_tools.native.candidates_float / candidates_q); the networks, gates, size check, score and NMS are
 applied here with the rules of the nets' side: the float detector's (float32 energies, box budget, float NMS) for
 the float nets, the integer detector's (Q16 energies, Q15 score, lidet_post_q's size check and NMS in C) for the
 int8 nets; the two pure combinations reproduce the detectors' outputs. Prints AP R40 3D moderate per class and,
@@ -30,7 +30,7 @@ sys.path[:0] = [str(ROOT / "tools"), str(ROOT / "codegen")]
 
 from lidet_codegen import quant as QU  # noqa: E402
 from lidet_ref import detector_q as RD  # noqa: E402
-from lidet_tools import kitti, native, native_q as nq  # noqa: E402
+from lidet_tools import kitti, native  # noqa: E402
 from lidet_tools.eval import kitti_ap as K  # noqa: E402
 
 CLASSES = native.CLASSES
@@ -73,17 +73,17 @@ def nets_float(fam, xyz, mean, vox, cid, max_boxes, npts):
     dets.sort(key=lambda d: (-d[0], d[1]))
     kept = []
     for d in dets:
-        if not any(nq.bev_iou_float(d[3][None], k[3][None])[0] > np.float32(0.1) for k in kept):
+        if not any(native.bev_iou_float(d[3][None], k[3][None])[0] > np.float32(0.1) for k in kept):
             kept.append(d)
     return [(d[2], d[0], d[3]) for d in kept]
 
 
 def nets_int8(fam, q4, m4, vox, cid, npts):
     """int8 nets on 4 mm proposals, the integer detector's rules: (cls, score, box (m, rad)) kept."""
-    gam = nq.pnq_models()[f"cls_{fam}_s8"]["gamma_q16"]
-    gam_b = nq.pnq_models()[f"box_{fam}_s8"]["gamma_q16"]
-    c = nq.pnq_classify(f"cls_{fam}_s8", q4, m4, vox)
-    b = nq.pnq_box(f"box_{fam}_s8", q4, m4, vox, c["cls"])
+    gam = native.pnq_models()[f"cls_{fam}_s8"]["gamma_q16"]
+    gam_b = native.pnq_models()[f"box_{fam}_s8"]["gamma_q16"]
+    c = native.pnq_classify(f"cls_{fam}_s8", q4, m4, vox)
+    b = native.pnq_box(f"box_{fam}_s8", q4, m4, vox, c["cls"])
     keep = np.flatnonzero(c["passed"] & b["passed"])
     if len(keep) == 0:
         return []
@@ -93,7 +93,7 @@ def nets_int8(fam, q4, m4, vox, cid, npts):
                                              round(SCORE_BOX_WEIGHT[c["cls"][k]] * 65536),
                                              round(SCORE_POINTS_WEIGHT[c["cls"][k]] * 65536)) for k in keep], np.int32)
     boxes = b["box"][keep]
-    ok = nq.post_q(boxes, score, cid[keep], cls, 3277)
+    ok = native.post_q(boxes, score, cid[keep], cls, 3277)
     # post_q returns the kept cluster ids in order (size check applied first)
     by_id = {int(cid[k]): i for i, k in enumerate(keep)}
     out = []
@@ -114,8 +114,8 @@ def run(sim: pathlib.Path, out: pathlib.Path, n_scans: int, fam: str = "hdl64", 
     for p in scans:
         pts = kitti.read_bin(p)
         calib = kitti.read_calib(sim / "calib" / f"{p.stem}.txt")
-        cf = nq.candidates_float(pts, fam, crop_half_rad=math.pi / 4, refine=True)
-        cq = nq.candidates_q(nq.to_mm(pts), fam, crop_half_bam=1 << 29)
+        cf = native.candidates_float(pts, fam, crop_half_rad=math.pi / 4, refine=True)
+        cq = native.candidates_q(native.to_mm(pts), fam, crop_half_bam=1 << 29)
         f_q4, f_m4 = QU.int_proposals(cf["xyz"], cf["mean"]) if len(cf["xyz"]) else (cf["xyz"], cf["mean"])
         res = {
             "float+float": nets_float(fam, cf["xyz"], cf["mean"], cf["voxel"], cf["cluster_id"], max_boxes,

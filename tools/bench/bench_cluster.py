@@ -96,12 +96,12 @@ def _int_vs_float(pts, sensor, repeat):
     image (the float projection's compact path and ground stage, as a detector workspace), in one process:
     (float ms, integer ms) medians of `repeat` runs each, or None when the bindings are not built."""
     try:
-        from lidet_tools import native_q
-        scan = native_q.compact_scan(pts, sensor)
+        from lidet_tools import native
+        scan = native.compact_scan(pts, sensor)
     except (FileNotFoundError, OSError, AttributeError):
         return None
-    cf = native_q.cluster_f_compact(scan, scan.planes, repeat=repeat)
-    cq = native_q.cluster_q(scan, native_q.planes_to_q(scan.planes), repeat=repeat)
+    cf = native.cluster_f_compact(scan, scan.planes, repeat=repeat)
+    cq = native.cluster_q(scan, native.planes_to_q(scan.planes), repeat=repeat)
     return float(np.median(cf.run_ns)) / 1e6, float(np.median(cq.run_ns)) / 1e6
 
 
@@ -248,7 +248,7 @@ def run(args) -> str:
               f"min_points=10)` on the non-ground points, median of {rep_d}, OMP_NUM_THREADS=1, point-cloud "
               "construction included. Integer versus float (docs/FIXED_POINT.md): both clusterings on the same "
               "compact image with the ground stage's mask and planes (Q30 for the integer one), through the bindings "
-              f"(lidet_tools.native_q: cluster_f_compact, cluster_q), the stage alone with its defaults (both with "
+              f"(lidet_tools.native: cluster_f_compact, cluster_q), the stage alone with its defaults (both with "
               f"the refinement and the worst-case budgets), median of {rep_l} runs per scan, then the median over the "
               "scans. Whole table: "
               "`python tools/bench/bench_cluster.py` (or `make bench`).", ""]

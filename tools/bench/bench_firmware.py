@@ -3,8 +3,8 @@
 with exact instruction counting, per core; compared with the host build of the same program on the same scan.
 
 Runs the firmware tests (`ctest -R '^firmware_'`, which write build/firmware/<board>/report.json through
-tools/firmware/run_fw.py) and turns their reports into the BENCHMARKS.md section. Needs the cross toolchains
-and QEMU (tools/scripts/install_deps.sh); without them the section says so. LIDET_BENCH_FW_REUSE=1: use the
+tools/firmware/run_fw.py) and turns their reports into the firmware section (docs/benchmarks/firmware.md). Needs the
+cross toolchains and QEMU (tools/scripts/install_deps.sh); without them the section says so. LIDET_BENCH_FW_REUSE=1: use the
 reports of the last ctest run instead of running the images again."""
 from __future__ import annotations
 

@@ -278,8 +278,8 @@ def q_table(sets, repeat):
     float projection's compact path, as a detector workspace): share of points with equal ground labels, IoU of
     each against the labels, host medians of each stage alone (interleaved in one process)."""
     try:
-        from lidet_tools import native_q
-        native_q.ground_q_fields()
+        from lidet_tools import native
+        native.ground_q_fields()
     except (ImportError, OSError, FileNotFoundError) as e:
         return [f"Integer ground stage: bindings not available ({e}): skipped.", ""]
     lines = ["**Integer ground stage (`lidet_ground_q`) next to the float one, same compact images**", "",
@@ -293,13 +293,13 @@ def q_table(sets, repeat):
         for b, lab in pairs:
             pts = kitti.read_bin(b)
             sem, _ = kitti.read_label(lab, len(pts))
-            fm, qm, img, _ = native_q.ground_pair(pts, sensor)
+            fm, qm, img, _ = native.ground_pair(pts, sensor)
             same += int(np.count_nonzero(fm == qm))
             total += len(pts)
             truth = ground_eval.ground_truth(sem)
             cf = cf + ground_eval.confusion(fm.astype(bool), truth)
             cq = cq + ground_eval.confusion(qm.astype(bool), truth)
-            a, b2, c, d = native_q.ground_q_time(img, sensor, repeat)
+            a, b2, c, d = native.ground_q_time(img, sensor, repeat)
             tf.append(a)
             tq.append(b2)
             mf.append(c)

@@ -16,13 +16,13 @@ import numpy as np
 
 import bench_pixel  # the table (tools/bench/bench_pixel.py)
 from lidet_ref import qmath
-from lidet_tools import cluster_eval, native, native_q
+from lidet_tools import cluster_eval, native, sensors
 
 
 def _image(pts, sensor: str, range_only: bool):
     """The integer projection of (N, >=3) float points (m) and its compact image, stored or decoded."""
-    s = native.get_sensor(sensor)
-    pj = native_q.project_q(native_q.to_mm(pts), sensor)
+    s = sensors.get_sensor(sensor)
+    pj = native.project_q(native.to_mm(pts), sensor)
     rows, cols = s.rows, s.cols
     rng = pj["range_4mm"].reshape(rows, cols)
     if range_only:
@@ -34,22 +34,22 @@ def _image(pts, sensor: str, range_only: bool):
 
 def ground_points(pts, sensor: str, range_only: bool) -> np.ndarray:
     pj, x, y, z, rng = _image(pts, sensor, range_only)
-    img = native_q.CompactImage(x, y, z, rng, pj["point_pixel"], pj["row_elev_bam"], 0)
-    mask = native_q.ground_q(img, sensor).mask.ravel()
+    img = native.CompactImage(x, y, z, rng, pj["point_pixel"], pj["row_elev_bam"], 0)
+    mask = native.ground_q(img, sensor).mask.ravel()
     pp = pj["point_pixel"]
     return np.where(pp >= 0, mask[np.maximum(pp, 0)], 0)
 
 
 def cluster_points(pts, lab, sensor: str, range_only: bool) -> np.ndarray:
-    s = native.get_sensor(sensor)
+    s = sensors.get_sensor(sensor)
     pj, x, y, z, rng = _image(pts, sensor, range_only)
     pp = pj["point_pixel"]
     ground = np.zeros(rng.size, np.uint8)
     g = cluster_eval.ground_mask(lab)
     ground[pp[(pp >= 0) & g]] = 1
-    scan = native_q.CompactScan(s, x, y, z, rng, pj["row_elev_bam"], np.zeros(s.rows, np.float32), pp,
-                                ground.reshape(rng.shape), np.zeros((0, 4), np.float32))
-    c = native_q.cluster_q(scan)
+    scan = native.CompactScan(s, x, y, z, rng, pj["row_elev_bam"], np.zeros(s.rows, np.float32), pp,
+                              ground.reshape(rng.shape), np.zeros((0, 4), np.float32))
+    c = native.cluster_q(scan)
     labels = c.labels.ravel()
     return np.where(pp >= 0, labels[np.maximum(pp, 0)], 0)
 

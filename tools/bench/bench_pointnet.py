@@ -70,7 +70,6 @@ def _int8_lines(native, xyz, mean, vox, fams, repeats) -> list:
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
-    from lidet_tools import native_q
     q4, m4 = QU.int_proposals(xyz, mean)
     out = ["", "int8 (issue 16, lib/src/pointnet/lidet_pointnet_q.c, portable C99, no float) against float, same proposals "
                "(integer ones: the same points rounded to 4 mm steps), same clock; flash: the bytes of the weight "
@@ -82,7 +81,7 @@ def _int8_lines(native, xyz, mean, vox, fams, repeats) -> list:
         if not (ROOT / "weights" / f"cls_{fam}.calib.json").exists():
             continue
         tf = native.pn_time(f"cls_{fam}", f"box_{fam}", xyz, mean, vox, repeats)
-        tq = native_q.pnq_time(f"cls_{fam}_s8", f"box_{fam}_s8", q4, m4, vox, repeats)
+        tq = native.pnq_time(f"cls_{fam}_s8", f"box_{fam}_s8", q4, m4, vox, repeats)
         for k, kind in enumerate(("cls", "box")):
             name = f"{kind}_{fam}"
             m = E.load(ROOT / "weights" / f"{name}.onnx", name)

@@ -32,10 +32,10 @@ def measure(points, sensor: str) -> dict:
     """Counts for one scan: points, same pixel / same winner for both float inputs, and for the points whose
     pixel differs with the same input, how many the float64 reference puts where the integer path does."""
     from lidet_ref.proj import project_ref
-    from lidet_tools import native, native_q, sensors
+    from lidet_tools import native, sensors
     s = sensors.get_sensor(sensor)
     mm = np.round(np.asarray(points, dtype=np.float64)[:, :3] * 1000.0).astype(np.int32)
-    q = native_q.project_q(mm, sensor)
+    q = native.project_q(mm, sensor)
     x = mm / 1000.0
     same = native.project(x.astype(np.float32), sensor)
     raw = native.project(points, sensor)

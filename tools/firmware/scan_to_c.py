@@ -24,7 +24,7 @@ def main(argv=None):
     ap.add_argument("--out", required=True, help="C file to write")
     ap.add_argument("--mm", action="store_true",
                     help="integer build: x, y, z as int32 millimetres (fw_scan_xyz_mm, rounded half away from zero, "
-                         "as lidet_tools.native_q.to_mm) instead of float metres, and with --ring the same scan as "
+                         "as lidet_tools.native.to_mm) instead of float metres, and with --ring the same scan as "
                          "the sensor's returns (fw_scan_returns: range, azimuth, ring)")
     a = ap.parse_args(argv)
 

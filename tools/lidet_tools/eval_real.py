@@ -7,7 +7,7 @@
 The frames and their side (train / val) come from tools/lidet_tools/real/split.txt, fixed once; the figures of
 docs/BENCHMARKS.md are those of the validation frames. Each frame is read by `lidet_tools.real` (boxes in the
 sensor frame), run through the detector of the bindings (`native.detect`: the float detector, 360 degrees, the
-source's sensor preset and mount height; `--fixed`: the integer detector, `native_q.detect_q`) and scored:
+source's sensor preset and mount height; `--fixed`: the integer detector, `native.detect_q`) and scored:
 
 * ground truth: Car, Pedestrian, Cyclist boxes in the source's labelled field of view with at least
   ``--min-points`` (10) points inside (+ 0.1 m); every other labelled box (fewer points, vans, trucks,
@@ -121,10 +121,10 @@ def _run_cli(fr, fixed: bool, model: str | None, sets=()):
     import subprocess
     import tempfile
 
-    from . import native_q
+    from . import native
     from .detect import find_cli
     if fixed:
-        fam = model or (fr.sensor if f"cls_{fr.sensor}_s8" in native_q.pnq_models() else "hdl64")
+        fam = model or (fr.sensor if f"cls_{fr.sensor}_s8" in native.pnq_models() else "hdl64")
     else:
         fam = model or native.default_family(fr.sensor)
     with tempfile.TemporaryDirectory() as td:

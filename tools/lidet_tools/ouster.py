@@ -1,6 +1,6 @@
 # SPDX-License-Identifier: MIT
 """Ouster captures: the sensor metadata a decoder needs, a lidar packet writer, and the C packet decoder
-(lib/src/decode/lidet_ouster.c, docs/DECODING.md) run over a whole capture through the bindings, with x, y, z
+(lib/src/decode/lidet_ouster.c, docs/OUSTER.md) run over a whole capture through the bindings, with x, y, z
 computed as ouster-sdk computes them.
 
     meta = load_metadata("OS-2-128.json")                        # packet format + beam tables (+ meta.sensor)
@@ -184,7 +184,7 @@ def xyz(meta: OusterMeta, ring, measurement_id, range_mm) -> np.ndarray:
 
 
 def _pixel_dtype(profile: str) -> np.dtype:
-    """One pixel of a profile, packed little-endian (the layouts of docs/DECODING.md)."""
+    """One pixel of a profile, packed little-endian (the layouts of docs/OUSTER.md)."""
     if profile == "LEGACY":
         return np.dtype([("word", "<u4"), ("rfl", "<u2"), ("sig", "<u2"), ("nir", "<u2"), ("pad", "<u2")])
     if profile == "RNG19_RFL8_SIG16_NIR16":
@@ -199,7 +199,7 @@ def write_packet(profile: str, pixels_per_column: int, columns_per_frame: int, *
                  frame_id: int = 0, first_mid: int = 0, measurement_ids=None, frame_ids=None, ranges_mm=None,
                  reflectivity=None, signal=None, flags=None, valid=None, timestamps_ns=None, encoder=None,
                  init_id: int = 0, prod_sn: int = 0, header: str = "STANDARD", packet_type: int = 1) -> bytes:
-    """A lidar payload as an Ouster sensor writes it (the layouts of docs/DECODING.md). Per column c and row r:
+    """A lidar payload as an Ouster sensor writes it (the layouts of docs/OUSTER.md). Per column c and row r:
     ranges_mm[c, r] (DUAL: [c, r, k], k = 0 first and 1 second return; RNG15_RFL8_NIR8: multiples of 8 mm),
     reflectivity, signal and flags likewise (default 0; broadcast); measurement_ids (default first_mid + c,
     wrapping at columns_per_frame into the next frame: LEGACY columns carry their own frame id, frame_ids[c]

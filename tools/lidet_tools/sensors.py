@@ -667,7 +667,7 @@ def write_sensor_file(sensor: Sensor, path) -> None:
     pathlib.Path(path).write_text(description_json(sensor))
 
 
-# ---- Velodyne calibrations (docs/SENSORS.md, "Velodyne calibration files") -----------------------------------
+# ---- Velodyne calibrations (docs/VELODYNE_CALIBRATION.md) ----------------------------------------------------
 # ports/host/cli_velodyne_calib.c reads them with libxml2 and libyaml by the same rules, in the same order, with
 # the same messages (tests/python/test_velodyne_calib.py).
 
@@ -1016,11 +1016,11 @@ def velodyne_calibration_kind(data: bytes) -> str:
 
 def load_velodyne_calibration(path, mount_height_m: float | None = None, cols: int | None = None,
                               name: str | None = None) -> Sensor:
-    """A sensor from a Velodyne calibration file (docs/SENSORS.md): the db.xml / VeloView XML (boost-serialized
-    <DB>: points_ / item / px with id_, vertCorrection_, rotCorrection_ in degrees, the other corrections in cm;
-    enabled_, distLSB_) or velodyne_pointcloud's YAML (num_lasers, lasers: laser_id, vert_correction,
-    rot_correction in radians, the other corrections in metres; distance_resolution), told apart by the first
-    character ('<': XML).
+    """A sensor from a Velodyne calibration file (docs/VELODYNE_CALIBRATION.md): the db.xml / VeloView XML
+    (boost-serialized <DB>: points_ / item / px with id_, vertCorrection_, rotCorrection_ in degrees, the other
+    corrections in cm; enabled_, distLSB_) or velodyne_pointcloud's YAML (num_lasers, lasers: laser_id,
+    vert_correction, rot_correction in radians, the other corrections in metres; distance_resolution), told apart by
+    the first character ('<': XML).
 
     The elevation table is in **ring order**: the lasers sorted by elevation, lowest first, as velodyne_pointcloud
     numbers its rings and as lidet's Velodyne decoder and presets do (ring 0 = the lowest beam), whatever the

@@ -21,7 +21,7 @@ PKGS="$PKGS libpcap-dev"
 PKGS="$PKGS clang-format"
 # Firmware images under QEMU (issue 17, tests/firmware.cmake): Arm and RISC-V cross compilers with their C
 # libraries, and the two QEMU system emulators. ~1 min to install on a Debian 12 CI runner once the package
-# lists are fresh (docs/BENCHMARKS.md). LIDET_NO_FIRMWARE=1 leaves them out; the firmware tests then skip.
+# lists are fresh (docs/benchmarks/firmware.md). LIDET_NO_FIRMWARE=1 leaves them out; the firmware tests then skip.
 FW_PKGS="gcc-arm-none-eabi libnewlib-arm-none-eabi qemu-system-arm gcc-riscv64-unknown-elf picolibc-riscv64-unknown-elf qemu-system-misc"
 if [ "${LIDET_NO_FIRMWARE:-0}" != 1 ]; then
   PKGS="$PKGS $FW_PKGS"

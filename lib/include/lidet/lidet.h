@@ -21,15 +21,22 @@
 
 #include "lidet_cluster.h"
 #include "lidet_cluster_q.h"
+#include "lidet_cluster_stats.h"
 #include "lidet_detector.h"
+#include "lidet_detector_common.h"
+#include "lidet_detector_q.h"
 #include "lidet_ground.h"
+#include "lidet_ground_common.h"
 #include "lidet_ground_q.h"
+#include "lidet_image.h"
 #include "lidet_opt.h"
 #include "lidet_ouster.h"
 #include "lidet_pointnet.h"
+#include "lidet_pointnet_common.h"
 #include "lidet_pointnet_q.h"
 #include "lidet_proj.h"
 #include "lidet_proj_q.h"
+#include "lidet_proj_stats.h"
 #include "lidet_q.h"
 #include "lidet_sensor.h"
 #include "lidet_sensor_q.h"
@@ -38,6 +45,7 @@
 #include "lidet_track_q.h"
 #include "lidet_types.h"
 #include "lidet_velodyne.h"
+#include "lidet_workspace.h"
 
 #ifdef __cplusplus
 extern "C" {

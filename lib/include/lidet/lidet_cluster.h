@@ -123,6 +123,8 @@
 #ifndef LIDET_CLUSTER_H
 #define LIDET_CLUSTER_H
 
+#include "lidet_cluster_stats.h"
+#include "lidet_image.h"
 #include "lidet_proj.h"
 #include "lidet_sensor.h"
 #include "lidet_types.h"
@@ -242,7 +244,8 @@ typedef struct
                                        crop sets it to the crop, with azimuth_half_rad the crop + 15 deg: the
                                        margin's pixels are visited only when they join an object that reaches
                                        into the crop (issue 14: clustering 1.02 -> 0.93 ms on the 11 real KITTI
-                                       crops, one pair of runs; docs/DETECTOR.md, "The crop's speed") */
+                                       crops, one pair of runs; docs/journal/detector.md, "The crop's
+                                       speed") */
     uint32_t max_join_pieces;   /**< join budget (bounds the joins' time whatever the scan): only the first
                                   max_join_pieces car pieces in slot order take part in the joins, the rest
                                   join nothing (stats n_join_skipped); the joins then test at most
@@ -297,36 +300,6 @@ typedef struct
     float max_m[3];
     float height_m; /**< mean's signed height above the ground plane used by the filter */
 } lidet_cluster_rec_t;
-
-/** @brief Counts of the last run (each dropped cluster is counted once, by the first filter it fails). */
-typedef struct
-{
-    uint32_t n_candidates;       /**< non-ground pixels holding a point */
-    uint32_t n_found;            /**< connected components of the first flood fill (before any filter; the
-                                       regrowth's parts included) */
-    uint32_t n_fragments;        /**< of them, below min_points and handed to the rescue (0 when it is off) */
-    uint32_t n_rescue_joined;    /**< rescue groups that joined a kept cluster */
-    uint32_t n_rescue_pixels;    /**< fragment pixels the rescue put into kept clusters (joined or new) */
-    uint32_t n_dropped_small;    /**< fewer than min_points pixels: components of the first fill when
-                                       the rescue is off; rescue groups that joined nothing when it is on */
-    uint32_t n_dropped_extent;   /**< extent above max_extent_m */
-    uint32_t n_dropped_height;   /**< mean height above max_mean_height_m */
-    uint32_t n_dropped_capacity; /**< passed the filters but dropped for LIDET_MAX_CLUSTERS (rescue
-                                       groups included) */
-    uint32_t n_kept;             /**< clusters in the output */
-    uint32_t n_pixels_kept;      /**< pixels labelled with a kept cluster */
-    uint32_t n_queue_overflow;   /**< always 0: the queue holds every pixel (kept for the record) */
-    uint32_t n_split;            /**< refinement: clusters cut into parts */
-    uint32_t n_split_parts;      /**< refinement: new clusters the cuts made */
-    uint32_t n_split_skipped;    /**< refinement: clusters examined but too large for the grid caps */
-    uint32_t n_joined;           /**< refinement: clusters joined into another (car fragments) */
-    uint32_t n_join_skipped;     /**< refinement: car pieces past max_join_pieces (joined nothing) */
-    uint32_t n_fragment_pixels;  /**< pixels of the fragments handed to the rescue */
-    uint32_t n_dropped_fragment_budget; /**< fragments dropped past max_fragment_pixels */
-    uint32_t n_bridge_steps;            /**< nearer candidates stepped over (occluder bridging) */
-    uint32_t n_regrown;      /**< over-extent components grown again with the tighter gap (regrow_gap_m) */
-    uint32_t n_regrow_parts; /**< the parts they gave (each then kept, a fragment or dropped by a filter) */
-} lidet_cluster_stats_t;
 
 /**
  * @brief What the clustering keeps across runs and its small outputs: configuration, the angle tables
@@ -480,14 +453,18 @@ typedef struct
     float azimuth_bin_rad; /**< voxel sizes (> 0); defaults 10 deg, 10 deg, 1 m (the paper) */
     float elevation_bin_rad;
     float range_bin_m;
+    uint32_t z_origin; /**< lidet_proposal_z_origin_t: where the points' z is measured from; default
+                              LIDET_PROPOSAL_Z_MEAN. A model says which one it was trained with
+                              (lidet_pn_model_t z_origin) and the detectors set it from the model. */
 } lidet_proposal_cfg_t;
 
 /** @brief One proposal: what the PointNets see. */
 typedef struct
 {
     float xyz[LIDET_PROPOSAL_POINTS][3]; /**< first n_points rows used: member points minus mean_m */
-    float mean_m[3];                     /**< the cluster mean (sensor frame) */
-    int16_t voxel[3];                    /**< azimuth, elevation, range bins of mean_m (signed) */
+    float mean_m[3];                     /**< the cluster mean (sensor frame); with LIDET_PROPOSAL_Z_GROUND,
+                                              mean_m[2] is the ground height under it */
+    int16_t voxel[3];                    /**< azimuth, elevation, range bins of the cluster mean (signed) */
     uint32_t n_points;                   /**< rows of xyz filled (= cfg n_points) */
     uint32_t n_points_src;               /**< member pixels of the cluster */
 } lidet_proposal_t;
@@ -503,7 +480,8 @@ void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg);
  * @param[in]  cfg           proposal configuration.
  * @param[out] out           the proposal.
  * @return LIDET_OK; LIDET_ERR_ARG (NULL, index out of range);
- *         LIDET_ERR_CONFIG (n_points outside [1, LIDET_PROPOSAL_POINTS], a bin size <= 0 or not finite);
+ *         LIDET_ERR_CONFIG (n_points outside [1, LIDET_PROPOSAL_POINTS], a bin size <= 0 or not finite,
+ *         z_origin not a lidet_proposal_z_origin_t);
  *         LIDET_ERR_STATE (never run).
  */
 lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_index,

@@ -48,8 +48,8 @@
 #ifndef LIDET_CLUSTER_Q_H
 #define LIDET_CLUSTER_Q_H
 
-#include "lidet_cluster.h"
-#include "lidet_proj.h"
+#include "lidet_cluster_stats.h"
+#include "lidet_image.h"
 #include "lidet_q.h"
 #include "lidet_types.h"
 
@@ -219,6 +219,8 @@ typedef struct
     uint32_t azimuth_bin_bam;   /**< (0, 2^31]; default 119304647 (10 deg) */
     uint32_t elevation_bin_bam; /**< (0, 2^31]; default 119304647 */
     uint32_t range_bin_4mm;     /**< >= 1; default 250 (1 m) */
+    uint32_t z_origin; /**< lidet_proposal_z_origin_t; default LIDET_PROPOSAL_Z_MEAN (the detector sets
+                                     the models') */
 } lidet_proposal_q_cfg_t;
 
 /** @brief Default integer proposal configuration (the float defaults rounded). */

@@ -35,6 +35,7 @@
 #ifndef LIDET_DETECTOR_H
 #define LIDET_DETECTOR_H
 
+#include "lidet_detector_common.h" /* lidet_clock_fn, stage indices, outcomes */
 #include "lidet_pointnet.h"
 #include "lidet_types.h"
 #include "lidet_workspace.h"
@@ -42,33 +43,6 @@
 #ifdef __cplusplus
 extern "C" {
 #endif
-
-/** @brief Stages timed by the detector (indices of lidet_detector_stats_t.ticks). */
-enum
-{
-    LIDET_DET_STAGE_PROJECT = 0,  /**< projection */
-    LIDET_DET_STAGE_GROUND = 1,   /**< ground segmentation */
-    LIDET_DET_STAGE_CLUSTER = 2,  /**< clustering */
-    LIDET_DET_STAGE_CLASSIFY = 3, /**< candidate ordering, proposals, classifier */
-    LIDET_DET_STAGE_BOX = 4,      /**< box net */
-    LIDET_DET_STAGE_POST = 5,     /**< size check, NMS */
-    LIDET_DET_N_STAGES = 6
-};
-
-/** @brief What became of each kept cluster in the last run (lidet_detector_outcomes). */
-typedef enum
-{
-    LIDET_DET_OUT_CROP = 1,     /**< outside the azimuth window */
-    LIDET_DET_OUT_RANGE = 2,    /**< beyond max_range_m */
-    LIDET_DET_OUT_BUDGET = 3,   /**< past max_proposals, or passed gate 1 past max_boxes */
-    LIDET_DET_OUT_GATE1 = 4,    /**< classified, rejected by gate 1 */
-    LIDET_DET_OUT_GATE2 = 5,    /**< boxed, rejected by gate 2 */
-    LIDET_DET_OUT_SIZE = 6,     /**< boxed, impossible size for its class (or a non-finite centre or yaw) */
-    LIDET_DET_OUT_NMS = 7,      /**< suppressed by the NMS */
-    LIDET_DET_OUT_CAPACITY = 8, /**< past LIDET_MAX_DETECTIONS */
-    LIDET_DET_OUT_DETECTED = 9, /**< a detection of the output */
-    LIDET_DET_OUT_TALL = 10     /**< taller than max_height_extent_m: no road user, not classified */
-} lidet_det_outcome_t;
 
 /** @brief Configuration. Fill with lidet_detector_cfg_default(). */
 typedef struct

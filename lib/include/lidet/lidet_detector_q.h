@@ -16,8 +16,9 @@
 #define LIDET_DETECTOR_Q_H
 
 #include "lidet_cluster_q.h"
-#include "lidet_detector.h" /* lidet_clock_fn, stage indices, outcomes */
+#include "lidet_detector_common.h" /* lidet_clock_fn, stage indices, outcomes */
 #include "lidet_ground_q.h"
+#include "lidet_image.h"
 #include "lidet_pointnet_q.h"
 #include "lidet_proj_q.h"
 #include "lidet_q.h"

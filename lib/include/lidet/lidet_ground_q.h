@@ -35,7 +35,8 @@
 #ifndef LIDET_GROUND_Q_H
 #define LIDET_GROUND_Q_H
 
-#include "lidet_ground.h"
+#include "lidet_ground_common.h"
+#include "lidet_image.h"
 #include "lidet_q.h"
 
 #ifdef __cplusplus

@@ -8,7 +8,7 @@
  * command line (CMake cache variables of the same name do that: cmake/lidet_options.cmake), or in a header
  * named `lidet_user_config.h` on the include path, read when `LIDET_USER_CONFIG` is defined.
  * All consistency checks (`#error`) live at the end of this file, in one place, in the order of the options.
- * docs/PORTING.md ("Every compile-time option") lists them all with their CMake variables.
+ * docs/OPTIONS.md ("Every compile-time option") lists them all with their CMake variables.
  *
  * Memory: every buffer of a stage is a fixed-size array inside its state struct, sized from these
  * options, so the linker reports a RAM overflow instead of the library failing at run time. The

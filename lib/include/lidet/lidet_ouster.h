@@ -6,7 +6,7 @@
  *
  * Sensors: Ouster OS0 / OS1 / OS2, 16 to 128 beams (pixels per column), 512 / 1024 / 2048 columns per frame,
  * packet profiles (udp_profile_lidar) LEGACY, RNG19_RFL8_SIG16_NIR16 (single return), RNG19_RFL8_SIG16_NIR16_DUAL
- * and RNG15_RFL8_NIR8 (low data rate). Little-endian throughout. Byte layouts (docs/DECODING.md; sources:
+ * and RNG15_RFL8_NIR8 (low data rate). Little-endian throughout. Byte layouts (docs/OUSTER.md; sources:
  * Ouster's OS1 manual, "Lidar Data Format" section, for LEGACY; the firmware user manual's "Lidar Data" page and
  * ouster-sdk's packet_format (ouster_client/src/parsing.cpp) for the others):
  *  - LEGACY: no packet header. columns_per_packet columns of timestamp u64 (ns), measurement id u16, frame id u16,
@@ -21,7 +21,7 @@
  *    second return the same at 4..7; signal u16 at 8 and 10, near-IR u16 at 12); RNG15_RFL8_NIR8 4 bytes (range
  *    u16 & 0x7FFF in 8 mm, flags byte 1 >> 7, reflectivity byte 2, near-IR byte 3).
  *
- * Algorithm (docs/DECODING.md), per packet, in integers only:
+ * Algorithm (docs/OUSTER.md), per packet, in integers only:
  *  1. Validate the whole payload first: its length for the profile, the packet header (packet type, optionally
  *     the sensor's init id and serial number), every valid column's measurement id (< columns per frame) and
  *     (LEGACY) encoder count, and the order of the valid columns (frame id, measurement id) after the last one

@@ -93,6 +93,7 @@ typedef struct
     float gamma[LIDET_N_CLASSES]; /**< gate threshold per class: keep when energy < gamma[class] */
     const char *name;             /**< model name given to codegen */
     const char *class_names;      /**< comma-separated, lidet_class_t order */
+    uint8_t z_origin;             /**< lidet_proposal_z_origin_t it was trained on (ONNX lidet.z_origin) */
 } lidet_pn_model_t;
 
 /** @brief A model with its scratch buffer, ready to run. */

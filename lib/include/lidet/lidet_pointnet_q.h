@@ -118,6 +118,7 @@ typedef struct
     int32_t gamma_q16[LIDET_N_CLASSES]; /**< gate thresholds, Q16 nats: keep when energy < gamma[class] */
     const char *name;
     const char *class_names;
+    uint8_t z_origin; /**< lidet_proposal_z_origin_t it was trained on (ONNX lidet.z_origin) */
 } lidet_pointnet_q_model_t;
 
 /** @brief A model with its scratch buffer. */

@@ -2,7 +2,7 @@
 /**
  * @file lidet_proj_q.h
  * @brief Spherical projection of the integer path: int32 mm points -> the compact range image
- *        (lidet_range_image_t of lidet_proj.h: int16 x, y, z and uint16 range in 4 mm steps).
+ *        (lidet_range_image_t of lidet_image.h: int16 x, y, z and uint16 range in 4 mm steps).
  *
  * The rules of lidet_proj.h, in integers (docs/FIXED_POINT.md, "Projection"):
  *  - row: the beam nearest in elevation, or the ring's row when the driver gives ring ids. The row boundaries
@@ -33,7 +33,8 @@
 #ifndef LIDET_PROJ_Q_H
 #define LIDET_PROJ_Q_H
 
-#include "lidet_proj.h"
+#include "lidet_image.h"
+#include "lidet_proj_stats.h"
 #include "lidet_q.h"
 #include "lidet_sensor_q.h"
 

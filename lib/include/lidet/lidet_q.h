@@ -8,7 +8,7 @@
  * - input points: int32 millimetres, records of `stride` int32 whose first three are x, y, z (sensor frame,
  *   lidet_types.h); |coordinate| <= LIDET_Q_COORD_MAX_MM, farther points are dropped and counted;
  * - range-image pixels and everything derived from them: 4 mm steps (LIDET_PIXEL_M), the compact image of
- *   lidet_proj.h (int16 x, y, z; uint16 range);
+ *   lidet_image.h (int16 x, y, z; uint16 range);
  * - angles: BAM32, 2^32 = one turn (int32 for signed angles, uint32 where they wrap); sensor beam
  *   elevations are given in microradians;
  * - unit vectors, sines and cosines: Q30 (2^30 = 1.0); ratios and slopes: Q16;

@@ -84,6 +84,22 @@ typedef struct
 } lidet_box_t;
 
 /**
+ * @brief The origin of a proposal's z (x and y are always centred on the cluster mean).
+ *
+ * LIDET_PROPOSAL_Z_MEAN: the points minus the cluster mean, as in Frustum PointNets.
+ * LIDET_PROPOSAL_Z_GROUND: z is measured from the ground under the mean (the cluster's plane, the same one its
+ * height filter reads: mean z minus the record's height above it, lidet_cluster_rec_t height_m or
+ * lidet_cluster_q_rec_t height_4mm), and the proposal's mean_m[2] is that ground
+ * height, so boxes decode from it. A person seen only from the waist up over a parked car then keeps the heights of
+ * a whole person's upper half instead of looking like a short object centred on 0.
+ */
+typedef enum
+{
+    LIDET_PROPOSAL_Z_MEAN = 0,
+    LIDET_PROPOSAL_Z_GROUND = 1
+} lidet_proposal_z_origin_t;
+
+/**
  * @brief A plane n . p + d = 0 in the sensor frame: (nx, ny, nz) unit normal pointing up (nz > 0),
  * so n . p + d is the signed height of p above the plane (metres). The ground stage produces one per
  * azimuth sector; later stages (cluster height filter) read them.

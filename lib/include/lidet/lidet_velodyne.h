@@ -129,9 +129,9 @@ typedef struct
     int16_t dist_mm;
 } lidet_velodyne_laser_calib_t;
 
-/** @brief A unit's calibration, filled by the caller (lib/ parses no files; the host tools read db.xml and YAML:
- *  docs/SENSORS.md). Only the elevations, rotational and distance corrections are used (no offsets, focal or
- *  two-point corrections). */
+/** @brief A unit's calibration, filled by the caller (lib/ parses no files; the host tools read db.xml and
+ *  YAML: docs/VELODYNE_CALIBRATION.md). Only the elevations, rotational and distance corrections are used (no
+ *  offsets, focal or two-point corrections). */
 typedef struct
 {
     /** the model's lasers: 16 (VLP-16), 32 (VLP-32C, HDL-32E), 64 (HDL-64E) */

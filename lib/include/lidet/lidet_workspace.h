@@ -45,6 +45,7 @@
 #define LIDET_WORKSPACE_H
 
 #include "lidet_cluster.h"
+#include "lidet_detector_common.h" /* lidet_clock_fn */
 #include "lidet_ground.h"
 #include "lidet_proj.h"
 #include "lidet_sensor.h"
@@ -166,9 +167,6 @@ lidet_status_t lidet_workspace_init(lidet_workspace_t *ws, const lidet_workspace
  */
 lidet_status_t lidet_workspace_run(lidet_workspace_t *ws, const float *points, uint32_t n_points,
                                    uint32_t stride, const uint16_t *ring, int32_t *point_pixel);
-
-/** @brief A timestamp source (e.g. a cycle counter or a monotonic clock); ticks in the caller's unit. */
-typedef uint32_t (*lidet_clock_fn)(void *ctx);
 
 /**
  * @brief lidet_workspace_run with per-stage timing: ticks[0..2] receive the clock differences around the

@@ -13,7 +13,7 @@
 
 void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *sensor)
 {
-    /* <= 16 beams: some defaults of their own, measured on sparse scans (docs/BENCHMARKS.md) */
+    /* <= 16 beams: some defaults of their own, measured on sparse scans (docs/benchmarks/cluster.md) */
     const int sparse = sensor != 0 && sensor->n_rows <= 16;
     if (cfg == 0)
     {
@@ -21,8 +21,8 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     }
     memset(cfg, 0, sizeof *cfg);
     /* measured on simulated (20 + 20 scans; checked on 12 + 12 scans of other seeds) and real
-     * SemanticKITTI scans, docs/BENCHMARKS.md: the 8-neighbourhood keeps the sparse, dotted returns of
-     * car bodies together on every profile; a small angle joins the fragments of car bodies (grazing
+     * SemanticKITTI scans, docs/benchmarks/cluster.md: the 8-neighbourhood keeps the sparse, dotted returns
+     * of car bodies together on every profile; a small angle joins the fragments of car bodies (grazing
      * hoods and roofs, dropouts) and the gap bound, growing with range, keeps neighbouring parked cars
      * apart (the merges the angle test alone made on real scans). Dense sensors (> 16 beams) also
      * bridge occluders; 16-beam images use no occluder rule (speed: >= 100x DBSCAN) */
@@ -31,7 +31,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     if (sensor != 0 && sensor->n_rows <= 16)
     {
         cfg->theta_rad = 0.12f;
-        cfg->max_steps = 5u; /* 4 before issue 15's crowd scenes (time: +1 %, docs/BENCHMARKS.md) */
+        cfg->max_steps = 5u; /* 4 before issue 15's crowd scenes (time: +1 %, docs/benchmarks/cluster.md) */
         cfg->bridge_occluders = 0;
         cfg->max_gap_per_m = 0.04f;
     }
@@ -43,15 +43,15 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
         cfg->max_gap_per_m = 0.025f;
     }
     cfg->max_steps = cfg->max_steps < STEPS ? cfg->max_steps : STEPS;
-    /* measured end to end with the shipped models (docs/DETECTOR.md, "Smallest cluster"): 10 lost sparse far
-     * objects and the VLP-16's pedestrians (simulated HDL-64 AP R40 3D moderate car 82.1 -> 84.0, pedestrian
-     * 64.4 -> 68.8; VLP-16 pedestrians within 20 m +2 to +7 points at every mount) and changed nothing on the
-     * real scans; each step lower adds proposals (VLP-16: 10 -> 8 -> 6 points, +16 / +40 %) */
+    /* measured end to end with the shipped models (docs/journal/detector.md, "Smallest cluster"): 10 lost
+     * sparse far objects and the VLP-16's pedestrians (simulated HDL-64 AP R40 3D moderate car 82.1 -> 84.0,
+     * pedestrian 64.4 -> 68.8; VLP-16 pedestrians within 20 m +2 to +7 points at every mount) and changed
+     * nothing on the real scans; each step lower adds proposals (VLP-16: 10 -> 8 -> 6 points, +16 / +40 %) */
     cfg->min_points = 8u;
     cfg->max_extent_m = 6.0f;
     cfg->max_mean_height_m = 2.5f;
     cfg->mount_height_m = sensor != 0 ? sensor->mount_height_m : 1.73f;
-    /* measured (docs/BENCHMARKS.md): see lidet_cluster.h */
+    /* measured (docs/benchmarks/cluster.md): see lidet_cluster.h */
     cfg->rescue_gap_m = sparse ? 1.0f : 0.8f;
     cfg->rescue_gap_per_m = 0.03f;
     cfg->rescue_rows = sparse ? 1u : 2u;
@@ -63,7 +63,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->regrow_max_pixels = 2000u;
     cfg->regrow_max_height_m = 2.5f;
     cfg->max_bridge_per_pixel = 2.0f;
-    /* refinement (issue 15), measured on the simulated crowd scenes (docs/BENCHMARKS.md); 16 beams:
+    /* refinement (issue 15), measured on the simulated crowd scenes (docs/benchmarks/cluster.md); 16 beams:
      * person-sized parts cut off from 9 pixels, a longer join gap (with max_steps and
      * rescue_gap_m above, measured on simulated VLP-16 crowd scenes: lidet_cluster.h) */
     cfg->split_people = 1u;

@@ -13,7 +13,8 @@
 
 void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, uint32_t mount_height_mm)
 {
-    /* lidet_cluster_cfg_default's values (measured there, docs/BENCHMARKS.md), rounded to the integer units */
+    /* lidet_cluster_cfg_default's values (measured there, docs/benchmarks/cluster.md), rounded to the integer
+     * units */
     const int sparse = n_rows >= 1u && n_rows <= 16u;
     if (cfg == 0)
     {

@@ -66,7 +66,7 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
     const lidet_cluster_rec_t *rec;
     const lidet_range_image_t *img;
     uint32_t i, npix, state;
-    float mx, my, mz, rxy;
+    float mx, my, mz, zo, rxy;
 
     if (c == 0 || cfg == 0 || out == 0)
     {
@@ -79,7 +79,8 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
     if (cfg->n_points < 1 || cfg->n_points > LIDET_PROPOSAL_POINTS ||
         !lidet__isfinite(cfg->azimuth_bin_rad) || !(cfg->azimuth_bin_rad > 0.0f) ||
         !lidet__isfinite(cfg->elevation_bin_rad) || !(cfg->elevation_bin_rad > 0.0f) ||
-        !lidet__isfinite(cfg->range_bin_m) || !(cfg->range_bin_m > 0.0f))
+        !lidet__isfinite(cfg->range_bin_m) || !(cfg->range_bin_m > 0.0f) ||
+        cfg->z_origin > LIDET_PROPOSAL_Z_GROUND)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -94,6 +95,8 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
     mx = rec->mean_m[0];
     my = rec->mean_m[1];
     mz = rec->mean_m[2];
+    /* the points' z origin: the cluster mean, or the ground under it (mean minus its height above the plane) */
+    zo = cfg->z_origin == LIDET_PROPOSAL_Z_GROUND ? mz - rec->height_m : mz;
     for (i = 0; i < cfg->n_points; ++i)
     {
         const int32_t p = c->members[rec->first_member +
@@ -104,11 +107,11 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
         }
         out->xyz[i][0] = lidet__img_x(img, (uint32_t)p) - mx;
         out->xyz[i][1] = lidet__img_y(img, (uint32_t)p) - my;
-        out->xyz[i][2] = lidet__img_z(img, (uint32_t)p) - mz;
+        out->xyz[i][2] = lidet__img_z(img, (uint32_t)p) - zo;
     }
     out->mean_m[0] = mx;
     out->mean_m[1] = my;
-    out->mean_m[2] = mz;
+    out->mean_m[2] = zo;
     rxy = sqrtf(mx * mx + my * my);
     out->voxel[0] = bin_of(atan2f(my, mx), cfg->azimuth_bin_rad);
     out->voxel[1] = bin_of(atan2f(mz, rxy), cfg->elevation_bin_rad);

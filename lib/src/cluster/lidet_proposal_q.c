@@ -41,7 +41,7 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
     const lidet_cluster_q_rec_t *rec;
     const lidet_range_image_t *img;
     uint32_t i, npix, state;
-    int32_t mx, my, mz;
+    int32_t mx, my, mz, zo;
     int64_t rxy2;
 
     if (c == 0 || cfg == 0 || out == 0)
@@ -55,7 +55,8 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
     }
     if (cfg->n_points < 1u || cfg->n_points > LIDET_PROPOSAL_POINTS || cfg->azimuth_bin_bam == 0u ||
         cfg->azimuth_bin_bam > LIDET_Q_BAM_HALF || cfg->elevation_bin_bam == 0u ||
-        cfg->elevation_bin_bam > LIDET_Q_BAM_HALF || cfg->range_bin_4mm == 0u)
+        cfg->elevation_bin_bam > LIDET_Q_BAM_HALF || cfg->range_bin_4mm == 0u ||
+        cfg->z_origin > LIDET_PROPOSAL_Z_GROUND)
     {
         return LIDET_ERR_CONFIG;
     }
@@ -69,6 +70,8 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
     mx = rec->mean_4mm[0];
     my = rec->mean_4mm[1];
     mz = rec->mean_4mm[2];
+    /* the points' z origin: the cluster mean, or the ground under it (the mean minus its height above the plane) */
+    zo = cfg->z_origin == LIDET_PROPOSAL_Z_GROUND ? mz - rec->height_4mm : mz;
     for (i = 0; i < cfg->n_points; ++i)
     {
         const int32_t p =
@@ -82,11 +85,11 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
         lidet__qpix_xyz(img, (uint32_t)p, v); /* stored or decoded (lidet_qpix.h) */
         out->xyz[i][0] = sat16(v[0] - mx);
         out->xyz[i][1] = sat16(v[1] - my);
-        out->xyz[i][2] = sat16(v[2] - mz);
+        out->xyz[i][2] = sat16(v[2] - zo);
     }
     out->mean_4mm[0] = mx;
     out->mean_4mm[1] = my;
-    out->mean_4mm[2] = mz;
+    out->mean_4mm[2] = zo;
     /* a mean lies within the int16 pixels it averages: the squares fit in 64 bits, the roots in int32 */
     rxy2 = (int64_t)mx * mx + (int64_t)my * my;
     out->voxel[0] = bin_q(lidet__q_atan2(my, mx), cfg->azimuth_bin_bam);

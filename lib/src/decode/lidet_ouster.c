@@ -1,5 +1,5 @@
 /* SPDX-License-Identifier: MIT */
-/* Ouster packet decoding (see lidet_ouster.h and docs/DECODING.md). Integers only: part of both builds.
+/* Ouster packet decoding (see lidet_ouster.h and docs/OUSTER.md). Integers only: part of both builds.
  * Byte layouts: Ouster's OS1 manual ("Lidar Data Format", LEGACY), its firmware user manual ("Lidar Data") and
  * ouster-sdk's packet_format (ouster_client/src/parsing.cpp: offsets, masks and shifts of each profile's fields).
  * The pixel angle follows ouster-sdk's make_xyz_lut: encoder angle 2 pi (1 - measurement_id / columns_per_frame)

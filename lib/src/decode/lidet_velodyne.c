@@ -465,6 +465,176 @@ static inline void emit(sink_t *s, uint32_t dist, uint32_t intensity, uint32_t f
     ++s->stats->n_returns;
 }
 
+/* Scan tracking on firing azimuth az (the firing's own, never an interpolated one, which may overshoot): a jump
+ * beyond max_step_cdeg aborts the scan in progress, crossing the seam closes it (complete when it began at the
+ * seam); either boundary lands at output index s->n */
+static void track_scan(lidet_velodyne_t *st, lidet_velodyne_result_t *res, sink_t *s, uint32_t az)
+{
+    if (!st->have_prev)
+    {
+        st->have_prev = 1u;
+        st->from_seam = 0u;
+    }
+    else
+    {
+        const uint32_t d = fwd_cdeg(st->prev_cdeg, az);
+        if (d > st->cfg.max_step_cdeg)
+        {
+            ++st->stats.n_jumps;
+            s->n = boundary(st, res, s->n, LIDET_VELODYNE_SCAN_ABORTED);
+            st->from_seam = 0u;
+        }
+        else if (fwd_cdeg(st->cfg.seam_cdeg, st->prev_cdeg) + d >= FULL_CDEG)
+        {
+            s->n = boundary(st, res, s->n,
+                            st->from_seam ? LIDET_VELODYNE_SCAN_COMPLETE : LIDET_VELODYNE_SCAN_PARTIAL);
+            st->from_seam = 1u;
+        }
+    }
+    st->prev_cdeg = (uint16_t)az;
+}
+
+/* The fast path (the firmware's case: a VLP-16 single-return block, no attributes, no calibration, room for the
+ * whole block): the returns the general path (decode_firing) would emit, without its per-point work, written
+ * from o on; returns how many. With X = a * 128 + 8437 (a: the point's azimuth in FINE units), emit()'s bam_cw =
+ * floor(X / 16875), and FULL_FINE * 128 = 16875 * 2^16: a turn more or less changes only the quotient's bits
+ * above 16, so no wrap is needed, and along the block X grows by step * fine_num * 128 per firing unit: quotient
+ * and remainder are carried from point to point (two divisions per block, none per point). 97 -> 43 instructions
+ * per return on the Cortex-M4 (docs/DECODING.md, "On a microcontroller"); fuzz_velodyne checks it against the
+ * general path on every payload. */
+static uint32_t decode_fast(const lidet_velodyne_t *st, const model_t *m, const uint8_t *first, uint32_t az,
+                            uint32_t step, lidet_return_t *o)
+{
+    /* VLP-16: two sequences of 16 lasers, firing units 0..15 and 24..39 */
+    const uint8_t *pt = first + 4u;
+    const uint32_t f128 = step * m->fine_num * 128u, dq = f128 / 16875u, dr = f128 % 16875u;
+    const uint32_t x = az * FINE * 128u + 8437u;
+    const uint8_t *ring = st->ring;
+    const lidet_return_t *const o0 = o;
+    uint32_t q = x / 16875u, r = x % 16875u, seq, k;
+    for (seq = 0; seq < 2u; ++seq)
+    {
+        for (k = 0; k < 16u; ++k, pt += 3)
+        {
+            const uint32_t d0 = (uint32_t)pt[0] | ((uint32_t)pt[1] << 8);
+            if (d0 != 0u)
+            {
+                o->range_mm = d0 * 2u;
+                o->azimuth = (uint16_t)(0u - q);
+                o->ring = ring[k];
+                ++o;
+            }
+            q += dq;
+            r += dr;
+            if (r >= 16875u)
+            {
+                r -= 16875u;
+                ++q;
+            }
+        }
+        for (k = 0; k < 8u; ++k) /* units 16..23: the gap between the sequences */
+        {
+            q += dq;
+            r += dr;
+            if (r >= 16875u)
+            {
+                r -= 16875u;
+                ++q;
+            }
+        }
+    }
+    return (uint32_t)(o - o0);
+}
+
+/* a dual-return pair's returns (d0, i0: the first block's, the last return; d1, i1: the second block's, the
+ * strongest, or the second strongest when the strongest is the last one, VLP-16 manual 9.3.2.2), as the
+ * configured filter keeps them */
+static inline void emit_dual(sink_t *s, uint32_t filter, uint32_t d0, uint32_t i0, uint32_t d1, uint32_t i1)
+{
+    const int second = d1 != 0u && d1 != d0;                   /* a distinct other return */
+    const int second_strong = second && (d0 == 0u || i1 > i0); /* it is the strongest */
+    if (filter == LIDET_VELODYNE_RETURN_STRONGEST)
+    {
+        if (second_strong)
+        {
+            emit(s, d1, i1, LIDET_VELODYNE_FLAG_STRONGEST);
+        }
+        else if (d0 != 0u)
+        {
+            emit(s, d0, i0, LIDET_VELODYNE_FLAG_LAST | LIDET_VELODYNE_FLAG_STRONGEST);
+        }
+    }
+    else
+    {
+        if (d0 != 0u)
+        {
+            emit(s, d0, i0, LIDET_VELODYNE_FLAG_LAST | (second_strong ? 0u : LIDET_VELODYNE_FLAG_STRONGEST));
+        }
+        if (filter == LIDET_VELODYNE_RETURN_BOTH && second)
+        {
+            emit(s, d1, i1, second_strong ? LIDET_VELODYNE_FLAG_STRONGEST : 0u);
+        }
+    }
+}
+
+/* The general path: firing g (its first block at `first`, azimuth az, step the rotation to the next firing) of
+ * per_group blocks, every point's azimuth interpolated in FINE units and its return(s) emitted into s. The banks
+ * of an HDL-64E firing one after the other (upper, then lower); a dual pair's second block is read beside the
+ * first. */
+static void decode_firing(const lidet_velodyne_t *st, const model_t *m, sink_t *s, const uint8_t *first,
+                          uint32_t az, uint32_t step, uint32_t g, uint32_t mode, uint32_t per_group)
+{
+    const int dual = mode == MODE_DUAL;
+    uint32_t bank, j;
+    for (bank = 0; bank < (dual ? 1u : per_group); ++bank)
+    {
+        const uint8_t *blk = first + bank * BLOCK_BYTES;
+        const uint8_t *other = dual ? blk + BLOCK_BYTES : 0;
+        for (j = 0; j < POINTS; ++j)
+        {
+            const uint8_t *pt = blk + 4u + 3u * j;
+            const uint32_t d0 = rd16(pt), i0 = pt[2];
+            const uint32_t d1 = dual ? rd16(other + 4u + 3u * j) : 0u,
+                           i1 = dual ? other[4u + 3u * j + 2u] : 0u;
+            const uint32_t off = m->off_units[j];
+            const uint32_t laser = bank * POINTS + (j & (m->n_lasers - 1u)); /* 16, 32 or 64 lasers */
+            uint32_t interp;
+            int32_t a;
+            if (d0 == 0u && d1 == 0u)
+            {
+                continue; /* no return */
+            }
+            /* az + step * off / block_units - rot, in FINE units, rounded half up: step * off * FINE /
+             * block_units = step * off * fine_num / fine_den (exact when fine_den is 1); step <= 18 000, off <
+             * block_units <= 800, fine_num <= 10: < 2^28; a in [-FULL_FINE / 2, 2 FULL_FINE) */
+            interp = m->fine_den == 1u ? step * off * m->fine_num
+                                       : (step * off * m->fine_num + m->fine_den / 2u) / m->fine_den;
+            a = (int32_t)(az * FINE + interp) - (int32_t)st->rot_cdeg[laser] * (int32_t)FINE;
+            a += a < 0 ? (int32_t)FULL_FINE : 0;
+            a -= a >= (int32_t)FULL_FINE ? (int32_t)FULL_FINE : 0;
+            a -= a >= (int32_t)FULL_FINE ? (int32_t)FULL_FINE : 0;
+            s->az_fine = (uint32_t)a;
+            s->t_ns = (g * m->block_units + off) * m->unit_ns;
+            s->ring = st->ring[laser];
+            s->corr_mm = st->dist_mm[laser];
+            if (!dual)
+            {
+                if (d0 != 0u)
+                {
+                    emit(s, d0, i0,
+                         m->banks == 2u      ? 0u
+                         : mode == MODE_LAST ? LIDET_VELODYNE_FLAG_LAST
+                                             : LIDET_VELODYNE_FLAG_STRONGEST);
+                }
+            }
+            else
+            {
+                emit_dual(s, st->cfg.filter, d0, i0, d1, i1);
+            }
+        }
+    }
+}
+
 lidet_status_t lidet_velodyne_packet(lidet_velodyne_t *st, const uint8_t *payload, uint32_t len,
                                      lidet_return_t *out, lidet_velodyne_attr_t *attr, uint32_t cap,
                                      lidet_velodyne_result_t *res)
@@ -522,7 +692,7 @@ lidet_status_t lidet_velodyne_packet(lidet_velodyne_t *st, const uint8_t *payloa
     {
         const uint8_t *first = payload + g * per_group * BLOCK_BYTES;
         const uint32_t az = rd16(first + 2);
-        uint32_t step, bank, j;
+        uint32_t step;
         /* the rotation from this firing to the next: interpolates the firings inside this one */
         if (g + 1u < n_groups)
         {
@@ -537,160 +707,16 @@ lidet_status_t lidet_velodyne_packet(lidet_velodyne_t *st, const uint8_t *payloa
         {
             step = step_prev; /* the last firing: the step before it (constant speed over one packet) */
         }
-        /* scan tracking on the firings' own azimuths (never the interpolated ones, which may overshoot) */
-        if (!st->have_prev)
+        track_scan(st, res, &s, az);
+        if (!dual && attr == 0 && m->fine_den == 1u && m->banks == 1u && m->delta_cdeg == 0 &&
+            !st->calibrated && m->n_lasers == 16u && s.n + POINTS <= cap)
         {
-            st->have_prev = 1u;
-            st->from_seam = 0u;
-        }
-        else
-        {
-            const uint32_t d = fwd_cdeg(st->prev_cdeg, az);
-            if (d > st->cfg.max_step_cdeg)
-            {
-                ++st->stats.n_jumps;
-                s.n = boundary(st, res, s.n, LIDET_VELODYNE_SCAN_ABORTED);
-                st->from_seam = 0u;
-            }
-            else if (fwd_cdeg(st->cfg.seam_cdeg, st->prev_cdeg) + d >= FULL_CDEG)
-            {
-                s.n = boundary(st, res, s.n,
-                               st->from_seam ? LIDET_VELODYNE_SCAN_COMPLETE : LIDET_VELODYNE_SCAN_PARTIAL);
-                st->from_seam = 1u;
-            }
-        }
-        st->prev_cdeg = (uint16_t)az;
-        /* The fast path (the firmware's case: a VLP-16 single-return block, no attributes, no calibration, room for
-         * the whole block): the returns the loop below would emit, without its per-point work. With X = a * 128 +
-         * 8437 (a: the point's azimuth in FINE units), emit()'s bam_cw = floor(X / 16875), and FULL_FINE * 128 =
-         * 16875 * 2^16: a turn more or less changes only the quotient's bits above 16, so no wrap is needed, and
-         * along the block X grows by step * fine_num * 128 per firing unit: quotient and remainder are carried
-         * from point to point (two divisions per block, none per point). 97 -> 43 instructions per return on the
-         * Cortex-M4 (docs/DECODING.md, "On a microcontroller"); fuzz_velodyne checks it against the loop below on
-         * every payload. */
-        const int fast = !dual && attr == 0 && m->fine_den == 1u && m->banks == 1u && m->delta_cdeg == 0 &&
-                         !st->calibrated && m->n_lasers == 16u && s.n + POINTS <= cap;
-        if (fast)
-        {
-            /* VLP-16: two sequences of 16 lasers, firing units 0..15 and 24..39 */
-            const uint8_t *pt = first + 4u;
-            const uint32_t f128 = step * m->fine_num * 128u, dq = f128 / 16875u, dr = f128 % 16875u;
-            const uint32_t x = az * FINE * 128u + 8437u;
-            const uint8_t *ring = st->ring;
-            uint32_t q = x / 16875u, r = x % 16875u, seq, k;
-            lidet_return_t *o = out + s.n;
-            for (seq = 0; seq < 2u; ++seq)
-            {
-                for (k = 0; k < 16u; ++k, pt += 3)
-                {
-                    const uint32_t d0 = (uint32_t)pt[0] | ((uint32_t)pt[1] << 8);
-                    if (d0 != 0u)
-                    {
-                        o->range_mm = d0 * 2u;
-                        o->azimuth = (uint16_t)(0u - q);
-                        o->ring = ring[k];
-                        ++o;
-                    }
-                    q += dq;
-                    r += dr;
-                    if (r >= 16875u)
-                    {
-                        r -= 16875u;
-                        ++q;
-                    }
-                }
-                for (k = 0; k < 8u; ++k) /* units 16..23: the gap between the sequences */
-                {
-                    q += dq;
-                    r += dr;
-                    if (r >= 16875u)
-                    {
-                        r -= 16875u;
-                        ++q;
-                    }
-                }
-            }
-            k = (uint32_t)(o - (out + s.n));
+            const uint32_t k = decode_fast(st, m, first, az, step, out + s.n);
             s.n += k;
             st->stats.n_returns += k;
             continue;
         }
-        /* the banks of an HDL-64E firing one after the other (upper, then lower); a dual pair's second block is
-         * read beside the first */
-        for (bank = 0; bank < (dual ? 1u : per_group); ++bank)
-        {
-            const uint8_t *blk = first + bank * BLOCK_BYTES;
-            const uint8_t *other = dual ? blk + BLOCK_BYTES : 0;
-            for (j = 0; j < POINTS; ++j)
-            {
-                const uint8_t *pt = blk + 4u + 3u * j;
-                const uint32_t d0 = rd16(pt), i0 = pt[2];
-                const uint32_t d1 = dual ? rd16(other + 4u + 3u * j) : 0u,
-                               i1 = dual ? other[4u + 3u * j + 2u] : 0u;
-                const uint32_t off = m->off_units[j];
-                const uint32_t laser = bank * POINTS + (j & (m->n_lasers - 1u)); /* 16, 32 or 64 lasers */
-                uint32_t interp;
-                int32_t a;
-                if (d0 == 0u && d1 == 0u)
-                {
-                    continue; /* no return */
-                }
-                /* az + step * off / block_units - rot, in FINE units, rounded half up: step * off * FINE /
-                 * block_units = step * off * fine_num / fine_den (exact when fine_den is 1); step <= 18 000, off <
-                 * block_units <= 800, fine_num <= 10: < 2^28; a in [-FULL_FINE / 2, 2 FULL_FINE) */
-                interp = m->fine_den == 1u ? step * off * m->fine_num
-                                           : (step * off * m->fine_num + m->fine_den / 2u) / m->fine_den;
-                a = (int32_t)(az * FINE + interp) - (int32_t)st->rot_cdeg[laser] * (int32_t)FINE;
-                a += a < 0 ? (int32_t)FULL_FINE : 0;
-                a -= a >= (int32_t)FULL_FINE ? (int32_t)FULL_FINE : 0;
-                a -= a >= (int32_t)FULL_FINE ? (int32_t)FULL_FINE : 0;
-                s.az_fine = (uint32_t)a;
-                s.t_ns = (g * m->block_units + off) * m->unit_ns;
-                s.ring = st->ring[laser];
-                s.corr_mm = st->dist_mm[laser];
-                if (!dual)
-                {
-                    if (d0 != 0u)
-                    {
-                        emit(&s, d0, i0,
-                             m->banks == 2u      ? 0u
-                             : mode == MODE_LAST ? LIDET_VELODYNE_FLAG_LAST
-                                                 : LIDET_VELODYNE_FLAG_STRONGEST);
-                    }
-                }
-                else
-                {
-                    /* first block: the last return; second: the strongest, or the second strongest when the
-                     * strongest is the last one (VLP-16 manual 9.3.2.2) */
-                    const int second = d1 != 0u && d1 != d0;                   /* a distinct other return */
-                    const int second_strong = second && (d0 == 0u || i1 > i0); /* it is the strongest */
-                    if (st->cfg.filter == LIDET_VELODYNE_RETURN_STRONGEST)
-                    {
-                        if (second_strong)
-                        {
-                            emit(&s, d1, i1, LIDET_VELODYNE_FLAG_STRONGEST);
-                        }
-                        else if (d0 != 0u)
-                        {
-                            emit(&s, d0, i0, LIDET_VELODYNE_FLAG_LAST | LIDET_VELODYNE_FLAG_STRONGEST);
-                        }
-                    }
-                    else
-                    {
-                        if (d0 != 0u)
-                        {
-                            emit(&s, d0, i0,
-                                 LIDET_VELODYNE_FLAG_LAST |
-                                     (second_strong ? 0u : LIDET_VELODYNE_FLAG_STRONGEST));
-                        }
-                        if (st->cfg.filter == LIDET_VELODYNE_RETURN_BOTH && second)
-                        {
-                            emit(&s, d1, i1, second_strong ? LIDET_VELODYNE_FLAG_STRONGEST : 0u);
-                        }
-                    }
-                }
-            }
-        }
+        decode_firing(st, m, &s, first, az, step, g, mode, per_group);
     }
     res->n_returns = s.n;
     if (res->scan_event == LIDET_VELODYNE_SCAN_NONE)

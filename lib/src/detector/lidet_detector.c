@@ -108,7 +108,8 @@ lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg
         return LIDET_ERR_CONFIG;
     }
     if (lidet_pn_check(cls, LIDET_PN_CLASSIFIER, 0) != LIDET_OK ||
-        lidet_pn_check(box, LIDET_PN_BOX, 0) != LIDET_OK || cls->n_points != box->n_points)
+        lidet_pn_check(box, LIDET_PN_BOX, 0) != LIDET_OK || cls->n_points != box->n_points ||
+        cls->z_origin != box->z_origin || cls->z_origin > LIDET_PROPOSAL_Z_GROUND)
     {
         return LIDET_ERR_MODEL;
     }
@@ -179,6 +180,7 @@ lidet_status_t lidet_detector_init(lidet_detector_t *d, const lidet_detector_cfg
     }
     d->cfg = *cfg;
     d->cfg.proposal.n_points = cls->n_points;
+    d->cfg.proposal.z_origin = cls->z_origin; /* the proposals the models were trained on */
     d->n_det = 0;
     memset(&d->stats, 0, sizeof d->stats);
     d->magic = LIDET_INIT_MAGIC;

@@ -112,7 +112,8 @@ lidet_status_t lidet_detector_q_init(lidet_detector_q_t *d, const lidet_detector
     }
     if (lidet_pointnet_q_check(cls, LIDET_PN_CLASSIFIER, 0) != LIDET_OK ||
         lidet_pointnet_q_check(box, LIDET_PN_BOX, 0) != LIDET_OK || cls->n_points != box->n_points ||
-        cls->n_points > LIDET_PROPOSAL_POINTS)
+        cls->n_points > LIDET_PROPOSAL_POINTS || cls->z_origin != box->z_origin ||
+        cls->z_origin > LIDET_PROPOSAL_Z_GROUND)
     {
         return LIDET_ERR_MODEL;
     }
@@ -127,6 +128,7 @@ lidet_status_t lidet_detector_q_init(lidet_detector_q_t *d, const lidet_detector
     }
     d->cfg = *cfg;
     d->cfg.proposal.n_points = cls->n_points;
+    d->cfg.proposal.z_origin = cls->z_origin; /* the proposals the models were trained on */
     if (cfg->crop_half_bam > 0)
     {
         /* the crop: the ground's RANSAC draws a stream per cell, as the float detector's crop does, so that

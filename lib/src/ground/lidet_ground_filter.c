@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "internal/lidet_assert.h"
-#include "internal/lidet_ground_internal.h"
+#include "internal/lidet_ground_float_internal.h"
 #include "internal/lidet_math.h"
 #include "internal/lidet_pixel.h"
 #include "internal/lidet_pixel_rxy.h"

@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "internal/lidet_assert.h"
-#include "internal/lidet_ground_internal.h"
+#include "internal/lidet_ground_float_internal.h"
 #include "internal/lidet_math.h"
 #include "internal/lidet_pixel.h"
 #include "internal/lidet_rng.h"
@@ -317,33 +317,18 @@ static uint32_t score_idx(const lidet_range_image_t *img, int compact, const lid
     return cnt;
 }
 
-/* RANSAC on one sector (mirrors lidet_ref/ground.py: ransac_sector). Returns 1 with *out set when a
- * plane passes every check. */
-static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img,
-                      const lidet_ground_sample_t *idx, uint32_t n, const lidet_plane_t *near, float at_x,
-                      float at_y, lidet_plane_t *out)
+/* The RANSAC draws of one sector: ransac_iters triples of its n samples; a plane within max_tilt (cos2: cos^2 of
+ * it) is scored on the scoring subset (copied: its contiguous copy sc->ev_*, n_eval points; else the samples
+ * idx[0, stride, ...)), and the highest count wins (ties: the first), with the adaptive stop. Returns 1 with
+ * *best and *best_cnt set when any hypothesis was scored. */
+static int best_hypothesis(lidet_ground_state_t *g, const lidet_ground_scratch_t *sc,
+                           const lidet_range_image_t *img, int compact, const lidet_ground_sample_t *idx,
+                           uint32_t n, uint32_t stride, uint32_t n_eval, int copied, float cos2,
+                           lidet_plane_t *best, uint32_t *best_cnt)
 {
-    const int compact = lidet__img_compact(img);
     const lidet_ground_cfg_t *cfg = &g->cfg;
-    const float cos_tilt = cosf(cfg->max_tilt_rad);
-    const float cos2 = cos_tilt * cos_tilt;
-    const uint32_t stride = (n + cfg->eval_samples - 1u) / cfg->eval_samples;
-    const uint32_t n_eval = (n + stride - 1u) / stride; /* size of the strided subset */
-    lidet_plane_t best;
-    /* the scoring subset: the strided one of the cell's samples (pixel indices into the image), copied
-     * once into the scratch when it fits, so that every hypothesis scores a contiguous block (same
-     * points, same counts); a larger subset is scored through the indices */
-    const int copied = n_eval <= LIDET_GROUND_EVAL_MAX;
-    uint32_t best_cnt = 0, it, r, i;
+    uint32_t it;
     int have = 0;
-    memset(&best, 0, sizeof best);
-    if (copied)
-    {
-        for (i = 0; i < n_eval; ++i)
-        {
-            lidet__img_xyz(img, idx[i * stride], compact, &sc->ev_x_m[i], &sc->ev_y_m[i], &sc->ev_z_m[i]);
-        }
-    }
     for (it = 0; it < cfg->ransac_iters; ++it)
     {
         const uint32_t i0 = lidet__rng_below(&g->rng, n);
@@ -389,10 +374,10 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
         ++g->stats.n_hypotheses;
         cnt = copied ? score(sc->ev_x_m, sc->ev_y_m, sc->ev_z_m, n_eval, &p, cfg->inlier_m)
                      : score_idx(img, compact, idx, n, stride, &p, cfg->inlier_m);
-        if (!have || cnt > best_cnt)
+        if (!have || cnt > *best_cnt)
         {
-            best = p;
-            best_cnt = cnt;
+            *best = p;
+            *best_cnt = cnt;
             have = 1;
             /* adaptive stop (deterministic: depends on counts only): enough hypotheses were drawn
              * to pick an all-inlier triple with probability `confidence`, given the inlier share w
@@ -413,15 +398,20 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
             }
         }
     }
-    if (!have || best_cnt < cfg->min_inliers)
-    {
-        return 0;
-    }
-    /* least-squares refinement on the inliers of the current plane (all samples of the sector), on a
-     * contiguous copy of them: the scoring copy when it holds them all (stride 1), else, when they fit, the
-     * row scratch of the label pass (free until that pass: x_row, y_row, z_rows[0]) filled once here, so the
-     * iterations neither gather nor decode again; the sums are those of the gathered blocks, bit for bit */
+    return have;
+}
+
+/* Least-squares refinement of *best on the inliers of the current plane (all n samples of the sector), up to
+ * refine_iters times, keeping the last good plane. It works on a contiguous copy of the samples: the scoring copy
+ * when it holds them all (stride 1), else, when they fit, the row scratch of the label pass (free until that
+ * pass: x_row, y_row, z_rows[0]) filled once here, so the iterations neither gather nor decode again; the sums
+ * are those of the gathered blocks, bit for bit */
+static void refine_plane(const lidet_ground_cfg_t *cfg, lidet_ground_scratch_t *sc,
+                         const lidet_range_image_t *img, int compact, const lidet_ground_sample_t *idx,
+                         uint32_t n, int copied, uint32_t stride, float cos2, lidet_plane_t *best)
+{
     const float *rx = 0, *ry = 0, *rz = 0;
+    uint32_t r, i;
     if (copied && stride == 1u)
     {
         rx = sc->ev_x_m;
@@ -445,16 +435,51 @@ static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const
         /* shift: the point of the plane under the sector's first sample */
         float z_first;
         lidet__img_xyz(img, idx[0], compact, &shift[0], &shift[1], &z_first);
-        shift[2] = best.nz > 0.0f ? -(best.nx * shift[0] + best.ny * shift[1] + best.d_m) / best.nz : z_first;
+        shift[2] =
+            best->nz > 0.0f ? -(best->nx * shift[0] + best->ny * shift[1] + best->d_m) / best->nz : z_first;
         if ((rx != 0
-                 ? accumulate(rx, ry, rz, n, &best, cfg->inlier_m, shift, cov, centroid)
-                 : accumulate_idx(img, compact, idx, n, &best, cfg->inlier_m, shift, cov, centroid)) < 3u ||
+                 ? accumulate(rx, ry, rz, n, best, cfg->inlier_m, shift, cov, centroid)
+                 : accumulate_idx(img, compact, idx, n, best, cfg->inlier_m, shift, cov, centroid)) < 3u ||
             !plane_from_cov(cov, centroid, &p, 0) || !(p.nz * p.nz >= cos2))
         {
             break; /* keep the last good plane */
         }
-        best = p;
+        *best = p;
     }
+}
+
+/* RANSAC on one sector (mirrors lidet_ref/ground.py: ransac_sector): the draws (best_hypothesis), the
+ * least-squares refinement (refine_plane), the checks. Returns 1 with *out set when a plane passes every check. */
+static int fit_sector(lidet_ground_state_t *g, lidet_ground_scratch_t *sc, const lidet_range_image_t *img,
+                      const lidet_ground_sample_t *idx, uint32_t n, const lidet_plane_t *near, float at_x,
+                      float at_y, lidet_plane_t *out)
+{
+    const int compact = lidet__img_compact(img);
+    const lidet_ground_cfg_t *cfg = &g->cfg;
+    const float cos_tilt = cosf(cfg->max_tilt_rad);
+    const float cos2 = cos_tilt * cos_tilt;
+    const uint32_t stride = (n + cfg->eval_samples - 1u) / cfg->eval_samples;
+    const uint32_t n_eval = (n + stride - 1u) / stride; /* size of the strided subset */
+    lidet_plane_t best;
+    /* the scoring subset: the strided one of the cell's samples (pixel indices into the image), copied
+     * once into the scratch when it fits, so that every hypothesis scores a contiguous block (same
+     * points, same counts); a larger subset is scored through the indices */
+    const int copied = n_eval <= LIDET_GROUND_EVAL_MAX;
+    uint32_t best_cnt = 0, i;
+    memset(&best, 0, sizeof best);
+    if (copied)
+    {
+        for (i = 0; i < n_eval; ++i)
+        {
+            lidet__img_xyz(img, idx[i * stride], compact, &sc->ev_x_m[i], &sc->ev_y_m[i], &sc->ev_z_m[i]);
+        }
+    }
+    if (!best_hypothesis(g, sc, img, compact, idx, n, stride, n_eval, copied, cos2, &best, &best_cnt) ||
+        best_cnt < cfg->min_inliers)
+    {
+        return 0;
+    }
+    refine_plane(cfg, sc, img, compact, idx, n, copied, stride, cos2, &best);
     if (!(best.nz >= cos_tilt))
     {
         return 0;

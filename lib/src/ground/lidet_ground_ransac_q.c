@@ -280,57 +280,71 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
     return 1;
 }
 
-/* RANSAC on one cell (lidet_ref/ground_q.py: ransac_cell): the float stage's draws and control flow; a hypothesis
- * is the exact cross product c of two 4 mm difference vectors, a sample its inlier when
- * 4 |c . (p - p0)| <= inlier_mm * |c|. Returns 1 with *out set when the plane passes every check. */
-static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
-                      const lidet__ground_q_pix_t *gp, const lidet_ground_sample_t *idx, uint32_t n,
-                      int far_step, qplane_t *out)
+/* The inlier count of hypothesis (c, p0, thr_l) over the cell's scoring subset (copied: the contiguous copy
+ * sc->ev_*, n_eval samples; else the samples 0, stride, ... of n): a sample is an inlier when
+ * 4 |c . (q - p0)| <= thr_l. With `have`, a count that can no longer beat best_cnt stops early (its count decides
+ * nothing else, so the fitted planes are those of the full count). */
+static uint32_t count_inliers(const lidet_ground_q_scratch_t *sc, const cell_src_t *img, uint32_t n,
+                              uint32_t stride, uint32_t n_eval, int copied, const int64_t c[3],
+                              const int32_t p0[3], int64_t thr_l, int have, uint32_t best_cnt)
 {
-    cell_src_t src, *const img = &src;
-    const lidet_ground_q_cfg_t *cfg = &g->cfg;
-    const uint32_t stride = (n + cfg->eval_samples - 1u) / cfg->eval_samples;
-    const uint32_t n_eval = (n + stride - 1u) / stride;
-    const int copied = n_eval <= LIDET_GROUND_EVAL_MAX;
-    const int64_t cos_t = g->cos_tilt_q30, inl = cfg->inlier_mm;
-    const int64_t miss_max = (int64_t)(65536u - cfg->confidence_q16) << 14;
-    int64_t best_c[3] = {0, 0, 0};
-    int32_t best_p0[3] = {0, 0, 0};
-    uint32_t best_len = 0, best_cnt = 0, it, r, i;
-    qplane_t best;
-    int have = 0;
-    src.img = gp;
-    src.idx = idx;
-    src.xyz = 0;
-    if (gp->ct != 0 &&
-        3u * n <= sizeof sc->r_rows / sizeof(int32_t)) /* a range-only image's cell that fits */
-    {
-        int32_t *xyz = &sc->r_rows[0][0];
-        for (i = 0; i < n; ++i)
-        {
-            pixel(&src, i, xyz + 3u * i);
-        }
-        src.xyz = xyz;
-    }
+    /* a sample is an inlier when 4 |h| <= thr_l, i.e. |h| <= t = floor(thr_l / 4), i.e. h + t in [0, 2t]
+     * (one unsigned comparison); c is within 2^29 after scale_down, so each product is one 32 x 32 -> 64
+     * multiply(-accumulate) */
+    const int32_t c0 = (int32_t)c[0], c1 = (int32_t)c[1], c2 = (int32_t)c[2];
+    const int64_t t = thr_l >> 2;
+    const uint64_t t2 = 2u * (uint64_t)t;
+    uint32_t i, cnt = 0;
     if (copied)
     {
-        for (i = 0; i < n_eval; ++i)
+        /* in blocks of 32 samples; a hypothesis that can no longer beat the best count stops */
+        for (i = 0; i < n_eval && (!have || cnt + (n_eval - i) > best_cnt);)
         {
-            int32_t q[3];
-            pixel(img, i * stride, q);
-            sc->ev_x[i] = (int16_t)q[0];
-            sc->ev_y[i] = (int16_t)q[1];
-            sc->ev_z[i] = (int16_t)q[2];
+            const uint32_t end = n_eval - i > 32u ? i + 32u : n_eval;
+            for (; i < end; ++i)
+            {
+                const int64_t h = (int64_t)c0 * (sc->ev_x[i] - p0[0]) + (int64_t)c1 * (sc->ev_y[i] - p0[1]) +
+                                  (int64_t)c2 * (sc->ev_z[i] - p0[2]);
+                cnt += (uint32_t)((uint64_t)(h + t) <= t2);
+            }
         }
     }
+    else
+    {
+        for (i = 0; i < n; i += stride)
+        {
+            int32_t q[3];
+            int64_t h;
+            pixel(img, i, q);
+            h = (int64_t)c0 * (q[0] - p0[0]) + (int64_t)c1 * (q[1] - p0[1]) + (int64_t)c2 * (q[2] - p0[2]);
+            cnt += (uint32_t)((uint64_t)(h + t) <= t2);
+        }
+    }
+    return cnt;
+}
+
+/* The RANSAC draws of one cell (the float stage's best_hypothesis): ransac_iters triples of its n samples, a
+ * hypothesis the exact cross product c of two 4 mm difference vectors (scaled within 2^29), rejected when
+ * degenerate or tilted beyond max_tilt, else scored by count_inliers; the highest count wins (ties: the first),
+ * with the adaptive stop. Returns 1 with the best hypothesis (best_c, best_p0, its length *best_len) and
+ * *best_cnt set when any was scored. */
+static int best_hypothesis_q(lidet_ground_q_state_t *g, const lidet_ground_q_scratch_t *sc,
+                             const cell_src_t *img, uint32_t n, uint32_t stride, uint32_t n_eval, int copied,
+                             int64_t best_c[3], int32_t best_p0[3], uint32_t *best_len, uint32_t *best_cnt)
+{
+    const lidet_ground_q_cfg_t *cfg = &g->cfg;
+    const int64_t cos_t = g->cos_tilt_q30, inl = cfg->inlier_mm;
+    const int64_t miss_max = (int64_t)(65536u - cfg->confidence_q16) << 14;
+    uint32_t it;
+    int have = 0;
     for (it = 0; it < cfg->ransac_iters; ++it)
     {
         const uint32_t i0 = lidet__rng_below(&g->rng, n);
         const uint32_t i1 = lidet__rng_below(&g->rng, n);
         const uint32_t i2 = lidet__rng_below(&g->rng, n);
         int32_t p0[3], p1[3], p2[3];
-        int64_t c[3], thr_l, len2;
-        uint32_t len, cnt = 0;
+        int64_t c[3], len2;
+        uint32_t len, cnt;
         if (i0 == i1 || i0 == i2 || i1 == i2)
         {
             continue;
@@ -359,49 +373,13 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
             continue;
         }
         ++g->stats.n_hypotheses;
-        thr_l = inl * (int64_t)len;
+        cnt = count_inliers(sc, img, n, stride, n_eval, copied, c, p0, inl * (int64_t)len, have, *best_cnt);
+        if (!have || cnt > *best_cnt)
         {
-            /* a sample is an inlier when 4 |h| <= thr_l, i.e. |h| <= t = floor(thr_l / 4), i.e. h + t in [0, 2t]
-             * (one unsigned comparison); c is within 2^29 after scale_down, so each product is one 32 x 32 -> 64
-             * multiply(-accumulate) */
-            const int32_t c0 = (int32_t)c[0], c1 = (int32_t)c[1], c2 = (int32_t)c[2];
-            const int64_t t = thr_l >> 2;
-            const uint64_t t2 = 2u * (uint64_t)t;
-            if (copied)
-            {
-                /* in blocks of 32 samples; a hypothesis that can no longer beat the best count stops (its count
-                 * decides nothing else, so the fitted planes are those of the full count) */
-                for (i = 0; i < n_eval && (!have || cnt + (n_eval - i) > best_cnt);)
-                {
-                    const uint32_t end = n_eval - i > 32u ? i + 32u : n_eval;
-                    for (; i < end; ++i)
-                    {
-                        const int64_t h = (int64_t)c0 * (sc->ev_x[i] - p0[0]) +
-                                          (int64_t)c1 * (sc->ev_y[i] - p0[1]) +
-                                          (int64_t)c2 * (sc->ev_z[i] - p0[2]);
-                        cnt += (uint32_t)((uint64_t)(h + t) <= t2);
-                    }
-                }
-            }
-            else
-            {
-                for (i = 0; i < n; i += stride)
-                {
-                    int32_t q[3];
-                    int64_t h;
-                    pixel(img, i, q);
-                    h = (int64_t)c0 * (q[0] - p0[0]) + (int64_t)c1 * (q[1] - p0[1]) +
-                        (int64_t)c2 * (q[2] - p0[2]);
-                    cnt += (uint32_t)((uint64_t)(h + t) <= t2);
-                }
-            }
-        }
-        if (!have || cnt > best_cnt)
-        {
-            memcpy(best_c, c, sizeof best_c);
-            memcpy(best_p0, p0, sizeof best_p0);
-            best_len = len;
-            best_cnt = cnt;
+            memcpy(best_c, c, 3 * sizeof best_c[0]);
+            memcpy(best_p0, p0, 3 * sizeof best_p0[0]);
+            *best_len = len;
+            *best_cnt = cnt;
             have = 1;
             /* adaptive stop without log: (1 - w^3)^(it + 1) <= 1 - confidence, all in Q30 (the power is
              * non-increasing, so the first factor that crosses the bound decides) */
@@ -422,7 +400,53 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
             }
         }
     }
-    if (!have || best_cnt < cfg->min_inliers)
+    return have;
+}
+
+/* RANSAC on one cell (lidet_ref/ground_q.py: ransac_cell): the float stage's draws and control flow
+ * (best_hypothesis_q), the hypothesis as a plane, its refinements (refine), the checks. A hypothesis is the exact
+ * cross product c of two 4 mm difference vectors, a sample its inlier when 4 |c . (p - p0)| <= inlier_mm * |c|.
+ * Returns 1 with *out set when the plane passes every check. */
+static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                      const lidet__ground_q_pix_t *gp, const lidet_ground_sample_t *idx, uint32_t n,
+                      int far_step, qplane_t *out)
+{
+    cell_src_t src, *const img = &src;
+    const lidet_ground_q_cfg_t *cfg = &g->cfg;
+    const uint32_t stride = (n + cfg->eval_samples - 1u) / cfg->eval_samples;
+    const uint32_t n_eval = (n + stride - 1u) / stride;
+    const int copied = n_eval <= LIDET_GROUND_EVAL_MAX;
+    const int64_t cos_t = g->cos_tilt_q30;
+    int64_t best_c[3] = {0, 0, 0};
+    int32_t best_p0[3] = {0, 0, 0};
+    uint32_t best_len = 0, best_cnt = 0, r, i;
+    qplane_t best;
+    src.img = gp;
+    src.idx = idx;
+    src.xyz = 0;
+    if (gp->ct != 0 &&
+        3u * n <= sizeof sc->r_rows / sizeof(int32_t)) /* a range-only image's cell that fits */
+    {
+        int32_t *xyz = &sc->r_rows[0][0];
+        for (i = 0; i < n; ++i)
+        {
+            pixel(&src, i, xyz + 3u * i);
+        }
+        src.xyz = xyz;
+    }
+    if (copied)
+    {
+        for (i = 0; i < n_eval; ++i)
+        {
+            int32_t q[3];
+            pixel(img, i * stride, q);
+            sc->ev_x[i] = (int16_t)q[0];
+            sc->ev_y[i] = (int16_t)q[1];
+            sc->ev_z[i] = (int16_t)q[2];
+        }
+    }
+    if (!best_hypothesis_q(g, sc, img, n, stride, n_eval, copied, best_c, best_p0, &best_len, &best_cnt) ||
+        best_cnt < cfg->min_inliers)
     {
         return 0;
     }

@@ -1,19 +1,40 @@
 /* SPDX-License-Identifier: MIT */
-/* The flood fill of the clustering, written once for every image format and arithmetic: lidet_cluster_grow.c
- * includes this file twice, with GROW_RNG_T float (a float image: ranges in metres) and uint16_t (a compact
- * image: ranges in 4 mm steps, read as floats; the caller scales the gap bound to steps), and
- * lidet_cluster_grow_q.c once more for the integer stage (ranges in 4 mm steps read as integers). The
- * parameters:
- *   GROW_RNG_T       the range plane's element type, GROW_RANGES(img) the plane;
- *   GROW_D_T         the type a range is read as (float, or uint32_t for the integer stage);
- *   GROW_TAB_T       the element type of the join test's two angle tables;
- *   GROW_TA(c, t), GROW_TB(c, t)  the two tables of kind t (col, row, diag) of state c: float sin and
- *                    cos of alpha, or the integer stage's sin(alpha + theta) and 4 sin^2(alpha / 2);
- *   GROW_LINK        the join test link(da, db, ta, tb, g);
- *   GROW_STATE_T, GROW_PARAM_T  the state and the run's constants (same member names in both stages);
- *   GROW_FN(name)    the copy's function names.
- * Each copy is the code the float stage had before the compact image (reads are (GROW_D_T)rng[n], a no-op
- * for float), so none pays for another. Not a public header; include nowhere else. */
+/* Macro template: the clustering's flood fill (the stage's hot loop): the directional searches with hole and
+ * occluder bridging and the breadth-first fill that calls them, written once for every image format and
+ * arithmetic.
+ *
+ * Instantiated by (each #include after #defining the parameters below; #undef between two copies):
+ *   lib/src/cluster/lidet_cluster_grow.c    twice: a float image (GROW_RNG_T float, GROW_D_T float, GROW_LINK
+ *                                          link, names *_m) and a compact one (GROW_RNG_T uint16_t, GROW_D_T
+ *                                          uint32_t, GROW_LINK link_4mm: ranges in 4 mm steps read and ordered
+ *                                          as integers, converted exactly for the float test, names *_4mm);
+ *                                          tables GROW_TAB_T float
+ *   lib/src/cluster/lidet_cluster_grow_q.c  once, the integer stage: GROW_RNG_T uint16_t, GROW_D_T uint32_t,
+ *                                          GROW_TAB_T uint32_t, GROW_LINK link_q, names *_q
+ *
+ * Parameters:
+ *   GROW_RNG_T          the range plane's element type
+ *   GROW_RANGES(img)    the range plane of image img
+ *   GROW_D_T            the type a range is read as: the join test's argument ((GROW_D_T)rng[n])
+ *   GROW_TAB_T          the element type of the join test's two angle tables
+ *   GROW_TA(c, t)       table A of kind t (col, row, diag) of state c: float sin(alpha), or the integer
+ *                       stage's sin(alpha + theta)
+ *   GROW_TB(c, t)       table B of that kind: float cos(alpha), or the integer stage's 4 sin^2(alpha / 2)
+ *   GROW_LINK(da, db, ta, tb, g)  the join test of two ranges with one entry of each table, nonzero to join
+ *   GROW_STATE_T        the stage's state (members labels, members, img and the tables; same names in both)
+ *   GROW_PARAM_T        the run's constants (rows, cols, ks, kc, diag, row_magic, bridged, bridge_max)
+ *   GROW_FN(name)       the copy's name of function `name` (a suffix per copy)
+ * Also read, from lidet_cluster_common.h: LAB_FREE, LAB_NONCAND, STEPS, lidet__cluster_take.
+ * Defines: static GROW_FN(search), GROW_FN(search_wrap), GROW_FN(grow) (the fill; the includer's entry point
+ * calls it with the occluder rule occl a constant).
+ *
+ * Why a template: C99 has no generic functions, and the three copies differ in the innermost loop (the range
+ * type, the test, the tables). A function taking the test as a function pointer or switching on the format
+ * would pay an indirect call or a branch per neighbour looked at; each copy here compiles to the code written
+ * for its types (the float copy is exactly the code the float stage had before the compact image, the reads a
+ * no-op cast), so none pays for another, and the three keep one control flow (the same joins in the same
+ * order, which the tests against codegen/lidet_ref/cluster.py and cluster_q.py rely on).
+ * Not a public header; include nowhere else. */
 
 /* One directional search from q (range dq): pixels q + k * step, k = 1..nk, never wrapping (the
  * caller sends the columns within kc of either edge to search_wrap); beam pair sin/cos at

@@ -1,11 +1,33 @@
 /* SPDX-License-Identifier: MIT */
-/* The fragment rescue's window walk, written once for the float stage (lidet_cluster_rescue.c) and the
- * integer one (lidet_cluster_rescue_q.c), each of which includes this file once. Parameters:
- *   RESCUE_STATE_T, RESCUE_PARAM_T, RESCUE_RS_T  the state, the run's constants, the group's running state;
- *   RESCUE_WIN_T, RESCUE_WIN_SET(c, win, q, g, compact)  what the stage derives from group pixel q before its
- *                window is looked at (its range and the range bounds of a possible partner);
- *   RESCUE_PROBE(c, rs, lab, n, win, g, compact)  the test of window pixel n (joins or records a contact).
- * `compact` is the float stage's image format (a constant per copy); the integer stage ignores it.
+/* Macro template: the fragment rescue's window walk (rescue_grow): the breadth-first fill of one rescue group,
+ * looking at every pixel of each member's window, four labels at a time where they can be skipped.
+ *
+ * Instantiated by (each #include once, after #defining the parameters below):
+ *   lib/src/cluster/lidet_cluster_rescue.c    the float stage: lidet_cluster_state_t, lidet__grow_t,
+ *                                            lidet__rescue_t; windows window_t (float ranges, m or 4 mm steps)
+ *   lib/src/cluster/lidet_cluster_rescue_q.c  the integer stage: lidet_cluster_q_state_t, lidet__grow_q_t,
+ *                                            lidet__rescue_q_t; windows window_q_t (integer 4 mm steps)
+ *
+ * Parameters:
+ *   RESCUE_STATE_T      the stage's state (members members, labels)
+ *   RESCUE_PARAM_T      the run's constants (rows, cols, rrows, rcols: the window's half height and width)
+ *   RESCUE_RS_T         the group's running state (member tail; the nearest contact)
+ *   RESCUE_WIN_T        what the stage derives from a group pixel before its window is looked at
+ *   RESCUE_WIN_SET(c, win, q, g, compact)  fill *win from group pixel q (its range, the bounds of a partner's)
+ *   RESCUE_PROBE(c, rs, lab, n, win, g, compact)  the test of window pixel n: it joins the group, is recorded
+ *                       as a contact, or is passed over
+ * `compact` is the float stage's image format (a constant in each of its calls); the integer stage ignores it.
+ * Also read, from lidet_cluster_common.h: LAB_PENDING, LAB_NONCAND.
+ * Defines: static inline void rescue_grow(RESCUE_STATE_T *c, const RESCUE_PARAM_T *g, uint32_t start,
+ * RESCUE_RS_T *rs, int compact), called by the includer's entry point (lidet__cluster_rescue_grow,
+ * lidet__cluster_q_rescue_grow).
+ *
+ * Why a template: the two stages' states, windows and distance tests are different types (float ranges and
+ * coordinates, or integer 4 mm steps), which no C99 function can take at once; RESCUE_PROBE runs once per window
+ * pixel, so a function pointer would cost an indirect call per pixel and keep the float stage's `compact` test in
+ * the loop. The template keeps one walk (the same pixels in the same order, so the same first contact on
+ * ties, as both references, codegen/lidet_ref/cluster.py and cluster_q.py, require) with each stage's test
+ * inlined.
  * Not a public header; include nowhere else. */
 
 /* Breadth-first fill of the rescue group seeded at members[start]. Around each member q it looks at

@@ -1,30 +1,54 @@
 /* SPDX-License-Identifier: MIT */
-/* The clustering's bookkeeping, written once for the float stage (lidet_cluster.c) and the integer one
- * (lidet_cluster_q.c), each of which includes this file once: the capacity (the smallest kept cluster,
- * a slot for a new one), the canonical ids, the searches for the next seed, and the run's driver (first
- * fill, rescue pass, canonical order). Nothing here reads a coordinate or a range. Parameters:
- *   RUN_STATE_T, RUN_REC_T       the state and its record type (members n_recs, recs, order, slot_id,
- *                                labels, members; records n_points, first_member, seed_pixel);
- *   RUN_MEAN(r), RUN_MIN(r), RUN_MAX(r), RUN_HEIGHT(r)  a record's numeric fields (summary fields: lo, hi,
- *                                mean, h);
- *   RUN_PARAM_T, RUN_PLANE_T     the flood fill's constants and the ground plane type;
- *   RUN_GROW(c, g, start, tail)  the first fill of one component (returns the new tail);
- *   RUN_RESCUE_T, RUN_RESCUE_FAR  the rescue group's running state and its "no contact yet" distance;
- *   RUN_RESCUE_GROW(c, g, start, rs);
- *   RUN_FRAGMENT_BUDGET(c)      the rescue budget in fragment pixels (0: none);
- *   RUN_REFINE_SPLIT(c, planes, n_sectors, st), RUN_REFINE_JOIN(...)  the stage's refinement (cuts, joins;
- *                                returns nonzero when it changed anything);
- * and the numeric kernels of the filters and records, static functions of the including file:
- *   RUN_SUMMARY_T                          what one pass over a component's members gives (sums, bounds, mean,
- *                                          height);
- *   int summarise(c, start, tail, small, s)  sums and bounds; nonzero when an extent exceeds the limit
- *                                          (small: no limit);
- *   int mean_height_ok(c, n, seed, s, planes, n_sectors)  the mean and its height; nonzero when it passes;
- *   void record_sums(c, slot, s)           what the stage keeps of s beside the record (or nothing);
+/* Macro template: the clustering's bookkeeping: the capacity (the smallest kept cluster, a slot for a new one),
+ * the filters and records of each component, the canonical ids, the searches for the next seed, and the run's
+ * driver (first fill, rescue pass, regrowth, refinement, canonical order). Nothing here reads a coordinate or a
+ * range.
+ *
+ * Instantiated by (each #include once, after #defining the parameters below):
+ *   lib/src/cluster/lidet_cluster.c    the float stage: lidet_cluster_state_t, lidet_cluster_rec_t (float
+ *                                     metres), lidet__grow_t, lidet_plane_t
+ *   lib/src/cluster/lidet_cluster_q.c  the integer stage: lidet_cluster_q_state_t, lidet_cluster_q_rec_t (int32
+ *                                     4 mm steps), lidet__grow_q_t, lidet_plane_q_t
+ *
+ * Parameters:
+ *   RUN_STATE_T                 the state (members cfg, n_recs, recs, order, slot_id, labels, members, img,
+ *                               stats, magic, geo_rows, geo_cols)
+ *   RUN_REC_T                   its record type (members n_points, first_member, seed_pixel, n_rescued)
+ *   RUN_MEAN(r), RUN_MIN(r), RUN_MAX(r)  record r's mean, minimum and maximum (arrays of 3)
+ *   RUN_HEIGHT(r)               record r's height above the ground
+ *   RUN_PARAM_T                 the flood fill's constants
+ *   RUN_PLANE_T                 the ground plane type
+ *   RUN_SUMMARY_T               what one pass over a component's members gives (members sum, lo, hi, mean, h)
+ *   RUN_GROW(c, g, start, tail)  the first fill of one component (the stage's flood fill); returns the new tail
+ *   RUN_RESCUE_T                the rescue group's running state (members tail, best, best_d2)
+ *   RUN_RESCUE_FAR              its "no contact yet" squared distance (above any)
+ *   RUN_RESCUE_GROW(c, g, start, rs)  the rescue fill of one group
+ *   RUN_FRAGMENT_BUDGET(c)      the rescue budget in fragment pixels (0: none)
+ *   RUN_REFINE_SPLIT(c, planes, n_sectors, st), RUN_REFINE_JOIN(...)  the stage's refinement (cuts, joins);
+ *                               nonzero when it changed anything
+ * and the numeric kernels, static functions of the including file:
+ *   int summarise(c, start, tail, small, s)  sums and bounds into *s; nonzero when an extent exceeds the limit
+ *                                          (small: no limit)
+ *   int mean_height_ok(c, n, seed, s, planes, n_sectors)  the mean and its height into *s; nonzero when it
+ *                                          passes
+ *   void record_sums(c, slot, s)           what the stage keeps of s beside the record (or nothing)
  *   void join_mean(c, slot, n, s)          a rescue group of n pixels added to the record's mean (before its
- *                                          count grows);
- *   void reheight(c, slot, planes, n_sectors)  the record's height from its mean and seed;
- *   int rescue_on(c)                       the fragment rescue is configured.
+ *                                          count grows)
+ *   void reheight(c, slot, planes, n_sectors)  the record's height from its mean and seed
+ *   int rescue_on(c)                       the fragment rescue is configured
+ *   int regrow_fits(c, s)                  a component the regrowth takes (low enough)
+ *   int regrow_param(c, lk, out)           the regrowth's flood fill constants into *out; 0 when it is off
+ * Also read, from lidet_cluster_common.h: the LAB_* labels, lidet__cluster_point_labels.
+ * Defines, for the includer: the type run_span_t and the static functions init_done, run_check, run_bind,
+ * run_fills, run_refine, labels_of_points (the steps of the stage's init and run), besides their own
+ * static functions.
+ *
+ * Why a template: the two stages' states and records are different types with the same member names, which a
+ * C99 function cannot take at once (short of void pointers and accessors for every field). The decisions
+ * written here (which cluster is dropped at capacity, the slot order, the canonical ids, when the rescue, the
+ * regrowth and the refinement run) must be the same in both stages, each of which the tests compare with its
+ * reference (codegen/lidet_ref/cluster.py, cluster_q.py); written once, they cannot drift apart. The
+ * numeric work stays in each stage's own kernels above.
  * Not a public header; include nowhere else. */
 
 #define RUN_NO_SLOT 0xFFFFFFFFu

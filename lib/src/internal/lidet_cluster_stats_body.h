@@ -1,13 +1,34 @@
 /* SPDX-License-Identifier: MIT */
-/* One pass over a component's members, written once for the float clustering (lidet_cluster.c: float values
- * and sums) and the integer one (lidet_cluster_q.c: int32 values of the int16 pixels, int64 sums), each of which
- * includes this file once. Parameters: STATS_STATE_T (the state: members, img), STATS_V_T (a coordinate),
- * STATS_S_T (a sum; zero-initialised scalars, kept in registers), STATS_B_T (the sum of one block of 64 members,
- * added to the sum after the block: the integer stage's int32, which holds 64 int16 values exactly and keeps the
- * 64-bit sums out of the member loop; the float stage's STATS_S_T itself, a float sum's order unchanged: it
- * accumulates into the sum directly), STATS_LIM_T (the extent limit),
- * STATS_READ(c, p, compact, x, y, z) (pixel p's coordinates; `compact` the float stage's image format, a
- * constant per copy), STATS_OVER(lo, hi, lim) (an extent above the limit). Not a public header. */
+/* Macro template: one pass over a component's members (member_stats_of): the sums, minima and maxima of their
+ * x, y, z, stopped early when an extent exceeds the limit.
+ *
+ * Instantiated by (each #include once, after #defining the parameters below):
+ *   lib/src/cluster/lidet_cluster.c    the float clustering: float values and float sums (STATS_BLOCK_SUMS 0);
+ *                                     its member_stats calls the copy with `compact` a constant 0 or 1
+ *   lib/src/cluster/lidet_cluster_q.c  the integer clustering: int32 values of the int16 pixels, int64 sums
+ *                                     added from int32 block sums (STATS_BLOCK_SUMS 1)
+ *
+ * Parameters:
+ *   STATS_STATE_T       the stage's state (members members, img)
+ *   STATS_V_T           a coordinate (float, int32_t)
+ *   STATS_S_T           a sum of coordinates (float, int64_t); zero-initialised scalars, kept in registers
+ *   STATS_BLOCK_SUMS    1: each block of 64 members is summed in STATS_B_T, then added to the sum (the 64-bit
+ *                       sums stay out of the member loop); 0: members are added to the sum directly (a float
+ *                       sum's order unchanged)
+ *   STATS_B_T           with STATS_BLOCK_SUMS 1 only: a block's sum (int32_t holds 64 int16 values exactly)
+ *   STATS_LIM_T         the extent limit's type (float m, uint32_t mm)
+ *   STATS_READ(c, p, compact, x, y, z)  pixel p's coordinates into *x, *y, *z (`compact` the float stage's
+ *                       image format; the integer stage ignores it)
+ *   STATS_OVER(lo, hi, lim)  nonzero when the extent hi - lo exceeds the limit
+ * Defines: static inline int member_stats_of(const STATS_STATE_T *c, uint32_t start, uint32_t tail,
+ * STATS_LIM_T max_extent, STATS_S_T sum[3], STATS_V_T lo[3], STATS_V_T hi[3], int compact).
+ *
+ * Why a template: the loop runs over every member of every component, and its two copies differ in the value
+ * and sum types and in where the sums are taken; a C99 function can take neither type, and reading a pixel
+ * through a function pointer would cost a call per member. The float sum must keep its order (the float
+ * reference's sums) and the integer one must be exact: the template writes the loop once and lets each copy
+ * keep its arithmetic.
+ * Not a public header; include nowhere else. */
 
 /* sums, min and max of the coordinates of members[start, tail) (tail > start). Returns 1 (the sums then
  * incomplete) as soon as an x, y or z extent exceeds max_extent: the test runs after every block of

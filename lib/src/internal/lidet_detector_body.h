@@ -1,27 +1,46 @@
 /* SPDX-License-Identifier: MIT */
-/* The detector's per-candidate loop, written once for the float detector (lidet_detector.c) and the integer one
- * (lidet_detector_q.c), each of which includes this file once: for every candidate cluster, nearest first, the
- * proposal, the classifier and gate 1, the box budget, the box net and gate 2, the class size check, and the
- * detection (kept sorted by score, the lowest dropped past LIDET_MAX_DETECTIONS), with each cluster's outcome and
- * the counts. The two builds differ only in their types and numbers, which the includer passes:
- *   DET_T                     the detector (members cfg.gate1, cfg.gate2, cfg.max_boxes, order, outcome, det,
- *                             n_det, stats);
- *   DET_CLS_OUT_T, DET_BOX_OUT_T  the classifier's and the box net's outputs (members cls, pass; box, pass);
- *   DET_DETECTION_T           one detection (members box, cls, cluster_id);
- *   DET_PROPOSAL(d, ci)       make cluster ci's proposal, a lidet_status_t;
- *   DET_CLASSIFY(d, co)       classify it into *co, a lidet_status_t;
- *   DET_BOX(d, cls, bo)       box it as class cls into *bo, a lidet_status_t;
- *   DET_SIZE_OK(d, cls, box)  1 when the box's size is plausible for class cls;
- *   DET_GATE1_PASS(d, co), DET_GATE2_PASS(d, cls, bo)  1 when the energy lies below the model's gamma of the
- *                             class plus the configured margin (the outputs' own `pass` is the margin-0 decision);
+/* Macro template: the detector's per-candidate loop (det_candidates): for every candidate cluster, nearest
+ * first, the proposal, the classifier and gate 1, the box budget, the box net and gate 2, the class size check,
+ * and the detection (kept sorted by score, the lowest dropped past LIDET_MAX_DETECTIONS), with each cluster's
+ * outcome and the counts.
+ *
+ * Instantiated by (each #include once, after #defining the parameters below):
+ *   lib/src/detector/lidet_detector.c    the float detector: lidet_detector_t, lidet_pn_class_out_t,
+ *                                       lidet_pn_box_out_t, lidet_detection_t (float energies and scores)
+ *   lib/src/detector/lidet_detector_q.c  the integer detector: lidet_detector_q_t, lidet_pointnet_q_class_out_t,
+ *                                       lidet_pointnet_q_box_out_t, lidet_detection_q_t (Q16 energies, Q15
+ *                                       scores)
+ *
+ * Parameters:
+ *   DET_T                 the detector (members cfg.gate1, cfg.gate2, cfg.max_boxes, order, outcome, det, n_det,
+ *                         stats)
+ *   DET_CLS_OUT_T         the classifier's output (member cls read here)
+ *   DET_BOX_OUT_T         the box net's output (member box read here)
+ *   DET_DETECTION_T       one detection (members box, cls, cluster_id)
+ *   DET_PROPOSAL(d, ci)   make cluster ci's proposal; a lidet_status_t
+ *   DET_CLASSIFY(d, co)   classify it into *co; a lidet_status_t
+ *   DET_BOX(d, cls, bo)   box it as class cls into *bo; a lidet_status_t
+ *   DET_SIZE_OK(d, cls, box)  1 when the box's size is plausible for class cls
+ *   DET_GATE1_PASS(d, co)  1 when the classifier's energy lies below the model's gamma of the class plus the
+ *                         configured margin (the output's own `pass` is the margin-0 decision)
+ *   DET_GATE2_PASS(d, cls, bo)  the same for the box net's energy
  *   DET_FILL(d, t, ci, co, bo)  the build's own fields of detection *t (score, energies, point count; the loop
- *                             sets box, cls and cluster_id);
- *   DET_INSERT(det, n)        move det[n] into det[0..n), kept sorted by score;
- *   DET_NOW(d)                the detector's clock.
+ *                         sets box, cls and cluster_id)
+ *   DET_INSERT(det, n)    move det[n] into det[0..n), kept sorted by score
+ *   DET_NOW(d)            the detector's clock (a uint32_t tick count)
  * Defines: static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *worst,
  * uint32_t *box_ticks). An error status (cannot happen after a successful init and run) ends the loop and is
  * returned; otherwise LIDET_OK, with *worst set to LIDET_TRUNCATED when the box budget or the detection capacity
- * was reached. Not a public header; include nowhere else. */
+ * was reached.
+ *
+ * Why a template: the two detectors must decide alike (the same gates in the same order, the same budget and
+ * capacity drops, the same outcome codes and counts: tests/python/test_detector_q.py compares the integer
+ * detector with the float one and with the chained references), and their detector, output and detection types
+ * differ. C99 has no generic function over those types; a plain function would need void pointers and about
+ * ten callbacks plus accessors for the outcome, detection and statistics arrays. The loop runs once per
+ * candidate (tens per scan, each costing a PointNet pass), so speed does not decide here: the template keeps
+ * the shared decisions in one place with each build's types checked by the compiler.
+ * Not a public header; include nowhere else. */
 
 static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *worst, uint32_t *box_ticks)
 {

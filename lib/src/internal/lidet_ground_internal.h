@@ -1,12 +1,16 @@
 /* SPDX-License-Identifier: MIT */
-/* Shared between lidet_ground_filter.c and lidet_ground_ransac.c (never installed). */
+/* What both ground stages share, the float one (lidet_ground_filter.c, lidet_ground_ransac.c) and the integer one
+ * (their _q twins): run checks, the sample buffer's cells, the per-cell control flow and the fallback. Only the
+ * shared public types (lidet_ground_common.h, lidet_image.h): the float stage's own declarations are in
+ * lidet_ground_float_internal.h, the integer stage's in lidet_ground_q_internal.h. Never installed. */
 #ifndef LIDET_GROUND_INTERNAL_H
 #define LIDET_GROUND_INTERNAL_H
 
 #include <string.h>
 
 #include "internal/lidet_assert.h"
-#include "lidet/lidet_ground.h"
+#include "lidet/lidet_ground_common.h"
+#include "lidet/lidet_image.h"
 
 /* first column of sector s: the smallest c with c * n_sectors / n_cols >= s */
 static inline uint32_t lidet__ground_sector_col(uint32_t s, uint32_t n_sectors, uint32_t n_cols)
@@ -234,11 +238,5 @@ static inline void lidet__ground_far2_cells(uint8_t *source, uint32_t *cell_firs
         }
     }
 }
-
-/* Fits one plane per cell from the samples sc->sample_pix (pixels of img) grouped by sc->cell_first /
- * cell_n, applies the fallback, fills g->planes, g->source and the sector counts of g->stats
- * (lidet_ground_ransac.c). */
-void lidet__ground_fit_sectors(lidet_ground_state_t *g, lidet_ground_scratch_t *sc,
-                               const lidet_range_image_t *img);
 
 #endif

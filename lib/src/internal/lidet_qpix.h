@@ -24,7 +24,7 @@
 
 #include <stdint.h>
 
-#include "lidet/lidet_proj.h"
+#include "lidet/lidet_image.h"
 #include "lidet_qmath.h"
 
 /** 1 for a range-only compact image (x, y, z decoded), 0 when it stores them */

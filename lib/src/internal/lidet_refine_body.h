@@ -1,32 +1,50 @@
 /* SPDX-License-Identifier: MIT */
-/* The proposal refinement's control flow (issue 15; the rules in lidet_cluster.h, cfg split_people, join_cars),
- * written once for the float stage (lidet_refine.c) and the integer one (lidet_refine_q.c), each of
- * which includes this file once: which clusters are examined, the bird's-eye-view grid and its 8-connected
- * parts, the choice of the parts that leave and their slots, the relabelling, and the joins' loop. Nothing here
- * reads a coordinate. Parameters:
- *   REFINE_STATE_T, REFINE_REC_T, REFINE_CFG_T   the state (members recs, n_recs, order, labels, members, img,
- *                                  cfg and the rf_* scratch) and its record and configuration types;
- *   REFINE_PLANE_T                 the ground plane type;
- *   REFINE_GEOM_T                  one examined cluster's grid (its corner, cell size);
- *   REFINE_Z_T, REFINE_Z_FAR       a z coordinate and a bound no z reaches;
- *   REFINE_V_T, REFINE_S_T         a coordinate and a sum of coordinates; REFINE_READ(c, p, v) pixel p's x, y, z
- *                                  into v[3];
- *   REFINE_MIN(r), REFINE_MAX(r), REFINE_MEAN(r), REFINE_H(r)  a record's bounds, mean and height;
- *   REFINE_HEIGHT(c, seed, mean, planes, n_sectors)  the height of a mean (the clustering's);
+/* Macro template: the proposal refinement's control flow (the rules in lidet_cluster.h, cfg split_people,
+ * join_cars): which clusters are examined, the bird's-eye-view grid and its 8-connected parts, the choice of the
+ * parts that leave and their slots, the relabelling, and the joins' loop. Nothing here reads a coordinate.
+ *
+ * Instantiated by (each #include once, after #defining the parameters below and its numeric kernels):
+ *   lib/src/cluster/lidet_refine.c    the float stage: lidet_cluster_state_t, lidet_cluster_rec_t,
+ *                                    lidet_cluster_cfg_t, lidet_plane_t; coordinates float (m), sums float
+ *   lib/src/cluster/lidet_refine_q.c  the integer stage: lidet_cluster_q_state_t, lidet_cluster_q_rec_t,
+ *                                    lidet_cluster_q_cfg_t, lidet_plane_q_t; coordinates int32_t (4 mm steps),
+ *                                    sums int64_t
+ *
+ * Parameters:
+ *   REFINE_STATE_T      the state (members recs, n_recs, order, labels, members, img, cfg and the rf_* scratch)
+ *   REFINE_REC_T        its record type
+ *   REFINE_CFG_T        its configuration type
+ *   REFINE_PLANE_T      the ground plane type
+ *   REFINE_GEOM_T       one examined cluster's grid (its corner, cell size)
+ *   REFINE_Z_T          a z coordinate; REFINE_Z_FAR a bound no z reaches
+ *   REFINE_V_T          a coordinate; REFINE_S_T a sum of coordinates
+ *   REFINE_READ(c, p, v)  pixel p's x, y, z into v[3]
+ *   REFINE_MIN(r), REFINE_MAX(r), REFINE_MEAN(r)  record r's bounds and mean (arrays of 3)
+ *   REFINE_H(r)         record r's height (an lvalue)
+ *   REFINE_HEIGHT(c, seed, mean, planes, n_sectors)  the height of a mean (the clustering's)
  *   REFINE_SPLIT_FN, REFINE_JOIN_FN  the names of the two entry points this file defines
- *                                  (lidet_cluster_internal.h, lidet_cluster_q_internal.h);
+ *                       (lidet_cluster_internal.h, lidet_cluster_q_internal.h)
  * and the numeric kernels, static functions of the including file:
- *   int refine_examined(cfg, rec)  wider than split_min_width in x or y, and at least person_min_height in z;
+ *   int refine_examined(cfg, rec)  wider than split_min_width in x or y, and at least person_min_height in z
  *   int refine_grid(cfg, rec, geom, nx, ny)  the grid of the cluster: its cells along x and y (0 when a count
- *                                  does not fit 32 bits);
- *   uint32_t refine_cell(c, p, geom, nx, ny)  the cell of member pixel p (clamped to the grid);
- *   REFINE_Z_T refine_z(c, p)      the z of pixel p;
+ *                       does not fit 32 bits)
+ *   uint32_t refine_cell(c, p, geom, nx, ny)  the cell of member pixel p (clamped to the grid)
+ *   REFINE_Z_T refine_z(c, p)  the z of pixel p
  *   int refine_person(cfg, geom, n, sx, sy, zlo, zhi, ncols)  a part of n points spanning sx, sy cells, z in
- *                                  [zlo, zhi], over ncols image columns, is person-sized;
- *   void refine_mean(c, slot, sum)  record `slot`'s mean from the sums of its n_points members;
- *   int refine_car_piece(cfg, rec), int refine_joinable(cfg, a, b)  the joins' box tests;
+ *                       [zlo, zhi], over ncols image columns, is person-sized
+ *   void refine_mean(c, slot, sum)  record `slot`'s mean from the sums of its n_points members
+ *   int refine_car_piece(cfg, rec), int refine_joinable(cfg, a, b)  the joins' box tests
  *   void refine_join_mean(c, i, j, first)  cluster j's mean into cluster i's (first: i's first join of the
- *                                  pass), before the counts grow.
+ *                       pass), before the counts grow
+ * Defines: int REFINE_SPLIT_FN(REFINE_STATE_T *c, const REFINE_PLANE_T *planes, uint32_t n_sectors,
+ * lidet_cluster_stats_t *st) and REFINE_JOIN_FN (the same arguments), nonzero when they changed anything, and
+ * their static functions.
+ *
+ * Why a template: the two stages' states, records and configurations are different types, which a C99 function
+ * cannot take at once (short of void pointers and accessors for every field). The decisions (which parts
+ * leave, their slots, the join order and budget) must be the same in both, each compared with its reference
+ * (refine_ref in codegen/lidet_ref/cluster.py, refine_q in cluster_q.py); written once, they cannot
+ * drift apart, while the arithmetic stays in each stage's kernels.
  * Not a public header; include nowhere else. */
 
 #define REFINE_CELL_OCC 0xFFFFu
@@ -123,6 +141,114 @@ static void refine_rebuild(REFINE_STATE_T *c, uint32_t slot, const REFINE_REC_T 
     REFINE_H(r) = REFINE_HEIGHT(c, seed, REFINE_MEAN(r), planes, n_sectors);
 }
 
+/* the extents of the parts of cluster rec (rf_grid: each occupied cell's part + 1, rf_cell: each member's cell):
+ * per part its member count rf_n, cell box rf_box (x lo, x hi, y lo, y hi), z range rf_z and image column span
+ * rf_col */
+static void refine_part_extents(REFINE_STATE_T *c, const REFINE_REC_T *rec, uint32_t nx, uint32_t n_parts)
+{
+    uint32_t i, p;
+    for (p = 0; p < n_parts; ++p)
+    {
+        c->rf_n[p] = 0;
+        c->rf_box[p][0] = 0xFFFFu;
+        c->rf_box[p][1] = 0;
+        c->rf_box[p][2] = 0xFFFFu;
+        c->rf_box[p][3] = 0;
+        c->rf_z[p][0] = REFINE_Z_FAR;
+        c->rf_z[p][1] = -REFINE_Z_FAR;
+        c->rf_col[p][0] = 0xFFFFu;
+        c->rf_col[p][1] = 0;
+    }
+    for (i = 0; i < rec->n_points; ++i)
+    {
+        const uint32_t px = (uint32_t)c->members[rec->first_member + i];
+        const uint32_t cell = c->rf_cell[i], cx = cell % nx, cy = cell / nx;
+        const uint32_t q = c->rf_grid[cell] - 1u;
+        const REFINE_Z_T z = refine_z(c, px);
+        const uint32_t col = px % c->img.n_cols;
+        ++c->rf_n[q];
+        c->rf_box[q][0] = (uint16_t)(cx < c->rf_box[q][0] ? cx : c->rf_box[q][0]);
+        c->rf_box[q][1] = (uint16_t)(cx > c->rf_box[q][1] ? cx : c->rf_box[q][1]);
+        c->rf_box[q][2] = (uint16_t)(cy < c->rf_box[q][2] ? cy : c->rf_box[q][2]);
+        c->rf_box[q][3] = (uint16_t)(cy > c->rf_box[q][3] ? cy : c->rf_box[q][3]);
+        c->rf_z[q][0] = z < c->rf_z[q][0] ? z : c->rf_z[q][0];
+        c->rf_z[q][1] = z > c->rf_z[q][1] ? z : c->rf_z[q][1];
+        c->rf_col[q][0] = (uint16_t)(col < c->rf_col[q][0] ? col : c->rf_col[q][0]);
+        c->rf_col[q][1] = (uint16_t)(col > c->rf_col[q][1] ? col : c->rf_col[q][1]);
+    }
+}
+
+/* which parts leave: person-sized parts leave (rf_target 1), the rest stays (0); when every part of min_points is
+ * person-sized the largest part stays, and when too few points would stay the largest person-sized part stays
+ * too (ties of size: the first part). Returns 0 (nothing leaves) when no part is person-sized. */
+static int refine_leaving(REFINE_STATE_T *c, const REFINE_GEOM_T *geo, uint32_t n_parts)
+{
+    const REFINE_CFG_T *cfg = &c->cfg;
+    const uint32_t pmin = cfg->person_min_points;
+    uint32_t p, largest = 0, largest_person = n_parts, n_stay = 0;
+    int any_person = 0, all_person = 1;
+    for (p = 0; p < n_parts; ++p)
+    {
+        const int person =
+            c->rf_n[p] >= pmin &&
+            refine_person(cfg, geo, c->rf_n[p], (uint32_t)(c->rf_box[p][1] - c->rf_box[p][0]) + 1u,
+                          (uint32_t)(c->rf_box[p][3] - c->rf_box[p][2]) + 1u, c->rf_z[p][0], c->rf_z[p][1],
+                          (uint32_t)(c->rf_col[p][1] - c->rf_col[p][0]) + 1u);
+        c->rf_target[p] = (uint16_t)(person ? 1u : 0u);
+        any_person |= person;
+        if (c->rf_n[p] >= cfg->min_points)
+        {
+            all_person &= person;
+        }
+        largest = c->rf_n[p] > c->rf_n[largest] ? p : largest;
+        if (person && (largest_person == n_parts || c->rf_n[p] > c->rf_n[largest_person]))
+        {
+            largest_person = p;
+        }
+    }
+    if (!any_person)
+    {
+        return 0;
+    }
+    if (all_person)
+    {
+        c->rf_target[largest] = 0;
+    }
+    for (p = 0; p < n_parts; ++p)
+    {
+        n_stay += c->rf_target[p] == 0u ? c->rf_n[p] : 0u;
+    }
+    if (n_stay < cfg->min_points)
+    {
+        c->rf_target[largest_person] = 0;
+    }
+    return 1;
+}
+
+/* slots: the staying parts -> k, the leaving ones -> free slots in part order (none free: it stays); rf_target
+ * becomes each part's slot. Returns the number of new slots. */
+static uint32_t refine_slots(REFINE_STATE_T *c, uint32_t k, uint32_t n_parts)
+{
+    uint32_t p, n_new = 0;
+    for (p = 0; p < n_parts; ++p)
+    {
+        if (c->rf_target[p] == 0u)
+        {
+            c->rf_target[p] = (uint16_t)k;
+        }
+        else if (c->n_recs < LIDET_MAX_CLUSTERS)
+        {
+            c->rf_target[p] = (uint16_t)c->n_recs++;
+            ++n_new;
+        }
+        else
+        {
+            c->rf_target[p] = (uint16_t)k; /* no free slot: it stays */
+        }
+    }
+    return n_new;
+}
+
 /* cut cluster k; returns 1 when it was cut */
 static int refine_split_one(REFINE_STATE_T *c, uint32_t k, const REFINE_PLANE_T *planes, uint32_t n_sectors,
                             lidet_cluster_stats_t *st)
@@ -131,8 +257,7 @@ static int refine_split_one(REFINE_STATE_T *c, uint32_t k, const REFINE_PLANE_T 
     const REFINE_REC_T rec = c->recs[k]; /* a copy: recs[k] is rebuilt below */
     REFINE_GEOM_T geo;
     const uint32_t pmin = cfg->person_min_points; /* [1, 1000000] (validated) */
-    uint32_t nx, ny, n_parts, i, p, largest, largest_person, n_stay, n_new;
-    int any_person = 0, all_person = 1;
+    uint32_t nx, ny, n_parts, i, p, n_new;
 
     /* examined: wider than one person. Two early outs that change no decision, only the time: a cut
      * needs a leaving part of person_min_points and a staying one of min_points or, when a person-sized
@@ -166,96 +291,17 @@ static int refine_split_one(REFINE_STATE_T *c, uint32_t k, const REFINE_PLANE_T 
     {
         return 0;
     }
-    for (p = 0; p < n_parts; ++p)
-    {
-        c->rf_n[p] = 0;
-        c->rf_box[p][0] = 0xFFFFu;
-        c->rf_box[p][1] = 0;
-        c->rf_box[p][2] = 0xFFFFu;
-        c->rf_box[p][3] = 0;
-        c->rf_z[p][0] = REFINE_Z_FAR;
-        c->rf_z[p][1] = -REFINE_Z_FAR;
-        c->rf_col[p][0] = 0xFFFFu;
-        c->rf_col[p][1] = 0;
-    }
-    for (i = 0; i < rec.n_points; ++i)
-    {
-        const uint32_t px = (uint32_t)c->members[rec.first_member + i];
-        const uint32_t cell = c->rf_cell[i], cx = cell % nx, cy = cell / nx;
-        const uint32_t q = c->rf_grid[cell] - 1u;
-        const REFINE_Z_T z = refine_z(c, px);
-        const uint32_t col = px % c->img.n_cols;
-        ++c->rf_n[q];
-        c->rf_box[q][0] = (uint16_t)(cx < c->rf_box[q][0] ? cx : c->rf_box[q][0]);
-        c->rf_box[q][1] = (uint16_t)(cx > c->rf_box[q][1] ? cx : c->rf_box[q][1]);
-        c->rf_box[q][2] = (uint16_t)(cy < c->rf_box[q][2] ? cy : c->rf_box[q][2]);
-        c->rf_box[q][3] = (uint16_t)(cy > c->rf_box[q][3] ? cy : c->rf_box[q][3]);
-        c->rf_z[q][0] = z < c->rf_z[q][0] ? z : c->rf_z[q][0];
-        c->rf_z[q][1] = z > c->rf_z[q][1] ? z : c->rf_z[q][1];
-        c->rf_col[q][0] = (uint16_t)(col < c->rf_col[q][0] ? col : c->rf_col[q][0]);
-        c->rf_col[q][1] = (uint16_t)(col > c->rf_col[q][1] ? col : c->rf_col[q][1]);
-    }
-    /* person-sized parts leave (target 1), the rest stays (target 0); ties of size: the first part */
-    largest = 0;
-    largest_person = n_parts;
-    for (p = 0; p < n_parts; ++p)
-    {
-        const int person =
-            c->rf_n[p] >= pmin &&
-            refine_person(cfg, &geo, c->rf_n[p], (uint32_t)(c->rf_box[p][1] - c->rf_box[p][0]) + 1u,
-                          (uint32_t)(c->rf_box[p][3] - c->rf_box[p][2]) + 1u, c->rf_z[p][0], c->rf_z[p][1],
-                          (uint32_t)(c->rf_col[p][1] - c->rf_col[p][0]) + 1u);
-        c->rf_target[p] = (uint16_t)(person ? 1u : 0u);
-        any_person |= person;
-        if (c->rf_n[p] >= cfg->min_points)
-        {
-            all_person &= person;
-        }
-        largest = c->rf_n[p] > c->rf_n[largest] ? p : largest;
-        if (person && (largest_person == n_parts || c->rf_n[p] > c->rf_n[largest_person]))
-        {
-            largest_person = p;
-        }
-    }
-    if (!any_person)
+    refine_part_extents(c, &rec, nx, n_parts);
+    if (!refine_leaving(c, &geo, n_parts))
     {
         return 0;
     }
-    if (all_person)
-    {
-        c->rf_target[largest] = 0;
-    }
-    n_stay = 0;
-    for (p = 0; p < n_parts; ++p)
-    {
-        n_stay += c->rf_target[p] == 0u ? c->rf_n[p] : 0u;
-    }
-    if (n_stay < cfg->min_points)
-    {
-        c->rf_target[largest_person] = 0;
-    }
-    /* slots: 0 -> k, leaving parts -> free slots in part order (none free: it stays) */
-    n_new = 0;
-    for (p = 0; p < n_parts; ++p)
-    {
-        if (c->rf_target[p] == 0u)
-        {
-            c->rf_target[p] = (uint16_t)k;
-        }
-        else if (c->n_recs < LIDET_MAX_CLUSTERS)
-        {
-            c->rf_target[p] = (uint16_t)c->n_recs++;
-            ++n_new;
-        }
-        else
-        {
-            c->rf_target[p] = (uint16_t)k; /* no free slot: it stays */
-        }
-    }
+    n_new = refine_slots(c, k, n_parts);
     if (n_new == 0u)
     {
         return 0;
     }
+    /* the cut: the members relabelled by part, the records rebuilt from them, none of them joins */
     for (i = 0; i < rec.n_points; ++i)
     {
         c->labels[c->members[rec.first_member + i]] =

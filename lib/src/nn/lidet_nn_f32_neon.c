@@ -19,10 +19,10 @@
  * outputs, and the last 1-3 outputs row by row. Rows left over (fewer than 8, the heads' single vectors) run
  * 16 outputs at a time in 4 accumulators (the 4 weight vectors of an input in one LD1), then 4, 2 and 1.
  *
- * Measured in instructions (exact, QEMU; the bare-metal Cortex-A72 image virt-aarch64, -O2, the VLP-16 sample scan:
- * docs/PORTING.md, section 9): the classifier 9.25 M and the box net 4.36 M per scan against the portable
- * kernel's 58.1 M and 29.1 M (0.16x); the whole scan 28.2 M against 101.8 M. The 8 x 8 tile's loop takes 92
- * instructions per four inputs, 64 of them FMLA. Time on silicon is not measured. */
+ * Measured in instructions (exact, QEMU; the bare-metal Cortex-A72 image virt-aarch64, -O2, the VLP-16 sample
+ * scan: docs/FIRMWARE.md, "Linux on ARM (aarch64)"): the classifier 9.25 M and the box net 4.36 M per scan
+ * against the portable kernel's 58.1 M and 29.1 M (0.16x); the whole scan 28.2 M against 101.8 M. The 8 x 8
+ * tile's loop takes 92 instructions per four inputs, 64 of them FMLA. Time on silicon is not measured. */
 #include "internal/lidet_nn.h"
 
 #if LIDET_NN_NEON

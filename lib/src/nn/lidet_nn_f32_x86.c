@@ -14,7 +14,8 @@
  * Why (measured on the host, 8 rows, the shared layers' shapes 32 x 64, 64 x 128, 128 x 256): the portable
  * kernel keeps its sums in memory and needs a multiply and an add per multiply-add, 33-38 GMAC/s with AVX-512;
  * an 8-row x 32-output tile held in 16 registers over all the inputs, each weight load shared by 8 rows and one
- * FMA per multiply-add, 68-77 GMAC/s (docs/BENCHMARKS.md: the classifier and the box net end to end). */
+ * FMA per multiply-add, 68-77 GMAC/s (docs/benchmarks/pointnet.md: the classifier and the box net end to
+ * end). */
 #include "internal/lidet_nn.h"
 
 #if LIDET_NN_FMA

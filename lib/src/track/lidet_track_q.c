@@ -451,41 +451,11 @@ static void birth(const lidet_tracker_q_cfg_t *cfg, lidet_track_q_slot_t *s, con
     s->state = (uint8_t)LIDET_TRACK_TENTATIVE;
 }
 
-lidet_status_t lidet_tracker_q_update(lidet_tracker_q_t *t, const lidet_detection_q_t *det, uint32_t n_det,
-                                      uint32_t dt_ms, const lidet_ego_q_t *ego)
+/* 1. the detections used: the first LIDET_TRACK_MAX_DETS, the valid ones in order (the columns t->col_det);
+ * returns their count */
+static uint32_t select_dets(lidet_tracker_q_t *t, const lidet_detection_q_t *det, uint32_t n_use)
 {
-    const lidet_tracker_q_cfg_t *cfg;
-    lidet_tracker_q_stats_t *st;
-    uint32_t i, j, nr = 0, nc = 0, n_use;
-    int64_t c = 0, sn = 0;
-    int32_t bigc;
-    lidet_status_t ret = LIDET_OK;
-    if (t == 0)
-    {
-        return LIDET_ERR_ARG;
-    }
-    if (t->magic != LIDET_INIT_MAGIC)
-    {
-        return LIDET_ERR_STATE;
-    }
-    if ((det == 0 && n_det > 0u) || dt_ms == 0u || dt_ms > LIDET_TRACK_Q_DT_MAX_MS ||
-        (ego != 0 && (!in_range(ego->dx_mm, -LIDET_TRACK_Q_COORD_MAX_MM, LIDET_TRACK_Q_COORD_MAX_MM) ||
-                      !in_range(ego->dy_mm, -LIDET_TRACK_Q_COORD_MAX_MM, LIDET_TRACK_Q_COORD_MAX_MM))))
-    {
-        return LIDET_ERR_ARG;
-    }
-    cfg = &t->cfg;
-    st = &t->stats;
-    memset(st, 0, sizeof *st);
-    bigc = cfg->gate_chi2_q16 + cfg->class_penalty_q16 + ONE_Q16;
-
-    /* 1. the detections used: the first LIDET_TRACK_MAX_DETS, the valid ones in order (the columns) */
-    n_use = n_det < (uint32_t)LIDET_TRACK_MAX_DETS ? n_det : (uint32_t)LIDET_TRACK_MAX_DETS;
-    st->n_dets_dropped = n_det - n_use;
-    if (st->n_dets_dropped > 0u)
-    {
-        ret = LIDET_TRUNCATED;
-    }
+    uint32_t j, nc = 0;
     for (j = 0; j < n_use; ++j)
     {
         if (det_ok(&det[j]))
@@ -494,11 +464,18 @@ lidet_status_t lidet_tracker_q_update(lidet_tracker_q_t *t, const lidet_detectio
         }
         else
         {
-            ++st->n_bad_dets;
+            ++t->stats.n_bad_dets;
         }
     }
+    return nc;
+}
 
-    /* 2.-3. ego motion and prediction (ref: _ego_predict); a track leaving the coordinate range dies */
+/* 2.-3. ego motion and prediction of every active track (ref: _ego_predict); a track leaving the coordinate range
+ * dies. The live tracks' slots become the rows (t->row_slot); returns their count */
+static uint32_t predict_tracks(lidet_tracker_q_t *t, uint32_t dt_ms, const lidet_ego_q_t *ego)
+{
+    int64_t c = 0, sn = 0;
+    uint32_t i, nr = 0;
     if (ego != 0)
     {
         c = lidet__q_cos((uint32_t)ego->dyaw_bam);
@@ -513,16 +490,24 @@ lidet_status_t lidet_tracker_q_update(lidet_tracker_q_t *t, const lidet_detectio
         }
         s->age += s->age < UINT32_MAX ? 1u : 0u;
         s->det_index = -1;
-        if (!ego_predict(cfg, s, dt_ms, ego, c, sn))
+        if (!ego_predict(&t->cfg, s, dt_ms, ego, c, sn))
         {
             s->active = 0;
-            ++st->n_deaths;
+            ++t->stats.n_deaths;
             continue;
         }
         t->row_slot[nr++] = (uint16_t)i;
     }
+    return nr;
+}
 
-    /* 4. gated costs (ref: _costs), Q16 */
+/* 4. gated costs (ref: _costs), Q16: bigc for a pair outside the gates */
+static void costs(lidet_tracker_q_t *t, const lidet_detection_q_t *det, uint32_t nr, uint32_t nc,
+                  int32_t bigc)
+{
+    const lidet_tracker_q_cfg_t *cfg = &t->cfg;
+    lidet_tracker_q_stats_t *st = &t->stats;
+    uint32_t i, j;
     for (i = 0; i < nr; ++i)
     {
         const lidet_track_q_slot_t *s = &t->slot[t->row_slot[i]];
@@ -550,25 +535,14 @@ lidet_status_t lidet_tracker_q_update(lidet_tracker_q_t *t, const lidet_detectio
             ++st->n_feasible_pairs;
         }
     }
+}
 
-    /* 5. assignment */
-    if (nr > 0u && nc > 0u && st->n_feasible_pairs > 0u)
-    {
-        lidet__track_q_assign(t, nr, nc, bigc, cfg->assign);
-    }
-    else
-    {
-        for (i = 0; i < nr; ++i)
-        {
-            t->row_col[i] = -1;
-        }
-        for (j = 0; j < nc; ++j)
-        {
-            t->col_row[j] = -1;
-        }
-    }
-
-    /* 6.-7. update the assigned tracks, count the misses (ref: _update, _miss) */
+/* 6.-7. update the assigned tracks, count the misses (ref: _update, _miss) */
+static void update_or_miss(lidet_tracker_q_t *t, const lidet_detection_q_t *det, uint32_t nr)
+{
+    const lidet_tracker_q_cfg_t *cfg = &t->cfg;
+    lidet_tracker_q_stats_t *st = &t->stats;
+    uint32_t i;
     for (i = 0; i < nr; ++i)
     {
         lidet_track_q_slot_t *s = &t->slot[t->row_slot[i]];
@@ -591,9 +565,16 @@ lidet_status_t lidet_tracker_q_update(lidet_tracker_q_t *t, const lidet_detectio
             s->state = (uint8_t)LIDET_TRACK_COASTING;
         }
     }
+}
 
-    /* 8. births in the lowest free slots, detections in input order */
-    i = 0;
+/* 8. births in the lowest free slots, detections in input order; returns LIDET_TRUNCATED when a birth found no
+ * free slot, else LIDET_OK */
+static lidet_status_t births(lidet_tracker_q_t *t, const lidet_detection_q_t *det, uint32_t nc)
+{
+    const lidet_tracker_q_cfg_t *cfg = &t->cfg;
+    lidet_tracker_q_stats_t *st = &t->stats;
+    lidet_status_t ret = LIDET_OK;
+    uint32_t i = 0, j;
     for (j = 0; j < nc; ++j)
     {
         const lidet_detection_q_t *d = &det[t->col_det[j]];
@@ -614,6 +595,71 @@ lidet_status_t lidet_tracker_q_update(lidet_tracker_q_t *t, const lidet_detectio
         birth(cfg, &t->slot[i], d, (int32_t)t->col_det[j], t->next_id);
         t->next_id = t->next_id == UINT32_MAX ? 1u : t->next_id + 1u;
         ++st->n_births;
+    }
+    return ret;
+}
+
+lidet_status_t lidet_tracker_q_update(lidet_tracker_q_t *t, const lidet_detection_q_t *det, uint32_t n_det,
+                                      uint32_t dt_ms, const lidet_ego_q_t *ego)
+{
+    const lidet_tracker_q_cfg_t *cfg;
+    lidet_tracker_q_stats_t *st;
+    uint32_t i, j, nr, nc, n_use;
+    int32_t bigc;
+    lidet_status_t ret = LIDET_OK;
+    if (t == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    if (t->magic != LIDET_INIT_MAGIC)
+    {
+        return LIDET_ERR_STATE;
+    }
+    if ((det == 0 && n_det > 0u) || dt_ms == 0u || dt_ms > LIDET_TRACK_Q_DT_MAX_MS ||
+        (ego != 0 && (!in_range(ego->dx_mm, -LIDET_TRACK_Q_COORD_MAX_MM, LIDET_TRACK_Q_COORD_MAX_MM) ||
+                      !in_range(ego->dy_mm, -LIDET_TRACK_Q_COORD_MAX_MM, LIDET_TRACK_Q_COORD_MAX_MM))))
+    {
+        return LIDET_ERR_ARG;
+    }
+    cfg = &t->cfg;
+    st = &t->stats;
+    memset(st, 0, sizeof *st);
+    bigc = cfg->gate_chi2_q16 + cfg->class_penalty_q16 + ONE_Q16;
+
+    /* 1. the detections used */
+    n_use = n_det < (uint32_t)LIDET_TRACK_MAX_DETS ? n_det : (uint32_t)LIDET_TRACK_MAX_DETS;
+    st->n_dets_dropped = n_det - n_use;
+    if (st->n_dets_dropped > 0u)
+    {
+        ret = LIDET_TRUNCATED;
+    }
+    nc = select_dets(t, det, n_use);
+    /* 2.-3. ego motion and prediction; 4. gated costs */
+    nr = predict_tracks(t, dt_ms, ego);
+    costs(t, det, nr, nc, bigc);
+
+    /* 5. assignment */
+    if (nr > 0u && nc > 0u && st->n_feasible_pairs > 0u)
+    {
+        lidet__track_q_assign(t, nr, nc, bigc, cfg->assign);
+    }
+    else
+    {
+        for (i = 0; i < nr; ++i)
+        {
+            t->row_col[i] = -1;
+        }
+        for (j = 0; j < nc; ++j)
+        {
+            t->col_row[j] = -1;
+        }
+    }
+
+    /* 6.-7. updates and misses; 8. births */
+    update_or_miss(t, det, nr);
+    if (births(t, det, nc) != LIDET_OK)
+    {
+        ret = LIDET_TRUNCATED;
     }
 
     /* 9. confirmation; the counts */

@@ -225,5 +225,6 @@ const lidet_pn_model_t lidet_model_fuzz_box64 = {
     1.0f, /* energy temperature */
     {0.0f, 0.0f, 0.0f}, /* gate thresholds per class */
     "fuzz_box64",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

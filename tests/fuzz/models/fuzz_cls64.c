@@ -113,5 +113,6 @@ const lidet_pn_model_t lidet_model_fuzz_cls64 = {
     1.0f, /* energy temperature */
     {0.0f, 0.0f, 0.0f}, /* gate thresholds per class */
     "fuzz_cls64",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

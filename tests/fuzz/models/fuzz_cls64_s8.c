@@ -160,5 +160,6 @@ const lidet_pointnet_q_model_t lidet_model_fuzz_cls64_s8 = {
     65536, /* energy temperature, Q16 */
     {0, 0, 0}, /* gate thresholds per class, Q16 nats */
     "fuzz_cls64_s8",
-    "Car,Cyclist,Pedestrian"
+    "Car,Cyclist,Pedestrian",
+    0u /* proposal z origin: mean */
 };

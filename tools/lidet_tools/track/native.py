@@ -14,6 +14,7 @@ import weakref
 import numpy as np
 
 from lidet_tools import native
+from lidet_tools.native._lib import f32p as _f32p, i32p as _i32p, opt as _opt, u32p as _u32p
 
 #: one record per track, in id order (the integer tracker returns the same fields, converted to SI units)
 TRACK_DTYPE = np.dtype([
@@ -41,9 +42,6 @@ _INT_FIELDS = {"assign", "confirm_hits", "max_misses", "heading_from_velocity", 
 _ALIASES = {"meas_sigma": "meas_sigma_m", "accel_sigma": "accel_sigma_mps2", "init_vel_sigma": "init_vel_sigma_mps",
             "gate_max": "gate_max_m", "heading_speed": "heading_speed_mps"}
 
-_f32p = np.ctypeslib.ndpointer(np.float32, flags="C_CONTIGUOUS")
-_i32p = np.ctypeslib.ndpointer(np.int32, flags="C_CONTIGUOUS")
-_u32p = np.ctypeslib.ndpointer(np.uint32, flags="C_CONTIGUOUS")
 _ready = False
 _sizes: dict | None = None
 
@@ -64,8 +62,8 @@ def _lib():
         L.lidet_py_track_cfg_default.argtypes = [_f32p]
         L.lidet_py_track_init.argtypes = [V, _f32p]
         L.lidet_py_track_reset.argtypes = [V]
-        L.lidet_py_track_update.argtypes = [V, native._opt(_f32p), C.c_uint32, C.c_uint32, C.c_float,
-                                            native._opt(_f32p)]
+        L.lidet_py_track_update.argtypes = [V, _opt(_f32p), C.c_uint32, C.c_uint32, C.c_float,
+                                            _opt(_f32p)]
         L.lidet_py_track_tracks.restype = C.c_uint32
         L.lidet_py_track_tracks.argtypes = [V, _f32p, _i32p, C.c_uint32, C.c_uint32]
         L.lidet_py_track_stats.argtypes = [V, _u32p]

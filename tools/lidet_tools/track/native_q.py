@@ -16,10 +16,8 @@ import numpy as np
 
 from lidet_ref import track_q as ref
 from lidet_tools import native
+from lidet_tools.native._lib import i32p as _i32p, i64p as _i64p, opt as _opt, u32p as _u32p
 
-_i32p = np.ctypeslib.ndpointer(np.int32, flags="C_CONTIGUOUS")
-_i64p = np.ctypeslib.ndpointer(np.int64, flags="C_CONTIGUOUS")
-_u32p = np.ctypeslib.ndpointer(np.uint32, flags="C_CONTIGUOUS")
 _ready = False
 
 TRACK_DTYPE = ref.TRACK_DTYPE
@@ -41,7 +39,7 @@ def _lib():
         L.lidet_py_track_q_cfg_default.argtypes = [_i64p]
         L.lidet_py_track_q_init.argtypes = [V, _i64p, C.c_uint32]
         L.lidet_py_track_q_reset.argtypes = [V]
-        L.lidet_py_track_q_update.argtypes = [V, native._opt(_i32p), C.c_uint32, C.c_uint32, native._opt(_i32p)]
+        L.lidet_py_track_q_update.argtypes = [V, _opt(_i32p), C.c_uint32, C.c_uint32, _opt(_i32p)]
         L.lidet_py_track_q_tracks.argtypes = [V, C.c_uint32, C.c_uint32, _i64p]
         L.lidet_py_track_q_stats.argtypes = [V, _u32p]
         L.lidet_py_track_q_assign.argtypes = [_i32p, C.c_uint32, C.c_uint32, C.c_int32, C.c_uint32, _i32p]

@@ -64,9 +64,9 @@ def scan_list(sensor: str, real_dir=None, scan_dirs=None):
     return scans
 
 
-def proposals_of(scans, sensor: str, seeds, n_points: int = 64):
+def proposals_of(scans, sensor: str, seeds, n_points: int = 64, z_origin: int = 0):
     """(xyz (B, N, 3) float32, mean (B, 3), voxel (B, 3) int16) of the scans (paths of KITTI .bin files, or
-    point arrays) with every resampling seed."""
+    point arrays) with every resampling seed; z_origin: the model's lidet_proposal_z_origin_t (mean: the origin)."""
     from lidet_tools import kitti, native
     xs, ms, vs = [], [], []
     for path in scans:
@@ -74,7 +74,7 @@ def proposals_of(scans, sensor: str, seeds, n_points: int = 64):
         g = native.ground(pts, sensor)
         cl = native.cluster(pts, sensor, ground=g.mask_point, planes=g.planes)
         for s in seeds:
-            p = native.proposals(cl, n_points=n_points, seed=s)
+            p = native.proposals(cl, n_points=n_points, seed=s, z_origin=z_origin)
             xs.append(p.xyz)
             ms.append(p.mean)
             vs.append(p.voxel)
@@ -94,7 +94,7 @@ def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS, scan_dir
     model = load(onnx_path, onnx_path.stem)
     scans = scan_list(sensor, real_dir, scan_dirs)
     sims = _sim_scans(sensor, CALIB_SIM_SEED, CALIB_N_SIM)
-    xyz, mean, vox = proposals_of(scans + sims, sensor, seeds, model.n_points)
+    xyz, mean, vox = proposals_of(scans + sims, sensor, seeds, model.n_points, model.z_origin)
     rng = Q.activation_ranges(model, xyz, mean, vox, onnx_path.parent)
 
     def rel(p):
@@ -106,7 +106,8 @@ def calibrate(onnx_path, sensor: str, real_dir=None, seeds=CALIB_SEEDS, scan_dir
             "sensor": sensor, "seeds": [int(s) for s in seeds], "percentile": rng["percentile"],
             "ranges_per": rng["ranges_per"],
             "scans": [rel(p) for p in scans] + [f"sim/{CALIB_SIM_SEED}/{k}" for k in range(CALIB_N_SIM)],
-            "n_proposals": int(len(xyz)), "n_points": int(model.n_points), "ranges": rng["ranges"]}
+            "n_proposals": int(len(xyz)), "n_points": int(model.n_points), "ranges": rng["ranges"],
+            **({"z_origin": int(model.z_origin)} if model.z_origin else {})}
 
 
 def refit(onnx_path, calib: dict, real_dir=None) -> dict:
@@ -122,7 +123,7 @@ def refit(onnx_path, calib: dict, real_dir=None) -> dict:
     if data is None:
         raise EmitError("refit: the calibration scans are not available")
     sims = _sim_scans(calib["sensor"], REFIT_SIM_SEED, REFIT_N_SIM)
-    extra = proposals_of(sims, calib["sensor"], calib["seeds"], model.n_points)
+    extra = proposals_of(sims, calib["sensor"], calib["seeds"], model.n_points, model.z_origin)
     xyz, mean, vox = (np.concatenate([a, b]) for a, b in zip(data, extra))
     fit = Q.head_refit(model, base, xyz, mean, vox)
     return dict(base, head_refit=dict(fit, sim_seed=REFIT_SIM_SEED, n_sim=REFIT_N_SIM))
@@ -130,7 +131,8 @@ def refit(onnx_path, calib: dict, real_dir=None) -> dict:
 
 def calib_set(calib: dict, real_dir=None):
     """Regenerate the calibration proposals a calibration file names (None when a scan is missing), with the
-    model's points per proposal (`n_points`; 64 in files written before it was recorded)."""
+    model's points per proposal (`n_points`; 64 in files written before it was recorded) and z origin (`z_origin`,
+    recorded for a model whose proposals start at the ground; absent: the cluster mean)."""
     paths, sims = [], []
     for s in calib["scans"]:
         if s.startswith("sim/"):  # a freshly simulated scan: sim/<seed>/<index>
@@ -147,7 +149,8 @@ def calib_set(calib: dict, real_dir=None):
     if not all(p.exists() for p in paths):
         return None
     sim_pts = [p for seed, k in sims for p in _sim_scans(calib["sensor"], seed, 1, first=k)]
-    return proposals_of(paths + sim_pts, calib["sensor"], calib["seeds"], int(calib.get("n_points", 64)))
+    return proposals_of(paths + sim_pts, calib["sensor"], calib["seeds"], int(calib.get("n_points", 64)),
+                        int(calib.get("z_origin", 0)))
 
 
 def report(onnx_path, calib_path, real_dir=None) -> list | None:

@@ -87,7 +87,9 @@ SEMKITTI_ID = {10: 0, 252: 0, 31: 1, 253: 1, 30: 2, 254: 2}
 SEMKITTI_IGNORED = (20, 259)
 GROUND_IDS = (40, 44, 48, 49, 60, 72)
 
-DEFAULTS = dict(purity=0.8, recall=0.5, ignored_share=0.5, margin=0.1, n_points=64)
+DEFAULTS = dict(purity=0.8, recall=0.5, ignored_share=0.5, margin=0.1, n_points=64, z_origin="mean")
+#: lidet_proposal_z_origin_t names, in enum order (ONNX metadata lidet.z_origin)
+Z_ORIGINS = ("mean", "ground")
 
 
 # ---- geometry -------------------------------------------------------------------------------------
@@ -336,7 +338,7 @@ def process_scan(scan: Scan, sensor: str, cfg: dict) -> dict:
     gr = native.ground(pts, s)
     cl = native.cluster(pts, s, ground=gr.mask_point, planes=gr.planes)
     k = len(cl)
-    pr = native.proposals(cl, n_points=cfg["n_points"])
+    pr = native.proposals(cl, n_points=cfg["n_points"], z_origin=Z_ORIGINS.index(cfg.get("z_origin", "mean")))
     nonground = (gr.mask_point == 0) & (gr.image.point_pixel >= 0)
     owner, objs = _objects(scan, nonground, cfg["margin"])
     lab = cl.point_labels.astype(np.int64)
@@ -510,6 +512,9 @@ def main(argv=None) -> int:
     ap.add_argument("--recall", type=float, default=DEFAULTS["recall"])
     ap.add_argument("--margin", type=float, default=DEFAULTS["margin"])
     ap.add_argument("--n-points", type=int, default=DEFAULTS["n_points"])
+    ap.add_argument("--z-origin", choices=Z_ORIGINS, default=DEFAULTS["z_origin"],
+                    help="where the proposals' z is measured from: the cluster mean (default) or the ground under it "
+                         "(lidet_proposal_z_origin_t; the models trained on the set carry it as lidet.z_origin)")
     ap.add_argument("--jobs", type=int, default=1, help="worker processes")
     ap.add_argument("--out", type=pathlib.Path, required=True)
     ap.add_argument("--no-progress", action="store_true")
@@ -530,7 +535,7 @@ def main(argv=None) -> int:
     except (FileNotFoundError, ValueError) as e:
         print(f"dataset: {e}", file=sys.stderr)
         return 2
-    cfg = dict(DEFAULTS, purity=a.purity, recall=a.recall, margin=a.margin, n_points=a.n_points)
+    cfg = dict(DEFAULTS, purity=a.purity, recall=a.recall, margin=a.margin, n_points=a.n_points, z_origin=a.z_origin)
     job = functools.partial(_job, sensor=a.sensor, cfg=cfg, behind_cars=a.sim_behind_cars)
     t0 = time.perf_counter()
     parts = [None] * len(tasks)

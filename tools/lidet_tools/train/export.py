@@ -120,6 +120,7 @@ def export_onnx(model, ck: dict, out_path, name: str | None = None) -> pathlib.P
         "lidet.n_points": str(n),
         "lidet.classes": ",".join(M.CLASSES),
         "lidet.frame": "azimuth",
+        "lidet.z_origin": str(meta.get("z_origin", "mean")),
         "lidet.pvle_bins": ",".join(repr(float(b)) for b in meta.get("pvle_bins", M.PVLE_BINS)),
         "lidet.energy_T": repr(float(meta.get("energy_T", 1.0))),
         "lidet.gamma": ",".join(repr(float(g)) for g in meta["gamma"]),

@@ -255,10 +255,11 @@ def user_tasks(folders, layout: str, share: float, defaults: dict) -> list:
     return tasks
 
 
-def build(tasks, sensor: str, n_points: int, jobs: int, progress: bool) -> dict:
-    """dataset.concat of the proposals of the tasks (dataset._job), run with `jobs` processes."""
+def build(tasks, sensor: str, n_points: int, jobs: int, progress: bool, z_origin: str = "mean") -> dict:
+    """dataset.concat of the proposals of the tasks (dataset._job), run with `jobs` processes; z_origin: the models'
+    (ONNX lidet.z_origin)."""
     import functools
-    cfg = dict(D.DEFAULTS, n_points=n_points)
+    cfg = dict(D.DEFAULTS, n_points=n_points, z_origin=z_origin)
     job = functools.partial(D._job, sensor=sensor, cfg=cfg)
     if jobs > 1:
         import multiprocessing as mp
@@ -271,15 +272,21 @@ def build(tasks, sensor: str, n_points: int, jobs: int, progress: bool) -> dict:
     return d
 
 
-def sim_data(fam: str, spec: dict, a) -> tuple[dict, str, bool]:
+def sim_data(fam: str, spec: dict, a, z_origin: str = "mean") -> tuple[dict, str, bool]:
     """The family's simulated proposals: data/train/<fam>.npz (or --sim-data) when it exists, else a fresh set of
-    --sim scans with the family's simulator settings (cached in --work). (dataset dict, its command, made now)."""
+    --sim scans with the family's simulator settings (cached in --work). (dataset dict, its command, made now).
+    The set's proposals must start where the models' do (z_origin)."""
     cached = a.sim_data or ROOT / "data" / "train" / f"{fam}.npz"
     if cached.exists():
         d = D.load(cached)
+        if d["meta"].get("z_origin", "mean") != z_origin:
+            raise ValueError(f"{cached}: proposals with z from the {d['meta'].get('z_origin', 'mean')}, the models' from "
+                             f"the {z_origin}: give --sim-data a set made with dataset --z-origin {z_origin}")
         return d, d["meta"].get("command", str(cached)), False
-    out = a.work / f"sim_{fam}_{a.sim.replace(',', '_')}.npz"
+    out = a.work / (f"sim_{fam}_{a.sim.replace(',', '_')}" + ("" if z_origin == "mean" else f"_z{z_origin}") + ".npz")
     argv = list(spec["dataset"])
+    if "--z-origin" not in argv:
+        argv += ["--z-origin", z_origin]
     i = argv.index("--sim")
     argv[i + 1] = a.sim
     argv += ["--jobs", str(a.jobs), "--out", str(out)] + ([] if a.progress else ["--no-progress"])
@@ -672,19 +679,22 @@ def finetune(a) -> dict:
         if models[k][1] != kind:
             raise ValueError(f"{src_onnx[k]}: lidet.kind {models[k][1]}, expected {kind}")
     n_points = int(models["cls"][2].get("lidet.n_points", 64))
+    z_origin = models["cls"][2].get("lidet.z_origin", "mean")
+    if models["box"][2].get("lidet.z_origin", "mean") != z_origin:
+        raise ValueError(f"{src_onnx['cls']} and {src_onnx['box']} were trained on proposals of different z origins")
 
     # 1. proposal sets
     t = time.perf_counter()
     defaults = dict(fov_half_deg=a.fov_deg, mount_height_m=a.mount_height)
     tasks = user_tasks(a.data, a.layout, a.val_share, defaults)
     _log(f"{len(tasks)} user scans ({sum(t[1] == 1 for t in tasks)} validation) -> proposals")
-    user = build(tasks, sensor, n_points, a.jobs, a.progress)
+    user = build(tasks, sensor, n_points, a.jobs, a.progress, z_origin)
     timings["user proposals"] = time.perf_counter() - t
     if not (user["label"] >= 0).any():
         raise ValueError(f"{', '.join(map(str, a.data))}: no labelled Car / Cyclist / Pedestrian proposal in "
                          f"{len(tasks)} scans (objects whose cluster holds most of them): nothing to fine-tune on")
     t = time.perf_counter()
-    sim, sim_cmd, made = sim_data(fam, spec, a)
+    sim, sim_cmd, made = sim_data(fam, spec, a, z_origin)
     timings["simulated proposals" + ("" if made else " (an existing set, read)")] = time.perf_counter() - t
     if int(sim["points"].shape[1]) != n_points:
         raise ValueError(f"the simulated set has {sim['points'].shape[1]} points per proposal, the models {n_points}")
@@ -725,13 +735,13 @@ def finetune(a) -> dict:
     out = {k: a.out_weights / f"{k}_{fam}.onnx" for k in ("cls", "box")}
     for k, kind in (("cls", "classifier"), ("box", "box")):
         meta = dict(n_points=n_points, gamma=gamma[k], energy_T=1.0, trained=1, sensor=sensor, data=data_desc,
-                    command=cmd)
+                    command=cmd, z_origin=z_origin)
         export_onnx(models[k][0].cpu(), dict(kind=kind, meta=meta), out[k])
     qat = None
     if spec.get("cls_finetune"):
         from . import finetune_q as FQ
         npz = a.work / "merged.npz"
-        np.savez_compressed(npz, meta=json.dumps(dict(sensor=sensor, command=data_desc)),
+        np.savez_compressed(npz, meta=json.dumps(dict(sensor=sensor, command=data_desc, z_origin=z_origin)),
                             **{k: v for k, v in data.items()})
         fargv = ["--onnx", str(out["cls"]), "--data", str(npz), "--out", str(out["cls"]), "--threads", str(a.threads)] \
             + spec["cls_finetune"]

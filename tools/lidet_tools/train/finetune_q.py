@@ -271,7 +271,8 @@ def finetune(a) -> dict:
     net = fc.to_net()
     meta = dict(n_points=fc.model.n_points, gamma=gamma, energy_T=1.0, trained=1,
                 sensor=data["meta"].get("sensor", ""), data=data["meta"].get("command", str(a.data)),
-                command=getattr(a, "command", None) or "python -m lidet_tools.train.finetune_q")
+                command=getattr(a, "command", None) or "python -m lidet_tools.train.finetune_q",
+                z_origin=data["meta"].get("z_origin", "mean"))
     res = dict(before=before, after=after, gamma=gamma, margins=dict(m_in=m_in, m_out=m_out), history=history)
     export_onnx(net, dict(kind="classifier", meta=meta), a.out)
     if a.checkpoint is not None:

@@ -292,6 +292,7 @@ def train(a) -> dict:
     gamma = C.per_class_gamma(r["energies"]["id"], r["energies"]["id_cls"])
     meta = dict(n_points=int(data["points"].shape[1]), gamma=gamma, energy_T=1.0, trained=1,
                 sensor=a.sensor or data["meta"].get("sensor", ""), data=data["meta"].get("command", str(a.data)),
+                z_origin=data["meta"].get("z_origin", "mean"),
                 command=getattr(a, "command", None) or "python -m lidet_tools.train.train_box",
                 margins=st["margins"], best_epoch=best["epoch"], seed=a.seed, history=st["history"],
                 train_seconds=st["history"][-1]["seconds"] if st["history"] else 0.0)

@@ -1,0 +1,52 @@
+/* SPDX-License-Identifier: MIT */
+/**
+ * @file lidet_detector_common.h
+ * @brief What the float detector (lidet_detector.h, with its workspace lidet_workspace.h) and the integer detector
+ *        (lidet_detector_q.h) share: the clock callback, the indices of the timed stages and what became of each
+ *        cluster. No numeric type in here.
+ */
+#ifndef LIDET_DETECTOR_COMMON_H
+#define LIDET_DETECTOR_COMMON_H
+
+#include "lidet_types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** @brief A timestamp source (e.g. a cycle counter or a monotonic clock); ticks in the caller's unit. */
+typedef uint32_t (*lidet_clock_fn)(void *ctx);
+
+/** @brief Stages timed by the detector (indices of lidet_detector_stats_t.ticks and lidet_detector_q_stats_t.ticks;
+ *         the first three are lidet_workspace_run_timed's ticks). */
+enum
+{
+    LIDET_DET_STAGE_PROJECT = 0,  /**< projection */
+    LIDET_DET_STAGE_GROUND = 1,   /**< ground segmentation */
+    LIDET_DET_STAGE_CLUSTER = 2,  /**< clustering */
+    LIDET_DET_STAGE_CLASSIFY = 3, /**< candidate ordering, proposals, classifier */
+    LIDET_DET_STAGE_BOX = 4,      /**< box net */
+    LIDET_DET_STAGE_POST = 5,     /**< size check, NMS */
+    LIDET_DET_N_STAGES = 6
+};
+
+/** @brief What became of each kept cluster in the last run (lidet_detector_outcomes, lidet_detector_q_outcomes). */
+typedef enum
+{
+    LIDET_DET_OUT_CROP = 1,     /**< outside the azimuth window */
+    LIDET_DET_OUT_RANGE = 2,    /**< beyond max_range_m */
+    LIDET_DET_OUT_BUDGET = 3,   /**< past max_proposals, or passed gate 1 past max_boxes */
+    LIDET_DET_OUT_GATE1 = 4,    /**< classified, rejected by gate 1 */
+    LIDET_DET_OUT_GATE2 = 5,    /**< boxed, rejected by gate 2 */
+    LIDET_DET_OUT_SIZE = 6,     /**< boxed, impossible size for its class (or a non-finite centre or yaw) */
+    LIDET_DET_OUT_NMS = 7,      /**< suppressed by the NMS */
+    LIDET_DET_OUT_CAPACITY = 8, /**< past LIDET_MAX_DETECTIONS */
+    LIDET_DET_OUT_DETECTED = 9, /**< a detection of the output */
+    LIDET_DET_OUT_TALL = 10     /**< taller than max_height_extent_m: no road user, not classified */
+} lidet_det_outcome_t;
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* LIDET_DETECTOR_COMMON_H */
