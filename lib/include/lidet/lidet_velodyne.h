@@ -37,7 +37,7 @@
  * ring, rotational and distance correction, elevation by ring), lidet_velodyne_attr_t 8 B per return; ~1.1 KiB
  * of const tables; no allocation, no recursion. Time: O(384) per packet, a few multiplications and divisions by
  * constants per data point; a VLP-16 single-return block without attributes or calibration takes a fast path with
- * two divisions a block and none per point (the same returns; about 43 instructions per return on a Cortex-M4,
+ * two divisions a block and none per point (the same returns; about 40 instructions per return on a Cortex-M4,
  * docs/DECODING.md). Outputs go into the caller's arrays (at most LIDET_VELODYNE_MAX_RETURNS per packet).
  */
 #ifndef LIDET_VELODYNE_H
