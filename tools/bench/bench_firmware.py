@@ -53,6 +53,12 @@ VLP16_PAYLOADS_PER_TURN = 75  # 900 blocks of 0.4 deg (600 rpm), 12 a payload
 STAGES = ["project", "ground", "cluster", "classify", "box", "post"]
 
 
+
+def _scan_file(name: str) -> str:
+    """The scan file an image's scan name (tools/firmware/scan_to_c.py: <folder>/<id>) stands for."""
+    head, _, stem = name.rpartition("/")
+    return f"{head}/velodyne/{stem}.bin" if head.startswith("tests/data/") else name
+
 def _m(v: int) -> str:
     return f"{v / 1e6:,.1f} M"
 
@@ -211,7 +217,7 @@ def run(args) -> str:
     mem = any_rep.get("mem") or {}
     out += [
         f"The whole float detector (`lidet_detector_run`, models `{hdr.get('models', '?')}`) on one simulated "
-        f"VLP-16 scan stored in flash (`{hdr.get('scan', '?')}`, {hdr.get('points', '?')} points with their ring "
+        f"VLP-16 scan stored in flash (`{_scan_file(hdr.get('scan', '?'))}`, {hdr.get('points', '?')} points with their ring "
         f"indices), capacities of `ports/firmware/config/vlp16/lidet_user_config.h` ({mem.get('max_rows')} x "
         f"{mem.get('max_cols')} pixels, {mem.get('max_points'):,} points, {mem.get('max_clusters')} clusters). "
         "Images built with GCC 12 (Debian's gcc-arm-none-eabi + newlib-nano, gcc-riscv64-unknown-elf + picolibc, "
@@ -219,7 +225,7 @@ def run(args) -> str:
         "-O2, and run under QEMU 7.2 with `-icount`. Two runs per image: `default` (the configuration a user gets: "
         "gates and size checks on) and `open` (gates and "
         "size checks off, so that every classified proposal is boxed and compared). The rows marked **HDL-64 scan** "
-        "are the KITTI-like images: the simulated HDL-64 scan `tests/data/sim_hdl64/000000` (124,205 points) with "
+        "are the KITTI-like images: the simulated HDL-64 scan `tests/data/sim_hdl64/velodyne/000000.bin` (124,205 points) with "
         "the capacities of `ports/firmware/config/hdl64/lidet_user_config.h` (64 x 2048, 131,072 points, 1024 "
         "clusters). Its detector (4.4 MiB) does not fit "
         "the MPS2 boards' 4 MiB SRAM: on the AN500's Cortex-M7 it is placed in the 16 MiB PSRAM with a section "
