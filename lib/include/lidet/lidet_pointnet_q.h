@@ -7,8 +7,10 @@
  * Same models as lidet_pointnet.h (same stages, block loop, fused max over the points, [g | onehot | PVLE]
  * concatenation, box coding), quantized by `python -m lidet_codegen emit --int8 --calib FILE MODEL.onnx`
  * into weights/<name>_s8.{c,h}:
- * - weights int8 per output channel (symmetric), activations int8 with one scale per tensor (zero point -128
- *   after a ReLU), int32 accumulators and biases (the input zero point folded in);
+ * - weights int8 per output channel (symmetric), activations int8 (zero point -128 after a ReLU) with one scale
+ *   per channel in the classifiers and per tensor in the box nets, a channel's scale folded into its layer's
+ *   multiplier and the next layer's weight column, so the kernel sees one scale per vector (docs/INT8.md);
+ *   int32 accumulators and biases (the input zero point folded in);
  * - requantization: y = zp + round_half_up(acc * mult / 2^shift), one rounding, mult in [2^30, 2^31),
  *   shift in [1, 62]; then clamped to [zp, 127] after a ReLU, [-128, 127] otherwise;
  * - the first shared layer takes the points rotated into the model frame as int16 millimetres (saturated:
