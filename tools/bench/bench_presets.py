@@ -2,7 +2,8 @@
 """The detector on every sensor preset (issue 37, item 5): simulated AP per preset against the matching model
 family on its own sensor (the preset's default family, `native.default_family`: hdl64 on hdl64 for 32 beams or more,
 vlp16 on vlp16), same run; for the 32-beam presets also the beams32 family (trained on simulated scans of all five
-32-beam presets; not a default: docs/SENSORS.md, "Model families"), against itself on vlp32c.
+32-beam presets; not a default: docs/SENSORS.md, "Model families"), against itself on vlp32c, and for the 128-beam
+presets the beams128 family (the three Ouster 128-beam presets), against itself on os1-128.
 
 Contract of tools/bench/run_bench.py: `run(args) -> str` returns a markdown section (args.build: the CMake build
 with the host CLI; args.quick: fewer scans). Alone: `python tools/bench/bench_presets.py [--quick]`.
@@ -24,8 +25,8 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 SEED = 9100
 CLASSES = ("Car", "Pedestrian", "Cyclist")
 #: families for a beam class besides the default one: rows -> family; the preset each is measured against
-ALT = {32: "beams32"}
-ALT_OWN = {"beams32": "vlp32c"}
+ALT = {32: "beams32", 128: "beams128"}
+ALT_OWN = {"beams32": "vlp32c", "beams128": "os1-128"}
 COLS = (("Car", "0-20"), ("Car", "20-40"), ("Pedestrian", "0-20"), ("Pedestrian", "20-40"), ("Cyclist", "0-20"))
 
 
@@ -95,7 +96,8 @@ def run(args=None) -> str:
         f"The detector on simulated scans of every preset ({scans} scans each, `lidet-sim --sensor S --seed {SEED}`, "
         "360 degrees, the preset's mount height), with the preset's default model family, against that family on "
         "its own sensor in the same run (hdl64 for 32 beams or more, vlp16); on the 32-beam presets a second row gives "
-        "the beams32 family (`--model beams32`), against itself on vlp32c: 3D AP R40 by distance band of the box "
+        "the beams32 family (`--model beams32`), against itself on vlp32c, on the 128-beam presets the beams128 family "
+        "(`--model beams128`), against itself on os1-128: 3D AP R40 by distance band of the box "
         "centre, sensor frame, KITTI overlaps (car 0.7, pedestrian and cyclist 0.5); '-' where a band holds no "
         "object of the class; in brackets the difference from the "
         "family on its own sensor (goal: within 5 AP). Command: `python tools/bench/bench_presets.py`.", "",

@@ -42,6 +42,13 @@ FAMILIES = {
                             "--mounts", "0.7,1.0,1.4,1.84", "--sim", "800,200,200", "--seed", "3000"],
                     cls=["--epochs-ce", "20", "--epochs-energy", "10"],
                     box=["--epochs-box", "30", "--epochs-energy", "10"]),
+    # beams128: a family for the 128-beam presets (issue 37, item 5): simulated scans of the three Ouster 128-beam
+    # presets (OS0 / OS1 / OS2) at four mount heights, each through its own C stages; the hdl64 family's schedule.
+    # Not any preset's default (docs/SENSORS.md, "Model families"); `--model beams128` runs it
+    "beams128": dict(sensor="os1-128", dataset=["--sensor", "os1-128", "--sim-sensors", "os0-128,os1-128,os2-128",
+                              "--mounts", "0.7,1.0,1.4,1.84", "--sim", "600,150,150", "--seed", "4000"],
+                     cls=["--epochs-ce", "20", "--epochs-energy", "10"],
+                     box=["--epochs-box", "30", "--epochs-energy", "10"]),
     # vlp16: 25 energy epochs with lam 0.3 (chosen on validation: FPR95 + 1 - balanced accuracy 0.127,
     # against 0.136 for 25 epochs at lam 0.1 and 0.197 for 10 epochs at lam 0.1)
     "vlp16": dict(dataset=["--sensor", "vlp16", "--mounts", "0.3,0.5,0.7,1.0", "--sim", "800,200,200", "--seed", "2000"],
