@@ -31,6 +31,17 @@ def cli():
 
 
 @pytest.fixture(scope="session")
+def pcli(cli):
+    """The CLI, when it was built with libpcap (else a skip; the message of a CLI without it is checked by
+    tests/cli_pcap.cmake)."""
+    import subprocess
+    r = subprocess.run([str(cli), "detect", "--pcap", "/nonexistent.pcap"], capture_output=True, text=True)
+    if "built without libpcap" in r.stderr:
+        pytest.skip("lidet was built without libpcap (apt-get install libpcap-dev)")
+    return cli
+
+
+@pytest.fixture(scope="session")
 def need_lib():
     """Skips when the bindings' shared library (liblidet_py.so) is not built."""
     from lidet_tools import native

@@ -102,15 +102,6 @@ def _scans(out):
 
 
 @pytest.fixture(scope="module")
-def pcli(cli):
-    """The CLI, when it was built with libpcap (else a skip: its message is checked by test_without_libpcap)."""
-    r = subprocess.run([str(cli), "detect", "--pcap", "/nonexistent.pcap"], capture_output=True, text=True)
-    if "built without libpcap" in r.stderr:
-        pytest.skip("lidet was built without libpcap (apt-get install libpcap-dev)")
-    return cli
-
-
-@pytest.fixture(scope="module")
 def vd(need_lib):
     from lidet_tools import native, velodyne
     if not hasattr(native.lib(), "lidet_py_velodyne_decode"):

@@ -74,14 +74,6 @@ def _decoder_line(err):
 
 
 @pytest.fixture(scope="module")
-def pcli(cli):
-    r = subprocess.run([str(cli), "detect", "--pcap", "/nonexistent.pcap"], capture_output=True, text=True)
-    if "built without libpcap" in r.stderr:
-        pytest.skip("lidet was built without libpcap (apt-get install libpcap-dev)")
-    return cli
-
-
-@pytest.fixture(scope="module")
 def vd(need_lib):
     from lidet_tools import native, velodyne
     if not hasattr(native.lib(), "lidet_velodyne_decoder_xyz"):

@@ -74,6 +74,7 @@ import time
 import zlib
 
 import numpy as np
+from lidet_codegen.emit import Z_ORIGINS  # lidet_proposal_z_origin_t names (ONNX lidet.z_origin)
 
 from .. import kitti
 from ..sensors import get_sensor
@@ -88,8 +89,6 @@ SEMKITTI_IGNORED = (20, 259)
 GROUND_IDS = (40, 44, 48, 49, 60, 72)
 
 DEFAULTS = dict(purity=0.8, recall=0.5, ignored_share=0.5, margin=0.1, n_points=64, z_origin="mean")
-#: lidet_proposal_z_origin_t names, in enum order (ONNX metadata lidet.z_origin)
-Z_ORIGINS = ("mean", "ground")
 
 
 # ---- geometry -------------------------------------------------------------------------------------
