@@ -13,6 +13,8 @@ import numpy as np
 from lidet_ref import cluster_q, ground_q, pointnet_q, post_q, proj_q, qmath
 
 OUT_CROP, OUT_RANGE, OUT_BUDGET, OUT_GATE1, OUT_GATE2, OUT_SIZE, OUT_NMS, OUT_CAPACITY, OUT_DETECTED, OUT_TALL = range(1, 11)
+#: lidet_detector_q_cfg_default's gate2_class: gate 2 judges cars and cyclists, pedestrians pass it
+GATE2_CLASS = (1, 1, 0)
 
 
 LN64_Q16 = 272557  # round(ln(64) * 2^16)
@@ -71,7 +73,8 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
            returns=None) -> dict:
     """The whole integer detector on (N, 3) int32 mm points. det_cfg: crop_half_bam, max_range_mm, max_height_extent_mm,
     max_proposals, max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max, score_box_weight_q16 (3), score_points_weight_q16 (3), and optionally gate1_margin_q16 / gate2_margin_q16
-    (0 when absent: the models' gammas). range_only: the image keeps only the range, every stage reads x, y, z
+    (0 when absent: the models' gammas) and gate2_class (3 flags, lidet_class_t order: the classes gate 2 judges;
+    GATE2_CLASS when absent, the C default). range_only: the image keeps only the range, every stage reads x, y, z
     decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
     (dicts), outcomes, stats. returns: (range_mm, azimuth, ring) instead of points_mm (lidet_detector_q_run_returns:
     proj_q.project_returns)."""
@@ -120,7 +123,7 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
         b = pointnet_q.box(box_model, xyz[None].astype(np.int64), mean[None], vox[None], cls)
         stats["n_boxed"] += 1
         e_box = int(b["energy"][0])
-        if det_cfg["gate2"] and not e_box < int(box_model.gamma_q16[cls]) + int(det_cfg.get("gate2_margin_q16", 0)):
+        if det_cfg["gate2"] and det_cfg.get("gate2_class", GATE2_CLASS)[cls] and not e_box < int(box_model.gamma_q16[cls]) + int(det_cfg.get("gate2_margin_q16", 0)):
             outcome[ci] = OUT_GATE2
             stats["n_gate2_rejected"] += 1
             continue

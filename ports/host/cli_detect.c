@@ -463,9 +463,10 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, gate1_margin)
     CLI_SET_FLOAT(c, kv, klen, v, gate2_margin)
     {
-        /* score_box_weight.CLASS / score_points_weight.CLASS, in lidet_class_t order */
+        /* score_box_weight.CLASS / score_points_weight.CLASS / gate2.CLASS, in lidet_class_t order */
         static const char *const names[LIDET_N_CLASSES] = {"score_box_weight.car", "score_box_weight.cyclist",
                                                            "score_box_weight.pedestrian"};
+        static const char *const gnames[LIDET_N_CLASSES] = {"gate2.car", "gate2.cyclist", "gate2.pedestrian"};
         static const char *const pnames[LIDET_N_CLASSES] = {"score_points_weight.car", "score_points_weight.cyclist",
                                                             "score_points_weight.pedestrian"};
         int k;
@@ -479,6 +480,13 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
             if (klen == strlen(pnames[k]) && strncmp(kv, pnames[k], klen) == 0)
             {
                 c->score_points_weight[k] = (float)v;
+                return 0;
+            }
+            if (klen == strlen(gnames[k]) && strncmp(kv, gnames[k], klen) == 0)
+            {
+                if (v != 0.0 && v != 1.0)
+                    return 1;
+                c->gate2_class[k] = (uint8_t)v;
                 return 0;
             }
         }
@@ -578,6 +586,8 @@ void cli_det_usage(FILE *f)
                "                   max_height_extent_m (0: classify tall clusters too),\n"
                "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
                "                   gate2_margin (nats added to the models' gates),\n"
+               "                   gate2.car|cyclist|pedestrian (0 or 1: whether gate 2\n"
+               "                   judges the class; default 1, 1, 0),\n"
                "                   score_box_weight.car|cyclist|pedestrian (the score's weight on gate 2's\n"
                "                   margin), score_points_weight.CLASS (on ln(points / 64));\n"
                "                   stages.cluster.KEY: a\n"

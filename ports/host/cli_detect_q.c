@@ -109,6 +109,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     cfg.gate2_margin_q16 = round_i32((double)fcfg->gate2_margin * 65536.0);
     for (k = 0; k < LIDET_N_CLASSES; ++k)
     {
+        cfg.gate2_class[k] = fcfg->gate2_class[k];
         cfg.score_box_weight_q16[k] = round_i32((double)fcfg->score_box_weight[k] * 65536.0);
         cfg.score_points_weight_q16[k] = round_i32((double)fcfg->score_points_weight[k] * 65536.0);
     }

@@ -19,7 +19,8 @@ static lidet_detector_t g_det;
 static int32_t g_pp[LIDET_MAX_POINTS];
 
 /* fcfg: crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin, mount_height_m (< 0: the profile's);
- * ucfg: max_proposals (0 = the default), gate1, gate2, refine (the clustering's split_people and join_cars).
+ * ucfg: max_proposals (0 = the default), gate1, gate2, refine (the clustering's split_people and join_cars),
+ * gate2_class as bits (bit k: class k, lidet_class_t order; 0xFFFFFFFF = the default).
  * out_det: LIDET_MAX_DETECTIONS rows of 12 floats (class, score, energy_cls, energy_box, cx, cy, cz, l, w, h,
  * yaw, cluster id); out_outcome: LIDET_MAX_CLUSTERS bytes; out_point_cluster / out_point_ground: n entries
  * (may be NULL); out_stats: 15 uint32 (the lidet_detector_stats_t counts in order, the status, then
@@ -62,6 +63,13 @@ static int det_run(const lidet_sensor_t *s, uint32_t cls_index, uint32_t box_ind
     }
     cfg.gate1 = (uint8_t)ucfg[1];
     cfg.gate2 = (uint8_t)ucfg[2];
+    if (ucfg[4] != 0xFFFFFFFFu) /* the classes gate 2 judges; all ones: the default */
+    {
+        for (k = 0; k < LIDET_N_CLASSES; ++k)
+        {
+            cfg.gate2_class[k] = (uint8_t)((ucfg[4] >> k) & 1u);
+        }
+    }
     cfg.stages.cluster.split_people = ucfg[3] != 0u; /* the proposal refinement (lidet_refine.c) */
     cfg.stages.cluster.join_cars = ucfg[3] != 0u;
     rc = lidet_detector_init(&g_det, &cfg, lidet_weights_models[cls_index].model,

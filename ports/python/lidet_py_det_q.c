@@ -51,6 +51,14 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
     }
     cfg.gate1_margin_q16 = icfg[7];
     cfg.gate2_margin_q16 = icfg[8];
+    if (icfg[10] >= 0) /* the classes gate 2 judges, as bits (class k: bit k); -1: the default */
+    {
+        int k;
+        for (k = 0; k < LIDET_N_CLASSES; ++k)
+        {
+            cfg.gate2_class[k] = (uint8_t)((icfg[10] >> k) & 1);
+        }
+    }
     if (icfg[9] >= 0) /* -1: the build's default */
     {
         cfg.range_only = (uint8_t)icfg[9];
@@ -65,7 +73,8 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
 }
 
 /* lidet_py_detq_run: icfg: crop_half_bam, max_range_mm, nms_iou_q15, max_proposals (0 = default), gate1, gate2,
- * max_boxes (0 = default), gate1_margin_q16, gate2_margin_q16, range_only (-1 = the build's default, 0, 1).
+ * max_boxes (0 = default), gate1_margin_q16, gate2_margin_q16, range_only (-1 = the build's default, 0, 1),
+ * gate2_class as bits (bit k: class k; -1 = the default).
  * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
  * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 14 uint32 (the
  * counts of lidet_detector_q_stats_t in order, then n_over_box_budget and n_too_tall). returns: n lidet_return_t

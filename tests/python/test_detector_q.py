@@ -51,9 +51,11 @@ def _agreement(nq, scans, range_only=False):
         used = set()
         for i in range(len(f.cls)):
             d = np.hypot(qb[:, 0] - f.box[i, 0], qb[:, 1] - f.box[i, 1]) if len(qb) else np.zeros(0)
-            for j in np.argsort(d):
+            # within 1 m, a detection of the same class first (two road users of different classes can stand
+            # within 1 m of each other, e.g. a pedestrian beside a cyclist), then the nearest
+            for j in sorted(range(len(d)), key=lambda j: (int(q["cls"][j] != f.cls[i]), d[j])):
                 if d[j] >= 1.0:
-                    break
+                    continue
                 if j in used:
                     continue
                 used.add(j)
@@ -109,7 +111,10 @@ def test_agrees_with_float_detector_on_real_scans(nq, real_dir, range_only):
     if not range_only:
         _check(a)
         return
-    assert a["class_same"] == a["matched"]
+    # one matched pair in a hundred may differ in class: pedestrians pass gate 2 (lidet_detector_cfg_t.gate2_class),
+    # and a cluster the two pixels see differently can be a pedestrian in one and a cyclist in the other (measured:
+    # 1 of 260)
+    assert a["matched"] - a["class_same"] <= 0.01 * a["matched"], a
     assert a["matched"] >= 0.68 * a["n_float"], a
     assert a["mean_iou"] >= 0.88, a
 
@@ -156,7 +161,8 @@ def test_score_matches_the_float_definition(nq):
 
 # ---- the integer detector against the chained numpy reference, bit for bit ---------------------------
 
-def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False, crop_half_bam=0, returns=None):
+def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False, crop_half_bam=0, returns=None,
+                gate2_class=None):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -174,12 +180,15 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
     det_cfg = dict(crop_half_bam=crop_half_bam, max_range_mm=0, max_height_extent_mm=2500, score_box_weight_q16=[32768, 0, 0], score_points_weight_q16=[6554, 0, 0], max_proposals=min(128 if s.rows <= 16 else 256, cap["max_clusters"]),
                    max_boxes=max_boxes or min(24 if s.rows <= 16 else 48, cap["max_clusters"]), gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM,
                    gate1_margin_q16=margins[0], gate2_margin_q16=margins[1])
+    if gate2_class is not None:
+        det_cfg["gate2_class"] = gate2_class
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
                      det_cfg, models["cls"], models["box"], cap["max_clusters"], cap["max_detections"],
                      cap["max_points"], range_only=range_only, returns=returns)
 
 
-@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "range_only_sample",
+@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "gate2_all",
+                                   "range_only_sample",
                                    "range_only_fresh", "range_only_real", "crop_hdl64", "crop_real",
                                    "returns_sample", "returns_range_only_sample", "returns_range_only_fresh"])
 def test_bit_exact_with_the_chained_reference(nq, which, request):
@@ -187,7 +196,7 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     qmath.decode_pixels) against the chained numpy reference, bit for bit; and the detector fed the sensor's
     returns (lidet_detector_q_run_returns: ring, azimuth, range) instead of points."""
     from lidet_ref import proj_q
-    sensor, max_boxes, margins = "vlp16", 0, (0, 0)
+    sensor, max_boxes, margins, g2c = "vlp16", 0, (0, 0), None
     use_returns = which.startswith("returns_")
     which = which.removeprefix("returns_")
     range_only = which.startswith("range_only_")
@@ -196,6 +205,8 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     ring = None
     if which == "margins":  # the gates' operating points moved: gate 1 looser by 1 nat, gate 2 stricter by 0.5
         pts, margins = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"), (65536, -32768)
+    elif which == "gate2_all":  # gate 2 judges pedestrians too (the default lets their boxes pass it)
+        pts, g2c = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"), (1, 1, 1)
     elif which == "box_budget":  # the box budget hit: 3 boxed, the rest counted, LIDET_TRUNCATED
         pts, max_boxes = _load(ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"), 3
     elif which == "sample":
@@ -213,8 +224,9 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     mm = nq.to_mm(pts)
     rets = proj_q.returns_of_points(mm, ring) if use_returns else None
     c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
-                    range_only=range_only, crop_half_bam=crop, returns=None if rets is None else nq.as_returns(*rets))
-    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop, returns=rets)
+                    range_only=range_only, crop_half_bam=crop, returns=None if rets is None else nq.as_returns(*rets),
+                    gate2_class=g2c)
+    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop, returns=rets, gate2_class=g2c)
     if use_returns:  # the same scan as points gives nearly the same detections (pixels move by rounding only)
         p = nq.detect_q(mm, sensor, range_only=range_only)
         assert abs(len(p["cls"]) - len(c["cls"])) <= 2 and c["stats"]["n_clusters"] > 0
@@ -223,6 +235,9 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     if margins != (0, 0):  # the margins bite: fewer gate-1 rejections, more gate-2 ones than at the models' gammas
         c0 = nq.detect_q(mm, sensor)
         assert c["stats"]["n_gate1_rejected"] < c0["stats"]["n_gate1_rejected"]
+        assert c["stats"]["n_gate2_rejected"] > c0["stats"]["n_gate2_rejected"]
+    if g2c is not None:  # the flags bite: gate 2 rejects pedestrians it let through by default
+        c0 = nq.detect_q(mm, sensor)
         assert c["stats"]["n_gate2_rejected"] > c0["stats"]["n_gate2_rejected"]
     if max_boxes:
         assert c["status"] == 1 and r["truncated"]

@@ -359,6 +359,23 @@ void test_crop_budget_range_and_gates(void)
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
     TEST_ASSERT_EQUAL_UINT32(3, lidet_detector_stats(&g.ws)->n_gate2_rejected);
+    {
+        /* gate 2 per class: the default judges cars and cyclists, not pedestrians; a class it does not judge
+         * passes whatever its box energy (the three detections here are cars) */
+        uint32_t nd;
+        lidet_detector_cfg_t d0;
+        lidet_detector_cfg_default(&d0, lidet_sensor_find("hdl64"));
+        TEST_ASSERT_EQUAL_UINT8(1, d0.gate2_class[LIDET_CLASS_CAR]);
+        TEST_ASSERT_EQUAL_UINT8(1, d0.gate2_class[LIDET_CLASS_CYCLIST]);
+        TEST_ASSERT_EQUAL_UINT8(0, d0.gate2_class[LIDET_CLASS_PEDESTRIAN]);
+        cfg.gate2_class[LIDET_CLASS_CAR] = 0;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+        TEST_ASSERT_EQUAL_UINT32(0, lidet_detector_stats(&g.ws)->n_gate2_rejected);
+        lidet_detector_detections(&g.ws, &nd);
+        TEST_ASSERT_EQUAL_UINT32(3, nd);
+        cfg.gate2_class[LIDET_CLASS_CAR] = 1;
+    }
     m_box.gamma[0] = 100.0f;
     cfg.size_max_m[LIDET_CLASS_CAR][0] = 3.0f;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
@@ -463,6 +480,9 @@ void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c = cfg;
     c.gate2_margin = 20.5f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
+    c.gate2_class[LIDET_CLASS_PEDESTRIAN] = 2; /* a flag: 0 or 1 */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c = cfg;
     c.size_min_m[1][2] = 5.0f;

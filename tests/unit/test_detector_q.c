@@ -81,6 +81,12 @@ static void test_init_errors(void)
     cfg.gate2_margin_q16 = INT32_MIN;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);
+    TEST_ASSERT_EQUAL_UINT8(1, cfg.gate2_class[LIDET_CLASS_CAR]); /* gate 2 judges cars and cyclists */
+    TEST_ASSERT_EQUAL_UINT8(1, cfg.gate2_class[LIDET_CLASS_CYCLIST]);
+    TEST_ASSERT_EQUAL_UINT8(0, cfg.gate2_class[LIDET_CLASS_PEDESTRIAN]);
+    cfg.gate2_class[LIDET_CLASS_CAR] = 2; /* a flag: 0 or 1 */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.max_proposals = 0;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);

@@ -43,6 +43,8 @@ BAM = 2.0 * math.pi / 2.0 ** 32
 #: tests/python/test_ablate_q.py checks that these rules reproduce both detectors
 SCORE_BOX_WEIGHT = (0.5, 0.0, 0.0)
 SCORE_POINTS_WEIGHT = (0.1, 0.0, 0.0)  # score_points_weight (_q16 = round(v 2^16))
+#: the classes gate 2 judges (car, cyclist, pedestrian): gate2_class of both detectors' defaults
+GATE2_CLASS = RD.GATE2_CLASS
 
 
 def nets_float(fam, xyz, mean, vox, cid, max_boxes, npts):
@@ -58,7 +60,7 @@ def nets_float(fam, xyz, mean, vox, cid, max_boxes, npts):
         if n_boxed == max_boxes:
             continue
         n_boxed += 1
-        if not b["passed"][k]:
+        if GATE2_CLASS[int(c["cls"][k])] and not b["passed"][k]:
             continue
         cl, bx = int(c["cls"][k]), b["box"][k]
         if not (np.all(bx[3:6] >= SIZE_MIN_M[cl]) and np.all(bx[3:6] <= SIZE_MAX_M[cl])):
@@ -84,7 +86,8 @@ def nets_int8(fam, q4, m4, vox, cid, npts):
     gam_b = native.pnq_models()[f"box_{fam}_s8"]["gamma_q16"]
     c = native.pnq_classify(f"cls_{fam}_s8", q4, m4, vox)
     b = native.pnq_box(f"box_{fam}_s8", q4, m4, vox, c["cls"])
-    keep = np.flatnonzero(c["passed"] & b["passed"])
+    g2 = np.asarray(GATE2_CLASS, bool)[c["cls"]]
+    keep = np.flatnonzero(c["passed"] & (b["passed"] | ~g2))
     if len(keep) == 0:
         return []
     cls = c["cls"][keep]

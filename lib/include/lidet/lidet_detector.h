@@ -75,6 +75,12 @@ typedef struct
                                          the validation road users; > 0 keeps more of them and more clutter
                                          (measured: docs/DETECTOR.md); [-20, 20] */
     float gate2_margin; /**< the same for gate 2 (the box net's gamma); [-20, 20], default 0 */
+    uint8_t gate2_class[LIDET_N_CLASSES]; /**< 1: gate 2 judges this class (lidet_class_t order), 0: its boxes
+                                               pass gate 2 whatever the box net's energy (the energy is still
+                                               reported). Default car 1, cyclist 1, pedestrian 0: a pedestrian's
+                                               heading is ambiguous, and on real scans gate 2 dropped more real
+                                               pedestrians than clutter (measured: docs/DETECTOR.md, "Gate 2 per
+                                               class") */
     float score_box_weight
         [LIDET_N_CLASSES]; /**< the detection score is 1 / (1 + e^-(m1 + w m2)), m1 = gamma1 - E1
                                                   and m2 = gamma2 - E2 the two gates' margins (the models' gammas),

@@ -42,6 +42,9 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     cfg->gate2 = 1u;
     cfg->gate1_margin_q16 = 0;
     cfg->gate2_margin_q16 = 0;
+    cfg->gate2_class[LIDET_CLASS_CAR] = 1u; /* the float detector's: pedestrians pass gate 2 */
+    cfg->gate2_class[LIDET_CLASS_CYCLIST] = 1u;
+    cfg->gate2_class[LIDET_CLASS_PEDESTRIAN] = 0u;
     cfg->score_box_weight_q16[LIDET_CLASS_CAR] = 32768; /* the float detector's 0.5 */
     cfg->score_box_weight_q16[LIDET_CLASS_CYCLIST] = 0;
     cfg->score_box_weight_q16[LIDET_CLASS_PEDESTRIAN] = 0;
@@ -73,6 +76,10 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
     }
     for (k = 0; k < (uint32_t)LIDET_N_CLASSES; ++k)
     {
+        if (c->gate2_class[k] > 1u)
+        {
+            return 0;
+        }
         if (c->score_box_weight_q16[k] < 0 || c->score_box_weight_q16[k] > 4 * 65536 ||
             c->score_points_weight_q16[k] < 0 || c->score_points_weight_q16[k] > 4 * 65536)
         {

@@ -12,8 +12,8 @@
  *                                       scores)
  *
  * Parameters:
- *   DET_T                 the detector (members cfg.gate1, cfg.gate2, cfg.max_boxes, order, outcome, det, n_det,
- *                         stats)
+ *   DET_T                 the detector (members cfg.gate1, cfg.gate2, cfg.gate2_class, cfg.max_boxes, order,
+ *                         outcome, det, n_det, stats)
  *   DET_CLS_OUT_T         the classifier's output (member cls read here)
  *   DET_BOX_OUT_T         the box net's output (member box read here)
  *   DET_DETECTION_T       one detection (members box, cls, cluster_id)
@@ -84,7 +84,7 @@ static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *
             return s;
         }
         ++d->stats.n_boxed;
-        if (d->cfg.gate2 && !DET_GATE2_PASS(d, co.cls, &bo))
+        if (d->cfg.gate2 && d->cfg.gate2_class[co.cls] && !DET_GATE2_PASS(d, co.cls, &bo))
         {
             d->outcome[ci] = LIDET_DET_OUT_GATE2;
             ++d->stats.n_gate2_rejected;

@@ -60,6 +60,14 @@ class Detections:
     stats: dict
 
 
+def _class_bits(flags) -> int:
+    """Three per-class flags (lidet_class_t order) as the bits the bindings take."""
+    f = [int(bool(v)) for v in flags]
+    if len(f) != 3:
+        raise ValueError(f"gate2_class needs 3 flags (Car, Cyclist, Pedestrian), got {flags!r}")
+    return f[0] | f[1] << 1 | f[2] << 2
+
+
 def default_family(sensor: str | Sensor) -> str:
     """The float model family the detector runs for a preset name: the sensor's own when the bindings hold its
     pair, else hdl64; for a `Sensor` (e.g. read from a file): its model, else hdl64 for >= 32 rows and vlp16 below
@@ -73,7 +81,7 @@ def default_family(sensor: str | Sensor) -> str:
 def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, crop_half_rad: float = 0.0,
            max_range_m: float = 0.0, nms_iou: float = 0.1, max_proposals: int | None = None, gate1: bool = True,
            gate2: bool = True, refine: bool = True, gate1_margin: float = 0.0, gate2_margin: float = 0.0,
-           mount_height_m: float | None = None) -> Detections:
+           mount_height_m: float | None = None, gate2_class=None) -> Detections:
     """lidet_detector_run on (N, >=3) points with the models cls_<model> / box_<model> compiled into the bindings
     (default: `default_family(sensor)`). sensor: a preset name (the C preset, lidet_sensor_find, as `lidet detect
     --sensor`) or a `Sensor` (its table in ring order, e.g. `sensors.load_sensor_file`, `load_ouster_metadata`, as
@@ -81,7 +89,9 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
     C default for the sensor (lidet_detector_cfg_default). refine False: the clustering without its refinement
     (split_people, join_cars: lidet_refine.c), as the integer detector runs it today. gate1_margin / gate2_margin:
     the gates' operating points (lidet_detector_cfg_t, nats added to the models' gammas). mount_height_m: the
-    sensor's height above the ground in m, [0, 10] (None: the profile's; `lidet detect --mount-height`)."""
+    sensor's height above the ground in m, [0, 10] (None: the profile's; `lidet detect --mount-height`).
+    gate2_class: 3 flags (Car, Cyclist, Pedestrian), the classes gate 2 judges (None: the C default,
+    lidet_detector_cfg_t.gate2_class)."""
     if max_proposals is not None and not (isinstance(max_proposals, (int, np.integer)) and max_proposals >= 1):
         raise ValueError(f"max_proposals must be a positive integer, got {max_proposals!r}")
     if not isinstance(sensor, (str, Sensor)):
@@ -105,7 +115,8 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
         raise ValueError(f"mount_height_m must be metres in [0, 10], got {mount_height_m!r}")
     fc = np.array([crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin,
                    -1.0 if mount_height_m is None else mount_height_m], np.float32)
-    uc = np.array([max_proposals or 0, int(bool(gate1)), int(bool(gate2)), int(bool(refine))], np.uint32)
+    uc = np.array([max_proposals or 0, int(bool(gate1)), int(bool(gate2)), int(bool(refine)),
+                   0xFFFFFFFF if gate2_class is None else _class_bits(gate2_class)], np.uint32)
     args = (ms[f"cls_{fam}"].index, ms[f"box_{fam}"].index, fc, uc, pts if n else np.zeros((1, 4), np.float32), n,
             stride, det, nd, oc, nc, pc, pg, st)
     if isinstance(sensor, str):
@@ -134,11 +145,12 @@ DETQ_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", 
 def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_half_bam: int = 0,
              max_range_mm: int = 0, nms_iou_q15: int = 3277, max_proposals: int = 0, gate1: bool = True,
              gate2: bool = True, max_boxes: int = 0, gate1_margin_q16: int = 0, gate2_margin_q16: int = 0,
-             range_only: bool | None = None, returns=None) -> dict:
+             range_only: bool | None = None, returns=None, gate2_class=None) -> dict:
     """lidet_detector_q_run on (N, 3) int32 mm points with the int8 models cls_<model>_s8 / box_<model>_s8
     (returns: a RETURN_DTYPE array instead, lidet_detector_q_run_returns; points_mm is then ignored).
     gate*_margin_q16: the gates' operating points (lidet_detector_q_cfg_t, Q16 nats). range_only: the range-only
-    pixel (lidet_detector_q_cfg_t.range_only; None = the build's default).
+    pixel (lidet_detector_q_cfg_t.range_only; None = the build's default). gate2_class: 3 flags (Car, Cyclist,
+    Pedestrian), the classes gate 2 judges (None: the C default).
 
     Returns {'cls', 'score_q15', 'energy_cls_q16', 'energy_box_q16', 'boxes' (N, 7: cx cy cz l w h mm, yaw BAM32),
     'cluster_id', 'n_points', 'outcome', 'stats', 'status'}."""
@@ -157,8 +169,8 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     nc = np.zeros(1, np.uint32)
     st = np.zeros(len(DETQ_STATS), np.uint32)
     icfg = np.array([crop_half_bam, max_range_mm, nms_iou_q15, max_proposals, int(bool(gate1)), int(bool(gate2)),
-                     max_boxes, gate1_margin_q16, gate2_margin_q16, -1 if range_only is None else int(bool(range_only))],
-                    np.int32)
+                     max_boxes, gate1_margin_q16, gate2_margin_q16, -1 if range_only is None else int(bool(range_only)),
+                     -1 if gate2_class is None else _class_bits(gate2_class)], np.int32)
     n = len(pts)
     rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
                              pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st,
