@@ -120,10 +120,11 @@ eval-real: deps build
 # classifier + box net per sensor family, ONNX export, test-split figures and weights/MODEL_CARD.md; then the
 # small VLP-16 pair of the integer firmware (family vlp16s, weights/MODEL_CARD_vlp16s.md), then the 32-beam family
 # (beams32: simulated VLP-32C, HDL-32E and Ouster 32-beam scans at four mounts, weights/MODEL_CARD_beams32.md; about
-# 12 min more) and the 128-beam family (beams128: the Ouster 128-beam presets at four mounts, MODEL_CARD_beams128.md). Each run ends with the int8 calibration of the models it trained (weights/*.calib.json) and every C model of weights/ regenerated
+# 12 min more), the 128-beam family (beams128: the Ouster 128-beam presets at four mounts, MODEL_CARD_beams128.md) and the
+# Ouster 64-beam family (beams64: the Ouster 64-beam presets at four mounts, MODEL_CARD_beams64.md). Each run ends with the int8 calibration of the models it trained (weights/*.calib.json) and every C model of weights/ regenerated
 # from the ONNX files (float *.c, int8 *_s8.c, lidet_weights.{c,h}: python -m lidet_codegen regen weights);
 # then the build, so build/ (lidet, the bindings, the tests) runs the new models.
-# Resumable (state under data/train/); about 55 min on a 2-core machine (docs/TRAINING.md).
+# Resumable (state under data/train/); about 65 min on a 2-core machine (docs/TRAINING.md).
 WEIGHTS_ARGS ?=
 weights: deps build
 	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \
@@ -134,6 +135,8 @@ weights: deps build
 	    --jobs $(JOBS) --threads 1 --families beams32 --card weights/MODEL_CARD_beams32.md $(WEIGHTS_ARGS)
 	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \
 	    --jobs $(JOBS) --threads 1 --families beams128 --card weights/MODEL_CARD_beams128.md $(WEIGHTS_ARGS)
+	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \
+	    --jobs $(JOBS) --threads 1 --families beams64 --card weights/MODEL_CARD_beams64.md $(WEIGHTS_ARGS)
 	$(MAKE) --no-print-directory build
 
 clean:

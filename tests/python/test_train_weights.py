@@ -19,9 +19,10 @@ WEIGHTS = pathlib.Path(__file__).resolve().parents[2] / "weights"
 #: proposal); vlp16s: the small VLP-16 pair of the integer firmware
 FAMILIES = {"hdl64": ("hdl64", 1002, [None], 64), "vlp16": ("vlp16", 2002, [0.3, 0.5, 0.7, 1.0], 64),
             "vlp16s": ("vlp16", 2002, [0.3, 0.5, 0.7, 1.0], 32), "beams32": ("vlp32c", 3002, [0.7, 1.0, 1.4, 1.84], 64),
-            "beams128": ("os1-128", 4002, [0.7, 1.0, 1.4, 1.84], 64)}
+            "beams128": ("os1-128", 4002, [0.7, 1.0, 1.4, 1.84], 64), "beams64": ("os1-64", 5002, [0.7, 1.0, 1.4, 1.84], 64)}
 #: the presets a family's simulated scans cycle over (dataset --sim-sensors); the others: its own sensor
-SIM_SENSORS = {"beams32": ["vlp32c", "hdl32", "os0-32", "os1-32", "os2-32"], "beams128": ["os0-128", "os1-128", "os2-128"]}
+SIM_SENSORS = {"beams32": ["vlp32c", "hdl32", "os0-32", "os1-32", "os2-32"], "beams128": ["os0-128", "os1-128", "os2-128"],
+               "beams64": ["os0-64", "os1-64", "os2-64"]}
 
 
 def _meta(path):

@@ -2,8 +2,9 @@
 """The detector on every sensor preset (issue 37, item 5): simulated AP per preset against the matching model
 family on its own sensor (the preset's default family, `native.default_family`: hdl64 on hdl64 for 32 beams or more,
 vlp16 on vlp16), same run; for the 32-beam presets also the beams32 family (trained on simulated scans of all five
-32-beam presets; not a default: docs/SENSORS.md, "Model families"), against itself on vlp32c, and for the 128-beam
-presets the beams128 family (the three Ouster 128-beam presets), against itself on os1-128.
+32-beam presets; not a default: docs/SENSORS.md, "Model families"), against itself on vlp32c, for the Ouster 64-beam
+presets the beams64 family (the three Ouster 64-beam presets; not hdl64 or pandar64), against itself on os1-64, and
+for the 128-beam presets the beams128 family (the three Ouster 128-beam presets), against itself on os1-128.
 
 Contract of tools/bench/run_bench.py: `run(args) -> str` returns a markdown section (args.build: the CMake build
 with the host CLI; args.quick: fewer scans). Alone: `python tools/bench/bench_presets.py [--quick]`.
@@ -24,9 +25,11 @@ import tempfile
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 SEED = 9100
 CLASSES = ("Car", "Pedestrian", "Cyclist")
-#: families for a beam class besides the default one: rows -> family; the preset each is measured against
-ALT = {32: "beams32", 128: "beams128"}
-ALT_OWN = {"beams32": "vlp32c", "beams128": "os1-128"}
+#: families for a beam class besides the default one: rows -> family; the preset each is measured against; the
+#: presets of its class a family is run on where not all of them (beams64: the Ouster ones, not hdl64 or pandar64)
+ALT = {32: "beams32", 64: "beams64", 128: "beams128"}
+ALT_OWN = {"beams32": "vlp32c", "beams64": "os1-64", "beams128": "os1-128"}
+ALT_ONLY = {"beams64": ("os0-64", "os1-64", "os2-64")}
 COLS = (("Car", "0-20"), ("Car", "20-40"), ("Pedestrian", "0-20"), ("Pedestrian", "20-40"), ("Cyclist", "0-20"))
 
 
@@ -40,6 +43,12 @@ def _ap(gt_dir, pred_dir) -> dict:
 def _env(build: pathlib.Path) -> dict:
     return dict(os.environ, LIDET_BUILD_DIR=str(build), OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1",
                 PYTHONPATH=str(ROOT / "tools") + os.pathsep + os.environ.get("PYTHONPATH", ""))
+
+
+def alt_family(name: str, sen) -> str | None:
+    """The second family measured on preset `name` (ALT, ALT_ONLY), or None."""
+    fam = ALT.get(sen.rows)
+    return fam if fam and name in ALT_ONLY.get(fam, (name,)) else None
 
 
 def measure(sensor: str, scans: int, build: pathlib.Path, tmp: pathlib.Path, model: str | None = None) -> dict:
@@ -72,8 +81,8 @@ def run(args=None) -> str:
     rows = []
     with tempfile.TemporaryDirectory() as t:
         res = {s: measure(s, scans, build, pathlib.Path(t)) for s in SENSORS}
-        res_alt = {s: measure(s, scans, build, pathlib.Path(t), ALT[sen.rows]) for s, sen in SENSORS.items()
-                   if sen.rows in ALT}
+        res_alt = {s: measure(s, scans, build, pathlib.Path(t), alt_family(s, sen)) for s, sen in SENSORS.items()
+                   if alt_family(s, sen)}
     fmt = lambda v: "-" if v is None else f"{v:.1f}"  # noqa: E731
 
     def cells(got, ref, own, base=None):
@@ -89,14 +98,16 @@ def run(args=None) -> str:
         rows.append(f"| {s} | {sen.rows} x {sen.cols} | {sen.mount_height_m:g} m | {fam} | "
                     + cells(res[s], ref, s == ref) + " |")
         if s in res_alt:
-            alt, own = ALT[sen.rows], ALT_OWN[ALT[sen.rows]]
+            alt = alt_family(s, sen)
+            own = ALT_OWN[alt]
             rows.append(f"| {s} | | | {alt} | " + cells(res_alt[s], own, s == own, res_alt) + " |")
     return "\n".join([
         "## Sensor presets (issue 37)", "",
         f"The detector on simulated scans of every preset ({scans} scans each, `lidet-sim --sensor S --seed {SEED}`, "
         "360 degrees, the preset's mount height), with the preset's default model family, against that family on "
         "its own sensor in the same run (hdl64 for 32 beams or more, vlp16); on the 32-beam presets a second row gives "
-        "the beams32 family (`--model beams32`), against itself on vlp32c, on the 128-beam presets the beams128 family "
+        "the beams32 family (`--model beams32`), against itself on vlp32c, on the Ouster 64-beam presets the beams64 "
+        "family (`--model beams64`), against itself on os1-64, on the 128-beam presets the beams128 family "
         "(`--model beams128`), against itself on os1-128: 3D AP R40 by distance band of the box "
         "centre, sensor frame, KITTI overlaps (car 0.7, pedestrian and cyclist 0.5); '-' where a band holds no "
         "object of the class; in brackets the difference from the "
