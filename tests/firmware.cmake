@@ -8,6 +8,10 @@
 #   build when its cross compiler is installed (tools/scripts/install_deps.sh installs them), and one ctest test
 #   per board that runs the image under QEMU and compares it with fw_host_ref (tools/firmware/run_fw.py).
 #   Without the compiler or QEMU the test reports itself skipped with the reason.
+# - the Ouster packet image (mps2-an386-q-packets-os1-32) and its reference fw_host_ref_pkt_ouster: a simulated OS1-32
+#   scan made at build time (lidet-sim, build/firmware/sim_os1-32) as Ouster payloads (tools/firmware/packets_to_c.py
+#   --lidar ouster, lidet_tools.ouster's writer); both need the project's venv (numpy): without it they are not
+#   built and the image's test reports itself skipped with the reason.
 # `make firmware` builds the target `firmware`; `make firmware-run` runs the tests with their figures.
 include(ExternalProject)
 set(fw_default ON)
@@ -34,20 +38,21 @@ function(lidet_fw_models out sensor fixed)
   set(m ${sensor})
   if(fixed AND sensor STREQUAL "vlp16")
     set(m vlp16s)
+  elseif(sensor STREQUAL "os1-32")
+    set(m beams32) # the 32-beam family (ports/firmware/CMakeLists.txt)
   endif()
   set(${out} ${m} PARENT_SCOPE)
 endfunction()
 
-function(lidet_fw_host_ref sensor exe)
-  # optional third argument FIXED: the integer-only build (the integer detector, int8 models, the scan in mm)
+# lidet and the models with a sensor configuration's capacities: lidet_fwcap_<sensor> (float), or with FIXED
+# lidet_fwcap_<sensor>_q (the integer-only build, the int8 models)
+function(lidet_fw_cap_lib sensor)
   set(lib lidet_fwcap_${sensor})
   set(srcs ${LIDET_SOURCES} ${fw_weights_sources})
-  set(mm "")
-  if(ARGV2 STREQUAL "FIXED")
+  if("FIXED" IN_LIST ARGN)
     set(lib lidet_fwcap_${sensor}_q)
     file(GLOB s8_weights CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/weights/*_s8*.c)
     set(srcs ${LIDET_FIXED_SOURCES} ${s8_weights})
-    set(mm --mm)
   endif()
   add_library(${lib} STATIC ${srcs})
   set_target_properties(${lib} PROPERTIES C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
@@ -57,11 +62,22 @@ function(lidet_fw_host_ref sensor exe)
   # the same numerics as the images: one rounding per operation, no errno, no AVX2 kernel clones
   target_compile_options(${lib} PRIVATE -Wall -Wextra -Wpedantic -Werror -Wdouble-promotion -fno-math-errno
                                         -ffp-contract=off)
-  if(ARGV2 STREQUAL "FIXED")
+  if("FIXED" IN_LIST ARGN)
     target_compile_definitions(${lib} PUBLIC LIDET_FIXED_POINT=1)
   elseif(LIDET_HAVE_LIBM)
     target_link_libraries(${lib} PUBLIC m)
   endif()
+endfunction()
+
+function(lidet_fw_host_ref sensor exe)
+  # optional third argument FIXED: the integer-only build (the integer detector, int8 models, the scan in mm)
+  set(lib lidet_fwcap_${sensor})
+  set(mm "")
+  if(ARGV2 STREQUAL "FIXED")
+    set(lib lidet_fwcap_${sensor}_q)
+    set(mm --mm)
+  endif()
+  lidet_fw_cap_lib(${sensor} ${ARGN})
   set(scan_c ${CMAKE_CURRENT_BINARY_DIR}/fw_host_scan_${exe}.c)
   set(data ${PROJECT_SOURCE_DIR}/tests/data/sim_${sensor})
   add_custom_command(OUTPUT ${scan_c}
@@ -110,6 +126,62 @@ target_link_libraries(fw_host_ref_pkt PRIVATE lidet_fwcap_vlp16_q)
 add_test(NAME firmware_fw_host_ref_pkt COMMAND fw_host_ref_pkt)
 set_tests_properties(firmware_fw_host_ref_pkt PROPERTIES PASS_REGULAR_EXPRESSION "lidet-fw: PASS")
 
+# the Ouster packet application's reference (fw_packets.c with FW_OUSTER and FW_PACKETS_HOST_REF): an OS1-32 scan
+# simulated at build time (lidet-sim --sensor os1-32 --seed 0, scan 000000: no Ouster scan is shipped) as Ouster
+# RNG19_RFL8_SIG16_NIR16 payloads (packets_to_c.py --lidar ouster: lidet_tools.ouster.write_packet), the capacities of
+# ports/firmware/config/os1-32, the beams32 int8 pair. The simulator and the writer need numpy: the project's venv
+# (LIDET_FW_SIM_PYTHON, default <repo>/.venv/bin/python, which `make deps` creates); without it neither the scan, nor
+# this reference, nor the image is built, and the image's test reports itself skipped.
+set(LIDET_FW_SIM_PYTHON "" CACHE FILEPATH
+    "Python with numpy for the Ouster packet image's simulated scan and payloads (empty: <repo>/.venv/bin/python)")
+set(fw_sim_py "${LIDET_FW_SIM_PYTHON}")
+if(fw_sim_py STREQUAL "")
+  set(fw_sim_py ${PROJECT_SOURCE_DIR}/.venv/bin/python)
+endif()
+set(fw_sim_ok OFF)
+if(EXISTS ${fw_sim_py})
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${PROJECT_SOURCE_DIR}/tools ${fw_sim_py} -c
+                          "import numpy, lidet_tools.sim.cli, lidet_tools.ouster"
+                  RESULT_VARIABLE fw_sim_rc OUTPUT_QUIET ERROR_QUIET)
+  if(fw_sim_rc EQUAL 0)
+    set(fw_sim_ok ON)
+  endif()
+endif()
+set(fw_os_sim ${CMAKE_BINARY_DIR}/firmware/sim_os1-32)
+set(fw_os_scan ${fw_os_sim}/velodyne/000000.bin)
+set(fw_os_ring ${fw_os_sim}/ring/000000.bin)
+set(fw_os_name sim_os1-32/000000)
+if(fw_sim_ok)
+  file(GLOB fw_sim_sources CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/tools/lidet_tools/sim/*.py)
+  add_custom_command(OUTPUT ${fw_os_scan} ${fw_os_ring}
+    COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${PROJECT_SOURCE_DIR}/tools ${fw_sim_py} -m lidet_tools.sim.cli
+            --sensor os1-32 --scenes 1 --seed 0 --out ${fw_os_sim} --no-progress
+    DEPENDS ${fw_sim_sources} ${PROJECT_SOURCE_DIR}/tools/lidet_tools/sensors.py
+    COMMENT "lidet-sim: the simulated OS1-32 scan of the Ouster packet image (${fw_os_sim})" VERBATIM)
+  add_custom_target(fw_sim_os1-32 DEPENDS ${fw_os_scan} ${fw_os_ring})
+  set(fw_pkt_os_c ${CMAKE_CURRENT_BINARY_DIR}/fw_host_pkt_ouster.c)
+  add_custom_command(OUTPUT ${fw_pkt_os_c}
+    COMMAND ${CMAKE_COMMAND} -E env PYTHONPATH=${PROJECT_SOURCE_DIR}/tools ${fw_sim_py}
+            ${PROJECT_SOURCE_DIR}/tools/firmware/packets_to_c.py ${fw_os_scan} --ring ${fw_os_ring} --lidar ouster
+            --sensor os1-32 --name ${fw_os_name} --out ${fw_pkt_os_c}
+    DEPENDS ${PROJECT_SOURCE_DIR}/tools/firmware/packets_to_c.py ${PROJECT_SOURCE_DIR}/tools/lidet_tools/ouster.py
+            ${fw_os_scan} ${fw_os_ring}
+    VERBATIM)
+  lidet_fw_cap_lib(os1-32 FIXED)
+  add_executable(fw_host_ref_pkt_ouster ${fw_src}/fw_packets.c ${fw_src}/fw_out.c ${fw_src}/fw_host_port.c
+                                        ${fw_pkt_os_c})
+  set_target_properties(fw_host_ref_pkt_ouster PROPERTIES C_STANDARD 99 C_EXTENSIONS OFF)
+  target_include_directories(fw_host_ref_pkt_ouster PRIVATE ${fw_src})
+  lidet_fw_models(fw_pkt_os_models os1-32 ON)
+  target_compile_definitions(fw_host_ref_pkt_ouster PRIVATE FW_PACKETS_HOST_REF=1 FW_OUSTER=1 FW_SENSOR="os1-32"
+                                                            FW_MODELS="${fw_pkt_os_models}"
+                                                            FW_MODELS_ID=${fw_pkt_os_models})
+  target_compile_options(fw_host_ref_pkt_ouster PRIVATE -Wall -Wextra -Werror)
+  target_link_libraries(fw_host_ref_pkt_ouster PRIVATE lidet_fwcap_os1-32_q)
+  add_test(NAME firmware_fw_host_ref_pkt_ouster COMMAND fw_host_ref_pkt_ouster)
+  set_tests_properties(firmware_fw_host_ref_pkt_ouster PROPERTIES PASS_REGULAR_EXPRESSION "lidet-fw: PASS")
+endif()
+
 # ---- the bare-metal aarch64 image's own C library functions (ports/aarch64/virt_libc.c: no C library there), built
 # for the host under other names and compared with the host's (tests/aarch64/test_virt_libc.c) ----
 set(virt_libc_defs "")
@@ -130,9 +202,13 @@ set_tests_properties(firmware_virt_libc PROPERTIES PASS_REGULAR_EXPRESSION "virt
 
 # ---- the images --------------------------------------------------------------------------------
 add_custom_target(firmware DEPENDS fw_host_ref fw_host_ref_hdl64 fw_host_ref_q fw_host_ref_pkt)
-# image name | board | sensor | toolchain file | compiler | size tool [| fixed [| application]]. The HDL-64
+if(fw_sim_ok)
+  add_dependencies(firmware fw_host_ref_pkt_ouster)
+endif()
+# image name | board | sensor | toolchain file | compiler | size tool [| fixed [| application [| lidar]]]. The HDL-64
 # (KITTI-like) images need ~4.5 MiB of RAM: QEMU virt, and the AN500's Cortex-M7 with the detector placed in its
-# 16 MiB PSRAM. The application is fw_detect.c unless an eighth field names another (LIDET_FW_APP).
+# 16 MiB PSRAM. The application is fw_detect.c unless an eighth field names another (LIDET_FW_APP); the packet
+# application's lidar is velodyne unless a ninth field says ouster (LIDET_FW_LIDAR).
 set(fw_images
     "mps2-an385|mps2-an385|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
     "mps2-an385-m0plus|mps2-an385-m0plus|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size"
@@ -153,6 +229,9 @@ set(fw_images
     "mps2-an386-q-packets|mps2-an386|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed|packets"
     "mps2-an385-m0plus-q-packets|mps2-an385-m0plus|vlp16|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed|packets"
     "virt-rv32imac-q-packets|virt-rv32imac|vlp16|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size|fixed|packets"
+    # Ouster OS1-32 payloads (a simulated scan, RNG19_RFL8_SIG16_NIR16) decoded (lidet_ouster_packet) and streamed
+    # into the integer detector, beams32 pair, compared bit for bit with fw_host_ref_pkt_ouster
+    "mps2-an386-q-packets-os1-32|mps2-an386|os1-32|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed|packets|ouster"
     # 64-bit Arm bare metal (QEMU virt, Cortex-A72; ports/aarch64): the float image with the NEON dense kernel, the
     # integer image compared bit for bit
     "virt-aarch64|virt-aarch64|vlp16|aarch64-bare-metal|aarch64-linux-gnu-gcc|aarch64-linux-gnu-size"
@@ -174,7 +253,28 @@ foreach(entry IN LISTS fw_images)
   if(nf GREATER 7)
     list(GET f 7 app)
   endif()
-  if(app STREQUAL "packets")
+  set(lidar velodyne)
+  if(nf GREATER 8)
+    list(GET f 8 lidar)
+  endif()
+  set(fw_py ${Python3_EXECUTABLE})
+  set(extra_args "")
+  set(extra_deps "")
+  if(lidar STREQUAL "ouster")
+    set(ref fw_host_ref_pkt_ouster)
+    if(NOT fw_sim_ok)
+      add_test(NAME firmware_${image}
+               COMMAND ${Python3_EXECUTABLE} ${PROJECT_SOURCE_DIR}/tools/firmware/run_fw.py --board ${board}
+                       --label ${image}
+                       --skip "no Python with numpy for its simulated OS1-32 scan and Ouster payloads (${fw_sim_py}: make deps creates the venv; or -DLIDET_FW_SIM_PYTHON=...)")
+      set_tests_properties(firmware_${image} PROPERTIES SKIP_RETURN_CODE 77)
+      continue()
+    endif()
+    # the simulated scan of the main build, the payloads written with the venv's Python (numpy)
+    set(fw_py ${fw_sim_py})
+    set(extra_args -DLIDET_FW_SCAN=${fw_os_scan} -DLIDET_FW_RING=${fw_os_ring} -DLIDET_FW_SCAN_NAME=${fw_os_name})
+    set(extra_deps DEPENDS fw_sim_os1-32)
+  elseif(app STREQUAL "packets")
     set(ref fw_host_ref_pkt)
   elseif(fixed)
     set(ref fw_host_ref_q)
@@ -198,8 +298,10 @@ foreach(entry IN LISTS fw_images)
     SOURCE_DIR ${fw_src}
     BINARY_DIR ${bdir}
     CMAKE_ARGS -DCMAKE_TOOLCHAIN_FILE=${PROJECT_SOURCE_DIR}/cmake/toolchains/${tc}.cmake
-               -DLIDET_FW_BOARD=${board} -DLIDET_FW_SENSOR=${sensor} -DPython3_EXECUTABLE=${Python3_EXECUTABLE}
+               -DLIDET_FW_BOARD=${board} -DLIDET_FW_SENSOR=${sensor} -DPython3_EXECUTABLE=${fw_py}
                -DLIDET_FW_FIXED=${fixed} -DLIDET_FW_MODELS=${models} -DLIDET_FW_APP=${app}
+               -DLIDET_FW_LIDAR=${lidar} ${extra_args}
+    ${extra_deps}
     BUILD_ALWAYS ON
     INSTALL_COMMAND ""
     BUILD_BYPRODUCTS ${bdir}/lidet_fw.elf)

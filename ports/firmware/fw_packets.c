@@ -1,16 +1,21 @@
 /* SPDX-License-Identifier: MIT */
-/* The packet application (LIDET_FW_APP=packets; integer build only): what a board does with a VLP-16's UDP stream.
- * The payloads of one rotation and a bit (fw_packets.h, in flash) are decoded one at a time with
- * lidet_velodyne_packet into a buffer of LIDET_VELODYNE_MAX_RETURNS returns and streamed into the integer detector
- * (lidet_detector_q_stream_begin at the first seam, _returns per payload, _end when the decoder reports the
- * rotation COMPLETE): no buffer for the scan (docs/PORTING.md, "Streaming the returns"). Two runs, as fw_detect.c:
+/* The packet application (LIDET_FW_APP=packets; integer build only): what a board does with a lidar's UDP stream.
+ * The payloads of one rotation and a bit (fw_packets.h, in flash) are decoded one at a time into a buffer of one
+ * payload's returns and streamed into the integer detector (lidet_detector_q_stream_begin at the first seam,
+ * _returns per payload, _end when the decoder reports the rotation COMPLETE): no buffer for the scan (docs/PORTING.md,
+ * "Streaming the returns"). The decoder: a VLP-16's (lidet_velodyne_packet, LIDET_VELODYNE_MAX_RETURNS returns a
+ * payload), or with FW_OUSTER=1 (LIDET_FW_LIDAR=ouster) an Ouster sensor's (lidet_ouster_packet, configured from the
+ * metadata in fw_packets.h; 16 columns x LIDET_MAX_ROWS returns a payload; a frame completes when the next frame's
+ * first payload arrives). Both decoders' scan events have the same values and meanings. Two runs, as fw_detect.c:
  * `default` (the configuration a user gets) and `open` (gates and size checks off, so that many boxes are compared).
  * No tracker: its 8 KiB do not fit beside the decoder's buffers in the integer image's 256 KiB (run_fw.py).
  *
  * Built for the host with FW_PACKETS_HOST_REF=1 (fw_host_ref_pkt, tests/firmware.cmake) it is the reference the
  * images are compared with: the same payloads decoded into a buffer of the whole scan (docs/DECODING.md, "Use")
  * and the completed scan given to lidet_detector_q_run_returns at once. Lines (tools/firmware/run_fw.py):
- *   lidet-fw board=... core=... build=fixed app=packets sensor=vlp16 models=... scan=... packets=N
+ *   lidet-fw board=... core=... build=fixed app=packets sensor=vlp16 models=... scan=... packets=N start_cdeg=..
+ *                                                    (Ouster: sensor=os1-32 ... packets=N lidar=ouster
+ *                                                    payload_bytes=.. first_mid=..)
  *   mem detector_bytes=.. decoder_bytes=.. buffer_bytes=.. max_rows=.. ...   sizes, capacities
  *   calib n=N expected=E measured=M                  the instruction counter against loops of known length
  *   stats run=R status=S clusters=... detections=D proj_in=..   the detector's counts (fw_detect.c's, + projection)
@@ -20,7 +25,7 @@
  *   digest run=default returns=N fnv1a=H             FNV-1a of the completed scan's returns (range, azimuth, ring),
  *                                                    from a second, untimed pass
  *   insn run=R decode=.. project=.. ground=.. cluster=.. classify=.. box=.. post=.. scan=..   instructions: decode =
- *                                                    lidet_velodyne_packet over every payload, project = stream_begin,
+ *                                                    the decoder over every payload, project = stream_begin,
  *                                                    every stream_returns and the projection's end, scan = all of it
  *   pktinsn run=R decode_max=.. stream_max=.. end=.. counter=..   the largest payload's decoding and stream_returns
  *                                                    call, stream_end (latency from the last packet), the counter
@@ -30,11 +35,10 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "fw_packets.h"
 #include "fw_out.h"
+#include "fw_packets.h"
 #include "fw_port.h"
 #include "lidet/lidet_detector_q.h"
-#include "lidet/lidet_velodyne.h"
 #include "lidet_weights.h"
 
 #if !LIDET_FIXED_POINT
@@ -53,13 +57,67 @@
 #define FW_XCAT(a, b) a##b
 #define FW_CAT(a, b) FW_XCAT(a, b)
 
+/* ---- the decoder: one payload in, its returns out, the same calls for both (fw_packets.h) ---------------- */
+#if FW_OUSTER
+typedef lidet_ouster_t fw_dec_t;
+typedef lidet_ouster_cfg_t fw_dec_cfg_t;
+typedef lidet_ouster_result_t fw_dec_result_t;
+typedef lidet_ouster_stats_t fw_dec_stats_t;
+#define FW_SCAN_NONE LIDET_OUSTER_SCAN_NONE
+#define FW_SCAN_COMPLETE LIDET_OUSTER_SCAN_COMPLETE
+#define FW_SCAN_PARTIAL LIDET_OUSTER_SCAN_PARTIAL
+#define FW_SCAN_ABORTED LIDET_OUSTER_SCAN_ABORTED
+/* one payload's returns: 16 columns of single-return pixels at the capacities' beams (checked: fw_main) */
+#define FW_MAX_RETURNS (LIDET_OUSTER_MAX_COLS_PER_PACKET * LIDET_MAX_ROWS)
+#define FW_PAYLOAD(k) (fw_pkt_payload + (k)*fw_pkt_bytes)
+#define FW_PAYLOAD_BYTES fw_pkt_bytes
+#define fw_dec_init lidet_ouster_init
+#define fw_dec_packet lidet_ouster_packet
+#define fw_dec_stats lidet_ouster_stats
+
+/* the decoder's configuration: the sensor's metadata (fw_pkt_ouster, made with the payloads) */
+static void dec_cfg(fw_dec_cfg_t *c)
+{
+    lidet_ouster_cfg_default(c);
+    c->profile = (lidet_ouster_profile_t)fw_pkt_ouster.profile;
+    c->pixels_per_column = fw_pkt_ouster.pixels_per_column;
+    c->columns_per_frame = fw_pkt_ouster.columns_per_frame;
+    c->columns_per_packet = fw_pkt_ouster.columns_per_packet;
+    c->beam_azimuth_mdeg = fw_pkt_ouster.beam_azimuth_mdeg;
+    c->init_id = fw_pkt_ouster.init_id;
+    /* (in two halves: a 64-bit copy may go through an FPU register where the core has one) */
+    c->prod_sn = (uint64_t)fw_pkt_ouster.prod_sn_hi << 32 | fw_pkt_ouster.prod_sn_lo;
+}
+#else
+typedef lidet_velodyne_t fw_dec_t;
+typedef lidet_velodyne_cfg_t fw_dec_cfg_t;
+typedef lidet_velodyne_result_t fw_dec_result_t;
+typedef lidet_velodyne_stats_t fw_dec_stats_t;
+#define FW_SCAN_NONE LIDET_VELODYNE_SCAN_NONE
+#define FW_SCAN_COMPLETE LIDET_VELODYNE_SCAN_COMPLETE
+#define FW_SCAN_PARTIAL LIDET_VELODYNE_SCAN_PARTIAL
+#define FW_SCAN_ABORTED LIDET_VELODYNE_SCAN_ABORTED
+#define FW_MAX_RETURNS LIDET_VELODYNE_MAX_RETURNS
+#define FW_PAYLOAD(k) fw_pkt_payload[k]
+#define FW_PAYLOAD_BYTES LIDET_VELODYNE_PAYLOAD_BYTES
+#define fw_dec_init lidet_velodyne_init
+#define fw_dec_packet lidet_velodyne_packet
+#define fw_dec_stats lidet_velodyne_stats
+
+static void dec_cfg(fw_dec_cfg_t *c)
+{
+    lidet_velodyne_cfg_default(c);
+    c->model = LIDET_VELODYNE_VLP16;
+}
+#endif
+
 /* What a product holds: the detector, the decoder and one payload's returns. */
 static lidet_detector_q_t g_det;
-static lidet_velodyne_t g_vlp;
-static lidet_return_t g_out[LIDET_VELODYNE_MAX_RETURNS];
+static fw_dec_t g_dec;
+static lidet_return_t g_out[FW_MAX_RETURNS];
 #if FW_PACKETS_HOST_REF
 /* the host reference's scan buffer (docs/DECODING.md, "Use"): a whole scan, then one more payload's returns */
-static lidet_return_t g_scan[LIDET_MAX_POINTS + LIDET_VELODYNE_MAX_RETURNS];
+static lidet_return_t g_scan[LIDET_MAX_POINTS + FW_MAX_RETURNS];
 #endif
 
 /* ---- output (no stdio) ----------------------------------------------------------------------------- */
@@ -179,23 +237,23 @@ typedef struct
     uint32_t first, last;                      /* payloads holding the completed scan's returns */
     uint32_t scan_returns;                     /* its returns */
     uint64_t counter;                          /* instructions of two back-to-back counter reads */
-    uint64_t decode, decode_max;               /* lidet_velodyne_packet: every payload, the largest */
+    uint64_t decode, decode_max;               /* the decoder: every payload, the largest */
     uint64_t end;                              /* lidet_detector_q_stream_end */
 } pkt_t;
 
 static void count_event(pkt_t *p, uint32_t ev)
 {
-    p->n_partial += ev == LIDET_VELODYNE_SCAN_PARTIAL;
-    p->n_complete += ev == LIDET_VELODYNE_SCAN_COMPLETE;
-    p->n_aborted += ev == LIDET_VELODYNE_SCAN_ABORTED;
+    p->n_partial += ev == FW_SCAN_PARTIAL;
+    p->n_complete += ev == FW_SCAN_COMPLETE;
+    p->n_aborted += ev == FW_SCAN_ABORTED;
 }
 
 /* decode payload k into g_out, its instructions added to p (minus the counter's own) */
-static lidet_status_t decode_one(uint32_t k, pkt_t *p, lidet_velodyne_result_t *r)
+static lidet_status_t decode_one(uint32_t k, pkt_t *p, fw_dec_result_t *r)
 {
     const uint64_t t0 = fw_insn64();
-    const lidet_status_t s = lidet_velodyne_packet(&g_vlp, fw_pkt_payload[k], LIDET_VELODYNE_PAYLOAD_BYTES,
-                                                   g_out, 0, LIDET_VELODYNE_MAX_RETURNS, r);
+    const lidet_status_t s =
+        fw_dec_packet(&g_dec, FW_PAYLOAD(k), FW_PAYLOAD_BYTES, g_out, 0, FW_MAX_RETURNS, r);
     const uint64_t d = fw_insn64() - t0 - p->counter;
     p->decode += d;
     p->decode_max = d > p->decode_max ? d : p->decode_max;
@@ -212,11 +270,11 @@ static __attribute__((noinline)) lidet_status_t run_packets(pkt_t *p)
     uint32_t k, from;
     for (k = 0; k < fw_pkt_n; ++k)
     {
-        lidet_velodyne_result_t r;
+        fw_dec_result_t r;
         lidet_status_t s = decode_one(k, p, &r);
         if (s != LIDET_OK)
             return s < 0 ? s : LIDET_ERR_STATE; /* a rejected or truncated payload: none is expected here */
-        if (r.scan_event == LIDET_VELODYNE_SCAN_COMPLETE && open)
+        if (r.scan_event == FW_SCAN_COMPLETE && open)
         {
             s = lidet_detector_q_stream_returns(&g_det, g_out, r.scan_end, 0);
             if (!LIDET_SUCCEEDED(s))
@@ -232,7 +290,7 @@ static __attribute__((noinline)) lidet_status_t run_packets(pkt_t *p)
         }
         /* without an event every return is the scan's (scan_end = n_returns); with one, those from scan_end on */
         from = 0u;
-        if (r.scan_event != LIDET_VELODYNE_SCAN_NONE)
+        if (r.scan_event != FW_SCAN_NONE)
         {
             /* a new rotation begins at the seam (after a partial, aborted or, in a product, a completed one) */
             s = lidet_detector_q_stream_begin(&g_det);
@@ -262,20 +320,20 @@ static lidet_status_t run_packets(pkt_t *p)
     uint32_t k, fill = 0u;
     for (k = 0; k < fw_pkt_n; ++k)
     {
-        lidet_velodyne_result_t r;
+        fw_dec_result_t r;
         lidet_status_t s = decode_one(k, p, &r);
         if (s != LIDET_OK)
             return s < 0 ? s : LIDET_ERR_STATE;
-        if (fill + r.n_returns > LIDET_MAX_POINTS + LIDET_VELODYNE_MAX_RETURNS)
+        if (fill + r.n_returns > LIDET_MAX_POINTS + FW_MAX_RETURNS)
             return LIDET_ERR_BUFFER; /* not with these payloads: the comparison needs the whole scan */
         memcpy(g_scan + fill, g_out, r.n_returns * sizeof g_out[0]);
-        if (r.scan_event == LIDET_VELODYNE_SCAN_COMPLETE && open)
+        if (r.scan_event == FW_SCAN_COMPLETE && open)
         {
             p->scan_returns = fill + r.scan_end;
             p->last = k;
             return lidet_detector_q_run_returns(&g_det, g_scan, fill + r.scan_end, 0);
         }
-        if (r.scan_event != LIDET_VELODYNE_SCAN_NONE)
+        if (r.scan_event != FW_SCAN_NONE)
         {
             memmove(g_scan, g_scan + fill + r.scan_end, (r.n_returns - r.scan_end) * sizeof g_scan[0]);
             fill = r.n_returns - r.scan_end; /* the next scan's first returns */
@@ -299,7 +357,7 @@ static __attribute__((noinline)) int report(const char *name, lidet_status_t st,
     static const char *const stage_names[LIDET_DET_N_STAGES] = {"project",  "ground", "cluster",
                                                                 "classify", "box",    "post"};
     const lidet_detector_q_stats_t *s = lidet_detector_q_stats(&g_det);
-    const lidet_velodyne_stats_t *vs = lidet_velodyne_stats(&g_vlp);
+    const fw_dec_stats_t *vs = fw_dec_stats(&g_dec);
     uint32_t n_det = 0, k;
     const lidet_detection_q_t *det = lidet_detector_q_detections(&g_det, &n_det);
     uint64_t stage64[LIDET_DET_N_STAGES];
@@ -344,7 +402,7 @@ static __attribute__((noinline)) int report(const char *name, lidet_status_t st,
         fw_put_s("insn run=");
         fw_put_s(name);
         fw_put_s(" FAIL: the clock calls do not match the streaming detector's order (fw_packets.c: "
-              "seq_stages)\n");
+                 "seq_stages)\n");
         return 1;
     }
     fw_put_s("insn run=");
@@ -368,17 +426,16 @@ static pkt_t g_pkt;
 
 static int run_once(const char *name, lidet_detector_q_cfg_t *cfg)
 {
-    lidet_velodyne_cfg_t vc;
+    fw_dec_cfg_t vc;
     lidet_status_t st;
     uint64_t t0, t1;
 
     cfg->clock = seq_clock;
     cfg->clock_ctx = &g_seq;
-    lidet_velodyne_cfg_default(&vc);
-    vc.model = LIDET_VELODYNE_VLP16;
+    dec_cfg(&vc);
     st = lidet_detector_q_init(&g_det, cfg, k_cls, k_box);
     if (st == LIDET_OK)
-        st = lidet_velodyne_init(&g_vlp, &vc);
+        st = fw_dec_init(&g_dec, &vc);
     if (st != LIDET_OK)
     {
         fw_put_s("init run=");
@@ -420,27 +477,25 @@ static uint32_t fnv_return(uint32_t h, const lidet_return_t *r)
  * run_fw.py compares with the host's, so a decoding difference shows before the detector's. -> 0, or 1. */
 static __attribute__((noinline)) int scan_digest(const char *name)
 {
-    lidet_velodyne_cfg_t vc;
+    fw_dec_cfg_t vc;
     uint32_t k, i, h = 2166136261u, n = 0u;
     int open = 0, done = 0;
-    lidet_velodyne_cfg_default(&vc);
-    vc.model = LIDET_VELODYNE_VLP16;
-    if (lidet_velodyne_init(&g_vlp, &vc) != LIDET_OK)
+    dec_cfg(&vc);
+    if (fw_dec_init(&g_dec, &vc) != LIDET_OK)
         return 1;
     for (k = 0; k < fw_pkt_n && !done; ++k)
     {
-        lidet_velodyne_result_t r;
+        fw_dec_result_t r;
         uint32_t from = 0u, to;
-        if (lidet_velodyne_packet(&g_vlp, fw_pkt_payload[k], LIDET_VELODYNE_PAYLOAD_BYTES, g_out, 0,
-                                  LIDET_VELODYNE_MAX_RETURNS, &r) != LIDET_OK)
+        if (fw_dec_packet(&g_dec, FW_PAYLOAD(k), FW_PAYLOAD_BYTES, g_out, 0, FW_MAX_RETURNS, &r) != LIDET_OK)
             return 1;
         to = r.n_returns;
-        if (r.scan_event == LIDET_VELODYNE_SCAN_COMPLETE && open)
+        if (r.scan_event == FW_SCAN_COMPLETE && open)
         {
             to = r.scan_end;
             done = 1;
         }
-        else if (r.scan_event != LIDET_VELODYNE_SCAN_NONE)
+        else if (r.scan_event != FW_SCAN_NONE)
         {
             open = 1;
             h = 2166136261u;
@@ -473,23 +528,45 @@ int fw_main(void)
     fw_put_s(" build=fixed app=packets sensor=" FW_SENSOR " models=" FW_MODELS "_s8 scan=");
     fw_put_s(fw_pkt_name);
     fw_put_kv("packets", fw_pkt_n);
+#if FW_OUSTER
+    fw_put_s(" lidar=ouster");
+    fw_put_kv("payload_bytes", fw_pkt_bytes);
+    fw_put_kv("first_mid", fw_pkt_first_mid);
+#else
     fw_put_kv("start_cdeg", fw_pkt_start_cdeg);
+#endif
     fw_putc('\n');
     fw_put_s("mem");
     fw_put_kv("detector_bytes", lidet_detector_q_bytes());
-    fw_put_kv("decoder_bytes", (uint32_t)sizeof g_vlp);
+    fw_put_kv("decoder_bytes", (uint32_t)sizeof g_dec);
     fw_put_kv("buffer_bytes", (uint32_t)sizeof g_out);
     fw_put_kv("max_rows", LIDET_MAX_ROWS);
     fw_put_kv("max_cols", LIDET_MAX_COLS);
     fw_put_kv("max_points", LIDET_MAX_POINTS);
     fw_put_kv("max_clusters", LIDET_MAX_CLUSTERS);
-    fw_put_kv("max_returns", LIDET_VELODYNE_MAX_RETURNS);
+    fw_put_kv("max_returns", FW_MAX_RETURNS);
     fw_putc('\n');
     if (sensor == 0)
     {
         fw_put_s("lidet-fw: FAIL (no " FW_SENSOR " sensor profile)\n");
         return 1;
     }
+#if FW_OUSTER
+    {
+        /* the metadata against the capacities: one payload's returns fit g_out, the payloads are the profile's */
+        fw_dec_cfg_t oc;
+        dec_cfg(&oc);
+        if (fw_dec_init(&g_dec, &oc) != LIDET_OK || lidet_ouster_max_returns(&g_dec) > FW_MAX_RETURNS ||
+            lidet_ouster_packet_bytes(&g_dec) != fw_pkt_bytes || oc.pixels_per_column != sensor->n_rows ||
+            oc.columns_per_frame != sensor->n_cols)
+        {
+            fw_put_s(
+                "lidet-fw: FAIL (the Ouster metadata does not fit the decoder, the buffer or the " FW_SENSOR
+                " profile)\n");
+            return 1;
+        }
+    }
+#endif
     if (fw_have_counter() && fw_calibrate(0) != 0)
     {
         fw_put_s("lidet-fw: FAIL (instruction counter does not match the calibration loop)\n");

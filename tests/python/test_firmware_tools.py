@@ -329,6 +329,32 @@ def test_packets_to_c_closes_one_rotation(tmp_path, need_lib):
     assert int((d.scan == 1).sum()) == 23252 and sum(d.stats[f"n_rejected_{r}"] for r in V.REJECTS) == 0
 
 
+def test_packets_to_c_ouster_closes_one_frame(tmp_path, need_lib):
+    """--lidar ouster (the Ouster packet image's payloads): a simulated OS1-32 scan as RNG19_RFL8_SIG16_NIR16 payloads,
+    with the metadata written beside them; decoded with lidet's decoder, a PARTIAL frame (the lead payload), then one
+    COMPLETE frame in which every simulated point comes back as one return, at its range, nothing rejected."""
+    np = pytest.importorskip("numpy")
+    from lidet_tools import ouster as O
+    from lidet_tools import velodyne as V
+    from lidet_tools.sim.simulate import simulate_scan
+    sc = simulate_scan("os1-32", seed=0, index=0)
+    scan, ring = tmp_path / "s.bin", tmp_path / "r.bin"
+    np.asarray(sc.points, np.float32).reshape(-1, 4).tofile(scan)
+    np.asarray(sc.ring, np.uint16).tofile(ring)
+    out, pcap, meta = tmp_path / "fw_scan.c", tmp_path / "p.pcap", tmp_path / "meta.json"
+    assert packets_to_c.main([str(scan), "--ring", str(ring), "--lidar", "ouster", "--sensor", "os1-32",
+                              "--out", str(out), "--pcap", str(pcap), "--meta", str(meta)]) == 0
+    payloads = [p for _, _, p in V.read_pcap_payloads(pcap)]
+    assert len(payloads) == 1024 // 16 + 2 and {len(p) for p in payloads} == {O.packet_bytes("RNG19_RFL8_SIG16_NIR16", 32)}
+    d = O.decode(payloads, O.load_metadata(meta))
+    assert d.scan_kinds()[:2] == [O.SCAN_PARTIAL, O.SCAN_COMPLETE]
+    full = d.scan == 1
+    assert int(full.sum()) == len(sc.points) and int(d.reject.sum()) == 0
+    rng = np.linalg.norm(np.asarray(sc.points, np.float64)[:, :3], axis=1) * 1000.0
+    np.testing.assert_allclose(np.sort(d.range_mm[full].astype(np.float64)), np.sort(rng), atol=1.0)
+    assert "fw_pkt_n" in out.read_text()
+
+
 def test_packets_to_c_rejects_bad_arguments(tmp_path):
     scan, ring = SIM_VLP16 / "velodyne" / "000000.bin", SIM_VLP16 / "ring" / "000000.bin"
     with pytest.raises(SystemExit):

@@ -49,6 +49,12 @@ PACKET_BOARDS = [
     ("virt-rv32imac-q-packets", "RV32IMAC, integer build (vlp16s)", "virt-rv32imac-q"),
 ]
 DECODE_GOAL = 1_000_000  # issue 37: decoding adds at most 1 M instructions to a VLP-16 scan
+# the Ouster packet image (LIDET_FW_LIDAR=ouster, ports/firmware/config/os1-32): a simulated OS1-32 scan as Ouster
+# RNG19_RFL8_SIG16_NIR16 payloads decoded with lidet_ouster_packet and streamed into the integer detector (beams32)
+OUSTER_PACKET_BOARDS = [
+    ("mps2-an386-q-packets-os1-32", "Cortex-M4, integer build, **Ouster OS1-32** (beams32; DSP)", 200e6),
+]
+OUSTER_FRAMES_PER_S = 10  # lidar mode 1024x10
 VLP16_PAYLOADS_PER_TURN = 75  # 900 blocks of 0.4 deg (600 rpm), 12 a payload
 STAGES = ["project", "ground", "cluster", "classify", "box", "post"]
 
@@ -185,6 +191,81 @@ def _packets_section(reports) -> list:
     return out
 
 
+def _ouster_section(reports) -> list:
+    """The Ouster packet image's table (OUSTER_PACKET_BOARDS): decoding per payload and per return, its share of the
+    scan, the scan with decoding; RAM and flash."""
+    rows = [b for b in OUSTER_PACKET_BOARDS if "default" in reports.get(b[0], {}).get("insn", {})]
+    if not rows:
+        return []
+    r0 = reports[rows[0][0]]
+    h, d0, mem = r0.get("header") or {}, r0["decode"]["default"], r0.get("mem") or {}
+    out = [
+        "",
+        "**Ouster packets from flash** (`LIDET_FW_LIDAR=ouster`, docs/OUSTER.md \"On a microcontroller\"): the image "
+        f"`{rows[0][0]}` holds a simulated OS1-32 scan (`lidet-sim --sensor os1-32 --seed 0`, scan 000000, made at "
+        f"build time in `build/firmware/sim_os1-32`) as {h.get('packets', '?')} Ouster lidar payloads "
+        f"({h.get('packets', '?')} x {int(h.get('payload_bytes', 0)):,} bytes: RNG19_RFL8_SIG16_NIR16, 32 beams x 16 "
+        "columns, written by lidet_tools.ouster's `write_packet` through tools/firmware/packets_to_c.py --lidar "
+        "ouster: "
+        "the last payload of one frame, the 64 of the next, the first of the one after), decodes them one at a time "
+        f"with `lidet_ouster_packet` into a buffer of {mem.get('max_returns', '?')} returns "
+        f"({mem.get('buffer_bytes', 0):,} B; the decoder {mem.get('decoder_bytes', 0):,} B) and streams them into the "
+        "integer detector as the VLP-16 images do; the frame completes when the next frame's first payload arrives "
+        f"(`COMPLETE`: {d0['scan_returns']:,} returns from payloads {d0['first']}..{d0['last']}). Capacities of "
+        f"`ports/firmware/config/os1-32` ({mem.get('max_rows')} x {mem.get('max_cols')} pixels, "
+        f"{mem.get('max_points', 0):,} points, {mem.get('max_clusters')} clusters, the range-only pixel; the detector "
+        f"{mem.get('detector_bytes', 0):,} B), models `{h.get('models', '?')}`. Compared with "
+        "`fw_host_ref_pkt_ouster` (the same payloads decoded on the host into a buffer of the whole frame, "
+        "`lidet_detector_q_run_returns` on it) by tools/firmware/run_fw.py: detections, counts, the decoder's counts "
+        "and the digest of the frame's returns identical. Run `default`; columns as above, decode per return = over "
+        "all the returns decoded:",
+        "",
+        "| core | **decode** (per payload: mean / largest; per return) | share of the scan | projection (largest "
+        "`stream_returns`) | rest | **total per scan** | flash (no payloads) | payloads in flash | **RAM** (data + bss "
+        "+ stack) | stack used |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for board, core, _ in rows:
+        r = reports[board]
+        ins, pk, d, sz = (r["insn"]["default"], r.get("pktinsn", {}).get("default", {}), r["decode"]["default"],
+                          r["size"])
+        rest = sum(ins[k] for k in ("ground", "cluster", "classify", "box", "post"))
+        out.append(
+            f"| {core} | **{_m(ins['decode'])}** ({ins['decode'] / d['packets'] / 1e3:,.1f} k / "
+            f"{pk.get('decode_max', 0) / 1e3:,.1f} k; {ins['decode'] / max(d['returns'], 1):.0f}) | "
+            f"{100.0 * ins['decode'] / ins['scan']:.1f}% | {_m(ins['project'])} "
+            f"({pk.get('stream_max', 0) / 1e3:,.1f} k) | {_m(rest)} | **{_m(ins['scan'])}** | "
+            f"{_kib(sz['flash_without_scan'])} | {_kib(sz['rodata_scan'])} | "
+            f"**{_kib(sz['ram'])}** ({sz['ram']:,} B) | {r['stack']['used']:,} B |")
+    board, core, hz = rows[0]
+    r = reports[board]
+    ins, d, sz = r["insn"]["default"], r["decode"]["default"], r["size"]
+    per_frame = int(r["mem"]["max_cols"]) // 16
+    frame = ins["decode"] * per_frame / d["packets"]
+    out += [
+        "",
+        f"On the Cortex-M4 `lidet_ouster_packet` takes {ins['decode']:,} instructions for the {d['packets']} payloads "
+        f"({frame / 1e6:.2f} M for the {per_frame} payloads of a frame, {frame * OUSTER_FRAMES_PER_S / 1e6:.1f} M a "
+        f"second at {OUSTER_FRAMES_PER_S} Hz; {ins['decode'] / max(d['returns'], 1):.0f} per return of the "
+        f"{d['returns']:,} decoded), {100.0 * ins['decode'] / ins['scan']:.1f}% of the {_m(ins['scan'])} from the "
+        f"first payload to the detections; the latency from the payload that completes the frame (the next frame's "
+        f"first) to them is `stream_end`'s {_m(r['pktinsn']['default']['end'])}. A single-issue core retires at most "
+        "one instruction a cycle: at "
+        f"{hz / 1e6:.0f} MHz the M4 runs at most {hz / ins['scan']:.1f} such scans a second (the sensor sends "
+        f"{OUSTER_FRAMES_PER_S} frames a second). RAM {sz['ram']:,} B: "
+        + ("within" if sz["ram"] <= 256 * 1024 else f"{(sz['ram'] - 256 * 1024):,} B over")
+        + f" the VLP-16 images' 256 KiB (the {mem.get('max_rows')} x {mem.get('max_cols')} image has "
+        f"{100.0 * (int(mem.get('max_rows', 0)) * int(mem.get('max_cols', 0)) / (16 * 1800) - 1):.0f} % more pixels "
+        "than 16 x 1800; docs/FIRMWARE.md).",
+        "",
+    ]
+    for board, core, _ in rows:
+        r = reports[board]
+        out.append(f"- {core}, against `fw_host_ref_pkt_ouster`: " + " / ".join(r.get("comparison", [])[:3]) +
+                   (" **FAILED: " + "; ".join(r["errors"]) + "**" if r.get("errors") else ""))
+    return out
+
+
 def run(args) -> str:
     build = pathlib.Path(args.build)
     if os.environ.get("LIDET_BENCH_FW_REUSE") == "1":  # the reports of the last ctest run, as they are
@@ -197,7 +278,7 @@ def run(args) -> str:
         f = build / "firmware" / board / "report.json"
         if f.exists() and board != AARCH64_PORTABLE:
             reports[board] = json.loads(f.read_text())
-    for board, *_ in PACKET_BOARDS:
+    for board, *_ in PACKET_BOARDS + OUSTER_PACKET_BOARDS:
         f = build / "firmware" / board / "report.json"
         if f.exists():
             reports[board] = json.loads(f.read_text())
@@ -460,6 +541,7 @@ def run(args) -> str:
             f"PointNets {100.0 * (ins['classify'] + ins['box']) / ins['scan']:.0f}% of it)" + m4q + ".",
         ]
     out += _packets_section(reports)
+    out += _ouster_section(reports)
     out += [
         "",
         "**Cost in CI.** Installing the toolchains and QEMU (`tools/scripts/install_deps.sh`, Debian 12: "

@@ -29,7 +29,8 @@
    microcontrollers': not virt-aarch64).
 The packet application (header app=packets, ports/firmware/fw_packets.c: VLP-16 payloads in flash decoded and
 streamed into the integer detector; its host reference fw_host_ref_pkt decodes the same payloads into a buffer and
-runs lidet_detector_q_run_returns on the completed scan): the same checks bit for bit but the tracker's (it has
+runs lidet_detector_q_run_returns on the completed scan; the Ouster image, header sensor=os1-32 lidar=ouster, the
+same with Ouster payloads and fw_host_ref_pkt_ouster): the same checks bit for bit but the tracker's (it has
 none), plus its `decode` lines (the decoder's counts, the completed scan's payloads and returns) and the `digest`
 of the scan's returns identical to the host's, and its instructions (`insn`: decode, the stages, the scan) and the
 largest payload's (`pktinsn`) in the report.
