@@ -39,6 +39,7 @@ beams, columns, beam azimuth offsets, init id, serial number); --meta writes tha
 import argparse
 import math
 import os
+import pathlib
 import struct
 import sys
 
@@ -89,6 +90,12 @@ def payloads(grid, n_packets, start_cdeg, t0_us=0):
         assert len(b) == PAYLOAD_BYTES
         out.append((t, bytes(b)))
     return out
+
+
+def _replace(path, write):
+    """write(tmp) into path + '.tmp', then move it over path (a build never sees a half-written file)."""
+    write(path + ".tmp")
+    os.replace(path + ".tmp", path)
 
 
 def _ip_checksum(h):
@@ -243,18 +250,12 @@ def ouster_main(a, raw, rring, n, name):
         for i in range(0, nbytes, 32):
             out.append("    " + ",".join(str(v) for v in p[i:i + 32]) + ",")
     out.append("};")
-    tmp = a.out + ".tmp"
-    with open(tmp, "w") as f:
-        f.write("\n".join(out) + "\n")
-    os.replace(tmp, a.out)
+    _replace(a.out, lambda t: pathlib.Path(t).write_text("\n".join(out) + "\n"))
     if a.meta:
-        with open(a.meta + ".tmp", "w") as f:
-            json.dump(meta, f, indent=1)
-        os.replace(a.meta + ".tmp", a.meta)
+        _replace(a.meta, lambda t: pathlib.Path(t).write_text(json.dumps(meta, indent=1)))
     if a.pcap:
         frames = [velodyne.udp_frame(p, dport=OUSTER_PORT, sport=OUSTER_PORT) for p in pays]
-        velodyne.write_pcap(a.pcap + ".tmp", frames)
-        os.replace(a.pcap + ".tmp", a.pcap)
+        _replace(a.pcap, lambda t: velodyne.write_pcap(t, frames))
     return 0
 
 
@@ -322,13 +323,9 @@ def main(argv=None):
             out.append("        " + ",".join(str(v) for v in p[i:i + 30]) + ",")
         out.append("    },")
     out.append("};")
-    tmp = a.out + ".tmp"
-    with open(tmp, "w") as f:
-        f.write("\n".join(out) + "\n")
-    os.replace(tmp, a.out)
+    _replace(a.out, lambda t: pathlib.Path(t).write_text("\n".join(out) + "\n"))
     if a.pcap:
-        write_pcap(a.pcap + ".tmp", pkts)
-        os.replace(a.pcap + ".tmp", a.pcap)
+        _replace(a.pcap, lambda t: write_pcap(t, pkts))
     return 0
 
 

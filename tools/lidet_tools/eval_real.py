@@ -93,6 +93,7 @@ class FrameResult:
     fp_kinds: list = field(default_factory=list)   # with point labels: FP_KINDS name of each wrong detection <= 40 m
     calib: object = None     # kitti.Calib for the KITTI frames (official protocol)
     label2: list = field(default_factory=list)
+    run: object = None       # the float run's native.Detections (clusters, outcomes, point labels); None with the CLI
 
 
 def _in_fov(x, y, fov_half_rad) -> bool:
@@ -193,7 +194,7 @@ def evaluate_frame(fr, fixed=False, model=None, min_points=10, sets=(), dontcare
         if dontcare is not None and dontcare(b):
             continue
         dets.append(b)
-    res = FrameResult(fr.source, fr.frame_id, len(fr.points), gt, gt_pts, ignore, dets, dets_all, ms=ms)
+    res = FrameResult(fr.source, fr.frame_id, len(fr.points), gt, gt_pts, ignore, dets, dets_all, ms=ms, run=d)
     if getattr(fr, "point_semantic", None) is not None:
         res.fp_kinds = fp_kinds(fr.points, fr.point_semantic, gt, dets)
     if d is not None:

@@ -88,7 +88,7 @@ def frame_gain(fr, person_m: float = 0.7) -> dict:
     from ..eval_real import IGNORE_MARGIN_M, LABELLED_CLASSES, _arr, _in_fov, evaluate_frame
     from ..where_lost import points_in_box, seen_points
     r = evaluate_frame(fr)
-    d = native.detect(fr.points, fr.sensor, mount_height_m=fr.mount_height_m)
+    d = r.run  # the float detector's run that was scored
     fam = native.default_family(fr.sensor)
     seen = seen_points(fr.points, fr.sensor)
     xyz = fr.points[:, :3].astype(np.float64)

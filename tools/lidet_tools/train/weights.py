@@ -270,18 +270,16 @@ def model_card(a, results: dict, real, timings: dict) -> str:
     L += ["", "Wall-clock seconds per step (training: the sum over its epochs, from the state history, so a "
           "resumed run still shows what the epochs cost; dataset: from its metadata when it was built):", "",
           "| step | seconds |", "|---|---:|"]
+    steps = 0.0  # the steps' seconds listed: a run that found its datasets and checkpoints in --work took less
     for fam, r in results.items():
         ds = r["dataset_meta"].get("seconds")
         L.append(f"| {fam} dataset | {ds:.0f} |" if ds is not None else f"| {fam} dataset | (built before; not recorded) |")
+        steps += float(ds or 0.0)
         for kind in ("cls", "box"):
             _, ck = load_checkpoint(a.work / f"{fam}_{kind}.pt")
             L.append(f"| {fam} {kind} training | {ck['meta'].get('train_seconds', float('nan')):.0f} |")
+            steps += float(ck["meta"].get("train_seconds") or 0.0)
         L.append(f"| {fam} evaluation | {timings.get(f'{fam} evaluation', float('nan')):.0f} |")
-    # a run that found its datasets and checkpoints in --work (it resumed) took less than the steps listed above
-    steps = sum(float(r["dataset_meta"].get("seconds") or 0.0) for r in results.values())
-    for fam in results:
-        for kind in ("cls", "box"):
-            steps += float(load_checkpoint(a.work / f"{fam}_{kind}.pt")[1]["meta"].get("train_seconds") or 0.0)
     resumed = timings.get("total", 0.0) < steps
     L += [f"| int8 calibration and C models (all families) | {timings.get('C models', float('nan')):.0f} |",
           f"| this invocation, in all{' (it reused the datasets and checkpoints of ' + str(a.work) + ')' if resumed else ''}"
