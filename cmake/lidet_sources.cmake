@@ -23,11 +23,11 @@ set(LIDET_SRC_PROJ_INT proj/lidet_proj_q.c proj/lidet_sensor_q.c)
 # ground: sample filter, gathering and labels; RANSAC planes
 set(LIDET_SRC_GROUND_FLOAT ground/lidet_ground_filter.c ground/lidet_ground_ransac.c)
 set(LIDET_SRC_GROUND_INT ground/lidet_ground_filter_q.c ground/lidet_ground_ransac_q.c)
-# clustering: run and records, growth, fragment rescue, refinement, proposals
+# clustering: run and records, growth, fragment rescue, refinement, proposals, the detectors' group split
 set(LIDET_SRC_CLUSTER_FLOAT cluster/lidet_cluster.c cluster/lidet_cluster_grow.c cluster/lidet_cluster_rescue.c
-    cluster/lidet_refine.c cluster/lidet_proposal.c)
+    cluster/lidet_refine.c cluster/lidet_proposal.c cluster/lidet_group.c)
 set(LIDET_SRC_CLUSTER_INT cluster/lidet_cluster_q.c cluster/lidet_cluster_grow_q.c cluster/lidet_cluster_rescue_q.c
-    cluster/lidet_refine_q.c cluster/lidet_proposal_q.c)
+    cluster/lidet_refine_q.c cluster/lidet_proposal_q.c cluster/lidet_group_q.c)
 # PointNets (the integer energy tables are generated: python -m lidet_codegen pnqtables)
 set(LIDET_SRC_POINTNET_FLOAT pointnet/lidet_pointnet.c)
 set(LIDET_SRC_POINTNET_INT pointnet/lidet_pointnet_q.c pointnet/lidet_pointnet_q_tables.c)

@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from lidet_ref import cluster_q, ground_q, pointnet_q, post_q, proj_q, qmath
+from lidet_ref import cluster_q, ground_q, group_q, pointnet_q, post_q, proj_q, qmath
 
-OUT_CROP, OUT_RANGE, OUT_BUDGET, OUT_GATE1, OUT_GATE2, OUT_SIZE, OUT_NMS, OUT_CAPACITY, OUT_DETECTED, OUT_TALL = range(1, 11)
+(OUT_CROP, OUT_RANGE, OUT_BUDGET, OUT_GATE1, OUT_GATE2, OUT_SIZE, OUT_NMS, OUT_CAPACITY, OUT_DETECTED, OUT_TALL,
+ OUT_GROUP) = range(1, 12)
 #: lidet_detector_q_cfg_default's gate2_class: gate 2 judges cars and cyclists, pedestrians pass it
 GATE2_CLASS = (1, 1, 0)
 
@@ -73,8 +74,9 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
            returns=None) -> dict:
     """The whole integer detector on (N, 3) int32 mm points. det_cfg: crop_half_bam, max_range_mm, max_height_extent_mm,
     max_proposals, max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max, score_box_weight_q16 (3), score_points_weight_q16 (3), and optionally gate1_margin_q16 / gate2_margin_q16
-    (0 when absent: the models' gammas) and gate2_class (3 flags, lidet_class_t order: the classes gate 2 judges;
-    GATE2_CLASS when absent, the C default). range_only: the image keeps only the range, every stage reads x, y, z
+    (0 when absent: the models' gammas), gate2_class (3 flags, lidet_class_t order: the classes gate 2 judges;
+    GATE2_CLASS when absent, the C default), group_split (0 when absent; the C default is 1 for > 16 rows) and
+    group_max_range_mm (40000 when absent). range_only: the image keeps only the range, every stage reads x, y, z
     decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
     (dicts), outcomes, stats. returns: (range_mm, azimuth, ring) instead of points_mm (lidet_detector_q_run_returns:
     proj_q.project_returns)."""
@@ -104,18 +106,87 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     order, truncated = candidates(recs, det_cfg, outcome)
     stats = dict(n_clusters=len(recs), n_too_tall=outcome.count(OUT_TALL), n_classified=0, n_gate1_rejected=0,
                  n_boxed=0, n_gate2_rejected=0, n_size_rejected=0, n_nms_suppressed=0, n_over_capacity=0,
-                 n_over_box_budget=0)
+                 n_over_box_budget=0, n_group_split=0, n_group_classified=0, n_group_boxed=0)
     dets = []
+    g2c = det_cfg.get("gate2_class", GATE2_CLASS)
+    g1m, g2m = int(det_cfg.get("gate1_margin_q16", 0)), int(det_cfg.get("gate2_margin_q16", 0))
+    Xf, Yf, Zf = X.ravel(), Y.ravel(), Z.ravel()
+
+    def gate1_pass(cls, energy):
+        return energy < int(cls_model.gamma_q16[cls]) + g1m
+
+    def add(d):
+        """the detector's insertion (after every entry with a higher score or an equal score and a lower id);
+        past max_detections the lowest goes (a cluster marked detected becomes capacity). Returns truncated."""
+        k = len(dets)
+        while k > 0 and (dets[k - 1]["score_q15"] < d["score_q15"] or
+                         (dets[k - 1]["score_q15"] == d["score_q15"] and dets[k - 1]["cluster_id"] > d["cluster_id"])):
+            k -= 1
+        dets.insert(k, d)
+        if len(dets) > max_detections:
+            gone = dets.pop()
+            if outcome[gone["cluster_id"] - 1] == OUT_DETECTED:
+                outcome[gone["cluster_id"] - 1] = OUT_CAPACITY
+            stats["n_over_capacity"] += 1
+            return True
+        return False
+
+    def detection(ci, cls, energy, b, n_points):
+        return dict(box=[int(v) for v in b["box"][0]], cls=cls,
+                    score_q15=detection_score_q15(energy, int(b["energy"][0]), n_points, int(cls_model.gamma_q16[cls]),
+                                                  int(box_model.gamma_q16[cls]), int(det_cfg["score_box_weight_q16"][cls]),
+                                                  int(det_cfg["score_points_weight_q16"][cls])),
+                    energy_cls_q16=energy, energy_box_q16=int(b["energy"][0]), cluster_id=ci + 1, n_points=n_points)
+
+    def group(ci):
+        """the group split of a classified cluster that gave no detection (lidet_detector_body.h det_group)."""
+        nonlocal truncated
+        rec = recs[ci]
+        g = group_q.shape(rec, members, Xf, Yf, Zf, int(det_cfg.get("group_max_range_mm", 40000)))
+        if g is None:
+            return
+        for k in range(g.k_max, g.k_min - 1, -1):
+            ok = group_q.cut(rec, members, Xf, Yf, Zf, g, k)
+            parts = []
+            for j in range(k):
+                if not ok:
+                    break
+                xyz, mean, vox, n_src = group_q.proposal(rec, members, Xf, Yf, Zf, g, j, pcfg)
+                c = pointnet_q.classify(cls_model, xyz[None].astype(np.int64), mean[None], vox[None])
+                stats["n_group_classified"] += 1
+                cls, energy = int(c["cls"][0]), int(c["energy"][0])
+                ok = cls == 2 and gate1_pass(cls, energy)  # lidet_class_t: 2 = pedestrian
+                parts.append((xyz, mean, vox, n_src, cls, energy))
+            if not ok:
+                continue
+            for xyz, mean, vox, n_src, cls, energy in parts:
+                if stats["n_boxed"] + stats["n_group_boxed"] >= det_cfg["max_boxes"]:
+                    truncated = True
+                    break
+                b = pointnet_q.box(box_model, xyz[None].astype(np.int64), mean[None], vox[None], cls)
+                stats["n_group_boxed"] += 1
+                if (det_cfg["gate2"] and g2c[cls] and not int(b["energy"][0]) < int(box_model.gamma_q16[cls]) + g2m) or \
+                        not post_q.size_ok(cls, [int(v) for v in b["box"][0]], det_cfg["size_min"], det_cfg["size_max"]):
+                    continue
+                if outcome[ci] != OUT_GROUP:
+                    outcome[ci] = OUT_GROUP
+                    stats["n_group_split"] += 1
+                truncated |= add(detection(ci, cls, energy, b, n_src))
+            return
+
+    group_on = int(det_cfg.get("group_split", 0))
     for ci in order:
         xyz, mean, vox = cluster_q.make_proposal_q(recs[ci], members, X, Y, Z, pcfg)
         c = pointnet_q.classify(cls_model, xyz[None].astype(np.int64), mean[None], vox[None])
         cls, energy = int(c["cls"][0]), int(c["energy"][0])
         stats["n_classified"] += 1
-        if det_cfg["gate1"] and not energy < int(cls_model.gamma_q16[cls]) + int(det_cfg.get("gate1_margin_q16", 0)):
+        if det_cfg["gate1"] and not gate1_pass(cls, energy):
             outcome[ci] = OUT_GATE1
             stats["n_gate1_rejected"] += 1
+            if group_on:
+                group(ci)
             continue
-        if stats["n_boxed"] == det_cfg["max_boxes"]:  # the box budget
+        if stats["n_boxed"] + stats["n_group_boxed"] >= det_cfg["max_boxes"]:  # the box budget (the groups' too)
             outcome[ci] = OUT_BUDGET
             stats["n_over_box_budget"] += 1
             truncated = True
@@ -123,36 +194,25 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
         b = pointnet_q.box(box_model, xyz[None].astype(np.int64), mean[None], vox[None], cls)
         stats["n_boxed"] += 1
         e_box = int(b["energy"][0])
-        if det_cfg["gate2"] and det_cfg.get("gate2_class", GATE2_CLASS)[cls] and not e_box < int(box_model.gamma_q16[cls]) + int(det_cfg.get("gate2_margin_q16", 0)):
+        if det_cfg["gate2"] and g2c[cls] and not e_box < int(box_model.gamma_q16[cls]) + g2m:
             outcome[ci] = OUT_GATE2
             stats["n_gate2_rejected"] += 1
+            if group_on:
+                group(ci)
             continue
-        box = [int(v) for v in b["box"][0]]
-        if not post_q.size_ok(cls, box, det_cfg["size_min"], det_cfg["size_max"]):
+        if not post_q.size_ok(cls, [int(v) for v in b["box"][0]], det_cfg["size_min"], det_cfg["size_max"]):
             outcome[ci] = OUT_SIZE
             stats["n_size_rejected"] += 1
+            if group_on:
+                group(ci)
             continue
-        sc = detection_score_q15(energy, e_box, recs[ci].n_points, int(cls_model.gamma_q16[cls]),
-                                 int(box_model.gamma_q16[cls]), int(det_cfg["score_box_weight_q16"][cls]),
-                                 int(det_cfg["score_points_weight_q16"][cls]))
-        d = dict(box=box, cls=cls, score_q15=sc, energy_cls_q16=energy,
-                 energy_box_q16=int(b["energy"][0]), cluster_id=ci + 1, n_points=recs[ci].n_points)
-        # the detector's insertion: after every entry with a higher score or an equal score and a lower id
-        k = len(dets)
-        while k > 0 and (dets[k - 1]["score_q15"] < d["score_q15"] or
-                         (dets[k - 1]["score_q15"] == d["score_q15"] and dets[k - 1]["cluster_id"] > d["cluster_id"])):
-            k -= 1
-        dets.insert(k, d)
         outcome[ci] = OUT_DETECTED
-        if len(dets) > max_detections:
-            gone = dets.pop()
-            outcome[gone["cluster_id"] - 1] = OUT_CAPACITY
-            stats["n_over_capacity"] += 1
-            truncated = True
+        truncated |= add(detection(ci, cls, energy, b, recs[ci].n_points))
     kept, flags = post_q.nms(dets, int(det_cfg["nms_iou_q15"]))
     for d, f in zip(dets, flags):
         if f:
-            outcome[d["cluster_id"] - 1] = OUT_NMS
+            if outcome[d["cluster_id"] - 1] == OUT_DETECTED:  # a group keeps its outcome
+                outcome[d["cluster_id"] - 1] = OUT_NMS
             stats["n_nms_suppressed"] += 1
     stats["n_detections"] = len(kept)
     return dict(detections=kept, outcome=outcome, stats=stats, truncated=truncated)

@@ -420,6 +420,9 @@ static void json_result(const cli_args_t *a, const char *chosen, const lidet_det
     cli_json_int(stdout, "gate2_rejected", ds->n_gate2_rejected);
     cli_json_int(stdout, "size_rejected", ds->n_size_rejected);
     cli_json_int(stdout, "nms_suppressed", ds->n_nms_suppressed);
+    cli_json_int(stdout, "group_split", ds->n_group_split);
+    cli_json_int(stdout, "group_classified", ds->n_group_classified);
+    cli_json_int(stdout, "group_boxed", ds->n_group_boxed);
     cli_json_int(stdout, "detections", n_det);
     cli_json_int(stdout, "status", st);
     cli_json_int(stdout, "repeat", a->repeat);
@@ -462,6 +465,8 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, gate2, uint8_t, 1)
     CLI_SET_FLOAT(c, kv, klen, v, gate1_margin)
     CLI_SET_FLOAT(c, kv, klen, v, gate2_margin)
+    CLI_SET_INT(c, kv, klen, v, group_split, uint8_t, 1)
+    CLI_SET_FLOAT(c, kv, klen, v, group_max_range_m)
     {
         /* score_box_weight.CLASS / score_points_weight.CLASS / gate2.CLASS, in lidet_class_t order */
         static const char *const names[LIDET_N_CLASSES] = {"score_box_weight.car", "score_box_weight.cyclist",
@@ -588,6 +593,9 @@ void cli_det_usage(FILE *f)
                "                   gate2_margin (nats added to the models' gates),\n"
                "                   gate2.car|cyclist|pedestrian (0 or 1: whether gate 2\n"
                "                   judges the class; default 1, 1, 0),\n"
+               "                   group_split (0 or 1: people side by side in one cluster\n"
+               "                   split by the classifier's judgement; default 1 for > 16\n"
+               "                   beams), group_max_range_m (default 40),\n"
                "                   score_box_weight.car|cyclist|pedestrian (the score's weight on gate 2's\n"
                "                   margin), score_points_weight.CLASS (on ln(points / 64));\n"
                "                   stages.cluster.KEY: a\n"

@@ -103,6 +103,8 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     cfg.cluster.regrow_max_pixels = fcfg->stages.cluster.regrow_max_pixels;
     cfg.cluster.regrow_max_height_mm =
         (uint32_t)round_i32((double)fcfg->stages.cluster.regrow_max_height_m * 1000.0);
+    cfg.group_split = fcfg->group_split;
+    cfg.group_max_range_mm = round_i32((double)fcfg->group_max_range_m * 1000.0);
     cfg.gate1 = fcfg->gate1;
     cfg.gate2 = fcfg->gate2;
     cfg.gate1_margin_q16 = round_i32((double)fcfg->gate1_margin * 65536.0);
@@ -204,6 +206,9 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     ds->n_over_capacity = st->n_over_capacity;
     ds->n_over_box_budget = st->n_over_box_budget;
     ds->n_too_tall = st->n_too_tall;
+    ds->n_group_split = st->n_group_split;
+    ds->n_group_classified = st->n_group_classified;
+    ds->n_group_boxed = st->n_group_boxed;
     ds->n_detections = st->n_detections;
     ds->stages.ground = st->ground; /* the same counts (lidet detect's mount-height warning reads them) */
     dq = lidet_detector_q_detections(&g_detq, n_det);

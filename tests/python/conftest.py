@@ -49,3 +49,14 @@ def need_lib():
         native.lib()
     except FileNotFoundError as e:
         pytest.skip(str(e))
+
+
+@pytest.fixture(scope="session")
+def nd():
+    """lidet_tools.native with its models loaded; skips when the bindings are not built."""
+    from lidet_tools import native
+    try:
+        native.pn_models()
+    except (OSError, FileNotFoundError) as e:  # pragma: no cover - bindings not built
+        pytest.skip(f"bindings not built: {e}")
+    return native

@@ -17,16 +17,6 @@ SCAN = ROOT / "tests/data/sim_vlp16/velodyne/000000.bin"
 PED = 2  # lidet_class_t
 
 
-@pytest.fixture(scope="module")
-def nd():
-    from lidet_tools import native
-    try:
-        native.pn_models()
-    except (OSError, FileNotFoundError) as e:  # pragma: no cover - bindings not built
-        pytest.skip(f"bindings not built: {e}")
-    return native
-
-
 def _pts():
     from lidet_tools import kitti
     return kitti.read_bin(SCAN)

@@ -162,7 +162,7 @@ def test_score_matches_the_float_definition(nq):
 # ---- the integer detector against the chained numpy reference, bit for bit ---------------------------
 
 def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False, crop_half_bam=0, returns=None,
-                gate2_class=None):
+                gate2_class=None, group_split=None, model=None):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -172,14 +172,15 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
     tab = proj_q.init(s.beam_elev_urad, s.cols, fov_margin_urad=87266, fov_urad=s.fov_urad)
     models = {}
     for kind in ("cls", "box"):
-        name = f"{kind}_{sensor}"
+        name = f"{kind}_{model or sensor}"
         calib = json.loads((ROOT / "weights" / f"{name}.calib.json").read_text())
         models[kind] = QU.quantize(E.load(ROOT / "weights" / f"{name}.onnx", name), calib)
     cc, pc = nq.cluster_q_defaults(sensor)
     cap = native.capacity()
     det_cfg = dict(crop_half_bam=crop_half_bam, max_range_mm=0, max_height_extent_mm=2500, score_box_weight_q16=[32768, 0, 0], score_points_weight_q16=[6554, 0, 0], max_proposals=min(128 if s.rows <= 16 else 256, cap["max_clusters"]),
                    max_boxes=max_boxes or min(24 if s.rows <= 16 else 48, cap["max_clusters"]), gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM,
-                   gate1_margin_q16=margins[0], gate2_margin_q16=margins[1])
+                   gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
+                   group_split=int(s.rows > 16 if group_split is None else group_split), group_max_range_mm=40000)
     if gate2_class is not None:
         det_cfg["gate2_class"] = gate2_class
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
@@ -187,7 +188,7 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
                      cap["max_points"], range_only=range_only, returns=returns)
 
 
-@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "gate2_all",
+@pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "gate2_all", "group", "group_real",
                                    "range_only_sample",
                                    "range_only_fresh", "range_only_real", "crop_hdl64", "crop_real",
                                    "returns_sample", "returns_range_only_sample", "returns_range_only_fresh"])
@@ -196,7 +197,7 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     qmath.decode_pixels) against the chained numpy reference, bit for bit; and the detector fed the sensor's
     returns (lidet_detector_q_run_returns: ring, azimuth, range) instead of points."""
     from lidet_ref import proj_q
-    sensor, max_boxes, margins, g2c = "vlp16", 0, (0, 0), None
+    sensor, max_boxes, margins, g2c, model = "vlp16", 0, (0, 0), None, None
     use_returns = which.startswith("returns_")
     which = which.removeprefix("returns_")
     range_only = which.startswith("range_only_")
@@ -218,6 +219,13 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
         pts, ring = sc.points, sc.ring
     elif which == "hdl64":
         sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
+    elif which == "group":  # gate 1 looser by 4 nats: a cluster boxed as something else is split into people
+        sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
+        margins = (4 * 65536, 0)
+    elif which == "group_real":  # a real PandaSet frame: people side by side split at the default gates
+        from lidet_tools import real as R
+        fr = R.load_frame(request.getfixturevalue("real_dir"), "pandaset", "000000")
+        sensor, pts, model = fr.sensor, fr.points, "hdl64"
     else:
         real = request.getfixturevalue("real_dir")
         sensor, pts = "hdl64", _load(real / "kitti/training/velodyne/000001.bin")
@@ -225,14 +233,20 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     rets = proj_q.returns_of_points(mm, ring) if use_returns else None
     c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
                     range_only=range_only, crop_half_bam=crop, returns=None if rets is None else nq.as_returns(*rets),
-                    gate2_class=g2c)
-    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop, returns=rets, gate2_class=g2c)
+                    gate2_class=g2c, model=model)
+    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop, returns=rets, gate2_class=g2c, model=model)
     if use_returns:  # the same scan as points gives nearly the same detections (pixels move by rounding only)
         p = nq.detect_q(mm, sensor, range_only=range_only)
         assert abs(len(p["cls"]) - len(c["cls"])) <= 2 and c["stats"]["n_clusters"] > 0
     if crop:
         assert c["stats"]["n_out_of_crop"] > 0
-    if margins != (0, 0):  # the margins bite: fewer gate-1 rejections, more gate-2 ones than at the models' gammas
+    if which in ("group", "group_real"):  # the group split fired: its parts' detections carry the cluster's id
+        groups = np.flatnonzero(c["outcome"] == 11) + 1
+        assert len(groups) >= 1
+        for g in groups:
+            parts = np.flatnonzero(c["cluster_id"] == g)
+            assert len(parts) >= 1 and np.all(c["cls"][parts] == 2)
+    elif margins != (0, 0):  # the margins bite: fewer gate-1 rejections, more gate-2 ones than at the models' gammas
         c0 = nq.detect_q(mm, sensor)
         assert c["stats"]["n_gate1_rejected"] < c0["stats"]["n_gate1_rejected"]
         assert c["stats"]["n_gate2_rejected"] > c0["stats"]["n_gate2_rejected"]
@@ -244,7 +258,8 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
         assert c["stats"]["n_boxed"] == max_boxes and c["stats"]["n_over_box_budget"] > 0
     assert c["outcome"].tolist() == r["outcome"]
     for k in ("n_clusters", "n_classified", "n_gate1_rejected", "n_boxed", "n_gate2_rejected", "n_size_rejected",
-              "n_nms_suppressed", "n_detections", "n_over_box_budget"):
+              "n_nms_suppressed", "n_detections", "n_over_box_budget", "n_group_split", "n_group_classified",
+              "n_group_boxed"):
         assert c["stats"][k] == r["stats"][k], k
     assert len(r["detections"]) == len(c["cls"]) > 0
     for i, d in enumerate(r["detections"]):

@@ -485,6 +485,23 @@ void test_init_errors(void)
     c.gate2_class[LIDET_CLASS_PEDESTRIAN] = 2; /* a flag: 0 or 1 */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c = cfg;
+    c.group_split = 2; /* a flag: 0 or 1 */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
+    c.group_max_range_m = -1.0f; /* [0, 1000] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.group_max_range_m = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    {
+        /* the group split: on for > 16 beams, off for <= 16, within 40 m */
+        lidet_detector_cfg_t d0;
+        lidet_detector_cfg_default(&d0, lidet_sensor_find("hdl64"));
+        TEST_ASSERT_EQUAL_UINT8(1, d0.group_split);
+        TEST_ASSERT_EQUAL_FLOAT(40.0f, d0.group_max_range_m);
+        lidet_detector_cfg_default(&d0, lidet_sensor_find("vlp16"));
+        TEST_ASSERT_EQUAL_UINT8(0, d0.group_split);
+    }
+    c = cfg;
     c.size_min_m[1][2] = 5.0f;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c = cfg;

@@ -87,6 +87,17 @@ static void test_init_errors(void)
     cfg.gate2_class[LIDET_CLASS_CAR] = 2; /* a flag: 0 or 1 */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.group_split = 2; /* a flag: 0 or 1 */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.group_max_range_mm = -1; /* [0, 10^6] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("hdl64")); /* the group split: on for > 16 rows */
+    TEST_ASSERT_EQUAL_UINT8(1, cfg.group_split);
+    TEST_ASSERT_EQUAL_INT32(40000, cfg.group_max_range_mm);
+    lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("vlp16"));
+    TEST_ASSERT_EQUAL_UINT8(0, cfg.group_split);
+    lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.max_proposals = 0;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);
@@ -139,7 +150,7 @@ static void test_init_errors(void)
 
 static void check_invariants(const lidet_detector_q_cfg_t *cfg)
 {
-    uint32_t n, nc, i, counts[11] = {0};
+    uint32_t n, nc, i, counts[12] = {0};
     const lidet_detection_q_t *d = lidet_detector_q_detections(&g.ws, &n);
     const uint8_t *oc = lidet_detector_q_outcomes(&g.ws, &nc);
     const lidet_detector_q_stats_t *st = lidet_detector_q_stats(&g.ws);
@@ -163,17 +174,23 @@ static void check_invariants(const lidet_detector_q_cfg_t *cfg)
     }
     for (i = 0; i < nc; ++i)
     {
-        TEST_ASSERT_TRUE(oc[i] >= 1 && oc[i] <= LIDET_DET_OUT_TALL);
+        TEST_ASSERT_TRUE(oc[i] >= 1 && oc[i] <= LIDET_DET_OUT_GROUP);
         ++counts[oc[i]];
     }
     TEST_ASSERT_EQUAL_UINT32(st->n_out_of_crop, counts[LIDET_DET_OUT_CROP]);
     TEST_ASSERT_EQUAL_UINT32(st->n_out_of_range, counts[LIDET_DET_OUT_RANGE]);
     TEST_ASSERT_EQUAL_UINT32(st->n_over_budget + st->n_over_box_budget, counts[LIDET_DET_OUT_BUDGET]);
-    TEST_ASSERT_EQUAL_UINT32(st->n_gate1_rejected, counts[LIDET_DET_OUT_GATE1]);
-    TEST_ASSERT_EQUAL_UINT32(st->n_gate2_rejected, counts[LIDET_DET_OUT_GATE2]);
-    TEST_ASSERT_EQUAL_UINT32(st->n_size_rejected, counts[LIDET_DET_OUT_SIZE]);
-    TEST_ASSERT_EQUAL_UINT32(st->n_nms_suppressed, counts[LIDET_DET_OUT_NMS]);
-    TEST_ASSERT_EQUAL_UINT32(n, counts[LIDET_DET_OUT_DETECTED]);
+    /* a cluster the group split cut keeps its rejection's count and has the outcome GROUP */
+    TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_GATE1] <= st->n_gate1_rejected);
+    TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_GATE2] <= st->n_gate2_rejected);
+    TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_SIZE] <= st->n_size_rejected);
+    TEST_ASSERT_EQUAL_UINT32(st->n_gate1_rejected + st->n_gate2_rejected + st->n_size_rejected,
+                             counts[LIDET_DET_OUT_GATE1] + counts[LIDET_DET_OUT_GATE2] + counts[LIDET_DET_OUT_SIZE] +
+                                 counts[LIDET_DET_OUT_GROUP]);
+    TEST_ASSERT_EQUAL_UINT32(st->n_group_split, counts[LIDET_DET_OUT_GROUP]);
+    TEST_ASSERT_TRUE(st->n_boxed + st->n_group_boxed <= cfg->max_boxes);
+    TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_NMS] <= st->n_nms_suppressed); /* a group keeps its outcome */
+    TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_DETECTED] <= n); /* a group's parts are detections of one cluster */
     TEST_ASSERT_EQUAL_UINT32(st->n_too_tall, counts[LIDET_DET_OUT_TALL]);
     TEST_ASSERT_EQUAL_UINT32(st->n_classified, st->n_gate1_rejected + st->n_over_box_budget + st->n_boxed);
     TEST_ASSERT_TRUE(st->n_boxed <= cfg->max_boxes);

@@ -90,14 +90,19 @@ def where_lost(points: np.ndarray, gt_boxes: np.ndarray, gt_cls: list, det, min_
         if held < CLUSTER_SHARE * ng.sum():
             out.append("split")
             continue
+        js = np.nonzero(det.cluster_id == cid)[0]
+        # a cluster the group split cut into people: its parts' detections carry its id
+        found = [j for j in js if classes[int(det.cls[j])] == cls and hit(det.box[j].astype(np.float64), b, cls)]
         if held < CLUSTER_SHARE * csize[cid]:
-            out.append("merged")
+            out.append("detected" if found and _outcome_name(det.outcome[cid - 1]) == "group" else "merged")
             continue
         stage = _OUTCOME_STAGE.get(_outcome_name(det.outcome[cid - 1]))
         if stage is not None:
             out.append(stage)
             continue
-        js = np.nonzero(det.cluster_id == cid)[0]
+        if found:
+            out.append("detected")
+            continue
         if len(js) == 0:  # a detection of a cluster always has its id; guard against a capacity-cut table
             out.append("budget/crop")
             continue

@@ -81,6 +81,16 @@ typedef struct
                                                heading is ambiguous, and on real scans gate 2 dropped more real
                                                pedestrians than clutter (measured: docs/DETECTOR.md, "Gate 2 per
                                                class") */
+    uint8_t group_split; /**< 1: a classified cluster that gave no detection and is shaped like people side by
+                              side (z spread 1.0-2.2 m, 0.9-3.5 m along its principal horizontal axis, >= 20
+                              points) is cut along that axis into 2-4 parts (one-dimensional k-means); the cut
+                              stands when the classifier calls every part a pedestrian passing gate 1, and each
+                              part is then boxed as a cluster is (its detections carry the cluster's id; outcome
+                              LIDET_DET_OUT_GROUP). Up to 9 more classifier passes per such cluster. Default 1 for
+                              > 16 beams, 0 for <= 16 (measured on the real frames: docs/DETECTOR.md, "People in
+                              groups") */
+    float group_max_range_m; /**< the group split examines clusters whose mean lies within this (horizontal);
+                                  [0, 1000], default 40 */
     float score_box_weight
         [LIDET_N_CLASSES]; /**< the detection score is 1 / (1 + e^-(m1 + w m2)), m1 = gamma1 - E1
                                                   and m2 = gamma2 - E2 the two gates' margins (the models' gammas),
@@ -107,7 +117,7 @@ typedef struct
     float energy_cls;    /**< classifier energy (gate 1) */
     float energy_box;    /**< box net energy, heading + size (gate 2) */
     uint32_t cluster_id; /**< 1-based id of its cluster in the last run (lidet_workspace_labels) */
-    uint32_t n_points;   /**< member pixels of that cluster */
+    uint32_t n_points;   /**< member pixels of that cluster (of its part, for a group split's detection) */
 } lidet_detection_t;
 
 /** @brief Counts of the last run. */
@@ -128,6 +138,10 @@ typedef struct
     uint32_t n_detections;      /**< in the output */
     uint32_t n_over_box_budget; /**< passed gate 1 past max_boxes (not boxed) */
     uint32_t n_too_tall;        /**< taller than max_height_extent_m (not classified) */
+    uint32_t n_group_split; /**< clusters the group split cut into people (outcome LIDET_DET_OUT_GROUP; their
+                                     rejection above still counts them: the counts above are per cluster) */
+    uint32_t n_group_classified; /**< classifier passes on the group split's parts (not in n_classified) */
+    uint32_t n_group_boxed; /**< box net passes on its parts (not in n_boxed; n_boxed + this <= max_boxes) */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_workspace_stats_t stages;     /**< the stages' own counts */
 } lidet_detector_stats_t;

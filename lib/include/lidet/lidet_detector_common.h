@@ -42,7 +42,9 @@ typedef enum
     LIDET_DET_OUT_NMS = 7,      /**< suppressed by the NMS */
     LIDET_DET_OUT_CAPACITY = 8, /**< past LIDET_MAX_DETECTIONS */
     LIDET_DET_OUT_DETECTED = 9, /**< a detection of the output */
-    LIDET_DET_OUT_TALL = 10     /**< taller than max_height_extent_m: no road user, not classified */
+    LIDET_DET_OUT_TALL = 10,    /**< taller than max_height_extent_m: no road user, not classified */
+    LIDET_DET_OUT_GROUP = 11    /**< no detection of its own, split into people by the group split: its parts'
+                                     detections carry its id (lidet_detector_cfg_t group_split) */
 } lidet_det_outcome_t;
 
 #ifdef __cplusplus

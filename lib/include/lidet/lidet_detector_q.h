@@ -40,7 +40,7 @@ typedef struct
     uint16_t cluster_id;    /**< 1-based id of the cluster it came from */
     uint8_t cls;            /**< lidet_class_t */
     uint8_t reserved;
-    uint32_t n_points; /**< member points of that cluster */
+    uint32_t n_points; /**< member points of that cluster (of its part, for a group split's detection) */
 } lidet_detection_q_t;
 
 /** @brief Plausible sizes per class (lidet_class_t order), l, w, h in mm. */
@@ -107,6 +107,9 @@ typedef struct
     int32_t gate2_margin_q16; /**< the same for gate 2; default 0 */
     uint8_t gate2_class[LIDET_N_CLASSES]; /**< 1: gate 2 judges this class, 0: it passes (the float detector's
                                                gate2_class); default car 1, cyclist 1, pedestrian 0 */
+    uint8_t group_split; /**< the float detector's group_split (lidet_detector.h): default 1 for > 16 rows,
+                                     0 for <= 16 */
+    int32_t group_max_range_mm; /**< the float detector's group_max_range_m in mm; [0, 10^6], default 40000 */
     int32_t
         score_box_weight_q16[LIDET_N_CLASSES]; /**< the float detector's score_box_weight in Q16: the score
                                                        is lidet_detector_q_score(E1 + round(w (E2 - gamma2)),
@@ -126,8 +129,9 @@ typedef struct
 {
     uint32_t n_clusters, n_out_of_crop, n_out_of_range, n_over_budget, n_classified, n_gate1_rejected,
         n_boxed, n_gate2_rejected, n_size_rejected, n_nms_suppressed, n_over_capacity, n_detections;
-    uint32_t n_over_box_budget;         /**< passed gate 1 past max_boxes (not boxed) */
-    uint32_t n_too_tall;                /**< taller than max_height_extent_mm (not classified) */
+    uint32_t n_over_box_budget; /**< passed gate 1 past max_boxes (not boxed) */
+    uint32_t n_too_tall;        /**< taller than max_height_extent_mm (not classified) */
+    uint32_t n_group_split, n_group_classified, n_group_boxed; /**< the float detector's group split counts */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_proj_stats_t proj;
     lidet_ground_stats_t ground;

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "internal/lidet_cluster_internal.h"
 #include "internal/lidet_math.h"
 #include "internal/lidet_pixel.h"
 #include "internal/lidet_proposal_rule.h"
@@ -54,6 +55,14 @@ static int16_t bin_of(float v, float bin)
     return (int16_t)f;
 }
 
+void lidet__proposal_voxel(float mx, float my, float mz, const lidet_proposal_cfg_t *cfg, int16_t voxel[3])
+{
+    const float rxy = sqrtf(mx * mx + my * my);
+    voxel[0] = bin_of(atan2f(my, mx), cfg->azimuth_bin_rad);
+    voxel[1] = bin_of(atan2f(mz, rxy), cfg->elevation_bin_rad);
+    voxel[2] = bin_of(sqrtf(mx * mx + my * my + mz * mz), cfg->range_bin_m);
+}
+
 lidet_status_t lidet_proposal_make(const lidet_cluster_t *c, uint32_t cluster_index,
                                    const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out)
 {
@@ -66,7 +75,7 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
     const lidet_cluster_rec_t *rec;
     const lidet_range_image_t *img;
     uint32_t i, npix, state;
-    float mx, my, mz, zo, rxy;
+    float mx, my, mz, zo;
 
     if (c == 0 || cfg == 0 || out == 0)
     {
@@ -112,10 +121,7 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
     out->mean_m[0] = mx;
     out->mean_m[1] = my;
     out->mean_m[2] = zo;
-    rxy = sqrtf(mx * mx + my * my);
-    out->voxel[0] = bin_of(atan2f(my, mx), cfg->azimuth_bin_rad);
-    out->voxel[1] = bin_of(atan2f(mz, rxy), cfg->elevation_bin_rad);
-    out->voxel[2] = bin_of(sqrtf(mx * mx + my * my + mz * mz), cfg->range_bin_m);
+    lidet__proposal_voxel(mx, my, mz, cfg, out->voxel);
     out->n_points = cfg->n_points;
     out->n_points_src = rec->n_points;
     return LIDET_OK;

@@ -4,6 +4,7 @@
  * only. Mirrored by codegen/lidet_ref/cluster_q.py: make_proposal_q. */
 #include <string.h>
 
+#include "internal/lidet_cluster_q_internal.h"
 #include "internal/lidet_proposal_rule.h"
 #include "internal/lidet_qmath.h"
 #include "internal/lidet_qpix.h"
@@ -35,6 +36,17 @@ static int16_t sat16(int32_t v)
     return (int16_t)(v < -32768 ? -32768 : (v > 32767 ? 32767 : v));
 }
 
+void lidet__proposal_q_voxel(int32_t mx, int32_t my, int32_t mz, const lidet_proposal_q_cfg_t *cfg,
+                             int16_t voxel[3])
+{
+    /* a mean lies within the int16 pixels it averages: the squares fit in 64 bits, the roots in int32 */
+    const int64_t rxy2 = (int64_t)mx * mx + (int64_t)my * my;
+    voxel[0] = bin_q(lidet__q_atan2(my, mx), cfg->azimuth_bin_bam);
+    voxel[1] =
+        bin_q(lidet__q_atan2(mz, (int32_t)lidet__q_sqrt_round64((uint64_t)rxy2)), cfg->elevation_bin_bam);
+    voxel[2] = bin_q(lidet__q_sqrt_round64((uint64_t)(rxy2 + (int64_t)mz * mz)), cfg->range_bin_4mm);
+}
+
 lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t cluster_index,
                                      const lidet_proposal_q_cfg_t *cfg, lidet_proposal_q_t *out)
 {
@@ -42,7 +54,6 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
     const lidet_range_image_t *img;
     uint32_t i, npix, state;
     int32_t mx, my, mz, zo;
-    int64_t rxy2;
 
     if (c == 0 || cfg == 0 || out == 0)
     {
@@ -90,12 +101,7 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
     out->mean_4mm[0] = mx;
     out->mean_4mm[1] = my;
     out->mean_4mm[2] = zo;
-    /* a mean lies within the int16 pixels it averages: the squares fit in 64 bits, the roots in int32 */
-    rxy2 = (int64_t)mx * mx + (int64_t)my * my;
-    out->voxel[0] = bin_q(lidet__q_atan2(my, mx), cfg->azimuth_bin_bam);
-    out->voxel[1] =
-        bin_q(lidet__q_atan2(mz, (int32_t)lidet__q_sqrt_round64((uint64_t)rxy2)), cfg->elevation_bin_bam);
-    out->voxel[2] = bin_q(lidet__q_sqrt_round64((uint64_t)(rxy2 + (int64_t)mz * mz)), cfg->range_bin_4mm);
+    lidet__proposal_q_voxel(mx, my, mz, cfg, out->voxel);
     out->n_points = cfg->n_points;
     out->n_points_src = rec->n_points;
     return LIDET_OK;

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "internal/lidet_group.h"
 #include "internal/lidet_math.h"
 #include "internal/lidet_sort.h"
 #include "lidet/lidet_detector.h"
@@ -52,6 +53,10 @@ void lidet_detector_cfg_default(lidet_detector_cfg_t *cfg, const lidet_sensor_t 
     cfg->gate2_class[LIDET_CLASS_CAR] = 1;
     cfg->gate2_class[LIDET_CLASS_CYCLIST] = 1;
     cfg->gate2_class[LIDET_CLASS_PEDESTRIAN] = 0;
+    /* people side by side split by the classifier's judgement, for the sensors whose people have the points to
+     * judge (measured on the real frames: docs/DETECTOR.md, "People in groups") */
+    cfg->group_split = sensor != 0 && sensor->n_rows <= 16 ? 0u : 1u;
+    cfg->group_max_range_m = 40.0f;
     /* chosen on simulated validation scans (lidet-sim seed 1001), docs/DETECTOR.md "Score" */
     cfg->score_box_weight[LIDET_CLASS_CAR] = 0.5f;
     cfg->score_box_weight[LIDET_CLASS_CYCLIST] = 0.0f;
@@ -72,9 +77,11 @@ static int cfg_ok(const lidet_detector_cfg_t *c)
         !lidet__isfinite(c->max_height_extent_m) || c->max_height_extent_m < 0.0f ||
         c->max_height_extent_m > 100.0f || c->max_proposals < 1 || c->max_proposals > LIDET_MAX_CLUSTERS ||
         c->max_boxes < 1 || c->max_boxes > LIDET_MAX_CLUSTERS || c->gate1 > 1 || c->gate2 > 1 ||
-        !lidet__isfinite(c->nms_iou) || c->nms_iou < 0.0f || c->nms_iou > 1.0f ||
-        !lidet__isfinite(c->gate1_margin) || c->gate1_margin < -20.0f || c->gate1_margin > 20.0f ||
-        !lidet__isfinite(c->gate2_margin) || c->gate2_margin < -20.0f || c->gate2_margin > 20.0f)
+        c->group_split > 1 || !lidet__isfinite(c->group_max_range_m) || c->group_max_range_m < 0.0f ||
+        c->group_max_range_m > 1000.0f || !lidet__isfinite(c->nms_iou) || c->nms_iou < 0.0f ||
+        c->nms_iou > 1.0f || !lidet__isfinite(c->gate1_margin) || c->gate1_margin < -20.0f ||
+        c->gate1_margin > 20.0f || !lidet__isfinite(c->gate2_margin) || c->gate2_margin < -20.0f ||
+        c->gate2_margin > 20.0f)
     {
         return 0;
     }
@@ -325,7 +332,8 @@ static void fill_detection(const lidet_detector_t *d, lidet_detection_t *t, uint
                            const lidet_pn_class_out_t *co, const lidet_pn_box_out_t *bo)
 {
     const float w = d->cfg.score_box_weight[co->cls], v = d->cfg.score_points_weight[co->cls];
-    const uint32_t n = d->ws.cluster.recs[ci].n_points;
+    const uint32_t n = d->proposal.n_points_src; /* the cluster's member pixels, or the group part's */
+    (void)ci;
     /* ln(n / 64) only where its weight is not 0 (the other classes' scores need no logf) */
     const float ln_n = v != 0.0f ? logf((float)(n > 0u ? n : 1u)) - 4.15888309f : 0.0f;
     t->score = 1.0f / (1.0f + expf((co->energy - d->cls.model->gamma[co->cls]) +
@@ -347,6 +355,12 @@ static void fill_detection(const lidet_detector_t *d, lidet_detection_t *t, uint
 #define DET_FILL fill_detection
 #define DET_INSERT insert_sorted
 #define DET_NOW now
+#define DET_GROUP_T lidet_group_t
+#define DET_GROUP_ON(d) ((d)->cfg.group_split != 0u)
+#define DET_GROUP_SHAPE(d, ci, g) lidet__group_shape(&(d)->ws.cluster, (ci), (d)->cfg.group_max_range_m, (g))
+#define DET_GROUP_CUT(d, ci, g, k) lidet__group_cut(&(d)->ws.cluster, (ci), (g), (k))
+#define DET_GROUP_PROPOSAL(d, ci, g, j)                                                                      \
+    lidet__group_proposal(&(d)->ws.cluster, (ci), (g), (j), &(d)->cfg.proposal, &(d)->proposal)
 #include "internal/lidet_detector_body.h"
 
 lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint32_t n_points,
@@ -441,7 +455,10 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
             }
             if (drop)
             {
-                d->outcome[d->det[i].cluster_id - 1u] = LIDET_DET_OUT_NMS;
+                if (d->outcome[d->det[i].cluster_id - 1u] == LIDET_DET_OUT_DETECTED)
+                {
+                    d->outcome[d->det[i].cluster_id - 1u] = LIDET_DET_OUT_NMS; /* a group keeps its outcome */
+                }
                 ++st->n_nms_suppressed;
                 continue;
             }

@@ -4,6 +4,7 @@
  * codegen/lidet_ref/detector_q.py. */
 #include <string.h>
 
+#include "internal/lidet_group_q.h"
 #include "internal/lidet_pointnet_q_internal.h"
 #include "internal/lidet_qmath.h"
 #include "internal/lidet_sort.h"
@@ -45,6 +46,8 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     cfg->gate2_class[LIDET_CLASS_CAR] = 1u; /* the float detector's: pedestrians pass gate 2 */
     cfg->gate2_class[LIDET_CLASS_CYCLIST] = 1u;
     cfg->gate2_class[LIDET_CLASS_PEDESTRIAN] = 0u;
+    cfg->group_split = rows <= 16u ? 0u : 1u; /* the float detector's */
+    cfg->group_max_range_mm = 40000;
     cfg->score_box_weight_q16[LIDET_CLASS_CAR] = 32768; /* the float detector's 0.5 */
     cfg->score_box_weight_q16[LIDET_CLASS_CYCLIST] = 0;
     cfg->score_box_weight_q16[LIDET_CLASS_PEDESTRIAN] = 0;
@@ -69,7 +72,8 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
         c->max_boxes < 1u || c->max_boxes > LIDET_MAX_CLUSTERS || c->gate1 > 1u || c->gate2 > 1u ||
         c->nms_iou_q15 < 0 || c->nms_iou_q15 > 32768 || c->gate1_margin_q16 < -MARGIN_MAX_Q16 ||
         c->gate1_margin_q16 > MARGIN_MAX_Q16 || c->gate2_margin_q16 < -MARGIN_MAX_Q16 ||
-        c->gate2_margin_q16 > MARGIN_MAX_Q16 || c->range_only > 1u ||
+        c->gate2_margin_q16 > MARGIN_MAX_Q16 || c->range_only > 1u || c->group_split > 1u ||
+        c->group_max_range_mm < 0 || c->group_max_range_mm > 1000000 ||
         (!LIDET_Q_PIXEL_XYZ && c->range_only == 0u))
     {
         return 0;
@@ -273,12 +277,13 @@ static uint32_t candidates(lidet_detector_q_t *d, lidet_status_t *worst)
 static void fill_detection(const lidet_detector_q_t *d, lidet_detection_q_t *t, uint32_t ci,
                            const lidet_pointnet_q_class_out_t *co, const lidet_pointnet_q_box_out_t *bo)
 {
+    (void)ci;
     t->reserved = 0;
     /* the score's energy: E1 + round(w (E2 - gamma2)) - round(v ln(n / 64)) (Q16, |.| < 2^51 before the
      * shifts), saturated to int32; ln n only where v is not 0, as the float detector */
     const int64_t m2 = (int64_t)bo->energy_q16 - d->box.model->gamma_q16[co->cls];
     const int32_t v = d->cfg.score_points_weight_q16[co->cls];
-    const uint32_t n = d->cluster.recs[ci].n_points;
+    const uint32_t n = d->proposal.n_points_src; /* the cluster's member pixels, or the group part's */
     int64_t e =
         (int64_t)co->energy_q16 + lidet__q_rshift_round(m2 * d->cfg.score_box_weight_q16[co->cls], 16);
     if (v != 0)
@@ -306,6 +311,12 @@ static void fill_detection(const lidet_detector_q_t *d, lidet_detection_q_t *t, 
 #define DET_FILL fill_detection
 #define DET_INSERT lidet_detections_q_insert
 #define DET_NOW now
+#define DET_GROUP_T lidet_group_q_t
+#define DET_GROUP_ON(d) ((d)->cfg.group_split != 0u)
+#define DET_GROUP_SHAPE(d, ci, g) lidet__group_q_shape(&(d)->cluster, (ci), (d)->cfg.group_max_range_mm, (g))
+#define DET_GROUP_CUT(d, ci, g, k) lidet__group_q_cut(&(d)->cluster, (ci), (g), (k))
+#define DET_GROUP_PROPOSAL(d, ci, g, j)                                                                      \
+    lidet__group_q_proposal(&(d)->cluster, (ci), (g), (j), &(d)->cfg.proposal, &(d)->proposal)
 #include "internal/lidet_detector_body.h"
 
 /* a detector to run: LIDET_OK, LIDET_ERR_ARG (NULL) or LIDET_ERR_STATE (not initialised) */
@@ -414,7 +425,10 @@ static lidet_status_t det_after_projection(lidet_detector_q_t *d, const lidet_pr
         {
             if (suppressed[i])
             {
-                d->outcome[ids[i] - 1u] = LIDET_DET_OUT_NMS;
+                if (d->outcome[ids[i] - 1u] == LIDET_DET_OUT_DETECTED)
+                {
+                    d->outcome[ids[i] - 1u] = LIDET_DET_OUT_NMS; /* a group keeps its outcome */
+                }
                 ++st->n_nms_suppressed;
             }
         }

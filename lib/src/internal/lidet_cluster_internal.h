@@ -60,4 +60,8 @@ int lidet__refine_split(lidet_cluster_state_t *c, const lidet_plane_t *planes, u
 int lidet__refine_join(lidet_cluster_state_t *c, const lidet_plane_t *planes, uint32_t n_sectors,
                        lidet_cluster_stats_t *st);
 
+/* a proposal's PVLE voxel of mean (mx, my, mz): floor(azimuth, elevation, range / their bins), saturated to int16
+ * (lidet_proposal.c; the group split's parts take theirs the same way) */
+void lidet__proposal_voxel(float mx, float my, float mz, const lidet_proposal_cfg_t *cfg, int16_t voxel[3]);
+
 #endif

@@ -52,4 +52,9 @@ int lidet__refine_q_split(lidet_cluster_q_state_t *c, const lidet_plane_q_t *pla
 int lidet__refine_q_join(lidet_cluster_q_state_t *c, const lidet_plane_q_t *planes, uint32_t n_sectors,
                          lidet_cluster_stats_t *st);
 
+/* a proposal's PVLE voxel of the mean (mx, my, mz) in 4 mm steps, from integer atan2 and square roots
+ * (lidet_proposal_q.c; the group split's parts take theirs the same way) */
+void lidet__proposal_q_voxel(int32_t mx, int32_t my, int32_t mz, const lidet_proposal_q_cfg_t *cfg,
+                             int16_t voxel[3]);
+
 #endif

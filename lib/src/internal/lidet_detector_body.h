@@ -28,6 +28,11 @@
  *                         sets box, cls and cluster_id)
  *   DET_INSERT(det, n)    move det[n] into det[0..n), kept sorted by score
  *   DET_NOW(d)            the detector's clock (a uint32_t tick count)
+ *   DET_GROUP_T           the group split's state (internal/lidet_group.h, internal/lidet_group_q.h)
+ *   DET_GROUP_ON(d)       1 when the group split is on (cfg group_split)
+ *   DET_GROUP_SHAPE(d, ci, g)  1 when cluster ci is shaped like a group (fills *g)
+ *   DET_GROUP_CUT(d, ci, g, k)  cut it into k parts; 1 when every part is large enough
+ *   DET_GROUP_PROPOSAL(d, ci, g, j)  make part j's proposal; a lidet_status_t
  * Defines: static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *worst,
  * uint32_t *box_ticks). An error status (cannot happen after a successful init and run) ends the loop and is
  * returned; otherwise LIDET_OK, with *worst set to LIDET_TRUNCATED when the box budget or the detection capacity
@@ -41,6 +46,109 @@
  * candidate (tens per scan, each costing a PointNet pass), so speed does not decide here: the template keeps
  * the shared decisions in one place with each build's types checked by the compiler.
  * Not a public header; include nowhere else. */
+
+/* a detection t filled at det[n_det]: insert it by score; past LIDET_MAX_DETECTIONS the lowest goes */
+static void det_insert(DET_T *d, lidet_status_t *worst)
+{
+    DET_INSERT(d->det, d->n_det);
+    ++d->n_det;
+    if (d->n_det > LIDET_MAX_DETECTIONS)
+    {
+        --d->n_det; /* the lowest score goes */
+        if (d->outcome[d->det[d->n_det].cluster_id - 1u] == LIDET_DET_OUT_DETECTED)
+        {
+            d->outcome[d->det[d->n_det].cluster_id - 1u] = LIDET_DET_OUT_CAPACITY;
+        }
+        ++d->stats.n_over_capacity;
+        *worst = LIDET_TRUNCATED;
+    }
+}
+
+/* The group split of cluster ci (classified, no detection): the cuts from k_max down; the first whose every part
+ * the classifier calls a pedestrian passing gate 1 is kept, each part then boxed, judged and sized as a cluster
+ * is, its detections carrying the cluster's id (outcome LIDET_DET_OUT_GROUP when one is kept, n_group_split).
+ * The parts' passes count in n_group_classified and n_group_boxed, not in the per-cluster counts, and the box
+ * budget holds for them (n_boxed + n_group_boxed <= max_boxes); a part past it ends the split. */
+#if defined(__GNUC__)
+__attribute__((noinline)) /* its parts' outputs stay out of the candidate loop's frame (no 16-beam default
+                             calls it) */
+#endif
+static lidet_status_t
+det_group(DET_T *d, uint32_t ci, lidet_status_t *worst, uint32_t *box_ticks)
+{
+    DET_GROUP_T g;
+    DET_CLS_OUT_T co[LIDET_GROUP_MAX_PARTS];
+    uint32_t k, j;
+    lidet_status_t s;
+    if (!DET_GROUP_SHAPE(d, ci, &g))
+    {
+        return LIDET_OK;
+    }
+    for (k = g.k_max; k >= g.k_min; --k)
+    {
+        int ok = DET_GROUP_CUT(d, ci, &g, k);
+        for (j = 0; j < k && ok; ++j)
+        {
+            s = DET_GROUP_PROPOSAL(d, ci, &g, j);
+            if (s == LIDET_OK)
+            {
+                s = DET_CLASSIFY(d, &co[j]);
+            }
+            if (s != LIDET_OK)
+            {
+                return s;
+            }
+            ++d->stats.n_group_classified;
+            ok = co[j].cls == LIDET_CLASS_PEDESTRIAN && DET_GATE1_PASS(d, &co[j]);
+        }
+        if (!ok)
+        {
+            continue;
+        }
+        for (j = 0; j < k; ++j)
+        {
+            DET_BOX_OUT_T bo;
+            DET_DETECTION_T *t;
+            uint32_t tb;
+            if (d->stats.n_boxed + d->stats.n_group_boxed >= d->cfg.max_boxes)
+            {
+                *worst = LIDET_TRUNCATED;
+                break;
+            }
+            s = DET_GROUP_PROPOSAL(d, ci, &g, j); /* the proposal buffer holds the last part classified */
+            if (s != LIDET_OK)
+            {
+                return s;
+            }
+            tb = DET_NOW(d);
+            s = DET_BOX(d, co[j].cls, &bo);
+            *box_ticks += DET_NOW(d) - tb;
+            if (s != LIDET_OK)
+            {
+                return s;
+            }
+            ++d->stats.n_group_boxed;
+            if ((d->cfg.gate2 && d->cfg.gate2_class[co[j].cls] && !DET_GATE2_PASS(d, co[j].cls, &bo)) ||
+                !DET_SIZE_OK(d, co[j].cls, &bo.box))
+            {
+                continue;
+            }
+            t = &d->det[d->n_det];
+            t->box = bo.box;
+            t->cls = co[j].cls;
+            t->cluster_id = ci + 1u;
+            DET_FILL(d, t, ci, &co[j], &bo);
+            if (d->outcome[ci] != LIDET_DET_OUT_GROUP)
+            {
+                d->outcome[ci] = LIDET_DET_OUT_GROUP;
+                ++d->stats.n_group_split;
+            }
+            det_insert(d, worst);
+        }
+        break;
+    }
+    return LIDET_OK;
+}
 
 static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *worst, uint32_t *box_ticks)
 {
@@ -67,9 +175,9 @@ static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *
         {
             d->outcome[ci] = LIDET_DET_OUT_GATE1;
             ++d->stats.n_gate1_rejected;
-            continue;
+            goto no_detection;
         }
-        if (d->stats.n_boxed == d->cfg.max_boxes)
+        if (d->stats.n_boxed + d->stats.n_group_boxed >= d->cfg.max_boxes)
         {
             d->outcome[ci] = LIDET_DET_OUT_BUDGET;
             ++d->stats.n_over_box_budget;
@@ -88,28 +196,31 @@ static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *
         {
             d->outcome[ci] = LIDET_DET_OUT_GATE2;
             ++d->stats.n_gate2_rejected;
-            continue;
+            goto no_detection;
         }
         if (!DET_SIZE_OK(d, co.cls, &bo.box))
         {
             d->outcome[ci] = LIDET_DET_OUT_SIZE;
             ++d->stats.n_size_rejected;
-            continue;
+            goto no_detection;
         }
         t = &d->det[d->n_det];
         t->box = bo.box;
         t->cls = co.cls;
         t->cluster_id = ci + 1u;
         DET_FILL(d, t, ci, &co, &bo);
-        DET_INSERT(d->det, d->n_det);
-        ++d->n_det;
         d->outcome[ci] = LIDET_DET_OUT_DETECTED;
-        if (d->n_det > LIDET_MAX_DETECTIONS)
+        det_insert(d, worst);
+        continue;
+    no_detection:
+        /* a classified cluster that gave no detection: people side by side in one cluster? */
+        if (DET_GROUP_ON(d))
         {
-            --d->n_det; /* the lowest score goes */
-            d->outcome[d->det[d->n_det].cluster_id - 1u] = LIDET_DET_OUT_CAPACITY;
-            ++d->stats.n_over_capacity;
-            *worst = LIDET_TRUNCATED;
+            s = det_group(d, ci, worst, box_ticks);
+            if (s != LIDET_OK)
+            {
+                return s;
+            }
         }
     }
     return LIDET_OK;

@@ -38,11 +38,12 @@ def _detector_lib(L):
 
 #: lidet_det_outcome_t values
 OUTCOME = {1: "crop", 2: "range", 3: "budget", 4: "gate1", 5: "gate2", 6: "size", 7: "nms", 8: "capacity",
-           9: "detected", 10: "tall"}
+           9: "detected", 10: "tall", 11: "group"}
 CLASSES = ("Car", "Cyclist", "Pedestrian")
 _DET_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity",
-              "n_detections", "status", "n_over_box_budget", "n_too_tall"]
+              "n_detections", "status", "n_over_box_budget", "n_too_tall", "n_group_split", "n_group_classified",
+              "n_group_boxed"]
 
 
 @dataclass
@@ -81,7 +82,7 @@ def default_family(sensor: str | Sensor) -> str:
 def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, crop_half_rad: float = 0.0,
            max_range_m: float = 0.0, nms_iou: float = 0.1, max_proposals: int | None = None, gate1: bool = True,
            gate2: bool = True, refine: bool = True, gate1_margin: float = 0.0, gate2_margin: float = 0.0,
-           mount_height_m: float | None = None, gate2_class=None) -> Detections:
+           mount_height_m: float | None = None, gate2_class=None, group_split: bool | None = None) -> Detections:
     """lidet_detector_run on (N, >=3) points with the models cls_<model> / box_<model> compiled into the bindings
     (default: `default_family(sensor)`). sensor: a preset name (the C preset, lidet_sensor_find, as `lidet detect
     --sensor`) or a `Sensor` (its table in ring order, e.g. `sensors.load_sensor_file`, `load_ouster_metadata`, as
@@ -91,7 +92,9 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
     the gates' operating points (lidet_detector_cfg_t, nats added to the models' gammas). mount_height_m: the
     sensor's height above the ground in m, [0, 10] (None: the profile's; `lidet detect --mount-height`).
     gate2_class: 3 flags (Car, Cyclist, Pedestrian), the classes gate 2 judges (None: the C default,
-    lidet_detector_cfg_t.gate2_class)."""
+    lidet_detector_cfg_t.gate2_class). group_split: people side by side split by the classifier's judgement
+    (lidet_detector_cfg_t.group_split; None: the C default for the sensor, on for > 16 beams); a group's parts give
+    detections with the cluster's id, and the cluster the outcome "group"."""
     if max_proposals is not None and not (isinstance(max_proposals, (int, np.integer)) and max_proposals >= 1):
         raise ValueError(f"max_proposals must be a positive integer, got {max_proposals!r}")
     if not isinstance(sensor, (str, Sensor)):
@@ -116,7 +119,8 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
     fc = np.array([crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin,
                    -1.0 if mount_height_m is None else mount_height_m], np.float32)
     uc = np.array([max_proposals or 0, int(bool(gate1)), int(bool(gate2)), int(bool(refine)),
-                   0xFFFFFFFF if gate2_class is None else _class_bits(gate2_class)], np.uint32)
+                   0xFFFFFFFF if gate2_class is None else _class_bits(gate2_class),
+                   0xFFFFFFFF if group_split is None else int(bool(group_split))], np.uint32)
     args = (ms[f"cls_{fam}"].index, ms[f"box_{fam}"].index, fc, uc, pts if n else np.zeros((1, 4), np.float32), n,
             stride, det, nd, oc, nc, pc, pg, st)
     if isinstance(sensor, str):
@@ -139,18 +143,19 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
 
 DETQ_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity", "n_detections",
-              "n_over_box_budget", "n_too_tall"]
+              "n_over_box_budget", "n_too_tall", "n_group_split", "n_group_classified", "n_group_boxed"]
 
 
 def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_half_bam: int = 0,
              max_range_mm: int = 0, nms_iou_q15: int = 3277, max_proposals: int = 0, gate1: bool = True,
              gate2: bool = True, max_boxes: int = 0, gate1_margin_q16: int = 0, gate2_margin_q16: int = 0,
-             range_only: bool | None = None, returns=None, gate2_class=None) -> dict:
+             range_only: bool | None = None, returns=None, gate2_class=None, group_split: bool | None = None) -> dict:
     """lidet_detector_q_run on (N, 3) int32 mm points with the int8 models cls_<model>_s8 / box_<model>_s8
     (returns: a RETURN_DTYPE array instead, lidet_detector_q_run_returns; points_mm is then ignored).
     gate*_margin_q16: the gates' operating points (lidet_detector_q_cfg_t, Q16 nats). range_only: the range-only
     pixel (lidet_detector_q_cfg_t.range_only; None = the build's default). gate2_class: 3 flags (Car, Cyclist,
-    Pedestrian), the classes gate 2 judges (None: the C default).
+    Pedestrian), the classes gate 2 judges (None: the C default). group_split: the float detector's (None: the C
+    default for the sensor).
 
     Returns {'cls', 'score_q15', 'energy_cls_q16', 'energy_box_q16', 'boxes' (N, 7: cx cy cz l w h mm, yaw BAM32),
     'cluster_id', 'n_points', 'outcome', 'stats', 'status'}."""
@@ -170,7 +175,8 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     st = np.zeros(len(DETQ_STATS), np.uint32)
     icfg = np.array([crop_half_bam, max_range_mm, nms_iou_q15, max_proposals, int(bool(gate1)), int(bool(gate2)),
                      max_boxes, gate1_margin_q16, gate2_margin_q16, -1 if range_only is None else int(bool(range_only)),
-                     -1 if gate2_class is None else _class_bits(gate2_class)], np.int32)
+                     -1 if gate2_class is None else _class_bits(gate2_class),
+                     -1 if group_split is None else int(bool(group_split))], np.int32)
     n = len(pts)
     rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
                              pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st,

@@ -1,7 +1,8 @@
 # SPDX-License-Identifier: MIT
-"""People walking side by side, split by the classifier's judgement: a measurement of what a group split stage
-would recover on the real frames, before it is built into the detector (docs/journal/real-streets.md, "People in
-groups").
+"""People walking side by side, split by the classifier's judgement: the prototype of the detectors' group split
+(lidet_detector_cfg_t.group_split, docs/DETECTOR.md "People in groups"; docs/journal/real-streets.md has both
+measurements). It runs on the detector's output, so with the split on (the default for > 16 beams) it measures what
+a split with this rule (percentiles and a two-dimensional k-means) would add to the built one.
 
     python -m lidet_tools.real.group_split [--root ../shared/data/real] [--side train] [--person-m 0.7]
 
