@@ -147,7 +147,7 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
             return
         for k in range(g.k_max, g.k_min - 1, -1):
             ok = group_q.cut(rec, members, Xf, Yf, Zf, g, k)
-            parts = []
+            parts, n_ped = [], 0
             for j in range(k):
                 if not ok:
                     break
@@ -155,11 +155,13 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
                 c = pointnet_q.classify(cls_model, xyz[None].astype(np.int64), mean[None], vox[None])
                 stats["n_group_classified"] += 1
                 cls, energy = int(c["cls"][0]), int(c["energy"][0])
-                ok = cls == 2 and gate1_pass(cls, energy)  # lidet_class_t: 2 = pedestrian
-                parts.append((xyz, mean, vox, n_src, cls, energy))
-            if not ok:
+                ok = cls in (1, 2) and gate1_pass(cls, energy)  # lidet_class_t: 1 cyclist, 2 pedestrian
+                n_ped += cls == 2
+                parts.append((xyz, mean, vox, n_src, energy))
+            if not ok or n_ped == 0:
                 continue
-            for xyz, mean, vox, n_src, cls, energy in parts:
+            cls = 2  # every part is boxed and scored as a pedestrian
+            for xyz, mean, vox, n_src, energy in parts:
                 if stats["n_boxed"] + stats["n_group_boxed"] >= det_cfg["max_boxes"]:
                     truncated = True
                     break

@@ -1,6 +1,7 @@
 # SPDX-License-Identifier: MIT
 """The group split (lidet_detector_cfg_t.group_split, on for > 16 beams): people standing side by side in one
-cluster, cut along the cluster's principal axis and kept when the classifier calls every part a pedestrian. The
+cluster, cut along the cluster's principal axis and kept when the classifier calls every part a pedestrian or a
+cyclist (one at least a pedestrian); every part is boxed as a pedestrian. The
 float detector through the bindings and the CLI on a simulated crowd scan where two labelled people share a
 cluster, and on a real PandaSet frame when ../shared is there. The integer detector's split is checked bit for
 bit against the numpy reference (codegen/lidet_ref/group_q.py) in test_detector_q.py (cases group, group_real)."""

@@ -84,11 +84,11 @@ typedef struct
     uint8_t group_split; /**< 1: a classified cluster that gave no detection and is shaped like people side by
                               side (z spread 1.0-2.2 m, 0.9-3.5 m along its principal horizontal axis, >= 20
                               points) is cut along that axis into 2-4 parts (one-dimensional k-means); the cut
-                              stands when the classifier calls every part a pedestrian passing gate 1, and each
-                              part is then boxed as a cluster is (its detections carry the cluster's id; outcome
-                              LIDET_DET_OUT_GROUP). Up to 9 more classifier passes per such cluster. Default 1 for
-                              > 16 beams, 0 for <= 16 (measured on the real frames: docs/DETECTOR.md, "People in
-                              groups") */
+                              stands when the classifier calls every part a pedestrian or a cyclist passing gate 1
+                              (one at least a pedestrian), and each part is then boxed as a pedestrian; its
+                              detections carry the cluster's id (outcome LIDET_DET_OUT_GROUP). Up to 9 more
+                              classifier passes per such cluster. Default 1 for > 16 beams, 0 for <= 16 (measured
+                              on the real frames: docs/DETECTOR.md, "People in groups") */
     float group_max_range_m; /**< the group split examines clusters whose mean lies within this (horizontal);
                                   [0, 1000], default 40 */
     float score_box_weight

@@ -86,7 +86,7 @@ det_group(DET_T *d, uint32_t ci, lidet_status_t *worst, uint32_t *box_ticks)
     }
     for (k = g.k_max; k >= g.k_min; --k)
     {
-        int ok = DET_GROUP_CUT(d, ci, &g, k);
+        int ok = DET_GROUP_CUT(d, ci, &g, k), n_ped = 0;
         for (j = 0; j < k && ok; ++j)
         {
             s = DET_GROUP_PROPOSAL(d, ci, &g, j);
@@ -99,9 +99,12 @@ det_group(DET_T *d, uint32_t ci, lidet_status_t *worst, uint32_t *box_ticks)
                 return s;
             }
             ++d->stats.n_group_classified;
-            ok = co[j].cls == LIDET_CLASS_PEDESTRIAN && DET_GATE1_PASS(d, &co[j]);
+            /* a person on foot, or one the classifier takes for a rider: each part passing gate 1 as its class */
+            ok = (co[j].cls == LIDET_CLASS_PEDESTRIAN || co[j].cls == LIDET_CLASS_CYCLIST) &&
+                 DET_GATE1_PASS(d, &co[j]);
+            n_ped += co[j].cls == LIDET_CLASS_PEDESTRIAN;
         }
-        if (!ok)
+        if (!ok || n_ped == 0)
         {
             continue;
         }
@@ -121,6 +124,8 @@ det_group(DET_T *d, uint32_t ci, lidet_status_t *worst, uint32_t *box_ticks)
                 return s;
             }
             tb = DET_NOW(d);
+            co[j].cls =
+                LIDET_CLASS_PEDESTRIAN; /* every part of a group is boxed and scored as a person on foot */
             s = DET_BOX(d, co[j].cls, &bo);
             *box_ticks += DET_NOW(d) - tb;
             if (s != LIDET_OK)

@@ -2,7 +2,8 @@
 /* The group split (lidet_detector_cfg_t group_split, lidet_detector_q_cfg_t group_split): a classified cluster
  * that gave no detection and is shaped like people standing side by side is cut along its principal horizontal
  * axis into k = 2..4 parts by a one-dimensional k-means; the detector keeps the cut when the classifier calls
- * every part a pedestrian that passes gate 1 (docs/DETECTOR.md, "People in groups").
+ * every part a pedestrian or a cyclist passing gate 1 as that class, one at least a pedestrian, and boxes every part
+ * as a pedestrian (docs/DETECTOR.md, "People in groups").
  *
  * The rule, the same in both builds (the float one in metres, lidet_group.c; the integer one in 4 mm steps,
  * lidet_group_q.c, mirrored bit for bit by codegen/lidet_ref/group_q.py):
