@@ -232,6 +232,9 @@ set(fw_images
     # Ouster OS1-32 payloads (a simulated scan, RNG19_RFL8_SIG16_NIR16) decoded (lidet_ouster_packet) and streamed
     # into the integer detector, beams32 pair, compared bit for bit with fw_host_ref_pkt_ouster
     "mps2-an386-q-packets-os1-32|mps2-an386|os1-32|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed|packets|ouster"
+    # ... and on the cores without the DSP extension
+    "mps2-an385-m0plus-q-packets-os1-32|mps2-an385-m0plus|os1-32|arm-none-eabi|arm-none-eabi-gcc|arm-none-eabi-size|fixed|packets|ouster"
+    "virt-rv32imac-q-packets-os1-32|virt-rv32imac|os1-32|riscv32-unknown-elf|riscv64-unknown-elf-gcc|riscv64-unknown-elf-size|fixed|packets|ouster"
     # 64-bit Arm bare metal (QEMU virt, Cortex-A72; ports/aarch64): the float image with the NEON dense kernel, the
     # integer image compared bit for bit
     "virt-aarch64|virt-aarch64|vlp16|aarch64-bare-metal|aarch64-linux-gnu-gcc|aarch64-linux-gnu-size"

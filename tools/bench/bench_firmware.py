@@ -53,6 +53,8 @@ DECODE_GOAL = 1_000_000  # issue 37: decoding adds at most 1 M instructions to a
 # RNG19_RFL8_SIG16_NIR16 payloads decoded with lidet_ouster_packet and streamed into the integer detector (beams32)
 OUSTER_PACKET_BOARDS = [
     ("mps2-an386-q-packets-os1-32", "Cortex-M4, integer build, **Ouster OS1-32** (beams32; DSP)", 200e6),
+    ("mps2-an385-m0plus-q-packets-os1-32", "Cortex-M0+ code, integer build, Ouster OS1-32 (beams32)", 200e6),
+    ("virt-rv32imac-q-packets-os1-32", "RV32IMAC, integer build, Ouster OS1-32 (beams32)", 200e6),
 ]
 OUSTER_FRAMES_PER_S = 10  # lidar mode 1024x10
 VLP16_PAYLOADS_PER_TURN = 75  # 900 blocks of 0.4 deg (600 rpm), 12 a payload
