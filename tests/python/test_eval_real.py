@@ -146,6 +146,27 @@ def test_eval_real_on_a_simulated_folder(tmp_path):
     assert sum(q["classes"][c]["40"]["found"] for c in eval_real.CLASSES) >= 0.6 * sum(want.values())
 
 
+def test_eval_real_round_mm(tmp_path, monkeypatch):
+    """--round-mm: the detector sees each scan in whole millimetres (the integer detector's input)."""
+    root, split = _sim_root(tmp_path)
+    seen = []
+    real_eval = eval_real.evaluate_frame
+
+    def spy(fr, *a, **k):
+        seen.append(fr.points[:, :3].astype(np.float64))
+        return real_eval(fr, *a, **k)
+    monkeypatch.setattr(eval_real, "evaluate_frame", spy)
+    out = tmp_path / "mm"
+    assert eval_real.main(["--root", str(root), "--split", str(split), "--out", str(out), "--no-pictures",
+                           "--round-mm"]) == 0
+    assert len(seen) == 2
+    for p in seen:
+        mm = p * 1000.0
+        assert np.abs(mm - np.round(mm)).max() < 0.01  # float32 holds the millimetres to within its precision
+    rep = json.loads((out / "report.json").read_text())
+    assert "--round-mm" in rep["meta"]["command"] and "millimetres" in rep["meta"]["detector"]
+
+
 def test_eval_real_missing_root(tmp_path, capsys):
     assert eval_real.main(["--root", str(tmp_path / "nope"), "--out", str(tmp_path / "o")]) == 2
     assert "not found" in capsys.readouterr().err

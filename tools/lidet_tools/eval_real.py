@@ -460,6 +460,10 @@ def main(argv=None) -> int:
     ap.add_argument("--as-sensor", metavar="NAME",
                     help="thin the 64-beam frames (hdl64, pandar64) to the beams of this preset (vlp16, vlp32c: "
                          "lidet_tools.real.thin) and run its detector on them; frames of other sensors are left out")
+    ap.add_argument("--round-mm", action="store_true",
+                    help="feed the detector each scan rounded to whole millimetres, the input the integer detector "
+                         "takes (`--fixed` rounds it so anyway): a float run on it tells the integer arithmetic's "
+                         "effect apart from the input's rounding")
     ap.add_argument("--no-pictures", action="store_true")
     ap.add_argument("--json", action="store_true", help="print report.json instead of the tables")
     a = ap.parse_args(argv)
@@ -496,6 +500,10 @@ def main(argv=None) -> int:
                 continue
             fr = dataclasses.replace(fr, points=thin.thin(fr.points, fr.sensor, a.as_sensor), sensor=a.as_sensor,
                                      point_instance=None, point_semantic=None)
+        if a.round_mm:
+            pts = fr.points.copy()
+            pts[:, :3] = (np.round(pts[:, :3].astype(np.float64) * 1000.0) / 1000.0).astype(pts.dtype)
+            fr = dataclasses.replace(fr, points=pts)
         calib, label2, dc = None, [], None
         if src == "kitti":
             base = root / "kitti" / "training"
@@ -514,9 +522,10 @@ def main(argv=None) -> int:
     cmd = "python -m lidet_tools.eval_real" + (f" --side {a.side}" if a.side != "val" else "") + \
         (" --fixed" if a.fixed else "") + (f" --sources {a.sources}" if a.sources else "") + \
         (f" --as-sensor {a.as_sensor}" if a.as_sensor else "") + (f" --model {a.model}" if a.model else "") + \
-        "".join(f" --set {kv}" for kv in a.set)
+        (" --round-mm" if a.round_mm else "") + "".join(f" --set {kv}" for kv in a.set)
     meta = {"side": a.side, "detector": ("integer (int8)" if a.fixed else "float") +
             (f", HDL-64 frames thinned to {a.as_sensor}" if a.as_sensor else "") + (f", models {a.model}" if a.model else "") +
+            (", scans rounded to millimetres" if a.round_mm else "") +
             "".join(f", {kv}" for kv in a.set), "command": cmd, "min_points": a.min_points}
     text = format_report(summary, meta)
     (out / "report.md").write_text(text)
