@@ -129,7 +129,8 @@ void cli_pcap_usage(FILE *f, int detect)
                "                   partial rotations (the capture's first and last) skipped; a summary\n"
                "                   on stderr (frames, decoder rejects, scans, time)\n"
                "  --lidar NAME     the sensor family: velodyne (default; VLP-16, VLP-32C, HDL-32E,\n"
-               "                   HDL-64E S2/S3 single return; the model from the packets or --sensor)\n"
+               "                   HDL-64E S2/S3 single or dual return; the model from the packets or\n"
+               "                   --sensor)\n"
                "                   or ouster (OS0/OS1/OS2, every packet profile; needs --ouster-meta M:\n"
                "                   its packet format and beams)\n"
                "  --port N         the sensor's data port (default: velodyne 2368, ouster the\n"
@@ -637,8 +638,9 @@ static int vel_xyz(const cli_capture_t *c, const lidet_return_t *r, uint32_t n, 
 static void vel_report(const cli_capture_t *c, FILE *f)
 {
     const lidet_velodyne_stats_t *s = &c->vstats;
-    /* the HDL-64E's payload has no return-mode byte: the decoder takes its single-return layout only */
-    const char *mode = c->model == LIDET_VELODYNE_HDL64E && s->n_decoded > 0u ? "single return"
+    /* the HDL-64E's payload has no return-mode byte: the decoder reports 0x39 for its dual-return layout */
+    const char *mode = c->model == LIDET_VELODYNE_HDL64E && s->n_decoded > 0u && c->return_mode != 0x39u
+                           ? "single return"
                        : c->return_mode == 0x37u                            ? "strongest return"
                        : c->return_mode == 0x38u                            ? "last return"
                        : c->return_mode == 0x39u                            ? "dual return"

@@ -6,10 +6,12 @@
  * (per laser: elevation i16 x 3 mdeg, rotational correction i16 (0.01 deg), distance correction i16 (mm); out of
  * range values included), then packets of [u16 length (mod 1400)][u8 room][length bytes]. With repair, a 1206-byte
  * payload gets valid flags, azimuths, factory bytes and dual pairs (HDL-64E: alternating banks, a firing's blocks
- * at one azimuth, one in eight a dual layout), so the decoding paths are reached. Checks: init refuses exactly the
- * invalid configurations, nothing past the room, scan_end <= n_returns, rings (the model's lasers), ranges and
- * azimuths in range, counts that add up; and a second decoder, fed the same payloads without the attribute array
- * (which takes the per-block fast path of single-return VLP-16 blocks), gives the same returns, results and counts. */
+ * at one azimuth, one in eight the dual-return layout of four blocks a firing), so the decoding paths are
+ * reached. Checks: init refuses exactly the invalid configurations, nothing past the room, scan_end <=
+ * n_returns, rings (the model's lasers), ranges and azimuths in range, counts that add up, an HDL-64E payload's
+ * mode (0x39 exactly for the dual layout), a dual payload's one return a laser per firing but with BOTH; and a
+ * second decoder, fed the same payloads without the attribute array (which takes the per-block fast path of
+ * single-return VLP-16 blocks), gives the same returns, results and counts. */
 #include "fuzz_common.h"
 
 static lidet_velodyne_t g_dec, g_dec2;
@@ -43,7 +45,7 @@ static void repair(uint8_t *p, uint32_t sel)
 }
 
 /* the HDL-64E layout: upper and lower banks alternating, a firing's blocks at the first one's azimuth (two blocks,
- * or four for the dual layout the decoder refuses) */
+ * or four for the dual-return layout) */
 static void repair_hdl64e(uint8_t *p, uint32_t sel)
 {
     const uint32_t per_firing = sel % 8u == 0u ? 4u : 2u;
@@ -152,7 +154,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         n_rings = lidet_velodyne_decoder_n_rings(&g_dec);
         FZ_CHECK(n_rings == lidet_velodyne_n_rings((lidet_velodyne_model_t)g_dec.model));
         FZ_CHECK(g_dec.model != LIDET_VELODYNE_HDL64E ||
-                 (res.model == LIDET_VELODYNE_HDL64E && res.return_mode == 0u));
+                 (res.model == LIDET_VELODYNE_HDL64E &&
+                  res.return_mode == (g_pkt[2] == g_pkt[202] && g_pkt[3] == g_pkt[203] ? 0x39u : 0u)));
+        /* one return a laser and firing (a dual payload: 6 x 32 points, HDL-64E 3 x 64) but with BOTH */
+        FZ_CHECK(res.return_mode != 0x39u || cfg.filter == LIDET_VELODYNE_RETURN_BOTH ||
+                 res.n_returns <= LIDET_VELODYNE_MAX_RETURNS / 2u);
         for (i = 0; i < res.n_returns; ++i)
         {
             int32_t e;

@@ -406,7 +406,7 @@ def test_hdl64e_feeds_the_hdl64_preset(vdec):
 
 
 def test_hdl64e_bad_payloads_counted(vdec):
-    """Wrong flags, sizes, a firing's blocks at two azimuths, the dual layout (refused: unsupported), a VLP-16 payload
+    """Wrong flags, sizes, a firing's blocks at two azimuths (two blocks; the dual layout's four), a VLP-16 payload
     among HDL-64E ones: each counted by reason, the rotation decoded on around them."""
     vd = vdec
     pts, ring = _sim64()
@@ -422,8 +422,9 @@ def test_hdl64e_bad_payloads_counted(vdec):
     bad.append(("azimuth", bytes(b)))
     b = bytearray(pay[6])
     for k in range(12):
-        b[100 * k + 2:100 * k + 4] = b[100 * (k // 4 * 4) + 2:100 * (k // 4 * 4) + 4]  # four blocks a firing
-    bad.append(("unsupported", bytes(b)))
+        b[100 * k + 2:100 * k + 4] = b[100 * (k // 4 * 4) + 2:100 * (k // 4 * 4) + 4]  # four blocks a firing (dual)
+    b[702:704] = struct.pack("<H", (struct.unpack("<H", b[702:704])[0] + 1) % 36000)  # firing 1's last pair: lower
+    bad.append(("azimuth", bytes(b)))
     bad.append(("product", vd.vlp16_payload([40 * k for k in range(12)], np.full((12, 32), 500), 0)))
     stream = []
     for i, p in enumerate(pay):
@@ -432,8 +433,9 @@ def test_hdl64e_bad_payloads_counted(vdec):
             stream.append(bad[i - 3][1])
     d = vd.decode(stream)
     st = d.stats
-    for why, _ in bad:
-        assert st[f"n_rejected_{why}"] == 1, (why, st)
+    for why in {w for w, _ in bad}:
+        assert st[f"n_rejected_{why}"] == sum(w == why for w, _ in bad), (why, st)
+    assert st["n_rejected_unsupported"] == 0
     assert st["n_decoded"] == len(pay) and st["n_jumps"] == 0 and st["n_scans"] + st["n_partial"] == 1
 
 

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* Unity tests of the Velodyne packet decoder (lib/src/decode/lidet_velodyne.c) on payloads built here: every
  * rejection reason, the firing-time interpolation, the seam, dual-return filters, truncation, jumps; the HDL-64E's
- * two banks, its ring order against the hdl64 preset, its refused dual layout; calibrations (rings by their
- * elevations, rotational and distance corrections) on every model. */
+ * two banks, its ring order against the hdl64 preset, its dual-return layout with every filter; calibrations
+ * (rings by their elevations, rotational and distance corrections) on every model. */
 #include <math.h>
 #include <string.h>
 
@@ -739,14 +739,13 @@ static void test_hdl64e_auto_and_rejections(void)
     put16(pkt + 100u * 4u + 2u, 36000u);
     put16(pkt + 100u * 5u + 2u, 36000u);
     expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_AZIMUTH);
-    make64(1108u, 0u, 500u); /* dual return (or a head standing still): four blocks a firing at one azimuth */
-    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_UNSUPPORTED);
     make64(1108u, 18u, 500u);
-    for (b = 0; b < 12u; ++b) /* a real dual layout: firings of four blocks */
+    /* a dual layout (firings of four blocks) whose second firing's last pair is elsewhere */
+    for (b = 0; b < 12u; ++b)
     {
-        put16(pkt + 100u * b + 2u, 1108u + (b / 4u) * 21u);
+        put16(pkt + 100u * b + 2u, 1108u + (b / 4u) * 21u + (b == 6u || b == 7u));
     }
-    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_UNSUPPORTED);
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_AZIMUTH);
     make(0x22u, 0x37u, 1108u, 40u, 500u); /* a VLP-16 payload to an HDL-64E decoder */
     expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_PRODUCT);
     pkt[1205] = 0x99u; /* no known product: its flags are not the HDL-64E's */
@@ -810,6 +809,298 @@ static void test_hdl64e_seam_and_jumps(void)
 /* ---- calibrations --------------------------------------------------------------------------------------------- */
 
 static lidet_velodyne_calib_t cal;
+
+/* ---- HDL-64E dual return ------------------------------------------------------------------------------------- */
+
+/* An HDL-64E dual-return payload: firing f at (az0 + f * step) mod 36000 in blocks 4f (upper bank) and 4f + 1
+ * (lower), the strongest return, and 4f + 2 (upper), 4f + 3 (lower), the last return; by default one return a
+ * laser (both pairs alike, as the sensor repeats a lone return): data point j of bank k at distance
+ * dist + j + 32 k (2 mm), intensity j + 2 f + k; timestamp 1000 us; status 'H', 7. */
+static void make64d(uint32_t az0, uint32_t step, uint32_t dist)
+{
+    uint32_t b, j;
+    memset(pkt, 0, sizeof pkt);
+    for (b = 0; b < 12u; ++b)
+    {
+        uint8_t *blk = pkt + 100u * b;
+        blk[0] = 0xFFu;
+        blk[1] = (b & 1u) ? 0xDDu : 0xEEu;
+        put16(blk + 2, (az0 + (b / 4u) * step) % 36000u);
+        for (j = 0; j < 32u; ++j)
+        {
+            put16(blk + 4u + 3u * j, dist + j + 32u * (b & 1u));
+            blk[4u + 3u * j + 2u] = (uint8_t)(j + 2u * (b / 4u) + (b & 1u));
+        }
+    }
+    pkt[1200] = 0xE8u;
+    pkt[1201] = 0x03u;
+    pkt[1204] = 0x48u;
+    pkt[1205] = 7u;
+}
+
+/* firing f, bank k (0 upper, 1 lower), laser j: the strongest pair's return (d_s, i_s), the last's (d_l, i_l) */
+static void set64d(uint32_t f, uint32_t k, uint32_t j, uint32_t d_s, uint32_t i_s, uint32_t d_l, uint32_t i_l)
+{
+    set_point(4u * f + k, j, d_s, i_s);
+    set_point(4u * f + 2u + k, j, d_l, i_l);
+}
+
+static uint32_t rank64(uint32_t laser)
+{
+    uint32_t rank = 0;
+    while (k_hdl64e_ascending[rank] != laser)
+    {
+        ++rank;
+    }
+    return rank;
+}
+
+/* One return as the test expects it: index n of the output, its firing, laser, range (mm), intensity, flags;
+ * the ring, time (57.6 us firings: the 48 us table stretched, 72 ns units) and azimuth (the single-return rule)
+ * follow. */
+static void expect64d(uint32_t n, uint32_t az0, uint32_t f, uint32_t laser, uint32_t range_mm,
+                      uint32_t intensity, uint32_t flags)
+{
+    const uint32_t j = laser % 32u, off_units = hdl64e_off_ns(j) / 60u;
+    const uint16_t cdeg = rule_cdeg((az0 + 21u * f) % 36000u, 21u, off_units, 800u, 0);
+    TEST_ASSERT_TRUE(n < res.n_returns);
+    TEST_ASSERT_EQUAL_UINT32(range_mm, g_out.ws[n].range_mm);
+    TEST_ASSERT_EQUAL_UINT16(rank64(laser), g_out.ws[n].ring);
+    TEST_ASSERT_EQUAL_UINT32(f * 57600u + off_units * 72u, attr[n].t_ns);
+    TEST_ASSERT_EQUAL_UINT16(cdeg, attr[n].azimuth_cdeg);
+    TEST_ASSERT_INT_WITHIN(1, 0, bam_diff(bam_of_cdeg(cdeg), g_out.ws[n].azimuth));
+    TEST_ASSERT_EQUAL_UINT8(intensity, attr[n].intensity);
+    TEST_ASSERT_EQUAL_UINT8(flags, attr[n].flags);
+}
+
+/* the hand-built payload of test_hdl64e_dual_filters: firing 0 holds every case of a laser's two returns */
+static void make64d_cases(void)
+{
+    make64d(35990u, 21u, 1000u);              /* three firings 0.21 deg apart across the seam's azimuth */
+    set64d(0u, 0u, 1u, 400u, 50u, 600u, 10u); /* laser 1: the last weaker than the other */
+    set64d(0u, 0u, 2u, 300u, 20u, 700u,
+           60u);                           /* laser 2: the last the strongest; the other second strongest */
+    set64d(0u, 0u, 3u, 900u, 30u, 0u, 0u); /* laser 3: only the strongest pair */
+    set64d(0u, 0u, 4u, 0u, 0u, 0u, 0u);    /* laser 4: no return */
+    set64d(0u, 0u, 5u, 450u, 40u, 500u, 40u); /* laser 5: two returns of equal intensity */
+    set64d(0u, 1u, 0u, 200u, 90u, 800u, 5u);  /* laser 32: the last weaker */
+    set64d(0u, 1u, 7u, 0u, 0u, 333u, 70u);    /* laser 39: only the last pair */
+}
+
+/* the returns of lasers left alike (one return each) from output index n: firing f, bank, points [from, to) */
+static uint32_t expect64d_alike(uint32_t n, uint32_t f, uint32_t bank, uint32_t from, uint32_t to)
+{
+    uint32_t j;
+    for (j = from; j < to; ++j)
+    {
+        expect64d(n++, 35990u, f, 32u * bank + j, 2u * (1000u + j + 32u * bank), j + 2u * f + bank,
+                  LIDET_VELODYNE_FLAG_LAST | LIDET_VELODYNE_FLAG_STRONGEST);
+    }
+    return n;
+}
+
+static void test_hdl64e_dual_filters(void)
+{
+    const uint32_t L = LIDET_VELODYNE_FLAG_LAST, S = LIDET_VELODYNE_FLAG_STRONGEST;
+    uint32_t n, f;
+    /* both (default): per laser the last return, then the other where its distance differs */
+    cfg.model = LIDET_VELODYNE_HDL64E;
+    init();
+    make64d_cases();
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT8(LIDET_VELODYNE_HDL64E, res.model);
+    TEST_ASSERT_EQUAL_UINT8(0x39u, res.return_mode); /* the layout, reported as the dual-return mode */
+    TEST_ASSERT_EQUAL_UINT32(1000u, res.time_us);
+    TEST_ASSERT_EQUAL_UINT8(LIDET_VELODYNE_REJECT_NONE, res.reject);
+    n = 0;
+    expect64d(n++, 35990u, 0u, 0u, 2000u, 0u, L | S); /* laser 0: alike, once */
+    expect64d(n++, 35990u, 0u, 1u, 1200u, 10u, L);
+    expect64d(n++, 35990u, 0u, 1u, 800u, 50u, S);
+    expect64d(n++, 35990u, 0u, 2u, 1400u, 60u, L | S);
+    expect64d(n++, 35990u, 0u, 2u, 600u, 20u, 0u);
+    expect64d(n++, 35990u, 0u, 3u, 1800u, 30u, S);
+    expect64d(n++, 35990u, 0u, 5u, 1000u, 40u, L | S); /* tie: the last is the strongest */
+    expect64d(n++, 35990u, 0u, 5u, 900u, 40u, 0u);
+    n = expect64d_alike(n, 0u, 0u, 6u, 32u);
+    expect64d(n++, 35990u, 0u, 32u, 1600u, 5u, L);
+    expect64d(n++, 35990u, 0u, 32u, 400u, 90u, S);
+    n = expect64d_alike(n, 0u, 1u, 1u, 7u);
+    expect64d(n++, 35990u, 0u, 39u, 666u, 70u, L | S); /* laser 39: its one return, whatever the filter */
+    n = expect64d_alike(n, 0u, 1u, 8u, 32u);
+    for (f = 1; f < 3u; ++f) /* firings 1, 2: the upper bank, then the lower */
+    {
+        n = expect64d_alike(n, f, 0u, 0u, 32u);
+        n = expect64d_alike(n, f, 1u, 0u, 32u);
+    }
+    TEST_ASSERT_EQUAL_UINT32(n, res.n_returns);
+    TEST_ASSERT_EQUAL_UINT32(8u + 26u + 2u + 31u + 128u, res.n_returns);
+    TEST_ASSERT_EQUAL_UINT32(res.n_returns, g.ws.stats.n_returns);
+    /* the last return of a firing's last laser: 45.66 us of 48 into a 0.21 deg step (as in single return) */
+    TEST_ASSERT_EQUAL_UINT16((35990u + 2u * 21u + 20u) % 36000u, attr[res.n_returns - 1u].azimuth_cdeg);
+    /* last */
+    cfg.filter = LIDET_VELODYNE_RETURN_LAST;
+    init();
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    n = 0;
+    expect64d(n++, 35990u, 0u, 0u, 2000u, 0u, L | S);
+    expect64d(n++, 35990u, 0u, 1u, 1200u, 10u, L);
+    expect64d(n++, 35990u, 0u, 2u, 1400u, 60u, L | S);
+    expect64d(n++, 35990u, 0u, 5u, 1000u, 40u, L | S); /* laser 3 (no last return) and 4 (none) skipped */
+    n = expect64d_alike(n, 0u, 0u, 6u, 32u);
+    expect64d(n++, 35990u, 0u, 32u, 1600u, 5u, L);
+    n = expect64d_alike(n, 0u, 1u, 1u, 7u);
+    expect64d(n++, 35990u, 0u, 39u, 666u, 70u, L | S);
+    n = expect64d_alike(n, 0u, 1u, 8u, 32u);
+    for (f = 1; f < 3u; ++f)
+    {
+        n = expect64d_alike(n, f, 0u, 0u, 32u);
+        n = expect64d_alike(n, f, 1u, 0u, 32u);
+    }
+    TEST_ASSERT_EQUAL_UINT32(n, res.n_returns);
+    TEST_ASSERT_EQUAL_UINT32(4u + 26u + 1u + 31u + 128u, res.n_returns);
+    /* strongest: per laser the return of higher intensity (tie: the last) */
+    cfg.filter = LIDET_VELODYNE_RETURN_STRONGEST;
+    init();
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    n = 0;
+    expect64d(n++, 35990u, 0u, 0u, 2000u, 0u, L | S);
+    expect64d(n++, 35990u, 0u, 1u, 800u, 50u, S);
+    expect64d(n++, 35990u, 0u, 2u, 1400u, 60u, L | S);
+    expect64d(n++, 35990u, 0u, 3u, 1800u, 30u, S);
+    expect64d(n++, 35990u, 0u, 5u, 1000u, 40u, L | S);
+    n = expect64d_alike(n, 0u, 0u, 6u, 32u);
+    expect64d(n++, 35990u, 0u, 32u, 400u, 90u, S);
+    n = expect64d_alike(n, 0u, 1u, 1u, 7u);
+    expect64d(n++, 35990u, 0u, 39u, 666u, 70u, L | S);
+    n = expect64d_alike(n, 0u, 1u, 8u, 32u);
+    for (f = 1; f < 3u; ++f)
+    {
+        n = expect64d_alike(n, f, 0u, 0u, 32u);
+        n = expect64d_alike(n, f, 1u, 0u, 32u);
+    }
+    TEST_ASSERT_EQUAL_UINT32(n, res.n_returns);
+    TEST_ASSERT_EQUAL_UINT32(5u + 26u + 1u + 31u + 128u, res.n_returns);
+    /* AUTO takes it for an HDL-64E by its flags and decodes it alike; a single-return payload after it too */
+    lidet_velodyne_cfg_default(&cfg);
+    init();
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT8(LIDET_VELODYNE_HDL64E, res.model);
+    TEST_ASSERT_EQUAL_UINT32(8u + 26u + 2u + 31u + 128u, res.n_returns);
+    make64(63u, 18u, 1000u); /* 0.21 deg after the dual payload's last firing */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT8(0u, res.return_mode);
+    TEST_ASSERT_EQUAL_UINT32(384u, res.n_returns);
+    TEST_ASSERT_EQUAL_UINT32(0u, g.ws.stats.n_jumps);
+    /* a calibration applies to both pairs alike: laser 1's two returns keep their ring, move by its corrections */
+    memset(&cal, 0, sizeof cal);
+    cal.n_lasers = 64u;
+    for (f = 0; f < 64u; ++f)
+    {
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_velodyne_ring_elev_mdeg(LIDET_VELODYNE_HDL64E, rank64(f),
+                                                                      &cal.laser[f].vert_mdeg));
+    }
+    cal.laser[1].rot_cdeg = 150;
+    cal.laser[1].dist_mm = -700;
+    cfg.model = LIDET_VELODYNE_HDL64E;
+    cfg.calib = &cal;
+    init();
+    make64d_cases();
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    TEST_ASSERT_EQUAL_UINT32(500u, g_out.ws[1].range_mm);
+    TEST_ASSERT_EQUAL_UINT32(100u, g_out.ws[2].range_mm);
+    TEST_ASSERT_EQUAL_UINT16(rank64(1u), g_out.ws[2].ring);
+    TEST_ASSERT_EQUAL_UINT16(rule_cdeg(35990u, 21u, 21u, 800u, 150), attr[1].azimuth_cdeg);
+    TEST_ASSERT_EQUAL_UINT16(attr[1].azimuth_cdeg, attr[2].azimuth_cdeg);
+    cfg.calib = 0;
+}
+
+/* malformed dual payloads (truncated, oversized, a firing's four blocks at two azimuths, bad flags) are counted by
+ * reason and change nothing; a dual payload decoded into a small room is cut at the room and counted */
+static void test_hdl64e_dual_rejections(void)
+{
+    uint32_t i, b;
+    cfg.model = LIDET_VELODYNE_HDL64E;
+    init();
+    make64d(1000u, 21u, 500u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+    make64d(1063u, 21u, 500u);
+    expect_reject(pkt, 1205u, LIDET_VELODYNE_REJECT_SIZE);
+    expect_reject(pkt, 1207u, LIDET_VELODYNE_REJECT_SIZE);
+    expect_reject(pkt, 600u, LIDET_VELODYNE_REJECT_SIZE); /* cut after the second firing */
+    expect_reject(pkt, 0u, LIDET_VELODYNE_REJECT_SIZE);
+    put16(pkt + 100u * 3u + 2u, 1064u); /* firing 0: the last pair's lower block elsewhere */
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_AZIMUTH);
+    make64d(1063u, 21u, 500u);
+    put16(pkt + 100u * 10u + 2u, 1063u + 2u * 21u + 1u); /* firing 2: its last pair elsewhere */
+    put16(pkt + 100u * 11u + 2u, 1063u + 2u * 21u + 1u);
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_AZIMUTH);
+    make64d(1063u, 21u, 500u);
+    for (b = 8u; b < 12u; ++b) /* firing 2 beyond the circle */
+    {
+        put16(pkt + 100u * b + 2u, 36000u);
+    }
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_AZIMUTH);
+    make64d(1063u, 21u, 500u);
+    pkt[100u * 2u + 1u] = 0xDDu; /* the last pair's upper block flagged lower */
+    expect_reject(pkt, LIDET_VELODYNE_PAYLOAD_BYTES, LIDET_VELODYNE_REJECT_FLAG);
+    TEST_ASSERT_EQUAL_UINT32(0u, g.ws.stats.n_rejected[LIDET_VELODYNE_REJECT_UNSUPPORTED]);
+    TEST_ASSERT_EQUAL_UINT32(1u, g.ws.stats.n_decoded);
+    /* a whole dual payload into a room of 100: the rest counted, nothing written past it, the rotation tracked */
+    make64d(1063u, 21u, 500u);
+    for (i = 0; i < CAP; ++i)
+    {
+        g_out.ws[i].range_mm = 0xA5A5A5A5u;
+    }
+    TEST_ASSERT_EQUAL_INT(LIDET_TRUNCATED, lidet_velodyne_packet(&g.ws, pkt, LIDET_VELODYNE_PAYLOAD_BYTES,
+                                                                 g_out.ws, attr, 100u, &res));
+    TEST_ASSERT_EQUAL_UINT32(100u, res.n_returns);
+    TEST_ASSERT_EQUAL_UINT32(192u - 100u, g.ws.stats.n_truncated);
+    for (i = 100u; i < CAP; ++i)
+    {
+        TEST_ASSERT_EQUAL_HEX32(0xA5A5A5A5u, g_out.ws[i].range_mm);
+    }
+    TEST_ASSERT_EQUAL_UINT16(1063u + 2u * 21u, g.ws.prev_cdeg);
+    TEST_ASSERT_EQUAL_UINT32(0u, g.ws.stats.n_jumps);
+    TEST_ASSERT_EQUAL_UINT32(2u, g.ws.stats.n_decoded);
+}
+
+/* dual payloads over a full turn: three firings of 0.18 deg a payload, scans closed between firings at the seam, a
+ * complete rotation of 2000 firings x 64 lasers (the last returns) */
+static void test_hdl64e_dual_seam(void)
+{
+    uint32_t p, az = 35100u, n_complete = 0, fill = 0, last = 0;
+    cfg.model = LIDET_VELODYNE_HDL64E;
+    cfg.filter = LIDET_VELODYNE_RETURN_LAST;
+    init();
+    for (p = 0; p < 1200u; ++p)
+    {
+        make64d(az, 18u, 1000u);
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
+        TEST_ASSERT_EQUAL_UINT32(192u, res.n_returns);
+        if (res.scan_event != LIDET_VELODYNE_SCAN_NONE)
+        {
+            const uint32_t f = res.scan_end / 64u;
+            TEST_ASSERT_EQUAL_UINT32(0u, res.scan_end % 64u);
+            TEST_ASSERT_TRUE((az + 18u * f) % 36000u < 18u);
+            if (res.scan_event == LIDET_VELODYNE_SCAN_COMPLETE)
+            {
+                TEST_ASSERT_EQUAL_UINT32(2000u * 64u, fill + res.scan_end);
+                ++n_complete;
+            }
+            last = fill + res.scan_end;
+            fill = res.n_returns - res.scan_end;
+        }
+        else
+        {
+            fill += res.n_returns;
+        }
+        az = (az + 54u) % 36000u;
+    }
+    TEST_ASSERT_EQUAL_UINT32(1u, n_complete); /* 1200 x 0.54 deg = 648 deg from 351 deg */
+    TEST_ASSERT_EQUAL_UINT32(1u, g.ws.stats.n_partial);
+    TEST_ASSERT_EQUAL_UINT32(2000u * 64u, last);
+    TEST_ASSERT_EQUAL_UINT32(0u, g.ws.stats.n_jumps);
+}
 
 static void test_calibration_validated_and_copied(void)
 {
@@ -1060,7 +1351,7 @@ static void test_random_payloads(void)
  * eight a dual layout), decoded by AUTO, an HDL-64E decoder and a calibrated one: counted, never out of bounds */
 static void test_random_hdl64e_payloads(void)
 {
-    uint32_t seed = 64u, p, i, k;
+    uint32_t seed = 64u, p, i, k, n_dual;
     memset(&cal, 0, sizeof cal);
     cal.n_lasers = 64u;
     for (i = 0; i < 64u; ++i)
@@ -1076,6 +1367,7 @@ static void test_random_hdl64e_payloads(void)
         cfg.calib = k == 2u ? &cal : 0;
         cfg.ring_top_first = (uint8_t)(k == 2u);
         init();
+        n_dual = 0u;
         for (p = 0; p < 1000u; ++p)
         {
             for (i = 0; i < LIDET_VELODYNE_PAYLOAD_BYTES; ++i)
@@ -1096,8 +1388,12 @@ static void test_random_hdl64e_payloads(void)
                           (uint32_t)(pkt[100u * src + 2u] | (pkt[100u * src + 3u] << 8)) % 36000u);
                 }
             }
-            (void)lidet_velodyne_packet(&g.ws, pkt, LIDET_VELODYNE_PAYLOAD_BYTES, g_out.ws, attr,
-                                        1u + p % CAP, &res);
+            if (LIDET_SUCCEEDED(lidet_velodyne_packet(&g.ws, pkt, LIDET_VELODYNE_PAYLOAD_BYTES, g_out.ws,
+                                                      attr, 1u + p % CAP, &res)))
+            {
+                n_dual += res.return_mode == 0x39u;
+                TEST_ASSERT_TRUE(res.return_mode == 0u || res.return_mode == 0x39u);
+            }
             TEST_ASSERT_TRUE(res.n_returns <= 1u + p % CAP);
             TEST_ASSERT_TRUE(res.scan_end <= res.n_returns);
             for (i = 0; i < res.n_returns; ++i)
@@ -1108,8 +1404,9 @@ static void test_random_hdl64e_payloads(void)
             }
         }
         TEST_ASSERT_EQUAL_UINT32(1000u, g.ws.stats.n_packets);
-        TEST_ASSERT_TRUE(g.ws.stats.n_decoded > 300u && g.ws.stats.n_decoded < 500u);
-        TEST_ASSERT_TRUE(g.ws.stats.n_rejected[LIDET_VELODYNE_REJECT_UNSUPPORTED] > 20u);
+        TEST_ASSERT_TRUE(g.ws.stats.n_decoded > 300u && g.ws.stats.n_decoded <= 500u);
+        TEST_ASSERT_EQUAL_UINT32(0u, g.ws.stats.n_rejected[LIDET_VELODYNE_REJECT_UNSUPPORTED]);
+        TEST_ASSERT_TRUE(n_dual > 20u); /* the dual layouts decoded */
         if (k == 2u)
         {
             TEST_ASSERT_TRUE(g.ws.stats.n_short_range > 0u);
@@ -1134,6 +1431,9 @@ int main(void)
     RUN_TEST(test_hdl64e_ring_order_matches_hdl64_preset);
     RUN_TEST(test_hdl64e_auto_and_rejections);
     RUN_TEST(test_hdl64e_seam_and_jumps);
+    RUN_TEST(test_hdl64e_dual_filters);
+    RUN_TEST(test_hdl64e_dual_rejections);
+    RUN_TEST(test_hdl64e_dual_seam);
     RUN_TEST(test_calibration_validated_and_copied);
     RUN_TEST(test_calibration_vlp16_applied_exactly);
     RUN_TEST(test_calibration_of_nominal_tables_is_identity);

@@ -10,7 +10,8 @@
                                                                  # elevations
 
 Writers for the tests: synthetic VLP-16 and HDL-64E payloads over a simulated scene (vlp16_packets,
-hdl64e_packets) and classic pcap files (udp_frame, write_pcap).
+hdl64e_packets; hdl64e_dual_packets for the HDL-64E's dual-return layout) and classic pcap files (udp_frame,
+write_pcap).
 """
 from __future__ import annotations
 
@@ -232,7 +233,7 @@ def vlp16_packets(scenes, n_packets, start_cdeg=0, t0_us=0, packet_us=VLP16_PACK
     return out
 
 
-# ---- HDL-64E (single return): mirrored from lib/src/decode/lidet_velodyne.c ------------------------------------------
+# ---- HDL-64E (single and dual return): mirrored from lib/src/decode/lidet_velodyne.c ---------------------------------
 
 #: each laser id's ring by nominal elevation, lowest first (a payload's upper-bank block holds lasers 0..31, its
 #: lower-bank block lasers 32..63); the order published unit calibrations share (docs/DECODING.md)
@@ -250,6 +251,11 @@ HDL64E_UNIT_NS = 60
 #: the simulated sensor of hdl64e_packets: 0.18 deg a firing, 2000 firings a turn (10.4 Hz at 48 us a firing)
 HDL64E_STEP_CDEG = 18
 HDL64E_PACKET_US = 288     # 6 firings of 48 us
+#: dual return: four blocks a firing (upper, lower: the strongest return; upper, lower: the last), three firings a
+#: payload, 57.6 us a firing: the single-return table stretched (HDL64E_OFF_UNITS of 72 ns, HDL64E_FIRING_UNITS a
+#: firing), so a data point's share of its firing, and its interpolated azimuth, are single return's
+HDL64E_DUAL_UNIT_NS = 72
+HDL64E_DUAL_PACKET_NS = 3 * HDL64E_FIRING_UNITS * HDL64E_DUAL_UNIT_NS  # 172.8 us
 
 
 def hdl64e_grid(points, ring, cols=36000 // HDL64E_STEP_CDEG) -> np.ndarray:
@@ -305,13 +311,57 @@ def hdl64e_packets(scenes, n_packets, start_cdeg=0, t0_us=0, packet_us=HDL64E_PA
             a = start_cdeg + step_cdeg * (6 * k + f)
             grid = scenes[min(a // 36000, len(scenes) - 1)]
             c = (a % 36000) * grid.shape[0] // 36000
-            for bank in range(2):
-                lasers = np.arange(32) + 32 * bank
-                r = grid[c, lr[lasers]] - corr[lasers]
-                dist[2 * f + bank] = np.where((grid[c, lr[lasers]] > 0) & (r > 0), np.clip(r, 0, None) // 2, 0)
+            dist[2 * f:2 * f + 2] = _hdl64e_raw(grid[c, lr], corr).reshape(2, 32)
             cdeg += [a % 36000] * 2
         t = t0_us + k * packet_us
         out.append((t, hdl64e_payload(cdeg, np.clip(dist, 0, 65535), t, intensity=intensity)))
+    return out
+
+
+def _hdl64e_raw(cells_mm, corr_mm) -> np.ndarray:
+    """A firing's 64 packet distances (2 mm units, by laser id) of the ranges the decoder must give (mm, 0: no
+    return), less each laser's distance correction; a range it would leave at 0 or below is no return."""
+    r = cells_mm - corr_mm
+    return np.where((cells_mm > 0) & (r > 0), np.clip(r, 0, None) // 2, 0)
+
+
+def hdl64e_dual_packets(last_scenes, strongest_scenes, n_packets, start_cdeg=0, t0_us=0, step_cdeg=HDL64E_STEP_CDEG,
+                        laser_ring=None, dist_corr_mm=None, last_intensity=100, strongest_intensity=100):
+    """Dual-return HDL-64E payloads of a sensor turning step_cdeg a firing, three firings a payload: firing k at
+    start_cdeg + k step_cdeg sees column (its azimuth) // step_cdeg of rotation r's scenes (the last ones past the
+    lists, as hdl64e_packets). Per firing four blocks at its azimuth: upper and lower bank of the strongest return
+    (strongest_scenes[r]: ranges in mm, hdl64e_grid's layout; 0 where the pair repeats the last return, as the sensor
+    does for a lone return), then upper and lower bank of the last return (last_scenes[r]). Intensities: a number, or
+    per rotation an array of the scenes' shape (last_intensity[r], strongest_intensity[r]; a repeated return keeps
+    the last one's). laser_ring, dist_corr_mm: as hdl64e_packets. Timestamps 172.8 us apart (three 57.6 us firings),
+    in whole microseconds. Returns [(time_us, payload)], time_us unwrapped (the payload holds it modulo the hour)."""
+    lr = np.array([63 - r for r in HDL64E_LASER_RING] if laser_ring is None else laser_ring, np.int64)
+    corr = np.zeros(64, np.int64) if dist_corr_mm is None else np.asarray(dist_corr_mm, np.int64)
+
+    def per_laser(table, r, c):  # a number, or rotation r's array: column c, each laser's ring
+        if np.ndim(table) == 0:
+            return np.full(64, int(table), np.int64)
+        return np.asarray(table[min(r, len(table) - 1)], np.int64)[c, lr]
+
+    out = []
+    for k in range(n_packets):
+        cdeg, dist, inten = [], np.zeros((12, 32), np.int64), np.zeros((12, 32), np.int64)
+        for f in range(3):
+            a = start_cdeg + step_cdeg * (3 * k + f)
+            r = a // 36000
+            last = last_scenes[min(r, len(last_scenes) - 1)]
+            c = (a % 36000) * last.shape[0] // 36000
+            strong = np.asarray(strongest_scenes[min(r, len(strongest_scenes) - 1)], np.int64)[c, lr]
+            d_last = _hdl64e_raw(last[c, lr], corr)
+            i_last = per_laser(last_intensity, r, c)
+            lone = strong <= 0
+            d_strong = np.where(lone, d_last, _hdl64e_raw(strong, corr))
+            i_strong = np.where(lone, i_last, per_laser(strongest_intensity, r, c))
+            dist[4 * f:4 * f + 2], dist[4 * f + 2:4 * f + 4] = d_strong.reshape(2, 32), d_last.reshape(2, 32)
+            inten[4 * f:4 * f + 2], inten[4 * f + 2:4 * f + 4] = i_strong.reshape(2, 32), i_last.reshape(2, 32)
+            cdeg += [a % 36000] * 4
+        t = t0_us + k * HDL64E_DUAL_PACKET_NS // 1000
+        out.append((t, hdl64e_payload(cdeg, np.clip(dist, 0, 65535), t, intensity=inten)))
     return out
 
 

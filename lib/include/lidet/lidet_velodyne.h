@@ -5,28 +5,33 @@
  *        scan completed where the rotation crosses a configurable azimuth (the seam).
  *
  * Sensors: VLP-16 (product byte 0x22), VLP-32C (0x28) and HDL-32E (0x21), return modes strongest (0x37), last
- * (0x38) and dual (0x39); HDL-64E S2 / S3 in single-return mode (no product byte: recognised by its lower-bank
- * flag 0xDDFF). A data payload is 1206 bytes: 12 blocks of 100 bytes (flag, azimuth uint16 in 0.01 deg, 32 x
- * (distance uint16 in 2 mm, VLP-32C 4 mm; intensity uint8)), a uint32 timestamp (microseconds past the hour) and
- * two bytes: VLP / HDL-32E the factory bytes (return mode, product), HDL-64E a rotating status (type, value).
+ * (0x38) and dual (0x39); HDL-64E S2 / S3 in single- and dual-return mode (no product or return-mode byte:
+ * recognised by its lower-bank flag 0xDDFF, the dual layout by four blocks a firing). A data payload is 1206
+ * bytes: 12 blocks of 100 bytes (flag, azimuth uint16 in 0.01 deg, 32 x (distance uint16 in 2 mm, VLP-32C 4 mm;
+ * intensity uint8)), a uint32 timestamp (microseconds past the hour) and two bytes: VLP / HDL-32E the factory
+ * bytes (return mode, product), HDL-64E a rotating status (type, value).
  * Little-endian. Block flags: bytes FF EE (0xEEFF read as a uint16); HDL-64E upper bank FF EE (lasers 0..31) and
- * lower bank FF DD (0xDDFF, lasers 32..63) alternating, the two blocks of a firing at one azimuth.
+ * lower bank FF DD (0xDDFF, lasers 32..63) alternating, the two blocks of a firing at one azimuth; HDL-64E dual
+ * return: four blocks a firing at one azimuth (upper, lower: the strongest return; upper, lower: the last), three
+ * firings a payload.
  *
  * Algorithm (docs/DECODING.md), per packet, in integers only:
  *  1. Validate the whole payload first (length, every block's flag and azimuth, the factory bytes, the blocks of
  *     one firing at one azimuth); a bad payload is rejected whole and counted by reason.
- *  2. Per firing (a block; a dual pair, an HDL-64E upper + lower pair), the rotation step to the next firing's
- *     azimuth; the last reuses the step before it. Each data point's azimuth is the firing's plus step x its
- *     firing time / the firing's duration (the manuals' timing: VLP-16 2.304 us per laser, 55.296 us per
- *     sequence, two sequences per block; VLP-32C lasers fired in pairs 2.304 us apart, one 55.296 us sequence per
- *     block; HDL-32E 1.152 us per laser, 46.08 us per block; HDL-64E lasers j of both banks together, in groups of
- *     four 6 us apart at 0, 1.26, 2.46, 3.66 us, 48 us per firing), minus the laser's rotational correction
+ *  2. Per firing (a block; a dual pair; an HDL-64E upper + lower pair, dual: two such pairs), the rotation step
+ *     to the next firing's azimuth; the last reuses the step before it. Each data point's azimuth is the firing's
+ *     plus step x its firing time / the firing's duration (the manuals' timing: VLP-16 2.304 us per laser,
+ *     55.296 us per sequence, two sequences per block; VLP-32C lasers fired in pairs 2.304 us apart, one
+ *     55.296 us sequence per block; HDL-32E 1.152 us per laser, 46.08 us per block; HDL-64E lasers j of both banks
+ *     together, in groups of four 6 us apart at 0, 1.26, 2.46, 3.66 us, 48 us per firing; dual return: the same
+ *     table stretched to a 57.6 us firing, the same interpolation), minus the laser's rotational correction
  *     (nominal: VLP-32C -+1.4 or -+4.2 deg, the others 0; or the caller's calibration).
  *  3. Each firing's azimuth is checked against the previous firing's (across packets too): a forward step of at
  *     most max_step_cdeg is the rotation, anything else (backwards, shuffled, lost packets) is an azimuth jump:
  *     the scan in progress is closed as aborted. A forward step across seam_cdeg closes it as a scan.
  *  4. Distances of 0 (no return) are skipped; the laser's distance correction (calibration) is added; in dual
- *     mode the return filter picks the last, the strongest, or both (the second block's return when it differs).
+ *     mode the return filter picks the last, the strongest, or both (the other block's return when it differs;
+ *     the last return: a VLP / HDL-32E pair's first block, an HDL-64E firing's second upper + lower pair).
  * Rings: ring 0 = the lowest beam, upwards by elevation (the "vlp16", "vlp32c", "hdl32" presets' order; HDL-64E by
  * its nominal table, or by the calibration's elevations); cfg.ring_top_first numbers them downwards instead (the
  * "hdl64" preset's order, KITTI's). Azimuths are BAM16 counterclockwise from +x (x forward, y left, z up), i.e.
@@ -68,7 +73,7 @@ typedef enum
     LIDET_VELODYNE_HDL32E = 0x21,
     LIDET_VELODYNE_VLP16 = 0x22,
     LIDET_VELODYNE_VLP32C = 0x28,
-    /** HDL-64E S2, S2.1, S3 (single return; dual-return payloads are refused) */
+    /** HDL-64E S2, S2.1, S3 (single and dual return) */
     LIDET_VELODYNE_HDL64E = 0x64
 } lidet_velodyne_model_t;
 
@@ -98,8 +103,8 @@ typedef enum
     LIDET_VELODYNE_REJECT_MODE = 5, /**< unknown return-mode byte */
     /** a block azimuth > 35999, or the blocks of one firing at two azimuths */
     LIDET_VELODYNE_REJECT_AZIMUTH = 6,
-    /** a layout this decoder does not decode: an HDL-64E dual-return payload (four blocks a firing, at one
-     *  azimuth; docs/DECODING.md says why) */
+    /** a layout this decoder does not decode; none at present (HDL-64E dual-return payloads, once counted here,
+     *  are decoded): kept so that the counts keep their places */
     LIDET_VELODYNE_REJECT_UNSUPPORTED = 7,
     LIDET_VELODYNE_N_REJECT = 8
 } lidet_velodyne_reject_t;
@@ -213,7 +218,9 @@ typedef struct
      *  clockwise from +x, [0, 35999] */
     uint16_t azimuth_cdeg;
     uint8_t intensity; /**< calibrated reflectivity */
-    uint8_t flags;     /**< LIDET_VELODYNE_FLAG_* (HDL-64E: 0, its payload does not say which return it is) */
+    /** LIDET_VELODYNE_FLAG_* (HDL-64E single return: 0, its payload does not say which return it is; dual
+     *  return: as the other models') */
+    uint8_t flags;
 } lidet_velodyne_attr_t;
 
 /** @brief What one payload gave. */
@@ -229,8 +236,8 @@ typedef struct
     /** the product byte (0 when rejected before it was read); LIDET_VELODYNE_HDL64E for an HDL-64E payload (one
      *  with lower-bank flags) */
     uint8_t model;
-    /** the return-mode byte (0x37, 0x38, 0x39; 0 when rejected before it was read, and for HDL-64E, whose payload
-     *  has none) */
+    /** the return-mode byte (0x37, 0x38, 0x39; 0 when rejected before it was read); HDL-64E, whose payload has
+     *  none: 0x39 for a decoded dual-return layout, else 0 */
     uint8_t return_mode;
 } lidet_velodyne_result_t;
 

@@ -3,7 +3,9 @@
  * Timing and laser tables from the vendors' user manuals (VLP-16 rev. E section 9, VLP-32C rev. C section 9,
  * HDL-32E section 9, HDL-64E S2 / S3 "Laser firing sequence and timing"): firing offsets, per-laser elevations and
  * (VLP-32C) azimuth offsets. The HDL-64E's laser order by elevation is the one published unit calibrations share
- * (docs/DECODING.md); its nominal elevations are the design's two blocks. */
+ * (docs/DECODING.md); its nominal elevations are the design's two blocks; its dual-return layout (four blocks a
+ * firing: the strongest return's upper + lower pair, then the last return's) is velodyne_decoder's reading of the
+ * S3 manual (docs/DECODING.md, "Dual return"). */
 #include <string.h>
 
 #include "lidet/lidet_velodyne.h"
@@ -101,6 +103,10 @@ static const model_t k_hdl32e = {1152u,         40u,           6u, 1u, 2u, 32u, 
                                  k_hdl32e_ring, k_hdl32e_elev, 0};
 static const model_t k_hdl64e = {60u,           800u,          3u, 10u, 2u, 64u, 2u, k_hdl64e_off,
                                  k_hdl64e_ring, k_hdl64e_elev, 0};
+/* HDL-64E dual return: the same table (the same share of a firing per data point, so the same interpolation)
+ * stretched to the dual firing's 57.6 us (800 units of 72 ns; 5,789 payloads of three firings a second) */
+static const model_t k_hdl64e_dual = {72u,           800u,          3u, 10u, 2u, 64u, 2u, k_hdl64e_off,
+                                      k_hdl64e_ring, k_hdl64e_elev, 0};
 
 /* the model of a VLP / HDL-32E product byte (never the HDL-64E, which sends none) */
 static const model_t *find_product(uint32_t product)
@@ -309,9 +315,18 @@ lidet_status_t lidet_velodyne_decoder_elev_mdeg(const lidet_velodyne_t *st, uint
     return LIDET_OK;
 }
 
-/* HDL-64E payload checks: flags alternating upper / lower, a firing's two blocks at one azimuth, no dual layout */
+/* an HDL-64E payload in the dual-return layout: four blocks a firing (upper, lower: the strongest return; upper,
+ * lower: the last), so blocks 0 and 2 at one azimuth; single-return firings are 48 us apart, at least 0.08 deg at
+ * the slowest spin (300 rpm) */
+static int hdl64e_dual(const uint8_t *p)
+{
+    return rd16(p + 2u) == rd16(p + 2u * BLOCK_BYTES + 2u);
+}
+
+/* HDL-64E payload checks: flags alternating upper / lower, a firing's blocks (two; dual: four) at one azimuth */
 static lidet_velodyne_reject_t check_hdl64e(const lidet_velodyne_t *st, const uint8_t *p, uint32_t n_lower)
 {
+    const uint32_t per_firing = hdl64e_dual(p) ? 4u : 2u;
     uint32_t b;
     if (n_lower == 0u && !st->cfg.force_model && find_product(p[1205]) != 0)
     {
@@ -328,16 +343,10 @@ static lidet_velodyne_reject_t check_hdl64e(const lidet_velodyne_t *st, const ui
     for (b = 0; b < BLOCKS; ++b)
     {
         const uint32_t az = rd16(p + b * BLOCK_BYTES + 2u);
-        if (az >= FULL_CDEG || ((b & 1u) && az != rd16(p + (b - 1u) * BLOCK_BYTES + 2u)))
+        if (az >= FULL_CDEG || az != rd16(p + (b - b % per_firing) * BLOCK_BYTES + 2u))
         {
             return LIDET_VELODYNE_REJECT_AZIMUTH;
         }
-    }
-    /* dual return: four blocks a firing (upper, lower, upper, lower) at one azimuth; single-return firings are
-     * 48 us apart, at least 0.08 deg at the slowest spin (300 rpm) */
-    if (rd16(p + 2u) == rd16(p + 2u * BLOCK_BYTES + 2u))
-    {
-        return LIDET_VELODYNE_REJECT_UNSUPPORTED;
     }
     return LIDET_VELODYNE_REJECT_NONE;
 }
@@ -577,19 +586,25 @@ static inline void emit_dual(sink_t *s, uint32_t filter, uint32_t d0, uint32_t i
     }
 }
 
-/* The general path: firing g (its first block at `first`, azimuth az, step the rotation to the next firing) of
- * per_group blocks, every point's azimuth interpolated in FINE units and its return(s) emitted into s. The banks
- * of an HDL-64E firing one after the other (upper, then lower); a dual pair's second block is read beside the
- * first. */
+/* The general path: firing g (its first block at `first`, azimuth az, step the rotation to the next firing), every
+ * point's azimuth interpolated in FINE units and its return(s) emitted into s. The banks of an HDL-64E firing one
+ * after the other (upper, then lower). Dual return: per laser the last return and the other block's, read side by
+ * side: a VLP / HDL-32E pair's first block (the last return) and second; an HDL-64E firing's second block pair (the
+ * last return: upper, lower) and first (the strongest). */
 static void decode_firing(const lidet_velodyne_t *st, const model_t *m, sink_t *s, const uint8_t *first,
-                          uint32_t az, uint32_t step, uint32_t g, uint32_t mode, uint32_t per_group)
+                          uint32_t az, uint32_t step, uint32_t g, uint32_t mode)
 {
     const int dual = mode == MODE_DUAL;
     uint32_t bank, j;
-    for (bank = 0; bank < (dual ? 1u : per_group); ++bank)
+    for (bank = 0; bank < m->banks; ++bank)
     {
-        const uint8_t *blk = first + bank * BLOCK_BYTES;
-        const uint8_t *other = dual ? blk + BLOCK_BYTES : 0;
+        const uint8_t *blk = first + bank * BLOCK_BYTES; /* single return; HDL-64E dual: the strongest */
+        const uint8_t *other = 0;
+        if (dual)
+        {
+            other = m->banks == 2u ? blk : blk + BLOCK_BYTES;
+            blk = m->banks == 2u ? blk + 2u * BLOCK_BYTES : blk;
+        }
         for (j = 0; j < POINTS; ++j)
         {
             const uint8_t *pt = blk + 4u + 3u * j;
@@ -677,9 +692,20 @@ lidet_status_t lidet_velodyne_packet(lidet_velodyne_t *st, const uint8_t *payloa
     {
         build_tables(st, m, 0);
     }
-    mode = m->banks == 2u ? MODE_STRONGEST : payload[1204];
+    if (m->banks == 2u)
+    {
+        /* HDL-64E: no return-mode byte; the layout says (res->return_mode reports it) */
+        mode = hdl64e_dual(payload) ? MODE_DUAL : MODE_STRONGEST;
+        m = mode == MODE_DUAL ? &k_hdl64e_dual : m;
+        res->return_mode = (uint8_t)(mode == MODE_DUAL ? MODE_DUAL : 0u);
+    }
+    else
+    {
+        mode = payload[1204];
+    }
     dual = mode == MODE_DUAL;
-    per_group = dual ? 2u : m->banks; /* blocks of one firing: a dual pair, an HDL-64E bank pair */
+    /* blocks of one firing: a VLP / HDL-32E block or dual pair, an HDL-64E bank pair or (dual) two bank pairs */
+    per_group = m->banks * (dual ? 2u : 1u);
     n_groups = BLOCKS / per_group;
     s.out = out;
     s.attr = attr;
@@ -716,7 +742,7 @@ lidet_status_t lidet_velodyne_packet(lidet_velodyne_t *st, const uint8_t *payloa
             st->stats.n_returns += k;
             continue;
         }
-        decode_firing(st, m, &s, first, az, step, g, mode, per_group);
+        decode_firing(st, m, &s, first, az, step, g, mode);
     }
     res->n_returns = s.n;
     if (res->scan_event == LIDET_VELODYNE_SCAN_NONE)
