@@ -326,6 +326,12 @@ static inline int32_t abs32(int32_t v)
     return v < 0 ? -v : v;
 }
 
+/* |v| as an unsigned value: zero-extended to 64 bits by a compiler that sign-extends abs32's */
+static inline uint32_t uabs32(int32_t v)
+{
+    return v < 0 ? 0u - (uint32_t)v : (uint32_t)v;
+}
+
 /* Pass 1 (lidet_ref/ground_q.py: sample_mask): the sample test of lidet_ground_filter.c with integer kernels.
  * dR in R steps (4 mm / 256), dZ in 4 mm: |dZ| <= fy |dR| is |dZ| * 2^24 <= fy_q16 * |dR|; F_x on R against
  * fx_max_mm * 64 (R steps), on Z as 4 |F_x| <= fx_max_mm. Every touched pixel holds a point (R > 0). Bitwise &
@@ -396,15 +402,20 @@ sample_test_plain(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const
     }
     dr = (2 * r0 + r0p) - (2 * r1 + r1p);
     dz = (2 * Z0[c] + Z0[cp1]) - (2 * Z1[c] + Z1[cp1]);
-    if (((uint64_t)(uint32_t)abs32(dz) << 24) > (uint64_t)fy * (uint32_t)abs32(dr))
+    if (((uint64_t)uabs32(dz) << 24) > (uint64_t)fy * uabs32(dr))
     {
         return 0;
     }
     return (uint8_t)(abs32((R0[cm1] + 2 * r0) - (2 * r0p + R0[cp2])) <= fx_r);
 }
 
-static void sample_row_plain(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
-                             uint32_t cols, const lidet__ground_q_filt_t *f, uint8_t *out)
+#if defined(__GNUC__)
+__attribute__((noinline)) /* fy a plain 32-bit argument: one 32 x 32 -> 64 multiply (inlined, the compiler's
+                           * range of the caller's uint64_t made it a 64 x 64 one) */
+#endif
+static void
+sample_row_plain(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1, uint32_t cols,
+                 const lidet__ground_q_filt_t *f, uint8_t *out)
 {
     const uint32_t fy = (uint32_t)f->fy;
     const int32_t fx_r = f->fx_r;
@@ -536,6 +547,7 @@ typedef struct
     uint8_t *mask;
     int32_t *z_up; /* per column: z of the pixel above (row r - 1), NO_POINT where it holds none */
     int64_t above0, below0, bf, slope, k;
+    uint64_t band; /* above0 + below0 - 1: the fixed tolerance's band, one unsigned comparison (label_span) */
     int32_t min_dz;
     uint32_t split_v, split2_v, n_ground, n_vetoed;
 } label_t;
@@ -594,7 +606,7 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
         int32_t P[3];
         uint32_t v;
         int64_t h, above = above0, below = below0;
-        int in, vt = 0;
+        int in, nz, vt = 0;
         if (ro)
         {
             if ((rng[p] & 0x7FFFu) == 0u)
@@ -608,6 +620,13 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
         else
         {
             lidet__qpix_stored(L->img, p, P);
+        }
+        nz = (P[0] | P[1]) != 0; /* x^2 + y^2 != 0 */
+        if (kz && !nz)
+        {
+            mask[p] = 0; /* x = y = 0: not in the band, never vetoed, no point above the next row's */
+            z_up[c] = NO_POINT;
+            continue;
         }
         v = (uint32_t)(P[0] * P[0]) + (uint32_t)(P[1] * P[1]);
         if (two && v >= L->split2_v)
@@ -624,15 +643,34 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
             above = L->above0 + ((L->k * r_pixel(L->img, rt, p, v)) << 6);
             below = lidet__q_rshift_round(L->bf * above, 16);
         }
-        in = (v != 0u) & (h < above) & (h > -below);
-        z_up[c] = v != 0u ? P[2] : NO_POINT;
+        if (kz)
+        {
+            /* -below0 < h < above0 as 0 <= h + below0 - 1 < above0 + below0 - 1: the planes' D carries
+             * below0 - 1 (label_rows) */
+            in = (uint64_t)h < L->band; /* nz here */
+        }
+        else
+        {
+            in = nz & (h < above) & (h > -below);
+        }
+        z_up[c] = nz ? P[2] : NO_POINT;
         if (in && zu != NO_POINT)
         {
             /* the pixel above holds a point: the veto (a step of more than veto_min_dz_mm, then the slope) */
             const int32_t dz = abs32(zu - P[2]);
             if ((4 * dz > L->min_dz) & (L->slope > 0))
             {
-                vt = veto_slope(L, rt, rtu, c, p, up, v, dz);
+                if (ro)
+                {
+                    /* veto_slope's test with the two ranges' R in line (veto_slope_q16 <= 6553600, init: the
+                     * product one 32 x 32 -> 64 multiply) */
+                    const int32_t dr = r_of_range(rng[p - up], rtu.ce) - r_of_range(rng[p], rt.ce);
+                    vt = ((int64_t)dz << 24) > (int64_t)(int32_t)L->slope * abs32(dr);
+                }
+                else
+                {
+                    vt = veto_slope(L, rt, rtu, c, p, up, v, dz);
+                }
             }
         }
         mask[p] = (uint8_t)(in & !vt);
@@ -693,6 +731,7 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
     L.bf = g->cfg.below_factor_q16;
     L.slope = g->cfg.veto_slope_q16;
     L.below0 = lidet__q_rshift_round(L.bf * L.above0, 16);
+    L.band = (uint64_t)(L.above0 + L.below0 - 1); /* above0 >= 2^28, below0 >= 0 */
     L.min_dz = (int32_t)g->cfg.veto_min_dz_mm;
     L.split_v = g->split_v;
     L.split2_v = g->split2_v;
@@ -732,6 +771,7 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
             {
                 if (L.k == 0)
                 {
+                    hp[0].d += L.below0 - 1; /* the band test's offset (label_span, kz) */
                     label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 0, 1, 1);
                 }
                 else

@@ -124,6 +124,30 @@ static inline void pixel(const cell_src_t *src, uint32_t i, int32_t q[3])
     lidet__ground_q_pix(src->img, src->idx[i], q); /* stored or decoded (lidet_qpix.h) */
 }
 
+/* the samples idx[0 .. n) of a range-only image decoded into xyz (3 int32 each), the same values as pixel's
+ * decode: the samples of a cell run row by row, so a row's number (a division) and trig are taken only where
+ * the row changes */
+static void decode_cell(const lidet__ground_q_pix_t *gp, const lidet_ground_sample_t *idx, uint32_t n,
+                        int32_t *xyz)
+{
+    const uint32_t cols = gp->img->n_cols;
+    uint32_t i, base = 0u - cols; /* no row yet: p - base >= cols for every p */
+    lidet__qpix_row_t rt;
+    rt.ce = 0;
+    rt.se = 0;
+    for (i = 0; i < n; ++i)
+    {
+        const uint32_t p = idx[i];
+        if (p - base >= cols)
+        {
+            const uint32_t r = p / cols;
+            base = r * cols;
+            rt = lidet__qpix_row(gp->img, r);
+        }
+        lidet__ground_q_pix_rc(gp, rt, p - base, p, xyz + 3u * i);
+    }
+}
+
 /* a += the scatter terms (xx xy xz yy yz zz) of one point, 64-bit products */
 #if defined(__GNUC__)
 __attribute__((always_inline))
@@ -153,7 +177,8 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
     uint32_t i, m = 0;
     int k, it;
     lidet__ground_q_hplane_t hp;
-    lidet__ground_q_hplane(cur->n, cur->d, &hp);
+    /* |h| <= thr as 0 <= h + thr <= 2 thr: D carries thr (one unsigned comparison per sample) */
+    lidet__ground_q_hplane(cur->n, cur->d + thr, &hp);
     pixel(img, 0u, first);
     /* one pass over the samples (each decoded once): the inliers' sums S1 = sum d and S2 = sum d d^T of
      * d = q - first, exact in int64 (|d| < 2^16: below n 2^32 for n samples); the cell's decoded copy read
@@ -180,7 +205,7 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
                 y = q[1];
                 z = q[2];
             }
-            if (abs64(lidet__ground_q_height(&hp, x, y, z)) > thr)
+            if ((uint64_t)lidet__ground_q_height(&hp, x, y, z) > 2u * (uint64_t)thr)
             {
                 continue;
             }
@@ -297,15 +322,17 @@ static uint32_t count_inliers(const lidet_ground_q_scratch_t *sc, const cell_src
     uint32_t i, cnt = 0;
     if (copied)
     {
+        /* h + t = c . q + (t - c . p0): the constant is each sum's start (exact in int64: |c . q| < 2^47) */
+        const int64_t h0 = t - ((int64_t)c0 * p0[0] + (int64_t)c1 * p0[1] + (int64_t)c2 * p0[2]);
         /* in blocks of 32 samples; a hypothesis that can no longer beat the best count stops */
         for (i = 0; i < n_eval && (!have || cnt + (n_eval - i) > best_cnt);)
         {
             const uint32_t end = n_eval - i > 32u ? i + 32u : n_eval;
             for (; i < end; ++i)
             {
-                const int64_t h = (int64_t)c0 * (sc->ev_x[i] - p0[0]) + (int64_t)c1 * (sc->ev_y[i] - p0[1]) +
-                                  (int64_t)c2 * (sc->ev_z[i] - p0[2]);
-                cnt += (uint32_t)((uint64_t)(h + t) <= t2);
+                const int64_t ht =
+                    h0 + (int64_t)c0 * sc->ev_x[i] + (int64_t)c1 * sc->ev_y[i] + (int64_t)c2 * sc->ev_z[i];
+                cnt += (uint32_t)((uint64_t)ht <= t2);
             }
         }
     }
@@ -428,10 +455,7 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
         3u * n <= sizeof sc->r_rows / sizeof(int32_t)) /* a range-only image's cell that fits */
     {
         int32_t *xyz = &sc->r_rows[0][0];
-        for (i = 0; i < n; ++i)
-        {
-            pixel(&src, i, xyz + 3u * i);
-        }
+        decode_cell(gp, idx, n, xyz);
         src.xyz = xyz;
     }
     if (copied)

@@ -43,8 +43,8 @@ static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, 
                                              int32_t z)
 {
 #if LIDET_Q_HAVE_MUL64
-    /* SMULL and two SMLAL (Cortex-M3 and up): the same exact value */
-    return (int64_t)h->n[0] * x + (int64_t)h->n[1] * y + (int64_t)h->n[2] * z + h->d;
+    /* three SMLAL from D (Cortex-M3 and up): the same exact value */
+    return h->d + (int64_t)h->n[0] * x + (int64_t)h->n[1] * y + (int64_t)h->n[2] * z;
 #else
     const int32_t a = h->hi[0] * x + h->hi[1] * y + h->hi[2] * z;
     const int32_t b = h->lo[0] * x + h->lo[1] * y + h->lo[2] * z;
