@@ -12,30 +12,21 @@ and lower bank of the last return; three firings a payload, 57.6 us a firing. A 
 both pairs. Filters: both (the last return, and the other one where its distance differs), last, strongest (the
 return of higher intensity; tie: the last)."""
 import math
-import pathlib
 
 import numpy as np
 import pytest
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-SIM64 = ROOT / "tests" / "data" / "sim_hdl64"
-START = 34992  # a multiple of the 0.18 deg firing step: the first payload 0.08 deg before the seam
+# the single-return tests' simulated scan, first payload (0.08 deg before the seam) and decoder fixture
+from test_velodyne_decode import START64 as START  # noqa: E402
+from test_velodyne_decode import _sim64, vdec  # noqa: E402,F401
+
 N_PK = 1400    # 4200 firings: 2.1 rotations, crossing the seam 3 times
 L, S = 1, 2    # FLAG_LAST, FLAG_STRONGEST
 
 
 @pytest.fixture(scope="module")
-def vd(need_lib):
-    from lidet_tools import native, velodyne
-    if not hasattr(native.lib(), "lidet_velodyne_decoder_xyz"):
-        pytest.skip("liblidet_py.so predates the HDL-64E decoder: rebuild")
-    return velodyne
-
-
-def _sim64():
-    from lidet_tools.sim import read_ring
-    pts = np.fromfile(SIM64 / "velodyne" / "000000.bin", dtype="<f4").reshape(-1, 4)
-    return pts, read_ring(SIM64 / "ring" / "000000.bin").astype(np.int64)
+def vd(vdec):
+    return vdec
 
 
 def _scenes(vd):

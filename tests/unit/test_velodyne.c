@@ -768,6 +768,30 @@ static void test_hdl64e_auto_and_rejections(void)
     TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
 }
 
+/* after run() on an HDL-64E payload whose firings, 0.18 deg apart, start at az (0.01 deg): a scan that ended in it
+ * ended at the firing that crossed the seam (it starts the next scan), and a complete scan holds the 2,000 firings of
+ * a turn. fill: the returns of the scan in progress; last: the size of the last scan that ended */
+static void seam_bookkeeping(uint32_t az, uint32_t *fill, uint32_t *last, uint32_t *n_complete)
+{
+    if (res.scan_event != LIDET_VELODYNE_SCAN_NONE)
+    {
+        const uint32_t f = res.scan_end / 64u;
+        TEST_ASSERT_EQUAL_UINT32(0u, res.scan_end % 64u);
+        TEST_ASSERT_TRUE((az + 18u * f) % 36000u < 18u);
+        if (res.scan_event == LIDET_VELODYNE_SCAN_COMPLETE)
+        {
+            TEST_ASSERT_EQUAL_UINT32(2000u * 64u, *fill + res.scan_end);
+            ++*n_complete;
+        }
+        *last = *fill + res.scan_end;
+        *fill = res.n_returns - res.scan_end;
+    }
+    else
+    {
+        *fill += res.n_returns;
+    }
+}
+
 static void test_hdl64e_seam_and_jumps(void)
 {
     uint32_t p, az = 35100u, n_complete = 0, fill = 0, last = 0;
@@ -777,23 +801,7 @@ static void test_hdl64e_seam_and_jumps(void)
     {
         make64(az, 18u, 1000u);
         TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
-        if (res.scan_event != LIDET_VELODYNE_SCAN_NONE)
-        {
-            const uint32_t f = res.scan_end / 64u; /* the firing that crossed the seam starts the next scan */
-            TEST_ASSERT_EQUAL_UINT32(0u, res.scan_end % 64u);
-            TEST_ASSERT_TRUE((az + 18u * f) % 36000u < 18u);
-            if (res.scan_event == LIDET_VELODYNE_SCAN_COMPLETE)
-            {
-                TEST_ASSERT_EQUAL_UINT32(2000u * 64u, fill + res.scan_end);
-                ++n_complete;
-            }
-            last = fill + res.scan_end;
-            fill = res.n_returns - res.scan_end;
-        }
-        else
-        {
-            fill += res.n_returns;
-        }
+        seam_bookkeeping(az, &fill, &last, &n_complete);
         az = (az + 108u) % 36000u;
     }
     TEST_ASSERT_EQUAL_UINT32(1u, n_complete); /* 600 x 1.08 deg = 648 deg from 351 deg */
@@ -1077,23 +1085,7 @@ static void test_hdl64e_dual_seam(void)
         make64d(az, 18u, 1000u);
         TEST_ASSERT_EQUAL_INT(LIDET_OK, run());
         TEST_ASSERT_EQUAL_UINT32(192u, res.n_returns);
-        if (res.scan_event != LIDET_VELODYNE_SCAN_NONE)
-        {
-            const uint32_t f = res.scan_end / 64u;
-            TEST_ASSERT_EQUAL_UINT32(0u, res.scan_end % 64u);
-            TEST_ASSERT_TRUE((az + 18u * f) % 36000u < 18u);
-            if (res.scan_event == LIDET_VELODYNE_SCAN_COMPLETE)
-            {
-                TEST_ASSERT_EQUAL_UINT32(2000u * 64u, fill + res.scan_end);
-                ++n_complete;
-            }
-            last = fill + res.scan_end;
-            fill = res.n_returns - res.scan_end;
-        }
-        else
-        {
-            fill += res.n_returns;
-        }
+        seam_bookkeeping(az, &fill, &last, &n_complete);
         az = (az + 54u) % 36000u;
     }
     TEST_ASSERT_EQUAL_UINT32(1u, n_complete); /* 1200 x 0.54 deg = 648 deg from 351 deg */
