@@ -8,7 +8,6 @@
 #include "internal/lidet_group.h"
 #include "internal/lidet_math.h"
 #include "internal/lidet_pixel.h"
-#include "internal/lidet_proposal_rule.h"
 
 /* 1.0 and 2.2 m (z), 0.9 and 3.5 m (along the axis), squared: the bounds on 12 var */
 #define GROUP_Z_LO2 1.0f
@@ -153,53 +152,26 @@ lidet_status_t lidet__group_proposal(const lidet_cluster_state_t *c, uint32_t ci
     const float mx = g->part_mean[part][0], my = g->part_mean[part][1], mz = g->part_mean[part][2];
     /* a ground-origin model measures z from the cluster's ground under its mean */
     const float zo = cfg->z_origin == LIDET_PROPOSAL_Z_GROUND ? r->mean_m[2] - r->height_m : mz;
-    uint32_t state = lidet__proposal_rng_start(cfg->seed, n_src), i = 0, ord = 0, m, want;
+    lidet_status_t st;
     if (n_src == 0u || n_out < 1u || n_out > LIDET_PROPOSAL_POINTS)
     {
         return LIDET_ERR_ARG;
     }
-    /* the resampling rule's indices into the part's members: 0, 1, ... n_src - 1 and then draws among them
-     * (n_src <= n_out), or one from each run (increasing): either way one pass in member order finds them */
-    want = lidet__proposal_next_index(&state, 0u, n_src, n_out);
-    for (m = 0; m < r->n_points && i < n_out; ++m)
+#define GP_MEMBER(m) ((uint32_t)c->members[r->first_member + (m)])
+#define GP_IN_PART(m) (part_of(g, offset_t(g, img, GP_MEMBER(m))) == part)
+#define GP_WRITE(i, m)                                                                                       \
+    (out->xyz[i][0] = lidet__img_x(img, GP_MEMBER(m)) - mx,                                                  \
+     out->xyz[i][1] = lidet__img_y(img, GP_MEMBER(m)) - my,                                                  \
+     out->xyz[i][2] = lidet__img_z(img, GP_MEMBER(m)) - zo)
+#define GP_COPY(i, k) memcpy(out->xyz[i], out->xyz[k], sizeof out->xyz[i])
+    LIDET__GROUP_RESAMPLE(cfg->seed, n_src, n_out, r->n_points, GP_IN_PART, GP_WRITE, GP_COPY, st);
+#undef GP_MEMBER
+#undef GP_IN_PART
+#undef GP_WRITE
+#undef GP_COPY
+    if (st != LIDET_OK)
     {
-        const uint32_t p = (uint32_t)c->members[r->first_member + m];
-        if (part_of(g, offset_t(g, img, p)) != part)
-        {
-            continue;
-        }
-        while (i < n_out && want == ord)
-        {
-            out->xyz[i][0] = lidet__img_x(img, p) - mx;
-            out->xyz[i][1] = lidet__img_y(img, p) - my;
-            out->xyz[i][2] = lidet__img_z(img, p) - zo;
-            ++i;
-            if (n_src <= n_out && i >= n_src)
-            {
-                break; /* the rest are draws among the rows written */
-            }
-            if (i < n_out)
-            {
-                want = lidet__proposal_next_index(&state, i, n_src, n_out);
-            }
-        }
-        ++ord;
-    }
-    if (n_src <= n_out)
-    {
-        if (i != n_src)
-        {
-            return LIDET_ERR_STATE; /* cannot happen: the cut counted these members */
-        }
-        for (; i < n_out; ++i)
-        {
-            const uint32_t k = lidet__proposal_next_index(&state, i, n_src, n_out);
-            memcpy(out->xyz[i], out->xyz[k], sizeof out->xyz[i]);
-        }
-    }
-    else if (i != n_out)
-    {
-        return LIDET_ERR_STATE;
+        return st;
     }
     out->mean_m[0] = mx;
     out->mean_m[1] = my;

@@ -7,7 +7,6 @@
 
 #include "internal/lidet_cluster_q_internal.h"
 #include "internal/lidet_group_q.h"
-#include "internal/lidet_proposal_rule.h"
 #include "internal/lidet_qmath.h"
 #include "internal/lidet_qpix.h"
 
@@ -186,55 +185,26 @@ lidet_status_t lidet__group_q_proposal(const lidet_cluster_q_state_t *c, uint32_
     const int32_t mx = g->part_mean[part][0], my = g->part_mean[part][1], mz = g->part_mean[part][2];
     /* a ground-origin model measures z from the cluster's ground under its mean */
     const int32_t zo = cfg->z_origin == LIDET_PROPOSAL_Z_GROUND ? r->mean_4mm[2] - r->height_4mm : mz;
-    uint32_t state = lidet__proposal_rng_start(cfg->seed, n_src), i = 0, ord = 0, m, want;
+    int32_t d[3];
+    lidet_status_t st;
     if (n_src == 0u || n_out < 1u || n_out > LIDET_PROPOSAL_POINTS)
     {
         return LIDET_ERR_ARG;
     }
-    /* the resampling rule's indices into the part's members, found in one pass in member order
-     * (lidet_group.c) */
-    want = lidet__proposal_next_index(&state, 0u, n_src, n_out);
-    for (m = 0; m < r->n_points && i < n_out; ++m)
+    /* IN_PART leaves the member's offsets from the cluster mean in d for WRITE */
+#define GP_IN_PART(m)                                                                                        \
+    (member_d(g, img, (uint32_t)c->members[r->first_member + (m)], d), part_of(g, offset_t(g, d)) == part)
+#define GP_WRITE(i, m)                                                                                       \
+    (out->xyz[i][0] = sat16(d[0] + g->mean[0] - mx), out->xyz[i][1] = sat16(d[1] + g->mean[1] - my),         \
+     out->xyz[i][2] = sat16(d[2] + g->mean[2] - zo))
+#define GP_COPY(i, k) memcpy(out->xyz[i], out->xyz[k], sizeof out->xyz[i])
+    LIDET__GROUP_RESAMPLE(cfg->seed, n_src, n_out, r->n_points, GP_IN_PART, GP_WRITE, GP_COPY, st);
+#undef GP_IN_PART
+#undef GP_WRITE
+#undef GP_COPY
+    if (st != LIDET_OK)
     {
-        int32_t d[3];
-        const uint32_t p = (uint32_t)c->members[r->first_member + m];
-        member_d(g, img, p, d);
-        if (part_of(g, offset_t(g, d)) != part)
-        {
-            continue;
-        }
-        while (i < n_out && want == ord)
-        {
-            out->xyz[i][0] = sat16(d[0] + g->mean[0] - mx);
-            out->xyz[i][1] = sat16(d[1] + g->mean[1] - my);
-            out->xyz[i][2] = sat16(d[2] + g->mean[2] - zo);
-            ++i;
-            if (n_src <= n_out && i >= n_src)
-            {
-                break; /* the rest are draws among the rows written */
-            }
-            if (i < n_out)
-            {
-                want = lidet__proposal_next_index(&state, i, n_src, n_out);
-            }
-        }
-        ++ord;
-    }
-    if (n_src <= n_out)
-    {
-        if (i != n_src)
-        {
-            return LIDET_ERR_STATE; /* cannot happen: the cut counted these members */
-        }
-        for (; i < n_out; ++i)
-        {
-            const uint32_t k = lidet__proposal_next_index(&state, i, n_src, n_out);
-            memcpy(out->xyz[i], out->xyz[k], sizeof out->xyz[i]);
-        }
-    }
-    else if (i != n_out)
-    {
-        return LIDET_ERR_STATE;
+        return st;
     }
     out->mean_4mm[0] = mx;
     out->mean_4mm[1] = my;
