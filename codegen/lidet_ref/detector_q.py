@@ -13,7 +13,9 @@ import numpy as np
 from lidet_ref import cluster_q, ground_q, group_q, pointnet_q, post_q, proj_q, qmath
 
 (OUT_CROP, OUT_RANGE, OUT_BUDGET, OUT_GATE1, OUT_GATE2, OUT_SIZE, OUT_NMS, OUT_CAPACITY, OUT_DETECTED, OUT_TALL,
- OUT_GROUP) = range(1, 12)
+ OUT_GROUP, OUT_SCORE) = range(1, 13)
+#: LIDET_DET_FLAT_MIN_POINTS: member pixels a car's cluster needs before the flat-surface test judges it
+FLAT_MIN_POINTS = 100
 #: lidet_detector_q_cfg_default's gate2_class: gate 2 judges cars and cyclists, pedestrians pass it
 GATE2_CLASS = (1, 1, 0)
 
@@ -76,7 +78,9 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     max_proposals, max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max, score_box_weight_q16 (3), score_points_weight_q16 (3), and optionally gate1_margin_q16 / gate2_margin_q16
     (0 when absent: the models' gammas), gate2_class (3 flags, lidet_class_t order: the classes gate 2 judges;
     GATE2_CLASS when absent, the C default), group_split (0 when absent; the C default is 1 for > 16 rows) and
-    group_max_range_mm (40000 when absent). range_only: the image keeps only the range, every stage reads x, y, z
+    group_max_range_mm (40000 when absent), min_score_q15 (3, the operating point; 0s when absent: off; the C
+    default is 19661 for cars and pedestrians with > 16 rows) and car_min_z_spread_mm (the cars' flat-surface test;
+    0 when absent: off; the C default is 600). range_only: the image keeps only the range, every stage reads x, y, z
     decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
     (dicts), outcomes, stats. returns: (range_mm, azimuth, ring) instead of points_mm (lidet_detector_q_run_returns:
     proj_q.project_returns)."""
@@ -106,11 +110,23 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     order, truncated = candidates(recs, det_cfg, outcome)
     stats = dict(n_clusters=len(recs), n_too_tall=outcome.count(OUT_TALL), n_classified=0, n_gate1_rejected=0,
                  n_boxed=0, n_gate2_rejected=0, n_size_rejected=0, n_nms_suppressed=0, n_over_capacity=0,
-                 n_over_box_budget=0, n_group_split=0, n_group_classified=0, n_group_boxed=0)
+                 n_over_box_budget=0, n_group_split=0, n_group_classified=0, n_group_boxed=0, n_score_rejected=0)
     dets = []
     g2c = det_cfg.get("gate2_class", GATE2_CLASS)
     g1m, g2m = int(det_cfg.get("gate1_margin_q16", 0)), int(det_cfg.get("gate2_margin_q16", 0))
     Xf, Yf, Zf = X.ravel(), Y.ravel(), Z.ravel()
+
+    min_score = [int(v) for v in det_cfg.get("min_score_q15", (0, 0, 0))]
+    flat_mm = int(det_cfg.get("car_min_z_spread_mm", 0))
+
+    def flat(ci):
+        """lidet_detector_q.c flat_surface: >= FLAT_MIN_POINTS members and 192 sum dz^2 < t^2 n (t in mm)."""
+        rec = recs[ci]
+        if flat_mm <= 0 or rec.n_points < FLAT_MIN_POINTS:
+            return False
+        pix = np.asarray(members, np.int64)[rec.first_member: rec.first_member + rec.n_points]
+        dz = Zf[pix] - int(rec.mean[2])
+        return 192 * int(np.dot(dz, dz)) < flat_mm * flat_mm * int(rec.n_points)
 
     def gate1_pass(cls, energy):
         return energy < int(cls_model.gamma_q16[cls]) + g1m
@@ -170,10 +186,13 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
                 if (det_cfg["gate2"] and g2c[cls] and not int(b["energy"][0]) < int(box_model.gamma_q16[cls]) + g2m) or \
                         not post_q.size_ok(cls, [int(v) for v in b["box"][0]], det_cfg["size_min"], det_cfg["size_max"]):
                     continue
+                d = detection(ci, cls, energy, b, n_src)
+                if d["score_q15"] < min_score[cls]:  # not counted: the counts are per cluster
+                    continue
                 if outcome[ci] != OUT_GROUP:
                     outcome[ci] = OUT_GROUP
                     stats["n_group_split"] += 1
-                truncated |= add(detection(ci, cls, energy, b, n_src))
+                truncated |= add(d)
             return
 
     group_on = int(det_cfg.get("group_split", 0))
@@ -202,14 +221,22 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
             if group_on:
                 group(ci)
             continue
-        if not post_q.size_ok(cls, [int(v) for v in b["box"][0]], det_cfg["size_min"], det_cfg["size_max"]):
+        if not post_q.size_ok(cls, [int(v) for v in b["box"][0]], det_cfg["size_min"], det_cfg["size_max"]) or \
+                (cls == 0 and flat(ci)):
             outcome[ci] = OUT_SIZE
             stats["n_size_rejected"] += 1
             if group_on:
                 group(ci)
             continue
+        d = detection(ci, cls, energy, b, recs[ci].n_points)
+        if d["score_q15"] < min_score[cls]:
+            outcome[ci] = OUT_SCORE
+            stats["n_score_rejected"] += 1
+            if group_on:
+                group(ci)
+            continue
         outcome[ci] = OUT_DETECTED
-        truncated |= add(detection(ci, cls, energy, b, recs[ci].n_points))
+        truncated |= add(d)
     kept, flags = post_q.nms(dets, int(det_cfg["nms_iou_q15"]))
     for d, f in zip(dets, flags):
         if f:

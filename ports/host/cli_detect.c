@@ -423,6 +423,7 @@ static void json_result(const cli_args_t *a, const char *chosen, const lidet_det
     cli_json_int(stdout, "group_split", ds->n_group_split);
     cli_json_int(stdout, "group_classified", ds->n_group_classified);
     cli_json_int(stdout, "group_boxed", ds->n_group_boxed);
+    cli_json_int(stdout, "score_rejected", ds->n_score_rejected);
     cli_json_int(stdout, "detections", n_det);
     cli_json_int(stdout, "status", st);
     cli_json_int(stdout, "repeat", a->repeat);
@@ -467,6 +468,7 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, gate2_margin)
     CLI_SET_INT(c, kv, klen, v, group_split, uint8_t, 1)
     CLI_SET_FLOAT(c, kv, klen, v, group_max_range_m)
+    CLI_SET_FLOAT(c, kv, klen, v, car_min_z_spread_m)
     {
         /* score_box_weight.CLASS / score_points_weight.CLASS / gate2.CLASS, in lidet_class_t order */
         static const char *const names[LIDET_N_CLASSES] = {"score_box_weight.car", "score_box_weight.cyclist",
@@ -474,6 +476,8 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
         static const char *const gnames[LIDET_N_CLASSES] = {"gate2.car", "gate2.cyclist", "gate2.pedestrian"};
         static const char *const pnames[LIDET_N_CLASSES] = {"score_points_weight.car", "score_points_weight.cyclist",
                                                             "score_points_weight.pedestrian"};
+        static const char *const mnames[LIDET_N_CLASSES] = {"min_score.car", "min_score.cyclist",
+                                                            "min_score.pedestrian"};
         int k;
         for (k = 0; k < LIDET_N_CLASSES; ++k)
         {
@@ -485,6 +489,11 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
             if (klen == strlen(pnames[k]) && strncmp(kv, pnames[k], klen) == 0)
             {
                 c->score_points_weight[k] = (float)v;
+                return 0;
+            }
+            if (klen == strlen(mnames[k]) && strncmp(kv, mnames[k], klen) == 0)
+            {
+                c->min_score[k] = (float)v;
                 return 0;
             }
             if (klen == strlen(gnames[k]) && strncmp(kv, gnames[k], klen) == 0)
@@ -596,6 +605,11 @@ void cli_det_usage(FILE *f)
                "                   group_split (0 or 1: people side by side in one cluster\n"
                "                   split by the classifier's judgement; default 1 for > 16\n"
                "                   beams), group_max_range_m (default 40),\n"
+               "                   min_score.car|cyclist|pedestrian (the operating point: detections\n"
+               "                   scoring below are dropped; default 0.6, 0, 0.6 for > 16 beams,\n"
+               "                   0 for <= 16), car_min_z_spread_m (a car's cluster of >= 100\n"
+               "                   pixels flatter than this in z is a surface; 0: off; default 0.6\n"
+               "                   for > 16 beams, 0 for <= 16),\n"
                "                   score_box_weight.car|cyclist|pedestrian (the score's weight on gate 2's\n"
                "                   margin), score_points_weight.CLASS (on ln(points / 64));\n"
                "                   stages.cluster.KEY: a\n"

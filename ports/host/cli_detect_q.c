@@ -105,6 +105,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
         (uint32_t)round_i32((double)fcfg->stages.cluster.regrow_max_height_m * 1000.0);
     cfg.group_split = fcfg->group_split;
     cfg.group_max_range_mm = round_i32((double)fcfg->group_max_range_m * 1000.0);
+    cfg.car_min_z_spread_mm = round_i32((double)fcfg->car_min_z_spread_m * 1000.0);
     cfg.gate1 = fcfg->gate1;
     cfg.gate2 = fcfg->gate2;
     cfg.gate1_margin_q16 = round_i32((double)fcfg->gate1_margin * 65536.0);
@@ -113,6 +114,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     {
         cfg.gate2_class[k] = fcfg->gate2_class[k];
         cfg.score_box_weight_q16[k] = round_i32((double)fcfg->score_box_weight[k] * 65536.0);
+        cfg.min_score_q15[k] = round_i32((double)fcfg->min_score[k] * 32768.0);
         cfg.score_points_weight_q16[k] = round_i32((double)fcfg->score_points_weight[k] * 65536.0);
     }
     cfg.nms_iou_q15 = round_i32((double)fcfg->nms_iou * 32768.0);
@@ -209,6 +211,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     ds->n_group_split = st->n_group_split;
     ds->n_group_classified = st->n_group_classified;
     ds->n_group_boxed = st->n_group_boxed;
+    ds->n_score_rejected = st->n_score_rejected;
     ds->n_detections = st->n_detections;
     ds->stages.ground = st->ground; /* the same counts (lidet detect's mount-height warning reads them) */
     dq = lidet_detector_q_detections(&g_detq, n_det);

@@ -18,14 +18,15 @@
 static lidet_detector_t g_det;
 static int32_t g_pp[LIDET_MAX_POINTS];
 
-/* fcfg: crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin, mount_height_m (< 0: the profile's);
+/* fcfg: crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin, mount_height_m (< 0: the profile's),
+ * min_score per class (3 entries, < 0: the default for the sensor), car_min_z_spread_m (< 0: the default);
  * ucfg: max_proposals (0 = the default), gate1, gate2, refine (the clustering's split_people and join_cars),
  * gate2_class as bits (bit k: class k, lidet_class_t order; 0xFFFFFFFF = the default), group_split (0, 1;
  * 0xFFFFFFFF = the default for the sensor).
  * out_det: LIDET_MAX_DETECTIONS rows of 12 floats (class, score, energy_cls, energy_box, cx, cy, cz, l, w, h,
  * yaw, cluster id); out_outcome: LIDET_MAX_CLUSTERS bytes; out_point_cluster / out_point_ground: n entries
- * (may be NULL); out_stats: 18 uint32 (the lidet_detector_stats_t counts in order, the status, then
- * n_over_box_budget, n_too_tall and the three group counts). */
+ * (may be NULL); out_stats: 19 uint32 (the lidet_detector_stats_t counts in order, the status, then
+ * n_over_box_budget, n_too_tall, the three group counts and n_score_rejected). */
 static int det_run(const lidet_sensor_t *s, uint32_t cls_index, uint32_t box_index, const float *fcfg,
                    const uint32_t *ucfg, const float *pts, uint32_t n, uint32_t stride, float *out_det,
                    uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters, uint32_t *out_point_cluster,
@@ -74,6 +75,17 @@ static int det_run(const lidet_sensor_t *s, uint32_t cls_index, uint32_t box_ind
     if (ucfg[5] != 0xFFFFFFFFu) /* the group split; all ones: the default for the sensor */
     {
         cfg.group_split = (uint8_t)(ucfg[5] != 0u);
+    }
+    for (k = 0; k < LIDET_N_CLASSES; ++k)
+    {
+        if (fcfg[6 + k] >= 0.0f) /* the operating point; < 0: the default for the sensor */
+        {
+            cfg.min_score[k] = fcfg[6 + k];
+        }
+    }
+    if (fcfg[9] >= 0.0f) /* the cars' flat-surface test; < 0: the default */
+    {
+        cfg.car_min_z_spread_m = fcfg[9];
     }
     cfg.stages.cluster.split_people = ucfg[3] != 0u; /* the proposal refinement (lidet_refine.c) */
     cfg.stages.cluster.join_cars = ucfg[3] != 0u;
@@ -143,6 +155,7 @@ static int det_run(const lidet_sensor_t *s, uint32_t cls_index, uint32_t box_ind
     out_stats[15] = st->n_group_split;
     out_stats[16] = st->n_group_classified;
     out_stats[17] = st->n_group_boxed;
+    out_stats[18] = st->n_score_rejected;
     return rc;
 }
 

@@ -63,6 +63,20 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
     {
         cfg.group_split = (uint8_t)(icfg[11] != 0);
     }
+    {
+        int k;
+        for (k = 0; k < LIDET_N_CLASSES; ++k)
+        {
+            if (icfg[12 + k] >= 0) /* the operating point per class; -1: the default for the sensor */
+            {
+                cfg.min_score_q15[k] = icfg[12 + k];
+            }
+        }
+    }
+    if (icfg[15] >= 0) /* the cars' flat-surface test; -1: the default */
+    {
+        cfg.car_min_z_spread_mm = icfg[15];
+    }
     if (icfg[9] >= 0) /* -1: the build's default */
     {
         cfg.range_only = (uint8_t)icfg[9];
@@ -78,10 +92,12 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
 
 /* lidet_py_detq_run: icfg: crop_half_bam, max_range_mm, nms_iou_q15, max_proposals (0 = default), gate1, gate2,
  * max_boxes (0 = default), gate1_margin_q16, gate2_margin_q16, range_only (-1 = the build's default, 0, 1),
- * gate2_class as bits (bit k: class k; -1 = the default), group_split (0, 1; -1 = the default for the sensor).
+ * gate2_class as bits (bit k: class k; -1 = the default), group_split (0, 1; -1 = the default for the sensor),
+ * min_score_q15 per class (3 entries, -1 = the default), car_min_z_spread_mm (-1 = the default).
  * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
- * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 17 uint32 (the
- * counts of lidet_detector_q_stats_t in order, then n_over_box_budget, n_too_tall and the three group counts). returns: n lidet_return_t
+ * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 18 uint32 (the
+ * counts of lidet_detector_q_stats_t in order, then n_over_box_budget, n_too_tall, the three group counts and
+ * n_score_rejected). returns: n lidet_return_t
  * instead of the points (lidet_detector_q_run_returns; pts_mm ignored), or NULL. Returns the run's status. */
 LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, const char *box_name,
                                    const int32_t *icfg, const int32_t *pts_mm, uint32_t n, uint32_t stride,
@@ -125,11 +141,11 @@ LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, con
     memcpy(out_outcome, oc, *n_clusters);
     st = lidet_detector_q_stats(&g_detq);
     {
-        const uint32_t v[17] = {st->n_clusters,     st->n_out_of_crop,    st->n_out_of_range,   st->n_over_budget,
+        const uint32_t v[18] = {st->n_clusters,     st->n_out_of_crop,    st->n_out_of_range,   st->n_over_budget,
                                 st->n_classified,   st->n_gate1_rejected, st->n_boxed,          st->n_gate2_rejected,
                                 st->n_size_rejected, st->n_nms_suppressed, st->n_over_capacity, st->n_detections,
                                 st->n_over_box_budget, st->n_too_tall, st->n_group_split,
-                                st->n_group_classified, st->n_group_boxed};
+                                st->n_group_classified, st->n_group_boxed, st->n_score_rejected};
         memcpy(out_stats, v, sizeof v);
     }
     return rc;

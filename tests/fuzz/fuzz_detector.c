@@ -78,7 +78,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     FZ_CHECK(ds->n_classified <= cfg.max_proposals && ds->n_boxed <= ds->n_classified);
     for (i = 0; i < n_cl; ++i)
     {
-        FZ_CHECK(out[i] >= 1 && out[i] <= LIDET_DET_OUT_GROUP);
+        FZ_CHECK(out[i] >= 1 && out[i] <= LIDET_DET_OUT_SCORE);
         n_detected += out[i] == LIDET_DET_OUT_DETECTED;
         n_budget += out[i] == LIDET_DET_OUT_BUDGET;
     }

@@ -164,7 +164,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
                                                                   ds->n_boxed);
     for (i = 0; i < n_cl; ++i)
     {
-        FZ_CHECK(out[i] >= 1 && out[i] <= LIDET_DET_OUT_GROUP);
+        FZ_CHECK(out[i] >= 1 && out[i] <= LIDET_DET_OUT_SCORE);
         n_detected += out[i] == LIDET_DET_OUT_DETECTED;
     }
     FZ_CHECK(n_detected <= n_det && n_det <= n_detected + 4u * ds->n_group_split); /* up to 4 per group */

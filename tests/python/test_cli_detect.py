@@ -33,7 +33,8 @@ def test_json_contract(cli):
     assert js["classified"] == min(js["clusters"] - js["out_of_crop"] - js["too_tall"] - js["out_of_range"],
                                    js["budget"])
     assert js["classified"] == js["gate1_rejected"] + js["boxed"]
-    assert js["boxed"] == js["gate2_rejected"] + js["size_rejected"] + js["nms_suppressed"] + js["detections"]
+    assert js["boxed"] == (js["gate2_rejected"] + js["size_rejected"] + js["score_rejected"] + js["nms_suppressed"] +
+                           js["detections"])
     assert len(js["boxes"]) == js["detections"]
     assert js["total_ms"] >= js["box_ms"]
 

@@ -70,9 +70,9 @@ def test_bad_values_say_what_was_expected(cli):
 
 def test_options_before_and_after_the_scan(cli, tmp_path):
     """The same run whatever the order: the box lines, the --dump bytes and the JSON (times aside)."""
-    opts = ["--sensor", "hdl64", "--set", "gate1=0", "--json"]
+    opts = ["--sensor", "hdl64", "--set", "min_score.car=0.5", "--json"]
     outs = []
-    for k, args in enumerate(([SCAN, *opts], [*opts, SCAN], ["--sensor", "hdl64", SCAN, "--set", "gate1=0", "--json"])):
+    for k, args in enumerate(([SCAN, *opts], [*opts, SCAN], ["--sensor", "hdl64", SCAN, "--set", "min_score.car=0.5", "--json"])):
         r = _run(cli, "detect", *args, "--out", tmp_path / f"b{k}.txt", "--dump", tmp_path / f"d{k}.bin")
         assert r.returncode == 0, r.stderr
         outs.append((_untimed(r.stdout), (tmp_path / f"b{k}.txt").read_bytes(), (tmp_path / f"d{k}.bin").read_bytes()))

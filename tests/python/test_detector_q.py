@@ -162,7 +162,7 @@ def test_score_matches_the_float_definition(nq):
 # ---- the integer detector against the chained numpy reference, bit for bit ---------------------------
 
 def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False, crop_half_bam=0, returns=None,
-                gate2_class=None, group_split=None, model=None):
+                gate2_class=None, group_split=None, model=None, min_score_q15=None, car_min_z_spread_mm=None):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -180,7 +180,10 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
     det_cfg = dict(crop_half_bam=crop_half_bam, max_range_mm=0, max_height_extent_mm=2500, score_box_weight_q16=[32768, 0, 0], score_points_weight_q16=[6554, 0, 0], max_proposals=min(128 if s.rows <= 16 else 256, cap["max_clusters"]),
                    max_boxes=max_boxes or min(24 if s.rows <= 16 else 48, cap["max_clusters"]), gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM,
                    gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
-                   group_split=int(s.rows > 16 if group_split is None else group_split), group_max_range_mm=40000)
+                   group_split=int(s.rows > 16 if group_split is None else group_split), group_max_range_mm=40000,
+                   min_score_q15=min_score_q15 or ([19661, 0, 19661] if s.rows > 16 else [0, 0, 0]),
+                   car_min_z_spread_mm=(600 if s.rows > 16 else 0) if car_min_z_spread_mm is None else
+                   car_min_z_spread_mm)
     if gate2_class is not None:
         det_cfg["gate2_class"] = gate2_class
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
@@ -189,6 +192,7 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
 
 
 @pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "gate2_all", "group", "group_real",
+                                   "min_score", "flat",
                                    "range_only_sample",
                                    "range_only_fresh", "range_only_real", "crop_hdl64", "crop_real",
                                    "returns_sample", "returns_range_only_sample", "returns_range_only_fresh"])
@@ -198,6 +202,7 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     returns (lidet_detector_q_run_returns: ring, azimuth, range) instead of points."""
     from lidet_ref import proj_q
     sensor, max_boxes, margins, g2c, model = "vlp16", 0, (0, 0), None, None
+    min_score, flat_mm = None, None
     use_returns = which.startswith("returns_")
     which = which.removeprefix("returns_")
     range_only = which.startswith("range_only_")
@@ -219,9 +224,16 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
         pts, ring = sc.points, sc.ring
     elif which == "hdl64":
         sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
-    elif which == "group":  # gate 1 looser by 4 nats: a cluster boxed as something else is split into people
+    elif which == "min_score":  # the operating point raised to 0.8 for every class: more detections dropped
         sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
-        margins = (4 * 65536, 0)
+        min_score = [26214] * 3
+    elif which == "flat":  # the flat-surface test at 1.6 m: the car of 122 members (z spread 1.3-1.6 m) goes
+        sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
+        flat_mm = 1600
+    elif which == "group":  # gate 1 looser by 4 nats: a cluster boxed as something else is split into people (the
+        # operating point off: parts passing a gate moved by 4 nats score below it)
+        sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
+        margins, min_score = (4 * 65536, 0), [0, 0, 0]
     elif which == "group_real":  # a real PandaSet frame: people side by side split at the default gates
         from lidet_tools import real as R
         fr = R.load_frame(request.getfixturevalue("real_dir"), "pandaset", "000000")
@@ -233,14 +245,21 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     rets = proj_q.returns_of_points(mm, ring) if use_returns else None
     c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
                     range_only=range_only, crop_half_bam=crop, returns=None if rets is None else nq.as_returns(*rets),
-                    gate2_class=g2c, model=model)
-    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop, returns=rets, gate2_class=g2c, model=model)
+                    gate2_class=g2c, model=model, min_score_q15=min_score, car_min_z_spread_mm=flat_mm)
+    r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop, returns=rets, gate2_class=g2c, model=model,
+                        min_score_q15=min_score, car_min_z_spread_mm=flat_mm)
     if use_returns:  # the same scan as points gives nearly the same detections (pixels move by rounding only)
         p = nq.detect_q(mm, sensor, range_only=range_only)
         assert abs(len(p["cls"]) - len(c["cls"])) <= 2 and c["stats"]["n_clusters"] > 0
     if crop:
         assert c["stats"]["n_out_of_crop"] > 0
-    if which in ("group", "group_real"):  # the group split fired: its parts' detections carry the cluster's id
+    if which in ("min_score", "flat"):  # the setting bites: against the defaults, more clusters lose their detection
+        c0 = nq.detect_q(mm, sensor)
+        key = "n_score_rejected" if which == "min_score" else "n_size_rejected"
+        assert c["stats"][key] > c0["stats"][key] and len(c["cls"]) < len(c0["cls"])
+        if which == "min_score":
+            assert np.all(c["score_q15"] >= 26214) and np.any(c["outcome"] == 12)
+    elif which in ("group", "group_real"):  # the group split fired: its parts' detections carry the cluster's id
         groups = np.flatnonzero(c["outcome"] == 11) + 1
         assert len(groups) >= 1
         for g in groups:
@@ -259,7 +278,7 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     assert c["outcome"].tolist() == r["outcome"]
     for k in ("n_clusters", "n_classified", "n_gate1_rejected", "n_boxed", "n_gate2_rejected", "n_size_rejected",
               "n_nms_suppressed", "n_detections", "n_over_box_budget", "n_group_split", "n_group_classified",
-              "n_group_boxed"):
+              "n_group_boxed", "n_score_rejected"):
         assert c["stats"][k] == r["stats"][k], k
     assert len(r["detections"]) == len(c["cls"]) > 0
     for i, d in enumerate(r["detections"]):

@@ -232,6 +232,53 @@ void test_three_objects_three_cars(void)
         c.score_points_weight[LIDET_CLASS_CYCLIST] = 4.01f;
         TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     }
+    {
+        /* the operating point: a car scoring below min_score is dropped (outcome SCORE); the flat-surface test: the
+         * three faces (1.5-1.7 m tall, hundreds of member pixels) spread about their height in z, so a test at
+         * 1.0 m keeps them and one at 2.0 m calls them surfaces (outcome SIZE) */
+        lidet_detector_cfg_t c = cfg;
+        uint32_t nc = 0, k2;
+        const uint8_t *oc;
+        float top = 0.0f;
+        c.score_box_weight[LIDET_CLASS_CAR] = 0.0f; /* the classifier's energy alone: scores about 0.995 */
+        c.score_points_weight[LIDET_CLASS_CAR] = 0.0f;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+        d = lidet_detector_detections(&g.ws, &n);
+        for (k2 = 0; k2 < n; ++k2)
+        {
+            top = d[k2].score > top ? d[k2].score : top;
+        }
+        TEST_ASSERT_TRUE(n == 3 && top < 0.999f);
+        c.min_score[LIDET_CLASS_CAR] = top + 1e-3f;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+        lidet_detector_detections(&g.ws, &n);
+        TEST_ASSERT_EQUAL_UINT32(0, n);
+        TEST_ASSERT_EQUAL_UINT32(3, lidet_detector_stats(&g.ws)->n_score_rejected);
+        oc = lidet_detector_outcomes(&g.ws, &nc);
+        for (k2 = 0; k2 < nc; ++k2)
+        {
+            TEST_ASSERT_EQUAL_UINT8(LIDET_DET_OUT_SCORE, oc[k2]);
+        }
+        c.min_score[LIDET_CLASS_CAR] = 0.0f;
+        c.car_min_z_spread_m = 1.0f;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+        lidet_detector_detections(&g.ws, &n);
+        TEST_ASSERT_EQUAL_UINT32(3, n);
+        c.car_min_z_spread_m = 2.0f;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+        lidet_detector_detections(&g.ws, &n);
+        TEST_ASSERT_EQUAL_UINT32(0, n);
+        TEST_ASSERT_EQUAL_UINT32(3, lidet_detector_stats(&g.ws)->n_size_rejected);
+        oc = lidet_detector_outcomes(&g.ws, &nc);
+        for (k2 = 0; k2 < nc; ++k2)
+        {
+            TEST_ASSERT_EQUAL_UINT8(LIDET_DET_OUT_SIZE, oc[k2]);
+        }
+    }
 }
 
 void test_crop_budget_range_and_gates(void)
@@ -240,6 +287,8 @@ void test_crop_budget_range_and_gates(void)
     const lidet_detection_t *d;
     uint32_t n = 0;
     scene();
+    /* the gates and the size check alone: the operating point off (the gammas moved below make the scores tiny) */
+    memset(cfg.min_score, 0, sizeof cfg.min_score);
     cfg.crop_half_rad = 0.25f * 3.14159265f;
     /* the crop's window on the clustering lifted (pi): C is clustered, then left out by the crop */
     cfg.stages.cluster.azimuth_half_rad = 3.14159265f;
@@ -492,14 +541,30 @@ void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c.group_max_range_m = NAN;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
+    c.min_score[LIDET_CLASS_PEDESTRIAN] = 1.5f; /* [0, 1] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.min_score[LIDET_CLASS_PEDESTRIAN] = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
+    c.car_min_z_spread_m = -0.1f; /* [0, 10] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.car_min_z_spread_m = INFINITY;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     {
-        /* the group split: on for > 16 beams, off for <= 16, within 40 m */
+        /* the group split, the operating point and the flat-surface test: on for > 16 beams, off for <= 16 */
         lidet_detector_cfg_t d0;
         lidet_detector_cfg_default(&d0, lidet_sensor_find("hdl64"));
         TEST_ASSERT_EQUAL_UINT8(1, d0.group_split);
         TEST_ASSERT_EQUAL_FLOAT(40.0f, d0.group_max_range_m);
+        TEST_ASSERT_EQUAL_FLOAT(0.6f, d0.min_score[LIDET_CLASS_CAR]);
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_CYCLIST]);
+        TEST_ASSERT_EQUAL_FLOAT(0.6f, d0.min_score[LIDET_CLASS_PEDESTRIAN]);
+        TEST_ASSERT_EQUAL_FLOAT(0.6f, d0.car_min_z_spread_m);
         lidet_detector_cfg_default(&d0, lidet_sensor_find("vlp16"));
         TEST_ASSERT_EQUAL_UINT8(0, d0.group_split);
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_CAR]);
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.car_min_z_spread_m);
     }
     c = cfg;
     c.size_min_m[1][2] = 5.0f;

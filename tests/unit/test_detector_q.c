@@ -92,11 +92,29 @@ static void test_init_errors(void)
     lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.group_max_range_mm = -1; /* [0, 10^6] */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
-    lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("hdl64")); /* the group split: on for > 16 rows */
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.min_score_q15[LIDET_CLASS_CYCLIST] = 32769; /* [0, 32768] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.min_score_q15[LIDET_CLASS_CYCLIST] = -1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.car_min_z_spread_mm = 10001; /* [0, 10000] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.car_min_z_spread_mm = -1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    /* the group split, the operating point and the flat-surface test: on for > 16 rows, off for <= 16 */
+    lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("hdl64"));
     TEST_ASSERT_EQUAL_UINT8(1, cfg.group_split);
     TEST_ASSERT_EQUAL_INT32(40000, cfg.group_max_range_mm);
+    TEST_ASSERT_EQUAL_INT32(19661, cfg.min_score_q15[LIDET_CLASS_CAR]);
+    TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_CYCLIST]);
+    TEST_ASSERT_EQUAL_INT32(19661, cfg.min_score_q15[LIDET_CLASS_PEDESTRIAN]);
+    TEST_ASSERT_EQUAL_INT32(600, cfg.car_min_z_spread_mm);
     lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("vlp16"));
     TEST_ASSERT_EQUAL_UINT8(0, cfg.group_split);
+    TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_CAR]);
+    TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_PEDESTRIAN]);
+    TEST_ASSERT_EQUAL_INT32(0, cfg.car_min_z_spread_mm);
     lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.max_proposals = 0;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
@@ -150,7 +168,7 @@ static void test_init_errors(void)
 
 static void check_invariants(const lidet_detector_q_cfg_t *cfg)
 {
-    uint32_t n, nc, i, counts[12] = {0};
+    uint32_t n, nc, i, counts[LIDET_DET_OUT_SCORE + 1] = {0};
     const lidet_detection_q_t *d = lidet_detector_q_detections(&g.ws, &n);
     const uint8_t *oc = lidet_detector_q_outcomes(&g.ws, &nc);
     const lidet_detector_q_stats_t *st = lidet_detector_q_stats(&g.ws);
@@ -174,7 +192,7 @@ static void check_invariants(const lidet_detector_q_cfg_t *cfg)
     }
     for (i = 0; i < nc; ++i)
     {
-        TEST_ASSERT_TRUE(oc[i] >= 1 && oc[i] <= LIDET_DET_OUT_GROUP);
+        TEST_ASSERT_TRUE(oc[i] >= 1 && oc[i] <= LIDET_DET_OUT_SCORE);
         ++counts[oc[i]];
     }
     TEST_ASSERT_EQUAL_UINT32(st->n_out_of_crop, counts[LIDET_DET_OUT_CROP]);
@@ -184,9 +202,10 @@ static void check_invariants(const lidet_detector_q_cfg_t *cfg)
     TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_GATE1] <= st->n_gate1_rejected);
     TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_GATE2] <= st->n_gate2_rejected);
     TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_SIZE] <= st->n_size_rejected);
-    TEST_ASSERT_EQUAL_UINT32(st->n_gate1_rejected + st->n_gate2_rejected + st->n_size_rejected,
+    TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_SCORE] <= st->n_score_rejected);
+    TEST_ASSERT_EQUAL_UINT32(st->n_gate1_rejected + st->n_gate2_rejected + st->n_size_rejected + st->n_score_rejected,
                              counts[LIDET_DET_OUT_GATE1] + counts[LIDET_DET_OUT_GATE2] + counts[LIDET_DET_OUT_SIZE] +
-                                 counts[LIDET_DET_OUT_GROUP]);
+                                 counts[LIDET_DET_OUT_SCORE] + counts[LIDET_DET_OUT_GROUP]);
     TEST_ASSERT_EQUAL_UINT32(st->n_group_split, counts[LIDET_DET_OUT_GROUP]);
     TEST_ASSERT_TRUE(st->n_boxed + st->n_group_boxed <= cfg->max_boxes);
     TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_NMS] <= st->n_nms_suppressed); /* a group keeps its outcome */

@@ -13,7 +13,8 @@ The candidates (classified clusters, nearest first) come from each detector's ow
 (lidet_tools.native.candidates_float / candidates_q); the networks, gates, size check, score and NMS are
 applied here with the rules of the nets' side: the float detector's (float32 energies, box budget, float NMS) for
 the float nets, the integer detector's (Q16 energies, Q15 score, lidet_post_q's size check and NMS in C) for the
-int8 nets; the two pure combinations reproduce the detectors' outputs. Prints AP R40 3D moderate per class and,
+int8 nets; the two pure combinations reproduce the detectors' outputs with the cars' flat-surface test off (it reads
+the cluster's members, which the candidates do not carry; it is off in all four here). Prints AP R40 3D moderate per class and,
 per class, the moderate objects each detector finds or loses against the float detector.
 """
 from __future__ import annotations
@@ -45,6 +46,19 @@ SCORE_BOX_WEIGHT = (0.5, 0.0, 0.0)
 SCORE_POINTS_WEIGHT = (0.1, 0.0, 0.0)  # score_points_weight (_q16 = round(v 2^16))
 #: the classes gate 2 judges (car, cyclist, pedestrian): gate2_class of both detectors' defaults
 GATE2_CLASS = RD.GATE2_CLASS
+#: the operating point (car, cyclist, pedestrian): min_score of lidet_detector_cfg_default for > 16 beams (0 for
+#: <= 16), and min_score_q15 = round(v 2^15) of lidet_detector_q_cfg_default
+MIN_SCORE = (0.6, 0.0, 0.6)
+
+
+def min_score(fam: str) -> tuple:
+    """The detectors' default operating point for a family's sensor (the family named after its preset)."""
+    from lidet_tools import sensors
+    try:
+        rows = sensors.get_sensor(fam).rows
+    except (KeyError, ValueError):
+        rows = 64
+    return MIN_SCORE if rows > 16 else (0.0, 0.0, 0.0)
 
 
 def nets_float(fam, xyz, mean, vox, cid, max_boxes, npts):
@@ -53,7 +67,7 @@ def nets_float(fam, xyz, mean, vox, cid, max_boxes, npts):
     mb = native.pn_models()[f"box_{fam}"]
     c = native.pn_classify(f"cls_{fam}", xyz, mean, vox)
     b = native.pn_box(f"box_{fam}", xyz, mean, vox, c["cls"])
-    dets, n_boxed = [], 0
+    dets, n_boxed, ms = [], 0, min_score(fam)
     for k in range(len(xyz)):
         if not c["passed"][k]:
             continue
@@ -71,6 +85,8 @@ def nets_float(fam, xyz, mean, vox, cid, max_boxes, npts):
             ln_n = np.float32(np.log(np.float32(max(int(npts[k]), 1)))) - np.float32(4.15888309)
             t = np.float32(t - np.float32(SCORE_POINTS_WEIGHT[cl]) * ln_n)
         s = np.float32(1.0) / (np.float32(1.0) + np.exp(np.float32(t)))
+        if s < np.float32(ms[cl]):
+            continue
         dets.append((float(s), int(cid[k]), cl, bx.astype(np.float64)))
     dets.sort(key=lambda d: (-d[0], d[1]))
     kept = []
@@ -95,6 +111,10 @@ def nets_int8(fam, q4, m4, vox, cid, npts):
                                              int(gam[c["cls"][k]]), int(gam_b[c["cls"][k]]),
                                              round(SCORE_BOX_WEIGHT[c["cls"][k]] * 65536),
                                              round(SCORE_POINTS_WEIGHT[c["cls"][k]] * 65536)) for k in keep], np.int32)
+    above = score >= np.asarray([round(v * 32768) for v in min_score(fam)])[cls]  # the operating point
+    keep, cls, score = keep[above], cls[above], score[above]
+    if len(keep) == 0:
+        return []
     boxes = b["box"][keep]
     ok = native.post_q(boxes, score, cid[keep], cls, 3277)
     # post_q returns the kept cluster ids in order (size check applied first)

@@ -27,10 +27,10 @@ from typing import Callable
 import numpy as np
 
 STAGES = ("too few points", "ground", "no cluster", "split", "merged", "budget/crop", "gate 1", "gate 2", "size",
-          "nms", "wrong class", "box off", "detected")
+          "score", "nms", "wrong class", "box off", "detected")
 #: native.OUTCOME name -> stage, for clusters that did not become a detection
 _OUTCOME_STAGE = {"crop": "budget/crop", "range": "budget/crop", "budget": "budget/crop", "capacity": "budget/crop",
-                  "tall": "budget/crop", "gate1": "gate 1", "gate2": "gate 2", "size": "size", "nms": "nms"}
+                  "tall": "budget/crop", "gate1": "gate 1", "gate2": "gate 2", "size": "size", "score": "score", "nms": "nms"}
 #: share of the object's non-ground points its cluster must hold, and share of the cluster that must be object
 CLUSTER_SHARE = 0.7
 

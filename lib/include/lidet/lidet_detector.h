@@ -91,6 +91,19 @@ typedef struct
                               on the real frames: docs/DETECTOR.md, "People in groups") */
     float group_max_range_m; /**< the group split examines clusters whose mean lies within this (horizontal);
                                   [0, 1000], default 40 */
+    float min_score
+        [LIDET_N_CLASSES]; /**< the operating point: a detection scoring below its class's value (lidet_class_t
+                                           order) is dropped, outcome LIDET_DET_OUT_SCORE (stats n_score_rejected);
+                                           a group split's part likewise. [0, 1]; 0 keeps every detection that
+                                           passed the gates. Default car 0.6, cyclist 0, pedestrian 0.6 for > 16
+                                           beams, 0 for <= 16 (measured on the real frames: docs/DETECTOR.md,
+                                           "Operating point") */
+    float
+        car_min_z_spread_m; /**< a car whose cluster holds at least LIDET_DET_FLAT_MIN_POINTS member pixels and
+                                   spreads less than this in z (sqrt(12 var z), the length of a uniform spread of
+                                   that variance) is a flat surface the ground stage kept (a raised pavement, a
+                                   terrace, a verge), not a car: outcome LIDET_DET_OUT_SIZE. [0, 10]; 0 turns the
+                                   test off; default 0.6 for > 16 beams, 0 for <= 16 (docs/DETECTOR.md, "Flat surfaces") */
     float score_box_weight
         [LIDET_N_CLASSES]; /**< the detection score is 1 / (1 + e^-(m1 + w m2)), m1 = gamma1 - E1
                                                   and m2 = gamma2 - E2 the two gates' margins (the models' gammas),
@@ -142,6 +155,9 @@ typedef struct
                                      rejection above still counts them: the counts above are per cluster) */
     uint32_t n_group_classified; /**< classifier passes on the group split's parts (not in n_classified) */
     uint32_t n_group_boxed; /**< box net passes on its parts (not in n_boxed; n_boxed + this <= max_boxes) */
+    uint32_t
+        n_score_rejected; /**< clusters whose detection scored below min_score (outcome LIDET_DET_OUT_SCORE,
+                                    or GROUP when the group split then cut it; a part's score is not counted) */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_workspace_stats_t stages;     /**< the stages' own counts */
 } lidet_detector_stats_t;

@@ -14,6 +14,10 @@
 extern "C" {
 #endif
 
+/** @brief Member pixels a car's cluster needs before the flat-surface test judges it (lidet_detector_cfg_t
+ *         car_min_z_spread_m): fewer are a far or partly hidden car, whose roof alone can be flat. */
+#define LIDET_DET_FLAT_MIN_POINTS 100u
+
 /** @brief A timestamp source (e.g. a cycle counter or a monotonic clock); ticks in the caller's unit. */
 typedef uint32_t (*lidet_clock_fn)(void *ctx);
 
@@ -38,13 +42,16 @@ typedef enum
     LIDET_DET_OUT_BUDGET = 3,   /**< past max_proposals, or passed gate 1 past max_boxes */
     LIDET_DET_OUT_GATE1 = 4,    /**< classified, rejected by gate 1 */
     LIDET_DET_OUT_GATE2 = 5,    /**< boxed, rejected by gate 2 */
-    LIDET_DET_OUT_SIZE = 6,     /**< boxed, impossible size for its class (or a non-finite centre or yaw) */
+    LIDET_DET_OUT_SIZE = 6,     /**< boxed, impossible size for its class (or a non-finite centre or yaw), or
+                                     a car whose cluster is a flat surface (lidet_detector_cfg_t
+                                     car_min_z_spread_m) */
     LIDET_DET_OUT_NMS = 7,      /**< suppressed by the NMS */
     LIDET_DET_OUT_CAPACITY = 8, /**< past LIDET_MAX_DETECTIONS */
     LIDET_DET_OUT_DETECTED = 9, /**< a detection of the output */
     LIDET_DET_OUT_TALL = 10,    /**< taller than max_height_extent_m: no road user, not classified */
-    LIDET_DET_OUT_GROUP = 11    /**< no detection of its own, split into people by the group split: its parts'
+    LIDET_DET_OUT_GROUP = 11,   /**< no detection of its own, split into people by the group split: its parts'
                                      detections carry its id (lidet_detector_cfg_t group_split) */
+    LIDET_DET_OUT_SCORE = 12 /**< its detection scored below its class's min_score (lidet_detector_cfg_t) */
 } lidet_det_outcome_t;
 
 #ifdef __cplusplus

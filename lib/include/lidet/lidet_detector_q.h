@@ -110,6 +110,14 @@ typedef struct
     uint8_t group_split; /**< the float detector's group_split (lidet_detector.h): default 1 for > 16 rows,
                                      0 for <= 16 */
     int32_t group_max_range_mm; /**< the float detector's group_max_range_m in mm; [0, 10^6], default 40000 */
+    int32_t min_score_q15
+        [LIDET_N_CLASSES];       /**< the float detector's min_score in Q15 (a detection whose score_q15
+                                                 is below is dropped, outcome LIDET_DET_OUT_SCORE); [0, 32768];
+                                                 default car 19661, cyclist 0, pedestrian 19661 (0.6) for > 16
+                                                 rows, 0 for <= 16 */
+    int32_t car_min_z_spread_mm; /**< the float detector's car_min_z_spread_m in mm (the test in 4 mm steps:
+                                      12 sum dz^2 < (this / 4)^2 n); [0, 10000]; 0: off; default 600 for > 16 rows, 0 for
+                                      <= 16 */
     int32_t
         score_box_weight_q16[LIDET_N_CLASSES]; /**< the float detector's score_box_weight in Q16: the score
                                                        is lidet_detector_q_score(E1 + round(w (E2 - gamma2)),
@@ -132,6 +140,7 @@ typedef struct
     uint32_t n_over_box_budget; /**< passed gate 1 past max_boxes (not boxed) */
     uint32_t n_too_tall;        /**< taller than max_height_extent_mm (not classified) */
     uint32_t n_group_split, n_group_classified, n_group_boxed; /**< the float detector's group split counts */
+    uint32_t n_score_rejected;                                 /**< the float detector's n_score_rejected */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_proj_stats_t proj;
     lidet_ground_stats_t ground;

@@ -7,6 +7,7 @@
 #include "internal/lidet_group_q.h"
 #include "internal/lidet_pointnet_q_internal.h"
 #include "internal/lidet_qmath.h"
+#include "internal/lidet_qpix.h"
 #include "internal/lidet_sort.h"
 #include "lidet/lidet_detector_q.h"
 
@@ -48,6 +49,11 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     cfg->gate2_class[LIDET_CLASS_PEDESTRIAN] = 0u;
     cfg->group_split = rows <= 16u ? 0u : 1u; /* the float detector's */
     cfg->group_max_range_mm = 40000;
+    /* the float detector's operating point and flat-surface test: 0.6 in Q15 = round(0.6 * 32768) */
+    cfg->min_score_q15[LIDET_CLASS_CAR] = rows <= 16u ? 0 : 19661;
+    cfg->min_score_q15[LIDET_CLASS_CYCLIST] = 0;
+    cfg->min_score_q15[LIDET_CLASS_PEDESTRIAN] = cfg->min_score_q15[LIDET_CLASS_CAR];
+    cfg->car_min_z_spread_mm = rows <= 16u ? 0 : 600;
     cfg->score_box_weight_q16[LIDET_CLASS_CAR] = 32768; /* the float detector's 0.5 */
     cfg->score_box_weight_q16[LIDET_CLASS_CYCLIST] = 0;
     cfg->score_box_weight_q16[LIDET_CLASS_PEDESTRIAN] = 0;
@@ -73,14 +79,14 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
         c->nms_iou_q15 < 0 || c->nms_iou_q15 > 32768 || c->gate1_margin_q16 < -MARGIN_MAX_Q16 ||
         c->gate1_margin_q16 > MARGIN_MAX_Q16 || c->gate2_margin_q16 < -MARGIN_MAX_Q16 ||
         c->gate2_margin_q16 > MARGIN_MAX_Q16 || c->range_only > 1u || c->group_split > 1u ||
-        c->group_max_range_mm < 0 || c->group_max_range_mm > 1000000 ||
-        (!LIDET_Q_PIXEL_XYZ && c->range_only == 0u))
+        c->group_max_range_mm < 0 || c->group_max_range_mm > 1000000 || c->car_min_z_spread_mm < 0 ||
+        c->car_min_z_spread_mm > 10000 || (!LIDET_Q_PIXEL_XYZ && c->range_only == 0u))
     {
         return 0;
     }
     for (k = 0; k < (uint32_t)LIDET_N_CLASSES; ++k)
     {
-        if (c->gate2_class[k] > 1u)
+        if (c->gate2_class[k] > 1u || c->min_score_q15[k] < 0 || c->min_score_q15[k] > 32768)
         {
             return 0;
         }
@@ -296,6 +302,27 @@ static void fill_detection(const lidet_detector_q_t *d, lidet_detection_q_t *t, 
     t->energy_box_q16 = bo->energy_q16;
     t->n_points = n;
 }
+/* the float detector's flat_surface in 4 mm steps: at least LIDET_DET_FLAT_MIN_POINTS members and
+ * 12 sum dz^2 < (t / 4)^2 n, i.e. 192 sum dz^2 < t^2 n with t in mm (dz from the rounded mean; |sum| < 2^50) */
+static int flat_surface(const lidet_detector_q_t *d, uint32_t ci)
+{
+    const lidet_cluster_q_state_t *c = &d->cluster;
+    const lidet_cluster_q_rec_t *r = &c->recs[ci];
+    const int64_t t = d->cfg.car_min_z_spread_mm;
+    int64_t szz = 0;
+    uint32_t i;
+    if (t <= 0 || r->n_points < LIDET_DET_FLAT_MIN_POINTS)
+    {
+        return 0;
+    }
+    for (i = 0; i < r->n_points; ++i)
+    {
+        int32_t v[3];
+        lidet__qpix_xyz(&c->img, (uint32_t)c->members[r->first_member + i], v);
+        szz += (int64_t)(v[2] - r->mean_4mm[2]) * (v[2] - r->mean_4mm[2]);
+    }
+    return 192 * szz < t * t * (int64_t)r->n_points;
+}
 #define DET_T lidet_detector_q_t
 #define DET_CLS_OUT_T lidet_pointnet_q_class_out_t
 #define DET_BOX_OUT_T lidet_pointnet_q_box_out_t
@@ -304,6 +331,8 @@ static void fill_detection(const lidet_detector_q_t *d, lidet_detection_q_t *t, 
 #define DET_CLASSIFY(d, co) lidet_pointnet_q_classify(&(d)->cls, &(d)->proposal, (co))
 #define DET_BOX(d, cls, bo) lidet_pointnet_q_box(&(d)->box, &(d)->proposal, (cls), (bo))
 #define DET_SIZE_OK(d, cls, box) lidet_size_ok_q(&(d)->cfg.size, (cls), (box))
+#define DET_FLAT(d, ci) flat_surface((d), (ci))
+#define DET_SCORE_OK(d, t) ((int32_t)(t)->score_q15 >= (d)->cfg.min_score_q15[(t)->cls])
 #define DET_GATE1_PASS(d, co)                                                                                \
     ((int64_t)(co)->energy_q16 < (int64_t)(d)->cls.model->gamma_q16[(co)->cls] + (d)->cfg.gate1_margin_q16)
 #define DET_GATE2_PASS(d, cls, bo)                                                                           \

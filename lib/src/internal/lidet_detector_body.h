@@ -1,7 +1,7 @@
 /* SPDX-License-Identifier: MIT */
 /* Macro template: the detector's per-candidate loop (det_candidates): for every candidate cluster, nearest
- * first, the proposal, the classifier and gate 1, the box budget, the box net and gate 2, the class size check,
- * and the detection (kept sorted by score, the lowest dropped past LIDET_MAX_DETECTIONS), with each cluster's
+ * first, the proposal, the classifier and gate 1, the box budget, the box net and gate 2, the class size check
+ * (and the cars' flat-surface test), the operating point (min_score), and the detection (kept sorted by score, the lowest dropped past LIDET_MAX_DETECTIONS), with each cluster's
  * outcome and the counts.
  *
  * Instantiated by (each #include once, after #defining the parameters below):
@@ -21,6 +21,8 @@
  *   DET_CLASSIFY(d, co)   classify it into *co; a lidet_status_t
  *   DET_BOX(d, cls, bo)   box it as class cls into *bo; a lidet_status_t
  *   DET_SIZE_OK(d, cls, box)  1 when the box's size is plausible for class cls
+ *   DET_FLAT(d, ci)       1 when cluster ci is a flat surface (the cars' test, cfg car_min_z_spread_*)
+ *   DET_SCORE_OK(d, t)    1 when detection *t (filled) scores at least its class's min_score
  *   DET_GATE1_PASS(d, co)  1 when the classifier's energy lies below the model's gamma of the class plus the
  *                         configured margin (the output's own `pass` is the margin-0 decision)
  *   DET_GATE2_PASS(d, cls, bo)  the same for the box net's energy
@@ -143,6 +145,11 @@ det_group(DET_T *d, uint32_t ci, lidet_status_t *worst, uint32_t *box_ticks)
             t->cls = co[j].cls;
             t->cluster_id = ci + 1u;
             DET_FILL(d, t, ci, &co[j], &bo);
+            if (!DET_SCORE_OK(
+                    d, t)) /* a part below the operating point (not counted: the counts are per cluster) */
+            {
+                continue;
+            }
             if (d->outcome[ci] != LIDET_DET_OUT_GROUP)
             {
                 d->outcome[ci] = LIDET_DET_OUT_GROUP;
@@ -203,7 +210,7 @@ static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *
             ++d->stats.n_gate2_rejected;
             goto no_detection;
         }
-        if (!DET_SIZE_OK(d, co.cls, &bo.box))
+        if (!DET_SIZE_OK(d, co.cls, &bo.box) || (co.cls == LIDET_CLASS_CAR && DET_FLAT(d, ci)))
         {
             d->outcome[ci] = LIDET_DET_OUT_SIZE;
             ++d->stats.n_size_rejected;
@@ -214,6 +221,12 @@ static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *
         t->cls = co.cls;
         t->cluster_id = ci + 1u;
         DET_FILL(d, t, ci, &co, &bo);
+        if (!DET_SCORE_OK(d, t))
+        {
+            d->outcome[ci] = LIDET_DET_OUT_SCORE;
+            ++d->stats.n_score_rejected;
+            goto no_detection;
+        }
         d->outcome[ci] = LIDET_DET_OUT_DETECTED;
         det_insert(d, worst);
         continue;

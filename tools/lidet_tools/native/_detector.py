@@ -38,12 +38,12 @@ def _detector_lib(L):
 
 #: lidet_det_outcome_t values
 OUTCOME = {1: "crop", 2: "range", 3: "budget", 4: "gate1", 5: "gate2", 6: "size", 7: "nms", 8: "capacity",
-           9: "detected", 10: "tall", 11: "group"}
+           9: "detected", 10: "tall", 11: "group", 12: "score"}
 CLASSES = ("Car", "Cyclist", "Pedestrian")
 _DET_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity",
               "n_detections", "status", "n_over_box_budget", "n_too_tall", "n_group_split", "n_group_classified",
-              "n_group_boxed"]
+              "n_group_boxed", "n_score_rejected"]
 
 
 @dataclass
@@ -69,6 +69,16 @@ def _class_bits(flags) -> int:
     return f[0] | f[1] << 1 | f[2] << 2
 
 
+def _per_class(v, name: str, lo: float, hi: float):
+    """None, or 3 numbers in [lo, hi] (lidet_class_t order: Car, Cyclist, Pedestrian) as floats."""
+    if v is None:
+        return None
+    f = [float(x) for x in v]
+    if len(f) != 3 or not all(lo <= x <= hi for x in f):
+        raise ValueError(f"{name} needs 3 values in [{lo}, {hi}] (Car, Cyclist, Pedestrian), got {v!r}")
+    return f
+
+
 def default_family(sensor: str | Sensor) -> str:
     """The float model family the detector runs for a preset name: the sensor's own when the bindings hold its
     pair, else hdl64; for a `Sensor` (e.g. read from a file): its model, else hdl64 for >= 32 rows and vlp16 below
@@ -82,7 +92,8 @@ def default_family(sensor: str | Sensor) -> str:
 def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, crop_half_rad: float = 0.0,
            max_range_m: float = 0.0, nms_iou: float = 0.1, max_proposals: int | None = None, gate1: bool = True,
            gate2: bool = True, refine: bool = True, gate1_margin: float = 0.0, gate2_margin: float = 0.0,
-           mount_height_m: float | None = None, gate2_class=None, group_split: bool | None = None) -> Detections:
+           mount_height_m: float | None = None, gate2_class=None, group_split: bool | None = None,
+           min_score=None, car_min_z_spread_m: float | None = None) -> Detections:
     """lidet_detector_run on (N, >=3) points with the models cls_<model> / box_<model> compiled into the bindings
     (default: `default_family(sensor)`). sensor: a preset name (the C preset, lidet_sensor_find, as `lidet detect
     --sensor`) or a `Sensor` (its table in ring order, e.g. `sensors.load_sensor_file`, `load_ouster_metadata`, as
@@ -94,7 +105,10 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
     gate2_class: 3 flags (Car, Cyclist, Pedestrian), the classes gate 2 judges (None: the C default,
     lidet_detector_cfg_t.gate2_class). group_split: people side by side split by the classifier's judgement
     (lidet_detector_cfg_t.group_split; None: the C default for the sensor, on for > 16 beams); a group's parts give
-    detections with the cluster's id, and the cluster the outcome "group"."""
+    detections with the cluster's id, and the cluster the outcome "group". min_score: 3 scores in [0, 1] (Car,
+    Cyclist, Pedestrian), the operating point below which a detection is dropped (outcome "score"; None: the C
+    default for the sensor, lidet_detector_cfg_t.min_score). car_min_z_spread_m: the cars' flat-surface test
+    (lidet_detector_cfg_t.car_min_z_spread_m, outcome "size"; 0 turns it off; None: the C default)."""
     if max_proposals is not None and not (isinstance(max_proposals, (int, np.integer)) and max_proposals >= 1):
         raise ValueError(f"max_proposals must be a positive integer, got {max_proposals!r}")
     if not isinstance(sensor, (str, Sensor)):
@@ -116,8 +130,13 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
     st = np.zeros(len(_DET_STATS), np.uint32)
     if mount_height_m is not None and not (0.0 <= float(mount_height_m) <= 10.0):
         raise ValueError(f"mount_height_m must be metres in [0, 10], got {mount_height_m!r}")
+    ms3 = _per_class(min_score, "min_score", 0.0, 1.0)
+    if car_min_z_spread_m is not None and not (0.0 <= float(car_min_z_spread_m) <= 10.0):
+        raise ValueError(f"car_min_z_spread_m must be metres in [0, 10], got {car_min_z_spread_m!r}")
     fc = np.array([crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin,
-                   -1.0 if mount_height_m is None else mount_height_m], np.float32)
+                   -1.0 if mount_height_m is None else mount_height_m,
+                   *([-1.0] * 3 if ms3 is None else ms3),
+                   -1.0 if car_min_z_spread_m is None else car_min_z_spread_m], np.float32)
     uc = np.array([max_proposals or 0, int(bool(gate1)), int(bool(gate2)), int(bool(refine)),
                    0xFFFFFFFF if gate2_class is None else _class_bits(gate2_class),
                    0xFFFFFFFF if group_split is None else int(bool(group_split))], np.uint32)
@@ -143,19 +162,22 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
 
 DETQ_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity", "n_detections",
-              "n_over_box_budget", "n_too_tall", "n_group_split", "n_group_classified", "n_group_boxed"]
+              "n_over_box_budget", "n_too_tall", "n_group_split", "n_group_classified", "n_group_boxed",
+              "n_score_rejected"]
 
 
 def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_half_bam: int = 0,
              max_range_mm: int = 0, nms_iou_q15: int = 3277, max_proposals: int = 0, gate1: bool = True,
              gate2: bool = True, max_boxes: int = 0, gate1_margin_q16: int = 0, gate2_margin_q16: int = 0,
-             range_only: bool | None = None, returns=None, gate2_class=None, group_split: bool | None = None) -> dict:
+             range_only: bool | None = None, returns=None, gate2_class=None, group_split: bool | None = None,
+             min_score_q15=None, car_min_z_spread_mm: int | None = None) -> dict:
     """lidet_detector_q_run on (N, 3) int32 mm points with the int8 models cls_<model>_s8 / box_<model>_s8
     (returns: a RETURN_DTYPE array instead, lidet_detector_q_run_returns; points_mm is then ignored).
     gate*_margin_q16: the gates' operating points (lidet_detector_q_cfg_t, Q16 nats). range_only: the range-only
     pixel (lidet_detector_q_cfg_t.range_only; None = the build's default). gate2_class: 3 flags (Car, Cyclist,
     Pedestrian), the classes gate 2 judges (None: the C default). group_split: the float detector's (None: the C
-    default for the sensor).
+    default for the sensor). min_score_q15 (3 values in [0, 32768]) and car_min_z_spread_mm: the float
+    detector's min_score and car_min_z_spread_m (None: the C defaults).
 
     Returns {'cls', 'score_q15', 'energy_cls_q16', 'energy_box_q16', 'boxes' (N, 7: cx cy cz l w h mm, yaw BAM32),
     'cluster_id', 'n_points', 'outcome', 'stats', 'status'}."""
@@ -176,7 +198,10 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     icfg = np.array([crop_half_bam, max_range_mm, nms_iou_q15, max_proposals, int(bool(gate1)), int(bool(gate2)),
                      max_boxes, gate1_margin_q16, gate2_margin_q16, -1 if range_only is None else int(bool(range_only)),
                      -1 if gate2_class is None else _class_bits(gate2_class),
-                     -1 if group_split is None else int(bool(group_split))], np.int32)
+                     -1 if group_split is None else int(bool(group_split)),
+                     *([-1] * 3 if min_score_q15 is None else [int(x) for x in _per_class(min_score_q15, "min_score_q15", 0,
+                                                                                             32768)]),
+                     -1 if car_min_z_spread_mm is None else int(car_min_z_spread_mm)], np.int32)
     n = len(pts)
     rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
                              pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st,
