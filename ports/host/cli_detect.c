@@ -606,7 +606,7 @@ void cli_det_usage(FILE *f)
                "                   split by the classifier's judgement; default 1 for > 16\n"
                "                   beams), group_max_range_m (default 40),\n"
                "                   min_score.car|cyclist|pedestrian (the operating point: detections\n"
-               "                   scoring below are dropped; default 0.6, 0, 0.6 for > 16 beams,\n"
+               "                   scoring below are dropped; default 0.6, 0, 0 for > 16 beams,\n"
                "                   0 for <= 16), car_min_z_spread_m (a car's cluster of >= 100\n"
                "                   pixels flatter than this in z is a surface; 0: off; default 0.6\n"
                "                   for > 16 beams, 0 for <= 16),\n"

@@ -181,7 +181,7 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
                    max_boxes=max_boxes or min(24 if s.rows <= 16 else 48, cap["max_clusters"]), gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM,
                    gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
                    group_split=int(s.rows > 16 if group_split is None else group_split), group_max_range_mm=40000,
-                   min_score_q15=min_score_q15 or ([19661, 0, 19661] if s.rows > 16 else [0, 0, 0]),
+                   min_score_q15=min_score_q15 or ([19661, 0, 0] if s.rows > 16 else [0, 0, 0]),
                    car_min_z_spread_mm=(600 if s.rows > 16 else 0) if car_min_z_spread_mm is None else
                    car_min_z_spread_mm)
     if gate2_class is not None:

@@ -559,7 +559,7 @@ void test_init_errors(void)
         TEST_ASSERT_EQUAL_FLOAT(40.0f, d0.group_max_range_m);
         TEST_ASSERT_EQUAL_FLOAT(0.6f, d0.min_score[LIDET_CLASS_CAR]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_CYCLIST]);
-        TEST_ASSERT_EQUAL_FLOAT(0.6f, d0.min_score[LIDET_CLASS_PEDESTRIAN]);
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_PEDESTRIAN]);
         TEST_ASSERT_EQUAL_FLOAT(0.6f, d0.car_min_z_spread_m);
         lidet_detector_cfg_default(&d0, lidet_sensor_find("vlp16"));
         TEST_ASSERT_EQUAL_UINT8(0, d0.group_split);

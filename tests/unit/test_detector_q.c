@@ -108,7 +108,7 @@ static void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT32(40000, cfg.group_max_range_mm);
     TEST_ASSERT_EQUAL_INT32(19661, cfg.min_score_q15[LIDET_CLASS_CAR]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_CYCLIST]);
-    TEST_ASSERT_EQUAL_INT32(19661, cfg.min_score_q15[LIDET_CLASS_PEDESTRIAN]);
+    TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_PEDESTRIAN]);
     TEST_ASSERT_EQUAL_INT32(600, cfg.car_min_z_spread_mm);
     lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("vlp16"));
     TEST_ASSERT_EQUAL_UINT8(0, cfg.group_split);

@@ -48,7 +48,7 @@ SCORE_POINTS_WEIGHT = (0.1, 0.0, 0.0)  # score_points_weight (_q16 = round(v 2^1
 GATE2_CLASS = RD.GATE2_CLASS
 #: the operating point (car, cyclist, pedestrian): min_score of lidet_detector_cfg_default for > 16 beams (0 for
 #: <= 16), and min_score_q15 = round(v 2^15) of lidet_detector_q_cfg_default
-MIN_SCORE = (0.6, 0.0, 0.6)
+MIN_SCORE = (0.6, 0.0, 0.0)
 
 
 def min_score(fam: str) -> tuple:

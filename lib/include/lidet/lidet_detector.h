@@ -95,9 +95,9 @@ typedef struct
         [LIDET_N_CLASSES]; /**< the operating point: a detection scoring below its class's value (lidet_class_t
                                            order) is dropped, outcome LIDET_DET_OUT_SCORE (stats n_score_rejected);
                                            a group split's part likewise. [0, 1]; 0 keeps every detection that
-                                           passed the gates. Default car 0.6, cyclist 0, pedestrian 0.6 for > 16
-                                           beams, 0 for <= 16 (measured on the real frames: docs/DETECTOR.md,
-                                           "Operating point") */
+                                           passed the gates. Default car 0.6 for > 16 beams, 0 for <= 16;
+                                           cyclist and pedestrian 0 (measured on the real frames and the
+                                           simulated presets: docs/DETECTOR.md, "Operating point") */
     float
         car_min_z_spread_m; /**< a car whose cluster holds at least LIDET_DET_FLAT_MIN_POINTS member pixels and
                                    spreads less than this in z (sqrt(12 var z), the length of a uniform spread of

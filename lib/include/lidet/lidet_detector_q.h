@@ -113,8 +113,8 @@ typedef struct
     int32_t min_score_q15
         [LIDET_N_CLASSES];       /**< the float detector's min_score in Q15 (a detection whose score_q15
                                                  is below is dropped, outcome LIDET_DET_OUT_SCORE); [0, 32768];
-                                                 default car 19661, cyclist 0, pedestrian 19661 (0.6) for > 16
-                                                 rows, 0 for <= 16 */
+                                                 default car 19661 (0.6) for > 16 rows, 0 for <= 16; cyclist and
+                                                 pedestrian 0 */
     int32_t car_min_z_spread_mm; /**< the float detector's car_min_z_spread_m in mm (the test in 4 mm steps:
                                       12 sum dz^2 < (this / 4)^2 n); [0, 10000]; 0: off; default 600 for > 16 rows, 0 for
                                       <= 16 */

@@ -52,7 +52,7 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     /* the float detector's operating point and flat-surface test: 0.6 in Q15 = round(0.6 * 32768) */
     cfg->min_score_q15[LIDET_CLASS_CAR] = rows <= 16u ? 0 : 19661;
     cfg->min_score_q15[LIDET_CLASS_CYCLIST] = 0;
-    cfg->min_score_q15[LIDET_CLASS_PEDESTRIAN] = cfg->min_score_q15[LIDET_CLASS_CAR];
+    cfg->min_score_q15[LIDET_CLASS_PEDESTRIAN] = 0;
     cfg->car_min_z_spread_mm = rows <= 16u ? 0 : 600;
     cfg->score_box_weight_q16[LIDET_CLASS_CAR] = 32768; /* the float detector's 0.5 */
     cfg->score_box_weight_q16[LIDET_CLASS_CYCLIST] = 0;
