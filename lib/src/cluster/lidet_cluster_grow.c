@@ -10,6 +10,10 @@
 #include "internal/lidet_cluster_internal.h"
 #include "internal/lidet_math.h"
 
+#if LIDET_HOST_SIMD && defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
 void lidet__cluster_setup_geometry(lidet_cluster_state_t *c, const lidet_range_image_t *img)
 {
     const uint32_t rows = img->n_rows, cols = img->n_cols;
@@ -62,16 +66,14 @@ void lidet__cluster_setup_geometry(lidet_cluster_state_t *c, const lidet_range_i
 static inline int link_ordered(float d1, float d2, float sn, float cs, const lidet__grow_t *g)
 {
     const float u = d1 - d2 * cs, v = d2 * sn;
-    if (!(v > g->tan_theta * u))
-    {
-        return 0;
-    }
     if (g->gap > 0.0f)
     {
+        /* both tests always computed, combined without a branch (the angle test's outcome is data and a
+         * branch on it mispredicts; the gap test costs a few multiplications) */
         const float gg = g->gap + g->gpm * d2;
-        return u * u + v * v <= gg * gg;
+        return (v > g->tan_theta * u) & (u * u + v * v <= gg * gg);
     }
-    return 1;
+    return v > g->tan_theta * u;
 }
 
 static inline int link(float da, float db, float sn, float cs, const lidet__grow_t *g)
@@ -92,10 +94,12 @@ static inline int link(float da, float db, float sn, float cs, const lidet__grow
 #define GROW_RNG_T float
 #define GROW_RANGES(img) ((img)->range_m)
 #define GROW_FN(name) name##_m
+#define GROW_TEST_EVERY 0
 #include "internal/lidet_cluster_grow_body.h"
 #undef GROW_RNG_T
 #undef GROW_RANGES
 #undef GROW_FN
+#undef GROW_TEST_EVERY
 
 /* the flood fill on a compact image (ranges in 4 mm steps): the ranges are read as integers, ordered as integers
  * (a select, where the float order compiled to a branch that mispredicts) and converted exactly (< 2^16) for the
@@ -110,13 +114,98 @@ static inline int link_4mm(uint32_t da, uint32_t db, float sn, float cs, const l
 #undef GROW_LINK
 #define GROW_D_T uint32_t
 #define GROW_LINK link_4mm
+
+#if LIDET_HOST_SIMD && defined(__SSE2__)
+/* link_4mm on four pairs at once (SSE2): q's range fq against the ranges dn, beam pair tables sn, cs per lane;
+ * the same IEEE operations in the same order as link_ordered (max / min of two exact integers are the integer
+ * order's d1, d2), so the same outcome in every lane. Returns the lanes that join (all bits set) */
+static inline __m128 link4_4mm(__m128 fq, __m128 dn, __m128 sn, __m128 cs, const lidet__grow_t *g)
+{
+    const __m128 d1 = _mm_max_ps(fq, dn), d2 = _mm_min_ps(fq, dn);
+    const __m128 u = _mm_sub_ps(d1, _mm_mul_ps(d2, cs)), v = _mm_mul_ps(d2, sn);
+    __m128 ok = _mm_cmpgt_ps(v, _mm_mul_ps(_mm_set1_ps(g->tan_theta), u));
+    if (g->gap > 0.0f)
+    {
+        const __m128 gg = _mm_add_ps(_mm_set1_ps(g->gap), _mm_mul_ps(_mm_set1_ps(g->gpm), d2));
+        ok = _mm_and_ps(ok, _mm_cmple_ps(_mm_add_ps(_mm_mul_ps(u, u), _mm_mul_ps(v, v)), _mm_mul_ps(gg, gg)));
+    }
+    return ok;
+}
+
+/* The 3 x 3 block of 16-bit values around the pixel at p (rows cols apart) as two vectors of 32-bit lanes:
+ * *a = right, left, down, up; *b = down-left, down-right, up-left, up-right. Three 8-byte loads (columns
+ * col - 1 .. col + 2 of the rows above, at and below: the caller keeps col + 2 within the row) and shuffles */
+static inline void block3_16(const uint16_t *p, uint32_t cols, __m128i *a, __m128i *b)
+{
+    const __m128i z = _mm_setzero_si128();
+    /* [col - 1, col, col + 1, col + 2] of each row */
+    const __m128 m =
+        _mm_castsi128_ps(_mm_unpacklo_epi16(_mm_loadl_epi64((const __m128i *)(const void *)(p - 1)), z));
+    const __m128 d = _mm_castsi128_ps(
+        _mm_unpacklo_epi16(_mm_loadl_epi64((const __m128i *)(const void *)(p + cols - 1u)), z));
+    const __m128 u = _mm_castsi128_ps(
+        _mm_unpacklo_epi16(_mm_loadl_epi64((const __m128i *)(const void *)(p - cols - 1u)), z));
+    /* [m2, m0] and [d1, u1] (of [d0, u0, d1, u1]) */
+    *a = _mm_castps_si128(_mm_shuffle_ps(m, _mm_unpacklo_ps(d, u), _MM_SHUFFLE(3, 2, 0, 2)));
+    *b = _mm_castps_si128(_mm_shuffle_ps(d, u, _MM_SHUFFLE(2, 0, 2, 0)));
+}
+
+/* GROW_NEIGHBOURS of the compact copy (lidet_cluster_grow_body.h), SSE2 hosts: the first steps of the four
+ * searches and the four diagonals of pixel q (row r, away from the edges, kc >= 2: columns col - 1 .. col + 2
+ * in the row) as two vectors of four lanes: labels, ranges and the join test at once, each outcome a bit.
+ * Measured on the 17 real KITTI scans (HDL-64, one x86-64 core): the stage's median 3.27 -> 2.80 ms with the
+ * searches from the second step; most of the gain is the branches per neighbour (data that mispredicts) that
+ * became bits, and the loads (three per plane, where scalar gathers of the eight cost more than they saved) */
+static inline void neighbours_4mm(const lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t q,
+                                  uint32_t r, uint32_t dq, int occl, uint32_t *take, uint32_t *redo,
+                                  uint32_t *nonc)
+{
+    const uint32_t ru = (r - 1u) * STEPS;
+    __m128i la, lb, ria, rib;
+    block3_16(c->labels + q, g->cols, &la, &lb);
+    block3_16(c->img.range_4mm + q, g->cols, &ria, &rib);
+    {
+        const __m128 ra = _mm_cvtepi32_ps(ria), rb = _mm_cvtepi32_ps(rib), fq = _mm_set1_ps((float)dq);
+        const __m128 ka = link4_4mm(
+            fq, ra, _mm_setr_ps(c->col_sin[0], c->col_sin[0], c->row_sin[r * STEPS], c->row_sin[ru]),
+            _mm_setr_ps(c->col_cos[0], c->col_cos[0], c->row_cos[r * STEPS], c->row_cos[ru]), g);
+        const uint32_t link_a = (uint32_t)_mm_movemask_ps(ka);
+        const uint32_t free_a =
+            (uint32_t)_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(la, _mm_setzero_si128())));
+        const uint32_t nonc_a = (uint32_t)_mm_movemask_ps(
+            _mm_castsi128_ps(_mm_cmpeq_epi32(la, _mm_set1_epi32((int)LAB_NONCAND))));
+        const uint32_t near_a = (uint32_t)_mm_movemask_ps(_mm_cmplt_ps(ra, fq));
+        uint32_t tb = 0u;
+        if (g->diag)
+        {
+            const __m128 kb = link4_4mm(
+                fq, rb, _mm_setr_ps(c->diag_sin[r], c->diag_sin[r], c->diag_sin[r - 1u], c->diag_sin[r - 1u]),
+                _mm_setr_ps(c->diag_cos[r], c->diag_cos[r], c->diag_cos[r - 1u], c->diag_cos[r - 1u]), g);
+            tb = (uint32_t)_mm_movemask_ps(kb) &
+                 (uint32_t)_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(lb, _mm_setzero_si128())));
+        }
+        /* a free candidate that passes the test joins (and ends its search); with the occluder rule a nearer
+         * candidate that fails it is an occluder the search steps over: that search is run */
+        *take = (free_a & link_a) | (tb << 4);
+        *redo = nonc_a | (occl ? near_a & ~link_a & ~nonc_a : 0u);
+        *nonc = nonc_a;
+    }
+}
+#define GROW_NEIGHBOURS(c, g, q, r, dq, occl, take, redo, nonc)                                              \
+    neighbours_4mm(c, g, q, r, dq, occl, take, redo, nonc)
+/* bits set in a 4-bit mask (a nibble per mask value) */
+#define GROW_POP4(m) ((uint32_t)(0x4332322132212110ull >> (4u * (m))) & 15u)
+#endif
 #define GROW_RNG_T uint16_t
 #define GROW_RANGES(img) ((img)->range_4mm)
 #define GROW_FN(name) name##_4mm
+#define GROW_TEST_EVERY 1
 #include "internal/lidet_cluster_grow_body.h"
 #undef GROW_RNG_T
 #undef GROW_RANGES
 #undef GROW_FN
+#undef GROW_NEIGHBOURS
+#undef GROW_POP4
 
 /* each image format's fill, a function of its own with the occluder rule an argument (each holds the expansion
  * with and without the rule: grow in lidet_cluster_grow_body.h). On an x86-64 host a function per rule, the

@@ -120,6 +120,7 @@ static inline int link_q(uint32_t da, uint32_t db, uint32_t s, uint32_t h, const
 #define GROW_RNG_T uint16_t
 #define GROW_RANGES(img) ((img)->range_4mm)
 #define GROW_FN(name) name##_q
+#define GROW_TEST_EVERY 1
 #include "internal/lidet_cluster_grow_body.h"
 
 /* the fill, a function per occluder rule (the rule a constant in each: on the Cortex-M4 image 4 % fewer

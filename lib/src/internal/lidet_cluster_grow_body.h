@@ -24,7 +24,19 @@
  *   GROW_STATE_T        the stage's state (members labels, members, img and the tables; same names in both)
  *   GROW_PARAM_T        the run's constants (rows, cols, ks, kc, diag, row_magic, bridged, bridge_max)
  *   GROW_FN(name)       the copy's name of function `name` (a suffix per copy)
- * Also read, from lidet_cluster_common.h: LAB_FREE, LAB_NONCAND, STEPS, lidet__cluster_take.
+ *   GROW_NEIGHBOURS(c, g, q, r, dq, occl, take, redo, nonc)  optional (a copy with SIMD): for a pixel away
+ *                       from the edges (kc >= 2), the first step of each search (right, left, down, up: bits 0-3)
+ *                       and the diagonals (bits 4-7; none without the 8-neighbourhood) decided at once: *take
+ *                       the pixels that join there, *redo the searches their first step does not end (a
+ *                       non-candidate; with the occluder rule a nearer candidate that fails the test: an
+ *                       occluder), *nonc those whose first step is a non-candidate
+ *   GROW_POP4(m)        with GROW_NEIGHBOURS: the number of bits set in the 4-bit mask m
+ *   GROW_TEST_EVERY     1: the occluder rule's search tests every candidate it meets, for copies whose test
+ *                       has no branch of its own (it saves one on the label); 0: a visited candidate is tested
+ *                       only when that decides (the float image's copy, whose test orders two floats with a
+ *                       branch: measured slower the other way). The same joins either way
+ * Also read, from lidet_cluster_common.h: LAB_FREE, LAB_NONCAND, STEPS, lidet__cluster_take. The compact float
+ * copy (lidet_cluster_grow.c) defines GROW_NEIGHBOURS on SSE2 hosts; the others run the searches as written.
  * Defines: static GROW_FN(search), GROW_FN(search_wrap), GROW_FN(expand) (one pixel's searches, the occluder
  * rule a constant) and GROW_FN(grow) (the fill; forced inline: the includer wraps it in a function of its own,
  * lidet_cluster_grow.c one per image format with the rule an argument, lidet_cluster_grow_q.c one per rule with
@@ -79,9 +91,23 @@ static inline uint32_t GROW_FN(search)(uint16_t *lab, lidet_member_t *mem, const
         }
         /* occluder bridging: a free candidate that passes the test joins, and the search ends; one
          * that fails it, or a visited one, ends the search unless it is nearer than q and fails the
-         * test (an occluder: the search goes on behind it). A visited candidate is only tested when
-         * that decides between the two (joining it again would change nothing) */
+         * test (an occluder: the search goes on behind it). */
         const GROW_D_T dn = (GROW_D_T)rng[n];
+#if GROW_TEST_EVERY
+        /* So any candidate ends the search when it passes the test or is not nearer, and joins when also
+         * free: the test made once whatever the label, a branch fewer on data that mispredicts (joining a
+         * visited one would change nothing) */
+        const int linked = GROW_LINK(dq, dn, *sn, *cs, g);
+        if (linked & (l == LAB_FREE))
+        {
+            tail = lidet__cluster_take(lab, mem, tail, n);
+        }
+        if (linked | !(dn < dq))
+        {
+            break;
+        }
+#else
+        /* A visited candidate is only tested when that decides between the two */
         if (l == LAB_FREE)
         {
             if (GROW_LINK(dq, dn, *sn, *cs, g))
@@ -98,6 +124,7 @@ static inline uint32_t GROW_FN(search)(uint16_t *lab, lidet_member_t *mem, const
         {
             break;
         }
+#endif
         ++*g->bridged; /* stepped over an occluder (the run's bridging budget, bridge_max) */
     }
     return tail;
@@ -158,6 +185,85 @@ GROW_FN(expand)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t tail, uint32_t 
     const GROW_D_T dq = (GROW_D_T)rng[q];
     const uint32_t nd = rows - 1u - r < ks ? rows - 1u - r : ks; /* steps that stay in the image */
     const uint32_t nu = r < ks ? r : ks;
+#ifdef GROW_NEIGHBOURS
+    /* a pixel away from the image's edges (no wrap, a row above and below): the first step of the four
+     * searches and the four diagonals decided at once (GROW_NEIGHBOURS, the same tests); a search is run only
+     * where its first step does not end it (a non-candidate, or an occluder to step over), from its second
+     * step. The pixels looked at here are distinct, and no search reaches another search's or a diagonal's,
+     * so deciding them first changes nothing; the joins keep the order right, left, down, up, then the
+     * diagonals down-left, down-right, up-left, up-right (the same members in the same order) */
+    if (r > 0u && r + 1u < rows && kc >= 2u && col >= kc && col + kc < cols)
+    {
+        uint32_t take, redo, nonc; /* bits: right, left, down, up, down-left, down-right, up-left, up-right */
+        GROW_NEIGHBOURS(c, g, q, r, dq, occl, &take, &redo, &nonc);
+        if ((take | redo) == 0u)
+        {
+            return tail; /* nothing joins, no search goes on */
+        }
+        /* a search that goes on past its first step goes on from its second: a first step that is an occluder
+         * counted here as the search would (a non-candidate is not), the search run over the steps after it
+         * (down and up: their table entries from the second, [r * STEPS + 1] and [(r - 2) * STEPS + 1]) */
+        *g->bridged += GROW_POP4(redo & ~nonc);
+        if (redo & 1u)
+        {
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q + 1u, 1, kc - 1u, GROW_TA(c, col) + 1,
+                                   GROW_TB(c, col) + 1, 1, g, occl);
+        }
+        else if (take & 1u)
+        {
+            tail = lidet__cluster_take(lab, mem, tail, q + 1u);
+        }
+        if (redo & 2u)
+        {
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q - 1u, -1, kc - 1u, GROW_TA(c, col) + 1,
+                                   GROW_TB(c, col) + 1, 1, g, occl);
+        }
+        else if (take & 2u)
+        {
+            tail = lidet__cluster_take(lab, mem, tail, q - 1u);
+        }
+        if ((redo & 4u) && nd > 1u)
+        {
+            tail =
+                GROW_FN(search)(lab, mem, rng, tail, dq, q + cols, (int32_t)cols, nd - 1u,
+                                GROW_TA(c, row) + r * STEPS + 1, GROW_TB(c, row) + r * STEPS + 1, 1, g, occl);
+        }
+        else if (take & 4u)
+        {
+            tail = lidet__cluster_take(lab, mem, tail, q + cols);
+        }
+        if ((redo & 8u) && nu > 1u)
+        {
+            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q - cols, -(int32_t)cols, nu - 1u,
+                                   GROW_TA(c, row) + (r - 2u) * STEPS + 1,
+                                   GROW_TB(c, row) + (r - 2u) * STEPS + 1, 1 - STEPS, g, occl);
+        }
+        else if (take & 8u)
+        {
+            tail = lidet__cluster_take(lab, mem, tail, q - cols);
+        }
+        if (take & 0xF0u)
+        {
+            if (take & 0x10u)
+            {
+                tail = lidet__cluster_take(lab, mem, tail, q + cols - 1u);
+            }
+            if (take & 0x20u)
+            {
+                tail = lidet__cluster_take(lab, mem, tail, q + cols + 1u);
+            }
+            if (take & 0x40u)
+            {
+                tail = lidet__cluster_take(lab, mem, tail, q - cols - 1u);
+            }
+            if (take & 0x80u)
+            {
+                tail = lidet__cluster_take(lab, mem, tail, q - cols + 1u);
+            }
+        }
+        return tail;
+    }
+#endif
     /* right, left (wrapping) */
     if (col + kc < cols)
     {

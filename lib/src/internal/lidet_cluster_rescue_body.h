@@ -16,6 +16,8 @@
  *   RESCUE_WIN_SET(c, win, q, g, compact)  fill *win from group pixel q (its range, the bounds of a partner's)
  *   RESCUE_PROBE(c, rs, lab, n, win, g, compact)  the test of window pixel n: it joins the group, is recorded
  *                       as a contact, or is passed over
+ *   RESCUE_ROW(c, rs, lab, b, e, win, g, compact)  optional (a copy with SIMD): the probes of window pixels
+ *                       [b, e) of one row, in order; nonzero when it made them (else the loop below does)
  * `compact` is the float stage's image format (a constant in each of its calls); the integer stage ignores it.
  * Also read, from lidet_cluster_common.h: LAB_PENDING, LAB_NONCAND.
  * Defines: static inline void rescue_grow(RESCUE_STATE_T *c, const RESCUE_PARAM_T *g, uint32_t start,
@@ -59,6 +61,12 @@ static inline void rescue_grow(RESCUE_STATE_T *c, const RESCUE_PARAM_T *g, uint3
             {
                 const uint32_t end = base + c0 + 2u * wc + 1u;
                 uint32_t n = base + c0;
+#ifdef RESCUE_ROW
+                if (RESCUE_ROW(c, rs, lab, n, end, &win, g, compact))
+                {
+                    continue; /* the row's probes made, in the same order */
+                }
+#endif
                 for (; n + 4u <= end; n += 4u)
                 {
                     uint64_t w4;
