@@ -267,6 +267,20 @@ static void rz_of_range_row(const lidet_range_image_t *img, uint32_t r, int32_t 
     const uint16_t *rng = img->range_4mm + (size_t)r * cols;
     const lidet__qpix_row_t rt = lidet__qpix_row(img, r);
     uint32_t c;
+#if LIDET_GROUND_Q_SMMULR
+    if (rt.ce >= 0)
+    {
+        /* r_of_range = (d ce + 2^6) >> 7 and rs15(d se) as SMMULR of d 2^16 and ce 2^9, 2 se (ce <= 2^15) */
+        const int32_t ce9 = rt.ce * 512, se2 = rt.se * 2;
+        for (c = 0; c < cols; ++c)
+        {
+            const int32_t d16 = (int32_t)((rng[c] & 0x7FFFu) << 16);
+            out[c] = lidet__ground_q_smmulr(d16, ce9);
+            z[c] = (int16_t)lidet__ground_q_smmulr(d16, se2);
+        }
+        return;
+    }
+#endif
     for (c = 0; c < cols; ++c)
     {
         const uint32_t d = rng[c] & 0x7FFFu;
@@ -595,6 +609,9 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
 {
     const uint16_t *rng = L->img->range_4mm;
     const int32_t *ct = L->gp->ct, *st = L->gp->st;
+#if LIDET_GROUND_Q_SMMULR
+    const lidet__ground_q_rows_t rts = lidet__ground_q_rows(rt);
+#endif
     int32_t *z_up = L->z_up;
     uint8_t *mask = L->mask;
     const int64_t above0 = L->above0, below0 = L->below0;
@@ -609,13 +626,18 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
         int in, nz, vt = 0;
         if (ro)
         {
-            if ((rng[p] & 0x7FFFu) == 0u)
+            const uint32_t r15 = rng[p] & 0x7FFFu;
+            if (r15 == 0u)
             {
                 mask[p] = 0; /* an empty pixel (x = y = 0): never ground, never vetoed */
                 z_up[c] = NO_POINT;
                 continue;
             }
+#if LIDET_GROUND_Q_SMMULR
+            lidet__ground_q_decode_r16((int32_t)(r15 << 16), rts, ct[c], st[c], P);
+#else
             lidet__qpix_decode(rng[p], rt, ct[c], st[c], P);
+#endif
         }
         else
         {

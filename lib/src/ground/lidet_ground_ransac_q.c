@@ -110,6 +110,10 @@ typedef struct
     const lidet__ground_q_pix_t *img;
     const lidet_ground_sample_t *idx;
     const int32_t *xyz; /* NULL: decode */
+#if LIDET_Q_HAVE_MUL64
+    int32_t *spare; /* with xyz: free int32 after the copy (the refinement's inliers), spare_n of them */
+    uint32_t spare_n;
+#endif
 } cell_src_t;
 
 static inline void pixel(const cell_src_t *src, uint32_t i, int32_t q[3])
@@ -133,6 +137,12 @@ static void decode_cell(const lidet__ground_q_pix_t *gp, const lidet_ground_samp
     const uint32_t cols = gp->img->n_cols;
     uint32_t i, base = 0u - cols; /* no row yet: p - base >= cols for every p */
     lidet__qpix_row_t rt;
+#if LIDET_GROUND_Q_SMMULR
+    const uint16_t *rng = gp->img->range_4mm;
+    lidet__ground_q_rows_t rts;
+    rts.nce = 0;
+    rts.se2 = 0;
+#endif
     rt.ce = 0;
     rt.se = 0;
     for (i = 0; i < n; ++i)
@@ -143,8 +153,15 @@ static void decode_cell(const lidet__ground_q_pix_t *gp, const lidet_ground_samp
             const uint32_t r = p / cols;
             base = r * cols;
             rt = lidet__qpix_row(gp->img, r);
+#if LIDET_GROUND_Q_SMMULR
+            rts = lidet__ground_q_rows(rt);
+#endif
         }
+#if LIDET_GROUND_Q_SMMULR
+        lidet__ground_q_decode_s(rng[p], rts, gp->ct[p - base], gp->st[p - base], xyz + 3u * i);
+#else
         lidet__ground_q_pix_rc(gp, rt, p - base, p, xyz + 3u * i);
+#endif
     }
 }
 
@@ -163,13 +180,128 @@ scatter_add64(int64_t a[6], int32_t x, int32_t y, int32_t z)
     a[5] += (int64_t)z * z;
 }
 
+#if LIDET_Q_HAVE_MUL64
+/* The refinement's sums over the inliers' differences d (3 int32 each, m < 2^11 of them, |d| < 2^16) from the
+ * cell's decoded copy: S1 += sum d (int32 partial sums: |sum| < 2^27) and S2 += sum d d^T (xx xy xz yy yz zz) in
+ * exact int64, in two passes of three 64-bit sums each, so each pass keeps its sums in registers (one pass of six
+ * spilled them to the stack on a Cortex-M4: a load and a store around each multiply-accumulate). The same sums.
+ * Cores with a 32 x 32 -> 64 multiply only (ARMv6-M keeps the one pass: its 64-bit products are calls). */
+#if defined(__GNUC__)
+__attribute__((noinline))
+#endif
+static void
+inlier_sums(const int32_t *d, uint32_t m, int64_t s1[3], int64_t a[6])
+{
+    const int32_t *p, *const end = d + 3u * m;
+    int64_t a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5];
+    int32_t t0 = 0, t1 = 0, t2 = 0;
+    for (p = d; p != end; p += 3)
+    {
+        const int32_t x = p[0], y = p[1], z = p[2];
+        a0 += (int64_t)x * x;
+        a1 += (int64_t)x * y;
+        a2 += (int64_t)x * z;
+        t0 += x;
+    }
+    for (p = d; p != end; p += 3)
+    {
+        const int32_t y = p[1], z = p[2];
+        a3 += (int64_t)y * y;
+        a4 += (int64_t)y * z;
+        a5 += (int64_t)z * z;
+        t1 += y;
+        t2 += z;
+    }
+    s1[0] += t0;
+    s1[1] += t1;
+    s1[2] += t2;
+    a[0] = a0;
+    a[1] = a1;
+    a[2] = a2;
+    a[3] = a3;
+    a[4] = a4;
+    a[5] = a5;
+}
+#endif
+
+#if LIDET_Q_HAVE_MUL64
+/* d = q - first added to the sums (in) or taken out of them */
+#if defined(__GNUC__)
+__attribute__((noinline)) /* off changed_sides' loop: its registers stay for the test */
+#endif
+static void
+side_change(const int32_t q[3], const int32_t first[3], int in, int64_t s1[3], int64_t a[6])
+{
+    const int32_t dx = q[0] - first[0], dy = q[1] - first[1], dz = q[2] - first[2];
+    if (in)
+    {
+        s1[0] += dx;
+        s1[1] += dy;
+        s1[2] += dz;
+        scatter_add64(a, dx, dy, dz);
+    }
+    else
+    {
+        s1[0] -= dx;
+        s1[1] -= dy;
+        s1[2] -= dz;
+        a[0] -= (int64_t)dx * dx;
+        a[1] -= (int64_t)dx * dy;
+        a[2] -= (int64_t)dx * dz;
+        a[3] -= (int64_t)dy * dy;
+        a[4] -= (int64_t)dy * dz;
+        a[5] -= (int64_t)dz * dz;
+    }
+}
+
+/* the samples of the cell's decoded copy xyz whose side of the band (|h| <= thr as h + thr in [0, t2]) differs
+ * from their flag fl: flag flipped, d = q - first added to or taken out of the sums; returns the new count */
+#if defined(__GNUC__)
+__attribute__((noinline)) /* its own frame: the test's constants in registers */
+#endif
+static uint32_t
+changed_sides(const int32_t *xyz, uint32_t n, uint8_t *fl, const lidet__ground_q_hplane_t *hp, uint64_t t2,
+              const int32_t first[3], uint32_t m, int64_t s1[3], int64_t a[6])
+{
+    const int32_t n0 = hp->n[0], n1 = hp->n[1], n2 = hp->n[2];
+    const int64_t d = hp->d;
+    const int32_t *p = xyz, *const end = xyz + 3u * n;
+    for (; p != end; p += 3, ++fl)
+    {
+        const int32_t x = p[0], y = p[1], z = p[2];
+        const uint8_t in =
+            (uint8_t)((uint64_t)(d + (int64_t)n0 * x + (int64_t)n1 * y + (int64_t)n2 * z) <= t2);
+        if (in != *fl)
+        {
+            *fl = in;
+            m = in ? m + 1u : m - 1u;
+            side_change(p, first, in, s1, a);
+        }
+    }
+    return m;
+}
+#endif
+
+/* the refinement's inlier sums carried from one of its iterations to the next (the cell's decoded copy on cores
+ * with a 32 x 32 -> 64 multiply): with each sample's side kept as a flag, an iteration adds and removes only the
+ * samples whose side changed, the same exact sums as a pass over its inliers (the planes of two iterations
+ * differ little, so most samples keep their side) */
+typedef struct
+{
+    int have; /* sums and flags of the previous iteration's plane */
+    uint32_t m;
+    int64_t s1[3], a[6];
+} refine_acc_t;
+
 /* The least-squares plane through the inliers (|height| <= thr) of cur among the cell's samples: their
  * centroid c0 (rounded to 4 mm steps) and scatter matrix about c0 in exact int64 sums, the normal by
  * power iteration on the adjugate of the scatter matrix starting from cur's normal (the adjugate's dominant
  * eigenvector is the scatter's least one; the ratio of a ground patch's two smallest spreads makes a few
  * iterations exact), D through the exact mean. Returns 0 (out untouched) for fewer than 3 inliers or points
  * (nearly) on a line. */
-static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_t thr, qplane_t *out)
+
+static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_t thr, qplane_t *out,
+                  refine_acc_t *ra)
 {
     int64_t s1[3] = {0, 0, 0}, e[3], a[6] = {0, 0, 0, 0, 0, 0}, dl[3], b[6], v[3], nd, mm;
     int32_t q[3], first[3], c0[3], nv[3];
@@ -180,11 +312,57 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
     /* |h| <= thr as 0 <= h + thr <= 2 thr: D carries thr (one unsigned comparison per sample) */
     lidet__ground_q_hplane(cur->n, cur->d + thr, &hp);
     pixel(img, 0u, first);
+    i = 0;
+#if LIDET_Q_HAVE_MUL64
+    if (img->xyz != 0 && 3u * n + (n + 3u) / 4u <= img->spare_n && n < 2048u)
+    {
+        /* each sample's side in flags after the spare ints the first iteration copies its inliers to */
+        uint8_t *const fl = (uint8_t *)(void *)(img->spare + 3u * n);
+        const int32_t *p = img->xyz, *const end = img->xyz + 3u * n;
+        const uint64_t t2 = 2u * (uint64_t)thr;
+        if (!ra->have)
+        {
+            /* the inliers' differences d = q - first copied into the spare ints, then their sums (inlier_sums) */
+            int32_t *o = img->spare;
+            uint8_t *f = fl;
+            for (; p != end; p += 3, ++f)
+            {
+                const int32_t x = p[0], y = p[1], z = p[2];
+                const uint8_t in = (uint8_t)((uint64_t)lidet__ground_q_height(&hp, x, y, z) <= t2);
+                *f = in;
+                if (in)
+                {
+                    o[0] = x - first[0];
+                    o[1] = y - first[1];
+                    o[2] = z - first[2];
+                    o += 3;
+                }
+            }
+            m = (uint32_t)(o - img->spare) / 3u;
+            inlier_sums(img->spare, m, s1, a);
+        }
+        else
+        {
+            /* the previous iteration's sums, the samples that changed side added or taken out */
+            m = ra->m;
+            memcpy(s1, ra->s1, sizeof s1);
+            memcpy(a, ra->a, sizeof a);
+            m = changed_sides(img->xyz, n, fl, &hp, t2, first, m, s1, a);
+        }
+        ra->have = 1;
+        ra->m = m;
+        memcpy(ra->s1, s1, sizeof s1);
+        memcpy(ra->a, a, sizeof a);
+        i = n; /* no pass below */
+    }
+#else
+    (void)ra;
+#endif
     /* one pass over the samples (each decoded once): the inliers' sums S1 = sum d and S2 = sum d d^T of
      * d = q - first, exact in int64 (|d| < 2^16: below n 2^32 for n samples); the cell's decoded copy read
      * directly where there is one. S1 is summed in int32 over blocks of 2^14 samples (|sum| < 2^30), each block
      * added to the int64 sum: the 64-bit sums stay out of the sample loop */
-    for (i = 0; i < n;)
+    while (i < n)
     {
         const uint32_t blk_end = n - i > 16384u ? i + 16384u : n;
         int32_t t0 = 0, t1 = 0, t2 = 0;
@@ -332,7 +510,18 @@ static uint32_t count_inliers(const lidet_ground_q_scratch_t *sc, const cell_src
             {
                 const int64_t ht =
                     h0 + (int64_t)c0 * sc->ev_x[i] + (int64_t)c1 * sc->ev_y[i] + (int64_t)c2 * sc->ev_z[i];
+#if defined(__GNUC__) && defined(__thumb2__) && !defined(__ARM_BIG_ENDIAN)
+                /* the unsigned comparison's carry added directly (GCC made it a conditional 0 / 1 and an add) */
+                uint32_t tmp;
+                __asm__("cmp %Q[t2], %Q[h]\n\t"
+                        "sbcs %[tmp], %R[t2], %R[h]\n\t"
+                        "adc %[cnt], %[cnt], #0"
+                        : [cnt] "+r"(cnt), [tmp] "=r"(tmp)
+                        : [t2] "r"(t2), [h] "r"(ht)
+                        : "cc");
+#else
                 cnt += (uint32_t)((uint64_t)ht <= t2);
+#endif
             }
         }
     }
@@ -434,9 +623,12 @@ static int best_hypothesis_q(lidet_ground_q_state_t *g, const lidet_ground_q_scr
  * (best_hypothesis_q), the hypothesis as a plane, its refinements (refine), the checks. A hypothesis is the exact
  * cross product c of two 4 mm difference vectors, a sample its inlier when 4 |c . (p - p0)| <= inlier_mm * |c|.
  * Returns 1 with *out set when the plane passes every check. */
-static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
-                      const lidet__ground_q_pix_t *gp, const lidet_ground_sample_t *idx, uint32_t n,
-                      int far_step, qplane_t *out)
+#if defined(__GNUC__)
+__attribute__((always_inline)) /* into its one caller: one frame on the deepest stack of the 16-beam images */
+#endif
+static inline int
+fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, const lidet__ground_q_pix_t *gp,
+           const lidet_ground_sample_t *idx, uint32_t n, int far_step, qplane_t *out)
 {
     cell_src_t src, *const img = &src;
     const lidet_ground_q_cfg_t *cfg = &g->cfg;
@@ -448,15 +640,30 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
     int32_t best_p0[3] = {0, 0, 0};
     uint32_t best_len = 0, best_cnt = 0, r, i;
     qplane_t best;
+#if LIDET_Q_HAVE_MUL64
+    refine_acc_t
+        ra; /* 80 bytes of stack: only where refine carries its sums (ARMv6-M's deepest frame is here) */
+#define RA_ARG (&ra)
+#else
+#define RA_ARG 0
+#endif
     src.img = gp;
     src.idx = idx;
     src.xyz = 0;
+#if LIDET_Q_HAVE_MUL64
+    src.spare = 0;
+    src.spare_n = 0;
+#endif
     if (gp->ct != 0 &&
         3u * n <= sizeof sc->r_rows / sizeof(int32_t)) /* a range-only image's cell that fits */
     {
         int32_t *xyz = &sc->r_rows[0][0];
         decode_cell(gp, idx, n, xyz);
         src.xyz = xyz;
+#if LIDET_Q_HAVE_MUL64
+        src.spare = xyz + 3u * n;
+        src.spare_n = (uint32_t)(sizeof sc->r_rows / sizeof(int32_t)) - 3u * n;
+#endif
     }
     if (copied)
     {
@@ -482,10 +689,13 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
     }
     best.d = -((int64_t)best.n[0] * best_p0[0] + (int64_t)best.n[1] * best_p0[1] +
                (int64_t)best.n[2] * best_p0[2]);
+#if LIDET_Q_HAVE_MUL64
+    ra.have = 0;
+#endif
     for (r = 0; r < cfg->refine_iters; ++r)
     {
         qplane_t p;
-        if (!refine(img, n, &best, (int64_t)cfg->inlier_mm << 28, &p) || p.n[2] < cos_t)
+        if (!refine(img, n, &best, (int64_t)cfg->inlier_mm << 28, &p, RA_ARG) || p.n[2] < cos_t)
         {
             break; /* keep the last good plane */
         }
@@ -499,6 +709,7 @@ static int fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
     *out = best;
     return 1;
 }
+#undef RA_ARG
 
 /* z (4 mm) of the plane (n, d) over the point (x, y) (4 mm): -(n_x x + n_y y + d) / n_z, rounded */
 static int32_t plane_z_at(const int32_t n[3], int64_t d, int32_t x, int32_t y)

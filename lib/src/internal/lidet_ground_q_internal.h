@@ -75,13 +75,67 @@ typedef struct
 void lidet__ground_q_sample_row(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1,
                                 uint32_t cols, const lidet__ground_q_filt_t *f, uint8_t *out, int early);
 
+/* LIDET_GROUND_Q_SMMULR: 1 on cores with SMMULR (the Arm DSP extension), where a range-only pixel's decode takes
+ * each of lidet__qpix_decode's five rounded products rs15(a b) = (a b + 2^14) >> 15 as one SMMULR of operands
+ * scaled by 2^17 together: (a' b' + 2^31) >> 32 with a' b' = a b 2^17, the same value (floor of the same exact
+ * quotient). The scaled operands stay within int32: -ce 2^16 >= -2^31 (ce <= 2^15), 2 ct, 2 st, 2 se, 2 u
+ * (|.| <= 2^16), r 2^16 < 2^31 (r < 2^15). */
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && defined(__GNUC__)
+#define LIDET_GROUND_Q_SMMULR 1
+/* (a b + 2^31) >> 32 */
+static inline int32_t lidet__ground_q_smmulr(int32_t a, int32_t b)
+{
+    int32_t r;
+    __asm__("smmulr %0, %1, %2" : "=r"(r) : "r"(a), "r"(b));
+    return r;
+}
+#else
+#define LIDET_GROUND_Q_SMMULR 0
+#endif
+
+/* a row's trig scaled for lidet__ground_q_decode_s: nce = -ce 2^16, se2 = 2 se */
+typedef struct
+{
+    int32_t nce, se2;
+} lidet__ground_q_rows_t;
+
+static inline lidet__ground_q_rows_t lidet__ground_q_rows(lidet__qpix_row_t rt)
+{
+    lidet__ground_q_rows_t t;
+    t.nce = (int32_t)(-(int64_t)rt.ce * 65536);
+    t.se2 = rt.se * 2;
+    return t;
+}
+
+#if LIDET_GROUND_Q_SMMULR
+/* lidet__qpix_decode's x, y, z from the scaled row trig t, the column's ct2 = 2 ct and nst2 = -2 st (the tables of
+ * lidet__ground_q_pix_t on these cores) and r16 = (rng & 0x7FFF) 2^16: ux = rs15(-ce ct), uy = rs15(ce st), then
+ * rs15(r ux), rs15(r uy), rs15(r se) */
+static inline void lidet__ground_q_decode_r16(int32_t r16, lidet__ground_q_rows_t t, int32_t ct2,
+                                              int32_t nst2, int32_t v[3])
+{
+    const int32_t ux2 = lidet__ground_q_smmulr(t.nce, ct2) * 2, uy2 = lidet__ground_q_smmulr(t.nce, nst2) * 2;
+    v[0] = lidet__ground_q_smmulr(r16, ux2);
+    v[1] = lidet__ground_q_smmulr(r16, uy2);
+    v[2] = lidet__ground_q_smmulr(r16, t.se2);
+}
+
+/* the same from the pixel's stored range */
+static inline void lidet__ground_q_decode_s(uint32_t rng, lidet__ground_q_rows_t t, int32_t ct2, int32_t nst2,
+                                            int32_t v[3])
+{
+    lidet__ground_q_decode_r16((int32_t)((rng & 0x7FFFu) << 16), t, ct2, nst2, v);
+}
+#endif
+
 /* The pixels of the passes after the filter (gathering, fits, labels). A range-only image's columns' cosines
  * and sines (lidet__qpix_col) are computed once per run into scratch the filter alone uses (r_rem, r_v), so a
  * decode reads them instead of folding the quarter-turn table's quadrant each time: the same values. */
 typedef struct
 {
     const lidet_range_image_t *img;
-    const int32_t *ct, *st; /* NULL: an image that stores x, y, z */
+    /* NULL: an image that stores x, y, z; where LIDET_GROUND_Q_SMMULR, 2 ct and -2 st (lidet__ground_q_decode_s) */
+    const int32_t *ct, *st;
 } lidet__ground_q_pix_t;
 
 static inline void lidet__ground_q_pix_init(lidet__ground_q_pix_t *gp, lidet_ground_q_scratch_t *sc,
@@ -97,6 +151,10 @@ static inline void lidet__ground_q_pix_init(lidet__ground_q_pix_t *gp, lidet_gro
         for (c = 0; c < img->n_cols; ++c)
         {
             lidet__qpix_col(img, c, &ct[c], &st[c]);
+#if LIDET_GROUND_Q_SMMULR
+            ct[c] *= 2;
+            st[c] *= -2;
+#endif
         }
         gp->ct = ct;
         gp->st = st;
@@ -112,7 +170,11 @@ static inline void lidet__ground_q_pix_rc(const lidet__ground_q_pix_t *gp, lidet
         lidet__qpix_stored(gp->img, p, v);
         return;
     }
+#if LIDET_GROUND_Q_SMMULR
+    lidet__ground_q_decode_s(gp->img->range_4mm[p], lidet__ground_q_rows(rt), gp->ct[c], gp->st[c], v);
+#else
     lidet__qpix_decode(gp->img->range_4mm[p], rt, gp->ct[c], gp->st[c], v);
+#endif
 }
 
 /* x, y, z of pixel p */

@@ -56,6 +56,19 @@ int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, 
 void lidet__nn_acc_s16_3_requant(const int16_t *in, uint32_t n_rows, const int8_t *w_t, const int32_t *b,
                                  uint32_t n_out, const int32_t *mult, const uint8_t *shift, int32_t zp,
                                  int32_t lo, int8_t *out);
+/* the first layer's usual case (every shift in [33, 48], lo = -128) on cores with the DSP extension: each
+ * channel's constants made once into tab (24 bytes a channel, 4-byte aligned), then any number of blocks of
+ * points run against it with the same values as lidet__nn_acc_s16_3_requant. Returns 0 where it does not apply
+ * (and on every other core: LIDET_NN_S16_3_TABLE 0), tab then undefined */
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && !defined(__ARM_BIG_ENDIAN)
+#define LIDET_NN_S16_3_TABLE 1
+#else
+#define LIDET_NN_S16_3_TABLE 0
+#endif
+int lidet__nn_s16_3_table(const int8_t *w_t, const int32_t *b, uint32_t n_out, const int32_t *mult,
+                          const uint8_t *shift, int32_t zp, int32_t lo, void *tab, uint32_t tab_bytes);
+void lidet__nn_s16_3_table_run(const int16_t *in, uint32_t n_rows, const void *tab, uint32_t n_out,
+                               int8_t *out);
 /* the same with int16 inputs (the first layer: points in mm, voxel bins) */
 void lidet__nn_acc_s16(const int16_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
                        uint32_t n_out, int32_t *acc);

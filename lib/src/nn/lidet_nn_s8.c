@@ -396,6 +396,103 @@ S8_ALWAYS_INLINE const uint32_t *pk_one(const uint32_t *xw, uint32_t n_g, const 
     return w;
 }
 
+/* The quad layout of four points' widened inputs: per group [A0 A1 A2 A3 B0 B1 B2 B3] (A, B as pk_widen's), then
+ * PK_END, which no widened word equals (its halves are sign-extended bytes: 0x8000 is none), and one word more:
+ * pk_quad's loop stops on it without a register for its end */
+#define PK_END 0x80000000u
+
+/* groups 0..n_g of the four points x0, x0 + n_in, x0 + 2 n_in, x0 + 3 n_in into xw (8 n_g + 2 words) */
+static void pk_widen4(const int8_t *x0, uint32_t n_in, uint32_t n_g, uint32_t *xw)
+{
+    uint32_t g;
+    for (g = 0; g < n_g; ++g, xw += 8)
+    {
+        const uint32_t u0 = s8_load4(x0 + 4u * g), u1 = s8_load4(x0 + n_in + 4u * g);
+        const uint32_t u2 = s8_load4(x0 + 2u * n_in + 4u * g), u3 = s8_load4(x0 + 3u * n_in + 4u * g);
+        xw[0] = S8_SXTB16(u0);
+        xw[1] = S8_SXTB16(u1);
+        xw[2] = S8_SXTB16(u2);
+        xw[3] = S8_SXTB16(u3);
+        xw[4] = S8_SXTB16_ROR8(u0);
+        xw[5] = S8_SXTB16_ROR8(u1);
+        xw[6] = S8_SXTB16_ROR8(u2);
+        xw[7] = S8_SXTB16_ROR8(u3);
+    }
+    xw[0] = PK_END;
+    xw[1] = 0u;
+}
+
+/* four points: s[2 j + k] (point j, channel k) += n_g >= 1 groups of the quad layout; returns w past them. On the
+ * DSP cores in assembly: per group 6 LDRD and 16 SMLAD for 64 multiply-adds (the pair kernel: 8 LDRD and 16
+ * SMLAD), and the loop's test on the next group's first word (PK_END) */
+S8_ALWAYS_INLINE const uint32_t *pk_quad(const uint32_t *xw, uint32_t n_g, const uint32_t *w, int32_t *s)
+{
+    int32_t s00 = s[0], s01 = s[1], s10 = s[2], s11 = s[3], s20 = s[4], s21 = s[5], s30 = s[6], s31 = s[7];
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP && defined(__GNUC__) && LIDET_NN_PK_ASM
+    uint32_t a0, a1, c0, c1;
+    (void)n_g;
+/* one group: A (inputs i, i + 2) of points 0, 1 and 2, 3 against the channels' A weights, then B */
+#define PK_QUAD_P01                                                                                          \
+    "smlad %[s00], %[a0], %[c0], %[s00]\n\t"                                                                 \
+    "smlad %[s01], %[a0], %[c1], %[s01]\n\t"                                                                 \
+    "smlad %[s10], %[a1], %[c0], %[s10]\n\t"                                                                 \
+    "smlad %[s11], %[a1], %[c1], %[s11]\n\t"
+#define PK_QUAD_P23                                                                                          \
+    "smlad %[s20], %[a0], %[c0], %[s20]\n\t"                                                                 \
+    "smlad %[s21], %[a0], %[c1], %[s21]\n\t"                                                                 \
+    "smlad %[s30], %[a1], %[c0], %[s30]\n\t"                                                                 \
+    "smlad %[s31], %[a1], %[c1], %[s31]\n\t"
+    __asm__ volatile("ldrd %[a0], %[a1], [%[x]], #8\n\t"
+                     "1:\n\t"
+                     "ldrd %[c0], %[c1], [%[w]], #8\n\t" PK_QUAD_P01
+                     "ldrd %[a0], %[a1], [%[x]], #8\n\t" PK_QUAD_P23 "ldrd %[c0], %[c1], [%[w]], #8\n\t"
+                     "ldrd %[a0], %[a1], [%[x]], #8\n\t" PK_QUAD_P01
+                     "ldrd %[a0], %[a1], [%[x]], #8\n\t" PK_QUAD_P23 "ldrd %[a0], %[a1], [%[x]], #8\n\t"
+                     "cmp %[a0], #0x80000000\n\t"
+                     "bne 1b\n\t"
+                     : [s00] "+r"(s00), [s01] "+r"(s01), [s10] "+r"(s10), [s11] "+r"(s11), [s20] "+r"(s20),
+                       [s21] "+r"(s21), [s30] "+r"(s30), [s31] "+r"(s31), [x] "+r"(xw), [w] "+r"(w),
+                       [a0] "=&r"(a0), [a1] "=&r"(a1), [c0] "=&r"(c0), [c1] "=&r"(c1)
+                     :
+                     : "cc", "memory");
+#undef PK_QUAD_P01
+#undef PK_QUAD_P23
+#else
+    const uint32_t *const end = xw + 8u * n_g;
+    do
+    {
+        const uint32_t c0 = w[0], c1 = w[1], d0 = w[2], d1 = w[3];
+        s00 = S8_SMLAD(xw[0], c0, s00);
+        s01 = S8_SMLAD(xw[0], c1, s01);
+        s10 = S8_SMLAD(xw[1], c0, s10);
+        s11 = S8_SMLAD(xw[1], c1, s11);
+        s20 = S8_SMLAD(xw[2], c0, s20);
+        s21 = S8_SMLAD(xw[2], c1, s21);
+        s30 = S8_SMLAD(xw[3], c0, s30);
+        s31 = S8_SMLAD(xw[3], c1, s31);
+        s00 = S8_SMLAD(xw[4], d0, s00);
+        s01 = S8_SMLAD(xw[4], d1, s01);
+        s10 = S8_SMLAD(xw[5], d0, s10);
+        s11 = S8_SMLAD(xw[5], d1, s11);
+        s20 = S8_SMLAD(xw[6], d0, s20);
+        s21 = S8_SMLAD(xw[6], d1, s21);
+        s30 = S8_SMLAD(xw[7], d0, s30);
+        s31 = S8_SMLAD(xw[7], d1, s31);
+        xw += 8;
+        w += 4;
+    } while (xw != end);
+#endif
+    s[0] = s00;
+    s[1] = s01;
+    s[2] = s10;
+    s[3] = s11;
+    s[4] = s20;
+    s[5] = s21;
+    s[6] = s30;
+    s[7] = s31;
+    return w;
+}
+
 /* the channel pairs of one pass (ng groups from group g0 of n_g; first: the sums start from the bias, else
  * from a0 / a1) for two points (a1 != NULL) or one */
 static void pk_pass(const uint32_t *xw, uint32_t ng, uint32_t n_g, uint32_t g0, const uint32_t *w_pk,
@@ -742,7 +839,7 @@ LIDET_NN_KERNEL void lidet__nn_max_rows_s32(const int32_t *acc, uint32_t n_rows,
  * |zp| 2^k <= 2^23, so no overflow), the clamp at -128 SSAT's own. c = rq_fast_c(k, zp) */
 static inline int32_t rq_fast_c(uint32_t k, int32_t zp)
 {
-    return ((int32_t)1 << (k - 1u)) + zp * ((int32_t)1 << k);
+    return (2 * zp + 1) * ((int32_t)1 << (k - 1u)); /* 2^(k-1) + zp 2^k */
 }
 
 S8_ALWAYS_INLINE int8_t rq_fast(int32_t a, int32_t m, uint32_t k, int32_t c)
@@ -756,27 +853,23 @@ S8_ALWAYS_INLINE int8_t rq_fast(int32_t a, int32_t m, uint32_t k, int32_t c)
 }
 
 /* the fused pass's rows: mode PKF_RQ requantizes with rq_one, PKF_RQ_FAST with rq_fast (every channel's shift in
- * [33, 48] and lo = -128, checked by the caller), PKF_MAX folds into vmax (a constant where inlined: each mode
- * is compiled on its own, without the others' branches) */
+ * [33, 48] and lo = -128, checked by the caller; each channel's k and rq_fast_c made where its pair of channels
+ * is requantized: four points share them, so a table of them made once per call, 240 bytes of stack, no longer
+ * paid), PKF_MAX folds into vmax (a constant where inlined: each mode is compiled on its own, without the others'
+ * branches) */
 enum
 {
     PKF_RQ,
     PKF_RQ_FAST,
-    PKF_RQ_FAST_WIDE,
     PKF_MAX
 };
-
-/* PKF_RQ_FAST's per-channel constants, made once per call (not once per pair of points): c = rq_fast_c(k, zp)
- * and k, for layers of at most PKF_FAST_MAX_OUT channels (the small models' hidden layers; wider ones take the
- * constants channel by channel, PKF_RQ_FAST_WIDE) */
-#define PKF_FAST_MAX_OUT 48u
 
 /* one pair of points (two: x0 and the row after it), or the last point alone; two and mode are constants where
  * inlined, so the pairs' loop carries no test for the odd last row */
 S8_ALWAYS_INLINE void pk_fused_block(const int8_t *x0, uint32_t n_in, const uint32_t *w_pk, const int32_t *b,
                                      uint32_t n_out, const int32_t *mult, const uint8_t *shift, int32_t zp,
-                                     int32_t lo, int8_t *d, int32_t *vmax, const int32_t *cq,
-                                     const uint8_t *kq, uint32_t *xw, const int two, const int mode)
+                                     int32_t lo, int8_t *d, int32_t *vmax, uint32_t *xw, const int two,
+                                     const int mode)
 {
     const uint32_t n_g = n_in / 4u;
     const uint32_t *w = w_pk;
@@ -788,13 +881,11 @@ S8_ALWAYS_INLINE void pk_fused_block(const int8_t *x0, uint32_t n_in, const uint
         s[0] = s[2] = b[o];
         s[1] = s[3] = b[o + 1u];
         w = two ? pk_pair(xw, n_g, w, s) : pk_one(xw, n_g, w, s);
-        if (mode == PKF_RQ_FAST || mode == PKF_RQ_FAST_WIDE)
+        if (mode == PKF_RQ_FAST)
         {
             const int32_t m0 = mult[o], m1 = mult[o + 1u];
-            const uint32_t k0 = mode == PKF_RQ_FAST ? kq[o] : shift[o] - 32u;
-            const uint32_t k1 = mode == PKF_RQ_FAST ? kq[o + 1u] : shift[o + 1u] - 32u;
-            const int32_t c0 = mode == PKF_RQ_FAST ? cq[o] : rq_fast_c(k0, zp);
-            const int32_t c1 = mode == PKF_RQ_FAST ? cq[o + 1u] : rq_fast_c(k1, zp);
+            const uint32_t k0 = shift[o] - 32u, k1 = shift[o + 1u] - 32u;
+            const int32_t c0 = rq_fast_c(k0, zp), c1 = rq_fast_c(k1, zp);
             d[o] = rq_fast(s[0], m0, k0, c0);
             d[o + 1u] = rq_fast(s[1], m1, k1, c1);
             if (two)
@@ -831,22 +922,102 @@ S8_ALWAYS_INLINE void pk_fused_block(const int8_t *x0, uint32_t n_in, const uint
     }
 }
 
+/* four points (x0 and the three rows after it): pk_fused_block's work for two pairs, the channel pair's
+ * constants and loop once for the four */
+S8_ALWAYS_INLINE void pk_fused_quad(const int8_t *x0, uint32_t n_in, const uint32_t *w_pk, const int32_t *b,
+                                    uint32_t n_out, const int32_t *mult, const uint8_t *shift, int32_t zp,
+                                    int32_t lo, int8_t *d, int32_t *vmax, uint32_t *xw, const int mode)
+{
+    const uint32_t n_g = n_in / 4u;
+    const uint32_t *w = w_pk;
+    uint32_t o;
+    pk_widen4(x0, n_in, n_g, xw);
+    if (mode == PKF_MAX)
+    {
+        /* pointers walked, not indexed: fewer of the loop's values reloaded around the kernel's 14 registers */
+        const int32_t *bp = b, *const bend = b + n_out;
+        int32_t *vp = vmax;
+        for (; bp != bend; bp += 2, vp += 2)
+        {
+            int32_t s[8], v0, v1;
+            s[0] = s[2] = s[4] = s[6] = bp[0];
+            s[1] = s[3] = s[5] = s[7] = bp[1];
+            w = pk_quad(xw, n_g, w, s);
+            v0 = vp[0];
+            v1 = vp[1];
+            v0 = s[0] > v0 ? s[0] : v0;
+            v1 = s[1] > v1 ? s[1] : v1;
+            v0 = s[2] > v0 ? s[2] : v0;
+            v1 = s[3] > v1 ? s[3] : v1;
+            v0 = s[4] > v0 ? s[4] : v0;
+            v1 = s[5] > v1 ? s[5] : v1;
+            v0 = s[6] > v0 ? s[6] : v0;
+            v1 = s[7] > v1 ? s[7] : v1;
+            vp[0] = v0;
+            vp[1] = v1;
+        }
+        return;
+    }
+    for (o = 0; o < n_out; o += 2u)
+    {
+        int32_t s[8];
+        s[0] = s[2] = s[4] = s[6] = b[o];
+        s[1] = s[3] = s[5] = s[7] = b[o + 1u];
+        w = pk_quad(xw, n_g, w, s);
+        if (mode == PKF_RQ_FAST)
+        {
+            const int32_t m0 = mult[o], m1 = mult[o + 1u];
+            const uint32_t k0 = shift[o] - 32u, k1 = shift[o + 1u] - 32u;
+            const int32_t c0 = rq_fast_c(k0, zp), c1 = rq_fast_c(k1, zp);
+            int8_t *const d1 = d + n_out, *const d2 = d1 + n_out, *const d3 = d2 + n_out;
+            d[o] = rq_fast(s[0], m0, k0, c0);
+            d[o + 1u] = rq_fast(s[1], m1, k1, c1);
+            d1[o] = rq_fast(s[2], m0, k0, c0);
+            d1[o + 1u] = rq_fast(s[3], m1, k1, c1);
+            d2[o] = rq_fast(s[4], m0, k0, c0);
+            d2[o + 1u] = rq_fast(s[5], m1, k1, c1);
+            d3[o] = rq_fast(s[6], m0, k0, c0);
+            d3[o + 1u] = rq_fast(s[7], m1, k1, c1);
+        }
+        else if (mode == PKF_RQ)
+        {
+            const int32_t m0 = mult[o], m1 = mult[o + 1u];
+            const uint32_t h0 = shift[o], h1 = shift[o + 1u];
+            int8_t *const d1 = d + n_out, *const d2 = d1 + n_out, *const d3 = d2 + n_out;
+            d[o] = rq_one(s[0], m0, h0, zp, lo);
+            d[o + 1u] = rq_one(s[1], m1, h1, zp, lo);
+            d1[o] = rq_one(s[2], m0, h0, zp, lo);
+            d1[o + 1u] = rq_one(s[3], m1, h1, zp, lo);
+            d2[o] = rq_one(s[4], m0, h0, zp, lo);
+            d2[o + 1u] = rq_one(s[5], m1, h1, zp, lo);
+            d3[o] = rq_one(s[6], m0, h0, zp, lo);
+            d3[o + 1u] = rq_one(s[7], m1, h1, zp, lo);
+        }
+    }
+}
+
 S8_ALWAYS_INLINE void pk_fused_rows(const int8_t *in, uint32_t n_rows, uint32_t n_in, const uint32_t *w_pk,
                                     const int32_t *b, uint32_t n_out, const int32_t *mult,
                                     const uint8_t *shift, int32_t zp, int32_t lo, int8_t *out, int32_t *vmax,
-                                    const int32_t *cq, const uint8_t *kq, const int mode)
+                                    const int mode)
 {
-    uint32_t xw[4u * PK_CHUNK_GROUPS];
+    uint32_t xw[8u * PK_CHUNK_GROUPS + 2u];
     uint32_t r;
-    for (r = 0; r + 1u < n_rows; r += 2u)
+    for (r = 0; r + 3u < n_rows; r += 4u)
+    {
+        pk_fused_quad(in + r * n_in, n_in, w_pk, b, n_out, mult, shift, zp, lo,
+                      mode != PKF_MAX ? out + r * n_out : 0, vmax, xw, mode);
+    }
+    if (r + 1u < n_rows)
     {
         pk_fused_block(in + r * n_in, n_in, w_pk, b, n_out, mult, shift, zp, lo,
-                       mode != PKF_MAX ? out + r * n_out : 0, vmax, cq, kq, xw, 1, mode);
+                       mode != PKF_MAX ? out + r * n_out : 0, vmax, xw, 1, mode);
+        r += 2u;
     }
     if (r < n_rows)
     {
         pk_fused_block(in + r * n_in, n_in, w_pk, b, n_out, mult, shift, zp, lo,
-                       mode != PKF_MAX ? out + r * n_out : 0, vmax, cq, kq, xw, 0, mode);
+                       mode != PKF_MAX ? out + r * n_out : 0, vmax, xw, 0, mode);
     }
 }
 
@@ -863,41 +1034,157 @@ int lidet__nn_acc_s8_pk_fused(const int8_t *in, uint32_t n_rows, uint32_t n_in, 
     }
     if (vmax != 0)
     {
-        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, 0, 0, PKF_MAX);
+        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, PKF_MAX);
         return 1;
     }
     for (o = 0; o < n_out && fast; ++o)
     {
         fast = shift[o] - 33u < 16u; /* shift in [33, 48] */
     }
-    if (fast && n_out <= PKF_FAST_MAX_OUT)
+    if (fast)
     {
-        int32_t cq[PKF_FAST_MAX_OUT];
-        uint8_t kq[PKF_FAST_MAX_OUT];
-        for (o = 0; o < n_out; ++o)
-        {
-            kq[o] = (uint8_t)(shift[o] - 32u);
-            cq[o] = rq_fast_c(kq[o], zp);
-        }
-        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, cq, kq, PKF_RQ_FAST);
-    }
-    else if (fast)
-    {
-        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, 0, 0,
-                      PKF_RQ_FAST_WIDE);
+        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, PKF_RQ_FAST);
     }
     else
     {
-        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, 0, 0, PKF_RQ);
+        pk_fused_rows(in, n_rows, n_in, w_pk, b, n_out, mult, shift, zp, lo, out, vmax, PKF_RQ);
     }
     return 1;
 }
+
+#if LIDET_NN_S16_3_TABLE
+/* lidet__nn_acc_s16_3_requant's usual case (every channel's shift in [33, 48], lo = -128) on the DSP cores,
+ * point by point: each channel's constants made once per call into a table (S16_3_TAB_MAX channels: 576 bytes of
+ * stack), read by one load of six words per output (the channel-outer loop made them per call and channel, with
+ * its pointers spilled: about 19 instructions per output, here about 12). Returns 0 where it does not apply. */
+#define S16_3_TAB_MAX 24u
+typedef struct
+{
+    uint32_t w01;     /* channel's weights of x (low half) and y (high half) */
+    int32_t bo, m, c; /* bias, multiplier, rq_fast_c */
+    int32_t w2;       /* weight of z */
+    uint32_t k;       /* shift - 32 */
+} s16_3_ch_t;
+
+int lidet__nn_s16_3_table(const int8_t *w_t, const int32_t *b, uint32_t n_out, const int32_t *mult,
+                          const uint8_t *shift, int32_t zp, int32_t lo, void *tab, uint32_t tab_bytes)
+{
+    s16_3_ch_t *const t = (s16_3_ch_t *)tab;
+    uint32_t o;
+    if (lo != -128 || n_out * (uint32_t)sizeof(s16_3_ch_t) > tab_bytes)
+    {
+        return 0;
+    }
+    for (o = 0; o < n_out; ++o)
+    {
+        const uint32_t k = (uint32_t)shift[o] - 32u;
+        if (k - 1u >= 16u)
+        {
+            return 0; /* a shift outside [33, 48] */
+        }
+        t[o].w01 = ((uint32_t)(int32_t)w_t[o] & 0xFFFFu) | ((uint32_t)(int32_t)w_t[n_out + o] << 16);
+        t[o].bo = b[o];
+        t[o].m = mult[o];
+        t[o].c = rq_fast_c(k, zp);
+        t[o].w2 = w_t[2u * n_out + o];
+        t[o].k = k;
+    }
+    return 1;
+}
+
+void lidet__nn_s16_3_table_run(const int16_t *in, uint32_t n_rows, const void *tab, uint32_t n_out,
+                               int8_t *out)
+{
+    const s16_3_ch_t *const t = (const s16_3_ch_t *)tab;
+    uint32_t r;
+    for (r = 0; r < n_rows; ++r, in += 3, out += n_out)
+    {
+        const s16_3_ch_t *e = t, *const end = t + n_out;
+        int8_t *d = out;
+        uint32_t xy;
+        const int32_t z = in[2];
+        memcpy(&xy, in, sizeof xy); /* x and y in one (possibly unaligned) little-endian word */
+#if defined(__GNUC__) && LIDET_NN_PK_ASM
+        /* one LDM of the channel's six words (its registers fixed here: LDM fills them in ascending order), then
+         * rq_fast's instructions (GCC loaded the words one by one) */
+        register uint32_t w01 __asm__("r2"), bo __asm__("r3"), m __asm__("r4"), c __asm__("r5");
+        register uint32_t w2 __asm__("r6"), k __asm__("r8");
+        uint32_t lo32;
+        __asm__ volatile("1:\n\t"
+                         "ldmia %[e]!, {r2, r3, r4, r5, r6, r8}\n\t"
+                         "smlad %[bo], %[xy], %[w01], %[bo]\n\t"
+                         "mla %[bo], %[z], %[w2], %[bo]\n\t"
+                         "smull %[lo], %[bo], %[m], %[bo]\n\t"
+                         "add %[bo], %[bo], %[c]\n\t"
+                         "asr %[bo], %[bo], %[k]\n\t"
+                         "ssat %[bo], #8, %[bo]\n\t"
+                         "strb %[bo], [%[d]], #1\n\t"
+                         "cmp %[e], %[end]\n\t"
+                         "bne 1b\n\t"
+                         : [e] "+r"(e), [d] "+r"(d), [w01] "=&r"(w01), [bo] "=&r"(bo), [m] "=&r"(m),
+                           [c] "=&r"(c), [w2] "=&r"(w2), [k] "=&r"(k), [lo] "=&r"(lo32)
+                         : [end] "r"(end), [xy] "r"(xy), [z] "r"(z)
+                         : "cc", "memory");
+#else
+        for (; e != end; ++e, ++d)
+        {
+            *d = rq_fast(S8_SMLAD(xy, e->w01, e->bo) + z * e->w2, e->m, e->k, e->c);
+        }
+#endif
+    }
+}
+
+/* the table on the stack, made for this call */
+static int acc_s16_3_tab(const int16_t *in, uint32_t n_rows, const int8_t *w_t, const int32_t *b,
+                         uint32_t n_out, const int32_t *mult, const uint8_t *shift, int32_t zp, int32_t lo,
+                         int8_t *out)
+{
+    s16_3_ch_t t[S16_3_TAB_MAX];
+    if (!lidet__nn_s16_3_table(w_t, b, n_out, mult, shift, zp, lo, t, sizeof t))
+    {
+        return 0;
+    }
+    lidet__nn_s16_3_table_run(in, n_rows, t, n_out, out);
+    return 1;
+}
+#else
+int lidet__nn_s16_3_table(const int8_t *w_t, const int32_t *b, uint32_t n_out, const int32_t *mult,
+                          const uint8_t *shift, int32_t zp, int32_t lo, void *tab, uint32_t tab_bytes)
+{
+    (void)w_t;
+    (void)b;
+    (void)n_out;
+    (void)mult;
+    (void)shift;
+    (void)zp;
+    (void)lo;
+    (void)tab;
+    (void)tab_bytes;
+    return 0; /* DSP cores only */
+}
+
+void lidet__nn_s16_3_table_run(const int16_t *in, uint32_t n_rows, const void *tab, uint32_t n_out,
+                               int8_t *out)
+{
+    (void)in;
+    (void)n_rows;
+    (void)tab;
+    (void)n_out;
+    (void)out;
+}
+#endif
 
 void lidet__nn_acc_s16_3_requant(const int16_t *in, uint32_t n_rows, const int8_t *w_t, const int32_t *b,
                                  uint32_t n_out, const int32_t *mult, const uint8_t *shift, int32_t zp,
                                  int32_t lo, int8_t *out)
 {
     uint32_t r, o;
+#if LIDET_NN_S16_3_TABLE
+    if (acc_s16_3_tab(in, n_rows, w_t, b, n_out, mult, shift, zp, lo, out))
+    {
+        return;
+    }
+#endif
     /* channel by channel: the channel's weights, bias and requantization stay in registers over the rows */
     for (o = 0; o < n_out; ++o)
     {

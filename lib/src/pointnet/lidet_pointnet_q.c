@@ -199,6 +199,14 @@ typedef struct
     int8_t *act[2];
     int8_t *vec[3];
     int16_t *pts;
+    uint32_t acc_bytes;
+    /* the first layer's table (lidet__nn_s16_3_table) kept in acc while no layer accumulates there: the layer it
+     * was made for (NULL: none), and whether it could be made */
+    struct first_tab
+    {
+        const lidet_pointnet_q_layer_t *layer;
+        int ok;
+    } * tab;
 } bufs_t;
 
 static void split_scratch(const lidet_pointnet_q_t *pn, bufs_t *b)
@@ -207,6 +215,7 @@ static void split_scratch(const lidet_pointnet_q_t *pn, bufs_t *b)
     const uint32_t w = pn->w_point > pn->w_vec ? pn->w_point : pn->w_vec;
     const uint32_t na = (uint32_t)LIDET_PN_BLOCK * pn->w_point;
     b->acc = (int32_t *)(void *)p;
+    b->acc_bytes = 4u * LIDET_PN_BLOCK * w;
     p += 4u * LIDET_PN_BLOCK * w;
     b->gmax = (int32_t *)(void *)p;
     p += 4u * pn->w_point;
@@ -285,6 +294,7 @@ static void run_vec_layers(const lidet_pointnet_q_layer_t *l, uint32_t n, const 
 {
     uint32_t i, o;
     const int8_t *cur = in8;
+    b->tab->layer = 0; /* acc is written below */
     for (i = 0; i < n; ++i)
     {
         int8_t *dst = i + 1u == n ? out_s8 : (cur == b->vec[1] ? b->vec[2] : b->vec[1]);
@@ -333,6 +343,7 @@ static void max_init(const bufs_t *b, uint32_t n)
 static void dense_acc(const lidet_pointnet_q_layer_t *ly, const void *in, uint32_t nb, const bufs_t *b,
                       uint32_t l)
 {
+    b->tab->layer = 0; /* acc is written here */
     if (l == 0)
     {
         lidet__nn_acc_s16((const int16_t *)in, nb, 3u, ly->w_t, ly->b, ly->n_out, b->acc);
@@ -355,6 +366,19 @@ static int fused_s8(const lidet_pointnet_q_layer_t *ly, const void *in, uint32_t
         if (LIDET_NN_SIMD || ly->n_in != 3u || dst == 0)
         {
             return 0;
+        }
+        if (LIDET_NN_S16_3_TABLE && b->tab->layer != ly)
+        {
+            /* the layer's constants once per stage, not once per block (the fused layers after it leave acc
+             * alone) */
+            b->tab->layer = ly;
+            b->tab->ok = lidet__nn_s16_3_table(ly->w_t, ly->b, ly->n_out, ly->mult, ly->shift, ly->out_zp,
+                                               ly->relu ? ly->out_zp : -128, b->acc, b->acc_bytes);
+        }
+        if (LIDET_NN_S16_3_TABLE && b->tab->ok)
+        {
+            lidet__nn_s16_3_table_run((const int16_t *)in, nb, b->acc, ly->n_out, dst);
+            return 1;
         }
         lidet__nn_acc_s16_3_requant((const int16_t *)in, nb, ly->w_t, ly->b, ly->n_out, ly->mult, ly->shift,
                                     ly->out_zp, ly->relu ? ly->out_zp : -128, dst);
@@ -408,7 +432,11 @@ static void forward(const lidet_pointnet_q_t *pn, const int16_t *xyz, uint32_t n
 {
     const lidet_pointnet_q_model_t *m = pn->model;
     bufs_t b;
+    struct first_tab tab;
     split_scratch(pn, &b);
+    tab.layer = 0;
+    tab.ok = 0;
+    b.tab = &tab;
     if (m->kind == LIDET_PN_CLASSIFIER)
     {
         run_stage(&m->stage[0], &b, xyz, n, f, voxel, 0, m->n_classes, out);
