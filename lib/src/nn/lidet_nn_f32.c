@@ -91,8 +91,9 @@ static inline void rows1(const float *x, uint32_t n_in, const float *w_t, uint32
 
 /* on x86-64 hosts with FMA dispatch (LIDET_NN_FMA) lidet_nn_f32_x86.c defines lidet__nn_dense_f32 and falls back
  * to this kernel, under another name, on CPUs without FMA; on aarch64 (LIDET_NN_NEON) lidet_nn_f32_neon.c defines it,
- * and this kernel stays under that name for the tests */
-#if LIDET_NN_FMA || LIDET_NN_NEON
+ * and this kernel stays under that name for the tests; on Cortex-M4F/M7 (LIDET_NN_F32_CM) lidet_nn_f32_cm.c defines it
+ * with this kernel's arithmetic and falls back to this one for widths not a multiple of 8 */
+#if LIDET_NN_FMA || LIDET_NN_NEON || LIDET_NN_F32_CM
 #define NN_DENSE_F32 lidet__nn_dense_f32_portable
 #else
 #define NN_DENSE_F32 lidet__nn_dense_f32
@@ -127,7 +128,14 @@ LIDET_NN_KERNEL_F32 void NN_DENSE_F32(const float *in, uint32_t n_rows, uint32_t
     }
 }
 
-void lidet__nn_max_rows_f32(const float *in, uint32_t n_rows, uint32_t n, float *vmax)
+/* on Cortex-M4F/M7 (LIDET_NN_F32_CM) lidet_nn_f32_cm.c defines lidet__nn_max_rows_f32, 8 columns per pass, the same
+ * comparisons; this one is its fallback for widths not a multiple of 8 */
+#if LIDET_NN_F32_CM
+#define NN_MAX_ROWS_F32 lidet__nn_max_rows_f32_portable
+#else
+#define NN_MAX_ROWS_F32 lidet__nn_max_rows_f32
+#endif
+void NN_MAX_ROWS_F32(const float *in, uint32_t n_rows, uint32_t n, float *vmax)
 {
     uint32_t r, k;
     for (r = 0; r < n_rows; ++r)
