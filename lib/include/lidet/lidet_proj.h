@@ -119,8 +119,9 @@ typedef struct
                                  computes it itself when the image has none */
     int32_t *point_idx;   /**< required: the winning input point of each pixel, -1 = empty. The run
                                  needs it as scratch; keep it only if per-pixel -> point is wanted.
-                                 A compact run uses its bytes as scratch for the squared ranges too:
-                                 it holds the winners' indices again when the run returns */
+                                 A compact run keeps each pixel's best squared range in rxy_m when
+                                 the image has that plane, else in range_4mm and z_4mm, until the
+                                 winners' values are written there when the run returns */
     int32_t *point_pixel; /**< optional (NULL: not produced): LIDET_MAX_POINTS entries, the pixel of
                                  each input point (per-point outputs: 4 B per point) */
 } lidet_proj_buffers_t;
