@@ -66,14 +66,28 @@ void lidet__cluster_setup_geometry(lidet_cluster_state_t *c, const lidet_range_i
 static inline int link_ordered(float d1, float d2, float sn, float cs, const lidet__grow_t *g)
 {
     const float u = d1 - d2 * cs, v = d2 * sn;
+#if defined(__x86_64__) || defined(__i386__)
     if (g->gap > 0.0f)
     {
-        /* both tests always computed, combined without a branch (the angle test's outcome is data and a
+        /* x86: both tests always computed, combined without a branch (the angle test's outcome is data and a
          * branch on it mispredicts; the gap test costs a few multiplications) */
         const float gg = g->gap + g->gpm * d2;
         return (v > g->tan_theta * u) & (u * u + v * v <= gg * gg);
     }
     return v > g->tan_theta * u;
+#else
+    /* in-order cores: the gap test only after the angle test passes (fewer instructions; the same outcome) */
+    if (!(v > g->tan_theta * u))
+    {
+        return 0;
+    }
+    if (g->gap > 0.0f)
+    {
+        const float gg = g->gap + g->gpm * d2;
+        return u * u + v * v <= gg * gg;
+    }
+    return 1;
+#endif
 }
 
 static inline int link(float da, float db, float sn, float cs, const lidet__grow_t *g)
@@ -199,7 +213,13 @@ static inline void neighbours_4mm(const lidet_cluster_state_t *c, const lidet__g
 #define GROW_RNG_T uint16_t
 #define GROW_RANGES(img) ((img)->range_4mm)
 #define GROW_FN(name) name##_4mm
+/* one test per candidate where it was measured faster (x86-64: the real KITTI scans' clustering); on the Arm
+ * and RISC-V images the HDL-64 scan's clustering took 7.2 M (Cortex-M7) and 5.0 M (RV32IMAFC) instructions more */
+#if defined(__x86_64__) || defined(__i386__)
 #define GROW_TEST_EVERY 1
+#else
+#define GROW_TEST_EVERY 0
+#endif
 #include "internal/lidet_cluster_grow_body.h"
 #undef GROW_RNG_T
 #undef GROW_RANGES
