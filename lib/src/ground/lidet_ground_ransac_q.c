@@ -293,28 +293,23 @@ typedef struct
     int64_t s1[3], a[6];
 } refine_acc_t;
 
-/* The least-squares plane through the inliers (|height| <= thr) of cur among the cell's samples: their
- * centroid c0 (rounded to 4 mm steps) and scatter matrix about c0 in exact int64 sums, the normal by
- * power iteration on the adjugate of the scatter matrix starting from cur's normal (the adjugate's dominant
- * eigenvector is the scatter's least one; the ratio of a ground patch's two smallest spreads makes a few
- * iterations exact), D through the exact mean. Returns 0 (out untouched) for fewer than 3 inliers or points
- * (nearly) on a line. */
-
-static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_t thr, qplane_t *out,
-                  refine_acc_t *ra)
-{
-    int64_t s1[3] = {0, 0, 0}, e[3], a[6] = {0, 0, 0, 0, 0, 0}, dl[3], b[6], v[3], nd, mm;
-    int32_t q[3], first[3], c0[3], nv[3];
-    uint64_t ma, mb;
-    uint32_t i, m = 0;
-    int k, it;
-    lidet__ground_q_hplane_t hp;
-    /* |h| <= thr as 0 <= h + thr <= 2 thr: D carries thr (one unsigned comparison per sample) */
-    lidet__ground_q_hplane(cur->n, cur->d + thr, &hp);
-    pixel(img, 0u, first);
-    i = 0;
 #if LIDET_Q_HAVE_MUL64
-    if (img->xyz != 0 && 3u * n + (n + 3u) / 4u <= img->spare_n && n < 2048u)
+/* refine's inlier sums where the core has a 32 x 32 -> 64 multiply and the cell's decoded copy leaves room in the
+ * spare ints: the first iteration copies the inliers' differences there and sums them in two passes of three
+ * (inlier_sums), later ones add or take out the samples that changed side (changed_sides), ra keeping the sums.
+ * Returns 0 (nothing set) where that does not apply, else 1 with *m, s1 and a set */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline int
+spare_sums(const cell_src_t *img, uint32_t n, const lidet__ground_q_hplane_t *hp, int64_t thr,
+           const int32_t first[3], refine_acc_t *ra, uint32_t *m_out, int64_t s1[3], int64_t a[6])
+{
+    uint32_t m;
+    if (!(img->xyz != 0 && 3u * n + (n + 3u) / 4u <= img->spare_n && n < 2048u))
+    {
+        return 0;
+    }
     {
         /* each sample's side in flags after the spare ints the first iteration copies its inliers to */
         uint8_t *const fl = (uint8_t *)(void *)(img->spare + 3u * n);
@@ -328,7 +323,7 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
             for (; p != end; p += 3, ++f)
             {
                 const int32_t x = p[0], y = p[1], z = p[2];
-                const uint8_t in = (uint8_t)((uint64_t)lidet__ground_q_height(&hp, x, y, z) <= t2);
+                const uint8_t in = (uint8_t)((uint64_t)lidet__ground_q_height(hp, x, y, z) <= t2);
                 *f = in;
                 if (in)
                 {
@@ -345,19 +340,30 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
         {
             /* the previous iteration's sums, the samples that changed side added or taken out */
             m = ra->m;
-            memcpy(s1, ra->s1, sizeof s1);
-            memcpy(a, ra->a, sizeof a);
-            m = changed_sides(img->xyz, n, fl, &hp, t2, first, m, s1, a);
+            memcpy(s1, ra->s1, sizeof ra->s1);
+            memcpy(a, ra->a, sizeof ra->a);
+            m = changed_sides(img->xyz, n, fl, hp, t2, first, m, s1, a);
         }
         ra->have = 1;
         ra->m = m;
-        memcpy(ra->s1, s1, sizeof s1);
-        memcpy(ra->a, a, sizeof a);
-        i = n; /* no pass below */
+        memcpy(ra->s1, s1, sizeof ra->s1);
+        memcpy(ra->a, a, sizeof ra->a);
     }
-#else
-    (void)ra;
+    *m_out = m;
+    return 1;
+}
 #endif
+
+/* refine's inlier sums in one pass over the samples (the general path): adds to s1 and a, returns the inliers */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline uint32_t
+pass_sums(const cell_src_t *img, uint32_t n, const lidet__ground_q_hplane_t *hp, int64_t thr,
+          const int32_t first[3], int64_t s1[3], int64_t a[6])
+{
+    uint32_t i = 0, m = 0;
+    int32_t q[3];
     /* one pass over the samples (each decoded once): the inliers' sums S1 = sum d and S2 = sum d d^T of
      * d = q - first, exact in int64 (|d| < 2^16: below n 2^32 for n samples); the cell's decoded copy read
      * directly where there is one. S1 is summed in int32 over blocks of 2^14 samples (|sum| < 2^30), each block
@@ -383,7 +389,7 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
                 y = q[1];
                 z = q[2];
             }
-            if ((uint64_t)lidet__ground_q_height(&hp, x, y, z) > 2u * (uint64_t)thr)
+            if ((uint64_t)lidet__ground_q_height(hp, x, y, z) > 2u * (uint64_t)thr)
             {
                 continue;
             }
@@ -416,6 +422,36 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
         s1[0] += t0;
         s1[1] += t1;
         s1[2] += t2;
+    }
+    return m;
+}
+
+/* The least-squares plane through the inliers (|height| <= thr) of cur among the cell's samples: their
+ * centroid c0 (rounded to 4 mm steps) and scatter matrix about c0 in exact int64 sums, the normal by
+ * power iteration on the adjugate of the scatter matrix starting from cur's normal (the adjugate's dominant
+ * eigenvector is the scatter's least one; the ratio of a ground patch's two smallest spreads makes a few
+ * iterations exact), D through the exact mean. Returns 0 (out untouched) for fewer than 3 inliers or points
+ * (nearly) on a line. */
+
+static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_t thr, qplane_t *out,
+                  refine_acc_t *ra)
+{
+    int64_t s1[3] = {0, 0, 0}, e[3], a[6] = {0, 0, 0, 0, 0, 0}, dl[3], b[6], v[3], nd, mm;
+    int32_t first[3], c0[3], nv[3];
+    uint64_t ma, mb;
+    uint32_t m = 0;
+    int k, it;
+    lidet__ground_q_hplane_t hp;
+    /* |h| <= thr as 0 <= h + thr <= 2 thr: D carries thr (one unsigned comparison per sample) */
+    lidet__ground_q_hplane(cur->n, cur->d + thr, &hp);
+    pixel(img, 0u, first);
+#if LIDET_Q_HAVE_MUL64
+    if (!spare_sums(img, n, &hp, thr, first, ra, &m, s1, a))
+#else
+    (void)ra;
+#endif
+    {
+        m = pass_sums(img, n, &hp, thr, first, s1, a);
     }
     if (m < 3u)
     {

@@ -37,7 +37,7 @@
  *                       branch: measured slower the other way). The same joins either way
  * Also read, from lidet_cluster_common.h: LAB_FREE, LAB_NONCAND, STEPS, lidet__cluster_take. The compact float
  * copy (lidet_cluster_grow.c) defines GROW_NEIGHBOURS on SSE2 hosts; the others run the searches as written.
- * Defines: static GROW_FN(search), GROW_FN(search_wrap), GROW_FN(expand) (one pixel's searches, the occluder
+ * Defines: static GROW_FN(search), GROW_FN(search_wrap), GROW_FN(diagonals), GROW_FN(expand) (one pixel's searches, the occluder
  * rule a constant) and GROW_FN(grow) (the fill; forced inline: the includer wraps it in a function of its own,
  * lidet_cluster_grow.c one per image format with the rule an argument, lidet_cluster_grow_q.c one per rule with
  * the rule a constant: the forms measured fastest on an x86-64 host and on the Cortex-M4 respectively).
@@ -164,6 +164,51 @@ static uint32_t GROW_FN(search_wrap)(GROW_STATE_T *c, uint32_t tail, GROW_D_T dq
             break;
         }
         ++*g->bridged;
+    }
+    return tail;
+}
+
+/* The diagonals of pixel (r, col) (8-neighbourhood option): direct neighbours only, no bridging; each joins when
+ * free and linked (down-left, down-right, up-left, up-right). Returns the new tail. */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline uint32_t
+GROW_FN(diagonals)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t tail, uint32_t r, uint32_t col,
+                   uint32_t rowbase, GROW_D_T dq)
+{
+    uint16_t *lab = c->labels;
+    lidet_member_t *mem = c->members;
+    const GROW_RNG_T *rng = GROW_RANGES(&c->img);
+    const uint32_t rows = g->rows, cols = g->cols;
+    const uint32_t cl = col > 0u ? col - 1u : cols - 1u, cr = col + 1u < cols ? col + 1u : 0u;
+    if (r + 1u < rows)
+    {
+        const uint32_t dl = rowbase + cols + cl, dr = rowbase + cols + cr;
+        if (lab[dl] == LAB_FREE &&
+            GROW_LINK(dq, (GROW_D_T)rng[dl], GROW_TA(c, diag)[r], GROW_TB(c, diag)[r], g))
+        {
+            tail = lidet__cluster_take(lab, mem, tail, dl);
+        }
+        if (lab[dr] == LAB_FREE &&
+            GROW_LINK(dq, (GROW_D_T)rng[dr], GROW_TA(c, diag)[r], GROW_TB(c, diag)[r], g))
+        {
+            tail = lidet__cluster_take(lab, mem, tail, dr);
+        }
+    }
+    if (r > 0u)
+    {
+        const uint32_t ul = rowbase - cols + cl, ur = rowbase - cols + cr;
+        if (lab[ul] == LAB_FREE &&
+            GROW_LINK(dq, (GROW_D_T)rng[ul], GROW_TA(c, diag)[r - 1u], GROW_TB(c, diag)[r - 1u], g))
+        {
+            tail = lidet__cluster_take(lab, mem, tail, ul);
+        }
+        if (lab[ur] == LAB_FREE &&
+            GROW_LINK(dq, (GROW_D_T)rng[ur], GROW_TA(c, diag)[r - 1u], GROW_TB(c, diag)[r - 1u], g))
+        {
+            tail = lidet__cluster_take(lab, mem, tail, ur);
+        }
     }
     return tail;
 }
@@ -296,39 +341,10 @@ GROW_FN(expand)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t tail, uint32_t 
                                GROW_TA(c, row) + (r - 1u) * STEPS, GROW_TB(c, row) + (r - 1u) * STEPS,
                                1 - STEPS, g, occl);
     }
-    /* diagonals (8-neighbourhood option): direct neighbours only, no bridging; each joins when
-     * free and linked (down-left, down-right, up-left, up-right) */
+    /* diagonals (8-neighbourhood option) */
     if (g->diag)
     {
-        const uint32_t cl = col > 0u ? col - 1u : cols - 1u, cr = col + 1u < cols ? col + 1u : 0u;
-        if (r + 1u < rows)
-        {
-            const uint32_t dl = rowbase + cols + cl, dr = rowbase + cols + cr;
-            if (lab[dl] == LAB_FREE &&
-                GROW_LINK(dq, (GROW_D_T)rng[dl], GROW_TA(c, diag)[r], GROW_TB(c, diag)[r], g))
-            {
-                tail = lidet__cluster_take(lab, mem, tail, dl);
-            }
-            if (lab[dr] == LAB_FREE &&
-                GROW_LINK(dq, (GROW_D_T)rng[dr], GROW_TA(c, diag)[r], GROW_TB(c, diag)[r], g))
-            {
-                tail = lidet__cluster_take(lab, mem, tail, dr);
-            }
-        }
-        if (r > 0u)
-        {
-            const uint32_t ul = rowbase - cols + cl, ur = rowbase - cols + cr;
-            if (lab[ul] == LAB_FREE &&
-                GROW_LINK(dq, (GROW_D_T)rng[ul], GROW_TA(c, diag)[r - 1u], GROW_TB(c, diag)[r - 1u], g))
-            {
-                tail = lidet__cluster_take(lab, mem, tail, ul);
-            }
-            if (lab[ur] == LAB_FREE &&
-                GROW_LINK(dq, (GROW_D_T)rng[ur], GROW_TA(c, diag)[r - 1u], GROW_TB(c, diag)[r - 1u], g))
-            {
-                tail = lidet__cluster_take(lab, mem, tail, ur);
-            }
-        }
+        tail = GROW_FN(diagonals)(c, g, tail, r, col, rowbase, dq);
     }
     return tail;
 }
