@@ -79,8 +79,9 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     (0 when absent: the models' gammas), gate2_class (3 flags, lidet_class_t order: the classes gate 2 judges;
     GATE2_CLASS when absent, the C default), group_split (0 when absent; the C default is 1 for > 16 rows) and
     group_max_range_mm (40000 when absent), min_score_q15 (3, the operating point; 0s when absent: off; the C
-    default is 19661 for cars and pedestrians with > 16 rows) and car_min_z_spread_mm (the cars' flat-surface test;
-    0 when absent: off; the C default is 600). range_only: the image keeps only the range, every stage reads x, y, z
+    default is 19661 for cars with > 16 rows), gate1_class_margin_q16 (3, added to gate1_margin_q16 per class; 0s
+    when absent, the C default) and car_min_z_spread_mm (the cars'
+    flat-surface test; 0 when absent: off; the C default is 600). range_only: the image keeps only the range, every stage reads x, y, z
     decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
     (dicts), outcomes, stats. returns: (range_mm, azimuth, ring) instead of points_mm (lidet_detector_q_run_returns:
     proj_q.project_returns)."""
@@ -117,6 +118,7 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     Xf, Yf, Zf = X.ravel(), Y.ravel(), Z.ravel()
 
     min_score = [int(v) for v in det_cfg.get("min_score_q15", (0, 0, 0))]
+    g1c = [int(v) for v in det_cfg.get("gate1_class_margin_q16", (0, 0, 0))]
     flat_mm = int(det_cfg.get("car_min_z_spread_mm", 0))
 
     def flat(ci):
@@ -129,7 +131,7 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
         return 192 * int(np.dot(dz, dz)) < flat_mm * flat_mm * int(rec.n_points)
 
     def gate1_pass(cls, energy):
-        return energy < int(cls_model.gamma_q16[cls]) + g1m
+        return energy < int(cls_model.gamma_q16[cls]) + g1m + g1c[cls]
 
     def add(d):
         """the detector's insertion (after every entry with a higher score or an equal score and a lower id);

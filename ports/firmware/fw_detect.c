@@ -677,7 +677,9 @@ static __attribute__((noinline)) int track_scene(void)
 
 int fw_main(void)
 {
-    fw_cfg_t cfg;
+    /* the configuration lives in .bss, not on the stack under the detector's deepest call (the Cortex-M0+ image
+     * has its stack's 80 % headroom to keep) */
+    static fw_cfg_t cfg;
     const fw_model_t *mc = 0, *mb = 0;
 #if LIDET_FIXED_POINT
     const lidet_sensor_q_t *sensor = lidet_sensor_q_find(FW_SENSOR);

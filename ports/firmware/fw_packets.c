@@ -518,7 +518,7 @@ static __attribute__((noinline)) int scan_digest(const char *name)
 int fw_main(void)
 {
     const lidet_sensor_q_t *sensor = lidet_sensor_q_find(FW_SENSOR);
-    lidet_detector_q_cfg_t cfg;
+    static lidet_detector_q_cfg_t cfg; /* in .bss, not on the stack under the detector (fw_detect.c) */
     int bad = 0, c, j;
 
     fw_put_s("lidet-fw board=");

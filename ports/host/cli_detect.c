@@ -478,6 +478,8 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
                                                             "score_points_weight.pedestrian"};
         static const char *const mnames[LIDET_N_CLASSES] = {"min_score.car", "min_score.cyclist",
                                                             "min_score.pedestrian"};
+        static const char *const g1names[LIDET_N_CLASSES] = {"gate1_margin.car", "gate1_margin.cyclist",
+                                                             "gate1_margin.pedestrian"};
         int k;
         for (k = 0; k < LIDET_N_CLASSES; ++k)
         {
@@ -494,6 +496,11 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
             if (klen == strlen(mnames[k]) && strncmp(kv, mnames[k], klen) == 0)
             {
                 c->min_score[k] = (float)v;
+                return 0;
+            }
+            if (klen == strlen(g1names[k]) && strncmp(kv, g1names[k], klen) == 0)
+            {
+                c->gate1_class_margin[k] = (float)v;
                 return 0;
             }
             if (klen == strlen(gnames[k]) && strncmp(kv, gnames[k], klen) == 0)
@@ -600,6 +607,8 @@ void cli_det_usage(FILE *f)
                "                   max_height_extent_m (0: classify tall clusters too),\n"
                "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
                "                   gate2_margin (nats added to the models' gates),\n"
+               "                   gate1_margin.car|cyclist|pedestrian (nats added to gate1_margin\n"
+               "                   for that class; default 0),\n"
                "                   gate2.car|cyclist|pedestrian (0 or 1: whether gate 2\n"
                "                   judges the class; default 1, 1, 0),\n"
                "                   group_split (0 or 1: people side by side in one cluster\n"

@@ -115,6 +115,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
         cfg.gate2_class[k] = fcfg->gate2_class[k];
         cfg.score_box_weight_q16[k] = round_i32((double)fcfg->score_box_weight[k] * 65536.0);
         cfg.min_score_q15[k] = round_i32((double)fcfg->min_score[k] * 32768.0);
+        cfg.gate1_class_margin_q16[k] = round_i32((double)fcfg->gate1_class_margin[k] * 65536.0);
         cfg.score_points_weight_q16[k] = round_i32((double)fcfg->score_points_weight[k] * 65536.0);
     }
     cfg.nms_iou_q15 = round_i32((double)fcfg->nms_iou * 32768.0);

@@ -19,7 +19,8 @@ static lidet_detector_t g_det;
 static int32_t g_pp[LIDET_MAX_POINTS];
 
 /* fcfg: crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin, mount_height_m (< 0: the profile's),
- * min_score per class (3 entries, < 0: the default for the sensor), car_min_z_spread_m (< 0: the default);
+ * min_score per class (3 entries, < 0: the default for the sensor), car_min_z_spread_m (< 0: the default),
+ * gate1_class_margin per class (3 entries, NaN: the default);
  * ucfg: max_proposals (0 = the default), gate1, gate2, refine (the clustering's split_people and join_cars),
  * gate2_class as bits (bit k: class k, lidet_class_t order; 0xFFFFFFFF = the default), group_split (0, 1;
  * 0xFFFFFFFF = the default for the sensor).
@@ -86,6 +87,13 @@ static int det_run(const lidet_sensor_t *s, uint32_t cls_index, uint32_t box_ind
     if (fcfg[9] >= 0.0f) /* the cars' flat-surface test; < 0: the default */
     {
         cfg.car_min_z_spread_m = fcfg[9];
+    }
+    for (k = 0; k < LIDET_N_CLASSES; ++k)
+    {
+        if (fcfg[10 + k] == fcfg[10 + k]) /* gate 1's margin per class; NaN: the default */
+        {
+            cfg.gate1_class_margin[k] = fcfg[10 + k];
+        }
     }
     cfg.stages.cluster.split_people = ucfg[3] != 0u; /* the proposal refinement (lidet_refine.c) */
     cfg.stages.cluster.join_cars = ucfg[3] != 0u;

@@ -391,6 +391,23 @@ void test_crop_budget_range_and_gates(void)
         TEST_ASSERT_EQUAL_UINT32(0, lidet_detector_stats(&g.ws)->n_gate1_rejected);
         lidet_detector_detections(&g.ws, &n);
         TEST_ASSERT_EQUAL_UINT32(3, n);
+        {
+            /* the same margin per class: given to the proposals' class (car) it lets them through, given to
+             * another class it does not */
+            lidet_detector_cfg_t c1 = cfg;
+            c1.gate1_margin = 0.0f;
+            c1.gate1_class_margin[LIDET_CLASS_CAR] = e1 + 6.0f + 0.5f;
+            c1.gate1_class_margin[LIDET_CLASS_PEDESTRIAN] = 0.0f;
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c1, &m_cls, &m_box));
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+            TEST_ASSERT_EQUAL_UINT32(0, lidet_detector_stats(&g.ws)->n_gate1_rejected);
+            c1.gate1_class_margin[LIDET_CLASS_CAR] = 0.0f;
+            c1.gate1_class_margin[LIDET_CLASS_PEDESTRIAN] = e1 + 6.0f + 0.5f;
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c1, &m_cls, &m_box));
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+            TEST_ASSERT_EQUAL_UINT32(3, lidet_detector_stats(&g.ws)->n_gate1_rejected);
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+        }
         m_box.gamma[0] = e2 + 0.5f;
         TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
         TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
@@ -547,6 +564,11 @@ void test_init_errors(void)
     c.min_score[LIDET_CLASS_PEDESTRIAN] = NAN;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c = cfg;
+    c.gate1_class_margin[LIDET_CLASS_CYCLIST] = -20.5f; /* [-20, 20] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.gate1_class_margin[LIDET_CLASS_CYCLIST] = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
     c.car_min_z_spread_m = -0.1f; /* [0, 10] */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c.car_min_z_spread_m = INFINITY;
@@ -561,8 +583,12 @@ void test_init_errors(void)
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_CYCLIST]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_PEDESTRIAN]);
         TEST_ASSERT_EQUAL_FLOAT(0.6f, d0.car_min_z_spread_m);
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_CAR]); /* gate 1: the models' thresholds */
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_CYCLIST]);
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_PEDESTRIAN]);
         lidet_detector_cfg_default(&d0, lidet_sensor_find("vlp16"));
         TEST_ASSERT_EQUAL_UINT8(0, d0.group_split);
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_PEDESTRIAN]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_CAR]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.car_min_z_spread_m);
     }

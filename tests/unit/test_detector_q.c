@@ -98,6 +98,11 @@ static void test_init_errors(void)
     cfg.min_score_q15[LIDET_CLASS_CYCLIST] = -1;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN] = 20 * 65536 + 1; /* [-20, 20] nats */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN] = -20 * 65536;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.car_min_z_spread_mm = 10001; /* [0, 10000] */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     cfg.car_min_z_spread_mm = -1;
@@ -110,8 +115,12 @@ static void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_CYCLIST]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_PEDESTRIAN]);
     TEST_ASSERT_EQUAL_INT32(600, cfg.car_min_z_spread_mm);
+    TEST_ASSERT_EQUAL_INT32(0, cfg.gate1_class_margin_q16[LIDET_CLASS_CAR]); /* gate 1: the models' thresholds */
+    TEST_ASSERT_EQUAL_INT32(0, cfg.gate1_class_margin_q16[LIDET_CLASS_CYCLIST]);
+    TEST_ASSERT_EQUAL_INT32(0, cfg.gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN]);
     lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("vlp16"));
     TEST_ASSERT_EQUAL_UINT8(0, cfg.group_split);
+    TEST_ASSERT_EQUAL_INT32(0, cfg.gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_CAR]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_PEDESTRIAN]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.car_min_z_spread_mm);

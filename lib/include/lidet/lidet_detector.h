@@ -75,6 +75,12 @@ typedef struct
                                          the validation road users; > 0 keeps more of them and more clutter
                                          (measured: docs/DETECTOR.md); [-20, 20] */
     float gate2_margin; /**< the same for gate 2 (the box net's gamma); [-20, 20], default 0 */
+    float gate1_class_margin
+        [LIDET_N_CLASSES]; /**< added to gate1_margin for a proposal the classifier calls this class
+                                           (lidet_class_t order; nats, [-20, 20]); default 0: the models'
+                                           thresholds. E.g. 1 for pedestrians keeps more real people that the
+                                           networks trained on simulated ones find out of distribution, and
+                                           more clutter (measured: docs/DETECTOR.md, "Operating points") */
     uint8_t gate2_class[LIDET_N_CLASSES]; /**< 1: gate 2 judges this class (lidet_class_t order), 0: its boxes
                                                pass gate 2 whatever the box net's energy (the energy is still
                                                reported). Default car 1, cyclist 1, pedestrian 0: a pedestrian's

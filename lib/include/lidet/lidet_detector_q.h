@@ -105,6 +105,9 @@ typedef struct
     int32_t gate1_margin_q16; /**< gate 1 passes when energy_q16 < the model's gamma_q16 + this (Q16 nats; the
                                           float detector's gate1_margin); [-20 * 65536, 20 * 65536], default 0 */
     int32_t gate2_margin_q16; /**< the same for gate 2; default 0 */
+    int32_t gate1_class_margin_q16
+        [LIDET_N_CLASSES]; /**< the float detector's gate1_class_margin in Q16 nats, added to gate1_margin_q16
+                                           for a proposal of that class; [-20 * 65536, 20 * 65536]; default 0 */
     uint8_t gate2_class[LIDET_N_CLASSES]; /**< 1: gate 2 judges this class, 0: it passes (the float detector's
                                                gate2_class); default car 1, cyclist 1, pedestrian 0 */
     uint8_t group_split; /**< the float detector's group_split (lidet_detector.h): default 1 for > 16 rows,

@@ -44,6 +44,9 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     cfg->gate2 = 1u;
     cfg->gate1_margin_q16 = 0;
     cfg->gate2_margin_q16 = 0;
+    cfg->gate1_class_margin_q16[LIDET_CLASS_CAR] = 0; /* the float detector's: the models' thresholds */
+    cfg->gate1_class_margin_q16[LIDET_CLASS_CYCLIST] = 0;
+    cfg->gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN] = 0;
     cfg->gate2_class[LIDET_CLASS_CAR] = 1u; /* the float detector's: pedestrians pass gate 2 */
     cfg->gate2_class[LIDET_CLASS_CYCLIST] = 1u;
     cfg->gate2_class[LIDET_CLASS_PEDESTRIAN] = 0u;
@@ -86,7 +89,8 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
     }
     for (k = 0; k < (uint32_t)LIDET_N_CLASSES; ++k)
     {
-        if (c->gate2_class[k] > 1u || c->min_score_q15[k] < 0 || c->min_score_q15[k] > 32768)
+        if (c->gate2_class[k] > 1u || c->min_score_q15[k] < 0 || c->min_score_q15[k] > 32768 ||
+            c->gate1_class_margin_q16[k] < -MARGIN_MAX_Q16 || c->gate1_class_margin_q16[k] > MARGIN_MAX_Q16)
         {
             return 0;
         }
@@ -334,7 +338,8 @@ static int flat_surface(const lidet_detector_q_t *d, uint32_t ci)
 #define DET_FLAT(d, ci) flat_surface((d), (ci))
 #define DET_SCORE_OK(d, t) ((int32_t)(t)->score_q15 >= (d)->cfg.min_score_q15[(t)->cls])
 #define DET_GATE1_PASS(d, co)                                                                                \
-    ((int64_t)(co)->energy_q16 < (int64_t)(d)->cls.model->gamma_q16[(co)->cls] + (d)->cfg.gate1_margin_q16)
+    ((int64_t)(co)->energy_q16 < (int64_t)(d)->cls.model->gamma_q16[(co)->cls] + (d)->cfg.gate1_margin_q16 + \
+                                     (d)->cfg.gate1_class_margin_q16[(co)->cls])
 #define DET_GATE2_PASS(d, cls, bo)                                                                           \
     ((int64_t)(bo)->energy_q16 < (int64_t)(d)->box.model->gamma_q16[(cls)] + (d)->cfg.gate2_margin_q16)
 #define DET_FILL fill_detection

@@ -24,7 +24,8 @@
  *   DET_FLAT(d, ci)       1 when cluster ci is a flat surface (the cars' test, cfg car_min_z_spread_*)
  *   DET_SCORE_OK(d, t)    1 when detection *t (filled) scores at least its class's min_score
  *   DET_GATE1_PASS(d, co)  1 when the classifier's energy lies below the model's gamma of the class plus the
- *                         configured margin (the output's own `pass` is the margin-0 decision)
+ *                         configured margins, gate1_margin and the class's gate1_class_margin (the output's own
+ *                         `pass` is the margin-0 decision)
  *   DET_GATE2_PASS(d, cls, bo)  the same for the box net's energy
  *   DET_FILL(d, t, ci, co, bo)  the build's own fields of detection *t (score, energies, point count; the loop
  *                         sets box, cls and cluster_id)
