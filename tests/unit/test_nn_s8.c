@@ -36,9 +36,13 @@ static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extrem
     static int32_t b[MAX_O], ref[MAX_R * MAX_O], got[MAX_R * MAX_O];
     uint32_t r, i, o, k;
     for (k = 0; k < rows * n_in; ++k)
-        in[k] = extreme ? (int8_t)((k & 1u) ? -128 : 127) : (int8_t)(next() & 0xFFu);
+    {
+        in[k] = extreme == 1 ? (int8_t)((k & 1u) ? -128 : 127) : (int8_t)(next() & 0xFFu);
+        if (extreme == 2 && next() % 5u < 3u) /* a ReLU layer's output: most inputs at its zero point */
+            in[k] = -128;
+    }
     for (k = 0; k < n_in * n_out; ++k)
-        w[k] = extreme ? (int8_t)-128 : (int8_t)(next() & 0xFFu);
+        w[k] = extreme == 1 ? (int8_t)-128 : (int8_t)(next() & 0xFFu);
     for (o = 0; o < n_out; ++o)
         b[o] = (int32_t)(next() % 2000001u) - 1000000;
     for (r = 0; r < rows; ++r)
@@ -51,6 +55,9 @@ static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extrem
         }
     memset(got, 0x5A, sizeof got);
     lidet__nn_acc_s8_cols(in, rows, n_in, w, b, n_out, n_out, got, n_out);
+    TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+    memset(got, 0x5A, sizeof got);
+    lidet__nn_acc_s8_skip(in, rows, n_in, w, b, n_out, got);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
     memset(got, 0x5A, sizeof got);
     lidet__nn_acc_s8_rows4(in, rows, n_in, w, b, n_out, got);
@@ -82,7 +89,10 @@ static void test_kernels_agree_on_every_shape(void)
     for (rows = 1; rows <= MAX_R; ++rows)
         for (n_in = 1; n_in <= MAX_I; n_in += 7u)
             for (n_out = 1; n_out <= MAX_O; n_out += 3u)
+            {
                 check_shape(rows, n_in, n_out, 0);
+                check_shape(rows, n_in, n_out, 2); /* 3 in 5 inputs at -128: the skipped products */
+            }
 }
 
 /* the packed kernel's cases: one group, several, exactly one 64-input pass, two and three passes */

@@ -281,7 +281,8 @@
 /** Which of those lidet__nn_acc_s8 runs (layers with packed weights take the packed kernel instead, see
  *  LIDET_PNQ_WEIGHTS_PK). One of the LIDET_NN_S8_KERNEL_* names above. Default: the one with the fewest
  *  instructions per multiply-add on the target (counted in lib/src/nn/lidet_nn_s8.c): R4O2 on RISC-V, DSP with
- *  the Arm DSP extension, R2O2 on other 32-bit Arm but ARMv6-M, COLS on ARMv6-M, ROWS4 elsewhere (hosts).
+ *  the Arm DSP extension, R2O2 on other 32-bit Arm but ARMv6-M, COLS on ARMv6-M (which skips the inputs at a
+ *  ReLU's zero point in layers of LIDET_NN_S8_SKIP_MIN_ROWS rows or more), ROWS4 elsewhere (hosts).
  *  Any kernel runs on any target (off the DSP cores the DSP one runs a C model of its three instructions). */
 #ifndef LIDET_NN_S8_KERNEL
 #if defined(__riscv)

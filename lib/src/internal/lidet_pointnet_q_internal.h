@@ -29,6 +29,12 @@ void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
 void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, uint32_t w_stride, int32_t *acc,
                            uint32_t a_stride);
+/* the output-inner loop skipping inputs at -128 (a ReLU's zero point): the bias less 128 sum w in the first row's
+ * accumulators, then only the nonzero x + 128; for layers of LIDET_NN_S8_SKIP_MIN_ROWS rows or more (the rows pay
+ * for the pass over the weights) */
+#define LIDET_NN_S8_SKIP_MIN_ROWS 8u
+void lidet__nn_acc_s8_skip(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                           const int32_t *b, uint32_t n_out, int32_t *acc);
 /* 2 x 2 blocks, 4 inputs per step with SMLAD (Cortex-M4/M7 DSP extension; a C model of it elsewhere) */
 void lidet__nn_acc_s8_dsp(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                           const int32_t *b, uint32_t n_out, int32_t *acc);
