@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "internal/lidet_pointnet_q_internal.h"
+#include "internal/lidet_qmath.h"
 #include "test_util.h"
 
 #define MAX_R 11
@@ -81,6 +82,30 @@ static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extrem
     memset(got, 0x5A, sizeof got);
     lidet__nn_acc_s8_pk(in, rows, n_in, w_pk, w, b, n_out, got);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+}
+
+/* the cores without a 32 x 32 -> 64 multiply (ARMv6-M) take these from 16-bit halves: exact against int64 on the
+ * corners of the ranges and on random operands */
+static void test_split_multiplies_are_exact(void)
+{
+    static const int32_t edge[] = {0, 1, -1, 2, -2, 65535, 65536, -65536, -65537, 32767, -32768, 0x7FFFFFFF,
+                                   -0x7FFFFFFF - 1, 0x40000000, -0x40000000, 123456789, -987654321};
+    const uint32_t ne = (uint32_t)(sizeof edge / sizeof edge[0]);
+    uint32_t i, j, k;
+    for (i = 0; i < ne; ++i)
+        for (j = 0; j < ne; ++j)
+        {
+            const int32_t a = edge[i], b = edge[j];
+            TEST_ASSERT_EQUAL_INT32((int32_t)(((int64_t)a * b) >> 32), lidet__q_smulhi32_split(a, b));
+            TEST_ASSERT_TRUE((uint64_t)(uint32_t)a * (uint32_t)b == lidet__q_umul32_split((uint32_t)a, (uint32_t)b));
+        }
+    for (k = 0; k < 200000u; ++k)
+    {
+        const uint32_t ua = next() ^ (next() << 16), ub = next() ^ (next() << 16);
+        const int32_t a = (int32_t)ua >> (k % 17u), b = (int32_t)ub >> (k % 13u);
+        TEST_ASSERT_EQUAL_INT32((int32_t)(((int64_t)a * b) >> 32), lidet__q_smulhi32_split(a, b));
+        TEST_ASSERT_TRUE((uint64_t)ua * ub == lidet__q_umul32_split(ua, ub));
+    }
 }
 
 static void test_kernels_agree_on_every_shape(void)
@@ -330,6 +355,7 @@ static void test_s16_layer_and_max_agree(void)
 int main(void)
 {
     UNITY_BEGIN();
+    RUN_TEST(test_split_multiplies_are_exact);
     RUN_TEST(test_kernels_agree_on_every_shape);
     RUN_TEST(test_packed_kernel_on_multiples_of_4);
     RUN_TEST(test_fused_pass_equals_acc_then_requant_or_max);

@@ -9,6 +9,7 @@
 #include "internal/lidet_assert.h"
 #include "internal/lidet_cluster_internal.h"
 #include "internal/lidet_math.h"
+#include "internal/lidet_qmath.h" /* lidet__q_umul32: the fill's row from the pixel index */
 
 #if LIDET_HOST_SIMD && defined(__SSE2__)
 #include <emmintrin.h>

@@ -103,8 +103,11 @@ static inline int link_q(uint32_t da, uint32_t db, uint32_t s, uint32_t h, const
             return 0;
         }
         /* ((x >> 29) + 1) >> 1 = (x + 2^29) >> 30, x <= (2^32 - 1)^2 (no overflow): one 64-bit shift */
-        cross = ((uint64_t)(d1 * d2) * h + ((uint64_t)1 << 29)) >> 30;
-        return (uint64_t)dd * dd + cross <= (uint64_t)gg * gg;
+        cross = (lidet__q_umul32(d1 * d2, h) + ((uint64_t)1 << 29)) >> 30;
+        /* dd <= 65535: dd^2 fits 32 bits (a 32-bit product where the long one is a call; the long one, as before,
+         * where it is one instruction) */
+        return (LIDET_Q_HAVE_MUL64 ? (uint64_t)dd * dd : (uint64_t)(dd * dd)) + cross <=
+               lidet__q_umul32(gg, gg);
     }
     return 1;
 }

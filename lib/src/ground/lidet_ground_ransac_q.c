@@ -538,14 +538,34 @@ static uint32_t count_inliers(const lidet_ground_q_scratch_t *sc, const cell_src
     {
         /* h + t = c . q + (t - c . p0): the constant is each sum's start (exact in int64: |c . q| < 2^47) */
         const int64_t h0 = t - ((int64_t)c0 * p0[0] + (int64_t)c1 * p0[1] + (int64_t)c2 * p0[2]);
+#if !LIDET_Q_HAVE_MUL64
+        int32_t ch[3], cl[3]; /* c split as lidet__ground_q_hplane splits a normal (|c| <= 2^29) */
+        {
+            const int32_t cc[3] = {c0, c1, c2};
+            int k;
+            for (k = 0; k < 3; ++k)
+            {
+                ch[k] = (int32_t)(((int64_t)cc[k] + (1 << 14)) >> 15);
+                cl[k] = cc[k] - (int32_t)((uint32_t)ch[k] << 15);
+            }
+        }
+#endif
         /* in blocks of 32 samples; a hypothesis that can no longer beat the best count stops */
         for (i = 0; i < n_eval && (!have || cnt + (n_eval - i) > best_cnt);)
         {
             const uint32_t end = n_eval - i > 32u ? i + 32u : n_eval;
             for (; i < end; ++i)
             {
+#if LIDET_Q_HAVE_MUL64
                 const int64_t ht =
                     h0 + (int64_t)c0 * sc->ev_x[i] + (int64_t)c1 * sc->ev_y[i] + (int64_t)c2 * sc->ev_z[i];
+#else
+                /* c = hi 2^15 + lo (|hi|, |lo| <= 2^14) against int16 samples: two sums of three 32-bit products
+                 * (each < 2^29), the same exact value without the 64 x 64 multiply helper */
+                const int32_t x = sc->ev_x[i], y = sc->ev_y[i], z = sc->ev_z[i];
+                const int64_t ht = h0 + (int64_t)(ch[0] * x + ch[1] * y + ch[2] * z) * 32768 +
+                                   (cl[0] * x + cl[1] * y + cl[2] * z);
+#endif
 #if defined(__GNUC__) && defined(__thumb2__) && !defined(__ARM_BIG_ENDIAN)
                 /* the unsigned comparison's carry added directly (GCC made it a conditional 0 / 1 and an add) */
                 uint32_t tmp;

@@ -366,7 +366,7 @@ GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t start, uint32_t t
     while (head < tail)
     {
         const uint32_t q = (uint32_t)mem[head++];
-        const uint32_t r = g->row_magic != 0u ? (uint32_t)(((uint64_t)q * g->row_magic) >> 32) : q / cols;
+        const uint32_t r = g->row_magic != 0u ? (uint32_t)(lidet__q_umul32(q, g->row_magic) >> 32) : q / cols;
         LIDET_ASSERT(tail <= g->rows * cols);
         if (occl && *g->bridged < g->bridge_max)
         {

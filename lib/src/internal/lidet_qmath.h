@@ -52,6 +52,52 @@ uint32_t lidet__q_isqrt64(uint64_t v);
  * instruction, which the integer path then writes directly; split into 32-bit products elsewhere. Same values
  * either way. */
 
+/* a * b exact in 64 bits from four 16 x 16 -> 32 products (the form of cores without a 32 x 32 -> 64 multiply,
+ * compiled everywhere so that the host tests check it) */
+static inline uint64_t lidet__q_umul32_split(uint32_t a, uint32_t b)
+{
+    const uint32_t al = a & 0xFFFFu, ah = a >> 16, bl = b & 0xFFFFu, bh = b >> 16;
+    const uint32_t ll = al * bl, lh = al * bh, hl = ah * bl;
+    const uint32_t mid = (ll >> 16) + (lh & 0xFFFFu) + (hl & 0xFFFFu); /* < 3 * 2^16 */
+    const uint32_t hi = ah * bh + (lh >> 16) + (hl >> 16) + (mid >> 16);
+    return ((uint64_t)hi << 32) | (uint32_t)((mid << 16) | (ll & 0xFFFFu));
+}
+
+/* a * b exact in 64 bits: one instruction where LIDET_Q_HAVE_MUL64; elsewhere (ARMv6-M) the split form, about
+ * 20 instructions where the compiler's 64 x 64 helper (__muldi3) took about three times that */
+static inline uint64_t lidet__q_umul32(uint32_t a, uint32_t b)
+{
+#if LIDET_Q_HAVE_MUL64
+    return (uint64_t)a * b;
+#else
+    return lidet__q_umul32_split(a, b);
+#endif
+}
+
+/* floor(a * b / 2^32), the high word of the exact signed product, from 16-bit halves: a = ah 2^16 + al (al in
+ * [0, 2^16), ah signed), the cross products' high halves by arithmetic shifts (floor), the low halves' carries
+ * summed in 32 bits (compiled everywhere so that the host tests check it) */
+static inline int32_t lidet__q_smulhi32_split(int32_t a, int32_t b)
+{
+    const uint32_t al = (uint32_t)a & 0xFFFFu, bl = (uint32_t)b & 0xFFFFu;
+    const int32_t ah = a >> 16, bh = b >> 16;
+    const uint32_t ll = al * bl;
+    const int32_t c1 = ah * (int32_t)bl, c2 = (int32_t)al * bh; /* |c| < 2^31 */
+    const uint32_t mid = (ll >> 16) + ((uint32_t)c1 & 0xFFFFu) + ((uint32_t)c2 & 0xFFFFu);
+    return ah * bh + (c1 >> 16) + (c2 >> 16) + (int32_t)(mid >> 16);
+}
+
+/* floor(a * b / 2^32): one long multiply where LIDET_Q_HAVE_MUL64; elsewhere (ARMv6-M) the split form, about 15
+ * instructions where the compiler called its 64 x 64 helper (__muldi3) */
+static inline int32_t lidet__q_smulhi32(int32_t a, int32_t b)
+{
+#if LIDET_Q_HAVE_MUL64
+    return (int32_t)(((int64_t)a * b) >> 32);
+#else
+    return lidet__q_smulhi32_split(a, b);
+#endif
+}
+
 /** floor(sqrt(v)), exact, 32-bit arithmetic only */
 uint32_t lidet__q_isqrt32(uint32_t v);
 

@@ -839,7 +839,7 @@ S8_ALWAYS_INLINE int8_t rq_one(int32_t a, int32_t m, uint32_t s, int32_t zp, int
     if (s > 32u)
     {
         const uint32_t k = s - 32u;
-        const int32_t hi = (int32_t)(((int64_t)a * m) >> 32);
+        const int32_t hi = lidet__q_smulhi32(a, m);
         return clamp_s8(((hi + ((int32_t)1 << (k - 1u))) >> k) + zp, lo);
     }
     {
@@ -878,7 +878,7 @@ void lidet__nn_requant_s8_by_channel(const int32_t *acc, uint32_t n_rows, uint32
             const int32_t half = (int32_t)1 << (k - 1u);
             for (r = 0; r < n_rows; ++r, a += n_out, d += n_out)
             {
-                const int32_t hi = (int32_t)(((int64_t)*a * m) >> 32);
+                const int32_t hi = lidet__q_smulhi32(*a, m);
                 *d = clamp_s8(((hi + half) >> k) + zp, lo);
             }
         }
@@ -948,7 +948,7 @@ static inline int32_t rq_fast_c(uint32_t k, int32_t zp)
 
 S8_ALWAYS_INLINE int8_t rq_fast(int32_t a, int32_t m, uint32_t k, int32_t c)
 {
-    const int32_t v = ((int32_t)(((int64_t)a * m) >> 32) + c) >> k;
+    const int32_t v = (lidet__q_smulhi32(a, m) + c) >> k;
 #if defined(__ARM_FEATURE_SAT) && __ARM_FEATURE_SAT
     return (int8_t)__ssat(v, 8); /* SSAT's own -128 (GCC does not drop clamp_s8's second compare after it) */
 #else
