@@ -629,6 +629,16 @@ skip_pair(int32_t *a, const int8_t *w0, const int8_t *w1, int32_t u0, int32_t u1
     } while (++k != 0);
 }
 
+/* a += u w over n channels: one input's weight row (the output-inner kernels' odd input) */
+static inline void acc_row(int32_t *a, const int8_t *w, int32_t u, uint32_t n)
+{
+    uint32_t o;
+    for (o = 0; o < n; ++o)
+    {
+        a[o] += u * (int32_t)w[o];
+    }
+}
+
 /* the output-inner kernel on channels [0, n_out) of a layer whose weight rows are w_stride long and whose
  * accumulator rows are a_stride long (a column slice, for the blocked kernels' leftovers) */
 void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
@@ -660,12 +670,7 @@ void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
         }
         for (; i < n_in; ++i)
         {
-            const int32_t x0 = x[i];
-            const int8_t *w0 = w_t + i * w_stride;
-            for (o = 0; o < n_out; ++o)
-            {
-                a[o] += x0 * (int32_t)w0[o];
-            }
+            acc_row(a, w_t + i * w_stride, x[i], n_out);
         }
     }
 }
@@ -693,11 +698,7 @@ void lidet__nn_acc_s8_skip(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
     }
     if (i < n_in)
     {
-        const int8_t *w = w_t + i * n_out;
-        for (o = 0; o < n_out; ++o)
-        {
-            acc[o] -= 128 * (int32_t)w[o];
-        }
+        acc_row(acc, w_t + i * n_out, -128, n_out);
     }
     for (r = n_rows; r-- > 0u;) /* the last row first: row 0 keeps the starting sums until the end */
     {
@@ -732,10 +733,7 @@ void lidet__nn_acc_s8_skip(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
         }
         if (w0 != 0)
         {
-            for (o = 0; o < n_out; ++o)
-            {
-                a[o] += u0 * (int32_t)w0[o];
-            }
+            acc_row(a, w0, u0, n_out);
         }
     }
 }

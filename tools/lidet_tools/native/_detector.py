@@ -209,7 +209,7 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
                      -1 if car_min_z_spread_mm is None else int(car_min_z_spread_mm),
                      *([np.iinfo(np.int32).min] * 3 if gate1_class_margin_q16 is None else
                        [int(x) for x in _per_class(gate1_class_margin_q16, "gate1_class_margin_q16", -20 * 65536,
-                                                   20 * 65536)])], np.int64).astype(np.int32)
+                                                   20 * 65536)])], np.int32)
     n = len(pts)
     rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
                              pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st,
