@@ -404,7 +404,9 @@ static int flat_surface(const lidet_detector_t *d, uint32_t ci)
 #define DET_GROUP_T lidet_group_t
 #define DET_GROUP_ON(d) ((d)->cfg.group_split != 0u)
 #define DET_GROUP_SHAPE(d, ci, g) lidet__group_shape(&(d)->ws.cluster, (ci), (d)->cfg.group_max_range_m, (g))
-#define DET_GROUP_CUT(d, ci, g, k) lidet__group_cut(&(d)->ws.cluster, (ci), (g), (k))
+/* the PointNets' scratch is idle during a cut */
+#define DET_GROUP_CUT(d, ci, g, k)                                                                           \
+    lidet__group_cut(&(d)->ws.cluster, (ci), (g), (k), (d)->pn_scratch, LIDET_DETECTOR_PN_SCRATCH / 4u)
 #define DET_GROUP_PROPOSAL(d, ci, g, j)                                                                      \
     lidet__group_proposal(&(d)->ws.cluster, (ci), (g), (j), &(d)->cfg.proposal, &(d)->proposal)
 #include "internal/lidet_detector_body.h"

@@ -24,8 +24,10 @@ typedef struct
 
 /* 1 when cluster ci of the last run is shaped like a group (rule 1); fills g's mean, axis, spread and cuts */
 int lidet__group_shape(const lidet_cluster_state_t *c, uint32_t ci, float max_range_m, lidet_group_t *g);
-/* the k-part cut of rule 3 into g; 1 when every part holds LIDET_GROUP_MIN_PART members */
-int lidet__group_cut(const lidet_cluster_state_t *c, uint32_t ci, lidet_group_t *g, uint32_t k);
+/* the k-part cut of rule 3 into g; 1 when every part holds LIDET_GROUP_MIN_PART members (the part means are
+ * set only then). scratch: n_scratch floats the cut may overwrite (the members' offsets t), or NULL */
+int lidet__group_cut(const lidet_cluster_state_t *c, uint32_t ci, lidet_group_t *g, uint32_t k,
+                     float *scratch, uint32_t n_scratch);
 /* part `part` of g's last cut as a proposal (rule 4) */
 lidet_status_t lidet__group_proposal(const lidet_cluster_state_t *c, uint32_t ci, const lidet_group_t *g,
                                      uint32_t part, const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out);

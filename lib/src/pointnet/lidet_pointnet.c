@@ -414,17 +414,30 @@ static void frame_of(const lidet_proposal_t *p, float cs[2], float voxel[3])
     voxel[2] = (float)p->voxel[2];
 }
 
+/* a row's bucket for LIDET__PROPOSAL_DISTINCT_ROWS_HASHED: a hash of its bits (rows ROW_EQ calls equal have
+ * the same bits) */
+static uint32_t row_hash(const float *row)
+{
+    uint32_t a, b, c;
+    memcpy(&a, &row[0], sizeof a);
+    memcpy(&b, &row[1], sizeof b);
+    memcpy(&c, &row[2], sizeof c);
+    return ((a ^ b * 0x85EBCA77u ^ c * 0xC2B2AE3Du) * 0x9E3779B1u) >> 25; /* 7 bits: LIDET__PDR_BUCKETS */
+}
+
 /* the rows the shared layers must see (internal/lidet_proposal_rule.h): the first n_points_src where the rest
  * repeat them, compared by value and by bits (a NaN row matches none, as its place in the maximum matters; -0
- * and +0 do not match each other) */
+ * and +0 do not match each other), through the rule's hash table (LIDET__PROPOSAL_DISTINCT_ROWS_HASHED) */
 static uint32_t distinct_rows(const lidet_proposal_t *p)
 {
     uint32_t n;
 #define ROW_EQ(i, j)                                                                                         \
     (p->xyz[i][0] == p->xyz[j][0] && p->xyz[i][1] == p->xyz[j][1] && p->xyz[i][2] == p->xyz[j][2] &&         \
      memcmp(p->xyz[i], p->xyz[j], sizeof p->xyz[i]) == 0)
-    LIDET__PROPOSAL_DISTINCT_ROWS(p->n_points, p->n_points_src, ROW_EQ, n);
+#define ROW_HASH(i) row_hash(p->xyz[i])
+    LIDET__PROPOSAL_DISTINCT_ROWS_HASHED(p->n_points, p->n_points_src, ROW_EQ, ROW_HASH, n);
 #undef ROW_EQ
+#undef ROW_HASH
     return n;
 }
 
