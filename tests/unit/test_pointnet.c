@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "internal/lidet_proposal_rule.h"
 #include "lidet/lidet.h"
 #include "test_util.h"
 
@@ -131,7 +132,8 @@ static float b_bp_w[3 * 2];
 static const float b_bp_b[2] = {0, 0};
 static float b_bh_w[5 * 11];
 /* centre residual, heading scores (bin 1 wins), heading residuals, size score, size residual */
-static float b_bh_b[11] = {0.5f, -0.25f, 1.0f, 0.0f, 3.0f, 0.0f, 0.5f, 2.0f, 0.1f, -0.5f, 0.0f}; /* [6]: see below */
+static float b_bh_b[11] = {0.5f, -0.25f, 1.0f, 0.0f,  3.0f, 0.0f,
+                           0.5f, 2.0f,   0.1f, -0.5f, 0.0f}; /* [6]: see below */
 static const float b_size[3] = {4.0f, 2.0f, 1.5f};
 static const lidet_pn_layer_t b_tpoint[1] = {{3, 3, 0, b_tp_w, b_tp_b}};
 static const lidet_pn_layer_t b_thead[1] = {{6, 3, 0, b_th_w, b_th_b}};
@@ -341,7 +343,8 @@ void test_bad_descriptors(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_pn_check(NULL, 0, 0));
 
     m.format_version = LIDET_WEIGHTS_FORMAT_VERSION + 1;
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_pn_init(&g_pn.ws, &m, g_scratch.ws.f, sizeof g_scratch.ws.f, &need));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL,
+                          lidet_pn_init(&g_pn.ws, &m, g_scratch.ws.f, sizeof g_scratch.ws.f, &need));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_STATE, lidet_pn_forward(&g_pn.ws, pts, 4, vox, NULL, out, 3));
     m = tiny_classifier();
     m.n_points = LIDET_PROPOSAL_POINTS + 1;
@@ -395,8 +398,10 @@ void test_bad_descriptors(void)
     TEST_ASSERT_EQUAL_UINT32(lidet_pn_scratch_bytes(&m), need);
     TEST_ASSERT_TRUE(need > 16);
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_BUFFER, lidet_pn_init(&g_pn.ws, &m, NULL, 0, &need));
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_pn_init(&g_pn.ws, &m, (char *)g_scratch.ws.f + 1, need + 8, NULL));
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_pn_init(NULL, &m, g_scratch.ws.f, sizeof g_scratch.ws.f, NULL));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG,
+                          lidet_pn_init(&g_pn.ws, &m, (char *)g_scratch.ws.f + 1, need + 8, NULL));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG,
+                          lidet_pn_init(NULL, &m, g_scratch.ws.f, sizeof g_scratch.ws.f, NULL));
 
     /* run-time arguments */
     init_ok(&m);
@@ -463,6 +468,96 @@ static void test_box_heading_wrap_terminates(void)
     b_bh_b[6] = saved;
 }
 
+/* LIDET__PROPOSAL_DISTINCT_ROWS_HASHED (the float PointNets' lookup of a proposal's repeated rows) gives the
+ * linear search's result on every row set: random sets of 2-320 rows (past the table's 255 first rows too) whose
+ * first rows repeat values, later rows mostly copies of first ones, sometimes a row of their own, a copy with
+ * -0 for +0, or a NaN copy; with a hash of the row's bits, a weak one (x's low bits) and one bucket for all */
+static float g_dr[320][3];
+static uint32_t dr_bits(float v)
+{
+    uint32_t b;
+    memcpy(&b, &v, sizeof b);
+    return b;
+}
+static uint32_t dr_hash_bits(uint32_t i)
+{
+    return ((dr_bits(g_dr[i][0]) ^ dr_bits(g_dr[i][1]) * 0x85EBCA77u ^ dr_bits(g_dr[i][2]) * 0xC2B2AE3Du) *
+            0x9E3779B1u) >>
+           25;
+}
+static uint32_t dr_hash_weak(uint32_t i)
+{
+    return dr_bits(g_dr[i][0]) & 127u;
+}
+static uint32_t dr_hash_one(uint32_t i)
+{
+    (void)i;
+    return 5u;
+}
+static uint32_t dr_next(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return *s >> 8;
+}
+
+void test_distinct_rows_hashed_matches_linear(void)
+{
+    static const float pool[6] = {0.0f, 1.5f, -2.25f, 0.004f, 1e30f, -7.0f};
+    uint32_t s = 12345u, trial, i, k, n_src_seen = 0, n_out_seen = 0;
+    for (trial = 0; trial < 4000u; ++trial)
+    {
+        const uint32_t n_out = 2u + dr_next(&s) % 319u;
+        const uint32_t n_src = 1u + dr_next(&s) % n_out;
+        const uint32_t odd = 1u + dr_next(&s) % 4u; /* how later rows may differ: 1 in n_out * odd */
+        uint32_t lin, h[3];
+        for (i = 0; i < n_src; ++i)
+        {
+            for (k = 0; k < 3u; ++k)
+            {
+                const uint32_t u = dr_next(&s);
+                g_dr[i][k] = u % 4u == 0u ? (float)(u % 1000u) * 0.01f : pool[u % 6u];
+            }
+            if (dr_next(&s) % 50u == 0u)
+            {
+                g_dr[i][dr_next(&s) % 3u] = NAN;
+            }
+        }
+        for (i = n_src; i < n_out; ++i)
+        {
+            const uint32_t u = dr_next(&s) % (n_out * odd);
+            memcpy(g_dr[i], g_dr[dr_next(&s) % n_src], sizeof g_dr[i]);
+            if (u == 0u)
+            {
+                g_dr[i][0] = 3.25f + (float)i; /* a row of its own */
+            }
+            else if (u == 1u)
+            {
+                g_dr[i][1] = g_dr[i][1] == 0.0f ? -g_dr[i][1] : g_dr[i][1]; /* +0 <-> -0 where zero */
+            }
+            else if (u == 2u)
+            {
+                g_dr[i][2] = NAN;
+            }
+        }
+#define ROW_EQ(a, b)                                                                                         \
+    (g_dr[a][0] == g_dr[b][0] && g_dr[a][1] == g_dr[b][1] && g_dr[a][2] == g_dr[b][2] &&                     \
+     memcmp(g_dr[a], g_dr[b], sizeof g_dr[a]) == 0)
+        LIDET__PROPOSAL_DISTINCT_ROWS(n_out, n_src, ROW_EQ, lin);
+        LIDET__PROPOSAL_DISTINCT_ROWS_HASHED(n_out, n_src, ROW_EQ, dr_hash_bits, h[0]);
+        LIDET__PROPOSAL_DISTINCT_ROWS_HASHED(n_out, n_src, ROW_EQ, dr_hash_weak, h[1]);
+        LIDET__PROPOSAL_DISTINCT_ROWS_HASHED(n_out, n_src, ROW_EQ, dr_hash_one, h[2]);
+#undef ROW_EQ
+        TEST_ASSERT_EQUAL_UINT32(lin, h[0]);
+        TEST_ASSERT_EQUAL_UINT32(lin, h[1]);
+        TEST_ASSERT_EQUAL_UINT32(lin, h[2]);
+        n_src_seen += lin == n_src && n_src < n_out;
+        n_out_seen += lin == n_out && n_src < n_out;
+    }
+    /* both outcomes occur often, with the table and past it */
+    TEST_ASSERT_TRUE(n_src_seen > 500u);
+    TEST_ASSERT_TRUE(n_out_seen > 500u);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -473,5 +568,6 @@ int main(void)
     RUN_TEST(test_bad_descriptors);
     RUN_TEST(test_find);
     RUN_TEST(test_box_heading_wrap_terminates);
+    RUN_TEST(test_distinct_rows_hashed_matches_linear);
     return UNITY_END();
 }
