@@ -210,6 +210,81 @@ static inline void neighbours_4mm(const lidet_cluster_state_t *c, const lidet__g
     neighbours_4mm(c, g, q, r, dq, occl, take, redo, nonc)
 /* bits set in a 4-bit mask (a nibble per mask value) */
 #define GROW_POP4(m) ((uint32_t)(0x4332322132212110ull >> (4u * (m))) & 15u)
+
+/* the first set bit of a 4-bit mask, 4 for none (a nibble per mask value) */
+#define CTZ4(m) ((uint32_t)(0x0102010301020104ull >> (4u * (m))) & 15u)
+
+/* GROW_FN(search) with the occluder rule and nk <= 4 steps (lidet_cluster_grow_body.h: GROW_SEARCH4), SSE2
+ * hosts: the searches that go on past their first step (57 % of the pixels expanded on real KITTI scan 000000
+ * have one, about 2.3 steps each). The labels and ranges of the (up to) four steps from n0 read at once (one
+ * 8-byte load each along a row, scalar gathers across rows; lanes past nk repeat the first step and are masked
+ * off), the join test on the four lanes (link4_4mm, the same outcome as link_4mm), and the search's end as the
+ * first candidate that joins or is not nearer than q: the same joins and the same count of bridged occluders
+ * (the candidates before the end) as the scalar loop, without its branches per step (data that mispredicts).
+ * Measured on the 17 real KITTI scans (HDL-64, x86-64, per scan the fastest of 5 medians of 10, mean over the
+ * scans): the stage 2.56 -> 2.30 ms; the searches along a row alone 2.45 ms. A branch-free take of the end
+ * pixel measured slower (2.34 -> 2.46 ms) */
+static inline uint32_t search4_4mm(uint16_t *lab, lidet_member_t *mem, const uint16_t *rng, uint32_t tail,
+                                   uint32_t dq, uint32_t n0, int32_t step, uint32_t nk, const float *sn,
+                                   const float *cs, int32_t gs, const lidet__grow_t *g)
+{
+    const __m128i z = _mm_setzero_si128();
+    __m128i l, ri;
+    __m128 tsn, tcs;
+    if (step == 1)
+    {
+        l = _mm_unpacklo_epi16(_mm_loadl_epi64((const __m128i *)(const void *)(lab + n0)), z);
+        ri = _mm_unpacklo_epi16(_mm_loadl_epi64((const __m128i *)(const void *)(rng + n0)), z);
+    }
+    else if (step == -1)
+    {
+        l = _mm_shuffle_epi32(
+            _mm_unpacklo_epi16(_mm_loadl_epi64((const __m128i *)(const void *)(lab + n0 - 3u)), z),
+            _MM_SHUFFLE(0, 1, 2, 3));
+        ri = _mm_shuffle_epi32(
+            _mm_unpacklo_epi16(_mm_loadl_epi64((const __m128i *)(const void *)(rng + n0 - 3u)), z),
+            _MM_SHUFFLE(0, 1, 2, 3));
+    }
+    else
+    {
+        const int32_t s1 = nk > 1u ? step : 0, s2 = nk > 2u ? 2 * step : 0, s3 = nk > 3u ? 3 * step : 0;
+        l = _mm_setr_epi32(lab[n0], lab[(int32_t)n0 + s1], lab[(int32_t)n0 + s2], lab[(int32_t)n0 + s3]);
+        ri = _mm_setr_epi32(rng[n0], rng[(int32_t)n0 + s1], rng[(int32_t)n0 + s2], rng[(int32_t)n0 + s3]);
+    }
+    /* the lanes past nk read inside the image: along a row columns col +- 2 .. 5 (a row above and below q),
+     * across rows and in the tables with a stride the first step's entries again; a table with a stride of 1
+     * (rows r and r + k, and the columns' table from k = 2) holds 4 entries from sn when STEPS >= 5 */
+    if (gs == 1 && STEPS >= 5u)
+    {
+        tsn = _mm_loadu_ps(sn);
+        tcs = _mm_loadu_ps(cs);
+    }
+    else
+    {
+        const int32_t t1 = nk > 1u ? gs : 0, t2 = nk > 2u ? 2 * gs : 0, t3 = nk > 3u ? 3 * gs : 0;
+        tsn = _mm_setr_ps(sn[0], sn[t1], sn[t2], sn[t3]);
+        tcs = _mm_setr_ps(cs[0], cs[t1], cs[t2], cs[t3]);
+    }
+    {
+        const __m128 fq = _mm_set1_ps((float)dq), dn = _mm_cvtepi32_ps(ri);
+        const uint32_t valid = (1u << nk) - 1u;
+        const uint32_t nonc =
+            (uint32_t)_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(l, _mm_set1_epi32((int)LAB_NONCAND))));
+        const uint32_t fre = (uint32_t)_mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(l, z)));
+        const uint32_t lnk = (uint32_t)_mm_movemask_ps(link4_4mm(fq, dn, tsn, tcs, g));
+        const uint32_t near = (uint32_t)_mm_movemask_ps(_mm_cmplt_ps(dn, fq));
+        const uint32_t cand = valid & ~nonc;
+        const uint32_t e = CTZ4(cand & (lnk | ~near)); /* the step that ends the search; 4: none */
+        *g->bridged += GROW_POP4(cand & ((1u << e) - 1u));
+        if (((lnk & fre) >> e) & 1u)
+        {
+            tail = lidet__cluster_take(lab, mem, tail, (uint32_t)((int32_t)n0 + (int32_t)e * step));
+        }
+    }
+    return tail;
+}
+#define GROW_SEARCH4(lab, mem, rng, tail, dq, n0, step, nk, sn, cs, gs, g)                                   \
+    search4_4mm(lab, mem, rng, tail, dq, n0, step, nk, sn, cs, gs, g)
 #endif
 #define GROW_RNG_T uint16_t
 #define GROW_RANGES(img) ((img)->range_4mm)
@@ -227,6 +302,8 @@ static inline void neighbours_4mm(const lidet_cluster_state_t *c, const lidet__g
 #undef GROW_FN
 #undef GROW_NEIGHBOURS
 #undef GROW_POP4
+#undef GROW_SEARCH4
+#undef CTZ4
 
 /* each image format's fill, a function of its own with the occluder rule an argument (each holds the expansion
  * with and without the rule: grow in lidet_cluster_grow_body.h). On an x86-64 host a function per rule, the

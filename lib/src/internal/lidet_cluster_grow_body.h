@@ -31,12 +31,17 @@
  *                       non-candidate; with the occluder rule a nearer candidate that fails the test: an
  *                       occluder), *nonc those whose first step is a non-candidate
  *   GROW_POP4(m)        with GROW_NEIGHBOURS: the number of bits set in the 4-bit mask m
+ *   GROW_SEARCH4(lab, mem, rng, tail, dq, n0, step, nk, sn, cs, gs, g)  optional, with GROW_NEIGHBOURS: the
+ *                       occluder rule's search of at most 4 steps from pixel n0 (its first step; tables sn, cs
+ *                       at that step), the same joins and bridged count as GROW_FN(search); the SIMD path
+ *                       runs the searches past their first step with it (GROW_FN(search_rest))
  *   GROW_TEST_EVERY     1: the occluder rule's search tests every candidate it meets, for copies whose test
  *                       has no branch of its own (it saves one on the label); 0: a visited candidate is tested
  *                       only when that decides (the float image's copy, whose test orders two floats with a
  *                       branch: measured slower the other way). The same joins either way
  * Also read, from lidet_cluster_common.h: LAB_FREE, LAB_NONCAND, STEPS, lidet__cluster_take. The compact float
- * copy (lidet_cluster_grow.c) defines GROW_NEIGHBOURS on SSE2 hosts; the others run the searches as written.
+ * copy (lidet_cluster_grow.c) defines GROW_NEIGHBOURS and GROW_SEARCH4 on SSE2 hosts; the others run the
+ * searches as written.
  * Defines: static GROW_FN(search), GROW_FN(search_wrap), GROW_FN(diagonals), GROW_FN(expand) (one pixel's searches, the occluder
  * rule a constant) and GROW_FN(grow) (the fill; forced inline: the includer wraps it in a function of its own,
  * lidet_cluster_grow.c one per image format with the rule an argument, lidet_cluster_grow_q.c one per rule with
@@ -213,6 +218,27 @@ GROW_FN(diagonals)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t tail, uint32
     return tail;
 }
 
+#ifdef GROW_NEIGHBOURS
+/* A search of the SIMD path (GROW_NEIGHBOURS) from its second step: GROW_SEARCH4 where the copy has it (the
+ * occluder rule, at most four steps), else GROW_FN(search) */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline uint32_t
+GROW_FN(search_rest)(uint16_t *lab, lidet_member_t *mem, const GROW_RNG_T *rng, uint32_t tail, GROW_D_T dq,
+                     uint32_t n0, int32_t step, uint32_t nk, const GROW_TAB_T *sn, const GROW_TAB_T *cs,
+                     int32_t gs, const GROW_PARAM_T *g, int occl)
+{
+#ifdef GROW_SEARCH4
+    if (occl && nk <= 4u)
+    {
+        return GROW_SEARCH4(lab, mem, rng, tail, dq, n0, step, nk, sn, cs, gs, g);
+    }
+#endif
+    return GROW_FN(search)(lab, mem, rng, tail, dq, n0 - (uint32_t)step, step, nk, sn, cs, gs, g, occl);
+}
+#endif
+
 /* The searches from pixel q (row r) in the reference's order: right, left, down, up, then the diagonals
  * down-left, down-right, up-left, up-right. occl is a constant at each call site (forced inline: each copy is
  * compiled for its own rule, with no test of the rule per search). Returns the new tail. */
@@ -251,8 +277,8 @@ GROW_FN(expand)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t tail, uint32_t 
         *g->bridged += GROW_POP4(redo & ~nonc);
         if (redo & 1u)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q + 1u, 1, kc - 1u, GROW_TA(c, col) + 1,
-                                   GROW_TB(c, col) + 1, 1, g, occl);
+            tail = GROW_FN(search_rest)(lab, mem, rng, tail, dq, q + 2u, 1, kc - 1u, GROW_TA(c, col) + 1,
+                                        GROW_TB(c, col) + 1, 1, g, occl);
         }
         else if (take & 1u)
         {
@@ -260,8 +286,8 @@ GROW_FN(expand)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t tail, uint32_t 
         }
         if (redo & 2u)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q - 1u, -1, kc - 1u, GROW_TA(c, col) + 1,
-                                   GROW_TB(c, col) + 1, 1, g, occl);
+            tail = GROW_FN(search_rest)(lab, mem, rng, tail, dq, q - 2u, -1, kc - 1u, GROW_TA(c, col) + 1,
+                                        GROW_TB(c, col) + 1, 1, g, occl);
         }
         else if (take & 2u)
         {
@@ -269,9 +295,9 @@ GROW_FN(expand)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t tail, uint32_t 
         }
         if ((redo & 4u) && nd > 1u)
         {
-            tail =
-                GROW_FN(search)(lab, mem, rng, tail, dq, q + cols, (int32_t)cols, nd - 1u,
-                                GROW_TA(c, row) + r * STEPS + 1, GROW_TB(c, row) + r * STEPS + 1, 1, g, occl);
+            tail = GROW_FN(search_rest)(lab, mem, rng, tail, dq, q + 2u * cols, (int32_t)cols, nd - 1u,
+                                        GROW_TA(c, row) + r * STEPS + 1, GROW_TB(c, row) + r * STEPS + 1, 1,
+                                        g, occl);
         }
         else if (take & 4u)
         {
@@ -279,9 +305,9 @@ GROW_FN(expand)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t tail, uint32_t 
         }
         if ((redo & 8u) && nu > 1u)
         {
-            tail = GROW_FN(search)(lab, mem, rng, tail, dq, q - cols, -(int32_t)cols, nu - 1u,
-                                   GROW_TA(c, row) + (r - 2u) * STEPS + 1,
-                                   GROW_TB(c, row) + (r - 2u) * STEPS + 1, 1 - STEPS, g, occl);
+            tail = GROW_FN(search_rest)(lab, mem, rng, tail, dq, q - 2u * cols, -(int32_t)cols, nu - 1u,
+                                        GROW_TA(c, row) + (r - 2u) * STEPS + 1,
+                                        GROW_TB(c, row) + (r - 2u) * STEPS + 1, 1 - STEPS, g, occl);
         }
         else if (take & 8u)
         {
