@@ -119,14 +119,16 @@ static void part_means(const lidet_cluster_state_t *c, const lidet_cluster_rec_t
 }
 
 #if GROUP_SSE2
-/* assign over kept offsets in SSE2, lane j part j: the bounds' tests in one compare (b <= t per lane, as
- * part_of), the part the run of passed tests from the first (part_of's loop), t added to its part's lane and
- * +0 to the others. A sum that starts at +0 is never -0 (rounding to nearest, x + y is -0 only when both
- * are), so adding +0 leaves its bits: each lane sums its part's t in member order, bit for bit the scalar
- * pass (any t, NaN included). It keeps the sums in a register where the scalar pass adds through memory, part
- * by part (a load waiting on the last store) */
-static void assign_sse2(const float *t_of, uint32_t n_points, const lidet_group_t *g,
-                        uint32_t n_out[LIDET_GROUP_MAX_PARTS], float sum_out[LIDET_GROUP_MAX_PARTS])
+/* assign in SSE2, lane j part j, over the kept offsets or, for a cluster past the scratch, offsets made again each
+ * pass (real KITTI scan 000000: its group cuts 5.5 -> 4.9 % of the detector's run, perf). The bounds' tests in
+ * one compare (b <= t per lane, as part_of), the part the run of passed tests from the first (part_of's loop), t
+ * added to its part's lane and +0 to the others. A sum that starts at +0 is never -0 (rounding to nearest, x + y
+ * is -0 only when both are), so adding +0 leaves its bits: each lane sums its part's t in member order, bit for
+ * bit the scalar pass (any t, NaN included). It keeps the sums in a register where the scalar pass adds through
+ * memory, part by part (a load waiting on the last store) */
+static void assign_sse2(const lidet_cluster_state_t *c, const lidet_cluster_rec_t *r, const float *t_of,
+                        const lidet_group_t *g, uint32_t n_out[LIDET_GROUP_MAX_PARTS],
+                        float sum_out[LIDET_GROUP_MAX_PARTS])
 {
     static const uint8_t run_of[8] = {0, 1, 0, 2, 0, 1, 0, 3}; /* trailing 1 bits of 3 tests */
     const __m128 b = _mm_setr_ps(g->bound[0], g->bound[1], g->bound[2], 0.0f);
@@ -135,9 +137,11 @@ static void assign_sse2(const float *t_of, uint32_t n_points, const lidet_group_
     __m128 sum = _mm_setzero_ps();
     __m128i n = _mm_setzero_si128();
     uint32_t i;
-    for (i = 0; i < n_points; ++i)
+    for (i = 0; i < r->n_points; ++i)
     {
-        const __m128 t = _mm_set1_ps(t_of[i]);
+        /* a cluster past the scratch: its offsets made again each pass (the same values) */
+        const __m128 t = _mm_set1_ps(
+            t_of != 0 ? t_of[i] : offset_t(g, &c->img, (uint32_t)c->members[r->first_member + i]));
         const int q = run_of[_mm_movemask_ps(_mm_cmple_ps(b, t)) & live];
         const __m128i on = _mm_cmpeq_epi32(_mm_set1_epi32(q), lane);
         sum = _mm_add_ps(sum, _mm_and_ps(t, _mm_castsi128_ps(on)));
@@ -152,14 +156,10 @@ static void assign_sse2(const float *t_of, uint32_t n_points, const lidet_group_
 static void assign(const lidet_cluster_state_t *c, const lidet_cluster_rec_t *r, const lidet_group_t *g,
                    const float *t_of, uint32_t n[LIDET_GROUP_MAX_PARTS], float sum[LIDET_GROUP_MAX_PARTS])
 {
-    uint32_t i;
 #if GROUP_SSE2
-    if (t_of != 0)
-    {
-        assign_sse2(t_of, r->n_points, g, n, sum);
-        return;
-    }
-#endif
+    assign_sse2(c, r, t_of, g, n, sum);
+#else
+    uint32_t i;
     memset(sum, 0, LIDET_GROUP_MAX_PARTS * sizeof sum[0]);
     memset(n, 0, LIDET_GROUP_MAX_PARTS * sizeof n[0]);
     for (i = 0; i < r->n_points; ++i)
@@ -169,6 +169,7 @@ static void assign(const lidet_cluster_state_t *c, const lidet_cluster_rec_t *r,
         ++n[q];
         sum[q] += t;
     }
+#endif
 }
 
 /* Rule 3. A member's offset t is computed once into the caller's scratch (when the cluster fits) and the
