@@ -9,10 +9,11 @@
 #include "internal/lidet_math.h"
 #include "internal/lidet_pixel.h"
 
-/* the cut's passes in SSE2 (assign_sse2): one lane per part */
-#if LIDET_HOST_SIMD && defined(__SSE2__) && LIDET_GROUP_MAX_PARTS == 4
+/* the cut's passes in SSE2 (assign_sse2): one lane per part, the rule's four parts in one vector */
+#if LIDET_HOST_SIMD && defined(__SSE2__)
 #define GROUP_SSE2 1
 #include <emmintrin.h>
+typedef char lidet__group_parts_fill_a_vector[LIDET_GROUP_MAX_PARTS == 4u ? 1 : -1];
 #else
 #define GROUP_SSE2 0
 #endif
