@@ -481,9 +481,7 @@ static uint32_t dr_bits(float v)
 }
 static uint32_t dr_hash_bits(uint32_t i)
 {
-    return ((dr_bits(g_dr[i][0]) ^ dr_bits(g_dr[i][1]) * 0x85EBCA77u ^ dr_bits(g_dr[i][2]) * 0xC2B2AE3Du) *
-            0x9E3779B1u) >>
-           25;
+    return lidet__proposal_row_hash(dr_bits(g_dr[i][0]), dr_bits(g_dr[i][1]), dr_bits(g_dr[i][2]));
 }
 static uint32_t dr_hash_weak(uint32_t i)
 {

@@ -80,6 +80,11 @@ static inline uint32_t lidet__proposal_next_index(uint32_t *s, uint32_t i, uint3
  * here; the float detector's distinct_rows 0.14 -> 0.03 ms a scan (perf). 383 B of stack; above
  * LIDET__PDR_MAX_SRC first rows (the links are uint8) the linear search runs. */
 #define LIDET__PDR_BUCKETS 128u
+/* a ROW_HASH for it: a row's bucket from the bits of its three coordinates (7 bits: LIDET__PDR_BUCKETS) */
+static inline uint32_t lidet__proposal_row_hash(uint32_t a, uint32_t b, uint32_t c)
+{
+    return ((a ^ b * 0x85EBCA77u ^ c * 0xC2B2AE3Du) * 0x9E3779B1u) >> 25;
+}
 #define LIDET__PDR_MAX_SRC 255u
 #define LIDET__PROPOSAL_DISTINCT_ROWS_HASHED(n_out, n_src, ROW_EQ, ROW_HASH, result)                         \
     do                                                                                                       \

@@ -422,7 +422,7 @@ static uint32_t row_hash(const float *row)
     memcpy(&a, &row[0], sizeof a);
     memcpy(&b, &row[1], sizeof b);
     memcpy(&c, &row[2], sizeof c);
-    return ((a ^ b * 0x85EBCA77u ^ c * 0xC2B2AE3Du) * 0x9E3779B1u) >> 25; /* 7 bits: LIDET__PDR_BUCKETS */
+    return lidet__proposal_row_hash(a, b, c);
 }
 
 /* the rows the shared layers must see (internal/lidet_proposal_rule.h): the first n_points_src where the rest
