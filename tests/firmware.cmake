@@ -44,11 +44,15 @@ function(lidet_fw_models out sensor fixed)
   set(${out} ${m} PARENT_SCOPE)
 endfunction()
 
-# lidet and the models with a sensor configuration's capacities: lidet_fwcap_<sensor> (float), or with FIXED
-# lidet_fwcap_<sensor>_q (the integer-only build, the int8 models)
+# lidet and the models with a sensor configuration's capacities: lidet_fwcap_<sensor> (float), with FIXED
+# lidet_fwcap_<sensor>_q (the integer-only build, the int8 models), with FUSED lidet_fwcap_<sensor>_fused (float, the
+# dense layers with fused multiply-adds)
 function(lidet_fw_cap_lib sensor)
   set(lib lidet_fwcap_${sensor})
   set(srcs ${LIDET_SOURCES} ${fw_weights_sources})
+  if("FUSED" IN_LIST ARGN)
+    set(lib lidet_fwcap_${sensor}_fused)
+  endif()
   if("FIXED" IN_LIST ARGN)
     set(lib lidet_fwcap_${sensor}_q)
     file(GLOB s8_weights CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/weights/*_s8*.c)
@@ -67,15 +71,23 @@ function(lidet_fw_cap_lib sensor)
   elseif(LIDET_HAVE_LIBM)
     target_link_libraries(${lib} PUBLIC m)
   endif()
+  if("FUSED" IN_LIST ARGN)
+    # the float dense layers with fused multiply-adds (lidet_nn_f32_x86.c on a CPU with FMA), the arithmetic of the
+    # Cortex-M4F/M7 and aarch64 images' kernels: every other source compiles to the same numerics with the clones
+    target_compile_definitions(${lib} PRIVATE LIDET_NN_CLONES=1)
+  endif()
 endfunction()
 
 function(lidet_fw_host_ref sensor exe)
-  # optional third argument FIXED: the integer-only build (the integer detector, int8 models, the scan in mm)
+  # optional third argument FIXED: the integer-only build (the integer detector, int8 models, the scan in mm);
+  # FUSED: the float build with the fused dense kernel (fw_host_ref_fused, for the images whose kernel fuses)
   set(lib lidet_fwcap_${sensor})
   set(mm "")
   if(ARGV2 STREQUAL "FIXED")
     set(lib lidet_fwcap_${sensor}_q)
     set(mm --mm)
+  elseif(ARGV2 STREQUAL "FUSED")
+    set(lib lidet_fwcap_${sensor}_fused)
   endif()
   lidet_fw_cap_lib(${sensor} ${ARGN})
   set(scan_c ${CMAKE_CURRENT_BINARY_DIR}/fw_host_scan_${exe}.c)
@@ -103,6 +115,18 @@ endfunction()
 lidet_fw_host_ref(vlp16 fw_host_ref)
 lidet_fw_host_ref(hdl64 fw_host_ref_hdl64)
 lidet_fw_host_ref(vlp16 fw_host_ref_q FIXED)
+# the images whose float dense kernel fuses (Cortex-M4F/M7: lidet_nn_f32_cm.c; aarch64: NEON) are compared with a
+# reference that fuses as they do, where the host can (x86-64 GCC/clang with the kernel clones; on a CPU without
+# FMA it runs the portable kernel and the comparison stays within run_fw.py's tolerances)
+set(fw_fused_ref fw_host_ref)
+set(fw_fused_ref_hdl64 fw_host_ref_hdl64)
+if(LIDET_NN_CLONES AND LIDET_NN_FMA AND CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64" AND NOT CMAKE_CROSSCOMPILING
+   AND CMAKE_C_COMPILER_ID MATCHES "GNU|Clang")
+  lidet_fw_host_ref(vlp16 fw_host_ref_fused FUSED)
+  lidet_fw_host_ref(hdl64 fw_host_ref_hdl64_fused FUSED)
+  set(fw_fused_ref fw_host_ref_fused)
+  set(fw_fused_ref_hdl64 fw_host_ref_hdl64_fused)
+endif()
 
 # the packet application's reference (ports/firmware/fw_packets.c with FW_PACKETS_HOST_REF): the same VLP-16
 # payloads (tools/firmware/packets_to_c.py) decoded on the host into a buffer of the whole scan, the completed scan
@@ -201,7 +225,8 @@ add_test(NAME firmware_virt_libc COMMAND test_virt_libc)
 set_tests_properties(firmware_virt_libc PROPERTIES PASS_REGULAR_EXPRESSION "virt_libc: PASS")
 
 # ---- the images --------------------------------------------------------------------------------
-add_custom_target(firmware DEPENDS fw_host_ref fw_host_ref_hdl64 fw_host_ref_q fw_host_ref_pkt)
+add_custom_target(firmware DEPENDS fw_host_ref ${fw_fused_ref} fw_host_ref_hdl64 ${fw_fused_ref_hdl64} fw_host_ref_q
+                                   fw_host_ref_pkt)
 if(fw_sim_ok)
   add_dependencies(firmware fw_host_ref_pkt_ouster)
 endif()
@@ -281,6 +306,13 @@ foreach(entry IN LISTS fw_images)
     set(ref fw_host_ref_pkt)
   elseif(fixed)
     set(ref fw_host_ref_q)
+  elseif(board MATCHES "^(mps2-an386|mps2-an500|virt-aarch64)$")
+    # a fused dense kernel (Cortex-M4F, M7, aarch64 NEON)
+    if(sensor STREQUAL "vlp16")
+      set(ref ${fw_fused_ref})
+    else()
+      set(ref ${fw_fused_ref_${sensor}})
+    endif()
   elseif(sensor STREQUAL "vlp16")
     set(ref fw_host_ref)
   else()
