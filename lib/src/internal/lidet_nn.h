@@ -21,12 +21,11 @@
 void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t, const float *b,
                          uint32_t n_out, int relu, float *out);
 
-/* Cortex-M4F, M7 (Armv7E-M with a single-precision FPU and its fused multiply-add; GCC or clang):
- * lidet__nn_dense_f32 is lib/src/nn/lidet_nn_f32_cm.c's kernel (VLDM/VSTM tiles of 8 outputs, VFMA, zero inputs of
- * ReLU layers skipped), the x86-64 FMA kernel's arithmetic; the portable one stays, as lidet__nn_dense_f32_portable.
- * Not an option: it follows the target. */
-#if defined(__GNUC__) && defined(__ARM_ARCH_7EM__) && defined(__ARM_FP) && defined(__ARM_FEATURE_FMA) &&     \
-    !LIDET_NN_FMA && !LIDET_NN_NEON
+/* Cortex-M4F, M7 (Armv7E-M with a single-precision FPU; GCC or clang): lidet__nn_dense_f32 is
+ * lib/src/nn/lidet_nn_f32_cm.c's kernel (VLDM/VSTM tiles of 8 outputs, zero inputs of ReLU layers skipped): the
+ * portable kernel's results bit for bit, or with LIDET_NN_CM_FMA (lidet_opt.h) the x86-64 FMA kernel's arithmetic
+ * (VFMA); the portable one stays, as lidet__nn_dense_f32_portable. Not an option: it follows the target. */
+#if defined(__GNUC__) && defined(__ARM_ARCH_7EM__) && defined(__ARM_FP) && !LIDET_NN_FMA && !LIDET_NN_NEON
 #define LIDET_NN_F32_CM ((__ARM_FP & 4) != 0)
 #else
 #define LIDET_NN_F32_CM 0
@@ -35,7 +34,7 @@ void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const 
 /* x86-64 hosts with FMA dispatch (internal/lidet_simd.h): lidet__nn_dense_f32 is lib/src/nn/lidet_nn_f32_x86.c's
  * register-tiled FMA kernel, this the portable one (lidet_nn_f32.c), its fallback on CPUs without FMA; aarch64
  * (LIDET_NN_NEON): lidet__nn_dense_f32 is lidet_nn_f32_neon.c's NEON kernel, this the portable one, for the tests;
- * Cortex-M (LIDET_NN_F32_CM): the portable one, for the tests */
+ * Cortex-M (LIDET_NN_F32_CM): the unfused kernel's fallback for widths not a multiple of 8, and the tests' oracle */
 void lidet__nn_dense_f32_portable(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t,
                                   const float *b, uint32_t n_out, int relu, float *out);
 #endif

@@ -92,7 +92,8 @@ static inline void rows1(const float *x, uint32_t n_in, const float *w_t, uint32
 /* on x86-64 hosts with FMA dispatch (LIDET_NN_FMA) lidet_nn_f32_x86.c defines lidet__nn_dense_f32 and falls back
  * to this kernel, under another name, on CPUs without FMA; on aarch64 (LIDET_NN_NEON) lidet_nn_f32_neon.c defines it,
  * and this kernel stays under that name for the tests; on Cortex-M4F/M7 (LIDET_NN_F32_CM) lidet_nn_f32_cm.c defines it
- * (fused multiply-adds, as the x86-64 and NEON kernels) */
+ * with this kernel's arithmetic (or, with LIDET_NN_CM_FMA, the fused one) and falls back to this one for widths not a
+ * multiple of 8 */
 #if LIDET_NN_FMA || LIDET_NN_NEON || LIDET_NN_F32_CM
 #define NN_DENSE_F32 lidet__nn_dense_f32_portable
 #else
