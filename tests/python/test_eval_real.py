@@ -144,6 +144,19 @@ def test_eval_real_on_a_simulated_folder(tmp_path):
                            "--no-pictures"]) == 0
     q = json.loads((out / "q" / "report.json").read_text())["summary"]["kitti"]
     assert sum(q["classes"][c]["40"]["found"] for c in eval_real.CLASSES) >= 0.6 * sum(want.values())
+    # each frame's tallies add up to the summary, and two runs compare frame by frame (lidet_tools.real.paired)
+    for rng in ("20", "40"):
+        for k, c in enumerate(eval_real.CLASSES):
+            tot = np.sum([f["counts"][rng][c] for f in rep["frames"]], axis=0)
+            v = s["classes"][c][rng]
+            assert list(tot[:3]) == [v["objects"], v["found"], v["detections"]]
+    from lidet_tools.real import paired
+    res = paired.compare(paired.load(out / "report.json"), paired.load(out / "q" / "report.json"), boot=200)
+    for c in eval_real.CLASSES:
+        r = res["classes"][c]
+        assert r["objects"] == s["classes"][c]["40"]["objects"]
+        assert (r["found_base"], r["found_new"]) == (s["classes"][c]["40"]["found"], q["classes"][c]["40"]["found"])
+        assert r["interval90"][0] <= r["diff"] <= r["interval90"][1] or r["frames_changed"] > 0
 
 
 def test_eval_real_round_mm(tmp_path, monkeypatch):

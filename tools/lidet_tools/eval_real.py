@@ -260,6 +260,12 @@ def match(gt: list, dets: list, cls: str, max_range: float, thr: float) -> tuple
     return int(inr.sum()), found, n_det, right
 
 
+def frame_counts(r) -> dict:
+    """One frame's tallies at the loose overlaps, {range: {class: [objects, found, detections, right]}}: what
+    report.json keeps per frame, so that two runs can be compared frame by frame (lidet_tools.real.paired)."""
+    return {f"{rng:g}": {c: list(match(r.gt, r.dets, c, rng, LOOSE[c])) for c in CLASSES} for rng in RANGES}
+
+
 def _boxset(frames: list) -> boxes_ap.BoxSet:
     return boxes_ap.boxset_from_frames(frames)
 
@@ -530,7 +536,7 @@ def main(argv=None) -> int:
     text = format_report(summary, meta)
     (out / "report.md").write_text(text)
     per_frame = [{"source": r.source, "frame": r.frame_id, "objects": len(r.gt), "detections": len(r.dets),
-                  "ms": r.ms, "lost": r.lost} for r in results]
+                  "ms": r.ms, "lost": r.lost, "counts": frame_counts(r)} for r in results]
     (out / "report.json").write_text(json.dumps({"meta": meta, "summary": summary, "frames": per_frame}, indent=1, default=_json_num))
     print(json.dumps(summary, indent=1, default=_json_num) if a.json else text)
     return 0
