@@ -16,11 +16,12 @@ set(LIDET_CAPACITY_OPTIONS
     LIDET_GROUND_MAX_SAMPLES LIDET_GROUND_EVAL_MAX)
 # memory layout and build variants (0 or 1)
 set(LIDET_LAYOUT_OPTIONS LIDET_Q_PIXEL_XYZ LIDET_WORKSPACE_KEEP_R LIDET_DEBUG LIDET_ENABLE_STATUS_STRINGS)
-# per target: kernel forms and instruction-set choices (the same results with every value, but LIDET_NN_CM_FMA: the
-# Cortex-M float dense kernel's fused arithmetic, that of the x86-64 FMA and aarch64 NEON kernels)
+# per target: kernel forms and instruction-set choices (the same results with every value, but LIDET_NN_CM_FMA and
+# LIDET_NN_RV_FMA: the Cortex-M and RISC-V float dense kernels' fused arithmetic, that of the x86-64 FMA and aarch64
+# NEON kernels)
 set(LIDET_TARGET_OPTIONS
     LIDET_HOST_SIMD LIDET_GROUND_Q_SQRT_LANES LIDET_NN_SIMD LIDET_Q_HAVE_DIV LIDET_Q_HAVE_MUL64 LIDET_NN_S8_KERNEL
-    LIDET_PNQ_WEIGHTS_PK LIDET_NN_PK_ASM LIDET_NN_CM_FMA)
+    LIDET_PNQ_WEIGHTS_PK LIDET_NN_PK_ASM LIDET_NN_CM_FMA LIDET_NN_RV_FMA)
 set(LIDET_OPT_OPTIONS ${LIDET_CAPACITY_OPTIONS} ${LIDET_LAYOUT_OPTIONS} ${LIDET_TARGET_OPTIONS})
 
 foreach(opt IN LISTS LIDET_OPT_OPTIONS)

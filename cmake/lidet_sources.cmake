@@ -37,8 +37,9 @@ set(LIDET_SRC_DETECTOR_INT detector/lidet_detector_q.c detector/lidet_post_q.c)
 # the tracker after the detector (docs/TRACKING.md)
 set(LIDET_SRC_TRACK_FLOAT track/lidet_track.c)
 set(LIDET_SRC_TRACK_INT track/lidet_track_q.c)
-# PointNet kernels: float (portable, x86 clones and FMA, aarch64 NEON, Cortex-M4F/M7) and int8
-set(LIDET_SRC_NN_FLOAT nn/lidet_nn_f32.c nn/lidet_nn_f32_x86.c nn/lidet_nn_f32_neon.c nn/lidet_nn_f32_cm.c)
+# PointNet kernels: float (portable, x86 clones and FMA, aarch64 NEON, Cortex-M4F/M7, RISC-V F) and int8
+set(LIDET_SRC_NN_FLOAT nn/lidet_nn_f32.c nn/lidet_nn_f32_x86.c nn/lidet_nn_f32_neon.c nn/lidet_nn_f32_cm.c
+                       nn/lidet_nn_f32_rv.c)
 set(LIDET_SRC_NN_INT nn/lidet_nn_s8.c)
 # integer math and its generated tables (python -m lidet_codegen qtables)
 set(LIDET_SRC_QMATH_FLOAT)

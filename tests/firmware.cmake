@@ -115,9 +115,9 @@ endfunction()
 lidet_fw_host_ref(vlp16 fw_host_ref)
 lidet_fw_host_ref(hdl64 fw_host_ref_hdl64)
 lidet_fw_host_ref(vlp16 fw_host_ref_q FIXED)
-# the images whose float dense kernel fuses (Cortex-M7: lidet_nn_f32_cm.c; aarch64: NEON) are compared with a
-# reference that fuses as they do, where the host can (x86-64 GCC/clang with the kernel clones; on a CPU without
-# FMA it runs the portable kernel and the comparison stays within run_fw.py's tolerances)
+# the images whose float dense kernel fuses (Cortex-M7: lidet_nn_f32_cm.c; aarch64: NEON; RISC-V F: _rv.c) are
+# compared with a reference that fuses as they do, where the host can (x86-64 GCC/clang with the kernel clones; on a
+# CPU without FMA it runs the portable kernel and the comparison stays within run_fw.py's tolerances)
 set(fw_fused_ref fw_host_ref)
 set(fw_fused_ref_hdl64 fw_host_ref_hdl64)
 if(LIDET_NN_CLONES AND LIDET_NN_FMA AND CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64" AND NOT CMAKE_CROSSCOMPILING
@@ -306,8 +306,9 @@ foreach(entry IN LISTS fw_images)
     set(ref fw_host_ref_pkt)
   elseif(fixed)
     set(ref fw_host_ref_q)
-  elseif(board MATCHES "^(mps2-an500|virt-aarch64)$")
-    # a fused dense kernel (Cortex-M7: LIDET_NN_CM_FMA, ports/firmware/CMakeLists.txt; aarch64: NEON)
+  elseif(board MATCHES "^(mps2-an500|virt-aarch64|virt-rv32imafc)$")
+    # a fused dense kernel (Cortex-M7: LIDET_NN_CM_FMA, ports/firmware/CMakeLists.txt; aarch64: NEON; RISC-V F:
+    # LIDET_NN_RV_FMA)
     if(sensor STREQUAL "vlp16")
       set(ref ${fw_fused_ref})
     else()

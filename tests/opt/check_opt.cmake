@@ -76,6 +76,7 @@ set(bad_cases
     "LIDET_PNQ_WEIGHTS_PK=2|LIDET_PNQ_WEIGHTS_PK must be 0 or 1"
     "LIDET_NN_PK_ASM=2|LIDET_NN_PK_ASM must be 0 or 1"
     "LIDET_NN_CM_FMA=2|LIDET_NN_CM_FMA must be 0 or 1"
+    "LIDET_NN_RV_FMA=1|LIDET_NN_RV_FMA must be 0, or 1 on a RISC-V target"
     "LIDET_NN_CLONES=2|LIDET_NN_CLONES must be 0 or 1"
     "LIDET_NN_FMA=2|LIDET_NN_FMA must be 0, or 1"
     "LIDET_NN_NEON=2|LIDET_NN_NEON must be 0, or 1")

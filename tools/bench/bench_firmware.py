@@ -448,7 +448,7 @@ def run(args) -> str:
            if "virt-rv32imafc-hdl64" in reports else "."),
         "",
         "**Against the host build** (`fw_host_ref`: the same program built for x86-64 against lidet with the same "
-        "capacities, on the same generated scan; for the Cortex-M7 and aarch64 float images, whose dense "
+        "capacities, on the same generated scan; for the Cortex-M7, RV32IMAFC and aarch64 float images, whose dense "
         "layers fuse their multiply-adds, `fw_host_ref_fused` and `fw_host_ref_hdl64_fused`, the same with the "
         "x86-64 FMA kernel; `tools/firmware/run_fw.py` compares every count of the detector "
         "and every detection, matched by cluster id, and for the tracker the counts of its last update and every "

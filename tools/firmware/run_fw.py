@@ -16,9 +16,9 @@
    Why not bit-identical: the host, newlib (Arm), picolibc (RISC-V) and the aarch64 image (ports/aarch64/virt_libc.c)
    each have their own expf, logf, sinf, cosf, tanf and atan2f (each within an ulp or two); everything else is IEEE
    single precision in the same order on both sides (-ffp-contract=off, no reassociation). The dense layers of the
-   Cortex-M7 and aarch64 float images fuse their multiply-adds (lib/src/nn/lidet_nn_f32_cm.c with LIDET_NN_CM_FMA,
-   _neon.c): their host reference (fw_host_ref_fused) runs the x86-64 FMA kernel, the same arithmetic, where the host
-   CPU has FMA.
+   Cortex-M7, RV32IMAFC and aarch64 float images fuse their multiply-adds (lib/src/nn/lidet_nn_f32_cm.c with
+   LIDET_NN_CM_FMA, _rv.c, _neon.c): their host reference (fw_host_ref_fused) runs the x86-64 FMA kernel, the same
+   arithmetic, where the host CPU has FMA.
    The report says how many values were bit-identical and the largest differences.
    The tracker after the detector (`track` and `trk` lines: run `default` = two updates on run default's
    detections, run `synthetic` = the image's generated 32 road users over 20 scans with ego motion): the same

@@ -366,6 +366,20 @@
 #define LIDET_NN_NEON LIDET__TARGET_AARCH64_NEON
 #endif
 
+#if defined(__riscv) && defined(__riscv_flen) && (__riscv_flen >= 32)
+#define LIDET__TARGET_RISCV_F 1
+#else
+#define LIDET__TARGET_RISCV_F 0
+#endif
+
+/** RISC-V targets with the F extension (single-precision registers): 1 makes the float dense kernel the one with
+ *  fused multiply-adds (lib/src/nn/lidet_nn_f32_rv.c: fmadd.s, the x86-64 FMA kernel's arithmetic, so the same bits
+ *  as those hosts; its last bits differ from the portable kernel's); 0 keeps the portable kernel. 0 or 1; 1 only on
+ *  such a target. Default: 1 on such a target, else 0. */
+#ifndef LIDET_NN_RV_FMA
+#define LIDET_NN_RV_FMA LIDET__TARGET_RISCV_F
+#endif
+
 /* ==== port hooks (defaults; a port header overrides them) ============================================= */
 /* LIDET_ASSERT(c): see lib/src/internal/lidet_assert.h (compiled out unless LIDET_DEBUG). */
 
@@ -498,6 +512,9 @@
 #endif
 #if LIDET_NN_CM_FMA != 0 && LIDET_NN_CM_FMA != 1
 #error "LIDET_NN_CM_FMA must be 0 or 1"
+#endif
+#if LIDET_NN_RV_FMA != 0 && (LIDET_NN_RV_FMA != 1 || !LIDET__TARGET_RISCV_F)
+#error "LIDET_NN_RV_FMA must be 0, or 1 on a RISC-V target with the F extension"
 #endif
 #if LIDET_NN_CLONES != 0 && LIDET_NN_CLONES != 1
 #error "LIDET_NN_CLONES must be 0 or 1"

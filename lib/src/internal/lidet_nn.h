@@ -30,11 +30,19 @@ void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const 
 #else
 #define LIDET_NN_F32_CM 0
 #endif
-#if LIDET_NN_FMA || LIDET_NN_NEON || LIDET_NN_F32_CM
+/* RISC-V cores with the F extension (GCC or clang): lidet__nn_dense_f32 is lib/src/nn/lidet_nn_f32_rv.c's fused kernel
+ * (fmadd.s, the x86-64 FMA kernel's arithmetic) where lidet_opt.h's LIDET_NN_RV_FMA is 1 (the default there) */
+#if defined(__GNUC__) && LIDET__TARGET_RISCV_F && LIDET_NN_RV_FMA
+#define LIDET_NN_F32_RV 1
+#else
+#define LIDET_NN_F32_RV 0
+#endif
+#if LIDET_NN_FMA || LIDET_NN_NEON || LIDET_NN_F32_CM || LIDET_NN_F32_RV
 /* x86-64 hosts with FMA dispatch (internal/lidet_simd.h): lidet__nn_dense_f32 is lib/src/nn/lidet_nn_f32_x86.c's
  * register-tiled FMA kernel, this the portable one (lidet_nn_f32.c), its fallback on CPUs without FMA; aarch64
  * (LIDET_NN_NEON): lidet__nn_dense_f32 is lidet_nn_f32_neon.c's NEON kernel, this the portable one, for the tests;
- * Cortex-M (LIDET_NN_F32_CM): the unfused kernel's fallback for widths not a multiple of 8, and the tests' oracle */
+ * Cortex-M (LIDET_NN_F32_CM): the unfused kernel's fallback for widths not a multiple of 8, and the tests' oracle;
+ * RISC-V (LIDET_NN_F32_RV): the tests' oracle */
 void lidet__nn_dense_f32_portable(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t,
                                   const float *b, uint32_t n_out, int relu, float *out);
 #endif

@@ -93,8 +93,8 @@ static inline void rows1(const float *x, uint32_t n_in, const float *w_t, uint32
  * to this kernel, under another name, on CPUs without FMA; on aarch64 (LIDET_NN_NEON) lidet_nn_f32_neon.c defines it,
  * and this kernel stays under that name for the tests; on Cortex-M4F/M7 (LIDET_NN_F32_CM) lidet_nn_f32_cm.c defines it
  * with this kernel's arithmetic (or, with LIDET_NN_CM_FMA, the fused one) and falls back to this one for widths not a
- * multiple of 8 */
-#if LIDET_NN_FMA || LIDET_NN_NEON || LIDET_NN_F32_CM
+ * multiple of 8; on RISC-V with F (LIDET_NN_F32_RV) lidet_nn_f32_rv.c defines it */
+#if LIDET_NN_FMA || LIDET_NN_NEON || LIDET_NN_F32_CM || LIDET_NN_F32_RV
 #define NN_DENSE_F32 lidet__nn_dense_f32_portable
 #else
 #define NN_DENSE_F32 lidet__nn_dense_f32
