@@ -16,6 +16,16 @@
 #include "internal/lidet_nn.h"
 #include "test_util.h"
 
+/* the RISC-V F kernel (lib/src/nn/lidet_nn_f32_rv.c: chunks of 64 inputs, 16 / 8 / 1 outputs a sweep, the zero inputs
+ * of ReLU layers skipped) is plain C with fmaf: compiled here for the host as rv_dense_host, so that every host checks
+ * its logic bit for bit against the fused arithmetic */
+#define NN_F32_RV_HOST_TEST 1
+#define lidet__nn_dense_f32 rv_dense_host
+#include "../../lib/src/nn/lidet_nn_f32_rv.c"
+#undef lidet__nn_dense_f32
+void rv_dense_host(const float *in, uint32_t n_rows, uint32_t n_in, const float *w_t, const float *b,
+                   uint32_t n_out, int relu, float *out);
+
 #define MAX_R 17
 #define MAX_I 200
 #define MAX_O 160
@@ -147,6 +157,43 @@ static void every_shape(dense_fn_t *fn, int want)
     TEST_ASSERT_TRUE(g_decisive > 100u); /* the two arithmetics told apart on many shapes */
 }
 
+/* the RISC-V kernel on every shape: the fused arithmetic bit for bit; then with zero inputs (+0 and -0, a ReLU
+ * layer's skipped inputs, whole rows of them too, and runs past a 64-input chunk) against the unskipped chain */
+void test_riscv_kernel_on_the_host(void)
+{
+    static float in[MAX_R * MAX_I], w[MAX_I * MAX_O], b[MAX_O], got[MAX_R * MAX_O];
+    uint32_t a, c, d, r, o, k, n_zero = 0;
+    every_shape(rv_dense_host, 1);
+    for (a = 0; a < sizeof k_rows / sizeof k_rows[0]; ++a)
+        for (c = 0; c < sizeof k_ins / sizeof k_ins[0]; ++c)
+            for (d = 0; d < sizeof k_outs / sizeof k_outs[0]; ++d)
+            {
+                const uint32_t rows = k_rows[a], n_in = k_ins[c], n_out = k_outs[d];
+                const int relu = (int)((a + c + d) & 1u);
+                for (k = 0; k < rows * n_in; ++k)
+                {
+                    const uint32_t u = (g_rng = g_rng * 1664525u + 1013904223u) >> 24;
+                    in[k] = u < 96u ? 0.0f : u < 128u ? -0.0f : next_f(); /* half of them zeros */
+                    n_zero += u < 128u;
+                }
+                if (rows > 2u)
+                    memset(in + n_in, 0, n_in * sizeof in[0]); /* row 1: no nonzero input at all */
+                for (k = 0; k < n_in * n_out; ++k)
+                    w[k] = next_f();
+                for (k = 0; k < n_out; ++k)
+                    b[k] = next_f();
+                rv_dense_host(in, rows, n_in, w, b, n_out, relu, got);
+                for (r = 0; r < rows; ++r)
+                    for (o = 0; o < n_out; ++o)
+                    {
+                        const float want = relu_of(fused_one(in + r * n_in, n_in, w, n_out, o, b[o]), relu);
+                        TEST_ASSERT_TRUE_MESSAGE(memcmp(&want, &got[r * n_out + o], sizeof want) == 0,
+                                                 "the RISC-V kernel with zero inputs is not the fused chain");
+                    }
+            }
+    TEST_ASSERT_TRUE(n_zero > 10000u);
+}
+
 void test_every_shape_one_arithmetic(void)
 {
     every_shape(lidet__nn_dense_f32, -1);
@@ -173,7 +220,8 @@ void test_each_variant(void)
     every_shape(lidet__nn_dense_f32, 1); /* the NEON kernel */
     printf("aarch64: the portable and the NEON kernel run\n");
 #else
-    TEST_IGNORE_MESSAGE("no FMA or NEON kernels in this build (LIDET_NN_FMA / LIDET_NN_NEON off, or another target)");
+    TEST_IGNORE_MESSAGE(
+        "no FMA or NEON kernels in this build (LIDET_NN_FMA / LIDET_NN_NEON off, or another target)");
 #endif
 }
 
@@ -232,9 +280,9 @@ static void near_portable(dense_fn_t *fn, uint32_t rows, uint32_t n_in, uint32_t
  * vlp16s families), at the row counts the forward pass uses (LIDET_PN_BLOCK 8, the heads' single vectors) and
  * around them (a short last block, a band plus a row) */
 static const uint32_t k_model_layers[][2] = {
-    {3, 32},   {32, 64},  {64, 128}, {32, 32},  {160, 64},  {64, 3},   {99, 64}, {3, 48},  {48, 96},
-    {96, 160}, {195, 128}, {128, 64}, {64, 39},  {3, 3},     {3, 16},   {16, 32}, {32, 64}, {16, 16},
-    {80, 32},  {32, 3},   {51, 32},  {3, 24},   {24, 40},   {40, 64},  {83, 64}, {64, 32}, {32, 39}};
+    {3, 32},   {32, 64},   {64, 128}, {32, 32}, {160, 64}, {64, 3},  {99, 64}, {3, 48},  {48, 96},
+    {96, 160}, {195, 128}, {128, 64}, {64, 39}, {3, 3},    {3, 16},  {16, 32}, {32, 64}, {16, 16},
+    {80, 32},  {32, 3},    {51, 32},  {3, 24},  {24, 40},  {40, 64}, {83, 64}, {64, 32}, {32, 39}};
 static const uint32_t k_model_rows[] = {1, 3, 7, 8, 9, 16};
 
 void test_model_shapes(void)
@@ -247,7 +295,8 @@ void test_model_shapes(void)
         for (r = 0; r < sizeof k_model_rows / sizeof k_model_rows[0]; ++r)
         {
             const int relu = (int)((l + r) & 1u);
-            check_shape(lidet__nn_dense_f32, -1, k_model_rows[r], k_model_layers[l][0], k_model_layers[l][1], relu);
+            check_shape(lidet__nn_dense_f32, -1, k_model_rows[r], k_model_layers[l][0], k_model_layers[l][1],
+                        relu);
             if (fused != 0)
             {
                 check_shape(fused, 1, k_model_rows[r], k_model_layers[l][0], k_model_layers[l][1], relu);
@@ -257,7 +306,8 @@ void test_model_shapes(void)
         }
     }
     if (fused == 0)
-        printf("no fused kernel in this build or on this CPU: the model shapes checked on the portable kernel\n");
+        printf("no fused kernel in this build or on this CPU: the model shapes checked on the portable "
+               "kernel\n");
 }
 
 /* NaN and -0 through every tile and tail of the fused kernel: 10 rows (a band of 8, two single rows) x 31 outputs
@@ -313,13 +363,14 @@ void test_fused_nan_and_negative_zero(void)
                 }
                 else
                 {
-                    TEST_ASSERT_TRUE_MESSAGE(memcmp(&got, &want, sizeof got) == 0, "not the fused chain bit for bit");
+                    TEST_ASSERT_TRUE_MESSAGE(memcmp(&got, &want, sizeof got) == 0,
+                                             "not the fused chain bit for bit");
                     n_neg0 += want == 0.0f && signbit(want);
                 }
             }
         }
     }
-    TEST_ASSERT_TRUE(n_nan >= 2u * O);   /* rows 2 and 8 */
+    TEST_ASSERT_TRUE(n_nan >= 2u * O);    /* rows 2 and 8 */
     TEST_ASSERT_TRUE(n_neg0 >= 2u * 11u); /* rows 5 and 9 where the bias is -0 */
 }
 
@@ -352,6 +403,7 @@ int main(void)
     UNITY_BEGIN();
     RUN_TEST(test_every_shape_one_arithmetic);
     RUN_TEST(test_each_variant);
+    RUN_TEST(test_riscv_kernel_on_the_host);
     RUN_TEST(test_model_shapes);
     RUN_TEST(test_fused_nan_and_negative_zero);
     RUN_TEST(test_relu_of_nan_and_negative_zero);

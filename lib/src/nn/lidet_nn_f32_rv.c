@@ -20,7 +20,9 @@
  * RISC-V cores with F that pipeline their floating-point unit, and saves the separate add. */
 #include "internal/lidet_nn.h"
 
-#if LIDET_NN_F32_RV
+/* NN_F32_RV_HOST_TEST: tests/unit/test_nn_f32.c compiles this file into the host test under another name (plain C:
+ * its logic is checked bit for bit on every host; the RISC-V images run it for real) */
+#if LIDET_NN_F32_RV || defined(NN_F32_RV_HOST_TEST)
 #include <math.h>
 #include <string.h>
 
@@ -28,14 +30,14 @@
 #define RV_CHUNK 64u
 
 /* a zero: +0 or -0 (the bits without the sign are 0) */
-static inline int is_zero(float v)
+static inline int rv_is_zero(float v)
 {
     uint32_t u;
     memcpy(&u, &v, sizeof u);
     return (u << 1) == 0u;
 }
 
-static inline float relu_of(float v, int relu)
+static inline float rv_relu(float v, int relu)
 {
     return relu && !(v > 0.0f) ? 0.0f : v;
 }
@@ -60,21 +62,21 @@ static inline float relu_of(float v, int relu)
 #define RV_STORE8(p, off)                                                                                    \
     do                                                                                                       \
     {                                                                                                        \
-        o[k + (off)] = relu_of(p##0, relu);                                                                  \
-        o[k + (off) + 1u] = relu_of(p##1, relu);                                                             \
-        o[k + (off) + 2u] = relu_of(p##2, relu);                                                             \
-        o[k + (off) + 3u] = relu_of(p##3, relu);                                                             \
-        o[k + (off) + 4u] = relu_of(p##4, relu);                                                             \
-        o[k + (off) + 5u] = relu_of(p##5, relu);                                                             \
-        o[k + (off) + 6u] = relu_of(p##6, relu);                                                             \
-        o[k + (off) + 7u] = relu_of(p##7, relu);                                                             \
+        o[k + (off)] = rv_relu(p##0, relu);                                                                  \
+        o[k + (off) + 1u] = rv_relu(p##1, relu);                                                             \
+        o[k + (off) + 2u] = rv_relu(p##2, relu);                                                             \
+        o[k + (off) + 3u] = rv_relu(p##3, relu);                                                             \
+        o[k + (off) + 4u] = rv_relu(p##4, relu);                                                             \
+        o[k + (off) + 5u] = rv_relu(p##5, relu);                                                             \
+        o[k + (off) + 6u] = rv_relu(p##6, relu);                                                             \
+        o[k + (off) + 7u] = rv_relu(p##7, relu);                                                             \
     } while (0)
 
 /* o[k] = the chain over the c gathered inputs from src[k], the ReLU where relu: 16 outputs at a time (16 of the 32
  * float registers hold the sums, so each input's value and weight row pointer are loaded once per 16 outputs), then
  * 8, then one by one */
-static void sweep(const float *xv, const float *const *wv, uint32_t c, const float *src, float *o,
-                  uint32_t n_out, int relu)
+static void rv_sweep(const float *xv, const float *const *wv, uint32_t c, const float *src, float *o,
+                     uint32_t n_out, int relu)
 {
     uint32_t k = 0, j;
     for (; k + 16u <= n_out; k += 16u)
@@ -109,7 +111,7 @@ static void sweep(const float *xv, const float *const *wv, uint32_t c, const flo
         {
             a = fmaf(xv[j], wv[j][k], a);
         }
-        o[k] = relu_of(a, relu);
+        o[k] = rv_relu(a, relu);
     }
 }
 
@@ -128,7 +130,7 @@ void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const 
         if (relu)
         {
             /* past the last nonzero input nothing is added: the ReLU goes with the last sweep */
-            while (last > 0u && is_zero(x[last - 1u]))
+            while (last > 0u && rv_is_zero(x[last - 1u]))
             {
                 --last;
             }
@@ -139,7 +141,7 @@ void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const 
             uint32_t c = 0;
             for (; i < last && c < RV_CHUNK; ++i)
             {
-                if (!relu || !is_zero(x[i]))
+                if (!relu || !rv_is_zero(x[i]))
                 {
                     xv[c] = x[i];
                     wv[c] = w_t + (size_t)i * n_out;
@@ -147,7 +149,7 @@ void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const 
                 }
             }
             /* the first sweep starts from the bias (also a row of no nonzero input), the others from the row */
-            sweep(xv, wv, c, src, o, n_out, relu && i >= last);
+            rv_sweep(xv, wv, c, src, o, n_out, relu && i >= last);
             src = o;
         } while (i < last);
     }
