@@ -21,9 +21,13 @@ BOARDS = [  # board, core, FPU, QEMU machine
     ("mps2-an500", "Cortex-M7", "single precision (fpv5-sp-d16)", "mps2-an500"),
     ("virt-rv32imafc", "RV32IMAFC", "single precision (F)", "virt"),
     # 64-bit Arm bare metal (ports/aarch64): the float dense layers in NEON (lib/src/nn/lidet_nn_f32_neon.c), and the
-    # same image with the portable kernel (built and run here: _aarch64_portable)
+    # same image with the portable kernel (built and run here: _variant_image)
     ("virt-aarch64", "Cortex-A72 (aarch64; NEON float dense kernel)", "double precision + NEON", "virt"),
     ("virt-aarch64-portable", "Cortex-A72 (aarch64; portable float dense kernel)", "double precision + NEON", "virt"),
+    # the M4F image with the fused Cortex-M kernel (LIDET_NN_CM_FMA=1: fewer instructions, more cycles by the M4's
+    # TRM; built and run here: _variant_image)
+    ("mps2-an386-fused", "Cortex-M4F, fused multiply-adds (`LIDET_NN_CM_FMA=1`, not the default)", "single precision",
+     "mps2-an386"),
     ("mps2-an385", "Cortex-M3", "none (soft float)", "mps2-an385"),
     ("mps2-an385-m0plus", "Cortex-M0+ code (ARMv6-M) on the AN385's M3", "none (soft float)", "mps2-an385"),
     ("mps2-an500-hdl64", "Cortex-M7, **HDL-64 scan** (config/hdl64; detector in PSRAM)",
@@ -41,6 +45,12 @@ BOARDS = [  # board, core, FPU, QEMU machine
      "virt"),
 ]
 AARCH64_PORTABLE = "virt-aarch64-portable"
+M4F_FUSED = "mps2-an386-fused"
+# images that are not part of tests/firmware.cmake's set: built here with another option
+VARIANTS = {AARCH64_PORTABLE: ("virt-aarch64", "aarch64-bare-metal", ["-DLIDET_NN_NEON=OFF"], "fw_host_ref",
+                               "aarch64-linux-gnu-size"),
+            M4F_FUSED: ("mps2-an386", "arm-none-eabi", ["-DLIDET_NN_CM_FMA=1"], "fw_host_ref_fused",
+                        "arm-none-eabi-size")}
 # the packet application (LIDET_FW_APP=packets, ports/firmware/fw_packets.c; issue 37): VLP-16 payloads in flash
 # decoded and streamed into the integer detector; image, core, the fw_detect.c image fed the same scan's returns
 PACKET_BOARDS = [
@@ -94,32 +104,33 @@ def _cycle_estimates(build, reports):
     return out
 
 
-def _aarch64_portable(build, reports):
-    """The virt-aarch64 float image with the portable float dense kernel (-DLIDET_NN_NEON=OFF), for the ratio of the
-    NEON kernel to it: configured, built and run here next to the build's images (tests/firmware.cmake builds only
-    the NEON one, to keep CI short), compared with the host like them (tools/firmware/run_fw.py). -> its report, or
-    None (no aarch64 image in this build, or a step failed)."""
-    bdir = build / "firmware" / AARCH64_PORTABLE
+def _variant_image(build, reports, name):
+    """An image of VARIANTS (the virt-aarch64 float image with the portable float dense kernel, for the ratio of the
+    NEON kernel to it; the M4F image with the fused Cortex-M kernel): configured, built and run here next to the
+    build's images (tests/firmware.cmake builds only the defaults, to keep CI short), compared with the host like them
+    (tools/firmware/run_fw.py). -> its report, or None (its board's image not in this build, or a step failed)."""
+    board, toolchain, defs, ref_name, size_tool = VARIANTS[name]
+    bdir = build / "firmware" / name
     rep = bdir / "report.json"
     if os.environ.get("LIDET_BENCH_FW_REUSE") == "1":
         return json.loads(rep.read_text()) if rep.exists() else None
-    ref = build / "tests" / "fw_host_ref"
-    if "virt-aarch64" not in reports or not ref.exists():
+    ref = build / "tests" / ref_name
+    if not ref.exists():
+        ref = build / "tests" / "fw_host_ref"
+    if board not in reports or not ref.exists():
         return None
     steps = [
         ["cmake", "-S", str(ROOT / "ports" / "firmware"), "-B", str(bdir),
-         f"-DCMAKE_TOOLCHAIN_FILE={ROOT / 'cmake' / 'toolchains' / 'aarch64-bare-metal.cmake'}",
-         "-DLIDET_FW_BOARD=virt-aarch64", "-DLIDET_FW_SENSOR=vlp16", "-DLIDET_NN_NEON=OFF",
-         f"-DPython3_EXECUTABLE={sys.executable}"],
+         f"-DCMAKE_TOOLCHAIN_FILE={ROOT / 'cmake' / 'toolchains' / f'{toolchain}.cmake'}",
+         f"-DLIDET_FW_BOARD={board}", "-DLIDET_FW_SENSOR=vlp16", *defs, f"-DPython3_EXECUTABLE={sys.executable}"],
         ["cmake", "--build", str(bdir), "-j", "2"],
-        [sys.executable, str(ROOT / "tools" / "firmware" / "run_fw.py"), "--board", "virt-aarch64", "--label",
-         AARCH64_PORTABLE, "--elf", str(bdir / "lidet_fw.elf"), "--host-ref", str(ref), "--size",
-         "aarch64-linux-gnu-size", "--json", str(rep)],
+        [sys.executable, str(ROOT / "tools" / "firmware" / "run_fw.py"), "--board", board, "--label", name,
+         "--elf", str(bdir / "lidet_fw.elf"), "--host-ref", str(ref), "--size", size_tool, "--json", str(rep)],
     ]
     for cmd in steps:
         p = subprocess.run(cmd, capture_output=True, text=True)
         if p.returncode != 0:
-            print(f"bench_firmware: {AARCH64_PORTABLE}: {' '.join(cmd[:3])} failed:\n{p.stdout[-2000:]}{p.stderr[-2000:]}",
+            print(f"bench_firmware: {name}: {' '.join(cmd[:3])} failed:\n{p.stdout[-2000:]}{p.stderr[-2000:]}",
                   file=sys.stderr)
             break
     return json.loads(rep.read_text()) if rep.exists() else None
@@ -278,15 +289,16 @@ def run(args) -> str:
     reports = {}
     for board, *_ in BOARDS:
         f = build / "firmware" / board / "report.json"
-        if f.exists() and board != AARCH64_PORTABLE:
+        if f.exists() and board not in VARIANTS:
             reports[board] = json.loads(f.read_text())
     for board, *_ in PACKET_BOARDS + OUSTER_PACKET_BOARDS:
         f = build / "firmware" / board / "report.json"
         if f.exists():
             reports[board] = json.loads(f.read_text())
-    a64p = _aarch64_portable(build, reports)
-    if a64p:
-        reports[AARCH64_PORTABLE] = a64p
+    for name in VARIANTS:
+        v = _variant_image(build, reports, name)
+        if v:
+            reports[name] = v
     out = ["## Firmware: Cortex-M and RISC-V under QEMU (issue 17)", ""]
     if not reports:
         out += ["Not measured in this run: no firmware image was built (the cross toolchains and QEMU come with "
@@ -372,6 +384,27 @@ def run(args) -> str:
             "tolerances below (its kernel fuses the multiply-adds: the last bits differ from the portable "
             "arithmetic); the portable image's only differ where libm's do.",
         ]
+    m4, m4f = reports.get("mps2-an386"), reports.get(M4F_FUSED)
+    if m4 and m4f and "default" in m4.get("insn", {}) and "default" in m4f.get("insn", {}):
+        u, f = m4["insn"]["default"], m4f["insn"]["default"]
+        both = lambda m: m["classify"] + m["box"]
+        out += [
+            "",
+            "**Cortex-M4F: fused multiply-adds or not.** The Cortex-M float dense kernel (lib/src/nn/lidet_nn_f32_cm.c) "
+            "has two arithmetics: by default the portable kernel's (VMUL + VADD, the bits of the portable kernel), with "
+            "`LIDET_NN_CM_FMA=1` the fused one of the x86-64 and NEON kernels (VFMA), which the Cortex-M7 images use. "
+            "The M4F image built both ways (the fused one compared with `fw_host_ref_fused`), instructions per scan, run "
+            "`default`:",
+            "",
+            "| Cortex-M4F dense kernel | classify | box net | classify + box net | **scan** |",
+            "|---|---|---|---|---|",
+            f"| VMUL + VADD (default) | {u['classify']:,} | {u['box']:,} | {both(u):,} | **{u['scan']:,}** |",
+            f"| VFMA (`LIDET_NN_CM_FMA=1`) | {f['classify']:,} | {f['box']:,} | {both(f):,} | **{f['scan']:,}** |",
+            "",
+            "Fewer instructions, not fewer cycles on this core: the Cortex-M4 TRM gives VFMA.F32 3 cycles against 1 "
+            "each for VMUL.F32 and VADD.F32, so a sweep of 8 outputs by four inputs costs about 153 cycles fused against "
+            "121 unfused (zero wait states; docs/journal/firmware.md). The default stays unfused on the M4F.",
+        ]
     out += [
         "",
         "Run `open` (gates and size checks off) differs only in `post` (size check and NMS on "
@@ -380,7 +413,7 @@ def run(args) -> str:
         + "; ".join(f"{core.split(' ')[0].rstrip(',')}{' HDL-64' if b.endswith('hdl64') else ''} "
                     f"{r['insn']['open']['post']:,}"
                     for b, core, *_ in BOARDS
-                    if (r := reports.get(b)) and "open" in r.get("insn", {}) and b != AARCH64_PORTABLE)
+                    if (r := reports.get(b)) and "open" in r.get("insn", {}) and b not in VARIANTS)
         + " instructions.",
         "",
         "**Size** (bytes, `size -A` of the linked image; the scan is test data and not part of a product's flash):",
@@ -553,7 +586,7 @@ def run(args) -> str:
         "picolibc-riscv64-unknown-elf, qemu-system-misc and their dependencies, 36 packages) took 59 s wall on this "
         "machine after `apt-get update` (314 MB downloaded in 2 s, the rest unpacking; 2.4 GB on disk, most of it "
         "the C libraries' multilib variants: picolibc-riscv64 1.0 GB, newlib-arm 0.37 GB, gcc-arm 0.44 GB). "
-        f"Building the {len([b for b in reports if b != AARCH64_PORTABLE])} images adds about a minute to `make build` "
+        f"Building the {len([b for b in reports if b not in VARIANTS])} images adds about a minute to `make build` "
         "on 2 cores; running them adds about "
         "a minute to ctest at -j2 (48 s of test time in all), most of it the two soft-float images"
         + (" (M0+ and M3: " + " and ".join(f"{sum(r['scan'] for r in reports[b]['insn'].values()) / 1e9:.1f} G"
