@@ -104,6 +104,15 @@ def _cycle_estimates(build, reports):
     return out
 
 
+def _kernel_rows(head: str, rows) -> list:
+    """A table of float dense kernels: head, then per (name, run `default` counts) its classify, box net, both and scan
+    instructions."""
+    out = [f"| {head} | classify | box net | classify + box net | **scan** |", "|---|---|---|---|---|"]
+    for name, m in rows:
+        out.append(f"| {name} | {m['classify']:,} | {m['box']:,} | {m['classify'] + m['box']:,} | **{m['scan']:,}** |")
+    return out
+
+
 def _variant_image(build, reports, name):
     """An image of VARIANTS (the virt-aarch64 float image with the portable float dense kernel, for the ratio of the
     NEON kernel to it; the M4F image with the fused Cortex-M kernel): configured, built and run here next to the
@@ -370,10 +379,7 @@ def run(args) -> str:
             "as every image: GCC 12 leaves its loops scalar there). Instructions per scan, run `default` (the stages "
             "before the networks are the same code in both):",
             "",
-            "| float dense kernel | classify | box net | classify + box net | **scan** |",
-            "|---|---|---|---|---|",
-            f"| NEON | {n['classify']:,} | {n['box']:,} | {both(n):,} | **{n['scan']:,}** |",
-            f"| portable | {p['classify']:,} | {p['box']:,} | {both(p):,} | **{p['scan']:,}** |",
+            *_kernel_rows("float dense kernel", [("NEON", n), ("portable", p)]),
             f"| NEON / portable | {n['classify'] / p['classify']:.3f} | {n['box'] / p['box']:.3f} | "
             f"{both(n) / both(p):.3f} | **{n['scan'] / p['scan']:.3f}** |",
             "",
@@ -387,7 +393,6 @@ def run(args) -> str:
     m4, m4f = reports.get("mps2-an386"), reports.get(M4F_FUSED)
     if m4 and m4f and "default" in m4.get("insn", {}) and "default" in m4f.get("insn", {}):
         u, f = m4["insn"]["default"], m4f["insn"]["default"]
-        both = lambda m: m["classify"] + m["box"]
         out += [
             "",
             "**Cortex-M4F: fused multiply-adds or not.** The Cortex-M float dense kernel (lib/src/nn/lidet_nn_f32_cm.c) "
@@ -396,10 +401,7 @@ def run(args) -> str:
             "The M4F image built both ways (the fused one compared with `fw_host_ref_fused`), instructions per scan, run "
             "`default`:",
             "",
-            "| Cortex-M4F dense kernel | classify | box net | classify + box net | **scan** |",
-            "|---|---|---|---|---|",
-            f"| VMUL + VADD (default) | {u['classify']:,} | {u['box']:,} | {both(u):,} | **{u['scan']:,}** |",
-            f"| VFMA (`LIDET_NN_CM_FMA=1`) | {f['classify']:,} | {f['box']:,} | {both(f):,} | **{f['scan']:,}** |",
+            *_kernel_rows("Cortex-M4F dense kernel", [("VMUL + VADD (default)", u), ("VFMA (`LIDET_NN_CM_FMA=1`)", f)]),
             "",
             "Fewer instructions, not fewer cycles on this core: the Cortex-M4 TRM gives VFMA.F32 3 cycles against 1 "
             "each for VMUL.F32 and VADD.F32, so a sweep of 8 outputs by four inputs costs about 153 cycles fused against "
