@@ -36,21 +36,14 @@
 
 #if LIDET_NN_F32_CM
 #include <math.h>
-#include <string.h>
+
+#include "internal/lidet_nn_skip.h"
 
 #if LIDET_NN_CM_FMA && defined(__ARM_FEATURE_FMA)
 #define LIDET__NN_CM_FUSED 1
 #else
 #define LIDET__NN_CM_FUSED 0
 #endif
-
-/* a zero: +0 or -0 (the bits without the sign are 0) */
-static inline int is_zero(float v)
-{
-    uint32_t u;
-    memcpy(&u, &v, sizeof u);
-    return (u << 1) == 0u;
-}
 
 /* the ReLU of one sum: +0 (the register z) where !(v > 0): negative, -0, +0, NaN (unordered: le holds) */
 #define CM_RELU1(r)                                                                                          \
@@ -265,15 +258,8 @@ void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const 
         const float *src = b;
         const float *wp[4];
         float xv[4];
-        uint32_t last = n_in;
-        if (relu)
-        {
-            /* past the last nonzero input nothing is added: the ReLU goes with the last sweep */
-            while (last > 0u && is_zero(x[last - 1u]))
-            {
-                --last;
-            }
-        }
+        /* past the last nonzero input nothing is added: the ReLU goes with the last sweep */
+        const uint32_t last = lidet__nn_inputs_used(x, n_in, relu);
         /* fused: the next four inputs, in order; unfused: the portable kernel's groups of four, then the last
          * n_in % 4 inputs one by one (each a group of one); in a ReLU layer only the nonzero inputs */
         for (i = 0; i < last;)
@@ -284,7 +270,7 @@ void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const 
             for (; i < end && (!LIDET__NN_CM_FUSED || c < 4u); ++i, w += n_out)
             {
                 const float v = x[i];
-                if (!relu || !is_zero(v))
+                if (!relu || !lidet__nn_is_zero(v))
                 {
                     wp[c] = w;
                     xv[c] = v;

@@ -24,18 +24,11 @@
  * its logic is checked bit for bit on every host; the RISC-V images run it for real) */
 #if LIDET_NN_F32_RV || defined(NN_F32_RV_HOST_TEST)
 #include <math.h>
-#include <string.h>
+
+#include "internal/lidet_nn_skip.h"
 
 /* inputs gathered at a time (stack: RV_CHUNK values and pointers) */
 #define RV_CHUNK 64u
-
-/* a zero: +0 or -0 (the bits without the sign are 0) */
-static inline int rv_is_zero(float v)
-{
-    uint32_t u;
-    memcpy(&u, &v, sizeof u);
-    return (u << 1) == 0u;
-}
 
 static inline float rv_relu(float v, int relu)
 {
@@ -126,22 +119,15 @@ void lidet__nn_dense_f32(const float *in, uint32_t n_rows, uint32_t n_in, const 
         const float *x = in + (size_t)r * n_in;
         float *o = out + (size_t)r * n_out;
         const float *src = b;
-        uint32_t last = n_in;
-        if (relu)
-        {
-            /* past the last nonzero input nothing is added: the ReLU goes with the last sweep */
-            while (last > 0u && rv_is_zero(x[last - 1u]))
-            {
-                --last;
-            }
-        }
+        /* past the last nonzero input nothing is added: the ReLU goes with the last sweep */
+        const uint32_t last = lidet__nn_inputs_used(x, n_in, relu);
         i = 0;
         do
         {
             uint32_t c = 0;
             for (; i < last && c < RV_CHUNK; ++i)
             {
-                if (!relu || !rv_is_zero(x[i]))
+                if (!relu || !lidet__nn_is_zero(x[i]))
                 {
                     xv[c] = x[i];
                     wv[c] = w_t + (size_t)i * n_out;
