@@ -73,7 +73,7 @@ function(lidet_fw_cap_lib sensor)
   endif()
   if("FUSED" IN_LIST ARGN)
     # the float dense layers with fused multiply-adds (lidet_nn_f32_x86.c on a CPU with FMA), the arithmetic of the
-    # Cortex-M4F/M7 and aarch64 images' kernels: every other source compiles to the same numerics with the clones
+    # Cortex-M7, RISC-V F and aarch64 images' kernels: every other source compiles to the same numerics with the clones
     target_compile_definitions(${lib} PRIVATE LIDET_NN_CLONES=1)
   endif()
 endfunction()
@@ -118,13 +118,13 @@ lidet_fw_host_ref(vlp16 fw_host_ref_q FIXED)
 # the images whose float dense kernel fuses (Cortex-M7: lidet_nn_f32_cm.c; aarch64: NEON; RISC-V F: _rv.c) are
 # compared with a reference that fuses as they do, where the host can (x86-64 GCC/clang with the kernel clones; on a
 # CPU without FMA it runs the portable kernel and the comparison stays within run_fw.py's tolerances)
-set(fw_fused_ref fw_host_ref)
+set(fw_fused_ref_vlp16 fw_host_ref)
 set(fw_fused_ref_hdl64 fw_host_ref_hdl64)
 if(LIDET_NN_CLONES AND LIDET_NN_FMA AND CMAKE_SYSTEM_PROCESSOR MATCHES "x86_64|AMD64" AND NOT CMAKE_CROSSCOMPILING
    AND CMAKE_C_COMPILER_ID MATCHES "GNU|Clang")
   lidet_fw_host_ref(vlp16 fw_host_ref_fused FUSED)
   lidet_fw_host_ref(hdl64 fw_host_ref_hdl64_fused FUSED)
-  set(fw_fused_ref fw_host_ref_fused)
+  set(fw_fused_ref_vlp16 fw_host_ref_fused)
   set(fw_fused_ref_hdl64 fw_host_ref_hdl64_fused)
 endif()
 
@@ -225,8 +225,8 @@ add_test(NAME firmware_virt_libc COMMAND test_virt_libc)
 set_tests_properties(firmware_virt_libc PROPERTIES PASS_REGULAR_EXPRESSION "virt_libc: PASS")
 
 # ---- the images --------------------------------------------------------------------------------
-add_custom_target(firmware DEPENDS fw_host_ref ${fw_fused_ref} fw_host_ref_hdl64 ${fw_fused_ref_hdl64} fw_host_ref_q
-                                   fw_host_ref_pkt)
+add_custom_target(firmware DEPENDS fw_host_ref ${fw_fused_ref_vlp16} fw_host_ref_hdl64 ${fw_fused_ref_hdl64}
+                                   fw_host_ref_q fw_host_ref_pkt)
 if(fw_sim_ok)
   add_dependencies(firmware fw_host_ref_pkt_ouster)
 endif()
@@ -309,11 +309,7 @@ foreach(entry IN LISTS fw_images)
   elseif(board MATCHES "^(mps2-an500|virt-aarch64|virt-rv32imafc)$")
     # a fused dense kernel (Cortex-M7: LIDET_NN_CM_FMA, ports/firmware/CMakeLists.txt; aarch64: NEON; RISC-V F:
     # LIDET_NN_RV_FMA)
-    if(sensor STREQUAL "vlp16")
-      set(ref ${fw_fused_ref})
-    else()
-      set(ref ${fw_fused_ref_${sensor}})
-    endif()
+    set(ref ${fw_fused_ref_${sensor}})
   elseif(sensor STREQUAL "vlp16")
     set(ref fw_host_ref)
   else()
