@@ -63,6 +63,49 @@ def test_onnx_loading_refuses_an_initializer_that_maps_nowhere(tmp_path):
         FT.load_onnx(p)
 
 
+def test_gamma_at_the_shipped_ood_count():
+    """--gamma ood: per class, the new gate lets through exactly as many OOD rows as the shipped gate did; a class the
+    shipped gate let wholly through, or the new model never predicts, keeps the fallback (TPR) gamma."""
+    g = np.random.default_rng(5)
+    e_old = g.normal(-5, 1, 300)
+    c_old = g.integers(0, 3, 300)
+    e_new = g.normal(-5.5, 1.2, 300)
+    c_new = np.where(g.random(300) < 0.8, c_old, 0)
+    c_new[c_new == 1] = 2  # the new model never predicts class 1
+    gamma_old = [-6.0, -5.8, -6.5]
+    fallback = [-4.0, -4.5, -4.2]
+    out = FT.gammas_at_ood((e_new, c_new), (e_old, c_old), gamma_old, fallback)
+    for c in (0, 2):
+        n_old = int(((c_old == c) & (e_old < gamma_old[c])).sum())
+        assert n_old > 0
+        assert int(((c_new == c) & (e_new < out[c])).sum()) == n_old
+        # the next energy up is the gamma (rounded down to a float32): no looser gamma keeps the count
+        e = np.sort(e_new[c_new == c])
+        assert e[n_old - 1] < out[c] <= e[n_old] and e[n_old] - out[c] < 1e-6
+    assert out[1] == fallback[1]
+    # the shipped gate let 3 rows through as class 0, the new model calls only 2 rows class 0: the fallback
+    few = FT.gammas_at_ood((np.array([-9.0, -8.0, -7.0]), np.array([0, 0, 2])),
+                           (np.array([-3.0, -2.0, -1.0]), np.array([0, 0, 0])), [10.0, 10.0, 10.0], fallback)
+    assert few[0] == fallback[0] and few[2] == -7.0
+
+
+def test_set_onnx_gamma(tmp_path):
+    p = tmp_path / "cls.onnx"
+    shutil.copy(ROOT / "weights" / "cls_hdl64.onnx", p)
+    FT.set_onnx_gamma(p, [-1.5, -2.25, -3.0])
+    a, b = onnx.load(str(ROOT / "weights" / "cls_hdl64.onnx")), onnx.load(str(p))
+    meta = {q.key: q.value for q in b.metadata_props}
+    assert [float(v) for v in meta["lidet.gamma"].split(",")] == [-1.5, -2.25, -3.0]
+    assert a.graph.SerializeToString() == b.graph.SerializeToString()
+    assert {q.key: q.value for q in a.metadata_props if q.key != "lidet.gamma"} == \
+        {k: v for k, v in meta.items() if k != "lidet.gamma"}
+    m = onnx.load(str(p))
+    del m.metadata_props[:]
+    onnx.save(m, str(p))
+    with pytest.raises(ValueError, match="no lidet.gamma"):
+        FT.set_onnx_gamma(p, [0.0, 0.0, 0.0])
+
+
 def test_augment_real_moves_boxes_with_their_points(monkeypatch):
     """Occlusion, dropout, mirror, rotation, scaling and shift move the box target with the points (jitter off)."""
     monkeypatch.setitem(FT.REAL_AUG, "jitter", 0.0)
@@ -149,8 +192,13 @@ def test_finetune_end_to_end(tmp_path, need_lib, monkeypatch, capsys):
     assert not list(out.glob("*_vlp16*"))  # --only-family
     card = (out / FT.CARD).read_text()
     for part in ("| user train | 2 |", "| user val | 1 |", "--sim-mix 0.25", "ONNX -> PyTorch", "shipped, user validation",
-                 "fine-tuned, user validation", "LIDET_WEIGHTS_DIR"):
+                 "fine-tuned, user validation", "LIDET_WEIGHTS_DIR", "gamma at 95 % TPR", "`--gamma ood`"):
         assert part in card, part
+    res = json.loads((out / "work" / "finetune.json").read_text())
+    assert res["gamma_rule"] == "ood" and len(res["gamma_tpr"]["cls"]) == 3
+    for k, n in (("cls", "cls_hdl64"), ("box", "box_hdl64")):  # the ONNX files carry the chosen gammas
+        meta = {p.key: p.value for p in onnx.load(str(out / f"{n}.onnx")).metadata_props}
+        assert [float(v) for v in meta["lidet.gamma"].split(",")] == res["gamma"][k]
     # the fine-tuned models load again and changed
     m0, _, _ = FT.load_onnx(ROOT / "weights" / "cls_hdl64.onnx")
     m1, _, _ = FT.load_onnx(out / "cls_hdl64.onnx")
