@@ -16,6 +16,8 @@ from lidet_ref import cluster_q, ground_q, group_q, pointnet_q, post_q, proj_q, 
  OUT_GROUP, OUT_SCORE) = range(1, 13)
 #: LIDET_DET_FLAT_MIN_POINTS: member pixels a car's cluster needs before the flat-surface test judges it
 FLAT_MIN_POINTS = 100
+#: lidet_detector_common.h LIDET_DET_GROUND_*: the car boxes' ground (lidet_detector_q.c car_to_ground)
+GROUND_MIN_PIXELS, GROUND_WINDOW_MM, GROUND_BIN_MM, GROUND_MAX_LIFT_MM = 5, 1000, 20, 500
 #: lidet_detector_q_cfg_default's gate2_class: gate 2 judges cars and cyclists, pedestrians pass it
 GATE2_CLASS = (1, 1, 0)
 
@@ -80,8 +82,9 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     GATE2_CLASS when absent, the C default), group_split (0 when absent; the C default is 1 for > 16 rows) and
     group_max_range_mm (40000 when absent), min_score_q15 (3, the operating point; 0s when absent: off; the C
     default is 19661 for cars with > 16 rows), gate1_class_margin_q16 (3, added to gate1_margin_q16 per class; 0s
-    when absent, the C default) and car_min_z_spread_mm (the cars'
-    flat-surface test; 0 when absent: off; the C default is 600). range_only: the image keeps only the range, every stage reads x, y, z
+    when absent, the C default), car_min_z_spread_mm (the cars'
+    flat-surface test; 0 when absent: off; the C default is 600) and car_ground_mm (car boxes down to the ground
+    around them, `ground_box`; 0 when absent: off; the C default is 1000 for > 16 rows). range_only: the image keeps only the range, every stage reads x, y, z
     decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
     (dicts), outcomes, stats. returns: (range_mm, azimuth, ring) instead of points_mm (lidet_detector_q_run_returns:
     proj_q.project_returns)."""
@@ -129,6 +132,53 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
         pix = np.asarray(members, np.int64)[rec.first_member: rec.first_member + rec.n_points]
         dz = Zf[pix] - int(rec.mean[2])
         return 192 * int(np.dot(dz, dz)) < flat_mm * flat_mm * int(rec.n_points)
+
+    ground_mm = int(det_cfg.get("car_ground_mm", 0))
+    ground_px = (np.asarray(mask).reshape(rows, cols) != 0) & (R > 0)
+
+    def column(x, y):
+        """lidet_detector_q.c column_q: floor((2^31 - atan2) mod 2^32 * cols / 2^32)."""
+        return (((1 << 31) - int(qmath.atan2(y, x))) & 0xFFFFFFFF) * cols >> 32
+
+    def ground_box(box):
+        """lidet_detector_q.c car_to_ground: the car box [cx, cy, cz, l, w, h, yaw] stretched down to the lower median
+        (20 mm bins over +-1 m of its bottom) of the ground pixels within car_ground_mm of its footprint, in the
+        columns its corners span (one more each side; every column when the footprint holds the sensor), when its
+        bottom lies 0-0.5 m above it; at least 5 pixels."""
+        if ground_mm <= 0:
+            return box
+        cx, cy, cz, ln, wd, h, yaw = box
+        c, s = int(qmath.cos(yaw)), int(qmath.sin(yaw))
+        a2, w2 = ln + 2 * ground_mm, wd + 2 * ground_mm
+        big_l, big_w = a2 << 30, w2 << 30
+
+        def inside(dx, dy):
+            u2, v2 = 2 * (c * dx + s * dy), 2 * (c * dy - s * dx)
+            return (np.abs(u2) <= big_l) & (np.abs(v2) <= big_w)
+
+        if inside(-cx, -cy):
+            sel_cols = np.arange(cols)
+        else:
+            cc, offs = column(cx, cy), [0]
+            for k in range(4):
+                a, w = (a2 if k & 1 else -a2), (w2 if k & 2 else -w2)
+                x = cx + int(qmath.rshift_round(c * a - s * w, 31))
+                y = cy + int(qmath.rshift_round(s * a + c * w, 31))
+                o = column(x, y) - cc
+                offs.append(o - cols if o > cols // 2 else (o + cols if o < -(cols // 2) else o))
+            sel_cols = (cc + min(offs) - 1 + np.arange(min(max(offs) - min(offs) + 3, cols))) % cols
+        gx, gy, gz, ok = X[:, sel_cols], Y[:, sel_cols], Z[:, sel_cols], ground_px[:, sel_cols]
+        t = 8 * gz - (2 * cz - h - 2 * GROUND_WINDOW_MM)
+        ok = ok & (t >= 0) & (t < 4 * GROUND_WINDOW_MM) & inside(4 * gx - cx, 4 * gy - cy)
+        n = int(ok.sum())
+        if n < GROUND_MIN_PIXELS:
+            return box
+        hist = np.bincount(t[ok] // (2 * GROUND_BIN_MM), minlength=2 * GROUND_WINDOW_MM // GROUND_BIN_MM)
+        i = int(np.argmax(np.cumsum(hist) >= (n + 1) // 2))
+        lift2 = 2 * GROUND_WINDOW_MM - (2 * i + 1) * GROUND_BIN_MM
+        if 0 < lift2 < 2 * GROUND_MAX_LIFT_MM:
+            return [cx, cy, cz - lift2 // 4, ln, wd, h + lift2 // 2, yaw]
+        return box
 
     def gate1_pass(cls, energy):
         return energy < int(cls_model.gamma_q16[cls]) + g1m + g1c[cls]
@@ -237,6 +287,8 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
             if group_on:
                 group(ci)
             continue
+        if cls == 0:
+            d["box"] = ground_box(d["box"])
         outcome[ci] = OUT_DETECTED
         truncated |= add(d)
     kept, flags = post_q.nms(dets, int(det_cfg["nms_iou_q15"]))

@@ -17,7 +17,6 @@ static lidet_detector_t g_det;
 
 const char *const cli_class_names[LIDET_N_CLASSES] = {"Car", "Cyclist", "Pedestrian"};
 
-
 /* ---- KITTI calibration and label_2 output (cli_read_calib, cli_kitti_box: lidet track's label_02 too) ---------- */
 
 int cli_read_calib(const char *path, cli_calib_t *c)
@@ -163,9 +162,9 @@ static int kitti_line(FILE *f, const cli_calib_t *c, const lidet_detection_t *d)
     cli_kitti_t k;
     if (cli_kitti_box(c, b, &k) != 0)
         return 1;
-    fprintf(f, "%s 0.00 0 %.2f %.2f %.2f %.2f %.2f %.3f %.3f %.3f %.3f %.3f %.3f %.4f %.4f\n", cli_class_names[d->cls],
-            k.alpha, k.bbox[0], k.bbox[1], k.bbox[2], k.bbox[3], (double)b->h_m, (double)b->w_m, (double)b->l_m,
-            k.loc[0], k.loc[1], k.loc[2], k.ry, (double)d->score);
+    fprintf(f, "%s 0.00 0 %.2f %.2f %.2f %.2f %.2f %.3f %.3f %.3f %.3f %.3f %.3f %.4f %.4f\n",
+            cli_class_names[d->cls], k.alpha, k.bbox[0], k.bbox[1], k.bbox[2], k.bbox[3], (double)b->h_m,
+            (double)b->w_m, (double)b->l_m, k.loc[0], k.loc[1], k.loc[2], k.ry, (double)d->score);
     return 0;
 }
 
@@ -216,11 +215,11 @@ static int read_gt(const char *path, gt_t **out, uint32_t *n)
             *hash = '\0';
         if (strspn(line, " \t\r\n") == strlen(line))
             continue;
-        if (sscanf(line, "%31s %f %f %f %f %f %f %f %f", g.cls, &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6],
-                   &v[7]) != 9)
+        if (sscanf(line, "%31s %f %f %f %f %f %f %f %f", g.cls, &v[0], &v[1], &v[2], &v[3], &v[4], &v[5],
+                   &v[6], &v[7]) != 9)
         {
-            fprintf(stderr, "lidet detect: %s:%d: expected '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>'\n", path,
-                    ln);
+            fprintf(stderr, "lidet detect: %s:%d: expected '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>'\n",
+                    path, ln);
             free(*out);
             fclose(f);
             return 1;
@@ -275,8 +274,9 @@ static int read_gt_kitti(const char *path, const cli_calib_t *c, gt_t **out, uin
         ++ln;
         if (strspn(line, " \t\r\n") == strlen(line))
             continue;
-        if (sscanf(line, "%31s %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf", g.cls, &v[0], &v[1], &v[2],
-                   &v[3], &v[4], &v[5], &v[6], &v[7], &v[8], &v[9], &v[10], &v[11], &v[12], &v[13]) != 15)
+        if (sscanf(line, "%31s %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf %lf", g.cls, &v[0], &v[1],
+                   &v[2], &v[3], &v[4], &v[5], &v[6], &v[7], &v[8], &v[9], &v[10], &v[11], &v[12],
+                   &v[13]) != 15)
         {
             fprintf(stderr, "lidet detect: %s:%d: not a KITTI label_2 line (15 fields)\n", path, ln);
             free(*out);
@@ -379,16 +379,17 @@ static void box_lines(FILE *f, const lidet_detection_t *det, uint32_t n_det)
 {
     uint32_t k;
     for (k = 0; k < n_det; ++k)
-        fprintf(f, "%s %.4f %.4f %.4f %.4f %.4f %.4f %.5f %.4f\n", cli_class_names[det[k].cls], (double)det[k].box.cx_m,
-                (double)det[k].box.cy_m, (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m,
-                (double)det[k].box.h_m, (double)det[k].box.yaw_rad, (double)det[k].score);
+        fprintf(f, "%s %.4f %.4f %.4f %.4f %.4f %.4f %.5f %.4f\n", cli_class_names[det[k].cls],
+                (double)det[k].box.cx_m, (double)det[k].box.cy_m, (double)det[k].box.cz_m,
+                (double)det[k].box.l_m, (double)det[k].box.w_m, (double)det[k].box.h_m,
+                (double)det[k].box.yaw_rad, (double)det[k].score);
 }
 
 /* the JSON object of a run (one line); scan: the capture's scan (--pcap: its number, kind, frames, returns and times
  * first), or NULL */
 static void json_result(const cli_args_t *a, const char *chosen, const lidet_detector_cfg_t *cfg,
-                        const lidet_detector_stats_t *ds, const lidet_detection_t *det, uint32_t n_det, lidet_status_t st,
-                        const double *ms, const cli_scan_info_t *scan)
+                        const lidet_detector_stats_t *ds, const lidet_detection_t *det, uint32_t n_det,
+                        lidet_status_t st, const double *ms, const cli_scan_info_t *scan)
 {
     uint32_t k;
     cli_json_begin(stdout);
@@ -436,14 +437,15 @@ static void json_result(const cli_args_t *a, const char *chosen, const lidet_det
     cli_json_num(stdout, "total_ms", ms[LIDET_DET_N_STAGES]);
     fprintf(stdout, ", \"boxes\": [");
     for (k = 0; k < n_det; ++k)
-        fprintf(stdout,
-                "%s{\"class\": \"%s\", \"score\": %.5f, \"energy_cls\": %.4f, \"energy_box\": %.4f, "
-                "\"x\": %.4f, \"y\": %.4f, \"z\": %.4f, \"l\": %.4f, \"w\": %.4f, \"h\": %.4f, \"yaw\": %.5f, "
-                "\"cluster\": %u, \"cluster_points\": %u}",
-                k ? ", " : "", cli_class_names[det[k].cls], (double)det[k].score, (double)det[k].energy_cls,
-                (double)det[k].energy_box, (double)det[k].box.cx_m, (double)det[k].box.cy_m,
-                (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m, (double)det[k].box.h_m,
-                (double)det[k].box.yaw_rad, det[k].cluster_id, det[k].n_points);
+        fprintf(
+            stdout,
+            "%s{\"class\": \"%s\", \"score\": %.5f, \"energy_cls\": %.4f, \"energy_box\": %.4f, "
+            "\"x\": %.4f, \"y\": %.4f, \"z\": %.4f, \"l\": %.4f, \"w\": %.4f, \"h\": %.4f, \"yaw\": %.5f, "
+            "\"cluster\": %u, \"cluster_points\": %u}",
+            k ? ", " : "", cli_class_names[det[k].cls], (double)det[k].score, (double)det[k].energy_cls,
+            (double)det[k].energy_box, (double)det[k].box.cx_m, (double)det[k].box.cy_m,
+            (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m, (double)det[k].box.h_m,
+            (double)det[k].box.yaw_rad, det[k].cluster_id, det[k].n_points);
     fprintf(stdout, "]");
     cli_json_end(stdout);
 }
@@ -469,13 +471,14 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, group_split, uint8_t, 1)
     CLI_SET_FLOAT(c, kv, klen, v, group_max_range_m)
     CLI_SET_FLOAT(c, kv, klen, v, car_min_z_spread_m)
+    CLI_SET_FLOAT(c, kv, klen, v, car_ground_m)
     {
         /* score_box_weight.CLASS / score_points_weight.CLASS / gate2.CLASS, in lidet_class_t order */
         static const char *const names[LIDET_N_CLASSES] = {"score_box_weight.car", "score_box_weight.cyclist",
                                                            "score_box_weight.pedestrian"};
         static const char *const gnames[LIDET_N_CLASSES] = {"gate2.car", "gate2.cyclist", "gate2.pedestrian"};
-        static const char *const pnames[LIDET_N_CLASSES] = {"score_points_weight.car", "score_points_weight.cyclist",
-                                                            "score_points_weight.pedestrian"};
+        static const char *const pnames[LIDET_N_CLASSES] = {
+            "score_points_weight.car", "score_points_weight.cyclist", "score_points_weight.pedestrian"};
         static const char *const mnames[LIDET_N_CLASSES] = {"min_score.car", "min_score.cyclist",
                                                             "min_score.pedestrian"};
         static const char *const g1names[LIDET_N_CLASSES] = {"gate1_margin.car", "gate1_margin.cyclist",
@@ -557,27 +560,31 @@ static int write_dump(const char *path, const int32_t *pp, uint32_t n_points)
     f = fopen(path, "wb");
     bad = ids == NULL || gnd == NULL || f == NULL || n_oc != n_cl ||
           lidet_workspace_point_labels(ws, pp, np, ids, gnd) != LIDET_OK;
-    bad = bad || fwrite("LDTD", 1, 4, f) != 4 || cli_put_u32(f, n_points) || cli_put_u32(f, n_cl) || cli_put_u32(f, n_det);
+    bad = bad || fwrite("LDTD", 1, 4, f) != 4 || cli_put_u32(f, n_points) || cli_put_u32(f, n_cl) ||
+          cli_put_u32(f, n_det);
     for (i = 0; !bad && i < n_points; ++i)
         bad = cli_put_u32(f, ids[i]) || fputc(gnd[i], f) == EOF;
     lidet_proposal_cfg_default(&pc);
     pc.n_points = g_det.cfg.proposal.n_points;
     for (k = 0; !bad && k < n_cl; ++k)
     {
-        bad = cli_put_u32(f, recs[k].n_points) || cli_put_u32(f, recs[k].seed_pixel) || cli_put_u32(f, recs[k].n_rescued) ||
-              cli_put_u32(f, oc[k]);
+        bad = cli_put_u32(f, recs[k].n_points) || cli_put_u32(f, recs[k].seed_pixel) ||
+              cli_put_u32(f, recs[k].n_rescued) || cli_put_u32(f, oc[k]);
         for (i = 0; !bad && i < 3; ++i)
-            bad = cli_put_f32(f, recs[k].mean_m[i]) || cli_put_f32(f, recs[k].min_m[i]) || cli_put_f32(f, recs[k].max_m[i]);
+            bad = cli_put_f32(f, recs[k].mean_m[i]) || cli_put_f32(f, recs[k].min_m[i]) ||
+                  cli_put_f32(f, recs[k].max_m[i]);
         bad = bad || lidet_workspace_proposal(ws, k, &pc, &prop) != LIDET_OK ||
               fwrite(prop.xyz, sizeof(float) * 3u, prop.n_points, f) != prop.n_points;
         for (i = 0; !bad && i < 3; ++i)
             bad = cli_put_f32(f, prop.mean_m[i]) || cli_put_u32(f, (uint32_t)(int32_t)prop.voxel[i]);
     }
     for (k = 0; !bad && k < n_det; ++k)
-        bad = cli_put_u32(f, det[k].cls) || cli_put_u32(f, det[k].cluster_id) || cli_put_u32(f, det[k].n_points) ||
-              cli_put_f32(f, det[k].score) || cli_put_f32(f, det[k].energy_cls) || cli_put_f32(f, det[k].energy_box) ||
-              cli_put_f32(f, det[k].box.cx_m) || cli_put_f32(f, det[k].box.cy_m) || cli_put_f32(f, det[k].box.cz_m) ||
-              cli_put_f32(f, det[k].box.l_m) || cli_put_f32(f, det[k].box.w_m) || cli_put_f32(f, det[k].box.h_m) ||
+        bad = cli_put_u32(f, det[k].cls) || cli_put_u32(f, det[k].cluster_id) ||
+              cli_put_u32(f, det[k].n_points) || cli_put_f32(f, det[k].score) ||
+              cli_put_f32(f, det[k].energy_cls) || cli_put_f32(f, det[k].energy_box) ||
+              cli_put_f32(f, det[k].box.cx_m) || cli_put_f32(f, det[k].box.cy_m) ||
+              cli_put_f32(f, det[k].box.cz_m) || cli_put_f32(f, det[k].box.l_m) ||
+              cli_put_f32(f, det[k].box.w_m) || cli_put_f32(f, det[k].box.h_m) ||
               cli_put_f32(f, det[k].box.yaw_rad);
     if (f != NULL && fclose(f) != 0)
         bad = 1;
@@ -596,60 +603,64 @@ void cli_det_usage(FILE *f)
         for (i = 0; i < LIDET_WEIGHTS_N_MODELS; ++i)
             fprintf(f, " %s", lidet_weights_models[i].name);
     }
-    fprintf(f, "\n  --crop           keep the KITTI camera field of view only (|azimuth| <= 45 deg)\n"
-               "  --fixed          the integer detector (lidet_detector_q.h: int8 models, no float; the scan\n"
-               "                   converted to millimetres); the same outputs\n"
-               "  --range-only     with --fixed: the range-only pixel of the integer firmware (x, y, z\n"
-               "                   decoded from row, column and range; lidet_detector_q_cfg_t.range_only)\n"
-               "  --cpu-clock      stage and total times (--json *_ms) in this thread's CPU time, not wall time\n"
-               "                   (what other processes on a busy machine do not inflate)\n"
-               "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
-               "                   max_height_extent_m (0: classify tall clusters too),\n"
-               "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
-               "                   gate2_margin (nats added to the models' gates),\n"
-               "                   gate1_margin.car|cyclist|pedestrian (nats added to gate1_margin\n"
-               "                   for that class; default 0),\n"
-               "                   gate2.car|cyclist|pedestrian (0 or 1: whether gate 2\n"
-               "                   judges the class; default 1, 1, 0),\n"
-               "                   group_split (0 or 1: people side by side in one cluster\n"
-               "                   split by the classifier's judgement; default 1 for > 16\n"
-               "                   beams), group_max_range_m (default 40),\n"
-               "                   min_score.car|cyclist|pedestrian (the operating point: detections\n"
-               "                   scoring below are dropped; default 0.6, 0, 0 for > 16 beams,\n"
-               "                   0 for <= 16), car_min_z_spread_m (a car's cluster of >= 100\n"
-               "                   pixels flatter than this in z is a surface; 0: off; default 0.6\n"
-               "                   for > 16 beams, 0 for <= 16),\n"
-               "                   score_box_weight.car|cyclist|pedestrian (the score's weight on gate 2's\n"
-               "                   margin), score_points_weight.CLASS (on ln(points / 64));\n"
-               "                   stages.cluster.KEY: a\n"
-               "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
-               "                   stages.cluster.split_people=0: no proposal refinement);\n"
-               "                   stages.proj.azimuth_half_rad: the projection's window and\n"
-               "                   stages.ground.seed_per_cell: a RANSAC stream per ground cell (the crop\n"
-               "                   sets both: the clustering's window + one ground sector, and 1)\n"
-               "                   stages.ground.KEY: a lidet_ground_cfg_t field as in lidet ground\n"
-               "                   --set (e.g. stages.ground.far_max_step_m=0: far planes judged by the\n"
-               "                   sensor's height); --fixed takes sample_step, sample_col_step,\n"
-               "                   ransac_iters, refine_iters, far_max_step_m, far2_split_m and the\n"
-               "                   clustering's\n"
-               "                   split_people, join_cars and regrow_* fields, in integer units\n");
+    fprintf(
+        f, "\n  --crop           keep the KITTI camera field of view only (|azimuth| <= 45 deg)\n"
+           "  --fixed          the integer detector (lidet_detector_q.h: int8 models, no float; the scan\n"
+           "                   converted to millimetres); the same outputs\n"
+           "  --range-only     with --fixed: the range-only pixel of the integer firmware (x, y, z\n"
+           "                   decoded from row, column and range; lidet_detector_q_cfg_t.range_only)\n"
+           "  --cpu-clock      stage and total times (--json *_ms) in this thread's CPU time, not wall time\n"
+           "                   (what other processes on a busy machine do not inflate)\n"
+           "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
+           "                   max_height_extent_m (0: classify tall clusters too),\n"
+           "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
+           "                   gate2_margin (nats added to the models' gates),\n"
+           "                   gate1_margin.car|cyclist|pedestrian (nats added to gate1_margin\n"
+           "                   for that class; default 0),\n"
+           "                   gate2.car|cyclist|pedestrian (0 or 1: whether gate 2\n"
+           "                   judges the class; default 1, 1, 0),\n"
+           "                   group_split (0 or 1: people side by side in one cluster\n"
+           "                   split by the classifier's judgement; default 1 for > 16\n"
+           "                   beams), group_max_range_m (default 40),\n"
+           "                   min_score.car|cyclist|pedestrian (the operating point: detections\n"
+           "                   scoring below are dropped; default 0.6, 0, 0 for > 16 beams,\n"
+           "                   0 for <= 16), car_min_z_spread_m (a car's cluster of >= 100\n"
+           "                   pixels flatter than this in z is a surface; 0: off; default 0.6\n"
+           "                   for > 16 beams, 0 for <= 16), car_ground_m (car boxes stretched\n"
+           "                   down to the ground pixels within this of the footprint; 0: off;\n"
+           "                   default 1 for > 16 beams, 0 for <= 16),\n"
+           "                   score_box_weight.car|cyclist|pedestrian (the score's weight on gate 2's\n"
+           "                   margin), score_points_weight.CLASS (on ln(points / 64));\n"
+           "                   stages.cluster.KEY: a\n"
+           "                   lidet_cluster_cfg_t field as in lidet cluster --set (e.g.\n"
+           "                   stages.cluster.split_people=0: no proposal refinement);\n"
+           "                   stages.proj.azimuth_half_rad: the projection's window and\n"
+           "                   stages.ground.seed_per_cell: a RANSAC stream per ground cell (the crop\n"
+           "                   sets both: the clustering's window + one ground sector, and 1)\n"
+           "                   stages.ground.KEY: a lidet_ground_cfg_t field as in lidet ground\n"
+           "                   --set (e.g. stages.ground.far_max_step_m=0: far planes judged by the\n"
+           "                   sensor's height); --fixed takes sample_step, sample_col_step,\n"
+           "                   ransac_iters, refine_iters, far_max_step_m, far2_split_m and the\n"
+           "                   clustering's\n"
+           "                   split_people, join_cars and regrow_* fields, in integer units\n");
 }
 
 static void usage_extra(void)
 {
     cli_det_usage(stderr);
-    fprintf(stderr, "  --calib FILE     KITTI calibration (P2, R0_rect, Tr_velo_to_cam) for --kitti-out\n"
-                    "  --kitti-out FILE label_2 lines in the camera frame (2D box from the projected corners)\n"
-                    "  --gt FILE        ground-truth boxes (lidet's sensor-frame lines) drawn in --png\n"
-                    "  --gt-kitti FILE  ground truth as KITTI label_2 (with --calib) drawn in --png\n"
-                    "  --returns        with --fixed and --ring: the scan fed as the sensor's returns (range,\n"
-                    "                   azimuth, ring: lidet_detector_q_run_returns), as the firmware takes it\n"
-                    "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n"
-                    "  --dump FILE      every result bit for bit (per-point labels, clusters, proposals,\n"
-                    "                   detections; binary, see write_dump in cli_detect.c; with --fixed the\n"
-                    "                   integer detector's labels, outcomes, counts and detections,\n"
-                    "                   cli_detect_q_dump in cli_detect_q.c)\n"
-                    "  lidet detect --pcap FILE [options]: the scans of a packet capture (Velodyne):\n");
+    fprintf(stderr,
+            "  --calib FILE     KITTI calibration (P2, R0_rect, Tr_velo_to_cam) for --kitti-out\n"
+            "  --kitti-out FILE label_2 lines in the camera frame (2D box from the projected corners)\n"
+            "  --gt FILE        ground-truth boxes (lidet's sensor-frame lines) drawn in --png\n"
+            "  --gt-kitti FILE  ground truth as KITTI label_2 (with --calib) drawn in --png\n"
+            "  --returns        with --fixed and --ring: the scan fed as the sensor's returns (range,\n"
+            "                   azimuth, ring: lidet_detector_q_run_returns), as the firmware takes it\n"
+            "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n"
+            "  --dump FILE      every result bit for bit (per-point labels, clusters, proposals,\n"
+            "                   detections; binary, see write_dump in cli_detect.c; with --fixed the\n"
+            "                   integer detector's labels, outcomes, counts and detections,\n"
+            "                   cli_detect_q_dump in cli_detect_q.c)\n"
+            "  lidet detect --pcap FILE [options]: the scans of a packet capture (Velodyne):\n");
     cli_pcap_usage(stderr, 1);
 }
 
@@ -743,8 +754,8 @@ int cli_det_config(const cli_args_t *a, const cli_det_opts_t *o, lidet_detector_
     {
         if (apply_set(cfg, o->sets[i]) != 0)
         {
-            fprintf(stderr, "lidet %s: bad --set '%s' (KEY=VALUE with a lidet_detector_cfg_t field)\n", cli_cmd,
-                    o->sets[i]);
+            fprintf(stderr, "lidet %s: bad --set '%s' (KEY=VALUE with a lidet_detector_cfg_t field)\n",
+                    cli_cmd, o->sets[i]);
             return 1;
         }
     }
@@ -765,8 +776,8 @@ int cli_detect_f_init(const lidet_detector_cfg_t *cfg, const lidet_pn_model_t *m
     return 0;
 }
 
-int cli_detect_f_run(const cli_args_t *a, int32_t *pp, double *ms, const lidet_detection_t **det, uint32_t *n_det,
-                     const lidet_detector_stats_t **ds, lidet_status_t *status)
+int cli_detect_f_run(const cli_args_t *a, int32_t *pp, double *ms, const lidet_detection_t **det,
+                     uint32_t *n_det, const lidet_detector_stats_t **ds, lidet_status_t *status)
 {
     const int repeat = a->repeat > 0 ? a->repeat : 1;
     const lidet_detector_stats_t *s;
@@ -806,8 +817,8 @@ int cli_detect_f_ground(const int32_t *pp, uint32_t n_points, uint8_t *point_gro
 {
     const uint32_t np = n_points < LIDET_MAX_POINTS ? n_points : LIDET_MAX_POINTS;
     uint32_t *ids = (uint32_t *)malloc(sizeof(uint32_t) * (size_t)(np + 1u));
-    int rc = ids == NULL ||
-             lidet_workspace_point_labels(lidet_detector_workspace(&g_det), pp, np, ids, point_ground) != LIDET_OK;
+    int rc = ids == NULL || lidet_workspace_point_labels(lidet_detector_workspace(&g_det), pp, np, ids,
+                                                         point_ground) != LIDET_OK;
     free(ids);
     return rc;
 }
@@ -826,9 +837,8 @@ static int save_scan(const char *dir, uint32_t k, const cli_args_t *a)
         FILE *f;
         snprintf(path, len, "%s/%s/%06u.bin", dir, sub ? "ring" : "velodyne", k);
         f = fopen(path, "wb");
-        bad = f == NULL ||
-              (sub ? fwrite(a->ring, sizeof(uint16_t), a->n_points, f) : fwrite(a->points, 4u * sizeof(float),
-                                                                                a->n_points, f)) != a->n_points;
+        bad = f == NULL || (sub ? fwrite(a->ring, sizeof(uint16_t), a->n_points, f)
+                                : fwrite(a->points, 4u * sizeof(float), a->n_points, f)) != a->n_points;
         if (f != NULL && fclose(f) != 0)
             bad = 1;
         if (bad)
@@ -840,7 +850,8 @@ static int save_scan(const char *dir, uint32_t k, const cli_args_t *a)
 
 /* `lidet detect --pcap FILE`: per scan of the capture a header line and its box lines (or a JSON object), --out
  * DIR/<K:06d>.txt, --png the last scan (or --png-scan K); the capture's summary on stderr. */
-static int detect_pcap(cli_args_t *a, const cli_det_opts_t *o, const cli_pcap_opts_t *po, const char *save_dir)
+static int detect_pcap(cli_args_t *a, const cli_det_opts_t *o, const cli_pcap_opts_t *po,
+                       const char *save_dir)
 {
     static lidet_detection_t det_q[LIDET_MAX_DETECTIONS];
     static lidet_detector_stats_t ds_q;
@@ -861,8 +872,8 @@ static int detect_pcap(cli_args_t *a, const cli_det_opts_t *o, const cli_pcap_op
     n_scans = cli_capture_n_scans(cap);
     if (po->png_scan >= 0 && (uint32_t)po->png_scan >= n_scans)
     {
-        fprintf(stderr, "lidet detect: --png-scan %ld: the capture gives %u scans (0..%u)\n", po->png_scan, n_scans,
-                n_scans - 1u);
+        fprintf(stderr, "lidet detect: --png-scan %ld: the capture gives %u scans (0..%u)\n", po->png_scan,
+                n_scans, n_scans - 1u);
         goto done;
     }
     png_k = po->png_scan >= 0 ? (uint32_t)po->png_scan : n_scans - 1u;
@@ -907,7 +918,8 @@ static int detect_pcap(cli_args_t *a, const cli_det_opts_t *o, const cli_pcap_op
         uint32_t n_det = 0;
         if (o->fixed)
         {
-            if (cli_detect_q_run(a, &cfg, chosen, det_q, &n_det, &ds_q, ms, draw ? gp : NULL, NULL, &st, rets) != 0)
+            if (cli_detect_q_run(a, &cfg, chosen, det_q, &n_det, &ds_q, ms, draw ? gp : NULL, NULL, &st,
+                                 rets) != 0)
                 goto done;
             det = det_q;
             ds = &ds_q;
@@ -918,9 +930,11 @@ static int detect_pcap(cli_args_t *a, const cli_det_opts_t *o, const cli_pcap_op
         if (!warned && 2u * (uint32_t)ds->stages.ground.n_sectors_rejected > cfg.stages.ground.n_sectors)
         {
             fprintf(stderr,
-                    "lidet detect: warning: scan %u: the ground stage refused the planes of %u of %u sectors: is the "
+                    "lidet detect: warning: scan %u: the ground stage refused the planes of %u of %u "
+                    "sectors: is the "
                     "mount height right? (--mount-height M; noted once)\n",
-                    info.index, (unsigned)ds->stages.ground.n_sectors_rejected, (unsigned)cfg.stages.ground.n_sectors);
+                    info.index, (unsigned)ds->stages.ground.n_sectors_rejected,
+                    (unsigned)cfg.stages.ground.n_sectors);
             warned = 1;
         }
         if (a->json)
@@ -964,7 +978,8 @@ static int detect_pcap(cli_args_t *a, const cli_det_opts_t *o, const cli_pcap_op
                      o->fixed ? " --fixed" : "", cli_basename(po->path), info.index, info.first_frame,
                      info.last_frame, a->sensor, label, ms[LIDET_DET_N_STAGES]);
             if ((!o->fixed && cli_detect_f_ground(pp, a->n_points, gp) != 0) ||
-                write_png(a->png_path, a->points, a->n_points, gp, det, n_det, NULL, 0, 0, title, a->n_points) != 0)
+                write_png(a->png_path, a->points, a->n_points, gp, det, n_det, NULL, 0, 0, title,
+                          a->n_points) != 0)
             {
                 fprintf(stderr, "lidet detect: cannot write the picture '%s'\n", a->png_path);
                 goto done;
@@ -996,14 +1011,15 @@ enum
     OPT_RETURNS
 };
 
-static const cli_opt_t k_detect_opts[] = {{"calib", required_argument, OPT_CALIB, "FILE: a KITTI calibration"},
-                                          {"kitti-out", required_argument, OPT_KITTI_OUT, "FILE"},
-                                          {"gt", required_argument, OPT_GT, "FILE: ground-truth boxes"},
-                                          {"gt-kitti", required_argument, OPT_GT_KITTI, "FILE: KITTI label_2 lines"},
-                                          {"dump", required_argument, OPT_DUMP, "FILE"},
-                                          {"save-scans", required_argument, OPT_SAVE_SCANS, "DIR"},
-                                          {"returns", no_argument, OPT_RETURNS, NULL},
-                                          {NULL, 0, 0, NULL}};
+static const cli_opt_t k_detect_opts[] = {
+    {"calib", required_argument, OPT_CALIB, "FILE: a KITTI calibration"},
+    {"kitti-out", required_argument, OPT_KITTI_OUT, "FILE"},
+    {"gt", required_argument, OPT_GT, "FILE: ground-truth boxes"},
+    {"gt-kitti", required_argument, OPT_GT_KITTI, "FILE: KITTI label_2 lines"},
+    {"dump", required_argument, OPT_DUMP, "FILE"},
+    {"save-scans", required_argument, OPT_SAVE_SCANS, "DIR"},
+    {"returns", no_argument, OPT_RETURNS, NULL},
+    {NULL, 0, 0, NULL}};
 
 typedef struct
 {
@@ -1094,8 +1110,10 @@ int cli_detect(int argc, char **argv)
         (po.port != 0 || po.force_sensor || po.partial || po.png_scan >= 0 || po.dual != NULL ||
          strcmp(po.lidar, "velodyne") != 0 || save_dir != NULL))
     {
-        fprintf(stderr, "lidet detect: --lidar, --port, --force-sensor, --dual, --partial, --png-scan and --save-scans "
-                        "go with --pcap FILE\n");
+        fprintf(
+            stderr,
+            "lidet detect: --lidar, --port, --force-sensor, --dual, --partial, --png-scan and --save-scans "
+            "go with --pcap FILE\n");
         i = CLI_PARSE_ERROR;
     }
     if (i == CLI_PARSE_OK && po.path != NULL)
@@ -1110,14 +1128,16 @@ int cli_detect(int argc, char **argv)
                                                   : NULL;
         if (one != NULL)
         {
-            fprintf(stderr, "lidet detect: %s goes with one scan file, not with --pcap (its scans are the capture's)\n",
-                    one);
+            fprintf(
+                stderr,
+                "lidet detect: %s goes with one scan file, not with --pcap (its scans are the capture's)\n",
+                one);
             i = CLI_PARSE_ERROR;
         }
         pos[0] = (char *)po.path; /* the scans' source */
         n_pos = 1;
         cli_fixed_returns = 0; /* --fixed feeds the decoded returns as they are */
-        a.capture = 1;         /* --sensor may name a --velodyne-calib's model; --print-sensor: the capture's */
+        a.capture = 1; /* --sensor may name a --velodyne-calib's model; --print-sensor: the capture's */
     }
     if (i == CLI_PARSE_OK)
         i = cli_args_finish(&a, pos, n_pos, "detect");
@@ -1220,7 +1240,8 @@ outputs:
         for (k = 0; f != NULL && k < n_det; ++k)
             written += kitti_line(f, &c, &det[k]) == 0 ? 1u : 0u;
         if (f != NULL && written == 0)
-            fprintf(f, "DontCare -1 -1 -10 0 0 0 0 -1 -1 -1 -1000 -1000 -1000 -10 0\n"); /* KITTI's empty frame */
+            fprintf(
+                f, "DontCare -1 -1 -10 0 0 0 0 -1 -1 -1 -1000 -1000 -1000 -10 0\n"); /* KITTI's empty frame */
         if (f == NULL || fclose(f) != 0)
         {
             fprintf(stderr, "lidet detect: cannot write '%s'\n", kitti_path);
@@ -1245,8 +1266,8 @@ outputs:
             fixed = 2; /* the integer run filled gp */
         if (gp == NULL || (fixed != 2 && cli_detect_f_ground(pp, a.n_points, gp) != 0) ||
             (gt_path != NULL && read_gt(gt_path, &gt, &n_gt) != 0) ||
-            (gt_kitti_path != NULL &&
-             (cli_read_calib(calib_path, &gcal) != 0 || read_gt_kitti(gt_kitti_path, &gcal, &gt, &n_gt) != 0)) ||
+            (gt_kitti_path != NULL && (cli_read_calib(calib_path, &gcal) != 0 ||
+                                       read_gt_kitti(gt_kitti_path, &gcal, &gt, &n_gt) != 0)) ||
             write_png(a.png_path, a.points, np, gp, det, n_det, gt, n_gt,
                       gt_path != NULL || gt_kitti_path != NULL, title, a.n_points) != 0)
         {
@@ -1278,28 +1299,31 @@ outputs:
     else
     {
         printf("scan         %s (%s, models %s)\n", a.scan_path, a.sensor, chosen);
-        printf("clusters     %u: %u classified (%u outside the crop, %u taller than %.1f m, %u beyond range, %u over "
+        printf("clusters     %u: %u classified (%u outside the crop, %u taller than %.1f m, %u beyond range, "
+               "%u over "
                "the budget of %u)\n",
-               ds->n_clusters, ds->n_classified, ds->n_out_of_crop, ds->n_too_tall, (double)cfg.max_height_extent_m,
-               ds->n_out_of_range, ds->n_over_budget, cfg.max_proposals);
-        printf("gates        %u rejected by gate 1, %u by gate 2; %u impossible sizes, %u suppressed by NMS\n",
-               ds->n_gate1_rejected, ds->n_gate2_rejected, ds->n_size_rejected, ds->n_nms_suppressed);
+               ds->n_clusters, ds->n_classified, ds->n_out_of_crop, ds->n_too_tall,
+               (double)cfg.max_height_extent_m, ds->n_out_of_range, ds->n_over_budget, cfg.max_proposals);
+        printf(
+            "gates        %u rejected by gate 1, %u by gate 2; %u impossible sizes, %u suppressed by NMS\n",
+            ds->n_gate1_rejected, ds->n_gate2_rejected, ds->n_size_rejected, ds->n_nms_suppressed);
         printf("time (ms)    project %.3f  ground %.3f  cluster %.3f  classify %.3f  box %.3f  total %.3f"
                " (median of %d)\n",
                ms[LIDET_DET_STAGE_PROJECT], ms[LIDET_DET_STAGE_GROUND], ms[LIDET_DET_STAGE_CLUSTER],
                ms[LIDET_DET_STAGE_CLASSIFY], ms[LIDET_DET_STAGE_BOX], ms[LIDET_DET_N_STAGES], a.repeat);
         printf("detections   %u\n", n_det);
         if (n_det > 0)
-            printf("  %-10s %6s %8s %8s %7s %7s %7s %5s %5s %5s %7s %6s\n", "class", "score", "E_cls", "E_box", "x",
-                   "y", "z", "l", "w", "h", "yaw", "points");
+            printf("  %-10s %6s %8s %8s %7s %7s %7s %5s %5s %5s %7s %6s\n", "class", "score", "E_cls",
+                   "E_box", "x", "y", "z", "l", "w", "h", "yaw", "points");
         for (k = 0; k < n_det; ++k)
             printf("  %-10s %6.3f %8.3f %8.3f %7.2f %7.2f %7.2f %5.2f %5.2f %5.2f %7.3f %6u\n",
                    cli_class_names[det[k].cls], (double)det[k].score, (double)det[k].energy_cls,
                    (double)det[k].energy_box, (double)det[k].box.cx_m, (double)det[k].box.cy_m,
-                   (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m, (double)det[k].box.h_m,
-                   (double)det[k].box.yaw_rad, det[k].n_points);
+                   (double)det[k].box.cz_m, (double)det[k].box.l_m, (double)det[k].box.w_m,
+                   (double)det[k].box.h_m, (double)det[k].box.yaw_rad, det[k].n_points);
         if (a.png_path != NULL)
-            printf("picture      %s (detections: car red, cyclist cyan, pedestrian yellow; ground truth green)\n",
+            printf("picture      %s (detections: car red, cyclist cyan, pedestrian yellow; ground truth "
+                   "green)\n",
                    a.png_path);
     }
     free(gp);

@@ -13,7 +13,6 @@
 
 static lidet_detector_q_t g_detq;
 
-
 static int32_t round_i32(double v)
 {
     return (int32_t)(v >= 0.0 ? v + 0.5 : v - 0.5);
@@ -34,8 +33,9 @@ static lidet_return_t return_of_point(const int32_t *p, uint16_t ring)
         ++q;
     q = (q + 1u) >> 1;
     r.range_mm = q > 0xFFFFFFFFu ? 0xFFFFFFFFu : (uint32_t)q;
-    r.azimuth = (uint16_t)((int64_t)floor(atan2((double)p[1], (double)p[0]) * (65536.0 / (2.0 * M_PI_D)) + 0.5) &
-                           0xFFFF);
+    r.azimuth =
+        (uint16_t)((int64_t)floor(atan2((double)p[1], (double)p[0]) * (65536.0 / (2.0 * M_PI_D)) + 0.5) &
+                   0xFFFF);
     r.ring = ring;
     return r;
 }
@@ -71,8 +71,8 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     mb = lidet_pointnet_q_find(lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, name);
     if (mc == NULL || mb == NULL)
     {
-        fprintf(stderr, "lidet %s --fixed: no int8 models cls_%s_s8 / box_%s_s8 in weights/\n", cli_cmd, family,
-                family);
+        fprintf(stderr, "lidet %s --fixed: no int8 models cls_%s_s8 / box_%s_s8 in weights/\n", cli_cmd,
+                family, family);
         return 1;
     }
     if (a->mount_height_m >= 0.0) /* --mount-height, in mm as the integer profile holds it */
@@ -82,8 +82,9 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
         s = &mounted;
     }
     lidet_detector_q_cfg_default(&cfg, s);
-    cfg.crop_half_bam = fcfg->crop_half_rad >= (float)M_PI_D ? 0x7FFFFFFF
-                                                             : round_i32((double)fcfg->crop_half_rad * bam_per_rad);
+    cfg.crop_half_bam = fcfg->crop_half_rad >= (float)M_PI_D
+                            ? 0x7FFFFFFF
+                            : round_i32((double)fcfg->crop_half_rad * bam_per_rad);
     cfg.max_range_mm = round_i32((double)fcfg->max_range_m * 1000.0);
     cfg.max_height_extent_mm = round_i32((double)fcfg->max_height_extent_m * 1000.0);
     cfg.max_proposals = fcfg->max_proposals;
@@ -99,13 +100,15 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     cfg.ground.far_max_step_mm = (uint32_t)round_i32((double)fcfg->stages.ground.far_max_step_m * 1000.0);
     cfg.ground.far2_split_mm = (uint32_t)round_i32((double)fcfg->stages.ground.far2_split_m * 1000.0);
     cfg.cluster.regrow_gap_mm = (uint32_t)round_i32((double)fcfg->stages.cluster.regrow_gap_m * 1000.0);
-    cfg.cluster.regrow_gap_per_m_q16 = (uint32_t)round_i32((double)fcfg->stages.cluster.regrow_gap_per_m * 65536.0);
+    cfg.cluster.regrow_gap_per_m_q16 =
+        (uint32_t)round_i32((double)fcfg->stages.cluster.regrow_gap_per_m * 65536.0);
     cfg.cluster.regrow_max_pixels = fcfg->stages.cluster.regrow_max_pixels;
     cfg.cluster.regrow_max_height_mm =
         (uint32_t)round_i32((double)fcfg->stages.cluster.regrow_max_height_m * 1000.0);
     cfg.group_split = fcfg->group_split;
     cfg.group_max_range_mm = round_i32((double)fcfg->group_max_range_m * 1000.0);
     cfg.car_min_z_spread_mm = round_i32((double)fcfg->car_min_z_spread_m * 1000.0);
+    cfg.car_ground_mm = round_i32((double)fcfg->car_ground_m * 1000.0);
     cfg.gate1 = fcfg->gate1;
     cfg.gate2 = fcfg->gate2;
     cfg.gate1_margin_q16 = round_i32((double)fcfg->gate1_margin * 65536.0);
@@ -147,7 +150,8 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
         for (i = 0; i < 3; ++i)
         {
             const double v = (double)a->points[4u * k + (uint32_t)i] * 1000.0;
-            pts[3u * k + (uint32_t)i] = v != v ? 0 : (v > 2.0e9 ? 2000000000 : (v < -2.0e9 ? -2000000000 : round_i32(v)));
+            pts[3u * k + (uint32_t)i] =
+                v != v ? 0 : (v > 2.0e9 ? 2000000000 : (v < -2.0e9 ? -2000000000 : round_i32(v)));
         }
     }
     if (cli_fixed_returns && returns == NULL)
@@ -176,8 +180,9 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     {
         const double t0 = cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms();
         *status = run_rets != NULL ? lidet_detector_q_run_returns(&g_detq, run_rets, np, i == 0 ? pp : NULL)
-                               : lidet_detector_q_run(&g_detq, pts, np, 3, a->ring, i == 0 ? pp : NULL);
-        t[(size_t)LIDET_DET_N_STAGES * (size_t)a->repeat + (size_t)i] = (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - t0;
+                                   : lidet_detector_q_run(&g_detq, pts, np, 3, a->ring, i == 0 ? pp : NULL);
+        t[(size_t)LIDET_DET_N_STAGES * (size_t)a->repeat + (size_t)i] =
+            (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - t0;
         if (!LIDET_SUCCEEDED(*status))
         {
             fprintf(stderr, "lidet %s --fixed: %s\n", cli_cmd, lidet_status_str(*status));
@@ -273,21 +278,23 @@ int cli_detect_q_dump(const char *path, uint32_t n_points, const uint32_t *point
     dq = lidet_detector_q_detections(&g_detq, &n_det);
     oc = lidet_detector_q_outcomes(&g_detq, &n_oc);
     bad = f == NULL || dq == NULL || oc == NULL || point_cluster == NULL || point_ground == NULL;
-    bad =
-        bad || fwrite("LDTQ", 1, 4, f) != 4 || cli_put_u32(f, n_points) || cli_put_u32(f, n_oc) || cli_put_u32(f, n_det);
+    bad = bad || fwrite("LDTQ", 1, 4, f) != 4 || cli_put_u32(f, n_points) || cli_put_u32(f, n_oc) ||
+          cli_put_u32(f, n_det);
     for (i = 0; !bad && i < n_points; ++i)
         bad = cli_put_u32(f, i < np ? point_cluster[i] : 0u) || fputc(i < np ? point_ground[i] : 0, f) == EOF;
     for (i = 0; !bad && i < n_oc; ++i)
         bad = cli_put_u32(f, oc[i]);
     bad = bad || cli_put_u32(f, st->n_clusters) || cli_put_u32(f, st->n_out_of_crop) ||
-          cli_put_u32(f, st->n_out_of_range) || cli_put_u32(f, st->n_over_budget) || cli_put_u32(f, st->n_classified) ||
-          cli_put_u32(f, st->n_gate1_rejected) || cli_put_u32(f, st->n_boxed) || cli_put_u32(f, st->n_gate2_rejected) ||
+          cli_put_u32(f, st->n_out_of_range) || cli_put_u32(f, st->n_over_budget) ||
+          cli_put_u32(f, st->n_classified) || cli_put_u32(f, st->n_gate1_rejected) ||
+          cli_put_u32(f, st->n_boxed) || cli_put_u32(f, st->n_gate2_rejected) ||
           cli_put_u32(f, st->n_size_rejected) || cli_put_u32(f, st->n_nms_suppressed) ||
           cli_put_u32(f, st->n_over_capacity) || cli_put_u32(f, st->n_detections) ||
           cli_put_u32(f, st->n_over_box_budget) || cli_put_u32(f, st->n_too_tall);
     for (i = 0; !bad && i < n_det; ++i)
-        bad = cli_put_u32(f, dq[i].cls) || cli_put_u32(f, dq[i].cluster_id) || cli_put_u32(f, dq[i].n_points) ||
-              cli_put_u32(f, (uint32_t)dq[i].score_q15) || cli_put_u32(f, (uint32_t)dq[i].energy_cls_q16) ||
+        bad = cli_put_u32(f, dq[i].cls) || cli_put_u32(f, dq[i].cluster_id) ||
+              cli_put_u32(f, dq[i].n_points) || cli_put_u32(f, (uint32_t)dq[i].score_q15) ||
+              cli_put_u32(f, (uint32_t)dq[i].energy_cls_q16) ||
               cli_put_u32(f, (uint32_t)dq[i].energy_box_q16) || cli_put_u32(f, (uint32_t)dq[i].box.cx_mm) ||
               cli_put_u32(f, (uint32_t)dq[i].box.cy_mm) || cli_put_u32(f, (uint32_t)dq[i].box.cz_mm) ||
               cli_put_u32(f, (uint32_t)dq[i].box.l_mm) || cli_put_u32(f, (uint32_t)dq[i].box.w_mm) ||

@@ -6,8 +6,8 @@
 
 #include "lidet/lidet.h"
 #include "lidet/lidet_detector_q.h"
-#include "lidet_weights.h"
 #include "lidet_py_detq.h"
+#include "lidet_weights.h"
 
 #if defined(_WIN32)
 #define LIDET_PY_API __declspec(dllexport)
@@ -87,6 +87,10 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
             }
         }
     }
+    if (icfg[19] >= 0) /* the car boxes' ground; -1: the default */
+    {
+        cfg.car_ground_mm = icfg[19];
+    }
     if (icfg[9] >= 0) /* -1: the build's default */
     {
         cfg.range_only = (uint8_t)icfg[9];
@@ -104,7 +108,7 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
  * max_boxes (0 = default), gate1_margin_q16, gate2_margin_q16, range_only (-1 = the build's default, 0, 1),
  * gate2_class as bits (bit k: class k; -1 = the default), group_split (0, 1; -1 = the default for the sensor),
  * min_score_q15 per class (3 entries, -1 = the default), car_min_z_spread_mm (-1 = the default),
- * gate1_class_margin_q16 per class (3 entries, INT32_MIN = the default).
+ * gate1_class_margin_q16 per class (3 entries, INT32_MIN = the default), car_ground_mm (-1 = the default).
  * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
  * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 18 uint32 (the
  * counts of lidet_detector_q_stats_t in order, then n_over_box_budget, n_too_tall, the three group counts and
@@ -112,8 +116,8 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
  * instead of the points (lidet_detector_q_run_returns; pts_mm ignored), or NULL. Returns the run's status. */
 LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, const char *box_name,
                                    const int32_t *icfg, const int32_t *pts_mm, uint32_t n, uint32_t stride,
-                                   int32_t *out_det, uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters,
-                                   uint32_t *out_stats, const lidet_return_t *returns)
+                                   int32_t *out_det, uint32_t *n_det, uint8_t *out_outcome,
+                                   uint32_t *n_clusters, uint32_t *out_stats, const lidet_return_t *returns)
 {
     const lidet_detection_q_t *d;
     const lidet_detector_q_stats_t *st;
@@ -152,11 +156,12 @@ LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, con
     memcpy(out_outcome, oc, *n_clusters);
     st = lidet_detector_q_stats(&g_detq);
     {
-        const uint32_t v[18] = {st->n_clusters,     st->n_out_of_crop,    st->n_out_of_range,   st->n_over_budget,
-                                st->n_classified,   st->n_gate1_rejected, st->n_boxed,          st->n_gate2_rejected,
-                                st->n_size_rejected, st->n_nms_suppressed, st->n_over_capacity, st->n_detections,
-                                st->n_over_box_budget, st->n_too_tall, st->n_group_split,
-                                st->n_group_classified, st->n_group_boxed, st->n_score_rejected};
+        const uint32_t v[18] = {
+            st->n_clusters,        st->n_out_of_crop,    st->n_out_of_range,  st->n_over_budget,
+            st->n_classified,      st->n_gate1_rejected, st->n_boxed,         st->n_gate2_rejected,
+            st->n_size_rejected,   st->n_nms_suppressed, st->n_over_capacity, st->n_detections,
+            st->n_over_box_budget, st->n_too_tall,       st->n_group_split,   st->n_group_classified,
+            st->n_group_boxed,     st->n_score_rejected};
         memcpy(out_stats, v, sizeof v);
     }
     return rc;

@@ -163,7 +163,7 @@ def test_score_matches_the_float_definition(nq):
 
 def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False, crop_half_bam=0, returns=None,
                 gate2_class=None, group_split=None, model=None, min_score_q15=None, car_min_z_spread_mm=None,
-                gate1_class_margin_q16=None):
+                gate1_class_margin_q16=None, car_ground_mm=None):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -185,7 +185,8 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
                    min_score_q15=min_score_q15 or ([19661, 0, 0] if s.rows > 16 else [0, 0, 0]),
                    car_min_z_spread_mm=(600 if s.rows > 16 else 0) if car_min_z_spread_mm is None else
                    car_min_z_spread_mm,
-                   gate1_class_margin_q16=gate1_class_margin_q16 or [0, 0, 0])
+                   gate1_class_margin_q16=gate1_class_margin_q16 or [0, 0, 0],
+                   car_ground_mm=(1000 if s.rows > 16 else 0) if car_ground_mm is None else car_ground_mm)
     if gate2_class is not None:
         det_cfg["gate2_class"] = gate2_class
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
@@ -194,7 +195,7 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
 
 
 @pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "gate2_all", "group", "group_real",
-                                   "min_score", "flat", "gate1_class",
+                                   "min_score", "flat", "gate1_class", "ground_off", "ground_wide",
                                    "range_only_sample",
                                    "range_only_fresh", "range_only_real", "crop_hdl64", "crop_real",
                                    "returns_sample", "returns_range_only_sample", "returns_range_only_fresh"])
@@ -204,7 +205,7 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     returns (lidet_detector_q_run_returns: ring, azimuth, range) instead of points."""
     from lidet_ref import proj_q
     sensor, max_boxes, margins, g2c, model = "vlp16", 0, (0, 0), None, None
-    min_score, flat_mm, g1c = None, None, None
+    min_score, flat_mm, g1c, ground_mm = None, None, None, None
     use_returns = which.startswith("returns_")
     which = which.removeprefix("returns_")
     range_only = which.startswith("range_only_")
@@ -232,6 +233,9 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     elif which == "gate1_class":  # gate 1 per class: cars 2 nats looser, pedestrians 1 nat looser, cyclists stricter
         sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
         g1c = [2 * 65536, -65536, 65536]
+    elif which in ("ground_off", "ground_wide"):  # the car boxes' ground off, or looked for within 3 m
+        sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
+        ground_mm = 0 if which == "ground_off" else 3000
     elif which == "flat":  # the flat-surface test at 1.6 m: the car of 122 members (z spread 1.3-1.6 m) goes
         sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
         flat_mm = 1600
@@ -251,9 +255,10 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
                     range_only=range_only, crop_half_bam=crop, returns=None if rets is None else nq.as_returns(*rets),
                     gate2_class=g2c, model=model, min_score_q15=min_score, car_min_z_spread_mm=flat_mm,
-                    gate1_class_margin_q16=g1c)
+                    gate1_class_margin_q16=g1c, car_ground_mm=ground_mm)
     r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop, returns=rets, gate2_class=g2c, model=model,
-                        min_score_q15=min_score, car_min_z_spread_mm=flat_mm, gate1_class_margin_q16=g1c)
+                        min_score_q15=min_score, car_min_z_spread_mm=flat_mm, gate1_class_margin_q16=g1c,
+                        car_ground_mm=ground_mm)
     if use_returns:  # the same scan as points gives nearly the same detections (pixels move by rounding only)
         p = nq.detect_q(mm, sensor, range_only=range_only)
         assert abs(len(p["cls"]) - len(c["cls"])) <= 2 and c["stats"]["n_clusters"] > 0
@@ -262,6 +267,19 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     if which == "gate1_class":  # the setting bites: against the defaults, gate 1 rejects fewer clusters
         c0 = nq.detect_q(mm, sensor)
         assert c["stats"]["n_gate1_rejected"] < c0["stats"]["n_gate1_rejected"]
+    if which.startswith("ground_"):  # the setting bites: some car boxes differ in height and z only
+        c0 = nq.detect_q(mm, sensor)
+        assert np.array_equal(c["cls"], c0["cls"]) and np.array_equal(c["boxes"][:, [0, 1, 3, 4, 6]],
+                                                                      c0["boxes"][:, [0, 1, 3, 4, 6]])
+        moved = np.flatnonzero(np.any(c["boxes"] != c0["boxes"], axis=1))
+        assert len(moved) >= 1 and np.all(c["cls"][moved] == 0)
+        # the default stretches cars down (taller, centre lower, top kept within a mm)
+        lo, hi = (c, c0) if which == "ground_off" else (None, None)
+        if lo is not None:
+            assert np.all(hi["boxes"][moved, 5] > lo["boxes"][moved, 5])
+            top_lo = lo["boxes"][moved, 2] + lo["boxes"][moved, 5] / 2
+            top_hi = hi["boxes"][moved, 2] + hi["boxes"][moved, 5] / 2
+            assert np.all(np.abs(top_hi - top_lo) <= 1)
     if which in ("min_score", "flat"):  # the setting bites: against the defaults, more clusters lose their detection
         c0 = nq.detect_q(mm, sensor)
         key = "n_score_rejected" if which == "min_score" else "n_size_rejected"

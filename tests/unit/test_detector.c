@@ -168,6 +168,24 @@ void test_tall_clusters_are_not_classified(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
 }
 
+/* runs the detector on the scene: three car boxes, each centred on its cluster's mean with the car template's
+ * height (none moved to the ground) */
+static void three_boxes_as_the_net_gave(void)
+{
+    uint32_t n = 0, k;
+    const lidet_detection_t *d;
+    const lidet_cluster_rec_t *recs;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    d = lidet_detector_detections(&g.ws, &n);
+    recs = lidet_workspace_clusters(lidet_detector_workspace(&g.ws), NULL);
+    TEST_ASSERT_EQUAL_UINT32(3, n);
+    for (k = 0; k < n; ++k)
+    {
+        TEST_ASSERT_CLOSE(recs[d[k].cluster_id - 1u].mean_m[2], d[k].box.cz_m, 1e-4, 0);
+        TEST_ASSERT_CLOSE(1.526, d[k].box.h_m, 1e-5, 0);
+    }
+}
+
 void test_three_objects_three_cars(void)
 {
     const lidet_detection_t *d;
@@ -201,7 +219,12 @@ void test_three_objects_three_cars(void)
         TEST_ASSERT_EQUAL_UINT8(LIDET_CLASS_CAR, d[k].cls);
         TEST_ASSERT_CLOSE(r->mean_m[0], d[k].box.cx_m, 1e-4, 0);
         TEST_ASSERT_CLOSE(r->mean_m[1], d[k].box.cy_m, 1e-4, 0);
-        TEST_ASSERT_CLOSE(r->mean_m[2], d[k].box.cz_m, 1e-4, 0);
+        /* the box net's box is centred on the mean with the car template's height (its bottom 0.04-0.14 m above
+         * the ground); car_ground_m (default 1 m) takes the bottom down to the ground plane z = -1.73 within half a
+         * 2 cm bin, the top kept */
+        TEST_ASSERT_CLOSE(r->mean_m[2] + 0.763f, d[k].box.cz_m + 0.5f * d[k].box.h_m, 1e-4, 0);
+        TEST_ASSERT_CLOSE(-1.73f, d[k].box.cz_m - 0.5f * d[k].box.h_m, 0.0101, 0);
+        TEST_ASSERT_TRUE(d[k].box.h_m > 1.526f + 0.02f);
         TEST_ASSERT_CLOSE(az, d[k].box.yaw_rad, 1e-4, 0);
         TEST_ASSERT_CLOSE(3.883, d[k].box.l_m, 1e-5, 0);
         TEST_ASSERT_EQUAL_UINT32(r->n_points, d[k].n_points);
@@ -209,10 +232,29 @@ void test_three_objects_three_cars(void)
          * w = 0.5 and v = 0.1 for cars (score_box_weight's and score_points_weight's defaults) */
         TEST_ASSERT_CLOSE(0.5f, cfg.score_box_weight[LIDET_CLASS_CAR], 0.0, 0);
         TEST_ASSERT_CLOSE(1.0 / (1.0 + exp(-(5.0 + log(1.0 + 2.0 * exp(-5.0))) +
-                                          0.5 * ((double)d[k].energy_box - (double)m_box.gamma[0]) -
-                                          0.1 * log((double)d[k].n_points / 64.0))),
+                                           0.5 * ((double)d[k].energy_box - (double)m_box.gamma[0]) -
+                                           0.1 * log((double)d[k].n_points / 64.0))),
                           d[k].score, 1e-5, 0);
         TEST_ASSERT_TRUE(k == 0 || d[k - 1].cluster_id < d[k].cluster_id); /* equal scores: id order */
+    }
+    {
+        /* the car boxes' ground off: the box net's boxes as they came, centred on the means */
+        lidet_detector_cfg_t c = cfg;
+        c.car_ground_m = 0.0f;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+        three_boxes_as_the_net_gave();
+    }
+    {
+        /* faces floating 0.6 m higher: their boxes' bottoms lie 0.64-0.74 m above the ground, beyond the 0.5 m a
+         * box is stretched by, so the default leaves them as they came */
+        uint32_t i;
+        for (i = 60000u; i < g_n; ++i)
+        {
+            g_pts[4 * i + 2] += 0.6f;
+        }
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+        three_boxes_as_the_net_gave();
+        scene();
     }
     {
         /* weight 0: the classifier's energy alone; out of [0, 4]: refused */
@@ -518,7 +560,8 @@ void test_init_errors(void)
     lidet_pn_model_t other, other_box;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_init(NULL, &cfg, &m_cls, &m_box));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_init(&g.ws, &cfg, NULL, &m_box));
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_init(&g.ws, &cfg, &m_box, &m_cls)); /* kinds swapped */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL,
+                          lidet_detector_init(&g.ws, &cfg, &m_box, &m_cls)); /* kinds swapped */
     other = m_box;
     other.n_points = 32; /* another points-per-proposal setting */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_init(&g.ws, &cfg, &m_cls, &other));
@@ -573,6 +616,13 @@ void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c.car_min_z_spread_m = INFINITY;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
+    c.car_ground_m = -0.1f; /* [0, 10] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.car_ground_m = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.car_ground_m = 10.5f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     {
         /* the group split, the operating point and the flat-surface test: on for > 16 beams, off for <= 16 */
         lidet_detector_cfg_t d0;
@@ -583,7 +633,9 @@ void test_init_errors(void)
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_CYCLIST]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_PEDESTRIAN]);
         TEST_ASSERT_EQUAL_FLOAT(0.6f, d0.car_min_z_spread_m);
-        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_CAR]); /* gate 1: the models' thresholds */
+        TEST_ASSERT_EQUAL_FLOAT(1.0f, d0.car_ground_m);
+        TEST_ASSERT_EQUAL_FLOAT(0.0f,
+                                d0.gate1_class_margin[LIDET_CLASS_CAR]); /* gate 1: the models' thresholds */
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_CYCLIST]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_PEDESTRIAN]);
         lidet_detector_cfg_default(&d0, lidet_sensor_find("vlp16"));
@@ -591,6 +643,7 @@ void test_init_errors(void)
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_PEDESTRIAN]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_CAR]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.car_min_z_spread_m);
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.car_ground_m);
     }
     c = cfg;
     c.size_min_m[1][2] = 5.0f;

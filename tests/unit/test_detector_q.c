@@ -70,7 +70,8 @@ static void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_init(NULL, &cfg, m_cls, m_box));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_init(&g.ws, NULL, m_cls, m_box));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_init(&g.ws, &cfg, NULL, m_box));
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL, lidet_detector_q_init(&g.ws, &cfg, m_box, m_cls)); /* kinds swapped */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_MODEL,
+                          lidet_detector_q_init(&g.ws, &cfg, m_box, m_cls)); /* kinds swapped */
     cfg.nms_iou_q15 = 32769;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);
@@ -107,6 +108,14 @@ static void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     cfg.car_min_z_spread_mm = -1;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.car_ground_mm = 10001; /* [0, 10000] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.car_ground_mm = -1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.car_ground_mm = 1000; /* a build that does not keep the ground mask past the clustering refuses it */
+    TEST_ASSERT_EQUAL_INT(LIDET_Q_PIXEL_XYZ ? LIDET_OK : LIDET_ERR_CONFIG,
+                          lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     /* the group split, the operating point and the flat-surface test: on for > 16 rows, off for <= 16 */
     lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("hdl64"));
     TEST_ASSERT_EQUAL_UINT8(1, cfg.group_split);
@@ -115,7 +124,9 @@ static void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_CYCLIST]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_PEDESTRIAN]);
     TEST_ASSERT_EQUAL_INT32(600, cfg.car_min_z_spread_mm);
-    TEST_ASSERT_EQUAL_INT32(0, cfg.gate1_class_margin_q16[LIDET_CLASS_CAR]); /* gate 1: the models' thresholds */
+    TEST_ASSERT_EQUAL_INT32(LIDET_Q_PIXEL_XYZ ? 1000 : 0, cfg.car_ground_mm);
+    TEST_ASSERT_EQUAL_INT32(0,
+                            cfg.gate1_class_margin_q16[LIDET_CLASS_CAR]); /* gate 1: the models' thresholds */
     TEST_ASSERT_EQUAL_INT32(0, cfg.gate1_class_margin_q16[LIDET_CLASS_CYCLIST]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN]);
     lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("vlp16"));
@@ -124,6 +135,7 @@ static void test_init_errors(void)
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_CAR]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_PEDESTRIAN]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.car_min_z_spread_mm);
+    TEST_ASSERT_EQUAL_INT32(0, cfg.car_ground_mm);
     lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.max_proposals = 0;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
@@ -212,9 +224,10 @@ static void check_invariants(const lidet_detector_q_cfg_t *cfg)
     TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_GATE2] <= st->n_gate2_rejected);
     TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_SIZE] <= st->n_size_rejected);
     TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_SCORE] <= st->n_score_rejected);
-    TEST_ASSERT_EQUAL_UINT32(st->n_gate1_rejected + st->n_gate2_rejected + st->n_size_rejected + st->n_score_rejected,
-                             counts[LIDET_DET_OUT_GATE1] + counts[LIDET_DET_OUT_GATE2] + counts[LIDET_DET_OUT_SIZE] +
-                                 counts[LIDET_DET_OUT_SCORE] + counts[LIDET_DET_OUT_GROUP]);
+    TEST_ASSERT_EQUAL_UINT32(
+        st->n_gate1_rejected + st->n_gate2_rejected + st->n_size_rejected + st->n_score_rejected,
+        counts[LIDET_DET_OUT_GATE1] + counts[LIDET_DET_OUT_GATE2] + counts[LIDET_DET_OUT_SIZE] +
+            counts[LIDET_DET_OUT_SCORE] + counts[LIDET_DET_OUT_GROUP]);
     TEST_ASSERT_EQUAL_UINT32(st->n_group_split, counts[LIDET_DET_OUT_GROUP]);
     TEST_ASSERT_TRUE(st->n_boxed + st->n_group_boxed <= cfg->max_boxes);
     TEST_ASSERT_TRUE(counts[LIDET_DET_OUT_NMS] <= st->n_nms_suppressed); /* a group keeps its outcome */
@@ -319,7 +332,8 @@ static void test_bad_points(void)
     TEST_ASSERT_TRUE(LIDET_SUCCEEDED(s));
     lidet_detector_q_detections(&g.ws, &n);
     TEST_ASSERT_EQUAL_UINT32(0u, n);
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_detector_q_run(&g.ws, bad, 10, 2, NULL, NULL)); /* stride < 3 */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG,
+                          lidet_detector_q_run(&g.ws, bad, 10, 2, NULL, NULL)); /* stride < 3 */
     CANARY_CHECK(g);
 }
 
@@ -409,7 +423,7 @@ static lidet_status_t stream(uint32_t n, const uint32_t *sizes, uint32_t n_sizes
 static void test_streamed_returns_equal_the_whole_scan(void)
 {
     static run_t whole, part;
-    static const uint32_t packets[] = {384u};                   /* a VLP-16 payload's returns */
+    static const uint32_t packets[] = {384u};                     /* a VLP-16 payload's returns */
     static const uint32_t odd[] = {1u, 0u, 7u, 1000u, 3u, 5000u}; /* empty and uneven chunks */
     lidet_detector_q_cfg_t cfg;
     uint32_t n = make_returns(), mode, i;
@@ -480,7 +494,8 @@ static void test_score(void)
     TEST_ASSERT_EQUAL_INT32(16384, lidet_detector_q_score(-5 * 65536, -5 * 65536));
     TEST_ASSERT_TRUE(lidet_detector_q_score(-9 * 65536, -5 * 65536) > 32000);
     TEST_ASSERT_TRUE(lidet_detector_q_score(-1 * 65536, -5 * 65536) < 700);
-    TEST_ASSERT_TRUE(lidet_detector_q_score(-6 * 65536, -5 * 65536) > lidet_detector_q_score(-4 * 65536, -5 * 65536));
+    TEST_ASSERT_TRUE(lidet_detector_q_score(-6 * 65536, -5 * 65536) >
+                     lidet_detector_q_score(-4 * 65536, -5 * 65536));
     TEST_ASSERT_EQUAL_INT32(0, lidet_detector_q_score(INT32_MAX, INT32_MIN));
     TEST_ASSERT_EQUAL_INT32(32768, lidet_detector_q_score(INT32_MIN, INT32_MAX));
 }

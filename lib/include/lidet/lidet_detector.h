@@ -110,6 +110,13 @@ typedef struct
                                    that variance) is a flat surface the ground stage kept (a raised pavement, a
                                    terrace, a verge), not a car: outcome LIDET_DET_OUT_SIZE. [0, 10]; 0 turns the
                                    test off; default 0.6 for > 16 beams, 0 for <= 16 (docs/DETECTOR.md, "Flat surfaces") */
+    float
+        car_ground_m; /**< a car box is stretched down to the ground pixels around it, its top kept: the median
+                             height of the ground pixels whose point lies within this of the box's footprint and
+                             within 1 m of its bottom (at least 5; lidet_detector_common.h LIDET_DET_GROUND_*), when
+                             the bottom lies 0-0.5 m above it (the ground stage takes a car's lowest returns for
+                             road). [0, 10]; 0 turns it off; default 1 for > 16 beams, 0 for <= 16
+                             (docs/DETECTOR.md, "Car boxes down to the ground") */
     float score_box_weight
         [LIDET_N_CLASSES]; /**< the detection score is 1 / (1 + e^-(m1 + w m2)), m1 = gamma1 - E1
                                                   and m2 = gamma2 - E2 the two gates' margins (the models' gammas),

@@ -18,6 +18,18 @@ extern "C" {
  *         car_min_z_spread_m): fewer are a far or partly hidden car, whose roof alone can be flat. */
 #define LIDET_DET_FLAT_MIN_POINTS 100u
 
+/** @brief The car boxes' ground (lidet_detector_cfg_t car_ground_m, lidet_detector_q_cfg_t car_ground_mm): a car
+ *         box is stretched down to the median height of the ground pixels around it when at least this many lie
+ *         within LIDET_DET_GROUND_WINDOW_MM of its bottom, the median taken in bins of LIDET_DET_GROUND_BIN_MM over
+ *         [bottom - window, bottom + window), and only when the box's bottom lies above it by less than
+ *         LIDET_DET_GROUND_MAX_LIFT_MM (docs/DETECTOR.md, "Car boxes down to the ground"). */
+#define LIDET_DET_GROUND_MIN_PIXELS 5u
+#define LIDET_DET_GROUND_WINDOW_MM 1000
+#define LIDET_DET_GROUND_BIN_MM 20
+#define LIDET_DET_GROUND_MAX_LIFT_MM 500
+/** @brief The histogram's bins (2 windows / bin) */
+#define LIDET_DET_GROUND_BINS (2 * LIDET_DET_GROUND_WINDOW_MM / LIDET_DET_GROUND_BIN_MM)
+
 /** @brief A timestamp source (e.g. a cycle counter or a monotonic clock); ticks in the caller's unit. */
 typedef uint32_t (*lidet_clock_fn)(void *ctx);
 

@@ -121,6 +121,11 @@ typedef struct
     int32_t car_min_z_spread_mm; /**< the float detector's car_min_z_spread_m in mm (the test in 4 mm steps:
                                       12 sum dz^2 < (this / 4)^2 n); [0, 10000]; 0: off; default 600 for > 16 rows, 0 for
                                       <= 16 */
+    int32_t car_ground_mm; /**< the float detector's car_ground_m in mm (the footprint test and the ground's
+                                median in integer steps: lidet_detector_common.h LIDET_DET_GROUND_*); [0, 10000];
+                                0: off; default 1000 for > 16 rows, 0 for <= 16. It reads the ground mask after the
+                                networks, which a build with LIDET_Q_PIXEL_XYZ 0 does not keep: there it must be 0
+                                (the default; LIDET_ERR_CONFIG otherwise) */
     int32_t
         score_box_weight_q16[LIDET_N_CLASSES]; /**< the float detector's score_box_weight in Q16: the score
                                                        is lidet_detector_q_score(E1 + round(w (E2 - gamma2)),

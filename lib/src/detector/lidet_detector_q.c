@@ -57,7 +57,8 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     cfg->min_score_q15[LIDET_CLASS_CYCLIST] = 0;
     cfg->min_score_q15[LIDET_CLASS_PEDESTRIAN] = 0;
     cfg->car_min_z_spread_mm = rows <= 16u ? 0 : 600;
-    cfg->score_box_weight_q16[LIDET_CLASS_CAR] = 32768; /* the float detector's 0.5 */
+    cfg->car_ground_mm = rows <= 16u || !LIDET_Q_PIXEL_XYZ ? 0 : 1000; /* the float detector's car_ground_m */
+    cfg->score_box_weight_q16[LIDET_CLASS_CAR] = 32768;                /* the float detector's 0.5 */
     cfg->score_box_weight_q16[LIDET_CLASS_CYCLIST] = 0;
     cfg->score_box_weight_q16[LIDET_CLASS_PEDESTRIAN] = 0;
     cfg->score_points_weight_q16[LIDET_CLASS_CAR] = 6554; /* the float detector's 0.1 */
@@ -83,7 +84,8 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
         c->gate1_margin_q16 > MARGIN_MAX_Q16 || c->gate2_margin_q16 < -MARGIN_MAX_Q16 ||
         c->gate2_margin_q16 > MARGIN_MAX_Q16 || c->range_only > 1u || c->group_split > 1u ||
         c->group_max_range_mm < 0 || c->group_max_range_mm > 1000000 || c->car_min_z_spread_mm < 0 ||
-        c->car_min_z_spread_mm > 10000 || (!LIDET_Q_PIXEL_XYZ && c->range_only == 0u))
+        c->car_min_z_spread_mm > 10000 || (!LIDET_Q_PIXEL_XYZ && c->range_only == 0u) ||
+        c->car_ground_mm < 0 || c->car_ground_mm > 10000 || (!LIDET_Q_PIXEL_XYZ && c->car_ground_mm != 0))
     {
         return 0;
     }
@@ -327,6 +329,120 @@ static int flat_surface(const lidet_detector_q_t *d, uint32_t ci)
     }
     return 192 * szz < t * t * (int64_t)r->n_points;
 }
+/* the image column of the azimuth of (x, y) (lidet_proj.h's rule, from the BAM32 atan2: floor((pi - az) / 2 pi
+ * n_cols)); the projection finds a point's column from its exact edges, which this may miss by one */
+static uint32_t column_q(int32_t x_mm, int32_t y_mm, uint32_t cols)
+{
+    const uint32_t a = 0x80000000u - (uint32_t)lidet__q_atan2(y_mm, x_mm);
+    return (uint32_t)(((uint64_t)a * cols) >> 32);
+}
+
+/* 1 when (dx, dy) mm from the box centre lies within the doubled half-extents L, W (Q30) in the box frame */
+static int in_footprint(int64_t c, int64_t s, int64_t dx, int64_t dy, int64_t L, int64_t W)
+{
+    const int64_t u2 = 2 * (c * dx + s * dy), v2 = 2 * (c * dy - s * dx);
+    return (u2 < 0 ? -u2 : u2) <= L && (v2 < 0 ? -v2 : v2) <= W;
+}
+
+/* The float detector's car_to_ground in integer steps (codegen/lidet_ref/detector_q.py ground_box, bit for bit):
+ * the footprint test on twice the box-frame coordinates against the doubled extents (Q30 cos, sin of the yaw), the
+ * heights in half-millimetres: a pixel's 2 z - (2 bottom - 2 window) in [0, 4 window) goes to bin t / (2 bin); the
+ * median's bin i gives g = bottom - window + (i + 1/2) bin, i.e. (window 1000, bin 20, lift < 500) a bottom
+ * lifted by 990 - 20 i mm for 25 <= i <= 49: h grows by it, cz goes down by half of it. Corner columns from the
+ * rounded corners; the histogram in the PointNets' scratch. Called with car_ground_mm > 0 only (DET_GROUND). */
+static void car_to_ground(lidet_detector_q_t *d, lidet_box_q_t *b)
+{
+    const int64_t r = d->cfg.car_ground_mm;
+    const lidet_range_image_t *img = &d->cluster.img;
+    const uint8_t *mask = ground_mask(d);
+    const uint32_t rows = img->n_rows, cols = img->n_cols;
+    const int64_t c = lidet__q_cos((uint32_t)b->yaw_bam), s = lidet__q_sin((uint32_t)b->yaw_bam);
+    const int64_t a2 = (int64_t)b->l_mm + 2 * r, w2 = (int64_t)b->w_mm + 2 * r;
+    const int64_t L = a2 * ((int64_t)1 << 30), W = w2 * ((int64_t)1 << 30);
+    const int64_t lo2 = 2 * (int64_t)b->cz_mm - b->h_mm - 2 * LIDET_DET_GROUND_WINDOW_MM;
+    int32_t *hist = d->pn_scratch;
+    uint32_t n = 0, k, i, col0, span, half, cum;
+    if (rows == 0u || cols == 0u)
+    {
+        return;
+    }
+    for (i = 0; i < (uint32_t)LIDET_DET_GROUND_BINS; ++i)
+    {
+        hist[i] = 0;
+    }
+    if (in_footprint(c, s, -(int64_t)b->cx_mm, -(int64_t)b->cy_mm, L, W))
+    {
+        col0 = 0u; /* the footprint holds the sensor: every column */
+        span = cols;
+    }
+    else
+    {
+        const int32_t cc = (int32_t)column_q(b->cx_mm, b->cy_mm, cols), half_cols = (int32_t)(cols / 2u);
+        int32_t omin = 0, omax = 0, first, last;
+        for (k = 0; k < 4u; ++k)
+        {
+            const int64_t a = (k & 1u) ? a2 : -a2, w = (k & 2u) ? w2 : -w2;
+            const int32_t x = (int32_t)(b->cx_mm + lidet__q_rshift_round(c * a - s * w, 31));
+            const int32_t y = (int32_t)(b->cy_mm + lidet__q_rshift_round(s * a + c * w, 31));
+            int32_t o = (int32_t)column_q(x, y, cols) - cc;
+            o = o > half_cols ? o - (int32_t)cols : (o < -half_cols ? o + (int32_t)cols : o);
+            omin = o < omin ? o : omin;
+            omax = o > omax ? o : omax;
+        }
+        first = cc + omin - 1;
+        last = cc + omax + 1;
+        span = (uint32_t)(last - first + 1);
+        span = span > cols ? cols : span;
+        col0 = (uint32_t)((first % (int32_t)cols + (int32_t)cols) % (int32_t)cols);
+    }
+    for (k = 0; k < span; ++k)
+    {
+        const uint32_t col = col0 + k < cols ? col0 + k : col0 + k - cols;
+        uint32_t row;
+        for (row = 0; row < rows; ++row)
+        {
+            const uint32_t p = row * cols + col;
+            int32_t v[3];
+            int64_t t;
+            if (!mask[p] || img->range_4mm[p] == 0u)
+            {
+                continue;
+            }
+            lidet__qpix_xyz(img, p, v);
+            t = 8 * (int64_t)v[2] - lo2;
+            if (t < 0 || t >= 4 * LIDET_DET_GROUND_WINDOW_MM ||
+                !in_footprint(c, s, 4 * (int64_t)v[0] - b->cx_mm, 4 * (int64_t)v[1] - b->cy_mm, L, W))
+            {
+                continue;
+            }
+            ++hist[t / (2 * LIDET_DET_GROUND_BIN_MM)];
+            ++n;
+        }
+    }
+    if (n < LIDET_DET_GROUND_MIN_PIXELS)
+    {
+        return;
+    }
+    half = (n + 1u) / 2u; /* the lower median */
+    for (i = 0, cum = 0; i < (uint32_t)LIDET_DET_GROUND_BINS; ++i)
+    {
+        cum += (uint32_t)hist[i];
+        if (cum >= half)
+        {
+            break;
+        }
+    }
+    {
+        /* lift = bottom - g = window - (i + 1/2) bin, in (0, max lift) */
+        const int32_t lift2 = 2 * LIDET_DET_GROUND_WINDOW_MM - (2 * (int32_t)i + 1) * LIDET_DET_GROUND_BIN_MM;
+        if (lift2 > 0 && lift2 < 2 * LIDET_DET_GROUND_MAX_LIFT_MM)
+        {
+            /* the bottom down by lift = 990 - 20 i mm (even), the top kept: the centre down by half of it */
+            b->h_mm += lift2 / 2;
+            b->cz_mm -= lift2 / 4;
+        }
+    }
+}
 #define DET_T lidet_detector_q_t
 #define DET_CLS_OUT_T lidet_pointnet_q_class_out_t
 #define DET_BOX_OUT_T lidet_pointnet_q_box_out_t
@@ -336,6 +452,7 @@ static int flat_surface(const lidet_detector_q_t *d, uint32_t ci)
 #define DET_BOX(d, cls, bo) lidet_pointnet_q_box(&(d)->box, &(d)->proposal, (cls), (bo))
 #define DET_SIZE_OK(d, cls, box) lidet_size_ok_q(&(d)->cfg.size, (cls), (box))
 #define DET_FLAT(d, ci) flat_surface((d), (ci))
+#define DET_GROUND(d, box) ((d)->cfg.car_ground_mm > 0 ? car_to_ground((d), (box)) : (void)0)
 #define DET_SCORE_OK(d, t) ((int32_t)(t)->score_q15 >= (d)->cfg.min_score_q15[(t)->cls])
 #define DET_GATE1_PASS(d, co)                                                                                \
     ((int64_t)(co)->energy_q16 < (int64_t)(d)->cls.model->gamma_q16[(co)->cls] + (d)->cfg.gate1_margin_q16 + \

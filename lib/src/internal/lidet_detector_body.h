@@ -22,6 +22,7 @@
  *   DET_BOX(d, cls, bo)   box it as class cls into *bo; a lidet_status_t
  *   DET_SIZE_OK(d, cls, box)  1 when the box's size is plausible for class cls
  *   DET_FLAT(d, ci)       1 when cluster ci is a flat surface (the cars' test, cfg car_min_z_spread_*)
+ *   DET_GROUND(d, box)    stretch car box *box down to the ground around it (cfg car_ground_*; a no-op when off)
  *   DET_SCORE_OK(d, t)    1 when detection *t (filled) scores at least its class's min_score
  *   DET_GATE1_PASS(d, co)  1 when the classifier's energy lies below the model's gamma of the class plus the
  *                         configured margins, gate1_margin and the class's gate1_class_margin (the output's own
@@ -227,6 +228,10 @@ static lidet_status_t det_candidates(DET_T *d, uint32_t n_cand, lidet_status_t *
             d->outcome[ci] = LIDET_DET_OUT_SCORE;
             ++d->stats.n_score_rejected;
             goto no_detection;
+        }
+        if (co.cls == LIDET_CLASS_CAR)
+        {
+            DET_GROUND(d, &t->box);
         }
         d->outcome[ci] = LIDET_DET_OUT_DETECTED;
         det_insert(d, worst);
