@@ -415,6 +415,7 @@ static void car_to_ground(lidet_detector_t *d, lidet_box_t *b)
     const float lo = bottom - 0.001f * (float)LIDET_DET_GROUND_WINDOW_MM;
     const float per_m = 1000.0f / (float)LIDET_DET_GROUND_BIN_MM;
     float *hist = d->pn_scratch; /* counts, exact in float up to 2^24 */
+    uint8_t *row_on = (uint8_t *)(void *)(d->pn_scratch + LIDET_DET_GROUND_BINS);
     uint32_t n = 0, k, col0, span, i, half;
     float g, cum;
     if (rows == 0u || cols == 0u)
@@ -454,17 +455,51 @@ static void car_to_ground(lidet_detector_t *d, lidet_box_t *b)
             }
         }
     }
-    for (k = 0; k < span; ++k)
+    /* the rows that can hold such a pixel (the same pixels, fewer looked at: 0.44 -> 0.13 ms a real KITTI scan with
+     * the columns): a point within the window and the footprint lies at an elevation between el_lo and el_hi (heights
+     * lo .. lo + 2 window, horizontal ranges dmin .. dmax of the widened footprint), and a pixel's point lies within
+     * the widest gap between two beams of its row's elevation */
+    if (img->row_elev_rad != 0)
     {
-        const uint32_t col = col0 + k < cols ? col0 + k : col0 + k - cols;
-        uint32_t row;
-        for (row = 0; row < rows; ++row)
+        const float hd = sqrtf(hl * hl + hw * hw), dc = sqrtf(b->cx_m * b->cx_m + b->cy_m * b->cy_m);
+        const float dmin = dc > hd ? dc - hd : 0.0f, dmax = dc + hd;
+        const float hi = lo + 0.002f * (float)LIDET_DET_GROUND_WINDOW_MM;
+        float gap = 0.0f, el_lo, el_hi;
+        for (i = 1; i < rows; ++i)
         {
-            const uint32_t p = row * cols + col;
+            const float de = fabsf(img->row_elev_rad[i - 1u] - img->row_elev_rad[i]);
+            gap = de > gap ? de : gap;
+        }
+        el_lo = atan2f(lo, lo < 0.0f ? dmin : dmax) - gap - 0.01f;
+        el_hi = atan2f(hi, hi < 0.0f ? dmax : dmin) + gap + 0.01f;
+        for (i = 0; i < rows; ++i)
+        {
+            row_on[i] = img->row_elev_rad[i] >= el_lo && img->row_elev_rad[i] <= el_hi;
+        }
+        row_on[0] = row_on[rows - 1u] =
+            1u; /* the edge rows also take the points beyond the outermost beams */
+    }
+    else
+    {
+        for (i = 0; i < rows; ++i)
+        {
+            row_on[i] = 1u;
+        }
+    }
+    /* row by row over the span's one or two runs of columns (it may wrap past the last column) */
+    for (k = 0; k < rows * 2u; ++k)
+    {
+        const uint32_t row = k >> 1, a = (k & 1u) ? 0u : col0;
+        const uint32_t e = !row_on[row] ? a
+                           : (k & 1u)   ? (col0 + span > cols ? col0 + span - cols : 0u)
+                                        : (col0 + span > cols ? cols : col0 + span);
+        uint32_t p;
+        for (p = row * cols + a; p < row * cols + e; ++p)
+        {
             float x, y, z, u, v, t;
             if (!mask[p] || !(lidet__img_range_c(img, p, compact) > 0.0f))
             {
-                continue;
+                continue; /* most of a span's pixels: not ground */
             }
             lidet__img_xyz(img, p, compact, &x, &y, &z);
             x -= b->cx_m;

@@ -395,13 +395,16 @@ static void car_to_ground(lidet_detector_q_t *d, lidet_box_q_t *b)
         span = span > cols ? cols : span;
         col0 = (uint32_t)((first % (int32_t)cols + (int32_t)cols) % (int32_t)cols);
     }
-    for (k = 0; k < span; ++k)
+    /* row by row over the span's one or two runs of columns (it may wrap past the last column); the counts do not
+     * depend on the order */
+    for (k = 0; k < rows * 2u; ++k)
     {
-        const uint32_t col = col0 + k < cols ? col0 + k : col0 + k - cols;
-        uint32_t row;
-        for (row = 0; row < rows; ++row)
+        const uint32_t row = k >> 1, a = (k & 1u) ? 0u : col0;
+        const uint32_t e = (k & 1u) ? (col0 + span > cols ? col0 + span - cols : 0u)
+                                    : (col0 + span > cols ? cols : col0 + span);
+        uint32_t p;
+        for (p = row * cols + a; p < row * cols + e; ++p)
         {
-            const uint32_t p = row * cols + col;
             int32_t v[3];
             int64_t t;
             if (!mask[p] || img->range_4mm[p] == 0u)
