@@ -402,7 +402,11 @@ static float column_of(float x, float y, float n_cols)
  * the columns the expanded footprint's corners span, one more each side (a pixel's column is its point's
  * azimuth's), every row; all columns when the footprint holds the sensor. The histogram (float counts) lives in the
  * PointNets' scratch, idle between a box and the next proposal. Called with car_ground_m > 0 only (DET_GROUND). */
-static void car_to_ground(lidet_detector_t *d, lidet_box_t *b)
+#if defined(__GNUC__)
+__attribute__((noinline)) /* out of the candidates loop's frame (the 16-beam images never call it) */
+#endif
+static void
+car_to_ground(lidet_detector_t *d, lidet_box_t *b)
 {
     const float r = d->cfg.car_ground_m;
     const lidet_range_image_t *img = &d->ws.cluster.img;

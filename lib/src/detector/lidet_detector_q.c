@@ -350,7 +350,11 @@ static int in_footprint(int64_t c, int64_t s, int64_t dx, int64_t dy, int64_t L,
  * median's bin i gives g = bottom - window + (i + 1/2) bin, i.e. (window 1000, bin 20, lift < 500) a bottom
  * lifted by 990 - 20 i mm for 25 <= i <= 49: h grows by it, cz goes down by half of it. Corner columns from the
  * rounded corners; the histogram in the PointNets' scratch. Called with car_ground_mm > 0 only (DET_GROUND). */
-static void car_to_ground(lidet_detector_q_t *d, lidet_box_q_t *b)
+#if defined(__GNUC__)
+__attribute__((noinline)) /* out of the candidates loop's frame (the 16-beam images never call it) */
+#endif
+static void
+car_to_ground(lidet_detector_q_t *d, lidet_box_q_t *b)
 {
     const int64_t r = d->cfg.car_ground_mm;
     const lidet_range_image_t *img = &d->cluster.img;
