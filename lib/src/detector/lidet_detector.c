@@ -400,8 +400,9 @@ static float column_of(float x, float y, float n_cols)
  * of its bottom, counted in bins; at least LIDET_DET_GROUND_MIN_PIXELS of them give the median's bin, whose centre
  * is the ground height g; a bottom 0 < bottom - g < max lift goes down to g, the top kept. The pixels looked at:
  * the columns the expanded footprint's corners span, one more each side (a pixel's column is its point's
- * azimuth's), every row; all columns when the footprint holds the sensor. The histogram (float counts) lives in the
- * PointNets' scratch, idle between a box and the next proposal. Called with car_ground_m > 0 only (DET_GROUND). */
+ * azimuth's; all columns when the footprint holds the sensor), in the rows whose elevation can hold such a pixel.
+ * The histogram (float counts) and the rows' flags live in the PointNets' scratch, idle between a box and the next
+ * proposal. Called with car_ground_m > 0 only (DET_GROUND). */
 #if defined(__GNUC__)
 __attribute__((noinline)) /* out of the candidates loop's frame (the 16-beam images never call it) */
 #endif
@@ -480,8 +481,8 @@ car_to_ground(lidet_detector_t *d, lidet_box_t *b)
         {
             row_on[i] = img->row_elev_rad[i] >= el_lo && img->row_elev_rad[i] <= el_hi;
         }
-        row_on[0] = row_on[rows - 1u] =
-            1u; /* the edge rows also take the points beyond the outermost beams */
+        /* the edge rows also take the points beyond the outermost beams */
+        row_on[0] = row_on[rows - 1u] = 1u;
     }
     else
     {
