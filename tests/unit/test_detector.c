@@ -124,6 +124,56 @@ void tearDown(void)
     CANARY_CHECK(g);
 }
 
+/* the car boxes' ground (car_ground_m) where its column span is special: a car 2.6 m ahead, whose widened footprint
+ * holds the sensor (every column looked at), and one straight behind, whose span crosses the image's seam (two runs of
+ * columns): both bottoms go down to the ground plane, the tops kept */
+void test_car_boxes_go_down_to_the_ground_near_and_behind(void)
+{
+    const lidet_detection_t *d;
+    const lidet_cluster_rec_t *recs;
+    uint32_t n = 0, k, i;
+    scene();
+    g_n = 60000u; /* the ground alone */
+    face(2.6f, 0.0f, 1.8f, 1.5f, 6000);
+    face(-20.0f, 0.3f, 1.8f, 1.5f, 6000);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    d = lidet_detector_detections(&g.ws, &n);
+    recs = lidet_workspace_clusters(lidet_detector_workspace(&g.ws), NULL);
+    TEST_ASSERT_EQUAL_UINT32(2, n);
+    for (k = 0; k < n; ++k)
+    {
+        const lidet_cluster_rec_t *r = &recs[d[k].cluster_id - 1u];
+        const float hl = 0.5f * d[k].box.l_m + cfg.car_ground_m,
+                    dc = sqrtf(r->mean_m[0] * r->mean_m[0] + r->mean_m[1] * r->mean_m[1]);
+        TEST_ASSERT_EQUAL_UINT8(LIDET_CLASS_CAR, d[k].cls);
+        TEST_ASSERT_TRUE(r->mean_m[0] > 0.0f ? dc < hl
+                                             : fabsf(r->mean_m[1]) < 1.0f); /* the two cases above */
+        TEST_ASSERT_CLOSE(r->mean_m[2] + 0.763f, d[k].box.cz_m + 0.5f * d[k].box.h_m, 1e-4, 0);
+        TEST_ASSERT_CLOSE(-1.73f, d[k].box.cz_m - 0.5f * d[k].box.h_m, 0.0101, 0);
+    }
+    /* without the ground around them (none within 1 m of either footprint): the boxes as the net gave them */
+    for (i = 0; i < 60000u; ++i)
+    {
+        const float x = g_pts[4 * i], y = g_pts[4 * i + 1];
+        if ((fabsf(x - 2.6f) < 4.0f && fabsf(y) < 3.0f) || (fabsf(x + 20.0f) < 4.0f && fabsf(y) < 3.0f))
+        {
+            g_pts[4 * i + 2] = 5.0f; /* lifted far out of the window (and out of the ground) */
+        }
+    }
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+    d = lidet_detector_detections(&g.ws, &n);
+    recs = lidet_workspace_clusters(lidet_detector_workspace(&g.ws), NULL);
+    TEST_ASSERT_TRUE(n >= 2u);
+    for (k = 0; k < n; ++k)
+    {
+        if (d[k].box.cz_m < 2.0f) /* the two faces (the lifted points make clusters of their own, high up) */
+        {
+            TEST_ASSERT_CLOSE(1.526, d[k].box.h_m, 1e-5, 0);
+        }
+    }
+}
+
 /* a cluster taller than max_height_extent_m (a 3.5 m pole beside the three objects) is not classified */
 void test_tall_clusters_are_not_classified(void)
 {
@@ -684,6 +734,7 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_three_objects_three_cars);
+    RUN_TEST(test_car_boxes_go_down_to_the_ground_near_and_behind);
     RUN_TEST(test_tall_clusters_are_not_classified);
     RUN_TEST(test_crop_budget_range_and_gates);
     RUN_TEST(test_nms_drops_overlapping_boxes);
