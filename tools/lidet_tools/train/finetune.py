@@ -565,21 +565,24 @@ def _margins(model, tr, ok_id, ok_ood, is_box, a):
     return e_id, max(e_ood, e_id + a.min_gap), e_id, e_ood
 
 
-def gate_ood(model, kind: str, d: dict) -> tuple[np.ndarray, np.ndarray]:
-    """(energy, class) of the OOD rows of d as the gate judges them: the classifier's energy and predicted class; the
-    box net's energy with the one-hot of a class drawn as metrics.eval_box draws it (the same draw for any model)."""
+def gate_energies(model, kind: str, d: dict) -> dict:
+    """The gate's (energy, class) on the rows of d, from one pass of the model: 'id' the ID rows (the classifier's
+    predicted class; the box net's true class, rows with a box target), 'ood' the OOD rows (the classifier's predicted
+    class; the box net's one-hot of a class drawn as metrics.eval_box draws it, the same draw for any model)."""
     if kind == "classifier":
-        lg = MX.cls_logits(model, sub(d, d["label"] < 0))
-        return MX.energy_np(lg), lg.argmax(1)
-    r = MX.eval_box(model, d)
-    return r["energies"]["ood"], r["energies"]["ood_cls"]
+        lg = MX.cls_logits(model, d)
+        e, c, idm = MX.energy_np(lg), lg.argmax(1), d["label"] >= 0
+        return {"id": (e[idm], c[idm]), "ood": (e[~idm], c[~idm])}
+    r = MX.eval_box(model, d)["energies"]
+    return {"id": (r["id"], r["id_cls"]), "ood": (r["ood"], r["ood_cls"])}
 
 
 def gammas_at_ood(new: tuple, old: tuple, gamma_old: list, fallback: list) -> list:
     """gamma per class that lets through as many of the OOD rows as that class (E < gamma) as the shipped gate did:
     with n the shipped gate's count (old energies below gamma_old), the new model's (n + 1)-th smallest energy of the
-    class (as float32, rounded down), which the strict test E < gamma leaves out. `fallback` (the TPR gammas) for a class of which the shipped gate let every row through or the new model
-    predicts none. new, old: gate_ood of the fine-tuned and the shipped model on the same rows."""
+    class (as float32, rounded down), which the strict test E < gamma leaves out. `fallback` (the TPR gammas) for a
+    class of which the shipped gate let every row through or the new model predicts none. new, old: gate_energies'
+    'ood' of the fine-tuned and the shipped model on the same rows."""
     (e_new, c_new), (e_old, c_old) = new, old
     out = []
     for c in range(M.N_CLASSES):
@@ -606,15 +609,10 @@ def set_onnx_gamma(path, gamma: list) -> None:
     onnx.save(m, str(path))
 
 
-def gammas(model, kind: str, va: dict) -> list:
-    """gamma per class, as the trainers: 95 % of the validation ID proposals (the classifier's predicted class; the
-    box net's true class) kept; pooled for a class with fewer than 20."""
-    if kind == "classifier":
-        lg = MX.cls_logits(model, va)
-        idm = va["label"] >= 0
-        return C.per_class_gamma(MX.energy_np(lg)[idm], lg.argmax(1)[idm])
-    r = MX.eval_box(model, va)
-    return C.per_class_gamma(r["energies"]["id"], r["energies"]["id_cls"])
+def gammas(energies: dict) -> list:
+    """gamma per class, as the trainers: 95 % of the validation ID proposals (gate_energies' 'id': the classifier's
+    predicted class; the box net's true class) kept; pooled for a class with fewer than 20."""
+    return C.per_class_gamma(*energies["id"])
 
 
 # ---- the command --------------------------------------------------------------------------------------------------
@@ -770,16 +768,16 @@ def finetune(a) -> dict:
     lam = {"cls": _arg_value(spec["cls"], "--lam", 0.1), "box": _arg_value(spec["box"], "--lam", 0.1)}
     kinds = {"cls": "classifier", "box": "box"}
     # the shipped gates on the validation OOD proposals (--gamma ood holds the fine-tuned ones to their counts)
-    ood_shipped = {k: gate_ood(models[k][0], kinds[k], va_all) for k in kinds}
+    ood_shipped = {k: gate_energies(models[k][0], kinds[k], va_all)["ood"] for k in kinds}
     records, gamma, gamma_tpr = {}, {}, {}
     for k, kind in kinds.items():
         t = time.perf_counter()
         _log(f"{k}: {a.epochs} + {a.epochs_energy} epochs")
         records[k] = finetune_net(kind, models[k][0], tr, vals, a, lam[k])
-        gamma[k] = gamma_tpr[k] = gammas(models[k][0], kind, va_all)
+        g = gate_energies(models[k][0], kind, va_all)
+        gamma[k] = gamma_tpr[k] = gammas(g)
         if a.gamma == "ood":
-            gamma[k] = gammas_at_ood(gate_ood(models[k][0], kind, va_all), ood_shipped[k], shipped_gamma[k],
-                                     gamma_tpr[k])
+            gamma[k] = gammas_at_ood(g["ood"], ood_shipped[k], shipped_gamma[k], gamma_tpr[k])
         _log(f"{k}: gamma {', '.join(f'{g:.3f}' for g in gamma[k])} (--gamma {a.gamma}; 95 % TPR: "
              f"{', '.join(f'{g:.3f}' for g in gamma_tpr[k])}; shipped: {', '.join(f'{g:.3f}' for g in shipped_gamma[k])})")
         timings[f"{k} training"] = time.perf_counter() - t
@@ -811,8 +809,8 @@ def finetune(a) -> dict:
         models["cls"] = (m, "classifier", meta)
         gamma["cls"] = gamma_tpr["cls"] = [float(v) for v in meta["lidet.gamma"].split(",")]
         if a.gamma == "ood":
-            gamma["cls"] = gammas_at_ood(gate_ood(m, "classifier", va_all), ood_shipped["cls"], shipped_gamma["cls"],
-                                         gamma_tpr["cls"])
+            gamma["cls"] = gammas_at_ood(gate_energies(m, "classifier", va_all)["ood"], ood_shipped["cls"],
+                                         shipped_gamma["cls"], gamma_tpr["cls"])
             set_onnx_gamma(out["cls"], gamma["cls"])
 
     # 5. the other families, int8 calibration on the user's scans, every C model
