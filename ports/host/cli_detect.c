@@ -472,6 +472,7 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, group_max_range_m)
     CLI_SET_FLOAT(c, kv, klen, v, car_min_z_spread_m)
     CLI_SET_FLOAT(c, kv, klen, v, car_ground_m)
+    CLI_SET_INT(c, kv, klen, v, proposal.seed, uint32_t, 4294967295.0)
     {
         /* score_box_weight.CLASS / score_points_weight.CLASS / gate2.CLASS, in lidet_class_t order */
         static const char *const names[LIDET_N_CLASSES] = {"score_box_weight.car", "score_box_weight.cyclist",
@@ -628,7 +629,9 @@ void cli_det_usage(FILE *f)
            "                   pixels flatter than this in z is a surface; 0: off; default 0.6\n"
            "                   for > 16 beams, 0 for <= 16), car_ground_m (car boxes stretched\n"
            "                   down to the ground pixels within this of the footprint; 0: off;\n"
-           "                   default 1 for > 16 beams, 0 for <= 16),\n"
+           "                   default 1 for > 16 beams, 0 for <= 16), proposal.seed (the\n"
+           "                   resampling's seed, default 0x5EED1234 = 1592594996: another draw of\n"
+           "                   64 points from each cluster; --fixed takes it too),\n"
            "                   score_box_weight.car|cyclist|pedestrian (the score's weight on gate 2's\n"
            "                   margin), score_points_weight.CLASS (on ln(points / 64));\n"
            "                   stages.cluster.KEY: a\n"

@@ -128,6 +128,25 @@ def test_set_refuses_nan_and_inf(cli):
     assert r.returncode == 1 and "bad --set" in r.stderr
 
 
+def test_set_proposal_seed(cli):
+    """--set proposal.seed draws each cluster's 64 points with another seed (both detectors): the default seed
+    written out gives the default's results, another seed other energies on the same clusters, and values outside
+    uint32 are refused."""
+    for fixed in ([], ["--fixed"]):
+        base = _run(cli, SCAN, "--sensor", "hdl64", "--json", *fixed).stdout
+        same = _run(cli, SCAN, "--sensor", "hdl64", "--json", *fixed, "--set", "proposal.seed=1592594996").stdout
+        other = json.loads(_run(cli, SCAN, "--sensor", "hdl64", "--json", *fixed, "--set", "proposal.seed=1").stdout)
+        def results(js):  # the timings aside
+            return {k: v for k, v in json.loads(js).items() if not k.endswith("_ms")}
+        assert results(same) == results(base), fixed
+        b = {d["cluster"]: d["energy_cls"] for d in json.loads(base)["boxes"]}
+        o = {d["cluster"]: d["energy_cls"] for d in other["boxes"]}
+        assert any(o[k] != b[k] for k in b.keys() & o.keys()), fixed  # another draw of the same clusters
+    for bad in ("proposal.seed=-1", "proposal.seed=4294967296", "proposal.seed=1.5"):
+        r = _run(cli, SCAN, "--sensor", "hdl64", "--set", bad, ok=False)
+        assert r.returncode == 1 and "bad --set" in r.stderr, bad
+
+
 def test_project_out_covers_every_point_past_capacity(cli, tmp_path):
     from lidet_tools import native
     cap = native.capacity()["max_points"]
