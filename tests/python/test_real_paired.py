@@ -75,6 +75,44 @@ def test_the_draws_are_reproducible_and_paired(tmp_path):
     assert c3["interval90"] == [-c1["interval90"][1], -c1["interval90"][0]]
 
 
+def _seed_dir(path, runs):
+    """eval_real --seeds' layout: {seed: frames} -> path/seed_<S>/report.json"""
+    for sd, frames in runs.items():
+        (path / f"seed_{sd}").mkdir(parents=True)
+        _report(path / f"seed_{sd}" / "report.json", frames)
+    return path
+
+
+def test_seed_folders_compare_draw_by_draw(tmp_path, capsys):
+    """Two folders of eval_real --seeds: per seed the difference, found and false positives the mean over the
+    seeds, the bootstrap over frames on those means, and how many seeds gain and lose."""
+    a = _seed_dir(tmp_path / "a", {"1592594996": _ten(), "1": _ten(), "2": _ten()})
+    b = _seed_dir(tmp_path / "b", {"1592594996": _ten(found_extra=1, on=10), "1": _ten(),
+                                   "2": _ten(found_extra=-1, on=4, fp_extra=3)})
+    res = paired.compare_runs(paired.load_runs(a), paired.load_runs(b), boot=500)
+    car = res["classes"]["Car"]
+    assert res["seeds"] == ["1", "2", "1592594996"]
+    assert car["per_seed"] == [0, -4, 10] and (car["seeds_gain"], car["seeds_loss"]) == (1, 1)
+    assert car["found_base"] == pytest.approx(30.0) and car["found_new"] == pytest.approx(32.0)
+    assert car["diff"] == pytest.approx(2.0) and car["interval90"][0] <= 2.0 <= car["interval90"][1]
+    fp = res["fp_per_frame"]
+    assert fp["per_seed"] == [0.0, pytest.approx(1.2), 0.0] and (fp["seeds_gain"], fp["seeds_loss"]) == (0, 1)
+    assert fp["diff"] == pytest.approx(0.4)
+    assert paired.main([str(a), str(b), "--boot", "200"]) == 0
+    out = capsys.readouterr().out
+    assert "3 draws" in out and "| Car | 50 | 30.0 | 32.0 | +2.0 |" in out and "+0, -4, +10 |" in out
+    # one report.json each is the single comparison; different seeds are refused
+    single = paired.compare_runs(paired.load_runs(a / "seed_1" / "report.json"),
+                                 paired.load_runs(b / "seed_1" / "report.json"), boot=100)
+    assert "seeds" not in single and single["classes"]["Car"]["diff"] == 0
+    c = _seed_dir(tmp_path / "c", {"1592594996": _ten(), "7": _ten()})
+    assert paired.main([str(a), str(c)]) == 2
+    assert "different seeds" in capsys.readouterr().err
+    (tmp_path / "empty").mkdir()
+    assert paired.main([str(a), str(tmp_path / "empty")]) == 2
+    assert "seed_*/report.json" in capsys.readouterr().err
+
+
 def test_errors(tmp_path, capsys):
     a = _report(tmp_path / "a.json", _ten())
     other = _report(tmp_path / "o.json", _ten()[:9] + [("pandaset", "000000", {"Car": [5, 3, 4, 3]})])

@@ -28,6 +28,13 @@ source's sensor preset and mount height; `--fixed`: the integer detector, `nativ
 * a BEV picture per frame (ground truth green, detections by class, ignore regions grey) in OUT/pictures/.
 
 Writes OUT/report.md and OUT/report.json and prints the report. Exit status 0; 2 when the folder is missing.
+
+`--seeds K` runs the evaluation K times, each with another draw of the proposals' points (`--set proposal.seed=S`:
+the default seed 0x5EED1234, then 1 .. K - 1), into OUT/seed_<S>/ (pictures of the first only), and writes
+OUT/seeds.md and OUT/seeds.json: per seed the headline figures (all sources) with their mean, minimum and maximum.
+On the 16 training frames the draw alone moves cars found by +-2, pedestrians by up to 4 and the false positives by
+0.4 per frame (docs/EVALUATION.md, section 4): compare settings over several seeds (`lidet_tools.real.paired`
+takes two such folders).
 """
 from __future__ import annotations
 
@@ -451,6 +458,63 @@ def add_frame_args(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--split", default=str(SPLIT), help="the split file (default: the repository's)")
 
 
+#: the resampling seeds of `--seeds K`: the detectors' default (lidet_proposal_cfg_t.seed), then 1, 2, ...
+DEFAULT_PROPOSAL_SEED = 0x5EED1234
+
+
+def seed_list(k: int) -> list[int]:
+    """The first k seeds of `--seeds`: the default seed, then 1 .. k - 1."""
+    return [DEFAULT_PROPOSAL_SEED] + list(range(1, k))
+
+
+def _headline(sm: dict) -> dict:
+    """The headline figures of seeds.md from a report's summary (its 'all' entry): per range the objects found per
+    class, false positives per frame, and the car and pedestrian AP R40 (3D at KITTI's overlaps, BEV loose). A
+    summary of one source has no 'all' entry: that source's."""
+    a = sm["all"] if "all" in sm else next(iter(sm.values()))
+    cl, ap3, loose = a["classes"], a["ap"]["kitti"], a["ap"]["loose"]
+    out = {}
+    for rng in ("20", "40"):
+        for c in CLASSES:
+            out[f"{c} found {rng} m"] = cl[c][rng]["found"]
+        out[f"FP/frame {rng} m"] = a["fp_per_frame"][rng]
+        out[f"car AP3D {rng} m"] = ap3["Car"]["3d"][f"{rng} m"]
+        out[f"car AP BEV loose {rng} m"] = loose["Car"]["bev"][f"{rng} m"]
+        out[f"ped AP3D {rng} m"] = ap3["Pedestrian"]["3d"][f"{rng} m"]
+        out[f"ped AP BEV loose {rng} m"] = loose["Pedestrian"]["bev"][f"{rng} m"]
+    return out
+
+
+def seeds_report(rows: dict, meta: dict) -> tuple[str, dict]:
+    """seeds.md text and seeds.json dict from {seed: headline dict} (_headline) of the same frames."""
+    seeds = list(rows)
+    keys = list(rows[seeds[0]])
+    objs = meta.get("objects", {})
+    stats = {}
+    for k in keys:
+        v = [rows[s][k] for s in seeds if rows[s][k] is not None]
+        stats[k] = None if not v else {"mean": float(np.mean(v)), "min": float(np.min(v)), "max": float(np.max(v))}
+    L = [f"Real labelled frames, side `{meta['side']}`, detector: {meta['detector']}; {len(seeds)} draws of the "
+         "proposals' points (`--set proposal.seed=S`). Command: `" + meta["command"] + "`.", "",
+         "| figure | " + " | ".join("default" if s == DEFAULT_PROPOSAL_SEED else f"seed {s}" for s in seeds) +
+         " | mean | min - max |",
+         "|---|" + "---:|" * (len(seeds) + 2)]
+
+    def fmt(k, v):
+        if v is None:
+            return "-"
+        return f"{v:.0f}" if " found " in k else f"{v:.2f}" if k.startswith("FP") else f"{v:.1f}"
+    for k in keys:
+        st = stats[k]
+        name = k + (f" (of {objs[k]})" if k in objs else "")
+        cells = [fmt(k, rows[s][k]) for s in seeds]
+        mean = None if st is None else f"{st['mean']:.2f}" if k.startswith("FP") else f"{st['mean']:.1f}"
+        tail = ["-", "-"] if st is None else [mean, f"{fmt(k, st['min'])} - {fmt(k, st['max'])}"]
+        L.append(f"| {name} | " + " | ".join(cells + tail) + " |")
+    return "\n".join(L) + "\n", {"meta": meta, "seeds": seeds, "per_seed": {str(s): rows[s] for s in seeds},
+                                  "stats": stats}
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m lidet_tools.eval_real", description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -471,9 +535,19 @@ def main(argv=None) -> int:
                     help="feed the detector each scan rounded to whole millimetres, the input the integer detector "
                          "takes (`--fixed` rounds it so anyway): a float run on it tells the integer arithmetic's "
                          "effect apart from the input's rounding")
+    ap.add_argument("--seeds", type=int, default=1, metavar="K",
+                    help="K draws of the proposals' points (the default seed, then 1 .. K - 1) into OUT/seed_<S>/, "
+                         "and OUT/seeds.md with each seed's headline figures, their mean and range (default 1: one "
+                         "run with the detector's own seed)")
     ap.add_argument("--no-pictures", action="store_true")
     ap.add_argument("--json", action="store_true", help="print report.json instead of the tables")
     a = ap.parse_args(argv)
+    if a.seeds < 1 or a.seeds > 64:
+        ap.error(f"--seeds must be in [1, 64], got {a.seeds}")
+    if a.seeds > 1:
+        if any(kv.split("=", 1)[0].strip() == "proposal.seed" for kv in a.set):
+            ap.error("--seeds sets proposal.seed itself: leave --set proposal.seed out")
+        return _main_seeds(a, argv)
     from . import real
     from .real import thin
     if a.as_sensor:
@@ -540,6 +614,50 @@ def main(argv=None) -> int:
                   "ms": r.ms, "lost": r.lost, "counts": frame_counts(r)} for r in results]
     (out / "report.json").write_text(json.dumps({"meta": meta, "summary": summary, "frames": per_frame}, indent=1, default=_json_num))
     print(json.dumps(summary, indent=1, default=_json_num) if a.json else text)
+    return 0
+
+
+def _main_seeds(a, argv) -> int:
+    """`--seeds K`: main once per seed into OUT/seed_<S>/, then OUT/seeds.md and seeds.json."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    # drop --seeds K / --seeds=K, --out DIR / --out=DIR and --json from the arguments passed on
+    rest, i = [], 0
+    while i < len(argv):
+        t = argv[i]
+        if t in ("--seeds", "--out"):
+            i += 2
+            continue
+        if t.startswith("--seeds=") or t.startswith("--out=") or t == "--json":
+            i += 1
+            continue
+        rest.append(t)
+        i += 1
+    out = pathlib.Path(a.out)
+    rows, meta = {}, None
+    for j, sd in enumerate(seed_list(a.seeds)):
+        sub = out / f"seed_{sd}"
+        extra = ["--set", f"proposal.seed={sd}", "--out", str(sub)] + ([] if j == 0 else ["--no-pictures"])
+        import contextlib
+        import io
+        buf = io.StringIO()
+        with contextlib.redirect_stdout(buf):
+            rc = main(rest + extra)
+        if rc != 0:
+            return rc
+        rep = json.loads((sub / "report.json").read_text())
+        rows[sd] = _headline(rep["summary"])
+        if meta is None:
+            sm = rep["summary"]
+            cl = (sm["all"] if "all" in sm else next(iter(sm.values())))["classes"]
+            meta = dict(rep["meta"])
+            meta["command"] = meta["command"].split(" --set proposal.seed=")[0] + f" --seeds {a.seeds}" + \
+                "".join(f" --set {kv}" for kv in a.set if f" --set {kv}" not in meta["command"])
+            meta["detector"] = meta["detector"].split(", proposal.seed=")[0]
+            meta["objects"] = {f"{c} found {r} m": cl[c][r]["objects"] for c in CLASSES for r in ("20", "40")}
+    text, js = seeds_report(rows, meta)
+    (out / "seeds.md").write_text(text)
+    (out / "seeds.json").write_text(json.dumps(js, indent=1, default=_json_num))
+    print(json.dumps(js, indent=1, default=_json_num) if a.json else text)
     return 0
 
 

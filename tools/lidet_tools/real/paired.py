@@ -4,6 +4,7 @@ frames more than which frames happen to be there?
 
     python -m lidet_tools.real.paired BASE/report.json NEW/report.json [--range 40] [--boot 10000] [--seed 0]
         [--json]
+    python -m lidet_tools.real.paired BASE_DIR NEW_DIR ...    # folders of eval_real --seeds K
 
 Both reports must hold the same frames (the same side and sources of split.txt) and each frame's tallies at the
 loose overlaps (`counts` in report.json, written by eval_real since the paired comparison exists). Per class: the
@@ -14,6 +15,12 @@ of the differences form the 90 % interval, and `P(gain)` is the share of draws i
 (more found, fewer false positives) minus the share in which it does worse. Frames are the unit because objects of
 one frame share its scene, sensor and clutter: on the 16 training frames a change that finds 2 more of 113 cars,
 both on one frame, has an interval from 0 to 2 and says nothing about the next street.
+
+Folders of `eval_real --seeds K` (OUT/seed_<S>/report.json) compare draw by draw: both must hold the same seeds.
+Each frame's tallies are then the mean over the seeds (the bootstrap over frames as above, on those means), and
+`seeds +/-` counts the seeds whose draw gains and loses (the same seed on both sides: the same draw of every
+cluster the two runs share). The draw alone moves the figures of 16 frames by a few objects (docs/EVALUATION.md,
+section 4); a change that gains on every seed is worth a look, one that gains on the default seed alone is not.
 
 Exit status 0; 2 with a message for a missing or unreadable report, different frames, or a report without
 per-frame tallies (made before them: run eval_real again).
@@ -104,6 +111,96 @@ def compare(base: dict, new: dict, rng: str = "40", boot: int = 10000, seed: int
     return res
 
 
+def load_runs(path) -> dict:
+    """A report.json, or a folder of `eval_real --seeds` (seed_<S>/report.json): {seed name: load(report)} ('' for
+    a single report)."""
+    p = pathlib.Path(path)
+    if p.is_dir():
+        reps = sorted(p.glob("seed_*/report.json"))
+        if not reps:
+            if (p / "report.json").exists():
+                return {"": load(p / "report.json")}
+            raise PairedError(f"{p}: neither seed_*/report.json (eval_real --seeds) nor report.json inside")
+        return {r.parent.name[len("seed_"):]: load(r) for r in reps}
+    return {"": load(p)}
+
+
+def compare_runs(base: dict, new: dict, rng: str = "40", boot: int = 10000, seed: int = 0) -> dict:
+    """compare() over the draws of two load_runs() results with the same seeds: found and false positives per frame
+    the mean over the seeds, the bootstrap over frames on those means, and per seed the difference. One run each
+    (two report.json files): compare() itself."""
+    if set(base) != set(new):
+        raise PairedError(f"the two runs hold different seeds: {sorted(base)} against {sorted(new)}")
+    seeds = sorted(base, key=lambda x: (len(x), x))
+    if len(seeds) == 1:
+        return compare(base[seeds[0]], new[seeds[0]], rng, boot, seed)
+    per = {sd: compare(base[sd], new[sd], rng, 1, seed) for sd in seeds}  # per seed: the same checks, its sums
+    if boot < 1:
+        raise PairedError(f"--boot must be at least 1, got {boot}")
+    keys = list(base[seeds[0]])
+    for sd in seeds:
+        if set(base[sd]) != set(keys) or set(new[sd]) != set(keys):
+            raise PairedError(f"seed {sd}: other frames than seed {seeds[0]}'s")
+    tb = [tallies({k: base[sd][k] for k in keys}, rng) for sd in seeds]
+    tn = [tallies({k: new[sd][k] for k in keys}, rng) for sd in seeds]
+    obj = tb[0][1]
+    found_b = np.mean([t[2] for t in tb], axis=0)
+    found_n = np.mean([t[2] for t in tn], axis=0)
+    fp_b = np.mean([t[3] for t in tb], axis=0)
+    fp_n = np.mean([t[3] for t in tn], axis=0)
+    n = len(keys)
+    draws = np.random.default_rng(seed).integers(0, n, size=(boot, n))
+    d_found = (found_n - found_b)[draws].sum(axis=1)
+    d_fp = (fp_n - fp_b)[draws].sum(axis=1) / n
+
+    def interval(v):
+        lo, hi = np.percentile(v, [5.0, 95.0])
+        return [float(lo), float(hi)]
+
+    res = {"range_m": float(rng), "frames": n, "boot": boot, "seed": seed, "seeds": seeds, "classes": {}}
+    for j, c in enumerate(CLASSES):
+        v = d_found[:, j]
+        ds = [per[sd]["classes"][c]["diff"] for sd in seeds]
+        res["classes"][c] = {
+            "objects": int(obj[:, j].sum()), "found_base": float(found_b[:, j].sum()),
+            "found_new": float(found_n[:, j].sum()), "diff": float((found_n - found_b)[:, j].sum()),
+            "interval90": interval(v), "p_gain": float((v > 0).mean() - (v < 0).mean()),
+            "per_seed": ds, "seeds_gain": int(sum(x > 0 for x in ds)), "seeds_loss": int(sum(x < 0 for x in ds))}
+    dfs = [per[sd]["fp_per_frame"]["diff"] for sd in seeds]
+    res["fp_per_frame"] = {
+        "base": float(fp_b.sum() / n), "new": float(fp_n.sum() / n), "diff": float((fp_n - fp_b).sum() / n),
+        "interval90": interval(d_fp), "p_gain": float((d_fp < 0).mean() - (d_fp > 0).mean()),
+        "per_seed": dfs, "seeds_gain": int(sum(x < 0 for x in dfs)), "seeds_loss": int(sum(x > 0 for x in dfs))}
+    return res
+
+
+def markdown_runs(res: dict, base_name: str, new_name: str) -> str:
+    """markdown() for compare_runs() over several seeds."""
+    r = res
+    L = [f"Paired comparison over {r['frames']} frames within {r['range_m']:g} m and {len(r['seeds'])} draws "
+         f"(seeds {', '.join(r['seeds'])}; first: `{base_name}`, second: `{new_name}`): found and false positives the "
+         f"mean over the draws; 90 % interval of the difference from a bootstrap over frames ({r['boot']} draws, "
+         "seed {0}); P(gain): share of draws where the second does better minus where it does worse; seeds +/-: the "
+         "draws where the second gains / loses; per seed: each draw's difference:".format(r["seed"]), "",
+         "| class | objects | found, first | found, second | difference | 90 % interval | P(gain) | seeds +/- | per seed |",
+         "|---|---:|---:|---:|---:|---|---:|---:|---|"]
+    for c, v in r["classes"].items():
+        if v["objects"] == 0 and v["diff"] == 0:
+            continue
+        lo, hi = v["interval90"]
+        L.append(f"| {c} | {v['objects']} | {v['found_base']:.1f} | {v['found_new']:.1f} | {v['diff']:+.1f} | "
+                 f"[{lo:+.1f}, {hi:+.1f}] | {v['p_gain']:+.2f} | {v['seeds_gain']} / {v['seeds_loss']} | "
+                 + ", ".join(f"{x:+d}" for x in v["per_seed"]) + " |")
+    f = r["fp_per_frame"]
+    lo, hi = f["interval90"]
+    L += ["", "| false positives per frame | first | second | difference | 90 % interval | P(gain) | seeds +/- | per seed |",
+          "|---|---:|---:|---:|---|---:|---:|---|",
+          f"| all classes | {f['base']:.2f} | {f['new']:.2f} | {f['diff']:+.2f} | [{lo:+.2f}, {hi:+.2f}] | "
+          f"{f['p_gain']:+.2f} | {f['seeds_gain']} / {f['seeds_loss']} | " +
+          ", ".join(f"{x:+.2f}" for x in f["per_seed"]) + " |"]
+    return "\n".join(L)
+
+
 def markdown(res: dict, base_name: str, new_name: str) -> str:
     r = res
     L = [f"Paired comparison over {r['frames']} frames within {r['range_m']:g} m (first: `{base_name}`, second: "
@@ -128,19 +225,21 @@ def markdown(res: dict, base_name: str, new_name: str) -> str:
 
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(prog="python -m lidet_tools.real.paired", description=__doc__.split("\n\n")[0])
-    ap.add_argument("base", help="the first run's report.json (eval_real --out DIR writes DIR/report.json)")
-    ap.add_argument("new", help="the second run's report.json, on the same frames")
+    ap.add_argument("base", help="the first run's report.json (eval_real --out DIR writes DIR/report.json), or a "
+                                 "folder of eval_real --seeds K")
+    ap.add_argument("new", help="the second run's report.json, on the same frames (a folder: the same seeds)")
     ap.add_argument("--range", choices=("20", "40"), default="40", help="within 20 or 40 m (default 40)")
     ap.add_argument("--boot", type=int, default=10000, help="bootstrap draws (default 10000)")
     ap.add_argument("--seed", type=int, default=0, help="the draws' seed (default 0)")
     ap.add_argument("--json", action="store_true", help="print the comparison as JSON")
     a = ap.parse_args(argv)
     try:
-        res = compare(load(a.base), load(a.new), a.range, a.boot, a.seed)
+        res = compare_runs(load_runs(a.base), load_runs(a.new), a.range, a.boot, a.seed)
     except PairedError as e:
         print(f"lidet_tools.real.paired: {e}", file=sys.stderr)
         return 2
-    print(json.dumps(res, indent=1) if a.json else markdown(res, a.base, a.new))
+    fmt = markdown_runs if "seeds" in res else markdown
+    print(json.dumps(res, indent=1) if a.json else fmt(res, a.base, a.new))
     return 0
 
 
