@@ -71,6 +71,12 @@ def tallies(rep: dict, rng: str) -> tuple[list, np.ndarray, np.ndarray, np.ndarr
     return keys, t[:, :, 0], t[:, :, 1], fp
 
 
+def _interval(v) -> list:
+    """The 90 % interval (5th and 95th percentiles) of the bootstrap's differences."""
+    lo, hi = np.percentile(v, [5.0, 95.0])
+    return [float(lo), float(hi)]
+
+
 def compare(base: dict, new: dict, rng: str = "40", boot: int = 10000, seed: int = 0) -> dict:
     """The paired comparison of two loaded reports (see the module's docstring) as a dict."""
     if set(base) != set(new):
@@ -93,20 +99,16 @@ def compare(base: dict, new: dict, rng: str = "40", boot: int = 10000, seed: int
     d_fp = (fp_n - fp_b)[draws].sum(axis=1) / n               # (boot,): per frame
     res = {"range_m": float(rng), "frames": n, "boot": boot, "seed": seed, "classes": {}}
 
-    def interval(v):
-        lo, hi = np.percentile(v, [5.0, 95.0])
-        return [float(lo), float(hi)]
-
     for j, c in enumerate(CLASSES):
         v = d_found[:, j]
         res["classes"][c] = {
             "objects": int(obj_b[:, j].sum()), "found_base": int(found_b[:, j].sum()),
             "found_new": int(found_n[:, j].sum()), "diff": int((found_n - found_b)[:, j].sum()),
-            "interval90": interval(v), "p_gain": float((v > 0).mean() - (v < 0).mean()),
+            "interval90": _interval(v), "p_gain": float((v > 0).mean() - (v < 0).mean()),
             "frames_changed": int(((found_n - found_b)[:, j] != 0).sum())}
     res["fp_per_frame"] = {
         "base": float(fp_b.sum() / n), "new": float(fp_n.sum() / n), "diff": float((fp_n - fp_b).sum() / n),
-        "interval90": interval(d_fp), "p_gain": float((d_fp < 0).mean() - (d_fp > 0).mean()),
+        "interval90": _interval(d_fp), "p_gain": float((d_fp < 0).mean() - (d_fp > 0).mean()),
         "frames_changed": int((fp_n != fp_b).sum())}
     return res
 
@@ -152,11 +154,6 @@ def compare_runs(base: dict, new: dict, rng: str = "40", boot: int = 10000, seed
     draws = np.random.default_rng(seed).integers(0, n, size=(boot, n))
     d_found = (found_n - found_b)[draws].sum(axis=1)
     d_fp = (fp_n - fp_b)[draws].sum(axis=1) / n
-
-    def interval(v):
-        lo, hi = np.percentile(v, [5.0, 95.0])
-        return [float(lo), float(hi)]
-
     res = {"range_m": float(rng), "frames": n, "boot": boot, "seed": seed, "seeds": seeds, "classes": {}}
     for j, c in enumerate(CLASSES):
         v = d_found[:, j]
@@ -164,62 +161,53 @@ def compare_runs(base: dict, new: dict, rng: str = "40", boot: int = 10000, seed
         res["classes"][c] = {
             "objects": int(obj[:, j].sum()), "found_base": float(found_b[:, j].sum()),
             "found_new": float(found_n[:, j].sum()), "diff": float((found_n - found_b)[:, j].sum()),
-            "interval90": interval(v), "p_gain": float((v > 0).mean() - (v < 0).mean()),
+            "interval90": _interval(v), "p_gain": float((v > 0).mean() - (v < 0).mean()),
             "per_seed": ds, "seeds_gain": int(sum(x > 0 for x in ds)), "seeds_loss": int(sum(x < 0 for x in ds))}
     dfs = [per[sd]["fp_per_frame"]["diff"] for sd in seeds]
     res["fp_per_frame"] = {
         "base": float(fp_b.sum() / n), "new": float(fp_n.sum() / n), "diff": float((fp_n - fp_b).sum() / n),
-        "interval90": interval(d_fp), "p_gain": float((d_fp < 0).mean() - (d_fp > 0).mean()),
+        "interval90": _interval(d_fp), "p_gain": float((d_fp < 0).mean() - (d_fp > 0).mean()),
         "per_seed": dfs, "seeds_gain": int(sum(x < 0 for x in dfs)), "seeds_loss": int(sum(x > 0 for x in dfs))}
     return res
 
 
-def markdown_runs(res: dict, base_name: str, new_name: str) -> str:
-    """markdown() for compare_runs() over several seeds."""
-    r = res
-    L = [f"Paired comparison over {r['frames']} frames within {r['range_m']:g} m and {len(r['seeds'])} draws "
-         f"(seeds {', '.join(r['seeds'])}; first: `{base_name}`, second: `{new_name}`): found and false positives the "
-         f"mean over the draws; 90 % interval of the difference from a bootstrap over frames ({r['boot']} draws, "
-         "seed {0}); P(gain): share of draws where the second does better minus where it does worse; seeds +/-: the "
-         "draws where the second gains / loses; per seed: each draw's difference:".format(r["seed"]), "",
-         "| class | objects | found, first | found, second | difference | 90 % interval | P(gain) | seeds +/- | per seed |",
-         "|---|---:|---:|---:|---:|---|---:|---:|---|"]
-    for c, v in r["classes"].items():
-        if v["objects"] == 0 and v["diff"] == 0:
-            continue
-        lo, hi = v["interval90"]
-        L.append(f"| {c} | {v['objects']} | {v['found_base']:.1f} | {v['found_new']:.1f} | {v['diff']:+.1f} | "
-                 f"[{lo:+.1f}, {hi:+.1f}] | {v['p_gain']:+.2f} | {v['seeds_gain']} / {v['seeds_loss']} | "
-                 + ", ".join(f"{x:+d}" for x in v["per_seed"]) + " |")
-    f = r["fp_per_frame"]
-    lo, hi = f["interval90"]
-    L += ["", "| false positives per frame | first | second | difference | 90 % interval | P(gain) | seeds +/- | per seed |",
-          "|---|---:|---:|---:|---|---:|---:|---|",
-          f"| all classes | {f['base']:.2f} | {f['new']:.2f} | {f['diff']:+.2f} | [{lo:+.2f}, {hi:+.2f}] | "
-          f"{f['p_gain']:+.2f} | {f['seeds_gain']} / {f['seeds_loss']} | " +
-          ", ".join(f"{x:+.2f}" for x in f["per_seed"]) + " |"]
-    return "\n".join(L)
-
-
 def markdown(res: dict, base_name: str, new_name: str) -> str:
+    """The comparison as markdown tables: compare()'s, or compare_runs()'s over several seeds (found and false
+    positives the mean over the draws, and the per-seed columns)."""
     r = res
-    L = [f"Paired comparison over {r['frames']} frames within {r['range_m']:g} m (first: `{base_name}`, second: "
-         f"`{new_name}`; bootstrap over frames, {r['boot']} draws, seed {r['seed']}; 90 % interval of the "
-         "difference; P(gain): share of draws where the second does better minus where it does worse):", "",
-         "| class | objects | found, first | found, second | difference | 90 % interval | P(gain) | frames changed |",
-         "|---|---:|---:|---:|---:|---|---:|---:|"]
+    many = "seeds" in r
+    if many:
+        head = (f"Paired comparison over {r['frames']} frames within {r['range_m']:g} m and {len(r['seeds'])} draws "
+                f"(seeds {', '.join(r['seeds'])}; first: `{base_name}`, second: `{new_name}`; found and false positives "
+                "the mean over the draws; bootstrap over frames")
+        last, rule = "seeds +/- | per seed", "---:|---|"
+    else:
+        head = (f"Paired comparison over {r['frames']} frames within {r['range_m']:g} m (first: `{base_name}`, "
+                f"second: `{new_name}`; bootstrap over frames")
+        last, rule = "frames changed", "---:|"
+    L = [head + f", {r['boot']} draws, seed {r['seed']}; 90 % interval of the difference; P(gain): share of draws "
+         "where the second does better minus where it does worse" +
+         ("; seeds +/-: the seeds whose draw gains / loses, then each seed's difference):" if many else "):"), "",
+         f"| class | objects | found, first | found, second | difference | 90 % interval | P(gain) | {last} |",
+         "|---|---:|---:|---:|---:|---|---:|" + rule]
+
+    def tail(v, fmt):
+        if many:
+            return f"{v['seeds_gain']} / {v['seeds_loss']} | " + ", ".join(format(x, fmt) for x in v["per_seed"])
+        return str(v["frames_changed"])
     for c, v in r["classes"].items():
         if v["objects"] == 0 and v["diff"] == 0:
             continue
         lo, hi = v["interval90"]
-        L.append(f"| {c} | {v['objects']} | {v['found_base']} | {v['found_new']} | {v['diff']:+d} | "
-                 f"[{lo:+.0f}, {hi:+.0f}] | {v['p_gain']:+.2f} | {v['frames_changed']} |")
+        n, d, i = (".1f", "+.1f", "+.1f") if many else ("d", "+d", "+.0f")
+        L.append(f"| {c} | {v['objects']} | {v['found_base']:{n}} | {v['found_new']:{n}} | {v['diff']:{d}} | "
+                 f"[{lo:{i}}, {hi:{i}}] | {v['p_gain']:+.2f} | {tail(v, '+d')} |")
     f = r["fp_per_frame"]
     lo, hi = f["interval90"]
-    L += ["", "| false positives per frame | first | second | difference | 90 % interval | P(gain) | frames changed |",
-          "|---|---:|---:|---:|---|---:|---:|",
+    L += ["", f"| false positives per frame | first | second | difference | 90 % interval | P(gain) | {last} |",
+          "|---|---:|---:|---:|---|---:|" + rule,
           f"| all classes | {f['base']:.2f} | {f['new']:.2f} | {f['diff']:+.2f} | [{lo:+.2f}, {hi:+.2f}] | "
-          f"{f['p_gain']:+.2f} | {f['frames_changed']} |"]
+          f"{f['p_gain']:+.2f} | {tail(f, '+.2f')} |"]
     return "\n".join(L)
 
 
@@ -238,8 +226,7 @@ def main(argv=None) -> int:
     except PairedError as e:
         print(f"lidet_tools.real.paired: {e}", file=sys.stderr)
         return 2
-    fmt = markdown_runs if "seeds" in res else markdown
-    print(json.dumps(res, indent=1) if a.json else fmt(res, a.base, a.new))
+    print(json.dumps(res, indent=1) if a.json else markdown(res, a.base, a.new))
     return 0
 
 
