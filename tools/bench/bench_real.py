@@ -21,6 +21,38 @@ def _run(real, out, *extra):
     return rep, (out / "report.md").read_text()
 
 
+def _draws(real, k: int) -> list:
+    """The float and integer detectors over k draws of the proposals' points (`eval_real --seeds k`): per figure
+    the mean and the range over the draws, all sources within 20 and 40 m."""
+    js = {}
+    for tag, extra in (("float", ()), ("integer", ("--fixed",))):
+        out = OUT / f"seeds_{tag}"
+        subprocess.run([sys.executable, "-m", "lidet_tools.eval_real", "--root", str(real), "--out", str(out),
+                        "--no-pictures", "--seeds", str(k), *extra], check=True, capture_output=True, text=True)
+        js[tag] = json.loads((out / "seeds.json").read_text())
+    lines = [f"### Over {k} draws of the proposals' points", "",
+             "Each proposal is 64 points drawn from its cluster with a seed (the figures above: the default seed). "
+             f"`python -m lidet_tools.eval_real --seeds {k} [--fixed]`: the same frames with the default seed and "
+             f"seeds 1 .. {k - 1}; mean over the draws and, in brackets, their range (docs/EVALUATION.md, section 4). "
+             "The draw alone moves a figure by that much; the integer detector draws other points than the float "
+             "one wherever a cluster differs by a pixel.", "",
+             "| figure | float | integer | integer - float (means) |", "|---|---|---|---:|"]
+    fl, fx = js["float"], js["integer"]
+    objs = fl["meta"].get("objects", {})
+    for key in fl["stats"]:
+        a, b = fl["stats"][key], fx["stats"].get(key)
+        if a is None or b is None or key.startswith("Cyclist") or " BEV " in key:
+            continue
+        d = 2 if key.startswith("FP") else 1
+
+        def cell(v):
+            return f"{v['mean']:.{d}f} [{v['min']:.{d if ' found ' not in key else 0}f} - " \
+                   f"{v['max']:.{d if ' found ' not in key else 0}f}]"
+        name = key + (f" (of {objs[key]})" if key in objs else "")
+        lines.append(f"| {name} | {cell(a)} | {cell(b)} | {b['mean'] - a['mean']:+.{d}f} |")
+    return lines + [""]
+
+
 def run(args) -> str:
     os.environ.setdefault("LIDET_BUILD_DIR", str(args.build))
     head = ["## Real labelled frames (issue 36)", ""]
@@ -52,6 +84,7 @@ def run(args) -> str:
                      f"{ca['found']} / {ca['objects']} | {cm['found']} / {cm['objects']} | "
                      f"{cb['found']} / {cb['objects']} |")
     lines.append("")
+    lines += _draws(args.real, 5)
     # the robot's families on real HDL-64 frames thinned to their beams
     lines += ["### The robot's sensor families on thinned real scans", "",
               "No labelled real VLP-16 or VLP-32C scan exists here: the HDL-64 validation frames thinned to the beams "
