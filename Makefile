@@ -111,7 +111,8 @@ bench: deps build
 
 # The detector on the real labelled frames of ../shared/data/real (validation side of
 # tools/lidet_tools/real/split.txt): recall, precision, AP per source and class, where objects are lost, a BEV
-# picture per frame in out/eval_real/pictures/. EVAL_REAL_ARGS: e.g. --fixed, --side train, --sources kitti.
+# picture per frame in out/eval_real/pictures/. EVAL_REAL_ARGS: e.g. --fixed, --side train, --sources kitti,
+# --seeds 5 (five draws of the proposals' points: out/eval_real/seeds.md).
 EVAL_REAL_ARGS ?=
 eval-real: deps build
 	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.eval_real --root $(REAL) --out out/eval_real $(EVAL_REAL_ARGS)
