@@ -39,7 +39,9 @@ takes two such folders).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
+import io
 import json
 import pathlib
 import sys
@@ -637,10 +639,7 @@ def _main_seeds(a, argv) -> int:
     for j, sd in enumerate(seed_list(a.seeds)):
         sub = out / f"seed_{sd}"
         extra = ["--set", f"proposal.seed={sd}", "--out", str(sub)] + ([] if j == 0 else ["--no-pictures"])
-        import contextlib
-        import io
-        buf = io.StringIO()
-        with contextlib.redirect_stdout(buf):
+        with contextlib.redirect_stdout(io.StringIO()):  # each seed's report is in its folder
             rc = main(rest + extra)
         if rc != 0:
             return rc
@@ -650,8 +649,8 @@ def _main_seeds(a, argv) -> int:
             sm = rep["summary"]
             cl = (sm["all"] if "all" in sm else next(iter(sm.values())))["classes"]
             meta = dict(rep["meta"])
-            meta["command"] = meta["command"].split(" --set proposal.seed=")[0] + f" --seeds {a.seeds}" + \
-                "".join(f" --set {kv}" for kv in a.set if f" --set {kv}" not in meta["command"])
+            # the seed's own --set is the last one: cut it, name --seeds instead
+            meta["command"] = meta["command"].split(" --set proposal.seed=")[0] + f" --seeds {a.seeds}"
             meta["detector"] = meta["detector"].split(", proposal.seed=")[0]
             meta["objects"] = {f"{c} found {r} m": cl[c][r]["objects"] for c in CLASSES for r in ("20", "40")}
     text, js = seeds_report(rows, meta)
