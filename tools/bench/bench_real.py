@@ -43,11 +43,11 @@ def _draws(real, k: int) -> list:
         a, b = fl["stats"][key], fx["stats"].get(key)
         if a is None or b is None or key.startswith("Cyclist") or " BEV " in key:
             continue
-        d = 2 if key.startswith("FP") else 1
+        d = 2 if key.startswith("FP") else 1  # decimals of the mean
+        e = 0 if " found " in key else d       # of the range (whole objects)
 
         def cell(v):
-            return f"{v['mean']:.{d}f} [{v['min']:.{d if ' found ' not in key else 0}f} - " \
-                   f"{v['max']:.{d if ' found ' not in key else 0}f}]"
+            return f"{v['mean']:.{d}f} [{v['min']:.{e}f} - {v['max']:.{e}f}]"
         name = key + (f" (of {objs[key]})" if key in objs else "")
         lines.append(f"| {name} | {cell(a)} | {cell(b)} | {b['mean'] - a['mean']:+.{d}f} |")
     return lines + [""]

@@ -39,9 +39,7 @@ takes two such folders).
 from __future__ import annotations
 
 import argparse
-import contextlib
 import dataclasses
-import io
 import json
 import pathlib
 import sys
@@ -549,7 +547,12 @@ def main(argv=None) -> int:
     if a.seeds > 1:
         if any(kv.split("=", 1)[0].strip() == "proposal.seed" for kv in a.set):
             ap.error("--seeds sets proposal.seed itself: leave --set proposal.seed out")
-        return _main_seeds(a, argv)
+        return _main_seeds(ap, a)
+    return _evaluate(ap, a)
+
+
+def _evaluate(ap, a, echo: bool = True) -> int:
+    """One evaluation with the parsed arguments `a` (ap: their parser, for its errors); prints the report when echo."""
     from . import real
     from .real import thin
     if a.as_sensor:
@@ -615,32 +618,22 @@ def main(argv=None) -> int:
     per_frame = [{"source": r.source, "frame": r.frame_id, "objects": len(r.gt), "detections": len(r.dets),
                   "ms": r.ms, "lost": r.lost, "counts": frame_counts(r)} for r in results]
     (out / "report.json").write_text(json.dumps({"meta": meta, "summary": summary, "frames": per_frame}, indent=1, default=_json_num))
-    print(json.dumps(summary, indent=1, default=_json_num) if a.json else text)
+    if echo:
+        print(json.dumps(summary, indent=1, default=_json_num) if a.json else text)
     return 0
 
 
-def _main_seeds(a, argv) -> int:
-    """`--seeds K`: main once per seed into OUT/seed_<S>/, then OUT/seeds.md and seeds.json."""
-    argv = list(sys.argv[1:] if argv is None else argv)
-    # drop --seeds K / --seeds=K, --out DIR / --out=DIR and --json from the arguments passed on
-    rest, i = [], 0
-    while i < len(argv):
-        t = argv[i]
-        if t in ("--seeds", "--out"):
-            i += 2
-            continue
-        if t.startswith("--seeds=") or t.startswith("--out=") or t == "--json":
-            i += 1
-            continue
-        rest.append(t)
-        i += 1
+def _main_seeds(ap, a) -> int:
+    """`--seeds K`: one evaluation per seed into OUT/seed_<S>/ (the seed's --set after the others), then
+    OUT/seeds.md and seeds.json."""
     out = pathlib.Path(a.out)
     rows, meta = {}, None
     for j, sd in enumerate(seed_list(a.seeds)):
         sub = out / f"seed_{sd}"
-        extra = ["--set", f"proposal.seed={sd}", "--out", str(sub)] + ([] if j == 0 else ["--no-pictures"])
-        with contextlib.redirect_stdout(io.StringIO()):  # each seed's report is in its folder
-            rc = main(rest + extra)
+        one = argparse.Namespace(**vars(a))
+        one.set, one.out, one.json = a.set + [f"proposal.seed={sd}"], str(sub), False
+        one.no_pictures = a.no_pictures or j > 0
+        rc = _evaluate(ap, one, echo=False)  # each seed's report is in its folder
         if rc != 0:
             return rc
         rep = json.loads((sub / "report.json").read_text())

@@ -77,22 +77,28 @@ def _interval(v) -> list:
     return [float(lo), float(hi)]
 
 
-def compare(base: dict, new: dict, rng: str = "40", boot: int = 10000, seed: int = 0) -> dict:
-    """The paired comparison of two loaded reports (see the module's docstring) as a dict."""
+def _paired(base: dict, new: dict, rng: str, keys=None):
+    """(keys, objects, found and false positives of base, of new) of two loaded reports of the same frames, in the
+    order of `keys` (default: base's); PairedError when they hold other frames or count other objects."""
     if set(base) != set(new):
         only_b = sorted(set(base) - set(new))
         only_n = sorted(set(new) - set(base))
         raise PairedError(f"the reports hold different frames: only in the first {only_b[:5]}"
                           f"{' ...' if len(only_b) > 5 else ''}, only in the second {only_n[:5]}"
                           f"{' ...' if len(only_n) > 5 else ''}")
-    if boot < 1:
-        raise PairedError(f"--boot must be at least 1, got {boot}")
-    keys, obj_b, found_b, fp_b = tallies(base, rng)
-    new = {k: new[k] for k in keys}
-    _, obj_n, found_n, fp_n = tallies(new, rng)
+    keys, obj_b, found_b, fp_b = tallies(base if keys is None else {k: base[k] for k in keys}, rng)
+    _, obj_n, found_n, fp_n = tallies({k: new[k] for k in keys}, rng)
     if not np.array_equal(obj_b, obj_n):
         raise PairedError("the reports count different objects in the same frames (another --min-points, readers "
                           "or split): compare runs of the same evaluation")
+    return keys, obj_b, found_b, fp_b, found_n, fp_n
+
+
+def compare(base: dict, new: dict, rng: str = "40", boot: int = 10000, seed: int = 0) -> dict:
+    """The paired comparison of two loaded reports (see the module's docstring) as a dict."""
+    keys, obj_b, found_b, fp_b, found_n, fp_n = _paired(base, new, rng)
+    if boot < 1:
+        raise PairedError(f"--boot must be at least 1, got {boot}")
     n = len(keys)
     draws = np.random.default_rng(seed).integers(0, n, size=(boot, n))
     d_found = (found_n - found_b)[draws].sum(axis=1)          # (boot, C)
@@ -136,20 +142,15 @@ def compare_runs(base: dict, new: dict, rng: str = "40", boot: int = 10000, seed
     seeds = sorted(base, key=lambda x: (len(x), x))
     if len(seeds) == 1:
         return compare(base[seeds[0]], new[seeds[0]], rng, boot, seed)
-    per = {sd: compare(base[sd], new[sd], rng, 1, seed) for sd in seeds}  # per seed: the same checks, its sums
     if boot < 1:
         raise PairedError(f"--boot must be at least 1, got {boot}")
     keys = list(base[seeds[0]])
     for sd in seeds:
-        if set(base[sd]) != set(keys) or set(new[sd]) != set(keys):
+        if set(base[sd]) != set(keys):
             raise PairedError(f"seed {sd}: other frames than seed {seeds[0]}'s")
-    tb = [tallies({k: base[sd][k] for k in keys}, rng) for sd in seeds]
-    tn = [tallies({k: new[sd][k] for k in keys}, rng) for sd in seeds]
-    obj = tb[0][1]
-    found_b = np.mean([t[2] for t in tb], axis=0)
-    found_n = np.mean([t[2] for t in tn], axis=0)
-    fp_b = np.mean([t[3] for t in tb], axis=0)
-    fp_n = np.mean([t[3] for t in tn], axis=0)
+    per = [_paired(base[sd], new[sd], rng, keys) for sd in seeds]  # (keys, obj, found_b, fp_b, found_n, fp_n)
+    obj = per[0][1]
+    found_b, fp_b, found_n, fp_n = (np.mean([t[i] for t in per], axis=0) for i in (2, 3, 4, 5))
     n = len(keys)
     draws = np.random.default_rng(seed).integers(0, n, size=(boot, n))
     d_found = (found_n - found_b)[draws].sum(axis=1)
@@ -157,13 +158,13 @@ def compare_runs(base: dict, new: dict, rng: str = "40", boot: int = 10000, seed
     res = {"range_m": float(rng), "frames": n, "boot": boot, "seed": seed, "seeds": seeds, "classes": {}}
     for j, c in enumerate(CLASSES):
         v = d_found[:, j]
-        ds = [per[sd]["classes"][c]["diff"] for sd in seeds]
+        ds = [int((t[4] - t[2])[:, j].sum()) for t in per]
         res["classes"][c] = {
             "objects": int(obj[:, j].sum()), "found_base": float(found_b[:, j].sum()),
             "found_new": float(found_n[:, j].sum()), "diff": float((found_n - found_b)[:, j].sum()),
             "interval90": _interval(v), "p_gain": float((v > 0).mean() - (v < 0).mean()),
             "per_seed": ds, "seeds_gain": int(sum(x > 0 for x in ds)), "seeds_loss": int(sum(x < 0 for x in ds))}
-    dfs = [per[sd]["fp_per_frame"]["diff"] for sd in seeds]
+    dfs = [float((t[5] - t[3]).sum() / n) for t in per]
     res["fp_per_frame"] = {
         "base": float(fp_b.sum() / n), "new": float(fp_n.sum() / n), "diff": float((fp_n - fp_b).sum() / n),
         "interval90": _interval(d_fp), "p_gain": float((d_fp < 0).mean() - (d_fp > 0).mean()),
