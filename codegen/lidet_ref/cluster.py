@@ -3,7 +3,7 @@
 lidet_cluster_grow.c, lidet_cluster_rescue.c and lidet_proposal.c; the contract is written in
 lib/include/lidet/lidet_cluster.h).
 
-- `proposal_indices` / `make_proposal` reproduce the C resampling *exactly* (integer xorshift32):
+- `proposal_indices` / `make_proposal` reproduce the C resampling *exactly* (integer xorshift32 and pixel keys):
   training uses them, or the bindings (`lidet_tools.native.proposals`), and both give the same points.
 - `cluster_ref` is a plain-Python BFS with the same rules (4- or 8-neighbourhood, hole bridging over
   non-candidates up to max_steps, optionally over nearer occluders, column wrap, the angle criterion in
@@ -27,26 +27,42 @@ def xorshift32(x: int) -> int:
     return x & _M32
 
 
-def proposal_indices(n_src: int, n_out: int, seed: int = 0x5EED1234) -> np.ndarray:
+def proposal_key(seed: int, pixels) -> np.ndarray:
+    """The keys of member pixels in the draw seeded with seed (lidet__proposal_key): MurmurHash3's 32-bit
+    finaliser of seed ^ (p * 0x9E3779B9), uint32 arithmetic; a bijection of p."""
+    p = np.asarray(pixels, np.int64).astype(np.uint64)
+    h = (np.uint64(seed & _M32) ^ ((p * np.uint64(0x9E3779B9)) & np.uint64(_M32)))
+    h ^= h >> np.uint64(16)
+    h = (h * np.uint64(0x85EBCA6B)) & np.uint64(_M32)
+    h ^= h >> np.uint64(13)
+    h = (h * np.uint64(0xC2B2AE35)) & np.uint64(_M32)
+    h ^= h >> np.uint64(16)
+    return h.astype(np.uint32)
+
+
+def proposal_indices(n_src: int, n_out: int, seed: int = 0x5EED1234, pixels=None) -> np.ndarray:
     """Member indices a proposal takes (lidet_proposal_indices): every member once then draws with
-    replacement when n_src <= n_out; one member per equal stratum otherwise."""
+    replacement when n_src <= n_out; otherwise from each of n_out equal strata of the member list the member
+    whose pixel (pixels: the n_src member pixels in member order, required then) has the smallest key."""
     if n_src <= 0 or n_out <= 0:
         raise ValueError("n_src and n_out must be positive")
-    s = (seed ^ ((n_src * 0x9E3779B9) & _M32)) & _M32
-    if s == 0:
-        s = 0x6C646574
     out = np.empty(n_out, np.int64)
     if n_src <= n_out:
+        s = (seed ^ ((n_src * 0x9E3779B9) & _M32)) & _M32
+        if s == 0:
+            s = 0x6C646574
         out[:n_src] = np.arange(n_src)
         for i in range(n_src, n_out):
             s = xorshift32(s)
             out[i] = s % n_src
-    else:
-        for i in range(n_out):
-            b0 = (i * n_src) // n_out
-            b1 = ((i + 1) * n_src) // n_out
-            s = xorshift32(s)
-            out[i] = b0 + s % (b1 - b0)
+        return out
+    if pixels is None or len(pixels) != n_src:
+        raise ValueError(f"a cluster of {n_src} > {n_out} members needs its {n_src} member pixels")
+    key = proposal_key(seed, pixels)
+    for i in range(n_out):
+        b0 = (i * n_src) // n_out
+        b1 = ((i + 1) * n_src) // n_out
+        out[i] = b0 + int(np.argmin(key[b0:b1]))  # keys never tie: the first minimum is the only one
     return out
 
 
@@ -66,9 +82,9 @@ def voxel_of(mean, azimuth_bin_rad=np.float32(np.radians(10.0)), elevation_bin_r
 
 def make_proposal(member_xyz: np.ndarray, mean=None, n_points: int = 64, seed: int = 0x5EED1234,
                   azimuth_bin_rad=np.float32(np.radians(10.0)), elevation_bin_rad=np.float32(np.radians(10.0)),
-                  range_bin_m: float = 1.0, height_m=None):
+                  range_bin_m: float = 1.0, height_m=None, pixels=None):
     """A proposal from a cluster's member points (n_src, 3) in member order (raster order of their
-    pixels, as lidet_cluster_members lists them). mean: the cluster mean (default: the float64 mean of
+    pixels, as lidet_cluster_members lists them); pixels: their pixel indices (needed when n_src > n_points). mean: the cluster mean (default: the float64 mean of
     the members). height_m: None for LIDET_PROPOSAL_Z_MEAN; else the record's height above its ground plane
     (lidet_cluster_rec_t height_m) and z is measured from the ground under the mean (LIDET_PROPOSAL_Z_GROUND),
     which is the returned mean's z. Returns (xyz (n_points, 3) float32 centred on the mean, mean float32 (3,),
@@ -78,7 +94,7 @@ def make_proposal(member_xyz: np.ndarray, mean=None, n_points: int = 64, seed: i
     origin = mean32.copy()
     if height_m is not None:
         origin[2] = mean32[2] - np.float32(height_m)  # float32 - float32, as in C
-    idx = proposal_indices(len(pts), n_points, seed)
+    idx = proposal_indices(len(pts), n_points, seed, pixels)
     xyz = pts[idx] - origin  # float32 - float32, as in C
     return xyz, origin, voxel_of(mean32, azimuth_bin_rad, elevation_bin_rad, range_bin_m)
 

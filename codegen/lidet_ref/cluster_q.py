@@ -442,8 +442,8 @@ def make_proposal_q(rec: Rec, members, x, y, z, cfg: dict):
     X, Y, Z = (np.asarray(a).ravel() for a in (x, y, z))
     mx, my, mz = rec.mean
     zo = mz - rec.height if int(cfg.get("z_origin", 0)) == 1 else mz
-    idx = proposal_indices(rec.n_points, cfg["n_points"], cfg["seed"])
-    pix = np.asarray(members)[rec.first_member + idx]
+    own = np.asarray(members)[rec.first_member: rec.first_member + rec.n_points]
+    pix = own[proposal_indices(rec.n_points, cfg["n_points"], cfg["seed"], own)]
     xyz = np.array([[_sat16(int(P[p]) - m) for P, m in ((X, mx), (Y, my), (Z, zo))] for p in pix], np.int16)
     rxy2 = mx * mx + my * my
 

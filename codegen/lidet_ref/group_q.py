@@ -121,7 +121,8 @@ def proposal(rec, members, X, Y, Z, g: Group, part: int, cfg: dict):
     n_src = len(sel)
     mx, my, mz = g.part_mean[part]
     zo = int(rec.mean[2]) - int(rec.height) if int(cfg.get("z_origin", 0)) == 1 else mz
-    idx = proposal_indices(n_src, int(cfg["n_points"]), int(cfg["seed"]))
+    pix = np.asarray(members, np.int64)[rec.first_member + sel]
+    idx = proposal_indices(n_src, int(cfg["n_points"]), int(cfg["seed"]), pix)
     rows = d[sel[idx]] + np.array(g.mean, np.int64)
     xyz = np.array([[_sat16(int(r[0]) - mx), _sat16(int(r[1]) - my), _sat16(int(r[2]) - zo)] for r in rows],
                    np.int16)

@@ -600,7 +600,26 @@ LIDET_PY_API int lidet_py_proposals(lidet_py_ctx_t *ctx, const lidet_proposal_cf
     return 0;
 }
 
-LIDET_PY_API int lidet_py_proposal_indices(uint32_t n_src, uint32_t n_out, uint32_t seed, uint32_t *out)
+/* pixels: the cluster's n_src member pixels (NULL: not needed when n_src <= n_out), converted to lidet_member_t */
+LIDET_PY_API int lidet_py_proposal_indices(const uint32_t *pixels, uint32_t n_src, uint32_t n_out,
+                                           uint32_t seed, uint32_t *out)
 {
-    return lidet_proposal_indices(n_src, n_out, seed, out);
+    lidet_member_t *m = 0;
+    lidet_status_t st;
+    uint32_t i;
+    if (pixels != 0 && n_src > 0u)
+    {
+        m = (lidet_member_t *)malloc((size_t)n_src * sizeof *m);
+        if (m == 0)
+        {
+            return LIDET_ERR_BUFFER;
+        }
+        for (i = 0; i < n_src; ++i)
+        {
+            m[i] = (lidet_member_t)pixels[i];
+        }
+    }
+    st = lidet_proposal_indices(m, n_src, n_out, seed, out);
+    free(m);
+    return st;
 }

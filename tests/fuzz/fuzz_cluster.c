@@ -86,7 +86,7 @@ static void proposal_knobs(fz_in_t *in, proposal_knobs_t *k)
     k->cfg.n_points = fz_u16(in) % (LIDET_PROPOSAL_POINTS + 3u);
     k->cfg.seed = fz_u32(in);
     fz_poke_f32(in, fl, 3u);
-    k->n_src = fz_u32(in);
+    k->n_src = fz_u32(in) % (NPIX + 1u); /* members of g_members (the last run's, or what the buffer holds) */
     k->n_out = fz_u16(in) % (LIDET_PROPOSAL_POINTS + 8u);
 }
 
@@ -109,12 +109,18 @@ static void proposals(const proposal_knobs_t *pk, const lidet_cluster_state_t *c
         }
         FZ_CHECK(g_prop.n_points == pk->cfg.n_points && g_prop.n_points_src == cs->recs[k].n_points);
     }
-    st = lidet_proposal_indices(pk->n_src, pk->n_out, pk->cfg.seed, g_indices);
+    st = lidet_proposal_indices(g_members, pk->n_src, pk->n_out, pk->cfg.seed, g_indices);
     FZ_CHECK(st == ((pk->n_src == 0 || pk->n_out == 0) ? LIDET_ERR_ARG : LIDET_OK));
     for (i = 0; st == LIDET_OK && i < pk->n_out; ++i)
     {
         FZ_CHECK(g_indices[i] < pk->n_src);
+        /* a large cluster: one member of each stratum */
+        FZ_CHECK(pk->n_src <= pk->n_out ||
+                 (g_indices[i] >= (uint32_t)((uint64_t)i * pk->n_src / pk->n_out) &&
+                  g_indices[i] < (uint32_t)((uint64_t)(i + 1u) * pk->n_src / pk->n_out)));
     }
+    st = lidet_proposal_indices(0, pk->n_src, pk->n_out, pk->cfg.seed, g_indices); /* no pixels */
+    FZ_CHECK(st == ((pk->n_src == 0 || pk->n_out == 0 || pk->n_src > pk->n_out) ? LIDET_ERR_ARG : LIDET_OK));
 }
 #endif
 

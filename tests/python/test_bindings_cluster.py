@@ -31,11 +31,45 @@ def _synthetic():
 
 
 def test_proposal_indices_match_reference():
+    rng = np.random.default_rng(3)
     for n_src, n_out, seed in [(1, 64, 0), (5, 8, 0x5EED1234), (10, 64, 7), (64, 64, 3), (65, 64, 3),
                                (1000, 128, 8), (123457, 64, 0xFFFFFFFF), (0x9E3779B9 % 100000 + 1, 16, 0x9E3779B9)]:
-        c = native.proposal_indices(n_src, n_out, seed)
-        r = ref.proposal_indices(n_src, n_out, seed)
+        pixels = np.sort(rng.choice(1 << 20, n_src, replace=False)).astype(np.uint32)
+        c = native.proposal_indices(n_src, n_out, seed, pixels)
+        r = ref.proposal_indices(n_src, n_out, seed, pixels)
         np.testing.assert_array_equal(c, r, err_msg=f"{n_src} {n_out} {seed}")
+        if n_src <= n_out:  # the pixels are not read
+            np.testing.assert_array_equal(native.proposal_indices(n_src, n_out, seed), r)
+        else:
+            with pytest.raises(native.LidetError):
+                native.proposal_indices(n_src, n_out, seed)
+            with pytest.raises(ValueError):
+                ref.proposal_indices(n_src, n_out, seed)
+
+
+def test_proposal_indices_follow_the_pixels_not_the_count():
+    """A cluster that gains or loses a pixel (the float and integer projections of one scan) takes the same member
+    pixels in every stratum the change leaves alone; the pick in a stratum is uniform over its members."""
+    rng = np.random.default_rng(5)
+    same = []
+    for trial in range(40):
+        n = int(rng.integers(200, 3000))
+        pixels = np.sort(rng.choice(200_000, n + 1, replace=False))
+        a = pixels[:-1] if trial % 2 else np.delete(pixels, int(rng.integers(0, n + 1)))
+        b = pixels
+        pa = a[native.proposal_indices(len(a), 64, 0x5EED1234, a)]
+        pb = b[native.proposal_indices(len(b), 64, 0x5EED1234, b)]
+        same.append(len(np.intersect1d(pa, pb)) / 64)
+    assert np.mean(same) > 0.9, np.mean(same)
+    # the position of the pick within its stratum: uniform (chi-square over 8 bins of the relative position)
+    pos = []
+    for seed in range(300):
+        pixels = np.arange(64 * 40) * 3 + seed
+        idx = native.proposal_indices(len(pixels), 64, seed, pixels)
+        pos.append(idx - np.arange(64) * 40)
+    h = np.bincount(np.concatenate(pos) * 8 // 40, minlength=8)
+    e = h.sum() / 8
+    assert ((h - e) ** 2 / e).sum() < 30, h  # chi-square, 7 degrees of freedom: 24.3 at p = 0.001
 
 
 def test_synthetic_objects_are_separate_clusters():
@@ -228,7 +262,7 @@ def test_proposals_match_reference(real_dir):
         edge = 0
         for i in range(len(c)):
             m = c.members[c.first_member[i]:c.first_member[i] + c.n_points[i]]
-            rx, rmean, rvox = ref.make_proposal(xyz[m], c.mean[i], n_points=n_points)
+            rx, rmean, rvox = ref.make_proposal(xyz[m], c.mean[i], n_points=n_points, pixels=m)
             np.testing.assert_array_equal(p.xyz[i], rx)  # bit-exact: same indices, same float32 subtraction
             np.testing.assert_array_equal(p.mean[i], rmean)
             assert p.n_src[i] == len(m)
@@ -254,7 +288,7 @@ def test_proposals_from_the_ground_match_reference(need_lib):
     xyz = np.stack([c.image.x, c.image.y, c.image.z], -1).reshape(-1, 3)
     for i in range(len(c)):
         m = c.members[c.first_member[i]:c.first_member[i] + c.n_points[i]]
-        rx, rmean, rvox = ref.make_proposal(xyz[m], c.mean[i], n_points=64, height_m=c.height[i])
+        rx, rmean, rvox = ref.make_proposal(xyz[m], c.mean[i], n_points=64, height_m=c.height[i], pixels=m)
         np.testing.assert_array_equal(b.xyz[i], rx)
         np.testing.assert_array_equal(b.mean[i], rmean)
     np.testing.assert_array_equal(a.voxel, b.voxel)

@@ -47,7 +47,7 @@ def test_proposals_read_the_scan_of_their_cluster_call():
     xyz = np.stack([ca.image.x, ca.image.y, ca.image.z], -1).reshape(-1, 3)
     for i in range(len(ca)):
         m = ca.members[ca.first_member[i]:ca.first_member[i] + ca.n_points[i]]
-        rx, rmean, _ = ref.make_proposal(xyz[m], ca.mean[i], n_points=32)
+        rx, rmean, _ = ref.make_proposal(xyz[m], ca.mean[i], n_points=32, pixels=m)
         np.testing.assert_array_equal(pa.xyz[i], rx)
         np.testing.assert_array_equal(pa.mean[i], rmean)
     # the first n only; a count past the clusters is refused

@@ -661,19 +661,24 @@ static void test_defaults_per_profile(void)
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &d));
 }
 
-/* the resampling rule: deterministic, in range, every member once when small, distinct when large */
+/* the resampling rule: deterministic, in range, every member once when small, one member of each stratum when large,
+ * chosen by the members' pixels */
 static void test_proposal_indices(void)
 {
-    uint32_t a[128], b[128], i;
+    static lidet_member_t pix[1001];
+    uint32_t a[128], b[128], i, same;
     uint8_t seen[1000];
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(10, 64, 7, a));
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(10, 64, 7, b));
+    static const uint32_t golden[8] = {1, 16, 34, 38, 54, 70, 81, 88};
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(0, 10, 64, 7, a)); /* pixels not read */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(0, 10, 64, 7, b));
     TEST_ASSERT_EQUAL_MEMORY(a, b, 64 * sizeof a[0]);
     for (i = 0; i < 10; ++i)
         TEST_ASSERT_EQUAL_UINT32(i, a[i]);
     for (i = 0; i < 64; ++i)
         TEST_ASSERT_TRUE(a[i] < 10);
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(1000, 128, 7, a));
+    for (i = 0; i < 1001; ++i)
+        pix[i] = (lidet_member_t)(3u * i + 7u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(pix, 1000, 128, 7, a));
     memset(seen, 0, sizeof seen);
     for (i = 0; i < 128; ++i)
     {
@@ -683,14 +688,25 @@ static void test_proposal_indices(void)
         TEST_ASSERT_TRUE(a[i] >= i * 1000 / 128 && a[i] < (i + 1) * 1000 / 128);
     }
     /* another seed gives another pattern */
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(1000, 128, 8, b));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(pix, 1000, 128, 8, b));
     TEST_ASSERT_TRUE(memcmp(a, b, 128 * sizeof a[0]) != 0);
-    /* golden values (codegen/lidet_ref/cluster.py: proposal_indices must give the same) */
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(5, 8, 0x5EED1234u, a));
+    /* one pixel more at the front: the members shift by one and the strata move, yet most picks keep their pixel */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(pix, 1001, 128, 7, b));
+    for (i = 0, same = 0; i < 128; ++i)
+        same += pix[a[i]] == pix[b[i]];
+    TEST_ASSERT_TRUE(same >= 110u);
+    /* golden values (codegen/lidet_ref/cluster.py: proposal_indices gives the same): pixels 11, 16, ..., 506 */
+    for (i = 0; i < 100; ++i)
+        pix[i] = (lidet_member_t)(5u * i + 11u);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(pix, 100, 8, 0x5EED1234u, a));
+    TEST_ASSERT_EQUAL_UINT32_ARRAY(golden, a, 8);
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(0, 5, 8, 0x5EED1234u, a));
     TEST_ASSERT_EQUAL_UINT32(0, a[0]);
     TEST_ASSERT_EQUAL_UINT32(4, a[4]);
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proposal_indices(0, 8, 1, a));
-    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proposal_indices(5, 0, 1, a));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proposal_indices(pix, 0, 8, 1, a));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_proposal_indices(pix, 5, 0, 1, a));
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG,
+                          lidet_proposal_indices(0, 100, 8, 1, a)); /* a large cluster needs them */
 }
 
 /* proposals: centred on the cluster mean, deterministic, voxel of the mean */

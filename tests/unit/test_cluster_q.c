@@ -344,7 +344,8 @@ static void test_proposal(void)
     TEST_ASSERT_EQUAL_INT16(0, pr.voxel[1]);
     TEST_ASSERT_TRUE(pr.voxel[2] == 9 || pr.voxel[2] == 10);
     /* the points are the resampled members minus the rounded mean (the float stage's indices) */
-    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(rec->n_points, pc.n_points, pc.seed, idx));
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(g.ws.members + rec->first_member, rec->n_points,
+                                                           pc.n_points, pc.seed, idx));
     for (i = 0; i < pc.n_points; ++i)
     {
         const int32_t px = g.ws.members[rec->first_member + idx[i]];

@@ -96,11 +96,15 @@
  * Proposals (lidet_proposal_make): a kept cluster resampled to N points (N <= LIDET_PROPOSAL_POINTS)
  * by a deterministic rule that codegen/lidet_ref/cluster.py reproduces exactly:
  *  - n_src <= N: every member once (member order), then N - n_src members drawn with replacement
- *    by an xorshift32 generator;
- *  - n_src > N: stratified without replacement: output i takes member b_i + (r_i mod (b_{i+1} - b_i))
- *    with b_i = floor(i n_src / N) and r_i from the same generator;
- *  - the generator state starts at seed ^ (n_src * 0x9E3779B9) (0 replaced by 0x6C646574); each draw
- *    is one xorshift32 step (13, 17, 5) and returns the new state;
+ *    by an xorshift32 generator whose state starts at seed ^ (n_src * 0x9E3779B9) (0 replaced by
+ *    0x6C646574); each draw is one xorshift32 step (13, 17, 5) and returns the new state;
+ *  - n_src > N: stratified without replacement: output i takes, of the members b_i .. b_{i+1} - 1
+ *    (b_i = floor(i n_src / N)), the one whose pixel p has the smallest key
+ *    fmix32(seed ^ (p * 0x9E3779B9)) (fmix32: MurmurHash3's 32-bit finaliser, a bijection, so keys never
+ *    tie). The pick depends on the pixels, not on the member count: two clusters that differ by a pixel
+ *    (the float and integer projections of one scan, a pixel that changes hands) take the same members
+ *    in every stratum that pixel leaves alone. A stratum's member at random, as a generator's draw in it
+ *    would be, so the proposals follow the law the networks were trained with;
  *  - points are centred on the cluster mean (record mean_m), and the mean's spherical voxel is
  *    floor(azimuth / az_bin), floor(elevation / el_bin), floor(range / range_bin) (azimuth =
  *    atan2(y, x), elevation = atan2(z, sqrt(x^2 + y^2)), signed bins, clamped to int16).
@@ -492,11 +496,14 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *st, uint32_t 
                                       const lidet_proposal_cfg_t *cfg, lidet_proposal_t *out);
 
 /**
- * @brief The resampling rule alone: writes n_out member indices (each < n_src) for a cluster of
- *        n_src members (see the file comment). Exposed for tests and the Python reference.
- * @return LIDET_OK; LIDET_ERR_ARG (NULL out, n_src 0, n_out 0).
+ * @brief The resampling rule alone: writes n_out member indices (each < n_src) for a cluster whose
+ *        n_src member pixels are pixels[0 .. n_src - 1] in member order (see the file comment; the
+ *        pixels are read only when n_src > n_out and may be NULL otherwise). Exposed for tests and the
+ *        Python reference.
+ * @return LIDET_OK; LIDET_ERR_ARG (NULL out, n_src 0, n_out 0, NULL pixels with n_src > n_out).
  */
-lidet_status_t lidet_proposal_indices(uint32_t n_src, uint32_t n_out, uint32_t seed, uint32_t *out);
+lidet_status_t lidet_proposal_indices(const lidet_member_t *pixels, uint32_t n_src, uint32_t n_out,
+                                      uint32_t seed, uint32_t *out);
 
 #ifdef __cplusplus
 }

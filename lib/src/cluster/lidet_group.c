@@ -253,7 +253,7 @@ lidet_status_t lidet__group_proposal(const lidet_cluster_state_t *c, uint32_t ci
      out->xyz[i][1] = lidet__img_y(img, GP_MEMBER(m)) - my,                                                  \
      out->xyz[i][2] = lidet__img_z(img, GP_MEMBER(m)) - zo)
 #define GP_COPY(i, k) memcpy(out->xyz[i], out->xyz[k], sizeof out->xyz[i])
-    LIDET__GROUP_RESAMPLE(cfg->seed, n_src, n_out, r->n_points, GP_IN_PART, GP_WRITE, GP_COPY, st);
+    LIDET__GROUP_RESAMPLE(cfg->seed, n_src, n_out, r->n_points, GP_MEMBER, GP_IN_PART, GP_WRITE, GP_COPY, st);
 #undef GP_MEMBER
 #undef GP_IN_PART
 #undef GP_WRITE

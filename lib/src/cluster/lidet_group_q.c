@@ -191,14 +191,16 @@ lidet_status_t lidet__group_q_proposal(const lidet_cluster_q_state_t *c, uint32_
     {
         return LIDET_ERR_ARG;
     }
-    /* IN_PART leaves the member's offsets from the cluster mean in d for WRITE */
+    /* IN_PART and WRITE compute the member's offsets from the cluster mean in d */
 #define GP_IN_PART(m)                                                                                        \
     (member_d(g, img, (uint32_t)c->members[r->first_member + (m)], d), part_of(g, offset_t(g, d)) == part)
+#define GP_PIXEL(m) ((uint32_t)c->members[r->first_member + (m)])
 #define GP_WRITE(i, m)                                                                                       \
-    (out->xyz[i][0] = sat16(d[0] + g->mean[0] - mx), out->xyz[i][1] = sat16(d[1] + g->mean[1] - my),         \
-     out->xyz[i][2] = sat16(d[2] + g->mean[2] - zo))
+    (member_d(g, img, GP_PIXEL(m), d), out->xyz[i][0] = sat16(d[0] + g->mean[0] - mx),                       \
+     out->xyz[i][1] = sat16(d[1] + g->mean[1] - my), out->xyz[i][2] = sat16(d[2] + g->mean[2] - zo))
 #define GP_COPY(i, k) memcpy(out->xyz[i], out->xyz[k], sizeof out->xyz[i])
-    LIDET__GROUP_RESAMPLE(cfg->seed, n_src, n_out, r->n_points, GP_IN_PART, GP_WRITE, GP_COPY, st);
+    LIDET__GROUP_RESAMPLE(cfg->seed, n_src, n_out, r->n_points, GP_PIXEL, GP_IN_PART, GP_WRITE, GP_COPY, st);
+#undef GP_PIXEL
 #undef GP_IN_PART
 #undef GP_WRITE
 #undef GP_COPY

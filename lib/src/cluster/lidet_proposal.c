@@ -25,17 +25,18 @@ void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg)
     cfg->range_bin_m = 1.0f;
 }
 
-lidet_status_t lidet_proposal_indices(uint32_t n_src, uint32_t n_out, uint32_t seed, uint32_t *out)
+lidet_status_t lidet_proposal_indices(const lidet_member_t *pixels, uint32_t n_src, uint32_t n_out,
+                                      uint32_t seed, uint32_t *out)
 {
     uint32_t i, s;
-    if (out == 0 || n_src == 0 || n_out == 0)
+    if (out == 0 || n_src == 0 || n_out == 0 || (pixels == 0 && n_src > n_out))
     {
         return LIDET_ERR_ARG;
     }
     s = lidet__proposal_rng_start(seed, n_src);
     for (i = 0; i < n_out; ++i)
     {
-        out[i] = lidet__proposal_next_index(&s, i, n_src, n_out);
+        out[i] = lidet__proposal_member(pixels, &s, i, n_src, n_out, seed);
     }
     return LIDET_OK;
 }
@@ -108,8 +109,10 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
     zo = cfg->z_origin == LIDET_PROPOSAL_Z_GROUND ? mz - rec->height_m : mz;
     for (i = 0; i < cfg->n_points; ++i)
     {
-        const int32_t p = c->members[rec->first_member +
-                                     lidet__proposal_next_index(&state, i, rec->n_points, cfg->n_points)];
+        const int32_t p =
+            (int32_t)c->members[rec->first_member + lidet__proposal_member(c->members + rec->first_member,
+                                                                           &state, i, rec->n_points,
+                                                                           cfg->n_points, cfg->seed)];
         if (p < 0 || (uint32_t)p >= npix)
         {
             return LIDET_ERR_STATE; /* cannot happen after a run; guards a stale state */

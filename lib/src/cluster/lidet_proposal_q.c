@@ -86,8 +86,9 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
     for (i = 0; i < cfg->n_points; ++i)
     {
         const int32_t p =
-            (int32_t)c->members[rec->first_member +
-                                lidet__proposal_next_index(&state, i, rec->n_points, cfg->n_points)];
+            (int32_t)c->members[rec->first_member + lidet__proposal_member(c->members + rec->first_member,
+                                                                           &state, i, rec->n_points,
+                                                                           cfg->n_points, cfg->seed)];
         int32_t v[3];
         if (p < 0 || (uint32_t)p >= npix)
         {

@@ -35,38 +35,59 @@
 #define LIDET_GROUP_MIN_PART 8u    /* member pixels of each part (the clustering's default min_points) */
 #define LIDET_GROUP_ITERS 8u       /* k-means passes at most */
 
-/* Rule 4's resampling walk, the same in both builds: the proposal rule's indices into a part's n_src members
- * (lidet_proposal_rule.h: 0, 1, ..., n_src - 1 and then draws among them when n_src <= n_out, else one from each of
- * n_out runs, increasing) found in one pass over the cluster's n_members members in member order. IN_PART(m): member m
- * is in the part; WRITE(i, m): output row i from member m; COPY(i, k): row i from row k. status: LIDET_OK, or
- * LIDET_ERR_STATE when the part does not hold n_src members (cannot happen after the cut counted them). */
-#define LIDET__GROUP_RESAMPLE(seed, n_src, n_out, n_members, IN_PART, WRITE, COPY, status)                   \
+/* Rule 4's resampling walk, the same in both builds: the proposal rule (lidet_proposal_rule.h) over a part's n_src
+ * members, found in one pass over the cluster's n_members members in member order. n_src <= n_out: the part's
+ * members in order, then draws among them; else from each of the n_out strata of the part's members the one whose
+ * pixel has the smallest key. PIXEL(m): member m's pixel; IN_PART(m): member m is in the part; WRITE(i, m): output
+ * row i from member m; COPY(i, k): row i from row k. status: LIDET_OK, or LIDET_ERR_STATE when the part does not
+ * hold n_src members (cannot happen after the cut counted them). */
+#define LIDET__GROUP_RESAMPLE(seed, n_src, n_out, n_members, PIXEL, IN_PART, WRITE, COPY, status)            \
     do                                                                                                       \
     {                                                                                                        \
-        const uint32_t grs_direct_ = (n_src) < (n_out) ? (n_src) : (n_out); /* rows taken in member order */ \
-        uint32_t grs_state_ = lidet__proposal_rng_start((seed), (n_src)), grs_i_ = 0, grs_ord_ = 0, grs_m_;  \
-        uint32_t grs_want_ = lidet__proposal_next_index(&grs_state_, 0u, (n_src), (n_out));                  \
-        for (grs_m_ = 0; grs_m_ < (n_members) && grs_i_ < grs_direct_; ++grs_m_)                             \
+        uint32_t grs_i_ = 0, grs_ord_ = 0, grs_m_;                                                           \
+        if ((n_src) <= (n_out))                                                                              \
         {                                                                                                    \
-            if (!(IN_PART(grs_m_)))                                                                          \
+            uint32_t grs_state_ = lidet__proposal_rng_start((seed), (n_src));                                \
+            for (grs_m_ = 0; grs_m_ < (n_members) && grs_i_ < (n_src); ++grs_m_)                             \
             {                                                                                                \
-                continue;                                                                                    \
-            }                                                                                                \
-            if (grs_want_ == grs_ord_) /* the indices never repeat below grs_direct_ */                      \
-            {                                                                                                \
-                WRITE(grs_i_, grs_m_);                                                                       \
-                if (++grs_i_ < grs_direct_)                                                                  \
+                if (IN_PART(grs_m_))                                                                         \
                 {                                                                                            \
-                    grs_want_ = lidet__proposal_next_index(&grs_state_, grs_i_, (n_src), (n_out));           \
+                    WRITE(grs_i_, grs_m_);                                                                   \
+                    ++grs_i_;                                                                                \
                 }                                                                                            \
             }                                                                                                \
-            ++grs_ord_;                                                                                      \
+            (status) = grs_i_ == (n_src) ? LIDET_OK : LIDET_ERR_STATE;                                       \
+            for (; (status) == LIDET_OK && grs_i_ < (n_out); ++grs_i_) /* draws among the rows */            \
+            {                                                                                                \
+                const uint32_t grs_k_ = lidet__proposal_next_index(&grs_state_, grs_i_, (n_src));            \
+                COPY(grs_i_, grs_k_);                                                                        \
+            }                                                                                                \
         }                                                                                                    \
-        (status) = grs_i_ == grs_direct_ ? LIDET_OK : LIDET_ERR_STATE;                                       \
-        for (; (status) == LIDET_OK && grs_i_ < (n_out); ++grs_i_) /* n_src < n_out: draws among the rows */ \
+        else                                                                                                 \
         {                                                                                                    \
-            const uint32_t grs_k_ = lidet__proposal_next_index(&grs_state_, grs_i_, (n_src), (n_out));       \
-            COPY(grs_i_, grs_k_);                                                                            \
+            uint32_t grs_start_ = 0, grs_end_ = lidet__proposal_bound(1u, (n_src), (n_out));                 \
+            uint32_t grs_best_ = 0, grs_key_ = 0;                                                            \
+            for (grs_m_ = 0; grs_m_ < (n_members) && grs_i_ < (n_out); ++grs_m_)                             \
+            {                                                                                                \
+                uint32_t grs_k_;                                                                             \
+                if (!(IN_PART(grs_m_)))                                                                      \
+                {                                                                                            \
+                    continue;                                                                                \
+                }                                                                                            \
+                grs_k_ = lidet__proposal_key((seed), (PIXEL(grs_m_)));                                       \
+                if (grs_ord_ == grs_start_ || grs_k_ < grs_key_)                                             \
+                {                                                                                            \
+                    grs_key_ = grs_k_;                                                                       \
+                    grs_best_ = grs_m_;                                                                      \
+                }                                                                                            \
+                if (++grs_ord_ == grs_end_) /* the stratum's last member */                                  \
+                {                                                                                            \
+                    WRITE(grs_i_, grs_best_);                                                                \
+                    grs_start_ = grs_end_;                                                                   \
+                    grs_end_ = lidet__proposal_bound(++grs_i_ + 1u, (n_src), (n_out));                       \
+                }                                                                                            \
+            }                                                                                                \
+            (status) = grs_i_ == (n_out) ? LIDET_OK : LIDET_ERR_STATE;                                       \
         }                                                                                                    \
     } while (0)
 

@@ -9,6 +9,7 @@
 #include <string.h>
 
 #include "internal/lidet_rng.h"
+#include "lidet/lidet_types.h" /* lidet_member_t */
 
 /* the generator state of one cluster's resampling: the seed mixed with the member count, so clusters
  * of different sizes draw different streams; 0 (xorshift's only fixed point) is replaced by
@@ -19,28 +20,65 @@ static inline uint32_t lidet__proposal_rng_start(uint32_t seed, uint32_t n_src)
     return s != 0 ? s : LIDET_RNG_PROPOSAL_ZERO_SEED;
 }
 
-/* member index of output i (0, 1, ... in order; *s is the generator state). n_src <= n_out: every
- * member once, then draws with replacement; else one member from each of n_out equal runs of the
- * member list (stratified, without replacement). */
-static inline uint32_t lidet__proposal_next_index(uint32_t *s, uint32_t i, uint32_t n_src, uint32_t n_out)
+/* member index of output i (0, 1, ... in order; *s is the generator state) of a cluster of n_src <= n_out
+ * members: every member once, then draws with replacement (a larger cluster: lidet__proposal_pick) */
+static inline uint32_t lidet__proposal_next_index(uint32_t *s, uint32_t i, uint32_t n_src)
+{
+    if (i < n_src)
+    {
+        return i;
+    }
+    return lidet__rng_next(s) % n_src;
+}
+
+/* b_i = floor(i n_src / n_out), the first member of stratum i of a cluster of n_src > n_out members.
+ * i n_src < 2^32 for every real proposal (i <= n_out <= 2^16, n_src <= 2^16): a 32-bit division, one
+ * instruction on a Cortex-M3/M4 instead of a 64-bit library call; the same quotients. */
+static inline uint32_t lidet__proposal_bound(uint32_t i, uint32_t n_src, uint32_t n_out)
+{
+    return n_src <= 0xFFFFu && n_out <= 0xFFFFu ? (i * n_src) / n_out
+                                                : (uint32_t)(((uint64_t)i * n_src) / n_out);
+}
+
+/* The key of member pixel p in the draw seeded with seed: MurmurHash3's 32-bit finaliser of seed ^ (p times
+ * the golden ratio), a bijection of p, so two pixels never tie. A cluster of n_src > n_out members takes from
+ * each stratum [b_i, b_{i+1}) the member whose pixel has the smallest key: the pick depends on the pixels
+ * themselves, not on how many members the cluster has or where the stratum starts, so two clusters that
+ * differ by a pixel or two (the float and integer projections, a pixel that changes hands) take the same
+ * points in all but the strata those pixels touch. */
+static inline uint32_t lidet__proposal_key(uint32_t seed, uint32_t p)
+{
+    return lidet__rng_mix(seed, p);
+}
+
+/* the member of stratum [b0, b1) (b1 > b0) of the member list mem whose pixel has the smallest key */
+static inline uint32_t lidet__proposal_pick(const lidet_member_t *mem, uint32_t b0, uint32_t b1,
+                                            uint32_t seed)
+{
+    uint32_t m, best = b0, key = lidet__proposal_key(seed, (uint32_t)mem[b0]);
+    for (m = b0 + 1u; m < b1; ++m)
+    {
+        const uint32_t k = lidet__proposal_key(seed, (uint32_t)mem[m]);
+        if (k < key)
+        {
+            key = k;
+            best = m;
+        }
+    }
+    return best;
+}
+
+/* member index of output i of a cluster's member list mem of n_src members, outputs 0, 1, ... in order (*s:
+ * the generator state from lidet__proposal_rng_start) */
+static inline uint32_t lidet__proposal_member(const lidet_member_t *mem, uint32_t *s, uint32_t i,
+                                              uint32_t n_src, uint32_t n_out, uint32_t seed)
 {
     if (n_src <= n_out)
     {
-        if (i < n_src)
-        {
-            return i;
-        }
-        return lidet__rng_next(s) % n_src;
+        return lidet__proposal_next_index(s, i, n_src);
     }
-    {
-        /* (i + 1) n_src < 2^32 for every real proposal (i < n_out <= 2^16, n_src <= 2^16): 32-bit divisions,
-         * one instruction on a Cortex-M3/M4 instead of a 64-bit library call; the same quotients */
-        const int small = n_src <= 0xFFFFu && n_out <= 0xFFFFu;
-        const uint32_t b0 = small ? (i * n_src) / n_out : (uint32_t)(((uint64_t)i * n_src) / n_out);
-        const uint32_t b1 =
-            small ? ((i + 1u) * n_src) / n_out : (uint32_t)(((uint64_t)(i + 1u) * n_src) / n_out);
-        return b0 + lidet__rng_next(s) % (b1 - b0); /* b1 > b0 because n_src > n_out */
-    }
+    return lidet__proposal_pick(mem, lidet__proposal_bound(i, n_src, n_out),
+                                lidet__proposal_bound(i + 1u, n_src, n_out), seed);
 }
 
 /* The rows a per-point network must see (lidet_pointnet.c, lidet_pointnet_q.c). A cluster of n_src < n_out

@@ -17,9 +17,9 @@ static inline uint32_t lidet__rng_seed(uint32_t seed)
     return seed != 0u ? seed : LIDET_RNG_DEFAULT_SEED;
 }
 
-/* the start state of cell k of a stage seeded with seed: a 32-bit mix (the finaliser of MurmurHash3) of both,
- * so every cell draws from a stream of its own, whatever the other cells held */
-static inline uint32_t lidet__rng_cell(uint32_t seed, uint32_t k)
+/* a 32-bit mix (the finaliser of MurmurHash3) of seed and k: seed ^ (k * 0x9E3779B9), then a bijection, so for one
+ * seed two values of k never give the same result */
+static inline uint32_t lidet__rng_mix(uint32_t seed, uint32_t k)
 {
     uint32_t h = seed ^ (k * 0x9E3779B9u);
     h ^= h >> 16;
@@ -27,7 +27,14 @@ static inline uint32_t lidet__rng_cell(uint32_t seed, uint32_t k)
     h ^= h >> 13;
     h *= 0xC2B2AE35u;
     h ^= h >> 16;
-    return lidet__rng_seed(h);
+    return h;
+}
+
+/* the start state of cell k of a stage seeded with seed: the mix of both, so every cell draws from a stream of its
+ * own, whatever the other cells held */
+static inline uint32_t lidet__rng_cell(uint32_t seed, uint32_t k)
+{
+    return lidet__rng_seed(lidet__rng_mix(seed, k));
 }
 
 /* advances *state and returns the new value (never 0 for a non-zero state) */

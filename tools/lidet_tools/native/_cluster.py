@@ -24,7 +24,7 @@ def _cluster_lib(L):
     L.lidet_py_cluster_run.argtypes = [V, opt(f32p), C.c_uint32, C.c_uint32, opt(u8p), opt(f32p), C.c_uint32, V,
                                        opt(u32p), opt(u16p), opt(i32p), opt(u32p), opt(f32p), C.c_uint32, opt(u32p), V]
     L.lidet_py_proposals.argtypes = [V, V, C.c_uint32, f32p, f32p, i16p, u32p]
-    L.lidet_py_proposal_indices.argtypes = [C.c_uint32, C.c_uint32, C.c_uint32, u32p]
+    L.lidet_py_proposal_indices.argtypes = [opt(u32p), C.c_uint32, C.c_uint32, C.c_uint32, u32p]
 
 
 # ---- the float stage (lidet_cluster.h) -----------------------------------------------------------------------
@@ -171,10 +171,16 @@ def proposals(clusters: Clusters, n_clusters: int | None = None, **cfg) -> Propo
     return Proposals(xyz, mean, vox, nsrc)
 
 
-def proposal_indices(n_src: int, n_out: int, seed: int = 0x5EED1234) -> np.ndarray:
-    """The C resampling rule (lidet_proposal_indices): n_out member indices."""
+def proposal_indices(n_src: int, n_out: int, seed: int = 0x5EED1234, pixels=None) -> np.ndarray:
+    """The C resampling rule (lidet_proposal_indices): n_out member indices of a cluster whose n_src member pixels
+    are `pixels` in member order (read when n_src > n_out; None there: LidetError LIDET_ERR_ARG)."""
     out = np.zeros(n_out, np.uint32)
-    st = _cluster_lib().lidet_py_proposal_indices(n_src, n_out, seed & 0xFFFFFFFF, out)
+    pix = None
+    if pixels is not None:
+        pix = np.ascontiguousarray(pixels, np.uint32)
+        if pix.shape != (n_src,):
+            raise ValueError(f"pixels: {n_src} member pixels expected, got shape {pix.shape}")
+    st = _cluster_lib().lidet_py_proposal_indices(pix, n_src, n_out, seed & 0xFFFFFFFF, out)
     if st < 0:
         raise LidetError(st, "lidet_proposal_indices")
     return out

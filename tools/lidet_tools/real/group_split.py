@@ -74,7 +74,8 @@ def split_group(pts: np.ndarray, family: str, span: float, person_m: float = 0.7
         parts = [pts[lab == j] for j in range(k)]
         if min(len(p) for p in parts) < 8:
             continue
-        props = [make_proposal(p) for p in parts]
+        # the parts' points stand in member order; their indices stand in for pixels (the same law of draws)
+        props = [make_proposal(p, pixels=np.arange(len(p))) for p in parts]
         xyz, mean, vox = (np.stack([p[i] for p in props]) for i in range(3))
         c = native.pn_classify(f"cls_{family}", xyz, mean, vox)
         if np.all(c["cls"] == PED) and np.all(c["energy"] < gamma):
