@@ -213,6 +213,21 @@ def test_eval_real_seeds(tmp_path, capsys):
     capsys.readouterr()
 
 
+def test_headline_has_the_kitti_protocol_rows():
+    """The seeds' headline figures carry the KITTI frames' AP3D moderate by KITTI's protocol when they are among
+    the sources, and leave it out otherwise."""
+    cls = {c: {r: {"found": 1} for r in ("20", "40")} for c in eval_real.CLASSES}
+    ap = {c: {"3d": {"20 m": 1.0, "40 m": 2.0}, "bev": {"20 m": 3.0, "40 m": 4.0}} for c in eval_real.CLASSES}
+    one = {"classes": cls, "fp_per_frame": {"20": 0.5, "40": 1.5}, "ap": {"kitti": ap, "loose": ap}}
+    ko = {c: {"3d": {"easy": 1.0, "moderate": m, "hard": 3.0}, "bev": {}} for c, m in
+          (("Car", 25.5), ("Pedestrian", 40.0), ("Cyclist", 7.0))}
+    h = eval_real._headline({"kitti": dict(one, kitti_official=ko), "pandaset": one, "all": one})
+    assert h["KITTI frames: car AP3D moderate"] == 25.5 and h["KITTI frames: ped AP3D moderate"] == 40.0
+    assert h["car AP3D 40 m"] == 2.0 and h["FP/frame 40 m"] == 1.5
+    assert not any(k.startswith("KITTI") for k in eval_real._headline({"pandaset": one, "all": one}))
+    assert not any(k.startswith("KITTI") for k in eval_real._headline({"kitti": dict(one, kitti_official=ko)}))
+
+
 def test_eval_real_missing_root(tmp_path, capsys):
     assert eval_real.main(["--root", str(tmp_path / "nope"), "--out", str(tmp_path / "o")]) == 2
     assert "not found" in capsys.readouterr().err

@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "internal/lidet_proposal_rule.h" /* the pick and its key */
 #include "lidet/lidet.h"
 #include "test_util.h"
 #include "test_cluster_util.h"
@@ -709,6 +710,35 @@ static void test_proposal_indices(void)
                           lidet_proposal_indices(0, 100, 8, 1, a)); /* a large cluster needs them */
 }
 
+/* the pick of a stratum (chunks of 64 keys on SIMD hosts, one pass elsewhere: lidet_proposal.c) is the member with
+ * the smallest key, at every stratum length around the chunk's, with keys from every part of the range */
+static void test_proposal_pick_is_the_smallest_key(void)
+{
+    static lidet_member_t pix[400];
+    uint32_t len, b0, i, seed = 0x5EED1234u, trial;
+    for (trial = 0; trial < 4u; ++trial)
+    {
+        for (i = 0; i < 400u; ++i)
+            pix[i] = (lidet_member_t)((i * 2654435761u + trial * 977u) % 60000u);
+        for (len = 1; len <= 200u; ++len)
+        {
+            for (b0 = 0; b0 + len <= 400u; b0 += 37u)
+            {
+                uint32_t best = b0, m;
+                for (m = b0 + 1u; m < b0 + len; ++m)
+                    if (lidet__proposal_key(seed, (uint32_t)pix[m]) < lidet__proposal_key(seed, (uint32_t)pix[best]))
+                        best = m;
+                TEST_ASSERT_EQUAL_UINT32(best, lidet__proposal_pick(pix, b0, b0 + len, seed));
+            }
+        }
+        seed = seed * 747796405u + 1u;
+    }
+    /* the key: a bijection of the pixel (no ties), MurmurHash3's finaliser of seed ^ (p * 0x9E3779B9) */
+    TEST_ASSERT_EQUAL_UINT32(4066478028u, lidet__proposal_key(0x5EED1234u, 0u));
+    TEST_ASSERT_EQUAL_UINT32(1913050917u, lidet__proposal_key(0x5EED1234u, 1u));
+    TEST_ASSERT_EQUAL_UINT32(2599926878u, lidet__proposal_key(0x5EED1234u, 11u));
+}
+
 /* proposals: centred on the cluster mean, deterministic, voxel of the mean */
 static void test_proposal_centred(void)
 {
@@ -804,6 +834,7 @@ int main(void)
     RUN_TEST(test_edge_cases);
     RUN_TEST(test_defaults_per_profile);
     RUN_TEST(test_proposal_indices);
+    RUN_TEST(test_proposal_pick_is_the_smallest_key);
     RUN_TEST(test_proposal_centred);
     return UNITY_END();
 }

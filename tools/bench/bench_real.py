@@ -34,8 +34,9 @@ def _draws(real, k: int) -> list:
              "Each proposal is 64 points drawn from its cluster with a seed (the figures above: the default seed). "
              f"`python -m lidet_tools.eval_real --seeds {k} [--fixed]`: the same frames with the default seed and "
              f"seeds 1 .. {k - 1}; mean over the draws and, in brackets, their range (docs/EVALUATION.md, section 4). "
-             "The draw alone moves a figure by that much; the integer detector draws other points than the float "
-             "one wherever a cluster differs by a pixel.", "",
+             "The draw alone moves a figure by that much. Both detectors pick each run's member by its pixel "
+             "(lidet_cluster.h), so they draw the same points wherever their clusters share the pixels. The KITTI "
+             "frames' rows: KITTI's protocol, AP R40 moderate (the table above).", "",
              "| figure | float | integer | integer - float (means) |", "|---|---|---|---:|"]
     fl, fx = js["float"], js["integer"]
     objs = fl["meta"].get("objects", {})

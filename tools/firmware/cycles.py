@@ -29,6 +29,7 @@ memory system: flash wait states, bus contention and interrupts add to them. `--
 the exact per-scan instruction counts of run_fw.py's report.
 """
 import argparse
+import bisect
 import json
 import os
 import re
@@ -136,6 +137,25 @@ def text_ranges(elf: str, nm: str):
     return ",".join(f"0x{a:x}..0x{b - 1:x}" for a, b in sorted(ranges))
 
 
+def functions(elf: str, nm: str):
+    """(starts, [(start, end, name)]) of the image's code symbols, sorted by address, for bisect; a symbol without
+    a size (the C library's assembly helpers) ends where the next one starts."""
+    out = subprocess.run([nm, "-S", "-n", elf], capture_output=True, text=True, check=True).stdout
+    fs = []
+    for line in out.splitlines():
+        f = line.split()
+        if len(f) == 4 and f[2] in "tT":
+            a = int(f[0], 16) & ~1
+            fs.append([a, a + int(f[1], 16), f[3]])
+        elif len(f) == 3 and f[1] in "tT" and not f[2].startswith("$"):
+            fs.append([int(f[0], 16) & ~1, None, f[2]])
+    fs.sort(key=lambda x: x[0])
+    for i, x in enumerate(fs):
+        if x[1] is None:
+            x[1] = fs[i + 1][0] if i + 1 < len(fs) else x[0] + 4
+    return [a for a, _, _ in fs], [tuple(x) for x in fs]
+
+
 def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800) -> dict:
     qcmd = [qemu] + QEMU[core][1:] if qemu else QEMU[core]
     with tempfile.TemporaryDirectory() as td:
@@ -151,6 +171,9 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
         # translation at pc. With -icount QEMU retranslates some blocks shorter (an instruction budget in the
         # cflags), so one address can have several blocks: each execution line names its translation's flags.
         blocks = {}
+        starts, fs = functions(elf, nm)
+        per_fn = {}  # function name -> instructions executed in it (blocks attributed by their first address)
+        calls = {}  # (library helper, calling function) -> calls
         tot_insn = lo = hi = 0
         pending = None  # the previous executed block's last instruction: (end address, kind)
         cur = None
@@ -179,7 +202,9 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
                                 h_ += ch
                                 prev_ls = kind == "ls"
                             a, size, mn, ops = cur[-1]
-                            blk = (len(cur), l_, h_, a + size, price(mn, ops, core, False)[2])
+                            blk = (len(cur), l_, h_, a + size, price(mn, ops, core, False)[2],
+                                   int(ops.lstrip("#"), 16) if base_mnemonic(mn) == "bl" and ops.startswith("#0x")
+                                   else None)
                             if cur[0][0] == pc:  # a block is logged when translated, just before its first run
                                 blocks[key] = blk
                             blocks.setdefault(cur[0][0], blk)
@@ -196,7 +221,15 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
                             elif kind == "pc":  # a PC write always refills
                                 lo += 1
                                 hi += 3
-                        n, l_, h_, end, kind = b
+                        n, l_, h_, end, kind, callee = b
+                        i = bisect.bisect_right(starts, pc) - 1
+                        fn = fs[i][2] if i >= 0 and pc < fs[i][1] else "?"
+                        per_fn[fn] = per_fn.get(fn, 0) + n
+                        if callee is not None:
+                            j = bisect.bisect_right(starts, callee) - 1
+                            if j >= 0 and fs[j][2].startswith("__"):  # calls into the C library's helpers
+                                k = (fs[j][2], fn)
+                                calls[k] = calls.get(k, 0) + 1
                         tot_insn += n
                         lo += l_
                         hi += h_
@@ -207,7 +240,8 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
     if tot_insn == 0:
         raise RuntimeError("empty trace: QEMU wrote nothing (wrong core or image?)")
     return dict(core=core, instructions=tot_insn, cycles_low=lo, cycles_high=hi, cpi_low=lo / tot_insn,
-                cpi_high=hi / tot_insn)
+                cpi_high=hi / tot_insn, per_function=dict(sorted(per_fn.items(), key=lambda kv: -kv[1])),
+                helper_calls=[(h, c, n) for (h, c), n in sorted(calls.items(), key=lambda kv: -kv[1])])
 
 
 def main(argv=None) -> int:
@@ -219,6 +253,8 @@ def main(argv=None) -> int:
     ap.add_argument("--qemu")
     ap.add_argument("--mhz", type=float, default=None, help="clock for scans per second (default: M4 200, M3 100)")
     ap.add_argument("--json")
+    ap.add_argument("--functions", type=int, default=0, metavar="N",
+                    help="also print the N functions that executed the most instructions (both runs of the image)")
     a = ap.parse_args(argv)
     for tool in (a.qemu or QEMU[a.core][0], a.nm):
         if subprocess.run(["which", tool], capture_output=True).returncode != 0:
@@ -231,6 +267,13 @@ def main(argv=None) -> int:
     mhz = a.mhz or (200.0 if a.core == "m4" else 100.0)
     print(f"{a.core}: {r['instructions']:,} instructions traced, estimated {r['cycles_low']:,} to {r['cycles_high']:,} "
           f"cycles: CPI {r['cpi_low']:.3f} to {r['cpi_high']:.3f}")
+    if a.functions:
+        print(f"the {a.functions} functions that executed the most instructions (both runs):")
+        for fn, n in list(r["per_function"].items())[:a.functions]:
+            print(f"  {n:>12,}  {100.0 * n / r['instructions']:5.1f} %  {fn}")
+        print("calls into the C library's helpers (helper, caller, calls):")
+        for h, c, n in r["helper_calls"][:a.functions]:
+            print(f"  {n:>12,}  {h} from {c}")
     if a.report:
         rep = json.load(open(a.report))
         ins = rep["insn"]["default"]

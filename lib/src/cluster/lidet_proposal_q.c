@@ -1,13 +1,15 @@
 /* SPDX-License-Identifier: MIT */
 /* Integer proposals (lidet_cluster_q.h): the float stage's resampling rule (internal/lidet_proposal_rule.h),
  * points minus the rounded mean in 4 mm steps, the mean's voxel from integer atan2 / square root. Integer
- * only. Mirrored by codegen/lidet_ref/cluster_q.py: make_proposal_q. */
+ * only. Mirrored by codegen/lidet_ref/cluster_q.py: make_proposal_q. Also the rule's pick of a large
+ * cluster's member (lidet__proposal_pick), which the float proposals share. */
 #include <string.h>
 
 #include "internal/lidet_cluster_q_internal.h"
 #include "internal/lidet_proposal_rule.h"
 #include "internal/lidet_qmath.h"
 #include "internal/lidet_qpix.h"
+#include "internal/lidet_simd.h"
 #include "lidet/lidet_cluster_q.h"
 
 void lidet_proposal_q_cfg_default(lidet_proposal_q_cfg_t *cfg)
@@ -22,6 +24,61 @@ void lidet_proposal_q_cfg_default(lidet_proposal_q_cfg_t *cfg)
     cfg->azimuth_bin_bam = 119304647u; /* 10 deg = 2^32 / 36, rounded */
     cfg->elevation_bin_bam = 119304647u;
     cfg->range_bin_4mm = 250u; /* 1 m */
+}
+
+#if LIDET_HOST_SIMD
+/* Hosts: the keys of up to 64 members at a time into a buffer, their minimum, then its position: the first two
+ * loops have independent lanes, which compilers vectorise (and build for AVX2 too, internal/lidet_simd.h); keys
+ * never tie, so the member found is the one the plain loop below finds. */
+#define PICK_CHUNK 64u
+LIDET_CLONES_AVX2 static uint32_t pick_chunked(const lidet_member_t *mem, uint32_t b0, uint32_t b1,
+                                               uint32_t seed)
+{
+    uint32_t key[PICK_CHUNK];
+    uint32_t m0, best = b0, best_key = 0xFFFFFFFFu;
+    for (m0 = b0; m0 < b1; m0 += PICK_CHUNK)
+    {
+        const uint32_t n = b1 - m0 < PICK_CHUNK ? b1 - m0 : PICK_CHUNK;
+        uint32_t j, lo = 0xFFFFFFFFu;
+        for (j = 0; j < n; ++j)
+        {
+            key[j] = lidet__proposal_key(seed, (uint32_t)mem[m0 + j]);
+        }
+        for (j = 0; j < n; ++j)
+        {
+            lo = key[j] < lo ? key[j] : lo;
+        }
+        if (lo < best_key || m0 == b0)
+        {
+            for (j = 0; key[j] != lo; ++j)
+            {
+            }
+            best_key = lo;
+            best = m0 + j;
+        }
+    }
+    return best;
+}
+#endif
+
+uint32_t lidet__proposal_pick(const lidet_member_t *mem, uint32_t b0, uint32_t b1, uint32_t seed)
+{
+#if LIDET_HOST_SIMD
+    return pick_chunked(mem, b0, b1, seed);
+#else
+    /* cores without SIMD: one pass, the best key in a register */
+    uint32_t m, best = b0, key = lidet__proposal_key(seed, (uint32_t)mem[b0]);
+    for (m = b0 + 1u; m < b1; ++m)
+    {
+        const uint32_t k = lidet__proposal_key(seed, (uint32_t)mem[m]);
+        if (k < key)
+        {
+            key = k;
+            best = m;
+        }
+    }
+    return best;
+#endif
 }
 
 /* floor(v / bin) as int16, saturating; bin >= 1 */

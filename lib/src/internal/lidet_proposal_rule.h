@@ -51,22 +51,9 @@ static inline uint32_t lidet__proposal_key(uint32_t seed, uint32_t p)
     return lidet__rng_mix(seed, p);
 }
 
-/* the member of stratum [b0, b1) (b1 > b0) of the member list mem whose pixel has the smallest key */
-static inline uint32_t lidet__proposal_pick(const lidet_member_t *mem, uint32_t b0, uint32_t b1,
-                                            uint32_t seed)
-{
-    uint32_t m, best = b0, key = lidet__proposal_key(seed, (uint32_t)mem[b0]);
-    for (m = b0 + 1u; m < b1; ++m)
-    {
-        const uint32_t k = lidet__proposal_key(seed, (uint32_t)mem[m]);
-        if (k < key)
-        {
-            key = k;
-            best = m;
-        }
-    }
-    return best;
-}
+/* the member of stratum [b0, b1) (b1 > b0) of the member list mem whose pixel has the smallest key
+ * (lidet_proposal_q.c, in the float and the integer-only library) */
+uint32_t lidet__proposal_pick(const lidet_member_t *mem, uint32_t b0, uint32_t b1, uint32_t seed);
 
 /* member index of output i of a cluster's member list mem of n_src members, outputs 0, 1, ... in order (*s:
  * the generator state from lidet__proposal_rng_start) */
