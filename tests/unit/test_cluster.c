@@ -733,6 +733,25 @@ static void test_proposal_pick_is_the_smallest_key(void)
         }
         seed = seed * 747796405u + 1u;
     }
+    /* the strata's bounds walked without divisions: floor(i n_src / n_out), at small and large counts */
+    {
+        static const uint32_t big[] = {65535u, 65536u, 131072u, 1000003u, 4000000000u};
+        uint32_t n_out, n_src, k;
+        for (n_out = 1; n_out <= 130u; n_out += 3u)
+        {
+            for (k = 0; k < 6u + sizeof big / sizeof big[0]; ++k)
+            {
+                lidet__strata_t st;
+                n_src = k < 6u ? n_out + 1u + k * 97u : big[k - 6u];
+                if (n_src <= n_out)
+                    continue;
+                lidet__strata_init(&st, n_src, n_out);
+                TEST_ASSERT_EQUAL_UINT32(0, st.b);
+                for (i = 1; i <= n_out; ++i)
+                    TEST_ASSERT_EQUAL_UINT32((uint32_t)((uint64_t)i * n_src / n_out), lidet__strata_next(&st));
+            }
+        }
+    }
     /* the key: a bijection of the pixel (no ties), MurmurHash3's finaliser of seed ^ (p * 0x9E3779B9) */
     TEST_ASSERT_EQUAL_UINT32(4066478028u, lidet__proposal_key(0x5EED1234u, 0u));
     TEST_ASSERT_EQUAL_UINT32(1913050917u, lidet__proposal_key(0x5EED1234u, 1u));

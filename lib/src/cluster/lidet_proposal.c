@@ -28,16 +28,11 @@ void lidet_proposal_cfg_default(lidet_proposal_cfg_t *cfg)
 lidet_status_t lidet_proposal_indices(const lidet_member_t *pixels, uint32_t n_src, uint32_t n_out,
                                       uint32_t seed, uint32_t *out)
 {
-    uint32_t i, s;
     if (out == 0 || n_src == 0 || n_out == 0 || (pixels == 0 && n_src > n_out))
     {
         return LIDET_ERR_ARG;
     }
-    s = lidet__proposal_rng_start(seed, n_src);
-    for (i = 0; i < n_out; ++i)
-    {
-        out[i] = lidet__proposal_member(pixels, &s, i, n_src, n_out, seed);
-    }
+    lidet__proposal_indices_of(pixels, n_src, n_out, seed, out);
     return LIDET_OK;
 }
 
@@ -75,7 +70,7 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
 {
     const lidet_cluster_rec_t *rec;
     const lidet_range_image_t *img;
-    uint32_t i, npix, state;
+    uint32_t i, npix, idx[LIDET_PROPOSAL_POINTS];
     float mx, my, mz, zo;
 
     if (c == 0 || cfg == 0 || out == 0)
@@ -101,7 +96,7 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
     rec = &c->recs[cluster_index];
     img = &c->img;
     npix = (uint32_t)img->n_rows * img->n_cols;
-    state = lidet__proposal_rng_start(cfg->seed, rec->n_points);
+    lidet__proposal_indices_of(c->members + rec->first_member, rec->n_points, cfg->n_points, cfg->seed, idx);
     mx = rec->mean_m[0];
     my = rec->mean_m[1];
     mz = rec->mean_m[2];
@@ -109,10 +104,7 @@ lidet_status_t lidet_proposal_make_of(const lidet_cluster_state_t *c, uint32_t c
     zo = cfg->z_origin == LIDET_PROPOSAL_Z_GROUND ? mz - rec->height_m : mz;
     for (i = 0; i < cfg->n_points; ++i)
     {
-        const int32_t p =
-            (int32_t)c->members[rec->first_member + lidet__proposal_member(c->members + rec->first_member,
-                                                                           &state, i, rec->n_points,
-                                                                           cfg->n_points, cfg->seed)];
+        const int32_t p = (int32_t)c->members[rec->first_member + idx[i]];
         if (p < 0 || (uint32_t)p >= npix)
         {
             return LIDET_ERR_STATE; /* cannot happen after a run; guards a stale state */

@@ -1,8 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* Integer proposals (lidet_cluster_q.h): the float stage's resampling rule (internal/lidet_proposal_rule.h),
  * points minus the rounded mean in 4 mm steps, the mean's voxel from integer atan2 / square root. Integer
- * only. Mirrored by codegen/lidet_ref/cluster_q.py: make_proposal_q. Also the rule's pick of a large
- * cluster's member (lidet__proposal_pick), which the float proposals share. */
+ * only. Mirrored by codegen/lidet_ref/cluster_q.py: make_proposal_q. Also the rule's member indices
+ * (lidet__proposal_indices_of), which the float proposals share. */
 #include <string.h>
 
 #include "internal/lidet_cluster_q_internal.h"
@@ -26,47 +26,9 @@ void lidet_proposal_q_cfg_default(lidet_proposal_q_cfg_t *cfg)
     cfg->range_bin_4mm = 250u; /* 1 m */
 }
 
-#if LIDET_HOST_SIMD
-/* Hosts: the keys of up to 64 members at a time into a buffer, their minimum, then its position: the first two
- * loops have independent lanes, which compilers vectorise (and build for AVX2 too, internal/lidet_simd.h); keys
- * never tie, so the member found is the one the plain loop below finds. */
-#define PICK_CHUNK 64u
-LIDET_CLONES_AVX2 static uint32_t pick_chunked(const lidet_member_t *mem, uint32_t b0, uint32_t b1,
-                                               uint32_t seed)
+/* the member of stratum [b0, b1) (b1 > b0) whose pixel has the smallest key: one pass, the best key in a register */
+static inline uint32_t pick(const lidet_member_t *mem, uint32_t b0, uint32_t b1, uint32_t seed)
 {
-    uint32_t key[PICK_CHUNK];
-    uint32_t m0, best = b0, best_key = 0xFFFFFFFFu;
-    for (m0 = b0; m0 < b1; m0 += PICK_CHUNK)
-    {
-        const uint32_t n = b1 - m0 < PICK_CHUNK ? b1 - m0 : PICK_CHUNK;
-        uint32_t j, lo = 0xFFFFFFFFu;
-        for (j = 0; j < n; ++j)
-        {
-            key[j] = lidet__proposal_key(seed, (uint32_t)mem[m0 + j]);
-        }
-        for (j = 0; j < n; ++j)
-        {
-            lo = key[j] < lo ? key[j] : lo;
-        }
-        if (lo < best_key || m0 == b0)
-        {
-            for (j = 0; key[j] != lo; ++j)
-            {
-            }
-            best_key = lo;
-            best = m0 + j;
-        }
-    }
-    return best;
-}
-#endif
-
-uint32_t lidet__proposal_pick(const lidet_member_t *mem, uint32_t b0, uint32_t b1, uint32_t seed)
-{
-#if LIDET_HOST_SIMD
-    return pick_chunked(mem, b0, b1, seed);
-#else
-    /* cores without SIMD: one pass, the best key in a register */
     uint32_t m, best = b0, key = lidet__proposal_key(seed, (uint32_t)mem[b0]);
     for (m = b0 + 1u; m < b1; ++m)
     {
@@ -78,7 +40,85 @@ uint32_t lidet__proposal_pick(const lidet_member_t *mem, uint32_t b0, uint32_t b
         }
     }
     return best;
+}
+
+uint32_t lidet__proposal_pick(const lidet_member_t *mem, uint32_t b0, uint32_t b1, uint32_t seed)
+{
+    return pick(mem, b0, b1, seed);
+}
+
+#if LIDET_HOST_SIMD
+/* Hosts: the keys of the cluster's members 256 at a time into a buffer (independent lanes, which compilers
+ * vectorise; built for AVX2 too on x86-64, internal/lidet_simd.h), then each stratum's smallest from the buffer.
+ * Strata are short (a few members for most clusters), so keys per stratum would leave the vector units idle. Keys
+ * never tie: the members found are pick()'s. */
+LIDET_CLONES_AVX2 static void picks(const lidet_member_t *mem, uint32_t n_src, uint32_t n_out, uint32_t seed,
+                                    uint32_t *idx)
+{
+    enum
+    {
+        CHUNK = 256
+    };
+    uint32_t key[CHUNK];
+    lidet__strata_t st;
+    uint32_t c0, i = 0, b1, best = 0, best_key = 0xFFFFFFFFu;
+    lidet__strata_init(&st, n_src, n_out);
+    b1 = lidet__strata_next(&st);
+    for (c0 = 0; c0 < n_src; c0 += CHUNK)
+    {
+        const uint32_t n = n_src - c0 < CHUNK ? n_src - c0 : CHUNK;
+        uint32_t j;
+        for (j = 0; j < n; ++j)
+        {
+            key[j] = lidet__proposal_key(seed, (uint32_t)mem[c0 + j]);
+        }
+        for (j = 0; j < n; ++j)
+        {
+            /* branch-free: a stratum of a few members makes "smaller than the best so far" a coin toss. The best
+             * key restarts at the largest value; keys never tie, so "<=" can only meet that value itself */
+            const uint32_t m = c0 + j, k = key[j];
+            const int le = k <= best_key;
+            best_key = le ? k : best_key;
+            best = le ? m : best;
+            if (m + 1u == b1) /* the stratum's last member */
+            {
+                idx[i++] = best;
+                best_key = 0xFFFFFFFFu;
+                b1 = lidet__strata_next(&st);
+            }
+        }
+    }
+}
+#else
+static void picks(const lidet_member_t *mem, uint32_t n_src, uint32_t n_out, uint32_t seed, uint32_t *idx)
+{
+    lidet__strata_t st;
+    uint32_t i, b0 = 0;
+    lidet__strata_init(&st, n_src, n_out);
+    for (i = 0; i < n_out; ++i)
+    {
+        const uint32_t b1 = lidet__strata_next(&st);
+        idx[i] = pick(mem, b0, b1, seed);
+        b0 = b1;
+    }
+}
 #endif
+
+void lidet__proposal_indices_of(const lidet_member_t *mem, uint32_t n_src, uint32_t n_out, uint32_t seed,
+                                uint32_t *idx)
+{
+    if (n_src > n_out)
+    {
+        picks(mem, n_src, n_out, seed, idx);
+    }
+    else
+    {
+        uint32_t i, s = lidet__proposal_rng_start(seed, n_src);
+        for (i = 0; i < n_out; ++i)
+        {
+            idx[i] = lidet__proposal_next_index(&s, i, n_src);
+        }
+    }
 }
 
 /* floor(v / bin) as int16, saturating; bin >= 1 */
@@ -109,7 +149,7 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
 {
     const lidet_cluster_q_rec_t *rec;
     const lidet_range_image_t *img;
-    uint32_t i, npix, state;
+    uint32_t i, npix, idx[LIDET_PROPOSAL_POINTS];
     int32_t mx, my, mz, zo;
 
     if (c == 0 || cfg == 0 || out == 0)
@@ -134,7 +174,7 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
     }
     rec = &c->recs[cluster_index];
     npix = (uint32_t)img->n_rows * img->n_cols;
-    state = lidet__proposal_rng_start(cfg->seed, rec->n_points);
+    lidet__proposal_indices_of(c->members + rec->first_member, rec->n_points, cfg->n_points, cfg->seed, idx);
     mx = rec->mean_4mm[0];
     my = rec->mean_4mm[1];
     mz = rec->mean_4mm[2];
@@ -142,10 +182,7 @@ lidet_status_t lidet_proposal_q_make(const lidet_cluster_q_state_t *c, uint32_t 
     zo = cfg->z_origin == LIDET_PROPOSAL_Z_GROUND ? mz - rec->height_4mm : mz;
     for (i = 0; i < cfg->n_points; ++i)
     {
-        const int32_t p =
-            (int32_t)c->members[rec->first_member + lidet__proposal_member(c->members + rec->first_member,
-                                                                           &state, i, rec->n_points,
-                                                                           cfg->n_points, cfg->seed)];
+        const int32_t p = (int32_t)c->members[rec->first_member + idx[i]];
         int32_t v[3];
         if (p < 0 || (uint32_t)p >= npix)
         {

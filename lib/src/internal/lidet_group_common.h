@@ -65,8 +65,11 @@
         }                                                                                                    \
         else                                                                                                 \
         {                                                                                                    \
-            uint32_t grs_start_ = 0, grs_end_ = lidet__proposal_bound(1u, (n_src), (n_out));                 \
+            lidet__strata_t grs_st_;                                                                         \
+            uint32_t grs_start_ = 0, grs_end_;                                                               \
             uint32_t grs_best_ = 0, grs_key_ = 0;                                                            \
+            lidet__strata_init(&grs_st_, (n_src), (n_out));                                                  \
+            grs_end_ = lidet__strata_next(&grs_st_);                                                         \
             for (grs_m_ = 0; grs_m_ < (n_members) && grs_i_ < (n_out); ++grs_m_)                             \
             {                                                                                                \
                 uint32_t grs_k_;                                                                             \
@@ -84,7 +87,8 @@
                 {                                                                                            \
                     WRITE(grs_i_, grs_best_);                                                                \
                     grs_start_ = grs_end_;                                                                   \
-                    grs_end_ = lidet__proposal_bound(++grs_i_ + 1u, (n_src), (n_out));                       \
+                    ++grs_i_;                                                                                \
+                    grs_end_ = lidet__strata_next(&grs_st_);                                                 \
                 }                                                                                            \
             }                                                                                                \
             (status) = grs_i_ == (n_out) ? LIDET_OK : LIDET_ERR_STATE;                                       \

@@ -31,13 +31,36 @@ static inline uint32_t lidet__proposal_next_index(uint32_t *s, uint32_t i, uint3
     return lidet__rng_next(s) % n_src;
 }
 
-/* b_i = floor(i n_src / n_out), the first member of stratum i of a cluster of n_src > n_out members.
- * i n_src < 2^32 for every real proposal (i <= n_out <= 2^16, n_src <= 2^16): a 32-bit division, one
- * instruction on a Cortex-M3/M4 instead of a 64-bit library call; the same quotients. */
-static inline uint32_t lidet__proposal_bound(uint32_t i, uint32_t n_src, uint32_t n_out)
+/* The strata of a cluster of n_src > n_out members: stratum i is members b_i .. b_{i+1} - 1 with
+ * b_i = floor(i n_src / n_out), walked without a division per stratum: with n_src = q n_out + r,
+ * b_{i+1} = b_i + q, plus one when the running remainder (i + 1) r mod n_out wraps (the same integers; two
+ * divisions per cluster, where a Cortex-M0+ has no divide instruction). */
+typedef struct
 {
-    return n_src <= 0xFFFFu && n_out <= 0xFFFFu ? (i * n_src) / n_out
-                                                : (uint32_t)(((uint64_t)i * n_src) / n_out);
+    uint32_t b, q, r, acc, n_out;
+} lidet__strata_t;
+
+/* s->b = b_0 = 0 */
+static inline void lidet__strata_init(lidet__strata_t *s, uint32_t n_src, uint32_t n_out)
+{
+    s->b = 0;
+    s->q = n_src / n_out;
+    s->r = n_src % n_out;
+    s->acc = 0;
+    s->n_out = n_out;
+}
+
+/* from b_i to b_{i+1}; returns it */
+static inline uint32_t lidet__strata_next(lidet__strata_t *s)
+{
+    s->b += s->q;
+    s->acc += s->r;
+    if (s->acc >= s->n_out)
+    {
+        s->acc -= s->n_out;
+        s->b += 1u;
+    }
+    return s->b;
 }
 
 /* The key of member pixel p in the draw seeded with seed: MurmurHash3's 32-bit finaliser of seed ^ (p times
@@ -51,22 +74,12 @@ static inline uint32_t lidet__proposal_key(uint32_t seed, uint32_t p)
     return lidet__rng_mix(seed, p);
 }
 
-/* the member of stratum [b0, b1) (b1 > b0) of the member list mem whose pixel has the smallest key
- * (lidet_proposal_q.c, in the float and the integer-only library) */
+/* the member of stratum [b0, b1) (b1 > b0) of the member list mem whose pixel has the smallest key; and the n_out
+ * member indices of a cluster whose n_src members are mem[0 .. n_src - 1] (lidet_proposal_q.c, in the float and the
+ * integer-only library) */
 uint32_t lidet__proposal_pick(const lidet_member_t *mem, uint32_t b0, uint32_t b1, uint32_t seed);
-
-/* member index of output i of a cluster's member list mem of n_src members, outputs 0, 1, ... in order (*s:
- * the generator state from lidet__proposal_rng_start) */
-static inline uint32_t lidet__proposal_member(const lidet_member_t *mem, uint32_t *s, uint32_t i,
-                                              uint32_t n_src, uint32_t n_out, uint32_t seed)
-{
-    if (n_src <= n_out)
-    {
-        return lidet__proposal_next_index(s, i, n_src);
-    }
-    return lidet__proposal_pick(mem, lidet__proposal_bound(i, n_src, n_out),
-                                lidet__proposal_bound(i + 1u, n_src, n_out), seed);
-}
+void lidet__proposal_indices_of(const lidet_member_t *mem, uint32_t n_src, uint32_t n_out, uint32_t seed,
+                                uint32_t *idx);
 
 /* The rows a per-point network must see (lidet_pointnet.c, lidet_pointnet_q.c). A cluster of n_src < n_out
  * members gives a proposal whose rows n_src, ..., n_out - 1 repeat rows of the first n_src (the rule above).
