@@ -243,6 +243,7 @@ cycles = _load("cycles")
     ("mla r0, r1, r2, r3", "m3", False, (2, 2, "")),
     ("smlad r0, r1, r2, r3", "m4", False, (1, 1, "")),
     ("udiv r0, r1, r2", "m4", False, (2, 12, "")),
+    ("udivls r3, r0, r1", "m4", False, (2, 12, "")),
     ("ldr.w r8, [r1]", "m4", False, (2, 2, "ls")),
     ("ldrb.w r3, [r6, #1]!", "m4", True, (1, 2, "ls")),
     ("strbne r3, [r0]", "m4", True, (1, 2, "ls")),
@@ -287,6 +288,12 @@ def test_cycle_estimate_of_the_m4_integer_image():
     exact += sum(run.get("insn_total", 0) for run in report.get("track", {}).values())  # and the tracker's updates
     assert abs(r["instructions"] - exact) <= 0.05 * exact, (r, exact)
     assert 1.0 < r["cpi_low"] < r["cpi_high"] < 3.0, r
+    # the profile (--functions): every traced instruction in one function, the int8 dense kernel first, and the
+    # projection's initialisation among the callers of the 64-bit division helper (its column tables)
+    pf = r["per_function"]
+    assert sum(pf.values()) == r["instructions"]
+    assert next(iter(pf)).startswith("lidet__nn_acc_s8"), list(pf)[:5]
+    assert any(h.startswith("__aeabi_uldivmod") and c == "lidet_proj_q_init" for h, c, _ in r["helper_calls"])
 
 
 # ---- the packet application (LIDET_FW_APP=packets, ports/firmware/fw_packets.c; issue 37) -----------------------

@@ -4,7 +4,7 @@
 with the cycle counts of the core's Technical Reference Manual (instruction set summary, zero wait states).
 
     python3 tools/firmware/cycles.py --elf build/firmware/mps2-an386-q/lidet_fw.elf --core m4 \\
-        [--report build/firmware/mps2-an386-q/report.json] [--json OUT]
+        [--report build/firmware/mps2-an386-q/report.json] [--json OUT] [--functions N]
 
 QEMU counts instructions exactly but has no timing model. This tool runs the image once more with
 `-d in_asm,exec,nochain` (every translated block's instructions once, then one line per executed block), limited
@@ -26,7 +26,10 @@ prices every executed instruction:
 The result is two estimates (low: P = 1, divides 2 cycles, loads pipelined where the TRM allows; high: P = 3,
 divides 12, no pipelining) and the cycles per instruction (CPI) of each. They are estimates on a zero-wait-state
 memory system: flash wait states, bus contention and interrupts add to them. `--report` applies both CPIs to
-the exact per-scan instruction counts of run_fw.py's report.
+the exact per-scan instruction counts of run_fw.py's report. `--functions N` also prints the N functions that executed
+the most instructions (a block counts for the function holding its first address; all of the image's runs, its
+initialisations included) and the calls into the C library's helpers by caller (64-bit divisions, soft-float): a
+profile, in instructions, of where a firmware scan goes.
 """
 import argparse
 import bisect
@@ -69,7 +72,8 @@ def base_mnemonic(m: str) -> str:
     for c in CONDS:  # a condition suffix (inside an IT block, or a conditional branch)
         if m.endswith(c) and len(m) > len(c):
             stem = m[: -len(c)]
-            if stem in BRANCH or stem in DP or stem in MUL1 or stem in MAC or stem.startswith(("ldr", "str", "ld", "st")) \
+            if stem in BRANCH or stem in DP or stem in MUL1 or stem in MAC or stem in LONG or stem in LONGACC \
+                    or stem in ("sdiv", "udiv") or stem.startswith(("ldr", "str", "ld", "st")) \
                     or stem.rstrip("s") in DP or stem.rstrip("s") in MUL1:
                 m = stem
                 break
