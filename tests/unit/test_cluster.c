@@ -710,15 +710,17 @@ static void test_proposal_indices(void)
                           lidet_proposal_indices(0, 100, 8, 1, a)); /* a large cluster needs them */
 }
 
-/* the pick of a stratum (chunks of 64 keys on SIMD hosts, one pass elsewhere: lidet_proposal.c) is the member with
- * the smallest key, at every stratum length around the chunk's, with keys from every part of the range */
+/* a large cluster's member indices (on SIMD hosts the keys of 256 members at a time, elsewhere one pass per stratum:
+ * lidet_proposal_q.c) are, stratum by stratum, the member with the smallest key: cluster sizes around the chunk's,
+ * keys from every part of the range; and lidet__proposal_pick alone on strata of every length up to 200 */
 static void test_proposal_pick_is_the_smallest_key(void)
 {
-    static lidet_member_t pix[400];
-    uint32_t len, b0, i, seed = 0x5EED1234u, trial;
+    static lidet_member_t pix[1100];
+    uint32_t len, b0, i, seed = 0x5EED1234u, trial, idx[LIDET_PROPOSAL_POINTS];
+    static const uint32_t sizes[] = {65, 100, 255, 256, 257, 511, 513, 1024, 1100};
     for (trial = 0; trial < 4u; ++trial)
     {
-        for (i = 0; i < 400u; ++i)
+        for (i = 0; i < 1100u; ++i)
             pix[i] = (lidet_member_t)((i * 2654435761u + trial * 977u) % 60000u);
         for (len = 1; len <= 200u; ++len)
         {
@@ -729,6 +731,21 @@ static void test_proposal_pick_is_the_smallest_key(void)
                     if (lidet__proposal_key(seed, (uint32_t)pix[m]) < lidet__proposal_key(seed, (uint32_t)pix[best]))
                         best = m;
                 TEST_ASSERT_EQUAL_UINT32(best, lidet__proposal_pick(pix, b0, b0 + len, seed));
+            }
+        }
+        for (i = 0; i < sizeof sizes / sizeof sizes[0]; ++i)
+        {
+            const uint32_t n_src = sizes[i], n_out = 64u;
+            uint32_t k;
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(pix, n_src, n_out, seed, idx));
+            for (k = 0; k < n_out; ++k)
+            {
+                const uint32_t lo = k * n_src / n_out, hi = (k + 1u) * n_src / n_out;
+                uint32_t best = lo, m;
+                for (m = lo + 1u; m < hi; ++m)
+                    if (lidet__proposal_key(seed, (uint32_t)pix[m]) < lidet__proposal_key(seed, (uint32_t)pix[best]))
+                        best = m;
+                TEST_ASSERT_EQUAL_UINT32(best, idx[k]);
             }
         }
         seed = seed * 747796405u + 1u;
