@@ -720,6 +720,16 @@ static void test_proposal_indices(void)
                           lidet_proposal_indices(0, 100, 8, 1, a)); /* a large cluster needs them */
 }
 
+/* the member of pix[lo .. hi - 1] whose pixel has the smallest key, by the definition */
+static uint32_t smallest_key(const lidet_member_t *pix, uint32_t lo, uint32_t hi, uint32_t seed)
+{
+    uint32_t best = lo, m;
+    for (m = lo + 1u; m < hi; ++m)
+        if (lidet__proposal_key(seed, (uint32_t)pix[m]) < lidet__proposal_key(seed, (uint32_t)pix[best]))
+            best = m;
+    return best;
+}
+
 /* a large cluster's member indices (on SIMD hosts the keys of 256 members at a time, elsewhere one pass per stratum:
  * lidet_proposal_q.c) are, stratum by stratum, the member with the smallest key: cluster sizes around the chunk's,
  * keys from every part of the range; and lidet__proposal_pick alone on strata of every length up to 200 */
@@ -735,13 +745,8 @@ static void test_proposal_pick_is_the_smallest_key(void)
         for (len = 1; len <= 200u; ++len)
         {
             for (b0 = 0; b0 + len <= 400u; b0 += 37u)
-            {
-                uint32_t best = b0, m;
-                for (m = b0 + 1u; m < b0 + len; ++m)
-                    if (lidet__proposal_key(seed, (uint32_t)pix[m]) < lidet__proposal_key(seed, (uint32_t)pix[best]))
-                        best = m;
-                TEST_ASSERT_EQUAL_UINT32(best, lidet__proposal_pick(pix, b0, b0 + len, seed));
-            }
+                TEST_ASSERT_EQUAL_UINT32(smallest_key(pix, b0, b0 + len, seed),
+                                         lidet__proposal_pick(pix, b0, b0 + len, seed));
         }
         for (i = 0; i < sizeof sizes / sizeof sizes[0]; ++i)
         {
@@ -749,14 +754,7 @@ static void test_proposal_pick_is_the_smallest_key(void)
             uint32_t k;
             TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_proposal_indices(pix, n_src, n_out, seed, idx));
             for (k = 0; k < n_out; ++k)
-            {
-                const uint32_t lo = k * n_src / n_out, hi = (k + 1u) * n_src / n_out;
-                uint32_t best = lo, m;
-                for (m = lo + 1u; m < hi; ++m)
-                    if (lidet__proposal_key(seed, (uint32_t)pix[m]) < lidet__proposal_key(seed, (uint32_t)pix[best]))
-                        best = m;
-                TEST_ASSERT_EQUAL_UINT32(best, idx[k]);
-            }
+                TEST_ASSERT_EQUAL_UINT32(smallest_key(pix, k * n_src / n_out, (k + 1u) * n_src / n_out, seed), idx[k]);
         }
         seed = seed * 747796405u + 1u;
     }

@@ -130,44 +130,40 @@ def price(mn: str, ops: str, core: str, prev_ls: bool):
     raise ValueError(f"no cycle count for '{mn} {ops}'")
 
 
-def text_ranges(elf: str, nm: str):
-    out = subprocess.run([nm, "-S", elf], capture_output=True, text=True, check=True).stdout
-    ranges = []
-    for line in out.splitlines():
-        f = line.split()
-        if len(f) == 4 and f[2] in "tT" and not EXCLUDE.match(f[3]):
-            a = int(f[0], 16) & ~1
-            ranges.append((a, a + int(f[1], 16)))
-    return ",".join(f"0x{a:x}..0x{b - 1:x}" for a, b in sorted(ranges))
-
-
-def functions(elf: str, nm: str):
-    """(starts, [(start, end, name)]) of the image's code symbols, sorted by address, for bisect; a symbol without
-    a size (the C library's assembly helpers) ends where the next one starts."""
+def code_symbols(elf: str, nm: str):
+    """The image's code symbols [(start, end, name, sized)], sorted by address; a symbol without a size (the C
+    library's assembly helpers) ends where the next one starts."""
     out = subprocess.run([nm, "-S", "-n", elf], capture_output=True, text=True, check=True).stdout
     fs = []
     for line in out.splitlines():
         f = line.split()
         if len(f) == 4 and f[2] in "tT":
             a = int(f[0], 16) & ~1
-            fs.append([a, a + int(f[1], 16), f[3]])
+            fs.append([a, a + int(f[1], 16), f[3], True])
         elif len(f) == 3 and f[1] in "tT" and not f[2].startswith("$"):
-            fs.append([int(f[0], 16) & ~1, None, f[2]])
+            fs.append([int(f[0], 16) & ~1, None, f[2], False])
     fs.sort(key=lambda x: x[0])
     for i, x in enumerate(fs):
         if x[1] is None:
             x[1] = fs[i + 1][0] if i + 1 < len(fs) else x[0] + 4
-    return [a for a, _, _ in fs], [tuple(x) for x in fs]
+    return [tuple(x) for x in fs]
+
+
+def text_ranges(syms) -> str:
+    """QEMU's -dfilter of the traced code: the sized symbols but the port's (EXCLUDE)."""
+    return ",".join(f"0x{a:x}..0x{b - 1:x}" for a, b, name, sized in syms if sized and not EXCLUDE.match(name))
 
 
 def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800) -> dict:
     qcmd = [qemu] + QEMU[core][1:] if qemu else QEMU[core]
+    syms = code_symbols(elf, nm)
+    starts = [a for a, _, _, _ in syms]
     with tempfile.TemporaryDirectory() as td:
         fifo = os.path.join(td, "trace")
         os.mkfifo(fifo)
         cmd = qcmd + ["-icount", "shift=8", "-semihosting-config", "enable=on,target=native", "-display", "none",
                       "-monitor", "none", "-serial", "null", "-kernel", elf, "-d", "in_asm,exec,nochain",
-                      "-dfilter", text_ranges(elf, nm), "-D", fifo]
+                      "-dfilter", text_ranges(syms), "-D", fifo]
         proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         timer = threading.Timer(timeout, proc.kill)
         timer.start()
@@ -175,7 +171,6 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
         # translation at pc. With -icount QEMU retranslates some blocks shorter (an instruction budget in the
         # cflags), so one address can have several blocks: each execution line names its translation's flags.
         blocks = {}
-        starts, fs = functions(elf, nm)
         per_fn = {}  # function name -> instructions executed in it (blocks attributed by their first address)
         calls = {}  # (library helper, calling function) -> calls
         tot_insn = lo = hi = 0
@@ -227,12 +222,12 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
                                 hi += 3
                         n, l_, h_, end, kind, callee = b
                         i = bisect.bisect_right(starts, pc) - 1
-                        fn = fs[i][2] if i >= 0 and pc < fs[i][1] else "?"
+                        fn = syms[i][2] if i >= 0 and pc < syms[i][1] else "?"
                         per_fn[fn] = per_fn.get(fn, 0) + n
                         if callee is not None:
                             j = bisect.bisect_right(starts, callee) - 1
-                            if j >= 0 and fs[j][2].startswith("__"):  # calls into the C library's helpers
-                                k = (fs[j][2], fn)
+                            if j >= 0 and syms[j][2].startswith("__"):  # calls into the C library's helpers
+                                k = (syms[j][2], fn)
                                 calls[k] = calls.get(k, 0) + 1
                         tot_insn += n
                         lo += l_
