@@ -118,7 +118,8 @@ eval-real: deps build
 	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.eval_real --root $(REAL) --out out/eval_real $(EVAL_REAL_ARGS)
 
 # Trains the PointNets from nothing: simulated proposal datasets (C stages through the bindings),
-# classifier + box net per sensor family, ONNX export, test-split figures and weights/MODEL_CARD.md; then the
+# classifier + box net per sensor family, ONNX export, test-split figures and a model card per run: the hdl64 family
+# (weights/MODEL_CARD_hdl64.md), the vlp16 family (weights/MODEL_CARD.md); then the
 # small VLP-16 pair of the integer firmware (family vlp16s, weights/MODEL_CARD_vlp16s.md), then the 32-beam family
 # (beams32: simulated VLP-32C, HDL-32E and Ouster 32-beam scans at four mounts, weights/MODEL_CARD_beams32.md; about
 # 12 min more), the 128-beam family (beams128: the Ouster 128-beam presets at four mounts, MODEL_CARD_beams128.md) and the
@@ -129,7 +130,10 @@ eval-real: deps build
 WEIGHTS_ARGS ?=
 weights: deps build
 	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \
-	    --jobs $(JOBS) --threads 1 --real $(REAL)/kitti/training --real-semantickitti $(REAL)/semantickitti $(WEIGHTS_ARGS)
+	    --jobs $(JOBS) --threads 1 --families hdl64 --card weights/MODEL_CARD_hdl64.md \
+	    --real $(REAL)/kitti/training --real-semantickitti $(REAL)/semantickitti $(WEIGHTS_ARGS)
+	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \
+	    --jobs $(JOBS) --threads 1 --families vlp16 --real $(REAL)/kitti/training $(WEIGHTS_ARGS)
 	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \
 	    --jobs $(JOBS) --threads 1 --families vlp16s --card weights/MODEL_CARD_vlp16s.md $(WEIGHTS_ARGS)
 	LIDET_BUILD_DIR=$(abspath $(BUILD)) $(PY) -m lidet_tools.train.weights --work data/train --weights weights \

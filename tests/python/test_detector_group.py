@@ -18,10 +18,10 @@ PED, GROUP = 2, 11  # lidet_class_t, LIDET_DET_OUT_GROUP
 
 @pytest.fixture(scope="module")
 def crowd():
-    """A simulated HDL-64 crowd scan (lidet-sim --crowd, seed 9313) where the detector's clustering leaves two
-    people walking side by side at 31 m in one cluster."""
+    """A simulated HDL-64 crowd scan (lidet-sim --crowd, seed 9363) where the detector's clustering leaves two
+    people walking side by side at 16 m in one cluster."""
     from lidet_tools.sim.simulate import simulate_scan
-    return simulate_scan("hdl64", seed=9313, index=0, crowd=True)
+    return simulate_scan("hdl64", seed=9363, index=0, crowd=True)
 
 
 def _bev(nd, a, b) -> float:
@@ -79,7 +79,7 @@ def test_cli_group_split(nd, crowd, tmp_path):
 
     want = nd.detect(crowd.points, "hdl64")
     for sets, n_split in (((), want.stats["n_group_split"]), (("group_split=0",), 0),
-                          (("group_max_range_m=20",), 0)):  # the group stands 31 m away
+                          (("group_max_range_m=10",), 0)):  # the group stands 16 m away
         r = run(*sets)
         assert r.returncode == 0, r.stderr
         js = json.loads(r.stdout)

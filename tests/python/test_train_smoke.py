@@ -74,6 +74,15 @@ def test_train_export_onnx_parity(tiny, tmp_path):
     ck2 = train_cls.train(a)
     for k, v in ck["state_dict"].items():
         assert torch.equal(v, ck2["state_dict"][k])
+    # another share of the validation ID proposals for the gammas resumes the finished state: the same model, the
+    # car gate where it keeps that share (a per-class share, `--gamma-tpr`), the other classes' gates as before
+    a.gamma_tpr = "0.5,0.95,0.95"
+    ck3 = train_cls.train(a)
+    for k, v in ck["state_dict"].items():
+        assert torch.equal(v, ck3["state_dict"][k])
+    assert ck3["meta"]["gamma_tpr"] == [0.5, 0.95, 0.95] and ck["meta"]["gamma_tpr"] == [0.95] * 3
+    assert ck3["meta"]["gamma"][1:] == ck["meta"]["gamma"][1:] and ck3["meta"]["gamma"][0] < ck["meta"]["gamma"][0]
+    a.gamma_tpr = "0.95"
     # other arguments with the same state folder are refused
     a.epochs_ce = 2
     with pytest.raises(ValueError, match="other arguments"):
@@ -104,6 +113,21 @@ def test_energy_gate_helpers():
     assert C.auroc(np.array([2.0, 3.0]), np.array([0.0, 1.0])) == 0.0
     assert C.auroc(np.array([1.0]), np.array([1.0])) == 0.5
     assert C.hinge(torch.tensor([-5.0, -1.0]), torch.tensor([0.0, -4.0]), -3.0, -2.0).item() == pytest.approx(2.0 + 2.0)
+
+
+def test_per_class_gamma_shares():
+    """gamma per class at its own share of that class's ID energies; a class with too few proposals takes the pooled
+    energies at its share; --gamma-tpr is one share or three, each in (0, 1]."""
+    e = np.concatenate([np.arange(100.0), 1000.0 + np.arange(100.0), [5000.0] * 5])
+    cls = np.array([0] * 100 + [2] * 100 + [1] * 5)
+    g = C.per_class_gamma(e, cls, [0.9, 0.95, 0.5])
+    assert np.mean(e[cls == 0] < g[0]) == 0.9 and np.mean(e[cls == 2] < g[2]) == 0.5
+    assert g[1] == C.threshold_at_tpr(e, 0.95)  # 5 cyclists: the pooled energies
+    assert C.per_class_gamma(e, cls, 0.95) == C.per_class_gamma(e, cls, [0.95] * 3)
+    assert train_cls.gamma_tprs("0.9") == [0.9] * 3 and train_cls.gamma_tprs("0.9,1,0.5") == [0.9, 1.0, 0.5]
+    for bad in ("0.9,0.9", "0", "1.5", "a", "0.9,0.9,0.9,0.9"):
+        with pytest.raises(ValueError, match="--gamma-tpr"):
+            train_cls.gamma_tprs(bad)
 
 
 def test_augment_keeps_box_consistent():

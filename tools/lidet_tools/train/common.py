@@ -213,13 +213,14 @@ def fpr_at_tpr(e_id: np.ndarray, e_ood: np.ndarray, tpr: float = 0.95) -> float:
     return float(np.mean(np.asarray(e_ood) < g))
 
 
-def per_class_gamma(e: np.ndarray, cls: np.ndarray, tpr: float = 0.95, min_n: int = 20) -> list:
-    """gamma per class at `tpr` ID recall; a class with fewer than min_n samples gets the pooled value."""
-    pooled = threshold_at_tpr(e, tpr)
+def per_class_gamma(e: np.ndarray, cls: np.ndarray, tpr=0.95, min_n: int = 20) -> list:
+    """gamma per class at `tpr` ID recall (one share, or one per class); a class with fewer than min_n samples gets
+    the pooled value at its share."""
+    tprs = [float(tpr)] * M.N_CLASSES if np.isscalar(tpr) else [float(t) for t in tpr]
     out = []
     for c in range(M.N_CLASSES):
         m = cls == c
-        out.append(threshold_at_tpr(e[m], tpr) if m.sum() >= min_n else pooled)
+        out.append(threshold_at_tpr(e[m], tprs[c]) if m.sum() >= min_n else threshold_at_tpr(e, tprs[c]))
     return out
 
 

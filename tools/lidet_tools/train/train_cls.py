@@ -15,7 +15,9 @@ Two phases, as energy_ood (wetliu/energy_ood) fine-tunes a pre-trained net:
    batches of 64 ID + 128 OOD proposals, Adam lr 5e-4 cosine. Model selection on validation only:
    lowest FPR at 95 % TPR + (1 - balanced accuracy).
 gamma_c (gate 1 keeps E < gamma_c, c the predicted class) is the energy that keeps 95 % of the
-validation ID proposals predicted as c (pooled when a class has fewer than 20).
+validation ID proposals predicted as c (pooled when a class has fewer than 20); `--gamma-tpr` sets that share,
+one value or one per class (Car, Cyclist, Pedestrian). It is applied after training, so a finished state
+resumes with another share at once.
 
 Fixed seeds; one thread by default (`--threads`); a state file in --work after every epoch makes the
 run resumable (the same command continues where it stopped, with the same result).
@@ -52,6 +54,9 @@ def add_args(ap):
     ap.add_argument("--batch", type=int, default=64)
     ap.add_argument("--lam", type=float, default=0.1, help="weight of the energy hinge")
     ap.add_argument("--min-gap", type=float, default=3.0, help="least m_out - m_in")
+    ap.add_argument("--gamma-tpr", default="0.95",
+                    help="share of the validation ID proposals each class's gate-1 gamma keeps: one value, or three "
+                         "(Car, Cyclist, Pedestrian)")
     ap.add_argument("--no-pvle", action="store_true", help="ablation: no PVLE branch")
     ap.add_argument("--point", default="32,64,128", help="shared MLP widths")
     ap.add_argument("--head", default="64", help="FC widths")
@@ -68,7 +73,21 @@ def _ints(s):
     return tuple(int(v) for v in s.split(",") if v)
 
 
+def gamma_tprs(s: str) -> list:
+    """--gamma-tpr as one share per class (Car, Cyclist, Pedestrian), each in (0, 1]."""
+    try:
+        v = [float(x) for x in str(s).split(",")]
+    except ValueError:
+        raise ValueError(f"--gamma-tpr {s!r}: one number or three, comma-separated") from None
+    if len(v) == 1:
+        v = v * M.N_CLASSES
+    if len(v) != M.N_CLASSES or not all(0.0 < x <= 1.0 for x in v):
+        raise ValueError(f"--gamma-tpr {s!r}: one share or {M.N_CLASSES} (Car, Cyclist, Pedestrian), each in (0, 1]")
+    return v
+
+
 def train(a) -> dict:
+    tprs = gamma_tprs(a.gamma_tpr)
     C.setup(a.seed, a.threads)
     dd = C.dist_from_env(a.device)  # None without torchrun: the single-process path below is unchanged
     main = dd is None or dd.main
@@ -88,7 +107,7 @@ def train(a) -> dict:
     model = M.ClassifierNet(**cfg).to(dev)
     state_path = a.work / "state.pt"
     args_key = {k: (str(v) if isinstance(v, pathlib.Path) else v) for k, v in vars(a).items()
-                if k not in ("no_progress", "threads", "device", "work", "out", "onnx", "command")}
+                if k not in ("no_progress", "threads", "device", "work", "out", "onnx", "command", "gamma_tpr")}
     if args_key.get("pvle") == "32,32":
         args_key.pop("pvle")  # states made before --pvle (at its default) resume as before
     if dd:
@@ -197,8 +216,8 @@ def train(a) -> dict:
     model.eval()
     lg = MX.cls_logits(model, va, dev)
     idm = va["label"] >= 0
-    gamma = C.per_class_gamma(MX.energy_np(lg)[idm], lg.argmax(1)[idm])
-    meta = dict(n_points=int(data["points"].shape[1]), gamma=gamma, energy_T=1.0, trained=1,
+    gamma = C.per_class_gamma(MX.energy_np(lg)[idm], lg.argmax(1)[idm], tprs)
+    meta = dict(n_points=int(data["points"].shape[1]), gamma=gamma, gamma_tpr=tprs, energy_T=1.0, trained=1,
                 sensor=a.sensor or data["meta"].get("sensor", ""), data=data["meta"].get("command", str(a.data)),
                 z_origin=data["meta"].get("z_origin", "mean"),
                 command=getattr(a, "command", None) or "python -m lidet_tools.train.train_cls",
