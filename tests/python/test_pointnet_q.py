@@ -176,8 +176,7 @@ def agreement(fam, props):
                 n_diff=int(diff.sum()), n_diff_kept=int((diff & (fc["passed"] | qc["passed"])).sum()),
                 diff_gap=float(gap[diff].max()) if diff.any() else 0.0,
                 gate1=float((fc["passed"] == qc["passed"]).mean()),
-                gate2=float((fb["passed"] == qb["passed"]).mean()),
-                gate2_kept=float((fb["passed"] == qb["passed"])[kept].mean()), iou=float(iou.mean()),
+                gate2=float((fb["passed"] == qb["passed"]).mean()), iou=float(iou.mean()),
                 energy1=float(np.abs(fc["energy"] - qc["energy"] / 65536.0).mean()),
                 energy2=float(np.abs(fb["energy"] - qb["energy"] / 65536.0).mean()))
 

@@ -236,14 +236,6 @@ def c_models(a, fams, scan_dirs=None) -> list:
     return regen.emit_all(a.weights)
 
 
-def _gamma_tprs(work: pathlib.Path, fam: str) -> list | None:
-    """The shares of the validation ID proposals the classifier's gate-1 gammas keep (`train_cls --gamma-tpr`), from
-    its checkpoint; None for a checkpoint made before the option (95 %)."""
-    from .export import load_checkpoint
-    _, ck = load_checkpoint(work / f"{fam}_cls.pt")
-    return ck["meta"].get("gamma_tpr")
-
-
 def model_card(a, results: dict, real, timings: dict) -> str:
     from .export import load_checkpoint
     L = ["# lidet PointNet weights: model card", "",
@@ -251,12 +243,17 @@ def model_card(a, results: dict, real, timings: dict) -> str:
          "choices and the ablation: docs/TRAINING.md.", ""]
     L += ["## Files", "", "| file | sensor family | kind | points | MACs | parameters | fp32 weights | gamma (Car, Cyclist, Pedestrian) | margins m_in / m_out | best epoch |",
           "|---|---|---|---:|---:|---:|---:|---|---|---:|"]
+    shares = []  # gate-1 shares other than 95 % (`train_cls --gamma-tpr`; checkpoints made before it hold none)
     for fam in results:
         for kind in ("cls", "box"):
             p = a.weights / f"{kind}_{fam}.onnx"
             c = MC.count(p)
             _, ck = load_checkpoint(a.work / f"{fam}_{kind}.pt")
             mg = ck["meta"]["margins"] or {}
+            tp = ck["meta"].get("gamma_tpr") if kind == "cls" else None
+            if tp and any(abs(t - 0.95) > 1e-9 for t in tp):
+                shares.append(f"; {fam}'s gate 1 keeps {', '.join(f'{100 * t:g} %' for t in tp)} (Car, Cyclist, "
+                              "Pedestrian: `train_cls --gamma-tpr`)")
             L.append(f"| `{p.name}` | {fam} | {c['kind']} | {c['n_points']} | {c['macs']:,} | {c['params']:,} | "
                      f"{c['weight_bytes_fp32'] / 1024:.1f} KiB | {', '.join(f'{g:.3f}' for g in ck['meta']['gamma'])} | "
                      f"{mg.get('m_in', float('nan')):.2f} / {mg.get('m_out', float('nan')):.2f} | {ck['meta']['best_epoch']} |")
@@ -269,10 +266,7 @@ def model_card(a, results: dict, real, timings: dict) -> str:
              if small else ""), "",
           "Gates: gate 1 keeps a proposal when E = -logsumexp(logits) < gamma[predicted class]; gate 2 when "
           "E(heading scores) + E(size scores) < gamma[class] (T = 1). Each gamma keeps 95 % of that class's "
-          "validation ID proposals" + "".join(
-              f"; {fam}'s gate 1 keeps {', '.join(f'{100 * t:g} %' for t in tp)} (Car, Cyclist, Pedestrian: "
-              "`train_cls --gamma-tpr`)" for fam, tp in ((f, _gamma_tprs(a.work, f)) for f in results)
-              if tp and any(abs(t - 0.95) > 1e-9 for t in tp)) + ".", ""]
+          "validation ID proposals" + "".join(shares) + ".", ""]
     L += ["## Data", ""]
     for fam, r in results.items():
         m = r["dataset_meta"]
