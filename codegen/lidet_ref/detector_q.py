@@ -82,7 +82,8 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     GATE2_CLASS when absent, the C default), group_split (0 when absent; the C default is 1 for > 16 rows) and
     group_max_range_mm (40000 when absent), min_score_q15 (3, the operating point; 0s when absent: off; the C
     default is 19661 for cars with > 16 rows), gate1_class_margin_q16 (3, added to gate1_margin_q16 per class; 0s
-    when absent, the C default), car_min_z_spread_mm (the cars'
+    when absent, the C default), group_gate1_margin_q16 (added to gate 1 when the group split judges a cut; 0 when
+    absent: every part must pass; the C default is 2 * 65536), car_min_z_spread_mm (the cars'
     flat-surface test; 0 when absent: off; the C default is 600) and car_ground_mm (car boxes down to the ground
     around them, `ground_box`; 0 when absent: off; the C default is 1000 for > 16 rows). range_only: the image keeps only the range, every stage reads x, y, z
     decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
@@ -180,8 +181,10 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
             return [cx, cy, cz - lift2 // 4, ln, wd, h + lift2 // 2, yaw]
         return box
 
-    def gate1_pass(cls, energy):
-        return energy < int(cls_model.gamma_q16[cls]) + g1m + g1c[cls]
+    g1g = int(det_cfg.get("group_gate1_margin_q16", 0))
+
+    def gate1_pass(cls, energy, extra=0):
+        return energy < int(cls_model.gamma_q16[cls]) + g1m + g1c[cls] + extra
 
     def add(d):
         """the detector's insertion (after every entry with a higher score or an equal score and a lower id);
@@ -223,13 +226,16 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
                 c = pointnet_q.classify(cls_model, xyz[None].astype(np.int64), mean[None], vox[None])
                 stats["n_group_classified"] += 1
                 cls, energy = int(c["cls"][0]), int(c["energy"][0])
-                ok = cls in (1, 2) and gate1_pass(cls, energy)  # lidet_class_t: 1 cyclist, 2 pedestrian
+                # lidet_class_t: 1 cyclist, 2 pedestrian; the cut judged with the group's margin
+                ok = cls in (1, 2) and gate1_pass(cls, energy, g1g)
                 n_ped += cls == 2
-                parts.append((xyz, mean, vox, n_src, energy))
+                parts.append((xyz, mean, vox, n_src, energy, cls))
             if not ok or n_ped == 0:
                 continue
             cls = 2  # every part is boxed and scored as a pedestrian
-            for xyz, mean, vox, n_src, energy in parts:
+            for xyz, mean, vox, n_src, energy, pcls in parts:
+                if not gate1_pass(pcls, energy):  # within the group's margin only: no box net pass
+                    continue
                 if stats["n_boxed"] + stats["n_group_boxed"] >= det_cfg["max_boxes"]:
                     truncated = True
                     break

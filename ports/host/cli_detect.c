@@ -470,6 +470,7 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_FLOAT(c, kv, klen, v, gate2_margin)
     CLI_SET_INT(c, kv, klen, v, group_split, uint8_t, 1)
     CLI_SET_FLOAT(c, kv, klen, v, group_max_range_m)
+    CLI_SET_FLOAT(c, kv, klen, v, group_gate1_margin)
     CLI_SET_FLOAT(c, kv, klen, v, car_min_z_spread_m)
     CLI_SET_FLOAT(c, kv, klen, v, car_ground_m)
     CLI_SET_INT(c, kv, klen, v, proposal.seed, uint32_t, 4294967295.0)
@@ -622,7 +623,9 @@ void cli_det_usage(FILE *f)
            "                   judges the class; default 1, 1, 0),\n"
            "                   group_split (0 or 1: people side by side in one cluster\n"
            "                   split by the classifier's judgement; default 1 for > 16\n"
-           "                   beams), group_max_range_m (default 40),\n"
+           "                   beams), group_max_range_m (default 40), group_gate1_margin\n"
+           "                   (nats added to gate 1 when a cut into people is judged;\n"
+           "                   default 2),\n"
            "                   min_score.car|cyclist|pedestrian (the operating point: detections\n"
            "                   scoring below are dropped; default 0.6, 0, 0 for > 16 beams,\n"
            "                   0 for <= 16), car_min_z_spread_m (a car's cluster of >= 100\n"

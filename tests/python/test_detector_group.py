@@ -110,3 +110,55 @@ def test_group_split_on_a_real_frame(nd, real_dir):
 
     assert on.stats["n_group_split"] >= 1
     assert len(found(on) - found(off)) >= 1 and found(off) <= found(on)
+
+
+def test_group_margin_judges_the_cut_not_the_parts(nd, real_dir):
+    """group_gate1_margin (default 2 nats) widens gate 1 for the judgement of a cut only: on PandaSet 000000 a cut
+    whose every part but one passes gate 1 now stands, and the people that pass it are found; a part that passes
+    only within the margin gives no detection (every group detection passes gate 1 itself)."""
+    from lidet_tools import real
+    from lidet_tools.eval_real import _arr
+    fr = real.load_frame(real_dir, "pandaset", "000000")
+    wide = nd.detect(fr.points, fr.sensor, mount_height_m=fr.mount_height_m)  # the default, 2 nats
+    strict = nd.detect(fr.points, fr.sensor, mount_height_m=fr.mount_height_m, group_gate1_margin=0.0)
+    assert wide.stats["n_group_split"] > strict.stats["n_group_split"]
+    # every part kept passes the plain gate 1 of its (pedestrian) class (margins 0 by default)
+    gamma_ped = float(nd.pn_models()["cls_hdl64"].gamma[PED])
+    groups = np.flatnonzero(wide.outcome == GROUP) + 1
+    parts = np.flatnonzero(np.isin(wide.cluster_id, groups))
+    assert len(parts) >= 1 and np.all(wide.cls[parts] == PED)
+    # a part may be a person the classifier calls a rider (its own gamma, lower or higher): at most the larger one
+    gamma_any = max(float(g) for g in nd.pn_models()["cls_hdl64"].gamma[1:])
+    assert np.all(wide.energy_cls[parts] < gamma_any) and np.any(wide.energy_cls[parts] < gamma_ped)
+    # and more labelled people within 40 m are found, none lost
+    peds = [_arr(b) for b in fr.boxes if b.cls == "Pedestrian" and np.hypot(b.x, b.y) <= 40.0]
+
+    def found(d):
+        return {i for i, g in enumerate(peds) for j in np.flatnonzero(d.cls == PED) if _bev(nd, d.box[j], g) >= 0.25}
+
+    assert found(strict) < found(wide)
+    with pytest.raises(ValueError, match="group_gate1_margin"):
+        nd.detect(fr.points, fr.sensor, group_gate1_margin=-1.0)
+
+
+def test_cli_group_margin(nd, crowd, tmp_path):
+    """`--set group_gate1_margin=M` reaches both detectors; out of [0, 20] it is refused."""
+    from lidet_tools import kitti
+    from lidet_tools.detect import find_cli
+    scan = tmp_path / "crowd.bin"
+    kitti.write_bin(scan, crowd.points)
+
+    def run(*args):
+        return subprocess.run([str(find_cli()), "detect", str(scan), "--sensor", "hdl64", "--json", *args],
+                              capture_output=True, text=True)
+
+    for fixed in ((), ("--fixed",)):
+        base = json.loads(run(*fixed).stdout)
+        same = run(*fixed, "--set", "group_gate1_margin=2")  # the default, said out loud
+        assert same.returncode == 0 and json.loads(same.stdout)["boxes"] == base["boxes"]
+        # a wider margin accepts every cut the default does (or an earlier one of the same cluster): no fewer
+        # clusters split
+        wide = json.loads(run(*fixed, "--set", "group_gate1_margin=20").stdout)
+        assert wide["group_split"] >= base["group_split"] >= 1
+        bad = run(*fixed, "--set", "group_gate1_margin=-0.5")
+        assert bad.returncode != 0

@@ -163,7 +163,7 @@ def test_score_matches_the_float_definition(nq):
 
 def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False, crop_half_bam=0, returns=None,
                 gate2_class=None, group_split=None, model=None, min_score_q15=None, car_min_z_spread_mm=None,
-                gate1_class_margin_q16=None, car_ground_mm=None):
+                gate1_class_margin_q16=None, car_ground_mm=None, group_gate1_margin_q16=None):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -182,6 +182,7 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
                    max_boxes=max_boxes or min(24 if s.rows <= 16 else 48, cap["max_clusters"]), gate1=1, gate2=1, nms_iou_q15=3277, size_min=post_q.SIZE_MIN_MM, size_max=post_q.SIZE_MAX_MM,
                    gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
                    group_split=int(s.rows > 16 if group_split is None else group_split), group_max_range_mm=40000,
+                   group_gate1_margin_q16=2 * 65536 if group_gate1_margin_q16 is None else group_gate1_margin_q16,
                    min_score_q15=min_score_q15 or ([19661, 0, 0] if s.rows > 16 else [0, 0, 0]),
                    car_min_z_spread_mm=(600 if s.rows > 16 else 0) if car_min_z_spread_mm is None else
                    car_min_z_spread_mm,
@@ -195,6 +196,7 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
 
 
 @pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "gate2_all", "group", "group_real",
+                                   "group_strict_real",
                                    "min_score", "flat", "gate1_class", "ground_off", "ground_wide",
                                    "range_only_sample",
                                    "range_only_fresh", "range_only_real", "crop_hdl64", "crop_real",
@@ -205,7 +207,7 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     returns (lidet_detector_q_run_returns: ring, azimuth, range) instead of points."""
     from lidet_ref import proj_q
     sensor, max_boxes, margins, g2c, model = "vlp16", 0, (0, 0), None, None
-    min_score, flat_mm, g1c, ground_mm = None, None, None, None
+    min_score, flat_mm, g1c, ground_mm, g1g = None, None, None, None, None
     use_returns = which.startswith("returns_")
     which = which.removeprefix("returns_")
     range_only = which.startswith("range_only_")
@@ -243,10 +245,12 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
         # operating point off: parts passing a gate moved by 4 nats score below it)
         sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
         margins, min_score = (4 * 65536, 0), [0, 0, 0]
-    elif which == "group_real":  # a real PandaSet frame: people side by side split at the default gates
+    elif which in ("group_real", "group_strict_real"):  # a real PandaSet frame: people side by side split at the
+        # default gates (the cut judged with gate 1 2 nats wider), or with the cut judged at gate 1 itself
         from lidet_tools import real as R
         fr = R.load_frame(request.getfixturevalue("real_dir"), "pandaset", "000000")
         sensor, pts, model = fr.sensor, fr.points, "hdl64"
+        g1g = 0 if which == "group_strict_real" else None
     else:
         real = request.getfixturevalue("real_dir")
         sensor, pts = "hdl64", _load(real / "kitti/training/velodyne/000001.bin")
@@ -255,10 +259,10 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
                     range_only=range_only, crop_half_bam=crop, returns=None if rets is None else nq.as_returns(*rets),
                     gate2_class=g2c, model=model, min_score_q15=min_score, car_min_z_spread_mm=flat_mm,
-                    gate1_class_margin_q16=g1c, car_ground_mm=ground_mm)
+                    gate1_class_margin_q16=g1c, car_ground_mm=ground_mm, group_gate1_margin_q16=g1g)
     r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop, returns=rets, gate2_class=g2c, model=model,
                         min_score_q15=min_score, car_min_z_spread_mm=flat_mm, gate1_class_margin_q16=g1c,
-                        car_ground_mm=ground_mm)
+                        car_ground_mm=ground_mm, group_gate1_margin_q16=g1g)
     if use_returns:  # the same scan as points gives nearly the same detections (pixels move by rounding only)
         p = nq.detect_q(mm, sensor, range_only=range_only)
         assert abs(len(p["cls"]) - len(c["cls"])) <= 2 and c["stats"]["n_clusters"] > 0
@@ -284,6 +288,9 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
         assert c["stats"][key] > c0["stats"][key] and len(c["cls"]) < len(c0["cls"])
         if which == "min_score":
             assert np.all(c["score_q15"] >= 26214) and np.any(c["outcome"] == 12)
+    elif which == "group_strict_real":  # the setting bites: fewer clusters split than with the default margin
+        c0 = nq.detect_q(mm, sensor, model=model)
+        assert 1 <= c["stats"]["n_group_split"] < c0["stats"]["n_group_split"]
     elif which in ("group", "group_real"):  # the group split fired: its parts' detections carry the cluster's id
         groups = np.flatnonzero(c["outcome"] == 11) + 1
         assert len(groups) >= 1

@@ -652,6 +652,15 @@ void test_init_errors(void)
     c.group_max_range_m = NAN;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c = cfg;
+    c.group_gate1_margin = -0.5f; /* [0, 20] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.group_gate1_margin = 20.5f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.group_gate1_margin = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.group_gate1_margin = 0.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
     c.min_score[LIDET_CLASS_PEDESTRIAN] = 1.5f; /* [0, 1] */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c.min_score[LIDET_CLASS_PEDESTRIAN] = NAN;
@@ -679,6 +688,7 @@ void test_init_errors(void)
         lidet_detector_cfg_default(&d0, lidet_sensor_find("hdl64"));
         TEST_ASSERT_EQUAL_UINT8(1, d0.group_split);
         TEST_ASSERT_EQUAL_FLOAT(40.0f, d0.group_max_range_m);
+        TEST_ASSERT_EQUAL_FLOAT(2.0f, d0.group_gate1_margin);
         TEST_ASSERT_EQUAL_FLOAT(0.6f, d0.min_score[LIDET_CLASS_CAR]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_CYCLIST]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_PEDESTRIAN]);

@@ -104,6 +104,13 @@ static void test_init_errors(void)
     cfg.gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN] = -20 * 65536;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.group_gate1_margin_q16 = 20 * 65536 + 1; /* [0, 20] nats */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.group_gate1_margin_q16 = -1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.group_gate1_margin_q16 = 0;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.car_min_z_spread_mm = 10001; /* [0, 10000] */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     cfg.car_min_z_spread_mm = -1;
@@ -120,6 +127,7 @@ static void test_init_errors(void)
     lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("hdl64"));
     TEST_ASSERT_EQUAL_UINT8(1, cfg.group_split);
     TEST_ASSERT_EQUAL_INT32(40000, cfg.group_max_range_mm);
+    TEST_ASSERT_EQUAL_INT32(2 * 65536, cfg.group_gate1_margin_q16);
     TEST_ASSERT_EQUAL_INT32(19661, cfg.min_score_q15[LIDET_CLASS_CAR]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_CYCLIST]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_PEDESTRIAN]);

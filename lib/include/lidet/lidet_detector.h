@@ -91,12 +91,19 @@ typedef struct
                               side (z spread 1.0-2.2 m, 0.9-3.5 m along its principal horizontal axis, >= 20
                               points) is cut along that axis into 2-4 parts (one-dimensional k-means); the cut
                               stands when the classifier calls every part a pedestrian or a cyclist passing gate 1
-                              (one at least a pedestrian), and each part is then boxed as a pedestrian; its
-                              detections carry the cluster's id (outcome LIDET_DET_OUT_GROUP). Up to 9 more
+                              widened by group_gate1_margin (one at least a pedestrian), and each part that passes
+                              gate 1 itself is then boxed as a pedestrian; its detections carry the cluster's id
+                              (outcome LIDET_DET_OUT_GROUP). Up to 9 more
                               classifier passes per such cluster. Default 1 for > 16 beams, 0 for <= 16 (measured
                               on the real frames: docs/DETECTOR.md, "People in groups") */
     float group_max_range_m; /**< the group split examines clusters whose mean lies within this (horizontal);
                                   [0, 1000], default 40 */
+    float
+        group_gate1_margin; /**< nats added to gate 1's threshold when the group split judges a cut (does the
+                                   classifier call every part a person?); a part still gives a detection only
+                                   when it passes gate 1 itself. [0, 20], default 2: one real person of a group
+                                   who looks out of distribution no longer vetoes the cut of the others
+                                   (measured: docs/DETECTOR.md, "People in groups"); 0: every part must pass */
     float min_score
         [LIDET_N_CLASSES]; /**< the operating point: a detection scoring below its class's value (lidet_class_t
                                            order) is dropped, outcome LIDET_DET_OUT_SCORE (stats n_score_rejected);

@@ -113,6 +113,8 @@ typedef struct
     uint8_t group_split; /**< the float detector's group_split (lidet_detector.h): default 1 for > 16 rows,
                                      0 for <= 16 */
     int32_t group_max_range_mm; /**< the float detector's group_max_range_m in mm; [0, 10^6], default 40000 */
+    int32_t group_gate1_margin_q16; /**< the float detector's group_gate1_margin in Q16 nats; [0, 20 * 65536],
+                                         default 2 * 65536 */
     int32_t min_score_q15
         [LIDET_N_CLASSES];       /**< the float detector's min_score in Q15 (a detection whose score_q15
                                                  is below is dropped, outcome LIDET_DET_OUT_SCORE); [0, 32768];

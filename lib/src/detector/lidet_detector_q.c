@@ -52,6 +52,7 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     cfg->gate2_class[LIDET_CLASS_PEDESTRIAN] = 0u;
     cfg->group_split = rows <= 16u ? 0u : 1u; /* the float detector's */
     cfg->group_max_range_mm = 40000;
+    cfg->group_gate1_margin_q16 = 2 * 65536; /* the float detector's */
     /* the float detector's operating point and flat-surface test: 0.6 in Q15 = round(0.6 * 32768) */
     cfg->min_score_q15[LIDET_CLASS_CAR] = rows <= 16u ? 0 : 19661;
     cfg->min_score_q15[LIDET_CLASS_CYCLIST] = 0;
@@ -83,7 +84,8 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
         c->nms_iou_q15 < 0 || c->nms_iou_q15 > 32768 || c->gate1_margin_q16 < -MARGIN_MAX_Q16 ||
         c->gate1_margin_q16 > MARGIN_MAX_Q16 || c->gate2_margin_q16 < -MARGIN_MAX_Q16 ||
         c->gate2_margin_q16 > MARGIN_MAX_Q16 || c->range_only > 1u || c->group_split > 1u ||
-        c->group_max_range_mm < 0 || c->group_max_range_mm > 1000000 || c->car_min_z_spread_mm < 0 ||
+        c->group_max_range_mm < 0 || c->group_max_range_mm > 1000000 || c->group_gate1_margin_q16 < 0 ||
+        c->group_gate1_margin_q16 > MARGIN_MAX_Q16 || c->car_min_z_spread_mm < 0 ||
         c->car_min_z_spread_mm > 10000 || (!LIDET_Q_PIXEL_XYZ && c->range_only == 0u) ||
         c->car_ground_mm < 0 || c->car_ground_mm > 10000 || (!LIDET_Q_PIXEL_XYZ && c->car_ground_mm != 0))
     {
@@ -464,6 +466,10 @@ car_to_ground(lidet_detector_q_t *d, lidet_box_q_t *b)
 #define DET_GATE1_PASS(d, co)                                                                                \
     ((int64_t)(co)->energy_q16 < (int64_t)(d)->cls.model->gamma_q16[(co)->cls] + (d)->cfg.gate1_margin_q16 + \
                                      (d)->cfg.gate1_class_margin_q16[(co)->cls])
+#define DET_GROUP_GATE1_PASS(d, co)                                                                          \
+    ((int64_t)(co)->energy_q16 < (int64_t)(d)->cls.model->gamma_q16[(co)->cls] + (d)->cfg.gate1_margin_q16 + \
+                                     (d)->cfg.gate1_class_margin_q16[(co)->cls] +                            \
+                                     (d)->cfg.group_gate1_margin_q16)
 #define DET_GATE2_PASS(d, cls, bo)                                                                           \
     ((int64_t)(bo)->energy_q16 < (int64_t)(d)->box.model->gamma_q16[(cls)] + (d)->cfg.gate2_margin_q16)
 #define DET_FILL fill_detection

@@ -27,6 +27,8 @@
  *   DET_GATE1_PASS(d, co)  1 when the classifier's energy lies below the model's gamma of the class plus the
  *                         configured margins, gate1_margin and the class's gate1_class_margin (the output's own
  *                         `pass` is the margin-0 decision)
+ *   DET_GROUP_GATE1_PASS(d, co)  DET_GATE1_PASS with the group split's margin (cfg group_gate1_margin*) added:
+ *                         the judgement of a cut
  *   DET_GATE2_PASS(d, cls, bo)  the same for the box net's energy
  *   DET_FILL(d, t, ci, co, bo)  the build's own fields of detection *t (score, energies, point count; the loop
  *                         sets box, cls and cluster_id)
@@ -69,8 +71,9 @@ static void det_insert(DET_T *d, lidet_status_t *worst)
 }
 
 /* The group split of cluster ci (classified, no detection): the cuts from k_max down; the first whose every part
- * the classifier calls a pedestrian passing gate 1 is kept, each part then boxed, judged and sized as a cluster
- * is, its detections carrying the cluster's id (outcome LIDET_DET_OUT_GROUP when one is kept, n_group_split).
+ * the classifier calls a pedestrian (or a rider) passing gate 1 widened by the group margin (DET_GROUP_GATE1_PASS)
+ * is kept, each part that passes gate 1 itself then boxed, judged and sized as a cluster is, its detections
+ * carrying the cluster's id (outcome LIDET_DET_OUT_GROUP when one is kept, n_group_split).
  * The parts' passes count in n_group_classified and n_group_boxed, not in the per-cluster counts, and the box
  * budget holds for them (n_boxed + n_group_boxed <= max_boxes); a part past it ends the split. */
 #if defined(__GNUC__)
@@ -103,9 +106,11 @@ det_group(DET_T *d, uint32_t ci, lidet_status_t *worst, uint32_t *box_ticks)
                 return s;
             }
             ++d->stats.n_group_classified;
-            /* a person on foot, or one the classifier takes for a rider: each part passing gate 1 as its class */
+            /* a person on foot, or one the classifier takes for a rider: each part passing the group's gate 1
+             * as its class (a real person among others who looks a little out of distribution does not veto
+             * the cut; the part gives a detection only if it passes gate 1 itself, below) */
             ok = (co[j].cls == LIDET_CLASS_PEDESTRIAN || co[j].cls == LIDET_CLASS_CYCLIST) &&
-                 DET_GATE1_PASS(d, &co[j]);
+                 DET_GROUP_GATE1_PASS(d, &co[j]);
             n_ped += co[j].cls == LIDET_CLASS_PEDESTRIAN;
         }
         if (!ok || n_ped == 0)
@@ -117,6 +122,10 @@ det_group(DET_T *d, uint32_t ci, lidet_status_t *worst, uint32_t *box_ticks)
             DET_BOX_OUT_T bo;
             DET_DETECTION_T *t;
             uint32_t tb;
+            if (!DET_GATE1_PASS(d, &co[j]))
+            {
+                continue; /* within the group's margin only: no detection, no box net pass */
+            }
             if (d->stats.n_boxed + d->stats.n_group_boxed >= d->cfg.max_boxes)
             {
                 *worst = LIDET_TRUNCATED;
