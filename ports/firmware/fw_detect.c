@@ -180,8 +180,9 @@ static uint32_t rec_clock(void *ctx)
 }
 
 /* -> 0 and out[] filled, or 1 when the recorded calls do not match the detector's order (both detectors call
- * the clock in the same order; s: their stats, which share the field names used here) */
-#define rec_stages(r, s, out) rec_stages_((r), (s)->n_boxed, (s)->ticks, (out))
+ * the clock in the same order; s: their stats, which share the field names used here). A pair per box net pass:
+ * the clusters' (n_boxed) and the group split's parts' (n_group_boxed), in the order they run */
+#define rec_stages(r, s, out) rec_stages_((r), (s)->n_boxed + (s)->n_group_boxed, (s)->ticks, (out))
 static int rec_stages_(const rec_t *r, uint32_t nb, const uint32_t *ticks, uint64_t out[LIDET_DET_N_STAGES])
 {
     uint64_t box = 0u;

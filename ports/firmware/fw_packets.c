@@ -158,8 +158,9 @@ static void put_det(const char *run, uint32_t k, const lidet_detection_q_t *d)
 /* The stages' ticks are uint32 (lidet_detector_q_stats_t); the hook rebuilds them in 64 bits as it is called,
  * from the order the streaming detector calls it in. While streaming, in pairs: stream_begin and each
  * stream_returns around their projection work. Then stream_end: k = 0 before the projection's end, 1 after it,
- * 2 after the ground stage, 3 after the clustering, 4 at the classification's start, then a pair per box net, the
- * classification's end, the post-processing's start and end (8 + 2 boxes calls, as lidet_detector_q_run's).
+ * 2 after the ground stage, 3 after the clustering, 4 at the classification's start, then a pair per box net pass
+ * (the group split's parts' too), the classification's end, the post-processing's start and end (8 + 2 boxes
+ * calls, as lidet_detector_q_run's).
  * From k = 5 on, the intervals of odd k are the classification's and of even k the box nets', but for the last
  * two: the gap before the post-processing (even) and the post-processing (odd). So two sums and the last two
  * intervals suffice (fw_detect.c keeps every timestamp instead: 1 KiB of RAM a product would not hold). */
@@ -215,7 +216,7 @@ static uint32_t seq_clock(void *ctx)
 static int seq_stages(const seq_t *q, const lidet_detector_q_stats_t *s, uint64_t out[LIDET_DET_N_STAGES])
 {
     uint32_t k;
-    if (!q->end_phase || q->n != 8u + 2u * s->n_boxed)
+    if (!q->end_phase || q->n != 8u + 2u * (s->n_boxed + s->n_group_boxed)) /* a pair per box net pass, parts too */
         return 1;
     out[LIDET_DET_STAGE_PROJECT] = q->project;
     out[LIDET_DET_STAGE_GROUND] = q->ground;
