@@ -556,12 +556,11 @@ car_to_ground(lidet_detector_t *d, lidet_box_t *b)
 #define DET_FLAT(d, ci) flat_surface((d), (ci))
 #define DET_GROUND(d, box) ((d)->cfg.car_ground_m > 0.0f ? car_to_ground((d), (box)) : (void)0)
 #define DET_SCORE_OK(d, t) ((t)->score >= (d)->cfg.min_score[(t)->cls])
-#define DET_GATE1_PASS(d, co)                                                                                \
-    ((co)->energy <                                                                                          \
-     (d)->cls.model->gamma[(co)->cls] + (d)->cfg.gate1_margin + (d)->cfg.gate1_class_margin[(co)->cls])
-#define DET_GROUP_GATE1_PASS(d, co)                                                                          \
-    ((co)->energy < (d)->cls.model->gamma[(co)->cls] + (d)->cfg.gate1_margin +                               \
-                        (d)->cfg.gate1_class_margin[(co)->cls] + (d)->cfg.group_gate1_margin)
+/* gate 1's threshold for classifier output co: the model's gamma of its class plus the configured margins */
+#define DET_GATE1_AT(d, co)                                                                                  \
+    ((d)->cls.model->gamma[(co)->cls] + (d)->cfg.gate1_margin + (d)->cfg.gate1_class_margin[(co)->cls])
+#define DET_GATE1_PASS(d, co) ((co)->energy < DET_GATE1_AT(d, co))
+#define DET_GROUP_GATE1_PASS(d, co) ((co)->energy < DET_GATE1_AT(d, co) + (d)->cfg.group_gate1_margin)
 #define DET_GATE2_PASS(d, cls, bo) ((bo)->energy < (d)->box.model->gamma[(cls)] + (d)->cfg.gate2_margin)
 #define DET_FILL fill_detection
 #define DET_INSERT insert_sorted

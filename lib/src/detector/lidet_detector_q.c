@@ -463,13 +463,13 @@ car_to_ground(lidet_detector_q_t *d, lidet_box_q_t *b)
 #define DET_FLAT(d, ci) flat_surface((d), (ci))
 #define DET_GROUND(d, box) ((d)->cfg.car_ground_mm > 0 ? car_to_ground((d), (box)) : (void)0)
 #define DET_SCORE_OK(d, t) ((int32_t)(t)->score_q15 >= (d)->cfg.min_score_q15[(t)->cls])
-#define DET_GATE1_PASS(d, co)                                                                                \
-    ((int64_t)(co)->energy_q16 < (int64_t)(d)->cls.model->gamma_q16[(co)->cls] + (d)->cfg.gate1_margin_q16 + \
-                                     (d)->cfg.gate1_class_margin_q16[(co)->cls])
+/* gate 1's threshold for classifier output co in Q16 nats (64 bits: gamma and two margins of up to 20 nats) */
+#define DET_GATE1_AT(d, co)                                                                                  \
+    ((int64_t)(d)->cls.model->gamma_q16[(co)->cls] + (d)->cfg.gate1_margin_q16 +                             \
+     (d)->cfg.gate1_class_margin_q16[(co)->cls])
+#define DET_GATE1_PASS(d, co) ((int64_t)(co)->energy_q16 < DET_GATE1_AT(d, co))
 #define DET_GROUP_GATE1_PASS(d, co)                                                                          \
-    ((int64_t)(co)->energy_q16 < (int64_t)(d)->cls.model->gamma_q16[(co)->cls] + (d)->cfg.gate1_margin_q16 + \
-                                     (d)->cfg.gate1_class_margin_q16[(co)->cls] +                            \
-                                     (d)->cfg.group_gate1_margin_q16)
+    ((int64_t)(co)->energy_q16 < DET_GATE1_AT(d, co) + (d)->cfg.group_gate1_margin_q16)
 #define DET_GATE2_PASS(d, cls, bo)                                                                           \
     ((int64_t)(bo)->energy_q16 < (int64_t)(d)->box.model->gamma_q16[(cls)] + (d)->cfg.gate2_margin_q16)
 #define DET_FILL fill_detection
