@@ -31,9 +31,10 @@ def test_pure_combinations_reproduce_the_detectors(ab, fam, crop):
     pts = kitti.read_bin(path)
     # integer geometry + int8 nets = the integer detector, bit for bit (classes, Q15 scores, mm boxes)
     cq = native.candidates_q(native.to_mm(pts), fam, crop_half_bam=(1 << 29) if crop else 0)
-    # (the detectors' post-processing that ablate_q leaves out off: the flat-surface test, the car boxes' ground)
+    # (the detectors' post-processing that ablate_q leaves out off: the flat-surface test, the car boxes' ground,
+    # and the group split, whose parts are proposals of their own that the candidates do not hold)
     dq = native.detect_q(native.to_mm(pts), fam, crop_half_bam=(1 << 29) if crop else 0, car_min_z_spread_mm=0,
-                         car_ground_mm=0)
+                         car_ground_mm=0, group_split=False)
     assert len(cq["xyz"]) == dq["stats"]["n_classified"] > 0
     got = ab.nets_int8(fam, cq["xyz"], cq["mean"], cq["voxel"], cq["cluster_id"], cq["n_points"])
     assert len(got) == len(dq["cls"]) > 0
@@ -43,7 +44,7 @@ def test_pure_combinations_reproduce_the_detectors(ab, fam, crop):
     # float geometry + float nets = the float detector without refinement (same float32 values)
     cf = native.candidates_float(pts, fam, crop_half_rad=math.pi / 4 if crop else 0.0)
     df = native.detect(pts, fam, crop_half_rad=math.pi / 4 if crop else 0.0, refine=False, car_min_z_spread_m=0,
-                       car_ground_m=0)
+                       car_ground_m=0, group_split=False)
     assert len(cf["xyz"]) == df.stats["n_classified"]
     got = ab.nets_float(fam, cf["xyz"], cf["mean"], cf["voxel"], cf["cluster_id"], max_boxes, cf["n_points"])
     assert len(got) == len(df.cls) > 0

@@ -201,10 +201,38 @@ def test_bad_widths_are_refused(tmp_path, capsys, bad):
     assert rc != 0 and "--widths" in capsys.readouterr().err
 
 
-def test_occlusion_out_of_range_is_refused(tmp_path, capsys):
-    rc = train_box.main(["--data", str(tmp_path / "none.npz"), "--work", str(tmp_path / "w"), "--out",
-                         str(tmp_path / "b.pt"), "--occlusion", "1.5", "--no-progress"])
+@pytest.mark.parametrize("trainer", [train_box, train_cls])
+def test_occlusion_out_of_range_is_refused(tmp_path, capsys, trainer):
+    rc = trainer.main(["--data", str(tmp_path / "none.npz"), "--work", str(tmp_path / "w"), "--out",
+                       str(tmp_path / "b.pt"), "--occlusion", "1.5", "--no-progress"])
     assert rc != 0 and "--occlusion must be a probability" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("bad", ['{"nope": 1}', '[0.02]', 'not json'])
+def test_classifier_aug_settings_are_checked(tmp_path, capsys, bad):
+    rc = train_cls.main(["--data", str(tmp_path / "none.npz"), "--work", str(tmp_path / "w"), "--out",
+                         str(tmp_path / "c.pt"), "--aug", bad, "--no-progress"])
+    assert rc != 0 and "--aug" in capsys.readouterr().err
+
+
+def test_classifier_occlusion_and_aug_train_and_resume(tiny, tmp_path):
+    """train_cls --occlusion and --aug reach the batches (another model than the defaults') and are part of the
+    resumable state's arguments (a state made with other settings is refused)."""
+    path, _ = tiny
+
+    def run(work, *extra):
+        a = train_cls.add_args(__import__("argparse").ArgumentParser()).parse_args(
+            ["--data", str(path), "--work", str(tmp_path / work), "--out", str(tmp_path / f"{work}.pt"),
+             "--epochs-ce", "1", "--epochs-energy", "1", "--batch", "8", "--no-progress", *extra])
+        return train_cls.train(a)
+
+    plain = run("plain")
+    aug = run("aug", "--occlusion", "0.5", "--aug", '{"jitter": 0.02}')
+    w0 = np.concatenate([v.cpu().numpy().ravel() for v in plain["state_dict"].values() if v.dtype.is_floating_point])
+    w1 = np.concatenate([v.cpu().numpy().ravel() for v in aug["state_dict"].values() if v.dtype.is_floating_point])
+    assert w0.shape == w1.shape and not np.array_equal(w0, w1)
+    with pytest.raises(ValueError, match="other arguments"):
+        run("aug", "--occlusion", "0.3")
 
 
 def test_finetune_q_round_trip_emulation_and_training(tiny, tmp_path, capsys):

@@ -17,6 +17,7 @@ Augmentation (training batches only, model frame; `augment`):
 """
 from __future__ import annotations
 
+import json
 import math
 import os
 import pathlib
@@ -153,6 +154,20 @@ def augment(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None = 
     # jitter
     pts += np.clip(rng.normal(0, g["jitter"], pts.shape), -g["jitter_clip"], g["jitter_clip"]).astype(np.float32)
     return pts.astype(np.float32), (None if box is None else box.astype(np.float32))
+
+
+def json_object_arg(text: str, flag: str, keys) -> dict:
+    """A command-line option holding a JSON object whose keys are among `keys` ({} when empty); ValueError naming
+    the option otherwise (train_cls --aug, train_box --widths)."""
+    if not text:
+        return {}
+    try:
+        d = json.loads(text)
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{flag}: not JSON ({e})") from None
+    if not isinstance(d, dict) or set(d) - set(keys):
+        raise ValueError(f"{flag}: a JSON object with keys among {tuple(keys)}, got {text!r}")
+    return d
 
 
 def energy(logits: torch.Tensor, T: float = 1.0) -> torch.Tensor:

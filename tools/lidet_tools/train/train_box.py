@@ -25,7 +25,6 @@ Selection: lowest validation (FPR95 of gate 2 - mean IoU). gamma_b per class: th
 """
 from __future__ import annotations
 
-import json
 import math
 import pathlib
 import sys
@@ -110,14 +109,7 @@ WIDTH_KEYS = ("tnet_point", "tnet_head", "point", "head", "pvle")
 
 def widths_arg(text: str) -> dict:
     """--widths JSON -> BoxNet keyword arguments (lists of positive ints); a clear error otherwise."""
-    if not text:
-        return {}
-    try:
-        w = json.loads(text)
-    except json.JSONDecodeError as e:
-        raise ValueError(f"--widths: not JSON ({e})") from None
-    if not isinstance(w, dict) or set(w) - set(WIDTH_KEYS):
-        raise ValueError(f"--widths: a JSON object with keys among {WIDTH_KEYS}, got {text!r}")
+    w = C.json_object_arg(text, "--widths", WIDTH_KEYS)
     for k, v in w.items():
         if not isinstance(v, list) or not v or not all(isinstance(x, int) and 0 < x <= 1024 for x in v):
             raise ValueError(f"--widths: {k} must be a non-empty list of widths in [1, 1024], got {v!r}")

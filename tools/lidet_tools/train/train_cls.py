@@ -57,6 +57,11 @@ def add_args(ap):
     ap.add_argument("--gamma-tpr", default="0.95",
                     help="share of the validation ID proposals each class's gate-1 gamma keeps: one value, or three "
                          "(Car, Cyclist, Pedestrian)")
+    ap.add_argument("--occlusion", type=float, default=0.0,
+                    help="probability per training proposal, road user or not, of hiding a part of it "
+                         "(common.occlude, as train_box --occlusion); 0 = off")
+    ap.add_argument("--aug", default="",
+                    help="augmentation settings changed from common.SIM_AUG, JSON (e.g. '{\"jitter\": 0.02}')")
     ap.add_argument("--no-pvle", action="store_true", help="ablation: no PVLE branch")
     ap.add_argument("--point", default="32,64,128", help="shared MLP widths")
     ap.add_argument("--head", default="64", help="FC widths")
@@ -86,8 +91,16 @@ def gamma_tprs(s: str) -> list:
     return v
 
 
+def aug_arg(text: str) -> dict:
+    """--aug: a JSON object of common.SIM_AUG's settings (ValueError naming --aug otherwise)."""
+    return C.json_object_arg(text, "--aug", C.SIM_AUG)
+
+
 def train(a) -> dict:
     tprs = gamma_tprs(a.gamma_tpr)
+    if not 0.0 <= a.occlusion <= 1.0:
+        raise ValueError(f"--occlusion must be a probability in [0, 1], got {a.occlusion}")
+    aug = aug_arg(a.aug)
     C.setup(a.seed, a.threads)
     dd = C.dist_from_env(a.device)  # None without torchrun: the single-process path below is unchanged
     main = dd is None or dd.main
@@ -110,6 +123,10 @@ def train(a) -> dict:
                 if k not in ("no_progress", "threads", "device", "work", "out", "onnx", "command", "gamma_tpr")}
     if args_key.get("pvle") == "32,32":
         args_key.pop("pvle")  # states made before --pvle (at its default) resume as before
+    if not args_key.get("occlusion"):
+        args_key.pop("occlusion", None)  # the same for --occlusion at its default
+    if not args_key.get("aug"):
+        args_key.pop("aug", None)
     if dd:
         args_key["world_size"] = dd.world  # the shards depend on it: resume with the same number of ranks
     st = dict(epoch=0, history=[], best_ce=None, best_en=None, margins=None, args=args_key)
@@ -169,10 +186,10 @@ def train(a) -> dict:
             ood = tr_ood
         for bi in C.progress(list(it), main and not a.no_progress, desc=f"cls {phase} {ep + 1}/{E1 + E2}", leave=False):
             idx = tr_id[bi]
-            p, _ = C.augment(rng, tr["points"][idx])
+            p, _ = C.augment(rng, tr["points"][idx], occlusion=a.occlusion, **aug)
             if phase == "energy":
                 oi = ood[rng.integers(0, len(ood), 2 * a.batch)]
-                po, _ = C.augment(rng, tr["points"][oi])
+                po, _ = C.augment(rng, tr["points"][oi], occlusion=a.occlusion, **aug)
                 pts, vox = C.tensors(tr, np.concatenate([idx, oi]), dev, np.concatenate([p, po]))
             else:
                 pts, vox = C.tensors(tr, idx, dev, p)
