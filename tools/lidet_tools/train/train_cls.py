@@ -91,16 +91,11 @@ def gamma_tprs(s: str) -> list:
     return v
 
 
-def aug_arg(text: str) -> dict:
-    """--aug: a JSON object of common.SIM_AUG's settings (ValueError naming --aug otherwise)."""
-    return C.json_object_arg(text, "--aug", C.SIM_AUG)
-
-
 def train(a) -> dict:
     tprs = gamma_tprs(a.gamma_tpr)
     if not 0.0 <= a.occlusion <= 1.0:
         raise ValueError(f"--occlusion must be a probability in [0, 1], got {a.occlusion}")
-    aug = aug_arg(a.aug)
+    aug = C.json_object_arg(a.aug, "--aug", C.SIM_AUG)  # settings of common.SIM_AUG
     C.setup(a.seed, a.threads)
     dd = C.dist_from_env(a.device)  # None without torchrun: the single-process path below is unchanged
     main = dd is None or dd.main
@@ -123,10 +118,9 @@ def train(a) -> dict:
                 if k not in ("no_progress", "threads", "device", "work", "out", "onnx", "command", "gamma_tpr")}
     if args_key.get("pvle") == "32,32":
         args_key.pop("pvle")  # states made before --pvle (at its default) resume as before
-    if not args_key.get("occlusion"):
-        args_key.pop("occlusion", None)  # the same for --occlusion at its default
-    if not args_key.get("aug"):
-        args_key.pop("aug", None)
+    for k in ("occlusion", "aug"):
+        if not args_key.get(k):
+            args_key.pop(k, None)  # the same for --occlusion and --aug at their defaults
     if dd:
         args_key["world_size"] = dd.world  # the shards depend on it: resume with the same number of ranks
     st = dict(epoch=0, history=[], best_ce=None, best_en=None, margins=None, args=args_key)
