@@ -349,24 +349,37 @@ def test_make_weights_family_with_int8_fine_tuning(tmp_path, monkeypatch, need_l
     assert ", ".join(f"{v:.3f}" for v in ck["meta"]["gamma"]) in card
 
 
+def _centred_proposals(rng, B, N, half_xy, half_z, box):
+    """B proposals of N points uniform in +-half_xy (x, y) and +-half_z (z), each centred on its mean, and B copies
+    of one box target."""
+    pts = rng.uniform(-half_xy, half_xy, (B, N, 3)).astype(np.float32)
+    pts[..., 2] = rng.uniform(-half_z, half_z, (B, N))
+    pts -= pts.mean(1, keepdims=True)
+    return pts, np.tile(np.array([box], np.float32), (B, 1))
+
+
+def _kept_points(before, after, box_before, box_after):
+    """A proposal cut and re-centred by common's occlusions: (the box target's offset, its points moved back);
+    asserts that it holds only points it had and is centred on their mean."""
+    off = box_after[:3] - box_before[:3]
+    orig = after - off  # undo the re-centring
+    d = np.abs(orig[:, None, :] - before[None, :, :]).max(-1).min(1)
+    assert d.max() < 1e-5  # only original points
+    np.testing.assert_allclose(after.mean(0), 0.0, atol=1e-5)
+    return off, orig
+
+
 def test_occlude_from_above_keeps_the_top_recentres_and_moves_the_box():
     """common.occlude_from_above: a hit proposal keeps only its points above a cut at 35-70 % of its z extent (a
     person seen over a parked car's roof), re-centred on their own mean, the box target moved by the same offset;
     a proposal that would keep fewer than 8 distinct points is left as it was."""
     rng = np.random.default_rng(3)
     B, N = 32, 64
-    pts = rng.uniform(-0.3, 0.3, (B, N, 3)).astype(np.float32)
-    pts[..., 2] = rng.uniform(-0.9, 0.9, (B, N))
-    pts -= pts.mean(1, keepdims=True)
-    box = np.tile(np.array([[0.0, 0.0, 0.0, 0.8, 0.6, 1.8, 0.0]], np.float32), (B, 1))
+    pts, box = _centred_proposals(rng, B, N, 0.3, 0.9, [0.0, 0.0, 0.0, 0.8, 0.6, 1.8, 0.0])
     p, b = pts.copy(), box.copy()
     C.occlude_from_above(rng, p, b, 1.0)
     for i in range(B):
-        off = b[i, :3] - box[i, :3]
-        orig = p[i] - off  # undo the re-centring
-        d = np.abs(orig[:, None, :] - pts[i][None, :, :]).max(-1).min(1)
-        assert d.max() < 1e-5  # only original points
-        np.testing.assert_allclose(p[i].mean(0), 0.0, atol=1e-5)
+        off, orig = _kept_points(pts[i], p[i], box[i], b[i])
         z0, z1 = pts[i, :, 2].min(), pts[i, :, 2].max()
         cut = orig[:, 2].min()
         assert cut >= z0 + 0.35 * (z1 - z0) - 1e-5  # the lower 35 % at least is gone (resampled: the top may be too)
@@ -377,6 +390,38 @@ def test_occlude_from_above_keeps_the_top_recentres_and_moves_the_box():
     f2 = few.copy()
     C.occlude_from_above(rng, f2, None, 1.0)
     np.testing.assert_array_equal(f2, few)
+
+
+def test_ground_cut_drops_the_lowest_points_recentres_and_moves_the_box():
+    """common.ground_cut: a hit proposal loses its points within h <= max_m of its lowest one (a real ground stage
+    eating a car's sills), re-centred on the kept points' mean, the box target moved by the same offset; a proposal
+    that would keep fewer than 8 distinct points is left as it was; augment's ground_cut (0, 0) draws nothing and a
+    bad setting is refused."""
+    rng = np.random.default_rng(4)
+    B, N = 32, 64
+    pts, box = _centred_proposals(rng, B, N, 1.0, 0.7, [0.1, 0.0, 0.05, 4.0, 1.7, 1.4, 0.2])
+    p, b = pts.copy(), box.copy()
+    C.ground_cut(rng, p, b, 1.0, 0.3)
+    cuts = []
+    for i in range(B):
+        _, orig = _kept_points(pts[i], p[i], box[i], b[i])
+        cuts.append(orig[:, 2].min() - pts[i, :, 2].min())
+    cuts = np.array(cuts)
+    # cuts drawn up to 0.3 m (the resampling may also miss a few of the lowest kept points: up to 0.1 m more)
+    assert cuts.min() >= 0.0 and cuts.max() <= 0.3 + 0.1 and np.median(cuts) > 0.08
+    few = np.zeros((1, N, 3), np.float32)
+    few[0, :, 2] = np.where(np.arange(N) < N - 3, -0.5, np.linspace(0.5, 1.0, N)[:N])  # 3 distinct points on top
+    f2 = few.copy()
+    C.ground_cut(np.random.default_rng(0), f2, None, 1.0, 1.0)
+    np.testing.assert_array_equal(f2, few)
+    a0, _ = C.augment(np.random.default_rng(1), pts)
+    a1, _ = C.augment(np.random.default_rng(1), pts, ground_cut=(0.0, 0.0))
+    a2, _ = C.augment(np.random.default_rng(1), pts, ground_cut=[0.5, 0.2])  # as JSON gives it (--aug)
+    np.testing.assert_array_equal(a0, a1)
+    assert not np.array_equal(a0, a2)
+    for bad in ((1.5, 0.1), (0.5, -0.1), (0.5,), 0.5):
+        with pytest.raises(ValueError, match="ground_cut"):
+            C.augment(rng, pts, ground_cut=bad)
 
 
 def test_top_occlusion_touches_only_cyclists_and_pedestrians():

@@ -42,6 +42,16 @@ def device(name: str) -> torch.device:
     return torch.device(name)
 
 
+def _keep_recentred(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None, i: int, keep) -> None:
+    """Proposal i of pts (B, N, 3) becomes N points drawn from its points `keep`, re-centred on their own mean (the
+    C proposal is centred on the mean of what it holds); its box target moves with them."""
+    q = pts[i][keep[rng.integers(0, len(keep), pts.shape[1])]]
+    c = q.mean(0)
+    pts[i] = q - c
+    if box is not None:
+        box[i, 0:3] -= c
+
+
 def occlude(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None, p: float) -> None:
     """In place, with probability p per proposal: hide a part of it as real scans do, then re-centre.
     One of three, equally likely: a lateral band (an occluder in front hides a range of azimuths: in the
@@ -51,7 +61,7 @@ def occlude(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None, p
     centred on the mean of the points it holds, so the kept points are re-centred on their own mean and
     the box target moves with them (the rotation about the new mean's azimuth is left to the +-5 deg
     rotation of `augment`)."""
-    B, N, _ = pts.shape
+    B = pts.shape[0]
     hit = np.nonzero(rng.random(B) < p)[0]
     kind = rng.integers(0, 3, len(hit))
     frac = rng.uniform(0.15, 0.45, len(hit))
@@ -69,11 +79,7 @@ def occlude(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None, p
         keep = np.nonzero(~hide)[0]
         if len(keep) < 8:
             continue
-        q = q[keep[rng.integers(0, len(keep), N)]]
-        c = q.mean(0)
-        pts[i] = q - c
-        if box is not None:
-            box[i, 0:3] -= c
+        _keep_recentred(rng, pts, box, i, keep)
 
 
 def occlude_from_above(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None, p: float,
@@ -83,7 +89,7 @@ def occlude_from_above(rng: np.random.Generator, pts: np.ndarray, box: np.ndarra
     up: docs/journal/real-streets.md). The cut hides a share drawn from `hide` of the proposal's z extent, far more
     than `occlude`'s lower part (15-45 % of the points); at least 8 points stay, else the proposal is left as it
     was. The kept points are resampled to N and re-centred on their own mean, the box target moving with them."""
-    B, N, _ = pts.shape
+    B = pts.shape[0]
     hit = np.nonzero(rng.random(B) < p)[0]
     frac = rng.uniform(hide[0], hide[1], len(hit))
     for i, f in zip(hit, frac):
@@ -92,16 +98,30 @@ def occlude_from_above(rng: np.random.Generator, pts: np.ndarray, box: np.ndarra
         keep = np.nonzero(q[:, 2] >= z0 + f * (z1 - z0))[0]
         if len(np.unique(keep)) < 8 or len(np.unique(q[keep], axis=0)) < 8:
             continue
-        q = q[keep[rng.integers(0, len(keep), N)]]
-        c = q.mean(0)
-        pts[i] = q - c
-        if box is not None:
-            box[i, 0:3] -= c
+        _keep_recentred(rng, pts, box, i, keep)
 
 
-#: the trainers' augmentation of simulated proposals (augment's defaults)
+def ground_cut(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None, p: float, max_m: float) -> None:
+    """In place, with probability p per proposal: drop the points within h of its lowest point, h drawn from [0,
+    max_m] metres, as a real ground stage eats a car's sills and a person's feet (on the real training frames a close
+    car's cluster starts 0.35 m above its box bottom, a simulated one's 0.22 m: docs/journal/real-streets.md). At
+    least 8 distinct points stay, else the proposal is left as it was. The kept points are resampled to N and
+    re-centred on their own mean, the box target moving with them (as `occlude`)."""
+    B = pts.shape[0]
+    hit = np.nonzero(rng.random(B) < p)[0]
+    cut = rng.uniform(0.0, max_m, len(hit))
+    for i, h in zip(hit, cut):
+        q = pts[i]
+        keep = np.nonzero(q[:, 2] >= float(q[:, 2].min()) + h)[0]
+        if len(np.unique(q[keep], axis=0)) < 8:
+            continue
+        _keep_recentred(rng, pts, box, i, keep)
+
+
+#: the trainers' augmentation of simulated proposals (augment's defaults); ground_cut: (probability, max metres)
+#: of `ground_cut`, (0, 0) draws nothing (the batches of earlier models)
 SIM_AUG = dict(keep=(0.6, 1.0), min_keep=4, rot_deg=5.0, scale=None, shift_xy=0.1, shift_z=0.05, jitter=0.01,
-               jitter_clip=0.03)
+               jitter_clip=0.03, ground_cut=(0.0, 0.0))
 
 
 def augment(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None = None, occlusion: float = 0.0,
@@ -109,7 +129,8 @@ def augment(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None = 
     """Augment a batch: pts (B, N, 3) model frame, box (B, 7) model-frame targets (or None). Copies.
     occlusion: the probability of `occlude` per proposal (0: no draw, the batches of earlier models).
     params: SIM_AUG's settings to change (keep: share of the points kept, min_keep, rot_deg: rotation about z,
-    scale: (lo, hi) about the mean with the box, or None for no draw, shift_xy / shift_z, jitter / jitter_clip)."""
+    scale: (lo, hi) about the mean with the box, or None for no draw, shift_xy / shift_z, jitter / jitter_clip,
+    ground_cut: (probability, max metres) of `ground_cut`)."""
     unknown = set(params) - set(SIM_AUG)
     if unknown:
         raise TypeError(f"unknown augmentation setting(s) {sorted(unknown)}")
@@ -119,6 +140,12 @@ def augment(rng: np.random.Generator, pts: np.ndarray, box: np.ndarray | None = 
     box = None if box is None else np.array(box, np.float32, copy=True)
     if occlusion > 0.0:
         occlude(rng, pts, box, occlusion)
+    gc = g["ground_cut"]
+    if not (isinstance(gc, (tuple, list)) and len(gc) == 2 and 0.0 <= gc[0] <= 1.0 and 0.0 <= gc[1] <= 1.0):
+        raise ValueError(f"ground_cut: (probability in [0, 1], max metres in [0, 1]), got {gc!r}")
+    gc_p, gc_m = gc
+    if gc_p > 0.0:
+        ground_cut(rng, pts, box, float(gc_p), float(gc_m))
     # dropout by resampling
     keep = rng.uniform(*g["keep"], B)
     for i in range(B):
