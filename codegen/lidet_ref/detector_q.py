@@ -83,7 +83,8 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     group_max_range_mm (40000 when absent), min_score_q15 (3, the operating point; 0s when absent: off; the C
     default is 19661 for cars with > 16 rows), gate1_class_margin_q16 (3, added to gate1_margin_q16 per class; 0s
     when absent, the C default), group_gate1_margin_q16 (added to gate 1 when the group split judges a cut; 0 when
-    absent: every part must pass; the C default is 2 * 65536), car_min_z_spread_mm (the cars'
+    absent: every part must pass; the C default is 2 * 65536), gate1_large_car_margin_q16 (added to gate 1 for a
+    car whose cluster holds >= FLAT_MIN_POINTS members; 0 when absent), car_min_z_spread_mm (the cars'
     flat-surface test; 0 when absent: off; the C default is 600) and car_ground_mm (car boxes down to the ground
     around them, `ground_box`; 0 when absent: off; the C default is 1000 for > 16 rows). range_only: the image keeps only the range, every stage reads x, y, z
     decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
@@ -182,6 +183,7 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
         return box
 
     g1g = int(det_cfg.get("group_gate1_margin_q16", 0))
+    g1l = int(det_cfg.get("gate1_large_car_margin_q16", 0))
 
     def gate1_pass(cls, energy, extra=0):
         return energy < int(cls_model.gamma_q16[cls]) + g1m + g1c[cls] + extra
@@ -259,7 +261,9 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
         c = pointnet_q.classify(cls_model, xyz[None].astype(np.int64), mean[None], vox[None])
         cls, energy = int(c["cls"][0]), int(c["energy"][0])
         stats["n_classified"] += 1
-        if det_cfg["gate1"] and not gate1_pass(cls, energy):
+        # a car in a cluster of >= FLAT_MIN_POINTS members: gate 1 widened by the large-car margin
+        large = g1l if cls == 0 and recs[ci].n_points >= FLAT_MIN_POINTS else 0
+        if det_cfg["gate1"] and not gate1_pass(cls, energy, large):
             outcome[ci] = OUT_GATE1
             stats["n_gate1_rejected"] += 1
             if group_on:

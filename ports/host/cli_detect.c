@@ -471,6 +471,7 @@ static int apply_set(lidet_detector_cfg_t *c, const char *kv)
     CLI_SET_INT(c, kv, klen, v, group_split, uint8_t, 1)
     CLI_SET_FLOAT(c, kv, klen, v, group_max_range_m)
     CLI_SET_FLOAT(c, kv, klen, v, group_gate1_margin)
+    CLI_SET_FLOAT(c, kv, klen, v, gate1_large_car_margin)
     CLI_SET_FLOAT(c, kv, klen, v, car_min_z_spread_m)
     CLI_SET_FLOAT(c, kv, klen, v, car_ground_m)
     CLI_SET_INT(c, kv, klen, v, proposal.seed, uint32_t, 4294967295.0)
@@ -618,7 +619,9 @@ void cli_det_usage(FILE *f)
            "                   nms_iou, max_proposals, max_boxes, gate1, gate2, gate1_margin,\n"
            "                   gate2_margin (nats added to the models' gates),\n"
            "                   gate1_margin.car|cyclist|pedestrian (nats added to gate1_margin\n"
-           "                   for that class; default 0),\n"
+           "                   for that class; default 0), gate1_large_car_margin (nats added\n"
+           "                   to gate 1 for a car whose cluster holds >= 100 pixels; default\n"
+           "                   1 for > 16 beams, 0 for <= 16),\n"
            "                   gate2.car|cyclist|pedestrian (0 or 1: whether gate 2\n"
            "                   judges the class; default 1, 1, 0),\n"
            "                   group_split (0 or 1: people side by side in one cluster\n"

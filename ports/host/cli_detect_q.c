@@ -108,6 +108,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     cfg.group_split = fcfg->group_split;
     cfg.group_max_range_mm = round_i32((double)fcfg->group_max_range_m * 1000.0);
     cfg.group_gate1_margin_q16 = round_i32((double)fcfg->group_gate1_margin * 65536.0);
+    cfg.gate1_large_car_margin_q16 = round_i32((double)fcfg->gate1_large_car_margin * 65536.0);
     cfg.car_min_z_spread_mm = round_i32((double)fcfg->car_min_z_spread_m * 1000.0);
     cfg.car_ground_mm = round_i32((double)fcfg->car_ground_m * 1000.0);
     cfg.proposal.seed = fcfg->proposal.seed;

@@ -21,7 +21,7 @@ static int32_t g_pp[LIDET_MAX_POINTS];
 /* fcfg: crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin, mount_height_m (< 0: the profile's),
  * min_score per class (3 entries, < 0: the default for the sensor), car_min_z_spread_m (< 0: the default),
  * gate1_class_margin per class (3 entries, NaN: the default), car_ground_m (< 0: the default),
- * group_gate1_margin (< 0: the default);
+ * group_gate1_margin (< 0: the default), gate1_large_car_margin (< 0: the default);
  * ucfg: max_proposals (0 = the default), gate1, gate2, refine (the clustering's split_people and join_cars),
  * gate2_class as bits (bit k: class k, lidet_class_t order; 0xFFFFFFFF = the default), group_split (0, 1;
  * 0xFFFFFFFF = the default for the sensor).
@@ -103,6 +103,10 @@ static int det_run(const lidet_sensor_t *s, uint32_t cls_index, uint32_t box_ind
     if (fcfg[14] >= 0.0f) /* the group split's gate-1 margin; < 0: the default */
     {
         cfg.group_gate1_margin = fcfg[14];
+    }
+    if (fcfg[15] >= 0.0f) /* gate 1's margin for cars in large clusters; < 0: the default */
+    {
+        cfg.gate1_large_car_margin = fcfg[15];
     }
     cfg.stages.cluster.split_people = ucfg[3] != 0u; /* the proposal refinement (lidet_refine.c) */
     cfg.stages.cluster.join_cars = ucfg[3] != 0u;

@@ -95,6 +95,10 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
     {
         cfg.group_gate1_margin_q16 = icfg[20];
     }
+    if (icfg[21] >= 0) /* gate 1's margin for cars in large clusters; -1: the default */
+    {
+        cfg.gate1_large_car_margin_q16 = icfg[21];
+    }
     if (icfg[9] >= 0) /* -1: the build's default */
     {
         cfg.range_only = (uint8_t)icfg[9];
@@ -113,7 +117,7 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
  * gate2_class as bits (bit k: class k; -1 = the default), group_split (0, 1; -1 = the default for the sensor),
  * min_score_q15 per class (3 entries, -1 = the default), car_min_z_spread_mm (-1 = the default),
  * gate1_class_margin_q16 per class (3 entries, INT32_MIN = the default), car_ground_mm (-1 = the default),
- * group_gate1_margin_q16 (-1 = the default).
+ * group_gate1_margin_q16 (-1 = the default), gate1_large_car_margin_q16 (-1 = the default).
  * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
  * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 18 uint32 (the
  * counts of lidet_detector_q_stats_t in order, then n_over_box_budget, n_too_tall, the three group counts and

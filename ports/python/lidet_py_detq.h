@@ -6,7 +6,7 @@
 #include "lidet/lidet_detector_q.h"
 
 /* The entries of icfg (lidet_py_detq_run's layout, lidet_py_det_q.c); every caller passes all of them */
-#define LIDET_PY_DETQ_ICFG 21
+#define LIDET_PY_DETQ_ICFG 22
 
 /* Configure det from the defaults of `sensor` and icfg (LIDET_PY_DETQ_ICFG entries: crop_half_bam, max_range_mm,
  * nms_iou_q15, max_proposals (0 = the default), gate1, gate2, max_boxes (0 = the default), ...) with the int8 models

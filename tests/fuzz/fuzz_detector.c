@@ -19,7 +19,8 @@ static void detector_knobs(fz_in_t *in, lidet_detector_cfg_t *c, uint8_t *vlp, u
 {
     float *const fl[] = {&c->crop_half_rad, &c->max_range_m, &c->nms_iou, &c->size_min_m[0][0],
                          &c->size_max_m[1][2], &c->proposal.range_bin_m, &c->gate1_margin, &c->gate2_margin,
-                         &c->gate1_class_margin[LIDET_CLASS_PEDESTRIAN], &c->group_gate1_margin};
+                         &c->gate1_class_margin[LIDET_CLASS_PEDESTRIAN], &c->group_gate1_margin,
+                         &c->gate1_large_car_margin};
     const uint8_t f = fz_u8(in);
     *vlp = f & 1u;
     *per_point = (f >> 1) & 1u;

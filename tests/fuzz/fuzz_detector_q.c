@@ -92,7 +92,8 @@ static void detector_q_knobs(fz_in_t *in, lidet_detector_q_cfg_t *c, uint8_t *p6
         &c->cluster.max_bridge_per_pixel_q16, &c->cluster.split_cell_mm, &c->cluster.split_min_width_mm,
         &c->cluster.person_min_aspect_q16, &c->cluster.join_gap_mm, &c->cluster.car_min_length_mm,
         (uint32_t *)&c->gate1_margin_q16, (uint32_t *)&c->gate2_margin_q16,
-        (uint32_t *)&c->gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN], (uint32_t *)&c->group_gate1_margin_q16};
+        (uint32_t *)&c->gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN], (uint32_t *)&c->group_gate1_margin_q16,
+        (uint32_t *)&c->gate1_large_car_margin_q16};
     const uint8_t f = fz_u8(in);
     *p64 = f & 1u;
     *per_point = (f >> 1) & 1u;

@@ -161,9 +161,14 @@ def test_score_matches_the_float_definition(nq):
 
 # ---- the integer detector against the chained numpy reference, bit for bit ---------------------------
 
+#: lidet_detector_q_cfg_default's gate1_large_car_margin_q16 for > 16 rows (0 for <= 16)
+LARGE_CAR_Q16 = 65536
+
+
 def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False, crop_half_bam=0, returns=None,
                 gate2_class=None, group_split=None, model=None, min_score_q15=None, car_min_z_spread_mm=None,
-                gate1_class_margin_q16=None, car_ground_mm=None, group_gate1_margin_q16=None):
+                gate1_class_margin_q16=None, car_ground_mm=None, group_gate1_margin_q16=None,
+                gate1_large_car_margin_q16=None):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -187,7 +192,9 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
                    car_min_z_spread_mm=(600 if s.rows > 16 else 0) if car_min_z_spread_mm is None else
                    car_min_z_spread_mm,
                    gate1_class_margin_q16=gate1_class_margin_q16 or [0, 0, 0],
-                   car_ground_mm=(1000 if s.rows > 16 else 0) if car_ground_mm is None else car_ground_mm)
+                   car_ground_mm=(1000 if s.rows > 16 else 0) if car_ground_mm is None else car_ground_mm,
+                   gate1_large_car_margin_q16=(LARGE_CAR_Q16 if s.rows > 16 else 0) if gate1_large_car_margin_q16 is None
+                   else gate1_large_car_margin_q16)
     if gate2_class is not None:
         det_cfg["gate2_class"] = gate2_class
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
@@ -197,7 +204,7 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
 
 @pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "gate2_all", "group", "group_real",
                                    "group_strict_real",
-                                   "min_score", "flat", "gate1_class", "ground_off", "ground_wide",
+                                   "min_score", "flat", "gate1_class", "large_car", "ground_off", "ground_wide",
                                    "range_only_sample",
                                    "range_only_fresh", "range_only_real", "crop_hdl64", "crop_real",
                                    "returns_sample", "returns_range_only_sample", "returns_range_only_fresh"])
@@ -207,7 +214,7 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     returns (lidet_detector_q_run_returns: ring, azimuth, range) instead of points."""
     from lidet_ref import proj_q
     sensor, max_boxes, margins, g2c, model = "vlp16", 0, (0, 0), None, None
-    min_score, flat_mm, g1c, ground_mm, g1g = None, None, None, None, None
+    min_score, flat_mm, g1c, ground_mm, g1g, g1l = None, None, None, None, None, None
     use_returns = which.startswith("returns_")
     which = which.removeprefix("returns_")
     range_only = which.startswith("range_only_")
@@ -235,6 +242,9 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     elif which == "gate1_class":  # gate 1 per class: cars 2 nats looser, pedestrians 1 nat looser, cyclists stricter
         sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
         g1c = [2 * 65536, -65536, 65536]
+    elif which == "large_car":  # gate 1 looser by 3 nats for cars in clusters of >= 100 members
+        sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
+        g1l = 3 * 65536
     elif which in ("ground_off", "ground_wide"):  # the car boxes' ground off, or looked for within 3 m
         sensor, pts = "hdl64", _load(ROOT / "tests/data/sim_hdl64/velodyne/000000.bin")
         ground_mm = 0 if which == "ground_off" else 3000
@@ -259,10 +269,11 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     c = nq.detect_q(mm, sensor, max_boxes=max_boxes, gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
                     range_only=range_only, crop_half_bam=crop, returns=None if rets is None else nq.as_returns(*rets),
                     gate2_class=g2c, model=model, min_score_q15=min_score, car_min_z_spread_mm=flat_mm,
-                    gate1_class_margin_q16=g1c, car_ground_mm=ground_mm, group_gate1_margin_q16=g1g)
+                    gate1_class_margin_q16=g1c, car_ground_mm=ground_mm, group_gate1_margin_q16=g1g,
+                    gate1_large_car_margin_q16=g1l)
     r = _ref_detect(nq, mm, sensor, max_boxes, margins, range_only, crop, returns=rets, gate2_class=g2c, model=model,
                         min_score_q15=min_score, car_min_z_spread_mm=flat_mm, gate1_class_margin_q16=g1c,
-                        car_ground_mm=ground_mm, group_gate1_margin_q16=g1g)
+                        car_ground_mm=ground_mm, group_gate1_margin_q16=g1g, gate1_large_car_margin_q16=g1l)
     if use_returns:  # the same scan as points gives nearly the same detections (pixels move by rounding only)
         p = nq.detect_q(mm, sensor, range_only=range_only)
         assert abs(len(p["cls"]) - len(c["cls"])) <= 2 and c["stats"]["n_clusters"] > 0
@@ -271,6 +282,14 @@ def test_bit_exact_with_the_chained_reference(nq, which, request):
     if which == "gate1_class":  # the setting bites: against the defaults, gate 1 rejects fewer clusters
         c0 = nq.detect_q(mm, sensor)
         assert c["stats"]["n_gate1_rejected"] < c0["stats"]["n_gate1_rejected"]
+    if which == "large_car":  # it bites on car clusters of >= 100 members only: the defaults' detections stay
+        c0 = nq.detect_q(mm, sensor, gate1_large_car_margin_q16=0)
+        assert c["stats"]["n_gate1_rejected"] < c0["stats"]["n_gate1_rejected"]
+        g1 = 4  # native.OUTCOME: gate1
+        assert np.any((c0["outcome"] == g1) & (c["outcome"] != g1))  # clusters past gate 1 now
+        for cid in np.setdiff1d(c["cluster_id"], c0["cluster_id"]):
+            k = np.flatnonzero(c["cluster_id"] == cid)
+            assert np.all(c["cls"][k] == 0) and np.all(c["n_points"][k] >= 100)
     if which.startswith("ground_"):  # the setting bites: some car boxes differ in height and z only
         c0 = nq.detect_q(mm, sensor)
         assert np.array_equal(c["cls"], c0["cls"]) and np.array_equal(c["boxes"][:, [0, 1, 3, 4, 6]],

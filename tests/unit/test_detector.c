@@ -58,6 +58,8 @@ static void make_models(void)
 }
 
 /* ---- a synthetic scan -------------------------------------------------------------------------------- */
+/* lidet_detector_cfg_default's gate1_large_car_margin for > 16 beams (0 for <= 16) */
+#define LARGE_CAR_DEFAULT 1.0f
 #define MAXP 120000
 static float g_pts[MAXP * 4];
 static uint32_t g_n;
@@ -451,8 +453,10 @@ void test_crop_budget_range_and_gates(void)
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
     TEST_ASSERT_EQUAL_UINT32(1, lidet_detector_stats(&g.ws)->n_out_of_range);
 
-    /* gate 1: a threshold below the energy rejects every proposal; gate off lets them through */
+    /* gate 1: a threshold below the energy rejects every proposal; gate off lets them through (the large-car
+     * margin, 1 nat by default for this 64-beam sensor, off until its own check below) */
     cfg.max_range_m = 0.0f;
+    cfg.gate1_large_car_margin = 0.0f;
     m_cls.gamma[0] = -6.0f;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
@@ -498,6 +502,23 @@ void test_crop_budget_range_and_gates(void)
             TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c1, &m_cls, &m_box));
             TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
             TEST_ASSERT_EQUAL_UINT32(3, lidet_detector_stats(&g.ws)->n_gate1_rejected);
+            /* the large-car margin: the car proposals of clusters of >= LIDET_DET_FLAT_MIN_POINTS members pass,
+             * the smaller ones stay rejected */
+            c1.gate1_class_margin[LIDET_CLASS_PEDESTRIAN] = 0.0f;
+            c1.gate1_large_car_margin = e1 + 6.0f + 0.5f;
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c1, &m_cls, &m_box));
+            TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_run(&g.ws, g_pts, g_n, 4, NULL, NULL));
+            {
+                uint32_t nl = 0, k2, big = 0;
+                const lidet_detection_t *dl = lidet_detector_detections(&g.ws, &nl);
+                for (k2 = 0; k2 < nl; ++k2)
+                {
+                    TEST_ASSERT_TRUE(dl[k2].n_points >= LIDET_DET_FLAT_MIN_POINTS);
+                    big += 1u;
+                }
+                TEST_ASSERT_TRUE(big >= 1u);
+                TEST_ASSERT_EQUAL_UINT32(3u - big, lidet_detector_stats(&g.ws)->n_gate1_rejected);
+            }
             TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &cfg, &m_cls, &m_box));
         }
         m_box.gamma[0] = e2 + 0.5f;
@@ -671,6 +692,15 @@ void test_init_errors(void)
     c.gate1_class_margin[LIDET_CLASS_CYCLIST] = NAN;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c = cfg;
+    c.gate1_large_car_margin = -0.5f; /* [0, 20] */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.gate1_large_car_margin = 20.5f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.gate1_large_car_margin = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c.gate1_large_car_margin = 20.0f;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
+    c = cfg;
     c.car_min_z_spread_m = -0.1f; /* [0, 10] */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     c.car_min_z_spread_m = INFINITY;
@@ -698,7 +728,9 @@ void test_init_errors(void)
                                 d0.gate1_class_margin[LIDET_CLASS_CAR]); /* gate 1: the models' thresholds */
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_CYCLIST]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_PEDESTRIAN]);
+        TEST_ASSERT_EQUAL_FLOAT(LARGE_CAR_DEFAULT, d0.gate1_large_car_margin);
         lidet_detector_cfg_default(&d0, lidet_sensor_find("vlp16"));
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_large_car_margin);
         TEST_ASSERT_EQUAL_UINT8(0, d0.group_split);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_PEDESTRIAN]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_CAR]);

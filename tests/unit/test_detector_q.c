@@ -104,6 +104,13 @@ static void test_init_errors(void)
     cfg.gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN] = -20 * 65536;
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.gate1_large_car_margin_q16 = 20 * 65536 + 1; /* [0, 20] nats */
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.gate1_large_car_margin_q16 = -1;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    cfg.gate1_large_car_margin_q16 = 20 * 65536;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
+    lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.group_gate1_margin_q16 = 20 * 65536 + 1; /* [0, 20] nats */
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));
     cfg.group_gate1_margin_q16 = -1;

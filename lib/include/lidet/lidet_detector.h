@@ -81,6 +81,13 @@ typedef struct
                                            thresholds. E.g. 1 for pedestrians keeps more real people that the
                                            networks trained on simulated ones find out of distribution, and
                                            more clutter (measured: docs/DETECTOR.md, "Operating points") */
+    float
+        gate1_large_car_margin; /**< added to gate 1's threshold for a proposal the classifier calls a car whose
+                                       cluster holds at least LIDET_DET_FLAT_MIN_POINTS member pixels (nats, [0,
+                                       20]): real cars that the networks trained on simulated ones find a little out
+                                       of distribution are mostly large clusters, the clutter a wider car gate lets
+                                       through mostly small ones. Default 1 for > 16 beams, 0 for <= 16
+                                       (measured: docs/DETECTOR.md, "Operating points") */
     uint8_t gate2_class[LIDET_N_CLASSES]; /**< 1: gate 2 judges this class (lidet_class_t order), 0: its boxes
                                                pass gate 2 whatever the box net's energy (the energy is still
                                                reported). Default car 1, cyclist 1, pedestrian 0: a pedestrian's

@@ -108,6 +108,10 @@ typedef struct
     int32_t gate1_class_margin_q16
         [LIDET_N_CLASSES]; /**< the float detector's gate1_class_margin in Q16 nats, added to gate1_margin_q16
                                            for a proposal of that class; [-20 * 65536, 20 * 65536]; default 0 */
+    int32_t
+        gate1_large_car_margin_q16; /**< the float detector's gate1_large_car_margin in Q16 nats, added to gate 1
+                                             for a car whose cluster holds >= LIDET_DET_FLAT_MIN_POINTS member
+                                             pixels; [0, 20 * 65536]; default 65536 for > 16 rows, 0 for <= 16 */
     uint8_t gate2_class[LIDET_N_CLASSES]; /**< 1: gate 2 judges this class, 0: it passes (the float detector's
                                                gate2_class); default car 1, cyclist 1, pedestrian 0 */
     uint8_t group_split; /**< the float detector's group_split (lidet_detector.h): default 1 for > 16 rows,

@@ -47,6 +47,7 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     cfg->gate1_class_margin_q16[LIDET_CLASS_CAR] = 0; /* the float detector's: the models' thresholds */
     cfg->gate1_class_margin_q16[LIDET_CLASS_CYCLIST] = 0;
     cfg->gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN] = 0;
+    cfg->gate1_large_car_margin_q16 = rows <= 16u ? 0 : 65536; /* the float detector's */
     cfg->gate2_class[LIDET_CLASS_CAR] = 1u; /* the float detector's: pedestrians pass gate 2 */
     cfg->gate2_class[LIDET_CLASS_CYCLIST] = 1u;
     cfg->gate2_class[LIDET_CLASS_PEDESTRIAN] = 0u;
@@ -87,7 +88,8 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
         c->group_max_range_mm < 0 || c->group_max_range_mm > 1000000 || c->group_gate1_margin_q16 < 0 ||
         c->group_gate1_margin_q16 > MARGIN_MAX_Q16 || c->car_min_z_spread_mm < 0 ||
         c->car_min_z_spread_mm > 10000 || (!LIDET_Q_PIXEL_XYZ && c->range_only == 0u) ||
-        c->car_ground_mm < 0 || c->car_ground_mm > 10000 || (!LIDET_Q_PIXEL_XYZ && c->car_ground_mm != 0))
+        c->car_ground_mm < 0 || c->car_ground_mm > 10000 || (!LIDET_Q_PIXEL_XYZ && c->car_ground_mm != 0) ||
+        c->gate1_large_car_margin_q16 < 0 || c->gate1_large_car_margin_q16 > MARGIN_MAX_Q16)
     {
         return 0;
     }
@@ -463,10 +465,14 @@ car_to_ground(lidet_detector_q_t *d, lidet_box_q_t *b)
 #define DET_FLAT(d, ci) flat_surface((d), (ci))
 #define DET_GROUND(d, box) ((d)->cfg.car_ground_mm > 0 ? car_to_ground((d), (box)) : (void)0)
 #define DET_SCORE_OK(d, t) ((int32_t)(t)->score_q15 >= (d)->cfg.min_score_q15[(t)->cls])
-/* gate 1's threshold for classifier output co in Q16 nats (64 bits: gamma and two margins of up to 20 nats) */
+/* gate 1's threshold for classifier output co in Q16 nats (64 bits: gamma and three margins of up to 20 nats);
+ * the large-car margin when the proposal just made is a car cluster's of >= LIDET_DET_FLAT_MIN_POINTS members */
 #define DET_GATE1_AT(d, co)                                                                                  \
     ((int64_t)(d)->cls.model->gamma_q16[(co)->cls] + (d)->cfg.gate1_margin_q16 +                             \
-     (d)->cfg.gate1_class_margin_q16[(co)->cls])
+     (d)->cfg.gate1_class_margin_q16[(co)->cls] +                                                            \
+     ((co)->cls == LIDET_CLASS_CAR && (d)->proposal.n_points_src >= LIDET_DET_FLAT_MIN_POINTS                \
+          ? (d)->cfg.gate1_large_car_margin_q16                                                              \
+          : 0))
 #define DET_GATE1_PASS(d, co) ((int64_t)(co)->energy_q16 < DET_GATE1_AT(d, co))
 #define DET_GROUP_GATE1_PASS(d, co)                                                                          \
     ((int64_t)(co)->energy_q16 < DET_GATE1_AT(d, co) + (d)->cfg.group_gate1_margin_q16)

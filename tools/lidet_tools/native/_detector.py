@@ -94,7 +94,8 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
            gate2: bool = True, refine: bool = True, gate1_margin: float = 0.0, gate2_margin: float = 0.0,
            mount_height_m: float | None = None, gate2_class=None, group_split: bool | None = None,
            min_score=None, car_min_z_spread_m: float | None = None, gate1_class_margin=None,
-           car_ground_m: float | None = None, group_gate1_margin: float | None = None) -> Detections:
+           car_ground_m: float | None = None, group_gate1_margin: float | None = None,
+           gate1_large_car_margin: float | None = None) -> Detections:
     """lidet_detector_run on (N, >=3) points with the models cls_<model> / box_<model> compiled into the bindings
     (default: `default_family(sensor)`). sensor: a preset name (the C preset, lidet_sensor_find, as `lidet detect
     --sensor`) or a `Sensor` (its table in ring order, e.g. `sensors.load_sensor_file`, `load_ouster_metadata`, as
@@ -114,7 +115,9 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
     proposal of that class (None: the C default, 0 for every class). car_ground_m: car boxes stretched down to the
     ground pixels within this of their footprint (lidet_detector_cfg_t.car_ground_m; 0 turns it off; None: the C
     default, 1 m for > 16 beams). group_gate1_margin: nats added to gate 1 when the group split judges a cut, in
-    [0, 20] (lidet_detector_cfg_t.group_gate1_margin; None: the C default, 2)."""
+    [0, 20] (lidet_detector_cfg_t.group_gate1_margin; None: the C default, 2). gate1_large_car_margin: nats added to
+    gate 1 for a car whose cluster holds >= 100 member pixels, in [0, 20] (lidet_detector_cfg_t.gate1_large_car_margin;
+    None: the C default)."""
     if max_proposals is not None and not (isinstance(max_proposals, (int, np.integer)) and max_proposals >= 1):
         raise ValueError(f"max_proposals must be a positive integer, got {max_proposals!r}")
     if not isinstance(sensor, (str, Sensor)):
@@ -144,13 +147,16 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
         raise ValueError(f"car_ground_m must be metres in [0, 10], got {car_ground_m!r}")
     if group_gate1_margin is not None and not (0.0 <= float(group_gate1_margin) <= 20.0):
         raise ValueError(f"group_gate1_margin must be nats in [0, 20], got {group_gate1_margin!r}")
+    if gate1_large_car_margin is not None and not (0.0 <= float(gate1_large_car_margin) <= 20.0):
+        raise ValueError(f"gate1_large_car_margin must be nats in [0, 20], got {gate1_large_car_margin!r}")
     fc = np.array([crop_half_rad, max_range_m, nms_iou, gate1_margin, gate2_margin,
                    -1.0 if mount_height_m is None else mount_height_m,
                    *([-1.0] * 3 if ms3 is None else ms3),
                    -1.0 if car_min_z_spread_m is None else car_min_z_spread_m,
                    *([np.nan] * 3 if g1c is None else g1c),
                    -1.0 if car_ground_m is None else car_ground_m,
-                   -1.0 if group_gate1_margin is None else group_gate1_margin], np.float32)
+                   -1.0 if group_gate1_margin is None else group_gate1_margin,
+                   -1.0 if gate1_large_car_margin is None else gate1_large_car_margin], np.float32)
     uc = np.array([max_proposals or 0, int(bool(gate1)), int(bool(gate2)), int(bool(refine)),
                    0xFFFFFFFF if gate2_class is None else _class_bits(gate2_class),
                    0xFFFFFFFF if group_split is None else int(bool(group_split))], np.uint32)
@@ -185,7 +191,8 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
              gate2: bool = True, max_boxes: int = 0, gate1_margin_q16: int = 0, gate2_margin_q16: int = 0,
              range_only: bool | None = None, returns=None, gate2_class=None, group_split: bool | None = None,
              min_score_q15=None, car_min_z_spread_mm: int | None = None, gate1_class_margin_q16=None,
-             car_ground_mm: int | None = None, group_gate1_margin_q16: int | None = None) -> dict:
+             car_ground_mm: int | None = None, group_gate1_margin_q16: int | None = None,
+             gate1_large_car_margin_q16: int | None = None) -> dict:
     """lidet_detector_q_run on (N, 3) int32 mm points with the int8 models cls_<model>_s8 / box_<model>_s8
     (returns: a RETURN_DTYPE array instead, lidet_detector_q_run_returns; points_mm is then ignored).
     gate*_margin_q16: the gates' operating points (lidet_detector_q_cfg_t, Q16 nats). range_only: the range-only
@@ -196,6 +203,8 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     [-20 * 65536, 20 * 65536], the float detector's gate1_class_margin in Q16 nats (None: the C default).
     car_ground_mm: the float detector's car_ground_m in mm (None: the C default). group_gate1_margin_q16: the float
     detector's group_gate1_margin in Q16 nats, [0, 20 * 65536] (None: the C default, 2 * 65536).
+    gate1_large_car_margin_q16: the float detector's gate1_large_car_margin in Q16 nats, [0, 20 * 65536] (None: the C
+    default).
 
     Returns {'cls', 'score_q15', 'energy_cls_q16', 'energy_box_q16', 'boxes' (N, 7: cx cy cz l w h mm, yaw BAM32),
     'cluster_id', 'n_points', 'outcome', 'stats', 'status'}."""
@@ -224,7 +233,8 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
                        [int(x) for x in _per_class(gate1_class_margin_q16, "gate1_class_margin_q16", -20 * 65536,
                                                    20 * 65536)]),
                      -1 if car_ground_mm is None else int(car_ground_mm),
-                     -1 if group_gate1_margin_q16 is None else int(group_gate1_margin_q16)], np.int32)
+                     -1 if group_gate1_margin_q16 is None else int(group_gate1_margin_q16),
+                     -1 if gate1_large_car_margin_q16 is None else int(gate1_large_car_margin_q16)], np.int32)
     n = len(pts)
     rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
                              pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st,
