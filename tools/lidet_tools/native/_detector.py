@@ -101,7 +101,8 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
     --sensor`) or a `Sensor` (its table in ring order, e.g. `sensors.load_sensor_file`, `load_ouster_metadata`, as
     `lidet detect --sensor-file`). max_proposals None: the
     C default for the sensor (lidet_detector_cfg_default). refine False: the clustering without its refinement
-    (split_people, join_cars: lidet_refine.c), as the integer detector runs it today. gate1_margin / gate2_margin:
+    (split_people, join_cars: lidet_refine.c; the integer detector refines too, lidet_refine_q.c, unless its
+    cluster configuration turns it off). gate1_margin / gate2_margin:
     the gates' operating points (lidet_detector_cfg_t, nats added to the models' gammas). mount_height_m: the
     sensor's height above the ground in m, [0, 10] (None: the profile's; `lidet detect --mount-height`).
     gate2_class: 3 flags (Car, Cyclist, Pedestrian), the classes gate 2 judges (None: the C default,
