@@ -15,16 +15,6 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 SAMPLE = ROOT / "tests/data/sim_hdl64/velodyne/000000.bin"
 
 
-@pytest.fixture(scope="module")
-def nd():
-    from lidet_tools import native
-    try:
-        native.pn_models()
-    except OSError as e:  # the bindings are built by `make build`
-        pytest.skip(f"bindings not built: {e}")
-    return native
-
-
 def test_margin_lets_through_only_large_car_clusters(nd):
     """Against the margin off, a wide margin adds detections and every added one is a car the classifier placed
     above the car gamma, from a cluster of >= 100 points; the detections without it all stay (the stages after
