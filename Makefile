@@ -67,6 +67,7 @@ fuzz: fuzz-build
 # The detector on the simulated scans shipped in the repo (hdl64 and vlp16; ground truth drawn in green),
 # and on a real KITTI frame when ../shared/data/real is there; then the stages one by one with their pictures.
 REAL_FRAME ?= $(REAL)/kitti/training
+REAL_CAPTURE ?= $(REAL)/../packets/ouster/OS-2-128-U1_v2.3.0_1024x10
 # builds only what it runs (the host CLI): the first picture comes about 10 s after a fresh configure here, where the
 # whole build (tests, firmware references) takes minutes; `make test` builds the rest
 demo: $(BUILD)/CMakeCache.txt
@@ -84,6 +85,13 @@ demo: $(BUILD)/CMakeCache.txt
 	    --calib $(REAL_FRAME)/calib/000000.txt --gt-kitti $(REAL_FRAME)/label_2/000000.txt \
 	    --png out/demo_detect_real.png --repeat 20; \
 	else echo "== (no real KITTI frame at $(REAL_FRAME): skipped)"; fi
+	@if [ -f $(REAL_CAPTURE).pcap ]; then \
+	  echo "== detector: real Ouster OS2-128 packets ($(REAL_CAPTURE).pcap: decoded by lidet_ouster)"; \
+	  $(BUILD)/ports/host/lidet detect --pcap $(REAL_CAPTURE).pcap --lidar ouster --ouster-meta $(REAL_CAPTURE).json \
+	    --mount-height 1.98 --png out/demo_capture.png 2>out/demo_capture.log \
+	    || { grep -q "without libpcap" out/demo_capture.log && echo "== (lidet built without libpcap: skipped)" \
+	         || { cat out/demo_capture.log; exit 1; }; }; \
+	else echo "== (no real packet capture at $(REAL_CAPTURE).pcap: skipped)"; fi
 	@echo "== the integer detector (no float: int8 models, the scan in millimetres) on the same VLP-16 scan"
 	$(BUILD)/ports/host/lidet detect tests/data/sim_vlp16/velodyne/000000.bin --sensor vlp16 --fixed \
 	    --gt tests/data/sim_vlp16/boxes/000000.txt --png out/demo_detect_vlp16_fixed.png --repeat 5
@@ -93,6 +101,7 @@ demo: $(BUILD)/CMakeCache.txt
 	$(BUILD)/ports/host/lidet cluster $(SAMPLE) --sensor hdl64 --png out/demo_cluster.png --repeat 20
 	@echo "demo: pictures in out/ (demo_detect*.png: detections, car red, cyclist cyan, pedestrian yellow;"
 	@echo "      ground truth green; demo_detect_vlp16_fixed.png: the integer detector;"
+	@echo "      demo_capture.png: a real Ouster capture's frame, when ../shared is there;"
 	@echo "      demo_project/ground/cluster.png: the stages)"
 
 # Firmware images (ports/firmware: Cortex-M3/M4F/M7 on QEMU's MPS2 boards, RISC-V rv32imafc on QEMU virt), built
