@@ -361,6 +361,73 @@ def write_track_corpora() -> None:
             (d / f"{name}.bin").write_bytes(b)
 
 
+def ouster_cfg(profile: int, filt: int = 0, fusa: bool = False, ppc: int = 8, cpf: int = 32, cpp: int = 16,
+               seam: int = 0, max_step: int = 0, offset: int = 32768, beams=None, init_id=None, sn=None,
+               frame: int = 100) -> bytes:
+    """The configuration bytes of fuzz_ouster.c (its comment): profile 0 LEGACY, 1 DUAL, 2 single, 3 low data
+    rate; cpf 16..128 (encoded as 16 + v % 113)."""
+    b0 = profile | (filt << 2) | (16 if fusa else 0) | (32 if init_id is not None else 0) | \
+        (64 if sn is not None else 0) | (128 if beams is not None else 0)
+    b = struct.pack("<BBHBHHH", b0, ppc - 1, cpf - 16, cpp, seam, max_step, offset)
+    if beams is not None:
+        b += b"".join(struct.pack("<h", v // 6) for v in beams)
+    if init_id is not None:
+        b += struct.pack("<IB", init_id, 0)
+    if sn is not None:
+        b += struct.pack("<IHB", sn & 0xFFFFFFFF, sn >> 32, 0)
+    return b + struct.pack("<H", frame)
+
+
+def ouster_op(op: int, room: int = -1, seed: int = 1, arg: int = 0) -> bytes:
+    """One operation of fuzz_ouster.c: op byte (% 16: 0 raw, 1 NULL, 2 reset, else a well-formed payload; bit 4
+    a new init id, bits 5-6 a move of the position, bit 7 invalid columns), room (-1: the most one payload gives),
+    pixel seed, argument."""
+    return struct.pack("<BBHH", op, 1 if room < 0 else (room << 1) & 0xFE, seed, arg)
+
+
+def ouster_seeds() -> dict:
+    """Packet streams for fuzz_ouster: every profile over several frames, a seam inside the packets, fragments
+    (a new init id and a seam crossing in one payload), columns straddling two frames (LEGACY), lost columns,
+    jumps and steps back, invalid columns, a small room, raw, NULL and cut payloads, resets, a beam table, a
+    configured init id and serial number, the FUSA header."""
+    run = b"".join(ouster_op(3, seed=k) for k in range(8))
+    seeds = {}
+    for prof, name in enumerate(("legacy", "dual", "single", "lowdata")):
+        seeds[f"{name}_frames"] = ouster_cfg(prof) + run
+        seeds[f"{name}_seam_small_room"] = ouster_cfg(prof, cpp=4, cpf=16, seam=5) + b"".join(
+            ouster_op(3, room=(7 * k) % 64, seed=k) for k in range(12))
+        seeds[f"{name}_restart_fragment"] = ouster_cfg(prof, seam=8) + ouster_op(3) + ouster_op(3) + \
+            ouster_op(3 | 16) + ouster_op(3) + ouster_op(3 | 16, seed=9) + ouster_op(3)
+        seeds[f"{name}_moves"] = ouster_cfg(prof, max_step=4) + ouster_op(3) + ouster_op(3 | 32, arg=3) + \
+            ouster_op(3 | 32, arg=9) + ouster_op(3 | 64, arg=2) + ouster_op(3) + ouster_op(3 | 96, arg=1) + \
+            ouster_op(3 | 128, arg=0x5A) + ouster_op(3)
+    for f in (1, 2, 3):
+        seeds[f"dual_filter{f}"] = ouster_cfg(1, filt=f, ppc=16) + run
+    seeds["legacy_straddle"] = ouster_cfg(0, cpf=16) + ouster_op(3 | 32, arg=8) + run
+    seeds["fusa_configured"] = ouster_cfg(2, fusa=True, init_id=0x123456, sn=0x0102030405, frame=65530) + run + \
+        ouster_op(3 | 16)
+    seeds["beam_table"] = ouster_cfg(2, ppc=4, beams=[4200, -4200, 1500, -179994]) + run
+    seeds["raw_null_reset"] = ouster_cfg(2) + ouster_op(0, arg=600) + bytes(range(40)) + ouster_op(1) + \
+        ouster_op(3) + ouster_op(2) + ouster_op(3) + ouster_op(0, arg=10) + bytes(40) + ouster_op(3)
+    seeds["odd_columns"] = ouster_cfg(0, cpf=100, cpp=8, seam=37, max_step=60) + run + ouster_op(3 | 32, arg=50) + run
+    seeds["jump_then_seam"] = ouster_cfg(0, cpp=8, max_step=4) + ouster_op(3) + ouster_op(3) + \
+        ouster_op(3 | 32, arg=5) + run
+    seeds["serial_only"] = ouster_cfg(2, sn=0x0A0B0C0D0E) + ouster_op(3) + ouster_op(3 | 16) + ouster_op(3)
+    seeds["back_a_frame_and_restart"] = ouster_cfg(0, cpp=8) + ouster_op(3) + ouster_op(3) + \
+        ouster_op(3 | 64, arg=20) + ouster_op(3) + ouster_op(3)
+    seeds["restart_back"] = ouster_cfg(2, cpp=8) + ouster_op(3) + ouster_op(3) + ouster_op(3 | 16 | 64, arg=40) + \
+        ouster_op(3) + ouster_op(3 | 64, arg=20) + ouster_op(3)
+    seeds["bad_config"] = ouster_cfg(2, cpp=17) + run
+    return seeds
+
+
+def write_ouster_corpus() -> None:
+    d = OUT / "ouster"
+    d.mkdir(exist_ok=True)
+    for name, b in ouster_seeds().items():
+        (d / f"{name}.bin").write_bytes(b)
+
+
 def main() -> None:
     OUT.mkdir(parents=True, exist_ok=True)
     for harness, knobs in KNOBS.items():
@@ -414,6 +481,7 @@ def main() -> None:
                 b += struct.pack("<BI", sel, v)
             (d / f"model{i}_{name}.bin").write_bytes(b + b"\x00\x00")
     write_track_corpora()
+    write_ouster_corpus()
     for p in sorted(OUT.rglob("*.bin")):
         print(p.relative_to(ROOT), p.stat().st_size)
 

@@ -16,7 +16,7 @@ JOBS=${FUZZ_JOBS:-1}
 NICE=${FUZZ_NICE:-0}
 harnesses=("$@")
 if [ ${#harnesses[@]} -eq 0 ]; then
-  harnesses=(proj ground cluster proposal pointnet pn_check detector pointnet_q detector_q velodyne track track_q)
+  harnesses=(proj ground cluster proposal pointnet pn_check detector pointnet_q detector_q velodyne ouster track track_q)
 fi
 mkdir -p "$BUILD/fuzz-artifacts" "$BUILD/fuzz-logs"
 run_one() {
