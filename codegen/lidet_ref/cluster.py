@@ -107,7 +107,7 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
                 max_fragment_pixels: int = 0, max_bridge_per_pixel: float = 0.0, split_people: bool = False,
                 join_cars: bool = False, azimuth_half_rad: float = 0.0, regrow_gap_m: float = 0.0,
                 regrow_gap_per_m: float = 0.0, regrow_max_pixels: int = 0, regrow_max_height_m: float = 1e30,
-                plane_split_m: float = 0.0, seed_half_rad: float = 0.0, **refine):
+                regrow_cut_m: float = 0.0, plane_split_m: float = 0.0, seed_half_rad: float = 0.0, **refine):
     """Reference clustering of a (rows, cols) range image. candidate: (rows, cols) bool (holds a
     non-ground point); xyz: (rows, cols, 3). Returns (labels (rows, cols) int64 canonical ids, list of
     member-pixel arrays per kept cluster in raster order). Float32 tangent and distance tests like the
@@ -119,7 +119,8 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
     split_people / join_cars turn the refinement on (refine_ref; lidet_cluster.h). regrow_gap_m > 0: a component
     past max_extent_m (at most regrow_max_pixels pixels, 0: any; z span at most regrow_max_height_m) is grown again
     from its own pixels, in its fill order, with the gap bound regrow_gap_m + regrow_gap_per_m * d2, and each part is
-    filtered as a component of its own (lidet_cluster_run_body.h regrow). plane_split_m: no planes here (flat
+    filtered as a component of its own (lidet_cluster_run_body.h regrow), less its pixels below regrow_cut_m above
+    the flat ground (z + mount_height_m, float32 as the C). plane_split_m: no planes here (flat
     ground), so it changes nothing. seed_half_rad in (0, pi): components start only at pixels of the columns within
     it (the window's column rule), in raster order, and still grow over every candidate; a component's seed (its
     canonical order) is then its first pixel in those columns."""
@@ -320,6 +321,9 @@ def cluster_ref(range_m: np.ndarray, candidate: np.ndarray, row_elev_rad: np.nda
             if (regrow and regrow_gap_m > 0 and (regrow_max_pixels == 0 or len(m) <= regrow_max_pixels)
                     and pts[:, 2].max() - pts[:, 2].min() <= regrow_max_height_m and len(m) <= rows * cols - n_cand):
                 state[m] = 0
+                if regrow_cut_m > 0:
+                    low = (P[m][:, 2].astype(np.float32) + np.float32(mount_height_m)) < np.float32(regrow_cut_m)
+                    state[m[low]] = -2  # left out: as a non-candidate
                 gp.update(tight)
                 for p in mem:
                     if state[p] == 0:

@@ -292,8 +292,10 @@ def cluster_q_ref(x, y, z, rng, row_elev_bam, ground=None, planes_q=None, cfg: d
                 # grown again from its own pixels (in its order) with the tighter gap; each part is filtered
                 del mem[start:]
                 st["n_regrown"] += 1
+                cut = c.get("regrow_cut_mm", 0)
                 for m in ms:
-                    lab[m] = FREE
+                    # the pixels less than regrow_cut_mm above their ground plane are left out
+                    lab[m] = NONCAND if cut > 0 and 4 * height(m, [X[m], Y[m], Z[m]]) < cut else FREE
                 gp.update(tight)
                 for m in ms:
                     if lab[m] != FREE:

@@ -105,6 +105,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     cfg.cluster.regrow_max_pixels = fcfg->stages.cluster.regrow_max_pixels;
     cfg.cluster.regrow_max_height_mm =
         (uint32_t)round_i32((double)fcfg->stages.cluster.regrow_max_height_m * 1000.0);
+    cfg.cluster.regrow_cut_mm = (uint32_t)round_i32((double)fcfg->stages.cluster.regrow_cut_m * 1000.0);
     cfg.group_split = fcfg->group_split;
     cfg.group_max_range_mm = round_i32((double)fcfg->group_max_range_m * 1000.0);
     cfg.group_gate1_margin_q16 = round_i32((double)fcfg->group_gate1_margin * 65536.0);

@@ -112,6 +112,7 @@ static const py_field_t k_fields[] = {
     FLD(lidet_cluster_cfg_t, max_bridge_per_pixel, 'f'), FLD(lidet_cluster_cfg_t, max_fragment_pixels, 'u'),
     FLD(lidet_cluster_cfg_t, regrow_gap_m, 'f'), FLD(lidet_cluster_cfg_t, regrow_gap_per_m, 'f'),
     FLD(lidet_cluster_cfg_t, regrow_max_pixels, 'u'), FLD(lidet_cluster_cfg_t, regrow_max_height_m, 'f'),
+    FLD(lidet_cluster_cfg_t, regrow_cut_m, 'f'),
     FLD(lidet_cluster_cfg_t, plane_split_m, 'f'),
     FLD(lidet_cluster_stats_t, n_candidates, 'u'), FLD(lidet_cluster_stats_t, n_found, 'u'),
     FLD(lidet_cluster_stats_t, n_fragments, 'u'), FLD(lidet_cluster_stats_t, n_rescue_joined, 'u'),

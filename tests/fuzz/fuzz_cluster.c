@@ -45,6 +45,15 @@ static void cluster_knobs(fz_in_t *in, lidet_cluster_cfg_t *c, uint8_t *mode)
     c->rescue_cols = fz_u8(in) % 18u;
     c->max_fragment_pixels = 8u * fz_u8(in); /* 0: no budget */
     c->max_join_pieces = fz_u8(in) % 8u; /* 0: no budget */
+    if (f & 0x20u)
+    {
+        /* the regrowth of over-extent components (off by default on these images of <= 8 rows) and its cut: gap
+         * 0-2.55 m, cut 0-2 m above the ground plane, at most 8 x byte pixels (0: any) */
+        c->regrow_gap_m = 0.01f * (float)fz_u8(in);
+        c->regrow_gap_per_m = 0.02f;
+        c->regrow_cut_m = 0.01f * (float)(fz_u8(in) % 201u);
+        c->regrow_max_pixels = 8u * fz_u8(in);
+    }
     fz_poke_f32(in, fl, (uint32_t)(sizeof fl / sizeof fl[0]));
 }
 

@@ -173,6 +173,25 @@ def test_rescue_matches_reference_on_sample(root):
     assert np.all(np.diff(c.seed_pixel.astype(np.int64)) > 0)
 
 
+def test_regrow_cut_matches_reference(root):
+    """regrow_cut_m (off by default): the regrowth leaves out the pixels less than the cut above the ground, in C and
+    in the reference, on the shipped simulated HDL-64 sample with a small extent limit that sends many components
+    through the regrowth; the cut changes the clusters."""
+    d = root / "tests" / "data" / "sim_hdl64"
+    pts = np.fromfile(d / "velodyne" / "000000.bin", np.float32).reshape(-1, 4)
+    lab = np.fromfile(d / "labels" / "000000.label", np.uint32)
+    ground = np.isin(lab & 0xFFFF, GROUND)
+    defaults = {k: v for k, v in native.cluster_defaults("hdl64").items() if k != "mount_height_m"}
+    assert defaults["regrow_cut_m"] == 0.0
+    kw = dict(defaults, max_extent_m=3.0, regrow_max_pixels=0)
+    uncut = _check_against_ref(pts, ground, kw, exact=True)
+    cut = _check_against_ref(pts, ground, dict(kw, regrow_cut_m=1.0), exact=True)
+    assert cut.stats["n_regrown"] == uncut.stats["n_regrown"] > 5
+    assert not np.array_equal(cut.pixel_labels, uncut.pixel_labels)
+    with pytest.raises(native.LidetError):
+        native.cluster(pts, "hdl64", regrow_cut_m=2.5)
+
+
 @pytest.mark.parametrize("sensor,half", [("vlp16", 0.8), ("hdl64", 1.3090)])
 def test_azimuth_window_matches_reference(root, sensor, half):
     """azimuth_half_rad (what the detector's crop sets): only the columns within it are candidates, in C and in

@@ -327,3 +327,18 @@ def test_fixed_dump_is_the_integer_run(cli, tmp_path):
         assert d["u"][1] == box["cluster"] and d["u"][2] == box["cluster_points"]
         assert round(d["i"][0] / 32768.0, 5) == box["score"]
         assert [round(float(v) / 1000.0, 4) for v in d["i"][3:9]] == [box[k] for k in ("x", "y", "z", "l", "w", "h")]
+
+
+def test_regrow_cut_reaches_both_detectors(cli):
+    """`--set stages.cluster.regrow_cut_m=M` (off by default) reaches the float clustering and, as regrow_cut_mm,
+    the integer one: with a small extent limit (many components regrown) a high cut changes the clusters of both, 0
+    is the default run, and values outside [0, 2] m are refused."""
+    small = ("--set", "stages.cluster.max_extent_m=3")
+    for fixed in ((), ("--fixed",)):
+        base = json.loads(_run(cli, SCAN, "--json", *fixed, *small).stdout)
+        off = json.loads(_run(cli, SCAN, "--json", *fixed, *small, "--set", "stages.cluster.regrow_cut_m=0").stdout)
+        cut = json.loads(_run(cli, SCAN, "--json", *fixed, *small, "--set", "stages.cluster.regrow_cut_m=1").stdout)
+        assert off["boxes"] == base["boxes"] and off["clusters"] == base["clusters"]
+        assert cut["clusters"] != base["clusters"]
+        r = _run(cli, SCAN, "--json", *fixed, "--set", "stages.cluster.regrow_cut_m=2.5", ok=False)
+        assert r.returncode != 0 and r.stderr.strip()

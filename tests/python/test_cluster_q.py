@@ -118,11 +118,28 @@ def test_bit_exact_regrowth(sim_scans):
             regrown += c.stats["n_regrown"]
     assert regrown > 0
     sensor, pts = sim_scans[0]
-    on = _check_bit_exact(sensor, pts, max_extent_mm=2500, regrow_max_pixels=0)
+    on = _check_bit_exact(sensor, pts, max_extent_mm=2500, regrow_max_pixels=0, regrow_cut_mm=0)
     assert on.stats["n_regrown"] > 5 and on.stats["n_regrow_parts"] > on.stats["n_regrown"]
     off = _check_bit_exact(sensor, pts, max_extent_mm=2500, regrow_gap_mm=0)
     assert off.stats["n_regrown"] == 0 and len(off) < len(on)
     assert native.cluster_q_defaults("vlp16")[0]["regrow_gap_mm"] == 0  # off on 16 beams (measured above 16 only)
+
+
+def test_bit_exact_regrowth_cut(sim_scans):
+    """regrow_cut_mm (default 0: off): the regrowth leaves out the component's pixels less
+    than the cut above their ground plane, bit for bit with the reference (with the sector planes and the flat ground);
+    the scene's outcome on a hand-made street: tests/unit/test_cluster.c, test_regrow_cut."""
+    assert native.cluster_q_defaults("hdl64")[0]["regrow_cut_mm"] == 0 == native.cluster_defaults("hdl64")["regrow_cut_m"]
+    sensor, pts = sim_scans[0]
+    kw = dict(max_extent_mm=2500, regrow_max_pixels=0)
+    uncut = _check_bit_exact(sensor, pts, **kw)
+    for cut_mm in (250, 600):
+        cut = _check_bit_exact(sensor, pts, regrow_cut_mm=cut_mm, **kw)
+        assert cut.stats["n_regrown"] == uncut.stats["n_regrown"] > 5
+        assert not np.array_equal(cut.labels, uncut.labels)  # the cut changes the parts
+    _check_bit_exact(sensor, pts, planes=False, regrow_cut_mm=400, **kw)
+    with pytest.raises(native.LidetError):
+        native.cluster_q(native.compact_scan(pts, sensor), None, regrow_cut_mm=2001)
 
 
 def test_bit_exact_far_planes(sim_scans):

@@ -113,6 +113,29 @@ def test_where_lost_on_the_simulated_scan():
     assert where_lost(pts, far, ["Car"], d, few, lambda *a: True, native.CLASSES) == ["too few points"]
 
 
+def test_where_lost_no_cluster_against_split():
+    """An object most of whose non-ground points are in no kept cluster (its component dropped, a car chained to the
+    kerb) is "no cluster", one whose points are mostly in clusters but none holding 70 % of them "split"; one
+    cluster holding 70 % and mostly the object: on to the cluster's outcome."""
+    from types import SimpleNamespace
+    box = np.array([[10.0, 0.0, 0.0, 4.0, 2.0, 2.0, 0.0]])
+    pts = np.zeros((30, 3))
+    pts[:, 0] = np.linspace(8.5, 11.5, 30)
+
+    def lost(point_cluster, outcome=(0, 0, 0)):
+        det = SimpleNamespace(point_cluster=np.asarray(point_cluster), point_ground=np.zeros(30, np.uint8),
+                              outcome=np.asarray(outcome), cluster_id=np.zeros(0, np.int64), cls=np.zeros(0),
+                              box=np.zeros((0, 7)))
+        return where_lost(pts, box, ["Car"], det, 8, lambda *a: True, native.CLASSES)[0]
+
+    assert lost([0] * 30) == "no cluster"
+    assert lost([0] * 25 + [1] * 5) == "no cluster"
+    assert lost([0] * 15 + [1] * 15) == "no cluster"  # half in clusters
+    assert lost([0] * 10 + [1] * 12 + [2] * 8) == "split"
+    gate1 = next(k for k, v in native.OUTCOME.items() if v == "gate1")
+    assert lost([0] * 5 + [1] * 25, (gate1, 0, 0)) == "gate 1"
+
+
 def test_eval_real_on_a_simulated_folder(tmp_path):
     root, split = _sim_root(tmp_path)
     out = tmp_path / "out"

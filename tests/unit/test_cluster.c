@@ -324,6 +324,72 @@ static void test_regrow_over_extent(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &cfg));
 }
 
+/* the regrowth's cut (regrow_cut_m): a block (a car, columns 10-11 at 5 m) standing on a kerb-high strip (the bottom
+ * row, 20 columns at 5 m: 10 m long, 0.09 m above the plane z = 0) that chains it into a component too wide for
+ * max_extent_m. The regrowth alone gives the same component back (the strip's returns are 0.49 m apart, inside its
+ * gap bound): dropped. With the cut the pixels less than regrow_cut_m above the plane (the bottom row, 0.09 m; the
+ * rows above are at 0.26 m and more) are left out and the block is kept; with the sector plane (lidet_plane_t) and
+ * with the flat ground (no planes: z + mount_height_m) alike */
+static void test_regrow_cut(void)
+{
+    static const char *const art[] = {
+        "..........aa....................................................",
+        "..........aa....................................................",
+        "..........aa....................................................",
+        "..........aaaaaaaaaaaaaaaaaaaa..................................",
+    };
+    static const char *const want[] = {
+        "0000000000110000000000000000000000000000000000000000000000000000",
+        "0000000000110000000000000000000000000000000000000000000000000000",
+        "0000000000110000000000000000000000000000000000000000000000000000",
+        "0000000000000000000000000000000000000000000000000000000000000000",
+    };
+    const lidet_plane_t plane = {0.0f, 0.0f, 1.0f, 0.0f};
+    const lidet_cluster_stats_t *st;
+    int with_plane;
+    cfg.theta_rad = 0.1f;
+    cfg.max_gap_m = 3.0f;
+    cfg.max_extent_m = 2.0f;
+    cfg.regrow_gap_m = 0.8f;
+    cfg.regrow_gap_per_m = 0.0f;
+    cfg.mount_height_m = 0.0f; /* the flat ground at z = 0 too */
+    for (with_plane = 0; with_plane < 2; ++with_plane)
+    {
+        tcu_draw(&t, art, 4);
+        cfg.regrow_cut_m = 0.0f;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK,
+                              lidet_cluster_run(&g.ws, &t.img, NULL, with_plane ? &plane : NULL, with_plane ? 1 : 0));
+        st = lidet_cluster_stats(&g.ws);
+        TEST_ASSERT_EQUAL_UINT32(1, st->n_regrown);
+        TEST_ASSERT_EQUAL_UINT32(1, st->n_regrow_parts); /* the same component again */
+        TEST_ASSERT_EQUAL_UINT32(1, st->n_dropped_extent);
+        TEST_ASSERT_EQUAL_UINT32(0, st->n_kept);
+        cfg.regrow_cut_m = 0.2f;
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_cluster_init(&g.ws, &cfg));
+        TEST_ASSERT_EQUAL_INT(LIDET_OK,
+                              lidet_cluster_run(&g.ws, &t.img, NULL, with_plane ? &plane : NULL, with_plane ? 1 : 0));
+        expect_labels(want, 4);
+        st = lidet_cluster_stats(&g.ws);
+        TEST_ASSERT_EQUAL_UINT32(1, st->n_regrown);
+        TEST_ASSERT_EQUAL_UINT32(1, st->n_regrow_parts);
+        TEST_ASSERT_EQUAL_UINT32(0, st->n_dropped_extent);
+        TEST_ASSERT_EQUAL_UINT32(1, st->n_kept);
+        TEST_ASSERT_EQUAL_UINT32(6, lidet_cluster_records(&g.ws, NULL)[0].n_points);
+    }
+    /* a cut as high as the block leaves nothing to regrow; bad values refused */
+    cfg.regrow_cut_m = 2.0f;
+    run(art, 4, NULL);
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g.ws)->n_kept);
+    TEST_ASSERT_EQUAL_UINT32(0, lidet_cluster_stats(&g.ws)->n_regrow_parts);
+    cfg.regrow_cut_m = 2.01f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &cfg));
+    cfg.regrow_cut_m = -0.01f;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &cfg));
+    cfg.regrow_cut_m = NAN;
+    TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_cluster_init(&g.ws, &cfg));
+}
+
 /* plane_split_m: planes holds the near and the far plane of each sector; a mean at or beyond the split is measured
  * against the far one (a block at 10 m: 5 m above the near plane here, 1 m above the far one) */
 static void test_far_plane_height(void)
@@ -871,6 +937,7 @@ int main(void)
     RUN_TEST(test_wraparound_joins);
     RUN_TEST(test_filters);
     RUN_TEST(test_regrow_over_extent);
+    RUN_TEST(test_regrow_cut);
     RUN_TEST(test_far_plane_height);
     RUN_TEST(test_fragment_rescue);
     RUN_TEST(test_records_members_determinism);

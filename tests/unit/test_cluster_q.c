@@ -233,11 +233,12 @@ static void test_config_and_arguments(void)
     int i;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_cluster_q_init(NULL, &qcfg));
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_ARG, lidet_cluster_q_init(&g.ws, NULL));
-    for (i = 0; i < 9; ++i)
+    for (i = 0; i < 10; ++i)
     {
         bad = qcfg;
         switch (i)
         {
+        case 8: bad.regrow_cut_mm = 2001; break;
         case 0: bad.theta_urad = 0; break;
         case 1: bad.theta_urad = 1500000; break;
         case 2: bad.max_steps = 0; break;

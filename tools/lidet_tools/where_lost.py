@@ -6,9 +6,11 @@ Stages, in the order they are tested (the first that applies is the object's):
 
 * ``too few points``: fewer than the clustering's ``min_points`` points inside the box (+ 0.1 m);
 * ``ground``: as few left once the ground stage's points are taken out;
-* ``no cluster``: none of its non-ground points is in a kept cluster (its component was dropped by the
-  clustering's filters: too wide, too tall, too many points; or it joined such a component);
-* ``split``: no cluster holds >= 70 % of the object's non-ground points (the object came out in pieces);
+* ``no cluster``: none of its non-ground points, or at most half of them, is in a kept cluster (its component was
+  dropped by the clustering's filters: too wide, too tall, too many points; or it joined such a component, as a
+  car chained to the kerb it stands on);
+* ``split``: no cluster holds >= 70 % of the object's non-ground points, and more than half of them are in kept
+  clusters (the object came out in pieces);
 * ``merged``: the cluster holding most of them is < 70 % object (the object was joined with a neighbour);
 * ``budget/crop``: the cluster was not classified (proposal budget, crop, range, capacity, too tall);
 * ``gate 1`` / ``gate 2``: rejected by the classifier's / the box net's energy gate;
@@ -82,7 +84,7 @@ def where_lost(points: np.ndarray, gt_boxes: np.ndarray, gt_cls: list, det, min_
             continue
         ids = pc[ng]
         ids = ids[ids > 0]
-        if len(ids) == 0:
+        if 2 * len(ids) <= ng.sum():
             out.append("no cluster")
             continue
         cid = int(np.bincount(ids).argmax())

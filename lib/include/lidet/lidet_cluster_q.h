@@ -106,6 +106,7 @@ typedef struct
     uint32_t regrow_gap_per_m_q16; /**< <= 65536; default 1311 (0.02), 0 (<= 16 rows) */
     uint32_t regrow_max_pixels;    /**< as lidet_cluster_cfg_t's; 0 = no limit */
     uint32_t regrow_max_height_mm; /**< as lidet_cluster_cfg_t's regrow_max_height_m; (0, 100000] */
+    uint32_t regrow_cut_mm;        /**< as lidet_cluster_cfg_t's regrow_cut_m; [0, 2000] */
     uint32_t
         plane_split_mm; /**< lidet_cluster_cfg_t's plane_split_m: > 0, planes holds 2 n_sectors planes and
                                         a mean with 16 (x^2 + y^2) >= plane_split_mm^2 takes its sector's far plane;

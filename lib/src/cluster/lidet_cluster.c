@@ -62,6 +62,7 @@ void lidet_cluster_cfg_default(lidet_cluster_cfg_t *cfg, const lidet_sensor_t *s
     cfg->regrow_gap_per_m = sparse ? 0.0f : 0.02f;
     cfg->regrow_max_pixels = 2000u;
     cfg->regrow_max_height_m = 2.5f;
+    cfg->regrow_cut_m = 0.0f; /* measured, not the default: docs/journal/real-streets.md */
     cfg->max_bridge_per_pixel = 2.0f;
     /* refinement (issue 15), measured on the simulated crowd scenes (docs/benchmarks/cluster.md); 16 beams:
      * person-sized parts cut off from 9 pixels, a longer join gap (with max_steps and
@@ -105,6 +106,7 @@ lidet_status_t lidet_cluster_state_init(lidet_cluster_state_t *c, const lidet_cl
         !(cfg->regrow_gap_m >= 0.0f && cfg->regrow_gap_m <= 100.0f) ||
         !(cfg->regrow_gap_per_m >= 0.0f && cfg->regrow_gap_per_m <= 1.0f) ||
         !(cfg->regrow_max_height_m > 0.0f && cfg->regrow_max_height_m <= 100.0f) ||
+        !(cfg->regrow_cut_m >= 0.0f && cfg->regrow_cut_m <= 2.0f) ||
         !(cfg->plane_split_m >= 0.0f && cfg->plane_split_m <= 500.0f) ||
         !lidet__isfinite(cfg->rescue_gap_m) || cfg->rescue_gap_m < 0.0f ||
         !lidet__isfinite(cfg->rescue_gap_per_m) || cfg->rescue_gap_per_m < 0.0f ||
@@ -266,6 +268,19 @@ static int rescue_on(const lidet_cluster_state_t *c)
 static int regrow_fits(const lidet_cluster_state_t *c, const summary_t *s)
 {
     return s->hi[2] - s->lo[2] <= c->cfg.regrow_max_height_m;
+}
+
+/* a pixel the regrowth leaves out (cfg regrow_cut_m): less than the cut above its ground plane */
+static int regrow_cut(const lidet_cluster_state_t *c, uint32_t p, const lidet_plane_t *planes,
+                      uint32_t n_sectors)
+{
+    float v[3];
+    if (!(c->cfg.regrow_cut_m > 0.0f))
+    {
+        return 0;
+    }
+    lidet__img_xyz(&c->img, p, lidet__img_compact(&c->img), &v[0], &v[1], &v[2]);
+    return lidet__cluster_height(c, p, v, planes, n_sectors) < c->cfg.regrow_cut_m;
 }
 
 /* the regrowth's flood fill constants (cfg regrow_gap_m > 0): the first fill's with the tighter gap bound */

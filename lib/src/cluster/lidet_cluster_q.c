@@ -43,6 +43,7 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
     cfg->regrow_gap_per_m_q16 = sparse ? 0u : 1311u; /* 0.02 */
     cfg->regrow_max_pixels = 2000u;
     cfg->regrow_max_height_mm = 2500u;
+    cfg->regrow_cut_mm = 0u;
     /* the refinement (issue 15) */
     cfg->split_people = 1u;
     cfg->split_min_width_mm = 700u;
@@ -182,6 +183,20 @@ static int regrow_fits(const lidet_cluster_q_state_t *c, const summary_q_t *s)
     return 4 * ((int64_t)s->hi[2] - s->lo[2]) <= (int64_t)c->cfg.regrow_max_height_mm;
 }
 
+/* a pixel the regrowth leaves out (cfg regrow_cut_mm): less than the cut above its ground plane, the plane a mean
+ * there would be measured against (4 mm steps) */
+static int regrow_cut(const lidet_cluster_q_state_t *c, uint32_t p, const lidet_plane_q_t *planes,
+                      uint32_t n_sectors)
+{
+    int32_t v[3];
+    if (c->cfg.regrow_cut_mm == 0u)
+    {
+        return 0;
+    }
+    read_q(c, p, &v[0], &v[1], &v[2]);
+    return 4 * (int64_t)lidet__cluster_q_height(c, p, v, planes, n_sectors) < (int64_t)c->cfg.regrow_cut_mm;
+}
+
 /* the regrowth's flood fill constants (cfg regrow_gap_mm > 0): the first fill's with the tighter gap bound (in
  * 4 mm steps, as the first fill's) */
 static int regrow_param(const lidet_cluster_q_state_t *c, const lidet__grow_q_t *lk, lidet__grow_q_t *out)
@@ -232,7 +247,7 @@ lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lide
         cfg->max_bridge_per_pixel_q16 > (64u << 16) || cfg->split_people > 1u ||
         cfg->regrow_gap_mm > 100000u || cfg->regrow_gap_per_m_q16 > 65536u ||
         cfg->regrow_max_height_mm == 0u || cfg->regrow_max_height_mm > 100000u ||
-        cfg->plane_split_mm > 500000u || cfg->split_min_width_mm == 0u ||
+        cfg->regrow_cut_mm > 2000u || cfg->plane_split_mm > 500000u || cfg->split_min_width_mm == 0u ||
         cfg->split_min_width_mm > 1000000u || cfg->split_cell_mm == 0u || cfg->split_cell_mm > 100000u ||
         cfg->split_cell_per_m_q16 > 65536u || cfg->person_max_width_mm == 0u ||
         cfg->person_max_width_mm > 1000000u || cfg->person_min_height_mm > 1000000u ||

@@ -531,7 +531,8 @@ static uint32_t regrow(RUN_STATE_T *c, const RUN_PARAM_T *tight, uint32_t start,
     memmove(mem + top, mem + start, n * sizeof *mem);
     for (i = top; i < npix; ++i)
     {
-        lab[mem[i]] = (uint16_t)LAB_FREE;
+        const uint32_t p = (uint32_t)mem[i];
+        lab[p] = (uint16_t)(regrow_cut(c, p, planes, n_sectors) ? LAB_NONCAND : LAB_FREE);
     }
     ++st->n_regrown;
     for (i = top; i < npix; ++i)

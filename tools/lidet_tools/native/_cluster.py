@@ -197,7 +197,7 @@ CLUSTER_Q_FIELDS = ["theta_urad", "max_steps", "bridge_occluders", "diagonals", 
                     "person_min_cols", "person_min_points", "join_cars", "join_gap_mm", "car_max_length_mm", "car_max_width_mm",
                     "car_max_height_mm", "car_min_length_mm", "upright_max_width_mm", "max_join_pieces",
                     "regrow_gap_mm", "regrow_gap_per_m_q16", "regrow_max_pixels", "regrow_max_height_mm",
-                    "plane_split_mm"]
+                    "regrow_cut_mm", "plane_split_mm"]
 PROPOSAL_Q_FIELDS = ["n_points", "seed", "azimuth_bin_bam", "elevation_bin_bam", "range_bin_4mm", "z_origin"]
 
 
