@@ -402,7 +402,8 @@ typedef struct
 } cli_legend_t;
 /* Writes a bird's-eye view (cli_bev.c): the scene (sw x sh RGB pixels of res_m metres, the sensor at the centre,
  * +x up, +y left) in a larger canvas with the title and subtitle (wrapped at their double spaces where too
- * wide), axes in metres (ticks every 10 m, labels every 20 m), a 10 m scale bar and the legend (an entry with an
+ * wide), axes in metres (ticks every 10 m and labels every 20 m for a view of 30 m or more each way, 5 / 10 m
+ * from 15 m, 2 / 4 m from 6 m, 1 / 2 m below), a scale bar one tick long and the legend (an entry with an
  * empty label: a swatch sharing the next entry's label). Deterministic for the same inputs. Returns 0 or -1. */
 int cli_bev_write(const char *path, const uint8_t *scene, uint32_t sw, uint32_t sh, float res_m,
                   const char *title, const char *subtitle, const cli_legend_t *items, int n_items);

@@ -16,9 +16,12 @@
 #define PAD 8
 #define TICK_MAJOR 8
 #define TICK_MINOR 4
-#define TICK_STEP_M 10
-#define LABEL_STEP_M 20
-#define SCALE_BAR_M 10
+/* the axes' ticks every tick_step(half) metres, labels every second tick, the scale bar one tick long: 10 / 20 / 10 m
+ * for the 40 m views, down to 1 / 2 / 1 m for a room */
+static int tick_step(float half_m)
+{
+    return half_m >= 30.0f ? 10 : (half_m >= 15.0f ? 5 : (half_m >= 6.0f ? 2 : 1));
+}
 
 static const uint8_t k_bg[3] = {24, 24, 30};
 static const uint8_t k_text[3] = {230, 230, 230};
@@ -93,6 +96,7 @@ static void axes(const canvas_t *cv, int top, uint32_t sw, uint32_t sh, float re
 {
     const int left = MARGIN_L, bottom = top + (int)sh, right = left + (int)sw;
     const int half_y_m = (int)((float)sw * 0.5f * res_m), half_x_m = (int)((float)sh * 0.5f * res_m);
+    const int tick_m = tick_step((float)sw * 0.5f * res_m), label_m = 2 * tick_m;
     int m;
     char buf[16];
     /* frame one pixel outside the scene */
@@ -101,10 +105,10 @@ static void axes(const canvas_t *cv, int top, uint32_t sw, uint32_t sh, float re
     fill(cv, left - 1, top - 1, 1, (int)sh + 2, k_axis);
     fill(cv, right, top - 1, 1, (int)sh + 2, k_axis);
     /* bottom axis: y (left positive), so +y is at the left end */
-    for (m = -(half_y_m / TICK_STEP_M) * TICK_STEP_M; m <= half_y_m; m += TICK_STEP_M)
+    for (m = -(half_y_m / tick_m) * tick_m; m <= half_y_m; m += tick_m)
     {
         const int col = left + (int)((float)sw * 0.5f - (float)m / res_m + 0.5f);
-        const int major = m % LABEL_STEP_M == 0;
+        const int major = m % label_m == 0;
         if (col < left || col > right)
             continue;
         fill(cv, col, bottom + 1, 1, major ? TICK_MAJOR : TICK_MINOR, k_axis);
@@ -116,10 +120,10 @@ static void axes(const canvas_t *cv, int top, uint32_t sw, uint32_t sh, float re
         }
     }
     /* left axis: x (forward) up */
-    for (m = -(half_x_m / TICK_STEP_M) * TICK_STEP_M; m <= half_x_m; m += TICK_STEP_M)
+    for (m = -(half_x_m / tick_m) * tick_m; m <= half_x_m; m += tick_m)
     {
         const int row = top + (int)((float)sh * 0.5f - (float)m / res_m + 0.5f);
-        const int major = m % LABEL_STEP_M == 0;
+        const int major = m % label_m == 0;
         if (row < top || row > bottom)
             continue;
         fill(cv, left - 1 - (major ? TICK_MAJOR : TICK_MINOR), row, major ? TICK_MAJOR : TICK_MINOR, 1,
@@ -137,14 +141,14 @@ static void axes(const canvas_t *cv, int top, uint32_t sw, uint32_t sh, float re
                   bottom + TICK_MAJOR + 4 + LINE_H + PAD, "y [m]", k_text, TEXT_SCALE);
 }
 
-static void scale_bar(const canvas_t *cv, int y, float res_m)
+static void scale_bar(const canvas_t *cv, int y, float res_m, int bar_m)
 {
-    const int len = (int)((float)SCALE_BAR_M / res_m + 0.5f);
+    const int len = (int)((float)bar_m / res_m + 0.5f);
     char buf[64];
     fill(cv, MARGIN_L, y + LINE_H / 2 - 1, len, 3, k_text);
     fill(cv, MARGIN_L, y, 2, LINE_H, k_text);
     fill(cv, MARGIN_L + len - 2, y, 2, LINE_H, k_text);
-    snprintf(buf, sizeof buf, "%d m", SCALE_BAR_M);
+    snprintf(buf, sizeof buf, "%d m", bar_m);
     cli_font_draw(cv->rgb, cv->w, cv->h, MARGIN_L + len + PAD, y, buf, k_text, TEXT_SCALE);
     text_fit(cv, MARGIN_L + len + 2 * PAD + cli_font_width(buf, TEXT_SCALE) + 3 * PAD, y,
              "x forward (up), y left, sensor at the centre", k_axis);
@@ -217,7 +221,7 @@ int cli_bev_write(const char *path, const uint8_t *scene, uint32_t sw, uint32_t 
     axes(&cv, top, sw, sh, res_m);
     y = top + (int)sh + below;
     legend_rows(&cv, y, items, n_items, 1);
-    scale_bar(&cv, y + rows * (LINE_H + PAD) + PAD, res_m);
+    scale_bar(&cv, y + rows * (LINE_H + PAD) + PAD, res_m, tick_step((float)sw * 0.5f * res_m));
     rc = lidet_png_write_rgb(path, cv.rgb, cv.w, cv.h);
     free(cv.rgb);
     return rc;

@@ -316,7 +316,9 @@ static int read_gt_kitti(const char *path, const cli_calib_t *c, gt_t **out, uin
 
 #define BEV_W 800u
 #define BEV_H 800u
-#define BEV_RES 0.1f
+/* --png-range M: the picture shows M metres each way around the sensor (default 40: 0.1 m a pixel) */
+static float g_png_half_m = 40.0f;
+#define BEV_RES (g_png_half_m / (0.5f * (float)BEV_W))
 
 static const uint8_t k_class_rgb[LIDET_N_CLASSES][3] = {{255, 80, 60}, {60, 220, 255}, {255, 220, 40}};
 static const char *const k_class_legend[LIDET_N_CLASSES] = {"car", "cyclist", "pedestrian"};
@@ -662,6 +664,8 @@ static void usage_extra(void)
             "  --kitti-out FILE label_2 lines in the camera frame (2D box from the projected corners)\n"
             "  --gt FILE        ground-truth boxes (lidet's sensor-frame lines) drawn in --png\n"
             "  --gt-kitti FILE  ground truth as KITTI label_2 (with --calib) drawn in --png\n"
+            "  --png-range M    --png shows M metres each way around the sensor, in [5, 200] (default\n"
+            "                   40; a room: 10)\n"
             "  --returns        with --fixed and --ring: the scan fed as the sensor's returns (range,\n"
             "                   azimuth, ring: lidet_detector_q_run_returns), as the firmware takes it\n"
             "  --out FILE       detections as '<class> <x> <y> <z> <l> <w> <h> <yaw> <score>' lines\n"
@@ -1017,6 +1021,7 @@ enum
     OPT_GT_KITTI,
     OPT_DUMP,
     OPT_SAVE_SCANS,
+    OPT_PNG_RANGE,
     OPT_RETURNS
 };
 
@@ -1027,6 +1032,7 @@ static const cli_opt_t k_detect_opts[] = {
     {"gt-kitti", required_argument, OPT_GT_KITTI, "FILE: KITTI label_2 lines"},
     {"dump", required_argument, OPT_DUMP, "FILE"},
     {"save-scans", required_argument, OPT_SAVE_SCANS, "DIR"},
+    {"png-range", required_argument, OPT_PNG_RANGE, "M: metres in [5, 200]"},
     {"returns", no_argument, OPT_RETURNS, NULL},
     {NULL, 0, 0, NULL}};
 
@@ -1058,6 +1064,19 @@ static int detect_take(void *ctx, int id, const char *v)
     case OPT_SAVE_SCANS:
         d->save_dir = v;
         break;
+    case OPT_PNG_RANGE:
+    {
+        char *end;
+        const double m = strtod(v, &end);
+        /* !(m >= 5 && m <= 200) also refuses NaN */
+        if (end == v || *end != '\0' || !(m >= 5.0 && m <= 200.0))
+        {
+            fprintf(stderr, "lidet detect: --png-range needs metres in [5, 200], got '%s'\n", v);
+            return 1;
+        }
+        g_png_half_m = (float)m;
+        break;
+    }
     default: /* OPT_RETURNS */
         cli_fixed_returns = 1;
         break;

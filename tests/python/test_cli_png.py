@@ -73,3 +73,33 @@ def test_detect_legend_lists_classes(cli, root, tmp_path):
     legend = a[_scene_top(a) + SCENE + 60:]
     for c in [(255, 80, 60), (60, 220, 255), (255, 220, 40), (60, 230, 90)]:
         assert _is(legend, np.array(c)).sum() >= 100, c
+
+
+@pytest.mark.parametrize("half,ticks", [(40, 9), (20, 9), (10, 11), (5, 11)])
+def test_detect_png_range(cli, root, tmp_path, half, ticks):
+    """`lidet detect --png-range M`: the scene shows M metres each way, its ticks every 10 m from 30 m, 5 m from
+    15 m, 2 m from 6 m, 1 m below (9 ticks over -40..40 and -20..20, 11 over -10..10 and -5..5); a box drawn at
+    the same place moves away from the centre by 40 / M; the default is 40; values outside [5, 200] are refused."""
+    box = tmp_path / "box.txt"
+    box.write_text("Car 3.0 0.0 -1.0 4.0 1.8 1.5 0.0 1.0\n")  # 3 m ahead
+    png = tmp_path / f"r{half}.png"
+    scan = root / "tests/data/sim_hdl64/velodyne/000000.bin"
+    subprocess.run([cli, "detect", scan, "--gt", box, "--png", png, "--png-range", str(half)], check=True,
+                   capture_output=True, cwd=root)
+    a = np.asarray(Image.open(png).convert("RGB")).astype(int)
+    top = _scene_top(a)
+    bottom = top + SCENE
+    assert _is(a[bottom + 1, LEFT:LEFT + SCENE + 1], AXIS).sum() == ticks
+    green = _is(a[top:bottom, LEFT:LEFT + SCENE], np.array([60, 230, 90]))
+    rows = np.nonzero(green.any(axis=1))[0]
+    # the box's far end (5 m ahead) lies 5 / (M / 400) pixels above the centre row
+    assert abs((SCENE // 2 - rows.min()) - 5.0 * 400 / half) <= 2
+    if half == 40:
+        dflt = tmp_path / "default.png"
+        subprocess.run([cli, "detect", scan, "--gt", box, "--png", dflt], check=True, capture_output=True, cwd=root)
+        b = np.asarray(Image.open(dflt).convert("RGB")).astype(int)
+        assert np.array_equal(a[top - 1:], b[top - 1:])  # all but the title (it holds the run's time)
+    for bad in ("4.9", "201", "nan", "x"):
+        r = subprocess.run([cli, "detect", scan, "--png", tmp_path / "bad.png", "--png-range", bad],
+                           capture_output=True, text=True, cwd=root)
+        assert r.returncode != 0 and "--png-range needs metres in [5, 200]" in r.stderr
