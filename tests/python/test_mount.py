@@ -46,3 +46,20 @@ def test_cli(tmp_path, need_lib):
         r = subprocess.run([sys.executable, "-m", "lidet_tools.mount", *args], capture_output=True, text=True)
         assert r.returncode == 1 and msg in r.stderr, (args, r.stderr)
     assert kitti.read_bin(d / "000000.bin").shape[1] == 4
+
+
+def test_warns_when_the_planes_lie_at_the_sensors_height(tmp_path, need_lib):
+    """An estimate below LOW_MOUNT_M (a sensor on the surface it sees, no floor in view) gives a warning on stderr
+    and in the JSON; a plausible one none."""
+    for h, warned in ((0.05, True), (0.4, False)):
+        f = tmp_path / f"m{h}.bin"
+        simulate_scan("vlp16", seed=8100, index=0, mount_height_m=h).points.astype(np.float32).tofile(f)
+        r = subprocess.run([sys.executable, "-m", "lidet_tools.mount", str(f), "--sensor", "vlp16", "--json"],
+                           capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        js = json.loads(r.stdout)
+        assert (js["mount_height_m"] < mount.LOW_MOUNT_M) == warned
+        assert ("warning:" in r.stderr) == warned and (js["warning"] is not None) == warned
+        r = subprocess.run([sys.executable, "-m", "lidet_tools.mount", str(f), "--sensor", "vlp16"],
+                           capture_output=True, text=True)
+        assert r.returncode == 0 and ("lidet detect --mount-height" in r.stdout) != warned

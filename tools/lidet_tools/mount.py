@@ -13,7 +13,10 @@ scans is the estimate. Record a few scans where the robot stands on open, level 
 
 Measured (20 simulated VLP-16 scans per mount; `lidet-sim --mount-height`): 0.31 / 0.53 / 0.74 / 1.04 m at 0.3 /
 0.5 / 0.7 / 1.0 m mounts, single scans within 0.05 (0.3 m) to 0.2 m (0.7 m) of it; the 9 labelled KITTI / SemanticKITTI scans of
-../shared/data/real give 1.67-1.81 m, median 1.80 m (KITTI's HDL-64 is mounted at 1.73 m).
+../shared/data/real give 1.67-1.81 m, median 1.80 m (KITTI's HDL-64 is mounted at 1.73 m); the real Ouster OS2-128
+and OS1-32 captures of ../shared/data/packets (car roofs) 1.98 and 1.88 m. An estimate below 0.1 m comes with a
+warning (and `"warning"` in the JSON): the planes lie at the sensor's own height, as in a real VLP-16 capture of an
+office (0.00 m: desks and walls, the floor out of the beams' view), where no ground below the sensor was seen.
 """
 from __future__ import annotations
 
@@ -26,6 +29,9 @@ import numpy as np
 
 #: the ground stage's height check while estimating (the largest the configuration accepts is 20 m)
 OPEN_HEIGHT_DEV_M = 10.0
+#: an estimate below this is reported with a warning: the planes lie at the sensor's own height (a sensor standing on
+#: the table it sees, or a room whose floor is out of the beams' view: a real VLP-16 capture in an office gives 0.00 m)
+LOW_MOUNT_M = 0.1
 
 
 def estimate(points, sensor: str = "hdl64") -> tuple[float, int]:
@@ -84,16 +90,24 @@ def main(argv=None) -> int:
         return 1
     med = float(np.median(hs[ok]))
     profile = presets[a.sensor][3]
+    warning = None
+    if med < LOW_MOUNT_M:
+        warning = (f"the fitted planes lie within {LOW_MOUNT_M:g} m of the sensor's own height ({med:.2f} m): is the "
+                   f"sensor standing on the surface it sees (a table), or is the floor out of view? Record scans on "
+                   f"open, level ground, or give the height you measured")
+        print(f"lidet_tools.mount: warning: {warning}", file=sys.stderr)
     if a.json:
         print(json.dumps({"sensor": a.sensor, "mount_height_m": round(med, 3), "profile_mount_height_m": profile,
+                          "warning": warning,
                           "scans": [{"scan": s, "mount_height_m": None if not np.isfinite(h) else round(h, 3),
                                      "sectors": n} for s, h, n in per]}))
     else:
         for s, h, n in per:
             print(f"{s}: {h:.3f} m ({n} sectors)" if np.isfinite(h) else f"{s}: no ground plane")
         lo, hi = float(hs[ok].min()), float(hs[ok].max())
+        advice = "no advice (see the warning)" if warning else f"lidet detect --mount-height {med:.2f}"
         print(f"mount height {med:.2f} m (median of {int(ok.sum())} scans, {lo:.2f}-{hi:.2f} m per scan; "
-              f"the {a.sensor} profile says {profile:.2f} m): lidet detect --mount-height {med:.2f}")
+              f"the {a.sensor} profile says {profile:.2f} m): {advice}")
     return 0
 
 
