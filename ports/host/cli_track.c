@@ -22,10 +22,11 @@
 #define TAIL_LEN 128
 #define TAIL_SLOTS (2 * LIDET_TRACK_MAX_TRACKS)
 #define TAIL_STALE 10
-/* the picture's scene: as lidet detect's, 80 m x 80 m */
+/* the picture's scene: as lidet detect's, 80 m x 80 m (--png-range M: 2 M x 2 M) */
 #define BEV_W 800u
 #define BEV_H 800u
-#define BEV_RES 0.1f
+static float g_png_half_m = 40.0f;
+#define BEV_RES (g_png_half_m / (0.5f * (float)BEV_W))
 /* the longest line of an --ego / --dt-file file */
 #define LINE_MAX_CHARS 1024
 /* dt of a scan, seconds: the float tracker takes (0, 10], the integer one [1, 10000] ms */
@@ -101,7 +102,8 @@ static void usage(void)
         "output\n"
         "             track's tail (its last %d centres, moved with the ego motion), box and id in the "
         "track's\n"
-        "             colour, and its velocity as an arrow of 1 s of motion\n"
+        "             colour, and its velocity as an arrow of 1 s of motion; 40 m each way around the\n"
+        "             sensor (--png-range M: M metres, in [5, 200])\n"
         "  --json     one JSON object per scan instead of the lines: frame, scan, points, detections, "
         "statuses,\n"
         "             detect_ms, track_ms, the tracker's stats and the tracks with every field (state, "
@@ -881,6 +883,7 @@ enum
     OPT_OUT,
     OPT_PNG,
     OPT_CALIB,
+    OPT_PNG_RANGE,
     OPT_PNG_SCAN
 };
 
@@ -893,6 +896,7 @@ static const cli_opt_t k_track_opts[] = {{"json", no_argument, OPT_JSON, NULL},
                                          {"out", required_argument, OPT_OUT, "DIR"},
                                          {"png", required_argument, OPT_PNG, "FILE"},
                                          {"calib", required_argument, OPT_CALIB, "FILE: a KITTI calibration"},
+                                         {"png-range", required_argument, OPT_PNG_RANGE, "M: metres in [5, 200]"},
                                          /* lidet detect's, refused with a word on what --png draws here */
                                          {"png-scan", optional_argument, OPT_PNG_SCAN, NULL},
                                          {NULL, 0, 0, NULL}};
@@ -947,6 +951,19 @@ static int track_take(void *ctx, int id, const char *v)
     case OPT_CALIB:
         t->calib_path = v;
         break;
+    case OPT_PNG_RANGE:
+    {
+        char *end;
+        const double m = strtod(v, &end);
+        /* !(m >= 5 && m <= 200) also refuses NaN */
+        if (end == v || *end != '\0' || !(m >= 5.0 && m <= 200.0))
+        {
+            fprintf(stderr, "lidet track: --png-range needs metres in [5, 200], got '%s'\n", v);
+            return 1;
+        }
+        g_png_half_m = (float)m;
+        break;
+    }
     default: /* OPT_PNG_SCAN */
         fprintf(stderr, "lidet track: --png draws the last scan (--png-scan is lidet detect's)\n");
         return 1;

@@ -103,3 +103,17 @@ def test_detect_png_range(cli, root, tmp_path, half, ticks):
         r = subprocess.run([cli, "detect", scan, "--png", tmp_path / "bad.png", "--png-range", bad],
                            capture_output=True, text=True, cwd=root)
         assert r.returncode != 0 and "--png-range needs metres in [5, 200]" in r.stderr
+
+
+def test_track_png_range(cli, root, tmp_path):
+    """`lidet track --png-range M` as lidet detect's: 11 ticks over -10..10 m, refused outside [5, 200]."""
+    scan = root / "tests/data/sim_hdl64/velodyne/000000.bin"
+    png = tmp_path / "t.png"
+    subprocess.run([cli, "track", scan, scan, "--png", png, "--png-range", "10"], check=True, capture_output=True,
+                   cwd=root)
+    a = np.asarray(Image.open(png).convert("RGB")).astype(int)
+    top = _scene_top(a)
+    assert _is(a[top + SCENE + 1, LEFT:LEFT + SCENE + 1], AXIS).sum() == 11
+    r = subprocess.run([cli, "track", scan, "--png", png, "--png-range", "300"], capture_output=True, text=True,
+                       cwd=root)
+    assert r.returncode != 0 and "--png-range needs metres in [5, 200]" in r.stderr
