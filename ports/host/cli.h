@@ -149,6 +149,8 @@ extern const cli_opt_t cli_opts_velodyne_calib[];
 int cli_args_take(void *a, int id, const char *value);
 int cli_velodyne_calib_take(void *a, int id, const char *value);
 /* a's defaults (sensor hdl64, repeat 1, the profile's mount height) */
+/* --png-range M (detect, track): metres in [5, 200] into *half_m; 1 with a message when refused */
+int cli_png_range(const char *v, float *half_m);
 void cli_args_default(cli_args_t *a);
 /* the shared sets over a into sets[]: the sensor and the Velodyne calibration, and with io also cli_opts_io;
  * returns how many (2 or 3) */

@@ -125,6 +125,20 @@ int cli_args_take(void *ctx, int id, const char *v)
     return 0;
 }
 
+int cli_png_range(const char *v, float *half_m)
+{
+    char *end;
+    const double m = strtod(v, &end);
+    /* !(m >= 5 && m <= 200) also refuses NaN */
+    if (end == v || *end != '\0' || !(m >= 5.0 && m <= 200.0))
+    {
+        fprintf(stderr, "lidet %s: --png-range needs metres in [5, 200], got '%s'\n", cli_cmd, v);
+        return 1;
+    }
+    *half_m = (float)m;
+    return 0;
+}
+
 void cli_args_default(cli_args_t *a)
 {
     memset(a, 0, sizeof *a);

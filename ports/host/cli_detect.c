@@ -1065,18 +1065,7 @@ static int detect_take(void *ctx, int id, const char *v)
         d->save_dir = v;
         break;
     case OPT_PNG_RANGE:
-    {
-        char *end;
-        const double m = strtod(v, &end);
-        /* !(m >= 5 && m <= 200) also refuses NaN */
-        if (end == v || *end != '\0' || !(m >= 5.0 && m <= 200.0))
-        {
-            fprintf(stderr, "lidet detect: --png-range needs metres in [5, 200], got '%s'\n", v);
-            return 1;
-        }
-        g_png_half_m = (float)m;
-        break;
-    }
+        return cli_png_range(v, &g_png_half_m);
     default: /* OPT_RETURNS */
         cli_fixed_returns = 1;
         break;

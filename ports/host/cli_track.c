@@ -952,18 +952,7 @@ static int track_take(void *ctx, int id, const char *v)
         t->calib_path = v;
         break;
     case OPT_PNG_RANGE:
-    {
-        char *end;
-        const double m = strtod(v, &end);
-        /* !(m >= 5 && m <= 200) also refuses NaN */
-        if (end == v || *end != '\0' || !(m >= 5.0 && m <= 200.0))
-        {
-            fprintf(stderr, "lidet track: --png-range needs metres in [5, 200], got '%s'\n", v);
-            return 1;
-        }
-        g_png_half_m = (float)m;
-        break;
-    }
+        return cli_png_range(v, &g_png_half_m);
     default: /* OPT_PNG_SCAN */
         fprintf(stderr, "lidet track: --png draws the last scan (--png-scan is lidet detect's)\n");
         return 1;
