@@ -148,9 +148,13 @@ extern const cli_opt_t cli_opts_io[];
 extern const cli_opt_t cli_opts_velodyne_calib[];
 int cli_args_take(void *a, int id, const char *value);
 int cli_velodyne_calib_take(void *a, int id, const char *value);
+/* --png-range M (detect, track): metres in [5, 200] into cli_png_half_m; 1 with a message when refused */
+int cli_png_range(const char *v);
+/* the half width of detect's and track's bird's-eye pictures, metres (default 40), and their metres per pixel
+ * for a scene w pixels wide */
+extern float cli_png_half_m;
+#define CLI_PNG_RES(w) (cli_png_half_m / (0.5f * (float)(w)))
 /* a's defaults (sensor hdl64, repeat 1, the profile's mount height) */
-/* --png-range M (detect, track): metres in [5, 200] into *half_m; 1 with a message when refused */
-int cli_png_range(const char *v, float *half_m);
 void cli_args_default(cli_args_t *a);
 /* the shared sets over a into sets[]: the sensor and the Velodyne calibration, and with io also cli_opts_io;
  * returns how many (2 or 3) */

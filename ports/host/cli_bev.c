@@ -92,11 +92,11 @@ static int legend_rows(const canvas_t *cv, int y, const cli_legend_t *items, int
     return rows;
 }
 
-static void axes(const canvas_t *cv, int top, uint32_t sw, uint32_t sh, float res_m)
+static void axes(const canvas_t *cv, int top, uint32_t sw, uint32_t sh, float res_m, int tick_m)
 {
     const int left = MARGIN_L, bottom = top + (int)sh, right = left + (int)sw;
     const int half_y_m = (int)((float)sw * 0.5f * res_m), half_x_m = (int)((float)sh * 0.5f * res_m);
-    const int tick_m = tick_step((float)sw * 0.5f * res_m), label_m = 2 * tick_m;
+    const int label_m = 2 * tick_m;
     int m;
     char buf[16];
     /* frame one pixel outside the scene */
@@ -198,6 +198,7 @@ int cli_bev_write(const char *path, const uint8_t *scene, uint32_t sw, uint32_t 
                   const char *title, const char *subtitle, const cli_legend_t *items, int n_items)
 {
     const int below = TICK_MAJOR + 4 + LINE_H + PAD + LINE_H + 2 * PAD; /* tick labels, the y axis name */
+    const int tick_m = tick_step((float)sw * 0.5f * res_m);
     canvas_t cv;
     int rows, y, rc, n_title, n_sub, top;
     uint32_t r;
@@ -218,10 +219,10 @@ int cli_bev_write(const char *path, const uint8_t *scene, uint32_t sw, uint32_t 
                (size_t)sw * 3u);
     text_lines(&cv, PAD, PAD, title, 1);
     text_lines(&cv, PAD, PAD + n_title * (LINE_H + PAD), subtitle, 1);
-    axes(&cv, top, sw, sh, res_m);
+    axes(&cv, top, sw, sh, res_m, tick_m);
     y = top + (int)sh + below;
     legend_rows(&cv, y, items, n_items, 1);
-    scale_bar(&cv, y + rows * (LINE_H + PAD) + PAD, res_m, tick_step((float)sw * 0.5f * res_m));
+    scale_bar(&cv, y + rows * (LINE_H + PAD) + PAD, res_m, tick_m);
     rc = lidet_png_write_rgb(path, cv.rgb, cv.w, cv.h);
     free(cv.rgb);
     return rc;

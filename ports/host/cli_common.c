@@ -125,7 +125,9 @@ int cli_args_take(void *ctx, int id, const char *v)
     return 0;
 }
 
-int cli_png_range(const char *v, float *half_m)
+float cli_png_half_m = 40.0f;
+
+int cli_png_range(const char *v)
 {
     char *end;
     const double m = strtod(v, &end);
@@ -135,7 +137,7 @@ int cli_png_range(const char *v, float *half_m)
         fprintf(stderr, "lidet %s: --png-range needs metres in [5, 200], got '%s'\n", cli_cmd, v);
         return 1;
     }
-    *half_m = (float)m;
+    cli_png_half_m = (float)m;
     return 0;
 }
 

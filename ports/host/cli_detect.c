@@ -317,8 +317,7 @@ static int read_gt_kitti(const char *path, const cli_calib_t *c, gt_t **out, uin
 #define BEV_W 800u
 #define BEV_H 800u
 /* --png-range M: the picture shows M metres each way around the sensor (default 40: 0.1 m a pixel) */
-static float g_png_half_m = 40.0f;
-#define BEV_RES (g_png_half_m / (0.5f * (float)BEV_W))
+#define BEV_RES CLI_PNG_RES(BEV_W)
 
 static const uint8_t k_class_rgb[LIDET_N_CLASSES][3] = {{255, 80, 60}, {60, 220, 255}, {255, 220, 40}};
 static const char *const k_class_legend[LIDET_N_CLASSES] = {"car", "cyclist", "pedestrian"};
@@ -1065,7 +1064,7 @@ static int detect_take(void *ctx, int id, const char *v)
         d->save_dir = v;
         break;
     case OPT_PNG_RANGE:
-        return cli_png_range(v, &g_png_half_m);
+        return cli_png_range(v);
     default: /* OPT_RETURNS */
         cli_fixed_returns = 1;
         break;

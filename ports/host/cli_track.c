@@ -25,8 +25,7 @@
 /* the picture's scene: as lidet detect's, 80 m x 80 m (--png-range M: 2 M x 2 M) */
 #define BEV_W 800u
 #define BEV_H 800u
-static float g_png_half_m = 40.0f;
-#define BEV_RES (g_png_half_m / (0.5f * (float)BEV_W))
+#define BEV_RES CLI_PNG_RES(BEV_W)
 /* the longest line of an --ego / --dt-file file */
 #define LINE_MAX_CHARS 1024
 /* dt of a scan, seconds: the float tracker takes (0, 10], the integer one [1, 10000] ms */
@@ -952,7 +951,7 @@ static int track_take(void *ctx, int id, const char *v)
         t->calib_path = v;
         break;
     case OPT_PNG_RANGE:
-        return cli_png_range(v, &g_png_half_m);
+        return cli_png_range(v);
     default: /* OPT_PNG_SCAN */
         fprintf(stderr, "lidet track: --png draws the last scan (--png-scan is lidet detect's)\n");
         return 1;

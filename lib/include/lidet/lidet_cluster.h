@@ -287,8 +287,8 @@ typedef struct
     float regrow_cut_m;  /**< the regrowth leaves out the component's pixels less than this above the ground
                                   plane (as the mean height's plane: the pixel's sector, far plane past
                                   plane_split_m; the flat ground without planes): curbs and kerb-high clutter that
-                                  chain a car to the street are cut away; 0 = none (default: 0.25 m found 1.6
-                                  more of 113 real training cars for 0.08 more false positives a frame, and the
+                                  chain a car to the street are cut away. 0 = none, the default (0.25 m found
+                                  1.6 more of 113 real training cars for 0.08 more false positives a frame, the
                                   integer detector none: docs/journal/real-streets.md). [0, 2] */
     float plane_split_m; /**< with planes: 0 (default) measures every mean against its sector's plane,
                                   planes[s]; > 0: planes holds 2 * n_sectors planes, near then far (the ground
