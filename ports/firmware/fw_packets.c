@@ -6,8 +6,10 @@
  * "Streaming the returns"). The decoder: a VLP-16's (lidet_velodyne_packet, LIDET_VELODYNE_MAX_RETURNS returns a
  * payload), or with FW_OUSTER=1 (LIDET_FW_LIDAR=ouster) an Ouster sensor's (lidet_ouster_packet, configured from the
  * metadata in fw_packets.h; 16 columns x LIDET_MAX_ROWS returns a payload; a frame completes when the next frame's
- * first payload arrives). Both decoders' scan events have the same values and meanings. Two runs, as fw_detect.c:
- * `default` (the configuration a user gets) and `open` (gates and size checks off, so that many boxes are compared).
+ * first payload arrives). Both decoders' scan events have the same values and meanings. Three runs: as fw_detect.c,
+ * `default` (the configuration a user gets) and `open` (gates and size checks off, so that many boxes are compared),
+ * and `sectors` (the default one with lidet_detector_q_cfg_t.stream_sectors: the ground stage done sector by sector
+ * while the payloads arrive, so stream_end, the latency from the last payload, has less to do).
  * No tracker: its 8 KiB do not fit beside the decoder's buffers in the integer image's 256 KiB (run_fw.py).
  *
  * Built for the host with FW_PACKETS_HOST_REF=1 (fw_host_ref_pkt, tests/firmware.cmake) it is the reference the
@@ -586,6 +588,11 @@ int fw_main(void)
             cfg.size.max_mm[c][j] = LIDET_Q_BOX_MAX_MM;
         }
     bad |= run_once("open", &cfg);
+    /* run 3: the default configuration with the ground stage streamed sector by sector (stream_sectors): the
+     * latency from the last payload to the detections (pktinsn end) against run 1's */
+    lidet_detector_q_cfg_default(&cfg, sensor);
+    cfg.stream_sectors = 1u;
+    bad |= run_once("sectors", &cfg);
     bad |= scan_digest("default");
 
     fw_put_s("stack");

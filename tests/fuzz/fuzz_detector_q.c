@@ -1,7 +1,8 @@
 /* SPDX-License-Identifier: MIT */
 /* libFuzzer harness: the integer detector (lidet_detector_q_init with fuzzed knobs, lidet_detector_q_run and,
  * on the same bytes read as the sensor's returns, lidet_detector_q_run_returns and the same returns streamed in
- * chunks, lidet_detector_q_stream_*, which must give the same results bit for bit:
+ * chunks, lidet_detector_q_stream_*, which must give the same results bit for bit (with stream_sectors on half of
+ * the range-only inputs, the returns then sorted by azimuth):
  * integer projection, ground, clustering, proposals, the int8 PointNets (the tiny models of
  * tests/fuzz/models), gates, size check, NMS) on any integer sensor and any int32 millimetre scan the input
  * describes (INT32_MIN/MAX coordinates, zero range, rings out of range). Checks the counts and outcomes agree,
@@ -119,6 +120,9 @@ static void detector_q_knobs(fz_in_t *in, lidet_detector_q_cfg_t *c, uint8_t *p6
         c->range_only = (uint8_t)(b >> 7);
     }
     c->ground.n_sectors = (uint16_t)(1u + fz_u8(in) % LIDET_GROUND_MAX_SECTORS);
+    /* the ground stage streamed sector by sector on half of the range-only inputs (an odd sector count; the
+     * input's layout unchanged) */
+    c->stream_sectors = (uint8_t)(c->range_only & (c->ground.n_sectors & 1u));
     c->cluster.max_steps = fz_u8(in) % (LIDET_CLUSTER_MAX_STEPS + 2u);
     poke_u32(in, f32, (uint32_t)(sizeof f32 / sizeof f32[0]));
 }
@@ -192,6 +196,27 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         g_ret[i].azimuth = (uint16_t)g_pts[i * s.stride + 1u];
         g_ret[i].ring = (uint16_t)g_pts[i * s.stride + 2u];
     }
+    if (cfg.stream_sectors)
+    {
+        /* in the order a spinning sensor sends them, to 1/256 turn (a counting sort on 2^15 - azimuth's top byte),
+         * so the stream does sectors before its end; the image does not depend on the order */
+        static lidet_return_t tmp[FZ_MAX_IN];
+        uint32_t at[257];
+        memset(at, 0, sizeof at);
+        for (i = 0; i < s.n_points; ++i)
+        {
+            ++at[1u + (((uint16_t)(0x8000u - g_ret[i].azimuth)) >> 8)];
+        }
+        for (i = 1; i < 257u; ++i)
+        {
+            at[i] += at[i - 1u];
+        }
+        for (i = 0; i < s.n_points; ++i)
+        {
+            tmp[at[((uint16_t)(0x8000u - g_ret[i].azimuth)) >> 8]++] = g_ret[i];
+        }
+        memcpy(g_ret, tmp, (size_t)s.n_points * sizeof g_ret[0]);
+    }
     st = lidet_detector_q_run_returns(&g_det, g_ret, s.n_points, per_point ? g_pp : NULL);
     FZ_CHECK(LIDET_SUCCEEDED(st));
     ds = lidet_detector_q_stats(&g_det);
@@ -223,7 +248,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK(lidet_detector_q_stream_begin(&g_det) == LIDET_OK);
         while (at < s.n_points)
         {
-            uint32_t m = (uint32_t)g_pts[(k++ * 7u) % (s.n_points * s.stride)] & 511u;
+            /* chunks of up to 511 returns, up to 7 with stream_sectors (packets of a sparse scan) */
+            uint32_t m =
+                (uint32_t)g_pts[(k++ * 7u) % (s.n_points * s.stride)] & (cfg.stream_sectors ? 7u : 511u);
             m = m < s.n_points - at ? m : s.n_points - at;
             FZ_CHECK(LIDET_SUCCEEDED(lidet_detector_q_stream_returns(&g_det, g_ret + at, m, NULL)));
             at += m;
@@ -242,6 +269,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         FZ_CHECK(memcmp(det, d0, n0 * sizeof d0[0]) == 0 && memcmp(o, o0, nc0) == 0);
         FZ_CHECK(memcmp(&ds->proj, &s0.proj, sizeof s0.proj) == 0 && ds->n_detections == s0.n_detections &&
                  ds->n_classified == s0.n_classified && ds->n_boxed == s0.n_boxed);
+        /* the streamed ground (stream_sectors) gives the whole stage's planes, mask and counts */
+        FZ_CHECK(memcmp(&ds->ground, &s0.ground, sizeof s0.ground) == 0 &&
+                 memcmp(&ds->cluster, &s0.cluster, sizeof s0.cluster) == 0);
+        FZ_CHECK(s0.n_stream_sectors == 0u &&
+                 ds->n_stream_sectors < (cfg.stream_sectors ? cfg.ground.n_sectors : 1u));
     }
     return 0;
 }

@@ -445,6 +445,11 @@ def main() -> None:
         head, body = scan_parts_q(sensor, table, rings, stride, tile, seed=len(name))
         k = KNOBS_Q if sensor != "vlp16" else bytes([KNOBS_Q[0] | 1]) + KNOBS_Q[1:]
         (d / f"{name}.bin").write_bytes(head + k + body)
+    # the range-only pixel (min_points byte's top bit: 0x88, min_points 5) and 9 ground sectors (byte 8): an odd count
+    # turns stream_sectors on (fuzz_detector_q.c), the ground stage streamed sector by sector
+    head, body = scan_parts_q("vlp16", True, True, 4, 1, seed=len("vlp16_table_rings"))
+    k = bytes([KNOBS_Q[0] | 1, KNOBS_Q[1], 0x88, 8]) + KNOBS_Q[4:]
+    (d / "vlp16_stream_sectors.bin").write_bytes(head + k + body)
     d = OUT / "pointnet_q"
     d.mkdir(exist_ok=True)
     # mode: bit 0 descriptor mutation, bit 1 box net, bit 2 64 points (fuzz_pointnet_q.c)

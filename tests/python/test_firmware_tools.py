@@ -400,16 +400,18 @@ def test_packet_lines_parse_and_compare():
 
 def test_host_reference_of_the_packet_application():
     """fw_host_ref_pkt: the payloads decoded on the host, the completed scan through lidet_detector_q_run_returns:
-    both runs, detections in the open run, one partial then one complete scan, its digest."""
+    the three runs (the third with the ground stage streamed sector by sector), detections in the open run, one
+    partial then one complete scan, its digest."""
     exe = pathlib.Path(os.environ.get("LIDET_BUILD_DIR", ROOT / "build")) / "tests" / "fw_host_ref_pkt"
     if not exe.exists():
         pytest.skip(f"{exe} not built")
     p = subprocess.run([str(exe)], capture_output=True, text=True, timeout=120)
     assert p.returncode == 0, p.stdout + p.stderr
     rep = run_fw.parse(p.stdout)
-    assert rep["pass"] and rep["header"]["app"] == "packets" and set(rep["stats"]) == {"default", "open"}
+    assert rep["pass"] and rep["header"]["app"] == "packets" and set(rep["stats"]) == {"default", "open", "sectors"}
     assert len(rep["det"]["open"]) == rep["stats"]["open"]["detections"] > 0 and not rep["track"]
-    for run in ("default", "open"):
+    assert rep["stats"]["sectors"]["detections"] > 0
+    for run in ("default", "open", "sectors"):
         d = rep["decode"][run]
         assert (d["packets"], d["decoded"], d["partial"], d["complete"], d["aborted"]) == (76, 76, 1, 1, 0)
         assert d["scan_returns"] == rep["stats"][run]["proj_in"] == int(rep["digest"]["default"]["returns"]) == 23252

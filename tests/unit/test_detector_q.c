@@ -471,6 +471,137 @@ static void test_streamed_returns_equal_the_whole_scan(void)
     }
 }
 
+/* ---- stream_sectors: the ground stage while the scan streams in ---- */
+static lidet_return_t sret[LIDET_MAX_POINTS];
+
+/* the simulated scan `name` (vlp16 or hdl64, its first frame) as returns into sret, in the order a spinning sensor
+ * sends them: by image column from the one of azimuth seam_bam (dir +1: columns upwards, -1: downwards) */
+static uint32_t sorted_returns(const char *name, int dir, uint16_t seam_bam)
+{
+    static float raw[LIDET_MAX_POINTS * 4];
+    static uint16_t ring[LIDET_MAX_POINTS];
+    static uint32_t key[LIDET_MAX_POINTS];
+    char path[512];
+    FILE *f;
+    size_t n, i, k;
+    snprintf(path, sizeof path, LIDET_SOURCE_DIR "/tests/data/sim_%s/velodyne/000000.bin", name);
+    f = fopen(path, "rb");
+    TEST_ASSERT_NOT_NULL(f);
+    n = fread(raw, 4 * sizeof(float), LIDET_MAX_POINTS, f);
+    fclose(f);
+    snprintf(path, sizeof path, LIDET_SOURCE_DIR "/tests/data/sim_%s/ring/000000.bin", name);
+    f = fopen(path, "rb");
+    TEST_ASSERT_NOT_NULL(f);
+    TEST_ASSERT_EQUAL_UINT32((uint32_t)n, (uint32_t)fread(ring, sizeof ring[0], LIDET_MAX_POINTS, f));
+    fclose(f);
+    TEST_ASSERT_TRUE(n > 1000u);
+    for (i = 0; i < n; ++i)
+    {
+        const double x = 1000.0 * (double)raw[4 * i], y = 1000.0 * (double)raw[4 * i + 1],
+                     z = 1000.0 * (double)raw[4 * i + 2];
+        const double a = atan2(y, x) * 65536.0 / (2.0 * 3.14159265358979323846);
+        lidet_return_t r;
+        r.range_mm = (uint32_t)(sqrt(x * x + y * y + z * z) + 0.5);
+        r.azimuth = (uint16_t)(int32_t)floor(a + 0.5);
+        r.ring = ring[i];
+        sret[i] = r;
+        /* the column order from the seam's column: (2^15 - azimuth) mod 2^16 from the seam's, mod 2^16 */
+        key[i] = (uint32_t)(uint16_t)((uint16_t)(0x8000u - r.azimuth) - (uint16_t)(0x8000u - seam_bam));
+        if (dir < 0)
+        {
+            key[i] = (uint32_t)(uint16_t)(0u - key[i]);
+        }
+    }
+    /* insertion sort by key, stable (the firmware's packets keep their firing order within a column) */
+    for (i = 1; i < n; ++i)
+    {
+        const lidet_return_t r = sret[i];
+        const uint32_t kk = key[i];
+        for (k = i; k > 0 && key[k - 1] > kk; --k)
+        {
+            sret[k] = sret[k - 1];
+            key[k] = key[k - 1];
+        }
+        sret[k] = r;
+        key[k] = kk;
+    }
+    return (uint32_t)n;
+}
+
+/* sret[0, n) streamed in chunks of `chunk` (chunk_order: 0 in order, 1 every other chunk held back to the end) */
+static lidet_status_t stream_sret(uint32_t n, uint32_t chunk, int held_back)
+{
+    uint32_t a, pass;
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_stream_begin(&g.ws));
+    for (pass = 0; pass < (held_back ? 2u : 1u); ++pass)
+    {
+        for (a = 0; a < n; a += chunk)
+        {
+            const uint32_t m = n - a < chunk ? n - a : chunk;
+            if (held_back && ((a / chunk) & 1u) != pass)
+            {
+                continue;
+            }
+            TEST_ASSERT_TRUE(LIDET_SUCCEEDED(lidet_detector_q_stream_returns(&g.ws, sret + a, m, NULL)));
+        }
+    }
+    return lidet_detector_q_stream_end(&g.ws);
+}
+
+static void test_streamed_sectors_equal_the_whole_scan(void)
+{
+    static run_t whole, part;
+    static const char *const names[] = {"vlp16", "hdl64"};
+    lidet_detector_q_cfg_t cfg;
+    uint32_t k, n;
+    for (k = 0; k < 2u; ++k)
+    {
+        const lidet_sensor_q_t *sn = lidet_sensor_q_find(names[k]);
+        const lidet_pointnet_q_model_t *mc = lidet_pointnet_q_find(
+            lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, k == 0 ? "cls_vlp16_s8" : "cls_hdl64_s8");
+        const lidet_pointnet_q_model_t *mb = lidet_pointnet_q_find(
+            lidet_weights_models_s8, LIDET_WEIGHTS_N_MODELS_S8, k == 0 ? "box_vlp16_s8" : "box_hdl64_s8");
+        uint32_t ns, dir;
+        TEST_ASSERT_NOT_NULL(sn);
+        TEST_ASSERT_NOT_NULL(mc);
+        TEST_ASSERT_NOT_NULL(mb);
+        lidet_detector_q_cfg_default(&cfg, sn);
+        cfg.stream_sectors = 1u;
+        cfg.range_only = 0u; /* the streamed ground needs the range-only image */
+        TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, mc, mb));
+        cfg.range_only = 1u;
+        cfg.stream_sectors = 2u;
+        TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, mc, mb));
+        cfg.stream_sectors = 1u;
+        CANARY_FILL(g);
+        TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_detector_q_init(&g.ws, &cfg, mc, mb));
+        TEST_ASSERT_EQUAL_UINT8(1u, g.ws.cfg.ground.seed_per_cell);
+        ns = g.ws.cfg.ground.n_sectors;
+        for (dir = 0; dir < 2u; ++dir)
+        {
+            /* a seam 30 degrees off the image's first column, columns up (Velodyne) or down */
+            n = sorted_returns(names[k], dir == 0u ? 1 : -1, (uint16_t)(0x8000u + 5461u));
+            keep(&whole, lidet_detector_q_run_returns(&g.ws, sret, n, NULL));
+            TEST_ASSERT_TRUE(LIDET_SUCCEEDED(whole.s));
+            TEST_ASSERT_TRUE(whole.n_det >= 2u);
+            TEST_ASSERT_EQUAL_UINT32(0u, whole.st.n_stream_sectors);
+            keep(&part, stream_sret(n, 384u, 0));
+            /* most sectors done before stream_end; the first one and those the margin holds back after it */
+            TEST_ASSERT_TRUE(part.st.n_stream_sectors + 4u >= ns - ns / 16u);
+            TEST_ASSERT_TRUE(part.st.n_stream_sectors < ns);
+            part.st.n_stream_sectors = 0;
+            same_run(&whole, &part);
+            TEST_ASSERT_EQUAL_MEMORY(whole.range, g.ws.range_4mm, sizeof whole.range);
+            /* every other packet held back to the end: returns come back to done sectors, and stream_end runs the
+             * whole stage: the same results */
+            keep(&part, stream_sret(n, 384u, 1));
+            TEST_ASSERT_EQUAL_UINT32(0u, part.st.n_stream_sectors);
+            same_run(&whole, &part);
+        }
+        CANARY_CHECK(g);
+    }
+}
+
 static void test_stream_states_and_truncation(void)
 {
     static run_t whole, part;
@@ -523,6 +654,7 @@ int main(void)
     RUN_TEST(test_crop_and_budget);
     RUN_TEST(test_bad_points);
     RUN_TEST(test_streamed_returns_equal_the_whole_scan);
+    RUN_TEST(test_streamed_sectors_equal_the_whole_scan);
     RUN_TEST(test_stream_states_and_truncation);
     RUN_TEST(test_score);
     return UNITY_END();

@@ -288,6 +288,47 @@ def _ouster_section(reports) -> list:
     return out
 
 
+def _sectors_section(reports) -> list:
+    """The packet images' run `sectors` (lidet_detector_q_cfg_t.stream_sectors) against run `default`: the latency
+    from the last payload to the detections (`stream_end`), the streamed ground's share of the payloads' calls, the
+    whole scan."""
+    rows = [(b, core) for b, core, _ in PACKET_BOARDS + OUSTER_PACKET_BOARDS
+            if "sectors" in reports.get(b, {}).get("pktinsn", {}) and "default" in reports[b]["pktinsn"]]
+    if not rows:
+        return []
+    out = [
+        "",
+        "**The ground stage while the payloads arrive** (`lidet_detector_q_cfg_t.stream_sectors`, docs/PORTING.md "
+        "\"Streaming the returns\"): the packet images' third run, `sectors`, is run `default` with the ground stage "
+        "done on each of its sectors as soon as the stream has moved past it, inside the `stream_returns` calls, so "
+        "`stream_end` has only the last sectors (the first payload's, and those within the margin of the last "
+        "payload) and the fallback left. Its results equal the host's `lidet_detector_q_run_returns` with the same "
+        "configuration bit for bit (the comparisons below; the configuration draws a RANSAC stream per ground cell, "
+        "so its detections may differ from run `default`'s). Latency = `stream_end`, from the payload that completes "
+        "the scan to the detections; ground = the ground stage's instructions inside `stream_end`; streaming = "
+        "`stream_begin` + every `stream_returns` (the projection, and in run `sectors` the streamed ground):",
+        "",
+        "| core | **latency** `default` | **latency** `sectors` | ratio | ground in `stream_end` | streaming "
+        "(largest call) | total per scan |",
+        "|---|---:|---:|---:|---|---|---|",
+    ]
+    for board, core in rows:
+        r = reports[board]
+        pd, ps = r["pktinsn"]["default"], r["pktinsn"]["sectors"]
+        idf, isc = r["insn"]["default"], r["insn"]["sectors"]
+        out.append(
+            f"| {core} | **{_m(pd['end'])}** | **{_m(ps['end'])}** | {ps['end'] / max(pd['end'], 1):.2f} | "
+            f"{_m(idf['ground'])} -> {_m(isc['ground'])} | {_m(idf['project'])} ({pd['stream_max'] / 1e3:,.1f} k) -> "
+            f"{_m(isc['project'])} ({ps['stream_max'] / 1e3:,.1f} k) | {_m(idf['scan'])} -> {_m(isc['scan'])} |")
+    out += [""]
+    for board, core in rows:
+        r = reports[board]
+        cmp = [c for c in r.get("comparison", []) if c.startswith("run sectors")]
+        out.append(f"- {core}, run sectors: " + " / ".join(cmp) +
+                   (" **FAILED: " + "; ".join(r["errors"]) + "**" if r.get("errors") else ""))
+    return out
+
+
 def run(args) -> str:
     build = pathlib.Path(args.build)
     if os.environ.get("LIDET_BENCH_FW_REUSE") == "1":  # the reports of the last ctest run, as they are
@@ -581,6 +622,7 @@ def run(args) -> str:
         ]
     out += _packets_section(reports)
     out += _ouster_section(reports)
+    out += _sectors_section(reports)
     out += [
         "",
         "**Cost in CI.** Installing the toolchains and QEMU (`tools/scripts/install_deps.sh`, Debian 12: "

@@ -100,8 +100,14 @@ typedef struct
     uint8_t range_only;           /**< 1: the image stores only the range per pixel, x, y, z are decoded from
                                    row, column and range (lib/src/internal/lidet_qpix.h); default
                                    !LIDET_Q_PIXEL_XYZ; must be 1 when LIDET_Q_PIXEL_XYZ is 0 */
-    uint8_t gate1;                /**< 1 (default): drop proposals failing gate 1 */
-    uint8_t gate2;                /**< 1 (default): drop boxes failing gate 2 */
+    uint8_t stream_sectors; /**< 1: a streamed scan (lidet_detector_q_stream_*) runs the ground stage on each
+                                       sector of the image as soon as the stream has moved past it, so stream_end
+                                       has less left to do; needs range_only 1 (LIDET_ERR_CONFIG otherwise) and
+                                       sets ground.seed_per_cell (a RANSAC stream per ground cell). Every run's
+                                       results are then those of a run with seed_per_cell on, streamed or not.
+                                       Default 0 (docs/PORTING.md, "Streaming the returns") */
+    uint8_t gate1;          /**< 1 (default): drop proposals failing gate 1 */
+    uint8_t gate2;          /**< 1 (default): drop boxes failing gate 2 */
     int32_t gate1_margin_q16; /**< gate 1 passes when energy_q16 < the model's gamma_q16 + this (Q16 nats; the
                                           float detector's gate1_margin); [-20 * 65536, 20 * 65536], default 0 */
     int32_t gate2_margin_q16; /**< the same for gate 2; default 0 */
@@ -155,6 +161,9 @@ typedef struct
     uint32_t n_too_tall;        /**< taller than max_height_extent_mm (not classified) */
     uint32_t n_group_split, n_group_classified, n_group_boxed; /**< the float detector's group split counts */
     uint32_t n_score_rejected;                                 /**< the float detector's n_score_rejected */
+    uint32_t n_stream_sectors; /**< cfg.stream_sectors: ground sectors done while the scan streamed in, before
+                                    stream_end (0 when a return came back to a done sector's columns: stream_end
+                                    then ran the whole stage) */
     uint32_t ticks[LIDET_DET_N_STAGES]; /**< clock ticks per stage (0 without a clock) */
     lidet_proj_stats_t proj;
     lidet_ground_stats_t ground;
@@ -206,6 +215,14 @@ typedef struct
     uint32_t n_det;
     lidet_detector_q_stats_t stats;
     uint32_t stream_ticks; /* a stream's projection ticks so far (lidet_detector_q_stream_*) */
+    /* cfg.stream_sectors: the stream's progress in columns travelled from its first return's column (the image's
+     * columns in the order the returns visit them: dir +1 or -1, 0 until known) */
+    uint16_t stream_first_col, stream_pos, stream_done;
+    uint16_t stream_late_u,
+        stream_late_span; /* the azimuths (as 2^15 - azimuth) of the done sectors' columns:
+                                                 [late_u, late_u + late_span] mod 2^16 */
+    int8_t stream_dir;
+    uint8_t stream_flags; /* LIDET__DETQ_STREAM_* (lidet_detector_q.c) */
 } lidet_detector_q_t;
 
 /**
@@ -252,7 +269,12 @@ lidet_status_t lidet_detector_q_run_returns(lidet_detector_q_t *d, const lidet_r
  * The detections, outcomes, stats and image equal lidet_detector_q_run_returns' on the chunks' concatenation, bit
  * for bit, however the scan is cut (lidet_proj_q_returns_begin). stats.ticks[PROJECT] sums the three calls'
  * projection time; the rest of the stages run inside end, so the latency from a scan's last packet to its
- * detections is end's time. Nothing else may run on the detector between begin and end: a run
+ * detections is end's time. With cfg.stream_sectors (a range-only image), stream_returns also runs the ground
+ * stage on every sector the stream has moved past (its columns and two on each side at least 1/32 turn + 4
+ * columns behind the chunk's last return; the first return's sector waits for end), so end does only the rest of
+ * it: the results are still run_returns' (which then draws a RANSAC stream per ground cell too), bit for bit, in
+ * any order of the returns; a return that comes back to a done sector's columns makes end run the whole ground
+ * stage again (stats.n_stream_sectors 0). ticks[PROJECT] then holds that ground work too. Nothing else may run on the detector between begin and end: a run
  * (lidet_detector_q_run, _run_returns) or a new begin drops an open stream.
  * @param point_pixel optional: n_returns int32 for *this chunk* (each return's pixel, -1 = dropped), or NULL.
  * @return begin: LIDET_OK; LIDET_ERR_ARG (NULL); LIDET_ERR_STATE (not initialised). stream_returns: LIDET_OK;

@@ -100,6 +100,9 @@ typedef struct
     int64_t plane_d[2 * LIDET_GROUND_MAX_SECTORS]; /* D of each plane, 4 mm / 2^30 (the labels use it) */
     uint8_t source[2 * LIDET_GROUND_MAX_SECTORS];  /* lidet_ground_plane_source_t */
     lidet_ground_stats_t stats;
+    uint32_t stream_lo, stream_hi,
+        stream_total; /* a streamed run's sample buffer so far (the integer detector's
+                                                    stream_sectors: lib/src/internal/lidet_ground_q_internal.h) */
 } lidet_ground_q_state_t;
 
 /** @brief Scratch of one run (only the sample mask is read after it, as a diagnostic). */

@@ -4,6 +4,8 @@
  * codegen/lidet_ref/detector_q.py. */
 #include <string.h>
 
+#include "internal/lidet_ground_internal.h"
+#include "internal/lidet_ground_q_internal.h"
 #include "internal/lidet_group_q.h"
 #include "internal/lidet_pointnet_q_internal.h"
 #include "internal/lidet_qmath.h"
@@ -89,7 +91,8 @@ static int cfg_ok(const lidet_detector_q_cfg_t *c)
         c->group_gate1_margin_q16 > MARGIN_MAX_Q16 || c->car_min_z_spread_mm < 0 ||
         c->car_min_z_spread_mm > 10000 || (!LIDET_Q_PIXEL_XYZ && c->range_only == 0u) ||
         c->car_ground_mm < 0 || c->car_ground_mm > 10000 || (!LIDET_Q_PIXEL_XYZ && c->car_ground_mm != 0) ||
-        c->gate1_large_car_margin_q16 < 0 || c->gate1_large_car_margin_q16 > MARGIN_MAX_Q16)
+        c->gate1_large_car_margin_q16 < 0 || c->gate1_large_car_margin_q16 > MARGIN_MAX_Q16 ||
+        c->stream_sectors > 1u || (c->stream_sectors && !c->range_only))
     {
         return 0;
     }
@@ -160,6 +163,11 @@ lidet_status_t lidet_detector_q_init(lidet_detector_q_t *d, const lidet_detector
     {
         /* the crop: the ground's RANSAC draws a stream per cell, as the float detector's crop does, so that
          * both builds draw the same samples of a sector (the float detector needs it for its windows) */
+        d->cfg.ground.seed_per_cell = 1u;
+    }
+    if (cfg->stream_sectors)
+    {
+        /* a sector's plane from its own samples alone, whichever sector the stream does first */
         d->cfg.ground.seed_per_cell = 1u;
     }
     s = lidet_proj_q_init(&d->proj, &d->cfg.proj);
@@ -533,7 +541,8 @@ static void det_buffers(lidet_detector_q_t *d, lidet_proj_q_buffers_t *buf, int3
  * on the finished image; the clock is read where run_scan always read it, so a firmware that rebuilds 64-bit
  * stage counts from the timestamps sees the same sequence */
 static lidet_status_t det_after_projection(lidet_detector_q_t *d, const lidet_proj_q_buffers_t *buf,
-                                           lidet_status_t s, uint32_t t_proj, uint32_t proj_ticks)
+                                           lidet_status_t s, uint32_t t_proj, uint32_t proj_ticks,
+                                           int streamed)
 {
     lidet_detector_q_stats_t *st = &d->stats;
     lidet_range_image_t img;
@@ -545,7 +554,21 @@ static lidet_status_t det_after_projection(lidet_detector_q_t *d, const lidet_pr
     img.point_idx = 0; /* the ground stage's scratch overlays it from here on */
     t1 = now(d);
     st->ticks[LIDET_DET_STAGE_PROJECT] = proj_ticks + (t1 - t_proj);
-    s = lidet_ground_q_run_buffers(&d->ground, &d->scratch.ground, ground_mask(d), &img);
+    s = LIDET_ERR_STATE;
+    if (streamed)
+    {
+        /* the sectors the stream has not done yet (lidet_detector_q_stream_returns); samples dropped make the
+         * buffer's order, hence which are dropped, follow the sectors' order: then the whole stage again */
+        s = lidet__ground_q_stream_end(&d->ground, &d->scratch.ground, ground_mask(d), &img);
+    }
+    if (s == LIDET_OK)
+    {
+        st->n_stream_sectors = d->stream_done;
+    }
+    else
+    {
+        s = lidet_ground_q_run_buffers(&d->ground, &d->scratch.ground, ground_mask(d), &img);
+    }
     st->ground = d->ground.stats;
     if (!LIDET_SUCCEEDED(s))
     {
@@ -629,7 +652,7 @@ static lidet_status_t run_scan(lidet_detector_q_t *d, const int32_t *points_mm, 
     {
         return s;
     }
-    return det_after_projection(d, &buf, s, t0, 0u);
+    return det_after_projection(d, &buf, s, t0, 0u, 0);
 }
 
 lidet_status_t lidet_detector_q_run(lidet_detector_q_t *d, const int32_t *points_mm, uint32_t n_points,
@@ -642,6 +665,114 @@ lidet_status_t lidet_detector_q_run_returns(lidet_detector_q_t *d, const lidet_r
                                             uint32_t n_returns, int32_t *point_pixel)
 {
     return run_scan(d, 0, n_returns, 0u, 0, returns, 1, point_pixel);
+}
+
+/* stream_flags: the streamed ground is on (cfg.stream_sectors, its begin succeeded); the first return's column is
+ * known; a return came where a done sector had read (stream_end runs the whole ground stage) */
+#define STREAM_ON 1u
+#define STREAM_FIRST 2u
+#define STREAM_LATE 4u
+
+/* the image column of a return (lidet_proj_q's: (2^15 - azimuth) mod 2^16 scaled to the columns) */
+static inline uint32_t return_col(const lidet_return_t *p, uint32_t cols)
+{
+    return ((uint32_t)(uint16_t)(0x8000u - p->azimuth) * cols) >> 16;
+}
+
+/* the smallest 2^15 - azimuth (mod 2^16) in column c (return_col's inverse; c = cols gives 2^16) */
+static inline uint32_t col_start_u(uint32_t c, uint32_t cols)
+{
+    return (c * 65536u + cols - 1u) / cols;
+}
+
+/* columns travelled from the stream's first column to column c (mod cols), in the stream's direction */
+static inline uint32_t stream_travel(const lidet_detector_q_t *d, uint32_t c, uint32_t cols)
+{
+    const uint32_t f = d->stream_first_col;
+    const uint32_t t = d->stream_dir > 0 ? c + cols - f : f + cols - c;
+    return t >= cols ? t - cols : t;
+}
+
+/* After a chunk: a return of it where a done sector read (its columns and two on each side) makes the streamed
+ * ground stale (stream_end then runs the whole stage: the same results, later); else the stream's position (the
+ * chunk's last return, moving on by less than half a turn) and every sector, in the order the stream visits
+ * them from the one after its first return's, whose columns and their neighbours all lie at least a margin
+ * (1/32 turn + 4 columns: the beams' azimuth offsets, a packet's interleaved firings) behind it: done now. The
+ * first return's sector waits for stream_end (its columns come first and last). */
+static void stream_sectors(lidet_detector_q_t *d, const lidet_proj_q_buffers_t *buf,
+                           const lidet_return_t *ret, uint32_t n)
+{
+    const uint32_t cols = d->cfg.proj.sensor.n_cols, ns = d->cfg.ground.n_sectors;
+    const uint32_t margin = cols / 32u + 4u;
+    lidet_range_image_t img;
+    uint32_t i, t, seam;
+    if (!(d->stream_flags & STREAM_FIRST))
+    {
+        d->stream_first_col = (uint16_t)return_col(&ret[0], cols);
+        d->stream_flags |= STREAM_FIRST;
+    }
+    if (d->stream_dir == 0)
+    {
+        /* the direction: the first chunk that ends more than 2 columns from the first return */
+        const uint32_t c = return_col(&ret[n - 1u], cols), f = d->stream_first_col;
+        const uint32_t ahead = c >= f ? c - f : c + cols - f;
+        if (ahead > 2u && ahead < cols - 2u)
+        {
+            d->stream_dir = (int8_t)(ahead < cols / 2u ? 1 : -1);
+        }
+        if (d->stream_dir == 0)
+        {
+            return;
+        }
+    }
+    else if (d->stream_done > 0u)
+    {
+        /* in the azimuth's units: the columns are ranges of (2^15 - azimuth) mod 2^16, no division per return */
+        const uint16_t lo = d->stream_late_u, span = d->stream_late_span;
+        for (i = 0; i < n; ++i)
+        {
+            if ((uint16_t)((uint16_t)(0x8000u - ret[i].azimuth) - lo) <= span)
+            {
+                d->stream_flags |= STREAM_LATE;
+                return;
+            }
+        }
+    }
+    t = stream_travel(d, return_col(&ret[n - 1u], cols), cols);
+    if (t < d->stream_pos || t - d->stream_pos >= cols / 2u)
+    {
+        return; /* back, or a jump of half a turn: the position stays */
+    }
+    d->stream_pos = (uint16_t)t;
+    lidet_proj_q_image(&d->proj, buf, &img);
+    img.point_idx = 0;
+    seam = (uint32_t)d->stream_first_col * ns / cols; /* the sector of column c: c ns / cols */
+    while (d->stream_done + 1u < ns)
+    {
+        const uint32_t k = d->stream_done + 1u;
+        const uint32_t s = d->stream_dir > 0 ? (seam + k) % ns : (seam + ns - k) % ns;
+        const uint32_t c0 = lidet__ground_sector_col(s, ns, cols),
+                       c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+        const uint32_t lo = c0 > 0u ? c0 - 1u : cols - 1u, hi = c1 + 1u < cols ? c1 + 1u : c1 + 1u - cols;
+        const uint32_t t_lo = stream_travel(d, lo, cols), t_hi = stream_travel(d, hi, cols);
+        const uint32_t first = d->stream_dir > 0 ? t_lo : t_hi, last = d->stream_dir > 0 ? t_hi : t_lo;
+        if (first > last || last + margin > t)
+        {
+            break; /* across the first column (stream_end's), or not passed yet */
+        }
+        lidet__ground_q_stream_sector(&d->ground, &d->scratch.ground, ground_mask(d), &img, s);
+        d->stream_done = (uint16_t)k;
+        {
+            /* the done columns so far: travel 0 .. last (the first return's sector too: a late return there costs
+             * a redo, never a wrong result), as a range of 2^15 - azimuth */
+            const uint32_t f = d->stream_first_col,
+                           far = d->stream_dir > 0 ? (f + last) % cols : (f + cols - last) % cols;
+            const uint32_t ca = d->stream_dir > 0 ? f : far, cb = d->stream_dir > 0 ? far : f;
+            const uint32_t ua = col_start_u(ca, cols), ub = col_start_u(cb + 1u, cols) - 1u;
+            d->stream_late_u = (uint16_t)ua;
+            d->stream_late_span = (uint16_t)(ub - ua);
+        }
+    }
 }
 
 lidet_status_t lidet_detector_q_stream_begin(lidet_detector_q_t *d)
@@ -657,6 +788,20 @@ lidet_status_t lidet_detector_q_stream_begin(lidet_detector_q_t *d)
     t0 = now(d);
     s = lidet_proj_q_returns_begin(&d->proj, &buf);
     d->stream_ticks = now(d) - t0;
+    d->stream_flags = 0;
+    d->stream_dir = 0;
+    d->stream_pos = d->stream_done = d->stream_first_col = 0;
+    d->stream_late_u = d->stream_late_span = 0;
+    if (s == LIDET_OK && d->cfg.stream_sectors)
+    {
+        lidet_range_image_t img;
+        lidet_proj_q_image(&d->proj, &buf, &img);
+        img.point_idx = 0;
+        if (lidet__ground_q_stream_begin(&d->ground, &img) == LIDET_OK)
+        {
+            d->stream_flags = STREAM_ON;
+        }
+    }
     return s;
 }
 
@@ -673,6 +818,10 @@ lidet_status_t lidet_detector_q_stream_returns(lidet_detector_q_t *d, const lide
     det_buffers(d, &buf, point_pixel);
     t0 = now(d);
     s = lidet_proj_q_returns_add(&d->proj, &buf, returns, n_returns);
+    if (LIDET_SUCCEEDED(s) && (d->stream_flags & (STREAM_ON | STREAM_LATE)) == STREAM_ON && n_returns > 0u)
+    {
+        stream_sectors(d, &buf, returns, n_returns); /* timed with the projection: one clock pair a call */
+    }
     d->stream_ticks += now(d) - t0;
     return s;
 }
@@ -682,6 +831,7 @@ lidet_status_t lidet_detector_q_stream_end(lidet_detector_q_t *d)
     lidet_proj_q_buffers_t buf;
     lidet_status_t s = det_check(d);
     uint32_t t0;
+    int streamed;
     if (s != LIDET_OK)
     {
         return s;
@@ -690,11 +840,13 @@ lidet_status_t lidet_detector_q_stream_end(lidet_detector_q_t *d)
     t0 = now(d);
     s = lidet_proj_q_returns_end(&d->proj, &buf);
     d->stats.proj = d->proj.stats;
+    streamed = (d->stream_flags & (STREAM_ON | STREAM_LATE)) == STREAM_ON;
+    d->stream_flags = 0;
     if (!LIDET_SUCCEEDED(s))
     {
         return s;
     }
-    return det_after_projection(d, &buf, s, t0, d->stream_ticks);
+    return det_after_projection(d, &buf, s, t0, d->stream_ticks, streamed);
 }
 
 const lidet_detection_q_t *lidet_detector_q_detections(const lidet_detector_q_t *d, uint32_t *n_detections)

@@ -259,9 +259,10 @@ static void r_of_row(const lidet_range_image_t *img, uint32_t r, int32_t *restri
     }
 }
 
-/* R and z of a range-only image's row r in one pass over its ranges (z as lidet__qpix_decode gives it) */
-static void rz_of_range_row(const lidet_range_image_t *img, uint32_t r, int32_t *restrict out,
-                            int16_t *restrict z)
+/* R and z of a range-only image's row r, columns [ca, cb), in one pass over its ranges (z as lidet__qpix_decode
+ * gives it) */
+static inline void rz_of_range_span(const lidet_range_image_t *img, uint32_t r, uint32_t ca, uint32_t cb,
+                                    int32_t *restrict out, int16_t *restrict z)
 {
     const uint32_t cols = img->n_cols;
     const uint16_t *rng = img->range_4mm + (size_t)r * cols;
@@ -272,7 +273,7 @@ static void rz_of_range_row(const lidet_range_image_t *img, uint32_t r, int32_t 
     {
         /* r_of_range = (d ce + 2^6) >> 7 and rs15(d se) as SMMULR of d 2^16 and ce 2^9, 2 se (ce <= 2^15) */
         const int32_t ce9 = rt.ce * 512, se2 = rt.se * 2;
-        for (c = 0; c < cols; ++c)
+        for (c = ca; c < cb; ++c)
         {
             const int32_t d16 = (int32_t)((rng[c] & 0x7FFFu) << 16);
             out[c] = lidet__ground_q_smmulr(d16, ce9);
@@ -281,12 +282,19 @@ static void rz_of_range_row(const lidet_range_image_t *img, uint32_t r, int32_t 
         return;
     }
 #endif
-    for (c = 0; c < cols; ++c)
+    for (c = ca; c < cb; ++c)
     {
         const uint32_t d = rng[c] & 0x7FFFu;
         out[c] = r_of_range(d, rt.ce);
         z[c] = (int16_t)lidet__qpix_rs15((int32_t)d * rt.se);
     }
+}
+
+/* the whole row */
+static void rz_of_range_row(const lidet_range_image_t *img, uint32_t r, int32_t *restrict out,
+                            int16_t *restrict z)
+{
+    rz_of_range_span(img, r, 0u, img->n_cols, out, z);
 }
 
 /* R (and, in a range-only image, z) of row r into slot r % 2 (once per row) */
@@ -479,6 +487,19 @@ void lidet__ground_q_sample_row(const int32_t *R0, const int32_t *R1, const int1
     }
 }
 
+/* the sample test's thresholds in the integer units */
+static void filt_setup(const lidet_ground_q_state_t *g, lidet__ground_q_filt_t *f)
+{
+    f->fy = g->cfg.fy_max_q16;
+    f->fx_r = (int32_t)g->cfg.fx_max_mm * (1 << (LIDET_GROUND_Q_R_SHIFT - 2)); /* mm in R steps */
+    f->fx_mm = (int32_t)g->cfg.fx_max_mm;
+    f->on_z = g->cfg.fx_on_z;
+    f->desc = g->cfg.require_descending;
+    f->gate = g->cfg.height_gate;
+    f->z_lo = -g->cfg.mount_height_mm - g->cfg.gate_below_mm;
+    f->z_hi = -g->cfg.mount_height_mm + g->cfg.gate_above_mm;
+}
+
 static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, r_rows_t *rr,
                         const lidet_range_image_t *img)
 {
@@ -486,14 +507,7 @@ static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_
     const uint32_t rows = img->n_rows, cols = img->n_cols, step = g->cfg.sample_step;
     lidet__ground_q_filt_t f;
     uint32_t r;
-    f.fy = g->cfg.fy_max_q16;
-    f.fx_r = (int32_t)g->cfg.fx_max_mm * (1 << (LIDET_GROUND_Q_R_SHIFT - 2)); /* mm in R steps */
-    f.fx_mm = (int32_t)g->cfg.fx_max_mm;
-    f.on_z = g->cfg.fx_on_z;
-    f.desc = g->cfg.require_descending;
-    f.gate = g->cfg.height_gate;
-    f.z_lo = -g->cfg.mount_height_mm - g->cfg.gate_below_mm;
-    f.z_hi = -g->cfg.mount_height_mm + g->cfg.gate_above_mm;
+    filt_setup(g, &f);
     memset(sample, 0, (size_t)rows * cols);
     for (r = 0; r + 1u < rows; r += step)
     {
@@ -506,44 +520,59 @@ static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_
 
 /* Pass 2 (lidet_ref/ground_q.py: gather_samples): the samples of the step grid grouped by cell, near ones from the
  * buffer's start upwards, far ones from its end downwards (the float stage's order); past the buffer they are
- * dropped and counted. */
-static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
-                           const lidet__ground_q_pix_t *gp)
+ * dropped and counted. Sector s's samples at the cursors *lo, *hi (counted in *total); gather_samples runs the
+ * sectors in order, the streamed run one at a time. */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void
+gather_sector(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, const lidet__ground_q_pix_t *gp,
+              uint32_t s, uint32_t *lo_io, uint32_t *hi_io, uint32_t *total_io)
 {
     const lidet_range_image_t *img = gp->img;
     const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
     const uint32_t cstep = g->cfg.sample_col_step, split_v = g->split_v;
     lidet_ground_sample_t *const si = sc->sample_pix;
-    uint32_t s, r, c, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
-    for (s = 0; s < ns; ++s)
+    const uint32_t c0 = lidet__ground_sector_col(s, ns, cols),
+                   c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+    uint32_t r, c, lo = *lo_io, hi = *hi_io, total = *total_io;
+    const uint32_t near_start = lo, far_end = hi;
+    for (r = 0; r + 1u < rows; r += step)
     {
-        const uint32_t c0 = lidet__ground_sector_col(s, ns, cols),
-                       c1 = lidet__ground_sector_col(s + 1u, ns, cols);
-        const uint32_t near_start = lo, far_end = hi;
-        for (r = 0; r + 1u < rows; r += step)
+        const uint32_t base = r * cols;
+        const lidet__qpix_row_t rt = lidet__qpix_row(img, r);
+        for (c = c0 + (cstep - c0 % cstep) % cstep; c < c1; c += cstep)
         {
-            const uint32_t base = r * cols;
-            const lidet__qpix_row_t rt = lidet__qpix_row(img, r);
-            for (c = c0 + (cstep - c0 % cstep) % cstep; c < c1; c += cstep)
+            if (sc->sample[base + c] != 0u)
             {
-                if (sc->sample[base + c] != 0u)
+                ++total;
+                if (lo < hi)
                 {
-                    ++total;
-                    if (lo < hi)
+                    int far = 0;
+                    if (split_v != 0xFFFFFFFFu) /* else every sample is near (x^2 + y^2 < 2^31) */
                     {
-                        int far = 0;
-                        if (split_v != 0xFFFFFFFFu) /* else every sample is near (x^2 + y^2 < 2^31) */
-                        {
-                            int32_t q[3];
-                            lidet__ground_q_pix_rc(gp, rt, c, base + c, q);
-                            far = (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]) >= split_v;
-                        }
-                        si[far ? --hi : lo++] = (lidet_ground_sample_t)(base + c);
+                        int32_t q[3];
+                        lidet__ground_q_pix_rc(gp, rt, c, base + c, q);
+                        far = (uint32_t)(q[0] * q[0]) + (uint32_t)(q[1] * q[1]) >= split_v;
                     }
+                    si[far ? --hi : lo++] = (lidet_ground_sample_t)(base + c);
                 }
             }
         }
-        lidet__ground_cell_span(sc->cell_first, sc->cell_n, s, ns, near_start, lo, hi, far_end);
+    }
+    lidet__ground_cell_span(sc->cell_first, sc->cell_n, s, ns, near_start, lo, hi, far_end);
+    *lo_io = lo;
+    *hi_io = hi;
+    *total_io = total;
+}
+
+static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                           const lidet__ground_q_pix_t *gp)
+{
+    uint32_t s, lo = 0, hi = LIDET_GROUND_MAX_SAMPLES, total = 0;
+    for (s = 0; s < g->cfg.n_sectors; ++s)
+    {
+        gather_sector(g, sc, gp, s, &lo, &hi, &total);
     }
     lidet__ground_sample_counts(&g->stats, total, lo, hi);
 }
@@ -736,75 +765,93 @@ label_span_two(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up,
     }
 }
 
+/* the labelling's constants, its counts at 0 (z_up: the free row of R, cols entries, set by the caller) */
+static void label_setup(label_t *L, const lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                        uint8_t *mask, const lidet__ground_q_pix_t *gp)
+{
+    L->img = gp->img;
+    L->gp = gp;
+    L->mask = mask;
+    L->z_up = sc->r_rows[0]; /* free after the fits */
+    L->above0 = (int64_t)g->cfg.ground_mm << 28;
+    L->k = g->cfg.ground_per_m_q16;
+    L->bf = g->cfg.below_factor_q16;
+    L->slope = g->cfg.veto_slope_q16;
+    L->below0 = lidet__q_rshift_round(L->bf * L->above0, 16);
+    L->band = (uint64_t)(L->above0 + L->below0 - 1); /* above0 >= 2^28, below0 >= 0 */
+    L->min_dz = (int32_t)g->cfg.veto_min_dz_mm;
+    L->split_v = g->split_v;
+    L->split2_v = g->split2_v;
+    L->n_ground = 0;
+    L->n_vetoed = 0;
+}
+
+/* row r of sector s (z_up holds row r - 1's z of the sector's columns) */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void
+label_cell(label_t *L, const lidet_ground_q_state_t *g, uint32_t r, uint32_t s)
+{
+    const lidet_range_image_t *img = L->img;
+    const uint32_t cols = img->n_cols, ns = g->cfg.n_sectors;
+    const int two = g->split_v != 0xFFFFFFFFu, ro = L->gp->ct != 0;
+    const uint32_t base = r * cols, up = r > 0u ? cols : 0u;
+    const lidet__qpix_row_t rt = lidet__qpix_row(img, r), rtu = lidet__qpix_row(img, r > 0u ? r - 1u : 0u);
+    const uint32_t c0 = lidet__ground_sector_col(s, ns, cols),
+                   c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+    lidet__ground_q_hplane_t hp[2];
+    uint32_t c;
+    for (c = 0; c < 2u; ++c)
+    {
+        const lidet_plane_q_t *pl = &g->planes[c * ns + s];
+        int32_t nn[3];
+        nn[0] = pl->nx;
+        nn[1] = pl->ny;
+        nn[2] = pl->nz;
+        lidet__ground_q_hplane(nn, g->plane_d[c * ns + s], &hp[c]);
+    }
+
+    /* the kernels: near and far cells or one, range-only image or stored x, y, z; a range-only image's also with
+     * the fixed tolerance (ground_per_m_q16 0) as a constant */
+    if (two)
+    {
+        label_span_two(L, c0, c1, base, up, rt, rtu, hp, ro, g, s);
+    }
+    else if (ro)
+    {
+        if (L->k == 0)
+        {
+            hp[0].d += L->below0 - 1; /* the band test's offset (label_span, kz) */
+            label_span(L, c0, c1, base, up, rt, rtu, hp, 0, 0, 1, 1);
+        }
+        else
+        {
+            label_span(L, c0, c1, base, up, rt, rtu, hp, 0, 0, 1, 0);
+        }
+    }
+    else
+    {
+        label_span(L, c0, c1, base, up, rt, rtu, hp, 0, 0, 0, 0);
+    }
+}
+
 static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, uint8_t *mask,
                        const lidet__ground_q_pix_t *gp)
 {
-    const lidet_range_image_t *img = gp->img;
-    const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors;
-    const int two = g->split_v != 0xFFFFFFFFu, ro = gp->ct != 0;
+    const uint32_t rows = gp->img->n_rows, cols = gp->img->n_cols, ns = g->cfg.n_sectors;
     label_t L;
     uint32_t r, s, c;
-    L.img = img;
-    L.gp = gp;
-    L.mask = mask;
-    L.z_up = sc->r_rows[0]; /* free after the fits */
-    L.above0 = (int64_t)g->cfg.ground_mm << 28;
-    L.k = g->cfg.ground_per_m_q16;
-    L.bf = g->cfg.below_factor_q16;
-    L.slope = g->cfg.veto_slope_q16;
-    L.below0 = lidet__q_rshift_round(L.bf * L.above0, 16);
-    L.band = (uint64_t)(L.above0 + L.below0 - 1); /* above0 >= 2^28, below0 >= 0 */
-    L.min_dz = (int32_t)g->cfg.veto_min_dz_mm;
-    L.split_v = g->split_v;
-    L.split2_v = g->split2_v;
-    L.n_ground = 0;
-    L.n_vetoed = 0;
+    label_setup(&L, g, sc, mask, gp);
     for (c = 0; c < cols; ++c)
     {
         L.z_up[c] = NO_POINT; /* row 0 has no pixel above: never vetoed */
     }
     for (r = 0; r < rows; ++r)
     {
-        const uint32_t base = r * cols, up = r > 0u ? cols : 0u;
-        const lidet__qpix_row_t rt = lidet__qpix_row(img, r),
-                                rtu = lidet__qpix_row(img, r > 0u ? r - 1u : 0u);
         for (s = 0; s < ns; ++s)
         {
-            const uint32_t c0 = lidet__ground_sector_col(s, ns, cols),
-                           c1 = lidet__ground_sector_col(s + 1u, ns, cols);
-            lidet__ground_q_hplane_t hp[2];
-            for (c = 0; c < 2u; ++c)
-            {
-                const lidet_plane_q_t *pl = &g->planes[c * ns + s];
-                int32_t nn[3];
-                nn[0] = pl->nx;
-                nn[1] = pl->ny;
-                nn[2] = pl->nz;
-                lidet__ground_q_hplane(nn, g->plane_d[c * ns + s], &hp[c]);
-            }
-
-            /* the kernels: near and far cells or one, range-only image or stored x, y, z; a range-only image's
-             * also with the fixed tolerance (ground_per_m_q16 0) as a constant */
-            if (two)
-            {
-                label_span_two(&L, c0, c1, base, up, rt, rtu, hp, ro, g, s);
-            }
-            else if (ro)
-            {
-                if (L.k == 0)
-                {
-                    hp[0].d += L.below0 - 1; /* the band test's offset (label_span, kz) */
-                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 0, 1, 1);
-                }
-                else
-                {
-                    label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 0, 1, 0);
-                }
-            }
-            else
-            {
-                label_span(&L, c0, c1, base, up, rt, rtu, hp, 0, 0, 0, 0);
-            }
+            label_cell(&L, g, r, s);
         }
     }
     g->stats.n_ground = L.n_ground;
@@ -837,6 +884,210 @@ lidet_status_t lidet_ground_q_run_buffers(lidet_ground_q_state_t *g, lidet_groun
     gather_samples(g, scratch, &gp);
     lidet__ground_q_fit_sectors(g, scratch, &gp);
     label_rows(g, scratch, mask, &gp);
+    return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
+}
+
+/* ---- the streamed run, sector by sector (lib/src/internal/lidet_ground_q_internal.h) ---------------------- */
+
+/* R and z of row r's columns c0 - 1 .. c1 + 1 (wrapping around), the ones sector [c0, c1)'s sample tests read */
+static void rz_of_sector(const lidet_range_image_t *img, uint32_t r, uint32_t c0, uint32_t c1, int32_t *out,
+                         int16_t *z)
+{
+    const uint32_t cols = img->n_cols, end = c1 + 2u;
+    rz_of_range_span(img, r, c0 > 0u ? c0 - 1u : 0u, end < cols ? end : cols, out, z);
+    if (c0 == 0u)
+    {
+        rz_of_range_span(img, r, cols - 1u, cols, out, z);
+    }
+    if (end > cols)
+    {
+        rz_of_range_span(img, r, 0u, end - cols, out, z);
+    }
+}
+
+/* the sample test of column c of a row pair (c - 1 .. c + 2 wrapping around), plain: the default switches */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline uint8_t
+sample_wrap(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1, uint32_t c,
+            uint32_t cols, const lidet__ground_q_filt_t *f, const int plain)
+{
+    const uint32_t cm1 = c > 0u ? c - 1u : cols - 1u, cp1 = c + 1u < cols ? c + 1u : c + 1u - cols,
+                   cp2 = c + 2u < cols ? c + 2u : c + 2u - cols;
+    return plain ? sample_test_plain(R0, R1, Z0, Z1, cm1, c, cp1, cp2, (uint32_t)f->fy, f->fx_r)
+                 : sample_test_early(R0, R1, Z0, Z1, cm1, c, cp1, cp2, f);
+}
+
+/* the tests of columns [c0, c1) of one row pair: the columns whose neighbours do not wrap in a loop of their own */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void
+sample_span(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const int16_t *Z1, uint32_t c0,
+            uint32_t c1, uint32_t cols, const lidet__ground_q_filt_t *f, uint8_t *out, const int plain)
+{
+    const uint32_t a = c0 > 0u ? c0 : 1u, b = c1 + 2u < cols ? c1 : cols - 2u;
+    uint32_t c;
+    for (c = c0; c < a && c < c1; ++c)
+    {
+        out[c] = sample_wrap(R0, R1, Z0, Z1, c, cols, f, plain);
+    }
+    for (c = a; c < b; ++c)
+    {
+        out[c] = plain
+                     ? sample_test_plain(R0, R1, Z0, Z1, c - 1u, c, c + 1u, c + 2u, (uint32_t)f->fy, f->fx_r)
+                     : sample_test_early(R0, R1, Z0, Z1, c - 1u, c, c + 1u, c + 2u, f);
+    }
+    for (c = b > a ? b : a; c < c1; ++c)
+    {
+        out[c] = sample_wrap(R0, R1, Z0, Z1, c, cols, f, plain);
+    }
+}
+
+/* Pass 1 on sector s's columns alone (filter_rows' tests on them; the early-exit kernels, whose values are the
+ * branch-free one's). R and z of a row are computed once (slot r % 2, as r_row's) */
+static void filter_sector(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                          const lidet_range_image_t *img, uint32_t s)
+{
+    const uint32_t rows = img->n_rows, cols = img->n_cols, ns = g->cfg.n_sectors, step = g->cfg.sample_step;
+    const uint32_t c0 = lidet__ground_sector_col(s, ns, cols),
+                   c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+    lidet__ground_q_filt_t f;
+    uint32_t r, k, have = 0xFFFFFFFFu; /* the row in the slot of parity have & 1 */
+    filt_setup(g, &f);
+    for (r = 0; r < rows; ++r)
+    {
+        memset(sc->sample + (size_t)r * cols + c0, 0, c1 - c0);
+    }
+    for (r = 0; r + 1u < rows; r += step)
+    {
+        uint8_t *out = sc->sample + (size_t)r * cols;
+        for (k = r; k <= r + 1u; ++k)
+        {
+            if (k != have)
+            {
+                rz_of_sector(img, k, c0, c1, sc->r_rows[k & 1u], sc->r_v.z[k & 1u]);
+            }
+        }
+        have = r + 1u;
+        if (!f.on_z && !f.desc && !f.gate && f.fy <= 0xFFFFFFFFu) /* lidet__ground_q_sample_row's choice */
+        {
+            sample_span(sc->r_rows[r & 1u], sc->r_rows[(r + 1u) & 1u], sc->r_v.z[r & 1u],
+                        sc->r_v.z[(r + 1u) & 1u], c0, c1, cols, &f, out, 1);
+        }
+        else
+        {
+            sample_span(sc->r_rows[r & 1u], sc->r_rows[(r + 1u) & 1u], sc->r_v.z[r & 1u],
+                        sc->r_v.z[(r + 1u) & 1u], c0, c1, cols, &f, out, 0);
+        }
+    }
+}
+
+/* Pass 3 on sector s's columns alone (label_rows' kernels; the counts added to the stage's) */
+static void label_sector(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, uint8_t *mask,
+                         const lidet__ground_q_pix_t *gp, uint32_t s)
+{
+    const uint32_t rows = gp->img->n_rows, cols = gp->img->n_cols, ns = g->cfg.n_sectors;
+    const uint32_t c0 = lidet__ground_sector_col(s, ns, cols),
+                   c1 = lidet__ground_sector_col(s + 1u, ns, cols);
+    label_t L;
+    uint32_t r, c;
+    label_setup(&L, g, sc, mask, gp);
+    for (c = c0; c < c1; ++c)
+    {
+        L.z_up[c] = NO_POINT;
+    }
+    for (r = 0; r < rows; ++r)
+    {
+        label_cell(&L, g, r, s);
+    }
+    g->stats.n_ground += L.n_ground;
+    g->stats.n_vetoed += L.n_vetoed;
+}
+
+/* a sector not yet done by the streamed run (its near cell's source; the run's other sources are never this) */
+#define STREAM_PENDING 0xFFu
+
+lidet_status_t lidet__ground_q_stream_begin(lidet_ground_q_state_t *g, const lidet_range_image_t *img)
+{
+    lidet_status_t st;
+    uint32_t s;
+    if (g == 0 || img == 0)
+    {
+        return LIDET_ERR_ARG;
+    }
+    st = lidet__ground_run_check(g->magic == LIDET_INIT_MAGIC, lidet__qpix_image_ok(img), img,
+                                 g->cfg.n_sectors, &g->stats);
+    if (st != LIDET_OK)
+    {
+        return st;
+    }
+    if (!lidet__qpix_range_only(img) || !g->cfg.seed_per_cell)
+    {
+        return LIDET_ERR_CONFIG;
+    }
+    g->n_rows = img->n_rows;
+    g->n_cols = img->n_cols;
+    g->rng = lidet__rng_seed(g->cfg.seed);
+    for (s = 0; s < g->cfg.n_sectors; ++s)
+    {
+        g->source[s] = STREAM_PENDING;
+    }
+    g->stream_lo = 0;
+    g->stream_hi = LIDET_GROUND_MAX_SAMPLES;
+    g->stream_total = 0;
+    return LIDET_OK;
+}
+
+void lidet__ground_q_stream_sector(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, uint8_t *mask,
+                                   const lidet_range_image_t *img, uint32_t s)
+{
+    const uint32_t ns = g->cfg.n_sectors, cols = img->n_cols;
+    lidet__ground_q_pix_t gp;
+    if (s >= ns || g->source[s] != STREAM_PENDING)
+    {
+        return;
+    }
+    filter_sector(g, sc, img, s);
+    /* the columns' tables over the filter's rows of z, dead from here on */
+    lidet__ground_q_pix_span(&gp, sc, img, lidet__ground_sector_col(s, ns, cols),
+                             lidet__ground_sector_col(s + 1u, ns, cols));
+    gather_sector(g, sc, &gp, s, &g->stream_lo, &g->stream_hi, &g->stream_total);
+    lidet__ground_q_fit_near(g, sc, &gp, s);
+    if (g->source[s] == LIDET_GROUND_PLANE_FITTED)
+    {
+        /* its own plane: final, so the rest of the sector is too */
+        lidet__ground_q_fit_rest(g, sc, &gp, s);
+        label_sector(g, sc, mask, &gp, s);
+    }
+}
+
+lidet_status_t lidet__ground_q_stream_end(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                                          uint8_t *mask, const lidet_range_image_t *img)
+{
+    const uint32_t ns = g->cfg.n_sectors, cols = img->n_cols;
+    lidet__ground_q_pix_t gp;
+    uint32_t s;
+    for (s = 0; s < ns; ++s)
+    {
+        lidet__ground_q_stream_sector(g, sc, mask, img, s);
+    }
+    /* the near cells without a plane of their own take their neighbours' (the planes themselves: no table) */
+    gp.img = img;
+    gp.ct = gp.st = 0;
+    lidet__ground_q_fallback(g, sc, &gp);
+    for (s = 0; s < ns; ++s)
+    {
+        if (g->source[s] != LIDET_GROUND_PLANE_FITTED) /* neighbour or mount: done now */
+        {
+            lidet__ground_q_pix_span(&gp, sc, img, lidet__ground_sector_col(s, ns, cols),
+                                     lidet__ground_sector_col(s + 1u, ns, cols));
+            lidet__ground_q_fit_rest(g, sc, &gp, s);
+            label_sector(g, sc, mask, &gp, s);
+        }
+    }
+    lidet__ground_sample_counts(&g->stats, g->stream_total, g->stream_lo, g->stream_hi);
     return g->stats.n_samples_dropped > 0u ? LIDET_TRUNCATED : LIDET_OK;
 }
 

@@ -892,3 +892,55 @@ void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scrat
         fit_far2(&f);
     }
 }
+
+/* The streamed run's steps (lidet_ground_filter_q.c, lidet__ground_q_stream_*), each the part of
+ * lidet__ground_q_fit_sectors that reads one sector: the near cell's fit; the near cells' fallback once every near
+ * cell is fitted; the rest of a sector (its far cell, judged against its final near plane, that cell's fallback to
+ * the near plane, the third cell) once its near plane is final. With a stream per cell (seed_per_cell) a cell's
+ * plane reads its own samples only, so any order of the sectors gives lidet__ground_q_fit_sectors' planes,
+ * sources and counts. */
+static fit_ctx_t fit_ctx(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                         const lidet__ground_q_pix_t *img)
+{
+    fit_ctx_t f;
+    f.g = g;
+    f.sc = sc;
+    f.img = img;
+    return f;
+}
+
+void lidet__ground_q_fit_near(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                              const lidet__ground_q_pix_t *img, uint32_t s)
+{
+    const uint32_t ns = g->cfg.n_sectors;
+    fit_ctx_t f = fit_ctx(g, sc, img);
+    lidet__ground_fit_one(g->source, sc->cell_n, ns, g->cfg.ring_split_mm > 0u ? 2u * ns : ns,
+                          g->cfg.min_samples, &g->stats, fit_cell, &f, s);
+}
+
+void lidet__ground_q_fallback(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                              const lidet__ground_q_pix_t *img)
+{
+    fit_ctx_t f = fit_ctx(g, sc, img);
+    lidet__ground_near_fallback(g->source, g->cfg.n_sectors, g->cfg.fallback_sectors, &g->stats, copy_plane,
+                                &f);
+}
+
+void lidet__ground_q_fit_rest(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                              const lidet__ground_q_pix_t *img, uint32_t s)
+{
+    const uint32_t ns = g->cfg.n_sectors, kf = ns + s;
+    fit_ctx_t f = fit_ctx(g, sc, img);
+    lidet__ground_fit_one(g->source, sc->cell_n, ns, g->cfg.ring_split_mm > 0u ? 2u * ns : ns,
+                          g->cfg.min_samples, &g->stats, fit_cell, &f, kf);
+    if (g->source[kf] != LIDET_GROUND_PLANE_FITTED)
+    {
+        copy_plane(&f, kf, (int32_t)s);
+        g->source[kf] = LIDET_GROUND_PLANE_NEAR;
+    }
+    if (g->split2_v != 0xFFFFFFFFu)
+    {
+        lidet__ground_far2_cell(g->source, sc->cell_first, sc->cell_n, sc->sample_pix, ns, g->cfg.min_samples,
+                                &g->stats, beyond_far2, fit_cell, copy_plane, &f, s);
+    }
+}

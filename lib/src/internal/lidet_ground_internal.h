@@ -201,41 +201,53 @@ static inline void lidet__ground_cells(uint8_t *source, const uint32_t *cell_n, 
  * cell_n: 3 ns <= 2 LIDET_GROUND_MAX_SECTORS, init checks it) and are fitted by fit(ctx, 2 ns + s), which judges a
  * third cell's plane against the far plane at far2_split (the step) or by the sensor's height; without a plane, or
  * with fewer than min_samples samples, the cell takes the far plane (copy). */
+/* one sector's third cell (the body of lidet__ground_far2_cells' loop, below; the integer stage's streamed run calls
+ * it sector by sector) */
+static inline void lidet__ground_far2_cell(uint8_t *source, uint32_t *cell_first, uint32_t *cell_n,
+                                           lidet_ground_sample_t *sample_pix, uint32_t ns,
+                                           uint32_t min_samples, lidet_ground_stats_t *stats,
+                                           lidet__ground_beyond_fn beyond, lidet__ground_fit_fn fit,
+                                           lidet__ground_copy_fn copy, void *ctx, uint32_t s)
+{
+    const uint32_t kf = ns + s, k = 2u * ns + s, a = cell_first[kf], n = cell_n[kf];
+    lidet_ground_sample_t *idx = sample_pix + a;
+    uint32_t i, m = 0;
+    LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
+    for (i = 0; i < n; ++i)
+    {
+        if (beyond(ctx, idx[i]))
+        {
+            const lidet_ground_sample_t t = idx[i];
+            idx[i] = idx[m];
+            idx[m] = t;
+            ++m;
+        }
+    }
+    cell_first[k] = a;
+    cell_n[k] = m;
+    if (m >= min_samples && fit(ctx, k))
+    {
+        source[k] = LIDET_GROUND_PLANE_FITTED;
+        ++stats->n_far2_fitted;
+    }
+    else
+    {
+        copy(ctx, k, (int32_t)kf);
+        source[k] = LIDET_GROUND_PLANE_NEAR; /* the cell inside it */
+    }
+}
+
 static inline void lidet__ground_far2_cells(uint8_t *source, uint32_t *cell_first, uint32_t *cell_n,
                                             lidet_ground_sample_t *sample_pix, uint32_t ns,
                                             uint32_t min_samples, lidet_ground_stats_t *stats,
                                             lidet__ground_beyond_fn beyond, lidet__ground_fit_fn fit,
                                             lidet__ground_copy_fn copy, void *ctx)
 {
-    uint32_t s, i;
+    uint32_t s;
     for (s = 0; s < ns; ++s)
     {
-        const uint32_t kf = ns + s, k = 2u * ns + s, a = cell_first[kf], n = cell_n[kf];
-        lidet_ground_sample_t *idx = sample_pix + a;
-        uint32_t m = 0;
-        LIDET_ASSERT(a + n <= LIDET_GROUND_MAX_SAMPLES);
-        for (i = 0; i < n; ++i)
-        {
-            if (beyond(ctx, idx[i]))
-            {
-                const lidet_ground_sample_t t = idx[i];
-                idx[i] = idx[m];
-                idx[m] = t;
-                ++m;
-            }
-        }
-        cell_first[k] = a;
-        cell_n[k] = m;
-        if (m >= min_samples && fit(ctx, k))
-        {
-            source[k] = LIDET_GROUND_PLANE_FITTED;
-            ++stats->n_far2_fitted;
-        }
-        else
-        {
-            copy(ctx, k, (int32_t)kf);
-            source[k] = LIDET_GROUND_PLANE_NEAR; /* the cell inside it */
-        }
+        lidet__ground_far2_cell(source, cell_first, cell_n, sample_pix, ns, min_samples, stats, beyond, fit,
+                                copy, ctx, s);
     }
 }
 

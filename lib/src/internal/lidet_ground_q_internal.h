@@ -138,6 +138,25 @@ typedef struct
     const int32_t *ct, *st;
 } lidet__ground_q_pix_t;
 
+/* the columns [ca, cb) of the tables (a range-only image; the streamed run fills a sector's at a time) */
+static inline void lidet__ground_q_pix_span(lidet__ground_q_pix_t *gp, lidet_ground_q_scratch_t *sc,
+                                            const lidet_range_image_t *img, uint32_t ca, uint32_t cb)
+{
+    int32_t *ct = (int32_t *)sc->r_rem, *st = (int32_t *)sc->r_v.v;
+    uint32_t c;
+    gp->img = img;
+    for (c = ca; c < cb; ++c)
+    {
+        lidet__qpix_col(img, c, &ct[c], &st[c]);
+#if LIDET_GROUND_Q_SMMULR
+        ct[c] *= 2;
+        st[c] *= -2;
+#endif
+    }
+    gp->ct = ct;
+    gp->st = st;
+}
+
 static inline void lidet__ground_q_pix_init(lidet__ground_q_pix_t *gp, lidet_ground_q_scratch_t *sc,
                                             const lidet_range_image_t *img)
 {
@@ -146,18 +165,7 @@ static inline void lidet__ground_q_pix_init(lidet__ground_q_pix_t *gp, lidet_gro
     gp->st = 0;
     if (lidet__qpix_range_only(img))
     {
-        int32_t *ct = (int32_t *)sc->r_rem, *st = (int32_t *)sc->r_v.v;
-        uint32_t c;
-        for (c = 0; c < img->n_cols; ++c)
-        {
-            lidet__qpix_col(img, c, &ct[c], &st[c]);
-#if LIDET_GROUND_Q_SMMULR
-            ct[c] *= 2;
-            st[c] *= -2;
-#endif
-        }
-        gp->ct = ct;
-        gp->st = st;
+        lidet__ground_q_pix_span(gp, sc, img, 0u, img->n_cols);
     }
 }
 
@@ -193,5 +201,29 @@ static inline void lidet__ground_q_pix(const lidet__ground_q_pix_t *gp, uint32_t
 /* Fits one plane per cell from the gathered samples, applies the fallback (lidet_ground_ransac_q.c). */
 void lidet__ground_q_fit_sectors(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
                                  const lidet__ground_q_pix_t *gp);
+
+/* The same sector by sector, for the streamed run (lidet_ground_ransac_q.c): sector s's near cell; the near cells'
+ * fallback (after every near cell); the rest of sector s (far and third cells) once its near plane is final. */
+void lidet__ground_q_fit_near(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                              const lidet__ground_q_pix_t *gp, uint32_t s);
+void lidet__ground_q_fallback(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                              const lidet__ground_q_pix_t *gp);
+void lidet__ground_q_fit_rest(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                              const lidet__ground_q_pix_t *gp, uint32_t s);
+
+/* The stage while a range-only image fills, sector by sector (lidet_ground_filter_q.c; the integer detector's
+ * stream_sectors): begin once the image's buffers are set (the run's checks; LIDET_ERR_CONFIG without
+ * seed_per_cell or on an image with stored x, y, z), then lidet__ground_q_stream_sector for each sector whose
+ * columns and their neighbours' (two on each side) will not change any more, in any order, then
+ * lidet__ground_q_stream_end on the finished image, which does the sectors not done yet, the fallback, and the
+ * sectors that waited for it. With seed_per_cell the planes, sources, mask and counts are those of
+ * lidet_ground_q_run_buffers on the finished image, bit for bit, provided no sample is dropped (stream_end's
+ * LIDET_TRUNCATED: the buffer's order, hence which samples are dropped, then follows the sectors' order) and no
+ * done sector's columns (or their neighbours) changed after it was done: the caller's to check. */
+lidet_status_t lidet__ground_q_stream_begin(lidet_ground_q_state_t *g, const lidet_range_image_t *img);
+void lidet__ground_q_stream_sector(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, uint8_t *mask,
+                                   const lidet_range_image_t *img, uint32_t s);
+lidet_status_t lidet__ground_q_stream_end(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc,
+                                          uint8_t *mask, const lidet_range_image_t *img);
 
 #endif
