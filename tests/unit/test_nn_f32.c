@@ -194,6 +194,60 @@ void test_riscv_kernel_on_the_host(void)
     TEST_ASSERT_TRUE(n_zero > 10000u);
 }
 
+/* the AVX-512 kernel with zero inputs (+0 and -0; inputs that are zero in every row of an 8-row band, which a
+ * ReLU layer's band leaves out, and whole rows of them) against the unskipped fused chain, bit for bit */
+void test_avx512_zero_inputs(void)
+{
+#if LIDET_NN_FMA
+    static float in[MAX_R * MAX_I], w[MAX_I * MAX_O], b[MAX_O], got[MAX_R * MAX_O];
+    uint32_t a, c, d, r, o, k, i, n_skip = 0;
+    if (!__builtin_cpu_supports("avx512f"))
+    {
+        TEST_IGNORE_MESSAGE("no AVX-512 here");
+    }
+    for (a = 0; a < sizeof k_rows / sizeof k_rows[0]; ++a)
+        for (c = 0; c < sizeof k_ins / sizeof k_ins[0]; ++c)
+            for (d = 0; d < sizeof k_outs / sizeof k_outs[0]; ++d)
+            {
+                const uint32_t rows = k_rows[a], n_in = k_ins[c], n_out = k_outs[d];
+                const int relu = (int)((a + c + d) & 1u);
+                for (k = 0; k < rows * n_in; ++k)
+                {
+                    const uint32_t u = (g_rng = g_rng * 1664525u + 1013904223u) >> 24;
+                    in[k] = u < 64u ? 0.0f : u < 96u ? -0.0f : next_f();
+                }
+                for (i = 0; i < n_in; ++i)
+                {
+                    const uint32_t u = (g_rng = g_rng * 1664525u + 1013904223u) >> 24;
+                    if (u < 96u) /* input i zero in every row (+0 or -0 by row) */
+                    {
+                        for (r = 0; r < rows; ++r)
+                            in[r * n_in + i] = ((r + i) & 1u) ? -0.0f : 0.0f;
+                        n_skip += rows >= 8u;
+                    }
+                }
+                if (rows > 2u)
+                    memset(in + n_in, 0, n_in * sizeof in[0]); /* row 1: no nonzero input at all */
+                for (k = 0; k < n_in * n_out; ++k)
+                    w[k] = next_f();
+                for (k = 0; k < n_out; ++k)
+                    b[k] = next_f();
+                lidet__nn_dense_f32_avx512(in, rows, n_in, w, b, n_out, relu, got);
+                for (r = 0; r < rows; ++r)
+                    for (o = 0; o < n_out; ++o)
+                    {
+                        const float want = relu_of(fused_one(in + r * n_in, n_in, w, n_out, o, b[o]), relu);
+                        TEST_ASSERT_TRUE_MESSAGE(
+                            memcmp(&want, &got[r * n_out + o], sizeof want) == 0,
+                            "the AVX-512 kernel with zero inputs is not the fused chain");
+                    }
+            }
+    TEST_ASSERT_TRUE(n_skip > 1000u);
+#else
+    TEST_IGNORE_MESSAGE("no FMA kernels in this build");
+#endif
+}
+
 void test_every_shape_one_arithmetic(void)
 {
     every_shape(lidet__nn_dense_f32, -1);
@@ -404,6 +458,7 @@ int main(void)
     RUN_TEST(test_every_shape_one_arithmetic);
     RUN_TEST(test_each_variant);
     RUN_TEST(test_riscv_kernel_on_the_host);
+    RUN_TEST(test_avx512_zero_inputs);
     RUN_TEST(test_model_shapes);
     RUN_TEST(test_fused_nan_and_negative_zero);
     RUN_TEST(test_relu_of_nan_and_negative_zero);
