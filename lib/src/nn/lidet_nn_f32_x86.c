@@ -160,6 +160,69 @@ static T512 void band8_512(const float *x, uint32_t n_in, const float *w_t, cons
     }
 }
 
+/* 4 rows x 64 outputs per tile (16 accumulators; each input: 4 weight loads and 4 broadcasts for 16 FMAs), for ReLU
+ * layers with n_out a multiple of 64: a band of 4 rows has more inputs that are zero in all its rows than one of 8
+ * (24-27 % against 13-19 % of the classifier's on real KITTI scans), left out the same way. Measured on the 17 real
+ * KITTI scans (HDL-64, 360 degrees, Intel Xeon, one core, AVX-512), after the 8-row skip: classify 1.27 -> 1.23 ms,
+ * box net 0.38 -> 0.38 ms */
+static T512 void band4_512(const float *x, uint32_t n_in, const float *w_t, const float *b, uint32_t n_out,
+                           int relu, float *o)
+{
+    uint32_t k, j;
+    uint32_t act[BAND_MAX_IN]; /* n_in <= BAND_MAX_IN (lidet__nn_dense_f32_avx512) */
+    const uint32_t n_act = band_active_512(x, n_in, 4u, act);
+    for (k = 0; k < n_out; k += 64u)
+    {
+        const __m512 b0 = _mm512_loadu_ps(b + k), b1 = _mm512_loadu_ps(b + k + 16u);
+        const __m512 b2 = _mm512_loadu_ps(b + k + 32u), b3 = _mm512_loadu_ps(b + k + 48u);
+        __m512 a00 = b0, a01 = b1, a02 = b2, a03 = b3, a10 = b0, a11 = b1, a12 = b2, a13 = b3;
+        __m512 a20 = b0, a21 = b1, a22 = b2, a23 = b3, a30 = b0, a31 = b1, a32 = b2, a33 = b3;
+        for (j = 0; j < n_act; ++j)
+        {
+            const uint32_t i = act[j];
+            const float *w = w_t + (size_t)i * n_out + k;
+            const __m512 w0 = _mm512_loadu_ps(w), w1 = _mm512_loadu_ps(w + 16);
+            const __m512 w2 = _mm512_loadu_ps(w + 32), w3 = _mm512_loadu_ps(w + 48);
+            __m512 p = _mm512_set1_ps(x[i]);
+            a00 = _mm512_fmadd_ps(p, w0, a00);
+            a01 = _mm512_fmadd_ps(p, w1, a01);
+            a02 = _mm512_fmadd_ps(p, w2, a02);
+            a03 = _mm512_fmadd_ps(p, w3, a03);
+            p = _mm512_set1_ps(x[n_in + i]);
+            a10 = _mm512_fmadd_ps(p, w0, a10);
+            a11 = _mm512_fmadd_ps(p, w1, a11);
+            a12 = _mm512_fmadd_ps(p, w2, a12);
+            a13 = _mm512_fmadd_ps(p, w3, a13);
+            p = _mm512_set1_ps(x[2u * n_in + i]);
+            a20 = _mm512_fmadd_ps(p, w0, a20);
+            a21 = _mm512_fmadd_ps(p, w1, a21);
+            a22 = _mm512_fmadd_ps(p, w2, a22);
+            a23 = _mm512_fmadd_ps(p, w3, a23);
+            p = _mm512_set1_ps(x[3u * n_in + i]);
+            a30 = _mm512_fmadd_ps(p, w0, a30);
+            a31 = _mm512_fmadd_ps(p, w1, a31);
+            a32 = _mm512_fmadd_ps(p, w2, a32);
+            a33 = _mm512_fmadd_ps(p, w3, a33);
+        }
+        _mm512_storeu_ps(o + k, relu512(a00, relu));
+        _mm512_storeu_ps(o + k + 16u, relu512(a01, relu));
+        _mm512_storeu_ps(o + k + 32u, relu512(a02, relu));
+        _mm512_storeu_ps(o + k + 48u, relu512(a03, relu));
+        _mm512_storeu_ps(o + n_out + k, relu512(a10, relu));
+        _mm512_storeu_ps(o + n_out + k + 16u, relu512(a11, relu));
+        _mm512_storeu_ps(o + n_out + k + 32u, relu512(a12, relu));
+        _mm512_storeu_ps(o + n_out + k + 48u, relu512(a13, relu));
+        _mm512_storeu_ps(o + 2u * n_out + k, relu512(a20, relu));
+        _mm512_storeu_ps(o + 2u * n_out + k + 16u, relu512(a21, relu));
+        _mm512_storeu_ps(o + 2u * n_out + k + 32u, relu512(a22, relu));
+        _mm512_storeu_ps(o + 2u * n_out + k + 48u, relu512(a23, relu));
+        _mm512_storeu_ps(o + 3u * n_out + k, relu512(a30, relu));
+        _mm512_storeu_ps(o + 3u * n_out + k + 16u, relu512(a31, relu));
+        _mm512_storeu_ps(o + 3u * n_out + k + 32u, relu512(a32, relu));
+        _mm512_storeu_ps(o + 3u * n_out + k + 48u, relu512(a33, relu));
+    }
+}
+
 /* one row (the heads' vectors, the last rows of a block): 64 outputs at a time, four chains in flight (one
  * chain alone waits on each FMA's latency), then 16 and the masked rest */
 static T512 void row_512(const float *x, uint32_t n_in, const float *w_t, const float *b, uint32_t n_out,
@@ -222,6 +285,14 @@ T512 void lidet__nn_dense_f32_avx512(const float *in, uint32_t n_rows, uint32_t 
          * chains */
         lidet__nn_dense_f32_avx2fma(in, n_rows, n_in, w_t, b, n_out, relu, out);
         return;
+    }
+    if (relu && n_out % 64u == 0u)
+    {
+        /* the ReLU layers 64 outputs wide: 4-row bands (band4_512) */
+        for (; r + 4u <= n_rows; r += 4u)
+        {
+            band4_512(in + (size_t)r * n_in, n_in, w_t, b, n_out, relu, out + (size_t)r * n_out);
+        }
     }
     for (; r + 8u <= n_rows; r += 8u)
     {
