@@ -281,7 +281,7 @@ T512 void lidet__nn_dense_f32_avx512(const float *in, uint32_t n_rows, uint32_t 
     uint32_t r = 0;
     if (n_in > BAND_MAX_IN)
     {
-        /* wider than the input lists (every model's layers have 256 inputs at most): the AVX2 kernel, the same
+        /* wider than the input lists (the shipped models' layers have 195 inputs at most): the AVX2 kernel, the same
          * chains */
         lidet__nn_dense_f32_avx2fma(in, n_rows, n_in, w_t, b, n_out, relu, out);
         return;
