@@ -786,18 +786,18 @@ static void label_setup(label_t *L, const lidet_ground_q_state_t *g, lidet_groun
     L->n_vetoed = 0;
 }
 
-/* row r of sector s (z_up holds row r - 1's z of the sector's columns) */
+/* row r of sector s (z_up holds row r - 1's z of the sector's columns; rt, rtu: rows r and r - 1's trig; two: near
+ * and far cells; ro: a range-only image) */
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
 static inline void
-label_cell(label_t *L, const lidet_ground_q_state_t *g, uint32_t r, uint32_t s)
+label_cell(label_t *L, const lidet_ground_q_state_t *g, uint32_t r, uint32_t s, lidet__qpix_row_t rt,
+           lidet__qpix_row_t rtu, const int two, const int ro)
 {
     const lidet_range_image_t *img = L->img;
     const uint32_t cols = img->n_cols, ns = g->cfg.n_sectors;
-    const int two = g->split_v != 0xFFFFFFFFu, ro = L->gp->ct != 0;
     const uint32_t base = r * cols, up = r > 0u ? cols : 0u;
-    const lidet__qpix_row_t rt = lidet__qpix_row(img, r), rtu = lidet__qpix_row(img, r > 0u ? r - 1u : 0u);
     const uint32_t c0 = lidet__ground_sector_col(s, ns, cols),
                    c1 = lidet__ground_sector_col(s + 1u, ns, cols);
     lidet__ground_q_hplane_t hp[2];
@@ -840,6 +840,7 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
                        const lidet__ground_q_pix_t *gp)
 {
     const uint32_t rows = gp->img->n_rows, cols = gp->img->n_cols, ns = g->cfg.n_sectors;
+    const int two = g->split_v != 0xFFFFFFFFu, ro = gp->ct != 0;
     label_t L;
     uint32_t r, s, c;
     label_setup(&L, g, sc, mask, gp);
@@ -849,9 +850,11 @@ static void label_rows(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, 
     }
     for (r = 0; r < rows; ++r)
     {
+        const lidet__qpix_row_t rt = lidet__qpix_row(gp->img, r),
+                                rtu = lidet__qpix_row(gp->img, r > 0u ? r - 1u : 0u);
         for (s = 0; s < ns; ++s)
         {
-            label_cell(&L, g, r, s);
+            label_cell(&L, g, r, s, rt, rtu, two, ro);
         }
     }
     g->stats.n_ground = L.n_ground;
@@ -1000,7 +1003,8 @@ static void label_sector(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc
     }
     for (r = 0; r < rows; ++r)
     {
-        label_cell(&L, g, r, s);
+        label_cell(&L, g, r, s, lidet__qpix_row(gp->img, r), lidet__qpix_row(gp->img, r > 0u ? r - 1u : 0u),
+                   g->split_v != 0xFFFFFFFFu, gp->ct != 0);
     }
     g->stats.n_ground += L.n_ground;
     g->stats.n_vetoed += L.n_vetoed;
