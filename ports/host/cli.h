@@ -226,6 +226,14 @@ extern int cli_stage_clock_cpu;
 extern int cli_fixed_range_only;
 /* lidet detect --returns: with --fixed and --ring, the scan fed as the sensor's returns (lidet_detector_q_run_returns) */
 extern int cli_fixed_returns;
+/* `lidet detect / track --fixed --stream N`: the scan's returns (--returns, --pcap) streamed into the integer detector
+ * N at a time (lidet_detector_q_stream_*), the time of stream_end (the latency after the last chunk) measured;
+ * --stream-sectors: lidet_detector_q_cfg_t.stream_sectors (and the range-only pixel it needs). The last run's: the
+ * sectors done before stream_end (stats.n_stream_sectors) and the median stream_end time */
+extern uint32_t cli_fixed_stream;
+extern int cli_fixed_stream_sectors;
+extern uint32_t cli_stream_sectors_done;
+extern double cli_stream_end_ms;
 uint32_t cli_stage_clock_ns(void *ctx);
 /* Median of n values (sorts in place). */
 double cli_median(double *v, int n);

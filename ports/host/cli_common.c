@@ -339,6 +339,10 @@ const char *cli_cmd = "detect";
 int cli_stage_clock_cpu = 0;
 int cli_fixed_range_only = 0;
 int cli_fixed_returns = 0;
+uint32_t cli_fixed_stream = 0;
+int cli_fixed_stream_sectors = 0;
+uint32_t cli_stream_sectors_done = 0;
+double cli_stream_end_ms = 0.0;
 
 uint32_t cli_stage_clock_ns(void *ctx)
 {

@@ -436,6 +436,15 @@ static void json_result(const cli_args_t *a, const char *chosen, const lidet_det
     cli_json_num(stdout, "box_ms", ms[LIDET_DET_STAGE_BOX]);
     cli_json_num(stdout, "post_ms", ms[LIDET_DET_STAGE_POST]);
     cli_json_num(stdout, "total_ms", ms[LIDET_DET_N_STAGES]);
+    if (cli_fixed_stream > 0u)
+    {
+        cli_json_int(stdout, "stream_chunk", cli_fixed_stream);
+        cli_json_num(stdout, "stream_end_ms", cli_stream_end_ms);
+    }
+    if (cli_fixed_stream_sectors)
+    {
+        cli_json_int(stdout, "stream_sectors", cli_stream_sectors_done);
+    }
     fprintf(stdout, ", \"boxes\": [");
     for (k = 0; k < n_det; ++k)
         fprintf(
@@ -613,6 +622,14 @@ void cli_det_usage(FILE *f)
            "                   converted to millimetres); the same outputs\n"
            "  --range-only     with --fixed: the range-only pixel of the integer firmware (x, y, z\n"
            "                   decoded from row, column and range; lidet_detector_q_cfg_t.range_only)\n"
+           "  --stream N       with --fixed and the scan as returns (--returns, --pcap): the returns\n"
+           "                   streamed into the detector N at a time, as a driver feeds packets\n"
+           "                   (lidet_detector_q_stream_*; the same results); --json adds\n"
+           "                   stream_end_ms, the time from the last chunk to the detections\n"
+           "  --stream-sectors with --fixed: the ground stage run sector by sector while the scan\n"
+           "                   streams in (lidet_detector_q_cfg_t.stream_sectors, the range-only pixel;\n"
+           "                   a RANSAC stream per ground cell); --json adds stream_sectors, the\n"
+           "                   sectors done before the end\n"
            "  --cpu-clock      stage and total times (--json *_ms) in this thread's CPU time, not wall time\n"
            "                   (what other processes on a busy machine do not inflate)\n"
            "  --set KEY=VALUE  override a lidet_detector_cfg_t field: crop_half_rad, max_range_m,\n"
@@ -683,6 +700,8 @@ enum
     OPT_CROP,
     OPT_FIXED,
     OPT_RANGE_ONLY,
+    OPT_STREAM,
+    OPT_STREAM_SECTORS,
     OPT_CPU_CLOCK
 };
 
@@ -691,6 +710,8 @@ const cli_opt_t cli_opts_det[] = {{"model", required_argument, OPT_MODEL, "NAME:
                                   {"crop", no_argument, OPT_CROP, NULL},
                                   {"fixed", no_argument, OPT_FIXED, NULL},
                                   {"range-only", no_argument, OPT_RANGE_ONLY, NULL},
+                                  {"stream", required_argument, OPT_STREAM, "N: returns per chunk, 1 to 1000000"},
+                                  {"stream-sectors", no_argument, OPT_STREAM_SECTORS, NULL},
                                   {"cpu-clock", no_argument, OPT_CPU_CLOCK, NULL},
                                   {NULL, 0, 0, NULL}};
 
@@ -713,6 +734,21 @@ int cli_det_take(void *ctx, int id, const char *v)
         break;
     case OPT_RANGE_ONLY:
         cli_fixed_range_only = 1;
+        break;
+    case OPT_STREAM:
+    {
+        char *end = NULL;
+        const unsigned long n = strtoul(v, &end, 10);
+        if (end == v || *end != '\0' || v[0] == '-' || n < 1ul || n > 1000000ul)
+        {
+            fprintf(stderr, "lidet %s: --stream %s: returns per chunk, 1 to 1000000\n", cli_cmd, v);
+            return 1;
+        }
+        cli_fixed_stream = (uint32_t)n;
+        break;
+    }
+    case OPT_STREAM_SECTORS:
+        cli_fixed_stream_sectors = 1;
         break;
     default: /* OPT_CPU_CLOCK */
         cli_stage_clock_cpu = 1;
@@ -750,10 +786,13 @@ int cli_det_config(const cli_args_t *a, const cli_det_opts_t *o, lidet_detector_
                    const lidet_pn_model_t **mc, const lidet_pn_model_t **mb, char *chosen, size_t chosen_len)
 {
     int i;
-    if ((cli_fixed_range_only || cli_fixed_returns) && !o->fixed)
+    if ((cli_fixed_range_only || cli_fixed_returns || cli_fixed_stream || cli_fixed_stream_sectors) && !o->fixed)
     {
         fprintf(stderr, "lidet %s: --%s is a setting of the integer detector: add --fixed\n", cli_cmd,
-                cli_fixed_returns ? "returns" : "range-only");
+                cli_fixed_returns          ? "returns"
+                : cli_fixed_stream         ? "stream"
+                : cli_fixed_stream_sectors ? "stream-sectors"
+                                           : "range-only");
         return 1;
     }
     /* a file's sensor: its own family (the description's "model", else by rows), without the fallback */

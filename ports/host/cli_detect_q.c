@@ -58,7 +58,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     int32_t *pts, *pp;
     lidet_return_t *rets = NULL;
     const lidet_return_t *run_rets = returns;
-    double *t;
+    double *t, *stream_end;
     int i;
     if (s == NULL)
     {
@@ -126,10 +126,11 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
         cfg.score_points_weight_q16[k] = round_i32((double)fcfg->score_points_weight[k] * 65536.0);
     }
     cfg.nms_iou_q15 = round_i32((double)fcfg->nms_iou * 32768.0);
-    if (cli_fixed_range_only)
+    if (cli_fixed_range_only || cli_fixed_stream_sectors)
     {
         cfg.range_only = 1u; /* the firmware's pixel: x, y, z decoded from row, column and range */
     }
+    cfg.stream_sectors = (uint8_t)(cli_fixed_stream_sectors != 0);
     cfg.clock = cli_stage_clock_ns;
     *status = lidet_detector_q_init(&g_detq, &cfg, mc, mb);
     if (*status != LIDET_OK)
@@ -140,7 +141,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     }
     pts = (int32_t *)malloc(sizeof(int32_t) * 3u * (size_t)(np + 1u));
     pp = (int32_t *)malloc(sizeof(int32_t) * LIDET_MAX_POINTS);
-    t = (double *)malloc(sizeof(double) * (size_t)a->repeat * (LIDET_DET_N_STAGES + 1u));
+    t = (double *)malloc(sizeof(double) * (size_t)a->repeat * (LIDET_DET_N_STAGES + 2u));
     if (pts == NULL || pp == NULL || t == NULL)
     {
         free(pts);
@@ -148,6 +149,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
         free(t);
         return 1;
     }
+    stream_end = t + (size_t)a->repeat * (LIDET_DET_N_STAGES + 1u); /* --stream: each run's stream_end time */
     for (k = 0; returns == NULL && k < np; ++k)
     {
         /* clamped to the int32 range first: a 1e19 m point must stay a (rejected) huge value, not UB */
@@ -180,11 +182,47 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
             rets[k] = return_of_point(pts + 3u * k, a->ring[k]);
         run_rets = rets;
     }
+    if (cli_fixed_stream > 0u && run_rets == NULL)
+    {
+        fprintf(stderr, "lidet %s --stream: needs the scan as the sensor's returns (--returns --ring FILE, or "
+                        "--pcap)\n",
+                cli_cmd);
+        free(pts);
+        free(pp);
+        free(t);
+        free(rets);
+        return 1;
+    }
     for (i = 0; i < a->repeat; ++i)
     {
         const double t0 = cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms();
-        *status = run_rets != NULL ? lidet_detector_q_run_returns(&g_detq, run_rets, np, i == 0 ? pp : NULL)
-                                   : lidet_detector_q_run(&g_detq, pts, np, 3, a->ring, i == 0 ? pp : NULL);
+        if (cli_fixed_stream > 0u)
+        {
+            /* a chunk at a time, as a driver feeds packets; stream_end timed alone (the latency) */
+            uint32_t at = 0;
+            double te;
+            *status = lidet_detector_q_stream_begin(&g_detq);
+            while (LIDET_SUCCEEDED(*status) && at < np)
+            {
+                const uint32_t m = np - at < cli_fixed_stream ? np - at : cli_fixed_stream;
+                const lidet_status_t sr =
+                    lidet_detector_q_stream_returns(&g_detq, run_rets + at, m, i == 0 ? pp + at : NULL);
+                *status = LIDET_SUCCEEDED(sr) ? *status : sr;
+                at += m;
+            }
+            te = cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms();
+            if (LIDET_SUCCEEDED(*status))
+            {
+                const lidet_status_t se = lidet_detector_q_stream_end(&g_detq);
+                *status = se != LIDET_OK ? se : *status;
+            }
+            stream_end[i] = (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - te;
+        }
+        else
+        {
+            *status = run_rets != NULL ? lidet_detector_q_run_returns(&g_detq, run_rets, np, i == 0 ? pp : NULL)
+                                       : lidet_detector_q_run(&g_detq, pts, np, 3, a->ring, i == 0 ? pp : NULL);
+        }
         t[(size_t)LIDET_DET_N_STAGES * (size_t)a->repeat + (size_t)i] =
             (cli_stage_clock_cpu ? cli_cpu_ms() : cli_now_ms()) - t0;
         if (!LIDET_SUCCEEDED(*status))
@@ -202,8 +240,10 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     }
     for (k = 0; k <= LIDET_DET_N_STAGES; ++k)
         ms[k] = cli_median(t + (size_t)k * (size_t)a->repeat, a->repeat);
+    cli_stream_end_ms = cli_fixed_stream > 0u ? cli_median(stream_end, a->repeat) : 0.0;
     free(t);
     st = lidet_detector_q_stats(&g_detq);
+    cli_stream_sectors_done = st->n_stream_sectors;
     memset(ds, 0, sizeof *ds);
     ds->n_clusters = st->n_clusters;
     ds->n_out_of_crop = st->n_out_of_crop;

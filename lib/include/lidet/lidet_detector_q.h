@@ -217,7 +217,8 @@ typedef struct
     uint32_t stream_ticks; /* a stream's projection ticks so far (lidet_detector_q_stream_*) */
     /* cfg.stream_sectors: the stream's progress in columns travelled from its first return's column (the image's
      * columns in the order the returns visit them: dir +1 or -1, 0 until known) */
-    uint16_t stream_first_col, stream_pos, stream_done;
+    uint16_t stream_first_col, stream_start_col, stream_pos, stream_done, stream_next;
+    uint16_t stream_spread_u; /* the widest chunk's azimuth spread so far (2^15 - azimuth units) */
     uint16_t stream_late_u,
         stream_late_span; /* the azimuths (as 2^15 - azimuth) of the done sectors' columns:
                                                  [late_u, late_u + late_span] mod 2^16 */
@@ -270,9 +271,10 @@ lidet_status_t lidet_detector_q_run_returns(lidet_detector_q_t *d, const lidet_r
  * for bit, however the scan is cut (lidet_proj_q_returns_begin). stats.ticks[PROJECT] sums the three calls'
  * projection time; the rest of the stages run inside end, so the latency from a scan's last packet to its
  * detections is end's time. With cfg.stream_sectors (a range-only image), stream_returns also runs the ground
- * stage on every sector the stream has moved past (its columns and two on each side at least 1/32 turn + 4
- * columns behind the chunk's last return; the first return's sector waits for end), so end does only the rest of
- * it: the results are still run_returns' (which then draws a RANSAC stream per ground cell too), bit for bit, in
+ * stage on every sector the stream has moved past (its columns and two on each side a margin behind the chunk's
+ * last return: 1/32 turn, or the widest chunk's azimuth spread so far if more, + 4 columns; the first return's
+ * sector and those within the margin after it wait for end, where the rotation's last returns land), so end does
+ * only the rest of it: the results are still run_returns' (which then draws a RANSAC stream per ground cell too), bit for bit, in
  * any order of the returns; a return that comes back to a done sector's columns makes end run the whole ground
  * stage again (stats.n_stream_sectors 0). ticks[PROJECT] then holds that ground work too. Nothing else may run on the detector between begin and end: a run
  * (lidet_detector_q_run, _run_returns) or a new begin drops an open stream.

@@ -697,15 +697,45 @@ static inline uint32_t stream_travel(const lidet_detector_q_t *d, uint32_t c, ui
  * ground stale (stream_end then runs the whole stage: the same results, later); else the stream's position (the
  * chunk's last return, moving on by less than half a turn) and every sector, in the order the stream visits
  * them from the one after its first return's, whose columns and their neighbours all lie at least a margin
- * (1/32 turn + 4 columns: the beams' azimuth offsets, a packet's interleaved firings) behind it: done now. The
- * first return's sector waits for stream_end (its columns come first and last). */
+ * behind it: done now. The margin is 1/32 turn, or the widest chunk's azimuth spread so far if more (a packet's
+ * firings and the beams' azimuth offsets: a real Ouster OS0-128's span +-11 degrees, which the default would not
+ * cover), + 4 columns. The first return's sector, and those whose columns start within the margin after its
+ * column, wait for stream_end: the rotation's last returns come back there. Measured on real captures
+ * (tests/python/test_cli_pcap.py): 25-29 of 32 sectors done early on VLP-16 and Ouster OS0/OS1/OS2 rotations,
+ * the same boxes as the whole scan. */
 static void stream_sectors(lidet_detector_q_t *d, const lidet_proj_q_buffers_t *buf,
                            const lidet_return_t *ret, uint32_t n)
 {
     const uint32_t cols = d->cfg.proj.sensor.n_cols, ns = d->cfg.ground.n_sectors;
-    const uint32_t margin = cols / 32u + 4u;
+    const uint16_t u0 = (uint16_t)(0x8000u - ret[0].azimuth), lo = d->stream_late_u,
+                   span = d->stream_late_span;
+    const uint32_t check = d->stream_done > 0u;
     lidet_range_image_t img;
-    uint32_t i, t, seam;
+    uint32_t i, t, seam, margin, late = 0u, spread;
+    int32_t dmin = 0, dmax = 0;
+    /* one pass over the chunk: whether a return falls where a done sector read (in the azimuth's units: the columns
+     * are ranges of (2^15 - azimuth) mod 2^16, no division per return), and the chunk's azimuth spread about its
+     * first return (a packet's firings and the beams' azimuth offsets: an Ouster OS0's span +-11 degrees) */
+    for (i = 0; i < n; ++i)
+    {
+        const uint16_t u = (uint16_t)(0x8000u - ret[i].azimuth);
+        const uint32_t du = (uint16_t)(u - u0);
+        const int32_t dv = du < 32768u ? (int32_t)du : (int32_t)du - 65536;
+        dmin = dv < dmin ? dv : dmin;
+        dmax = dv > dmax ? dv : dmax;
+        late |= check & (uint32_t)((uint16_t)(u - lo) <= span);
+    }
+    if (late)
+    {
+        d->stream_flags |= STREAM_LATE;
+        return;
+    }
+    spread = (uint32_t)(dmax - dmin);
+    d->stream_spread_u =
+        spread > d->stream_spread_u ? (uint16_t)(spread < 65535u ? spread : 65535u) : d->stream_spread_u;
+    /* the margin: 1/32 turn, or the widest chunk's spread so far if more, + 4 columns */
+    spread = ((uint32_t)d->stream_spread_u * cols + 65535u) >> 16;
+    margin = (spread > cols / 32u ? spread : cols / 32u) + 4u;
     if (!(d->stream_flags & STREAM_FIRST))
     {
         d->stream_first_col = (uint16_t)return_col(&ret[0], cols);
@@ -713,29 +743,17 @@ static void stream_sectors(lidet_detector_q_t *d, const lidet_proj_q_buffers_t *
     }
     if (d->stream_dir == 0)
     {
-        /* the direction: the first chunk that ends more than 2 columns from the first return */
+        /* the direction: the first chunk that ends more than the margin from the first return (beams' azimuth
+         * offsets put a chunk's last return a few columns either side of its column) */
         const uint32_t c = return_col(&ret[n - 1u], cols), f = d->stream_first_col;
         const uint32_t ahead = c >= f ? c - f : c + cols - f;
-        if (ahead > 2u && ahead < cols - 2u)
+        if (ahead > margin && ahead + margin < cols)
         {
             d->stream_dir = (int8_t)(ahead < cols / 2u ? 1 : -1);
         }
         if (d->stream_dir == 0)
         {
             return;
-        }
-    }
-    else if (d->stream_done > 0u)
-    {
-        /* in the azimuth's units: the columns are ranges of (2^15 - azimuth) mod 2^16, no division per return */
-        const uint16_t lo = d->stream_late_u, span = d->stream_late_span;
-        for (i = 0; i < n; ++i)
-        {
-            if ((uint16_t)((uint16_t)(0x8000u - ret[i].azimuth) - lo) <= span)
-            {
-                d->stream_flags |= STREAM_LATE;
-                return;
-            }
         }
     }
     t = stream_travel(d, return_col(&ret[n - 1u], cols), cols);
@@ -747,30 +765,45 @@ static void stream_sectors(lidet_detector_q_t *d, const lidet_proj_q_buffers_t *
     lidet_proj_q_image(&d->proj, buf, &img);
     img.point_idx = 0;
     seam = (uint32_t)d->stream_first_col * ns / cols; /* the sector of column c: c ns / cols */
-    while (d->stream_done + 1u < ns)
+    while (d->stream_next + 1u < ns)
     {
-        const uint32_t k = d->stream_done + 1u;
+        const uint32_t k = d->stream_next + 1u;
         const uint32_t s = d->stream_dir > 0 ? (seam + k) % ns : (seam + ns - k) % ns;
         const uint32_t c0 = lidet__ground_sector_col(s, ns, cols),
                        c1 = lidet__ground_sector_col(s + 1u, ns, cols);
-        const uint32_t lo = c0 > 0u ? c0 - 1u : cols - 1u, hi = c1 + 1u < cols ? c1 + 1u : c1 + 1u - cols;
-        const uint32_t t_lo = stream_travel(d, lo, cols), t_hi = stream_travel(d, hi, cols);
+        const uint32_t c_lo = c0 > 0u ? c0 - 1u : cols - 1u, c_hi = c1 + 1u < cols ? c1 + 1u : c1 + 1u - cols;
+        const uint32_t t_lo = stream_travel(d, c_lo, cols), t_hi = stream_travel(d, c_hi, cols);
         const uint32_t first = d->stream_dir > 0 ? t_lo : t_hi, last = d->stream_dir > 0 ? t_hi : t_lo;
-        if (first > last || last + margin > t)
+        if (first > last || first < margin)
         {
-            break; /* across the first column (stream_end's), or not passed yet */
+            /* across the first column, or within the margin after it (the rotation's last returns come back
+             * there): left for stream_end */
+            d->stream_next = (uint16_t)k;
+            continue;
+        }
+        if (last + margin > t)
+        {
+            break; /* not passed yet */
         }
         lidet__ground_q_stream_sector(&d->ground, &d->scratch.ground, ground_mask(d), &img, s);
-        d->stream_done = (uint16_t)k;
+        d->stream_next = (uint16_t)k;
+        ++d->stream_done;
         {
-            /* the done columns so far: travel 0 .. last (the first return's sector too: a late return there costs
-             * a redo, never a wrong result), as a range of 2^15 - azimuth */
+            /* the columns the done sectors read: from the first one's trailing neighbour to this one's leading
+             * one (travel first .. last), as a range of 2^15 - azimuth; the first return's sector is not in it
+             * (a rotation ends where it began) */
             const uint32_t f = d->stream_first_col,
                            far = d->stream_dir > 0 ? (f + last) % cols : (f + cols - last) % cols;
-            const uint32_t ca = d->stream_dir > 0 ? f : far, cb = d->stream_dir > 0 ? far : f;
-            const uint32_t ua = col_start_u(ca, cols), ub = col_start_u(cb + 1u, cols) - 1u;
-            d->stream_late_u = (uint16_t)ua;
-            d->stream_late_span = (uint16_t)(ub - ua);
+            uint32_t ca, cb;
+            if (d->stream_done == 1u)
+            {
+                d->stream_start_col =
+                    (uint16_t)(d->stream_dir > 0 ? (f + first) % cols : (f + cols - first) % cols);
+            }
+            ca = d->stream_dir > 0 ? d->stream_start_col : far;
+            cb = d->stream_dir > 0 ? far : d->stream_start_col;
+            d->stream_late_u = (uint16_t)col_start_u(ca, cols);
+            d->stream_late_span = (uint16_t)(col_start_u(cb + 1u, cols) - 1u - d->stream_late_u);
         }
     }
 }
@@ -790,7 +823,8 @@ lidet_status_t lidet_detector_q_stream_begin(lidet_detector_q_t *d)
     d->stream_ticks = now(d) - t0;
     d->stream_flags = 0;
     d->stream_dir = 0;
-    d->stream_pos = d->stream_done = d->stream_first_col = 0;
+    d->stream_pos = d->stream_done = d->stream_next = d->stream_first_col = d->stream_start_col = 0;
+    d->stream_spread_u = 0;
     d->stream_late_u = d->stream_late_span = 0;
     if (s == LIDET_OK && d->cfg.stream_sectors)
     {
