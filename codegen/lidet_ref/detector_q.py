@@ -78,7 +78,8 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
            returns=None) -> dict:
     """The whole integer detector on (N, 3) int32 mm points. det_cfg: crop_half_bam, max_range_mm, max_height_extent_mm,
     max_proposals, max_boxes, gate1, gate2, nms_iou_q15, size_min (3x3 mm), size_max, score_box_weight_q16 (3), score_points_weight_q16 (3), and optionally gate1_margin_q16 / gate2_margin_q16
-    (0 when absent: the models' gammas), gate2_class (3 flags, lidet_class_t order: the classes gate 2 judges;
+    (0 when absent: the models' gammas), stream_sectors (0 when absent; 1: a RANSAC stream per ground cell, as
+    lidet_detector_q_cfg_t.stream_sectors sets), gate2_class (3 flags, lidet_class_t order: the classes gate 2 judges;
     GATE2_CLASS when absent, the C default), group_split (0 when absent; the C default is 1 for > 16 rows) and
     group_max_range_mm (40000 when absent), min_score_q15 (3, the operating point; 0s when absent: off; the C
     default is 19661 for cars with > 16 rows), gate1_class_margin_q16 (3, added to gate1_margin_q16 per class; 0s
@@ -101,7 +102,9 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     if range_only:
         X, Y, Z = qmath.decode_pixels(R, tab.row_elev_bam)
         RG = ground_q.r_of_range(R, tab.row_elev_bam)
-    if int(det_cfg["crop_half_bam"]) > 0:  # the crop: a RANSAC stream per ground cell (lidet_detector_q_init)
+    if int(det_cfg["crop_half_bam"]) > 0 or int(det_cfg.get("stream_sectors", 0)):
+        # the crop, or the ground streamed sector by sector: a RANSAC stream per ground cell (lidet_detector_q_init;
+        # a streamed run's results are the whole scan's with it, so the reference has no streaming of its own)
         ground_cfg = dict(ground_cfg, seed_per_cell=1)
     mask, _, planes, _, _, _ = ground_q.ground(X, Y, Z, ground_cfg, RG)
     ns = int(ground_cfg["n_sectors"])

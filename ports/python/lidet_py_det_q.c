@@ -103,10 +103,25 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
     {
         cfg.range_only = (uint8_t)icfg[9];
     }
+    cfg.stream_sectors = (uint8_t)(icfg[22] == 1); /* the ground stage sector by sector while streamed */
     rc = lidet_detector_q_init(det, &cfg, mc, mb);
     if (rc != LIDET_OK)
     {
         return rc;
+    }
+    if (returns != NULL && icfg[23] > 0)
+    {
+        /* the returns streamed icfg[23] at a time (lidet_detector_q_stream_*) */
+        uint32_t at = 0;
+        rc = lidet_detector_q_stream_begin(det);
+        while (rc == LIDET_OK && at < n)
+        {
+            const uint32_t m = n - at < (uint32_t)icfg[23] ? n - at : (uint32_t)icfg[23];
+            const int sr = lidet_detector_q_stream_returns(det, returns + at, m, NULL);
+            rc = LIDET_SUCCEEDED(sr) ? LIDET_OK : sr;
+            at += m;
+        }
+        return rc == LIDET_OK ? lidet_detector_q_stream_end(det) : rc;
     }
     return returns != NULL ? lidet_detector_q_run_returns(det, returns, n, NULL)
                            : lidet_detector_q_run(det, pts_mm, n, stride, NULL, NULL);
@@ -117,11 +132,12 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
  * gate2_class as bits (bit k: class k; -1 = the default), group_split (0, 1; -1 = the default for the sensor),
  * min_score_q15 per class (3 entries, -1 = the default), car_min_z_spread_mm (-1 = the default),
  * gate1_class_margin_q16 per class (3 entries, INT32_MIN = the default), car_ground_mm (-1 = the default),
- * group_gate1_margin_q16 (-1 = the default), gate1_large_car_margin_q16 (-1 = the default).
+ * group_gate1_margin_q16 (-1 = the default), gate1_large_car_margin_q16 (-1 = the default), stream_sectors (1: on),
+ * stream chunk (returns per lidet_detector_q_stream_returns call; 0: one run).
  * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
- * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 18 uint32 (the
+ * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 19 uint32 (the
  * counts of lidet_detector_q_stats_t in order, then n_over_box_budget, n_too_tall, the three group counts and
- * n_score_rejected). returns: n lidet_return_t
+ * n_score_rejected, n_stream_sectors: 19 in all). returns: n lidet_return_t
  * instead of the points (lidet_detector_q_run_returns; pts_mm ignored), or NULL. Returns the run's status. */
 LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, const char *box_name,
                                    const int32_t *icfg, const int32_t *pts_mm, uint32_t n, uint32_t stride,
@@ -165,12 +181,12 @@ LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, con
     memcpy(out_outcome, oc, *n_clusters);
     st = lidet_detector_q_stats(&g_detq);
     {
-        const uint32_t v[18] = {
+        const uint32_t v[19] = {
             st->n_clusters,        st->n_out_of_crop,    st->n_out_of_range,  st->n_over_budget,
             st->n_classified,      st->n_gate1_rejected, st->n_boxed,         st->n_gate2_rejected,
             st->n_size_rejected,   st->n_nms_suppressed, st->n_over_capacity, st->n_detections,
             st->n_over_box_budget, st->n_too_tall,       st->n_group_split,   st->n_group_classified,
-            st->n_group_boxed,     st->n_score_rejected};
+            st->n_group_boxed,     st->n_score_rejected, st->n_stream_sectors};
         memcpy(out_stats, v, sizeof v);
     }
     return rc;

@@ -168,7 +168,7 @@ LARGE_CAR_Q16 = 65536
 def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=False, crop_half_bam=0, returns=None,
                 gate2_class=None, group_split=None, model=None, min_score_q15=None, car_min_z_spread_mm=None,
                 gate1_class_margin_q16=None, car_ground_mm=None, group_gate1_margin_q16=None,
-                gate1_large_car_margin_q16=None):
+                gate1_large_car_margin_q16=None, stream_sectors=False):
     import json
     from lidet_codegen import emit as E
     from lidet_codegen import quant as QU
@@ -197,9 +197,45 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
                    else gate1_large_car_margin_q16)
     if gate2_class is not None:
         det_cfg["gate2_class"] = gate2_class
+    det_cfg["stream_sectors"] = int(bool(stream_sectors))
     return RD.detect(pts_mm, tab, dict(min_range_mm=100, max_range_mm=0), nq.ground_q_defaults(sensor), cc, pc,
                      det_cfg, models["cls"], models["box"], cap["max_clusters"], cap["max_detections"],
                      cap["max_points"], range_only=range_only, returns=returns)
+
+
+@pytest.mark.parametrize("sensor", ["vlp16", "hdl64"])
+def test_streamed_sectors_bit_exact_with_the_reference(nq, sensor):
+    """lidet_detector_q_cfg_t.stream_sectors: the sample scan's returns in the order a spinning sensor sends them,
+    streamed 384 at a time with the ground stage done sector by sector while they arrive, against the chained numpy
+    reference on the whole scan (a RANSAC stream per ground cell), bit for bit; most sectors done before the end, and
+    the same detections from one run_returns and from a stream in the reverse direction."""
+    from lidet_ref import proj_q
+    pts = _load(ROOT / f"tests/data/sim_{sensor}/velodyne/000000.bin")
+    ring = np.fromfile(ROOT / f"tests/data/sim_{sensor}/ring/000000.bin", np.uint16)
+    mm = nq.to_mm(pts)
+    rng, az, rg = proj_q.returns_of_points(mm, ring)
+    u = (0x8000 - az) & 0xFFFF  # the image's column order (lidet_proj_q: col = u cols / 2^16)
+    order = np.argsort((u + 5461) & 0xFFFF, kind="stable")  # from the column of azimuth 210 degrees on
+    rets = (rng[order], az[order], rg[order])
+    c = nq.detect_q(mm, sensor, range_only=True, returns=nq.as_returns(*rets), stream_sectors=True, stream=384)
+    r = _ref_detect(nq, mm, sensor, range_only=True, returns=rets, stream_sectors=True)
+    ns = int(nq.ground_q_defaults(sensor)["n_sectors"])
+    assert ns - 6 <= c["stats"]["n_stream_sectors"] < ns
+    assert c["outcome"].tolist() == r["outcome"]
+    for k in ("n_clusters", "n_classified", "n_gate1_rejected", "n_boxed", "n_gate2_rejected", "n_detections"):
+        assert c["stats"][k] == r["stats"][k], k
+    assert len(r["detections"]) == len(c["cls"]) > 0
+    for i, d in enumerate(r["detections"]):
+        assert d["cls"] == c["cls"][i] and d["score_q15"] == c["score_q15"][i]
+        assert d["box"] == c["boxes"][i].tolist()
+    whole = nq.detect_q(mm, sensor, range_only=True, returns=nq.as_returns(*rets), stream_sectors=True)
+    back = nq.detect_q(mm, sensor, range_only=True, returns=nq.as_returns(*(v[::-1] for v in rets)),
+                       stream_sectors=True, stream=384)
+    assert whole["stats"]["n_stream_sectors"] == 0 and back["stats"]["n_stream_sectors"] >= ns - 6
+    for o in (whole, back):
+        assert np.array_equal(o["boxes"], c["boxes"]) and np.array_equal(o["outcome"], c["outcome"])
+    with pytest.raises(ValueError):
+        nq.detect_q(mm, sensor, stream=384)  # a stream needs the returns
 
 
 @pytest.mark.parametrize("which", ["sample", "fresh", "hdl64", "real", "box_budget", "margins", "gate2_all", "group", "group_real",

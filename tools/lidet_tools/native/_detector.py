@@ -184,7 +184,7 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
 DETQ_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity", "n_detections",
               "n_over_box_budget", "n_too_tall", "n_group_split", "n_group_classified", "n_group_boxed",
-              "n_score_rejected"]
+              "n_score_rejected", "n_stream_sectors"]
 
 
 def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_half_bam: int = 0,
@@ -193,7 +193,8 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
              range_only: bool | None = None, returns=None, gate2_class=None, group_split: bool | None = None,
              min_score_q15=None, car_min_z_spread_mm: int | None = None, gate1_class_margin_q16=None,
              car_ground_mm: int | None = None, group_gate1_margin_q16: int | None = None,
-             gate1_large_car_margin_q16: int | None = None) -> dict:
+             gate1_large_car_margin_q16: int | None = None, stream_sectors: bool = False,
+             stream: int = 0) -> dict:
     """lidet_detector_q_run on (N, 3) int32 mm points with the int8 models cls_<model>_s8 / box_<model>_s8
     (returns: a RETURN_DTYPE array instead, lidet_detector_q_run_returns; points_mm is then ignored).
     gate*_margin_q16: the gates' operating points (lidet_detector_q_cfg_t, Q16 nats). range_only: the range-only
@@ -205,7 +206,9 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     car_ground_mm: the float detector's car_ground_m in mm (None: the C default). group_gate1_margin_q16: the float
     detector's group_gate1_margin in Q16 nats, [0, 20 * 65536] (None: the C default, 2 * 65536).
     gate1_large_car_margin_q16: the float detector's gate1_large_car_margin in Q16 nats, [0, 20 * 65536] (None: the C
-    default).
+    default). stream_sectors: lidet_detector_q_cfg_t.stream_sectors (the ground stage sector by sector while the returns
+    stream in; needs the range-only pixel). stream > 0 (with returns): the returns streamed that many at a time
+    (lidet_detector_q_stream_*) instead of one run; stats['n_stream_sectors'] counts the sectors done before the end.
 
     Returns {'cls', 'score_q15', 'energy_cls_q16', 'energy_box_q16', 'boxes' (N, 7: cx cy cz l w h mm, yaw BAM32),
     'cluster_id', 'n_points', 'outcome', 'stats', 'status'}."""
@@ -235,7 +238,10 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
                                                    20 * 65536)]),
                      -1 if car_ground_mm is None else int(car_ground_mm),
                      -1 if group_gate1_margin_q16 is None else int(group_gate1_margin_q16),
-                     -1 if gate1_large_car_margin_q16 is None else int(gate1_large_car_margin_q16)], np.int32)
+                     -1 if gate1_large_car_margin_q16 is None else int(gate1_large_car_margin_q16),
+                     int(bool(stream_sectors)), int(stream)], np.int32)
+    if stream < 0 or (stream and returns is None):
+        raise ValueError("stream: a count of returns per chunk (>= 0), with returns")
     n = len(pts)
     rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
                              pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st,
