@@ -28,7 +28,8 @@ foreach(opt IN LISTS LIDET_OPT_OPTIONS)
   set(${opt} "" CACHE STRING "Override ${opt} of lidet_opt.h (empty: its default; docs/OPTIONS.md)")
 endforeach()
 set_property(CACHE LIDET_NN_S8_KERNEL PROPERTY STRINGS "" LIDET_NN_S8_KERNEL_ROWS4 LIDET_NN_S8_KERNEL_COLS
-             LIDET_NN_S8_KERNEL_DSP LIDET_NN_S8_KERNEL_R2O2 LIDET_NN_S8_KERNEL_R4O2)
+             LIDET_NN_S8_KERNEL_DSP LIDET_NN_S8_KERNEL_R2O2 LIDET_NN_S8_KERNEL_R4O2
+             LIDET_NN_S8_KERNEL_LIST)
 
 # lidet_opt_definitions(<target> <PUBLIC|PRIVATE|INTERFACE>): -D<option>=<value> for every option set in the cache
 function(lidet_opt_definitions target scope)

@@ -130,7 +130,7 @@ def test_kernel_variants_are_named(root, opt):
     evaluates to 0 in #if, so 0 must not name a kernel); the selector in lidet_nn_s8.c reads each name and ends in
     an #error; lidet_opt.h's check names every one."""
     names = dict(re.findall(r"^#define\s+(LIDET_NN_S8_KERNEL_\w+)\s+(\d+)\s*$", opt, re.M))
-    assert set(names) == {f"LIDET_NN_S8_KERNEL_{k}" for k in ("ROWS4", "COLS", "DSP", "R2O2", "R4O2")}
+    assert set(names) == {f"LIDET_NN_S8_KERNEL_{k}" for k in ("ROWS4", "COLS", "DSP", "R2O2", "R4O2", "LIST")}
     values = [int(v) for v in names.values()]
     assert len(set(values)) == len(values) and 0 not in values
     # the values these names replaced, so that an old command line fails instead of picking another kernel

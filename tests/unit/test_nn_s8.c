@@ -1,6 +1,6 @@
 /* SPDX-License-Identifier: MIT */
 /* The int8 accumulation kernels (lib/src/nn/lidet_nn_s8.c): the host kernel, the output-inner loop and the 2 x 2
- * and 4 x 2 register-blocked kernels give the same int32 sums on every shape, odd row and channel counts included, and
+ * and 4 x 2 register-blocked kernels and the list kernel give the same int32 sums on every shape, odd row and channel counts included, and
  * equal a plain triple loop; the extreme int8 values too. */
 #include <string.h>
 
@@ -41,6 +41,8 @@ static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extrem
         in[k] = extreme == 1 ? (int8_t)((k & 1u) ? -128 : 127) : (int8_t)(next() & 0xFFu);
         if (extreme == 2 && next() % 5u < 3u) /* a ReLU layer's output: most inputs at its zero point */
             in[k] = -128;
+        if (extreme == 3) /* every input at the zero point: nothing left to add */
+            in[k] = -128;
     }
     for (k = 0; k < n_in * n_out; ++k)
         w[k] = extreme == 1 ? (int8_t)-128 : (int8_t)(next() & 0xFFu);
@@ -68,6 +70,9 @@ static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extrem
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
     memset(got, 0x5A, sizeof got);
     lidet__nn_acc_s8_r4o2(in, rows, n_in, w, b, n_out, got);
+    TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+    memset(got, 0x5A, sizeof got);
+    lidet__nn_acc_s8_list(in, rows, n_in, w, b, n_out, got);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
     memset(got, 0x5A, sizeof got);
     lidet__nn_acc_s8_dsp(in, rows, n_in, w, b, n_out, got);
@@ -117,6 +122,8 @@ static void test_kernels_agree_on_every_shape(void)
             {
                 check_shape(rows, n_in, n_out, 0);
                 check_shape(rows, n_in, n_out, 2); /* 3 in 5 inputs at -128: the skipped products */
+                if (n_in % 3u == 1u)
+                    check_shape(rows, n_in, n_out, 3); /* all at -128 */
             }
 }
 
@@ -214,6 +221,37 @@ static void test_first_layer_in_one_pass(void)
                 lidet__nn_acc_s16_3_requant(in, rows, w, b, n_out, mult, shift, zp, lo, out);
                 TEST_ASSERT_EQUAL_INT8_ARRAY(ref8, out, rows * n_out);
             }
+}
+
+/* the list kernel past 16-bit weight offsets (n_in n_out > 65536: it hands the layer on) and up to them */
+static void test_list_kernel_on_large_layers(void)
+{
+    static int8_t in[9 * 300], w[300 * 224];
+    static int32_t b[256], ref[9 * 256], got[9 * 256];
+    static const uint32_t shapes[][2] = {{300u, 224u}, {256u, 256u}, {257u, 255u}};
+    uint32_t k, rows, r, i, o;
+    for (k = 0; k < sizeof shapes / sizeof shapes[0]; ++k)
+        for (rows = 1; rows <= 9u; rows += 4u)
+        {
+            const uint32_t n_in = shapes[k][0], n_out = shapes[k][1];
+            for (i = 0; i < rows * n_in; ++i)
+                in[i] = next() % 2u ? (int8_t)-128 : (int8_t)(next() & 0xFFu);
+            for (i = 0; i < n_in * n_out; ++i)
+                w[i] = (int8_t)(next() & 0xFFu);
+            for (o = 0; o < n_out; ++o)
+                b[o] = (int32_t)(next() % 2000001u) - 1000000;
+            for (r = 0; r < rows; ++r)
+                for (o = 0; o < n_out; ++o)
+                {
+                    int32_t s = b[o];
+                    for (i = 0; i < n_in; ++i)
+                        s += (int32_t)in[r * n_in + i] * (int32_t)w[i * n_out + o];
+                    ref[r * n_out + o] = s;
+                }
+            memset(got, 0x5A, sizeof got);
+            lidet__nn_acc_s8_list(in, rows, n_in, w, b, n_out, got);
+            TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+        }
 }
 
 static void test_kernels_agree_at_the_extremes(void)
@@ -361,6 +399,7 @@ int main(void)
     RUN_TEST(test_fused_pass_equals_acc_then_requant_or_max);
     RUN_TEST(test_first_layer_in_one_pass);
     RUN_TEST(test_kernels_agree_at_the_extremes);
+    RUN_TEST(test_list_kernel_on_large_layers);
     RUN_TEST(test_requant_equals_the_int64_rule);
     RUN_TEST(test_requant_rows_and_channels_agree);
     RUN_TEST(test_s16_layer_and_max_agree);

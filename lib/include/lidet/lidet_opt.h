@@ -269,30 +269,33 @@
  * that they agree). */
 /** four points share each weight row, output-inner: what host compilers vectorise */
 #define LIDET_NN_S8_KERNEL_ROWS4 10
-/** the plain output-inner loop: ARMv6-M (Cortex-M0+: 8 low registers, no multiply-accumulate) */
+/** the plain output-inner loop (ARMv6-M's former default: 8 low registers, no multiply-accumulate) */
 #define LIDET_NN_S8_KERNEL_COLS 11
 /** 2 x 2 (points x output channels) accumulators in registers, two multiply-adds per SMLAD: Arm DSP extension */
 #define LIDET_NN_S8_KERNEL_DSP 12
 /** 2 x 2 accumulators in registers: 32-bit Arm without the DSP extension (Cortex-M3) */
 #define LIDET_NN_S8_KERNEL_R2O2 13
-/** 4 x 2 accumulators in registers: RV32 (more registers) */
+/** 4 x 2 accumulators in registers (RV32's former default) */
 #define LIDET_NN_S8_KERNEL_R4O2 14
+/** one point at a time over a list of its inputs (those off a ReLU's zero point in layers of several rows), a block
+ *  of output channels in registers: cores without multiply-accumulate, RV32 (16 channels) and ARMv6-M (4) */
+#define LIDET_NN_S8_KERNEL_LIST 15
 
 /** Which of those lidet__nn_acc_s8 runs (layers with packed weights take the packed kernel instead, see
  *  LIDET_PNQ_WEIGHTS_PK). One of the LIDET_NN_S8_KERNEL_* names above. Default: the one with the fewest
- *  instructions per multiply-add on the target (counted in lib/src/nn/lidet_nn_s8.c): R4O2 on RISC-V, DSP with
- *  the Arm DSP extension, R2O2 on other 32-bit Arm but ARMv6-M, COLS on ARMv6-M (which skips the inputs at a
- *  ReLU's zero point in layers of LIDET_NN_S8_SKIP_MIN_ROWS rows or more), ROWS4 elsewhere (hosts).
+ *  instructions per multiply-add on the target (counted in lib/src/nn/lidet_nn_s8.c): LIST on RISC-V and on
+ *  ARMv6-M (which skip the inputs at a ReLU's zero point in layers of 4, ARMv6-M 8, rows or more), DSP with the
+ *  Arm DSP extension, R2O2 on other 32-bit Arm, ROWS4 elsewhere (hosts).
  *  Any kernel runs on any target (off the DSP cores the DSP one runs a C model of its three instructions). */
 #ifndef LIDET_NN_S8_KERNEL
 #if defined(__riscv)
-#define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_R4O2
+#define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_LIST
 #elif defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
 #define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_DSP
 #elif defined(__arm__) && !defined(__ARM_ARCH_6M__)
 #define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_R2O2
 #elif defined(__ARM_ARCH_6M__)
-#define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_COLS
+#define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_LIST
 #else
 #define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_ROWS4
 #endif
@@ -501,8 +504,8 @@
 #endif
 #if LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_ROWS4 && LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_COLS &&       \
     LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_DSP && LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_R2O2 &&         \
-    LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_R4O2
-#error "LIDET_NN_S8_KERNEL must be one of LIDET_NN_S8_KERNEL_ROWS4, _COLS, _DSP, _R2O2, _R4O2"
+    LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_R4O2 && LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_LIST
+#error "LIDET_NN_S8_KERNEL must be one of LIDET_NN_S8_KERNEL_ROWS4, _COLS, _DSP, _R2O2, _R4O2, _LIST"
 #endif
 #if LIDET_PNQ_WEIGHTS_PK != 0 && LIDET_PNQ_WEIGHTS_PK != 1
 #error "LIDET_PNQ_WEIGHTS_PK must be 0 or 1"

@@ -26,6 +26,10 @@ void lidet__nn_acc_s8_r2o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
                            const int32_t *b, uint32_t n_out, int32_t *acc);
 void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, int32_t *acc);
+/* one point at a time, a block of output channels in registers, over a list of its inputs (those off -128 in layers
+ * of several rows): cores without multiply-accumulate (RV32, ARMv6-M) */
+void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                           const int32_t *b, uint32_t n_out, int32_t *acc);
 void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, uint32_t w_stride, int32_t *acc,
                            uint32_t a_stride);
