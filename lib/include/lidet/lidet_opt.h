@@ -273,28 +273,25 @@
 #define LIDET_NN_S8_KERNEL_COLS 11
 /** 2 x 2 (points x output channels) accumulators in registers, two multiply-adds per SMLAD: Arm DSP extension */
 #define LIDET_NN_S8_KERNEL_DSP 12
-/** 2 x 2 accumulators in registers: 32-bit Arm without the DSP extension (Cortex-M3) */
+/** 2 x 2 accumulators in registers (the former default of 32-bit Arm without the DSP extension, Cortex-M3) */
 #define LIDET_NN_S8_KERNEL_R2O2 13
 /** 4 x 2 accumulators in registers (RV32's former default) */
 #define LIDET_NN_S8_KERNEL_R4O2 14
 /** one point at a time over a list of its inputs (those off a ReLU's zero point in layers of several rows), a block
- *  of output channels in registers: cores without multiply-accumulate, RV32 (16 channels) and ARMv6-M (4) */
+ *  of output channels in registers: cores without the Arm DSP extension, RV32 (16 channels), 32-bit Arm (8),
+ *  ARMv6-M (4) */
 #define LIDET_NN_S8_KERNEL_LIST 15
 
 /** Which of those lidet__nn_acc_s8 runs (layers with packed weights take the packed kernel instead, see
  *  LIDET_PNQ_WEIGHTS_PK). One of the LIDET_NN_S8_KERNEL_* names above. Default: the one with the fewest
- *  instructions per multiply-add on the target (counted in lib/src/nn/lidet_nn_s8.c): LIST on RISC-V and on
- *  ARMv6-M (which skip the inputs at a ReLU's zero point in layers of 4, ARMv6-M 8, rows or more), DSP with the
- *  Arm DSP extension, R2O2 on other 32-bit Arm, ROWS4 elsewhere (hosts).
+ *  instructions per scan on the target (lib/src/nn/lidet_nn_s8.c counts them per multiply-add): DSP with the Arm
+ *  DSP extension, LIST on other 32-bit Arm, ARMv6-M and RISC-V (which skips the inputs at a ReLU's zero point in
+ *  layers of 4 rows or more, ARMv6-M 2), ROWS4 elsewhere (hosts).
  *  Any kernel runs on any target (off the DSP cores the DSP one runs a C model of its three instructions). */
 #ifndef LIDET_NN_S8_KERNEL
-#if defined(__riscv)
-#define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_LIST
-#elif defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
+#if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP
 #define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_DSP
-#elif defined(__arm__) && !defined(__ARM_ARCH_6M__)
-#define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_R2O2
-#elif defined(__ARM_ARCH_6M__)
+#elif defined(__riscv) || defined(__arm__)
 #define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_LIST
 #else
 #define LIDET_NN_S8_KERNEL LIDET_NN_S8_KERNEL_ROWS4

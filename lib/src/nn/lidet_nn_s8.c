@@ -63,23 +63,24 @@ LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, u
     }
 }
 
-/* The accumulation has four kernels with the same results (int32 sums of exact products: the order does not
+/* The accumulation has several kernels with the same results (int32 sums of exact products: the order does not
  * matter): lidet__nn_acc_s8_rows4 above (four rows share each weight row, output-inner and unit-stride: what
  * host compilers vectorise, with an AVX2 clone on x86-64), the plain output-inner loop on a column slice (the
- * blocked kernels' leftovers), and two register-blocked ones for 32-bit cores, which keep 2 x 2 or 4 x 2 (points x output channels) accumulators in registers and
- * load each weight once per block of points: 2.75 instead of 4.5 instructions per multiply-add on a Cortex-M3
- * (2 x 2), 3.5 instead of 6 on RV32IM (4 x 2, more registers), counted in the compilers' inner loops.
- * ARMv6-M (Cortex-M0+: 8 low registers, no multiply-accumulate) takes the plain output-inner loop (two
- * inputs per pass: 6 instructions per multiply-add, rows4 costs more there), and for layers of 8 rows or more
- * (the shared layers' blocks of points) its form that skips the inputs at a ReLU's zero point, -128
- * (lidet__nn_acc_s8_skip: 5.5 instructions per multiply-add left, 40-50 % of them skipped). Cores with the DSP extension
- * (Cortex-M4, M7, M33 with DSP: __ARM_FEATURE_DSP) take lidet__nn_acc_s8_dsp below, two multiply-adds per
- * SMLAD. LIDET_NN_S8_KERNEL (lidet_opt.h) picks one by name: LIDET_NN_S8_KERNEL_ROWS4 (rows4), _COLS
- * (output-inner), _DSP, _R2O2 (2 x 2) or _R4O2 (4 x 2); its default is the target's as above. Layers whose model
- * carries the packed int16 copy of the weights (w_pk: the generated models on DSP cores) take the packed kernel
- * and the fused pass further below instead (about 0.75 instead of 1.5 instructions per multiply-add).
- * tests/unit/test_nn_s8.c checks that all agree (on the host the DSP kernels run on a C model of the three
- * instructions they use). */
+ * blocked kernels' leftovers), two register-blocked ones for 32-bit cores, which keep 2 x 2 or 4 x 2 (points x
+ * output channels) accumulators in registers and load each weight once per block of points (2.75 instead of 4.5
+ * instructions per multiply-add on a Cortex-M3, 3.5 instead of 6 on RV32IM, counted in the compilers' inner
+ * loops), the form of the output-inner loop that skips the inputs at a ReLU's zero point, -128
+ * (lidet__nn_acc_s8_skip: 5.5 instructions per multiply-add on ARMv6-M, 40-50 % of them skipped), and the list
+ * kernel below, the default of the cores without the DSP extension: one point at a time over the list of its
+ * inputs off -128, a block of output channels' sums in registers (per multiply-add left: 3.3 instructions on
+ * RV32IM, 3.0 on a Cortex-M3, 4.25 on ARMv6-M). Cores with the DSP extension (Cortex-M4, M7, M33 with DSP:
+ * __ARM_FEATURE_DSP) take lidet__nn_acc_s8_dsp below, two multiply-adds per SMLAD. LIDET_NN_S8_KERNEL
+ * (lidet_opt.h) picks one by name: LIDET_NN_S8_KERNEL_ROWS4 (rows4), _COLS (output-inner; the skipping form for
+ * layers of LIDET_NN_S8_SKIP_MIN_ROWS rows or more), _DSP, _R2O2 (2 x 2), _R4O2 (4 x 2) or _LIST; its default is
+ * the target's as above. Layers whose model carries the packed int16 copy of the weights (w_pk: the generated
+ * models on DSP cores) take the packed kernel and the fused pass further below instead (about 0.75 instead of 1.5
+ * instructions per multiply-add). tests/unit/test_nn_s8.c checks that all agree (on the host the DSP kernels run
+ * on a C model of the three instructions they use). */
 
 void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, int32_t *acc)
@@ -126,22 +127,28 @@ void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
     }
 }
 
-/* The list kernel, for cores without multiply-accumulate (RV32IM, ARMv6-M): one point at a time, a block of output
- * channels' sums in registers over a list of the point's inputs, each entry the offset of its weight row and its
- * value. In layers of enough rows the list holds only the inputs off -128 (a ReLU's zero point: 40-50 % of a
- * hidden layer's), with u = x + 128 and the bias less 128 sum w (lidet__nn_acc_s8_skip's form, made once per call
+/* The list kernel, for cores without the DSP extension (RV32IM, Cortex-M3, ARMv6-M): one point at a time, a block
+ * of output channels' sums in registers over a list of the point's inputs, each entry the offset of its weight row
+ * and its value. In layers of enough rows the list holds only the inputs off -128 (a ReLU's zero point: 40-50 % of
+ * a hidden layer's), with u = x + 128 and the bias less 128 sum w (lidet__nn_acc_s8_skip's form, made once per call
  * in the first row's accumulators; every row starts from them, the first row last); in smaller layers every input
- * but the zero ones, with x and the bias. RV32IM (LIST_MIN_ROWS 4): 16 channels, per entry 2 loads, an add, 16 LB,
- * 16 MUL, 16 ADD, the pointer's add and the branch: 53 instructions per 16 multiply-adds (3.3; R4O2: 3.5 per
- * multiply-add, none skipped). ARMv6-M (LIST_MIN_ROWS 8, smaller layers take lidet__nn_acc_s8_cols): 4 channels in
- * high registers, per entry 2 loads, 4 LDRSB (register offset, the row's offset against 4 channels' bases), 4 MULS,
- * 4 ADD and 3 for the loop: 17 instructions per 4 multiply-adds (4.25; the skip kernel's loop: 5.5). Exact integer
- * sums: the same results as the other kernels. */
+ * but the zero ones, with x and the bias. Per entry, in the compilers' inner loops: RV32IM, 16 channels: 2 loads,
+ * an add, 16 LB, 16 MUL, 16 ADD, the pointer's add and the branch, 53 instructions per 16 multiply-adds (3.3; R4O2:
+ * 3.5 per multiply-add, none skipped). Cortex-M3, 8 channels: 2 loads, an add, 8 LDRSB and 8 MLA, 5 for the loop,
+ * 24 per 8 (3.0; R2O2: 2.75, none skipped). ARMv6-M, 4 channels in high registers (Thumb-1 assembly): 2 loads, 4
+ * LDRSB (register offset, the row's offset against 4 channels' bases), 4 MULS, 4 ADD and 3 for the loop, 17 per 4
+ * (4.25; the skip kernel's loop: 5.5). Exact integer sums: the same results as the other kernels. */
 #define LIST_CHUNK 64u /* inputs per list: 256 bytes of stack */
 #if defined(__ARM_ARCH_6M__)
-#define LIST_MIN_ROWS LIDET_NN_S8_SKIP_MIN_ROWS
+#define LIST_MIN_ROWS 2u /* ARMv6-M: 8 and 4 gave 1.0 % and 0.03 % more instructions per scan */
 #else
 #define LIST_MIN_ROWS 4u /* fewest rows that skip (RV32: 8 and 2 gave 0.04 % more instructions per scan) */
+#endif
+/* 16 channels a pass where the core has the registers (RV32: 31), else 8 (32-bit Arm: 13) */
+#if defined(__arm__)
+#define LIST_W16 0
+#else
+#define LIST_W16 1
 #endif
 /* the Thumb-1 assembly loop (GCC: its inline assembly is in divided syntax unless -masm-syntax-unified) */
 #if defined(__ARM_ARCH_6M__) && defined(__GNUC__) && !defined(__clang__) && LIDET_NN_PK_ASM
@@ -182,7 +189,7 @@ S8_ALWAYS_INLINE list_ent_t *list_make(const int8_t *x, uint32_t n, uint32_t off
 #define LIST_NO_SCHED
 #endif
 
-#if !LIST_T1_ASM
+#if LIST_W16
 /* a[0..15] = c[0..15] + sum over the entries e of e.v * w[e.off + 0..15] (a may be c; e != end) */
 LIST_NO_SCHED static void list_run16(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
                                      const int32_t *c, int32_t *a)
@@ -229,6 +236,36 @@ LIST_NO_SCHED static void list_run16(const list_ent_t *e, const list_ent_t *end,
     a[15] = s15;
 }
 
+#endif
+
+#if !LIST_T1_ASM
+/* the same for 8 channels */
+LIST_NO_SCHED static void list_run8(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
+                                    const int32_t *c, int32_t *a)
+{
+    int32_t s0 = c[0], s1 = c[1], s2 = c[2], s3 = c[3], s4 = c[4], s5 = c[5], s6 = c[6], s7 = c[7];
+    do
+    {
+        const int8_t *p = w + e->off;
+        const int32_t v = e->v;
+        s0 += v * p[0];
+        s1 += v * p[1];
+        s2 += v * p[2];
+        s3 += v * p[3];
+        s4 += v * p[4];
+        s5 += v * p[5];
+        s6 += v * p[6];
+        s7 += v * p[7];
+    } while (++e != end);
+    a[0] = s0;
+    a[1] = s1;
+    a[2] = s2;
+    a[3] = s3;
+    a[4] = s4;
+    a[5] = s5;
+    a[6] = s6;
+    a[7] = s7;
+}
 #endif
 
 /* the same for 4 channels (e != end; on ARMv6-M the entries' v must be u = x + 128, 1..255: LDRH) */
@@ -297,10 +334,16 @@ static void list_row(const list_ent_t *e, const list_ent_t *end, const int8_t *w
         }
         return;
     }
-#if !LIST_T1_ASM
+#if LIST_W16
     for (; o + 16u <= n_out; o += 16u)
     {
         list_run16(e, end, w_t + o, c + o, a + o);
+    }
+#endif
+#if !LIST_T1_ASM
+    for (; o + 8u <= n_out; o += 8u)
+    {
+        list_run8(e, end, w_t + o, c + o, a + o);
     }
 #endif
     for (; o + 4u <= n_out; o += 4u)
@@ -319,7 +362,7 @@ static void list_row(const list_ent_t *e, const list_ent_t *end, const int8_t *w
     }
 }
 
-#if !LIST_T1_ASM
+#if LIST_W16
 /* a[0..15] = b[0..15] - 128 sum_i w[i n_out + 0..15], i < n_in: the skipping rows' starting sums (a load and an add
  * per weight) */
 LIST_NO_SCHED static void list_bias16(const int8_t *w, uint32_t n_in, uint32_t n_out, const int32_t *b,
@@ -367,6 +410,35 @@ LIST_NO_SCHED static void list_bias16(const int8_t *w, uint32_t n_in, uint32_t n
 
 #endif
 
+#if !LIST_T1_ASM
+/* the same for 8 channels */
+LIST_NO_SCHED static void list_bias8(const int8_t *w, uint32_t n_in, uint32_t n_out, const int32_t *b,
+                                     int32_t *a)
+{
+    int32_t s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0;
+    const int8_t *const end = w + n_in * n_out;
+    for (; w != end; w += n_out)
+    {
+        s0 += w[0];
+        s1 += w[1];
+        s2 += w[2];
+        s3 += w[3];
+        s4 += w[4];
+        s5 += w[5];
+        s6 += w[6];
+        s7 += w[7];
+    }
+    a[0] = b[0] - s0 * 128;
+    a[1] = b[1] - s1 * 128;
+    a[2] = b[2] - s2 * 128;
+    a[3] = b[3] - s3 * 128;
+    a[4] = b[4] - s4 * 128;
+    a[5] = b[5] - s5 * 128;
+    a[6] = b[6] - s6 * 128;
+    a[7] = b[7] - s7 * 128;
+}
+#endif
+
 /* acc[0..n_out) = b - 128 sum_i w[i n_out + o] */
 static void list_bias(const int8_t *w_t, uint32_t n_in, const int32_t *b, uint32_t n_out, int32_t *acc,
                       list_ent_t *list)
@@ -395,9 +467,15 @@ static void list_bias(const int8_t *w_t, uint32_t n_in, const int32_t *b, uint32
     }
 #else
     (void)list;
+#if LIST_W16
     for (; o + 16u <= n_out; o += 16u)
     {
         list_bias16(w_t + o, n_in, n_out, b + o, acc + o);
+    }
+#endif
+    for (; o + 8u <= n_out; o += 8u)
+    {
+        list_bias8(w_t + o, n_in, n_out, b + o, acc + o);
     }
     for (; o < n_out; ++o)
     {
