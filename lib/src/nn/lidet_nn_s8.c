@@ -150,6 +150,13 @@ void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
 #else
 #define LIST_W16 1
 #endif
+/* the 8-channel loop in Thumb-2 assembly (GCC, 32-bit Arm without the DSP extension) */
+#if defined(__thumb2__) && !(defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP) && defined(__GNUC__) &&        \
+    !defined(__clang__) && LIDET_NN_PK_ASM
+#define LIST_T2_ASM 1
+#else
+#define LIST_T2_ASM 0
+#endif
 /* the Thumb-1 assembly loop (GCC: its inline assembly is in divided syntax unless -masm-syntax-unified) */
 #if defined(__ARM_ARCH_6M__) && defined(__GNUC__) && !defined(__clang__) && LIDET_NN_PK_ASM
 #define LIST_T1_ASM 1
@@ -238,12 +245,97 @@ LIST_NO_SCHED static void list_run16(const list_ent_t *e, const list_ent_t *end,
 
 #endif
 
-#if !LIST_T1_ASM
-/* the same for 8 channels */
+/* the same for 8 channels (ARMv6-M: the list ends in an entry of v = 0 at end, u being 1..255) */
 LIST_NO_SCHED static void list_run8(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
                                     const int32_t *c, int32_t *a)
 {
     int32_t s0 = c[0], s1 = c[1], s2 = c[2], s3 = c[3], s4 = c[4], s5 = c[5], s6 = c[6], s7 = c[7];
+#if LIST_T1_ASM
+    const int8_t *const w4 = w + 4;
+    uint32_t u, off;
+    (void)end;
+    /* channels k and k + 4 from the bases w and w + 4, the offset stepped by one between; five sums in high
+     * registers (GCC gives no more), two in low ones and s4 in LR (its own register the product's meanwhile); no
+     * register left for the end: the loop stops on the entry of u = 0 (per entry 33 instructions, 1 fewer than two
+     * passes of list_run4, and half the passes) */
+    __asm__ volatile(
+        ".syntax unified\n\t"
+        "mov lr, %[s4]\n\t"
+        "1:\n\t"
+        "ldrh %[u], [%[e], #2]\n\t"
+        "cmp %[u], #0\n\t"
+        "beq 2f\n\t"
+        "ldrh %[off], [%[e], #0]\n\t"
+        "ldrsb %[s4], [%[w0], %[off]]\n\t"
+        "muls %[s4], %[u], %[s4]\n\t"
+        "add %[s0], %[s4]\n\t"
+        "ldrsb %[s4], [%[w4], %[off]]\n\t"
+        "muls %[s4], %[u], %[s4]\n\t"
+        "add lr, %[s4]\n\t"
+        "adds %[off], %[off], #1\n\t"
+        "ldrsb %[s4], [%[w0], %[off]]\n\t"
+        "muls %[s4], %[u], %[s4]\n\t"
+        "add %[s1], %[s4]\n\t"
+        "ldrsb %[s4], [%[w4], %[off]]\n\t"
+        "muls %[s4], %[u], %[s4]\n\t"
+        "add %[s5], %[s4]\n\t"
+        "adds %[off], %[off], #1\n\t"
+        "ldrsb %[s4], [%[w0], %[off]]\n\t"
+        "muls %[s4], %[u], %[s4]\n\t"
+        "add %[s2], %[s4]\n\t"
+        "ldrsb %[s4], [%[w4], %[off]]\n\t"
+        "muls %[s4], %[u], %[s4]\n\t"
+        "adds %[s6], %[s6], %[s4]\n\t"
+        "adds %[off], %[off], #1\n\t"
+        "ldrsb %[s4], [%[w0], %[off]]\n\t"
+        "muls %[s4], %[u], %[s4]\n\t"
+        "add %[s3], %[s4]\n\t"
+        "ldrsb %[s4], [%[w4], %[off]]\n\t"
+        "muls %[s4], %[u], %[s4]\n\t"
+        "adds %[s7], %[s7], %[s4]\n\t"
+        "adds %[e], %[e], #4\n\t"
+        "b 1b\n\t"
+        "2:\n\t"
+        "mov %[s4], lr\n\t"
+#if !defined(__ARM_ASM_SYNTAX_UNIFIED__)
+        ".syntax divided\n\t"
+#endif
+        : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [s5] "+h"(s5), [s4] "+l"(s4),
+          [s6] "+l"(s6), [s7] "+l"(s7), [e] "+l"(e), [u] "=&l"(u), [off] "=&l"(off)
+        : [w0] "l"(w), [w4] "l"(w4)
+        : "cc", "memory", "lr");
+#elif LIST_T2_ASM
+    uint32_t v, p, t;
+    /* the 14 registers: 8 sums, the entry, its end, the weights, the value, the row and the weight (GCC: 24
+     * instructions per entry, the end reloaded from the stack) */
+    __asm__ volatile(
+        "1:\n\t"
+        "ldrh %[p], [%[e]], #4\n\t"
+        "ldrsh %[v], [%[e], #-2]\n\t"
+        "add %[p], %[w], %[p]\n\t"
+        "ldrsb %[t], [%[p]]\n\t"
+        "mla %[s0], %[v], %[t], %[s0]\n\t"
+        "ldrsb %[t], [%[p], #1]\n\t"
+        "mla %[s1], %[v], %[t], %[s1]\n\t"
+        "ldrsb %[t], [%[p], #2]\n\t"
+        "mla %[s2], %[v], %[t], %[s2]\n\t"
+        "ldrsb %[t], [%[p], #3]\n\t"
+        "mla %[s3], %[v], %[t], %[s3]\n\t"
+        "ldrsb %[t], [%[p], #4]\n\t"
+        "mla %[s4], %[v], %[t], %[s4]\n\t"
+        "ldrsb %[t], [%[p], #5]\n\t"
+        "mla %[s5], %[v], %[t], %[s5]\n\t"
+        "ldrsb %[t], [%[p], #6]\n\t"
+        "mla %[s6], %[v], %[t], %[s6]\n\t"
+        "ldrsb %[t], [%[p], #7]\n\t"
+        "mla %[s7], %[v], %[t], %[s7]\n\t"
+        "cmp %[e], %[end]\n\t"
+        "bne 1b\n\t"
+        : [s0] "+r"(s0), [s1] "+r"(s1), [s2] "+r"(s2), [s3] "+r"(s3), [s4] "+r"(s4), [s5] "+r"(s5),
+          [s6] "+r"(s6), [s7] "+r"(s7), [e] "+r"(e), [v] "=&r"(v), [p] "=&r"(p), [t] "=&r"(t)
+        : [w] "r"(w), [end] "r"(end)
+        : "cc", "memory");
+#else
     do
     {
         const int8_t *p = w + e->off;
@@ -257,6 +349,7 @@ LIST_NO_SCHED static void list_run8(const list_ent_t *e, const list_ent_t *end, 
         s6 += v * p[6];
         s7 += v * p[7];
     } while (++e != end);
+#endif
     a[0] = s0;
     a[1] = s1;
     a[2] = s2;
@@ -266,7 +359,6 @@ LIST_NO_SCHED static void list_run8(const list_ent_t *e, const list_ent_t *end, 
     a[6] = s6;
     a[7] = s7;
 }
-#endif
 
 /* the same for 4 channels (e != end; on ARMv6-M the entries' v must be u = x + 128, 1..255: LDRH) */
 S8_ALWAYS_INLINE void list_run4(const list_ent_t *e, const list_ent_t *end, const int8_t *w, const int32_t *c,
@@ -340,12 +432,10 @@ static void list_row(const list_ent_t *e, const list_ent_t *end, const int8_t *w
         list_run16(e, end, w_t + o, c + o, a + o);
     }
 #endif
-#if !LIST_T1_ASM
     for (; o + 8u <= n_out; o += 8u)
     {
         list_run8(e, end, w_t + o, c + o, a + o);
     }
-#endif
     for (; o + 4u <= n_out; o += 4u)
     {
         list_run4(e, end, w_t + o, c + o, a + o);
@@ -459,6 +549,7 @@ static void list_bias(const int8_t *w_t, uint32_t n_in, const int32_t *b, uint32
             list[i].off = (uint16_t)((i0 + i) * n_out);
             list[i].v = 128;
         }
+        list[n].v = 0; /* the end's mark */
         list_row(list, list + n, w_t, acc, n_out, acc);
     }
     for (o = 0; o < n_out; ++o)
@@ -492,7 +583,7 @@ static void list_bias(const int8_t *w_t, uint32_t n_in, const int32_t *b, uint32
 void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, int32_t *acc)
 {
-    list_ent_t list[LIST_CHUNK];
+    list_ent_t list[LIST_CHUNK + 1u]; /* and the end's mark */
     const int skip = n_rows >= LIST_MIN_ROWS;
     uint32_t r, i0;
     if (n_in * n_out > 65536u || (LIST_T1_ASM && !skip)) /* offsets past 16 bits; ARMv6-M: u only */
@@ -519,8 +610,11 @@ void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
         for (i0 = 0; i0 < n_in; i0 += LIST_CHUNK)
         {
             const uint32_t n = n_in - i0 < LIST_CHUNK ? n_in - i0 : LIST_CHUNK;
-            const list_ent_t *const end = skip ? list_make(x + i0, n, i0 * n_out, n_out, 128, list)
-                                               : list_make(x + i0, n, i0 * n_out, n_out, 0, list);
+            list_ent_t *const end = skip ? list_make(x + i0, n, i0 * n_out, n_out, 128, list)
+                                         : list_make(x + i0, n, i0 * n_out, n_out, 0, list);
+#if LIST_T1_ASM
+            end->v = 0; /* the end's mark */
+#endif
             list_row(list, end, w_t, i0 == 0u ? (skip ? acc : b) : a, n_out, a);
         }
     }
