@@ -198,8 +198,8 @@ S8_ALWAYS_INLINE list_ent_t *list_make(const int8_t *x, uint32_t n, uint32_t off
 
 #if LIST_W16
 /* a[0..15] = c[0..15] + sum over the entries e of e.v * w[e.off + 0..15] (a may be c; e != end) */
-LIST_NO_SCHED static void list_run16(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
-                                     const int32_t *c, int32_t *a)
+S8_ALWAYS_INLINE void list_run16_body(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
+                                      const int32_t *c, int32_t *a, const int fold)
 {
     int32_t s0 = c[0], s1 = c[1], s2 = c[2], s3 = c[3], s4 = c[4], s5 = c[5], s6 = c[6], s7 = c[7];
     int32_t s8 = c[8], s9 = c[9], s10 = c[10], s11 = c[11], s12 = c[12], s13 = c[13], s14 = c[14],
@@ -225,29 +225,64 @@ LIST_NO_SCHED static void list_run16(const list_ent_t *e, const list_ent_t *end,
         s14 += v * p[14];
         s15 += v * p[15];
     } while (++e != end);
-    a[0] = s0;
-    a[1] = s1;
-    a[2] = s2;
-    a[3] = s3;
-    a[4] = s4;
-    a[5] = s5;
-    a[6] = s6;
-    a[7] = s7;
-    a[8] = s8;
-    a[9] = s9;
-    a[10] = s10;
-    a[11] = s11;
-    a[12] = s12;
-    a[13] = s13;
-    a[14] = s14;
-    a[15] = s15;
+    if (fold) /* into the running maximum */
+    {
+        a[0] = a[0] > s0 ? a[0] : s0;
+        a[1] = a[1] > s1 ? a[1] : s1;
+        a[2] = a[2] > s2 ? a[2] : s2;
+        a[3] = a[3] > s3 ? a[3] : s3;
+        a[4] = a[4] > s4 ? a[4] : s4;
+        a[5] = a[5] > s5 ? a[5] : s5;
+        a[6] = a[6] > s6 ? a[6] : s6;
+        a[7] = a[7] > s7 ? a[7] : s7;
+        a[8] = a[8] > s8 ? a[8] : s8;
+        a[9] = a[9] > s9 ? a[9] : s9;
+        a[10] = a[10] > s10 ? a[10] : s10;
+        a[11] = a[11] > s11 ? a[11] : s11;
+        a[12] = a[12] > s12 ? a[12] : s12;
+        a[13] = a[13] > s13 ? a[13] : s13;
+        a[14] = a[14] > s14 ? a[14] : s14;
+        a[15] = a[15] > s15 ? a[15] : s15;
+    }
+    else
+    {
+        a[0] = s0;
+        a[1] = s1;
+        a[2] = s2;
+        a[3] = s3;
+        a[4] = s4;
+        a[5] = s5;
+        a[6] = s6;
+        a[7] = s7;
+        a[8] = s8;
+        a[9] = s9;
+        a[10] = s10;
+        a[11] = s11;
+        a[12] = s12;
+        a[13] = s13;
+        a[14] = s14;
+        a[15] = s15;
+    }
+}
+
+LIST_NO_SCHED static void list_run16(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
+                                     const int32_t *c, int32_t *a)
+{
+    list_run16_body(e, end, w, c, a, 0);
+}
+
+/* the same, a[k] the larger of itself and the sum (the last shared layer's maximum) */
+LIST_NO_SCHED static void list_run16_max(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
+                                         const int32_t *c, int32_t *a)
+{
+    list_run16_body(e, end, w, c, a, 1);
 }
 
 #endif
 
 /* the same for 8 channels (ARMv6-M: the list ends in an entry of v = 0 at end, u being 1..255) */
-LIST_NO_SCHED static void list_run8(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
-                                    const int32_t *c, int32_t *a)
+S8_ALWAYS_INLINE void list_run8_body(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
+                                     const int32_t *c, int32_t *a, const int fold)
 {
     int32_t s0 = c[0], s1 = c[1], s2 = c[2], s3 = c[3], s4 = c[4], s5 = c[5], s6 = c[6], s7 = c[7];
 #if LIST_T1_ASM
@@ -350,19 +385,46 @@ LIST_NO_SCHED static void list_run8(const list_ent_t *e, const list_ent_t *end, 
         s7 += v * p[7];
     } while (++e != end);
 #endif
-    a[0] = s0;
-    a[1] = s1;
-    a[2] = s2;
-    a[3] = s3;
-    a[4] = s4;
-    a[5] = s5;
-    a[6] = s6;
-    a[7] = s7;
+    if (fold) /* into the running maximum */
+    {
+        a[0] = a[0] > s0 ? a[0] : s0;
+        a[1] = a[1] > s1 ? a[1] : s1;
+        a[2] = a[2] > s2 ? a[2] : s2;
+        a[3] = a[3] > s3 ? a[3] : s3;
+        a[4] = a[4] > s4 ? a[4] : s4;
+        a[5] = a[5] > s5 ? a[5] : s5;
+        a[6] = a[6] > s6 ? a[6] : s6;
+        a[7] = a[7] > s7 ? a[7] : s7;
+    }
+    else
+    {
+        a[0] = s0;
+        a[1] = s1;
+        a[2] = s2;
+        a[3] = s3;
+        a[4] = s4;
+        a[5] = s5;
+        a[6] = s6;
+        a[7] = s7;
+    }
+}
+
+LIST_NO_SCHED static void list_run8(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
+                                    const int32_t *c, int32_t *a)
+{
+    list_run8_body(e, end, w, c, a, 0);
+}
+
+/* the same, a[k] the larger of itself and the sum (the last shared layer's maximum) */
+LIST_NO_SCHED static void list_run8_max(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
+                                        const int32_t *c, int32_t *a)
+{
+    list_run8_body(e, end, w, c, a, 1);
 }
 
 /* the same for 4 channels (e != end; on ARMv6-M the entries' v must be u = x + 128, 1..255: LDRH) */
 S8_ALWAYS_INLINE void list_run4(const list_ent_t *e, const list_ent_t *end, const int8_t *w, const int32_t *c,
-                                int32_t *a)
+                                int32_t *a, int fold)
 {
     int32_t s0 = c[0], s1 = c[1], s2 = c[2], s3 = c[3];
 #if LIST_T1_ASM
@@ -407,38 +469,63 @@ S8_ALWAYS_INLINE void list_run4(const list_ent_t *e, const list_ent_t *end, cons
         s3 += v * p[3];
     } while (++e != end);
 #endif
-    a[0] = s0;
-    a[1] = s1;
-    a[2] = s2;
-    a[3] = s3;
+    if (fold) /* into the running maximum */
+    {
+        a[0] = a[0] > s0 ? a[0] : s0;
+        a[1] = a[1] > s1 ? a[1] : s1;
+        a[2] = a[2] > s2 ? a[2] : s2;
+        a[3] = a[3] > s3 ? a[3] : s3;
+    }
+    else
+    {
+        a[0] = s0;
+        a[1] = s1;
+        a[2] = s2;
+        a[3] = s3;
+    }
 }
 
-/* one row: a[o] = c[o] + sum over the entries of v w[off + o], o < n_out (a may be c) */
-static void list_row(const list_ent_t *e, const list_ent_t *end, const int8_t *w_t, const int32_t *c,
-                     uint32_t n_out, int32_t *a)
+/* one row: a[o] = c[o] + sum over the entries of v w[off + o], o < n_out (a may be c); fold: a[o] the larger of
+ * itself and that */
+S8_ALWAYS_INLINE void list_row_body(const list_ent_t *e, const list_ent_t *end, const int8_t *w_t,
+                                    const int32_t *c, uint32_t n_out, int32_t *a, const int fold)
 {
     uint32_t o = 0;
     if (e == end) /* nothing to add */
     {
         for (; o < n_out; ++o)
         {
-            a[o] = c[o];
+            a[o] = fold && a[o] > c[o] ? a[o] : c[o];
         }
         return;
     }
 #if LIST_W16
     for (; o + 16u <= n_out; o += 16u)
     {
-        list_run16(e, end, w_t + o, c + o, a + o);
+        if (fold)
+        {
+            list_run16_max(e, end, w_t + o, c + o, a + o);
+        }
+        else
+        {
+            list_run16(e, end, w_t + o, c + o, a + o);
+        }
     }
 #endif
     for (; o + 8u <= n_out; o += 8u)
     {
-        list_run8(e, end, w_t + o, c + o, a + o);
+        if (fold)
+        {
+            list_run8_max(e, end, w_t + o, c + o, a + o);
+        }
+        else
+        {
+            list_run8(e, end, w_t + o, c + o, a + o);
+        }
     }
     for (; o + 4u <= n_out; o += 4u)
     {
-        list_run4(e, end, w_t + o, c + o, a + o);
+        list_run4(e, end, w_t + o, c + o, a + o, fold);
     }
     for (; o < n_out; ++o)
     {
@@ -448,8 +535,20 @@ static void list_row(const list_ent_t *e, const list_ent_t *end, const int8_t *w
         {
             s += f->v * (int32_t)w_t[f->off + o];
         }
-        a[o] = s;
+        a[o] = fold && a[o] > s ? a[o] : s;
     }
+}
+
+static void list_row(const list_ent_t *e, const list_ent_t *end, const int8_t *w_t, const int32_t *c,
+                     uint32_t n_out, int32_t *a)
+{
+    list_row_body(e, end, w_t, c, n_out, a, 0);
+}
+
+static void list_row_max(const list_ent_t *e, const list_ent_t *end, const int8_t *w_t, const int32_t *c,
+                         uint32_t n_out, int32_t *a)
+{
+    list_row_body(e, end, w_t, c, n_out, a, 1);
 }
 
 #if LIST_W16
@@ -580,13 +679,58 @@ static void list_bias(const int8_t *w_t, uint32_t n_in, const int32_t *b, uint32
 #endif
 }
 
-void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                           const int32_t *b, uint32_t n_out, int32_t *acc)
+/* lidet__nn_acc_s8_list, or (vmax != NULL, skipping rows only) each row's sums folded into vmax, acc scratch */
+static void acc_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
+                     uint32_t n_out, int32_t *acc, int32_t *vmax)
 {
     list_ent_t list[LIST_CHUNK + 1u]; /* and the end's mark */
     const int skip = n_rows >= LIST_MIN_ROWS;
     uint32_t r, i0;
-    if (n_in * n_out > 65536u || (LIST_T1_ASM && !skip)) /* offsets past 16 bits; ARMv6-M: u only */
+    if (skip) /* the first row's accumulators: b - 128 sum w */
+    {
+        list_bias(w_t, n_in, b, n_out, acc, list);
+    }
+    for (r = n_rows; r-- > 0u;) /* the last row first: row 0 keeps the starting sums until the end */
+    {
+        const int8_t *x = in + r * n_in;
+        /* folded: the sums of a row of several lists in row 1 (free: no row is written) */
+        int32_t *a = vmax != 0 ? acc + n_out : acc + r * n_out;
+        for (i0 = 0; i0 < n_in; i0 += LIST_CHUNK)
+        {
+            const uint32_t n = n_in - i0 < LIST_CHUNK ? n_in - i0 : LIST_CHUNK;
+            const int last = i0 + n == n_in;
+            list_ent_t *const end = skip ? list_make(x + i0, n, i0 * n_out, n_out, 128, list)
+                                         : list_make(x + i0, n, i0 * n_out, n_out, 0, list);
+#if LIST_T1_ASM
+            end->v = 0; /* the end's mark */
+#endif
+            const int32_t *const c = i0 == 0u ? (skip ? acc : b) : a;
+            if (vmax != 0 && last)
+            {
+                list_row_max(list, end, w_t, c, n_out, vmax);
+            }
+            else
+            {
+                list_row(list, end, w_t, c, n_out, a);
+            }
+        }
+    }
+}
+
+/* whether the list kernel takes the layer: its entries' offsets in 16 bits; ARMv6-M: u only (skipping rows) */
+static int list_fits(uint32_t n_rows, uint32_t n_in, uint32_t n_out)
+{
+    return n_in * n_out <= 65536u && (!LIST_T1_ASM || n_rows >= LIST_MIN_ROWS);
+}
+
+void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                           const int32_t *b, uint32_t n_out, int32_t *acc)
+{
+    if (n_rows == 0u)
+    {
+        return;
+    }
+    if (!list_fits(n_rows, n_in, n_out))
     {
 #if LIST_T1_ASM
         lidet__nn_acc_s8_cols(in, n_rows, n_in, w_t, b, n_out, n_out, acc, n_out);
@@ -595,29 +739,18 @@ void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
 #endif
         return;
     }
-    if (n_rows == 0u)
+    acc_list(in, n_rows, n_in, w_t, b, n_out, acc, 0);
+}
+
+int lidet__nn_acc_s8_list_max(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
+                              const int32_t *b, uint32_t n_out, int32_t *acc, int32_t *vmax)
+{
+    if (n_rows < LIST_MIN_ROWS || n_rows < 2u || !list_fits(n_rows, n_in, n_out))
     {
-        return;
+        return 0;
     }
-    if (skip) /* the first row's accumulators: b - 128 sum w */
-    {
-        list_bias(w_t, n_in, b, n_out, acc, list);
-    }
-    for (r = n_rows; r-- > 0u;) /* the last row first: row 0 keeps the starting sums until the end */
-    {
-        const int8_t *x = in + r * n_in;
-        int32_t *a = acc + r * n_out;
-        for (i0 = 0; i0 < n_in; i0 += LIST_CHUNK)
-        {
-            const uint32_t n = n_in - i0 < LIST_CHUNK ? n_in - i0 : LIST_CHUNK;
-            list_ent_t *const end = skip ? list_make(x + i0, n, i0 * n_out, n_out, 128, list)
-                                         : list_make(x + i0, n, i0 * n_out, n_out, 0, list);
-#if LIST_T1_ASM
-            end->v = 0; /* the end's mark */
-#endif
-            list_row(list, end, w_t, i0 == 0u ? (skip ? acc : b) : a, n_out, a);
-        }
-    }
+    acc_list(in, n_rows, n_in, w_t, b, n_out, acc, vmax);
+    return 1;
 }
 
 /* The DSP kernel: 2 x 2 (points x output channels) accumulators, 4 inputs per step. One 32-bit load brings 4 int8

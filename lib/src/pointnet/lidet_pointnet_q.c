@@ -384,6 +384,16 @@ static int fused_s8(const lidet_pointnet_q_layer_t *ly, const void *in, uint32_t
                                     ly->out_zp, ly->relu ? ly->out_zp : -128, dst);
         return 1;
     }
+#if LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_LIST
+    /* the last layer: its rows' sums folded into the running maximum as they are made (not written, then read) */
+    if (dst == 0 && ly->w_pk == 0 &&
+        lidet__nn_acc_s8_list_max((const int8_t *)in, nb, ly->n_in, ly->w_t, ly->b, ly->n_out, b->acc,
+                                  b->gmax))
+    {
+        b->tab->layer = 0; /* acc is written */
+        return 1;
+    }
+#endif
     if (ly->w_pk == 0)
     {
         return 0;
