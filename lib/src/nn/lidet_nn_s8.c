@@ -1930,6 +1930,9 @@ void lidet__nn_acc_s16_3_requant(const int16_t *in, uint32_t n_rows, const int8_
                                  int32_t lo, int8_t *out)
 {
     uint32_t r, o;
+    /* after a ReLU an accumulator <= 0 gives lo (as in lidet__nn_requant_s8_by_channel), where the multiply is long
+     * (ARMv6-M); a test per value costs more than the multiply it saves elsewhere (RV32IM, M3: 0.3-0.4 % more) */
+    const int relu = !LIDET_Q_HAVE_MUL64 && lo >= zp;
 #if LIDET_NN_S16_3_TABLE
     if (acc_s16_3_tab(in, n_rows, w_t, b, n_out, mult, shift, zp, lo, out))
     {
@@ -1969,7 +1972,9 @@ void lidet__nn_acc_s16_3_requant(const int16_t *in, uint32_t n_rows, const int8_
 #else
             for (r = 0; r < n_rows; ++r, x += 3, d += n_out)
             {
-                *d = rq_fast(bo + x[0] * w0 + x[1] * w1 + x[2] * w2, m, k, c);
+                const int32_t a = bo + x[0] * w0 + x[1] * w1 + x[2] * w2;
+                *d = relu && a <= 0 ? (int8_t)lo
+                                    : rq_fast(a, m, k, c); /* as lidet__nn_requant_s8_by_channel */
             }
 #endif
         }
@@ -1977,7 +1982,8 @@ void lidet__nn_acc_s16_3_requant(const int16_t *in, uint32_t n_rows, const int8_
         {
             for (r = 0; r < n_rows; ++r, x += 3, d += n_out)
             {
-                *d = rq_one(bo + x[0] * w0 + x[1] * w1 + x[2] * w2, m, sh, zp, lo);
+                const int32_t a = bo + x[0] * w0 + x[1] * w1 + x[2] * w2;
+                *d = relu && a <= 0 ? (int8_t)lo : rq_one(a, m, sh, zp, lo);
             }
         }
     }
