@@ -150,15 +150,18 @@ void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
 #else
 #define LIST_W16 1
 #endif
-/* the 8-channel loop in Thumb-2 assembly (GCC, 32-bit Arm without the DSP extension) */
+/* the 8-channel loop in Thumb-2 assembly (GCC, 32-bit Arm without the DSP extension; optimised builds: it takes 14
+ * registers, the frame pointer's among them) */
 #if defined(__thumb2__) && !(defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP) && defined(__GNUC__) &&        \
-    !defined(__clang__) && LIDET_NN_PK_ASM
+    !defined(__clang__) && defined(__OPTIMIZE__) && LIDET_NN_PK_ASM
 #define LIST_T2_ASM 1
 #else
 #define LIST_T2_ASM 0
 #endif
-/* the Thumb-1 assembly loop (GCC: its inline assembly is in divided syntax unless -masm-syntax-unified) */
-#if defined(__ARM_ARCH_6M__) && defined(__GNUC__) && !defined(__clang__) && LIDET_NN_PK_ASM
+/* the Thumb-1 assembly loops (GCC: its inline assembly is in divided syntax unless -masm-syntax-unified; optimised
+ * builds but -Os: they take the 8 low registers and 5 high ones, which GCC 12 finds at -O1, -O2, -O3, not at -Os) */
+#if defined(__ARM_ARCH_6M__) && defined(__GNUC__) && !defined(__clang__) && defined(__OPTIMIZE__) &&         \
+    !defined(__OPTIMIZE_SIZE__) && LIDET_NN_PK_ASM
 #define LIST_T1_ASM 1
 #else
 #define LIST_T1_ASM 0
