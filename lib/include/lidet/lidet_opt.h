@@ -286,7 +286,7 @@
  *  LIDET_PNQ_WEIGHTS_PK). One of the LIDET_NN_S8_KERNEL_* names above. Default: the one with the fewest
  *  instructions per scan on the target (lib/src/nn/lidet_nn_s8.c counts them per multiply-add): DSP with the Arm
  *  DSP extension, LIST on other 32-bit Arm, ARMv6-M and RISC-V (which skips the inputs at a ReLU's zero point in
- *  layers of 4 rows or more, ARMv6-M 2), ROWS4 elsewhere (hosts).
+ *  layers of 4 rows or more, ARMv6-M 3), ROWS4 elsewhere (hosts).
  *  Any kernel runs on any target (off the DSP cores the DSP one runs a C model of its three instructions). */
 #ifndef LIDET_NN_S8_KERNEL
 #if defined(__ARM_FEATURE_DSP) && __ARM_FEATURE_DSP

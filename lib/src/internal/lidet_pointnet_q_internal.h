@@ -32,7 +32,7 @@ void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
                            const int32_t *b, uint32_t n_out, int32_t *acc);
 /* the list kernel's sums of each row folded into vmax (vmax[o] = max(vmax[o], sum of row r)) instead of written, acc
  * (n_rows x n_out) its scratch: the last shared layer's accumulation and max-pooling in one pass; 0 (nothing
- * touched) where it does not apply (fewer than 4 rows, ARMv6-M 2; offsets past 16 bits) */
+ * touched) where it does not apply (fewer than 4 rows, ARMv6-M 3; offsets past 16 bits) */
 int lidet__nn_acc_s8_list_max(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                               const int32_t *b, uint32_t n_out, int32_t *acc, int32_t *vmax);
 void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,

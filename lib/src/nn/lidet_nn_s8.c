@@ -73,7 +73,7 @@ LIDET_NN_KERNEL void lidet__nn_acc_s8_rows4(const int8_t *in, uint32_t n_rows, u
  * (lidet__nn_acc_s8_skip: 5.5 instructions per multiply-add on ARMv6-M, 40-50 % of them skipped), and the list
  * kernel below, the default of the cores without the DSP extension: one point at a time over the list of its
  * inputs off -128, a block of output channels' sums in registers (per multiply-add left: 3.3 instructions on
- * RV32IM, 3.0 on a Cortex-M3, 4.25 on ARMv6-M). Cores with the DSP extension (Cortex-M4, M7, M33 with DSP:
+ * RV32IM, 2.6 on a Cortex-M3, 4.1 on ARMv6-M). Cores with the DSP extension (Cortex-M4, M7, M33 with DSP:
  * __ARM_FEATURE_DSP) take lidet__nn_acc_s8_dsp below, two multiply-adds per SMLAD. LIDET_NN_S8_KERNEL
  * (lidet_opt.h) picks one by name: LIDET_NN_S8_KERNEL_ROWS4 (rows4), _COLS (output-inner; the skipping form for
  * layers of LIDET_NN_S8_SKIP_MIN_ROWS rows or more), _DSP, _R2O2 (2 x 2), _R4O2 (4 x 2) or _LIST; its default is
@@ -129,20 +129,25 @@ void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
 
 /* The list kernel, for cores without the DSP extension (RV32IM, Cortex-M3, ARMv6-M): one point at a time, a block
  * of output channels' sums in registers over a list of the point's inputs, each entry the offset of its weight row
- * and its value. In layers of enough rows the list holds only the inputs off -128 (a ReLU's zero point: 40-50 % of
- * a hidden layer's), with u = x + 128 and the bias less 128 sum w (lidet__nn_acc_s8_skip's form, made once per call
- * in the first row's accumulators; every row starts from them, the first row last); in smaller layers every input
- * but the zero ones, with x and the bias. Per entry, in the compilers' inner loops: RV32IM, 16 channels: 2 loads,
- * an add, 16 LB, 16 MUL, 16 ADD, the pointer's add and the branch, 53 instructions per 16 multiply-adds (3.3; R4O2:
- * 3.5 per multiply-add, none skipped). Cortex-M3, 8 channels: 2 loads, an add, 8 LDRSB and 8 MLA, 5 for the loop,
- * 24 per 8 (3.0; R2O2: 2.75, none skipped). ARMv6-M, 4 channels in high registers (Thumb-1 assembly): 2 loads, 4
- * LDRSB (register offset, the row's offset against 4 channels' bases), 4 MULS, 4 ADD and 3 for the loop, 17 per 4
- * (4.25; the skip kernel's loop: 5.5). Exact integer sums: the same results as the other kernels. */
+ * and its value. In layers of LIST_MIN_ROWS rows or more the list holds only the inputs off -128 (a ReLU's zero
+ * point: 40-50 % of a hidden layer's), with u = x + 128 and the bias less 128 sum w (lidet__nn_acc_s8_skip's form,
+ * made once per call in the first row's accumulators; every row starts from them, the first row last); in smaller
+ * layers every input but the zero ones, with x and the bias. Per entry, in the inner loops: RV32IM (GCC's), 16
+ * channels: 2 loads, an add, 16 LB, 16 MUL, 16 ADD, the pointer's add and the branch, 53 instructions per 16
+ * multiply-adds (3.3; R4O2: 3.5 per multiply-add, none skipped). Cortex-M3 (Thumb-2 assembly), 8 channels: a
+ * post-indexed LDRH, LDRSH, an add, 8 LDRSB and 8 MLA, compare and branch, 21 per 8 (2.6; R2O2: 2.75, none
+ * skipped). ARMv6-M (Thumb-1 assembly), 8 channels, six sums in high registers and LR: 2 loads and the end's test
+ * (the entry of value 0 that ends the list), 8 LDRSB (register offset, the row's offset against the bases of
+ * channels 0 and 4, stepped 3 times), 8 MULS, 8 ADD and 2 for the loop, 33 per 8 (4.1; x sign-extended, 34; the
+ * skip kernel's loop: 5.5). The last shared layer's rows fold into the running maximum instead of being written
+ * (lidet__nn_acc_s8_list_max). Exact integer sums: the same results as the other kernels. */
 #define LIST_CHUNK 64u /* inputs per list: 256 bytes of stack */
+/* the fewest rows that skip (per scan, ARMv6-M: 2 and 4 rows 0.03 % and 0.005 % more instructions; RV32: 2 and 8
+ * 0.04 % more; Cortex-M3: 2 as many, 8 0.8 % more) */
 #if defined(__ARM_ARCH_6M__)
-#define LIST_MIN_ROWS 2u /* ARMv6-M: 8 and 4 gave 1.0 % and 0.03 % more instructions per scan */
+#define LIST_MIN_ROWS 3u
 #else
-#define LIST_MIN_ROWS 4u /* fewest rows that skip (RV32: 8 and 2 gave 0.04 % more instructions per scan) */
+#define LIST_MIN_ROWS 4u
 #endif
 /* 16 channels a pass where the core has the registers (RV32: 31), else 8 (32-bit Arm: 13) */
 #if defined(__arm__)
@@ -285,7 +290,7 @@ LIST_NO_SCHED static void list_run16_max(const list_ent_t *e, const list_ent_t *
 
 /* the same for 8 channels (ARMv6-M: the list ends in an entry of v = 0 at end, u being 1..255) */
 S8_ALWAYS_INLINE void list_run8_body(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
-                                     const int32_t *c, int32_t *a, const int fold)
+                                     const int32_t *c, int32_t *a, const int fold, const int sgn)
 {
     int32_t s0 = c[0], s1 = c[1], s2 = c[2], s3 = c[3], s4 = c[4], s5 = c[5], s6 = c[6], s7 = c[7];
 #if LIST_T1_ASM
@@ -296,54 +301,108 @@ S8_ALWAYS_INLINE void list_run8_body(const list_ent_t *e, const list_ent_t *end,
      * registers (GCC gives no more), two in low ones and s4 in LR (its own register the product's meanwhile); no
      * register left for the end: the loop stops on the entry of u = 0 (per entry 33 instructions, 1 fewer than two
      * passes of list_run4, and half the passes) */
-    __asm__ volatile(
-        ".syntax unified\n\t"
-        "mov lr, %[s4]\n\t"
-        "1:\n\t"
-        "ldrh %[u], [%[e], #2]\n\t"
-        "cmp %[u], #0\n\t"
-        "beq 2f\n\t"
-        "ldrh %[off], [%[e], #0]\n\t"
-        "ldrsb %[s4], [%[w0], %[off]]\n\t"
-        "muls %[s4], %[u], %[s4]\n\t"
-        "add %[s0], %[s4]\n\t"
-        "ldrsb %[s4], [%[w4], %[off]]\n\t"
-        "muls %[s4], %[u], %[s4]\n\t"
-        "add lr, %[s4]\n\t"
-        "adds %[off], %[off], #1\n\t"
-        "ldrsb %[s4], [%[w0], %[off]]\n\t"
-        "muls %[s4], %[u], %[s4]\n\t"
-        "add %[s1], %[s4]\n\t"
-        "ldrsb %[s4], [%[w4], %[off]]\n\t"
-        "muls %[s4], %[u], %[s4]\n\t"
-        "add %[s5], %[s4]\n\t"
-        "adds %[off], %[off], #1\n\t"
-        "ldrsb %[s4], [%[w0], %[off]]\n\t"
-        "muls %[s4], %[u], %[s4]\n\t"
-        "add %[s2], %[s4]\n\t"
-        "ldrsb %[s4], [%[w4], %[off]]\n\t"
-        "muls %[s4], %[u], %[s4]\n\t"
-        "adds %[s6], %[s6], %[s4]\n\t"
-        "adds %[off], %[off], #1\n\t"
-        "ldrsb %[s4], [%[w0], %[off]]\n\t"
-        "muls %[s4], %[u], %[s4]\n\t"
-        "add %[s3], %[s4]\n\t"
-        "ldrsb %[s4], [%[w4], %[off]]\n\t"
-        "muls %[s4], %[u], %[s4]\n\t"
-        "adds %[s7], %[s7], %[s4]\n\t"
-        "adds %[e], %[e], #4\n\t"
-        "b 1b\n\t"
-        "2:\n\t"
-        "mov %[s4], lr\n\t"
+    if (sgn) /* x: a halfword sign-extended */
+    {
+        __asm__ volatile(
+            ".syntax unified\n\t"
+            "mov lr, %[s4]\n\t"
+            "1:\n\t"
+            "ldrh %[u], [%[e], #2]\n\t"
+            "sxth %[u], %[u]\n\t"
+            "cmp %[u], #0\n\t"
+            "beq 2f\n\t"
+            "ldrh %[off], [%[e], #0]\n\t"
+            "ldrsb %[s4], [%[w0], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add %[s0], %[s4]\n\t"
+            "ldrsb %[s4], [%[w4], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add lr, %[s4]\n\t"
+            "adds %[off], %[off], #1\n\t"
+            "ldrsb %[s4], [%[w0], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add %[s1], %[s4]\n\t"
+            "ldrsb %[s4], [%[w4], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add %[s5], %[s4]\n\t"
+            "adds %[off], %[off], #1\n\t"
+            "ldrsb %[s4], [%[w0], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add %[s2], %[s4]\n\t"
+            "ldrsb %[s4], [%[w4], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "adds %[s6], %[s6], %[s4]\n\t"
+            "adds %[off], %[off], #1\n\t"
+            "ldrsb %[s4], [%[w0], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add %[s3], %[s4]\n\t"
+            "ldrsb %[s4], [%[w4], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "adds %[s7], %[s7], %[s4]\n\t"
+            "adds %[e], %[e], #4\n\t"
+            "b 1b\n\t"
+            "2:\n\t"
+            "mov %[s4], lr\n\t"
 #if !defined(__ARM_ASM_SYNTAX_UNIFIED__)
-        ".syntax divided\n\t"
+            ".syntax divided\n\t"
 #endif
-        : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [s5] "+h"(s5), [s4] "+l"(s4),
-          [s6] "+l"(s6), [s7] "+l"(s7), [e] "+l"(e), [u] "=&l"(u), [off] "=&l"(off)
-        : [w0] "l"(w), [w4] "l"(w4)
-        : "cc", "memory", "lr");
+            : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [s5] "+h"(s5), [s4] "+l"(s4),
+              [s6] "+l"(s6), [s7] "+l"(s7), [e] "+l"(e), [u] "=&l"(u), [off] "=&l"(off)
+            : [w0] "l"(w), [w4] "l"(w4)
+            : "cc", "memory", "lr");
+    }
+    else
+    {
+        __asm__ volatile(
+            ".syntax unified\n\t"
+            "mov lr, %[s4]\n\t"
+            "1:\n\t"
+            "ldrh %[u], [%[e], #2]\n\t"
+            "cmp %[u], #0\n\t"
+            "beq 2f\n\t"
+            "ldrh %[off], [%[e], #0]\n\t"
+            "ldrsb %[s4], [%[w0], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add %[s0], %[s4]\n\t"
+            "ldrsb %[s4], [%[w4], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add lr, %[s4]\n\t"
+            "adds %[off], %[off], #1\n\t"
+            "ldrsb %[s4], [%[w0], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add %[s1], %[s4]\n\t"
+            "ldrsb %[s4], [%[w4], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add %[s5], %[s4]\n\t"
+            "adds %[off], %[off], #1\n\t"
+            "ldrsb %[s4], [%[w0], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add %[s2], %[s4]\n\t"
+            "ldrsb %[s4], [%[w4], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "adds %[s6], %[s6], %[s4]\n\t"
+            "adds %[off], %[off], #1\n\t"
+            "ldrsb %[s4], [%[w0], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "add %[s3], %[s4]\n\t"
+            "ldrsb %[s4], [%[w4], %[off]]\n\t"
+            "muls %[s4], %[u], %[s4]\n\t"
+            "adds %[s7], %[s7], %[s4]\n\t"
+            "adds %[e], %[e], #4\n\t"
+            "b 1b\n\t"
+            "2:\n\t"
+            "mov %[s4], lr\n\t"
+#if !defined(__ARM_ASM_SYNTAX_UNIFIED__)
+            ".syntax divided\n\t"
+#endif
+            : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [s5] "+h"(s5), [s4] "+l"(s4),
+              [s6] "+l"(s6), [s7] "+l"(s7), [e] "+l"(e), [u] "=&l"(u), [off] "=&l"(off)
+            : [w0] "l"(w), [w4] "l"(w4)
+            : "cc", "memory", "lr");
+    }
 #elif LIST_T2_ASM
     uint32_t v, p, t;
+    (void)sgn;
     /* the 14 registers: 8 sums, the entry, its end, the weights, the value, the row and the weight (GCC: 24
      * instructions per entry, the end reloaded from the stack) */
     __asm__ volatile(
@@ -374,6 +433,7 @@ S8_ALWAYS_INLINE void list_run8_body(const list_ent_t *e, const list_ent_t *end,
         : [w] "r"(w), [end] "r"(end)
         : "cc", "memory");
 #else
+    (void)sgn;
     do
     {
         const int8_t *p = w + e->off;
@@ -415,19 +475,28 @@ S8_ALWAYS_INLINE void list_run8_body(const list_ent_t *e, const list_ent_t *end,
 LIST_NO_SCHED static void list_run8(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
                                     const int32_t *c, int32_t *a)
 {
-    list_run8_body(e, end, w, c, a, 0);
+    list_run8_body(e, end, w, c, a, 0, 0);
 }
+
+#if LIST_T1_ASM
+/* the same for values x (not u): ARMv6-M's rows that do not skip */
+static void list_run8_s(const list_ent_t *e, const list_ent_t *end, const int8_t *w, const int32_t *c,
+                        int32_t *a)
+{
+    list_run8_body(e, end, w, c, a, 0, 1);
+}
+#endif
 
 /* the same, a[k] the larger of itself and the sum (the last shared layer's maximum) */
 LIST_NO_SCHED static void list_run8_max(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
                                         const int32_t *c, int32_t *a)
 {
-    list_run8_body(e, end, w, c, a, 1);
+    list_run8_body(e, end, w, c, a, 1, 0);
 }
 
-/* the same for 4 channels (e != end; on ARMv6-M the entries' v must be u = x + 128, 1..255: LDRH) */
+/* the same for 4 channels (e != end; on ARMv6-M sgn: the entries' v are x, else u = x + 128) */
 S8_ALWAYS_INLINE void list_run4(const list_ent_t *e, const list_ent_t *end, const int8_t *w, const int32_t *c,
-                                int32_t *a, int fold)
+                                int32_t *a, const int fold, const int sgn)
 {
     int32_t s0 = c[0], s1 = c[1], s2 = c[2], s3 = c[3];
 #if LIST_T1_ASM
@@ -435,33 +504,67 @@ S8_ALWAYS_INLINE void list_run4(const list_ent_t *e, const list_ent_t *end, cons
     uint32_t t, u, off;
     /* the sums in high registers (ADD takes them), the 4 channels' bases, the offset, the value and the product in
      * the 8 low ones */
-    __asm__ volatile(".syntax unified\n\t"
-                     "1:\n\t"
-                     "ldrh %[off], [%[e], #0]\n\t"
-                     "ldrh %[u], [%[e], #2]\n\t"
-                     "ldrsb %[t], [%[w0], %[off]]\n\t"
-                     "muls %[t], %[u], %[t]\n\t"
-                     "add %[s0], %[t]\n\t"
-                     "ldrsb %[t], [%[w1], %[off]]\n\t"
-                     "muls %[t], %[u], %[t]\n\t"
-                     "add %[s1], %[t]\n\t"
-                     "ldrsb %[t], [%[w2], %[off]]\n\t"
-                     "muls %[t], %[u], %[t]\n\t"
-                     "add %[s2], %[t]\n\t"
-                     "ldrsb %[t], [%[w3], %[off]]\n\t"
-                     "muls %[t], %[u], %[t]\n\t"
-                     "add %[s3], %[t]\n\t"
-                     "adds %[e], %[e], #4\n\t"
-                     "cmp %[e], %[end]\n\t"
-                     "bne 1b\n\t"
+    if (sgn) /* x: a halfword sign-extended */
+    {
+        __asm__ volatile(".syntax unified\n\t"
+                         "1:\n\t"
+                         "ldrh %[off], [%[e], #0]\n\t"
+                         "ldrh %[u], [%[e], #2]\n\t"
+                         "sxth %[u], %[u]\n\t"
+                         "ldrsb %[t], [%[w0], %[off]]\n\t"
+                         "muls %[t], %[u], %[t]\n\t"
+                         "add %[s0], %[t]\n\t"
+                         "ldrsb %[t], [%[w1], %[off]]\n\t"
+                         "muls %[t], %[u], %[t]\n\t"
+                         "add %[s1], %[t]\n\t"
+                         "ldrsb %[t], [%[w2], %[off]]\n\t"
+                         "muls %[t], %[u], %[t]\n\t"
+                         "add %[s2], %[t]\n\t"
+                         "ldrsb %[t], [%[w3], %[off]]\n\t"
+                         "muls %[t], %[u], %[t]\n\t"
+                         "add %[s3], %[t]\n\t"
+                         "adds %[e], %[e], #4\n\t"
+                         "cmp %[e], %[end]\n\t"
+                         "bne 1b\n\t"
 #if !defined(__ARM_ASM_SYNTAX_UNIFIED__)
-                     ".syntax divided\n\t"
+                         ".syntax divided\n\t"
 #endif
-                     : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [e] "+l"(e), [t] "=&l"(t),
-                       [u] "=&l"(u), [off] "=&l"(off)
-                     : [w0] "l"(w0), [w1] "l"(w1), [w2] "l"(w2), [w3] "l"(w3), [end] "h"(end)
-                     : "cc", "memory");
+                         : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [e] "+l"(e),
+                           [t] "=&l"(t), [u] "=&l"(u), [off] "=&l"(off)
+                         : [w0] "l"(w0), [w1] "l"(w1), [w2] "l"(w2), [w3] "l"(w3), [end] "h"(end)
+                         : "cc", "memory");
+    }
+    else
+    {
+        __asm__ volatile(".syntax unified\n\t"
+                         "1:\n\t"
+                         "ldrh %[off], [%[e], #0]\n\t"
+                         "ldrh %[u], [%[e], #2]\n\t"
+                         "ldrsb %[t], [%[w0], %[off]]\n\t"
+                         "muls %[t], %[u], %[t]\n\t"
+                         "add %[s0], %[t]\n\t"
+                         "ldrsb %[t], [%[w1], %[off]]\n\t"
+                         "muls %[t], %[u], %[t]\n\t"
+                         "add %[s1], %[t]\n\t"
+                         "ldrsb %[t], [%[w2], %[off]]\n\t"
+                         "muls %[t], %[u], %[t]\n\t"
+                         "add %[s2], %[t]\n\t"
+                         "ldrsb %[t], [%[w3], %[off]]\n\t"
+                         "muls %[t], %[u], %[t]\n\t"
+                         "add %[s3], %[t]\n\t"
+                         "adds %[e], %[e], #4\n\t"
+                         "cmp %[e], %[end]\n\t"
+                         "bne 1b\n\t"
+#if !defined(__ARM_ASM_SYNTAX_UNIFIED__)
+                         ".syntax divided\n\t"
+#endif
+                         : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [e] "+l"(e),
+                           [t] "=&l"(t), [u] "=&l"(u), [off] "=&l"(off)
+                         : [w0] "l"(w0), [w1] "l"(w1), [w2] "l"(w2), [w3] "l"(w3), [end] "h"(end)
+                         : "cc", "memory");
+    }
 #else
+    (void)sgn;
     do
     {
         const int8_t *p = w + e->off;
@@ -491,7 +594,8 @@ S8_ALWAYS_INLINE void list_run4(const list_ent_t *e, const list_ent_t *end, cons
 /* one row: a[o] = c[o] + sum over the entries of v w[off + o], o < n_out (a may be c); fold: a[o] the larger of
  * itself and that */
 S8_ALWAYS_INLINE void list_row_body(const list_ent_t *e, const list_ent_t *end, const int8_t *w_t,
-                                    const int32_t *c, uint32_t n_out, int32_t *a, const int fold)
+                                    const int32_t *c, uint32_t n_out, int32_t *a, const int fold,
+                                    const int sgn)
 {
     uint32_t o = 0;
     if (e == end) /* nothing to add */
@@ -517,6 +621,13 @@ S8_ALWAYS_INLINE void list_row_body(const list_ent_t *e, const list_ent_t *end, 
 #endif
     for (; o + 8u <= n_out; o += 8u)
     {
+#if LIST_T1_ASM
+        if (sgn)
+        {
+            list_run8_s(e, end, w_t + o, c + o, a + o);
+            continue;
+        }
+#endif
         if (fold)
         {
             list_run8_max(e, end, w_t + o, c + o, a + o);
@@ -528,7 +639,7 @@ S8_ALWAYS_INLINE void list_row_body(const list_ent_t *e, const list_ent_t *end, 
     }
     for (; o + 4u <= n_out; o += 4u)
     {
-        list_run4(e, end, w_t + o, c + o, a + o, fold);
+        list_run4(e, end, w_t + o, c + o, a + o, fold, sgn);
     }
     for (; o < n_out; ++o)
     {
@@ -545,13 +656,22 @@ S8_ALWAYS_INLINE void list_row_body(const list_ent_t *e, const list_ent_t *end, 
 static void list_row(const list_ent_t *e, const list_ent_t *end, const int8_t *w_t, const int32_t *c,
                      uint32_t n_out, int32_t *a)
 {
-    list_row_body(e, end, w_t, c, n_out, a, 0);
+    list_row_body(e, end, w_t, c, n_out, a, 0, 0);
 }
+
+#if LIST_T1_ASM
+/* the same for values x: the rows that do not skip */
+static void list_row_s(const list_ent_t *e, const list_ent_t *end, const int8_t *w_t, const int32_t *c,
+                       uint32_t n_out, int32_t *a)
+{
+    list_row_body(e, end, w_t, c, n_out, a, 0, 1);
+}
+#endif
 
 static void list_row_max(const list_ent_t *e, const list_ent_t *end, const int8_t *w_t, const int32_t *c,
                          uint32_t n_out, int32_t *a)
 {
-    list_row_body(e, end, w_t, c, n_out, a, 1);
+    list_row_body(e, end, w_t, c, n_out, a, 1, 0);
 }
 
 #if LIST_W16
@@ -712,6 +832,12 @@ static void acc_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int
             {
                 list_row_max(list, end, w_t, c, n_out, vmax);
             }
+#if LIST_T1_ASM
+            else if (!skip)
+            {
+                list_row_s(list, end, w_t, c, n_out, a);
+            }
+#endif
             else
             {
                 list_row(list, end, w_t, c, n_out, a);
@@ -720,10 +846,10 @@ static void acc_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int
     }
 }
 
-/* whether the list kernel takes the layer: its entries' offsets in 16 bits; ARMv6-M: u only (skipping rows) */
-static int list_fits(uint32_t n_rows, uint32_t n_in, uint32_t n_out)
+/* whether the list kernel takes the layer: its entries' offsets in 16 bits */
+static int list_fits(uint32_t n_in, uint32_t n_out)
 {
-    return n_in * n_out <= 65536u && (!LIST_T1_ASM || n_rows >= LIST_MIN_ROWS);
+    return n_in * n_out <= 65536u;
 }
 
 void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
@@ -733,7 +859,7 @@ void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
     {
         return;
     }
-    if (!list_fits(n_rows, n_in, n_out))
+    if (!list_fits(n_in, n_out))
     {
 #if LIST_T1_ASM
         lidet__nn_acc_s8_cols(in, n_rows, n_in, w_t, b, n_out, n_out, acc, n_out);
@@ -748,7 +874,7 @@ void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
 int lidet__nn_acc_s8_list_max(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                               const int32_t *b, uint32_t n_out, int32_t *acc, int32_t *vmax)
 {
-    if (n_rows < LIST_MIN_ROWS || n_rows < 2u || !list_fits(n_rows, n_in, n_out))
+    if (n_rows < LIST_MIN_ROWS || n_rows < 2u || !list_fits(n_in, n_out))
     {
         return 0;
     }
