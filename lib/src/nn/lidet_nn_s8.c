@@ -288,6 +288,58 @@ LIST_NO_SCHED static void list_run16_max(const list_ent_t *e, const list_ent_t *
 
 #endif
 
+#if LIST_T1_ASM
+#if defined(__ARM_ASM_SYNTAX_UNIFIED__)
+#define LIST_T1_SYNTAX_END ""
+#else
+#define LIST_T1_SYNTAX_END ".syntax divided\n\t"
+#endif
+/* ARMv6-M's 8-channel loop (list_run8_body), EXT after the value's load */
+#define LIST_T1_RUN8(EXT)                                                                                    \
+    __asm__ volatile(                                                                                        \
+        ".syntax unified\n\t"                                                                                \
+        "mov lr, %[s4]\n\t"                                                                                  \
+        "1:\n\t"                                                                                             \
+        "ldrh %[u], [%[e], #2]\n\t" EXT "cmp %[u], #0\n\t"                                                   \
+        "beq 2f\n\t"                                                                                         \
+        "ldrh %[off], [%[e], #0]\n\t"                                                                        \
+        "ldrsb %[s4], [%[w0], %[off]]\n\t"                                                                   \
+        "muls %[s4], %[u], %[s4]\n\t"                                                                        \
+        "add %[s0], %[s4]\n\t"                                                                               \
+        "ldrsb %[s4], [%[w4], %[off]]\n\t"                                                                   \
+        "muls %[s4], %[u], %[s4]\n\t"                                                                        \
+        "add lr, %[s4]\n\t"                                                                                  \
+        "adds %[off], %[off], #1\n\t"                                                                        \
+        "ldrsb %[s4], [%[w0], %[off]]\n\t"                                                                   \
+        "muls %[s4], %[u], %[s4]\n\t"                                                                        \
+        "add %[s1], %[s4]\n\t"                                                                               \
+        "ldrsb %[s4], [%[w4], %[off]]\n\t"                                                                   \
+        "muls %[s4], %[u], %[s4]\n\t"                                                                        \
+        "add %[s5], %[s4]\n\t"                                                                               \
+        "adds %[off], %[off], #1\n\t"                                                                        \
+        "ldrsb %[s4], [%[w0], %[off]]\n\t"                                                                   \
+        "muls %[s4], %[u], %[s4]\n\t"                                                                        \
+        "add %[s2], %[s4]\n\t"                                                                               \
+        "ldrsb %[s4], [%[w4], %[off]]\n\t"                                                                   \
+        "muls %[s4], %[u], %[s4]\n\t"                                                                        \
+        "adds %[s6], %[s6], %[s4]\n\t"                                                                       \
+        "adds %[off], %[off], #1\n\t"                                                                        \
+        "ldrsb %[s4], [%[w0], %[off]]\n\t"                                                                   \
+        "muls %[s4], %[u], %[s4]\n\t"                                                                        \
+        "add %[s3], %[s4]\n\t"                                                                               \
+        "ldrsb %[s4], [%[w4], %[off]]\n\t"                                                                   \
+        "muls %[s4], %[u], %[s4]\n\t"                                                                        \
+        "adds %[s7], %[s7], %[s4]\n\t"                                                                       \
+        "adds %[e], %[e], #4\n\t"                                                                            \
+        "b 1b\n\t"                                                                                           \
+        "2:\n\t"                                                                                             \
+        "mov %[s4], lr\n\t" LIST_T1_SYNTAX_END                                                               \
+        : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [s5] "+h"(s5), [s4] "+l"(s4),          \
+          [s6] "+l"(s6), [s7] "+l"(s7), [e] "+l"(e), [u] "=&l"(u), [off] "=&l"(off)                          \
+        : [w0] "l"(w), [w4] "l"(w4)                                                                          \
+        : "cc", "memory", "lr")
+#endif
+
 /* the same for 8 channels (ARMv6-M: the list ends in an entry of v = 0 at end, u being 1..255) */
 S8_ALWAYS_INLINE void list_run8_body(const list_ent_t *e, const list_ent_t *end, const int8_t *w,
                                      const int32_t *c, int32_t *a, const int fold, const int sgn)
@@ -303,102 +355,11 @@ S8_ALWAYS_INLINE void list_run8_body(const list_ent_t *e, const list_ent_t *end,
      * passes of list_run4, and half the passes) */
     if (sgn) /* x: a halfword sign-extended */
     {
-        __asm__ volatile(
-            ".syntax unified\n\t"
-            "mov lr, %[s4]\n\t"
-            "1:\n\t"
-            "ldrh %[u], [%[e], #2]\n\t"
-            "sxth %[u], %[u]\n\t"
-            "cmp %[u], #0\n\t"
-            "beq 2f\n\t"
-            "ldrh %[off], [%[e], #0]\n\t"
-            "ldrsb %[s4], [%[w0], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add %[s0], %[s4]\n\t"
-            "ldrsb %[s4], [%[w4], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add lr, %[s4]\n\t"
-            "adds %[off], %[off], #1\n\t"
-            "ldrsb %[s4], [%[w0], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add %[s1], %[s4]\n\t"
-            "ldrsb %[s4], [%[w4], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add %[s5], %[s4]\n\t"
-            "adds %[off], %[off], #1\n\t"
-            "ldrsb %[s4], [%[w0], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add %[s2], %[s4]\n\t"
-            "ldrsb %[s4], [%[w4], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "adds %[s6], %[s6], %[s4]\n\t"
-            "adds %[off], %[off], #1\n\t"
-            "ldrsb %[s4], [%[w0], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add %[s3], %[s4]\n\t"
-            "ldrsb %[s4], [%[w4], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "adds %[s7], %[s7], %[s4]\n\t"
-            "adds %[e], %[e], #4\n\t"
-            "b 1b\n\t"
-            "2:\n\t"
-            "mov %[s4], lr\n\t"
-#if !defined(__ARM_ASM_SYNTAX_UNIFIED__)
-            ".syntax divided\n\t"
-#endif
-            : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [s5] "+h"(s5), [s4] "+l"(s4),
-              [s6] "+l"(s6), [s7] "+l"(s7), [e] "+l"(e), [u] "=&l"(u), [off] "=&l"(off)
-            : [w0] "l"(w), [w4] "l"(w4)
-            : "cc", "memory", "lr");
+        LIST_T1_RUN8("sxth %[u], %[u]\n\t");
     }
     else
     {
-        __asm__ volatile(
-            ".syntax unified\n\t"
-            "mov lr, %[s4]\n\t"
-            "1:\n\t"
-            "ldrh %[u], [%[e], #2]\n\t"
-            "cmp %[u], #0\n\t"
-            "beq 2f\n\t"
-            "ldrh %[off], [%[e], #0]\n\t"
-            "ldrsb %[s4], [%[w0], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add %[s0], %[s4]\n\t"
-            "ldrsb %[s4], [%[w4], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add lr, %[s4]\n\t"
-            "adds %[off], %[off], #1\n\t"
-            "ldrsb %[s4], [%[w0], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add %[s1], %[s4]\n\t"
-            "ldrsb %[s4], [%[w4], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add %[s5], %[s4]\n\t"
-            "adds %[off], %[off], #1\n\t"
-            "ldrsb %[s4], [%[w0], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add %[s2], %[s4]\n\t"
-            "ldrsb %[s4], [%[w4], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "adds %[s6], %[s6], %[s4]\n\t"
-            "adds %[off], %[off], #1\n\t"
-            "ldrsb %[s4], [%[w0], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "add %[s3], %[s4]\n\t"
-            "ldrsb %[s4], [%[w4], %[off]]\n\t"
-            "muls %[s4], %[u], %[s4]\n\t"
-            "adds %[s7], %[s7], %[s4]\n\t"
-            "adds %[e], %[e], #4\n\t"
-            "b 1b\n\t"
-            "2:\n\t"
-            "mov %[s4], lr\n\t"
-#if !defined(__ARM_ASM_SYNTAX_UNIFIED__)
-            ".syntax divided\n\t"
-#endif
-            : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [s5] "+h"(s5), [s4] "+l"(s4),
-              [s6] "+l"(s6), [s7] "+l"(s7), [e] "+l"(e), [u] "=&l"(u), [off] "=&l"(off)
-            : [w0] "l"(w), [w4] "l"(w4)
-            : "cc", "memory", "lr");
+        LIST_T1_RUN8("");
     }
 #elif LIST_T2_ASM
     uint32_t v, p, t;
