@@ -239,6 +239,12 @@ def test_finetune_errors(tmp_path, capsys):
     assert "--family vlp32c: no shipped weights" in err and "hdl64" in err
     assert _run([d, "--family", "hdl64", "--out-weights", ROOT / "weights"]) == 2
     assert "shipped weights folder" in capsys.readouterr().err
+    other = tmp_path / "other_checkout"  # another checkout's weights (a worktree run with this one's environment)
+    (other / "lib" / "include" / "lidet").mkdir(parents=True)
+    (other / "lib" / "include" / "lidet" / "lidet.h").write_text("/* lidet */\n")
+    (other / "weights").mkdir()
+    assert _run([d, "--family", "hdl64", "--out-weights", other / "weights"]) == 2
+    assert "shipped weights folder" in capsys.readouterr().err
     assert not out.exists()
 
 

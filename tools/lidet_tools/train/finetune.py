@@ -692,7 +692,10 @@ def check_args(a) -> tuple[str, dict]:
         raise ValueError(f"--sim takes TRAIN,VAL,TEST scan counts (train and val > 0), got {a.sim!r}")
     for f in a.data:
         folder_layout(f, a.layout)
-    if a.out_weights.resolve() == a.weights.resolve():
+    out = a.out_weights.resolve()
+    # the shipped folder of this checkout, or of any lidet checkout (a tree with lib/include/lidet/lidet.h beside its
+    # weights/: another worktree run with this one's environment)
+    if out == a.weights.resolve() or (out.name == "weights" and (out.parent / "lib/include/lidet/lidet.h").is_file()):
         raise ValueError(f"--out-weights {a.out_weights}: that is the shipped weights folder; write elsewhere")
     spec = FAMILIES[a.family]
     return spec.get("sensor", a.family), spec
