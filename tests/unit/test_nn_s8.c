@@ -30,12 +30,27 @@ void tearDown(void)
 {
 }
 
+/* the exact int32 sums, point by point: b[o] + sum_i in[r][i] w[i][o] */
+static void ref_acc(const int8_t *in, uint32_t rows, uint32_t n_in, const int8_t *w, const int32_t *b, uint32_t n_out,
+                    int32_t *ref)
+{
+    uint32_t r, o, i;
+    for (r = 0; r < rows; ++r)
+        for (o = 0; o < n_out; ++o)
+        {
+            int32_t s = b[o];
+            for (i = 0; i < n_in; ++i)
+                s += (int32_t)in[r * n_in + i] * (int32_t)w[i * n_out + o];
+            ref[r * n_out + o] = s;
+        }
+}
+
 static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extreme)
 {
     static int8_t in[MAX_R * MAX_I], w[MAX_I * MAX_O];
     static uint32_t w_pk[MAX_I * MAX_O / 2u + 1u];
     static int32_t b[MAX_O], ref[MAX_R * MAX_O], got[MAX_R * MAX_O], vmax[MAX_O], refmax[MAX_O];
-    uint32_t r, i, o, k;
+    uint32_t r, o, k;
     for (k = 0; k < rows * n_in; ++k)
     {
         in[k] = extreme == 1 ? (int8_t)((k & 1u) ? -128 : 127) : (int8_t)(next() & 0xFFu);
@@ -48,14 +63,7 @@ static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extrem
         w[k] = extreme == 1 ? (int8_t)-128 : (int8_t)(next() & 0xFFu);
     for (o = 0; o < n_out; ++o)
         b[o] = (int32_t)(next() % 2000001u) - 1000000;
-    for (r = 0; r < rows; ++r)
-        for (o = 0; o < n_out; ++o)
-        {
-            int32_t s = b[o];
-            for (i = 0; i < n_in; ++i)
-                s += (int32_t)in[r * n_in + i] * (int32_t)w[i * n_out + o];
-            ref[r * n_out + o] = s;
-        }
+    ref_acc(in, rows, n_in, w, b, n_out, ref);
     memset(got, 0x5A, sizeof got);
     lidet__nn_acc_s8_cols(in, rows, n_in, w, b, n_out, n_out, got, n_out);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
@@ -252,14 +260,7 @@ static void test_list_kernel_on_large_layers(void)
                 w[i] = (int8_t)(next() & 0xFFu);
             for (o = 0; o < n_out; ++o)
                 b[o] = (int32_t)(next() % 2000001u) - 1000000;
-            for (r = 0; r < rows; ++r)
-                for (o = 0; o < n_out; ++o)
-                {
-                    int32_t s = b[o];
-                    for (i = 0; i < n_in; ++i)
-                        s += (int32_t)in[r * n_in + i] * (int32_t)w[i * n_out + o];
-                    ref[r * n_out + o] = s;
-                }
+            ref_acc(in, rows, n_in, w, b, n_out, ref);
             memset(got, 0x5A, sizeof got);
             lidet__nn_acc_s8_list(in, rows, n_in, w, b, n_out, got);
             TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);

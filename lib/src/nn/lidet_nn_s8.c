@@ -338,6 +338,30 @@ LIST_NO_SCHED static void list_run16_max(const list_ent_t *e, const list_ent_t *
           [s6] "+l"(s6), [s7] "+l"(s7), [e] "+l"(e), [u] "=&l"(u), [off] "=&l"(off)                          \
         : [w0] "l"(w), [w4] "l"(w4)                                                                          \
         : "cc", "memory", "lr")
+/* ARMv6-M's 4-channel loop (list_run4), EXT after the value's load */
+#define LIST_T1_RUN4(EXT)                                                                                    \
+    __asm__ volatile(".syntax unified\n\t"                                                                   \
+                     "1:\n\t"                                                                                \
+                     "ldrh %[off], [%[e], #0]\n\t"                                                           \
+                     "ldrh %[u], [%[e], #2]\n\t" EXT "ldrsb %[t], [%[w0], %[off]]\n\t"                       \
+                     "muls %[t], %[u], %[t]\n\t"                                                             \
+                     "add %[s0], %[t]\n\t"                                                                   \
+                     "ldrsb %[t], [%[w1], %[off]]\n\t"                                                       \
+                     "muls %[t], %[u], %[t]\n\t"                                                             \
+                     "add %[s1], %[t]\n\t"                                                                   \
+                     "ldrsb %[t], [%[w2], %[off]]\n\t"                                                       \
+                     "muls %[t], %[u], %[t]\n\t"                                                             \
+                     "add %[s2], %[t]\n\t"                                                                   \
+                     "ldrsb %[t], [%[w3], %[off]]\n\t"                                                       \
+                     "muls %[t], %[u], %[t]\n\t"                                                             \
+                     "add %[s3], %[t]\n\t"                                                                   \
+                     "adds %[e], %[e], #4\n\t"                                                               \
+                     "cmp %[e], %[end]\n\t"                                                                  \
+                     "bne 1b\n\t" LIST_T1_SYNTAX_END                                                         \
+                     : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [e] "+l"(e),              \
+                       [t] "=&l"(t), [u] "=&l"(u), [off] "=&l"(off)                                          \
+                     : [w0] "l"(w0), [w1] "l"(w1), [w2] "l"(w2), [w3] "l"(w3), [end] "h"(end)                \
+                     : "cc", "memory")
 #endif
 
 /* the same for 8 channels (ARMv6-M: the list ends in an entry of v = 0 at end, u being 1..255) */
@@ -467,62 +491,11 @@ S8_ALWAYS_INLINE void list_run4(const list_ent_t *e, const list_ent_t *end, cons
      * the 8 low ones */
     if (sgn) /* x: a halfword sign-extended */
     {
-        __asm__ volatile(".syntax unified\n\t"
-                         "1:\n\t"
-                         "ldrh %[off], [%[e], #0]\n\t"
-                         "ldrh %[u], [%[e], #2]\n\t"
-                         "sxth %[u], %[u]\n\t"
-                         "ldrsb %[t], [%[w0], %[off]]\n\t"
-                         "muls %[t], %[u], %[t]\n\t"
-                         "add %[s0], %[t]\n\t"
-                         "ldrsb %[t], [%[w1], %[off]]\n\t"
-                         "muls %[t], %[u], %[t]\n\t"
-                         "add %[s1], %[t]\n\t"
-                         "ldrsb %[t], [%[w2], %[off]]\n\t"
-                         "muls %[t], %[u], %[t]\n\t"
-                         "add %[s2], %[t]\n\t"
-                         "ldrsb %[t], [%[w3], %[off]]\n\t"
-                         "muls %[t], %[u], %[t]\n\t"
-                         "add %[s3], %[t]\n\t"
-                         "adds %[e], %[e], #4\n\t"
-                         "cmp %[e], %[end]\n\t"
-                         "bne 1b\n\t"
-#if !defined(__ARM_ASM_SYNTAX_UNIFIED__)
-                         ".syntax divided\n\t"
-#endif
-                         : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [e] "+l"(e),
-                           [t] "=&l"(t), [u] "=&l"(u), [off] "=&l"(off)
-                         : [w0] "l"(w0), [w1] "l"(w1), [w2] "l"(w2), [w3] "l"(w3), [end] "h"(end)
-                         : "cc", "memory");
+        LIST_T1_RUN4("sxth %[u], %[u]\n\t");
     }
     else
     {
-        __asm__ volatile(".syntax unified\n\t"
-                         "1:\n\t"
-                         "ldrh %[off], [%[e], #0]\n\t"
-                         "ldrh %[u], [%[e], #2]\n\t"
-                         "ldrsb %[t], [%[w0], %[off]]\n\t"
-                         "muls %[t], %[u], %[t]\n\t"
-                         "add %[s0], %[t]\n\t"
-                         "ldrsb %[t], [%[w1], %[off]]\n\t"
-                         "muls %[t], %[u], %[t]\n\t"
-                         "add %[s1], %[t]\n\t"
-                         "ldrsb %[t], [%[w2], %[off]]\n\t"
-                         "muls %[t], %[u], %[t]\n\t"
-                         "add %[s2], %[t]\n\t"
-                         "ldrsb %[t], [%[w3], %[off]]\n\t"
-                         "muls %[t], %[u], %[t]\n\t"
-                         "add %[s3], %[t]\n\t"
-                         "adds %[e], %[e], #4\n\t"
-                         "cmp %[e], %[end]\n\t"
-                         "bne 1b\n\t"
-#if !defined(__ARM_ASM_SYNTAX_UNIFIED__)
-                         ".syntax divided\n\t"
-#endif
-                         : [s0] "+h"(s0), [s1] "+h"(s1), [s2] "+h"(s2), [s3] "+h"(s3), [e] "+l"(e),
-                           [t] "=&l"(t), [u] "=&l"(u), [off] "=&l"(off)
-                         : [w0] "l"(w0), [w1] "l"(w1), [w2] "l"(w2), [w3] "l"(w3), [end] "h"(end)
-                         : "cc", "memory");
+        LIST_T1_RUN4("");
     }
 #else
     (void)sgn;
