@@ -157,12 +157,34 @@ static void every_shape(dense_fn_t *fn, int want)
     TEST_ASSERT_TRUE(g_decisive > 100u); /* the two arithmetics told apart on many shapes */
 }
 
+/* in (rows x n_in, its zeros set by the caller) with row 1 all zeros, fresh weights and biases, through fn: each output
+ * the unskipped fused chain's, bit for bit (the kernels that leave zero inputs out) */
+static void zero_inputs_fused(dense_fn_t *fn, float *in, uint32_t rows, uint32_t n_in, uint32_t n_out, int relu,
+                              const char *msg)
+{
+    static float w[MAX_I * MAX_O], b[MAX_O], got[MAX_R * MAX_O];
+    uint32_t r, o, k;
+    if (rows > 2u)
+        memset(in + n_in, 0, n_in * sizeof in[0]); /* row 1: no nonzero input at all */
+    for (k = 0; k < n_in * n_out; ++k)
+        w[k] = next_f();
+    for (k = 0; k < n_out; ++k)
+        b[k] = next_f();
+    fn(in, rows, n_in, w, b, n_out, relu, got);
+    for (r = 0; r < rows; ++r)
+        for (o = 0; o < n_out; ++o)
+        {
+            const float want = relu_of(fused_one(in + r * n_in, n_in, w, n_out, o, b[o]), relu);
+            TEST_ASSERT_TRUE_MESSAGE(memcmp(&want, &got[r * n_out + o], sizeof want) == 0, msg);
+        }
+}
+
 /* the RISC-V kernel on every shape: the fused arithmetic bit for bit; then with zero inputs (+0 and -0, a ReLU
  * layer's skipped inputs, whole rows of them too, and runs past a 64-input chunk) against the unskipped chain */
 void test_riscv_kernel_on_the_host(void)
 {
-    static float in[MAX_R * MAX_I], w[MAX_I * MAX_O], b[MAX_O], got[MAX_R * MAX_O];
-    uint32_t a, c, d, r, o, k, n_zero = 0;
+    static float in[MAX_R * MAX_I];
+    uint32_t a, c, d, k, n_zero = 0;
     every_shape(rv_dense_host, 1);
     for (a = 0; a < sizeof k_rows / sizeof k_rows[0]; ++a)
         for (c = 0; c < sizeof k_ins / sizeof k_ins[0]; ++c)
@@ -176,20 +198,8 @@ void test_riscv_kernel_on_the_host(void)
                     in[k] = u < 96u ? 0.0f : u < 128u ? -0.0f : next_f(); /* half of them zeros */
                     n_zero += u < 128u;
                 }
-                if (rows > 2u)
-                    memset(in + n_in, 0, n_in * sizeof in[0]); /* row 1: no nonzero input at all */
-                for (k = 0; k < n_in * n_out; ++k)
-                    w[k] = next_f();
-                for (k = 0; k < n_out; ++k)
-                    b[k] = next_f();
-                rv_dense_host(in, rows, n_in, w, b, n_out, relu, got);
-                for (r = 0; r < rows; ++r)
-                    for (o = 0; o < n_out; ++o)
-                    {
-                        const float want = relu_of(fused_one(in + r * n_in, n_in, w, n_out, o, b[o]), relu);
-                        TEST_ASSERT_TRUE_MESSAGE(memcmp(&want, &got[r * n_out + o], sizeof want) == 0,
-                                                 "the RISC-V kernel with zero inputs is not the fused chain");
-                    }
+                zero_inputs_fused(rv_dense_host, in, rows, n_in, n_out, relu,
+                                  "the RISC-V kernel with zero inputs is not the fused chain");
             }
     TEST_ASSERT_TRUE(n_zero > 10000u);
 }
@@ -199,8 +209,8 @@ void test_riscv_kernel_on_the_host(void)
 void test_avx512_zero_inputs(void)
 {
 #if LIDET_NN_FMA
-    static float in[MAX_R * MAX_I], w[MAX_I * MAX_O], b[MAX_O], got[MAX_R * MAX_O];
-    uint32_t a, c, d, r, o, k, i, n_skip = 0;
+    static float in[MAX_R * MAX_I];
+    uint32_t a, c, d, r, k, i, n_skip = 0;
     if (!__builtin_cpu_supports("avx512f"))
     {
         TEST_IGNORE_MESSAGE("no AVX-512 here");
@@ -226,21 +236,8 @@ void test_avx512_zero_inputs(void)
                         n_skip += rows >= 8u;
                     }
                 }
-                if (rows > 2u)
-                    memset(in + n_in, 0, n_in * sizeof in[0]); /* row 1: no nonzero input at all */
-                for (k = 0; k < n_in * n_out; ++k)
-                    w[k] = next_f();
-                for (k = 0; k < n_out; ++k)
-                    b[k] = next_f();
-                lidet__nn_dense_f32_avx512(in, rows, n_in, w, b, n_out, relu, got);
-                for (r = 0; r < rows; ++r)
-                    for (o = 0; o < n_out; ++o)
-                    {
-                        const float want = relu_of(fused_one(in + r * n_in, n_in, w, n_out, o, b[o]), relu);
-                        TEST_ASSERT_TRUE_MESSAGE(
-                            memcmp(&want, &got[r * n_out + o], sizeof want) == 0,
-                            "the AVX-512 kernel with zero inputs is not the fused chain");
-                    }
+                zero_inputs_fused(lidet__nn_dense_f32_avx512, in, rows, n_in, n_out, relu,
+                                  "the AVX-512 kernel with zero inputs is not the fused chain");
             }
     TEST_ASSERT_TRUE(n_skip > 1000u);
 #else
