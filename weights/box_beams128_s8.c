@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "box_beams128_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "box_beams128_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "box_beams128_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* tnet.point[0] weights [3][32] int8 (per-channel scale) */
@@ -256,9 +256,18 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams128_s8_tnet_point1_w
     4292214903u, 4291952712u, 4294246287u, 2359273u, 4289920925u, 4294246320u, 3276831u, 4293918709u, 5242983u, 4289527754u, 3276697u, 4292214874u, 4289396674u, 4290314350u, 4289921084u, 3080180u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* tnet.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_beams128_s8_tnet_point1_lb[64] = {
+    9543, 2511, 5787, 7925, 6149, 9858, -10148, -2059, 35, 1754, 6847, 1135, 6464, 5980, 5376, -509,
+    -936, -7266, -781, 4931, 4675, -7198, -6524, 6719, -2671, 10813, 164, 8429, 1110, 868, 15341, 9193,
+    8544, 9913, 3712, -22281, 1450, 6481, -6591, -10999, 807, 10441, -6267, 13745, 346, 3808, -1963, 4764,
+    -2703, 2547, -2825, 1667, -8363, -352, -495, -877, -925, -1188, -2706, 4914, 1927, 9257, 3097, 7100
+};
+#endif
 static const lidet_pointnet_q_layer_t box_beams128_s8_tnet_point[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_tnet_point0_w, box_beams128_s8_tnet_point0_b, box_beams128_s8_tnet_point0_m, box_beams128_s8_tnet_point0_s, 0},
-    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_tnet_point1_w, box_beams128_s8_tnet_point1_b, box_beams128_s8_tnet_point1_m, box_beams128_s8_tnet_point1_s, LIDET_PNQ_PK(box_beams128_s8_tnet_point1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_tnet_point0_w, box_beams128_s8_tnet_point0_b, box_beams128_s8_tnet_point0_m, box_beams128_s8_tnet_point0_s, 0, 0},
+    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_tnet_point1_w, box_beams128_s8_tnet_point1_b, box_beams128_s8_tnet_point1_m, box_beams128_s8_tnet_point1_s, LIDET_PNQ_PK(box_beams128_s8_tnet_point1_wpk), LIDET_PNQ_LB(box_beams128_s8_tnet_point1_lb)}
 };
 
 /* tnet.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -405,8 +414,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams128_s8_tnet_pvle1_wp
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams128_s8_tnet_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_tnet_pvle0_w, box_beams128_s8_tnet_pvle0_b, box_beams128_s8_tnet_pvle0_m, box_beams128_s8_tnet_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_tnet_pvle1_w, box_beams128_s8_tnet_pvle1_b, box_beams128_s8_tnet_pvle1_m, box_beams128_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_beams128_s8_tnet_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_tnet_pvle0_w, box_beams128_s8_tnet_pvle0_b, box_beams128_s8_tnet_pvle0_m, box_beams128_s8_tnet_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_tnet_pvle1_w, box_beams128_s8_tnet_pvle1_b, box_beams128_s8_tnet_pvle1_m, box_beams128_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_beams128_s8_tnet_pvle1_wpk), 0}
 };
 
 /* tnet.head[0] weights [96][64] int8 (per-channel scale) */
@@ -1051,8 +1060,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams128_s8_tnet_head1_wp
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams128_s8_tnet_head[2] = {
-    {96u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_tnet_head0_w, box_beams128_s8_tnet_head0_b, box_beams128_s8_tnet_head0_m, box_beams128_s8_tnet_head0_s, LIDET_PNQ_PK(box_beams128_s8_tnet_head0_wpk)},
-    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams128_s8_tnet_head1_w, box_beams128_s8_tnet_head1_b, box_beams128_s8_tnet_head1_m, box_beams128_s8_tnet_head1_s, LIDET_PNQ_PK(box_beams128_s8_tnet_head1_wpk)}
+    {96u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_tnet_head0_w, box_beams128_s8_tnet_head0_b, box_beams128_s8_tnet_head0_m, box_beams128_s8_tnet_head0_s, LIDET_PNQ_PK(box_beams128_s8_tnet_head0_wpk), 0},
+    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams128_s8_tnet_head1_w, box_beams128_s8_tnet_head1_b, box_beams128_s8_tnet_head1_m, box_beams128_s8_tnet_head1_s, LIDET_PNQ_PK(box_beams128_s8_tnet_head1_wpk), 0}
 };
 
 /* tnet: class one-hot folded into head[0], [class][out] int32 */
@@ -1565,6 +1574,17 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams128_s8_box_point1_wp
     4291428321u, 4289462351u, 1703968u, 4289134553u, 4294836196u, 5111828u, 1703976u, 4293394456u, 2424818u, 4288610358u, 4293984273u, 851874u, 4288741352u, 4291624925u, 4294180816u, 4325333u,
     4294246458u, 3538817u, 4292345886u, 4292739082u, 1900564u, 4288085929u, 458809u, 4291821557u, 4293853202u, 4849604u, 4290969594u, 4290379719u, 4291493848u, 4259891u, 3145709u, 4289724343u,
     4293722046u, 4293787607u, 4288348155u, 4292345752u, 4292083692u, 1638297u, 1703965u, 4290445358u, 4291559414u, 4063296u, 4294574048u, 4292476915u, 4286709714u, 4286709658u, 3801107u, 6094788u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_beams128_s8_box_point1_lb[96] = {
+    10508, 24912, -12938, 3321, 14812, -3424, 9681, 18499, -12745, 2769, 12088, 4034, 19420, 19158, -280, -12397,
+    -21858, -23100, 1142, 5075, 6107, 5963, 6098, -21619, -8994, 8579, 3306, 10746, 12979, 24469, -1364, -25367,
+    2707, 8662, 21214, 15516, -5314, -17175, 7254, -8194, -382, 7254, -21290, -6034, 2539, 17399, 8647, 10004,
+    7518, 20376, 11861, -4734, -6244, 13555, -9158, 2691, 6910, -5014, 4556, 878, 8911, 711, 20244, -20318,
+    356, -2555, 13753, -4521, -16273, -875, -5180, 12011, -17557, 9502, -11249, 8692, -9398, 1997, 15825, 29274,
+    -29165, -3078, 1317, 1692, -12154, -10935, 16394, -6306, 14269, 11100, 3171, 19710, 20798, 9151, 9148, 20802
 };
 #endif
 /* box.point[2] weights [96][160] int8 (per-channel scale) */
@@ -3054,10 +3074,25 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams128_s8_box_point2_wp
     7929890u, 4294246425u, 7864360u, 4294443038u, 2359347u, 4291362747u, 4289527793u, 4290314242u, 7077939u, 4291035090u, 4293001175u, 1703934u, 720951u, 3932247u, 4294770670u, 1572802u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_beams128_s8_box_point2_lb[160] = {
+    21592, 7185, 12796, 9783, 10736, 4734, -4217, 4035, 11852, -923, -2983, 7886, 15960, 2576, 19523, -13493,
+    18989, -11107, 8141, 9240, 15748, -10474, 16589, 3017, 18598, 284, 23375, 13209, -6210, -1627, -3095, 17695,
+    -1802, 19741, 25, 11161, 10239, -2507, 22439, 4315, -14650, 22480, 3966, 7737, -16124, 1257, -1619, -11272,
+    18574, 35985, -617, 8698, -5787, -467, 12953, 10220, 505, -11224, 14855, 10474, 13968, 13360, -2647, -258,
+    21433, 11457, 8210, 9580, 19297, 13445, 10414, 17191, 7580, 11305, -25019, 13470, 11495, 17019, 9685, 12256,
+    11362, 12585, 8072, -7487, 6671, -404, 16249, -5485, 27371, -3242, -25777, 9530, 13163, -11263, 22778, -8704,
+    -6838, 11873, -8673, 5015, 15826, 24631, 13118, -1271, 17930, 3071, -5111, 8170, 2141, 9627, -7144, 12261,
+    -4875, 27347, 18020, 15674, 3525, 11731, 3381, -11562, 13807, 6727, -13528, 27948, 6641, 8455, -414, 11462,
+    -16032, 4814, 4969, 3260, 17294, -5578, -3023, 26337, -25542, -6618, 9734, 4403, -2248, 14990, -9680, 24546,
+    20451, 3996, -8015, 16099, 16656, 6576, 2826, 15060, 19448, 22387, 15748, 9898, 1499, -10156, -19121, 3484
+};
+#endif
 static const lidet_pointnet_q_layer_t box_beams128_s8_box_point[3] = {
-    {3u, 48u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_point0_w, box_beams128_s8_box_point0_b, box_beams128_s8_box_point0_m, box_beams128_s8_box_point0_s, 0},
-    {48u, 96u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_point1_w, box_beams128_s8_box_point1_b, box_beams128_s8_box_point1_m, box_beams128_s8_box_point1_s, LIDET_PNQ_PK(box_beams128_s8_box_point1_wpk)},
-    {96u, 160u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_point2_w, box_beams128_s8_box_point2_b, box_beams128_s8_box_point2_m, box_beams128_s8_box_point2_s, LIDET_PNQ_PK(box_beams128_s8_box_point2_wpk)}
+    {3u, 48u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_point0_w, box_beams128_s8_box_point0_b, box_beams128_s8_box_point0_m, box_beams128_s8_box_point0_s, 0, 0},
+    {48u, 96u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_point1_w, box_beams128_s8_box_point1_b, box_beams128_s8_box_point1_m, box_beams128_s8_box_point1_s, LIDET_PNQ_PK(box_beams128_s8_box_point1_wpk), LIDET_PNQ_LB(box_beams128_s8_box_point1_lb)},
+    {96u, 160u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_point2_w, box_beams128_s8_box_point2_b, box_beams128_s8_box_point2_m, box_beams128_s8_box_point2_s, LIDET_PNQ_PK(box_beams128_s8_box_point2_wpk), LIDET_PNQ_LB(box_beams128_s8_box_point2_lb)}
 };
 
 /* box.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -3204,8 +3239,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams128_s8_box_pvle1_wpk
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams128_s8_box_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_pvle0_w, box_beams128_s8_box_pvle0_b, box_beams128_s8_box_pvle0_m, box_beams128_s8_box_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_pvle1_w, box_beams128_s8_box_pvle1_b, box_beams128_s8_box_pvle1_m, box_beams128_s8_box_pvle1_s, LIDET_PNQ_PK(box_beams128_s8_box_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_pvle0_w, box_beams128_s8_box_pvle0_b, box_beams128_s8_box_pvle0_m, box_beams128_s8_box_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_pvle1_w, box_beams128_s8_box_pvle1_b, box_beams128_s8_box_pvle1_m, box_beams128_s8_box_pvle1_s, LIDET_PNQ_PK(box_beams128_s8_box_pvle1_wpk), 0}
 };
 
 /* box.head[0] weights [192][128] int8 (per-channel scale) */
@@ -6609,9 +6644,9 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams128_s8_box_head2_wpk
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams128_s8_box_head[3] = {
-    {192u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_head0_w, box_beams128_s8_box_head0_b, box_beams128_s8_box_head0_m, box_beams128_s8_box_head0_s, LIDET_PNQ_PK(box_beams128_s8_box_head0_wpk)},
-    {128u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_head1_w, box_beams128_s8_box_head1_b, box_beams128_s8_box_head1_m, box_beams128_s8_box_head1_s, LIDET_PNQ_PK(box_beams128_s8_box_head1_wpk)},
-    {64u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams128_s8_box_head2_w, box_beams128_s8_box_head2_b, box_beams128_s8_box_head2_m, box_beams128_s8_box_head2_s, LIDET_PNQ_PK(box_beams128_s8_box_head2_wpk)}
+    {192u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_head0_w, box_beams128_s8_box_head0_b, box_beams128_s8_box_head0_m, box_beams128_s8_box_head0_s, LIDET_PNQ_PK(box_beams128_s8_box_head0_wpk), 0},
+    {128u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams128_s8_box_head1_w, box_beams128_s8_box_head1_b, box_beams128_s8_box_head1_m, box_beams128_s8_box_head1_s, LIDET_PNQ_PK(box_beams128_s8_box_head1_wpk), 0},
+    {64u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams128_s8_box_head2_w, box_beams128_s8_box_head2_b, box_beams128_s8_box_head2_m, box_beams128_s8_box_head2_s, LIDET_PNQ_PK(box_beams128_s8_box_head2_wpk), 0}
 };
 
 /* box: class one-hot folded into head[0], [class][out] int32 */

@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "box_beams32_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "box_beams32_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "box_beams32_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* tnet.point[0] weights [3][32] int8 (per-channel scale) */
@@ -256,9 +256,18 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams32_s8_tnet_point1_wp
     4292608080u, 4293394493u, 327594u, 262149u, 4291952554u, 917412u, 3276836u, 720862u, 4128847u, 4289593314u, 1965988u, 4291166261u, 4290117587u, 4293460076u, 4291166291u, 3801079u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* tnet.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_beams32_s8_tnet_point1_lb[64] = {
+    6948, 926, 7009, -3700, 7101, 4527, -14892, 1310, -19158, 3146, 3262, 1238, 4819, -1425, 2540, -169,
+    -1243, -6105, 1275, 5789, 5280, -2613, 5788, 201, -1292, 4078, -1787, 14632, -4652, -3443, 17523, 10869,
+    11655, 3219, 7179, -11015, 13349, 8404, -4055, -8329, 807, 64, -16294, 6622, -1945, 2073, 2408, 5640,
+    1773, 1341, -3522, 3295, -1887, 378, 4360, 361, 3585, 9477, 334, -5938, 5059, 8301, 307, 5227
+};
+#endif
 static const lidet_pointnet_q_layer_t box_beams32_s8_tnet_point[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_tnet_point0_w, box_beams32_s8_tnet_point0_b, box_beams32_s8_tnet_point0_m, box_beams32_s8_tnet_point0_s, 0},
-    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_tnet_point1_w, box_beams32_s8_tnet_point1_b, box_beams32_s8_tnet_point1_m, box_beams32_s8_tnet_point1_s, LIDET_PNQ_PK(box_beams32_s8_tnet_point1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_tnet_point0_w, box_beams32_s8_tnet_point0_b, box_beams32_s8_tnet_point0_m, box_beams32_s8_tnet_point0_s, 0, 0},
+    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_tnet_point1_w, box_beams32_s8_tnet_point1_b, box_beams32_s8_tnet_point1_m, box_beams32_s8_tnet_point1_s, LIDET_PNQ_PK(box_beams32_s8_tnet_point1_wpk), LIDET_PNQ_LB(box_beams32_s8_tnet_point1_lb)}
 };
 
 /* tnet.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -405,8 +414,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams32_s8_tnet_pvle1_wpk
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams32_s8_tnet_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_tnet_pvle0_w, box_beams32_s8_tnet_pvle0_b, box_beams32_s8_tnet_pvle0_m, box_beams32_s8_tnet_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_tnet_pvle1_w, box_beams32_s8_tnet_pvle1_b, box_beams32_s8_tnet_pvle1_m, box_beams32_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_beams32_s8_tnet_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_tnet_pvle0_w, box_beams32_s8_tnet_pvle0_b, box_beams32_s8_tnet_pvle0_m, box_beams32_s8_tnet_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_tnet_pvle1_w, box_beams32_s8_tnet_pvle1_b, box_beams32_s8_tnet_pvle1_m, box_beams32_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_beams32_s8_tnet_pvle1_wpk), 0}
 };
 
 /* tnet.head[0] weights [96][64] int8 (per-channel scale) */
@@ -1051,8 +1060,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams32_s8_tnet_head1_wpk
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams32_s8_tnet_head[2] = {
-    {96u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_tnet_head0_w, box_beams32_s8_tnet_head0_b, box_beams32_s8_tnet_head0_m, box_beams32_s8_tnet_head0_s, LIDET_PNQ_PK(box_beams32_s8_tnet_head0_wpk)},
-    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams32_s8_tnet_head1_w, box_beams32_s8_tnet_head1_b, box_beams32_s8_tnet_head1_m, box_beams32_s8_tnet_head1_s, LIDET_PNQ_PK(box_beams32_s8_tnet_head1_wpk)}
+    {96u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_tnet_head0_w, box_beams32_s8_tnet_head0_b, box_beams32_s8_tnet_head0_m, box_beams32_s8_tnet_head0_s, LIDET_PNQ_PK(box_beams32_s8_tnet_head0_wpk), 0},
+    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams32_s8_tnet_head1_w, box_beams32_s8_tnet_head1_b, box_beams32_s8_tnet_head1_m, box_beams32_s8_tnet_head1_s, LIDET_PNQ_PK(box_beams32_s8_tnet_head1_wpk), 0}
 };
 
 /* tnet: class one-hot folded into head[0], [class][out] int32 */
@@ -1565,6 +1574,17 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams32_s8_box_point1_wpk
     4291559328u, 4288675925u, 2424877u, 4286775281u, 2031588u, 4063270u, 3670100u, 4291821597u, 2949086u, 4288872480u, 655394u, 262073u, 4288085998u, 4290445240u, 4294311933u, 3080220u,
     4293394511u, 3932084u, 4292935764u, 4291297292u, 2687008u, 4287823758u, 393264u, 4291428378u, 4292804649u, 3604400u, 4289658878u, 4289331132u, 4290379700u, 4390987u, 5963705u, 4290510770u,
     4294115230u, 4290904034u, 4290641903u, 4291362715u, 4286644229u, 1834881u, 1572916u, 4287561755u, 4290838484u, 1835098u, 4294115274u, 4292739018u, 4286971844u, 4287627142u, 6225949u, 4063169u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_beams32_s8_box_point1_lb[96] = {
+    6966, 19212, -12725, 9167, 20398, 282, 8523, 26667, -11964, 3537, 5684, 2555, 12797, 17974, 3540, -12907,
+    -11660, -27127, -3471, -260, 8810, -4077, 2490, -14653, 2201, 8092, 11373, 3946, 15959, 24414, -2102, -18200,
+    -2748, 8066, 15344, 7215, -7247, -15871, -738, -5280, 5288, -6457, -6463, -5299, -501, 19698, 10080, 7984,
+    16601, 15152, 6590, 3220, -5504, 14426, -14262, 11853, 13021, -11755, 9788, 8525, 9887, -7121, 22602, -20662,
+    6881, 6546, 9240, 4855, -6084, -5494, -9622, 7961, -6025, -13293, -12035, 10953, -12080, 6783, 2454, 22808,
+    -5395, -3853, 14016, -15942, -5752, -13191, 15717, -11954, 14029, 11402, -2243, 15519, 20921, -3456, 6868, 25082
 };
 #endif
 /* box.point[2] weights [96][160] int8 (per-channel scale) */
@@ -3054,10 +3074,25 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams32_s8_box_point2_wpk
     6225892u, 4293001285u, 4063250u, 1179622u, 5898285u, 4291428246u, 4290838480u, 4289789986u, 2293830u, 4292411346u, 1507339u, 4291493836u, 53u, 4849691u, 4293263338u, 196586u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_beams32_s8_box_point2_lb[160] = {
+    18154, 12908, 20370, 15668, 11952, 903, 9615, -7571, 21341, -5732, 14259, 7255, 16587, -20286, 12070, 762,
+    10582, -7386, -3467, 21829, 16842, -3302, 13771, 5463, 24864, 8745, 9744, -1097, 120, -3070, -1406, 13735,
+    4660, 20685, 12863, 10463, -6259, 11877, 10874, -1710, 9159, 18201, 5597, 10446, 8022, 19558, 5983, -5362,
+    -4269, 28088, 9710, -16283, -14713, 6293, 505, 14063, 4559, 4753, 22914, 8322, 4978, 13782, 2771, 151,
+    13708, 26945, 18, 16760, 11304, 10084, 20800, 7190, 12700, 26538, -10258, 10419, -6598, -3616, 7147, 870,
+    1488, 13161, 9436, 6269, -5302, -200, 5670, -24011, 9675, 16907, 6240, 975, -11840, 9287, 16665, -11988,
+    1846, 4512, -8576, -2190, 24609, 19330, 4051, 964, 18145, 12932, 19729, 11171, 11536, -13771, 2163, 9934,
+    2952, 12077, 7278, 6958, 18662, 6812, -7065, -6723, 4378, -28035, 13211, 3803, 4767, -1811, -5547, 4863,
+    -3031, 478, 13263, 5433, -10425, 13721, 936, 5257, -8512, -6225, 1039, 15530, -15873, 9654, 28468, 10592,
+    1295, 5681, 11193, 129, 13832, 23, 2274, 24918, 19066, -9004, 2943, -7411, -11025, 10270, 11436, 21259
+};
+#endif
 static const lidet_pointnet_q_layer_t box_beams32_s8_box_point[3] = {
-    {3u, 48u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_point0_w, box_beams32_s8_box_point0_b, box_beams32_s8_box_point0_m, box_beams32_s8_box_point0_s, 0},
-    {48u, 96u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_point1_w, box_beams32_s8_box_point1_b, box_beams32_s8_box_point1_m, box_beams32_s8_box_point1_s, LIDET_PNQ_PK(box_beams32_s8_box_point1_wpk)},
-    {96u, 160u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_point2_w, box_beams32_s8_box_point2_b, box_beams32_s8_box_point2_m, box_beams32_s8_box_point2_s, LIDET_PNQ_PK(box_beams32_s8_box_point2_wpk)}
+    {3u, 48u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_point0_w, box_beams32_s8_box_point0_b, box_beams32_s8_box_point0_m, box_beams32_s8_box_point0_s, 0, 0},
+    {48u, 96u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_point1_w, box_beams32_s8_box_point1_b, box_beams32_s8_box_point1_m, box_beams32_s8_box_point1_s, LIDET_PNQ_PK(box_beams32_s8_box_point1_wpk), LIDET_PNQ_LB(box_beams32_s8_box_point1_lb)},
+    {96u, 160u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_point2_w, box_beams32_s8_box_point2_b, box_beams32_s8_box_point2_m, box_beams32_s8_box_point2_s, LIDET_PNQ_PK(box_beams32_s8_box_point2_wpk), LIDET_PNQ_LB(box_beams32_s8_box_point2_lb)}
 };
 
 /* box.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -3204,8 +3239,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams32_s8_box_pvle1_wpk[
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams32_s8_box_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_pvle0_w, box_beams32_s8_box_pvle0_b, box_beams32_s8_box_pvle0_m, box_beams32_s8_box_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_pvle1_w, box_beams32_s8_box_pvle1_b, box_beams32_s8_box_pvle1_m, box_beams32_s8_box_pvle1_s, LIDET_PNQ_PK(box_beams32_s8_box_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_pvle0_w, box_beams32_s8_box_pvle0_b, box_beams32_s8_box_pvle0_m, box_beams32_s8_box_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_pvle1_w, box_beams32_s8_box_pvle1_b, box_beams32_s8_box_pvle1_m, box_beams32_s8_box_pvle1_s, LIDET_PNQ_PK(box_beams32_s8_box_pvle1_wpk), 0}
 };
 
 /* box.head[0] weights [192][128] int8 (per-channel scale) */
@@ -6609,9 +6644,9 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams32_s8_box_head2_wpk[
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams32_s8_box_head[3] = {
-    {192u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_head0_w, box_beams32_s8_box_head0_b, box_beams32_s8_box_head0_m, box_beams32_s8_box_head0_s, LIDET_PNQ_PK(box_beams32_s8_box_head0_wpk)},
-    {128u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_head1_w, box_beams32_s8_box_head1_b, box_beams32_s8_box_head1_m, box_beams32_s8_box_head1_s, LIDET_PNQ_PK(box_beams32_s8_box_head1_wpk)},
-    {64u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams32_s8_box_head2_w, box_beams32_s8_box_head2_b, box_beams32_s8_box_head2_m, box_beams32_s8_box_head2_s, LIDET_PNQ_PK(box_beams32_s8_box_head2_wpk)}
+    {192u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_head0_w, box_beams32_s8_box_head0_b, box_beams32_s8_box_head0_m, box_beams32_s8_box_head0_s, LIDET_PNQ_PK(box_beams32_s8_box_head0_wpk), 0},
+    {128u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams32_s8_box_head1_w, box_beams32_s8_box_head1_b, box_beams32_s8_box_head1_m, box_beams32_s8_box_head1_s, LIDET_PNQ_PK(box_beams32_s8_box_head1_wpk), 0},
+    {64u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams32_s8_box_head2_w, box_beams32_s8_box_head2_b, box_beams32_s8_box_head2_m, box_beams32_s8_box_head2_s, LIDET_PNQ_PK(box_beams32_s8_box_head2_wpk), 0}
 };
 
 /* box: class one-hot folded into head[0], [class][out] int32 */

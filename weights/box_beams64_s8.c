@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "box_beams64_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "box_beams64_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "box_beams64_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* tnet.point[0] weights [3][32] int8 (per-channel scale) */
@@ -256,9 +256,18 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams64_s8_tnet_point1_wp
     4291428444u, 4291887181u, 655263u, 655352u, 4291821475u, 4294901663u, 2949174u, 524268u, 4063330u, 4289003468u, 3342217u, 4291297336u, 4289986491u, 4291821695u, 4288872573u, 4849633u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* tnet.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_beams64_s8_tnet_point1_lb[64] = {
+    6826, 1965, 287, 4078, 6258, 3113, -4579, -2060, -1256, 3288, 5065, 751, 4623, 2877, 1513, -398,
+    233, 2641, 1455, -4809, 1172, -3284, 898, 5311, 486, 7614, -2516, 8589, 6398, -3717, 8937, 9164,
+    2751, 4340, 295, -7420, 7080, 6403, -3172, -6183, 4755, 3440, -11862, 826, 2520, -1456, -2345, 3327,
+    -3438, -1853, -816, 2247, -14958, 1352, 2625, -5466, -803, 12181, -1750, -1642, 2429, 4545, -887, 5155
+};
+#endif
 static const lidet_pointnet_q_layer_t box_beams64_s8_tnet_point[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_tnet_point0_w, box_beams64_s8_tnet_point0_b, box_beams64_s8_tnet_point0_m, box_beams64_s8_tnet_point0_s, 0},
-    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_tnet_point1_w, box_beams64_s8_tnet_point1_b, box_beams64_s8_tnet_point1_m, box_beams64_s8_tnet_point1_s, LIDET_PNQ_PK(box_beams64_s8_tnet_point1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_tnet_point0_w, box_beams64_s8_tnet_point0_b, box_beams64_s8_tnet_point0_m, box_beams64_s8_tnet_point0_s, 0, 0},
+    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_tnet_point1_w, box_beams64_s8_tnet_point1_b, box_beams64_s8_tnet_point1_m, box_beams64_s8_tnet_point1_s, LIDET_PNQ_PK(box_beams64_s8_tnet_point1_wpk), LIDET_PNQ_LB(box_beams64_s8_tnet_point1_lb)}
 };
 
 /* tnet.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -405,8 +414,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams64_s8_tnet_pvle1_wpk
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams64_s8_tnet_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_tnet_pvle0_w, box_beams64_s8_tnet_pvle0_b, box_beams64_s8_tnet_pvle0_m, box_beams64_s8_tnet_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_tnet_pvle1_w, box_beams64_s8_tnet_pvle1_b, box_beams64_s8_tnet_pvle1_m, box_beams64_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_beams64_s8_tnet_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_tnet_pvle0_w, box_beams64_s8_tnet_pvle0_b, box_beams64_s8_tnet_pvle0_m, box_beams64_s8_tnet_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_tnet_pvle1_w, box_beams64_s8_tnet_pvle1_b, box_beams64_s8_tnet_pvle1_m, box_beams64_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_beams64_s8_tnet_pvle1_wpk), 0}
 };
 
 /* tnet.head[0] weights [96][64] int8 (per-channel scale) */
@@ -1051,8 +1060,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams64_s8_tnet_head1_wpk
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams64_s8_tnet_head[2] = {
-    {96u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_tnet_head0_w, box_beams64_s8_tnet_head0_b, box_beams64_s8_tnet_head0_m, box_beams64_s8_tnet_head0_s, LIDET_PNQ_PK(box_beams64_s8_tnet_head0_wpk)},
-    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams64_s8_tnet_head1_w, box_beams64_s8_tnet_head1_b, box_beams64_s8_tnet_head1_m, box_beams64_s8_tnet_head1_s, LIDET_PNQ_PK(box_beams64_s8_tnet_head1_wpk)}
+    {96u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_tnet_head0_w, box_beams64_s8_tnet_head0_b, box_beams64_s8_tnet_head0_m, box_beams64_s8_tnet_head0_s, LIDET_PNQ_PK(box_beams64_s8_tnet_head0_wpk), 0},
+    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams64_s8_tnet_head1_w, box_beams64_s8_tnet_head1_b, box_beams64_s8_tnet_head1_m, box_beams64_s8_tnet_head1_s, LIDET_PNQ_PK(box_beams64_s8_tnet_head1_wpk), 0}
 };
 
 /* tnet: class one-hot folded into head[0], [class][out] int32 */
@@ -1565,6 +1574,17 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams64_s8_box_point1_wpk
     4293132174u, 4289790016u, 4325432u, 4289396755u, 1900494u, 1638437u, 3604574u, 4290576410u, 3407846u, 4292018241u, 3145759u, 983008u, 4287496158u, 4292280295u, 4293984267u, 4390929u,
     4293197918u, 4063159u, 4291821660u, 4293591043u, 2097180u, 4290314149u, 65585u, 4292083743u, 4290969611u, 5242834u, 4289003512u, 4290379727u, 4288741282u, 4390982u, 8388519u, 4291428293u,
     589709u, 196606u, 458694u, 4292607949u, 4287758338u, 1638273u, 1114164u, 4292411410u, 4289658829u, 4194391u, 4293197751u, 4292345857u, 4287954864u, 4289068972u, 7733275u, 4915164u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_beams64_s8_box_point1_lb[96] = {
+    8727, 12079, -5127, 809, 4958, 2008, 7817, 6013, -9789, -7807, 5755, 6726, 18421, 16717, 2678, -9927,
+    -8439, -11913, 2706, 2789, 3305, -4681, -6260, -13753, -1581, 5828, -7918, 5101, 11533, 14520, 5743, -17204,
+    -1495, 8573, 14420, 6139, -1896, -7391, 3605, -2934, -7656, -8163, -8851, -3281, -6268, 9999, 9238, 3066,
+    12570, 5081, 9475, -1072, -9114, 6177, -9130, 5128, 8816, -4967, 7108, 4158, 6067, 2415, 9193, -18111,
+    2294, 6005, 10109, 4334, -4132, -3672, -3869, 9361, -7438, -9175, -10074, 8676, -6275, 7646, 4142, 15164,
+    -7971, 5019, 6491, 3325, -2243, -3570, 12285, -11935, 9279, 9910, 4961, 4062, 13207, 4706, 5378, 6415
 };
 #endif
 /* box.point[2] weights [96][160] int8 (per-channel scale) */
@@ -3054,10 +3074,25 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams64_s8_box_point2_wpk
     5111782u, 4292608038u, 3997705u, 4294901726u, 5046310u, 4291231695u, 4290707418u, 4290510854u, 5242934u, 4292870160u, 1507306u, 4293918666u, 4293132332u, 4915244u, 4294574064u, 2228165u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_beams64_s8_box_point2_lb[160] = {
+    19207, 7679, 6690, 4725, 8973, 840, 10884, -3754, 17151, -11496, 19705, 14663, 7833, 13780, 9527, -11743,
+    6462, -12433, -654, 13948, -625, -6719, 15946, 2684, 24498, -2748, -686, 8446, -1007, 2179, 3111, 11027,
+    1530, 15010, 14898, 13562, 22572, 7031, 4614, -14209, -10363, 16434, 10419, 9040, -20765, 1292, 1967, -12446,
+    9529, 15949, 6647, 18108, 4390, 6995, -3655, 9905, 660, 6527, 1729, 7245, 648, 16305, -2337, -1735,
+    4571, 14099, 4476, 6066, 20302, 14024, -2197, 10608, -8100, 4514, -26790, 8611, 10234, 5155, -3376, 3658,
+    -4595, -5657, 5648, -8111, 2918, 1899, 9776, -8110, 16248, 1120, -5316, 4850, 1677, -13949, 11374, 2740,
+    -759, 9418, -11389, -17948, 18693, 16343, 11276, 5994, 15522, 7485, -8834, 5478, 9829, -4141, -8012, -287,
+    17136, -139, -3235, 11006, 12777, 15995, -57, 102, 9768, -17257, 7248, 13716, 7444, -14641, -12142, -7808,
+    3839, 6255, 6247, -2013, 2225, -10368, 2689, 11236, -7771, -4649, 4351, 7867, 1850, 1818, -2267, 15065,
+    4865, 22399, -9968, 6949, 2500, 8720, 9666, 16524, 16959, 4104, 776, -2900, 9013, 21405, -194, 12200
+};
+#endif
 static const lidet_pointnet_q_layer_t box_beams64_s8_box_point[3] = {
-    {3u, 48u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_point0_w, box_beams64_s8_box_point0_b, box_beams64_s8_box_point0_m, box_beams64_s8_box_point0_s, 0},
-    {48u, 96u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_point1_w, box_beams64_s8_box_point1_b, box_beams64_s8_box_point1_m, box_beams64_s8_box_point1_s, LIDET_PNQ_PK(box_beams64_s8_box_point1_wpk)},
-    {96u, 160u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_point2_w, box_beams64_s8_box_point2_b, box_beams64_s8_box_point2_m, box_beams64_s8_box_point2_s, LIDET_PNQ_PK(box_beams64_s8_box_point2_wpk)}
+    {3u, 48u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_point0_w, box_beams64_s8_box_point0_b, box_beams64_s8_box_point0_m, box_beams64_s8_box_point0_s, 0, 0},
+    {48u, 96u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_point1_w, box_beams64_s8_box_point1_b, box_beams64_s8_box_point1_m, box_beams64_s8_box_point1_s, LIDET_PNQ_PK(box_beams64_s8_box_point1_wpk), LIDET_PNQ_LB(box_beams64_s8_box_point1_lb)},
+    {96u, 160u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_point2_w, box_beams64_s8_box_point2_b, box_beams64_s8_box_point2_m, box_beams64_s8_box_point2_s, LIDET_PNQ_PK(box_beams64_s8_box_point2_wpk), LIDET_PNQ_LB(box_beams64_s8_box_point2_lb)}
 };
 
 /* box.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -3204,8 +3239,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams64_s8_box_pvle1_wpk[
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams64_s8_box_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_pvle0_w, box_beams64_s8_box_pvle0_b, box_beams64_s8_box_pvle0_m, box_beams64_s8_box_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_pvle1_w, box_beams64_s8_box_pvle1_b, box_beams64_s8_box_pvle1_m, box_beams64_s8_box_pvle1_s, LIDET_PNQ_PK(box_beams64_s8_box_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_pvle0_w, box_beams64_s8_box_pvle0_b, box_beams64_s8_box_pvle0_m, box_beams64_s8_box_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_pvle1_w, box_beams64_s8_box_pvle1_b, box_beams64_s8_box_pvle1_m, box_beams64_s8_box_pvle1_s, LIDET_PNQ_PK(box_beams64_s8_box_pvle1_wpk), 0}
 };
 
 /* box.head[0] weights [192][128] int8 (per-channel scale) */
@@ -6609,9 +6644,9 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_beams64_s8_box_head2_wpk[
 };
 #endif
 static const lidet_pointnet_q_layer_t box_beams64_s8_box_head[3] = {
-    {192u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_head0_w, box_beams64_s8_box_head0_b, box_beams64_s8_box_head0_m, box_beams64_s8_box_head0_s, LIDET_PNQ_PK(box_beams64_s8_box_head0_wpk)},
-    {128u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_head1_w, box_beams64_s8_box_head1_b, box_beams64_s8_box_head1_m, box_beams64_s8_box_head1_s, LIDET_PNQ_PK(box_beams64_s8_box_head1_wpk)},
-    {64u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams64_s8_box_head2_w, box_beams64_s8_box_head2_b, box_beams64_s8_box_head2_m, box_beams64_s8_box_head2_s, LIDET_PNQ_PK(box_beams64_s8_box_head2_wpk)}
+    {192u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_head0_w, box_beams64_s8_box_head0_b, box_beams64_s8_box_head0_m, box_beams64_s8_box_head0_s, LIDET_PNQ_PK(box_beams64_s8_box_head0_wpk), 0},
+    {128u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_beams64_s8_box_head1_w, box_beams64_s8_box_head1_b, box_beams64_s8_box_head1_m, box_beams64_s8_box_head1_s, LIDET_PNQ_PK(box_beams64_s8_box_head1_wpk), 0},
+    {64u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_beams64_s8_box_head2_w, box_beams64_s8_box_head2_b, box_beams64_s8_box_head2_m, box_beams64_s8_box_head2_s, LIDET_PNQ_PK(box_beams64_s8_box_head2_wpk), 0}
 };
 
 /* box: class one-hot folded into head[0], [class][out] int32 */

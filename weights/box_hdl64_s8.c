@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "box_hdl64_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "box_hdl64_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "box_hdl64_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* tnet.point[0] weights [3][32] int8 (per-channel scale) */
@@ -256,9 +256,18 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_hdl64_s8_tnet_point1_wpk[
     4294705206u, 4293918817u, 2424708u, 65525u, 4292345760u, 4294901714u, 4784119u, 917465u, 4718645u, 4290707360u, 4294836097u, 4292935764u, 4291035097u, 4291821669u, 4292411437u, 2555922u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* tnet.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_hdl64_s8_tnet_point1_lb[64] = {
+    14503, -2224, 6256, 1272, 3724, -450, -17515, 11131, -2159, 9100, 13694, 6062, 9434, 1152, 88, -270,
+    1467, 7582, 4828, 16011, -729, 761, -715, 5225, -5501, 5025, 475, 23974, -167, -312, 15862, 8660,
+    1953, 6031, 5605, -12341, 8961, 12466, -5077, -8277, 9610, 15485, -11712, 10090, 690, -5239, 2142, -1743,
+    11225, 9890, 6293, 2718, -25441, 6226, 10165, 1220, 14742, 3024, -4099, 10928, 2715, 11224, 2946, 1440
+};
+#endif
 static const lidet_pointnet_q_layer_t box_hdl64_s8_tnet_point[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_tnet_point0_w, box_hdl64_s8_tnet_point0_b, box_hdl64_s8_tnet_point0_m, box_hdl64_s8_tnet_point0_s, 0},
-    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_tnet_point1_w, box_hdl64_s8_tnet_point1_b, box_hdl64_s8_tnet_point1_m, box_hdl64_s8_tnet_point1_s, LIDET_PNQ_PK(box_hdl64_s8_tnet_point1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_tnet_point0_w, box_hdl64_s8_tnet_point0_b, box_hdl64_s8_tnet_point0_m, box_hdl64_s8_tnet_point0_s, 0, 0},
+    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_tnet_point1_w, box_hdl64_s8_tnet_point1_b, box_hdl64_s8_tnet_point1_m, box_hdl64_s8_tnet_point1_s, LIDET_PNQ_PK(box_hdl64_s8_tnet_point1_wpk), LIDET_PNQ_LB(box_hdl64_s8_tnet_point1_lb)}
 };
 
 /* tnet.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -405,8 +414,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_hdl64_s8_tnet_pvle1_wpk[5
 };
 #endif
 static const lidet_pointnet_q_layer_t box_hdl64_s8_tnet_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_tnet_pvle0_w, box_hdl64_s8_tnet_pvle0_b, box_hdl64_s8_tnet_pvle0_m, box_hdl64_s8_tnet_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_tnet_pvle1_w, box_hdl64_s8_tnet_pvle1_b, box_hdl64_s8_tnet_pvle1_m, box_hdl64_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_hdl64_s8_tnet_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_tnet_pvle0_w, box_hdl64_s8_tnet_pvle0_b, box_hdl64_s8_tnet_pvle0_m, box_hdl64_s8_tnet_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_tnet_pvle1_w, box_hdl64_s8_tnet_pvle1_b, box_hdl64_s8_tnet_pvle1_m, box_hdl64_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_hdl64_s8_tnet_pvle1_wpk), 0}
 };
 
 /* tnet.head[0] weights [96][64] int8 (per-channel scale) */
@@ -1051,8 +1060,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_hdl64_s8_tnet_head1_wpk[6
 };
 #endif
 static const lidet_pointnet_q_layer_t box_hdl64_s8_tnet_head[2] = {
-    {96u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_tnet_head0_w, box_hdl64_s8_tnet_head0_b, box_hdl64_s8_tnet_head0_m, box_hdl64_s8_tnet_head0_s, LIDET_PNQ_PK(box_hdl64_s8_tnet_head0_wpk)},
-    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_hdl64_s8_tnet_head1_w, box_hdl64_s8_tnet_head1_b, box_hdl64_s8_tnet_head1_m, box_hdl64_s8_tnet_head1_s, LIDET_PNQ_PK(box_hdl64_s8_tnet_head1_wpk)}
+    {96u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_tnet_head0_w, box_hdl64_s8_tnet_head0_b, box_hdl64_s8_tnet_head0_m, box_hdl64_s8_tnet_head0_s, LIDET_PNQ_PK(box_hdl64_s8_tnet_head0_wpk), 0},
+    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_hdl64_s8_tnet_head1_w, box_hdl64_s8_tnet_head1_b, box_hdl64_s8_tnet_head1_m, box_hdl64_s8_tnet_head1_s, LIDET_PNQ_PK(box_hdl64_s8_tnet_head1_wpk), 0}
 };
 
 /* tnet: class one-hot folded into head[0], [class][out] int32 */
@@ -1565,6 +1574,17 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_hdl64_s8_box_point1_wpk[2
     196499u, 4289724450u, 917587u, 4291100641u, 1966036u, 1638427u, 4849701u, 4293328925u, 1769427u, 4292608048u, 4289593378u, 1638337u, 4288479208u, 4294574029u, 4293853193u, 1114055u,
     4293591150u, 3407808u, 4291821590u, 4291493905u, 327728u, 4291887022u, 1376304u, 4293459949u, 4291231740u, 2883536u, 4289331184u, 4293263344u, 4292476860u, 3670072u, 8257485u, 4289134530u,
     458652u, 4291362813u, 4286709748u, 4293394377u, 4290248728u, 1179608u, 589875u, 4290969594u, 4290445266u, 1900603u, 130984u, 4293656545u, 4289396697u, 4286709721u, 4259854u, 3604472u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_hdl64_s8_box_point1_lb[96] = {
+    12278, 19612, 5447, 11093, 11320, -5289, 13169, 21263, -3919, 457, 14682, -9761, 28548, 16329, 2496, -19794,
+    -29310, -42486, -14877, 9883, 19654, 9352, 7478, -20650, -27423, 9584, 9683, 6114, 13964, 27238, 9659, -27976,
+    1969, 9421, 21303, 8751, -12123, -31922, 19965, -4412, -328, -16030, -6099, -2054, -13352, 18357, 6455, 10345,
+    16742, 23655, 12955, -20186, 15831, 16583, -5524, 7591, 18528, -7053, 16088, 5791, 12581, 378, 23982, -36859,
+    4246, 11011, 21476, 4740, 6535, 530, 4906, 20548, -25878, 5009, -3627, 8590, -18892, 10705, -6963, 24583,
+    -15224, -11934, 7740, 6352, 565, -6097, 6235, -18262, 12219, 8907, 5284, 19941, 9488, 10683, 6468, 17639
 };
 #endif
 /* box.point[2] weights [96][160] int8 (per-channel scale) */
@@ -3054,10 +3074,25 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_hdl64_s8_box_point2_wpk[7
     1769434u, 4294443050u, 2883550u, 458752u, 1835020u, 4293132257u, 4293459946u, 4291297250u, 917553u, 1376234u, 4291559385u, 4292149157u, 4294377518u, 4128800u, 4292542463u, 2621394u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_hdl64_s8_box_point2_lb[160] = {
+    23409, 13759, 16013, 4027, 9540, 7476, 11419, 26491, 6842, -5479, -9497, 3511, 16271, 9402, 25238, 9228,
+    15456, -117, 2336, 9106, 18656, -13432, 13472, 26567, 11802, -1139, 17931, 7593, 11479, 9156, -1877, 21419,
+    -9251, 23183, 12092, 9138, 29527, 34221, 29930, 19347, 4743, 13445, 35926, -877, -4168, 25913, 10007, -12804,
+    8265, 29859, 12776, 25452, 506, 13045, 28154, 17654, -2402, 26816, 30641, 9595, 10543, 11491, 8241, 12956,
+    11366, 15330, 4321, 12000, 12619, 12299, -1165, 8559, 6642, 3123, 16483, 13619, 11598, 12466, 7798, 3076,
+    8058, -10539, 8579, -14969, 11728, 21407, 35511, -5954, 11984, 8473, 12012, -2682, -1461, -191, 27033, 13727,
+    33681, 2829, 3630, 13134, 13693, 19105, 18817, 14350, 17541, 7640, -3859, 21953, 1901, 16211, 7611, -4077,
+    9473, 40187, 15395, 12680, 10208, 6187, 3910, -10247, 3109, 19294, 9366, 15439, 13014, 19222, 40310, 31900,
+    22309, 3987, 19308, 15402, 7503, 13786, -1529, 21194, -21, -3534, 6117, 7453, -800, 9966, 364, 18781,
+    -10723, 7310, 24702, -12440, 20559, 13360, -10921, 22321, 31800, 14902, 20991, -23050, 15190, -2384, 11612, 21819
+};
+#endif
 static const lidet_pointnet_q_layer_t box_hdl64_s8_box_point[3] = {
-    {3u, 48u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_point0_w, box_hdl64_s8_box_point0_b, box_hdl64_s8_box_point0_m, box_hdl64_s8_box_point0_s, 0},
-    {48u, 96u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_point1_w, box_hdl64_s8_box_point1_b, box_hdl64_s8_box_point1_m, box_hdl64_s8_box_point1_s, LIDET_PNQ_PK(box_hdl64_s8_box_point1_wpk)},
-    {96u, 160u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_point2_w, box_hdl64_s8_box_point2_b, box_hdl64_s8_box_point2_m, box_hdl64_s8_box_point2_s, LIDET_PNQ_PK(box_hdl64_s8_box_point2_wpk)}
+    {3u, 48u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_point0_w, box_hdl64_s8_box_point0_b, box_hdl64_s8_box_point0_m, box_hdl64_s8_box_point0_s, 0, 0},
+    {48u, 96u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_point1_w, box_hdl64_s8_box_point1_b, box_hdl64_s8_box_point1_m, box_hdl64_s8_box_point1_s, LIDET_PNQ_PK(box_hdl64_s8_box_point1_wpk), LIDET_PNQ_LB(box_hdl64_s8_box_point1_lb)},
+    {96u, 160u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_point2_w, box_hdl64_s8_box_point2_b, box_hdl64_s8_box_point2_m, box_hdl64_s8_box_point2_s, LIDET_PNQ_PK(box_hdl64_s8_box_point2_wpk), LIDET_PNQ_LB(box_hdl64_s8_box_point2_lb)}
 };
 
 /* box.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -3204,8 +3239,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_hdl64_s8_box_pvle1_wpk[51
 };
 #endif
 static const lidet_pointnet_q_layer_t box_hdl64_s8_box_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_pvle0_w, box_hdl64_s8_box_pvle0_b, box_hdl64_s8_box_pvle0_m, box_hdl64_s8_box_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_pvle1_w, box_hdl64_s8_box_pvle1_b, box_hdl64_s8_box_pvle1_m, box_hdl64_s8_box_pvle1_s, LIDET_PNQ_PK(box_hdl64_s8_box_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_pvle0_w, box_hdl64_s8_box_pvle0_b, box_hdl64_s8_box_pvle0_m, box_hdl64_s8_box_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_pvle1_w, box_hdl64_s8_box_pvle1_b, box_hdl64_s8_box_pvle1_m, box_hdl64_s8_box_pvle1_s, LIDET_PNQ_PK(box_hdl64_s8_box_pvle1_wpk), 0}
 };
 
 /* box.head[0] weights [192][128] int8 (per-channel scale) */
@@ -6609,9 +6644,9 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_hdl64_s8_box_head2_wpk[12
 };
 #endif
 static const lidet_pointnet_q_layer_t box_hdl64_s8_box_head[3] = {
-    {192u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_head0_w, box_hdl64_s8_box_head0_b, box_hdl64_s8_box_head0_m, box_hdl64_s8_box_head0_s, LIDET_PNQ_PK(box_hdl64_s8_box_head0_wpk)},
-    {128u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_head1_w, box_hdl64_s8_box_head1_b, box_hdl64_s8_box_head1_m, box_hdl64_s8_box_head1_s, LIDET_PNQ_PK(box_hdl64_s8_box_head1_wpk)},
-    {64u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_hdl64_s8_box_head2_w, box_hdl64_s8_box_head2_b, box_hdl64_s8_box_head2_m, box_hdl64_s8_box_head2_s, LIDET_PNQ_PK(box_hdl64_s8_box_head2_wpk)}
+    {192u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_head0_w, box_hdl64_s8_box_head0_b, box_hdl64_s8_box_head0_m, box_hdl64_s8_box_head0_s, LIDET_PNQ_PK(box_hdl64_s8_box_head0_wpk), 0},
+    {128u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_hdl64_s8_box_head1_w, box_hdl64_s8_box_head1_b, box_hdl64_s8_box_head1_m, box_hdl64_s8_box_head1_s, LIDET_PNQ_PK(box_hdl64_s8_box_head1_wpk), 0},
+    {64u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_hdl64_s8_box_head2_w, box_hdl64_s8_box_head2_b, box_hdl64_s8_box_head2_m, box_hdl64_s8_box_head2_s, LIDET_PNQ_PK(box_hdl64_s8_box_head2_wpk), 0}
 };
 
 /* box: class one-hot folded into head[0], [class][out] int32 */

@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "box_vlp16_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "box_vlp16_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "box_vlp16_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* tnet.point[0] weights [3][32] int8 (per-channel scale) */
@@ -256,9 +256,18 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16_s8_tnet_point1_wpk[
     4292214854u, 4292542540u, 393113u, 2818034u, 4292214691u, 4294573977u, 2359313u, 458717u, 4522050u, 4289724357u, 1769376u, 4290707510u, 4289462222u, 4290773111u, 4290576475u, 4521976u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* tnet.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_vlp16_s8_tnet_point1_lb[64] = {
+    4279, 481, 6617, 5000, 6376, 5972, -19126, -1587, -18234, 10651, 6043, -5054, 2160, 3120, -41, -6764,
+    2222, -2187, 2774, 2250, 13353, -4088, -4803, 2782, 1813, 8299, -2378, 16623, -9040, 3211, 19882, 14766,
+    7641, 5341, 5158, -14985, 5492, 8261, -10117, -6805, 3068, 5104, -14085, 7270, 7147, -2474, 3672, 470,
+    1766, 4846, 3718, 4553, -1314, 2022, -1246, 291, 1806, 4435, -516, -2630, -2580, 8198, 2178, 7212
+};
+#endif
 static const lidet_pointnet_q_layer_t box_vlp16_s8_tnet_point[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_tnet_point0_w, box_vlp16_s8_tnet_point0_b, box_vlp16_s8_tnet_point0_m, box_vlp16_s8_tnet_point0_s, 0},
-    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_tnet_point1_w, box_vlp16_s8_tnet_point1_b, box_vlp16_s8_tnet_point1_m, box_vlp16_s8_tnet_point1_s, LIDET_PNQ_PK(box_vlp16_s8_tnet_point1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_tnet_point0_w, box_vlp16_s8_tnet_point0_b, box_vlp16_s8_tnet_point0_m, box_vlp16_s8_tnet_point0_s, 0, 0},
+    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_tnet_point1_w, box_vlp16_s8_tnet_point1_b, box_vlp16_s8_tnet_point1_m, box_vlp16_s8_tnet_point1_s, LIDET_PNQ_PK(box_vlp16_s8_tnet_point1_wpk), LIDET_PNQ_LB(box_vlp16_s8_tnet_point1_lb)}
 };
 
 /* tnet.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -405,8 +414,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16_s8_tnet_pvle1_wpk[5
 };
 #endif
 static const lidet_pointnet_q_layer_t box_vlp16_s8_tnet_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_tnet_pvle0_w, box_vlp16_s8_tnet_pvle0_b, box_vlp16_s8_tnet_pvle0_m, box_vlp16_s8_tnet_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_tnet_pvle1_w, box_vlp16_s8_tnet_pvle1_b, box_vlp16_s8_tnet_pvle1_m, box_vlp16_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_vlp16_s8_tnet_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_tnet_pvle0_w, box_vlp16_s8_tnet_pvle0_b, box_vlp16_s8_tnet_pvle0_m, box_vlp16_s8_tnet_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_tnet_pvle1_w, box_vlp16_s8_tnet_pvle1_b, box_vlp16_s8_tnet_pvle1_m, box_vlp16_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_vlp16_s8_tnet_pvle1_wpk), 0}
 };
 
 /* tnet.head[0] weights [96][64] int8 (per-channel scale) */
@@ -1051,8 +1060,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16_s8_tnet_head1_wpk[6
 };
 #endif
 static const lidet_pointnet_q_layer_t box_vlp16_s8_tnet_head[2] = {
-    {96u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_tnet_head0_w, box_vlp16_s8_tnet_head0_b, box_vlp16_s8_tnet_head0_m, box_vlp16_s8_tnet_head0_s, LIDET_PNQ_PK(box_vlp16_s8_tnet_head0_wpk)},
-    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_vlp16_s8_tnet_head1_w, box_vlp16_s8_tnet_head1_b, box_vlp16_s8_tnet_head1_m, box_vlp16_s8_tnet_head1_s, LIDET_PNQ_PK(box_vlp16_s8_tnet_head1_wpk)}
+    {96u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_tnet_head0_w, box_vlp16_s8_tnet_head0_b, box_vlp16_s8_tnet_head0_m, box_vlp16_s8_tnet_head0_s, LIDET_PNQ_PK(box_vlp16_s8_tnet_head0_wpk), 0},
+    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_vlp16_s8_tnet_head1_w, box_vlp16_s8_tnet_head1_b, box_vlp16_s8_tnet_head1_m, box_vlp16_s8_tnet_head1_s, LIDET_PNQ_PK(box_vlp16_s8_tnet_head1_wpk), 0}
 };
 
 /* tnet: class one-hot folded into head[0], [class][out] int32 */
@@ -1565,6 +1574,17 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16_s8_box_point1_wpk[2
     4292280223u, 4288086110u, 786502u, 4288544765u, 1966025u, 3670055u, 3407944u, 4290117652u, 2359267u, 4289986627u, 4294049815u, 327622u, 4286709720u, 4291428325u, 4293722109u, 2818079u,
     4293394527u, 4259734u, 4291231798u, 4293132296u, 917543u, 4288544655u, 4294246445u, 4291559444u, 4292608006u, 5963727u, 4288741348u, 4289920960u, 4290903984u, 5308487u, 5832627u, 4289462208u,
     196489u, 1245163u, 4288151511u, 4291231667u, 4288675834u, 2228108u, 2687039u, 4291231763u, 4289724370u, 4587605u, 4293787593u, 4291624954u, 4287102920u, 4286709667u, 5177351u, 5570508u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_vlp16_s8_box_point1_lb[96] = {
+    14915, 23820, -8444, 7688, 17610, -5543, 7888, 20634, -15599, -3315, 675, 4147, 22743, 22080, 6349, -15898,
+    -15923, -32089, 4392, -22643, 12714, -2337, 8871, -22700, 2104, 11828, 4082, 11741, 16502, 9019, -1675, -16453,
+    2470, 11550, 7443, 8847, -14315, -4697, 13293, 3781, 7656, -8370, -16318, -10078, -15084, 14605, -11642, 10444,
+    10940, 12629, 16846, 7874, -17591, 19197, -14111, 5605, -2084, 3070, 5364, 14293, 5410, 5143, 11429, -22014,
+    13218, 8798, 16879, -7231, -18265, -8425, -5068, 12070, 225, 8902, -13577, 17656, -2901, 4804, 2478, 28900,
+    -12456, -3919, 10948, -226, -6400, -13036, 15570, -17910, 16748, 18457, 8776, 21079, 26285, -169, 14774, 17035
 };
 #endif
 /* box.point[2] weights [96][160] int8 (per-channel scale) */
@@ -3054,10 +3074,25 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16_s8_box_point2_wpk[7
     4390932u, 4293591078u, 3342367u, 2686913u, 3932222u, 4291821471u, 4291297210u, 4288282597u, 3539030u, 4294967262u, 4293328891u, 4291559322u, 4293918718u, 3473507u, 4292214768u, 1507288u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_vlp16_s8_box_point2_lb[160] = {
+    20285, 17376, 11278, -20162, 19257, 7155, -4844, 12739, 9031, -9578, 18794, -599, -676, -6512, 19084, 9383,
+    3335, -11599, 4684, -1885, 28052, -12646, 24002, 11373, 3303, 6515, 3867, 26481, 462, 217, -32867, 19625,
+    3960, 18131, 10562, 18823, 17458, 11795, 22183, 12001, 24458, 20443, 22156, 10263, -33805, 7464, 25379, 4456,
+    5549, 31292, 7607, 5946, -12507, 11698, 4342, 11932, 13154, 5646, 11168, 13677, -1965, 5533, -6591, -1788,
+    21500, 2421, 13601, 13011, 12892, 2925, 21762, -386, -13874, 15088, -21587, 11914, 5996, 18513, -6004, -2839,
+    12183, 4064, 4187, 4024, 10190, 20694, 34214, -2180, 3831, 3709, 8656, 3570, 185, 6872, 18808, -755,
+    13882, 14513, -18329, 5669, 20975, 26177, 25576, 11017, 11946, 8176, 2473, 9816, -9223, 1905, 373, 8669,
+    10775, 15787, -7470, 8284, 5375, 10638, -20535, -15503, 10005, 6040, 19454, 12773, 10357, 4166, 25573, 15181,
+    -13919, 6324, 15144, 28566, 13801, 13986, 12644, 4145, -15095, -19666, 5144, 14590, -21876, 10791, 3101, 8496,
+    2893, 3046, 4883, 10348, 2891, -12175, -7060, 12379, -1376, 12521, 3944, 1694, -11324, 6385, 7372, 9350
+};
+#endif
 static const lidet_pointnet_q_layer_t box_vlp16_s8_box_point[3] = {
-    {3u, 48u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_point0_w, box_vlp16_s8_box_point0_b, box_vlp16_s8_box_point0_m, box_vlp16_s8_box_point0_s, 0},
-    {48u, 96u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_point1_w, box_vlp16_s8_box_point1_b, box_vlp16_s8_box_point1_m, box_vlp16_s8_box_point1_s, LIDET_PNQ_PK(box_vlp16_s8_box_point1_wpk)},
-    {96u, 160u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_point2_w, box_vlp16_s8_box_point2_b, box_vlp16_s8_box_point2_m, box_vlp16_s8_box_point2_s, LIDET_PNQ_PK(box_vlp16_s8_box_point2_wpk)}
+    {3u, 48u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_point0_w, box_vlp16_s8_box_point0_b, box_vlp16_s8_box_point0_m, box_vlp16_s8_box_point0_s, 0, 0},
+    {48u, 96u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_point1_w, box_vlp16_s8_box_point1_b, box_vlp16_s8_box_point1_m, box_vlp16_s8_box_point1_s, LIDET_PNQ_PK(box_vlp16_s8_box_point1_wpk), LIDET_PNQ_LB(box_vlp16_s8_box_point1_lb)},
+    {96u, 160u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_point2_w, box_vlp16_s8_box_point2_b, box_vlp16_s8_box_point2_m, box_vlp16_s8_box_point2_s, LIDET_PNQ_PK(box_vlp16_s8_box_point2_wpk), LIDET_PNQ_LB(box_vlp16_s8_box_point2_lb)}
 };
 
 /* box.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -3204,8 +3239,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16_s8_box_pvle1_wpk[51
 };
 #endif
 static const lidet_pointnet_q_layer_t box_vlp16_s8_box_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_pvle0_w, box_vlp16_s8_box_pvle0_b, box_vlp16_s8_box_pvle0_m, box_vlp16_s8_box_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_pvle1_w, box_vlp16_s8_box_pvle1_b, box_vlp16_s8_box_pvle1_m, box_vlp16_s8_box_pvle1_s, LIDET_PNQ_PK(box_vlp16_s8_box_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_pvle0_w, box_vlp16_s8_box_pvle0_b, box_vlp16_s8_box_pvle0_m, box_vlp16_s8_box_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_pvle1_w, box_vlp16_s8_box_pvle1_b, box_vlp16_s8_box_pvle1_m, box_vlp16_s8_box_pvle1_s, LIDET_PNQ_PK(box_vlp16_s8_box_pvle1_wpk), 0}
 };
 
 /* box.head[0] weights [192][128] int8 (per-channel scale) */
@@ -6609,9 +6644,9 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16_s8_box_head2_wpk[12
 };
 #endif
 static const lidet_pointnet_q_layer_t box_vlp16_s8_box_head[3] = {
-    {192u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_head0_w, box_vlp16_s8_box_head0_b, box_vlp16_s8_box_head0_m, box_vlp16_s8_box_head0_s, LIDET_PNQ_PK(box_vlp16_s8_box_head0_wpk)},
-    {128u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_head1_w, box_vlp16_s8_box_head1_b, box_vlp16_s8_box_head1_m, box_vlp16_s8_box_head1_s, LIDET_PNQ_PK(box_vlp16_s8_box_head1_wpk)},
-    {64u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_vlp16_s8_box_head2_w, box_vlp16_s8_box_head2_b, box_vlp16_s8_box_head2_m, box_vlp16_s8_box_head2_s, LIDET_PNQ_PK(box_vlp16_s8_box_head2_wpk)}
+    {192u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_head0_w, box_vlp16_s8_box_head0_b, box_vlp16_s8_box_head0_m, box_vlp16_s8_box_head0_s, LIDET_PNQ_PK(box_vlp16_s8_box_head0_wpk), 0},
+    {128u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16_s8_box_head1_w, box_vlp16_s8_box_head1_b, box_vlp16_s8_box_head1_m, box_vlp16_s8_box_head1_s, LIDET_PNQ_PK(box_vlp16_s8_box_head1_wpk), 0},
+    {64u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_vlp16_s8_box_head2_w, box_vlp16_s8_box_head2_b, box_vlp16_s8_box_head2_m, box_vlp16_s8_box_head2_s, LIDET_PNQ_PK(box_vlp16_s8_box_head2_wpk), 0}
 };
 
 /* box: class one-hot folded into head[0], [class][out] int32 */

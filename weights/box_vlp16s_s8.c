@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "box_vlp16s_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "box_vlp16s_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "box_vlp16s_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* tnet.point[0] weights [3][16] int8 (per-channel scale) */
@@ -100,9 +100,16 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16s_s8_tnet_point1_wpk
     4289855475u, 4294639513u, 4292739168u, 720827u, 4286709680u, 4291887024u, 4287496296u, 4292542591u, 262241u, 5570617u, 4291428252u, 2293799u, 2228187u, 4292476913u, 4294574056u, 6815687u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* tnet.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_vlp16s_s8_tnet_point1_lb[32] = {
+    -2455, -12, 10609, -1124, 1266, 9581, 338, -687, 6460, -633, 1843, -2011, 6649, 1469, 11113, -2964,
+    -6368, -12555, -2671, 45, 787, -1921, 4261, 4446, -2535, 888, -267, -9702, 3985, 4567, 6362, 1329
+};
+#endif
 static const lidet_pointnet_q_layer_t box_vlp16s_s8_tnet_point[2] = {
-    {3u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_tnet_point0_w, box_vlp16s_s8_tnet_point0_b, box_vlp16s_s8_tnet_point0_m, box_vlp16s_s8_tnet_point0_s, 0},
-    {16u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_tnet_point1_w, box_vlp16s_s8_tnet_point1_b, box_vlp16s_s8_tnet_point1_m, box_vlp16s_s8_tnet_point1_s, LIDET_PNQ_PK(box_vlp16s_s8_tnet_point1_wpk)}
+    {3u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_tnet_point0_w, box_vlp16s_s8_tnet_point0_b, box_vlp16s_s8_tnet_point0_m, box_vlp16s_s8_tnet_point0_s, 0, 0},
+    {16u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_tnet_point1_w, box_vlp16s_s8_tnet_point1_b, box_vlp16s_s8_tnet_point1_m, box_vlp16s_s8_tnet_point1_s, LIDET_PNQ_PK(box_vlp16s_s8_tnet_point1_wpk), LIDET_PNQ_LB(box_vlp16s_s8_tnet_point1_lb)}
 };
 
 /* tnet.pvle[0] weights [3][16] int8 (per-channel scale) */
@@ -168,8 +175,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16s_s8_tnet_pvle1_wpk[
 };
 #endif
 static const lidet_pointnet_q_layer_t box_vlp16s_s8_tnet_pvle[2] = {
-    {3u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_tnet_pvle0_w, box_vlp16s_s8_tnet_pvle0_b, box_vlp16s_s8_tnet_pvle0_m, box_vlp16s_s8_tnet_pvle0_s, 0},
-    {16u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_tnet_pvle1_w, box_vlp16s_s8_tnet_pvle1_b, box_vlp16s_s8_tnet_pvle1_m, box_vlp16s_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_vlp16s_s8_tnet_pvle1_wpk)}
+    {3u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_tnet_pvle0_w, box_vlp16s_s8_tnet_pvle0_b, box_vlp16s_s8_tnet_pvle0_m, box_vlp16s_s8_tnet_pvle0_s, 0, 0},
+    {16u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_tnet_pvle1_w, box_vlp16s_s8_tnet_pvle1_b, box_vlp16s_s8_tnet_pvle1_m, box_vlp16s_s8_tnet_pvle1_s, LIDET_PNQ_PK(box_vlp16s_s8_tnet_pvle1_wpk), 0}
 };
 
 /* tnet.head[0] weights [48][32] int8 (per-channel scale) */
@@ -368,8 +375,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16s_s8_tnet_head1_wpk[
 };
 #endif
 static const lidet_pointnet_q_layer_t box_vlp16s_s8_tnet_head[2] = {
-    {48u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_tnet_head0_w, box_vlp16s_s8_tnet_head0_b, box_vlp16s_s8_tnet_head0_m, box_vlp16s_s8_tnet_head0_s, LIDET_PNQ_PK(box_vlp16s_s8_tnet_head0_wpk)},
-    {32u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_vlp16s_s8_tnet_head1_w, box_vlp16s_s8_tnet_head1_b, box_vlp16s_s8_tnet_head1_m, box_vlp16s_s8_tnet_head1_s, LIDET_PNQ_PK(box_vlp16s_s8_tnet_head1_wpk)}
+    {48u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_tnet_head0_w, box_vlp16s_s8_tnet_head0_b, box_vlp16s_s8_tnet_head0_m, box_vlp16s_s8_tnet_head0_s, LIDET_PNQ_PK(box_vlp16s_s8_tnet_head0_wpk), 0},
+    {32u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, box_vlp16s_s8_tnet_head1_w, box_vlp16s_s8_tnet_head1_b, box_vlp16s_s8_tnet_head1_m, box_vlp16s_s8_tnet_head1_s, LIDET_PNQ_PK(box_vlp16s_s8_tnet_head1_wpk), 0}
 };
 
 /* tnet: class one-hot folded into head[0], [class][out] int32 */
@@ -518,6 +525,14 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16s_s8_box_point1_wpk[
     65579u, 4294180780u, 5767107u, 4288479256u, 4390895u, 4291362943u, 4291559418u, 4288020454u, 3342334u, 4289462152u, 8323124u, 4291625007u, 4290379778u, 4294049698u, 4293394454u, 4063327u,
     1245149u, 5570640u, 2687043u, 4291559328u, 1048643u, 4287758428u, 4293459982u, 1441850u, 5308428u, 4294967289u, 4288806841u, 4849748u, 5242824u, 4292542512u, 5046372u, 3211223u,
     4289134565u, 4286709634u, 4294180737u, 7602252u, 4292804682u, 4849749u, 3866651u, 4289855472u, 4293197888u, 655357u, 4292804497u, 4292804635u, 1441786u, 458756u, 5373974u, 4652981u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_vlp16s_s8_box_point1_lb[40] = {
+    -7570, -7782, 7868, -7562, -1015, 2548, -3606, -3899, 744, -726, -7739, 2448, -2314, 6081, 11617, 4150,
+    6488, -10086, 3705, 14069, -4834, 226, 11208, 11249, -6786, 5907, -8799, 14374, 10613, 6368, 9231, 8277,
+    7267, 6984, 15946, 404, -7608, 5475, -56, -2646
 };
 #endif
 /* box.point[2] weights [40][64] int8 (per-channel scale) */
@@ -789,10 +804,19 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16s_s8_box_point2_wpk[
     4915200u, 6684617u, 4292149239u, 4293787715u, 1966119u, 4286644267u, 4849665u, 131004u, 4286709657u, 4294967225u, 4288217018u, 4291952748u, 4915146u, 3473328u, 4293853121u, 4294901802u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t box_vlp16s_s8_box_point2_lb[64] = {
+    6260, -18382, 6134, 8204, 1497, 8317, 12325, 1187, -741, 5334, 9136, 6830, -7812, 2607, 8617, 284,
+    -10090, -417, 11810, 9448, -8323, 6394, 12608, 5464, -1972, 8608, -5866, 14913, 898, 8457, 13247, -4443,
+    8388, -9857, -2148, 7863, -2637, -10931, -1819, 4899, 4556, 7844, 2908, 788, 3363, -966, 3628, 11164,
+    -9428, 3190, 3785, -158, 11926, -2382, -3609, -330, 2538, 2007, 9851, 9740, 2799, 6453, 7929, 4965
+};
+#endif
 static const lidet_pointnet_q_layer_t box_vlp16s_s8_box_point[3] = {
-    {3u, 24u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_point0_w, box_vlp16s_s8_box_point0_b, box_vlp16s_s8_box_point0_m, box_vlp16s_s8_box_point0_s, 0},
-    {24u, 40u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_point1_w, box_vlp16s_s8_box_point1_b, box_vlp16s_s8_box_point1_m, box_vlp16s_s8_box_point1_s, LIDET_PNQ_PK(box_vlp16s_s8_box_point1_wpk)},
-    {40u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_point2_w, box_vlp16s_s8_box_point2_b, box_vlp16s_s8_box_point2_m, box_vlp16s_s8_box_point2_s, LIDET_PNQ_PK(box_vlp16s_s8_box_point2_wpk)}
+    {3u, 24u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_point0_w, box_vlp16s_s8_box_point0_b, box_vlp16s_s8_box_point0_m, box_vlp16s_s8_box_point0_s, 0, 0},
+    {24u, 40u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_point1_w, box_vlp16s_s8_box_point1_b, box_vlp16s_s8_box_point1_m, box_vlp16s_s8_box_point1_s, LIDET_PNQ_PK(box_vlp16s_s8_box_point1_wpk), LIDET_PNQ_LB(box_vlp16s_s8_box_point1_lb)},
+    {40u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_point2_w, box_vlp16s_s8_box_point2_b, box_vlp16s_s8_box_point2_m, box_vlp16s_s8_box_point2_s, LIDET_PNQ_PK(box_vlp16s_s8_box_point2_wpk), LIDET_PNQ_LB(box_vlp16s_s8_box_point2_lb)}
 };
 
 /* box.pvle[0] weights [3][16] int8 (per-channel scale) */
@@ -858,8 +882,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16s_s8_box_pvle1_wpk[1
 };
 #endif
 static const lidet_pointnet_q_layer_t box_vlp16s_s8_box_pvle[2] = {
-    {3u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_pvle0_w, box_vlp16s_s8_box_pvle0_b, box_vlp16s_s8_box_pvle0_m, box_vlp16s_s8_box_pvle0_s, 0},
-    {16u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_pvle1_w, box_vlp16s_s8_box_pvle1_b, box_vlp16s_s8_box_pvle1_m, box_vlp16s_s8_box_pvle1_s, LIDET_PNQ_PK(box_vlp16s_s8_box_pvle1_wpk)}
+    {3u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_pvle0_w, box_vlp16s_s8_box_pvle0_b, box_vlp16s_s8_box_pvle0_m, box_vlp16s_s8_box_pvle0_s, 0, 0},
+    {16u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_pvle1_w, box_vlp16s_s8_box_pvle1_b, box_vlp16s_s8_box_pvle1_m, box_vlp16s_s8_box_pvle1_s, LIDET_PNQ_PK(box_vlp16s_s8_box_pvle1_wpk), 0}
 };
 
 /* box.head[0] weights [80][64] int8 (per-channel scale) */
@@ -1729,9 +1753,9 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t box_vlp16s_s8_box_head2_wpk[6
 };
 #endif
 static const lidet_pointnet_q_layer_t box_vlp16s_s8_box_head[3] = {
-    {80u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_head0_w, box_vlp16s_s8_box_head0_b, box_vlp16s_s8_box_head0_m, box_vlp16s_s8_box_head0_s, LIDET_PNQ_PK(box_vlp16s_s8_box_head0_wpk)},
-    {64u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_head1_w, box_vlp16s_s8_box_head1_b, box_vlp16s_s8_box_head1_m, box_vlp16s_s8_box_head1_s, LIDET_PNQ_PK(box_vlp16s_s8_box_head1_wpk)},
-    {32u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_vlp16s_s8_box_head2_w, box_vlp16s_s8_box_head2_b, box_vlp16s_s8_box_head2_m, box_vlp16s_s8_box_head2_s, LIDET_PNQ_PK(box_vlp16s_s8_box_head2_wpk)}
+    {80u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_head0_w, box_vlp16s_s8_box_head0_b, box_vlp16s_s8_box_head0_m, box_vlp16s_s8_box_head0_s, LIDET_PNQ_PK(box_vlp16s_s8_box_head0_wpk), 0},
+    {64u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, box_vlp16s_s8_box_head1_w, box_vlp16s_s8_box_head1_b, box_vlp16s_s8_box_head1_m, box_vlp16s_s8_box_head1_s, LIDET_PNQ_PK(box_vlp16s_s8_box_head1_wpk), 0},
+    {32u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, box_vlp16s_s8_box_head2_w, box_vlp16s_s8_box_head2_b, box_vlp16s_s8_box_head2_m, box_vlp16s_s8_box_head2_s, LIDET_PNQ_PK(box_vlp16s_s8_box_head2_wpk), 0}
 };
 
 /* box: class one-hot folded into head[0], [class][out] int32 */

@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "cls_beams128_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "cls_beams128_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "cls_beams128_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* cls.point[0] weights [3][32] int8 (per-channel scale) */
@@ -254,6 +254,15 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams128_s8_cls_point1_wp
     4286644271u, 4286775334u, 4291297398u, 4587558u, 982958u, 4294442918u, 5439376u, 4291231767u, 6160290u, 917567u, 4290838615u, 4294115451u, 196630u, 917565u, 4291952574u, 4292083741u,
     524289u, 1114061u, 4291035216u, 4294443011u, 3604394u, 6750101u, 4293918690u, 6684648u, 4292345863u, 720940u, 4294508570u, 4289789952u, 2490339u, 4293853225u, 2424832u, 4293066625u,
     4291428395u, 4293197904u, 327553u, 917468u, 4292607918u, 655266u, 4294180864u, 327625u, 3670072u, 4290117606u, 1572743u, 4291362885u, 4291493800u, 4293066869u, 4291035196u, 4259841u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_beams128_s8_cls_point1_lb[64] = {
+    15208, 9176, 13191, 2600, 9718, 8488, -15863, -1939, -16751, 12032, 6889, 7665, 16891, 5269, 11145, 3266,
+    -1035, -2062, 4803, 7723, 12964, 9659, -8377, -968, 4360, 9077, 5906, 11114, 10788, -7724, 18492, 13561,
+    11317, 13678, 971, -359, 6283, 13196, 4594, -14225, 12519, 14080, -7344, 13841, 6596, 16675, -11910, 9342,
+    -8353, 1480, -14872, -1385, -1983, 2172, 9796, -2807, 11201, 10555, -13314, -3677, 5827, 12493, 6587, 3394
 };
 #endif
 /* cls.point[2] weights [64][128] int8 (per-channel scale) */
@@ -1065,10 +1074,23 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams128_s8_cls_point2_wp
     4291362757u, 4287823817u, 5111775u, 1966101u, 4294246342u, 851925u, 4289265652u, 1441821u, 4290510847u, 4289462292u, 1703958u, 4292870074u, 4294049815u, 3211265u, 393237u, 4290772953u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_beams128_s8_cls_point2_lb[128] = {
+    4772, 2149, 3356, -2427, 5868, 11793, -2732, 11592, 1951, 14673, -12027, 220, -19249, 15935, 12174, 17616,
+    -6973, 5082, 18708, 30475, -2435, 23670, 419, 11256, 7320, -11581, -16500, 9770, -6270, -104, -10798, -15108,
+    4407, 28191, 11106, 4246, 7407, 7559, 10141, 12691, 1049, 6950, 29076, 20091, 14573, 8573, 12605, -13373,
+    13936, 4100, 8436, 24166, 13513, 10951, 20606, 99, -5189, -10923, -6045, 7560, 8822, 26486, 14464, 7080,
+    -25959, -7849, -582, 9898, 3405, 10918, -5317, 4041, 20615, 8463, 5219, 4556, 7865, -891, 4487, 17465,
+    2307, -3307, -14418, -6093, 8282, 23403, 17814, -12881, 10491, -11175, 8359, 7284, 2114, 17524, 568, -12679,
+    -15968, 35, 272, -14671, -2437, -13423, 7523, 4622, 13923, -4090, 14314, 7743, 24454, 10170, 6452, 7039,
+    17299, -3114, 16621, 10246, 8075, 14515, 20526, 23918, 854, 3049, 10350, 6313, 4499, 6432, 1070, 20816
+};
+#endif
 static const lidet_pointnet_q_layer_t cls_beams128_s8_cls_point[3] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_point0_w, cls_beams128_s8_cls_point0_b, cls_beams128_s8_cls_point0_m, cls_beams128_s8_cls_point0_s, 0},
-    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_point1_w, cls_beams128_s8_cls_point1_b, cls_beams128_s8_cls_point1_m, cls_beams128_s8_cls_point1_s, LIDET_PNQ_PK(cls_beams128_s8_cls_point1_wpk)},
-    {64u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_point2_w, cls_beams128_s8_cls_point2_b, cls_beams128_s8_cls_point2_m, cls_beams128_s8_cls_point2_s, LIDET_PNQ_PK(cls_beams128_s8_cls_point2_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_point0_w, cls_beams128_s8_cls_point0_b, cls_beams128_s8_cls_point0_m, cls_beams128_s8_cls_point0_s, 0, 0},
+    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_point1_w, cls_beams128_s8_cls_point1_b, cls_beams128_s8_cls_point1_m, cls_beams128_s8_cls_point1_s, LIDET_PNQ_PK(cls_beams128_s8_cls_point1_wpk), LIDET_PNQ_LB(cls_beams128_s8_cls_point1_lb)},
+    {64u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_point2_w, cls_beams128_s8_cls_point2_b, cls_beams128_s8_cls_point2_m, cls_beams128_s8_cls_point2_s, LIDET_PNQ_PK(cls_beams128_s8_cls_point2_wpk), LIDET_PNQ_LB(cls_beams128_s8_cls_point2_lb)}
 };
 
 /* cls.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -1215,8 +1237,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams128_s8_cls_pvle1_wpk
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_beams128_s8_cls_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_pvle0_w, cls_beams128_s8_cls_pvle0_b, cls_beams128_s8_cls_pvle0_m, cls_beams128_s8_cls_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_pvle1_w, cls_beams128_s8_cls_pvle1_b, cls_beams128_s8_cls_pvle1_m, cls_beams128_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_beams128_s8_cls_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_pvle0_w, cls_beams128_s8_cls_pvle0_b, cls_beams128_s8_cls_pvle0_m, cls_beams128_s8_cls_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_pvle1_w, cls_beams128_s8_cls_pvle1_b, cls_beams128_s8_cls_pvle1_m, cls_beams128_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_beams128_s8_cls_pvle1_wpk), 0}
 };
 
 /* cls.head[0] weights [160][64] int8 (per-channel scale) */
@@ -2245,8 +2267,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams128_s8_cls_head1_wpk
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_beams128_s8_cls_head[2] = {
-    {160u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_head0_w, cls_beams128_s8_cls_head0_b, cls_beams128_s8_cls_head0_m, cls_beams128_s8_cls_head0_s, LIDET_PNQ_PK(cls_beams128_s8_cls_head0_wpk)},
-    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_beams128_s8_cls_head1_w, cls_beams128_s8_cls_head1_b, cls_beams128_s8_cls_head1_m, cls_beams128_s8_cls_head1_s, LIDET_PNQ_PK(cls_beams128_s8_cls_head1_wpk)}
+    {160u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams128_s8_cls_head0_w, cls_beams128_s8_cls_head0_b, cls_beams128_s8_cls_head0_m, cls_beams128_s8_cls_head0_s, LIDET_PNQ_PK(cls_beams128_s8_cls_head0_wpk), 0},
+    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_beams128_s8_cls_head1_w, cls_beams128_s8_cls_head1_b, cls_beams128_s8_cls_head1_m, cls_beams128_s8_cls_head1_s, LIDET_PNQ_PK(cls_beams128_s8_cls_head1_wpk), 0}
 };
 
 const lidet_pointnet_q_model_t lidet_model_cls_beams128_s8 = {

@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "cls_beams32_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "cls_beams32_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "cls_beams32_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* cls.point[0] weights [3][32] int8 (per-channel scale) */
@@ -254,6 +254,15 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams32_s8_cls_point1_wpk
     4287889455u, 4288282651u, 4291428450u, 5177358u, 1376172u, 4293918647u, 5111696u, 4291166213u, 4784046u, 720946u, 4290576447u, 4294049873u, 589841u, 327727u, 4292804521u, 4292739130u,
     1114095u, 393172u, 4293722239u, 4294770678u, 6881175u, 6750094u, 4292739004u, 8388589u, 4290904046u, 196655u, 4293132332u, 4289986558u, 3342302u, 4294049802u, 3276818u, 4291035040u,
     4292280380u, 4294115381u, 4294639504u, 4294443016u, 4289068969u, 1638310u, 3342373u, 1441749u, 2490412u, 4291166191u, 2031505u, 4291362884u, 4288806834u, 4293787766u, 4290641991u, 4587548u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_beams32_s8_cls_point1_lb[64] = {
+    14113, 340, 14977, 4856, 13787, 2029, -13325, -2301, -14321, 16787, 8604, -1251, 26217, 3496, 13715, 1032,
+    4649, 1568, 7659, 5482, 13117, 2376, -10193, -7366, -1565, 11443, 5543, 14621, 3398, -18166, 21194, 16038,
+    14657, 14468, 12591, -13428, 7058, 8365, -9908, -10787, 9592, 12611, 1816, 15686, 11362, 12931, -2299, 8116,
+    -8019, 4006, 3922, 2766, -4471, 99, 9602, 3270, 10136, 13661, -5907, -4607, 7623, 10584, 6669, 1648
 };
 #endif
 /* cls.point[2] weights [64][128] int8 (per-channel scale) */
@@ -1065,10 +1074,23 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams32_s8_cls_point2_wpk
     4293853099u, 4293328848u, 5439437u, 1638393u, 4294639524u, 2621368u, 4290183079u, 458792u, 4290510845u, 4291559442u, 983059u, 4290314219u, 4291493930u, 3407875u, 1048596u, 4291756020u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_beams32_s8_cls_point2_lb[128] = {
+    12744, -3093, 9459, -650, 19929, 16296, 6483, 16450, 8155, 22751, 9489, 7482, -2442, 3877, 14584, 24375,
+    -4669, 10057, 19502, 34943, 12587, 29666, 14509, 11616, 15758, -2597, 10397, 4005, 4936, 811, -19400, -14645,
+    -1767, 30399, 8007, 14077, 10550, 2655, 26194, -32799, 1096, 10058, 36444, 16628, 15440, 13218, 5859, 16583,
+    14257, -577, -1229, 24504, 9386, 15055, 21436, 321, -3037, -20654, 3363, -20795, 16779, 20292, 18466, 1796,
+    -4672, 2485, -3698, 17279, 18152, -7362, -8559, 11139, 37324, 12109, 2778, -2125, 3206, -10251, -18491, -252,
+    -14458, 8043, 3587, 7778, 12044, 24018, 5492, -7929, 3621, -4906, 14071, 20354, 11679, 9507, 2508, -13681,
+    5610, 12709, -12918, -9346, -3969, -18897, 9256, 8051, 17551, -6079, -312, 15273, 12020, -979, 15747, 3961,
+    12569, -902, 14511, 9449, -3944, 12674, 18245, 21855, 7563, 12080, 18656, 9876, 8202, 6541, 3405, 14883
+};
+#endif
 static const lidet_pointnet_q_layer_t cls_beams32_s8_cls_point[3] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_point0_w, cls_beams32_s8_cls_point0_b, cls_beams32_s8_cls_point0_m, cls_beams32_s8_cls_point0_s, 0},
-    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_point1_w, cls_beams32_s8_cls_point1_b, cls_beams32_s8_cls_point1_m, cls_beams32_s8_cls_point1_s, LIDET_PNQ_PK(cls_beams32_s8_cls_point1_wpk)},
-    {64u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_point2_w, cls_beams32_s8_cls_point2_b, cls_beams32_s8_cls_point2_m, cls_beams32_s8_cls_point2_s, LIDET_PNQ_PK(cls_beams32_s8_cls_point2_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_point0_w, cls_beams32_s8_cls_point0_b, cls_beams32_s8_cls_point0_m, cls_beams32_s8_cls_point0_s, 0, 0},
+    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_point1_w, cls_beams32_s8_cls_point1_b, cls_beams32_s8_cls_point1_m, cls_beams32_s8_cls_point1_s, LIDET_PNQ_PK(cls_beams32_s8_cls_point1_wpk), LIDET_PNQ_LB(cls_beams32_s8_cls_point1_lb)},
+    {64u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_point2_w, cls_beams32_s8_cls_point2_b, cls_beams32_s8_cls_point2_m, cls_beams32_s8_cls_point2_s, LIDET_PNQ_PK(cls_beams32_s8_cls_point2_wpk), LIDET_PNQ_LB(cls_beams32_s8_cls_point2_lb)}
 };
 
 /* cls.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -1215,8 +1237,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams32_s8_cls_pvle1_wpk[
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_beams32_s8_cls_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_pvle0_w, cls_beams32_s8_cls_pvle0_b, cls_beams32_s8_cls_pvle0_m, cls_beams32_s8_cls_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_pvle1_w, cls_beams32_s8_cls_pvle1_b, cls_beams32_s8_cls_pvle1_m, cls_beams32_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_beams32_s8_cls_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_pvle0_w, cls_beams32_s8_cls_pvle0_b, cls_beams32_s8_cls_pvle0_m, cls_beams32_s8_cls_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_pvle1_w, cls_beams32_s8_cls_pvle1_b, cls_beams32_s8_cls_pvle1_m, cls_beams32_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_beams32_s8_cls_pvle1_wpk), 0}
 };
 
 /* cls.head[0] weights [160][64] int8 (per-channel scale) */
@@ -2245,8 +2267,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams32_s8_cls_head1_wpk[
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_beams32_s8_cls_head[2] = {
-    {160u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_head0_w, cls_beams32_s8_cls_head0_b, cls_beams32_s8_cls_head0_m, cls_beams32_s8_cls_head0_s, LIDET_PNQ_PK(cls_beams32_s8_cls_head0_wpk)},
-    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_beams32_s8_cls_head1_w, cls_beams32_s8_cls_head1_b, cls_beams32_s8_cls_head1_m, cls_beams32_s8_cls_head1_s, LIDET_PNQ_PK(cls_beams32_s8_cls_head1_wpk)}
+    {160u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams32_s8_cls_head0_w, cls_beams32_s8_cls_head0_b, cls_beams32_s8_cls_head0_m, cls_beams32_s8_cls_head0_s, LIDET_PNQ_PK(cls_beams32_s8_cls_head0_wpk), 0},
+    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_beams32_s8_cls_head1_w, cls_beams32_s8_cls_head1_b, cls_beams32_s8_cls_head1_m, cls_beams32_s8_cls_head1_s, LIDET_PNQ_PK(cls_beams32_s8_cls_head1_wpk), 0}
 };
 
 const lidet_pointnet_q_model_t lidet_model_cls_beams32_s8 = {

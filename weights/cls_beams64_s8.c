@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "cls_beams64_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "cls_beams64_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "cls_beams64_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* cls.point[0] weights [3][32] int8 (per-channel scale) */
@@ -254,6 +254,15 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams64_s8_cls_point1_wpk
     4287103013u, 4286644254u, 4291952767u, 3473444u, 982965u, 4294508450u, 5439423u, 4291690503u, 3342282u, 4294639659u, 4291428422u, 4292870246u, 851987u, 458840u, 4292804526u, 4292608039u,
     589824u, 1638370u, 4293591093u, 4294639582u, 2097091u, 1572766u, 4294115300u, 6815742u, 4292345857u, 1441805u, 4294246410u, 4291428322u, 2097126u, 4293853237u, 2228224u, 4294311837u,
     4292018208u, 4293263384u, 4294770561u, 4293787650u, 4293263287u, 851900u, 1245175u, 1114101u, 1900571u, 4292542461u, 262031u, 4292214844u, 4292149161u, 4294443135u, 4291952694u, 2949135u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_beams64_s8_cls_point1_lb[64] = {
+    11553, 2025, 7407, 2480, 9153, 5429, -12617, 2738, -3896, 10790, 5857, -5629, 12783, 1520, 218, 5591,
+    5880, -722, 5866, 4766, 9189, 9029, 690, -1750, -3188, 8475, 6960, 14081, 4600, -6204, 13691, 11875,
+    8222, 3699, 6079, -6864, 6016, 6980, -3700, -8392, 10523, 9173, -77, 12655, 8879, 8215, -4292, 2230,
+    -7093, 335, -77, 2578, 237, -618, 4510, -1315, 7105, 5307, -12582, -6257, 4057, 8595, 5890, 2786
 };
 #endif
 /* cls.point[2] weights [64][128] int8 (per-channel scale) */
@@ -1065,10 +1074,23 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams64_s8_cls_point2_wpk
     4293590984u, 4292280237u, 1245158u, 1310752u, 4293984224u, 5439467u, 4292542424u, 3276881u, 4290707446u, 4294574106u, 1376273u, 4292542410u, 4294705172u, 2490362u, 196614u, 4290314218u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_beams64_s8_cls_point2_lb[128] = {
+    3798, -7051, 14672, -5907, 12120, -5559, -2982, 7534, 2677, 13831, -1579, -3596, -3790, -3242, 11265, 15067,
+    273, 5184, 14946, 17514, 11458, 14664, 3216, 3956, 6753, -6960, 8639, 7356, 4607, -7110, -12702, -11181,
+    924, 12608, 5882, 2344, 7504, 3799, 21898, -13020, 11709, 1518, 18504, 13093, 10893, 9788, 5082, 7571,
+    5706, 4032, 7355, 16148, 6749, 9483, 4096, -5030, 3414, 670, -12585, 3304, 7891, 9832, 10004, -166,
+    -3249, 570, 8186, 7234, 3903, 5201, -4346, 6421, 18071, 8591, 6481, 6177, 9403, -2221, 4700, 10054,
+    -3182, 6406, -1482, 1234, 8888, 10115, 9648, -9445, 2442, 1080, 9717, 5611, 4840, 12855, 1986, 730,
+    2444, 5367, 3009, -11343, -1939, -3088, -583, -1122, 9089, -7357, 5885, 2829, 11484, 37, 6597, 145,
+    9161, 454, 3077, 15830, 6009, 5111, 10004, 16073, 3141, 3702, 1289, 2052, 8043, 5270, 1035, 12996
+};
+#endif
 static const lidet_pointnet_q_layer_t cls_beams64_s8_cls_point[3] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_point0_w, cls_beams64_s8_cls_point0_b, cls_beams64_s8_cls_point0_m, cls_beams64_s8_cls_point0_s, 0},
-    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_point1_w, cls_beams64_s8_cls_point1_b, cls_beams64_s8_cls_point1_m, cls_beams64_s8_cls_point1_s, LIDET_PNQ_PK(cls_beams64_s8_cls_point1_wpk)},
-    {64u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_point2_w, cls_beams64_s8_cls_point2_b, cls_beams64_s8_cls_point2_m, cls_beams64_s8_cls_point2_s, LIDET_PNQ_PK(cls_beams64_s8_cls_point2_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_point0_w, cls_beams64_s8_cls_point0_b, cls_beams64_s8_cls_point0_m, cls_beams64_s8_cls_point0_s, 0, 0},
+    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_point1_w, cls_beams64_s8_cls_point1_b, cls_beams64_s8_cls_point1_m, cls_beams64_s8_cls_point1_s, LIDET_PNQ_PK(cls_beams64_s8_cls_point1_wpk), LIDET_PNQ_LB(cls_beams64_s8_cls_point1_lb)},
+    {64u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_point2_w, cls_beams64_s8_cls_point2_b, cls_beams64_s8_cls_point2_m, cls_beams64_s8_cls_point2_s, LIDET_PNQ_PK(cls_beams64_s8_cls_point2_wpk), LIDET_PNQ_LB(cls_beams64_s8_cls_point2_lb)}
 };
 
 /* cls.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -1215,8 +1237,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams64_s8_cls_pvle1_wpk[
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_beams64_s8_cls_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_pvle0_w, cls_beams64_s8_cls_pvle0_b, cls_beams64_s8_cls_pvle0_m, cls_beams64_s8_cls_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_pvle1_w, cls_beams64_s8_cls_pvle1_b, cls_beams64_s8_cls_pvle1_m, cls_beams64_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_beams64_s8_cls_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_pvle0_w, cls_beams64_s8_cls_pvle0_b, cls_beams64_s8_cls_pvle0_m, cls_beams64_s8_cls_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_pvle1_w, cls_beams64_s8_cls_pvle1_b, cls_beams64_s8_cls_pvle1_m, cls_beams64_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_beams64_s8_cls_pvle1_wpk), 0}
 };
 
 /* cls.head[0] weights [160][64] int8 (per-channel scale) */
@@ -2245,8 +2267,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_beams64_s8_cls_head1_wpk[
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_beams64_s8_cls_head[2] = {
-    {160u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_head0_w, cls_beams64_s8_cls_head0_b, cls_beams64_s8_cls_head0_m, cls_beams64_s8_cls_head0_s, LIDET_PNQ_PK(cls_beams64_s8_cls_head0_wpk)},
-    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_beams64_s8_cls_head1_w, cls_beams64_s8_cls_head1_b, cls_beams64_s8_cls_head1_m, cls_beams64_s8_cls_head1_s, LIDET_PNQ_PK(cls_beams64_s8_cls_head1_wpk)}
+    {160u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_beams64_s8_cls_head0_w, cls_beams64_s8_cls_head0_b, cls_beams64_s8_cls_head0_m, cls_beams64_s8_cls_head0_s, LIDET_PNQ_PK(cls_beams64_s8_cls_head0_wpk), 0},
+    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_beams64_s8_cls_head1_w, cls_beams64_s8_cls_head1_b, cls_beams64_s8_cls_head1_m, cls_beams64_s8_cls_head1_s, LIDET_PNQ_PK(cls_beams64_s8_cls_head1_wpk), 0}
 };
 
 const lidet_pointnet_q_model_t lidet_model_cls_beams64_s8 = {

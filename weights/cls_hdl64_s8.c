@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "cls_hdl64_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "cls_hdl64_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "cls_hdl64_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* cls.point[0] weights [3][32] int8 (per-channel scale) */
@@ -254,6 +254,15 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_hdl64_s8_cls_point1_wpk[1
     4290117660u, 4287561771u, 4292739168u, 3342363u, 262107u, 4294770621u, 3080158u, 4291559429u, 3211211u, 4294705199u, 4293394489u, 4293591119u, 9u, 852016u, 4292935594u, 4291559466u,
     4294574071u, 2293711u, 4293066840u, 4292739023u, 4456392u, 1376136u, 4293656541u, 6881279u, 4291231744u, 1310749u, 4293918757u, 4287496123u, 2555870u, 4291100715u, 1966052u, 4293722025u,
     4292935715u, 4292542507u, 65450u, 4292476933u, 4292214692u, 2097090u, 786431u, 4294836213u, 2818085u, 4286644230u, 4294639489u, 4292739141u, 4291428284u, 4294901881u, 4291166252u, 1966095u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_hdl64_s8_cls_point1_lb[64] = {
+    20218, 6387, 10104, 3289, 9865, 8878, -21493, -13870, -17836, 12862, 10037, -8875, 16997, 5134, 5956, 9502,
+    8197, -14196, 6966, 6132, 11126, 3448, -9260, -6930, 2196, 17331, 6593, 14276, 9857, -13423, 29171, 21661,
+    12087, 18960, 3714, -1389, 11788, 12703, -12547, -11478, 12623, 16784, -14119, 23361, 10810, 15947, -20498, 2752,
+    -6257, 3570, -19149, 6222, 3652, 8486, 3705, 786, 9230, 13570, -25079, -5364, 6461, 11836, 5917, 8481
 };
 #endif
 /* cls.point[2] weights [64][128] int8 (per-channel scale) */
@@ -1065,10 +1074,23 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_hdl64_s8_cls_point2_wpk[4
     4292804517u, 4287692754u, 1769454u, 1179660u, 4294377471u, 524285u, 4291100650u, 7340022u, 4289462271u, 4289200139u, 1048601u, 4291362760u, 4293525511u, 2621430u, 1114123u, 4291821540u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_hdl64_s8_cls_point2_lb[128] = {
+    15064, 16192, 10284, 2749, 27060, 23822, -12953, 14993, -8203, 22388, 280, 17455, 1270, 650, 18683, 31051,
+    -4616, 28648, 27420, 38840, 11318, 5290, -5371, 23723, 15313, -4630, 11369, 16363, 20492, 21194, 18676, 3796,
+    -6652, 24171, 10961, 5502, 15937, 13091, 22195, -40870, 33390, 8912, 41389, 24798, 40935, 27154, 3030, -15006,
+    28031, 19100, 1001, 18426, 11593, 10536, 21897, 5336, 3884, 13751, -12274, 16019, 22284, 29130, 11599, 2515,
+    -22803, -7378, -6292, 1183, 11987, 12342, 2536, 18635, 24092, 1288, 8923, -33613, 18576, 5367, 10912, 8115,
+    9825, 4824, -25343, -7377, 15463, 37988, 15547, -9704, 10450, 738, 19851, 15119, -7151, 12895, 5213, 211,
+    -2265, 17810, -3100, -21617, 1098, -22934, 13022, 887, 19878, -37879, 8166, 9248, 22609, 9747, 13427, 7333,
+    14563, 151, 9168, 11702, 5857, 13344, 29921, 31195, -6314, -5659, 4719, -9505, 12417, 11796, 5574, 31441
+};
+#endif
 static const lidet_pointnet_q_layer_t cls_hdl64_s8_cls_point[3] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_point0_w, cls_hdl64_s8_cls_point0_b, cls_hdl64_s8_cls_point0_m, cls_hdl64_s8_cls_point0_s, 0},
-    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_point1_w, cls_hdl64_s8_cls_point1_b, cls_hdl64_s8_cls_point1_m, cls_hdl64_s8_cls_point1_s, LIDET_PNQ_PK(cls_hdl64_s8_cls_point1_wpk)},
-    {64u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_point2_w, cls_hdl64_s8_cls_point2_b, cls_hdl64_s8_cls_point2_m, cls_hdl64_s8_cls_point2_s, LIDET_PNQ_PK(cls_hdl64_s8_cls_point2_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_point0_w, cls_hdl64_s8_cls_point0_b, cls_hdl64_s8_cls_point0_m, cls_hdl64_s8_cls_point0_s, 0, 0},
+    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_point1_w, cls_hdl64_s8_cls_point1_b, cls_hdl64_s8_cls_point1_m, cls_hdl64_s8_cls_point1_s, LIDET_PNQ_PK(cls_hdl64_s8_cls_point1_wpk), LIDET_PNQ_LB(cls_hdl64_s8_cls_point1_lb)},
+    {64u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_point2_w, cls_hdl64_s8_cls_point2_b, cls_hdl64_s8_cls_point2_m, cls_hdl64_s8_cls_point2_s, LIDET_PNQ_PK(cls_hdl64_s8_cls_point2_wpk), LIDET_PNQ_LB(cls_hdl64_s8_cls_point2_lb)}
 };
 
 /* cls.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -1215,8 +1237,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_hdl64_s8_cls_pvle1_wpk[51
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_hdl64_s8_cls_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_pvle0_w, cls_hdl64_s8_cls_pvle0_b, cls_hdl64_s8_cls_pvle0_m, cls_hdl64_s8_cls_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_pvle1_w, cls_hdl64_s8_cls_pvle1_b, cls_hdl64_s8_cls_pvle1_m, cls_hdl64_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_hdl64_s8_cls_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_pvle0_w, cls_hdl64_s8_cls_pvle0_b, cls_hdl64_s8_cls_pvle0_m, cls_hdl64_s8_cls_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_pvle1_w, cls_hdl64_s8_cls_pvle1_b, cls_hdl64_s8_cls_pvle1_m, cls_hdl64_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_hdl64_s8_cls_pvle1_wpk), 0}
 };
 
 /* cls.head[0] weights [160][64] int8 (per-channel scale) */
@@ -2245,8 +2267,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_hdl64_s8_cls_head1_wpk[64
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_hdl64_s8_cls_head[2] = {
-    {160u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_head0_w, cls_hdl64_s8_cls_head0_b, cls_hdl64_s8_cls_head0_m, cls_hdl64_s8_cls_head0_s, LIDET_PNQ_PK(cls_hdl64_s8_cls_head0_wpk)},
-    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_hdl64_s8_cls_head1_w, cls_hdl64_s8_cls_head1_b, cls_hdl64_s8_cls_head1_m, cls_hdl64_s8_cls_head1_s, LIDET_PNQ_PK(cls_hdl64_s8_cls_head1_wpk)}
+    {160u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_hdl64_s8_cls_head0_w, cls_hdl64_s8_cls_head0_b, cls_hdl64_s8_cls_head0_m, cls_hdl64_s8_cls_head0_s, LIDET_PNQ_PK(cls_hdl64_s8_cls_head0_wpk), 0},
+    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_hdl64_s8_cls_head1_w, cls_hdl64_s8_cls_head1_b, cls_hdl64_s8_cls_head1_m, cls_hdl64_s8_cls_head1_s, LIDET_PNQ_PK(cls_hdl64_s8_cls_head1_wpk), 0}
 };
 
 const lidet_pointnet_q_model_t lidet_model_cls_hdl64_s8 = {

@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "cls_vlp16_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "cls_vlp16_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "cls_vlp16_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* cls.point[0] weights [3][32] int8 (per-channel scale) */
@@ -254,6 +254,15 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_vlp16_s8_cls_point1_wpk[1
     4289134639u, 4288872456u, 4290969708u, 4456486u, 65470u, 4293721985u, 4587447u, 4292411404u, 4194205u, 4293853252u, 4291493950u, 4291690580u, 4294246414u, 983116u, 4292018095u, 4293066789u,
     1441798u, 1376216u, 4293328971u, 4293722067u, 3473331u, 1965953u, 4292345816u, 6094841u, 4292673522u, 1310762u, 4294705178u, 4288937953u, 3211242u, 4292411432u, 2752514u, 4293722029u,
     4291362864u, 4292804661u, 65409u, 4292739079u, 4290838432u, 2162608u, 786468u, 458738u, 4849730u, 4289658877u, 1703820u, 4291625026u, 4290117541u, 4294312039u, 4291493955u, 2359314u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_vlp16_s8_cls_point1_lb[64] = {
+    16161, 4728, 9906, 694, 7543, 11085, -18888, 4312, -10869, 13099, 10675, 866, 16527, 373, -1365, 7546,
+    4680, -2692, 8197, 10285, 10886, 2781, 4970, -5255, -4397, 19681, 11010, 17065, 8186, -12908, 24060, 21391,
+    13501, 15632, 10709, -10258, 4603, 10151, -2640, -15515, 18557, 16972, -7723, 12111, 8232, 14927, -15148, 7962,
+    -10916, 2366, 1488, 4743, 2111, 1319, 7078, 5230, 17486, 14560, -5989, 2382, 7837, 14984, 5307, 6631
 };
 #endif
 /* cls.point[2] weights [64][128] int8 (per-channel scale) */
@@ -1065,10 +1074,23 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_vlp16_s8_cls_point2_wpk[4
     4294180809u, 4293525458u, 3342289u, 2162735u, 4294770657u, 2883557u, 4293001200u, 2883632u, 4291887107u, 4293591062u, 1900558u, 4291428300u, 4293263377u, 3604492u, 524310u, 4289593329u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_vlp16_s8_cls_point2_lb[128] = {
+    9939, -5078, 17964, 7959, 25992, 19886, 12707, 17895, 7208, 18661, -12373, 20793, 2117, -1611, 15641, 17413,
+    4698, 10856, 12670, 36597, 13711, 23598, 10801, 3633, 13093, -21407, 20607, 10074, 4811, 767, 14362, -3191,
+    3406, 15656, 11520, -16607, 15838, 7009, 17671, -1327, -1440, 13779, 37011, 13405, 12161, 6452, 2545, 2605,
+    13146, 17249, 1872, 19430, 5806, 5621, 2009, -8820, 10675, -26162, -5338, -2502, 9235, 21867, 16218, -6595,
+    20882, -1727, 3981, 28214, 3529, 2488, -23087, 11919, 26838, 10603, 9243, 5875, 62, -7626, 7390, 14594,
+    -3504, 9531, 909, -11080, 16547, 16025, 12101, -18095, 2337, 2070, 12493, 13278, 4811, 13833, 4547, -2924,
+    3732, 5690, 5992, -13589, -13374, -4600, -11934, 3735, 13850, -13538, 10810, 13206, 10712, -8004, 5358, 10511,
+    14050, -8244, 19954, 13991, 15350, 23123, 7995, 22184, 16133, 20702, 6100, 2517, 10073, 8851, -14675, 6643
+};
+#endif
 static const lidet_pointnet_q_layer_t cls_vlp16_s8_cls_point[3] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_point0_w, cls_vlp16_s8_cls_point0_b, cls_vlp16_s8_cls_point0_m, cls_vlp16_s8_cls_point0_s, 0},
-    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_point1_w, cls_vlp16_s8_cls_point1_b, cls_vlp16_s8_cls_point1_m, cls_vlp16_s8_cls_point1_s, LIDET_PNQ_PK(cls_vlp16_s8_cls_point1_wpk)},
-    {64u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_point2_w, cls_vlp16_s8_cls_point2_b, cls_vlp16_s8_cls_point2_m, cls_vlp16_s8_cls_point2_s, LIDET_PNQ_PK(cls_vlp16_s8_cls_point2_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_point0_w, cls_vlp16_s8_cls_point0_b, cls_vlp16_s8_cls_point0_m, cls_vlp16_s8_cls_point0_s, 0, 0},
+    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_point1_w, cls_vlp16_s8_cls_point1_b, cls_vlp16_s8_cls_point1_m, cls_vlp16_s8_cls_point1_s, LIDET_PNQ_PK(cls_vlp16_s8_cls_point1_wpk), LIDET_PNQ_LB(cls_vlp16_s8_cls_point1_lb)},
+    {64u, 128u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_point2_w, cls_vlp16_s8_cls_point2_b, cls_vlp16_s8_cls_point2_m, cls_vlp16_s8_cls_point2_s, LIDET_PNQ_PK(cls_vlp16_s8_cls_point2_wpk), LIDET_PNQ_LB(cls_vlp16_s8_cls_point2_lb)}
 };
 
 /* cls.pvle[0] weights [3][32] int8 (per-channel scale) */
@@ -1215,8 +1237,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_vlp16_s8_cls_pvle1_wpk[51
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_vlp16_s8_cls_pvle[2] = {
-    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_pvle0_w, cls_vlp16_s8_cls_pvle0_b, cls_vlp16_s8_cls_pvle0_m, cls_vlp16_s8_cls_pvle0_s, 0},
-    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_pvle1_w, cls_vlp16_s8_cls_pvle1_b, cls_vlp16_s8_cls_pvle1_m, cls_vlp16_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_vlp16_s8_cls_pvle1_wpk)}
+    {3u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_pvle0_w, cls_vlp16_s8_cls_pvle0_b, cls_vlp16_s8_cls_pvle0_m, cls_vlp16_s8_cls_pvle0_s, 0, 0},
+    {32u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_pvle1_w, cls_vlp16_s8_cls_pvle1_b, cls_vlp16_s8_cls_pvle1_m, cls_vlp16_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_vlp16_s8_cls_pvle1_wpk), 0}
 };
 
 /* cls.head[0] weights [160][64] int8 (per-channel scale) */
@@ -2245,8 +2267,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_vlp16_s8_cls_head1_wpk[64
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_vlp16_s8_cls_head[2] = {
-    {160u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_head0_w, cls_vlp16_s8_cls_head0_b, cls_vlp16_s8_cls_head0_m, cls_vlp16_s8_cls_head0_s, LIDET_PNQ_PK(cls_vlp16_s8_cls_head0_wpk)},
-    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_vlp16_s8_cls_head1_w, cls_vlp16_s8_cls_head1_b, cls_vlp16_s8_cls_head1_m, cls_vlp16_s8_cls_head1_s, LIDET_PNQ_PK(cls_vlp16_s8_cls_head1_wpk)}
+    {160u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16_s8_cls_head0_w, cls_vlp16_s8_cls_head0_b, cls_vlp16_s8_cls_head0_m, cls_vlp16_s8_cls_head0_s, LIDET_PNQ_PK(cls_vlp16_s8_cls_head0_wpk), 0},
+    {64u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_vlp16_s8_cls_head1_w, cls_vlp16_s8_cls_head1_b, cls_vlp16_s8_cls_head1_m, cls_vlp16_s8_cls_head1_s, LIDET_PNQ_PK(cls_vlp16_s8_cls_head1_wpk), 0}
 };
 
 const lidet_pointnet_q_model_t lidet_model_cls_vlp16_s8 = {

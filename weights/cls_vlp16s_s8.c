@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "cls_vlp16s_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "cls_vlp16s_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "cls_vlp16s_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* cls.point[0] weights [3][16] int8 (per-channel scale) */
@@ -98,6 +98,13 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_vlp16s_s8_cls_point1_wpk[
     4286709682u, 8126357u, 3080161u, 7471047u, 7798781u, 5046168u, 4259939u, 8323167u, 4293918723u, 1966202u, 1900509u, 1572805u, 6225971u, 4293001218u, 4294442889u, 5963792u,
     4293394356u, 4849656u, 4259778u, 8060832u, 5308330u, 4286709677u, 4291428347u, 4293984144u, 4294049850u, 4292018146u, 4290117582u, 2949031u, 8388514u, 4294115230u, 4292280256u, 4289265685u,
     4291035153u, 4292345729u, 4294115382u, 3342226u, 4290248682u, 4291297163u, 4286644280u, 4292083782u, 1179720u, 3145794u, 589781u, 851970u, 2555883u, 4294115293u, 4294770658u, 3997577u
+};
+#endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_vlp16s_s8_cls_point1_lb[32] = {
+    -3069, 7363, 7609, 6852, -4398, 10666, 9772, -5117, 14454, 4450, 4454, 5259, 3633, 7093, 9449, 8686,
+    1413, -15525, 9325, 1708, -3745, -7815, 8727, 6306, -746, 123, -2821, -9431, 9255, 14364, 2357, 7553
 };
 #endif
 /* cls.point[2] weights [32][64] int8 (per-channel scale) */
@@ -321,10 +328,19 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_vlp16s_s8_cls_point2_wpk[
     4292607986u, 393164u, 4293918612u, 1441680u, 4292738945u, 4294443029u, 4292149269u, 1638448u, 3801020u, 4293656577u, 3866558u, 4294901752u, 983021u, 524344u, 327673u, 720829u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[2] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t cls_vlp16s_s8_cls_point2_lb[64] = {
+    1376, -4211, -9055, -8616, -10024, -301, -68, -6728, 884, -1298, 7951, 3662, 14709, 17590, -4471, 11569,
+    17610, 17830, 11626, -4883, -15479, 12669, 12676, -4440, -14474, 19499, 5576, -2529, 9851, 16544, 9175, 4922,
+    13539, 4145, 14029, 9819, 9071, -2977, -16766, 3832, -5872, -5513, 22209, 6868, 4001, 3920, 6459, -3202,
+    2678, 14344, -2328, 1195, 8991, 10182, -423, 16455, 11347, -669, 21492, 4191, 7699, -15530, 13929, 16397
+};
+#endif
 static const lidet_pointnet_q_layer_t cls_vlp16s_s8_cls_point[3] = {
-    {3u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_point0_w, cls_vlp16s_s8_cls_point0_b, cls_vlp16s_s8_cls_point0_m, cls_vlp16s_s8_cls_point0_s, 0},
-    {16u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_point1_w, cls_vlp16s_s8_cls_point1_b, cls_vlp16s_s8_cls_point1_m, cls_vlp16s_s8_cls_point1_s, LIDET_PNQ_PK(cls_vlp16s_s8_cls_point1_wpk)},
-    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_point2_w, cls_vlp16s_s8_cls_point2_b, cls_vlp16s_s8_cls_point2_m, cls_vlp16s_s8_cls_point2_s, LIDET_PNQ_PK(cls_vlp16s_s8_cls_point2_wpk)}
+    {3u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_point0_w, cls_vlp16s_s8_cls_point0_b, cls_vlp16s_s8_cls_point0_m, cls_vlp16s_s8_cls_point0_s, 0, 0},
+    {16u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_point1_w, cls_vlp16s_s8_cls_point1_b, cls_vlp16s_s8_cls_point1_m, cls_vlp16s_s8_cls_point1_s, LIDET_PNQ_PK(cls_vlp16s_s8_cls_point1_wpk), LIDET_PNQ_LB(cls_vlp16s_s8_cls_point1_lb)},
+    {32u, 64u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_point2_w, cls_vlp16s_s8_cls_point2_b, cls_vlp16s_s8_cls_point2_m, cls_vlp16s_s8_cls_point2_s, LIDET_PNQ_PK(cls_vlp16s_s8_cls_point2_wpk), LIDET_PNQ_LB(cls_vlp16s_s8_cls_point2_lb)}
 };
 
 /* cls.pvle[0] weights [3][16] int8 (per-channel scale) */
@@ -390,8 +406,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_vlp16s_s8_cls_pvle1_wpk[1
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_vlp16s_s8_cls_pvle[2] = {
-    {3u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_pvle0_w, cls_vlp16s_s8_cls_pvle0_b, cls_vlp16s_s8_cls_pvle0_m, cls_vlp16s_s8_cls_pvle0_s, 0},
-    {16u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_pvle1_w, cls_vlp16s_s8_cls_pvle1_b, cls_vlp16s_s8_cls_pvle1_m, cls_vlp16s_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_vlp16s_s8_cls_pvle1_wpk)}
+    {3u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_pvle0_w, cls_vlp16s_s8_cls_pvle0_b, cls_vlp16s_s8_cls_pvle0_m, cls_vlp16s_s8_cls_pvle0_s, 0, 0},
+    {16u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_pvle1_w, cls_vlp16s_s8_cls_pvle1_b, cls_vlp16s_s8_cls_pvle1_m, cls_vlp16s_s8_cls_pvle1_s, LIDET_PNQ_PK(cls_vlp16s_s8_cls_pvle1_wpk), 0}
 };
 
 /* cls.head[0] weights [80][32] int8 (per-channel scale) */
@@ -686,8 +702,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t cls_vlp16s_s8_cls_head1_wpk[3
 };
 #endif
 static const lidet_pointnet_q_layer_t cls_vlp16s_s8_cls_head[2] = {
-    {80u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_head0_w, cls_vlp16s_s8_cls_head0_b, cls_vlp16s_s8_cls_head0_m, cls_vlp16s_s8_cls_head0_s, LIDET_PNQ_PK(cls_vlp16s_s8_cls_head0_wpk)},
-    {32u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_vlp16s_s8_cls_head1_w, cls_vlp16s_s8_cls_head1_b, cls_vlp16s_s8_cls_head1_m, cls_vlp16s_s8_cls_head1_s, LIDET_PNQ_PK(cls_vlp16s_s8_cls_head1_wpk)}
+    {80u, 32u, 1u, LIDET_PNQ_OUT_S8, -128, cls_vlp16s_s8_cls_head0_w, cls_vlp16s_s8_cls_head0_b, cls_vlp16s_s8_cls_head0_m, cls_vlp16s_s8_cls_head0_s, LIDET_PNQ_PK(cls_vlp16s_s8_cls_head0_wpk), 0},
+    {32u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, cls_vlp16s_s8_cls_head1_w, cls_vlp16s_s8_cls_head1_b, cls_vlp16s_s8_cls_head1_m, cls_vlp16s_s8_cls_head1_s, LIDET_PNQ_PK(cls_vlp16s_s8_cls_head1_wpk), 0}
 };
 
 const lidet_pointnet_q_model_t lidet_model_cls_vlp16s_s8 = {

@@ -46,7 +46,7 @@ import numpy as np
 from . import __version__
 from .emit import FORMAT_VERSION, Z_ORIGINS, EmitError, Model, load
 
-PNQ_LAYOUT_VERSION = 2  # LIDET_PNQ_LAYOUT_VERSION (lidet_pointnet_q.h): the layer tables' fields (w_pk)
+PNQ_LAYOUT_VERSION = 3  # LIDET_PNQ_LAYOUT_VERSION (lidet_pointnet_q.h): the layer tables' fields (w_pk, b_list)
 
 PREC_S8 = 1  # LIDET_PN_S8
 PTS_SCALE = 0.001  # the first shared layer's input: millimetres
@@ -467,6 +467,12 @@ def pack_pk(w_q: np.ndarray) -> np.ndarray:
     return np.array(words, dtype=np.uint64)
 
 
+def list_bias(l) -> np.ndarray:
+    """The list kernel's starting sums of an int8 x int8 layer (lidet_pointnet_q_layer_t.b_list): b - 128 sum_i w,
+    per output channel (int64 here; within int32 for any layer lidet_pointnet_q_init accepts)."""
+    return np.asarray(l.b, dtype=np.int64) - 128 * np.asarray(l.w_q, dtype=np.int64).sum(axis=1)
+
+
 def emit_c_s8(qm: QModel, onnx_path, calib_path, cmd: str, src_sha: str, calib_sha: str) -> tuple[str, str]:
     n = qm.name
     up = n.upper()
@@ -514,9 +520,17 @@ def emit_c_s8(qm: QModel, onnx_path, calib_path, cmd: str, src_sha: str, calib_s
                                                                  f"the DSP kernel, the same as _w", suffix="u")
                              + "#endif\n")
                     pk = f"LIDET_PNQ_PK({base}_wpk)"
+                lb = "0"
+                # the shared point layers after the first (blocks of points, inputs at the ReLU's zero point
+                # -128 skipped): the list kernel's starting sums (LIDET_PNQ_LIST_BIAS; offsets within 16 bits)
+                if pn == "point" and not l.in_s16 and l.n_in * l.n_out <= 65536:
+                    c.append("#if LIDET_PNQ_LIST_BIAS\n" + _ints(base + "_lb", "int32_t", list_bias(l),
+                                                                 f"{tag}.{pn}[{i}] the list kernel's starting sums, "
+                                                                 f"b - 128 sum_i w[i]") + "#endif\n")
+                    lb = f"LIDET_PNQ_LB({base}_lb)"
                 kind = "LIDET_PNQ_OUT_Q16" if l.out_q16 else "LIDET_PNQ_OUT_S8"
                 entries.append(f"    {{{l.n_in}u, {l.n_out}u, {1 if l.relu else 0}u, {kind}, {l.out_zp}, "
-                               f"{base}_w, {base}_b, {base}_m, {base}_s, {pk}}}")
+                               f"{base}_w, {base}_b, {base}_m, {base}_s, {pk}, {lb}}}")
             arr = f"{n}_{tag}_{pn}"
             c.append(f"static const lidet_pointnet_q_layer_t {arr}[{len(layers)}] = {{\n" + ",\n".join(entries)
                      + "\n};\n\n")

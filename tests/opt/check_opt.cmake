@@ -74,6 +74,7 @@ set(bad_cases
     "LIDET_NN_S8_KERNEL=42|LIDET_NN_S8_KERNEL must be one of"
     "LIDET_NN_S8_KERNEL=DSP|LIDET_NN_S8_KERNEL must be one of"
     "LIDET_PNQ_WEIGHTS_PK=2|LIDET_PNQ_WEIGHTS_PK must be 0 or 1"
+    "LIDET_PNQ_LIST_BIAS=2|LIDET_PNQ_LIST_BIAS must be 0 or 1"
     "LIDET_NN_PK_ASM=2|LIDET_NN_PK_ASM must be 0 or 1"
     "LIDET_NN_CM_FMA=2|LIDET_NN_CM_FMA must be 0 or 1"
     "LIDET_NN_RV_FMA=1|LIDET_NN_RV_FMA must be 0, or 1 on a RISC-V target"

@@ -45,11 +45,23 @@ static void ref_acc(const int8_t *in, uint32_t rows, uint32_t n_in, const int8_t
         }
 }
 
+/* b - 128 sum_i w[i][o]: the list kernel's starting sums (lidet_pointnet_q_layer_t.b_list) */
+static void list_bias_of(const int8_t *w, uint32_t n_in, const int32_t *b, uint32_t n_out, int32_t *b_list)
+{
+    uint32_t i, o;
+    for (o = 0; o < n_out; ++o)
+    {
+        b_list[o] = b[o];
+        for (i = 0; i < n_in; ++i)
+            b_list[o] -= 128 * (int32_t)w[i * n_out + o];
+    }
+}
+
 static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extreme)
 {
     static int8_t in[MAX_R * MAX_I], w[MAX_I * MAX_O];
     static uint32_t w_pk[MAX_I * MAX_O / 2u + 1u];
-    static int32_t b[MAX_O], ref[MAX_R * MAX_O], got[MAX_R * MAX_O], vmax[MAX_O], refmax[MAX_O];
+    static int32_t b[MAX_O], b_list[MAX_O], ref[MAX_R * MAX_O], got[MAX_R * MAX_O], vmax[MAX_O], refmax[MAX_O];
     uint32_t r, o, k;
     for (k = 0; k < rows * n_in; ++k)
     {
@@ -80,20 +92,29 @@ static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extrem
     lidet__nn_acc_s8_r4o2(in, rows, n_in, w, b, n_out, got);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
     memset(got, 0x5A, sizeof got);
-    lidet__nn_acc_s8_list(in, rows, n_in, w, b, n_out, got);
+    lidet__nn_acc_s8_list(in, rows, n_in, w, b, 0, n_out, got);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
-    /* the list kernel folding its rows into a running maximum (4 rows or more on the host), acc its scratch */
-    for (o = 0; o < n_out; ++o)
-    {
-        vmax[o] = refmax[o] = (int32_t)(next() % 4000001u) - 2000000;
-        for (r = 0; r < rows; ++r)
-            refmax[o] = ref[r * n_out + o] > refmax[o] ? ref[r * n_out + o] : refmax[o];
-    }
+    /* with the starting sums given (b_list: b - 128 sum w, as the generated models carry them) */
+    list_bias_of(w, n_in, b, n_out, b_list);
     memset(got, 0x5A, sizeof got);
-    if (lidet__nn_acc_s8_list_max(in, rows, n_in, w, b, n_out, got, vmax))
-        TEST_ASSERT_EQUAL_INT32_ARRAY(refmax, vmax, n_out);
-    else
-        TEST_ASSERT_TRUE(rows < 4u);
+    lidet__nn_acc_s8_list(in, rows, n_in, w, b, b_list, n_out, got);
+    TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+    /* the list kernel folding its rows into a running maximum (4 rows or more on the host), acc its scratch; with
+     * and without b_list */
+    for (k = 0; k < 2u; ++k)
+    {
+        for (o = 0; o < n_out; ++o)
+        {
+            vmax[o] = refmax[o] = (int32_t)(next() % 4000001u) - 2000000;
+            for (r = 0; r < rows; ++r)
+                refmax[o] = ref[r * n_out + o] > refmax[o] ? ref[r * n_out + o] : refmax[o];
+        }
+        memset(got, 0x5A, sizeof got);
+        if (lidet__nn_acc_s8_list_max(in, rows, n_in, w, b, k ? b_list : 0, n_out, got, vmax))
+            TEST_ASSERT_EQUAL_INT32_ARRAY(refmax, vmax, n_out);
+        else
+            TEST_ASSERT_TRUE(rows < 4u);
+    }
     memset(got, 0x5A, sizeof got);
     lidet__nn_acc_s8_dsp(in, rows, n_in, w, b, n_out, got);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
@@ -247,7 +268,7 @@ static void test_first_layer_in_one_pass(void)
 static void test_list_kernel_on_large_layers(void)
 {
     static int8_t in[9 * 300], w[300 * 224];
-    static int32_t b[256], ref[9 * 256], got[9 * 256], vmax[256], refmax[256];
+    static int32_t b[256], b_list[256], ref[9 * 256], got[9 * 256], vmax[256], refmax[256];
     static const uint32_t shapes[][2] = {{300u, 224u}, {256u, 256u}, {257u, 255u}};
     uint32_t k, rows, r, i, o;
     for (k = 0; k < sizeof shapes / sizeof shapes[0]; ++k)
@@ -262,7 +283,11 @@ static void test_list_kernel_on_large_layers(void)
                 b[o] = (int32_t)(next() % 2000001u) - 1000000;
             ref_acc(in, rows, n_in, w, b, n_out, ref);
             memset(got, 0x5A, sizeof got);
-            lidet__nn_acc_s8_list(in, rows, n_in, w, b, n_out, got);
+            lidet__nn_acc_s8_list(in, rows, n_in, w, b, 0, n_out, got);
+            TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
+            list_bias_of(w, n_in, b, n_out, b_list);
+            memset(got, 0x5A, sizeof got);
+            lidet__nn_acc_s8_list(in, rows, n_in, w, b, b_list, n_out, got);
             TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
             /* folded into a maximum: 3 lists a row (n_in > 128), or declined past 16-bit offsets */
             for (o = 0; o < n_out; ++o)
@@ -271,7 +296,7 @@ static void test_list_kernel_on_large_layers(void)
                 for (r = 0; r < rows; ++r)
                     refmax[o] = ref[r * n_out + o] > refmax[o] ? ref[r * n_out + o] : refmax[o];
             }
-            if (lidet__nn_acc_s8_list_max(in, rows, n_in, w, b, n_out, got, vmax))
+            if (lidet__nn_acc_s8_list_max(in, rows, n_in, w, b, b_list, n_out, got, vmax))
                 TEST_ASSERT_EQUAL_INT32_ARRAY(refmax, vmax, n_out);
             else
                 TEST_ASSERT_TRUE(rows < 4u || n_in * n_out > 65536u);

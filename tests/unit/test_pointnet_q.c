@@ -24,6 +24,7 @@ void tearDown(void)
 /* point layer 3 -> 2: ch0 = x, ch1 = y (mm), requant round(acc / 2) - 128 (ReLU, zero point -128) */
 static const int8_t k_w0[6] = {1, 0, 0, 1, 0, 0};
 static const int32_t k_b0[2] = {0, 0};
+static const int32_t k_lb[2] = {-128, -128}, k_lb_bad[2] = {-128, -127}; /* b - 128 sum_i w[i][o], and one off */
 static const int32_t k_m0[2] = {1 << 30, 1 << 30};
 static const uint8_t k_s0[2] = {31, 31};
 /* head 2 -> 3, Q16 out: out = acc * 2^16, acc = b + g . W */
@@ -37,8 +38,8 @@ static lidet_pointnet_q_model_t g_model;
 
 static void make_model(void)
 {
-    const lidet_pointnet_q_layer_t p = {3, 2, 1, LIDET_PNQ_OUT_S8, -128, k_w0, k_b0, k_m0, k_s0, 0};
-    const lidet_pointnet_q_layer_t h = {2, 3, 0, LIDET_PNQ_OUT_Q16, 0, k_w1, k_b1, k_m1, k_s1, 0};
+    const lidet_pointnet_q_layer_t p = {3, 2, 1, LIDET_PNQ_OUT_S8, -128, k_w0, k_b0, k_m0, k_s0, 0, 0};
+    const lidet_pointnet_q_layer_t h = {2, 3, 0, LIDET_PNQ_OUT_Q16, 0, k_w1, k_b1, k_m1, k_s1, 0, 0};
     g_point[0] = p;
     g_head[0] = h;
     memset(&g_model, 0, sizeof g_model);
@@ -164,11 +165,15 @@ void test_malformed_descriptors(void)
     EXPECT_BAD(p0.w_t = NULL);
     EXPECT_BAD(p0.n_in = 4);
     EXPECT_BAD(p0.b = big_b);
+    EXPECT_BAD(p0.b_list = k_lb_bad); /* the list kernel's starting sums, one off b - 128 sum w */
     EXPECT_BAD(p0.shift = bad_s);
     EXPECT_BAD(p0.out = LIDET_PNQ_OUT_Q16);
     EXPECT_BAD(g_head[0].out = LIDET_PNQ_OUT_S8);
     EXPECT_BAD(g_head[0].n_out = 2); /* not n_classes logits */
 #undef EXPECT_BAD
+    make_model();
+    g_point[0].b_list = k_lb; /* exactly b - 128 sum w: accepted */
+    TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_pointnet_q_check(&g_model, LIDET_PN_CLASSIFIER, 2));
     make_model();
 }
 

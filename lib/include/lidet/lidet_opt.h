@@ -311,6 +311,19 @@
 #endif
 #endif
 
+/** 1: the generated int8 models carry, for each shared point layer after the first, the list kernel's starting
+ *  sums b - 128 sum w (lidet_pointnet_q_layer_t.b_list: n_out int32 of flash a layer), so that the kernel does not
+ *  sum the layer's weights again for every block of points; 0: it does. 0 or 1. Default: 1 where
+ *  LIDET_NN_S8_KERNEL is LIDET_NN_S8_KERNEL_LIST, else 0. Define it the same for the library and the generated
+ *  models. */
+#ifndef LIDET_PNQ_LIST_BIAS
+#if LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_LIST
+#define LIDET_PNQ_LIST_BIAS 1
+#else
+#define LIDET_PNQ_LIST_BIAS 0
+#endif
+#endif
+
 /** GCC on cores with the Arm DSP extension: 1 runs the packed kernel's inner loops as inline assembly (paired
  *  LDRD loads, the four sums kept in registers: 13 instead of 19 instructions per group), 0 as the C loops the
  *  compiler schedules (same sums). Likewise the list kernel's loops on 32-bit Arm without the DSP extension (21
@@ -506,6 +519,9 @@
     LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_DSP && LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_R2O2 &&         \
     LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_R4O2 && LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_LIST
 #error "LIDET_NN_S8_KERNEL must be one of LIDET_NN_S8_KERNEL_ROWS4, _COLS, _DSP, _R2O2, _R4O2, _LIST"
+#endif
+#if LIDET_PNQ_LIST_BIAS != 0 && LIDET_PNQ_LIST_BIAS != 1
+#error "LIDET_PNQ_LIST_BIAS must be 0 or 1"
 #endif
 #if LIDET_PNQ_WEIGHTS_PK != 0 && LIDET_PNQ_WEIGHTS_PK != 1
 #error "LIDET_PNQ_WEIGHTS_PK must be 0 or 1"

@@ -74,6 +74,13 @@ typedef struct
                                generated models fill it for every int8 x int8 layer with n_in a multiple of 4
                                where LIDET_PNQ_WEIGHTS_PK is 1 (the default on cores with the DSP extension:
                                Cortex-M4, M7, M33) and leave it NULL elsewhere (no second copy in flash) */
+    const int32_t
+        *b_list; /**< optional: b[o] - 128 sum_i w_t[i][o] (n_out), the list kernel's starting sums for
+                                inputs counted from the ReLU's zero point -128 (LIDET_NN_S8_KERNEL_LIST); NULL:
+                                the kernel sums the weights itself, once per block of points. The generated
+                                models fill it for the shared point layers after the first where
+                                LIDET_PNQ_LIST_BIAS is 1 (the default where the list kernel is) and leave it NULL
+                                elsewhere; lidet_pointnet_q_init refuses a model whose b_list is not exactly that */
 } lidet_pointnet_q_layer_t;
 
 /* the generated int8 layer tables name their packed copy through this macro: NULL where LIDET_PNQ_WEIGHTS_PK
@@ -83,9 +90,15 @@ typedef struct
 #else
 #define LIDET_PNQ_PK(a) 0
 #endif
-/** The layout of the generated int8 layer tables (2: w_pk; 1 had an int8 [out][in] copy,
- *  w_oi): the generated files refuse to compile against another. */
-#define LIDET_PNQ_LAYOUT_VERSION 2
+/* and their list kernel's starting sums through this one: NULL where LIDET_PNQ_LIST_BIAS (lidet_opt.h) is 0 */
+#if LIDET_PNQ_LIST_BIAS
+#define LIDET_PNQ_LB(a) (a)
+#else
+#define LIDET_PNQ_LB(a) 0
+#endif
+/** The layout of the generated int8 layer tables (3: b_list; 2 had w_pk, not b_list; 1 had an int8 [out][in]
+ *  copy, w_oi): the generated files refuse to compile against another. */
+#define LIDET_PNQ_LAYOUT_VERSION 3
 /* a file of layout 1 names its [out][in] copy through this macro: the compiler's error then names the fix */
 #define LIDET_PNQ_OI(a) lidet_weights_of_layout_1_regenerate_them_with_lidet_codegen_emit_int8
 

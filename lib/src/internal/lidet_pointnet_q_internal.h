@@ -27,14 +27,16 @@ void lidet__nn_acc_s8_r2o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
 void lidet__nn_acc_s8_r4o2(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, int32_t *acc);
 /* one point at a time, a block of output channels in registers, over a list of its inputs (those off -128 in layers
- * of several rows): cores without multiply-accumulate (RV32, ARMv6-M) */
+ * of several rows): cores without multiply-accumulate (RV32, ARMv6-M). b_list: b - 128 sum w per channel (the
+ * generated models' lidet_pointnet_q_layer_t.b_list), the starting sums of those rows; NULL: summed per call */
 void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                           const int32_t *b, uint32_t n_out, int32_t *acc);
+                           const int32_t *b, const int32_t *b_list, uint32_t n_out, int32_t *acc);
 /* the list kernel's sums of each row folded into vmax (vmax[o] = max(vmax[o], sum of row r)) instead of written, acc
  * (n_rows x n_out) its scratch: the last shared layer's accumulation and max-pooling in one pass; 0 (nothing
  * touched) where it does not apply (fewer than 4 rows, ARMv6-M 3; offsets past 16 bits) */
 int lidet__nn_acc_s8_list_max(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                              const int32_t *b, uint32_t n_out, int32_t *acc, int32_t *vmax);
+                              const int32_t *b, const int32_t *b_list, uint32_t n_out, int32_t *acc,
+                              int32_t *vmax);
 void lidet__nn_acc_s8_cols(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
                            const int32_t *b, uint32_t n_out, uint32_t w_stride, int32_t *acc,
                            uint32_t a_stride);

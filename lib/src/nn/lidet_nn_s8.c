@@ -736,14 +736,16 @@ static void list_bias(const int8_t *w_t, uint32_t n_in, const int32_t *b, uint32
 #endif
 }
 
-/* lidet__nn_acc_s8_list, or (vmax != NULL, skipping rows only) each row's sums folded into vmax, acc scratch */
+/* lidet__nn_acc_s8_list, or (vmax != NULL, skipping rows only) each row's sums folded into vmax, acc scratch;
+ * b_list: the skipping rows' starting sums b - 128 sum w (NULL: summed here into the first row's accumulators) */
 static void acc_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
-                     uint32_t n_out, int32_t *acc, int32_t *vmax)
+                     const int32_t *b_list, uint32_t n_out, int32_t *acc, int32_t *vmax)
 {
     list_ent_t list[LIST_CHUNK + 1u]; /* and the end's mark */
     const int skip = n_rows >= LIST_MIN_ROWS;
+    const int32_t *start = b_list != 0 ? b_list : acc;
     uint32_t r, i0;
-    if (skip) /* the first row's accumulators: b - 128 sum w */
+    if (skip && b_list == 0) /* the first row's accumulators: b - 128 sum w */
     {
         list_bias(w_t, n_in, b, n_out, acc, list);
     }
@@ -761,7 +763,7 @@ static void acc_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int
 #if LIST_T1_ASM
             end->v = 0; /* the end's mark */
 #endif
-            const int32_t *const c = i0 == 0u ? (skip ? acc : b) : a;
+            const int32_t *const c = i0 == 0u ? (skip ? start : b) : a;
             if (vmax != 0 && last)
             {
                 list_row_max(list, end, w_t, c, n_out, vmax);
@@ -787,7 +789,7 @@ static int list_fits(uint32_t n_in, uint32_t n_out)
 }
 
 void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                           const int32_t *b, uint32_t n_out, int32_t *acc)
+                           const int32_t *b, const int32_t *b_list, uint32_t n_out, int32_t *acc)
 {
     if (n_rows == 0u)
     {
@@ -802,17 +804,18 @@ void lidet__nn_acc_s8_list(const int8_t *in, uint32_t n_rows, uint32_t n_in, con
 #endif
         return;
     }
-    acc_list(in, n_rows, n_in, w_t, b, n_out, acc, 0);
+    acc_list(in, n_rows, n_in, w_t, b, b_list, n_out, acc, 0);
 }
 
 int lidet__nn_acc_s8_list_max(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t,
-                              const int32_t *b, uint32_t n_out, int32_t *acc, int32_t *vmax)
+                              const int32_t *b, const int32_t *b_list, uint32_t n_out, int32_t *acc,
+                              int32_t *vmax)
 {
     if (n_rows < LIST_MIN_ROWS || n_rows < 2u || !list_fits(n_in, n_out))
     {
         return 0;
     }
-    acc_list(in, n_rows, n_in, w_t, b, n_out, acc, vmax);
+    acc_list(in, n_rows, n_in, w_t, b, b_list, n_out, acc, vmax);
     return 1;
 }
 
@@ -1284,7 +1287,7 @@ void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const in
 #elif LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_R4O2
     lidet__nn_acc_s8_r4o2(in, n_rows, n_in, w_t, b, n_out, acc);
 #elif LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_LIST
-    lidet__nn_acc_s8_list(in, n_rows, n_in, w_t, b, n_out, acc);
+    lidet__nn_acc_s8_list(in, n_rows, n_in, w_t, b, 0, n_out, acc);
 #elif LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_COLS
     if (n_rows >= LIDET_NN_S8_SKIP_MIN_ROWS)
     {

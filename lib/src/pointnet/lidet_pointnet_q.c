@@ -35,6 +35,20 @@ static int layer_ok(const lidet_pointnet_q_layer_t *l, uint32_t n_in, int last_o
         {
             return 0;
         }
+        if (l->b_list != 0)
+        {
+            /* the list kernel's starting sums must be the bias less 128 times the channel's weights, exactly */
+            int32_t v = l->b[o];
+            uint32_t i;
+            for (i = 0; i < n_in; ++i)
+            {
+                v -= 128 * (int32_t)l->w_t[i * l->n_out + o];
+            }
+            if (l->b_list[o] != v)
+            {
+                return 0;
+            }
+        }
     }
     return 1;
 }
@@ -276,7 +290,11 @@ static void acc_s8(const lidet_pointnet_q_layer_t *ly, const int8_t *in, uint32_
     }
     else
     {
+#if LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_LIST
+        lidet__nn_acc_s8_list(in, n_rows, ly->n_in, ly->w_t, ly->b, ly->b_list, ly->n_out, acc);
+#else
         lidet__nn_acc_s8(in, n_rows, ly->n_in, ly->w_t, ly->b, ly->n_out, acc);
+#endif
     }
 }
 
@@ -387,8 +405,8 @@ static int fused_s8(const lidet_pointnet_q_layer_t *ly, const void *in, uint32_t
 #if LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_LIST
     /* the last layer: its rows' sums folded into the running maximum as they are made (not written, then read) */
     if (dst == 0 && ly->w_pk == 0 &&
-        lidet__nn_acc_s8_list_max((const int8_t *)in, nb, ly->n_in, ly->w_t, ly->b, ly->n_out, b->acc,
-                                  b->gmax))
+        lidet__nn_acc_s8_list_max((const int8_t *)in, nb, ly->n_in, ly->w_t, ly->b, ly->b_list, ly->n_out,
+                                  b->acc, b->gmax))
     {
         b->tab->layer = 0; /* acc is written */
         return 1;

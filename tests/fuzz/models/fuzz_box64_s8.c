@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "fuzz_box64_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "fuzz_box64_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "fuzz_box64_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* tnet.point[0] weights [3][8] int8 (per-channel scale) */
@@ -29,7 +29,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box64_s8_tnet_point0_s[8]
     42, 42, 42, 42, 43, 41, 42, 42
 };
 static const lidet_pointnet_q_layer_t fuzz_box64_s8_tnet_point[1] = {
-    {3u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_tnet_point0_w, fuzz_box64_s8_tnet_point0_b, fuzz_box64_s8_tnet_point0_m, fuzz_box64_s8_tnet_point0_s, 0}
+    {3u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_tnet_point0_w, fuzz_box64_s8_tnet_point0_b, fuzz_box64_s8_tnet_point0_m, fuzz_box64_s8_tnet_point0_s, 0, 0}
 };
 
 /* tnet.pvle[0] weights [3][4] int8 (per-channel scale) */
@@ -49,7 +49,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box64_s8_tnet_pvle0_s[4] 
     35, 36, 35, 36
 };
 static const lidet_pointnet_q_layer_t fuzz_box64_s8_tnet_pvle[1] = {
-    {3u, 4u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_tnet_pvle0_w, fuzz_box64_s8_tnet_pvle0_b, fuzz_box64_s8_tnet_pvle0_m, fuzz_box64_s8_tnet_pvle0_s, 0}
+    {3u, 4u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_tnet_pvle0_w, fuzz_box64_s8_tnet_pvle0_b, fuzz_box64_s8_tnet_pvle0_m, fuzz_box64_s8_tnet_pvle0_s, 0, 0}
 };
 
 /* tnet.head[0] weights [12][8] int8 (per-channel scale) */
@@ -105,8 +105,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_box64_s8_tnet_head1_wpk[
 };
 #endif
 static const lidet_pointnet_q_layer_t fuzz_box64_s8_tnet_head[2] = {
-    {12u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_tnet_head0_w, fuzz_box64_s8_tnet_head0_b, fuzz_box64_s8_tnet_head0_m, fuzz_box64_s8_tnet_head0_s, LIDET_PNQ_PK(fuzz_box64_s8_tnet_head0_wpk)},
-    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box64_s8_tnet_head1_w, fuzz_box64_s8_tnet_head1_b, fuzz_box64_s8_tnet_head1_m, fuzz_box64_s8_tnet_head1_s, LIDET_PNQ_PK(fuzz_box64_s8_tnet_head1_wpk)}
+    {12u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_tnet_head0_w, fuzz_box64_s8_tnet_head0_b, fuzz_box64_s8_tnet_head0_m, fuzz_box64_s8_tnet_head0_s, LIDET_PNQ_PK(fuzz_box64_s8_tnet_head0_wpk), 0},
+    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box64_s8_tnet_head1_w, fuzz_box64_s8_tnet_head1_b, fuzz_box64_s8_tnet_head1_m, fuzz_box64_s8_tnet_head1_s, LIDET_PNQ_PK(fuzz_box64_s8_tnet_head1_wpk), 0}
 };
 
 /* tnet: class one-hot folded into head[0], [class][out] int32 */
@@ -163,9 +163,15 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_box64_s8_box_point1_wpk[
     4287496303u, 4293394483u, 4456575u, 4293918799u, 4294508442u, 4293197951u, 4290510747u, 4293656687u, 1572874u, 4286906325u, 4286644276u, 4287233946u, 4290707399u, 4587606u, 655300u, 7471231u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* box.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_box64_s8_box_point1_lb[16] = {
+    14302, -2281, 323, -7054, -9829, -12868, 4495, 4745, 12779, 6351, 4237, 15095, 1346, 297, 142, -5241
+};
+#endif
 static const lidet_pointnet_q_layer_t fuzz_box64_s8_box_point[2] = {
-    {3u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_point0_w, fuzz_box64_s8_box_point0_b, fuzz_box64_s8_box_point0_m, fuzz_box64_s8_box_point0_s, 0},
-    {8u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_point1_w, fuzz_box64_s8_box_point1_b, fuzz_box64_s8_box_point1_m, fuzz_box64_s8_box_point1_s, LIDET_PNQ_PK(fuzz_box64_s8_box_point1_wpk)}
+    {3u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_point0_w, fuzz_box64_s8_box_point0_b, fuzz_box64_s8_box_point0_m, fuzz_box64_s8_box_point0_s, 0, 0},
+    {8u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_point1_w, fuzz_box64_s8_box_point1_b, fuzz_box64_s8_box_point1_m, fuzz_box64_s8_box_point1_s, LIDET_PNQ_PK(fuzz_box64_s8_box_point1_wpk), LIDET_PNQ_LB(fuzz_box64_s8_box_point1_lb)}
 };
 
 /* box.pvle[0] weights [3][4] int8 (per-channel scale) */
@@ -185,7 +191,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_box64_s8_box_pvle0_s[4] =
     35, 33, 36, 35
 };
 static const lidet_pointnet_q_layer_t fuzz_box64_s8_box_pvle[1] = {
-    {3u, 4u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_pvle0_w, fuzz_box64_s8_box_pvle0_b, fuzz_box64_s8_box_pvle0_m, fuzz_box64_s8_box_pvle0_s, 0}
+    {3u, 4u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_pvle0_w, fuzz_box64_s8_box_pvle0_b, fuzz_box64_s8_box_pvle0_m, fuzz_box64_s8_box_pvle0_s, 0, 0}
 };
 
 /* box.head[0] weights [20][8] int8 (per-channel scale) */
@@ -280,8 +286,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_box64_s8_box_head1_wpk[1
 };
 #endif
 static const lidet_pointnet_q_layer_t fuzz_box64_s8_box_head[2] = {
-    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_head0_w, fuzz_box64_s8_box_head0_b, fuzz_box64_s8_box_head0_m, fuzz_box64_s8_box_head0_s, LIDET_PNQ_PK(fuzz_box64_s8_box_head0_wpk)},
-    {8u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box64_s8_box_head1_w, fuzz_box64_s8_box_head1_b, fuzz_box64_s8_box_head1_m, fuzz_box64_s8_box_head1_s, LIDET_PNQ_PK(fuzz_box64_s8_box_head1_wpk)}
+    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_box64_s8_box_head0_w, fuzz_box64_s8_box_head0_b, fuzz_box64_s8_box_head0_m, fuzz_box64_s8_box_head0_s, LIDET_PNQ_PK(fuzz_box64_s8_box_head0_wpk), 0},
+    {8u, 39u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_box64_s8_box_head1_w, fuzz_box64_s8_box_head1_b, fuzz_box64_s8_box_head1_m, fuzz_box64_s8_box_head1_s, LIDET_PNQ_PK(fuzz_box64_s8_box_head1_wpk), 0}
 };
 
 /* box: class one-hot folded into head[0], [class][out] int32 */

@@ -7,8 +7,8 @@
 #if LIDET_WEIGHTS_FORMAT_VERSION != 1
 #error "fuzz_cls64_s8: generated for weights format 1; regenerate with python -m lidet_codegen emit"
 #endif
-#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 2
-#error "fuzz_cls64_s8: generated for the int8 layer layout 2; regenerate with python -m lidet_codegen emit --int8"
+#if !defined(LIDET_PNQ_LAYOUT_VERSION) || LIDET_PNQ_LAYOUT_VERSION != 3
+#error "fuzz_cls64_s8: generated for the int8 layer layout 3; regenerate with python -m lidet_codegen emit --int8"
 #endif
 
 /* cls.point[0] weights [3][8] int8 (per-channel scale) */
@@ -60,9 +60,15 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_cls64_s8_cls_point1_wpk[
     2818041u, 4291493864u, 8323084u, 4289789942u, 2752441u, 8388605u, 4291887130u, 720954u, 1310593u, 4291297153u, 2228204u, 4291297263u, 2686988u, 4294246471u, 6094799u, 4294705208u
 };
 #endif
+#if LIDET_PNQ_LIST_BIAS
+/* cls.point[1] the list kernel's starting sums, b - 128 sum_i w[i] */
+LIDET_ALIGN(16) LIDET_RODATA static const int32_t fuzz_cls64_s8_cls_point1_lb[16] = {
+    14019, 10851, -2475, 6442, -3204, -2680, -9217, -3290, -15426, 11901, -12172, 1288, -9137, 1435, -7291, 7777
+};
+#endif
 static const lidet_pointnet_q_layer_t fuzz_cls64_s8_cls_point[2] = {
-    {3u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_point0_w, fuzz_cls64_s8_cls_point0_b, fuzz_cls64_s8_cls_point0_m, fuzz_cls64_s8_cls_point0_s, 0},
-    {8u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_point1_w, fuzz_cls64_s8_cls_point1_b, fuzz_cls64_s8_cls_point1_m, fuzz_cls64_s8_cls_point1_s, LIDET_PNQ_PK(fuzz_cls64_s8_cls_point1_wpk)}
+    {3u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_point0_w, fuzz_cls64_s8_cls_point0_b, fuzz_cls64_s8_cls_point0_m, fuzz_cls64_s8_cls_point0_s, 0, 0},
+    {8u, 16u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_point1_w, fuzz_cls64_s8_cls_point1_b, fuzz_cls64_s8_cls_point1_m, fuzz_cls64_s8_cls_point1_s, LIDET_PNQ_PK(fuzz_cls64_s8_cls_point1_wpk), LIDET_PNQ_LB(fuzz_cls64_s8_cls_point1_lb)}
 };
 
 /* cls.pvle[0] weights [3][4] int8 (per-channel scale) */
@@ -82,7 +88,7 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint8_t fuzz_cls64_s8_cls_pvle0_s[4] =
     34, 35, 33, 34
 };
 static const lidet_pointnet_q_layer_t fuzz_cls64_s8_cls_pvle[1] = {
-    {3u, 4u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_pvle0_w, fuzz_cls64_s8_cls_pvle0_b, fuzz_cls64_s8_cls_pvle0_m, fuzz_cls64_s8_cls_pvle0_s, 0}
+    {3u, 4u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_pvle0_w, fuzz_cls64_s8_cls_pvle0_b, fuzz_cls64_s8_cls_pvle0_m, fuzz_cls64_s8_cls_pvle0_s, 0, 0}
 };
 
 /* cls.head[0] weights [20][8] int8 (per-channel scale) */
@@ -144,8 +150,8 @@ LIDET_ALIGN(16) LIDET_RODATA static const uint32_t fuzz_cls64_s8_cls_head1_wpk[8
 };
 #endif
 static const lidet_pointnet_q_layer_t fuzz_cls64_s8_cls_head[2] = {
-    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_head0_w, fuzz_cls64_s8_cls_head0_b, fuzz_cls64_s8_cls_head0_m, fuzz_cls64_s8_cls_head0_s, LIDET_PNQ_PK(fuzz_cls64_s8_cls_head0_wpk)},
-    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_cls64_s8_cls_head1_w, fuzz_cls64_s8_cls_head1_b, fuzz_cls64_s8_cls_head1_m, fuzz_cls64_s8_cls_head1_s, LIDET_PNQ_PK(fuzz_cls64_s8_cls_head1_wpk)}
+    {20u, 8u, 1u, LIDET_PNQ_OUT_S8, -128, fuzz_cls64_s8_cls_head0_w, fuzz_cls64_s8_cls_head0_b, fuzz_cls64_s8_cls_head0_m, fuzz_cls64_s8_cls_head0_s, LIDET_PNQ_PK(fuzz_cls64_s8_cls_head0_wpk), 0},
+    {8u, 3u, 0u, LIDET_PNQ_OUT_Q16, 0, fuzz_cls64_s8_cls_head1_w, fuzz_cls64_s8_cls_head1_b, fuzz_cls64_s8_cls_head1_m, fuzz_cls64_s8_cls_head1_s, LIDET_PNQ_PK(fuzz_cls64_s8_cls_head1_wpk), 0}
 };
 
 const lidet_pointnet_q_model_t lidet_model_fuzz_cls64_s8 = {
