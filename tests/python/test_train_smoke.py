@@ -329,7 +329,8 @@ def test_make_weights_family_with_int8_fine_tuning(tmp_path, monkeypatch, need_l
     np.savez_compressed(work / "tiny.npz", meta=json.dumps({"sensor": "hdl64", "command": "test"}), **d)
     small = ["--batch", "8"]
     monkeypatch.setitem(Wt.FAMILIES, "tiny", dict(
-        sensor="hdl64", dataset=[], cls=["--epochs-ce", "1", "--epochs-energy", "1"] + small,
+        sensor="hdl64", dataset=[],
+        cls=["--epochs-ce", "1", "--epochs-energy", "1", "--gamma-tpr", "0.9,0.95,0.97"] + small,
         box=["--epochs-box", "1", "--epochs-energy", "1"] + small, cls_finetune=["--epochs", "1"] + small))
     a = argparse.Namespace(work=work, weights=wdir, docs_img=tmp_path / "img", jobs=1, threads=1, device="cpu",
                            seed=0, no_progress=True)
@@ -339,6 +340,9 @@ def test_make_weights_family_with_int8_fine_tuning(tmp_path, monkeypatch, need_l
     res = Wt.run_family("tiny", a, timings)
     _, ck = load_checkpoint(work / "tiny_cls.pt")
     assert ck["meta"]["finetune"]["epochs"] == 1 and "finetune_q" in ck["meta"]["finetune"]["command"]
+    # the fine-tuning's gates keep the shares the family trained with (train_cls --gamma-tpr)
+    assert ck["meta"]["gamma_tpr"] == [0.9, 0.95, 0.97]
+    assert "--gamma-tpr 0.9,0.95,0.97" in ck["meta"]["finetune"]["command"]
     # a family named apart from its sensor (as vlp16s) trains for the sensor its spec names
     assert ck["meta"]["sensor"] == "hdl64" and "--sensor hdl64" in ck["meta"]["command"]
     g = [float(v) for v in {p.key: p.value for p in __import__("onnx").load(str(wdir / "cls_tiny.onnx")).metadata_props}

@@ -22,7 +22,7 @@ What: a few epochs from the trained (folded) network, every layer a linear map +
   the raw agreement counts and what decides which gamma gate 1 uses).
 The points are rounded to the 4 mm steps the integer detector sees. Adam, cosine from `--lr`. The output is an
 ONNX of the same contract (models.ClassifierNet, batch norms set to identity) with gamma recomputed on the
-validation split as `train_cls` does (95 % of each class's ID proposals).
+validation split as `train_cls` does (`--gamma-tpr` of each class's ID proposals: 95 % unless given).
 
 Measured on the shipped VLP-16 classifier (docs/journal/fixed-point.md, "Quantization-aware fine-tuning"): int8
 disagreements on 12,662 held-out simulated proposals 171 -> 69-77 (seeds 7, 8, 9; calibrate and quantize as
@@ -180,6 +180,9 @@ def add_args(ap):
                     "trained with (weights/MODEL_CARD.md); default: from the network, as train_cls takes them")
     ap.add_argument("--min-gap", type=float, default=3.0, help="least m_out - m_in, as train_cls")
     ap.add_argument("--percentile", type=float, default=99.9, help="activation ranges (quant.CALIB_RULE's)")
+    ap.add_argument("--gamma-tpr", default="0.95",
+                    help="share of each class's validation ID proposals gate 1 keeps (train_cls --gamma-tpr: one "
+                         "share, or three for Car, Cyclist, Pedestrian); give the network's own training value")
     ap.add_argument("--seed", type=int, default=7)
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--checkpoint", type=pathlib.Path, default=None,
@@ -193,6 +196,7 @@ def add_args(ap):
 
 def finetune(a) -> dict:
     from lidet_codegen.emit import load
+    from . import train_cls as TC
     from .export import export_onnx
     C.setup(a.seed, a.threads)
     # torch's deterministic kernels made an epoch 25x slower here (50 s against 2 s on the VLP-16 set); the CPU
@@ -267,9 +271,10 @@ def finetune(a) -> dict:
     after = _figures(fc, va, ranges())
     lg = _logits(fc, va, grid=False)  # the points as train_cls takes its gamma from them
     idm = va["label"] >= 0
-    gamma = C.per_class_gamma(MX.energy_np(lg)[idm], lg.argmax(1)[idm])
+    tprs = TC.gamma_tprs(a.gamma_tpr)
+    gamma = C.per_class_gamma(MX.energy_np(lg)[idm], lg.argmax(1)[idm], tprs)
     net = fc.to_net()
-    meta = dict(n_points=fc.model.n_points, gamma=gamma, energy_T=1.0, trained=1,
+    meta = dict(n_points=fc.model.n_points, gamma=gamma, gamma_tpr=tprs, energy_T=1.0, trained=1,
                 sensor=data["meta"].get("sensor", ""), data=data["meta"].get("command", str(a.data)),
                 command=getattr(a, "command", None) or "python -m lidet_tools.train.finetune_q",
                 z_origin=data["meta"].get("z_origin", "mean"))
@@ -278,7 +283,8 @@ def finetune(a) -> dict:
     if a.checkpoint is not None:
         # the training's record kept (margins, best epoch, history, seconds), this step added
         keep = dict(src["meta"]) if src is not None else dict(margins=dict(m_in=m_in, m_out=m_out), best_epoch=0)
-        keep.update(gamma=gamma, finetune=dict(command=meta["command"], epochs=a.epochs, before=before, after=after))
+        keep.update(gamma=gamma, gamma_tpr=tprs,
+                    finetune=dict(command=meta["command"], epochs=a.epochs, before=before, after=after))
         C.save_atomic(dict(kind="classifier", cfg=dict(net.cfg), state_dict=net.state_dict(), meta=keep), a.checkpoint)
     if a.card is not None:
         update_card(a.card, a.out.name, gamma, meta["command"], before, after)

@@ -125,6 +125,8 @@ def run_family(fam: str, a, timings: dict) -> dict:
             from . import finetune_q as FQ
             fargv = ["--onnx", str(onnx), "--data", str(data), "--out", str(onnx), "--checkpoint", str(ck),
                      "--threads", str(a.threads)] + spec["cls_finetune"]
+            if "--gamma-tpr" in extra:  # the gates keep the shares the family trained with
+                fargv += ["--gamma-tpr", extra[extra.index("--gamma-tpr") + 1]]
             _log(f"{fam}: {kind} fine-tuned for int8 -> {onnx}")
             fp = FQ.add_args(argparse.ArgumentParser()).parse_args(fargv)
             fp.command = "python -m lidet_tools.train.finetune_q " + shlex.join(fargv)
