@@ -623,7 +623,10 @@ static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, const run_span_t *s
     }
     if (st->n_fragments > 0u)
     {
-        for (p = next_fragment(lab, 0, npix); p < npix; p = next_fragment(lab, p + 1u, npix))
+        /* the fragments' pixels not yet in a group: the search stops at the last one instead of the image's end */
+        uint32_t left = st->n_fragment_pixels;
+        for (p = next_fragment(lab, 0, npix); p < npix;
+             p = left == 0u ? npix : next_fragment(lab, p + 1u, npix))
         {
             RUN_RESCUE_T rs;
             const uint32_t start = tail;
@@ -633,6 +636,7 @@ static void run_fills(RUN_STATE_T *c, const RUN_PARAM_T *lk, const run_span_t *s
             rs.best = 0u;
             rs.best_d2 = RUN_RESCUE_FAR;
             RUN_RESCUE_GROW(c, lk, start, &rs);
+            left -= rs.tail - start < left ? rs.tail - start : left; /* the group: fragment pixels only */
             if (rs.best != 0u)
             {
                 rescue_join(c, rs.best - 1u, start, rs.tail, planes, n_sectors, st);
