@@ -119,7 +119,7 @@ static void check_shape(uint32_t rows, uint32_t n_in, uint32_t n_out, int extrem
     lidet__nn_acc_s8_dsp(in, rows, n_in, w, b, n_out, got);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
     memset(got, 0x5A, sizeof got);
-    lidet__nn_acc_s8(in, rows, n_in, w, b, n_out, got);
+    lidet__nn_acc_s8(in, rows, n_in, w, b, 0, n_out, got);
     TEST_ASSERT_EQUAL_INT32_ARRAY(ref, got, rows * n_out);
     /* the packed DSP kernel (n_in not a multiple of 4: it takes w_t, never reading w_pk) */
     memset(w_pk, 0xA5, sizeof w_pk);
@@ -210,7 +210,7 @@ static void test_fused_pass_equals_acc_then_requant_or_max(void)
                         refmax[i] = vmax[i] = (int32_t)(next() % 2000001u) - 1000000;
                     }
                     lidet__nn_pack_s8_pk(w, n_in, n_out, w_pk);
-                    lidet__nn_acc_s8(in, rows, n_in, w, b, n_out, acc);
+                    lidet__nn_acc_s8(in, rows, n_in, w, b, 0, n_out, acc);
                     lidet__nn_requant_s8(acc, rows, n_out, mult, shift, zp, lo, ref8);
                     lidet__nn_max_rows_s32(acc, rows, n_out, refmax);
                     memset(out, 0x5A, sizeof out);

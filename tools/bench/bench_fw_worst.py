@@ -12,7 +12,6 @@ Needs the Arm cross compiler and qemu-system-arm (tools/scripts/install_deps.sh)
 BUILD/firmware-worst (one build folder, the scan swapped between builds: only the scan's object is rebuilt)."""
 from __future__ import annotations
 
-import os
 import pathlib
 import shutil
 import subprocess

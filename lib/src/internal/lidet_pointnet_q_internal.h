@@ -14,9 +14,10 @@ extern const int32_t lidet__pnq_exp2_neg_q30[LIDET_PNQ_TABLE_STEPS + 1];
 extern const int32_t lidet__pnq_log2_q30[LIDET_PNQ_TABLE_STEPS + 1];
 
 /* acc[r * n_out + o] = b[o] + sum_i in[r * n_in + i] * w_t[i * n_out + o], r < n_rows (int32: the caller's
- * descriptor check bounds |b| < 2^30, so no overflow for n_in <= 1024). */
+ * descriptor check bounds |b| < 2^30, so no overflow for n_in <= 1024). b_list: the layer's b - 128 sum w
+ * (lidet_pointnet_q_layer_t.b_list, or NULL), which the list kernel starts from; the other kernels ignore it. */
 void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
-                      uint32_t n_out, int32_t *acc);
+                      const int32_t *b_list, uint32_t n_out, int32_t *acc);
 /* the kernels behind lidet__nn_acc_s8 (nn/lidet_nn_s8.c: which one a target uses), exposed for their test:
  * the host kernel (4 rows per weight row), 2 x 2 and 4 x 2 register blocks, the DSP one, and the output-inner loop on a column slice of a layer (weight rows
  * w_stride long, accumulator rows a_stride long) */

@@ -1255,7 +1255,7 @@ void lidet__nn_acc_s8_pk(const int8_t *in, uint32_t n_rows, uint32_t n_in, const
     uint32_t r, g0;
     if (n_in % 4u != 0u || n_in == 0u || n_pairs == 0u)
     {
-        lidet__nn_acc_s8(in, n_rows, n_in, w_t, b, n_out, acc);
+        lidet__nn_acc_s8(in, n_rows, n_in, w_t, b, 0, n_out, acc);
         return;
     }
     for (r = 0; r < n_rows; r += 2u)
@@ -1278,8 +1278,11 @@ void lidet__nn_acc_s8_pk(const int8_t *in, uint32_t n_rows, uint32_t n_in, const
 }
 
 void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const int8_t *w_t, const int32_t *b,
-                      uint32_t n_out, int32_t *acc)
+                      const int32_t *b_list, uint32_t n_out, int32_t *acc)
 {
+#if LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_LIST
+    (void)b_list;
+#endif
 #if LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_DSP
     lidet__nn_acc_s8_dsp(in, n_rows, n_in, w_t, b, n_out, acc);
 #elif LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_R2O2
@@ -1287,7 +1290,7 @@ void lidet__nn_acc_s8(const int8_t *in, uint32_t n_rows, uint32_t n_in, const in
 #elif LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_R4O2
     lidet__nn_acc_s8_r4o2(in, n_rows, n_in, w_t, b, n_out, acc);
 #elif LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_LIST
-    lidet__nn_acc_s8_list(in, n_rows, n_in, w_t, b, 0, n_out, acc);
+    lidet__nn_acc_s8_list(in, n_rows, n_in, w_t, b, b_list, n_out, acc);
 #elif LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_COLS
     if (n_rows >= LIDET_NN_S8_SKIP_MIN_ROWS)
     {

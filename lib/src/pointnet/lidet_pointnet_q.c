@@ -290,11 +290,7 @@ static void acc_s8(const lidet_pointnet_q_layer_t *ly, const int8_t *in, uint32_
     }
     else
     {
-#if LIDET_NN_S8_KERNEL == LIDET_NN_S8_KERNEL_LIST
-        lidet__nn_acc_s8_list(in, n_rows, ly->n_in, ly->w_t, ly->b, ly->b_list, ly->n_out, acc);
-#else
-        lidet__nn_acc_s8(in, n_rows, ly->n_in, ly->w_t, ly->b, ly->n_out, acc);
-#endif
+        lidet__nn_acc_s8(in, n_rows, ly->n_in, ly->w_t, ly->b, ly->b_list, ly->n_out, acc);
     }
 }
 
