@@ -154,6 +154,61 @@ static void test_split_multiplies_are_exact(void)
     }
 }
 
+/* the PointNets' rotation into the model frame on those cores: round((c x + s y) / 2^28) from 15-bit halves of
+ * c and s, exact against the int64 sum wherever |ch| + |sh| <= 65000 (every rotation of a Q30 unit vector, and
+ * beyond), on the corners of the int16 inputs and on random operands */
+static void check_dot2(int32_t c, int32_t s, int32_t x, int32_t y)
+{
+    const int32_t ch = (int32_t)(((int64_t)c + (1 << 14)) >> 15), sh = (int32_t)(((int64_t)s + (1 << 14)) >> 15);
+    const int32_t cl = c - (int32_t)((uint32_t)ch << 15), sl = s - (int32_t)((uint32_t)sh << 15);
+    const int64_t ref = lidet__q_rshift_round((int64_t)c * x + (int64_t)s * y, 28);
+    TEST_ASSERT_TRUE(cl >= -16384 && cl < 16384 && sl >= -16384 && sl < 16384);
+    if ((ch < 0 ? -ch : ch) + (sh < 0 ? -sh : sh) > 65000)
+        return;
+    TEST_ASSERT_EQUAL_INT64(ref, lidet__q_dot2_r28_split(ch, cl, sh, sl, x, y));
+}
+
+static void test_rotation_split_is_exact(void)
+{
+    static const int32_t cs[] = {0, 1, -1, 1 << 30, -(1 << 30), 759250125, -759250125, 16383, 16384, -16385,
+                                 1065000000, -1065000000, 2129000000, -2129000000};
+    static const int32_t xy[] = {0, 1, -1, 32767, -32768, 16384, -16383, 255, -1000};
+    const uint32_t nc = (uint32_t)(sizeof cs / sizeof cs[0]), nx = (uint32_t)(sizeof xy / sizeof xy[0]);
+    uint32_t a, b, i, j, k, checked = 0;
+    for (a = 0; a < nc; ++a)
+        for (b = 0; b < nc; ++b)
+            for (i = 0; i < nx; ++i)
+                for (j = 0; j < nx; ++j)
+                    check_dot2(cs[a], cs[b], xy[i], xy[j]);
+    for (k = 0; k < 300000u; ++k)
+    {
+        /* a unit vector at a random angle (as the frame's cos, sin), scaled by up to 1.4, and any int16 point */
+        const uint32_t t = next() ^ (next() << 16);
+        const int32_t scale = 65536 + (int32_t)(next() % 26000u);
+        const int32_t c = (int32_t)(((int64_t)lidet__q_cos(t) * scale) >> 16);
+        const int32_t s = (int32_t)(((int64_t)lidet__q_sin(t) * scale) >> 16);
+        const int32_t x = (int32_t)(int16_t)next(), y = (int32_t)(int16_t)next();
+        const int32_t ch = (c + (1 << 14)) >> 15, sh = (s + (1 << 14)) >> 15;
+        check_dot2(c, s, x, y);
+        checked += (ch < 0 ? -ch : ch) + (sh < 0 ? -sh : sh) <= 65000;
+    }
+    TEST_ASSERT_TRUE(checked > 290000u); /* the bound leaves out none of these but the largest scales */
+}
+
+/* the sine table's interpolation on those cores: every step of the table against every 61st fraction and the
+ * fractions' ends, exact against the int64 product */
+static void test_sine_interpolation_split_is_exact(void)
+{
+    uint32_t i, f;
+    for (i = 0; i < LIDET_Q_SIN_STEPS; ++i)
+    {
+        const int32_t d = lidet__q_sin_q30[i + 1] - lidet__q_sin_q30[i];
+        TEST_ASSERT_TRUE(d >= 0 && d < (1 << 21));
+        for (f = 0; f < (1u << 20); f += f < 2048u || f > (1u << 20) - 2048u ? 1u : 61u)
+            TEST_ASSERT_EQUAL_INT64(lidet__q_rshift_round((int64_t)d * f, 20), lidet__q_mul_r20_split(d, f));
+    }
+}
+
 static void test_kernels_agree_on_every_shape(void)
 {
     uint32_t rows, n_in, n_out;
@@ -443,6 +498,8 @@ int main(void)
 {
     UNITY_BEGIN();
     RUN_TEST(test_split_multiplies_are_exact);
+    RUN_TEST(test_rotation_split_is_exact);
+    RUN_TEST(test_sine_interpolation_split_is_exact);
     RUN_TEST(test_kernels_agree_on_every_shape);
     RUN_TEST(test_packed_kernel_on_multiples_of_4);
     RUN_TEST(test_fused_pass_equals_acc_then_requant_or_max);

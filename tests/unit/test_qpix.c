@@ -205,6 +205,38 @@ void test_div_round_on_both_sides_of_32_bits(void)
     }
 }
 
+/* the row of a pixel as (p m) >> 26 (the cores without a divide instruction): wherever lidet__q_row_m26
+ * gives an m, every pixel's row is p / cols; and it gives one for the sensors' image sizes */
+static void test_row_without_a_divide(void)
+{
+    static const uint32_t sizes[][2] = {{16, 1800}, {32, 1800}, {32, 1024}, {64, 2048}, {64, 1800},
+                                        {32, 1085}, {64, 1024}, {16, 2}, {1, 3}, {7, 999}};
+    uint32_t k, cols, p;
+    for (k = 0; k < sizeof sizes / sizeof sizes[0]; ++k)
+    {
+        const uint32_t rows = sizes[k][0], c = sizes[k][1], m = lidet__q_row_m26(rows, c);
+        TEST_ASSERT_TRUE(m != 0u);
+        for (p = 0; p < rows * c; ++p)
+            TEST_ASSERT_EQUAL_UINT32(p / c, (p * m) >> 26);
+    }
+    /* 128 rows: p m would pass 32 bits, so the row is divided */
+    TEST_ASSERT_EQUAL_UINT32(0u, lidet__q_row_m26(128, 2048));
+    TEST_ASSERT_EQUAL_UINT32(0u, lidet__q_row_m26(128, 1024));
+    /* every width up to 2048 at 16 and 64 rows: exact where given, and given up to 64 rows */
+    for (cols = 2; cols <= 2048u; ++cols)
+    {
+        const uint32_t m16 = lidet__q_row_m26(16, cols), m64 = lidet__q_row_m26(64, cols);
+        TEST_ASSERT_TRUE(m16 != 0u);
+        for (p = 0; p < 16u * cols; p += 1u + p / 4096u)
+            TEST_ASSERT_EQUAL_UINT32(p / cols, (p * m16) >> 26);
+        if (m64 != 0u)
+            for (p = 0; p < 64u * cols; p += 1u + p / 4096u)
+                TEST_ASSERT_EQUAL_UINT32(p / cols, (p * m64) >> 26);
+    }
+    TEST_ASSERT_EQUAL_UINT32(0u, lidet__q_row_m26(0, 1800));
+    TEST_ASSERT_EQUAL_UINT32(0u, lidet__q_row_m26(16, 0));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -212,5 +244,6 @@ int main(void)
     RUN_TEST(test_projected_points_decode_back);
     RUN_TEST(test_empty_pixels_and_accepted_images);
     RUN_TEST(test_div_round_on_both_sides_of_32_bits);
+    RUN_TEST(test_row_without_a_divide);
     return UNITY_END();
 }

@@ -136,6 +136,8 @@ typedef struct
     /* derived from the image's geometry on the first run (and when it changes): S = sin(alpha + theta) Q16
      * (clamped at 0), H = 4 sin^2(alpha / 2) Q30 (saturated), same layout as the float stage's sin/cos */
     uint16_t geo_rows, geo_cols;
+    uint32_t
+        geo_row_m26; /* a pixel's row as (p m) >> 26 on cores without a divide (lidet_qpix.h), 0: p / cols */
     int32_t geo_elev_bam[LIDET_MAX_ROWS];
     uint32_t col_s[LIDET_CLUSTER_MAX_STEPS], col_h[LIDET_CLUSTER_MAX_STEPS];
     uint32_t row_s[LIDET_MAX_ROWS * LIDET_CLUSTER_MAX_STEPS];

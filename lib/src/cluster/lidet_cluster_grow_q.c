@@ -7,6 +7,7 @@
 #include "internal/lidet_assert.h"
 #include "internal/lidet_cluster_q_internal.h"
 #include "internal/lidet_qmath.h"
+#include "internal/lidet_qpix.h"
 
 /* 4 sin^2(alpha / 2) in Q30 from sin(alpha / 2) in Q30, rounded, saturated at 2^32 - 1 (alpha = pi) */
 static uint32_t h_of(int32_t sin_half)
@@ -80,6 +81,7 @@ void lidet__cluster_q_setup_geometry(lidet_cluster_q_state_t *c, const lidet_ran
     }
     c->geo_rows = (uint16_t)rows;
     c->geo_cols = (uint16_t)cols;
+    c->geo_row_m26 = lidet__q_row_m26(rows, cols);
 }
 
 /* beta > theta  <=>  d2 sin(alpha + theta) > d1 sin(theta) (d1 >= d2; uint32: d <= 65535, S <= 65536). With

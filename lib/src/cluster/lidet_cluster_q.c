@@ -69,7 +69,7 @@ void lidet_cluster_q_cfg_default(lidet_cluster_q_cfg_t *cfg, uint32_t n_rows, ui
 static inline void read_q(const lidet_cluster_q_state_t *c, uint32_t p, int32_t *x, int32_t *y, int32_t *z)
 {
     int32_t v[3];
-    lidet__qpix_xyz(&c->img, p, v); /* stored or decoded (lidet_qpix.h) */
+    lidet__qpix_xyz_m(&c->img, p, c->geo_row_m26, v); /* stored or decoded (lidet_qpix.h) */
     *x = v[0];
     *y = v[1];
     *z = v[2];
@@ -93,7 +93,10 @@ int32_t lidet__cluster_q_height(const lidet_cluster_q_state_t *c, uint32_t seed,
     if (planes != 0)
     {
         const uint32_t col = seed % c->img.n_cols;
-        uint32_t s = (uint32_t)(((uint64_t)col * n_sectors) / c->img.n_cols);
+        /* col n_sectors in 32 bits where it fits (col < 2^16): a 32-bit division, not a 64-bit library call on
+         * the cores without a divide instruction (as the float stage's) */
+        uint32_t s = n_sectors <= 0xFFFFu ? (col * n_sectors) / c->img.n_cols
+                                          : (uint32_t)(((uint64_t)col * n_sectors) / c->img.n_cols);
         const lidet_plane_q_t *pl;
         s = s < n_sectors ? s : n_sectors - 1u;
         pl = &planes[s];

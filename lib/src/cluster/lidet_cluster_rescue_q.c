@@ -22,7 +22,7 @@ static inline void window_set_q(const lidet_cluster_q_state_t *c, window_q_t *w,
     (void)compact;
     w->q = q;
     w->dq = c->img.range_4mm[q];
-    lidet__qpix_xyz(&c->img, q, w->v);
+    lidet__qpix_xyz_m(&c->img, q, c->geo_row_m26, w->v);
 }
 
 /* |a - b| of two int16 coordinates <= gg (no overflow: int32) */
@@ -54,7 +54,7 @@ static inline void probe_q(lidet_cluster_q_state_t *c, lidet__rescue_q_t *rs, co
     {
         return;
     }
-    lidet__qpix_xyz(img, n, v); /* stored or decoded (lidet_qpix.h) */
+    lidet__qpix_xyz_m(img, n, c->geo_row_m26, v); /* stored or decoded (lidet_qpix.h) */
     if (!near_q(v[0], w->v[0], (int32_t)gg) || !near_q(v[1], w->v[1], (int32_t)gg) ||
         !near_q(v[2], w->v[2], (int32_t)gg))
     {

@@ -55,7 +55,7 @@ static uint32_t refine_cell(const lidet_cluster_q_state_t *c, uint32_t p, const 
 {
     int32_t v[3];
     uint32_t ix, iy;
-    lidet__qpix_xyz(&c->img, p, v); /* stored or decoded (lidet_qpix.h) */
+    lidet__qpix_xyz_m(&c->img, p, c->geo_row_m26, v); /* stored or decoded (lidet_qpix.h) */
     ix = (uint32_t)(((uint64_t)span_mm(g->lo[0], v[0]) * g->inv) >> 40);
     iy = (uint32_t)(((uint64_t)span_mm(g->lo[1], v[1]) * g->inv) >> 40);
     ix = ix < nx ? ix : nx - 1u;
@@ -66,7 +66,7 @@ static uint32_t refine_cell(const lidet_cluster_q_state_t *c, uint32_t p, const 
 static int32_t refine_z(const lidet_cluster_q_state_t *c, uint32_t p)
 {
     int32_t v[3];
-    lidet__qpix_xyz(&c->img, p, v);
+    lidet__qpix_xyz_m(&c->img, p, c->geo_row_m26, v);
     return v[2];
 }
 
@@ -136,7 +136,7 @@ static void sums_of(const lidet_cluster_q_state_t *c, const lidet_cluster_q_rec_
     for (m = r->first_member; m < r->first_member + r->n_points; ++m)
     {
         int32_t v[3];
-        lidet__qpix_xyz(&c->img, (uint32_t)c->members[m], v);
+        lidet__qpix_xyz_m(&c->img, (uint32_t)c->members[m], c->geo_row_m26, v);
         s[0] += v[0];
         s[1] += v[1];
         s[2] += v[2];
@@ -173,7 +173,7 @@ static void refine_join_mean(lidet_cluster_q_state_t *c, uint32_t i, uint32_t j,
 #define REFINE_Z_FAR 0x7FFFFFFF
 #define REFINE_V_T int32_t
 #define REFINE_S_T int64_t
-#define REFINE_READ(c, p, v) lidet__qpix_xyz(&(c)->img, p, v)
+#define REFINE_READ(c, p, v) lidet__qpix_xyz_m(&(c)->img, p, (c)->geo_row_m26, v)
 #define REFINE_MIN(r) ((r)->min_4mm)
 #define REFINE_MAX(r) ((r)->max_4mm)
 #define REFINE_MEAN(r) ((r)->mean_4mm)

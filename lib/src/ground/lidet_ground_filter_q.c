@@ -716,7 +716,7 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
                     /* veto_slope's test with the two ranges' R in line (veto_slope_q16 <= 6553600, init: the
                      * product one 32 x 32 -> 64 multiply) */
                     const int32_t dr = r_of_range(rng[p - up], rtu.ce) - r_of_range(rng[p], rt.ce);
-                    vt = ((int64_t)dz << 24) > (int64_t)(int32_t)L->slope * abs32(dr);
+                    vt = ((uint64_t)(uint32_t)dz << 24) > lidet__q_umul32((uint32_t)L->slope, uabs32(dr));
                 }
                 else
                 {

@@ -9,6 +9,7 @@
 #include <stdint.h>
 
 #include "lidet/lidet_types.h" /* lidet_member_t */
+#include "lidet_qmath.h"       /* lidet__q_row_m26, LIDET_Q_HAVE_MUL64 */
 #include "lidet_simd.h"        /* LIDET_HOST_SIMD */
 
 /* pixel states in labels[] during a run (ids 1..LIDET_MAX_CLUSTERS are slots + 1) */
@@ -16,6 +17,16 @@
 #define LAB_SMALL 0xFFFDu   /* a fragment (component below min_points) waiting for the rescue pass */
 #define LAB_PENDING 0xFFFEu /* visited: current cluster, or a dropped one */
 #define LAB_NONCAND 0xFFFFu /* no point, or ground: bridged over, never joined */
+
+/* LIDET__LAB_WORDS: 1 where four labels are read as one 64-bit word (memcpy) in a few instructions: cores with
+ * unaligned loads (x86, aarch64, Armv7-M and up); the label scans then skip four at a time. 0 on cores whose loads
+ * must be aligned (ARMv6-M: memcpy of 8 bytes from a 2-byte aligned address is a call to the C library's memcpy,
+ * about 60 instructions; RV32: 8 byte loads and 8 byte stores), where the scans read the labels one by one */
+#if defined(__x86_64__) || defined(__i386__) || defined(__aarch64__) || defined(__ARM_FEATURE_UNALIGNED)
+#define LIDET__LAB_WORDS 1
+#else
+#define LIDET__LAB_WORDS 0
+#endif
 
 #define STEPS LIDET_CLUSTER_MAX_STEPS
 #define RESCUE_MAX_COLS                                                                                      \
@@ -60,7 +71,9 @@ static inline uint32_t lidet__cluster_mark_4mm(const uint16_t *rng, const uint8_
  * without a division: floor(q * m / 2^32) with m = floor(2^32 / cols) + 1 is floor(q / cols) exactly when
  * q * cols < 2^32 (m exceeds 2^32 / cols by e in (0, 1], so the quotient is overestimated by q e / 2^32
  * < 1 / cols, less than the distance of q / cols to the next integer). q < npix, so npix * cols <= 2^32
- * suffices (128 x 2048: 2^29); else row_magic is 0 and the fill divides. */
+ * suffices (128 x 2048: 2^29); else row_magic is 0 and the fill divides. On the cores without a 32 x 32 -> 64
+ * multiply (LIDET_Q_HAVE_MUL64 0) that product is a library call or four 16-bit ones: there row_magic is
+ * lidet__q_row_m26's m, the row (q m) >> 26 in 32 bits. */
 #define LIDET__GROW_GEOMETRY(lk, n_rows, n_cols, cfg)                                                        \
     do                                                                                                       \
     {                                                                                                        \
@@ -71,7 +84,8 @@ static inline uint32_t lidet__cluster_mark_4mm(const uint16_t *rng, const uint8_
         (lk).diag = (cfg).diagonals != 0;                                                                    \
         (lk).rrows = (cfg).rescue_rows;                                                                      \
         (lk).rcols = (cfg).rescue_cols < ((lk).cols - 1u) / 2u ? (cfg).rescue_cols : ((lk).cols - 1u) / 2u;  \
-        (lk).row_magic = (uint64_t)(lk).rows * (lk).cols * (lk).cols <= 0xFFFFFFFFu                          \
+        (lk).row_magic = !LIDET_Q_HAVE_MUL64 ? lidet__q_row_m26((lk).rows, (lk).cols)                        \
+                         : (uint64_t)(lk).rows * (lk).cols * (lk).cols <= 0xFFFFFFFFu                        \
                              ? (uint32_t)(0xFFFFFFFFu / (lk).cols) + 1u                                      \
                              : 0u;                                                                           \
     } while (0)

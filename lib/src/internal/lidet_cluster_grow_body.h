@@ -392,7 +392,11 @@ GROW_FN(grow)(GROW_STATE_T *c, const GROW_PARAM_T *g, uint32_t start, uint32_t t
     while (head < tail)
     {
         const uint32_t q = (uint32_t)mem[head++];
+#if LIDET_Q_HAVE_MUL64
         const uint32_t r = g->row_magic != 0u ? (uint32_t)(lidet__q_umul32(q, g->row_magic) >> 32) : q / cols;
+#else
+        const uint32_t r = g->row_magic != 0u ? (q * g->row_magic) >> 26 : q / cols; /* lidet__q_row_m26 */
+#endif
         LIDET_ASSERT(tail <= g->rows * cols);
         if (occl && *g->bridged < g->bridge_max)
         {

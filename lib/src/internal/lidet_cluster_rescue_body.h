@@ -34,9 +34,10 @@
 
 /* Breadth-first fill of the rescue group seeded at members[start]. Around each member q it looks at
  * every pixel of the window rescue_rows rows up and down and rescue_cols columns left and right
- * (wrapping), row by row from the top left, q itself excepted. Four labels at a time (a 64-bit
- * word) are skipped when all are LAB_PENDING or LAB_NONCAND (0xFFFE, 0xFFFF: the only labels with
- * every bit but the lowest set). Fragments are few (hundreds of pixels per scan), windows small. */
+ * (wrapping), row by row from the top left, q itself excepted. Where LIDET__LAB_WORDS, four labels at a
+ * time (a 64-bit word) are skipped when all are LAB_PENDING or LAB_NONCAND (0xFFFE, 0xFFFF: the only labels
+ * with every bit but the lowest set); elsewhere each label is read alone. Fragments are few (hundreds of pixels
+ * per scan), windows small. */
 static inline void rescue_grow(RESCUE_STATE_T *c, const RESCUE_PARAM_T *g, uint32_t start, RESCUE_RS_T *rs,
                                int compact)
 {
@@ -65,6 +66,16 @@ static inline void rescue_grow(RESCUE_STATE_T *c, const RESCUE_PARAM_T *g, uint3
                 if (RESCUE_ROW(c, rs, lab, n, end, &win, g, compact))
                 {
                     continue; /* the row's probes made, in the same order */
+                }
+#endif
+#if !LIDET__LAB_WORDS
+                /* one label at a time (LIDET__LAB_WORDS): the probe only where it can do anything */
+                for (; n < end; ++n)
+                {
+                    if (lab[n] < LAB_PENDING)
+                    {
+                        RESCUE_PROBE(c, rs, lab, n, &win, g, compact);
+                    }
                 }
 #endif
                 for (; n + 4u <= end; n += 4u)

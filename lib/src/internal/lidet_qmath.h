@@ -74,6 +74,49 @@ static inline uint64_t lidet__q_umul32(uint32_t a, uint32_t b)
 #endif
 }
 
+/* The row of pixel p < rows cols as (p m) >> 26 in 32 bits, for the cores without a divide instruction (where
+ * p / cols is a library call of about 40 instructions: lidet_qpix.h's decode) or without a 32 x 32 -> 64 multiply
+ * (the clustering's fill, whose row is otherwise the high word of a 64-bit product): m = ceil(2^26 / cols), e =
+ * m cols - 2^26 in [0, cols). With p = q cols + t (t < cols), p m / 2^26 = q + (t + p e / 2^26) / cols, so the
+ * floor is q while p e < 2^26; and p m must fit 32 bits. Returns m where both hold for every p < rows cols, else
+ * 0 (then the row is divided) */
+static inline uint32_t lidet__q_row_m26(uint32_t rows, uint32_t cols)
+{
+    const uint64_t last = (uint64_t)rows * cols - 1u; /* the last pixel */
+    uint32_t m, e;
+    if (cols == 0u || cols > 0xFFFFu || rows == 0u)
+    {
+        return 0u;
+    }
+    m = ((1u << 26) + cols - 1u) / cols;
+    e = m * cols - (1u << 26);
+    return last * e < ((uint64_t)1 << 26) && last * m <= 0xFFFFFFFFu ? m : 0u;
+}
+
+/* round((c x + s y) / 2^28), lidet__q_rshift_round of the exact sum, from 32-bit products (the cores without a
+ * 32 x 32 -> 64 multiply, where the 64-bit products are library calls): c = ch 2^15 + cl and s = sh 2^15 + sl
+ * with |cl|, |sl| <= 2^14 (ch = (c + 2^14) >> 15), x and y int16. With a = ch x + sh y and b = cl x + sl y,
+ * c x + s y + 2^27 = (a + floor((b + 2^27) / 2^15)) 2^15 + ((b + 2^27) mod 2^15), so the result is
+ * floor((a + ((b + 2^27) >> 15)) / 2^13). In int32 while |ch| + |sh| <= 65000 (|a| <= 65000 2^15, |b| <= 2^30),
+ * which the caller checks (compiled everywhere so that the host tests check it) */
+static inline int32_t lidet__q_dot2_r28_split(int32_t ch, int32_t cl, int32_t sh, int32_t sl, int32_t x,
+                                              int32_t y)
+{
+    const int32_t a = ch * x + sh * y, b = cl * x + sl * y;
+    return (a + ((b + (1 << 27)) >> 15)) >> 13;
+}
+
+/* round(d f / 2^20), lidet__q_rshift_round of the exact product, for 0 <= d < 2^21 and f < 2^20 (the sine
+ * table's interpolation: d the step between two entries, at most 1,647,089, f the fraction) from 32-bit
+ * products: f = fh 2^10 + fl, d f + 2^19 = (d fh + floor((d fl + 2^19) / 2^10)) 2^10 + ((d fl + 2^19) mod 2^10), so
+ * the result is floor((d fh + ((d fl + 2^19) >> 10)) / 2^10); d fh < 2^31 (compiled everywhere so that the host
+ * tests check it) */
+static inline int32_t lidet__q_mul_r20_split(int32_t d, uint32_t f)
+{
+    const int32_t fh = (int32_t)(f >> 10), fl = (int32_t)(f & 0x3FFu);
+    return (d * fh + ((d * fl + (1 << 19)) >> 10)) >> 10;
+}
+
 /* floor(a * b / 2^32), the high word of the exact signed product, from 16-bit halves: a = ah 2^16 + al (al in
  * [0, 2^16), ah signed), the cross products' high halves by arithmetic shifts (floor), the low halves' carries
  * summed in 32 bits (compiled everywhere so that the host tests check it) */
@@ -101,14 +144,6 @@ static inline int32_t lidet__q_smulhi32(int32_t a, int32_t b)
 /** floor(sqrt(v)), exact, 32-bit arithmetic only */
 uint32_t lidet__q_isqrt32(uint32_t v);
 
-/* lidet__q_isqrt32 inline, for the per-pixel loops (the projection's range, the ground stage's R) */
-#if LIDET_Q_HAVE_DIV
-/* Cores with a divide instruction: Newton's iteration from above, x <- (x + v / x) / 2 in integers, never goes
- * below floor(sqrt(v)) (AM-GM on the integer parts). Started at 2^(k-1) + v / 2^(k+1) for v in [4^k, 4^(k+1))
- * (one real Newton step from 2^k: at most 1.25 times the root), three steps leave at most 1.00000005 times it,
- * i.e. floor(sqrt(v)) or one above; a last compare settles it. About 20 instructions on a Cortex-M4 instead of
- * the digits' 80. Exhaustively checked against the digit version (every v < 2^32: a throwaway harness);
- * tests/python/test_proj_q.py checks it against numpy's exact root. */
 static inline unsigned lidet__q_half_log4(uint32_t v) /* k with 4^k <= v < 4^(k+1), v > 0 */
 {
 #if defined(__GNUC__) &&                                                                                     \
@@ -139,6 +174,14 @@ static inline unsigned lidet__q_half_log4(uint32_t v) /* k with 4^k <= v < 4^(k+
 #endif
 }
 
+/* lidet__q_isqrt32 inline, for the per-pixel loops (the projection's range, the ground stage's R) */
+#if LIDET_Q_HAVE_DIV
+/* Cores with a divide instruction: Newton's iteration from above, x <- (x + v / x) / 2 in integers, never goes
+ * below floor(sqrt(v)) (AM-GM on the integer parts). Started at 2^(k-1) + v / 2^(k+1) for v in [4^k, 4^(k+1))
+ * (one real Newton step from 2^k: at most 1.25 times the root), three steps leave at most 1.00000005 times it,
+ * i.e. floor(sqrt(v)) or one above; a last compare settles it. About 20 instructions on a Cortex-M4 instead of
+ * the digits' 80. Exhaustively checked against the digit version (every v < 2^32: a throwaway harness);
+ * tests/python/test_proj_q.py checks it against numpy's exact root. */
 static inline uint32_t lidet__q_isqrt32_inl(uint32_t v)
 {
     unsigned k;

@@ -162,8 +162,9 @@ static inline void lidet__qpix_xyz_rc(const lidet_range_image_t *img, lidet__qpi
     lidet__qpix_decode(img->range_4mm[p], rt, ct, st, v);
 }
 
-/** x, y, z of pixel p (4 mm steps), stored or decoded */
-static inline void lidet__qpix_xyz(const lidet_range_image_t *img, uint32_t p, int32_t v[3])
+/** x, y, z of pixel p (4 mm steps), stored or decoded; m26: lidet__q_row_m26 of the image (or 0), which
+ *  the cores without a divide instruction use for the row */
+static inline void lidet__qpix_xyz_m(const lidet_range_image_t *img, uint32_t p, uint32_t m26, int32_t v[3])
 {
     uint32_t r;
     if (img->x_4mm != 0)
@@ -171,8 +172,19 @@ static inline void lidet__qpix_xyz(const lidet_range_image_t *img, uint32_t p, i
         lidet__qpix_stored(img, p, v);
         return;
     }
+#if !LIDET_Q_HAVE_DIV
+    r = m26 != 0u ? (p * m26) >> 26 : p / img->n_cols;
+#else
+    (void)m26;
     r = p / img->n_cols;
+#endif
     lidet__qpix_xyz_rc(img, lidet__qpix_row(img, r), p - r * img->n_cols, p, v);
+}
+
+/** x, y, z of pixel p (4 mm steps), stored or decoded */
+static inline void lidet__qpix_xyz(const lidet_range_image_t *img, uint32_t p, int32_t v[3])
+{
+    lidet__qpix_xyz_m(img, p, 0u, v);
 }
 
 /** The tables of the rule for rows rows of elevations elev_bam and cols columns: row_trig 2 rows entries,

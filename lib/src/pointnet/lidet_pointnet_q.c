@@ -262,11 +262,24 @@ static const void *load_block(const bufs_t *b, const int16_t *xyz, uint32_t nb, 
     uint32_t i;
     const int32_t sx = f->shift_mm != 0 ? f->shift_mm[0] : 0, sy = f->shift_mm != 0 ? f->shift_mm[1] : 0;
     const int32_t sz = f->shift_mm != 0 ? f->shift_mm[2] : 0;
+    /* without a 32 x 32 -> 64 multiply (LIDET_Q_HAVE_MUL64 0): c and s split into 15-bit halves, the two sums
+     * from 32-bit products (lidet__q_dot2_r28_split; the same values) where |ch| + |sh| allows it (every frame of
+     * a mean farther than a few steps from the sensor) */
+    const int32_t ch = (int32_t)(((int64_t)f->c + (1 << 14)) >> 15);
+    const int32_t sh = (int32_t)(((int64_t)f->s + (1 << 14)) >> 15);
+    const int32_t cl = f->c - (int32_t)((uint32_t)ch << 15), sl = f->s - (int32_t)((uint32_t)sh << 15);
+    const int split = !LIDET_Q_HAVE_MUL64 && f->rotate && (ch < 0 ? -ch : ch) + (sh < 0 ? -sh : sh) <= 65000;
     for (i = 0; i < nb; ++i)
     {
         const int64_t x = xyz[3u * i], y = xyz[3u * i + 1u], z = xyz[3u * i + 2u];
         int64_t xr = x, yr = y, zr = z;
-        if (f->rotate)
+        if (split)
+        {
+            xr = lidet__q_dot2_r28_split(ch, cl, sh, sl, (int32_t)x, (int32_t)y);
+            yr = lidet__q_dot2_r28_split(-sh, -sl, ch, cl, (int32_t)x, (int32_t)y);
+            zr = z * 4;
+        }
+        else if (f->rotate)
         {
             /* 4 mm steps -> mm: Q30 products shifted by 28 */
             xr = lidet__q_rshift_round((int64_t)f->c * x + (int64_t)f->s * y, 28);

@@ -5,10 +5,11 @@
 uint32_t lidet__q_isqrt64(uint64_t v)
 {
     uint64_t rem = v, res = 0, bit = (uint64_t)1 << 62;
-#if LIDET_Q_HAVE_DIV && LIDET_Q_HAVE_MUL64
-    /* Cores with a divide and a 32 x 32 -> 64 multiply, v < 2^60 (the ground fits' normals, the proposals'
-     * ranges): the top 16 bits of the root from a 32-bit root, the rest by one Newton step in 32 bits, one
-     * compare. About 45 instructions on a Cortex-M4 instead of the digits' 590. Why it is exact:
+    /* v < 2^60 (the ground fits' normals, the proposals' ranges): the top 16 bits of the root from a 32-bit root,
+     * the rest by one Newton step in 32 bits, one compare. About 45 instructions on a Cortex-M4 instead of the
+     * digits' 590; on the cores without a divide instruction or a 32 x 32 -> 64 multiply (ARMv6-M: the division a
+     * library call of about 60 instructions, the last product lidet__q_umul32's 16-bit halves) about 200 instead
+     * of about 500. Why it is exact:
      * - s = k + 1 with 4^k <= v / 2^32 < 4^(k+1) puts v / 4^s in [2^30, 2^32): x0 = isqrt(v / 4^s) is in
      *   [2^15, 2^16) and X = x0 2^s <= sqrt(v) = X + d with 0 <= d < 2^s; e = v - X^2 < (2 x0 + 1) 4^s, so
      *   e / 2^s < 2^31 and q = floor(floor(e / 2^s) / (2 x0)) is a 32-bit division;
@@ -23,12 +24,11 @@ uint32_t lidet__q_isqrt64(uint64_t v)
     {
         const unsigned s = lidet__q_half_log4((uint32_t)(v >> 32)) + 1u; /* 1..14 */
         const uint32_t x0 = lidet__q_isqrt32_inl((uint32_t)(v >> (2u * s)));
-        const uint64_t xs = (uint64_t)x0 << s;
-        const uint32_t e = (uint32_t)((v - xs * xs) >> s);
-        const uint32_t r = (uint32_t)xs + e / (2u * x0); /* floor(sqrt(v)) or one above, < 2^30 + 1 */
-        return r - (uint32_t)((uint64_t)r * r > v);
+        /* X^2 = x0^2 4^s, x0 < 2^16: a 32-bit square */
+        const uint32_t e = (uint32_t)((v - ((uint64_t)(x0 * x0) << (2u * s))) >> s);
+        const uint32_t r = (x0 << s) + e / (2u * x0); /* floor(sqrt(v)) or one above, < 2^30 + 1 */
+        return r - (uint32_t)(lidet__q_umul32(r, r) > v);
     }
-#endif
     /* digit by digit, two bits of v per step: exact, no division, 32 steps at most */
     while ((bit >> 16) > v) /* the highest power of 4 <= v: 8 bits of the result at a time, then 1 */
     {
@@ -73,7 +73,11 @@ static int32_t quarter_sin(uint32_t p)
     {
         return (int32_t)s0;
     }
+#if LIDET_Q_HAVE_MUL64
     return (int32_t)(s0 + lidet__q_rshift_round((lidet__q_sin_q30[i + 1] - s0) * frac, 20));
+#else
+    return (int32_t)s0 + lidet__q_mul_r20_split((int32_t)(lidet__q_sin_q30[i + 1] - s0), (uint32_t)frac);
+#endif
 }
 
 int32_t lidet__q_sin(uint32_t a)
