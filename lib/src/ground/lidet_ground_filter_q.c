@@ -508,7 +508,14 @@ static void filter_rows(const lidet_ground_q_state_t *g, lidet_ground_q_scratch_
     lidet__ground_q_filt_t f;
     uint32_t r;
     filt_setup(g, &f);
-    memset(sample, 0, (size_t)rows * cols);
+    /* the rows no pair writes (the last, and those off the step grid) cleared; the others are written whole */
+    for (r = 0; r < rows; ++r)
+    {
+        if (r + 1u >= rows || r % step != 0u)
+        {
+            memset(sample + (size_t)r * cols, 0, cols);
+        }
+    }
     for (r = 0; r + 1u < rows; r += step)
     {
         const int32_t *R0 = r_row(rr, r), *R1 = r_row(rr, r + 1u);
