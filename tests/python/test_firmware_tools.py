@@ -280,7 +280,7 @@ def test_cycle_estimate_of_the_m4_integer_image():
     for tool in ("qemu-system-arm", "arm-none-eabi-nm"):
         if subprocess.run(["which", tool], capture_output=True).returncode != 0:
             pytest.skip(f"{tool} not installed")
-    r = cycles.estimate(str(elf), "m4", "arm-none-eabi-nm", timeout=600)
+    r = cycles.estimate(str(elf), "m4", "arm-none-eabi-nm", timeout=600, lines=True)
     import json
     report = json.loads(rep.read_text())
     ins = report["insn"]
@@ -294,6 +294,11 @@ def test_cycle_estimate_of_the_m4_integer_image():
     assert sum(pf.values()) == r["instructions"]
     assert next(iter(pf)).startswith("lidet__nn_acc_s8"), list(pf)[:5]
     assert any(h.startswith("__aeabi_uldivmod") and c == "lidet_proj_q_init" for h, c, _ in r["helper_calls"])
+    # the lines (--lines): every traced instruction on a source line of the repository, the busiest one in the int8
+    # kernel (its SMLAD loop)
+    pl = r["per_line"]
+    assert sum(pl.values()) == r["instructions"]
+    assert next(iter(pl)).startswith("lib/src/nn/lidet_nn_s8.c:"), list(pl)[:5]
 
 
 # ---- the packet application (LIDET_FW_APP=packets, ports/firmware/fw_packets.c; issue 37) -----------------------

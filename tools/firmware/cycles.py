@@ -29,7 +29,9 @@ memory system: flash wait states, bus contention and interrupts add to them. `--
 the exact per-scan instruction counts of run_fw.py's report. `--functions N` also prints the N functions that executed
 the most instructions (a block counts for the function holding its first address; all of the image's runs, its
 initialisations included) and the calls into the C library's helpers by caller (64-bit divisions, soft-float): a
-profile, in instructions, of where a firmware scan goes.
+profile, in instructions, of where a firmware scan goes. `--lines N` prints the N source lines that executed the
+most (each executed instruction credited to the line `addr2line` gives its address: for inlined code the inlined
+function's own line; the image is built with -g): where inside a function the instructions go.
 """
 import argparse
 import bisect
@@ -154,7 +156,22 @@ def text_ranges(syms) -> str:
     return ",".join(f"0x{a:x}..0x{b - 1:x}" for a, b, name, sized in syms if sized and not EXCLUDE.match(name))
 
 
-def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800) -> dict:
+def source_lines(elf: str, nm: str, per_addr: dict) -> dict:
+    """Instructions per source line ('file:line', paths relative to the repository) from executions per
+    instruction address, with the toolchain's addr2line (the one beside nm)."""
+    a2l = nm[:-2] + "addr2line" if nm.endswith("nm") else "addr2line"
+    addrs = sorted(per_addr)
+    out = subprocess.run([a2l, "-e", elf], input="\n".join(hex(a) for a in addrs), capture_output=True, text=True,
+                         check=True).stdout.splitlines()
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))) + os.sep
+    lines = {}
+    for a, loc in zip(addrs, out):
+        loc = loc.split(" (discriminator")[0].replace(root, "")
+        lines[loc] = lines.get(loc, 0) + per_addr[a]
+    return dict(sorted(lines.items(), key=lambda kv: -kv[1]))
+
+
+def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800, lines: bool = False) -> dict:
     qcmd = [qemu] + QEMU[core][1:] if qemu else QEMU[core]
     syms = code_symbols(elf, nm)
     starts = [a for a, _, _, _ in syms]
@@ -173,6 +190,7 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
         blocks = {}
         per_fn = {}  # function name -> instructions executed in it (blocks attributed by their first address)
         calls = {}  # (library helper, calling function) -> calls
+        per_addr = {}  # instruction address -> executions (lines only)
         tot_insn = lo = hi = 0
         pending = None  # the previous executed block's last instruction: (end address, kind)
         cur = None
@@ -203,7 +221,7 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
                             a, size, mn, ops = cur[-1]
                             blk = (len(cur), l_, h_, a + size, price(mn, ops, core, False)[2],
                                    int(ops.lstrip("#"), 16) if base_mnemonic(mn) == "bl" and ops.startswith("#0x")
-                                   else None)
+                                   else None, tuple(x[0] for x in cur) if lines else ())
                             if cur[0][0] == pc:  # a block is logged when translated, just before its first run
                                 blocks[key] = blk
                             blocks.setdefault(cur[0][0], blk)
@@ -220,7 +238,9 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
                             elif kind == "pc":  # a PC write always refills
                                 lo += 1
                                 hi += 3
-                        n, l_, h_, end, kind, callee = b
+                        n, l_, h_, end, kind, callee, addrs = b
+                        for x in addrs:
+                            per_addr[x] = per_addr.get(x, 0) + 1
                         i = bisect.bisect_right(starts, pc) - 1
                         fn = syms[i][2] if i >= 0 and pc < syms[i][1] else "?"
                         per_fn[fn] = per_fn.get(fn, 0) + n
@@ -238,9 +258,12 @@ def estimate(elf: str, core: str, nm: str, qemu: str = None, timeout: int = 1800
             proc.wait()
     if tot_insn == 0:
         raise RuntimeError("empty trace: QEMU wrote nothing (wrong core or image?)")
-    return dict(core=core, instructions=tot_insn, cycles_low=lo, cycles_high=hi, cpi_low=lo / tot_insn,
-                cpi_high=hi / tot_insn, per_function=dict(sorted(per_fn.items(), key=lambda kv: -kv[1])),
-                helper_calls=[(h, c, n) for (h, c), n in sorted(calls.items(), key=lambda kv: -kv[1])])
+    r = dict(core=core, instructions=tot_insn, cycles_low=lo, cycles_high=hi, cpi_low=lo / tot_insn,
+             cpi_high=hi / tot_insn, per_function=dict(sorted(per_fn.items(), key=lambda kv: -kv[1])),
+             helper_calls=[(h, c, n) for (h, c), n in sorted(calls.items(), key=lambda kv: -kv[1])])
+    if lines:
+        r["per_line"] = source_lines(elf, nm, per_addr)
+    return r
 
 
 def main(argv=None) -> int:
@@ -253,7 +276,9 @@ def main(argv=None) -> int:
     ap.add_argument("--mhz", type=float, default=None, help="clock for scans per second (default: M4 200, M3 100)")
     ap.add_argument("--json")
     ap.add_argument("--functions", type=int, default=0, metavar="N",
-                    help="also print the N functions that executed the most instructions (both runs of the image)")
+                    help="also print the N functions that executed the most instructions (all runs of the image)")
+    ap.add_argument("--lines", type=int, default=0, metavar="N",
+                    help="also print the N source lines that executed the most instructions (addr2line)")
     a = ap.parse_args(argv)
     for tool in (a.qemu or QEMU[a.core][0], a.nm):
         if subprocess.run(["which", tool], capture_output=True).returncode != 0:
@@ -262,17 +287,21 @@ def main(argv=None) -> int:
     if not os.path.exists(a.elf):
         print(f"cycles: {a.elf} not found (make firmware)", file=sys.stderr)
         return 2
-    r = estimate(a.elf, a.core, a.nm, a.qemu)
+    r = estimate(a.elf, a.core, a.nm, a.qemu, lines=a.lines > 0)
     mhz = a.mhz or (200.0 if a.core == "m4" else 100.0)
     print(f"{a.core}: {r['instructions']:,} instructions traced, estimated {r['cycles_low']:,} to {r['cycles_high']:,} "
           f"cycles: CPI {r['cpi_low']:.3f} to {r['cpi_high']:.3f}")
     if a.functions:
-        print(f"the {a.functions} functions that executed the most instructions (both runs):")
+        print(f"the {a.functions} functions that executed the most instructions (all of the image's runs):")
         for fn, n in list(r["per_function"].items())[:a.functions]:
             print(f"  {n:>12,}  {100.0 * n / r['instructions']:5.1f} %  {fn}")
         print("calls into the C library's helpers (helper, caller, calls):")
         for h, c, n in r["helper_calls"][:a.functions]:
             print(f"  {n:>12,}  {h} from {c}")
+    if a.lines:
+        print(f"the {a.lines} source lines that executed the most instructions (all of the image's runs):")
+        for loc, n in list(r["per_line"].items())[:a.lines]:
+            print(f"  {n:>12,}  {100.0 * n / r['instructions']:5.1f} %  {loc}")
     if a.report:
         rep = json.load(open(a.report))
         ins = rep["insn"]["default"]
