@@ -110,10 +110,8 @@ typedef struct
     const lidet__ground_q_pix_t *img;
     const lidet_ground_sample_t *idx;
     const int32_t *xyz; /* NULL: decode */
-#if LIDET_Q_HAVE_MUL64
-    int32_t *spare; /* with xyz: free int32 after the copy (the refinement's inliers), spare_n of them */
+    int32_t *spare;     /* with xyz: free int32 after the copy (the refinement's inliers), spare_n of them */
     uint32_t spare_n;
-#endif
 } cell_src_t;
 
 static inline void pixel(const cell_src_t *src, uint32_t i, int32_t q[3])
@@ -180,12 +178,58 @@ scatter_add64(int64_t a[6], int32_t x, int32_t y, int32_t z)
     a[5] += (int64_t)z * z;
 }
 
-#if LIDET_Q_HAVE_MUL64
+#if !LIDET_Q_HAVE_MUL64
+/* the same added (neg 0) or taken out (neg 1) on the cores without a 32 x 32 -> 64 multiply: 32-bit products where
+ * every coordinate is within +-46340 (a product below 2^31), the 64-bit ones (library calls) elsewhere */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void
+scatter_acc32(int64_t a[6], int32_t x, int32_t y, int32_t z, int neg)
+{
+    if (x >= -46340 && x <= 46340 && y >= -46340 && y <= 46340 && z >= -46340 && z <= 46340)
+    {
+        const int32_t p0 = x * x, p1 = x * y, p2 = x * z, p3 = y * y, p4 = y * z, p5 = z * z;
+        if (neg)
+        {
+            a[0] -= p0;
+            a[1] -= p1;
+            a[2] -= p2;
+            a[3] -= p3;
+            a[4] -= p4;
+            a[5] -= p5;
+        }
+        else
+        {
+            a[0] += p0;
+            a[1] += p1;
+            a[2] += p2;
+            a[3] += p3;
+            a[4] += p4;
+            a[5] += p5;
+        }
+    }
+    else if (neg)
+    {
+        a[0] -= (int64_t)x * x;
+        a[1] -= (int64_t)x * y;
+        a[2] -= (int64_t)x * z;
+        a[3] -= (int64_t)y * y;
+        a[4] -= (int64_t)y * z;
+        a[5] -= (int64_t)z * z;
+    }
+    else
+    {
+        scatter_add64(a, x, y, z);
+    }
+}
+#endif
+
 /* The refinement's sums over the inliers' differences d (3 int32 each, m < 2^11 of them, |d| < 2^16) from the
  * cell's decoded copy: S1 += sum d (int32 partial sums: |sum| < 2^27) and S2 += sum d d^T (xx xy xz yy yz zz) in
  * exact int64, in two passes of three 64-bit sums each, so each pass keeps its sums in registers (one pass of six
  * spilled them to the stack on a Cortex-M4: a load and a store around each multiply-accumulate). The same sums.
- * Cores with a 32 x 32 -> 64 multiply only (ARMv6-M keeps the one pass: its 64-bit products are calls). */
+ * Without a 32 x 32 -> 64 multiply (ARMv6-M) one pass of 32-bit products (scatter_acc32). */
 #if defined(__GNUC__)
 __attribute__((noinline))
 #endif
@@ -193,6 +237,19 @@ static void
 inlier_sums(const int32_t *d, uint32_t m, int64_t s1[3], int64_t a[6])
 {
     const int32_t *p, *const end = d + 3u * m;
+#if !LIDET_Q_HAVE_MUL64
+    int32_t u0 = 0, u1 = 0, u2 = 0;
+    for (p = d; p != end; p += 3)
+    {
+        u0 += p[0];
+        u1 += p[1];
+        u2 += p[2];
+        scatter_acc32(a, p[0], p[1], p[2], 0);
+    }
+    s1[0] += u0;
+    s1[1] += u1;
+    s1[2] += u2;
+#else
     int64_t a0 = a[0], a1 = a[1], a2 = a[2], a3 = a[3], a4 = a[4], a5 = a[5];
     int32_t t0 = 0, t1 = 0, t2 = 0;
     for (p = d; p != end; p += 3)
@@ -221,10 +278,9 @@ inlier_sums(const int32_t *d, uint32_t m, int64_t s1[3], int64_t a[6])
     a[3] = a3;
     a[4] = a4;
     a[5] = a5;
-}
 #endif
+}
 
-#if LIDET_Q_HAVE_MUL64
 /* d = q - first added to the sums (in) or taken out of them */
 #if defined(__GNUC__)
 __attribute__((noinline)) /* off changed_sides' loop: its registers stay for the test */
@@ -238,13 +294,21 @@ side_change(const int32_t q[3], const int32_t first[3], int in, int64_t s1[3], i
         s1[0] += dx;
         s1[1] += dy;
         s1[2] += dz;
+#if LIDET_Q_HAVE_MUL64
         scatter_add64(a, dx, dy, dz);
+#else
+        scatter_acc32(a, dx, dy, dz, 0);
+#endif
     }
     else
     {
         s1[0] -= dx;
         s1[1] -= dy;
         s1[2] -= dz;
+#if !LIDET_Q_HAVE_MUL64
+        scatter_acc32(a, dx, dy, dz, 1);
+        return;
+#endif
         a[0] -= (int64_t)dx * dx;
         a[1] -= (int64_t)dx * dy;
         a[2] -= (int64_t)dx * dz;
@@ -263,14 +327,21 @@ static uint32_t
 changed_sides(const int32_t *xyz, uint32_t n, uint8_t *fl, const lidet__ground_q_hplane_t *hp, uint64_t t2,
               const int32_t first[3], uint32_t m, int64_t s1[3], int64_t a[6])
 {
+#if LIDET_Q_HAVE_MUL64
     const int32_t n0 = hp->n[0], n1 = hp->n[1], n2 = hp->n[2];
     const int64_t d = hp->d;
+#endif
     const int32_t *p = xyz, *const end = xyz + 3u * n;
     for (; p != end; p += 3, ++fl)
     {
         const int32_t x = p[0], y = p[1], z = p[2];
+#if LIDET_Q_HAVE_MUL64
         const uint8_t in =
             (uint8_t)((uint64_t)(d + (int64_t)n0 * x + (int64_t)n1 * y + (int64_t)n2 * z) <= t2);
+#else
+        const uint8_t in =
+            (uint8_t)((uint64_t)lidet__ground_q_height(hp, x, y, z) <= t2); /* 32-bit products */
+#endif
         if (in != *fl)
         {
             *fl = in;
@@ -280,10 +351,9 @@ changed_sides(const int32_t *xyz, uint32_t n, uint8_t *fl, const lidet__ground_q
     }
     return m;
 }
-#endif
 
-/* the refinement's inlier sums carried from one of its iterations to the next (the cell's decoded copy on cores
- * with a 32 x 32 -> 64 multiply): with each sample's side kept as a flag, an iteration adds and removes only the
+/* the refinement's inlier sums carried from one of its iterations to the next (the cell's decoded copy): with
+ * each sample's side kept as a flag, an iteration adds and removes only the
  * samples whose side changed, the same exact sums as a pass over its inliers (the planes of two iterations
  * differ little, so most samples keep their side) */
 typedef struct
@@ -293,11 +363,10 @@ typedef struct
     int64_t s1[3], a[6];
 } refine_acc_t;
 
-#if LIDET_Q_HAVE_MUL64
-/* refine's inlier sums where the core has a 32 x 32 -> 64 multiply and the cell's decoded copy leaves room in the
- * spare ints: the first iteration copies the inliers' differences there and sums them in two passes of three
- * (inlier_sums), later ones add or take out the samples that changed side (changed_sides), ra keeping the sums.
- * Returns 0 (nothing set) where that does not apply, else 1 with *m, s1 and a set */
+/* refine's inlier sums where the cell's decoded copy leaves room in the spare ints: the first iteration copies the
+ * inliers' differences there and sums them (inlier_sums), later ones add or take out the samples that changed side
+ * (changed_sides), ra keeping the sums. Returns 0 (nothing set) where that does not apply, else 1 with *m, s1 and a
+ * set */
 #if defined(__GNUC__)
 __attribute__((always_inline))
 #endif
@@ -352,7 +421,6 @@ spare_sums(const cell_src_t *img, uint32_t n, const lidet__ground_q_hplane_t *hp
     *m_out = m;
     return 1;
 }
-#endif
 
 /* refine's inlier sums in one pass over the samples (the general path): adds to s1 and a, returns the inliers */
 #if defined(__GNUC__)
@@ -403,20 +471,7 @@ pass_sums(const cell_src_t *img, uint32_t n, const lidet__ground_q_hplane_t *hp,
 #if LIDET_Q_HAVE_MUL64
             scatter_add64(a, x, y, z); /* one SMLAL each (Cortex-M3 and up) */
 #else
-            if (x >= -46340 && x <= 46340 && y >= -46340 && y <= 46340 && z >= -46340 && z <= 46340)
-            {
-                /* the products fit int32: no 64-bit multiplication helper */
-                a[0] += x * x;
-                a[1] += x * y;
-                a[2] += x * z;
-                a[3] += y * y;
-                a[4] += y * z;
-                a[5] += z * z;
-            }
-            else
-            {
-                scatter_add64(a, x, y, z);
-            }
+            scatter_acc32(a, x, y, z, 0); /* the products fit int32: no 64-bit multiplication helper */
 #endif
         }
         s1[0] += t0;
@@ -445,11 +500,7 @@ static int refine(const cell_src_t *img, uint32_t n, const qplane_t *cur, int64_
     /* |h| <= thr as 0 <= h + thr <= 2 thr: D carries thr (one unsigned comparison per sample) */
     lidet__ground_q_hplane(cur->n, cur->d + thr, &hp);
     pixel(img, 0u, first);
-#if LIDET_Q_HAVE_MUL64
     if (!spare_sums(img, n, &hp, thr, first, ra, &m, s1, a))
-#else
-    (void)ra;
-#endif
     {
         m = pass_sums(img, n, &hp, thr, first, s1, a);
     }
@@ -696,30 +747,20 @@ fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, const lidet_
     int32_t best_p0[3] = {0, 0, 0};
     uint32_t best_len = 0, best_cnt = 0, r, i;
     qplane_t best;
-#if LIDET_Q_HAVE_MUL64
-    refine_acc_t
-        ra; /* 80 bytes of stack: only where refine carries its sums (ARMv6-M's deepest frame is here) */
-#define RA_ARG (&ra)
-#else
-#define RA_ARG 0
-#endif
+    refine_acc_t ra; /* 80 bytes of stack (ARMv6-M's deepest frame is here) */
     src.img = gp;
     src.idx = idx;
     src.xyz = 0;
-#if LIDET_Q_HAVE_MUL64
     src.spare = 0;
     src.spare_n = 0;
-#endif
     if (gp->ct != 0 &&
         3u * n <= sizeof sc->r_rows / sizeof(int32_t)) /* a range-only image's cell that fits */
     {
         int32_t *xyz = &sc->r_rows[0][0];
         decode_cell(gp, idx, n, xyz);
         src.xyz = xyz;
-#if LIDET_Q_HAVE_MUL64
         src.spare = xyz + 3u * n;
         src.spare_n = (uint32_t)(sizeof sc->r_rows / sizeof(int32_t)) - 3u * n;
-#endif
     }
     if (copied)
     {
@@ -745,13 +786,11 @@ fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, const lidet_
     }
     best.d = -((int64_t)best.n[0] * best_p0[0] + (int64_t)best.n[1] * best_p0[1] +
                (int64_t)best.n[2] * best_p0[2]);
-#if LIDET_Q_HAVE_MUL64
     ra.have = 0;
-#endif
     for (r = 0; r < cfg->refine_iters; ++r)
     {
         qplane_t p;
-        if (!refine(img, n, &best, (int64_t)cfg->inlier_mm << 28, &p, RA_ARG) || p.n[2] < cos_t)
+        if (!refine(img, n, &best, (int64_t)cfg->inlier_mm << 28, &p, &ra) || p.n[2] < cos_t)
         {
             break; /* keep the last good plane */
         }
@@ -765,7 +804,6 @@ fit_cell_q(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *sc, const lidet_
     *out = best;
     return 1;
 }
-#undef RA_ARG
 
 /* z (4 mm) of the plane (n, d) over the point (x, y) (4 mm): -(n_x x + n_y y + d) / n_z, rounded */
 static int32_t plane_z_at(const int32_t n[3], int64_t d, int32_t x, int32_t y)
