@@ -22,6 +22,21 @@ def real_dir():
 
 
 @pytest.fixture(scope="session")
+def bench_mod():
+    """load(name): tools/bench/bench_<name>.py as a module (its folder on sys.path, for its run_bench imports)."""
+    import importlib.util
+    import sys
+
+    def load(name):
+        sys.path.insert(0, str(ROOT / "tools" / "bench"))
+        spec = importlib.util.spec_from_file_location(f"bench_{name}", ROOT / "tools" / "bench" / f"bench_{name}.py")
+        m = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(m)
+        return m
+    return load
+
+
+@pytest.fixture(scope="session")
 def cli():
     """The host CLI `lidet` of the build under test ($LIDET_BUILD_DIR, else build/); skips if not built."""
     exe = pathlib.Path(os.environ.get("LIDET_BUILD_DIR", ROOT / "build")) / "ports" / "host" / "lidet"

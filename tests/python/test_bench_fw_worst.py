@@ -2,10 +2,8 @@
 """The firmware worst-case benchmark (tools/bench/bench_fw_worst.py): the rings it gives scans that have none (each
 point's nearest beam, in the sensor's ring order) and, where the Arm toolchain and QEMU are installed, the one
 image it builds and runs, measured on the typical scan as the firmware ctest measures it."""
-import importlib.util
 import pathlib
 import shutil
-import sys
 
 import numpy as np
 import pytest
@@ -13,17 +11,9 @@ import pytest
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
-def _mod():
-    sys.path.insert(0, str(ROOT / "tools" / "bench"))
-    spec = importlib.util.spec_from_file_location("bench_fw_worst", ROOT / "tools" / "bench" / "bench_fw_worst.py")
-    m = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(m)
-    return m
-
-
-def test_rings_of_points_at_each_beam():
+def test_rings_of_points_at_each_beam(bench_mod):
     from lidet_tools.sensors import get_sensor
-    m = _mod()
+    m = bench_mod("fw_worst")
     el = np.asarray(get_sensor("vlp16").beam_elev_rad, np.float64)
     rng = np.random.default_rng(3)
     ring = rng.integers(0, len(el), 500)
@@ -40,11 +30,11 @@ def test_rings_of_points_at_each_beam():
 
 @pytest.mark.skipif(shutil.which("arm-none-eabi-gcc") is None or shutil.which("qemu-system-arm") is None,
                     reason="no Arm cross compiler or qemu-system-arm (tools/scripts/install_deps.sh)")
-def test_the_typical_scan_measures_as_the_firmware_ctest(tmp_path):
+def test_the_typical_scan_measures_as_the_firmware_ctest(tmp_path, bench_mod):
     """_measure on the ctest's scan gives the stage counts of build/firmware/mps2-an386-q's report when there is one
     (the same image), and sane counts otherwise"""
     import json
-    m = _mod()
+    m = bench_mod("fw_worst")
     data = ROOT / "tests/data/sim_vlp16"
     r = m._measure(tmp_path / "fw", data / "velodyne/000000.bin", data / "ring/000000.bin", "typical")
     assert "error" not in r, r

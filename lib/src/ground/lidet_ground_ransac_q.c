@@ -178,6 +178,21 @@ scatter_add64(int64_t a[6], int32_t x, int32_t y, int32_t z)
     a[5] += (int64_t)z * z;
 }
 
+/* a -= the same */
+#if defined(__GNUC__)
+__attribute__((always_inline))
+#endif
+static inline void
+scatter_sub64(int64_t a[6], int32_t x, int32_t y, int32_t z)
+{
+    a[0] -= (int64_t)x * x;
+    a[1] -= (int64_t)x * y;
+    a[2] -= (int64_t)x * z;
+    a[3] -= (int64_t)y * y;
+    a[4] -= (int64_t)y * z;
+    a[5] -= (int64_t)z * z;
+}
+
 #if !LIDET_Q_HAVE_MUL64
 /* the same added (neg 0) or taken out (neg 1) on the cores without a 32 x 32 -> 64 multiply: 32-bit products where
  * every coordinate is within +-46340 (a product below 2^31), the 64-bit ones (library calls) elsewhere */
@@ -211,12 +226,7 @@ scatter_acc32(int64_t a[6], int32_t x, int32_t y, int32_t z, int neg)
     }
     else if (neg)
     {
-        a[0] -= (int64_t)x * x;
-        a[1] -= (int64_t)x * y;
-        a[2] -= (int64_t)x * z;
-        a[3] -= (int64_t)y * y;
-        a[4] -= (int64_t)y * z;
-        a[5] -= (int64_t)z * z;
+        scatter_sub64(a, x, y, z);
     }
     else
     {
@@ -305,16 +315,11 @@ side_change(const int32_t q[3], const int32_t first[3], int in, int64_t s1[3], i
         s1[0] -= dx;
         s1[1] -= dy;
         s1[2] -= dz;
-#if !LIDET_Q_HAVE_MUL64
+#if LIDET_Q_HAVE_MUL64
+        scatter_sub64(a, dx, dy, dz);
+#else
         scatter_acc32(a, dx, dy, dz, 1);
-        return;
 #endif
-        a[0] -= (int64_t)dx * dx;
-        a[1] -= (int64_t)dx * dy;
-        a[2] -= (int64_t)dx * dz;
-        a[3] -= (int64_t)dy * dy;
-        a[4] -= (int64_t)dy * dz;
-        a[5] -= (int64_t)dz * dz;
     }
 }
 
