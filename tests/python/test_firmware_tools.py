@@ -256,6 +256,15 @@ cycles = _load("cycles")
     ("bl #0xcedc", "m4", False, (1, 1, "br")),
     ("bx lr", "m4", False, (1, 1, "br")),
     ("tbb [pc, r3]", "m4", False, (2, 2, "pc")),
+    # the M4F's FPU (the float images)
+    ("vadd.f32 s0, s1, s2", "m4", False, (1, 1, "")),
+    ("vfma.f32 s0, s1, s2", "m4", False, (3, 3, "")),
+    ("vmla.f32 s0, s1, s2", "m4", False, (3, 3, "")),
+    ("vdiv.f32 s0, s1, s2", "m4", False, (14, 14, "")),
+    ("vldr s15, [r5, #0x14]", "m4", False, (2, 2, "")),
+    ("vldmia r0!, {s0-s7}", "m4", False, (9, 9, "")),
+    ("vstmia r1, {d8-d11}", "m4", False, (9, 9, "")),
+    ("vmovgt.f32 s0, s1", "m4", False, (1, 1, "")),
 ])
 def test_cycle_prices_follow_the_trm(insn, core, prev_ls, want):
     """tools/firmware/cycles.py prices each instruction with the TRM's counts (zero wait states): condition and
@@ -266,7 +275,7 @@ def test_cycle_prices_follow_the_trm(insn, core, prev_ls, want):
 
 def test_cycle_prices_refuse_an_unknown_instruction():
     with pytest.raises(ValueError, match="no cycle count"):
-        cycles.price("vfma.f32", "s0, s1, s2", "m4", False)
+        cycles.price("vrintz.f32", "s0, s1", "m4", False)
 
 
 def test_cycle_estimate_of_the_m4_integer_image():

@@ -86,14 +86,17 @@ def _kib(v: int) -> str:
 
 
 def _cycle_estimates(build, reports):
-    """tools/firmware/cycles.py on the Cortex-M4 and M3 integer images (skipped without QEMU or the images)"""
+    """tools/firmware/cycles.py on the Cortex-M4 and M3 integer images and the M4F float image with either dense
+    kernel (skipped without QEMU or the images)"""
     import importlib.util
     spec = importlib.util.spec_from_file_location("cycles", ROOT / "tools" / "firmware" / "cycles.py")
     cyc = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(cyc)
     out = []
     for board, core, label, mhz in (("mps2-an386-q", "m4", "Cortex-M4, integer build (vlp16s)", 200.0),
-                                    ("mps2-an385-q", "m3", "Cortex-M3, integer build (vlp16s)", 100.0)):
+                                    ("mps2-an385-q", "m3", "Cortex-M3, integer build (vlp16s)", 100.0),
+                                    ("mps2-an386", "m4", "Cortex-M4F, float build (VMUL + VADD, the default)", 200.0),
+                                    (M4F_FUSED, "m4", "Cortex-M4F, float build (VFMA, `LIDET_NN_CM_FMA=1`)", 200.0)):
         elf = build / "firmware" / board / "lidet_fw.elf"
         if board not in reports or not elf.exists() or not shutil.which("qemu-system-arm"):
             continue
@@ -446,7 +449,8 @@ def run(args) -> str:
             "",
             "Fewer instructions, not fewer cycles on this core: the Cortex-M4 TRM gives VFMA.F32 3 cycles against 1 "
             "each for VMUL.F32 and VADD.F32, so a sweep of 8 outputs by four inputs costs about 153 cycles fused against "
-            "121 unfused (zero wait states; docs/journal/firmware.md). The default stays unfused on the M4F.",
+            "121 unfused (zero wait states; docs/journal/firmware.md), and the whole scan priced the same way takes more "
+            "cycles fused (\"Cycles, estimated\" below). The default stays unfused on the M4F.",
         ]
     out += [
         "",
@@ -567,12 +571,14 @@ def run(args) -> str:
                     "multi-cycle loads, 14-cycle divides and square roots).")
     est = _cycle_estimates(build, reports)
     if est:
-        out += ["", "**Cycles of the integer images, estimated** (`python3 tools/firmware/cycles.py --elf "
+        out += ["", "**Cycles, estimated** (`python3 tools/firmware/cycles.py --elf "
                 "build/firmware/<image>/lidet_fw.elf --core m4|m3 --report build/firmware/<image>/report.json`): "
-                "QEMU's trace of every executed instruction (both runs, lidet's and the application's code), each "
+                "QEMU's trace of every executed instruction (all runs, lidet's and the application's code), each "
                 "priced with the cycle counts of the core's Technical Reference Manual at zero wait states (loads 1-2 "
-                "with the TRM's pipelining, taken branches 1 + P with P 1-3, divides 2-12, M3 long multiplies 3-7); "
-                "low and high estimates, not measurements: flash wait states and bus contention come on top.", "",
+                "with the TRM's pipelining, taken branches 1 + P with P 1-3, divides 2-12, M3 long multiplies 3-7; "
+                "the M4's FPU: VADD and VMUL 1, VFMA and VMLA 3, VDIV and VSQRT 14, VLDR 2, VLDM 1 + N); the "
+                "trace's cycles per instruction applied to run `default`'s exact count; low and high estimates, not "
+                "measurements: flash wait states and bus contention come on top.", "",
                 "| image | CPI (low - high) | cycles per scan, estimated | time per scan at the clock |",
                 "|---|---|---|---|"]
         for board, core, mhz, r in est:

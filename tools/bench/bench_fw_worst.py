@@ -157,8 +157,7 @@ def run(args) -> str:
               f"{MAX_BOXES} boxed at most {per_box / 1e6:.3f} M each, the largest per-proposal costs measured: "
               f"{_m(nets)} M) and NMS ({_m(worst['post'])} M): **{_m(bound)} M instructions**, "
               f"{bound / 200e6 * 1e3:.0f} ms at 200 MHz and one instruction a cycle (the M4's 1.35-1.59 estimated "
-              "cycles per instruction on top: docs/benchmarks/firmware.md, \"Cycles of the integer images, "
-              "estimated\").", ""]
+              "cycles per instruction on top: docs/benchmarks/firmware.md, \"Cycles, estimated\").", ""]
     return "\n".join(lines) + "\n"
 
 

@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 # SPDX-License-Identifier: MIT
-"""Estimated cycles of a Cortex-M3 or M4 firmware image: QEMU's trace of the instructions it executes, priced
+"""Estimated cycles of a Cortex-M3 or M4 (or M4F) firmware image: QEMU's trace of the instructions it executes, priced
 with the cycle counts of the core's Technical Reference Manual (instruction set summary, zero wait states).
 
     python3 tools/firmware/cycles.py --elf build/firmware/mps2-an386-q/lidet_fw.elf --core m4 \\
@@ -16,6 +16,9 @@ prices every executed instruction:
 - multiplies: M4 1 (MUL, MLA, MLS, SMULL, UMULL, SMLAL, UMLAL, the DSP MACs); M3 MUL 1, MLA/MLS 2,
   SMULL/UMULL 3-5, SMLAL/UMLAL 4-7;
 - SDIV/UDIV: 2-12 (data dependent);
+- the single-precision FPU (the M4F images): VADD, VSUB, VMUL, VNMUL, VABS, VNEG, VCMP, VCVT, VMOV, VMRS, VMSR
+  1; VMLA/VMLS/VNMLA/VNMLS and VFMA/VFMS/VFNMA/VFNMS 3; VDIV, VSQRT 14; VLDR/VSTR 2 (3 for a d register);
+  VLDM/VSTM/VPUSH/VPOP 1 + N (N 32-bit registers);
 - single loads and stores: 2, or 1 when they follow another single load or store (the TRM's pipelining of
   neighbouring loads and stores; the low estimate assumes it always applies there, the high one never);
   LDRD/STRD 3; LDM/STM/PUSH/POP 1 + N registers;
@@ -100,9 +103,38 @@ def n_regs(ops: str) -> int:
     return n
 
 
+FP1 = {"vadd", "vsub", "vmul", "vnmul", "vabs", "vneg", "vcmp", "vcmpe", "vcvt", "vcvtr", "vmov", "vmrs", "vmsr"}
+FP3 = {"vmla", "vmls", "vnmla", "vnmls", "vfma", "vfms", "vfnma", "vfnms"}
+
+
+def price_fp(m: str, ops: str):
+    """(low, high) cycles of a Cortex-M4 FPU instruction (the TRM's FPU table), None if m is not one"""
+    if m in FP1:
+        return 1, 1
+    if m in FP3:
+        return 3, 3
+    if m in ("vdiv", "vsqrt"):
+        return 14, 14
+    if m in ("vldr", "vstr"):
+        return (3, 3) if re.match(r"\s*d\d", ops) else (2, 2)
+    if m in ("vldm", "vldmia", "vldmdb", "vstm", "vstmia", "vstmdb", "vpush", "vpop"):
+        n = n_regs(ops) * (2 if re.search(r"\{\s*d", ops) else 1)
+        return 1 + n, 1 + n
+    return None
+
+
 def price(mn: str, ops: str, core: str, prev_ls: bool):
     """(low, high) cycles of one instruction, its kind ('ls' single load/store, 'br' branch, 'pc' PC write, '')
     and the refill it adds when taken (1 = yes)"""
+    if mn.lower().startswith("v"):
+        stem = mn.split(".")[0].lower()
+        fp = price_fp(stem, ops)
+        for c in CONDS if fp is None else ():  # a condition suffix (inside an IT block)
+            if stem.endswith(c) and price_fp(stem[: -len(c)], ops) is not None:
+                fp = price_fp(stem[: -len(c)], ops)
+                break
+        if fp is not None:
+            return fp[0], fp[1], ""
     m = base_mnemonic(mn)
     writes_pc = bool(re.match(r"\s*pc\b", ops)) or ("pc}" in ops.replace(" ", "") and m in ("pop", "ldm", "ldmia"))
     if m in BRANCH:
