@@ -266,6 +266,7 @@ lidet_status_t lidet_cluster_q_state_init(lidet_cluster_q_state_t *c, const lide
     c->cfg = *cfg;
     c->theta_bam = lidet__q_urad_to_bam((int32_t)cfg->theta_urad);
     c->sin_theta_q16 = (uint32_t)lidet__q_rshift_round(lidet__q_sin((uint32_t)c->theta_bam), 14);
+    c->geo_row_m26 = 0u; /* set with the geometry on the first run (lidet__cluster_q_setup_geometry) */
     return init_done(c);
 }
 
