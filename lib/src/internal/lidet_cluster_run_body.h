@@ -291,8 +291,9 @@ static void canonicalise(RUN_STATE_T *c, const run_span_t *sp, lidet_cluster_sta
 
 /* the first free pixel (label 0) at or after p, npix if none. Seeds are rare once most pixels are
  * visited: where LIDET__LAB_WORDS, four labels at a time (a 64-bit word, read with memcpy) are skipped when
- * none is 0 (elsewhere one label at a time). The test (w - 0x0001..) & ~w & 0x8000.. is nonzero exactly when some 16-bit lane of w is zero (a
- * borrow only starts at a zero lane, and the lowest zero lane always sets its top bit) */
+ * none is 0 (elsewhere one label at a time). The test (w - 0x0001..) & ~w & 0x8000.. is nonzero exactly when
+ * some 16-bit lane of w is zero (a borrow only starts at a zero lane, and the lowest zero lane always sets its
+ * top bit) */
 static inline uint32_t next_free(const uint16_t *lab, uint32_t p, uint32_t npix)
 {
 #if !LIDET__LAB_WORDS
