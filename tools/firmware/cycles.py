@@ -78,7 +78,7 @@ def base_mnemonic(m: str) -> str:
         if m.endswith(c) and len(m) > len(c):
             stem = m[: -len(c)]
             if stem in BRANCH or stem in DP or stem in MUL1 or stem in MAC or stem in LONG or stem in LONGACC \
-                    or stem in ("sdiv", "udiv") or stem.startswith(("ldr", "str", "ld", "st")) \
+                    or stem in ("sdiv", "udiv") or stem.startswith(("ldr", "str", "ld", "st")) or stem in FP_ALL \
                     or stem.rstrip("s") in DP or stem.rstrip("s") in MUL1:
                 m = stem
                 break
@@ -105,6 +105,8 @@ def n_regs(ops: str) -> int:
 
 FP1 = {"vadd", "vsub", "vmul", "vnmul", "vabs", "vneg", "vcmp", "vcmpe", "vcvt", "vcvtr", "vmov", "vmrs", "vmsr"}
 FP3 = {"vmla", "vmls", "vnmla", "vnmls", "vfma", "vfms", "vfnma", "vfnms"}
+FPLS = {"vldm", "vldmia", "vldmdb", "vstm", "vstmia", "vstmdb", "vpush", "vpop"}
+FP_ALL = FP1 | FP3 | FPLS | {"vdiv", "vsqrt", "vldr", "vstr"}
 
 
 def price_fp(m: str, ops: str):
@@ -117,7 +119,7 @@ def price_fp(m: str, ops: str):
         return 14, 14
     if m in ("vldr", "vstr"):
         return (3, 3) if re.match(r"\s*d\d", ops) else (2, 2)
-    if m in ("vldm", "vldmia", "vldmdb", "vstm", "vstmia", "vstmdb", "vpush", "vpop"):
+    if m in FPLS:
         n = n_regs(ops) * (2 if re.search(r"\{\s*d", ops) else 1)
         return 1 + n, 1 + n
     return None
@@ -126,16 +128,10 @@ def price_fp(m: str, ops: str):
 def price(mn: str, ops: str, core: str, prev_ls: bool):
     """(low, high) cycles of one instruction, its kind ('ls' single load/store, 'br' branch, 'pc' PC write, '')
     and the refill it adds when taken (1 = yes)"""
-    if mn.lower().startswith("v"):
-        stem = mn.split(".")[0].lower()
-        fp = price_fp(stem, ops)
-        for c in CONDS if fp is None else ():  # a condition suffix (inside an IT block)
-            if stem.endswith(c) and price_fp(stem[: -len(c)], ops) is not None:
-                fp = price_fp(stem[: -len(c)], ops)
-                break
-        if fp is not None:
-            return fp[0], fp[1], ""
     m = base_mnemonic(mn)
+    fp = price_fp(m, ops) if m in FP_ALL else None
+    if fp is not None:
+        return fp[0], fp[1], ""
     writes_pc = bool(re.match(r"\s*pc\b", ops)) or ("pc}" in ops.replace(" ", "") and m in ("pop", "ldm", "ldmia"))
     if m in BRANCH:
         return 1, 1, "br"

@@ -202,35 +202,25 @@ __attribute__((always_inline))
 static inline void
 scatter_acc32(int64_t a[6], int32_t x, int32_t y, int32_t z, int neg)
 {
+    int64_t t[6];
+    int k;
     if (x >= -46340 && x <= 46340 && y >= -46340 && y <= 46340 && z >= -46340 && z <= 46340)
     {
-        const int32_t p0 = x * x, p1 = x * y, p2 = x * z, p3 = y * y, p4 = y * z, p5 = z * z;
-        if (neg)
-        {
-            a[0] -= p0;
-            a[1] -= p1;
-            a[2] -= p2;
-            a[3] -= p3;
-            a[4] -= p4;
-            a[5] -= p5;
-        }
-        else
-        {
-            a[0] += p0;
-            a[1] += p1;
-            a[2] += p2;
-            a[3] += p3;
-            a[4] += p4;
-            a[5] += p5;
-        }
-    }
-    else if (neg)
-    {
-        scatter_sub64(a, x, y, z);
+        t[0] = x * x;
+        t[1] = x * y;
+        t[2] = x * z;
+        t[3] = y * y;
+        t[4] = y * z;
+        t[5] = z * z;
     }
     else
     {
-        scatter_add64(a, x, y, z);
+        t[0] = t[1] = t[2] = t[3] = t[4] = t[5] = 0;
+        scatter_add64(t, x, y, z);
+    }
+    for (k = 0; k < 6; ++k)
+    {
+        a[k] = neg ? a[k] - t[k] : a[k] + t[k];
     }
 }
 #endif
@@ -332,21 +322,12 @@ static uint32_t
 changed_sides(const int32_t *xyz, uint32_t n, uint8_t *fl, const lidet__ground_q_hplane_t *hp, uint64_t t2,
               const int32_t first[3], uint32_t m, int64_t s1[3], int64_t a[6])
 {
-#if LIDET_Q_HAVE_MUL64
-    const int32_t n0 = hp->n[0], n1 = hp->n[1], n2 = hp->n[2];
-    const int64_t d = hp->d;
-#endif
+    const lidet__ground_q_hplane_t h = *hp; /* a local copy: the flags' stores cannot alias it (registers) */
     const int32_t *p = xyz, *const end = xyz + 3u * n;
     for (; p != end; p += 3, ++fl)
     {
         const int32_t x = p[0], y = p[1], z = p[2];
-#if LIDET_Q_HAVE_MUL64
-        const uint8_t in =
-            (uint8_t)((uint64_t)(d + (int64_t)n0 * x + (int64_t)n1 * y + (int64_t)n2 * z) <= t2);
-#else
-        const uint8_t in =
-            (uint8_t)((uint64_t)lidet__ground_q_height(hp, x, y, z) <= t2); /* 32-bit products */
-#endif
+        const uint8_t in = (uint8_t)((uint64_t)lidet__ground_q_height(&h, x, y, z) <= t2);
         if (in != *fl)
         {
             *fl = in;

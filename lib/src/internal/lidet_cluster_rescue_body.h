@@ -68,17 +68,7 @@ static inline void rescue_grow(RESCUE_STATE_T *c, const RESCUE_PARAM_T *g, uint3
                     continue; /* the row's probes made, in the same order */
                 }
 #endif
-#if !LIDET__LAB_WORDS
-                /* one label at a time (LIDET__LAB_WORDS): the probe only where it can do anything */
-                for (; n < end; ++n)
-                {
-                    if (lab[n] < LAB_PENDING)
-                    {
-                        RESCUE_PROBE(c, rs, lab, n, &win, g, compact);
-                    }
-                }
-#endif
-                for (; n + 4u <= end; n += 4u)
+                for (; LIDET__LAB_WORDS && n + 4u <= end; n += 4u)
                 {
                     uint64_t w4;
                     memcpy(&w4, &lab[n], sizeof w4);
@@ -92,7 +82,12 @@ static inline void rescue_grow(RESCUE_STATE_T *c, const RESCUE_PARAM_T *g, uint3
                 }
                 for (; n < end; ++n)
                 {
-                    RESCUE_PROBE(c, rs, lab, n, &win, g, compact);
+                    /* one label at a time (all of them where !LIDET__LAB_WORDS): the probe only where it can do
+                     * anything there (the label read inline; the probe may be a call) */
+                    if (LIDET__LAB_WORDS || lab[n] < LAB_PENDING)
+                    {
+                        RESCUE_PROBE(c, rs, lab, n, &win, g, compact);
+                    }
                 }
             }
             else

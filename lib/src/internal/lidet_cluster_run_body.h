@@ -296,16 +296,9 @@ static void canonicalise(RUN_STATE_T *c, const run_span_t *sp, lidet_cluster_sta
  * top bit) */
 static inline uint32_t next_free(const uint16_t *lab, uint32_t p, uint32_t npix)
 {
-#if !LIDET__LAB_WORDS
-    while (p < npix && lab[p] != LAB_FREE)
-    {
-        ++p;
-    }
-    return p;
-#endif
     for (;;)
     {
-        while (p + 4u <= npix)
+        while (LIDET__LAB_WORDS && p + 4u <= npix)
         {
             uint64_t w;
             memcpy(&w, &lab[p], sizeof w);
