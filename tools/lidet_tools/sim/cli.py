@@ -40,6 +40,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--behind-cars", type=float, default=0.0, metavar="RATE",
                    help="mean number of people (alone or 2-4 side by side) standing just behind a parked car per scan, "
                         "seen from the waist or chest up (default 0: none)")
+    p.add_argument("--foliage", type=float, default=0.0, metavar="M",
+                   help="mean depth in m that rays reach into vegetation (canopies, bushes, hedges) before they return, "
+                        "drawn per ray (default 0: from its surface; docs/SIMULATOR.md, \"Foliage\")")
     p.add_argument("--range-noise", type=float, default=0.02, help="1-sigma range noise in m")
     p.add_argument("--dropout", type=float, default=0.015, help="random dropout probability")
     g = p.add_argument_group("sequences (sequence.py)")
@@ -60,7 +63,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def _one(a, i):
     r = simulate_scan(a.sensor, a.seed, i, a.mount_height, a.pitch_deg, a.roll_deg, a.scene,
-                      a.range_noise, a.dropout, crowd=a.crowd, behind_cars=a.behind_cars)
+                      a.range_noise, a.dropout, crowd=a.crowd, behind_cars=a.behind_cars,
+                      foliage_m=a.foliage)
     write_scan(a.out, f"{i:06d}", r)
     return i
 
@@ -72,6 +76,12 @@ def main(argv=None) -> int:
         return 2
     if not (0.0 <= a.behind_cars <= 50.0):
         print("lidet-sim: --behind-cars must be in [0, 50]", file=sys.stderr)
+        return 2
+    if not (0.0 <= a.foliage <= 2.0):
+        print("lidet-sim: --foliage must be in [0, 2] m", file=sys.stderr)
+        return 2
+    if a.foliage > 0.0 and a.sequence is not None:
+        print("lidet-sim: --foliage applies to single scans, not to --sequence", file=sys.stderr)
         return 2
     if a.mount_height is not None and not 0.1 <= a.mount_height <= 5.0:
         print("lidet-sim: --mount-height must be in [0.1, 5] m", file=sys.stderr)

@@ -147,13 +147,16 @@ class Scan:
         self.sensor = sensor  # the C stages' sensor profile when it is not the dataset's, else None
 
 
-def sim_scan(sensor: str, seed: int, index: int, mount: float | None, behind_cars: float = 0.0) -> Scan:
+def sim_scan(sensor: str, seed: int, index: int, mount: float | None, behind_cars: float = 0.0,
+             foliage_m: float = 0.0) -> Scan:
     """Simulated scan `index` of run `seed`; behind_cars: `lidet-sim --behind-cars` (people standing behind parked
-    cars, seen from the waist up; 0 = the default scenes)."""
+    cars, seen from the waist up; 0 = the default scenes); foliage_m: `lidet-sim --foliage` (the mean depth rays
+    reach into vegetation; 0 = returns from its surface)."""
     from ..sim.simulate import simulate_scan
-    r = simulate_scan(sensor, seed, index, mount, behind_cars=behind_cars)
+    r = simulate_scan(sensor, seed, index, mount, behind_cars=behind_cars, foliage_m=foliage_m)
     boxes = [(b.cls, (b.x, b.y, b.z, b.l, b.w, b.h, b.yaw)) for b in r.boxes]
-    name = f"sim:{sensor}:{seed}:{index}:{mount}" + (f":behind{behind_cars:g}" if behind_cars > 0 else "")
+    name = (f"sim:{sensor}:{seed}:{index}:{mount}" + (f":behind{behind_cars:g}" if behind_cars > 0 else "")
+            + (f":foliage{foliage_m:g}" if foliage_m > 0 else ""))
     return Scan(name, r.points, boxes, sem=r.sem.astype(np.int64),
                 inst=r.inst, ring=r.ring, mount=mount)
 
@@ -395,11 +398,11 @@ def process_scan(scan: Scan, sensor: str, cfg: dict) -> dict:
 
 # ---- jobs -------------------------------------------------------------------------------------------
 
-def _job(task, sensor, cfg, behind_cars=0.0):
+def _job(task, sensor, cfg, behind_cars=0.0, foliage_m=0.0):
     kind, split, a, b, c = task[:5]
     sensor = task[5] if len(task) > 5 else sensor  # a simulated scan of a mixed set names its own sensor
     if kind == "sim":
-        scan = sim_scan(sensor, a, b, c, behind_cars)
+        scan = sim_scan(sensor, a, b, c, behind_cars, foliage_m)
     elif kind == "kitti":
         scan = kitti_scan(a, b)
     elif kind == "boxes":
@@ -496,6 +499,9 @@ def main(argv=None) -> int:
     ap.add_argument("--sim-behind-cars", type=float, default=0.0, metavar="RATE",
                     help="simulated scans: mean number of people (or rows of people) standing behind parked cars "
                          "per scan (`lidet-sim --behind-cars`; default 0)")
+    ap.add_argument("--sim-foliage", type=float, default=0.0, metavar="M",
+                    help="simulated scans: the mean depth in m that rays reach into vegetation before they return "
+                         "(`lidet-sim --foliage`; default 0: from its surface)")
     ap.add_argument("--kitti", action="append", type=pathlib.Path, help="KITTI folder (velodyne/ label_2/ calib/)")
     ap.add_argument("--semantickitti", action="append", type=pathlib.Path, help="SemanticKITTI folder (velodyne/ labels/)")
     ap.add_argument("--boxes", action="append", type=pathlib.Path,
@@ -529,13 +535,16 @@ def main(argv=None) -> int:
             ap.error(f"--sim-sensors: presets ({', '.join(SENSORS)}) with --sim" + (f"; unknown: {', '.join(bad)}" if bad else ""))
     if not 0.0 <= a.sim_behind_cars <= 50.0:
         ap.error("--sim-behind-cars must be in [0, 50]")
+    if not 0.0 <= a.sim_foliage <= 2.0:
+        ap.error("--sim-foliage must be in [0, 2] m")
     try:
         tasks = build_tasks(a)
     except (FileNotFoundError, ValueError) as e:
         print(f"dataset: {e}", file=sys.stderr)
         return 2
     cfg = dict(DEFAULTS, purity=a.purity, recall=a.recall, margin=a.margin, n_points=a.n_points, z_origin=a.z_origin)
-    job = functools.partial(_job, sensor=a.sensor, cfg=cfg, behind_cars=a.sim_behind_cars)
+    job = functools.partial(_job, sensor=a.sensor, cfg=cfg, behind_cars=a.sim_behind_cars,
+                            foliage_m=a.sim_foliage)
     t0 = time.perf_counter()
     parts = [None] * len(tasks)
     bar = None
@@ -560,7 +569,8 @@ def main(argv=None) -> int:
     if len(d["label"]) == 0:
         print("dataset: no proposals (empty scans?)", file=sys.stderr)
         return 1
-    meta = dict(sensor=a.sensor, sim_sensors=a.sim_sensors, sim=a.sim, seed=a.seed, mounts=a.mounts, sim_behind_cars=a.sim_behind_cars, kitti=[str(p) for p in a.kitti or []],
+    meta = dict(sensor=a.sensor, sim_sensors=a.sim_sensors, sim=a.sim, seed=a.seed, mounts=a.mounts, sim_behind_cars=a.sim_behind_cars,
+                sim_foliage=a.sim_foliage, kitti=[str(p) for p in a.kitti or []],
                 semantickitti=[str(p) for p in a.semantickitti or []], boxes=[str(p) for p in a.boxes or []], n_excluded=int(sum(p["n_excluded"] for p in parts)),
                 n_objects=[int(v) for v in np.sum([p["n_objects"] for p in parts], axis=0)], **cfg,
                 command="python -m lidet_tools.train.dataset " + " ".join(argv if argv is not None else sys.argv[1:]))
