@@ -86,7 +86,7 @@ def _kib(v: int) -> str:
 
 
 def _cycle_estimates(build, reports):
-    """tools/firmware/cycles.py on the Cortex-M4 and M3 integer images and the M4F float image with either dense
+    """tools/firmware/cycles.py on the Cortex-M4, M3 and M0+ integer images and the M4F float image with either dense
     kernel (skipped without QEMU or the images)"""
     import importlib.util
     spec = importlib.util.spec_from_file_location("cycles", ROOT / "tools" / "firmware" / "cycles.py")
@@ -95,6 +95,8 @@ def _cycle_estimates(build, reports):
     out = []
     for board, core, label, mhz in (("mps2-an386-q", "m4", "Cortex-M4, integer build (vlp16s)", 200.0),
                                     ("mps2-an385-q", "m3", "Cortex-M3, integer build (vlp16s)", 100.0),
+                                    ("mps2-an385-m0plus-q", "m0plus", "Cortex-M0+, integer build (vlp16s; the "
+                                     "RP2040's clock)", 133.0),
                                     ("mps2-an386", "m4", "Cortex-M4F, float build (VMUL + VADD, the default)", 200.0),
                                     (M4F_FUSED, "m4", "Cortex-M4F, float build (VFMA, `LIDET_NN_CM_FMA=1`)", 200.0)):
         elf = build / "firmware" / board / "lidet_fw.elf"
@@ -572,11 +574,12 @@ def run(args) -> str:
     est = _cycle_estimates(build, reports)
     if est:
         out += ["", "**Cycles, estimated** (`python3 tools/firmware/cycles.py --elf "
-                "build/firmware/<image>/lidet_fw.elf --core m4|m3 --report build/firmware/<image>/report.json`): "
+                "build/firmware/<image>/lidet_fw.elf --core m4|m3|m0plus --report build/firmware/<image>/report.json`): "
                 "QEMU's trace of every executed instruction (all runs, lidet's and the application's code), each "
                 "priced with the cycle counts of the core's Technical Reference Manual at zero wait states (loads 1-2 "
                 "with the TRM's pipelining, taken branches 1 + P with P 1-3, divides 2-12, M3 long multiplies 3-7; "
-                "the M4's FPU: VADD and VMUL 1, VFMA and VMLA 3, VDIV and VSQRT 14, VLDR 2, VLDM 1 + N); the "
+                "the M4's FPU: VADD and VMUL 1, VFMA and VMLA 3, VDIV and VSQRT 14, VLDR 2, VLDM 1 + N; the M0+ by its "
+                "own TRM: loads and stores 2, taken branches 2, BL 3, MULS 1 as on the RP2040, no divide); the "
                 "trace's cycles per instruction applied to run `default`'s exact count; low and high estimates, not "
                 "measurements: flash wait states and bus contention come on top.", "",
                 "| image | CPI (low - high) | cycles per scan, estimated | time per scan at the clock |",
