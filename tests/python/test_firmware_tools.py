@@ -370,8 +370,8 @@ Trace 0: 0x7fe144000200 [00000000/80000110/00109003/ff020200]
 
 
 def test_tally_prices_a_hand_made_m0plus_log():
-    """tally on a hand-made trace: blocks logged once and run again, a taken branch's refill, a call into a helper
-    (bl to a '__' symbol) counted by caller, instructions per function and per address."""
+    """tally on a hand-made trace: blocks logged once and run again, a taken branch's refill, a call into a C
+    library routine (bl to a '__' symbol) counted by caller, instructions per function and per address."""
     syms = [(0x100, 0x108, "fw_main", True), (0x108, 0x110, "lidet_x", True), (0x110, 0x112, "__aeabi_uidiv", True)]
     r = cycles.tally(M0_LOG.splitlines(True), syms, "m0plus", lines=True)
     assert r["instructions"] == 3 + 2 + 1 + 3
@@ -384,8 +384,8 @@ def test_tally_prices_a_hand_made_m0plus_log():
 
 
 def test_tally_profiles_a_hand_made_rv32_log():
-    """RV32 (no cycle model): instructions, the per-function profile and the helper calls (jal ra to a '__' symbol,
-    its target from QEMU's comment); compressed instructions are 2 bytes."""
+    """RV32 (no cycle model): instructions, the per-function profile and the calls into C library routines (jal ra
+    to a '__' symbol, its target from QEMU's comment); compressed instructions are 2 bytes."""
     syms = [(0x80000100, 0x80000110, "fw_main", True), (0x80000110, 0x80000118, "__udivdi3", True)]
     r = cycles.tally(RV_LOG.splitlines(True), syms, "rv32", lines=True)
     assert r["instructions"] == 2 + 2 * 2

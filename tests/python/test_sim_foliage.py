@@ -2,7 +2,6 @@
 """lidet-sim --foliage (simulate.cast_scene foliage_m): rays return from inside vegetation, not its surface; and
 foliage_report's roughness measure."""
 import numpy as np
-import pytest
 
 from lidet_tools.sim import cli as sim_cli
 from lidet_tools.sim import foliage_report as FR

@@ -148,14 +148,20 @@ def price_fp(m: str, ops: str):
     return None
 
 
+def _writes_pc(m: str, ops: str) -> bool:
+    """whether instruction m (base mnemonic) with operands ops writes the PC (a destination pc, or pc in a POP's or
+    LDM's register list)"""
+    return bool(re.match(r"\s*pc\b", ops)) or ("pc}" in ops.replace(" ", "") and m in ("pop", "ldm", "ldmia"))
+
+
 def price_m0plus(m: str, ops: str):
     """(low, high) cycles and kind of a Cortex-M0+ instruction (base mnemonic m; the M0+ TRM's table)"""
-    writes_pc = bool(re.match(r"\s*pc\b", ops)) or ("pc}" in ops.replace(" ", "") and m in ("pop", "ldm", "ldmia"))
+    writes_pc = _writes_pc(m, ops)
     if m == "bl":
         return 2, 2, "br"  # 3 with the refill of the taken branch
     if m in BRANCH:
         return 1, 1, "br"
-    if m in ("mul", "muls"):
+    if m == "mul":  # MULS (base_mnemonic drops the S)
         return 1, 1, ""
     if m in ("push", "pop", "stm", "stmia", "ldm", "ldmia", "stmea", "ldmfd"):
         n = n_regs(ops)
@@ -178,7 +184,7 @@ def price(mn: str, ops: str, core: str, prev_ls: bool):
     fp = price_fp(m, ops) if m in FP_ALL else None
     if fp is not None:
         return fp[0], fp[1], ""
-    writes_pc = bool(re.match(r"\s*pc\b", ops)) or ("pc}" in ops.replace(" ", "") and m in ("pop", "ldm", "ldmia"))
+    writes_pc = _writes_pc(m, ops)
     if m in BRANCH:
         return 1, 1, "br"
     if m in ("tbb", "tbh"):
@@ -257,8 +263,9 @@ def source_lines(elf: str, nm: str, per_addr: dict) -> dict:
 
 def tally(log, syms, core: str, lines: bool = False) -> dict:
     """The counts of a QEMU `-d in_asm,exec,nochain` log (an iterable of its lines) against the image's code symbols
-    (code_symbols): instructions, cycle estimates (the PRICED cores; None otherwise), per function, helper calls and,
-    with lines, executions per instruction address ('per_addr')."""
+    (code_symbols): instructions, cycle estimates (the PRICED cores; None otherwise), per function, the calls into
+    the C library's routines by caller ('helper_calls') and, with lines, executions per instruction address
+    ('per_addr')."""
     priced = core in PRICED
     refill = REFILL.get(core, (0, 0))
     starts = [a for a, _, _, _ in syms]
@@ -267,7 +274,7 @@ def tally(log, syms, core: str, lines: bool = False) -> dict:
     # can have several blocks: each execution line names its translation's flags.
     blocks = {}
     per_fn = {}  # function name -> instructions executed in it (blocks attributed by their first address)
-    calls = {}  # (library helper, calling function) -> calls
+    calls = {}  # (C library routine, calling function) -> calls
     per_addr = {}  # instruction address -> executions (lines only)
     tot_insn = lo = hi = 0
     pending = None  # the previous executed block's last instruction: (end address, kind)
@@ -319,7 +326,7 @@ def tally(log, syms, core: str, lines: bool = False) -> dict:
             per_fn[fn] = per_fn.get(fn, 0) + n
             if callee is not None:
                 j = bisect.bisect_right(starts, callee) - 1
-                if j >= 0 and syms[j][2].startswith("__"):  # calls into the C library's helpers
+                if j >= 0 and syms[j][2].startswith("__"):  # calls into the C library's routines
                     k = (syms[j][2], fn)
                     calls[k] = calls.get(k, 0) + 1
             tot_insn += n

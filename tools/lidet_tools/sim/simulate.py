@@ -14,14 +14,15 @@ import numpy as np
 from .. import kitti
 from ..sensors import get_sensor
 from . import raycast as rc
+from .objects import S
 from .scene import SURF_ALB, SURF_ROUGH_DROP, SURF_SEM, Scene, make_scene
 from .sensor_model import SensorModel
 
 #: label_2 classes emitted (buses are 'Misc': KITTI has no bus class)
 LABEL2_CLASSES = ("Car", "Van", "Truck", "Pedestrian", "Cyclist", "Misc", "DontCare")
 DONTCARE_RANGE_M = 70.0
-#: SemanticKITTI's vegetation id (objects.S): the primitives foliage_m applies to
-S_VEGETATION = 70
+#: the primitives foliage_m applies to (SemanticKITTI's vegetation: canopies, bushes, hedges)
+S_VEGETATION = S["vegetation"]
 #: a foliage depth is capped at this many times its mean (a ray does not cross a whole canopy)
 FOLIAGE_CAP = 3.0
 
@@ -85,8 +86,8 @@ def cast_scene(scene: Scene, sm: SensorModel, noise_rng, keep_scene: bool = Fals
     from an exponential law of that mean, capped at FOLIAGE_CAP times it, instead of from its surface: real
     foliage scatters returns in depth. On the labelled SemanticKITTI training scan (spvnas_000000) the
     vegetation's points lie 3.8 cm (5-15 m) and 5.8 cm (15-30 m) from the plane of their 12 nearest neighbours
-    (median rms), the simulated surfaces' 1.2-1.5 and 1.3-1.8 cm (`python -m lidet_tools.sim.report --foliage`). `simulate_scan` is make_scene + this; the
-    sequences (sequence.py) call it once per scan with the scene moved into that scan's sensor frame."""
+    (median rms), the simulated surfaces' 1.3 and 1.5 cm (`python -m lidet_tools.sim.foliage_report`).
+    `simulate_scan` is make_scene + this; the sequences (sequence.py) call it once per scan with the scene moved into that scan's sensor frame."""
     sensor = sm.sensor
     grid, row2ring = sm.ray_grid()
     dirs = grid.dirs
