@@ -67,6 +67,7 @@ set(bad_cases
     "LIDET_NN_SIMD=2|LIDET_NN_SIMD must be 0 or 1"
     "LIDET_Q_HAVE_DIV=2|LIDET_Q_HAVE_DIV must be 0 or 1"
     "LIDET_Q_HAVE_MUL64=2|LIDET_Q_HAVE_MUL64 must be 0 or 1"
+    "LIDET_GROUND_Q_BAND32=2|LIDET_GROUND_Q_BAND32 must be 0 or 1"
     # the kernel variants are names: a number (the values 0, 1, 2, 22, 42 the names replaced included) or an
     # unknown word is refused
     "LIDET_NN_S8_KERNEL=0|LIDET_NN_S8_KERNEL must be one of"

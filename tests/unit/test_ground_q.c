@@ -337,6 +337,133 @@ void test_sample_kernels_agree(void)
     TEST_ASSERT_GREATER_THAN_UINT32(50000u, n_clear);
 }
 
+/* The band test from the 32-bit hi part (lidet__ground_q_in_band, what the ARMv6-M and RV32 images run; this host
+ * build takes the exact 64-bit height) gives the exact test's outcome: random unit normals (tilted up to about 60
+ * degrees), offsets and bands, points spread over the int16 range and points placed within a few 4 mm steps of either
+ * edge of the band, where the lo part decides; every path of the test is taken (surely out, surely in, exact). */
+static void q30_unit(int32_t *n, uint32_t *s)
+{
+    int64_t v[3], len2;
+    uint32_t len, k;
+    v[0] = (int64_t)(lcg(s) % 2000001u) - 1000000;
+    v[1] = (int64_t)(lcg(s) % 2000001u) - 1000000;
+    v[2] = 600000 + (int64_t)(lcg(s) % 1400000u);
+    len2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    len = lidet__q_isqrt64((uint64_t)len2);
+    for (k = 0; k < 3u; ++k)
+    {
+        n[k] = (int32_t)lidet__q_div_round(v[k] * ((int64_t)1 << 30), (int64_t)len);
+    }
+}
+
+void test_band_test_from_the_hi_part(void)
+{
+    uint32_t s = 777u, trial, j, n_in = 0, n_out = 0, n_edge = 0;
+    for (trial = 0; trial < 4000u; ++trial)
+    {
+        int32_t n[3];
+        lidet__ground_q_hplane_t h;
+        lidet__ground_q_band_t b;
+        /* D: the plane 0.5-2.5 m below the sensor (4 mm / 2^30), plus the band's offset; t: a band of 2-60 cm */
+        const int64_t d = ((int64_t)(100 + lcg(&s) % 600u) << 30) + (int64_t)(lcg(&s) % 50u) * ((int64_t)1 << 28);
+        const uint64_t t = (uint64_t)(5 + lcg(&s) % 150u) << 30;
+        q30_unit(n, &s);
+        lidet__ground_q_hplane(n, d, &h);
+        lidet__ground_q_band(h.lo, h.d, t, 15u, &b);
+        for (j = 0; j < 64u; ++j)
+        {
+            int32_t p[3];
+            int64_t hh;
+            int exact, fast;
+            p[0] = (int32_t)(lcg(&s) % 65536u) - 32768;
+            p[1] = (int32_t)(lcg(&s) % 65536u) - 32768;
+            p[2] = (int32_t)(lcg(&s) % 2001u) - 1000; /* x, y halved below: |p| within 2^15 steps, as an image's */
+            p[0] /= 2;
+            p[1] /= 2;
+            if (j % 4u != 0u)
+            {
+                /* z on the band's lower edge (1) or upper edge (3) within +-8 steps, where the lo part decides, or
+                 * anywhere in the band (2) */
+                const int64_t e = j % 4u == 1u ? 0 : (j % 4u == 3u ? (int64_t)t : (int64_t)(t / 2u));
+                const int64_t num = e - d - (int64_t)n[0] * p[0] - (int64_t)n[1] * p[1];
+                const int64_t w = j % 4u == 2u ? (int64_t)(t >> 31) : 8;
+                int64_t z = num / n[2] + (int64_t)(lcg(&s) % (uint32_t)(2 * w + 1)) - w;
+                z = z < -32768 ? -32768 : (z > 32767 ? 32767 : z);
+                p[2] = (int32_t)z;
+            }
+            hh = lidet__ground_q_height(&h, p[0], p[1], p[2]);
+            exact = (uint64_t)hh <= t;
+            fast = lidet__ground_q_in_band(&h, &b, t, p[0], p[1], p[2]);
+            TEST_ASSERT_EQUAL_INT(exact, fast);
+            n_in += (uint32_t)exact;
+            n_out += (uint32_t)!exact;
+            {
+                const int32_t a = h.hi[0] * p[0] + h.hi[1] * p[1] + h.hi[2] * p[2];
+                n_edge += (uint32_t)((uint32_t)a - (uint32_t)b.pos_lo <= b.pos_span &&
+                                     !((uint32_t)a - (uint32_t)b.in_lo < b.in_n));
+            }
+        }
+    }
+    TEST_ASSERT_GREATER_THAN_UINT32(20000u, n_in);
+    TEST_ASSERT_GREATER_THAN_UINT32(20000u, n_out);
+    TEST_ASSERT_GREATER_THAN_UINT32(2000u, n_edge); /* the exact fallback is exercised */
+}
+
+/* The RANSAC's inlier count from the hi part (count_inliers with LIDET_GROUND_Q_BAND32): hypotheses c of every
+ * size up to 2^29 (short cross products leave a split shift of a few bits, long ones 15) split by
+ * lidet__ground_q_split, the band h + t in [0, 2t] of samples near and far from the plane through p0: the same
+ * count as the exact 64-bit products. */
+void test_inlier_band_of_any_hypothesis(void)
+{
+    uint32_t s = 4242u, trial, j, n_exact = 0, n_in = 0, n_sh[16] = {0};
+    for (trial = 0; trial < 3000u; ++trial)
+    {
+        const unsigned bits = 1u + lcg(&s) % 29u; /* |c| below 2^bits */
+        int32_t c[3], ch[3], cl[3], p0[3];
+        lidet__ground_q_band_t b;
+        unsigned sh, k;
+        int64_t t, h0;
+        for (k = 0; k < 3u; ++k)
+        {
+            c[k] = (int32_t)(((lcg(&s) << 8) ^ lcg(&s)) % (1u << bits)) * ((lcg(&s) & 1u) ? 1 : -1); /* 32 bits */
+            p0[k] = (int32_t)(lcg(&s) % 20001u) - 10000;
+        }
+        sh = lidet__ground_q_split(c, ch, cl);
+        n_sh[sh] += 1u;
+        for (k = 0; k < 3u; ++k)
+        {
+            TEST_ASSERT_TRUE(ch[k] <= (1 << 14) && ch[k] >= -(1 << 14));
+            TEST_ASSERT_EQUAL_INT64((int64_t)c[k], (int64_t)ch[k] * ((int64_t)1 << sh) + cl[k]);
+        }
+        /* the inlier distance 5-60 cm times |c| (4 mm units): t = thr |c| roughly, as count_inliers' thr_l / 4 */
+        t = (int64_t)(12 + lcg(&s) % 140u) * (int64_t)(1u << (bits > 1u ? bits - 1u : 0u));
+        h0 = t - ((int64_t)c[0] * p0[0] + (int64_t)c[1] * p0[1] + (int64_t)c[2] * p0[2]);
+        lidet__ground_q_band(cl, h0, 2u * (uint64_t)t, sh, &b);
+        for (j = 0; j < 64u; ++j)
+        {
+            int32_t q[3];
+            int64_t ht;
+            int r, fast;
+            for (k = 0; k < 3u; ++k)
+            {
+                const int32_t spread = j % 2u == 0u ? 400 : 16000; /* near p0 (many inliers), or anywhere */
+                int32_t v = p0[k] + (int32_t)(lcg(&s) % (uint32_t)(2 * spread + 1)) - spread;
+                q[k] = v < -32768 ? -32768 : (v > 32767 ? 32767 : v);
+            }
+            ht = h0 + (int64_t)c[0] * q[0] + (int64_t)c[1] * q[1] + (int64_t)c[2] * q[2];
+            r = lidet__ground_q_band_of(&b, ch[0] * q[0] + ch[1] * q[1] + ch[2] * q[2]);
+            fast = r >= 0 ? r : (uint64_t)ht <= 2u * (uint64_t)t;
+            TEST_ASSERT_EQUAL_INT((uint64_t)ht <= 2u * (uint64_t)t, fast);
+            n_exact += (uint32_t)(r < 0);
+            n_in += (uint32_t)fast;
+        }
+    }
+    TEST_ASSERT_GREATER_THAN_UINT32(10000u, n_in);
+    TEST_ASSERT_GREATER_THAN_UINT32(100u, n_exact);
+    TEST_ASSERT_GREATER_THAN_UINT32(0u, n_sh[0]);
+    TEST_ASSERT_GREATER_THAN_UINT32(0u, n_sh[15]);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -347,5 +474,7 @@ int main(void)
     RUN_TEST(test_coordinates_at_the_limits);
     RUN_TEST(test_arguments_and_config);
     RUN_TEST(test_sample_kernels_agree);
+    RUN_TEST(test_band_test_from_the_hi_part);
+    RUN_TEST(test_inlier_band_of_any_hypothesis);
     return UNITY_END();
 }

@@ -264,6 +264,19 @@
 #endif
 #endif
 
+/** The integer ground stage's band tests (its labelling, the RANSAC's inlier counts and refits): 1 = each point's
+ *  32-bit hi part of n . p + D decides first, the exact 64-bit height only for the points near the band's edges
+ *  (cores where that height is many instructions: ARMv6-M's split products, RV32's MUL + MULH pairs), 0 = the
+ *  exact height for every point (cores with a 64-bit multiply-accumulate, hosts). The same outcome either way
+ *  (tests/unit/test_ground_q.c). 0 or 1. Default: 1 where LIDET_Q_HAVE_MUL64 is 0 or on RISC-V, else 0. */
+#ifndef LIDET_GROUND_Q_BAND32
+#if !LIDET_Q_HAVE_MUL64 || defined(__riscv)
+#define LIDET_GROUND_Q_BAND32 1
+#else
+#define LIDET_GROUND_Q_BAND32 0
+#endif
+#endif
+
 /* The int8 x int8 accumulation kernels of the integer PointNets, the values of LIDET_NN_S8_KERNEL
  * (lib/src/nn/lidet_nn_s8.c describes each; every one gives the same int32 sums, tests/unit/test_nn_s8.c checks
  * that they agree). */
@@ -514,6 +527,9 @@
 #endif
 #if LIDET_Q_HAVE_MUL64 != 0 && LIDET_Q_HAVE_MUL64 != 1
 #error "LIDET_Q_HAVE_MUL64 must be 0 or 1"
+#endif
+#if LIDET_GROUND_Q_BAND32 != 0 && LIDET_GROUND_Q_BAND32 != 1
+#error "LIDET_GROUND_Q_BAND32 must be 0 or 1"
 #endif
 #if LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_ROWS4 && LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_COLS &&       \
     LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_DSP && LIDET_NN_S8_KERNEL != LIDET_NN_S8_KERNEL_R2O2 &&         \

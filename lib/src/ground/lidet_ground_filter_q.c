@@ -584,6 +584,55 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
     lidet__ground_sample_counts(&g->stats, total, lo, hi);
 }
 
+/* ---- the band test from the hi part (LIDET_GROUND_Q_BAND32, lidet_ground_q_internal.h) ---- */
+/* floor(v / 2^s) (|v| < 2^62, s <= 15) by shifts of non-negative values only (a 64-bit division is a library call
+ * on the cores that take this path) */
+static int64_t floor_sh(int64_t v, unsigned s)
+{
+    return v >= 0 ? (int64_t)((uint64_t)v >> s) : -(int64_t)(((uint64_t)-v + ((1u << s) - 1u)) >> s);
+}
+
+static int64_t clip32(int64_t v)
+{
+    return v < INT32_MIN ? INT32_MIN : (v > INT32_MAX ? INT32_MAX : v);
+}
+
+/* lidet_ground_q_internal.h */
+void lidet__ground_q_band(const int32_t lo[3], int64_t d, uint64_t t, unsigned sh, lidet__ground_q_band_t *b)
+{
+    const int64_t bmax = ((int64_t)(lo[0] < 0 ? -lo[0] : lo[0]) + (lo[1] < 0 ? -lo[1] : lo[1]) +
+                          (lo[2] < 0 ? -lo[2] : lo[2])) *
+                         32768;
+    const int64_t tt = (int64_t)t;
+    /* possibly in: a 2^sh + D + B >= 0 and a 2^sh + D - B <= t */
+    const int64_t plo = -floor_sh(d + bmax, sh), phi = floor_sh(tt - d + bmax, sh);
+    /* surely in: a 2^sh + D - B >= 0 and a 2^sh + D + B <= t */
+    const int64_t ilo = -floor_sh(d - bmax, sh), ihi = floor_sh(tt - d - bmax, sh);
+    const int64_t pl = clip32(plo), ph = clip32(phi);
+    const int64_t il = clip32(ilo), ih = clip32(ihi);
+    if (pl > ph || plo > INT32_MAX || phi < INT32_MIN)
+    {
+        b->pos_lo = 0; /* nothing possibly in: a = 0 alone goes on, to the exact test */
+        b->pos_span = 0u;
+    }
+    else
+    {
+        b->pos_lo = (int32_t)pl;
+        b->pos_span = (uint32_t)(ph - pl);
+    }
+    if (il > ih || ilo > INT32_MAX || ihi < INT32_MIN)
+    {
+        b->in_lo = 0;
+        b->in_n = 0u;
+    }
+    else
+    {
+        b->in_lo = (int32_t)il;
+        b->in_n = ih - il + 1 > (int64_t)0xFFFFFFFFu ? 0xFFFFFFFFu
+                                                     : (uint32_t)(ih - il + 1); /* one a fewer: exact */
+    }
+}
+
 /* Pass 3 (lidet_ref/ground_q.py: label_pixels): ground = holds a point, -below < h < above with h = n . p + D in
  * 4 mm / 2^30 (the tolerances in mm are exact in that unit: 1 mm = 2^28), and not vetoed: the pixel above
  * (row - 1) holds a point, 4 |dz| > veto_min_dz_mm and |dz| * 2^24 > veto_slope_q16 * |dR|. R is computed only
@@ -640,8 +689,8 @@ __attribute__((always_inline))
 #endif
 static inline void
 label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lidet__qpix_row_t rt,
-           lidet__qpix_row_t rtu, const lidet__ground_q_hplane_t *hp, const far2_plane_t *f2, const int two,
-           const int ro, const int kz)
+           lidet__qpix_row_t rtu, const lidet__ground_q_hplane_t *hp, const lidet__ground_q_band_t *bd,
+           const far2_plane_t *f2, const int two, const int ro, const int kz)
 {
     const uint16_t *rng = L->img->range_4mm;
     const int32_t *ct = L->gp->ct, *st = L->gp->st;
@@ -687,7 +736,11 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
             continue;
         }
         v = (uint32_t)(P[0] * P[0]) + (uint32_t)(P[1] * P[1]);
-        if (two && v >= L->split2_v)
+        if (LIDET_GROUND_Q_BAND32 && kz && !two)
+        {
+            h = 0; /* the band test below, from the 32-bit hi part where that decides */
+        }
+        else if (two && v >= L->split2_v)
         {
             h = (int64_t)f2->n[0] * P[0] + (int64_t)f2->n[1] * P[1] + (int64_t)f2->n[2] * P[2] + f2->d;
         }
@@ -705,7 +758,9 @@ label_span(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up, lid
         {
             /* -below0 < h < above0 as 0 <= h + below0 - 1 < above0 + below0 - 1: the planes' D carries
              * below0 - 1 (label_rows) */
-            in = (uint64_t)h < L->band; /* nz here */
+            in = LIDET_GROUND_Q_BAND32 && !two
+                     ? lidet__ground_q_in_band(&hp[0], bd, L->band - 1u, P[0], P[1], P[2])
+                     : (uint64_t)h < L->band; /* nz here */
         }
         else
         {
@@ -764,11 +819,11 @@ label_span_two(label_t *L, uint32_t c0, uint32_t c1, uint32_t base, uint32_t up,
     }
     if (ro)
     {
-        label_span(L, c0, c1, base, up, rt, rtu, hp, &f2, 1, 1, 0);
+        label_span(L, c0, c1, base, up, rt, rtu, hp, 0, &f2, 1, 1, 0);
     }
     else
     {
-        label_span(L, c0, c1, base, up, rt, rtu, hp, &f2, 1, 0, 0);
+        label_span(L, c0, c1, base, up, rt, rtu, hp, 0, &f2, 1, 0, 0);
     }
 }
 
@@ -829,17 +884,22 @@ label_cell(label_t *L, const lidet_ground_q_state_t *g, uint32_t r, uint32_t s, 
     {
         if (L->k == 0)
         {
+            lidet__ground_q_band_t bd;
             hp[0].d += L->below0 - 1; /* the band test's offset (label_span, kz) */
-            label_span(L, c0, c1, base, up, rt, rtu, hp, 0, 0, 1, 1);
+            if (LIDET_GROUND_Q_BAND32)
+            {
+                lidet__ground_q_band(hp[0].lo, hp[0].d, L->band - 1u, 15u, &bd);
+            }
+            label_span(L, c0, c1, base, up, rt, rtu, hp, &bd, 0, 0, 1, 1);
         }
         else
         {
-            label_span(L, c0, c1, base, up, rt, rtu, hp, 0, 0, 1, 0);
+            label_span(L, c0, c1, base, up, rt, rtu, hp, 0, 0, 0, 1, 0);
         }
     }
     else
     {
-        label_span(L, c0, c1, base, up, rt, rtu, hp, 0, 0, 0, 0);
+        label_span(L, c0, c1, base, up, rt, rtu, hp, 0, 0, 0, 0, 0);
     }
 }
 

@@ -324,10 +324,18 @@ changed_sides(const int32_t *xyz, uint32_t n, uint8_t *fl, const lidet__ground_q
 {
     const lidet__ground_q_hplane_t h = *hp; /* a local copy: the flags' stores cannot alias it (registers) */
     const int32_t *p = xyz, *const end = xyz + 3u * n;
+#if LIDET_GROUND_Q_BAND32
+    lidet__ground_q_band_t bd;
+    lidet__ground_q_band(h.lo, h.d, t2, 15u, &bd);
+#endif
     for (; p != end; p += 3, ++fl)
     {
         const int32_t x = p[0], y = p[1], z = p[2];
+#if LIDET_GROUND_Q_BAND32
+        const uint8_t in = (uint8_t)lidet__ground_q_in_band(&h, &bd, t2, x, y, z);
+#else
         const uint8_t in = (uint8_t)((uint64_t)lidet__ground_q_height(&h, x, y, z) <= t2);
+#endif
         if (in != *fl)
         {
             *fl = in;
@@ -375,10 +383,18 @@ spare_sums(const cell_src_t *img, uint32_t n, const lidet__ground_q_hplane_t *hp
             /* the inliers' differences d = q - first copied into the spare ints, then their sums (inlier_sums) */
             int32_t *o = img->spare;
             uint8_t *f = fl;
+#if LIDET_GROUND_Q_BAND32
+            lidet__ground_q_band_t bd;
+            lidet__ground_q_band(hp->lo, hp->d, t2, 15u, &bd);
+#endif
             for (; p != end; p += 3, ++f)
             {
                 const int32_t x = p[0], y = p[1], z = p[2];
+#if LIDET_GROUND_Q_BAND32
+                const uint8_t in = (uint8_t)lidet__ground_q_in_band(hp, &bd, t2, x, y, z);
+#else
                 const uint8_t in = (uint8_t)((uint64_t)lidet__ground_q_height(hp, x, y, z) <= t2);
+#endif
                 *f = in;
                 if (in)
                 {
@@ -418,6 +434,10 @@ pass_sums(const cell_src_t *img, uint32_t n, const lidet__ground_q_hplane_t *hp,
 {
     uint32_t i = 0, m = 0;
     int32_t q[3];
+#if LIDET_GROUND_Q_BAND32
+    lidet__ground_q_band_t bd;
+    lidet__ground_q_band(hp->lo, hp->d, 2u * (uint64_t)thr, 15u, &bd);
+#endif
     /* one pass over the samples (each decoded once): the inliers' sums S1 = sum d and S2 = sum d d^T of
      * d = q - first, exact in int64 (|d| < 2^16: below n 2^32 for n samples); the cell's decoded copy read
      * directly where there is one. S1 is summed in int32 over blocks of 2^14 samples (|sum| < 2^30), each block
@@ -443,7 +463,11 @@ pass_sums(const cell_src_t *img, uint32_t n, const lidet__ground_q_hplane_t *hp,
                 y = q[1];
                 z = q[2];
             }
+#if LIDET_GROUND_Q_BAND32
+            if (!lidet__ground_q_in_band(hp, &bd, 2u * (uint64_t)thr, x, y, z))
+#else
             if ((uint64_t)lidet__ground_q_height(hp, x, y, z) > 2u * (uint64_t)thr)
+#endif
             {
                 continue;
             }
@@ -575,7 +599,16 @@ static uint32_t count_inliers(const lidet_ground_q_scratch_t *sc, const cell_src
     {
         /* h + t = c . q + (t - c . p0): the constant is each sum's start (exact in int64: |c . q| < 2^47) */
         const int64_t h0 = t - ((int64_t)c0 * p0[0] + (int64_t)c1 * p0[1] + (int64_t)c2 * p0[2]);
-#if !LIDET_Q_HAVE_MUL64
+#if LIDET_GROUND_Q_BAND32
+        /* the band h + t in [0, 2t] in terms of a = ch . q with c = ch 2^sh + cl (lidet__ground_q_split: the hi part
+         * as large as int32 allows), decided from a alone unless it lies near an edge (lidet__ground_q_in_band's
+         * test) */
+        int32_t ch[3], cl[3];
+        lidet__ground_q_band_t bd;
+        const int32_t cc[3] = {c0, c1, c2};
+        const unsigned sh = lidet__ground_q_split(cc, ch, cl);
+        lidet__ground_q_band(cl, h0, t2, sh, &bd);
+#elif !LIDET_Q_HAVE_MUL64
         int32_t ch[3], cl[3]; /* c split as lidet__ground_q_hplane splits a normal (|c| <= 2^29) */
         {
             const int32_t cc[3] = {c0, c1, c2};
@@ -593,6 +626,22 @@ static uint32_t count_inliers(const lidet_ground_q_scratch_t *sc, const cell_src
             const uint32_t end = n_eval - i > 32u ? i + 32u : n_eval;
             for (; i < end; ++i)
             {
+#if LIDET_GROUND_Q_BAND32
+                /* the hi part decides unless it lies near an edge of the band (lidet__ground_q_in_band) */
+                const int32_t x = sc->ev_x[i], y = sc->ev_y[i], z = sc->ev_z[i];
+                const int32_t ah = ch[0] * x + ch[1] * y + ch[2] * z;
+                const int r = lidet__ground_q_band_of(&bd, ah);
+                if (r >= 0)
+                {
+                    cnt += (uint32_t)r;
+                }
+                else
+                {
+                    const int64_t ht =
+                        h0 + (int64_t)ah * ((int64_t)1 << sh) + (cl[0] * x + cl[1] * y + cl[2] * z);
+                    cnt += (uint32_t)((uint64_t)ht <= t2);
+                }
+#else
 #if LIDET_Q_HAVE_MUL64
                 const int64_t ht =
                     h0 + (int64_t)c0 * sc->ev_x[i] + (int64_t)c1 * sc->ev_y[i] + (int64_t)c2 * sc->ev_z[i];
@@ -614,6 +663,7 @@ static uint32_t count_inliers(const lidet_ground_q_scratch_t *sc, const cell_src
                         : "cc");
 #else
                 cnt += (uint32_t)((uint64_t)ht <= t2);
+#endif
 #endif
             }
         }

@@ -52,6 +52,71 @@ static inline int64_t lidet__ground_q_height(const lidet__ground_q_hplane_t *h, 
 #endif
 }
 
+/* LIDET_GROUND_Q_BAND32 (lidet_opt.h): the band test 0 <= n . p + D <= t from the 32-bit hi part
+ * a = sum hi p = (n . p - sum lo p) / 2^15 where that decides, the exact height only for the points whose a lies
+ * within the lo part's reach of the band's edges (lidet__ground_q_in_band; the same outcome every time). Compiled
+ * everywhere, so that the host tests check it against the exact test. */
+
+/* A band 0 <= h <= t of heights h = a 2^sh + b + D, a = sum hi p the int32 part, b = sum lo p with
+ * |b| <= B = 2^15 sum |lo| (|p| <= 2^15 per axis; a prepared plane's split has sh = 15): a outside
+ * [pos_lo, pos_lo + pos_span] is surely out of the band, a in [in_lo, in_lo + in_n) surely in, and any other a
+ * needs the exact height. Both sets are clipped to int32 (a is one); an empty "surely in" set has in_n 0, and
+ * an empty "possibly in" set is left as one value, which then takes the exact test. */
+typedef struct
+{
+    int32_t pos_lo, in_lo;
+    uint32_t pos_span, in_n;
+} lidet__ground_q_band_t;
+
+/* the band 0 <= a 2^sh + sum lo p + D <= t (0 <= t < 2^61, |D| < 2^61, sh <= 15; a prepared plane: its lo parts,
+ * sh 15), for lidet__ground_q_in_band and the RANSAC's inlier counts (lidet_ground_filter_q.c; a function of its
+ * own, out of its callers' frames) */
+void lidet__ground_q_band(const int32_t lo[3], int64_t d, uint64_t t, unsigned sh, lidet__ground_q_band_t *b);
+
+/* what the hi part a says of band b: 0 surely out, 1 surely in, -1 near an edge (the exact height decides) */
+static inline int lidet__ground_q_band_of(const lidet__ground_q_band_t *b, int32_t a)
+{
+    if ((uint32_t)a - (uint32_t)b->pos_lo > b->pos_span)
+    {
+        return 0;
+    }
+    return (uint32_t)a - (uint32_t)b->in_lo < b->in_n ? 1 : -1;
+}
+
+/* (uint64_t)(n . p + D) <= t, i.e. 0 <= n . p + D <= t, for band b = lidet__ground_q_band(h->lo, h->d, t, 15): the
+ * 32-bit hi part decides unless it lies near an edge (the same outcome as the exact test) */
+static inline int lidet__ground_q_in_band(const lidet__ground_q_hplane_t *h, const lidet__ground_q_band_t *b,
+                                          uint64_t t, int32_t x, int32_t y, int32_t z)
+{
+    const int r = lidet__ground_q_band_of(b, h->hi[0] * x + h->hi[1] * y + h->hi[2] * z);
+    return r >= 0 ? r : (uint64_t)lidet__ground_q_height(h, x, y, z) <= t;
+}
+
+/* c = ch 2^sh + cl for a vector of |c| <= 2^29 with sh the fewest bits (<= 15) that leave |ch| <= 2^14 (|cl| <=
+ * 2^(sh - 1)): ch . q is then exact in int32 for int16 q and carries as much of c . q as it can (a fixed split at
+ * 2^15 leaves a short vector all in cl). Returns sh. */
+static inline unsigned lidet__ground_q_split(const int32_t c[3], int32_t ch[3], int32_t cl[3])
+{
+    uint32_t mx = 0u;
+    unsigned sh = 0u;
+    int k;
+    for (k = 0; k < 3; ++k)
+    {
+        const uint32_t m = c[k] < 0 ? 0u - (uint32_t)c[k] : (uint32_t)c[k];
+        mx = m > mx ? m : mx;
+    }
+    while (sh < 15u && (mx >> sh) >= (1u << 14))
+    {
+        ++sh;
+    }
+    for (k = 0; k < 3; ++k)
+    {
+        ch[k] = sh == 0u ? c[k] : (int32_t)(((int64_t)c[k] + ((int64_t)1 << (sh - 1u))) >> sh);
+        cl[k] = c[k] - (int32_t)((uint32_t)ch[k] << sh);
+    }
+    return sh;
+}
+
 /* LIDET_GROUND_Q_SQRT_LANES (lidet_opt.h; SIMD hosts or not). The rows of R: 1 = column-wise lanes (each digit
  * step of the square root over the whole row: a compiler vectorises the column loop on SIMD hosts), 0 = pixel by
  * pixel with root and remainder in registers (cores without SIMD: fewer loads and stores). The sample test: 1 =
