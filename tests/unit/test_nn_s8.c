@@ -145,6 +145,19 @@ static void test_split_multiplies_are_exact(void)
             TEST_ASSERT_EQUAL_INT32((int32_t)(((int64_t)a * b) >> 32), lidet__q_smulhi32_split(a, b));
             TEST_ASSERT_TRUE((uint64_t)(uint32_t)a * (uint32_t)b == lidet__q_umul32_split((uint32_t)a, (uint32_t)b));
         }
+    /* the short form on its whole range of a (|a| <= 2^15) against the corners of b and random b */
+    for (k = 0; k <= 65536u; ++k)
+    {
+        const int32_t a = (int32_t)k - 32768;
+        for (j = 0; j < ne; ++j)
+        {
+            TEST_ASSERT_EQUAL_INT32((int32_t)(((int64_t)a * edge[j]) >> 32), lidet__q_smulhi32_short(a, edge[j]));
+        }
+        {
+            const int32_t b = (int32_t)(next() ^ (next() << 16));
+            TEST_ASSERT_EQUAL_INT32((int32_t)(((int64_t)a * b) >> 32), lidet__q_smulhi32_short(a, b));
+        }
+    }
     for (k = 0; k < 200000u; ++k)
     {
         const uint32_t ua = next() ^ (next() << 16), ub = next() ^ (next() << 16);

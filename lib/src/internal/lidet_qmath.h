@@ -132,12 +132,22 @@ static inline int32_t lidet__q_smulhi32_split(int32_t a, int32_t b)
 
 /* floor(a * b / 2^32): one long multiply where LIDET_Q_HAVE_MUL64; elsewhere (ARMv6-M) the split form, about 15
  * instructions where the compiler called its 64 x 64 helper (__muldi3) */
+/* the same where |a| <= 2^15 (the requantization's usual accumulators): from two products, b = bh 2^16 + bl
+ * (bl in [0, 2^16), bh signed): a b = a bh 2^16 + a bl with |a bh| <= 2^30 and |a bl| < 2^31, so
+ * floor(a b / 2^32) = floor((a bh + floor(a bl / 2^16)) / 2^16) in 32 bits (compiled everywhere so that the host
+ * tests check it) */
+static inline int32_t lidet__q_smulhi32_short(int32_t a, int32_t b)
+{
+    return (a * (b >> 16) + ((a * (int32_t)((uint32_t)b & 0xFFFFu)) >> 16)) >> 16;
+}
+
 static inline int32_t lidet__q_smulhi32(int32_t a, int32_t b)
 {
 #if LIDET_Q_HAVE_MUL64
     return (int32_t)(((int64_t)a * b) >> 32);
 #else
-    return lidet__q_smulhi32_split(a, b);
+    /* two products where |a| <= 2^15, four elsewhere */
+    return (uint32_t)a + 0x8000u <= 0x10000u ? lidet__q_smulhi32_short(a, b) : lidet__q_smulhi32_split(a, b);
 #endif
 }
 
