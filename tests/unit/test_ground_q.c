@@ -464,6 +464,57 @@ void test_inlier_band_of_any_hypothesis(void)
     TEST_ASSERT_GREATER_THAN_UINT32(0u, n_sh[15]);
 }
 
+/* The sample test's slope condition without a 32 x 32 -> 64 multiply (lidet__ground_q_shl24_gt, the ARMv6-M images'
+ * form): the exact comparison on random operands of every size (inside and outside its fast path's ranges) and on
+ * operands placed at the threshold, where the 64-bit product decides */
+void test_slope_condition_from_32_bit_products(void)
+{
+    uint32_t s = 99u, k, n_true = 0, n_false = 0;
+    for (k = 0; k < 400000u; ++k)
+    {
+        const uint32_t f = ((lcg(&s) << 8) ^ lcg(&s)) >> (lcg(&s) % 16u);
+        const uint32_t r = ((lcg(&s) << 8) ^ lcg(&s)) >> (lcg(&s) % 16u);
+        uint32_t z = ((lcg(&s) << 8) ^ lcg(&s)) >> (lcg(&s) % 24u);
+        int exact;
+        if (k % 2u == 0u)
+        {
+            /* z at f r / 2^24 within +-2 */
+            const uint64_t q = ((uint64_t)f * r) >> 24;
+            z = (uint32_t)(q > 0xFFFFFFFDu ? 0xFFFFFFFDu : q) + lcg(&s) % 5u;
+            z = z >= 2u ? z - 2u : z;
+        }
+        exact = ((uint64_t)z << 24) > (uint64_t)f * r;
+        TEST_ASSERT_EQUAL_INT(exact, lidet__ground_q_shl24_gt(z, f, r));
+        n_true += (uint32_t)exact;
+        n_false += (uint32_t)!exact;
+    }
+    /* the corners of the fast path's ranges (its window's bound at its largest) */
+    {
+        static const uint32_t fs[] = {0u, 1u, 255u, 256u, (1u << 20) - 1u, 1u << 20, 0xFFFFFFFFu};
+        static const uint32_t rs[] = {0u, 1u, 255u, 256u, (1u << 27) - 1u, 1u << 27, (1u << 28) - 1u, 0xFFFFFFFFu};
+        static const uint32_t zs[] = {0u, 1u, (1u << 24) - 1u, 1u << 24, 0xFFFFFFFFu};
+        uint32_t i, j, m;
+        for (i = 0; i < sizeof fs / sizeof fs[0]; ++i)
+            for (j = 0; j < sizeof rs / sizeof rs[0]; ++j)
+                for (m = 0; m < sizeof zs / sizeof zs[0]; ++m)
+                {
+                    const uint64_t q = ((uint64_t)fs[i] * rs[j]) >> 24;
+                    TEST_ASSERT_EQUAL_INT(((uint64_t)zs[m] << 24) > (uint64_t)fs[i] * rs[j],
+                                          lidet__ground_q_shl24_gt(zs[m], fs[i], rs[j]));
+                    if (q < 0xFFFFFFFFu)
+                    {
+                        const uint32_t z = (uint32_t)q;
+                        TEST_ASSERT_EQUAL_INT(((uint64_t)z << 24) > (uint64_t)fs[i] * rs[j],
+                                              lidet__ground_q_shl24_gt(z, fs[i], rs[j]));
+                        TEST_ASSERT_EQUAL_INT(((uint64_t)(z + 1u) << 24) > (uint64_t)fs[i] * rs[j],
+                                              lidet__ground_q_shl24_gt(z + 1u, fs[i], rs[j]));
+                    }
+                }
+    }
+    TEST_ASSERT_GREATER_THAN_UINT32(100000u, n_true);
+    TEST_ASSERT_GREATER_THAN_UINT32(100000u, n_false);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -476,5 +527,6 @@ int main(void)
     RUN_TEST(test_sample_kernels_agree);
     RUN_TEST(test_band_test_from_the_hi_part);
     RUN_TEST(test_inlier_band_of_any_hypothesis);
+    RUN_TEST(test_slope_condition_from_32_bit_products);
     return UNITY_END();
 }

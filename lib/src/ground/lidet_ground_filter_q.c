@@ -424,7 +424,11 @@ sample_test_plain(const int32_t *R0, const int32_t *R1, const int16_t *Z0, const
     }
     dr = (2 * r0 + r0p) - (2 * r1 + r1p);
     dz = (2 * Z0[c] + Z0[cp1]) - (2 * Z1[c] + Z1[cp1]);
+#if LIDET_Q_HAVE_MUL64
     if (((uint64_t)uabs32(dz) << 24) > lidet__q_umul32(fy, uabs32(dr)))
+#else
+    if (lidet__ground_q_shl24_gt(uabs32(dz), fy, uabs32(dr))) /* the 64-bit product only near the threshold */
+#endif
     {
         return 0;
     }

@@ -117,6 +117,28 @@ static inline unsigned lidet__ground_q_split(const int32_t c[3], int32_t ch[3], 
     return sh;
 }
 
+/* (uint64_t)z << 24 > (uint64_t)f r, exactly (the sample test's slope condition): where z < 2^24, f < 2^20 and
+ * r < 2^27, from f = fh 2^8 + fl and r = rh 2^8 + rl, f r lies in [fh rh 2^16, (fh rh + fh + rh + 1) 2^16) (the
+ * bound below 2^31: no wrap), so one 32-bit product decides unless z 2^8 falls in that window; elsewhere the exact
+ * 64-bit product (the cores without a 32 x 32 -> 64 multiply take this form; compiled everywhere, so that the host
+ * tests check it) */
+static inline int lidet__ground_q_shl24_gt(uint32_t z, uint32_t f, uint32_t r)
+{
+    if (((z >> 24) | (f >> 20) | (r >> 27)) == 0u)
+    {
+        const uint32_t fh = f >> 8, rh = r >> 8, lo = fh * rh, z8 = z << 8;
+        if (z8 >= lo + fh + rh + 1u)
+        {
+            return 1;
+        }
+        if (z8 <= lo)
+        {
+            return 0;
+        }
+    }
+    return ((uint64_t)z << 24) > lidet__q_umul32(f, r);
+}
+
 /* LIDET_GROUND_Q_SQRT_LANES (lidet_opt.h; SIMD hosts or not). The rows of R: 1 = column-wise lanes (each digit
  * step of the square root over the whole row: a compiler vectorises the column loop on SIMD hosts), 0 = pixel by
  * pixel with root and remainder in registers (cores without SIMD: fewer loads and stores). The sample test: 1 =
