@@ -589,11 +589,10 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
 }
 
 /* ---- the band test from the hi part (LIDET_GROUND_Q_BAND32, lidet_ground_q_internal.h) ---- */
-/* floor(v / 2^s) (|v| < 2^62, s <= 15) by shifts of non-negative values only (a 64-bit division is a library call
- * on the cores that take this path) */
+/* floor(v / 2^s): an arithmetic shift, as the stage's other shifts of signed values (GCC and Clang define it so) */
 static int64_t floor_sh(int64_t v, unsigned s)
 {
-    return v >= 0 ? (int64_t)((uint64_t)v >> s) : -(int64_t)(((uint64_t)-v + ((1u << s) - 1u)) >> s);
+    return v >> s;
 }
 
 static int64_t clip32(int64_t v)
