@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "internal/lidet_cluster_q_internal.h"
 #include "lidet/lidet.h"
 #include "test_util.h"
 #include "test_cluster_util.h"
@@ -369,6 +370,72 @@ static void test_proposal(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proposal_q_make(&g.ws.state, 0, &pc, &pr));
 }
 
+/* The join test's gap bound on the cores without a 32 x 32 -> 64 multiply (lidet__cluster_q_gap_ok): the exact
+ * 64-bit comparison on random ranges, angles and gaps (near and far from the bound, gaps above 2^16 too) and on the
+ * corners of its operands */
+static uint32_t gap_lcg(uint32_t *s)
+{
+    *s = *s * 1664525u + 1013904223u;
+    return *s;
+}
+
+static int gap_ref(uint32_t dd, uint32_t gg, uint32_t x, uint32_t h)
+{
+    return (uint64_t)dd * dd + (((uint64_t)x * h + ((uint64_t)1 << 29)) >> 30) <= (uint64_t)gg * gg;
+}
+
+void test_gap_bound_from_32_bit_products(void)
+{
+    static const uint32_t xs[] = {0u, 1u, 65535u, 65536u, 0xFFFE0001u, 0xFFFFFFFFu};
+    static const uint32_t hs[] = {0u, 1u, 13000u, 65535u, 65536u, 1300000u, 0x40000000u, 0xFFFFFFFFu};
+    static const uint32_t gs[] = {0u, 1u, 175u, 65535u, 65536u, 0xFFFFFFFFu};
+    uint32_t s = 2024u, k, i, j, m, n_ok = 0, n_no = 0;
+    for (i = 0; i < sizeof xs / sizeof xs[0]; ++i)
+        for (j = 0; j < sizeof hs / sizeof hs[0]; ++j)
+            for (m = 0; m < sizeof gs / sizeof gs[0]; ++m)
+            {
+                const uint32_t gg = gs[m], dd = gg < 65535u ? gg : 65535u;
+                TEST_ASSERT_EQUAL_INT(gap_ref(dd, gg, xs[i], hs[j]), lidet__cluster_q_gap_ok(dd, gg, xs[i], hs[j]));
+                TEST_ASSERT_EQUAL_INT(gap_ref(0u, gg, xs[i], hs[j]), lidet__cluster_q_gap_ok(0u, gg, xs[i], hs[j]));
+            }
+    for (k = 0; k < 500000u; ++k)
+    {
+        const uint32_t d1 = 1u + gap_lcg(&s) % 65535u, d2 = 1u + gap_lcg(&s) % d1;
+        const uint32_t x = d1 * d2, h = gap_lcg(&s) >> (gap_lcg(&s) % 32u);
+        const uint32_t gg = k % 50u == 0u ? gap_lcg(&s) >> (gap_lcg(&s) % 16u) : 1u + gap_lcg(&s) % 3000u;
+        uint32_t dd = gap_lcg(&s) % (gg < 65535u ? gg + 1u : 65536u);
+        int ref;
+        if (k % 2u == 0u && gg < 65536u)
+        {
+            /* dd near the bound: dd^2 + cross = gg^2 within a few units */
+            const uint64_t cross = ((uint64_t)x * h + ((uint64_t)1 << 29)) >> 30, g2 = (uint64_t)gg * gg;
+            if (cross <= g2)
+            {
+                /* the largest dd with dd^2 <= gg^2 - cross, moved by -1..+1 */
+                const uint64_t r = g2 - cross;
+                uint64_t root = (uint64_t)sqrt((double)r);
+                while (root * root > r)
+                {
+                    --root;
+                }
+                while ((root + 1u) * (root + 1u) <= r)
+                {
+                    ++root;
+                }
+                root = root + (gap_lcg(&s) % 3u);
+                root = root > 0u ? root - 1u : 0u;
+                dd = root > gg ? gg : (uint32_t)root;
+            }
+        }
+        ref = gap_ref(dd, gg, x, h);
+        TEST_ASSERT_EQUAL_INT(ref, lidet__cluster_q_gap_ok(dd, gg, x, h));
+        n_ok += (uint32_t)ref;
+        n_no += (uint32_t)!ref;
+    }
+    TEST_ASSERT_GREATER_THAN_UINT32(50000u, n_ok);
+    TEST_ASSERT_GREATER_THAN_UINT32(50000u, n_no);
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -378,5 +445,6 @@ int main(void)
     RUN_TEST(test_config_and_arguments);
     RUN_TEST(test_integer_limits);
     RUN_TEST(test_proposal);
+    RUN_TEST(test_gap_bound_from_32_bit_products);
     return UNITY_END();
 }

@@ -99,17 +99,17 @@ static inline int link_q(uint32_t da, uint32_t db, uint32_t s, uint32_t h, const
     {
         const uint32_t gg = g->gap + ((d2 * g->gpm + 32768u) >> 16);
         const uint32_t dd = d1 - d2;
-        uint64_t cross;
         if (dd > gg)
         {
             return 0;
         }
+#if LIDET_Q_HAVE_MUL64
         /* ((x >> 29) + 1) >> 1 = (x + 2^29) >> 30, x <= (2^32 - 1)^2 (no overflow): one 64-bit shift */
-        cross = (lidet__q_umul32(d1 * d2, h) + ((uint64_t)1 << 29)) >> 30;
-        /* dd <= 65535: dd^2 fits 32 bits (a 32-bit product where the long one is a call; the long one, as before,
-         * where it is one instruction) */
-        return (LIDET_Q_HAVE_MUL64 ? (uint64_t)dd * dd : (uint64_t)(dd * dd)) + cross <=
+        return (uint64_t)dd * dd + ((lidet__q_umul32(d1 * d2, h) + ((uint64_t)1 << 29)) >> 30) <=
                lidet__q_umul32(gg, gg);
+#else
+        return lidet__cluster_q_gap_ok(dd, gg, d1 * d2, h); /* the 64-bit products only near the bound */
+#endif
     }
     return 1;
 }

@@ -6,6 +6,7 @@
 #define LIDET_CLUSTER_Q_INTERNAL_H
 
 #include "internal/lidet_cluster_common.h"
+#include "internal/lidet_qmath.h"
 #include "lidet/lidet_cluster_q.h"
 
 /* Constants of one run's flood fill (the geometry members named as lidet__grow_t's: the templates read
@@ -22,6 +23,32 @@ typedef struct
     uint32_t bridge_max; /* occluder bridging budget of the run (the shared flood fill reads it) */
     uint32_t *bridged;   /* steps bridged so far in the run */
 } lidet__grow_q_t;
+
+/* The join test's gap bound without a 64-bit product: dd^2 + floor((x h + 2^29) / 2^30) <= gg^2 for dd <= gg
+ * (x = d1 d2 and h the table's 4 sin^2(alpha / 2), Q30, both uint32), exactly. With gg < 2^16, R = gg^2 - dd^2 fits
+ * 32 bits and the bound is x h < (R + 1/2) 2^30; from x = xh 2^16 + xl and h = hh 2^16 + hl, x h lies in
+ * [L 2^32, (L + xh + hh + 1) 2^32) with L = xh hh, so L > R / 4 rejects and L + xh + hh + 1 <= R / 4 accepts (the
+ * second test only reached when L <= R / 4 < 2^30: no wrap); between them, or with gg >= 2^16, the exact 64-bit
+ * test (the form of cores without a 32 x 32 -> 64 multiply, lidet_cluster_grow_q.c; compiled everywhere, so that the
+ * host tests check it) */
+static inline int lidet__cluster_q_gap_ok(uint32_t dd, uint32_t gg, uint32_t x, uint32_t h)
+{
+    if (gg < 65536u)
+    {
+        const uint32_t q = (gg * gg - dd * dd) >> 2, xh = x >> 16, hh = h >> 16, lo = xh * hh;
+        if (lo > q)
+        {
+            return 0;
+        }
+        if (lo + xh + hh + 1u <= q)
+        {
+            return 1;
+        }
+    }
+    /* dd <= 65535 (a range difference): dd^2 in 32 bits */
+    return (uint64_t)(dd * dd) + ((lidet__q_umul32(x, h) + ((uint64_t)1 << 29)) >> 30) <=
+           lidet__q_umul32(gg, gg);
+}
 
 /* Running state of one rescue group. */
 typedef struct
