@@ -370,7 +370,7 @@ static void test_proposal(void)
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_proposal_q_make(&g.ws.state, 0, &pc, &pr));
 }
 
-/* The join test's gap bound of the ARMv6-M and RV32 images (lidet__cluster_q_gap_ok): the exact
+/* The join test's gap bound on the cores without a 32 x 32 -> 64 multiply (lidet__cluster_q_gap_ok): the exact
  * 64-bit comparison on random ranges, angles and gaps (near and far from the bound, gaps above 2^16 too) and on the
  * corners of its operands */
 static uint32_t gap_lcg(uint32_t *s)

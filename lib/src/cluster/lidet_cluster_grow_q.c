@@ -103,14 +103,12 @@ static inline int link_q(uint32_t da, uint32_t db, uint32_t s, uint32_t h, const
         {
             return 0;
         }
-#if LIDET_Q_HAVE_MUL64 && !defined(__riscv)
+#if LIDET_Q_HAVE_MUL64
         /* ((x >> 29) + 1) >> 1 = (x + 2^29) >> 30, x <= (2^32 - 1)^2 (no overflow): one 64-bit shift */
         return (uint64_t)dd * dd + ((lidet__q_umul32(d1 * d2, h) + ((uint64_t)1 << 29)) >> 30) <=
                lidet__q_umul32(gg, gg);
 #else
-        /* ARMv6-M (split products) and RV32 (MUL + MULHU pairs and carries): the 64-bit products only near the
-         * bound (RV32IMAC image: 55 k instructions fewer a scan) */
-        return lidet__cluster_q_gap_ok(dd, gg, d1 * d2, h);
+        return lidet__cluster_q_gap_ok(dd, gg, d1 * d2, h); /* the 64-bit products only near the bound */
 #endif
     }
     return 1;

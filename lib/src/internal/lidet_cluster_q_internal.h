@@ -29,8 +29,8 @@ typedef struct
  * 32 bits and the bound is x h < (R + 1/2) 2^30; from x = xh 2^16 + xl and h = hh 2^16 + hl, x h lies in
  * [L 2^32, (L + xh + hh + 1) 2^32) with L = xh hh, so L > R / 4 rejects and L + xh + hh + 1 <= R / 4 accepts (the
  * second test only reached when L <= R / 4 < 2^30: no wrap); between them, or with gg >= 2^16, the exact 64-bit
- * test (the form of ARMv6-M and RV32, lidet_cluster_grow_q.c; compiled everywhere, so that the host tests check
- * it) */
+ * test (the form of cores without a 32 x 32 -> 64 multiply, lidet_cluster_grow_q.c; compiled everywhere, so that the
+ * host tests check it) */
 static inline int lidet__cluster_q_gap_ok(uint32_t dd, uint32_t gg, uint32_t x, uint32_t h)
 {
     if (gg < 65536u)
