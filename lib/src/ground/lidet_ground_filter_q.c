@@ -589,12 +589,6 @@ static void gather_samples(lidet_ground_q_state_t *g, lidet_ground_q_scratch_t *
 }
 
 /* ---- the band test from the hi part (LIDET_GROUND_Q_BAND32, lidet_ground_q_internal.h) ---- */
-/* floor(v / 2^s): an arithmetic shift, as the stage's other shifts of signed values (GCC and Clang define it so) */
-static int64_t floor_sh(int64_t v, unsigned s)
-{
-    return v >> s;
-}
-
 static int64_t clip32(int64_t v)
 {
     return v < INT32_MIN ? INT32_MIN : (v > INT32_MAX ? INT32_MAX : v);
@@ -603,14 +597,13 @@ static int64_t clip32(int64_t v)
 /* lidet_ground_q_internal.h */
 void lidet__ground_q_band(const int32_t lo[3], int64_t d, uint64_t t, unsigned sh, lidet__ground_q_band_t *b)
 {
-    const int64_t bmax = ((int64_t)(lo[0] < 0 ? -lo[0] : lo[0]) + (lo[1] < 0 ? -lo[1] : lo[1]) +
-                          (lo[2] < 0 ? -lo[2] : lo[2])) *
-                         32768;
+    const int64_t bmax = ((int64_t)uabs32(lo[0]) + uabs32(lo[1]) + uabs32(lo[2])) * 32768;
     const int64_t tt = (int64_t)t;
-    /* possibly in: a 2^sh + D + B >= 0 and a 2^sh + D - B <= t */
-    const int64_t plo = -floor_sh(d + bmax, sh), phi = floor_sh(tt - d + bmax, sh);
+    /* floors of quotients by 2^sh as arithmetic shifts, as the stage's other shifts of signed values;
+     * possibly in: a 2^sh + D + B >= 0 and a 2^sh + D - B <= t */
+    const int64_t plo = -((d + bmax) >> sh), phi = (tt - d + bmax) >> sh;
     /* surely in: a 2^sh + D - B >= 0 and a 2^sh + D + B <= t */
-    const int64_t ilo = -floor_sh(d - bmax, sh), ihi = floor_sh(tt - d - bmax, sh);
+    const int64_t ilo = -((d - bmax) >> sh), ihi = (tt - d - bmax) >> sh;
     const int64_t pl = clip32(plo), ph = clip32(phi);
     const int64_t il = clip32(ilo), ih = clip32(ihi);
     if (pl > ph || plo > INT32_MAX || phi < INT32_MIN)

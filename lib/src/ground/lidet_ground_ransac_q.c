@@ -609,16 +609,10 @@ static uint32_t count_inliers(const lidet_ground_q_scratch_t *sc, const cell_src
         const unsigned sh = lidet__ground_q_split(cc, ch, cl);
         lidet__ground_q_band(cl, h0, t2, sh, &bd);
 #elif !LIDET_Q_HAVE_MUL64
-        int32_t ch[3], cl[3]; /* c split as lidet__ground_q_hplane splits a normal (|c| <= 2^29) */
-        {
-            const int32_t cc[3] = {c0, c1, c2};
-            int k;
-            for (k = 0; k < 3; ++k)
-            {
-                ch[k] = (int32_t)(((int64_t)cc[k] + (1 << 14)) >> 15);
-                cl[k] = cc[k] - (int32_t)((uint32_t)ch[k] << 15);
-            }
-        }
+        /* c split into two sums of three 32-bit products (lidet__ground_q_split) */
+        int32_t ch[3], cl[3];
+        const int32_t cc[3] = {c0, c1, c2};
+        const unsigned sh = lidet__ground_q_split(cc, ch, cl);
 #endif
         /* in blocks of 32 samples; a hypothesis that can no longer beat the best count stops */
         for (i = 0; i < n_eval && (!have || cnt + (n_eval - i) > best_cnt);)
@@ -646,10 +640,10 @@ static uint32_t count_inliers(const lidet_ground_q_scratch_t *sc, const cell_src
                 const int64_t ht =
                     h0 + (int64_t)c0 * sc->ev_x[i] + (int64_t)c1 * sc->ev_y[i] + (int64_t)c2 * sc->ev_z[i];
 #else
-                /* c = hi 2^15 + lo (|hi|, |lo| <= 2^14) against int16 samples: two sums of three 32-bit products
+                /* c = ch 2^sh + cl (|ch|, |cl| <= 2^14) against int16 samples: two sums of three 32-bit products
                  * (each < 2^29), the same exact value without the 64 x 64 multiply helper */
                 const int32_t x = sc->ev_x[i], y = sc->ev_y[i], z = sc->ev_z[i];
-                const int64_t ht = h0 + (int64_t)(ch[0] * x + ch[1] * y + ch[2] * z) * 32768 +
+                const int64_t ht = h0 + (int64_t)(ch[0] * x + ch[1] * y + ch[2] * z) * ((int64_t)1 << sh) +
                                    (cl[0] * x + cl[1] * y + cl[2] * z);
 #endif
 #if defined(__GNUC__) && defined(__thumb2__) && !defined(__ARM_BIG_ENDIAN)
