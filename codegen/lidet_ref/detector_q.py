@@ -82,12 +82,12 @@ def detect(points_mm, tab, proj_cfg: dict, ground_cfg: dict, cluster_cfg: dict, 
     lidet_detector_q_cfg_t.stream_sectors sets), gate2_class (3 flags, lidet_class_t order: the classes gate 2 judges;
     GATE2_CLASS when absent, the C default), group_split (0 when absent; the C default is 1 for > 16 rows) and
     group_max_range_mm (40000 when absent), min_score_q15 (3, the operating point; 0s when absent: off; the C
-    default is 19661 for cars with > 16 rows), gate1_class_margin_q16 (3, added to gate1_margin_q16 per class; 0s
+    default is 19661 for cars), gate1_class_margin_q16 (3, added to gate1_margin_q16 per class; 0s
     when absent, the C default), group_gate1_margin_q16 (added to gate 1 when the group split judges a cut; 0 when
     absent: every part must pass; the C default is 2 * 65536), gate1_large_car_margin_q16 (added to gate 1 for a
     car whose cluster holds >= FLAT_MIN_POINTS members; 0 when absent), car_min_z_spread_mm (the cars'
     flat-surface test; 0 when absent: off; the C default is 600) and car_ground_mm (car boxes down to the ground
-    around them, `ground_box`; 0 when absent: off; the C default is 1000 for > 16 rows). range_only: the image keeps only the range, every stage reads x, y, z
+    around them, `ground_box`; 0 when absent: off; the C default is 1000). range_only: the image keeps only the range, every stage reads x, y, z
     decoded from row, column and range (qmath.decode_pixels; lidet_detector_q_cfg_t range_only). Returns detections
     (dicts), outcomes, stats. returns: (range_mm, azimuth, ring) instead of points_mm (lidet_detector_q_run_returns:
     proj_q.project_returns)."""

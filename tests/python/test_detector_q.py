@@ -188,11 +188,11 @@ def _ref_detect(nq, pts_mm, sensor, max_boxes=0, margins=(0, 0), range_only=Fals
                    gate1_margin_q16=margins[0], gate2_margin_q16=margins[1],
                    group_split=int(s.rows > 16 if group_split is None else group_split), group_max_range_mm=40000,
                    group_gate1_margin_q16=2 * 65536 if group_gate1_margin_q16 is None else group_gate1_margin_q16,
-                   min_score_q15=min_score_q15 or ([19661, 0, 0] if s.rows > 16 else [0, 0, 0]),
+                   min_score_q15=min_score_q15 or [19661, 0, 0],
                    car_min_z_spread_mm=(600 if s.rows > 16 else 0) if car_min_z_spread_mm is None else
                    car_min_z_spread_mm,
                    gate1_class_margin_q16=gate1_class_margin_q16 or [0, 0, 0],
-                   car_ground_mm=(1000 if s.rows > 16 else 0) if car_ground_mm is None else car_ground_mm,
+                   car_ground_mm=1000 if car_ground_mm is None else car_ground_mm,
                    gate1_large_car_margin_q16=(LARGE_CAR_Q16 if s.rows > 16 else 0) if gate1_large_car_margin_q16 is None
                    else gate1_large_car_margin_q16)
     if gate2_class is not None:

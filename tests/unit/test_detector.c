@@ -713,7 +713,8 @@ void test_init_errors(void)
     c.car_ground_m = 10.5f;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_init(&g.ws, &c, &m_cls, &m_box));
     {
-        /* the group split, the operating point and the flat-surface test: on for > 16 beams, off for <= 16 */
+        /* the group split, the large cars' gate and the flat-surface test: on for > 16 beams, off for <= 16; the
+         * operating point and the car boxes' ground: the same for every sensor */
         lidet_detector_cfg_t d0;
         lidet_detector_cfg_default(&d0, lidet_sensor_find("hdl64"));
         TEST_ASSERT_EQUAL_UINT8(1, d0.group_split);
@@ -733,9 +734,10 @@ void test_init_errors(void)
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_large_car_margin);
         TEST_ASSERT_EQUAL_UINT8(0, d0.group_split);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.gate1_class_margin[LIDET_CLASS_PEDESTRIAN]);
-        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_CAR]);
+        TEST_ASSERT_EQUAL_FLOAT(0.6f, d0.min_score[LIDET_CLASS_CAR]);
+        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.min_score[LIDET_CLASS_PEDESTRIAN]);
         TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.car_min_z_spread_m);
-        TEST_ASSERT_EQUAL_FLOAT(0.0f, d0.car_ground_m);
+        TEST_ASSERT_EQUAL_FLOAT(1.0f, d0.car_ground_m);
     }
     c = cfg;
     c.size_min_m[1][2] = 5.0f;

@@ -147,10 +147,11 @@ static void test_init_errors(void)
     lidet_detector_q_cfg_default(&cfg, lidet_sensor_q_find("vlp16"));
     TEST_ASSERT_EQUAL_UINT8(0, cfg.group_split);
     TEST_ASSERT_EQUAL_INT32(0, cfg.gate1_class_margin_q16[LIDET_CLASS_PEDESTRIAN]);
-    TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_CAR]);
+    TEST_ASSERT_EQUAL_INT32(19661, cfg.min_score_q15[LIDET_CLASS_CAR]); /* the same for every sensor */
     TEST_ASSERT_EQUAL_INT32(0, cfg.min_score_q15[LIDET_CLASS_PEDESTRIAN]);
     TEST_ASSERT_EQUAL_INT32(0, cfg.car_min_z_spread_mm);
-    TEST_ASSERT_EQUAL_INT32(0, cfg.car_ground_mm);
+    TEST_ASSERT_EQUAL_INT32(LIDET_Q_PIXEL_XYZ ? 1000 : 0, cfg.car_ground_mm);
+    TEST_ASSERT_EQUAL_INT32(0, cfg.gate1_large_car_margin_q16);
     lidet_detector_q_cfg_default(&cfg, sensor);
     cfg.max_proposals = 0;
     TEST_ASSERT_EQUAL_INT(LIDET_ERR_CONFIG, lidet_detector_q_init(&g.ws, &cfg, m_cls, m_box));

@@ -46,19 +46,14 @@ SCORE_BOX_WEIGHT = (0.5, 0.0, 0.0)
 SCORE_POINTS_WEIGHT = (0.1, 0.0, 0.0)  # score_points_weight (_q16 = round(v 2^16))
 #: the classes gate 2 judges (car, cyclist, pedestrian): gate2_class of both detectors' defaults
 GATE2_CLASS = RD.GATE2_CLASS
-#: the operating point (car, cyclist, pedestrian): min_score of lidet_detector_cfg_default for > 16 beams (0 for
-#: <= 16), and min_score_q15 = round(v 2^15) of lidet_detector_q_cfg_default
+#: the operating point (car, cyclist, pedestrian): min_score of lidet_detector_cfg_default, and min_score_q15 =
+#: round(v 2^15) of lidet_detector_q_cfg_default
 MIN_SCORE = (0.6, 0.0, 0.0)
 
 
 def min_score(fam: str) -> tuple:
-    """The detectors' default operating point for a family's sensor (the family named after its preset)."""
-    from lidet_tools import sensors
-    try:
-        rows = sensors.get_sensor(fam).rows
-    except (KeyError, ValueError):
-        rows = 64
-    return MIN_SCORE if rows > 16 else (0.0, 0.0, 0.0)
+    """The detectors' default operating point (the same for every sensor)."""
+    return MIN_SCORE
 
 
 def nets_float(fam, xyz, mean, vox, cid, max_boxes, npts):

@@ -80,14 +80,14 @@ typedef struct
                                            (lidet_class_t order; nats, [-20, 20]); default 0: the models'
                                            thresholds. E.g. 1 for pedestrians keeps more real people that the
                                            networks trained on simulated ones find out of distribution, and
-                                           more clutter (measured: docs/DETECTOR.md, "Operating points") */
+                                           more clutter (measured: docs/DETECTOR.md, "Gates") */
     float
         gate1_large_car_margin; /**< added to gate 1's threshold for a proposal the classifier calls a car whose
                                        cluster holds at least LIDET_DET_FLAT_MIN_POINTS member pixels (nats, [0,
                                        20]): real cars that the networks trained on simulated ones find a little out
                                        of distribution are mostly large clusters, the clutter a wider car gate lets
                                        through mostly small ones. Default 1 for > 16 beams, 0 for <= 16
-                                       (measured: docs/DETECTOR.md, "Operating points") */
+                                       (measured: docs/DETECTOR.md, "Gates") */
     uint8_t gate2_class[LIDET_N_CLASSES]; /**< 1: gate 2 judges this class (lidet_class_t order), 0: its boxes
                                                pass gate 2 whatever the box net's energy (the energy is still
                                                reported). Default car 1, cyclist 1, pedestrian 0: a pedestrian's
@@ -115,8 +115,7 @@ typedef struct
         [LIDET_N_CLASSES]; /**< the operating point: a detection scoring below its class's value (lidet_class_t
                                            order) is dropped, outcome LIDET_DET_OUT_SCORE (stats n_score_rejected);
                                            a group split's part likewise. [0, 1]; 0 keeps every detection that
-                                           passed the gates. Default car 0.6 for > 16 beams, 0 for <= 16;
-                                           cyclist and pedestrian 0 (measured on the real frames and the
+                                           passed the gates. Default car 0.6, cyclist and pedestrian 0 (measured on the real frames and the
                                            simulated presets: docs/DETECTOR.md, "Operating point") */
     float
         car_min_z_spread_m; /**< a car whose cluster holds at least LIDET_DET_FLAT_MIN_POINTS member pixels and
@@ -129,8 +128,7 @@ typedef struct
                              height of the ground pixels whose point lies within this of the box's footprint and
                              within 1 m of its bottom (at least 5; lidet_detector_common.h LIDET_DET_GROUND_*), when
                              the bottom lies 0-0.5 m above it (the ground stage takes a car's lowest returns for
-                             road). [0, 10]; 0 turns it off; default 1 for > 16 beams, 0 for <= 16
-                             (docs/DETECTOR.md, "Car boxes down to the ground") */
+                             road). [0, 10]; 0 turns it off; default 1 (docs/DETECTOR.md, "Car boxes down to the ground") */
     float score_box_weight
         [LIDET_N_CLASSES]; /**< the detection score is 1 / (1 + e^-(m1 + w m2)), m1 = gamma1 - E1
                                                   and m2 = gamma2 - E2 the two gates' margins (the models' gammas),

@@ -128,14 +128,13 @@ typedef struct
     int32_t min_score_q15
         [LIDET_N_CLASSES];       /**< the float detector's min_score in Q15 (a detection whose score_q15
                                                  is below is dropped, outcome LIDET_DET_OUT_SCORE); [0, 32768];
-                                                 default car 19661 (0.6) for > 16 rows, 0 for <= 16; cyclist and
-                                                 pedestrian 0 */
+                                                 default car 19661 (0.6), cyclist and pedestrian 0 */
     int32_t car_min_z_spread_mm; /**< the float detector's car_min_z_spread_m in mm (the test in 4 mm steps:
                                       12 sum dz^2 < (this / 4)^2 n); [0, 10000]; 0: off; default 600 for > 16 rows, 0 for
                                       <= 16 */
     int32_t car_ground_mm; /**< the float detector's car_ground_m in mm (the footprint test and the ground's
                                 median in integer steps: lidet_detector_common.h LIDET_DET_GROUND_*); [0, 10000];
-                                0: off; default 1000 for > 16 rows, 0 for <= 16. It reads the ground mask after the
+                                0: off; default 1000. It reads the ground mask after the
                                 networks, which a build with LIDET_Q_PIXEL_XYZ 0 does not keep: there it must be 0
                                 (the default; LIDET_ERR_CONFIG otherwise) */
     int32_t

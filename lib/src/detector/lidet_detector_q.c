@@ -57,12 +57,12 @@ void lidet_detector_q_cfg_default(lidet_detector_q_cfg_t *cfg, const lidet_senso
     cfg->group_max_range_mm = 40000;
     cfg->group_gate1_margin_q16 = 2 * 65536; /* the float detector's */
     /* the float detector's operating point and flat-surface test: 0.6 in Q15 = round(0.6 * 32768) */
-    cfg->min_score_q15[LIDET_CLASS_CAR] = rows <= 16u ? 0 : 19661;
+    cfg->min_score_q15[LIDET_CLASS_CAR] = 19661;
     cfg->min_score_q15[LIDET_CLASS_CYCLIST] = 0;
     cfg->min_score_q15[LIDET_CLASS_PEDESTRIAN] = 0;
     cfg->car_min_z_spread_mm = rows <= 16u ? 0 : 600;
-    cfg->car_ground_mm = rows <= 16u || !LIDET_Q_PIXEL_XYZ ? 0 : 1000; /* the float detector's car_ground_m */
-    cfg->score_box_weight_q16[LIDET_CLASS_CAR] = 32768;                /* the float detector's 0.5 */
+    cfg->car_ground_mm = !LIDET_Q_PIXEL_XYZ ? 0 : 1000; /* the float detector's car_ground_m */
+    cfg->score_box_weight_q16[LIDET_CLASS_CAR] = 32768; /* the float detector's 0.5 */
     cfg->score_box_weight_q16[LIDET_CLASS_CYCLIST] = 0;
     cfg->score_box_weight_q16[LIDET_CLASS_PEDESTRIAN] = 0;
     cfg->score_points_weight_q16[LIDET_CLASS_CAR] = 6554; /* the float detector's 0.1 */
