@@ -154,6 +154,11 @@ int cli_png_range(const char *v);
  * for a scene w pixels wide */
 extern float cli_png_half_m;
 #define CLI_PNG_RES(w) (cli_png_half_m / (0.5f * (float)(w)))
+/* A point cloud that does not look like sensor s's scan, from its projection's counts (ps): more than a tenth of
+ * the points outside the beams' elevations (a cloud upside down, in a camera's frame, or from another sensor), or
+ * more than a quarter beyond the range the image keeps (coordinates in millimetres or centimetres). Prints a
+ * warning per cause to stderr, headed `who` (with what `scan` names, if not NULL); returns how many it printed */
+int cli_warn_frame(const char *who, const char *scan, const lidet_proj_stats_t *ps, const lidet_sensor_t *s);
 /* a's defaults (sensor hdl64, repeat 1, the profile's mount height) */
 void cli_args_default(cli_args_t *a);
 /* the shared sets over a into sets[]: the sensor and the Velodyne calibration, and with io also cli_opts_io;

@@ -353,6 +353,7 @@ int cli_cluster(int argc, char **argv)
         ms_gnd = cli_median(t_gnd, a.repeat);
     free(t_proj);
     cs = lidet_cluster_stats(&g_cl);
+    (void)cli_warn_frame("lidet cluster", NULL, lidet_proj_stats(&g_proj), a.sensor_profile);
     pp = lidet_proj_point_pixels(&g_proj, &n_pp);
     lidet_cluster_point_labels(&g_cl, pp, n_pp, ids);
     for (p = n_pp; p < a.n_points; ++p)

@@ -141,6 +141,53 @@ int cli_png_range(const char *v)
     return 0;
 }
 
+/* The real labelled frames of ../shared/data/real put at most 0.5 % of their points outside their presets' beams
+ * (KITTI, KITTI-360, SemanticKITTI 0 %, PandaSet 0.1-0.4 %, Argoverse 0.5 %); a KITTI scan turned upside down (y
+ * and z negated) puts 48 % there, half of its points then lying above an HDL-64's top beam
+ * (tests/python/test_cli_detect.py, docs/ROBUSTNESS.md "A cloud in another frame") */
+int cli_warn_frame(const char *who, const char *scan, const lidet_proj_stats_t *ps, const lidet_sensor_t *s)
+{
+    const uint32_t n = ps->n_points_in;
+    const double pct = n > 0u ? 100.0 / (double)n : 0.0;
+    int k = 0;
+    if (n < 100u)
+        return 0; /* too few points to judge a frame by */
+    if (ps->n_out_of_fov > n / 10u)
+    {
+        double lo = 90.0, hi = -90.0;
+        uint32_t r;
+        for (r = 0; r < s->n_rows; ++r)
+        {
+            const double e = s->beam_elev_rad != NULL ? (double)s->beam_elev_rad[r] * (180.0 / 3.14159265358979)
+                                                      : 0.0;
+            lo = e < lo ? e : lo;
+            hi = e > hi ? e : hi;
+        }
+        if (s->beam_elev_rad == NULL)
+        {
+            lo = (double)s->fov_down_rad * (180.0 / 3.14159265358979);
+            hi = (double)s->fov_up_rad * (180.0 / 3.14159265358979);
+        }
+        fprintf(stderr,
+                "%s: warning: %s%s%u of %u points (%.0f %%) lie outside the %s's beams (%.1f to %.1f degrees): "
+                "lidet reads x forward, y left, z up, in metres; a cloud upside down, in a camera's frame or "
+                "from another sensor looks like this (--sensor NAME, --sensor-file F)\n",
+                who, scan != NULL ? scan : "", scan != NULL ? ": " : "", (unsigned)ps->n_out_of_fov, (unsigned)n,
+                (double)ps->n_out_of_fov * pct, s->name != NULL ? s->name : "sensor", lo, hi);
+        ++k;
+    }
+    if (ps->n_too_far > n / 4u)
+    {
+        fprintf(stderr,
+                "%s: warning: %s%s%u of %u points (%.0f %%) lie beyond the range the image keeps: are the "
+                "coordinates in metres?\n",
+                who, scan != NULL ? scan : "", scan != NULL ? ": " : "", (unsigned)ps->n_too_far, (unsigned)n,
+                (double)ps->n_too_far * pct);
+        ++k;
+    }
+    return k;
+}
+
 void cli_args_default(cli_args_t *a)
 {
     memset(a, 0, sizeof *a);

@@ -1335,6 +1335,7 @@ outputs:
         }
         free(gt);
     }
+    (void)cli_warn_frame("lidet detect", NULL, &ds->stages.proj, a.sensor_profile);
     {
         /* a mount height far from the real one makes the ground stage refuse most sectors' planes (their
          * height is checked against it) and fall back to planes at the wrong height: the ground is then

@@ -264,6 +264,7 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     ds->n_score_rejected = st->n_score_rejected;
     ds->n_detections = st->n_detections;
     ds->stages.ground = st->ground; /* the same counts (lidet detect's mount-height warning reads them) */
+    ds->stages.proj = st->proj;     /* and its frame check (cli_warn_frame) */
     dq = lidet_detector_q_detections(&g_detq, n_det);
     for (k = 0; k < *n_det; ++k)
     {

@@ -216,6 +216,7 @@ int cli_ground(int argc, char **argv)
     for (i = 0; i < a.n_points; ++i)
         n_ground_points += label[i];
     gs = lidet_ground_stats(&g_ground);
+    (void)cli_warn_frame("lidet ground", NULL, lidet_proj_stats(&g_proj), a.sensor_profile);
 
     if (a.out_path != NULL)
     {

@@ -97,6 +97,7 @@ int cli_project(int argc, char **argv)
     ms = cli_median(times, a.repeat);
     free(times);
     s = lidet_proj_stats(&g_proj);
+    (void)cli_warn_frame("lidet project", NULL, s, a.sensor_profile);
 
     if (a.out_path != NULL)
     {

@@ -970,7 +970,7 @@ int cli_track(int argc, char **argv)
     const char *ego_path, *dt_path, *out_dir, *png_path, *calib_path;
     double rate;
     double *t_dt = NULL;
-    int npos = 0, i, json, rate_given, ego_none, rc = 1, warned_mount = 0, warned_trunc = 0;
+    int npos = 0, i, json, rate_given, ego_none, rc = 1, warned_mount = 0, warned_trunc = 0, warned_frame = 0;
     uint32_t flags, k, cap = 0, n_tr = 0;
     int32_t *pp = NULL;
     uint8_t *gp = NULL;
@@ -1393,6 +1393,8 @@ int cli_track(int argc, char **argv)
                     (unsigned)LIDET_TRACK_MAX_TRACKS);
             warned_trunc = 1;
         }
+        if (!warned_frame)
+            warned_frame = cli_warn_frame("lidet track", q.scans[k], &ds->stages.proj, a.sensor_profile) > 0;
         if (!warned_mount &&
             2u * (uint32_t)ds->stages.ground.n_sectors_rejected > cfg.stages.ground.n_sectors)
         {

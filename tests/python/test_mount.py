@@ -63,3 +63,24 @@ def test_warns_when_the_planes_lie_at_the_sensors_height(tmp_path, need_lib):
         r = subprocess.run([sys.executable, "-m", "lidet_tools.mount", str(f), "--sensor", "vlp16"],
                            capture_output=True, text=True)
         assert r.returncode == 0 and ("lidet detect --mount-height" in r.stdout) != warned
+
+
+def test_warns_when_the_cloud_is_not_in_lidets_frame(tmp_path, need_lib):
+    """A scan turned upside down (y and z negated: the ground above the sensor) leaves many of its points outside
+    the sensor's beams; the tool says so, on stderr and in the JSON, and gives no --mount-height advice. The scan
+    as simulated puts none there."""
+    p = simulate_scan("hdl64", seed=8100, index=0).points.astype(np.float32)
+    q = p.copy()
+    q[:, 1:3] *= -1.0
+    assert mount.out_of_beams(p, "hdl64") == 0.0 and mount.out_of_beams(q, "hdl64") > mount.OUT_OF_BEAMS_SHARE
+    for pts, warned in ((p, False), (q, True)):
+        f = tmp_path / f"s{int(warned)}.bin"
+        pts.tofile(f)
+        r = subprocess.run([sys.executable, "-m", "lidet_tools.mount", str(f), "--sensor", "hdl64", "--json"],
+                           capture_output=True, text=True)
+        assert r.returncode == 0, r.stderr
+        w = json.loads(r.stdout)["warning"]
+        assert (w is not None and "x forward, y left, z up" in w and "outside the hdl64's beams" in w) == warned
+        r = subprocess.run([sys.executable, "-m", "lidet_tools.mount", str(f), "--sensor", "hdl64"],
+                           capture_output=True, text=True)
+        assert r.returncode == 0 and ("lidet detect --mount-height" in r.stdout) != warned

@@ -34,6 +34,19 @@ OPEN_HEIGHT_DEV_M = 10.0
 LOW_MOUNT_M = 0.1
 
 
+#: more than this share of a scan's points outside the sensor's beams (the projection's n_out_of_fov) says the cloud
+#: is not in lidet's frame or not from that sensor: the real labelled frames of ../shared/data/real put at most 0.5 %
+#: there, a KITTI scan turned upside down 48 % (the CLI's commands warn at the same share: cli_warn_frame)
+OUT_OF_BEAMS_SHARE = 0.1
+
+
+def out_of_beams(points, sensor: str = "hdl64") -> float:
+    """The share of (N, >=3) points that the sensor's projection drops as outside its beams' elevations."""
+    from . import native
+    n = len(points)
+    return float(native.project(points, sensor).stats["n_out_of_fov"]) / n if n else 0.0
+
+
 def estimate(points, sensor: str = "hdl64") -> tuple[float, int]:
     """(height in m, fitted sectors it comes from) for one scan of (N, >=3) points; (nan, 0) when no sector got a
     plane of its own (an empty or tiny scan)."""
@@ -74,6 +87,7 @@ def main(argv=None) -> int:
         print("lidet_tools.mount: error: no scans", file=sys.stderr)
         return 1
     per = []
+    frame_warning = None
     for f in files:
         try:
             pts = kitti.read_bin(f)
@@ -82,6 +96,12 @@ def main(argv=None) -> int:
             return 1
         h, n = estimate(pts, a.sensor)
         per.append((str(f), h, n))
+        share = out_of_beams(pts, a.sensor)
+        if share > OUT_OF_BEAMS_SHARE and frame_warning is None:
+            frame_warning = (f"{f}: {100 * share:.0f} % of the points lie outside the {a.sensor}'s beams: lidet reads "
+                             f"x forward, y left, z up, in metres; a cloud upside down, in a camera's frame or from "
+                             f"another sensor looks like this, and its estimate means nothing")
+            print(f"lidet_tools.mount: warning: {frame_warning}", file=sys.stderr)
     hs = np.array([h for _, h, _ in per])
     ok = np.isfinite(hs)
     if not ok.any():
@@ -90,8 +110,8 @@ def main(argv=None) -> int:
         return 1
     med = float(np.median(hs[ok]))
     profile = presets[a.sensor][3]
-    warning = None
-    if med < LOW_MOUNT_M:
+    warning = frame_warning
+    if warning is None and med < LOW_MOUNT_M:
         warning = (f"the fitted planes lie within {LOW_MOUNT_M:g} m of the sensor's own height ({med:.2f} m): is the "
                    f"sensor standing on the surface it sees (a table), or is the floor out of view? Record scans on "
                    f"open, level ground, or give the height you measured")
