@@ -110,7 +110,7 @@ def test_batch_script_writes_a_prediction_folder(cli, tmp_path):
     r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(kd), "--out", str(tmp_path / "pred"),
                         "--set", "gate1=0"], capture_output=True, text=True,
                        env={**__import__("os").environ, "LIDET_BUILD_DIR": str(pathlib.Path(cli).parents[2])})
-    assert r.returncode == 0, r.stderr
+    assert r.returncode == 0 and "scans warned" not in r.stderr, r.stderr
     assert (tmp_path / "pred" / "label_2" / "000000.txt").exists()
     assert (tmp_path / "pred" / "boxes" / "000000.txt").exists()
     t = json.loads((tmp_path / "pred" / "timing.json").read_text())
@@ -118,6 +118,27 @@ def test_batch_script_writes_a_prediction_folder(cli, tmp_path):
     r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(tmp_path / "nothing"), "--out",
                         str(tmp_path / "p2")], capture_output=True, text=True)
     assert r.returncode == 1 and "no scans" in r.stderr
+
+
+def test_batch_script_passes_the_warnings_on(cli, tmp_path):
+    """The batch script captures each scan's `lidet detect`; the warnings come through, one line per kind with how
+    many scans drew it: two of three scans upside down (the frame, and the ground refused under them)."""
+    kd = tmp_path / "kitti" / "velodyne"
+    kd.mkdir(parents=True)
+    p = np.fromfile(SCAN, np.float32).reshape(-1, 4)
+    q = p.copy()
+    q[:, 1:3] *= -1.0
+    for k, a in enumerate((q, p, q)):
+        a.tofile(kd / f"{k:06d}.bin")
+    env = {**__import__("os").environ, "LIDET_BUILD_DIR": str(pathlib.Path(cli).parents[2])}
+    r = subprocess.run([sys.executable, "-m", "lidet_tools.detect", str(kd.parent), "--out", str(tmp_path / "pred")],
+                       capture_output=True, text=True, env=env)
+    assert r.returncode == 0, r.stderr
+    lines = [x for x in r.stderr.splitlines() if "scans warned" in x]
+    assert any(x.startswith("lidet_tools.detect: 2 of 3 scans warned, the first (000000)") and
+               "outside the hdl64's beams" in x for x in lines), r.stderr
+    assert any("2 of 3 scans warned" in x and "is the mount height right?" in x for x in lines), r.stderr
+    assert len(lines) == 2, lines
 
 
 def test_set_refuses_nan_and_inf(cli):

@@ -16,6 +16,7 @@ import concurrent.futures as cf
 import json
 import os
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -46,7 +47,9 @@ def detect_frame(exe, bin_path, out_dir, calib=None, sensor="hdl64", crop=False,
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)}\n{r.stderr.strip()}")
-    return json.loads(r.stdout)
+    js = json.loads(r.stdout)
+    js["warnings"] = [w for w in r.stderr.splitlines() if ": warning: " in w]
+    return js
 
 
 def run_folder(kitti_dir, out_dir, sensor="hdl64", crop=False, model=None, jobs=1, extra=(), progress=True,
@@ -74,7 +77,7 @@ def run_folder(kitti_dir, out_dir, sensor="hdl64", crop=False, model=None, jobs=
             more += ["--ring", str(rp)]
         return p.stem, detect_frame(exe, p, out_dir, calib, sensor, crop, model, more)
 
-    results = []
+    results, warned = [], []
     it = scans
     try:
         from tqdm import tqdm
@@ -83,14 +86,28 @@ def run_folder(kitti_dir, out_dir, sensor="hdl64", crop=False, model=None, jobs=
         bar = None
     with cf.ThreadPoolExecutor(max_workers=max(1, jobs)) as ex:
         for fid, js in ex.map(one, it):
-            results.append(dict(frame=fid, **{k: v for k, v in js.items() if k != "boxes"},
+            results.append(dict(frame=fid, **{k: v for k, v in js.items() if k not in ("boxes", "warnings")},
                                 n_boxes=len(js.get("boxes", []))))
+            warned.extend((fid, w) for w in js.get("warnings", []))
             if bar is not None:
                 bar.update(1)
     if bar is not None:
         bar.close()
     (out_dir / "timing.json").write_text(json.dumps(results, indent=1))
+    _summarise_warnings(warned, len(scans))
     return results
+
+
+def _summarise_warnings(warned: list, n_scans: int) -> None:
+    """The CLI's warnings (a cloud in another frame, a mount height the ground refuses), once per kind with how many
+    scans drew it, on stderr: the per-scan runs capture the CLI's stderr."""
+    kinds: dict = {}
+    for fid, w in warned:
+        key = re.sub(r"[-+]?\d[\d.]*", "#", w)  # the same warning with other counts
+        kinds.setdefault(key, []).append((fid, w))
+    for hits in kinds.values():
+        fid, w = hits[0]
+        print(f"lidet_tools.detect: {len(hits)} of {n_scans} scans warned, the first ({fid}): {w}", file=sys.stderr)
 
 
 def main(argv=None) -> int:
