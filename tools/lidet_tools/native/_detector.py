@@ -115,7 +115,7 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
     gate1_class_margin: 3 margins in nats in [-20, 20] (Car, Cyclist, Pedestrian) added to gate1_margin for a
     proposal of that class (None: the C default, 0 for every class). car_ground_m: car boxes stretched down to the
     ground pixels within this of their footprint (lidet_detector_cfg_t.car_ground_m; 0 turns it off; None: the C
-    default, 1 m for > 16 beams). group_gate1_margin: nats added to gate 1 when the group split judges a cut, in
+    default, 1 m). group_gate1_margin: nats added to gate 1 when the group split judges a cut, in
     [0, 20] (lidet_detector_cfg_t.group_gate1_margin; None: the C default, 2). gate1_large_car_margin: nats added to
     gate 1 for a car whose cluster holds >= 100 member pixels, in [0, 20] (lidet_detector_cfg_t.gate1_large_car_margin;
     None: the C default)."""
