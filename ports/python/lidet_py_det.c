@@ -27,8 +27,9 @@ static int32_t g_pp[LIDET_MAX_POINTS];
  * 0xFFFFFFFF = the default for the sensor).
  * out_det: LIDET_MAX_DETECTIONS rows of 12 floats (class, score, energy_cls, energy_box, cx, cy, cz, l, w, h,
  * yaw, cluster id); out_outcome: LIDET_MAX_CLUSTERS bytes; out_point_cluster / out_point_ground: n entries
- * (may be NULL); out_stats: 19 uint32 (the lidet_detector_stats_t counts in order, the status, then
- * n_over_box_budget, n_too_tall, the three group counts and n_score_rejected). */
+ * (may be NULL); out_stats: 22 uint32 (the lidet_detector_stats_t counts in order, the status, then
+ * n_over_box_budget, n_too_tall, the three group counts, n_score_rejected, and the projection's n_points_in,
+ * n_out_of_fov and n_too_far). */
 static int det_run(const lidet_sensor_t *s, uint32_t cls_index, uint32_t box_index, const float *fcfg,
                    const uint32_t *ucfg, const float *pts, uint32_t n, uint32_t stride, float *out_det,
                    uint32_t *n_det, uint8_t *out_outcome, uint32_t *n_clusters, uint32_t *out_point_cluster,
@@ -177,6 +178,9 @@ static int det_run(const lidet_sensor_t *s, uint32_t cls_index, uint32_t box_ind
     out_stats[16] = st->n_group_classified;
     out_stats[17] = st->n_group_boxed;
     out_stats[18] = st->n_score_rejected;
+    out_stats[19] = st->stages.proj.n_points_in; /* the projection's counts: the bindings' frame check */
+    out_stats[20] = st->stages.proj.n_out_of_fov;
+    out_stats[21] = st->stages.proj.n_too_far;
     return rc;
 }
 

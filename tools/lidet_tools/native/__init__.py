@@ -32,8 +32,9 @@ from ._cluster import (CLUSTER_Q_FIELDS, PROPOSAL_Q_FIELDS, Clusters, ClustersOn
                        plane_sectors, planes_to_q, proposal_defaults, proposal_indices, proposals)
 from ._pointnet import (PnModel, pn_box, pn_classify, pn_forward, pn_models, pn_time, pnq_box, pnq_classify,
                         pnq_energy, pnq_forward, pnq_models, pnq_time)
-from ._detector import (CLASSES, DETQ_STATS, OUTCOME, Detections, bev_iou_float, bev_iou_q, candidates_float,
-                        candidates_q, default_family, detect, detect_q, detector_q_bytes, post_q)
+from ._detector import (CLASSES, DETQ_STATS, OUTCOME, Detections, LidetFrameWarning, bev_iou_float, bev_iou_q,
+                        candidates_float, candidates_q, default_family, detect, detect_q, detector_q_bytes,
+                        frame_warning, post_q)
 
 __all__ = [
     "MAX_STRIDE", "PIXEL_MODELS", "LidetError", "ScanContext", "capacity", "lib", "status_names", "struct_layouts",
@@ -47,6 +48,7 @@ __all__ = [
     "planes_to_q", "proposal_defaults", "proposal_indices", "proposals",
     "PnModel", "pn_box", "pn_classify", "pn_forward", "pn_models", "pn_time", "pnq_box", "pnq_classify",
     "pnq_energy", "pnq_forward", "pnq_models", "pnq_time",
-    "CLASSES", "DETQ_STATS", "OUTCOME", "Detections", "bev_iou_float", "bev_iou_q", "candidates_float",
-    "candidates_q", "default_family", "detect", "detect_q", "detector_q_bytes", "post_q",
+    "CLASSES", "DETQ_STATS", "OUTCOME", "Detections", "LidetFrameWarning", "bev_iou_float", "bev_iou_q",
+    "candidates_float", "candidates_q", "default_family", "detect", "detect_q", "detector_q_bytes", "frame_warning",
+    "post_q",
 ]

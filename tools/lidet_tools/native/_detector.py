@@ -5,6 +5,7 @@ candidates for the int8 accuracy ablations (ports/python/lidet_py_acc_q.c)."""
 from __future__ import annotations
 
 import ctypes as C
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,7 +44,30 @@ CLASSES = ("Car", "Cyclist", "Pedestrian")
 _DET_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity",
               "n_detections", "status", "n_over_box_budget", "n_too_tall", "n_group_split", "n_group_classified",
-              "n_group_boxed", "n_score_rejected"]
+              "n_group_boxed", "n_score_rejected", "n_points_in", "n_out_of_fov", "n_too_far"]
+
+
+class LidetFrameWarning(UserWarning):
+    """`detect` on a cloud that does not look like the sensor's scan (`frame_warning`)."""
+
+
+def frame_warning(stats: dict, sensor_name: str) -> str | None:
+    """What looks wrong with a scan's frame, from the projection's counts in `stats` (n_points_in, n_out_of_fov,
+    n_too_far), or None: the rule of the CLI's warning (ports/host/cli_common.c, cli_warn_frame; docs/ROBUSTNESS.md,
+    "A cloud in another frame"): more than a tenth of the points outside the sensor's beams, or more than a quarter
+    beyond the range the image keeps."""
+    n = int(stats.get("n_points_in", 0))
+    if n < 100:
+        return None
+    out = []
+    if int(stats["n_out_of_fov"]) > n // 10:
+        out.append(f"{stats['n_out_of_fov']} of {n} points ({100 * stats['n_out_of_fov'] / n:.0f} %) lie outside the "
+                   f"{sensor_name}'s beams: lidet reads x forward, y left, z up, in metres; a cloud upside down, in a "
+                   f"camera's frame or from another sensor looks like this")
+    if int(stats["n_too_far"]) > n // 4:
+        out.append(f"{stats['n_too_far']} of {n} points ({100 * stats['n_too_far'] / n:.0f} %) lie beyond the range "
+                   f"the image keeps: are the coordinates in metres?")
+    return "; ".join(out) or None
 
 
 @dataclass
@@ -174,9 +198,12 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
     if rc < 0:
         raise LidetError(rc, "lidet_detector")
     d = det[: int(nd[0])]
+    stats = dict(zip(_DET_STATS, map(int, st)))
+    w = frame_warning(stats, sensor if isinstance(sensor, str) else sensor.name)
+    if w is not None:
+        warnings.warn(w, LidetFrameWarning, stacklevel=2)
     return Detections(d[:, 0].astype(np.int64), d[:, 1].copy(), d[:, 2].copy(), d[:, 3].copy(), d[:, 4:11].copy(),
-                      d[:, 11].astype(np.int64), oc[: int(nc[0])].copy(), pc[:n], pg[:n],
-                      dict(zip(_DET_STATS, map(int, st))))
+                      d[:, 11].astype(np.int64), oc[: int(nc[0])].copy(), pc[:n], pg[:n], stats)
 
 
 # ---- the integer detector (lib/src/detector/lidet_detector_q.c) ---------------------------------------------
