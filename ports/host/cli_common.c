@@ -147,33 +147,31 @@ int cli_png_range(const char *v)
  * (tests/python/test_cli_detect.py, docs/ROBUSTNESS.md "A cloud in another frame") */
 int cli_warn_frame(const char *who, const char *scan, const lidet_proj_stats_t *ps, const lidet_sensor_t *s)
 {
+    const double deg = 180.0 / 3.14159265358979, pct = ps->n_points_in > 0u ? 100.0 / ps->n_points_in : 0.0;
     const uint32_t n = ps->n_points_in;
-    const double pct = n > 0u ? 100.0 / (double)n : 0.0;
+    const char *sep = scan != NULL ? ": " : "";
     int k = 0;
     if (n < 100u)
         return 0; /* too few points to judge a frame by */
+    if (scan == NULL)
+        scan = "";
     if (ps->n_out_of_fov > n / 10u)
     {
-        double lo = 90.0, hi = -90.0;
+        /* the beams' span: the table's extremes, or the uniform field of view */
+        double lo = (double)s->fov_down_rad * deg, hi = (double)s->fov_up_rad * deg;
         uint32_t r;
-        for (r = 0; r < s->n_rows; ++r)
+        for (r = 0; s->beam_elev_rad != NULL && r < s->n_rows; ++r)
         {
-            const double e = s->beam_elev_rad != NULL ? (double)s->beam_elev_rad[r] * (180.0 / 3.14159265358979)
-                                                      : 0.0;
-            lo = e < lo ? e : lo;
-            hi = e > hi ? e : hi;
-        }
-        if (s->beam_elev_rad == NULL)
-        {
-            lo = (double)s->fov_down_rad * (180.0 / 3.14159265358979);
-            hi = (double)s->fov_up_rad * (180.0 / 3.14159265358979);
+            const double e = (double)s->beam_elev_rad[r] * deg;
+            lo = r == 0u || e < lo ? e : lo;
+            hi = r == 0u || e > hi ? e : hi;
         }
         fprintf(stderr,
                 "%s: warning: %s%s%u of %u points (%.0f %%) lie outside the %s's beams (%.1f to %.1f degrees): "
                 "lidet reads x forward, y left, z up, in metres; a cloud upside down, in a camera's frame or "
                 "from another sensor looks like this (--sensor NAME, --sensor-file F)\n",
-                who, scan != NULL ? scan : "", scan != NULL ? ": " : "", (unsigned)ps->n_out_of_fov, (unsigned)n,
-                (double)ps->n_out_of_fov * pct, s->name != NULL ? s->name : "sensor", lo, hi);
+                who, scan, sep, (unsigned)ps->n_out_of_fov, (unsigned)n, ps->n_out_of_fov * pct,
+                s->name != NULL ? s->name : "sensor", lo, hi);
         ++k;
     }
     if (ps->n_too_far > n / 4u)
@@ -181,8 +179,7 @@ int cli_warn_frame(const char *who, const char *scan, const lidet_proj_stats_t *
         fprintf(stderr,
                 "%s: warning: %s%s%u of %u points (%.0f %%) lie beyond the range the image keeps: are the "
                 "coordinates in metres?\n",
-                who, scan != NULL ? scan : "", scan != NULL ? ": " : "", (unsigned)ps->n_too_far, (unsigned)n,
-                (double)ps->n_too_far * pct);
+                who, scan, sep, (unsigned)ps->n_too_far, (unsigned)n, ps->n_too_far * pct);
         ++k;
     }
     return k;

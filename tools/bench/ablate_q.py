@@ -51,18 +51,13 @@ GATE2_CLASS = RD.GATE2_CLASS
 MIN_SCORE = (0.6, 0.0, 0.0)
 
 
-def min_score(fam: str) -> tuple:
-    """The detectors' default operating point (the same for every sensor)."""
-    return MIN_SCORE
-
-
 def nets_float(fam, xyz, mean, vox, cid, max_boxes, npts):
     """Float nets on proposals in metres, the float detector's rules: (cls, score, box (m, rad)) kept."""
     m = native.pn_models()[f"cls_{fam}"]
     mb = native.pn_models()[f"box_{fam}"]
     c = native.pn_classify(f"cls_{fam}", xyz, mean, vox)
     b = native.pn_box(f"box_{fam}", xyz, mean, vox, c["cls"])
-    dets, n_boxed, ms = [], 0, min_score(fam)
+    dets, n_boxed, ms = [], 0, MIN_SCORE
     for k in range(len(xyz)):
         if not c["passed"][k]:
             continue
@@ -106,7 +101,7 @@ def nets_int8(fam, q4, m4, vox, cid, npts):
                                              int(gam[c["cls"][k]]), int(gam_b[c["cls"][k]]),
                                              round(SCORE_BOX_WEIGHT[c["cls"][k]] * 65536),
                                              round(SCORE_POINTS_WEIGHT[c["cls"][k]] * 65536)) for k in keep], np.int32)
-    above = score >= np.asarray([round(v * 32768) for v in min_score(fam)])[cls]  # the operating point
+    above = score >= np.asarray([round(v * 32768) for v in MIN_SCORE])[cls]  # the operating point
     keep, cls, score = keep[above], cls[above], score[above]
     if len(keep) == 0:
         return []

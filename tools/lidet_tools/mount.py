@@ -36,7 +36,8 @@ LOW_MOUNT_M = 0.1
 
 #: more than this share of a scan's points outside the sensor's beams (the projection's n_out_of_fov) says the cloud
 #: is not in lidet's frame or not from that sensor: the real labelled frames of ../shared/data/real put at most 0.5 %
-#: there, a KITTI scan turned upside down 48 % (the CLI's commands warn at the same share: cli_warn_frame)
+#: there, a KITTI scan turned upside down 48 % (the rule of `native.frame_warning` and the CLI's cli_warn_frame,
+#: which main applies)
 OUT_OF_BEAMS_SHARE = 0.1
 
 
@@ -96,11 +97,9 @@ def main(argv=None) -> int:
             return 1
         h, n = estimate(pts, a.sensor)
         per.append((str(f), h, n))
-        share = out_of_beams(pts, a.sensor)
-        if share > OUT_OF_BEAMS_SHARE and frame_warning is None:
-            frame_warning = (f"{f}: {100 * share:.0f} % of the points lie outside the {a.sensor}'s beams: lidet reads "
-                             f"x forward, y left, z up, in metres; a cloud upside down, in a camera's frame or from "
-                             f"another sensor looks like this, and its estimate means nothing")
+        w = native.frame_warning(native.project(pts, a.sensor).stats, a.sensor) if frame_warning is None else None
+        if w is not None:
+            frame_warning = f"{f}: {w}; its estimate means nothing"
             print(f"lidet_tools.mount: warning: {frame_warning}", file=sys.stderr)
     hs = np.array([h for _, h, _ in per])
     ok = np.isfinite(hs)
