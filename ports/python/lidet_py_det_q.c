@@ -135,9 +135,9 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
  * group_gate1_margin_q16 (-1 = the default), gate1_large_car_margin_q16 (-1 = the default), stream_sectors (1: on),
  * stream chunk (returns per lidet_detector_q_stream_returns call; 0: one run).
  * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
- * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 19 uint32 (the
+ * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 23 uint32 (the
  * counts of lidet_detector_q_stats_t in order, then n_over_box_budget, n_too_tall, the three group counts and
- * n_score_rejected, n_stream_sectors: 19 in all). returns: n lidet_return_t
+ * n_score_rejected, n_stream_sectors, then the projection's n_points_in, n_out_of_fov, n_too_far and n_too_close: 23 in all). returns: n lidet_return_t
  * instead of the points (lidet_detector_q_run_returns; pts_mm ignored), or NULL. Returns the run's status. */
 LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, const char *box_name,
                                    const int32_t *icfg, const int32_t *pts_mm, uint32_t n, uint32_t stride,
@@ -181,12 +181,14 @@ LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, con
     memcpy(out_outcome, oc, *n_clusters);
     st = lidet_detector_q_stats(&g_detq);
     {
-        const uint32_t v[19] = {
+        const uint32_t v[23] = {
             st->n_clusters,        st->n_out_of_crop,    st->n_out_of_range,  st->n_over_budget,
             st->n_classified,      st->n_gate1_rejected, st->n_boxed,         st->n_gate2_rejected,
             st->n_size_rejected,   st->n_nms_suppressed, st->n_over_capacity, st->n_detections,
             st->n_over_box_budget, st->n_too_tall,       st->n_group_split,   st->n_group_classified,
-            st->n_group_boxed,     st->n_score_rejected, st->n_stream_sectors};
+            st->n_group_boxed,     st->n_score_rejected, st->n_stream_sectors,
+            /* the projection's counts: the bindings' frame check (native.frame_warning) */
+            st->proj.n_points_in,  st->proj.n_out_of_fov, st->proj.n_too_far,   st->proj.n_too_close};
         memcpy(out_stats, v, sizeof v);
     }
     return rc;

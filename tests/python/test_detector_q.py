@@ -128,7 +128,8 @@ def test_deterministic_and_bad_input(nq):
     assert a["stats"] == b["stats"]
     # empty scan, zero-range points, coordinates at the integer limits: statuses, never a crash
     assert nq.detect_q(np.zeros((0, 3), np.int32), "vlp16")["stats"]["n_detections"] == 0
-    assert nq.detect_q(np.zeros((100, 3), np.int32), "vlp16")["stats"]["n_clusters"] == 0
+    with pytest.warns(nq.LidetFrameWarning, match="closer than the minimum range"):
+        assert nq.detect_q(np.zeros((100, 3), np.int32), "vlp16")["stats"]["n_clusters"] == 0
     lim = np.array([[2**31 - 1, 0, 0], [-(2**31), 0, 0], [0, 2**31 - 1, -(2**31)], [131_000, 131_000, 131_000]] * 50,
                    np.int32)
     r = nq.detect_q(np.concatenate([pts, lim]), "vlp16")

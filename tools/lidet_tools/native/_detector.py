@@ -44,18 +44,22 @@ CLASSES = ("Car", "Cyclist", "Pedestrian")
 _DET_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity",
               "n_detections", "status", "n_over_box_budget", "n_too_tall", "n_group_split", "n_group_classified",
-              "n_group_boxed", "n_score_rejected", "n_points_in", "n_out_of_fov", "n_too_far"]
+              "n_group_boxed", "n_score_rejected", "n_points_in", "n_out_of_fov", "n_too_far",
+              "n_too_close"]
 
 
 class LidetFrameWarning(UserWarning):
     """`detect` on a cloud that does not look like the sensor's scan (`frame_warning`)."""
 
 
-def frame_warning(stats: dict, sensor_name: str) -> str | None:
+def frame_warning(stats: dict, sensor_name: str, unit: str = "m") -> str | None:
     """What looks wrong with a scan's frame, from the projection's counts in `stats` (n_points_in, n_out_of_fov,
     n_too_far), or None: the rule of the CLI's warning (ports/host/cli_common.c, cli_warn_frame; docs/ROBUSTNESS.md,
     "A cloud in another frame"): more than a tenth of the points outside the sensor's beams, or more than a quarter
-    beyond the range the image keeps."""
+    beyond the range the image keeps. unit "mm" (`detect_q`'s input): also more than a quarter closer than the
+    minimum range (stats' n_too_close), what a cloud in metres given as millimetres gives."""
+    if unit not in ("m", "mm"):
+        raise ValueError(f"unit: 'm' or 'mm', got {unit!r}")
     n = int(stats.get("n_points_in", 0))
     if n < 100:
         return None
@@ -66,7 +70,10 @@ def frame_warning(stats: dict, sensor_name: str) -> str | None:
                    f"camera's frame or from another sensor looks like this")
     if int(stats["n_too_far"]) > n // 4:
         out.append(f"{stats['n_too_far']} of {n} points ({100 * stats['n_too_far'] / n:.0f} %) lie beyond the range "
-                   f"the image keeps: are the coordinates in metres?")
+                   f"the image keeps: are the coordinates in {'millimetres' if unit == 'mm' else 'metres'}?")
+    if unit == "mm" and int(stats.get("n_too_close", 0)) > n // 4:
+        out.append(f"{stats['n_too_close']} of {n} points ({100 * stats['n_too_close'] / n:.0f} %) lie closer than "
+                   f"the minimum range: detect_q takes millimetres (native.to_mm converts metres)")
     return "; ".join(out) or None
 
 
@@ -211,7 +218,8 @@ def detect(points, sensor: str | Sensor = "hdl64", model: str | None = None, cro
 DETQ_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity", "n_detections",
               "n_over_box_budget", "n_too_tall", "n_group_split", "n_group_classified", "n_group_boxed",
-              "n_score_rejected", "n_stream_sectors"]
+              "n_score_rejected", "n_stream_sectors", "n_points_in", "n_out_of_fov", "n_too_far",
+              "n_too_close"]
 
 
 def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_half_bam: int = 0,
@@ -238,12 +246,18 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     (lidet_detector_q_stream_*) instead of one run; stats['n_stream_sectors'] counts the sectors done before the end.
 
     Returns {'cls', 'score_q15', 'energy_cls_q16', 'energy_box_q16', 'boxes' (N, 7: cx cy cz l w h mm, yaw BAM32),
-    'cluster_id', 'n_points', 'outcome', 'stats', 'status'}."""
+    'cluster_id', 'n_points', 'outcome', 'stats', 'status'}; stats also carry the projection's n_points_in,
+    n_out_of_fov, n_too_far and n_too_close, and a cloud that does not look like the sensor's scan in millimetres
+    (points, not returns) gives a LidetFrameWarning (`frame_warning(stats, sensor, unit="mm")`). A float array of
+    points that are not whole millimetres is refused (TypeError): metres cast to integers would lose every point."""
     L = _detector_lib()
     if returns is not None:
         returns = np.ascontiguousarray(returns, dtype=RETURN_DTYPE)
         points_mm = np.zeros((len(returns), 3), np.int32)
-    pts = np.ascontiguousarray(points_mm, dtype=np.int32)
+    raw = np.asarray(points_mm)
+    if raw.dtype.kind == "f" and not np.array_equal(raw, np.round(raw)):
+        raise TypeError("points_mm: whole millimetres (an integer array); native.to_mm(points) converts metres")
+    pts = np.ascontiguousarray(raw, dtype=np.int32)
     if pts.ndim != 2 or pts.shape[1] < 3:
         raise ValueError(f"points_mm must be (N, >=3) int32, got {pts.shape}")
     fam = model or sensor
@@ -276,9 +290,13 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     if rc < 0:
         raise LidetError(rc, "lidet_detector_q")
     d = det[: int(nd[0])]
+    stats = dict(zip(DETQ_STATS, map(int, st)))
+    w = frame_warning(stats, sensor, unit="mm") if returns is None else None
+    if w is not None:
+        warnings.warn(w, LidetFrameWarning, stacklevel=2)
     return {"cls": d[:, 0].copy(), "score_q15": d[:, 1].copy(), "energy_cls_q16": d[:, 2].copy(),
             "energy_box_q16": d[:, 3].copy(), "boxes": d[:, 4:11].copy(), "cluster_id": d[:, 11].copy(),
-            "n_points": d[:, 12].copy(), "outcome": oc[: int(nc[0])].copy(), "stats": dict(zip(DETQ_STATS, map(int, st))),
+            "n_points": d[:, 12].copy(), "outcome": oc[: int(nc[0])].copy(), "stats": stats,
             "status": int(rc)}
 
 
