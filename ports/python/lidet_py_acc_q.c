@@ -109,8 +109,10 @@ LIDET_PY_API int lidet_py_acc_cands_q(const char *sensor, const char *cls_name, 
     /* NMS, gates, box budget, pixel, gate 2's classes: the defaults; no group split (the candidates are the
      * clusters classified); the layout of lidet_py_detq_run's icfg */
     const int32_t cfg6[LIDET_PY_DETQ_ICFG] = {icfg[0], icfg[1], 3277, icfg[2], 1, 1, 0, 0, 0, -1, -1,
-                                              0, -1, -1, -1, -1, INT32_MIN, INT32_MIN, INT32_MIN, -1, -1, -1};
-    const int rc = lidet_py__detq_init_run(&g_acc_detq, sensor, cls_name, box_name, cfg6, pts_mm, n, stride, NULL);
+                                              0, -1, -1, -1, -1, INT32_MIN, INT32_MIN, INT32_MIN, -1, -1, -1,
+                                              0, 0, -1};
+    const int rc =
+        lidet_py__detq_init_run(&g_acc_detq, sensor, cls_name, box_name, cfg6, pts_mm, n, stride, NULL, NULL);
     return put_cands(rc, lidet_detector_q_stats(&g_acc_detq)->n_classified, g_acc_detq.cfg.proposal.n_points,
                      g_acc_detq.order, make_q, &g_prop_q, g_prop_q.xyz, sizeof(int16_t), g_prop_q.mean_4mm,
                      sizeof g_prop_q.mean_4mm, g_prop_q.voxel, xyz, mean, voxel, cluster_id, n_cand, n_points);

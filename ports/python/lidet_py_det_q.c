@@ -19,8 +19,9 @@ static lidet_detector_q_t g_detq;
 
 int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const char *cls_name,
                             const char *box_name, const int32_t *icfg, const int32_t *pts_mm, uint32_t n,
-                            uint32_t stride, const lidet_return_t *returns)
+                            uint32_t stride, const lidet_return_t *returns, int32_t *point_pixel)
 {
+    static lidet_sensor_q_t mounted; /* the preset at another mount height (outlives the run) */
     const lidet_sensor_q_t *s = lidet_sensor_q_find(sensor);
     const lidet_pointnet_q_model_t *mc, *mb;
     lidet_detector_q_cfg_t cfg;
@@ -34,6 +35,16 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
     if (mc == NULL || mb == NULL)
     {
         return LIDET_ERR_NOT_FOUND;
+    }
+    if (icfg[24] >= 0) /* the mount height in mm, as lidet detect --fixed --mount-height sets it */
+    {
+        if (icfg[24] > 10000)
+        {
+            return LIDET_ERR_CONFIG;
+        }
+        mounted = *s;
+        mounted.mount_height_mm = icfg[24];
+        s = &mounted;
     }
     lidet_detector_q_cfg_default(&cfg, s);
     cfg.crop_half_bam = icfg[0];
@@ -123,8 +134,8 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
         }
         return rc == LIDET_OK ? lidet_detector_q_stream_end(det) : rc;
     }
-    return returns != NULL ? lidet_detector_q_run_returns(det, returns, n, NULL)
-                           : lidet_detector_q_run(det, pts_mm, n, stride, NULL, NULL);
+    return returns != NULL ? lidet_detector_q_run_returns(det, returns, n, point_pixel)
+                           : lidet_detector_q_run(det, pts_mm, n, stride, NULL, point_pixel);
 }
 
 /* lidet_py_detq_run: icfg: crop_half_bam, max_range_mm, nms_iou_q15, max_proposals (0 = default), gate1, gate2,
@@ -138,12 +149,17 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
  * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 23 uint32 (the
  * counts of lidet_detector_q_stats_t in order, then n_over_box_budget, n_too_tall, the three group counts and
  * n_score_rejected, n_stream_sectors, then the projection's n_points_in, n_out_of_fov, n_too_far and n_too_close: 23 in all). returns: n lidet_return_t
- * instead of the points (lidet_detector_q_run_returns; pts_mm ignored), or NULL. Returns the run's status. */
+ * instead of the points (lidet_detector_q_run_returns; pts_mm ignored), or NULL. out_point_cluster (n uint32) and
+ * out_point_ground (n bytes), both or neither (NULL): each point's cluster id and ground label (not with a stream).
+ * Returns the run's status. */
 LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, const char *box_name,
                                    const int32_t *icfg, const int32_t *pts_mm, uint32_t n, uint32_t stride,
                                    int32_t *out_det, uint32_t *n_det, uint8_t *out_outcome,
-                                   uint32_t *n_clusters, uint32_t *out_stats, const lidet_return_t *returns)
+                                   uint32_t *n_clusters, uint32_t *out_stats, const lidet_return_t *returns,
+                                   uint32_t *out_point_cluster, uint8_t *out_point_ground)
 {
+    static int32_t point_pixel[LIDET_MAX_POINTS];
+    const int per_point = out_point_cluster != NULL && out_point_ground != NULL;
     const lidet_detection_q_t *d;
     const lidet_detector_q_stats_t *st;
     const uint8_t *oc;
@@ -154,10 +170,33 @@ LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, con
     {
         return lidet_sensor_q_find(sensor) == NULL ? LIDET_ERR_NOT_FOUND : LIDET_ERR_ARG;
     }
-    rc = lidet_py__detq_init_run(&g_detq, sensor, cls_name, box_name, icfg, pts_mm, n, stride, returns);
+    if (per_point && (n > LIDET_MAX_POINTS || (returns != NULL && icfg[23] > 0)))
+    {
+        return LIDET_ERR_ARG; /* per-point labels: one run of at most LIDET_MAX_POINTS points or returns */
+    }
+    rc = lidet_py__detq_init_run(&g_detq, sensor, cls_name, box_name, icfg, pts_mm, n, stride, returns,
+                                 per_point ? point_pixel : NULL);
     if (rc < 0)
     {
         return rc;
+    }
+    if (per_point)
+    {
+        /* each point's cluster id (the winner's of its pixel; 0: none) and ground label, from the run's buffers
+         * (the ground mask of the build with x, y, z per pixel; without it, none is kept: every point 0) */
+        int s = lidet_cluster_q_point_labels(&g_detq.cluster, point_pixel, n, out_point_cluster);
+#if LIDET_Q_PIXEL_XYZ
+        if (s == LIDET_OK)
+        {
+            s = lidet_ground_q_point_labels_of(&g_detq.ground, g_detq.mask, point_pixel, n, out_point_ground);
+        }
+#else
+        memset(out_point_ground, 0, n);
+#endif
+        if (s != LIDET_OK)
+        {
+            return s;
+        }
     }
     d = lidet_detector_q_detections(&g_detq, n_det);
     for (k = 0; k < *n_det; ++k)

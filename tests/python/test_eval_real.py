@@ -167,6 +167,10 @@ def test_eval_real_on_a_simulated_folder(tmp_path):
                            "--no-pictures"]) == 0
     q = json.loads((out / "q" / "report.json").read_text())["summary"]["kitti"]
     assert sum(q["classes"][c]["40"]["found"] for c in eval_real.CLASSES) >= 0.6 * sum(want.values())
+    # ... where each object was lost, from the integer run's own per-point labels
+    assert sum(sum(v.values()) for v in q["where_lost"].values()) == sum(want.values())
+    assert sum(q["where_lost"][c]["detected"] for c in eval_real.CLASSES) >= 0.5 * sum(want.values())
+    assert "`lidet_tools.where_lost`; the integer (int8) detector" in (out / "q" / "report.md").read_text()
     # each frame's tallies add up to the summary, and two runs compare frame by frame (lidet_tools.real.paired)
     for rng in ("20", "40"):
         for k, c in enumerate(eval_real.CLASSES):
@@ -338,3 +342,28 @@ def test_dontcare_regions_of_kitti_frames():
     test = eval_real.dontcare_test(calib, [dc])
     assert test(car) and not test(_box("Car", 15, -8)) and not test(_box("Car", -15, 1))
     assert eval_real.dontcare_test(calib, []) is None
+
+
+def test_integer_run_through_the_bindings_is_the_clis(tmp_path):
+    """eval_real --fixed runs the integer detector through the bindings (native.detect_q, with the per-point labels
+    where_lost reads); with --set it goes through `lidet detect --fixed`. Both give the same boxes (the CLI's JSON
+    rounds them to 0.1 mm and 1e-5 rad), and the labels are the run's: a detection's cluster holds its points."""
+    from lidet_tools import native, real
+    root, _ = _sim_root(tmp_path)
+    fr = real.load_frame(root, "kitti", "000000")
+    a, run, _ = eval_real._run_fixed(fr, None)
+    b, none, _ = eval_real._run_cli(fr, True, None)
+    assert none is None and len(a) == len(b) > 0
+    for x, y in zip(a, b):
+        assert x.cls == y.cls
+        np.testing.assert_allclose([x.x, x.y, x.z, x.l, x.w, x.h], [y.x, y.y, y.z, y.l, y.w, y.h], atol=6e-5)
+        assert abs(x.yaw - y.yaw) < 1e-4 and abs(x.score - y.score) < 1e-4
+    assert len(run.outcome) == run.point_cluster.max() == run.stats["n_clusters"]
+    for cid, bx in zip(run.cluster_id, run.box):
+        inside = points_in_box(fr.points, bx.astype(np.float64), margin=0.3)
+        assert np.mean(run.point_cluster[inside] == cid) > 0.2
+    assert 0.3 < run.point_ground.mean() < 0.9
+    d = native.detect_q(native.to_mm(fr.points), fr.sensor, point_labels=True)
+    np.testing.assert_array_equal(d["point_cluster"], run.point_cluster)
+    with pytest.raises(ValueError, match="mount_height_m"):
+        native.detect_q(native.to_mm(fr.points), fr.sensor, mount_height_m=11.0)

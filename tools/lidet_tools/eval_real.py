@@ -22,7 +22,8 @@ source's sensor preset and mount height; `--fixed`: the integer detector, `nativ
   AP R40 (`lidet_tools.eval.boxes_ap`: BEV and 3D, KITTI overlaps 0.7 / 0.5 / 0.5 and the loose ones);
 * KITTI's own protocol on the KITTI frames (label_2 with 2D boxes, difficulties): AP R40 3D / BEV moderate;
 * where each object within 40 m was lost (`lidet_tools.where_lost` over the points that won their pixel of the
-  projection, the ones the detector sees; float detector only), and the share of points seen per source: a
+  float projection, the ones the detector sees; either detector, but not through the CLI, i.e. not with `--set`,
+  which gives no per-point labels), and the share of points seen per source: a
   sensor whose beams the preset does not describe (Argoverse's two stacked VLP-32C on `vlp32c`) loses many points
   to pixel collisions;
 * a BEV picture per frame (ground truth green, detections by class, ignore regions grey) in OUT/pictures/.
@@ -94,7 +95,7 @@ class FrameResult:
     ignore: list             # Box3D ignore regions
     dets: list               # Box3D detections kept for scoring (in the field of view, outside ignore regions)
     dets_all: list           # every detection of the run
-    lost: list = field(default_factory=list)   # where_lost stage per gt (within 40 m), float detector only
+    lost: list = field(default_factory=list)   # where_lost stage per gt (within 40 m); not through the CLI
     ms: float = 0.0
     seen_share: float | None = None   # share of the points that won their pixel (float detector's projection)
     fp_kinds: list = field(default_factory=list)   # with point labels: FP_KINDS name of each wrong detection <= 40 m
@@ -112,14 +113,55 @@ def _arr(b) -> np.ndarray:
 
 
 def _run_detector(fr, fixed: bool, model: str | None, sets=()):
-    """(detections as Box3D, native.Detections or None, milliseconds)."""
-    if fixed or sets:
+    """(detections as Box3D, native.Detections (the integer run: `_QRun`) or None, milliseconds)."""
+    if sets:
         return _run_cli(fr, fixed, model, sets)
+    if fixed:
+        return _run_fixed(fr, model)
     t0 = time.perf_counter()
     d = native.detect(fr.points, fr.sensor, model=model, mount_height_m=fr.mount_height_m)
     ms = (time.perf_counter() - t0) * 1e3
     out = [kitti.Box3D(native.CLASSES[int(c)], *map(float, b), float(s)) for c, s, b in zip(d.cls, d.score, d.box)]
     return out, d, ms
+
+
+@dataclass
+class _QRun:
+    """The integer detector's run in the fields `where_lost` reads (boxes in metres and radians)."""
+    cls: np.ndarray
+    score: np.ndarray
+    box: np.ndarray
+    cluster_id: np.ndarray
+    outcome: np.ndarray
+    point_cluster: np.ndarray
+    point_ground: np.ndarray
+    stats: dict
+
+
+def _q_family(fr, model: str | None) -> str:
+    from . import native
+    return model or (fr.sensor if f"cls_{fr.sensor}_s8" in native.pnq_models() else "hdl64")
+
+
+def _run_fixed(fr, model: str | None):
+    """The integer detector through the bindings (`native.detect_q`: int8 models, the scan in millimetres, the
+    source's mount height), with its per-point labels for where_lost; boxes converted as `lidet detect --fixed`
+    does (mm * 1e-3, BAM32 / (2^32 / 2 pi), score_q15 / 32768)."""
+    from . import native
+    mm = native.to_mm(fr.points)
+    t0 = time.perf_counter()
+    q = native.detect_q(mm, fr.sensor, model=_q_family(fr, model), mount_height_m=fr.mount_height_m,
+                        point_labels=True)
+    ms = (time.perf_counter() - t0) * 1e3
+    b = q["boxes"].astype(np.float64)
+    box = np.empty((len(b), 7), np.float32)
+    box[:, :6] = (b[:, :6] * 1e-3).astype(np.float32)
+    box[:, 6] = (b[:, 6] / (4294967296.0 / (2.0 * np.pi))).astype(np.float32)
+    score = (q["score_q15"].astype(np.float64) / 32768.0).astype(np.float32)
+    run = _QRun(q["cls"].astype(np.int64), score, box, q["cluster_id"].astype(np.int64), q["outcome"],
+                q["point_cluster"], q["point_ground"], q["stats"])
+    out = [kitti.Box3D(native.CLASSES[int(c)], *map(float, bx), float(sc)) for c, sc, bx in zip(run.cls, score, box)]
+    return out, run, ms
 
 
 def _run_cli(fr, fixed: bool, model: str | None, sets=()):
@@ -132,7 +174,7 @@ def _run_cli(fr, fixed: bool, model: str | None, sets=()):
     from . import native
     from .detect import find_cli
     if fixed:
-        fam = model or (fr.sensor if f"cls_{fr.sensor}_s8" in native.pnq_models() else "hdl64")
+        fam = _q_family(fr, model)
     else:
         fam = model or native.default_family(fr.sensor)
     with tempfile.TemporaryDirectory() as td:
@@ -410,7 +452,7 @@ def format_report(summary: dict, meta: dict) -> str:
             L.append(f"| {src} | {s['frames']} | {sum(k.values())} | " +
                      ", ".join(f"{name} {n}" for name, n in sorted(k.items(), key=lambda x: -x[1])) + " |")
     if any(sum(sum(v.values()) for v in s["where_lost"].values()) for s in summary.values()):
-        L += ["", "Where the objects within 40 m were lost (`lidet_tools.where_lost`; float detector):", "",
+        L += ["", f"Where the objects within 40 m were lost (`lidet_tools.where_lost`; the {meta['detector'].split(',')[0]} detector):", "",
               "| source | class | " + " | ".join(STAGES) + " |", "|---|---|" + "---:|" * len(STAGES)]
         for src, s in summary.items():
             for c in CLASSES:

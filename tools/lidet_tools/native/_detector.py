@@ -23,7 +23,7 @@ def _detector_lib(L):
     L.lidet_py_det_run.argtypes = [C.c_char_p] + tail
     L.lidet_py_det_run_table.argtypes = [C.c_char_p, C.c_uint32, C.c_uint32, f32p, C.c_float, C.c_float] + tail
     L.lidet_py_detq_run.argtypes = [C.c_char_p, C.c_char_p, C.c_char_p, i32p, i32p, C.c_uint32, C.c_uint32, i32p,
-                                    u32p, u8p, u32p, u32p, C.c_void_p]
+                                    u32p, u8p, u32p, u32p, C.c_void_p, opt(u32p), opt(u8p)]
     L.lidet_py_detq_bytes.restype = C.c_uint32
     L.lidet_py_q_bev_iou.argtypes = [i32p, i32p, C.c_uint32, i32p]
     L.lidet_py_bev_iou.argtypes = [f32p, f32p, C.c_uint32, f32p]
@@ -229,7 +229,7 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
              min_score_q15=None, car_min_z_spread_mm: int | None = None, gate1_class_margin_q16=None,
              car_ground_mm: int | None = None, group_gate1_margin_q16: int | None = None,
              gate1_large_car_margin_q16: int | None = None, stream_sectors: bool = False,
-             stream: int = 0) -> dict:
+             stream: int = 0, mount_height_m: float | None = None, point_labels: bool = False) -> dict:
     """lidet_detector_q_run on (N, 3) int32 mm points with the int8 models cls_<model>_s8 / box_<model>_s8
     (returns: a RETURN_DTYPE array instead, lidet_detector_q_run_returns; points_mm is then ignored).
     gate*_margin_q16: the gates' operating points (lidet_detector_q_cfg_t, Q16 nats). range_only: the range-only
@@ -244,6 +244,10 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     default). stream_sectors: lidet_detector_q_cfg_t.stream_sectors (the ground stage sector by sector while the returns
     stream in; needs the range-only pixel). stream > 0 (with returns): the returns streamed that many at a time
     (lidet_detector_q_stream_*) instead of one run; stats['n_stream_sectors'] counts the sectors done before the end.
+    mount_height_m: the sensor's height above the ground, [0, 10] m, rounded to mm as `lidet detect --fixed
+    --mount-height` does (None: the preset's). point_labels (not with a stream): the result also holds
+    'point_cluster' (each point's cluster id, the winner's of its pixel as `detect`'s; 0: none) and 'point_ground'
+    (1: the ground stage's), which `lidet_tools.where_lost` reads.
 
     Returns {'cls', 'score_q15', 'energy_cls_q16', 'energy_box_q16', 'boxes' (N, 7: cx cy cz l w h mm, yaw BAM32),
     'cluster_id', 'n_points', 'outcome', 'stats', 'status'}; stats also carry the projection's n_points_in,
@@ -283,10 +287,19 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
                      int(bool(stream_sectors)), int(stream)], np.int32)
     if stream < 0 or (stream and returns is None):
         raise ValueError("stream: a count of returns per chunk (>= 0), with returns")
+    if mount_height_m is not None and not 0.0 <= float(mount_height_m) <= 10.0:
+        raise ValueError(f"mount_height_m must lie in [0, 10] m, got {mount_height_m!r}")
+    if point_labels and stream:
+        raise ValueError("point_labels: one run, not a stream")
     n = len(pts)
+    if point_labels and n > cap["max_points"]:
+        raise ValueError(f"point_labels: at most {cap['max_points']} points (the build's LIDET_MAX_POINTS), got {n}")
+    icfg = np.append(icfg, -1 if mount_height_m is None else int(np.floor(float(mount_height_m) * 1000.0 + 0.5))).astype(np.int32)
+    pcl = np.zeros(max(n, 1), np.uint32) if point_labels else None
+    pgr = np.zeros(max(n, 1), np.uint8) if point_labels else None
     rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
                              pts if n else np.zeros((1, 3), np.int32), n, pts.shape[1], det, nd, oc, nc, st,
-                             None if returns is None else returns.ctypes.data_as(C.c_void_p))
+                             None if returns is None else returns.ctypes.data_as(C.c_void_p), pcl, pgr)
     if rc < 0:
         raise LidetError(rc, "lidet_detector_q")
     d = det[: int(nd[0])]
@@ -297,7 +310,7 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     return {"cls": d[:, 0].copy(), "score_q15": d[:, 1].copy(), "energy_cls_q16": d[:, 2].copy(),
             "energy_box_q16": d[:, 3].copy(), "boxes": d[:, 4:11].copy(), "cluster_id": d[:, 11].copy(),
             "n_points": d[:, 12].copy(), "outcome": oc[: int(nc[0])].copy(), "stats": stats,
-            "status": int(rc)}
+            "status": int(rc), **({"point_cluster": pcl[:n], "point_ground": pgr[:n]} if point_labels else {})}
 
 
 def detector_q_bytes() -> int:
