@@ -85,6 +85,17 @@ def run(args) -> str:
                      f"{ca['found']} / {ca['objects']} | {cm['found']} / {cm['objects']} | "
                      f"{cb['found']} / {cb['objects']} |")
     lines.append("")
+    wl = b.get("where_lost") or {}
+    if any(sum(v.values()) for v in wl.values()):
+        from lidet_tools.where_lost import STAGES
+        lines += ["Where the integer detector lost the objects within 40 m (`--fixed`: `lidet_tools.where_lost` over its "
+                  "own per-point labels, all sources together; the float detector's rows are the table's above):", "",
+                  "| class | " + " | ".join(STAGES) + " |", "|---|" + "---:|" * len(STAGES)]
+        for c in ("Car", "Pedestrian", "Cyclist"):
+            row = wl.get(c, {})
+            if sum(row.values()):
+                lines.append(f"| {c} ({sum(row.values())}) | " + " | ".join(str(row.get(x, 0)) for x in STAGES) + " |")
+        lines.append("")
     lines += _draws(args.real, 5)
     # the robot's families on real HDL-64 frames thinned to their beams
     lines += ["### The robot's sensor families on thinned real scans", "",
