@@ -144,12 +144,12 @@ int lidet_py__detq_init_run(lidet_detector_q_t *det, const char *sensor, const c
  * min_score_q15 per class (3 entries, -1 = the default), car_min_z_spread_mm (-1 = the default),
  * gate1_class_margin_q16 per class (3 entries, INT32_MIN = the default), car_ground_mm (-1 = the default),
  * group_gate1_margin_q16 (-1 = the default), gate1_large_car_margin_q16 (-1 = the default), stream_sectors (1: on),
- * stream chunk (returns per lidet_detector_q_stream_returns call; 0: one run).
+ * stream chunk (returns per lidet_detector_q_stream_returns call; 0: one run), mount height in mm (-1 = the preset's).
  * out_det: LIDET_MAX_DETECTIONS rows of 13 int32 (class, score_q15, energy_cls_q16, energy_box_q16, cx, cy, cz,
  * l, w, h (mm), yaw_bam, cluster id, n_points); out_outcome: LIDET_MAX_CLUSTERS bytes; out_stats: 23 uint32 (the
  * counts of lidet_detector_q_stats_t in order, then n_over_box_budget, n_too_tall, the three group counts and
- * n_score_rejected, n_stream_sectors, then the projection's n_points_in, n_out_of_fov, n_too_far and n_too_close: 23 in all). returns: n lidet_return_t
- * instead of the points (lidet_detector_q_run_returns; pts_mm ignored), or NULL. out_point_cluster (n uint32) and
+ * n_score_rejected, n_stream_sectors, then the projection's n_points_in, n_out_of_fov, n_too_far and n_too_close).
+ * returns: n lidet_return_t instead of the points (lidet_detector_q_run_returns; pts_mm ignored), or NULL. out_point_cluster (n uint32) and
  * out_point_ground (n bytes), both or neither (NULL): each point's cluster id and ground label (not with a stream).
  * Returns the run's status. */
 LIDET_PY_API int lidet_py_detq_run(const char *sensor, const char *cls_name, const char *box_name,

@@ -12,12 +12,18 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 SCAN = ROOT / "tests" / "data" / "sim_hdl64" / "velodyne" / "000000.bin"
 
 
-def _detect(points, sensor="hdl64"):
+def _frame_warned(run, points, sensor):
+    """run(points, sensor)'s result and the LidetFrameWarnings it gave."""
     from lidet_tools import native
     with warnings.catch_warnings(record=True) as got:
         warnings.simplefilter("always")
-        d = native.detect(points, sensor)
+        d = run(points, sensor)
     return d, [w for w in got if issubclass(w.category, native.LidetFrameWarning)]
+
+
+def _detect(points, sensor="hdl64"):
+    from lidet_tools import native
+    return _frame_warned(native.detect, points, sensor)
 
 
 def test_detect_names_a_cloud_in_another_frame(need_lib):
@@ -56,10 +62,7 @@ def test_real_frames_draw_no_frame_warning(need_lib, real_dir, source):
 
 def _detect_q(points_mm, sensor="hdl64"):
     from lidet_tools import native
-    with warnings.catch_warnings(record=True) as got:
-        warnings.simplefilter("always")
-        d = native.detect_q(points_mm, sensor)
-    return d, [w for w in got if issubclass(w.category, native.LidetFrameWarning)]
+    return _frame_warned(native.detect_q, points_mm, sensor)
 
 
 def test_detect_q_names_a_cloud_in_another_frame_or_unit(need_lib):

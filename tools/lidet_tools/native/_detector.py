@@ -44,8 +44,7 @@ CLASSES = ("Car", "Cyclist", "Pedestrian")
 _DET_STATS = ["n_clusters", "n_out_of_crop", "n_out_of_range", "n_over_budget", "n_classified", "n_gate1_rejected",
               "n_boxed", "n_gate2_rejected", "n_size_rejected", "n_nms_suppressed", "n_over_capacity",
               "n_detections", "status", "n_over_box_budget", "n_too_tall", "n_group_split", "n_group_classified",
-              "n_group_boxed", "n_score_rejected", "n_points_in", "n_out_of_fov", "n_too_far",
-              "n_too_close"]
+              "n_group_boxed", "n_score_rejected", "n_points_in", "n_out_of_fov", "n_too_far"]
 
 
 class LidetFrameWarning(UserWarning):
@@ -264,6 +263,8 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
     pts = np.ascontiguousarray(raw, dtype=np.int32)
     if pts.ndim != 2 or pts.shape[1] < 3:
         raise ValueError(f"points_mm must be (N, >=3) int32, got {pts.shape}")
+    if mount_height_m is not None and not 0.0 <= float(mount_height_m) <= 10.0:
+        raise ValueError(f"mount_height_m must lie in [0, 10] m, got {mount_height_m!r}")
     fam = model or sensor
     cap = capacity()
     det = np.zeros((cap["max_detections"], 13), np.int32)
@@ -284,17 +285,15 @@ def detect_q(points_mm, sensor: str = "hdl64", model: str | None = None, crop_ha
                      -1 if car_ground_mm is None else int(car_ground_mm),
                      -1 if group_gate1_margin_q16 is None else int(group_gate1_margin_q16),
                      -1 if gate1_large_car_margin_q16 is None else int(gate1_large_car_margin_q16),
-                     int(bool(stream_sectors)), int(stream)], np.int32)
+                     int(bool(stream_sectors)), int(stream),
+                     -1 if mount_height_m is None else int(np.floor(float(mount_height_m) * 1000.0 + 0.5))], np.int32)
     if stream < 0 or (stream and returns is None):
         raise ValueError("stream: a count of returns per chunk (>= 0), with returns")
-    if mount_height_m is not None and not 0.0 <= float(mount_height_m) <= 10.0:
-        raise ValueError(f"mount_height_m must lie in [0, 10] m, got {mount_height_m!r}")
     if point_labels and stream:
         raise ValueError("point_labels: one run, not a stream")
     n = len(pts)
     if point_labels and n > cap["max_points"]:
         raise ValueError(f"point_labels: at most {cap['max_points']} points (the build's LIDET_MAX_POINTS), got {n}")
-    icfg = np.append(icfg, -1 if mount_height_m is None else int(np.floor(float(mount_height_m) * 1000.0 + 0.5))).astype(np.int32)
     pcl = np.zeros(max(n, 1), np.uint32) if point_labels else None
     pgr = np.zeros(max(n, 1), np.uint8) if point_labels else None
     rc = L.lidet_py_detq_run(sensor.encode(), f"cls_{fam}_s8".encode(), f"box_{fam}_s8".encode(), icfg,
