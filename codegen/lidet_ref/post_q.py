@@ -12,6 +12,8 @@ SIZE_MAX_MM = ((7500, 3000, 3200), (2600, 1500, 2400), (1600, 1600, 2400))
 BOX_MAX_MM = 50000
 MAX_CENTRE_MM = 1 << 20
 MAX_VERTS = 16
+#: the NMS bound between two parts of one group cut (lidet_group_common.h: LIDET_GROUP_NMS_IOU_Q15, 0.25)
+GROUP_NMS_IOU_Q15 = 8192
 
 
 def _div_round(n: int, d: int) -> int:
@@ -90,10 +92,13 @@ def bev_iou(a, b) -> int:
 
 
 def nms(dets: list[dict], iou_q15: int) -> tuple[list[dict], list[int]]:
-    """dets sorted best first (score_q15 desc, cluster_id asc); returns (kept, suppressed flags)."""
+    """dets sorted best first (score_q15 desc, cluster_id asc); returns (kept, suppressed flags). Between two
+    detections of one cluster id (the parts of one group cut) the bound is max(iou_q15, GROUP_NMS_IOU_Q15)."""
+    own = max(iou_q15, GROUP_NMS_IOU_Q15)
     kept, flags = [], []
     for d in dets:
-        drop = any(bev_iou(d["box"], k["box"]) > iou_q15 for k in kept)
+        drop = any(bev_iou(d["box"], k["box"]) > (iou_q15 if d["cluster_id"] != k["cluster_id"] else own)
+                   for k in kept)
         flags.append(int(drop))
         if not drop:
             kept.append(d)

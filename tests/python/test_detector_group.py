@@ -112,6 +112,31 @@ def test_group_split_on_a_real_frame(nd, real_dir):
     assert len(found(on) - found(off)) >= 1 and found(off) <= found(on)
 
 
+def test_group_parts_touching_both_stand(nd, real_dir):
+    """Four people side by side at 19 m on PandaSet 000000 (a training frame) share one cluster; the cut boxes
+    each of them, and neighbouring part boxes touch (BEV IoU about 0.1). Parts of one cut suppress each other
+    only past 0.25 (lidet_group_common.h): the float detector keeps its four parts even with nms_iou 0.05, and
+    the integer one the pair whose IoU (0.103) passes the default 0.1, which the NMS of other clusters drops."""
+    from lidet_tools import real
+    fr = real.load_frame(real_dir, "pandaset", "000000")
+
+    for nms in (0.1, 0.05):
+        d = nd.detect(fr.points, fr.sensor, mount_height_m=fr.mount_height_m, nms_iou=nms)
+        box = np.asarray(d.box)
+        near = np.flatnonzero((np.hypot(box[:, 0] - 19.2, box[:, 1] + 14.0) < 1.5) &
+                              (d.outcome[d.cluster_id - 1] == GROUP))
+        assert len(near) == 4 and len(set(d.cluster_id[near].tolist())) == 1
+        ious = [_bev(nd, box[i], box[j]) for i in near for j in near if i < j]
+        assert 0.05 < max(ious) <= 0.25  # past 0.05: the NMS of other clusters would drop one
+    q = nd.detect_q(nd.to_mm(fr.points), fr.sensor, model="hdl64", mount_height_m=fr.mount_height_m)
+    b = q["boxes"].astype(np.float64) * 1e-3
+    near = np.flatnonzero((np.hypot(b[:, 0] - 19.2, b[:, 1] + 14.0) < 1.5) &
+                          (q["outcome"][q["cluster_id"] - 1] == GROUP))
+    assert len(near) >= 3 and len(set(q["cluster_id"][near].tolist())) == 1
+    iq = [int(nd.bev_iou_q(q["boxes"][[i]], q["boxes"][[j]])[0]) for i in near for j in near if i < j]
+    assert 3277 < max(iq) <= 8192
+
+
 def test_group_margin_judges_the_cut_not_the_parts(nd, real_dir):
     """group_gate1_margin (default 2 nats) widens gate 1 for the judgement of a cut only: on PandaSet 000000 a cut
     whose every part but one passes gate 1 now stands, and the people that pass it are found; a part that passes

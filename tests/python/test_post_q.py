@@ -83,7 +83,8 @@ def test_size_check_and_nms_match_reference(nq):
         boxes[:, 6] = rng.integers(-(2**31), 2**31, n)
         score = rng.integers(1, 32768, n)
         score[: n // 3] = score[0]  # ties, broken by cluster id
-        cid = rng.permutation(np.arange(1, n + 1))
+        # every other trial: shared cluster ids (a group cut's parts), whose pairs have their own NMS bound
+        cid = rng.permutation(np.arange(1, n + 1)) if trial % 2 == 0 else rng.integers(1, n // 3 + 2, n)
         cls = rng.integers(0, 3, n)
         iou = int(rng.integers(0, 32769))
         c = nq.post_q(boxes, score, cid, cls, iou)
@@ -95,3 +96,22 @@ def test_size_check_and_nms_match_reference(nq):
         assert c["suppressed"] == flags
         if iou == 32768:
             assert len(kept) == n  # nothing exceeds IoU 1
+
+
+def test_nms_between_parts_of_one_group(nq):
+    """Two parts of one group cut (one cluster id) suppress each other only past max(iou_q15, 0.25): people side
+    by side give part boxes that touch; parts overlapping more are one person cut twice."""
+    a = [10_000, 0, 0, 1000, 700, 1700, 0]
+    touch = [10_650, 0, 0, 1000, 700, 1700, 0]  # 0.35 x 0.7 m shared of 0.7 + 0.7: IoU 0.212
+    same = [10_300, 0, 0, 1000, 700, 1700, 0]   # IoU 0.538
+    assert 0.2 * 32768 < nq.bev_iou_q([a], [touch])[0] < 0.25 * 32768 < nq.bev_iou_q([a], [same])[0]
+    boxes = np.array([a, touch], np.int64)
+    score = np.array([30000, 20000])
+    cls = np.array([2, 2])
+    assert nq.post_q(boxes, score, np.array([5, 5]), cls, 3277)["suppressed"] == [0, 0]  # one cut: both stand
+    assert nq.post_q(boxes, score, np.array([5, 6]), cls, 3277)["suppressed"] == [0, 1]  # two clusters: dropped
+    boxes = np.array([a, same], np.int64)
+    assert nq.post_q(boxes, score, np.array([5, 5]), cls, 3277)["suppressed"] == [0, 1]  # one person cut twice
+    assert nq.post_q(boxes, score, np.array([5, 5]), cls, 32768)["suppressed"] == [0, 0]  # NMS off: off for all
+    dets = [{"box": b, "score_q15": int(s), "cluster_id": 5} for b, s in zip(boxes.tolist(), score)]
+    assert ref.nms(dets, 3277)[1] == [0, 1] and ref.nms(dets, 32768)[1] == [0, 0]

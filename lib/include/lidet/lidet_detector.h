@@ -22,7 +22,8 @@
  *  4. Boxes of impossible size for their class (outside [size_min, size_max] per dimension), or with a
  *     non-finite centre or yaw, are dropped.
  *  5. Non-maximum suppression in bird's-eye view: detections sorted by score (ties: cluster id); one
- *     whose rotated BEV IoU with a kept detection of any class exceeds nms_iou is dropped.
+ *     whose rotated BEV IoU with a kept detection of any class exceeds nms_iou is dropped; between two
+ *     parts of one group cut (one cluster id) the bound is the larger of nms_iou and 0.25.
  * Score: 1 / (1 + exp(E_c - gamma_c[class])), monotonic in the classifier energy, 0.5 at gate 1's
  * threshold (the authors' score is also a function of the classifier energy alone).
  *

@@ -69,7 +69,8 @@ void lidet_detections_q_insert(lidet_detection_q_t *det, uint32_t n);
 
 /**
  * @brief Greedy NMS over det[0..n) sorted by lidet_detections_q_insert: keeps a detection unless its BEV IoU
- *        with an already kept one is > iou_q15; the kept ones move to the front in order.
+ *        with an already kept one is > iou_q15; between two detections of one cluster_id (the parts of one
+ *        group cut) the bound is the larger of iou_q15 and 8192 (0.25). The kept ones move to the front in order.
  * @param[out] suppressed optional (NULL): 1 per input detection that was dropped, else 0 (input order).
  * @return the number kept; 0 for NULL det.
  */

@@ -667,16 +667,19 @@ lidet_status_t lidet_detector_run(lidet_detector_t *d, const float *points, uint
     st->ticks[LIDET_DET_STAGE_CLASSIFY] = cls_ticks;
     st->ticks[LIDET_DET_STAGE_BOX] = box_ticks;
 
-    /* NMS over the score-sorted list: keep a detection unless it overlaps a kept one too much */
+    /* NMS over the score-sorted list: keep a detection unless it overlaps a kept one too much; two parts of one
+     * group cut (one cluster id) only past LIDET_GROUP_NMS_IOU as well (lidet_group_common.h) */
     t0 = now(d);
     {
+        const float own = d->cfg.nms_iou > LIDET_GROUP_NMS_IOU ? d->cfg.nms_iou : LIDET_GROUP_NMS_IOU;
         uint32_t kept = 0, j;
         for (i = 0; i < d->n_det; ++i)
         {
             int drop = 0;
             for (j = 0; j < kept && !drop; ++j)
             {
-                drop = lidet_box_bev_iou(&d->det[i].box, &d->det[j].box) > d->cfg.nms_iou;
+                drop = lidet_box_bev_iou(&d->det[i].box, &d->det[j].box) >
+                       (d->det[i].cluster_id != d->det[j].cluster_id ? d->cfg.nms_iou : own);
             }
             if (drop)
             {

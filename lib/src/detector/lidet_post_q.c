@@ -3,6 +3,7 @@
  * Integers only; mirrored bit for bit by codegen/lidet_ref/post_q.py. */
 #include <string.h>
 
+#include "internal/lidet_group_common.h" /* LIDET_GROUP_NMS_IOU_Q15 */
 #include "internal/lidet_qmath.h"
 #include "lidet/lidet_detector_q.h"
 
@@ -156,6 +157,7 @@ void lidet_detections_q_insert(lidet_detection_q_t *det, uint32_t n)
 
 uint32_t lidet_detections_q_nms(lidet_detection_q_t *det, uint32_t n, int32_t iou_q15, uint8_t *suppressed)
 {
+    const int32_t own = iou_q15 > LIDET_GROUP_NMS_IOU_Q15 ? iou_q15 : LIDET_GROUP_NMS_IOU_Q15;
     uint32_t i, j, kept = 0;
     if (det == 0)
     {
@@ -166,7 +168,9 @@ uint32_t lidet_detections_q_nms(lidet_detection_q_t *det, uint32_t n, int32_t io
         int drop = 0;
         for (j = 0; j < kept && !drop; ++j)
         {
-            drop = lidet_box_q_bev_iou(&det[i].box, &det[j].box) > iou_q15;
+            /* two parts of one group cut (one cluster id): past LIDET_GROUP_NMS_IOU_Q15 as well */
+            drop = lidet_box_q_bev_iou(&det[i].box, &det[j].box) >
+                   (det[i].cluster_id != det[j].cluster_id ? iou_q15 : own);
         }
         if (suppressed != 0)
         {
