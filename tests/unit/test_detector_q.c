@@ -647,6 +647,45 @@ static void test_score(void)
     TEST_ASSERT_EQUAL_INT32(32768, lidet_detector_q_score(INT32_MIN, INT32_MAX));
 }
 
+/* two people side by side: boxes 1.0 x 0.7 m whose centres lie 0.65 m apart (BEV IoU 0.212) or 0.3 m apart (0.538) */
+static lidet_detection_q_t det_at(int32_t cx_mm, int32_t score_q15, uint16_t cluster_id)
+{
+    lidet_detection_q_t d;
+    memset(&d, 0, sizeof d);
+    d.box.cx_mm = cx_mm;
+    d.box.l_mm = 1000;
+    d.box.w_mm = 700;
+    d.box.h_mm = 1700;
+    d.score_q15 = score_q15;
+    d.cluster_id = cluster_id;
+    d.cls = LIDET_CLASS_PEDESTRIAN;
+    return d;
+}
+
+static void test_nms_of_a_group_cut(void)
+{
+    lidet_detection_q_t d[2];
+    uint8_t sup[2];
+    d[0] = det_at(10000, 30000, 5);
+    d[1] = det_at(10650, 20000, 6);
+    TEST_ASSERT_TRUE(lidet_box_q_bev_iou(&d[0].box, &d[1].box) > 6553); /* > 0.2 */
+    TEST_ASSERT_TRUE(lidet_box_q_bev_iou(&d[0].box, &d[1].box) <= 8192);
+    /* two clusters: the lower one goes at the default 0.1 */
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_detections_q_nms(d, 2, 3277, sup));
+    TEST_ASSERT_EQUAL_UINT8(1, sup[1]);
+    /* two parts of one group cut (one cluster id): both stand below 0.25 */
+    d[0] = det_at(10000, 30000, 5);
+    d[1] = det_at(10650, 20000, 5);
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_detections_q_nms(d, 2, 3277, sup));
+    TEST_ASSERT_EQUAL_UINT8(0, sup[1]);
+    /* one person cut twice: past 0.25 the lower part goes, and the larger nms bound holds for parts too */
+    d[1] = det_at(10300, 20000, 5);
+    TEST_ASSERT_TRUE(lidet_box_q_bev_iou(&d[0].box, &d[1].box) > 8192);
+    TEST_ASSERT_EQUAL_UINT32(1, lidet_detections_q_nms(d, 2, 3277, sup));
+    d[1] = det_at(10300, 20000, 5);
+    TEST_ASSERT_EQUAL_UINT32(2, lidet_detections_q_nms(d, 2, 32768, sup));
+}
+
 int main(void)
 {
     UNITY_BEGIN();
@@ -658,5 +697,6 @@ int main(void)
     RUN_TEST(test_streamed_sectors_equal_the_whole_scan);
     RUN_TEST(test_stream_states_and_truncation);
     RUN_TEST(test_score);
+    RUN_TEST(test_nms_of_a_group_cut);
     return UNITY_END();
 }
