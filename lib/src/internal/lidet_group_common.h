@@ -37,8 +37,9 @@
 /* The NMS between two parts of one cut (they share their cluster id): dropped past this BEV IoU or the detector's
  * nms_iou, the larger. People side by side give part boxes that touch (BEV IoU about 0.1 at 0.6 m apart, past the
  * default nms_iou of 0.1); two parts overlapping past the loose pedestrian match (0.25) are one person cut twice */
-#define LIDET_GROUP_NMS_IOU 0.25f
-#define LIDET_GROUP_NMS_IOU_Q15 8192
+#define LIDET_GROUP_NMS_IOU_Q15 8192 /* 0.25 */
+#define LIDET_GROUP_NMS_IOU                                                                                  \
+    ((float)LIDET_GROUP_NMS_IOU_Q15 / 32768.0f) /* the float detector's, the same 0.25 */
 
 /* Rule 4's resampling walk, the same in both builds: the proposal rule (lidet_proposal_rule.h) over a part's n_src
  * members, found in one pass over the cluster's n_members members in member order. n_src <= n_out: the part's
