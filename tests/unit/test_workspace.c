@@ -22,6 +22,10 @@ static int32_t g_pp[LIDET_MAX_POINTS];
 static uint32_t g_ids_ws[LIDET_MAX_POINTS], g_ids_ref[LIDET_MAX_POINTS];
 static uint8_t g_gnd_ws[LIDET_MAX_POINTS], g_gnd_ref[LIDET_MAX_POINTS];
 static lidet_proposal_t g_prop_ws, g_prop_ref;
+/* a change to the defaults for compare_on (NULL: none; set by test_workspace_edge_plane, which also skips the
+ * float stages' tolerances: they were measured on the defaults) */
+static void (*g_tweak)(lidet_workspace_cfg_t *cfg);
+static int g_check_r; /* compare_on checks the workspace's R plane (a run that writes no edge plane there) */
 
 void setUp(void)
 {
@@ -246,6 +250,10 @@ static void compare_on(const char *rel, const char *sensor_name)
     CANARY_FILL(g_ground);
     CANARY_FILL(g_cluster);
     lidet_workspace_cfg_default(&cfg, s);
+    if (g_tweak != NULL)
+    {
+        g_tweak(&cfg);
+    }
     TEST_ASSERT_EQUAL_INT(LIDET_OK, lidet_workspace_init(&g_ws.ws, &cfg));
 
     /* the workspace, first without per-point outputs, then with them: the same results */
@@ -259,25 +267,30 @@ static void compare_on(const char *rel, const char *sensor_name)
     TEST_ASSERT_NULL(wimg.point_idx);
     TEST_ASSERT_NULL(wimg.x_m);
     npix = (uint32_t)wimg.n_rows * wimg.n_cols;
+    /* R is the ground stage's scratch: the image of the last run has none (its plane holds the clustering's edges on
+     * x86-64 hosts with AVX-512) */
+    TEST_ASSERT_NULL(wimg.rxy_m);
 #if LIDET_WORKSPACE_KEEP_R
-    /* R kept: exactly the ground stage's own expression on the decoded 4 mm values (so the stages chained by hand
-     * below, on a compact image without R, must give the same bits) */
-    TEST_ASSERT_NOT_NULL(wimg.rxy_m);
+    if (g_check_r)
     {
+        /* a run whose clustering writes no edge plane (the regrowth's cut): R as the projection kept it, exactly the
+         * ground stage's own expression on the decoded 4 mm values (so the stages chained by hand below, on a
+         * compact image without R, must give the same bits) */
         uint32_t p;
         for (p = 0; p < npix; ++p)
         {
             const float x = (float)wimg.x_4mm[p] * LIDET_PIXEL_M, y = (float)wimg.y_4mm[p] * LIDET_PIXEL_M;
             const float r = sqrtf(x * x + y * y);
-            TEST_ASSERT_EQUAL_MEMORY(&r, &wimg.rxy_m[p], sizeof r);
+            TEST_ASSERT_EQUAL_MEMORY(&r, &g_ws.ws.r.rxy_m[p], sizeof r);
         }
     }
-#else
-    TEST_ASSERT_NULL(wimg.rxy_m);
 #endif
 
     /* 1. the float stages (the reference): agreement within the tolerances */
-    against_float(rel, &cfg, n);
+    if (g_tweak == NULL)
+    {
+        against_float(rel, &cfg, n);
+    }
 
     /* 2. the stages chained by hand on the compact image: equal, bit for bit */
     cfg_ref = cfg;
@@ -374,6 +387,73 @@ static void test_workspace_real_scans(void)
     }
     if (ran == 0u)
         TEST_IGNORE_MESSAGE("../shared/data/real not present");
+}
+
+/* The workspace's flood fill decides its searches beforehand in an edge plane on x86-64 hosts with AVX-512
+ * (lidet_cluster_grow.c, lidet__cluster_edges); the standalone stage chained by hand in compare_on has no plane
+ * and runs the searches as it goes. Both must give the same clusters, members, labels and counts bit for bit, on
+ * the defaults (the tests above) and where the plane's rules change: the bridging budget spent mid-fill (the
+ * pixels after it expanded without the occluder rule), the occluder rule off (a search ends at its first
+ * candidate), no diagonals, no gap bound, max_steps 7 (the plane's limit) and 8 (no plane), the regrowth's cut
+ * (no plane) */
+static void tweak_budget(lidet_workspace_cfg_t *cfg)
+{
+    cfg->cluster.max_bridge_per_pixel = 0.05f;
+}
+static void tweak_no_occluders(lidet_workspace_cfg_t *cfg)
+{
+    cfg->cluster.bridge_occluders = 0u;
+}
+static void tweak_no_diagonals(lidet_workspace_cfg_t *cfg)
+{
+    cfg->cluster.diagonals = 0u;
+    cfg->cluster.max_gap_m = 0.0f;
+}
+static void tweak_steps7(lidet_workspace_cfg_t *cfg)
+{
+    cfg->cluster.max_steps = 7u;
+}
+static void tweak_steps8(lidet_workspace_cfg_t *cfg)
+{
+    cfg->cluster.max_steps = 8u;
+}
+static void tweak_cut(lidet_workspace_cfg_t *cfg)
+{
+    cfg->cluster.regrow_cut_m = 0.3f;
+}
+
+static void test_workspace_edge_plane(void)
+{
+    static void (*const tweaks[])(lidet_workspace_cfg_t *) = {tweak_budget,      tweak_no_occluders,
+                                                               tweak_no_diagonals, tweak_steps7,
+                                                               tweak_steps8,       tweak_cut};
+    uint32_t i;
+#if LIDET_WORKSPACE_KEEP_R
+    uint32_t p, written = 0;
+    g_tweak = NULL;
+    compare_on("tests/data/sim_hdl64/velodyne/000000.bin", "hdl64");
+    for (p = 0; p < (uint32_t)LIDET_MAX_ROWS * LIDET_MAX_COLS; ++p)
+    {
+        written += g_ws.ws.r.edges[p] >> 31; /* a word written for a candidate */
+    }
+    printf("edge plane: %u words written on the simulated HDL-64 scan (0: this CPU or build does not use it)\n",
+           (unsigned)written);
+#if LIDET_HOST_SIMD && defined(__GNUC__) && defined(__x86_64__)
+    if (__builtin_cpu_supports("avx512f"))
+    {
+        TEST_ASSERT_TRUE(written > 10000u);
+    }
+#endif
+#endif
+    for (i = 0; i < sizeof tweaks / sizeof tweaks[0]; ++i)
+    {
+        g_tweak = tweaks[i];
+        g_check_r = tweaks[i] == tweak_cut;
+        compare_on("tests/data/sim_hdl64/velodyne/000000.bin", "hdl64");
+        compare_on("tests/data/sim_vlp16/velodyne/000000.bin", "vlp16");
+    }
+    g_tweak = NULL;
+    g_check_r = 0;
 }
 
 static void test_workspace_errors(void)
@@ -506,5 +586,6 @@ int main(void)
     RUN_TEST(test_workspace_matches_stages_vlp16);
     RUN_TEST(test_workspace_matches_stages_hdl64);
     RUN_TEST(test_workspace_real_scans);
+    RUN_TEST(test_workspace_edge_plane);
     return UNITY_END();
 }

@@ -103,8 +103,15 @@ typedef struct
     uint16_t range_4mm[LIDET__WS_PIXELS];
     uint8_t ground_mask[LIDET__WS_PIXELS];
 #if LIDET_WORKSPACE_KEEP_R
-    /* R of each pixel's decoded x, y (LIDET_WORKSPACE_KEEP_R: 64-bit targets, large images; lidet_opt.h) */
-    float rxy_m[LIDET__WS_PIXELS];
+    /* R of each pixel's decoded x, y (LIDET_WORKSPACE_KEEP_R: 64-bit targets, large images; lidet_opt.h), read by
+     * the ground stage alone; then, on x86-64 hosts with AVX-512, the clustering's edge plane: every candidate's
+     * searches decided before its flood fill, sixteen pixels at a time (lidet_cluster_grow.c; the same clusters,
+     * found faster) */
+    union
+    {
+        float rxy_m[LIDET__WS_PIXELS];
+        uint32_t edges[LIDET__WS_PIXELS];
+    } r;
 #endif
 #ifdef LIDET__WS_ALIAS_GAP
     uint8_t alias_gap[LIDET__WS_ALIAS_GAP]; /* never read or written: see LIDET__WS_ALIAS_GAP */
@@ -177,8 +184,9 @@ lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *poi
                                          uint32_t stride, const uint16_t *ring, int32_t *point_pixel,
                                          lidet_clock_fn clock, void *clock_ctx, uint32_t ticks[3]);
 
-/** @brief The range image of the last run: a compact image (x_m ... range_m, rxy_m and point_idx NULL;
- *         x_4mm, y_4mm, z_4mm, range_4mm set: decode as value * LIDET_PIXEL_M metres). */
+/** @brief The range image of the last run: a compact image (x_m ... range_m, rxy_m and point_idx NULL: R and the
+ *         winners are scratch of the stages; x_4mm, y_4mm, z_4mm, range_4mm set: decode as value * LIDET_PIXEL_M
+ *         metres). */
 void lidet_workspace_image(const lidet_workspace_t *ws, lidet_range_image_t *img);
 
 /** @brief Ground mask of the last run (n_rows * n_cols bytes, 1 = ground). */

@@ -291,6 +291,7 @@ static int regrow_param(const lidet_cluster_state_t *c, const lidet__grow_t *lk,
         return 0;
     }
     *out = *lk;
+    out->edges = 0; /* decided with the first fill's gap bound */
     out->gap = c->cfg.regrow_gap_m;
     out->gpm = c->cfg.regrow_gap_per_m;
     return 1;
@@ -319,6 +320,14 @@ static int regrow_param(const lidet_cluster_state_t *c, const lidet__grow_t *lk,
 lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *labels, lidet_member_t *members,
                                          const lidet_range_image_t *img, const uint8_t *ground_mask,
                                          const lidet_plane_t *planes, uint32_t n_sectors)
+{
+    return lidet__cluster_run_edges(c, labels, members, 0, img, ground_mask, planes, n_sectors);
+}
+
+lidet_status_t lidet__cluster_run_edges(lidet_cluster_state_t *c, uint16_t *labels, lidet_member_t *members,
+                                        uint32_t *edges, const lidet_range_image_t *img,
+                                        const uint8_t *ground_mask, const lidet_plane_t *planes,
+                                        uint32_t n_sectors)
 {
     uint32_t rows, cols, npix, p;
     uint16_t *lab;
@@ -351,6 +360,7 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
     lk.rgpm = c->cfg.rescue_gap_per_m;
     lk.bridge_max = 0xFFFFFFFFu; /* set once the candidates are counted */
     lk.bridged = &st.n_bridge_steps;
+    lk.edges = 0;
 
     /* candidates: FREE (0) or NONCAND (0xFFFF) = cand - 1 in 16 bits; no branch, so it vectorises.
      * A pixel holds a point iff its range is > 0 (the image contract; point_idx may be absent) */
@@ -391,6 +401,10 @@ lidet_status_t lidet_cluster_run_buffers(lidet_cluster_state_t *c, uint16_t *lab
             /* <= 64 * 2^24 * 4: fits */
             lk.bridge_max = (uint32_t)(c->cfg.max_bridge_per_pixel * (float)n_cand);
         }
+    }
+    if (edges != 0)
+    {
+        lk.edges = lidet__cluster_edges(c, &lk, edges);
     }
 
     run_fills(c, &lk, &sp, planes, n_sectors, &st);

@@ -3,6 +3,7 @@
  * their states and on buffers placed by lifetime, the scratch of each overlaid with the others'. */
 #include <string.h>
 
+#include "internal/lidet_cluster_internal.h" /* lidet__cluster_run_edges */
 #include "internal/lidet_math.h"
 #include "lidet/lidet_workspace.h"
 
@@ -59,16 +60,20 @@ lidet_status_t lidet_workspace_init(lidet_workspace_t *ws, const lidet_workspace
     return LIDET_OK;
 }
 
-/* the workspace's R plane, or NULL (the ground stage then computes R itself) */
+/* the workspace's R plane, or NULL (the ground stage then computes R itself); and the clustering's edge plane in
+ * the same memory (R is read by the ground stage alone), or NULL */
 #if LIDET_WORKSPACE_KEEP_R
-#define WS_RXY(ws) ((ws)->rxy_m)
+#define WS_RXY(ws) ((ws)->r.rxy_m)
+#define WS_EDGES(ws) ((ws)->r.edges)
 #else
 #define WS_RXY(ws) 0
+#define WS_EDGES(ws) 0
 #endif
 
-/* the image the later stages read: R only with LIDET_WORKSPACE_KEEP_R (else the ground stage recomputes it
- * into its scratch), no point_idx (the overlay reuses it once the projection is done) */
-static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
+/* the image the later stages read: R for the ground stage only with LIDET_WORKSPACE_KEEP_R (else the ground stage
+ * recomputes it into its scratch), never after it (the clustering writes its edge plane there); no point_idx (the
+ * overlay reuses it once the projection is done) */
+static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img, int with_r)
 {
     img->n_rows = ws->proj.cfg.sensor.n_rows;
     img->n_cols = ws->proj.cfg.sensor.n_cols;
@@ -80,7 +85,11 @@ static void ws_image(const lidet_workspace_t *ws, lidet_range_image_t *img)
     img->y_4mm = ws->y_4mm;
     img->z_4mm = ws->z_4mm;
     img->range_4mm = ws->range_4mm;
-    img->rxy_m = WS_RXY(ws);
+    img->rxy_m = 0;
+    if (with_r)
+    {
+        img->rxy_m = WS_RXY(ws);
+    }
     img->point_idx = 0;
     img->row_elev_rad = ws->proj.row_elev_rad;
     img->row_elev_bam = ws->proj.row_elev_bam;
@@ -143,7 +152,7 @@ lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *poi
         return st;
     }
     worst = st;
-    ws_image(ws, &img);
+    ws_image(ws, &img, 1);
     st = lidet_ground_run_buffers(&ws->ground, &ws->overlay.ground, ws->ground_mask, &img);
     t0 = tick(clock, clock_ctx);
     ticks[1] = t0 - t1;
@@ -152,8 +161,10 @@ lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *poi
         return st;
     }
     worst = st > worst ? st : worst;
-    st = lidet_cluster_run_buffers(&ws->cluster, ws->overlay.cluster.labels, ws->overlay.cluster.members,
-                                   &img, ws->ground_mask, ws->ground.planes, ws->ground.cfg.n_sectors);
+    img.rxy_m = 0; /* R is dead: its plane takes the clustering's edges */
+    st = lidet__cluster_run_edges(&ws->cluster, ws->overlay.cluster.labels, ws->overlay.cluster.members,
+                                  WS_EDGES(ws), &img, ws->ground_mask, ws->ground.planes,
+                                  ws->ground.cfg.n_sectors);
     ticks[2] = tick(clock, clock_ctx) - t0;
     if (st < 0)
     {
@@ -168,7 +179,7 @@ void lidet_workspace_image(const lidet_workspace_t *ws, lidet_range_image_t *img
     {
         return;
     }
-    ws_image(ws, img);
+    ws_image(ws, img, 0);
 }
 
 const uint8_t *lidet_workspace_ground_mask(const lidet_workspace_t *ws)
@@ -270,7 +281,7 @@ void lidet_workspace_sizes(lidet_workspace_sizes_t *out)
     out->cluster_state = (uint32_t)sizeof w->cluster;
     out->image = (uint32_t)(sizeof w->x_4mm + sizeof w->y_4mm + sizeof w->z_4mm + sizeof w->range_4mm);
 #if LIDET_WORKSPACE_KEEP_R
-    out->image += (uint32_t)sizeof w->rxy_m;
+    out->image += (uint32_t)sizeof w->r;
 #endif
     out->ground_mask = (uint32_t)sizeof w->ground_mask;
     out->overlay_proj = (uint32_t)sizeof w->overlay.proj_point_idx;

@@ -20,6 +20,7 @@ typedef struct
         bridge_max;    /* occluder bridging budget of the run (max_bridge_per_pixel * candidates; 0xFFFFFFFF:
                           * none) */
     uint32_t *bridged; /* steps bridged so far in the run; a pixel bridges only while below bridge_max */
+    const uint32_t *edges; /* the first fill's searches decided beforehand (lidet__cluster_edges), or NULL */
 } lidet__grow_t;
 
 /* Running state of one rescue group: the queue tail and the nearest kept pixel met so far. */
@@ -37,6 +38,17 @@ void lidet__cluster_setup_geometry(lidet_cluster_state_t *c, const lidet_range_i
 /* Breadth-first flood fill of the cluster seeded at members[start] (tail = start + 1); returns the new
  * tail (lidet_cluster_grow.c) */
 uint32_t lidet__cluster_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start, uint32_t tail);
+
+/* The first fill's searches of every candidate pixel decided before the fill, into edges (rows * cols words):
+ * returns edges when it did (x86-64 hosts with AVX-512, the compact image, max_steps <= 7, no regrowth cut), else
+ * NULL, and the fill then runs the searches as it goes; the same clusters either way (lidet_cluster_grow.c) */
+const uint32_t *lidet__cluster_edges(const lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t *edges);
+
+/* lidet_cluster_run_buffers with the edge plane of lidet__cluster_edges (rows * cols words, or NULL) */
+lidet_status_t lidet__cluster_run_edges(lidet_cluster_state_t *c, uint16_t *labels, lidet_member_t *members,
+                                        uint32_t *edges, const lidet_range_image_t *img,
+                                        const uint8_t *ground_mask, const lidet_plane_t *planes,
+                                        uint32_t n_sectors);
 
 /* Breadth-first fill of the rescue group seeded at members[start] (lidet_cluster_rescue.c) */
 void lidet__cluster_rescue_grow(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t start,
