@@ -667,7 +667,8 @@ void cli_det_usage(FILE *f)
            "                   stages.ground.KEY: a lidet_ground_cfg_t field as in lidet ground\n"
            "                   --set (e.g. stages.ground.far_max_step_m=0: far planes judged by the\n"
            "                   sensor's height); --fixed takes sample_step, sample_col_step,\n"
-           "                   ransac_iters, refine_iters, far_max_step_m, far2_split_m and the\n"
+           "                   ransac_iters, refine_iters, seed, seed_per_cell, far_max_step_m,\n"
+           "                   far2_split_m and the\n"
            "                   clustering's\n"
            "                   split_people, join_cars and regrow_* fields, in integer units\n");
 }

@@ -96,6 +96,8 @@ int cli_detect_q_run(const cli_args_t *a, const lidet_detector_cfg_t *fcfg, cons
     cfg.ground.sample_col_step = fcfg->stages.ground.sample_col_step;
     cfg.ground.ransac_iters = fcfg->stages.ground.ransac_iters;
     cfg.ground.refine_iters = fcfg->stages.ground.refine_iters;
+    cfg.ground.seed = fcfg->stages.ground.seed; /* the RANSAC's draws: the same streams as the float stage's */
+    cfg.ground.seed_per_cell = fcfg->stages.ground.seed_per_cell;
     /* the far-plane, third-cell and regrowth rules, in integer units (the float defaults round to the integer ones exactly) */
     cfg.ground.far_max_step_mm = (uint32_t)round_i32((double)fcfg->stages.ground.far_max_step_m * 1000.0);
     cfg.ground.far2_split_mm = (uint32_t)round_i32((double)fcfg->stages.ground.far2_split_m * 1000.0);

@@ -57,6 +57,23 @@ def test_crop_keeps_the_front(cli):
     assert strip == [{k: v for k, v in b.items() if k != "cluster"} for b in nowin["boxes"]]
 
 
+@pytest.mark.parametrize("fixed", [False, True])
+def test_ground_seed_settings_reach_both_detectors(cli, tmp_path, fixed):
+    """stages.ground.seed and seed_per_cell change the ground RANSAC's draws in the float and the integer detector
+    alike (--fixed once ignored them); the default seed given explicitly changes nothing"""
+    fx = ["--fixed"] if fixed else []
+
+    def dump(*sets):
+        out = tmp_path / f"d{len(list(tmp_path.iterdir()))}.bin"
+        _run(cli, SCAN, *fx, *[a for s in sets for a in ("--set", s)], "--dump", out)
+        return out.read_bytes()
+
+    base = dump()
+    assert dump("stages.ground.seed=12345") == base
+    assert dump("stages.ground.seed=777") != base
+    assert dump("stages.ground.seed_per_cell=1") != base
+
+
 def test_outputs_agree_with_python_conversion(cli, tmp_path):
     out, kout = tmp_path / "b.txt", tmp_path / "k.txt"
     # gates off so that the (possibly untrained) models still give boxes to compare; the size check and
