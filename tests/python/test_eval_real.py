@@ -240,6 +240,32 @@ def test_eval_real_seeds(tmp_path, capsys):
     capsys.readouterr()
 
 
+@pytest.mark.parametrize("vary", ["ground", "both"])
+def test_eval_real_seeds_vary(tmp_path, capsys, vary):
+    """--seeds K --vary ground|both: each run draws the ground stage's RANSAC hypotheses anew (its default seed
+    first), with the proposals' draw too for both; the first run is the defaults' (the plain run's figures)"""
+    root, split = _sim_root(tmp_path)
+    base = ["--root", str(root), "--split", str(split), "--no-pictures"]
+    assert eval_real.main(base + ["--out", str(tmp_path / "one")]) == 0
+    one = json.loads((tmp_path / "one" / "report.json").read_text())["summary"]
+    out = tmp_path / vary
+    assert eval_real.main(base + ["--out", str(out), "--seeds", "3", "--vary", vary]) == 0
+    js = json.loads((out / "seeds.json").read_text())
+    first = eval_real.DEFAULT_GROUND_SEED if vary == "ground" else eval_real.DEFAULT_PROPOSAL_SEED
+    assert js["seeds"] == [first, 1, 2]
+    for j, sd in enumerate(js["seeds"]):
+        cmd = json.loads((out / f"seed_{sd}" / "report.json").read_text())["meta"]["command"]
+        assert f"stages.ground.seed={12345 if j == 0 else j}" in cmd
+        assert ("proposal.seed=" in cmd) == (vary == "both")
+    assert js["per_seed"][str(first)] == eval_real._headline(one)
+    md = (out / "seeds.md").read_text()
+    assert "RANSAC" in md and f"--seeds 3 --vary {vary}" in md and "| figure | default | seed 1 | seed 2 |" in md
+    for bad in (["--vary", "ground"], ["--seeds", "2", "--vary", "ground", "--set", "stages.ground.seed=5"]):
+        with pytest.raises(SystemExit):
+            eval_real.main(base + ["--out", str(tmp_path / "bad")] + bad)
+    capsys.readouterr()
+
+
 def test_headline_has_the_kitti_protocol_rows():
     """The seeds' headline figures carry the KITTI frames' AP3D moderate by KITTI's protocol when they are among
     the sources, and leave it out otherwise."""

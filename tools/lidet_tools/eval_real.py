@@ -35,7 +35,9 @@ the default seed 0x5EED1234, then 1 .. K - 1), into OUT/seed_<S>/ (pictures of t
 OUT/seeds.md and OUT/seeds.json: per seed the headline figures (all sources) with their mean, minimum and maximum.
 On the 16 training frames the draw alone moves cars found by +-2, pedestrians by up to 4 and the false positives by
 0.4 per frame (docs/EVALUATION.md, section 4): compare settings over several seeds (`lidet_tools.real.paired`
-takes two such folders).
+takes two such folders). `--vary ground` draws the ground stage's RANSAC hypotheses anew instead
+(`--set stages.ground.seed=S`: the default 12345, then 1 .. K - 1), `--vary both` both together: the ground seed
+alone moves the cars found on the training frames by as much as the proposals' draw (63-67 of 113).
 """
 from __future__ import annotations
 
@@ -502,11 +504,30 @@ def add_frame_args(ap: argparse.ArgumentParser) -> None:
 
 #: the resampling seeds of `--seeds K`: the detectors' default (lidet_proposal_cfg_t.seed), then 1, 2, ...
 DEFAULT_PROPOSAL_SEED = 0x5EED1234
+#: the ground RANSAC's seeds of `--seeds K --vary ground|both`: the stage's default (lidet_ground_cfg_t.seed), then
+#: 1, 2, ...
+DEFAULT_GROUND_SEED = 12345
+#: what `--seeds K` draws anew in each run: the proposals' points, the ground stage's RANSAC hypotheses, or both
+VARY = {"proposal": ("proposal.seed",), "ground": ("stages.ground.seed",),
+        "both": ("proposal.seed", "stages.ground.seed")}
+_VARY_TEXT = {"proposal": "draws of the proposals' points (`--set proposal.seed=S`)",
+              "ground": "draws of the ground stage's RANSAC hypotheses (`--set stages.ground.seed=S`)",
+              "both": "draws of the proposals' points and of the ground stage's RANSAC hypotheses together "
+                      "(`--set proposal.seed=S --set stages.ground.seed=S`)"}
 
 
-def seed_list(k: int) -> list[int]:
+def seed_list(k: int, default: int = DEFAULT_PROPOSAL_SEED) -> list[int]:
     """The first k seeds of `--seeds`: the default seed, then 1 .. k - 1."""
-    return [DEFAULT_PROPOSAL_SEED] + list(range(1, k))
+    return [default] + list(range(1, k))
+
+
+def vary_sets(vary: str, j: int) -> list[str]:
+    """The --set arguments of run j (0: the defaults) of `--seeds K --vary VARY`."""
+    out = []
+    for key in VARY[vary]:
+        default = DEFAULT_PROPOSAL_SEED if key == "proposal.seed" else DEFAULT_GROUND_SEED
+        out.append(f"{key}={default if j == 0 else j}")
+    return out
 
 
 def _headline(sm: dict) -> dict:
@@ -542,9 +563,9 @@ def seeds_report(rows: dict, meta: dict) -> tuple[str, dict]:
     for k in keys:
         v = [rows[s][k] for s in seeds if rows[s][k] is not None]
         stats[k] = None if not v else {"mean": float(np.mean(v)), "min": float(np.min(v)), "max": float(np.max(v))}
-    L = [f"Real labelled frames, side `{meta['side']}`, detector: {meta['detector']}; {len(seeds)} draws of the "
-         "proposals' points (`--set proposal.seed=S`). Command: `" + meta["command"] + "`.", "",
-         "| figure | " + " | ".join("default" if s == DEFAULT_PROPOSAL_SEED else f"seed {s}" for s in seeds) +
+    L = [f"Real labelled frames, side `{meta['side']}`, detector: {meta['detector']}; {len(seeds)} "
+         f"{_VARY_TEXT[meta.get('vary', 'proposal')]}. Command: `" + meta["command"] + "`.", "",
+         "| figure | " + " | ".join("default" if j == 0 else f"seed {s}" for j, s in enumerate(seeds)) +
          " | mean | min - max |",
          "|---|" + "---:|" * (len(seeds) + 2)]
 
@@ -587,14 +608,21 @@ def main(argv=None) -> int:
                     help="K draws of the proposals' points (the default seed, then 1 .. K - 1) into OUT/seed_<S>/, "
                          "and OUT/seeds.md with each seed's headline figures, their mean and range (default 1: one "
                          "run with the detector's own seed)")
+    ap.add_argument("--vary", choices=sorted(VARY), default="proposal",
+                    help="what --seeds draws anew: the proposals' points (default), the ground stage's RANSAC "
+                         "hypotheses (stages.ground.seed: its default 12345, then 1 .. K - 1), or both together; "
+                         "the ground seed moves the real figures about as much as the proposals' draw")
     ap.add_argument("--no-pictures", action="store_true")
     ap.add_argument("--json", action="store_true", help="print report.json instead of the tables")
     a = ap.parse_args(argv)
     if a.seeds < 1 or a.seeds > 64:
         ap.error(f"--seeds must be in [1, 64], got {a.seeds}")
+    if a.vary != "proposal" and a.seeds < 2:
+        ap.error("--vary needs --seeds K with K >= 2")
     if a.seeds > 1:
-        if any(kv.split("=", 1)[0].strip() == "proposal.seed" for kv in a.set):
-            ap.error("--seeds sets proposal.seed itself: leave --set proposal.seed out")
+        for key in VARY[a.vary]:
+            if any(kv.split("=", 1)[0].strip() == key for kv in a.set):
+                ap.error(f"--seeds sets {key} itself: leave --set {key} out")
         return _main_seeds(ap, a)
     return _evaluate(ap, a)
 
@@ -676,10 +704,11 @@ def _main_seeds(ap, a) -> int:
     OUT/seeds.md and seeds.json."""
     out = pathlib.Path(a.out)
     rows, meta = {}, None
-    for j, sd in enumerate(seed_list(a.seeds)):
+    default = DEFAULT_GROUND_SEED if a.vary == "ground" else DEFAULT_PROPOSAL_SEED
+    for j, sd in enumerate(seed_list(a.seeds, default)):
         sub = out / f"seed_{sd}"
         one = argparse.Namespace(**vars(a))
-        one.set, one.out, one.json = a.set + [f"proposal.seed={sd}"], str(sub), False
+        one.set, one.out, one.json = a.set + vary_sets(a.vary, j), str(sub), False
         one.no_pictures = a.no_pictures or j > 0
         rc = _evaluate(ap, one, echo=False)  # each seed's report is in its folder
         if rc != 0:
@@ -690,9 +719,12 @@ def _main_seeds(ap, a) -> int:
             sm = rep["summary"]
             cl = (sm["all"] if "all" in sm else next(iter(sm.values())))["classes"]
             meta = dict(rep["meta"])
-            # the seed's own --set is the last one: cut it, name --seeds instead
-            meta["command"] = meta["command"].split(" --set proposal.seed=")[0] + f" --seeds {a.seeds}"
-            meta["detector"] = meta["detector"].split(", proposal.seed=")[0]
+            # the seeds' own --set are the last ones: cut them, name --seeds (and --vary) instead
+            first = VARY[a.vary][0]
+            meta["command"] = (meta["command"].split(f" --set {first}=")[0] + f" --seeds {a.seeds}" +
+                               ("" if a.vary == "proposal" else f" --vary {a.vary}"))
+            meta["detector"] = meta["detector"].split(f", {first}=")[0]
+            meta["vary"] = a.vary
             meta["objects"] = {f"{c} found {r} m": cl[c][r]["objects"] for c in CLASSES for r in ("20", "40")}
     text, js = seeds_report(rows, meta)
     (out / "seeds.md").write_text(text)
