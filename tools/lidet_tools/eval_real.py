@@ -523,11 +523,8 @@ def seed_list(k: int, default: int = DEFAULT_PROPOSAL_SEED) -> list[int]:
 
 def vary_sets(vary: str, j: int) -> list[str]:
     """The --set arguments of run j (0: the defaults) of `--seeds K --vary VARY`."""
-    out = []
-    for key in VARY[vary]:
-        default = DEFAULT_PROPOSAL_SEED if key == "proposal.seed" else DEFAULT_GROUND_SEED
-        out.append(f"{key}={default if j == 0 else j}")
-    return out
+    return [f"{key}={seed_list(j + 1, DEFAULT_PROPOSAL_SEED if key == 'proposal.seed' else DEFAULT_GROUND_SEED)[j]}"
+            for key in VARY[vary]]
 
 
 def _headline(sm: dict) -> dict:

@@ -161,7 +161,7 @@ lidet_status_t lidet_workspace_run_timed(lidet_workspace_t *ws, const float *poi
         return st;
     }
     worst = st > worst ? st : worst;
-    img.rxy_m = 0; /* R is dead: its plane takes the clustering's edges */
+    ws_image(ws, &img, 0); /* R is dead: its plane takes the clustering's edges */
     st = lidet__cluster_run_edges(&ws->cluster, ws->overlay.cluster.labels, ws->overlay.cluster.members,
                                   WS_EDGES(ws), &img, ws->ground_mask, ws->ground.planes,
                                   ws->ground.cfg.n_sectors);
