@@ -508,7 +508,9 @@ __attribute__((noinline))
 static uint32_t
 expand_edgeless(lidet_cluster_state_t *c, const lidet__grow_t *g, uint32_t tail, uint32_t q)
 {
-    return expand_pixel_4mm(c, g, tail, q, c->cfg.bridge_occluders != 0u);
+    const uint32_t r = g->row_magic != 0u ? (uint32_t)(lidet__q_umul32(q, g->row_magic) >> 32) : q / g->cols;
+    return c->cfg.bridge_occluders != 0u && *g->bridged < g->bridge_max ? expand_4mm(c, g, tail, q, r, 1)
+                                                                        : expand_4mm(c, g, tail, q, r, 0);
 }
 
 /* the first fill with the searches decided beforehand (grow_4mm's fill with the plane): each pixel's joins in the
