@@ -14,9 +14,11 @@
 #if LIDET_NN_CLONES && LIDET__TARGET_X86_64_GNU
 #define LIDET_CLONES_AVX2 __attribute__((target_clones("avx2", "default")))
 #define LIDET_CLONES_AVX512 __attribute__((target_clones("avx512f", "avx2", "default")))
+#define LIDET_HOST_CLONES 1 /* the clones are built: a loop written branch-free for them runs vectorised */
 #else
 #define LIDET_CLONES_AVX2
 #define LIDET_CLONES_AVX512
+#define LIDET_HOST_CLONES 0
 #endif
 /* the one exception to "same results": the float dense kernel's FMA variants (lib/src/nn/lidet_nn_f32_x86.c),
  * where LIDET_NN_FMA is 1 (by default with the clones; CMake LIDET_NN_FMA=OFF passes 0; the -O0 CLI of the
