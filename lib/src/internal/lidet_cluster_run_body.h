@@ -191,23 +191,44 @@ static void relabel_pixels(RUN_STATE_T *c, uint16_t *lab, uint32_t b, uint32_t e
         const uint32_t l = lab[i];
         lab[i] = (uint16_t)(l < LAB_SMALL ? l : 0u);
     }
-    /* slot + 1 -> id and the members in raster order. Kept pixels are a minority: blocks of four
-     * labels that are all 0 (one 64-bit word, read with memcpy) are skipped at once */
-    for (i = b; i + 4u <= e; i += 4u)
+    /* slot + 1 -> id and the members in raster order, a run of one cluster's pixels along the row at a time: its
+     * next member's place kept in a register over the run, not read back from the record pixel by pixel (each
+     * increment there waited for the one before, through memory; on the 17 real KITTI scans this pass went from
+     * 3.3 to 3.1 % of the detector, perf). Blocks of four labels that are all 0 (one 64-bit word, read with memcpy)
+     * are skipped at once. The cores without SIMD keep the one pass above: there the runs cost more instructions
+     * (the Cortex-M4 integer image's clustering 5.37 -> 5.47 M a VLP-16 scan) */
+    i = b;
+    while (i < e)
     {
-        uint64_t w;
-        memcpy(&w, &lab[i], sizeof w);
-        if (w != 0u)
+        uint32_t l;
+        if (i + 4u <= e)
         {
-            place_kept(c, lab, i);
-            place_kept(c, lab, i + 1u);
-            place_kept(c, lab, i + 2u);
-            place_kept(c, lab, i + 3u);
+            uint64_t w;
+            memcpy(&w, &lab[i], sizeof w);
+            if (w == 0u)
+            {
+                i += 4u;
+                continue;
+            }
         }
-    }
-    for (; i < e; ++i)
-    {
-        place_kept(c, lab, i);
+        l = lab[i];
+        if (l == 0u)
+        {
+            ++i;
+            continue;
+        }
+        {
+            const uint32_t id = c->slot_id[l];
+            RUN_REC_T *r = &c->recs[id - 1u];
+            uint32_t m = r->first_member;
+            do
+            {
+                lab[i] = (uint16_t)id;
+                c->members[m++] = (lidet_member_t)i;
+                ++i;
+            } while (i < e && lab[i] == l);
+            r->first_member = m;
+        }
     }
 }
 
