@@ -433,6 +433,33 @@ LIDET_CLONES_AVX512 static void ground_bins(const uint8_t *mask, const uint16_t 
         bin[j] = (uint8_t)(in ? (int32_t)tc : (int32_t)LIDET_DET_GROUND_BINS);
     }
 }
+
+/* a compact image's pixels [p, pe) of one row (ground_bins' box kb): the bins of those that count added to hist, their
+ * number returned. The ones that count are gathered without a branch, then counted (counting every pixel, the others
+ * into a bin of their own, chained each increment on the one before through memory) */
+static uint32_t count_ground_run(const lidet_range_image_t *img, const uint8_t *mask, uint32_t p, uint32_t pe,
+                                 const float *kb, float *hist)
+{
+    uint8_t bin[GROUND_RUN], hit[GROUND_RUN];
+    uint32_t n = 0;
+    for (; p < pe; p += GROUND_RUN)
+    {
+        const uint32_t m = pe - p < GROUND_RUN ? pe - p : GROUND_RUN;
+        uint32_t j, nv = 0;
+        ground_bins(mask + p, img->range_4mm + p, img->x_4mm + p, img->y_4mm + p, img->z_4mm + p, m, kb, bin);
+        for (j = 0; j < m; ++j)
+        {
+            hit[nv] = bin[j];
+            nv += (uint32_t)(bin[j] < LIDET_DET_GROUND_BINS);
+        }
+        for (j = 0; j < nv; ++j)
+        {
+            hist[hit[j]] += 1.0f;
+        }
+        n += nv;
+    }
+    return n;
+}
 #endif
 
 /* A car box stretched down to the ground around it (cfg car_ground_m; docs/DETECTOR.md, "Car boxes down to the
@@ -463,6 +490,9 @@ car_to_ground(lidet_detector_t *d, lidet_box_t *b)
     uint8_t *row_on = (uint8_t *)(void *)(d->pn_scratch + LIDET_DET_GROUND_BINS);
     uint32_t n = 0, k, col0, span, i, half;
     float g, cum;
+#if LIDET_HOST_CLONES
+    const float kb[8] = {b->cx_m, b->cy_m, c, s, hl, hw, lo, per_m}; /* ground_bins' box */
+#endif
     if (rows == 0u || cols == 0u)
     {
         return;
@@ -542,28 +572,7 @@ car_to_ground(lidet_detector_t *d, lidet_box_t *b)
 #if LIDET_HOST_CLONES
         if (compact)
         {
-            /* the run's bins without a branch, then counted: the same pixels in the same bins */
-            const float kb[8] = {b->cx_m, b->cy_m, c, s, hl, hw, lo, per_m};
-            uint8_t bin[GROUND_RUN], hit[GROUND_RUN];
-            for (p = row * cols + a; p < row * cols + e; p += GROUND_RUN)
-            {
-                const uint32_t m = row * cols + e - p < GROUND_RUN ? row * cols + e - p : GROUND_RUN;
-                uint32_t j, nv = 0;
-                ground_bins(mask + p, img->range_4mm + p, img->x_4mm + p, img->y_4mm + p, img->z_4mm + p, m,
-                            kb, bin);
-                /* the bins that count, gathered without a branch (counting every pixel, the others into a bin of
-                 * their own, chained each increment on the one before through memory), then counted */
-                for (j = 0; j < m; ++j)
-                {
-                    hit[nv] = bin[j];
-                    nv += (uint32_t)(bin[j] < LIDET_DET_GROUND_BINS);
-                }
-                for (j = 0; j < nv; ++j)
-                {
-                    hist[hit[j]] += 1.0f;
-                }
-                n += nv;
-            }
+            n += count_ground_run(img, mask, row * cols + a, row * cols + e, kb, hist);
             continue;
         }
 #endif
